@@ -1,0 +1,513 @@
+"""The empirical harmonic model fitted automatically (thesis ch. 3).
+
+The disturbance of one channel is ``sum_i C_i Ω² sin(h_i |Ω| t + α_i)``
+(Eq. 3.1 with Ω in rad/s, C_i in SI).  :func:`fit_empirical` does what the
+thesis toolbox did with a manual decision at every step:
+
+1. **Lines** (``iden_harm.m``/``findpeaks.m``): in every PSD, local maxima
+   above a noise threshold.  The thesis's histogram threshold is replaced by a
+   statistical one: a Welch PSD of noise is its local mean times
+   chi²(dof)/dof, the local mean comes from a running median, and the
+   threshold is set for a chosen false-alarm probability per spectrum.
+   Hann side lobes of strong lines are discarded.
+2. **Harmonic numbers** (``bin.m``): peak frequencies divided by the speed,
+   and for every candidate h the presence P = N_bin / N_poss (Eq. 3.5), where
+   N_poss counts the (run, channel) pairs in which h·|Ω| is inside the good
+   band (0, f_lim] (Table 3.2).  x and y channels of a direction are pooled,
+   which is the thesis's radial combination.  Peaks of P above P_0 are
+   harmonics; each h is refined by least squares of f = h·|Ω| over its lines.
+3. **Amplitudes** (``find_coeff.m``): the line amplitude in each run where
+   the line is in band, detected (Eq. 3.11) and resolved from the other
+   harmonics, measured as the power under the line (exact between bins, by
+   Parseval) less the local noise floor; C by Eq. 3.10.
+4. **Modal amplification** (``remove_mode.m``, automatic): speeds where the
+   amplitude departs from C·Ω² by more than noise and scatter allow, grown
+   into contiguous speed ranges, are excluded and C is refitted; the ranges
+   are reported.
+5. **Standard error** of every C: a cluster-robust (sandwich) estimate of the
+   Eq. 3.10 least-squares fit, clustered by run so x and y measurements of
+   one run are not counted as independent.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import ndimage, signal, stats
+from tqdm.auto import tqdm
+
+from .model import DIRECTIONS, Harmonic, WheelModel
+from .spectra import Spectra, detection_threshold, welch_dof
+from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
+
+
+@dataclass
+class FitSettings:
+    """Tuning of the automatic fit; defaults follow the thesis (Table 3.5) where it has one.
+
+    p_false : false-alarm probability of line detection per spectrum.
+    epsilon : binning tolerance on the normalised frequency (thesis ε).
+    presence_min : bin percentage threshold P_0 as a fraction.
+    min_detections : fewest (run, channel) detections for a harmonic.
+    min_points : fewest measurements left after exclusion to keep a harmonic.
+    h_range : (lowest, highest) harmonic number searched.
+    f_min_bins : lines below this many bins above 0 Hz are not used.
+    line_half_width : bins either side summed for a line's power (Hann lobe ±2).
+    sidelobe_db : a peak this much below a stronger one within 6 bins is a side lobe.
+    exclude_modes : detect and exclude modal amplification.
+    amp_min : smallest relative amplification that can mark a speed as modal.
+    n_sigma : amplification threshold in standard deviations.
+    scatter_floor : relative scatter assumed besides noise (model error).
+    """
+
+    p_false: float = 0.01
+    epsilon: float = 0.02
+    presence_min: float = 0.25
+    min_detections: int = 5
+    min_points: int = 5
+    h_range: tuple = (0.1, 40.0)
+    f_min_bins: int = 4
+    line_half_width: int = 3
+    sidelobe_db: float = 25.0
+    exclude_modes: bool = True
+    amp_min: float = 0.03
+    n_sigma: float = 4.0
+    scatter_floor: float = 0.01
+
+
+@dataclass
+class LineFit:
+    """One harmonic of one direction, with every measurement behind its C.
+
+    speed (rad/s, >0), channel, amplitude (N or N·m), used (bool): one entry
+    per measurement.  C, C_stderr, C_all in SI per (rad/s)²; C_all is Eq. 3.10
+    over every measurement before modal exclusion (the thesis's C-bar).
+    excluded_rpm: [[lo, hi], ...] speed ranges excluded as modal amplification.
+    """
+
+    direction: str
+    h: float
+    C: float
+    C_stderr: float
+    C_all: float
+    speed: np.ndarray
+    channel: np.ndarray
+    amplitude: np.ndarray
+    used: np.ndarray
+    excluded_rpm: list
+    presence: float
+    n_possible: int
+
+    @property
+    def n_points(self) -> int:
+        return int(np.sum(self.used))
+
+
+@dataclass
+class BinStat:
+    """A candidate harmonic number and its presence statistics (thesis Table 3.2)."""
+
+    direction: str
+    h: float
+    n_bin: int
+    n_possible: int
+    presence: float
+    kept: bool
+    reason: str = ""
+
+
+@dataclass
+class EmpiricalFit:
+    """The fitted model plus everything needed to judge it."""
+
+    model: WheelModel
+    spectra: Spectra
+    lines: list
+    bins: list
+    settings: dict = field(default_factory=dict)
+
+
+@dataclass
+class _Lines:
+    """Detected lines of one direction, flat and sorted by (pair, normalised frequency).
+
+    A *pair* is one (run, channel) spectrum.  pair_* arrays have one entry per
+    pair; line_* arrays one per detected line.
+    """
+
+    pair_run: np.ndarray       # index into the fitted runs
+    pair_chan: np.ndarray      # channel name
+    pair_speed_hz: np.ndarray  # |Ω|/2π of the pair's run
+    pair_tol: np.ndarray       # tolerance on h for the pair
+    line_pair: np.ndarray
+    line_star: np.ndarray      # f / speed_hz (normalised frequency)
+    line_freq: np.ndarray      # Hz, refined
+    scale: float               # > every line_star; keys = pair + star/scale are sorted
+
+    def match(self, h):
+        """Frequency (Hz) of the line nearest h·speed in every pair, within the
+        pair's tolerance, else NaN.  h: (n_h,) -> (n_h, n_pairs)."""
+        h = np.atleast_1d(np.asarray(h, float))
+        n_pairs = self.pair_run.size
+        out = np.full((h.size, n_pairs), np.nan)
+        if self.line_pair.size == 0:
+            return out
+        keys = self.line_pair + self.line_star / self.scale
+        pair = np.arange(n_pairs)[None, :]
+        target = pair + h[:, None] / self.scale
+        idx = np.searchsorted(keys, target)
+        best = np.full(out.shape, np.inf)
+        for cand in (idx - 1, idx):
+            c = np.clip(cand, 0, keys.size - 1)
+            ok = (cand >= 0) & (cand < keys.size) & (self.line_pair[c] == pair)
+            dist = np.where(ok, np.abs(self.line_star[c] - h[:, None]), np.inf)
+            better = (dist < best) & (dist <= self.pair_tol[None, :])
+            out = np.where(better, self.line_freq[c], out)
+            best = np.where(better, dist, best)
+        return out
+
+
+# --------------------------------------------------------------------------- step 1: lines
+
+def block_floor(psd: np.ndarray, block: int = 32, dof: float = 2.0) -> np.ndarray:
+    """Mean noise level of PSDs (n_runs, n_f): medians of blocks of ``block`` bins,
+    interpolated between block centres, scaled from the median to the mean of
+    chi²(dof)/dof.  Block medians cost O(n) and ignore lines narrower than half a block.
+    """
+    n_runs, n_f = psd.shape
+    n_blocks = max(n_f // block, 1)
+    med = np.median(psd[:, :n_blocks * block].reshape(n_runs, n_blocks, block), axis=-1)
+    centres = (np.arange(n_blocks) + 0.5) * block
+    # linear interpolation between block centres, flat beyond the end ones, all rows at once
+    x = np.clip(np.arange(n_f), centres[0], centres[-1])
+    k = np.clip(np.searchsorted(centres, x, "right") - 1, 0, max(n_blocks - 2, 0))
+    if n_blocks > 1:
+        t = (x - centres[k]) / block
+        floor = med[:, k] * (1 - t) + med[:, k + 1] * t
+    else:
+        floor = np.repeat(med, n_f, axis=1)
+    dof = max(dof, 2.0)
+    return floor * (dof / stats.chi2.median(dof))
+
+
+def detect_lines(psd: np.ndarray, f: np.ndarray, floor: np.ndarray, threshold: float,
+                 f_lo: float, f_hi: float, sidelobe_db: float):
+    """Significant peaks of every row of ``psd`` (n_runs, n_f), Hann side lobes removed.
+
+    Returns (run index, refined frequency Hz) of each line.  A local maximum
+    counts when it exceeds ``threshold`` × the local mean noise; it is a side
+    lobe when something ``sidelobe_db`` stronger lies within 6 bins.  The
+    frequency is refined by a log-parabolic fit through three bins.
+    """
+    df = f[1] - f[0]
+    band = (f >= f_lo) & (f <= f_hi)
+    mid = psd[:, 1:-1]
+    is_peak = (mid > psd[:, :-2]) & (mid >= psd[:, 2:]) & (mid > threshold * floor[:, 1:-1]) & band[None, 1:-1]
+    is_peak &= np.isfinite(mid)
+    strongest = ndimage.maximum_filter1d(np.nan_to_num(psd), size=13, axis=1)[:, 1:-1]
+    is_peak &= ~(strongest > 10 ** (sidelobe_db / 10) * mid)
+    run, k = np.nonzero(is_peak)
+    k = k + 1
+    lo, md, hi = (np.log(np.maximum(psd[run, k + o], 1e-300)) for o in (-1, 0, 1))
+    denom = lo - 2 * md + hi
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = np.where(denom < 0, 0.5 * (lo - hi) / denom, 0.0)
+    return run, f[k] + np.clip(delta, -0.5, 0.5) * df
+
+
+# --------------------------------------------------------------------------- step 2: harmonic numbers
+
+def collect_lines(spectra: Spectra, chans, fit_runs, detected: dict, epsilon: float) -> _Lines:
+    """Pool the lines of a direction's channels over the fitted runs."""
+    speed_hz_all = np.abs(spectra.speed) / (2 * np.pi)
+    pr, pc, lp, ls, lf = [], [], [], [], []
+    base = 0
+    for c in chans:
+        runs = fit_runs[spectra.available(c)[fit_runs]]
+        remap = -np.ones(len(spectra.speed), int)
+        remap[runs] = base + np.arange(runs.size)
+        run_of_line, freq = detected[c]
+        pair = remap[run_of_line]
+        keep = pair >= 0
+        pr.append(runs)
+        pc.append(np.full(runs.size, c))
+        lp.append(pair[keep])
+        lf.append(freq[keep])
+        ls.append(freq[keep] / speed_hz_all[run_of_line[keep]])
+        base += runs.size
+    pair_run = np.concatenate(pr)
+    pair_speed = speed_hz_all[pair_run]
+    line_pair, line_star, line_freq = np.concatenate(lp), np.concatenate(ls), np.concatenate(lf)
+    order = np.lexsort((line_star, line_pair))
+    scale = float(line_star.max() * 2 + 1) if line_star.size else 1.0
+    tol = np.maximum(epsilon, 0.5 * spectra.df / pair_speed)
+    return _Lines(pair_run, np.concatenate(pc), pair_speed, tol, line_pair[order], line_star[order],
+                  line_freq[order], scale)
+
+
+def presence_curve(h_grid: np.ndarray, lines: _Lines, f_lo: float, f_hi: float):
+    """N_bin and N_poss (thesis Eq. 3.5, Table 3.2) on a grid of h.
+
+    N_bin(h): pairs with a line within ±tol of h; N_poss(h): pairs in which
+    f_lo <= h·speed <= f_hi.  Each line covers a grid interval; a difference
+    array turns intervals into per-pair coverage without loops.
+    """
+    n_pairs, n_grid = lines.pair_run.size, h_grid.size
+    in_band = (h_grid[None, :] * lines.pair_speed_hz[:, None] >= f_lo) & \
+              (h_grid[None, :] * lines.pair_speed_hz[:, None] <= f_hi)
+    diff = np.zeros((n_pairs, n_grid + 1), np.int32)
+    tol = lines.pair_tol[lines.line_pair]
+    lo = np.searchsorted(h_grid, lines.line_star - tol, "left")
+    hi = np.searchsorted(h_grid, lines.line_star + tol, "right")
+    np.add.at(diff, (lines.line_pair, lo), 1)
+    np.add.at(diff, (lines.line_pair, hi), -1)
+    covered = np.cumsum(diff[:, :-1], axis=1) > 0
+    return (covered & in_band).sum(axis=0), in_band.sum(axis=0)
+
+
+def _in_band(h, lines: _Lines, f_lo, f_hi):
+    f_line = np.asarray(h)[:, None] * lines.pair_speed_hz[None, :]
+    return (f_line >= f_lo) & (f_line <= f_hi)
+
+
+def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, direction: str):
+    """Harmonic numbers of one direction: candidate bins from N_bin(h), each h
+    refined by least squares of f = h·|Ω| over its lines (Eq. 3.2), kept when
+    P >= P_0.  Returns a list of :class:`BinStat` sorted by h."""
+    if lines.pair_run.size == 0:
+        return []
+    h_hi = min(s.h_range[1], f_hi / lines.pair_speed_hz.min())
+    step = s.epsilon / 4
+    h_grid = np.arange(s.h_range[0], h_hi + step, step)
+    n_bin, _ = presence_curve(h_grid, lines, f_lo, f_hi)
+    cand, _ = signal.find_peaks(np.concatenate([[0], n_bin, [0]]), height=s.min_detections,
+                                distance=max(int(2 * s.epsilon / step), 1))
+    h = h_grid[cand - 1]
+    for _ in range(2):
+        fpk = lines.match(h)
+        ok = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)
+        w = np.where(ok, lines.pair_speed_hz[None, :], 0.0)
+        num, den = np.sum(np.where(ok, fpk, 0.0) * w, axis=1), np.sum(w**2, axis=1)
+        h = np.where(den > 0, num / np.where(den > 0, den, 1), h)
+    ok = np.isfinite(lines.match(h)) & _in_band(h, lines, f_lo, f_hi)
+    n_b, n_p = ok.sum(axis=1), _in_band(h, lines, f_lo, f_hi).sum(axis=1)
+    stats_ = []
+    for hk, nb, npss in zip(h, n_b, n_p):
+        presence = float(nb / npss) if npss else 0.0
+        kept = presence >= s.presence_min and nb >= s.min_detections
+        reason = "" if kept else (f"presence {presence:.0%} < P0 {s.presence_min:.0%}"
+                                  if presence < s.presence_min else f"only {int(nb)} detections")
+        stats_.append(BinStat(direction, float(hk), int(nb), int(npss), presence, kept, reason))
+    stats_.sort(key=lambda b: b.h)
+    merged = []
+    for b in stats_:  # two candidates refined onto one line: keep the better supported
+        if merged and abs(b.h - merged[-1].h) < s.epsilon:
+            if b.n_bin > merged[-1].n_bin:
+                merged[-1] = b
+            continue
+        merged.append(b)
+    return merged
+
+
+# --------------------------------------------------------------------------- steps 3-5: coefficients
+
+def _eq310(d, w):
+    """Amplitude coefficient by thesis Eq. 3.10: C = Σ d Ω² / Σ Ω⁴."""
+    return float(np.sum(d * w**2) / np.sum(w**4))
+
+
+def _cluster_stderr(d, w, runs, C):
+    """Cluster-robust standard error of the Eq. 3.10 estimate, clustered by run."""
+    e = d - C * w**2
+    uniq, inv = np.unique(runs, return_inverse=True)
+    g = np.bincount(inv, weights=w**2 * e)
+    n_cl = uniq.size
+    if n_cl < 2:
+        return float("nan")
+    var = np.sum(g**2) / np.sum(w**4) ** 2 * n_cl / (n_cl - 1)
+    return float(np.sqrt(var))
+
+
+def _ranges(speeds_sorted, flags_sorted):
+    """Contiguous runs of flagged points -> [[lo, hi], ...] in the speed's unit."""
+    out = []
+    start = None
+    for k, fl in enumerate(flags_sorted):
+        if fl and start is None:
+            start = k
+        if (not fl or k == len(flags_sorted) - 1) and start is not None:
+            stop = k if fl else k - 1
+            out.append([float(speeds_sorted[start]), float(speeds_sorted[stop])])
+            start = None
+    return out
+
+
+def modal_exclusion(d, w, run, sigma_noise, s: FitSettings):
+    """Flag measurements amplified by a structural mode.
+
+    d : amplitudes; w : speeds (rad/s); run : run index; sigma_noise : relative
+    amplitude error expected from noise.  Returns a boolean mask of excluded
+    measurements.
+
+    Works on the log ratio ℓ = log(d / (C·Ω²)) per run (x and y of a run share
+    a verdict), in speed order.  C is the median ratio of the runs not yet
+    flagged: a mode's wide skirts bias Eq. 3.10 (whose Ω⁴ weights favour the
+    top speeds), not the median.  The random scatter is estimated from
+    differences of neighbouring runs, so the smooth rise of a resonance is not
+    mistaken for noise.  A core of runs departing by more than
+    max(amp_min, n_sigma·σ) is grown into neighbours departing by more than
+    half that, single-run gaps are closed, and the whole is repeated with the
+    new C until nothing changes.  One-sided: C only falls as runs are flagged,
+    so the flagged set only grows and the loop converges.
+    """
+    uniq, inv = np.unique(run, return_inverse=True)
+    n = uniq.size
+    counts = np.bincount(inv)
+    w_run = np.bincount(inv, weights=w) / counts
+    order = np.argsort(w_run, kind="stable")
+    log_ratio = np.log(np.maximum(d, 1e-300) / w**2)
+    lr_run = np.bincount(inv, weights=log_ratio) / counts
+    sig_run = np.sqrt(np.bincount(inv, weights=sigma_noise**2)) / counts
+    excluded_run = np.zeros(n, bool)
+    for _ in range(20):
+        clean = ~excluded_run
+        if clean.sum() < 3:
+            break
+        ell_run = lr_run - np.median(lr_run[clean])
+        steps = np.diff(ell_run[order][clean[order]])
+        scatter = 1.4826 * np.median(np.abs(steps)) / np.sqrt(2) if steps.size > 4 else 0.0
+        scatter = max(scatter, s.scatter_floor)
+        thr = np.maximum(np.log1p(s.amp_min), s.n_sigma * np.sqrt(sig_run**2 + scatter**2))
+        e_s, t_s = ell_run[order], thr[order]
+        f_s = e_s > t_s
+        weak = e_s > 0.5 * t_s
+        while True:  # grow along speed
+            nb = np.zeros(n, bool)
+            nb[1:] |= f_s[:-1]
+            nb[:-1] |= f_s[1:]
+            grown = f_s | (nb & weak)
+            if np.array_equal(grown, f_s):
+                break
+            f_s = grown
+        gap = np.zeros(n, bool)
+        gap[1:-1] = ~f_s[1:-1] & f_s[:-2] & f_s[2:]
+        f_s |= gap
+        new = np.empty(n, bool)
+        new[order] = f_s
+        if np.array_equal(new, excluded_run):
+            break
+        excluded_run = new
+    return excluded_run[inv]
+
+
+def fit_direction(spectra: Spectra, direction: str, s: FitSettings, floors: dict, detected: dict,
+                  fit_runs: np.ndarray):
+    """Harmonics of one direction: identification, coefficients, modal exclusion."""
+    chans = [c for c in DIRECTION_CHANNELS[direction] if c in spectra.psd]
+    if not chans:
+        return [], []
+    f, df = spectra.f, spectra.df
+    f_lo, f_hi = s.f_min_bins * df, spectra.band_limit
+    lines = collect_lines(spectra, chans, fit_runs, detected, s.epsilon)
+    bins = identify_harmonics(lines, f_lo, f_hi, s, direction)
+    kept = [b for b in bins if b.kept]
+    if not kept:
+        return [], bins
+    h = np.array([b.h for b in kept])
+    fpk = lines.match(h)                                    # (n_h, n_pairs)
+    predicted = h[:, None] * lines.pair_speed_hz[None, :]
+    valid = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)
+    # resolved: no other harmonic's line within the summed bins of this one
+    sep = np.abs(predicted[None, :, :] - np.where(np.isfinite(fpk), fpk, predicted)[:, None, :])
+    sep[np.arange(h.size), np.arange(h.size), :] = np.inf
+    valid &= sep.min(axis=1) >= (2 * s.line_half_width + 1) * df
+    hi_, pi_ = np.nonzero(valid)
+    # line power in every valid (harmonic, pair), one gather per channel
+    d = np.zeros(hi_.size)
+    sig = np.zeros(hi_.size)
+    offsets = np.arange(-s.line_half_width, s.line_half_width + 1)
+    for c in chans:
+        m = lines.pair_chan[pi_] == c
+        if not m.any():
+            continue
+        runs = lines.pair_run[pi_[m]]
+        bins_ = np.clip(np.rint(fpk[hi_[m], pi_[m]] / df).astype(int)[:, None] + offsets, 0, f.size - 1)
+        p = spectra.psd[c][runs[:, None], bins_].sum(axis=1) * df
+        noise = floors[c][runs[:, None], bins_].sum(axis=1) * df
+        power = np.maximum(p - noise, 0.0)
+        d[m] = np.sqrt(2 * power)
+        sig[m] = np.sqrt(noise / np.maximum(2 * power, 1e-300))
+    w_all = 2 * np.pi * lines.pair_speed_hz[pi_]
+    out = []
+    for k, b in enumerate(kept):
+        m = (hi_ == k) & (d > 0)
+        if not m.any():
+            continue
+        w, dk, run, ch, sg = w_all[m], d[m], lines.pair_run[pi_[m]], lines.pair_chan[pi_[m]], sig[m]
+        C_all = _eq310(dk, w)
+        excluded = modal_exclusion(dk, w, run, sg, s) if s.exclude_modes else np.zeros(w.size, bool)
+        used = ~excluded
+        if used.sum() < s.min_points:
+            b.kept = False
+            b.reason = f"only {int(used.sum())} measurements outside modal ranges (< {s.min_points})"
+            continue
+        C = _eq310(dk[used], w[used])
+        se = _cluster_stderr(dk[used], w[used], run[used], C)
+        rpm = w * RAD_S_TO_RPM
+        order = np.argsort(rpm, kind="stable")
+        out.append(LineFit(direction, float(b.h), C, se, C_all, w, ch, dk, used,
+                           _ranges(rpm[order], excluded[order]), b.presence, b.n_possible))
+    return out, bins
+
+
+def fit_empirical(spectra: Spectra, settings: FitSettings | None = None, directions=None,
+                  name: str = "fitted wheel", progress: bool = False) -> EmpiricalFit:
+    """Fit the empirical model to the spectra of a steady-state test.
+
+    Runs at zero speed (noise runs) are not used.  Returns an
+    :class:`EmpiricalFit` whose ``model`` goes to the model file.
+    """
+    s = settings or FitSettings()
+    directions = tuple(directions) if directions is not None else DIRECTIONS
+    speed = np.abs(spectra.speed)
+    fit_runs = np.nonzero(speed > 0)[0]
+    if fit_runs.size == 0:
+        raise ValueError("no run with non-zero wheel speed to fit")
+    dof = welch_dof(int(np.min(spectra.n_segments)))
+    f = spectra.f
+    f_lo, f_hi = s.f_min_bins * spectra.df, spectra.band_limit
+    n_bins = int(np.sum((f >= f_lo) & (f <= f_hi)))
+    threshold = detection_threshold(dof, n_bins, s.p_false)
+    floors, detected = {}, {}
+    channels = [c for c in spectra.channels if any(c in DIRECTION_CHANNELS[d] for d in directions)]
+    bar = tqdm(total=len(channels) + len(directions), desc="rwadist fit", disable=not progress, unit="step")
+    for c in channels:
+        psd = spectra.psd[c]
+        fl = np.full_like(psd, np.nan)
+        ok = spectra.available(c)
+        fl[ok] = block_floor(psd[ok], dof=dof)
+        floors[c] = fl
+        detected[c] = detect_lines(psd, f, fl, threshold, f_lo, f_hi, s.sidelobe_db)
+        bar.update()
+    model = WheelModel(name=name)
+    lines, bins = [], []
+    for d in directions:
+        ls, bs = fit_direction(spectra, d, s, floors, detected, fit_runs)
+        lines += ls
+        bins += bs
+        model.empirical[d] = [Harmonic(h=round(x.h, 4), C=x.C, C_stderr=x.C_stderr, n_points=x.n_points,
+                                       presence=round(x.presence, 4), excluded_rpm=x.excluded_rpm) for x in ls]
+        bar.update()
+    bar.close()
+    model.provenance = {
+        "method": "rwadist empirical fit (thesis ch. 3, automatic)",
+        "n_runs": int(fit_runs.size),
+        "speed_range_rpm": [float(speed[fit_runs].min() * RAD_S_TO_RPM), float(speed[fit_runs].max() * RAD_S_TO_RPM)],
+        "f_lim_hz": spectra.f_lim,
+        "nperseg": spectra.nperseg,
+        "sample_rate_hz": spectra.sample_rate,
+    }
+    settings_doc = {k: getattr(s, k) for k in s.__dataclass_fields__}
+    settings_doc["detection_threshold"] = threshold
+    settings_doc["dof"] = dof
+    return EmpiricalFit(model=model, spectra=spectra, lines=lines, bins=bins, settings=settings_doc)

@@ -1,0 +1,164 @@
+"""The automatic empirical fit against data whose truth is known.
+
+The data here are generated directly with numpy (independent of the virtual
+test stand): rotating radial lines Fx = A cos φ, Fy = A sin φ, A = C·Ω².
+"""
+import numpy as np
+import pytest
+
+from rwadist.data import Run, SteadyTest
+from rwadist.empirical import FitSettings, _cluster_stderr, _eq310, fit_empirical, modal_exclusion
+from rwadist.spectra import compute_spectra
+from rwadist.units import rpm_to_rad_s
+
+FS = 1024.0
+
+
+def peaking_gain(f, f_mode, zeta=0.02, gain=5.0):
+    """Unit gain far from f_mode, `gain` at it (a lightly participating mode)."""
+    r = f / f_mode
+    return (1 - r**2 + 2j * gain * zeta * r) / (1 - r**2 + 2j * zeta * r)
+
+
+def make_test(harmonics, speeds_rpm, n=4096, noise=1e-3, seed=0, mode=None, extra=None):
+    """Steady runs of the radial force channels. harmonics: [(h, C_SI)].
+
+    mode: (f_mode_hz, zeta, gain) amplifies lines near f_mode.
+    extra: (f_hz, amplitude) a fixed-frequency sinusoid in every run (test-stand resonance).
+    """
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / FS
+    runs = []
+    for rpm in speeds_rpm:
+        w = float(rpm_to_rad_s(rpm))
+        fx = noise * rng.standard_normal(n)
+        fy = noise * rng.standard_normal(n)
+        for h, C in harmonics:
+            a = C * w**2 * np.ones(1, complex)
+            if mode is not None:
+                a = a * peaking_gain(h * abs(w) / (2 * np.pi), *mode)
+            phi = h * abs(w) * t + rng.uniform(0, 2 * np.pi)
+            fx += np.abs(a) * np.cos(phi + np.angle(a))
+            fy += np.sign(w) * np.abs(a) * np.sin(phi + np.angle(a))
+        if extra is not None:
+            fx += extra[1] * np.sin(2 * np.pi * extra[0] * t)
+            fy += extra[1] * np.cos(2 * np.pi * extra[0] * t)
+        runs.append(Run(w, FS, {"Fx": fx, "Fy": fy}, name=f"r{rpm:g}.csv"))
+    return SteadyTest(runs).sorted()
+
+
+TRUTH = [(0.5, 1.0e-6), (1.0, 4.0e-6), (2.0, 1.0e-6), (2.73, 0.6e-6), (4.4, 0.8e-6)]
+SPEEDS = np.linspace(600, 3000, 25)
+
+
+def _match(fit, direction="radial_force"):
+    return {round(x.h, 2): x for x in fit.lines if x.direction == direction}
+
+
+def test_finds_integer_non_integer_and_subharmonics():
+    fit = fit_empirical(compute_spectra(make_test(TRUTH, SPEEDS)))
+    got = [x for x in fit.lines if x.direction == "radial_force"]
+    assert len(got) == len(TRUTH)
+    for (h, C), x in zip(TRUTH, sorted(got, key=lambda x: x.h)):
+        assert abs(x.h - h) < 0.01
+        assert x.C == pytest.approx(C, rel=0.02)
+        assert x.C_stderr > 0 and x.C_stderr < 0.02 * C
+        assert x.presence > 0.9
+
+
+def test_pure_noise_gives_no_harmonic():
+    fit = fit_empirical(compute_spectra(make_test([], SPEEDS, noise=1e-2, seed=3)))
+    assert fit.lines == []
+
+
+def test_band_limit_counts_possible_speeds_as_table_3_2():
+    """A line above f_lim at high speed is neither counted possible nor measured there;
+    a strong fixed-frequency resonance above f_lim creates no harmonic."""
+    f_lim = 150.0
+    test = make_test(TRUTH, SPEEDS, extra=(300.0, 0.5))
+    fit = fit_empirical(compute_spectra(test, f_lim=f_lim))
+    lines = _match(fit)
+    speed_hz = np.abs(test.speeds) / (2 * np.pi)
+    for h in (2.73, 4.4):
+        x = lines[h]
+        # N_poss: spectra (2 channels per run) where h·Ω is inside (f_min, f_lim]
+        expected_poss = 2 * int(np.sum(x.h * speed_hz <= f_lim))
+        assert x.n_possible == expected_poss
+        assert np.all(x.h * x.speed / (2 * np.pi) <= f_lim)
+    assert all(abs(x.h * SPEEDS.max() / 60 - 300) > 5 for x in fit.lines)
+    assert len(fit.lines) == len(TRUTH)
+
+
+def test_modal_amplification_is_excluded_automatically():
+    """One harmonic crosses a mode mid-range: the excluded range brackets the crossing
+    speed, C comes back unbiased, the all-points C (thesis C-bar) is biased high."""
+    h, C, f_mode = 3.0, 1.0e-6, 120.0
+    speeds = np.linspace(600, 3000, 61)
+    crossing_rpm = f_mode / h * 60
+    test = make_test([(1.0, 4.0e-6), (h, C)], speeds, mode=(f_mode, 0.02, 6.0))
+    fit = fit_empirical(compute_spectra(test))
+    x = _match(fit)[3.0]
+    assert x.excluded_rpm, "no range excluded"
+    lo, hi = min(r[0] for r in x.excluded_rpm), max(r[1] for r in x.excluded_rpm)
+    assert lo < crossing_rpm < hi
+    assert x.C == pytest.approx(C, rel=0.03)
+    assert x.C_all > 1.05 * C
+    # the same data without exclusion is biased: the exclusion did the work
+    raw = _match(fit_empirical(compute_spectra(test), FitSettings(exclude_modes=False)))[3.0]
+    assert abs(raw.C / C - 1) > abs(x.C / C - 1)
+
+
+def test_negative_zero_and_duplicate_speeds():
+    """Negative speeds fit by |Ω|; the zero-speed noise run is skipped; duplicate speeds count twice."""
+    speeds = np.concatenate([-SPEEDS[::2], [0.0], SPEEDS[1::2], [SPEEDS[-1]]])
+    fit = fit_empirical(compute_spectra(make_test(TRUTH, speeds)))
+    x = _match(fit)[1.0]
+    assert x.C == pytest.approx(4.0e-6, rel=0.02)
+    assert np.all(x.speed > 0)
+    assert fit.model.provenance["n_runs"] == len(speeds) - 1
+
+
+def test_eq_3_10_and_its_standard_error_closed_form():
+    """Eq. 3.10 on exact data returns C; the sandwich SE equals the OLS SE when the
+    residuals are homoscedastic in the Ω² regressor (checked by Monte Carlo)."""
+    rng = np.random.default_rng(5)
+    w = np.linspace(50, 300, 40)
+    assert _eq310(2.5e-6 * w**2, w) == pytest.approx(2.5e-6, rel=1e-12)
+    estimates, ses = [], []
+    for _ in range(2000):
+        d = 2.5e-6 * w**2 + 1e-3 * rng.standard_normal(w.size)
+        c = _eq310(d, w)
+        estimates.append(c)
+        ses.append(_cluster_stderr(d, w, np.arange(w.size), c))
+    true_sd = 1e-3 / np.sqrt(np.sum(w**4))   # closed form of the OLS slope's sd
+    assert np.std(estimates) == pytest.approx(true_sd, rel=0.05)
+    assert np.median(ses) == pytest.approx(true_sd, rel=0.1)
+
+
+def test_reported_stderr_matches_spread_over_seeds():
+    """The standard error the fit reports predicts the scatter of C over noise seeds."""
+    speeds = np.linspace(600, 3000, 15)
+    truth = [(1.0, 4.0e-6), (2.0, 0.4e-6)]
+    cs, ses = [], []
+    for seed in range(12):
+        fit = fit_empirical(compute_spectra(make_test(truth, speeds, noise=2e-2, seed=seed, n=2048)))
+        x = _match(fit)[2.0]
+        cs.append(x.C)
+        ses.append(x.C_stderr)
+    ratio = np.std(cs, ddof=1) / np.median(ses)
+    assert 0.5 < ratio < 2.0, ratio
+
+
+def test_modal_exclusion_grows_a_contiguous_range():
+    w = np.linspace(60, 300, 50)
+    d = 1e-6 * w**2
+    bump = np.exp(-0.5 * ((w - 200) / 8) ** 2)
+    d = d * (1 + 0.8 * bump)
+    ex = modal_exclusion(d, w, np.arange(w.size), np.full(w.size, 1e-3), FitSettings())
+    assert ex[np.argmin(np.abs(w - 200))]
+    # contiguous: no gaps inside the flagged set
+    idx = np.nonzero(ex)[0]
+    assert np.all(np.diff(idx) == 1)
+    # every point amplified by more than amp_min (3 %) is out, nothing amplified < 1 % is
+    assert np.all(ex[0.8 * bump > 0.03])
+    assert not np.any(ex[0.8 * bump < 0.01])
