@@ -129,7 +129,7 @@ class Sweep:
 def _read_numeric_csv(path: Path, allowed: set, required_first: str):
     """Read a numeric CSV with a header; return (columns, 2-D array). Errors name the line."""
     try:
-        with open(path, "r", newline="") as fh:
+        with open(path, "r", newline="", encoding="utf-8-sig") as fh:
             header_line = fh.readline()
             body = fh.read()
     except OSError as exc:
@@ -157,13 +157,14 @@ def _read_numeric_csv(path: Path, allowed: set, required_first: str):
     except ValueError:
         data = None
     if data is None or data.shape[1] != len(header):
-        _diagnose_rows(path, body, len(header))
+        _diagnose_rows(path, body, header)
         raise DataError(path, "data", "could not be parsed as numbers")  # pragma: no cover
     return header, data
 
 
-def _diagnose_rows(path: Path, body: str, n_cols: int):
+def _diagnose_rows(path: Path, body: str, header: list):
     """Slow path after a parse failure: find and name the first bad line."""
+    n_cols = len(header)
     for lineno, line in enumerate(body.splitlines(), start=2):
         if not line.strip():
             continue
@@ -171,11 +172,11 @@ def _diagnose_rows(path: Path, body: str, n_cols: int):
         if len(fields) != n_cols:
             raise DataError(path, f"line {lineno}",
                             f"has {len(fields)} fields, header has {n_cols} (truncated file?): {line[:80]!r}")
-        for value in fields:
+        for col, value in zip(header, fields):
             try:
                 float(value)
             except ValueError:
-                raise DataError(path, f"line {lineno}", f"value {value.strip()!r} is not a number") from None
+                raise DataError(path, f"{col} (line {lineno})", f"value {value.strip()!r} is not a number") from None
 
 
 def _check_finite(path: Path, header, data):
@@ -250,7 +251,7 @@ def read_steady(directory) -> SteadyTest:
         raise DataError(directory, RUNS_FILE, f"directory {what}; a steady-state test needs {RUNS_FILE} "
                         "with columns file,speed_rpm")
     meta = _read_meta(directory)
-    with open(runs_path, newline="") as fh:
+    with open(runs_path, newline="", encoding="utf-8-sig") as fh:
         reader = csv.DictReader(fh)
         if reader.fieldnames is None:
             raise DataError(runs_path, "header", "file is empty")
@@ -258,11 +259,19 @@ def read_steady(directory) -> SteadyTest:
         for need in ("file", "speed_rpm"):
             if need not in cols:
                 raise DataError(runs_path, need, f"column missing; header is {cols}")
-        rows = [{k.strip(): (v or "").strip() for k, v in row.items() if k is not None} for row in reader]
+        rows = []
+        for row in reader:
+            if None in row:  # more fields than the header: '1,000' would otherwise read as 1 rpm
+                last = reader.fieldnames[-1]
+                text = ",".join([row.get(last) or ""] + list(row[None]))
+                raise DataError(runs_path, f"{last.strip()} (line {reader.line_num})",
+                                f"value {text!r} is not a number: the row has {len(cols) + len(row[None])} "
+                                f"fields, the header {len(cols)} (thousands separator?)")
+            rows.append((reader.line_num, {k.strip(): (v or "").strip() for k, v in row.items()}))
     if not rows:
         raise DataError(runs_path, "rows", "no runs listed")
     runs, files_seen = [], {}
-    for lineno, row in enumerate(rows, start=2):
+    for lineno, row in rows:
         fname, speed_text = row.get("file", ""), row.get("speed_rpm", "")
         if not fname:
             raise DataError(runs_path, f"file (line {lineno})", "empty file name")
@@ -309,7 +318,7 @@ def read_data(path):
     path = Path(path)
     if path.is_dir():
         return read_steady(path)
-    if path.suffix in (".h5", ".hdf5"):
+    if path.suffix.lower() in (".h5", ".hdf5"):
         from .hdf5 import read_hdf5
         return read_hdf5(path)
     return read_sweep(path)
@@ -344,17 +353,21 @@ def write_steady(test: SteadyTest, directory) -> Path:
         meta["sample_rate_hz"] = rates.pop()
     else:
         meta.pop("sample_rate_hz", None)
-    names = []
+    names, taken = [], {RUNS_FILE, META_FILE}
     for i, run in enumerate(test.runs):
         name = run.name or f"run_{i:04d}.csv"
-        if name in names:
-            name = f"run_{i:04d}.csv"
+        k = i
+        while name in taken:  # never overwrite another run or the index files
+            name = f"run_{k:04d}.csv"
+            k += 1
+        taken.add(name)
         names.append(name)
         write_run(directory / name, run)
     with open(directory / RUNS_FILE, "w", newline="") as fh:
-        fh.write("file,speed_rpm\n")
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(["file", "speed_rpm"])
         for name, run in zip(names, test.runs):
-            fh.write(f"{name},{float(rad_s_to_rpm(run.speed))!r}\n")
+            writer.writerow([name, repr(float(rad_s_to_rpm(run.speed)))])
     (directory / META_FILE).write_text(json.dumps(meta, indent=2, default=_json_default) + os.linesep)
     return directory
 

@@ -158,7 +158,10 @@ def noise_floor(psd: np.ndarray, f: np.ndarray, dof: float = 2.0, width_hz: floa
     n = max(min_bins, int(round(width_hz / df)) | 1)
     size = [1] * psd.ndim
     size[-1] = n
-    med = ndimage.median_filter(psd, size=tuple(size), mode="nearest")
+    # DC (detrended) and Nyquist (not doubled) bins are not noise-like: take the
+    # median over the interior with mirrored edges and copy it to the end bins.
+    inner = ndimage.median_filter(psd[..., 1:-1], size=tuple(size), mode="mirror")
+    med = np.concatenate([inner[..., :1], inner, inner[..., -1:]], axis=-1)
     return med * (max(dof, 2.0) / stats.chi2.median(max(dof, 2.0)))
 
 
