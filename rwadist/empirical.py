@@ -294,7 +294,7 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
     stats_ = []
     for hk, nb, npss in zip(h, n_b, n_p):
         presence = float(nb / npss) if npss else 0.0
-        kept = presence >= s.presence_min and nb >= s.min_detections
+        kept = bool(presence >= s.presence_min and nb >= s.min_detections)
         reason = "" if kept else (f"presence {presence:.0%} < P0 {s.presence_min:.0%}"
                                   if presence < s.presence_min else f"only {int(nb)} detections")
         stats_.append(BinStat(direction, float(hk), int(nb), int(npss), presence, kept, reason))

@@ -1,0 +1,494 @@
+"""Validation report of an empirical fit: plots and tables (thesis §3.1.3-3.1.4,
+``find_coeff.m`` / ``remove_mode.m`` curve-fit plots and ``comp_model.m``).
+
+The ``plot_*`` functions draw on a given Axes or on a new
+:class:`matplotlib.figure.Figure` (Agg canvas, no pyplot global state) and
+return ``(figure, axes)`` so notebooks can reuse them.  :func:`write_report`
+is the only function that touches the disk.
+
+Speeds are plotted as |speed| in rpm (the model depends on |Ω|); frequencies in
+Hz; amplitudes and RMS in N or N·m.  The ``fit`` argument is an
+``rwadist.empirical.EmpiricalFit`` (``model``, ``spectra``, ``lines``, ``bins``,
+``settings``); anything with those attributes works.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from . import compare
+from .spectra import cumulative_rms
+from .units import (CHANNEL_DIRECTION, CHANNEL_UNIT, DIRECTION_C_UNIT, DIRECTION_CHANNELS,
+                    RAD_S_TO_RPM, rad_s_to_rpm, rpm_to_rad_s)
+
+_UNIT_LABEL = {"N": "N", "Nm": "N·m"}
+_DPI = 110
+
+
+def _unit(channel: str) -> str:
+    return _UNIT_LABEL[CHANNEL_UNIT[channel]]
+
+
+def _direction_unit(direction: str) -> str:
+    return _unit(DIRECTION_CHANNELS[direction][0])
+
+
+def _direction_label(direction: str) -> str:
+    return direction.replace("_", " ")
+
+
+def _new_figure(figsize) -> Figure:
+    fig = Figure(figsize=figsize, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    fig.savefig(path, dpi=_DPI)
+    fig.clear()
+    return path
+
+
+def _band_top(spectra, f_max):
+    top = float(spectra.band_limit)
+    return top if f_max is None else min(float(f_max), top)
+
+
+def _is_modal(line) -> np.ndarray:
+    """Measurements of a LineFit left out as modal amplification: unused and inside an excluded range."""
+    rpm = np.abs(rad_s_to_rpm(line.speed))
+    inside = np.zeros(rpm.shape, dtype=bool)
+    for lo, hi in line.excluded_rpm:
+        inside |= (rpm >= lo) & (rpm <= hi)
+    return inside & ~np.asarray(line.used, dtype=bool)
+
+
+# --------------------------------------------------------------------------- waterfall
+
+def _merge_speeds(rpm: np.ndarray, rows: np.ndarray):
+    """Average rows of runs at the same |speed| (NaN-aware); returns (unique rpm, rows)."""
+    u, inv = np.unique(rpm, return_inverse=True)
+    good = np.isfinite(rows)
+    total = np.zeros((len(u), rows.shape[1]))
+    count = np.zeros_like(total)
+    np.add.at(total, inv, np.where(good, rows, 0.0))
+    np.add.at(count, inv, good)
+    with np.errstate(invalid="ignore"):
+        return u, np.where(count > 0, total / np.maximum(count, 1), np.nan)
+
+
+def _edges(centres: np.ndarray, default_half: float) -> np.ndarray:
+    if len(centres) == 1:
+        return np.array([centres[0] - default_half, centres[0] + default_half])
+    mid = 0.5 * (centres[1:] + centres[:-1])
+    return np.concatenate([[centres[0] - (mid[0] - centres[0])], mid, [centres[-1] + (centres[-1] - mid[-1])]])
+
+
+def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | None = None,
+                   lines=None, max_columns: int = 1500):
+    """Data PSD of ``channel`` as a |speed| (rpm) × frequency (Hz) image, log10 colour, up to
+    min(f_max, band limit); the model's lines h·|Ω| (Eq. 3.12) overlaid as circles, and the
+    measurements ``lines`` (LineFit list) left out as modal amplification as red crosses.
+
+    Runs at the same |speed| are averaged; when the band holds more than ``max_columns``
+    bins, adjacent bins are merged by their maximum so narrow lines stay visible.
+    Returns (figure, axes).
+    """
+    fig = ax.figure if ax is not None else _new_figure((9.0, 6.0))
+    ax = ax if ax is not None else fig.add_subplot()
+    top = _band_top(spectra, f_max)
+    f = spectra.f
+    keep = f <= top
+    rpm = np.abs(rad_s_to_rpm(spectra.speed))
+    u_rpm, rows = _merge_speeds(rpm, spectra.psd[channel][:, keep])
+    fk = f[keep]
+    df = f[1] - f[0]
+    k = int(np.ceil(len(fk) / max_columns))
+    if k > 1:
+        n = (len(fk) // k) * k
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks of absent runs
+            rows = np.nanmax(rows[:, :n].reshape(len(u_rpm), n // k, k), axis=-1)
+        f_edges = np.concatenate([fk[:n:k] - df / 2, [fk[n - 1] + df / 2]])
+    else:
+        f_edges = np.concatenate([fk - df / 2, [fk[-1] + df / 2]])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = np.log10(np.where(rows > 0, rows, np.nan))
+    z = np.ma.masked_invalid(z)
+    unit = _unit(channel)
+    y_edges = _edges(u_rpm, 50.0)
+    if z.count():
+        vals = z.compressed()
+        mesh = ax.pcolormesh(f_edges, y_edges, z, cmap="viridis", shading="flat",
+                             vmin=np.percentile(vals, 2), vmax=vals.max(), rasterized=True)
+        fig.colorbar(mesh, ax=ax, label=f"log10 PSD ({unit}²/Hz)")
+    handles = []
+    if model is not None and channel in CHANNEL_DIRECTION:
+        direction = CHANNEL_DIRECTION[channel]
+        f_line, _ = compare.model_psd_lines(model, direction, rpm_to_rad_s(u_rpm))
+        if f_line.size:
+            yy = np.broadcast_to(u_rpm[:, None], f_line.shape)
+            m = (f_line <= top) & (yy > 0)
+            handles += ax.plot(f_line[m], yy[m], "o", mfc="none", mec="white", mew=0.8, ms=4,
+                               label="model lines h·Ω")
+    if lines is not None:
+        fx, fy = [], []
+        for ln in lines:
+            sel = (np.asarray(ln.channel) == channel) & _is_modal(ln)
+            fx.append(ln.h * np.abs(ln.speed[sel]) / (2 * np.pi))
+            fy.append(np.abs(ln.speed[sel]) * RAD_S_TO_RPM)
+        fx = np.concatenate(fx) if fx else np.empty(0)
+        if fx.size:
+            handles += ax.plot(fx, np.concatenate(fy), "x", color="red", mew=1.5, ms=6,
+                               label="excluded (modal) measurement")
+    ax.set_xlim(max(f_edges[0], 0.0), min(f_edges[-1], top))
+    ax.set_ylim(max(y_edges[0], 0.0), y_edges[-1])
+    ax.set_xlabel("Frequency (Hz)")
+    ax.set_ylabel("Wheel speed |Ω| (rpm)")
+    name = f" vs model '{model.name}'" if model is not None else ""
+    ax.set_title(f"{channel} PSD waterfall{name} (band 0–{top:g} Hz)")
+    if handles:
+        leg = ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=len(handles),
+                        facecolor="0.35", framealpha=1.0, fontsize="small")
+        for t in leg.get_texts():
+            t.set_color("white")
+    return fig, ax
+
+
+# --------------------------------------------------------------------------- RMS vs speed
+
+def plot_rms_vs_speed(spectra, model, direction: str, ax=None, f_max: float | None = None):
+    """Data RMS of each channel of ``direction`` and the model RMS (Eq. 3.19), band-limited
+    alike, vs |speed| (rpm).  With ``ax=None`` a second panel shows model/data.
+    Returns (figure, axes) -- axes a tuple (rms, ratio) when created here.
+    """
+    own = ax is None
+    if own:
+        fig = _new_figure((8.0, 6.0))
+        ax_rms, ax_ratio = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
+    else:
+        fig, ax_rms, ax_ratio = ax.figure, ax, None
+    top = _band_top(spectra, f_max)
+    unit = _direction_unit(direction)
+    omega = np.asarray(spectra.speed, dtype=float)
+    rpm = np.abs(rad_s_to_rpm(omega))
+    model_runs = compare.model_rms_vs_speed(model, direction, omega, top)
+    has_model = len(model.harmonics(direction)) > 0
+    for ch, marker in zip(DIRECTION_CHANNELS[direction], ("o", "s")):
+        if ch not in spectra.psd:
+            continue
+        d = compare.data_rms(spectra, ch, top)
+        ok = np.isfinite(d) & (d > 0)
+        ax_rms.plot(rpm[ok], d[ok], marker, mfc="none", label=f"data {ch}")
+        if ax_ratio is not None and has_model:
+            r = np.where(ok, model_runs / np.where(ok, d, 1.0), np.nan)
+            ax_ratio.plot(rpm[ok & (rpm > 0)], r[ok & (rpm > 0)], marker, mfc="none", label=ch)
+    if has_model and rpm.max() > 0:
+        grid = np.linspace(max(rpm[rpm > 0].min(), 1.0) * 0.5, rpm.max() * 1.02, 600)
+        ax_rms.plot(grid, compare.model_rms_vs_speed(model, direction, rpm_to_rad_s(grid), top), "-",
+                    color="k", label=f"model (lines ≤ {top:g} Hz)")
+    ax_rms.set_yscale("log")
+    ax_rms.set_ylabel(f"RMS 0–{top:g} Hz ({unit})")
+    ax_rms.set_title(f"{_direction_label(direction)}: RMS vs wheel speed, data vs model")
+    ax_rms.grid(True, which="both", alpha=0.3)
+    ax_rms.legend()
+    if ax_ratio is not None:
+        ax_ratio.axhline(1.0, color="k", lw=0.8)
+        ax_ratio.set_ylabel("model / data")
+        ax_ratio.set_xlabel("Wheel speed |Ω| (rpm)")
+        ax_ratio.grid(True, alpha=0.3)
+        if has_model:
+            ax_ratio.legend(fontsize="small")
+        return fig, (ax_rms, ax_ratio)
+    ax_rms.set_xlabel("Wheel speed |Ω| (rpm)")
+    return fig, ax_rms
+
+
+# --------------------------------------------------------------------------- cumulative RMS
+
+def nearest_run(spectra, channels, speed_rpm: float) -> int:
+    """Index of the run whose |speed| is nearest ``speed_rpm`` among runs having any of ``channels``."""
+    have = np.zeros(len(spectra.speed), dtype=bool)
+    for ch in channels:
+        if ch in spectra.psd:
+            have |= spectra.available(ch)
+    if not have.any():
+        raise ValueError(f"no run has any of the channels {tuple(channels)}")
+    dist = np.abs(np.abs(rad_s_to_rpm(spectra.speed)) - abs(speed_rpm))
+    return int(np.argmin(np.where(have, dist, np.inf)))
+
+
+def default_speeds_rpm(spectra, n: int = 3) -> list:
+    """Low, middle and top |speed| (rpm) among the spinning runs (fewer if fewer distinct speeds)."""
+    u = np.unique(np.abs(rad_s_to_rpm(spectra.speed)))
+    u = u[u > 0]
+    if len(u) <= n:
+        return [float(x) for x in u]
+    return [float(u[int(round(i))]) for i in np.linspace(0, len(u) - 1, n)]
+
+
+def plot_cumulative_rms(spectra, model, direction: str, speed_rpm: float, axes=None,
+                        f_max: float | None = None):
+    """At the run nearest ``speed_rpm``: data amplitude spectra of the direction's channels
+    with the model amplitudes C·Ω² as stems (thesis Fig. 3-13, upper panel) and the data
+    cumulative RMS (Eq. 2.13) with the model's staircase (lower panel), over [0, band].
+    ``axes`` = (upper, lower) or None.  Returns (figure, (upper, lower)).
+    """
+    if axes is None:
+        fig = _new_figure((7.0, 6.5))
+        ax_a, ax_c = fig.subplots(2, 1, sharex=True)
+    else:
+        ax_a, ax_c = axes
+        fig = ax_a.figure
+    top = _band_top(spectra, f_max)
+    chans = [ch for ch in DIRECTION_CHANNELS[direction] if ch in spectra.psd]
+    j = nearest_run(spectra, chans, speed_rpm)
+    omega = float(spectra.speed[j])
+    rpm = abs(omega) * RAD_S_TO_RPM
+    unit = _direction_unit(direction)
+    keep = spectra.f <= top
+    f = spectra.f[keep]
+    floor = []
+    for ch in chans:
+        if not spectra.available(ch)[j]:
+            continue
+        floor.append(np.median(spectra.amplitude[ch][j, keep]))
+        ax_a.plot(f, spectra.amplitude[ch][j, keep], lw=0.8, label=f"data {ch}")
+        ax_c.plot(f, cumulative_rms(spectra.psd[ch][j, keep], f), lw=1.2, label=f"data {ch}")
+    f_line, var = compare.model_psd_lines(model, direction, omega)
+    m = f_line[0] <= top
+    if m.any():
+        amp = np.sqrt(2.0 * var[0][m])
+        base = 0.5 * min(floor) if floor and min(floor) > 0 else amp.min() * 1e-2
+        ax_a.vlines(f_line[0][m], np.minimum(base, amp), amp, color="k", lw=0.8)
+        ax_a.plot(f_line[0][m], amp, "o", mfc="none", color="k", label="model C·Ω²")
+    ax_c.plot(f, compare.model_cumulative_rms(model, direction, omega, f), "k--", lw=1.2,
+              drawstyle="steps-post", label="model (staircase)")
+    ax_a.set_yscale("log")
+    ax_a.set_ylabel(f"Amplitude ({unit})")
+    ax_a.set_title(f"{_direction_label(direction)} at {rpm:.0f} rpm")
+    ax_a.legend(fontsize="small")
+    ax_a.grid(True, which="both", alpha=0.3)
+    ax_c.set_xlabel("Frequency (Hz)")
+    ax_c.set_ylabel(f"Cumulative RMS ({unit})")
+    ax_c.set_xlim(0, top)
+    ax_c.legend(fontsize="small", loc="lower right")
+    ax_c.grid(True, alpha=0.3)
+    return fig, (ax_a, ax_c)
+
+
+# --------------------------------------------------------------------------- coefficient curve fits
+
+def plot_coefficient(line, ax=None, rpm_max: float | None = None):
+    """One harmonic's curve fit (thesis Figs. 3-7, 3-9): measured amplitudes vs |speed| (used: dark
+    crosses; left out: light circles), C·Ω² solid, C_all·Ω² dashed, (C ± 2·stderr)·Ω² band,
+    excluded speed ranges shaded.  Returns (figure, axes)."""
+    fig = ax.figure if ax is not None else _new_figure((5.0, 3.8))
+    ax = ax if ax is not None else fig.add_subplot()
+    rpm = np.abs(rad_s_to_rpm(line.speed))
+    used = np.asarray(line.used, dtype=bool)
+    for k, (lo, hi) in enumerate(line.excluded_rpm):
+        ax.axvspan(lo, hi, color="tab:red", alpha=0.08, lw=0, label="excluded speed range" if k == 0 else None)
+    ax.plot(rpm[~used], line.amplitude[~used], "o", color="tab:orange", mfc="none", alpha=0.8, ms=5,
+            label="left out of C")
+    ax.plot(rpm[used], line.amplitude[used], "x", color="tab:blue", ms=5, label="used")
+    top = rpm_max if rpm_max is not None else (rpm.max() * 1.05 if rpm.size else 1.0)
+    g = np.linspace(0.0, top, 300)
+    w2 = rpm_to_rad_s(g) ** 2
+    band = 2.0 * (line.C_stderr if np.isfinite(line.C_stderr) else 0.0)
+    ax.fill_between(g, np.maximum(line.C - band, 0.0) * w2, (line.C + band) * w2, color="k", alpha=0.15,
+                    lw=0, label="C ± 2σ")
+    ax.plot(g, line.C * w2, "k-", lw=1.2, label="C·Ω²")
+    ax.plot(g, line.C_all * w2, "--", color="tab:orange", lw=1.2, label="C_all·Ω² (all points)")
+    cu = DIRECTION_C_UNIT[line.direction]
+    ax.set_title(f"h = {line.h:.4g}: C = {line.C:.3g} {cu}", fontsize="medium")
+    ax.set_xlim(0.0, top)
+    ax.set_ylim(bottom=0.0)
+    ax.grid(True, alpha=0.3)
+    return fig, ax
+
+
+def plot_coefficients(lines, direction: str, fig=None):
+    """Grid of :func:`plot_coefficient`, one subplot per harmonic of ``direction`` (by h).
+    Returns (figure, array of axes)."""
+    sel = sorted((ln for ln in lines if ln.direction == direction), key=lambda ln: ln.h)
+    if not sel:
+        raise ValueError(f"no harmonics of direction {direction!r} among the lines")
+    n = len(sel)
+    ncol = int(np.ceil(np.sqrt(n)))
+    nrow = int(np.ceil(n / ncol))
+    fig = fig if fig is not None else _new_figure((3.6 * ncol + 0.6, 2.9 * nrow + 0.8))
+    axes = np.atleast_1d(fig.subplots(nrow, ncol, squeeze=False)).ravel()
+    rpm_max = max((np.abs(rad_s_to_rpm(ln.speed)).max() for ln in sel if ln.speed.size), default=1.0) * 1.05
+    unit = _direction_unit(direction)
+    for ax, ln in zip(axes, sel):
+        plot_coefficient(ln, ax, rpm_max)
+    for i, ax in enumerate(axes):
+        if i >= n:
+            ax.set_visible(False)
+            continue
+        if i % ncol == 0:
+            ax.set_ylabel(f"Amplitude ({unit})")
+        if i >= n - ncol:
+            ax.set_xlabel("Wheel speed |Ω| (rpm)")
+    handles = {}
+    for ax in axes[:n]:
+        for hd, lb in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lb, hd)
+    fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncol=min(len(handles), 6),
+               fontsize="small")
+    fig.suptitle(f"{_direction_label(direction)}: amplitude coefficient curve fits")
+    return fig, axes[:n]
+
+
+# --------------------------------------------------------------------------- tables
+
+def _same_h(a: float, b: float) -> bool:
+    """Harmonic numbers equal to the model file's precision (it rounds h to 4 decimals)."""
+    return abs(float(a) - float(b)) <= 1e-4 * max(1.0, abs(float(b)))
+
+
+def harmonic_rows(fit) -> list:
+    """One dict per harmonic: direction, h, C_SI, C_stderr_SI, C_all_SI, n_points, presence,
+    excluded_rpm (list), in_model.  From the fit's lines; harmonics of the model without a line
+    are added from the model (C_all unknown: NaN)."""
+    model_h = {d: [float(hm.h) for hm in fit.model.harmonics(d)] for d in DIRECTION_CHANNELS}
+    rows = []
+    matched = {d: set() for d in DIRECTION_CHANNELS}
+    for ln in fit.lines:
+        hit = [i for i, h in enumerate(model_h.get(ln.direction, [])) if _same_h(ln.h, h)]
+        matched.setdefault(ln.direction, set()).update(hit)
+        rows.append({"direction": ln.direction, "h": float(ln.h), "C_SI": float(ln.C),
+                     "C_stderr_SI": float(ln.C_stderr), "C_all_SI": float(ln.C_all),
+                     "n_points": int(np.count_nonzero(ln.used)), "presence": float(ln.presence),
+                     "excluded_rpm": [[float(a), float(b)] for a, b in ln.excluded_rpm],
+                     "in_model": bool(hit)})
+    for d in DIRECTION_CHANNELS:
+        for i, hm in enumerate(fit.model.harmonics(d)):
+            if i in matched[d]:
+                continue
+            rows.append({"direction": d, "h": float(hm.h), "C_SI": float(hm.C),
+                         "C_stderr_SI": float(hm.C_stderr) if hm.C_stderr is not None else np.nan,
+                         "C_all_SI": np.nan, "n_points": int(hm.n_points),
+                         "presence": float(hm.presence) if hm.presence is not None else np.nan,
+                         "excluded_rpm": [[float(a), float(b)] for a, b in hm.excluded_rpm],
+                         "in_model": True})
+    order = {d: i for i, d in enumerate(DIRECTION_CHANNELS)}
+    rows.sort(key=lambda r: (order.get(r["direction"], 99), r["h"]))
+    return rows
+
+
+def _fmt(v) -> str:
+    if isinstance(v, (bool, np.bool_)):
+        return "true" if v else "false"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        return "" if not np.isfinite(v) else repr(float(v))
+    if isinstance(v, list):
+        return json.dumps(v)
+    return str(v)
+
+
+def _write_csv(path: Path, columns: list, rows) -> Path:
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(columns)
+        for r in rows:
+            w.writerow([_fmt(r[c]) for c in columns])
+    return path
+
+
+HARMONICS_COLUMNS = ["direction", "h", "C_SI", "C_stderr_SI", "C_all_SI", "n_points", "presence",
+                     "excluded_rpm", "in_model"]
+BINS_COLUMNS = ["direction", "h", "n_bin", "n_possible", "presence", "kept", "reason"]
+EXCLUDED_COLUMNS = ["direction", "h", "lo_rpm", "hi_rpm"]
+
+
+def _summary_md(fit, rows, table, top, files) -> str:
+    sp = fit.spectra
+    rpm = np.abs(rad_s_to_rpm(sp.speed))
+    out = [f"# Empirical fit report: {fit.model.name}", "",
+           f"- runs: {len(sp.speed)}, |speed| {rpm.min():.0f}–{rpm.max():.0f} rpm; channels: "
+           f"{', '.join(sp.channels)}",
+           f"- sample rate {sp.sample_rate:g} Hz, resolution {sp.df:.4g} Hz, band used 0–{top:g} Hz", ""]
+    out += ["## Harmonics (amplitude = C·Ω², Ω in rad/s)", "",
+            "| direction | h | C (SI) | ±σ | C_all (SI) | points | presence | excluded rpm | in model |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        exc = "; ".join(f"{a:.0f}–{b:.0f}" for a, b in r["excluded_rpm"]) or "–"
+        out.append(f"| {r['direction']} | {r['h']:.4g} | {r['C_SI']:.4g} {DIRECTION_C_UNIT[r['direction']]} | "
+                   f"{r['C_stderr_SI']:.2g} | {r['C_all_SI']:.4g} | {r['n_points']} | {r['presence']:.2f} | "
+                   f"{exc} | {'yes' if r['in_model'] else 'no'} |")
+    if not rows:
+        out.append("| (none) | | | | | | | | |")
+    out += ["", "## RMS model/data (median over spinning runs)", ""]
+    spin = np.abs(table["speed_rpm"]) > 0
+    for key, v in table.items():
+        if key.startswith("ratio_"):
+            vals = v[spin & np.isfinite(v)]
+            med = f"{np.median(vals):.3f}" if vals.size else "n/a"
+            out.append(f"- {key[6:]}: {med}")
+    out += ["", "## Files", ""] + [f"- `{p.name}`" for p in files] + ["- `summary.md`", ""]
+    return "\n".join(out)
+
+
+def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None = None) -> list:
+    """Write the validation report of ``fit`` to ``out_dir``; return the paths written.
+
+    Files: ``waterfall_<ch>.png`` per channel, ``rms_vs_speed_<direction>.png`` and
+    ``cumulative_rms_<direction>.png`` per direction with data, ``coefficients_<direction>.png``
+    per direction with fitted lines, ``harmonics.csv``, ``rms_vs_speed.csv``, ``bins.csv``,
+    ``excluded_ranges.csv`` and ``summary.md``.  ``cumulative_speeds_rpm``: speeds of the
+    cumulative-RMS panels (nearest runs), default low, middle and top speed.  ``f_max``: upper
+    band edge, Hz (default and ceiling: the spectra's band limit).
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    sp, model = fit.spectra, fit.model
+    top = _band_top(sp, f_max)
+    files = []
+    for ch in sp.channels:
+        if not sp.available(ch).any():
+            continue
+        fig, _ = plot_waterfall(sp, ch, model=model, f_max=top, lines=fit.lines)
+        files.append(_save(fig, out / f"waterfall_{ch}.png"))
+    directions = [d for d in DIRECTION_CHANNELS
+                  if any(ch in sp.psd and sp.available(ch).any() for ch in DIRECTION_CHANNELS[d])]
+    speeds = default_speeds_rpm(sp) if cumulative_speeds_rpm is None else [float(s) for s in cumulative_speeds_rpm]
+    for d in directions:
+        fig, _ = plot_rms_vs_speed(sp, model, d, f_max=top)
+        files.append(_save(fig, out / f"rms_vs_speed_{d}.png"))
+        if speeds:
+            fig = _new_figure((4.6 * len(speeds) + 0.4, 7.0))
+            axes = fig.subplots(2, len(speeds), sharex="col", squeeze=False)
+            for k, s in enumerate(speeds):
+                plot_cumulative_rms(sp, model, d, s, axes=(axes[0, k], axes[1, k]), f_max=top)
+            fig.suptitle(f"{_direction_label(d)}: amplitude spectra and cumulative RMS, data vs model")
+            files.append(_save(fig, out / f"cumulative_rms_{d}.png"))
+    for d in DIRECTION_CHANNELS:
+        if any(ln.direction == d for ln in fit.lines):
+            fig, _ = plot_coefficients(fit.lines, d)
+            files.append(_save(fig, out / f"coefficients_{d}.png"))
+
+    rows = harmonic_rows(fit)
+    files.append(_write_csv(out / "harmonics.csv", HARMONICS_COLUMNS, rows))
+    table = compare.rms_table(fit, top)
+    cols = list(table)
+    files.append(_write_csv(out / "rms_vs_speed.csv", cols,
+                            ({c: float(table[c][i]) for c in cols} for i in range(len(table["speed_rpm"])))))
+    files.append(_write_csv(out / "bins.csv", BINS_COLUMNS,
+                            ({c: getattr(b, c, "") for c in BINS_COLUMNS} for b in fit.bins)))
+    exc = [{"direction": r["direction"], "h": r["h"], "lo_rpm": float(lo), "hi_rpm": float(hi)}
+           for r in rows for lo, hi in r["excluded_rpm"]]
+    files.append(_write_csv(out / "excluded_ranges.csv", EXCLUDED_COLUMNS, exc))
+    summary = out / "summary.md"
+    summary.write_text(_summary_md(fit, rows, table, top, files))
+    files.append(summary)
+    return files
