@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm, rpm_to_rad_s
 
@@ -239,8 +240,9 @@ def read_run(path, speed: float, sample_rate: float | None = None) -> Run:
     return Run(speed=float(speed), sample_rate=fs, signals=signals, t0=float(time[0]), name=path.name)
 
 
-def read_steady(directory) -> SteadyTest:
-    """Read a steady-state test directory (``runs.csv`` + one CSV per run)."""
+def read_steady(directory, progress: bool = False) -> SteadyTest:
+    """Read a steady-state test directory (``runs.csv`` + one CSV per run);
+    ``progress`` shows a bar over the runs."""
     directory = Path(directory)
     if not directory.is_dir():
         raise DataError(directory, "directory", "does not exist or is not a directory")
@@ -271,7 +273,7 @@ def read_steady(directory) -> SteadyTest:
     if not rows:
         raise DataError(runs_path, "rows", "no runs listed")
     runs, files_seen = [], {}
-    for lineno, row in rows:
+    for lineno, row in tqdm(rows, desc="reading runs", unit="run", disable=not progress, leave=False):
         fname, speed_text = row.get("file", ""), row.get("speed_rpm", "")
         if not fname:
             raise DataError(runs_path, f"file (line {lineno})", "empty file name")
@@ -313,11 +315,11 @@ def read_sweep(path, sample_rate: float | None = None) -> Sweep:
     return Sweep(time=time, signals=signals, sample_rate=fs, tach=tach)
 
 
-def read_data(path):
+def read_data(path, progress: bool = False):
     """A directory is a steady-state test, a file a sweep (``.h5`` files: HDF5)."""
     path = Path(path)
     if path.is_dir():
-        return read_steady(path)
+        return read_steady(path, progress=progress)
     if path.suffix.lower() in (".h5", ".hdf5"):
         from .hdf5 import read_hdf5
         return read_hdf5(path)

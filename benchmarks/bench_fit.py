@@ -1,0 +1,53 @@
+"""Benchmark: the whole empirical fit of the 120-speed, 6-channel E-wheel dataset
+against its floor, the Welch PSDs alone, measured in the same run.
+
+Target (issue 2): whole fit (spectra + identification + coefficients + modal
+exclusion) within 3x the floor.  Data are generated in memory by the virtual
+test stand, so disk and CSV parsing are not timed (they are the same for any
+method).  Prints both timings and their ratio; exits 1 when the target is missed.
+
+    python benchmarks/bench_fit.py [--repeat 5]
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+import numpy as np
+
+from rwadist.empirical import fit_empirical
+from rwadist.spectra import compute_spectra
+from rwadist.teststand import preset, simulate_steady
+
+
+def best_of(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--target", type=float, default=3.0)
+    args = ap.parse_args(argv)
+    wheel = preset("ithaco-e")
+    test = simulate_steady(wheel, np.linspace(300, 2400, 120), sample_rate=3840.0, n_samples=8192,
+                           noise=0.01, modes=True, seed=0)
+    compute_spectra(test)  # warm-up (imports, FFT plans)
+    floor = best_of(lambda: compute_spectra(test), args.repeat)
+    whole = best_of(lambda: fit_empirical(compute_spectra(test)), args.repeat)
+    ratio = whole / floor
+    print(f"dataset: {len(test.runs)} runs x {test.runs[0].n_samples} samples x {len(test.channels)} channels")
+    print(f"floor  (Welch PSDs alone):         {floor * 1e3:8.1f} ms")
+    print(f"whole fit (spectra + fit):         {whole * 1e3:8.1f} ms")
+    print(f"ratio whole/floor: {ratio:.2f}  (target <= {args.target:g})  {'PASS' if ratio <= args.target else 'FAIL'}")
+    return 0 if ratio <= args.target else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,249 @@
+"""The ``rwadist`` command line.  rpm and Hz at this edge, SI inside."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import data as data_io
+from . import model as model_io
+from .data import DataError
+from .units import RAD_S_TO_RPM, rpm_to_rad_s
+
+
+def parse_speeds(text: str, n: int | None = None) -> np.ndarray:
+    """rpm list from 'A,B,C', 'START:STOP:STEP' (stop inclusive) or 'START:STOP' with ``n`` points."""
+    try:
+        if ":" in text:
+            parts = [float(p) for p in text.split(":")]
+            if len(parts) == 2:
+                if not n:
+                    raise ValueError("START:STOP needs --n-speeds")
+                return np.linspace(parts[0], parts[1], int(n))
+            start, stop, step = parts
+            if step <= 0:
+                raise ValueError("STEP must be > 0")
+            return np.arange(start, stop + 0.5 * step, step)
+        return np.array([float(p) for p in text.split(",") if p.strip()])
+    except ValueError as exc:
+        raise DataError("--speeds-rpm", "value", f"{text!r}: {exc}") from None
+
+
+# --------------------------------------------------------------------------- simulate-test
+
+def cmd_simulate(args) -> int:
+    from .teststand import preset, simulate_steady, simulate_sweep
+
+    wheel = preset(args.preset)
+    out = Path(args.out_dir)
+    if args.sweep:
+        end = args.sweep_end_rpm if args.sweep_end_rpm is not None else 2400.0
+        sweep = simulate_sweep(wheel, rpm_start=args.sweep_start_rpm, rpm_end=end, duration=args.duration,
+                               sample_rate=args.sample_rate or 3840.0, noise=args.noise, modes=not args.no_modes,
+                               test_stand=not args.no_test_stand, seed=args.seed, profile=args.profile,
+                               tach=not args.no_tach)
+        path = data_io.write_sweep(sweep, out / "sweep.csv")
+        print(f"wrote sweep {path} ({len(sweep.time)} samples, {sweep.sample_rate:g} Hz)")
+        return 0
+    default_speeds = getattr(wheel, "default_speeds_rpm", None)
+    if args.speeds_rpm:
+        speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
+    elif default_speeds is not None:
+        speeds = np.asarray(default_speeds, float)
+    else:
+        speeds = np.linspace(300.0, 2400.0, 120)
+    fs = args.sample_rate or getattr(wheel, "default_sample_rate", None) or 3840.0
+    test = simulate_steady(wheel, speeds, sample_rate=fs, n_samples=args.samples, noise=args.noise,
+                           modes=not args.no_modes, test_stand=not args.no_test_stand, seed=args.seed)
+    if wheel.f_lim_hz is not None and not args.no_test_stand:
+        # the test engineer's record of where the fixture corrupts the data; `rwadist fit` uses it
+        test.meta["f_lim_hz"] = wheel.f_lim_hz
+    data_io.write_steady(test, out)
+    print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g}-{speeds.max():g} rpm, {fs:g} Hz, "
+          f"{args.samples} samples each)")
+    return 0
+
+
+# --------------------------------------------------------------------------- fit
+
+def load_steady(path, args):
+    """A steady test from a directory, a sweep CSV (sliced) or HDF5."""
+    obj = data_io.read_data(path, progress=True)
+    if isinstance(obj, data_io.Sweep):
+        from .sweep import slice_sweep
+
+        test, _ = slice_sweep(obj, slice_samples=args.slice_samples, speed_source=args.speed_source)
+        print(f"sliced sweep into {len(test.runs)} quasi-steady runs (speed from {args.speed_source})")
+        return test
+    return obj
+
+
+def run_fit(test, args, name: str, progress: bool = True):
+    from .empirical import FitSettings, fit_empirical
+    from .spectra import compute_spectra
+
+    f_lim = args.f_lim
+    if f_lim is None:
+        f_lim = test.meta.get("f_lim_hz")
+    spectra = compute_spectra(test, nperseg=args.nperseg, f_lim=f_lim)
+    settings = FitSettings(presence_min=args.presence, epsilon=args.epsilon,
+                           exclude_modes=not args.no_mode_exclusion)
+    return fit_empirical(spectra, settings, name=name, progress=progress)
+
+
+def cmd_fit(args) -> int:
+    from .report import write_report
+
+    t0 = time.perf_counter()
+    test = load_steady(args.data, args)
+    fit = run_fit(test, args, name=Path(args.data).name)
+    fit.model.provenance["data"] = str(args.data)
+    model_io.save(fit.model, args.output)
+    report_dir = Path(args.report) if args.report else Path(args.output).with_suffix("").parent / (
+        Path(args.output).stem + "_report")
+    print(f"writing report to {report_dir} ...", flush=True)
+    files = write_report(fit, report_dir)
+    n = sum(len(v) for v in fit.model.empirical.values())
+    print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
+    print(f"model:  {args.output}")
+    print(f"report: {report_dir} ({len(files)} files)")
+    return 0
+
+
+def _add_fit_options(p):
+    p.add_argument("--f-lim", type=float, default=None, help="upper limit of good data, Hz (test-stand resonance)")
+    p.add_argument("--nperseg", type=int, default=None, help="FFT length (default: largest power of 2 in a run)")
+    p.add_argument("--presence", type=float, default=0.25, help="bin presence threshold P0, fraction (default 0.25)")
+    p.add_argument("--epsilon", type=float, default=0.02, help="binning tolerance on h (default 0.02)")
+    p.add_argument("--no-mode-exclusion", action="store_true", help="keep modally amplified speeds in the fit")
+    p.add_argument("--slice-samples", type=int, default=8192, help="sweep slice length, samples")
+    p.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
+                   help="speed of sweep slices: tach column, estimated from data, or auto")
+
+
+# --------------------------------------------------------------------------- model show
+
+def cmd_model_show(args) -> int:
+    m = model_io.load(args.model)
+    rows = [(d, h) for d in model_io.DIRECTIONS for h in m.harmonics(d)]
+    if args.format == "json":
+        print(json.dumps(model_io.to_json(m), indent=2))
+        return 0
+    if args.format == "csv":
+        print("direction,h,C_SI,C_stderr_SI")
+        for d, h in rows:
+            se = "" if h.C_stderr is None else repr(float(h.C_stderr))
+            print(f"{d},{h.h!r},{h.C!r},{se}")
+        return 0
+    print(f"model {m.name!r}  (C in SI per (rad/s)^2: kg·m for forces, kg·m² for torques)")
+    print(f"{'direction':<14} {'h':>7} {'C':>12} {'stderr':>10} {'points':>6}  excluded rpm")
+    for d, h in rows:
+        se = "" if h.C_stderr is None else f"{h.C_stderr:.2e}"
+        ex = " ".join(f"{lo:.0f}-{hi:.0f}" for lo, hi in h.excluded_rpm)
+        print(f"{d:<14} {h.h:7.3f} {h.C:12.4e} {se:>10} {h.n_points:6d}  {ex}")
+    return 0
+
+
+# --------------------------------------------------------------------------- demo
+
+def cmd_demo(args) -> int:
+    """simulate (E-wheel preset, modes on) -> write -> read -> fit -> model + report, vs the truth."""
+    from .report import write_report
+    from .teststand import preset, simulate_steady
+
+    out = Path(args.out)
+    wheel = preset("ithaco-e")
+    speeds = np.linspace(300.0, 2400.0, args.n_speeds)
+    print(f"1/4 virtual test stand: {wheel.name}, {len(speeds)} speeds 300-2400 rpm, 3840 Hz, 8192 samples, "
+          "noise 1 %, wheel modes on")
+    test = simulate_steady(wheel, speeds, sample_rate=3840.0, n_samples=8192, noise=0.01, modes=True, seed=args.seed)
+    data_dir = data_io.write_steady(test, out / "data")
+    print(f"2/4 wrote interchange format: {data_dir}")
+    test = data_io.read_steady(data_dir)
+    print("3/4 fitting the empirical model")
+    ns = argparse.Namespace(f_lim=None, nperseg=None, presence=0.25, epsilon=0.02, no_mode_exclusion=False)
+    fit = run_fit(test, ns, name="demo: " + wheel.name)
+    model_path = model_io.save(fit.model, out / "model.json")
+    files = write_report(fit, out / "report")
+    print(f"4/4 model {model_path}, report {out / 'report'} ({len(files)} files)\n")
+    truth = wheel.to_model()
+    print(f"{'direction':<14} {'h fit':>7} {'h true':>7} {'C fit':>11} {'C true':>11} {'err':>7}  excluded rpm")
+    for d in model_io.DIRECTIONS:
+        th, tc = truth.h_and_C(d)
+        for hm in fit.model.harmonics(d):
+            k = int(np.argmin(np.abs(th - hm.h))) if th.size else -1
+            if k >= 0 and abs(th[k] - hm.h) < 0.05:
+                err = f"{100 * (hm.C / tc[k] - 1):+6.1f}%"
+                tru_h, tru_c = f"{th[k]:7.2f}", f"{tc[k]:11.3e}"
+            else:
+                err, tru_h, tru_c = "  extra", "      -", "          -"
+            ex = " ".join(f"{lo:.0f}-{hi:.0f}" for lo, hi in hm.excluded_rpm)
+            print(f"{d:<14} {hm.h:7.3f} {tru_h} {hm.C:11.3e} {tru_c} {err}  {ex}")
+    return 0
+
+
+# --------------------------------------------------------------------------- main
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="rwadist", description="Reaction wheel disturbance models from test data.")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("simulate-test", help="virtual test stand: synthetic load-cell data in the interchange format")
+    s.add_argument("out_dir")
+    s.add_argument("--preset", required=True, help="wheel preset, e.g. ithaco-e, ithaco-b")
+    s.add_argument("--speeds-rpm", help="'A,B,C', 'START:STOP:STEP' or 'START:STOP' with --n-speeds")
+    s.add_argument("--n-speeds", type=int, default=None)
+    s.add_argument("--sample-rate", type=float, default=None, help="Hz (default: the preset's test)")
+    s.add_argument("--samples", type=int, default=8192, help="samples per steady run")
+    s.add_argument("--noise", type=float, default=0.01, help="sensor noise std as a fraction of the top-speed fundamental")
+    s.add_argument("--no-modes", action="store_true", help="switch the wheel's structural modes off")
+    s.add_argument("--no-test-stand", action="store_true", help="switch test-stand resonances off")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--sweep", action="store_true", help="one spin-up record instead of steady runs")
+    s.add_argument("--sweep-start-rpm", type=float, default=0.0)
+    s.add_argument("--sweep-end-rpm", type=float, default=None)
+    s.add_argument("--duration", type=float, default=390.0, help="sweep duration, s")
+    s.add_argument("--profile", choices=("linear", "exp"), default="linear")
+    s.add_argument("--no-tach", action="store_true", help="sweep without the speed_rpm tach column")
+    s.set_defaults(func=cmd_simulate)
+
+    f = sub.add_parser("fit", help="fit the empirical model to test data; writes the model file and a report")
+    f.add_argument("data", help="steady-state directory, sweep CSV, or .h5")
+    f.add_argument("-o", "--output", required=True, help="model file to write (JSON)")
+    f.add_argument("--report", help="report directory (default: <model>_report)")
+    _add_fit_options(f)
+    f.set_defaults(func=cmd_fit)
+
+    m = sub.add_parser("model", help="model file tools")
+    msub = m.add_subparsers(dest="model_command", required=True)
+    ms = msub.add_parser("show", help="print a model's harmonics")
+    ms.add_argument("model")
+    ms.add_argument("--format", choices=("table", "csv", "json"), default="table")
+    ms.set_defaults(func=cmd_model_show)
+
+    d = sub.add_parser("demo", help="simulate -> fit -> report on the bundled example wheel")
+    d.add_argument("--out", default="demo_out", help="output directory (default demo_out)")
+    d.add_argument("--n-speeds", type=int, default=120)
+    d.add_argument("--seed", type=int, default=0)
+    d.set_defaults(func=cmd_demo)
+    return p
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except DataError as exc:
+        print(f"rwadist: error: {exc}", file=sys.stderr)
+        return 2
+    except ValueError as exc:
+        print(f"rwadist: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,501 @@
+"""Virtual test stand: synthetic hard-mounted load-cell data from a wheel description.
+
+A :class:`WheelDescription` holds the *truth* -- empirical harmonics (h, C) per
+direction, SI (``C`` in kg·m for forces, kg·m² for torques, amplitude C·Ω² with
+Ω in rad/s) -- plus the structural modes that amplify them.
+:func:`simulate_steady` and :func:`simulate_sweep` turn it into the load-cell
+records a hard-mounted test would give (:class:`rwadist.data.SteadyTest`,
+:class:`rwadist.data.Sweep`); the CLI writes them with
+:func:`rwadist.data.write_steady` / :func:`rwadist.data.write_sweep`.
+
+Signal model (thesis Eq. 3.1, one line per harmonic i of direction d)::
+
+    A_i = C_i Ω²,   ψ(t) = ∫ Ω dt (signed rotation angle, rad)
+    radial:  Fx = Re[A_i·G̃_x·e^{j(h_i ψ + α_i)}],  Fy = Im[A_i·G̃_y·e^{j(h_i ψ + α_i)}]   (Tx, Ty alike)
+    axial:   Fz = Re[A_i·G̃_z·e^{j(h_i ψ + α_i)}]                                    (Tz: axial_torque)
+
+For positive spin this is Fx = A cos φ, Fy = A sin φ with φ = h|Ω|t + α: the
+force vector turns counter-clockwise about +z.  For negative spin ψ decreases,
+so Fx = A cos φ', Fy = -A sin φ' with φ' = h|Ω|t - α (the wheel turns about
+-z); the random phase α is uniform, so ±α is the same distribution.  Writing it
+through the signed angle keeps a sweep through zero speed continuous.  G̃_ch is
+the modal gain (product over the modes acting on the channel) of the line at
+its positive frequency h|Ω|/2π, conjugated when Ω < 0 (the line then sits at
+negative frequency in this complex notation, where a real filter's response is
+the conjugate).
+
+Modal amplification is a simple resonance per mode (not rotor dynamics; a
+later issue replaces it)::
+
+    H(r) = (1 - r² + 2j·g·ζ·r) / (1 - r² + 2j·ζ·r),   r = f / f_mode(Ω)
+
+with ζ the damping ratio and g the peak gain.  H → 1 for r ≪ 1 and r ≫ 1 and
+|H(1)| = g: it is the transfer of a *lightly participating* mode -- the line
+is measured at its true value C·Ω² away from every mode (that is what the
+empirical model describes) and is amplified by g where it crosses the mode.
+A plain single-degree-of-freedom transmissibility would instead roll off
+above the mode and change C·Ω² everywhere, which the thesis data do not show.
+
+The rocking mode of a spinning disc splits into forward (+) and backward (-)
+whirl (thesis §2.3, §4.1.1)::
+
+    f_±(Ω) = sqrt((a·Ω_hz/2)² + f0²) ± a·Ω_hz/2,   a = I_zz/I_rr,  Ω_hz = |Ω|/2π
+
+A harmonic h meets it where h·Ω_hz = f_±, i.e. Ω_hz = f0 / sqrt(h (h ∓ a)):
+with a = 2, f0 = 54.9 Hz this is 1902 rpm for h = 1 backward and h = 3
+forward, 1165 rpm for h = 2 backward and h = 4 forward (thesis Table 3.6:
+1900–2000, 1800–2000, 800–1300 and 1150–1400 rpm).
+
+Lines at or above the Nyquist frequency are not recorded (an ideal
+anti-aliasing filter, as a real acquisition has: the B wheel test filtered at
+480 Hz for 1 kHz sampling).
+
+Randomness: one :class:`numpy.random.SeedSequence` per call spawns two
+generators, one for the phases (per run, per direction, per harmonic) and one
+for the sensor noise, so switching noise or modes on and off leaves the
+phases unchanged -- a run with and without modes differs by the modal gain
+only.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .data import Run, SteadyTest, Sweep
+from .model import Harmonic, WheelModel
+from .units import CHANNELS, DIRECTION_CHANNELS, rad_s_to_hz, rad_s_to_rpm, rpm_to_rad_s
+
+#: Channel group -> direction whose fundamental sets the noise level of the group.
+NOISE_REFERENCE = {"Fx": "radial_force", "Fy": "radial_force", "Fz": "radial_force",
+                   "Tx": "radial_torque", "Ty": "radial_torque", "Tz": "radial_torque"}
+#: Samples per block when synthesising a sweep (bounds memory of long records).
+_SWEEP_BLOCK = 1 << 17
+
+
+# --------------------------------------------------------------------------- modes
+
+@dataclass
+class Mode:
+    """A resonance that amplifies the harmonic lines on some channels.
+
+    name : label, e.g. ``"rocking_backward"``.
+    f0_hz : natural frequency at zero wheel speed, Hz (> 0).
+    zeta : damping ratio (> 0); the -3 dB width of the peak is about 2ζ·f_mode.
+    peak_gain : |gain| at the resonance (r = 1); > 1 amplifies.
+    channels : channels it acts on (subset of Fx, Fy, Fz, Tx, Ty, Tz).
+    whirl : 0 fixed frequency; +1 forward whirl; -1 backward whirl.
+    inertia_ratio : a = I_zz/I_rr of the gyroscopic whirl law (thin disc: 2).
+    """
+
+    name: str
+    f0_hz: float
+    zeta: float
+    peak_gain: float
+    channels: tuple
+    whirl: int = 0
+    inertia_ratio: float = 2.0
+
+    def __post_init__(self):
+        self.channels = tuple(self.channels)
+        bad = [c for c in self.channels if c not in CHANNELS]
+        if bad:
+            raise ValueError(f"mode {self.name!r}: unknown channel(s) {bad}; expected some of {list(CHANNELS)}")
+        if not (np.isfinite(self.f0_hz) and self.f0_hz > 0):
+            raise ValueError(f"mode {self.name!r}: f0_hz must be > 0, got {self.f0_hz!r}")
+        if not (np.isfinite(self.zeta) and self.zeta > 0):
+            raise ValueError(f"mode {self.name!r}: zeta must be > 0, got {self.zeta!r}")
+        if not (np.isfinite(self.peak_gain) and self.peak_gain > 0):
+            raise ValueError(f"mode {self.name!r}: peak_gain must be > 0, got {self.peak_gain!r}")
+        if self.whirl not in (-1, 0, 1):
+            raise ValueError(f"mode {self.name!r}: whirl must be -1, 0 or +1, got {self.whirl!r}")
+        if self.whirl and not self.inertia_ratio >= 0:
+            raise ValueError(f"mode {self.name!r}: inertia_ratio must be >= 0, got {self.inertia_ratio!r}")
+
+    def frequency_hz(self, omega):
+        """Natural frequency (Hz) at wheel speed ``omega`` (rad/s, sign ignored); vectorised."""
+        w = np.abs(np.asarray(omega, dtype=float))
+        if self.whirl == 0:
+            return np.full_like(w, float(self.f0_hz))
+        half = 0.5 * self.inertia_ratio * rad_s_to_hz(w)
+        return np.sqrt(half**2 + self.f0_hz**2) + self.whirl * half
+
+    def gain(self, f_hz, omega):
+        """Complex gain H(r), r = f_hz / f_mode(omega), of a line at ``f_hz`` (Hz, >= 0) with the
+        wheel at ``omega`` (rad/s); ``f_hz`` and ``omega`` broadcast.  |H| = peak_gain at r = 1,
+        H -> 1 far from the mode on both sides."""
+        return self.response(np.abs(np.asarray(f_hz, dtype=float)) / self.frequency_hz(omega))
+
+    def response(self, r):
+        """H(r) = (1 - r² + 2j·g·ζ·r) / (1 - r² + 2j·ζ·r) at frequency ratio r = f / f_mode."""
+        r = np.asarray(r, dtype=float)
+        base = 1.0 - r * r
+        two_zr = 2.0 * self.zeta * r
+        return (base + 1j * self.peak_gain * two_zr) / (base + 1j * two_zr)
+
+    def crossing_speed_hz(self, h: float) -> float | None:
+        """Wheel speed |Ω|/2π (Hz) at which harmonic ``h`` meets this mode (h·Ω_hz = f_mode), or None.
+
+        Fixed mode: f0/h.  Whirl s = ±1: h·x = sqrt((a x/2)² + f0²) + s·a·x/2  =>  x = f0/sqrt(h(h - s·a)),
+        which exists for the forward whirl only when h > a (the forward whirl rises with slope a);
+        thesis Eq. 4.84: (ω∓)² = h·k_θ/(h·I_rr ± I_zz), Ω = ω/h.
+        """
+        if h <= 0:
+            return None
+        if self.whirl == 0:
+            return self.f0_hz / h
+        q = h * (h - self.whirl * self.inertia_ratio)
+        if q <= 0:
+            return None
+        return self.f0_hz / np.sqrt(q)
+
+    def to_json(self) -> dict:
+        return {"name": self.name, "f0_hz": float(self.f0_hz), "zeta": float(self.zeta),
+                "peak_gain": float(self.peak_gain), "channels": list(self.channels), "whirl": int(self.whirl),
+                "inertia_ratio": float(self.inertia_ratio)}
+
+
+# --------------------------------------------------------------------------- wheel
+
+@dataclass
+class WheelDescription:
+    """The truth a virtual test measures.
+
+    name : wheel label.
+    harmonics : direction -> list of (h, C) with C in SI per (rad/s)² (kg·m forces, kg·m² torques).
+    modes : wheel structural modes (:class:`Mode`), applied when ``modes=True``.
+    test_stand_modes : fixture resonances, applied when ``test_stand=True``.
+    max_speed_rpm : speed range of the wheel, rpm (catalogue value).
+    mass_kg, radius_m : flywheel mass (kg) and radius (m), if known.
+    f_lim_hz : upper limit of uncorrupted data (Hz) when the stand resonates, else None.
+    default_speeds_rpm : speeds of the reference steady test, rpm (None: no steady reference test).
+    default_sample_rate : sample rate of the reference test, Hz.
+    default_n_samples : samples per steady run of the reference test.
+    default_sweep : keyword arguments of :func:`simulate_sweep` reproducing the reference sweep, or None.
+    notes : free text (source of the numbers).
+    """
+
+    name: str
+    harmonics: dict
+    modes: list
+    test_stand_modes: list = field(default_factory=list)
+    max_speed_rpm: float = 6000.0
+    mass_kg: float | None = None
+    radius_m: float | None = None
+    f_lim_hz: float | None = None
+    default_speeds_rpm: np.ndarray | None = None
+    default_sample_rate: float = 3840.0
+    default_n_samples: int = 8192
+    default_sweep: dict | None = None
+    notes: str = ""
+
+    def __post_init__(self):
+        clean = {}
+        for d, items in self.harmonics.items():
+            if d not in DIRECTION_CHANNELS:
+                raise ValueError(f"wheel {self.name!r}: unknown direction {d!r}; expected {list(DIRECTION_CHANNELS)}")
+            pairs = [(float(h), float(C)) for h, C in items]
+            for h, C in pairs:
+                if not (np.isfinite(h) and h > 0 and np.isfinite(C) and C >= 0):
+                    raise ValueError(f"wheel {self.name!r}: {d}: need h > 0 and C >= 0, got h={h!r}, C={C!r}")
+            clean[d] = pairs
+        self.harmonics = clean
+        if self.default_speeds_rpm is not None:
+            self.default_speeds_rpm = np.asarray(self.default_speeds_rpm, dtype=float)
+
+    def h_and_C(self, direction: str):
+        """Arrays (h, C) of a direction, SI (empty when the direction has none)."""
+        pairs = self.harmonics.get(direction, [])
+        return (np.array([p[0] for p in pairs], dtype=float), np.array([p[1] for p in pairs], dtype=float))
+
+    def fundamental_C(self, direction: str) -> float:
+        """C of the harmonic nearest h = 1 in ``direction`` (0 when the direction has none)."""
+        h, C = self.h_and_C(direction)
+        if h.size == 0:
+            return 0.0
+        return float(C[np.argmin(np.abs(h - 1.0))])
+
+    def all_modes(self, modes: bool = True, test_stand: bool = True) -> list:
+        return (list(self.modes) if modes else []) + (list(self.test_stand_modes) if test_stand else [])
+
+    def truth_json(self) -> dict:
+        """Harmonic lists in SI, JSON-ready: direction -> [{"h": .., "C": ..}, ...]."""
+        return {d: [{"h": h, "C": C} for h, C in pairs] for d, pairs in self.harmonics.items()}
+
+    def wheel_json(self) -> dict:
+        doc = {"name": self.name, "max_speed_rpm": float(self.max_speed_rpm)}
+        if self.mass_kg is not None:
+            doc["mass_kg"] = float(self.mass_kg)
+        if self.radius_m is not None:
+            doc["radius_m"] = float(self.radius_m)
+        if self.f_lim_hz is not None:
+            doc["f_lim_hz"] = float(self.f_lim_hz)
+        return doc
+
+    def to_model(self) -> WheelModel:
+        """The truth as a :class:`rwadist.model.WheelModel` (harmonics only, no modes)."""
+        wheel = {k: v for k, v in self.wheel_json().items() if k != "name"}
+        empirical = {d: [] for d in DIRECTION_CHANNELS}
+        for d, pairs in self.harmonics.items():
+            empirical[d] = [Harmonic(h=h, C=C) for h, C in pairs]
+        return WheelModel(name=self.name, wheel=wheel, empirical=empirical,
+                          provenance={"source": "rwadist.teststand.WheelDescription (simulation truth)",
+                                      "notes": self.notes})
+
+    def crossings(self, direction: str, speeds_rpm, modes: bool = True, test_stand: bool = True) -> list:
+        """Where harmonics of ``direction`` meet the modes acting on its channels.
+
+        speeds_rpm : speeds (rpm) whose |range| is searched: [min|s|, max|s|], or [0, max|s|] when the
+        speeds change sign.  Returns a list of dicts {h, mode, whirl, speed_rpm, f_hz} sorted by speed,
+        speed_rpm >= 0 being the |wheel speed| at which h·|Ω|/2π equals the mode frequency f_hz.
+        """
+        s = np.asarray(speeds_rpm, dtype=float).ravel()
+        if s.size == 0:
+            return []
+        lo = 0.0 if (s.min() <= 0.0 <= s.max()) else float(np.abs(s).min())
+        hi = float(np.abs(s).max())
+        chans = set(DIRECTION_CHANNELS[direction])
+        h_arr, _ = self.h_and_C(direction)
+        out = []
+        for mode in self.all_modes(modes, test_stand):
+            if not chans & set(mode.channels):
+                continue
+            for h in h_arr:
+                x = mode.crossing_speed_hz(float(h))
+                if x is None:
+                    continue
+                rpm = 60.0 * x
+                if lo <= rpm <= hi:
+                    out.append({"h": float(h), "mode": mode.name, "whirl": mode.whirl, "speed_rpm": float(rpm),
+                                "f_hz": float(h * x)})
+        out.sort(key=lambda d: (d["speed_rpm"], d["h"]))
+        return out
+
+
+# --------------------------------------------------------------------------- synthesis
+
+def _channel_modes(wheel: WheelDescription, modes: bool, test_stand: bool) -> dict:
+    active = wheel.all_modes(modes, test_stand)
+    return {ch: [m for m in active if ch in m.channels] for ch in CHANNELS}
+
+
+def _noise_std(wheel: WheelDescription, omega_max: float, noise: float) -> dict:
+    """Per-channel sensor noise std: noise × C_1·Ω_max² of the group's reference direction."""
+    return {ch: float(noise * wheel.fundamental_C(NOISE_REFERENCE[ch]) * omega_max**2) for ch in CHANNELS}
+
+
+def _line_gain(ch_modes: list, f_line, omega):
+    """Product of the gains of ``ch_modes`` for lines at f_line (Hz) at speed omega (rad/s); None if no mode."""
+    g = None
+    for m in ch_modes:
+        gm = m.gain(f_line, omega)
+        g = gm if g is None else g * gm
+    return g
+
+
+def _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, nyquist_dropped, extra) -> dict:
+    meta = {
+        "sample_rate_hz": float(sample_rate),
+        "wheel": wheel.wheel_json(),
+        "generator": "rwadist.teststand",
+        "seed": int(seed) if isinstance(seed, (int, np.integer)) else repr(seed),
+        "noise_relative": float(noise),
+        "noise_std": noise_std,
+        "modes": bool(modes),
+        "test_stand": bool(test_stand),
+        "active_modes": [m.to_json() for m in wheel.all_modes(modes, test_stand)],
+        "truth": wheel.truth_json(),
+        "truth_units": {"C": "SI per (rad/s)^2: kg*m (forces), kg*m^2 (torques)",
+                        "note": "amplitude = C * omega^2 away from modes, frequency = h * |omega| / 2pi"},
+        "anti_aliasing": "lines at or above Nyquist are not recorded (ideal anti-aliasing filter)",
+        "lines_above_nyquist": nyquist_dropped,
+        "notes": f"synthetic hard-mounted load-cell data of {wheel.name}",
+    }
+    meta.update(extra)
+    return meta
+
+
+def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 3840.0, n_samples: int = 8192,
+                    noise: float = 0.01, modes: bool = True, test_stand: bool = True, seed=0) -> SteadyTest:
+    """Steady-speed runs of ``wheel`` hard-mounted on the virtual stand.
+
+    speeds_rpm : wheel speeds, rpm (signed; negative spins about -z), one run each, in the order given.
+    sample_rate : Hz.  n_samples : samples per run.
+    noise : white Gaussian sensor noise std relative to the group's fundamental at the top speed,
+        std = noise · C_1 · Ω_max² (Ω_max = max |speed|, rad/s; forces use the radial-force
+        fundamental, torques the radial-torque one); recorded in ``meta["noise_std"]``.
+    modes / test_stand : apply the wheel modes / the fixture resonances.
+    seed : seed of the numpy Generator (phases and noise).
+    Returns a :class:`SteadyTest` with all six channels (N, N·m), runs named ``run_0000.csv``, ….
+    """
+    speeds = np.atleast_1d(np.asarray(speeds_rpm, dtype=float))
+    if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)):
+        raise ValueError(f"speeds_rpm must be a non-empty 1-D list of finite speeds, got {speeds_rpm!r}")
+    if not sample_rate > 0:
+        raise ValueError(f"sample_rate must be > 0 Hz, got {sample_rate!r}")
+    n_samples = int(n_samples)
+    if n_samples < 2:
+        raise ValueError(f"n_samples must be >= 2, got {n_samples!r}")
+    omegas = rpm_to_rad_s(speeds)
+    omega_max = float(np.abs(omegas).max())
+    noise_std = _noise_std(wheel, omega_max, noise)
+    ch_modes = _channel_modes(wheel, modes, test_stand)
+    phase_rng, noise_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
+    nyquist = 0.5 * sample_rate
+    t = np.arange(n_samples) / sample_rate
+    hc = {d: wheel.h_and_C(d) for d in DIRECTION_CHANNELS}
+    dropped = []
+    runs = []
+    for k, omega in enumerate(omegas):
+        signals = {ch: np.zeros(n_samples) for ch in CHANNELS}
+        for d, chans in DIRECTION_CHANNELS.items():
+            h, C = hc[d]
+            if h.size == 0:
+                continue
+            alpha = phase_rng.uniform(0.0, 2.0 * np.pi, size=h.size)  # drawn even if lines are dropped
+            f_line = h * abs(omega) / (2.0 * np.pi)
+            keep = f_line < nyquist
+            if not keep.all():
+                dropped.extend({"speed_rpm": float(speeds[k]), "direction": d, "h": float(x)} for x in h[~keep])
+            if not keep.any() or omega == 0.0:
+                continue
+            amp = (C * omega**2)[keep]
+            # exp(j(h ψ + α)), ψ = Ω t: (n_lines × n_samples) complex
+            carrier = np.exp(1j * (np.outer(h[keep] * omega, t) + alpha[keep, None]))
+            for i, ch in enumerate(chans):
+                g = _line_gain(ch_modes[ch], f_line[keep], omega)
+                c = amp if g is None else amp * (g if omega > 0 else np.conj(g))
+                z = c @ carrier
+                # radial: x = Re, y = Im (vector turning with the wheel); axial: Re
+                signals[ch] += z.imag if i == 1 else z.real
+        for ch in CHANNELS:
+            if noise_std[ch] > 0:
+                signals[ch] += noise_rng.normal(0.0, noise_std[ch], n_samples)
+        runs.append(Run(speed=float(omega), sample_rate=float(sample_rate), signals=signals, t0=0.0,
+                        name=f"run_{k:04d}.csv"))
+    meta = _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, dropped,
+                 {"kind": "steady", "n_samples": n_samples})
+    return SteadyTest(runs=runs, meta=meta)
+
+
+def speed_profile(t, rpm_start: float, rpm_end: float, duration: float, profile="linear"):
+    """Wheel speed Ω(t) in rad/s of a sweep.
+
+    "linear": constant acceleration rpm_start -> rpm_end over ``duration`` (s).
+    "exp": Ω = Ω_end + (Ω_start - Ω_end)·exp(-t/τ), τ = duration/5 -- full motor voltage with the
+        torque falling with back-EMF, saturating like the thesis E-wheel spin-up (with rpm_start = 0
+        this is Ω_end·(1 - exp(-t/τ)); it reaches 99.3 % of Ω_end at t = duration).
+    callable: profile(t) -> rpm, any custom profile.
+    """
+    t = np.asarray(t, dtype=float)
+    w0, w1 = float(rpm_to_rad_s(rpm_start)), float(rpm_to_rad_s(rpm_end))
+    if callable(profile):
+        return rpm_to_rad_s(np.broadcast_to(np.asarray(profile(t), dtype=float), t.shape))
+    if profile == "linear":
+        return w0 + (w1 - w0) * (t / duration)
+    if profile == "exp":
+        tau = duration / 5.0
+        return w1 + (w0 - w1) * np.exp(-t / tau)
+    raise ValueError(f"unknown sweep profile {profile!r}; expected 'linear', 'exp' or a callable t -> rpm")
+
+
+def _cumtrapz(y: np.ndarray, dt: float) -> np.ndarray:
+    """Cumulative trapezoid integral of uniformly sampled y, starting at 0."""
+    out = np.empty_like(y)
+    out[0] = 0.0
+    np.cumsum(0.5 * dt * (y[1:] + y[:-1]), out=out[1:])
+    return out
+
+
+def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: float = 2400.0,
+                   duration: float = 390.0, sample_rate: float = 3840.0, noise: float = 0.01, modes: bool = True,
+                   test_stand: bool = True, seed=0, profile="linear", tach: bool = True) -> Sweep:
+    """A continuous record through a speed change (spin-up or run-down).
+
+    rpm_start, rpm_end : speeds (rpm, signed); duration : s; sample_rate : Hz.
+    profile : "linear", "exp" or a callable t (s) -> rpm (see :func:`speed_profile`).
+    Each line's phase is h_i·ψ(t) + α_i with ψ = ∫Ω dt (cumulative trapezoid of the speed profile,
+    not Ω(t)·t), its amplitude C_i·Ω(t)².  Modal gain is applied *quasi-steadily*: each sample's
+    line is multiplied by the gain at its instantaneous frequency h_i|Ω(t)|/2π and speed Ω(t), as if
+    the wheel dwelt there -- valid while the line crosses a mode slowly compared with the mode's
+    build-up time 1/(ζ·2π·f_mode) (the thesis spin-ups take minutes); transient ringing is not modelled.
+    noise : relative sensor noise, std = noise · C_1 · Ω_max², Ω_max the sweep's largest |Ω|.
+    tach : store Ω(t) (rad/s) in ``Sweep.tach``; else None.
+    Lines are built one harmonic at a time (memory ~ a few arrays of the record length).
+    """
+    if not duration > 0:
+        raise ValueError(f"duration must be > 0 s, got {duration!r}")
+    if not sample_rate > 0:
+        raise ValueError(f"sample_rate must be > 0 Hz, got {sample_rate!r}")
+    n = int(round(duration * sample_rate))
+    if n < 2:
+        raise ValueError(f"duration × sample_rate gives {n} samples; need at least 2")
+    dt = 1.0 / sample_rate
+    t = np.arange(n) * dt
+    omega = speed_profile(t, rpm_start, rpm_end, duration, profile)
+    psi = _cumtrapz(omega, dt)                          # signed rotation angle, rad
+    w_abs = np.abs(omega)
+    negative = omega < 0
+    omega_max = float(w_abs.max())
+    noise_std = _noise_std(wheel, omega_max, noise)
+    ch_modes = _channel_modes(wheel, modes, test_stand)
+    active = wheel.all_modes(modes, test_stand)
+    phase_rng, noise_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
+    nyquist = 0.5 * sample_rate
+    signals = {ch: np.zeros(n) for ch in CHANNELS}
+    dropped = []
+    lines = []                                          # (channels, h, C, alpha) per harmonic
+    for d, chans in DIRECTION_CHANNELS.items():
+        h_arr, C_arr = wheel.h_and_C(d)
+        if h_arr.size == 0:
+            continue
+        alpha = phase_rng.uniform(0.0, 2.0 * np.pi, size=h_arr.size)
+        for h, C, a in zip(h_arr, C_arr, alpha):
+            f_top = h * omega_max / (2.0 * np.pi)
+            if f_top >= nyquist:
+                dropped.append({"direction": d, "h": float(h),
+                                "above_rpm": float(rad_s_to_rpm(2.0 * np.pi * nyquist / h))})
+            lines.append((chans, float(h), float(C), float(a)))
+    # Blocks of samples bound the temporaries (a 390 s record at 3840 Hz is 1.5 M samples);
+    # within a block, one harmonic at a time.
+    for start in range(0, n, _SWEEP_BLOCK):
+        sl = slice(start, min(start + _SWEEP_BLOCK, n))
+        w_b, psi_b, neg_b = omega[sl], psi[sl], negative[sl]
+        wa_b = w_abs[sl]
+        amp_scale = w_b * w_b
+        fm_b = {id(m): m.frequency_hz(wa_b) for m in active}
+        for chans, h, C, a in lines:
+            f_line = (h / (2.0 * np.pi)) * wa_b
+            recorded = f_line < nyquist
+            if not recorded.any():
+                continue
+            z0 = (C * amp_scale) * np.exp(1j * (h * psi_b + a))
+            if not recorded.all():
+                z0[~recorded] = 0.0
+            for i, ch in enumerate(chans):
+                z = z0
+                if ch_modes[ch]:
+                    g = np.ones(len(w_b), dtype=complex)
+                    for m in ch_modes[ch]:
+                        g *= m.response(f_line / fm_b[id(m)])
+                    np.conjugate(g, out=g, where=neg_b)
+                    z = z0 * g
+                signals[ch][sl] += z.imag if i == 1 else z.real
+    for ch in CHANNELS:
+        if noise_std[ch] > 0:
+            signals[ch] += noise_rng.normal(0.0, noise_std[ch], n)
+    extra = {"kind": "sweep", "profile": profile if isinstance(profile, str) else "custom",
+             "rpm_start": float(rpm_start), "rpm_end": float(rpm_end), "duration_s": float(duration),
+             "modal_gain": "quasi-steady (gain at the instantaneous line frequency and speed)"}
+    if profile == "exp":
+        extra["tau_s"] = duration / 5.0
+    meta = _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, dropped, extra)
+    return Sweep(time=t, signals=signals, sample_rate=float(sample_rate), tach=omega if tach else None, meta=meta)
+
+
+def __getattr__(name):
+    # Convenience: rwadist.teststand.PRESETS / preset (defined in rwadist.presets, which imports this module).
+    if name in ("PRESETS", "preset"):
+        from . import presets
+        return getattr(presets, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
