@@ -72,7 +72,7 @@ class FitSettings:
     exclude_modes: bool = True
     amp_min: float = 0.03
     n_sigma: float = 4.0
-    scatter_floor: float = 0.01
+    scatter_floor: float = 0.005
 
 
 @dataclass
