@@ -1,0 +1,553 @@
+"""Speed sweeps (spin-up, run-down) cut into quasi-steady slices (thesis §2.2.2).
+
+The E-wheel test of the thesis was one 390 s record at 3840 Hz through a
+spin-up; it was cut into 8192-sample slices (2.133 s), each treated as a steady
+run at the slice's mean speed.  The thesis took the frequency of the largest
+peak of each slice as the wheel speed.  That fails whenever a structural mode
+lifts another line above the 1× line, so the speed is found here by a harmonic
+comb with a continuity constraint, then refined on the detected lines:
+
+1. **Spectra.**  Each slice (a 2-D array of slices, one FFT call) gets a
+   Hann periodogram zero-padded ``PAD`` times.  Each radial channel's PSD is
+   divided by one number, its median noise floor in that slice
+   (:func:`rwadist.spectra.noise_floor`), and the channels are averaged (P),
+   so no channel dominates by its unit; the same average of the local floors
+   is F, and ``R = P / F`` is a signal-to-noise ratio, 1 in pure noise.
+2. **Comb.**  A candidate fundamental ``f0`` scores
+   ``sum_k clip(ln R(k·f0), 0, ln COMB_CAP)`` over ``harmonics``.  The cap
+   keeps one very strong line (a mode) from outscoring a comb of several
+   moderate lines: a fixed-frequency modal peak scores at k = 1 only, a true
+   speed at several k.  Candidates lie on a uniform grid fine enough that every
+   comb tooth moves by at most half a bin between neighbours.
+3. **Continuity.**  The scores are max-pooled onto cells uniform in ln f0
+   (width ``LOG_CELL``) and a Viterbi path is run over the slices with a cost
+   ``JUMP_COST`` per e-fold of speed change between slices, plus a "no line"
+   state whose score is the largest comb that white noise reaches on the same
+   grid (calibrated on generated noise, fixed seed).  Slices on that state
+   (the wheel near rest) get ``speed = nan``.  The best candidate inside the
+   chosen cell (±1 cell) is then taken.
+4. **Refinement.**  The lines near k·f0 are found and their frequencies
+   refined with :func:`rwadist.spectra.find_lines` on P (log-parabolic
+   interpolation on the zero-padded spectrum; P has no frequency-dependent
+   normalisation, so the peak is not shifted).  The lines vote for f0 (f_k/k);
+   the largest agreeing set is kept (a line pulled by a mode it is crossing is
+   outvoted) and f0 is their weighted least-squares fit of f_k = k·f0, weights
+   1/σ_k², σ_k ≈ 0.4·df/sqrt(n_channels·SNR_k).  Then each slice is fused with
+   the leave-one-out quadratic prediction of its neighbours (inverse-variance
+   mean, model error estimated from the data, outliers excluded), so slices
+   whose lines are near the noise borrow from the smooth speed track while
+   precise slices keep their own value.
+5. **Sign.**  A spectrum sees only |Ω|.  For positive spin a rotating radial
+   vector is Fx = A cos φ, Fy = A sin φ (counter-clockwise about +z), so Fy
+   lags Fx by 90° and the cross-spectrum conj(X)·Y at the 1× line has phase
+   -90°.  The sign of the speed is minus the sign of Im(conj(X)·Y), from the
+   (Fx, Fy) pair, else (Tx, Ty); without either pair the speed is |Ω|.
+
+Units: SI inside (rad/s for wheel speed, Hz for frequencies); rpm only in the
+``rpm_range`` / ``min_speed_rpm`` arguments and in ``meta``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import fft as sfft
+from scipy import signal
+
+from .data import TACH_COLUMN, DataError, Run, SteadyTest, Sweep
+from .spectra import find_lines, noise_floor
+from .units import rad_s_to_rpm, rpm_to_rad_s
+
+#: Zero-padding factor of the slice periodograms (sub-bin sampling of the comb and the peaks).
+PAD = 4
+#: Upper clip of one comb tooth's SNR ratio (a single line cannot score more than ln of this).
+COMB_CAP = 1.0e3
+#: Width of the continuity cells, in e-folds of f0 (1 %).
+LOG_CELL = 0.01
+#: Viterbi cost of a speed change between consecutive slices, comb-score units per e-fold.
+JUMP_COST = 4.0
+#: Viterbi cost of entering or leaving the "no line" state.
+SILENT_COST = 2.0
+#: Slices of white noise used to calibrate the "no line" level of the comb (fixed seed: deterministic).
+NOISE_CAL_SLICES = 48
+NOISE_CAL_SEED = 20240611
+#: Weight cap (SNR ratio) of one line in the least-squares refinement.
+WEIGHT_CAP = 1.0e4
+#: Relative tolerance within which two harmonic lines count as agreeing on f0 (0.05 %).
+AGREE_REL = 5.0e-4
+#: Neighbours (slices either side) of the continuity fusion of the speed track.
+FUSE_HALF_WIDTH = 4
+#: Default drop level: fraction of the largest |speed| found.
+MIN_SPEED_FRACTION = 0.05
+RADIAL = ("Fx", "Fy", "Tx", "Ty")
+ROTATING_PAIRS = (("Fx", "Fy"), ("Tx", "Ty"))
+
+
+@dataclass
+class SliceInfo:
+    """One quasi-steady slice of a sweep.
+
+    start, stop : sample indices into the sweep (stop exclusive).
+    speed : wheel speed assigned to the slice, rad/s (signed when the tach or
+        the x/y phase tells the sense; nan when no line was found in the data).
+    speed_source : "tach" or "data".
+    speed_spread : rad/s.  Tach: max - min of the tach over the slice.  Data:
+        hypot(2·σ, ΔΩ), σ the standard error of the estimate and ΔΩ the change
+        of the estimated speed track across the slice length.
+    confidence : 0..1.  Tach: 1.  Data: comb-score margin of the chosen speed
+        over the best candidate more than 5 % away, relative to its score.
+    speed_stderr : rad/s, standard error of the slice's mean speed (0 for the tach;
+        for data, from the scatter of the harmonic lines and the track fusion).
+    """
+
+    start: int
+    stop: int
+    speed: float
+    speed_source: str
+    speed_spread: float
+    confidence: float
+    speed_stderr: float = 0.0
+
+
+# --------------------------------------------------------------------------- slicing
+
+def _sweep_name(sweep: Sweep) -> str:
+    return str(sweep.meta.get("file", sweep.meta.get("source", "<sweep>"))) if sweep.meta else "<sweep>"
+
+
+def _n_samples(sweep: Sweep) -> int:
+    if not sweep.signals:
+        raise DataError(_sweep_name(sweep), "signals", "the sweep has no channels")
+    return len(next(iter(sweep.signals.values())))
+
+
+def _slice_starts(sweep: Sweep, slice_samples: int, hop: int | None) -> tuple:
+    """Start indices of the slices, and the hop (samples)."""
+    slice_samples = int(slice_samples)
+    if slice_samples < 16:
+        raise ValueError(f"slice_samples must be >= 16, got {slice_samples!r}")
+    hop = slice_samples if hop is None else int(hop)
+    if hop < 1:
+        raise ValueError(f"hop must be >= 1 sample, got {hop!r}")
+    n = _n_samples(sweep)
+    if n < slice_samples:
+        raise DataError(_sweep_name(sweep), "samples",
+                        f"{n} samples, shorter than one slice (slice_samples={slice_samples}); "
+                        "pass a smaller slice_samples")
+    return np.arange(0, n - slice_samples + 1, hop), hop
+
+
+def _slices(x: np.ndarray, starts: np.ndarray, slice_samples: int) -> np.ndarray:
+    """(n_slices, slice_samples) view of x."""
+    view = np.lib.stride_tricks.sliding_window_view(np.asarray(x, dtype=float), slice_samples)
+    return view[starts]
+
+
+# --------------------------------------------------------------------------- speed from data
+
+def _estimation_channels(sweep: Sweep, channels) -> tuple:
+    if channels is not None:
+        chans = tuple(channels)
+        missing = [c for c in chans if c not in sweep.signals]
+        if missing:
+            raise DataError(_sweep_name(sweep), missing[0], f"channel not in the sweep (has {sweep.channels})")
+        return chans
+    chans = tuple(c for c in RADIAL if c in sweep.signals)
+    return chans if chans else sweep.channels
+
+
+def _snr_spectra(sweep: Sweep, starts, slice_samples: int, channels) -> tuple:
+    """Zero-padded slice periodograms of ``channels``, combined without letting units dominate.
+
+    Returns (f_pad Hz, P, F, df native Hz), P and F of shape (n_slices, n_f_pad):
+    P = mean over channels of PSD_ch / m_ch, m_ch the slice's median noise floor of the channel
+    (one number per channel and slice, so line shapes and peak positions are untouched), and
+    F = the same combination of the local noise floors (:func:`rwadist.spectra.noise_floor`,
+    linearly interpolated onto the padded grid).  P / F is a signal-to-noise ratio, 1 in noise.
+    """
+    fs = float(sweep.sample_rate)
+    nfft = PAD * slice_samples
+    win = signal.get_window("hann", slice_samples)
+    scale = 2.0 / (fs * np.sum(win**2))
+    f_pad = np.fft.rfftfreq(nfft, 1.0 / fs)
+    f_nat = f_pad[::PAD]
+    pos = np.arange(len(f_pad)) / PAD
+    j0 = np.minimum(np.floor(pos).astype(int), len(f_nat) - 2)
+    w = pos - j0
+    P = np.zeros((len(starts), len(f_pad)))
+    F = np.zeros_like(P)
+    tiny = np.finfo(float).tiny
+    for ch in channels:
+        block = _slices(sweep.signals[ch], starts, slice_samples)
+        block = (block - block.mean(axis=1, keepdims=True)) * win
+        p = np.abs(sfft.rfft(block, n=nfft, axis=1)) ** 2 * scale
+        floor = noise_floor(p[:, ::PAD], f_nat, dof=2.0)
+        m = np.maximum(np.median(floor, axis=1, keepdims=True), tiny)
+        P += p / m
+        F += (floor[:, j0] * (1.0 - w) + floor[:, j0 + 1] * w) / m
+    n = max(len(channels), 1)
+    return f_pad, P / n, np.maximum(F / n, tiny), fs / slice_samples
+
+
+def _interp_rows(R: np.ndarray, f_pad: np.ndarray, f_query: np.ndarray) -> np.ndarray:
+    """Linear interpolation of every row of R at f_query (Hz); 0 beyond the spectrum."""
+    dfp = f_pad[1] - f_pad[0]
+    pos = f_query / dfp
+    i0 = np.floor(pos).astype(int)
+    w = pos - i0
+    inside = (i0 >= 0) & (i0 + 1 < R.shape[1])
+    i0c = np.clip(i0, 0, R.shape[1] - 2)
+    vals = R[:, i0c] * (1.0 - w) + R[:, i0c + 1] * w
+    return np.where(inside, vals, 0.0)
+
+
+def _comb_scores(R, f_pad, f_grid, harmonics) -> np.ndarray:
+    """Harmonic-comb score of every candidate f0 (n_slices, n_grid)."""
+    cap = np.log(COMB_CAP)
+    C = np.zeros((R.shape[0], len(f_grid)))
+    for h in harmonics:
+        v = _interp_rows(R, f_pad, h * f_grid)
+        C += np.clip(np.log(np.maximum(v, 1e-300)), 0.0, cap)
+    return C
+
+
+def _noise_comb_level(n_channels: int, slice_samples: int, fs: float, f_grid, harmonics) -> float:
+    """Largest comb score that white noise reaches in ``NOISE_CAL_SLICES`` slices on the same grid
+    (about its 98th percentile per slice): the "no line" level of the Viterbi path."""
+    rng = np.random.default_rng(NOISE_CAL_SEED)
+    n = NOISE_CAL_SLICES * slice_samples
+    names = tuple(f"noise{i}" for i in range(max(n_channels, 1)))
+    fake = Sweep(time=np.arange(n) / fs, signals={c: rng.standard_normal(n) for c in names}, sample_rate=fs)
+    starts = np.arange(NOISE_CAL_SLICES) * slice_samples
+    f_pad, P, F, _ = _snr_spectra(fake, starts, slice_samples, names)
+    return float(_comb_scores(P / F, f_pad, f_grid, harmonics).max())
+
+
+def _running_argmax(a: np.ndarray) -> tuple:
+    """Running max of a 1-D array and the index where it was attained (last on ties)."""
+    cm = np.maximum.accumulate(a)
+    idx = np.maximum.accumulate(np.where(a == cm, np.arange(len(a)), 0))
+    return cm, idx
+
+
+def _viterbi(E: np.ndarray, silent: np.ndarray, step_cost: float, silent_cost: float) -> np.ndarray:
+    """Best path over (n_slices, n_cells) emission scores with cost ``step_cost`` per cell of jump,
+    plus a "silent" state of emission ``silent`` per slice.  Returns cell per slice, -1 for silent.
+
+    max_j D[j] - c|i - j| is computed for all i in O(n) with running maxima from both sides.
+    """
+    n_s, n_c = E.shape
+    j = np.arange(n_c)
+    back = np.empty((n_s, n_c), dtype=np.int64)      # previous cell (or -1 for silent)
+    back_sil = np.empty(n_s, dtype=np.int64)          # previous state of the silent state
+    D = E[0].copy()
+    Ds = float(silent[0])
+    back[0] = -2
+    back_sil[0] = -2
+    for s in range(1, n_s):
+        lv, li = _running_argmax(D + step_cost * j)          # j <= i: D[j] - c(i - j)
+        left = lv - step_cost * j
+        rv, ri = _running_argmax((D - step_cost * j)[::-1])  # j >= i
+        right = rv[::-1] + step_cost * j
+        ri = (n_c - 1 - ri)[::-1]
+        best = np.where(left >= right, left, right)
+        arg = np.where(left >= right, li, ri)
+        from_sil = Ds - silent_cost
+        take_sil = from_sil > best
+        back[s] = np.where(take_sil, -1, arg)
+        best = np.where(take_sil, from_sil, best)
+        k = int(np.argmax(D))
+        if D[k] - silent_cost > Ds:
+            Ds_new, back_sil[s] = D[k] - silent_cost, k
+        else:
+            Ds_new, back_sil[s] = Ds, -1
+        D = best + E[s]
+        Ds = Ds_new + float(silent[s])
+    path = np.empty(n_s, dtype=np.int64)
+    k = int(np.argmax(D))
+    state = -1 if Ds >= D[k] else k
+    for s in range(n_s - 1, -1, -1):
+        path[s] = state
+        prev = back_sil[s] if state == -1 else back[s, state]
+        state = int(prev)
+    return path
+
+
+def _refine(P_row, F_row, f_pad, f0: float, harmonics, df: float, threshold: float, n_channels: int = 1) -> tuple:
+    """Weighted LS of f_h = h·f0 over the lines found near h·f0 (P_row, F_row from :func:`_snr_spectra`).
+
+    Lines are found and their frequencies refined by :func:`rwadist.spectra.find_lines` on P_row
+    (no frequency-dependent normalisation, so the log-parabolic peak is unbiased) against F_row.
+    Returns (f0 Hz, standard error Hz, number of lines used).
+    """
+    h_arr = np.asarray(harmonics, dtype=float)
+    tol = max(df, 0.01 * f0)
+    lo = max(h_arr.min() * f0 - tol - 2 * df, 0.0)
+    hi = h_arr.max() * f0 + tol + 2 * df
+    f_lines, idx = find_lines(P_row, f_pad, F_row, threshold, f_max=hi, f_min=lo)
+    hs, fk, snr = [], [], []
+    for h in h_arr:
+        if f_lines.size == 0:
+            break
+        d = np.abs(f_lines - h * f0)
+        i = int(np.argmin(d))
+        if d[i] <= tol:
+            hs.append(h)
+            fk.append(f_lines[i])
+            snr.append(P_row[idx[i]] / F_row[idx[i]])
+    if not hs:
+        return f0, df / 4.0, 0
+    hs, fk, snr = np.array(hs), np.array(fk), np.array(snr)
+    # Cramér-Rao-like scatter of a line frequency: about 0.4·df/sqrt(SNR) (Hann, one segment), the
+    # SNR of the channel average being n_channels times that of one channel
+    sig = 0.4 * df / np.sqrt(n_channels * np.minimum(snr, WEIGHT_CAP))
+    # Consensus: each line's f/h is a vote for f0; two lines agree within 3 combined σ plus
+    # AGREE_REL (relative).  The kept set is the one agreeing with the line of largest support
+    # (number of agreeing lines, then their SNR): a line pulled by a mode it crosses, or a noise peak
+    # near a high harmonic (h² leverage), cannot set f0 against the others.
+    r, sr = fk / hs, sig / hs
+    agree = np.abs(r[:, None] - r[None, :]) <= 3.0 * np.hypot(sr[:, None], sr[None, :]) + AGREE_REL * r[:, None]
+    support = agree.sum(axis=1) + (agree * np.minimum(snr, WEIGHT_CAP)[None, :]).sum(axis=1) / (
+        2.0 * len(hs) * WEIGHT_CAP)
+    keep = agree[int(np.argmax(support))]
+    w = keep / sig**2
+    f_est = np.sum(w * hs * fk) / np.sum(w * hs**2)
+    stderr = 1.0 / np.sqrt(np.sum(w * hs**2))
+    n_used = int(keep.sum())
+    if n_used > 1:
+        resid = (fk - hs * f_est)[keep]
+        chi2 = np.sum(w[keep] * resid**2) / (n_used - 1)
+        stderr *= np.sqrt(max(chi2, 1.0))
+    return float(f_est), float(stderr), n_used
+
+
+def _predict_from_neighbours(f0, sigma, usable, half_width: int) -> tuple:
+    """Leave-one-out prediction of every slice from a weighted quadratic (in slice index) through
+    the ``usable`` slices within ``half_width`` either side.  Returns (prediction, its variance), Hz."""
+    n = len(f0)
+    pred = np.full(n, np.nan)
+    pvar = np.full(n, np.nan)
+    use = np.nonzero(usable)[0]
+    for i in np.nonzero(np.isfinite(f0))[0]:
+        j = use[(np.abs(use - i) <= half_width) & (use != i)]
+        if len(j) < 4 or not (j.min() < i < j.max()) and len(j) < 6:
+            continue
+        x = (j - i).astype(float)
+        A = np.stack([np.ones_like(x), x, x * x], axis=1)
+        w = 1.0 / sigma[j] ** 2
+        cov = np.linalg.inv(A.T @ (A * w[:, None]))
+        pred[i], pvar[i] = (cov @ (A.T @ (w * f0[j])))[0], cov[0, 0]
+    return pred, pvar
+
+
+def _fuse_track(f0: np.ndarray, sigma: np.ndarray, half_width: int = FUSE_HALF_WIDTH) -> tuple:
+    """Combine each slice's estimate with the prediction of its neighbours (continuity).
+
+    For every slice with an estimate, a quadratic in slice index is fitted by weighted least squares
+    (weights 1/σ²) to the estimates of the detected neighbours within ``half_width`` slices, the
+    slice itself left out (an extrapolation needs 6 neighbours); its value at the slice is the
+    prediction p (variance v).  Slices more than 4 combined σ from their prediction are not used
+    as neighbours in a second pass (a mis-picked line must not bend the track of the others).  The
+    model error m of the prediction is estimated from the data (robust method of moments on the
+    residuals, relative to f0), and each slice's value becomes the inverse-variance mean of its
+    own estimate (σ²) and p (v + m²f0²); an outlier keeps its own value.  Precise slices keep
+    their value; noisy ones (the wheel slow, its lines near the noise) borrow from the track.
+    Returns (f0, σ) fused, Hz.
+    """
+    good = np.isfinite(f0) & np.isfinite(sigma) & (sigma > 0)
+    pred, pvar = _predict_from_neighbours(f0, sigma, good, half_width)
+    have = np.isfinite(pred)
+    outlier = np.zeros(len(f0), dtype=bool)
+    outlier[have] = np.abs(f0[have] - pred[have]) > 4.0 * np.sqrt(sigma[have] ** 2 + pvar[have])
+    if outlier.any():
+        pred, pvar = _predict_from_neighbours(f0, sigma, good & ~outlier, half_width)
+        have = np.isfinite(pred)
+    if have.sum() < 3:
+        return f0, sigma
+    r = f0[have] - pred[have]
+    excess = (r**2 - sigma[have] ** 2 - pvar[have]) / f0[have] ** 2
+    m_rel2 = max(float(np.median(excess[~outlier[have]])) if (~outlier[have]).any() else 0.0, 0.0)
+    vp = pvar[have] + m_rel2 * f0[have] ** 2
+    ok = np.abs(r) <= 4.0 * np.sqrt(sigma[have] ** 2 + vp)
+    w_own, w_pred = 1.0 / sigma[have] ** 2, np.where(ok, 1.0 / vp, 0.0)
+    out_f, out_s = f0.copy(), sigma.copy()
+    out_f[have] = (w_own * f0[have] + w_pred * pred[have]) / (w_own + w_pred)
+    out_s[have] = 1.0 / np.sqrt(w_own + w_pred)
+    return out_f, out_s
+
+
+def _rotation_sign(sweep: Sweep, starts, slice_samples: int, f1: np.ndarray) -> np.ndarray:
+    """+1 / -1 per slice from the phase of Y against X at the 1× line (f1 Hz); +1 if no x/y pair."""
+    pair = next(((x, y) for x, y in ROTATING_PAIRS if x in sweep.signals and y in sweep.signals), None)
+    sign = np.ones(len(starts))
+    ok = np.isfinite(f1) & (f1 > 0)
+    if pair is None or not ok.any():
+        return sign
+    fs = float(sweep.sample_rate)
+    win = signal.get_window("hann", slice_samples)
+    n = np.arange(slice_samples)
+    st = starts[ok]
+    phasor = np.exp(-2j * np.pi * np.outer(f1[ok] / fs, n)) * win        # (n_ok, N)
+    X, Y = (np.sum(_slices(sweep.signals[c], st, slice_samples) * phasor, axis=1) for c in pair)
+    im = np.imag(np.conj(X) * Y)
+    sign[ok] = np.where(im > 0, -1.0, 1.0)
+    return sign
+
+
+def estimate_speeds(sweep: Sweep, slice_samples: int = 8192, hop: int | None = None, channels=None,
+                    rpm_range=None, harmonics=(1, 2, 3, 4)) -> list:
+    """Wheel speed of every slice of ``sweep`` from the data alone (the tach is ignored).
+
+    slice_samples : samples per slice; hop : samples between slice starts (default slice_samples).
+    channels : channels used (default the radial ones present, Fx Fy Tx Ty; else all).
+    rpm_range : (lo, hi) |speed| search range, rpm (default from 2 frequency bins to
+        Nyquist / max(harmonics)).
+    harmonics : harmonic numbers of the comb (any positive numbers; 1 should be among them).
+    Returns one :class:`SliceInfo` per slice in time order; speed rad/s (signed by the x/y phase),
+    nan where the slice shows no line above its noise (confidence 0).
+    """
+    starts, hop = _slice_starts(sweep, slice_samples, hop)
+    h_arr = np.asarray(sorted(set(float(h) for h in harmonics)), dtype=float)
+    if h_arr.size == 0 or np.any(h_arr <= 0):
+        raise ValueError(f"harmonics must be positive numbers, got {harmonics!r}")
+    chans = _estimation_channels(sweep, channels)
+    fs = float(sweep.sample_rate)
+    f_pad, P, F, df = _snr_spectra(sweep, starts, slice_samples, chans)
+    nyq = fs / 2.0
+    f_lo, f_hi = 2.0 * df, 0.98 * nyq / h_arr.max()
+    if rpm_range is not None:
+        lo, hi = sorted(abs(float(v)) for v in rpm_range)
+        f_lo = max(f_lo, lo / 60.0)
+        f_hi = min(0.98 * nyq / h_arr.min(), hi / 60.0)
+    if not f_hi > f_lo:
+        raise ValueError(f"empty speed search range: {f_lo:g}..{f_hi:g} Hz "
+                         f"(slice resolution {df:g} Hz, Nyquist {nyq:g} Hz)")
+    # uniform candidate grid: every tooth moves <= df/2 between neighbours
+    step = df / (2.0 * h_arr.max())
+    f_grid = np.arange(f_lo, f_hi + step, step)
+    C = _comb_scores(P / F, f_pad, f_grid, h_arr)
+    # cells uniform in ln f0 for the continuity path
+    n_cells = max(int(np.ceil(np.log(f_grid[-1] / f_grid[0]) / LOG_CELL)), 1)
+    edges = f_grid[0] * np.exp(LOG_CELL * np.arange(n_cells + 1))
+    cell_lo = np.minimum(np.searchsorted(f_grid, edges[:-1], side="left"), len(f_grid) - 1)
+    cell_hi = np.maximum(np.minimum(np.searchsorted(f_grid, edges[1:], side="left"), len(f_grid)), cell_lo + 1)
+    E = np.maximum.reduceat(C, cell_lo, axis=1)
+    silent = np.full(len(starts), _noise_comb_level(len(chans), slice_samples, fs, f_grid, h_arr))
+    path = _viterbi(E, silent, JUMP_COST * LOG_CELL, SILENT_COST)
+
+    n_s = len(starts)
+    f0 = np.full(n_s, np.nan)
+    sigma = np.full(n_s, np.nan)
+    conf = np.zeros(n_s)
+    threshold = 1.0 + 4.0 / np.sqrt(len(chans))    # ~ 4 sigma of a noise-normalised averaged PSD bin
+    for s in np.nonzero(path >= 0)[0]:
+        c = path[s]
+        a, b = cell_lo[max(c - 1, 0)], cell_hi[min(c + 1, n_cells - 1)]
+        g = a + int(np.argmax(C[s, a:b]))
+        far = np.abs(np.log(f_grid / f_grid[g])) > 0.05
+        best, alt = C[s, g], (C[s, far].max() if far.any() else 0.0)
+        conf[s] = float(np.clip((best - alt) / best, 0.0, 1.0)) if best > 0 else 0.0
+        f0[s], sigma[s], _ = _refine(P[s], F[s], f_pad, f_grid[g], h_arr, df, threshold, len(chans))
+    f0, sigma = _fuse_track(f0, sigma)
+    sign = _rotation_sign(sweep, starts, slice_samples, f0)
+    omega = sign * 2.0 * np.pi * f0
+    # change of the speed track across one slice (finite differences over detected neighbours)
+    grad = np.full(n_s, np.nan)
+    good = np.isfinite(f0)
+    if good.sum() >= 2:
+        idx = np.nonzero(good)[0]
+        grad[idx] = np.abs(np.gradient(2.0 * np.pi * f0[idx], idx))
+    drift = np.nan_to_num(grad) * (slice_samples / hop)
+    spread = np.hypot(2.0 * 2.0 * np.pi * sigma, drift)
+    return [SliceInfo(start=int(st), stop=int(st + slice_samples), speed=float(omega[i]), speed_source="data",
+                      speed_spread=float(spread[i]), confidence=float(conf[i]),
+                      speed_stderr=float(2.0 * np.pi * sigma[i]))
+            for i, st in enumerate(starts)]
+
+
+# --------------------------------------------------------------------------- slicing into a steady test
+
+def _tach_infos(sweep: Sweep, starts, slice_samples: int) -> list:
+    if sweep.tach is None:
+        raise DataError(_sweep_name(sweep), TACH_COLUMN,
+                        "speed_source='tach' but the sweep has no tach column; use 'data' or 'auto'")
+    tach = np.asarray(sweep.tach, dtype=float)
+    if len(tach) != _n_samples(sweep):
+        raise DataError(_sweep_name(sweep), TACH_COLUMN,
+                        f"{len(tach)} tach samples for {_n_samples(sweep)} data samples")
+    block = _slices(tach, starts, slice_samples)
+    mean, spread = block.mean(axis=1), block.max(axis=1) - block.min(axis=1)
+    return [SliceInfo(int(st), int(st + slice_samples), float(mean[i]), "tach", float(spread[i]), 1.0)
+            for i, st in enumerate(starts)]
+
+
+def slice_sweep(sweep: Sweep, slice_samples: int = 8192, hop: int | None = None, speed_source: str = "auto",
+                min_speed_rpm: float | None = None, channels=None, max_speed_error: float = 0.005) -> tuple:
+    """Cut ``sweep`` into quasi-steady slices: a :class:`SteadyTest` plus one :class:`SliceInfo` per run.
+
+    slice_samples, hop : samples per slice and between slice starts (default hop = slice_samples,
+        non-overlapping, as the thesis).
+    speed_source : "auto" (tach if the sweep has one, else data), "tach" (mean of the tach over
+        the slice; DataError naming ``speed_rpm`` without one) or "data" (:func:`estimate_speeds`).
+    min_speed_rpm : slices with |speed| below this (rpm) are dropped; default 5 % of the largest
+        |speed| found.  Slices where the data show no line (speed nan) are dropped too.
+    channels : channels used to estimate the speed from data (default radial); the runs always
+        carry every channel of the sweep.
+    max_speed_error : relative; a slice whose speed comes from data is dropped when three
+        standard errors of its speed exceed this fraction of it (default 0.5 %: at the
+        lowest speeds the lines are too close to the noise to place the speed better).
+    Each kept slice becomes a :class:`Run` named ``slice_NNNN.csv`` (NNNN its index in time order),
+    t0 = time of its first sample, speed rad/s.  Runs are sorted by speed (:meth:`SteadyTest.sorted`)
+    and the returned infos are in the same order.  ``test.meta`` carries the sweep's meta plus
+    ``"slicing"``: slice length, hop, source, counts and the minimum speed used.
+    """
+    if speed_source not in ("auto", "tach", "data"):
+        raise ValueError(f"speed_source must be 'auto', 'tach' or 'data', got {speed_source!r}")
+    starts, hop = _slice_starts(sweep, slice_samples, hop)
+    source = ("tach" if sweep.tach is not None else "data") if speed_source == "auto" else speed_source
+    if source == "tach":
+        infos = _tach_infos(sweep, starts, slice_samples)
+    else:
+        infos = estimate_speeds(sweep, slice_samples, hop, channels=channels)
+    speeds = np.array([i.speed for i in infos])
+    found = np.isfinite(speeds)
+    if min_speed_rpm is None:
+        top = float(np.abs(speeds[found]).max()) if found.any() else 0.0
+        min_speed = MIN_SPEED_FRACTION * top
+    else:
+        min_speed = float(rpm_to_rad_s(abs(float(min_speed_rpm))))
+    fast = found & (np.abs(np.where(found, speeds, 0.0)) >= min_speed)
+    stderr = np.array([i.speed_stderr for i in infos])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        certain = ~(3.0 * stderr > max_speed_error * np.abs(speeds))
+    keep = fast & certain
+    fs = float(sweep.sample_rate)
+    time = np.asarray(sweep.time, dtype=float)
+    runs = []
+    kept = np.nonzero(keep)[0]
+    for i in kept:
+        a, b = infos[i].start, infos[i].stop
+        runs.append(Run(speed=float(speeds[i]), sample_rate=fs,
+                        signals={ch: np.array(sweep.signals[ch][a:b]) for ch in sweep.channels},
+                        t0=float(time[a]), name=f"slice_{i:04d}.csv"))
+    meta = {k: v for k, v in (sweep.meta or {}).items()}
+    meta["slicing"] = {
+        "slice_samples": int(slice_samples),
+        "hop_samples": int(hop),
+        "slice_duration_s": slice_samples / fs,
+        "speed_source": source,
+        "n_slices": int(len(infos)),
+        "n_kept": int(len(kept)),
+        "n_dropped": int(len(infos) - len(kept)),
+        "n_dropped_no_line": int((~found).sum()),
+        "n_dropped_slow": int((found & ~fast).sum()),
+        "n_dropped_uncertain": int((fast & ~certain).sum()),
+        "max_speed_error": float(max_speed_error),
+        "min_speed_rpm": float(rad_s_to_rpm(min_speed)),
+        "min_speed_rule": ("given" if min_speed_rpm is not None
+                           else f"{MIN_SPEED_FRACTION:g} x largest |speed| found"),
+        "dropped_slices": [int(i) for i in np.nonzero(~keep)[0]],
+    }
+    order = np.argsort(speeds[kept], kind="stable")
+    test = SteadyTest([runs[k] for k in order], meta)
+    return test, [infos[kept[k]] for k in order]
