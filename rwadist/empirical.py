@@ -33,7 +33,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import ndimage, signal, stats
+from scipy import signal, stats
 from tqdm.auto import tqdm
 
 from .model import DIRECTIONS, Harmonic, WheelModel
@@ -204,10 +204,13 @@ def detect_lines(psd: np.ndarray, f: np.ndarray, floor: np.ndarray, threshold: f
     mid = psd[:, 1:-1]
     is_peak = (mid > psd[:, :-2]) & (mid >= psd[:, 2:]) & (mid > threshold * floor[:, 1:-1]) & band[None, 1:-1]
     is_peak &= np.isfinite(mid)
-    strongest = ndimage.maximum_filter1d(np.nan_to_num(psd), size=13, axis=1)[:, 1:-1]
-    is_peak &= ~(strongest > 10 ** (sidelobe_db / 10) * mid)
     run, k = np.nonzero(is_peak)
     k = k + 1
+    # side lobes: the strongest value within ±6 bins, gathered at the candidates only
+    window = np.clip(k[:, None] + np.arange(-6, 7), 0, psd.shape[1] - 1)
+    strongest = psd[run[:, None], window].max(axis=1)
+    lobe = strongest > 10 ** (sidelobe_db / 10) * psd[run, k]
+    run, k = run[~lobe], k[~lobe]
     lo, md, hi = (np.log(np.maximum(psd[run, k + o], 1e-300)) for o in (-1, 0, 1))
     denom = lo - 2 * md + hi
     with np.errstate(divide="ignore", invalid="ignore"):
