@@ -152,7 +152,7 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
     ax.set_xlabel("Frequency (Hz)")
     ax.set_ylabel("Wheel speed |Ω| (rpm)")
     name = f" vs model '{model.name}'" if model is not None else ""
-    ax.set_title(f"{channel} PSD waterfall{name} (band 0–{top:g} Hz)")
+    ax.set_title(f"{channel} PSD waterfall{name} (0–{top:.0f} Hz)")
     if handles:
         leg = ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=len(handles),
                         facecolor="0.35", framealpha=1.0, fontsize="small")
@@ -453,11 +453,15 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
     out.mkdir(parents=True, exist_ok=True)
     sp, model = fit.spectra, fit.model
     top = _band_top(sp, f_max)
+    # the waterfall is drawn up to 1.5x the highest model line (where the harmonics are),
+    # RMS values still integrate the whole band
+    line_top = max((x.h * float(np.max(np.abs(sp.speed))) / (2 * np.pi) for x in fit.lines), default=top)
+    view = min(top, 1.5 * line_top) if f_max is None else top
     files = []
     for ch in sp.channels:
         if not sp.available(ch).any():
             continue
-        fig, _ = plot_waterfall(sp, ch, model=model, f_max=top, lines=fit.lines)
+        fig, _ = plot_waterfall(sp, ch, model=model, f_max=view, lines=fit.lines)
         files.append(_save(fig, out / f"waterfall_{ch}.png"))
     directions = [d for d in DIRECTION_CHANNELS
                   if any(ch in sp.psd and sp.available(ch).any() for ch in DIRECTION_CHANNELS[d])]
