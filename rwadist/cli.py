@@ -106,7 +106,8 @@ def cmd_fit(args) -> int:
     report_dir = Path(args.report) if args.report else Path(args.output).with_suffix("").parent / (
         Path(args.output).stem + "_report")
     print(f"writing report to {report_dir} ...", flush=True)
-    files = write_report(fit, report_dir)
+    cum = parse_speeds(args.cumulative_rpm) if args.cumulative_rpm else None
+    files = write_report(fit, report_dir, cumulative_speeds_rpm=cum)
     n = sum(len(v) for v in fit.model.empirical.values())
     print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
     print(f"model:  {args.output}")
@@ -215,6 +216,8 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("data", help="steady-state directory, sweep CSV, or .h5")
     f.add_argument("-o", "--output", required=True, help="model file to write (JSON)")
     f.add_argument("--report", help="report directory (default: <model>_report)")
+    f.add_argument("--cumulative-rpm", help="speeds of the cumulative-RMS plots, e.g. '600,1500,2400' "
+                   "(default: lowest, middle, top)")
     _add_fit_options(f)
     f.set_defaults(func=cmd_fit)
 

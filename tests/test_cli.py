@@ -33,7 +33,7 @@ def test_simulate_fit_show(tmp_path, capsys):
     assert code == 0 and "16 runs" in out
     assert len(read_steady(data).runs) == 16
     model = tmp_path / "m.json"
-    code, out, _ = run(capsys, "fit", data, "-o", model)
+    code, out, _ = run(capsys, "fit", data, "-o", model, "--cumulative-rpm", "700,1500")
     assert code == 0 and model.exists() and (tmp_path / "m_report" / "summary.md").exists()
     code, out, _ = run(capsys, "model", "show", model, "--format", "csv")
     rows = list(csv.DictReader(io.StringIO(out)))
