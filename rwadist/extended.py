@@ -290,14 +290,16 @@ def imbalance_lines(p: ExtendedParams, phase_s: float = 0.0, phase_d: float = 0.
 def lines_from_model(model, p: ExtendedParams, senses: dict | None = None) -> list:
     """Lines of a :class:`~rwadist.model.WheelModel`: the imbalances from ``p`` replace the h = 1
     radial force/torque harmonics (thesis Eqs. 4.48–4.49); every other empirical harmonic
-    becomes a line with sense ``senses.get((direction, h), 'co')``."""
+    becomes a line with sense ``senses.get((direction, h))``, else the harmonic's own ``sense``
+    from the model file, else 'co'."""
     senses = senses or {}
     out = imbalance_lines(p)
     for d in DIRECTIONS:
         for hm in model.harmonics(d):
             if d in ("radial_force", "radial_torque") and abs(hm.h - 1.0) < 1e-9:
                 continue
-            out.append(Line(d, float(hm.h), float(hm.C), senses.get((d, float(hm.h)), "co")))
+            sense = senses.get((d, float(hm.h))) or getattr(hm, "sense", None) or "co"
+            out.append(Line(d, float(hm.h), float(hm.C), sense))
     return out
 
 

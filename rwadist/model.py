@@ -51,6 +51,7 @@ class Harmonic:
     n_points: int = 0
     presence: float | None = None
     excluded_rpm: list = field(default_factory=list)
+    sense: str | None = None
 
     def to_json(self) -> dict:
         d = asdict(self)
@@ -146,7 +147,10 @@ def from_json(doc: dict, source: str = "<model>") -> WheelModel:
                     raise DataError(source, f"{where}.{key}", f"must be a finite number, got {v!r}")
             if item["h"] <= 0 or item["C"] < 0:
                 raise DataError(source, where, f"needs h > 0 and C >= 0, got h={item['h']!r}, C={item['C']!r}")
-            known = {k: item[k] for k in ("h", "C", "C_stderr", "n_points", "presence", "excluded_rpm") if k in item}
+            if item.get("sense") not in (None, "co", "counter", "planar"):
+                raise DataError(source, f"{where}.sense", f"{item['sense']!r}; expected co, counter or planar")
+            known = {k: item[k] for k in ("h", "C", "C_stderr", "n_points", "presence", "excluded_rpm", "sense")
+                     if k in item}
             hs.append(Harmonic(**known))
         empirical[d] = hs
     for d in DIRECTIONS:
