@@ -50,6 +50,8 @@ def cmd_simulate(args) -> int:
         print(f"wrote sweep {path} ({len(sweep.time)} samples, {sweep.sample_rate:g} Hz)")
         return 0
     default_speeds = getattr(wheel, "default_speeds_rpm", None)
+    if args.n_speeds and not args.speeds_rpm:
+        raise DataError("--n-speeds", "value", "needs --speeds-rpm START:STOP")
     if args.speeds_rpm:
         speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
     elif default_speeds is not None:
@@ -79,6 +81,10 @@ def load_steady(path, args):
         test, _ = slice_sweep(obj, slice_samples=args.slice_samples, speed_source=args.speed_source)
         print(f"sliced sweep into {len(test.runs)} quasi-steady runs (speed from {args.speed_source})")
         return test
+    if obj.meta.get("unlisted_files"):
+        names = obj.meta["unlisted_files"]
+        print(f"note: {len(names)} file(s) in {path} not listed in runs.csv, not read: {', '.join(names[:5])}"
+              + (" ..." if len(names) > 5 else ""))
     return obj
 
 

@@ -186,7 +186,7 @@ def _check_finite(path: Path, header, data):
         rows, cols = np.nonzero(bad)
         col = header[cols[0]]
         raise DataError(path, col, f"{bad.sum()} non-finite sample(s) (NaN/inf); first at data row {rows[0] + 1}"
-                        f" (line {rows[0] + 2}), value {data[rows[0], cols[0]]!r}")
+                        f" (line {rows[0] + 2}), value {data[rows[0], cols[0]]:g}")
 
 
 def _sample_rate(path: Path, time: np.ndarray, declared: float | None) -> float:
@@ -195,12 +195,12 @@ def _sample_rate(path: Path, time: np.ndarray, declared: float | None) -> float:
     dt = np.diff(time)
     step = float(np.median(dt))
     if not step > 0:
-        raise DataError(path, TIME_COLUMN, f"time does not increase (median step {step!r} s)")
+        raise DataError(path, TIME_COLUMN, f"time does not increase (median step {step:.9g} s)")
     dev = np.abs(dt - step)
     if dev.max() > UNIFORM_TIME_RTOL * step + 1e-12 * abs(time).max():
         i = int(np.argmax(dev))
-        raise DataError(path, TIME_COLUMN, f"sampling is not uniform: step {dt[i]!r} s at line {i + 3}, "
-                        f"median step {step!r} s")
+        raise DataError(path, TIME_COLUMN, f"sampling is not uniform: step {dt[i]:.9g} s at line {i + 3}, "
+                        f"median step {step:.9g} s")
     fs = 1.0 / step
     if declared is not None:
         if abs(fs - declared) > 1e-6 * declared:
@@ -291,6 +291,11 @@ def read_steady(directory, progress: bool = False) -> SteadyTest:
         if not run_path.exists():
             raise DataError(runs_path, f"file (line {lineno})", f"{fname!r} does not exist in {directory}")
         runs.append(read_run(run_path, float(rpm_to_rad_s(rpm)), meta.get("sample_rate_hz")))
+    listed = set(files_seen) | {RUNS_FILE, META_FILE}
+    unlisted = sorted(p.name for p in directory.iterdir() if p.is_file() and p.name not in listed)
+    if unlisted:
+        # kept in meta so nothing goes unnoticed; the CLI prints it
+        meta = dict(meta, unlisted_files=unlisted)
     return SteadyTest(runs, meta).sorted()
 
 

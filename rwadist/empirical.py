@@ -30,12 +30,13 @@ thesis toolbox did with a manual decision at every step:
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import signal, stats
 from tqdm.auto import tqdm
 
+from .data import DataError
 from .model import DIRECTIONS, Harmonic, WheelModel
 from .spectra import Spectra, detection_threshold, welch_dof
 from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
@@ -282,9 +283,12 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
     h_hi = min(s.h_range[1], f_hi / lines.pair_speed_hz.min())
     step = s.epsilon / 4
     h_grid = np.arange(s.h_range[0], h_hi + step, step)
-    n_bin, _ = presence_curve(h_grid, lines, f_lo, f_hi)
+    # candidates from the strict tolerance ε only: the half-bin widening at low speed would
+    # smear two close harmonics into one peak; presence below uses the widened tolerance
+    strict = replace(lines, pair_tol=np.full_like(lines.pair_tol, s.epsilon))
+    n_bin, _ = presence_curve(h_grid, strict, f_lo, f_hi)
     cand, _ = signal.find_peaks(np.concatenate([[0], n_bin, [0]]), height=s.min_detections,
-                                distance=max(int(2 * s.epsilon / step), 1))
+                                distance=max(int(s.epsilon / step), 1))
     h = h_grid[cand - 1]
     for _ in range(2):
         fpk = lines.match(h)
@@ -424,6 +428,15 @@ def fit_direction(spectra: Spectra, direction: str, s: FitSettings, floors: dict
     sep = np.abs(predicted[None, :, :] - np.where(np.isfinite(fpk), fpk, predicted)[:, None, :])
     sep[np.arange(h.size), np.arange(h.size), :] = np.inf
     valid &= sep.min(axis=1) >= (2 * s.line_half_width + 1) * df
+    # ... nor any other detected line (a harmonic too weak or too rare to be kept) under its window
+    if lines.line_pair.size:
+        keys = lines.line_pair + lines.line_star / lines.scale
+        half = (s.line_half_width + 0.5) * df / lines.pair_speed_hz[None, :]
+        star = np.where(np.isfinite(fpk), fpk, 0.0) / lines.pair_speed_hz[None, :]
+        pair = np.arange(lines.pair_run.size)[None, :]
+        n_near = (np.searchsorted(keys, pair + (star + half) / lines.scale, "right")
+                  - np.searchsorted(keys, pair + (star - half) / lines.scale, "left"))
+        valid &= n_near <= 1
     hi_, pi_ = np.nonzero(valid)
     # line power in every valid (harmonic, pair), one gather per channel
     d = np.zeros(hi_.size)
@@ -445,6 +458,8 @@ def fit_direction(spectra: Spectra, direction: str, s: FitSettings, floors: dict
     for k, b in enumerate(kept):
         m = (hi_ == k) & (d > 0)
         if not m.any():
+            b.kept = False
+            b.reason = "no measurement resolved from the other lines"
             continue
         w, dk, run, ch, sg = w_all[m], d[m], lines.pair_run[pi_[m]], lines.pair_chan[pi_[m]], sig[m]
         C_all = _eq310(dk, w)
@@ -475,7 +490,8 @@ def fit_empirical(spectra: Spectra, settings: FitSettings | None = None, directi
     speed = np.abs(spectra.speed)
     fit_runs = np.nonzero(speed > 0)[0]
     if fit_runs.size == 0:
-        raise ValueError("no run with non-zero wheel speed to fit")
+        raise DataError(spectra.run_names[0] if spectra.run_names else "<test>", "speed_rpm",
+                        "every run is at zero speed: nothing to fit (zero-speed runs are noise runs)")
     dof = welch_dof(int(np.min(spectra.n_segments)))
     f = spectra.f
     f_lo, f_hi = s.f_min_bins * spectra.df, spectra.band_limit

@@ -73,8 +73,9 @@ def compute_spectra(test: SteadyTest, nperseg: int | None = None, overlap: float
     Parameters
     ----------
     nperseg : FFT segment length; default the largest power of two that fits
-        in the shortest run (one segment, the finest resolution, as the thesis
-        did for the E wheel).
+        in the typical (median-length) run -- one segment, the finest resolution,
+        as the thesis did for the E wheel.  A run shorter than that is an error
+        naming the run, not a reason to coarsen every spectrum.
     overlap : fraction of segment overlap.
     f_lim : upper frequency limit of good data, Hz (e.g. below a test-stand
         resonance); stored, applied by the fit.
@@ -89,7 +90,7 @@ def compute_spectra(test: SteadyTest, nperseg: int | None = None, overlap: float
     fs = float(rates[0])
     lengths = np.array([r.n_samples for r in test.runs])
     if nperseg is None:
-        nperseg = _default_nperseg(int(lengths.min()))
+        nperseg = _default_nperseg(int(np.median(lengths)))
     short = np.nonzero(lengths < nperseg)[0]
     if short.size:
         r = test.runs[short[0]]

@@ -118,6 +118,13 @@ def test_b_wheel_band_limit_counts_as_table_3_2():
         # the table's counts, except 8.09 where 8.09 x 1500 rpm = 202 Hz is just out of band
         assert abs(n_closed - n_tab) <= (1 if h_tab == 8.09 else 0), (h_tab, n_closed, n_tab)
     assert matched == len(table_3_2)
+    # every Table 3.3 radial-force harmonic is found as a bin: fitted, or dropped with a stated reason
+    th, _ = wheel.to_model().h_and_C("radial_force")
+    fitted = [x.h for x in fit.lines if x.direction == "radial_force"]
+    for h in th:
+        b = min(bins, key=lambda b: abs(b.h - h))
+        assert abs(b.h - h) <= 0.01, f"Table 3.3 harmonic {h} not found"
+        assert (b.kept and np.min(np.abs(np.array(fitted) - h)) <= 0.01) or (not b.kept and b.reason)
     for x in fit.lines:
         assert np.all(x.h * x.speed / (2 * np.pi) <= 200.0)
         # a fixed-frequency fixture resonance is not a harmonic: no line sits on 300 Hz at all speeds

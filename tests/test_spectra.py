@@ -231,8 +231,11 @@ def test_run_shorter_than_nperseg_names_run():
         compute_spectra(SteadyTest(runs), nperseg=1024)
     msg = str(info.value)
     assert "short_run.csv" in msg and "700" in msg and "1024" in msg
-    # the default nperseg fits the shortest run: 512
-    assert compute_spectra(SteadyTest(runs)).nperseg == 512
+    # the default nperseg follows the typical run; a truncated run is named, not silently absorbed
+    runs.append(Run(30.0, FS, {"Fx": rng.standard_normal(4096)}, name="long2.csv"))
+    with pytest.raises(DataError) as info:
+        compute_spectra(SteadyTest(runs))
+    assert "short_run.csv" in str(info.value) and "4096" in str(info.value)
 
 
 def test_different_sample_rates_raise():
