@@ -26,7 +26,11 @@ thesis toolbox did with a manual decision at every step:
    are reported.
 5. **Standard error** of every C: a cluster-robust (sandwich) estimate of the
    Eq. 3.10 least-squares fit, clustered by run so x and y measurements of
-   one run are not counted as independent.
+   one run are not counted as independent.  It is the *statistical* error
+   (noise, speed-to-speed scatter).  It does not cover a bias the model form
+   cannot see: amplification by a mode's skirts below the exclusion threshold,
+   or an amplitude law other than Ω²; compare C with C_all and look at the
+   coefficient plots for those.
 """
 from __future__ import annotations
 
