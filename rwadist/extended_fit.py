@@ -1,0 +1,355 @@
+"""Fit the extended (analytical) wheel model to test data, starting from the empirical fit.
+
+Thesis §4.3 fitted the analytical model by hand and only for the fundamental,
+and could not match both the height and the width of a resonance.  Here every
+harmonic takes part and the fit is a least-squares problem:
+
+1. **Rotation sense** of every radial line from the x/y phase in the time
+   series: a line rotating with the spin has its power in X + iY (X, Y the
+   complex spectra of the x and y channels at +f), a counter-rotating one in
+   X − iY (for Ω < 0 the two swap).  Only counter-rotating content can excite
+   backward whirl (the thesis's "pole-zero cancellation").
+2. **Mode frequencies** from the amplification peaks the empirical fit
+   excluded: a radial-force peak sits on the radial translation mode (constant
+   frequency); a radial-torque peak on the rocking whirl of its sense,
+   f± = sqrt((aΩ/2)² + f0²) ± aΩ/2, so f0² = f² ∓ aΩf gives the rocking
+   frequency at rest; an axial-force peak on the axial mode.  These start the
+   stiffnesses: k_r = M ω_T², k_rock = I_rr ω0², k_z = M ω_z².
+3. **Least squares** of log amplitude over every measured line at every speed
+   (amplified or not): stiffnesses, damping of each mode and the forcing
+   coefficient of each line (U_s and U_d are the h = 1 radial force and torque
+   lines) are adjusted together, so height *and* width of each resonance are
+   matched where a linear model can match them; the residual near each mode
+   says where it cannot.  Standard errors come from the Jacobian.
+
+Modes not seen in the data (no amplification peak) keep their starting values
+and are reported as not identified.  Mass and radius come from the datasheet
+(thin-disc inertias, CONVENTIONS.md); ``height`` (lever arm from the radial
+force to the reported torque) is geometry, given, default 0 (torques about the
+rotor centre).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy import optimize, signal
+
+from . import extended as ext
+from .data import SteadyTest
+from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
+from .model import Harmonic
+from .spectra import welch_dof
+from .units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
+
+CHANNEL_INDEX = {c: i for i, c in enumerate(CHANNELS)}
+RADIAL = ("radial_force", "radial_torque")
+
+
+@dataclass
+class ExtendedFit:
+    """Result of :func:`fit_extended`.
+
+    params : fitted :class:`~rwadist.extended.ExtendedParams`.
+    lines : forcing lines (direction, h, C, sense) of the fitted model.
+    zeta : damping ratio per mode ("radial_translation", "rocking", "axial_translation").
+    rel_stderr : relative standard error per fitted parameter (k_r, c_r, ... and line C's).
+    identified : per mode, whether the data showed it (an amplification peak).
+    peaks : the amplification peaks that located the modes (dicts).
+    senses : (direction, h) -> (sense, fraction of power co-rotating).
+    rms : model-vs-data RMS comparison (see :func:`rms_comparison`).
+    residual_db : per mode, RMS log-amplitude residual (dB) of the measurements near it.
+    notes : what could not be fitted and why.
+    """
+
+    params: ext.ExtendedParams
+    lines: list
+    zeta: dict
+    rel_stderr: dict
+    identified: dict
+    peaks: list
+    senses: dict
+    rms: dict = field(default_factory=dict)
+    residual_db: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
+
+
+# --------------------------------------------------------------------------- 1. senses
+
+def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) -> dict:
+    """Rotation sense of each radial line from the x/y phase, (direction, h) -> (sense, co_fraction).
+
+    For each run the complex Hann-windowed DFT of the x and y channels at +h|Ω|
+    gives the co-rotating power |X + iY|² and the counter-rotating |X − iY|²
+    (swapped for Ω < 0); summed over runs, co_fraction = P_co / (P_co + P_counter).
+    Above ``threshold``: "co"; below 1 − threshold: "counter"; between: "planar".
+    """
+    out = {}
+    by_dir = {d: [x for x in fit.lines if x.direction == d] for d in RADIAL}
+    for d, lines in by_dir.items():
+        cx, cy = DIRECTION_CHANNELS[d]
+        if not lines:
+            continue
+        h = np.array([x.h for x in lines])
+        p_co = np.zeros(h.size)
+        p_ct = np.zeros(h.size)
+        for run in test.runs:
+            if cx not in run.signals or cy not in run.signals or run.speed == 0:
+                continue
+            n = run.n_samples
+            t = np.arange(n) / run.sample_rate
+            w = signal.windows.hann(n, sym=False)
+            f = h * abs(run.speed) / (2 * np.pi)
+            ok = f < 0.45 * run.sample_rate
+            e = np.exp(-2j * np.pi * f[ok, None] * t[None, :])
+            X = e @ (w * run.signals[cx])
+            Y = e @ (w * run.signals[cy])
+            co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
+            if run.speed < 0:
+                co, ct = ct, co
+            p_co[ok] += co
+            p_ct[ok] += ct
+        frac = p_co / np.maximum(p_co + p_ct, 1e-300)
+        for hk, fr in zip(h, frac):
+            sense = "co" if fr >= threshold else ("counter" if fr <= 1 - threshold else "planar")
+            out[(d, float(hk))] = (sense, float(fr))
+    return out
+
+
+# --------------------------------------------------------------------------- 2. mode frequencies
+
+def amplification_peaks(fit: EmpiricalFit, min_gain: float = 1.25) -> list:
+    """The largest amplification (measured / C·Ω²) inside each excluded speed range of each line."""
+    peaks = []
+    for x in fit.lines:
+        if not x.excluded_rpm:
+            continue
+        rpm = x.speed * RAD_S_TO_RPM
+        ratio = x.amplitude / (x.C * x.speed**2)
+        for lo, hi in x.excluded_rpm:
+            m = (rpm >= lo - 1e-9) & (rpm <= hi + 1e-9)
+            if not m.any():
+                continue
+            k = np.nonzero(m)[0][np.argmax(ratio[m])]
+            if ratio[k] < min_gain:
+                continue
+            # a maximum at an end of the measured speeds is a skirt, not a peak: a bound only
+            edge = bool(rpm[k] >= rpm.max() - 1e-9 or rpm[k] <= rpm.min() + 1e-9)
+            peaks.append({"direction": x.direction, "h": x.h, "speed_rad_s": float(x.speed[k]),
+                          "speed_rpm": float(rpm[k]), "f_hz": float(x.h * x.speed[k] / (2 * np.pi)),
+                          "gain": float(ratio[k]), "at_range_edge": edge})
+    return peaks
+
+
+def mode_frequencies(peaks: list, senses: dict, inertia_ratio: float) -> dict:
+    """Starting mode frequencies (Hz at rest) from amplification peaks; None where none seen."""
+    out = {"radial_translation": None, "rocking": None, "axial_translation": None}
+    trans = [p["f_hz"] for p in peaks if p["direction"] == "radial_force" and not p["at_range_edge"]]
+    trans = trans or [p["f_hz"] for p in peaks if p["direction"] == "radial_force"]
+    if trans:
+        out["radial_translation"] = float(np.median(trans))
+    axial = [p["f_hz"] for p in peaks if p["direction"] == "axial_force"]
+    if axial:
+        out["axial_translation"] = float(np.median(axial))
+    cands = []
+    for p in peaks:
+        if p["direction"] != "radial_torque":
+            continue
+        sense = senses.get(("radial_torque", float(p["h"])), ("co", 1.0))[0]
+        w_hz = p["speed_rad_s"] / (2 * np.pi)
+        for s, name in ((1, "co"), (-1, "counter")):
+            if sense in (name, "planar"):
+                f0sq = p["f_hz"] ** 2 - s * inertia_ratio * w_hz * p["f_hz"]
+                if f0sq > 0:
+                    cands.append(math.sqrt(f0sq))
+    if cands:
+        out["rocking"] = float(np.median(cands))
+    return out
+
+
+# --------------------------------------------------------------------------- 3. least squares
+
+_MODE_PARAMS = {"radial_translation": ("k_r", "c_r", "mass"), "rocking": ("k_rock", "c_rock", "I_rr"),
+                "axial_translation": ("k_z", "c_z", "mass")}
+
+
+def _measurements(fit: EmpiricalFit):
+    """Flat arrays of every measured line amplitude: line index (position in ``fit.lines``),
+    speed, channel index, amplitude."""
+    li, sp, ch, amp = [], [], [], []
+    for j, x in enumerate(fit.lines):
+        li.append(np.full(x.speed.size, j))
+        sp.append(x.speed)
+        ch.append(np.array([CHANNEL_INDEX[c] for c in x.channel]))
+        amp.append(x.amplitude)
+    return np.concatenate(li), np.concatenate(sp), np.concatenate(ch), np.concatenate(amp)
+
+
+def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float, height: float = 0.0,
+                 start: ext.ExtendedParams | None = None, zeta0: float = 0.02, progress: bool = False) -> ExtendedFit:
+    """Fit the extended model to a steady test whose empirical fit is ``fit``.
+
+    mass (kg), radius (m): datasheet values (thin-disc inertias).  height (m): lever arm
+    from the rotor centre to the torque reference point.  start: parameters for the modes the
+    data do not show (default: modes at 3x the top line frequency, ζ = zeta0).
+    """
+    I_zz, I_rr = ext.thin_disc(mass, radius)
+    a = I_zz / I_rr
+    # every line the data show, with every measurement: the empirical fit without modal
+    # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped)
+    settings = FitSettings(**{k: v for k, v in fit.settings.items() if k in FitSettings.__dataclass_fields__})
+    meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False))
+    senses = line_senses(test, meas)
+    peaks = amplification_peaks(fit)
+    f_modes = mode_frequencies(peaks, senses, a)
+    f_top = max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines), default=100.0)
+    notes = []
+
+    def start_k(mode, inertia, attr):
+        f = f_modes[mode]
+        if f is not None:
+            return inertia * (2 * np.pi * f) ** 2
+        notes.append(f"{mode}: no amplification seen in the data; kept at its starting value")
+        if start is not None:
+            return getattr(start, attr)
+        return inertia * (2 * np.pi * 3 * f_top) ** 2
+
+    k_r = start_k("radial_translation", mass, "k_r")
+    k_rock = start_k("rocking", I_rr, "k_rock")
+    k_z = start_k("axial_translation", mass, "k_z")
+    # forcing lines from the empirical fit (its C is the hard-mounted amplitude away from modes)
+    lines = []
+    for x in meas.lines:
+        sense = senses.get((x.direction, float(x.h)), ("co", 1.0))[0] if x.direction in RADIAL else "co"
+        imb = x.direction in RADIAL and abs(x.h - 1.0) < 0.01 and sense == "co"
+        lines.append(ext.Line(x.direction, 1.0 if imb else float(x.h), float(x.C), sense, imbalance=imb))
+    if not lines:
+        raise ValueError("the empirical fit has no harmonics: nothing to fit the extended model to")
+    li, sp, ch, amp = _measurements(meas)
+    speeds, s_idx = np.unique(sp, return_inverse=True)
+    identified = {m: f_modes[m] is not None for m in _MODE_PARAMS}
+    free_modes = [m for m in _MODE_PARAMS if identified[m]]
+    base = dict(mass=mass, I_zz=I_zz, I_rr=I_rr, k_r=k_r, k_rock=k_rock, k_z=k_z, height=height,
+                c_r=2 * zeta0 * math.sqrt(k_r * mass), c_rock=2 * zeta0 * math.sqrt(k_rock * I_rr),
+                c_z=2 * zeta0 * math.sqrt(k_z * mass), U_s=0.0, U_d=0.0)
+    names = [p for m in free_modes for p in _MODE_PARAMS[m][:2]] + [f"C[{ln.direction},{ln.h:g}]" for ln in lines]
+    x0 = np.log([base[n] for m in free_modes for n in _MODE_PARAMS[m][:2]] + [ln.C for ln in lines])
+    n_mode = 2 * len(free_modes)
+
+    def unpack(theta):
+        vals = dict(base)
+        k = 0
+        for m in free_modes:
+            kn, cn, inertia = _MODE_PARAMS[m]
+            vals[kn] = math.exp(theta[k])
+            # damping stays below critical (the model refuses overdamped modes)
+            vals[cn] = min(math.exp(theta[k + 1]), 1.9 * math.sqrt(vals[kn] * vals[inertia]))
+            k += 2
+        C = np.exp(theta[n_mode:])
+        lns = [replace(ln, C=float(c)) for ln, c in zip(lines, C)]
+        vals["U_s"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_force"), 0.0)
+        vals["U_d"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_torque"), 0.0)
+        return ext.ExtendedParams(**vals), lns
+
+    def residuals(theta):
+        p, lns = unpack(theta)
+        _, A = ext.steady_lines(p, lns, speeds)
+        pred = np.abs(A[s_idx, li, ch])
+        return np.log(np.maximum(amp, 1e-300)) - np.log(np.maximum(pred, 1e-300))
+
+    res = optimize.least_squares(residuals, x0, method="trf", x_scale="jac", max_nfev=400,
+                                 verbose=2 if progress else 0)
+    params, fitted_lines = unpack(res.x)
+    dof = max(res.fun.size - res.x.size, 1)
+    s2 = float(np.sum(res.fun**2) / dof)
+    try:
+        cov = np.linalg.pinv(res.jac.T @ res.jac) * s2
+        rel_se = np.sqrt(np.clip(np.diag(cov), 0, None))
+    except np.linalg.LinAlgError:
+        rel_se = np.full(res.x.size, np.nan)
+    rel_stderr = {n: float(v) for n, v in zip(names, rel_se)}
+    zeta = {"radial_translation": params.zeta_r, "rocking": params.zeta_rock, "axial_translation": params.zeta_z}
+    # residual near each mode: measurements within ±10 % of the mode frequency at their speed
+    resid_db = {}
+    f_line = np.array([ln.h for ln in lines])[li] * np.abs(sp) / (2 * np.pi)
+    modes_f = ext.whirl_frequencies(params, sp)
+    chan_dir = {0: "radial_force", 1: "radial_force", 3: "radial_torque", 4: "radial_torque", 2: "axial_force"}
+    for m, keys in (("radial_translation", ("radial_translation",)),
+                    ("rocking", ("rocking_forward", "rocking_backward")),
+                    ("axial_translation", ("axial_translation",))):
+        near = np.zeros(sp.size, bool)
+        for key in keys:
+            near |= np.abs(f_line / modes_f[key] - 1) < 0.1
+        dirs = {"radial_translation": ("radial_force",), "rocking": ("radial_torque",),
+                "axial_translation": ("axial_force",)}[m]
+        near &= np.isin([chan_dir.get(c, "") for c in ch], dirs)
+        if near.any():
+            resid_db[m] = float(20 / np.log(10) * np.sqrt(np.mean(res.fun[near] ** 2)))
+    return ExtendedFit(params=params, lines=fitted_lines, zeta=zeta, rel_stderr=rel_stderr, identified=identified,
+                       peaks=peaks, senses=senses, residual_db=resid_db, notes=notes)
+
+
+# --------------------------------------------------------------------------- 4. comparison
+
+def rms_comparison(efit: ExtendedFit, fit: EmpiricalFit) -> dict:
+    """RMS vs speed of data, empirical model and extended model, per direction, and the
+    error of each model where modes are excited (speeds inside any excluded range of that
+    direction).
+
+    Data RMS is over (0, band limit] with the noise floor's mean square removed, so what
+    is compared is the harmonic content.  Error = RMS over those speeds of
+    (model − data) / data.
+    """
+    from .model import model_rms
+
+    sp = fit.spectra
+    f, df = sp.f, sp.df
+    band = (f > 0) & (f <= sp.band_limit)
+    dof = welch_dof(int(np.min(sp.n_segments)))
+    speed = np.abs(sp.speed)
+    rpm = speed * RAD_S_TO_RPM
+    ext_rms = ext.steady_rms(efit.params, efit.lines, sp.speed, f_max=sp.band_limit)
+    out = {}
+    for d in ("radial_force", "radial_torque", "axial_force"):
+        c = DIRECTION_CHANNELS[d][0]
+        if c not in sp.psd:
+            continue
+        ok = sp.available(c) & (speed > 0)
+        psd = sp.psd[c][ok]
+        floor = block_floor(psd, dof=dof)
+        data = np.sqrt(np.maximum(np.sum(psd[:, band], axis=1) - np.sum(floor[:, band], axis=1), 0) * df)
+        emp = model_rms(fit.model, d, sp.speed[ok], f_max=sp.band_limit)
+        exm = ext_rms[ok, CHANNEL_INDEX[c]]
+        ranges = [r for x in fit.lines if x.direction == d for r in x.excluded_rpm]
+        in_modes = np.zeros(ok.sum(), bool)
+        for lo, hi in ranges:
+            in_modes |= (rpm[ok] >= lo) & (rpm[ok] <= hi)
+        def err(model):
+            m = in_modes & (data > 0)
+            return float(np.sqrt(np.mean(((model[m] - data[m]) / data[m]) ** 2))) if m.any() else float("nan")
+        out[d] = {"speed_rpm": rpm[ok], "data": data, "empirical": emp, "extended": exm, "in_modes": in_modes,
+                  "error_empirical": err(emp), "error_extended": err(exm)}
+    return out
+
+
+def to_model(efit: ExtendedFit, fit: EmpiricalFit):
+    """The empirical model of ``fit`` with senses, plus the analytical section of ``efit``."""
+    from copy import deepcopy
+
+    model = deepcopy(fit.model)
+    for d in RADIAL:
+        model.empirical[d] = [Harmonic(**{**vars(h), "sense": efit.senses.get((d, h.h), (None,))[0]
+                                          if (d, h.h) in efit.senses else _nearest_sense(efit.senses, d, h.h)})
+                              for h in model.empirical[d]]
+    analytical = ext.params_to_dict(efit.params)
+    analytical["fit"] = {"zeta": efit.zeta, "identified": efit.identified,
+                         "rel_stderr": efit.rel_stderr, "residual_db_near_mode": efit.residual_db,
+                         "notes": efit.notes}
+    model.analytical = analytical
+    return model
+
+
+def _nearest_sense(senses: dict, d: str, h: float):
+    best = min(((abs(k[1] - h), v[0]) for k, v in senses.items() if k[0] == d), default=(1.0, None))
+    return best[1] if best[0] < 1e-3 else None
