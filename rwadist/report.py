@@ -496,3 +496,73 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
     summary.write_text(_summary_md(fit, rows, table, top, files))
     files.append(summary)
     return files
+
+
+# --------------------------------------------------------------------------- extended model
+
+def plot_extended_rms(comparison: dict, direction: str, ax=None):
+    """RMS vs speed of the data (noise floor removed), the empirical and the extended model;
+    speeds where modes act (excluded ranges of the empirical fit) shaded."""
+    c = comparison[direction]
+    if ax is None:
+        fig = _new_figure((8.0, 4.8))
+        ax = fig.add_subplot(1, 1, 1)
+    else:
+        fig = ax.figure
+    order = np.argsort(c["speed_rpm"])
+    rpm = c["speed_rpm"][order]
+    shade = c["in_modes"][order]
+    if shade.any():
+        ax.fill_between(rpm, 0, 1, where=shade, transform=ax.get_xaxis_transform(), color="tab:red", alpha=0.08,
+                        label="modes act (empirical exclusion)")
+    ax.semilogy(rpm, c["data"][order], "o", ms=3, color="k", label="data (noise floor removed)")
+    ax.semilogy(rpm, c["empirical"][order], "-", color="tab:orange",
+                label=f"empirical model (error in modes {100 * c['error_empirical']:.1f} %)")
+    ax.semilogy(rpm, c["extended"][order], "-", color="tab:blue",
+                label=f"extended model (error in modes {100 * c['error_extended']:.1f} %)")
+    ax.set_xlabel("Wheel speed |Ω| (rpm)")
+    ax.set_ylabel(f"RMS ({_direction_unit(direction)})")
+    ax.set_title(f"{_direction_label(direction)}: data vs empirical and extended model")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig, ax
+
+
+def write_extended_report(efit, fit, out_dir) -> list:
+    """Extended-model part of the report: ``extended_rms_<direction>.png``,
+    ``extended_rms_vs_speed.csv`` and ``extended_params.csv``."""
+    from .extended import params_to_dict
+    from .extended_fit import rms_comparison
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    comparison = rms_comparison(efit, fit)
+    files = []
+    for d in comparison:
+        fig, _ = plot_extended_rms(comparison, d)
+        files.append(_save(fig, out / f"extended_rms_{d}.png"))
+    path = out / "extended_rms_vs_speed.csv"
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["direction", "speed_rpm", "data_rms", "empirical_rms", "extended_rms", "modes_act"])
+        for d, c in comparison.items():
+            for k in np.argsort(c["speed_rpm"]):
+                w.writerow([d, _fmt(c["speed_rpm"][k]), _fmt(c["data"][k]), _fmt(c["empirical"][k]),
+                            _fmt(c["extended"][k]), int(c["in_modes"][k])])
+    files.append(path)
+    path = out / "extended_params.csv"
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["parameter", "value", "rel_stderr"])
+        for key, value in params_to_dict(efit.params).items():
+            if key == "kind":
+                continue
+            name = key.split("_")[0] + ("_" + key.split("_")[1] if key.startswith(("k_", "c_", "U_", "I_")) else "")
+            w.writerow([key, _fmt(value), _fmt(efit.rel_stderr.get(name, float("nan")))])
+        for mode, z in efit.zeta.items():
+            w.writerow([f"zeta_{mode}", _fmt(z), ""])
+        for d, c in comparison.items():
+            w.writerow([f"rms_error_in_modes_empirical_{d}", _fmt(c["error_empirical"]), ""])
+            w.writerow([f"rms_error_in_modes_extended_{d}", _fmt(c["error_extended"]), ""])
+    files.append(path)
+    return files
