@@ -45,7 +45,7 @@ def cmd_simulate(args) -> int:
         sweep = simulate_sweep(wheel, rpm_start=args.sweep_start_rpm, rpm_end=end, duration=args.duration,
                                sample_rate=args.sample_rate or 3840.0, noise=args.noise, modes=not args.no_modes,
                                test_stand=not args.no_test_stand, seed=args.seed, profile=args.profile,
-                               tach=not args.no_tach)
+                               tach=not args.no_tach, physics=args.physics)
         path = data_io.write_sweep(sweep, out / "sweep.csv")
         print(f"wrote sweep {path} ({len(sweep.time)} samples, {sweep.sample_rate:g} Hz)")
         return 0
@@ -60,7 +60,8 @@ def cmd_simulate(args) -> int:
         speeds = np.linspace(300.0, 2400.0, 120)
     fs = args.sample_rate or getattr(wheel, "default_sample_rate", None) or 3840.0
     test = simulate_steady(wheel, speeds, sample_rate=fs, n_samples=args.samples, noise=args.noise,
-                           modes=not args.no_modes, test_stand=not args.no_test_stand, seed=args.seed)
+                           modes=not args.no_modes, test_stand=not args.no_test_stand, seed=args.seed,
+                           physics=args.physics)
     if wheel.f_lim_hz is not None and not args.no_test_stand:
         # the test engineer's record of where the fixture corrupts the data; `rwadist fit` uses it
         test.meta["f_lim_hz"] = wheel.f_lim_hz
@@ -108,17 +109,56 @@ def cmd_fit(args) -> int:
     test = load_steady(args.data, args)
     fit = run_fit(test, args, name=Path(args.data).name)
     fit.model.provenance["data"] = str(args.data)
-    model_io.save(fit.model, args.output)
+    model = fit.model
+    efit = None
+    if args.extended:
+        efit, model = run_extended_fit(test, fit, args)
+    model_io.save(model, args.output)
     report_dir = Path(args.report) if args.report else Path(args.output).with_suffix("").parent / (
         Path(args.output).stem + "_report")
     print(f"writing report to {report_dir} ...", flush=True)
     cum = parse_speeds(args.cumulative_rpm) if args.cumulative_rpm else None
     files = write_report(fit, report_dir, cumulative_speeds_rpm=cum)
+    if efit is not None:
+        from .report import write_extended_report
+
+        files += write_extended_report(efit, fit, report_dir)
     n = sum(len(v) for v in fit.model.empirical.values())
     print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
     print(f"model:  {args.output}")
     print(f"report: {report_dir} ({len(files)} files)")
     return 0
+
+
+def run_extended_fit(test, fit, args):
+    """The extended model fitted on top of the empirical fit; mass and radius from the options or a preset."""
+    from .extended_fit import fit_extended, to_model
+
+    mass, radius, start = args.mass, args.radius, None
+    if args.preset:
+        from .teststand import preset
+
+        wheel = preset(args.preset)
+        mass = mass if mass is not None else wheel.mass_kg
+        radius = radius if radius is not None else wheel.radius_m
+        start = getattr(wheel, "extended", None)
+    if mass is None or radius is None:
+        raise DataError("--extended", "mass/radius", "the extended fit needs the rotor mass and radius: "
+                        "give --mass KG --radius M or --preset NAME")
+    print(f"fitting the extended model (M = {mass:g} kg, R = {radius:g} m, height = {args.height:g} m) ...",
+          flush=True)
+    efit = fit_extended(test, fit, mass, radius, height=args.height, start=start)
+    p = efit.params
+    print(f"  radial translation {p.omega_r / (2 * np.pi):7.2f} Hz  zeta {efit.zeta['radial_translation']:.3f}"
+          f"  (k_r {p.k_r:.4g} N/m)")
+    print(f"  rocking at rest    {p.omega_rock / (2 * np.pi):7.2f} Hz  zeta {efit.zeta['rocking']:.3f}"
+          f"  (k_rock {p.k_rock:.4g} N·m/rad)")
+    print(f"  axial translation  {p.omega_z / (2 * np.pi):7.2f} Hz  zeta {efit.zeta['axial_translation']:.3f}"
+          f"  (k_z {p.k_z:.4g} N/m)")
+    print(f"  U_s {p.U_s:.4g} kg·m, U_d {p.U_d:.4g} kg·m²")
+    for note in efit.notes:
+        print(f"  note: {note}")
+    return efit, to_model(efit, fit)
 
 
 def _add_fit_options(p):
@@ -130,6 +170,13 @@ def _add_fit_options(p):
     p.add_argument("--slice-samples", type=int, default=8192, help="sweep slice length, samples")
     p.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
                    help="speed of sweep slices: tach column, estimated from data, or auto")
+    p.add_argument("--extended", action="store_true",
+                   help="also fit the extended model (modes, damping, imbalances) into the model file")
+    p.add_argument("--mass", type=float, default=None, help="rotor mass, kg (extended fit)")
+    p.add_argument("--radius", type=float, default=None, help="rotor radius, m (extended fit; thin-disc inertias)")
+    p.add_argument("--height", type=float, default=0.0,
+                   help="lever arm from the rotor centre to the torque reference point, m (default 0)")
+    p.add_argument("--preset", default=None, help="take mass and radius (and unseen modes) from a wheel preset")
 
 
 # --------------------------------------------------------------------------- model show
@@ -193,6 +240,39 @@ def cmd_demo(args) -> int:
     return 0
 
 
+# --------------------------------------------------------------------------- campbell
+
+def cmd_campbell(args) -> int:
+    """Campbell table (CSV) + plot (PNG next to it) of a model file's or preset's extended parameters;
+    prints the harmonic/mode crossing speeds."""
+    from . import extended
+    from .campbell import campbell_crossings, campbell_table, plot_campbell, write_campbell_csv
+
+    if args.preset:
+        from .teststand import preset
+
+        wheel = preset(args.preset)
+        if wheel.extended is None:
+            raise DataError(args.preset, "extended", "this preset has no extended (analytical) parameters")
+        params, lines, source = wheel.extended, wheel.extended_lines(), f"preset {wheel.name}"
+    else:
+        m = model_io.load(args.model)
+        params = extended.params_from_model(m, str(args.model))
+        lines, source = extended.lines_from_model(m, params), str(args.model)
+    speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
+    table = campbell_table(params, speeds)
+    csv_path = write_campbell_csv(table, args.output)
+    png_path = csv_path.with_suffix(".png")
+    plot_campbell(params, speeds, lines).savefig(png_path, dpi=120)
+    print(f"Campbell table of {source}: {csv_path} ({len(speeds)} speeds), plot: {png_path}")
+    rows = campbell_crossings(params, speeds, lines)
+    print(f"{'h':>6} {'direction':<14} {'sense':<8} {'mode':<19} {'speed_rpm':>10} {'f_Hz':>8}  excites")
+    for r in rows:
+        print(f"{r['h']:6g} {r['direction']:<14} {r['sense']:<8} {r['mode']:<19} {r['speed_rpm']:10.2f} "
+              f"{r['f_Hz']:8.2f}  {'yes' if r['excited'] else 'no'}")
+    return 0
+
+
 # --------------------------------------------------------------------------- main
 
 def build_parser() -> argparse.ArgumentParser:
@@ -216,6 +296,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--duration", type=float, default=390.0, help="sweep duration, s")
     s.add_argument("--profile", choices=("linear", "exp"), default="linear")
     s.add_argument("--no-tach", action="store_true", help="sweep without the speed_rpm tach column")
+    s.add_argument("--physics", choices=("simple", "extended"), default="simple",
+                   help="simple resonances (default) or the extended rotor model of the preset")
     s.set_defaults(func=cmd_simulate)
 
     f = sub.add_parser("fit", help="fit the empirical model to test data; writes the model file and a report")
@@ -239,6 +321,16 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--n-speeds", type=int, default=120)
     d.add_argument("--seed", type=int, default=0)
     d.set_defaults(func=cmd_demo)
+
+    c = sub.add_parser("campbell", help="Campbell table and plot of the extended model; prints crossing speeds")
+    src = c.add_mutually_exclusive_group(required=True)
+    src.add_argument("model", nargs="?", help="model file (JSON) with an analytical section")
+    src.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
+    c.add_argument("--speeds-rpm", default="0:3000:100", help="'START:STOP:STEP', 'A,B,C' or 'START:STOP' "
+                   "with --n-speeds (default 0:3000:100)")
+    c.add_argument("--n-speeds", type=int, default=None)
+    c.add_argument("-o", "--output", default="campbell.csv", help="CSV to write; the plot goes next to it (.png)")
+    c.set_defaults(func=cmd_campbell)
     return p
 
 

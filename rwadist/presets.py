@@ -18,13 +18,45 @@ every line is amplified by several percent at every speed and C·Ω² is visible
 nowhere in the data.
 
 The same values are used for the B wheel's modes (the thesis gives no table for them).
+
+Extended physics (``physics="extended"``, issue 3).  Each preset also carries
+:class:`rwadist.extended.ExtendedParams`, rotation senses and an imbalance phase:
+
+* E wheel: ``replace(from_table_4_2(), height=0.0)``.  Height 0 because the thesis's
+  Eq. 4.96 gives the interface loads as F = k·x, T = k_θ·θ, with no lever arm, and the
+  empirical radial-torque coefficients (Table 3.4) were measured at the interface: a
+  lever arm would add height·F to the torque and count the force lines' torque twice.
+  Senses from the whirl each harmonic excites in Tables 3.6/3.7 (a co-rotating load
+  only meets the forward whirl, counter-rotating content is what excites backward
+  whirl): h = 2 counter (backward whirl, 800–1300 / 1150–1350 rpm); h = 3, 4, 4.42
+  co (forward whirl); h = 5.37, 5.57, 5.58 co (radial translation, no whirl split);
+  the imbalance is co-rotating by nature.  Note: Tables 3.6/3.7 also attribute an h = 1
+  amplification near 1900–2000 rpm to the *backward* whirl, which a co-rotating
+  imbalance cannot excite; the model does not reproduce it.
+* B wheel: mass 5.9 kg and radius 0.1275 m (Table 2.2) as a thin disc; k_r puts radial
+  translation at 200 Hz, k_rock rocking at 85 Hz at rest, k_z axial at 65 Hz (Table
+  2.3); damping ratios equal to the E wheel's (radial ζ_r = 0.167 and rocking
+  ζ_rock = 0.040 of Table 4.2's c, d_c; axial ζ_z = 0.05, the assumption of
+  :func:`rwadist.extended.from_table_4_2`); U_s, U_d = Table 3.3's h = 0.99 radial
+  force / torque coefficients (0.2134, 0.0630 ×1e-7 N/rpm², N·m/rpm²) in SI; height 0
+  (as for E).  Senses: h = 1.99 counter (the radial-torque amplification of §3.2.1 at
+  1200–1900 rpm lies on the backward whirl: 85 Hz/√(1.99·3.99) → 1810 rpm), all others
+  co.  The 0.99 radial lines are the imbalances (``IMBALANCE_H_TOL``).
+* ``imbalance_phase`` (dynamic imbalance ahead of static, rad) is not measured in the
+  thesis; both presets use 0.6 rad, a fixed assumed value.
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
+from . import extended as ext
 from .teststand import Mode, WheelDescription
 from .units import THESIS_C_TO_SI
+
+#: Assumed angle of the dynamic imbalance ahead of the static one, rad (not in the thesis).
+IMBALANCE_PHASE = 0.6
 
 RADIAL_CHANNELS = ("Fx", "Fy", "Tx", "Ty")
 ALL_CHANNELS = ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")
@@ -68,7 +100,33 @@ def ithaco_e() -> WheelDescription:
         default_sweep={"rpm_start": 0.0, "rpm_end": 2400.0, "duration": 390.0, "sample_rate": 3840.0,
                        "profile": "exp"},  # full-torque spin-up saturating near 2400 rpm, 390 s (§2.2.2)
         notes="Ithaco TW-50E300: harmonics Table 3.4, modes Tables 2.3/4.2, specs Table 2.2 (Masterson 1999)",
+        extended=replace(ext.from_table_4_2(), height=0.0),   # Eq. 4.96: interface loads, no lever arm
+        senses=_senses(harmonics, counter=(2.0,)),             # Tables 3.6/3.7: h = 2 on the backward whirl
+        imbalance_phase=IMBALANCE_PHASE,
     )
+
+
+def _senses(harmonics: dict, counter=()) -> dict:
+    """(direction, h) -> sense for every radial harmonic: 'counter' for h in ``counter``, else 'co'."""
+    return {(d, h): ("counter" if any(abs(h - c) < 1e-9 for c in counter) else "co")
+            for d in ("radial_force", "radial_torque") for h, _ in harmonics.get(d, [])}
+
+
+def ithaco_b_extended() -> ext.ExtendedParams:
+    """B wheel rotor: thin disc 5.9 kg, R 0.1275 m; modes at Table 2.3's 200 / 85 / 65 Hz; E-wheel damping
+    ratios; imbalances from Table 3.3's h = 0.99 coefficients; height 0."""
+    M, R = 5.9, 0.1275
+    I_zz, I_rr = ext.thin_disc(M, R)
+    e = ext.from_table_4_2()
+    k_r = M * (2 * np.pi * 200.0) ** 2
+    k_rock = I_rr * (2 * np.pi * 85.0) ** 2
+    k_z = M * (2 * np.pi * 65.0) ** 2
+    return ext.ExtendedParams(
+        mass=M, I_zz=I_zz, I_rr=I_rr,
+        k_r=k_r, c_r=2 * e.zeta_r * np.sqrt(k_r * M),
+        k_rock=k_rock, c_rock=2 * e.zeta_rock * np.sqrt(k_rock * I_rr),
+        k_z=k_z, c_z=2 * e.zeta_z * np.sqrt(k_z * M),
+        height=0.0, U_s=0.2134 * THESIS_C_TO_SI, U_d=0.0630 * THESIS_C_TO_SI)
 
 
 def ithaco_b() -> WheelDescription:
@@ -110,6 +168,9 @@ def ithaco_b() -> WheelDescription:
         default_sweep=None,
         notes="Ithaco TW-16B32: harmonics Table 3.3, modes Table 2.3, stand §2.2.1, specs Table 2.2 "
               "(Masterson 1999)",
+        extended=ithaco_b_extended(),
+        senses=_senses(harmonics, counter=(1.99,)),            # §3.2.1: h = 1.99 on the backward whirl
+        imbalance_phase=IMBALANCE_PHASE,
     )
 
 

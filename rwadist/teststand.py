@@ -50,6 +50,29 @@ Lines at or above the Nyquist frequency are not recorded (an ideal
 anti-aliasing filter, as a real acquisition has: the B wheel test filtered at
 480 Hz for 1 kHz sampling).
 
+Extended physics (``physics="extended"``, issue 3).  The wheel's own modes come from
+:mod:`rwadist.extended` (rigid rotor on a flexible suspension: radial translation,
+gyroscopic rocking with forward/backward whirl, axial translation) instead of the
+simple resonances above.  The lines are :func:`extended_lines` of the wheel: the
+static and dynamic imbalances ``U_s``, ``U_d`` of ``WheelDescription.extended``
+replace the radial force/torque harmonics at h ≈ 1 (within
+:data:`IMBALANCE_H_TOL`), every other harmonic keeps its C with the rotation sense
+``WheelDescription.senses[(direction, h)]`` (default 'co').  Steady runs are the
+closed form :func:`rwadist.extended.steady_lines` at each run speed with, per run,
+a uniform random phase for each non-imbalance line and *one* random phase β
+shared by the two imbalances: static at β, dynamic at β + ``imbalance_phase``
+(a fixed property of the rotor), so the 1× torque/force ratio is the same in
+every run.  Sweeps are :func:`rwadist.extended.simulate_time` (exact modal
+integration, phases h·∫Ω dt, tangential imbalance force U·Ω̇, closed-form steady
+state at the first sample) with one set of phases drawn per sweep.  Fixture
+resonances (``test_stand_modes``, fixed frequency) act in both physics; with
+extended physics they are applied as the real LTI filter H(f) they describe
+(steady: × H(f_line); sweep: H(f) on the FFT of the record, circular -- away from
+the record ends it matches the steady lines to ~1e-4 of the peak, the residue sitting
+near Nyquist where a complex H cannot be applied to sampled data exactly).
+The ``modes`` switch belongs to the simple physics (the extended model's modes are
+its suspension).  Noise and the anti-aliasing rule are the same in both physics.
+
 Randomness: one :class:`numpy.random.SeedSequence` per call spawns two
 generators, one for the phases (per run, per direction, per harmonic) and one
 for the sensor noise, so switching noise or modes on and off leaves the
@@ -62,6 +85,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import extended as ext
 from .data import Run, SteadyTest, Sweep
 from .model import Harmonic, WheelModel
 from .units import CHANNELS, DIRECTION_CHANNELS, rad_s_to_hz, rad_s_to_rpm, rpm_to_rad_s
@@ -71,6 +95,11 @@ NOISE_REFERENCE = {"Fx": "radial_force", "Fy": "radial_force", "Fz": "radial_for
                    "Tx": "radial_torque", "Ty": "radial_torque", "Tz": "radial_torque"}
 #: Samples per block when synthesising a sweep (bounds memory of long records).
 _SWEEP_BLOCK = 1 << 17
+#: Physics of the virtual stand: simple resonances (issue 2) or the extended rotor model (issue 3).
+PHYSICS = ("simple", "extended")
+#: Radial harmonics with |h − 1| at most this are the imbalances the extended model replaces
+#: (the thesis's B wheel lists its fundamental at h = 0.99).
+IMBALANCE_H_TOL = 0.02
 
 
 # --------------------------------------------------------------------------- modes
@@ -173,6 +202,11 @@ class WheelDescription:
     default_n_samples : samples per steady run of the reference test.
     default_sweep : keyword arguments of :func:`simulate_sweep` reproducing the reference sweep, or None.
     notes : free text (source of the numbers).
+    extended : :class:`rwadist.extended.ExtendedParams` of the rotor for ``physics="extended"``, or None.
+    senses : (direction, h) -> 'co' | 'counter' | 'planar', rotation sense of a radial harmonic in the
+        extended physics (missing: 'co').  Keys use the harmonic numbers of ``harmonics``.
+    imbalance_phase : fixed angle (rad) of the dynamic imbalance ahead of the static one; a property
+        of the rotor (same in every run).
     """
 
     name: str
@@ -188,6 +222,9 @@ class WheelDescription:
     default_n_samples: int = 8192
     default_sweep: dict | None = None
     notes: str = ""
+    extended: ext.ExtendedParams | None = None
+    senses: dict = field(default_factory=dict)
+    imbalance_phase: float = 0.0
 
     def __post_init__(self):
         clean = {}
@@ -200,6 +237,25 @@ class WheelDescription:
                     raise ValueError(f"wheel {self.name!r}: {d}: need h > 0 and C >= 0, got h={h!r}, C={C!r}")
             clean[d] = pairs
         self.harmonics = clean
+        senses = {}
+        for key, sense in dict(self.senses).items():
+            try:
+                d, h = key
+                h = float(h)
+            except (TypeError, ValueError):
+                raise ValueError(f"wheel {self.name!r}: senses key {key!r} must be (direction, h)") from None
+            if d not in DIRECTION_CHANNELS:
+                raise ValueError(f"wheel {self.name!r}: senses: unknown direction {d!r}")
+            if sense not in ext.SENSES:
+                raise ValueError(f"wheel {self.name!r}: senses[{key!r}] = {sense!r}; expected one of {ext.SENSES}")
+            senses[(d, h)] = sense
+        self.senses = senses
+        if self.extended is not None and not isinstance(self.extended, ext.ExtendedParams):
+            raise ValueError(f"wheel {self.name!r}: extended must be an ExtendedParams, got "
+                             f"{type(self.extended).__name__}")
+        self.imbalance_phase = float(self.imbalance_phase)
+        if not np.isfinite(self.imbalance_phase):
+            raise ValueError(f"wheel {self.name!r}: imbalance_phase must be finite, got {self.imbalance_phase!r}")
         if self.default_speeds_rpm is not None:
             self.default_speeds_rpm = np.asarray(self.default_speeds_rpm, dtype=float)
 
@@ -233,14 +289,30 @@ class WheelDescription:
         return doc
 
     def to_model(self) -> WheelModel:
-        """The truth as a :class:`rwadist.model.WheelModel` (harmonics only, no modes)."""
+        """The truth as a :class:`rwadist.model.WheelModel`: harmonics (no simple modes); with
+        ``extended`` set also its ``analytical`` section and each radial harmonic's sense."""
         wheel = {k: v for k, v in self.wheel_json().items() if k != "name"}
         empirical = {d: [] for d in DIRECTION_CHANNELS}
         for d, pairs in self.harmonics.items():
-            empirical[d] = [Harmonic(h=h, C=C) for h, C in pairs]
-        return WheelModel(name=self.name, wheel=wheel, empirical=empirical,
+            radial = self.extended is not None and d in ("radial_force", "radial_torque")
+            empirical[d] = [Harmonic(h=h, C=C, sense=self.senses.get((d, h), "co") if radial else None)
+                            for h, C in pairs]
+        analytical = ext.params_to_dict(self.extended) if self.extended is not None else None
+        return WheelModel(name=self.name, wheel=wheel, empirical=empirical, analytical=analytical,
                           provenance={"source": "rwadist.teststand.WheelDescription (simulation truth)",
                                       "notes": self.notes})
+
+    def extended_lines(self) -> list:
+        """Lines of the extended physics (phases 0): :func:`rwadist.extended.lines_from_model` of
+        the harmonics with the radial h ≈ 1 ones (|h − 1| <= IMBALANCE_H_TOL) replaced by the
+        imbalances of ``extended``, senses from ``senses``.  ValueError without ``extended``."""
+        if self.extended is None:
+            raise ValueError(f"wheel {self.name!r} has no extended parameters (WheelDescription.extended); "
+                             "physics='extended' needs them")
+        model = self.to_model()
+        for d in ("radial_force", "radial_torque"):
+            model.empirical[d] = [hm for hm in model.empirical[d] if abs(hm.h - 1.0) > IMBALANCE_H_TOL]
+        return ext.lines_from_model(model, self.extended, self.senses)
 
     def crossings(self, direction: str, speeds_rpm, modes: bool = True, test_stand: bool = True) -> list:
         """Where harmonics of ``direction`` meet the modes acting on its channels.
@@ -316,7 +388,8 @@ def _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, nyquist
 
 
 def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 3840.0, n_samples: int = 8192,
-                    noise: float = 0.01, modes: bool = True, test_stand: bool = True, seed=0) -> SteadyTest:
+                    noise: float = 0.01, modes: bool = True, test_stand: bool = True, seed=0,
+                    physics: str = "simple") -> SteadyTest:
     """Steady-speed runs of ``wheel`` hard-mounted on the virtual stand.
 
     speeds_rpm : wheel speeds, rpm (signed; negative spins about -z), one run each, in the order given.
@@ -326,8 +399,11 @@ def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 38
         fundamental, torques the radial-torque one); recorded in ``meta["noise_std"]``.
     modes / test_stand : apply the wheel modes / the fixture resonances.
     seed : seed of the numpy Generator (phases and noise).
+    physics : "simple" (lines × simple resonances, the default) or "extended" (closed-form response of
+        :mod:`rwadist.extended` with ``wheel.extended``; see the module docstring).
     Returns a :class:`SteadyTest` with all six channels (N, N·m), runs named ``run_0000.csv``, ….
     """
+    _check_physics(wheel, physics, modes)
     speeds = np.atleast_1d(np.asarray(speeds_rpm, dtype=float))
     if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)):
         raise ValueError(f"speeds_rpm must be a non-empty 1-D list of finite speeds, got {speeds_rpm!r}")
@@ -343,6 +419,9 @@ def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 38
     phase_rng, noise_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
     nyquist = 0.5 * sample_rate
     t = np.arange(n_samples) / sample_rate
+    if physics == "extended":
+        return _steady_extended(wheel, speeds, omegas, t, sample_rate, noise, test_stand, seed, noise_std,
+                                phase_rng, noise_rng)
     hc = {d: wheel.h_and_C(d) for d in DIRECTION_CHANNELS}
     dropped = []
     runs = []
@@ -374,8 +453,140 @@ def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 38
         runs.append(Run(speed=float(omega), sample_rate=float(sample_rate), signals=signals, t0=0.0,
                         name=f"run_{k:04d}.csv"))
     meta = _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, dropped,
-                 {"kind": "steady", "n_samples": n_samples})
+                 {"kind": "steady", "n_samples": n_samples, "physics": "simple"})
     return SteadyTest(runs=runs, meta=meta)
+
+
+# --------------------------------------------------------------------------- extended physics
+
+def _check_physics(wheel: WheelDescription, physics: str, modes: bool):
+    if physics not in PHYSICS:
+        raise ValueError(f"physics must be one of {PHYSICS}, got {physics!r}")
+    if physics == "extended":
+        if wheel.extended is None:
+            raise ValueError(f"wheel {wheel.name!r} has no extended parameters (WheelDescription.extended); "
+                             "physics='extended' needs them")
+        if not modes:
+            raise ValueError("modes=False applies to physics='simple' only: with physics='extended' the wheel's "
+                             "modes are its suspension (ExtendedParams)")
+
+
+def _fixture_modes(wheel: WheelDescription, test_stand: bool) -> list:
+    """Active fixture resonances (fixed frequency: they are real LTI filters)."""
+    out = list(wheel.test_stand_modes) if test_stand else []
+    for m in out:
+        if m.whirl != 0:
+            raise ValueError(f"test-stand mode {m.name!r} has whirl {m.whirl}; fixture resonances must be "
+                             "fixed-frequency (whirl 0)")
+    return out
+
+
+def _fixture_gain(fixture: list, f_hz) -> np.ndarray:
+    """(…, 6) complex gain of the fixture resonances at f_hz (Hz, >= 0) on each channel."""
+    f = np.asarray(f_hz, dtype=float)
+    g = np.ones(f.shape + (len(CHANNELS),), dtype=complex)
+    for m in fixture:
+        r = m.response(f / m.f0_hz)
+        for i, ch in enumerate(CHANNELS):
+            if ch in m.channels:
+                g[..., i] *= r
+    return g
+
+
+def _extended_phases(wheel: WheelDescription, lines: list, rng) -> np.ndarray:
+    """Per-line phases: β (static imbalance), β + imbalance_phase (dynamic), uniform for the others.
+    Draw order: β first, then one per non-imbalance line in line order."""
+    beta = rng.uniform(0.0, 2.0 * np.pi)
+    n_other = sum(1 for ln in lines if not ln.imbalance)
+    others = iter(rng.uniform(0.0, 2.0 * np.pi, size=n_other))
+    out = []
+    for ln in lines:
+        if not ln.imbalance:
+            out.append(next(others))
+        elif ln.direction == "radial_force":
+            out.append(beta)
+        else:
+            out.append(beta + wheel.imbalance_phase)
+    return np.array(out, dtype=float)
+
+
+def _with_phases(lines: list, phases) -> list:
+    return [ext.Line(ln.direction, ln.h, ln.C, ln.sense, float(p), ln.angle, ln.imbalance)
+            for ln, p in zip(lines, phases)]
+
+
+def _extended_meta(wheel: WheelDescription, lines: list) -> dict:
+    return {"physics": "extended",
+            "extended": ext.params_to_dict(wheel.extended),
+            "imbalance_phase_rad": float(wheel.imbalance_phase),
+            "lines": [{"direction": ln.direction, "h": ln.h, "C": ln.C, "sense": ln.sense,
+                       "imbalance": ln.imbalance} for ln in lines],
+            "extended_note": "wheel modes from rwadist.extended (ExtendedParams); imbalances U_s, U_d replace the "
+                             "radial h~1 harmonics; static imbalance at a random phase per run, dynamic at "
+                             "that phase + imbalance_phase_rad"}
+
+
+def _steady_extended(wheel, speeds, omegas, t, sample_rate, noise, test_stand, seed, noise_std, phase_rng,
+                     noise_rng) -> SteadyTest:
+    base = wheel.extended_lines()
+    fixture = _fixture_modes(wheel, test_stand)
+    nyquist = 0.5 * sample_rate
+    n_samples = t.size
+    dropped, runs = [], []
+    for k, omega in enumerate(omegas):
+        lines = _with_phases(base, _extended_phases(wheel, base, phase_rng))
+        f, A = ext.steady_lines(wheel.extended, lines, [omega])
+        f, A = f[0], A[0]                                    # (n_lines,), (n_lines, 6)
+        keep = f < nyquist
+        dropped.extend({"speed_rpm": float(speeds[k]), "direction": ln.direction, "h": ln.h}
+                       for ln, kp in zip(lines, keep) if not kp)
+        if fixture:
+            A = A * _fixture_gain(fixture, f)
+        A = A[keep]
+        z = A.T @ np.exp(2j * np.pi * np.outer(f[keep], t))  # (6, n_samples)
+        signals = {ch: z[i].real.copy() for i, ch in enumerate(CHANNELS)}
+        for ch in CHANNELS:
+            if noise_std[ch] > 0:
+                signals[ch] += noise_rng.normal(0.0, noise_std[ch], n_samples)
+        runs.append(Run(speed=float(omega), sample_rate=float(sample_rate), signals=signals, t0=0.0,
+                        name=f"run_{k:04d}.csv"))
+    meta = _meta(wheel, sample_rate, seed, noise, True, test_stand, noise_std, dropped,
+                 {"kind": "steady", "n_samples": n_samples, **_extended_meta(wheel, base)})
+    meta["active_modes"] = [m.to_json() for m in fixture]
+    return SteadyTest(runs=runs, meta=meta)
+
+
+def _sweep_extended(wheel, t, omega, sample_rate, test_stand, phase_rng) -> tuple:
+    """(signals dict, dropped lines, base lines) of an extended-physics sweep without noise."""
+    p = wheel.extended
+    base = wheel.extended_lines()
+    lines = _with_phases(base, _extended_phases(wheel, base, phase_rng))
+    nyquist = 0.5 * sample_rate
+    w_abs = np.abs(omega)
+    w_max = float(w_abs.max())
+    below = [ln for ln in lines if ln.h * w_max / (2.0 * np.pi) < nyquist]
+    above = [ln for ln in lines if ln.h * w_max / (2.0 * np.pi) >= nyquist]
+    out = np.zeros((t.size, len(CHANNELS)))
+    if below:
+        out += ext.simulate_time(p, below, t, omega, start="steady")
+    dropped = []
+    for ln in above:
+        # superposition: a line reaching Nyquist runs alone and is not recorded while at or above it
+        dropped.append({"direction": ln.direction, "h": ln.h,
+                        "above_rpm": float(rad_s_to_rpm(2.0 * np.pi * nyquist / ln.h))})
+        x = ext.simulate_time(p, [ln], t, omega, start="steady")
+        x[ln.h * w_abs / (2.0 * np.pi) >= nyquist] = 0.0
+        out += x
+    fixture = _fixture_modes(wheel, test_stand)
+    if fixture:
+        # the fixture resonances are real LTI filters: exact H(f) on the record's spectrum (circular).
+        # An odd FFT length (one zero appended when needed) has no Nyquist bin, where a complex H
+        # cannot be applied to a real signal.
+        m = t.size + (1 - t.size % 2)
+        f = np.fft.rfftfreq(m, 1.0 / sample_rate)
+        X = np.fft.rfft(out, n=m, axis=0) * _fixture_gain(fixture, f)
+        out = np.fft.irfft(X, n=m, axis=0)[: t.size]
+    return {ch: out[:, i].copy() for i, ch in enumerate(CHANNELS)}, dropped, base
 
 
 def speed_profile(t, rpm_start: float, rpm_end: float, duration: float, profile="linear"):
@@ -409,7 +620,8 @@ def _cumtrapz(y: np.ndarray, dt: float) -> np.ndarray:
 
 def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: float = 2400.0,
                    duration: float = 390.0, sample_rate: float = 3840.0, noise: float = 0.01, modes: bool = True,
-                   test_stand: bool = True, seed=0, profile="linear", tach: bool = True) -> Sweep:
+                   test_stand: bool = True, seed=0, profile="linear", tach: bool = True,
+                   physics: str = "simple") -> Sweep:
     """A continuous record through a speed change (spin-up or run-down).
 
     rpm_start, rpm_end : speeds (rpm, signed); duration : s; sample_rate : Hz.
@@ -422,7 +634,13 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
     noise : relative sensor noise, std = noise · C_1 · Ω_max², Ω_max the sweep's largest |Ω|.
     tach : store Ω(t) (rad/s) in ``Sweep.tach``; else None.
     Lines are built one harmonic at a time (memory ~ a few arrays of the record length).
+    physics : "simple" (above, the default) or "extended": :func:`rwadist.extended.simulate_time` of
+        ``wheel.extended`` (exact modal integration incl. transients and the tangential imbalance force,
+        started in the closed-form steady state at the first sample; one phase per line per sweep,
+        imbalances β and β + imbalance_phase); |dΩ/dt| must stay below
+        :data:`rwadist.extended.DEFAULT_MAX_ACCEL`.
     """
+    _check_physics(wheel, physics, modes)
     if not duration > 0:
         raise ValueError(f"duration must be > 0 s, got {duration!r}")
     if not sample_rate > 0:
@@ -442,6 +660,22 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
     active = wheel.all_modes(modes, test_stand)
     phase_rng, noise_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
     nyquist = 0.5 * sample_rate
+    extra = {"kind": "sweep", "profile": profile if isinstance(profile, str) else "custom",
+             "rpm_start": float(rpm_start), "rpm_end": float(rpm_end), "duration_s": float(duration)}
+    if profile == "exp":
+        extra["tau_s"] = duration / 5.0
+    if physics == "extended":
+        signals, dropped, base = _sweep_extended(wheel, t, omega, sample_rate, test_stand, phase_rng)
+        for ch in CHANNELS:
+            if noise_std[ch] > 0:
+                signals[ch] += noise_rng.normal(0.0, noise_std[ch], n)
+        extra.update(_extended_meta(wheel, base))
+        extra["modal_gain"] = ("exact modal integration (rwadist.extended.simulate_time, start: steady state); "
+                               "fixture resonances as LTI filters (FFT, circular)")
+        meta = _meta(wheel, sample_rate, seed, noise, True, test_stand, noise_std, dropped, extra)
+        meta["active_modes"] = [m.to_json() for m in _fixture_modes(wheel, test_stand)]
+        return Sweep(time=t, signals=signals, sample_rate=float(sample_rate), tach=omega if tach else None,
+                     meta=meta)
     signals = {ch: np.zeros(n) for ch in CHANNELS}
     dropped = []
     lines = []                                          # (channels, h, C, alpha) per harmonic
@@ -484,11 +718,8 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
     for ch in CHANNELS:
         if noise_std[ch] > 0:
             signals[ch] += noise_rng.normal(0.0, noise_std[ch], n)
-    extra = {"kind": "sweep", "profile": profile if isinstance(profile, str) else "custom",
-             "rpm_start": float(rpm_start), "rpm_end": float(rpm_end), "duration_s": float(duration),
-             "modal_gain": "quasi-steady (gain at the instantaneous line frequency and speed)"}
-    if profile == "exp":
-        extra["tau_s"] = duration / 5.0
+    extra["modal_gain"] = "quasi-steady (gain at the instantaneous line frequency and speed)"
+    extra["physics"] = "simple"
     meta = _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, dropped, extra)
     return Sweep(time=t, signals=signals, sample_rate=float(sample_rate), tach=omega if tach else None, meta=meta)
 

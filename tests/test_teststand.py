@@ -408,3 +408,265 @@ def test_full_e_wheel_spin_up_slice_matches_truth():
             gain *= m.gain(h * w / TWO_PI, w)
     expected = C * w**2 * np.abs(gain)
     np.testing.assert_allclose(amps, expected, rtol=0.02, atol=3 * sw.meta["noise_std"]["Fx"] / np.sqrt(4096))
+
+
+# --------------------------------------------------------------------------- extended physics (issue 3)
+
+from dataclasses import asdict, replace  # noqa: E402
+
+from rwadist import extended as ex  # noqa: E402
+from rwadist.cli import main as cli_main  # noqa: E402
+from rwadist.units import THESIS_C_TO_SI  # noqa: E402
+
+
+def fit_complex(x, t, freqs):
+    """Least-squares complex amplitudes a_k of x ≈ Re Σ a_k e^{i2πf_k t} (second method to the closed form)."""
+    w = TWO_PI * np.asarray(freqs, dtype=float)
+    design = np.hstack([np.cos(np.outer(t, w)), np.sin(np.outer(t, w))])
+    coef, *_ = np.linalg.lstsq(design, x, rcond=None)
+    return coef[: len(w)] - 1j * coef[len(w):]
+
+
+def whirl_fit(z, t, freqs):
+    """Least-squares (forward, backward) content of the complex signal z = X + iY:
+    z ≈ Σ a_k e^{+i2πf_k t} + b_k e^{−i2πf_k t}; returns (a, b)."""
+    w = TWO_PI * np.asarray(freqs, dtype=float)
+    design = np.hstack([np.exp(1j * np.outer(t, w)), np.exp(-1j * np.outer(t, w))])
+    coef, *_ = np.linalg.lstsq(design, z, rcond=None)
+    return coef[: len(w)], coef[len(w):]
+
+
+def test_extended_steady_equals_closed_form_by_least_squares():
+    """Every line of every channel: least-squares sinusoid fit at the known frequency = steady_lines amplitude
+    times one unit phase factor per line (the run's random phase), the same on all the line's channels."""
+    wheel = preset("ithaco-e")
+    p = wheel.extended
+    lines = wheel.extended_lines()
+    fs, n = 3840.0, 4096
+    t = np.arange(n) / fs
+    speeds = [900.0, -1500.0, 1907.0]                  # 1907 rpm: h = 3 on the forward whirl
+    test = simulate_steady(wheel, speeds, sample_rate=fs, n_samples=n, noise=0.0, seed=5, physics="extended")
+    assert test.meta["physics"] == "extended"
+    assert ex.params_from_dict(test.meta["extended"]) == p
+    for run, rpm in zip(test.runs, speeds):
+        f, A0 = ex.steady_lines(p, lines, [rpm * RPM])          # phases 0
+        f, A0 = f[0], A0[0]
+        fitted = np.zeros_like(A0)
+        for ci, ch in enumerate(data.CHANNELS):
+            used = np.nonzero(np.abs(A0[:, ci]) > 0)[0]
+            if used.size == 0:
+                assert np.abs(run.signals[ch]).max() == 0.0
+                continue
+            fu, inv = np.unique(np.round(f[used], 9), return_inverse=True)
+            assert fu.size == used.size                           # no two lines at one frequency per channel
+            fitted[used, ci] = fit_complex(run.signals[ch], t, f[used])
+        for j, ln in enumerate(lines):
+            on = np.abs(A0[j]) > 1e-6 * np.abs(A0[j]).max()
+            ratio = fitted[j, on] / A0[j, on]
+            np.testing.assert_allclose(np.abs(ratio), 1.0, rtol=1e-7, err_msg=f"{ln} at {rpm} rpm")
+            np.testing.assert_allclose(ratio, ratio[0], rtol=1e-7, err_msg=f"{ln} at {rpm} rpm")
+    # and the modes are really there: h = 3 (co) radial torque at its forward-whirl crossing is amplified
+    j3 = [j for j, ln in enumerate(lines) if ln.direction == "radial_torque" and ln.h == 3.0][0]
+    _, A = ex.steady_lines(p, lines, [1907.0 * RPM])
+    assert abs(A[0, j3, 3]) > 3 * lines[j3].C * (1907.0 * RPM) ** 2
+
+
+def test_extended_imbalance_torque_force_ratio_is_a_wheel_property():
+    """Static and dynamic imbalance share one random phase per run plus the fixed imbalance_phase: the 1×
+    Tx/Fx ratio is the same in every run at a speed (and equals the closed form), while Fx's phase is not."""
+    wheel = preset("ithaco-e")
+    p = wheel.extended
+    fs, n = 3840.0, 3840
+    t = np.arange(n) / fs
+    for rpm in (1200.0, -1800.0):
+        test = simulate_steady(wheel, [rpm] * 4, sample_rate=fs, n_samples=n, noise=0.0, seed=9, physics="extended")
+        lines = wheel.extended_lines()
+        f_all, _ = ex.steady_lines(p, lines, [rpm * RPM])
+        fr = np.unique(np.round(f_all[0], 9))            # every frequency in the record, for a clean fit
+        k1 = int(np.argmin(np.abs(fr - abs(rpm) / 60.0)))
+        fx = [fit_complex(r.signals["Fx"], t, fr)[k1] for r in test.runs]
+        tx = [fit_complex(r.signals["Tx"], t, fr)[k1] for r in test.runs]
+        ratio = np.array(tx) / np.array(fx)
+        # closed form with static at 0 and dynamic at imbalance_phase
+        _, A = ex.steady_lines(p, ex.imbalance_lines(p, 0.0, wheel.imbalance_phase), [rpm * RPM])
+        expected = A[0, 1, 3] / A[0, 0, 0]
+        np.testing.assert_allclose(ratio, expected, rtol=1e-7)
+        assert np.ptp(np.angle(fx)) > 0.1                 # the shared phase itself is random per run
+    # a different imbalance_phase changes the ratio by exactly that angle
+    other = replace(wheel, imbalance_phase=wheel.imbalance_phase + 0.5)
+    r0 = simulate_steady(wheel, [1200.0], sample_rate=fs, n_samples=n, noise=0.0, seed=9, physics="extended").runs[0]
+    r1 = simulate_steady(other, [1200.0], sample_rate=fs, n_samples=n, noise=0.0, seed=9, physics="extended").runs[0]
+    f_all, _ = ex.steady_lines(p, wheel.extended_lines(), [1200.0 * RPM])
+    fr = np.unique(np.round(f_all[0], 9))
+    k1 = int(np.argmin(np.abs(fr - 20.0)))
+    q0 = fit_complex(r0.signals["Tx"], t, fr)[k1] / fit_complex(r0.signals["Fx"], t, fr)[k1]
+    q1 = fit_complex(r1.signals["Tx"], t, fr)[k1] / fit_complex(r1.signals["Fx"], t, fr)[k1]
+    assert wrap(np.angle(q1 / q0)) == pytest.approx(0.5, abs=1e-7)
+
+
+@pytest.mark.parametrize("rpm", [1165.0, -1165.0])
+def test_extended_counter_rotating_h2_is_backward_content(rpm):
+    """E wheel h = 2 is counter-rotating: its radial force and torque are X − iY content (whirl against the
+    spin) for Ω > 0 and X + iY for Ω < 0; the co-rotating h = 3 the opposite.  At 1165 rpm the h = 2 torque
+    sits on the backward whirl and is amplified."""
+    wheel = preset("ithaco-e")
+    fs, n = 3840.0, 4096
+    t = np.arange(n) / fs
+    run = simulate_steady(wheel, [rpm], sample_rate=fs, n_samples=n, noise=0.0, seed=1, physics="extended").runs[0]
+    f_all, _ = ex.steady_lines(wheel.extended, wheel.extended_lines(), [rpm * RPM])
+    fr = np.unique(np.round(f_all[0], 9))
+    spin = np.sign(rpm)
+    for chx, chy, d in (("Fx", "Fy", "radial_force"), ("Tx", "Ty", "radial_torque")):
+        fwd, bwd = whirl_fit(run.signals[chx] + 1j * run.signals[chy], t, fr)
+        plus, minus = (fwd, bwd) if spin > 0 else (bwd, fwd)     # plus: rotating with the spin
+        k2 = int(np.argmin(np.abs(fr - 2 * abs(rpm) / 60.0)))
+        k3 = int(np.argmin(np.abs(fr - 3 * abs(rpm) / 60.0)))
+        C2 = dict(wheel.harmonics[d])[2.0]
+        assert abs(minus[k2]) > 0.5 * C2 * (rpm * RPM) ** 2 and abs(plus[k2]) < 1e-9 * abs(minus[k2]), d
+        assert abs(plus[k3]) > 0 and abs(minus[k3]) < 1e-9 * abs(plus[k3]), d
+        if d == "radial_torque":
+            assert abs(minus[k2]) > 3 * C2 * (rpm * RPM) ** 2     # backward-whirl amplification
+
+
+def test_extended_sweep_is_simulate_time_and_matches_steady_at_constant_speed():
+    wheel = preset("ithaco-e")
+    p = wheel.extended
+    fs, dur = 3840.0, 3.0
+    sw = simulate_sweep(wheel, 300.0, 1500.0, duration=dur, sample_rate=fs, noise=0.0, seed=3, physics="extended")
+    assert sw.meta["physics"] == "extended" and ex.params_from_dict(sw.meta["extended"]) == p
+    # the documented phase rule: β (static), β + imbalance_phase (dynamic), uniform for the others in order
+    lines = wheel.extended_lines()
+    rng = np.random.default_rng(np.random.SeedSequence(3).spawn(2)[0])
+    beta = rng.uniform(0, TWO_PI)
+    others = list(rng.uniform(0, TWO_PI, size=len(lines) - 2))
+    phases = [beta, beta + wheel.imbalance_phase] + others
+    assert [ln.imbalance for ln in lines[:2]] == [True, True]
+    ref = ex.simulate_time(p, lines, sw.time, sw.tach, phases=phases, start="steady")
+    for i, ch in enumerate(data.CHANNELS):
+        np.testing.assert_allclose(sw.signals[ch], ref[:, i], rtol=0, atol=1e-12 * np.abs(ref).max())
+    # constant speed: time-domain sweep (started in steady state) = closed-form steady run with the same seed
+    n = 4096
+    sw_c = simulate_sweep(wheel, 1300.0, 1300.0, duration=n / fs, sample_rate=fs, noise=0.01, seed=8,
+                          physics="extended")
+    st = simulate_steady(wheel, [1300.0], sample_rate=fs, n_samples=n, noise=0.01, seed=8, physics="extended")
+    for ch in data.CHANNELS:
+        scale = np.abs(st.runs[0].signals[ch]).max()
+        np.testing.assert_allclose(sw_c.signals[ch], st.runs[0].signals[ch], rtol=0, atol=1e-6 * scale + 1e-300)
+
+
+def test_extended_fixture_resonance_and_anti_aliasing_b_wheel():
+    """B wheel: fixture resonances multiply each steady line by H(f); the sweep applies the same real filter
+    (FFT) so at constant speed it equals the steady run away from the record ends; lines at or above
+    Nyquist are not recorded in either."""
+    wheel = preset("ithaco-b")
+    fs, n, rpm = 1000.0, 8000, 2000.0
+    t = np.arange(n) / fs
+    on = simulate_steady(wheel, [rpm], sample_rate=fs, n_samples=n, noise=0.0, seed=2, physics="extended")
+    off = simulate_steady(wheel, [rpm], sample_rate=fs, n_samples=n, noise=0.0, seed=2, test_stand=False,
+                          physics="extended")
+    f_all, _ = ex.steady_lines(wheel.extended, wheel.extended_lines(), [rpm * RPM])
+    fr = np.unique(np.round(f_all[0], 9))
+    a_on = fit_complex(on.runs[0].signals["Fx"], t, fr)
+    a_off = fit_complex(off.runs[0].signals["Fx"], t, fr)
+    H = np.ones(fr.size, dtype=complex)
+    for f0 in (300.0, 460.0):                          # H(r) = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r), g 10, ζ 0.01
+        r = fr / f0
+        H *= (1 - r**2 + 2j * 10 * 0.01 * r) / (1 - r**2 + 2j * 0.01 * r)
+    big = np.abs(a_off) > 1e-6 * np.abs(a_off).max()
+    np.testing.assert_allclose(a_on[big], (H * a_off)[big], rtol=1e-7)
+    sw = simulate_sweep(wheel, rpm, rpm, duration=n / fs, sample_rate=fs, noise=0.0, seed=2, physics="extended")
+    # away from the circular ends; the FFT filter of a non-periodic record leaves a ~1e-4 residue near
+    # Nyquist (H is complex there), so 1e-3 of the peak -- the fixture itself changes the signal by O(1)
+    mid = slice(n // 4, 3 * n // 4)
+    for ch in ("Fx", "Ty", "Fz"):
+        ref = on.runs[0].signals[ch]
+        np.testing.assert_allclose(sw.signals[ch][mid], ref[mid], rtol=0, atol=1e-3 * np.abs(ref).max())
+        assert np.abs(off.runs[0].signals[ch] - ref).max() > 0.05 * np.abs(ref).max()   # >> the 1e-3 bound
+    # anti-aliasing: at 3400 rpm h = 8.83, 9.54, 10.25 (>= 500 Hz) are absent, h = 8.09 (458.4 Hz) present
+    hi = simulate_steady(wheel, [3400.0], sample_rate=fs, n_samples=n, noise=0.0, seed=2, test_stand=False,
+                         physics="extended")
+    dropped = {(d["direction"], d["h"]) for d in hi.meta["lines_above_nyquist"]}
+    assert dropped == {("radial_force", 8.83), ("radial_force", 9.54), ("radial_force", 10.25)}
+    f_hi, _ = ex.steady_lines(wheel.extended, wheel.extended_lines(), [3400.0 * RPM])
+    kept = np.unique(np.round(f_hi[0][f_hi[0] < 500.0], 9))
+    alias = 1000.0 - 9.54 * 3400 / 60                  # where h = 9.54 would alias (459.4 Hz)
+    a = fit_complex(hi.runs[0].signals["Fx"], t, np.append(kept, alias))
+    C954 = dict(wheel.harmonics["radial_force"])[9.54]
+    assert abs(a[-1]) < 1e-9 * C954 * (3400 * RPM) ** 2
+    assert abs(a[np.argmin(np.abs(kept - 8.09 * 3400 / 60))]) > 0.1 * C954 * (3400 * RPM) ** 2
+
+
+def test_physics_switch_default_and_bad_input():
+    wheel = preset("ithaco-e")
+    a = simulate_steady(wheel, [800.0, 1600.0], n_samples=512, seed=4)
+    b = simulate_steady(wheel, [800.0, 1600.0], n_samples=512, seed=4, physics="simple")
+    c = simulate_steady(wheel, [800.0, 1600.0], n_samples=512, seed=4, physics="extended")
+    for ra, rb, rc in zip(a.runs, b.runs, c.runs):
+        np.testing.assert_array_equal(ra.signals["Tx"], rb.signals["Tx"])
+        assert not np.allclose(ra.signals["Tx"], rc.signals["Tx"])
+    assert a.meta["physics"] == "simple" and c.meta["physics"] == "extended"
+    with pytest.raises(ValueError, match="physics"):
+        simulate_steady(wheel, [800.0], physics="rotordynamic")
+    with pytest.raises(ValueError, match="modes=False"):
+        simulate_steady(wheel, [800.0], modes=False, physics="extended")
+    with pytest.raises(ValueError, match="extended"):
+        simulate_sweep(one_line(), 0, 100, duration=0.1, physics="extended")
+    with pytest.raises(ValueError, match="senses"):
+        WheelDescription("x", {"radial_force": [(2.0, 1e-7)]}, [], senses={("radial_force", 2.0): "sideways"})
+
+
+def test_presets_extended_parameters():
+    e, b = preset("ithaco-e"), preset("ithaco-b")
+    assert asdict(e.extended) == {**asdict(ex.from_table_4_2()), "height": 0.0}
+    assert e.senses[("radial_force", 2.0)] == "counter" == e.senses[("radial_torque", 2.0)]
+    assert {e.senses[(d, h)] for d in ("radial_force", "radial_torque") for h in (3.0, 4.0, 4.42)} == {"co"}
+    pb = b.extended
+    assert pb.mass == 5.9 and pb.I_zz == pytest.approx(0.5 * 5.9 * 0.1275**2) and pb.height == 0.0
+    for omega, f in ((pb.omega_r, 200.0), (pb.omega_rock, 85.0), (pb.omega_z, 65.0)):   # Table 2.3
+        assert omega / TWO_PI == pytest.approx(f, rel=1e-12)
+    pe = e.extended
+    for z in ("zeta_r", "zeta_rock", "zeta_z"):
+        assert getattr(pb, z) == pytest.approx(getattr(pe, z), rel=1e-12)
+    # Table 3.3's h = 0.99 coefficients, N/rpm² ×1e-7 -> kg·m with (60/2π)²
+    assert pb.U_s == pytest.approx(0.2134e-7 * (60 / TWO_PI) ** 2, rel=1e-12)
+    assert pb.U_d == pytest.approx(0.0630 * THESIS_C_TO_SI, rel=1e-12)
+    # the 0.99 lines are the imbalances (no double count), the rest carry over
+    lines = b.extended_lines()
+    assert [ln.h for ln in lines if ln.direction == "radial_force" and not ln.imbalance][0] == 1.99
+    assert sum(ln.imbalance for ln in lines) == 2
+    assert len(lines) == sum(len(v) for v in b.harmonics.values())
+    # the truth model carries the analytical section and senses
+    m = e.to_model()
+    assert ex.params_from_model(m) == pe
+    assert {hm.h: hm.sense for hm in m.harmonics("radial_torque")}[2.0] == "counter"
+
+
+def test_cli_simulate_test_physics_extended(tmp_path, capsys):
+    out = tmp_path / "e"
+    assert cli_main(["simulate-test", str(out), "--preset", "ithaco-e", "--physics", "extended",
+                     "--speeds-rpm", "600,1200", "--samples", "512", "--noise", "0"]) == 0
+    back = data.read_steady(out)
+    meta = json.loads((out / "meta.json").read_text())
+    assert meta["physics"] == "extended" and ex.params_from_dict(meta["extended"]) == preset("ithaco-e").extended
+    ref = simulate_steady(preset("ithaco-e"), [600.0, 1200.0], n_samples=512, noise=0.0, seed=0, physics="extended")
+    for r, q in zip(back.runs, ref.runs):
+        np.testing.assert_allclose(r.signals["Tx"], q.signals["Tx"], rtol=1e-12, atol=1e-15)
+    assert cli_main(["simulate-test", str(tmp_path / "x"), "--preset", "ithaco-e", "--physics", "extended",
+                     "--no-modes", "--speeds-rpm", "600"]) == 2
+    assert "modes=False" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_full_e_wheel_extended_spin_up():
+    """390 s, 3840 Hz extended spin-up of the E wheel: the last slice's 1× force equals the closed form at
+    the (saturated) speed, and the backward-whirl crossing of h = 2 shows in the torque."""
+    wheel = preset("ithaco-e")
+    t0 = time.perf_counter()
+    sw = simulate_sweep(wheel, **wheel.default_sweep, noise=0.0, seed=0, physics="extended")
+    print(f"\nextended 390 s sweep: {time.perf_counter() - t0:.1f} s")
+    sl = slice(-8192, None)
+    w = float(np.mean(sw.tach[sl]))
+    t = sw.time[sl] - sw.time[sl][0]
+    _, A = ex.steady_lines(wheel.extended, ex.imbalance_lines(wheel.extended), [w])
+    amp = fit_complex(sw.signals["Fx"][sl], t, [w / TWO_PI])
+    assert abs(amp[0]) == pytest.approx(abs(A[0, 0, 0]), rel=2e-3)
