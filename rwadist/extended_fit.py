@@ -258,7 +258,17 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
         pred = np.abs(A[s_idx, li, ch])
         return np.log(np.maximum(amp, 1e-300)) - np.log(np.maximum(pred, 1e-300))
 
-    res = optimize.least_squares(residuals, x0, method="trf", x_scale="jac", max_nfev=400,
+    # bounds keep the search physical: stiffness within 4x of its start (the peaks place it
+    # far better), damping ratio in [1e-4, 0.95], line coefficients within 1000x
+    lo, hi = [], []
+    for m in free_modes:
+        kn, cn, inertia = _MODE_PARAMS[m]
+        crit = 2 * math.sqrt(base[kn] * base[inertia])
+        lo += [math.log(base[kn] / 4), math.log(1e-4 * crit / 2)]
+        hi += [math.log(base[kn] * 4), math.log(0.95 * crit * 2)]
+    lo += list(x0[n_mode:] - math.log(1e3))
+    hi += list(x0[n_mode:] + math.log(1e3))
+    res = optimize.least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
                                  verbose=2 if progress else 0)
     params, fitted_lines = unpack(res.x)
     dof = max(res.fun.size - res.x.size, 1)

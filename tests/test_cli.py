@@ -99,3 +99,30 @@ def test_demo_small(tmp_path, capsys):
     assert code == 0
     assert (tmp_path / "demo" / "model.json").exists() and (tmp_path / "demo" / "report" / "summary.md").exists()
     assert "h fit" in out and "radial_force" in out
+
+
+def test_fit_extended_then_campbell_from_the_fitted_model(tmp_path, capsys):
+    """simulate (extended physics) -> fit --extended -> campbell on the fitted model file."""
+    from rwadist import extended as ext
+    from rwadist import model as model_io
+
+    data = tmp_path / "e"
+    code, _, _ = run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400",
+                     "--n-speeds", "30", "--samples", "4096", "--sample-rate", "1920", "--physics", "extended")
+    assert code == 0
+    code, out, _ = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--extended", "--preset", "ithaco-e")
+    assert code == 0 and "rocking at rest" in out
+    p = ext.params_from_model(model_io.load(tmp_path / "m.json"))
+    assert p.k_rock == pytest.approx(preset("ithaco-e").extended.k_rock, rel=0.02)
+    assert (tmp_path / "m_report" / "extended_params.csv").exists()
+    code, out, _ = run(capsys, "campbell", tmp_path / "m.json", "--speeds-rpm", "0:3000:500",
+                       "-o", tmp_path / "c.csv")
+    assert code == 0 and (tmp_path / "c.csv").exists() and (tmp_path / "c.png").exists()
+
+
+def test_fit_extended_needs_mass_and_radius(tmp_path, capsys):
+    data = tmp_path / "e"
+    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "8",
+        "--samples", "2048", "--sample-rate", "1920")
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--extended")
+    assert code == 2 and "mass" in err
