@@ -156,6 +156,9 @@ def run_extended_fit(test, fit, args):
     print(f"  axial translation  {p.omega_z / (2 * np.pi):7.2f} Hz  zeta {efit.zeta['axial_translation']:.3f}"
           f"  (k_z {p.k_z:.4g} N/m)")
     print(f"  U_s {p.U_s:.4g} kg·m, U_d {p.U_d:.4g} kg·m²")
+    for mode, db in efit.residual_db.items():
+        print(f"  residual near {mode}: {db:.2f} dB RMS"
+              + ("  (a linear model does not match this resonance well)" if db > 2.0 else ""))
     for note in efit.notes:
         print(f"  note: {note}")
     return efit, to_model(efit, fit)

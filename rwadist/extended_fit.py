@@ -61,6 +61,7 @@ class ExtendedFit:
     rms : model-vs-data RMS comparison (see :func:`rms_comparison`).
     residual_db : per mode, RMS log-amplitude residual (dB) of the measurements near it.
     notes : what could not be fitted and why.
+    measured : the line measurements the least squares used (LineFit list, every speed).
     """
 
     params: ext.ExtendedParams
@@ -73,6 +74,7 @@ class ExtendedFit:
     rms: dict = field(default_factory=dict)
     residual_db: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
+    measured: list = field(default_factory=list)
 
 
 # --------------------------------------------------------------------------- 1. senses
@@ -297,7 +299,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
         if near.any():
             resid_db[m] = float(20 / np.log(10) * np.sqrt(np.mean(res.fun[near] ** 2)))
     return ExtendedFit(params=params, lines=fitted_lines, zeta=zeta, rel_stderr=rel_stderr, identified=identified,
-                       peaks=peaks, senses=senses, residual_db=resid_db, notes=notes)
+                       peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines)
 
 
 # --------------------------------------------------------------------------- 4. comparison

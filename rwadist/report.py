@@ -528,9 +528,44 @@ def plot_extended_rms(comparison: dict, direction: str, ax=None):
     return fig, ax
 
 
+def plot_extended_lines(efit, direction: str, fig=None):
+    """One panel per harmonic of ``direction``: measured line amplitude vs speed (every speed),
+    the extended model's |A| (modal amplification included) and the hard-mounted C·Ω²."""
+    from .extended import steady_lines
+
+    pairs = [(j, x) for j, x in enumerate(efit.measured) if x.direction == direction]
+    if not pairs:
+        return None
+    n = len(pairs)
+    cols = min(3, n)
+    rows_ = int(np.ceil(n / cols))
+    fig = fig if fig is not None else _new_figure((4.2 * cols, 3.2 * rows_))
+    ch = DIRECTION_CHANNELS[direction][0]
+    k_ch = ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz").index(ch)
+    for i, (j, x) in enumerate(pairs):
+        ax = fig.add_subplot(rows_, cols, i + 1)
+        w = np.linspace(np.abs(x.speed).min(), np.abs(x.speed).max(), 400)
+        _, A = steady_lines(efit.params, [efit.lines[j]], w)
+        rpm = w * RAD_S_TO_RPM
+        sel = np.asarray(x.channel) == ch
+        ax.plot(np.abs(x.speed[sel]) * RAD_S_TO_RPM, x.amplitude[sel], ".", ms=3, color="k", label=f"data {ch}")
+        ax.plot(rpm, np.abs(A[:, 0, k_ch]), "-", color="tab:blue", label="extended model")
+        ax.plot(rpm, efit.lines[j].C * w**2, "--", color="tab:orange", label="C·Ω² (hard-mounted)")
+        ax.set_yscale("log")
+        ax.set_title(f"h = {x.h:.2f} ({efit.lines[j].sense})", fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+        if i % cols == 0:
+            ax.set_ylabel(f"amplitude ({_direction_unit(direction)})")
+        if i >= n - cols:
+            ax.set_xlabel("|Ω| (rpm)")
+    fig.axes[0].legend(fontsize=7)
+    fig.suptitle(f"{_direction_label(direction)}: line amplitudes, data vs extended model")
+    return fig
+
+
 def write_extended_report(efit, fit, out_dir) -> list:
     """Extended-model part of the report: ``extended_rms_<direction>.png``,
-    ``extended_rms_vs_speed.csv`` and ``extended_params.csv``."""
+    ``extended_lines_<direction>.png``, ``extended_rms_vs_speed.csv`` and ``extended_params.csv``."""
     from .extended import params_to_dict
     from .extended_fit import rms_comparison
 
@@ -541,6 +576,9 @@ def write_extended_report(efit, fit, out_dir) -> list:
     for d in comparison:
         fig, _ = plot_extended_rms(comparison, d)
         files.append(_save(fig, out / f"extended_rms_{d}.png"))
+        fig = plot_extended_lines(efit, d)
+        if fig is not None:
+            files.append(_save(fig, out / f"extended_lines_{d}.png"))
     path = out / "extended_rms_vs_speed.csv"
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
