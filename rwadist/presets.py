@@ -180,9 +180,39 @@ _FACTORIES = {"ithaco-e": ithaco_e, "ithaco-b": ithaco_b}
 PRESETS = {name: make() for name, make in _FACTORIES.items()}
 
 
+def from_model(model) -> WheelDescription:
+    """A :class:`WheelDescription` of a model file (e.g. a catalogue wheel): its harmonics, its
+    analytical parameters as the extended physics, the senses of its radial harmonics.  A model
+    carries no simple resonances, so ``physics="simple"`` gives the harmonics alone; use
+    ``physics="extended"`` for the modes."""
+    from . import extended as ext
+
+    harmonics = {d: [(h.h, h.C) for h in model.harmonics(d)] for d in model.empirical if model.harmonics(d)}
+    senses = {(d, h.h): h.sense for d in ("radial_force", "radial_torque") for h in model.harmonics(d) if h.sense}
+    params = ext.params_from_model(model, model.name) if model.analytical else None
+    wheel = model.wheel or {}
+    return WheelDescription(
+        name=model.name, harmonics=harmonics, modes=[], test_stand_modes=[],
+        max_speed_rpm=float(wheel.get("max_speed_rpm", 6000.0)),
+        mass_kg=wheel.get("mass_kg"), radius_m=wheel.get("radius_m"),
+        notes=str(model.provenance.get("source", "")), extended=params, senses=senses)
+
+
+def names() -> list:
+    """Every preset name: the test-stand wheels and the catalogue."""
+    from . import catalogue
+
+    return sorted(set(_FACTORIES) | set(catalogue.names()))
+
+
 def preset(name: str) -> WheelDescription:
-    """A fresh :class:`WheelDescription` of a named preset; ValueError listing the names if unknown."""
+    """A fresh :class:`WheelDescription` of a named preset (a test-stand wheel of this module, else a
+    catalogue wheel of :mod:`rwadist.catalogue`); ValueError listing the names if unknown."""
+    from . import catalogue
+
     key = str(name).strip().lower()
-    if key not in _FACTORIES:
-        raise ValueError(f"unknown wheel preset {name!r}; available: {', '.join(sorted(_FACTORIES))}")
-    return _FACTORIES[key]()
+    if key in _FACTORIES:
+        return _FACTORIES[key]()
+    if key in catalogue.names():
+        return from_model(catalogue.load(key))
+    raise ValueError(f"unknown wheel preset {name!r}; available: {', '.join(names())}")

@@ -1,0 +1,90 @@
+"""A catalogue of real wheels for early design: one model file per wheel (CONVENTIONS.md format).
+
+Each file's ``provenance`` says where every number comes from: ``source`` (citation),
+``measured`` (what was measured, what is a datasheet value, what is assumed) and
+``date``; datasheet imbalance limits, where known, under ``datasheet_limits``.
+:mod:`rwadist.catalogue.build_catalogue` writes the files from their sources.
+
+    names()        -> sorted catalogue names
+    load(name)     -> WheelModel (DataError for a file without source/measured/date)
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..data import DataError
+from ..model import WheelModel
+from ..model import load as _load_model
+
+HERE = Path(__file__).parent
+REQUIRED = ("source", "measured", "date")
+
+
+def names() -> list:
+    """Names of the catalogue wheels (file stems), sorted."""
+    return sorted(p.stem for p in HERE.glob("*.json"))
+
+
+def path(name: str) -> Path:
+    key = str(name).strip().lower()
+    p = HERE / f"{key}.json"
+    if not p.exists():
+        raise DataError("--preset", "name", f"unknown wheel {name!r}; known: {', '.join(names())}")
+    return p
+
+
+def check_provenance(model: WheelModel, source) -> WheelModel:
+    """A catalogue entry must say where its numbers come from."""
+    for key in REQUIRED:
+        if not model.provenance.get(key):
+            raise DataError(source, f"provenance.{key}", "missing: every catalogue entry states its source, "
+                            "what was measured and the date")
+    return model
+
+
+def load(name: str) -> WheelModel:
+    """The catalogue wheel ``name`` as a :class:`~rwadist.model.WheelModel`."""
+    p = path(name)
+    return check_provenance(_load_model(p), p)
+
+
+def _imbalances(model: WheelModel) -> dict:
+    """U_s (kg·m), U_d (kg·m²) of a model: its analytical section, else its h ≈ 1 radial lines."""
+    out = {}
+    a = model.analytical or {}
+    if "U_s_kg_m" in a:
+        out["U_s_kg_m"], out["U_d_kg_m2"] = float(a["U_s_kg_m"]), float(a["U_d_kg_m2"])
+        return out
+    for d, key in (("radial_force", "U_s_kg_m"), ("radial_torque", "U_d_kg_m2")):
+        near = [h for h in model.harmonics(d) if abs(h.h - 1.0) <= 0.03]
+        if near:
+            out[key] = max(h.C for h in near)
+    return out
+
+
+def compare(fitted: WheelModel, reference: WheelModel, h_tol: float = 0.03) -> dict:
+    """A fitted model next to a catalogue wheel of the same type.
+
+    Returns {"harmonics": [(direction, h_fit, C_fit, h_ref, C_ref)], "imbalance": [(name, fitted,
+    limit, above)]}: harmonics matched by nearest h within ``h_tol`` (None where only one side
+    has the line); imbalances against the reference's datasheet limits (or its values when no
+    limit is stated), ``above`` True when the fitted one exceeds it.
+    """
+    rows = []
+    for d in ("radial_force", "radial_torque", "axial_force", "axial_torque"):
+        ref = list(reference.harmonics(d))
+        used = set()
+        for h in fitted.harmonics(d):
+            best = min(range(len(ref)), key=lambda i: abs(ref[i].h - h.h), default=None)
+            if best is not None and abs(ref[best].h - h.h) <= h_tol and best not in used:
+                used.add(best)
+                rows.append((d, h.h, h.C, ref[best].h, ref[best].C))
+            else:
+                rows.append((d, h.h, h.C, None, None))
+        rows += [(d, None, None, r.h, r.C) for i, r in enumerate(ref) if i not in used]
+    limits = reference.provenance.get("datasheet_limits") or _imbalances(reference)
+    mine = _imbalances(fitted)
+    imb = [(k, mine.get(k), limits.get(k), bool(mine.get(k) is not None and limits.get(k) is not None
+                                                 and mine[k] > limits[k]))
+           for k in ("U_s_kg_m", "U_d_kg_m2")]
+    return {"harmonics": rows, "imbalance": imb}
