@@ -287,19 +287,31 @@ def imbalance_lines(p: ExtendedParams, phase_s: float = 0.0, phase_d: float = 0.
             Line("radial_torque", 1.0, p.U_d, "co", phase_d, imbalance=True)]
 
 
+#: A radial harmonic within this of h = 1 that rotates with the spin is the imbalance (fitted
+#: fundamentals come out at 0.99 or 1.01; thesis Table 3.3 lists 0.99).
+IMBALANCE_H_TOL = 0.02
+
+
+def is_imbalance(direction: str, h: float, sense) -> bool:
+    """True for the co-rotating radial fundamental, which the imbalances U_s, U_d describe."""
+    return (direction in ("radial_force", "radial_torque") and abs(h - 1.0) <= IMBALANCE_H_TOL
+            and sense in (None, "co"))
+
+
 def lines_from_model(model, p: ExtendedParams, senses: dict | None = None) -> list:
-    """Lines of a :class:`~rwadist.model.WheelModel`: the imbalances from ``p`` replace the h = 1
-    radial force/torque harmonics (thesis Eqs. 4.48–4.49); every other empirical harmonic
-    becomes a line with sense ``senses.get((direction, h))``, else the harmonic's own ``sense``
-    from the model file, else 'co'."""
+    """Lines of a :class:`~rwadist.model.WheelModel`: the imbalances from ``p`` replace the
+    co-rotating radial fundamentals (|h − 1| <= IMBALANCE_H_TOL; thesis Eqs. 4.48–4.49); every
+    other empirical harmonic -- a counter-rotating fundamental included -- becomes a line with
+    sense ``senses.get((direction, h))``, else the harmonic's own ``sense`` from the model file,
+    else 'co'."""
     senses = senses or {}
     out = imbalance_lines(p)
     for d in DIRECTIONS:
         for hm in model.harmonics(d):
-            if d in ("radial_force", "radial_torque") and abs(hm.h - 1.0) < 1e-9:
+            sense = senses.get((d, float(hm.h))) or getattr(hm, "sense", None)
+            if is_imbalance(d, hm.h, sense):
                 continue
-            sense = senses.get((d, float(hm.h))) or getattr(hm, "sense", None) or "co"
-            out.append(Line(d, float(hm.h), float(hm.C), sense))
+            out.append(Line(d, float(hm.h), float(hm.C), sense or "co"))
     return out
 
 

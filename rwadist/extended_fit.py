@@ -40,7 +40,7 @@ from . import extended as ext
 from .data import SteadyTest
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .model import Harmonic
-from .spectra import welch_dof
+from .spectra import compute_spectra, welch_dof
 from .units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
 
 CHANNEL_INDEX = {c: i for i, c in enumerate(CHANNELS)}
@@ -75,6 +75,11 @@ class ExtendedFit:
     residual_db: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
     measured: list = field(default_factory=list)
+
+    def parts_of(self, direction: str, h: float) -> list:
+        """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
+        tol = ext.IMBALANCE_H_TOL if abs(h - 1.0) <= ext.IMBALANCE_H_TOL else 1e-6
+        return [ln for ln in self.lines if ln.direction == direction and abs(ln.h - h) <= tol]
 
 
 # --------------------------------------------------------------------------- 1. senses
@@ -188,23 +193,70 @@ def _measurements(fit: EmpiricalFit):
     return np.concatenate(li), np.concatenate(sp), np.concatenate(ch), np.concatenate(amp)
 
 
+def remove_lever_arm(test: SteadyTest, height: float) -> SteadyTest:
+    """Torques about the rotor centre from torques about the interface: T_rotor = T_int − i·height·F,
+    i.e. Tx += height·Fy, Ty −= height·Fx (runs lacking a channel are left as they are)."""
+    runs = []
+    for r in test.runs:
+        sig = dict(r.signals)
+        if all(c in sig for c in ("Fx", "Fy", "Tx", "Ty")):
+            sig["Tx"] = sig["Tx"] + height * sig["Fy"]
+            sig["Ty"] = sig["Ty"] - height * sig["Fx"]
+        runs.append(replace(r, signals=sig))
+    return SteadyTest(runs, dict(test.meta))
+
+
+def _radial_power(meas_lines):
+    """Per radial line and run, the measured x and y amplitudes combined: d_x² + d_y² (only runs
+    where both are measured).  Returns (line index, speed, power, direction) arrays."""
+    li, sp, pw, dr = [], [], [], []
+    for j, x in enumerate(meas_lines):
+        if x.direction not in RADIAL:
+            continue
+        cx, cy = DIRECTION_CHANNELS[x.direction]
+        speeds = np.unique(x.speed)
+        for w in speeds:
+            m = x.speed == w
+            chans = list(x.channel[m])
+            if cx in chans and cy in chans:
+                dx = x.amplitude[m][chans.index(cx)]
+                dy = x.amplitude[m][chans.index(cy)]
+                li.append(j)
+                sp.append(w)
+                pw.append(dx**2 + dy**2)
+                dr.append(x.direction)
+    return np.array(li, int), np.array(sp), np.array(pw), np.array(dr)
+
+
 def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float, height: float = 0.0,
                  start: ext.ExtendedParams | None = None, zeta0: float = 0.02, progress: bool = False) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
-    mass (kg), radius (m): datasheet values (thin-disc inertias).  height (m): lever arm
-    from the rotor centre to the torque reference point.  start: parameters for the modes the
-    data do not show (default: modes at 3x the top line frequency, ζ = zeta0).
+    mass (kg), radius (m): datasheet values (thin-disc inertias).  height (m): z of the rotor
+    centre above the point the torques are measured about (the interface), as in
+    :class:`rwadist.extended.ExtendedParams`; the lever-arm torque height × F is removed from the
+    data before the fit and put back in the model.  start: parameters for the modes the data do not
+    show (default: modes at 3x the top line frequency, ζ = zeta0).
+
+    Each radial line gets two forcing coefficients, one rotating with the spin and one against
+    it, fitted to the x-plus-y line power (which does not depend on their relative phase): the
+    rotation sense is read from the forcing, not from the response (a mode amplifies one sense
+    more than the other, so the response alone would mislabel a planar load).
     """
     I_zz, I_rr = ext.thin_disc(mass, radius)
     a = I_zz / I_rr
+    settings = FitSettings(**{k: v for k, v in fit.settings.items() if k in FitSettings.__dataclass_fields__})
+    if height:
+        sp0 = fit.spectra
+        test = remove_lever_arm(test, height)
+        spectra = compute_spectra(test, nperseg=sp0.nperseg, f_lim=sp0.f_lim, window=sp0.window)
+        fit = fit_empirical(spectra, settings)
     # every line the data show, with every measurement: the empirical fit without modal
     # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped)
-    settings = FitSettings(**{k: v for k, v in fit.settings.items() if k in FitSettings.__dataclass_fields__})
     meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False))
-    senses = line_senses(test, meas)
+    senses_xy = line_senses(test, meas)
     peaks = amplification_peaks(fit)
-    f_modes = mode_frequencies(peaks, senses, a)
+    f_modes = mode_frequencies(peaks, senses_xy, a)
     f_top = max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines), default=100.0)
     notes = []
 
@@ -220,22 +272,44 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
     k_r = start_k("radial_translation", mass, "k_r")
     k_rock = start_k("rocking", I_rr, "k_rock")
     k_z = start_k("axial_translation", mass, "k_z")
-    # forcing lines from the empirical fit (its C is the hard-mounted amplitude away from modes)
-    lines = []
-    for x in meas.lines:
-        sense = senses.get((x.direction, float(x.h)), ("co", 1.0))[0] if x.direction in RADIAL else "co"
-        imb = x.direction in RADIAL and abs(x.h - 1.0) < 0.01 and sense == "co"
-        lines.append(ext.Line(x.direction, 1.0 if imb else float(x.h), float(x.C), sense, imbalance=imb))
+    # forcing lines: axial one coefficient; radial a co- and a counter-rotating part, started
+    # from the x/y-phase split (floored so both can grow)
+    lines, owner = [], []
+    for j, x in enumerate(meas.lines):
+        if x.direction in RADIAL:
+            fr = senses_xy.get((x.direction, float(x.h)), ("co", 1.0))[1]
+            c_co, c_ct = x.C * max(math.sqrt(fr), 0.03), x.C * max(math.sqrt(1 - fr), 0.03)
+            imb = abs(x.h - 1.0) <= ext.IMBALANCE_H_TOL
+            lines.append(ext.Line(x.direction, 1.0 if imb else float(x.h), float(c_co), "co", imbalance=imb))
+            lines.append(ext.Line(x.direction, float(x.h), float(c_ct), "counter"))
+            owner += [j, j]
+        else:
+            lines.append(ext.Line(x.direction, float(x.h), float(x.C), "co"))
+            owner.append(j)
     if not lines:
         raise ValueError("the empirical fit has no harmonics: nothing to fit the extended model to")
-    li, sp, ch, amp = _measurements(meas)
-    speeds, s_idx = np.unique(sp, return_inverse=True)
+    owner = np.array(owner)
+    # axial measurements: per channel amplitude; radial: x²+y² power per run
+    la, sa, ca, aa = _measurements(meas)
+    keep_ax = np.array([meas.lines[j].direction not in RADIAL for j in la], bool)
+    la, sa, ca, aa = la[keep_ax], sa[keep_ax], ca[keep_ax], aa[keep_ax]
+    lr, sr, pr, dr = _radial_power(meas.lines)
+    speeds, inv = np.unique(np.concatenate([sa, sr]), return_inverse=True)
+    ia, ir = inv[:sa.size], inv[sa.size:]
+    line_of = {}
+    for k, j in enumerate(owner):
+        line_of.setdefault(int(j), []).append(k)
+    ax_line = np.array([line_of[int(j)][0] for j in la], int)
+    rad_parts = np.array([line_of[int(j)] for j in lr], int).reshape(-1, 2) if lr.size else np.zeros((0, 2), int)
+    rad_ch = np.array([[CHANNEL_INDEX[c] for c in DIRECTION_CHANNELS[d]] for d in dr], int).reshape(-1, 2)
+
     identified = {m: f_modes[m] is not None for m in _MODE_PARAMS}
     free_modes = [m for m in _MODE_PARAMS if identified[m]]
-    base = dict(mass=mass, I_zz=I_zz, I_rr=I_rr, k_r=k_r, k_rock=k_rock, k_z=k_z, height=height,
+    base = dict(mass=mass, I_zz=I_zz, I_rr=I_rr, k_r=k_r, k_rock=k_rock, k_z=k_z, height=0.0,
                 c_r=2 * zeta0 * math.sqrt(k_r * mass), c_rock=2 * zeta0 * math.sqrt(k_rock * I_rr),
                 c_z=2 * zeta0 * math.sqrt(k_z * mass), U_s=0.0, U_d=0.0)
-    names = [p for m in free_modes for p in _MODE_PARAMS[m][:2]] + [f"C[{ln.direction},{ln.h:g}]" for ln in lines]
+    names = [p for m in free_modes for p in _MODE_PARAMS[m][:2]] + \
+            [f"C[{ln.direction},{ln.h:g},{ln.sense}]" for ln in lines]
     x0 = np.log([base[n] for m in free_modes for n in _MODE_PARAMS[m][:2]] + [ln.C for ln in lines])
     n_mode = 2 * len(free_modes)
 
@@ -257,22 +331,30 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
     def residuals(theta):
         p, lns = unpack(theta)
         _, A = ext.steady_lines(p, lns, speeds)
-        pred = np.abs(A[s_idx, li, ch])
-        return np.log(np.maximum(amp, 1e-300)) - np.log(np.maximum(pred, 1e-300))
+        P = np.abs(A) ** 2
+        r_ax = np.log(np.maximum(aa, 1e-300)) - 0.5 * np.log(np.maximum(P[ia, ax_line, ca], 1e-300))
+        pred = np.zeros(lr.size)
+        for part in range(2):
+            for c in range(2):
+                pred += P[ir, rad_parts[:, part], rad_ch[:, c]]
+        r_rad = 0.5 * (np.log(np.maximum(pr, 1e-300)) - np.log(np.maximum(pred, 1e-300)))
+        return np.concatenate([r_ax, r_rad])
 
     # bounds keep the search physical: stiffness within 4x of its start (the peaks place it
-    # far better), damping ratio in [1e-4, 0.95], line coefficients within 1000x
+    # far better), damping ratio in [1e-4, 0.95], line coefficients within 1000x (down to 1e-4
+    # of the line for the sense parts, which may vanish)
     lo, hi = [], []
     for m in free_modes:
         kn, cn, inertia = _MODE_PARAMS[m]
         crit = 2 * math.sqrt(base[kn] * base[inertia])
         lo += [math.log(base[kn] / 4), math.log(1e-4 * crit / 2)]
         hi += [math.log(base[kn] * 4), math.log(0.95 * crit * 2)]
-    lo += list(x0[n_mode:] - math.log(1e3))
+    lo += list(x0[n_mode:] - math.log(1e4))
     hi += list(x0[n_mode:] + math.log(1e3))
     res = optimize.least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
                                  verbose=2 if progress else 0)
     params, fitted_lines = unpack(res.x)
+    params = replace(params, height=float(height))
     dof = max(res.fun.size - res.x.size, 1)
     s2 = float(np.sum(res.fun**2) / dof)
     try:
@@ -282,23 +364,43 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
         rel_se = np.full(res.x.size, np.nan)
     rel_stderr = {n: float(v) for n, v in zip(names, rel_se)}
     zeta = {"radial_translation": params.zeta_r, "rocking": params.zeta_rock, "axial_translation": params.zeta_z}
+    # rotation sense from the fitted forcing; negligible parts (< 1 % of the line's power) dropped
+    senses, kept_lines = {}, []
+    for j, x in enumerate(meas.lines):
+        parts = [fitted_lines[k] for k in line_of[j]]
+        if x.direction not in RADIAL:
+            kept_lines += parts
+            continue
+        p_co, p_ct = parts[0].C ** 2, parts[1].C ** 2
+        fr = p_co / (p_co + p_ct)
+        sense = "co" if fr >= 0.99 else ("counter" if fr <= 0.01 else "co+counter")
+        senses[(x.direction, float(x.h))] = (sense, float(fr))
+        kept_lines += [ln for ln, pw in zip(parts, (p_co, p_ct)) if pw >= 0.01 * (p_co + p_ct) or ln.imbalance]
     # residual near each mode: measurements within ±10 % of the mode frequency at their speed
     resid_db = {}
-    f_line = np.array([ln.h for ln in lines])[li] * np.abs(sp) / (2 * np.pi)
-    modes_f = ext.whirl_frequencies(params, sp)
-    chan_dir = {0: "radial_force", 1: "radial_force", 3: "radial_torque", 4: "radial_torque", 2: "axial_force"}
-    for m, keys in (("radial_translation", ("radial_translation",)),
-                    ("rocking", ("rocking_forward", "rocking_backward")),
-                    ("axial_translation", ("axial_translation",))):
-        near = np.zeros(sp.size, bool)
-        for key in keys:
-            near |= np.abs(f_line / modes_f[key] - 1) < 0.1
-        dirs = {"radial_translation": ("radial_force",), "rocking": ("radial_torque",),
-                "axial_translation": ("axial_force",)}[m]
-        near &= np.isin([chan_dir.get(c, "") for c in ch], dirs)
-        if near.any():
-            resid_db[m] = float(20 / np.log(10) * np.sqrt(np.mean(res.fun[near] ** 2)))
-    return ExtendedFit(params=params, lines=fitted_lines, zeta=zeta, rel_stderr=rel_stderr, identified=identified,
+    f_ax = np.array([lines[k].h for k in ax_line]) * np.abs(sa) / (2 * np.pi)
+    f_rd = np.array([lines[k].h for k in rad_parts[:, 0]]) * np.abs(sr) / (2 * np.pi) if lr.size else np.empty(0)
+    r_ax, r_rad = res.fun[:sa.size], res.fun[sa.size:]
+    for m, keys, use_rad, dirs in (("radial_translation", ("radial_translation",), True, ("radial_force",)),
+                                   ("rocking", ("rocking_forward", "rocking_backward"), True, ("radial_torque",)),
+                                   ("axial_translation", ("axial_translation",), False, ("axial_force",))):
+        if use_rad:
+            fm = ext.whirl_frequencies(params, sr)
+            near = np.zeros(sr.size, bool)
+            for key in keys:
+                near |= np.abs(f_rd / fm[key] - 1) < 0.1
+            near &= np.isin(dr, dirs)
+            rr = r_rad[near]
+        else:
+            fm = ext.whirl_frequencies(params, sa)
+            rr = r_ax[np.abs(f_ax / fm[keys[0]] - 1) < 0.1]
+        if rr.size:
+            resid_db[m] = float(20 / np.log(10) * np.sqrt(np.mean(rr**2)))
+            if resid_db[m] > 1.0:
+                notes.append(f"{m}: the linear model misses the data near this mode by {resid_db[m]:.1f} dB RMS "
+                             "(a fixture resonance inside the band -- set f_lim --, nonlinear damping, or a "
+                             "mode the model lacks)")
+    return ExtendedFit(params=params, lines=kept_lines, zeta=zeta, rel_stderr=rel_stderr, identified=identified,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines)
 
 
@@ -346,22 +448,26 @@ def rms_comparison(efit: ExtendedFit, fit: EmpiricalFit) -> dict:
 
 
 def to_model(efit: ExtendedFit, fit: EmpiricalFit):
-    """The empirical model of ``fit`` with senses, plus the analytical section of ``efit``."""
+    """A model file for the extended fit: the analytical section, and as harmonics the fitted
+    forcing lines (each radial one split into its co- and counter-rotating parts where both carry
+    power), which is what :func:`rwadist.extended.lines_from_model` reads back.  The forcing
+    coefficient equals the hard-mounted amplitude C·Ω² wherever the suspension is rigid."""
     from copy import deepcopy
 
     model = deepcopy(fit.model)
-    for d in RADIAL:
-        model.empirical[d] = [Harmonic(**{**vars(h), "sense": efit.senses.get((d, h.h), (None,))[0]
-                                          if (d, h.h) in efit.senses else _nearest_sense(efit.senses, d, h.h)})
-                              for h in model.empirical[d]]
+    se = efit.rel_stderr
+    for d in model.empirical:
+        model.empirical[d] = [
+            Harmonic(h=round(ln.h, 4), C=ln.C, C_stderr=ln.C * se.get(f"C[{ln.direction},{ln.h:g},{ln.sense}]", np.nan),
+                     sense=ln.sense if d in RADIAL else None)
+            for ln in efit.lines if ln.direction == d]
     analytical = ext.params_to_dict(efit.params)
     analytical["fit"] = {"zeta": efit.zeta, "identified": efit.identified,
                          "rel_stderr": efit.rel_stderr, "residual_db_near_mode": efit.residual_db,
+                         "senses": {f"{d} h={h:.4g}": {"sense": s_, "co_fraction": fr}
+                                    for (d, h), (s_, fr) in efit.senses.items()},
                          "notes": efit.notes}
     model.analytical = analytical
+    model.provenance = dict(model.provenance, extended_fit="rwadist fit --extended: harmonics are the fitted "
+                            "forcing lines of the extended model")
     return model
-
-
-def _nearest_sense(senses: dict, d: str, h: float):
-    best = min(((abs(k[1] - h), v[0]) for k, v in senses.items() if k[0] == d), default=(1.0, None))
-    return best[1] if best[0] < 1e-3 else None

@@ -533,7 +533,7 @@ def plot_extended_lines(efit, direction: str, fig=None):
     the extended model's |A| (modal amplification included) and the hard-mounted C·Ω²."""
     from .extended import steady_lines
 
-    pairs = [(j, x) for j, x in enumerate(efit.measured) if x.direction == direction]
+    pairs = [x for x in efit.measured if x.direction == direction]
     if not pairs:
         return None
     n = len(pairs)
@@ -542,17 +542,21 @@ def plot_extended_lines(efit, direction: str, fig=None):
     fig = fig if fig is not None else _new_figure((4.2 * cols, 3.2 * rows_))
     ch = DIRECTION_CHANNELS[direction][0]
     k_ch = ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz").index(ch)
-    for i, (j, x) in enumerate(pairs):
+    for i, x in enumerate(pairs):
         ax = fig.add_subplot(rows_, cols, i + 1)
+        parts = efit.parts_of(direction, x.h)
         w = np.linspace(np.abs(x.speed).min(), np.abs(x.speed).max(), 400)
-        _, A = steady_lines(efit.params, [efit.lines[j]], w)
+        _, A = steady_lines(efit.params, parts, w)
+        model_amp = np.sqrt(np.sum(np.abs(A[:, :, k_ch]) ** 2, axis=1))   # parts add in power
+        c_total = float(np.sqrt(sum(p.C**2 for p in parts)))
         rpm = w * RAD_S_TO_RPM
         sel = np.asarray(x.channel) == ch
         ax.plot(np.abs(x.speed[sel]) * RAD_S_TO_RPM, x.amplitude[sel], ".", ms=3, color="k", label=f"data {ch}")
-        ax.plot(rpm, np.abs(A[:, 0, k_ch]), "-", color="tab:blue", label="extended model")
-        ax.plot(rpm, efit.lines[j].C * w**2, "--", color="tab:orange", label="C·Ω² (hard-mounted)")
+        ax.plot(rpm, model_amp, "-", color="tab:blue", label="extended model")
+        ax.plot(rpm, c_total * w**2, "--", color="tab:orange", label="C·Ω² (hard-mounted)")
         ax.set_yscale("log")
-        ax.set_title(f"h = {x.h:.2f} ({efit.lines[j].sense})", fontsize=9)
+        sense = "+".join(p.sense for p in parts)
+        ax.set_title(f"h = {x.h:.2f} ({sense})", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         if i % cols == 0:
             ax.set_ylabel(f"amplitude ({_direction_unit(direction)})")

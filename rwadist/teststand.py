@@ -99,7 +99,7 @@ _SWEEP_BLOCK = 1 << 17
 PHYSICS = ("simple", "extended")
 #: Radial harmonics with |h − 1| at most this are the imbalances the extended model replaces
 #: (the thesis's B wheel lists its fundamental at h = 0.99).
-IMBALANCE_H_TOL = 0.02
+IMBALANCE_H_TOL = ext.IMBALANCE_H_TOL
 
 
 # --------------------------------------------------------------------------- modes
@@ -309,10 +309,7 @@ class WheelDescription:
         if self.extended is None:
             raise ValueError(f"wheel {self.name!r} has no extended parameters (WheelDescription.extended); "
                              "physics='extended' needs them")
-        model = self.to_model()
-        for d in ("radial_force", "radial_torque"):
-            model.empirical[d] = [hm for hm in model.empirical[d] if abs(hm.h - 1.0) > IMBALANCE_H_TOL]
-        return ext.lines_from_model(model, self.extended, self.senses)
+        return ext.lines_from_model(self.to_model(), self.extended, self.senses)
 
     def crossings(self, direction: str, speeds_rpm, modes: bool = True, test_stand: bool = True) -> list:
         """Where harmonics of ``direction`` meet the modes acting on its channels.
