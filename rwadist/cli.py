@@ -331,6 +331,140 @@ def cmd_campbell(args) -> int:
     return 0
 
 
+# --------------------------------------------------------------------------- fmu
+
+def cmd_fmu_build(args) -> int:
+    try:
+        from fmu.build import build_fmu
+        from fmu.runtime import ModelError
+    except ImportError as exc:
+        raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
+    if args.model:
+        source = args.model
+    else:
+        from .teststand import preset
+        source = preset(args.preset or "ithaco-e").to_model()
+    try:
+        path = build_fmu(source, args.output)
+    except ModelError as exc:
+        raise DataError(args.model or args.preset, "model", str(exc)) from None
+    print(f"wrote {path} (model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')})")
+    return 0
+
+
+def cmd_fmu_check(args) -> int:
+    try:
+        from fmpy import simulate_fmu
+        from fmpy.validation import validate_fmu
+    except ImportError as exc:
+        raise DataError(args.fmu, "check", f"needs fmpy ({exc})") from None
+    if not Path(args.fmu).is_file():
+        raise DataError(args.fmu, "file", "does not exist")
+    problems = validate_fmu(args.fmu)
+    for prob in problems:
+        print(f"validation: {prob}")
+    print(f"fmpy validation: {len(problems)} problem(s)")
+    w_end = float(rpm_to_rad_s(args.speed_rpm))
+    n = int(round(args.stop_time / args.step_size))
+    t = np.linspace(0.0, n * args.step_size, n + 1)
+    sig = np.zeros(t.size, dtype=[("time", float), ("wheel_speed", float)])
+    sig["time"], sig["wheel_speed"] = t, w_end * t / t[-1]
+    t0 = time.perf_counter()
+    res = simulate_fmu(args.fmu, stop_time=float(t[-1]), step_size=args.step_size, input=sig,
+                       output_interval=args.step_size)
+    wall = time.perf_counter() - t0
+    names = [c for c in res.dtype.names if c != "time"]
+    finite = all(np.all(np.isfinite(res[c])) for c in names)
+    print(f"simulated 0 -> {args.speed_rpm:g} rpm over {t[-1]:g} s at {args.step_size:g} s steps in {wall:.2f} s "
+          f"wall ({len(res)} samples)")
+    for c in names:
+        print(f"  {c:<6} max |.| = {np.max(np.abs(res[c])):.4g}")
+    if problems or not finite:
+        print("rwadist: error: FMU check failed" + ("" if finite else " (non-finite outputs)"), file=sys.stderr)
+        return 1
+    return 0
+
+
+# --------------------------------------------------------------------------- psd
+
+def cmd_psd(args) -> int:
+    """Broadband PSD over a speed distribution (Melody's model, or the extended model with the modal
+    amplification inside the speed integral); one wheel or a wheels.json set in the spacecraft frame."""
+    from . import broadband as bb
+    from .mounting import load_wheels, spacecraft_csd
+
+    if args.preset and args.model:
+        raise DataError("psd", "model/--preset", "give a model file or --preset, not both")
+    if not args.speed_rpm:
+        raise DataError("--speed-rpm", "value", "missing MIN:MAX (rpm)")
+    try:
+        lo_rpm, hi_rpm = (float(x) for x in args.speed_rpm.split(":"))
+    except ValueError:
+        raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: expected MIN:MAX in rpm") from None
+    law = bb.law_from_spec(args.dist, lo_rpm, hi_rpm, args.std_rpm)
+
+    def default_lines():
+        if args.preset:
+            try:
+                return bb.preset_lines(args.preset, args.empirical)
+            except ValueError as exc:
+                raise DataError("--preset", "name", str(exc)) from None
+        if not args.model:
+            raise DataError("psd", "model", "give a model file or --preset NAME")
+        m = model_io.load(args.model)
+        return bb.empirical_lines(m) if args.empirical else bb.extended_lines_from_model(m, str(args.model))
+
+    out = Path(args.output)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    fmax = args.fmax
+    if args.wheels:
+        wheels = load_wheels(args.wheels, default_lines if (args.model or args.preset) else None, law, args.empirical)
+        if fmax is None:
+            fmax = _default_fmax([(w.lines, w.law or wheels[w.tie.to].law) for w in wheels])
+        res = spacecraft_csd(wheels, fmax, args.n_freq, args.n_speeds, progress=True)
+        sources = [(w.lines, w.mounting) for w in wheels]
+    else:
+        lines = default_lines()
+        if fmax is None:
+            fmax = _default_fmax([(lines, law)])
+        res = bb.broadband_psd(lines, law, fmax, args.n_freq, args.n_speeds, progress=True)
+        sources = [(lines, None)]
+    kind = "empirical (Melody)" if args.empirical else "extended (modal amplification)"
+    if args.format == "nastran":
+        from .nastran import write_deck
+
+        written = write_deck(res, out, fmt=args.nastran_fields, cross=args.nastran_cross)
+        print(f"wrote NASTRAN deck {out} ({len(written)} TABRND1 tables, {args.nastran_fields} field)")
+    else:
+        bb.write_psd_csv(res, out)
+        print(f"wrote PSD table {out}")
+    stem = out.with_suffix("")
+    if args.cross == "csv":
+        p = bb.write_cross_csv(res, stem.parent / (stem.name + "_cross.csv"))
+        print(f"cross-spectra: {p}")
+    elif args.cross == "h5":
+        p = bb.write_hdf5(res, stem.parent / (stem.name + "_cross.h5"), "csd")
+        print(f"cross-spectra: {p} (group /csd)")
+    lo_w, hi_w = law.support if not args.wheels else (min(w.law.support[0] for w in wheels if w.law),
+                                                       max(w.law.support[1] for w in wheels if w.law))
+    env = bb.line_envelope(sources, (lo_w, hi_w), res.f)
+    p_env = bb.write_envelope_csv(env, stem.parent / (stem.name + "_envelope.csv"))
+    png = stem.parent / (stem.name + ".png")
+    bb.plot_psd(res, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm").savefig(png, dpi=110)
+    rms = res.rms()
+    print(f"{kind}, {res.frame} frame, {res.f.size} frequencies to {fmax:g} Hz, {time.perf_counter() - t0:.1f} s")
+    print("RMS: " + ", ".join(f"{c} {v:.4g}" for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
+    print(f"worst-case line envelope: {p_env}; plots: {png}")
+    return 0
+
+
+def _default_fmax(pairs) -> float:
+    """1.2 × the highest line frequency over the speed laws, Hz."""
+    top = max(float(lines.h.max()) * max(abs(law.support[0]), abs(law.support[1])) for lines, law in pairs)
+    return 1.2 * top / (2 * np.pi)
+
+
 # --------------------------------------------------------------------------- main
 
 def build_parser() -> argparse.ArgumentParser:
@@ -402,6 +536,42 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--n-speeds", type=int, default=None)
     c.add_argument("-o", "--output", default="campbell.csv", help="CSV to write; the plot goes next to it (.png)")
     c.set_defaults(func=cmd_campbell)
+
+    q = sub.add_parser("psd", help="broadband disturbance PSD over a wheel-speed distribution (Melody's model / "
+                       "extended model), optionally several wheels in the spacecraft frame")
+    q.add_argument("model", nargs="?", help="model file (JSON)")
+    q.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
+    q.add_argument("--speed-rpm", required=True, help="MIN:MAX speed range, rpm (negative = spinning about -z)")
+    q.add_argument("--dist", default="uniform", help="uniform | normal | FILE.csv (speed_rpm,weight histogram, "
+                   "speed_rpm,pdf_per_rpm density, or time_s,speed_rpm profile)")
+    q.add_argument("--std-rpm", type=float, default=None, help="std of the normal law, rpm (default range/6)")
+    q.add_argument("--wheels", help="wheels.json: several wheels with mountings (spacecraft-frame 6x6 CSD)")
+    q.add_argument("--fmax", type=float, default=None, help="top frequency, Hz (default 1.2 x highest line)")
+    q.add_argument("--n-freq", type=int, default=20001, help="frequency points 0..fmax (default 20001)")
+    q.add_argument("--n-speeds", type=int, default=2000, help="speed cells of the law (default 2000)")
+    q.add_argument("--empirical", action="store_true", help="Melody's model from the harmonics alone, no modes")
+    q.add_argument("--format", choices=("csv", "nastran"), default="csv")
+    q.add_argument("--nastran-fields", choices=("small", "free"), default="small")
+    q.add_argument("--nastran-cross", action="store_true", help="also RANDPS/TABRND1 of the cross-spectra")
+    q.add_argument("--cross", choices=("csv", "h5", "none"), default="csv",
+                   help="cross-spectra next to the output: <out>_cross.csv (default) or <out>_cross.h5")
+    q.add_argument("-o", "--output", default="psd.csv", help="output file (CSV or NASTRAN bulk data)")
+    q.set_defaults(func=cmd_psd)
+
+    fm = sub.add_parser("fmu", help="FMI 2.0 co-simulation FMU of the extended model (build, check)")
+    fsub = fm.add_subparsers(dest="fmu_command", required=True)
+    fb = fsub.add_parser("build", help="build the FMU from a model file or a preset (default: ithaco-e)")
+    fsrc = fb.add_mutually_exclusive_group()
+    fsrc.add_argument("model", nargs="?", help="model file (JSON) with an analytical section")
+    fsrc.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
+    fb.add_argument("-o", "--output", default="wheel.fmu", help="FMU to write (default wheel.fmu)")
+    fb.set_defaults(func=cmd_fmu_build)
+    fc = fsub.add_parser("check", help="fmpy validation and a short spin-up simulation of an FMU")
+    fc.add_argument("fmu")
+    fc.add_argument("--stop-time", type=float, default=1.0, help="s (default 1)")
+    fc.add_argument("--step-size", type=float, default=1e-3, help="communication step, s (default 1e-3)")
+    fc.add_argument("--speed-rpm", type=float, default=1500.0, help="end speed of the ramp from 0 (default 1500)")
+    fc.set_defaults(func=cmd_fmu_check)
     return p
 
 

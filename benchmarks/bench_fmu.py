@@ -1,0 +1,86 @@
+"""Benchmark (issue 5): the wheel FMU vs a trivial pythonfmu FMU (y = u), both stepped the same
+way at 1 kHz for 60 s of simulated time (60 000 steps: set input, doStep, read all outputs), in
+fmpy and in libcosim (libcosimpy).  Prints wall times, their ratio (target <= 2) and the
+real-time factor (simulated / wall time).
+
+    .venv/bin/python benchmarks/bench_fmu.py [--seconds 60] [--hosts fmpy,libcosim]
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+from fmu import hosts
+from fmu.build import build_preset
+
+TRIVIAL = '''
+from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
+
+
+class TrivialEcho(Fmi2Slave):
+    description = "y = u"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.u = 0.0
+        self.y = 0.0
+        self.register_variable(Real("u", causality=Fmi2Causality.input, variability=Fmi2Variability.continuous))
+        self.register_variable(Real("y", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
+                                    initial=Fmi2Initial.exact))
+
+    def do_step(self, current_time, step_size):
+        self.y = self.u
+        return True
+'''
+
+
+def build_trivial(dest: Path) -> Path:
+    from pythonfmu import FmuBuilder
+    src = dest / "rwadist_bench_trivial_echo.py"
+    src.write_text(TRIVIAL)
+    path_before = list(sys.path)
+    try:
+        return Path(FmuBuilder.build_FMU(src, dest=dest / "trivial.fmu"))
+    finally:
+        sys.path[:] = path_before
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=60.0, help="simulated time, s (default 60)")
+    ap.add_argument("--rate", type=float, default=1000.0, help="communication rate, Hz (default 1000)")
+    ap.add_argument("--hosts", default="fmpy,libcosim")
+    args = ap.parse_args(argv)
+    h = 1.0 / args.rate
+    n = int(round(args.seconds * args.rate))
+    t = np.arange(n + 1) * h
+    # spin-up 0 -> 3000 rpm then reversal to -3000 rpm (max 21 rad/s²)
+    w = 3000 * 2 * np.pi / 60 * np.interp(t, [0, args.seconds / 3, args.seconds], [0.0, 1.0, -1.0])
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        wheel = build_preset("ithaco-e", tmp / "wheel.fmu")
+        trivial = build_trivial(tmp)
+        print(f"{n} steps of {h:g} s ({args.seconds:g} s simulated); wheel: ithaco-e preset, 18 lines, 12 outputs")
+        for host in args.hosts.split(","):
+            run = {"fmpy": hosts.run_fmpy, "libcosim": hosts.run_libcosim}[host]
+            walls = {}
+            for name, path, inputs in (("trivial y=u", trivial, {"u": w}), ("wheel", wheel, {"wheel_speed": w})):
+                t0 = time.perf_counter()
+                out = run(path, t, inputs)
+                walls[name] = time.perf_counter() - t0
+                assert np.all(np.isfinite(out[1:])), f"{host} {name}: non-finite outputs"
+                print(f"{host:>8} {name:<12} wall {walls[name]:7.2f} s  {walls[name] / n * 1e6:6.1f} us/step  "
+                      f"real-time factor {args.seconds / walls[name]:6.1f}")
+            ratio = walls["wheel"] / walls["trivial y=u"]
+            print(f"{host:>8} ratio wheel / trivial = {ratio:.2f} (target <= 2)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

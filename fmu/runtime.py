@@ -1,0 +1,437 @@
+"""Self-contained runtime of the extended wheel model for the FMU (numpy only, no rwadist).
+
+This file is copied verbatim into the FMU's ``resources/`` so a host needs only Python and
+numpy.  It re-implements, step by step, the equations of :mod:`rwadist.extended` (rigid rotor
+on a flexible suspension; see that module's docstring for the physics and sign conventions)
+and is tested against :func:`rwadist.extended.simulate_time` to 1e-9 relative
+(tests/test_fmu.py).  Everything is SI: rad/s, rad/s², s, N, N·m, kg, m.
+
+One communication step [t_n, t_n + h] with wheel speed Ω_n and acceleration α (rad/s²):
+
+* speed is linear over the step, Ω(τ) = Ω_n + α τ; rotor angle φ += (Ω_n + Ω_{n+1}) h / 2
+  (exact for the linear speed, the trapezoid of ``simulate_time``);
+* each forcing line is C·coef·amp(τ)·e^{iσh(φ_n + Δφ τ/h)}, amplitude linear over the step from
+  C(Ω_n² − iΩ̇_n) to C(Ω_{n+1}² − iΩ̇_{n+1}) (the −iΩ̇ tangential term for imbalance lines only;
+  Ω̇_n is the mean of the previous and this step's α -- the central difference of
+  ``simulate_time`` -- and Ω̇_{n+1} = α);
+* every mode is a linear state integrated exactly against that load over the step: radial and
+  axial translation through their two complex eigen-coordinates (fixed poles), rocking through
+  the exact 2×2 transition matrix at the step's mean speed (gyroscopic term frozen over a step);
+* outputs are the suspension reactions at t_n + h (wheel frame, Fx, Fy, Fz, Tx, Ty, Tz) and
+  their spacecraft-frame image F_sc = R F, T_sc = R T + r × F_sc.
+"""
+from __future__ import annotations
+
+import cmath
+import json
+import math
+
+import numpy as np
+
+SCHEMA = "rwadist.model"
+SCHEMA_VERSION = 1
+ANALYTICAL_KIND = "rigid_rotor_5dof"
+DIRECTIONS = ("radial_force", "radial_torque", "axial_force", "axial_torque")
+CHANNELS = ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")
+PARAM_KEYS = {
+    "mass": "mass_kg", "I_zz": "I_zz_kg_m2", "I_rr": "I_rr_kg_m2",
+    "k_r": "k_r_N_per_m", "c_r": "c_r_N_s_per_m",
+    "k_rock": "k_rock_Nm_per_rad", "c_rock": "c_rock_Nm_s_per_rad",
+    "k_z": "k_z_N_per_m", "c_z": "c_z_N_s_per_m",
+    "height": "height_m", "U_s": "U_s_kg_m", "U_d": "U_d_kg_m2",
+}
+SMALL_Z = 1e-3
+
+
+class ModelError(ValueError):
+    """Invalid or unreadable model file, parameter or input; the message names the problem."""
+
+
+# ------------------------------------------------------------------ model file
+
+#: as rwadist.extended.IMBALANCE_H_TOL
+IMBALANCE_H_TOL = 0.02
+
+def load_model(path):
+    """(params dict, lines) from a model file of schema rwadist.model v1.
+
+    lines: list of (direction, h, C, sense, imbalance) in the order of
+    ``rwadist.extended.lines_from_model``: the static and dynamic imbalance first (U_s, U_d of
+    the analytical section), then every empirical harmonic per direction except the radial
+    h = 1 ones.  ModelError naming the file and field on any problem."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh)
+    except OSError as exc:
+        raise ModelError(f"model file {path!r} cannot be read: {exc.strerror or exc}") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ModelError(f"model file {path!r} is not valid JSON: {exc}") from None
+    return model_from_doc(doc, str(path))
+
+
+def _num(v, where):
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ModelError(f"{where}: must be a finite number, got {v!r}")
+    return float(v)
+
+
+def model_from_doc(doc, source="<model>"):
+    """Validated (params, lines) of a parsed model document (see :func:`load_model`)."""
+    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
+        raise ModelError(f"{source}: schema: not an rwadist model file")
+    if doc.get("schema_version") != SCHEMA_VERSION:
+        raise ModelError(f"{source}: schema_version: file has version {doc.get('schema_version')!r}; "
+                         f"this FMU reads version {SCHEMA_VERSION} only")
+    an = doc.get("analytical")
+    if not isinstance(an, dict):
+        raise ModelError(f"{source}: analytical: missing; the FMU needs the extended-model parameters")
+    if an.get("kind", ANALYTICAL_KIND) != ANALYTICAL_KIND:
+        raise ModelError(f"{source}: analytical.kind: {an.get('kind')!r} is not {ANALYTICAL_KIND!r}")
+    p = {}
+    for name, key in PARAM_KEYS.items():
+        if key not in an:
+            raise ModelError(f"{source}: analytical.{key}: missing")
+        p[name] = _num(an[key], f"{source}: analytical.{key}")
+    for name in ("mass", "I_zz", "I_rr", "k_r", "k_rock", "k_z"):
+        if p[name] <= 0:
+            raise ModelError(f"{source}: analytical.{PARAM_KEYS[name]}: must be > 0, got {p[name]!r}")
+    for name in ("c_r", "c_rock", "c_z", "U_s", "U_d"):
+        if p[name] < 0:
+            raise ModelError(f"{source}: analytical.{PARAM_KEYS[name]}: must be >= 0, got {p[name]!r}")
+    if p["I_zz"] > 2.0 * p["I_rr"] * (1 + 1e-12):
+        raise ModelError(f"{source}: analytical: I_zz exceeds 2·I_rr (no rigid body has that)")
+    for m, c, k, what in ((p["mass"], p["c_r"], p["k_r"], "radial"), (p["I_rr"], p["c_rock"], p["k_rock"], "rocking"),
+                          (p["mass"], p["c_z"], p["k_z"], "axial")):
+        if c / (2.0 * math.sqrt(k * m)) >= 1.0:
+            raise ModelError(f"{source}: analytical: the {what} mode is overdamped")
+    lines = [("radial_force", 1.0, p["U_s"], "co", True), ("radial_torque", 1.0, p["U_d"], "co", True)]
+    emp = doc.get("empirical") or {}
+    if not isinstance(emp, dict):
+        raise ModelError(f"{source}: empirical: must be an object keyed by direction")
+    for d in emp:
+        if d not in DIRECTIONS:
+            raise ModelError(f"{source}: empirical.{d}: unknown direction")
+    for d in DIRECTIONS:
+        for i, item in enumerate(emp.get(d) or []):
+            where = f"{source}: empirical.{d}[{i}]"
+            if not isinstance(item, dict):
+                raise ModelError(f"{where}: must be an object")
+            h, C = _num(item.get("h"), where + ".h"), _num(item.get("C"), where + ".C")
+            if h <= 0 or C < 0:
+                raise ModelError(f"{where}: needs h > 0 and C >= 0, got h={h!r}, C={C!r}")
+            sense = item.get("sense")
+            if sense not in (None, "co", "counter", "planar"):
+                raise ModelError(f"{where}.sense: {sense!r}; expected co, counter or planar")
+            # the co-rotating radial fundamental is the imbalance (same rule as
+            # rwadist.extended.is_imbalance; the runtime is self-contained, a test pins the tolerance)
+            if d in ("radial_force", "radial_torque") and abs(h - 1.0) <= IMBALANCE_H_TOL and sense in (None, "co"):
+                continue
+            lines.append((d, h, C, sense or "co", False))
+    return p, lines
+
+
+def components(direction, sense, phase, angle=0.0):
+    """[(sigma, coef)] of a line, as ``rwadist.extended.Line.components``."""
+    if direction in ("axial_force", "axial_torque") or sense == "co":
+        return [(1, cmath.exp(1j * phase))]
+    if sense == "counter":
+        return [(-1, cmath.exp(-1j * phase))]
+    return [(1, 0.5 * cmath.exp(1j * (angle + phase))), (-1, 0.5 * cmath.exp(1j * (angle - phase)))]
+
+
+def quad_roots(m, c, k):
+    """Both roots of m λ² + c λ + k = 0 (c complex), the stable form of rwadist.extended."""
+    c = complex(c)
+    disc = cmath.sqrt(c * c - 4 * m * k)
+    sgn = 1.0 if (c.conjugate() * disc).real >= 0 else -1.0
+    q = -0.5 * (c + sgn * disc)
+    return q / m, k / q
+
+
+def rotation_check(R, tol=1e-6):
+    """ModelError unless R (3×3) is a proper rotation (RᵀR = I within ``tol``, det > 0)."""
+    R = np.asarray(R, dtype=float).reshape(3, 3)
+    if not np.all(np.isfinite(R)):
+        raise ModelError("mounting DCM has non-finite entries")
+    err = float(np.max(np.abs(R.T @ R - np.eye(3))))
+    if err > tol or np.linalg.det(R) <= 0:
+        raise ModelError(f"mounting DCM is not a proper rotation (max |RᵀR − I| = {err:.3g}, "
+                         f"det = {np.linalg.det(R):.6g})")
+    return R
+
+
+def to_spacecraft(out, R, r):
+    """Spacecraft-frame loads (…, 6) of wheel-frame loads ``out`` (…, 6): F_sc = R F,
+    T_sc = R T + r × F_sc (R wheel → spacecraft DCM, r interface position in m)."""
+    out = np.asarray(out, dtype=float)
+    F = out[..., :3] @ np.asarray(R).T
+    T = out[..., 3:] @ np.asarray(R).T + np.cross(np.asarray(r, dtype=float), F)
+    return np.concatenate([F, T], axis=-1)
+
+
+# ------------------------------------------------------------------ the stepping model
+
+class WheelRuntime:
+    """The extended wheel model as a stepping state machine.
+
+    params, lines : from :func:`load_model`.  seed : None -> each line's phase 0 (the model
+    file's), else phases = numpy default_rng(seed).uniform(0, 2π, len(lines)) over *all* lines
+    (as ``simulate_time(seed=...)``), so switching effects off keeps the others' phases.
+    imbalance, harmonics, modes : effect switches (modes off: the internal loads reach the
+    interface directly).  start_steady : start from the closed-form steady state at the first
+    step's speed instead of rest.  max_accel : |dΩ/dt| limit, rad/s².  max_step : largest
+    communication step accepted, s.
+    """
+
+    def __init__(self, params, lines, *, seed=None, imbalance=True, harmonics=True, modes=True,
+                 start_steady=False, max_accel=500.0, max_step=0.01):
+        self.p = dict(params)
+        if not (math.isfinite(max_accel) and max_accel > 0):
+            raise ModelError(f"max_acceleration must be finite and > 0, got {max_accel!r}")
+        if not (math.isfinite(max_step) and max_step > 0):
+            raise ModelError(f"max_step_size must be finite and > 0, got {max_step!r}")
+        self.max_accel, self.max_step = float(max_accel), float(max_step)
+        self.modes, self.start_steady = bool(modes), bool(start_steady)
+        n = len(lines)
+        ph = (np.random.default_rng(int(seed)).uniform(0, 2 * np.pi, n) if seed is not None else np.zeros(n))
+        sh, coef, C, imb, dirs = [], [], [], [], []
+        for (d, h, c, sense, is_imb), q in zip(lines, ph):
+            if (is_imb and not imbalance) or (not is_imb and not harmonics):
+                continue
+            for sigma, cf in components(d, sense, float(q)):
+                sh.append(sigma * h)
+                coef.append(cf)
+                C.append(c)
+                imb.append(is_imb)
+                dirs.append(DIRECTIONS.index(d))
+        self.sh = np.array(sh, dtype=float)
+        self.coef = np.array(coef, dtype=complex)
+        self.C = np.array(C, dtype=float)
+        self.imb = np.array(imb, dtype=float)
+        self.dirs = np.array(dirs, dtype=int)
+        self.sel = np.zeros((4, self.sh.size), dtype=complex)
+        self.sel[self.dirs, np.arange(self.sh.size)] = 1.0
+        self.at = self.dirs == 3
+        self.ish = 1j * self.sh
+        self.cC = self.coef * self.C
+        self.cCi = -1j * self.coef * self.C * self.imb
+        self.rock = np.nonzero(self.dirs == 1)[0]
+        p = self.p
+        self.lam_r = quad_roots(p["mass"], p["c_r"], p["k_r"])
+        self.lam_z = quad_roots(p["mass"], p["c_z"], p["k_z"])
+        lam = np.zeros((self.sh.size, 2), dtype=complex)
+        for j, ls in ((0, self.lam_r), (2, self.lam_z)):
+            lam[self.dirs == j] = ls
+        # axial-torque components load no mode; a dummy pole keeps their (discarded) integrals
+        # finite so that 0·x in the direction sums stays 0
+        lam[self.dirs == 3] = -1.0
+        self._lam_static = lam
+        self._cache = {}
+        self.reset()
+
+    # ------------------------------------------------------------ state
+    def reset(self):
+        """Back to t0: rotor angle 0, all modal states zero, no previous step."""
+        self.phi = 0.0
+        self.S = np.ones(self.sh.size, dtype=complex)
+        self.eta_r = [0j, 0j]
+        self.eta_z = [0j, 0j]
+        self.x_rock = [0j, 0j]
+        self.prev_alpha = None
+        self.prev_end = None          # (Ω at the end of the previous step, step size)
+        self.started = False
+        self.out = np.zeros(6)
+
+    def _amp(self, w, wdot):
+        """coef·C·(Ω² − iΩ̇·[imbalance]) per component."""
+        return self.cC * (w * w) + self.cCi * wdot
+
+    def _loads(self, w, wdot, phi):
+        """Internal complex loads per direction (4,) at speed w, acceleration wdot, angle phi."""
+        return self.sel @ (self._amp(w, wdot) * np.exp(self.ish * phi))
+
+    def _steady_init(self, w0, wdot0):
+        p = self.p
+        amp0 = self._amp(w0, wdot0)
+        subs = ((p["mass"], p["c_r"], p["k_r"], 0.0), (p["I_rr"], p["c_rock"], p["k_rock"], p["I_zz"]),
+                (p["mass"], p["c_z"], p["k_z"], 0.0))
+        st = []
+        for j, (m, c, k, g) in enumerate(subs):
+            keep = self.dirs == j
+            nu = self.sh[keep] * w0
+            G = 1.0 / (k - m * nu**2 + g * w0 * nu + 1j * c * nu)
+            st.append((complex(np.sum(G * amp0[keep])), complex(np.sum(1j * nu * G * amp0[keep]))))
+        (q, qd), (qr, qdr), (qz, qdz) = st
+        l1, l2 = self.lam_r
+        self.eta_r = [(qd - l2 * q) / (l1 - l2), (l1 * q - qd) / (l1 - l2)]
+        l1, l2 = self.lam_z
+        self.eta_z = [(qdz - l2 * qz) / (l1 - l2), (l1 * qz - qdz) / (l1 - l2)]
+        self.x_rock = [qr, qdr]
+
+    def _lti_consts(self, h):
+        """Per step size h: (λh (n,2) and e^{λh} (n,2) with the rocking rows left to fill, the
+        smallest |Re λh| of the fixed modes, e^{λ_r h}, e^{λ_z h})."""
+        c = self._cache.get(h)
+        if c is None:
+            if len(self._cache) > 64:
+                self._cache.clear()
+            lamh = self._lam_static * h
+            fixed = np.concatenate([np.array(self.lam_r), np.array(self.lam_z)]) * h
+            c = (lamh, np.exp(lamh), float(np.min(np.abs(fixed.real))),
+                 np.exp(np.array(self.lam_r) * h), np.exp(np.array(self.lam_z) * h))
+            self._cache[h] = c
+        return c
+
+    # ------------------------------------------------------------ checks
+    def check_step(self, omega, alpha, h):
+        """ModelError naming the problem if (Ω, α, h) cannot be stepped; None if fine."""
+        if not math.isfinite(h) or h <= 0:
+            raise ModelError(f"communication step size {h!r} s is not a positive finite number")
+        if h > self.max_step * (1 + 1e-12):
+            raise ModelError(f"communication step size {h:.6g} s exceeds max_step_size = {self.max_step:.6g} s "
+                             "(the frozen-speed rocking transition and the derived acceleration are only "
+                             "resolved below it)")
+        if h < 1e-9:
+            raise ModelError(f"communication step size {h:.3g} s is below the 1 ns the FMU resolves")
+        if not math.isfinite(omega):
+            raise ModelError(f"wheel_speed is not finite: {omega!r} rad/s")
+        if alpha is not None and not math.isfinite(alpha):
+            raise ModelError(f"wheel_acceleration is not finite: {alpha!r} rad/s²")
+        if alpha is not None and abs(alpha) > self.max_accel:
+            raise ModelError(f"wheel_acceleration {alpha:.6g} rad/s² exceeds max_acceleration = "
+                             f"{self.max_accel:.6g} rad/s²")
+        if self.prev_end is not None:
+            w_end, h_prev = self.prev_end
+            jump = abs(omega - w_end) / h_prev
+            if jump > self.max_accel:
+                raise ModelError(f"wheel_speed jumps from {w_end:.6g} to {omega:.6g} rad/s over one step "
+                                 f"({h_prev:.6g} s): |dΩ/dt| = {jump:.3g} rad/s² > max_acceleration = "
+                                 f"{self.max_accel:.6g} rad/s²")
+
+    # ------------------------------------------------------------ step
+    def step(self, omega, alpha, h):
+        """Advance one communication step from speed ``omega`` (rad/s) with acceleration ``alpha``
+        (rad/s²; None: derived as the previous step's mean rate, 0 on the first step) over ``h``
+        seconds.  Returns the wheel-frame outputs at the step's end (6,).  Raises ModelError
+        (state untouched) on bad input."""
+        omega, h = float(omega), float(h)
+        alpha = None if alpha is None else float(alpha)
+        self.check_step(omega, alpha, h)
+        if alpha is None:
+            if self.prev_end is None:
+                alpha = 0.0
+            else:
+                w_end, h_prev = self.prev_end
+                # previous step's start speed -> this step's start speed
+                alpha = (omega - self._prev_start) / h_prev
+                if abs(alpha) > self.max_accel:
+                    raise ModelError(f"derived wheel acceleration {alpha:.6g} rad/s² exceeds max_acceleration = "
+                                     f"{self.max_accel:.6g} rad/s²")
+        wd0 = alpha if self.prev_alpha is None else 0.5 * (self.prev_alpha + alpha)
+        if not self.started:
+            if self.start_steady:
+                self._steady_init(omega, wd0)
+            self.started = True
+        p = self.p
+        w1 = omega + alpha * h
+        dphi = 0.5 * (omega + w1) * h
+        phi1 = self.phi + dphi
+        S0 = self.S
+        S1 = np.exp(self.ish * phi1)
+        a0 = self._amp(omega, wd0)
+        a1 = self._amp(w1, alpha)
+        loads1 = self.sel @ (a1 * S1)
+        if self.modes and self.sh.size:
+            w_mid = 0.5 * (omega + w1)
+            lk1, lk2 = quad_roots(p["I_rr"], p["c_rock"] - 1j * p["I_zz"] * w_mid, p["k_rock"])
+            lamh0, X0, min_re, Xr, Xz = self._lti_consts(h)
+            e1, e2 = cmath.exp(lk1 * h), cmath.exp(lk2 * h)
+            lamh, X = lamh0.copy(), X0.copy()
+            lamh[self.rock] = (lk1 * h, lk2 * h)
+            X[self.rock] = (e1, e2)
+            z = (self.ish * dphi)[:, None] - lamh
+            XS0 = X * S0[:, None]
+            S1c = S1[:, None]
+            # |z| >= |Re z| = |Re λh|: the series is needed only if some |Re λh| < SMALL_Z
+            if min(min_re, abs(lk1.real * h), abs(lk2.real * h)) >= SMALL_Z:
+                t0 = (S1c - XS0) / z
+                t1 = (S1c - t0) / z
+            else:
+                small = np.abs(z) < SMALL_Z
+                zb = np.where(small, 1.0, z)
+                t0 = (S1c - XS0) / zb
+                t1 = (S1c - t0) / zb
+                if small.any():
+                    zs = z[small]
+                    e0s = 1 + zs * (1 / 2 + zs * (1 / 6 + zs * (1 / 24 + zs / 120)))
+                    e1s = 1 / 2 + zs * (1 / 3 + zs * (1 / 8 + zs * (1 / 30 + zs / 144)))
+                    t0[small] = XS0[small] * e0s
+                    t1[small] = XS0[small] * e1s
+            W = (self.sel @ (a0[:, None] * t0 + (a1 - a0)[:, None] * t1)) * h   # (4, 2)
+            # radial and axial translation: eigen-coordinates η_j' = pole η_j + w_j/(m(λ_j − λ_k))
+            for eta, (l1, l2), Xp, row, (m, c, k) in (
+                    (self.eta_r, self.lam_r, Xr, 0, (p["mass"], p["c_r"], p["k_r"])),
+                    (self.eta_z, self.lam_z, Xz, 2, (p["mass"], p["c_z"], p["k_z"]))):
+                eta[0] = Xp[0] * eta[0] + W[row, 0] / (m * (l1 - l2))
+                eta[1] = Xp[1] * eta[1] + W[row, 1] / (m * (l2 - l1))
+            # rocking: exact transition at the mean speed of the step
+            dl = lk1 - lk2
+            q, qd = self.x_rock
+            kI = p["k_rock"] / p["I_rr"]
+            P00 = (e1 * (-lk2) - e2 * (-lk1)) / dl
+            P01 = (e1 - e2) / dl
+            P10 = (-kI) * (e1 - e2) / dl
+            P11 = (e1 * lk1 - e2 * lk2) / dl
+            w1r = W[1, 0] / (p["I_rr"] * dl)
+            w2r = W[1, 1] / (-p["I_rr"] * dl)
+            self.x_rock = [P00 * q + P01 * qd + w1r + w2r, P10 * q + P11 * qd + lk1 * w1r + lk2 * w2r]
+        self.phi = phi1
+        self.S = S1
+        self._prev_start = omega
+        self.prev_alpha = alpha
+        self.prev_end = (w1, h)
+        self.out = self._outputs(loads1)
+        return self.out
+
+    def outputs_now(self, omega, alpha=0.0):
+        """Outputs at the current state for speed ``omega`` (used at t0 before the first step)."""
+        if not self.started and self.start_steady:
+            self._steady_init(float(omega), float(alpha))
+        loads = self._loads(float(omega), float(alpha), self.phi)
+        self.out = self._outputs(loads)
+        return self.out
+
+    def _outputs(self, loads):
+        p = self.p
+        if self.modes:
+            l1, l2 = self.lam_r
+            q, qd = self.eta_r[0] + self.eta_r[1], l1 * self.eta_r[0] + l2 * self.eta_r[1]
+            F = p["k_r"] * q + p["c_r"] * qd
+            l1, l2 = self.lam_z
+            qz, qdz = self.eta_z[0] + self.eta_z[1], l1 * self.eta_z[0] + l2 * self.eta_z[1]
+            Fz = (p["k_z"] * qz + p["c_z"] * qdz).real
+            Tc = p["k_rock"] * self.x_rock[0] + p["c_rock"] * self.x_rock[1]
+        else:
+            F, Fz, Tc = complex(loads[0]), float(loads[2].real), complex(loads[1])
+        Tint = Tc + 1j * p["height"] * F
+        return np.array([F.real, F.imag, Fz, Tint.real, Tint.imag, float(loads[3].real)])
+
+    # ------------------------------------------------------------ convenience
+    def run(self, t, omega, alpha="slope"):
+        """Step through a uniform profile (t, omega) as a host would; returns (n, 6) outputs with
+        row 0 the t0 outputs.  alpha: 'slope' (each step gets (Ω_{n+1} − Ω_n)/h as
+        wheel_acceleration), None (derived), or an array per sample."""
+        t = np.asarray(t, dtype=float)
+        w = np.asarray(omega, dtype=float)
+        h = (t[-1] - t[0]) / (t.size - 1)
+        if isinstance(alpha, str):
+            acc = np.append(np.diff(w) / h, 0.0)
+        elif alpha is None:
+            acc = [None] * w.size
+        else:
+            acc = np.asarray(alpha, dtype=float)
+        out = np.empty((t.size, 6))
+        out[0] = self.outputs_now(w[0], 0.0 if acc[0] is None else acc[0])
+        for n in range(t.size - 1):
+            out[n + 1] = self.step(w[n], acc[n], h)
+        return out

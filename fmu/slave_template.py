@@ -1,0 +1,202 @@
+"""pythonfmu co-simulation slave of the rwadist extended wheel model (template).
+
+``fmu/build.py`` copies this file into the FMU under a module name unique to each build and
+renames the class ``RwadistWheelSlave`` to a unique name as well, so FMUs of different builds
+load side by side in one process.  The physics lives in ``rwadist_fmu_runtime.py`` (a copy of
+``fmu/runtime.py``, numpy only) and the wheel in ``wheel_model.json``, both in the FMU's
+``resources/``; rwadist itself is not needed by the host.
+
+Bad input never raises out of ``do_step`` (pythonfmu turns an exception into fmi2Fatal): the
+slave logs the problem with status fmi2Error (category logStatusError) and returns False, which
+pythonfmu's native layer reports as fmi2Discard; the state is left at the last good step, so
+the host may retry (e.g. with a smaller step or a corrected input).
+"""
+import importlib.util
+import math
+import os
+import sys
+from xml.etree.ElementTree import Element, SubElement
+
+from pythonfmu import (Boolean, DefaultExperiment, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer,
+                       Real, String)
+from pythonfmu.enums import Fmi2Status
+
+RUNTIME_FILE = "rwadist_fmu_runtime.py"
+MODEL_FILE = "wheel_model.json"
+#: unit -> SI base-unit exponents (kg, m, s, rad) for the UnitDefinitions of modelDescription.xml
+UNITS = {"N": dict(kg=1, m=1, s=-2), "N.m": dict(kg=1, m=2, s=-2), "rad/s": dict(s=-1, rad=1),
+         "rad/s2": dict(s=-2, rad=1), "s": dict(s=1), "m": dict(m=1), "1": {}}
+OUTPUTS = (("Fx", "N", "force the wheel exerts on its interface, wheel frame x"),
+           ("Fy", "N", "force on the interface, wheel frame y"),
+           ("Fz", "N", "force on the interface, wheel frame z (spin axis)"),
+           ("Tx", "N.m", "torque on the interface about wheel x, at the interface point"),
+           ("Ty", "N.m", "torque on the interface about wheel y, at the interface point"),
+           ("Tz", "N.m", "torque on the interface about wheel z (axial-torque harmonics)"))
+
+
+class RealU(Real):
+    """pythonfmu Real with a unit attribute."""
+
+    def __init__(self, name, unit=None, **kwargs):
+        super().__init__(name, **kwargs)
+        self.unit = unit
+
+    def to_xml(self):
+        node = super().to_xml()
+        if self.unit is not None:
+            node.find("Real").set("unit", self.unit)
+        return node
+
+
+def _load_runtime(resources):
+    name = f"{__name__}_runtime"
+    mod = sys.modules.get(name)
+    if mod is None:
+        spec = importlib.util.spec_from_file_location(name, os.path.join(resources, RUNTIME_FILE))
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        sys.modules[name] = mod
+    return mod
+
+
+class RwadistWheelSlave(Fmi2Slave):
+    author = "rwadist"
+    description = ("Reaction-wheel micro-vibration, extended model (harmonics through the rotor's "
+                   "suspension modes), time domain; outputs in wheel and spacecraft frames")
+    default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-3)
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.rt = _load_runtime(self.resources)
+        self.wheel_speed = 0.0
+        self.wheel_acceleration = 0.0
+        self.model_file = ""
+        self.use_wheel_acceleration = False
+        self.seed = -1
+        self.imbalance = True
+        self.harmonics = True
+        self.modes = True
+        self.start_steady = False
+        self.max_acceleration = 500.0
+        self.max_step_size = 0.01
+        self.dcm = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+        self.pos = [0.0, 0.0, 0.0]
+        self._y = [0.0] * 12
+        self.model = None       # WheelRuntime once initialised without error
+        self.error = "not initialised"
+
+        inp, par, out = Fmi2Causality.input, Fmi2Causality.parameter, Fmi2Causality.output
+        fixed, cont = Fmi2Variability.fixed, Fmi2Variability.continuous
+        self.register_variable(RealU("wheel_speed", "rad/s", causality=inp, variability=cont,
+                                     description="wheel speed, signed (positive about +z of the wheel frame)"))
+        self.register_variable(RealU("wheel_acceleration", "rad/s2", causality=inp, variability=cont,
+                                     description="wheel acceleration over the coming step; used when "
+                                                 "use_wheel_acceleration is true, else derived from wheel_speed"))
+        self.register_variable(String("model_file", causality=par, variability=fixed,
+                                      description="model file (rwadist.model JSON); empty: the one in the FMU "
+                                                  "resources"))
+        self.register_variable(Boolean("use_wheel_acceleration", causality=par, variability=fixed,
+                                       description="take the acceleration from the wheel_acceleration input "
+                                                   "(else the previous step's mean rate of wheel_speed)"))
+        self.register_variable(Integer("seed", causality=par, variability=fixed,
+                                       description="random line phases from this seed; -1: the model file's "
+                                                   "phases (0)"))
+        self.register_variable(Boolean("imbalance", causality=par, variability=fixed,
+                                       description="static and dynamic imbalance (h = 1) on"))
+        self.register_variable(Boolean("harmonics", causality=par, variability=fixed,
+                                       description="all other empirical harmonics on"))
+        self.register_variable(Boolean("modes", causality=par, variability=fixed,
+                                       description="suspension modes on (off: internal loads reach the "
+                                                   "interface directly)"))
+        self.register_variable(Boolean("start_steady", causality=par, variability=fixed,
+                                       description="start from the steady state at the first speed instead "
+                                                   "of rest"))
+        self.register_variable(RealU("max_acceleration", "rad/s2", causality=par, variability=fixed,
+                                     description="largest |dΩ/dt| accepted; a faster speed change is an error"))
+        self.register_variable(RealU("max_step_size", "s", causality=par, variability=fixed,
+                                     description="largest communication step accepted"))
+        for i in range(3):
+            for j in range(3):
+                k = 3 * i + j
+                self.register_variable(RealU(
+                    f"dcm_{i + 1}{j + 1}", "1", causality=par, variability=fixed,
+                    description=f"mounting DCM wheel -> spacecraft, row {i + 1} column {j + 1}",
+                    getter=lambda k=k: self.dcm[k], setter=lambda v, k=k: self.dcm.__setitem__(k, float(v))))
+        for i, ax in enumerate("xyz"):
+            self.register_variable(RealU(
+                f"r_{ax}", "m", causality=par, variability=fixed,
+                description=f"interface position in the spacecraft frame, {ax}",
+                getter=lambda i=i: self.pos[i], setter=lambda v, i=i: self.pos.__setitem__(i, float(v))))
+        for frame, off, suffix, where in (("wheel", 0, "", "wheel frame"),
+                                          ("spacecraft", 6, "_sc", "spacecraft frame, about its reference point")):
+            for i, (ch, unit, desc) in enumerate(OUTPUTS):
+                k = off + i
+                self.register_variable(RealU(
+                    ch + suffix, unit, causality=out, variability=cont, initial=Fmi2Initial.exact,
+                    description=desc if frame == "wheel" else f"{ch} in the {where}",
+                    getter=lambda k=k: self._y[k]))
+
+    # ------------------------------------------------------------ modelDescription
+    def to_xml(self, model_options=dict()):
+        root = super().to_xml(model_options)
+        defs = Element("UnitDefinitions")
+        for name, exps in UNITS.items():
+            SubElement(SubElement(defs, "Unit", name=name), "BaseUnit", {k: str(v) for k, v in exps.items()})
+        idx = list(root).index(root.find("CoSimulation")) + 1
+        root.insert(idx, defs)
+        return root
+
+    # ------------------------------------------------------------ FMI
+    def _fail(self, msg):
+        self.error = msg
+        self.log(f"rwadist wheel: {msg}", Fmi2Status.error)
+        return False
+
+    def exit_initialization_mode(self):
+        rt = self.rt
+        try:
+            path = self.model_file or os.path.join(self.resources, MODEL_FILE)
+            params, lines = rt.load_model(path)
+            R = rt.rotation_check(self.dcm)
+            if not all(math.isfinite(v) for v in self.pos):
+                raise rt.ModelError(f"interface position r = {self.pos!r} m is not finite")
+            seed = int(self.seed)
+            if seed < -1:
+                raise rt.ModelError(f"seed must be >= 0, or -1 for the model file's phases; got {seed}")
+            self.model = rt.WheelRuntime(
+                params, lines, seed=None if seed == -1 else seed, imbalance=bool(self.imbalance),
+                harmonics=bool(self.harmonics), modes=bool(self.modes), start_steady=bool(self.start_steady),
+                max_accel=float(self.max_acceleration), max_step=float(self.max_step_size))
+            self._R = [list(map(float, row)) for row in R]
+            self.error = None
+            w = float(self.wheel_speed)
+            if math.isfinite(w):
+                a = float(self.wheel_acceleration) if self.use_wheel_acceleration else 0.0
+                self._publish(self.model.outputs_now(w, a if math.isfinite(a) else 0.0))
+        except Exception as exc:   # never let it reach pythonfmu (it would be fmi2Fatal)
+            self.model = None
+            self._fail(f"initialisation failed: {exc}")
+
+    def _publish(self, o):
+        R, (rx, ry, rz) = self._R, self.pos
+        f0, f1, f2, t0, t1, t2 = (float(v) for v in o)
+        fx = R[0][0] * f0 + R[0][1] * f1 + R[0][2] * f2
+        fy = R[1][0] * f0 + R[1][1] * f1 + R[1][2] * f2
+        fz = R[2][0] * f0 + R[2][1] * f1 + R[2][2] * f2
+        tx = R[0][0] * t0 + R[0][1] * t1 + R[0][2] * t2 + ry * fz - rz * fy
+        ty = R[1][0] * t0 + R[1][1] * t1 + R[1][2] * t2 + rz * fx - rx * fz
+        tz = R[2][0] * t0 + R[2][1] * t1 + R[2][2] * t2 + rx * fy - ry * fx
+        self._y = [f0, f1, f2, t0, t1, t2, fx, fy, fz, tx, ty, tz]
+
+    def do_step(self, current_time, step_size):
+        if self.model is None:
+            return self._fail(f"cannot step: {self.error}")
+        try:
+            w = float(self.wheel_speed)
+            a = float(self.wheel_acceleration) if self.use_wheel_acceleration else None
+            self._publish(self.model.step(w, a, float(step_size)))
+            return True
+        except self.rt.ModelError as exc:
+            return self._fail(f"step at t = {current_time:.9g} s rejected: {exc}")
+        except Exception as exc:   # anything unforeseen: still no fmi2Fatal
+            return self._fail(f"step at t = {current_time:.9g} s failed: {type(exc).__name__}: {exc}")

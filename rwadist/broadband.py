@@ -1,0 +1,831 @@
+"""Stochastic broadband disturbance PSD over a wheel-speed distribution (Melody's model).
+
+Thesis §1.3 and Fig. 1-4 block (e): the wheel speed Ω is a random variable with a
+density p_Ω; the discrete harmonic lines of the steady model are smeared into a PSD.
+
+Derivation.  At a fixed speed Ω a line i is ``x_c(t) = Re(A_ic(Ω) e^{i(2π f_i t + α_i)})``
+in channel c, f_i = h_i|Ω|/2π, α_i uniform and independent between lines (thesis App. B,
+Eq. B.12: the autocorrelation of the empirical model is Σ_i C_i²Ω⁴/2 · cos(2π f_i τ), the
+cross terms i ≠ j average out).  Its one-sided cross-spectral density between channels a, b
+is a line of weight ``σ_ab,i(Ω) = A_ia conj(A_ib) / 2`` at f_i; for a = b the weight is the
+variance ``σ_i²(Ω) = |A_i(Ω)|²/2`` (empirical model: C_i²Ω⁴/2).  With Ω random and
+independent of the phases, the expected spectrum is the speed average of the lines::
+
+    S_ab(f) = Σ_i ∫ p_Ω(Ω) σ_ab,i(Ω) δ(f − h_i|Ω|/2π) dΩ
+            = Σ_i Σ_{Ω: h_i|Ω|/2π = f} σ_ab,i(Ω) p_Ω(Ω) |dΩ/df|,      |dΩ/df| = 2π/h_i,
+
+the inner sum running over both roots Ω = ±2πf/h_i inside the support (bidirectional
+operation: a negative speed puts its lines at the same |frequency|, with the radial x/y
+phase relation and the extended model's whirl response of the opposite spin).  Parseval:
+∫S_aa df = E_Ω[Σ_i σ_i²(Ω)], the speed-averaged mean square.  Melody's empirical model
+uses A = C Ω² (no modes); the extended model puts the modal amplification inside the
+integral: A_i(Ω) = :func:`rwadist.extended.steady_lines`, which carries |H(f, Ω)|² of the
+rotor's speed-dependent whirl modes -- Melody's model cannot.
+
+Discretisation (power-conserving).  The speed support is cut into cells (split at Ω = 0);
+each cell has its exact probability P_c (from the law's CDF) and amplitudes evaluated at
+its midpoint.  The cell's line power σ·P_c is spread uniformly over the frequency interval
+[h|Ω_lo|, h|Ω_hi|]/2π the cell maps to, and integrated exactly over the frequency bins
+(bins centred on f_k = k·df, width df): a uniform density on [a, b] contributes to bin k
+the length of the overlap, which is the first difference of a ramp; the ramp's second
+difference is two cloud-in-cell (linear-split) deposits, so bin powers are one cumsum of
+deposits made with ``np.bincount``.  Cells narrower than 1e-6·df (a point mass in speed)
+deposit their power with linear splitting between the two neighbouring bin centres.
+Σ_k S_k df equals Σ (line powers) inside [0, f_max] to rounding.  Memory: the output
+(n_freq × 21 complex upper-triangle pairs) plus one chunk of (speeds × lines) deposits;
+never a dense speeds × frequencies × harmonics array.
+
+Coherence.  Within one wheel the channels of a line are coherent (radial x and y 90°
+apart from the complex amplitudes; in the extended model a radial force line also gives
+the lever-arm torque, and the static and dynamic imbalance lines are one coherent source
+at their relative phase).  Different lines of one wheel, and the empirical model's
+different directions, have independent random phases (thesis App. B; the virtual test
+stand draws them independently too).  Different wheels are independent.  Tied speeds
+(:class:`Member` with a ratio) change nothing by themselves -- the PSD depends only on each
+wheel's marginal speed law and the line phases are random per wheel -- so cross-wheel terms
+appear only with ``phase_lock``: the tied wheels are then identical rotors whose line phases
+are equal up to the rotor-angle offset δ (factor e^{i·sign(Ω)·h·δ}, a time shift); their
+amplitudes add coherently (in the spacecraft frame) before the outer product, so
+cross-wheel terms appear exactly where their lines coincide.
+
+Convention: ``csd[k, a, b] = E[X_a conj(X_b)]`` one-sided (the matrix E[X X^H],
+Hermitian positive semidefinite); scipy.signal.csd(x_a, x_b) returns its conjugate.
+Units: N²/Hz, N·(N·m)/Hz, (N·m)²/Hz; frequencies Hz; speeds rad/s.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+from . import extended as ext
+from .data import DataError
+from .model import WheelModel
+from .units import CHANNELS, PSD_COLUMN, RAD_S_TO_RPM, rpm_to_rad_s
+
+#: Upper-triangle channel pairs (a <= b), 21 of them.
+PAIRS = tuple((a, b) for a in range(6) for b in range(a, 6))
+_PAIR_A = np.array([p[0] for p in PAIRS])
+_PAIR_B = np.array([p[1] for p in PAIRS])
+#: Relative tolerance on a pdf's integral before it counts as not normalised.
+PDF_RTOL = 1e-3
+#: Radial harmonics with |h − 1| at most this are the imbalances the extended model replaces
+#: (same rule as :data:`rwadist.teststand.IMBALANCE_H_TOL`).
+IMBALANCE_H_TOL = 0.02
+_CROSS_UNIT = {(0, 0): "N2", (0, 1): "N2m", (1, 1): "Nm2"}
+
+
+# =========================================================================== speed laws
+
+def _check_range(name, lo, hi):
+    for key, v in (("lo", lo), ("hi", hi)):
+        if not isinstance(v, (int, float, np.floating, np.integer)) or not math.isfinite(v):
+            raise DataError(name, key, f"must be a finite speed in rad/s, got {v!r}")
+    if not lo < hi:
+        raise DataError(name, "lo/hi", f"empty or inverted speed range: lo = {lo!r} rad/s >= hi = {hi!r} rad/s")
+
+
+@dataclass(frozen=True)
+class Uniform:
+    """Wheel speed uniform on [lo, hi], rad/s (signed; may straddle zero)."""
+
+    lo: float
+    hi: float
+
+    def __post_init__(self):
+        _check_range("Uniform", self.lo, self.hi)
+
+    @property
+    def support(self):
+        return float(self.lo), float(self.hi)
+
+    def pdf(self, omega):
+        w = np.asarray(omega, float)
+        return np.where((w >= self.lo) & (w <= self.hi), 1.0 / (self.hi - self.lo), 0.0)
+
+    def cdf(self, omega):
+        return np.clip((np.asarray(omega, float) - self.lo) / (self.hi - self.lo), 0.0, 1.0)
+
+    def sample(self, rng, n):
+        return rng.uniform(self.lo, self.hi, n)
+
+    def breakpoints(self):
+        return [self.lo, self.hi]
+
+
+@dataclass(frozen=True)
+class TruncatedNormal:
+    """Wheel speed normal (mean, std rad/s) truncated to [lo, hi] rad/s and renormalised."""
+
+    mean: float
+    std: float
+    lo: float
+    hi: float
+
+    def __post_init__(self):
+        _check_range("TruncatedNormal", self.lo, self.hi)
+        if not (math.isfinite(self.mean)):
+            raise DataError("TruncatedNormal", "mean", f"must be finite, got {self.mean!r}")
+        if not (math.isfinite(self.std) and self.std > 0):
+            raise DataError("TruncatedNormal", "std", f"must be > 0 rad/s, got {self.std!r}")
+
+    @property
+    def support(self):
+        return float(self.lo), float(self.hi)
+
+    @property
+    def _dist(self):
+        a, b = (self.lo - self.mean) / self.std, (self.hi - self.mean) / self.std
+        return stats.truncnorm(a, b, loc=self.mean, scale=self.std)
+
+    def pdf(self, omega):
+        return self._dist.pdf(np.asarray(omega, float))
+
+    def cdf(self, omega):
+        return self._dist.cdf(np.asarray(omega, float))
+
+    def sample(self, rng, n):
+        return self._dist.rvs(size=n, random_state=rng)
+
+    def breakpoints(self):
+        return [self.lo, self.hi]
+
+
+@dataclass(frozen=True)
+class Histogram:
+    """Piecewise-constant speed density: ``pdf[k]`` (1/(rad/s)) on [edges[k], edges[k+1]] rad/s.
+
+    Σ pdf·width must be 1 (relative tolerance :data:`PDF_RTOL`); use :meth:`from_weights` for
+    relative weights (counts, time fractions) that are normalised for you.
+    """
+
+    edges: tuple
+    pdf_values: tuple
+    source: str = "Histogram"
+
+    def __post_init__(self):
+        e = np.asarray(self.edges, float)
+        p = np.asarray(self.pdf_values, float)
+        if e.ndim != 1 or e.size < 2 or p.shape != (e.size - 1,):
+            raise DataError(self.source, "edges/pdf", f"need n+1 edges for n pdf values, got {e.size} edges and "
+                            f"{p.size} values")
+        if not (np.all(np.isfinite(e)) and np.all(np.isfinite(p))):
+            raise DataError(self.source, "edges/pdf", "contain NaN or inf")
+        if np.any(np.diff(e) <= 0):
+            i = int(np.argmax(np.diff(e) <= 0))
+            raise DataError(self.source, "edges", f"empty or inverted speed range: edge {i} = {e[i]!r} >= edge "
+                            f"{i + 1} = {e[i + 1]!r} rad/s")
+        if np.any(p < 0):
+            i = int(np.argmax(p < 0))
+            raise DataError(self.source, "pdf", f"negative density {p[i]!r} in bin {i}")
+        total = float(np.sum(p * np.diff(e)))
+        if abs(total - 1.0) > PDF_RTOL:
+            raise DataError(self.source, "pdf", f"integrates to {total:.6g}, not 1 (tolerance {PDF_RTOL:g})")
+        object.__setattr__(self, "edges", tuple(float(x) for x in e))
+        object.__setattr__(self, "pdf_values", tuple(float(x) for x in p))
+
+    @classmethod
+    def from_weights(cls, edges, weights, source="Histogram"):
+        """Density from relative bin weights (any positive total), normalised."""
+        e = np.asarray(edges, float)
+        w = np.asarray(weights, float)
+        if e.ndim != 1 or e.size < 2 or w.shape != (e.size - 1,):
+            raise DataError(source, "edges/weights", f"need n+1 edges for n weights, got {e.size} and {w.size}")
+        if np.any(~np.isfinite(w)) or np.any(w < 0):
+            raise DataError(source, "weight", "weights must be finite and >= 0")
+        total = float(w.sum())
+        if not total > 0:
+            raise DataError(source, "weight", f"weights sum to {total!r}; need a positive total")
+        if np.any(np.diff(e) <= 0):
+            raise DataError(source, "speed", "speeds must be strictly increasing (empty or inverted range)")
+        return cls(tuple(e), tuple(w / total / np.diff(e)), source)
+
+    @property
+    def support(self):
+        return self.edges[0], self.edges[-1]
+
+    def pdf(self, omega):
+        w = np.asarray(omega, float)
+        e = np.asarray(self.edges)
+        k = np.clip(np.searchsorted(e, w, side="right") - 1, 0, len(self.pdf_values) - 1)
+        return np.where((w >= e[0]) & (w <= e[-1]), np.asarray(self.pdf_values)[k], 0.0)
+
+    def _cum(self):
+        e = np.asarray(self.edges)
+        c = np.concatenate([[0.0], np.cumsum(np.asarray(self.pdf_values) * np.diff(e))])
+        return e, c / c[-1]
+
+    def cdf(self, omega):
+        e, c = self._cum()
+        return np.interp(np.asarray(omega, float), e, c)
+
+    def sample(self, rng, n):
+        e, c = self._cum()
+        return np.interp(rng.uniform(0.0, 1.0, n), c, e)
+
+    def breakpoints(self):
+        return list(self.edges)
+
+
+def histogram_from_centres(speeds, weights, source="histogram") -> Histogram:
+    """Histogram from bin centres (rad/s, strictly increasing) and relative weights; edges halfway
+    between centres, the outer bins as wide as their neighbours."""
+    c = np.asarray(speeds, float)
+    if c.ndim != 1 or c.size < 2:
+        raise DataError(source, "speed_rpm", f"need at least 2 histogram rows, got {c.size}")
+    if np.any(np.diff(c) <= 0):
+        i = int(np.argmax(np.diff(c) <= 0))
+        raise DataError(source, "speed_rpm", f"must be strictly increasing: row {i + 1} "
+                        f"({c[i + 1] * RAD_S_TO_RPM:g} rpm) <= row {i} ({c[i] * RAD_S_TO_RPM:g} rpm)")
+    mid = 0.5 * (c[1:] + c[:-1])
+    edges = np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
+    return Histogram.from_weights(edges, weights, source)
+
+
+def from_time_profile(t, omega, n_bins: int = 2000, source="time profile") -> Histogram:
+    """Speed law of a mission profile: fraction of time spent at each speed.
+
+    t : sample times, s (increasing).  omega : speed at each sample, rad/s (linear between samples).
+    Each interval spends its duration uniformly over [Ω_k, Ω_k+1] (exact for the linear profile);
+    a constant-speed interval is a point mass, deposited by linear splitting between the two
+    neighbouring bins.  Returns a :class:`Histogram` of ``n_bins`` equal bins over the profile range.
+    """
+    t = np.asarray(t, float)
+    w = np.asarray(omega, float)
+    if t.ndim != 1 or t.shape != w.shape or t.size < 2:
+        raise DataError(source, "time_s/speed_rpm", f"need two equal 1-D columns with >= 2 rows, got {t.shape}, "
+                        f"{w.shape}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(w))):
+        raise DataError(source, "time_s/speed_rpm", "contain NaN or inf")
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        i = int(np.argmax(dt <= 0))
+        raise DataError(source, "time_s", f"must increase: row {i + 1} ({t[i + 1]!r}) <= row {i} ({t[i]!r})")
+    lo, hi = float(w.min()), float(w.max())
+    if not hi > lo:
+        raise DataError(source, "speed_rpm", f"constant speed {lo * RAD_S_TO_RPM:g} rpm: empty speed range "
+                        "(a single speed is a line, not a distribution)")
+    step = (hi - lo) / n_bins
+    a = (np.minimum(w[:-1], w[1:]) - lo) / step - 0.5      # bin-centre units: bin k centred at k
+    b = (np.maximum(w[:-1], w[1:]) - lo) / step - 0.5
+    bins = _spread(a, b, dt[None, :] / dt.sum(), n_bins).real[0]
+    bins = np.maximum(bins, 0.0)
+    return Histogram.from_weights(lo + step * np.arange(n_bins + 1), bins, source)
+
+
+def speed_cells(law, n_speeds: int):
+    """Cell edges over the law's support, split at Ω = 0 when it straddles zero, and each cell's
+    exact probability.  Returns (lo_edges, hi_edges, mid, P) rad/s, rad/s, rad/s, 1."""
+    lo, hi = law.support
+    n_speeds = int(n_speeds)
+    if n_speeds < 1:
+        raise DataError("speed grid", "n_speeds", f"must be >= 1, got {n_speeds}")
+    if lo < 0.0 < hi:
+        n_neg = max(1, int(round(n_speeds * (-lo) / (hi - lo))))
+        n_pos = max(1, n_speeds - n_neg)
+        edges = np.concatenate([np.linspace(lo, 0.0, n_neg + 1), np.linspace(0.0, hi, n_pos + 1)[1:]])
+    else:
+        edges = np.linspace(lo, hi, n_speeds + 1)
+    P = np.diff(law.cdf(edges))
+    return edges[:-1], edges[1:], 0.5 * (edges[:-1] + edges[1:]), np.maximum(P, 0.0)
+
+
+# =========================================================================== line sources
+
+@dataclass
+class WheelLines:
+    """The coherent line sources of one wheel, each with its harmonic number.
+
+    kind : 'empirical' (Melody: A = C·Ω², no modes) or 'extended' (closed-form steady response).
+    h : (n_sources,) harmonic numbers.  labels : one per source.
+    For 'empirical', ``spec`` is a list of (direction, C kg·m or kg·m², mode) with mode one of
+    'co', 'counter', 'x', 'y', 'axial'.  For 'extended', ``params`` and ``groups`` (a list of
+    lists of :class:`rwadist.extended.Line`, the lines of one group adding coherently).
+    """
+
+    kind: str
+    h: np.ndarray
+    labels: list
+    spec: list = field(default_factory=list)
+    params: ext.ExtendedParams | None = None
+    groups: list = field(default_factory=list)
+    name: str = "wheel"
+
+    def __len__(self):
+        return len(self.labels)
+
+    def amplitudes(self, omega, idx=None) -> np.ndarray:
+        """Complex channel amplitudes (n_speeds, n_sel, 6) at speeds ``omega`` (rad/s, signed) of the
+        sources ``idx`` (default all): channel c is Re(A_c e^{i 2π f t}), f = h|Ω|/2π, N or N·m."""
+        w = np.atleast_1d(np.asarray(omega, float))
+        idx = np.arange(len(self)) if idx is None else np.atleast_1d(idx)
+        out = np.zeros((w.size, idx.size, 6), dtype=complex)
+        if self.kind == "empirical":
+            s = np.where(w < 0, -1.0, 1.0)
+            for j, i in enumerate(idx):
+                d, C, mode = self.spec[i]
+                a = C * w**2
+                base = {"radial_force": 0, "radial_torque": 3, "axial_force": 2, "axial_torque": 5}[d]
+                if mode == "axial":
+                    out[:, j, base] = a
+                elif mode == "x":
+                    out[:, j, base] = a
+                elif mode == "y":
+                    out[:, j, base + 1] = a
+                else:
+                    out[:, j, base] = a
+                    out[:, j, base + 1] = (-1j if mode == "co" else 1j) * s * a
+            return out
+        flat, owner = [], []
+        for j, i in enumerate(idx):
+            for ln in self.groups[i]:
+                flat.append(ln)
+                owner.append(j)
+        _, amp = ext.steady_lines(self.params, flat, w)
+        for k, j in enumerate(owner):
+            out[:, j, :] += amp[:, k, :]
+        return out
+
+
+def empirical_lines(model: WheelModel) -> WheelLines:
+    """Melody's model of a :class:`~rwadist.model.WheelModel`: every harmonic of every direction is a
+    source with its own random phase.  Radial harmonics turn with the rotor: x and y 90° apart,
+    co-rotating unless the harmonic's ``sense`` is 'counter'; a 'planar' harmonic has no defined x/y
+    phase relation in this model and becomes two independent sources (x and y), each C·Ω² -- so every
+    radial channel carries C²Ω⁴/2, as the fit measured it."""
+    h, labels, spec = [], [], []
+    for d in ("radial_force", "radial_torque", "axial_force", "axial_torque"):
+        for hm in model.harmonics(d):
+            if d.startswith("axial"):
+                modes = ["axial"]
+            elif hm.sense == "planar":
+                modes = ["x", "y"]
+            else:
+                modes = ["counter" if hm.sense == "counter" else "co"]
+            for m in modes:
+                h.append(float(hm.h))
+                labels.append(f"{d} h={hm.h:g}" + ("" if m in ("co", "axial") else f" ({m})"))
+                spec.append((d, float(hm.C), m))
+    return WheelLines("empirical", np.array(h, float), labels, spec=spec, name=model.name)
+
+
+def extended_lines(params: ext.ExtendedParams, lines) -> WheelLines:
+    """Sources of the extended model: the imbalance lines form one coherent source (they sit on the
+    same rotor at their relative ``phase``), every other :class:`~rwadist.extended.Line` is its own."""
+    imb = [ln for ln in lines if ln.imbalance]
+    others = [ln for ln in lines if not ln.imbalance]
+    groups = ([imb] if imb else []) + [[ln] for ln in others]
+    labels = (["imbalance h=1"] if imb else []) + [f"{ln.direction} h={ln.h:g} ({ln.sense})" for ln in others]
+    h = np.array([g[0].h for g in groups], float)
+    return WheelLines("extended", h, labels, params=params, groups=groups)
+
+
+def extended_lines_from_model(model: WheelModel, source="<model>") -> WheelLines:
+    """Extended sources of a model file: ``analytical`` parameters; the radial harmonics within
+    :data:`IMBALANCE_H_TOL` of h = 1 are replaced by the imbalances U_s, U_d (as the virtual stand
+    does); the imbalance phases are those of :func:`rwadist.extended.imbalance_lines` (0, 0)."""
+    params = ext.params_from_model(model, source)
+    m = WheelModel(name=model.name, wheel=model.wheel, empirical=dict(model.empirical),
+                   analytical=model.analytical)
+    for d in ("radial_force", "radial_torque"):
+        m.empirical[d] = [hm for hm in model.harmonics(d) if abs(hm.h - 1.0) > IMBALANCE_H_TOL]
+    src = extended_lines(params, ext.lines_from_model(m, params))
+    src.name = model.name
+    return src
+
+
+def preset_lines(name: str, empirical: bool = False) -> WheelLines:
+    """Sources of a virtual-stand preset (:func:`rwadist.teststand.preset`): empirical from its
+    harmonics, or extended from its ``extended_lines()`` with the dynamic imbalance at the preset's
+    ``imbalance_phase`` ahead of the static one."""
+    from .teststand import preset
+
+    wheel = preset(name)
+    if empirical:
+        src = empirical_lines(wheel.to_model())
+    else:
+        if wheel.extended is None:
+            raise DataError(name, "extended", "this preset has no extended parameters; use --empirical")
+        lines = [ext.Line(ln.direction, ln.h, ln.C, ln.sense,
+                          wheel.imbalance_phase if (ln.imbalance and ln.direction == "radial_torque") else ln.phase,
+                          ln.angle, ln.imbalance) for ln in wheel.extended_lines()]
+        src = extended_lines(wheel.extended, lines)
+    src.name = wheel.name
+    return src
+
+
+# =========================================================================== binning
+
+def _spread(a, b, weights, n_bins):
+    """Bin powers of uniform densities on [a, b] (positions in bin-centre units: bin k covers
+    [k − ½, k + ½]) carrying total ``weights`` (n_pairs, n_items) complex; exact overlap integrals
+    (ramp second differences, linear split) for a < b, linear split at a for point masses.
+    Returns (n_pairs, n_bins)."""
+    a = np.asarray(a, float).ravel()
+    b = np.asarray(b, float).ravel()
+    W = np.asarray(weights)
+    W = W.reshape(W.shape[0], -1)
+    width = b - a
+    wide = width > 1e-6
+    slot = n_bins + 1                                        # trash slot for positions past the grid
+    idx_parts, coef_parts = [], []
+    # ramp starts/ends: positions on the edge grid (edge j at j − ½); deposit ±W/width split linearly
+    for pos, sgn in ((a[wide] + 0.5, 1.0), (b[wide] + 0.5, -1.0)):
+        m = np.floor(pos)
+        t = pos - m
+        m = np.clip(m, 0, slot).astype(np.int64)
+        m1 = np.minimum(m + 1, slot)
+        dens = sgn / width[wide]
+        idx_parts += [m, m1]
+        coef_parts += [(1 - t) * dens, t * dens]
+    ramp_items = np.concatenate([np.nonzero(wide)[0]] * 4)
+    idx_r = np.concatenate(idx_parts) if idx_parts else np.zeros(0, np.int64)
+    coef_r = np.concatenate(coef_parts) if coef_parts else np.zeros(0)
+    # point masses
+    pt = np.nonzero(~wide)[0]
+    u = 0.5 * (a[pt] + b[pt])
+    k = np.floor(u)
+    t = u - k
+    k = np.clip(k, 0, slot).astype(np.int64)
+    k1 = np.minimum(k + 1, slot)
+    idx_p = np.concatenate([k, k1])
+    coef_p = np.concatenate([1 - t, t])
+    pt_items = np.concatenate([pt, pt])
+    out = np.zeros((W.shape[0], n_bins), dtype=complex if np.iscomplexobj(W) else float)
+    for p in range(W.shape[0]):
+        for part in ("real", "imag") if np.iscomplexobj(W) else ("real",):
+            wp = getattr(W[p], part)
+            d2 = np.bincount(idx_r, weights=coef_r * wp[ramp_items], minlength=slot + 1)
+            binned = np.cumsum(d2[:n_bins])
+            binned += np.bincount(idx_p, weights=coef_p * wp[pt_items], minlength=slot + 1)[:n_bins]
+            if part == "real":
+                out[p] += binned
+            else:
+                out[p] += 1j * binned
+    return out
+
+
+# =========================================================================== result
+
+@dataclass
+class BroadbandPSD:
+    """One-sided cross-spectral density matrix on a uniform frequency grid.
+
+    f : (n,) Hz, f[k] = k·df.  csd : (n, 6, 6) complex, csd[k, a, b] = E[X_a conj(X_b)] per Hz
+    (channels Fx, Fy, Fz, Tx, Ty, Tz; N²/Hz, N·N·m/Hz, (N·m)²/Hz).  frame : 'wheel' or 'spacecraft'.
+    meta : description (laws, wheels, model kind).
+    """
+
+    f: np.ndarray
+    csd: np.ndarray
+    frame: str = "wheel"
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def df(self) -> float:
+        return float(self.f[1] - self.f[0])
+
+    @property
+    def psd(self) -> np.ndarray:
+        """Auto-spectra (n, 6), real."""
+        return np.real(np.einsum("kaa->ka", self.csd))
+
+    def mean_square(self) -> np.ndarray:
+        """∫S df per channel (rectangle rule on the bins: exact for the binned power)."""
+        return self.psd.sum(axis=0) * self.df
+
+    def rms(self) -> np.ndarray:
+        return np.sqrt(self.mean_square())
+
+    def cumulative_rms(self) -> np.ndarray:
+        """(n, 6): sqrt of the power up to and including each bin (thesis Eq. 2.13)."""
+        return np.sqrt(np.cumsum(self.psd, axis=0) * self.df)
+
+
+def _transform_of(mounting):
+    if mounting is None:
+        return np.eye(6)
+    T = getattr(mounting, "transform", mounting)
+    T = np.asarray(T, float)
+    if T.shape != (6, 6):
+        raise ValueError(f"mounting transform must be 6x6, got {T.shape}")
+    return T
+
+
+@dataclass
+class Member:
+    """One wheel of a coherent group: its sources, 6×6 transform to the output frame (None: wheel
+    frame), speed ratio to the group's speed (±1; −1 = spinning the other way), and rotor-angle
+    offset ``phase_offset`` (rad) to the group's rotor angle (used only under phase lock)."""
+
+    lines: WheelLines
+    transform: object = None
+    ratio: float = 1.0
+    phase_offset: float = 0.0
+
+
+def _freq_grid(f_max, n_freq):
+    if not (math.isfinite(f_max) and f_max > 0):
+        raise DataError("frequency grid", "fmax", f"must be > 0 Hz, got {f_max!r}")
+    n_freq = int(n_freq)
+    if n_freq < 2:
+        raise DataError("frequency grid", "n_freq", f"must be >= 2, got {n_freq}")
+    return np.linspace(0.0, f_max, n_freq)
+
+
+def _check_fmax(groups, f_max):
+    h_min = min(float(m.lines.h.min()) for members, law in groups for m in members if len(m.lines))
+    w_max = max(max(abs(law.support[0]), abs(law.support[1])) for _, law in groups)
+    f_first = h_min * w_max / (2 * np.pi)
+    if f_max < f_first:
+        raise DataError("frequency grid", "fmax", f"{f_max:g} Hz is below the first harmonic's highest "
+                        f"frequency ({f_first:g} Hz: h = {h_min:g} at {w_max * RAD_S_TO_RPM:g} rpm); "
+                        "the PSD would miss lines -- raise --fmax")
+
+
+def csd_groups(groups, f_max: float, n_freq: int = 20001, n_speeds: int = 2000, progress: bool = False,
+               chunk: int = 20000, frame: str = "wheel", check_fmax: bool = True) -> BroadbandPSD:
+    """The CSD of independent groups of coherent wheels.
+
+    groups : list of (members, law): ``members`` a list of :class:`Member` sharing one speed
+        (each at ratio·Ω) and, when more than one, phase-locked (amplitudes add before the outer
+        product); ``law`` the group's speed law (rad/s).
+    f_max : top of the grid, Hz; n_freq : grid points (0 .. f_max).  n_speeds : speed cells per law.
+    chunk : speeds × sources evaluated at once (bounds memory).
+    Raises DataError when f_max is below the top frequency of the lowest harmonic (``check_fmax``).
+    """
+    from tqdm.auto import tqdm
+
+    f = _freq_grid(f_max, n_freq)
+    df = f[1] - f[0]
+    if check_fmax:
+        _check_fmax(groups, f_max)
+    acc = np.zeros((len(PAIRS), f.size), dtype=complex)
+    work = []
+    for members, law in groups:
+        lo_e, hi_e, mid, P = speed_cells(law, n_speeds)
+        n_src = len(members[0].lines)
+        if len(members) > 1 and any(len(m.lines) != n_src or not np.allclose(m.lines.h, members[0].lines.h)
+                                    for m in members):
+            raise DataError("wheels", "tie", "phase-locked wheels must use the same wheel model (same lines)")
+        per = max(1, chunk // max(1, mid.size))
+        for s0 in range(0, n_src, per):
+            work.append((members, lo_e, hi_e, mid, P, np.arange(s0, min(n_src, s0 + per))))
+    bar = tqdm(work, desc="broadband PSD", unit="chunk", disable=not progress or len(work) < 4, leave=False)
+    for members, lo_e, hi_e, mid, P, idx in bar:
+        h = members[0].lines.h[idx]
+        A = np.zeros((mid.size, idx.size, 6), dtype=complex)
+        for m in members:
+            T = _transform_of(m.transform)
+            w = m.ratio * mid
+            Am = m.lines.amplitudes(w, idx) @ T.T
+            if len(members) > 1 and m.phase_offset:
+                Am = Am * np.exp(1j * np.sign(w)[:, None] * h[None, :] * m.phase_offset)[..., None]
+            A += Am
+        wl = np.minimum(np.abs(lo_e), np.abs(hi_e))[:, None]
+        wh = np.maximum(np.abs(lo_e), np.abs(hi_e))[:, None]
+        a = (h[None, :] * wl / (2 * np.pi)) / df
+        b = (h[None, :] * wh / (2 * np.pi)) / df
+        Q = 0.5 * A[..., _PAIR_A] * np.conj(A[..., _PAIR_B]) * P[:, None, None]     # (S, n, 21)
+        acc += _spread(a, b, np.moveaxis(Q, -1, 0), f.size)
+    acc /= df
+    diag = _PAIR_A == _PAIR_B
+    acc[diag] = acc[diag].real                 # auto-spectra are real (rounding leaves ~1e-33 j)
+    csd = np.empty((f.size, 6, 6), dtype=complex)
+    csd[:, _PAIR_A, _PAIR_B] = acc.T
+    csd[:, _PAIR_B, _PAIR_A] = np.conj(acc.T)
+    return BroadbandPSD(f=f, csd=csd, frame=frame)
+
+
+def broadband_psd(lines: WheelLines, law, f_max: float, n_freq: int = 20001, n_speeds: int = 2000,
+                  mounting=None, progress: bool = False) -> BroadbandPSD:
+    """Broadband CSD of one wheel with speed law ``law`` (rad/s); in the wheel frame, or in the
+    spacecraft frame through ``mounting`` (an object with a 6×6 ``transform``, e.g.
+    :class:`rwadist.mounting.Mounting`)."""
+    out = csd_groups([([Member(lines, mounting)], law)], f_max, n_freq, n_speeds, progress,
+                     frame="wheel" if mounting is None else "spacecraft")
+    out.meta.update({"model": lines.kind, "wheel": lines.name, "law": repr(law)})
+    return out
+
+
+def expected_mean_square(lines: WheelLines, law, f_max: float | None = None, n_speeds: int = 4000) -> np.ndarray:
+    """E_Ω[Σ_i |A_ic(Ω)|²/2] per channel (wheel frame) by Gauss–Legendre quadrature per cell
+    (lines above ``f_max`` Hz excluded): the Parseval target of :func:`broadband_psd`."""
+    lo_e, hi_e, _, _ = speed_cells(law, n_speeds)
+    x, wq = np.polynomial.legendre.leggauss(4)
+    total = np.zeros(6)
+    for xi, wi in zip(x, wq):
+        w = 0.5 * (lo_e + hi_e) + 0.5 * (hi_e - lo_e) * xi
+        A = lines.amplitudes(w)
+        p2 = np.abs(A) ** 2 / 2
+        if f_max is not None:
+            p2 = p2 * (lines.h[None, :] * np.abs(w)[:, None] / (2 * np.pi) <= f_max)[..., None]
+        total += np.einsum("s,sc->c", 0.5 * (hi_e - lo_e) * wi * law.pdf(w), p2.sum(axis=1))
+    return total
+
+
+# =========================================================================== envelope
+
+@dataclass
+class Envelope:
+    """Worst-case line spectrum: ``amplitude[k, c]`` is the largest peak amplitude (N or N·m) of any
+    line that can sit at f[k] for some speed in the range; ``table`` lists per source and channel the
+    largest amplitude over the range and the speed (rpm) and frequency (Hz) where it occurs."""
+
+    f: np.ndarray
+    amplitude: np.ndarray
+    table: list
+
+
+def line_envelope(wheels, speed_range, f: np.ndarray, n_speeds: int = 4000) -> Envelope:
+    """Worst-case envelope of the lines of ``wheels`` = [(WheelLines, transform or None), ...] over
+    ``speed_range`` = (lo, hi) rad/s (signed), on the frequency grid ``f`` (Hz).
+
+    Each source's amplitude is evaluated on a fine speed grid (per sign branch) and interpolated in
+    frequency onto ``f``; the envelope is the maximum over sources, branches and wheels (a single
+    wheel's line, not a sum)."""
+    lo, hi = float(speed_range[0]), float(speed_range[1])
+    _check_range("envelope speed range", lo, hi)
+    f = np.asarray(f, float)
+    env = np.zeros((f.size, 6))
+    table = []
+    branches = []
+    if hi > 0:
+        branches.append(np.linspace(max(lo, 0.0), hi, n_speeds))
+    if lo < 0:
+        branches.append(np.linspace(min(hi, 0.0), lo, n_speeds))
+    for wi, (lines, mounting) in enumerate(wheels):
+        T = _transform_of(mounting)
+        best = np.zeros((len(lines), 6))
+        best_w = np.zeros((len(lines), 6))
+        for w in branches:
+            A = np.abs(lines.amplitudes(w) @ T.T)                      # (S, L, 6)
+            fw = lines.h[None, :] * np.abs(w)[:, None] / (2 * np.pi)   # (S, L), increasing in S
+            for i in range(len(lines)):
+                sel = (f >= fw[0, i]) & (f <= fw[-1, i])
+                for c in range(6):
+                    if sel.any() and fw[-1, i] > fw[0, i]:
+                        env[sel, c] = np.maximum(env[sel, c], np.interp(f[sel], fw[:, i], A[:, i, c]))
+                k = np.argmax(A[:, i, :], axis=0)
+                val = A[k, i, np.arange(6)]
+                upd = val > best[i]
+                best[i] = np.where(upd, val, best[i])
+                best_w[i] = np.where(upd, w[k], best_w[i])
+        for i in range(len(lines)):
+            for c, ch in enumerate(CHANNELS):
+                if best[i, c] > 0:
+                    table.append({"wheel": wi, "source": lines.labels[i], "h": float(lines.h[i]), "channel": ch,
+                                  "max_amplitude": float(best[i, c]),
+                                  "speed_rpm": float(best_w[i, c] * RAD_S_TO_RPM),
+                                  "f_Hz": float(lines.h[i] * abs(best_w[i, c]) / (2 * np.pi))})
+    return Envelope(f=f, amplitude=env, table=table)
+
+
+# =========================================================================== files and plots
+
+def write_psd_csv(res: BroadbandPSD, path) -> Path:
+    """Auto-spectra: columns f_Hz, Fx_N2_per_Hz, ..., Tz_Nm2_per_Hz (CONVENTIONS.md)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data = np.column_stack([res.f, res.psd])
+    header = ",".join(["f_Hz"] + [PSD_COLUMN[c] for c in CHANNELS])
+    np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.10e")
+    return path
+
+
+def cross_columns() -> list:
+    """Column names of the cross-spectra file: '<a>_<b>_re_<unit>_per_Hz', '<a>_<b>_im_...' for a < b."""
+    cols = []
+    for a, b in PAIRS:
+        if a == b:
+            continue
+        unit = _CROSS_UNIT[(a // 3, b // 3)]
+        for part in ("re", "im"):
+            cols.append(f"{CHANNELS[a]}_{CHANNELS[b]}_{part}_{unit}_per_Hz")
+    return cols
+
+
+def write_cross_csv(res: BroadbandPSD, path) -> Path:
+    """Cross-spectra csd[a, b] (a < b) as real and imaginary columns; csd[b, a] is the conjugate."""
+    path = Path(path)
+    cols = [res.f]
+    for a, b in PAIRS:
+        if a != b:
+            cols += [res.csd[:, a, b].real, res.csd[:, a, b].imag]
+    np.savetxt(path, np.column_stack(cols), delimiter=",", header=",".join(["f_Hz"] + cross_columns()),
+               comments="", fmt="%.10e")
+    return path
+
+
+def read_psd_csv(path) -> tuple:
+    """(f, {channel: psd}) from a PSD table."""
+    with open(path, newline="") as fh:
+        header = next(csv.reader(fh))
+    arr = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    inv = {v: k for k, v in PSD_COLUMN.items()}
+    return arr[:, 0], {inv[h]: arr[:, i] for i, h in enumerate(header) if h in inv}
+
+
+def write_hdf5(res: BroadbandPSD, path, group: str = "psd") -> Path:
+    """HDF5 group with datasets f_Hz (n), psd (n, 6) and csd (n, 6, 6) complex; attrs channels, frame."""
+    import h5py
+
+    path = Path(path)
+    with h5py.File(path, "a") as fh:
+        if group in fh:
+            del fh[group]
+        g = fh.create_group(group)
+        g.create_dataset("f_Hz", data=res.f)
+        g.create_dataset("psd", data=res.psd)
+        g.create_dataset("csd", data=res.csd, compression="gzip")
+        g.attrs["channels"] = ",".join(CHANNELS)
+        g.attrs["frame"] = res.frame
+        g.attrs["convention"] = "csd[k,a,b] = E[X_a conj(X_b)], one-sided, unit^2/Hz"
+    return path
+
+
+def plot_psd(res: BroadbandPSD, title: str = ""):
+    """Figure (Agg canvas, no pyplot): PSDs (top, log scale) and cumulative RMS (bottom)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(10, 8))
+    FigureCanvasAgg(fig)
+    ax1, ax2 = fig.add_subplot(2, 2, 1), fig.add_subplot(2, 2, 2)
+    ax3, ax4 = fig.add_subplot(2, 2, 3), fig.add_subplot(2, 2, 4)
+    psd, cum, f = res.psd, res.cumulative_rms(), res.f
+    for c, ch in enumerate(CHANNELS):
+        ax = ax1 if c < 3 else ax2
+        y = np.where(psd[:, c] > 0, psd[:, c], np.nan)
+        ax.semilogy(f, y, lw=0.8, label=ch)
+        (ax3 if c < 3 else ax4).plot(f, cum[:, c], lw=1.0, label=ch)
+    ax1.set_ylabel("PSD, N²/Hz")
+    ax2.set_ylabel("PSD, (N·m)²/Hz")
+    ax3.set_ylabel("cumulative RMS, N")
+    ax4.set_ylabel("cumulative RMS, N·m")
+    for ax in (ax1, ax2, ax3, ax4):
+        ax.set_xlabel("frequency, Hz")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title or f"broadband disturbance PSD ({res.frame} frame)")
+    fig.tight_layout()
+    return fig
+
+
+def write_envelope_csv(env: Envelope, path) -> Path:
+    cols = ["f_Hz"] + [f"{c}_{'N' if c.startswith('F') else 'Nm'}" for c in CHANNELS]
+    np.savetxt(path, np.column_stack([env.f, env.amplitude]), delimiter=",", header=",".join(cols),
+               comments="", fmt="%.8e")
+    return Path(path)
+
+
+# =========================================================================== CLI helpers
+
+def law_from_spec(dist: str, min_rpm: float, max_rpm: float, std_rpm: float | None = None,
+                  source: str = "--dist") -> object:
+    """Speed law from CLI-style arguments: 'uniform' on [min, max] rpm; 'normal' centred in the
+    range, std ``std_rpm`` (default range/6, i.e. ±3σ), truncated to the range; otherwise a CSV file
+    (:func:`law_from_csv`; the range then only bounds nothing -- the file's own speeds are used)."""
+    if dist == "uniform":
+        return Uniform(float(rpm_to_rad_s(min_rpm)), float(rpm_to_rad_s(max_rpm)))
+    if dist == "normal":
+        lo, hi = float(rpm_to_rad_s(min_rpm)), float(rpm_to_rad_s(max_rpm))
+        _check_range("--speed-rpm", lo, hi)
+        std = (hi - lo) / 6.0 if std_rpm is None else float(rpm_to_rad_s(std_rpm))
+        return TruncatedNormal(0.5 * (lo + hi), std, lo, hi)
+    return law_from_csv(dist)
+
+
+def law_from_csv(path, n_bins: int = 2000):
+    """Speed law from a CSV: columns (speed_rpm, weight) = histogram of relative weights at bin
+    centres; (speed_rpm, pdf_per_rpm) = a density that must integrate to 1 over rpm; (time_s,
+    speed_rpm) = a mission time profile (:func:`from_time_profile`)."""
+    path = Path(path)
+    if not path.exists():
+        raise DataError(path, "file", "does not exist (expected uniform, normal or a CSV file)")
+    with open(path, newline="") as fh:
+        header = [h.strip() for h in next(csv.reader(fh))]
+    try:
+        arr = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except ValueError as exc:
+        raise DataError(path, "data", f"not numeric CSV ({exc})") from None
+    col = {h: arr[:, i] for i, h in enumerate(header)}
+    if "time_s" in col and "speed_rpm" in col:
+        return from_time_profile(col["time_s"], rpm_to_rad_s(col["speed_rpm"]), n_bins, str(path))
+    if "speed_rpm" in col and "weight" in col:
+        return histogram_from_centres(rpm_to_rad_s(col["speed_rpm"]), col["weight"], str(path))
+    if "speed_rpm" in col and "pdf_per_rpm" in col:
+        s, p = col["speed_rpm"], col["pdf_per_rpm"]
+        hist = histogram_from_centres(rpm_to_rad_s(s), np.maximum(p, 0), str(path))
+        widths = np.diff(np.asarray(hist.edges)) * RAD_S_TO_RPM
+        total = float(np.sum(p * widths))
+        if abs(total - 1.0) > PDF_RTOL:
+            raise DataError(path, "pdf_per_rpm", f"integrates to {total:.6g} over rpm, not 1 "
+                            f"(tolerance {PDF_RTOL:g}); give relative weights in a 'weight' column instead")
+        return hist
+    raise DataError(path, "header", f"{header}: expected columns speed_rpm,weight or speed_rpm,pdf_per_rpm "
+                    "or time_s,speed_rpm")

@@ -1,0 +1,331 @@
+"""Wheel mountings in the spacecraft frame and the ``wheels.json`` file (thesis Fig. 1-4 block (g)).
+
+A :class:`Mounting` is a direction-cosine matrix ``dcm`` (wheel → spacecraft: v_sc = dcm · v_wheel)
+and the interface position ``position_m`` (m, spacecraft frame, from the spacecraft reference
+point).  Loads move to the reference point as::
+
+    F_sc = R F_w,      T_sc = R T_w + r × (R F_w)
+
+i.e. the 6×6 ``transform`` [[R, 0], [[r]× R, R]] acting on (Fx, Fy, Fz, Tx, Ty, Tz); a CSD
+matrix transforms as T S Tᵀ (real T).
+
+``wheels.json``::
+
+    {"wheels": [
+       {"name": "RW1", "model": "e_wheel.json"          # or "preset": "ithaco-e"
+        "dcm": [[...], [...], [...]], "position_m": [x, y, z],
+        # or "mounting": {"preset": "pyramid-4", "index": 0}
+        "speed": {"dist": "uniform", "min_rpm": 500, "max_rpm": 3000}   # optional
+        # or "tie": {"to": "RW1", "ratio": -1, "phase_lock": false, "phase_offset_deg": 0}
+       }, ...]}
+
+A top-level list of wheel objects is accepted too.  ``model`` paths are relative to the
+wheels file; a wheel with neither ``model`` nor ``preset`` uses the model given on the command
+line.  ``speed`` defaults to the command line's law; ``dist`` is 'uniform', 'normal' (with
+optional ``std_rpm``) or a CSV path (relative to the wheels file).  A tied wheel runs at
+``ratio`` (±1) times the speed of wheel ``to``; see :mod:`rwadist.broadband` for what ties and
+``phase_lock`` mean.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .data import DataError
+
+#: Tolerance on ‖RᵀR − I‖ (max abs) and on det R − 1.
+ORTHO_TOL = 1e-6
+#: Spin-axis elevation of the pyramid preset from the spacecraft x-y plane: the classic
+#: "NASA standard" pyramid with all four spin axes at arctan(1/√2) = 35.26° (equal authority on x, y, z).
+PYRAMID_ELEVATION_DEG = math.degrees(math.atan(1 / math.sqrt(2)))
+
+
+def skew(r) -> np.ndarray:
+    """[r]× such that skew(r) @ v = r × v."""
+    x, y, z = np.asarray(r, float)
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+@dataclass(frozen=True)
+class Mounting:
+    """dcm : 3×3 wheel → spacecraft, orthonormal with det +1.  position_m : interface point (m)."""
+
+    dcm: tuple
+    position_m: tuple = (0.0, 0.0, 0.0)
+    name: str = ""
+
+    def __post_init__(self):
+        R = np.asarray(self.dcm, float)
+        where = f"mounting {self.name!r}" if self.name else "mounting"
+        if R.shape != (3, 3) or not np.all(np.isfinite(R)):
+            raise DataError(where, "dcm", f"must be a finite 3x3 matrix, got {np.asarray(self.dcm).tolist()!r}")
+        err = float(np.max(np.abs(R.T @ R - np.eye(3))))
+        if err > ORTHO_TOL:
+            raise DataError(where, "dcm", f"not orthonormal: max |RᵀR − I| = {err:.3g} > {ORTHO_TOL:g}; "
+                            f"dcm = {R.tolist()}")
+        det = float(np.linalg.det(R))
+        if abs(det - 1.0) > ORTHO_TOL:
+            raise DataError(where, "dcm", f"det = {det:.6g}, not +1 (a reflection, not a rotation)")
+        r = np.asarray(self.position_m, float)
+        if r.shape != (3,) or not np.all(np.isfinite(r)):
+            raise DataError(where, "position_m", f"must be 3 finite numbers (m), got {self.position_m!r}")
+        object.__setattr__(self, "dcm", tuple(tuple(float(x) for x in row) for row in R))
+        object.__setattr__(self, "position_m", tuple(float(x) for x in r))
+
+    @property
+    def R(self) -> np.ndarray:
+        return np.asarray(self.dcm, float)
+
+    @property
+    def transform(self) -> np.ndarray:
+        """6×6 map of (F, T) at the interface, wheel frame → (F, T) at the reference point, s/c frame."""
+        R = self.R
+        T = np.zeros((6, 6))
+        T[:3, :3] = R
+        T[3:, 3:] = R
+        T[3:, :3] = skew(self.position_m) @ R
+        return T
+
+    @property
+    def spin_axis(self) -> np.ndarray:
+        return self.R[:, 2]
+
+    def apply(self, loads) -> np.ndarray:
+        """Loads (..., 6) wheel frame at the interface → spacecraft frame at the reference point."""
+        return np.asarray(loads) @ self.transform.T
+
+
+def dcm_from_spin_axis(axis, ref=(0.0, 0.0, 1.0)) -> np.ndarray:
+    """A DCM whose third column (wheel z) is ``axis``; wheel x is the component of ``ref`` normal to
+    the axis (or of spacecraft x when ``ref`` is parallel), y = z × x."""
+    z = np.asarray(axis, float)
+    z = z / np.linalg.norm(z)
+    x = np.asarray(ref, float) - np.dot(ref, z) * z
+    if np.linalg.norm(x) < 1e-9:
+        x = np.array([1.0, 0.0, 0.0]) - z[0] * z
+        if np.linalg.norm(x) < 1e-9:
+            x = np.array([0.0, 1.0, 0.0]) - z[1] * z
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+def preset_mountings(name: str, radius_m: float = 0.3, elevation_deg: float = PYRAMID_ELEVATION_DEG) -> list:
+    """Mounting presets.
+
+    'pyramid-4' : four wheels, spin axes at azimuth 45°, 135°, 225°, 315° about spacecraft z and
+        ``elevation_deg`` above the x-y plane (default 35.26°), interfaces on a circle of
+        ``radius_m`` at those azimuths (z = 0).
+    'ortho-3-skew' : wheels along spacecraft +x, +y, +z and a fourth skewed along (1, 1, 1)/√3,
+        interfaces at ``radius_m`` along their own spin axes.
+    """
+    key = str(name).strip().lower()
+    out = []
+    if key == "pyramid-4":
+        el = math.radians(elevation_deg)
+        for i, az_deg in enumerate((45.0, 135.0, 225.0, 315.0)):
+            az = math.radians(az_deg)
+            axis = (math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el))
+            pos = (radius_m * math.cos(az), radius_m * math.sin(az), 0.0)
+            out.append(Mounting(tuple(map(tuple, dcm_from_spin_axis(axis))), pos, f"pyramid-4[{i}]"))
+    elif key == "ortho-3-skew":
+        axes = [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0), tuple(np.ones(3) / math.sqrt(3))]
+        for i, ax in enumerate(axes):
+            out.append(Mounting(tuple(map(tuple, dcm_from_spin_axis(ax))), tuple(radius_m * np.asarray(ax)),
+                                f"ortho-3-skew[{i}]"))
+    else:
+        raise DataError("mounting preset", "name", f"unknown preset {name!r}; available: pyramid-4, ortho-3-skew")
+    return out
+
+
+@dataclass
+class Tie:
+    """Speed tie: this wheel runs at ``ratio`` (±1) × the speed of wheel index ``to``; with
+    ``phase_lock`` the two rotors are identical and locked at rotor-angle offset ``phase_offset`` rad."""
+
+    to: int
+    ratio: float = 1.0
+    phase_lock: bool = False
+    phase_offset: float = 0.0
+
+
+@dataclass
+class WheelSpec:
+    """One wheel of a set: name, line sources (:class:`rwadist.broadband.WheelLines`), mounting,
+    speed law (rad/s; None when tied) and tie."""
+
+    name: str
+    lines: object
+    mounting: Mounting
+    law: object = None
+    tie: Tie | None = None
+    model_ref: str = ""
+    meta: dict = field(default_factory=dict)
+
+
+def _speed_law(spec, default_law, base: Path, where: str):
+    from . import broadband as bb
+
+    if spec is None:
+        if default_law is None:
+            raise DataError(where, "speed", "no speed law: give one here or on the command line")
+        return default_law
+    if not isinstance(spec, dict):
+        raise DataError(where, "speed", f"must be an object, got {spec!r}")
+    dist = spec.get("dist", "uniform")
+    if dist in ("uniform", "normal"):
+        for k in ("min_rpm", "max_rpm"):
+            if not isinstance(spec.get(k), (int, float)):
+                raise DataError(where, f"speed.{k}", f"must be a number (rpm), got {spec.get(k)!r}")
+        return bb.law_from_spec(dist, spec["min_rpm"], spec["max_rpm"], spec.get("std_rpm"), f"{where}.speed")
+    p = Path(dist)
+    return bb.law_from_csv(p if p.is_absolute() else base / p)
+
+
+def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bool = False) -> list:
+    """Read a wheels.json file into :class:`WheelSpec` objects.
+
+    default_lines_loader : callable() -> WheelLines used for wheels without ``model``/``preset``.
+    default_law : speed law for wheels without ``speed`` (rad/s).  empirical : Melody's model
+    (harmonics only) instead of the extended model.
+    DataError names the file and the field (missing model file, bad DCM, unknown tie, ...).
+    """
+    from . import broadband as bb
+    from . import model as model_io
+
+    path = Path(path)
+    if not path.exists():
+        raise DataError(path, "file", "does not exist")
+    try:
+        doc = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise DataError(path, f"line {exc.lineno}", f"not valid JSON ({exc.msg})") from None
+    items = doc.get("wheels") if isinstance(doc, dict) else doc
+    if not isinstance(items, list) or not items:
+        raise DataError(path, "wheels", "must be a non-empty list of wheel objects")
+    base = path.parent
+    names = [str(w.get("name", f"wheel{i}")) if isinstance(w, dict) else "" for i, w in enumerate(items)]
+    out = []
+    cache = {}
+    for i, w in enumerate(items):
+        where = f"wheels[{i}]"
+        if not isinstance(w, dict):
+            raise DataError(path, where, f"must be an object, got {w!r}")
+        # sources
+        if "model" in w:
+            mp = Path(w["model"])
+            mp = mp if mp.is_absolute() else base / mp
+            if not mp.exists():
+                raise DataError(path, f"{where}.model", f"model file {str(mp)!r} does not exist")
+            key = ("model", str(mp))
+            if key not in cache:
+                m = model_io.load(mp)
+                cache[key] = bb.empirical_lines(m) if empirical else bb.extended_lines_from_model(m, str(mp))
+            lines, ref = cache[key], str(mp)
+        elif "preset" in w:
+            key = ("preset", w["preset"])
+            try:
+                if key not in cache:
+                    cache[key] = bb.preset_lines(w["preset"], empirical)
+            except ValueError as exc:
+                raise DataError(path, f"{where}.preset", str(exc)) from None
+            lines, ref = cache[key], f"preset {w['preset']}"
+        else:
+            if default_lines_loader is None:
+                raise DataError(path, f"{where}.model", "no model: give 'model' or 'preset' (or a model on the "
+                                "command line)")
+            if "default" not in cache:
+                cache["default"] = default_lines_loader()
+            lines, ref = cache["default"], "command-line model"
+        # mounting
+        try:
+            if "mounting" in w:
+                mspec = w["mounting"]
+                ms = preset_mountings(mspec.get("preset", ""), **{k: v for k, v in mspec.items()
+                                                                    if k in ("radius_m", "elevation_deg")})
+                idx = int(mspec.get("index", i))
+                if not 0 <= idx < len(ms):
+                    raise DataError(path, f"{where}.mounting.index", f"{idx} out of range 0..{len(ms) - 1}")
+                mount = ms[idx]
+            else:
+                if "dcm" not in w:
+                    raise DataError(path, f"{where}.dcm", "missing (give 'dcm' and 'position_m' or 'mounting')")
+                mount = Mounting(w["dcm"], w.get("position_m", (0.0, 0.0, 0.0)), names[i])
+        except DataError as exc:
+            if exc.file == str(path):
+                raise
+            raise DataError(path, f"{where}.{exc.field}", str(exc).split(": ", 2)[-1]) from None
+        # speed or tie
+        tie, law = None, None
+        if "tie" in w:
+            t = w["tie"]
+            to = t.get("to")
+            if isinstance(to, str):
+                if to not in names:
+                    raise DataError(path, f"{where}.tie.to", f"no wheel named {to!r}; names: {names}")
+                to = names.index(to)
+            if not isinstance(to, int) or not 0 <= to < len(items) or to == i:
+                raise DataError(path, f"{where}.tie.to", f"must name or index another wheel, got {t.get('to')!r}")
+            ratio = float(t.get("ratio", 1.0))
+            if ratio not in (1.0, -1.0):
+                raise DataError(path, f"{where}.tie.ratio", f"must be +1 or -1, got {ratio!r}")
+            tie = Tie(to, ratio, bool(t.get("phase_lock", False)), math.radians(float(t.get("phase_offset_deg", 0))))
+        else:
+            law = _speed_law(w.get("speed"), default_law, base, f"{path}: {where}")
+        out.append(WheelSpec(names[i], lines, mount, law, tie, ref))
+    # resolve chains of ties to their root
+    for i, ws in enumerate(out):
+        seen = {i}
+        j = i
+        while out[j].tie is not None:
+            j = out[j].tie.to
+            if j in seen:
+                raise DataError(path, f"wheels[{i}].tie", "ties form a cycle")
+            seen.add(j)
+    return out
+
+
+def _root(wheels, i):
+    ratio, offset, lock = 1.0, 0.0, True
+    while wheels[i].tie is not None:
+        t = wheels[i].tie
+        ratio *= t.ratio
+        offset += t.phase_offset
+        lock = lock and t.phase_lock
+        i = t.to
+    return i, ratio, offset, lock
+
+
+def wheel_groups(wheels: list) -> list:
+    """Groups for :func:`rwadist.broadband.csd_groups`: phase-locked tied wheels share a group
+    (coherent); all other wheels -- tied without lock included -- are groups of one, with the
+    root wheel's law (a ratio −1 shows as the member's ratio)."""
+    from .broadband import Member
+
+    groups = {}
+    order = []
+    for i, ws in enumerate(wheels):
+        root, ratio, offset, lock = _root(wheels, i)
+        key = root if (lock and (ws.tie is not None or any(
+            w.tie is not None and _root(wheels, k)[0] == i and _root(wheels, k)[3]
+            for k, w in enumerate(wheels)))) else ("solo", i)
+        if key not in groups:
+            groups[key] = ([], wheels[root].law)
+            order.append(key)
+        groups[key][0].append(Member(ws.lines, ws.mounting, ratio, offset if lock else 0.0))
+    return [groups[k] for k in order]
+
+
+def spacecraft_csd(wheels: list, f_max: float, n_freq: int = 20001, n_speeds: int = 2000, progress: bool = False):
+    """6×6 CSD in the spacecraft frame at the reference point of a list of :class:`WheelSpec`."""
+    from .broadband import csd_groups
+
+    res = csd_groups(wheel_groups(wheels), f_max, n_freq, n_speeds, progress, frame="spacecraft")
+    res.meta["wheels"] = [{"name": w.name, "model": w.model_ref, "dcm": [list(r) for r in w.mounting.dcm],
+                           "position_m": list(w.mounting.position_m),
+                           "law": repr(w.law) if w.tie is None else f"tied to {wheels[w.tie.to].name}"}
+                          for w in wheels]
+    return res

@@ -1,0 +1,458 @@
+"""The FMU of the extended wheel model (issue 5): runtime vs rwadist.extended.simulate_time,
+steady amplitudes vs the closed-form modal gain, fmpy validation, four instances, bad input
+through the host, step-size convergence, CLI, and (slow) a fresh venv without rwadist."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+
+from fmu import hosts, runtime as rt
+from fmu.build import build_fmu
+from rwadist import extended as ext
+from rwadist import model as model_io
+from rwadist.presets import preset
+
+pytest.importorskip("pythonfmu")
+fmpy = pytest.importorskip("fmpy")
+
+RPM = 2 * np.pi / 60
+
+
+def wheel_model():
+    """The E-wheel preset plus an axial-torque line and a planar radial line (every branch)."""
+    m = preset("ithaco-e").to_model()
+    m.empirical["axial_torque"] = [model_io.Harmonic(h=2.0, C=3.0e-7)]
+    m.empirical["radial_force"].append(model_io.Harmonic(h=2.7, C=4.0e-7, sense="planar"))
+    return m
+
+
+@pytest.fixture(scope="module")
+def model():
+    return wheel_model()
+
+
+@pytest.fixture(scope="module")
+def model_path(tmp_path_factory, model):
+    return model_io.save(model, tmp_path_factory.mktemp("m") / "wheel.json")
+
+
+@pytest.fixture(scope="module")
+def wheel_fmu(tmp_path_factory, model):
+    return build_fmu(model, tmp_path_factory.mktemp("fmu") / "wheel.fmu")
+
+
+def reference(model, t, w, seed):
+    p = ext.params_from_model(model)
+    return ext.simulate_time(p, ext.lines_from_model(model, p), t, w, seed=seed)
+
+
+def spin_up(dt=1e-3, T=8.0):
+    t = np.arange(int(round(T / dt)) + 1) * dt
+    return t, 3000 * RPM * t / T
+
+
+def reversal(dt=1e-3, T=6.0):
+    t = np.arange(int(round(T / dt)) + 1) * dt
+    return t, 1500 * RPM * (1 - 2 * t / T)
+
+
+def slope(t, w):
+    return np.append(np.diff(w) / (t[1] - t[0]), 0.0)
+
+
+def rel_err(out, ref):
+    scale = np.max(np.abs(ref), axis=0)
+    return np.max(np.abs(out - ref), axis=0) / scale
+
+
+# ------------------------------------------------------------------ runtime = simulate_time
+
+@pytest.mark.parametrize("profile", [spin_up, reversal])
+def test_runtime_equals_simulate_time(model_path, model, profile):
+    """The FMU's stepping runtime reproduces the batch time-domain model (1e-9 relative)."""
+    t, w = profile()
+    params, lines = rt.load_model(model_path)
+    for seed in (None, 11):
+        ref = reference(model, t, w, seed)
+        out = rt.WheelRuntime(params, lines, seed=seed, max_step=0.01).run(t, w)
+        err = rel_err(out, ref)
+        assert np.all(err < 1e-9), err
+
+
+def test_fmu_in_fmpy_equals_simulate_time(wheel_fmu, model):
+    """Through fmpy: spin-up 0→3000 rpm and reversal +1500→−1500 rpm, 12 outputs, 1e-9."""
+    R = np.array([[0.0, -1.0, 0.0], [np.sqrt(0.5), 0.0, -np.sqrt(0.5)], [np.sqrt(0.5), 0.0, np.sqrt(0.5)]])
+    r = np.array([0.3, -0.2, 0.5])
+    params = {"use_wheel_acceleration": True, "seed": 3, "r_x": r[0], "r_y": r[1], "r_z": r[2]}
+    params.update({f"dcm_{i + 1}{j + 1}": R[i, j] for i in range(3) for j in range(3)})
+    for t, w in (spin_up(T=4.0), reversal(T=4.0)):
+        ref = reference(model, t, w, 3)
+        out = hosts.run_fmpy(wheel_fmu, t, {"wheel_speed": w, "wheel_acceleration": slope(t, w)}, params)
+        assert np.all(rel_err(out[:, :6], ref) < 1e-9), rel_err(out[:, :6], ref)
+        # spacecraft frame, checked with an independent cross product
+        F = ref[:, :3] @ R.T
+        sc = np.hstack([F, ref[:, 3:] @ R.T + np.cross(r, F)])
+        assert np.all(rel_err(out[:, 6:], sc) < 1e-9)
+
+
+def test_derived_acceleration_close_to_reference(model_path, model):
+    """Without the acceleration input the FMU uses the previous step's rate; on a ramp that
+    starts from a hold it then differs from the reference only through the kink."""
+    t = np.arange(6001) * 1e-3
+    w = np.clip((t - 1.0) / 5.0, 0, 1) * 3000 * RPM
+    params, lines = rt.load_model(model_path)
+    ref = reference(model, t, w, 2)
+    out = rt.WheelRuntime(params, lines, seed=2).run(t, w, alpha=None)
+    err = rel_err(out, ref)
+    assert np.all(err < 1e-3), err
+
+
+# ------------------------------------------------------------------ steady amplitudes
+
+def modal_gain(p, direction, nu, omega):
+    """|interface/internal| of a whirl load e^{iνt}, written out here from the equations of motion."""
+    if direction == "radial_force":
+        m, c, k, g = p.mass, p.c_r, p.k_r, 0.0
+    elif direction == "radial_torque":
+        m, c, k, g = p.I_rr, p.c_rock, p.k_rock, p.I_zz
+    elif direction == "axial_force":
+        m, c, k, g = p.mass, p.c_z, p.k_z, 0.0
+    else:
+        return 1.0
+    return abs((k + 1j * c * nu) / (k - m * nu**2 + g * omega * nu + 1j * c * nu))
+
+
+@pytest.mark.parametrize("rpm", [2400.0, -1100.0])
+def test_constant_speed_amplitudes(wheel_fmu, model, rpm):
+    """At constant speed each line's amplitude (least squares on the FMU output) is
+    C·Ω²·|coef|·|modal gain| within 0.5 %."""
+    p = ext.params_from_model(model)
+    lines = ext.lines_from_model(model, p)
+    omega = rpm * RPM
+    dt = 1e-4
+    t = np.arange(5001) * dt
+    w = np.full(t.size, omega)
+    out = hosts.run_fmpy(wheel_fmu, t, {"wheel_speed": w}, {"start_steady": True, "seed": 4})
+    out = out[1:]
+    tt = t[1:]
+    F = out[:, 0] + 1j * out[:, 1]
+    signals = {"radial_force": F, "radial_torque": out[:, 3] + 1j * out[:, 4] - 1j * p.height * F,
+               "axial_force": out[:, 2], "axial_torque": out[:, 5]}
+    checked = 0
+    for d, sig in signals.items():
+        comps = [(ln, s, c) for ln in lines if ln.direction == d for s, c in ln.components()]
+        if d in ("axial_force", "axial_torque"):       # real signal: e^{±i hΩ t}
+            freqs = [s * ln.h * abs(omega) for ln, s, _ in comps] + [-ln.h * abs(omega) for ln, _, _ in comps]
+        else:
+            freqs = [s * ln.h * omega for ln, s, _ in comps]
+        A = np.exp(1j * np.outer(tt, freqs))
+        coef, *_ = np.linalg.lstsq(A, sig.astype(complex), rcond=None)
+        for k, (ln, s, cf) in enumerate(comps):
+            nu = s * ln.h * omega
+            expect = ln.C * omega**2 * abs(cf) * modal_gain(p, d, nu, omega)
+            got = abs(coef[k]) * (2 if d.startswith("axial") else 1)
+            assert got == pytest.approx(expect, rel=5e-3), (d, ln.h, s, got, expect)
+            checked += 1
+    assert checked == sum(len(ln.components()) for ln in lines)
+
+
+# ------------------------------------------------------------------ model description
+
+def test_fmpy_validate_and_model_description(wheel_fmu):
+    from fmpy.validation import validate_fmu
+    assert validate_fmu(str(wheel_fmu)) == []
+    md = fmpy.read_model_description(str(wheel_fmu))
+    names = [v.name for v in md.modelVariables]
+    for ch in ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"):
+        assert ch in names and ch + "_sc" in names
+    for v in md.modelVariables:
+        assert v.description, v.name
+        if v.causality in ("output", "input", "parameter"):
+            assert v.start is not None, v.name
+        if v.type == "Real":
+            assert v.unit, v.name
+        if v.causality == "output":
+            assert v.initial == "exact"
+    units = {v.name: v.unit for v in md.modelVariables if v.type == "Real"}
+    assert units["Fx"] == "N" and units["Tz_sc"] == "N.m" and units["wheel_speed"] == "rad/s"
+    files = zipfile.ZipFile(wheel_fmu).namelist()
+    assert "resources/wheel_model.json" in files and "resources/rwadist_fmu_runtime.py" in files
+    # the shipped runtime is this package's runtime, byte for byte
+    shipped = zipfile.ZipFile(wheel_fmu).read("resources/rwadist_fmu_runtime.py")
+    assert shipped == Path(rt.__file__).read_bytes()
+
+
+# ------------------------------------------------------------------ four instances
+
+def test_four_instances_one_process(tmp_path, model):
+    """A pyramid of four wheels: two separate builds (different models, unique module names) and
+    two instances of each, each with its own speed, seed and mounting, stepped in lockstep."""
+    m2 = wheel_model()
+    for d in m2.empirical:
+        for hm in m2.empirical[d]:
+            hm.C *= 1.7
+    f1 = build_fmu(model, tmp_path / "a.fmu")
+    f2 = build_fmu(m2, tmp_path / "b.fmu")
+    beta = np.radians(54.74)
+    t = np.arange(1501) * 1e-3
+    insts, paths, refs = [], [], []
+    for k in range(4):
+        az = k * np.pi / 2
+        spin = np.array([np.cos(az) * np.sin(beta), np.sin(az) * np.sin(beta), np.cos(beta)])
+        x = np.cross([0, 0, 1.0], spin)
+        x /= np.linalg.norm(x)
+        R = np.column_stack([x, np.cross(spin, x), spin])
+        r = 0.25 * np.array([np.cos(az), np.sin(az), 0.1])
+        w = (800 + 400 * k) * RPM * (1 - (2 if k % 2 else 0.5) * t / t[-1])
+        params = {"use_wheel_acceleration": True, "seed": 10 + k, "r_x": r[0], "r_y": r[1], "r_z": r[2]}
+        params.update({f"dcm_{i + 1}{j + 1}": R[i, j] for i in range(3) for j in range(3)})
+        insts.append((f"wheel{k}", {"wheel_speed": w, "wheel_acceleration": slope(t, w)}, params))
+        paths.append(f1 if k < 2 else f2)
+        ref = reference(model if k < 2 else m2, t, w, 10 + k)
+        refs.append(np.hstack([ref, rt.to_spacecraft(ref, R, r)]))
+    outs = hosts.run_fmpy_many(paths, t, insts)
+    for out, ref in zip(outs, refs):
+        assert np.all(rel_err(out, ref) < 1e-9)
+    assert not np.allclose(outs[0], outs[2][:, :], rtol=1e-3)
+
+
+# ------------------------------------------------------------------ bad input through the host
+
+def _instance(path, params=None, log=None):
+    return hosts.FmpyInstance(path, "bad", params or {}, {"wheel_speed": 100.0}, log=log)
+
+
+@pytest.mark.parametrize("case", ["nan_speed", "inf_speed", "speed_jump", "step_too_large", "bad_acceleration"])
+def test_bad_input_is_refused_and_host_survives(wheel_fmu, case):
+    from fmpy.fmi1 import FMICallException
+    log = hosts.HostLog()
+    params = {"use_wheel_acceleration": True} if case == "bad_acceleration" else {}
+    inst = _instance(wheel_fmu, params, log)
+    try:
+        inst.fmu.doStep(0.0, 1e-3)
+        y_good = inst.get()
+        h, speed, acc = 1e-3, 100.0, 0.0
+        if case == "nan_speed":
+            speed = float("nan")
+        elif case == "inf_speed":
+            speed = float("inf")
+        elif case == "speed_jump":
+            speed = 200.0
+        elif case == "step_too_large":
+            h = 0.05
+        else:
+            acc = float("nan")
+        inst.set("wheel_speed", speed)
+        inst.set("wheel_acceleration", acc)
+        with pytest.raises(FMICallException) as exc:
+            inst.fmu.doStep(1e-3, h)
+        assert exc.value.status in (2, 3)          # pythonfmu maps a refused step to fmi2Discard
+        errors = log.messages(min_status=3)
+        key = {"nan_speed": "wheel_speed is not finite", "inf_speed": "wheel_speed is not finite",
+               "speed_jump": "jumps", "step_too_large": "exceeds max_step_size",
+               "bad_acceleration": "wheel_acceleration is not finite"}[case]
+        assert any(key in m for m in errors), errors
+        assert inst.get() == y_good                 # state untouched
+        # the host goes on: a good input steps again
+        inst.set("wheel_speed", 100.0)
+        inst.set("wheel_acceleration", 0.0)
+        inst.fmu.doStep(1e-3, 1e-3)
+        assert all(np.isfinite(inst.get()))
+    finally:
+        inst.close()
+
+
+@pytest.mark.parametrize("case", ["missing_file", "invalid_json", "no_analytical", "bad_dcm", "bad_seed"])
+def test_bad_model_or_parameter(wheel_fmu, tmp_path, case):
+    from fmpy.fmi1 import FMICallException
+    params = {}
+    if case == "missing_file":
+        params["model_file"] = str(tmp_path / "nope.json")
+        key = "cannot be read"
+    elif case == "invalid_json":
+        (tmp_path / "bad.json").write_text("{not json")
+        params["model_file"] = str(tmp_path / "bad.json")
+        key = "not valid JSON"
+    elif case == "no_analytical":
+        doc = model_io.to_json(preset("ithaco-e").to_model())
+        doc.pop("analytical")
+        (tmp_path / "m.json").write_text(json.dumps(doc))
+        params["model_file"] = str(tmp_path / "m.json")
+        key = "analytical: missing"
+    elif case == "bad_dcm":
+        params["dcm_11"] = 2.0
+        key = "not a proper rotation"
+    else:
+        params["seed"] = -5
+        key = "seed must be"
+    log = hosts.HostLog()
+    inst = _instance(wheel_fmu, params, log)
+    try:
+        assert any(key in m for m in log.messages(3)), log.records
+        with pytest.raises(FMICallException):
+            inst.fmu.doStep(0.0, 1e-3)
+        assert any("cannot step" in m and key in m for m in log.messages(3))
+    finally:
+        inst.close()
+    # the host process still runs other instances
+    good = hosts.run_fmpy(wheel_fmu, np.arange(11) * 1e-3, {"wheel_speed": np.full(11, 50.0)})
+    assert np.all(np.isfinite(good))
+
+
+def test_alternative_model_file_parameter(wheel_fmu, tmp_path, model):
+    """The model_file string parameter points the FMU at another wheel."""
+    m2 = wheel_model()
+    m2.analytical = dict(m2.analytical, U_s_kg_m=3 * m2.analytical["U_s_kg_m"])
+    path = model_io.save(m2, tmp_path / "other.json")
+    t, w = reversal(T=1.0)
+    out = hosts.run_fmpy(wheel_fmu, t, {"wheel_speed": w, "wheel_acceleration": slope(t, w)},
+                         {"model_file": str(path), "use_wheel_acceleration": True})
+    assert np.all(rel_err(out[:, :6], reference(m2, t, w, None)) < 1e-9)
+    assert not np.allclose(out[:, :6], reference(model, t, w, None), rtol=1e-3)
+
+
+# ------------------------------------------------------------------ effects, frames
+
+def test_effect_switches_and_rigid_mounting(model_path, model):
+    """modes off: the interface sees the internal loads C·Ω²·coef·e^{iσhφ} directly; imbalance /
+    harmonics off remove exactly their lines (superposition)."""
+    params, lines = rt.load_model(model_path)
+    t = np.arange(801) * 1e-3
+    w = 1200 * RPM + 20 * t
+    full = rt.WheelRuntime(params, lines, seed=1).run(t, w)
+    imb = rt.WheelRuntime(params, lines, seed=1, harmonics=False).run(t, w)
+    har = rt.WheelRuntime(params, lines, seed=1, imbalance=False).run(t, w)
+    assert np.max(np.abs(imb + har - full)) < 1e-12 * np.max(np.abs(full))
+    rigid = rt.WheelRuntime(params, lines, seed=1, modes=False).run(t, w)
+    p = ext.params_from_model(model)
+    ph = np.random.default_rng(1).uniform(0, 2 * np.pi, len(lines))
+    phi = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * 1e-3)])
+    F = np.zeros(t.size, complex)
+    T = np.zeros(t.size, complex)
+    Fz = np.zeros(t.size)
+    wdot = np.full(t.size, 20.0)
+    for ln, q in zip(ext.lines_from_model(model, p), ph):
+        line = ext.Line(ln.direction, ln.h, ln.C, ln.sense, q, ln.angle, ln.imbalance)
+        amp = ln.C * (w**2 - 1j * wdot * ln.imbalance)
+        for s, cf in line.components():
+            load = cf * amp * np.exp(1j * s * ln.h * phi)
+            if ln.direction == "radial_force":
+                F += load
+            elif ln.direction == "radial_torque":
+                T += load
+            elif ln.direction == "axial_force":
+                Fz += load.real
+    T = T + 1j * p.height * F
+    expect = np.column_stack([F.real, F.imag, Fz, T.real, T.imag, rigid[:, 5]])
+    assert np.allclose(rigid[1:], expect[1:], rtol=0, atol=1e-12 * np.max(np.abs(expect)))
+
+
+def test_rotation_check():
+    rt.rotation_check(np.eye(3))
+    with pytest.raises(rt.ModelError):
+        rt.rotation_check(np.diag([1.0, 1.0, -1.0]))     # a reflection
+    with pytest.raises(rt.ModelError):
+        rt.rotation_check(1.01 * np.eye(3))
+
+
+# ------------------------------------------------------------------ convergence in the step size
+
+def test_step_size_convergence(model_path, model):
+    """Spin-up 0→3000 rpm in 4 s through every resonance; outputs at common times for steps
+    1e-4, 1e-3, 1e-2 s against simulate_time at 1e-5 s.  With the acceleration input the error
+    (frozen-speed rocking transition, linear amplitude over a step) is second order in the step:
+    measured ~1e-7 / 1e-5 / 1e-3 relative.  With the derived acceleration (one-step lag) it is
+    about first order: ~1e-5 / 1e-4 / 1e-2."""
+    params, lines = rt.load_model(model_path)
+    T = 4.0
+    t_ref = np.arange(int(round(T / 1e-5)) + 1) * 1e-5
+    ref = reference(model, t_ref, 3000 * RPM * t_ref / T, 6)[::1000]        # every 10 ms
+    scale = np.max(np.abs(ref), axis=0)
+    errs = {}
+    for mode in ("slope", None):
+        for h in (1e-4, 1e-3, 1e-2):
+            n = int(round(T / h))
+            t = np.arange(n + 1) * h
+            out = rt.WheelRuntime(params, lines, seed=6).run(t, 3000 * RPM * t / T, alpha=mode)
+            every = int(round(1e-2 / h))
+            errs[(mode, h)] = float(np.max(np.max(np.abs(out[::every] - ref), axis=0) / scale))
+    print("step-size convergence (max rel. error vs simulate_time at 1e-5 s):", errs)
+    assert errs[("slope", 1e-2)] < 5e-3 and errs[("slope", 1e-3)] < 5e-5 and errs[("slope", 1e-4)] < 5e-7
+    assert errs[("slope", 1e-3)] < 0.03 * errs[("slope", 1e-2)]          # second order
+    assert errs[(None, 1e-2)] < 3e-2 and errs[(None, 1e-3)] < 4e-4 and errs[(None, 1e-4)] < 5e-5
+
+
+def test_runtime_refuses_unresolvable_steps(model_path):
+    params, lines = rt.load_model(model_path)
+    wr = rt.WheelRuntime(params, lines, max_step=0.01)
+    for h in (0.0, -1e-3, float("nan"), 0.02, 1e-12):
+        with pytest.raises(rt.ModelError):
+            wr.step(10.0, 0.0, h)
+
+
+# ------------------------------------------------------------------ CLI
+
+def test_cli_fmu_build_and_check(tmp_path, model_path, capsys):
+    from rwadist.cli import main
+    out = tmp_path / "w.fmu"
+    assert main(["fmu", "build", str(model_path), "-o", str(out)]) == 0
+    assert main(["fmu", "check", str(out), "--stop-time", "0.2"]) == 0
+    text = capsys.readouterr().out
+    assert "fmpy validation: 0 problem(s)" in text and "Fx_sc" in text
+    assert main(["fmu", "build", "--preset", "ithaco-e", "-o", str(tmp_path / "e.fmu")]) == 0
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    assert main(["fmu", "build", str(bad), "-o", str(tmp_path / "x.fmu")]) == 2
+    assert "schema" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ fresh venv, second host
+
+@pytest.mark.slow
+def test_fresh_venv_fmpy_and_libcosim(tmp_path, wheel_fmu, model):
+    """A new virtual environment with only numpy, fmpy (+ its XML reader) and libcosimpy -- no
+    rwadist, no pythonfmu -- runs the FMU in both hosts and reproduces simulate_time."""
+    pip_ok = subprocess.run([sys.executable, "-m", "pip", "--version"], capture_output=True).returncode == 0
+    if not pip_ok:
+        pytest.skip("no pip for the fresh venv")
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    py = venv / "bin" / "python"
+    pkgs = ["numpy", "lxml", "attrs", "libcosimpy"]
+    subprocess.run([str(py), "-m", "pip", "install", "--quiet", *pkgs], check=True, timeout=300)
+    subprocess.run([str(py), "-m", "pip", "install", "--quiet", "--no-deps", "fmpy"], check=True, timeout=300)
+    t, w = reversal(T=1.0)
+    np.savez(tmp_path / "prof.npz", t=t, omega=w, alpha=slope(t, w), seed=8)
+    script = tmp_path / "hosts.py"
+    shutil.copy2(hosts.__file__, script)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    res = subprocess.run([str(py), str(script), str(wheel_fmu), str(tmp_path / "prof.npz"),
+                          str(tmp_path / "out.npz")], capture_output=True, text=True, timeout=300,
+                         cwd=tmp_path, env=env)
+    assert res.returncode == 0, res.stderr[-3000:]
+    got = np.load(tmp_path / "out.npz")
+    assert not bool(got["rwadist_importable"])
+    ref = reference(model, t, w, 8)
+    assert np.all(rel_err(got["fmpy"][:, :6], ref) < 1e-9)
+    assert np.all(rel_err(got["libcosim"][1:, :6], ref[1:]) < 1e-9)
+
+
+def test_runtime_imbalance_rule_matches_the_kit():
+    """The self-contained runtime reads model files exactly as rwadist does (h ≈ 1 co-rotating = imbalance)."""
+    assert rt.IMBALANCE_H_TOL == ext.IMBALANCE_H_TOL
+    from rwadist import catalogue
+
+    m = catalogue.load("ithaco-b")   # fundamentals listed at h = 0.99
+    p = ext.params_from_model(m)
+    kit = ext.lines_from_model(m, p)
+    _, lines = rt.model_from_doc(model_io.to_json(m))
+    assert len(lines) == len(kit)
