@@ -73,9 +73,9 @@ _PAIR_A = np.array([p[0] for p in PAIRS])
 _PAIR_B = np.array([p[1] for p in PAIRS])
 #: Relative tolerance on a pdf's integral before it counts as not normalised.
 PDF_RTOL = 1e-3
-#: Radial harmonics with |h − 1| at most this are the imbalances the extended model replaces
-#: (same rule as :data:`rwadist.teststand.IMBALANCE_H_TOL`).
-IMBALANCE_H_TOL = 0.02
+#: Co-rotating radial harmonics with |h − 1| at most this are the imbalances the extended
+#: model replaces (one rule for every path: :data:`rwadist.extended.IMBALANCE_H_TOL`).
+IMBALANCE_H_TOL = ext.IMBALANCE_H_TOL
 _CROSS_UNIT = {(0, 0): "N2", (0, 1): "N2m", (1, 1): "Nm2"}
 
 
@@ -385,15 +385,12 @@ def extended_lines(params: ext.ExtendedParams, lines) -> WheelLines:
 
 
 def extended_lines_from_model(model: WheelModel, source="<model>") -> WheelLines:
-    """Extended sources of a model file: ``analytical`` parameters; the radial harmonics within
-    :data:`IMBALANCE_H_TOL` of h = 1 are replaced by the imbalances U_s, U_d (as the virtual stand
-    does); the imbalance phases are those of :func:`rwadist.extended.imbalance_lines` (0, 0)."""
+    """Extended sources of a model file: ``analytical`` parameters; the co-rotating radial
+    harmonics within :data:`IMBALANCE_H_TOL` of h = 1 are replaced by the imbalances U_s, U_d
+    (:func:`rwadist.extended.lines_from_model`, as the virtual stand does); the imbalance phases
+    are those of :func:`rwadist.extended.imbalance_lines` (0, 0)."""
     params = ext.params_from_model(model, source)
-    m = WheelModel(name=model.name, wheel=model.wheel, empirical=dict(model.empirical),
-                   analytical=model.analytical)
-    for d in ("radial_force", "radial_torque"):
-        m.empirical[d] = [hm for hm in model.harmonics(d) if abs(hm.h - 1.0) > IMBALANCE_H_TOL]
-    src = extended_lines(params, ext.lines_from_model(m, params))
+    src = extended_lines(params, ext.lines_from_model(model, params))
     src.name = model.name
     return src
 

@@ -1,0 +1,133 @@
+"""Mounting geometry: where a 6-axis component sits on a plant's interface nodes.
+
+Convention (``shared/CONVENTIONS.md``): a mounting is a direction-cosine matrix ``dcm``
+(wheel frame -> spacecraft frame, so ``v_sc = dcm @ v_wheel``) plus the interface
+position ``position`` (m, spacecraft frame) relative to the reference point of the plant
+node it is bolted to.  Moving a load from the interface point to the node adds r × F to
+the torque.
+
+Load transform (wheel-frame loads at the interface point -> node loads, spacecraft frame)::
+
+    T = [[R, 0], [r̃ R, R]]          F_node = R F_w,  T_node = R T_w + r × (R F_w)
+
+and, by virtual work, the kinematic transform is its transpose: the interface's linear and
+angular acceleration in the wheel frame is ``a_w = T^T a_node`` (a + α × r rotated back).
+
+``rwadist.mounting`` (written in parallel) did not exist when this was written; the small
+rotation / lever-arm transform needed here lives in this module.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import InterfaceMismatchError, NotARotationError
+
+#: Tolerance on ||RᵀR − I|| (max abs entry) and |det R − 1| for a DCM.
+DCM_TOL = 1e-9
+
+
+def skew(r) -> np.ndarray:
+    """Cross-product matrix r̃ with r̃ v = r × v."""
+    x, y, z = (float(v) for v in r)
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def check_dcm(dcm, tol: float = DCM_TOL) -> np.ndarray:
+    """The DCM as a float (3, 3) array; NotARotationError unless orthonormal with det +1."""
+    R = np.asarray(dcm, dtype=float)
+    if R.shape != (3, 3):
+        raise NotARotationError(f"DCM must be 3×3, got shape {R.shape}")
+    if not np.all(np.isfinite(R)):
+        raise NotARotationError("DCM contains NaN or inf")
+    orth = np.max(np.abs(R.T @ R - np.eye(3)))
+    if orth > tol:
+        raise NotARotationError(f"DCM is not orthonormal: max |RᵀR − I| = {orth:.3g} > {tol:g}")
+    det = np.linalg.det(R)
+    if abs(det - 1.0) > tol:
+        raise NotARotationError(f"DCM has det {det:.6g}: a reflection, not a rotation")
+    return R
+
+
+def rotation(axis: str, angle: float) -> np.ndarray:
+    """DCM of a right-handed rotation by ``angle`` (rad) about 'x', 'y' or 'z'."""
+    c, s = np.cos(angle), np.sin(angle)
+    if axis == "x":
+        return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    if axis == "y":
+        return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+    if axis == "z":
+        return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    raise ValueError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
+
+
+def spin_axis_dcm(axis) -> np.ndarray:
+    """A DCM taking the wheel's z (spin) axis onto the unit vector ``axis`` (spacecraft frame);
+    the wheel x axis is chosen perpendicular to it (any choice: the wheel is axisymmetric)."""
+    z = np.asarray(axis, dtype=float)
+    n = np.linalg.norm(z)
+    if not np.isfinite(n) or n == 0:
+        raise ValueError(f"spin axis must be a finite non-zero vector, got {axis!r}")
+    z = z / n
+    helper = np.array([1.0, 0, 0]) if abs(z[0]) < 0.9 else np.array([0, 1.0, 0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    return np.column_stack([x, y, z])
+
+
+def load_transform(dcm, position) -> np.ndarray:
+    """6×6 T mapping wheel-frame loads at the interface point to node loads (see module doc)."""
+    R = check_dcm(dcm)
+    r = np.asarray(position, dtype=float)
+    if r.shape != (3,) or not np.all(np.isfinite(r)):
+        raise ValueError(f"position must be 3 finite numbers (m), got {position!r}")
+    T = np.zeros((6, 6))
+    T[:3, :3] = R
+    T[3:, 3:] = R
+    T[3:, :3] = skew(r) @ R
+    return T
+
+
+@dataclass(frozen=True)
+class Mount:
+    """Where a 6-axis component is bolted: plant interface node ``node`` (0-based; node k owns
+    plant interface DOFs 6k..6k+5 in the order x, y, z, θx, θy, θz), DCM wheel -> spacecraft,
+    interface position (m) relative to the node's reference point, spacecraft frame."""
+
+    node: int = 0
+    dcm: np.ndarray = field(default_factory=lambda: np.eye(3))
+    position: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        check_dcm(self.dcm)
+        if not isinstance(self.node, (int, np.integer)) or self.node < 0:
+            raise ValueError(f"Mount.node must be an integer >= 0, got {self.node!r}")
+
+    def selector(self, n_component: int, n_interface: int) -> np.ndarray:
+        """Mt (n_component × n_interface): component interface accelerations = Mt @ plant
+        interface accelerations; plant interface loads += Mtᵀ @ component loads."""
+        if n_component != 6:
+            raise InterfaceMismatchError(f"a Mount places a 6-axis component; this component has "
+                                         f"{n_component} interface DOFs (attach it with mount=None)")
+        if n_interface % 6:
+            raise InterfaceMismatchError(f"a Mount needs a plant whose interface is 6-DOF nodes; the plant "
+                                         f"has {n_interface} interface DOFs, not a multiple of 6")
+        if 6 * (self.node + 1) > n_interface:
+            raise InterfaceMismatchError(f"Mount.node = {self.node} but the plant has only "
+                                         f"{n_interface // 6} interface node(s)")
+        E = np.zeros((6, n_interface))
+        E[:, 6 * self.node:6 * self.node + 6] = np.eye(6)
+        return load_transform(self.dcm, self.position).T @ E
+
+
+def selector(mount, n_component: int, n_interface: int) -> np.ndarray:
+    """Mt for ``mount`` (a :class:`Mount`) or, for ``mount=None``, the identity when the component
+    and plant interfaces have the same size (InterfaceMismatchError otherwise)."""
+    if mount is None:
+        if n_component != n_interface:
+            raise InterfaceMismatchError(f"component has {n_component} interface DOFs, plant has "
+                                         f"{n_interface}; give a Mount (6-axis) or matching sizes")
+        return np.eye(n_interface)
+    return mount.selector(n_component, n_interface)
