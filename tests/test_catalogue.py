@@ -118,3 +118,44 @@ def test_catalogue_list_and_show(capsys):
     assert main(["catalogue", "show", "honeywell-hr16-75"]) == 0
     out = capsys.readouterr().out
     assert "Basilisk" in out and "3.8000e-06" in out
+
+
+# Masterson Table 3.4 (E wheel), every line, N/rpm² x 1e-7
+TABLE_3_4 = {"radial_force": [(1.00, 0.4155), (2.00, 0.0832), (3.00, 0.0543), (4.00, 0.0621), (4.42, 0.1097),
+                              (5.37, 0.0542), (5.57, 0.0690)],
+             "radial_torque": [(1.00, 0.2205), (2.00, 0.0609), (3.00, 0.0242), (4.00, 0.0243), (4.42, 0.0485),
+                               (5.58, 0.0498)],
+             "axial_force": [(1.00, 0.3038), (1.98, 0.2818), (2.96, 0.0719), (4.00, 0.0685), (4.33, 0.1011)]}
+S2E_ALL = {"radial_force": [1.01, 14.5, 10.67, 8.73, 6.78, 1.99, 9.63, 11.65, 14.88, 11.95, 7.76, 6.33],
+           "radial_torque": [1.01, 14.49, 13.82, 8.88, 6.78, 9.62, 13.44, 11.65, 1.98, 13.07, 5.8, 14.87]}
+
+
+def test_e_wheel_pins_all_of_table_3_4_and_table_4_2():
+    m = catalogue.load("ithaco-e")
+    for d, rows in TABLE_3_4.items():
+        got = [(h.h, h.C) for h in m.harmonics(d)]
+        assert [g[0] for g in got] == [r[0] for r in rows]
+        np.testing.assert_allclose([g[1] for g in got], [r[1] * THESIS_C_TO_SI for r in rows], rtol=1e-12)
+    a = m.analytical
+    assert a["mass_kg"] == 10.6 and a["k_r_N_per_m"] == 21.7e6
+    assert a["k_rock_Nm_per_rad"] == pytest.approx(21.7e6 * 0.0237**2, rel=1e-12)
+    assert a["U_s_kg_m"] == pytest.approx(0.38e-5) and a["U_d_kg_m2"] == pytest.approx(24.77e-7)
+
+
+def test_s2e_pins_every_harmonic_number():
+    m = catalogue.load("s2e-sample-rw")
+    for d, hs in S2E_ALL.items():
+        assert [h.h for h in m.harmonics(d)] == hs
+        assert all(h.sense is None for h in m.harmonics(d))
+
+
+def test_presets_work_for_psd_and_fmu(tmp_path, capsys):
+    """Issue 8: psd and fmu build take catalogue presets (on an installed package, as CI runs it)."""
+    out = tmp_path / "psd.csv"
+    assert main(["psd", "--preset", "honeywell-hr16-75", "--speed-rpm", "0:6000", "--dist", "uniform",
+                 "--n-freq", "2001", "--n-speeds", "400", "-o", str(out)]) == 0
+    header = out.read_text().splitlines()[0].split(",")
+    assert header[:3] == ["f_Hz", "Fx_N2_per_Hz", "Fy_N2_per_Hz"]
+    fmu_path = tmp_path / "wheel.fmu"
+    assert main(["fmu", "build", "--preset", "ithaco-e", "-o", str(fmu_path)]) == 0
+    assert fmu_path.exists() and fmu_path.stat().st_size > 0

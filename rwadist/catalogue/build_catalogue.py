@@ -146,6 +146,10 @@ def s2e_sample() -> WheelModel:
                 "mass_kg": "assumed (0.13 kg), only for the thin-disc radius of the assumed modes",
                 "analytical": ASSUMED_MODES,
                 "U_s, U_d": "the h = 1.01 lines (treated as the imbalances)",
+                "sense": "not known: S2E applies (x, y) = C·ω²·(sin, cos) of the phase, which turns clockwise "
+                         "about +z for positive speed; whether that reflects the wheel or the simulator's "
+                         "convention is not stated, so the file leaves the sense unset (the extended model "
+                         "then assumes co-rotating)",
             },
             "date": DATE,
         })
