@@ -22,16 +22,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rwadist.mounting import Mounting, skew  # noqa: F401  (skew re-exported)
+
 from .errors import InterfaceMismatchError, NotARotationError
 
 #: Tolerance on ||RᵀR − I|| (max abs entry) and |det R − 1| for a DCM.
 DCM_TOL = 1e-9
-
-
-def skew(r) -> np.ndarray:
-    """Cross-product matrix r̃ with r̃ v = r × v."""
-    x, y, z = (float(v) for v in r)
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
 def check_dcm(dcm, tol: float = DCM_TOL) -> np.ndarray:
@@ -83,11 +79,8 @@ def load_transform(dcm, position) -> np.ndarray:
     r = np.asarray(position, dtype=float)
     if r.shape != (3,) or not np.all(np.isfinite(r)):
         raise ValueError(f"position must be 3 finite numbers (m), got {position!r}")
-    T = np.zeros((6, 6))
-    T[:3, :3] = R
-    T[3:, 3:] = R
-    T[3:, :3] = skew(r) @ R
-    return T
+    # the same transform the broadband PSD uses for the spacecraft frame
+    return Mounting(dcm=R, position_m=r).transform
 
 
 @dataclass(frozen=True)
