@@ -385,6 +385,45 @@ def cmd_fmu_check(args) -> int:
     return 0
 
 
+# --------------------------------------------------------------------------- diagnose
+
+def cmd_diagnose(args) -> int:
+    """Fit (or take) a model, find what it leaves in the residual, add the effects that pass, report."""
+    from .diagnose import diagnose, write_report
+    from .spectra import compute_spectra
+
+    if args.preset and args.model:
+        raise DataError("diagnose", "--model/--preset", "give a model file or --preset, not both")
+    t0 = time.perf_counter()
+    test = load_steady(args.data, args)
+    nperseg = args.nperseg
+    if nperseg is None:   # several Welch averages: the residual needs noise statistics (default n/4)
+        n = int(np.median([r.n_samples for r in test.runs]))
+        nperseg = int(2 ** np.floor(np.log2(max(n // 4, 16))))
+    f_lim = args.f_lim if args.f_lim is not None else test.meta.get("f_lim_hz")
+    spectra = compute_spectra(test, nperseg=nperseg, f_lim=f_lim)
+    model = None
+    if args.model:
+        model = model_io.load(args.model)
+    elif args.preset:
+        from .presets import preset
+
+        try:
+            model = preset(args.preset).to_model()
+        except (KeyError, ValueError) as exc:
+            raise DataError("--preset", "name", str(exc)) from None
+    diag = diagnose(spectra, model, k_sigma=args.k_sigma, min_gain=args.min_gain)
+    files = write_report(diag, args.output)
+    print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s)")
+    for e in diag.summary()["effects"]:
+        par = ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in e.items()
+                        if k not in ("kind", "evidence", "f_Hz", "psd_ref", "channel"))
+        print(f"  + {e['kind']}: {par} (held-out gain {e['evidence']['heldout_gain_fraction']:.1%})")
+    print(f"error ({diag.summary()['metric']}): {diag.error_before:.4g} -> {diag.error_after:.4g}")
+    print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")
+    return 0
+
+
 # --------------------------------------------------------------------------- psd
 
 def cmd_psd(args) -> int:
@@ -557,6 +596,23 @@ def build_parser() -> argparse.ArgumentParser:
                    help="cross-spectra next to the output: <out>_cross.csv (default) or <out>_cross.h5")
     q.add_argument("-o", "--output", default="psd.csv", help="output file (CSV or NASTRAN bulk data)")
     q.set_defaults(func=cmd_psd)
+
+    dg = sub.add_parser("diagnose", help="residual of a model against test data; finds, adds and reports the "
+                        "effects the model lacks (missing harmonics, amplitude laws, broadband floors)")
+    dg.add_argument("data", help="steady-test directory, sweep CSV or HDF5")
+    dsrc = dg.add_mutually_exclusive_group()
+    dsrc.add_argument("--model", help="model file to start from (default: the empirical fit of the data)")
+    dsrc.add_argument("--preset", help="start from a wheel preset's model, e.g. ithaco-e")
+    dg.add_argument("-o", "--output", required=True, help="report directory")
+    dg.add_argument("--nperseg", type=int, default=None, help="FFT length (default: power of 2 <= run length/4)")
+    dg.add_argument("--f-lim", type=float, default=None, help="upper limit of good data, Hz")
+    dg.add_argument("--k-sigma", type=float, default=4.0, help="held-out gain needed, noise standard errors (4)")
+    dg.add_argument("--min-gain", type=float, default=0.05,
+                    help="held-out gain needed, fraction of the unexplained power (0.05)")
+    dg.add_argument("--slice-samples", type=int, default=8192, help="sweep slice length, samples")
+    dg.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
+                    help="speed of sweep slices: tach column, estimated from data, or auto")
+    dg.set_defaults(func=cmd_diagnose)
 
     fm = sub.add_parser("fmu", help="FMI 2.0 co-simulation FMU of the extended model (build, check)")
     fsub = fm.add_subparsers(dest="fmu_command", required=True)
