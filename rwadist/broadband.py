@@ -314,9 +314,29 @@ class WheelLines:
     params: ext.ExtendedParams | None = None
     groups: list = field(default_factory=list)
     name: str = "wheel"
+    #: source index -> (amplitude_ref N or N·m, omega_ref rad/s, exponent p): the source's amplitude
+    #: goes as amplitude_ref·(|Ω|/omega_ref)^p instead of C·Ω² (a diagnosed ``amplitude_law``)
+    laws: dict = field(default_factory=dict)
+    #: broadband floors (channel index, f knots Hz, psd_ref unit²/Hz, omega_ref rad/s, exponent p):
+    #: S(f, Ω) = psd_ref(f)·(|Ω|/omega_ref)^p, incoherent with everything (a diagnosed ``broadband_floor``)
+    floors: list = field(default_factory=list)
 
     def __len__(self):
         return len(self.labels)
+
+    def _source_C(self, i) -> float:
+        return self.spec[i][1] if self.kind == "empirical" else self.groups[i][0].C
+
+    def _law_factor(self, w, idx) -> np.ndarray:
+        """(n_speeds, n_sel) factor turning C·Ω² into the diagnosed amplitude law (1 without one)."""
+        fac = np.ones((w.size, idx.size))
+        for j, i in enumerate(idx):
+            if int(i) in self.laws:
+                a_ref, w_ref, p = self.laws[int(i)]
+                C = self._source_C(int(i))
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    fac[:, j] = np.where(w != 0, a_ref * (np.abs(w) / w_ref) ** p / (C * w**2), 0.0)
+        return fac
 
     def amplitudes(self, omega, idx=None) -> np.ndarray:
         """Complex channel amplitudes (n_speeds, n_sel, 6) at speeds ``omega`` (rad/s, signed) of the
@@ -339,7 +359,7 @@ class WheelLines:
                 else:
                     out[:, j, base] = a
                     out[:, j, base + 1] = (-1j if mode == "co" else 1j) * s * a
-            return out
+            return out * self._law_factor(w, idx)[..., None] if self.laws else out
         flat, owner = [], []
         for j, i in enumerate(idx):
             for ln in self.groups[i]:
@@ -348,7 +368,28 @@ class WheelLines:
         _, amp = ext.steady_lines(self.params, flat, w)
         for k, j in enumerate(owner):
             out[:, j, :] += amp[:, k, :]
-        return out
+        return out * self._law_factor(w, idx)[..., None] if self.laws else out
+
+
+def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
+    """Attach a model file's diagnosed effects (``rwadist diagnose``) to its sources: an
+    ``amplitude_law`` rescales the matching harmonic (same direction, |Δh| < 1e-3), a
+    ``broadband_floor`` adds its floor to its channel.  Missing harmonics are already harmonics."""
+    from .units import CHANNELS
+
+    for e in model.effects or []:
+        kind = e.get("kind")
+        if kind == "amplitude_law":
+            for i in range(len(src)):
+                d = src.spec[i][0] if src.kind == "empirical" else src.groups[i][0].direction
+                if d == e["direction"] and abs(src.h[i] - float(e["h"])) < 1e-3:
+                    src.laws[i] = (float(e["amplitude_ref"]), float(e["omega_ref_rad_s"]), float(e["exponent"]))
+        elif kind == "broadband_floor":
+            chans = e["channel"] if isinstance(e["channel"], list) else [e["channel"]]
+            for c in chans:
+                src.floors.append((CHANNELS.index(c), np.asarray(e["f_Hz"], float), np.asarray(e["psd_ref"], float),
+                                   float(e["omega_ref_rad_s"]), float(e["exponent"])))
+    return src
 
 
 def empirical_lines(model: WheelModel) -> WheelLines:
@@ -370,7 +411,7 @@ def empirical_lines(model: WheelModel) -> WheelLines:
                 h.append(float(hm.h))
                 labels.append(f"{d} h={hm.h:g}" + ("" if m in ("co", "axial") else f" ({m})"))
                 spec.append((d, float(hm.C), m))
-    return WheelLines("empirical", np.array(h, float), labels, spec=spec, name=model.name)
+    return apply_effects(WheelLines("empirical", np.array(h, float), labels, spec=spec, name=model.name), model)
 
 
 def extended_lines(params: ext.ExtendedParams, lines) -> WheelLines:
@@ -392,7 +433,7 @@ def extended_lines_from_model(model: WheelModel, source="<model>") -> WheelLines
     params = ext.params_from_model(model, source)
     src = extended_lines(params, ext.lines_from_model(model, params))
     src.name = model.name
-    return src
+    return apply_effects(src, model)
 
 
 def preset_lines(name: str, empirical: bool = False) -> WheelLines:
@@ -562,9 +603,16 @@ def csd_groups(groups, f_max: float, n_freq: int = 20001, n_speeds: int = 2000, 
     if check_fmax:
         _check_fmax(groups, f_max)
     acc = np.zeros((len(PAIRS), f.size), dtype=complex)
+    floors = np.zeros((f.size, 6, 6), dtype=complex)
     work = []
     for members, law in groups:
         lo_e, hi_e, mid, P = speed_cells(law, n_speeds)
+        for m in members:   # broadband floors: incoherent, E_Ω[(|Ω|/Ω_ref)^p]·psd_ref(f) per channel
+            T = _transform_of(m.transform)
+            for c, f_k, psd_k, w_ref, p in m.lines.floors:
+                gain = float(np.sum(P * (np.abs(m.ratio * mid) / w_ref) ** p))
+                S = gain * np.interp(f, f_k, psd_k, left=0.0, right=0.0)
+                floors += S[:, None, None] * np.outer(T[:, c], T[:, c])[None, :, :]
         n_src = len(members[0].lines)
         if len(members) > 1 and any(len(m.lines) != n_src or not np.allclose(m.lines.h, members[0].lines.h)
                                     for m in members):
@@ -595,7 +643,7 @@ def csd_groups(groups, f_max: float, n_freq: int = 20001, n_speeds: int = 2000, 
     csd = np.empty((f.size, 6, 6), dtype=complex)
     csd[:, _PAIR_A, _PAIR_B] = acc.T
     csd[:, _PAIR_B, _PAIR_A] = np.conj(acc.T)
-    return BroadbandPSD(f=f, csd=csd, frame=frame)
+    return BroadbandPSD(f=f, csd=csd + floors, frame=frame)
 
 
 def broadband_psd(lines: WheelLines, law, f_max: float, n_freq: int = 20001, n_speeds: int = 2000,

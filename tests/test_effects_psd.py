@@ -1,0 +1,49 @@
+"""Diagnosed effects in a model file flow into the broadband PSD (Parseval against quadrature)."""
+import numpy as np
+import pytest
+from scipy import integrate
+
+from rwadist.broadband import Uniform, broadband_psd, empirical_lines
+from rwadist.model import Harmonic, WheelModel
+from rwadist.units import rpm_to_rad_s
+
+LAW = Uniform(float(rpm_to_rad_s(600.0)), float(rpm_to_rad_s(3000.0)))
+W_REF = float(rpm_to_rad_s(1800.0))
+
+
+def _model(effects):
+    m = WheelModel(name="t")
+    m.empirical["radial_force"] = [Harmonic(2.0, 1.0e-6, sense="co")]
+    m.effects = effects
+    return m
+
+
+def _mean(fn):
+    val, _ = integrate.quad(lambda w: fn(w) * LAW.pdf(w), LAW.lo, LAW.hi, limit=200)
+    return val
+
+
+def test_amplitude_law_changes_the_psd_as_quadrature_says():
+    a_ref, p = 1.0e-6 * W_REF**2, 2.5
+    m = _model([{"kind": "amplitude_law", "direction": "radial_force", "h": 2.0, "exponent": p,
+                 "amplitude_ref": a_ref, "omega_ref_rad_s": W_REF}])
+    res = broadband_psd(empirical_lines(m), LAW, f_max=150.0, n_freq=30001, n_speeds=4000)
+    ms = np.sum(res.psd[:, 0]) * (res.f[1] - res.f[0])
+    expected = _mean(lambda w: (a_ref * (abs(w) / W_REF) ** p) ** 2 / 2)
+    assert ms == pytest.approx(expected, rel=5e-3)
+    plain = broadband_psd(empirical_lines(_model([])), LAW, f_max=150.0, n_freq=30001, n_speeds=4000)
+    assert abs(np.sum(plain.psd[:, 0]) * (plain.f[1] - plain.f[0]) / expected - 1) > 0.02   # the law matters
+
+
+def test_broadband_floor_adds_its_speed_averaged_power():
+    f_k = np.linspace(0.0, 150.0, 31)
+    psd_k = 1e-6 * (1 + f_k / 150.0)
+    floor = {"kind": "broadband_floor", "channel": ["Fx"], "exponent": 3.0, "omega_ref_rad_s": W_REF,
+             "f_Hz": f_k.tolist(), "psd_ref": psd_k.tolist()}
+    with_floor = broadband_psd(empirical_lines(_model([floor])), LAW, f_max=150.0, n_freq=30001, n_speeds=4000)
+    without = broadband_psd(empirical_lines(_model([])), LAW, f_max=150.0, n_freq=30001, n_speeds=4000)
+    df = with_floor.f[1] - with_floor.f[0]
+    added = np.sum(with_floor.psd[:, 0] - without.psd[:, 0]) * df
+    expected = _mean(lambda w: (abs(w) / W_REF) ** 3) * np.trapezoid(psd_k, f_k)
+    assert added == pytest.approx(expected, rel=2e-3)
+    np.testing.assert_allclose(with_floor.psd[:, 1], without.psd[:, 1])    # only Fx carries it
