@@ -320,6 +320,9 @@ class WheelLines:
     #: broadband floors (channel index, f knots Hz, psd_ref unit²/Hz, omega_ref rad/s, exponent p):
     #: S(f, Ω) = psd_ref(f)·(|Ω|/omega_ref)^p, incoherent with everything (a diagnosed ``broadband_floor``)
     floors: list = field(default_factory=list)
+    #: wheel-mode resonances (directions, f_r Hz, ζ, peak gain) multiplying the lines of those
+    #: directions by H(f) (a diagnosed ``fixed_resonance`` with role ``wheel_mode``)
+    resonances: list = field(default_factory=list)
 
     def __len__(self):
         return len(self.labels)
@@ -328,8 +331,17 @@ class WheelLines:
         return self.spec[i][1] if self.kind == "empirical" else self.groups[i][0].C
 
     def _law_factor(self, w, idx) -> np.ndarray:
-        """(n_speeds, n_sel) factor turning C·Ω² into the diagnosed amplitude law (1 without one)."""
-        fac = np.ones((w.size, idx.size))
+        """(n_speeds, n_sel) factor turning C·Ω² into the diagnosed amplitude law (1 without one),
+        times the diagnosed wheel-mode resonances of the source's direction."""
+        fac = np.ones((w.size, idx.size), dtype=complex)
+        for dirs, f_r, zeta, g in self.resonances:
+            from .diagnose import resonance
+
+            for j, i in enumerate(idx):
+                d = self.spec[int(i)][0] if self.kind == "empirical" else self.groups[int(i)][0].direction
+                if d in dirs:
+                    H = resonance(self.h[int(i)] * np.abs(w) / (2 * np.pi), f_r, zeta, g)
+                    fac[:, j] *= np.where(w < 0, np.conj(H), H)   # a real filter at negative frequency
         for j, i in enumerate(idx):
             if int(i) in self.laws:
                 a_ref, w_ref, p = self.laws[int(i)]
@@ -359,7 +371,7 @@ class WheelLines:
                 else:
                     out[:, j, base] = a
                     out[:, j, base + 1] = (-1j if mode == "co" else 1j) * s * a
-            return out * self._law_factor(w, idx)[..., None] if self.laws else out
+            return out * self._law_factor(w, idx)[..., None] if (self.laws or self.resonances) else out
         flat, owner = [], []
         for j, i in enumerate(idx):
             for ln in self.groups[i]:
@@ -368,13 +380,15 @@ class WheelLines:
         _, amp = ext.steady_lines(self.params, flat, w)
         for k, j in enumerate(owner):
             out[:, j, :] += amp[:, k, :]
-        return out * self._law_factor(w, idx)[..., None] if self.laws else out
+        return out * self._law_factor(w, idx)[..., None] if (self.laws or self.resonances) else out
 
 
 def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
     """Attach a model file's diagnosed effects (``rwadist diagnose``) to its sources: an
     ``amplitude_law`` rescales the matching harmonic (same direction, |Δh| < 1e-3), a
-    ``broadband_floor`` adds its floor to its channel.  Missing harmonics are already harmonics."""
+    ``broadband_floor`` adds its floor to its channel, a ``fixed_resonance`` of role ``wheel_mode``
+    amplifies its directions' lines.  Missing harmonics are already harmonics; a ``test_stand``
+    resonance and a ``cross_coupling`` load-cell offset are measurement artefacts, not disturbance."""
     from .units import CHANNELS
 
     for e in model.effects or []:
@@ -389,6 +403,10 @@ def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
             for c in chans:
                 src.floors.append((CHANNELS.index(c), np.asarray(e["f_Hz"], float), np.asarray(e["psd_ref"], float),
                                    float(e["omega_ref_rad_s"]), float(e["exponent"])))
+        elif kind == "fixed_resonance" and e.get("role") == "wheel_mode":
+            dirs = e.get("directions") or []
+            dirs = [dirs] if isinstance(dirs, str) else list(dirs)
+            src.resonances.append((dirs, float(e["f_Hz"]), float(e["zeta"]), float(e["peak_gain"])))
     return src
 
 

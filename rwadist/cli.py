@@ -412,7 +412,7 @@ def cmd_diagnose(args) -> int:
             model = preset(args.preset).to_model()
         except (KeyError, ValueError) as exc:
             raise DataError("--preset", "name", str(exc)) from None
-    diag = diagnose(spectra, model, k_sigma=args.k_sigma, min_gain=args.min_gain)
+    diag = diagnose(spectra, model, k_sigma=args.k_sigma, min_gain=args.min_gain, test=test)
     files = write_report(diag, args.output)
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s)")
     for e in diag.summary()["effects"]:

@@ -26,6 +26,9 @@ Predicted PSD of channel c at speed Ω (unit²/Hz on the spectra's grid)::
   :func:`rwadist.empirical.block_floor` (speed independent by assumption).
 * B_c is the wheel's broadband floor (zero until a ``broadband_floor`` effect
   is added).
+* a line's amplitude is multiplied by |H(f)| of every ``fixed_resonance``
+  acting on the channel; after a ``cross_coupling`` effect the torque data are
+  read corrected for the load-cell offset (T − r × F, Welch PSD recomputed).
 
 Error metric (``waterfall_unexplained_fraction``): the speed × frequency plane
 of each channel is cut into bands of :data:`BAND_BINS` bins over
@@ -74,8 +77,30 @@ Effect classes (``kind`` in the model file's ``effects`` list and in
     linear least squares on the per-run floors, p on a grid.  Parameters:
     channel, exponent, omega_ref_rad_s, f_Hz and psd_ref (unit²/Hz) knots.
 
-Not built yet: fixed-frequency resonances, cross-axis coupling, counter
-rotation, sidebands, speed ripple, spin acceleration.
+``fixed_resonance``  (:class:`FixedResonance`) amplification of the passing
+    lines around a frequency f_r that does not move with speed, the simple
+    resonance H(r) = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r), r = f/f_r
+    (:meth:`rwadist.teststand.Mode.response`) multiplying every line of its
+    channels.  Signature: the lines' measured/predicted power ratio peaking at
+    one frequency whatever the harmonic and speed.  Fit: f_r, ζ, g by robust
+    nonlinear least squares of ln|H|² on those log ratios (lines that beat with
+    a neighbour within 2·LINE_HALF bins left out), re-measured with the
+    tentative resonance in place.  Two hypotheses compete on held-out speeds:
+    one common to every channel, ``role`` = ``test_stand`` (a fixture
+    resonance: to be excluded from the wheel's model), and one per direction,
+    ``role`` = ``wheel_mode`` (an unmodelled wheel mode: to be added).
+    Parameters: f_Hz, zeta, peak_gain (|H| at f_r), role, directions.
+``cross_coupling``  (:class:`CrossCoupling`) a load-cell offset: the torque
+    channels carry r × F of the force channels, T_measured = T + r × F (r in m,
+    wheel frame).  Signature: torque content at the force lines' frequencies,
+    coherent with the forces.  Fit: r by weighted linear least squares on the
+    complex line amplitudes of forces and torques at the model's force-line
+    frequencies (needs the time series: ``diagnose(..., test=...)``; without
+    them the class is not tried).  Parameters: r_m, r_stderr_m.  Applied as a
+    calibration of the measurement: the torque data are corrected, so the
+    metric after it is that of the corrected data.
+
+Not built yet: counter rotation, sidebands, speed ripple, spin acceleration.
 """
 from __future__ import annotations
 
@@ -88,7 +113,10 @@ from scipy import stats
 from .empirical import block_floor, fit_empirical
 from .model import Harmonic, WheelModel
 from .spectra import Spectra, welch_dof
-from .units import CHANNEL_DIRECTION, CHANNEL_UNIT, DIRECTION_CHANNELS, RAD_S_TO_RPM
+from .units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
+
+#: Torque channels, in the order of the components of r × F.
+TORQUE_CHANNELS = ("Tx", "Ty", "Tz")
 
 #: Bins per band of the error metric.
 BAND_BINS = 8
@@ -101,6 +129,8 @@ KERNEL_HALF = 16
 #: Exponent grid of the broadband-floor fit (PSD ∝ |Ω|^p).
 FLOOR_EXPONENTS = np.arange(0.5, 8.01, 0.25)
 METRIC = "waterfall_unexplained_fraction"
+#: Line-to-noise power ratio above which a line's log gain gets full weight in a resonance fit.
+SNR_KNEE = 10.0
 #: Noise standard deviations forgiven per band by the error metric.
 NOISE_Z = 2.0
 
@@ -130,6 +160,9 @@ class State:
 
     model : WheelModel (harmonics in ``empirical``).  laws : (direction, h) -> (amp_ref, omega_ref, p).
     noise : channel -> N_c(f), unit²/Hz.  floors : channel -> (psd_ref(f) unit²/Hz, omega_ref rad/s, p).
+    resonances : (f_r Hz, ζ, g, channels) fixed-frequency resonances multiplying the lines of their channels.
+    coupling : load-cell offset r (m, 3-vector) of a ``cross_coupling`` effect, or None: the torque data are
+        then read corrected, T − r × F (:meth:`Context.data`).
     effects : effect objects added so far.
     """
 
@@ -138,9 +171,12 @@ class State:
     laws: dict = field(default_factory=dict)
     floors: dict = field(default_factory=dict)
     effects: list = field(default_factory=list)
+    resonances: list = field(default_factory=list)
+    coupling: tuple | None = None
 
     def copy(self) -> "State":
-        return State(copy.deepcopy(self.model), self.noise, dict(self.laws), dict(self.floors), list(self.effects))
+        return State(copy.deepcopy(self.model), self.noise, dict(self.laws), dict(self.floors), list(self.effects),
+                     list(self.resonances), self.coupling)
 
     def lines(self, channel: str):
         """(h, amplitude function of omega) for every harmonic acting on ``channel``."""
@@ -153,10 +189,18 @@ class State:
 
 
 class Context:
-    """Spectra, kernel, bands and run split shared by every step of a diagnosis."""
+    """Spectra, kernel, bands and run split shared by every step of a diagnosis.
 
-    def __init__(self, spectra: Spectra, channels=None):
+    test : the SteadyTest the spectra were computed from (same runs, same order), or None; the time
+    series are needed by the ``cross_coupling`` effect only (complex line amplitudes, corrected PSDs)."""
+
+    def __init__(self, spectra: Spectra, channels=None, test=None):
         self.sp = spectra
+        if test is not None and (len(test.runs) != len(spectra.speed) or not np.allclose(
+                [r.speed for r in test.runs], spectra.speed)):
+            raise ValueError("diagnose: the test's runs are not those of the spectra (count or speeds differ)")
+        self.test = test
+        self._corrected = {}
         self.f = spectra.f
         self.df = spectra.df
         self.omega = np.abs(np.asarray(spectra.speed, dtype=float))
@@ -176,6 +220,48 @@ class Context:
         # forces are weighed against forces, torques against torques (mean data power of the unit group)
         self._scale = {c: float(np.mean([power[k] for k in self.channels if CHANNEL_UNIT[k] == CHANNEL_UNIT[c]]))
                        for c in self.channels}
+
+    def data(self, state: State, c: str) -> np.ndarray:
+        """Measured PSD (n_runs, n_f) of channel ``c`` as the state reads it: a torque channel corrected for
+        the state's load-cell offset, T − r × F, its Welch PSD recomputed with the spectra's settings."""
+        if state.coupling is None or c not in TORQUE_CHANNELS:
+            return self.sp.psd[c]
+        key = tuple(float(x) for x in state.coupling)
+        if key not in self._corrected:
+            from .spectra import compute_spectra
+
+            test = copy.deepcopy(self.test)
+            r = np.asarray(key)
+            for run in test.runs:
+                F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
+                T = np.cross(r[None, :], F)
+                for j, k in enumerate(TORQUE_CHANNELS):
+                    if k in run.signals:
+                        run.signals[k] = run.signals[k] - T[:, j]
+            chans = [k for k in TORQUE_CHANNELS if k in self.sp.psd]
+            sp = compute_spectra(test, nperseg=self.sp.nperseg, window=self.sp.window, f_lim=self.sp.f_lim,
+                                 channels=chans)
+            if not np.array_equal(sp.n_segments, self.sp.n_segments):
+                raise ValueError("diagnose: the spectra were not computed with 50 % overlap; cannot correct them")
+            self._corrected[key] = sp.psd
+        return self._corrected[key][c]
+
+    def phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> np.ndarray:
+        """Complex amplitudes (len(runs), L, 6) of every channel at frequencies ``f_hz`` (len(runs), L), Hz:
+        X = 2·Σ w x e^{−2πj f t}/Σ w over the whole run (Hann window), so x(t) ≈ Re(X e^{2πj f t});
+        NaN for a channel the run lacks."""
+        from scipy import signal
+
+        out = np.full((runs.size, f_hz.shape[1], len(CHANNELS)), np.nan + 0j)
+        for i, r in enumerate(runs):                      # one matrix product per run
+            run = self.test.runs[r]
+            t = np.arange(run.n_samples) / run.sample_rate
+            w = signal.get_window(self.sp.window, run.n_samples)
+            have = [j for j, c in enumerate(CHANNELS) if c in run.signals]
+            x = np.column_stack([run.signals[CHANNELS[j]] for j in have]) * w[:, None]
+            E = np.exp(-2j * np.pi * np.outer(f_hz[i], t))
+            out[i][:, have] = 2.0 * (E @ x) / np.sum(w)
+        return out
 
     def _floor(self, c):
         psd = self.sp.psd[c]
@@ -203,6 +289,14 @@ class Context:
         np.add.at(out, (rows[ok], k[ok]), val[ok])
         return out
 
+    def gain(self, state: State, c: str, f_hz) -> np.ndarray:
+        """|H| of the state's fixed resonances acting on channel ``c`` at line frequencies ``f_hz`` (Hz)."""
+        g = np.ones_like(np.asarray(f_hz, dtype=float))
+        for f_r, zeta, peak, chans in state.resonances:
+            if c in chans:
+                g = g * np.abs(resonance(f_hz, f_r, zeta, peak))
+        return g
+
     def amplitude(self, C, law, runs):
         w = self.omega[runs]
         if law is None:
@@ -223,7 +317,10 @@ class Context:
         for h, C, law in state.lines(c):
             if skip is not None and abs(h - skip) < 1e-9:
                 continue
-            out += self.line_psd(h, self.amplitude(C, law, runs), runs)
+            amp = self.amplitude(C, law, runs)
+            if state.resonances:
+                amp = amp * self.gain(state, c, h * self.omega[runs] / (2 * np.pi))
+            out += self.line_psd(h, amp, runs)
         return out
 
     def band_centres(self) -> np.ndarray:
@@ -236,7 +333,7 @@ class Context:
         from scipy import stats
 
         P = self.predict(state, c, runs)
-        D = self.sp.psd[c][runs] - (P - self.floor_psd(state, c, runs))     # data less the model's lines
+        D = self.data(state, c)[runs] - (P - self.floor_psd(state, c, runs))     # data less the model's lines
         mask = np.zeros(D.shape, bool)
         offs = np.arange(-LINE_HALF, LINE_HALF + 1)
         rows = np.arange(runs.size)[:, None]
@@ -284,7 +381,7 @@ class Context:
         tot = np.zeros(runs.size)
         parts = {}
         for c in channels or self.channels:
-            Dfull = self.sp.psd[c][runs]
+            Dfull = self.data(state, c)[runs]
             ok = np.isfinite(Dfull[:, 0])
             D = self.band_sums(Dfull)
             N = self.floor_psd(state, c, runs)
@@ -308,7 +405,7 @@ class Context:
     def rms_error(self, state: State) -> float:
         vals = []
         for c in self.channels:
-            D = self.band_sums(self.sp.psd[c][self.runs]).sum(1)
+            D = self.band_sums(self.data(state, c)[self.runs]).sum(1)
             M = self.band_sums(self.predict(state, c, self.runs)).sum(1)
             vals.append(np.abs(np.sqrt(M) - np.sqrt(D)) / np.sqrt(D))
         return float(np.nanmean(np.concatenate(vals)))
@@ -316,7 +413,7 @@ class Context:
     def measure_line(self, state: State, c: str, h: float, runs: np.ndarray, skip=None):
         """Amplitude (unit) of a line h in the data of ``runs`` less everything else the state
         predicts (other lines, floors); NaN where the line is out of band or not above noise."""
-        R = self.sp.psd[c][runs] - self.predict(state, c, runs, skip=skip)
+        R = self.data(state, c)[runs] - self.predict(state, c, runs, skip=skip)
         pos = h * self.omega[runs] / (2 * np.pi) / self.df
         k0 = np.rint(pos).astype(int)
         offs = np.arange(-LINE_HALF, LINE_HALF + 1)
@@ -523,7 +620,225 @@ class BroadbandFloor:
         return out
 
 
-EFFECT_CLASSES = (MissingHarmonic, AmplitudeLaw, BroadbandFloor)
+def resonance(f_hz, f_r: float, zeta: float, peak_gain: float):
+    """Complex gain H(r) = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r), r = f/f_r, of a simple resonance at f_r (Hz)
+    with damping ratio ζ and |H(1)| = g (:meth:`rwadist.teststand.Mode.response`); H → 1 far from f_r."""
+    r = np.abs(np.asarray(f_hz, dtype=float)) / f_r
+    base = 1.0 - r * r
+    two_zr = 2.0 * zeta * r
+    return (base + 1j * peak_gain * two_zr) / (base + 1j * two_zr)
+
+
+def _line_gain_points(ctx, state, chans, runs):
+    """(f Hz, y, weight) of every model line of ``chans`` on ``runs`` measured above the noise and at least
+    2·LINE_HALF bins from the channel's other lines:
+    y = ln(measured power / predicted power) = 2 ln(a_measured/a_predicted), the log power gain a
+    further resonance would have to supply at the line's frequency f = h|Ω|/2π.  weight = s²/(s² + s_k²)
+    with s the line's power over the noise power in its window and s_k = :data:`SNR_KNEE`: the scatter of
+    a log power falls as 1/s for weak lines and is bounded by model error for strong ones."""
+    fs, ys, ws = [], [], []
+    offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+    for c in chans:
+        noise = ctx.floor_psd(state, c, runs)
+        hs = np.array([x[0] for x in state.lines(c)])
+        for h, C, law in state.lines(c):
+            f = h * ctx.omega[runs] / (2 * np.pi)
+            a_pred = ctx.amplitude(C, law, runs) * ctx.gain(state, c, f)
+            a = ctx.measure_line(state, c, h, runs, skip=h)
+            # a line within 2·LINE_HALF bins of another beats with it in the Welch estimate: left out
+            sep = np.abs(hs[hs != h][:, None] - h) * ctx.omega[runs][None, :] / (2 * np.pi) / ctx.df
+            alone = np.all(sep >= 2 * LINE_HALF, axis=0) if sep.size else np.ones(runs.size, bool)
+            ok = np.isfinite(a) & (a_pred > 0) & alone
+            k = np.clip(np.rint(f / ctx.df).astype(int)[:, None] + offs, 0, ctx.f.size - 1)
+            snr = np.where(ok, a, 0.0) ** 2 / 2 / (np.take_along_axis(noise, k, axis=1).sum(1) * ctx.df)
+            fs.append(f[ok])
+            ys.append(2.0 * np.log(a[ok] / a_pred[ok]))
+            ws.append(snr[ok] ** 2 / (snr[ok] ** 2 + SNR_KNEE**2))
+    if not fs:
+        return np.empty(0), np.empty(0), np.empty(0)
+    return np.concatenate(fs), np.concatenate(ys), np.concatenate(ws)
+
+
+@dataclass
+class FixedResonance:
+    """A resonance at a fixed frequency f_r (Hz, the same at every speed) multiplying every line of its
+    channels by H(f/f_r) (:func:`resonance`; ζ damping ratio, g = |H| at f_r).  ``role``: "test_stand" when
+    it acts on every channel alike (a fixture resonance, to be excluded from the wheel's model),
+    "wheel_mode" when on one direction's channels only (an unmodelled wheel mode, to be added)."""
+
+    f_r: float
+    zeta: float
+    peak_gain: float
+    channels: tuple
+    role: str
+    n_points: int = 0
+    kind: str = "fixed_resonance"
+
+    def apply(self, state: State) -> State:
+        s = state.copy()
+        s.resonances.append((self.f_r, self.zeta, self.peak_gain, tuple(self.channels)))
+        s.effects.append(self)
+        return s
+
+    def params(self) -> dict:
+        dirs = sorted({CHANNEL_DIRECTION[c] for c in self.channels})
+        return {"f_Hz": self.f_r, "zeta": self.zeta, "peak_gain": self.peak_gain, "role": self.role,
+                "directions": dirs, "n_points": self.n_points,
+                "gain_law": "H = (1 - r^2 + 2j*peak_gain*zeta*r)/(1 - r^2 + 2j*zeta*r) with r = f/f_Hz"}
+
+    @staticmethod
+    def peak(f: np.ndarray, y: np.ndarray, lo: float, hi: float, df: float):
+        """Frequency (Hz) and mean log power gain of the strongest excess of ``y`` vs ``f``: the mean of y
+        within ±max(2 df, 2 %) of every grid frequency, scored by |mean|·sqrt(count) (4 points at least)."""
+        grid = np.arange(lo, hi, df)
+        if grid.size == 0 or f.size < 4:
+            return None
+        half = np.maximum(2.0 * df, 0.02 * grid)
+        inside = np.abs(f[None, :] - grid[:, None]) <= half[:, None]
+        cnt = inside.sum(1)
+        mean = np.where(cnt > 0, (inside * y[None, :]).sum(1) / np.maximum(cnt, 1), 0.0)
+        score = np.where(cnt >= 4, np.abs(mean) * np.sqrt(cnt), 0.0)
+        i = int(np.argmax(score))
+        return (float(grid[i]), float(mean[i])) if score[i] > 0 else None
+
+    @staticmethod
+    def fit(ctx: Context, state: State, channels, runs, f0: float | None = None,
+            role: str = "wheel_mode", n_iter: int = 3) -> "FixedResonance | None":
+        """f_r, ζ, g by robust (soft-L1) nonlinear least squares of ln|H(f)|² against the lines' log power
+        gains (:func:`_line_gain_points`), parameters in logs (positive), started at the strongest excess
+        (or ``f0``) with ζ ∈ {0.01, 0.03, 0.1}; ``n_iter`` passes, each re-measuring the lines with the
+        previous pass's resonance in the state."""
+        from scipy.optimize import least_squares
+
+        chans = [c for c in channels if c in ctx.channels]
+        f, y, wt = _line_gain_points(ctx, state, chans, runs)
+        lo, hi = ctx.k_lo * ctx.df, ctx.k_hi * ctx.df
+        pk = FixedResonance.peak(f, y, lo, hi, ctx.df)
+        if pk is None or f.size < 6:
+            return None
+        lb, ub = np.log([lo, 1e-3, 0.02]), np.log([hi, 0.5, 200.0])
+        g0 = float(np.clip(np.exp(pk[1] / 2.0), 0.1, 50.0))
+        starts = [np.log([pk[0] if f0 is None else f0, z0, max(g0, 1.01) if pk[1] > 0 else min(g0, 0.99)])
+                  for z0 in (0.01, 0.03, 0.1)]
+        e = None
+        for _ in range(n_iter):
+            if e is not None:
+                # re-measure with the tentative resonance in the state, so that neighbouring lines are
+                # subtracted amplified; the total log gain is the residual one plus the tentative ln|H|²
+                st = e.apply(state)
+                f, y, wt = _line_gain_points(ctx, st, chans, runs)
+                y = y + np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain)) ** 2)
+                starts = [np.log([e.f_r, e.zeta, e.peak_gain])]
+            if f.size < 6:
+                return None
+
+            def res(x):
+                return np.sqrt(wt) * (y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2))
+            best = None
+            for x0 in starts:
+                sol = least_squares(res, np.clip(x0, lb + 1e-9, ub - 1e-9), loss="soft_l1", f_scale=0.5,
+                                    bounds=(lb, ub))
+                if best is None or sol.cost < best.cost:
+                    best = sol
+            f_r, zeta, g = (float(v) for v in np.exp(best.x))
+            e = FixedResonance(f_r, zeta, g, tuple(channels), role, int(f.size))
+        return e
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        """One resonance per direction (role wheel_mode) and one common to every channel (role test_stand)."""
+        out = []
+        dirs = [d for d, ch in DIRECTION_CHANNELS.items()
+                if any(c in ctx.channels for c in ch) and state.model.harmonics(d)]
+        for d in dirs:
+            e = FixedResonance.fit(ctx, state, DIRECTION_CHANNELS[d], runs, role="wheel_mode")
+            if e is not None:
+                out.append(e)
+        if len(dirs) > 1:
+            e = FixedResonance.fit(ctx, state, ctx.channels, runs, role="test_stand")
+            if e is not None:
+                out.append(e)
+        return [e for e in out if not any(abs(e.f_r - r[0]) < 0.02 * r[0] and set(e.channels) & set(r[3])
+                                          for r in state.resonances)]
+
+
+
+@dataclass
+class CrossCoupling:
+    """Load-cell offset: the measured torque carries r × F of the measured force (r in m, wheel frame),
+    T_measured = T + r × F, i.e. Tx += r_y·Fz − r_z·Fy, Ty += r_z·Fx − r_x·Fz, Tz += r_x·Fy − r_y·Fx.
+    Added to a state it reads the torque data corrected, T − r × F (a calibration of the measurement,
+    not a part of the wheel)."""
+
+    r: np.ndarray
+    r_stderr: np.ndarray
+    n_points: int = 0
+    kind: str = "cross_coupling"
+
+    @property
+    def channels(self):
+        return TORQUE_CHANNELS
+
+    def apply(self, state: State) -> State:
+        s = state.copy()
+        s.coupling = tuple(float(x) for x in self.r)
+        s.effects.append(self)
+        return s
+
+    def params(self) -> dict:
+        return {"r_m": [float(x) for x in self.r], "r_stderr_m": [float(x) for x in self.r_stderr],
+                "n_points": self.n_points, "law": "T_measured = T + r x F (r in m in the wheel frame)"}
+
+    @staticmethod
+    def fit(ctx: Context, state: State, runs) -> "CrossCoupling | None":
+        """r by weighted linear least squares on the complex amplitudes (:meth:`Context.phasors`) of the
+        forces and torques at every force line of the model (radial and axial force harmonics, in band):
+        T_c = T0_c + M_c(F)·r with M(F) = −[F]× (r × F = −F × r), real and imaginary parts stacked.  The
+        wheel's own torque T0 is the error term: each equation is weighted by 1/P_c(f), P_c the torque PSD
+        the state predicts at the line (its torque lines and noise), so lines shared with the torque
+        harmonics weigh little.  Unbiased when T0 and F have independent phases (as the test stand's
+        random phases); standard errors from the weighted residual."""
+        if ctx.test is None or state.coupling is not None:
+            return None
+        tq = [c for c in TORQUE_CHANNELS if c in ctx.channels]
+        if not tq or not all(c in ctx.channels for c in ("Fx", "Fy", "Fz")):
+            return None
+        hs = sorted({round(x.h, 4) for d in ("radial_force", "axial_force") for x in state.model.harmonics(d)})
+        if not hs:
+            return None
+        f = np.outer(ctx.omega[runs], hs) / (2 * np.pi)                     # (n_runs, L) Hz
+        inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
+        X = ctx.phasors(runs, f)                                             # (n_runs, L, 6)
+        Fx, Fy, Fz = X[..., 0], X[..., 1], X[..., 2]
+        zero = np.zeros_like(Fx)
+        M = {"Tx": (zero, Fz, -Fy), "Ty": (-Fz, zero, Fx), "Tz": (Fy, -Fx, zero)}
+        k = np.clip(np.rint(f / ctx.df).astype(int), 0, ctx.f.size - 1)
+        rows, rhs = [], []
+        for c in tq:
+            P = np.take_along_axis(ctx.predict(state, c, runs), k, axis=1)      # unit²/Hz at the lines
+            T = X[..., CHANNELS.index(c)]
+            ok = inb & np.isfinite(T) & np.isfinite(Fx) & np.isfinite(Fy) & np.isfinite(Fz) & (P > 0)
+            wt = 1.0 / np.sqrt(P[ok])
+            A = np.column_stack([m[ok] for m in M[c]]) * wt[:, None]
+            b = T[ok] * wt
+            rows += [A.real, A.imag]
+            rhs += [b.real, b.imag]
+        A, b = np.vstack(rows), np.concatenate(rhs)
+        if b.size < 6:
+            return None
+        r, *_ = np.linalg.lstsq(A, b, rcond=None)
+        res = b - A @ r
+        s2 = float(res @ res) / max(b.size - 3, 1)
+        cov = s2 * np.linalg.pinv(A.T @ A)
+        return CrossCoupling(r, np.sqrt(np.diag(cov)), int(b.size // 2))
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        e = CrossCoupling.fit(ctx, state, runs)
+        return [] if e is None else [e]
+
+
+EFFECT_CLASSES = (MissingHarmonic, AmplitudeLaw, BroadbandFloor, FixedResonance, CrossCoupling)
 
 
 def _measure(ctx, state, direction, h, runs, skip=None):
@@ -533,6 +848,7 @@ def _measure(ctx, state, direction, h, runs, skip=None):
         if c not in ctx.channels:
             continue
         a = ctx.measure_line(state, c, h, runs, skip=skip)
+        a = a / ctx.gain(state, c, h * ctx.omega[runs] / (2 * np.pi))     # the line before any resonance
         ok = np.isfinite(a)
         ds.append(a[ok])
         ws.append(ctx.omega[runs][ok])
@@ -544,7 +860,7 @@ def _ridge_score(ctx, state, chans, runs, h_grid):
     score = np.zeros(h_grid.size)
     count = np.zeros(h_grid.size)
     for c in chans:
-        R = ctx.sp.psd[c][runs] - ctx.predict(state, c, runs)
+        R = ctx.data(state, c)[runs] - ctx.predict(state, c, runs)
         z = R / ctx.floor_psd(state, c, runs)
         zmax = np.maximum(np.maximum(z, np.roll(z, 1, axis=1)), np.roll(z, -1, axis=1))
         k = np.rint(np.outer(h_grid, ctx.omega[runs]) / (2 * np.pi) / ctx.df).astype(int)   # (n_h, n_runs)
@@ -579,7 +895,7 @@ def refine_h(ctx, state, chans, runs, h, n_iter: int = 3):
     for _ in range(n_iter):
         fs_, ws_ = [], []
         for c in chans:
-            R = ctx.sp.psd[c][runs] - ctx.predict(state, c, runs)
+            R = ctx.data(state, c)[runs] - ctx.predict(state, c, runs)
             z = R / ctx.floor_psd(state, c, runs)
             k0 = np.rint(h * ctx.omega[runs] / (2 * np.pi) / ctx.df).astype(int)
             offs = np.arange(-2, 3)
@@ -692,6 +1008,10 @@ def _refit(ctx, state, effect):
         return AmplitudeLaw.fit(ctx, state, effect.direction, effect.h, runs) or effect
     if isinstance(effect, BroadbandFloor):
         return BroadbandFloor.fit(ctx, state, effect.channel, runs) or effect
+    if isinstance(effect, FixedResonance):
+        return FixedResonance.fit(ctx, state, effect.channels, runs, effect.f_r, effect.role) or effect
+    if isinstance(effect, CrossCoupling):
+        return CrossCoupling.fit(ctx, state, runs) or effect
     return effect
 
 
@@ -717,15 +1037,17 @@ def initial_state(ctx: Context, model: WheelModel) -> State:
 
 
 def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float = 4.0, min_gain: float = 0.05,
-             max_iterations: int = 8, channels=None) -> Diagnosis:
+             max_iterations: int = 8, channels=None, test=None) -> Diagnosis:
     """Greedy effect search on ``spectra`` starting from ``model`` (default: the empirical fit).
 
-    k_sigma, min_gain : acceptance rule (module docstring).  Returns a :class:`Diagnosis` whose
-    ``model`` carries the added harmonics in ``empirical`` and every effect in ``effects``.
+    k_sigma, min_gain : acceptance rule (module docstring).  test : the SteadyTest ``spectra`` were
+    computed from (50 % overlap), needed for ``cross_coupling`` (phases); without it that class is not tried.
+    Returns a :class:`Diagnosis` whose ``model`` carries the added harmonics in ``empirical`` and every
+    effect in ``effects``.
     """
     if model is None:
         model = fit_empirical(spectra).model
-    ctx = Context(spectra, channels)
+    ctx = Context(spectra, channels, test)
     state0 = initial_state(ctx, model)
     state = state0
     hyps = []
@@ -784,6 +1106,13 @@ def rms_vs_speed(diag: Diagnosis) -> dict:
     return cols
 
 
+def _fmt(v, spec: str) -> str:
+    """A parameter for the report: floats with ``spec``, short lists space-separated (no commas: CSV)."""
+    if isinstance(v, (list, tuple)):
+        return "[" + " ".join(_fmt(x, spec) for x in v) + "]"
+    return format(v, spec) if isinstance(v, float) else str(v)
+
+
 def _write_csv(path, cols: dict):
     names = list(cols)
     arr = np.column_stack([np.asarray(cols[k], dtype=float) for k in names])
@@ -802,8 +1131,8 @@ def _waterfall_figure(diag: Diagnosis):
     fc = ctx.band_centres()
     rpm = ctx.omega[runs] * RAD_S_TO_RPM
     for j, c in enumerate(chans):
-        D = ctx.band_sums(ctx.sp.psd[c][runs])
         for i, (tag, st) in enumerate((("before", diag.state_before), ("after", diag.state_after))):
+            D = ctx.band_sums(ctx.data(st, c)[runs])
             ax = fig.add_subplot(2, len(chans), i * len(chans) + j + 1)
             M = ctx.band_sums(ctx.predict(st, c, runs))
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -872,8 +1201,8 @@ def write_report(diag: Diagnosis, out_dir) -> list:
     lines = ["iteration,kind,channels,parameters,heldout_gain,heldout_gain_fraction,t,passed"]
     for h in diag.hypotheses:
         e = h.effect
-        par = ";".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in e.params().items()
-                       if not isinstance(v, list))
+        par = ";".join(f"{k}={_fmt(v, '.6g')}" for k, v in e.params().items()
+                       if not (isinstance(v, list) and len(v) > 4)).replace(",", " ")     # one CSV field
         lines.append(f"{h.iteration},{e.kind},{' '.join(e.channels)},{par},{h.gain:.6g},{h.gain_fraction:.6g},"
                      f"{h.t:.4g},{h.passed}")
     p.write_text("\n".join(lines) + "\n")
@@ -888,8 +1217,8 @@ def write_report(diag: Diagnosis, out_dir) -> list:
     if not chosen:
         md.append("None: nothing left in the residual passed the held-out test.")
     for h in chosen:
-        par = ", ".join(f"{k} = {v:.5g}" if isinstance(v, float) else f"{k} = {v}"
-                        for k, v in h.effect.params().items() if not isinstance(v, list))
+        par = ", ".join(f"{k} = {_fmt(v, '.5g')}"
+                        for k, v in h.effect.params().items() if not (isinstance(v, list) and len(v) > 4))
         md.append(f"- **{h.effect.kind}** ({par}): held-out gain {h.gain_fraction:.1%} of the unexplained "
                   f"power, {h.t:.1f} noise standard errors")
     md += ["", "## Hypotheses (best five per iteration)", "", "see `hypotheses.csv`", "",

@@ -5,7 +5,8 @@ Data: the E wheel (preset "ithaco-e", simple physics, modes off), 40 speeds 600-
 own model (the truth without the injected effect), so every injected effect is the only thing
 missing; one test starts from the empirical fit instead.
 Tolerances: missing harmonic |h - h_true| < 0.01 and C within 5 %; amplitude exponent within 0.05;
-broadband-floor PSD exponent within 0.5.  Error metric: ``waterfall_unexplained_fraction``.
+broadband-floor PSD exponent within 0.5; fixed resonance f_r within 1 %, zeta within 10 %, peak gain
+within 5 %; load-cell offset r within 1 mm per component.  Error metric: ``waterfall_unexplained_fraction``.
 """
 from __future__ import annotations
 
@@ -20,10 +21,11 @@ from rwadist import broadband as bb
 from rwadist import cli
 from rwadist import model as model_io
 from rwadist.data import write_steady
-from rwadist.diagnose import diagnose, line_kernel
+from rwadist.diagnose import Context, diagnose, line_kernel, resonance, write_report
 from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
-from rwadist.teststand import simulate_steady
+from rwadist.teststand import Mode, simulate_steady
+from rwadist.units import CHANNELS
 
 SPEEDS = np.linspace(600.0, 2400.0, 40)
 FS, N, NPERSEG = 1920.0, 4096, 1024
@@ -65,6 +67,16 @@ def inject_floor(test, chans, ref_amp, p, fc, fs, seed):
             r.signals[c] += ref_amp[c] * (abs(r.speed) / wmax) ** (p / 2) * x
 
 
+def inject_coupling(test, r):
+    """Load-cell offset: every run's torques get r × F of its forces (time series, r in m)."""
+    r = np.asarray(r, float)
+    for run in test.runs:
+        F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
+        T = np.cross(r[None, :], F)
+        for j, k in enumerate(("Tx", "Ty", "Tz")):
+            run.signals[k] = run.signals[k] + T[:, j]
+
+
 def spectra(test, f_lim=None):
     return compute_spectra(test, nperseg=NPERSEG, f_lim=f_lim)
 
@@ -102,14 +114,20 @@ def test_line_kernel_matches_welch_and_parseval():
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_clean_data_adds_nothing(seed):
-    d = diagnose(spectra(e_data(seed)), TRUTH)
+    """Every class tried (the time series given, so cross_coupling too): nothing passes."""
+    test = e_data(seed)
+    d = diagnose(spectra(test), TRUTH, test=test)
     assert d.model.effects == []
     assert d.error_after == d.error_before < 2e-3
+    assert {h.effect.kind for h in d.hypotheses} >= {"broadband_floor"}
 
 
 @pytest.mark.slow
 def test_clean_data_ten_seeds_no_false_addition():
-    added = [kinds(diagnose(spectra(e_data(100 + s)), TRUTH)) for s in range(10)]
+    added = []
+    for s in range(10):
+        test = e_data(100 + s)
+        added.append(kinds(diagnose(spectra(test), TRUTH, test=test)))
     assert added == [[]] * 10
 
 
@@ -240,3 +258,78 @@ def test_cli_report_and_psd_round_trip(tmp_path):
     assert ms == pytest.approx(expect, rel=0.02)
     w = np.linspace(600, 2400, 2001) * np.pi / 30
     assert expect - without == pytest.approx(np.mean((C * w**2) ** 2) / 2, rel=0.05)   # the added line, closed form
+
+
+# --------------------------------------------------------------------------- fixed-frequency resonance
+
+def test_resonance_gain_is_the_test_stand_mode():
+    """diagnose.resonance is the teststand's Mode gain (second implementation), |H(1)| = g, H -> 1 far off."""
+    m = Mode("m", 150.0, 0.03, 5.0, CHANNELS)
+    f = np.linspace(1.0, 600.0, 777)
+    assert np.allclose(resonance(f, 150.0, 0.03, 5.0), m.gain(f, 100.0), rtol=1e-12)
+    assert abs(resonance(150.0, 150.0, 0.03, 5.0)) == pytest.approx(5.0)
+    assert abs(resonance(1500.0, 150.0, 0.03, 5.0)) == pytest.approx(1.0, abs=0.01)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("channels,role", [(CHANNELS, "test_stand"), (("Fx", "Fy"), "wheel_mode")])
+def test_fixed_resonance_found(seed, channels, role):
+    """A resonance at 150 Hz (zeta 0.03, |H| = 5) on every channel (a fixture) or on the radial-force
+    channels only (a wheel mode), applied by the virtual stand to the lines passing through it."""
+    w = replace(preset("ithaco-e"), test_stand_modes=[Mode("injected", 150.0, 0.03, 5.0, channels)])
+    test = simulate_steady(w, SPEEDS, sample_rate=FS, n_samples=N, modes=False, noise=0.01, seed=seed)
+    d = diagnose(spectra(test), TRUTH)
+    assert kinds(d) == ["fixed_resonance"]
+    e = d.model.effects[0]
+    assert e["role"] == role
+    assert set(e["channel"]) == set(channels)
+    assert e["f_Hz"] == pytest.approx(150.0, rel=0.01)
+    assert e["zeta"] == pytest.approx(0.03, rel=0.10)
+    assert e["peak_gain"] == pytest.approx(5.0, rel=0.05)
+    assert d.error_before > 3 * d.error_after
+
+
+# --------------------------------------------------------------------------- cross-axis coupling
+
+def test_phasors_read_amplitude_and_phase():
+    """Context.phasors of a sinusoid between bins: its complex amplitude (closed form), x = Re(X e^{2πjft})."""
+    test = e_data(0, speeds=np.array([1200.0, 1800.0]))
+    rng = np.random.default_rng(5)
+    f0 = np.array([[77.3, 123.45], [51.7, 200.2]])
+    X0 = rng.normal(size=(2, 2, 6)) + 1j * rng.normal(size=(2, 2, 6))
+    for i, run in enumerate(test.runs):
+        t = np.arange(run.n_samples) / run.sample_rate
+        for j, c in enumerate(CHANNELS):
+            run.signals[c] = np.real(X0[i, :, j, None] * np.exp(2j * np.pi * f0[i, :, None] * t)).sum(0)
+    ctx = Context(spectra(test), test=test)
+    X = ctx.phasors(np.arange(2), f0)
+    assert np.allclose(X, X0, atol=1e-3 * np.abs(X0).max())
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("r", [(0.0, 0.0, 0.05), (0.03, -0.02, 0.05)])
+def test_cross_coupling_found(seed, r):
+    """Torques carrying r × F of the forces (load-cell offset); the fit needs the time series."""
+    test = e_data(seed)
+    inject_coupling(test, r)
+    d = diagnose(spectra(test), TRUTH, test=test)
+    assert kinds(d) == ["cross_coupling"]
+    e = d.model.effects[0]
+    assert np.allclose(e["r_m"], r, atol=1e-3)
+    assert set(e["channel"]) == {"Tx", "Ty", "Tz"}
+    assert d.error_before > 3 * d.error_after
+
+
+def test_cross_coupling_report(tmp_path):
+    """The report of a coupling diagnosis: r in summary.json and the model file, a well-formed hypotheses.csv."""
+    test = e_data(3)
+    inject_coupling(test, (0.0, 0.0, 0.05))
+    d = diagnose(spectra(test), TRUTH, test=test)
+    write_report(d, tmp_path)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert [e["kind"] for e in summary["effects"]] == ["cross_coupling"]
+    assert summary["effects"][0]["r_m"][2] == pytest.approx(0.05, abs=1e-3)
+    assert model_io.load(tmp_path / "model.json").effects[0]["r_m"] == summary["effects"][0]["r_m"]
+    rows = (tmp_path / "hypotheses.csv").read_text().strip().splitlines()
+    assert len({len(x.split(",")) for x in rows}) == 1
+    assert summary["error_before"] > 3 * summary["error_after"]

@@ -47,3 +47,21 @@ def test_broadband_floor_adds_its_speed_averaged_power():
     expected = _mean(lambda w: (abs(w) / W_REF) ** 3) * np.trapezoid(psd_k, f_k)
     assert added == pytest.approx(expected, rel=2e-3)
     np.testing.assert_allclose(with_floor.psd[:, 1], without.psd[:, 1])    # only Fx carries it
+
+
+def test_wheel_mode_resonance_enters_the_psd_test_stand_does_not():
+    from rwadist.diagnose import resonance
+
+    res_e = {"kind": "fixed_resonance", "f_Hz": 80.0, "zeta": 0.05, "peak_gain": 4.0, "role": "wheel_mode",
+             "directions": ["radial_force"]}
+    m = _model([res_e])
+    res = broadband_psd(empirical_lines(m), LAW, f_max=150.0, n_freq=30001, n_speeds=4000)
+    ms = np.sum(res.psd[:, 0]) * (res.f[1] - res.f[0])
+    expected = _mean(lambda w: abs(1.0e-6 * w**2 * resonance(2 * abs(w) / (2 * np.pi), 80.0, 0.05, 4.0)) ** 2 / 2)
+    assert ms == pytest.approx(expected, rel=5e-3)
+    stand = dict(res_e, role="test_stand")
+    coupling = {"kind": "cross_coupling", "r_m": [0.0, 0.0, 0.05]}
+    plain = broadband_psd(empirical_lines(_model([])), LAW, f_max=150.0, n_freq=30001, n_speeds=4000)
+    artefacts = broadband_psd(empirical_lines(_model([stand, coupling])), LAW, f_max=150.0, n_freq=30001,
+                              n_speeds=4000)
+    np.testing.assert_allclose(artefacts.psd, plain.psd)
