@@ -189,18 +189,25 @@ def _check_finite(path: Path, header, data):
                         f" (line {rows[0] + 2}), value {data[rows[0], cols[0]]:g}")
 
 
-def _sample_rate(path: Path, time: np.ndarray, declared: float | None) -> float:
+def uniform_step(path, field_name: str, time: np.ndarray, position=lambda i: f"line {i + 3}") -> float:
+    """The sampling step (s) of a time column, DataError unless it increases uniformly.
+    ``position(i)`` names where step i sits in the file (a CSV line, an HDF5 index)."""
     if len(time) < 2:
-        raise DataError(path, TIME_COLUMN, f"only {len(time)} sample(s); need at least 2")
+        raise DataError(path, field_name, f"only {len(time)} sample(s); need at least 2")
     dt = np.diff(time)
     step = float(np.median(dt))
     if not step > 0:
-        raise DataError(path, TIME_COLUMN, f"time does not increase (median step {step:.9g} s)")
+        raise DataError(path, field_name, f"time does not increase (median step {step:.9g} s)")
     dev = np.abs(dt - step)
-    if dev.max() > UNIFORM_TIME_RTOL * step + 1e-12 * abs(time).max():
+    if dev.max() > UNIFORM_TIME_RTOL * step + 1e-12 * np.abs(time).max():
         i = int(np.argmax(dev))
-        raise DataError(path, TIME_COLUMN, f"sampling is not uniform: step {dt[i]:.9g} s at line {i + 3}, "
+        raise DataError(path, field_name, f"sampling is not uniform: step {dt[i]:.9g} s at {position(i)}, "
                         f"median step {step:.9g} s")
+    return step
+
+
+def _sample_rate(path: Path, time: np.ndarray, declared: float | None) -> float:
+    step = uniform_step(path, TIME_COLUMN, time)
     fs = 1.0 / step
     if declared is not None:
         if abs(fs - declared) > 1e-6 * declared:
@@ -210,14 +217,22 @@ def _sample_rate(path: Path, time: np.ndarray, declared: float | None) -> float:
     return fs
 
 
+def read_json(path):
+    """A JSON document; DataError naming the file (missing) or the line (invalid)."""
+    path = Path(path)
+    if not path.exists():
+        raise DataError(path, "file", "does not exist")
+    try:
+        return json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise DataError(path, f"line {exc.lineno}", f"not valid JSON ({exc.msg})") from None
+
+
 def _read_meta(directory: Path) -> dict:
     path = directory / META_FILE
     if not path.exists():
         return {}
-    try:
-        meta = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise DataError(path, f"line {exc.lineno}", f"not valid JSON ({exc.msg})") from exc
+    meta = read_json(path)
     if not isinstance(meta, dict):
         raise DataError(path, "document", "must be a JSON object")
     fs = meta.get("sample_rate_hz")

@@ -34,7 +34,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .data import DataError, Run, SteadyTest, Sweep, UNIFORM_TIME_RTOL, _json_default
+from .data import DataError, Run, SteadyTest, Sweep, _json_default, uniform_step
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm
 
 FORMAT = "rwadist.test"
@@ -173,17 +173,7 @@ def _channels(path, group, skip=()) -> dict:
 
 def _check_time(path, time: np.ndarray, fs: float):
     field = f"/{TIME_DATASET}"
-    if len(time) < 2:
-        raise DataError(path, field, f"only {len(time)} sample(s); need at least 2")
-    dt = np.diff(time)
-    step = float(np.median(dt))
-    if not step > 0:
-        raise DataError(path, field, f"time does not increase (median step {step!r} s)")
-    dev = np.abs(dt - step)
-    if dev.max() > UNIFORM_TIME_RTOL * step + 1e-12 * np.abs(time).max():
-        i = int(np.argmax(dev))
-        raise DataError(path, field, f"sampling is not uniform: step {dt[i]!r} s at index {i + 1}, "
-                        f"median step {step!r} s")
+    step = uniform_step(path, field, time, position=lambda i: f"index {i + 1}")
     if abs(1.0 / step - fs) > 1e-6 * fs:
         raise DataError(path, field, f"sample rate from time {1.0 / step:.9g} Hz disagrees with "
                         f"attribute sample_rate_hz {fs!r}")

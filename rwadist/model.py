@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .data import DataError
+from .data import DataError, read_json
 from .units import DIRECTION_CHANNELS, DIRECTION_C_UNIT
 
 SCHEMA = "rwadist.model"
@@ -161,11 +161,4 @@ def from_json(doc: dict, source: str = "<model>") -> WheelModel:
 
 
 def load(path) -> WheelModel:
-    path = Path(path)
-    if not path.exists():
-        raise DataError(path, "file", "does not exist")
-    try:
-        doc = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise DataError(path, f"line {exc.lineno}", f"not valid JSON ({exc.msg})") from exc
-    return from_json(doc, str(path))
+    return from_json(read_json(path), str(path))

@@ -28,14 +28,13 @@ optional ``std_rpm``) or a CSV path (relative to the wheels file).  A tied wheel
 """
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .data import DataError
+from .data import DataError, read_json
 
 #: Tolerance on ‖RᵀR − I‖ (max abs) and on det R − 1.
 ORTHO_TOL = 1e-6
@@ -197,12 +196,7 @@ def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bo
     from . import model as model_io
 
     path = Path(path)
-    if not path.exists():
-        raise DataError(path, "file", "does not exist")
-    try:
-        doc = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise DataError(path, f"line {exc.lineno}", f"not valid JSON ({exc.msg})") from None
+    doc = read_json(path)
     items = doc.get("wheels") if isinstance(doc, dict) else doc
     if not isinstance(items, list) or not items:
         raise DataError(path, "wheels", "must be a non-empty list of wheel objects")

@@ -353,6 +353,13 @@ def _noise_std(wheel: WheelDescription, omega_max: float, noise: float) -> dict:
     return {ch: float(noise * wheel.fundamental_C(NOISE_REFERENCE[ch]) * omega_max**2) for ch in CHANNELS}
 
 
+def _add_noise(signals: dict, noise_std: dict, rng) -> None:
+    """White sensor noise, std ``noise_std[ch]`` per channel, drawn in channel order (in place)."""
+    for ch in CHANNELS:
+        if noise_std[ch] > 0:
+            signals[ch] += rng.normal(0.0, noise_std[ch], len(signals[ch]))
+
+
 def _line_gain(ch_modes: list, f_line, omega):
     """Product of the gains of ``ch_modes`` for lines at f_line (Hz) at speed omega (rad/s); None if no mode."""
     g = None
@@ -444,9 +451,7 @@ def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 38
                 z = c @ carrier
                 # radial: x = Re, y = Im (vector turning with the wheel); axial: Re
                 signals[ch] += z.imag if i == 1 else z.real
-        for ch in CHANNELS:
-            if noise_std[ch] > 0:
-                signals[ch] += noise_rng.normal(0.0, noise_std[ch], n_samples)
+        _add_noise(signals, noise_std, noise_rng)
         runs.append(Run(speed=float(omega), sample_rate=float(sample_rate), signals=signals, t0=0.0,
                         name=f"run_{k:04d}.csv"))
     meta = _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, dropped,
@@ -542,9 +547,7 @@ def _steady_extended(wheel, speeds, omegas, t, sample_rate, noise, test_stand, s
         A = A[keep]
         z = A.T @ np.exp(2j * np.pi * np.outer(f[keep], t))  # (6, n_samples)
         signals = {ch: z[i].real.copy() for i, ch in enumerate(CHANNELS)}
-        for ch in CHANNELS:
-            if noise_std[ch] > 0:
-                signals[ch] += noise_rng.normal(0.0, noise_std[ch], n_samples)
+        _add_noise(signals, noise_std, noise_rng)
         runs.append(Run(speed=float(omega), sample_rate=float(sample_rate), signals=signals, t0=0.0,
                         name=f"run_{k:04d}.csv"))
     meta = _meta(wheel, sample_rate, seed, noise, True, test_stand, noise_std, dropped,
@@ -663,9 +666,7 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
         extra["tau_s"] = duration / 5.0
     if physics == "extended":
         signals, dropped, base = _sweep_extended(wheel, t, omega, sample_rate, test_stand, phase_rng)
-        for ch in CHANNELS:
-            if noise_std[ch] > 0:
-                signals[ch] += noise_rng.normal(0.0, noise_std[ch], n)
+        _add_noise(signals, noise_std, noise_rng)
         extra.update(_extended_meta(wheel, base))
         extra["modal_gain"] = ("exact modal integration (rwadist.extended.simulate_time, start: steady state); "
                                "fixture resonances as LTI filters (FFT, circular)")
@@ -712,9 +713,7 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
                     np.conjugate(g, out=g, where=neg_b)
                     z = z0 * g
                 signals[ch][sl] += z.imag if i == 1 else z.real
-    for ch in CHANNELS:
-        if noise_std[ch] > 0:
-            signals[ch] += noise_rng.normal(0.0, noise_std[ch], n)
+    _add_noise(signals, noise_std, noise_rng)
     extra["modal_gain"] = "quasi-steady (gain at the instantaneous line frequency and speed)"
     extra["physics"] = "simple"
     meta = _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, dropped, extra)
