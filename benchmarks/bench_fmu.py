@@ -56,6 +56,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seconds", type=float, default=60.0, help="simulated time, s (default 60)")
     ap.add_argument("--rate", type=float, default=1000.0, help="communication rate, Hz (default 1000)")
     ap.add_argument("--hosts", default="fmpy,libcosim")
+    ap.add_argument("--repeat", type=int, default=3, help="interleaved runs of each FMU; the best is reported")
     args = ap.parse_args(argv)
     h = 1.0 / args.rate
     n = int(round(args.seconds * args.rate))
@@ -66,18 +67,25 @@ def main(argv=None) -> int:
         tmp = Path(tmp)
         wheel = build_preset("ithaco-e", tmp / "wheel.fmu")
         trivial = build_trivial(tmp)
-        print(f"{n} steps of {h:g} s ({args.seconds:g} s simulated); wheel: ithaco-e preset, 18 lines, 12 outputs")
+        from fmu.build import has_native
+        print(f"{n} steps of {h:g} s ({args.seconds:g} s simulated); wheel: ithaco-e preset, 18 lines, 12 outputs, "
+              f"native layer: {'yes (C kernel)' if has_native(wheel) else 'no (numpy steps)'}")
         for host in args.hosts.split(","):
             run = {"fmpy": hosts.run_fmpy, "libcosim": hosts.run_libcosim}[host]
-            walls = {}
-            for name, path, inputs in (("trivial y=u", trivial, {"u": w}), ("wheel", wheel, {"wheel_speed": w})):
-                t0 = time.perf_counter()
-                out = run(path, t, inputs)
-                walls[name] = time.perf_counter() - t0
-                assert np.all(np.isfinite(out[1:])), f"{host} {name}: non-finite outputs"
-                print(f"{host:>8} {name:<12} wall {walls[name]:7.2f} s  {walls[name] / n * 1e6:6.1f} us/step  "
-                      f"real-time factor {args.seconds / walls[name]:6.1f}")
-            ratio = walls["wheel"] / walls["trivial y=u"]
+            walls = {"trivial y=u": [], "wheel": []}
+            # interleaved repeats, best of each: the ratio should not depend on what else the machine does
+            for _ in range(args.repeat):
+                for name, path, inputs in (("trivial y=u", trivial, {"u": w}), ("wheel", wheel, {"wheel_speed": w})):
+                    t0 = time.perf_counter()
+                    out = run(path, t, inputs)
+                    walls[name].append(time.perf_counter() - t0)
+                    assert np.all(np.isfinite(out[1:])), f"{host} {name}: non-finite outputs"
+            for name, ws in walls.items():
+                best = min(ws)
+                print(f"{host:>8} {name:<12} wall {best:7.2f} s  {best / n * 1e6:6.1f} us/step  "
+                      f"real-time factor {args.seconds / best:6.1f}  (best of {len(ws)}: "
+                      + ", ".join(f"{x:.2f}" for x in ws) + ")")
+            ratio = min(walls["wheel"]) / min(walls["trivial y=u"])
             print(f"{host:>8} ratio wheel / trivial = {ratio:.2f} (target <= 2)")
     return 0
 

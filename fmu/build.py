@@ -4,20 +4,86 @@
 build (two FMUs whose slave modules share a name cannot load in one process), and ships
 ``runtime.py`` (as ``rwadist_fmu_runtime.py``) and the model file (``wheel_model.json``) in the
 FMU's resources.  pythonfmu embeds itself there too, so a host needs Python + numpy only.
+
+Native layer (Linux x86-64, when a C compiler is found): ``native/rwadist_fmu_native.c`` is
+compiled into ``binaries/linux64/<id>.so`` in front of pythonfmu's library (renamed
+``<id>_pythonfmu.so``).  It forwards every FMI call, turns a refused input into fmi2Error
+(pythonfmu alone reports fmi2Discard or fmi2Fatal) and carries the C step kernel the slave
+uses instead of numpy.  Without a compiler the FMU is pythonfmu's plain one: same results,
+slower steps, refused inputs reported as fmi2Discard.
 """
 from __future__ import annotations
 
 import json
+import os
+import platform
 import shutil
+import subprocess
 import sys
 import tempfile
 import uuid
+import warnings
+import zipfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 TEMPLATE = HERE / "slave_template.py"
 RUNTIME = HERE / "runtime.py"
 TEMPLATE_CLASS = "RwadistWheelSlave"
+NATIVE_SOURCE = HERE / "native" / "rwadist_fmu_native.c"
+NATIVE_PLATFORM = "linux64"
+
+
+class NativeBuildError(RuntimeError):
+    """The native layer was required (``native=True``) but cannot be compiled here."""
+
+
+def native_supported() -> bool:
+    """True on Linux x86-64 (the platform the native layer is written for)."""
+    return sys.platform.startswith("linux") and platform.machine() in ("x86_64", "AMD64")
+
+
+def compile_native(output) -> Path:
+    """Compile the native layer to the shared library ``output``; NativeBuildError on failure.
+
+    The compiler is ``$CC`` or ``cc``."""
+    cc = shutil.which(os.environ.get("CC", "cc"))
+    if cc is None:
+        raise NativeBuildError(f"no C compiler ({os.environ.get('CC', 'cc')!r} not on PATH)")
+    output = Path(output)
+    cmd = [cc, "-O2", "-fPIC", "-shared", "-o", str(output), str(NATIVE_SOURCE), "-ldl", "-lm"]
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    if res.returncode != 0:
+        raise NativeBuildError(f"{' '.join(cmd)} failed:\n{res.stderr.strip()}")
+    return output
+
+
+def _add_native(fmu_path: Path, model_identifier: str, lib: Path) -> None:
+    """Rewrite the FMU zip: pythonfmu's linux64 library moves to <id>_pythonfmu.so, ``lib``
+    takes its place as <id>.so."""
+    ours = f"binaries/{NATIVE_PLATFORM}/{model_identifier}.so"
+    theirs = f"binaries/{NATIVE_PLATFORM}/{model_identifier}_pythonfmu.so"
+    tmp = fmu_path.with_suffix(".fmu.tmp")
+    with zipfile.ZipFile(fmu_path) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
+        names = src.namelist()
+        if ours not in names:
+            raise NativeBuildError(f"pythonfmu wrote no {ours} into {fmu_path}")
+        for info in src.infolist():
+            data = src.read(info)
+            if info.filename == ours:
+                info = zipfile.ZipInfo(theirs, date_time=info.date_time)
+                info.external_attr = 0o755 << 16
+            dst.writestr(info, data, compress_type=zipfile.ZIP_DEFLATED)
+        zi = zipfile.ZipInfo(ours, date_time=(2026, 1, 1, 0, 0, 0))
+        zi.external_attr = 0o755 << 16
+        dst.writestr(zi, lib.read_bytes(), compress_type=zipfile.ZIP_DEFLATED)
+    os.replace(tmp, fmu_path)
+
+
+def has_native(fmu_path) -> bool:
+    """True when the FMU at ``fmu_path`` carries the rwadist native layer."""
+    with zipfile.ZipFile(fmu_path) as z:
+        return any(n.endswith("_pythonfmu.so") for n in z.namelist())
 
 
 def _runtime():
@@ -46,11 +112,13 @@ def model_document(model) -> dict:
     return doc
 
 
-def build_fmu(model, output, *, tag: str | None = None) -> Path:
+def build_fmu(model, output, *, tag: str | None = None, native: bool | None = None) -> Path:
     """Write the FMU of ``model`` (path, dict or WheelModel) to ``output`` (.fmu path); returns it.
 
     ``tag`` (default: random) makes the slave module ``rwadist_wheel_<tag>`` and the class /
-    model identifier ``RwadistWheel_<tag>`` unique to this build."""
+    model identifier ``RwadistWheel_<tag>`` unique to this build.  ``native``: add the native
+    layer (module docstring); None (default) adds it where it can be compiled and warns where it
+    cannot, True raises NativeBuildError where it cannot, False builds pythonfmu's plain FMU."""
     from pythonfmu import FmuBuilder
 
     doc = model_document(model)
@@ -62,6 +130,8 @@ def build_fmu(model, output, *, tag: str | None = None) -> Path:
     if output.suffix != ".fmu":
         raise ValueError(f"output {str(output)!r} must end in .fmu")
     output.parent.mkdir(parents=True, exist_ok=True)
+    if native and not native_supported():
+        raise NativeBuildError(f"the native layer is for Linux x86-64, not {sys.platform} {platform.machine()}")
     src = TEMPLATE.read_text()
     if src.count(f"class {TEMPLATE_CLASS}(") != 1:
         raise RuntimeError("slave template lost its class")
@@ -81,6 +151,14 @@ def build_fmu(model, output, *, tag: str | None = None) -> Path:
             sys.path[:] = path_before
             for name in (module, f"{module}_runtime"):
                 sys.modules.pop(name, None)
+        if native is not False and native_supported():
+            try:
+                _add_native(Path(out), cls, compile_native(tmp / "native.so"))
+            except NativeBuildError as exc:
+                if native:
+                    raise
+                warnings.warn(f"rwadist FMU built without its native layer ({exc}): refused inputs are "
+                              "reported as fmi2Discard and steps run in numpy", RuntimeWarning, stacklevel=2)
     return Path(out)
 
 

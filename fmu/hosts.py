@@ -48,9 +48,11 @@ def _describe(path):
 
 
 class FmpyInstance:
-    """One instance of an FMU in fmpy (FMU2Slave), set up to the end of initialisation."""
+    """One instance of an FMU in fmpy (FMU2Slave), set up to the end of initialisation
+    (``exit_init=False``: left in initialisation mode, parameters and inputs set)."""
 
-    def __init__(self, path, name, params=None, inputs=None, log: HostLog | None = None, unzipdir=None):
+    def __init__(self, path, name, params=None, inputs=None, log: HostLog | None = None, unzipdir=None,
+                 exit_init=True):
         from fmpy import extract
         from fmpy.fmi2 import FMU2Slave
         self.md, self.vars = _describe(path)
@@ -65,7 +67,8 @@ class FmpyInstance:
             self.set(k, v)
         for k, v in (inputs or {}).items():
             self.set(k, v)
-        self.fmu.exitInitializationMode()
+        if exit_init:
+            self.fmu.exitInitializationMode()
         self.outputs = [v.valueReference for v in self.md.modelVariables if v.causality == "output"]
         self.output_names = [v.name for v in self.md.modelVariables if v.causality == "output"]
 

@@ -19,10 +19,16 @@ One communication step [t_n, t_n + h] with wheel speed Ω_n and acceleration α 
   the exact 2×2 transition matrix at the step's mean speed (gyroscopic term frozen over a step);
 * outputs are the suspension reactions at t_n + h (wheel frame, Fx, Fy, Fz, Tx, Ty, Tz) and
   their spacecraft-frame image F_sc = R F, T_sc = R T + r × F_sc.
+
+The step runs in numpy, or, when the FMU carries its native library (built from
+``fmu/native/rwadist_fmu_native.c`` by ``rwadist fmu build`` where a C compiler is found), in
+that library's ``rwadist_kernel_step`` -- the same equations in C, ~10× faster per step, tested
+against this numpy code (:func:`load_kernel`, :data:`KERNEL_LAYOUT`).
 """
 from __future__ import annotations
 
 import cmath
+import ctypes
 import json
 import math
 
@@ -169,6 +175,43 @@ def to_spacecraft(out, R, r):
     return np.concatenate([F, T], axis=-1)
 
 
+# ------------------------------------------------------------------ native kernel
+
+#: cfg layout of ``rwadist_kernel_step`` (fmu/native/rwadist_fmu_native.c): parameter order,
+#: offsets of the fixed poles, mounting, and the per-component block (σh, direction, coef·C,
+#: −i·coef·C·[imbalance]).  The C file repeats it; tests/test_fmu.py checks both agree by running.
+KERNEL_PARAMS = ("mass", "c_r", "k_r", "I_rr", "c_rock", "k_rock", "I_zz", "c_z", "k_z", "height")
+KERNEL_COMP = 32
+KERNEL_STRIDE = 6
+
+
+def load_kernel(path):
+    """``rwadist_kernel_step`` of the native library at ``path`` as a ctypes function, or None
+    when the file is missing or is not the rwadist native library (then numpy steps)."""
+    try:
+        lib = ctypes.CDLL(str(path))
+        fn = lib.rwadist_kernel_step
+    except (OSError, AttributeError):
+        return None
+    fn.restype = None
+    fn.argtypes = [ctypes.c_void_p] * 3 + [ctypes.c_double] * 4
+    return fn
+
+
+def frame12(o, R, r):
+    """[wheel-frame 6] + [spacecraft-frame 6] as a list of floats (R 3×3 nested, r 3)."""
+    f0, f1, f2, t0, t1, t2 = (float(v) for v in o)
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R
+    rx, ry, rz = r
+    fx = r00 * f0 + r01 * f1 + r02 * f2
+    fy = r10 * f0 + r11 * f1 + r12 * f2
+    fz = r20 * f0 + r21 * f1 + r22 * f2
+    return [f0, f1, f2, t0, t1, t2, fx, fy, fz,
+            r00 * t0 + r01 * t1 + r02 * t2 + ry * fz - rz * fy,
+            r10 * t0 + r11 * t1 + r12 * t2 + rz * fx - rx * fz,
+            r20 * t0 + r21 * t1 + r22 * t2 + rx * fy - ry * fx]
+
+
 # ------------------------------------------------------------------ the stepping model
 
 class WheelRuntime:
@@ -180,11 +223,13 @@ class WheelRuntime:
     imbalance, harmonics, modes : effect switches (modes off: the internal loads reach the
     interface directly).  start_steady : start from the closed-form steady state at the first
     step's speed instead of rest.  max_accel : |dΩ/dt| limit, rad/s².  max_step : largest
-    communication step accepted, s.
+    communication step accepted, s.  dcm, position : mounting, wheel → spacecraft DCM (3×3,
+    default identity) and interface position, m (default 0), for the spacecraft-frame outputs.
+    kernel : ``rwadist_kernel_step`` from :func:`load_kernel`, or None to step in numpy.
     """
 
     def __init__(self, params, lines, *, seed=None, imbalance=True, harmonics=True, modes=True,
-                 start_steady=False, max_accel=500.0, max_step=0.01):
+                 start_steady=False, max_accel=500.0, max_step=0.01, dcm=None, position=None, kernel=None):
         self.p = dict(params)
         if not (math.isfinite(max_accel) and max_accel > 0):
             raise ModelError(f"max_acceleration must be finite and > 0, got {max_accel!r}")
@@ -227,7 +272,43 @@ class WheelRuntime:
         lam[self.dirs == 3] = -1.0
         self._lam_static = lam
         self._cache = {}
+        R = np.eye(3) if dcm is None else rotation_check(dcm)
+        pos = np.zeros(3) if position is None else np.asarray(position, dtype=float).reshape(3)
+        if not np.all(np.isfinite(pos)):
+            raise ModelError(f"interface position r = {pos.tolist()!r} m is not finite")
+        self.R = [list(map(float, row)) for row in R]
+        self.pos = [float(v) for v in pos]
+        self._kernel = kernel
+        if kernel is not None:
+            n = self.sh.size
+            cfg = np.zeros(KERNEL_COMP + KERNEL_STRIDE * n)
+            cfg[0], cfg[1] = n, float(self.modes)
+            cfg[2:12] = [p[k] for k in KERNEL_PARAMS]
+            cfg[12:16] = np.array(self.lam_r, dtype=complex).view(float)
+            cfg[16:20] = np.array(self.lam_z, dtype=complex).view(float)
+            cfg[20:29] = np.ravel(self.R)
+            cfg[29:32] = self.pos
+            comp = cfg[KERNEL_COMP:].reshape(n, KERNEL_STRIDE)
+            comp[:, 0], comp[:, 1] = self.sh, self.dirs
+            comp[:, 2:4] = self.cC.view(float).reshape(n, 2)
+            comp[:, 4:6] = self.cCi.view(float).reshape(n, 2)
+            self._cfg = cfg
+            self._st = np.zeros(2 + 2 * n + 12)
+            self._kout = np.zeros(12)
+            self._ptrs = (cfg.ctypes.data, self._st.ctypes.data, self._kout.ctypes.data)
         self.reset()
+
+    @property
+    def native(self) -> bool:
+        """True when steps run in the native kernel."""
+        return self._kernel is not None
+
+    def _pack(self):
+        """Current state into the kernel's state array."""
+        n = self.sh.size
+        st = self._st
+        st[0] = self.phi
+        st[2:].view(complex)[:] = np.concatenate([self.S, self.eta_r, self.eta_z, self.x_rock])[: n + 6]
 
     # ------------------------------------------------------------ state
     def reset(self):
@@ -241,6 +322,7 @@ class WheelRuntime:
         self.prev_end = None          # (Ω at the end of the previous step, step size)
         self.started = False
         self.out = np.zeros(6)
+        self.y = [0.0] * 12
 
     def _amp(self, w, wdot):
         """coef·C·(Ω² − iΩ̇·[imbalance]) per component."""
@@ -314,6 +396,10 @@ class WheelRuntime:
         (rad/s²; None: derived as the previous step's mean rate, 0 on the first step) over ``h``
         seconds.  Returns the wheel-frame outputs at the step's end (6,).  Raises ModelError
         (state untouched) on bad input."""
+        return np.array(self.step12(omega, alpha, h)[:6])
+
+    def step12(self, omega, alpha, h):
+        """As :meth:`step`, returning the 12 outputs (wheel frame, then spacecraft frame) as a list."""
         omega, h = float(omega), float(h)
         alpha = None if alpha is None else float(alpha)
         self.check_step(omega, alpha, h)
@@ -332,8 +418,18 @@ class WheelRuntime:
             if self.start_steady:
                 self._steady_init(omega, wd0)
             self.started = True
-        p = self.p
+            if self._kernel is not None:
+                self._pack()
         w1 = omega + alpha * h
+        if self._kernel is not None:
+            cfg, st, out = self._ptrs
+            self._kernel(cfg, st, out, omega, wd0, alpha, h)
+            self._prev_start = omega
+            self.prev_alpha = alpha
+            self.prev_end = (w1, h)
+            self.y = y = self._kout.tolist()
+            return y
+        p = self.p
         dphi = 0.5 * (omega + w1) * h
         phi1 = self.phi + dphi
         S0 = self.S
@@ -391,7 +487,8 @@ class WheelRuntime:
         self.prev_alpha = alpha
         self.prev_end = (w1, h)
         self.out = self._outputs(loads1)
-        return self.out
+        self.y = frame12(self.out, self.R, self.pos)
+        return self.y
 
     def outputs_now(self, omega, alpha=0.0):
         """Outputs at the current state for speed ``omega`` (used at t0 before the first step)."""
@@ -399,6 +496,7 @@ class WheelRuntime:
             self._steady_init(float(omega), float(alpha))
         loads = self._loads(float(omega), float(alpha), self.phi)
         self.out = self._outputs(loads)
+        self.y = frame12(self.out, self.R, self.pos)
         return self.out
 
     def _outputs(self, loads):

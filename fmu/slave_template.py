@@ -7,10 +7,13 @@ load side by side in one process.  The physics lives in ``rwadist_fmu_runtime.py
 ``resources/``; rwadist itself is not needed by the host.
 
 Bad input never raises out of ``do_step`` (pythonfmu turns an exception into fmi2Fatal): the
-slave logs the problem with status fmi2Error (category logStatusError) and returns False, which
-pythonfmu's native layer reports as fmi2Discard; the state is left at the last good step, so
-the host may retry (e.g. with a smaller step or a corrected input).
+slave logs the problem with status fmi2Error (category logStatusError), flags it to the FMU's
+native layer (``binaries/linux64/<id>.so``, see fmu/build.py) and returns False; the native
+layer then returns fmi2Error from the FMI call (pythonfmu alone would report fmi2Discard).  The
+state is left at the last good step, so the host may retry (e.g. with a smaller step or a
+corrected input).  The same native library carries the C step kernel the runtime uses.
 """
+import ctypes
 import importlib.util
 import math
 import os
@@ -46,6 +49,21 @@ class RealU(Real):
         if self.unit is not None:
             node.find("Real").set("unit", self.unit)
         return node
+
+
+def _native_library(resources, model_identifier):
+    """The FMU's rwadist native library (ctypes.CDLL), or None where it is absent (plain
+    pythonfmu build, or a platform it was not built for)."""
+    if not sys.platform.startswith("linux"):
+        return None
+    path = os.path.join(os.path.dirname(os.path.abspath(resources)), "binaries", "linux64",
+                        model_identifier + ".so")
+    try:
+        lib = ctypes.CDLL(path)
+        lib.rwadist_fmu_native_version
+    except (OSError, AttributeError):
+        return None
+    return lib
 
 
 def _load_runtime(resources):
@@ -84,6 +102,11 @@ class RwadistWheelSlave(Fmi2Slave):
         self._y = [0.0] * 12
         self.model = None       # WheelRuntime once initialised without error
         self.error = "not initialised"
+        self._native = _native_library(self.resources, type(self).__name__)
+        self._flag_error = None if self._native is None else self._native.rwadist_fmu_flag_error
+        self._kernel = None
+        if self._native is not None:
+            self._kernel = self.rt.load_kernel(self._native._name)
 
         inp, par, out = Fmi2Causality.input, Fmi2Causality.parameter, Fmi2Causality.output
         fixed, cont = Fmi2Variability.fixed, Fmi2Variability.continuous
@@ -127,6 +150,9 @@ class RwadistWheelSlave(Fmi2Slave):
                 f"r_{ax}", "m", causality=par, variability=fixed,
                 description=f"interface position in the spacecraft frame, {ax}",
                 getter=lambda i=i: self.pos[i], setter=lambda v, i=i: self.pos.__setitem__(i, float(v))))
+        self._vr_speed = self.vars_by_name("wheel_speed")
+        self._vr_accel = self.vars_by_name("wheel_acceleration")
+        self._out_index = {}
         for frame, off, suffix, where in (("wheel", 0, "", "wheel frame"),
                                           ("spacecraft", 6, "_sc", "spacecraft frame, about its reference point")):
             for i, (ch, unit, desc) in enumerate(OUTPUTS):
@@ -135,6 +161,56 @@ class RwadistWheelSlave(Fmi2Slave):
                     ch + suffix, unit, causality=out, variability=cont, initial=Fmi2Initial.exact,
                     description=desc if frame == "wheel" else f"{ch} in the {where}",
                     getter=lambda k=k: self._y[k]))
+                self._out_index[self.vars_by_name(ch + suffix)] = k
+        self._index_reals()
+
+    def vars_by_name(self, name):
+        """Value reference of the registered variable ``name``."""
+        for vr, var in self.vars.items():
+            if var.name == name:
+                return vr
+        raise KeyError(name)
+
+    # Hosts read the outputs (libcosim: every Real) and set the speed every step: a value list
+    # indexed by value reference answers them directly instead of pythonfmu's per-variable
+    # getter loop (same values, a fraction of the time).  Reals change only through set_real
+    # (inputs, parameters) and _set_outputs, which keep the list current.
+    def _index_reals(self):
+        vrs = sorted(self.vars)
+        self._rv = rv = [None] * (vrs[-1] + 1)
+        for vr, var in self.vars.items():
+            if isinstance(var, Real):
+                rv[vr] = float(var.getter())
+        outs = sorted(self._out_index)
+        self._out0 = outs[0]
+        if outs != list(range(outs[0], outs[0] + len(outs))) or \
+                [self._out_index[v] for v in outs] != list(range(len(outs))):
+            raise RuntimeError("outputs must have consecutive value references in output order")
+
+    def _set_outputs(self, y):
+        self._y = y
+        self._rv[self._out0:self._out0 + len(y)] = y
+
+    def get_real(self, vrs):
+        rv = self._rv
+        try:
+            out = [rv[vr] for vr in vrs]
+        except IndexError:
+            out = [None]
+        if None in out:
+            return super().get_real(vrs)    # names the unknown or non-Real variable
+        return out
+
+    def set_real(self, vrs, values):
+        rv = self._rv
+        for vr, v in zip(vrs, values):
+            if vr == self._vr_speed:
+                self.wheel_speed = v
+            elif vr == self._vr_accel:
+                self.wheel_acceleration = v
+            else:
+                super().set_real([vr], [v])
+            rv[vr] = float(v)
 
     # ------------------------------------------------------------ modelDescription
     def to_xml(self, model_options=dict()):
@@ -150,6 +226,8 @@ class RwadistWheelSlave(Fmi2Slave):
     def _fail(self, msg):
         self.error = msg
         self.log(f"rwadist wheel: {msg}", Fmi2Status.error)
+        if self._flag_error is not None:
+            self._flag_error()
         return False
 
     def exit_initialization_mode(self):
@@ -157,36 +235,23 @@ class RwadistWheelSlave(Fmi2Slave):
         try:
             path = self.model_file or os.path.join(self.resources, MODEL_FILE)
             params, lines = rt.load_model(path)
-            R = rt.rotation_check(self.dcm)
-            if not all(math.isfinite(v) for v in self.pos):
-                raise rt.ModelError(f"interface position r = {self.pos!r} m is not finite")
             seed = int(self.seed)
             if seed < -1:
                 raise rt.ModelError(f"seed must be >= 0, or -1 for the model file's phases; got {seed}")
             self.model = rt.WheelRuntime(
                 params, lines, seed=None if seed == -1 else seed, imbalance=bool(self.imbalance),
                 harmonics=bool(self.harmonics), modes=bool(self.modes), start_steady=bool(self.start_steady),
-                max_accel=float(self.max_acceleration), max_step=float(self.max_step_size))
-            self._R = [list(map(float, row)) for row in R]
+                max_accel=float(self.max_acceleration), max_step=float(self.max_step_size),
+                dcm=self.dcm, position=self.pos, kernel=self._kernel)
             self.error = None
             w = float(self.wheel_speed)
             if math.isfinite(w):
                 a = float(self.wheel_acceleration) if self.use_wheel_acceleration else 0.0
-                self._publish(self.model.outputs_now(w, a if math.isfinite(a) else 0.0))
+                self.model.outputs_now(w, a if math.isfinite(a) else 0.0)
+                self._set_outputs(self.model.y)
         except Exception as exc:   # never let it reach pythonfmu (it would be fmi2Fatal)
             self.model = None
             self._fail(f"initialisation failed: {exc}")
-
-    def _publish(self, o):
-        R, (rx, ry, rz) = self._R, self.pos
-        f0, f1, f2, t0, t1, t2 = (float(v) for v in o)
-        fx = R[0][0] * f0 + R[0][1] * f1 + R[0][2] * f2
-        fy = R[1][0] * f0 + R[1][1] * f1 + R[1][2] * f2
-        fz = R[2][0] * f0 + R[2][1] * f1 + R[2][2] * f2
-        tx = R[0][0] * t0 + R[0][1] * t1 + R[0][2] * t2 + ry * fz - rz * fy
-        ty = R[1][0] * t0 + R[1][1] * t1 + R[1][2] * t2 + rz * fx - rx * fz
-        tz = R[2][0] * t0 + R[2][1] * t1 + R[2][2] * t2 + rx * fy - ry * fx
-        self._y = [f0, f1, f2, t0, t1, t2, fx, fy, fz, tx, ty, tz]
 
     def do_step(self, current_time, step_size):
         if self.model is None:
@@ -194,7 +259,7 @@ class RwadistWheelSlave(Fmi2Slave):
         try:
             w = float(self.wheel_speed)
             a = float(self.wheel_acceleration) if self.use_wheel_acceleration else None
-            self._publish(self.model.step(w, a, float(step_size)))
+            self._set_outputs(self.model.step12(w, a, step_size))
             return True
         except self.rt.ModelError as exc:
             return self._fail(f"step at t = {current_time:.9g} s rejected: {exc}")

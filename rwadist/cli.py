@@ -348,7 +348,9 @@ def cmd_fmu_build(args) -> int:
         path = build_fmu(source, args.output)
     except ModelError as exc:
         raise DataError(args.model or args.preset, "model", str(exc)) from None
-    print(f"wrote {path} (model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')})")
+    from fmu.build import has_native
+    print(f"wrote {path} (model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')}; "
+          f"native layer: {'yes' if has_native(path) else 'no, numpy steps and fmi2Discard on bad input'})")
     return 0
 
 
@@ -364,15 +366,29 @@ def cmd_fmu_check(args) -> int:
     for prob in problems:
         print(f"validation: {prob}")
     print(f"fmpy validation: {len(problems)} problem(s)")
+    try:
+        from fmu.build import has_native
+        print(f"native layer (fmi2Error on bad input, C step kernel): {'yes' if has_native(args.fmu) else 'no'}")
+    except Exception:   # informational only; validation above already judged the file
+        pass
     w_end = float(rpm_to_rad_s(args.speed_rpm))
     n = int(round(args.stop_time / args.step_size))
     t = np.linspace(0.0, n * args.step_size, n + 1)
     sig = np.zeros(t.size, dtype=[("time", float), ("wheel_speed", float)])
     sig["time"], sig["wheel_speed"] = t, w_end * t / t[-1]
     t0 = time.perf_counter()
-    res = simulate_fmu(args.fmu, stop_time=float(t[-1]), step_size=args.step_size, input=sig,
-                       output_interval=args.step_size)
+    try:
+        res = simulate_fmu(args.fmu, stop_time=float(t[-1]), step_size=args.step_size, input=sig,
+                           output_interval=args.step_size)
+    except Exception as exc:   # fmpy raises FMICallException on a refused step; the FMU logged why
+        print(f"rwadist: error: FMU check failed: the simulation stopped: {exc} (a ramp of "
+              f"{abs(w_end) / t[-1]:.4g} rad/s² may exceed the FMU's max_acceleration)", file=sys.stderr)
+        return 1
     wall = time.perf_counter() - t0
+    if len(res) < t.size:
+        print(f"rwadist: error: FMU check failed: the simulation stopped after {len(res)} of {t.size} samples",
+              file=sys.stderr)
+        return 1
     names = [c for c in res.dtype.names if c != "time"]
     finite = all(np.all(np.isfinite(res[c])) for c in names)
     print(f"simulated 0 -> {args.speed_rpm:g} rpm over {t[-1]:g} s at {args.step_size:g} s steps in {wall:.2f} s "

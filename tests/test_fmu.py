@@ -16,7 +16,7 @@ import pytest
 
 
 from fmu import hosts, runtime as rt
-from fmu.build import build_fmu
+from fmu.build import build_fmu, has_native, native_supported
 from rwadist import extended as ext
 from rwadist import model as model_io
 from rwadist.presets import preset
@@ -86,6 +86,45 @@ def test_runtime_equals_simulate_time(model_path, model, profile):
         out = rt.WheelRuntime(params, lines, seed=seed, max_step=0.01).run(t, w)
         err = rel_err(out, ref)
         assert np.all(err < 1e-9), err
+
+
+@pytest.fixture(scope="module")
+def kernel(tmp_path_factory):
+    """The native step kernel compiled here (None where no C compiler / not Linux x86-64)."""
+    from fmu.build import NativeBuildError, compile_native
+    if REFUSED != 3:
+        return None
+    try:
+        return rt.load_kernel(compile_native(tmp_path_factory.mktemp("native") / "k.so"))
+    except NativeBuildError:
+        return None
+
+
+@pytest.mark.parametrize("profile", [spin_up, reversal])
+def test_native_kernel_equals_numpy_runtime(model_path, model, kernel, profile):
+    """The C kernel and the numpy runtime step the same equations: every switch and start, both
+    acceleration modes, and a mounting for the spacecraft-frame outputs (1e-12 relative); and
+    the kernel alone reproduces simulate_time (1e-9)."""
+    if kernel is None:
+        assert REFUSED == 2       # only where the native layer cannot be built
+        pytest.skip("no C compiler / not Linux x86-64: the FMU steps in numpy")
+    t, w = profile()
+    params, lines = rt.load_model(model_path)
+    R = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+    for kw in (dict(), dict(start_steady=True), dict(modes=False), dict(harmonics=False), dict(imbalance=False)):
+        for alpha in ("slope", None):
+            a = rt.WheelRuntime(params, lines, seed=4, dcm=R, position=[0.1, 0.2, -0.3], **kw)
+            b = rt.WheelRuntime(params, lines, seed=4, dcm=R, position=[0.1, 0.2, -0.3], kernel=kernel, **kw)
+            assert b.native and not a.native
+            h = t[1] - t[0]
+            acc = slope(t, w) if alpha == "slope" else [None] * t.size
+            ya = np.array([a.step12(w[n], acc[n], h) for n in range(t.size - 1)])
+            yb = np.array([b.step12(w[n], acc[n], h) for n in range(t.size - 1)])
+            scale = np.max(np.abs(ya), axis=0)      # a channel with no content must stay exactly 0
+            assert np.all(np.abs(yb - ya) <= 1e-12 * scale), (kw, alpha, np.max(np.abs(yb - ya), axis=0) / scale)
+    ref = reference(model, t, w, 11)
+    out = rt.WheelRuntime(params, lines, seed=11, kernel=kernel).run(t, w)
+    assert np.all(rel_err(out, ref) < 1e-9)
 
 
 def test_fmu_in_fmpy_equals_simulate_time(wheel_fmu, model):
@@ -227,8 +266,42 @@ def test_four_instances_one_process(tmp_path, model):
 
 # ------------------------------------------------------------------ bad input through the host
 
-def _instance(path, params=None, log=None):
-    return hosts.FmpyInstance(path, "bad", params or {}, {"wheel_speed": 100.0}, log=log)
+def _instance(path, params=None, log=None, exit_init=True):
+    return hosts.FmpyInstance(path, "bad", params or {}, {"wheel_speed": 100.0}, log=log, exit_init=exit_init)
+
+
+#: status of a refused input: fmi2Error through the FMU's native layer (built wherever it can
+#: be: Linux x86-64 with a C compiler, as CI), fmi2Discard through pythonfmu's plain library
+REFUSED = 3 if native_supported() and shutil.which(os.environ.get("CC", "cc")) else 2
+
+
+def test_native_layer_is_built_where_it_can_be(wheel_fmu):
+    assert has_native(wheel_fmu) == (REFUSED == 3)
+    with zipfile.ZipFile(wheel_fmu) as z:
+        names = z.namelist()
+    ident = hosts._describe(wheel_fmu)[0].coSimulation.modelIdentifier
+    assert f"binaries/linux64/{ident}.so" in names
+    assert (f"binaries/linux64/{ident}_pythonfmu.so" in names) == (REFUSED == 3)
+
+
+def test_plain_pythonfmu_build_reports_discard(tmp_path, model):
+    """native=False: pythonfmu's own library, a refused step is fmi2Discard; results identical."""
+    from fmpy.fmi1 import FMICallException
+    plain = build_fmu(model, tmp_path / "plain.fmu", native=False)
+    assert not has_native(plain)
+    t, w = spin_up(T=2.0)
+    t, w = t[:501], w[:501]
+    a = hosts.run_fmpy(plain, t, {"wheel_speed": w})
+    b = hosts.run_fmpy(build_fmu(model, tmp_path / "n.fmu"), t, {"wheel_speed": w})
+    assert np.all(rel_err(b, a) < 1e-12)      # numpy steps vs the C kernel
+    inst = _instance(plain)
+    try:
+        inst.set("wheel_speed", float("nan"))
+        with pytest.raises(FMICallException) as exc:
+            inst.fmu.doStep(0.0, 1e-3)
+        assert exc.value.status == 2
+    finally:
+        inst.close()
 
 
 @pytest.mark.parametrize("case", ["nan_speed", "inf_speed", "speed_jump", "step_too_large", "bad_acceleration"])
@@ -255,7 +328,7 @@ def test_bad_input_is_refused_and_host_survives(wheel_fmu, case):
         inst.set("wheel_acceleration", acc)
         with pytest.raises(FMICallException) as exc:
             inst.fmu.doStep(1e-3, h)
-        assert exc.value.status in (2, 3)          # pythonfmu maps a refused step to fmi2Discard
+        assert exc.value.status == REFUSED, exc.value.status
         errors = log.messages(min_status=3)
         key = {"nan_speed": "wheel_speed is not finite", "inf_speed": "wheel_speed is not finite",
                "speed_jump": "jumps", "step_too_large": "exceeds max_step_size",
@@ -295,11 +368,18 @@ def test_bad_model_or_parameter(wheel_fmu, tmp_path, case):
         params["seed"] = -5
         key = "seed must be"
     log = hosts.HostLog()
-    inst = _instance(wheel_fmu, params, log)
+    inst = _instance(wheel_fmu, params, log, exit_init=False)
     try:
+        if REFUSED == 3:
+            with pytest.raises(FMICallException) as exc:
+                inst.fmu.exitInitializationMode()
+            assert exc.value.status == 3
+        else:
+            inst.fmu.exitInitializationMode()
         assert any(key in m for m in log.messages(3)), log.records
-        with pytest.raises(FMICallException):
+        with pytest.raises(FMICallException) as exc:
             inst.fmu.doStep(0.0, 1e-3)
+        assert exc.value.status == REFUSED
         assert any("cannot step" in m and key in m for m in log.messages(3))
     finally:
         inst.close()
@@ -405,9 +485,12 @@ def test_cli_fmu_build_and_check(tmp_path, model_path, capsys):
     from rwadist.cli import main
     out = tmp_path / "w.fmu"
     assert main(["fmu", "build", str(model_path), "-o", str(out)]) == 0
-    assert main(["fmu", "check", str(out), "--stop-time", "0.2"]) == 0
+    assert main(["fmu", "check", str(out), "--stop-time", "0.5"]) == 0
     text = capsys.readouterr().out
-    assert "fmpy validation: 0 problem(s)" in text and "Fx_sc" in text
+    assert "fmpy validation: 0 problem(s)" in text and "Fx_sc" in text and "(501 samples)" in text
+    # 1500 rpm in 0.2 s is 785 rad/s², above the FMU's max_acceleration (500): refused, reported
+    assert main(["fmu", "check", str(out), "--stop-time", "0.2"]) == 1
+    assert "max_acceleration" in capsys.readouterr().err
     assert main(["fmu", "build", "--preset", "ithaco-e", "-o", str(tmp_path / "e.fmu")]) == 0
     bad = tmp_path / "bad.json"
     bad.write_text("{}")
