@@ -536,3 +536,24 @@ def test_runtime_imbalance_rule_matches_the_kit():
     kit = ext.lines_from_model(m, p)
     _, lines = rt.model_from_doc(model_io.to_json(m))
     assert len(lines) == len(kit)
+
+
+def test_get_real_of_parameters_inputs_and_outputs(wheel_fmu):
+    """The slave's direct Real paths return what was set (parameters, inputs) and what was
+    computed (outputs), in any order and mix, and a non-Real reference is still refused."""
+    from fmpy.fmi1 import FMICallException
+    inst = _instance(wheel_fmu, {"dcm_11": 0.0, "dcm_12": -1.0, "dcm_21": 1.0, "dcm_22": 0.0, "r_y": 0.25,
+                                 "max_step_size": 0.005})
+    try:
+        inst.set("wheel_speed", 120.0)
+        inst.fmu.doStep(0.0, 1e-3)
+        v = inst.vars
+        names = ["Tz_sc", "dcm_12", "wheel_speed", "r_y", "Fx", "max_step_size", "Fy_sc", "dcm_33"]
+        got = inst.fmu.getReal([v[n].valueReference for n in names])
+        y = dict(zip(inst.output_names, inst.get()))
+        assert got == [y["Tz_sc"], -1.0, 120.0, 0.25, y["Fx"], 0.005, y["Fy_sc"], 1.0]
+        assert y["Fy_sc"] == y["Fx"]                     # row 2 of the DCM is (1, 0, 0)
+        with pytest.raises(FMICallException):
+            inst.fmu.getReal([v["seed"].valueReference])
+    finally:
+        inst.close()
