@@ -108,7 +108,13 @@ def model_document(model) -> dict:
     else:
         from rwadist import model as model_io
         doc, source = model_io.to_json(model), "<model>"
-    _runtime().model_from_doc(doc, source)
+    rt = _runtime()
+    params, lines = rt.model_from_doc(doc, source)
+    laws = rt.laws_from_doc(doc, source)
+    unused = set(laws) - rt.WheelRuntime(params, lines, laws=laws).laws_used
+    for d, h in sorted(unused):
+        warnings.warn(f"{source}: amplitude_law of {d} h={h:g} matches no line of the model; the FMU ignores it",
+                      RuntimeWarning, stacklevel=3)
     return doc
 
 

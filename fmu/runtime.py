@@ -58,6 +58,49 @@ class ModelError(ValueError):
 #: as rwadist.extended.IMBALANCE_H_TOL
 IMBALANCE_H_TOL = 0.02
 
+def read_document(path):
+    """The parsed JSON document of a model file; ModelError naming the file if unreadable."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return json.load(fh)
+    except OSError as exc:
+        raise ModelError(f"model file {path!r} cannot be read: {exc.strerror or exc}") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ModelError(f"model file {path!r} is not valid JSON: {exc}") from None
+
+
+#: |Δh| within which a diagnosed amplitude law belongs to a line (as rwadist.broadband.apply_effects)
+LAW_H_TOL = 1e-3
+
+
+def laws_from_doc(doc, source="<model>"):
+    """Diagnosed amplitude laws of a model document (``effects`` entries of kind
+    ``amplitude_law``, written by ``rwadist diagnose``): {(direction, h): (A_ref, Ω_ref, p)} with
+    the line's amplitude A_ref·(|Ω|/Ω_ref)^p (N or N·m, rad/s) in place of C·Ω².  Other effect
+    kinds are not time-domain forcing the FMU models and are ignored (missing harmonics are
+    already harmonics of ``empirical``)."""
+    out = {}
+    effects = doc.get("effects") or []
+    if not isinstance(effects, list):
+        raise ModelError(f"{source}: effects: must be a list")
+    for i, e in enumerate(effects):
+        if not isinstance(e, dict) or e.get("kind") != "amplitude_law":
+            continue
+        where = f"{source}: effects[{i}]"
+        d = e.get("direction")
+        if d not in DIRECTIONS:
+            raise ModelError(f"{where}.direction: {d!r} is not one of {', '.join(DIRECTIONS)}")
+        h = _num(e.get("h"), where + ".h")
+        a = _num(e.get("amplitude_ref"), where + ".amplitude_ref")
+        w = _num(e.get("omega_ref_rad_s"), where + ".omega_ref_rad_s")
+        x = _num(e.get("exponent"), where + ".exponent")
+        if h <= 0 or a < 0 or w <= 0 or x < 0:
+            raise ModelError(f"{where}: needs h > 0, amplitude_ref >= 0, omega_ref_rad_s > 0 and exponent >= 0; "
+                             f"got h={h!r}, amplitude_ref={a!r}, omega_ref_rad_s={w!r}, exponent={x!r}")
+        out[(d, h)] = (a, w, x)
+    return out
+
+
 def load_model(path):
     """(params dict, lines) from a model file of schema rwadist.model v1.
 
@@ -65,14 +108,7 @@ def load_model(path):
     ``rwadist.extended.lines_from_model``: the static and dynamic imbalance first (U_s, U_d of
     the analytical section), then every empirical harmonic per direction except the radial
     h = 1 ones.  ModelError naming the file and field on any problem."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            doc = json.load(fh)
-    except OSError as exc:
-        raise ModelError(f"model file {path!r} cannot be read: {exc.strerror or exc}") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ModelError(f"model file {path!r} is not valid JSON: {exc}") from None
-    return model_from_doc(doc, str(path))
+    return model_from_doc(read_document(path), str(path))
 
 
 def _num(v, where):
@@ -179,10 +215,11 @@ def to_spacecraft(out, R, r):
 
 #: cfg layout of ``rwadist_kernel_step`` (fmu/native/rwadist_fmu_native.c): parameter order,
 #: offsets of the fixed poles, mounting, and the per-component block (σh, direction, coef·C,
-#: −i·coef·C·[imbalance]).  The C file repeats it; tests/test_fmu.py checks both agree by running.
+#: −i·coef·C·[imbalance], coef·A_ref, Ω_ref, p of an amplitude law).  The C file repeats it;
+#: tests/test_fmu.py checks both agree by running.
 KERNEL_PARAMS = ("mass", "c_r", "k_r", "I_rr", "c_rock", "k_rock", "I_zz", "c_z", "k_z", "height")
 KERNEL_COMP = 32
-KERNEL_STRIDE = 6
+KERNEL_STRIDE = 10
 
 
 def load_kernel(path):
@@ -226,10 +263,14 @@ class WheelRuntime:
     communication step accepted, s.  dcm, position : mounting, wheel → spacecraft DCM (3×3,
     default identity) and interface position, m (default 0), for the spacecraft-frame outputs.
     kernel : ``rwadist_kernel_step`` from :func:`load_kernel`, or None to step in numpy.
+    laws : diagnosed amplitude laws from :func:`laws_from_doc`; a line (same direction,
+    |Δh| < LAW_H_TOL) with a law has amplitude A_ref·(|Ω|/Ω_ref)^p instead of C·Ω² (an imbalance
+    line keeps its tangential term −i·C·Ω̇).
     """
 
     def __init__(self, params, lines, *, seed=None, imbalance=True, harmonics=True, modes=True,
-                 start_steady=False, max_accel=500.0, max_step=0.01, dcm=None, position=None, kernel=None):
+                 start_steady=False, max_accel=500.0, max_step=0.01, dcm=None, position=None, kernel=None,
+                 laws=None):
         self.p = dict(params)
         if not (math.isfinite(max_accel) and max_accel > 0):
             raise ModelError(f"max_acceleration must be finite and > 0, got {max_accel!r}")
@@ -239,16 +280,22 @@ class WheelRuntime:
         self.modes, self.start_steady = bool(modes), bool(start_steady)
         n = len(lines)
         ph = (np.random.default_rng(int(seed)).uniform(0, 2 * np.pi, n) if seed is not None else np.zeros(n))
-        sh, coef, C, imb, dirs = [], [], [], [], []
+        sh, coef, C, imb, dirs, law = [], [], [], [], [], []
+        laws = dict(laws or {})
+        self.laws_used = set()
         for (d, h, c, sense, is_imb), q in zip(lines, ph):
             if (is_imb and not imbalance) or (not is_imb and not harmonics):
                 continue
+            key = next((k for k in laws if k[0] == d and abs(k[1] - h) < LAW_H_TOL), None)
+            if key is not None:
+                self.laws_used.add(key)
             for sigma, cf in components(d, sense, float(q)):
                 sh.append(sigma * h)
                 coef.append(cf)
                 C.append(c)
                 imb.append(is_imb)
                 dirs.append(DIRECTIONS.index(d))
+                law.append((1.0, *laws[key]) if key is not None else (0.0, 0.0, 1.0, 0.0))
         self.sh = np.array(sh, dtype=float)
         self.coef = np.array(coef, dtype=complex)
         self.C = np.array(C, dtype=float)
@@ -260,6 +307,12 @@ class WheelRuntime:
         self.ish = 1j * self.sh
         self.cC = self.coef * self.C
         self.cCi = -1j * self.coef * self.C * self.imb
+        law = np.array(law, dtype=float).reshape(-1, 4)
+        self.law_idx = np.nonzero(law[:, 0] > 0)[0]             # components with a diagnosed law
+        self.law_scale = self.coef[self.law_idx] * law[self.law_idx, 1]
+        self.law_ref = law[self.law_idx, 2]
+        self.law_p = law[self.law_idx, 3]
+        self.cC[self.law_idx] = 0.0                              # C·Ω² replaced by the law
         self.rock = np.nonzero(self.dirs == 1)[0]
         p = self.p
         self.lam_r = quad_roots(p["mass"], p["c_r"], p["k_r"])
@@ -292,6 +345,10 @@ class WheelRuntime:
             comp[:, 0], comp[:, 1] = self.sh, self.dirs
             comp[:, 2:4] = self.cC.view(float).reshape(n, 2)
             comp[:, 4:6] = self.cCi.view(float).reshape(n, 2)
+            comp[:, 8] = 1.0
+            comp[self.law_idx, 6:8] = self.law_scale.view(float).reshape(-1, 2)
+            comp[self.law_idx, 8] = self.law_ref
+            comp[self.law_idx, 9] = self.law_p
             self._cfg = cfg
             self._st = np.zeros(2 + 2 * n + 12)
             self._kout = np.zeros(12)
@@ -325,8 +382,12 @@ class WheelRuntime:
         self.y = [0.0] * 12
 
     def _amp(self, w, wdot):
-        """coef·C·(Ω² − iΩ̇·[imbalance]) per component."""
-        return self.cC * (w * w) + self.cCi * wdot
+        """coef·C·(Ω² − iΩ̇·[imbalance]) per component (coef·A_ref·(|Ω|/Ω_ref)^p in place of
+        coef·C·Ω² for a line with a diagnosed amplitude law)."""
+        a = self.cC * (w * w) + self.cCi * wdot
+        if self.law_idx.size:
+            a[self.law_idx] += self.law_scale * (abs(w) / self.law_ref) ** self.law_p
+        return a
 
     def _loads(self, w, wdot, phi):
         """Internal complex loads per direction (4,) at speed w, acceleration wdot, angle phi."""

@@ -234,7 +234,9 @@ class RwadistWheelSlave(Fmi2Slave):
         rt = self.rt
         try:
             path = self.model_file or os.path.join(self.resources, MODEL_FILE)
-            params, lines = rt.load_model(path)
+            doc = rt.read_document(path)
+            params, lines = rt.model_from_doc(doc, path)
+            laws = rt.laws_from_doc(doc, path)
             seed = int(self.seed)
             if seed < -1:
                 raise rt.ModelError(f"seed must be >= 0, or -1 for the model file's phases; got {seed}")
@@ -242,7 +244,10 @@ class RwadistWheelSlave(Fmi2Slave):
                 params, lines, seed=None if seed == -1 else seed, imbalance=bool(self.imbalance),
                 harmonics=bool(self.harmonics), modes=bool(self.modes), start_steady=bool(self.start_steady),
                 max_accel=float(self.max_acceleration), max_step=float(self.max_step_size),
-                dcm=self.dcm, position=self.pos, kernel=self._kernel)
+                dcm=self.dcm, position=self.pos, kernel=self._kernel, laws=laws)
+            for d, h in sorted(set(laws) - self.model.laws_used):
+                self.log(f"rwadist wheel: amplitude_law of {d} h={h:g} matches no line of the model; ignored",
+                         Fmi2Status.warning)
             self.error = None
             w = float(self.wheel_speed)
             if math.isfinite(w):

@@ -174,6 +174,62 @@ def modal_gain(p, direction, nu, omega):
 def test_constant_speed_amplitudes(wheel_fmu, model, rpm):
     """At constant speed each line's amplitude (least squares on the FMU output) is
     C·Ω²·|coef|·|modal gain| within 0.5 %."""
+    check_amplitudes(wheel_fmu, model, rpm, lambda ln, omega: ln.C * omega**2)
+
+
+#: diagnosed amplitude laws (as ``rwadist diagnose`` writes them): the imbalance, a radial-force
+#: harmonic and an axial one
+LAWS = [{"kind": "amplitude_law", "direction": "radial_force", "h": 1.0, "exponent": 1.7,
+         "amplitude_ref": 0.02, "omega_ref_rad_s": 200.0, "channel": ["Fx", "Fy"]},
+        {"kind": "amplitude_law", "direction": "radial_force", "h": 2.0, "exponent": 2.5,
+         "amplitude_ref": 0.004, "omega_ref_rad_s": 200.0, "channel": ["Fx", "Fy"]},
+        {"kind": "amplitude_law", "direction": "axial_force", "h": 2.0, "exponent": 3.0,
+         "amplitude_ref": 0.01, "omega_ref_rad_s": 150.0, "channel": ["Fz"]}]
+
+
+@pytest.mark.parametrize("rpm", [2400.0, -1100.0])
+def test_fmu_reads_amplitude_laws(tmp_path, model, rpm):
+    """A model file improved by diagnose: each line with an amplitude law has amplitude
+    A_ref·(|Ω|/Ω_ref)^p·|coef|·|modal gain| at constant speed (0.5 %), the others stay C·Ω²."""
+    doc = model_io.to_json(model)
+    doc["effects"] = LAWS
+    path = build_fmu(doc, tmp_path / "laws.fmu")
+
+    def amp(ln, omega):
+        for e in LAWS:
+            if e["direction"] == ln.direction and abs(e["h"] - ln.h) < 1e-3:
+                return e["amplitude_ref"] * (abs(omega) / e["omega_ref_rad_s"]) ** e["exponent"]
+        return ln.C * omega**2
+    check_amplitudes(path, model, rpm, amp)
+
+
+def test_amplitude_law_of_exponent_two_is_the_model(model_path, kernel):
+    """A law with p = 2 and A_ref = C·Ω_ref² is C·Ω² again: outputs equal the law-free runtime on a
+    spin-up (numpy and native), the imbalance's tangential term included; a law matching no line
+    is reported as unused."""
+    params, lines = rt.load_model(model_path)
+    laws = {(d, h): (C * 180.0**2, 180.0, 2.0) for d, h, C, _, _ in lines}
+    laws[("axial_force", 7.77)] = (1.0, 100.0, 2.0)
+    t, w = spin_up(T=4.0)
+    for k in (None, kernel):
+        a = rt.WheelRuntime(params, lines, seed=5, kernel=k).run(t, w)
+        W = rt.WheelRuntime(params, lines, seed=5, kernel=k, laws=laws)
+        b = W.run(t, w)
+        assert ("axial_force", 7.77) not in W.laws_used and len(W.laws_used) == len(lines)
+        assert np.all(np.abs(b - a) <= 1e-12 * np.max(np.abs(a), axis=0)), rel_err(b, a)
+
+
+def test_bad_amplitude_law_is_refused(model):
+    doc = model_io.to_json(model)
+    doc["effects"] = [dict(LAWS[0], exponent=-1.0)]
+    with pytest.raises(rt.ModelError, match=r"effects\[0\].*exponent"):
+        build_fmu(doc, "/nonexistent/x.fmu")
+
+
+def check_amplitudes(fmu_path, model, rpm, amplitude):
+    """Least-squares line amplitudes of the FMU output at constant ``rpm`` against
+    amplitude(line, Ω)·|coef|·|modal gain| (0.5 %)."""
+    wheel_fmu = fmu_path
     p = ext.params_from_model(model)
     lines = ext.lines_from_model(model, p)
     omega = rpm * RPM
@@ -197,7 +253,7 @@ def test_constant_speed_amplitudes(wheel_fmu, model, rpm):
         coef, *_ = np.linalg.lstsq(A, sig.astype(complex), rcond=None)
         for k, (ln, s, cf) in enumerate(comps):
             nu = s * ln.h * omega
-            expect = ln.C * omega**2 * abs(cf) * modal_gain(p, d, nu, omega)
+            expect = amplitude(ln, omega) * abs(cf) * modal_gain(p, d, nu, omega)
             got = abs(coef[k]) * (2 if d.startswith("axial") else 1)
             assert got == pytest.approx(expect, rel=5e-3), (d, ln.h, s, got, expect)
             checked += 1

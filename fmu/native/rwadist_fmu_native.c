@@ -207,11 +207,12 @@ FORWARD(fmi2Status, fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind 
 /* ------------------------------------------------------------------ step kernel
  * cfg (read only): [0] n components, [1] modes on, [2..11] mass, c_r, k_r, I_rr, c_rock, k_rock, I_zz,
  * c_z, k_z, height, [12..15] λ_r (2 complex), [16..19] λ_z, [20..28] R (row major), [29..31] r,
- * then per component 6 doubles: σh, direction index, coef·C (complex), −i·coef·C·[imbalance] (complex).
+ * then per component 10 doubles: σh, direction index, coef·C (complex), −i·coef·C·[imbalance] (complex),
+ * coef·A_ref (complex, 0 without an amplitude law), Ω_ref, p: amplitude += coef·A_ref·(|Ω|/Ω_ref)^p.
  * st (state): [0] rotor angle φ, [1] unused, then S = e^{iσhφ} (n complex), η_r (2), η_z (2),
  * x_rock = (q, q̇) (2), complex.  out: 12 outputs (wheel frame, spacecraft frame). */
 enum { C_N, C_MODES, C_M, C_CR, C_KR, C_IRR, C_CROCK, C_KROCK, C_IZZ, C_CZ, C_KZ, C_HEIGHT, C_LAMR = 12,
-       C_LAMZ = 16, C_R = 20, C_POS = 29, C_COMP = 32, C_STRIDE = 6 };
+       C_LAMZ = 16, C_R = 20, C_POS = 29, C_COMP = 32, C_STRIDE = 10 };
 #define SMALL_Z 1e-3
 
 static void quad_roots(double m, double complex c, double k, double complex *l1, double complex *l2)
@@ -252,8 +253,13 @@ EXPORT void rwadist_kernel_step(const double *cfg, double *st, double *out, doub
         const double sh = c[0];
         const int d = (int)c[1];
         const double complex cC = CMPLX(c[2], c[3]), cCi = CMPLX(c[4], c[5]);
-        const double complex a0 = cC * (omega * omega) + cCi * wd0;
-        const double complex a1 = cC * (w1 * w1) + cCi * alpha;
+        double complex a0 = cC * (omega * omega) + cCi * wd0;
+        double complex a1 = cC * (w1 * w1) + cCi * alpha;
+        if (c[6] != 0.0 || c[7] != 0.0) {
+            const double complex ls = CMPLX(c[6], c[7]);
+            a0 += ls * pow(fabs(omega) / c[8], c[9]);
+            a1 += ls * pow(fabs(w1) / c[8], c[9]);
+        }
         const double complex S1 = cexp(CMPLX(0.0, sh * phi1));
         loads1[d] += a1 * S1;
         if (modes && d != 3) {
