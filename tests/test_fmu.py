@@ -183,7 +183,7 @@ LAWS = [{"kind": "amplitude_law", "direction": "radial_force", "h": 1.0, "expone
          "amplitude_ref": 0.02, "omega_ref_rad_s": 200.0, "channel": ["Fx", "Fy"]},
         {"kind": "amplitude_law", "direction": "radial_force", "h": 2.0, "exponent": 2.5,
          "amplitude_ref": 0.004, "omega_ref_rad_s": 200.0, "channel": ["Fx", "Fy"]},
-        {"kind": "amplitude_law", "direction": "axial_force", "h": 2.0, "exponent": 3.0,
+        {"kind": "amplitude_law", "direction": "axial_force", "h": 1.98, "exponent": 3.0,
          "amplitude_ref": 0.01, "omega_ref_rad_s": 150.0, "channel": ["Fz"]}]
 
 
