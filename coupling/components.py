@@ -355,7 +355,7 @@ def free_lines(p: ext.ExtendedParams, lines, omega):
         wj = w[:, 0]
         for sigma, coef in ln.components():
             nu = sigma * ln.h * wj
-            resp = coef * ln.C * wj**2 + 0j
+            resp = coef * ln.amplitude(wj) + 0j
             pos = nu >= 0
             a_re = np.where(pos, resp, np.conj(resp))
             a_im = np.where(pos, -1j * resp, 1j * np.conj(resp))

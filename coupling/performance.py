@@ -56,7 +56,8 @@ class WheelSpec:
 
 def wheel_spec_from_model(model, mount=None, **kw) -> WheelSpec:
     """A WheelSpec from a :class:`rwadist.model.WheelModel` with an analytical section (a fitted
-    model file or ``preset(...).to_model()``): lines via :func:`rwadist.extended.lines_from_model`."""
+    model file or ``preset(...).to_model()``): lines via :func:`rwadist.extended.lines_from_model`,
+    with the diagnosed amplitude laws of ``model.effects`` attached (``rwadist diagnose``)."""
     p = ext.params_from_model(model)
     return WheelSpec(p, tuple(ext.lines_from_model(model, p)), mount or geometry.Mount(), **kw)
 

@@ -67,7 +67,7 @@ frequencies returned as Hz.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from scipy import optimize, signal
@@ -249,6 +249,9 @@ class Line:
     sense : 'co' | 'counter' | 'planar' (radial directions; ignored for axial ones).
     phase : rad.  angle : direction of a planar load in the x-y plane, rad.
     imbalance : an imbalance line (h = 1, co-rotating) with the tangential −iΩ̇ term.
+    law : (A_ref, Ω_ref, p) of a diagnosed ``amplitude_law`` (N or N·m, rad/s, -): the line's
+        amplitude is A_ref·(|Ω|/Ω_ref)^p instead of C·Ω² (an imbalance keeps its −iC·Ω̇ term);
+        None: C·Ω².
     """
 
     direction: str
@@ -258,6 +261,7 @@ class Line:
     phase: float = 0.0
     angle: float = 0.0
     imbalance: bool = False
+    law: tuple | None = None
 
     def __post_init__(self):
         if self.direction not in DIRECTIONS:
@@ -270,6 +274,19 @@ class Line:
             raise ValueError(f"Line.C must be finite and >= 0, got {self.C!r}")
         if self.imbalance and (self.h != 1.0 or self.sense != "co"):
             raise ValueError("an imbalance Line must have h = 1 and sense 'co'")
+        if self.law is not None:
+            a, w, x = (float(v) for v in self.law)
+            if not (math.isfinite(a) and a >= 0 and math.isfinite(w) and w > 0 and math.isfinite(x) and x >= 0):
+                raise ValueError(f"Line.law (A_ref, omega_ref, exponent) needs A_ref >= 0, omega_ref > 0, "
+                                 f"exponent >= 0, got {self.law!r}")
+
+    def amplitude(self, omega):
+        """Load amplitude at wheel speeds ``omega`` (rad/s): C·Ω², or A_ref·(|Ω|/Ω_ref)^p with a law."""
+        w = np.asarray(omega, dtype=float)
+        if self.law is None:
+            return self.C * w**2
+        a, w_ref, x = self.law
+        return a * (np.abs(w) / w_ref) ** x
 
     def components(self):
         """[(sigma, coefficient)]: load = C·coefficient·amp(t)·e^{i·sigma·h·φ}; sigma = ±1."""
@@ -298,12 +315,17 @@ def is_imbalance(direction: str, h: float, sense) -> bool:
             and sense in (None, "co"))
 
 
-def lines_from_model(model, p: ExtendedParams, senses: dict | None = None) -> list:
+#: |Δh| within which a diagnosed amplitude law belongs to a line (as rwadist.broadband.apply_effects)
+LAW_H_TOL = 1e-3
+
+
+def lines_from_model(model, p: ExtendedParams, senses: dict | None = None, effects: bool = True) -> list:
     """Lines of a :class:`~rwadist.model.WheelModel`: the imbalances from ``p`` replace the
     co-rotating radial fundamentals (|h − 1| <= IMBALANCE_H_TOL; thesis Eqs. 4.48–4.49); every
     other empirical harmonic -- a counter-rotating fundamental included -- becomes a line with
     sense ``senses.get((direction, h))``, else the harmonic's own ``sense`` from the model file,
-    else 'co'."""
+    else 'co'.  effects : attach the model's diagnosed ``amplitude_law`` effects (``rwadist
+    diagnose``) to their lines (same direction, |Δh| < LAW_H_TOL) as :attr:`Line.law`."""
     senses = senses or {}
     out = imbalance_lines(p)
     for d in DIRECTIONS:
@@ -312,6 +334,13 @@ def lines_from_model(model, p: ExtendedParams, senses: dict | None = None) -> li
             if is_imbalance(d, hm.h, sense):
                 continue
             out.append(Line(d, float(hm.h), float(hm.C), sense or "co"))
+    if effects:
+        for e in getattr(model, "effects", None) or []:
+            if e.get("kind") != "amplitude_law":
+                continue
+            law = (float(e["amplitude_ref"]), float(e["omega_ref_rad_s"]), float(e["exponent"]))
+            out = [replace(ln, law=law) if ln.direction == e["direction"] and abs(ln.h - float(e["h"])) < LAW_H_TOL
+                   else ln for ln in out]
     return out
 
 
@@ -473,7 +502,7 @@ def steady_lines(p: ExtendedParams, lines, omega) -> tuple:
     f_hz = h * np.abs(w) / (2 * np.pi)
     for j, ln in enumerate(lines):
         wj = w[:, 0]
-        load0 = ln.C * wj**2
+        load0 = ln.amplitude(wj)
         for sigma, coef in ln.components():
             nu = sigma * ln.h * wj
             resp = transmissibility(p, ln.direction, nu, wj) * coef * load0
@@ -698,15 +727,14 @@ def simulate_time(p: ExtendedParams, lines, t, omega, *, seed=None, phases=None,
             raise ValueError(f"phases must have one value per line ({len(lines)}), got shape {ph.shape}")
     else:
         ph = np.array([ln.phase for ln in lines])
-    lines = [Line(ln.direction, ln.h, ln.C, ln.sense, float(q), ln.angle, ln.imbalance) for ln, q in zip(lines, ph)]
+    lines = [replace(ln, phase=float(q)) for ln, q in zip(lines, ph)]
 
     phi = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * T)])
     wdot = np.gradient(w, T)
-    base = w**2
     out = np.zeros((t.size, 6))
     groups = {d: [] for d in DIRECTIONS}
     for ln in lines:
-        amp = ln.C * (base - 1j * wdot if ln.imbalance else base)
+        amp = ln.amplitude(w) - 1j * ln.C * wdot if ln.imbalance else ln.amplitude(w)
         for sigma, coef in ln.components():
             groups[ln.direction].append((sigma * ln.h, coef, amp))
 

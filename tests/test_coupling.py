@@ -323,3 +323,33 @@ def test_example_notebook_executes(tmp_path):
                             resources={"metadata": {"path": str(tmp_path)}}).execute()
     errors = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", []) if o.output_type == "error"]
     assert not errors
+
+
+def test_diagnosed_amplitude_law_reaches_the_coupled_prediction():
+    """A model improved by diagnose (amplitude law on a radial-force harmonic) flows into the
+    coupling kit: wheel_spec_from_model attaches the law, the free excitation of that line is
+    A_ref·(|Ω|/Ω_ref)^p (= a harmonic with C rescaled to that amplitude at each speed, built by
+    hand), the hard-mounted path still equals extended.steady_lines, other lines unchanged."""
+    from coupling.performance import wheel_spec_from_model
+    model = preset("ithaco-e").to_model()
+    model.effects = [{"kind": "amplitude_law", "direction": "radial_force", "h": 2.0, "exponent": 2.6,
+                      "amplitude_ref": 0.003, "omega_ref_rad_s": 200.0}]
+    spec = wheel_spec_from_model(model)
+    law_lines = [ln for ln in spec.lines if ln.law is not None]
+    assert [(ln.direction, ln.h) for ln in law_lines] == [("radial_force", 2.0)]
+    plain = ext.lines_from_model(model, spec.params, effects=False)
+    for rpm in (700.0, -2300.0):
+        om = rpm * RPM_TO_RAD_S
+        f, W = cp.free_lines(spec.params, spec.lines, om)
+        f0, W0 = cp.free_lines(spec.params, plain, om)
+        j = next(i for i, ln in enumerate(spec.lines) if ln.law is not None)
+        target = 0.003 * (abs(om) / 200.0) ** 2.6
+        by_hand = [replace(ln, C=target / om**2) if i == j else ln for i, ln in enumerate(plain)]
+        _, Wh = cp.free_lines(spec.params, by_hand, om)
+        assert np.allclose(W, Wh, rtol=1e-13, atol=0)
+        assert np.allclose(np.delete(W, j, axis=1), np.delete(W0, j, axis=1), rtol=0, atol=0)
+        assert abs(W[0, j, 0]) == pytest.approx(target, rel=1e-12)
+        wc = cp.wheel(spec.params, om)
+        _, B = wc.frf(f[0])
+        _, ref = ext.steady_lines(spec.params, spec.lines, om)
+        assert np.max(np.abs(np.einsum("lij,lj->li", B, W[0]) - ref[0])) < 1e-10 * np.max(np.abs(ref[0]))

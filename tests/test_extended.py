@@ -331,3 +331,14 @@ def test_model_file_round_trip_and_missing_field():
         ex.params_from_dict({**d, "k_z_N_per_m": -1.0}, "e.json")
     with pytest.raises(DataError, match="analytical: missing"):
         ex.params_from_model(WheelModel(name="empty"), "e.json")
+
+
+def test_line_amplitude_law():
+    """Line.law replaces C·Ω² by A_ref·(|Ω|/Ω_ref)^p (sign of Ω ignored); bad laws are refused."""
+    ln = ex.Line("radial_force", 2.0, 1e-6, law=(0.01, 100.0, 2.5))
+    w = np.array([-300.0, 0.0, 50.0, 100.0])
+    assert np.allclose(ln.amplitude(w), 0.01 * (np.abs(w) / 100.0) ** 2.5, rtol=1e-15, atol=0)
+    assert np.array_equal(ex.Line("radial_force", 2.0, 1e-6).amplitude(w), 1e-6 * w**2)
+    for bad in ((-1.0, 100.0, 2.0), (0.01, 0.0, 2.0), (0.01, 100.0, -0.5), (np.nan, 100.0, 2.0)):
+        with pytest.raises(ValueError, match="law"):
+            ex.Line("radial_force", 2.0, 1e-6, law=bad)

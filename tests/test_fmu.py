@@ -613,3 +613,21 @@ def test_get_real_of_parameters_inputs_and_outputs(wheel_fmu):
             inst.fmu.getReal([v["seed"].valueReference])
     finally:
         inst.close()
+
+
+@pytest.mark.parametrize("profile", [spin_up, reversal])
+def test_fmu_with_laws_equals_simulate_time_with_laws(tmp_path, model, profile):
+    """A diagnosed model file through fmpy equals rwadist.extended.simulate_time of the lines
+    lines_from_model builds from the same file (laws attached), 1e-9 relative."""
+    doc = model_io.to_json(model)
+    doc["effects"] = LAWS
+    improved = model_io.from_json(doc)
+    p = ext.params_from_model(improved)
+    lines = ext.lines_from_model(improved, p)
+    assert sum(ln.law is not None for ln in lines) == 3
+    t, w = profile(T=4.0)
+    ref = ext.simulate_time(p, lines, t, w, seed=8)
+    out = hosts.run_fmpy(build_fmu(doc, tmp_path / "laws.fmu"), t,
+                         {"wheel_speed": w, "wheel_acceleration": slope(t, w)},
+                         {"use_wheel_acceleration": True, "seed": 8})
+    assert np.all(rel_err(out[:, :6], ref) < 1e-9), rel_err(out[:, :6], ref)
