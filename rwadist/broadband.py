@@ -383,19 +383,61 @@ class WheelLines:
         return out * self._law_factor(w, idx)[..., None] if (self.laws or self.resonances) else out
 
 
+def _copy_source(src: WheelLines, i: int, label: str, scale: float = 1.0, law=None) -> None:
+    """Append a copy of source ``i`` (its own random phase) with its amplitude times ``scale``: an empirical
+    source's C and an extended group's lines' C scaled (and the A_ref of its amplitude law, so the law keeps
+    its shape), or with the amplitude law ``law`` = (A_ref, omega_ref, p) instead."""
+    from dataclasses import replace
+
+    j = len(src)
+    src.h = np.append(src.h, src.h[i])
+    if src.kind == "empirical":
+        d, C, mode = src.spec[i]
+        src.spec.append((d, C * scale, mode))
+    else:
+        src.groups.append([replace(ln, C=ln.C * scale) for ln in src.groups[i]])
+    src.labels.append(label)
+    if law is not None:
+        src.laws[j] = law
+    elif i in src.laws:
+        a_ref, w_ref, p = src.laws[i]
+        src.laws[j] = (a_ref * scale, w_ref, p)
+
+
+def _source_direction(src: WheelLines, i: int) -> str:
+    return src.spec[i][0] if src.kind == "empirical" else src.groups[i][0].direction
+
+
 def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
     """Attach a model file's diagnosed effects (``rwadist diagnose``) to its sources: an
     ``amplitude_law`` rescales the matching harmonic (same direction, |Δh| < 1e-3), a
     ``broadband_floor`` adds its floor to its channel, a ``fixed_resonance`` of role ``wheel_mode``
     amplifies its directions' lines.  Missing harmonics are already harmonics; a ``test_stand``
-    resonance and a ``cross_coupling`` load-cell offset are measurement artefacts, not disturbance."""
+    resonance and a ``cross_coupling`` load-cell offset are measurement artefacts, not disturbance.
+
+    Modulation effects, after those (so a carrier's amplitude law carries over to its sidebands):
+
+    * ``sidebands`` (depth m, f_mod_Hz): the matching sources get two copies of amplitude m/2 each, with
+      their own random phases (lines at different frequencies: no cross-spectrum with the carrier) and the
+      carrier's channel pattern (an amplitude-modulated rotating vector still rotates).  The added mean
+      square m²/2 of the carrier's is exact (Parseval); the copies are placed AT THE CARRIER's frequency:
+      the line integration (:func:`csd_groups`) maps a source to f = h|Ω|/2π only and has no fixed-offset
+      term, so each sideband's power sits up to f_mod Hz from where it belongs.
+    * ``speed_ripple`` (ΔΩ(|Ω|) = delta_omega_rad_s·(|Ω|/omega_ref)^q, f_ripple_Hz): the phase modulation
+      only moves each line's power to f_i + k·f_ripple (Σ_k J_k(β)² = 1), a redistribution over a few
+      f_ripple that a PSD over a speed law does not resolve: nothing is moved.  The amplitude modulation
+      of an empirical line C·Ω(t)² raises its mean square by the factor E_θ[(1 + ε sin θ)⁴] =
+      1 + 3ε² + 3ε⁴/8, ε = ΔΩ/|Ω|; that is added exactly, as two sources per line with amplitude laws
+      √3·C·ΔΩ·|Ω| (exponent 1 + q) and √(3/8)·C·ΔΩ² (exponent 2q).  Sources with an amplitude law or of
+      the extended model (not ∝ Ω²) get no amplitude term (it is O(ε²): 3·10⁻⁴ at ε = 1 %)."""
     from .units import CHANNELS
 
+    later = []
     for e in model.effects or []:
         kind = e.get("kind")
         if kind == "amplitude_law":
             for i in range(len(src)):
-                d = src.spec[i][0] if src.kind == "empirical" else src.groups[i][0].direction
+                d = _source_direction(src, i)
                 if d == e["direction"] and abs(src.h[i] - float(e["h"])) < 1e-3:
                     src.laws[i] = (float(e["amplitude_ref"]), float(e["omega_ref_rad_s"]), float(e["exponent"]))
         elif kind == "broadband_floor":
@@ -407,6 +449,26 @@ def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
             dirs = e.get("directions") or []
             dirs = [dirs] if isinstance(dirs, str) else list(dirs)
             src.resonances.append((dirs, float(e["f_Hz"]), float(e["zeta"]), float(e["peak_gain"])))
+        elif kind in ("sidebands", "speed_ripple"):
+            later.append(e)
+    for e in sorted(later, key=lambda x: x["kind"] != "sidebands"):
+        n0 = len(src)
+        if e["kind"] == "sidebands":
+            m, f_m = float(e["depth"]), float(e["f_mod_Hz"])
+            for i in range(n0):
+                if _source_direction(src, i) == e["direction"] and abs(src.h[i] - float(e["h"])) < 1e-3:
+                    for sgn in ("+", "-"):
+                        _copy_source(src, i, f"{src.labels[i]} sideband {sgn}{f_m:g} Hz (at the carrier)", 0.5 * m)
+        elif src.kind == "empirical":
+            dw, w_ref, q = float(e["delta_omega_rad_s"]), float(e["omega_ref_rad_s"]), float(e.get("speed_exponent", 0))
+            for i in range(n0):
+                if i in src.laws:
+                    continue
+                C = src.spec[i][1]
+                _copy_source(src, i, f"{src.labels[i]} speed-ripple AM (eps^2)", law=(np.sqrt(3.0) * C * dw * w_ref,
+                                                                                       w_ref, 1.0 + q))
+                _copy_source(src, i, f"{src.labels[i]} speed-ripple AM (eps^4)", law=(np.sqrt(3.0 / 8.0) * C * dw**2,
+                                                                                       w_ref, 2.0 * q))
     return src
 
 
@@ -449,7 +511,7 @@ def extended_lines_from_model(model: WheelModel, source="<model>") -> WheelLines
     (:func:`rwadist.extended.lines_from_model`, as the virtual stand does); the imbalance phases
     are those of :func:`rwadist.extended.imbalance_lines` (0, 0)."""
     params = ext.params_from_model(model, source)
-    src = extended_lines(params, ext.lines_from_model(model, params))
+    src = extended_lines(params, ext.lines_from_model(model, params, effects=False))   # apply_effects adds laws
     src.name = model.name
     return apply_effects(src, model)
 

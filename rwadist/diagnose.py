@@ -29,6 +29,14 @@ Predicted PSD of channel c at speed Ω (unit²/Hz on the spectra's grid)::
 * a line's amplitude is multiplied by |H(f)| of every ``fixed_resonance``
   acting on the channel; after a ``cross_coupling`` effect the torque data are
   read corrected for the load-cell offset (T − r × F, Welch PSD recomputed).
+* a ``sidebands`` effect adds to its carrier two lines at f_i ± f_mod of
+  amplitude m·a_i/2; a ``speed_ripple`` replaces every line (sidebands
+  included) by lines at f + k·f_ripple of mean squares (a²/2)·|c_k|²
+  (:func:`ripple_sideband_powers`); all through the same kernel K, each
+  component with the resonance gain at its own frequency.  Components of one
+  line are coherent; their Welch cross terms are neglected (they are ≥ 2.5
+  bins apart, where the Hann kernels barely overlap, and their relative phase
+  turns between Welch segments).
 
 Error metric (``waterfall_unexplained_fraction``): the speed × frequency plane
 of each channel is cut into bands of :data:`BAND_BINS` bins over
@@ -100,7 +108,45 @@ Effect classes (``kind`` in the model file's ``effects`` list and in
     calibration of the measurement: the torque data are corrected, so the
     metric after it is that of the corrected data.
 
-Not built yet: counter rotation, sidebands, speed ripple, spin acceleration.
+``sidebands``  (:class:`Sidebands`) amplitude modulation of one model line at
+    a FIXED frequency f_mod (Hz; a cage or electronics frequency):
+    a(Ω)(1 + m cos 2πf_mod t)·cos(2πf_i t + φ) is the carrier plus two lines
+    at f_i ± f_mod of amplitude m·a/2 each (depth m the same at every speed).
+    A modulation at a frequency proportional to speed would put the sidebands
+    at harmonics h ± h_m, which ``missing_harmonic`` already takes; only the
+    fixed-frequency case is built.  Signature: a pair of residual ridges
+    parallel to a model harmonic at a constant offset ±f_mod on the speed ×
+    frequency plane (:func:`_offset_scores`, offsets 2.5 bins to 50 Hz).  Fit:
+    f_mod from the refined residual peaks on both sides (median), m² by linear
+    least squares of the sideband window powers on (a/2)²/2 over every
+    speed.  One (h, f_mod, m) explains both sides at all speeds, so it beats
+    a missing harmonic, whose straight ridge h|Ω| crosses the offset ridge at
+    one speed only.  Parameters: direction, h, f_mod_Hz, depth.
+``speed_ripple``  (:class:`SpeedRipple`) a periodic wheel-speed ripple
+    Ω(t) = Ω0 + ΔΩ sin 2πf_r t at a fixed f_r (Hz: a speed-loop limit cycle, a
+    torque disturbance at a fixed frequency).  The rotation angle is
+    ψ = Ω0 t − (ΔΩ/2πf_r) cos 2πf_r t, so the line h is phase modulated with
+    index β_h = h·ΔΩ/(2π f_r) (ΔΩ rad/s, f_r Hz) and, its amplitude following
+    the instantaneous speed (a ∝ |Ω(t)|^p, p = 2 or the line's amplitude-law
+    exponent), amplitude modulated with ε = ΔΩ/|Ω0|: lines at f_i + k f_r of
+    power fraction |c_k|² (:func:`ripple_sideband_powers`; J_k(β)² when
+    ε = 0, Σ = 1 by Parseval; the amplitude term is kept, it is first order
+    in ε like the phase term and makes the sidebands asymmetric, upper ε + β/2,
+    lower β/2 − ε for p = 2).  Neglected: the imbalance's tangential force
+    ∝ dΩ/dt (relative size ΔΩ·2πf_r/Ω0²) and the resonance gain's variation
+    with the instantaneous speed.  ΔΩ is absolute (rad/s), not a fraction:
+    a torque ripple T at a fixed frequency gives ΔΩ = T/(I_zz 2πf_r) whatever
+    the speed; the fraction law ΔΩ = ε·|Ω| is fitted too (``speed_exponent``
+    q = 1 of ΔΩ = ΔΩ_ref (|Ω|/Ω_ref)^q) and the two compete on held-out
+    speeds (β_h constant vs growing with speed).  Signature: sideband pairs at
+    the same offset ±f_r around every line of every channel, deeper with h
+    (β ∝ h) - unlike ``sidebands``, one depth for one line.  Fit: f_r by the
+    refined peaks pooled over all lines, ΔΩ_ref by a robust (soft-L1) fit of
+    the log first-order sideband powers above 5σ (grid, then a bounded
+    minimisation).  Parameters: f_ripple_Hz, delta_omega_rad_s,
+    omega_ref_rad_s, speed_exponent, ripple_frac_at_ref.
+
+Not built yet: counter rotation, spin acceleration.
 """
 from __future__ import annotations
 
@@ -163,6 +209,10 @@ class State:
     resonances : (f_r Hz, ζ, g, channels) fixed-frequency resonances multiplying the lines of their channels.
     coupling : load-cell offset r (m, 3-vector) of a ``cross_coupling`` effect, or None: the torque data are
         then read corrected, T − r × F (:meth:`Context.data`).
+    sidebands : (direction, h, f_mod Hz, depth m) of ``sidebands`` effects: the line h of that direction
+        carries two more lines at h|Ω|/2π ± f_mod of amplitude m·a/2.
+    ripple : (ΔΩ_ref rad/s, f_ripple Hz, Ω_ref rad/s, q) of a ``speed_ripple`` effect, or None: every line
+        is spread over f_i + k·f_ripple with the powers of :func:`ripple_sideband_powers`.
     effects : effect objects added so far.
     """
 
@@ -173,10 +223,22 @@ class State:
     effects: list = field(default_factory=list)
     resonances: list = field(default_factory=list)
     coupling: tuple | None = None
+    sidebands: list = field(default_factory=list)
+    ripple: tuple | None = None
 
     def copy(self) -> "State":
         return State(copy.deepcopy(self.model), self.noise, dict(self.laws), dict(self.floors), list(self.effects),
-                     list(self.resonances), self.coupling)
+                     list(self.resonances), self.coupling, list(self.sidebands), self.ripple)
+
+    def line_components(self, channel: str, h: float):
+        """(frequency shift Hz, relative amplitude) of the line h of ``channel``: the carrier (0, 1) and the
+        pairs (±f_mod, m/2) of its ``sidebands`` effects."""
+        d = CHANNEL_DIRECTION[channel]
+        out = [(0.0, 1.0)]
+        for dd, hh, f_m, m in self.sidebands:
+            if dd == d and abs(hh - h) < 1e-4:
+                out += [(f_m, 0.5 * m), (-f_m, 0.5 * m)]
+        return out
 
     def lines(self, channel: str):
         """(h, amplitude function of omega) for every harmonic acting on ``channel``."""
@@ -276,18 +338,40 @@ class Context:
     # ---- predictions
     def line_psd(self, h: float, amp: np.ndarray, runs: np.ndarray) -> np.ndarray:
         """PSD (len(runs), n_f) of one line h at amplitudes ``amp`` (per run)."""
-        out = np.zeros((runs.size, self.f.size))
-        pos = h * self.omega[runs] / (2 * np.pi) / self.df            # fractional bin
+        return self.psd_at(h * self.omega[runs] / (2 * np.pi), amp**2 / 2.0)
+
+    def psd_at(self, f_hz: np.ndarray, power: np.ndarray) -> np.ndarray:
+        """PSD (n_runs, n_f) of lines at frequencies ``f_hz`` (n_runs,) or (n_runs, n) Hz with mean squares
+        ``power`` (same shape, unit²) through the line kernel; a line at negative frequency (a lower
+        sideband below 0 Hz) folds to |f|."""
+        f_hz = np.asarray(f_hz, dtype=float)
+        power = np.broadcast_to(np.asarray(power, dtype=float), f_hz.shape)
+        if f_hz.ndim == 1:
+            f_hz, power = f_hz[:, None], power[:, None]
+        n_runs, n_l = f_hz.shape
+        out = np.zeros((n_runs, self.f.size))
+        pos = (np.abs(f_hz) / self.df).ravel()                           # fractional bin
         k0 = np.rint(pos).astype(int)
         offs = np.arange(-KERNEL_HALF, KERNEL_HALF + 1)
         k = k0[:, None] + offs
         dlt = k - pos[:, None]                                         # bin minus line, bins
         idx = np.clip(np.rint((dlt - self.delta[0]) * self.osmp).astype(int), 0, self.delta.size - 1)
-        val = (amp**2 / 2.0)[:, None] * self.kernel[idx]
+        val = power.ravel()[:, None] * self.kernel[idx]
         ok = (k >= 0) & (k < self.f.size)
-        rows = np.broadcast_to(np.arange(runs.size)[:, None], k.shape)
+        rows = np.broadcast_to(np.repeat(np.arange(n_runs), n_l)[:, None], k.shape)
         np.add.at(out, (rows[ok], k[ok]), val[ok])
         return out
+
+    def ripple_powers(self, state: State, h: float, law, runs: np.ndarray):
+        """(k, P) of the state's speed ripple for a line h: sideband orders k (2K+1,) and their power
+        fractions P (len(runs), 2K+1) (:func:`ripple_sideband_powers`), or None without a ripple."""
+        if state.ripple is None:
+            return None
+        d_ref, f_r, w_ref, q = state.ripple
+        w = self.omega[runs]
+        dw = d_ref * (w / w_ref) ** q
+        p_amp = 2.0 if law is None else law[2]
+        return ripple_sideband_powers(h * dw / (2 * np.pi * f_r), dw / np.maximum(w, 1e-12), p_amp)
 
     def gain(self, state: State, c: str, f_hz) -> np.ndarray:
         """|H| of the state's fixed resonances acting on channel ``c`` at line frequencies ``f_hz`` (Hz)."""
@@ -312,15 +396,27 @@ class Context:
         return out
 
     def predict(self, state: State, c: str, runs: np.ndarray, skip=None) -> np.ndarray:
-        """Expected PSD of channel ``c`` on ``runs``; ``skip`` = h of a line to leave out."""
+        """Expected PSD of channel ``c`` on ``runs``; ``skip`` = h of a line to leave out (with its
+        sidebands).  A line's components (carrier and ``sidebands``, :meth:`State.line_components`) are
+        each multiplied by the resonance gain at their own frequency and, under a ``speed_ripple``,
+        spread over f + k·f_ripple with the power fractions of :meth:`ripple_powers`."""
         out = self.floor_psd(state, c, runs)
         for h, C, law in state.lines(c):
             if skip is not None and abs(h - skip) < 1e-9:
                 continue
             amp = self.amplitude(C, law, runs)
-            if state.resonances:
-                amp = amp * self.gain(state, c, h * self.omega[runs] / (2 * np.pi))
-            out += self.line_psd(h, amp, runs)
+            f0 = h * self.omega[runs] / (2 * np.pi)
+            rip = self.ripple_powers(state, h, law, runs)
+            for shift, rel in state.line_components(c, h):
+                f = f0 + shift
+                a = amp * rel
+                if state.resonances:
+                    a = a * self.gain(state, c, f)
+                if rip is None:
+                    out += self.psd_at(f, a**2 / 2.0)
+                else:
+                    k, P = rip
+                    out += self.psd_at(f[:, None] + k[None, :] * state.ripple[1], (a**2 / 2.0)[:, None] * P)
         return out
 
     def band_centres(self) -> np.ndarray:
@@ -341,6 +437,23 @@ class Context:
             k = np.clip(np.rint(h * self.omega[runs] / (2 * np.pi) / self.df).astype(int)[:, None] + offs,
                         0, self.f.size - 1)
             mask[rows, k] = True
+        if state.sidebands or state.ripple is not None:
+            # the model's sideband and ripple lines too, where their power is above a tenth of the noise
+            # power in their window
+            noise = self.floor_psd(state, c, runs)
+            for h, C, law in state.lines(c):
+                amp = self.amplitude(C, law, runs)
+                f0 = h * self.omega[runs] / (2 * np.pi)
+                rip = self.ripple_powers(state, h, law, runs) or (np.zeros(1), np.ones((runs.size, 1)))
+                for shift, rel in state.line_components(c, h):
+                    for j, kk in enumerate(rip[0]):
+                        if shift == 0.0 and kk == 0:
+                            continue
+                        f = np.abs(f0 + shift + kk * (state.ripple[1] if state.ripple else 0.0))
+                        k = np.clip(np.rint(f / self.df).astype(int)[:, None] + offs, 0, self.f.size - 1)
+                        pw = (amp * rel) ** 2 / 2 * rip[1][:, j]
+                        big = pw > 0.1 * noise[rows, k].sum(1) * self.df
+                        mask[rows, k] |= big[:, None]
         z = D / np.maximum(self.floor[c][runs], 1e-300) - 1.0     # against the run's own block floor
         thr = stats.chi2.isf(1e-4, self.dof) / self.dof - 1.0
         peak = z > thr
@@ -583,7 +696,9 @@ class BroadbandFloor:
         for _ in range(3):
             # weights: bins used / expected value² (a band mean of chi² bins has variance ∝ mean²/bins),
             # re-estimated from the previous pass (iteratively reweighted least squares)
-            wts = wt / np.maximum(expected, 1e-300) ** 2
+            # (relative to the largest level, floored at 1e-12 of it: squares of tiny PSDs underflow, and a
+            # band 12 decades down carries no information worth an astronomically large weight)
+            wts = wt / np.maximum(expected / float(np.max(level)), 1e-12) ** 2
             best = None
             for p in FLOOR_EXPONENTS:
                 x = x0[:, None] ** p
@@ -838,7 +953,345 @@ class CrossCoupling:
         return [] if e is None else [e]
 
 
-EFFECT_CLASSES = (MissingHarmonic, AmplitudeLaw, BroadbandFloor, FixedResonance, CrossCoupling)
+# --------------------------------------------------------------------------- modulation: sidebands, speed ripple
+
+def ripple_sideband_powers(beta, eps, p=2.0, k_max: int | None = None):
+    """Power fractions of the lines a periodic speed ripple makes of one harmonic line.
+
+    With Ω(t) = Ω0 + ΔΩ·sin θ, θ = 2π f_r t, the rotation angle is ψ = Ω0 t − (ΔΩ/2πf_r)·cos θ, so the line
+    h of amplitude a(Ω) ∝ |Ω|^p becomes a·g(θ)·e^{j2πf_i t} with
+    g(θ) = (1 + ε sin θ)^p · exp(−jβ cos θ),  β = h·ΔΩ/(2π f_r) (phase-modulation index, rad),
+    ε = ΔΩ/|Ω0|, and g = Σ_k c_k e^{jkθ}: lines at f_i + k·f_r of amplitude |c_k|·a.  Without the amplitude
+    term (ε = 0) c_k = J_k(β)e^{-jkπ/2}, |c_k|² = J_k(β)² and Σ_k |c_k|² = 1 (Parseval); with it Σ|c_k|² is the
+    mean of (1 + ε sin θ)^{2p} (1 + 3ε² + 3ε⁴/8 for p = 2).  c_k by an FFT over one period of θ.
+
+    beta, eps : broadcastable arrays (shape S); p : amplitude exponent (scalar or broadcastable).
+    Returns (k (2K+1,), P (S + (2K+1,))), P = |c_k|².
+    """
+    beta, eps, p = np.broadcast_arrays(np.asarray(beta, float), np.asarray(eps, float), np.asarray(p, float))
+    b = float(np.max(np.abs(beta))) if beta.size else 0.0
+    if k_max is None:
+        k_max = int(np.ceil(1.1 * b + 4.0 * b ** (1.0 / 3.0) + (float(np.max(np.abs(p))) if p.size else 2.0) + 4))
+    n = 1 << int(np.ceil(np.log2(4 * (2 * k_max + 1))))
+    th = 2 * np.pi * np.arange(n) / n
+    base = np.maximum(1.0 + eps[..., None] * np.sin(th), 0.0)
+    g = base ** p[..., None] * np.exp(-1j * beta[..., None] * np.cos(th))
+    c = np.fft.fft(g, axis=-1) / n
+    k = np.arange(-k_max, k_max + 1)
+    return k, np.abs(c[..., k % n]) ** 2
+
+
+def _residual_z(ctx, state, c, runs):
+    """Residual (data − model) of channel ``c`` and its value over the model's floor, the latter the
+    maximum of each bin and its two neighbours (a line between bins)."""
+    R = ctx.data(state, c)[runs] - ctx.predict(state, c, runs)
+    z = R / ctx.floor_psd(state, c, runs)
+    return R, np.maximum(np.maximum(z, np.roll(z, 1, axis=1)), np.roll(z, -1, axis=1))
+
+
+def _offset_scores(ctx, state, chans, runs, hs, offsets):
+    """Sum and count (len(hs), len(offsets)) of the clipped normalised residual at h|Ω|/2π ± Δ for every
+    carrier h of ``hs`` and offset Δ (Hz) of ``offsets``, over ``chans``, ``runs`` and both sides (in band
+    only): parallel ridges at a constant frequency offset from a line."""
+    tot = np.zeros((len(hs), offsets.size))
+    cnt = np.zeros((len(hs), offsets.size))
+    rows = np.arange(runs.size)[None, :]
+    for c in chans:
+        _, z = _residual_z(ctx, state, c, runs)
+        z = np.clip(z, -5.0, 20.0)
+        for i, h in enumerate(hs):
+            f0 = h * ctx.omega[runs] / (2 * np.pi)
+            for side in (1.0, -1.0):
+                k = np.rint((f0[None, :] + side * offsets[:, None]) / ctx.df).astype(int)
+                inb = (k >= ctx.k_lo) & (k <= ctx.k_hi)
+                vals = z[rows, np.clip(k, 0, ctx.f.size - 1)]
+                tot[i] += np.where(inb, vals, 0.0).sum(1)
+                cnt[i] += inb.sum(1)
+    return tot, cnt
+
+
+def _offset_threshold(ctx, n):
+    """Pooled-score threshold of a ridge (as :func:`ridge_peaks`): 10 noise standard deviations of a mean
+    of ``n`` normalised residual bins, plus 0.5."""
+    return 10.0 * np.sqrt(2.0 / ctx.dof) / np.sqrt(max(n, 1)) + 0.5
+
+
+def _offset_grid(ctx, f_max: float = 50.0):
+    """Offsets (Hz) searched for sidebands: from 2.5 bins (clear of the carrier's main lobe) to f_max."""
+    return np.arange(2.5 * ctx.df, min(f_max, 0.5 * ctx.k_hi * ctx.df), 0.25 * ctx.df)
+
+
+def _refine_offset(ctx, state, chans, runs, hs, off, n_iter: int = 2):
+    """Constant offset (Hz) of the sideband ridges near ``off`` around the carriers ``hs``: in every (channel,
+    run, carrier, side) the residual peak within ±2 bins of f_i ± off, refined by a log-parabola through three
+    bins and kept when > 20 × floor; the offset is the median of side·(f_peak − f_i).  Returns (offset, count)."""
+    n = 0
+    for _ in range(n_iter):
+        est = []
+        for c in chans:
+            R, _ = _residual_z(ctx, state, c, runs)
+            z = R / ctx.floor_psd(state, c, runs)
+            r = np.arange(runs.size)
+            for h in hs:
+                f0 = h * ctx.omega[runs] / (2 * np.pi)
+                for side in (1.0, -1.0):
+                    k0 = np.rint((f0 + side * off) / ctx.df).astype(int)
+                    k = np.clip(k0[:, None] + np.arange(-2, 3), 1, ctx.f.size - 2)
+                    kp = k[r, np.argmax(z[r[:, None], k], axis=1)]
+                    ok = (kp - 1 >= ctx.k_lo) & (kp + 1 <= ctx.k_hi) & (z[r, kp] > 20.0)
+                    lo, mid, hi = (np.log(np.maximum(R[r, kp + j], 1e-300)) for j in (-1, 0, 1))
+                    den = lo - 2 * mid + hi
+                    with np.errstate(divide="ignore", invalid="ignore"):
+                        dl = np.clip(np.where(den < 0, 0.5 * (lo - hi) / den, 0.0), -0.5, 0.5)
+                    est.append((side * ((kp + dl) * ctx.df - f0))[ok])
+        est = np.concatenate(est) if est else np.empty(0)
+        n = est.size
+        if n < 3:
+            return off, n
+        off = float(np.median(est))
+    return off, n
+
+
+def _window_power(ctx, state, c, runs, f_hz, R):
+    """Residual power (unit²) in ±LINE_HALF bins around ``f_hz`` (len(runs),), the model floor's power there,
+    its noise standard deviation (as :meth:`Context.measure_line`) and an in-band mask."""
+    k0 = np.rint(np.abs(f_hz) / ctx.df).astype(int)
+    offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+    inband = (k0 - LINE_HALF >= ctx.k_lo) & (k0 + LINE_HALF <= ctx.k_hi)
+    k = np.clip(k0[:, None] + offs, 0, ctx.f.size - 1)
+    p = np.take_along_axis(R, k, axis=1).sum(1) * ctx.df
+    noise = np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1).sum(1) * ctx.df
+    sig = 2.0 * noise * np.sqrt(2.0 / ctx.dof) / np.sqrt(2 * LINE_HALF + 1)
+    return p, noise, sig, inband
+
+
+def _clear_of_lines(ctx, state, c, runs, f_hz, own_h):
+    """True where frequency ``f_hz`` (len(runs),) lies at least 2·LINE_HALF bins from every line of channel
+    ``c`` other than ``own_h`` (and their sidebands): its window measures that line's component alone."""
+    ok = np.ones(runs.size, bool)
+    for h, _, _ in state.lines(c):
+        if abs(h - own_h) < 1e-9:
+            continue
+        for shift, _ in state.line_components(c, h):
+            g = np.abs(h * ctx.omega[runs] / (2 * np.pi) + shift)
+            ok &= np.abs(g - np.abs(f_hz)) >= 2 * LINE_HALF * ctx.df
+    return ok
+
+
+@dataclass
+class Sidebands:
+    """Amplitude modulation of one harmonic line at a FIXED frequency f_mod (Hz, the same at every speed: a
+    cage or electronics frequency, a drive's PWM beat): a(Ω)·(1 + m·cos 2πf_mod t)·cos(2πf_i t + φ) is the
+    carrier plus two lines at f_i ± f_mod of amplitude m·a/2 (depth m, dimensionless)."""
+
+    direction: str
+    h: float
+    f_mod: float
+    depth: float
+    n_points: int = 0
+    kind: str = "sidebands"
+
+    @property
+    def channels(self):
+        return DIRECTION_CHANNELS[self.direction]
+
+    def apply(self, state: State) -> State:
+        s = state.copy()
+        s.sidebands.append((self.direction, round(self.h, 4), self.f_mod, self.depth))
+        s.effects.append(self)
+        return s
+
+    def params(self) -> dict:
+        return {"direction": self.direction, "h": round(self.h, 4), "f_mod_Hz": self.f_mod, "depth": self.depth,
+                "n_points": self.n_points,
+                "law": "a(1 + depth*cos(2 pi f_mod t)): lines at h|omega|/2pi +- f_mod_Hz of amplitude depth*a/2"}
+
+    @staticmethod
+    def fit(ctx: Context, state: State, direction: str, h: float, runs, f_mod: float) -> "Sidebands | None":
+        """f_mod by :func:`_refine_offset` on both sides of the carrier; m² by linear least squares of the
+        measured sideband window powers P on their prediction per unit m², q = (a/2)²/2 (a the carrier's model
+        amplitude, times the resonance gain at the sideband), over every in-band side clear of other lines."""
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        f_mod, n = _refine_offset(ctx, state, chans, runs, [h], f_mod)
+        if n < 3 or f_mod <= 0:
+            return None
+        P, Q = [], []
+        for c in chans:
+            R, _ = _residual_z(ctx, state, c, runs)
+            law = state.laws.get((direction, round(h, 4)))
+            C = next((x[1] for x in state.lines(c) if abs(x[0] - h) < 1e-9), None)
+            if C is None:
+                return None
+            a = ctx.amplitude(C, law, runs)
+            for side in (1.0, -1.0):
+                f = h * ctx.omega[runs] / (2 * np.pi) + side * f_mod
+                p, _, _, inb = _window_power(ctx, state, c, runs, f, R)
+                ok = inb & _clear_of_lines(ctx, state, c, runs, f, h) & (f > 0)
+                g = ctx.gain(state, c, f) if state.resonances else 1.0
+                P.append(p[ok])
+                Q.append(((a * g) ** 2 / 8.0 * np.ones(runs.size))[ok])
+        P, Q = np.concatenate(P), np.concatenate(Q)
+        if P.size < 3 or not np.sum(Q * Q) > 0:
+            return None
+        m2 = float(np.sum(P * Q) / np.sum(Q * Q))
+        if m2 <= 0:
+            return None
+        return Sidebands(direction, float(h), float(f_mod), float(np.sqrt(m2)), int(P.size))
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs, max_per_direction: int = 3) -> list:
+        """Per direction, the carriers whose best constant-offset ridge pair (:func:`_offset_scores`) clears
+        :func:`_offset_threshold`; at most ``max_per_direction``, strongest first."""
+        out = []
+        offsets = _offset_grid(ctx)
+        if offsets.size < 3:
+            return out
+        for d, chans in DIRECTION_CHANNELS.items():
+            chans = [c for c in chans if c in ctx.channels]
+            hs = [x.h for x in state.model.harmonics(d)
+                  if not any(dd == d and abs(hh - x.h) < 1e-4 for dd, hh, _, _ in state.sidebands)]
+            if not chans or not hs:
+                continue
+            tot, cnt = _offset_scores(ctx, state, chans, runs, hs, offsets)
+            score = np.where(cnt >= 6, tot / np.maximum(cnt, 1), 0.0)
+            found = []
+            for i, h in enumerate(hs):
+                s = score[i]
+                j = int(np.argmax(s))
+                if 0 < j < s.size - 1 and s[j] > _offset_threshold(ctx, cnt[i, j]):
+                    found.append((s[j], h, float(offsets[j])))
+            for _, h, f_m in sorted(found, reverse=True)[:max_per_direction]:
+                e = Sidebands.fit(ctx, state, d, h, runs, f_m)
+                if e is not None:
+                    out.append(e)
+        return out
+
+
+@dataclass
+class SpeedRipple:
+    """A periodic wheel-speed ripple at a fixed frequency f_ripple (Hz): Ω(t) = Ω0 + ΔΩ·sin(2π f_ripple t),
+    with ΔΩ(|Ω0|) = ΔΩ_ref·(|Ω0|/Ω_ref)^q (rad/s; q = 0 a ripple of fixed size, q = 1 a fixed fraction of the
+    speed).  Every line is phase modulated (β_h = h·ΔΩ/2πf_ripple) and amplitude modulated (a ∝ |Ω(t)|^p):
+    lines at f_i + k·f_ripple with the power fractions of :func:`ripple_sideband_powers`."""
+
+    delta_omega: float
+    f_ripple: float
+    omega_ref: float
+    exponent: float = 0.0
+    n_points: int = 0
+    kind: str = "speed_ripple"
+
+    @property
+    def channels(self):
+        return CHANNELS
+
+    def apply(self, state: State) -> State:
+        s = state.copy()
+        s.ripple = (self.delta_omega, self.f_ripple, self.omega_ref, self.exponent)
+        s.effects.append(self)
+        return s
+
+    def params(self) -> dict:
+        return {"f_ripple_Hz": self.f_ripple, "delta_omega_rad_s": self.delta_omega,
+                "omega_ref_rad_s": self.omega_ref, "speed_exponent": self.exponent,
+                "ripple_frac_at_ref": self.delta_omega / self.omega_ref, "n_points": self.n_points,
+                "law": "omega(t) = omega0 + dw*sin(2 pi f_ripple t), dw = delta_omega_rad_s*(|omega0|/omega_ref)"
+                       "^speed_exponent; line h: phase index h*dw/(2 pi f_ripple), amplitude ~ |omega(t)|^p"}
+
+    @staticmethod
+    def _points(ctx, state, runs, f_r):
+        """Measured first-order ripple sidebands of every model line: (P window power, σ noise std, h, Ω,
+        a carrier amplitude × gain, p amplitude exponent, side) over channels, lines and both sides, in band
+        and clear of other lines."""
+        cols = {k: [] for k in ("P", "sig", "h", "w", "a", "p", "side")}
+        for c in ctx.channels:
+            if not np.isfinite(ctx.sp.psd[c][runs, 0]).all():
+                continue
+            R, _ = _residual_z(ctx, state, c, runs)
+            for h, C, law in state.lines(c):
+                a = ctx.amplitude(C, law, runs)
+                f0 = h * ctx.omega[runs] / (2 * np.pi)
+                for side in (1.0, -1.0):
+                    f = f0 + side * f_r
+                    p, _, sig, inb = _window_power(ctx, state, c, runs, f, R)
+                    ok = inb & (f > 0) & _clear_of_lines(ctx, state, c, runs, f, h)
+                    g = ctx.gain(state, c, f0) if state.resonances else np.ones(runs.size)
+                    for k, v in (("P", p), ("sig", sig), ("h", np.full(runs.size, h)), ("w", ctx.omega[runs]),
+                                 ("a", a * g), ("p", np.full(runs.size, 2.0 if law is None else law[2])),
+                                 ("side", np.full(runs.size, side))):
+                        cols[k].append(np.asarray(v, float)[ok])
+        return {k: np.concatenate(v) if v else np.empty(0) for k, v in cols.items()}
+
+    @staticmethod
+    def fit(ctx: Context, state: State, runs, f_r: float, exponent: float = 0.0) -> "SpeedRipple | None":
+        """f_ripple by :func:`_refine_offset` over every line of every channel; ΔΩ_ref by a robust (soft-L1)
+        fit of ln P to ln(|c_{±1}|²·a²/2) over the first-order sidebands standing 5σ above the noise (a log-
+        spaced grid, then a bounded scalar minimisation), with ΔΩ < ½·min|Ω| of the runs."""
+        from scipy.optimize import minimize_scalar
+
+        hs = sorted({x[0] for c in ctx.channels for x in state.lines(c)})
+        if not hs:
+            return None
+        f_r, n = _refine_offset(ctx, state, ctx.channels, runs, hs, f_r)
+        if n < 3 or f_r <= 0:
+            return None
+        pt = SpeedRipple._points(ctx, state, runs, f_r)
+        det = pt["P"] > 5.0 * pt["sig"]
+        if det.sum() < 5:
+            return None
+        pt = {k: v[det] for k, v in pt.items()}
+        w_ref = ctx.omega_ref()
+        y = np.log(pt["P"])
+        ki = np.where(pt["side"] > 0, 1, -1)
+
+        def cost(x):
+            dw = np.exp(x) * (pt["w"] / w_ref) ** exponent
+            k, P = ripple_sideband_powers(pt["h"] * dw / (2 * np.pi * f_r), dw / pt["w"], pt["p"], k_max=4)
+            pred = P[np.arange(ki.size), ki + 4] * pt["a"] ** 2 / 2
+            r = (y - np.log(np.maximum(pred, 1e-300))) / 0.5
+            return float(np.sum(2.0 * (np.sqrt(1.0 + r * r) - 1.0)))        # soft-L1
+
+        top = np.log(0.5 * float(np.min(ctx.omega[runs] * (w_ref / ctx.omega[runs]) ** exponent)))
+        grid = np.linspace(top - 12.0, top, 97)
+        vals = [cost(x) for x in grid]
+        i = int(np.argmin(vals))
+        lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+        sol = minimize_scalar(cost, bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
+        x = float(sol.x) if sol.fun <= vals[i] else float(grid[i])
+        return SpeedRipple(float(np.exp(x)), float(f_r), w_ref, float(exponent), int(y.size))
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        """The strongest constant offset of residual ridges around every line of every channel pooled
+        (:func:`_offset_scores`), fitted with q = 0 and q = 1 (two hypotheses judged on held-out speeds)."""
+        if state.ripple is not None:
+            return []
+        offsets = _offset_grid(ctx)
+        tot = np.zeros(offsets.size)
+        cnt = np.zeros(offsets.size)
+        for c in ctx.channels:
+            hs = [x[0] for x in state.lines(c)]
+            if not hs:
+                continue
+            t, n = _offset_scores(ctx, state, [c], runs, hs, offsets)
+            tot += t.sum(0)
+            cnt += n.sum(0)
+        score = np.where(cnt >= 6, tot / np.maximum(cnt, 1), 0.0)
+        if score.size < 3:
+            return []
+        j = int(np.argmax(score))
+        if not (0 < j < score.size - 1 and score[j] > _offset_threshold(ctx, cnt[j])):
+            return []
+        out = []
+        for q in (0.0, 1.0):
+            e = SpeedRipple.fit(ctx, state, runs, float(offsets[j]), q)
+            if e is not None:
+                out.append(e)
+        return out
+
+
+EFFECT_CLASSES = (MissingHarmonic, AmplitudeLaw, BroadbandFloor, FixedResonance, CrossCoupling, Sidebands,
+                  SpeedRipple)
 
 
 def _measure(ctx, state, direction, h, runs, skip=None):
@@ -1012,13 +1465,17 @@ def _refit(ctx, state, effect):
         return FixedResonance.fit(ctx, state, effect.channels, runs, effect.f_r, effect.role) or effect
     if isinstance(effect, CrossCoupling):
         return CrossCoupling.fit(ctx, state, runs) or effect
+    if isinstance(effect, Sidebands):
+        return Sidebands.fit(ctx, state, effect.direction, effect.h, runs, effect.f_mod) or effect
+    if isinstance(effect, SpeedRipple):
+        return SpeedRipple.fit(ctx, state, runs, effect.f_ripple, effect.exponent) or effect
     return effect
 
 
 def initial_state(ctx: Context, model: WheelModel) -> State:
     """The model with a speed-independent instrument noise per channel: the off-line band means
-    (:meth:`Context.offline_bands`) averaged over every run, interpolated between band centres
-    (the median block floor of the data outside the band)."""
+    (:meth:`Context.offline_bands`) averaged over every run, interpolated between the centres of the
+    bands with a positive mean (the median block floor of the data outside them)."""
     rough = {c: np.nanmedian(ctx.floor[c][ctx.runs], axis=0) for c in ctx.channels}
     state = State(copy.deepcopy(model), rough)
     noise = {}
@@ -1027,7 +1484,9 @@ def initial_state(ctx: Context, model: WheelModel) -> State:
         ok = ctx.runs[np.isfinite(ctx.sp.psd[c][ctx.runs, 0])]
         y, cnt = ctx.offline_bands(state, c, ok)
         mean = np.sum(y * cnt, 0) / np.maximum(cnt.sum(0), 1)
-        good = cnt.sum(0) > 0
+        # a band whose mean is not positive (the model's line skirts exceed the data there: coherent lines
+        # closer than the kernel beat in the Welch estimate) says nothing about the noise: interpolated over
+        good = (cnt.sum(0) > 0) & (mean > 0)
         n = np.array(rough[c], dtype=float)
         band = (ctx.f >= fc[0]) & (ctx.f <= fc[-1])
         if good.sum() >= 2:
