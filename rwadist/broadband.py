@@ -323,9 +323,18 @@ class WheelLines:
     #: wheel-mode resonances (directions, f_r Hz, ζ, peak gain) multiplying the lines of those
     #: directions by H(f) (a diagnosed ``fixed_resonance`` with role ``wheel_mode``)
     resonances: list = field(default_factory=list)
+    #: source index -> fixed frequency offset, Hz: the source sits at h|Ω|/2π + offset (a sideband of a
+    #: diagnosed ``sidebands`` effect, ±f_mod from its carrier)
+    offsets: dict = field(default_factory=dict)
 
     def __len__(self):
         return len(self.labels)
+
+    def freqs(self, w, idx=None) -> np.ndarray:
+        """(n_speeds, n_sel) line frequencies, Hz, at wheel speeds ``w`` (rad/s): |h|Ω|/2π + offset|."""
+        idx = np.arange(len(self)) if idx is None else np.asarray(idx)
+        off = np.array([self.offsets.get(int(i), 0.0) for i in idx])
+        return np.abs(self.h[idx][None, :] * np.abs(np.asarray(w, float))[:, None] / (2 * np.pi) + off[None, :])
 
     def _source_C(self, i) -> float:
         return self.spec[i][1] if self.kind == "empirical" else self.groups[i][0].C
@@ -340,7 +349,7 @@ class WheelLines:
             for j, i in enumerate(idx):
                 d = self.spec[int(i)][0] if self.kind == "empirical" else self.groups[int(i)][0].direction
                 if d in dirs:
-                    H = resonance(self.h[int(i)] * np.abs(w) / (2 * np.pi), f_r, zeta, g)
+                    H = resonance(self.freqs(w, [i])[:, 0], f_r, zeta, g)
                     fac[:, j] *= np.where(w < 0, np.conj(H), H)   # a real filter at negative frequency
         for j, i in enumerate(idx):
             if int(i) in self.laws:
@@ -383,10 +392,11 @@ class WheelLines:
         return out * self._law_factor(w, idx)[..., None] if (self.laws or self.resonances) else out
 
 
-def _copy_source(src: WheelLines, i: int, label: str, scale: float = 1.0, law=None) -> None:
+def _copy_source(src: WheelLines, i: int, label: str, scale: float = 1.0, law=None, f_off: float = 0.0) -> None:
     """Append a copy of source ``i`` (its own random phase) with its amplitude times ``scale``: an empirical
     source's C and an extended group's lines' C scaled (and the A_ref of its amplitude law, so the law keeps
-    its shape), or with the amplitude law ``law`` = (A_ref, omega_ref, p) instead."""
+    its shape), or with the amplitude law ``law`` = (A_ref, omega_ref, p) instead; ``f_off`` (Hz) is added
+    to the copy's frequency offset."""
     from dataclasses import replace
 
     j = len(src)
@@ -397,6 +407,8 @@ def _copy_source(src: WheelLines, i: int, label: str, scale: float = 1.0, law=No
     else:
         src.groups.append([replace(ln, C=ln.C * scale) for ln in src.groups[i]])
     src.labels.append(label)
+    if src.offsets.get(i, 0.0) + f_off:
+        src.offsets[j] = src.offsets.get(i, 0.0) + f_off
     if law is not None:
         src.laws[j] = law
     elif i in src.laws:
@@ -419,10 +431,9 @@ def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
 
     * ``sidebands`` (depth m, f_mod_Hz): the matching sources get two copies of amplitude m/2 each, with
       their own random phases (lines at different frequencies: no cross-spectrum with the carrier) and the
-      carrier's channel pattern (an amplitude-modulated rotating vector still rotates).  The added mean
-      square m²/2 of the carrier's is exact (Parseval); the copies are placed AT THE CARRIER's frequency:
-      the line integration (:func:`csd_groups`) maps a source to f = h|Ω|/2π only and has no fixed-offset
-      term, so each sideband's power sits up to f_mod Hz from where it belongs.
+      carrier's channel pattern (an amplitude-modulated rotating vector still rotates), at h|Ω|/2π ± f_mod
+      (:attr:`WheelLines.offsets`; a lower sideband below 0 Hz folds to |f|).  The added mean square m²/2
+      of the carrier's is exact (Parseval).
     * ``speed_ripple`` (ΔΩ(|Ω|) = delta_omega_rad_s·(|Ω|/omega_ref)^q, f_ripple_Hz): the phase modulation
       only moves each line's power to f_i + k·f_ripple (Σ_k J_k(β)² = 1), a redistribution over a few
       f_ripple that a PSD over a speed law does not resolve: nothing is moved.  The amplitude modulation
@@ -457,8 +468,8 @@ def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
             m, f_m = float(e["depth"]), float(e["f_mod_Hz"])
             for i in range(n0):
                 if _source_direction(src, i) == e["direction"] and abs(src.h[i] - float(e["h"])) < 1e-3:
-                    for sgn in ("+", "-"):
-                        _copy_source(src, i, f"{src.labels[i]} sideband {sgn}{f_m:g} Hz (at the carrier)", 0.5 * m)
+                    for sgn in (1.0, -1.0):
+                        _copy_source(src, i, f"{src.labels[i]} sideband {sgn * f_m:+g} Hz", 0.5 * m, f_off=sgn * f_m)
         elif src.kind == "empirical":
             dw, w_ref, q = float(e["delta_omega_rad_s"]), float(e["omega_ref_rad_s"]), float(e.get("speed_exponent", 0))
             for i in range(n0):
@@ -695,7 +706,7 @@ def csd_groups(groups, f_max: float, n_freq: int = 20001, n_speeds: int = 2000, 
                 floors += S[:, None, None] * np.outer(T[:, c], T[:, c])[None, :, :]
         n_src = len(members[0].lines)
         if len(members) > 1 and any(len(m.lines) != n_src or not np.allclose(m.lines.h, members[0].lines.h)
-                                    for m in members):
+                                    or m.lines.offsets != members[0].lines.offsets for m in members):
             raise DataError("wheels", "tie", "phase-locked wheels must use the same wheel model (same lines)")
         per = max(1, chunk // max(1, mid.size))
         for s0 in range(0, n_src, per):
@@ -713,8 +724,11 @@ def csd_groups(groups, f_max: float, n_freq: int = 20001, n_speeds: int = 2000, 
             A += Am
         wl = np.minimum(np.abs(lo_e), np.abs(hi_e))[:, None]
         wh = np.maximum(np.abs(lo_e), np.abs(hi_e))[:, None]
-        a = (h[None, :] * wl / (2 * np.pi)) / df
-        b = (h[None, :] * wh / (2 * np.pi)) / df
+        off = np.array([members[0].lines.offsets.get(int(i), 0.0) for i in idx])[None, :]
+        fa = np.abs(h[None, :] * wl / (2 * np.pi) + off)     # a sideband below 0 Hz folds to |f|
+        fb = np.abs(h[None, :] * wh / (2 * np.pi) + off)
+        a = np.minimum(fa, fb) / df
+        b = np.maximum(fa, fb) / df
         Q = 0.5 * A[..., _PAIR_A] * np.conj(A[..., _PAIR_B]) * P[:, None, None]     # (S, n, 21)
         acc += _spread(a, b, np.moveaxis(Q, -1, 0), f.size)
     acc /= df
@@ -748,7 +762,7 @@ def expected_mean_square(lines: WheelLines, law, f_max: float | None = None, n_s
         A = lines.amplitudes(w)
         p2 = np.abs(A) ** 2 / 2
         if f_max is not None:
-            p2 = p2 * (lines.h[None, :] * np.abs(w)[:, None] / (2 * np.pi) <= f_max)[..., None]
+            p2 = p2 * (lines.freqs(w) <= f_max)[..., None]
         total += np.einsum("s,sc->c", 0.5 * (hi_e - lo_e) * wi * law.pdf(w), p2.sum(axis=1))
     return total
 
@@ -789,7 +803,7 @@ def line_envelope(wheels, speed_range, f: np.ndarray, n_speeds: int = 4000) -> E
         best_w = np.zeros((len(lines), 6))
         for w in branches:
             A = np.abs(lines.amplitudes(w) @ T.T)                      # (S, L, 6)
-            fw = lines.h[None, :] * np.abs(w)[:, None] / (2 * np.pi)   # (S, L), increasing in S
+            fw = lines.freqs(w)                                        # (S, L), increasing in S
             for i in range(len(lines)):
                 sel = (f >= fw[0, i]) & (f <= fw[-1, i])
                 for c in range(6):
@@ -806,7 +820,7 @@ def line_envelope(wheels, speed_range, f: np.ndarray, n_speeds: int = 4000) -> E
                     table.append({"wheel": wi, "source": lines.labels[i], "h": float(lines.h[i]), "channel": ch,
                                   "max_amplitude": float(best[i, c]),
                                   "speed_rpm": float(best_w[i, c] * RAD_S_TO_RPM),
-                                  "f_Hz": float(lines.h[i] * abs(best_w[i, c]) / (2 * np.pi))})
+                                  "f_Hz": float(lines.freqs([best_w[i, c]], [i])[0, 0])})
     return Envelope(f=f, amplitude=env, table=table)
 
 

@@ -65,3 +65,26 @@ def test_wheel_mode_resonance_enters_the_psd_test_stand_does_not():
     artefacts = broadband_psd(empirical_lines(_model([stand, coupling])), LAW, f_max=150.0, n_freq=30001,
                               n_speeds=4000)
     np.testing.assert_allclose(artefacts.psd, plain.psd)
+
+
+def test_sidebands_sit_at_the_carrier_plus_minus_f_mod():
+    """At (nearly) one speed the sidebands of the h = 2 line appear at 2f₁ ± f_mod with (m/2)² of the
+    carrier's power each, and nothing else moves (bin sums over ±0.5 Hz windows)."""
+    rpm = 1500.0
+    law = Uniform(float(rpm_to_rad_s(rpm - 0.5)), float(rpm_to_rad_s(rpm + 0.5)))
+    sb = {"kind": "sidebands", "direction": "radial_force", "h": 2.0, "f_mod_Hz": 7.0, "depth": 0.4}
+    res = broadband_psd(empirical_lines(_model([sb])), law, f_max=120.0, n_freq=24001, n_speeds=64)
+    plain = broadband_psd(empirical_lines(_model([])), law, f_max=120.0, n_freq=24001, n_speeds=64)
+    df = res.f[1] - res.f[0]
+    f2 = 2.0 * rpm / 60.0
+
+    def window(r, fc):
+        sel = np.abs(r.f - fc) <= 0.5
+        return r.psd[sel, 0].sum() * df
+
+    carrier = window(plain, f2)
+    assert carrier > 0
+    assert window(res, f2) == pytest.approx(carrier, rel=1e-9)
+    for fc in (f2 + 7.0, f2 - 7.0):
+        assert window(plain, fc) < 1e-12 * carrier
+        assert window(res, fc) == pytest.approx(0.2**2 * carrier, rel=1e-6)
