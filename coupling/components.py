@@ -344,18 +344,23 @@ def free_lines(p: ext.ExtendedParams, lines, omega):
     the wheel component's w order wFx, wFy, wFz, wTx, wTy, wTz; channel = Re(W e^{i2πft})).
 
     Same line algebra as :func:`rwadist.extended.steady_lines` with the transmissibility
-    replaced by 1 and no lever arm (the lever arm is in the component's geometry)."""
+    replaced by 1 and no lever arm (the lever arm is in the component's geometry): the line
+    frequency is |hΩ/2π + f_offset| (h|Ω|/2π for a harmonic; a sideband has a fixed offset) and a
+    line's diagnosed wheel-mode resonances multiply each component by H at its whirl rate
+    (:class:`rwadist.extended.Line`; quasi-static, exact for these steady lines)."""
     w = np.atleast_1d(np.asarray(omega, dtype=float))[:, None]
     lines = list(lines)
     W = np.zeros((w.shape[0], len(lines), 6), dtype=complex)
-    h = np.array([ln.h for ln in lines], dtype=float)[None, :]
-    f_hz = h * np.abs(w) / (2 * np.pi)
+    f_hz = np.zeros((w.shape[0], len(lines)))
     col = {"radial_force": (0, 1), "radial_torque": (3, 4), "axial_force": (2,), "axial_torque": (5,)}
     for j, ln in enumerate(lines):
         wj = w[:, 0]
+        f_hz[:, j] = ln.frequency(wj)
         for sigma, coef in ln.components():
-            nu = sigma * ln.h * wj
+            nu = ln.nu(sigma, wj)
             resp = coef * ln.amplitude(wj) + 0j
+            if ln.resonances:
+                resp = resp * ln.gain(nu)
             pos = nu >= 0
             a_re = np.where(pos, resp, np.conj(resp))
             a_im = np.where(pos, -1j * resp, 1j * np.conj(resp))

@@ -14,9 +14,11 @@ where F_k = B_k w_k are wheel k's hard-mounted line loads, i.e.
 besides the wheels' dynamic masses.  Practices: 'i' u = Mt_kᵀ F_k; 'ii' Zc_i replaced by the
 rigid mass −M6_i; 'iii' F_k replaced by B_k F_k (measured loads fed as free excitation).
 
-Line phasors: channel = Re(Y e^{i2πft}); lines of one wheel with the same harmonic number are
-coherent (their phasors add); lines of different harmonic numbers and of different wheels are
-taken as incoherent (powers add): RMS = sqrt(Σ |Y|²/2).
+Line phasors: channel = Re(Y e^{i2πft}); lines of one wheel with the same harmonic number (and
+the same fixed frequency offset: a diagnosed sideband sits at |hΩ/2π ± f_mod|) are coherent
+(their phasors add); lines of different harmonic numbers or offsets and of different wheels are
+taken as incoherent (powers add): RMS = sqrt(Σ |Y|²/2).  Each group is evaluated at its own
+frequency (plant, wheel dynamic mass and blocked loads alike).
 """
 from __future__ import annotations
 
@@ -57,14 +59,16 @@ class WheelSpec:
 def wheel_spec_from_model(model, mount=None, **kw) -> WheelSpec:
     """A WheelSpec from a :class:`rwadist.model.WheelModel` with an analytical section (a fitted
     model file or ``preset(...).to_model()``): lines via :func:`rwadist.extended.lines_from_model`,
-    with the diagnosed amplitude laws of ``model.effects`` attached (``rwadist diagnose``)."""
+    with the diagnosed effects of ``model.effects`` applied (``rwadist diagnose``; amplitude laws,
+    wheel-mode resonances, sidebands: :func:`rwadist.extended.apply_line_effects`)."""
     p = ext.params_from_model(model)
     return WheelSpec(p, tuple(ext.lines_from_model(model, p)), mount or geometry.Mount(), **kw)
 
 
 @dataclass(frozen=True, eq=False)
 class LineResponses:
-    """Per wheel k: h[k] (J_k,) harmonic numbers, f_hz[k] (S, J_k), y[practice][k] (S, J_k, n_perf)
+    """Per wheel k: h[k] (J_k,) harmonic numbers (a harmonic repeats for its sideband groups, whose
+    frequency offsets are in f_offset[k] (J_k,) Hz), f_hz[k] (S, J_k), y[practice][k] (S, J_k, n_perf)
     complex output phasors, loads[k] (S, J_k, 6) coupled loads wheel k exerts (own frame, own
     lines), hard_mounted[k] (S, J_k, 6) the same lines on a rigid mount."""
 
@@ -75,6 +79,7 @@ class LineResponses:
     y: dict
     loads: list
     hard_mounted: list
+    f_offset: list = field(default_factory=list)
 
     def rms(self, practice: str = "coupled") -> np.ndarray:
         """(S, n_perf) RMS of each performance output over all lines of all wheels."""
@@ -83,13 +88,15 @@ class LineResponses:
 
 
 def _grouped_lines(spec: WheelSpec, omega):
-    """Hard-mounted line phasors summed over lines with equal h: (h (J,), F (S, J, 6))."""
-    hs = np.array([ln.h for ln in spec.lines])
-    hu, inv = np.unique(hs, return_inverse=True)
-    _, amp = ext.steady_lines(spec.params, spec.lines, omega)
-    ind = np.zeros((hu.size, hs.size))
-    ind[inv, np.arange(hs.size)] = 1.0
-    return hu, np.einsum("jl,slc->sjc", ind, amp)
+    """Hard-mounted line phasors summed over lines with equal h and frequency offset:
+    (h (J,), f_offset (J,) Hz, f (S, J) Hz, F (S, J, 6))."""
+    keys = np.array([(ln.h, ln.f_offset) for ln in spec.lines], dtype=float)
+    ku, first, inv = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    inv = np.ravel(inv)
+    f_all, amp = ext.steady_lines(spec.params, spec.lines, omega)
+    ind = np.zeros((ku.shape[0], keys.shape[0]))
+    ind[inv, np.arange(keys.shape[0])] = 1.0
+    return ku[:, 0], ku[:, 1], f_all[:, first], np.einsum("jl,slc->sjc", ind, amp)
 
 
 def _wheel_frf(spec, omega, f):
@@ -122,7 +129,7 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
         L = np.eye(n_if) - Zm @ plant.frf(np.array([1e6]))[0][0]
         if np.linalg.cond(L) > 1e12:
             raise SingularInterfaceError("practice 'ii' interface matrix is singular")
-    hs, fs, hms, loads = [], [], [], []
+    hs, offs, fs, hms, loads = [], [], [], [], []
     ys = {p: [] for p in practices}
     eye = np.eye(n_if)
     for k, wk in enumerate(wheels):
@@ -131,8 +138,7 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
         for i0 in range(0, om.size, chunk):
             o = om[i0:i0 + chunk]
             ok = o * wk.speed_scale
-            hk, Fk = _grouped_lines(wk, ok)
-            f = hk[None, :] * np.abs(ok)[:, None] / (2 * np.pi)
+            hk, offk, f, Fk = _grouped_lines(wk, ok)
             live = f > 0
             fe = np.where(live, f, 1.0)
             G, P = plant.frf(fe)
@@ -160,12 +166,13 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
             fk_all.append(f)
             Fk_all.append(Fk)
         hs.append(hk)
+        offs.append(offk)
         fs.append(np.concatenate(fk_all))
         hms.append(np.concatenate(Fk_all))
         loads.append(np.concatenate(lk))
         for p in practices:
             ys[p].append(np.concatenate(parts[p]))
-    return LineResponses(om, plant.perf_names, hs, fs, ys, loads, hms)
+    return LineResponses(om, plant.perf_names, hs, fs, ys, loads, hms, offs)
 
 
 @dataclass(frozen=True, eq=False)

@@ -110,11 +110,16 @@ def model_document(model) -> dict:
         doc, source = model_io.to_json(model), "<model>"
     rt = _runtime()
     params, lines = rt.model_from_doc(doc, source)
-    laws = rt.laws_from_doc(doc, source)
-    unused = set(laws) - rt.WheelRuntime(params, lines, laws=laws).laws_used
-    for d, h in sorted(unused):
+    effects = rt.effects_from_doc(doc, source)
+    laws = effects["laws"]
+    probe = rt.WheelRuntime(params, lines, **effects)
+    for d, h in sorted(set(laws) - probe.laws_used):
         warnings.warn(f"{source}: amplitude_law of {d} h={h:g} matches no line of the model; the FMU ignores it",
                       RuntimeWarning, stacklevel=3)
+    for j, (d, h, f_mod, _) in enumerate(effects["sidebands"]):
+        if j not in probe.sidebands_used:
+            warnings.warn(f"{source}: sidebands of {d} h={h:g} (f_mod {f_mod:g} Hz) match no line of the model; "
+                          "the FMU ignores them", RuntimeWarning, stacklevel=3)
     return doc
 
 

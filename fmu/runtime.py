@@ -101,6 +101,55 @@ def laws_from_doc(doc, source="<model>"):
     return out
 
 
+def effects_from_doc(doc, source="<model>"):
+    """All time-domain forcing effects of a model document (``rwadist diagnose``), validated, as
+    keyword arguments of :class:`WheelRuntime`:
+
+    * ``laws``: :func:`laws_from_doc`;
+    * ``resonances``: [(directions, f_r Hz, ζ, peak_gain)] of each ``fixed_resonance`` of role
+      ``wheel_mode`` (an unmodelled wheel mode): every component of every line of those directions
+      is multiplied by H(ν/2π) = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r), r = ν/(2π f_r) signed, at
+      its instantaneous whirl rate ν = σ(hΩ + 2π f_offset) -- QUASI-STATIC (exact at constant speed,
+      no ringing of that resonance in transients).  Role ``test_stand`` (a fixture resonance) is a
+      measurement artefact: left out, as are ``cross_coupling`` (load-cell offset) entries;
+    * ``sidebands``: [(direction, h, f_mod Hz, depth m)]: the matching lines (|Δh| < LAW_H_TOL) are
+      amplitude modulated, a(1 + m·cos 2πf_mod t) = the carrier + two lines of amplitude m·a/2 whose
+      phases advance by ±2πf_mod·t (exact in the time domain).
+
+    ModelError naming ``effects[i].<field>`` on a bad entry."""
+    out = {"laws": laws_from_doc(doc, source), "resonances": [], "sidebands": []}
+    for i, e in enumerate(doc.get("effects") or []):
+        if not isinstance(e, dict):
+            continue
+        where = f"{source}: effects[{i}]"
+        kind = e.get("kind")
+        if kind == "fixed_resonance":
+            role = e.get("role")
+            if role not in ("wheel_mode", "test_stand"):
+                raise ModelError(f"{where}.role: {role!r} is not wheel_mode or test_stand")
+            vals = [_num(e.get(k), f"{where}.{k}") for k in ("f_Hz", "zeta", "peak_gain")]
+            for k, v in zip(("f_Hz", "zeta", "peak_gain"), vals):
+                if v <= 0:
+                    raise ModelError(f"{where}.{k}: must be > 0, got {v!r}")
+            dirs = e.get("directions")
+            dirs = [dirs] if isinstance(dirs, str) else dirs
+            if not isinstance(dirs, list) or not dirs or any(d not in DIRECTIONS for d in dirs):
+                raise ModelError(f"{where}.directions: {e.get('directions')!r} must be a non-empty list of "
+                                 f"{', '.join(DIRECTIONS)}")
+            if role == "wheel_mode":
+                out["resonances"].append((tuple(dirs), *vals))
+        elif kind == "sidebands":
+            d = e.get("direction")
+            if d not in DIRECTIONS:
+                raise ModelError(f"{where}.direction: {d!r} is not one of {', '.join(DIRECTIONS)}")
+            h, f_mod, m = (_num(e.get(k), f"{where}.{k}") for k in ("h", "f_mod_Hz", "depth"))
+            for k, v, ok in (("h", h, h > 0), ("f_mod_Hz", f_mod, f_mod > 0), ("depth", m, m >= 0)):
+                if not ok:
+                    raise ModelError(f"{where}.{k}: must be {'>= 0' if k == 'depth' else '> 0'}, got {v!r}")
+            out["sidebands"].append((d, h, f_mod, m))
+    return out
+
+
 def load_model(path):
     """(params dict, lines) from a model file of schema rwadist.model v1.
 
@@ -215,11 +264,14 @@ def to_spacecraft(out, R, r):
 
 #: cfg layout of ``rwadist_kernel_step`` (fmu/native/rwadist_fmu_native.c): parameter order,
 #: offsets of the fixed poles, mounting, and the per-component block (σh, direction, coef·C,
-#: −i·coef·C·[imbalance], coef·A_ref, Ω_ref, p of an amplitude law).  The C file repeats it;
-#: tests/test_fmu.py checks both agree by running.
+#: −i·coef·C·[imbalance], coef·A_ref, Ω_ref, p of an amplitude law, ω_off (rad/s, sidebands),
+#: number of resonances, cfg index of its resonance entries), then the resonance table
+#: (KERNEL_RES doubles per entry: 2π f_r, 2·g·ζ, 2·ζ).  State: [0] φ, [1] time since t0, then the
+#: complex states.  The C file repeats it; tests/test_fmu.py checks both agree by running.
 KERNEL_PARAMS = ("mass", "c_r", "k_r", "I_rr", "c_rock", "k_rock", "I_zz", "c_z", "k_z", "height")
 KERNEL_COMP = 32
-KERNEL_STRIDE = 10
+KERNEL_STRIDE = 13
+KERNEL_RES = 3
 
 
 def load_kernel(path):
@@ -265,12 +317,16 @@ class WheelRuntime:
     kernel : ``rwadist_kernel_step`` from :func:`load_kernel`, or None to step in numpy.
     laws : diagnosed amplitude laws from :func:`laws_from_doc`; a line (same direction,
     |Δh| < LAW_H_TOL) with a law has amplitude A_ref·(|Ω|/Ω_ref)^p instead of C·Ω² (an imbalance
-    line keeps its tangential term −i·C·Ω̇).
+    line keeps its tangential term −i·C·Ω̇).  resonances, sidebands : diagnosed wheel-mode
+    resonances and sidebands from :func:`effects_from_doc` (see there).  Sideband lines are appended
+    after the model's lines (per sideband effect, per matching carrier: +f_mod then −f_mod; the
+    order of ``rwadist.extended.apply_line_effects``) and the seed's phases are drawn over that
+    whole list; they follow their carrier's imbalance/harmonics switch.
     """
 
     def __init__(self, params, lines, *, seed=None, imbalance=True, harmonics=True, modes=True,
                  start_steady=False, max_accel=500.0, max_step=0.01, dcm=None, position=None, kernel=None,
-                 laws=None):
+                 laws=None, resonances=None, sidebands=None):
         self.p = dict(params)
         if not (math.isfinite(max_accel) and max_accel > 0):
             raise ModelError(f"max_acceleration must be finite and > 0, got {max_accel!r}")
@@ -278,25 +334,51 @@ class WheelRuntime:
             raise ModelError(f"max_step_size must be finite and > 0, got {max_step!r}")
         self.max_accel, self.max_step = float(max_accel), float(max_step)
         self.modes, self.start_steady = bool(modes), bool(start_steady)
-        n = len(lines)
-        ph = (np.random.default_rng(int(seed)).uniform(0, 2 * np.pi, n) if seed is not None else np.zeros(n))
-        sh, coef, C, imb, dirs, law = [], [], [], [], [], []
         laws = dict(laws or {})
+        resonances = list(resonances or [])
+        sidebands = list(sidebands or [])
         self.laws_used = set()
-        for (d, h, c, sense, is_imb), q in zip(lines, ph):
-            if (is_imb and not imbalance) or (not is_imb and not harmonics):
-                continue
+        self.sidebands_used = set()
+        # every line: (direction, h, C, sense, imbalance, law (A_ref, Ω_ref, p) or None, f_offset Hz)
+        full = []
+        for d, h, c, sense, is_imb in lines:
             key = next((k for k in laws if k[0] == d and abs(k[1] - h) < LAW_H_TOL), None)
             if key is not None:
                 self.laws_used.add(key)
+            full.append((d, h, c, sense, is_imb, None if key is None else tuple(laws[key]), 0.0))
+        carriers = list(full)
+        for j, (sd, shh, f_mod, m) in enumerate(sidebands):
+            for d, h, c, sense, is_imb, lw, _ in carriers:
+                if d == sd and abs(h - shh) < LAW_H_TOL:
+                    self.sidebands_used.add(j)
+                    lw2 = None if lw is None else (lw[0] * 0.5 * m, lw[1], lw[2])
+                    for off in (f_mod, -f_mod):
+                        full.append((d, h, c * 0.5 * m, sense, is_imb, lw2, off))
+        n = len(full)
+        self.n_lines = n
+        ph = (np.random.default_rng(int(seed)).uniform(0, 2 * np.pi, n) if seed is not None else np.zeros(n))
+        sh, woff, coef, C, imb, dirs, law, res = [], [], [], [], [], [], [], []
+        for (d, h, c, sense, is_imb, lw, off), q in zip(full, ph):
+            if (is_imb and not imbalance) or (not is_imb and not harmonics):
+                continue
+            rs = [(2.0 * math.pi * f_r, 2.0 * g * z, 2.0 * z) for dd, f_r, z, g in resonances if d in dd]
             for sigma, cf in components(d, sense, float(q)):
                 sh.append(sigma * h)
+                woff.append(sigma * 2.0 * math.pi * off)
                 coef.append(cf)
                 C.append(c)
                 imb.append(is_imb)
                 dirs.append(DIRECTIONS.index(d))
-                law.append((1.0, *laws[key]) if key is not None else (0.0, 0.0, 1.0, 0.0))
+                law.append((1.0, *lw) if lw is not None else (0.0, 0.0, 1.0, 0.0))
+                res.append(rs)
         self.sh = np.array(sh, dtype=float)
+        self.woff = np.array(woff, dtype=float)
+        self.has_off = bool(np.any(self.woff != 0.0))
+        # resonance table: one row per (component, resonance): component index, 2π f_r, 2gζ, 2ζ
+        self.res_comp = np.array([i for i, rs in enumerate(res) for _ in rs], dtype=int)
+        tab = np.array([r for rs in res for r in rs], dtype=float).reshape(-1, 3)
+        self.res_w, self.res_2gz, self.res_2z = tab[:, 0], tab[:, 1], tab[:, 2]
+        self.res_sh, self.res_off = self.sh[self.res_comp], self.woff[self.res_comp]
         self.coef = np.array(coef, dtype=complex)
         self.C = np.array(C, dtype=float)
         self.imb = np.array(imb, dtype=float)
@@ -334,14 +416,14 @@ class WheelRuntime:
         self._kernel = kernel
         if kernel is not None:
             n = self.sh.size
-            cfg = np.zeros(KERNEL_COMP + KERNEL_STRIDE * n)
+            cfg = np.zeros(KERNEL_COMP + KERNEL_STRIDE * n + KERNEL_RES * self.res_comp.size)
             cfg[0], cfg[1] = n, float(self.modes)
             cfg[2:12] = [p[k] for k in KERNEL_PARAMS]
             cfg[12:16] = np.array(self.lam_r, dtype=complex).view(float)
             cfg[16:20] = np.array(self.lam_z, dtype=complex).view(float)
             cfg[20:29] = np.ravel(self.R)
             cfg[29:32] = self.pos
-            comp = cfg[KERNEL_COMP:].reshape(n, KERNEL_STRIDE)
+            comp = cfg[KERNEL_COMP:KERNEL_COMP + KERNEL_STRIDE * n].reshape(n, KERNEL_STRIDE)
             comp[:, 0], comp[:, 1] = self.sh, self.dirs
             comp[:, 2:4] = self.cC.view(float).reshape(n, 2)
             comp[:, 4:6] = self.cCi.view(float).reshape(n, 2)
@@ -349,6 +431,14 @@ class WheelRuntime:
             comp[self.law_idx, 6:8] = self.law_scale.view(float).reshape(-1, 2)
             comp[self.law_idx, 8] = self.law_ref
             comp[self.law_idx, 9] = self.law_p
+            comp[:, 10] = self.woff
+            base = KERNEL_COMP + KERNEL_STRIDE * n
+            table = cfg[base:].reshape(-1, KERNEL_RES)
+            table[:, 0], table[:, 1], table[:, 2] = self.res_w, self.res_2gz, self.res_2z
+            for i in range(n):
+                rows = np.nonzero(self.res_comp == i)[0]
+                comp[i, 11] = rows.size
+                comp[i, 12] = base + KERNEL_RES * rows[0] if rows.size else 0.0
             self._cfg = cfg
             self._st = np.zeros(2 + 2 * n + 12)
             self._kout = np.zeros(12)
@@ -365,12 +455,14 @@ class WheelRuntime:
         n = self.sh.size
         st = self._st
         st[0] = self.phi
+        st[1] = self.t
         st[2:].view(complex)[:] = np.concatenate([self.S, self.eta_r, self.eta_z, self.x_rock])[: n + 6]
 
     # ------------------------------------------------------------ state
     def reset(self):
         """Back to t0: rotor angle 0, all modal states zero, no previous step."""
         self.phi = 0.0
+        self.t = 0.0
         self.S = np.ones(self.sh.size, dtype=complex)
         self.eta_r = [0j, 0j]
         self.eta_z = [0j, 0j]
@@ -387,11 +479,24 @@ class WheelRuntime:
         a = self.cC * (w * w) + self.cCi * wdot
         if self.law_idx.size:
             a[self.law_idx] += self.law_scale * (abs(w) / self.law_ref) ** self.law_p
+        if self.res_comp.size:
+            # quasi-static wheel-mode resonances at each component's whirl rate ν = σhΩ + ω_off
+            r = (self.res_sh * w + self.res_off) / self.res_w
+            base = 1.0 - r * r
+            G = np.ones(a.size, dtype=complex)
+            np.multiply.at(G, self.res_comp, (base + 1j * self.res_2gz * r) / (base + 1j * self.res_2z * r))
+            a = a * G
         return a
+
+    def _phase(self, phi, t):
+        """e^{i(σhφ + ω_off t)} per component."""
+        if self.has_off:
+            return np.exp(1j * (self.sh * phi + self.woff * t))
+        return np.exp(self.ish * phi)
 
     def _loads(self, w, wdot, phi):
         """Internal complex loads per direction (4,) at speed w, acceleration wdot, angle phi."""
-        return self.sel @ (self._amp(w, wdot) * np.exp(self.ish * phi))
+        return self.sel @ (self._amp(w, wdot) * self._phase(phi, self.t))
 
     def _steady_init(self, w0, wdot0):
         p = self.p
@@ -401,7 +506,7 @@ class WheelRuntime:
         st = []
         for j, (m, c, k, g) in enumerate(subs):
             keep = self.dirs == j
-            nu = self.sh[keep] * w0
+            nu = self.sh[keep] * w0 + self.woff[keep]
             G = 1.0 / (k - m * nu**2 + g * w0 * nu + 1j * c * nu)
             st.append((complex(np.sum(G * amp0[keep])), complex(np.sum(1j * nu * G * amp0[keep]))))
         (q, qd), (qr, qdr), (qz, qdz) = st
@@ -493,8 +598,9 @@ class WheelRuntime:
         p = self.p
         dphi = 0.5 * (omega + w1) * h
         phi1 = self.phi + dphi
+        t_end = self.t + h
         S0 = self.S
-        S1 = np.exp(self.ish * phi1)
+        S1 = self._phase(phi1, t_end)
         a0 = self._amp(omega, wd0)
         a1 = self._amp(w1, alpha)
         loads1 = self.sel @ (a1 * S1)
@@ -506,7 +612,7 @@ class WheelRuntime:
             lamh, X = lamh0.copy(), X0.copy()
             lamh[self.rock] = (lk1 * h, lk2 * h)
             X[self.rock] = (e1, e2)
-            z = (self.ish * dphi)[:, None] - lamh
+            z = ((1j * (self.sh * dphi + self.woff * h)) if self.has_off else (self.ish * dphi))[:, None] - lamh
             XS0 = X * S0[:, None]
             S1c = S1[:, None]
             # |z| >= |Re z| = |Re λh|: the series is needed only if some |Re λh| < SMALL_Z
@@ -543,6 +649,7 @@ class WheelRuntime:
             w2r = W[1, 1] / (-p["I_rr"] * dl)
             self.x_rock = [P00 * q + P01 * qd + w1r + w2r, P10 * q + P11 * qd + lk1 * w1r + lk2 * w2r]
         self.phi = phi1
+        self.t = t_end
         self.S = S1
         self._prev_start = omega
         self.prev_alpha = alpha

@@ -24,6 +24,14 @@ from pythonfmu import (Boolean, DefaultExperiment, Fmi2Causality, Fmi2Initial, F
                        Real, String)
 from pythonfmu.enums import Fmi2Status
 
+# Work around a pythonfmu bug (0.7.0; its sources to mid-2025 have it): on every fmi2Instantiate
+# its native layer (findClass) re-executes this module's source in the module's __dict__ and then
+# calls Py_DECREF on that dict, a reference it only borrowed (PyModule_GetDict).  Each instance
+# leaves the dict's count one short; after a few dozen instances in one process the garbage
+# collector trips over live objects and the host segfaults.  This line runs once per execution
+# of the module and gives that count back (an import is one execution more: a harmless +1).
+ctypes.pythonapi.Py_IncRef(ctypes.py_object(globals()))
+
 RUNTIME_FILE = "rwadist_fmu_runtime.py"
 MODEL_FILE = "wheel_model.json"
 #: unit -> SI base-unit exponents (kg, m, s, rad) for the UnitDefinitions of modelDescription.xml
@@ -191,26 +199,76 @@ class RwadistWheelSlave(Fmi2Slave):
         self._y = y
         self._rv[self._out0:self._out0 + len(y)] = y
 
+    # No exception may leave a method pythonfmu calls: its native layer then releases the slave's
+    # Python objects once (handle_py_exception) and again when the host frees the instance -- a
+    # double free that crashes the host later.  A wrong value reference or type is logged, flagged
+    # (fmi2Error through the native layer) and answered with placeholder values.
+    def _refuse(self, what, exc, n, fill):
+        self._log_error(f"{what}: {exc}")
+        return [fill] * n
+
     def get_real(self, vrs):
         rv = self._rv
         try:
             out = [rv[vr] for vr in vrs]
-        except IndexError:
+        except (IndexError, TypeError):
             out = [None]
         if None in out:
-            return super().get_real(vrs)    # names the unknown or non-Real variable
+            try:
+                return super().get_real(vrs)    # names the unknown or non-Real variable
+            except Exception as exc:
+                return self._refuse("fmi2GetReal", exc, len(vrs), math.nan)
         return out
 
     def set_real(self, vrs, values):
         rv = self._rv
         for vr, v in zip(vrs, values):
-            if vr == self._vr_speed:
-                self.wheel_speed = v
-            elif vr == self._vr_accel:
-                self.wheel_acceleration = v
-            else:
-                super().set_real([vr], [v])
-            rv[vr] = float(v)
+            try:
+                if vr == self._vr_speed:
+                    self.wheel_speed = v
+                elif vr == self._vr_accel:
+                    self.wheel_acceleration = v
+                else:
+                    super().set_real([vr], [v])
+                rv[vr] = float(v)
+            except Exception as exc:
+                self._log_error(f"fmi2SetReal of value reference {vr}: {exc}")
+
+    def get_integer(self, vrs):
+        try:
+            return super().get_integer(vrs)
+        except Exception as exc:
+            return self._refuse("fmi2GetInteger", exc, len(vrs), 0)
+
+    def get_boolean(self, vrs):
+        try:
+            return super().get_boolean(vrs)
+        except Exception as exc:
+            return self._refuse("fmi2GetBoolean", exc, len(vrs), False)
+
+    def get_string(self, vrs):
+        try:
+            return super().get_string(vrs)
+        except Exception as exc:
+            return self._refuse("fmi2GetString", exc, len(vrs), "")
+
+    def set_integer(self, vrs, values):
+        try:
+            super().set_integer(vrs, values)
+        except Exception as exc:
+            self._log_error(f"fmi2SetInteger: {exc}")
+
+    def set_boolean(self, vrs, values):
+        try:
+            super().set_boolean(vrs, values)
+        except Exception as exc:
+            self._log_error(f"fmi2SetBoolean: {exc}")
+
+    def set_string(self, vrs, values):
+        try:
+            super().set_string(vrs, values)
+        except Exception as exc:
+            self._log_error(f"fmi2SetString: {exc}")
 
     # ------------------------------------------------------------ modelDescription
     def to_xml(self, model_options=dict()):
@@ -223,11 +281,15 @@ class RwadistWheelSlave(Fmi2Slave):
         return root
 
     # ------------------------------------------------------------ FMI
-    def _fail(self, msg):
-        self.error = msg
+    def _log_error(self, msg):
+        """Log ``msg`` at fmi2Error and flag it to the native layer (the FMI call returns fmi2Error)."""
         self.log(f"rwadist wheel: {msg}", Fmi2Status.error)
         if self._flag_error is not None:
             self._flag_error()
+
+    def _fail(self, msg):
+        self.error = msg
+        self._log_error(msg)
         return False
 
     def exit_initialization_mode(self):
@@ -236,7 +298,8 @@ class RwadistWheelSlave(Fmi2Slave):
             path = self.model_file or os.path.join(self.resources, MODEL_FILE)
             doc = rt.read_document(path)
             params, lines = rt.model_from_doc(doc, path)
-            laws = rt.laws_from_doc(doc, path)
+            effects = rt.effects_from_doc(doc, path)
+            laws = effects["laws"]
             seed = int(self.seed)
             if seed < -1:
                 raise rt.ModelError(f"seed must be >= 0, or -1 for the model file's phases; got {seed}")
@@ -244,10 +307,14 @@ class RwadistWheelSlave(Fmi2Slave):
                 params, lines, seed=None if seed == -1 else seed, imbalance=bool(self.imbalance),
                 harmonics=bool(self.harmonics), modes=bool(self.modes), start_steady=bool(self.start_steady),
                 max_accel=float(self.max_acceleration), max_step=float(self.max_step_size),
-                dcm=self.dcm, position=self.pos, kernel=self._kernel, laws=laws)
+                dcm=self.dcm, position=self.pos, kernel=self._kernel, **effects)
             for d, h in sorted(set(laws) - self.model.laws_used):
                 self.log(f"rwadist wheel: amplitude_law of {d} h={h:g} matches no line of the model; ignored",
                          Fmi2Status.warning)
+            for j, (d, h, f_mod, _) in enumerate(effects["sidebands"]):
+                if j not in self.model.sidebands_used:
+                    self.log(f"rwadist wheel: sidebands of {d} h={h:g} (f_mod {f_mod:g} Hz) match no line of the "
+                             "model; ignored", Fmi2Status.warning)
             self.error = None
             w = float(self.wheel_speed)
             if math.isfinite(w):

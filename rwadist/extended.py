@@ -252,6 +252,17 @@ class Line:
     law : (A_ref, Ω_ref, p) of a diagnosed ``amplitude_law`` (N or N·m, rad/s, -): the line's
         amplitude is A_ref·(|Ω|/Ω_ref)^p instead of C·Ω² (an imbalance keeps its −iC·Ω̇ term);
         None: C·Ω².
+    f_offset : fixed frequency offset, Hz (signed; 0 for a harmonic).  Each component's phase is
+        σ·(h·φ + 2π·f_offset·(t − t0)), its whirl rate ν = σ·(hΩ + 2π·f_offset) rad/s and the line's
+        frequency |hΩ/2π + f_offset| Hz.  A diagnosed ``sidebands`` effect (depth m, f_mod) is two
+        such copies of its carrier, f_offset = ±f_mod with C (and A_ref) times m/2:
+        a(1 + m·cos 2πf_mod t) = a + (m/2)a·e^{+i2πf_mod t} + (m/2)a·e^{−i2πf_mod t} per component.
+    resonances : ((f_r Hz, ζ, peak_gain), ...) of diagnosed ``fixed_resonance`` effects of role
+        ``wheel_mode``: each component's load is multiplied by H(ν/2π) (:func:`resonance_gain`,
+        the formula of :func:`rwadist.diagnose.resonance` with a signed frequency, i.e. a real
+        filter acting on x and y alike) at the component's instantaneous whirl rate ν.
+        QUASI-STATIC: exact at constant speed; in a transient the gain follows the speed at once
+        (no ringing of that resonance, no lag).
     """
 
     direction: str
@@ -262,6 +273,8 @@ class Line:
     angle: float = 0.0
     imbalance: bool = False
     law: tuple | None = None
+    f_offset: float = 0.0
+    resonances: tuple = ()
 
     def __post_init__(self):
         if self.direction not in DIRECTIONS:
@@ -279,6 +292,13 @@ class Line:
             if not (math.isfinite(a) and a >= 0 and math.isfinite(w) and w > 0 and math.isfinite(x) and x >= 0):
                 raise ValueError(f"Line.law (A_ref, omega_ref, exponent) needs A_ref >= 0, omega_ref > 0, "
                                  f"exponent >= 0, got {self.law!r}")
+        if not math.isfinite(self.f_offset):
+            raise ValueError(f"Line.f_offset must be finite, got {self.f_offset!r}")
+        object.__setattr__(self, "resonances", tuple(tuple(float(v) for v in r) for r in self.resonances))
+        for r in self.resonances:
+            if len(r) != 3 or not all(math.isfinite(v) and v > 0 for v in r):
+                raise ValueError(f"Line.resonances entries (f_r Hz, zeta, peak_gain) must be finite and > 0, "
+                                 f"got {r!r}")
 
     def amplitude(self, omega):
         """Load amplitude at wheel speeds ``omega`` (rad/s): C·Ω², or A_ref·(|Ω|/Ω_ref)^p with a law."""
@@ -288,14 +308,42 @@ class Line:
         a, w_ref, x = self.law
         return a * (np.abs(w) / w_ref) ** x
 
+    def nu(self, sigma, omega):
+        """Whirl rate (rad/s, signed) of component ``sigma`` at speeds ``omega``: σ(hΩ + 2π f_offset)."""
+        return sigma * (self.h * np.asarray(omega, dtype=float) + 2.0 * np.pi * self.f_offset)
+
+    def frequency(self, omega):
+        """Line frequency, Hz, at speeds ``omega`` (rad/s): |hΩ/2π + f_offset| (h|Ω|/2π for a harmonic)."""
+        w = np.asarray(omega, dtype=float)
+        if self.f_offset == 0.0:
+            return self.h * np.abs(w) / (2 * np.pi)
+        return np.abs(self.h * w / (2 * np.pi) + self.f_offset)
+
+    def gain(self, nu):
+        """Product of the line's wheel-mode resonance gains at whirl rates ``nu`` (rad/s, signed)."""
+        return resonance_gain(nu, self.resonances)
+
     def components(self):
-        """[(sigma, coefficient)]: load = C·coefficient·amp(t)·e^{i·sigma·h·φ}; sigma = ±1."""
+        """[(sigma, coefficient)]: load = C·coefficient·amp(t)·e^{i·sigma·(h·φ + 2π f_offset t)}; sigma = ±1."""
         if self.direction in ("axial_force", "axial_torque") or self.sense == "co":
             return [(1, np.exp(1j * self.phase))]
         if self.sense == "counter":
             return [(-1, np.exp(-1j * self.phase))]
         return [(1, 0.5 * np.exp(1j * (self.angle + self.phase))),
                 (-1, 0.5 * np.exp(1j * (self.angle - self.phase)))]
+
+
+def resonance_gain(nu, resonances):
+    """Π over ``resonances`` = ((f_r Hz, ζ, g), ...) of H = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r),
+    r = ν/(2π f_r) SIGNED (``nu`` rad/s): :func:`rwadist.diagnose.resonance` for ν >= 0 and its complex
+    conjugate for ν < 0, so a load Re/Im pair sees the same real filter.  |H(f_r)| = g, H(0) = 1."""
+    nu = np.asarray(nu, dtype=float)
+    out = np.ones(nu.shape, dtype=complex)
+    for f_r, zeta, g in resonances:
+        r = nu / (2.0 * np.pi * f_r)
+        base = 1.0 - r * r
+        out = out * ((base + 1j * (2.0 * g * zeta) * r) / (base + 1j * (2.0 * zeta) * r))
+    return out
 
 
 def imbalance_lines(p: ExtendedParams, phase_s: float = 0.0, phase_d: float = 0.0) -> list:
@@ -319,13 +367,101 @@ def is_imbalance(direction: str, h: float, sense) -> bool:
 LAW_H_TOL = 1e-3
 
 
+def _effect_number(e, i, key, ok, need):
+    """effects[i][key] as a float; ValueError naming ``effects[i].key`` unless finite and ``ok``."""
+    v = e.get(key)
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not ok(v):
+        raise ValueError(f"effects[{i}].{key}: must be {need}, got {v!r}")
+    return float(v)
+
+
+def _effect_direction(e, i, key="direction"):
+    d = e.get(key)
+    if d not in DIRECTIONS:
+        raise ValueError(f"effects[{i}].{key}: {d!r} is not one of {', '.join(DIRECTIONS)}")
+    return d
+
+
+def line_effects(effects) -> dict:
+    """The time-domain forcing effects of a model file's ``effects`` list (``rwadist diagnose``),
+    validated: {'laws': [(direction, h, (A_ref, Ω_ref, p))], 'resonances': [(directions, (f_r, ζ, g))],
+    'sidebands': [(direction, h, f_mod Hz, depth)]} in file order.  A ``fixed_resonance`` of role
+    ``test_stand`` (a fixture resonance) and a ``cross_coupling`` (load-cell offset) are measurement
+    artefacts and are left out; ``missing_harmonic`` is already a harmonic; ``broadband_floor`` and
+    ``speed_ripple`` are not line forcing.  ValueError naming ``effects[i].<field>`` on a bad entry."""
+    out = {"laws": [], "resonances": [], "sidebands": []}
+    if effects is None:
+        return out
+    if not isinstance(effects, (list, tuple)):
+        raise ValueError(f"effects: must be a list, got {type(effects).__name__}")
+    pos = "a finite number > 0"
+    for i, e in enumerate(effects):
+        if not isinstance(e, dict):
+            raise ValueError(f"effects[{i}]: must be an object")
+        kind = e.get("kind")
+        if kind == "amplitude_law":
+            d = _effect_direction(e, i)
+            h = _effect_number(e, i, "h", lambda v: v > 0, pos)
+            law = (_effect_number(e, i, "amplitude_ref", lambda v: v >= 0, "a finite number >= 0"),
+                   _effect_number(e, i, "omega_ref_rad_s", lambda v: v > 0, pos),
+                   _effect_number(e, i, "exponent", lambda v: v >= 0, "a finite number >= 0"))
+            out["laws"].append((d, h, law))
+        elif kind == "fixed_resonance":
+            role = e.get("role")
+            if role not in ("wheel_mode", "test_stand"):
+                raise ValueError(f"effects[{i}].role: {role!r} is not 'wheel_mode' or 'test_stand'")
+            res = (_effect_number(e, i, "f_Hz", lambda v: v > 0, pos),
+                   _effect_number(e, i, "zeta", lambda v: v > 0, pos),
+                   _effect_number(e, i, "peak_gain", lambda v: v > 0, pos))
+            dirs = e.get("directions")
+            dirs = [dirs] if isinstance(dirs, str) else dirs
+            if not isinstance(dirs, (list, tuple)) or not dirs or any(d not in DIRECTIONS for d in dirs):
+                raise ValueError(f"effects[{i}].directions: {e.get('directions')!r} must be a non-empty list of "
+                                 f"{', '.join(DIRECTIONS)}")
+            if role == "wheel_mode":
+                out["resonances"].append((tuple(dirs), res))
+        elif kind == "sidebands":
+            d = _effect_direction(e, i)
+            out["sidebands"].append((d, _effect_number(e, i, "h", lambda v: v > 0, pos),
+                                     _effect_number(e, i, "f_mod_Hz", lambda v: v > 0, pos),
+                                     _effect_number(e, i, "depth", lambda v: v >= 0, "a finite number >= 0")))
+    return out
+
+
+def apply_line_effects(lines, effects) -> list:
+    """``lines`` with the forcing effects of :func:`line_effects` (a model file's ``effects`` list):
+
+    1. ``amplitude_law`` -> :attr:`Line.law` of the lines of its direction with |Δh| < LAW_H_TOL;
+    2. ``fixed_resonance`` (role ``wheel_mode``) -> appended to :attr:`Line.resonances` of every line of
+       its directions (quasi-static gain, see :class:`Line`);
+    3. ``sidebands`` -> for each matching line (as 1; carriers only, in line order) two copies appended
+       after all lines, f_offset = +f_mod then −f_mod, C and A_ref times depth/2, everything else (phase,
+       sense, imbalance with its tangential term, resonances) the carrier's.  The FMU runtime builds the
+       same list in the same order (its random phases are drawn over it)."""
+    eff = line_effects(effects)
+    out = list(lines)
+    for d, h, law in eff["laws"]:
+        out = [replace(ln, law=law) if ln.direction == d and abs(ln.h - h) < LAW_H_TOL else ln for ln in out]
+    for dirs, res in eff["resonances"]:
+        out = [replace(ln, resonances=ln.resonances + (res,)) if ln.direction in dirs else ln for ln in out]
+    carriers = list(out)
+    for d, h, f_mod, m in eff["sidebands"]:
+        for ln in carriers:
+            if ln.direction == d and abs(ln.h - h) < LAW_H_TOL:
+                law = None if ln.law is None else (ln.law[0] * 0.5 * m, ln.law[1], ln.law[2])
+                for off in (f_mod, -f_mod):
+                    out.append(replace(ln, C=ln.C * 0.5 * m, law=law, f_offset=ln.f_offset + off))
+    return out
+
+
 def lines_from_model(model, p: ExtendedParams, senses: dict | None = None, effects: bool = True) -> list:
     """Lines of a :class:`~rwadist.model.WheelModel`: the imbalances from ``p`` replace the
     co-rotating radial fundamentals (|h − 1| <= IMBALANCE_H_TOL; thesis Eqs. 4.48–4.49); every
     other empirical harmonic -- a counter-rotating fundamental included -- becomes a line with
     sense ``senses.get((direction, h))``, else the harmonic's own ``sense`` from the model file,
-    else 'co'.  effects : attach the model's diagnosed ``amplitude_law`` effects (``rwadist
-    diagnose``) to their lines (same direction, |Δh| < LAW_H_TOL) as :attr:`Line.law`."""
+    else 'co'.  effects : apply the model's diagnosed effects (``rwadist diagnose``) with
+    :func:`apply_line_effects`: amplitude laws, wheel-mode resonances (quasi-static gains) and
+    sidebands (extra lines at a fixed frequency offset, appended after the harmonics)."""
     senses = senses or {}
     out = imbalance_lines(p)
     for d in DIRECTIONS:
@@ -335,12 +471,7 @@ def lines_from_model(model, p: ExtendedParams, senses: dict | None = None, effec
                 continue
             out.append(Line(d, float(hm.h), float(hm.C), sense or "co"))
     if effects:
-        for e in getattr(model, "effects", None) or []:
-            if e.get("kind") != "amplitude_law":
-                continue
-            law = (float(e["amplitude_ref"]), float(e["omega_ref_rad_s"]), float(e["exponent"]))
-            out = [replace(ln, law=law) if ln.direction == e["direction"] and abs(ln.h - float(e["h"])) < LAW_H_TOL
-                   else ln for ln in out]
+        out = apply_line_effects(out, getattr(model, "effects", None))
     return out
 
 
@@ -434,7 +565,8 @@ def crossings(p: ExtendedParams, lines, speed_range) -> list:
     """Speeds where each line h·|Ω| meets each mode, by root finding (brentq) in ``speed_range``
     = (lo, hi) rad/s of |Ω|, with the closed form alongside.
 
-    ``lines``: :class:`Line` objects or bare harmonic numbers.  Returns a list of dicts with
+    ``lines``: :class:`Line` objects or bare harmonic numbers (sideband lines, with a frequency
+    offset, are skipped).  Returns a list of dicts with
     keys h, direction, sense, mode, speed_rad_s, speed_rpm, closed_form_rad_s, f_Hz, excited
     (whether the line's direction and sense can drive that mode in this model).
     """
@@ -445,6 +577,8 @@ def crossings(p: ExtendedParams, lines, speed_range) -> list:
     out = []
     for ln in lines:
         line = ln if isinstance(ln, Line) else Line("radial_force", float(ln), 0.0)
+        if line.f_offset != 0.0:      # a sideband: not a harmonic of the speed, no h·|Ω| crossing
+            continue
         for mode in MODES:
             def g(w, mode=mode):
                 return line.h * w / (2 * np.pi) - whirl_frequencies(p, w)[mode]
@@ -493,19 +627,24 @@ def steady_lines(p: ExtendedParams, lines, omega) -> tuple:
     """Steady-state lines at constant wheel speeds ``omega`` (rad/s, signed), closed form.
 
     Returns (f_hz (n_speeds, n_lines), amplitude (n_speeds, n_lines, 6) complex): each channel
-    (Fx, Fy, Fz, Tx, Ty, Tz) of each line is Re(A e^{i 2π f (t − t0)}), N or N·m.
+    (Fx, Fy, Fz, Tx, Ty, Tz) of each line is Re(A e^{i 2π f (t − t0)}), N or N·m.  f = h|Ω|/2π for a
+    harmonic, |hΩ/2π + f_offset| for a line with a frequency offset (a sideband, :class:`Line`); a
+    line's wheel-mode resonances multiply each component by H at its whirl rate.
     """
     w = _omega_array(np.atleast_1d(omega))[:, None]
+    lines = list(lines)
     n_l = len(lines)
     amp = np.zeros((w.shape[0], n_l, 6), dtype=complex)
-    h = np.array([ln.h for ln in lines], dtype=float)[None, :]
-    f_hz = h * np.abs(w) / (2 * np.pi)
+    f_hz = np.zeros((w.shape[0], n_l))
     for j, ln in enumerate(lines):
         wj = w[:, 0]
+        f_hz[:, j] = ln.frequency(wj)
         load0 = ln.amplitude(wj)
         for sigma, coef in ln.components():
-            nu = sigma * ln.h * wj
+            nu = ln.nu(sigma, wj)
             resp = transmissibility(p, ln.direction, nu, wj) * coef * load0
+            if ln.resonances:
+                resp = resp * ln.gain(nu)
             pos = nu >= 0
             a_re = np.where(pos, resp, np.conj(resp))              # Re(resp e^{iνt}) at e^{i|ν|t}
             a_im = np.where(pos, -1j * resp, 1j * np.conj(resp))   # Im(resp e^{iνt})
@@ -566,24 +705,30 @@ def _small_z_terms(z):
     return e0, e1
 
 
-def _forcing_terms(lam, lines_comp, phi, T):
+def _forcing_terms(lam, lines_comp, phi_tau, T):
     """Input integral over each sample interval for one mode with eigenvalue ``lam`` (scalar, or one
-    per interval) of the loads ``lines_comp`` = [(σh, coef, amplitude (n+1))].
+    per interval) of the loads ``lines_comp`` = [(σh, ω_off, coef, amplitude (n+1))]; ``phi_tau`` =
+    (rotor angle φ, time since t0) at the samples.
 
-    For a load coef·(a_n + Δa·τ/T)·e^{iσh(φ_n + Δφ_n τ/T)} the integral
-    ∫0^T e^{λ(T−τ)} load dτ = T·coef·(a_n·X S0 E0(z) + Δa·X S0 E1(z)), z = iσhΔφ_n − λT,
-    X = e^{λT}, S0 = e^{iσhφ_n}, E0 = (e^z − 1)/z, E1 = (e^z − E0)/z.  Since X S0 e^z = S1 = e^{iσhφ_{n+1}}:
+    For a load coef·(a_n + Δa·τ/T)·e^{i(σh(φ_n + Δφ_n τ/T) + ω_off(t_n + τ))} the integral
+    ∫0^T e^{λ(T−τ)} load dτ = T·coef·(a_n·X S0 E0(z) + Δa·X S0 E1(z)), z = i(σhΔφ_n + ω_off T) − λT,
+    X = e^{λT}, S0 = e^{i(σhφ_n + ω_off t_n)}, E0 = (e^z − 1)/z, E1 = (e^z − E0)/z.  Since X S0 e^z = S1:
     X S0 E0 = (S1 − X S0)/z and X S0 E1 = (S1 − X S0 E0)/z; a series replaces them where |z| < 1e-3.
     """
+    phi, tau = phi_tau
     n = phi.size - 1
     lams = lam if isinstance(lam, tuple) else (lam,)
     accs = [np.zeros(n, dtype=complex) for _ in lams]
     Xs = [np.exp(lm * T) for lm in lams]
     dphi = np.diff(phi)
-    for sh, coef, a in lines_comp:
-        S = np.exp(1j * sh * phi)
+    for sh, woff, coef, a in lines_comp:
+        if woff == 0.0:
+            S = np.exp(1j * sh * phi)
+            iw = 1j * sh * dphi
+        else:
+            S = np.exp(1j * (sh * phi + woff * tau))
+            iw = 1j * (sh * dphi + woff * T)
         S0, S1 = S[:-1], S[1:]
-        iw = 1j * sh * dphi
         a0 = a[:-1]
         da = a[1:] - a0
         for lm, X, acc in zip(lams, Xs, accs):
@@ -604,18 +749,19 @@ def _forcing_terms(lam, lines_comp, phi, T):
     return accs if isinstance(lam, tuple) else accs[0]
 
 
-def _modal_lti(m, c, k, comps, phi, T, x0):
+def _modal_lti(m, c, k, comps, phi_tau, T, x0):
     """Constant-coefficient subsystem m q̈ + c q̇ + k q = load, exact per interval; lfilter on modes.
 
     Returns (q, qdot) at every sample (n+1)."""
     l1, l2 = _quad_roots(m, c, k)
     l1, l2 = complex(l1), complex(l2)
+    phi = phi_tau[0]
     q = np.zeros(phi.size, dtype=complex)
     qd = np.zeros(phi.size, dtype=complex)
     # modal coordinates: q = η1 + η2, q̇ = λ1 η1 + λ2 η2; η̇_j = λ_j η_j + load/(m(λ_j − λ_k))
     q0, qd0 = x0
     eta0 = ((qd0 - l2 * q0) / (l1 - l2), (l1 * q0 - qd0) / (l1 - l2))
-    ws = _forcing_terms((l1, l2), comps, phi, T)
+    ws = _forcing_terms((l1, l2), comps, phi_tau, T)
     for lam, other, e0, w in ((l1, l2, eta0[0], ws[0]), (l2, l1, eta0[1], ws[1])):
         w = w / (m * (lam - other))
         pole = np.exp(lam * T)
@@ -660,7 +806,7 @@ def _affine_scan(P, g, x0, block=256):
     return x[: n + 1]
 
 
-def _rocking_ltv(p, comps, phi, omega_mid, T, x0):
+def _rocking_ltv(p, comps, phi_tau, omega_mid, T, x0):
     """Rocking with speed-dependent gyroscopic term: exact transition per interval at the
     interval's mean speed, exact exponential-times-linear forcing, affine scan."""
     l1, l2 = _quad_roots(p.I_rr, p.c_rock - 1j * p.I_zz * omega_mid, p.k_rock)
@@ -668,13 +814,13 @@ def _rocking_ltv(p, comps, phi, omega_mid, T, x0):
     dl = l1 - l2
     # A = [[0, 1], [−k/I, λ1+λ2]];  P_j = (A − λ_k I)/(λ_j − λ_k); Φ = e1 P_1 + e2 P_2
     k_over_i = p.k_rock / p.I_rr
-    P = np.empty((phi.size - 1, 2, 2), dtype=complex)
+    P = np.empty((phi_tau[0].size - 1, 2, 2), dtype=complex)
     P[:, 0, 0] = (e1 * (-l2) - e2 * (-l1)) / dl
     P[:, 0, 1] = (e1 - e2) / dl
     P[:, 1, 0] = (-k_over_i) * (e1 - e2) / dl
     P[:, 1, 1] = (e1 * l1 - e2 * l2) / dl
     # P_j B = [1, λ_j]/(I (λ_j − λ_k))
-    w1, w2 = _forcing_terms((l1, l2), comps, phi, T)
+    w1, w2 = _forcing_terms((l1, l2), comps, phi_tau, T)
     w1 = w1 / (p.I_rr * dl)
     w2 = w2 / (-p.I_rr * dl)
     g = np.stack([w1 + w2, l1 * w1 + l2 * w2], axis=1)
@@ -687,8 +833,8 @@ def _steady_state_init(p, direction, comps_c, omega0):
     sub = _subsystem(p, direction)
     m, c, k, gyro = sub
     q = qd = 0j
-    for sh, coef, amp0 in comps_c:
-        nu = sh * omega0
+    for sh, woff, coef, amp0 in comps_c:
+        nu = sh * omega0 + woff
         G = 1.0 / (k - m * nu**2 + gyro * omega0 * nu + 1j * c * nu)
         q += G * coef * amp0
         qd += 1j * nu * G * coef * amp0
@@ -701,13 +847,17 @@ def simulate_time(p: ExtendedParams, lines, t, omega, *, seed=None, phases=None,
 
     t : uniform sample times, s.  omega : wheel speed at each sample, rad/s (signed; may pass
     through zero).  Rotor angle φ = cumulative trapezoid of Ω from t[0] (φ(t0) = 0); line phases
-    h·φ; imbalance lines add the tangential −iΩ̇ term (Ω̇ by central differences).
-    seed : draw every line's phase uniformly (overrides ``phases``); phases : one per line, rad
+    h·φ (+ 2π f_offset (t − t0) for a sideband line); imbalance lines add the tangential −iΩ̇ term
+    (Ω̇ by central differences).  A line's wheel-mode resonances multiply each component's amplitude
+    by H at the sample's whirl rate (quasi-static: exact at constant speed, no ringing in transients).
+    seed : draw every line's phase uniformly (overrides ``phases``; sideband lines get their own
+    draws: the same spectrum as the amplitude modulation, whose exact phase relation to the
+    carrier holds with the lines' own phases); phases : one per line, rad
     (default: each Line's own phase).  start : 'rest' (all states zero) or 'steady' (the closed-form
     steady state at Ω(t0)).  max_accel : |dΩ/dt| above which a step counts as a jump, rad/s².
 
     Method: the modes are linear; over each sample interval the load of a line is exactly
-    (amplitude linear in time) × e^{iσhΔφ τ/T}, and its integral against the mode's exponentials is
+    (amplitude linear in time) × e^{i(σhΔφ + ω_off T) τ/T}, and its integral against the mode's exponentials is
     taken in closed form; translation and axial modes (fixed coefficients) run as two complex
     first-order recursions each through scipy.signal.lfilter; the rocking mode's transition matrix
     is the exact exponential at the interval's mean speed and the time-varying recursion runs as a
@@ -730,34 +880,38 @@ def simulate_time(p: ExtendedParams, lines, t, omega, *, seed=None, phases=None,
     lines = [replace(ln, phase=float(q)) for ln, q in zip(lines, ph)]
 
     phi = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * T)])
+    tau = t - t[0]
     wdot = np.gradient(w, T)
     out = np.zeros((t.size, 6))
     groups = {d: [] for d in DIRECTIONS}
     for ln in lines:
         amp = ln.amplitude(w) - 1j * ln.C * wdot if ln.imbalance else ln.amplitude(w)
         for sigma, coef in ln.components():
-            groups[ln.direction].append((sigma * ln.h, coef, amp))
+            # quasi-static wheel-mode resonance: the gain at each sample's whirl rate
+            a = amp * ln.gain(ln.nu(sigma, w)) if ln.resonances else amp
+            groups[ln.direction].append((sigma * ln.h, sigma * 2.0 * np.pi * ln.f_offset, coef, a))
 
     # Tz: axial torque lines pass straight through
-    for sh, coef, amp in groups["axial_torque"]:
-        out[:, 5] += np.real(coef * amp * np.exp(1j * sh * phi))
+    for sh, woff, coef, amp in groups["axial_torque"]:
+        out[:, 5] += np.real(coef * amp * np.exp(1j * (sh * phi + woff * tau)))
 
     def init(direction):
         if start == "rest" or not groups[direction]:
             return (0j, 0j)
-        return _steady_state_init(p, direction, [(sh, coef, a[0]) for sh, coef, a in groups[direction]], w[0])
+        return _steady_state_init(p, direction, [(sh, wo, coef, a[0]) for sh, wo, coef, a in groups[direction]],
+                                  w[0])
 
     F = np.zeros(t.size, dtype=complex)
     if groups["radial_force"]:
-        q, qd = _modal_lti(p.mass, p.c_r, p.k_r, groups["radial_force"], phi, T, init("radial_force"))
+        q, qd = _modal_lti(p.mass, p.c_r, p.k_r, groups["radial_force"], (phi, tau), T, init("radial_force"))
         F = p.k_r * q + p.c_r * qd
     if groups["axial_force"]:
-        q, qd = _modal_lti(p.mass, p.c_z, p.k_z, groups["axial_force"], phi, T, init("axial_force"))
+        q, qd = _modal_lti(p.mass, p.c_z, p.k_z, groups["axial_force"], (phi, tau), T, init("axial_force"))
         out[:, 2] = np.real(p.k_z * q + p.c_z * qd)
     Tc = np.zeros(t.size, dtype=complex)
     if groups["radial_torque"]:
         w_mid = 0.5 * (w[1:] + w[:-1])
-        q, qd = _rocking_ltv(p, groups["radial_torque"], phi, w_mid, T, init("radial_torque"))
+        q, qd = _rocking_ltv(p, groups["radial_torque"], (phi, tau), w_mid, T, init("radial_torque"))
         Tc = p.k_rock * q + p.c_rock * qd
     Tint = Tc + 1j * p.height * F
     out[:, 0], out[:, 1] = F.real, F.imag

@@ -353,3 +353,63 @@ def test_diagnosed_amplitude_law_reaches_the_coupled_prediction():
         _, B = wc.frf(f[0])
         _, ref = ext.steady_lines(spec.params, spec.lines, om)
         assert np.max(np.abs(np.einsum("lij,lj->li", B, W[0]) - ref[0])) < 1e-10 * np.max(np.abs(ref[0]))
+
+
+#: a wheel-mode resonance on the radial force, sidebands on the imbalance and on a rocking line, and a
+#: test-stand resonance (a fixture artefact: must not reach the prediction)
+EFFECTS = [{"kind": "fixed_resonance", "role": "wheel_mode", "f_Hz": 70.0, "zeta": 0.05, "peak_gain": 3.0,
+            "directions": ["radial_force"]},
+           {"kind": "fixed_resonance", "role": "test_stand", "f_Hz": 40.0, "zeta": 0.02, "peak_gain": 8.0,
+            "directions": ["radial_force", "radial_torque", "axial_force", "axial_torque"]},
+           {"kind": "sidebands", "direction": "radial_force", "h": 1.0, "f_mod_Hz": 6.0, "depth": 0.3},
+           {"kind": "sidebands", "direction": "radial_torque", "h": 4.42, "f_mod_Hz": 9.0, "depth": 0.25}]
+
+
+def test_diagnosed_resonance_and_sidebands_reach_the_coupled_prediction():
+    """wheel_spec_from_model applies wheel-mode resonances and sidebands: each radial-force line's free
+    excitation is the effect-free one times H(f) (rwadist.diagnose.resonance), each sideband is its
+    carrier times m/2 (and H at its own frequency) at |hΩ/2π ± f_mod|; the hard-mounted path still
+    equals extended.steady_lines; and the coupled prediction (line_responses on a flexible spacecraft)
+    equals the one where every sideband is replaced, at that speed, by a plain harmonic of the same
+    whirl rate h' = h ± 2πf_mod/Ω -- an independent route to the frequency the plant is evaluated at."""
+    from coupling.performance import wheel_spec_from_model
+    from rwadist.diagnose import resonance
+    model = preset("ithaco-e").to_model()
+    model.effects = [dict(e) for e in EFFECTS]
+    spec = wheel_spec_from_model(model)
+    plain = ext.lines_from_model(model, spec.params, effects=False)
+    n0 = len(plain)
+    assert len(spec.lines) == n0 + 4
+    plant = cp.example_spacecraft()
+    for rpm in (1900.0, -2600.0):
+        om = rpm * RPM_TO_RAD_S
+        f, W = cp.free_lines(spec.params, spec.lines, om)
+        f0, W0 = cp.free_lines(spec.params, plain, om)
+        assert np.array_equal(f[:, :n0], f0)
+        for j, ln in enumerate(plain):
+            g = resonance(f0[0, j], 70.0, 0.05, 3.0) if ln.direction == "radial_force" else 1.0
+            assert np.allclose(W[0, j], W0[0, j] * g, rtol=1e-13, atol=0)
+        carriers = [next(j for j, ln in enumerate(plain) if ln.direction == d and ln.h == h)
+                    for d, h in (("radial_force", 1.0), ("radial_force", 1.0), ("radial_torque", 4.42),
+                                 ("radial_torque", 4.42))]
+        for k, (j, sgn) in enumerate(zip(carriers, (1, -1, 1, -1))):
+            e = EFFECTS[2] if k < 2 else EFFECTS[3]
+            fs = abs(plain[j].h * om / (2 * np.pi) + sgn * e["f_mod_Hz"])
+            assert f[0, n0 + k] == pytest.approx(fs, rel=1e-14)
+            g = resonance(fs, 70.0, 0.05, 3.0) if k < 2 else 1.0
+            expect = 0.5 * e["depth"] * np.abs(W0[0, j]) * abs(g)
+            assert np.allclose(np.abs(W[0, n0 + k]), expect, rtol=1e-12, atol=0)
+        wc = cp.wheel(spec.params, om)
+        _, B = wc.frf(f[0])
+        _, ref = ext.steady_lines(spec.params, spec.lines, om)
+        assert np.max(np.abs(np.einsum("lij,lj->li", B, W[0]) - ref[0])) < 1e-10 * np.max(np.abs(ref[0]))
+        # the coupled prediction vs sidebands rewritten as plain harmonics of the same whirl rate
+        same = [replace(ln, h=ln.h + 2 * np.pi * ln.f_offset / om, f_offset=0.0, imbalance=False) if ln.f_offset
+                else ln
+                for ln in spec.lines]
+        lr = cp.line_responses(plant, [spec], [om])
+        lr2 = cp.line_responses(plant, [replace(spec, lines=tuple(same))], [om])
+        assert np.sort(lr.f_hz[0][0]) == pytest.approx(np.sort(lr2.f_hz[0][0]), rel=1e-12)
+        for p in ("coupled", "i", "ii", "iii"):
+            assert lr.rms(p) == pytest.approx(lr2.rms(p), rel=1e-10)
+        assert sorted(lr.f_offset[0]) == sorted([0.0] * (len(lr.h[0]) - 4) + [-9.0, -6.0, 6.0, 9.0])

@@ -342,3 +342,100 @@ def test_line_amplitude_law():
     for bad in ((-1.0, 100.0, 2.0), (0.01, 0.0, 2.0), (0.01, 100.0, -0.5), (np.nan, 100.0, 2.0)):
         with pytest.raises(ValueError, match="law"):
             ex.Line("radial_force", 2.0, 1e-6, law=bad)
+
+
+# ------------------------------------------------------------------ diagnosed effects (issue 7)
+
+#: wheel-mode resonances on the radial force and on the rocking + axial torque lines, a test-stand
+#: resonance (left out), sidebands on the imbalance, a planar rocking line and the axial-torque line
+EFFECTS = [{"kind": "fixed_resonance", "role": "wheel_mode", "f_Hz": 40.0, "zeta": 0.05, "peak_gain": 4.0,
+            "directions": ["radial_force"]},
+           {"kind": "fixed_resonance", "role": "wheel_mode", "f_Hz": 75.0, "zeta": 0.1, "peak_gain": 0.4,
+            "directions": ["radial_torque", "axial_torque"]},
+           {"kind": "fixed_resonance", "role": "test_stand", "f_Hz": 30.0, "zeta": 0.02, "peak_gain": 9.0,
+            "directions": list(ex.DIRECTIONS)},
+           {"kind": "sidebands", "direction": "radial_force", "h": 1.0, "f_mod_Hz": 6.0, "depth": 0.3},
+           {"kind": "sidebands", "direction": "radial_torque", "h": 4.42, "f_mod_Hz": 9.0, "depth": 0.25},
+           {"kind": "sidebands", "direction": "axial_torque", "h": 1.5, "f_mod_Hz": 4.0, "depth": 0.6}]
+
+
+def test_sidebands_are_amplitude_modulation_and_resonance_a_real_filter():
+    """The axial torque passes straight to the interface, so its line is known in closed form on any
+    speed profile: with sidebands (depth m, f_mod) and a wheel-mode resonance H,
+    Tz = C·Ω²·Re[coef·e^{ihφ}·(H(f) + (m/2)(H(f + f_mod)·e^{i2πf_mod t} + H(f − f_mod)·e^{−i2πf_mod t}))],
+    f = hΩ/2π signed (H of a negative frequency = conj H: a real filter), quasi-static (H at each
+    sample's speed); without a resonance this is C·Ω²·(1 + m·cos 2πf_mod t)·cos(hφ + p).  H from
+    rwadist.diagnose.resonance."""
+    from rwadist.diagnose import resonance
+
+    def H(f):
+        g = resonance(np.abs(f), 75.0, 0.1, 0.4)
+        return np.where(f < 0, np.conj(g), g)
+
+    t = np.arange(int(2.0 * FS)) / FS
+    w = 300.0 - 280.0 * t                              # through zero: Ω from +300 to −260 rad/s
+    phi = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) / FS)])
+    carrier = ex.Line("axial_torque", 1.5, 1e-7, phase=0.3)
+    for effects in (EFFECTS[5:], EFFECTS[1:2] + EFFECTS[5:]):
+        lines = ex.apply_line_effects([carrier], effects)
+        assert [ln.f_offset for ln in lines] == [0.0, 4.0, -4.0]
+        tz = ex.simulate_time(E, lines, t, w)[:, 5]
+        f = 1.5 * w / (2 * np.pi)
+        wm = 2 * np.pi * 4.0 * t
+        if len(effects) == 1:
+            ref = 1e-7 * w**2 * (1 + 0.6 * np.cos(wm)) * np.cos(1.5 * phi + 0.3)
+        else:
+            ref = 1e-7 * w**2 * np.real(np.exp(1j * (1.5 * phi + 0.3)) * (
+                H(f) + 0.3 * (H(f + 4.0) * np.exp(1j * wm) + H(f - 4.0) * np.exp(-1j * wm))))
+        assert np.max(np.abs(tz - ref)) < 1e-12 * np.max(np.abs(ref))
+        fs, _ = ex.steady_lines(E, lines, [-200.0])
+        assert np.allclose(fs[0], [1.5 * 200 / (2 * np.pi), 1.5 * 200 / (2 * np.pi) - 4.0,
+                                   1.5 * 200 / (2 * np.pi) + 4.0], rtol=1e-14)
+
+
+@pytest.mark.parametrize("w", [180.0, -230.0])
+def test_wheel_mode_resonance_multiplies_each_steady_line_by_H(w):
+    """Every channel of every line of the resonance's directions (lever-arm torques included) is the
+    effect-free line times H(f) (rwadist.diagnose.resonance at the line's positive frequency), for
+    co, counter and planar lines; other directions and the test-stand resonance change nothing."""
+    from rwadist.diagnose import resonance
+    lines = ex.apply_line_effects(LINES, EFFECTS[:3])
+    f0, A0 = ex.steady_lines(E, LINES, [w])
+    f1, A1 = ex.steady_lines(E, lines, [w])
+    assert np.array_equal(f0, f1)
+    for j, ln in enumerate(LINES):
+        g = 1.0 + 0j
+        for e in EFFECTS[:2]:
+            if ln.direction in e["directions"]:
+                g = g * resonance(f0[0, j], e["f_Hz"], e["zeta"], e["peak_gain"])
+        assert np.allclose(A1[0, j], A0[0, j] * g, rtol=1e-13, atol=1e-15 * np.abs(A0[0, j]).max()), ln
+    assert ex.apply_line_effects(LINES, EFFECTS[2:3]) == LINES
+
+
+@pytest.mark.parametrize("w", [150.0, -230.0])
+def test_effects_time_domain_equals_closed_form(w):
+    """simulate_time with resonances and sidebands (rocking, translation, axial; starting from the
+    steady state) equals the steady_lines closed form at constant speed, lines at |hΩ/2π ± f_mod|."""
+    lines = ex.apply_line_effects(LINES, EFFECTS)
+    assert len(lines) == len(LINES) + 6 and sum(bool(ln.resonances) for ln in lines) == 7 + 6
+    t = np.arange(int(1.0 * FS)) / FS
+    x = ex.simulate_time(E, lines, t, np.full(t.size, w), start="steady")
+    ref = _closed_form_signal(E, lines, w, t)
+    err = np.abs(x - ref).max(0) / np.abs(ref).max(0)
+    assert err.max() < 1e-9, err
+
+
+def test_effect_lines_validation_and_crossings():
+    """Bad offsets or resonances are refused; sidebands are not harmonics (no h·|Ω| crossing); the laws
+    carry over to sidebands scaled by m/2."""
+    with pytest.raises(ValueError, match="f_offset"):
+        ex.Line("radial_force", 1.0, 1e-6, f_offset=float("nan"))
+    for bad in ((40.0, 0.0, 2.0), (40.0, 0.1, -2.0), (np.inf, 0.1, 2.0), (40.0, 0.1)):
+        with pytest.raises(ValueError, match="resonances"):
+            ex.Line("radial_force", 1.0, 1e-6, resonances=(bad,))
+    lines = ex.apply_line_effects(LINES, [{"kind": "amplitude_law", "direction": "axial_torque", "h": 1.5,
+                                           "exponent": 2.5, "amplitude_ref": 0.01, "omega_ref_rad_s": 100.0},
+                                          EFFECTS[5]])
+    sb = [ln for ln in lines if ln.f_offset != 0]
+    assert [ln.law for ln in sb] == [(0.01 * 0.3, 100.0, 2.5)] * 2
+    assert len(ex.crossings(E, lines, (10.0, 400.0))) == len(ex.crossings(E, LINES, (10.0, 400.0)))

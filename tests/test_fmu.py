@@ -609,10 +609,23 @@ def test_get_real_of_parameters_inputs_and_outputs(wheel_fmu):
         y = dict(zip(inst.output_names, inst.get()))
         assert got == [y["Tz_sc"], -1.0, 120.0, 0.25, y["Fx"], 0.005, y["Fy_sc"], 1.0]
         assert y["Fy_sc"] == y["Fx"]                     # row 2 of the DCM is (1, 0, 0)
-        with pytest.raises(FMICallException):
+        # a wrong type is refused the FMI way (no exception into pythonfmu: it would double-free the
+        # slave when the host frees the instance), and the instance still works and closes cleanly
+        with pytest.raises(FMICallException) as exc:
             inst.fmu.getReal([v["seed"].valueReference])
+        assert exc.value.status == REFUSED
+        with pytest.raises(FMICallException) as exc:
+            inst.fmu.setReal([v["seed"].valueReference], [3.0])
+        assert exc.value.status == REFUSED
+        with pytest.raises(FMICallException) as exc:
+            inst.fmu.getInteger([v["Fx"].valueReference])
+        assert exc.value.status == REFUSED
+        inst.fmu.doStep(1e-3, 1e-3)
+        assert np.all(np.isfinite(inst.get()))
     finally:
         inst.close()
+    import gc
+    gc.collect()
 
 
 @pytest.mark.parametrize("profile", [spin_up, reversal])
@@ -631,3 +644,171 @@ def test_fmu_with_laws_equals_simulate_time_with_laws(tmp_path, model, profile):
                          {"wheel_speed": w, "wheel_acceleration": slope(t, w)},
                          {"use_wheel_acceleration": True, "seed": 8})
     assert np.all(rel_err(out[:, :6], ref) < 1e-9), rel_err(out[:, :6], ref)
+
+
+# ------------------------------------------------------------------ wheel-mode resonances and sidebands (issue 7)
+
+#: diagnosed effects as ``rwadist diagnose`` writes them: two wheel-mode resonances (radial force; rocking and
+#: axial torque together), a test-stand resonance (a fixture artefact the FMU must leave out), and sidebands on
+#: the imbalance (tangential term), a planar radial line, a rocking line and an axial-torque line
+EFFECTS = [{"kind": "fixed_resonance", "role": "wheel_mode", "f_Hz": 95.0, "zeta": 0.05, "peak_gain": 4.0,
+            "directions": ["radial_force"], "channel": ["Fx", "Fy"]},
+           {"kind": "fixed_resonance", "role": "wheel_mode", "f_Hz": 60.0, "zeta": 0.08, "peak_gain": 0.3,
+            "directions": ["radial_torque", "axial_torque"], "channel": ["Tx", "Ty", "Tz"]},
+           {"kind": "fixed_resonance", "role": "test_stand", "f_Hz": 70.0, "zeta": 0.03, "peak_gain": 5.0,
+            "directions": list(ext.DIRECTIONS), "channel": ["Fx", "Fy", "Fz", "Tx", "Ty", "Tz"]},
+           {"kind": "sidebands", "direction": "radial_force", "h": 1.0, "f_mod_Hz": 7.0, "depth": 0.3},
+           {"kind": "sidebands", "direction": "radial_force", "h": 2.7, "f_mod_Hz": 9.5, "depth": 0.2},
+           {"kind": "sidebands", "direction": "radial_torque", "h": 4.42, "f_mod_Hz": 11.0, "depth": 0.4},
+           {"kind": "sidebands", "direction": "axial_torque", "h": 2.0, "f_mod_Hz": 5.0, "depth": 0.5}]
+
+
+def effects_doc(model, effects=EFFECTS):
+    doc = model_io.to_json(model)
+    doc["effects"] = [dict(e) for e in effects]
+    return doc
+
+
+def effects_runtime(doc, **kw):
+    params, lines = rt.model_from_doc(doc)
+    return rt.WheelRuntime(params, lines, **rt.effects_from_doc(doc), **kw)
+
+
+@pytest.mark.parametrize("profile", [spin_up, reversal])
+def test_fmu_with_resonances_and_sidebands_equals_simulate_time(tmp_path, model, profile):
+    """A model file with wheel-mode resonances and sidebands (round-tripped through the model-file
+    JSON) through fmpy and through the numpy runtime equals rwadist.extended.simulate_time of the
+    lines lines_from_model builds from it, 1e-9 relative; the test-stand resonance is left out."""
+    doc = effects_doc(model)
+    improved = model_io.from_json(json.loads(json.dumps(doc)))
+    assert model_io.to_json(improved)["effects"] == doc["effects"]
+    p = ext.params_from_model(improved)
+    lines = ext.lines_from_model(improved, p)
+    assert sum(ln.f_offset != 0 for ln in lines) == 8
+    assert all(res[0] != 70.0 for ln in lines for res in ln.resonances)
+    t, w = profile(T=4.0)
+    for seed in (None, 8):
+        ref = ext.simulate_time(p, lines, t, w, seed=seed)
+        out = effects_runtime(doc, seed=seed).run(t, w)
+        assert np.all(rel_err(out, ref) < 1e-9), rel_err(out, ref)
+    fmu_path = build_fmu(doc, tmp_path / "effects.fmu")
+    with zipfile.ZipFile(fmu_path) as z:
+        shipped = json.loads(z.read("resources/wheel_model.json"))
+    assert shipped["effects"] == doc["effects"]
+    out = hosts.run_fmpy(fmu_path, t, {"wheel_speed": w, "wheel_acceleration": slope(t, w)},
+                         {"use_wheel_acceleration": True, "seed": 8})
+    assert np.all(rel_err(out[:, :6], ref) < 1e-9), rel_err(out[:, :6], ref)
+
+
+def resonance_magnitude(direction, f_hz):
+    """|Π H| of the wheel-mode resonances of EFFECTS on ``direction`` at |f| (rwadist.diagnose.resonance)."""
+    from rwadist.diagnose import resonance
+    g = 1.0
+    for e in EFFECTS:
+        if e["kind"] == "fixed_resonance" and e["role"] == "wheel_mode" and direction in e["directions"]:
+            g *= abs(resonance(abs(f_hz), e["f_Hz"], e["zeta"], e["peak_gain"]))
+    return g
+
+
+@pytest.mark.parametrize("rpm", [2400.0, -1100.0])
+def test_resonance_and_sideband_amplitudes_at_constant_speed(tmp_path, model, rpm):
+    """At constant speed (fmpy, least squares on the output): every carrier has C·Ω²·|coef|·|modal gain|
+    ·|H(f)| and each of its sidebands, whose whirl rate is σ(hΩ ± 2πf_mod), (m/2)·C·Ω²·|coef|·|modal
+    gain|·|H| at the sideband's own frequency (0.5 %).  Written out from the effects, not from Line."""
+    p = ext.params_from_model(model)
+    base = ext.lines_from_model(model, p)          # no effects: the carriers
+    comps = []                                     # (direction, whirl rate ν rad/s, expected amplitude)
+    omega = rpm * RPM
+    for ln in base:
+        for s, cf in ln.components():
+            a = ln.C * omega**2 * abs(cf)
+            parts = [(s * ln.h * omega, a)]
+            for e in EFFECTS:
+                if e["kind"] == "sidebands" and e["direction"] == ln.direction and abs(e["h"] - ln.h) < 1e-3:
+                    wm = 2 * np.pi * e["f_mod_Hz"]
+                    parts += [(s * (ln.h * omega + wm), 0.5 * e["depth"] * a),
+                              (s * (ln.h * omega - wm), 0.5 * e["depth"] * a)]
+            for nu, amp in parts:
+                amp *= modal_gain(p, ln.direction, nu, omega) * resonance_magnitude(ln.direction, nu / (2 * np.pi))
+                comps.append((ln.direction, nu, amp))
+    assert len(comps) == sum(len(ln.components()) for ln in base) + 2 * 5
+    path = build_fmu(effects_doc(model), tmp_path / "effects.fmu")
+    dt = 1e-4
+    t = np.arange(5001) * dt
+    out = hosts.run_fmpy(path, t, {"wheel_speed": np.full(t.size, omega)}, {"start_steady": True, "seed": 4})[1:]
+    tt = t[1:]
+    F = out[:, 0] + 1j * out[:, 1]
+    signals = {"radial_force": F, "radial_torque": out[:, 3] + 1j * out[:, 4] - 1j * p.height * F,
+               "axial_force": out[:, 2], "axial_torque": out[:, 5]}
+    worst = 0.0
+    for d, sig in signals.items():
+        mine = [(nu, amp) for dd, nu, amp in comps if dd == d]
+        freqs = [nu for nu, _ in mine]
+        if d.startswith("axial"):                  # real signal: e^{±iνt}
+            freqs = freqs + [-nu for nu in freqs]
+        coef, *_ = np.linalg.lstsq(np.exp(1j * np.outer(tt, freqs)), sig.astype(complex), rcond=None)
+        for k, (nu, amp) in enumerate(mine):
+            got = abs(coef[k]) * (2 if d.startswith("axial") else 1)
+            assert got == pytest.approx(amp, rel=5e-3), (d, nu / (2 * np.pi), got, amp)
+            worst = max(worst, abs(got / amp - 1))
+    print(f"\n{rpm} rpm: largest relative amplitude error over {len(comps)} components {worst:.2e}")
+
+
+@pytest.mark.parametrize("profile", [spin_up, reversal])
+def test_native_kernel_with_resonances_and_sidebands_equals_numpy(model, kernel, profile):
+    """C kernel = numpy runtime with resonances and sidebands (1e-12 relative), every switch and start."""
+    if kernel is None:
+        pytest.skip("no C compiler / not Linux x86-64: the FMU steps in numpy")
+    t, w = profile(T=3.0)
+    doc = effects_doc(model)
+    h = t[1] - t[0]
+    acc = slope(t, w)
+    for kw in (dict(), dict(start_steady=True), dict(modes=False), dict(harmonics=False), dict(imbalance=False)):
+        a = effects_runtime(doc, seed=4, **kw)
+        b = effects_runtime(doc, seed=4, kernel=kernel, **kw)
+        assert b.native and not a.native
+        ya = np.array([a.step12(w[n], acc[n], h) for n in range(t.size - 1)])
+        yb = np.array([b.step12(w[n], acc[n], h) for n in range(t.size - 1)])
+        scale = np.max(np.abs(ya), axis=0)
+        assert np.all(np.abs(yb - ya) <= 1e-12 * scale), (kw, np.max(np.abs(yb - ya), axis=0) / scale)
+
+
+def test_test_stand_resonance_is_left_out(model_path, model):
+    """A test-stand resonance (and a load-cell offset) is a measurement artefact: the FMU output is the
+    effect-free one, bit for bit."""
+    doc = effects_doc(model, [EFFECTS[2], {"kind": "cross_coupling", "r_m": [0.0, 0.0, 0.05]}])
+    t, w = spin_up(T=2.0)
+    params, lines = rt.load_model(model_path)
+    a = rt.WheelRuntime(params, lines, seed=3).run(t, w)
+    b = effects_runtime(doc, seed=3).run(t, w)
+    assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("index, field, value", [
+    (0, "f_Hz", float("nan")), (0, "zeta", 0.0), (0, "peak_gain", -1.0), (1, "directions", ["sideways"]),
+    (1, "role", "fixture"), (3, "depth", -0.1), (4, "f_mod_Hz", 0.0), (5, "h", float("inf")),
+    (6, "direction", "radial")])
+def test_bad_resonance_or_sideband_entry_is_refused(model, index, field, value):
+    """A bad entry is refused naming effects[i].<field>: by the FMU build (ModelError) and by
+    rwadist.extended.lines_from_model (ValueError)."""
+    effects = [dict(e) for e in EFFECTS]
+    effects[index][field] = value
+    doc = effects_doc(model, effects)
+    pattern = rf"effects\[{index}\]\.{field}"
+    with pytest.raises(rt.ModelError, match=pattern):
+        build_fmu(doc, "/nonexistent/x.fmu")
+    p = ext.params_from_model(model)
+    improved = model_io.from_json(json.loads(json.dumps(doc, allow_nan=True)))
+    with pytest.raises(ValueError, match=pattern):
+        ext.lines_from_model(improved, p)
+
+
+def test_unmatched_sidebands_warn(model):
+    """Sidebands of a harmonic the model does not have add nothing, and the build says so."""
+    from fmu.build import model_document
+    doc = effects_doc(model, [{"kind": "sidebands", "direction": "axial_force", "h": 6.5, "f_mod_Hz": 3.0,
+                               "depth": 0.2}])
+    with pytest.warns(RuntimeWarning, match="sidebands of axial_force h=6.5"):
+        model_document(doc)
+    W = effects_runtime(doc)
+    assert W.sidebands_used == set() and W.n_lines == len(rt.model_from_doc(doc)[1])

@@ -207,12 +207,16 @@ FORWARD(fmi2Status, fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind 
 /* ------------------------------------------------------------------ step kernel
  * cfg (read only): [0] n components, [1] modes on, [2..11] mass, c_r, k_r, I_rr, c_rock, k_rock, I_zz,
  * c_z, k_z, height, [12..15] λ_r (2 complex), [16..19] λ_z, [20..28] R (row major), [29..31] r,
- * then per component 10 doubles: σh, direction index, coef·C (complex), −i·coef·C·[imbalance] (complex),
- * coef·A_ref (complex, 0 without an amplitude law), Ω_ref, p: amplitude += coef·A_ref·(|Ω|/Ω_ref)^p.
- * st (state): [0] rotor angle φ, [1] unused, then S = e^{iσhφ} (n complex), η_r (2), η_z (2),
- * x_rock = (q, q̇) (2), complex.  out: 12 outputs (wheel frame, spacecraft frame). */
+ * then per component 13 doubles: σh, direction index, coef·C (complex), −i·coef·C·[imbalance] (complex),
+ * coef·A_ref (complex, 0 without an amplitude law), Ω_ref, p: amplitude += coef·A_ref·(|Ω|/Ω_ref)^p,
+ * ω_off (rad/s, a sideband's fixed phase rate), number of wheel-mode resonances, cfg index of their
+ * entries; then the resonance table, 3 doubles per entry: 2π f_r, 2·g·ζ, 2·ζ.  The amplitude is
+ * multiplied by H = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r), r = (σhΩ + ω_off)/(2π f_r), of each
+ * resonance at both step ends (quasi-static).
+ * st (state): [0] rotor angle φ, [1] time since t0, then S = e^{i(σhφ + ω_off t)} (n complex), η_r (2),
+ * η_z (2), x_rock = (q, q̇) (2), complex.  out: 12 outputs (wheel frame, spacecraft frame). */
 enum { C_N, C_MODES, C_M, C_CR, C_KR, C_IRR, C_CROCK, C_KROCK, C_IZZ, C_CZ, C_KZ, C_HEIGHT, C_LAMR = 12,
-       C_LAMZ = 16, C_R = 20, C_POS = 29, C_COMP = 32, C_STRIDE = 10 };
+       C_LAMZ = 16, C_R = 20, C_POS = 29, C_COMP = 32, C_STRIDE = 13, C_RES = 3 };
 #define SMALL_Z 1e-3
 
 static void quad_roots(double m, double complex c, double k, double complex *l1, double complex *l2)
@@ -235,6 +239,7 @@ EXPORT void rwadist_kernel_step(const double *cfg, double *st, double *out, doub
     const double w1 = omega + alpha * h;
     const double dphi = 0.5 * (omega + w1) * h;
     const double phi1 = st[0] + dphi;
+    const double t1 = st[1] + h;
     const int modes = cfg[C_MODES] != 0.0;
     double complex loads1[4] = {0, 0, 0, 0};
     double complex W[4][2] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}};
@@ -260,13 +265,27 @@ EXPORT void rwadist_kernel_step(const double *cfg, double *st, double *out, doub
             a0 += ls * pow(fabs(omega) / c[8], c[9]);
             a1 += ls * pow(fabs(w1) / c[8], c[9]);
         }
-        const double complex S1 = cexp(CMPLX(0.0, sh * phi1));
+        const double woff = c[10];
+        const int nres = (int)c[11];
+        if (nres > 0) {
+            const double *rt = cfg + (size_t)c[12];
+            double complex g0 = 1.0, g1 = 1.0;
+            for (int k = 0; k < nres; k++, rt += C_RES) {
+                const double r0 = (sh * omega + woff) / rt[0], r1 = (sh * w1 + woff) / rt[0];
+                const double b0 = 1.0 - r0 * r0, b1 = 1.0 - r1 * r1;
+                g0 *= CMPLX(b0, rt[1] * r0) / CMPLX(b0, rt[2] * r0);
+                g1 *= CMPLX(b1, rt[1] * r1) / CMPLX(b1, rt[2] * r1);
+            }
+            a0 *= g0;
+            a1 *= g1;
+        }
+        const double complex S1 = cexp(CMPLX(0.0, sh * phi1 + woff * t1));
         loads1[d] += a1 * S1;
         if (modes && d != 3) {
             const double complex *lam = d == 0 ? lam_r : (d == 2 ? lam_z : lk);
             const double complex *X = Xp[d == 0 ? 0 : (d == 2 ? 2 : 1)];
             for (int j = 0; j < 2; j++) {
-                const double complex z = CMPLX(0.0, sh * dphi) - lam[j] * h;
+                const double complex z = CMPLX(0.0, sh * dphi + woff * h) - lam[j] * h;
                 const double complex XS0 = X[j] * S[i];
                 double complex t0, t1;
                 if (cabs(z) < SMALL_Z) {
@@ -312,6 +331,7 @@ EXPORT void rwadist_kernel_step(const double *cfg, double *st, double *out, doub
         Tc = loads1[1];
     }
     st[0] = phi1;
+    st[1] = t1;
     const double complex Tint = Tc + I * cfg[C_HEIGHT] * F;
     const double o[6] = {creal(F), cimag(F), Fz, creal(Tint), cimag(Tint), creal(loads1[3])};
     const double *R = cfg + C_R, *r = cfg + C_POS;
