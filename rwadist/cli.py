@@ -428,9 +428,19 @@ def cmd_diagnose(args) -> int:
             model = preset(args.preset).to_model()
         except (KeyError, ValueError) as exc:
             raise DataError("--preset", "name", str(exc)) from None
-    diag = diagnose(spectra, model, k_sigma=args.k_sigma, min_gain=args.min_gain, test=test)
+    base = args.base
+    if base == "auto":
+        # extended when the model has an analytical section, unless the record says the wheel's modes were
+        # off (a virtual-stand test made with modes=False is hard-mounted C·Ω² truth: meta.json "modes": false)
+        base = "extended" if (model is not None and model.analytical and test.meta.get("modes") is not False) \
+            else "empirical"
+    try:
+        diag = diagnose(spectra, model, k_sigma=args.k_sigma, min_gain=args.min_gain, test=test, base=base)
+    except ValueError as exc:
+        raise DataError("diagnose", "--base", str(exc)) from None
     files = write_report(diag, args.output)
-    print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s)")
+    print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
+          f"{base} base")
     for e in diag.summary()["effects"]:
         par = ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in e.items()
                         if k not in ("kind", "evidence", "f_Hz", "psd_ref", "channel"))
@@ -614,7 +624,8 @@ def build_parser() -> argparse.ArgumentParser:
     q.set_defaults(func=cmd_psd)
 
     dg = sub.add_parser("diagnose", help="residual of a model against test data; finds, adds and reports the "
-                        "effects the model lacks (missing harmonics, amplitude laws, broadband floors)")
+                        "effects the model lacks (missing harmonics, amplitude laws, broadband floors, resonances, "
+                        "coupling, sidebands, speed ripple, counter rotation)")
     dg.add_argument("data", help="steady-test directory, sweep CSV or HDF5")
     dsrc = dg.add_mutually_exclusive_group()
     dsrc.add_argument("--model", help="model file to start from (default: the empirical fit of the data)")
@@ -625,6 +636,11 @@ def build_parser() -> argparse.ArgumentParser:
     dg.add_argument("--k-sigma", type=float, default=4.0, help="held-out gain needed, noise standard errors (4)")
     dg.add_argument("--min-gain", type=float, default=0.05,
                     help="held-out gain needed, fraction of the unexplained power (0.05)")
+    dg.add_argument("--base", choices=("auto", "empirical", "extended"), default="auto",
+                    help="starting prediction of the lines: 'empirical' C*omega^2 hard mounted, 'extended' through "
+                         "the rotor's suspension modes of the model's analytical section (forward/backward whirl, "
+                         "rotation sense); auto (default): extended when the model (--model/--preset) has an "
+                         "analytical section and the data's meta.json does not say modes: false")
     dg.add_argument("--slice-samples", type=int, default=8192, help="sweep slice length, samples")
     dg.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
                     help="speed of sweep slices: tach column, estimated from data, or auto")

@@ -21,7 +21,29 @@ Predicted PSD of channel c at speed Ω (unit²/Hz on the spectra's grid)::
   area), and its area is a²/2 (Parseval).
 * a_i(Ω) = C_i Ω² for the model's harmonics, or A_ref (|Ω|/Ω_ref)^p after an
   ``amplitude_law`` effect.  A radial harmonic appears with amplitude a in both
-  x and y channels of its direction (the test-stand convention).
+  x and y channels of its direction (the test-stand convention).  This is the
+  *empirical base* (``base="empirical"``, the default of :func:`diagnose`).
+* *Extended base* (``base="extended"``, or ``"auto"`` with a model that has an
+  ``analytical`` section; ``rwadist diagnose --preset/--model`` picks it by
+  default): the lines are those of :func:`rwadist.extended.lines_from_model`
+  (the imbalances U_s, U_d of the analytical section replace the co-rotating
+  radial fundamentals; every other harmonic with its rotation ``sense``), and
+  a line's amplitude in channel c is |A_c| of
+  :func:`rwadist.extended.steady_lines` at each run speed: modal amplification
+  by the suspension (radial translation, rocking with gyroscopic forward and
+  backward whirl, axial translation), the sense deciding which whirl a radial
+  line meets, the lever arm ``height``.  Lines of one h acting on one channel
+  add in power (independent phases: the expected PSD; the fixed imbalance
+  phase between U_s and U_d, not in the model file, matters only when
+  height ≠ 0).  Every effect composes as on the empirical base: an amplitude
+  law replaces the line's free load C·Ω² (:attr:`rwadist.extended.Line.law`);
+  a missing harmonic is a wheel disturbance and goes through the modes
+  (co-rotating, the model file's default; its C is fitted on the measured
+  amplitude divided by the co-rotating modal gain); fixed resonances multiply
+  the modal amplitude; sidebands and ripple components take the carrier's
+  modal gain (the modes' variation over ±f_mod neglected); coupling as before.
+  The modal gain g = a_channel / a_free of each line (:meth:`Context.channel_lines`)
+  is divided out wherever a free load is measured (:func:`_measure`).
 * N_c(f) is the instrument noise: the median over runs of
   :func:`rwadist.empirical.block_floor` (speed independent by assumption).
 * B_c is the wheel's broadband floor (zero until a ``broadband_floor`` effect
@@ -146,12 +168,45 @@ Effect classes (``kind`` in the model file's ``effects`` list and in
     minimisation).  Parameters: f_ripple_Hz, delta_omega_rad_s,
     omega_ref_rad_s, speed_exponent, ripple_frac_at_ref.
 
-Not built yet: counter rotation, spin acceleration.
+``counter_rotation``  (:class:`CounterRotation`, extended base only) counter-
+    rotating content of a radial harmonic (support anisotropy, planar loads):
+    F = a₊e^{+ihφ} + a₋e^{−ihφ} with counter fraction q = |a₋|²/(|a₊|² + |a₋|²),
+    the total free power C²Ω⁴ kept.  Hard mounted the senses have the same PSD;
+    through the modes the co part meets the forward whirl, the counter part the
+    backward one.  Signature: residual power in a radial line where |G₋| ≠ |G₊|,
+    chiefly at its backward-whirl crossing (and x/y asymmetry: the co/counter
+    cross term, random per run, cancels in x + y only).  Fit: q by weighted
+    least squares of the log x + y line power on P_o + P₊ + q(P₋ − P₊);
+    with the time series (``test=``) a second estimate from the x/y phase
+    (co |X + iY|², counter |X − iY|², each divided by its modal gain),
+    reported as ``counter_fraction_phase``.  Recorded in the model as a co
+    harmonic C·sqrt(1 − q) and a counter harmonic C·sqrt(q) at the same h (the
+    imbalance's co part scales U_s or U_d in ``analytical``), which
+    :func:`rwadist.extended.lines_from_model` reads.  Radial-force lines are not
+    proposed (the translation mode has no gyroscopic split: no PSD signature).
+    Parameters: direction, h, counter_fraction, counter_fraction_stderr,
+    counter_fraction_phase.
+
+``spin_acceleration``  (:class:`SpinAcceleration`) the wheel accelerating
+    during each run: quasi-steady slices of a spin-up or run-down (``rwadist
+    fit/diagnose`` on a sweep CSV) see each line sweep h|α|T/2π Hz in a run of
+    length T.  Signature: lines broader than the window's kernel, the more the
+    higher h, on every channel.  Prediction: each line spread over that range
+    (:meth:`Context.smear_offsets`: points ≤ ½ bin apart, weighted by the Welch
+    segments' squared windows and the instantaneous power (Ω(τ)/Ω)⁴).  Fit: |α|
+    by a bounded 1-D minimisation of the fit runs' misplaced power; the noise
+    floor re-estimated with the smeared lines masked.  Tried only on runs that
+    are slices of one sweep (distinct start times, ``test=`` given); the speed
+    track |ΔΩ/Δt0| is the independent estimate ``alpha_track_rad_s2``.  A
+    measurement artefact (``role`` = ``measurement``): not a disturbance, so
+    ``rwadist psd``, the FMU and coupling ignore it (the FMU takes the wheel's
+    acceleration as an input; its tangential imbalance force is in the extended
+    model).  Parameters: alpha_rad_s2, alpha_track_rad_s2, role.
 """
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import stats
@@ -213,6 +268,8 @@ class State:
         carries two more lines at h|Ω|/2π ± f_mod of amplitude m·a/2.
     ripple : (ΔΩ_ref rad/s, f_ripple Hz, Ω_ref rad/s, q) of a ``speed_ripple`` effect, or None: every line
         is spread over f_i + k·f_ripple with the powers of :func:`ripple_sideband_powers`.
+    smear : |dΩ/dt| (rad/s²) of a ``spin_acceleration`` effect, or None: every line of a run is spread
+        uniformly over the frequencies its harmonic sweeps during the run (:meth:`Context.smear_offsets`).
     effects : effect objects added so far.
     """
 
@@ -225,10 +282,32 @@ class State:
     coupling: tuple | None = None
     sidebands: list = field(default_factory=list)
     ripple: tuple | None = None
+    ext: object = None
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+    smear: float | None = None
 
     def copy(self) -> "State":
         return State(copy.deepcopy(self.model), self.noise, dict(self.laws), dict(self.floors), list(self.effects),
-                     list(self.resonances), self.coupling, list(self.sidebands), self.ripple)
+                     list(self.resonances), self.coupling, list(self.sidebands), self.ripple, self.ext,
+                     smear=self.smear)
+
+    @property
+    def base(self) -> str:
+        """'extended' when the lines go through the rotor's suspension modes (``ext`` set), else 'empirical'."""
+        return "empirical" if self.ext is None else "extended"
+
+    def ext_lines(self) -> list:
+        """The :class:`rwadist.extended.Line` objects of the extended base: :func:`rwadist.extended.lines_from_model`
+        of the model (imbalances from ``ext``, senses from the harmonics) with the state's amplitude laws attached
+        (same direction, |Δh| < LAW_H_TOL)."""
+        from . import extended as ext
+
+        out = ext.lines_from_model(self.model, self.ext, effects=False)
+        if self.laws:
+            laws = [(d, h, law) for (d, h), law in self.laws.items()]
+            out = [replace(ln, law=next((lw for d, h, lw in laws if d == ln.direction and abs(h - ln.h) < ext.LAW_H_TOL),
+                                        None)) for ln in out]
+        return out
 
     def line_components(self, channel: str, h: float):
         """(frequency shift Hz, relative amplitude) of the line h of ``channel``: the carrier (0, 1) and the
@@ -262,6 +341,7 @@ class Context:
                 [r.speed for r in test.runs], spectra.speed)):
             raise ValueError("diagnose: the test's runs are not those of the spectra (count or speeds differ)")
         self.test = test
+        self._memo = {}
         self._corrected = {}
         self.f = spectra.f
         self.df = spectra.df
@@ -381,6 +461,79 @@ class Context:
                 g = g * np.abs(resonance(f_hz, f_r, zeta, peak))
         return g
 
+    def channel_lines(self, state: State, c: str, runs: np.ndarray) -> list:
+        """[(h, law, a, g)] of every line acting on channel ``c``: harmonic number, amplitude law or None, the
+        line's amplitude a (unit, one per run of ``runs``, before the fixed resonances) and its modal gain g = a / the
+        free load amplitude of the channel's direction at h.
+
+        Empirical base: the state's harmonics, a = C·Ω² (or the law), g = 1.  Extended base (``state.ext`` set):
+        the lines of :meth:`State.ext_lines` through :func:`rwadist.extended.steady_lines` (suspension modes,
+        gyroscopic whirl, rotation sense, lever arm), lines of one h acting on the channel merged into one entry
+        of power Σ|A|²/2 (independent phases: the expected power; a co/counter pair of one h has a cross term
+        of zero mean that cancels between x and y).  Cached on the state per set of runs."""
+        if state.ext is None:
+            return [(h, law, self.amplitude(C, law, runs), np.ones(runs.size)) for h, C, law in state.lines(c)]
+        key = ("lines", runs.tobytes())
+        if key not in state._cache:
+            state._cache[key] = self._ext_lines(state, runs)
+        return state._cache[key].get(c, [])
+
+    def _ext_lines(self, state: State, runs: np.ndarray) -> dict:
+        from . import extended as ext
+
+        lines = state.ext_lines()
+        w = self.omega[runs]
+        out = {c: [] for c in self.channels}
+        if not lines:
+            return out
+        _, A = ext.steady_lines(state.ext, lines, w)                  # (S, L, 6)
+        P = np.abs(A) ** 2                                             # 2 × mean square
+        hs = np.array([ln.h for ln in lines])
+        free = np.array([ln.amplitude(w) for ln in lines]).T           # (S, L) load amplitudes
+        groups = []
+        for j in np.argsort(hs, kind="stable"):
+            if groups and abs(hs[j] - hs[groups[-1][0]]) < ext.LAW_H_TOL:
+                groups[-1].append(j)
+            else:
+                groups.append([j])
+        for c in self.channels:
+            k = CHANNELS.index(c)
+            d = CHANNEL_DIRECTION[c]
+            for g in groups:
+                p = P[:, g, k].sum(1)
+                if not np.any(p > 0):
+                    continue
+                own = [j for j in g if lines[j].direction == d]
+                a_free = np.sqrt(np.sum(free[:, own] ** 2, axis=1)) if own else np.zeros(w.size)
+                a = np.sqrt(p)
+                gain = np.where(a_free > 0, a / np.where(a_free > 0, a_free, 1.0), 1.0)
+                j0 = own[0] if own else g[0]
+                out[c].append((float(lines[j0].h), lines[j0].law, a, gain))
+        return out
+
+    def unit_gain(self, state: State, c: str, direction: str, h: float, sense: str, runs: np.ndarray) -> np.ndarray:
+        """|amplitude in channel ``c``| per unit load amplitude of a line (direction, h, sense) through the state's
+        suspension modes (:func:`rwadist.extended.steady_lines`), per run; ones on the empirical base."""
+        if state.ext is None:
+            return np.ones(runs.size)
+        from . import extended as ext
+
+        w = self.omega[runs]
+        _, A = ext.steady_lines(state.ext, [ext.Line(direction, float(h), 1.0, sense)], w)
+        return np.abs(A[:, 0, CHANNELS.index(c)]) / np.maximum(w**2, 1e-300)
+
+    def modal_gain(self, state: State, c: str, h: float, runs: np.ndarray) -> np.ndarray:
+        """Modal gain g of the line h of channel ``c`` (:meth:`channel_lines`); for a line the state lacks, that
+        of a co-rotating line of the channel's direction (a wheel disturbance goes through the modes)."""
+        if state.ext is None:
+            return np.ones(runs.size)
+        from . import extended as ext
+
+        for hh, _, _, g in self.channel_lines(state, c, runs):
+            if abs(hh - h) < ext.LAW_H_TOL:
+                return g
+        return self.unit_gain(state, c, CHANNEL_DIRECTION[c], h, "co", runs)
+
     def amplitude(self, C, law, runs):
         w = self.omega[runs]
         if law is None:
@@ -401,10 +554,9 @@ class Context:
         each multiplied by the resonance gain at their own frequency and, under a ``speed_ripple``,
         spread over f + k·f_ripple with the power fractions of :meth:`ripple_powers`."""
         out = self.floor_psd(state, c, runs)
-        for h, C, law in state.lines(c):
+        for h, law, amp, _ in self.channel_lines(state, c, runs):
             if skip is not None and abs(h - skip) < 1e-9:
                 continue
-            amp = self.amplitude(C, law, runs)
             f0 = h * self.omega[runs] / (2 * np.pi)
             rip = self.ripple_powers(state, h, law, runs)
             for shift, rel in state.line_components(c, h):
@@ -412,12 +564,57 @@ class Context:
                 a = amp * rel
                 if state.resonances:
                     a = a * self.gain(state, c, f)
-                if rip is None:
+                if state.smear is not None:
+                    du, wt = self.smear_offsets(state, h, runs)
+                    out += self.psd_at(f[:, None] + du, (a**2 / 2.0)[:, None] * wt)
+                elif rip is None:
                     out += self.psd_at(f, a**2 / 2.0)
                 else:
                     k, P = rip
                     out += self.psd_at(f[:, None] + k[None, :] * state.ripple[1], (a**2 / 2.0)[:, None] * P)
         return out
+
+    def run_durations(self, runs: np.ndarray) -> np.ndarray:
+        """Length of each run's record, s: from the time series when known, else from the Welch
+        segments (50 % overlap: (n_segments + 1)·nperseg/2 samples)."""
+        if self.test is not None:
+            return np.array([self.test.runs[r].n_samples / self.test.runs[r].sample_rate for r in runs])
+        n = np.asarray(self.sp.n_segments, dtype=float)[runs]
+        return (n + 1.0) * self.sp.nperseg / 2.0 / self.sp.sample_rate
+
+    def smear_offsets(self, state: State, h: float, runs: np.ndarray, n_max: int = 48):
+        """(offsets Hz, weights) (len(runs), M) of a line h smeared by the state's spin acceleration:
+        during a run of length T at mean speed Ω the line sweeps f ± h|α|T/(4π); M points spaced at most
+        half a bin cover that range, each weighted by the instantaneous power (Ω(τ)/Ω)⁴/M (a C·Ω² line;
+        the Welch average weighs the record's instants alike, an approximation at its ends)."""
+        alpha = float(state.smear)
+        T = self.run_durations(runs)
+        width = h * alpha * T / (2 * np.pi)                                  # Hz swept during the run
+        m = int(np.clip(np.ceil(2.0 * np.max(width) / self.df) + 1, 1, n_max))
+        u = (np.arange(m) + 0.5) / m - 0.5                                     # −½ … ½
+        du = width[:, None] * u[None, :]
+        w = np.maximum(np.abs(self.omega[runs]), 1e-12)
+        amp = (1.0 + alpha * T[:, None] * u[None, :] / w[:, None]) ** 4
+        n_samp = np.rint(T * self.sp.sample_rate).astype(int)
+        prof = np.array([self._welch_weights(int(n), m) for n in n_samp])
+        return du, amp * prof
+
+    def _welch_weights(self, n: int, m: int) -> np.ndarray:
+        """How much each of m equal parts of an n-sample record weighs in its Welch PSD (sum 1): Σ over
+        the segments (50 % overlap) of the squared window falling in the part."""
+        key = ("welch_w", n, m)
+        if key not in self._memo:
+            from scipy import signal
+
+            L = self.sp.nperseg
+            w2 = signal.get_window(self.sp.window, L) ** 2
+            acc = np.zeros(n)
+            for s0 in range(0, n - L + 1, L // 2):
+                acc[s0:s0 + L] += w2
+            edges = np.rint(np.linspace(0, n, m + 1)).astype(int)
+            part = np.add.reduceat(acc, edges[:-1]) if n >= m else np.full(m, acc.sum() / m)
+            self._memo[key] = part / part.sum()
+        return self._memo[key]
 
     def band_centres(self) -> np.ndarray:
         return self.f[self.k_lo + BAND_BINS * np.arange(self.n_bands) + BAND_BINS // 2] - 0.5 * self.df
@@ -433,16 +630,20 @@ class Context:
         mask = np.zeros(D.shape, bool)
         offs = np.arange(-LINE_HALF, LINE_HALF + 1)
         rows = np.arange(runs.size)[:, None]
-        for h, _, _ in state.lines(c):
+        for h, _, _, _ in self.channel_lines(state, c, runs):
             k = np.clip(np.rint(h * self.omega[runs] / (2 * np.pi) / self.df).astype(int)[:, None] + offs,
                         0, self.f.size - 1)
             mask[rows, k] = True
+            if state.smear is not None:     # the whole range a smeared line sweeps, ±LINE_HALF bins
+                half = h * state.smear * self.run_durations(runs) / (4 * np.pi) / self.df + LINE_HALF
+                kc = h * self.omega[runs] / (2 * np.pi) / self.df
+                kk = np.arange(self.f.size)[None, :]
+                mask |= (kk >= (kc - half)[:, None]) & (kk <= (kc + half)[:, None])
         if state.sidebands or state.ripple is not None:
             # the model's sideband and ripple lines too, where their power is above a tenth of the noise
             # power in their window
             noise = self.floor_psd(state, c, runs)
-            for h, C, law in state.lines(c):
-                amp = self.amplitude(C, law, runs)
+            for h, law, amp, _ in self.channel_lines(state, c, runs):
                 f0 = h * self.omega[runs] / (2 * np.pi)
                 rip = self.ripple_powers(state, h, law, runs) or (np.zeros(1), np.ones((runs.size, 1)))
                 for shift, rel in state.line_components(c, h):
@@ -634,6 +835,8 @@ class AmplitudeLaw:
         r = np.log(d) - X @ coef
         s2 = float(r @ r) / max(d.size - 2, 1)
         cov = s2 * np.linalg.inv(X.T @ X)
+        if state.ext is not None and coef[1] < 0:
+            return None         # rwadist.extended.Line takes laws of exponent >= 0 only (extended base)
         return AmplitudeLaw(direction, float(h), float(coef[1]), float(np.exp(coef[0])), w_ref,
                             float(np.sqrt(cov[1, 1])))
 
@@ -755,10 +958,11 @@ def _line_gain_points(ctx, state, chans, runs):
     offs = np.arange(-LINE_HALF, LINE_HALF + 1)
     for c in chans:
         noise = ctx.floor_psd(state, c, runs)
-        hs = np.array([x[0] for x in state.lines(c)])
-        for h, C, law in state.lines(c):
+        cl = ctx.channel_lines(state, c, runs)
+        hs = np.array([x[0] for x in cl])
+        for h, law, amp, _ in cl:
             f = h * ctx.omega[runs] / (2 * np.pi)
-            a_pred = ctx.amplitude(C, law, runs) * ctx.gain(state, c, f)
+            a_pred = amp * ctx.gain(state, c, f)
             a = ctx.measure_line(state, c, h, runs, skip=h)
             # a line within 2·LINE_HALF bins of another beats with it in the Welch estimate: left out
             sep = np.abs(hs[hs != h][:, None] - h) * ctx.omega[runs][None, :] / (2 * np.pi) / ctx.df
@@ -1118,11 +1322,9 @@ class Sidebands:
         P, Q = [], []
         for c in chans:
             R, _ = _residual_z(ctx, state, c, runs)
-            law = state.laws.get((direction, round(h, 4)))
-            C = next((x[1] for x in state.lines(c) if abs(x[0] - h) < 1e-9), None)
-            if C is None:
+            a = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - h) < 1e-9), None)
+            if a is None:
                 return None
-            a = ctx.amplitude(C, law, runs)
             for side in (1.0, -1.0):
                 f = h * ctx.omega[runs] / (2 * np.pi) + side * f_mod
                 p, _, _, inb = _window_power(ctx, state, c, runs, f, R)
@@ -1208,8 +1410,7 @@ class SpeedRipple:
             if not np.isfinite(ctx.sp.psd[c][runs, 0]).all():
                 continue
             R, _ = _residual_z(ctx, state, c, runs)
-            for h, C, law in state.lines(c):
-                a = ctx.amplitude(C, law, runs)
+            for h, law, a, _ in ctx.channel_lines(state, c, runs):
                 f0 = h * ctx.omega[runs] / (2 * np.pi)
                 for side in (1.0, -1.0):
                     f = f0 + side * f_r
@@ -1289,9 +1490,292 @@ class SpeedRipple:
                 out.append(e)
         return out
 
+# --------------------------------------------------------------------------- counter rotation (extended base)
+
+def _sense_group(state: State, direction: str, h: float):
+    """The state's extended lines of (direction, h) (|Δh| < LAW_H_TOL) when they are all co- or counter-rotating and
+    carry no amplitude law: (h of the group, C_co, C_counter, imbalance?) with C the root-sum-square of the lines'
+    C (kg·m or kg·m², per (rad/s)²; an imbalance's C is U_s or U_d of the analytical section); else None."""
+    from . import extended as ext
+
+    if state.ext is None:
+        return None
+    g = [ln for ln in state.ext_lines() if ln.direction == direction and abs(ln.h - h) < ext.LAW_H_TOL]
+    if not g or any(ln.sense == "planar" or ln.law is not None for ln in g):
+        return None
+    c_co = float(np.sqrt(sum(ln.C**2 for ln in g if ln.sense == "co")))
+    c_ct = float(np.sqrt(sum(ln.C**2 for ln in g if ln.sense == "counter")))
+    if c_co**2 + c_ct**2 <= 0:
+        return None
+    return float(g[0].h), c_co, c_ct, any(ln.imbalance for ln in g)
+
+
+@dataclass
+class CounterRotation:
+    """Counter-rotating content of a radial harmonic (extended base only).
+
+    The radial load of harmonic h is F = a₊e^{+iσθ} + a₋e^{−iσθ} (θ = h·φ, φ the rotor angle, complex x + iy
+    coordinates): a co-rotating part a₊ and a counter-rotating part a₋ (a planar, anisotropic load is
+    |a₊| = |a₋|).  ``counter_fraction`` q = |a₋|²/(|a₊|² + |a₋|²), the total free power |a₊|² + |a₋|² = C²Ω⁴
+    kept: the harmonic becomes a co line of C·sqrt(1 − q) and a counter line of C·sqrt(q) (for the
+    imbalance h = 1 the co part is U_s or U_d of the analytical section, scaled by sqrt(1 − q)).
+    Hard mounted the two parts have the same PSD; through the rotor's modes the co part meets the forward
+    whirl and the counter part the backward one (:mod:`rwadist.extended`), so q is seen where
+    |G₊| ≠ |G₋|, above all at the backward-whirl crossing.  The radial translation has no gyroscopic split
+    (|G₊| = |G₋|): q of a radial-force line is not seen in PSDs and the class does not propose it.
+    ``counter_fraction_phase``: a second, independent estimate from the x/y phase of the time series
+    (:meth:`fit`), NaN without them."""
+
+    direction: str
+    h: float
+    counter_fraction: float
+    counter_fraction_stderr: float = float("nan")
+    counter_fraction_phase: float = float("nan")
+    n_points: int = 0
+    kind: str = "counter_rotation"
+
+    @property
+    def channels(self):
+        return DIRECTION_CHANNELS[self.direction]
+
+    def split(self, state: State):
+        """(C_co, C_counter) of the harmonic after this effect, from the state's group total."""
+        g = _sense_group(state, self.direction, self.h)
+        if g is None:
+            raise ValueError(f"counter_rotation: no co/counter line {self.direction} h = {self.h} in the state")
+        c_tot = float(np.hypot(g[1], g[2]))
+        q = float(np.clip(self.counter_fraction, 0.0, 1.0))
+        return c_tot * np.sqrt(1.0 - q), c_tot * np.sqrt(q)
+
+    def apply(self, state: State) -> State:
+        from . import extended as ext
+
+        h0, c_co0, c_ct0, imb = _sense_group(state, self.direction, self.h)
+        c_co, c_ct = self.split(state)
+        s = state.copy()
+        d = self.direction
+        old = s.model.harmonics(d)
+        at_h = [x for x in old if abs(x.h - h0) < ext.LAW_H_TOL]
+        keep = [x for x in old if abs(x.h - h0) >= ext.LAW_H_TOL]
+        h_key = at_h[0].h if at_h else h0
+        new = []
+        if imb:
+            # the co part is the imbalance of the analytical section; the model's co harmonic (its empirical
+            # coefficient, read by the hard-mounted consumers) is scaled alike
+            name = "U_s" if d == "radial_force" else "U_d"
+            s.ext = replace(s.ext, **{name: c_co})
+            s.model.analytical = dict(s.model.analytical or {}, **ext.params_to_dict(s.ext))
+            scale = c_co / c_co0 if c_co0 > 0 else 0.0
+            new += [replace(x, C=x.C * scale) for x in at_h if x.sense != "counter"]
+        elif c_co > 0:
+            new.append(Harmonic(h=h_key, C=c_co, sense="co"))
+        if c_ct > 0:
+            new.append(Harmonic(h=h_key, C=c_ct, sense="counter"))
+        s.model.empirical[d] = sorted(keep + new, key=lambda x: (x.h, x.sense == "counter"))
+        s.effects.append(self)
+        return s
+
+    def params(self) -> dict:
+        return {"direction": self.direction, "h": round(self.h, 4), "counter_fraction": self.counter_fraction,
+                "counter_fraction_stderr": self.counter_fraction_stderr,
+                "counter_fraction_phase": self.counter_fraction_phase, "n_points": self.n_points,
+                "law": "radial load C*omega^2*(sqrt(1-q) e^{+i h phi} + sqrt(q) e^{-i h phi}), q = counter_fraction "
+                       "= |a-|^2/(|a+|^2+|a-|^2); model: a co harmonic C*sqrt(1-q) and a counter one C*sqrt(q)"}
+
+    @staticmethod
+    def _points(ctx, state, direction, h, runs):
+        """Per run: measured power of the line h summed over the direction's x and y channels (cross term of
+        the co/counter pair cancels), and its prediction P_o + P₊ + q·(P₋ − P₊) at counter fraction q;
+        returns (Pm, P_o, P₊, P₋, weight, ok) arrays."""
+        g = _sense_group(state, direction, h)
+        h0, c_co, c_ct, _ = g
+        c_tot = float(np.hypot(c_co, c_ct))
+        q0 = c_ct**2 / c_tot**2
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        w = ctx.omega[runs]
+        f = h0 * w / (2 * np.pi)
+        a2 = (c_tot * w**2) ** 2 / 2.0                      # free mean square of the harmonic
+        Pm, Po, Pp, Pn, Nn = (np.zeros(runs.size) for _ in range(5))
+        ok = np.ones(runs.size, bool)
+        offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+        k = np.clip(np.rint(f / ctx.df).astype(int)[:, None] + offs, 0, ctx.f.size - 1)
+        for c in chans:
+            a = ctx.measure_line(state, c, h0, runs, skip=h0)
+            ok &= np.isfinite(a)
+            Hc2 = ctx.gain(state, c, f) ** 2
+            gp = ctx.unit_gain(state, c, direction, h0, "co", runs) ** 2
+            gn = ctx.unit_gain(state, c, direction, h0, "counter", runs) ** 2
+            grp = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - h0) < 1e-3), np.zeros(runs.size))
+            other = np.maximum(grp**2 / 2.0 - a2 * ((1 - q0) * gp + q0 * gn), 0.0)
+            Pm += np.where(np.isfinite(a), a, 0.0) ** 2 / 2.0
+            Po += other * Hc2
+            Pp += a2 * gp * Hc2
+            Pn += a2 * gn * Hc2
+            Nn += np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1).sum(1) * ctx.df
+        snr = Pm / np.maximum(Nn, 1e-300)
+        return Pm, Po, Pp, Pn, snr**2 / (snr**2 + SNR_KNEE**2), ok & (Pm > 0)
+
+    @staticmethod
+    def phase_fraction(ctx, state, direction, h, runs) -> float:
+        """Counter fraction from the x/y phase of the time series (NaN without them): per run the complex
+        amplitudes X, Y of the direction's x and y channels at h|Ω|/2π (:meth:`Context.phasors`) split into the
+        co-rotating |X + iY|²/4 and counter-rotating |X − iY|²/4 mean squares (swapped for Ω < 0), each divided
+        by its modal power gain |G±|² (and the fixed resonances) to the free load; q = Σ counter / Σ both."""
+        chans = DIRECTION_CHANNELS[direction]
+        if ctx.test is None or not all(c in ctx.channels for c in chans):
+            return float("nan")
+        h0 = _sense_group(state, direction, h)[0]
+        f = h0 * ctx.omega[runs] / (2 * np.pi)
+        inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
+        X = ctx.phasors(runs, f[:, None])[:, 0, :]
+        x, y = X[:, CHANNELS.index(chans[0])], X[:, CHANNELS.index(chans[1])]
+        co, ct = np.abs(x + 1j * y) ** 2 / 4.0, np.abs(x - 1j * y) ** 2 / 4.0
+        neg = np.asarray(ctx.sp.speed, float)[runs] < 0
+        co, ct = np.where(neg, ct, co), np.where(neg, co, ct)
+        Hc2 = ctx.gain(state, chans[0], f) ** 2
+        co = co / (ctx.unit_gain(state, chans[0], direction, h0, "co", runs) ** 2 * Hc2)
+        ct = ct / (ctx.unit_gain(state, chans[0], direction, h0, "counter", runs) ** 2 * Hc2)
+        ok = inb & np.isfinite(co) & np.isfinite(ct)
+        tot = float(np.sum(co[ok] + ct[ok]))
+        return float(np.sum(ct[ok]) / tot) if tot > 0 else float("nan")
+
+    @staticmethod
+    def fit(ctx: Context, state: State, direction: str, h: float, runs) -> "CounterRotation | None":
+        """q by weighted least squares of ln(measured x + y line power) on ln(P_o + P₊ + q(P₋ − P₊)) over the
+        runs where the line stands above the noise (:meth:`_points`; weights s²/(s² + SNR_KNEE²), s the line's
+        power over the noise in its window), q in [0, 1] (grid, then a bounded scalar minimisation); its
+        standard error from the curvature and the residual scatter.  None when the data cannot tell the senses
+        apart (max |ln P₋/P₊| < 0.1 over the runs) or fewer than 3 runs measure the line."""
+        from scipy.optimize import minimize_scalar
+
+        if _sense_group(state, direction, h) is None:
+            return None
+        Pm, Po, Pp, Pn, wt, ok = CounterRotation._points(ctx, state, direction, h, runs)
+        if ok.sum() < 3:
+            return None
+        Pm, Po, Pp, Pn, wt = (v[ok] for v in (Pm, Po, Pp, Pn, wt))
+        if np.max(np.abs(np.log(np.maximum(Pn, 1e-300) / np.maximum(Pp, 1e-300)))) < 0.1:
+            return None
+        y = np.log(Pm)
+
+        def cost(q):
+            return float(np.sum(wt * (y - np.log(np.maximum(Po + Pp + q * (Pn - Pp), 1e-300))) ** 2))
+
+        grid = np.linspace(0.0, 1.0, 201)
+        vals = [cost(q) for q in grid]
+        i = int(np.argmin(vals))
+        sol = minimize_scalar(cost, bounds=(grid[max(i - 1, 0)], grid[min(i + 1, 200)]), method="bounded",
+                              options={"xatol": 1e-6})
+        q = float(sol.x) if sol.fun <= vals[i] else float(grid[i])
+        P = Po + Pp + q * (Pn - Pp)
+        J = (Pn - Pp) / P
+        info = float(np.sum(wt * J**2))
+        s2 = cost(q) / max(y.size - 1, 1)
+        se = float(np.sqrt(s2 / info)) if info > 0 else float("inf")
+        return CounterRotation(direction, float(h), q, se, CounterRotation.phase_fraction(ctx, state, direction, h, runs),
+                               int(y.size))
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        """Every co/counter radial harmonic of the extended base not yet split, whose fitted q departs from the
+        state's own (0 for a co line, 1 for a counter line) by more than 0.01 and 2 standard errors."""
+        if state.ext is None:
+            return []
+        done = {(e.direction, round(e.h, 3)) for e in state.effects if isinstance(e, CounterRotation)}
+        out = []
+        for d in ("radial_force", "radial_torque"):
+            if not any(c in ctx.channels for c in DIRECTION_CHANNELS[d]):
+                continue
+            hs = sorted({round(ln.h, 4) for ln in state.ext_lines() if ln.direction == d})
+            for h in hs:
+                g = _sense_group(state, d, h)
+                if g is None or (d, round(h, 3)) in done:
+                    continue
+                q0 = g[2] ** 2 / (g[1] ** 2 + g[2] ** 2)
+                e = CounterRotation.fit(ctx, state, d, h, runs)
+                if e is not None and abs(e.counter_fraction - q0) > max(0.01, 2 * e.counter_fraction_stderr):
+                    out.append(e)
+        return out
+
+
+@dataclass
+class SpinAcceleration:
+    """Lines smeared by the wheel's acceleration during each run of a sweep (a measurement artefact of
+    slicing a spin-up or run-down into quasi-steady runs): the line of harmonic h sweeps h|α|T/2π Hz
+    during a run of length T.  ``alpha`` (rad/s², |dΩ/dt|) is fitted to the residual; ``alpha_track``
+    is the independent estimate from the runs' speeds and start times (NaN for steady runs)."""
+
+    alpha: float
+    alpha_track: float = float("nan")
+    noise: dict | None = None        # instrument noise re-estimated with the smeared lines masked
+    kind: str = "spin_acceleration"
+
+    @property
+    def channels(self):
+        return CHANNELS
+
+    def apply(self, state: State) -> State:
+        s = state.copy()
+        s.smear = self.alpha
+        if self.noise is not None:
+            s.noise = self.noise
+        s.effects.append(self)
+        return s
+
+    def params(self) -> dict:
+        return {"alpha_rad_s2": self.alpha, "alpha_track_rad_s2": self.alpha_track, "role": "measurement"}
+
+    @staticmethod
+    def track(ctx: Context, runs) -> float:
+        """Median |dΩ/dt| (rad/s²) from the runs' speeds against their start times (runs of one sweep,
+        ``Run.t0`` distinct), or NaN."""
+        if ctx.test is None or len(runs) < 3:
+            return float("nan")
+        t0 = np.array([ctx.test.runs[r].t0 for r in runs], dtype=float)
+        w = ctx.omega[runs]
+        order = np.argsort(t0)
+        dt = np.diff(t0[order])
+        if not np.all(np.isfinite(t0)) or np.any(dt <= 0):
+            return float("nan")
+        return float(np.median(np.abs(np.diff(w[order]) / dt)))
+
+    @staticmethod
+    def fit(ctx: Context, state: State, runs) -> "SpinAcceleration | None":
+        from scipy import optimize
+
+        if state.smear is not None or len(runs) < 3:
+            return None
+        track = SpinAcceleration.track(ctx, np.asarray(runs))
+        if not np.isfinite(track):      # not slices of one sweep (steady runs, or no time series given)
+            return None
+        T = float(np.median(ctx.run_durations(runs)))
+        h_max = max((h for c in ctx.channels for h, *_ in ctx.channel_lines(state, c, runs)), default=0.0)
+        if h_max <= 0 or T <= 0:
+            return None
+        # search up to the acceleration that smears the highest line over 16 bins
+        a_max = max(2 * np.pi * 16 * ctx.df / (h_max * T), 3.0 * track)
+
+        def cost(a):
+            trial = state.copy()
+            trial.smear = float(a)
+            return float(ctx.run_errors(trial, runs)[0].sum())
+
+        res = optimize.minimize_scalar(cost, bounds=(0.0, a_max), method="bounded",
+                                       options={"xatol": 1e-3 * a_max})
+        if not (res.x > 1e-3 * a_max and res.fun < cost(0.0)):
+            return None
+        trial = state.copy()
+        trial.smear = float(res.x)
+        return SpinAcceleration(float(res.x), track, noise_estimate(ctx, trial))
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        e = SpinAcceleration.fit(ctx, state, runs)
+        return [] if e is None else [e]
+
 
 EFFECT_CLASSES = (MissingHarmonic, AmplitudeLaw, BroadbandFloor, FixedResonance, CrossCoupling, Sidebands,
-                  SpeedRipple)
+                  SpeedRipple, CounterRotation, SpinAcceleration)
 
 
 def _measure(ctx, state, direction, h, runs, skip=None):
@@ -1302,6 +1786,8 @@ def _measure(ctx, state, direction, h, runs, skip=None):
             continue
         a = ctx.measure_line(state, c, h, runs, skip=skip)
         a = a / ctx.gain(state, c, h * ctx.omega[runs] / (2 * np.pi))     # the line before any resonance
+        if state.ext is not None:
+            a = a / ctx.modal_gain(state, c, h, runs)                      # ... and before the wheel's modes
         ok = np.isfinite(a)
         ds.append(a[ok])
         ws.append(ctx.omega[runs][ok])
@@ -1405,6 +1891,7 @@ class Diagnosis:
         chosen = [h for h in self.hypotheses if h.passed]
         return {
             "metric": METRIC,
+            "base": self.state_before.base,
             "metric_definition": "sum over channels, runs and %d-bin bands of |data - model| power / sum of "
                                  "data power (each channel divided by the mean power of its unit group)" % BAND_BINS,
             "error_before": self.error_before, "error_after": self.error_after,
@@ -1469,15 +1956,27 @@ def _refit(ctx, state, effect):
         return Sidebands.fit(ctx, state, effect.direction, effect.h, runs, effect.f_mod) or effect
     if isinstance(effect, SpeedRipple):
         return SpeedRipple.fit(ctx, state, runs, effect.f_ripple, effect.exponent) or effect
+    if isinstance(effect, CounterRotation):
+        return CounterRotation.fit(ctx, state, effect.direction, effect.h, runs) or effect
+    if isinstance(effect, SpinAcceleration):
+        return SpinAcceleration.fit(ctx, state, runs) or effect
     return effect
 
 
-def initial_state(ctx: Context, model: WheelModel) -> State:
+def initial_state(ctx: Context, model: WheelModel, ext_params=None) -> State:
     """The model with a speed-independent instrument noise per channel: the off-line band means
     (:meth:`Context.offline_bands`) averaged over every run, interpolated between the centres of the
-    bands with a positive mean (the median block floor of the data outside them)."""
+    bands with a positive mean (the median block floor of the data outside them).  ``ext_params``:
+    the :class:`rwadist.extended.ExtendedParams` of the extended base, or None (empirical base)."""
     rough = {c: np.nanmedian(ctx.floor[c][ctx.runs], axis=0) for c in ctx.channels}
-    state = State(copy.deepcopy(model), rough)
+    state = State(copy.deepcopy(model), rough, ext=ext_params)
+    return State(state.model, noise_estimate(ctx, state), ext=ext_params)
+
+
+def noise_estimate(ctx: Context, state: State) -> dict:
+    """Instrument noise per channel (unit²/Hz on the grid) as :func:`initial_state` estimates it, the
+    model's lines (as ``state`` predicts them, smear included) masked out; ``state.noise`` is the
+    fallback outside the bands."""
     noise = {}
     fc = ctx.band_centres()
     for c in ctx.channels:
@@ -1487,27 +1986,53 @@ def initial_state(ctx: Context, model: WheelModel) -> State:
         # a band whose mean is not positive (the model's line skirts exceed the data there: coherent lines
         # closer than the kernel beat in the Welch estimate) says nothing about the noise: interpolated over
         good = (cnt.sum(0) > 0) & (mean > 0)
-        n = np.array(rough[c], dtype=float)
+        n = np.array(state.noise[c], dtype=float)
         band = (ctx.f >= fc[0]) & (ctx.f <= fc[-1])
         if good.sum() >= 2:
             n[band] = np.interp(ctx.f[band], fc[good], mean[good])
         noise[c] = n
-    return State(state.model, noise)
+    return noise
+
+
+BASES = ("empirical", "extended", "auto")
+
+
+def resolve_base(model: WheelModel | None, base: str = "empirical") -> str:
+    """'empirical' or 'extended' for a ``base`` request: 'auto' is 'extended' when the model has an
+    ``analytical`` section, else 'empirical'; 'extended' without one is a ValueError."""
+    if base not in BASES:
+        raise ValueError(f"diagnose: base must be one of {BASES}, got {base!r}")
+    has = model is not None and bool(getattr(model, "analytical", None))
+    if base == "auto":
+        return "extended" if has else "empirical"
+    if base == "extended" and not has:
+        raise ValueError("diagnose: base 'extended' needs a model with an analytical section "
+                         "(rwadist.extended.params_to_dict), e.g. preset('ithaco-e').to_model()")
+    return base
 
 
 def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float = 4.0, min_gain: float = 0.05,
-             max_iterations: int = 8, channels=None, test=None) -> Diagnosis:
+             max_iterations: int = 8, channels=None, test=None, base: str = "empirical") -> Diagnosis:
     """Greedy effect search on ``spectra`` starting from ``model`` (default: the empirical fit).
 
     k_sigma, min_gain : acceptance rule (module docstring).  test : the SteadyTest ``spectra`` were
     computed from (50 % overlap), needed for ``cross_coupling`` (phases); without it that class is not tried.
+    base : 'empirical' (default; lines C·Ω², hard mounted), 'extended' (lines through the suspension modes of
+    the model's ``analytical`` section, :func:`rwadist.extended.steady_lines`) or 'auto' (extended when the
+    model has an analytical section); see :func:`resolve_base`.
     Returns a :class:`Diagnosis` whose ``model`` carries the added harmonics in ``empirical`` and every
     effect in ``effects``.
     """
     if model is None:
         model = fit_empirical(spectra).model
+    base = resolve_base(model, base)
+    ext_params = None
+    if base == "extended":
+        from .extended import params_from_model
+
+        ext_params = params_from_model(model, getattr(model, "name", "<model>"))
     ctx = Context(spectra, channels, test)
-    state0 = initial_state(ctx, model)
+    state0 = initial_state(ctx, model, ext_params)
     state = state0
     hyps = []
     it = 0
@@ -1532,7 +2057,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         it = max_iterations
     out = copy.deepcopy(state.model)
     out.effects = list(model.effects) + [effect_entry(h) for h in hyps if h.passed]
-    out.provenance = dict(out.provenance, diagnose={"metric": METRIC})
+    out.provenance = dict(out.provenance, diagnose={"metric": METRIC, "base": base})
     return Diagnosis(out, state0, state, ctx.error(state0), ctx.error(state), ctx.rms_error(state0),
                      ctx.rms_error(state), hyps, it, ctx)
 
@@ -1669,6 +2194,9 @@ def write_report(diag: Diagnosis, out_dir) -> list:
     md = ["# rwadist diagnose", "",
           f"Metric: `{METRIC}` — {summary['metric_definition']}; a band's misplaced power is counted beyond "
           f"{NOISE_Z:g} noise standard deviations.", "",
+          f"- base: {diag.state_before.base} (lines "
+          + ("through the suspension modes of the model's analytical section)" if diag.state_before.ext is not None
+             else "C·Ω², hard mounted)"),
           f"- error before: {diag.error_before:.4g}", f"- error after: {diag.error_after:.4g}",
           f"- RMS-vs-speed relative error before / after: {diag.rms_error_before:.4g} / {diag.rms_error_after:.4g}",
           f"- iterations: {diag.iterations}", "", "## Effects added", ""]

@@ -1,0 +1,72 @@
+"""spin_acceleration (issue 7): lines of a fast spin-up smeared within each quasi-steady slice.
+
+The sweep comes from the virtual stand (preset E wheel, modes off, a linear ramp); nothing in the
+data says how fast it was.  Diagnose must name the smear, fit |dΩ/dt| from the residual alone, agree
+with the independent estimate from the slices' speeds and start times, and cut the error ≥ 3×."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rwadist.diagnose import SpinAcceleration, diagnose
+from rwadist.spectra import compute_spectra
+from rwadist.sweep import slice_sweep
+from rwadist.teststand import preset, simulate_sweep
+
+RPM = 2 * np.pi / 60
+
+
+def sweep_data(duration, seed, rpm=(500.0, 2400.0)):
+    wheel = preset("ithaco-e")
+    sw = simulate_sweep(wheel, rpm[0], rpm[1], duration=duration, sample_rate=1920.0, modes=False,
+                        test_stand=False, seed=seed)
+    test, _ = slice_sweep(sw, slice_samples=4096)
+    return wheel, test, compute_spectra(test, nperseg=1024)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_spin_acceleration_found(seed):
+    wheel, test, sp = sweep_data(40.0, seed)
+    alpha_true = (2400.0 - 500.0) * RPM / 40.0                      # 4.97 rad/s²
+    d = diagnose(sp, model=wheel.to_model(), test=test)
+    kinds = [e["kind"] for e in d.summary()["effects"]]
+    print(f"seed {seed}: {kinds}, error {d.error_before:.5f} -> {d.error_after:.5f}")
+    assert kinds[0] == "spin_acceleration"
+    e = d.summary()["effects"][0]
+    assert e["alpha_rad_s2"] == pytest.approx(alpha_true, rel=0.05)
+    assert e["alpha_track_rad_s2"] == pytest.approx(alpha_true, rel=0.02)
+    assert "missing_harmonic" not in kinds and "speed_ripple" not in kinds and "sidebands" not in kinds
+    assert d.error_before / d.error_after >= 3.0
+    # a measurement artefact: recorded with its role, not a disturbance
+    assert e["role"] == "measurement"
+
+
+def test_smear_prediction_conserves_power_and_spreads_with_h():
+    """The smeared line keeps its power (weights sum to the mean of (Ω(τ)/Ω)⁴ over the record, ≥ 1) and
+    spreads over h|α|T/2π Hz: twice as wide for h = 2 as for h = 1."""
+    wheel, test, sp = sweep_data(40.0, 1)
+    from rwadist.diagnose import Context, initial_state
+
+    ctx = Context(sp, test=test)
+    st = initial_state(ctx, wheel.to_model())
+    st.smear = 5.0
+    runs = ctx.runs[:4]
+    T = ctx.run_durations(runs)
+    for h in (1.0, 2.0):
+        du, wt = ctx.smear_offsets(st, h, runs)
+        span = du.max(1) - du.min(1)
+        m = du.shape[1]
+        assert np.allclose(span, h * 5.0 * T / (2 * np.pi) * (m - 1) / m, rtol=1e-12)
+        x = 5.0 * T / np.abs(ctx.omega[runs])                        # αT/Ω
+        assert np.all(wt.sum(1) >= 1.0 - 1e-12) and np.all(wt.sum(1) <= (1 + x / 2) ** 4)
+
+
+def test_steady_runs_do_not_try_spin_acceleration():
+    """Runs that are not slices of one sweep (equal start times) have no speed track: the class stays out."""
+    wheel, test, sp = sweep_data(40.0, 1)
+    for r in test.runs:
+        r.t0 = 0.0
+    from rwadist.diagnose import Context, initial_state
+
+    ctx = Context(sp, test=test)
+    assert SpinAcceleration.fit(ctx, initial_state(ctx, wheel.to_model()), ctx.fit_runs) is None
