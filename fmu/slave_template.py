@@ -202,7 +202,7 @@ class RwadistWheelSlave(Fmi2Slave):
     # No exception may leave a method pythonfmu calls: its native layer then releases the slave's
     # Python objects once (handle_py_exception) and again when the host frees the instance -- a
     # double free that crashes the host later.  A wrong value reference or type is logged, flagged
-    # (fmi2Error through the native layer) and answered with placeholder values.
+    # (fmi2Error through the native layer) and answered with NaN, 0, False or "" values.
     def _refuse(self, what, exc, n, fill):
         self._log_error(f"{what}: {exc}")
         return [fill] * n

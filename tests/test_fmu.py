@@ -26,6 +26,10 @@ fmpy = pytest.importorskip("fmpy")
 
 RPM = 2 * np.pi / 60
 
+#: status of a refused input: fmi2Error through the FMU's native layer (built wherever it can
+#: be: Linux x86-64 with a C compiler, as CI), fmi2Discard through pythonfmu's plain library
+REFUSED = 3 if native_supported() and shutil.which(os.environ.get("CC", "cc")) else 2
+
 
 def wheel_model():
     """The E-wheel preset plus an axial-torque line and a planar radial line (every branch)."""
@@ -100,14 +104,16 @@ def kernel(tmp_path_factory):
         return None
 
 
+NATIVE_ONLY = pytest.mark.skipif(REFUSED != 3, reason="no C compiler / not Linux x86-64: the FMU steps in numpy")
+
+
+@NATIVE_ONLY
 @pytest.mark.parametrize("profile", [spin_up, reversal])
 def test_native_kernel_equals_numpy_runtime(model_path, model, kernel, profile):
     """The C kernel and the numpy runtime step the same equations: every switch and start, both
     acceleration modes, and a mounting for the spacecraft-frame outputs (1e-12 relative); and
     the kernel alone reproduces simulate_time (1e-9)."""
-    if kernel is None:
-        assert REFUSED == 2       # only where the native layer cannot be built
-        pytest.skip("no C compiler / not Linux x86-64: the FMU steps in numpy")
+    assert kernel is not None     # REFUSED == 3: the native layer compiles here
     t, w = profile()
     params, lines = rt.load_model(model_path)
     R = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
@@ -326,9 +332,6 @@ def _instance(path, params=None, log=None, exit_init=True):
     return hosts.FmpyInstance(path, "bad", params or {}, {"wheel_speed": 100.0}, log=log, exit_init=exit_init)
 
 
-#: status of a refused input: fmi2Error through the FMU's native layer (built wherever it can
-#: be: Linux x86-64 with a C compiler, as CI), fmi2Discard through pythonfmu's plain library
-REFUSED = 3 if native_supported() and shutil.which(os.environ.get("CC", "cc")) else 2
 
 
 def test_native_layer_is_built_where_it_can_be(wheel_fmu):
@@ -753,12 +756,11 @@ def test_resonance_and_sideband_amplitudes_at_constant_speed(tmp_path, model, rp
             worst = max(worst, abs(got / amp - 1))
     print(f"\n{rpm} rpm: largest relative amplitude error over {len(comps)} components {worst:.2e}")
 
-
+@NATIVE_ONLY
 @pytest.mark.parametrize("profile", [spin_up, reversal])
 def test_native_kernel_with_resonances_and_sidebands_equals_numpy(model, kernel, profile):
     """C kernel = numpy runtime with resonances and sidebands (1e-12 relative), every switch and start."""
-    if kernel is None:
-        pytest.skip("no C compiler / not Linux x86-64: the FMU steps in numpy")
+    assert kernel is not None
     t, w = profile(T=3.0)
     doc = effects_doc(model)
     h = t[1] - t[0]
