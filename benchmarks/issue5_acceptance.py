@@ -20,7 +20,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import test_fmu as T  # noqa: E402  (the tests' reference, profiles and helpers)
 from fmu import hosts, runtime as rt  # noqa: E402
 from fmu.build import build_fmu, has_native  # noqa: E402
-from rwadist import extended as ext  # noqa: E402
 from rwadist import model as model_io  # noqa: E402
 
 
@@ -51,31 +50,10 @@ def main() -> int:
             print(f"{name:<32} {host:<9} max relative error (12 outputs) "
                   f"{np.max(T.rel_err(out[1:], ref12[1:])):.2e}")
 
-    # 2. constant-speed amplitudes
-    p = ext.params_from_model(model)
-    lines = ext.lines_from_model(model, p)
+    # 2. constant-speed amplitudes (the test's least-squares check, which also returns its worst case)
     for rpm in (2400.0, -1100.0):
-        omega = rpm * T.RPM
-        dt = 1e-4
-        t = np.arange(5001) * dt
-        out = hosts.run_fmpy(fmu, t, {"wheel_speed": np.full(t.size, omega)}, {"start_steady": True, "seed": 4})[1:]
-        tt = t[1:]
-        Fc = out[:, 0] + 1j * out[:, 1]
-        sig = {"radial_force": Fc, "radial_torque": out[:, 3] + 1j * out[:, 4] - 1j * p.height * Fc,
-               "axial_force": out[:, 2], "axial_torque": out[:, 5]}
-        worst = 0.0
-        for d, s in sig.items():
-            comps = [(ln, sg, c) for ln in lines if ln.direction == d for sg, c in ln.components()]
-            if d.startswith("axial"):
-                freqs = [sg * ln.h * abs(omega) for ln, sg, _ in comps] + [-ln.h * abs(omega) for ln, _, _ in comps]
-            else:
-                freqs = [sg * ln.h * omega for ln, sg, _ in comps]
-            coef, *_ = np.linalg.lstsq(np.exp(1j * np.outer(tt, freqs)), s.astype(complex), rcond=None)
-            for k, (ln, sg, cf) in enumerate(comps):
-                expect = ln.C * omega**2 * abs(cf) * T.modal_gain(p, d, sg * ln.h * omega, omega)
-                got = abs(coef[k]) * (2 if d.startswith("axial") else 1)
-                worst = max(worst, abs(got / expect - 1))
-        print(f"constant speed {rpm:+.0f} rpm: {sum(len(ln.components()) for ln in lines)} line components, "
+        worst, n = T.check_amplitudes(fmu, model, rpm, lambda ln, omega: ln.C * omega**2)
+        print(f"constant speed {rpm:+.0f} rpm: {n} line components, "
               f"worst |amplitude / (C·Ω²·|gain|) - 1| = {worst:.2e}")
 
     # 3. validation

@@ -335,7 +335,7 @@ def cmd_campbell(args) -> int:
 
 def cmd_fmu_build(args) -> int:
     try:
-        from fmu.build import build_fmu
+        from fmu.build import build_fmu, has_native
         from fmu.runtime import ModelError
     except ImportError as exc:
         raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
@@ -348,7 +348,6 @@ def cmd_fmu_build(args) -> int:
         path = build_fmu(source, args.output)
     except ModelError as exc:
         raise DataError(args.model or args.preset, "model", str(exc)) from None
-    from fmu.build import has_native
     print(f"wrote {path} (model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')}; "
           f"native layer: {'yes' if has_native(path) else 'no, numpy steps and fmi2Discard on bad input'})")
     return 0
