@@ -116,8 +116,15 @@ def effects_from_doc(doc, source="<model>"):
       amplitude modulated, a(1 + m·cos 2πf_mod t) = the carrier + two lines of amplitude m·a/2 whose
       phases advance by ±2πf_mod·t (exact in the time domain).
 
+    * ``floors``: [(channel index, f knots Hz, psd_ref knots unit²/Hz, Ω_ref rad/s, p)] of each
+      ``broadband_floor`` (one entry per channel it names): a blocked-load PSD
+      S(f, Ω) = psd_ref(f)·(|Ω|/Ω_ref)^p (linear between knots, 0 outside), added to the wheel-frame
+      output as a random-phase multisine (see :class:`WheelRuntime`);
+    * ``ripples``: [(ΔΩ_ref rad/s, Ω_ref rad/s, q, f_r Hz)] of each ``speed_ripple``: the wheel turns at
+      Ω(t) + ΔΩ_ref·(|Ω|/Ω_ref)^q·sin(2π f_r t + θ) (see :class:`WheelRuntime`).
+
     ModelError naming ``effects[i].<field>`` on a bad entry."""
-    out = {"laws": laws_from_doc(doc, source), "resonances": [], "sidebands": []}
+    out = {"laws": laws_from_doc(doc, source), "resonances": [], "sidebands": [], "floors": [], "ripples": []}
     for i, e in enumerate(doc.get("effects") or []):
         if not isinstance(e, dict):
             continue
@@ -147,7 +154,46 @@ def effects_from_doc(doc, source="<model>"):
                 if not ok:
                     raise ModelError(f"{where}.{k}: must be {'>= 0' if k == 'depth' else '> 0'}, got {v!r}")
             out["sidebands"].append((d, h, f_mod, m))
+        elif kind == "broadband_floor":
+            out["floors"].extend(_floor_from_entry(e, where))
+        elif kind == "speed_ripple":
+            vals = []
+            for k, need, ok in (("delta_omega_rad_s", ">= 0", lambda v: v >= 0), ("omega_ref_rad_s", "> 0", lambda v: v > 0),
+                                ("speed_exponent", ">= 0", lambda v: v >= 0), ("f_ripple_Hz", "> 0", lambda v: v > 0)):
+                v = _num(e.get(k, 0.0) if k == "speed_exponent" else e.get(k), f"{where}.{k}")
+                if not ok(v):
+                    raise ModelError(f"{where}.{k}: must be {need}, got {v!r}")
+                vals.append(v)
+            out["ripples"].append(tuple(vals))
     return out
+
+
+def _floor_from_entry(e, where):
+    """[(channel index, f knots, psd knots, Ω_ref, p)] of one ``broadband_floor`` entry, validated."""
+    chans = e.get("channel")
+    chans = [chans] if isinstance(chans, str) else chans
+    if not isinstance(chans, list) or not chans or any(c not in CHANNELS for c in chans):
+        raise ModelError(f"{where}.channel: {e.get('channel')!r} must be one of {', '.join(CHANNELS)} or a list of them")
+    knots = {}
+    for k in ("f_Hz", "psd_ref"):
+        v = e.get(k)
+        if not isinstance(v, list) or len(v) < 2:
+            raise ModelError(f"{where}.{k}: must be a list of at least two numbers")
+        knots[k] = np.array([_num(x, f"{where}.{k}[{i}]") for i, x in enumerate(v)])
+    f, psd = knots["f_Hz"], knots["psd_ref"]
+    if f.size != psd.size:
+        raise ModelError(f"{where}.psd_ref: has {psd.size} values for {f.size} f_Hz knots")
+    if f[0] < 0 or np.any(np.diff(f) <= 0):
+        raise ModelError(f"{where}.f_Hz: knots must be >= 0 and strictly increasing")
+    if np.any(psd < 0):
+        raise ModelError(f"{where}.psd_ref: values must be >= 0, got {float(psd.min())!r}")
+    w_ref = _num(e.get("omega_ref_rad_s"), f"{where}.omega_ref_rad_s")
+    p = _num(e.get("exponent"), f"{where}.exponent")
+    if w_ref <= 0:
+        raise ModelError(f"{where}.omega_ref_rad_s: must be > 0, got {w_ref!r}")
+    if p < 0:
+        raise ModelError(f"{where}.exponent: must be >= 0, got {p!r}")
+    return [(CHANNELS.index(c), f, psd, w_ref, p) for c in chans]
 
 
 def load_model(path):
@@ -273,6 +319,11 @@ KERNEL_COMP = 32
 KERNEL_STRIDE = 13
 KERNEL_RES = 3
 
+#: floor phasors are recomputed from the time every so many steps (rounding of the rotation stays ~1e-13)
+FLOOR_RESYNC = 1000
+#: most sinusoids the broadband floors may take (memory ~50 MB, ~10 ms per step beyond it)
+FLOOR_MAX_COMPONENTS = 2_000_000
+
 
 def load_kernel(path):
     """``rwadist_kernel_step`` of the native library at ``path`` as a ctypes function, or None
@@ -322,11 +373,30 @@ class WheelRuntime:
     after the model's lines (per sideband effect, per matching carrier: +f_mod then −f_mod; the
     order of ``rwadist.extended.apply_line_effects``) and the seed's phases are drawn over that
     whole list; they follow their carrier's imbalance/harmonics switch.
+
+    ripples : diagnosed speed ripples (:func:`effects_from_doc`), used when ``speed_ripple``: the rotor
+    turns at the input speed plus r(t) = Σ ΔΩ_ref·(|Ω(t)|/Ω_ref)^q·sin(2π f_r t + θ) (t since t0; θ = 0
+    without a seed, else uniform from ``default_rng((seed, 1))``).  Each step runs from Ω_n + r(t_n) to
+    Ω_{n+1} + r(t_{n+1}) (linear in between, like any step), so the lines are phase and amplitude
+    modulated through the same equations as a rippled input speed would be -- exactly the FMU fed that
+    speed with the slope as acceleration (tested).  Switch it off when the input is a measured speed that
+    already carries the ripple.  Input checks (finite, max_acceleration, jumps) apply to the input speed.
+
+    floors : diagnosed broadband floors (:func:`effects_from_doc`), used when ``broadband_floor``: each is
+    added to its wheel-frame output channel (a blocked load, like the measurement it was fitted to) as
+    g(Ω)·Σ_k a_k cos(2π f_k t + φ_k) with f_k = k·``floor_resolution`` (Hz) over the knots' span,
+    a_k = sqrt(2·psd_ref(f_k)·df) and g = (|Ω|/Ω_ref)^{p/2} at the step's end speed: over one period
+    1/df its mean square is Σ_k psd_ref(f_k)·df·g² (Parseval; the floor's integral) and its PSD at a
+    resolution coarser than df is psd_ref·g².  Phases φ_k: uniform from ``default_rng((seed, 2))``, or
+    Schroeder's phases −πk(k−1)/N (deterministic, low crest factor) without a seed.  The sum is kept as
+    rotating phasors (one complex multiply per component per step), resynchronised to t every
+    FLOOR_RESYNC steps.
     """
 
     def __init__(self, params, lines, *, seed=None, imbalance=True, harmonics=True, modes=True,
                  start_steady=False, max_accel=500.0, max_step=0.01, dcm=None, position=None, kernel=None,
-                 laws=None, resonances=None, sidebands=None):
+                 laws=None, resonances=None, sidebands=None, ripples=None, floors=None, speed_ripple=True,
+                 broadband_floor=True, floor_resolution=0.1):
         self.p = dict(params)
         if not (math.isfinite(max_accel) and max_accel > 0):
             raise ModelError(f"max_acceleration must be finite and > 0, got {max_accel!r}")
@@ -443,7 +513,81 @@ class WheelRuntime:
             self._st = np.zeros(2 + 2 * n + 12)
             self._kout = np.zeros(12)
             self._ptrs = (cfg.ctypes.data, self._st.ctypes.data, self._kout.ctypes.data)
+        self._init_ripple(ripples if speed_ripple else None, seed)
+        self._init_floor(floors if broadband_floor else None, seed, floor_resolution)
         self.reset()
+
+    def _init_ripple(self, ripples, seed):
+        rip = [tuple(float(v) for v in r) for r in (ripples or [])]
+        self.has_ripple = bool(rip)
+        theta = (np.random.default_rng((int(seed), 1)).uniform(0, 2 * np.pi, len(rip)) if seed is not None
+                 else np.zeros(len(rip)))
+        # (ΔΩ_ref, Ω_ref, q, 2π f_r, θ) per ripple; plain floats: one or two per model, called twice a step
+        self.ripples = [(dw, w_ref, q, 2.0 * math.pi * f_r, float(th)) for (dw, w_ref, q, f_r), th in zip(rip, theta)]
+
+    def ripple(self, omega, t):
+        """Speed ripple r (rad/s) at input speed ``omega`` (rad/s) and time ``t`` since t0 (s)."""
+        r = 0.0
+        for dw, w_ref, q, w_r, th in self.ripples:
+            r += (dw * (abs(omega) / w_ref) ** q if q else dw) * math.sin(w_r * t + th)
+        return r
+
+    def _init_floor(self, floors, seed, df):
+        floors = list(floors or [])
+        self.has_floor = bool(floors)
+        if not self.has_floor:
+            return
+        if not (math.isfinite(df) and df > 0):
+            raise ModelError(f"floor_resolution must be finite and > 0, got {df!r} Hz")
+        amp, wk, chan, ref, expo, starts = [], [], [], [], [], []
+        for c, f_k, psd_k, w_ref, p in floors:
+            k = np.arange(max(1, math.ceil(f_k[0] / df)), math.floor(f_k[-1] / df) + 1)
+            S = np.interp(k * df, f_k, psd_k, left=0.0, right=0.0)
+            keep = S > 0
+            if not keep.any():
+                continue
+            starts.append(sum(a.size for a in amp))
+            amp.append(np.sqrt(2.0 * S[keep] * df))
+            wk.append(2.0 * math.pi * df * k[keep])
+            chan.append(c)
+            ref.append(w_ref)
+            expo.append(0.5 * p)
+        n = sum(a.size for a in amp)
+        if n > FLOOR_MAX_COMPONENTS:
+            raise ModelError(f"broadband floors need {n} sinusoids at floor_resolution = {df:g} Hz (limit "
+                             f"{FLOOR_MAX_COMPONENTS}); use a coarser floor_resolution")
+        self.has_floor = n > 0
+        if not self.has_floor:
+            return
+        A, self.floor_w = np.concatenate(amp), np.concatenate(wk)
+        if seed is not None:
+            ph = np.random.default_rng((int(seed), 2)).uniform(0, 2 * np.pi, n)
+        else:       # Schroeder phases per floor
+            ph = np.concatenate([-np.pi * np.arange(a.size) * (np.arange(a.size) - 1) / a.size for a in amp])
+        self.floor_A = A * np.exp(1j * ph)
+        self.floor_starts = np.array(starts, dtype=int)
+        self.floor_chan = np.array(chan, dtype=int)
+        self.floor_ref = np.array(ref)
+        self.floor_half_p = np.array(expo)
+        self.floor_rot = {}
+
+    def floor_now(self, omega, t, advance=None):
+        """(6,) floor loads at input speed ``omega`` and time ``t``: the phasors advanced by ``advance``
+        seconds (a step) or, with None or every FLOOR_RESYNC steps, set from t exactly."""
+        if advance is None or self._floor_count >= FLOOR_RESYNC:
+            self._floor_Z = self.floor_A * np.exp(1j * self.floor_w * t)
+            self._floor_count = 0
+        else:
+            rot = self.floor_rot.get(advance)
+            if rot is None:
+                if len(self.floor_rot) > 64:
+                    self.floor_rot.clear()
+                rot = self.floor_rot[advance] = np.exp(1j * self.floor_w * advance)
+            self._floor_Z *= rot
+            self._floor_count += 1
+        sums = np.add.reduceat(self._floor_Z.real, self.floor_starts)
+        g = (abs(omega) / self.floor_ref) ** self.floor_half_p
+        return np.bincount(self.floor_chan, weights=g * sums, minlength=6)
 
     @property
     def native(self) -> bool:
@@ -472,6 +616,7 @@ class WheelRuntime:
         self.started = False
         self.out = np.zeros(6)
         self.y = [0.0] * 12
+        self._floor_count = FLOOR_RESYNC      # the first floor value is set from t
 
     def _amp(self, w, wdot):
         """coef·C·(Ω² − iΩ̇·[imbalance]) per component (coef·A_ref·(|Ω|/Ω_ref)^p in place of
@@ -579,6 +724,12 @@ class WheelRuntime:
                 if abs(alpha) > self.max_accel:
                     raise ModelError(f"derived wheel acceleration {alpha:.6g} rad/s² exceeds max_acceleration = "
                                      f"{self.max_accel:.6g} rad/s²")
+        w_in, w1_in = omega, omega + alpha * h
+        t_end = self.t + h
+        if self.has_ripple:      # the rotor's speed: input + ripple, linear over the step
+            r0 = self.ripple(omega, self.t)
+            alpha = alpha + (self.ripple(w1_in, t_end) - r0) / h
+            omega = omega + r0
         wd0 = alpha if self.prev_alpha is None else 0.5 * (self.prev_alpha + alpha)
         if not self.started:
             if self.start_steady:
@@ -590,15 +741,19 @@ class WheelRuntime:
         if self._kernel is not None:
             cfg, st, out = self._ptrs
             self._kernel(cfg, st, out, omega, wd0, alpha, h)
-            self._prev_start = omega
+            self._prev_start = w_in
             self.prev_alpha = alpha
-            self.prev_end = (w1, h)
-            self.y = y = self._kout.tolist()
+            self.prev_end = (w1_in, h)
+            self.t = t_end
+            if self.has_floor:
+                self.out = self._kout[:6] + self.floor_now(w1_in, t_end, h)
+                self.y = y = frame12(self.out, self.R, self.pos)
+            else:
+                self.y = y = self._kout.tolist()
             return y
         p = self.p
         dphi = 0.5 * (omega + w1) * h
         phi1 = self.phi + dphi
-        t_end = self.t + h
         S0 = self.S
         S1 = self._phase(phi1, t_end)
         a0 = self._amp(omega, wd0)
@@ -651,19 +806,27 @@ class WheelRuntime:
         self.phi = phi1
         self.t = t_end
         self.S = S1
-        self._prev_start = omega
+        self._prev_start = w_in
         self.prev_alpha = alpha
-        self.prev_end = (w1, h)
+        self.prev_end = (w1_in, h)
         self.out = self._outputs(loads1)
+        if self.has_floor:
+            self.out = self.out + self.floor_now(w1_in, t_end, h)
         self.y = frame12(self.out, self.R, self.pos)
         return self.y
 
     def outputs_now(self, omega, alpha=0.0):
         """Outputs at the current state for speed ``omega`` (used at t0 before the first step)."""
+        w_in = float(omega)
+        omega, alpha = w_in, float(alpha)
+        if self.has_ripple:
+            omega += self.ripple(w_in, self.t)
         if not self.started and self.start_steady:
-            self._steady_init(float(omega), float(alpha))
-        loads = self._loads(float(omega), float(alpha), self.phi)
+            self._steady_init(omega, alpha)
+        loads = self._loads(omega, alpha, self.phi)
         self.out = self._outputs(loads)
+        if self.has_floor:
+            self.out = self.out + self.floor_now(w_in, self.t)
         self.y = frame12(self.out, self.R, self.pos)
         return self.out
 

@@ -36,7 +36,7 @@ RUNTIME_FILE = "rwadist_fmu_runtime.py"
 MODEL_FILE = "wheel_model.json"
 #: unit -> SI base-unit exponents (kg, m, s, rad) for the UnitDefinitions of modelDescription.xml
 UNITS = {"N": dict(kg=1, m=1, s=-2), "N.m": dict(kg=1, m=2, s=-2), "rad/s": dict(s=-1, rad=1),
-         "rad/s2": dict(s=-2, rad=1), "s": dict(s=1), "m": dict(m=1), "1": {}}
+         "rad/s2": dict(s=-2, rad=1), "s": dict(s=1), "m": dict(m=1), "Hz": dict(s=-1), "1": {}}
 OUTPUTS = (("Fx", "N", "force the wheel exerts on its interface, wheel frame x"),
            ("Fy", "N", "force on the interface, wheel frame y"),
            ("Fz", "N", "force on the interface, wheel frame z (spin axis)"),
@@ -103,6 +103,9 @@ class RwadistWheelSlave(Fmi2Slave):
         self.harmonics = True
         self.modes = True
         self.start_steady = False
+        self.speed_ripple = True
+        self.broadband_floor = True
+        self.floor_resolution = 0.1
         self.max_acceleration = 500.0
         self.max_step_size = 0.01
         self.dcm = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
@@ -142,6 +145,16 @@ class RwadistWheelSlave(Fmi2Slave):
         self.register_variable(Boolean("start_steady", causality=par, variability=fixed,
                                        description="start from the steady state at the first speed instead "
                                                    "of rest"))
+        self.register_variable(Boolean("speed_ripple", causality=par, variability=fixed,
+                                       description="diagnosed wheel-speed ripple (model file effects) added to "
+                                                   "wheel_speed; off when wheel_speed is a measured speed that "
+                                                   "already carries it"))
+        self.register_variable(Boolean("broadband_floor", causality=par, variability=fixed,
+                                       description="diagnosed broadband floors (model file effects) added to the "
+                                                   "outputs as random-phase multisines"))
+        self.register_variable(RealU("floor_resolution", "Hz", causality=par, variability=fixed,
+                                     description="frequency spacing of the broadband-floor multisine (it repeats "
+                                                 "after 1/floor_resolution s)"))
         self.register_variable(RealU("max_acceleration", "rad/s2", causality=par, variability=fixed,
                                      description="largest |dΩ/dt| accepted; a faster speed change is an error"))
         self.register_variable(RealU("max_step_size", "s", causality=par, variability=fixed,
@@ -307,7 +320,8 @@ class RwadistWheelSlave(Fmi2Slave):
                 params, lines, seed=None if seed == -1 else seed, imbalance=bool(self.imbalance),
                 harmonics=bool(self.harmonics), modes=bool(self.modes), start_steady=bool(self.start_steady),
                 max_accel=float(self.max_acceleration), max_step=float(self.max_step_size),
-                dcm=self.dcm, position=self.pos, kernel=self._kernel, **effects)
+                dcm=self.dcm, position=self.pos, kernel=self._kernel, speed_ripple=bool(self.speed_ripple),
+                broadband_floor=bool(self.broadband_floor), floor_resolution=float(self.floor_resolution), **effects)
             for d, h in sorted(set(laws) - self.model.laws_used):
                 self.log(f"rwadist wheel: amplitude_law of {d} h={h:g} matches no line of the model; ignored",
                          Fmi2Status.warning)
