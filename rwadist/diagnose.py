@@ -878,6 +878,10 @@ class BroadbandFloor:
     psd_ref: np.ndarray
     noise: np.ndarray
     kind: str = "broadband_floor"
+    #: the knots written to the model file (band centres with flat ends over the analysed band): psd_ref is
+    #: exactly their linear interpolation (0 outside), so the file reproduces the fitted floor
+    knots_f: np.ndarray | None = None
+    knots_psd: np.ndarray | None = None
 
     @property
     def channels(self):
@@ -892,12 +896,13 @@ class BroadbandFloor:
         return s
 
     def params(self) -> dict:
-        step = BAND_BINS
+        kf = self.f_hz[::BAND_BINS] if self.knots_f is None else self.knots_f
+        kp = self.psd_ref[::BAND_BINS] if self.knots_psd is None else self.knots_psd
         return {"channel": self.channel, "exponent": self.exponent, "omega_ref_rad_s": self.omega_ref,
-                "psd_law": "psd_ref(f) * (|omega|/omega_ref)^exponent",
+                "psd_law": "psd_ref(f) * (|omega|/omega_ref)^exponent, linear between knots, 0 outside",
                 "unit": f"{CHANNEL_UNIT[self.channel]}^2/Hz",
-                "f_Hz": [float(x) for x in self.f_hz[::step]],
-                "psd_ref": [float(x) for x in self.psd_ref[::step]]}
+                "f_Hz": [float(x) for x in kf],
+                "psd_ref": [float(x) for x in kp]}
 
     @staticmethod
     def fit(ctx: Context, state: State, c: str, runs) -> "BroadbandFloor | None":
@@ -930,13 +935,16 @@ class BroadbandFloor:
             _, p, n, g = best
             expected = np.maximum(n[None, :] + g[None, :] * x0[:, None] ** p, 1e-300)
         _, p, n, g = best
-        fc = ctx.band_centres()
         f = ctx.f
+        # knots: the band centres, held flat out to the analysed band's first and last bins (a floor below
+        # the first centre -- energy below 1x -- is there in the data too)
+        kf = np.concatenate([[f[ctx.k_lo]], ctx.band_centres(), [f[ctx.k_lo + ctx.n_bands * BAND_BINS - 1]]])
+        kg, kn = np.concatenate([[g[0]], g, [g[-1]]]), np.concatenate([[n[0]], n, [n[-1]]])
         n0 = np.array(state.noise[c], dtype=float)
-        band = (f >= fc[0]) & (f <= fc[-1])
-        n0[band] = np.interp(f[band], fc, n)
-        ref = np.interp(f, fc, g, left=0.0, right=0.0)
-        return BroadbandFloor(c, float(p), w_ref, f.copy(), ref, n0)
+        band = (f >= kf[0]) & (f <= kf[-1])
+        n0[band] = np.interp(f[band], kf, kn)
+        ref = np.interp(f, kf, kg, left=0.0, right=0.0)
+        return BroadbandFloor(c, float(p), w_ref, f.copy(), ref, n0, knots_f=kf, knots_psd=kg)
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
