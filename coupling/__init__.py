@@ -4,7 +4,8 @@ components : wheel / rigid mass / spring-mass / isolated components (python-cont
              interface acceleration in -> load out) and plants (StateSpace, modal data, rigid).
 assemble   : acceleration-feedback assembly; the three practices of Table 5.1 as systems.
 geometry   : mounts (DCM + lever arm) of 6-axis components on plant nodes.
-performance: line responses, jitter RMS vs speed, practice errors, speed-averaged PSD.
+performance: line responses (speed ripple included), broadband floors, jitter RMS vs speed, practice
+             errors, speed-averaged PSD.
 sweep      : the same over speeds / wheel sets in parallel with dask (local or a cluster).
 """
 from .assemble import PRACTICES, Assembly, Attachment, assemble, practice_systems
@@ -14,8 +15,8 @@ from .components import (Component, Plant, example_spacecraft, free_lines, frf, 
 from .errors import (CouplingError, InterfaceMismatchError, NotARotationError, SingularInterfaceError,
                      UnstablePlantError)
 from .geometry import Mount, check_dcm, load_transform, rotation, spin_axis_dcm
-from .performance import (JitterResult, LineResponses, WheelSpec, jitter_vs_speed, line_responses, output_psd,
-                          wheel_spec_from_model)
+from .performance import (Floor, FloorResponses, JitterResult, LineResponses, WheelSpec, floor_grid, floor_responses,
+                          floors_from_effects, jitter_vs_speed, line_responses, output_psd, wheel_spec_from_model)
 from .sweep import sweep
 
 __all__ = [n for n in dir() if not n.startswith("_")]

@@ -1,5 +1,5 @@
-"""Performance prediction: harmonic lines of several wheels through the coupled spacecraft,
-side by side with the three practices of thesis Table 5.1.
+"""Performance prediction: harmonic lines and broadband floors of several wheels through the coupled
+spacecraft, side by side with the three practices of thesis Table 5.1.
 
 Method (frequency domain, exact for steady lines; the same physics as
 :func:`coupling.assemble.assemble`, checked against it in the tests).  At a line of wheel k at
@@ -19,15 +19,31 @@ the same fixed frequency offset: a diagnosed sideband sits at |hΩ/2π ± f_mod|
 (their phasors add); lines of different harmonic numbers or offsets and of different wheels are
 taken as incoherent (powers add): RMS = sqrt(Σ |Y|²/2).  Each group is evaluated at its own
 frequency (plant, wheel dynamic mass and blocked loads alike).
+
+Diagnosed effects that are not lines of the extended model (``rwadist diagnose``, read by
+:func:`wheel_spec_from_model`):
+
+* ``speed_ripple`` (:class:`rwadist.extended.Ripple`): the wheel speed is Ω0 + ΔΩ sin 2πf_r t; every line
+  becomes lines at its frequency + m·f_r with the complex coefficients of
+  :func:`rwadist.extended.ripple_lines` (phase modulation of the rotor angle, amplitude modulation of
+  a(|Ω|)), each evaluated through the wheel's modes and the coupled plant at its own frequency.  The
+  coefficients act per line before the lines of one (h, offset) group are summed (they share the ripple);
+  the groups are then (h, offset, m).  Neglected: the imbalance's tangential term and the ripple's
+  modulation of the gyroscopic dynamics (see ripple_lines).
+* ``broadband_floor`` (:class:`Floor`): a blocked (hard-mounted) load PSD S_c(f, Ω) on channel c of the
+  wheel, incoherent with everything.  Its output PSD is Σ_wheels Σ_c |T_{y,c}(f)|² S_c(f, Ω·speed_scale),
+  T the same interface equation with F_k = e_c (:func:`floor_responses`); its mean square adds to the
+  lines' in :func:`jitter_vs_speed` and its PSD to :func:`output_psd`.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from rwadist import extended as ext
-from rwadist.units import RAD_S_TO_RPM
+from rwadist.units import CHANNELS, RAD_S_TO_RPM
 
 from . import geometry
 from .assemble import PRACTICES
@@ -35,12 +51,107 @@ from .components import Plant, wheel_matrices, wheel_rigid_mass_matrix
 from .errors import CouplingError, SingularInterfaceError
 
 
+# ----------------------------------------------------------------------------- broadband floors
+
+@dataclass(frozen=True, eq=False)
+class Floor:
+    """A broadband floor of one load channel of a wheel (a diagnosed ``broadband_floor``): the blocked
+    load PSD S(f, Ω) = interp(f; f_hz, psd_ref; 0 outside)·(|Ω|/omega_ref)^exponent, one-sided, unit²/Hz.
+
+    channel : 0..5 (Fx, Fy, Fz, Tx, Ty, Tz, wheel frame).  f_hz : knots, Hz (>= 0, increasing, >= 2).
+    psd_ref : PSD at the knots at Ω = omega_ref, N²/Hz or (N·m)²/Hz (>= 0).  omega_ref : rad/s (> 0).
+    exponent : speed exponent p (>= 0)."""
+
+    channel: int
+    f_hz: np.ndarray
+    psd_ref: np.ndarray
+    omega_ref: float
+    exponent: float = 0.0
+
+    def __post_init__(self):
+        f = np.asarray(self.f_hz, dtype=float).ravel()
+        s = np.asarray(self.psd_ref, dtype=float).ravel()
+        if self.channel not in range(6):
+            raise CouplingError(f"Floor.channel must be 0..5 ({', '.join(CHANNELS)}), got {self.channel!r}")
+        if f.size < 2 or not np.all(np.isfinite(f)) or f[0] < 0 or np.any(np.diff(f) <= 0):
+            raise CouplingError("Floor.f_hz must be >= 2 finite, non-negative, strictly increasing frequencies")
+        if s.shape != f.shape or not np.all(np.isfinite(s)) or np.any(s < 0):
+            raise CouplingError(f"Floor.psd_ref must be {f.size} finite values >= 0 (one per knot)")
+        if not (math.isfinite(self.omega_ref) and self.omega_ref > 0):
+            raise CouplingError(f"Floor.omega_ref must be > 0, got {self.omega_ref!r}")
+        if not (math.isfinite(self.exponent) and self.exponent >= 0):
+            raise CouplingError(f"Floor.exponent must be finite and >= 0, got {self.exponent!r}")
+        object.__setattr__(self, "f_hz", f)
+        object.__setattr__(self, "psd_ref", s)
+
+    def psd(self, f_hz, omega) -> np.ndarray:
+        """S (n_speeds, n_f) at frequencies ``f_hz`` (Hz) and wheel speeds ``omega`` (rad/s)."""
+        shape = np.interp(np.asarray(f_hz, dtype=float), self.f_hz, self.psd_ref, left=0.0, right=0.0)
+        gain = (np.abs(np.atleast_1d(np.asarray(omega, dtype=float))) / self.omega_ref) ** self.exponent
+        return gain[:, None] * shape[None, :]
+
+    def support(self):
+        """(lo, hi) Hz outside which the floor is zero, or None for an all-zero floor."""
+        nz = np.nonzero(self.psd_ref > 0)[0]
+        if nz.size == 0:
+            return None
+        return float(self.f_hz[max(nz[0] - 1, 0)]), float(self.f_hz[min(nz[-1] + 1, self.f_hz.size - 1)])
+
+
+def floors_from_effects(effects) -> tuple:
+    """The :class:`Floor` s of a model file's ``effects`` list: each ``broadband_floor`` entry
+    {"channel": name or list of names, "exponent", "omega_ref_rad_s", "f_Hz": [...], "psd_ref": [...]}
+    gives one Floor per channel.  CouplingError naming ``effects[i].<field>`` on a bad entry."""
+    if not effects:
+        return ()
+    if not isinstance(effects, (list, tuple)):
+        raise CouplingError(f"effects: must be a list, got {type(effects).__name__}")
+    out = []
+    for i, e in enumerate(effects):
+        if not isinstance(e, dict) or e.get("kind") != "broadband_floor":
+            continue
+        ch = e.get("channel")
+        chans = [ch] if isinstance(ch, str) else ch
+        if not isinstance(chans, (list, tuple)) or not chans or any(c not in CHANNELS for c in chans):
+            raise CouplingError(f"effects[{i}].channel: {ch!r} must be one of {', '.join(CHANNELS)} or a "
+                                "non-empty list of them")
+        try:
+            p = ext._effect_number(e, i, "exponent", lambda v: v >= 0, "a finite number >= 0")
+            w_ref = ext._effect_number(e, i, "omega_ref_rad_s", lambda v: v > 0, "a finite number > 0")
+        except ValueError as exc:
+            raise CouplingError(str(exc)) from exc
+        f = _number_list(e, i, "f_Hz")
+        if f.size < 2 or f[0] < 0 or np.any(np.diff(f) <= 0):
+            raise CouplingError(f"effects[{i}].f_Hz: must be at least 2 frequencies >= 0, strictly increasing")
+        s = _number_list(e, i, "psd_ref")
+        if s.size != f.size or np.any(s < 0):
+            raise CouplingError(f"effects[{i}].psd_ref: must be {f.size} values >= 0 (one per f_Hz knot), "
+                                f"got {s.size}" + (" with negative values" if np.any(s < 0) else ""))
+        for c in dict.fromkeys(chans):
+            out.append(Floor(CHANNELS.index(c), f, s, w_ref, p))
+    return tuple(out)
+
+
+def _number_list(e, i, key):
+    v = e.get(key)
+    if not isinstance(v, (list, tuple)) or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v):
+        raise CouplingError(f"effects[{i}].{key}: must be a list of numbers, got {v!r}")
+    a = np.asarray(v, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise CouplingError(f"effects[{i}].{key}: must be finite numbers")
+    return a
+
+
+# ----------------------------------------------------------------------------- wheels
+
 @dataclass(frozen=True, eq=False)
 class WheelSpec:
     """One wheel on the plant.  params: extended-model parameters; lines: its forcing lines
     (:class:`rwadist.extended.Line`); mount: where it sits; housing mass (kg) and inertia
     (kg·m², about the interface point); speed_scale: this wheel's speed = speed_scale × the
-    sweep speed (e.g. −1 for a wheel spinning the other way, 0.9 for a slower one)."""
+    sweep speed (e.g. −1 for a wheel spinning the other way, 0.9 for a slower one).
+    floors: its broadband floors (:class:`Floor`, blocked loads, incoherent); ripple: its speed
+    ripple (:class:`rwadist.extended.Ripple`) or None."""
 
     params: ext.ExtendedParams
     lines: tuple
@@ -49,28 +160,50 @@ class WheelSpec:
     housing_inertia: tuple = (0.0, 0.0, 0.0)
     speed_scale: float = 1.0
     name: str = "wheel"
+    floors: tuple = ()
+    ripple: ext.Ripple | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "lines", tuple(self.lines))
+        object.__setattr__(self, "floors", tuple(self.floors))
         if not self.lines:
             raise CouplingError(f"{self.name}: no forcing lines")
+        if any(not isinstance(f, Floor) for f in self.floors):
+            raise CouplingError(f"{self.name}: floors must be coupling.performance.Floor objects")
+        if self.ripple is not None and not isinstance(self.ripple, ext.Ripple):
+            raise CouplingError(f"{self.name}: ripple must be a rwadist.extended.Ripple or None")
 
 
 def wheel_spec_from_model(model, mount=None, **kw) -> WheelSpec:
     """A WheelSpec from a :class:`rwadist.model.WheelModel` with an analytical section (a fitted
     model file or ``preset(...).to_model()``): lines via :func:`rwadist.extended.lines_from_model`,
     with the diagnosed effects of ``model.effects`` applied (``rwadist diagnose``; amplitude laws,
-    wheel-mode resonances, sidebands: :func:`rwadist.extended.apply_line_effects`)."""
+    wheel-mode resonances, sidebands: :func:`rwadist.extended.apply_line_effects`), its
+    ``broadband_floor`` entries as :attr:`WheelSpec.floors` (:func:`floors_from_effects`) and its
+    ``speed_ripple`` as :attr:`WheelSpec.ripple` (:func:`rwadist.extended.ripple_from_effects`).
+    A bad entry raises CouplingError naming ``effects[i].<field>``."""
+    effects = getattr(model, "effects", None)
     p = ext.params_from_model(model)
-    return WheelSpec(p, tuple(ext.lines_from_model(model, p)), mount or geometry.Mount(), **kw)
+    try:
+        lines = tuple(ext.lines_from_model(model, p))
+        ripple = ext.ripple_from_effects(effects)
+    except ValueError as exc:
+        raise CouplingError(str(exc)) from exc
+    kw.setdefault("floors", floors_from_effects(effects))
+    kw.setdefault("ripple", ripple)
+    return WheelSpec(p, lines, mount or geometry.Mount(), **kw)
 
+
+# ----------------------------------------------------------------------------- lines
 
 @dataclass(frozen=True, eq=False)
 class LineResponses:
     """Per wheel k: h[k] (J_k,) harmonic numbers (a harmonic repeats for its sideband groups, whose
-    frequency offsets are in f_offset[k] (J_k,) Hz), f_hz[k] (S, J_k), y[practice][k] (S, J_k, n_perf)
-    complex output phasors, loads[k] (S, J_k, 6) coupled loads wheel k exerts (own frame, own
-    lines), hard_mounted[k] (S, J_k, 6) the same lines on a rigid mount."""
+    frequency offsets are in f_offset[k] (J_k,) Hz: a diagnosed sideband's ±f_mod plus the speed-ripple
+    order ripple_order[k] (J_k,) × f_r), f_hz[k] (S, J_k), y[practice][k] (S, J_k, n_perf) complex
+    output phasors, loads[k] (S, J_k, 6) coupled loads wheel k exerts (own frame, own lines),
+    hard_mounted[k] (S, J_k, 6) the same lines on a rigid mount.  floor: the wheels' broadband floors
+    through the same practices (:class:`FloorResponses`), None when no wheel has one."""
 
     omega: np.ndarray
     perf_names: tuple
@@ -80,41 +213,99 @@ class LineResponses:
     loads: list
     hard_mounted: list
     f_offset: list = field(default_factory=list)
+    ripple_order: list = field(default_factory=list)
+    floor: "FloorResponses | None" = None
 
     def rms(self, practice: str = "coupled") -> np.ndarray:
-        """(S, n_perf) RMS of each performance output over all lines of all wheels."""
+        """(S, n_perf) RMS of each performance output over all lines of all wheels (floors excluded)."""
         ms = sum(np.sum(np.abs(yk) ** 2, axis=1) / 2.0 for yk in self.y[practice])
         return np.sqrt(ms)
 
+    def total_rms(self, practice: str = "coupled") -> np.ndarray:
+        """(S, n_perf) RMS of lines and broadband floors: sqrt(lines' mean square + floors' mean square)
+        (incoherent)."""
+        ms = self.rms(practice) ** 2
+        if self.floor is not None:
+            ms = ms + self.floor.ms[practice]
+        return np.sqrt(ms)
 
-def _grouped_lines(spec: WheelSpec, omega):
-    """Hard-mounted line phasors summed over lines with equal h and frequency offset:
-    (h (J,), f_offset (J,) Hz, f (S, J) Hz, F (S, J, 6))."""
-    keys = np.array([(ln.h, ln.f_offset) for ln in spec.lines], dtype=float)
+
+def _grouped_lines(spec: WheelSpec, omega, k_max: int = 0):
+    """Hard-mounted line phasors summed over lines with equal h and frequency offset (and, with a speed
+    ripple, the ripple order m, the complex ripple coefficient applied per line first):
+    (h (J,), f_offset (J,) Hz incl. m·f_r, m (J,), f (S, J) Hz, F (S, J, 6))."""
+    S = np.size(omega)
+    if spec.ripple is None:
+        m = np.zeros(1, dtype=int)
+        f_all, amp = ext.steady_lines(spec.params, spec.lines, omega)
+        f_all, amp = f_all[:, :, None], amp[:, :, None, :]
+    else:
+        m, f_all, amp = ext.ripple_lines(spec.params, spec.lines, omega, spec.ripple, k_max)
+    L, M = len(spec.lines), m.size
+    keys = np.array([(ln.h, ln.f_offset, mm) for ln in spec.lines for mm in m], dtype=float)
     ku, first, inv = np.unique(keys, axis=0, return_index=True, return_inverse=True)
     inv = np.ravel(inv)
-    f_all, amp = ext.steady_lines(spec.params, spec.lines, omega)
     ind = np.zeros((ku.shape[0], keys.shape[0]))
     ind[inv, np.arange(keys.shape[0])] = 1.0
-    return ku[:, 0], ku[:, 1], f_all[:, first], np.einsum("jl,slc->sjc", ind, amp)
+    A2 = np.moveaxis(amp.reshape(S, L * M, 6), 1, 0).reshape(L * M, S * 6)
+    F = np.moveaxis((ind @ A2.real + 1j * (ind @ A2.imag)).reshape(-1, S, 6), 0, 1)
+    fr = 0.0 if spec.ripple is None else spec.ripple.f_hz
+    return (ku[:, 0], ku[:, 1] + ku[:, 2] * fr, ku[:, 2].astype(int), f_all.reshape(S, L * M)[:, first], F)
+
+
+#: Eigenvector-matrix condition number above which the wheel FRF falls back to direct solves.
+_EIG_COND = 1e8
 
 
 def _wheel_frf(spec, omega, f):
-    """(Zc, B) of a flexible wheel at speeds omega (S,) and frequencies f (S, J): (S, J, 6, 6) each."""
+    """(Zc, B) of a flexible wheel at speeds omega (S,) and frequencies f (S, J): (S, J, 6, 6) each.
+
+    Modal form per speed, H(s) = C V (s − Λ)⁻¹ V⁻¹ B + D (one 12×12 eigen-decomposition per speed, then a
+    product per frequency; cond(V) ≈ 1.5e3 for the wheel's state scaling, so ~1e-12 relative); direct
+    solves of (sI − A) X = B at speeds where V is ill-conditioned (> 1e8)."""
     A, B, C, D = wheel_matrices(spec.params, omega, spec.housing_mass, spec.housing_inertia)
-    s = 2j * np.pi * f
-    M = s[..., None, None] * np.eye(12) - A[:, None]
-    X = np.linalg.solve(M, np.broadcast_to(B, M.shape[:-2] + B.shape))
-    H = C @ X + D
+    s = 2j * np.pi * np.asarray(f, dtype=float)
+    lam, V = np.linalg.eig(A)                                           # (S, 12), (S, 12, 12)
+    ok = np.linalg.cond(V) < _EIG_COND
+    H = np.empty(s.shape + (6, 12), dtype=complex)
+    if ok.any():
+        CV = (C @ V[ok])[:, None]                                       # (s, 1, 6, 12)
+        VB = np.linalg.solve(V[ok], np.broadcast_to(B, (int(ok.sum()),) + B.shape))[:, None]
+        r = 1.0 / (s[ok][..., None] - lam[ok][:, None, :])              # (s, J, 12)
+        H[ok] = (CV * r[..., None, :]) @ VB + D
+    if not ok.all():
+        bad = ~ok
+        M = s[bad][..., None, None] * np.eye(12) - A[bad][:, None]
+        X = np.linalg.solve(M, np.broadcast_to(B, M.shape[:-2] + B.shape))
+        H[bad] = C @ X + D
     return H[..., :6], H[..., 6:]
 
 
-def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int = 250) -> LineResponses:
-    """Steady line responses of the performance outputs for every wheel and practice at sweep
-    speeds ``omega`` (rad/s, (S,)).  Processes ``chunk`` speeds at a time."""
-    wheels = list(wheels)
+def _wheel_key(w):
+    return (w.params, float(w.housing_mass), tuple(float(x) for x in w.housing_inertia), float(w.speed_scale))
+
+
+class _FrfCache:
+    """Wheel FRFs of one speed chunk, shared by identical wheels (same parameters, housing and speed scale:
+    the mount does not enter Zc, B) evaluated at the same frequencies."""
+
+    def __init__(self):
+        self.f = None
+        self.store = {}
+
+    def get(self, w, omega, f):
+        if self.f is None or self.f.shape != f.shape or not np.array_equal(self.f, f):
+            self.f, self.store = f, {}
+        key = _wheel_key(w)
+        if key not in self.store:
+            self.store[key] = _wheel_frf(w, omega * w.speed_scale, f)
+        return self.store[key]
+
+
+def _setup(plant: Plant, wheels, practices, omega):
+    """Checks; (speeds (S,), mount selectors Mt_i, −Σ Mt_iᵀ M6_i Mt_i)."""
     if plant.kind != "accelerance":
-        raise CouplingError("line_responses needs a plant in accelerance form (modal or StateSpace)")
+        raise CouplingError("line and floor responses need a plant in accelerance form (modal or StateSpace)")
     for p in practices:
         if p not in PRACTICES:
             raise CouplingError(f"unknown practice {p!r}; use {PRACTICES}")
@@ -129,30 +320,44 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
         L = np.eye(n_if) - Zm @ plant.frf(np.array([1e6]))[0][0]
         if np.linalg.cond(L) > 1e12:
             raise SingularInterfaceError("practice 'ii' interface matrix is singular")
-    hs, offs, fs, hms, loads = [], [], [], [], []
-    ys = {p: [] for p in practices}
+    return om, Mts, Zm
+
+
+def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int = 250,
+                   floor_f_hz=None) -> LineResponses:
+    """Steady line responses of the performance outputs for every wheel and practice at sweep
+    speeds ``omega`` (rad/s, (S,)).  Processes ``chunk`` speeds at a time.  A wheel with a speed
+    ripple gets its sideband orders m = −K..K, K = :func:`rwadist.extended.ripple_order` over all the
+    speeds (so every chunk has the same groups).  When a wheel has broadband floors, their responses
+    are computed too (:func:`floor_responses` on ``floor_f_hz``, default :func:`floor_grid`) and kept
+    in :attr:`LineResponses.floor`."""
+    wheels = list(wheels)
+    om, Mts, Zm = _setup(plant, wheels, practices, omega)
+    n_if = plant.n_interface
+    kmax = [0 if w.ripple is None else ext.ripple_order(w.lines, om * w.speed_scale, w.ripple) for w in wheels]
+    nw = len(wheels)
+    hs, offs, orders = [None] * nw, [None] * nw, [None] * nw
+    fs, hms, loads = ([[] for _ in range(nw)] for _ in range(3))
+    ys = {p: [[] for _ in range(nw)] for p in practices}
     eye = np.eye(n_if)
-    for k, wk in enumerate(wheels):
-        parts = {p: [] for p in practices}
-        lk, fk_all, Fk_all = [], [], []
-        for i0 in range(0, om.size, chunk):
-            o = om[i0:i0 + chunk]
-            ok = o * wk.speed_scale
-            hk, offk, f, Fk = _grouped_lines(wk, ok)
+    for i0 in range(0, om.size, chunk):
+        o = om[i0:i0 + chunk]
+        cache = _FrfCache()
+        for k, wk in enumerate(wheels):
+            hs[k], offs[k], orders[k], f, Fk = _grouped_lines(wk, o * wk.speed_scale, kmax[k])
             live = f > 0
             fe = np.where(live, f, 1.0)
             G, P = plant.frf(fe)
             Zsum = np.zeros(fe.shape + (n_if, n_if), dtype=complex)
-            Bk = None
             for i, wi in enumerate(wheels):
-                Zc, Bw = _wheel_frf(wi, o * wi.speed_scale, fe)
+                Zc, Bw = cache.get(wi, o, fe)
                 Zsum += Mts[i].T @ Zc @ Mts[i]
                 if i == k:
                     Zck, Bk = Zc, Bw
             rhs = (Mts[k].T @ Fk[..., None])                     # (S, J, n_if, 1)
             Lc = eye - Zsum @ G                                   # coupled interface equation
             uc = np.linalg.solve(Lc, rhs)
-            lk.append(np.where(live[..., None], (Fk[..., None] + Zck @ (Mts[k] @ (G @ uc)))[..., 0], 0))
+            loads[k].append(np.where(live[..., None], (Fk[..., None] + Zck @ (Mts[k] @ (G @ uc)))[..., 0], 0))
             for p in practices:
                 if p == "coupled":
                     u = uc
@@ -162,23 +367,202 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
                     u = np.linalg.solve(eye - Zm @ G, rhs)
                 else:
                     u = np.linalg.solve(Lc, Mts[k].T @ (Bk @ Fk[..., None]))
-                parts[p].append(np.where(live[..., None], (P @ u)[..., 0], 0))
-            fk_all.append(f)
-            Fk_all.append(Fk)
-        hs.append(hk)
-        offs.append(offk)
-        fs.append(np.concatenate(fk_all))
-        hms.append(np.concatenate(Fk_all))
-        loads.append(np.concatenate(lk))
-        for p in practices:
-            ys[p].append(np.concatenate(parts[p]))
-    return LineResponses(om, plant.perf_names, hs, fs, ys, loads, hms, offs)
+                ys[p][k].append(np.where(live[..., None], (P @ u)[..., 0], 0))
+            fs[k].append(f)
+            hms[k].append(Fk)
+    fs, hms, loads = ([np.concatenate(x) for x in lst] for lst in (fs, hms, loads))
+    ys = {p: [np.concatenate(x) for x in v] for p, v in ys.items()}
+    floor = None
+    if any(w.floors for w in wheels):
+        floor = floor_responses(plant, wheels, om, practices, f_hz=floor_f_hz)
+    return LineResponses(om, plant.perf_names, hs, fs, ys, loads, hms, offs, orders, floor)
 
+
+# ----------------------------------------------------------------------------- floors through the plant
+
+@dataclass(frozen=True, eq=False)
+class FloorResponses:
+    """Broadband floors through the coupled plant: f_hz (F,) grid, Hz; psd[practice] (S, F, n_perf)
+    one-sided PSD of the performance outputs (unit²/Hz) at each sweep speed; ms[practice] (S, n_perf)
+    its integral over f_hz (trapezoid, i.e. the exact integral of the PSD's piecewise-linear interpolant)."""
+
+    omega: np.ndarray
+    perf_names: tuple
+    f_hz: np.ndarray
+    psd: dict
+    ms: dict
+
+    def rms(self, practice: str = "coupled") -> np.ndarray:
+        return np.sqrt(self.ms[practice])
+
+
+def _trapz(y, x, axis=-1):
+    y = np.moveaxis(y, axis, -1)
+    return np.sum(0.5 * (y[..., 1:] + y[..., :-1]) * np.diff(x), axis=-1)
+
+
+def _floor_band(wheels):
+    sup = [fl.support() for w in wheels for fl in w.floors]
+    sup = [s for s in sup if s is not None]
+    if not sup:
+        return None
+    lo, hi = min(s[0] for s in sup), max(s[1] for s in sup)
+    return (lo if lo > 0 else 1e-4 * hi), hi
+
+
+#: Largest number of speeds at which :func:`floor_grid` computes the coupled poles.
+GRID_SPEEDS = 16
+
+
+def _pole_damping(plant: Plant, wheels, omega):
+    """(f Hz, ζ) of the oscillatory poles that shape the floor responses: the plant's ('i'), the plant with
+    the wheels as rigid masses ('ii'), the coupled system at up to GRID_SPEEDS of the speeds (evenly
+    picked; 'coupled', 'iii') and every wheel's blocked rotor modes at all the speeds ('iii')."""
+    from .assemble import Attachment, assemble
+    from .components import rigid_mass, wheel
+
+    lams = [np.linalg.eigvals(np.asarray(plant.sys.A))]
+    rig = [Attachment(rigid_mass(wheel_rigid_mass_matrix(w.params, w.housing_mass, w.housing_inertia)), w.mount)
+           for w in wheels]
+    lams.append(np.linalg.eigvals(np.asarray(assemble(plant, rig).sys.A)))
+    om = np.unique(np.atleast_1d(omega))
+    pick = om[np.unique(np.linspace(0, om.size - 1, min(om.size, GRID_SPEEDS)).round().astype(int))]
+    for o in pick:
+        atts = [Attachment(wheel(w.params, o * w.speed_scale, w.housing_mass, w.housing_inertia), w.mount)
+                for w in wheels]
+        lams.append(np.linalg.eigvals(np.asarray(assemble(plant, atts).sys.A)))
+    for w in wheels:
+        lams += [np.ravel(s) for s in ext.damped_modes(w.params, om * w.speed_scale).values()]
+    lam = np.concatenate(lams)
+    lam = lam[np.abs(lam.imag) > 1e-9 * np.abs(lam)]
+    return np.abs(lam) / (2 * np.pi), -lam.real / np.abs(lam)
+
+
+#: Damping ratio below which a pole inside the floor band counts as undamped (infinite mean square).
+MIN_FLOOR_ZETA = 1e-4
+
+
+def floor_grid(plant: Plant, wheels, omega, points_per_halfwidth: float = 2.0, per_decade: int = 100,
+               max_points: int = 200_000) -> np.ndarray:
+    """Default frequency grid (Hz) for :func:`floor_responses`.
+
+    Band: from the lowest to the highest frequency where any wheel's floor is non-zero (a band starting at
+    0 Hz starts at 1e-4 × its top instead: a free-free plant's displacement diverges at 0 Hz).  Spacing:
+    geometric, Δf/f = ζ_min/``points_per_halfwidth`` (and at least ``per_decade`` points per decade),
+    ζ_min the smallest damping ratio of the oscillatory poles near the band (lo/2 .. 2·hi) of every system
+    the practices solve -- the plant alone, the plant with rigid wheel masses, the coupled assembly
+    (:func:`coupling.assemble.assemble`, at up to GRID_SPEEDS of the speeds) -- and of the wheels' blocked
+    rotor modes at all the speeds (:func:`rwadist.extended.damped_modes`).  (The coupled poles are needed:
+    mass loading lowers a mode's damping ratio, ζ_c ≈ ζ·f_c/f, below its constituents'.)  A resonance of
+    half-power half-width ζf then gets ``points_per_halfwidth`` points per half-width.  The mean square is
+    the trapezoid rule on this grid (the exact integral of the piecewise-linear PSD); its error falls as the
+    square of the spacing: measured 1.6e-5 for a single oscillator of ζ = 0.05 (vs G/(4kc)) and 2e-6 on a
+    coupled 8-mode plant with two wheels (vs a grid 4× finer) at the default 2 points per half-width (tests).
+    Every floor knot inside the band is a grid point (the floors are piecewise linear between knots).
+    CouplingError when a pole near the band has ζ < 1e-4 (infinite or unresolvable mean square) or the
+    grid would exceed ``max_points``."""
+    wheels = list(wheels)
+    band = _floor_band(wheels)
+    if band is None:
+        raise CouplingError("no wheel has a non-zero broadband floor")
+    lo, hi = band
+    f, zeta = _pole_damping(plant, wheels, omega)
+    near = (f >= lo / 2) & (f <= 2 * hi)
+    zmin = float(np.min(zeta[near])) if near.any() else 1.0
+    if zmin < MIN_FLOOR_ZETA:
+        j = np.nonzero(near)[0][np.argmin(zeta[near])]
+        raise CouplingError(f"a pole at {f[j]:.6g} Hz near the floor band {lo:.6g}-{hi:.6g} Hz has damping ratio "
+                            f"{zeta[j]:.3g} < {MIN_FLOOR_ZETA:g}: the floor's mean square is infinite or unresolvable")
+    ratio = min(1.0 + min(zmin, 1.0) / points_per_halfwidth, 10.0 ** (1.0 / per_decade))
+    n = int(np.ceil(np.log(hi / lo) / np.log(ratio))) + 1
+    if n > max_points:
+        raise CouplingError(f"floor grid would need {n} points ({lo:.6g}-{hi:.6g} Hz, ζ_min {zmin:.3g}); "
+                            "pass f_hz")
+    knots = np.concatenate([fl.f_hz for w in wheels for fl in w.floors])
+    knots = knots[(knots >= lo) & (knots <= hi)]
+    return np.unique(np.concatenate([np.geomspace(lo, hi, max(n, 2)), knots]))
+
+
+def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
+                    chunk_points: int = 20000) -> FloorResponses:
+    """The wheels' broadband floors through the plant for each practice at sweep speeds ``omega`` (rad/s).
+
+    A floor is a blocked load PSD S_c(f, Ω) on channel c of wheel k (:class:`Floor`, Ω = sweep speed ×
+    speed_scale), incoherent with everything else, so the output PSD is
+    Σ_k Σ_c |T_{y,kc}(f)|² S_kc(f, Ω), with T the response to a unit blocked load e_c of wheel k through
+    the practice's interface equation, as :func:`line_responses` for a line: coupled
+    u = solve(I − Σ_i Mt_iᵀ Zc_i Mt_i G, Mt_kᵀ e_c); 'i' u = Mt_kᵀ e_c; 'ii' Zc_i → −M6_i (rigid wheels);
+    'iii' Mt_kᵀ B_k e_c in the coupled solve; y = P u.  Several floors on one channel add.
+
+    f_hz : frequency grid, Hz (increasing, > 0; default :func:`floor_grid`, which resolves the lightly
+    damped plant and wheel modes).  chunk_points : speeds × frequencies evaluated at once (memory).
+    Returns :class:`FloorResponses` (mean square = trapezoid over f_hz)."""
+    wheels = list(wheels)
+    practices = tuple(practices)
+    om, Mts, Zm = _setup(plant, wheels, practices, omega)
+    n_if = plant.n_interface
+    cols = [(k, c) for k, w in enumerate(wheels) for c in sorted({fl.channel for fl in w.floors})]
+    if not cols:
+        raise CouplingError("no wheel has a broadband floor")
+    if f_hz is None:
+        f = floor_grid(plant, wheels, om)
+    else:
+        f = np.asarray(f_hz, dtype=float).ravel()
+        if f.size < 2 or not np.all(np.isfinite(f)) or f[0] <= 0 or np.any(np.diff(f) <= 0):
+            raise CouplingError("f_hz must be >= 2 finite, positive, strictly increasing frequencies")
+    G, P = plant.frf(f)
+    if not (np.all(np.isfinite(G)) and np.all(np.isfinite(P))):
+        raise CouplingError(f"the plant's response is not finite on the floor grid ({f[0]:.6g}-{f[-1]:.6g} Hz)")
+    R = np.stack([Mts[k].T[:, c] for k, c in cols], axis=1)                 # (n_if, N) unit blocked loads
+    Sin = np.zeros((om.size, f.size, len(cols)))
+    for j, (k, c) in enumerate(cols):
+        for fl in wheels[k].floors:
+            if fl.channel == c:
+                Sin[:, :, j] += fl.psd(f, om * wheels[k].speed_scale)
+    psd = {}
+    if "i" in practices:
+        psd["i"] = (np.abs(P @ R) ** 2 @ Sin[..., None])[..., 0]
+    if "ii" in practices:
+        Y = P @ np.linalg.solve(np.eye(n_if) - Zm @ G, np.broadcast_to(R, (f.size,) + R.shape))
+        psd["ii"] = (np.abs(Y) ** 2 @ Sin[..., None])[..., 0]
+    dyn = [p for p in ("coupled", "iii") if p in practices]
+    if dyn:
+        out = {p: np.zeros((om.size, f.size, plant.n_perf)) for p in dyn}
+        step = max(1, int(chunk_points) // f.size)
+        eye = np.eye(n_if)
+        for i0 in range(0, om.size, step):
+            o = om[i0:i0 + step]
+            fe = np.broadcast_to(f, (o.size, f.size))
+            Zsum = np.zeros((o.size, f.size, n_if, n_if), dtype=complex)
+            Bs = {}
+            cache = _FrfCache()
+            for i, wi in enumerate(wheels):
+                Zc, Bw = cache.get(wi, o, fe)
+                Zsum += Mts[i].T @ Zc @ Mts[i]
+                if wi.floors:
+                    Bs[i] = Bw
+            Lc = eye - Zsum @ G
+            sl = slice(i0, i0 + o.size)
+            if "coupled" in dyn:
+                Y = P @ np.linalg.solve(Lc, np.broadcast_to(R, Lc.shape[:-2] + R.shape))
+                out["coupled"][sl] = (np.abs(Y) ** 2 @ Sin[sl][..., None])[..., 0]
+            if "iii" in dyn:
+                R3 = np.stack([np.einsum("ij,sfj->sfi", Mts[k].T, Bs[k][..., :, c]) for k, c in cols], axis=-1)
+                Y = P @ np.linalg.solve(Lc, R3)
+                out["iii"][sl] = (np.abs(Y) ** 2 @ Sin[sl][..., None])[..., 0]
+        psd.update(out)
+    psd = {p: psd[p] for p in practices}
+    ms = {p: _trapz(v, f, axis=1) for p, v in psd.items()}
+    return FloorResponses(om, plant.perf_names, f, psd, ms)
+
+
+# ----------------------------------------------------------------------------- jitter and PSD
 
 @dataclass(frozen=True, eq=False)
 class JitterResult:
-    """RMS of each performance output vs sweep speed for each practice, and the relative error
-    (rms_practice − rms_coupled)/rms_coupled (nan where the coupled RMS is 0)."""
+    """RMS of each performance output vs sweep speed for each practice (lines and, when the wheels have
+    any, broadband floors), and the relative error (rms_practice − rms_coupled)/rms_coupled (nan where the
+    coupled RMS is 0)."""
 
     omega: np.ndarray
     perf_names: tuple
@@ -204,25 +588,43 @@ class JitterResult:
         return float(abs(e[i])), float(e[i]), float(self.speed_rpm[i])
 
 
-def jitter_vs_speed(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int = 250) -> JitterResult:
-    """RMS of the named performance outputs vs wheel speed for each practice (see module doc)."""
+def jitter_vs_speed(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int = 250,
+                    floor_f_hz=None) -> JitterResult:
+    """RMS of the named performance outputs vs wheel speed for each practice (see module doc): the lines'
+    mean square plus, when wheels have broadband floors, the floors' mean square (incoherent, added in
+    quadrature: :meth:`LineResponses.total_rms`; ``floor_f_hz`` as in :func:`floor_responses`).  Without
+    floors the lines alone, as before."""
     practices = tuple(practices)
     if "coupled" not in practices:
         practices = ("coupled",) + practices
-    lr = line_responses(plant, wheels, omega, practices, chunk)
-    rms = {p: lr.rms(p) for p in practices}
+    lr = line_responses(plant, wheels, omega, practices, chunk, floor_f_hz)
+    rms = {p: lr.total_rms(p) for p in practices}
     rc = rms["coupled"]
     with np.errstate(invalid="ignore", divide="ignore"):
         err = {p: np.where(rc > 0, (rms[p] - rc) / rc, np.nan) for p in practices}
     return JitterResult(lr.omega, lr.perf_names, rms, err)
 
 
+def _cumint_piecewise_linear(x, y, xq):
+    """∫_{x0}^{xq} of the piecewise-linear interpolant of y (F, n) on x (F,) (zero outside [x0, x_end]),
+    exactly, at points xq (Q,): (Q, n)."""
+    C = np.concatenate([np.zeros((1,) + y.shape[1:]), np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(x)[:, None], 0)])
+    xc = np.clip(xq, x[0], x[-1])
+    i = np.clip(np.searchsorted(x, xc, side="right") - 1, 0, x.size - 2)
+    d = (xc - x[i])[:, None]
+    dx = (x[i + 1] - x[i])[:, None]
+    return C[i] + y[i] * d + (y[i + 1] - y[i]) * d * d / (2 * dx)
+
+
 def output_psd(lr: LineResponses, practice: str, weights, f_edges):
     """One-sided PSD (unit²/Hz) of the performance outputs when the wheel speed is spread over
     the sweep speeds with probability ``weights`` (S,, summing to 1): each line's mean-square
     |Y|²/2 × weight is put in the frequency bin (``f_edges`` Hz) it falls in and divided by the
-    bin width.  Its integral is the speed-averaged mean square (Σ_s weight_s · rms_s²).
-    Returns (f_centres, psd (n_bins, n_perf))."""
+    bin width; the broadband floors' PSD (:attr:`LineResponses.floor`), weighted over the speeds likewise,
+    is integrated exactly over each bin (its piecewise-linear interpolant on the floor grid) and divided by
+    the bin width.  Its integral is the speed-averaged mean square inside the edges,
+    Σ_s weight_s · (lines' mean square + floors' mean square), i.e. Σ_s weight_s · total_rms_s² when the
+    edges span every line and the floor grid.  Returns (f_centres, psd (n_bins, n_perf))."""
     edges = np.asarray(f_edges, dtype=float)
     wts = np.asarray(weights, dtype=float)
     if wts.shape != lr.omega.shape or np.any(wts < 0):
@@ -235,4 +637,7 @@ def output_psd(lr: LineResponses, practice: str, weights, f_edges):
         power = np.abs(yk) ** 2 / 2.0 * wts[:, None, None]
         for j in range(psd.shape[1]):
             psd[:, j] += np.bincount(idx[ok], weights=power[..., j][ok], minlength=nb)
+    if lr.floor is not None:
+        fl = np.einsum("s,sfp->fp", wts, lr.floor.psd[practice])
+        psd += np.diff(_cumint_piecewise_linear(lr.floor.f_hz, fl, edges), axis=0)
     return 0.5 * (edges[1:] + edges[:-1]), psd / np.diff(edges)[:, None]

@@ -1187,22 +1187,18 @@ def ripple_sideband_powers(beta, eps, p=2.0, k_max: int | None = None):
     g(θ) = (1 + ε sin θ)^p · exp(−jβ cos θ),  β = h·ΔΩ/(2π f_r) (phase-modulation index, rad),
     ε = ΔΩ/|Ω0|, and g = Σ_k c_k e^{jkθ}: lines at f_i + k·f_r of amplitude |c_k|·a.  Without the amplitude
     term (ε = 0) c_k = J_k(β)e^{-jkπ/2}, |c_k|² = J_k(β)² and Σ_k |c_k|² = 1 (Parseval); with it Σ|c_k|² is the
-    mean of (1 + ε sin θ)^{2p} (1 + 3ε² + 3ε⁴/8 for p = 2).  c_k by an FFT over one period of θ.
+    mean of (1 + ε sin θ)^{2p} (1 + 3ε² + 3ε⁴/8 for p = 2).  c_k by an FFT over one period of θ: the complex
+    coefficients are :func:`rwadist.extended.ripple_coefficients` (which the coupling kit applies per line);
+    this returns their squared moduli.  (For ε > 1, a speed reversal within the ripple, the amplitude is
+    |1 + ε sin θ|^p, the exact |Ω(t)|^p.)
 
     beta, eps : broadcastable arrays (shape S); p : amplitude exponent (scalar or broadcastable).
     Returns (k (2K+1,), P (S + (2K+1,))), P = |c_k|².
     """
-    beta, eps, p = np.broadcast_arrays(np.asarray(beta, float), np.asarray(eps, float), np.asarray(p, float))
-    b = float(np.max(np.abs(beta))) if beta.size else 0.0
-    if k_max is None:
-        k_max = int(np.ceil(1.1 * b + 4.0 * b ** (1.0 / 3.0) + (float(np.max(np.abs(p))) if p.size else 2.0) + 4))
-    n = 1 << int(np.ceil(np.log2(4 * (2 * k_max + 1))))
-    th = 2 * np.pi * np.arange(n) / n
-    base = np.maximum(1.0 + eps[..., None] * np.sin(th), 0.0)
-    g = base ** p[..., None] * np.exp(-1j * beta[..., None] * np.cos(th))
-    c = np.fft.fft(g, axis=-1) / n
-    k = np.arange(-k_max, k_max + 1)
-    return k, np.abs(c[..., k % n]) ** 2
+    from .extended import ripple_coefficients
+
+    k, c = ripple_coefficients(beta, eps, p, k_max)
+    return k, np.abs(c) ** 2
 
 
 def _residual_z(ctx, state, c, runs):
