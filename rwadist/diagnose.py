@@ -702,7 +702,8 @@ class Context:
         """Per run: (E_num, D_tot) summed over channels and bands, E_num = Σ max(|D − M| − 2σ, 0)
         (the misplaced power beyond two noise standard deviations), each channel divided by the mean
         data power of its unit group so forces and torques weigh alike.  ``detail``: also the per-band
-        (channel -> (M, σ)) arrays."""
+        (channel -> (D − M, σ)) arrays (the residual: an effect may change the model M or, a measurement
+        correction, the data D as the state reads them)."""
         err = np.zeros(runs.size)
         tot = np.zeros(runs.size)
         parts = {}
@@ -718,7 +719,7 @@ class Context:
             e = np.maximum(np.abs(D - M) - NOISE_Z * sig, 0.0)
             err[ok] += e[ok].sum(1) / scale
             tot[ok] += D[ok].sum(1) / scale
-            parts[c] = (M / scale, sig / scale)
+            parts[c] = ((D - M) / scale, sig / scale)
         return (err, tot, parts) if detail else (err, tot)
 
     def scale(self, c):
@@ -1930,10 +1931,11 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration):
     """Held-out evidence of ``effect`` (fitted on the fit runs) added to ``state``.
 
     gain = Σ over held-out runs of the drop in misplaced power; its noise standard error is
-    sqrt(Σ_bands min(|M_1 − M_0|, σ)²·P_b): if the data were M_0 plus Gaussian noise of std σ, a
-    band's term max(|D − M| − zσ, 0) changes by at most |M_1 − M_0| (and by about σ when the change
-    is larger), and changes at all only with probability P_b = 2·Q(z − |M_1 − M_0|/σ).  Passes when
-    gain > k_sigma·SE and gain ≥ min_gain × the held-out misplaced power."""
+    sqrt(Σ_bands min(|Δ|, σ)²·P_b), Δ = the change of the residual D − M (of the model M, or of the data
+    D as read for a measurement correction such as ``cross_coupling``): if the data were M_0 plus
+    Gaussian noise of std σ, a band's term max(|D − M| − zσ, 0) changes by at most |Δ| (and by about σ
+    when the change is larger), and changes at all only with probability P_b = 2·Q(z − |Δ|/σ).  Passes
+    when gain > k_sigma·SE and gain ≥ min_gain × the held-out misplaced power."""
     runs = ctx.held_runs
     chans = [c for c in effect.channels if c in ctx.channels]
     e0, _, p0 = ctx.run_errors(state, runs, chans, detail=True)
@@ -1941,7 +1943,7 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration):
     e0_all, all_tot = ctx.run_errors(state, runs)
     var = 0.0
     for c in chans:
-        dm, sig = np.abs(p1[c][0] - p0[c][0]), p0[c][1]
+        dm, sig = np.abs(p1[c][0] - p0[c][0]), p0[c][1]       # |Δ(D − M)|
         r = dm / np.maximum(sig, 1e-300)
         # a band's term changes only when the noise reaches past the forgiven NOISE_Z·σ less |ΔM|
         p_change = np.minimum(2.0 * stats.norm.sf(np.maximum(NOISE_Z - r, 0.0)), 1.0)
