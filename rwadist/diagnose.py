@@ -1857,9 +1857,12 @@ def refine_h(ctx, state, chans, runs, h, n_iter: int = 3):
             offs = np.arange(-2, 3)
             k = np.clip(k0[:, None] + offs, 1, ctx.f.size - 2)
             rows = np.arange(runs.size)[:, None]
-            kp = k[np.arange(runs.size), np.argmax(z[rows, k], axis=1)]
+            # the peak of the residual itself (z = R / floor can peak beside it where the floor dips), kept
+            # only where it is a local maximum standing clear of the noise
+            kp = k[np.arange(runs.size), np.argmax(R[rows, k], axis=1)]
             r = np.arange(runs.size)
             ok = (kp - 1 >= ctx.k_lo) & (kp + 1 <= ctx.k_hi) & (z[r, kp] > 20.0)
+            ok &= (R[r, kp] >= R[r, kp - 1]) & (R[r, kp] >= R[r, np.minimum(kp + 1, ctx.f.size - 1)])
             lo, mid, hi = (np.log(np.maximum(R[r, kp + j], 1e-300)) for j in (-1, 0, 1))
             den = lo - 2 * mid + hi
             with np.errstate(divide="ignore", invalid="ignore"):
