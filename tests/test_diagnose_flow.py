@@ -88,3 +88,46 @@ def test_diagnosed_ripple_reaches_the_fmu_output():
             worst = max(worst, abs(got / want - 1))
     assert worst < 0.08, worst
     print(f"\nFMU ripple sidebands of the diagnosed model vs the injected ripple's closed form, worst: {worst:.3f}")
+
+
+def test_diagnosed_floor_reaches_the_coupling_kit():
+    """The same diagnosed floor read by ``coupling.wheel_spec_from_model``: the blocked-load PSD of each
+    floored channel at 1500 rpm is within 25 % of the injected floor's in every 20-Hz band from 10 to 210 Hz;
+    carried through a spacecraft (practice 'i', the blocked load on the bus), the line-of-sight mean square
+    over 10-300 Hz is within 25 % of that of the injected floor through the same transfer."""
+    import coupling as cp
+
+    test = e_data(1)
+    wmax = np.abs(SPEEDS).max() * 2 * np.pi / 60
+    ref = 0.2 * C1 * wmax**2
+    inject_floor(test, ("Fx", "Fy", "Fz"), {c: ref for c in ("Fx", "Fy", "Fz")}, p=3.0, fc=60.0, fs=FS, seed=1)
+    d = diagnose(spectra(test), TRUTH)
+    improved = model_io.from_json(json.loads(json.dumps(model_io.to_json(d.model))))     # via the model file
+    spec = cp.wheel_spec_from_model(improved, mount=cp.Mount(0, np.eye(3), (0.3, 0.2, 0.1)))
+    assert sorted(fl.channel for fl in spec.floors) == [0, 1, 2]
+    w0 = 1500 * 2 * np.pi / 60
+    b, a = signal.butter(2, 60.0, fs=FS)
+    f_f, H = signal.freqz(b, a, worN=8192, fs=FS)
+    shape = np.abs(H) ** 2 / np.trapezoid(np.abs(H) ** 2, f_f)
+
+    def truth(f):
+        return ref**2 * (w0 / wmax) ** 3 * np.interp(f, f_f, shape)
+
+    f = np.linspace(10.0, 210.0, 2001)
+    worst = 0.0
+    for c in (0, 1, 2):
+        S = sum(fl.psd(f, np.array([w0]))[0] for fl in spec.floors if fl.channel == c)
+        for lo in np.arange(10.0, 210.0, 20.0):
+            band = (f >= lo) & (f < lo + 20.0)
+            worst = max(worst, abs(S[band].mean() / truth(f[band]).mean() - 1))
+    assert worst < 0.25, worst
+    plant = cp.example_spacecraft()
+    fg = np.geomspace(10.0, 300.0, 4000)
+    fr = cp.floor_responses(plant, [spec], [w0], practices=("i",), f_hz=fg)
+    G, P = plant.frf(fg)
+    Mt = cp.geometry.selector(spec.mount, 6, plant.n_interface)
+    T = P @ Mt.T[:, :3]                                 # wheel Fx, Fy, Fz (with their lever arm) -> LOS
+    ms_truth = np.trapezoid(np.sum(np.abs(T) ** 2, axis=2) * truth(fg)[:, None], fg, axis=0)
+    ratio = fr.ms["i"][0] / ms_truth
+    assert np.all(np.abs(ratio - 1) < 0.25), ratio
+    print(f"\ncoupling: diagnosed floor vs injected, worst 20-Hz band {worst:.3f}; LOS mean square ratio {ratio}")
