@@ -43,8 +43,8 @@ def inject_sidebands(seed, direction="radial_force", h=2.0, f_mod=7.0, depth=0.4
 
 def rippled_data(seed, f_ripple=8.0, delta_omega=3.0):
     """E-wheel data at a rippled speed Ω(t) = Ω0 + ΔΩ sin(2π f_r t + φ_r): every line of the preset is
-    C·Ω(t)²·exp(j(h·ψ(t) + α)), ψ = ∫Ω dt in closed form (as the stand's sweeps: amplitude at the instantaneous
-    speed, phase h·ψ); the sensor noise is that of e_data(seed) exactly (noisy minus noise-free run)."""
+    C·Ω(t)²·exp(±j(h·ψ(t) + α)) (− for the preset's counter-rotating harmonics), ψ = ∫Ω dt in closed form
+    (as the stand's sweeps: amplitude at the instantaneous speed, phase h·ψ); the sensor noise is that of e_data(seed) exactly (noisy minus noise-free run)."""
     w = preset("ithaco-e")
     noisy = e_data(seed)
     clean = simulate_steady(w, SPEEDS, sample_rate=FS, n_samples=N, modes=False, noise=0.0, seed=seed)
@@ -60,7 +60,8 @@ def rippled_data(seed, f_ripple=8.0, delta_omega=3.0):
             r.signals[ch] = r.signals[ch] - c.signals[ch]                 # the noise alone
         for d, chans in DIRECTION_CHANNELS.items():
             for h, C in w.harmonics.get(d, []):
-                z = C * omega**2 * np.exp(1j * (h * psi + rng.uniform(0, 2 * np.pi)))
+                sign = -1.0 if w.senses.get((d, h)) == "counter" else 1.0      # a counter-rotating line: e^{-ihψ}
+                z = C * omega**2 * np.exp(1j * sign * (h * psi + rng.uniform(0, 2 * np.pi)))
                 r.signals[chans[0]] += z.real
                 if len(chans) > 1:
                     r.signals[chans[1]] += z.imag
