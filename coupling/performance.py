@@ -407,7 +407,10 @@ def _floor_band(wheels):
     if not sup:
         return None
     lo, hi = min(s[0] for s in sup), max(s[1] for s in sup)
-    return (lo if lo > 0 else 1e-4 * hi), hi
+    if lo <= 0:
+        raise CouplingError("a broadband floor reaches 0 Hz: pass f_hz explicitly (a free-free plant's response, "
+                            "and a gyroscopic precession pole near 0 Hz, make the low end the analyst's choice)")
+    return lo, hi
 
 
 #: Largest number of speeds at which :func:`floor_grid` computes the coupled poles.
@@ -447,7 +450,7 @@ def floor_grid(plant: Plant, wheels, omega, points_per_halfwidth: float = 2.0, p
     """Default frequency grid (Hz) for :func:`floor_responses`.
 
     Band: from the lowest to the highest frequency where any wheel's floor is non-zero (a band starting at
-    0 Hz starts at 1e-4 × its top instead: a free-free plant's displacement diverges at 0 Hz).  Spacing:
+    0 Hz is refused: a free-free plant's response diverges there, so the low end needs an explicit f_hz).  Spacing:
     geometric, Δf/f = ζ_min/``points_per_halfwidth`` (and at least ``per_decade`` points per decade),
     ζ_min the smallest damping ratio of the oscillatory poles near the band (lo/2 .. 2·hi) of every system
     the practices solve -- the plant alone, the plant with rigid wheel masses, the coupled assembly

@@ -120,8 +120,8 @@ def effects_from_doc(doc, source="<model>"):
       ``broadband_floor`` (one entry per channel it names): a blocked-load PSD
       S(f, Ω) = psd_ref(f)·(|Ω|/Ω_ref)^p (linear between knots, 0 outside), added to the wheel-frame
       output as a random-phase multisine (see :class:`WheelRuntime`);
-    * ``ripples``: [(ΔΩ_ref rad/s, Ω_ref rad/s, q, f_r Hz)] of each ``speed_ripple``: the wheel turns at
-      Ω(t) + ΔΩ_ref·(|Ω|/Ω_ref)^q·sin(2π f_r t + θ) (see :class:`WheelRuntime`).
+    * ``ripples``: [(ΔΩ_ref rad/s, Ω_ref rad/s, q, f_r Hz)] of the ``speed_ripple`` (at most one): the wheel
+      turns at Ω(t) + ΔΩ_ref·(|Ω|/Ω_ref)^q·sin(2π f_r t + θ) (see :class:`WheelRuntime`).
 
     ModelError naming ``effects[i].<field>`` on a bad entry."""
     out = {"laws": laws_from_doc(doc, source), "resonances": [], "sidebands": [], "floors": [], "ripples": []}
@@ -157,6 +157,9 @@ def effects_from_doc(doc, source="<model>"):
         elif kind == "broadband_floor":
             out["floors"].extend(_floor_from_entry(e, where))
         elif kind == "speed_ripple":
+            if out["ripples"]:
+                raise ModelError(f"{where}.kind: a second speed_ripple; one speed ripple per wheel is supported "
+                                 "(as rwadist.extended.ripple_from_effects)")
             vals = []
             for k, need, ok in (("delta_omega_rad_s", ">= 0", lambda v: v >= 0), ("omega_ref_rad_s", "> 0", lambda v: v > 0),
                                 ("speed_exponent", ">= 0", lambda v: v >= 0), ("f_ripple_Hz", "> 0", lambda v: v > 0)):
@@ -174,6 +177,7 @@ def _floor_from_entry(e, where):
     chans = [chans] if isinstance(chans, str) else chans
     if not isinstance(chans, list) or not chans or any(c not in CHANNELS for c in chans):
         raise ModelError(f"{where}.channel: {e.get('channel')!r} must be one of {', '.join(CHANNELS)} or a list of them")
+    chans = list(dict.fromkeys(chans))          # a channel named twice has one floor (as the coupling kit reads it)
     knots = {}
     for k in ("f_Hz", "psd_ref"):
         v = e.get(k)
@@ -321,8 +325,13 @@ KERNEL_RES = 3
 
 #: floor phasors are recomputed from the time every so many steps (rounding of the rotation stays ~1e-13)
 FLOOR_RESYNC = 1000
-#: most sinusoids the broadband floors may take (memory ~50 MB, ~10 ms per step beyond it)
+#: most sinusoids the broadband floors may take (~200 MB with the rotation caches, ~3 ms per step)
 FLOOR_MAX_COMPONENTS = 2_000_000
+#: seed of the floors' phases when the FMU has none (seed -1): deterministic, still independent per sinusoid
+FLOOR_DEFAULT_SEED = 20_251_122
+#: a speed ripple needs this many communication steps per ripple period (the rotor's speed is linear over
+#: a step: at 20 the sidebands are within ~1 % of their closed form)
+RIPPLE_STEPS_PER_PERIOD = 20
 
 
 def load_kernel(path):
@@ -387,10 +396,12 @@ class WheelRuntime:
     g(Ω)·Σ_k a_k cos(2π f_k t + φ_k) with f_k = k·``floor_resolution`` (Hz) over the knots' span,
     a_k = sqrt(2·psd_ref(f_k)·df) and g = (|Ω|/Ω_ref)^{p/2} at the step's end speed: over one period
     1/df its mean square is Σ_k psd_ref(f_k)·df·g² (Parseval; the floor's integral) and its PSD at a
-    resolution coarser than df is psd_ref·g².  Phases φ_k: uniform from ``default_rng((seed, 2))``, or
-    Schroeder's phases −πk(k−1)/N (deterministic, low crest factor) without a seed.  The sum is kept as
-    rotating phasors (one complex multiply per component per step), resynchronised to t every
-    FLOOR_RESYNC steps.
+    resolution coarser than df is psd_ref·g².  Phases φ_k: independent, uniform, from
+    ``default_rng((seed, 2))`` (``(FLOOR_DEFAULT_SEED, 2)`` without a seed): the channels and floors are
+    incoherent with each other; two wheels need two seeds to be incoherent with each other (as their lines).
+    The sum is kept as rotating phasors (one complex multiply per component per step), resynchronised to t
+    every FLOOR_RESYNC steps.  The output is sampled at the host's steps: floor content above 1/(2h) folds
+    back (the FMU slave warns once).
     """
 
     def __init__(self, params, lines, *, seed=None, imbalance=True, harmonics=True, modes=True,
@@ -524,6 +535,7 @@ class WheelRuntime:
                  else np.zeros(len(rip)))
         # (ΔΩ_ref, Ω_ref, q, 2π f_r, θ) per ripple; plain floats: one or two per model, called twice a step
         self.ripples = [(dw, w_ref, q, 2.0 * math.pi * f_r, float(th)) for (dw, w_ref, q, f_r), th in zip(rip, theta)]
+        self.ripple_f_max = max((r[3] for r in rip), default=0.0)
 
     def ripple(self, omega, t):
         """Speed ripple r (rad/s) at input speed ``omega`` (rad/s) and time ``t`` since t0 (s)."""
@@ -532,19 +544,35 @@ class WheelRuntime:
             r += (dw * (abs(omega) / w_ref) ** q if q else dw) * math.sin(w_r * t + th)
         return r
 
+    def ripple_rate(self, omega, t):
+        """dr/dt (rad/s²) of the speed ripple at input speed ``omega`` (held) and time ``t``."""
+        r = 0.0
+        for dw, w_ref, q, w_r, th in self.ripples:
+            r += (dw * (abs(omega) / w_ref) ** q if q else dw) * w_r * math.cos(w_r * t + th)
+        return r
+
     def _init_floor(self, floors, seed, df):
+        if not (isinstance(df, (int, float)) and math.isfinite(df) and df > 0):
+            raise ModelError(f"floor_resolution must be finite and > 0, got {df!r} Hz")
         floors = list(floors or [])
         self.has_floor = bool(floors)
+        self.floor_f_max = 0.0
         if not self.has_floor:
             return
-        if not (math.isfinite(df) and df > 0):
-            raise ModelError(f"floor_resolution must be finite and > 0, got {df!r} Hz")
+        spans = [(max(1, math.ceil(f_k[0] / df)), math.floor(f_k[-1] / df)) for _, f_k, _, _, _ in floors]
+        n_max = sum(max(0, k1 - k0 + 1) for k0, k1 in spans)       # before allocating anything
+        if n_max > FLOOR_MAX_COMPONENTS:
+            raise ModelError(f"broadband floors need {n_max} sinusoids at floor_resolution = {df:g} Hz (limit "
+                             f"{FLOOR_MAX_COMPONENTS}); use a coarser floor_resolution")
         amp, wk, chan, ref, expo, starts = [], [], [], [], [], []
-        for c, f_k, psd_k, w_ref, p in floors:
-            k = np.arange(max(1, math.ceil(f_k[0] / df)), math.floor(f_k[-1] / df) + 1)
+        for (c, f_k, psd_k, w_ref, p), (k0, k1) in zip(floors, spans):
+            k = np.arange(k0, k1 + 1)
             S = np.interp(k * df, f_k, psd_k, left=0.0, right=0.0)
             keep = S > 0
             if not keep.any():
+                if np.any(psd_k > 0):
+                    raise ModelError(f"a broadband floor of {CHANNELS[c]} ({f_k[0]:g}-{f_k[-1]:g} Hz) has no "
+                                     f"sinusoid at floor_resolution = {df:g} Hz; use a finer floor_resolution")
                 continue
             starts.append(sum(a.size for a in amp))
             amp.append(np.sqrt(2.0 * S[keep] * df))
@@ -552,18 +580,14 @@ class WheelRuntime:
             chan.append(c)
             ref.append(w_ref)
             expo.append(0.5 * p)
-        n = sum(a.size for a in amp)
-        if n > FLOOR_MAX_COMPONENTS:
-            raise ModelError(f"broadband floors need {n} sinusoids at floor_resolution = {df:g} Hz (limit "
-                             f"{FLOOR_MAX_COMPONENTS}); use a coarser floor_resolution")
-        self.has_floor = n > 0
+        self.has_floor = bool(amp)
         if not self.has_floor:
             return
         A, self.floor_w = np.concatenate(amp), np.concatenate(wk)
-        if seed is not None:
-            ph = np.random.default_rng((int(seed), 2)).uniform(0, 2 * np.pi, n)
-        else:       # Schroeder phases per floor
-            ph = np.concatenate([-np.pi * np.arange(a.size) * (np.arange(a.size) - 1) / a.size for a in amp])
+        self.floor_f_max = float(self.floor_w.max() / (2.0 * math.pi))
+        # independent uniform phases for every sinusoid of every channel and floor (channels are
+        # incoherent); without a seed from a fixed one, so the FMU stays deterministic
+        ph = np.random.default_rng((FLOOR_DEFAULT_SEED if seed is None else int(seed), 2)).uniform(0, 2 * np.pi, A.size)
         self.floor_A = A * np.exp(1j * ph)
         self.floor_starts = np.array(starts, dtype=int)
         self.floor_chan = np.array(chan, dtype=int)
@@ -580,7 +604,7 @@ class WheelRuntime:
         else:
             rot = self.floor_rot.get(advance)
             if rot is None:
-                if len(self.floor_rot) > 64:
+                if len(self.floor_rot) >= 4:         # a host with a varying step: a few sizes, bounded memory
                     self.floor_rot.clear()
                 rot = self.floor_rot[advance] = np.exp(1j * self.floor_w * advance)
             self._floor_Z *= rot
@@ -686,6 +710,11 @@ class WheelRuntime:
                              "resolved below it)")
         if h < 1e-9:
             raise ModelError(f"communication step size {h:.3g} s is below the 1 ns the FMU resolves")
+        if self.has_ripple and h * self.ripple_f_max * RIPPLE_STEPS_PER_PERIOD > 1 + 1e-12:
+            raise ModelError(f"communication step size {h:.6g} s does not resolve the speed ripple of "
+                             f"{self.ripple_f_max:.6g} Hz (at most {1 / (RIPPLE_STEPS_PER_PERIOD * self.ripple_f_max):.6g}"
+                             f" s: {RIPPLE_STEPS_PER_PERIOD} steps per period); use smaller steps or speed_ripple = "
+                             "false")
         if not math.isfinite(omega):
             raise ModelError(f"wheel_speed is not finite: {omega!r} rad/s")
         if alpha is not None and not math.isfinite(alpha):
@@ -821,6 +850,7 @@ class WheelRuntime:
         omega, alpha = w_in, float(alpha)
         if self.has_ripple:
             omega += self.ripple(w_in, self.t)
+            alpha += self.ripple_rate(w_in, self.t)
         if not self.started and self.start_steady:
             self._steady_init(omega, alpha)
         loads = self._loads(omega, alpha, self.phi)

@@ -112,6 +112,7 @@ class RwadistWheelSlave(Fmi2Slave):
         self.pos = [0.0, 0.0, 0.0]
         self._y = [0.0] * 12
         self.model = None       # WheelRuntime once initialised without error
+        self._floor_warned = False
         self.error = "not initialised"
         self._native = _native_library(self.resources, type(self).__name__)
         self._flag_error = None if self._native is None else self._native.rwadist_fmu_flag_error
@@ -346,6 +347,11 @@ class RwadistWheelSlave(Fmi2Slave):
             w = float(self.wheel_speed)
             a = float(self.wheel_acceleration) if self.use_wheel_acceleration else None
             self._set_outputs(self.model.step12(w, a, step_size))
+            if self.model.has_floor and not self._floor_warned and self.model.floor_f_max * 2 * step_size > 1:
+                self._floor_warned = True
+                self.log(f"rwadist wheel: the broadband floors reach {self.model.floor_f_max:g} Hz, above the "
+                         f"{0.5 / step_size:g} Hz a {step_size:g}-s step samples; that content folds back",
+                         Fmi2Status.warning)
             return True
         except self.rt.ModelError as exc:
             return self._fail(f"step at t = {current_time:.9g} s rejected: {exc}")

@@ -346,3 +346,11 @@ def test_second_ripple_and_unresolvable_floor_refused():
     plant = cp.modal_plant([30.0, 80.0], [0.0, 0.02], np.eye(6)[:, :2], np.ones((1, 2)))
     with pytest.raises(cp.CouplingError, match="Hz near the floor band .* damping ratio .* infinite"):
         cp.floor_responses(plant, [spec], [100.0])
+    # a floor reaching 0 Hz: the default grid cannot choose the low end; an explicit grid is taken
+    model.effects = [dict(FLOOR, f_Hz=[0.0, 40.0, 250.0], psd_ref=[2e-9, 5e-9, 1e-9])]
+    spec = wheel_spec_from_model(model)
+    good = cp.modal_plant([30.0, 80.0], [0.02, 0.02], np.eye(6)[:, :2], np.ones((1, 2)))
+    with pytest.raises(cp.CouplingError, match="reaches 0 Hz: pass f_hz"):
+        cp.floor_responses(good, [spec], [100.0])
+    fr = cp.floor_responses(good, [spec], [100.0], f_hz=np.geomspace(1.0, 250.0, 3000))
+    assert np.all(np.isfinite(fr.ms["coupled"])) and np.all(fr.ms["coupled"] > 0)

@@ -102,6 +102,31 @@ def test_floor_psd_matches_psd_ref():
     print(f"\nworst 10-Hz band of a 4-s Hann Welch PSD of the floor vs psd_ref: {worst:.3f}")
 
 
+@pytest.mark.parametrize("seed", [None, 3])
+def test_floors_of_channels_and_entries_are_incoherent(seed):
+    """With or without a seed, two channels of one floor entry and two entries with different shapes are
+    incoherent: mean Welch coherence over 10-290 Hz below 0.15 for every pair (identical phases would
+    give 1), so a 45° mounting adds their powers (spacecraft-frame Fx mean square = the mean of the two
+    within 5 %)."""
+    from scipy.signal import coherence
+    fy = dict(FLOOR, channel="Fy", f_Hz=[5.0, 100.0, 300.0], psd_ref=[2.0e-5, 3.0e-5, 1.0e-5])
+    doc = doc_with([FLOOR, fy])
+    dt = 1e-3
+    t = np.arange(20001) * dt
+    c45 = np.sqrt(0.5)
+    R = [[c45, -c45, 0.0], [c45, c45, 0.0], [0.0, 0.0, 1.0]]
+    W = runtime(doc, seed=seed, imbalance=False, harmonics=False, dcm=R)
+    h = dt
+    y = np.array([W.step12(200.0, 0.0, h) for _ in range(t.size - 1)])
+    x, yy, z = y[:, 0], y[:, 1], y[:, 5]
+    for a, b in ((x, z), (x, yy), (yy, z)):
+        f, C = coherence(a, b, fs=1 / dt, nperseg=1024)
+        band = (f > 10) & (f < 290)
+        assert C[band].mean() < 0.15, C[band].mean()
+    ms = np.mean(y[:, 6] ** 2)
+    assert ms == pytest.approx(0.5 * (np.mean(x**2) + np.mean(yy**2)), rel=0.05)
+
+
 def test_floor_adds_to_the_lines_and_reaches_the_spacecraft_frame():
     """Floor on = floor off + the floor alone (the lines' phases do not move), on a spin-up with modes;
     the spacecraft-frame outputs are R·F and R·T + r × R·F of the wheel-frame ones."""
@@ -166,11 +191,11 @@ def test_ripple_equals_the_fmu_fed_the_rippled_speed(q):
     t, w = spin_up(T=3.0)
     for seed in (None, 9):
         theta = 0.0 if seed is None else np.random.default_rng((seed, 1)).uniform(0, 2 * np.pi, 1)[0]
-        a = runtime(doc, seed=seed).run(t, w)
+        a = runtime(doc, seed=seed).run(t, w)[1:]      # (t0 row: the FMU takes dr/dt there, the host a slope)
         wr = rippled_speed(t, w, e, theta)
-        b = runtime(plain, seed=seed).run(t, wr)
+        b = runtime(plain, seed=seed).run(t, wr)[1:]
         assert np.all(worst_rel(a, b) < 1e-10), worst_rel(a, b)
-        c = runtime(doc, seed=seed, speed_ripple=False).run(t, w)
+        c = runtime(doc, seed=seed, speed_ripple=False).run(t, w)[1:]
         assert np.max(worst_rel(a, c)) > 1e-3          # the ripple does something
 
 
@@ -256,9 +281,81 @@ def test_bad_floor_or_ripple_entry_is_refused(index, field, value):
         build_fmu(doc_with(effects), "/nonexistent/x.fmu")
 
 
-def test_floor_resolution_is_checked():
+def test_floor_resolution_and_effect_rules():
+    """floor_resolution is checked (with or without floors); a floor span needing more than
+    FLOOR_MAX_COMPONENTS sinusoids is refused before anything is allocated (a 2e9-Hz span answers at
+    once); a floor narrower than the resolution is refused; a channel named twice is one floor (as the
+    coupling kit reads it); a second speed_ripple is refused (as the coupling kit)."""
+    import time
     doc = doc_with([FLOOR])
-    with pytest.raises(rt.ModelError, match="floor_resolution"):
-        runtime(doc, floor_resolution=0.0)
+    for bad in (0.0, float("nan"), -1.0):
+        with pytest.raises(rt.ModelError, match="floor_resolution"):
+            runtime(doc, floor_resolution=bad)
+        with pytest.raises(rt.ModelError, match="floor_resolution"):
+            runtime(doc_with([]), floor_resolution=bad)
     with pytest.raises(rt.ModelError, match="coarser floor_resolution"):
         runtime(doc, floor_resolution=1e-4)
+    huge = doc_with([dict(FLOOR, f_Hz=[5.0, 2.0e9], psd_ref=[1e-6, 1e-6])])
+    t0 = time.perf_counter()
+    with pytest.raises(rt.ModelError, match="coarser floor_resolution"):
+        runtime(huge)
+    assert time.perf_counter() - t0 < 1.0
+    with pytest.raises(rt.ModelError, match="finer floor_resolution"):
+        runtime(doc_with([dict(FLOOR, f_Hz=[10.01, 10.05], psd_ref=[1e-6, 1e-6])]))
+    dt = 1e-3
+    t = np.arange(int(round(1 / 0.25 / dt)) + 1) * dt
+    twice = doc_with([dict(FLOOR, channel=["Fx", "Fx"])])
+    out = runtime(twice, seed=1, imbalance=False, harmonics=False, floor_resolution=0.25).run(t, np.full(t.size, 200.0))
+    assert np.mean(out[1:, 0] ** 2) == pytest.approx(floor_integral(FLOOR), rel=1e-3)
+    with pytest.raises(rt.ModelError, match=r"effects\[1\]\.kind: a second speed_ripple"):
+        rt.effects_from_doc(doc_with([RIPPLE, dict(RIPPLE, f_ripple_Hz=9.0)]))
+
+
+def test_ripple_needs_steps_that_resolve_it():
+    """A communication step longer than 1/(20 f_r) is refused with a message naming the ripple (the
+    ripple would otherwise be weakened, or vanish at h = 1/(2 f_r)); without the ripple it is taken."""
+    doc = doc_with([RIPPLE])                     # 4 Hz: at most 12.5 ms
+    runtime(doc, max_step=0.1).step12(200.0, 0.0, 0.0125)
+    with pytest.raises(rt.ModelError, match="does not resolve the speed ripple of 4 Hz"):
+        runtime(doc, max_step=0.1).step12(200.0, 0.0, 0.02)
+    runtime(doc, max_step=0.1, speed_ripple=False).step12(200.0, 0.0, 0.02)
+
+
+def test_fmu_ripple_equals_the_coupling_kits_sidebands():
+    """Two independent implementations: the FMU's time-domain ripple (the rotor's speed rippled step by step,
+    modes on, steady start) and rwadist.extended.ripple_lines (closed-form sideband coefficients through the
+    rotor's modes, used by the coupling kit) agree on every line's sidebands in Fx, Fy, Fz to 1e-4 of the
+    channel's largest line, at +1700 and −2000 rpm, with counter-rotating lines and a speed law q = 0.5.
+    (Tx, Ty are left out: ripple_lines neglects the ripple's modulation of the gyroscopic rocking, 8-12 % of
+    the largest Tx/Ty line here, at sidebands near the rocking whirl.)"""
+    from dataclasses import replace
+    from rwadist import extended as ext
+    m = preset("ithaco-e").to_model()
+    rip_e = dict(RIPPLE, f_ripple_Hz=2.3, delta_omega_rad_s=3.0, speed_exponent=0.5)
+    m.effects = [rip_e]
+    doc = doc_with([rip_e], m)
+    pe = ext.params_from_model(m)
+    lines = [ln for ln in ext.lines_from_model(m, pe) if not ln.imbalance]   # imbalance: tangential term
+    rip = ext.ripple_from_effects(m.effects)
+    h, T = 5e-4, 24.0
+    t = np.arange(int(T / h) + 1) * h
+    sel = t >= 8.0                             # the start transient of the modes decays
+    for rpm in (1700.0, -2000.0):
+        om = rpm * 2 * np.pi / 60
+        # the FMU's rotor angle is 0 at t0; ripple_lines' mean angle is: shift each line's phase by hΔΩ/(2πf_r)
+        d = float(rip.delta(om)) / (2 * np.pi * rip.f_hz)
+        shifted = [replace(ln, phase=ln.phase + ln.h * d) for ln in lines]
+        _, f, A = ext.ripple_lines(pe, shifted, [om], rip)
+        f, A = f[0].ravel(), A[0].reshape(-1, 6)
+        fu, idx = np.unique(np.round(f, 9), return_inverse=True)
+        pred = np.zeros((fu.size, 6), complex)
+        np.add.at(pred, idx, A)
+        keep = np.abs(pred).max(1) > 1e-6 * np.abs(pred).max()
+        fu, pred = fu[keep], pred[keep]
+        out = runtime(doc, imbalance=False, start_steady=True).run(t, np.full(t.size, om))
+        E = np.exp(2j * np.pi * fu[None, :] * t[sel, None])
+        coef = np.linalg.lstsq(np.hstack([E.real, -E.imag]), out[sel], rcond=None)[0]
+        fit = coef[:fu.size] + 1j * coef[fu.size:]
+        err = np.abs(fit - pred)[:, :5].max(0) / np.abs(pred)[:, :5].max(0)    # (Tz: no line of this model)
+        assert np.all(err[:3] < 1e-4), (rpm, err)
+        print(f"\n{rpm} rpm: {fu.size} line frequencies, FMU vs ripple_lines per channel {np.array2string(err, precision=1)}")
