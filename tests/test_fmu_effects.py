@@ -16,7 +16,7 @@ from fmu.build import build_fmu
 from rwadist import model as model_io
 from rwadist.presets import preset
 
-from test_fmu import NATIVE_ONLY, kernel, slope, spin_up  # noqa: F401  (kernel: a fixture)
+from test_fmu import NATIVE_ONLY, assert_native_equals_numpy, kernel, slope, spin_up  # noqa: F401  (kernel: a fixture)
 
 pytest.importorskip("pythonfmu")
 pytest.importorskip("fmpy")
@@ -242,13 +242,7 @@ def test_native_kernel_with_floor_and_ripple_equals_numpy(kernel):  # noqa: F811
     t, w = spin_up(T=2.0)
     h = t[1] - t[0]
     for kw, acc in ((dict(), slope(t, w)), (dict(start_steady=True), [None] * t.size)):
-        a = runtime(doc, seed=4, **kw)
-        b = runtime(doc, seed=4, kernel=kernel, **kw)
-        assert b.native and not a.native
-        ya = np.array([a.step12(w[n], acc[n], h) for n in range(t.size - 1)])
-        yb = np.array([b.step12(w[n], acc[n], h) for n in range(t.size - 1)])
-        scale = np.max(np.abs(ya), axis=0)
-        assert np.all(np.abs(yb - ya) <= 1e-12 * scale), np.max(np.abs(yb - ya), axis=0) / scale
+        assert_native_equals_numpy(runtime(doc, seed=4, **kw), runtime(doc, seed=4, kernel=kernel, **kw), w, acc, h, kw)
 
 
 def test_fmu_with_floor_and_ripple_through_fmpy(tmp_path):
