@@ -513,30 +513,34 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
         f = np.asarray(f_hz, dtype=float).ravel()
         if f.size < 2 or not np.all(np.isfinite(f)) or f[0] <= 0 or np.any(np.diff(f) <= 0):
             raise CouplingError("f_hz must be >= 2 finite, positive, strictly increasing frequencies")
-    G, P = plant.frf(f)
-    if not (np.all(np.isfinite(G)) and np.all(np.isfinite(P))):
-        raise CouplingError(f"the plant's response is not finite on the floor grid ({f[0]:.6g}-{f[-1]:.6g} Hz)")
     R = np.stack([Mts[k].T[:, c] for k, c in cols], axis=1)                 # (n_if, N) unit blocked loads
     Sin = np.zeros((om.size, f.size, len(cols)))
     for j, (k, c) in enumerate(cols):
         for fl in wheels[k].floors:
             if fl.channel == c:
                 Sin[:, :, j] += fl.psd(f, om * wheels[k].speed_scale)
-    psd = {}
-    if "i" in practices:
-        psd["i"] = (np.abs(P @ R) ** 2 @ Sin[..., None])[..., 0]
-    if "ii" in practices:
-        Y = P @ np.linalg.solve(np.eye(n_if) - Zm @ G, np.broadcast_to(R, (f.size,) + R.shape))
-        psd["ii"] = (np.abs(Y) ** 2 @ Sin[..., None])[..., 0]
+    psd = {p: np.zeros((om.size, f.size, plant.n_perf)) for p in practices}
     dyn = [p for p in ("coupled", "iii") if p in practices]
-    if dyn:
-        out = {p: np.zeros((om.size, f.size, plant.n_perf)) for p in dyn}
-        step = max(1, int(chunk_points) // f.size)
-        eye = np.eye(n_if)
+    eye = np.eye(n_if)
+    fstep = max(1, min(f.size, int(chunk_points)))
+    for j0 in range(0, f.size, fstep):               # frequency chunks: the n_if × n_if work arrays stay bounded
+        fs = slice(j0, j0 + fstep)
+        fc = f[fs]
+        G, P = plant.frf(fc)
+        if not (np.all(np.isfinite(G)) and np.all(np.isfinite(P))):
+            raise CouplingError(f"the plant's response is not finite on the floor grid ({f[0]:.6g}-{f[-1]:.6g} Hz)")
+        if "i" in practices:
+            psd["i"][:, fs] = (np.abs(P @ R) ** 2 @ Sin[:, fs][..., None])[..., 0]
+        if "ii" in practices:
+            Y = P @ np.linalg.solve(eye - Zm @ G, np.broadcast_to(R, (fc.size,) + R.shape))
+            psd["ii"][:, fs] = (np.abs(Y) ** 2 @ Sin[:, fs][..., None])[..., 0]
+        if not dyn:
+            continue
+        step = max(1, int(chunk_points) // fc.size)
         for i0 in range(0, om.size, step):
             o = om[i0:i0 + step]
-            fe = np.broadcast_to(f, (o.size, f.size))
-            Zsum = np.zeros((o.size, f.size, n_if, n_if), dtype=complex)
+            fe = np.broadcast_to(fc, (o.size, fc.size))
+            Zsum = np.zeros((o.size, fc.size, n_if, n_if), dtype=complex)
             Bs = {}
             cache = _FrfCache()
             for i, wi in enumerate(wheels):
@@ -545,15 +549,14 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
                 if wi.floors:
                     Bs[i] = Bw
             Lc = eye - Zsum @ G
-            sl = slice(i0, i0 + o.size)
+            Sc = Sin[i0:i0 + o.size, fs][..., None]
             if "coupled" in dyn:
                 Y = P @ np.linalg.solve(Lc, np.broadcast_to(R, Lc.shape[:-2] + R.shape))
-                out["coupled"][sl] = (np.abs(Y) ** 2 @ Sin[sl][..., None])[..., 0]
+                psd["coupled"][i0:i0 + o.size, fs] = (np.abs(Y) ** 2 @ Sc)[..., 0]
             if "iii" in dyn:
                 R3 = np.stack([np.einsum("ij,sfj->sfi", Mts[k].T, Bs[k][..., :, c]) for k, c in cols], axis=-1)
                 Y = P @ np.linalg.solve(Lc, R3)
-                out["iii"][sl] = (np.abs(Y) ** 2 @ Sin[sl][..., None])[..., 0]
-        psd.update(out)
+                psd["iii"][i0:i0 + o.size, fs] = (np.abs(Y) ** 2 @ Sc)[..., 0]
     psd = {p: psd[p] for p in practices}
     ms = {p: _trapz(v, f, axis=1) for p, v in psd.items()}
     return FloorResponses(om, plant.perf_names, f, psd, ms)

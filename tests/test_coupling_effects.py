@@ -98,6 +98,13 @@ def test_floor_through_coupled_plant_equals_lyapunov_covariance():
     assert max(conv.values()) < 2e-5
     # the coupling matters here (the test is not passed by the plant alone)
     assert np.max(np.abs(fr.ms["i"][0] / var_c - 1)) > 0.1
+    # chunked in frequency and speed (bounded work arrays) = all at once
+    chunked = cp.floor_responses(plant, [w1, w2], [om, 0.5 * om], practices=("coupled", "ii", "i", "iii"),
+                                 f_hz=fr.f_hz, chunk_points=97)
+    whole = cp.floor_responses(plant, [w1, w2], [om, 0.5 * om], practices=("coupled", "ii", "i", "iii"),
+                               f_hz=fr.f_hz, chunk_points=10**7)
+    for k in whole.psd:
+        assert np.allclose(chunked.psd[k], whole.psd[k], rtol=1e-12, atol=0)
 
 
 def test_floor_practice_i_spring_mass_closed_form():
