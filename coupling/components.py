@@ -410,8 +410,16 @@ class Plant:
             wn, zeta, Phi, Phip = self.modal
             om = 2 * np.pi * f[..., None]
             hdisp = 1.0 / (wn**2 - om**2 + 2j * zeta * wn * om)       # (..., n_modes)
-            G = (Phi * (-(om**2) * hdisp)[..., None, :]) @ Phi.T
-            P = (Phip * hdisp[..., None, :]) @ Phi.T
+            # Σ_m φ_m φ_mᵀ h_m(f) for every frequency at once: the modal responses (complex) times the modes'
+            # outer products (real), two real matrix products over all frequencies (BLAS), not a complex
+            # n×n_modes×n product per frequency
+            m = wn.size
+            KG = np.einsum("im,jm->mij", Phi, Phi).reshape(m, n * n)
+            KP = np.einsum("im,jm->mij", Phip, Phi).reshape(m, -1)
+            ha = (-(om**2) * hdisp).reshape(-1, m)
+            hd = hdisp.reshape(-1, m)
+            G = (ha.real @ KG + 1j * (ha.imag @ KG)).reshape(f.shape + (n, n))
+            P = (hd.real @ KP + 1j * (hd.imag @ KP)).reshape(f.shape + (Phip.shape[0], n))
             return G, P
         A, B, C, D = (np.asarray(x) for x in (self.sys.A, self.sys.B, self.sys.C, self.sys.D))
         s = 2j * np.pi * f

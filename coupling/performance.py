@@ -281,6 +281,27 @@ def _wheel_frf(spec, omega, f):
     return H[..., :6], H[..., 6:]
 
 
+def _interface_matrix(G, parts) -> np.ndarray:
+    """The coupled interface matrix I − Σ_i Mt_iᵀ Zc_i Mt_i G for plant accelerances G (..., n, n) and wheels
+    ``parts`` = [(Mt_i (6, n) mount selector, Zc_i (..., 6, 6) dynamic mass)], broadcast together.  Each
+    wheel touches only the interface DOFs its selector reaches (its non-zero columns: one node's six), so
+    its term is Tᵀ Zc T·G[those rows] with T the selector's non-zero block -- a 6×6 and a 6×n product per
+    point instead of n×n ones."""
+    n = G.shape[-1]
+    L = None
+    for Mt, Z in parts:
+        cols = np.nonzero(np.any(Mt != 0, axis=0))[0]
+        T = Mt[:, cols]
+        term = (T.T @ Z @ T) @ G[..., cols, :]
+        if L is None:
+            L = np.zeros(np.broadcast_shapes(term.shape[:-2], G.shape[:-2]) + (n, n), dtype=complex)
+        L[..., cols, :] -= term
+    if L is None:
+        L = np.zeros(G.shape, dtype=complex)
+    L[..., np.arange(n), np.arange(n)] += 1.0
+    return L
+
+
 def _wheel_key(w):
     return (w.params, float(w.housing_mass), tuple(float(x) for x in w.housing_inertia), float(w.speed_scale))
 
@@ -348,14 +369,14 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
             live = f > 0
             fe = np.where(live, f, 1.0)
             G, P = plant.frf(fe)
-            Zsum = np.zeros(fe.shape + (n_if, n_if), dtype=complex)
+            parts = []
             for i, wi in enumerate(wheels):
                 Zc, Bw = cache.get(wi, o, fe)
-                Zsum += Mts[i].T @ Zc @ Mts[i]
+                parts.append((Mts[i], Zc))
                 if i == k:
                     Zck, Bk = Zc, Bw
             rhs = (Mts[k].T @ Fk[..., None])                     # (S, J, n_if, 1)
-            Lc = eye - Zsum @ G                                   # coupled interface equation
+            Lc = _interface_matrix(G, parts)                      # coupled interface equation
             uc = np.linalg.solve(Lc, rhs)
             loads[k].append(np.where(live[..., None], (Fk[..., None] + Zck @ (Mts[k] @ (G @ uc)))[..., 0], 0))
             for p in practices:
@@ -540,23 +561,24 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
         for i0 in range(0, om.size, step):
             o = om[i0:i0 + step]
             fe = np.broadcast_to(fc, (o.size, fc.size))
-            Zsum = np.zeros((o.size, fc.size, n_if, n_if), dtype=complex)
-            Bs = {}
+            parts, Bs = [], {}
             cache = _FrfCache()
             for i, wi in enumerate(wheels):
                 Zc, Bw = cache.get(wi, o, fe)
-                Zsum += Mts[i].T @ Zc @ Mts[i]
+                parts.append((Mts[i], Zc))
                 if wi.floors:
                     Bs[i] = Bw
-            Lc = eye - Zsum @ G
+            Lc = _interface_matrix(G, parts)
             Sc = Sin[i0:i0 + o.size, fs][..., None]
+            # P·Lc⁻¹ once, by the transposed system (n_perf right-hand sides, usually fewer than the loads;
+            # one factorisation serves 'coupled' and 'iii')
+            PT = np.broadcast_to(np.swapaxes(P, -1, -2), Lc.shape[:-2] + (n_if, plant.n_perf))
+            PL = np.swapaxes(np.linalg.solve(np.swapaxes(Lc, -1, -2), PT), -1, -2)     # (s, f, n_perf, n_if)
             if "coupled" in dyn:
-                Y = P @ np.linalg.solve(Lc, np.broadcast_to(R, Lc.shape[:-2] + R.shape))
-                psd["coupled"][i0:i0 + o.size, fs] = (np.abs(Y) ** 2 @ Sc)[..., 0]
+                psd["coupled"][i0:i0 + o.size, fs] = (np.abs(PL @ R) ** 2 @ Sc)[..., 0]
             if "iii" in dyn:
                 R3 = np.stack([np.einsum("ij,sfj->sfi", Mts[k].T, Bs[k][..., :, c]) for k, c in cols], axis=-1)
-                Y = P @ np.linalg.solve(Lc, R3)
-                psd["iii"][i0:i0 + o.size, fs] = (np.abs(Y) ** 2 @ Sc)[..., 0]
+                psd["iii"][i0:i0 + o.size, fs] = (np.abs(PL @ R3) ** 2 @ Sc)[..., 0]
     psd = {p: psd[p] for p in practices}
     ms = {p: _trapz(v, f, axis=1) for p, v in psd.items()}
     return FloorResponses(om, plant.perf_names, f, psd, ms)
