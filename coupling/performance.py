@@ -281,6 +281,20 @@ def _wheel_frf(spec, omega, f):
     return H[..., :6], H[..., 6:]
 
 
+def _congruence(T, Z) -> np.ndarray:
+    """Tᵀ Z T for a constant real T (6, 6) and stacked complex Z (..., 6, 6), as one matrix product over all
+    of them: (TᵀZT)_cd = Σ_ab T_ac Z_ab T_bd, i.e. vec(Z) times kron(T, T) (real and imaginary parts apart)."""
+    K = np.kron(T, T)
+    Zf = np.ascontiguousarray(Z).reshape(-1, K.shape[0])
+    return (Zf.real @ K + 1j * (Zf.imag @ K)).reshape(Z.shape[:-2] + (T.shape[1], T.shape[1]))
+
+
+def _apply_left(M, x) -> np.ndarray:
+    """M @ x[..., :] for a constant real M (a, b) and stacked complex vectors x (..., b): one matrix product."""
+    xf = np.ascontiguousarray(x).reshape(-1, M.shape[1])
+    return (xf.real @ M.T + 1j * (xf.imag @ M.T)).reshape(x.shape[:-1] + (M.shape[0],))
+
+
 def _interface_matrix(G, parts) -> np.ndarray:
     """The coupled interface matrix I − Σ_i Mt_iᵀ Zc_i Mt_i G for plant accelerances G (..., n, n) and wheels
     ``parts`` = [(Mt_i (6, n) mount selector, Zc_i (..., 6, 6) dynamic mass)], broadcast together.  Each
@@ -292,13 +306,15 @@ def _interface_matrix(G, parts) -> np.ndarray:
     for Mt, Z in parts:
         cols = np.nonzero(np.any(Mt != 0, axis=0))[0]
         T = Mt[:, cols]
-        term = (T.T @ Z @ T) @ G[..., cols, :]
+        if cols.size and np.all(np.diff(cols) == 1):
+            cols = slice(int(cols[0]), int(cols[-1]) + 1)      # a node's DOFs: a view (fancy indexing copies)
+        term = _congruence(T, Z) @ G[..., cols, :]
         if L is None:
             L = np.zeros(np.broadcast_shapes(term.shape[:-2], G.shape[:-2]) + (n, n), dtype=complex)
         L[..., cols, :] -= term
     if L is None:
         L = np.zeros(G.shape, dtype=complex)
-    L[..., np.arange(n), np.arange(n)] += 1.0
+    L.reshape(L.shape[:-2] + (n * n,))[..., :: n + 1] += 1.0      # the diagonal, in place
     return L
 
 
@@ -577,7 +593,7 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
             if "coupled" in dyn:
                 psd["coupled"][i0:i0 + o.size, fs] = (np.abs(PL @ R) ** 2 @ Sc)[..., 0]
             if "iii" in dyn:
-                R3 = np.stack([np.einsum("ij,sfj->sfi", Mts[k].T, Bs[k][..., :, c]) for k, c in cols], axis=-1)
+                R3 = np.stack([_apply_left(Mts[k].T, Bs[k][..., :, c]) for k, c in cols], axis=-1)
                 psd["iii"][i0:i0 + o.size, fs] = (np.abs(PL @ R3) ** 2 @ Sc)[..., 0]
     psd = {p: psd[p] for p in practices}
     ms = {p: _trapz(v, f, axis=1) for p, v in psd.items()}
