@@ -375,13 +375,19 @@ def cmd_fmu_check(args) -> int:
     t = np.linspace(0.0, n * args.step_size, n + 1)
     sig = np.zeros(t.size, dtype=[("time", float), ("wheel_speed", float)])
     sig["time"], sig["wheel_speed"] = t, w_end * t / t[-1]
+    errors = []
+
+    def fmu_log(component, instance, status, category, message):
+        if status >= 3:       # fmi2Error and worse: the FMU says why it refused
+            errors.append(message.decode(errors="replace") if isinstance(message, bytes) else str(message))
+
     t0 = time.perf_counter()
     try:
         res = simulate_fmu(args.fmu, stop_time=float(t[-1]), step_size=args.step_size, input=sig,
-                           output_interval=args.step_size)
+                           output_interval=args.step_size, logger=fmu_log, debug_logging=True)
     except Exception as exc:   # fmpy raises FMICallException on a refused step; the FMU logged why
-        print(f"rwadist: error: FMU check failed: the simulation stopped: {exc} (a ramp of "
-              f"{abs(w_end) / t[-1]:.4g} rad/s² may exceed the FMU's max_acceleration)", file=sys.stderr)
+        why = f"; the FMU says: {errors[-1]}" if errors else ""
+        print(f"rwadist: error: FMU check failed: the simulation stopped: {exc}{why}", file=sys.stderr)
         return 1
     wall = time.perf_counter() - t0
     if len(res) < t.size:

@@ -315,6 +315,20 @@ def test_ripple_needs_steps_that_resolve_it():
     runtime(doc, max_step=0.1, speed_ripple=False).step12(200.0, 0.0, 0.02)
 
 
+def test_cli_fmu_check_reports_the_fmus_reason(tmp_path, capsys):
+    """`rwadist fmu check` of a rippled wheel: fine at 1-ms steps; at 10-ms steps (an 8-Hz ripple needs
+    at most 6.25 ms) it fails and prints the FMU's own reason."""
+    from rwadist.cli import main
+    m = preset("ithaco-e").to_model()
+    m.effects = [dict(RIPPLE, f_ripple_Hz=8.0)]
+    path = tmp_path / "rippled.fmu"
+    assert main(["fmu", "build", str(model_io.save(m, tmp_path / "m.json")), "-o", str(path)]) == 0
+    assert main(["fmu", "check", str(path)]) == 0
+    capsys.readouterr()
+    assert main(["fmu", "check", str(path), "--step-size", "0.01"]) == 1
+    assert "does not resolve the speed ripple of 8 Hz" in capsys.readouterr().err
+
+
 def test_fmu_ripple_equals_the_coupling_kits_sidebands():
     """Two independent implementations: the FMU's time-domain ripple (the rotor's speed rippled step by step,
     modes on, steady start) and rwadist.extended.ripple_lines (closed-form sideband coefficients through the
