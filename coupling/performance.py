@@ -43,6 +43,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rwadist import extended as ext
+from rwadist import schema
+from rwadist.schema import ModelError
 from rwadist.units import CHANNELS, RAD_S_TO_RPM
 
 from . import geometry
@@ -98,48 +100,22 @@ class Floor:
         return float(self.f_hz[max(nz[0] - 1, 0)]), float(self.f_hz[min(nz[-1] + 1, self.f_hz.size - 1)])
 
 
-def floors_from_effects(effects) -> tuple:
-    """The :class:`Floor` s of a model file's ``effects`` list: each ``broadband_floor`` entry
-    {"channel": name or list of names, "exponent", "omega_ref_rad_s", "f_Hz": [...], "psd_ref": [...]}
-    gives one Floor per channel.  CouplingError naming ``effects[i].<field>`` on a bad entry."""
-    if not effects:
-        return ()
-    if not isinstance(effects, (list, tuple)):
-        raise CouplingError(f"effects: must be a list, got {type(effects).__name__}")
+class CouplingModelError(ModelError, CouplingError):
+    """A bad model-file entry read by the coupling kit: the schema's one :class:`rwadist.schema.ModelError`
+    (same message in every consumer), also a :class:`CouplingError`."""
+
+
+def floors_from_effects(effects, source: str = "<model>") -> tuple:
+    """The :class:`Floor` s of a model file's ``effects`` list (dicts or typed effects): each
+    ``broadband_floor`` entry {"channel": name or list of names, "exponent", "omega_ref_rad_s",
+    "f_Hz": [...], "psd_ref": [...]} gives one Floor per channel (a channel named twice, one).  Read by
+    the schema (:func:`rwadist.schema.parse_effects`): :class:`CouplingModelError` naming
+    ``effects[i].<field>`` on a bad entry."""
     out = []
-    for i, e in enumerate(effects):
-        if not isinstance(e, dict) or e.get("kind") != "broadband_floor":
-            continue
-        ch = e.get("channel")
-        chans = [ch] if isinstance(ch, str) else ch
-        if not isinstance(chans, (list, tuple)) or not chans or any(c not in CHANNELS for c in chans):
-            raise CouplingError(f"effects[{i}].channel: {ch!r} must be one of {', '.join(CHANNELS)} or a "
-                                "non-empty list of them")
-        try:
-            p = ext._effect_number(e, i, "exponent", lambda v: v >= 0, "a finite number >= 0")
-            w_ref = ext._effect_number(e, i, "omega_ref_rad_s", lambda v: v > 0, "a finite number > 0")
-        except ValueError as exc:
-            raise CouplingError(str(exc)) from exc
-        f = _number_list(e, i, "f_Hz")
-        if f.size < 2 or f[0] < 0 or np.any(np.diff(f) <= 0):
-            raise CouplingError(f"effects[{i}].f_Hz: must be at least 2 frequencies >= 0, strictly increasing")
-        s = _number_list(e, i, "psd_ref")
-        if s.size != f.size or np.any(s < 0):
-            raise CouplingError(f"effects[{i}].psd_ref: must be {f.size} values >= 0 (one per f_Hz knot), "
-                                f"got {s.size}" + (" with negative values" if np.any(s < 0) else ""))
-        for c in dict.fromkeys(chans):
-            out.append(Floor(CHANNELS.index(c), f, s, w_ref, p))
+    for e in schema.of_kind(effects or None, schema.BroadbandFloor, source, CouplingModelError):
+        for c in e.channel_indices:
+            out.append(Floor(c, e.f_Hz, e.psd_ref, float(e.omega_ref_rad_s), float(e.exponent)))
     return tuple(out)
-
-
-def _number_list(e, i, key):
-    v = e.get(key)
-    if not isinstance(v, (list, tuple)) or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v):
-        raise CouplingError(f"effects[{i}].{key}: must be a list of numbers, got {v!r}")
-    a = np.asarray(v, dtype=float)
-    if not np.all(np.isfinite(a)):
-        raise CouplingError(f"effects[{i}].{key}: must be finite numbers")
-    return a
 
 
 # ----------------------------------------------------------------------------- wheels
@@ -181,14 +157,11 @@ def wheel_spec_from_model(model, mount=None, **kw) -> WheelSpec:
     wheel-mode resonances, sidebands: :func:`rwadist.extended.apply_line_effects`), its
     ``broadband_floor`` entries as :attr:`WheelSpec.floors` (:func:`floors_from_effects`) and its
     ``speed_ripple`` as :attr:`WheelSpec.ripple` (:func:`rwadist.extended.ripple_from_effects`).
-    A bad entry raises CouplingError naming ``effects[i].<field>``."""
-    effects = getattr(model, "effects", None)
+    A bad entry raises :class:`CouplingModelError` (a CouplingError) naming ``effects[i].<field>``."""
+    effects = schema.parse_effects(getattr(model, "effects", None), "<model>", CouplingModelError)
     p = ext.params_from_model(model)
-    try:
-        lines = tuple(ext.lines_from_model(model, p))
-        ripple = ext.ripple_from_effects(effects)
-    except ValueError as exc:
-        raise CouplingError(str(exc)) from exc
+    lines = tuple(ext.lines_from_model(model, p))
+    ripple = ext.ripple_from_effects(effects)
     kw.setdefault("floors", floors_from_effects(effects))
     kw.setdefault("ripple", ripple)
     return WheelSpec(p, lines, mount or geometry.Mount(), **kw)

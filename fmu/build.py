@@ -2,7 +2,8 @@
 
 :func:`build_fmu` renders ``slave_template.py`` under a module and class name unique to the
 build (two FMUs whose slave modules share a name cannot load in one process), and ships
-``runtime.py`` (as ``rwadist_fmu_runtime.py``) and the model file (``wheel_model.json``) in the
+``runtime.py`` (as ``rwadist_fmu_runtime.py``), ``rwadist/schema.py`` (as
+``rwadist_model_schema.py``, the runtime's reader of the model file) and the model file (``wheel_model.json``) in the
 FMU's resources.  pythonfmu embeds itself there too, so a host needs Python + numpy only.
 
 Native layer (Linux x86-64, when a C compiler is found): ``native/rwadist_fmu_native.c`` is
@@ -86,6 +87,12 @@ def has_native(fmu_path) -> bool:
         return any(n.endswith("_pythonfmu.so") for n in z.namelist())
 
 
+def _schema_source() -> Path:
+    """rwadist/schema.py (the installed package's, so an installed rwadist ships its own schema)."""
+    from rwadist import schema
+    return Path(schema.__file__)
+
+
 def _runtime():
     from . import runtime
     return runtime
@@ -153,11 +160,14 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
         extra = tmp / "extra"
         extra.mkdir()
         shutil.copy2(RUNTIME, extra / "rwadist_fmu_runtime.py")
+        schema_copy = extra / _runtime().SCHEMA_FILE
+        shutil.copyfile(_schema_source(), schema_copy)
         (extra / "wheel_model.json").write_text(json.dumps(doc, indent=1) + "\n")
         path_before = list(sys.path)
         try:
             out = FmuBuilder.build_FMU(script, dest=output,
-                                       project_files=[extra / "rwadist_fmu_runtime.py", extra / "wheel_model.json"])
+                                       project_files=[extra / "rwadist_fmu_runtime.py", schema_copy,
+                                                      extra / "wheel_model.json"])
         finally:
             sys.path[:] = path_before
             for name in (module, f"{module}_runtime"):

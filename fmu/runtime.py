@@ -1,7 +1,9 @@
 """Self-contained runtime of the extended wheel model for the FMU (numpy only, no rwadist).
 
 This file is copied verbatim into the FMU's ``resources/`` so a host needs only Python and
-numpy.  It re-implements, step by step, the equations of :mod:`rwadist.extended` (rigid rotor
+numpy; next to it goes a verbatim copy of :mod:`rwadist.schema` (``rwadist_model_schema.py``), the
+one reader of the model file, which this module imports from there (from rwadist itself when run
+from the source tree; a test pins the copy to the source byte for byte).  It re-implements, step by step, the equations of :mod:`rwadist.extended` (rigid rotor
 on a flexible suspension; see that module's docstring for the physics and sign conventions)
 and is tested against :func:`rwadist.extended.simulate_time` to 1e-9 relative
 (tests/test_fmu.py).  Everything is SI: rad/s, rad/s², s, N, N·m, kg, m.
@@ -29,28 +31,46 @@ from __future__ import annotations
 
 import cmath
 import ctypes
+import importlib.util
 import json
 import math
+import os
+import sys
 
 import numpy as np
 
-SCHEMA = "rwadist.model"
-SCHEMA_VERSION = 1
-ANALYTICAL_KIND = "rigid_rotor_5dof"
-DIRECTIONS = ("radial_force", "radial_torque", "axial_force", "axial_torque")
-CHANNELS = ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")
-PARAM_KEYS = {
-    "mass": "mass_kg", "I_zz": "I_zz_kg_m2", "I_rr": "I_rr_kg_m2",
-    "k_r": "k_r_N_per_m", "c_r": "c_r_N_s_per_m",
-    "k_rock": "k_rock_Nm_per_rad", "c_rock": "c_rock_Nm_s_per_rad",
-    "k_z": "k_z_N_per_m", "c_z": "c_z_N_s_per_m",
-    "height": "height_m", "U_s": "U_s_kg_m", "U_d": "U_d_kg_m2",
-}
+#: the schema's file name in the FMU's resources (``fmu/build.py`` copies rwadist/schema.py there)
+SCHEMA_FILE = "rwadist_model_schema.py"
+
+
+def _load_schema():
+    """The model-file schema: the copy next to this file (inside an FMU), else :mod:`rwadist.schema`."""
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), SCHEMA_FILE)
+    if not os.path.isfile(path):
+        from rwadist import schema
+        return schema
+    name = f"{__name__}_schema"          # unique per FMU: two FMUs may load side by side
+    mod = sys.modules.get(name)
+    if mod is None:
+        spec = importlib.util.spec_from_file_location(name, path)
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[name] = mod          # dataclasses look their module up while the class is made
+        spec.loader.exec_module(mod)
+    return mod
+
+
+_schema = _load_schema()
+SCHEMA = _schema.SCHEMA
+SCHEMA_VERSION = _schema.SCHEMA_VERSION
+ANALYTICAL_KIND = _schema.ANALYTICAL_KIND
+DIRECTIONS = _schema.DIRECTIONS
+CHANNELS = _schema.CHANNELS
+PARAM_KEYS = _schema.PARAM_KEYS
 SMALL_Z = 1e-3
 
-
-class ModelError(ValueError):
-    """Invalid or unreadable model file, parameter or input; the message names the problem."""
+#: Invalid or unreadable model file, parameter or input; the message names the problem.  The schema's
+#: one error type, so a bad model-file entry reads the same here as in rwadist and the coupling kit.
+ModelError = _schema.ModelError
 
 
 # ------------------------------------------------------------------ model file
@@ -78,32 +98,14 @@ def laws_from_doc(doc, source="<model>"):
     ``amplitude_law``, written by ``rwadist diagnose``): {(direction, h): (A_ref, Ω_ref, p)} with
     the line's amplitude A_ref·(|Ω|/Ω_ref)^p (N or N·m, rad/s) in place of C·Ω².  Other effect
     kinds are not time-domain forcing the FMU models and are ignored (missing harmonics are
-    already harmonics of ``empirical``)."""
-    out = {}
-    effects = doc.get("effects") or []
-    if not isinstance(effects, list):
-        raise ModelError(f"{source}: effects: must be a list")
-    for i, e in enumerate(effects):
-        if not isinstance(e, dict) or e.get("kind") != "amplitude_law":
-            continue
-        where = f"{source}: effects[{i}]"
-        d = e.get("direction")
-        if d not in DIRECTIONS:
-            raise ModelError(f"{where}.direction: {d!r} is not one of {', '.join(DIRECTIONS)}")
-        h = _num(e.get("h"), where + ".h")
-        a = _num(e.get("amplitude_ref"), where + ".amplitude_ref")
-        w = _num(e.get("omega_ref_rad_s"), where + ".omega_ref_rad_s")
-        x = _num(e.get("exponent"), where + ".exponent")
-        if h <= 0 or a < 0 or w <= 0 or x < 0:
-            raise ModelError(f"{where}: needs h > 0, amplitude_ref >= 0, omega_ref_rad_s > 0 and exponent >= 0; "
-                             f"got h={h!r}, amplitude_ref={a!r}, omega_ref_rad_s={w!r}, exponent={x!r}")
-        out[(d, h)] = (a, w, x)
-    return out
+    already harmonics of ``empirical``).  The effects are read (all of them) by the schema."""
+    return {(e.direction, float(e.h)): e.law for e in _schema.of_kind(doc.get("effects"), _schema.AmplitudeLaw,
+                                                                      source)}
 
 
 def effects_from_doc(doc, source="<model>"):
-    """All time-domain forcing effects of a model document (``rwadist diagnose``), validated, as
-    keyword arguments of :class:`WheelRuntime`:
+    """All time-domain forcing effects of a model document (``rwadist diagnose``), validated by the
+    schema (:func:`rwadist.schema.parse_effects`), as keyword arguments of :class:`WheelRuntime`:
 
     * ``laws``: :func:`laws_from_doc`;
     * ``resonances``: [(directions, f_r Hz, ζ, peak_gain)] of each ``fixed_resonance`` of role
@@ -124,80 +126,27 @@ def effects_from_doc(doc, source="<model>"):
       turns at Ω(t) + ΔΩ_ref·(|Ω|/Ω_ref)^q·sin(2π f_r t + θ) (see :class:`WheelRuntime`).
 
     ModelError naming ``effects[i].<field>`` on a bad entry."""
-    out = {"laws": laws_from_doc(doc, source), "resonances": [], "sidebands": [], "floors": [], "ripples": []}
-    for i, e in enumerate(doc.get("effects") or []):
-        if not isinstance(e, dict):
-            continue
-        where = f"{source}: effects[{i}]"
-        kind = e.get("kind")
-        if kind == "fixed_resonance":
-            role = e.get("role")
-            if role not in ("wheel_mode", "test_stand"):
-                raise ModelError(f"{where}.role: {role!r} is not wheel_mode or test_stand")
-            vals = [_num(e.get(k), f"{where}.{k}") for k in ("f_Hz", "zeta", "peak_gain")]
-            for k, v in zip(("f_Hz", "zeta", "peak_gain"), vals):
-                if v <= 0:
-                    raise ModelError(f"{where}.{k}: must be > 0, got {v!r}")
-            dirs = e.get("directions")
-            dirs = [dirs] if isinstance(dirs, str) else dirs
-            if not isinstance(dirs, list) or not dirs or any(d not in DIRECTIONS for d in dirs):
-                raise ModelError(f"{where}.directions: {e.get('directions')!r} must be a non-empty list of "
-                                 f"{', '.join(DIRECTIONS)}")
-            if role == "wheel_mode":
-                out["resonances"].append((tuple(dirs), *vals))
-        elif kind == "sidebands":
-            d = e.get("direction")
-            if d not in DIRECTIONS:
-                raise ModelError(f"{where}.direction: {d!r} is not one of {', '.join(DIRECTIONS)}")
-            h, f_mod, m = (_num(e.get(k), f"{where}.{k}") for k in ("h", "f_mod_Hz", "depth"))
-            for k, v, ok in (("h", h, h > 0), ("f_mod_Hz", f_mod, f_mod > 0), ("depth", m, m >= 0)):
-                if not ok:
-                    raise ModelError(f"{where}.{k}: must be {'>= 0' if k == 'depth' else '> 0'}, got {v!r}")
-            out["sidebands"].append((d, h, f_mod, m))
-        elif kind == "broadband_floor":
-            out["floors"].extend(_floor_from_entry(e, where))
-        elif kind == "speed_ripple":
-            if out["ripples"]:
-                raise ModelError(f"{where}.kind: a second speed_ripple; one speed ripple per wheel is supported "
-                                 "(as rwadist.extended.ripple_from_effects)")
-            vals = []
-            for k, need, ok in (("delta_omega_rad_s", ">= 0", lambda v: v >= 0), ("omega_ref_rad_s", "> 0", lambda v: v > 0),
-                                ("speed_exponent", ">= 0", lambda v: v >= 0), ("f_ripple_Hz", "> 0", lambda v: v > 0)):
-                v = _num(e.get(k, 0.0) if k == "speed_exponent" else e.get(k), f"{where}.{k}")
-                if not ok(v):
-                    raise ModelError(f"{where}.{k}: must be {need}, got {v!r}")
-                vals.append(v)
-            out["ripples"].append(tuple(vals))
+    effects = _schema.parse_effects(doc.get("effects") or None, source)
+    out = {"laws": laws_from_doc({"effects": effects}, source), "resonances": [], "sidebands": [], "floors": [],
+           "ripples": []}
+    for e in effects:
+        if isinstance(e, _schema.FixedResonance) and e.role == "wheel_mode":
+            out["resonances"].append((e.directions, *e.resonance))
+        elif isinstance(e, _schema.Sidebands):
+            out["sidebands"].append((e.direction, float(e.h), float(e.f_mod_Hz), float(e.depth)))
+        elif isinstance(e, _schema.BroadbandFloor):
+            out["floors"].extend(_floor_from_entry(e))
+        elif isinstance(e, _schema.SpeedRipple):
+            out["ripples"].append((float(e.delta_omega_rad_s), float(e.omega_ref_rad_s), float(e.speed_exponent),
+                                   float(e.f_ripple_Hz)))
     return out
 
 
-def _floor_from_entry(e, where):
-    """[(channel index, f knots, psd knots, Ω_ref, p)] of one ``broadband_floor`` entry, validated."""
-    chans = e.get("channel")
-    chans = [chans] if isinstance(chans, str) else chans
-    if not isinstance(chans, list) or not chans or any(c not in CHANNELS for c in chans):
-        raise ModelError(f"{where}.channel: {e.get('channel')!r} must be one of {', '.join(CHANNELS)} or a list of them")
-    chans = list(dict.fromkeys(chans))          # a channel named twice has one floor (as the coupling kit reads it)
-    knots = {}
-    for k in ("f_Hz", "psd_ref"):
-        v = e.get(k)
-        if not isinstance(v, list) or len(v) < 2:
-            raise ModelError(f"{where}.{k}: must be a list of at least two numbers")
-        knots[k] = np.array([_num(x, f"{where}.{k}[{i}]") for i, x in enumerate(v)])
-    f, psd = knots["f_Hz"], knots["psd_ref"]
-    if f.size != psd.size:
-        raise ModelError(f"{where}.psd_ref: has {psd.size} values for {f.size} f_Hz knots")
-    if f[0] < 0 or np.any(np.diff(f) <= 0):
-        raise ModelError(f"{where}.f_Hz: knots must be >= 0 and strictly increasing")
-    if np.any(psd < 0):
-        raise ModelError(f"{where}.psd_ref: values must be >= 0, got {float(psd.min())!r}")
-    w_ref = _num(e.get("omega_ref_rad_s"), f"{where}.omega_ref_rad_s")
-    p = _num(e.get("exponent"), f"{where}.exponent")
-    if w_ref <= 0:
-        raise ModelError(f"{where}.omega_ref_rad_s: must be > 0, got {w_ref!r}")
-    if p < 0:
-        raise ModelError(f"{where}.exponent: must be >= 0, got {p!r}")
-    return [(CHANNELS.index(c), f, psd, w_ref, p) for c in chans]
+def _floor_from_entry(e):
+    """[(channel index, f knots, psd knots, Ω_ref, p)] of one (typed, validated) ``broadband_floor``; a
+    channel named twice has one floor (as the coupling kit reads it)."""
+    return [(c, np.array(e.f_Hz), np.array(e.psd_ref), float(e.omega_ref_rad_s), float(e.exponent))
+            for c in e.channel_indices]
 
 
 def load_model(path):

@@ -63,6 +63,7 @@ import numpy as np
 from scipy import stats
 
 from . import extended as ext
+from . import schema
 from .data import DataError
 from .model import WheelModel
 from .units import CHANNELS, PSD_COLUMN, RAD_S_TO_RPM, rpm_to_rad_s
@@ -440,38 +441,35 @@ def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
       of an empirical line C·Ω(t)² raises its mean square by the factor E_θ[(1 + ε sin θ)⁴] =
       1 + 3ε² + 3ε⁴/8, ε = ΔΩ/|Ω|; that is added exactly, as two sources per line with amplitude laws
       √3·C·ΔΩ·|Ω| (exponent 1 + q) and √(3/8)·C·ΔΩ² (exponent 2q).  Sources with an amplitude law or of
-      the extended model (not ∝ Ω²) get no amplitude term (it is O(ε²): 3·10⁻⁴ at ε = 1 %)."""
-    from .units import CHANNELS
+      the extended model (not ∝ Ω²) get no amplitude term (it is O(ε²): 3·10⁻⁴ at ε = 1 %).
 
+    The effects are read by the schema (:func:`rwadist.schema.parse_effects`; typed already when the
+    model came from a file): :class:`rwadist.schema.ModelError` naming ``effects[i].<field>`` on a bad
+    entry, as every other consumer."""
     later = []
-    for e in model.effects or []:
-        kind = e.get("kind")
-        if kind == "amplitude_law":
+    for e in schema.parse_effects(model.effects):
+        if isinstance(e, schema.AmplitudeLaw):
             for i in range(len(src)):
-                d = _source_direction(src, i)
-                if d == e["direction"] and abs(src.h[i] - float(e["h"])) < 1e-3:
-                    src.laws[i] = (float(e["amplitude_ref"]), float(e["omega_ref_rad_s"]), float(e["exponent"]))
-        elif kind == "broadband_floor":
-            chans = e["channel"] if isinstance(e["channel"], list) else [e["channel"]]
-            for c in chans:
-                src.floors.append((CHANNELS.index(c), np.asarray(e["f_Hz"], float), np.asarray(e["psd_ref"], float),
-                                   float(e["omega_ref_rad_s"]), float(e["exponent"])))
-        elif kind == "fixed_resonance" and e.get("role") == "wheel_mode":
-            dirs = e.get("directions") or []
-            dirs = [dirs] if isinstance(dirs, str) else list(dirs)
-            src.resonances.append((dirs, float(e["f_Hz"]), float(e["zeta"]), float(e["peak_gain"])))
-        elif kind in ("sidebands", "speed_ripple"):
+                if _source_direction(src, i) == e.direction and abs(src.h[i] - float(e.h)) < 1e-3:
+                    src.laws[i] = e.law
+        elif isinstance(e, schema.BroadbandFloor):
+            for c in e.channel_indices:
+                src.floors.append((c, np.array(e.f_Hz), np.array(e.psd_ref), float(e.omega_ref_rad_s),
+                                   float(e.exponent)))
+        elif isinstance(e, schema.FixedResonance) and e.role == "wheel_mode":
+            src.resonances.append((list(e.directions), *e.resonance))
+        elif isinstance(e, (schema.Sidebands, schema.SpeedRipple)):
             later.append(e)
-    for e in sorted(later, key=lambda x: x["kind"] != "sidebands"):
+    for e in sorted(later, key=lambda x: not isinstance(x, schema.Sidebands)):
         n0 = len(src)
-        if e["kind"] == "sidebands":
-            m, f_m = float(e["depth"]), float(e["f_mod_Hz"])
+        if isinstance(e, schema.Sidebands):
+            m, f_m = float(e.depth), float(e.f_mod_Hz)
             for i in range(n0):
-                if _source_direction(src, i) == e["direction"] and abs(src.h[i] - float(e["h"])) < 1e-3:
+                if _source_direction(src, i) == e.direction and abs(src.h[i] - float(e.h)) < 1e-3:
                     for sgn in (1.0, -1.0):
                         _copy_source(src, i, f"{src.labels[i]} sideband {sgn * f_m:+g} Hz", 0.5 * m, f_off=sgn * f_m)
         elif src.kind == "empirical":
-            dw, w_ref, q = float(e["delta_omega_rad_s"]), float(e["omega_ref_rad_s"]), float(e.get("speed_exponent", 0))
+            dw, w_ref, q = float(e.delta_omega_rad_s), float(e.omega_ref_rad_s), float(e.speed_exponent)
             for i in range(n0):
                 if i in src.laws:
                     continue

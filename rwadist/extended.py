@@ -72,24 +72,18 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 from scipy import optimize, signal
 
-from .data import DataError
+from . import schema
 from .units import CHANNELS, G_CM2_TO_KG_M2, G_CM_TO_KG_M, RAD_S_TO_RPM
 
 MODES = ("radial_translation", "rocking_forward", "rocking_backward", "axial_translation")
 SENSES = ("co", "counter", "planar")
 DIRECTIONS = ("radial_force", "radial_torque", "axial_force", "axial_torque")
-ANALYTICAL_KIND = "rigid_rotor_5dof"
+ANALYTICAL_KIND = schema.ANALYTICAL_KIND
 #: Largest |dΩ/dt| (rad/s²) a speed profile may show before it counts as a jump.
 DEFAULT_MAX_ACCEL = 500.0
 
-#: Model-file keys of :class:`ExtendedParams` (field -> key with unit).
-_DICT_KEYS = {
-    "mass": "mass_kg", "I_zz": "I_zz_kg_m2", "I_rr": "I_rr_kg_m2",
-    "k_r": "k_r_N_per_m", "c_r": "c_r_N_s_per_m",
-    "k_rock": "k_rock_Nm_per_rad", "c_rock": "c_rock_Nm_s_per_rad",
-    "k_z": "k_z_N_per_m", "c_z": "c_z_N_s_per_m",
-    "height": "height_m", "U_s": "U_s_kg_m", "U_d": "U_d_kg_m2",
-}
+#: Model-file keys of :class:`ExtendedParams` (field -> key with unit): the schema's one table.
+_DICT_KEYS = schema.PARAM_KEYS
 
 
 def thin_disc(mass: float, radius: float) -> tuple:
@@ -210,27 +204,18 @@ def params_to_dict(p: ExtendedParams) -> dict:
 
 
 def params_from_dict(d, source="<model>") -> ExtendedParams:
-    """Inverse of :func:`params_to_dict`; DataError(source, 'analytical.<key>', ...) on a missing
-    or invalid field, DataError(source, 'analytical', ...) when the values are unphysical."""
+    """Inverse of :func:`params_to_dict` (a dict or a :class:`rwadist.schema.Analytical`), read by the
+    schema: a :class:`rwadist.model.ModelFileError` (a DataError) naming ``analytical.<key>`` on a
+    missing or invalid field, ``analytical`` when the values are unphysical."""
+    from .model import ModelFileError
+
     if d is None:
-        raise DataError(source, "analytical", "missing: the model file has no analytical parameters")
-    if not isinstance(d, dict):
-        raise DataError(source, "analytical", f"must be an object, got {type(d).__name__}")
-    kind = d.get("kind", ANALYTICAL_KIND)
-    if kind != ANALYTICAL_KIND:
-        raise DataError(source, "analytical.kind", f"{kind!r} is not {ANALYTICAL_KIND!r}")
-    vals = {}
-    for name, key in _DICT_KEYS.items():
-        if key not in d:
-            raise DataError(source, f"analytical.{key}", "missing")
-        v = d[key]
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise DataError(source, f"analytical.{key}", f"must be a finite number, got {v!r}")
-        vals[name] = float(v)
+        raise ModelFileError(source, "analytical", "missing: the model file has no analytical parameters")
+    vals = schema.Analytical.from_json(d, source, ModelFileError).require(source, ModelFileError)
     try:
         return ExtendedParams(**vals)
     except ValueError as exc:
-        raise DataError(source, "analytical", str(exc)) from exc
+        raise ModelFileError(source, "analytical", str(exc)) from exc
 
 
 def params_from_model(model, source="<model>") -> ExtendedParams:
@@ -367,64 +352,23 @@ def is_imbalance(direction: str, h: float, sense) -> bool:
 LAW_H_TOL = 1e-3
 
 
-def _effect_number(e, i, key, ok, need):
-    """effects[i][key] as a float; ValueError naming ``effects[i].key`` unless finite and ``ok``."""
-    v = e.get(key)
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or not ok(v):
-        raise ValueError(f"effects[{i}].{key}: must be {need}, got {v!r}")
-    return float(v)
-
-
-def _effect_direction(e, i, key="direction"):
-    d = e.get(key)
-    if d not in DIRECTIONS:
-        raise ValueError(f"effects[{i}].{key}: {d!r} is not one of {', '.join(DIRECTIONS)}")
-    return d
-
-
-def line_effects(effects) -> dict:
-    """The time-domain forcing effects of a model file's ``effects`` list (``rwadist diagnose``),
-    validated: {'laws': [(direction, h, (A_ref, Ω_ref, p))], 'resonances': [(directions, (f_r, ζ, g))],
+def line_effects(effects, source: str = "<model>") -> dict:
+    """The time-domain forcing effects of a model file's ``effects`` list (``rwadist diagnose``; dicts
+    or typed :class:`rwadist.schema.Effect` s), validated by the schema (:func:`rwadist.schema.parse_effects`):
+    {'laws': [(direction, h, (A_ref, Ω_ref, p))], 'resonances': [(directions, (f_r, ζ, g))],
     'sidebands': [(direction, h, f_mod Hz, depth)]} in file order.  A ``fixed_resonance`` of role
     ``test_stand`` (a fixture resonance) and a ``cross_coupling`` (load-cell offset) are measurement
     artefacts and are left out; ``missing_harmonic`` is already a harmonic; ``broadband_floor`` and
-    ``speed_ripple`` are not line forcing.  ValueError naming ``effects[i].<field>`` on a bad entry."""
-    out = {"laws": [], "resonances": [], "sidebands": []}
-    if effects is None:
-        return out
-    if not isinstance(effects, (list, tuple)):
-        raise ValueError(f"effects: must be a list, got {type(effects).__name__}")
-    pos = "a finite number > 0"
-    for i, e in enumerate(effects):
-        if not isinstance(e, dict):
-            raise ValueError(f"effects[{i}]: must be an object")
-        kind = e.get("kind")
-        if kind == "amplitude_law":
-            d = _effect_direction(e, i)
-            h = _effect_number(e, i, "h", lambda v: v > 0, pos)
-            law = (_effect_number(e, i, "amplitude_ref", lambda v: v >= 0, "a finite number >= 0"),
-                   _effect_number(e, i, "omega_ref_rad_s", lambda v: v > 0, pos),
-                   _effect_number(e, i, "exponent", lambda v: v >= 0, "a finite number >= 0"))
-            out["laws"].append((d, h, law))
-        elif kind == "fixed_resonance":
-            role = e.get("role")
-            if role not in ("wheel_mode", "test_stand"):
-                raise ValueError(f"effects[{i}].role: {role!r} is not 'wheel_mode' or 'test_stand'")
-            res = (_effect_number(e, i, "f_Hz", lambda v: v > 0, pos),
-                   _effect_number(e, i, "zeta", lambda v: v > 0, pos),
-                   _effect_number(e, i, "peak_gain", lambda v: v > 0, pos))
-            dirs = e.get("directions")
-            dirs = [dirs] if isinstance(dirs, str) else dirs
-            if not isinstance(dirs, (list, tuple)) or not dirs or any(d not in DIRECTIONS for d in dirs):
-                raise ValueError(f"effects[{i}].directions: {e.get('directions')!r} must be a non-empty list of "
-                                 f"{', '.join(DIRECTIONS)}")
-            if role == "wheel_mode":
-                out["resonances"].append((tuple(dirs), res))
-        elif kind == "sidebands":
-            d = _effect_direction(e, i)
-            out["sidebands"].append((d, _effect_number(e, i, "h", lambda v: v > 0, pos),
-                                     _effect_number(e, i, "f_mod_Hz", lambda v: v > 0, pos),
-                                     _effect_number(e, i, "depth", lambda v: v >= 0, "a finite number >= 0")))
+    ``speed_ripple`` are not line forcing.  :class:`rwadist.schema.ModelError` (a ValueError) naming
+    ``effects[i].<field>`` on a bad entry."""
+    out: dict = {"laws": [], "resonances": [], "sidebands": []}
+    for e in schema.parse_effects(effects, source):
+        if isinstance(e, schema.AmplitudeLaw):
+            out["laws"].append((e.direction, float(e.h), e.law))
+        elif isinstance(e, schema.FixedResonance) and e.role == "wheel_mode":
+            out["resonances"].append((e.directions, e.resonance))
+        elif isinstance(e, schema.Sidebands):
+            out["sidebands"].append((e.direction, float(e.h), float(e.f_mod_Hz), float(e.depth)))
     return out
 
 
@@ -708,29 +652,16 @@ class Ripple:
         return self.delta_omega * (np.abs(np.asarray(omega, dtype=float)) / self.omega_ref) ** self.exponent
 
 
-def ripple_from_effects(effects):
+def ripple_from_effects(effects, source: str = "<model>"):
     """The :class:`Ripple` of a model file's ``effects`` list (its ``speed_ripple`` entry: f_ripple_Hz,
-    delta_omega_rad_s, omega_ref_rad_s, speed_exponent (default 0)), or None.  ValueError naming
+    delta_omega_rad_s, omega_ref_rad_s, speed_exponent (default 0)), or None.  Read by the schema
+    (:func:`rwadist.schema.parse_effects`): :class:`rwadist.schema.ModelError` (a ValueError) naming
     ``effects[i].<field>`` on a bad entry, and on a second ``speed_ripple`` (one per wheel)."""
-    if not effects:
-        return None
-    if not isinstance(effects, (list, tuple)):
-        raise ValueError(f"effects: must be a list, got {type(effects).__name__}")
-    out, first = None, None
-    for i, e in enumerate(effects):
-        if not isinstance(e, dict) or e.get("kind") != "speed_ripple":
-            continue
-        if out is not None:
-            raise ValueError(f"effects[{i}].kind: a second speed_ripple (the first is effects[{first}]); "
-                             "one speed ripple per wheel is supported")
-        q = e.get("speed_exponent", 0.0)
-        out = Ripple(_effect_number(e, i, "f_ripple_Hz", lambda v: v > 0, "a finite number > 0"),
-                     _effect_number(e, i, "delta_omega_rad_s", lambda v: v >= 0, "a finite number >= 0"),
-                     _effect_number(e, i, "omega_ref_rad_s", lambda v: v > 0, "a finite number > 0"),
-                     _effect_number({"speed_exponent": q}, i, "speed_exponent", lambda v: v >= 0,
-                                    "a finite number >= 0"))
-        first = i
-    return out
+    for e in schema.parse_effects(effects or None, source):
+        if isinstance(e, schema.SpeedRipple):
+            return Ripple(float(e.f_ripple_Hz), float(e.delta_omega_rad_s), float(e.omega_ref_rad_s),
+                          float(e.speed_exponent))
+    return None
 
 
 def ripple_k_max(beta_max: float, p_max: float = 2.0) -> int:

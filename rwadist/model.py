@@ -15,67 +15,70 @@ One document drives the kit, ``rwadist psd`` and the FMU::
     }
 
 ``C`` is SI per (rad/s)²: kg·m for forces (amplitude N = C·Ω²), kg·m² for
-torques.  Sections this version does not interpret (``analytical``,
-``effects``) are carried through unchanged.
+torques.  The document is read by the one typed schema, :mod:`rwadist.schema` (the
+``analytical`` section and every ``effects`` entry become typed objects, validated once);
+keys and effect kinds this version does not interpret are carried through unchanged.
 """
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from . import schema
 from .data import DataError, read_json
+from .schema import Analytical, Effect, Harmonic, ModelError
 from .units import DIRECTION_CHANNELS, DIRECTION_C_UNIT
 
-SCHEMA = "rwadist.model"
-SCHEMA_VERSION = 1
+SCHEMA = schema.SCHEMA
+SCHEMA_VERSION = schema.SCHEMA_VERSION
 DIRECTIONS = tuple(DIRECTION_CHANNELS)
 
+__all__ = ["Analytical", "Effect", "Harmonic", "ModelError", "ModelFileError", "WheelModel", "from_json", "load",
+           "line_amplitudes", "model_rms", "save", "to_json"]
 
-@dataclass
-class Harmonic:
-    """One empirical harmonic: amplitude C·Ω² at frequency h·|Ω|.
 
-    h : harmonic number (dimensionless).  C : SI per (rad/s)².
-    C_stderr : standard error of C (same unit), None if unknown.
-    n_points : measurements the fit used.  presence : fraction of possible speeds
-    where the line was detected.  excluded_rpm : speed ranges left out of the fit
-    because a structural mode amplified the line, [[lo, hi], ...] in rpm.
-    """
-
-    h: float
-    C: float
-    C_stderr: float | None = None
-    n_points: int = 0
-    presence: float | None = None
-    excluded_rpm: list = field(default_factory=list)
-    sense: str | None = None
-
-    def to_json(self) -> dict:
-        d = asdict(self)
-        return {k: v for k, v in d.items() if v is not None}
+class ModelFileError(ModelError, DataError):
+    """A bad model file read by the kit: a :class:`rwadist.schema.ModelError` (the one error of every
+    consumer) that is also the kit's :class:`rwadist.data.DataError` (``file``, ``field``)."""
 
 
 @dataclass
 class WheelModel:
-    """A wheel: geometry, empirical harmonics per direction, and pass-through sections."""
+    """A wheel: geometry, empirical harmonics per direction, its extended-model parameters and its
+    diagnosed effects.
+
+    name : wheel name.  wheel : the ``wheel`` section (mass_kg, radius_m, max_speed_rpm, ...).
+    empirical : {direction: [Harmonic]}.  analytical : :class:`rwadist.schema.Analytical` (a model
+    file read by :func:`from_json`; a plain dict set in code is read the same way by its consumers)
+    or None.  effects : [:class:`rwadist.schema.Effect`] (typed when read from a file).
+    provenance : free-form."""
 
     name: str = "wheel"
     wheel: dict = field(default_factory=dict)
     empirical: dict = field(default_factory=lambda: {d: [] for d in DIRECTIONS})
-    analytical: dict | None = None
+    analytical: Any = None
     effects: list = field(default_factory=list)
     provenance: dict = field(default_factory=dict)
 
     def harmonics(self, direction: str) -> list:
-        return self.empirical.get(direction, [])
+        return list(self.empirical.get(direction, []))
 
-    def h_and_C(self, direction: str):
+    def h_and_C(self, direction: str) -> tuple:
         """Arrays (h, C) of a direction, SI."""
         hs = self.harmonics(direction)
         return (np.array([x.h for x in hs], dtype=float), np.array([x.C for x in hs], dtype=float))
+
+    def typed_effects(self, source: str = "<model>", error: type = ModelError) -> tuple:
+        """The effects as typed objects, validated (:func:`rwadist.schema.parse_effects`)."""
+        return schema.parse_effects(self.effects, source, error)
+
+    def typed_analytical(self, source: str = "<model>", error: type = ModelError) -> Analytical | None:
+        """The analytical section as :class:`rwadist.schema.Analytical` (validated), or None."""
+        return None if self.analytical is None else Analytical.from_json(self.analytical, source, error)
 
 
 def line_amplitudes(model: WheelModel, direction: str, omega) -> tuple:
@@ -99,6 +102,10 @@ def model_rms(model: WheelModel, direction: str, omega, f_max: float | None = No
 
 # --------------------------------------------------------------------------- file
 
+def _json(x: Any) -> Any:
+    return x.to_json() if isinstance(x, (Effect, Analytical)) else x
+
+
 def to_json(model: WheelModel) -> dict:
     doc = {
         "schema": SCHEMA,
@@ -107,11 +114,11 @@ def to_json(model: WheelModel) -> dict:
         "units": {"C": dict(DIRECTION_C_UNIT), "note": "amplitude = C * omega^2, omega in rad/s"},
         "wheel": model.wheel,
         "empirical": {d: [h.to_json() for h in model.empirical.get(d, [])] for d in DIRECTIONS},
-        "effects": model.effects,
+        "effects": [_json(e) for e in model.effects],
         "provenance": model.provenance,
     }
     if model.analytical is not None:
-        doc["analytical"] = model.analytical
+        doc["analytical"] = _json(model.analytical)
     return doc
 
 
@@ -123,40 +130,21 @@ def save(model: WheelModel, path) -> Path:
 
 
 def from_json(doc: dict, source: str = "<model>") -> WheelModel:
-    if not isinstance(doc, dict):
-        raise DataError(source, "document", "must be a JSON object")
-    if doc.get("schema") != SCHEMA:
-        raise DataError(source, "schema", f"{doc.get('schema')!r} is not {SCHEMA!r}; not an rwadist model file")
-    version = doc.get("schema_version")
-    if version != SCHEMA_VERSION:
-        raise DataError(source, "schema_version", f"file has version {version!r}; this rwadist reads version "
-                        f"{SCHEMA_VERSION} only")
-    emp = doc.get("empirical", {}) or {}
-    if not isinstance(emp, dict):
-        raise DataError(source, "empirical", "must be an object keyed by direction")
-    empirical = {}
-    for d, items in emp.items():
-        if d not in DIRECTIONS:
-            raise DataError(source, f"empirical.{d}", f"unknown direction; expected one of {list(DIRECTIONS)}")
-        hs = []
-        for i, item in enumerate(items):
-            where = f"empirical.{d}[{i}]"
-            for key in ("h", "C"):
-                v = item.get(key)
-                if not isinstance(v, (int, float)) or not np.isfinite(v):
-                    raise DataError(source, f"{where}.{key}", f"must be a finite number, got {v!r}")
-            if item["h"] <= 0 or item["C"] < 0:
-                raise DataError(source, where, f"needs h > 0 and C >= 0, got h={item['h']!r}, C={item['C']!r}")
-            if item.get("sense") not in (None, "co", "counter", "planar"):
-                raise DataError(source, f"{where}.sense", f"{item['sense']!r}; expected co, counter or planar")
-            known = {k: item[k] for k in ("h", "C", "C_stderr", "n_points", "presence", "excluded_rpm", "sense")
-                     if k in item}
-            hs.append(Harmonic(**known))
-        empirical[d] = hs
-    for d in DIRECTIONS:
-        empirical.setdefault(d, [])
-    return WheelModel(name=doc.get("name", "wheel"), wheel=doc.get("wheel", {}) or {}, empirical=empirical,
-                      analytical=doc.get("analytical"), effects=doc.get("effects", []) or [],
+    """The typed, validated model of a parsed model document; :class:`ModelFileError` naming
+    ``source`` and the field (``effects[2].amplitude_ref: missing``) on any bad entry."""
+    err = ModelFileError
+    schema.check_header(doc, source, err)
+    for key in ("wheel", "provenance"):
+        if doc.get(key) is not None and not isinstance(doc[key], dict):
+            raise err(source, key, f"must be an object, got {type(doc[key]).__name__}")
+    name = doc.get("name", "wheel")
+    if not isinstance(name, str):
+        raise err(source, "name", f"must be a string, got {name!r}")
+    analytical = doc.get("analytical")
+    return WheelModel(name=name, wheel=doc.get("wheel", {}) or {},
+                      empirical=schema.parse_empirical(doc.get("empirical", {}), source, err),
+                      analytical=None if analytical is None else Analytical.from_json(analytical, source, err),
+                      effects=list(schema.parse_effects(doc.get("effects", []), source, err)),
                       provenance=doc.get("provenance", {}) or {})
 
 

@@ -1,0 +1,696 @@
+"""The model file (``rwadist.model`` version 1) as typed objects: parsed and validated once.
+
+One reader for every consumer: the kit (:mod:`rwadist.model`, :mod:`rwadist.extended`,
+``rwadist psd``), the coupling package and the FMU runtime.  A bad field gives the same
+:class:`ModelError` everywhere, naming the file and the field (``model.json:
+effects[2].amplitude_ref: missing``).
+
+This module imports numpy only (never rwadist): ``rwadist fmu build`` copies it byte for byte
+into the FMU's resources, where the runtime imports the copy (a test pins the copy to this file).
+
+Effects.  Every diagnosed effect kind (``rwadist diagnose``) is a frozen dataclass registered
+under its ``kind`` in :data:`EFFECT_KINDS`; its fields are the file's keys, each declared with
+its check (:func:`number`, :func:`choice`, ...).  Adding a kind is one small class::
+
+    @register
+    @dataclass(frozen=True, eq=False, kw_only=True)
+    class NewKind(Effect):
+        KIND: ClassVar[str] = "new_kind"
+        direction: str = field(metadata=check(choice(DIRECTIONS)))
+        h: float = field(metadata=check(number(gt=0)))
+
+Keys a class does not declare (the ``evidence`` of the search, ``law`` texts, ``unit``) are
+carried through unchanged, and an entry parsed from a file is written back exactly as read
+(:meth:`Effect.to_json`), so loading and saving a file changes no byte.  An effect kind this
+version does not know is kept as an :class:`UnknownEffect` (read by no consumer), as a
+newer writer's section would be.  Effects read like the JSON objects they came from
+(``effect["h"]``, ``effect.get("role")``) and compare equal to them.
+
+Units: SI (rad/s, Hz, N, N·m, kg, m), rpm only in ``excluded_rpm`` and the ``wheel`` section.
+"""
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import MISSING, dataclass, field, fields
+from typing import Any, ClassVar
+
+import numpy as np
+
+SCHEMA = "rwadist.model"
+SCHEMA_VERSION = 1
+DIRECTIONS = ("radial_force", "radial_torque", "axial_force", "axial_torque")
+CHANNELS = ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")
+SENSES = ("co", "counter", "planar")
+ANALYTICAL_KIND = "rigid_rotor_5dof"
+#: Suspension modes an extended fit may leave unidentified (``analytical.unconstrained``).
+UNCONSTRAINED_MODES = ("radial_translation", "rocking", "axial")
+#: Model-file keys of the extended-model parameters (parameter name -> key with its unit): the one
+#: table the kit (:class:`rwadist.extended.ExtendedParams`) and the FMU runtime read.
+PARAM_KEYS = {
+    "mass": "mass_kg", "I_zz": "I_zz_kg_m2", "I_rr": "I_rr_kg_m2",
+    "k_r": "k_r_N_per_m", "c_r": "c_r_N_s_per_m",
+    "k_rock": "k_rock_Nm_per_rad", "c_rock": "c_rock_Nm_s_per_rad",
+    "k_z": "k_z_N_per_m", "c_z": "c_z_N_s_per_m",
+    "height": "height_m", "U_s": "U_s_kg_m", "U_d": "U_d_kg_m2",
+}
+#: Parameters that must be > 0 (the others >= 0, except the signed ``height``).
+POSITIVE_PARAMS = ("mass", "I_zz", "I_rr", "k_r", "k_rock", "k_z")
+NONNEGATIVE_PARAMS = ("c_r", "c_rock", "c_z", "U_s", "U_d")
+
+
+class ModelError(ValueError):
+    """An invalid model file or entry.
+
+    ``ModelError(source, field, problem)`` reads ``"<source>: <field>: <problem>"``; the parts are kept
+    as ``source`` (also ``file``), ``field`` and ``problem``.  ``ModelError(message)`` is an error that
+    is not about one field (a refused input of the FMU runtime).  Consumers with their own error
+    types subclass it (``class X(ModelError, TheirError)``) so one ``except ModelError`` catches all."""
+
+    def __init__(self, source: object, field: str | None = None, problem: str | None = None):
+        self.source = self.file = str(source)
+        self.field = field
+        self.problem = problem
+        message = self.source if field is None else f"{self.source}: {field}: {problem}"
+        Exception.__init__(self, message)
+
+
+# =========================================================================== field checks
+#
+# A check is fn(value, where, err) -> typed value; ``where`` is "<source>: <field path>" split as
+# (source, path) so the error names both.
+
+Check = Callable[[Any, tuple, type], Any]
+_ABSENT = object()
+
+
+def _fail(where: tuple, err: type, problem: str):
+    raise err(where[0], where[1], problem)
+
+
+def _is_number(v: Any) -> bool:
+    return (not isinstance(v, (bool, np.bool_))) and isinstance(v, (int, float, np.integer, np.floating))
+
+
+def _plain(v: Any) -> Any:
+    """Python int/float of a numpy scalar (JSON-serialisable); other values as they are."""
+    if isinstance(v, np.integer):
+        return int(v)
+    if isinstance(v, np.floating):
+        return float(v)
+    return v
+
+
+def number(gt: float | None = None, ge: float | None = None, le: float | None = None) -> Check:
+    """A finite number (booleans are not numbers) with optional bounds gt < v, ge <= v, v <= le."""
+    need = " and ".join(s for s, b in (("> %g" % gt if gt is not None else "", gt is not None),
+                                       (">= %g" % ge if ge is not None else "", ge is not None),
+                                       ("<= %g" % le if le is not None else "", le is not None)) if b)
+    text = "a finite number" + (f" {need}" if need else "")
+
+    def run(v, where, err):
+        if v is _ABSENT:
+            _fail(where, err, "missing")
+        if not _is_number(v) or not math.isfinite(v) or (gt is not None and not v > gt) \
+                or (ge is not None and not v >= ge) or (le is not None and not v <= le):
+            _fail(where, err, f"must be {text}, got {v!r}")
+        return _plain(v)
+    return run
+
+
+def integer(ge: int = 0) -> Check:
+    """An integer >= ``ge`` (a float with an integral value, as JSON may write it, is refused)."""
+    def run(v, where, err):
+        if v is _ABSENT:
+            _fail(where, err, "missing")
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < ge:
+            _fail(where, err, f"must be an integer >= {ge}, got {v!r}")
+        return int(v)
+    return run
+
+
+def optional(inner: Check, default: Any = None) -> Check:
+    """``inner`` when present and not null; ``default`` when absent or null."""
+    def run(v, where, err):
+        if v is _ABSENT or v is None:
+            return default
+        return inner(v, where, err)
+    return run
+
+
+def statistic(ge: float | None = 0.0) -> Check:
+    """A fitted statistic (a standard error, a phase): null or absent -> None, NaN (could not be
+    computed; kept as written) or a finite number >= ``ge``."""
+    inner = number(ge=ge)
+
+    def run(v, where, err):
+        if v is _ABSENT or v is None:
+            return None
+        if _is_number(v) and math.isnan(v):
+            return _plain(v)
+        return inner(v, where, err)
+    return run
+
+
+def choice(options: tuple) -> Check:
+    def run(v, where, err):
+        if v is _ABSENT:
+            _fail(where, err, "missing")
+        if not isinstance(v, str) or v not in options:
+            _fail(where, err, f"{v!r} is not one of {', '.join(options)}")
+        return v
+    return run
+
+
+def names(options: tuple) -> Check:
+    """One name of ``options`` or a non-empty list of them -> tuple (duplicates dropped, order kept)."""
+    def run(v, where, err):
+        if v is _ABSENT:
+            _fail(where, err, "missing")
+        items = [v] if isinstance(v, str) else v
+        if not isinstance(items, (list, tuple)) or not items or any(not isinstance(x, str) or x not in options
+                                                                    for x in items):
+            _fail(where, err, f"{v!r} must be one of {', '.join(options)} or a non-empty list of them")
+        return tuple(dict.fromkeys(items))
+    return run
+
+
+def numbers(min_len: int = 0, length: int | None = None, ge: float | None = None,
+            increasing: bool = False) -> Check:
+    """A list of finite numbers -> float array (read-only)."""
+    def run(v, where, err):
+        if v is _ABSENT:
+            _fail(where, err, "missing")
+        if not isinstance(v, (list, tuple, np.ndarray)) or any(not _is_number(x) for x in v):
+            _fail(where, err, f"must be a list of numbers, got {v!r}")
+        a = np.array(v, dtype=float)
+        if a.ndim != 1 or not np.all(np.isfinite(a)):
+            _fail(where, err, f"must be a list of finite numbers, got {v!r}")
+        if a.size < min_len:
+            _fail(where, err, f"must have at least {min_len} values, got {a.size}")
+        if length is not None and a.size != length:
+            _fail(where, err, f"must have {length} values, got {a.size}")
+        if ge is not None and a.size and a.min() < ge:
+            _fail(where, err, f"values must be >= {ge:g}, got {float(a.min())!r}")
+        if increasing and np.any(np.diff(a) <= 0):
+            _fail(where, err, f"must be strictly increasing, got {v!r}")
+        a.setflags(write=False)
+        return a
+    return run
+
+
+def text() -> Check:
+    def run(v, where, err):
+        if v is _ABSENT:
+            _fail(where, err, "missing")
+        if not isinstance(v, str):
+            _fail(where, err, f"must be a string, got {v!r}")
+        return v
+    return run
+
+
+def boolean() -> Check:
+    def run(v, where, err):
+        if v is _ABSENT:
+            _fail(where, err, "missing")
+        if not isinstance(v, bool):
+            _fail(where, err, f"must be true or false, got {v!r}")
+        return v
+    return run
+
+
+def check(fn: Check, key: str | None = None) -> dict:
+    """Field metadata: the field's check and, when it differs from the field name, its file key."""
+    return {"check": fn, "key": key}
+
+
+def _json_value(v: Any) -> Any:
+    if isinstance(v, np.ndarray):
+        return [float(x) for x in v]
+    if isinstance(v, tuple):
+        return [_json_value(x) for x in v]
+    return _plain(v)
+
+
+# =========================================================================== effects
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class Effect(Mapping):
+    """A diagnosed effect of the model file's ``effects`` list (base class; see the module docstring).
+
+    extra : keys the class does not interpret (``evidence``, ``law`` texts, ...), carried through.
+    Reads as the JSON object it came from (a read-only Mapping) and equals it."""
+
+    KIND: ClassVar[str] = ""
+    #: True for effects that are disturbance the wheel makes (read by the kit, coupling and the FMU);
+    #: False for measurement corrections (a fixture resonance, a load-cell offset, ...).
+    extra: Mapping = field(default_factory=dict, repr=False)
+
+    # the document this effect was parsed from, written back unchanged (not an init field, so
+    # dataclasses.replace() makes an effect that is serialised from its fields)
+    _source_json: dict | None = field(default=None, init=False, repr=False, compare=False)
+
+    @property
+    def kind(self) -> str:
+        return self.KIND
+
+    @classmethod
+    def spec(cls) -> list:
+        """[(field name, file key, check)] of the class's typed fields."""
+        return [(f.name, f.metadata.get("key") or f.name, f.metadata["check"]) for f in fields(cls)
+                if "check" in f.metadata]
+
+    @classmethod
+    def from_json(cls, doc: Mapping, source: str, path: str, error: type = ModelError) -> "Effect":
+        kw = {}
+        for name, key, fn in cls.spec():
+            kw[name] = fn(doc.get(key, _ABSENT), (source, f"{path}.{key}"), error)
+        keys = {key for _, key, _ in cls.spec()} | {"kind"}
+        kw["extra"] = {k: v for k, v in doc.items() if k not in keys}
+        out = cls(**kw)
+        cls._validate(out, source, path, error)
+        object.__setattr__(out, "_source_json", _plain_doc(doc))
+        return out
+
+    def _validate(self, source: str, path: str, error: type) -> None:
+        """Checks across fields (a subclass's); ``error(source, f"{path}.<key>", problem)``."""
+
+    def to_json(self) -> dict:
+        """The file's JSON object: the parsed document unchanged, or the fields (then ``extra``)."""
+        if self._source_json is not None:
+            return copy.deepcopy(self._source_json)
+        out: dict = {"kind": self.KIND}
+        for name, key, _ in self.spec():
+            v = getattr(self, name)
+            if v is not None:
+                out[key] = _json_value(v)
+        out.update(copy.deepcopy(dict(self.extra)))
+        return out
+
+    # ------------------------------------------------------------ read like the JSON object
+    def __getitem__(self, key: str) -> Any:
+        return self.to_json()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.to_json())
+
+    def __len__(self) -> int:
+        return len(self.to_json())
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Mapping):
+            return self.to_json() == dict(other.items()) if not isinstance(other, Effect) \
+                else self.to_json() == other.to_json()
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+def _plain_doc(x: Any) -> Any:
+    """A JSON-safe deep copy (numpy scalars to Python numbers)."""
+    if isinstance(x, Mapping):
+        return {k: _plain_doc(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain_doc(v) for v in x]
+    return _plain(x)
+
+
+#: kind -> Effect subclass
+EFFECT_KINDS: dict[str, type[Effect]] = {}
+
+
+def register(cls: type[Effect]) -> type[Effect]:
+    """Class decorator: make ``cls`` the reader of effects of kind ``cls.KIND``."""
+    if not cls.KIND or cls.KIND in EFFECT_KINDS:
+        raise ValueError(f"effect kind {cls.KIND!r} is empty or registered twice")
+    EFFECT_KINDS[cls.KIND] = cls
+    return cls
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class UnknownEffect(Effect):
+    """An effect kind this version does not know: carried through unchanged, read by no consumer."""
+
+    unknown_kind: str = ""
+
+    @property
+    def kind(self) -> str:
+        return self.unknown_kind
+
+    def to_json(self) -> dict:
+        if self._source_json is not None:
+            return copy.deepcopy(self._source_json)
+        return {"kind": self.unknown_kind, **copy.deepcopy(dict(self.extra))}
+
+
+_POS = number(gt=0)
+_NONNEG = number(ge=0)
+_N_POINTS = optional(integer(ge=0))
+_STDERR = statistic(ge=0.0)
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class MissingHarmonic(Effect):
+    """A harmonic the fit missed: C·Ω² at h·|Ω|/2π (C in kg·m or kg·m²)."""
+
+    KIND: ClassVar[str] = "missing_harmonic"
+    direction: str = field(metadata=check(choice(DIRECTIONS)))
+    h: float = field(metadata=check(_POS))
+    C: float = field(metadata=check(_NONNEG))
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class AmplitudeLaw(Effect):
+    """A line's amplitude amplitude_ref·(|Ω|/omega_ref_rad_s)^exponent (N or N·m) instead of C·Ω²."""
+
+    KIND: ClassVar[str] = "amplitude_law"
+    direction: str = field(metadata=check(choice(DIRECTIONS)))
+    h: float = field(metadata=check(_POS))
+    exponent: float = field(metadata=check(_NONNEG))
+    exponent_stderr: float | None = field(default=None, metadata=check(_STDERR))
+    amplitude_ref: float = field(metadata=check(_NONNEG))
+    omega_ref_rad_s: float = field(metadata=check(_POS))
+
+    @property
+    def law(self) -> tuple:
+        """(A_ref N or N·m, Ω_ref rad/s, exponent)."""
+        return (float(self.amplitude_ref), float(self.omega_ref_rad_s), float(self.exponent))
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class BroadbandFloor(Effect):
+    """A blocked-load PSD S(f, Ω) = psd_ref(f)·(|Ω|/omega_ref_rad_s)^exponent on each of its channels,
+    psd_ref linear between the knots f_Hz (Hz, >= 0, increasing), 0 outside; unit²/Hz."""
+
+    KIND: ClassVar[str] = "broadband_floor"
+    channel: tuple = field(metadata=check(names(CHANNELS)))
+    exponent: float = field(metadata=check(_NONNEG))
+    omega_ref_rad_s: float = field(metadata=check(_POS))
+    f_Hz: np.ndarray = field(metadata=check(numbers(min_len=2, ge=0.0, increasing=True)))
+    psd_ref: np.ndarray = field(metadata=check(numbers(ge=0.0)))
+
+    def _validate(self, source, path, error):
+        if self.psd_ref.size != self.f_Hz.size:
+            raise error(source, f"{path}.psd_ref", f"has {self.psd_ref.size} values for {self.f_Hz.size} "
+                        "f_Hz knots (one per knot)")
+
+    @property
+    def channel_indices(self) -> tuple:
+        return tuple(CHANNELS.index(c) for c in self.channel)
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class FixedResonance(Effect):
+    """A resonance at f_Hz (damping ratio zeta, gain peak_gain at f_Hz) of role ``wheel_mode`` (the
+    wheel's loads of ``directions`` pass through it) or ``test_stand`` (a fixture: measurement only)."""
+
+    KIND: ClassVar[str] = "fixed_resonance"
+    f_Hz: float = field(metadata=check(_POS))
+    zeta: float = field(metadata=check(_POS))
+    peak_gain: float = field(metadata=check(_POS))
+    role: str = field(metadata=check(choice(("wheel_mode", "test_stand"))))
+    directions: tuple = field(metadata=check(names(DIRECTIONS)))
+    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
+
+    @property
+    def resonance(self) -> tuple:
+        """(f_r Hz, ζ, peak gain)."""
+        return (float(self.f_Hz), float(self.zeta), float(self.peak_gain))
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class CrossCoupling(Effect):
+    """A load-cell offset r (m, wheel frame): T_measured = T + r × F.  Measurement only."""
+
+    KIND: ClassVar[str] = "cross_coupling"
+    r_m: np.ndarray = field(metadata=check(numbers(length=3)))
+    r_stderr_m: np.ndarray | None = field(default=None, metadata=check(optional(numbers(length=3, ge=0.0))))
+    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class Sidebands(Effect):
+    """Amplitude modulation a(1 + depth·cos 2π f_mod_Hz t) of the lines (direction, h)."""
+
+    KIND: ClassVar[str] = "sidebands"
+    direction: str = field(metadata=check(choice(DIRECTIONS)))
+    h: float = field(metadata=check(_POS))
+    f_mod_Hz: float = field(metadata=check(_POS))
+    depth: float = field(metadata=check(_NONNEG))
+    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class SpeedRipple(Effect):
+    """Ω(t) = Ω0 + ΔΩ sin 2π f_ripple_Hz t, ΔΩ = delta_omega_rad_s·(|Ω0|/omega_ref_rad_s)^speed_exponent."""
+
+    KIND: ClassVar[str] = "speed_ripple"
+    f_ripple_Hz: float = field(metadata=check(_POS))
+    delta_omega_rad_s: float = field(metadata=check(_NONNEG))
+    omega_ref_rad_s: float = field(metadata=check(_POS))
+    speed_exponent: float = field(default=0.0, metadata=check(optional(_NONNEG, 0.0)))
+    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class CounterRotation(Effect):
+    """A radial line with a counter-rotating part: fraction counter_fraction (0..1) of its power."""
+
+    KIND: ClassVar[str] = "counter_rotation"
+    direction: str = field(metadata=check(choice(("radial_force", "radial_torque"))))
+    h: float = field(metadata=check(_POS))
+    counter_fraction: float = field(metadata=check(number(ge=0, le=1)))
+    counter_fraction_stderr: float | None = field(default=None, metadata=check(_STDERR))
+    counter_fraction_phase: float | None = field(default=None, metadata=check(statistic(ge=None)))
+    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class SpinAcceleration(Effect):
+    """The runs were recorded while the wheel accelerated at alpha_rad_s2 (rad/s²).  Measurement only."""
+
+    KIND: ClassVar[str] = "spin_acceleration"
+    alpha_rad_s2: float = field(metadata=check(number()))
+    alpha_track_rad_s2: float | None = field(default=None, metadata=check(statistic(ge=None)))
+
+
+def parse_effect(doc: Any, source: str = "<model>", path: str = "effects[0]", error: type = ModelError) -> Effect:
+    """The typed effect of one ``effects`` entry (an Effect is returned as it is)."""
+    if isinstance(doc, Effect):
+        return doc
+    if not isinstance(doc, Mapping):
+        raise error(source, path, f"must be an object, got {type(doc).__name__}")
+    kind = doc.get("kind", _ABSENT)
+    if kind is _ABSENT:
+        raise error(source, f"{path}.kind", "missing")
+    if not isinstance(kind, str):
+        raise error(source, f"{path}.kind", f"must be a string, got {kind!r}")
+    cls = EFFECT_KINDS.get(kind)
+    if cls is None:
+        out: Effect = UnknownEffect(unknown_kind=kind, extra={k: v for k, v in doc.items() if k != "kind"})
+        object.__setattr__(out, "_source_json", _plain_doc(doc))
+        return out
+    return cls.from_json(doc, source, path, error)
+
+
+def parse_effects(effects: Any, source: str = "<model>", error: type = ModelError) -> tuple:
+    """The typed effects of a model file's ``effects`` list (None or absent: none), validated: every
+    entry by its kind's class, and at most one ``speed_ripple`` per wheel.  ``error`` (a
+    :class:`ModelError` subclass) is raised naming ``effects[i].<field>``."""
+    if effects is None:
+        return ()
+    if not isinstance(effects, (list, tuple)):
+        raise error(source, "effects", f"must be a list, got {type(effects).__name__}")
+    out = tuple(parse_effect(e, source, f"effects[{i}]", error) for i, e in enumerate(effects))
+    ripples = [i for i, e in enumerate(out) if isinstance(e, SpeedRipple)]
+    if len(ripples) > 1:
+        raise error(source, f"effects[{ripples[1]}].kind", f"a second speed_ripple (the first is "
+                    f"effects[{ripples[0]}]); one speed ripple per wheel is supported")
+    return out
+
+
+def of_kind(effects: Any, cls: type, source: str = "<model>", error: type = ModelError) -> list:
+    """The effects of class ``cls`` in ``effects`` (parsed and validated as a whole, see
+    :func:`parse_effects`), in file order."""
+    return [e for e in parse_effects(effects, source, error) if isinstance(e, cls)]
+
+
+# =========================================================================== empirical harmonics
+
+@dataclass
+class Harmonic:
+    """One empirical harmonic: amplitude C·Ω² at frequency h·|Ω|.
+
+    h : harmonic number (dimensionless, > 0).  C : SI per (rad/s)² (>= 0; kg·m forces, kg·m² torques).
+    C_stderr : standard error of C (same unit, >= 0), None if unknown.
+    n_points : measurements the fit used (integer >= 0).  presence : fraction (0..1) of possible speeds
+    where the line was detected.  excluded_rpm : speed ranges left out of the fit because a structural
+    mode amplified the line, [[lo, hi], ...] in rpm, lo <= hi.  sense : 'co', 'counter', 'planar' or None.
+    """
+
+    h: float
+    C: float
+    C_stderr: float | None = None
+    n_points: int = 0
+    presence: float | None = None
+    excluded_rpm: list = field(default_factory=list)
+    sense: str | None = None
+
+    def to_json(self) -> dict:
+        d = {"h": self.h, "C": self.C, "C_stderr": self.C_stderr, "n_points": self.n_points,
+             "presence": self.presence, "excluded_rpm": [list(p) for p in self.excluded_rpm], "sense": self.sense}
+        return {k: v for k, v in d.items() if v is not None}
+
+    @classmethod
+    def from_json(cls, item: Any, source: str, path: str, error: type = ModelError) -> "Harmonic":
+        if not isinstance(item, Mapping):
+            raise error(source, path, f"must be an object, got {type(item).__name__}")
+        kw: dict = {}
+        for key, fn in (("h", _POS), ("C", _NONNEG), ("C_stderr", _STDERR), ("n_points", optional(integer(), 0)),
+                        ("presence", optional(number(ge=0, le=1))), ("sense", optional(choice(SENSES)))):
+            v = fn(item.get(key, _ABSENT), (source, f"{path}.{key}"), error)
+            if key in item:
+                kw[key] = v
+        ex = item.get("excluded_rpm", [])
+        where = f"{path}.excluded_rpm"
+        if not isinstance(ex, list):
+            raise error(source, where, f"must be a list of [lo, hi] rpm pairs, got {ex!r}")
+        for j, pair in enumerate(ex):
+            if not isinstance(pair, (list, tuple)) or len(pair) != 2 or not all(_is_number(x) and math.isfinite(x)
+                                                                              for x in pair) or pair[0] > pair[1]:
+                raise error(source, f"{where}[{j}]", f"must be a pair [lo, hi] of finite speeds in rpm with "
+                            f"lo <= hi, got {pair!r}")
+        kw["excluded_rpm"] = [list(p) for p in ex]
+        return cls(**kw)
+
+
+# =========================================================================== analytical section
+
+@dataclass(frozen=True, eq=False)
+class Analytical(Mapping):
+    """The ``analytical`` section: the extended model's parameters (SI, keys of :data:`PARAM_KEYS`).
+
+    params : parameter name -> value for the keys present (each finite; mass, inertias and stiffnesses
+    > 0; dampings and imbalances >= 0; height signed).  A section may lack parameters (a partial
+    model); :meth:`require` names the first missing one when the extended model needs them all.
+    modes_assumed : the suspension modes are assumed (a datasheet wheel), not measured.
+    unconstrained : modes the extended fit could not identify (their values are starting values).
+    extra : other keys (e.g. ``fit``), carried through.  Reads as (and equals) the JSON object."""
+
+    kind: str = ANALYTICAL_KIND
+    params: Mapping = field(default_factory=dict)
+    modes_assumed: bool | None = None
+    unconstrained: tuple | None = None
+    extra: Mapping = field(default_factory=dict, repr=False)
+    _source_json: dict | None = field(default=None, init=False, repr=False, compare=False)
+
+    @classmethod
+    def from_json(cls, doc: Any, source: str = "<model>", error: type = ModelError) -> "Analytical":
+        if isinstance(doc, Analytical):
+            return doc
+        if not isinstance(doc, Mapping):
+            raise error(source, "analytical", f"must be an object, got {type(doc).__name__}")
+        kind = doc.get("kind", ANALYTICAL_KIND)
+        if kind != ANALYTICAL_KIND:
+            raise error(source, "analytical.kind", f"{kind!r} is not {ANALYTICAL_KIND!r}")
+        params = {}
+        for name, key in PARAM_KEYS.items():
+            if key not in doc:
+                continue
+            v = float(number()(doc[key], (source, f"analytical.{key}"), error))
+            if (name in POSITIVE_PARAMS and not v > 0) or (name in NONNEGATIVE_PARAMS and not v >= 0):
+                raise error(source, "analytical", f"{name} must be {'> 0' if name in POSITIVE_PARAMS else '>= 0'}, "
+                            f"got {v!r} ({key})")
+            params[name] = v
+        assumed = optional(boolean())(doc.get("modes_assumed", _ABSENT), (source, "analytical.modes_assumed"), error)
+        unc = doc.get("unconstrained", _ABSENT)
+        unconstrained = None
+        if unc is not _ABSENT:
+            if not isinstance(unc, list) or any(not isinstance(m, str) or m not in UNCONSTRAINED_MODES for m in unc):
+                raise error(source, "analytical.unconstrained", f"{unc!r} must be a list of "
+                            f"{', '.join(UNCONSTRAINED_MODES)}")
+            unconstrained = tuple(unc)
+        known = set(PARAM_KEYS.values()) | {"kind", "modes_assumed", "unconstrained"}
+        out = cls(kind=kind, params=params, modes_assumed=assumed, unconstrained=unconstrained,
+                  extra={k: v for k, v in doc.items() if k not in known})
+        object.__setattr__(out, "_source_json", _plain_doc(doc))
+        return out
+
+    def require(self, source: str = "<model>", error: type = ModelError) -> dict:
+        """All parameters {name: value} (SI); ``error`` naming ``analytical.<key>: missing`` otherwise."""
+        for name, key in PARAM_KEYS.items():
+            if name not in self.params:
+                raise error(source, f"analytical.{key}", "missing")
+        return dict(self.params)
+
+    def to_json(self) -> dict:
+        if self._source_json is not None:
+            return copy.deepcopy(self._source_json)
+        out: dict = {"kind": self.kind}
+        out.update({key: self.params[name] for name, key in PARAM_KEYS.items() if name in self.params})
+        if self.modes_assumed is not None:
+            out["modes_assumed"] = self.modes_assumed
+        if self.unconstrained is not None:
+            out["unconstrained"] = list(self.unconstrained)
+        out.update(copy.deepcopy(dict(self.extra)))
+        return out
+
+    def __getitem__(self, key: str) -> Any:
+        return self.to_json()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.to_json())
+
+    def __len__(self) -> int:
+        return len(self.to_json())
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Mapping):
+            return self.to_json() == (other.to_json() if isinstance(other, Analytical) else dict(other.items()))
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+# =========================================================================== the document
+
+def check_header(doc: Any, source: str = "<model>", error: type = ModelError, reader: str = "this rwadist") -> None:
+    """``error`` unless ``doc`` is a JSON object of schema rwadist.model, version :data:`SCHEMA_VERSION`."""
+    if not isinstance(doc, Mapping):
+        raise error(source, "document", "must be a JSON object")
+    if doc.get("schema") != SCHEMA:
+        raise error(source, "schema", f"{doc.get('schema')!r} is not {SCHEMA!r}; not an rwadist model file")
+    version = doc.get("schema_version")
+    if version != SCHEMA_VERSION:
+        raise error(source, "schema_version", f"file has version {version!r}; {reader} reads version "
+                    f"{SCHEMA_VERSION} only")
+
+
+def parse_empirical(emp: Any, source: str = "<model>", error: type = ModelError) -> dict:
+    """{direction: [Harmonic]} of the ``empirical`` section (every direction present, maybe empty)."""
+    if emp is None:
+        emp = {}
+    if not isinstance(emp, Mapping):
+        raise error(source, "empirical", "must be an object keyed by direction")
+    out: dict = {}
+    for d, items in emp.items():
+        if d not in DIRECTIONS:
+            raise error(source, f"empirical.{d}", f"unknown direction; expected one of {list(DIRECTIONS)}")
+        if items is None:
+            items = []
+        if not isinstance(items, list):
+            raise error(source, f"empirical.{d}", f"must be a list of harmonics, got {type(items).__name__}")
+        out[d] = [Harmonic.from_json(item, source, f"empirical.{d}[{i}]", error) for i, item in enumerate(items)]
+    for d in DIRECTIONS:
+        out.setdefault(d, [])
+    return out
