@@ -13,8 +13,8 @@ Load transform (wheel-frame loads at the interface point -> node loads, spacecra
 and, by virtual work, the kinematic transform is its transpose: the interface's linear and
 angular acceleration in the wheel frame is ``a_w = T^T a_node`` (a + α × r rotated back).
 
-``rwadist.mounting`` (written in parallel) did not exist when this was written; the small
-rotation / lever-arm transform needed here lives in this module.
+The DCM check (one tolerance), the lever-arm transform and the spin-axis DCM have one home,
+:mod:`rwadist.geometry`; this module adds the plant-node placement (:class:`Mount`).
 """
 from __future__ import annotations
 
@@ -22,28 +22,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rwadist.mounting import Mounting, skew  # noqa: F401  (skew re-exported)
+from rwadist import geometry
+from rwadist.geometry import DCM_TOL, skew  # noqa: F401  (re-exported: their home is rwadist.geometry)
 
 from .errors import InterfaceMismatchError, NotARotationError
 
-#: Tolerance on ||RᵀR − I|| (max abs entry) and |det R − 1| for a DCM.
-DCM_TOL = 1e-9
-
 
 def check_dcm(dcm, tol: float = DCM_TOL) -> np.ndarray:
-    """The DCM as a float (3, 3) array; NotARotationError unless orthonormal with det +1."""
-    R = np.asarray(dcm, dtype=float)
-    if R.shape != (3, 3):
-        raise NotARotationError(f"DCM must be 3×3, got shape {R.shape}")
-    if not np.all(np.isfinite(R)):
-        raise NotARotationError("DCM contains NaN or inf")
-    orth = np.max(np.abs(R.T @ R - np.eye(3)))
-    if orth > tol:
-        raise NotARotationError(f"DCM is not orthonormal: max |RᵀR − I| = {orth:.3g} > {tol:g}")
-    det = np.linalg.det(R)
-    if abs(det - 1.0) > tol:
-        raise NotARotationError(f"DCM has det {det:.6g}: a reflection, not a rotation")
-    return R
+    """The DCM as a float (3, 3) array; NotARotationError unless a proper rotation
+    (:func:`rwadist.geometry.rotation_problem`, tolerance :data:`rwadist.geometry.DCM_TOL`)."""
+    problem = geometry.rotation_problem(dcm, tol)
+    if problem is not None:
+        raise NotARotationError(f"DCM {problem}")
+    return np.asarray(dcm, dtype=float)
 
 
 def rotation(axis: str, angle: float) -> np.ndarray:
@@ -60,17 +51,15 @@ def rotation(axis: str, angle: float) -> np.ndarray:
 
 def spin_axis_dcm(axis) -> np.ndarray:
     """A DCM taking the wheel's z (spin) axis onto the unit vector ``axis`` (spacecraft frame);
-    the wheel x axis is chosen perpendicular to it (any choice: the wheel is axisymmetric)."""
+    the wheel x axis is chosen perpendicular to it (any choice: the wheel is axisymmetric) along
+    helper × axis, helper = spacecraft x (or y when the axis is within 26° of x):
+    :func:`rwadist.geometry.spin_axis_dcm` with that reference."""
     z = np.asarray(axis, dtype=float)
     n = np.linalg.norm(z)
-    if not np.isfinite(n) or n == 0:
+    if z.shape != (3,) or not np.isfinite(n) or n == 0:
         raise ValueError(f"spin axis must be a finite non-zero vector, got {axis!r}")
-    z = z / n
-    helper = np.array([1.0, 0, 0]) if abs(z[0]) < 0.9 else np.array([0, 1.0, 0])
-    x = np.cross(helper, z)
-    x /= np.linalg.norm(x)
-    y = np.cross(z, x)
-    return np.column_stack([x, y, z])
+    helper = np.array([1.0, 0, 0]) if abs(z[0] / n) < 0.9 else np.array([0, 1.0, 0])
+    return geometry.spin_axis_dcm(z, np.cross(helper, z / n))
 
 
 def load_transform(dcm, position) -> np.ndarray:
@@ -80,7 +69,7 @@ def load_transform(dcm, position) -> np.ndarray:
     if r.shape != (3,) or not np.all(np.isfinite(r)):
         raise ValueError(f"position must be 3 finite numbers (m), got {position!r}")
     # the same transform the broadband PSD uses for the spacecraft frame
-    return Mounting(dcm=R, position_m=r).transform
+    return geometry.load_transform(R, r)
 
 
 @dataclass(frozen=True)

@@ -347,6 +347,8 @@ def cmd_fmu_build(args) -> int:
     try:
         path = build_fmu(source, args.output)
     except ModelError as exc:
+        if exc.field is not None:       # a bad model-file field: the schema's message names file and field
+            raise
         raise DataError(args.model or args.preset, "model", str(exc)) from None
     print(f"wrote {path} (model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')}; "
           f"native layer: {'yes' if has_native(path) else 'no, numpy steps and fmi2Discard on bad input'})")

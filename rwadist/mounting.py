@@ -34,19 +34,15 @@ from pathlib import Path
 
 import numpy as np
 
+from . import geometry
 from .data import DataError, read_json
+from .geometry import skew  # noqa: F401  (re-exported: its home is rwadist.geometry)
 
-#: Tolerance on ‖RᵀR − I‖ (max abs) and on det R − 1.
-ORTHO_TOL = 1e-6
+#: Tolerance on ‖RᵀR − I‖ (max abs) and on det R − 1: the one of :data:`rwadist.geometry.DCM_TOL`.
+ORTHO_TOL = geometry.DCM_TOL
 #: Spin-axis elevation of the pyramid preset from the spacecraft x-y plane: the classic
 #: "NASA standard" pyramid with all four spin axes at arctan(1/√2) = 35.26° (equal authority on x, y, z).
 PYRAMID_ELEVATION_DEG = math.degrees(math.atan(1 / math.sqrt(2)))
-
-
-def skew(r) -> np.ndarray:
-    """[r]× such that skew(r) @ v = r × v."""
-    x, y, z = np.asarray(r, float)
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
 @dataclass(frozen=True)
@@ -58,17 +54,11 @@ class Mounting:
     name: str = ""
 
     def __post_init__(self):
-        R = np.asarray(self.dcm, float)
         where = f"mounting {self.name!r}" if self.name else "mounting"
-        if R.shape != (3, 3) or not np.all(np.isfinite(R)):
-            raise DataError(where, "dcm", f"must be a finite 3x3 matrix, got {np.asarray(self.dcm).tolist()!r}")
-        err = float(np.max(np.abs(R.T @ R - np.eye(3))))
-        if err > ORTHO_TOL:
-            raise DataError(where, "dcm", f"not orthonormal: max |RᵀR − I| = {err:.3g} > {ORTHO_TOL:g}; "
-                            f"dcm = {R.tolist()}")
-        det = float(np.linalg.det(R))
-        if abs(det - 1.0) > ORTHO_TOL:
-            raise DataError(where, "dcm", f"det = {det:.6g}, not +1 (a reflection, not a rotation)")
+        problem = geometry.rotation_problem(self.dcm)
+        if problem is not None:
+            raise DataError(where, "dcm", problem)
+        R = np.asarray(self.dcm, float)
         r = np.asarray(self.position_m, float)
         if r.shape != (3,) or not np.all(np.isfinite(r)):
             raise DataError(where, "position_m", f"must be 3 finite numbers (m), got {self.position_m!r}")
@@ -82,12 +72,7 @@ class Mounting:
     @property
     def transform(self) -> np.ndarray:
         """6×6 map of (F, T) at the interface, wheel frame → (F, T) at the reference point, s/c frame."""
-        R = self.R
-        T = np.zeros((6, 6))
-        T[:3, :3] = R
-        T[3:, 3:] = R
-        T[3:, :3] = skew(self.position_m) @ R
-        return T
+        return geometry.load_transform(self.R, self.position_m)
 
     @property
     def spin_axis(self) -> np.ndarray:
@@ -99,17 +84,8 @@ class Mounting:
 
 
 def dcm_from_spin_axis(axis, ref=(0.0, 0.0, 1.0)) -> np.ndarray:
-    """A DCM whose third column (wheel z) is ``axis``; wheel x is the component of ``ref`` normal to
-    the axis (or of spacecraft x when ``ref`` is parallel), y = z × x."""
-    z = np.asarray(axis, float)
-    z = z / np.linalg.norm(z)
-    x = np.asarray(ref, float) - np.dot(ref, z) * z
-    if np.linalg.norm(x) < 1e-9:
-        x = np.array([1.0, 0.0, 0.0]) - z[0] * z
-        if np.linalg.norm(x) < 1e-9:
-            x = np.array([0.0, 1.0, 0.0]) - z[1] * z
-    x /= np.linalg.norm(x)
-    return np.column_stack([x, np.cross(z, x), z])
+    """A DCM whose third column (wheel z) is ``axis``: :func:`rwadist.geometry.spin_axis_dcm`."""
+    return geometry.spin_axis_dcm(axis, ref)
 
 
 def preset_mountings(name: str, radius_m: float = 0.3, elevation_deg: float = PYRAMID_ELEVATION_DEG) -> list:

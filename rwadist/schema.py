@@ -33,7 +33,7 @@ from __future__ import annotations
 import copy
 import math
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
 import numpy as np
@@ -116,6 +116,8 @@ def number(gt: float | None = None, ge: float | None = None, le: float | None = 
                 or (ge is not None and not v >= ge) or (le is not None and not v <= le):
             _fail(where, err, f"must be {text}, got {v!r}")
         return _plain(v)
+    run.json = {"type": "number", **({"exclusiveMinimum": gt} if gt is not None else {}),  # type: ignore[attr-defined]
+                **({"minimum": ge} if ge is not None else {}), **({"maximum": le} if le is not None else {})}
     return run
 
 
@@ -127,6 +129,7 @@ def integer(ge: int = 0) -> Check:
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < ge:
             _fail(where, err, f"must be an integer >= {ge}, got {v!r}")
         return int(v)
+    run.json = {"type": "integer", "minimum": ge}  # type: ignore[attr-defined]
     return run
 
 
@@ -136,6 +139,8 @@ def optional(inner: Check, default: Any = None) -> Check:
         if v is _ABSENT or v is None:
             return default
         return inner(v, where, err)
+    run.json = {"anyOf": [inner.json, {"type": "null"}]}  # type: ignore[attr-defined]
+    run.optional = True  # type: ignore[attr-defined]
     return run
 
 
@@ -150,6 +155,8 @@ def statistic(ge: float | None = 0.0) -> Check:
         if _is_number(v) and math.isnan(v):
             return _plain(v)
         return inner(v, where, err)
+    run.json = {"anyOf": [inner.json, {"type": "null"}]}  # type: ignore[attr-defined]
+    run.optional = True  # type: ignore[attr-defined]
     return run
 
 
@@ -160,6 +167,7 @@ def choice(options: tuple) -> Check:
         if not isinstance(v, str) or v not in options:
             _fail(where, err, f"{v!r} is not one of {', '.join(options)}")
         return v
+    run.json = {"enum": list(options)}  # type: ignore[attr-defined]
     return run
 
 
@@ -173,6 +181,8 @@ def names(options: tuple) -> Check:
                                                                     for x in items):
             _fail(where, err, f"{v!r} must be one of {', '.join(options)} or a non-empty list of them")
         return tuple(dict.fromkeys(items))
+    run.json = {"anyOf": [{"enum": list(options)},  # type: ignore[attr-defined]
+                          {"type": "array", "items": {"enum": list(options)}, "minItems": 1}]}
     return run
 
 
@@ -197,6 +207,9 @@ def numbers(min_len: int = 0, length: int | None = None, ge: float | None = None
             _fail(where, err, f"must be strictly increasing, got {v!r}")
         a.setflags(write=False)
         return a
+    run.json = {"type": "array", "items": {"type": "number", **({"minimum": ge} if ge is not None else {})},  # type: ignore[attr-defined]
+                **({"minItems": min_len} if min_len else {}),
+                **({"minItems": length, "maxItems": length} if length is not None else {})}
     return run
 
 
@@ -207,6 +220,7 @@ def text() -> Check:
         if not isinstance(v, str):
             _fail(where, err, f"must be a string, got {v!r}")
         return v
+    run.json = {"type": "string"}  # type: ignore[attr-defined]
     return run
 
 
@@ -217,6 +231,7 @@ def boolean() -> Check:
         if not isinstance(v, bool):
             _fail(where, err, f"must be true or false, got {v!r}")
         return v
+    run.json = {"type": "boolean"}  # type: ignore[attr-defined]
     return run
 
 
@@ -243,8 +258,6 @@ class Effect(Mapping):
     Reads as the JSON object it came from (a read-only Mapping) and equals it."""
 
     KIND: ClassVar[str] = ""
-    #: True for effects that are disturbance the wheel makes (read by the kit, coupling and the FMU);
-    #: False for measurement corrections (a fixture resonance, a load-cell offset, ...).
     extra: Mapping = field(default_factory=dict, repr=False)
 
     # the document this effect was parsed from, written back unchanged (not an init field, so
@@ -527,6 +540,11 @@ def of_kind(effects: Any, cls: type, source: str = "<model>", error: type = Mode
 
 # =========================================================================== empirical harmonics
 
+#: Checks of an empirical harmonic's keys (``excluded_rpm``, a list of [lo, hi] rpm pairs, is checked apart).
+HARMONIC_CHECKS = {"h": _POS, "C": _NONNEG, "C_stderr": _STDERR, "n_points": optional(integer(), 0),
+                   "presence": optional(number(ge=0, le=1)), "sense": optional(choice(SENSES))}
+
+
 @dataclass
 class Harmonic:
     """One empirical harmonic: amplitude C·Ω² at frequency h·|Ω|.
@@ -556,8 +574,7 @@ class Harmonic:
         if not isinstance(item, Mapping):
             raise error(source, path, f"must be an object, got {type(item).__name__}")
         kw: dict = {}
-        for key, fn in (("h", _POS), ("C", _NONNEG), ("C_stderr", _STDERR), ("n_points", optional(integer(), 0)),
-                        ("presence", optional(number(ge=0, le=1))), ("sense", optional(choice(SENSES)))):
+        for key, fn in HARMONIC_CHECKS.items():
             v = fn(item.get(key, _ABSENT), (source, f"{path}.{key}"), error)
             if key in item:
                 kw[key] = v

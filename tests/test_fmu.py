@@ -298,6 +298,9 @@ def test_fmpy_validate_and_model_description(wheel_fmu):
     # the shipped runtime is this package's runtime, byte for byte
     shipped = zipfile.ZipFile(wheel_fmu).read("resources/rwadist_fmu_runtime.py")
     assert shipped == Path(rt.__file__).read_bytes()
+    # and its reader of the model file is rwadist's one schema, byte for byte
+    from rwadist import schema
+    assert zipfile.ZipFile(wheel_fmu).read(f"resources/{rt.SCHEMA_FILE}") == Path(schema.__file__).read_bytes()
 
 
 # ------------------------------------------------------------------ four instances

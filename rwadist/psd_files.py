@@ -1,0 +1,107 @@
+"""Files and plots of the broadband PSD: CSV (auto and cross spectra, envelopes), HDF5, a figure.
+Part of :mod:`rwadist.broadband`, which re-exports these names."""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from .broadband import _CROSS_UNIT, PAIRS, BroadbandPSD, Envelope
+from .units import CHANNELS, PSD_COLUMN
+
+
+def write_psd_csv(res: BroadbandPSD, path) -> Path:
+    """Auto-spectra: columns f_Hz, Fx_N2_per_Hz, ..., Tz_Nm2_per_Hz (CONVENTIONS.md)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data = np.column_stack([res.f, res.psd])
+    header = ",".join(["f_Hz"] + [PSD_COLUMN[c] for c in CHANNELS])
+    np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.10e")
+    return path
+
+
+def cross_columns() -> list:
+    """Column names of the cross-spectra file: '<a>_<b>_re_<unit>_per_Hz', '<a>_<b>_im_...' for a < b."""
+    cols = []
+    for a, b in PAIRS:
+        if a == b:
+            continue
+        unit = _CROSS_UNIT[(a // 3, b // 3)]
+        for part in ("re", "im"):
+            cols.append(f"{CHANNELS[a]}_{CHANNELS[b]}_{part}_{unit}_per_Hz")
+    return cols
+
+
+def write_cross_csv(res: BroadbandPSD, path) -> Path:
+    """Cross-spectra csd[a, b] (a < b) as real and imaginary columns; csd[b, a] is the conjugate."""
+    path = Path(path)
+    cols = [res.f]
+    for a, b in PAIRS:
+        if a != b:
+            cols += [res.csd[:, a, b].real, res.csd[:, a, b].imag]
+    np.savetxt(path, np.column_stack(cols), delimiter=",", header=",".join(["f_Hz"] + cross_columns()),
+               comments="", fmt="%.10e")
+    return path
+
+
+def read_psd_csv(path) -> tuple:
+    """(f, {channel: psd}) from a PSD table."""
+    with open(path, newline="") as fh:
+        header = next(csv.reader(fh))
+    arr = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    inv = {v: k for k, v in PSD_COLUMN.items()}
+    return arr[:, 0], {inv[h]: arr[:, i] for i, h in enumerate(header) if h in inv}
+
+
+def write_hdf5(res: BroadbandPSD, path, group: str = "psd") -> Path:
+    """HDF5 group with datasets f_Hz (n), psd (n, 6) and csd (n, 6, 6) complex; attrs channels, frame."""
+    import h5py
+
+    path = Path(path)
+    with h5py.File(path, "a") as fh:
+        if group in fh:
+            del fh[group]
+        g = fh.create_group(group)
+        g.create_dataset("f_Hz", data=res.f)
+        g.create_dataset("psd", data=res.psd)
+        g.create_dataset("csd", data=res.csd, compression="gzip")
+        g.attrs["channels"] = ",".join(CHANNELS)
+        g.attrs["frame"] = res.frame
+        g.attrs["convention"] = "csd[k,a,b] = E[X_a conj(X_b)], one-sided, unit^2/Hz"
+    return path
+
+
+def plot_psd(res: BroadbandPSD, title: str = ""):
+    """Figure (Agg canvas, no pyplot): PSDs (top, log scale) and cumulative RMS (bottom)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(10, 8))
+    FigureCanvasAgg(fig)
+    ax1, ax2 = fig.add_subplot(2, 2, 1), fig.add_subplot(2, 2, 2)
+    ax3, ax4 = fig.add_subplot(2, 2, 3), fig.add_subplot(2, 2, 4)
+    psd, cum, f = res.psd, res.cumulative_rms(), res.f
+    for c, ch in enumerate(CHANNELS):
+        ax = ax1 if c < 3 else ax2
+        y = np.where(psd[:, c] > 0, psd[:, c], np.nan)
+        ax.semilogy(f, y, lw=0.8, label=ch)
+        (ax3 if c < 3 else ax4).plot(f, cum[:, c], lw=1.0, label=ch)
+    ax1.set_ylabel("PSD, N²/Hz")
+    ax2.set_ylabel("PSD, (N·m)²/Hz")
+    ax3.set_ylabel("cumulative RMS, N")
+    ax4.set_ylabel("cumulative RMS, N·m")
+    for ax in (ax1, ax2, ax3, ax4):
+        ax.set_xlabel("frequency, Hz")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title or f"broadband disturbance PSD ({res.frame} frame)")
+    fig.tight_layout()
+    return fig
+
+
+def write_envelope_csv(env: Envelope, path) -> Path:
+    cols = ["f_Hz"] + [f"{c}_{'N' if c.startswith('F') else 'Nm'}" for c in CHANNELS]
+    np.savetxt(path, np.column_stack([env.f, env.amplitude]), delimiter=",", header=",".join(cols),
+               comments="", fmt="%.8e")
+    return Path(path)

@@ -1,0 +1,328 @@
+"""Wheel-speed laws for the broadband PSD (densities over the signed speed, rad/s), their speed cells,
+the CLI's ways to give one (``--dist``), and the exact interval binning the laws and the PSD share.
+Part of :mod:`rwadist.broadband`, which re-exports these names (method and units there)."""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+from .data import DataError
+from .units import RAD_S_TO_RPM, rpm_to_rad_s
+
+#: Relative tolerance on a pdf's integral before it counts as not normalised.
+PDF_RTOL = 1e-3
+
+
+def _check_range(name, lo, hi):
+    for key, v in (("lo", lo), ("hi", hi)):
+        if not isinstance(v, (int, float, np.floating, np.integer)) or not math.isfinite(v):
+            raise DataError(name, key, f"must be a finite speed in rad/s, got {v!r}")
+    if not lo < hi:
+        raise DataError(name, "lo/hi", f"empty or inverted speed range: lo = {lo!r} rad/s >= hi = {hi!r} rad/s")
+
+
+@dataclass(frozen=True)
+class Uniform:
+    """Wheel speed uniform on [lo, hi], rad/s (signed; may straddle zero)."""
+
+    lo: float
+    hi: float
+
+    def __post_init__(self):
+        _check_range("Uniform", self.lo, self.hi)
+
+    @property
+    def support(self):
+        return float(self.lo), float(self.hi)
+
+    def pdf(self, omega):
+        w = np.asarray(omega, float)
+        return np.where((w >= self.lo) & (w <= self.hi), 1.0 / (self.hi - self.lo), 0.0)
+
+    def cdf(self, omega):
+        return np.clip((np.asarray(omega, float) - self.lo) / (self.hi - self.lo), 0.0, 1.0)
+
+    def sample(self, rng, n):
+        return rng.uniform(self.lo, self.hi, n)
+
+    def breakpoints(self):
+        return [self.lo, self.hi]
+
+
+@dataclass(frozen=True)
+class TruncatedNormal:
+    """Wheel speed normal (mean, std rad/s) truncated to [lo, hi] rad/s and renormalised."""
+
+    mean: float
+    std: float
+    lo: float
+    hi: float
+
+    def __post_init__(self):
+        _check_range("TruncatedNormal", self.lo, self.hi)
+        if not (math.isfinite(self.mean)):
+            raise DataError("TruncatedNormal", "mean", f"must be finite, got {self.mean!r}")
+        if not (math.isfinite(self.std) and self.std > 0):
+            raise DataError("TruncatedNormal", "std", f"must be > 0 rad/s, got {self.std!r}")
+
+    @property
+    def support(self):
+        return float(self.lo), float(self.hi)
+
+    @property
+    def _dist(self):
+        a, b = (self.lo - self.mean) / self.std, (self.hi - self.mean) / self.std
+        return stats.truncnorm(a, b, loc=self.mean, scale=self.std)
+
+    def pdf(self, omega):
+        return self._dist.pdf(np.asarray(omega, float))
+
+    def cdf(self, omega):
+        return self._dist.cdf(np.asarray(omega, float))
+
+    def sample(self, rng, n):
+        return self._dist.rvs(size=n, random_state=rng)
+
+    def breakpoints(self):
+        return [self.lo, self.hi]
+
+
+@dataclass(frozen=True)
+class Histogram:
+    """Piecewise-constant speed density: ``pdf[k]`` (1/(rad/s)) on [edges[k], edges[k+1]] rad/s.
+
+    Σ pdf·width must be 1 (relative tolerance :data:`PDF_RTOL`); use :meth:`from_weights` for
+    relative weights (counts, time fractions) that are normalised for you.
+    """
+
+    edges: tuple
+    pdf_values: tuple
+    source: str = "Histogram"
+
+    def __post_init__(self):
+        e = np.asarray(self.edges, float)
+        p = np.asarray(self.pdf_values, float)
+        if e.ndim != 1 or e.size < 2 or p.shape != (e.size - 1,):
+            raise DataError(self.source, "edges/pdf", f"need n+1 edges for n pdf values, got {e.size} edges and "
+                            f"{p.size} values")
+        if not (np.all(np.isfinite(e)) and np.all(np.isfinite(p))):
+            raise DataError(self.source, "edges/pdf", "contain NaN or inf")
+        if np.any(np.diff(e) <= 0):
+            i = int(np.argmax(np.diff(e) <= 0))
+            raise DataError(self.source, "edges", f"empty or inverted speed range: edge {i} = {e[i]!r} >= edge "
+                            f"{i + 1} = {e[i + 1]!r} rad/s")
+        if np.any(p < 0):
+            i = int(np.argmax(p < 0))
+            raise DataError(self.source, "pdf", f"negative density {p[i]!r} in bin {i}")
+        total = float(np.sum(p * np.diff(e)))
+        if abs(total - 1.0) > PDF_RTOL:
+            raise DataError(self.source, "pdf", f"integrates to {total:.6g}, not 1 (tolerance {PDF_RTOL:g})")
+        object.__setattr__(self, "edges", tuple(float(x) for x in e))
+        object.__setattr__(self, "pdf_values", tuple(float(x) for x in p))
+
+    @classmethod
+    def from_weights(cls, edges, weights, source="Histogram"):
+        """Density from relative bin weights (any positive total), normalised."""
+        e = np.asarray(edges, float)
+        w = np.asarray(weights, float)
+        if e.ndim != 1 or e.size < 2 or w.shape != (e.size - 1,):
+            raise DataError(source, "edges/weights", f"need n+1 edges for n weights, got {e.size} and {w.size}")
+        if np.any(~np.isfinite(w)) or np.any(w < 0):
+            raise DataError(source, "weight", "weights must be finite and >= 0")
+        total = float(w.sum())
+        if not total > 0:
+            raise DataError(source, "weight", f"weights sum to {total!r}; need a positive total")
+        if np.any(np.diff(e) <= 0):
+            raise DataError(source, "speed", "speeds must be strictly increasing (empty or inverted range)")
+        return cls(tuple(e), tuple(w / total / np.diff(e)), source)
+
+    @property
+    def support(self):
+        return self.edges[0], self.edges[-1]
+
+    def pdf(self, omega):
+        w = np.asarray(omega, float)
+        e = np.asarray(self.edges)
+        k = np.clip(np.searchsorted(e, w, side="right") - 1, 0, len(self.pdf_values) - 1)
+        return np.where((w >= e[0]) & (w <= e[-1]), np.asarray(self.pdf_values)[k], 0.0)
+
+    def _cum(self):
+        e = np.asarray(self.edges)
+        c = np.concatenate([[0.0], np.cumsum(np.asarray(self.pdf_values) * np.diff(e))])
+        return e, c / c[-1]
+
+    def cdf(self, omega):
+        e, c = self._cum()
+        return np.interp(np.asarray(omega, float), e, c)
+
+    def sample(self, rng, n):
+        e, c = self._cum()
+        return np.interp(rng.uniform(0.0, 1.0, n), c, e)
+
+    def breakpoints(self):
+        return list(self.edges)
+
+
+def histogram_from_centres(speeds, weights, source="histogram") -> Histogram:
+    """Histogram from bin centres (rad/s, strictly increasing) and relative weights; edges halfway
+    between centres, the outer bins as wide as their neighbours."""
+    c = np.asarray(speeds, float)
+    if c.ndim != 1 or c.size < 2:
+        raise DataError(source, "speed_rpm", f"need at least 2 histogram rows, got {c.size}")
+    if np.any(np.diff(c) <= 0):
+        i = int(np.argmax(np.diff(c) <= 0))
+        raise DataError(source, "speed_rpm", f"must be strictly increasing: row {i + 1} "
+                        f"({c[i + 1] * RAD_S_TO_RPM:g} rpm) <= row {i} ({c[i] * RAD_S_TO_RPM:g} rpm)")
+    mid = 0.5 * (c[1:] + c[:-1])
+    edges = np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
+    return Histogram.from_weights(edges, weights, source)
+
+
+def from_time_profile(t, omega, n_bins: int = 2000, source="time profile") -> Histogram:
+    """Speed law of a mission profile: fraction of time spent at each speed.
+
+    t : sample times, s (increasing).  omega : speed at each sample, rad/s (linear between samples).
+    Each interval spends its duration uniformly over [Ω_k, Ω_k+1] (exact for the linear profile);
+    a constant-speed interval is a point mass, deposited by linear splitting between the two
+    neighbouring bins.  Returns a :class:`Histogram` of ``n_bins`` equal bins over the profile range.
+    """
+    t = np.asarray(t, float)
+    w = np.asarray(omega, float)
+    if t.ndim != 1 or t.shape != w.shape or t.size < 2:
+        raise DataError(source, "time_s/speed_rpm", f"need two equal 1-D columns with >= 2 rows, got {t.shape}, "
+                        f"{w.shape}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(w))):
+        raise DataError(source, "time_s/speed_rpm", "contain NaN or inf")
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        i = int(np.argmax(dt <= 0))
+        raise DataError(source, "time_s", f"must increase: row {i + 1} ({t[i + 1]!r}) <= row {i} ({t[i]!r})")
+    lo, hi = float(w.min()), float(w.max())
+    if not hi > lo:
+        raise DataError(source, "speed_rpm", f"constant speed {lo * RAD_S_TO_RPM:g} rpm: empty speed range "
+                        "(a single speed is a line, not a distribution)")
+    step = (hi - lo) / n_bins
+    a = (np.minimum(w[:-1], w[1:]) - lo) / step - 0.5      # bin-centre units: bin k centred at k
+    b = (np.maximum(w[:-1], w[1:]) - lo) / step - 0.5
+    bins = _spread(a, b, dt[None, :] / dt.sum(), n_bins).real[0]
+    bins = np.maximum(bins, 0.0)
+    return Histogram.from_weights(lo + step * np.arange(n_bins + 1), bins, source)
+
+
+def speed_cells(law, n_speeds: int):
+    """Cell edges over the law's support, split at Ω = 0 when it straddles zero, and each cell's
+    exact probability.  Returns (lo_edges, hi_edges, mid, P) rad/s, rad/s, rad/s, 1."""
+    lo, hi = law.support
+    n_speeds = int(n_speeds)
+    if n_speeds < 1:
+        raise DataError("speed grid", "n_speeds", f"must be >= 1, got {n_speeds}")
+    if lo < 0.0 < hi:
+        n_neg = max(1, int(round(n_speeds * (-lo) / (hi - lo))))
+        n_pos = max(1, n_speeds - n_neg)
+        edges = np.concatenate([np.linspace(lo, 0.0, n_neg + 1), np.linspace(0.0, hi, n_pos + 1)[1:]])
+    else:
+        edges = np.linspace(lo, hi, n_speeds + 1)
+    P = np.diff(law.cdf(edges))
+    return edges[:-1], edges[1:], 0.5 * (edges[:-1] + edges[1:]), np.maximum(P, 0.0)
+
+
+def law_from_spec(dist: str, min_rpm: float, max_rpm: float, std_rpm: float | None = None,
+                  source: str = "--dist") -> object:
+    """Speed law from CLI-style arguments: 'uniform' on [min, max] rpm; 'normal' centred in the
+    range, std ``std_rpm`` (default range/6, i.e. ±3σ), truncated to the range; otherwise a CSV file
+    (:func:`law_from_csv`; the range then only bounds nothing -- the file's own speeds are used)."""
+    if dist == "uniform":
+        return Uniform(float(rpm_to_rad_s(min_rpm)), float(rpm_to_rad_s(max_rpm)))
+    if dist == "normal":
+        lo, hi = float(rpm_to_rad_s(min_rpm)), float(rpm_to_rad_s(max_rpm))
+        _check_range("--speed-rpm", lo, hi)
+        std = (hi - lo) / 6.0 if std_rpm is None else float(rpm_to_rad_s(std_rpm))
+        return TruncatedNormal(0.5 * (lo + hi), std, lo, hi)
+    return law_from_csv(dist)
+
+
+def law_from_csv(path, n_bins: int = 2000):
+    """Speed law from a CSV: columns (speed_rpm, weight) = histogram of relative weights at bin
+    centres; (speed_rpm, pdf_per_rpm) = a density that must integrate to 1 over rpm; (time_s,
+    speed_rpm) = a mission time profile (:func:`from_time_profile`)."""
+    path = Path(path)
+    if not path.exists():
+        raise DataError(path, "file", "does not exist (expected uniform, normal or a CSV file)")
+    with open(path, newline="") as fh:
+        header = [h.strip() for h in next(csv.reader(fh))]
+    try:
+        arr = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except ValueError as exc:
+        raise DataError(path, "data", f"not numeric CSV ({exc})") from None
+    col = {h: arr[:, i] for i, h in enumerate(header)}
+    if "time_s" in col and "speed_rpm" in col:
+        return from_time_profile(col["time_s"], rpm_to_rad_s(col["speed_rpm"]), n_bins, str(path))
+    if "speed_rpm" in col and "weight" in col:
+        return histogram_from_centres(rpm_to_rad_s(col["speed_rpm"]), col["weight"], str(path))
+    if "speed_rpm" in col and "pdf_per_rpm" in col:
+        s, p = col["speed_rpm"], col["pdf_per_rpm"]
+        hist = histogram_from_centres(rpm_to_rad_s(s), np.maximum(p, 0), str(path))
+        widths = np.diff(np.asarray(hist.edges)) * RAD_S_TO_RPM
+        total = float(np.sum(p * widths))
+        if abs(total - 1.0) > PDF_RTOL:
+            raise DataError(path, "pdf_per_rpm", f"integrates to {total:.6g} over rpm, not 1 "
+                            f"(tolerance {PDF_RTOL:g}); give relative weights in a 'weight' column instead")
+        return hist
+    raise DataError(path, "header", f"{header}: expected columns speed_rpm,weight or speed_rpm,pdf_per_rpm "
+                    "or time_s,speed_rpm")
+
+
+# =========================================================================== binning
+
+def _spread(a, b, weights, n_bins):
+    """Bin powers of uniform densities on [a, b] (positions in bin-centre units: bin k covers
+    [k − ½, k + ½]) carrying total ``weights`` (n_pairs, n_items) complex; exact overlap integrals
+    (ramp second differences, linear split) for a < b, linear split at a for point masses.
+    Returns (n_pairs, n_bins)."""
+    a = np.asarray(a, float).ravel()
+    b = np.asarray(b, float).ravel()
+    W = np.asarray(weights)
+    W = W.reshape(W.shape[0], -1)
+    width = b - a
+    wide = width > 1e-6
+    slot = n_bins + 1                                        # trash slot for positions past the grid
+    idx_parts, coef_parts = [], []
+    # ramp starts/ends: positions on the edge grid (edge j at j − ½); deposit ±W/width split linearly
+    for pos, sgn in ((a[wide] + 0.5, 1.0), (b[wide] + 0.5, -1.0)):
+        m = np.floor(pos)
+        t = pos - m
+        m = np.clip(m, 0, slot).astype(np.int64)
+        m1 = np.minimum(m + 1, slot)
+        dens = sgn / width[wide]
+        idx_parts += [m, m1]
+        coef_parts += [(1 - t) * dens, t * dens]
+    ramp_items = np.concatenate([np.nonzero(wide)[0]] * 4)
+    idx_r = np.concatenate(idx_parts) if idx_parts else np.zeros(0, np.int64)
+    coef_r = np.concatenate(coef_parts) if coef_parts else np.zeros(0)
+    # point masses
+    pt = np.nonzero(~wide)[0]
+    u = 0.5 * (a[pt] + b[pt])
+    k = np.floor(u)
+    t = u - k
+    k = np.clip(k, 0, slot).astype(np.int64)
+    k1 = np.minimum(k + 1, slot)
+    idx_p = np.concatenate([k, k1])
+    coef_p = np.concatenate([1 - t, t])
+    pt_items = np.concatenate([pt, pt])
+    out = np.zeros((W.shape[0], n_bins), dtype=complex if np.iscomplexobj(W) else float)
+    for p in range(W.shape[0]):
+        for part in ("real", "imag") if np.iscomplexobj(W) else ("real",):
+            wp = getattr(W[p], part)
+            d2 = np.bincount(idx_r, weights=coef_r * wp[ramp_items], minlength=slot + 1)
+            binned = np.cumsum(d2[:n_bins])
+            binned += np.bincount(idx_p, weights=coef_p * wp[pt_items], minlength=slot + 1)[:n_bins]
+            if part == "real":
+                out[p] += binned
+            else:
+                out[p] += 1j * binned
+    return out
