@@ -126,7 +126,7 @@ def effects_from_doc(doc, source="<model>"):
       turns at Ω(t) + ΔΩ_ref·(|Ω|/Ω_ref)^q·sin(2π f_r t + θ) (see :class:`WheelRuntime`).
 
     ModelError naming ``effects[i].<field>`` on a bad entry."""
-    effects = _schema.parse_effects(doc.get("effects") or None, source)
+    effects = _schema.parse_effects(doc.get("effects"), source)
     out = {"laws": laws_from_doc({"effects": effects}, source), "resonances": [], "sidebands": [], "floors": [],
            "ripples": []}
     for e in effects:

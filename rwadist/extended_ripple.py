@@ -44,7 +44,7 @@ def ripple_from_effects(effects, source: str = "<model>"):
     delta_omega_rad_s, omega_ref_rad_s, speed_exponent (default 0)), or None.  Read by the schema
     (:func:`rwadist.schema.parse_effects`): :class:`rwadist.schema.ModelError` (a ValueError) naming
     ``effects[i].<field>`` on a bad entry, and on a second ``speed_ripple`` (one per wheel)."""
-    for e in schema.parse_effects(effects or None, source):
+    for e in schema.parse_effects(effects, source):
         if isinstance(e, schema.SpeedRipple):
             return Ripple(float(e.f_ripple_Hz), float(e.delta_omega_rad_s), float(e.omega_ref_rad_s),
                           float(e.speed_exponent))

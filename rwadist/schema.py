@@ -78,8 +78,9 @@ class ModelError(ValueError):
 
 # =========================================================================== field checks
 #
-# A check is fn(value, where, err) -> typed value; ``where`` is "<source>: <field path>" split as
-# (source, path) so the error names both.
+# A check is fn(value, where, err) -> the typed value: ``where`` = (source, field path) for the error
+# ``err(source, path, problem)``, ``value`` the file's value or _ABSENT.  Its ``json`` attribute is the
+# JSON Schema fragment of the same rule (rwadist/schema_json.py builds docs/model.schema.json from it).
 
 Check = Callable[[Any, tuple, type], Any]
 _ABSENT = object()
@@ -104,9 +105,7 @@ def _plain(v: Any) -> Any:
 
 def number(gt: float | None = None, ge: float | None = None, le: float | None = None) -> Check:
     """A finite number (booleans are not numbers) with optional bounds gt < v, ge <= v, v <= le."""
-    need = " and ".join(s for s, b in (("> %g" % gt if gt is not None else "", gt is not None),
-                                       (">= %g" % ge if ge is not None else "", ge is not None),
-                                       ("<= %g" % le if le is not None else "", le is not None)) if b)
+    need = " and ".join(f"{op} {b:g}" for op, b in ((">", gt), (">=", ge), ("<=", le)) if b is not None)
     text = "a finite number" + (f" {need}" if need else "")
 
     def run(v, where, err):

@@ -301,3 +301,34 @@ def test_mutated_documents_are_refused_by_both(validator, path, value):
     assert list(validator.iter_errors(doc)), path
     with pytest.raises(schema.ModelError):
         model_io.from_json(doc, "m.json")
+
+
+def test_fmu_runtime_reads_through_its_own_copy_without_rwadist(tmp_path):
+    """Inside a built FMU the runtime imports the shipped schema copy (rwadist blocked from import) and
+    refuses the bad entry with the same message."""
+    pytest.importorskip("pythonfmu")
+    import subprocess
+    import sys
+    import zipfile
+
+    from fmu.build import build_fmu
+
+    fmu = build_fmu(BASE, tmp_path / "w.fmu", native=False)
+    zipfile.ZipFile(fmu).extractall(tmp_path / "x")
+    res = tmp_path / "x" / "resources"
+    p, _ = write(tmp_path, [LAW])
+    code = f"""
+import importlib.util, json, sys
+sys.modules["rwadist"] = None                      # any 'import rwadist' fails
+spec = importlib.util.spec_from_file_location("fmu_rt", {str(res / "rwadist_fmu_runtime.py")!r})
+rt = importlib.util.module_from_spec(spec); spec.loader.exec_module(rt)
+assert rt._schema.__file__ == {str(res / "rwadist_model_schema.py")!r}, rt._schema.__file__
+doc = json.load(open({str(p)!r}))
+try:
+    rt.effects_from_doc(doc, {str(p)!r})
+except rt.ModelError as exc:
+    print(exc)
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == f"{p}: effects[0].amplitude_ref: missing"
