@@ -65,6 +65,7 @@ from scipy import stats
 from . import extended as ext
 from .data import DataError
 from .model import WheelModel
+from .resonance import resonance
 from .units import CHANNELS, PSD_COLUMN, RAD_S_TO_RPM, rpm_to_rad_s
 
 #: Upper-triangle channel pairs (a <= b), 21 of them.
@@ -344,8 +345,6 @@ class WheelLines:
         times the diagnosed wheel-mode resonances of the source's direction."""
         fac = np.ones((w.size, idx.size), dtype=complex)
         for dirs, f_r, zeta, g in self.resonances:
-            from .diagnose import resonance
-
             for j, i in enumerate(idx):
                 d = self.spec[int(i)][0] if self.kind == "empirical" else self.groups[int(i)][0].direction
                 if d in dirs:
@@ -528,10 +527,10 @@ def extended_lines_from_model(model: WheelModel, source="<model>") -> WheelLines
 
 
 def preset_lines(name: str, empirical: bool = False) -> WheelLines:
-    """Sources of a virtual-stand preset (:func:`rwadist.teststand.preset`): empirical from its
+    """Sources of a virtual-stand preset (:func:`rwadist.presets.preset`): empirical from its
     harmonics, or extended from its ``extended_lines()`` with the dynamic imbalance at the preset's
     ``imbalance_phase`` ahead of the static one."""
-    from .teststand import preset
+    from .presets import preset
 
     wheel = preset(name)
     if empirical:
