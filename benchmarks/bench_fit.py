@@ -19,7 +19,8 @@ from scipy import signal
 
 from rwadist.empirical import fit_empirical
 from rwadist.spectra import compute_spectra
-from rwadist.teststand import preset, simulate_steady
+from rwadist.presets import preset
+from rwadist.teststand import simulate_steady
 
 
 def best_of_interleaved(fns, repeat):

@@ -13,7 +13,8 @@ import numpy as np
 
 from rwadist.empirical import fit_empirical
 from rwadist.spectra import compute_spectra
-from rwadist.teststand import preset, simulate_steady, simulate_sweep
+from rwadist.presets import preset
+from rwadist.teststand import simulate_steady, simulate_sweep
 
 # Thesis speed ranges (rpm) where a mode amplified the harmonic: Tables 3.6 (radial force),
 # 3.7 (radial torque), 3.9 (axial force).  None = open ("2200+").

@@ -184,6 +184,6 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
 
 
 def build_preset(name: str, output, **kw) -> Path:
-    """FMU of a test-stand preset (e.g. 'ithaco-e'): ``rwadist.teststand.preset(name).to_model()``."""
+    """FMU of a test-stand preset (e.g. 'ithaco-e'): ``rwadist.presets.preset(name).to_model()``."""
     from rwadist.presets import preset
     return build_fmu(preset(name).to_model(), output, **kw)

@@ -1,9 +1,49 @@
 """rwadist: reaction wheel assembly micro-vibration from test data.
 
-Data flow, one module per step: ``data`` (interchange format) -> ``sweep``
-(quasi-steady slices) -> ``spectra`` (Welch PSDs, waterfall) -> ``empirical``
-(fitted harmonic model) -> ``compare``/``report`` (model vs data) and
-``model`` (the versioned model file).  ``teststand`` makes synthetic tests.
-SI units inside; rpm only at the edges.
+The way in from Python (each with units and shapes in its docstring)::
+
+    import rwadist
+    test = rwadist.simulate_test("ithaco-e", speeds_rpm=range(600, 2401, 100))   # or rwadist.read(path)
+    fit = rwadist.fit(test)                    # empirical harmonics C·Ω²: fit.model is a WheelModel
+    rwadist.save_model(fit.model, "wheel.json")
+    diag = rwadist.diagnose(test, fit.model)   # effects the model lacks, judged on held-out speeds
+    res = rwadist.psd(fit.model, (600, 2400), empirical=True)   # broadband PSD over a speed range
+
+- :func:`read`, :func:`simulate_test`: test data (steady runs; sweeps are sliced);
+- :func:`fit`, :func:`fit_extended`: the empirical and extended models;
+- :func:`diagnose`: what a model leaves out of the data;
+- :func:`psd`, :func:`campbell`: broadband PSD over a speed distribution, Campbell diagram;
+- :class:`WheelModel`, :func:`load_model`, :func:`save_model`: the versioned model file.
+
+Under it, one module per step: ``data`` (interchange format) -> ``sweep`` (quasi-steady slices) ->
+``spectra`` (Welch PSDs) -> ``empirical`` (fitted harmonic model) -> ``compare``/``report`` and
+``model`` (the model file); ``extended`` (rotor model), ``diagnose``, ``broadband`` (PSD),
+``teststand``/``presets`` (synthetic tests).  SI units inside; rpm only at the edges.
 """
+import sys as _sys
+import types as _types
+
+from .api import WheelModel, campbell, diagnose, fit, fit_extended, load_model, psd, read, save_model, simulate_test
+
 __version__ = "0.1.0"
+
+#: API functions named like a submodule (``rwadist/diagnose/``, ``rwadist/campbell.py``).  Importing a
+#: submodule binds it as an attribute of its package, which would replace the function: ``rwadist.diagnose``
+#: must stay the function.  The submodules are reached by ``from rwadist.diagnose import Context`` (through
+#: ``sys.modules``), never as attributes of the package.
+_SHADOWED_SUBMODULES = frozenset({"diagnose", "campbell"})
+
+
+class _Package(_types.ModuleType):
+    """The ``rwadist`` package object: binding a submodule over an API function of its name is skipped."""
+
+    def __setattr__(self, name, value):
+        if name in _SHADOWED_SUBMODULES and isinstance(value, _types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+_sys.modules[__name__].__class__ = _Package
+
+__all__ = ["read", "simulate_test", "fit", "fit_extended", "diagnose", "psd", "campbell", "WheelModel",
+           "load_model", "save_model", "__version__"]

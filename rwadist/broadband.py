@@ -64,6 +64,7 @@ from . import extended as ext
 from . import schema
 from .data import DataError
 from .model import WheelModel
+from .resonance import resonance
 from .speed_laws import (PDF_RTOL, Histogram, TruncatedNormal, Uniform, _check_range, _spread,  # noqa: F401
                          from_time_profile, histogram_from_centres, law_from_csv, law_from_spec, speed_cells)
 from .units import CHANNELS, RAD_S_TO_RPM
@@ -128,8 +129,6 @@ class WheelLines:
         times the diagnosed wheel-mode resonances of the source's direction."""
         fac = np.ones((w.size, idx.size), dtype=complex)
         for dirs, f_r, zeta, g in self.resonances:
-            from .diagnose import resonance
-
             for j, i in enumerate(idx):
                 d = self.spec[int(i)][0] if self.kind == "empirical" else self.groups[int(i)][0].direction
                 if d in dirs:
@@ -309,10 +308,10 @@ def extended_lines_from_model(model: WheelModel, source="<model>") -> WheelLines
 
 
 def preset_lines(name: str, empirical: bool = False) -> WheelLines:
-    """Sources of a virtual-stand preset (:func:`rwadist.teststand.preset`): empirical from its
+    """Sources of a virtual-stand preset (:func:`rwadist.presets.preset`): empirical from its
     harmonics, or extended from its ``extended_lines()`` with the dynamic imbalance at the preset's
     ``imbalance_phase`` ahead of the static one."""
-    from .teststand import preset
+    from .presets import preset
 
     wheel = preset(name)
     if empirical:

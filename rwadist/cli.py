@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import api
 from . import data as data_io
 from . import model as model_io
 from .data import DataError
@@ -36,11 +37,12 @@ def parse_speeds(text: str, n: int | None = None) -> np.ndarray:
 # --------------------------------------------------------------------------- simulate-test
 
 def cmd_simulate(args) -> int:
-    from .teststand import preset, simulate_steady, simulate_sweep
+    from .presets import preset
+    from .teststand import simulate_sweep
 
-    wheel = preset(args.preset)
     out = Path(args.out_dir)
     if args.sweep:
+        wheel = preset(args.preset)
         end = args.sweep_end_rpm if args.sweep_end_rpm is not None else 2400.0
         sweep = simulate_sweep(wheel, rpm_start=args.sweep_start_rpm, rpm_end=end, duration=args.duration,
                                sample_rate=args.sample_rate or 3840.0, noise=args.noise, modes=not args.no_modes,
@@ -49,22 +51,14 @@ def cmd_simulate(args) -> int:
         path = data_io.write_sweep(sweep, out / "sweep.csv")
         print(f"wrote sweep {path} ({len(sweep.time)} samples, {sweep.sample_rate:g} Hz)")
         return 0
-    default_speeds = getattr(wheel, "default_speeds_rpm", None)
     if args.n_speeds and not args.speeds_rpm:
         raise DataError("--n-speeds", "value", "needs --speeds-rpm START:STOP")
-    if args.speeds_rpm:
-        speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
-    elif default_speeds is not None:
-        speeds = np.asarray(default_speeds, float)
-    else:
-        speeds = np.linspace(300.0, 2400.0, 120)
-    fs = args.sample_rate or getattr(wheel, "default_sample_rate", None) or 3840.0
-    test = simulate_steady(wheel, speeds, sample_rate=fs, n_samples=args.samples, noise=args.noise,
-                           modes=not args.no_modes, test_stand=not args.no_test_stand, seed=args.seed,
-                           physics=args.physics)
-    if wheel.f_lim_hz is not None and not args.no_test_stand:
-        # the test engineer's record of where the fixture corrupts the data; `rwadist fit` uses it
-        test.meta["f_lim_hz"] = wheel.f_lim_hz
+    speeds = parse_speeds(args.speeds_rpm, args.n_speeds) if args.speeds_rpm else None
+    test = api.simulate_test(args.preset, speeds, sample_rate=args.sample_rate, n_samples=args.samples,
+                             noise=args.noise, modes=not args.no_modes, test_stand=not args.no_test_stand,
+                             seed=args.seed, physics=args.physics)
+    speeds = np.array([r.speed for r in test.runs]) * RAD_S_TO_RPM
+    fs = test.runs[0].sample_rate
     data_io.write_steady(test, out)
     print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g}-{speeds.max():g} rpm, {fs:g} Hz, "
           f"{args.samples} samples each)")
@@ -74,32 +68,14 @@ def cmd_simulate(args) -> int:
 # --------------------------------------------------------------------------- fit
 
 def load_steady(path, args):
-    """A steady test from a directory, a sweep CSV (sliced) or HDF5."""
-    obj = data_io.read_data(path, progress=True)
-    if isinstance(obj, data_io.Sweep):
-        from .sweep import slice_sweep
-
-        test, _ = slice_sweep(obj, slice_samples=args.slice_samples, speed_source=args.speed_source)
-        print(f"sliced sweep into {len(test.runs)} quasi-steady runs (speed from {args.speed_source})")
-        return test
-    if obj.meta.get("unlisted_files"):
-        names = obj.meta["unlisted_files"]
-        print(f"note: {len(names)} file(s) in {path} not listed in runs.csv, not read: {', '.join(names[:5])}"
-              + (" ..." if len(names) > 5 else ""))
-    return obj
+    """A steady test from a directory, a sweep CSV (sliced) or HDF5 (:func:`rwadist.read`)."""
+    return api.read(path, slice_samples=args.slice_samples, speed_source=args.speed_source, progress=True,
+                    log=print)
 
 
 def run_fit(test, args, name: str, progress: bool = True):
-    from .empirical import FitSettings, fit_empirical
-    from .spectra import compute_spectra
-
-    f_lim = args.f_lim
-    if f_lim is None:
-        f_lim = test.meta.get("f_lim_hz")
-    spectra = compute_spectra(test, nperseg=args.nperseg, f_lim=f_lim)
-    settings = FitSettings(presence_min=args.presence, epsilon=args.epsilon,
-                           exclude_modes=not args.no_mode_exclusion)
-    return fit_empirical(spectra, settings, name=name, progress=progress)
+    return api.fit(test, f_lim=args.f_lim, nperseg=args.nperseg, presence=args.presence, epsilon=args.epsilon,
+                   exclude_modes=not args.no_mode_exclusion, name=name, progress=progress)
 
 
 def cmd_fit(args) -> int:
@@ -132,22 +108,18 @@ def cmd_fit(args) -> int:
 
 def run_extended_fit(test, fit, args):
     """The extended model fitted on top of the empirical fit; mass and radius from the options or a preset."""
-    from .extended_fit import fit_extended, to_model
-
-    mass, radius, start = args.mass, args.radius, None
+    mass, radius = args.mass, args.radius
     if args.preset:
-        from .teststand import preset
+        from .presets import preset
 
         wheel = preset(args.preset)
         mass = mass if mass is not None else wheel.mass_kg
         radius = radius if radius is not None else wheel.radius_m
-        start = getattr(wheel, "extended", None)
-    if mass is None or radius is None:
-        raise DataError("--extended", "mass/radius", "the extended fit needs the rotor mass and radius: "
-                        "give --mass KG --radius M or --preset NAME")
-    print(f"fitting the extended model (M = {mass:g} kg, R = {radius:g} m, height = {args.height:g} m) ...",
-          flush=True)
-    efit = fit_extended(test, fit, mass, radius, height=args.height, start=start)
+    if mass is not None and radius is not None:
+        print(f"fitting the extended model (M = {mass:g} kg, R = {radius:g} m, height = {args.height:g} m) ...",
+              flush=True)
+    efit, model = api.fit_extended(test, fit, mass=args.mass, radius=args.radius, height=args.height,
+                                   preset=args.preset)
     p = efit.params
     print(f"  radial translation {p.omega_r / (2 * np.pi):7.2f} Hz  zeta {efit.zeta['radial_translation']:.3f}"
           f"  (k_r {p.k_r:.4g} N/m)")
@@ -161,7 +133,7 @@ def run_extended_fit(test, fit, args):
               + ("  (a linear model does not match this resonance well)" if db > 2.0 else ""))
     for note in efit.notes:
         print(f"  note: {note}")
-    return efit, to_model(efit, fit)
+    return efit, model
 
 
 def _add_fit_options(p):
@@ -264,8 +236,9 @@ def cmd_model_compare(args) -> int:
 
 def cmd_demo(args) -> int:
     """simulate (E-wheel preset, modes on) -> write -> read -> fit -> model + report, vs the truth."""
+    from .presets import preset
     from .report import write_report
-    from .teststand import preset, simulate_steady
+    from .teststand import simulate_steady
 
     out = Path(args.out)
     wheel = preset("ithaco-e")
@@ -303,27 +276,15 @@ def cmd_demo(args) -> int:
 def cmd_campbell(args) -> int:
     """Campbell table (CSV) + plot (PNG next to it) of a model file's or preset's extended parameters;
     prints the harmonic/mode crossing speeds."""
-    from . import extended
-    from .campbell import campbell_crossings, campbell_table, plot_campbell, write_campbell_csv
+    from .campbell import plot_campbell, write_campbell_csv
 
-    if args.preset:
-        from .teststand import preset
-
-        wheel = preset(args.preset)
-        if wheel.extended is None:
-            raise DataError(args.preset, "extended", "this preset has no extended (analytical) parameters")
-        params, lines, source = wheel.extended, wheel.extended_lines(), f"preset {wheel.name}"
-    else:
-        m = model_io.load(args.model)
-        params = extended.params_from_model(m, str(args.model))
-        lines, source = extended.lines_from_model(m, params), str(args.model)
+    params, lines, source = api.extended_source(args.model, preset=args.preset)
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
-    table = campbell_table(params, speeds)
+    table, rows = api.campbell(args.model, speeds, preset=args.preset)
     csv_path = write_campbell_csv(table, args.output)
     png_path = csv_path.with_suffix(".png")
     plot_campbell(params, speeds, lines).savefig(png_path, dpi=120)
     print(f"Campbell table of {source}: {csv_path} ({len(speeds)} speeds), plot: {png_path}")
-    rows = campbell_crossings(params, speeds, lines)
     print(f"{'h':>6} {'direction':<14} {'sense':<8} {'mode':<19} {'speed_rpm':>10} {'f_Hz':>8}  excites")
     for r in rows:
         print(f"{r['h']:6g} {r['direction']:<14} {r['sense']:<8} {r['mode']:<19} {r['speed_rpm']:10.2f} "
@@ -342,7 +303,7 @@ def cmd_fmu_build(args) -> int:
     if args.model:
         source = args.model
     else:
-        from .teststand import preset
+        from .presets import preset
         source = preset(args.preset or "ithaco-e").to_model()
     try:
         path = build_fmu(source, args.output)
@@ -412,42 +373,23 @@ def cmd_fmu_check(args) -> int:
 
 def cmd_diagnose(args) -> int:
     """Fit (or take) a model, find what it leaves in the residual, add the effects that pass, report."""
-    from .diagnose import diagnose, write_report
-    from .spectra import compute_spectra
+    from .diagnose import write_report
 
     if args.preset and args.model:
         raise DataError("diagnose", "--model/--preset", "give a model file or --preset, not both")
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
-    nperseg = args.nperseg
-    if nperseg is None:   # several Welch averages: the residual needs noise statistics (default n/4)
-        n = int(np.median([r.n_samples for r in test.runs]))
-        nperseg = int(2 ** np.floor(np.log2(max(n // 4, 16))))
-    f_lim = args.f_lim if args.f_lim is not None else test.meta.get("f_lim_hz")
-    spectra = compute_spectra(test, nperseg=nperseg, f_lim=f_lim)
-    model = None
-    if args.model:
-        model = model_io.load(args.model)
-    elif args.preset:
-        from .presets import preset
-
-        try:
-            model = preset(args.preset).to_model()
-        except (KeyError, ValueError) as exc:
-            raise DataError("--preset", "name", str(exc)) from None
-    base = args.base
-    if base == "auto":
-        # extended when the model has an analytical section, unless the record says the wheel's modes were
-        # off (a virtual-stand test made with modes=False is hard-mounted C·Ω² truth: meta.json "modes": false)
-        base = "extended" if (model is not None and model.analytical and test.meta.get("modes") is not False) \
-            else "empirical"
+    model = model_io.load(args.model) if args.model else None
     try:
-        diag = diagnose(spectra, model, k_sigma=args.k_sigma, min_gain=args.min_gain, test=test, base=base)
+        diag = api.diagnose(test, model, preset=args.preset, base=args.base, nperseg=args.nperseg,
+                            f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain)
+    except DataError:
+        raise
     except ValueError as exc:
         raise DataError("diagnose", "--base", str(exc)) from None
     files = write_report(diag, args.output)
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
-          f"{base} base")
+          f"{diag.state_before.base} base")
     for e in diag.summary()["effects"]:
         par = ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in e.items()
                         if k not in ("kind", "evidence", "f_Hz", "psd_ref", "channel"))
@@ -476,15 +418,7 @@ def cmd_psd(args) -> int:
     law = bb.law_from_spec(args.dist, lo_rpm, hi_rpm, args.std_rpm)
 
     def default_lines():
-        if args.preset:
-            try:
-                return bb.preset_lines(args.preset, args.empirical)
-            except ValueError as exc:
-                raise DataError("--preset", "name", str(exc)) from None
-        if not args.model:
-            raise DataError("psd", "model", "give a model file or --preset NAME")
-        m = model_io.load(args.model)
-        return bb.empirical_lines(m) if args.empirical else bb.extended_lines_from_model(m, str(args.model))
+        return api.wheel_lines(args.model, preset=args.preset, empirical=args.empirical)
 
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -531,10 +465,7 @@ def cmd_psd(args) -> int:
     return 0
 
 
-def _default_fmax(pairs) -> float:
-    """1.2 × the highest line frequency over the speed laws, Hz."""
-    top = max(float(lines.h.max()) * max(abs(law.support[0]), abs(law.support[1])) for lines, law in pairs)
-    return 1.2 * top / (2 * np.pi)
+_default_fmax = api.default_fmax
 
 
 # --------------------------------------------------------------------------- main

@@ -74,6 +74,7 @@ import numpy as np
 from scipy import optimize
 
 from . import schema
+from .resonance import resonance_gain
 from .units import G_CM2_TO_KG_M2, G_CM_TO_KG_M, RAD_S_TO_RPM
 
 MODES = ("radial_translation", "rocking_forward", "rocking_backward", "axial_translation")
@@ -245,7 +246,7 @@ class Line:
         a(1 + m·cos 2πf_mod t) = a + (m/2)a·e^{+i2πf_mod t} + (m/2)a·e^{−i2πf_mod t} per component.
     resonances : ((f_r Hz, ζ, peak_gain), ...) of diagnosed ``fixed_resonance`` effects of role
         ``wheel_mode``: each component's load is multiplied by H(ν/2π) (:func:`resonance_gain`,
-        the formula of :func:`rwadist.diagnose.resonance` with a signed frequency, i.e. a real
+        the formula of :func:`rwadist.resonance.resonance` with a signed frequency, i.e. a real
         filter acting on x and y alike) at the component's instantaneous whirl rate ν.
         QUASI-STATIC: exact at constant speed; in a transient the gain follows the speed at once
         (no ringing of that resonance, no lag).
@@ -317,19 +318,6 @@ class Line:
             return [(-1, np.exp(-1j * self.phase))]
         return [(1, 0.5 * np.exp(1j * (self.angle + self.phase))),
                 (-1, 0.5 * np.exp(1j * (self.angle - self.phase)))]
-
-
-def resonance_gain(nu, resonances):
-    """Π over ``resonances`` = ((f_r Hz, ζ, g), ...) of H = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r),
-    r = ν/(2π f_r) SIGNED (``nu`` rad/s): :func:`rwadist.diagnose.resonance` for ν >= 0 and its complex
-    conjugate for ν < 0, so a load Re/Im pair sees the same real filter.  |H(f_r)| = g, H(0) = 1."""
-    nu = np.asarray(nu, dtype=float)
-    out = np.ones(nu.shape, dtype=complex)
-    for f_r, zeta, g in resonances:
-        r = nu / (2.0 * np.pi * f_r)
-        base = 1.0 - r * r
-        out = out * ((base + 1j * (2.0 * g * zeta) * r) / (base + 1j * (2.0 * zeta) * r))
-    return out
 
 
 def imbalance_lines(p: ExtendedParams, phase_s: float = 0.0, phase_d: float = 0.0) -> list:

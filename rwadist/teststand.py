@@ -88,6 +88,7 @@ import numpy as np
 from . import extended as ext
 from .data import Run, SteadyTest, Sweep
 from .model import Harmonic, WheelModel
+from .resonance import resonance_response
 from .units import CHANNELS, DIRECTION_CHANNELS, rad_s_to_hz, rad_s_to_rpm, rpm_to_rad_s
 
 #: Channel group -> direction whose fundamental sets the noise level of the group.
@@ -157,10 +158,7 @@ class Mode:
 
     def response(self, r):
         """H(r) = (1 - r² + 2j·g·ζ·r) / (1 - r² + 2j·ζ·r) at frequency ratio r = f / f_mode."""
-        r = np.asarray(r, dtype=float)
-        base = 1.0 - r * r
-        two_zr = 2.0 * self.zeta * r
-        return (base + 1j * self.peak_gain * two_zr) / (base + 1j * two_zr)
+        return resonance_response(r, self.zeta, self.peak_gain)
 
     def crossing_speed_hz(self, h: float) -> float | None:
         """Wheel speed |Ω|/2π (Hz) at which harmonic ``h`` meets this mode (h·Ω_hz = f_mode), or None.
@@ -719,10 +717,3 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
     meta = _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, dropped, extra)
     return Sweep(time=t, signals=signals, sample_rate=float(sample_rate), tach=omega if tach else None, meta=meta)
 
-
-def __getattr__(name):
-    # Convenience: rwadist.teststand.PRESETS / preset (defined in rwadist.presets, which imports this module).
-    if name in ("PRESETS", "preset"):
-        from . import presets
-        return getattr(presets, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -10,7 +10,8 @@ import pytest
 from rwadist.empirical import fit_empirical
 from rwadist.model import DIRECTIONS
 from rwadist.spectra import compute_spectra
-from rwadist.teststand import preset, simulate_steady
+from rwadist.presets import preset
+from rwadist.teststand import simulate_steady
 
 pytestmark = pytest.mark.slow
 

@@ -14,7 +14,8 @@ from rwadist import extended as ext
 from rwadist.cli import main
 from rwadist.data import DataError
 from rwadist.model import Harmonic, WheelModel, save
-from rwadist.teststand import preset, simulate_steady
+from rwadist.presets import preset
+from rwadist.teststand import simulate_steady
 from rwadist.units import RAD_S_TO_RPM, rpm_to_rad_s
 
 E_MODEL = preset("ithaco-e").to_model()

@@ -7,7 +7,7 @@ import pytest
 
 from rwadist.cli import main, parse_speeds
 from rwadist.data import DataError, read_steady, read_sweep
-from rwadist.teststand import preset
+from rwadist.presets import preset
 
 
 def run(capsys, *argv):

@@ -11,7 +11,8 @@ import pytest
 from rwadist.diagnose import SpinAcceleration, diagnose
 from rwadist.spectra import compute_spectra
 from rwadist.sweep import slice_sweep
-from rwadist.teststand import preset, simulate_sweep
+from rwadist.presets import preset
+from rwadist.teststand import simulate_sweep
 
 RPM = 2 * np.pi / 60
 

@@ -8,7 +8,7 @@ from rwadist import broadband as bb
 from rwadist import mounting as mt
 from rwadist.data import DataError
 from rwadist.model import Harmonic, WheelModel, save
-from rwadist.teststand import preset
+from rwadist.presets import preset
 from rwadist.units import rpm_to_rad_s
 
 W = float(rpm_to_rad_s(1.0))

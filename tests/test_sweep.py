@@ -183,7 +183,8 @@ def test_ithaco_e_spinup_speeds_from_data(modes, seed):
     the data alone (tach ignored).  Every kept slice within 0.5 % of the mean true speed.
     Seeds 7 and 13 once put the slowest slices (112-138 rpm) over 0.5 % before slices whose
     speed is uncertain by more than 0.5 % (3 sigma) were dropped."""
-    from rwadist.teststand import preset, simulate_sweep
+    from rwadist.presets import preset
+    from rwadist.teststand import simulate_sweep
     sw = simulate_sweep(preset("ithaco-e"), rpm_start=0.0, rpm_end=2400.0, duration=390.0, sample_rate=3840.0,
                         noise=0.01, modes=modes, test_stand=True, seed=seed, profile="linear", tach=True)
     test, infos = slice_sweep(without_tach(sw), slice_samples=8192)

@@ -1,0 +1,78 @@
+"""``amplitude_law``: a model harmonic whose amplitude goes as |Ω|^p, p ≠ 2."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...units import DIRECTION_CHANNELS
+from ..engine import Context
+from ..measure import _measure
+from ..state import State
+from .base import register, schema_entry
+
+
+@register(order=20)
+@dataclass
+class AmplitudeLaw:
+    """A model harmonic whose amplitude is A_ref·(|Ω|/Ω_ref)^p (A_ref N or N·m, Ω_ref rad/s)."""
+
+    direction: str
+    h: float
+    exponent: float
+    amplitude_ref: float
+    omega_ref: float
+    exponent_stderr: float = float("nan")
+    kind: str = "amplitude_law"
+
+    @property
+    def channels(self):
+        return DIRECTION_CHANNELS[self.direction]
+
+    def apply(self, state: State) -> State:
+        s = state.copy()
+        s.laws[(self.direction, round(self.h, 4))] = (self.amplitude_ref, self.omega_ref, self.exponent)
+        s.effects.append(self)
+        return s
+
+    def refit(self, ctx: Context, state: State) -> "AmplitudeLaw":
+        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
+        return AmplitudeLaw.fit(ctx, state, self.direction, self.h, ctx.runs) or self
+
+    def to_schema(self) -> dict:
+        return schema_entry(self)
+
+    def params(self) -> dict:
+        return {"direction": self.direction, "h": round(self.h, 4), "exponent": self.exponent,
+                "exponent_stderr": self.exponent_stderr, "amplitude_ref": self.amplitude_ref,
+                "omega_ref_rad_s": self.omega_ref}
+
+    @staticmethod
+    def fit(ctx: Context, state: State, direction: str, h: float, runs) -> "AmplitudeLaw | None":
+        d, w = _measure(ctx, state, direction, h, runs, skip=h)
+        if d.size < 5 or np.ptp(np.log(w)) < 0.3:
+            return None
+        w_ref = ctx.omega_ref()
+        X = np.column_stack([np.ones(w.size), np.log(w / w_ref)])
+        coef, res, *_ = np.linalg.lstsq(X, np.log(d), rcond=None)
+        r = np.log(d) - X @ coef
+        s2 = float(r @ r) / max(d.size - 2, 1)
+        cov = s2 * np.linalg.inv(X.T @ X)
+        if state.ext is not None and coef[1] < 0:
+            return None         # rwadist.extended.Line takes laws of exponent >= 0 only (extended base)
+        return AmplitudeLaw(direction, float(h), float(coef[1]), float(np.exp(coef[0])), w_ref,
+                            float(np.sqrt(cov[1, 1])))
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        out = []
+        for d in DIRECTION_CHANNELS:
+            if not any(c in ctx.channels for c in DIRECTION_CHANNELS[d]):
+                continue
+            for hm in state.model.harmonics(d):
+                if (d, round(hm.h, 4)) in state.laws:
+                    continue
+                e = AmplitudeLaw.fit(ctx, state, d, hm.h, runs)
+                if e is not None:
+                    out.append(e)
+        return out

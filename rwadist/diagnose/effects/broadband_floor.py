@@ -1,0 +1,111 @@
+"""``broadband_floor``: a noise-like floor of one channel growing with speed."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...units import CHANNEL_UNIT
+from ..constants import BAND_BINS, FLOOR_EXPONENTS
+from ..engine import Context
+from ..state import State
+from .base import register, schema_entry
+
+
+@register(order=30)
+@dataclass
+class BroadbandFloor:
+    """A broadband floor of one channel: S(f, Ω) = psd_ref(f)·(|Ω|/Ω_ref)^p, unit²/Hz."""
+
+    channel: str
+    exponent: float
+    omega_ref: float
+    f_hz: np.ndarray
+    psd_ref: np.ndarray
+    noise: np.ndarray
+    kind: str = "broadband_floor"
+    #: the knots written to the model file (band centres with flat ends over the analysed band): psd_ref is
+    #: exactly their linear interpolation (0 outside), so the file reproduces the fitted floor
+    knots_f: np.ndarray | None = None
+    knots_psd: np.ndarray | None = None
+
+    @property
+    def channels(self):
+        return (self.channel,)
+
+    def apply(self, state: State) -> State:
+        s = state.copy()
+        s.noise = dict(s.noise)
+        s.noise[self.channel] = self.noise
+        s.floors[self.channel] = (self.psd_ref, self.omega_ref, self.exponent)
+        s.effects.append(self)
+        return s
+
+    def refit(self, ctx: Context, state: State) -> "BroadbandFloor":
+        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
+        return BroadbandFloor.fit(ctx, state, self.channel, ctx.runs) or self
+
+    def to_schema(self) -> dict:
+        return schema_entry(self)
+
+    def params(self) -> dict:
+        kf = self.f_hz[::BAND_BINS] if self.knots_f is None else self.knots_f
+        kp = self.psd_ref[::BAND_BINS] if self.knots_psd is None else self.knots_psd
+        return {"channel": self.channel, "exponent": self.exponent, "omega_ref_rad_s": self.omega_ref,
+                "psd_law": "psd_ref(f) * (|omega|/omega_ref)^exponent, linear between knots, 0 outside",
+                "unit": f"{CHANNEL_UNIT[self.channel]}^2/Hz",
+                "f_Hz": [float(x) for x in kf],
+                "psd_ref": [float(x) for x in kp]}
+
+    @staticmethod
+    def fit(ctx: Context, state: State, c: str, runs) -> "BroadbandFloor | None":
+        y, wt = ctx.offline_bands(state, c, runs)                       # (n_runs, n_bands) unit²/Hz
+        if not np.isfinite(ctx.sp.psd[c][runs, 0]).all() or wt.sum(0).min() < 0:
+            return None
+        w_ref = ctx.omega_ref()
+        x0 = ctx.omega[runs] / w_ref
+        level = np.maximum(np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300), 1e-300)
+        expected = np.broadcast_to(level, y.shape)
+        for _ in range(3):
+            # weights: bins used / expected value² (a band mean of chi² bins has variance ∝ mean²/bins),
+            # re-estimated from the previous pass (iteratively reweighted least squares)
+            # (relative to the largest level, floored at 1e-12 of it: squares of tiny PSDs underflow, and a
+            # band 12 decades down carries no information worth an astronomically large weight)
+            wts = wt / np.maximum(expected / float(np.max(level)), 1e-12) ** 2
+            best = None
+            for p in FLOOR_EXPONENTS:
+                x = x0[:, None] ** p
+                # weighted 2-parameter least squares per band: y = n + g·x
+                s0, s1, s2 = wts.sum(0), (wts * x).sum(0), (wts * x * x).sum(0)
+                t0, t1 = (wts * y).sum(0), (wts * x * y).sum(0)
+                det = s0 * s2 - s1 * s1
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    g = np.maximum(np.where(det > 0, (s0 * t1 - s1 * t0) / det, 0.0), 0.0)
+                n = np.where(s0 > 0, np.maximum((t0 - g * s1) / np.maximum(s0, 1e-300), 0.0), 0.0)
+                sse = float(np.sum(wts * (y - n - g * x) ** 2))
+                if best is None or sse < best[0]:
+                    best = (sse, p, n, g)
+            _, p, n, g = best
+            expected = np.maximum(n[None, :] + g[None, :] * x0[:, None] ** p, 1e-300)
+        _, p, n, g = best
+        f = ctx.f
+        # knots: the band centres, held flat out to the analysed band's first and last bins (a floor below
+        # the first centre -- energy below 1x -- is there in the data too)
+        kf = np.concatenate([[f[ctx.k_lo]], ctx.band_centres(), [f[ctx.k_lo + ctx.n_bands * BAND_BINS - 1]]])
+        kg, kn = np.concatenate([[g[0]], g, [g[-1]]]), np.concatenate([[n[0]], n, [n[-1]]])
+        n0 = np.array(state.noise[c], dtype=float)
+        band = (f >= kf[0]) & (f <= kf[-1])
+        n0[band] = np.interp(f[band], kf, kn)
+        ref = np.interp(f, kf, kg, left=0.0, right=0.0)
+        return BroadbandFloor(c, float(p), w_ref, f.copy(), ref, n0, knots_f=kf, knots_psd=kg)
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        out = []
+        for c in ctx.channels:
+            if c in state.floors:
+                continue
+            e = BroadbandFloor.fit(ctx, state, c, runs)
+            if e is not None and e.psd_ref.max() > 0:
+                out.append(e)
+        return out

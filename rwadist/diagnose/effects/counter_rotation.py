@@ -1,0 +1,227 @@
+"""``counter_rotation``: counter-rotating content of a radial harmonic (extended base only)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ...model import Harmonic
+from ...units import CHANNELS, DIRECTION_CHANNELS
+from ..constants import LINE_HALF, SNR_KNEE
+from ..engine import Context
+from ..state import State
+from .base import register, schema_entry
+
+
+def _sense_group(state: State, direction: str, h: float):
+    """The state's extended lines of (direction, h) (|Δh| < LAW_H_TOL) when they are all co- or counter-rotating and
+    carry no amplitude law: (h of the group, C_co, C_counter, imbalance?) with C the root-sum-square of the lines'
+    C (kg·m or kg·m², per (rad/s)²; an imbalance's C is U_s or U_d of the analytical section); else None."""
+    from ... import extended as ext
+
+    if state.ext is None:
+        return None
+    g = [ln for ln in state.ext_lines() if ln.direction == direction and abs(ln.h - h) < ext.LAW_H_TOL]
+    if not g or any(ln.sense == "planar" or ln.law is not None for ln in g):
+        return None
+    c_co = float(np.sqrt(sum(ln.C**2 for ln in g if ln.sense == "co")))
+    c_ct = float(np.sqrt(sum(ln.C**2 for ln in g if ln.sense == "counter")))
+    if c_co**2 + c_ct**2 <= 0:
+        return None
+    return float(g[0].h), c_co, c_ct, any(ln.imbalance for ln in g)
+
+
+@register(order=80)
+@dataclass
+class CounterRotation:
+    """Counter-rotating content of a radial harmonic (extended base only).
+
+    The radial load of harmonic h is F = a₊e^{+iσθ} + a₋e^{−iσθ} (θ = h·φ, φ the rotor angle, complex x + iy
+    coordinates): a co-rotating part a₊ and a counter-rotating part a₋ (a planar, anisotropic load is
+    |a₊| = |a₋|).  ``counter_fraction`` q = |a₋|²/(|a₊|² + |a₋|²), the total free power |a₊|² + |a₋|² = C²Ω⁴
+    kept: the harmonic becomes a co line of C·sqrt(1 − q) and a counter line of C·sqrt(q) (for the
+    imbalance h = 1 the co part is U_s or U_d of the analytical section, scaled by sqrt(1 − q)).
+    Hard mounted the two parts have the same PSD; through the rotor's modes the co part meets the forward
+    whirl and the counter part the backward one (:mod:`rwadist.extended`), so q is seen where
+    |G₊| ≠ |G₋|, above all at the backward-whirl crossing.  The radial translation has no gyroscopic split
+    (|G₊| = |G₋|): q of a radial-force line is not seen in PSDs and the class does not propose it.
+    ``counter_fraction_phase``: a second, independent estimate from the x/y phase of the time series
+    (:meth:`fit`), NaN without them."""
+
+    direction: str
+    h: float
+    counter_fraction: float
+    counter_fraction_stderr: float = float("nan")
+    counter_fraction_phase: float = float("nan")
+    n_points: int = 0
+    kind: str = "counter_rotation"
+
+    @property
+    def channels(self):
+        return DIRECTION_CHANNELS[self.direction]
+
+    def split(self, state: State):
+        """(C_co, C_counter) of the harmonic after this effect, from the state's group total."""
+        g = _sense_group(state, self.direction, self.h)
+        if g is None:
+            raise ValueError(f"counter_rotation: no co/counter line {self.direction} h = {self.h} in the state")
+        c_tot = float(np.hypot(g[1], g[2]))
+        q = float(np.clip(self.counter_fraction, 0.0, 1.0))
+        return c_tot * np.sqrt(1.0 - q), c_tot * np.sqrt(q)
+
+    def apply(self, state: State) -> State:
+        from ... import extended as ext
+
+        h0, c_co0, c_ct0, imb = _sense_group(state, self.direction, self.h)
+        c_co, c_ct = self.split(state)
+        s = state.copy()
+        d = self.direction
+        old = s.model.harmonics(d)
+        at_h = [x for x in old if abs(x.h - h0) < ext.LAW_H_TOL]
+        keep = [x for x in old if abs(x.h - h0) >= ext.LAW_H_TOL]
+        h_key = at_h[0].h if at_h else h0
+        new = []
+        if imb:
+            # the co part is the imbalance of the analytical section; the model's co harmonic (its empirical
+            # coefficient, read by the hard-mounted consumers) is scaled alike
+            name = "U_s" if d == "radial_force" else "U_d"
+            s.ext = replace(s.ext, **{name: c_co})
+            s.model.analytical = dict(s.model.analytical or {}, **ext.params_to_dict(s.ext))
+            scale = c_co / c_co0 if c_co0 > 0 else 0.0
+            new += [replace(x, C=x.C * scale) for x in at_h if x.sense != "counter"]
+        elif c_co > 0:
+            new.append(Harmonic(h=h_key, C=c_co, sense="co"))
+        if c_ct > 0:
+            new.append(Harmonic(h=h_key, C=c_ct, sense="counter"))
+        s.model.empirical[d] = sorted(keep + new, key=lambda x: (x.h, x.sense == "counter"))
+        s.effects.append(self)
+        return s
+
+    def refit(self, ctx: Context, state: State) -> "CounterRotation":
+        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
+        return CounterRotation.fit(ctx, state, self.direction, self.h, ctx.runs) or self
+
+    def to_schema(self) -> dict:
+        return schema_entry(self)
+
+    def params(self) -> dict:
+        return {"direction": self.direction, "h": round(self.h, 4), "counter_fraction": self.counter_fraction,
+                "counter_fraction_stderr": self.counter_fraction_stderr,
+                "counter_fraction_phase": self.counter_fraction_phase, "n_points": self.n_points,
+                "law": "radial load C*omega^2*(sqrt(1-q) e^{+i h phi} + sqrt(q) e^{-i h phi}), q = counter_fraction "
+                       "= |a-|^2/(|a+|^2+|a-|^2); model: a co harmonic C*sqrt(1-q) and a counter one C*sqrt(q)"}
+
+    @staticmethod
+    def _points(ctx, state, direction, h, runs):
+        """Per run: measured power of the line h summed over the direction's x and y channels (cross term of
+        the co/counter pair cancels), and its prediction P_o + P₊ + q·(P₋ − P₊) at counter fraction q;
+        returns (Pm, P_o, P₊, P₋, weight, ok) arrays."""
+        g = _sense_group(state, direction, h)
+        h0, c_co, c_ct, _ = g
+        c_tot = float(np.hypot(c_co, c_ct))
+        q0 = c_ct**2 / c_tot**2
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        w = ctx.omega[runs]
+        f = h0 * w / (2 * np.pi)
+        a2 = (c_tot * w**2) ** 2 / 2.0                      # free mean square of the harmonic
+        Pm, Po, Pp, Pn, Nn = (np.zeros(runs.size) for _ in range(5))
+        ok = np.ones(runs.size, bool)
+        offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+        k = np.clip(np.rint(f / ctx.df).astype(int)[:, None] + offs, 0, ctx.f.size - 1)
+        for c in chans:
+            a = ctx.measure_line(state, c, h0, runs, skip=h0)
+            ok &= np.isfinite(a)
+            Hc2 = ctx.gain(state, c, f) ** 2
+            gp = ctx.unit_gain(state, c, direction, h0, "co", runs) ** 2
+            gn = ctx.unit_gain(state, c, direction, h0, "counter", runs) ** 2
+            grp = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - h0) < 1e-3), np.zeros(runs.size))
+            other = np.maximum(grp**2 / 2.0 - a2 * ((1 - q0) * gp + q0 * gn), 0.0)
+            Pm += np.where(np.isfinite(a), a, 0.0) ** 2 / 2.0
+            Po += other * Hc2
+            Pp += a2 * gp * Hc2
+            Pn += a2 * gn * Hc2
+            Nn += np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1).sum(1) * ctx.df
+        snr = Pm / np.maximum(Nn, 1e-300)
+        return Pm, Po, Pp, Pn, snr**2 / (snr**2 + SNR_KNEE**2), ok & (Pm > 0)
+
+    @staticmethod
+    def phase_fraction(ctx, state, direction, h, runs) -> float:
+        """Counter fraction from the x/y phase of the time series (NaN without them): per run the complex
+        amplitudes X, Y of the direction's x and y channels at h|Ω|/2π (:meth:`Context.phasors`) split into the
+        co-rotating |X + iY|²/4 and counter-rotating |X − iY|²/4 mean squares (swapped for Ω < 0), each divided
+        by its modal power gain |G±|² (and the fixed resonances) to the free load; q = Σ counter / Σ both."""
+        chans = DIRECTION_CHANNELS[direction]
+        if ctx.test is None or not all(c in ctx.channels for c in chans):
+            return float("nan")
+        h0 = _sense_group(state, direction, h)[0]
+        f = h0 * ctx.omega[runs] / (2 * np.pi)
+        inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
+        X = ctx.phasors(runs, f[:, None])[:, 0, :]
+        x, y = X[:, CHANNELS.index(chans[0])], X[:, CHANNELS.index(chans[1])]
+        co, ct = np.abs(x + 1j * y) ** 2 / 4.0, np.abs(x - 1j * y) ** 2 / 4.0
+        neg = np.asarray(ctx.sp.speed, float)[runs] < 0
+        co, ct = np.where(neg, ct, co), np.where(neg, co, ct)
+        Hc2 = ctx.gain(state, chans[0], f) ** 2
+        co = co / (ctx.unit_gain(state, chans[0], direction, h0, "co", runs) ** 2 * Hc2)
+        ct = ct / (ctx.unit_gain(state, chans[0], direction, h0, "counter", runs) ** 2 * Hc2)
+        ok = inb & np.isfinite(co) & np.isfinite(ct)
+        tot = float(np.sum(co[ok] + ct[ok]))
+        return float(np.sum(ct[ok]) / tot) if tot > 0 else float("nan")
+
+    @staticmethod
+    def fit(ctx: Context, state: State, direction: str, h: float, runs) -> "CounterRotation | None":
+        """q by weighted least squares of ln(measured x + y line power) on ln(P_o + P₊ + q(P₋ − P₊)) over the
+        runs where the line stands above the noise (:meth:`_points`; weights s²/(s² + SNR_KNEE²), s the line's
+        power over the noise in its window), q in [0, 1] (grid, then a bounded scalar minimisation); its
+        standard error from the curvature and the residual scatter.  None when the data cannot tell the senses
+        apart (max |ln P₋/P₊| < 0.1 over the runs) or fewer than 3 runs measure the line."""
+        from scipy.optimize import minimize_scalar
+
+        if _sense_group(state, direction, h) is None:
+            return None
+        Pm, Po, Pp, Pn, wt, ok = CounterRotation._points(ctx, state, direction, h, runs)
+        if ok.sum() < 3:
+            return None
+        Pm, Po, Pp, Pn, wt = (v[ok] for v in (Pm, Po, Pp, Pn, wt))
+        if np.max(np.abs(np.log(np.maximum(Pn, 1e-300) / np.maximum(Pp, 1e-300)))) < 0.1:
+            return None
+        y = np.log(Pm)
+
+        def cost(q):
+            return float(np.sum(wt * (y - np.log(np.maximum(Po + Pp + q * (Pn - Pp), 1e-300))) ** 2))
+
+        grid = np.linspace(0.0, 1.0, 201)
+        vals = [cost(q) for q in grid]
+        i = int(np.argmin(vals))
+        sol = minimize_scalar(cost, bounds=(grid[max(i - 1, 0)], grid[min(i + 1, 200)]), method="bounded",
+                              options={"xatol": 1e-6})
+        q = float(sol.x) if sol.fun <= vals[i] else float(grid[i])
+        P = Po + Pp + q * (Pn - Pp)
+        J = (Pn - Pp) / P
+        info = float(np.sum(wt * J**2))
+        s2 = cost(q) / max(y.size - 1, 1)
+        se = float(np.sqrt(s2 / info)) if info > 0 else float("inf")
+        q_phase = CounterRotation.phase_fraction(ctx, state, direction, h, runs)
+        return CounterRotation(direction, float(h), q, se, q_phase, int(y.size))
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        """Every co/counter radial harmonic of the extended base not yet split, whose fitted q departs from the
+        state's own (0 for a co line, 1 for a counter line) by more than 0.01 and 2 standard errors."""
+        if state.ext is None:
+            return []
+        done = {(e.direction, round(e.h, 3)) for e in state.effects if isinstance(e, CounterRotation)}
+        out = []
+        for d in ("radial_force", "radial_torque"):
+            if not any(c in ctx.channels for c in DIRECTION_CHANNELS[d]):
+                continue
+            hs = sorted({round(ln.h, 4) for ln in state.ext_lines() if ln.direction == d})
+            for h in hs:
+                g = _sense_group(state, d, h)
+                if g is None or (d, round(h, 3)) in done:
+                    continue
+                q0 = g[2] ** 2 / (g[1] ** 2 + g[2] ** 2)
+                e = CounterRotation.fit(ctx, state, d, h, runs)
+                if e is not None and abs(e.counter_fraction - q0) > max(0.01, 2 * e.counter_fraction_stderr):
+                    out.append(e)
+        return out

@@ -1,0 +1,155 @@
+"""``fixed_resonance``: a resonance at a fixed frequency multiplying the lines of its channels."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...resonance import resonance
+from ...units import CHANNEL_DIRECTION, DIRECTION_CHANNELS
+from ..constants import LINE_HALF, SNR_KNEE
+from ..engine import Context
+from ..state import State
+from .base import register, schema_entry
+
+
+def _line_gain_points(ctx, state, chans, runs):
+    """(f Hz, y, weight) of every model line of ``chans`` on ``runs`` measured above the noise and at least
+    2·LINE_HALF bins from the channel's other lines:
+    y = ln(measured power / predicted power) = 2 ln(a_measured/a_predicted), the log power gain a
+    further resonance would have to supply at the line's frequency f = h|Ω|/2π.  weight = s²/(s² + s_k²)
+    with s the line's power over the noise power in its window and s_k = :data:`SNR_KNEE`: the scatter of
+    a log power falls as 1/s for weak lines and is bounded by model error for strong ones."""
+    fs, ys, ws = [], [], []
+    offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+    for c in chans:
+        noise = ctx.floor_psd(state, c, runs)
+        cl = ctx.channel_lines(state, c, runs)
+        hs = np.array([x[0] for x in cl])
+        for h, law, amp, _ in cl:
+            f = h * ctx.omega[runs] / (2 * np.pi)
+            a_pred = amp * ctx.gain(state, c, f)
+            a = ctx.measure_line(state, c, h, runs, skip=h)
+            # a line within 2·LINE_HALF bins of another beats with it in the Welch estimate: left out
+            sep = np.abs(hs[hs != h][:, None] - h) * ctx.omega[runs][None, :] / (2 * np.pi) / ctx.df
+            alone = np.all(sep >= 2 * LINE_HALF, axis=0) if sep.size else np.ones(runs.size, bool)
+            ok = np.isfinite(a) & (a_pred > 0) & alone
+            k = np.clip(np.rint(f / ctx.df).astype(int)[:, None] + offs, 0, ctx.f.size - 1)
+            snr = np.where(ok, a, 0.0) ** 2 / 2 / (np.take_along_axis(noise, k, axis=1).sum(1) * ctx.df)
+            fs.append(f[ok])
+            ys.append(2.0 * np.log(a[ok] / a_pred[ok]))
+            ws.append(snr[ok] ** 2 / (snr[ok] ** 2 + SNR_KNEE**2))
+    if not fs:
+        return np.empty(0), np.empty(0), np.empty(0)
+    return np.concatenate(fs), np.concatenate(ys), np.concatenate(ws)
+
+
+@register(order=40)
+@dataclass
+class FixedResonance:
+    """A resonance at a fixed frequency f_r (Hz, the same at every speed) multiplying every line of its
+    channels by H(f/f_r) (:func:`resonance`; ζ damping ratio, g = |H| at f_r).  ``role``: "test_stand" when
+    it acts on every channel alike (a fixture resonance, to be excluded from the wheel's model),
+    "wheel_mode" when on one direction's channels only (an unmodelled wheel mode, to be added)."""
+
+    f_r: float
+    zeta: float
+    peak_gain: float
+    channels: tuple
+    role: str
+    n_points: int = 0
+    kind: str = "fixed_resonance"
+
+    def apply(self, state: State) -> State:
+        s = state.copy()
+        s.resonances.append((self.f_r, self.zeta, self.peak_gain, tuple(self.channels)))
+        s.effects.append(self)
+        return s
+
+    def refit(self, ctx: Context, state: State) -> "FixedResonance":
+        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
+        return FixedResonance.fit(ctx, state, self.channels, ctx.runs, self.f_r, self.role) or self
+
+    def to_schema(self) -> dict:
+        return schema_entry(self)
+
+    def params(self) -> dict:
+        dirs = sorted({CHANNEL_DIRECTION[c] for c in self.channels})
+        return {"f_Hz": self.f_r, "zeta": self.zeta, "peak_gain": self.peak_gain, "role": self.role,
+                "directions": dirs, "n_points": self.n_points,
+                "gain_law": "H = (1 - r^2 + 2j*peak_gain*zeta*r)/(1 - r^2 + 2j*zeta*r) with r = f/f_Hz"}
+
+    @staticmethod
+    def peak(f: np.ndarray, y: np.ndarray, lo: float, hi: float, df: float):
+        """Frequency (Hz) and mean log power gain of the strongest excess of ``y`` vs ``f``: the mean of y
+        within ±max(2 df, 2 %) of every grid frequency, scored by |mean|·sqrt(count) (4 points at least)."""
+        grid = np.arange(lo, hi, df)
+        if grid.size == 0 or f.size < 4:
+            return None
+        half = np.maximum(2.0 * df, 0.02 * grid)
+        inside = np.abs(f[None, :] - grid[:, None]) <= half[:, None]
+        cnt = inside.sum(1)
+        mean = np.where(cnt > 0, (inside * y[None, :]).sum(1) / np.maximum(cnt, 1), 0.0)
+        score = np.where(cnt >= 4, np.abs(mean) * np.sqrt(cnt), 0.0)
+        i = int(np.argmax(score))
+        return (float(grid[i]), float(mean[i])) if score[i] > 0 else None
+
+    @staticmethod
+    def fit(ctx: Context, state: State, channels, runs, f0: float | None = None,
+            role: str = "wheel_mode", n_iter: int = 3) -> "FixedResonance | None":
+        """f_r, ζ, g by robust (soft-L1) nonlinear least squares of ln|H(f)|² against the lines' log power
+        gains (:func:`_line_gain_points`), parameters in logs (positive), started at the strongest excess
+        (or ``f0``) with ζ ∈ {0.01, 0.03, 0.1}; ``n_iter`` passes, each re-measuring the lines with the
+        previous pass's resonance in the state."""
+        from scipy.optimize import least_squares
+
+        chans = [c for c in channels if c in ctx.channels]
+        f, y, wt = _line_gain_points(ctx, state, chans, runs)
+        lo, hi = ctx.k_lo * ctx.df, ctx.k_hi * ctx.df
+        pk = FixedResonance.peak(f, y, lo, hi, ctx.df)
+        if pk is None or f.size < 6:
+            return None
+        lb, ub = np.log([lo, 1e-3, 0.02]), np.log([hi, 0.5, 200.0])
+        g0 = float(np.clip(np.exp(pk[1] / 2.0), 0.1, 50.0))
+        starts = [np.log([pk[0] if f0 is None else f0, z0, max(g0, 1.01) if pk[1] > 0 else min(g0, 0.99)])
+                  for z0 in (0.01, 0.03, 0.1)]
+        e = None
+        for _ in range(n_iter):
+            if e is not None:
+                # re-measure with the tentative resonance in the state, so that neighbouring lines are
+                # subtracted amplified; the total log gain is the residual one plus the tentative ln|H|²
+                st = e.apply(state)
+                f, y, wt = _line_gain_points(ctx, st, chans, runs)
+                y = y + np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain)) ** 2)
+                starts = [np.log([e.f_r, e.zeta, e.peak_gain])]
+            if f.size < 6:
+                return None
+
+            def res(x):
+                return np.sqrt(wt) * (y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2))
+            best = None
+            for x0 in starts:
+                sol = least_squares(res, np.clip(x0, lb + 1e-9, ub - 1e-9), loss="soft_l1", f_scale=0.5,
+                                    bounds=(lb, ub))
+                if best is None or sol.cost < best.cost:
+                    best = sol
+            f_r, zeta, g = (float(v) for v in np.exp(best.x))
+            e = FixedResonance(f_r, zeta, g, tuple(channels), role, int(f.size))
+        return e
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        """One resonance per direction (role wheel_mode) and one common to every channel (role test_stand)."""
+        out = []
+        dirs = [d for d, ch in DIRECTION_CHANNELS.items()
+                if any(c in ctx.channels for c in ch) and state.model.harmonics(d)]
+        for d in dirs:
+            e = FixedResonance.fit(ctx, state, DIRECTION_CHANNELS[d], runs, role="wheel_mode")
+            if e is not None:
+                out.append(e)
+        if len(dirs) > 1:
+            e = FixedResonance.fit(ctx, state, ctx.channels, runs, role="test_stand")
+            if e is not None:
+                out.append(e)
+        return [e for e in out if not any(abs(e.f_r - r[0]) < 0.02 * r[0] and set(e.channels) & set(r[3])
+                                          for r in state.resonances)]

@@ -1,0 +1,458 @@
+"""The prediction engine of ``rwadist diagnose``: the line kernel and the :class:`Context` that predicts
+the expected Welch PSD of a :class:`~rwadist.diagnose.state.State` on every run and channel.
+
+Theory: docs/diagnose.md ("Prediction").
+"""
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+
+from ..empirical import block_floor
+from ..model import WheelModel
+from ..resonance import resonance
+from ..spectra import Spectra, welch_dof
+from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
+from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, TORQUE_CHANNELS
+from .metric import Metric
+from .state import State
+
+# --------------------------------------------------------------------------- line kernel
+
+def line_kernel(nperseg: int, fs: float, window: str = "hann", half: int = KERNEL_HALF, oversample: int = 64):
+    """Tabulated PSD shape of a unit-variance sinusoid in a Welch estimate, 1/Hz.
+
+    Returns (delta, K): K(δ) = |W(δ)|²/(f_s Σw²) at offsets δ (bins) from −half−1
+    to half+1 in steps of 1/oversample; Σ_k K(δ+k)·df = 1 over all integer k (Parseval).
+    """
+    from scipy import signal
+
+    w = signal.get_window(window, nperseg)
+    n = np.arange(nperseg)
+    delta = np.arange(-(half + 1) * oversample, (half + 1) * oversample + 1) / oversample
+    W = np.exp(-2j * np.pi * np.outer(delta, n) / nperseg) @ w
+    return delta, np.abs(W) ** 2 / (fs * np.sum(w**2))
+
+
+
+class Context(Metric):
+    """Spectra, kernel, bands and run split shared by every step of a diagnosis.
+
+    test : the SteadyTest the spectra were computed from (same runs, same order), or None; the time
+    series are needed by the ``cross_coupling`` effect only (complex line amplitudes, corrected PSDs)."""
+
+    def __init__(self, spectra: Spectra, channels=None, test=None):
+        self.sp = spectra
+        if test is not None and (len(test.runs) != len(spectra.speed) or not np.allclose(
+                [r.speed for r in test.runs], spectra.speed)):
+            raise ValueError("diagnose: the test's runs are not those of the spectra (count or speeds differ)")
+        self.test = test
+        self._memo = {}
+        self._corrected = {}
+        self.f = spectra.f
+        self.df = spectra.df
+        self.omega = np.abs(np.asarray(spectra.speed, dtype=float))
+        self.runs = np.nonzero(self.omega > 0)[0]
+        order = self.runs[np.argsort(self.omega[self.runs], kind="stable")]
+        self.fit_runs, self.held_runs = np.sort(order[0::2]), np.sort(order[1::2])
+        self.channels = tuple(c for c in (channels or spectra.channels) if c in spectra.psd
+                              and c in CHANNEL_DIRECTION)
+        self.dof = welch_dof(int(np.min(spectra.n_segments)))
+        self.k_lo = F_MIN_BINS
+        self.k_hi = int(np.floor(spectra.band_limit / self.df))
+        self.n_bands = max((self.k_hi - self.k_lo + 1) // BAND_BINS, 1)
+        self.delta, self.kernel = line_kernel(spectra.nperseg, spectra.sample_rate, spectra.window)
+        self.osmp = int(round(1 / (self.delta[1] - self.delta[0])))
+        self.floor = {c: self._floor(c) for c in self.channels}
+        power = {c: float(np.nanmean(self.band_sums(self.sp.psd[c][self.runs]).sum(1))) for c in self.channels}
+        # forces are weighed against forces, torques against torques (mean data power of the unit group)
+        self._scale = {c: float(np.mean([power[k] for k in self.channels if CHANNEL_UNIT[k] == CHANNEL_UNIT[c]]))
+                       for c in self.channels}
+
+    def data(self, state: State, c: str) -> np.ndarray:
+        """Measured PSD (n_runs, n_f) of channel ``c`` as the state reads it: a torque channel corrected for
+        the state's load-cell offset, T − r × F, its Welch PSD recomputed with the spectra's settings."""
+        if state.coupling is None or c not in TORQUE_CHANNELS:
+            return self.sp.psd[c]
+        key = tuple(float(x) for x in state.coupling)
+        if key not in self._corrected:
+            from ..spectra import compute_spectra
+
+            test = copy.deepcopy(self.test)
+            r = np.asarray(key)
+            for run in test.runs:
+                F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
+                T = np.cross(r[None, :], F)
+                for j, k in enumerate(TORQUE_CHANNELS):
+                    if k in run.signals:
+                        run.signals[k] = run.signals[k] - T[:, j]
+            chans = [k for k in TORQUE_CHANNELS if k in self.sp.psd]
+            sp = compute_spectra(test, nperseg=self.sp.nperseg, window=self.sp.window, f_lim=self.sp.f_lim,
+                                 channels=chans)
+            if not np.array_equal(sp.n_segments, self.sp.n_segments):
+                raise ValueError("diagnose: the spectra were not computed with 50 % overlap; cannot correct them")
+            self._corrected[key] = sp.psd
+        return self._corrected[key][c]
+
+    def phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> np.ndarray:
+        """Complex amplitudes (len(runs), L, 6) of every channel at frequencies ``f_hz`` (len(runs), L), Hz:
+        X = 2·Σ w x e^{−2πj f t}/Σ w over the whole run (Hann window), so x(t) ≈ Re(X e^{2πj f t});
+        NaN for a channel the run lacks."""
+        from scipy import signal
+
+        out = np.full((runs.size, f_hz.shape[1], len(CHANNELS)), np.nan + 0j)
+        for i, r in enumerate(runs):                      # one matrix product per run
+            run = self.test.runs[r]
+            t = np.arange(run.n_samples) / run.sample_rate
+            w = signal.get_window(self.sp.window, run.n_samples)
+            have = [j for j, c in enumerate(CHANNELS) if c in run.signals]
+            x = np.column_stack([run.signals[CHANNELS[j]] for j in have]) * w[:, None]
+            E = np.exp(-2j * np.pi * np.outer(f_hz[i], t))
+            out[i][:, have] = 2.0 * (E @ x) / np.sum(w)
+        return out
+
+    def _floor(self, c):
+        psd = self.sp.psd[c]
+        fl = np.full_like(psd, np.nan)
+        ok = np.isfinite(psd[:, 0])
+        fl[ok] = block_floor(psd[ok], dof=self.dof)
+        return fl
+
+    def omega_ref(self) -> float:
+        return float(np.median(self.omega[self.runs]))
+
+    # ---- predictions
+    def line_psd(self, h: float, amp: np.ndarray, runs: np.ndarray) -> np.ndarray:
+        """PSD (len(runs), n_f) of one line h at amplitudes ``amp`` (per run)."""
+        return self.psd_at(h * self.omega[runs] / (2 * np.pi), amp**2 / 2.0)
+
+    def psd_at(self, f_hz: np.ndarray, power: np.ndarray) -> np.ndarray:
+        """PSD (n_runs, n_f) of lines at frequencies ``f_hz`` (n_runs,) or (n_runs, n) Hz with mean squares
+        ``power`` (same shape, unit²) through the line kernel; a line at negative frequency (a lower
+        sideband below 0 Hz) folds to |f|."""
+        f_hz = np.asarray(f_hz, dtype=float)
+        power = np.broadcast_to(np.asarray(power, dtype=float), f_hz.shape)
+        if f_hz.ndim == 1:
+            f_hz, power = f_hz[:, None], power[:, None]
+        n_runs, n_l = f_hz.shape
+        out = np.zeros((n_runs, self.f.size))
+        pos = (np.abs(f_hz) / self.df).ravel()                           # fractional bin
+        k0 = np.rint(pos).astype(int)
+        offs = np.arange(-KERNEL_HALF, KERNEL_HALF + 1)
+        k = k0[:, None] + offs
+        dlt = k - pos[:, None]                                         # bin minus line, bins
+        idx = np.clip(np.rint((dlt - self.delta[0]) * self.osmp).astype(int), 0, self.delta.size - 1)
+        val = power.ravel()[:, None] * self.kernel[idx]
+        ok = (k >= 0) & (k < self.f.size)
+        rows = np.broadcast_to(np.repeat(np.arange(n_runs), n_l)[:, None], k.shape)
+        np.add.at(out, (rows[ok], k[ok]), val[ok])
+        return out
+
+    def ripple_powers(self, state: State, h: float, law, runs: np.ndarray):
+        """(k, P) of the state's speed ripple for a line h: sideband orders k (2K+1,) and their power
+        fractions P (len(runs), 2K+1) (:func:`ripple_sideband_powers`), or None without a ripple."""
+        if state.ripple is None:
+            return None
+        d_ref, f_r, w_ref, q = state.ripple
+        w = self.omega[runs]
+        dw = d_ref * (w / w_ref) ** q
+        p_amp = 2.0 if law is None else law[2]
+        return ripple_sideband_powers(h * dw / (2 * np.pi * f_r), dw / np.maximum(w, 1e-12), p_amp)
+
+    def gain(self, state: State, c: str, f_hz) -> np.ndarray:
+        """|H| of the state's fixed resonances acting on channel ``c`` at line frequencies ``f_hz`` (Hz)."""
+        g = np.ones_like(np.asarray(f_hz, dtype=float))
+        for f_r, zeta, peak, chans in state.resonances:
+            if c in chans:
+                g = g * np.abs(resonance(f_hz, f_r, zeta, peak))
+        return g
+
+    def channel_lines(self, state: State, c: str, runs: np.ndarray) -> list:
+        """[(h, law, a, g)] of every line acting on channel ``c``: harmonic number, amplitude law or None, the
+        line's amplitude a (unit, one per run of ``runs``, before the fixed resonances) and its modal gain g = a / the
+        free load amplitude of the channel's direction at h.
+
+        Empirical base: the state's harmonics, a = C·Ω² (or the law), g = 1.  Extended base (``state.ext`` set):
+        the lines of :meth:`State.ext_lines` through :func:`rwadist.extended.steady_lines` (suspension modes,
+        gyroscopic whirl, rotation sense, lever arm), lines of one h acting on the channel merged into one entry
+        of power Σ|A|²/2 (independent phases: the expected power; a co/counter pair of one h has a cross term
+        of zero mean that cancels between x and y).  Cached on the state per set of runs."""
+        if state.ext is None:
+            return [(h, law, self.amplitude(C, law, runs), np.ones(runs.size)) for h, C, law in state.lines(c)]
+        key = ("lines", runs.tobytes())
+        if key not in state._cache:
+            state._cache[key] = self._ext_lines(state, runs)
+        return state._cache[key].get(c, [])
+
+    def _ext_lines(self, state: State, runs: np.ndarray) -> dict:
+        from .. import extended as ext
+
+        lines = state.ext_lines()
+        w = self.omega[runs]
+        out = {c: [] for c in self.channels}
+        if not lines:
+            return out
+        _, A = ext.steady_lines(state.ext, lines, w)                  # (S, L, 6)
+        P = np.abs(A) ** 2                                             # 2 × mean square
+        hs = np.array([ln.h for ln in lines])
+        free = np.array([ln.amplitude(w) for ln in lines]).T           # (S, L) load amplitudes
+        groups = []
+        for j in np.argsort(hs, kind="stable"):
+            if groups and abs(hs[j] - hs[groups[-1][0]]) < ext.LAW_H_TOL:
+                groups[-1].append(j)
+            else:
+                groups.append([j])
+        for c in self.channels:
+            k = CHANNELS.index(c)
+            d = CHANNEL_DIRECTION[c]
+            for g in groups:
+                p = P[:, g, k].sum(1)
+                if not np.any(p > 0):
+                    continue
+                own = [j for j in g if lines[j].direction == d]
+                a_free = np.sqrt(np.sum(free[:, own] ** 2, axis=1)) if own else np.zeros(w.size)
+                a = np.sqrt(p)
+                gain = np.where(a_free > 0, a / np.where(a_free > 0, a_free, 1.0), 1.0)
+                j0 = own[0] if own else g[0]
+                out[c].append((float(lines[j0].h), lines[j0].law, a, gain))
+        return out
+
+    def unit_gain(self, state: State, c: str, direction: str, h: float, sense: str, runs: np.ndarray) -> np.ndarray:
+        """|amplitude in channel ``c``| per unit load amplitude of a line (direction, h, sense) through the state's
+        suspension modes (:func:`rwadist.extended.steady_lines`), per run; ones on the empirical base."""
+        if state.ext is None:
+            return np.ones(runs.size)
+        from .. import extended as ext
+
+        w = self.omega[runs]
+        _, A = ext.steady_lines(state.ext, [ext.Line(direction, float(h), 1.0, sense)], w)
+        return np.abs(A[:, 0, CHANNELS.index(c)]) / np.maximum(w**2, 1e-300)
+
+    def modal_gain(self, state: State, c: str, h: float, runs: np.ndarray) -> np.ndarray:
+        """Modal gain g of the line h of channel ``c`` (:meth:`channel_lines`); for a line the state lacks, that
+        of a co-rotating line of the channel's direction (a wheel disturbance goes through the modes)."""
+        if state.ext is None:
+            return np.ones(runs.size)
+        from .. import extended as ext
+
+        for hh, _, _, g in self.channel_lines(state, c, runs):
+            if abs(hh - h) < ext.LAW_H_TOL:
+                return g
+        return self.unit_gain(state, c, CHANNEL_DIRECTION[c], h, "co", runs)
+
+    def amplitude(self, C, law, runs):
+        w = self.omega[runs]
+        if law is None:
+            return C * w**2
+        a_ref, w_ref, p = law
+        return a_ref * (w / w_ref) ** p
+
+    def floor_psd(self, state: State, c: str, runs: np.ndarray) -> np.ndarray:
+        out = np.broadcast_to(state.noise[c], (runs.size, self.f.size)).copy()
+        if c in state.floors:
+            ref, w_ref, p = state.floors[c]
+            out += ref[None, :] * (self.omega[runs][:, None] / w_ref) ** p
+        return out
+
+    def predict(self, state: State, c: str, runs: np.ndarray, skip=None) -> np.ndarray:
+        """Expected PSD of channel ``c`` on ``runs``; ``skip`` = h of a line to leave out (with its
+        sidebands).  A line's components (carrier and ``sidebands``, :meth:`State.line_components`) are
+        each multiplied by the resonance gain at their own frequency and, under a ``speed_ripple``,
+        spread over f + k·f_ripple with the power fractions of :meth:`ripple_powers`."""
+        out = self.floor_psd(state, c, runs)
+        for h, law, amp, _ in self.channel_lines(state, c, runs):
+            if skip is not None and abs(h - skip) < 1e-9:
+                continue
+            f0 = h * self.omega[runs] / (2 * np.pi)
+            rip = self.ripple_powers(state, h, law, runs)
+            for shift, rel in state.line_components(c, h):
+                f = f0 + shift
+                a = amp * rel
+                if state.resonances:
+                    a = a * self.gain(state, c, f)
+                if state.smear is not None:
+                    du, wt = self.smear_offsets(state, h, runs)
+                    out += self.psd_at(f[:, None] + du, (a**2 / 2.0)[:, None] * wt)
+                elif rip is None:
+                    out += self.psd_at(f, a**2 / 2.0)
+                else:
+                    k, P = rip
+                    out += self.psd_at(f[:, None] + k[None, :] * state.ripple[1], (a**2 / 2.0)[:, None] * P)
+        return out
+
+    def run_durations(self, runs: np.ndarray) -> np.ndarray:
+        """Length of each run's record, s: from the time series when known, else from the Welch
+        segments (50 % overlap: (n_segments + 1)·nperseg/2 samples)."""
+        if self.test is not None:
+            return np.array([self.test.runs[r].n_samples / self.test.runs[r].sample_rate for r in runs])
+        n = np.asarray(self.sp.n_segments, dtype=float)[runs]
+        return (n + 1.0) * self.sp.nperseg / 2.0 / self.sp.sample_rate
+
+    def smear_offsets(self, state: State, h: float, runs: np.ndarray, n_max: int = 48):
+        """(offsets Hz, weights) (len(runs), 3M) of a line h smeared by the state's spin acceleration:
+        during a run of length T at mean speed Ω the line sweeps f ± h|α|T/(4π); M points spaced at most
+        half a bin cover that range, each weighted by the instantaneous power (Ω(τ)/Ω)⁴ (a C·Ω² line) and
+        by how much its part of the record weighs in the Welch estimate (:meth:`_welch_weights`), each
+        point split in three across a segment's own sweep (see the comment in the code)."""
+        alpha = float(state.smear)
+        T = self.run_durations(runs)
+        width = h * alpha * T / (2 * np.pi)                                  # Hz swept during the run
+        m = int(np.clip(np.ceil(2.0 * np.max(width) / self.df) + 1, 1, n_max))
+        u = (np.arange(m) + 0.5) / m - 0.5                                     # −½ … ½
+        du = width[:, None] * u[None, :]
+        w = np.maximum(np.abs(self.omega[runs]), 1e-12)
+        amp = (1.0 + alpha * T[:, None] * u[None, :] / w[:, None]) ** 4
+        n_samp = np.rint(T * self.sp.sample_rate).astype(int)
+        prof = np.array([self._welch_weights(int(n), m) for n in n_samp])
+        # within one Welch segment the line still sweeps h|α|L/(2π f_s) Hz and a chirp's windowed spectrum
+        # is broader than the average of instantaneous kernels: each point is spread over ±⅓ of that
+        # width as well.  Partly double counted (the record-level spread already holds the segments'
+        # chirp), so a fitted |α| comes out some 5-8 % low on fast sweeps -- without it the residual
+        # skirts of high harmonics invite a spurious broadband floor.
+        seg = h * alpha * self.sp.nperseg / self.sp.sample_rate / (2 * np.pi)
+        v = np.array([-1.0, 0.0, 1.0]) / 3.0
+        du = (du[:, :, None] + seg * v[None, None, :]).reshape(du.shape[0], -1)
+        wt = np.repeat(amp * prof, v.size, axis=1) / v.size
+        return du, wt
+
+    def _welch_weights(self, n: int, m: int) -> np.ndarray:
+        """How much each of m equal parts of an n-sample record weighs in its Welch PSD (sum 1): Σ over
+        the segments (50 % overlap) of the squared window falling in the part."""
+        key = ("welch_w", n, m)
+        if key not in self._memo:
+            from scipy import signal
+
+            L = self.sp.nperseg
+            w2 = signal.get_window(self.sp.window, L) ** 2
+            acc = np.zeros(n)
+            for s0 in range(0, n - L + 1, L // 2):
+                acc[s0:s0 + L] += w2
+            edges = np.rint(np.linspace(0, n, m + 1)).astype(int)
+            part = np.add.reduceat(acc, edges[:-1]) if n >= m else np.full(m, acc.sum() / m)
+            self._memo[key] = part / part.sum()
+        return self._memo[key]
+
+    def band_centres(self) -> np.ndarray:
+        return self.f[self.k_lo + BAND_BINS * np.arange(self.n_bands) + BAND_BINS // 2] - 0.5 * self.df
+
+    def offline_bands(self, state: State, c: str, runs: np.ndarray):
+        """Mean PSD of the data less the model's lines (their kernel skirts) per band, over the bins away
+        from every line (model lines ±LINE_HALF bins and residual peaks above a 1e-4 false-alarm
+        threshold ±2 bins): (value unit²/Hz, bins used) per run and band."""
+        from scipy import stats
+
+        P = self.predict(state, c, runs)
+        D = self.data(state, c)[runs] - (P - self.floor_psd(state, c, runs))     # data less the model's lines
+        mask = np.zeros(D.shape, bool)
+        offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+        rows = np.arange(runs.size)[:, None]
+        for h, _, _, _ in self.channel_lines(state, c, runs):
+            k = np.clip(np.rint(h * self.omega[runs] / (2 * np.pi) / self.df).astype(int)[:, None] + offs,
+                        0, self.f.size - 1)
+            mask[rows, k] = True
+            if state.smear is not None:     # the whole range a smeared line sweeps, ±LINE_HALF bins
+                half = h * state.smear * self.run_durations(runs) / (4 * np.pi) / self.df + LINE_HALF
+                kc = h * self.omega[runs] / (2 * np.pi) / self.df
+                kk = np.arange(self.f.size)[None, :]
+                mask |= (kk >= (kc - half)[:, None]) & (kk <= (kc + half)[:, None])
+        if state.sidebands or state.ripple is not None:
+            # the model's sideband and ripple lines too, where their power is above a tenth of the noise
+            # power in their window
+            noise = self.floor_psd(state, c, runs)
+            for h, law, amp, _ in self.channel_lines(state, c, runs):
+                f0 = h * self.omega[runs] / (2 * np.pi)
+                rip = self.ripple_powers(state, h, law, runs) or (np.zeros(1), np.ones((runs.size, 1)))
+                for shift, rel in state.line_components(c, h):
+                    for j, kk in enumerate(rip[0]):
+                        if shift == 0.0 and kk == 0:
+                            continue
+                        f = np.abs(f0 + shift + kk * (state.ripple[1] if state.ripple else 0.0))
+                        k = np.clip(np.rint(f / self.df).astype(int)[:, None] + offs, 0, self.f.size - 1)
+                        pw = (amp * rel) ** 2 / 2 * rip[1][:, j]
+                        big = pw > 0.1 * noise[rows, k].sum(1) * self.df
+                        mask[rows, k] |= big[:, None]
+        z = D / np.maximum(self.floor[c][runs], 1e-300) - 1.0     # against the run's own block floor
+        thr = stats.chi2.isf(1e-4, self.dof) / self.dof - 1.0
+        peak = z > thr
+        for j in (-2, -1, 1, 2):
+            peak |= np.roll(z > thr, j, axis=1)
+        mask |= peak
+        lo, n = self.k_lo, self.n_bands * BAND_BINS
+        keep = ~mask[:, lo:lo + n].reshape(runs.size, self.n_bands, BAND_BINS)
+        vals = D[:, lo:lo + n].reshape(runs.size, self.n_bands, BAND_BINS)
+        cnt = keep.sum(-1)
+        mean = np.where(cnt > 0, (vals * keep).sum(-1) / np.maximum(cnt, 1), 0.0)
+        return mean, cnt.astype(float)
+
+
+    def measure_line(self, state: State, c: str, h: float, runs: np.ndarray, skip=None):
+        """Amplitude (unit) of a line h in the data of ``runs`` less everything else the state
+        predicts (other lines, floors); NaN where the line is out of band or not above noise."""
+        R = self.data(state, c)[runs] - self.predict(state, c, runs, skip=skip)
+        pos = h * self.omega[runs] / (2 * np.pi) / self.df
+        k0 = np.rint(pos).astype(int)
+        offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+        inband = (k0 - LINE_HALF >= self.k_lo) & (k0 + LINE_HALF <= self.k_hi)
+        k = np.clip(k0[:, None] + offs, 0, self.f.size - 1)
+        p = np.take_along_axis(R, k, axis=1).sum(1) * self.df
+        noise = np.take_along_axis(self.floor_psd(state, c, runs), k, axis=1).sum(1) * self.df
+        # 3 standard deviations of the window's noise power: std of a bin mean·sqrt(2/ν), summed
+        # over the window's bins with a factor 2 for the Hann correlation of neighbouring bins
+        sig = 3.0 * 2.0 * noise * np.sqrt(2.0 / self.dof) / np.sqrt(2 * LINE_HALF + 1)
+        amp = np.where(inband & (p > sig), np.sqrt(2 * np.maximum(p, 0)), np.nan)
+        return amp
+
+
+
+def ripple_sideband_powers(beta, eps, p=2.0, k_max: int | None = None):
+    """Power fractions of the lines a periodic speed ripple makes of one harmonic line.
+
+    With Ω(t) = Ω0 + ΔΩ·sin θ, θ = 2π f_r t, the rotation angle is ψ = Ω0 t − (ΔΩ/2πf_r)·cos θ, so the line
+    h of amplitude a(Ω) ∝ |Ω|^p becomes a·g(θ)·e^{j2πf_i t} with
+    g(θ) = (1 + ε sin θ)^p · exp(−jβ cos θ),  β = h·ΔΩ/(2π f_r) (phase-modulation index, rad),
+    ε = ΔΩ/|Ω0|, and g = Σ_k c_k e^{jkθ}: lines at f_i + k·f_r of amplitude |c_k|·a.  Without the amplitude
+    term (ε = 0) c_k = J_k(β)e^{-jkπ/2}, |c_k|² = J_k(β)² and Σ_k |c_k|² = 1 (Parseval); with it Σ|c_k|² is the
+    mean of (1 + ε sin θ)^{2p} (1 + 3ε² + 3ε⁴/8 for p = 2).  c_k by an FFT over one period of θ: the complex
+    coefficients are :func:`rwadist.extended.ripple_coefficients` (which the coupling kit applies per line);
+    this returns their squared moduli.  (For ε > 1, a speed reversal within the ripple, the amplitude is
+    |1 + ε sin θ|^p, the exact |Ω(t)|^p.)
+
+    beta, eps : broadcastable arrays (shape S); p : amplitude exponent (scalar or broadcastable).
+    Returns (k (2K+1,), P (S + (2K+1,))), P = |c_k|².
+    """
+    from ..extended import ripple_coefficients
+
+    k, c = ripple_coefficients(beta, eps, p, k_max)
+    return k, np.abs(c) ** 2
+
+
+def initial_state(ctx: Context, model: WheelModel, ext_params=None) -> State:
+    """The model with a speed-independent instrument noise per channel: the off-line band means
+    (:meth:`Context.offline_bands`) averaged over every run, interpolated between the centres of the
+    bands with a positive mean (the median block floor of the data outside them).  ``ext_params``:
+    the :class:`rwadist.extended.ExtendedParams` of the extended base, or None (empirical base)."""
+    rough = {c: np.nanmedian(ctx.floor[c][ctx.runs], axis=0) for c in ctx.channels}
+    state = State(copy.deepcopy(model), rough, ext=ext_params)
+    return State(state.model, noise_estimate(ctx, state), ext=ext_params)
+
+
+def noise_estimate(ctx: Context, state: State) -> dict:
+    """Instrument noise per channel (unit²/Hz on the grid) as :func:`initial_state` estimates it, the
+    model's lines (as ``state`` predicts them, smear included) masked out; ``state.noise`` is the
+    fallback outside the bands."""
+    noise = {}
+    fc = ctx.band_centres()
+    for c in ctx.channels:
+        ok = ctx.runs[np.isfinite(ctx.sp.psd[c][ctx.runs, 0])]
+        y, cnt = ctx.offline_bands(state, c, ok)
+        mean = np.sum(y * cnt, 0) / np.maximum(cnt.sum(0), 1)
+        # a band whose mean is not positive (the model's line skirts exceed the data there: coherent lines
+        # closer than the kernel beat in the Welch estimate) says nothing about the noise: interpolated over
+        good = (cnt.sum(0) > 0) & (mean > 0)
+        n = np.array(state.noise[c], dtype=float)
+        band = (ctx.f >= fc[0]) & (ctx.f <= fc[-1])
+        if good.sum() >= 2:
+            n[band] = np.interp(ctx.f[band], fc[good], mean[good])
+        noise[c] = n
+    return noise

@@ -1,0 +1,186 @@
+"""Residual measurements shared by several effect families: line amplitudes pooled over a direction,
+residual ridges along h·|Ω| and at constant frequency offsets, window powers."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import DIRECTION_CHANNELS
+from .constants import LINE_HALF
+
+
+def _measure(ctx, state, direction, h, runs, skip=None):
+    """Line amplitudes of (direction, h) pooled over the direction's channels: (amplitude, omega)."""
+    ds, ws = [], []
+    for c in DIRECTION_CHANNELS[direction]:
+        if c not in ctx.channels:
+            continue
+        a = ctx.measure_line(state, c, h, runs, skip=skip)
+        a = a / ctx.gain(state, c, h * ctx.omega[runs] / (2 * np.pi))     # the line before any resonance
+        if state.ext is not None:
+            a = a / ctx.modal_gain(state, c, h, runs)                      # ... and before the wheel's modes
+        ok = np.isfinite(a)
+        ds.append(a[ok])
+        ws.append(ctx.omega[runs][ok])
+    return np.concatenate(ds) if ds else np.empty(0), np.concatenate(ws) if ws else np.empty(0)
+
+
+def _ridge_score(ctx, state, chans, runs, h_grid):
+    """Mean normalised residual along f = h|Ω|/2π for every h of ``h_grid`` (pairs in band only)."""
+    score = np.zeros(h_grid.size)
+    count = np.zeros(h_grid.size)
+    for c in chans:
+        R = ctx.data(state, c)[runs] - ctx.predict(state, c, runs)
+        z = R / ctx.floor_psd(state, c, runs)
+        zmax = np.maximum(np.maximum(z, np.roll(z, 1, axis=1)), np.roll(z, -1, axis=1))
+        k = np.rint(np.outer(h_grid, ctx.omega[runs]) / (2 * np.pi) / ctx.df).astype(int)   # (n_h, n_runs)
+        inb = (k >= ctx.k_lo) & (k <= ctx.k_hi)
+        vals = zmax[np.arange(runs.size)[None, :], np.clip(k, 0, ctx.f.size - 1)]
+        vals = np.clip(vals, -5.0, 20.0)          # a presence-like score: strong lines count alike
+        score += np.where(inb, vals, 0).sum(1)
+        count += inb.sum(1)
+    return np.where(count >= 6, score / np.maximum(count, 1), 0.0)
+
+
+def ridge_peaks(ctx, state, chans, runs, n_max: int, h_min: float = 0.1):
+    """Harmonic numbers of the strongest residual ridges (local maxima of the ridge score above
+    10 noise standard deviations of a pooled residual)."""
+    top = ctx.k_hi * ctx.df * 2 * np.pi / max(ctx.omega[runs].min(), 1e-9)
+    h_grid = np.arange(h_min, min(top, 40.0), 0.005)
+    if h_grid.size < 3:
+        return []
+    s = _ridge_score(ctx, state, chans, runs, h_grid)
+    # a noise bin of the pooled mean has std ~ sqrt(2/dof)/sqrt(n_pairs); demand a clear ridge
+    thr = 10.0 * np.sqrt(2.0 / ctx.dof) / np.sqrt(max(runs.size * len(chans), 1)) + 0.5
+    peaks = np.nonzero((s[1:-1] > s[:-2]) & (s[1:-1] >= s[2:]) & (s[1:-1] > thr))[0] + 1
+    peaks = peaks[np.argsort(-s[peaks])][:n_max]
+    return [float(h_grid[i]) for i in peaks]
+
+
+def refine_h(ctx, state, chans, runs, h, n_iter: int = 3):
+    """Harmonic number of the ridge near ``h``: in every (run, channel) the residual peak within
+    ±2 bins of h|Ω|/2π, its frequency refined by a log-parabola through three bins (accurate to a few
+    hundredths of a bin for a Hann window), and h = least squares of f_peak = h·|Ω|/2π over the peaks
+    standing clear of the noise (residual > 20 × floor)."""
+    for _ in range(n_iter):
+        fs_, ws_ = [], []
+        for c in chans:
+            R = ctx.data(state, c)[runs] - ctx.predict(state, c, runs)
+            z = R / ctx.floor_psd(state, c, runs)
+            k0 = np.rint(h * ctx.omega[runs] / (2 * np.pi) / ctx.df).astype(int)
+            offs = np.arange(-2, 3)
+            k = np.clip(k0[:, None] + offs, 1, ctx.f.size - 2)
+            rows = np.arange(runs.size)[:, None]
+            # the peak of the residual itself (z = R / floor can peak beside it where the floor dips), kept
+            # only where it is a local maximum standing clear of the noise
+            kp = k[np.arange(runs.size), np.argmax(R[rows, k], axis=1)]
+            r = np.arange(runs.size)
+            ok = (kp - 1 >= ctx.k_lo) & (kp + 1 <= ctx.k_hi) & (z[r, kp] > 20.0)
+            ok &= (R[r, kp] >= R[r, kp - 1]) & (R[r, kp] >= R[r, np.minimum(kp + 1, ctx.f.size - 1)])
+            lo, mid, hi = (np.log(np.maximum(R[r, kp + j], 1e-300)) for j in (-1, 0, 1))
+            den = lo - 2 * mid + hi
+            with np.errstate(divide="ignore", invalid="ignore"):
+                dl = np.clip(np.where(den < 0, 0.5 * (lo - hi) / den, 0.0), -0.5, 0.5)
+            fs_.append(((kp + dl) * ctx.df)[ok])
+            ws_.append((ctx.omega[runs] / (2 * np.pi))[ok])
+        f_pk, w_hz = np.concatenate(fs_), np.concatenate(ws_)
+        if f_pk.size < 3:
+            return h
+        h = float(np.sum(f_pk * w_hz) / np.sum(w_hz**2))
+    return h
+
+
+def _residual_z(ctx, state, c, runs):
+    """Residual (data − model) of channel ``c`` and its value over the model's floor, the latter the
+    maximum of each bin and its two neighbours (a line between bins)."""
+    R = ctx.data(state, c)[runs] - ctx.predict(state, c, runs)
+    z = R / ctx.floor_psd(state, c, runs)
+    return R, np.maximum(np.maximum(z, np.roll(z, 1, axis=1)), np.roll(z, -1, axis=1))
+
+
+def _offset_scores(ctx, state, chans, runs, hs, offsets):
+    """Sum and count (len(hs), len(offsets)) of the clipped normalised residual at h|Ω|/2π ± Δ for every
+    carrier h of ``hs`` and offset Δ (Hz) of ``offsets``, over ``chans``, ``runs`` and both sides (in band
+    only): parallel ridges at a constant frequency offset from a line."""
+    tot = np.zeros((len(hs), offsets.size))
+    cnt = np.zeros((len(hs), offsets.size))
+    rows = np.arange(runs.size)[None, :]
+    for c in chans:
+        _, z = _residual_z(ctx, state, c, runs)
+        z = np.clip(z, -5.0, 20.0)
+        for i, h in enumerate(hs):
+            f0 = h * ctx.omega[runs] / (2 * np.pi)
+            for side in (1.0, -1.0):
+                k = np.rint((f0[None, :] + side * offsets[:, None]) / ctx.df).astype(int)
+                inb = (k >= ctx.k_lo) & (k <= ctx.k_hi)
+                vals = z[rows, np.clip(k, 0, ctx.f.size - 1)]
+                tot[i] += np.where(inb, vals, 0.0).sum(1)
+                cnt[i] += inb.sum(1)
+    return tot, cnt
+
+
+def _offset_threshold(ctx, n):
+    """Pooled-score threshold of a ridge (as :func:`ridge_peaks`): 10 noise standard deviations of a mean
+    of ``n`` normalised residual bins, plus 0.5."""
+    return 10.0 * np.sqrt(2.0 / ctx.dof) / np.sqrt(max(n, 1)) + 0.5
+
+
+def _offset_grid(ctx, f_max: float = 50.0):
+    """Offsets (Hz) searched for sidebands: from 2.5 bins (clear of the carrier's main lobe) to f_max."""
+    return np.arange(2.5 * ctx.df, min(f_max, 0.5 * ctx.k_hi * ctx.df), 0.25 * ctx.df)
+
+
+def _refine_offset(ctx, state, chans, runs, hs, off, n_iter: int = 2):
+    """Constant offset (Hz) of the sideband ridges near ``off`` around the carriers ``hs``: in every (channel,
+    run, carrier, side) the residual peak within ±2 bins of f_i ± off, refined by a log-parabola through three
+    bins and kept when > 20 × floor; the offset is the median of side·(f_peak − f_i).  Returns (offset, count)."""
+    n = 0
+    for _ in range(n_iter):
+        est = []
+        for c in chans:
+            R, _ = _residual_z(ctx, state, c, runs)
+            z = R / ctx.floor_psd(state, c, runs)
+            r = np.arange(runs.size)
+            for h in hs:
+                f0 = h * ctx.omega[runs] / (2 * np.pi)
+                for side in (1.0, -1.0):
+                    k0 = np.rint((f0 + side * off) / ctx.df).astype(int)
+                    k = np.clip(k0[:, None] + np.arange(-2, 3), 1, ctx.f.size - 2)
+                    kp = k[r, np.argmax(z[r[:, None], k], axis=1)]
+                    ok = (kp - 1 >= ctx.k_lo) & (kp + 1 <= ctx.k_hi) & (z[r, kp] > 20.0)
+                    lo, mid, hi = (np.log(np.maximum(R[r, kp + j], 1e-300)) for j in (-1, 0, 1))
+                    den = lo - 2 * mid + hi
+                    with np.errstate(divide="ignore", invalid="ignore"):
+                        dl = np.clip(np.where(den < 0, 0.5 * (lo - hi) / den, 0.0), -0.5, 0.5)
+                    est.append((side * ((kp + dl) * ctx.df - f0))[ok])
+        est = np.concatenate(est) if est else np.empty(0)
+        n = est.size
+        if n < 3:
+            return off, n
+        off = float(np.median(est))
+    return off, n
+
+
+def _window_power(ctx, state, c, runs, f_hz, R):
+    """Residual power (unit²) in ±LINE_HALF bins around ``f_hz`` (len(runs),), the model floor's power there,
+    its noise standard deviation (as :meth:`Context.measure_line`) and an in-band mask."""
+    k0 = np.rint(np.abs(f_hz) / ctx.df).astype(int)
+    offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+    inband = (k0 - LINE_HALF >= ctx.k_lo) & (k0 + LINE_HALF <= ctx.k_hi)
+    k = np.clip(k0[:, None] + offs, 0, ctx.f.size - 1)
+    p = np.take_along_axis(R, k, axis=1).sum(1) * ctx.df
+    noise = np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1).sum(1) * ctx.df
+    sig = 2.0 * noise * np.sqrt(2.0 / ctx.dof) / np.sqrt(2 * LINE_HALF + 1)
+    return p, noise, sig, inband
+
+
+def _clear_of_lines(ctx, state, c, runs, f_hz, own_h):
+    """True where frequency ``f_hz`` (len(runs),) lies at least 2·LINE_HALF bins from every line of channel
+    ``c`` other than ``own_h`` (and their sidebands): its window measures that line's component alone."""
+    ok = np.ones(runs.size, bool)
+    for h, _, _ in state.lines(c):
+        if abs(h - own_h) < 1e-9:
+            continue
+        for shift, _ in state.line_components(c, h):
+            g = np.abs(h * ctx.omega[runs] / (2 * np.pi) + shift)
+            ok &= np.abs(g - np.abs(f_hz)) >= 2 * LINE_HALF * ctx.df
+    return ok

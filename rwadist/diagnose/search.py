@@ -1,0 +1,173 @@
+"""The greedy search of ``rwadist diagnose``: hypotheses from every registered effect family, judged on
+held-out speeds, the best passing one refitted on every run and added (docs/diagnose.md)."""
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+from ..empirical import fit_empirical
+from ..model import WheelModel
+from ..spectra import Spectra
+from .constants import BAND_BINS, METRIC, NOISE_Z
+from .effects import EFFECT_CLASSES
+from .engine import Context, initial_state
+from .state import State
+
+
+@dataclass
+class Hypothesis:
+    """A fitted effect judged on held-out speeds."""
+
+    effect: object
+    gain: float           # held-out improvement / held-out data power
+    gain_fraction: float  # improvement / held-out unexplained power
+    t: float              # improvement in standard errors
+    passed: bool
+    iteration: int
+
+
+@dataclass
+class Diagnosis:
+    model: WheelModel
+    state_before: State
+    state_after: State
+    error_before: float
+    error_after: float
+    rms_error_before: float
+    rms_error_after: float
+    hypotheses: list
+    iterations: int
+    ctx: Context
+
+    @property
+    def effects(self) -> list:
+        return self.state_after.effects
+
+    def summary(self) -> dict:
+        chosen = [h for h in self.hypotheses if h.passed]
+        return {
+            "metric": METRIC,
+            "base": self.state_before.base,
+            "metric_definition": "sum over channels, runs and %d-bin bands of |data - model| power / sum of "
+                                 "data power (each channel divided by the mean power of its unit group)" % BAND_BINS,
+            "error_before": self.error_before, "error_after": self.error_after,
+            "rms_relative_error_before": self.rms_error_before, "rms_relative_error_after": self.rms_error_after,
+            "iterations": self.iterations,
+            "effects": [effect_entry(h) for h in chosen],
+            "hypotheses": [effect_entry(h) for h in self.hypotheses],
+        }
+
+
+def effect_entry(hyp: Hypothesis) -> dict:
+    """The model file's entry of a hypothesis's effect (:meth:`Effect.to_schema`) with its held-out evidence."""
+    e = hyp.effect
+    d = {**e.to_schema(),
+         "evidence": {"heldout_gain": hyp.gain, "heldout_gain_fraction": hyp.gain_fraction,
+                      "t": hyp.t, "passed": hyp.passed, "iteration": hyp.iteration}}
+    return d
+
+
+def _judge(ctx, state, effect, k_sigma, min_gain, iteration):
+    """Held-out evidence of ``effect`` (fitted on the fit runs) added to ``state``.
+
+    gain = Σ over held-out runs of the drop in misplaced power; its noise standard error is
+    sqrt(Σ_bands min(|Δ|, σ)²·P_b), Δ = the change of the residual D − M (of the model M, or of the data
+    D as read for a measurement correction such as ``cross_coupling``): if the data were M_0 plus
+    Gaussian noise of std σ, a band's term max(|D − M| − zσ, 0) changes by at most |Δ| (and by about σ
+    when the change is larger), and changes at all only with probability P_b = 2·Q(z − |Δ|/σ).  Passes
+    when gain > k_sigma·SE and gain ≥ min_gain × the held-out misplaced power."""
+    runs = ctx.held_runs
+    chans = [c for c in effect.channels if c in ctx.channels]
+    e0, _, p0 = ctx.run_errors(state, runs, chans, detail=True)
+    e1, _, p1 = ctx.run_errors(effect.apply(state), runs, chans, detail=True)
+    e0_all, all_tot = ctx.run_errors(state, runs)
+    var = 0.0
+    for c in chans:
+        dm, sig = np.abs(p1[c][0] - p0[c][0]), p0[c][1]       # |Δ(D − M)|
+        r = dm / np.maximum(sig, 1e-300)
+        # a band's term changes only when the noise reaches past the forgiven NOISE_Z·σ less |ΔM|
+        p_change = np.minimum(2.0 * stats.norm.sf(np.maximum(NOISE_Z - r, 0.0)), 1.0)
+        var += float(np.sum(np.minimum(dm, sig) ** 2 * p_change))
+    se = np.sqrt(var)
+    d = e0 - e1
+    gain = float(d.sum())
+    t = gain / se if se > 0 else (np.inf if gain > 0 else 0.0)
+    frac = gain / max(float(e0_all.sum()), 1e-300)
+    passed = bool(t > k_sigma and frac >= min_gain)
+    return Hypothesis(effect, gain / max(float(all_tot.sum()), 1e-300), frac, float(t), passed, iteration)
+
+
+BASES = ("empirical", "extended", "auto")
+
+
+def resolve_base(model: WheelModel | None, base: str = "empirical", test=None) -> str:
+    """'empirical' or 'extended' for a ``base`` request (the one rule of the library and the CLI).
+
+    'auto' is 'extended' when the model has an ``analytical`` section, unless the test's record says the
+    wheel's modes were off (``test.meta["modes"] is False``: a virtual-stand test made with modes=False is
+    hard-mounted C·Ω² truth); else 'empirical'.  'extended' without an analytical section is a ValueError.
+    ``test``: the SteadyTest (or None: no record)."""
+    if base not in BASES:
+        raise ValueError(f"diagnose: base must be one of {BASES}, got {base!r}")
+    has = model is not None and bool(getattr(model, "analytical", None))
+    if base == "auto":
+        modes_off = test is not None and getattr(test, "meta", {}).get("modes") is False
+        return "extended" if has and not modes_off else "empirical"
+    if base == "extended" and not has:
+        raise ValueError("diagnose: base 'extended' needs a model with an analytical section "
+                         "(rwadist.extended.params_to_dict), e.g. preset('ithaco-e').to_model()")
+    return base
+
+
+def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float = 4.0, min_gain: float = 0.05,
+             max_iterations: int = 8, channels=None, test=None, base: str = "empirical") -> Diagnosis:
+    """Greedy effect search on ``spectra`` starting from ``model`` (default: the empirical fit).
+
+    k_sigma, min_gain : acceptance rule (docs/diagnose.md).  test : the SteadyTest ``spectra`` were
+    computed from (50 % overlap), needed for ``cross_coupling`` (phases); without it that class is not tried.
+    base : 'empirical' (default; lines C·Ω², hard mounted), 'extended' (lines through the suspension modes of
+    the model's ``analytical`` section, :func:`rwadist.extended.steady_lines`) or 'auto' (extended when the
+    model has an analytical section and ``test`` does not record the modes off); see :func:`resolve_base`.
+    Returns a :class:`Diagnosis` whose ``model`` carries the added harmonics in ``empirical`` and every
+    effect in ``effects``.
+    """
+    if model is None:
+        model = fit_empirical(spectra).model
+    base = resolve_base(model, base, test)
+    ext_params = None
+    if base == "extended":
+        from ..extended import params_from_model
+
+        ext_params = params_from_model(model, getattr(model, "name", "<model>"))
+    ctx = Context(spectra, channels, test)
+    state0 = initial_state(ctx, model, ext_params)
+    state = state0
+    hyps = []
+    it = 0
+    for it in range(1, max_iterations + 1):
+        cands = []
+        for cls in EFFECT_CLASSES:
+            cands += cls.candidates(ctx, state, ctx.fit_runs)
+        judged = [_judge(ctx, state, e, k_sigma, min_gain, it) for e in cands]
+        judged.sort(key=lambda h: -h.gain)
+        passing = [h for h in judged if h.passed]
+        for h in judged:
+            h.passed = False
+        if not passing:
+            hyps += judged[:5]
+            break
+        best = passing[0]
+        best.passed = True
+        hyps += judged[:5]
+        state = best.effect.refit(ctx, state).apply(state)
+        best.effect = state.effects[-1]
+    else:
+        it = max_iterations
+    out = copy.deepcopy(state.model)
+    out.effects = list(model.effects) + [effect_entry(h) for h in hyps if h.passed]
+    out.provenance = dict(out.provenance, diagnose={"metric": METRIC, "base": base})
+    return Diagnosis(out, state0, state, ctx.error(state0), ctx.error(state), ctx.rms_error(state0),
+                     ctx.rms_error(state), hyps, it, ctx)
