@@ -31,7 +31,7 @@ import numpy as np
 from . import schema
 from .data import DataError, read_json
 from .schema import Analytical, Effect, Harmonic, ModelError
-from .units import DIRECTION_CHANNELS, DIRECTION_C_UNIT
+from .units import DIRECTION_C_UNIT, DIRECTION_CHANNELS
 
 SCHEMA = schema.SCHEMA
 SCHEMA_VERSION = schema.SCHEMA_VERSION

@@ -29,8 +29,10 @@ def test_one_tolerance_for_every_consumer():
     for eps, ok in ((1e-7, True), (1e-5, False)):
         bad = _off(R, eps)
         results = []
-        for make, err in ((lambda: mounting.Mounting(bad), DataError), (lambda: cp.Mount(0, bad), cp.NotARotationError),
-                          (lambda: rt.rotation_check(bad), rt.ModelError), (lambda: geometry.check_dcm(bad), ValueError)):
+        for make, err in ((lambda: mounting.Mounting(bad), DataError),
+                          (lambda: cp.Mount(0, bad), cp.NotARotationError),
+                          (lambda: rt.rotation_check(bad), rt.ModelError),
+                          (lambda: geometry.check_dcm(bad), ValueError)):
             try:
                 make()
                 results.append(True)
@@ -42,8 +44,9 @@ def test_one_tolerance_for_every_consumer():
 
 def test_runtime_copy_matches_the_home():
     """The FMU runtime's self-contained rotation check and spacecraft transform equal rwadist.geometry's."""
-    from fmu import runtime as rt
     import inspect
+
+    from fmu import runtime as rt
 
     assert inspect.signature(rt.rotation_check).parameters["tol"].default == geometry.DCM_TOL
     rng = np.random.default_rng(2)
