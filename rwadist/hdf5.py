@@ -34,7 +34,9 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .data import DataError, Run, SteadyTest, Sweep, _json_default, uniform_step
+from .formats.records import DataError, Run, SteadyTest, Sweep
+from .formats.records import json_default as _json_default
+from .formats.timebase import sample_step
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm
 
 FORMAT = "rwadist.test"
@@ -173,10 +175,8 @@ def _channels(path, group, skip=()) -> dict:
 
 def _check_time(path, time: np.ndarray, fs: float):
     field = f"/{TIME_DATASET}"
-    step = uniform_step(path, field, time, position=lambda i: f"index {i + 1}")
-    if abs(1.0 / step - fs) > 1e-6 * fs:
-        raise DataError(path, field, f"sample rate from time {1.0 / step:.9g} Hz disagrees with "
-                        f"attribute sample_rate_hz {fs!r}")
+    sample_step(path, field, time, fs, declared_by="attribute sample_rate_hz",
+                position=lambda i: f"index {i + 1}")
 
 
 def _read_run(path, group) -> Run:
