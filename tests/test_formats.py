@@ -1,0 +1,207 @@
+"""Lab file formats (issue 15): each format is written by its own library (pyuff, npTDMS, scipy.io, h5py),
+never by rwadist, and must read to the same samples and the same fitted model as the CSV interchange."""
+from __future__ import annotations
+
+import json
+
+import h5py
+import numpy as np
+import pyuff
+import pytest
+from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
+from scipy.io import savemat
+
+from rwadist.data import DataError, read_data, read_steady, read_sweep, write_steady, write_sweep
+from rwadist.empirical import fit_empirical
+from rwadist.spectra import compute_spectra
+from rwadist.teststand import preset, simulate_steady, simulate_sweep
+from rwadist.units import CHANNEL_COLUMN, CHANNELS, rad_s_to_rpm
+
+FS = 3840.0
+SPEEDS_RPM = np.linspace(600.0, 2400.0, 8)
+DIRECTIONS = ("radial_force", "radial_torque", "axial_force", "axial_torque")
+#: pyuff writes ASCII ordinates as %20.11e: 12 significant digits.
+UFF_ASCII_RTOL = 5e-12
+
+
+@pytest.fixture(scope="module")
+def steady():
+    return simulate_steady(preset("ithaco-e"), SPEEDS_RPM, sample_rate=FS, n_samples=4096, noise=0.01, seed=5)
+
+
+@pytest.fixture(scope="module")
+def reference(steady, tmp_path_factory):
+    """The test through the CSV interchange, and its fitted model."""
+    test = read_steady(write_steady(steady, tmp_path_factory.mktemp("csv")))
+    return test, model_C(test)
+
+
+@pytest.fixture(scope="module")
+def sweep():
+    return simulate_sweep(preset("ithaco-e"), rpm_start=300.0, rpm_end=2400.0, duration=4.0, sample_rate=FS,
+                          seed=3, tach=True)
+
+
+def model_C(test) -> dict:
+    model = fit_empirical(compute_spectra(test), progress=False).model
+    return {d: model.h_and_C(d) for d in DIRECTIONS}
+
+
+def same_model(a: dict, b: dict) -> float:
+    """Same harmonics in every direction; the largest relative difference of C."""
+    assert sum(a[d][1].size for d in a) >= 10
+    worst = 0.0
+    for d in DIRECTIONS:
+        np.testing.assert_array_equal(a[d][0], b[d][0])
+        if a[d][1].size:
+            worst = max(worst, float(np.max(np.abs(b[d][1] / a[d][1] - 1))))
+    return worst
+
+
+# --------------------------------------------------------------------------- independent writers
+
+def uff_sets(signals: dict, fs: float, t0: float, binary: bool, speed_rpm=None) -> list:
+    n = len(next(iter(signals.values())))
+    x = t0 + np.arange(n) / fs
+    common = dict(binary=int(binary), func_type=1, rsp_node=1, ref_node=0, ref_dir=0, x=x, abscissa_spacing=1,
+                  abscissa_min=t0, abscissa_inc=1.0 / fs, abscissa_spec_data_type=17, ordinate_spec_data_type=13,
+                  orddenom_spec_data_type=0, z_axis_spec_data_type=0, abscissa_axis_units_lab="s")
+    sets = []
+    for ch, y in signals.items():
+        unit = "N" if ch.startswith("F") else "N·m"
+        sets.append(pyuff.prepare_58(rsp_dir=CHANNELS.index(ch) + 1, id1=f"load cell {ch}", data=y,
+                                     ordinate_axis_units_lab=unit, **common))
+    if speed_rpm is not None:
+        sets.append(pyuff.prepare_58(rsp_dir=0, id1="speed_rpm", data=speed_rpm, **common))
+    return sets
+
+
+def write_uff(path, signals, fs, t0=0.0, binary=False, speed_rpm=None):
+    pyuff.UFF(str(path)).write_sets(uff_sets(signals, fs, t0, binary, speed_rpm), mode="add")
+
+
+def write_tdms(path, signals, fs, t0=0.0, speed_rpm=None, names=None, group="run"):
+    objects = [RootObject(), GroupObject(group)]
+    for ch, y in signals.items():
+        unit = "N" if ch.startswith("F") else "N·m"
+        objects.append(ChannelObject(group, (names or {}).get(ch, ch), y, properties={
+            "wf_increment": 1.0 / fs, "wf_start_offset": t0, "unit_string": unit}))
+    if speed_rpm is not None:
+        objects.append(ChannelObject(group, "speed_rpm", speed_rpm,
+                                     properties={"wf_increment": 1.0 / fs, "wf_start_offset": t0}))
+    with TdmsWriter(str(path)) as writer:
+        writer.write_segment(objects)
+
+
+def mat_columns(signals, fs, t0, speed_rpm=None):
+    n = len(next(iter(signals.values())))
+    cols = {"time_s": t0 + np.arange(n) / fs}
+    cols.update({CHANNEL_COLUMN[ch]: y for ch, y in signals.items()})
+    if speed_rpm is not None:
+        cols["speed_rpm"] = speed_rpm
+    return cols
+
+
+def write_mat5(path, signals, fs, t0=0.0, speed_rpm=None):
+    savemat(str(path), {k: v.reshape(-1, 1) for k, v in mat_columns(signals, fs, t0, speed_rpm).items()})
+
+
+def write_mat73(path, signals, fs, t0=0.0, speed_rpm=None):
+    """A MATLAB v7.3 file as MATLAB writes it: HDF5 with a 512-byte header, vectors stored transposed (1 x n)."""
+    with h5py.File(path, "w", userblock_size=512) as fh:
+        for name, v in mat_columns(signals, fs, t0, speed_rpm).items():
+            fh.create_dataset(name, data=v.reshape(1, -1)).attrs["MATLAB_class"] = np.bytes_("double")
+    with open(path, "r+b") as fh:
+        fh.write(b"MATLAB 7.3 MAT-file, written by h5py for a test".ljust(116) + bytes(8) + b"\x00\x02IM")
+
+
+WRITERS = {
+    "uff": (".uff", lambda p, s, fs, t0, v=None: write_uff(p, s, fs, t0, False, v)),
+    "uff-binary": (".uff", lambda p, s, fs, t0, v=None: write_uff(p, s, fs, t0, True, v)),
+    "tdms": (".tdms", write_tdms),
+    "mat": (".mat", write_mat5),
+    "mat73": (".mat", write_mat73),
+}
+
+
+def write_lab_steady(test, directory, fmt, meta=None):
+    ext, writer = WRITERS[fmt]
+    directory.mkdir()
+    lines = ["file,speed_rpm"]
+    for i, run in enumerate(test.runs):
+        name = f"run_{i:02d}{ext}"
+        writer(directory / name, {c: run.signals[c] for c in run.channels}, run.sample_rate, run.t0)
+        lines.append(f"{name},{float(rad_s_to_rpm(run.speed))!r}")
+    (directory / "runs.csv").write_text("\n".join(lines) + "\n")
+    (directory / "meta.json").write_text(json.dumps(meta if meta is not None else {"sample_rate_hz": FS}))
+    return directory
+
+
+# --------------------------------------------------------------------------- every format = the interchange
+
+@pytest.mark.parametrize("fmt", list(WRITERS))
+def test_steady_in_lab_format_reads_as_the_interchange(tmp_path, steady, reference, fmt):
+    ref_test, ref_model = reference
+    back = read_steady(write_lab_steady(steady, tmp_path / fmt, fmt))
+    assert len(back.runs) == len(ref_test.runs)
+    for a, b in zip(ref_test.runs, back.runs):
+        assert a.speed == b.speed and a.sample_rate == b.sample_rate and a.channels == b.channels
+        for ch in a.channels:
+            if fmt == "uff":
+                np.testing.assert_allclose(b.signals[ch], a.signals[ch], rtol=UFF_ASCII_RTOL, atol=0)
+            else:
+                assert np.array_equal(a.signals[ch].view(np.uint64), b.signals[ch].view(np.uint64))
+    assert same_model(ref_model, model_C(back)) <= 1e-6
+
+
+def test_uff_ascii_rounded_rate_without_meta(tmp_path, steady, reference):
+    """Without meta.json the rate is the 6-digit abscissa increment's: accepted, and the model barely moves."""
+    d = write_lab_steady(steady, tmp_path / "u", "uff", meta={})
+    back = read_steady(d)
+    fs = back.runs[0].sample_rate
+    assert fs != FS and abs(fs / FS - 1) < 5e-6  # 1/2.60417e-4 s
+    assert same_model(reference[1], model_C(back)) <= 1e-5
+
+
+@pytest.mark.parametrize("fmt", ["csv"] + list(WRITERS))
+def test_sweep_in_one_file(tmp_path, sweep, fmt):
+    speed_rpm = rad_s_to_rpm(sweep.tach)
+    signals = {c: sweep.signals[c] for c in sweep.channels}
+    if fmt == "csv":
+        path = write_sweep(sweep, tmp_path / "s.csv")
+    else:
+        ext, writer = WRITERS[fmt]
+        path = tmp_path / f"sweep{ext}"
+        writer(path, signals, FS, float(sweep.time[0]), speed_rpm)
+        path.with_suffix(".meta.json").write_text(json.dumps({"sample_rate_hz": FS}))
+    back = read_data(path)
+    # the CSV sweep has no meta.json: its rate is the time stamps' least-squares step
+    assert back.sample_rate == pytest.approx(FS, rel=1e-12 if fmt == "csv" else 0)
+    assert back.channels == sweep.channels
+    rtol = UFF_ASCII_RTOL if fmt == "uff" else 0.0
+    for ch in sweep.channels:
+        np.testing.assert_allclose(back.signals[ch], sweep.signals[ch], rtol=rtol, atol=0)
+    np.testing.assert_allclose(back.tach, sweep.tach, rtol=max(rtol, 1e-15), atol=0)
+    np.testing.assert_allclose(back.time, sweep.time, rtol=1e-15, atol=1e-15)  # t0 + i/fs, to the ulp
+
+
+def test_tdms_group_per_run_in_one_file(tmp_path, steady, reference):
+    """One TDMS file, one group per run, runs.csv naming FILE.tdms:GROUP."""
+    path = tmp_path / "d" / "test.tdms"
+    path.parent.mkdir()
+    objects, lines = [RootObject()], ["file,speed_rpm"]
+    for i, run in enumerate(steady.runs):
+        g = f"run {i}"
+        objects.append(GroupObject(g))
+        for ch in run.channels:
+            objects.append(ChannelObject(g, CHANNEL_COLUMN[ch], run.signals[ch],
+                                         properties={"wf_increment": 1 / FS, "wf_start_offset": 0.0}))
+        lines.append(f"test.tdms:{g},{float(rad_s_to_rpm(run.speed))!r}")
+    with TdmsWriter(str(path)) as w:
+        w.write_segment(objects)
+    (path.parent / "runs.csv").write_text("\n".join(lines) + "\n")
+    back = read_steady(path.parent)
+    assert "unlisted_files" not in back.meta
+    for a, b in zip(reference[0].runs, back.runs):
+        for ch in a.channels:
+            np.testing.assert_array_equal(a.signals[ch], b.signals[ch])
