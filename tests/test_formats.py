@@ -205,3 +205,76 @@ def test_tdms_group_per_run_in_one_file(tmp_path, steady, reference):
     for a, b in zip(reference[0].runs, back.runs):
         for ch in a.channels:
             np.testing.assert_array_equal(a.signals[ch], b.signals[ch])
+
+
+# --------------------------------------------------------------------------- channel map
+
+LBF = 4.4482216152605
+IN_LBF = 0.1129848290276167
+FT_LBF = 1.3558179483314004
+#: lab channel -> (our channel, unit, factor to SI, sign): names swapped, imperial units, two signs flipped
+LAB_MAP = {"LC_A": ("Fy", "lbf", LBF, -1), "LC_B": ("Fx", "lbf", LBF, 1), "LC_C": ("Fz", "kN", 1000.0, 1),
+           "LC_D": ("Ty", "in·lbf", IN_LBF, 1), "LC_E": ("Tx", "in-lbf", IN_LBF, -1), "LC_F": ("Tz", "ft·lbf", FT_LBF, 1)}
+
+
+def calibration_matrix():
+    rng = np.random.default_rng(42)
+    return np.eye(6) + 0.05 * rng.standard_normal((6, 6))  # cross-talk of a real 6-axis load cell
+
+
+def write_mapped(test, directory, matrix, unit_override=None):
+    """The SI test as a lab writes it: channels LC_A..LC_F in lbf/in·lbf, raw = matrix^-1 · calibrated."""
+    directory.mkdir()
+    names = list(LAB_MAP)
+    lines = ["file,speed_rpm"]
+    for i, run in enumerate(test.runs):
+        calibrated = np.vstack([run.signals[LAB_MAP[n][0]] / (LAB_MAP[n][2] * LAB_MAP[n][3]) for n in names])
+        raw = np.linalg.solve(matrix, calibrated)
+        t = run.t0 + np.arange(run.n_samples) / run.sample_rate
+        np.savetxt(directory / f"lab_{i}.csv", np.column_stack([t, raw.T]), delimiter=",", fmt="%.17g",
+                   header=",".join(["time_s"] + names), comments="")
+        lines.append(f"lab_{i}.csv,{float(rad_s_to_rpm(run.speed))!r}")
+    (directory / "runs.csv").write_text("\n".join(lines) + "\n")
+    channels = {n: {"channel": ch, "unit": unit, "sign": sign} for n, (ch, unit, _, sign) in LAB_MAP.items()}
+    channels.update(unit_override or {})
+    meta = {"sample_rate_hz": FS,
+            "channel_map": {"calibration": {"inputs": names, "matrix": matrix.tolist()}, "channels": channels}}
+    (directory / "meta.json").write_text(json.dumps(meta))
+    return directory
+
+
+def test_channel_map_imperial_units_calibration_and_swapped_names(tmp_path, steady, reference):
+    back = read_steady(write_mapped(steady, tmp_path / "lab", calibration_matrix()))
+    worst = 0.0
+    for a, b in zip(reference[0].runs, back.runs):
+        assert a.channels == b.channels
+        for ch in a.channels:
+            worst = max(worst, float(np.max(np.abs(b.signals[ch] - a.signals[ch])) / np.max(np.abs(a.signals[ch]))))
+    assert worst < 1e-12  # a 6x6 solve and product mixing channels 1000x apart in size: round-off only
+    assert same_model(reference[1], model_C(back)) <= 1e-6
+
+
+def test_channel_map_unknown_unit_names_the_channel(tmp_path, steady):
+    d = write_mapped(steady, tmp_path / "lab", calibration_matrix(),
+                     unit_override={"LC_D": {"channel": "Ty", "unit": "oz·in", "sign": 1}})
+    with pytest.raises(DataError, match=r"channel_map\.channels\.LC_D\.unit \(file channel 'LC_D'\): unit 'oz·in' "
+                                        r"is not known"):
+        read_steady(d)
+
+
+def test_channel_map_singular_calibration_refused(tmp_path, steady):
+    m = calibration_matrix()
+    m[3] = m[1] * 2.0  # two rows dependent
+    d = write_mapped(steady, tmp_path / "lab", calibration_matrix())
+    meta = json.loads((d / "meta.json").read_text())
+    meta["channel_map"]["calibration"]["matrix"] = m.tolist()
+    (d / "meta.json").write_text(json.dumps(meta))
+    with pytest.raises(DataError, match=r"meta.json: channel_map.calibration.matrix: is singular \(condition number"):
+        read_steady(d)
+
+
+def test_channel_map_force_unit_on_a_torque_refused(tmp_path, steady):
+    d = write_mapped(steady, tmp_path / "lab", calibration_matrix(),
+                     unit_override={"LC_F": {"channel": "Tz", "unit": "lbf", "sign": 1}})
+    with pytest.raises(DataError, match=r"LC_F.*'lbf' is a force unit, but channel Tz is a torque"):
+        read_steady(d)
