@@ -11,22 +11,28 @@ the time and the sample.
 
 The shaft angle at edge k is 2·pi·k/N.  A steady run's speed is the
 least-squares slope of angle against edge time (every edge weighs in, so the
-sub-sample timing error averages out); a sweep's speed is the derivative of a
-smoothing spline through angle against time (:func:`scipy.interpolate.make_smoothing_spline`,
-its smoothing chosen by generalised cross-validation), evaluated at every
-sample and held constant before the first and after the last edge.  A pulse
-gives the magnitude of the speed: it is reported positive.
+sub-sample timing error averages out); a sweep's speed is the slope of a local
+quadratic least-squares fit of angle against time (exact for a constant
+acceleration), over a window of at least ``SWEEP_WINDOW_S`` seconds and
+``SWEEP_WINDOW_EDGES`` edges, evaluated on a grid every ``SWEEP_GRID_S`` seconds,
+interpolated to every sample; before the first and after the last edge the
+fit of the nearest window is extrapolated (less than one pulse interval at
+speed; at standstill the first window's).  A pulse gives the magnitude of the speed: it is reported positive.
 """
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import make_smoothing_spline
 from scipy.ndimage import median_filter
 
 from .records import DataError
 
 MISSING_PULSE_RATIO = 1.5
 DOUBLE_TRIGGER_RATIO = 0.5
+#: Local fit window of a sweep's speed: at least this long (s) and this many edges.
+SWEEP_WINDOW_S = 0.5
+SWEEP_WINDOW_EDGES = 16
+#: Spacing of the sweep's speed estimates before interpolation to the samples, s.
+SWEEP_GRID_S = 0.02
 
 
 def tach_settings(meta: dict, meta_path) -> tuple | None:
@@ -94,11 +100,28 @@ def steady_speed(edges: np.ndarray, ppr: int) -> float:
 
 
 def sweep_speed(edges: np.ndarray, ppr: int, time: np.ndarray) -> np.ndarray:
-    """Wheel speed at each sample time (s from the first sample), rad/s, shape (n,)."""
+    """Wheel speed at each sample time (s from the first sample), rad/s, shape (n,).
+
+    Local quadratic least squares of angle against edge time around each grid point (window: the
+    larger of ``SWEEP_WINDOW_S`` and ``SWEEP_WINDOW_EDGES`` edges), its slope at the grid point.
+    """
     angle = 2.0 * np.pi * np.arange(len(edges)) / ppr
-    spline = make_smoothing_spline(edges, angle)
-    speed = spline.derivative()(np.clip(time, edges[0], edges[-1]))
-    return np.abs(speed)
+    time = np.asarray(time, dtype=float)
+    grid = np.arange(time[0], time[-1] + SWEEP_GRID_S, SWEEP_GRID_S)
+    half_edges = SWEEP_WINDOW_EDGES // 2
+    speed = np.empty(len(grid))
+    nearest = np.searchsorted(edges, grid)
+    lo_t = np.searchsorted(edges, grid - 0.5 * SWEEP_WINDOW_S)
+    hi_t = np.searchsorted(edges, grid + 0.5 * SWEEP_WINDOW_S, side="right")
+    lo = np.maximum(0, np.minimum(lo_t, nearest - half_edges))
+    hi = np.minimum(len(edges), np.maximum(hi_t, nearest + half_edges))
+    for j, (a, b) in enumerate(zip(lo, hi)):
+        if b - a < 4:
+            a, b = max(0, b - 4), min(len(edges), a + 4)
+        centre = 0.5 * (edges[a] + edges[b - 1])  # fit about the window's centre (conditioning)
+        coef = np.polyfit(edges[a:b] - centre, angle[a:b], 2)
+        speed[j] = coef[1] + 2.0 * coef[0] * (grid[j] - centre)  # d(angle)/dt at the grid point
+    return np.abs(np.interp(time, grid, speed))
 
 
 def _pulse_channel(path, extras: dict, meta: dict, meta_path):
