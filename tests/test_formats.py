@@ -278,3 +278,79 @@ def test_channel_map_force_unit_on_a_torque_refused(tmp_path, steady):
                      unit_override={"LC_F": {"channel": "Tz", "unit": "lbf", "sign": 1}})
     with pytest.raises(DataError, match=r"LC_F.*'lbf' is a force unit, but channel Tz is a torque"):
         read_steady(d)
+
+
+# --------------------------------------------------------------------------- bad input per format
+
+def _one_run(steady):
+    run = steady.runs[0]
+    return {c: run.signals[c] for c in run.channels}
+
+
+def test_uff_truncated(tmp_path, steady):
+    path = tmp_path / "r.uff"
+    write_uff(path, _one_run(steady), FS)
+    text = path.read_text()
+    cut = text[: int(len(text) * 0.55)]  # mid-way through the 4th of 6 datasets
+    path.write_text(cut)
+    with pytest.raises(DataError, match=r"r\.uff: file: is truncated"):
+        read_data(path)
+    path.write_text(cut[: cut.rindex("\n")] + "\n    -1\n")  # closed by hand after a cut: header count disagrees
+    with pytest.raises(DataError, match=r"r\.uff: dataset \d: holds \d+ samples, its header states 4096"):
+        read_data(path)
+
+
+@pytest.mark.parametrize("func_type, name", [(4, "frequency response function"), (2, "auto spectrum"),
+                                             (9, "power spectral density")])
+def test_uff_dataset_of_another_function_type(tmp_path, steady, func_type, name):
+    sets = uff_sets(_one_run(steady), FS, 0.0, binary=False)
+    f = np.arange(64) * 2.0
+    sets.insert(2, pyuff.prepare_58(func_type=func_type, rsp_node=1, rsp_dir=3, ref_node=1, ref_dir=3, id1="H33",
+                                    data=np.exp(1j * f / 30) if func_type == 4 else 1 + f, x=f, abscissa_spacing=1, abscissa_min=0.0,
+                                    abscissa_inc=2.0, abscissa_spec_data_type=18, ordinate_spec_data_type=13,
+                                    orddenom_spec_data_type=13, z_axis_spec_data_type=0))
+    path = tmp_path / "r.uff"
+    pyuff.UFF(str(path)).write_sets(sets, mode="add")
+    with pytest.raises(DataError, match=rf"r\.uff: dataset 3: function type {func_type} \({name}\), expected 1"):
+        read_data(path)
+
+
+def test_tdms_without_waveform_properties(tmp_path, steady):
+    path = tmp_path / "s.tdms"
+    with TdmsWriter(str(path)) as w:
+        w.write_segment([RootObject(), GroupObject("g"),
+                         ChannelObject("g", "Fx_N", steady.runs[0].signals["Fx"], properties={"unit_string": "N"})])
+    with pytest.raises(DataError, match=r"s\.tdms: /g/Fx_N: has no NI waveform property wf_increment"):
+        read_data(path)
+
+
+@pytest.mark.parametrize("v73", [False, True])
+def test_mat_matrix_of_unknown_orientation(tmp_path, steady, v73):
+    run = steady.runs[0]
+    matrix = np.column_stack([run.signals[c] for c in run.channels])  # n x 6
+    path = tmp_path / "s.mat"
+    if v73:
+        with h5py.File(path, "w", userblock_size=512) as fh:
+            fh["loads"] = matrix.T
+            fh["sample_rate_hz"] = np.array([[FS]])
+    else:
+        savemat(str(path), {"loads": matrix, "sample_rate_hz": FS})
+    with pytest.raises(DataError, match=r"s\.mat: variable loads: is a \d+x\d+ matrix: its orientation"):
+        read_data(path)
+
+
+def test_mixed_sample_rates_across_runs(tmp_path, steady):
+    d = write_lab_steady(steady, tmp_path / "t", "tdms", meta={})
+    write_tdms(d / "run_03.tdms", _one_run(steady), 2 * FS)
+    with pytest.raises(DataError, match=r"run_03\.tdms: sample rate: 7680.0 Hz differs from run_00\.tdms's 3840.0 Hz"):
+        read_steady(d)
+
+
+def test_unknown_unit_in_a_tdms_file(tmp_path, steady):
+    path = tmp_path / "s.tdms"
+    with TdmsWriter(str(path)) as w:
+        w.write_segment([RootObject(), GroupObject("g"), ChannelObject(
+            "g", "Tx", steady.runs[0].signals["Tx"],
+            properties={"wf_increment": 1 / FS, "wf_start_offset": 0.0, "unit_string": "kgf·cm"})])
+    with pytest.raises(DataError, match=r"s\.tdms: /g/Tx: unit 'kgf·cm' is not known"):
+        read_data(path)
