@@ -47,7 +47,7 @@ from tqdm.auto import tqdm
 from .formats import registry
 from .formats.channels import SPEED_COLUMN, to_run, to_sweep
 from .formats.csv_table import TIME_COLUMN
-from .formats.records import DataError, RawRecord, Run, SteadyTest, Sweep, json_default, read_json
+from .formats.records import DataError, RawRecord, Run, SteadyTest, Sweep, json_default, portable_meta, read_json
 from .formats.timebase import sample_step
 from .units import rad_s_to_rpm, rpm_to_rad_s
 
@@ -208,8 +208,7 @@ def write_steady(test: SteadyTest, directory, fmt: str = "csv") -> Path:
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     rates = {r.sample_rate for r in test.runs}
-    meta = dict(test.meta)
-    meta.pop("unlisted_files", None)
+    meta = portable_meta(test.meta)
     if len(rates) == 1:
         meta["sample_rate_hz"] = rates.pop()
     else:
@@ -251,7 +250,7 @@ def write_sweep(sweep: Sweep, path, fmt: str | None = None, with_meta: bool = Fa
     else:
         registry.write_record(path, fmt, {c: sweep.signals[c] for c in sweep.channels}, sweep.sample_rate,
                               float(sweep.time[0]), sweep.tach)
-    meta = {k: v for k, v in (sweep.meta or {}).items() if k not in ("tach", "channel_map")}
-    if with_meta and meta:
+    meta = dict(portable_meta(sweep.meta), sample_rate_hz=float(sweep.sample_rate))
+    if with_meta:
         path.with_suffix(".meta.json").write_text(json.dumps(meta, indent=2, default=json_default) + os.linesep)
     return path

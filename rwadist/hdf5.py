@@ -36,6 +36,7 @@ import numpy as np
 
 from .formats.records import DataError, Run, SteadyTest, Sweep
 from .formats.records import json_default as _json_default
+from .formats.records import portable_meta
 from .formats.timebase import sample_step
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm
 
@@ -48,19 +49,25 @@ TACH_DATASET = "speed_rad_s"
 
 # --------------------------------------------------------------------------- writing
 
-def _float_dataset(group, name, values, compression):
-    data = np.ascontiguousarray(values, dtype=np.float64)
+def _float_dataset(group, name, values, compression, dtype=np.float64):
+    data = np.ascontiguousarray(values, dtype=dtype)
     if data.ndim != 1:
         raise ValueError(f"{name}: expected a 1-D array, got shape {data.shape}")
     kw = {"compression": compression, "shuffle": True} if compression and data.size else {}
     group.create_dataset(name, data=data, **kw)
 
 
-def write_hdf5(obj, path, *, compression: str | None = None) -> Path:
+def write_hdf5(obj, path, *, compression: str | None = None, precision: str = "float64") -> Path:
     """Write a :class:`SteadyTest` or :class:`Sweep` to an HDF5 file. Returns the path.
 
     ``compression``: an h5py filter name (e.g. ``"gzip"``), lossless; None stores raw.
+    ``precision``: ``"float64"`` (lossless, the default) or ``"float32"`` for the load channels
+    (a 24-bit mantissa: the resolution of a 24-bit acquisition system, half the size on disk);
+    time, tach and every attribute stay float64.
     """
+    if precision not in ("float64", "float32"):
+        raise ValueError(f"precision {precision!r} is neither 'float64' nor 'float32'")
+    sample_dtype = np.dtype(precision)
     path = Path(path)
     if isinstance(obj, SteadyTest):
         kind = "steady"
@@ -73,7 +80,7 @@ def write_hdf5(obj, path, *, compression: str | None = None) -> Path:
         fh.attrs["format"] = FORMAT
         fh.attrs["format_version"] = FORMAT_VERSION
         fh.attrs["kind"] = kind
-        fh.attrs["meta"] = json.dumps(dict(obj.meta), default=_json_default)
+        fh.attrs["meta"] = json.dumps(portable_meta(obj.meta), default=_json_default)
         if kind == "steady":
             runs = fh.create_group(RUNS_GROUP)
             width = max(4, len(str(len(obj.runs))))
@@ -85,12 +92,12 @@ def write_hdf5(obj, path, *, compression: str | None = None) -> Path:
                 g.attrs["t0"] = float(run.t0)
                 g.attrs["name"] = str(run.name)
                 for ch in run.channels:
-                    _float_dataset(g, CHANNEL_COLUMN[ch], run.signals[ch], compression)
+                    _float_dataset(g, CHANNEL_COLUMN[ch], run.signals[ch], compression, sample_dtype)
         else:
             fh.attrs["sample_rate_hz"] = float(obj.sample_rate)
             _float_dataset(fh, TIME_DATASET, obj.time, compression)
             for ch in obj.channels:
-                _float_dataset(fh, CHANNEL_COLUMN[ch], obj.signals[ch], compression)
+                _float_dataset(fh, CHANNEL_COLUMN[ch], obj.signals[ch], compression, sample_dtype)
             if obj.tach is not None:
                 _float_dataset(fh, TACH_DATASET, obj.tach, compression)
     return path

@@ -106,6 +106,15 @@ def read_json(path):
         raise DataError(path, f"line {exc.lineno}", f"not valid JSON ({exc.msg})") from None
 
 
+#: meta.json keys that describe how a lab file is to be read; once read, the data are SI in our channels.
+READING_KEYS = ("channel_map", "tach", "unlisted_files")
+
+
+def portable_meta(meta) -> dict:
+    """``meta`` without the keys that only describe the source files (channel map, tach pulse channel)."""
+    return {k: v for k, v in dict(meta or {}).items() if k not in READING_KEYS}
+
+
 def json_default(obj):
     if isinstance(obj, np.generic):
         return obj.item()
