@@ -14,7 +14,7 @@ from rwadist.units import rpm_to_rad_s
 
 FS = 25600.0  # a DAQ rate that resolves 60 pulses/rev at 2400 rpm (2.4 kHz pulse rate)
 N = 32768
-SPEEDS_RPM = (300.0, 1200.0, 2400.0)
+SPEEDS_RPM = (307.3, 1234.5, 2399.1)  # periods not a whole number of samples: edge timing errors differ
 
 
 def ttl(angle: np.ndarray, ppr: int, seed=0) -> np.ndarray:

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rpm_to_rad_s
 from .records import DataError, RawRecord, Run, Sweep
+from .tach import steady_speed_from_tach, sweep_speed_from_tach
 from .timebase import check_rate, sample_step
 
 #: Unit spellings -> (kind, factor to SI).  Forces in N, torques in N·m.
@@ -189,7 +190,6 @@ def to_run(record: RawRecord, speed, meta: dict, meta_path="meta.json", name: st
     signals, extras = map_channels(record, meta, meta_path)
     fs, t0 = record_rate(record, meta.get("sample_rate_hz") if isinstance(meta, dict) else None)
     if speed is None:
-        from .tach import steady_speed_from_tach
         speed = steady_speed_from_tach(record.path, extras, fs, meta, meta_path)
     return Run(speed=float(speed), sample_rate=fs, signals=signals, t0=t0, name=name or record.path.name)
 
@@ -206,7 +206,6 @@ def to_sweep(record: RawRecord, meta: dict, meta_path="meta.json", declared_rate
     if SPEED_COLUMN in extras:
         tach = rpm_to_rad_s(extras[SPEED_COLUMN])
     else:
-        from .tach import sweep_speed_from_tach
         tach = sweep_speed_from_tach(record.path, extras, time, fs, meta, meta_path)
     return Sweep(time=np.asarray(time, dtype=float), signals=signals, sample_rate=fs, tach=tach,
                  meta=dict(meta) if isinstance(meta, dict) else {})
