@@ -354,3 +354,59 @@ def test_unknown_unit_in_a_tdms_file(tmp_path, steady):
             properties={"wf_increment": 1 / FS, "wf_start_offset": 0.0, "unit_string": "kgf·cm"})])
     with pytest.raises(DataError, match=r"s\.tdms: /g/Tx: unit 'kgf·cm' is not known"):
         read_data(path)
+
+
+def test_uff_units_from_label_or_exponents(tmp_path, steady):
+    """Ordinate label 'lbf' is converted; an empty label falls back to the unit exponents (force 1, length 1: N·m);
+    exponents of another quantity are refused naming the dataset."""
+    run = steady.runs[0]
+    common = dict(binary=0, func_type=1, rsp_node=1, ref_node=0, ref_dir=0, abscissa_spacing=1, abscissa_min=0.0,
+                  abscissa_inc=1 / FS, x=np.arange(run.n_samples) / FS, abscissa_spec_data_type=17,
+                  ordinate_spec_data_type=13, orddenom_spec_data_type=0, z_axis_spec_data_type=0)
+    sets = [pyuff.prepare_58(rsp_dir=1, data=run.signals["Fx"] / LBF, ordinate_axis_units_lab="lbf", **common),
+            pyuff.prepare_58(rsp_dir=-6, data=-run.signals["Tz"], ordinate_len_unit_exp=1, ordinate_force_unit_exp=1,
+                             **common)]
+    path = tmp_path / "r.uff"
+    pyuff.UFF(str(path)).write_sets(sets, mode="add")
+    (tmp_path / "r.meta.json").write_text(json.dumps({"sample_rate_hz": FS}))
+    back = read_data(path)
+    np.testing.assert_allclose(back.signals["Fx"], run.signals["Fx"], rtol=1e-11)
+    np.testing.assert_allclose(back.signals["Tz"], run.signals["Tz"], rtol=1e-11)  # direction -6: sign flipped
+    path.unlink()
+    sets[1] = pyuff.prepare_58(rsp_dir=6, data=run.signals["Tz"], ordinate_len_unit_exp=2, ordinate_force_unit_exp=0,
+                               **common)
+    pyuff.UFF(str(path)).write_sets(sets, mode="add")
+    with pytest.raises(DataError, match=r"r\.uff: dataset 2 \(Tz\): unit 'unit exponents length 2, force 0' is not"):
+        read_data(path)
+
+
+@pytest.mark.parametrize("fmt", ["uff-binary", "tdms", "mat"])
+def test_sweep_tach_pulse_in_lab_formats(tmp_path, sweep, fmt):
+    """A once-per-rev pulse recorded in the lab file (UFF direction-0 dataset named 'tach', a TDMS channel, a .mat
+    vector) gives the sweep's speed."""
+    angle = np.concatenate([[0.0], np.cumsum(0.5 * (sweep.tach[1:] + sweep.tach[:-1]) / FS)])
+    pulse = 5.0 * ((angle / (2 * np.pi)) % 1.0 < 0.5)
+    n = len(pulse)
+    path = tmp_path / f"s{WRITERS[fmt][0]}"
+    if fmt == "uff-binary":
+        sets = uff_sets({"Fx": sweep.signals["Fx"]}, FS, 0.0, True)
+        sets.append(pyuff.prepare_58(binary=1, func_type=1, rsp_node=1, rsp_dir=0, ref_node=0, ref_dir=0, id1="tach",
+                                     data=pulse, x=np.arange(n) / FS, abscissa_spacing=1, abscissa_min=0.0,
+                                     abscissa_inc=1 / FS, abscissa_spec_data_type=17, ordinate_spec_data_type=0,
+                                     orddenom_spec_data_type=0, z_axis_spec_data_type=0))
+        pyuff.UFF(str(path)).write_sets(sets, mode="add")
+    elif fmt == "tdms":
+        wf = {"wf_increment": 1 / FS, "wf_start_offset": 0.0}
+        with TdmsWriter(str(path)) as w:
+            w.write_segment([RootObject(), GroupObject("sweep"),
+                             ChannelObject("sweep", "Fx_N", sweep.signals["Fx"], properties=wf),
+                             ChannelObject("sweep", "tach", pulse, properties=wf)])
+    else:
+        savemat(str(path), {"Fx_N": sweep.signals["Fx"][:, None], "tach": pulse[:, None], "sample_rate_hz": FS})
+    path.with_suffix(".meta.json").write_text(json.dumps({"sample_rate_hz": FS, "tach": {"channel": "tach"}}))
+    back = read_data(path)
+    # a 4-s sweep at 55 rad/s² sampled at 3840 Hz: inside, the local fits see both sides (measured 3.8e-4);
+    # within 0.25 s of the record's ends they are one-sided and extrapolate (measured 2.2e-3 there)
+    inside = (sweep.time > 0.25) & (sweep.time < sweep.time[-1] - 0.25)
+    assert np.max(np.abs(back.tach[inside] / sweep.tach[inside] - 1)) < 5e-4
+    assert np.max(np.abs(back.tach / sweep.tach - 1)) < 5e-3
