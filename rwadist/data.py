@@ -49,6 +49,7 @@ from .formats.channels import SPEED_COLUMN, to_run, to_sweep
 from .formats.csv_table import TIME_COLUMN
 from .formats.records import DataError, RawRecord, Run, SteadyTest, Sweep, json_default, portable_meta, read_json
 from .formats.timebase import sample_step
+from .hdf5 import read_hdf5
 from .units import rad_s_to_rpm, rpm_to_rad_s
 
 __all__ = ["DataError", "Run", "SteadyTest", "Sweep", "RawRecord", "read_json", "read_run", "read_steady",
@@ -191,7 +192,6 @@ def read_data(path, progress: bool = False):
     if path.is_dir():
         return read_steady(path, progress=progress)
     if path.suffix.lower() in (".h5", ".hdf5"):
-        from .hdf5 import read_hdf5
         return read_hdf5(path)
     return read_sweep(path)
 

@@ -180,10 +180,11 @@ def _channels(path, group, skip=()) -> dict:
     return {ch: signals[ch] for ch in CHANNELS if ch in signals}
 
 
-def _check_time(path, time: np.ndarray, fs: float):
+def _check_time(path, time: np.ndarray, fs: float, stored_dtype=np.float64):
     field = f"/{TIME_DATASET}"
+    stored_rtol = float(np.finfo(stored_dtype).eps) if np.dtype(stored_dtype).kind == "f" else 0.0
     sample_step(path, field, time, fs, declared_by="attribute sample_rate_hz",
-                position=lambda i: f"index {i + 1}")
+                position=lambda i: f"index {i + 1}", stored_rtol=stored_rtol if stored_rtol > 1e-15 else 0.0)
 
 
 def _read_run(path, group) -> Run:
@@ -225,7 +226,7 @@ def _read_sweep(path, fh) -> Sweep:
     for ch, x in signals.items():
         if len(x) != n:
             raise DataError(path, f"/{CHANNEL_COLUMN[ch]}", f"{len(x)} samples, {TIME_DATASET} has {n}")
-    _check_time(path, time, fs)
+    _check_time(path, time, fs, fh[TIME_DATASET].dtype)
     tach = None
     if TACH_DATASET in fh:
         tach = _samples(path, fh, TACH_DATASET)

@@ -141,3 +141,22 @@ def test_hdf5_sweep_time_rounded_to_microseconds(tmp_path):
         fh["time_s"] = np.round(np.delete(np.arange(n + 1) / FS, 77), 6)
     with pytest.raises(DataError, match=r"/time_s: sampling is not uniform: .*index 77 .*1 dropped sample"):
         read_hdf5(path)
+
+
+def test_hdf5_sweep_time_stored_as_float32(tmp_path):
+    """A lab's HDF5 time stamps in float32 jitter by float32 rounding: accepted; a dropped sample still refused."""
+    from rwadist.data import Sweep
+    import h5py
+
+    n = 4096
+    t = np.arange(n) / FS
+    path = write_hdf5(Sweep(time=t, signals={"Fx": np.cos(t)}, sample_rate=FS), tmp_path / "s.h5")
+    with h5py.File(path, "r+") as fh:
+        del fh["time_s"]
+        fh["time_s"] = t.astype(np.float32)
+    assert read_hdf5(path).sample_rate == FS
+    with h5py.File(path, "r+") as fh:
+        del fh["time_s"]
+        fh["time_s"] = np.delete(np.arange(n + 1) / FS, 2000).astype(np.float32)
+    with pytest.raises(DataError, match=r"/time_s: sampling is not uniform: .*index 2000 .*1 dropped sample"):
+        read_hdf5(path)

@@ -22,7 +22,7 @@ FLOAT_MARGIN = 8.0 * np.finfo(float).eps
 MAX_RESOLUTION_FRACTION = 0.25
 
 
-def printed_resolution(time: np.ndarray) -> np.ndarray:
+def printed_resolution(time: np.ndarray, stored_rtol: float = 0.0) -> np.ndarray:
     """Rounding step of each printed time value, s, shape (n,).
 
     The column is taken to be printed either with a fixed number of decimals
@@ -34,6 +34,7 @@ def printed_resolution(time: np.ndarray) -> np.ndarray:
     Parameters
     ----------
     time : array, shape (n,), s.
+    stored_rtol : relative precision of the storage (float32 time stamps: its epsilon), 0 for float64/text.
 
     Returns
     -------
@@ -60,7 +61,7 @@ def printed_resolution(time: np.ndarray) -> np.ndarray:
     significant = int((decimals + exponent + 1)[nonzero].max())
     fixed = 10.0 ** (-fixed_decimals)
     relative = 10.0 ** (exponent + 1 - significant).astype(float)
-    return np.maximum(np.maximum(fixed, relative), FLOAT_MARGIN * mag)
+    return np.maximum(np.maximum(fixed, relative), (FLOAT_MARGIN + stored_rtol) * mag)
 
 
 def _least_squares_step(time: np.ndarray) -> tuple:
@@ -85,7 +86,7 @@ def _kind_of_step(ratio: float) -> str:
 
 def sample_step(path, field_name: str, time, declared_rate: float | None = None,
                 declared_by: str = "meta.json sample_rate_hz",
-                position=lambda i: f"line {i + 3}") -> float:
+                position=lambda i: f"line {i + 3}", stored_rtol: float = 0.0) -> float:
     """The sampling step of a time column, s; DataError unless it is uniform up to its printed rounding.
 
     Parameters
@@ -97,6 +98,7 @@ def sample_step(path, field_name: str, time, declared_rate: float | None = None,
     declared_by : how errors name where ``declared_rate`` comes from.
     position : ``position(i)`` names where the step from sample i to i+1 ends in the file
         (a CSV line by default: header on line 1, sample 0 on line 2).
+    stored_rtol : relative precision of the storage beyond printing (float32: its epsilon).
 
     Returns
     -------
@@ -109,7 +111,7 @@ def sample_step(path, field_name: str, time, declared_rate: float | None = None,
     step, _ = _least_squares_step(t)
     if not step > 0:
         raise DataError(path, field_name, f"time does not increase (least-squares step {step:.9g} s)")
-    q = printed_resolution(t)
+    q = printed_resolution(t, stored_rtol)
     q_max = float(q.max())
     # a step differs from the true step by at most the rounding of its two ends (q/2 each), and the
     # estimated step from the truth by at most 1.5·q_max/n (worst case of the least-squares slope)
