@@ -410,3 +410,16 @@ def test_sweep_tach_pulse_in_lab_formats(tmp_path, sweep, fmt):
     inside = (sweep.time > 0.25) & (sweep.time < sweep.time[-1] - 0.25)
     assert np.max(np.abs(back.tach[inside] / sweep.tach[inside] - 1)) < 5e-4
     assert np.max(np.abs(back.tach / sweep.tach - 1)) < 5e-3
+
+
+def test_mat_time_vector_and_sample_rate_must_agree(tmp_path, steady):
+    """A .mat with both a microsecond-rounded time vector and a sample rate: consistent reads, 0.1 % off is refused."""
+    run = steady.runs[0]
+    t = np.round(np.arange(run.n_samples) / FS, 6)
+    path = tmp_path / "s.mat"
+    savemat(str(path), {"time_s": t[:, None], "Fx_N": run.signals["Fx"][:, None], "sample_rate_hz": FS})
+    assert read_data(path).sample_rate == FS
+    savemat(str(path), {"time_s": t[:, None], "Fx_N": run.signals["Fx"][:, None], "sample_rate_hz": FS * 1.001})
+    with pytest.raises(DataError, match=r"s\.mat: variable time_s: sample rate from the time stamps .*disagrees with "
+                                        r"variable sample_rate_hz"):
+        read_data(path)

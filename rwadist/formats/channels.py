@@ -174,10 +174,13 @@ def record_rate(record: RawRecord, declared_rate, declared_by="meta.json sample_
     """(sample rate Hz, t0 s) of a record, checked against a declared rate."""
     if record.time is not None:
         kw = {} if record.time_position is None else {"position": record.time_position}
+        if record.sample_rate is not None:  # the file stores both: its rate is checked like a declared one
+            if declared_rate is None:
+                declared_rate, declared_by = record.sample_rate, record.rate_field
+            else:
+                declared_rate = check_rate(record.path, record.rate_field, record.sample_rate, record.rate_rtol,
+                                           declared_rate, declared_by)
         step = sample_step(record.path, record.time_field, record.time, declared_rate, declared_by, **kw)
-        if record.sample_rate is not None:
-            check_rate(record.path, record.rate_field, record.sample_rate, record.rate_rtol, 1.0 / step,
-                       declared_by=f"the time stamps' {record.time_field}")
         return 1.0 / step, float(record.time[0])
     if record.sample_rate is None:
         raise DataError(record.path, record.time_field, "neither time stamps nor a sample rate stored")
