@@ -246,9 +246,12 @@ def cmd_demo(args) -> int:
     print(f"1/4 virtual test stand: {wheel.name}, {len(speeds)} speeds 300-2400 rpm, 3840 Hz, 8192 samples, "
           "noise 1 %, wheel modes on")
     test = simulate_steady(wheel, speeds, sample_rate=3840.0, n_samples=8192, noise=0.01, modes=True, seed=args.seed)
-    data_dir = data_io.write_steady(test, out / "data")
-    print(f"2/4 wrote interchange format: {data_dir}")
-    test = data_io.read_steady(data_dir)
+    from .hdf5 import read_hdf5, write_hdf5
+
+    data_path = write_hdf5(test, out / "data.h5", compression="gzip", precision="float32")
+    print(f"2/4 wrote the test as HDF5: {data_path} ({data_path.stat().st_size / 1e6:.1f} MB; float32 samples, "
+          "gzip; `rwadist convert` writes any other format)")
+    test = read_hdf5(data_path)
     print("3/4 fitting the empirical model")
     ns = argparse.Namespace(f_lim=None, nperseg=None, presence=0.25, epsilon=0.02, no_mode_exclusion=False)
     fit = run_fit(test, ns, name="demo: " + wheel.name)
@@ -268,6 +271,42 @@ def cmd_demo(args) -> int:
                 err, tru_h, tru_c = "  extra", "      -", "          -"
             ex = " ".join(f"{lo:.0f}-{hi:.0f}" for lo, hi in hm.excluded_rpm)
             print(f"{d:<14} {hm.h:7.3f} {tru_h} {hm.C:11.3e} {tru_c} {err}  {ex}")
+    return 0
+
+
+# --------------------------------------------------------------------------- convert
+
+def cmd_convert(args) -> int:
+    """Read test data in any supported format and write it in another (see docs/formats.md)."""
+    from .formats.registry import EXTENSION, READ_EXTENSIONS
+    from .hdf5 import write_hdf5
+
+    src, dst = Path(args.src), Path(args.output)
+    obj = data_io.read_data(src, progress=True)
+    if dst.suffix.lower() in (".h5", ".hdf5"):
+        write_hdf5(obj, dst, compression="gzip", precision=args.precision)
+        print(f"wrote {dst} (HDF5, {args.precision}, gzip; {dst.stat().st_size / 1e6:.2f} MB)")
+        return 0
+    if args.precision != "float64":
+        raise DataError("--precision", "value", f"{args.precision!r} applies to HDF5 output only")
+    if isinstance(obj, data_io.SteadyTest):
+        fmt = args.format or "csv"
+        if dst.suffix.lower() in READ_EXTENSIONS:
+            raise DataError(dst, "-o", f"a steady test is a directory (runs.csv + one {fmt} file per run) or an "
+                            ".h5 file, not a {dst.suffix} file")
+        data_io.write_steady(obj, dst, fmt)
+        print(f"wrote {len(obj.runs)} runs to {dst} ({fmt}, runs.csv, meta.json)")
+        return 0
+    fmt = args.format
+    if fmt is None:
+        if dst.suffix.lower() not in READ_EXTENSIONS:
+            raise DataError(dst, "-o", f"extension {dst.suffix!r} does not name a format; use one of "
+                            f"{sorted(READ_EXTENSIONS)} or .h5, or give --format")
+        fmt = READ_EXTENSIONS[dst.suffix.lower()]
+    if dst.suffix.lower() != EXTENSION[fmt]:
+        raise DataError(dst, "-o", f"a {fmt} sweep file must end in {EXTENSION[fmt]}")
+    data_io.write_sweep(obj, dst, fmt, with_meta=True)
+    print(f"wrote sweep {dst} ({fmt}, {len(obj.time)} samples)")
     return 0
 
 
@@ -529,6 +568,16 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--n-speeds", type=int, default=120)
     d.add_argument("--seed", type=int, default=0)
     d.set_defaults(func=cmd_demo)
+
+    cv = sub.add_parser("convert", help="convert test data between formats: CSV interchange, HDF5, UFF 58, TDMS, "
+                        "MATLAB (docs/formats.md)")
+    cv.add_argument("src", help="a steady-test directory (runs.csv), a sweep file or an .h5 file")
+    cv.add_argument("-o", "--output", required=True, help="an .h5 file, a directory (steady test) or a sweep file")
+    cv.add_argument("--format", choices=["csv", "uff", "uff-binary", "tdms", "mat", "mat73"], default=None,
+                    help="run/sweep file format (default: csv for a directory, else from the extension)")
+    cv.add_argument("--precision", choices=["float64", "float32"], default="float64",
+                    help="HDF5 sample precision (default float64, lossless)")
+    cv.set_defaults(func=cmd_convert)
 
     c = sub.add_parser("campbell", help="Campbell table and plot of the extended model; prints crossing speeds")
     src = c.add_mutually_exclusive_group(required=True)

@@ -1,0 +1,160 @@
+"""The sampling step of a time column as instruments write it.
+
+A data-acquisition system prints its time stamps with a fixed number of
+decimals (``%.6f``: microseconds) or of significant digits (``%.10g``), so
+consecutive steps jitter by the rounding of the last printed digit.  The step
+is therefore estimated from the whole column (a least-squares line through
+sample index and time), and a column is refused only for what rounding cannot
+explain: a repeated sample, a dropped sample, a gap, or a rate that disagrees
+with the declared one by more than the rounding allows.  Every reader (CSV,
+HDF5, UFF, TDMS, MATLAB) uses :func:`sample_step`.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .records import DataError
+
+#: Float64 relative precision margin (a few ulp) added to every rounding bound.
+FLOAT_MARGIN = 8.0 * np.finfo(float).eps
+#: Largest deviation of one step accepted as rounding, as a fraction of the step
+#: (a dropped or repeated sample is a whole step off).
+MAX_RESOLUTION_FRACTION = 0.25
+
+
+def printed_resolution(time: np.ndarray, stored_rtol: float = 0.0) -> np.ndarray:
+    """Rounding step of each printed time value, s, shape (n,).
+
+    The column is taken to be printed either with a fixed number of decimals
+    or with a fixed number of significant digits; both are inferred from the
+    values themselves (the most decimals and the most significant digits any
+    value needs), and each sample gets the coarser of the two resolutions.
+    Values stored at full float64 precision get a resolution of a few ulp.
+
+    Parameters
+    ----------
+    time : array, shape (n,), s.
+    stored_rtol : relative precision of the storage (float32 time stamps: its epsilon), 0 for float64/text.
+
+    Returns
+    -------
+    array, shape (n,), s: bound on twice the rounding error of each value.
+    """
+    t = np.asarray(time, dtype=float)
+    mag = np.abs(t)
+    decimals = np.full(t.shape, 17, dtype=int)
+    pending = mag > 0
+    for k in range(0, 17):
+        if not pending.any():
+            break
+        scaled = t[pending] * 10.0**k
+        exact = np.abs(scaled - np.rint(scaled)) <= FLOAT_MARGIN * np.abs(scaled)
+        idx = np.flatnonzero(pending)[exact]
+        decimals[idx] = k
+        pending[idx] = False
+    nonzero = mag > 0
+    if not nonzero.any():
+        return np.full(t.shape, np.inf)
+    exponent = np.zeros(t.shape, dtype=int)
+    exponent[nonzero] = np.floor(np.log10(mag[nonzero])).astype(int)
+    fixed_decimals = int(decimals[nonzero].max())
+    significant = int((decimals + exponent + 1)[nonzero].max())
+    fixed = 10.0 ** (-fixed_decimals)
+    relative = 10.0 ** (exponent + 1 - significant).astype(float)
+    return np.maximum(np.maximum(fixed, relative), (FLOAT_MARGIN + stored_rtol) * mag)
+
+
+def _least_squares_step(time: np.ndarray) -> tuple:
+    """(step, intercept) of the line time ≈ intercept + step·i, i = 0..n-1."""
+    n = len(time)
+    i = np.arange(n, dtype=float)
+    i_mean = 0.5 * (n - 1)
+    t_mean = float(np.mean(time))
+    di = i - i_mean
+    step = float(np.dot(di, time - t_mean) / np.dot(di, di))
+    return step, t_mean - step * i_mean
+
+
+def _kind_of_step(ratio: float) -> str:
+    if ratio < 0.5:
+        return "a repeated sample (time stamp written twice)" if ratio > -0.5 else "time going backwards"
+    n_missing = round(ratio) - 1
+    if n_missing >= 1 and abs(ratio - round(ratio)) < 0.05:
+        return f"{n_missing} dropped sample(s)"
+    return "a gap in the sampling"
+
+
+def sample_step(path, field_name: str, time, declared_rate: float | None = None,
+                declared_by: str = "meta.json sample_rate_hz",
+                position=lambda i: f"line {i + 3}", stored_rtol: float = 0.0) -> float:
+    """The sampling step of a time column, s; DataError unless it is uniform up to its printed rounding.
+
+    Parameters
+    ----------
+    path : file named in errors.
+    field_name : column or dataset named in errors.
+    time : array, shape (n,), s, as read from the file.
+    declared_rate : Hz, a sample rate stated elsewhere (meta.json, an attribute), or None.
+    declared_by : how errors name where ``declared_rate`` comes from.
+    position : ``position(i)`` names where the step from sample i to i+1 ends in the file
+        (a CSV line by default: header on line 1, sample 0 on line 2).
+    stored_rtol : relative precision of the storage beyond printing (float32: its epsilon).
+
+    Returns
+    -------
+    float, s: ``1/declared_rate`` when given and consistent, else the least-squares step.
+    """
+    t = np.asarray(time, dtype=float)
+    n = len(t)
+    if n < 2:
+        raise DataError(path, field_name, f"only {n} sample(s); need at least 2")
+    step, _ = _least_squares_step(t)
+    if not step > 0:
+        raise DataError(path, field_name, f"time does not increase (least-squares step {step:.9g} s)")
+    q = printed_resolution(t, stored_rtol)
+    q_max = float(q.max())
+    # a step differs from the true step by at most the rounding of its two ends (q/2 each), and the
+    # estimated step from the truth by at most 1.5·q_max/n (worst case of the least-squares slope)
+    step_error = 1.5 * q_max / n + FLOAT_MARGIN * step
+    dt = np.diff(t)
+    # values that merely look round (exact multiples of 1 ms) must not widen the tolerance to where a
+    # dropped or repeated sample (one whole step off) would pass: cap it at a fraction of the step
+    tolerance = np.minimum(0.5 * (q[:-1] + q[1:]) + step_error * 1.01 + FLOAT_MARGIN * np.abs(t[1:]),
+                           MAX_RESOLUTION_FRACTION * step)
+    excess = np.abs(dt - step) - tolerance
+    if excess.max() > 0:
+        i = int(np.argmax(excess))
+        ratio = dt[i] / step
+        hint = ""
+        if q_max > MAX_RESOLUTION_FRACTION * step:
+            hint = (f"; the time stamps are printed to {q_max:.3g} s, too coarse for this step: write more digits "
+                    "(%.10g or 17 significant digits)")
+        raise DataError(path, field_name, f"sampling is not uniform: step {dt[i]:.9g} s at {position(i)} is "
+                        f"{ratio:.4g} sampling steps ({_kind_of_step(ratio)}); sampling step {step:.9g} s "
+                        f"from a least-squares line through all {n} time stamps, printed rounding "
+                        f"explains ±{tolerance[i]:.2g} s{hint}")
+    if declared_rate is not None:
+        declared_step = 1.0 / float(declared_rate)
+        if abs(declared_step - step) > step_error * 1.01 + FLOAT_MARGIN * step:
+            raise DataError(path, field_name, f"sample rate from the time stamps {1.0 / step:.9g} Hz "
+                            f"(±{step_error / step * 1.0 / step:.2g} Hz from their printed rounding) disagrees "
+                            f"with {declared_by} {declared_rate!r}")
+        return declared_step
+    return step
+
+
+def check_rate(path, field_name: str, rate: float, rate_rtol: float, declared_rate: float | None,
+               declared_by: str = "meta.json sample_rate_hz") -> float:
+    """A sample rate stored by the file (Hz, relative precision ``rate_rtol``) against a declared one.
+
+    Returns the declared rate when given and consistent within the file's precision, else ``rate``.
+    """
+    if not (np.isfinite(rate) and rate > 0):
+        raise DataError(path, field_name, f"sample rate {rate!r} Hz is not a positive number")
+    if declared_rate is None:
+        return float(rate)
+    tol = (rate_rtol + FLOAT_MARGIN) * rate
+    if abs(rate - declared_rate) > tol:
+        raise DataError(path, field_name, f"sample rate {rate:.9g} Hz (stored to ±{tol:.2g} Hz) disagrees with "
+                        f"{declared_by} {declared_rate!r}")
+    return float(declared_rate)
