@@ -254,3 +254,16 @@ def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bo
                     z.writestr(info, f.read_bytes(), compress_type=zipfile.ZIP_DEFLATED)
         os.replace(tmp_out, output)
     return output
+
+
+def compile_c_host(output) -> Path:
+    """Compile ``native/c_host.c`` (an FMI 2.0 host in C, no Python: dlopen, fmi2DoStep over a speed ramp)
+    into the executable ``output``; NativeBuildError on failure."""
+    cc = shutil.which(os.environ.get("CC", "cc"))
+    if cc is None:
+        raise NativeBuildError(f"no C compiler ({os.environ.get('CC', 'cc')!r} not on PATH)")
+    cmd = [cc, "-O2", f"-I{NATIVE}", "-o", str(output), str(NATIVE / "c_host.c"), "-ldl"]
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    if res.returncode != 0:
+        raise NativeBuildError(f"{' '.join(cmd)} failed:\n{res.stderr.strip()}")
+    return Path(output)

@@ -90,8 +90,18 @@ static void logf_(Wheel *w, fmi2Status status, const char *category, const char 
     va_end(ap);
     if (status == fmi2OK && !(w && w->logging_on))
         return;
+    /* the message is the format itself ('%' doubled): hosts whose logger cannot read varargs (ctypes
+     * callbacks, e.g. fmpy) still see it */
+    char msg[2048];
+    size_t j = 0;
+    for (size_t i = 0; buf[i] && j + 2 < sizeof msg; i++) {
+        if (buf[i] == '%')
+            msg[j++] = '%';
+        msg[j++] = buf[i];
+    }
+    msg[j] = 0;
     if (w && w->cb.logger)
-        w->cb.logger(w->cb.componentEnvironment, w->name, status, category, "%s", buf);
+        w->cb.logger(w->cb.componentEnvironment, w->name, status, category, msg);
 }
 
 static fmi2Status fail(Wheel *w, const char *fmt, ...)
