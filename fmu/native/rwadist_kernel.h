@@ -27,6 +27,14 @@ enum { C_N, C_MODES, C_M, C_CR, C_KR, C_IRR, C_CROCK, C_KROCK, C_IZZ, C_CZ, C_KZ
        C_LAMZ = 16, C_R = 20, C_POS = 29, C_COMP = 32, C_STRIDE = 13, C_RES = 3 };
 #define SMALL_Z 1e-3
 
+/* (b + i·p)/(b + i·q) in real arithmetic (the complex division of C calls a slow, scaling
+ * library routine; these values are moderate) */
+static inline double complex rw_ratio(double b, double p, double q)
+{
+    const double den = b * b + q * q;
+    return CMPLX((b * b + p * q) / den, (p * b - b * q) / den);
+}
+
 static void quad_roots(double m, double complex c, double k, double complex *l1, double complex *l2)
 {
     double complex disc = csqrt(c * c - 4.0 * m * k);
@@ -81,13 +89,14 @@ static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out,
             for (int k = 0; k < nres; k++, rt += C_RES) {
                 const double r0 = (sh * omega + woff) / rt[0], r1 = (sh * w1 + woff) / rt[0];
                 const double b0 = 1.0 - r0 * r0, b1 = 1.0 - r1 * r1;
-                g0 *= CMPLX(b0, rt[1] * r0) / CMPLX(b0, rt[2] * r0);
-                g1 *= CMPLX(b1, rt[1] * r1) / CMPLX(b1, rt[2] * r1);
+                g0 *= rw_ratio(b0, rt[1] * r0, rt[2] * r0);
+                g1 *= rw_ratio(b1, rt[1] * r1, rt[2] * r1);
             }
             a0 *= g0;
             a1 *= g1;
         }
-        const double complex S1 = cexp(CMPLX(0.0, sh * phi1 + woff * t1));
+        const double arg = sh * phi1 + woff * t1;
+        const double complex S1 = CMPLX(cos(arg), sin(arg));
         loads1[d] += a1 * S1;
         if (modes && d != 3) {
             const double complex *lam = d == 0 ? lam_r : (d == 2 ? lam_z : lk);
@@ -96,12 +105,14 @@ static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out,
                 const double complex z = CMPLX(0.0, sh * dphi + woff * h) - lam[j] * h;
                 const double complex XS0 = X[j] * S[i];
                 double complex t0, t1;
-                if (cabs(z) < SMALL_Z) {
+                const double zz = creal(z) * creal(z) + cimag(z) * cimag(z);
+                if (zz < SMALL_Z * SMALL_Z) {
                     t0 = XS0 * (1 + z * (1.0 / 2 + z * (1.0 / 6 + z * (1.0 / 24 + z / 120))));
                     t1 = XS0 * (1.0 / 2 + z * (1.0 / 3 + z * (1.0 / 8 + z * (1.0 / 30 + z / 144))));
                 } else {
-                    t0 = (S1 - XS0) / z;
-                    t1 = (S1 - t0) / z;
+                    const double complex iz = CMPLX(creal(z) / zz, -cimag(z) / zz);   /* 1/z */
+                    t0 = (S1 - XS0) * iz;
+                    t1 = (S1 - t0) * iz;
                 }
                 W[d][j] += a0 * t0 + (a1 - a0) * t1;
             }

@@ -483,14 +483,32 @@ static void floor_now(Wheel *w, double om, double t, double advance, double out[
                 w->floor_rot[i] = CMPLX(cos(w->floor_w[i] * advance), sin(w->floor_w[i] * advance));
             w->floor_rot_h = advance;
         }
-        for (int i = 0; i < w->n_floor; i++)
-            w->floor_Z[i] *= w->floor_rot[i];
+        /* Z *= rot, written out (the products of C's complex multiply, without its NaN branch) */
+        double *z = (double *)w->floor_Z;
+        const double *r = (const double *)w->floor_rot;
+        for (int i = 0; i < 2 * w->n_floor; i += 2) {
+            const double zr = z[i] * r[i] - z[i + 1] * r[i + 1], zi = z[i] * r[i + 1] + z[i + 1] * r[i];
+            z[i] = zr;
+            z[i + 1] = zi;
+        }
         w->mu.floor_count++;
     }
+    const double *z = (const double *)w->floor_Z;
     for (int s = 0; s < w->n_seg; s++) {
-        double sum = 0.0;
-        for (int i = w->seg_start[s]; i < w->seg_start[s + 1]; i++)
-            sum += creal(w->floor_Z[i]);
+        /* four partial sums: independent additions the CPU overlaps (the order differs from numpy's
+         * pairwise sum only in rounding) */
+        double acc[4] = {0.0, 0.0, 0.0, 0.0};
+        int i = w->seg_start[s];
+        const int end = w->seg_start[s + 1];
+        for (; i + 3 < end; i += 4) {
+            acc[0] += z[2 * i];
+            acc[1] += z[2 * i + 2];
+            acc[2] += z[2 * i + 4];
+            acc[3] += z[2 * i + 6];
+        }
+        for (; i < end; i++)
+            acc[0] += z[2 * i];
+        const double sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
         out[w->seg_chan[s]] += pow(fabs(om) / w->seg_ref[s], w->seg_half_p[s]) * sum;
     }
 }
