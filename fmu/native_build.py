@@ -9,7 +9,7 @@ kernel ``native/rwadist_kernel.h`` (shared with the pythonfmu FMU's native layer
 ``native/rwadist_rng.h`` (numpy's ``default_rng`` in C: the same seed gives the same line, ripple
 and floor phases as the Python FMU) into ``binaries/linux64/<id>.so``.  The FMU ships those
 sources and the FMI 2.0 headers in ``sources/`` (listed in ``<SourceFiles>``), so a host on
-another platform can compile it (e.g. ``fmpy.util.compile_platform_binary``; needs a C99 compiler
+another platform can compile it (e.g. ``fmpy.build.build_platform_binary`` on the unzipped FMU; needs a C99 compiler
 with ``complex.h``: gcc, clang).
 
 Its variables, value references, parameters, units and start values are those of the pythonfmu
@@ -244,7 +244,7 @@ def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bo
         (root / "documentation" / "index.txt").write_text(
             f"rwadist wheel FMU (native C, FMI 2.0 co-simulation).\nPhysics: {physics}\n"
             "Build on another platform: compile sources/rwadist_wheel_fmu.c (C11 with complex.h) into a shared\n"
-            f"library named {model_identifier} (e.g. fmpy.util.compile_platform_binary).\n")
+            f"library named {model_identifier} (e.g. fmpy.build.build_platform_binary on the unzipped FMU).\n")
         tmp_out = output.with_suffix(".fmu.tmp")
         with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
             for f in sorted(root.rglob("*")):

@@ -177,3 +177,32 @@ def test_simulate_test_extended_on_assumed_modes_needs_the_flag(tmp_path, capsys
     assert "--assumed-modes" in capsys.readouterr().err
     assert main(base + ["--assumed-modes"]) == 0
     assert "ASSUMED" in json.loads((tmp_path / "st" / "meta.json").read_text())["modes_assumed"]
+
+
+@pytest.mark.skipif(not __import__("fmu.build", fromlist=["x"]).native_supported(), reason="native FMU: Linux x86-64")
+def test_native_fmu_empirical_and_hr16_default(tmp_path, capsys):
+    """The native FMU (rwadist fmu build --native) of an empirical fit gives the C·Ω² lines (1e-9); of HR16-75
+    it is hard-mounted by default (U_s·Ω², U_d·Ω² to 1e-6 at 3000 and 6000 rpm) and with --assumed-modes it
+    starts with modes on and warns at instantiation."""
+    from rwadist.cli import main
+    doc = empirical_only()
+    (tmp_path / "emp.json").write_text(json.dumps(doc))
+    assert main(["fmu", "build", "--native", str(tmp_path / "emp.json"), "-o", str(tmp_path / "emp.fmu")]) == 0
+    assert "native FMU" in capsys.readouterr().out
+    t = np.arange(501) * 1e-3
+    w = 3000 * RPM
+    out = hosts.run_fmpy(tmp_path / "emp.fmu", t, {"wheel_speed": np.full(t.size, w)}, {})
+    ref = closed_form_lines(doc, w, t)
+    assert np.max(np.abs(out[:, :6] - ref)) <= 1e-9 * np.max(np.abs(ref))
+    an = json.loads(catalogue.path(HR16).read_text())["analytical"]
+    assert main(["fmu", "build", "--native", "--preset", HR16, "-o", str(tmp_path / "hr.fmu")]) == 0
+    assert main(["fmu", "build", "--native", "--assumed-modes", "--preset", HR16, "-o", str(tmp_path / "hra.fmu")]) == 0
+    for rpm in (3000.0, 6000.0):
+        w = rpm * RPM
+        f, tq = fundamental_amplitudes(hosts.run_fmpy(tmp_path / "hr.fmu", t, {"wheel_speed": np.full(t.size, w)}, {}))
+        assert np.max(np.abs(f / (an["U_s_kg_m"] * w**2) - 1)) < 1e-6
+        assert np.max(np.abs(tq / (an["U_d_kg_m2"] * w**2) - 1)) < 1e-6
+    log = hosts.HostLog()
+    inst = hosts.FmpyInstance(tmp_path / "hra.fmu", "a", {}, {"wheel_speed": 100.0}, log=log)
+    inst.close()
+    assert any("ASSUMED" in m for m in log.messages(1)), log.records
