@@ -59,7 +59,7 @@ static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out,
     const int modes = cfg[C_MODES] != 0.0;
     double complex loads1[4] = {0, 0, 0, 0};
     double complex W[4][2] = {{0, 0}, {0, 0}, {0, 0}, {0, 0}};
-    double complex lk[2] = {0, 0}, Xp[3][2];
+    double complex lk[2] = {0, 0}, Xp[3][2], lamh[3][2];   /* per subsystem: e^{λh}, λh */
     if (modes) {
         const double w_mid = 0.5 * (omega + w1);
         quad_roots(cfg[C_IRR], CMPLX(cfg[C_CROCK], -cfg[C_IZZ] * w_mid), cfg[C_KROCK], &lk[0], &lk[1]);
@@ -67,6 +67,9 @@ static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out,
             Xp[0][j] = cexp(lam_r[j] * h);
             Xp[1][j] = cexp(lk[j] * h);
             Xp[2][j] = cexp(lam_z[j] * h);
+            lamh[0][j] = lam_r[j] * h;
+            lamh[1][j] = lk[j] * h;
+            lamh[2][j] = lam_z[j] * h;
         }
     }
     for (int i = 0; i < n; i++) {
@@ -99,10 +102,11 @@ static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out,
         const double complex S1 = CMPLX(cos(arg), sin(arg));
         loads1[d] += a1 * S1;
         if (modes && d != 3) {
-            const double complex *lam = d == 0 ? lam_r : (d == 2 ? lam_z : lk);
-            const double complex *X = Xp[d == 0 ? 0 : (d == 2 ? 2 : 1)];
+            const int sub = d == 0 ? 0 : (d == 2 ? 2 : 1);
+            const double complex *X = Xp[sub];
+            const double wz = sh * dphi + woff * h;
             for (int j = 0; j < 2; j++) {
-                const double complex z = CMPLX(0.0, sh * dphi + woff * h) - lam[j] * h;
+                const double complex z = CMPLX(-creal(lamh[sub][j]), wz - cimag(lamh[sub][j]));
                 const double complex XS0 = X[j] * S[i];
                 double complex t0, t1;
                 const double zz = creal(z) * creal(z) + cimag(z) * cimag(z);
@@ -110,7 +114,8 @@ static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out,
                     t0 = XS0 * (1 + z * (1.0 / 2 + z * (1.0 / 6 + z * (1.0 / 24 + z / 120))));
                     t1 = XS0 * (1.0 / 2 + z * (1.0 / 3 + z * (1.0 / 8 + z * (1.0 / 30 + z / 144))));
                 } else {
-                    const double complex iz = CMPLX(creal(z) / zz, -cimag(z) / zz);   /* 1/z */
+                    const double inv = 1.0 / zz;
+                    const double complex iz = CMPLX(creal(z) * inv, -cimag(z) * inv);   /* 1/z */
                     t0 = (S1 - XS0) * iz;
                     t1 = (S1 - t0) * iz;
                 }
