@@ -184,6 +184,12 @@ def wheel_spec_from_model(model, mount=None, **kw) -> WheelSpec:
     A bad entry raises CouplingError naming ``effects[i].<field>``."""
     effects = getattr(model, "effects", None)
     p = ext.params_from_model(model)
+    an = getattr(model, "analytical", None)
+    if isinstance(an, dict) and an.get("modes_assumed") is True:
+        import warnings
+        warnings.warn(f"{getattr(model, 'name', 'wheel')}: the suspension modes are ASSUMED (datasheet wheel, "
+                      "analytical.modes_assumed), not measured; the coupled results rest on assumed values",
+                      RuntimeWarning, stacklevel=2)
     try:
         lines = tuple(ext.lines_from_model(model, p))
         ripple = ext.ripple_from_effects(effects)

@@ -206,3 +206,14 @@ def test_native_fmu_empirical_and_hr16_default(tmp_path, capsys):
     inst = hosts.FmpyInstance(tmp_path / "hra.fmu", "a", {}, {"wheel_speed": 100.0}, log=log)
     inst.close()
     assert any("ASSUMED" in m for m in log.messages(1)), log.records
+
+
+def test_coupling_warns_on_assumed_modes():
+    """The coupling kit keeps a model's analytical section as it is, and says when its modes are assumed."""
+    from coupling.performance import wheel_spec_from_model
+    with pytest.warns(RuntimeWarning, match="ASSUMED"):
+        wheel_spec_from_model(catalogue.load(HR16))
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        wheel_spec_from_model(catalogue.load("ithaco-e"))
