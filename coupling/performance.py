@@ -160,8 +160,17 @@ def wheel_spec_from_model(model, mount=None, **kw) -> WheelSpec:
     A bad entry raises :class:`CouplingModelError` (a CouplingError) naming ``effects[i].<field>``."""
     effects = schema.parse_effects(getattr(model, "effects", None), "<model>", CouplingModelError)
     p = ext.params_from_model(model)
-    lines = tuple(ext.lines_from_model(model, p))
-    ripple = ext.ripple_from_effects(effects)
+    an = getattr(model, "analytical", None)
+    if an is not None and an.get("modes_assumed") is True:
+        import warnings
+        warnings.warn(f"{getattr(model, 'name', 'wheel')}: the suspension modes are ASSUMED (datasheet wheel, "
+                      "analytical.modes_assumed), not measured; the coupled results rest on assumed values",
+                      RuntimeWarning, stacklevel=2)
+    try:
+        lines = tuple(ext.lines_from_model(model, p))
+        ripple = ext.ripple_from_effects(effects)
+    except ValueError as exc:
+        raise CouplingError(str(exc)) from exc
     kw.setdefault("floors", floors_from_effects(effects))
     kw.setdefault("ripple", ripple)
     return WheelSpec(p, lines, mount or geometry.Mount(), **kw)

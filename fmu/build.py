@@ -119,7 +119,7 @@ def model_document(model) -> dict:
     params, lines = rt.model_from_doc(doc, source)
     effects = rt.effects_from_doc(doc, source)
     laws = effects["laws"]
-    probe = rt.WheelRuntime(params, lines, **effects)
+    probe = rt.WheelRuntime(params, lines, modes=params["suspension"], **effects)
     for d, h in sorted(set(laws) - probe.laws_used):
         warnings.warn(f"{source}: amplitude_law of {d} h={h:g} matches no line of the model; the FMU ignores it",
                       RuntimeWarning, stacklevel=3)
@@ -130,13 +130,37 @@ def model_document(model) -> dict:
     return doc
 
 
-def build_fmu(model, output, *, tag: str | None = None, native: bool | None = None) -> Path:
+def _render(src: str, cls: str, physics: str, modes_default: bool) -> str:
+    """The slave template for one build: class renamed, physics and ``modes`` start value set."""
+    for name, value in (("BUILD_PHYSICS", physics), ("BUILD_MODES_DEFAULT", modes_default)):
+        lines = [ln for ln in src.splitlines() if ln.startswith(f"{name} = ")]
+        if len(lines) != 1:
+            raise RuntimeError(f"slave template lost its {name} line")
+        src = src.replace(lines[0], f"{name} = {value!r}")
+    return src.replace(TEMPLATE_CLASS, cls)
+
+
+def model_physics(doc, assumed_modes: bool = False) -> tuple:
+    """(physics sentence, ``modes`` default) of a validated model document: modes default on only for a
+    model with measured suspension modes, or assumed ones when ``assumed_modes`` (``--assumed-modes``)."""
+    rt = _runtime()
+    params, lines = rt.model_from_doc(doc)
+    effects = rt.effects_from_doc(doc)
+    modes_default = bool(params["suspension"]) and (not params["modes_assumed"] or bool(assumed_modes))
+    return rt.physics_of(params, lines, effects), modes_default
+
+
+def build_fmu(model, output, *, tag: str | None = None, native: bool | None = None,
+              assumed_modes: bool = False) -> Path:
     """Write the FMU of ``model`` (path, dict or WheelModel) to ``output`` (.fmu path); returns it.
 
     ``tag`` (default: random) makes the slave module ``rwadist_wheel_<tag>`` and the class /
     model identifier ``RwadistWheel_<tag>`` unique to this build.  ``native``: add the native
     layer (module docstring); None (default) adds it where it can be compiled and warns where it
-    cannot, True raises NativeBuildError where it cannot, False builds pythonfmu's plain FMU."""
+    cannot, True raises NativeBuildError where it cannot, False builds pythonfmu's plain FMU.
+    ``assumed_modes``: a wheel whose suspension modes are assumed (``analytical.modes_assumed``) gets
+    ``modes`` = true by default (else false: hard-mounted); the FMU warns at instantiation when it runs
+    assumed modes.  A model without ``analytical`` is hard-mounted (``modes`` false)."""
     from pythonfmu import FmuBuilder
 
     doc = model_document(model)
@@ -153,10 +177,11 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
     src = TEMPLATE.read_text()
     if src.count(f"class {TEMPLATE_CLASS}(") != 1:
         raise RuntimeError("slave template lost its class")
+    physics, modes_default = model_physics(doc, assumed_modes)
     with tempfile.TemporaryDirectory(prefix="rwadist_fmu_") as tmp:
         tmp = Path(tmp)
         script = tmp / f"{module}.py"
-        script.write_text(src.replace(TEMPLATE_CLASS, cls))
+        script.write_text(_render(src, cls, physics, modes_default))
         extra = tmp / "extra"
         extra.mkdir()
         shutil.copy2(RUNTIME, extra / "rwadist_fmu_runtime.py")

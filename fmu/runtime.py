@@ -173,8 +173,11 @@ def model_from_doc(doc, source="<model>"):
         raise ModelError(f"{source}: schema_version: file has version {doc.get('schema_version')!r}; "
                          f"this FMU reads version {SCHEMA_VERSION} only")
     an = doc.get("analytical")
+    if an is None:
+        return _empirical_only(doc, source)
     if not isinstance(an, dict):
-        raise ModelError(f"{source}: analytical: missing; the FMU needs the extended-model parameters")
+        raise ModelError(f"{source}: analytical: must be an object (the extended-model parameters), "
+                         f"got {type(an).__name__}")
     if an.get("kind", ANALYTICAL_KIND) != ANALYTICAL_KIND:
         raise ModelError(f"{source}: analytical.kind: {an.get('kind')!r} is not {ANALYTICAL_KIND!r}")
     p = {}
@@ -194,13 +197,32 @@ def model_from_doc(doc, source="<model>"):
                           (p["mass"], p["c_z"], p["k_z"], "axial")):
         if c / (2.0 * math.sqrt(k * m)) >= 1.0:
             raise ModelError(f"{source}: analytical: the {what} mode is overdamped")
+    p["suspension"] = True
+    p["modes_assumed"] = _modes_assumed(an, source)
     lines = [("radial_force", 1.0, p["U_s"], "co", True), ("radial_torque", 1.0, p["U_d"], "co", True)]
+    for d, h, C, sense, fundamental in _harmonics(doc, source):
+        if not fundamental:        # the imbalances U_s, U_d above replace the co-rotating radial fundamentals
+            lines.append((d, h, C, sense, False))
+    return p, lines
+
+
+def _modes_assumed(an, source):
+    """``analytical.modes_assumed`` (default false): the suspension modes are assumed, not measured."""
+    v = an.get("modes_assumed", False)
+    if not isinstance(v, bool):
+        raise ModelError(f"{source}: analytical.modes_assumed: must be true or false, got {v!r}")
+    return v
+
+
+def _harmonics(doc, source):
+    """[(direction, h, C, sense, co-rotating radial fundamental?)] of the ``empirical`` section, validated."""
     emp = doc.get("empirical") or {}
     if not isinstance(emp, dict):
         raise ModelError(f"{source}: empirical: must be an object keyed by direction")
     for d in emp:
         if d not in DIRECTIONS:
             raise ModelError(f"{source}: empirical.{d}: unknown direction")
+    out = []
     for d in DIRECTIONS:
         for i, item in enumerate(emp.get(d) or []):
             where = f"{source}: empirical.{d}[{i}]"
@@ -214,10 +236,43 @@ def model_from_doc(doc, source="<model>"):
                 raise ModelError(f"{where}.sense: {sense!r}; expected co, counter or planar")
             # the co-rotating radial fundamental is the imbalance (same rule as
             # rwadist.extended.is_imbalance; the runtime is self-contained, a test pins the tolerance)
-            if d in ("radial_force", "radial_torque") and abs(h - 1.0) <= IMBALANCE_H_TOL and sense in (None, "co"):
-                continue
-            lines.append((d, h, C, sense or "co", False))
+            fundamental = d in ("radial_force", "radial_torque") and abs(h - 1.0) <= IMBALANCE_H_TOL \
+                and sense in (None, "co")
+            out.append((d, h, C, sense or "co", fundamental))
+    return out
+
+
+def _empirical_only(doc, source):
+    """(params, lines) of a model without an ``analytical`` section: every empirical harmonic is a
+    line of amplitude C·Ω² at its own h and sense, hard-mounted (the loads measured at the
+    interface reach it directly: no suspension, torques already about the interface, height 0).
+    The co-rotating radial fundamentals are the imbalance: they keep their tangential term −i·C·Ω̇
+    (zero at constant speed) and follow the ``imbalance`` switch.  params carry
+    ``suspension`` False and no modal values (0): :class:`WheelRuntime` refuses modes on."""
+    lines = [(d, h, C, sense, fundamental) for d, h, C, sense, fundamental in _harmonics(doc, source)]
+    if not lines:
+        raise ModelError(f"{source}: empirical: no harmonics and no analytical section; the model has no lines")
+    p = {name: 0.0 for name in PARAM_KEYS}
+    p["suspension"] = False
+    p["modes_assumed"] = False
     return p, lines
+
+
+def physics_of(params, lines, effects=None) -> str:
+    """One sentence saying which physics a model carries (for the FMU's description and logs)."""
+    if not params.get("suspension", True):
+        what = f"empirical harmonics only ({len(lines)} lines, amplitude C*Omega^2), hard-mounted"
+    elif params.get("modes_assumed"):
+        what = ("extended model with ASSUMED suspension modes (datasheet wheel; hard-mounted unless "
+                "modes = true)")
+    else:
+        what = "extended model: harmonics through the measured suspension modes"
+    kinds = [k for k, v in (effects or {}).items() if v]
+    names = {"laws": "amplitude laws", "resonances": "wheel-mode resonances", "sidebands": "sidebands",
+             "floors": "broadband floors", "ripples": "speed ripple"}
+    if kinds:
+        what += "; diagnosed effects: " + ", ".join(names.get(k, k) for k in kinds)
+    return what
 
 
 def components(direction, sense, phase, angle=0.0):
@@ -312,6 +367,31 @@ def frame12(o, R, r):
 
 # ------------------------------------------------------------------ the stepping model
 
+def expand_lines(lines, laws=None, sidebands=None):
+    """(full, laws_used, sidebands_used): every line of the model as (direction, h, C, sense, imbalance,
+    law (A_ref, Ω_ref, p) or None, f_offset Hz) -- the model's lines with their amplitude laws
+    (|Δh| < LAW_H_TOL), then per sideband effect, per matching carrier, the +f_mod and −f_mod copies
+    (C and A_ref times depth/2); the order of ``rwadist.extended.apply_line_effects`` (the seed's
+    phases are drawn over this list).  Used by :class:`WheelRuntime` and the native FMU builder."""
+    laws = dict(laws or {})
+    laws_used, sidebands_used = set(), set()
+    full = []
+    for d, h, c, sense, is_imb in lines:
+        key = next((k for k in laws if k[0] == d and abs(k[1] - h) < LAW_H_TOL), None)
+        if key is not None:
+            laws_used.add(key)
+        full.append((d, h, c, sense, is_imb, None if key is None else tuple(laws[key]), 0.0))
+    carriers = list(full)
+    for j, (sd, shh, f_mod, m) in enumerate(sidebands or []):
+        for d, h, c, sense, is_imb, lw, _ in carriers:
+            if d == sd and abs(h - shh) < LAW_H_TOL:
+                sidebands_used.add(j)
+                lw2 = None if lw is None else (lw[0] * 0.5 * m, lw[1], lw[2])
+                for off in (f_mod, -f_mod):
+                    full.append((d, h, c * 0.5 * m, sense, is_imb, lw2, off))
+    return full, laws_used, sidebands_used
+
+
 class WheelRuntime:
     """The extended wheel model as a stepping state machine.
 
@@ -364,26 +444,12 @@ class WheelRuntime:
             raise ModelError(f"max_step_size must be finite and > 0, got {max_step!r}")
         self.max_accel, self.max_step = float(max_accel), float(max_step)
         self.modes, self.start_steady = bool(modes), bool(start_steady)
-        laws = dict(laws or {})
+        self.suspension = bool(self.p.get("suspension", True))
+        if self.modes and not self.suspension:
+            raise ModelError("modes: on, but the model has no suspension (analytical: missing -- an empirical "
+                             "fit, harmonics only); it runs hard-mounted: set modes = false")
         resonances = list(resonances or [])
-        sidebands = list(sidebands or [])
-        self.laws_used = set()
-        self.sidebands_used = set()
-        # every line: (direction, h, C, sense, imbalance, law (A_ref, Ω_ref, p) or None, f_offset Hz)
-        full = []
-        for d, h, c, sense, is_imb in lines:
-            key = next((k for k in laws if k[0] == d and abs(k[1] - h) < LAW_H_TOL), None)
-            if key is not None:
-                self.laws_used.add(key)
-            full.append((d, h, c, sense, is_imb, None if key is None else tuple(laws[key]), 0.0))
-        carriers = list(full)
-        for j, (sd, shh, f_mod, m) in enumerate(sidebands):
-            for d, h, c, sense, is_imb, lw, _ in carriers:
-                if d == sd and abs(h - shh) < LAW_H_TOL:
-                    self.sidebands_used.add(j)
-                    lw2 = None if lw is None else (lw[0] * 0.5 * m, lw[1], lw[2])
-                    for off in (f_mod, -f_mod):
-                        full.append((d, h, c * 0.5 * m, sense, is_imb, lw2, off))
+        full, self.laws_used, self.sidebands_used = expand_lines(lines, laws, sidebands)
         n = len(full)
         self.n_lines = n
         ph = (np.random.default_rng(int(seed)).uniform(0, 2 * np.pi, n) if seed is not None else np.zeros(n))
@@ -427,8 +493,11 @@ class WheelRuntime:
         self.cC[self.law_idx] = 0.0                              # C·Ω² replaced by the law
         self.rock = np.nonzero(self.dirs == 1)[0]
         p = self.p
-        self.lam_r = quad_roots(p["mass"], p["c_r"], p["k_r"])
-        self.lam_z = quad_roots(p["mass"], p["c_z"], p["k_z"])
+        if self.suspension:
+            self.lam_r = quad_roots(p["mass"], p["c_r"], p["k_r"])
+            self.lam_z = quad_roots(p["mass"], p["c_z"], p["k_z"])
+        else:       # never used (modes are off); distinct poles keep the kernel's layout finite
+            self.lam_r = self.lam_z = (-1.0 + 0j, -2.0 + 0j)
         lam = np.zeros((self.sh.size, 2), dtype=complex)
         for j, ls in ((0, self.lam_r), (2, self.lam_z)):
             lam[self.dirs == j] = ls
@@ -710,7 +779,7 @@ class WheelRuntime:
             omega = omega + r0
         wd0 = alpha if self.prev_alpha is None else 0.5 * (self.prev_alpha + alpha)
         if not self.started:
-            if self.start_steady:
+            if self.start_steady and self.suspension:
                 self._steady_init(omega, wd0)
             self.started = True
             if self._kernel is not None:
@@ -800,7 +869,7 @@ class WheelRuntime:
         if self.has_ripple:
             omega += self.ripple(w_in, self.t)
             alpha += self.ripple_rate(w_in, self.t)
-        if not self.started and self.start_steady:
+        if not self.started and self.start_steady and self.suspension:
             self._steady_init(omega, alpha)
         loads = self._loads(omega, alpha, self.phi)
         self.out = self._outputs(loads)

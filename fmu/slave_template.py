@@ -32,6 +32,11 @@ from pythonfmu.enums import Fmi2Status
 # of the module and gives that count back (an import is one execution more: a harmless +1).
 ctypes.pythonapi.Py_IncRef(ctypes.py_object(globals()))
 
+#: set by fmu/build.py for each build (this line is rewritten): the physics the model file carries
+BUILD_PHYSICS = "extended model: harmonics through the measured suspension modes"
+#: set by fmu/build.py (this line is rewritten): start value of the ``modes`` parameter -- False for a model
+#: without suspension and for assumed (datasheet) modes unless the build opted in (--assumed-modes)
+BUILD_MODES_DEFAULT = True
 RUNTIME_FILE = "rwadist_fmu_runtime.py"
 MODEL_FILE = "wheel_model.json"
 #: unit -> SI base-unit exponents (kg, m, s, rad) for the UnitDefinitions of modelDescription.xml
@@ -87,8 +92,8 @@ def _load_runtime(resources):
 
 class RwadistWheelSlave(Fmi2Slave):
     author = "rwadist"
-    description = ("Reaction-wheel micro-vibration, extended model (harmonics through the rotor's "
-                   "suspension modes), time domain; outputs in wheel and spacecraft frames")
+    description = ("Reaction-wheel micro-vibration, time domain; outputs in wheel and spacecraft frames. "
+                   "Physics: " + BUILD_PHYSICS)
     default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-3)
 
     def __init__(self, **kwargs):
@@ -101,7 +106,7 @@ class RwadistWheelSlave(Fmi2Slave):
         self.seed = -1
         self.imbalance = True
         self.harmonics = True
-        self.modes = True
+        self.modes = BUILD_MODES_DEFAULT
         self.start_steady = False
         self.speed_ripple = True
         self.broadband_floor = True
@@ -330,6 +335,10 @@ class RwadistWheelSlave(Fmi2Slave):
                 if j not in self.model.sidebands_used:
                     self.log(f"rwadist wheel: sidebands of {d} h={h:g} (f_mod {f_mod:g} Hz) match no line of the "
                              "model; ignored", Fmi2Status.warning)
+            if params.get("modes_assumed") and self.modes:
+                self.log("rwadist wheel: the suspension modes of this wheel are ASSUMED (datasheet wheel, not "
+                         "measured); the outputs with modes = true are built on assumed values (modes = false: "
+                         "hard-mounted, as the datasheet states)", Fmi2Status.warning)
             self.error = None
             w = float(self.wheel_speed)
             if math.isfinite(w):

@@ -41,6 +41,7 @@ def cmd_simulate(args) -> int:
     from .teststand import simulate_sweep
 
     out = Path(args.out_dir)
+    assumed_note = _simulate_assumed_modes(args)
     if args.sweep:
         wheel = preset(args.preset)
         end = args.sweep_end_rpm if args.sweep_end_rpm is not None else 2400.0
@@ -48,6 +49,8 @@ def cmd_simulate(args) -> int:
                                sample_rate=args.sample_rate or 3840.0, noise=args.noise, modes=not args.no_modes,
                                test_stand=not args.no_test_stand, seed=args.seed, profile=args.profile,
                                tach=not args.no_tach, physics=args.physics)
+        if assumed_note:
+            sweep.meta["modes_assumed"] = assumed_note
         path = data_io.write_sweep(sweep, out / "sweep.csv")
         print(f"wrote sweep {path} ({len(sweep.time)} samples, {sweep.sample_rate:g} Hz)")
         return 0
@@ -59,10 +62,29 @@ def cmd_simulate(args) -> int:
                              seed=args.seed, physics=args.physics)
     speeds = np.array([r.speed for r in test.runs]) * RAD_S_TO_RPM
     fs = test.runs[0].sample_rate
+    if assumed_note:
+        test.meta["modes_assumed"] = assumed_note
     data_io.write_steady(test, out)
     print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g}-{speeds.max():g} rpm, {fs:g} Hz, "
           f"{args.samples} samples each)")
     return 0
+
+
+def _simulate_assumed_modes(args):
+    """The note for a catalogue wheel with assumed modes simulated through them (--physics extended with
+    --assumed-modes), else None.  Without --assumed-modes such a wheel is refused with --physics extended:
+    its default (simple physics: its lines, no modes) is hard-mounted, as its datasheet states."""
+    from . import catalogue
+    m = catalogue.preset_model(args.preset)
+    if args.physics != "extended" or m is None or not catalogue.modes_assumed(m):
+        return None
+    if not args.assumed_modes:
+        raise DataError("--physics", "extended", f"{args.preset}: its suspension modes are assumed (datasheet "
+                        "wheel), not measured; it runs hard-mounted by default (drop --physics extended), or add "
+                        "--assumed-modes to simulate through the assumed modes")
+    note = catalogue.ASSUMED_MODES_NOTE.format(name=args.preset)
+    print("WARNING: " + note, file=sys.stderr)
+    return note
 
 
 # --------------------------------------------------------------------------- fit
@@ -342,16 +364,25 @@ def cmd_fmu_build(args) -> int:
     if args.model:
         source = args.model
     else:
+        from . import catalogue
         from .presets import preset
-        source = preset(args.preset or "ithaco-e").to_model()
+        source = catalogue.preset_model(args.preset or "ithaco-e") or preset(args.preset or "ithaco-e").to_model()
     try:
-        path = build_fmu(source, args.output)
+        if getattr(args, "native", False):
+            from fmu.native_build import build_native_fmu
+            path = build_native_fmu(source, args.output, assumed_modes=args.assumed_modes)
+        else:
+            path = build_fmu(source, args.output, assumed_modes=args.assumed_modes)
     except ModelError as exc:
         if exc.field is not None:       # a bad model-file field: the schema's message names file and field
             raise
         raise DataError(args.model or args.preset, "model", str(exc)) from None
-    print(f"wrote {path} (model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')}; "
-          f"native layer: {'yes' if has_native(path) else 'no, numpy steps and fmi2Discard on bad input'})")
+    what = f"model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')}"
+    if getattr(args, "native", False):
+        print(f"wrote {path} ({what}; native FMU: C only, no Python needed by the host)")
+    else:
+        print(f"wrote {path} ({what}; native layer: "
+              f"{'yes' if has_native(path) else 'no, numpy steps and fmi2Discard on bad input'})")
     return 0
 
 
@@ -457,7 +488,14 @@ def cmd_psd(args) -> int:
     law = bb.law_from_spec(args.dist, lo_rpm, hi_rpm, args.std_rpm)
 
     def default_lines():
-        return api.wheel_lines(args.model, preset=args.preset, empirical=args.empirical)
+        return api.wheel_lines(args.model, preset=args.preset, empirical=hard_mounted)
+
+    # a wheel whose suspension modes are assumed (datasheet) runs hard-mounted unless --assumed-modes
+    assumed = _psd_modes_assumed(args)
+    hard_mounted = args.empirical or (assumed and not args.assumed_modes)
+    if assumed and hard_mounted and not args.empirical:
+        print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); running it "
+              "hard-mounted (Melody's model of its lines); --assumed-modes uses the assumed modes")
 
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -475,7 +513,17 @@ def cmd_psd(args) -> int:
             fmax = _default_fmax([(lines, law)])
         res = bb.broadband_psd(lines, law, fmax, args.n_freq, args.n_speeds, progress=True)
         sources = [(lines, None)]
-    kind = "empirical (Melody)" if args.empirical else "extended (modal amplification)"
+    kind = "empirical (Melody)" if hard_mounted else "extended (modal amplification)"
+    if assumed and not hard_mounted and not args.wheels:
+        from .catalogue import ASSUMED_MODES_NOTE
+        note = "WARNING: " + ASSUMED_MODES_NOTE.format(name=args.model or args.preset)
+        kind += " on ASSUMED modes"
+        print(note, file=sys.stderr)
+        stem0 = out.with_suffix("")
+        note_path = stem0.parent / (stem0.name + "_ASSUMED_MODES.txt")
+        note_path.write_text(note + "\n(this note belongs to " + ", ".join(
+            str(stem0.parent / (stem0.name + s)) for s in (out.suffix, "_cross.csv", "_envelope.csv", ".png")) + ")\n")
+        print(f"note written next to the outputs: {note_path}")
     if args.format == "nastran":
         from .nastran import write_deck
 
@@ -502,6 +550,18 @@ def cmd_psd(args) -> int:
     print("RMS: " + ", ".join(f"{c} {v:.4g}" for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
     print(f"worst-case line envelope: {p_env}; plots: {png}")
     return 0
+
+
+def _psd_modes_assumed(args) -> bool:
+    """True when the single wheel of ``rwadist psd`` (model file or catalogue preset) has assumed modes."""
+    from . import catalogue
+    if args.model:
+        return catalogue.modes_assumed(model_io.load(args.model))
+    if args.preset:
+        m = catalogue.preset_model(args.preset)
+        return m is not None and catalogue.modes_assumed(m)
+    return False
+
 
 
 _default_fmax = api.default_fmax
@@ -532,6 +592,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-tach", action="store_true", help="sweep without the speed_rpm tach column")
     s.add_argument("--physics", choices=("simple", "extended"), default="simple",
                    help="simple resonances (default) or the extended rotor model of the preset")
+    s.add_argument("--assumed-modes", action="store_true",
+                   help="allow --physics extended on a catalogue wheel whose suspension modes are assumed "
+                        "(the data's metadata then says so)")
     s.set_defaults(func=cmd_simulate)
 
     f = sub.add_parser("fit", help="fit the empirical model to test data; writes the model file and a report")
@@ -602,6 +665,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--n-freq", type=int, default=20001, help="frequency points 0..fmax (default 20001)")
     q.add_argument("--n-speeds", type=int, default=2000, help="speed cells of the law (default 2000)")
     q.add_argument("--empirical", action="store_true", help="Melody's model from the harmonics alone, no modes")
+    q.add_argument("--assumed-modes", action="store_true",
+                   help="run a wheel with assumed (datasheet) suspension modes through them (default: hard-mounted); "
+                        "the outputs then carry a note that they rest on assumed values")
     q.add_argument("--format", choices=("csv", "nastran"), default="csv")
     q.add_argument("--nastran-fields", choices=("small", "free"), default="small")
     q.add_argument("--nastran-cross", action="store_true", help="also RANDPS/TABRND1 of the cross-spectra")
@@ -637,9 +703,14 @@ def build_parser() -> argparse.ArgumentParser:
     fsub = fm.add_subparsers(dest="fmu_command", required=True)
     fb = fsub.add_parser("build", help="build the FMU from a model file or a preset (default: ithaco-e)")
     fsrc = fb.add_mutually_exclusive_group()
-    fsrc.add_argument("model", nargs="?", help="model file (JSON) with an analytical section")
+    fsrc.add_argument("model", nargs="?", help="model file (JSON): empirical, extended or diagnosed")
     fsrc.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
     fb.add_argument("-o", "--output", default="wheel.fmu", help="FMU to write (default wheel.fmu)")
+    fb.add_argument("--native", action="store_true",
+                    help="write a pure-C FMU (no Python on the host; sources/ included) instead of pythonfmu's")
+    fb.add_argument("--assumed-modes", action="store_true",
+                    help="a wheel with assumed (datasheet) suspension modes runs them by default (modes = true); "
+                         "without it such a wheel is hard-mounted by default")
     fb.set_defaults(func=cmd_fmu_build)
     fc = fsub.add_parser("check", help="fmpy validation and a short spin-up simulation of an FMU")
     fc.add_argument("fmu")

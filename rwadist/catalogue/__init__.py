@@ -10,6 +10,8 @@ Each file's ``provenance`` says where every number comes from: ``source`` (citat
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from pathlib import Path
 
 from ..data import DataError
@@ -88,3 +90,29 @@ def compare(fitted: WheelModel, reference: WheelModel, h_tol: float = 0.03) -> d
                                                  and mine[k] > limits[k]))
            for k in ("U_s_kg_m", "U_d_kg_m2")]
     return {"harmonics": rows, "imbalance": imb}
+
+
+#: what every output built on assumed suspension modes says (psd note files, FMU log, simulate-test meta)
+ASSUMED_MODES_NOTE = ("the suspension modes of {name} are ASSUMED (datasheet wheel: analytical.modes_assumed), "
+                      "not measured; outputs with the modes are built on assumed values -- without "
+                      "--assumed-modes the wheel runs hard-mounted, as its datasheet states")
+
+
+def modes_assumed(model) -> bool:
+    """True when ``model`` (a :class:`~rwadist.model.WheelModel`) carries ``analytical.modes_assumed``:
+    its suspension modes are assumed (a datasheet wheel), not measured.  DataError on a non-boolean."""
+    an = getattr(model, "analytical", None)
+    if not isinstance(an, Mapping):
+        return False
+    v = an.get("modes_assumed", False)
+    if not isinstance(v, bool):
+        raise DataError(getattr(model, "name", "<model>"), "analytical.modes_assumed",
+                        f"must be true or false, got {v!r}")
+    return v
+
+
+def preset_model(name: str):
+    """The catalogue model of preset ``name`` (with its provenance and ``modes_assumed``), or None for a
+    test-stand preset that is not in the catalogue."""
+    key = str(name).strip().lower()
+    return load(key) if key in names() else None

@@ -27,7 +27,9 @@ sections are assumptions, written into each file: the suspension is scaled so th
 modes sit at the E wheel's fitted frequencies (radial translation 227.7 Hz, rocking
 54.9 Hz at rest, axial 70 Hz; thesis Table 4.2/2.3) with its damping ratios, i.e.
 a wheel of the same construction class -- replace them with a fit
-(`rwadist fit --extended`) as soon as test data exist.
+(`rwadist fit --extended`) as soon as test data exist.  Their ``analytical`` sections carry
+``modes_assumed: true``: every command runs such a wheel hard-mounted (its datasheet lines) unless
+``--assumed-modes`` opts in to the assumed modes.
 """
 from __future__ import annotations
 
@@ -106,7 +108,7 @@ def honeywell(name: str) -> WheelModel:
         empirical={"radial_force": [Harmonic(h=1.0, C=U_s, sense="co")],
                    "radial_torque": [Harmonic(h=1.0, C=U_d, sense="co")],
                    "axial_force": [], "axial_torque": []},
-        analytical=ext.params_to_dict(p),
+        analytical=dict(ext.params_to_dict(p), modes_assumed=True),
         provenance={
             "source": BASILISK,
             "measured": {
@@ -135,7 +137,7 @@ def s2e_sample() -> WheelModel:
         empirical={"radial_force": [Harmonic(h=h, C=c) for h, c in S2E_FORCE],
                    "radial_torque": [Harmonic(h=h, C=c) for h, c in S2E_TORQUE],
                    "axial_force": [], "axial_torque": []},
-        analytical=ext.params_to_dict(p),
+        analytical=dict(ext.params_to_dict(p), modes_assumed=True),
         provenance={
             "source": S2E_SOURCE,
             "measured": {
