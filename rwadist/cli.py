@@ -142,11 +142,17 @@ def run_extended_fit(test, fit, args):
         mass = mass if mass is not None else wheel.mass_kg
         radius = radius if radius is not None else wheel.radius_m
         start = getattr(wheel, "extended", None)
+    for flag, value in (("--mass", mass), ("--radius", radius)):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            raise DataError(flag, "value", f"{value!r}: must be a positive number (kg / m)")
     if mass is None or radius is None:
-        raise DataError("--extended", "mass/radius", "the extended fit needs the rotor mass and radius: "
-                        "give --mass KG --radius M or --preset NAME")
-    print(f"fitting the extended model (M = {mass:g} kg, R = {radius:g} m, height = {args.height:g} m) ...",
-          flush=True)
+        mass = radius = None
+        print("fitting the extended model per unit mass and inertia (no --mass/--radius: the interface loads "
+              f"depend only on k/M, c/M, k_theta/I_rr, c_theta/I_rr, I_zz/I_rr; height = {args.height:g} m) ...",
+              flush=True)
+    else:
+        print(f"fitting the extended model (M = {mass:g} kg, R = {radius:g} m, height = {args.height:g} m) ...",
+              flush=True)
     efit = fit_extended(test, fit, mass, radius, height=args.height, start=start)
     p = efit.params
     print(f"  radial translation {p.omega_r / (2 * np.pi):7.2f} Hz  zeta {efit.zeta['radial_translation']:.3f}"
@@ -161,7 +167,19 @@ def run_extended_fit(test, fit, args):
               + ("  (a linear model does not match this resonance well)" if db > 2.0 else ""))
     for note in efit.notes:
         print(f"  note: {note}")
+    if efit.unconstrained:
+        print(f"  UNCONSTRAINED by the data (starting values, listed in the model file): "
+              f"{', '.join(efit.unconstrained)}")
     return efit, to_model(efit, fit)
+
+
+def _warn_unconstrained(model, source, use) -> None:
+    """Print (stderr) that the model has modes the extended fit could not identify, if it has."""
+    from .extended_fit import unconstrained_warning
+
+    text = unconstrained_warning(model, str(source), use)
+    if text:
+        print(text, file=sys.stderr)
 
 
 def _add_fit_options(p):
@@ -175,7 +193,8 @@ def _add_fit_options(p):
                    help="speed of sweep slices: tach column, estimated from data, or auto")
     p.add_argument("--extended", action="store_true",
                    help="also fit the extended model (modes, damping, imbalances) into the model file")
-    p.add_argument("--mass", type=float, default=None, help="rotor mass, kg (extended fit)")
+    p.add_argument("--mass", type=float, default=None,
+                   help="rotor mass, kg (extended fit; without --mass/--radius the fit is per unit mass/inertia)")
     p.add_argument("--radius", type=float, default=None, help="rotor radius, m (extended fit; thin-disc inertias)")
     p.add_argument("--height", type=float, default=0.0,
                    help="lever arm from the rotor centre to the torque reference point, m (default 0)")
@@ -341,6 +360,7 @@ def cmd_fmu_build(args) -> int:
         raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
     if args.model:
         source = args.model
+        _warn_unconstrained(model_io.load(args.model), args.model, "the FMU")
     else:
         from .teststand import preset
         source = preset(args.preset or "ithaco-e").to_model()
@@ -426,6 +446,7 @@ def cmd_diagnose(args) -> int:
     model = None
     if args.model:
         model = model_io.load(args.model)
+        _warn_unconstrained(model, args.model, "diagnose's extended base")
     elif args.preset:
         from .presets import preset
 
@@ -482,6 +503,8 @@ def cmd_psd(args) -> int:
         if not args.model:
             raise DataError("psd", "model", "give a model file or --preset NAME")
         m = model_io.load(args.model)
+        if not args.empirical:
+            _warn_unconstrained(m, args.model, "the PSD")
         return bb.empirical_lines(m) if args.empirical else bb.extended_lines_from_model(m, str(args.model))
 
     out = Path(args.output)
