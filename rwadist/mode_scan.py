@@ -18,8 +18,9 @@ the profile over f0 (minimum over ζ, a and the forcing).  A mode is **found** w
 an interior minimum that is sharp: every f0 more than ``tolerance`` away from the best one fits
 worse by a log-likelihood ratio of at least ``min_log_lr`` (n/2·ln(SSR/SSR_best), n measurements;
 2.0 is about the 95 % level of one parameter, Δχ² = 3.84) -- the data then exclude a frequency
-error larger than the tolerance.  The profile uses f0 steps of 1 %, ζ steps of a factor 1.6 and
-a-steps of 0.1; the best point is refined to 0.1 % (the least squares that follows refines it).  Otherwise the data do not
+error larger than the tolerance.  The profile uses f0 steps of 1 % (2 % when a is scanned), ζ steps
+of a factor 1.6 (2.0) and a-steps of 0.2; the best point is refined to 0.1 % (the least squares that
+follows refines it).  Otherwise the data do not
 constrain the mode (no line comes near it, only a skirt is seen, or the whirl it shows trades off
 against I_zz/I_rr) and the result says so; nothing is invented.
 """
@@ -134,20 +135,22 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     if rocking:
         # the backward whirl of a mode at f0 falls to ~f0²/(a·f_spin): f0 may sit above every line
         f_hi = 4.0 * f_line.max()
-    f0_grid = np.exp(np.arange(math.log(f_lo), math.log(f_hi), 0.01))
-    zeta_grid = np.exp(np.linspace(math.log(0.002), math.log(0.6), 13))
     if not rocking:
         a_grid = np.array([0.0])
     elif inertia_ratio is not None:
         a_grid = np.array([float(inertia_ratio)])
     else:
-        a_grid = np.linspace(0.1, 2.0, 20)
+        a_grid = np.linspace(0.2, 2.0, 10)
+    # a third axis (a unknown) costs 10x: coarser f0 and ζ steps there, the refinement recovers them
+    f_step = 0.01 if a_grid.size == 1 else 0.02
+    f0_grid = np.exp(np.arange(math.log(f_lo), math.log(f_hi), f_step))
+    zeta_grid = np.exp(np.linspace(math.log(0.002), math.log(0.6), 13 if a_grid.size == 1 else 9))
     ssr = _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
     i, j, k = np.unravel_index(np.nanargmin(ssr), ssr.shape)
     # refine around the best point: f0 to 0.1 %, ζ and a finer
-    f_fine = f0_grid[i] * np.exp(np.arange(-0.03, 0.0301, 0.001))
-    z_fine = zeta_grid[j] * np.exp(np.linspace(-0.5, 0.5, 11))
-    a_fine = a_grid if a_grid.size == 1 else np.clip(a_grid[k] + np.linspace(-0.1, 0.1, 11), 0.02, 2.0)
+    f_fine = f0_grid[i] * np.exp(np.arange(-2 * f_step - 0.01, 2 * f_step + 0.0101, 0.001))
+    z_fine = zeta_grid[j] * np.exp(np.linspace(-0.5, 0.5, 11) * (1 if a_grid.size == 1 else 1.5))
+    a_fine = a_grid if a_grid.size == 1 else np.unique(np.clip(a_grid[k] + np.linspace(-0.2, 0.2, 21), 0.02, 2.0))
     fine = _grid_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
     fi, fj, fk = np.unravel_index(np.nanargmin(fine), fine.shape)
     best = float(fine[fi, fj, fk])
