@@ -40,6 +40,8 @@ def cmd_simulate(args) -> int:
 
     wheel = preset(args.preset)
     out = Path(args.out_dir)
+    if args.sweep and args.inject:
+        raise DataError("--inject", "--sweep", "injections apply to steady runs; leave out --sweep")
     if args.sweep:
         end = args.sweep_end_rpm if args.sweep_end_rpm is not None else 2400.0
         sweep = simulate_sweep(wheel, rpm_start=args.sweep_start_rpm, rpm_end=end, duration=args.duration,
@@ -59,9 +61,18 @@ def cmd_simulate(args) -> int:
     else:
         speeds = np.linspace(300.0, 2400.0, 120)
     fs = args.sample_rate or getattr(wheel, "default_sample_rate", None) or 3840.0
-    test = simulate_steady(wheel, speeds, sample_rate=fs, n_samples=args.samples, noise=args.noise,
-                           modes=not args.no_modes, test_stand=not args.no_test_stand, seed=args.seed,
-                           physics=args.physics)
+    if args.inject:
+        from .inject import parse, simulate_with_injections
+
+        test = simulate_with_injections(wheel, [parse(x) for x in args.inject], speeds, physics=args.physics,
+                                        seed=args.seed, sample_rate=fs, n_samples=args.samples, noise=args.noise,
+                                        modes=not args.no_modes, test_stand=not args.no_test_stand)
+        for e in test.meta["injected"]:
+            print("injected " + e["kind"] + ": " + ", ".join(f"{k}={v}" for k, v in e.items() if k != "kind"))
+    else:
+        test = simulate_steady(wheel, speeds, sample_rate=fs, n_samples=args.samples, noise=args.noise,
+                               modes=not args.no_modes, test_stand=not args.no_test_stand, seed=args.seed,
+                               physics=args.physics)
     if wheel.f_lim_hz is not None and not args.no_test_stand:
         # the test engineer's record of where the fixture corrupts the data; `rwadist fit` uses it
         test.meta["f_lim_hz"] = wheel.f_lim_hz
@@ -583,6 +594,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-tach", action="store_true", help="sweep without the speed_rpm tach column")
     s.add_argument("--physics", choices=("simple", "extended"), default="simple",
                    help="simple resonances (default) or the extended rotor model of the preset")
+    s.add_argument("--inject", action="append", default=[], metavar="KIND:PARAM=VALUE,...",
+                   help="add a known effect to try diagnose on (repeatable; recorded in meta.json 'injected'): "
+                        "missing_harmonic, amplitude_law, broadband_floor, fixed_resonance, cross_coupling, "
+                        "sidebands, speed_ripple, counter_rotation (parameters: see rwadist/inject.py)")
     s.set_defaults(func=cmd_simulate)
 
     f = sub.add_parser("fit", help="fit the empirical model to test data; writes the model file and a report")
