@@ -87,7 +87,7 @@ def _as_test(data, **read_options) -> SteadyTest:
 
 def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: float | None = None,
                   n_samples: int = 8192, noise: float = 0.01, modes: bool = True, test_stand: bool = True,
-                  seed: int = 0, physics: str = "simple") -> SteadyTest:
+                  seed: int = 0, physics: str = "simple", inject=()) -> SteadyTest:
     """Steady runs of a preset wheel on the virtual test stand.
 
     Parameters
@@ -109,6 +109,9 @@ def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: flo
         Random seed (phases, noise).
     physics : {"simple", "extended"}
         Simple resonances, or the preset's extended rotor model.
+    inject : sequence of str or dict
+        Known effects to add, ``"KIND:PARAM=VALUE,..."`` or parsed dicts (:mod:`rwadist.inject`);
+        recorded in ``meta["injected"]``.
 
     Returns
     -------
@@ -123,8 +126,15 @@ def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: flo
         default = getattr(wheel, "default_speeds_rpm", None)
         speeds_rpm = np.linspace(300.0, 2400.0, 120) if default is None else np.asarray(default, float)
     fs = sample_rate or getattr(wheel, "default_sample_rate", None) or 3840.0
-    test = simulate_steady(wheel, speeds_rpm, sample_rate=fs, n_samples=n_samples, noise=noise, modes=modes,
-                           test_stand=test_stand, seed=seed, physics=physics)
+    if inject:
+        from .inject import parse, simulate_with_injections
+
+        specs = [parse(x) if isinstance(x, str) else dict(x) for x in inject]
+        test = simulate_with_injections(wheel, specs, speeds_rpm, physics=physics, seed=seed, sample_rate=fs,
+                                        n_samples=n_samples, noise=noise, modes=modes, test_stand=test_stand)
+    else:
+        test = simulate_steady(wheel, speeds_rpm, sample_rate=fs, n_samples=n_samples, noise=noise,
+                               modes=modes, test_stand=test_stand, seed=seed, physics=physics)
     if wheel.f_lim_hz is not None and test_stand:
         # the test engineer's record of where the fixture corrupts the data; `fit` uses it
         test.meta["f_lim_hz"] = wheel.f_lim_hz
@@ -187,7 +197,8 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     empirical : rwadist.empirical.EmpiricalFit or None
         Its empirical fit; default :func:`fit` of ``data`` with default settings.
     mass : float or None
-        Rotor mass, kg; default the preset's.
+        Rotor mass, kg; default the preset's.  Without mass or radius the fit is per unit mass and
+        inertia (the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr and I_zz/I_rr).
     radius : float or None
         Rotor radius, m (thin-disc inertias); default the preset's.
     height : float
@@ -218,9 +229,12 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
         mass = mass if mass is not None else wheel.mass_kg
         radius = radius if radius is not None else wheel.radius_m
         start = getattr(wheel, "extended", None)
+    for flag, value in (("--mass", mass), ("--radius", radius)):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            raise DataError(flag, "value", f"{value!r}: must be a positive number (kg / m)")
     if mass is None or radius is None:
-        raise DataError("--extended", "mass/radius", "the extended fit needs the rotor mass and radius: "
-                        "give --mass KG --radius M or --preset NAME")
+        # per unit mass and inertia: the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr, I_zz/I_rr
+        mass = radius = None
     efit = _fit_extended(test, empirical, mass, radius, height=height, start=start, progress=progress)
     return efit, to_model(efit, empirical)
 

@@ -42,6 +42,8 @@ def cmd_simulate(args) -> int:
 
     out = Path(args.out_dir)
     assumed_note = _simulate_assumed_modes(args)
+    if args.sweep and args.inject:
+        raise DataError("--inject", "--sweep", "injections apply to steady runs; leave out --sweep")
     if args.sweep:
         wheel = preset(args.preset)
         end = args.sweep_end_rpm if args.sweep_end_rpm is not None else 2400.0
@@ -59,7 +61,9 @@ def cmd_simulate(args) -> int:
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds) if args.speeds_rpm else None
     test = api.simulate_test(args.preset, speeds, sample_rate=args.sample_rate, n_samples=args.samples,
                              noise=args.noise, modes=not args.no_modes, test_stand=not args.no_test_stand,
-                             seed=args.seed, physics=args.physics)
+                             seed=args.seed, physics=args.physics, inject=args.inject)
+    for e in test.meta.get("injected", []):
+        print("injected " + e["kind"] + ": " + ", ".join(f"{k}={v}" for k, v in e.items() if k != "kind"))
     speeds = np.array([r.speed for r in test.runs]) * RAD_S_TO_RPM
     fs = test.runs[0].sample_rate
     if assumed_note:
@@ -137,7 +141,14 @@ def run_extended_fit(test, fit, args):
         wheel = preset(args.preset)
         mass = mass if mass is not None else wheel.mass_kg
         radius = radius if radius is not None else wheel.radius_m
-    if mass is not None and radius is not None:
+    for flag, value in (("--mass", mass), ("--radius", radius)):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            raise DataError(flag, "value", f"{value!r}: must be a positive number (kg / m)")
+    if mass is None or radius is None:
+        print("fitting the extended model per unit mass and inertia (no --mass/--radius: the interface loads "
+              f"depend only on k/M, c/M, k_theta/I_rr, c_theta/I_rr, I_zz/I_rr; height = {args.height:g} m) ...",
+              flush=True)
+    else:
         print(f"fitting the extended model (M = {mass:g} kg, R = {radius:g} m, height = {args.height:g} m) ...",
               flush=True)
     efit, model = api.fit_extended(test, fit, mass=args.mass, radius=args.radius, height=args.height,
@@ -155,7 +166,19 @@ def run_extended_fit(test, fit, args):
               + ("  (a linear model does not match this resonance well)" if db > 2.0 else ""))
     for note in efit.notes:
         print(f"  note: {note}")
+    if efit.unconstrained:
+        print(f"  UNCONSTRAINED by the data (starting values, listed in the model file): "
+              f"{', '.join(efit.unconstrained)}")
     return efit, model
+
+
+def _warn_unconstrained(model, source, use) -> None:
+    """Print (stderr) that the model has modes the extended fit could not identify, if it has."""
+    from .extended_fit import unconstrained_warning
+
+    text = unconstrained_warning(model, str(source), use)
+    if text:
+        print(text, file=sys.stderr)
 
 
 def _add_fit_options(p):
@@ -169,7 +192,8 @@ def _add_fit_options(p):
                    help="speed of sweep slices: tach column, estimated from data, or auto")
     p.add_argument("--extended", action="store_true",
                    help="also fit the extended model (modes, damping, imbalances) into the model file")
-    p.add_argument("--mass", type=float, default=None, help="rotor mass, kg (extended fit)")
+    p.add_argument("--mass", type=float, default=None,
+                   help="rotor mass, kg (extended fit; without --mass/--radius the fit is per unit mass/inertia)")
     p.add_argument("--radius", type=float, default=None, help="rotor radius, m (extended fit; thin-disc inertias)")
     p.add_argument("--height", type=float, default=0.0,
                    help="lever arm from the rotor centre to the torque reference point, m (default 0)")
@@ -363,6 +387,7 @@ def cmd_fmu_build(args) -> int:
         raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
     if args.model:
         source = args.model
+        _warn_unconstrained(model_io.load(args.model), args.model, "the FMU")
     else:
         from . import catalogue
         from .presets import preset
@@ -450,6 +475,8 @@ def cmd_diagnose(args) -> int:
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
     model = model_io.load(args.model) if args.model else None
+    if model is not None:
+        _warn_unconstrained(model, args.model, "diagnose's extended base")
     try:
         diag = api.diagnose(test, model, preset=args.preset, base=args.base, nperseg=args.nperseg,
                             f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain)
@@ -488,6 +515,8 @@ def cmd_psd(args) -> int:
     law = bb.law_from_spec(args.dist, lo_rpm, hi_rpm, args.std_rpm)
 
     def default_lines():
+        if args.model and not hard_mounted:
+            _warn_unconstrained(model_io.load(args.model), args.model, "the PSD")
         return api.wheel_lines(args.model, preset=args.preset, empirical=hard_mounted)
 
     # a wheel whose suspension modes are assumed (datasheet) runs hard-mounted unless --assumed-modes
@@ -595,6 +624,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--assumed-modes", action="store_true",
                    help="allow --physics extended on a catalogue wheel whose suspension modes are assumed "
                         "(the data's metadata then says so)")
+    s.add_argument("--inject", action="append", default=[], metavar="KIND:PARAM=VALUE,...",
+                   help="add a known effect to try diagnose on (repeatable; recorded in meta.json 'injected'): "
+                        "missing_harmonic, amplitude_law, broadband_floor, fixed_resonance, cross_coupling, "
+                        "sidebands, speed_ripple, counter_rotation (parameters: see rwadist/inject.py)")
     s.set_defaults(func=cmd_simulate)
 
     f = sub.add_parser("fit", help="fit the empirical model to test data; writes the model file and a report")

@@ -9,12 +9,11 @@ harmonic takes part and the fit is a least-squares problem:
    complex spectra of the x and y channels at +f), a counter-rotating one in
    X − iY (for Ω < 0 the two swap).  Only counter-rotating content can excite
    backward whirl (the thesis's "pole-zero cancellation").
-2. **Mode frequencies** from the amplification peaks the empirical fit
-   excluded: a radial-force peak sits on the radial translation mode (constant
-   frequency); a radial-torque peak on the rocking whirl of its sense,
-   f± = sqrt((aΩ/2)² + f0²) ± aΩ/2, so f0² = f² ∓ aΩf gives the rocking
-   frequency at rest; an axial-force peak on the axial mode.  These start the
-   stiffnesses: k_r = M ω_T², k_rock = I_rr ω0², k_z = M ω_z².
+2. **Mode frequencies** by a profile scan (:mod:`rwadist.mode_scan`) over every measured line
+   at every speed: radial-force lines place the radial translation mode, radial-torque lines the
+   rocking mode through BOTH whirls (co-rotating content meets the forward whirl, counter-rotating
+   the backward one, f± = sqrt((aΩ/2)² + f0²) ± aΩ/2, a = I_zz/I_rr), axial-force lines the axial
+   mode.  The scan also gives the damping start and, without mass and radius, a.
 3. **Least squares** of log amplitude over every measured line at every speed
    (amplified or not): stiffnesses, damping of each mode and the forcing
    coefficient of each line (U_s and U_d are the h = 1 radial force and torque
@@ -22,9 +21,10 @@ harmonic takes part and the fit is a least-squares problem:
    matched where a linear model can match them; the residual near each mode
    says where it cannot.  Standard errors come from the Jacobian.
 
-Modes not seen in the data (no amplification peak) keep their starting values
-and are reported as not identified.  Mass and radius come from the datasheet
-(thin-disc inertias, CONVENTIONS.md); ``height`` (lever arm from the radial
+A mode the data do not constrain keeps its starting value and is said to be so: a note, and
+``unconstrained`` (``analytical.unconstrained`` in the model file), never silently.  Mass and
+radius come from the datasheet (thin-disc inertias, CONVENTIONS.md) or are left out (a per-unit
+fit: the interface loads depend only on the ratios); ``height`` (lever arm from the radial
 force to the reported torque) is geometry, given, default 0 (torques about the
 rotor centre).
 """
@@ -41,10 +41,13 @@ from .data import SteadyTest
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .model import Harmonic
 from .spectra import compute_spectra, welch_dof
+from .mode_scan import MODE_DIRECTION, scan_mode
 from .units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
 
 CHANNEL_INDEX = {c: i for i, c in enumerate(CHANNELS)}
 RADIAL = ("radial_force", "radial_torque")
+#: mode key of the fit -> its name in the model file's ``analytical.unconstrained``
+UNCONSTRAINED_NAME = {"radial_translation": "radial_translation", "rocking": "rocking", "axial_translation": "axial"}
 
 
 @dataclass
@@ -55,13 +58,17 @@ class ExtendedFit:
     lines : forcing lines (direction, h, C, sense) of the fitted model.
     zeta : damping ratio per mode ("radial_translation", "rocking", "axial_translation").
     rel_stderr : relative standard error per fitted parameter (k_r, c_r, ... and line C's).
-    identified : per mode, whether the data showed it (an amplification peak).
+    identified : per mode, whether the data locate it (:func:`rwadist.mode_scan.scan_mode`).
     peaks : the amplification peaks that located the modes (dicts).
     senses : (direction, h) -> (sense, fraction of power co-rotating).
     rms : model-vs-data RMS comparison (see :func:`rms_comparison`).
     residual_db : per mode, RMS log-amplitude residual (dB) of the measurements near it.
     notes : what could not be fitted and why.
     measured : the line measurements the least squares used (LineFit list, every speed).
+    unconstrained : modes the data do not constrain ("radial_translation", "rocking", "axial"):
+        their values are starting values (written to ``analytical.unconstrained``).
+    scans : per mode, the :class:`~rwadist.mode_scan.ModeScan` that located it or said why not.
+    per_unit : True when mass/radius were not given (M = 1 kg, I_rr = 1 kg·m²).
     """
 
     params: ext.ExtendedParams
@@ -75,6 +82,9 @@ class ExtendedFit:
     residual_db: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
     measured: list = field(default_factory=list)
+    unconstrained: list = field(default_factory=list)
+    scans: dict = field(default_factory=dict)
+    per_unit: bool = False
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -228,23 +238,47 @@ def _radial_power(meas_lines):
     return np.array(li, int), np.array(sp), np.array(pw), np.array(dr)
 
 
-def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float, height: float = 0.0,
-                 start: ext.ExtendedParams | None = None, zeta0: float = 0.02, progress: bool = False) -> ExtendedFit:
+def _scan_all(meas_lines, la, sa, aa, inertia_ratio, tolerance):
+    """Profile scan (:mod:`rwadist.mode_scan`) of each mode on the measured lines."""
+    lr, sr, pr, dr = _radial_power(meas_lines)
+    h_of = np.array([x.h for x in meas_lines]) if meas_lines else np.zeros(0)
+    scans = {}
+    for mode, direction in MODE_DIRECTION.items():
+        if direction == "axial_force":
+            line, omega, power = la, sa, aa**2
+        else:
+            m = dr == direction
+            line, omega, power = lr[m], sr[m], pr[m]
+        scans[mode] = scan_mode(mode, line, h_of[line] if line.size else np.zeros(0), omega, power,
+                                inertia_ratio=inertia_ratio if mode == "rocking" else None, tolerance=tolerance)
+    return scans
+
+
+def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None, radius: float | None = None,
+                 height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
+                 progress: bool = False, tolerance: float = 0.02) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
-    mass (kg), radius (m): datasheet values (thin-disc inertias).  height (m): z of the rotor
-    centre above the point the torques are measured about (the interface), as in
+    mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None:
+    the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr and I_zz/I_rr, so the fit is
+    then per unit mass and per unit transverse inertia (M = 1 kg, I_rr = 1 kg·m², I_zz = the fitted
+    ratio; stated in the notes) and I_zz/I_rr is fitted from the two whirls.  height (m): z of the
+    rotor centre above the point the torques are measured about (the interface), as in
     :class:`rwadist.extended.ExtendedParams`; the lever-arm torque height × F is removed from the
-    data before the fit and put back in the model.  start: parameters for the modes the data do not
-    show (default: modes at 3x the top line frequency, ζ = zeta0).
+    data before the fit and put back in the model.  start: parameters for modes the data do not
+    constrain (default: modes at 3x the top line frequency, ζ = zeta0).  tolerance: relative
+    frequency error the data must exclude for a mode to count as found (:func:`scan_mode`).
 
+    Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
+    measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
+    do not pin down keeps its starting value, is named in ``unconstrained`` and in the notes.
     Each radial line gets two forcing coefficients, one rotating with the spin and one against
     it, fitted to the x-plus-y line power (which does not depend on their relative phase): the
     rotation sense is read from the forcing, not from the response (a mode amplifies one sense
     more than the other, so the response alone would mislabel a planar load).
     """
-    I_zz, I_rr = ext.thin_disc(mass, radius)
-    a = I_zz / I_rr
+    physical = mass is not None and radius is not None
+    notes = []
     settings = FitSettings(**{k: v for k, v in fit.settings.items() if k in FitSettings.__dataclass_fields__})
     if height:
         sp0 = fit.spectra
@@ -256,18 +290,35 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
     meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False))
     senses_xy = line_senses(test, meas)
     peaks = amplification_peaks(fit)
-    f_modes = mode_frequencies(peaks, senses_xy, a)
+    la, sa, ca, aa = _measurements(meas)
+    keep_ax = np.array([meas.lines[j].direction not in RADIAL for j in la], bool)
+    la, sa, ca, aa = la[keep_ax], sa[keep_ax], ca[keep_ax], aa[keep_ax]
+    scans = _scan_all(meas.lines, la, sa, aa, 2.0 if physical else None, tolerance)
+    if physical:
+        I_zz, I_rr = ext.thin_disc(mass, radius)
+    else:
+        a_fit = scans["rocking"].inertia_ratio if scans["rocking"].found else 2.0
+        mass, I_rr, I_zz = 1.0, 1.0, float(a_fit)
+        notes.append("mass/radius not given: parameters are per unit mass (M = 1 kg) and per unit transverse "
+                     f"inertia (I_rr = 1 kg·m²); I_zz/I_rr = {a_fit:.3f} "
+                     + ("fitted from the whirls" if scans["rocking"].found else "ASSUMED (thin disc): the rocking "
+                        "whirls do not constrain it"))
+    a = I_zz / I_rr
+    f_modes = {m: (sc.f0_hz if sc.found else None) for m, sc in scans.items()}
     f_top = max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines), default=100.0)
-    notes = []
 
     def start_k(mode, inertia, attr):
         f = f_modes[mode]
         if f is not None:
             return inertia * (2 * np.pi * f) ** 2
-        notes.append(f"{mode}: no amplification seen in the data; kept at its starting value")
-        if start is not None:
-            return getattr(start, attr)
-        return inertia * (2 * np.pi * 3 * f_top) ** 2
+        if start is not None and physical:
+            k = getattr(start, attr)
+        else:
+            k = inertia * (2 * np.pi * 3 * f_top) ** 2
+        f_start = math.sqrt(k / inertia) / (2 * np.pi)
+        notes.append(f"{mode}: NOT CONSTRAINED by the data ({scans[mode].reason}); its {f_start:.4g} Hz is a "
+                     "starting value, listed in analytical.unconstrained")
+        return k
 
     k_r = start_k("radial_translation", mass, "k_r")
     k_rock = start_k("rocking", I_rr, "k_rock")
@@ -290,9 +341,6 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
         raise ValueError("the empirical fit has no harmonics: nothing to fit the extended model to")
     owner = np.array(owner)
     # axial measurements: per channel amplitude; radial: x²+y² power per run
-    la, sa, ca, aa = _measurements(meas)
-    keep_ax = np.array([meas.lines[j].direction not in RADIAL for j in la], bool)
-    la, sa, ca, aa = la[keep_ax], sa[keep_ax], ca[keep_ax], aa[keep_ax]
     lr, sr, pr, dr = _radial_power(meas.lines)
     speeds, inv = np.unique(np.concatenate([sa, sr]), return_inverse=True)
     ia, ir = inv[:sa.size], inv[sa.size:]
@@ -305,9 +353,11 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
 
     identified = {m: f_modes[m] is not None for m in _MODE_PARAMS}
     free_modes = [m for m in _MODE_PARAMS if identified[m]]
+    z_start = {m: (scans[m].zeta if identified[m] else zeta0) for m in _MODE_PARAMS}
     base = dict(mass=mass, I_zz=I_zz, I_rr=I_rr, k_r=k_r, k_rock=k_rock, k_z=k_z, height=0.0,
-                c_r=2 * zeta0 * math.sqrt(k_r * mass), c_rock=2 * zeta0 * math.sqrt(k_rock * I_rr),
-                c_z=2 * zeta0 * math.sqrt(k_z * mass), U_s=0.0, U_d=0.0)
+                c_r=2 * z_start["radial_translation"] * math.sqrt(k_r * mass),
+                c_rock=2 * z_start["rocking"] * math.sqrt(k_rock * I_rr),
+                c_z=2 * z_start["axial_translation"] * math.sqrt(k_z * mass), U_s=0.0, U_d=0.0)
     names = [p for m in free_modes for p in _MODE_PARAMS[m][:2]] + \
             [f"C[{ln.direction},{ln.h:g},{ln.sense}]" for ln in lines]
     x0 = np.log([base[n] for m in free_modes for n in _MODE_PARAMS[m][:2]] + [ln.C for ln in lines])
@@ -340,15 +390,15 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
         r_rad = 0.5 * (np.log(np.maximum(pr, 1e-300)) - np.log(np.maximum(pred, 1e-300)))
         return np.concatenate([r_ax, r_rad])
 
-    # bounds keep the search physical: stiffness within 4x of its start (the peaks place it
-    # far better), damping ratio in [1e-4, 0.95], line coefficients within 1000x (down to 1e-4
-    # of the line for the sense parts, which may vanish)
+    # bounds keep the search physical: stiffness within ±10 % of the scan's (frequency ±5 %: the
+    # scan placed it to 1 %), damping ratio in [1e-4, 0.95], line coefficients within 1000x (down
+    # to 1e-4 of the line for the sense parts, which may vanish)
     lo, hi = [], []
     for m in free_modes:
         kn, cn, inertia = _MODE_PARAMS[m]
         crit = 2 * math.sqrt(base[kn] * base[inertia])
-        lo += [math.log(base[kn] / 4), math.log(1e-4 * crit / 2)]
-        hi += [math.log(base[kn] * 4), math.log(0.95 * crit * 2)]
+        lo += [math.log(base[kn] / 1.1), math.log(1e-4 * crit / 2)]
+        hi += [math.log(base[kn] * 1.1), math.log(0.95 * crit * 2)]
     lo += list(x0[n_mode:] - math.log(1e4))
     hi += list(x0[n_mode:] + math.log(1e3))
     res = optimize.least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
@@ -400,8 +450,10 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float, radius: float
                 notes.append(f"{m}: the linear model misses the data near this mode by {resid_db[m]:.1f} dB RMS "
                              "(a fixture resonance inside the band -- set f_lim --, nonlinear damping, or a "
                              "mode the model lacks)")
+    unconstrained = [UNCONSTRAINED_NAME[m] for m in _MODE_PARAMS if not identified[m]]
     return ExtendedFit(params=params, lines=kept_lines, zeta=zeta, rel_stderr=rel_stderr, identified=identified,
-                       peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines)
+                       peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
+                       unconstrained=unconstrained, scans=scans, per_unit=not physical)
 
 
 # --------------------------------------------------------------------------- 4. comparison
@@ -467,7 +519,27 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
                          "senses": {f"{d} h={h:.4g}": {"sense": s_, "co_fraction": fr}
                                     for (d, h), (s_, fr) in efit.senses.items()},
                          "notes": efit.notes}
+    analytical["unconstrained"] = list(efit.unconstrained)
+    if efit.per_unit:
+        analytical["fit"]["per_unit"] = ("mass and radius not given: mass_kg = 1 and I_rr = 1 are units, the "
+                                         "stiffnesses and damping are per unit mass / transverse inertia")
     model.analytical = analytical
     model.provenance = dict(model.provenance, extended_fit="rwadist fit --extended: harmonics are the fitted "
                             "forcing lines of the extended model")
     return model
+
+
+def unconstrained_warning(model, source: str, use: str) -> str | None:
+    """The warning a command prints when it uses ``model`` whose ``analytical.unconstrained`` lists modes
+    (the extended fit could not identify them: their values are starting values); None otherwise.
+
+    source : where the model came from (file name), for the message.  use : what the command does with it.
+    """
+    analytical = getattr(model, "analytical", None) or {}
+    modes = analytical.get("unconstrained") or []
+    if not modes:
+        return None
+    return (f"warning: {source}: analytical.unconstrained = {list(modes)}: the extended fit could not identify "
+            f"{'this mode' if len(modes) == 1 else 'these modes'} from the test data; {use} uses "
+            f"{'its' if len(modes) == 1 else 'their'} starting values (measure a speed range whose lines cross "
+            "the mode, or give the mode from another source)")

@@ -1,0 +1,76 @@
+"""Load-cell time series from ROSS's steady-state response (tests/data/ross_loadcell.json).
+
+``benchmarks/ross_loadcell.py`` (run with ROSS) stores, per speed and forcing line, the complex
+phasors of the six channels and ROSS's Campbell diagram.  Here each run is built as
+Σ_lines Re(A·e^{iφ}·e^{i2πft}) with a random phase φ per line and run (the two imbalances share one:
+they sit on one rotor), plus white noise as a fraction of the top-speed fundamental (forces: the
+static imbalance's Fx; torques: the dynamic imbalance's Tx).  Feed it to anything that takes a
+SteadyTest, or write it for the command line::
+
+    python tests/ross_dataset.py OUT_DIR         # then: rwadist diagnose OUT_DIR -o report
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+DATA = Path(__file__).resolve().parent / "data" / "ross_loadcell.json"
+CHANNELS = ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")
+
+
+def load_doc(path=DATA) -> dict:
+    """The stored ROSS document (json)."""
+    return json.loads(Path(path).read_text())
+
+
+def campbell(doc=None) -> list:
+    """ROSS's own whirl frequencies: [{speed_rpm, modes_hz, whirl}] (run_modal, lateral modes)."""
+    return (doc or load_doc())["campbell"]
+
+
+def ross_test(noise=0.01, seed=0, sample_rate=3840.0, n_samples=4096, path=DATA):
+    """The ROSS dataset as an rwadist SteadyTest (one run per stored speed)."""
+    from rwadist.data import Run, SteadyTest
+
+    doc = load_doc(path)
+    rng = np.random.default_rng(seed)
+    speeds = np.asarray(doc["speeds_rpm"], float) * 2 * np.pi / 60
+    lines = doc["lines"]
+    A = np.array([np.asarray(ln["phasors_re"]) + 1j * np.asarray(ln["phasors_im"]) for ln in lines])  # (L, S, 6)
+    h = np.array([ln["h"] for ln in lines])
+    imb = np.array([bool(ln["imbalance"]) for ln in lines])
+    std_f = noise * abs(A[0, -1, 0])
+    std_t = noise * abs(A[1, -1, 3])
+    t = np.arange(int(n_samples)) / sample_rate
+    runs = []
+    for k, om in enumerate(speeds):
+        phase = rng.uniform(0, 2 * np.pi, len(lines))
+        phase[imb] = phase[np.argmax(imb)]
+        f = h * om / (2 * np.pi)
+        keep = f < 0.45 * sample_rate
+        z = (A[keep, k, :] * np.exp(1j * phase[keep])[:, None]).T @ np.exp(2j * np.pi * np.outer(f[keep], t))
+        sig = {c: z[i].real + (std_f if c.startswith("F") else std_t) * rng.standard_normal(t.size)
+               for i, c in enumerate(CHANNELS)}
+        runs.append(Run(speed=float(om), sample_rate=float(sample_rate), signals=sig, t0=0.0, name=f"run_{k:04d}.csv"))
+    meta = {"source": doc["source"], "generator": "tests/ross_dataset.py", "noise": noise, "seed": seed}
+    return SteadyTest(runs=runs, meta=meta)
+
+
+def main(argv=None):
+    from rwadist import data as data_io
+
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) != 1:
+        print("usage: python tests/ross_dataset.py OUT_DIR", file=sys.stderr)
+        return 2
+    test = ross_test()
+    data_io.write_steady(test, Path(argv[0]))
+    print(f"wrote {len(test.runs)} runs of the ROSS dataset to {argv[0]}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
