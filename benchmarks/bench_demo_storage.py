@@ -13,7 +13,8 @@ import numpy as np
 
 from rwadist.data import write_steady
 from rwadist.hdf5 import read_hdf5, write_hdf5
-from rwadist.teststand import preset, simulate_steady
+from rwadist.presets import preset
+from rwadist.teststand import simulate_steady
 
 
 def size(path: Path) -> int:

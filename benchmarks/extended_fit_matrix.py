@@ -56,7 +56,8 @@ def generate(cell):
     """(SteadyTest, truth Hz per mode, mass, radius) of one cell."""
     speeds = np.linspace(*cell["rpm"], cell["n_speeds"])
     if cell["generator"] == "stand":
-        from rwadist.teststand import preset, simulate_steady
+        from rwadist.presets import preset
+        from rwadist.teststand import simulate_steady
 
         wheel = preset("ithaco-e")
         test = simulate_steady(wheel, speeds, sample_rate=cell["rate"], n_samples=cell["samples"],

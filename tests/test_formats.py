@@ -6,15 +6,23 @@ import json
 
 import h5py
 import numpy as np
-import pyuff
 import pytest
+import pyuff
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 from scipy.io import savemat
 
-from rwadist.data import DataError, read_data, read_steady, read_sweep, write_steady, write_sweep
+from rwadist.data import (
+    DataError,
+    read_data,
+    read_steady,
+    read_sweep,
+    write_steady,
+    write_sweep,
+)
 from rwadist.empirical import fit_empirical
+from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
-from rwadist.teststand import preset, simulate_steady, simulate_sweep
+from rwadist.teststand import simulate_steady, simulate_sweep
 from rwadist.units import CHANNEL_COLUMN, CHANNELS, rad_s_to_rpm
 
 FS = 3840.0

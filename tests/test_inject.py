@@ -8,7 +8,8 @@ from rwadist import data as data_io
 from rwadist.cli import main
 from rwadist.data import DataError
 from rwadist.inject import parse, simulate_with_injections
-from rwadist.teststand import preset, simulate_steady
+from rwadist.presets import preset
+from rwadist.teststand import simulate_steady
 
 SPEEDS = np.linspace(900.0, 2400.0, 6)
 KW = dict(sample_rate=1920.0, n_samples=4096, noise=0.0, modes=False, test_stand=False)

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from rwadist.data import DataError, read_steady, read_sweep
-from rwadist.teststand import preset, simulate_sweep
+from rwadist.presets import preset
+from rwadist.teststand import simulate_sweep
 from rwadist.units import rpm_to_rad_s
 
 FS = 25600.0  # a DAQ rate that resolves 60 pulses/rev at 2400 rpm (2.4 kHz pulse rate)

@@ -11,8 +11,9 @@ import pytest
 from rwadist.data import DataError, read_steady, write_steady
 from rwadist.empirical import fit_empirical
 from rwadist.hdf5 import read_hdf5, write_hdf5
+from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
-from rwadist.teststand import preset, simulate_steady
+from rwadist.teststand import simulate_steady
 from rwadist.units import CHANNEL_COLUMN
 
 FS = 3840.0
@@ -125,8 +126,9 @@ def test_rate_disagreeing_with_meta_beyond_rounding_is_refused(tmp_path, steady)
 
 def test_hdf5_sweep_time_rounded_to_microseconds(tmp_path):
     """HDF5 uses the same time check: a sweep whose time dataset holds microsecond-rounded stamps reads."""
-    from rwadist.data import Sweep
     import h5py
+
+    from rwadist.data import Sweep
 
     n = 4096
     t = np.arange(n) / FS
@@ -145,8 +147,9 @@ def test_hdf5_sweep_time_rounded_to_microseconds(tmp_path):
 
 def test_hdf5_sweep_time_stored_as_float32(tmp_path):
     """A lab's HDF5 time stamps in float32 jitter by float32 rounding: accepted; a dropped sample still refused."""
-    from rwadist.data import Sweep
     import h5py
+
+    from rwadist.data import Sweep
 
     n = 4096
     t = np.arange(n) / FS
