@@ -4,7 +4,8 @@
 (:func:`fmu.runtime.model_from_doc`, :func:`fmu.runtime.effects_from_doc`,
 :func:`fmu.runtime.expand_lines`), writes the parsed model as C data (``wheel_model.h``: every
 number as a C99 hexadecimal float literal, so the C model holds the very doubles Python holds),
-and compiles ``native/rwadist_wheel_fmu.c`` (FMI 2.0 API, run-time checks, state), the step
+and compiles ``native/rwadist_wheel_fmu.c`` (FMI 2.0 API, FMU state) with
+``native/rwadist_wheel_runtime.h`` (model set-up from the parameters, input checks, ripple, floors), the step
 kernel ``native/rwadist_kernel.h`` (shared with the pythonfmu FMU's native layer) and
 ``native/rwadist_rng.h`` (numpy's ``default_rng`` in C: the same seed gives the same line, ripple
 and floor phases as the Python FMU) into ``binaries/linux64/<id>.so``.  The FMU ships those
@@ -35,7 +36,7 @@ from .build import NativeBuildError, model_document, model_physics, native_suppo
 HERE = Path(__file__).resolve().parent
 NATIVE = HERE / "native"
 C_SOURCE = "rwadist_wheel_fmu.c"
-SOURCES = (C_SOURCE, "rwadist_kernel.h", "rwadist_rng.h")
+SOURCES = (C_SOURCE, "rwadist_wheel_runtime.h", "rwadist_kernel.h", "rwadist_rng.h")
 FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 PLATFORM = "linux64"
 
