@@ -50,7 +50,7 @@ from .formats.csv_table import TIME_COLUMN
 from .formats.records import DataError, RawRecord, Run, SteadyTest, Sweep, json_default, portable_meta, read_json
 from .formats.timebase import sample_step
 from .hdf5 import read_hdf5
-from .units import rad_s_to_rpm, rpm_to_rad_s
+from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm, rpm_to_rad_s  # noqa: F401 (re-exported)
 
 __all__ = ["DataError", "Run", "SteadyTest", "Sweep", "RawRecord", "read_json", "read_run", "read_steady",
            "read_sweep", "read_data", "write_run", "write_steady", "write_sweep", "sample_step",
