@@ -1,6 +1,7 @@
 """The rwadist command line end to end on small generated data."""
 import csv
 import io
+import json
 
 import numpy as np
 import pytest
@@ -120,9 +121,15 @@ def test_fit_extended_then_campbell_from_the_fitted_model(tmp_path, capsys):
     assert code == 0 and (tmp_path / "c.csv").exists() and (tmp_path / "c.png").exists()
 
 
-def test_fit_extended_needs_mass_and_radius(tmp_path, capsys):
+def test_fit_extended_without_mass_and_radius_is_per_unit(tmp_path, capsys):
+    # issue 14: mass and radius are optional (the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr,
+    # I_zz/I_rr); 8 speeds of hard-mounted-like data pin no mode, and the fit says so in the file
     data = tmp_path / "e"
     run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "8",
         "--samples", "2048", "--sample-rate", "1920")
-    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--extended")
-    assert code == 2 and "mass" in err
+    code, out, _ = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--extended")
+    assert code == 0 and "per unit mass" in out
+    doc = json.loads((tmp_path / "m.json").read_text())
+    assert doc["analytical"]["mass_kg"] == 1.0 and doc["analytical"]["unconstrained"]
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m2.json", "--extended", "--mass", "0", "--radius", "0.2")
+    assert code == 2 and "--mass" in err
