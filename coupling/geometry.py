@@ -1,6 +1,6 @@
 """Mounting geometry: where a 6-axis component sits on a plant's interface nodes.
 
-Convention (``shared/CONVENTIONS.md``): a mounting is a direction-cosine matrix ``dcm``
+Convention (``docs/formats.md``): a mounting is a direction-cosine matrix ``dcm``
 (wheel frame -> spacecraft frame, so ``v_sc = dcm @ v_wheel``) plus the interface
 position ``position`` (m, spacecraft frame) relative to the reference point of the plant
 node it is bolted to.  Moving a load from the interface point to the node adds r × F to

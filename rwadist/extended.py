@@ -16,7 +16,7 @@ housing, which is rigid and bolted to the interface:
       I_rr ψ̈ + (c_rock − i·I_zz·Ω) ψ̇ + k_rock ψ = T(t)
 
   (the thesis's Eq. 4.19 written with ψ; its Eq. 4.5 swaps the inertias, see
-  CONVENTIONS.md).  With ψ ∝ e^{iνt} the undamped characteristic polynomial is
+  docs/formats.md).  With ψ ∝ e^{iνt} the undamped characteristic polynomial is
   ``I_rr ν² − I_zz Ω ν − k_rock = 0``: ν = aΩ/2 ± sqrt((aΩ/2)² + ω0²), a = I_zz/I_rr,
   ω0² = k_rock/I_rr.  For Ω > 0 the root ν > 0 whirls with the spin (forward, rises
   with speed) and ν < 0 against it (backward, falls).  For Ω < 0 the roles swap:

@@ -23,7 +23,7 @@ harmonic takes part and the fit is a least-squares problem:
 
 A mode the data do not constrain keeps its starting value and is said to be so: a note, and
 ``unconstrained`` (``analytical.unconstrained`` in the model file), never silently.  Mass and
-radius come from the datasheet (thin-disc inertias, CONVENTIONS.md) or are left out (a per-unit
+radius come from the datasheet (thin-disc inertias, docs/formats.md) or are left out (a per-unit
 fit: the interface loads depend only on the ratios); ``height`` (lever arm from the radial
 force to the reported torque) is geometry, given, default 0 (torques about the
 rotor centre).

@@ -1,6 +1,6 @@
 """Mounting geometry, one home: the DCM check, the lever-arm load transform and the spin-axis DCM.
 
-Convention (``shared/CONVENTIONS.md``): a mounting is a direction-cosine matrix R (wheel frame ->
+Convention (``docs/formats.md``): a mounting is a direction-cosine matrix R (wheel frame ->
 spacecraft frame, ``v_sc = R @ v_wheel``) and the interface position r (m, spacecraft frame, from the
 reference point the loads are moved to).  Loads move as::
 

@@ -1,4 +1,4 @@
-"""The wheel model and its versioned JSON file (``shared/CONVENTIONS.md``).
+"""The wheel model and its versioned JSON file (``docs/formats.md``).
 
 One document drives the kit, ``rwadist psd`` and the FMU::
 

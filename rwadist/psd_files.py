@@ -12,7 +12,7 @@ from .units import CHANNELS, PSD_COLUMN
 
 
 def write_psd_csv(res: BroadbandPSD, path) -> Path:
-    """Auto-spectra: columns f_Hz, Fx_N2_per_Hz, ..., Tz_Nm2_per_Hz (CONVENTIONS.md)."""
+    """Auto-spectra: columns f_Hz, Fx_N2_per_Hz, ..., Tz_Nm2_per_Hz (docs/formats.md)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     data = np.column_stack([res.f, res.psd])

@@ -1,6 +1,6 @@
 """Spectra of steady-state runs: Welch PSDs, amplitude spectra, RMS, peaks.
 
-Conventions (``shared/CONVENTIONS.md``): PSDs are one-sided, unit²/Hz, Welch
+Conventions (``docs/formats.md``): PSDs are one-sided, unit²/Hz, Welch
 with a Hann window; their integral over frequency is the mean square.
 Amplitude spectra read the peak amplitude of a sinusoid centred on a bin
 (``sqrt(2 * power spectrum)``); between bins a Hann window reads up to 15 %

@@ -1,4 +1,4 @@
-"""Units, channels and directions fixed by ``shared/CONVENTIONS.md``.
+"""Units, channels and directions fixed by ``docs/formats.md``.
 
 SI inside the code (rad/s for wheel speed ``omega``); rpm exists only at the
 edges and is converted here, once.

@@ -1,4 +1,4 @@
-"""A catalogue of real wheels for early design: one model file per wheel (CONVENTIONS.md format).
+"""A catalogue of real wheels for early design: one model file per wheel (docs/formats.md).
 
 Each file's ``provenance`` says where every number comes from: ``source`` (citation),
 ``measured`` (what was measured, what is a datasheet value, what is assumed) and
