@@ -22,7 +22,6 @@ speed; at standstill the first window's).  A pulse gives the magnitude of the sp
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import median_filter
 
 from .records import DataError
 
@@ -80,6 +79,8 @@ def pulse_edges(path, channel: str, x: np.ndarray, fs: float, ppr: int) -> np.nd
                         "need at least 3")
     d = np.diff(edges)
     window = max(5, 2 * ppr + 1)
+    from scipy.ndimage import median_filter  # here, not at import: `import rwadist` stays light
+
     typical = median_filter(d, size=window, mode="nearest")
     ratio = d / typical
     bad = np.flatnonzero((ratio > MISSING_PULSE_RATIO) | (ratio < DOUBLE_TRIGGER_RATIO))
