@@ -166,6 +166,8 @@ def run_extended_fit(test, fit, args):
               flush=True)
     efit = fit_extended(test, fit, mass, radius, height=args.height, start=start)
     p = efit.params
+    if efit.per_unit:
+        print("  (stiffness and damping below are per kg of rotor mass / per kg·m² of transverse inertia)")
     print(f"  radial translation {p.omega_r / (2 * np.pi):7.2f} Hz  zeta {efit.zeta['radial_translation']:.3f}"
           f"  (k_r {p.k_r:.4g} N/m)")
     print(f"  rocking at rest    {p.omega_rock / (2 * np.pi):7.2f} Hz  zeta {efit.zeta['rocking']:.3f}"
