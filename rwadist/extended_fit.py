@@ -13,7 +13,10 @@ harmonic takes part and the fit is a least-squares problem:
    at every speed: radial-force lines place the radial translation mode, radial-torque lines the
    rocking mode through BOTH whirls (co-rotating content meets the forward whirl, counter-rotating
    the backward one, f± = sqrt((aΩ/2)² + f0²) ± aΩ/2, a = I_zz/I_rr), axial-force lines the axial
-   mode.  The scan also gives the damping start and, without mass and radius, a.
+   mode.  The scan also gives the damping start and, without mass and radius, a.  A mode whose
+   scan has an interior best point is *located*; it is *found* when the least squares below pins
+   its frequency (1.5 standard errors within ``tolerance``, 2 %, and not at the ±5 % search
+   limit); otherwise it is declared not constrained and the least squares is repeated without it.
 3. **Least squares** of log amplitude over every measured line at every speed
    (amplified or not): stiffnesses, damping of each mode and the forcing
    coefficient of each line (U_s and U_d are the h = 1 radial force and torque
@@ -250,7 +253,8 @@ def _scan_all(meas_lines, la, sa, aa, inertia_ratio, tolerance):
             m = dr == direction
             line, omega, power = lr[m], sr[m], pr[m]
         scans[mode] = scan_mode(mode, line, h_of[line] if line.size else np.zeros(0), omega, power,
-                                inertia_ratio=inertia_ratio if mode == "rocking" else None, tolerance=tolerance)
+                                inertia_ratio=inertia_ratio if mode == "rocking" else None, tolerance=tolerance,
+                                min_log_lr=-math.inf)
     return scans
 
 
@@ -352,66 +356,98 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     rad_ch = np.array([[CHANNEL_INDEX[c] for c in DIRECTION_CHANNELS[d]] for d in dr], int).reshape(-1, 2)
 
     identified = {m: f_modes[m] is not None for m in _MODE_PARAMS}
-    free_modes = [m for m in _MODE_PARAMS if identified[m]]
     z_start = {m: (scans[m].zeta if identified[m] else zeta0) for m in _MODE_PARAMS}
     base = dict(mass=mass, I_zz=I_zz, I_rr=I_rr, k_r=k_r, k_rock=k_rock, k_z=k_z, height=0.0,
                 c_r=2 * z_start["radial_translation"] * math.sqrt(k_r * mass),
                 c_rock=2 * z_start["rocking"] * math.sqrt(k_rock * I_rr),
                 c_z=2 * z_start["axial_translation"] * math.sqrt(k_z * mass), U_s=0.0, U_d=0.0)
-    names = [p for m in free_modes for p in _MODE_PARAMS[m][:2]] + \
-            [f"C[{ln.direction},{ln.h:g},{ln.sense}]" for ln in lines]
-    x0 = np.log([base[n] for m in free_modes for n in _MODE_PARAMS[m][:2]] + [ln.C for ln in lines])
-    n_mode = 2 * len(free_modes)
+    x_lines = np.log([ln.C for ln in lines])
 
-    def unpack(theta):
-        vals = dict(base)
-        k = 0
+    def least_squares(free_modes):
+        """Log-amplitude least squares with the stiffness and damping of ``free_modes`` free."""
+        names = [p for m in free_modes for p in _MODE_PARAMS[m][:2]] + \
+                [f"C[{ln.direction},{ln.h:g},{ln.sense}]" for ln in lines]
+        x0 = np.concatenate([np.log([base[n] for m in free_modes for n in _MODE_PARAMS[m][:2]]), x_lines])
+        n_mode = 2 * len(free_modes)
+
+        def unpack(theta):
+            vals = dict(base)
+            k = 0
+            for m in free_modes:
+                kn, cn, inertia = _MODE_PARAMS[m]
+                vals[kn] = math.exp(theta[k])
+                # damping stays below critical (the model refuses overdamped modes)
+                vals[cn] = min(math.exp(theta[k + 1]), 1.9 * math.sqrt(vals[kn] * vals[inertia]))
+                k += 2
+            C = np.exp(theta[n_mode:])
+            lns = [replace(ln, C=float(c)) for ln, c in zip(lines, C)]
+            vals["U_s"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_force"), 0.0)
+            vals["U_d"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_torque"), 0.0)
+            return ext.ExtendedParams(**vals), lns
+
+        def residuals(theta):
+            p, lns = unpack(theta)
+            _, A = ext.steady_lines(p, lns, speeds)
+            P = np.abs(A) ** 2
+            r_ax = np.log(np.maximum(aa, 1e-300)) - 0.5 * np.log(np.maximum(P[ia, ax_line, ca], 1e-300))
+            pred = np.zeros(lr.size)
+            for part in range(2):
+                for c in range(2):
+                    pred += P[ir, rad_parts[:, part], rad_ch[:, c]]
+            r_rad = 0.5 * (np.log(np.maximum(pr, 1e-300)) - np.log(np.maximum(pred, 1e-300)))
+            return np.concatenate([r_ax, r_rad])
+
+        # bounds keep the search physical: stiffness within ±10 % of the scan's (frequency ±5 %),
+        # damping ratio in [1e-4, 0.95], line coefficients within 1000x (down to 1e-4 of the line
+        # for the sense parts, which may vanish)
+        lo, hi = [], []
         for m in free_modes:
             kn, cn, inertia = _MODE_PARAMS[m]
-            vals[kn] = math.exp(theta[k])
-            # damping stays below critical (the model refuses overdamped modes)
-            vals[cn] = min(math.exp(theta[k + 1]), 1.9 * math.sqrt(vals[kn] * vals[inertia]))
-            k += 2
-        C = np.exp(theta[n_mode:])
-        lns = [replace(ln, C=float(c)) for ln, c in zip(lines, C)]
-        vals["U_s"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_force"), 0.0)
-        vals["U_d"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_torque"), 0.0)
-        return ext.ExtendedParams(**vals), lns
+            crit = 2 * math.sqrt(base[kn] * base[inertia])
+            lo += [math.log(base[kn] / 1.1), math.log(1e-4 * crit / 2)]
+            hi += [math.log(base[kn] * 1.1), math.log(0.95 * crit * 2)]
+        lo += list(x0[n_mode:] - math.log(1e4))
+        hi += list(x0[n_mode:] + math.log(1e3))
+        res = optimize.least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
+                                     verbose=2 if progress else 0)
+        dof = max(res.fun.size - res.x.size, 1)
+        s2 = float(np.sum(res.fun**2) / dof)
+        try:
+            rel_se = np.sqrt(np.clip(np.diag(np.linalg.pinv(res.jac.T @ res.jac) * s2), 0, None))
+        except np.linalg.LinAlgError:
+            rel_se = np.full(res.x.size, np.nan)
+        at_bound = {m: bool(min(res.x[2 * i] - lo[2 * i], hi[2 * i] - res.x[2 * i]) < 0.01)
+                    for i, m in enumerate(free_modes)}
+        return res, names, rel_se, unpack, at_bound
 
-    def residuals(theta):
-        p, lns = unpack(theta)
-        _, A = ext.steady_lines(p, lns, speeds)
-        P = np.abs(A) ** 2
-        r_ax = np.log(np.maximum(aa, 1e-300)) - 0.5 * np.log(np.maximum(P[ia, ax_line, ca], 1e-300))
-        pred = np.zeros(lr.size)
-        for part in range(2):
-            for c in range(2):
-                pred += P[ir, rad_parts[:, part], rad_ch[:, c]]
-        r_rad = 0.5 * (np.log(np.maximum(pr, 1e-300)) - np.log(np.maximum(pred, 1e-300)))
-        return np.concatenate([r_ax, r_rad])
-
-    # bounds keep the search physical: stiffness within ±10 % of the scan's (frequency ±5 %: the
-    # scan placed it to 1 %), damping ratio in [1e-4, 0.95], line coefficients within 1000x (down
-    # to 1e-4 of the line for the sense parts, which may vanish)
-    lo, hi = [], []
-    for m in free_modes:
-        kn, cn, inertia = _MODE_PARAMS[m]
-        crit = 2 * math.sqrt(base[kn] * base[inertia])
-        lo += [math.log(base[kn] / 1.1), math.log(1e-4 * crit / 2)]
-        hi += [math.log(base[kn] * 1.1), math.log(0.95 * crit * 2)]
-    lo += list(x0[n_mode:] - math.log(1e4))
-    hi += list(x0[n_mode:] + math.log(1e3))
-    res = optimize.least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
-                                 verbose=2 if progress else 0)
+    # a located mode counts as found when the least squares pins its frequency: 1.5 standard errors
+    # (of f = sqrt(k/m)/2π, half the relative error of k) within the tolerance, away from the bounds;
+    # otherwise it goes back to its starting value, is declared, and the fit is repeated without it
+    free_modes = [m for m in _MODE_PARAMS if identified[m]]
+    while True:
+        res, names, rel_se, unpack, at_bound = least_squares(free_modes)
+        loose = []
+        for i, m in enumerate(free_modes):
+            se_f = 0.5 * float(rel_se[2 * i])
+            if at_bound[m] or not (1.5 * se_f <= tolerance):
+                f_fit = math.sqrt(math.exp(res.x[2 * i]) / base[_MODE_PARAMS[m][2]]) / (2 * np.pi)
+                why = ("the best fit sits at the ±5 % limit around the scan's frequency" if at_bound[m] else
+                       f"located at {f_fit:.4g} Hz but only to ±{100 * 1.5 * se_f:.1f} % (1.5 standard errors), "
+                       f"not {100 * tolerance:g} %")
+                loose.append((m, why))
+        if not loose:
+            break
+        for m, why in loose:
+            scans[m].reason = why
+            scans[m].found = False
+            identified[m] = False
+            f_modes[m] = None
+            kn, cn, inertia = _MODE_PARAMS[m]
+            base[kn] = start_k(m, base[inertia], kn)
+            base[cn] = 2 * zeta0 * math.sqrt(base[kn] * base[inertia])
+            free_modes.remove(m)
     params, fitted_lines = unpack(res.x)
     params = replace(params, height=float(height))
-    dof = max(res.fun.size - res.x.size, 1)
-    s2 = float(np.sum(res.fun**2) / dof)
-    try:
-        cov = np.linalg.pinv(res.jac.T @ res.jac) * s2
-        rel_se = np.sqrt(np.clip(np.diag(cov), 0, None))
-    except np.linalg.LinAlgError:
-        rel_se = np.full(res.x.size, np.nan)
     rel_stderr = {n: float(v) for n, v in zip(names, rel_se)}
     zeta = {"radial_translation": params.zeta_r, "rocking": params.zeta_rock, "axial_translation": params.zeta_z}
     # rotation sense from the fitted forcing; negligible parts (< 1 % of the line's power) dropped

@@ -23,6 +23,10 @@ of a factor 1.6 (2.0) and a-steps of 0.2; the best point is refined to 0.1 % (th
 follows refines it).  Otherwise the data do not
 constrain the mode (no line comes near it, only a skirt is seen, or the whirl it shows trades off
 against I_zz/I_rr) and the result says so; nothing is invented.
+
+:func:`rwadist.extended_fit.fit_extended` uses the scan only to locate each mode (interior best point,
+``min_log_lr = -inf``) and decides "found" from its log-amplitude least squares (standard error of
+the frequency), which measured more reliable than this profile on edge-of-range cases.
 """
 from __future__ import annotations
 
@@ -158,15 +162,26 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     profile = np.nanmin(ssr, axis=(1, 2))
     log_lr = 0.5 * n * np.log(np.maximum(profile, 1e-300) / max(best, 1e-300))
     off = np.abs(np.log(f0_grid / f_best)) > math.log1p(tolerance)
-    log_lr_off = float(np.min(log_lr[off])) if off.any() else math.inf
-    inside = np.nonzero(log_lr < min_log_lr)[0]
+    log_lr_off = math.inf
+    if off.any():
+        # the competitor farther than the tolerance gets the same refinement as the best point (a coarse
+        # ζ grid would make it look worse than it is and the mode look pinned when it is not)
+        io = np.nonzero(off)[0][np.argmin(log_lr[off])]
+        jo, ko = np.unravel_index(np.nanargmin(ssr[io]), ssr[io].shape)
+        f_o = f0_grid[io] * np.exp(np.arange(-f_step, f_step + 0.0001, 0.002))
+        f_o = f_o[np.abs(np.log(f_o / f_best)) > math.log1p(tolerance)]
+        z_o = zeta_grid[jo] * np.exp(np.linspace(-0.5, 0.5, 11) * (1 if a_grid.size == 1 else 1.5))
+        a_o = a_grid if a_grid.size == 1 else np.unique(np.clip(a_grid[ko] + np.linspace(-0.2, 0.2, 21), 0.02, 2.0))
+        ssr_o = min(float(np.nanmin(_grid_search(line, h, omega, power, f_o, z_o, a_o, two_parts))), float(profile[io]))
+        log_lr_off = float(0.5 * n * np.log(max(ssr_o, 1e-300) / max(best, 1e-300)))
+    inside = np.nonzero(log_lr < max(min_log_lr, 2.0))[0]
     interval = (float(f0_grid[inside.min()]), float(f0_grid[inside.max()])) if inside.size else (f_best, f_best)
     reason = ""
     if f_best <= f0_grid[2] * 1.001 or f_best >= f0_grid[-3] * 0.999:
         reason = (f"the best fit puts it at the end of the scanned range ({f_best:.4g} Hz of "
                   f"{f0_grid[0]:.4g}-{f0_grid[-1]:.4g} Hz): no line comes near it")
     elif log_lr_off < min_log_lr:
-        far = f0_grid[off][np.argmin(log_lr[off])]
+        far = f0_grid[io]
         reason = (f"the data fit a mode at {far:.4g} Hz almost as well as at {f_best:.4g} Hz "
                   f"(log-likelihood ratio {log_lr_off:.1f} < {min_log_lr:g}): its frequency is not pinned to "
                   f"{100 * tolerance:g} % (f0 within {interval[0]:.4g}-{interval[1]:.4g} Hz)")

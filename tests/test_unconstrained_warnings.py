@@ -1,0 +1,48 @@
+"""A model whose analytical.unconstrained lists modes: psd, fmu build and diagnose say so (stderr), once,
+naming the file and the modes; a model without the list (or with it empty) gives no warning."""
+import pytest
+
+from rwadist import model as model_io
+from rwadist.cli import main
+from rwadist.extended_fit import unconstrained_warning
+from rwadist.teststand import preset
+
+
+@pytest.fixture()
+def model_file(tmp_path):
+    m = preset("ithaco-e").to_model()
+    m.analytical["unconstrained"] = ["rocking"]
+    return model_io.save(m, tmp_path / "m.json")
+
+
+def test_warning_text_names_modes_and_file():
+    m = preset("ithaco-e").to_model()
+    assert unconstrained_warning(m, "x.json", "the PSD") is None
+    m.analytical["unconstrained"] = []
+    assert unconstrained_warning(m, "x.json", "the PSD") is None
+    m.analytical["unconstrained"] = ["rocking", "axial"]
+    text = unconstrained_warning(m, "x.json", "the PSD")
+    assert "x.json" in text and "'rocking'" in text and "'axial'" in text and "starting values" in text
+
+
+def test_psd_warns(model_file, tmp_path, capsys):
+    assert main(["psd", str(model_file), "--speed-rpm", "500:1500", "--n-freq", "200", "--n-speeds", "20",
+                 "-o", str(tmp_path / "p.csv")]) == 0
+    err = capsys.readouterr().err
+    assert err.count("analytical.unconstrained") == 1 and "the PSD" in err
+
+
+def test_fmu_build_warns(model_file, tmp_path, capsys):
+    pytest.importorskip("pythonfmu")
+    assert main(["fmu", "build", str(model_file), "-o", str(tmp_path / "w.fmu")]) == 0
+    err = capsys.readouterr().err
+    assert err.count("analytical.unconstrained") == 1 and "the FMU" in err
+
+
+def test_diagnose_warns(model_file, tmp_path, capsys):
+    data = tmp_path / "d"
+    assert main(["simulate-test", str(data), "--preset", "ithaco-e", "--speeds-rpm", "600:2400", "--n-speeds", "6",
+                 "--samples", "2048", "--sample-rate", "1920"]) == 0
+    main(["diagnose", str(data), "-o", str(tmp_path / "r"), "--model", str(model_file)])
+    err = capsys.readouterr().err
+    assert err.count("analytical.unconstrained") == 1 and "diagnose" in err
