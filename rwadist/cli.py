@@ -144,10 +144,6 @@ def run_extended_fit(test, fit, args):
     for flag, value in (("--mass", mass), ("--radius", radius)):
         if value is not None and not (np.isfinite(value) and value > 0):
             raise DataError(flag, "value", f"{value!r}: must be a positive number (kg / m)")
-    if (mass is None or radius is None) and not args.per_unit:
-        raise DataError("--extended", "mass/radius", "the extended fit needs the rotor mass and radius: "
-                        "give --mass KG --radius M or --preset NAME, or --per-unit to fit per unit mass and "
-                        "inertia (the interface loads depend only on the ratios)")
     if mass is None or radius is None:
         print("fitting the extended model per unit mass and inertia (no --mass/--radius: the interface loads "
               f"depend only on k/M, c/M, k_theta/I_rr, c_theta/I_rr, I_zz/I_rr; height = {args.height:g} m) ...",
@@ -198,9 +194,8 @@ def _add_fit_options(p):
                    help="speed of sweep slices: tach column, estimated from data, or auto")
     p.add_argument("--extended", action="store_true",
                    help="also fit the extended model (modes, damping, imbalances) into the model file")
-    p.add_argument("--mass", type=float, default=None, help="rotor mass, kg (extended fit)")
-    p.add_argument("--per-unit", action="store_true",
-                   help="extended fit without --mass/--radius: per unit mass and inertia, I_zz/I_rr fitted")
+    p.add_argument("--mass", type=float, default=None,
+                   help="rotor mass, kg (extended fit; without --mass/--radius the fit is per unit mass/inertia)")
     p.add_argument("--radius", type=float, default=None, help="rotor radius, m (extended fit; thin-disc inertias)")
     p.add_argument("--height", type=float, default=0.0,
                    help="lever arm from the rotor centre to the torque reference point, m (default 0)")
