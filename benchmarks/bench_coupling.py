@@ -20,7 +20,7 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-import coupling as cp  # noqa: E402
+from rwadist import coupling as cp  # noqa: E402
 from rwadist import extended as ext  # noqa: E402
 from rwadist.presets import preset  # noqa: E402
 from rwadist.units import RPM_TO_RAD_S  # noqa: E402

@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 
 
-from fmu import hosts
-from fmu.build import build_preset
+from rwadist.fmu import hosts
+from rwadist.fmu.build import build_preset
 
 TRIVIAL = '''
 from pythonfmu import Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real
@@ -69,7 +69,7 @@ def main(argv=None) -> int:
         tmp = Path(tmp)
         wheel = build_preset("ithaco-e", tmp / "wheel.fmu")
         trivial = build_trivial(tmp)
-        from fmu.build import build_fmu
+        from rwadist.fmu.build import build_fmu
         from rwadist.presets import preset
         model = preset("ithaco-e").to_model()
         model.effects = [{"kind": "broadband_floor", "channel": ["Fx", "Fy", "Fz"], "exponent": 3.0,
@@ -78,7 +78,7 @@ def main(argv=None) -> int:
                          {"kind": "speed_ripple", "f_ripple_Hz": 8.0, "delta_omega_rad_s": 3.0,
                           "omega_ref_rad_s": 300.0}]
         effects = build_fmu(model, tmp / "wheel_effects.fmu")
-        from fmu.build import has_native
+        from rwadist.fmu.build import has_native
         print(f"{n} steps of {h:g} s ({args.seconds:g} s simulated); wheel: ithaco-e preset, 18 lines, 12 outputs, "
               f"native layer: {'yes (C kernel)' if has_native(wheel) else 'no (numpy steps)'}")
         for host in args.hosts.split(","):

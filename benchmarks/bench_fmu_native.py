@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu.native_build import FMI2_HEADERS, NATIVE, build_native_fmu, compile_c_host, compile_sources  # noqa: F401
+from rwadist.fmu.native_build import FMI2_HEADERS, NATIVE, build_native_fmu, compile_c_host, compile_sources  # noqa: F401
 from rwadist import model as model_io
 from rwadist.presets import preset
 

@@ -23,9 +23,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from fmu import hosts  # noqa: E402
-from fmu.build import build_fmu  # noqa: E402
-from fmu.native_build import build_native_fmu  # noqa: E402
+from rwadist.fmu import hosts  # noqa: E402
+from rwadist.fmu.build import build_fmu  # noqa: E402
+from rwadist.fmu.native_build import build_native_fmu  # noqa: E402
 from rwadist import catalogue  # noqa: E402
 from rwadist import extended as ext  # noqa: E402
 from rwadist import model as model_io  # noqa: E402

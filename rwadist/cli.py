@@ -383,8 +383,8 @@ def cmd_campbell(args) -> int:
 
 def cmd_fmu_build(args) -> int:
     try:
-        from fmu.build import build_fmu, has_native
-        from fmu.runtime import ModelError
+        from rwadist.fmu.build import build_fmu, has_native
+        from rwadist.fmu.runtime import ModelError
     except ImportError as exc:
         raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
     if args.model:
@@ -396,7 +396,7 @@ def cmd_fmu_build(args) -> int:
         source = catalogue.preset_model(args.preset or "ithaco-e") or preset(args.preset or "ithaco-e").to_model()
     try:
         if getattr(args, "native", False):
-            from fmu.native_build import build_native_fmu
+            from rwadist.fmu.native_build import build_native_fmu
             path = build_native_fmu(source, args.output, assumed_modes=args.assumed_modes)
         else:
             path = build_fmu(source, args.output, assumed_modes=args.assumed_modes)
@@ -426,7 +426,7 @@ def cmd_fmu_check(args) -> int:
         print(f"validation: {prob}")
     print(f"fmpy validation: {len(problems)} problem(s)")
     try:
-        from fmu.build import has_native
+        from rwadist.fmu.build import has_native
         print(f"native layer (fmi2Error on bad input, C step kernel): {'yes' if has_native(args.fmu) else 'no'}")
     except Exception:   # informational only; validation above already judged the file
         pass

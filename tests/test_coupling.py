@@ -9,8 +9,8 @@ import control
 import numpy as np
 import pytest
 
-import coupling as cp
-from coupling import components as comp
+from rwadist import coupling as cp
+from rwadist.coupling import components as comp
 from rwadist import extended as ext
 from rwadist.presets import preset
 from rwadist.units import RPM_TO_RAD_S
@@ -330,7 +330,7 @@ def test_diagnosed_amplitude_law_reaches_the_coupled_prediction():
     coupling kit: wheel_spec_from_model attaches the law, the free excitation of that line is
     A_ref·(|Ω|/Ω_ref)^p (= a harmonic with C rescaled to that amplitude at each speed, built by
     hand), the hard-mounted path still equals extended.steady_lines, other lines unchanged."""
-    from coupling.performance import wheel_spec_from_model
+    from rwadist.coupling.performance import wheel_spec_from_model
     model = preset("ithaco-e").to_model()
     model.effects = [{"kind": "amplitude_law", "direction": "radial_force", "h": 2.0, "exponent": 2.6,
                       "amplitude_ref": 0.003, "omega_ref_rad_s": 200.0}]
@@ -372,7 +372,7 @@ def test_diagnosed_resonance_and_sidebands_reach_the_coupled_prediction():
     equals extended.steady_lines; and the coupled prediction (line_responses on a flexible spacecraft)
     equals the one where every sideband is replaced, at that speed, by a plain harmonic of the same
     whirl rate h' = h ± 2πf_mod/Ω -- an independent route to the frequency the plant is evaluated at."""
-    from coupling.performance import wheel_spec_from_model
+    from rwadist.coupling.performance import wheel_spec_from_model
     from rwadist.diagnose import resonance
     model = preset("ithaco-e").to_model()
     model.effects = [dict(e) for e in EFFECTS]

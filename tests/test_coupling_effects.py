@@ -12,8 +12,8 @@ import pytest
 from scipy import integrate, linalg
 from scipy.special import jv
 
-import coupling as cp
-from coupling.performance import wheel_spec_from_model
+from rwadist import coupling as cp
+from rwadist.coupling.performance import wheel_spec_from_model
 from rwadist import extended as ext
 from rwadist.diagnose import ripple_sideband_powers
 from rwadist.presets import preset

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from fmu import runtime as rt
+from rwadist.fmu import runtime as rt
 from rwadist import model as model_io
 from rwadist.diagnose import diagnose
 
@@ -95,7 +95,7 @@ def test_diagnosed_floor_reaches_the_coupling_kit():
     floored channel at 1500 rpm is within 25 % of the injected floor's in every 20-Hz band from 10 to 210 Hz;
     carried through a spacecraft (practice 'i', the blocked load on the bus), the line-of-sight mean square
     over 10-300 Hz is within 25 % of that of the injected floor through the same transfer."""
-    import coupling as cp
+    from rwadist import coupling as cp
 
     test = e_data(1)
     wmax = np.abs(SPEEDS).max() * 2 * np.pi / 60

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 
-from fmu import hosts, runtime as rt
-from fmu.build import build_fmu, has_native, native_supported
+from rwadist.fmu import hosts, runtime as rt
+from rwadist.fmu.build import build_fmu, has_native, native_supported
 from rwadist import extended as ext
 from rwadist import model as model_io
 from rwadist.presets import preset
@@ -95,7 +95,7 @@ def test_runtime_equals_simulate_time(model_path, model, profile):
 @pytest.fixture(scope="module")
 def kernel(tmp_path_factory):
     """The native step kernel compiled here (None where no C compiler / not Linux x86-64)."""
-    from fmu.build import NativeBuildError, compile_native
+    from rwadist.fmu.build import NativeBuildError, compile_native
     if REFUSED != 3:
         return None
     try:
@@ -814,7 +814,7 @@ def test_bad_resonance_or_sideband_entry_is_refused(model, index, field, value):
 
 def test_unmatched_sidebands_warn(model):
     """Sidebands of a harmonic the model does not have add nothing, and the build says so."""
-    from fmu.build import model_document
+    from rwadist.fmu.build import model_document
     doc = effects_doc(model, [{"kind": "sidebands", "direction": "axial_force", "h": 6.5, "f_mod_Hz": 3.0,
                                "depth": 0.2}])
     with pytest.warns(RuntimeWarning, match="sidebands of axial_force h=6.5"):

@@ -11,8 +11,8 @@ import pytest
 from scipy.signal import welch
 from scipy.special import jv
 
-from fmu import hosts, runtime as rt
-from fmu.build import build_fmu
+from rwadist.fmu import hosts, runtime as rt
+from rwadist.fmu.build import build_fmu
 from rwadist import model as model_io
 from rwadist.presets import preset
 

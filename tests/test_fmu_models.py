@@ -8,8 +8,8 @@ import json
 import numpy as np
 import pytest
 
-from fmu import hosts, runtime as rt
-from fmu.build import build_fmu
+from rwadist.fmu import hosts, runtime as rt
+from rwadist.fmu.build import build_fmu
 from rwadist import catalogue
 
 pytest.importorskip("pythonfmu")
@@ -179,7 +179,7 @@ def test_simulate_test_extended_on_assumed_modes_needs_the_flag(tmp_path, capsys
     assert "ASSUMED" in json.loads((tmp_path / "st" / "meta.json").read_text())["modes_assumed"]
 
 
-@pytest.mark.skipif(not __import__("fmu.build", fromlist=["x"]).native_supported(), reason="native FMU: Linux x86-64")
+@pytest.mark.skipif(not __import__("rwadist.fmu.build", fromlist=["x"]).native_supported(), reason="native FMU: Linux x86-64")
 def test_native_fmu_empirical_and_hr16_default(tmp_path, capsys):
     """The native FMU (rwadist fmu build --native) of an empirical fit gives the C·Ω² lines (1e-9); of HR16-75
     it is hard-mounted by default (U_s·Ω², U_d·Ω² to 1e-6 at 3000 and 6000 rpm) and with --assumed-modes it
@@ -210,7 +210,7 @@ def test_native_fmu_empirical_and_hr16_default(tmp_path, capsys):
 
 def test_coupling_warns_on_assumed_modes():
     """The coupling kit keeps a model's analytical section as it is, and says when its modes are assumed."""
-    from coupling.performance import wheel_spec_from_model
+    from rwadist.coupling.performance import wheel_spec_from_model
     with pytest.warns(RuntimeWarning, match="ASSUMED"):
         wheel_spec_from_model(catalogue.load(HR16))
     import warnings

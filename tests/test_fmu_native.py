@@ -14,8 +14,8 @@ import zipfile
 import numpy as np
 import pytest
 
-from fmu import hosts, runtime as rt
-from fmu.build import build_fmu, native_supported
+from rwadist.fmu import hosts, runtime as rt
+from rwadist.fmu.build import build_fmu, native_supported
 from rwadist import extended as ext
 from rwadist import model as model_io
 from rwadist.presets import preset
@@ -25,7 +25,7 @@ fmpy = pytest.importorskip("fmpy")
 pytestmark = pytest.mark.skipif(not (native_supported() and shutil.which(os.environ.get("CC", "cc"))),
                                 reason="the native FMU's binary is built on Linux x86-64 with a C compiler")
 
-from fmu.native_build import VARIABLES, build_native_fmu, compile_c_host  # noqa: E402
+from rwadist.fmu.native_build import VARIABLES, build_native_fmu, compile_c_host  # noqa: E402
 
 RPM = 2 * np.pi / 60
 

@@ -23,7 +23,7 @@ def test_one_tolerance_for_every_consumer():
     """A DCM 1e-7 off (as typed with 7 digits) passes psd mountings, coupling and the FMU runtime alike;
     1e-5 off fails all three (before: coupling refused at 1e-9, the others at 1e-6)."""
     cp = pytest.importorskip("coupling")
-    from fmu import runtime as rt
+    from rwadist.fmu import runtime as rt
 
     R = _rot(np.random.default_rng(1))
     for eps, ok in ((1e-7, True), (1e-5, False)):
@@ -46,7 +46,7 @@ def test_runtime_copy_matches_the_home():
     """The FMU runtime's self-contained rotation check and spacecraft transform equal rwadist.geometry's."""
     import inspect
 
-    from fmu import runtime as rt
+    from rwadist.fmu import runtime as rt
 
     assert inspect.signature(rt.rotation_check).parameters["tol"].default == geometry.DCM_TOL
     rng = np.random.default_rng(2)

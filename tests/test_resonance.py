@@ -51,7 +51,7 @@ def test_teststand_mode_uses_the_home():
 def test_fmu_runtime_copy_matches_the_home(rpm):
     """fmu/runtime.py applies H inline (self-contained for hosts): each component's amplitude with the
     resonances over the one without is resonance_gain at its whirl rate ν = σhΩ + ω_off, to 1e-12."""
-    from fmu.runtime import WheelRuntime, model_from_doc
+    from rwadist.fmu.runtime import WheelRuntime, model_from_doc
 
     params, lines = model_from_doc(model_io.to_json(preset("ithaco-e").to_model()))
     dirs = ("radial_force", "radial_torque", "axial_force", "axial_torque")

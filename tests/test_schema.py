@@ -117,8 +117,8 @@ def test_extended_kit_refuses(entry, tail):
 @pytest.mark.parametrize("entry, tail", BAD, ids=["law_without_amplitude_ref", "floor_2_knots_1_psd"])
 def test_fmu_build_and_runtime_refuse(tmp_path, entry, tail, capsys):
     pytest.importorskip("pythonfmu")
-    from fmu import runtime as rt
-    from fmu.build import build_fmu
+    from rwadist.fmu import runtime as rt
+    from rwadist.fmu.build import build_fmu
 
     p, doc = write(tmp_path, [entry])
     with pytest.raises(rt.ModelError) as info:
@@ -134,8 +134,8 @@ def test_fmu_build_and_runtime_refuse(tmp_path, entry, tail, capsys):
 @pytest.mark.parametrize("entry, tail", BAD, ids=["law_without_amplitude_ref", "floor_2_knots_1_psd"])
 def test_coupling_refuses(entry, tail):
     pytest.importorskip("control")
-    from coupling import performance as cp
-    from coupling.errors import CouplingError
+    from rwadist.coupling import performance as cp
+    from rwadist.coupling.errors import CouplingError
 
     m = model_io.load(BASE)
     m.effects = [entry]
@@ -311,7 +311,7 @@ def test_fmu_runtime_reads_through_its_own_copy_without_rwadist(tmp_path):
     import sys
     import zipfile
 
-    from fmu.build import build_fmu
+    from rwadist.fmu.build import build_fmu
 
     fmu = build_fmu(BASE, tmp_path / "w.fmu", native=False)
     zipfile.ZipFile(fmu).extractall(tmp_path / "x")
