@@ -5,7 +5,7 @@ import pytest
 from rwadist import model as model_io
 from rwadist.cli import main
 from rwadist.extended_fit import unconstrained_warning
-from rwadist.teststand import preset
+from rwadist.presets import preset
 
 
 @pytest.fixture()
