@@ -87,9 +87,20 @@ static inline double complex rw_cexp(double complex z)
     return CMPLX(e * c, e * s);
 }
 
+/* principal square root in real arithmetic (csqrt's branch cut; without its scaling and hypot: the
+ * discriminants of the suspension modes are moderate) */
+static inline double complex rw_csqrt(double complex z)
+{
+    const double a = creal(z), b = cimag(z);
+    if (a == 0.0 && b == 0.0)
+        return CMPLX(0.0, b);
+    const double t = sqrt(0.5 * (fabs(a) + sqrt(a * a + b * b)));
+    return a >= 0 ? CMPLX(t, b / (2.0 * t)) : CMPLX(fabs(b) / (2.0 * t), copysign(t, b));
+}
+
 static void quad_roots(double m, double complex c, double k, double complex *l1, double complex *l2)
 {
-    double complex disc = csqrt(c * c - 4.0 * m * k);
+    double complex disc = rw_csqrt(c * c - 4.0 * m * k);
     double sgn = creal(conj(c) * disc) >= 0 ? 1.0 : -1.0;
     double complex q = -0.5 * (c + sgn * disc);
     *l1 = q / m;
