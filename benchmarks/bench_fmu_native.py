@@ -27,7 +27,13 @@ from pathlib import Path
 
 import numpy as np
 
-from fmu.native_build import FMI2_HEADERS, NATIVE, build_native_fmu, compile_c_host, compile_sources  # noqa: F401
+from fmu.native_build import (
+    FMI2_HEADERS,
+    NATIVE,
+    build_native_fmu,
+    compile_c_host,
+    compile_sources,
+)
 from rwadist import model as model_io
 from rwadist.presets import preset
 
@@ -81,20 +87,22 @@ NO(fmi2GetBooleanStatus, const fmi2StatusKind k, fmi2Boolean *v)
 NO(fmi2GetStringStatus, const fmi2StatusKind k, fmi2String *v)
 '''
 
-TRIVIAL_MD = '''<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="2.0" modelName="TrivialEchoC" guid="{trivial-echo-c}" description="y = u"
+_TRIVIAL_OUTPUTS = "\n".join(f'    <ScalarVariable name="y{k}" valueReference="{k + 1}" causality="output" '
+                             'variability="continuous" initial="exact"><Real start="0"/></ScalarVariable>'
+                             for k in range(12))
+TRIVIAL_MD = f'''<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="TrivialEchoC" guid="{{trivial-echo-c}}" description="y_k = u"
   variableNamingConvention="structured" numberOfEventIndicators="0">
   <CoSimulation modelIdentifier="TrivialEchoC" canHandleVariableCommunicationStepSize="true"/>
   <DefaultExperiment startTime="0.0" stopTime="1.0" stepSize="0.001"/>
   <ModelVariables>
     <ScalarVariable name="u" valueReference="0" causality="input" variability="continuous"><Real start="0"/></ScalarVariable>
-%s
+{_TRIVIAL_OUTPUTS}
   </ModelVariables>
-  <ModelStructure><Outputs>%s</Outputs></ModelStructure>
+  <ModelStructure><Outputs>{"".join(f'<Unknown index="{k + 2}"/>' for k in range(12))}</Outputs></ModelStructure>
 </fmiModelDescription>
-''' % ("\n".join(f'    <ScalarVariable name="y{k}" valueReference="{k + 1}" causality="output" variability="continuous" '
-                   'initial="exact"><Real start="0"/></ScalarVariable>' for k in range(12)),
-       "".join(f'<Unknown index="{k + 2}"/>' for k in range(12)))
+'''
+
 
 FLOORS = {"kind": "broadband_floor", "channel": ["Fx", "Fy", "Fz"], "exponent": 2.0, "omega_ref_rad_s": 300.0,
           "f_Hz": [2.0, 500.0], "psd_ref": [1e-6, 1e-6]}
