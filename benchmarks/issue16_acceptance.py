@@ -2,7 +2,8 @@
 
 1. empirical-only model: FMU outputs (pythonfmu and native) vs the closed-form C·Ω² lines;
 2. HR16-75: fundamental |F|/(U_s·Ω²) and |T|/(U_d·Ω²) at 3000 and 6000 rpm, by default and with
-   --assumed-modes, in both FMUs and in `rwadist psd` (line envelope);
+   --assumed-modes, in both FMUs, in `rwadist psd` (line envelope), in the coupling kit (blocked lines of
+   coupling.wheel_spec_from_model) and in a `psd --wheels` set (rwadist.mounting.load_wheels);
 3. native FMU vs pythonfmu FMU vs rwadist.extended.simulate_time, spin-up 0→3000 rpm and reversal ±1500 rpm,
    every effect class on (simulate_time: the line effects; it has no ripple or floor);
 4. floor multisine, native vs pythonfmu, same seed;
@@ -26,11 +27,21 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from rwadist.fmu import hosts  # noqa: E402
 from rwadist.fmu.build import build_fmu  # noqa: E402
 from rwadist.fmu.native_build import build_native_fmu  # noqa: E402
+from test_fmu_models import closed_form_lines, empirical_only  # noqa: E402
+from test_fmu_native import (  # noqa: E402
+    EFFECTS,
+    LINE_EFFECTS,
+    mount_params,
+    reversal,
+    slope,
+    spin_up,
+    wheel_doc,
+    worst,
+)
+
 from rwadist import catalogue  # noqa: E402
 from rwadist import extended as ext  # noqa: E402
 from rwadist import model as model_io  # noqa: E402
-from test_fmu_models import closed_form_lines, empirical_only  # noqa: E402
-from test_fmu_native import EFFECTS, LINE_EFFECTS, mount_params, reversal, slope, spin_up, wheel_doc, worst  # noqa: E402
 
 RPM = 2 * np.pi / 60
 
@@ -76,6 +87,33 @@ def main() -> int:
                       f"F/(U_s W^2) - 1 = {env[i, 1] / (an['U_s_kg_m'] * w**2) - 1:+.2e}, "
                       f"T/(U_d W^2) - 1 = {env[i, 4] / (an['U_d_kg_m2'] * w**2) - 1:+.2e}; note file: "
                       f"{(tmp / f'psd{len(flag)}_ASSUMED_MODES.txt').exists()}")
+
+        import warnings
+
+        from rwadist.coupling.performance import wheel_spec_from_model
+        from test_assumed_modes_default import _fundamental, _plant, _wheels_file
+
+        from rwadist import coupling as cp
+        from rwadist.mounting import load_wheels
+        omega = np.array([3000.0, 6000.0]) * RPM
+        U_s, U_d = an["U_s_kg_m"], an["U_d_kg_m2"]
+        for flag in (False, True):
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                spec = wheel_spec_from_model(catalogue.load("honeywell-hr16-75"), assumed_modes=flag)
+            F = _fundamental(cp.line_responses(_plant(), [spec], omega))
+            for i, rpm in enumerate((3000, 6000)):
+                print(f"2. HR16-75 coupling {'assumed_modes=True' if flag else 'default           '} {rpm:5d} rpm: "
+                      f"|F|/(U_s W^2) - 1 = {abs(F[i, 0]) / (U_s * omega[i]**2) - 1:+.2e}, "
+                      f"|T|/(U_d W^2) - 1 = {abs(F[i, 3]) / (U_d * omega[i]**2) - 1:+.2e}; warning: "
+                      f"{'; '.join(str(c.message)[:60] for c in caught)}")
+            for w in load_wheels(_wheels_file(tmp), assumed_modes=flag)[:1]:
+                a = w.lines.amplitudes(omega)[:, np.nonzero(w.lines.h == 1.0)[0], :]
+                for i, rpm in enumerate((3000, 6000)):
+                    print(f"2. HR16-75 psd --wheels {'--assumed-modes' if flag else 'default        '} {rpm:5d} rpm: "
+                          f"|F|/(U_s W^2) - 1 = {np.abs(a[i, :, 0]).max() / (U_s * omega[i]**2) - 1:+.2e}, "
+                          f"|T|/(U_d W^2) - 1 = {np.abs(a[i, :, 3]).max() / (U_d * omega[i]**2) - 1:+.2e} "
+                          f"({w.meta['modes_assumed']})")
 
         full = wheel_doc(EFFECTS)
         native, python = build_native_fmu(full, tmp / "c.fmu"), build_fmu(full, tmp / "p.fmu")

@@ -127,7 +127,10 @@ class WheelSpec:
     (kg·m², about the interface point); speed_scale: this wheel's speed = speed_scale × the
     sweep speed (e.g. −1 for a wheel spinning the other way, 0.9 for a slower one).
     floors: its broadband floors (:class:`Floor`, blocked loads, incoherent); ripple: its speed
-    ripple (:class:`rwadist.extended.Ripple`) or None."""
+    ripple (:class:`rwadist.extended.Ripple`) or None.  hard_mounted: the suspension is rigid (the rotor
+    moves with the housing; a datasheet wheel whose modes are only assumed runs so by default): its blocked
+    loads are the lines' free loads (C·Ω², U_s·Ω², U_d·Ω², the radial force with its lever arm ``height``)
+    and its dynamic mass the rigid wheel's with the rotor's gyroscopic coupling (:func:`rigid_wheel_frf`)."""
 
     params: ext.ExtendedParams
     lines: tuple
@@ -138,6 +141,7 @@ class WheelSpec:
     name: str = "wheel"
     floors: tuple = ()
     ripple: ext.Ripple | None = None
+    hard_mounted: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "lines", tuple(self.lines))
@@ -150,22 +154,36 @@ class WheelSpec:
             raise CouplingError(f"{self.name}: ripple must be a rwadist.extended.Ripple or None")
 
 
-def wheel_spec_from_model(model, mount=None, **kw) -> WheelSpec:
+def wheel_spec_from_model(model, mount=None, *, assumed_modes: bool = False, **kw) -> WheelSpec:
     """A WheelSpec from a :class:`rwadist.model.WheelModel` with an analytical section (a fitted
     model file or ``preset(...).to_model()``): lines via :func:`rwadist.extended.lines_from_model`,
     with the diagnosed effects of ``model.effects`` applied (``rwadist diagnose``; amplitude laws,
     wheel-mode resonances, sidebands: :func:`rwadist.extended.apply_line_effects`), its
     ``broadband_floor`` entries as :attr:`WheelSpec.floors` (:func:`floors_from_effects`) and its
     ``speed_ripple`` as :attr:`WheelSpec.ripple` (:func:`rwadist.extended.ripple_from_effects`).
-    A bad entry raises :class:`CouplingModelError` (a CouplingError) naming ``effects[i].<field>``."""
+    A bad entry raises :class:`CouplingModelError` (a CouplingError) naming ``effects[i].<field>``.
+
+    A wheel whose suspension modes are assumed (``analytical.modes_assumed``: a catalogue datasheet wheel)
+    is hard-mounted (:attr:`WheelSpec.hard_mounted`), as its datasheet states, with a RuntimeWarning saying
+    so; ``assumed_modes=True`` runs it through the assumed modes, with a RuntimeWarning that the coupled
+    results rest on assumed values."""
+    import warnings
+
+    from rwadist.catalogue import modes_assumed
+
     effects = schema.parse_effects(getattr(model, "effects", None), "<model>", CouplingModelError)
     p = ext.params_from_model(model)
-    an = getattr(model, "analytical", None)
-    if an is not None and an.get("modes_assumed") is True:
-        import warnings
-        warnings.warn(f"{getattr(model, 'name', 'wheel')}: the suspension modes are ASSUMED (datasheet wheel, "
-                      "analytical.modes_assumed), not measured; the coupled results rest on assumed values",
-                      RuntimeWarning, stacklevel=2)
+    name = getattr(model, "name", "wheel")
+    if modes_assumed(model):
+        if assumed_modes:
+            warnings.warn(f"{name}: the suspension modes are ASSUMED (datasheet wheel, analytical.modes_assumed), "
+                          "not measured; assumed_modes=True: the coupled results rest on assumed values",
+                          RuntimeWarning, stacklevel=2)
+        else:
+            kw.setdefault("hard_mounted", True)
+            warnings.warn(f"{name}: the suspension modes are ASSUMED (datasheet wheel, analytical.modes_assumed); "
+                          "the wheel runs hard-mounted (rigid suspension), as its datasheet states; "
+                          "assumed_modes=True runs the assumed modes", RuntimeWarning, stacklevel=2)
     try:
         lines = tuple(ext.lines_from_model(model, p))
         ripple = ext.ripple_from_effects(effects)
@@ -219,10 +237,10 @@ def _grouped_lines(spec: WheelSpec, omega, k_max: int = 0):
     S = np.size(omega)
     if spec.ripple is None:
         m = np.zeros(1, dtype=int)
-        f_all, amp = ext.steady_lines(spec.params, spec.lines, omega)
+        f_all, amp = ext.steady_lines(spec.params, spec.lines, omega, rigid=spec.hard_mounted)
         f_all, amp = f_all[:, :, None], amp[:, :, None, :]
     else:
-        m, f_all, amp = ext.ripple_lines(spec.params, spec.lines, omega, spec.ripple, k_max)
+        m, f_all, amp = ext.ripple_lines(spec.params, spec.lines, omega, spec.ripple, k_max, rigid=spec.hard_mounted)
     L, M = len(spec.lines), m.size
     keys = np.array([(ln.h, ln.f_offset, mm) for ln in spec.lines for mm in m], dtype=float)
     ku, first, inv = np.unique(keys, axis=0, return_index=True, return_inverse=True)
@@ -239,12 +257,36 @@ def _grouped_lines(spec: WheelSpec, omega, k_max: int = 0):
 _EIG_COND = 1e8
 
 
+def rigid_wheel_frf(p: ext.ExtendedParams, omega, f, housing_mass: float = 0.0, housing_inertia=(0.0, 0.0, 0.0)):
+    """(Zc, B) of a hard-mounted (rigid-suspension) wheel at speeds omega (S,) rad/s and frequencies f (S, J)
+    Hz: Zc (S, J, 6, 6), B (6, 6).  The limit of :func:`coupling.components.wheel_matrices` as the suspension
+    stiffnesses grow without bound (test): the rotor moves with the housing, so
+    f = −M6 a + (gyroscopic) + B w with M6 the rigid wheel's mass matrix
+    (:func:`coupling.components.wheel_rigid_mass_matrix`), the rotor's angular momentum I_zz·Ω giving
+    Tx = −I_zz Ω ω_y, Ty = +I_zz Ω ω_x (ω = α/s, s = i2πf), and B passing the free loads with the radial
+    force's lever arm h (Tx −= h·wFy, Ty += h·wFx)."""
+    om = np.asarray(omega, dtype=float)
+    s = 2j * np.pi * np.asarray(f, dtype=float)
+    M6 = wheel_rigid_mass_matrix(p, housing_mass, housing_inertia)
+    Zc = np.broadcast_to(-M6, s.shape + (6, 6)).astype(complex)
+    gyro = p.I_zz * om.reshape(om.shape + (1,) * (s.ndim - om.ndim)) / s
+    Zc[..., 3, 4] -= gyro
+    Zc[..., 4, 3] += gyro
+    B = np.eye(6)
+    B[3, 1], B[4, 0] = -p.height, p.height
+    return Zc, B
+
+
 def _wheel_frf(spec, omega, f):
     """(Zc, B) of a flexible wheel at speeds omega (S,) and frequencies f (S, J): (S, J, 6, 6) each.
 
     Modal form per speed, H(s) = C V (s − Λ)⁻¹ V⁻¹ B + D (one 12×12 eigen-decomposition per speed, then a
     product per frequency; cond(V) ≈ 1.5e3 for the wheel's state scaling, so ~1e-12 relative); direct
-    solves of (sI − A) X = B at speeds where V is ill-conditioned (> 1e8)."""
+    solves of (sI − A) X = B at speeds where V is ill-conditioned (> 1e8).  A hard-mounted wheel:
+    :func:`rigid_wheel_frf`."""
+    if spec.hard_mounted:
+        Zc, B = rigid_wheel_frf(spec.params, omega, f, spec.housing_mass, spec.housing_inertia)
+        return Zc, np.broadcast_to(B, Zc.shape)
     A, B, C, D = wheel_matrices(spec.params, omega, spec.housing_mass, spec.housing_inertia)
     s = 2j * np.pi * np.asarray(f, dtype=float)
     lam, V = np.linalg.eig(A)                                           # (S, 12), (S, 12, 12)
@@ -301,7 +343,8 @@ def _interface_matrix(G, parts) -> np.ndarray:
 
 
 def _wheel_key(w):
-    return (w.params, float(w.housing_mass), tuple(float(x) for x in w.housing_inertia), float(w.speed_scale))
+    return (w.params, float(w.housing_mass), tuple(float(x) for x in w.housing_inertia), float(w.speed_scale),
+            bool(w.hard_mounted))
 
 
 class _FrfCache:
@@ -450,11 +493,13 @@ def _pole_damping(plant: Plant, wheels, omega):
     om = np.unique(np.atleast_1d(omega))
     pick = om[np.unique(np.linspace(0, om.size - 1, min(om.size, GRID_SPEEDS)).round().astype(int))]
     for o in pick:
-        atts = [Attachment(wheel(w.params, o * w.speed_scale, w.housing_mass, w.housing_inertia), w.mount)
-                for w in wheels]
+        atts = [Attachment(rigid_mass(wheel_rigid_mass_matrix(w.params, w.housing_mass, w.housing_inertia))
+                           if w.hard_mounted else wheel(w.params, o * w.speed_scale, w.housing_mass, w.housing_inertia),
+                           w.mount) for w in wheels]
         lams.append(np.linalg.eigvals(np.asarray(assemble(plant, atts).sys.A)))
     for w in wheels:
-        lams += [np.ravel(s) for s in ext.damped_modes(w.params, om * w.speed_scale).values()]
+        if not w.hard_mounted:          # a rigid suspension has no rotor modes
+            lams += [np.ravel(s) for s in ext.damped_modes(w.params, om * w.speed_scale).values()]
     lam = np.concatenate(lams)
     lam = lam[np.abs(lam.imag) > 1e-9 * np.abs(lam)]
     return np.abs(lam) / (2 * np.pi), -lam.real / np.abs(lam)

@@ -479,14 +479,25 @@ def cmd_diagnose(args) -> int:
     model = model_io.load(args.model) if args.model else None
     if model is not None:
         _warn_unconstrained(model, args.model, "diagnose's extended base")
+    # a starting model whose suspension modes are assumed (datasheet wheel) is hard-mounted unless
+    # --base extended asks for its assumed modes explicitly
+    assumed = _starting_model_modes_assumed(model, args.preset)
+    base = args.base
+    if assumed and base == "auto":
+        base = "empirical"
+        print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); the starting "
+              "prediction is hard-mounted (C*omega^2); --base extended uses the assumed modes")
     try:
-        diag = api.diagnose(test, model, preset=args.preset, base=args.base, nperseg=args.nperseg,
+        diag = api.diagnose(test, model, preset=args.preset, base=base, nperseg=args.nperseg,
                             f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain)
     except DataError:
         raise
     except ValueError as exc:
         raise DataError("diagnose", "--base", str(exc)) from None
     files = write_report(diag, args.output)
+    if assumed and diag.state_before.base == "extended":
+        from .catalogue import write_assumed_note
+        files.append(write_assumed_note(Path(args.output) / "ASSUMED_MODES.txt", [args.model or args.preset], files))
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
           f"{diag.state_before.base} base")
     for e in diag.summary()["effects"]:
@@ -533,7 +544,13 @@ def cmd_psd(args) -> int:
     t0 = time.perf_counter()
     fmax = args.fmax
     if args.wheels:
-        wheels = load_wheels(args.wheels, default_lines if (args.model or args.preset) else None, law, args.empirical)
+        wheels = load_wheels(args.wheels, default_lines if (args.model or args.preset) else None, law, args.empirical,
+                             assumed_modes=args.assumed_modes)
+        rigid_set = [w.name for w in wheels if w.meta.get("modes_assumed") == "hard-mounted"]
+        if rigid_set:
+            print(f"note: {args.wheels}: wheels {', '.join(rigid_set)} have assumed suspension modes (datasheet "
+                  "wheels); running them hard-mounted (Melody's model of their lines); --assumed-modes uses the "
+                  "assumed modes")
         if fmax is None:
             fmax = _default_fmax([(w.lines, w.law or wheels[w.tie.to].law) for w in wheels])
         res = spacecraft_csd(wheels, fmax, args.n_freq, args.n_speeds, progress=True)
@@ -545,16 +562,15 @@ def cmd_psd(args) -> int:
         res = bb.broadband_psd(lines, law, fmax, args.n_freq, args.n_speeds, progress=True)
         sources = [(lines, None)]
     kind = "empirical (Melody)" if hard_mounted else "extended (modal amplification)"
-    if assumed and not hard_mounted and not args.wheels:
-        from .catalogue import ASSUMED_MODES_NOTE
-        note = "WARNING: " + ASSUMED_MODES_NOTE.format(name=args.model or args.preset)
+    on_assumed = ([args.model or args.preset] if assumed and not hard_mounted else []) + (
+        [f"{w.name} ({w.model_ref})" for w in wheels if w.meta.get("modes_assumed") == "assumed modes used"]
+        if args.wheels else [])
+    if on_assumed:
         kind += " on ASSUMED modes"
-        print(note, file=sys.stderr)
         stem0 = out.with_suffix("")
-        note_path = stem0.parent / (stem0.name + "_ASSUMED_MODES.txt")
-        note_path.write_text(note + "\n(this note belongs to " + ", ".join(
-            str(stem0.parent / (stem0.name + s)) for s in (out.suffix, "_cross.csv", "_envelope.csv", ".png")) + ")\n")
-        print(f"note written next to the outputs: {note_path}")
+        from .catalogue import write_assumed_note
+        write_assumed_note(stem0.parent / (stem0.name + "_ASSUMED_MODES.txt"), on_assumed,
+                           [stem0.parent / (stem0.name + s) for s in (out.suffix, "_cross.csv", "_envelope.csv", ".png")])
     if args.format == "nastran":
         from .nastran import write_deck
 
@@ -581,6 +597,15 @@ def cmd_psd(args) -> int:
     print("RMS: " + ", ".join(f"{c} {v:.4g}" for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
     print(f"worst-case line envelope: {p_env}; plots: {png}")
     return 0
+
+
+def _starting_model_modes_assumed(model, preset) -> bool:
+    """True when diagnose's starting model (a loaded model file, else the catalogue wheel ``preset``) has
+    assumed suspension modes."""
+    from . import catalogue
+    if model is None and preset:
+        model = catalogue.preset_model(preset)
+    return model is not None and catalogue.modes_assumed(model)
 
 
 def _psd_modes_assumed(args) -> bool:

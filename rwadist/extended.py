@@ -556,13 +556,16 @@ def transmissibility(p: ExtendedParams, direction: str, nu, omega):
     return (k + 1j * c * nu) / (k - m * nu**2 + gyro * omega * nu + 1j * c * nu)
 
 
-def steady_lines(p: ExtendedParams, lines, omega) -> tuple:
+def steady_lines(p: ExtendedParams, lines, omega, rigid: bool = False) -> tuple:
     """Steady-state lines at constant wheel speeds ``omega`` (rad/s, signed), closed form.
 
     Returns (f_hz (n_speeds, n_lines), amplitude (n_speeds, n_lines, 6) complex): each channel
     (Fx, Fy, Fz, Tx, Ty, Tz) of each line is Re(A e^{i 2π f (t − t0)}), N or N·m.  f = h|Ω|/2π for a
     harmonic, |hΩ/2π + f_offset| for a line with a frequency offset (a sideband, :class:`Line`); a
-    line's wheel-mode resonances multiply each component by H at its whirl rate.
+    line's wheel-mode resonances multiply each component by H at its whirl rate.  ``rigid``: the
+    suspension is rigid (a hard-mounted wheel, e.g. a datasheet wheel whose modes are only assumed): no
+    transmissibility, each line's free load (C·Ω², U_s·Ω², U_d·Ω²) reaches the interface as it is, the
+    radial force with its lever arm ``height``.
     """
     w = _omega_array(np.atleast_1d(omega))[:, None]
     lines = list(lines)
@@ -575,7 +578,7 @@ def steady_lines(p: ExtendedParams, lines, omega) -> tuple:
         load0 = ln.amplitude(wj)
         for sigma, coef in ln.components():
             nu = ln.nu(sigma, wj)
-            resp = transmissibility(p, ln.direction, nu, wj) * coef * load0
+            resp = coef * load0 if rigid else transmissibility(p, ln.direction, nu, wj) * coef * load0
             if ln.resonances:
                 resp = resp * ln.gain(nu)
             _add_to_channels(amp[:, j], ln.direction, p.height, resp, nu)

@@ -117,7 +117,8 @@ def ripple_order(lines, omega, ripple: Ripple, tol: float = 1e-6) -> int:
     return int(np.max(np.abs(k[big]))) if big.size else 0
 
 
-def ripple_lines(p: ExtendedParams, lines, omega, ripple: Ripple, k_max: int | None = None) -> tuple:
+def ripple_lines(p: ExtendedParams, lines, omega, ripple: Ripple, k_max: int | None = None,
+                 rigid: bool = False) -> tuple:
     """Steady-state lines under a periodic speed ripple (mean speeds ``omega`` rad/s, signed), closed form.
 
     Each component σ (whirl sense, ±1) of each line, load = coef·a(Ω(t))·e^{jσ(hφ + 2π f_offset t)}, is
@@ -138,7 +139,8 @@ def ripple_lines(p: ExtendedParams, lines, omega, ripple: Ripple, k_max: int | N
     the rocking channels Tx, Ty off by up to ~10 % of their largest line at sidebands near a rocking whirl
     (the gyroscopic modulation is not small there).
 
-    k_max : highest order (default :func:`ripple_order`).  Returns (m (M,), f_hz (S, L, M),
+    k_max : highest order (default :func:`ripple_order`).  rigid : a rigid suspension (hard-mounted wheel,
+    as :func:`steady_lines`): no transmissibility.  Returns (m (M,), f_hz (S, L, M),
     amplitude (S, L, M, 6) complex): channel = Re(A e^{i2πf(t − t0)}), N or N·m."""
     w = np.atleast_1d(_omega_array(omega))
     lines = list(lines)
@@ -160,7 +162,7 @@ def ripple_lines(p: ExtendedParams, lines, omega, ripple: Ripple, k_max: int | N
             d = np.fft.fft(a_th * np.exp(-1j * sigma * beta[:, None] * cos_t[None, :]), axis=-1) / n
             dk = d[:, (sigma * m) % n]                                          # (S, M): order m = σk
             nu = sigma * (ln.h * w2 + 2 * np.pi * off)
-            resp = transmissibility(p, ln.direction, nu, w2) * coef * dk
+            resp = coef * dk if rigid else transmissibility(p, ln.direction, nu, w2) * coef * dk
             if ln.resonances:
                 resp = resp * ln.gain(nu)
             _add_to_channels(amp[:, j], ln.direction, p.height, resp, nu)

@@ -160,15 +160,20 @@ def _speed_law(spec, default_law, base: Path, where: str):
     return bb.law_from_csv(p if p.is_absolute() else base / p)
 
 
-def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bool = False) -> list:
+def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bool = False,
+                assumed_modes: bool = False) -> list:
     """Read a wheels.json file into :class:`WheelSpec` objects.
 
     default_lines_loader : callable() -> WheelLines used for wheels without ``model``/``preset``.
     default_law : speed law for wheels without ``speed`` (rad/s).  empirical : Melody's model
-    (harmonics only) instead of the extended model.
+    (harmonics only) instead of the extended model.  assumed_modes : run a wheel whose suspension modes
+    are assumed (``analytical.modes_assumed``: a catalogue datasheet wheel) through those modes; without
+    it such a wheel is hard-mounted (Melody's model of its lines), as its datasheet states.  Either way
+    the wheel's ``meta["modes_assumed"]`` says which ('hard-mounted' or 'assumed modes used').
     DataError names the file and the field (missing model file, bad DCM, unknown tie, ...).
     """
     from . import broadband as bb
+    from . import catalogue
     from . import model as model_io
 
     path = Path(path)
@@ -193,23 +198,27 @@ def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bo
             key = ("model", str(mp))
             if key not in cache:
                 m = model_io.load(mp)
-                cache[key] = bb.empirical_lines(m) if empirical else bb.extended_lines_from_model(m, str(mp))
-            lines, ref = cache[key], str(mp)
+                assumed = catalogue.modes_assumed(m)
+                rigid = empirical or (assumed and not assumed_modes)
+                cache[key] = (bb.empirical_lines(m) if rigid else bb.extended_lines_from_model(m, str(mp)), assumed)
+            (lines, assumed), ref = cache[key], str(mp)
         elif "preset" in w:
             key = ("preset", w["preset"])
             try:
                 if key not in cache:
-                    cache[key] = bb.preset_lines(w["preset"], empirical)
+                    cm = catalogue.preset_model(w["preset"])
+                    assumed = cm is not None and catalogue.modes_assumed(cm)
+                    cache[key] = (bb.preset_lines(w["preset"], empirical or (assumed and not assumed_modes)), assumed)
             except ValueError as exc:
                 raise DataError(path, f"{where}.preset", str(exc)) from None
-            lines, ref = cache[key], f"preset {w['preset']}"
+            (lines, assumed), ref = cache[key], f"preset {w['preset']}"
         else:
             if default_lines_loader is None:
                 raise DataError(path, f"{where}.model", "no model: give 'model' or 'preset' (or a model on the "
                                 "command line)")
             if "default" not in cache:
                 cache["default"] = default_lines_loader()
-            lines, ref = cache["default"], "command-line model"
+            lines, ref, assumed = cache["default"], "command-line model", False   # the caller notes its own
         # mounting
         try:
             if "mounting" in w:
@@ -245,7 +254,10 @@ def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bo
             tie = Tie(to, ratio, bool(t.get("phase_lock", False)), math.radians(float(t.get("phase_offset_deg", 0))))
         else:
             law = _speed_law(w.get("speed"), default_law, base, f"{path}: {where}")
-        out.append(WheelSpec(names[i], lines, mount, law, tie, ref))
+        meta = {}
+        if assumed and not empirical:
+            meta["modes_assumed"] = "assumed modes used" if assumed_modes else "hard-mounted"
+        out.append(WheelSpec(names[i], lines, mount, law, tie, ref, meta))
     # resolve chains of ties to their root
     for i, ws in enumerate(out):
         seen = {i}

@@ -5,6 +5,7 @@
 #ifndef RWADIST_KERNEL_H
 #define RWADIST_KERNEL_H
 #include <complex.h>
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 
@@ -35,13 +36,75 @@ static inline double complex rw_ratio(double b, double p, double q)
     return CMPLX((b * b + p * q) / den, (p * b - b * q) / den);
 }
 
+/* sin and cos of one argument together, inline: Cody-Waite reduction by π/2 in three parts and the
+ * fdlibm kernels (__kernel_sin, __kernel_cos minimax polynomials on [-π/4, π/4]); within ~1 ulp of libm
+ * for |x| < 2^19·π/2 (checked against libm: tests/test_fmu_native.py); larger |x| go to libm. */
+static inline void rw_sincos(double x, double *s, double *c)
+{
+    const double ax = fabs(x);
+    if (!(ax < 823550.0)) {                 /* 2^19·π/2: q·PIO2_1 stays exact; NaN/inf to libm as well */
+        *s = sin(x);
+        *c = cos(x);
+        return;
+    }
+#if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0
+    /* round to nearest (even) by the 1.5·2^52 shift: nearbyint's value, without its library call */
+    const double q = (x * 6.36619772367581382433e-01 + 6755399441055744.0) - 6755399441055744.0;   /* 2/π */
+#else /* extended-precision evaluation (x87) would break the shift */
+    const double q = nearbyint(x * 6.36619772367581382433e-01);
+#endif
+    const double r = ((x - q * 1.57079632673412561417e+00) - q * 6.07710050630396597660e-11) -
+                     q * 2.02226624871116645580e-21;
+    const double z = r * r;
+    const double sr = r + r * z * (-1.66666666666666324348e-01 + z * (8.33333333332248946124e-03 +
+                      z * (-1.98412698298579493134e-04 + z * (2.75573137070700676789e-06 +
+                      z * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)))));
+    const double cr = 1.0 - 0.5 * z + z * z * (4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 +
+                      z * (2.48015872894767294178e-05 + z * (-2.75573143513906633035e-07 +
+                      z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11)))));
+    switch ((long)q & 3) {
+    case 0: *s = sr; *c = cr; break;
+    case 1: *s = cr; *c = -sr; break;
+    case 2: *s = -sr; *c = -cr; break;
+    default: *s = -cr; *c = sr; break;
+    }
+}
+
+/* 1/z in real arithmetic (C's complex division calls a slow, scaling library routine; these values are
+ * moderate: eigenvalues of the suspension modes and their differences) */
+static inline double complex rw_cinv(double complex z)
+{
+    const double den = creal(z) * creal(z) + cimag(z) * cimag(z);
+    return CMPLX(creal(z) / den, -cimag(z) / den);
+}
+
+/* e^z with rw_sincos (within ~1 ulp of cexp for the moderate λh of the suspension modes) */
+static inline double complex rw_cexp(double complex z)
+{
+    double s, c;
+    rw_sincos(cimag(z), &s, &c);
+    const double e = exp(creal(z));
+    return CMPLX(e * c, e * s);
+}
+
+/* principal square root in real arithmetic (csqrt's branch cut; without its scaling and hypot: the
+ * discriminants of the suspension modes are moderate) */
+static inline double complex rw_csqrt(double complex z)
+{
+    const double a = creal(z), b = cimag(z);
+    if (a == 0.0 && b == 0.0)
+        return CMPLX(0.0, b);
+    const double t = sqrt(0.5 * (fabs(a) + sqrt(a * a + b * b)));
+    return a >= 0 ? CMPLX(t, b / (2.0 * t)) : CMPLX(fabs(b) / (2.0 * t), copysign(t, b));
+}
+
 static void quad_roots(double m, double complex c, double k, double complex *l1, double complex *l2)
 {
-    double complex disc = csqrt(c * c - 4.0 * m * k);
+    double complex disc = rw_csqrt(c * c - 4.0 * m * k);
     double sgn = creal(conj(c) * disc) >= 0 ? 1.0 : -1.0;
     double complex q = -0.5 * (c + sgn * disc);
     *l1 = q / m;
-    *l2 = k / q;
+    *l2 = k * rw_cinv(q);
 }
 
 static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out, double omega, double wd0, double alpha,
@@ -64,9 +127,9 @@ static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out,
         const double w_mid = 0.5 * (omega + w1);
         quad_roots(cfg[C_IRR], CMPLX(cfg[C_CROCK], -cfg[C_IZZ] * w_mid), cfg[C_KROCK], &lk[0], &lk[1]);
         for (int j = 0; j < 2; j++) {
-            Xp[0][j] = cexp(lam_r[j] * h);
-            Xp[1][j] = cexp(lk[j] * h);
-            Xp[2][j] = cexp(lam_z[j] * h);
+            Xp[0][j] = rw_cexp(lam_r[j] * h);
+            Xp[1][j] = rw_cexp(lk[j] * h);
+            Xp[2][j] = rw_cexp(lam_z[j] * h);
             lamh[0][j] = lam_r[j] * h;
             lamh[1][j] = lk[j] * h;
             lamh[2][j] = lam_z[j] * h;
@@ -99,7 +162,9 @@ static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out,
             a1 *= g1;
         }
         const double arg = sh * phi1 + woff * t1;
-        const double complex S1 = CMPLX(cos(arg), sin(arg));
+        double s_arg, c_arg;
+        rw_sincos(arg, &s_arg, &c_arg);
+        const double complex S1 = CMPLX(c_arg, s_arg);
         loads1[d] += a1 * S1;
         if (modes && d != 3) {
             const int sub = d == 0 ? 0 : (d == 2 ? 2 : 1);
@@ -132,16 +197,17 @@ static void rwadist_kernel_step_impl(const double *cfg, double *st, double *out,
         for (int d = 0; d < 3; d++)
             for (int j = 0; j < 2; j++)
                 W[d][j] *= h;
-        eta_r[0] = Xp[0][0] * eta_r[0] + W[0][0] / (m * (lam_r[0] - lam_r[1]));
-        eta_r[1] = Xp[0][1] * eta_r[1] + W[0][1] / (m * (lam_r[1] - lam_r[0]));
-        eta_z[0] = Xp[2][0] * eta_z[0] + W[2][0] / (m * (lam_z[0] - lam_z[1]));
-        eta_z[1] = Xp[2][1] * eta_z[1] + W[2][1] / (m * (lam_z[1] - lam_z[0]));
-        const double complex dl = lk[0] - lk[1], e1 = Xp[1][0], e2 = Xp[1][1];
+        const double complex ir = rw_cinv(m * (lam_r[0] - lam_r[1])), iz = rw_cinv(m * (lam_z[0] - lam_z[1]));
+        eta_r[0] = Xp[0][0] * eta_r[0] + W[0][0] * ir;
+        eta_r[1] = Xp[0][1] * eta_r[1] - W[0][1] * ir;
+        eta_z[0] = Xp[2][0] * eta_z[0] + W[2][0] * iz;
+        eta_z[1] = Xp[2][1] * eta_z[1] - W[2][1] * iz;
+        const double complex dl = lk[0] - lk[1], idl = rw_cinv(dl), e1 = Xp[1][0], e2 = Xp[1][1];
         const double complex q = x_rock[0], qd = x_rock[1];
         const double kI = k_rock / I_rr;
-        const double complex P00 = (e1 * (-lk[1]) - e2 * (-lk[0])) / dl, P01 = (e1 - e2) / dl;
-        const double complex P10 = (-kI) * (e1 - e2) / dl, P11 = (e1 * lk[0] - e2 * lk[1]) / dl;
-        const double complex w1r = W[1][0] / (I_rr * dl), w2r = W[1][1] / (-I_rr * dl);
+        const double complex P00 = (e1 * (-lk[1]) - e2 * (-lk[0])) * idl, P01 = (e1 - e2) * idl;
+        const double complex P10 = (-kI) * (e1 - e2) * idl, P11 = (e1 * lk[0] - e2 * lk[1]) * idl;
+        const double complex w1r = W[1][0] * idl / I_rr, w2r = -W[1][1] * idl / I_rr;
         x_rock[0] = P00 * q + P01 * qd + w1r + w2r;
         x_rock[1] = P10 * q + P11 * qd + lk[0] * w1r + lk[1] * w2r;
         const double complex qr = eta_r[0] + eta_r[1], qdr = lam_r[0] * eta_r[0] + lam_r[1] * eta_r[1];

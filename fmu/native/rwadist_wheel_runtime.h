@@ -456,49 +456,78 @@ static void steady_init(Wheel *w, double w0, double wdot0)
     x_rock[1] = qd[1];
 }
 
-/* floor loads at input speed om, time t: phasors advanced by `advance` (> 0) or set from t (runtime.floor_now) */
+/* floor loads at input speed om, time t: phasors advanced by `advance` (> 0) or set from t (runtime.floor_now).
+ * The phasors Z and rotations e^{iω h} are stored split (all real parts, then all imaginary parts, in the
+ * buffers floor_Z and floor_rot) so the rotation and the sum run as one pass of 2-wide vector arithmetic:
+ * the same products as C's complex multiply (without its NaN branch) and the same four partial sums
+ * (i mod 4 from each segment's start) as before, so the values are unchanged bit for bit. */
+typedef double rw_v2d __attribute__((vector_size(16), aligned(8), may_alias));   /* unaligned, aliases double */
+
 static void floor_now(Wheel *w, double om, double t, double advance, double out[6])
 {
     for (int k = 0; k < 6; k++)
         out[k] = 0.0;
     if (!w->n_floor)
         return;
+    const int nf = w->n_floor;
+    double *zr = (double *)w->floor_Z, *zi = zr + nf;
+    int rotate = 0;
     if (advance <= 0 || w->mu.floor_count >= FLOOR_RESYNC) {
-        for (int i = 0; i < w->n_floor; i++)
-            w->floor_Z[i] = w->floor_A[i] * CMPLX(cos(w->floor_w[i] * t), sin(w->floor_w[i] * t));
+        for (int i = 0; i < nf; i++) {
+            const double complex z = w->floor_A[i] * CMPLX(cos(w->floor_w[i] * t), sin(w->floor_w[i] * t));
+            zr[i] = creal(z);
+            zi[i] = cimag(z);
+        }
         w->mu.floor_count = 0;
     } else {
         if (advance != w->floor_rot_h) {
-            for (int i = 0; i < w->n_floor; i++)
-                w->floor_rot[i] = CMPLX(cos(w->floor_w[i] * advance), sin(w->floor_w[i] * advance));
+            double *rr = (double *)w->floor_rot, *ri = rr + nf;
+            for (int i = 0; i < nf; i++) {
+                rr[i] = cos(w->floor_w[i] * advance);
+                ri[i] = sin(w->floor_w[i] * advance);
+            }
             w->floor_rot_h = advance;
         }
-        /* Z *= rot, written out (the products of C's complex multiply, without its NaN branch) */
-        double *z = (double *)w->floor_Z;
-        const double *r = (const double *)w->floor_rot;
-        for (int i = 0; i < 2 * w->n_floor; i += 2) {
-            const double zr = z[i] * r[i] - z[i + 1] * r[i + 1], zi = z[i] * r[i + 1] + z[i + 1] * r[i];
-            z[i] = zr;
-            z[i + 1] = zi;
-        }
+        rotate = 1;
         w->mu.floor_count++;
     }
-    const double *z = (const double *)w->floor_Z;
+    const double *rr = (const double *)w->floor_rot, *ri = rr + nf;
     for (int s = 0; s < w->n_seg; s++) {
         /* four partial sums: independent additions the CPU overlaps (the order differs from numpy's
          * pairwise sum only in rounding) */
-        double acc[4] = {0.0, 0.0, 0.0, 0.0};
+        rw_v2d acc01 = {0.0, 0.0}, acc23 = {0.0, 0.0};
         int i = w->seg_start[s];
         const int end = w->seg_start[s + 1];
-        for (; i + 3 < end; i += 4) {
-            acc[0] += z[2 * i];
-            acc[1] += z[2 * i + 2];
-            acc[2] += z[2 * i + 4];
-            acc[3] += z[2 * i + 6];
+        if (rotate) {
+            for (; i + 3 < end; i += 4) {
+                const rw_v2d a_r = *(const rw_v2d *)(zr + i), a_i = *(const rw_v2d *)(zi + i);
+                const rw_v2d b_r = *(const rw_v2d *)(zr + i + 2), b_i = *(const rw_v2d *)(zi + i + 2);
+                const rw_v2d ra_r = *(const rw_v2d *)(rr + i), ra_i = *(const rw_v2d *)(ri + i);
+                const rw_v2d rb_r = *(const rw_v2d *)(rr + i + 2), rb_i = *(const rw_v2d *)(ri + i + 2);
+                const rw_v2d na_r = a_r * ra_r - a_i * ra_i, na_i = a_r * ra_i + a_i * ra_r;
+                const rw_v2d nb_r = b_r * rb_r - b_i * rb_i, nb_i = b_r * rb_i + b_i * rb_r;
+                *(rw_v2d *)(zr + i) = na_r;
+                *(rw_v2d *)(zi + i) = na_i;
+                *(rw_v2d *)(zr + i + 2) = nb_r;
+                *(rw_v2d *)(zi + i + 2) = nb_i;
+                acc01 += na_r;
+                acc23 += nb_r;
+            }
+            for (; i < end; i++) {
+                const double nr = zr[i] * rr[i] - zi[i] * ri[i], ni = zr[i] * ri[i] + zi[i] * rr[i];
+                zr[i] = nr;
+                zi[i] = ni;
+                acc01[0] += nr;
+            }
+        } else {
+            for (; i + 3 < end; i += 4) {
+                acc01 += *(const rw_v2d *)(zr + i);
+                acc23 += *(const rw_v2d *)(zr + i + 2);
+            }
+            for (; i < end; i++)
+                acc01[0] += zr[i];
         }
-        for (; i < end; i++)
-            acc[0] += z[2 * i];
-        const double sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+        const double sum = (acc01[0] + acc01[1]) + (acc23[0] + acc23[1]);
         out[w->seg_chan[s]] += pow(fabs(om) / w->seg_ref[s], w->seg_half_p[s]) * sum;
     }
 }

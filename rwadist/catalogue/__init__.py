@@ -98,6 +98,21 @@ ASSUMED_MODES_NOTE = ("the suspension modes of {name} are ASSUMED (datasheet whe
                       "--assumed-modes the wheel runs hard-mounted, as its datasheet states")
 
 
+def write_assumed_note(note_path, names, outputs):
+    """Say on stderr and in ``note_path`` (a text file next to ``outputs``) that the outputs of wheels
+    ``names`` rest on assumed (datasheet) suspension modes (:data:`ASSUMED_MODES_NOTE`).  Returns the path."""
+    import sys
+    from pathlib import Path
+
+    note_path = Path(note_path)
+    note = "WARNING: " + ASSUMED_MODES_NOTE.format(name=", ".join(str(n) for n in names))
+    print(note, file=sys.stderr)
+    note_path.parent.mkdir(parents=True, exist_ok=True)
+    note_path.write_text(note + "\n(this note belongs to " + ", ".join(str(p) for p in outputs) + ")\n")
+    print(f"note written next to the outputs: {note_path}")
+    return note_path
+
+
 def modes_assumed(model) -> bool:
     """True when ``model`` (a :class:`~rwadist.model.WheelModel`) carries ``analytical.modes_assumed``:
     its suspension modes are assumed (a datasheet wheel), not measured.  DataError on a non-boolean."""
