@@ -31,7 +31,9 @@ def _fit_runs(ctx: Context, runs):
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
-    sp = compute_spectra(test, nperseg=ctx.sp.nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
+    # the fit's own resolution (the longest segment, as ``rwadist fit``): close lines (h = 5.37, 5.57 of the
+    # E wheel) that diagnose's shorter Welch segments cannot separate are resolved here
+    sp = compute_spectra(test, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
     fit = fit_empirical(sp)
     if not amplification_peaks(fit):
         return None
