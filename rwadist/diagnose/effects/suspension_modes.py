@@ -21,9 +21,15 @@ from ..state import State
 from .base import register, schema_entry
 
 
-def _fit_runs(ctx: Context, runs):
+def _fit_runs(ctx: Context, runs, state: State):
     """(SteadyTest, EmpiricalFit, ExtendedFit) of ``runs``, or None when the runs show no modal amplification
-    (or the extended fit fails)."""
+    (or the extended fit fails).
+
+    A fixture resonance on every channel is fitted beside the modes, never into them: after a first
+    extended fit, a ``fixed_resonance`` common to all channels (role test_stand) is fitted on that base;
+    when it is a resonance (:data:`MIN_PEAK_GAIN`), the extended fit is repeated with it divided out of the
+    measured lines (``stand`` of :func:`rwadist.extended_fit.fit_extended`).  The stand resonance itself is
+    left to the search (it is then a clear residual of the extended base: a ``fixed_resonance`` effect)."""
     from ...data import SteadyTest
     from ...empirical import fit_empirical
     from ...extended_fit import amplification_peaks, fit_extended
@@ -39,6 +45,13 @@ def _fit_runs(ctx: Context, runs):
         return None
     try:
         efit = fit_extended(test, fit)
+        if len(efit.unconstrained) < 3 and len(ctx.channels) > 3:
+            from ..effects.fixed_resonance import MIN_PEAK_GAIN, FixedResonance
+
+            st = SuspensionModes.from_fit(efit, fit, len(runs)).apply(state)
+            stand = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), role="test_stand")
+            if stand is not None and abs(np.log(stand.peak_gain)) >= np.log(MIN_PEAK_GAIN):
+                efit = fit_extended(test, fit, stand=(stand.f_r, stand.zeta, stand.peak_gain))
     except ValueError:
         return None
     if len(efit.unconstrained) == 3:
@@ -98,7 +111,7 @@ class SuspensionModes:
 
     def refit(self, ctx: Context, state: State) -> "SuspensionModes":
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""
-        return SuspensionModes.fit(ctx, ctx.runs) or self
+        return SuspensionModes.fit(ctx, state, ctx.runs) or self
 
     def whirl_Hz(self, omega_rad_s: float) -> dict:
         """Whirl frequencies (Hz) at wheel speed ``omega_rad_s``: translation, rocking forward/backward, axial."""
@@ -120,10 +133,10 @@ class SuspensionModes:
         return schema_entry(self)
 
     @staticmethod
-    def fit(ctx: Context, runs) -> "SuspensionModes | None":
+    def fit(ctx: Context, state: State, runs) -> "SuspensionModes | None":
         """The modes fitted on ``runs`` (per unit mass and inertia), or None when those runs show no modal
         amplification or no mode can be located."""
-        got = _fit_runs(ctx, runs)
+        got = _fit_runs(ctx, runs, state)
         return None if got is None else SuspensionModes.from_fit(got[2], got[1], len(runs))
 
     @staticmethod
@@ -134,5 +147,5 @@ class SuspensionModes:
             return []
         if any(e.kind == "suspension_modes" for e in state.effects):
             return []
-        e = SuspensionModes.fit(ctx, runs)
+        e = SuspensionModes.fit(ctx, state, runs)
         return [] if e is None else [e]
