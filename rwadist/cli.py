@@ -485,11 +485,16 @@ def cmd_diagnose(args) -> int:
     except ValueError as exc:
         raise DataError("diagnose", "--base", str(exc)) from None
     files = write_report(diag, args.output)
+    base = diag.state_before.base
+    if diag.state_after.base != base:
+        base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
-          f"{diag.state_before.base} base")
+          f"{base} base")
     for e in diag.summary()["effects"]:
+        # key numbers only: no arrays (a floor's f_Hz knots, psd_ref), texts of laws or evidence
         par = ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in e.items()
-                        if k not in ("kind", "evidence", "f_Hz", "psd_ref", "channel"))
+                        if k not in ("kind", "evidence", "psd_ref", "channel", "whirl", "gain_law")
+                        and not isinstance(v, (list, tuple)) or k in ("directions", "unconstrained"))
         print(f"  + {e['kind']}: {par} (held-out gain {e['evidence']['heldout_gain_fraction']:.1%})")
     print(f"error ({diag.summary()['metric']}): {diag.error_before:.4g} -> {diag.error_after:.4g}")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")
