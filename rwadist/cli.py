@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import api
+from . import api, catalogue
 from . import data as data_io
 from . import model as model_io
 from .data import DataError
@@ -481,7 +481,7 @@ def cmd_diagnose(args) -> int:
         _warn_unconstrained(model, args.model, "diagnose's extended base")
     # a starting model whose suspension modes are assumed (datasheet wheel) is hard-mounted unless
     # --base extended asks for its assumed modes explicitly
-    assumed = _starting_model_modes_assumed(model, args.preset)
+    assumed = catalogue.source_modes_assumed(model, args.preset)
     base = args.base
     if assumed and base == "auto":
         base = "empirical"
@@ -498,11 +498,16 @@ def cmd_diagnose(args) -> int:
     if assumed and diag.state_before.base == "extended":
         from .catalogue import write_assumed_note
         files.append(write_assumed_note(Path(args.output) / "ASSUMED_MODES.txt", [args.model or args.preset], files))
+    base = diag.state_before.base
+    if diag.state_after.base != base:
+        base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
-          f"{diag.state_before.base} base")
+          f"{base} base")
     for e in diag.summary()["effects"]:
+        # key numbers only: no arrays (a floor's f_Hz knots, psd_ref), texts of laws or evidence
         par = ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in e.items()
-                        if k not in ("kind", "evidence", "f_Hz", "psd_ref", "channel"))
+                        if k not in ("kind", "evidence", "psd_ref", "channel", "whirl", "gain_law")
+                        and not isinstance(v, (list, tuple)) or k in ("directions", "unconstrained"))
         print(f"  + {e['kind']}: {par} (held-out gain {e['evidence']['heldout_gain_fraction']:.1%})")
     print(f"error ({diag.summary()['metric']}): {diag.error_before:.4g} -> {diag.error_after:.4g}")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")
@@ -533,7 +538,7 @@ def cmd_psd(args) -> int:
         return api.wheel_lines(args.model, preset=args.preset, empirical=hard_mounted)
 
     # a wheel whose suspension modes are assumed (datasheet) runs hard-mounted unless --assumed-modes
-    assumed = _psd_modes_assumed(args)
+    assumed = catalogue.source_modes_assumed(args.model, args.preset)
     hard_mounted = args.empirical or (assumed and not args.assumed_modes)
     if assumed and hard_mounted and not args.empirical:
         print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); running it "
@@ -597,27 +602,6 @@ def cmd_psd(args) -> int:
     print("RMS: " + ", ".join(f"{c} {v:.4g}" for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
     print(f"worst-case line envelope: {p_env}; plots: {png}")
     return 0
-
-
-def _starting_model_modes_assumed(model, preset) -> bool:
-    """True when diagnose's starting model (a loaded model file, else the catalogue wheel ``preset``) has
-    assumed suspension modes."""
-    from . import catalogue
-    if model is None and preset:
-        model = catalogue.preset_model(preset)
-    return model is not None and catalogue.modes_assumed(model)
-
-
-def _psd_modes_assumed(args) -> bool:
-    """True when the single wheel of ``rwadist psd`` (model file or catalogue preset) has assumed modes."""
-    from . import catalogue
-    if args.model:
-        return catalogue.modes_assumed(model_io.load(args.model))
-    if args.preset:
-        m = catalogue.preset_model(args.preset)
-        return m is not None and catalogue.modes_assumed(m)
-    return False
-
 
 
 _default_fmax = api.default_fmax

@@ -260,7 +260,7 @@ def _scan_all(meas_lines, la, sa, aa, inertia_ratio, tolerance):
 
 def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None, radius: float | None = None,
                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
-                 progress: bool = False, tolerance: float = 0.02) -> ExtendedFit:
+                 progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
     mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None:
@@ -272,6 +272,10 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     data before the fit and put back in the model.  start: parameters for modes the data do not
     constrain (default: modes at 3x the top line frequency, ζ = zeta0).  tolerance: relative
     frequency error the data must exclude for a mode to count as found (:func:`scan_mode`).
+    stand: (f_r Hz, ζ, peak gain) of a fixture resonance acting on every channel (``rwadist diagnose``'s
+    ``fixed_resonance`` of role test_stand), or None: every measured line amplitude is divided by its |H|
+    (:func:`rwadist.resonance.resonance`) before the modes are located and fitted, so that the fixture's
+    amplification is not taken for the wheel's.
 
     Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
     measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
@@ -292,6 +296,11 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     # every line the data show, with every measurement: the empirical fit without modal
     # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped)
     meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False))
+    if stand is not None:
+        from .resonance import resonance
+
+        meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / np.abs(resonance(
+            x.h * np.abs(x.speed) / (2 * np.pi), *stand))) for x in meas.lines])
     senses_xy = line_senses(test, meas)
     peaks = amplification_peaks(fit)
     la, sa, ca, aa = _measurements(meas)

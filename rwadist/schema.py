@@ -496,6 +496,27 @@ class SpinAcceleration(Effect):
     alpha_track_rad_s2: float | None = field(default=None, metadata=check(statistic(ge=None)))
 
 
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class SuspensionModes(Effect):
+    """The wheel's own suspension modes as diagnose fitted them from the data (per unit mass and transverse
+    inertia): frequencies at rest (Hz), damping ratios, I_zz/I_rr, and the modes the data do not locate.
+    The fitted parameters themselves are the model's ``analytical`` section."""
+
+    KIND: ClassVar[str] = "suspension_modes"
+    radial_translation_Hz: float = field(metadata=check(_POS))
+    rocking_Hz: float = field(metadata=check(_POS))
+    axial_Hz: float = field(metadata=check(_POS))
+    zeta_radial_translation: float = field(metadata=check(_NONNEG))
+    zeta_rocking: float = field(metadata=check(_NONNEG))
+    zeta_axial: float = field(metadata=check(_NONNEG))
+    inertia_ratio: float = field(metadata=check(_POS))
+    unconstrained: tuple = field(default=(), metadata=check(optional(names(("radial_translation", "rocking",
+                                                                               "axial")), ())))
+    per_unit: bool = field(default=True, metadata=check(optional(boolean(), True)))
+    n_runs: int | None = field(default=None, metadata=check(_N_POINTS))
+
+
 def parse_effect(doc: Any, source: str = "<model>", path: str = "effects[0]", error: type = ModelError) -> Effect:
     """The typed effect of one ``effects`` entry (an Effect is returned as it is)."""
     if isinstance(doc, Effect):

@@ -243,6 +243,9 @@ EVERY_KIND = [
     {"kind": "counter_rotation", "direction": "radial_force", "h": 2.0, "counter_fraction": 0.3,
      "counter_fraction_stderr": 0.01, "counter_fraction_phase": -1.2, "n_points": 9},
     {"kind": "spin_acceleration", "alpha_rad_s2": 2.0, "alpha_track_rad_s2": None, "role": "measurement"},
+    {"kind": "suspension_modes", "radial_translation_Hz": 227.0, "rocking_Hz": 55.0, "axial_Hz": 70.0,
+     "zeta_radial_translation": 0.17, "zeta_rocking": 0.04, "zeta_axial": 0.05, "inertia_ratio": 2.0,
+     "unconstrained": ["axial"], "per_unit": True, "n_runs": 60, "channel": ["Fx", "Fy", "Fz", "Tx", "Ty", "Tz"]},
 ]
 
 

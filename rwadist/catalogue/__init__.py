@@ -131,3 +131,13 @@ def preset_model(name: str):
     test-stand preset that is not in the catalogue."""
     key = str(name).strip().lower()
     return load(key) if key in names() else None
+
+
+def source_modes_assumed(model=None, preset: str | None = None) -> bool:
+    """True when a command's wheel has assumed suspension modes: ``model`` (a WheelModel or a model file
+    path), else the catalogue wheel ``preset`` (a test-stand preset outside the catalogue: False)."""
+    if isinstance(model, (str, Path)):
+        model = _load_model(model)
+    if model is None and preset:
+        model = preset_model(preset)
+    return model is not None and modes_assumed(model)

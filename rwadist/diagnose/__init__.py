@@ -41,6 +41,7 @@ from .effects.missing_harmonic import MissingHarmonic
 from .effects.sidebands import Sidebands
 from .effects.speed_ripple import SpeedRipple
 from .effects.spin_acceleration import SpinAcceleration
+from .effects.suspension_modes import SuspensionModes
 from .engine import Context, initial_state, line_kernel, noise_estimate, ripple_sideband_powers
 from .measure import refine_h, ridge_peaks
 from .report import rms_vs_speed, write_report
@@ -51,7 +52,7 @@ __all__ = [
     "BAND_BINS", "BASES", "EFFECT_CLASSES", "F_MIN_BINS", "FLOOR_EXPONENTS", "KERNEL_HALF", "LINE_HALF", "METRIC",
     "NOISE_Z", "REGISTRY", "SNR_KNEE", "TORQUE_CHANNELS", "AmplitudeLaw", "BroadbandFloor", "Context",
     "CounterRotation", "CrossCoupling", "Diagnosis", "Effect", "FixedResonance", "Hypothesis", "MissingHarmonic",
-    "Sidebands", "SpeedRipple", "SpinAcceleration", "State", "diagnose", "effect_entry", "initial_state",
+    "Sidebands", "SpeedRipple", "SpinAcceleration", "State", "SuspensionModes", "diagnose", "effect_entry", "initial_state",
     "line_kernel", "noise_estimate", "refine_h", "resonance", "resolve_base", "ridge_peaks",
     "ripple_sideband_powers", "rms_vs_speed", "write_report",
 ]

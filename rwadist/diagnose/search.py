@@ -136,6 +136,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     """
     if model is None:
         model = fit_empirical(spectra).model
+    request = base
     base = resolve_base(model, base, test)
     ext_params = None
     if base == "extended":
@@ -143,6 +144,10 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
 
         ext_params = params_from_model(model, getattr(model, "name", "<model>"))
     ctx = Context(spectra, channels, test)
+    # 'auto' on the empirical base (no analytical model) may move to the extended base: the wheel's own
+    # suspension modes, fitted from the data (``suspension_modes``), unless the test records the modes off
+    ctx.base_switch = (request == "auto" and base == "empirical"
+                       and not (test is not None and getattr(test, "meta", {}).get("modes") is False))
     state0 = initial_state(ctx, model, ext_params)
     state = state0
     hyps = []
@@ -153,7 +158,8 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
             cands += cls.candidates(ctx, state, ctx.fit_runs)
         judged = [_judge(ctx, state, e, k_sigma, min_gain, it) for e in cands]
         judged.sort(key=lambda h: -h.gain)
-        passing = [h for h in judged if h.passed]
+        # a family marked ``first`` (the wheel's own modes) is taken before any other passing effect
+        passing = sorted((h for h in judged if h.passed), key=lambda h: not getattr(h.effect, "first", False))
         for h in judged:
             h.passed = False
         if not passing:
@@ -168,6 +174,6 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         it = max_iterations
     out = copy.deepcopy(state.model)
     out.effects = list(model.effects) + [effect_entry(h) for h in hyps if h.passed]
-    out.provenance = dict(out.provenance, diagnose={"metric": METRIC, "base": base})
+    out.provenance = dict(out.provenance, diagnose={"metric": METRIC, "base": state.base})
     return Diagnosis(out, state0, state, ctx.error(state0), ctx.error(state), ctx.rms_error(state0),
                      ctx.rms_error(state), hyps, it, ctx)

@@ -12,6 +12,10 @@ from ..state import State
 from .base import register, schema_entry
 
 
+#: Standard errors an exponent must lie away from 2 (the model's C·Ω²) to be proposed as a law.
+EXPONENT_Z = 4.0
+
+
 @register(order=20)
 @dataclass
 class AmplitudeLaw:
@@ -73,6 +77,9 @@ class AmplitudeLaw:
                 if (d, round(hm.h, 4)) in state.laws:
                     continue
                 e = AmplitudeLaw.fit(ctx, state, d, hm.h, runs)
-                if e is not None:
+                # an exponent within EXPONENT_Z standard errors of the model's 2 is no new law, only a
+                # re-estimate of the line's C (on the extended base the fit's C is a compromise across the
+                # modes, a few per mille off where the line is strong): not proposed
+                if e is not None and not abs(e.exponent - 2.0) <= EXPONENT_Z * e.exponent_stderr:
                     out.append(e)
         return out

@@ -13,6 +13,11 @@ from ..state import State
 from .base import register, schema_entry
 
 
+#: Smallest peak gain (or 1/gain, an anti-resonance) proposed: |H| within 10 % of 1 everywhere is the size of the
+#: fit's own model error near a mode (a per-unit extended base leaves ~1-3 % there), not a resonance.
+MIN_PEAK_GAIN = 1.1
+
+
 def _line_gain_points(ctx, state, chans, runs):
     """(f Hz, y, weight) of every model line of ``chans`` on ``runs`` measured above the noise and at least
     2·LINE_HALF bins from the channel's other lines:
@@ -151,5 +156,7 @@ class FixedResonance:
             e = FixedResonance.fit(ctx, state, ctx.channels, runs, role="test_stand")
             if e is not None:
                 out.append(e)
+        # a "resonance" that changes no line by more than MIN_PEAK_GAIN is a patch on model error, not a mode
+        out = [e for e in out if abs(np.log(e.peak_gain)) >= np.log(MIN_PEAK_GAIN)]
         return [e for e in out if not any(abs(e.f_r - r[0]) < 0.02 * r[0] and set(e.channels) & set(r[3])
                                           for r in state.resonances)]

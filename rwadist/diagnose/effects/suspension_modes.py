@@ -1,0 +1,151 @@
+"""``suspension_modes``: the wheel's own suspension modes (radial translation, rocking forward and backward
+whirl, axial translation), fitted from the data with the extended fit and made the base of the search.
+
+Data of a real wheel show modal amplification: lines grow and shrink as they cross the rotor's modes.
+On the empirical (hard-mounted, C·Ω²) base that looks like foreign effects (fixed resonances, amplitude
+laws); it is the wheel itself.  This family proposes, when the search started from the empirical base and
+the empirical fit of the fit runs shows amplification (:func:`rwadist.extended_fit.amplification_peaks`),
+the extended model fitted to those runs (:func:`rwadist.extended_fit.fit_extended`, per unit mass and
+inertia: the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr and I_zz/I_rr).  Applied, it
+switches the state to the extended base (every line through the fitted modes); the search judges it on
+the held-out runs like any effect and carries on from it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..engine import Context
+from ..state import State
+from .base import register, schema_entry
+
+
+def _fit_runs(ctx: Context, runs, state: State):
+    """(SteadyTest, EmpiricalFit, ExtendedFit) of ``runs``, or None when the runs show no modal amplification
+    (or the extended fit fails).
+
+    A fixture resonance on every channel is fitted beside the modes, never into them: after a first
+    extended fit, a ``fixed_resonance`` common to all channels (role test_stand) is fitted on that base;
+    when it is a resonance (:data:`MIN_PEAK_GAIN`), the extended fit is repeated with it divided out of the
+    measured lines (``stand`` of :func:`rwadist.extended_fit.fit_extended`).  The stand resonance itself is
+    left to the search (it is then a clear residual of the extended base: a ``fixed_resonance`` effect)."""
+    from ...data import SteadyTest
+    from ...empirical import fit_empirical
+    from ...extended_fit import amplification_peaks, fit_extended
+    from ...spectra import compute_spectra
+
+    runs = [int(r) for r in runs]
+    test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
+    # the fit's own resolution (the longest segment, as ``rwadist fit``): close lines (h = 5.37, 5.57 of the
+    # E wheel) that diagnose's shorter Welch segments cannot separate are resolved here
+    sp = compute_spectra(test, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
+    fit = fit_empirical(sp)
+    if not amplification_peaks(fit):
+        return None
+    try:
+        efit = fit_extended(test, fit)
+        if len(efit.unconstrained) < 3 and len(ctx.channels) > 3:
+            from ..effects.fixed_resonance import MIN_PEAK_GAIN, FixedResonance
+
+            st = SuspensionModes.from_fit(efit, fit, len(runs)).apply(state)
+            stand = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), role="test_stand")
+            if stand is not None and abs(np.log(stand.peak_gain)) >= np.log(MIN_PEAK_GAIN):
+                efit = fit_extended(test, fit, stand=(stand.f_r, stand.zeta, stand.peak_gain))
+    except ValueError:
+        return None
+    if len(efit.unconstrained) == 3:
+        return None                     # no mode located: nothing to name
+    return test, fit, efit
+
+
+@register(order=100)
+@dataclass
+class SuspensionModes:
+    """The rotor's suspension modes fitted per unit mass (M = 1 kg) and transverse inertia (I_rr = 1 kg·m²).
+
+    model : the extended model (:func:`rwadist.extended_fit.to_model`: harmonics = forcing lines, with the
+        ``analytical`` section).  f0_Hz : mode frequencies at rest, Hz ("radial_translation", "rocking",
+        "axial"); zeta : damping ratios; inertia_ratio : I_zz/I_rr; unconstrained : modes the data do not
+        locate (starting values, as in ``analytical.unconstrained``); n_runs : runs fitted.
+    """
+
+    model: object = field(repr=False)
+    f0_Hz: dict
+    zeta: dict
+    inertia_ratio: float
+    unconstrained: tuple
+    n_runs: int
+    kind: str = "suspension_modes"
+    #: the search takes a passing suspension_modes before any other effect: the wheel's own modes first
+    first = True
+
+    @property
+    def channels(self) -> tuple:
+        return ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")
+
+    @staticmethod
+    def from_fit(efit, fit, n_runs: int) -> "SuspensionModes":
+        from ...extended_fit import to_model
+
+        p = efit.params
+        f0 = {"radial_translation": float(p.omega_r / (2 * np.pi)), "rocking": float(p.omega_rock / (2 * np.pi)),
+              "axial": float(np.sqrt(p.k_z / p.mass) / (2 * np.pi))}
+        zeta = {"radial_translation": float(p.zeta_r), "rocking": float(p.zeta_rock), "axial": float(p.zeta_z)}
+        return SuspensionModes(to_model(efit, fit), f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained),
+                               n_runs)
+
+    def apply(self, state: State) -> State:
+        import copy
+
+        from ...extended import params_from_model
+
+        s = state.copy()
+        s.model = copy.deepcopy(self.model)
+        s.model.effects = list(state.model.effects)
+        s.ext = params_from_model(s.model, "suspension_modes")
+        s.laws = {}
+        s._cache = {}
+        s.effects.append(self)
+        return s
+
+    def refit(self, ctx: Context, state: State) -> "SuspensionModes":
+        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
+        return SuspensionModes.fit(ctx, state, ctx.runs) or self
+
+    def whirl_Hz(self, omega_rad_s: float) -> dict:
+        """Whirl frequencies (Hz) at wheel speed ``omega_rad_s``: translation, rocking forward/backward, axial."""
+        half = 0.5 * self.inertia_ratio * abs(omega_rad_s) / (2 * np.pi)
+        root = np.sqrt(half**2 + self.f0_Hz["rocking"] ** 2)
+        return {"radial_translation": self.f0_Hz["radial_translation"], "rocking_forward": float(root + half),
+                "rocking_backward": float(root - half), "axial": self.f0_Hz["axial"]}
+
+    def params(self) -> dict:
+        return {"radial_translation_Hz": self.f0_Hz["radial_translation"], "rocking_Hz": self.f0_Hz["rocking"],
+                "axial_Hz": self.f0_Hz["axial"], "zeta_radial_translation": self.zeta["radial_translation"],
+                "zeta_rocking": self.zeta["rocking"], "zeta_axial": self.zeta["axial"],
+                "inertia_ratio": self.inertia_ratio, "unconstrained": list(self.unconstrained) or None,
+                "per_unit": True, "n_runs": self.n_runs,
+                "whirl": "rocking forward/backward f = sqrt((a·f_spin/2)^2 + rocking_Hz^2) ± a·f_spin/2, "
+                         "a = inertia_ratio; the model's analytical section holds the fitted parameters"}
+
+    def to_schema(self) -> dict:
+        return schema_entry(self)
+
+    @staticmethod
+    def fit(ctx: Context, state: State, runs) -> "SuspensionModes | None":
+        """The modes fitted on ``runs`` (per unit mass and inertia), or None when those runs show no modal
+        amplification or no mode can be located."""
+        got = _fit_runs(ctx, runs, state)
+        return None if got is None else SuspensionModes.from_fit(got[2], got[1], len(runs))
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs) -> list:
+        """The extended fit of ``runs`` when the search may change its base (``ctx.base_switch``), the state
+        is on the empirical base, the time series are known and the runs show modal amplification."""
+        if state.ext is not None or ctx.test is None or not getattr(ctx, "base_switch", False):
+            return []
+        if any(e.kind == "suspension_modes" for e in state.effects):
+            return []
+        e = SuspensionModes.fit(ctx, state, runs)
+        return [] if e is None else [e]
