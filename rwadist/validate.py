@@ -1,0 +1,101 @@
+"""One validation layer for command-line values: finite numbers, ranges, integers, speed lists.
+
+Each check is an argparse ``type`` (argparse then names the flag: ``argument --noise: 'nan': must be
+a finite number in [0, 10] (fraction of the top-speed fundamental)``) or a function raising
+:class:`DataError` naming the flag, the value and the allowed range.  rpm and Hz at this edge.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+
+import numpy as np
+
+from .formats.records import DataError
+
+#: highest wheel speed any command accepts, rpm (flight wheels run below ~10 000 rpm)
+MAX_RPM = 100_000.0
+#: most speeds in a list or grid (a Campbell grid, a simulated test)
+MAX_SPEEDS = 100_000
+#: most samples of a simulated record (memory: 6 channels x 8 bytes each)
+MAX_SAMPLES = 50_000_000
+
+
+def _fmt(x) -> str:
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def _range_text(lo, hi, lo_open: bool, hi_open: bool) -> str:
+    if lo is not None and hi is not None:
+        return f"{'(' if lo_open else '['}{_fmt(lo)}, {_fmt(hi)}{')' if hi_open else ']'}"
+    if lo is not None:
+        return f"{'>' if lo_open else '>='} {_fmt(lo)}"
+    if hi is not None:
+        return f"{'<' if hi_open else '<='} {_fmt(hi)}"
+    return "any finite value"
+
+
+def check_number(value, flag: str, lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False,
+                 integer: bool = False, unit: str = ""):
+    """``value`` as a float (or int) checked finite and in range; :class:`DataError` naming ``flag``
+    otherwise.  ``lo_open``/``hi_open``: the bound itself is excluded."""
+    text = value if isinstance(value, str) else repr(value)
+    kind = "an integer" if integer else "a finite number"
+    allowed = _range_text(lo, hi, lo_open, hi_open) + (f" {unit}" if unit else "")
+    if isinstance(value, bool):
+        raise DataError(flag, "value", f"{text}: must be {kind} in {allowed}")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise DataError(flag, "value", f"{text!r}: must be {kind} in {allowed}") from None
+    if not math.isfinite(x):
+        raise DataError(flag, "value", f"{text!r}: must be {kind} in {allowed}")
+    if integer:
+        if x != int(x):
+            raise DataError(flag, "value", f"{text!r}: must be {kind} in {allowed}")
+        x = int(x)
+    if (lo is not None and (x < lo or (lo_open and x == lo))) or (
+            hi is not None and (x > hi or (hi_open and x == hi))):
+        raise DataError(flag, "value", f"{text}: out of range; allowed {allowed}")
+    return x
+
+
+def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
+           unit: str = ""):
+    """An argparse ``type`` checking a finite number (or an integer) in a range."""
+    def parse(text):
+        try:
+            return check_number(text, "value", lo, hi, lo_open=lo_open, hi_open=hi_open, integer=integer,
+                                unit=unit)
+        except DataError as exc:
+            raise argparse.ArgumentTypeError(str(exc).split(": ", 2)[-1]) from None
+
+    parse.__name__ = "integer" if integer else "number"
+    return parse
+
+
+def rpm(lo: float = -MAX_RPM, hi: float = MAX_RPM):
+    """An argparse ``type``: a wheel speed in rpm within [lo, hi]."""
+    return number(lo, hi, unit="rpm")
+
+
+def check_speeds_rpm(speeds, flag: str) -> np.ndarray:
+    """A speed list (rpm) checked: non-empty, finite, |speed| <= MAX_RPM, at most MAX_SPEEDS entries."""
+    s = np.asarray(speeds, dtype=float).ravel()
+    if s.size == 0:
+        raise DataError(flag, "value", "no speeds: give at least one speed in rpm")
+    if s.size > MAX_SPEEDS:
+        raise DataError(flag, "value", f"{s.size} speeds: at most {MAX_SPEEDS}; use a coarser step")
+    bad = s[~np.isfinite(s) | (np.abs(s) > MAX_RPM)]
+    if bad.size:
+        raise DataError(flag, "value", f"speed {float(bad[0])!r} rpm: must be finite in [{-MAX_RPM:g}, {MAX_RPM:g}] rpm")
+    return s
+
+
+def check_grid_size(start: float, stop: float, step: float, flag: str) -> None:
+    """Refuse a START:STOP:STEP grid of more than MAX_SPEEDS points before it is allocated."""
+    n = (stop - start) / step + 1 if step > 0 else math.inf
+    if not math.isfinite(n) or n > MAX_SPEEDS:
+        raise DataError(flag, "value", f"{_fmt(start)}:{_fmt(stop)}:{_fmt(step)} makes "
+                        f"{'too many' if not math.isfinite(n) else int(n)} speeds: at most {MAX_SPEEDS}; "
+                        "use a larger step")
