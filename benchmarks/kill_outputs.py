@@ -35,6 +35,22 @@ def valid_model(path: Path) -> bool:
         return False
 
 
+def mark_model(path: Path) -> None:
+    """The old model: the reference fit renamed (still a complete, valid model file)."""
+    doc = json.loads(path.read_text())
+    doc["name"] = "OLD reference"
+    path.write_text(json.dumps(doc, indent=2) + "\n")
+
+
+def mark_psd(path: Path) -> None:
+    """The old PSD table: the reference one with a different first value (still complete, 20001 rows)."""
+    lines = path.read_text().splitlines()
+    cells = lines[1].split(",")
+    cells[1] = "1.2345678900e-30"
+    lines[1] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n")
+
+
 def valid_psd(path: Path, n_freq: int) -> bool:
     from rwadist.broadband import read_psd_csv
     try:
@@ -52,7 +68,7 @@ def valid_fmu(path: Path) -> bool:
         return False
 
 
-def run_kills(name, cmd, out: Path, is_valid, kills: int, rng: random.Random, cwd: Path) -> dict:
+def run_kills(name, cmd, out: Path, is_valid, kills: int, rng: random.Random, cwd: Path, mark_old=None) -> dict:
     t0 = time.perf_counter()      # a complete output ("the old file"); when its temporary file appears
     proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     t_write = None
@@ -65,17 +81,20 @@ def run_kills(name, cmd, out: Path, is_valid, kills: int, rng: random.Random, cw
     if proc.returncode != 0:
         raise SystemExit(f"{name}: the reference run failed (exit {proc.returncode})")
     t_write = duration if t_write is None else t_write
+    if mark_old is not None:     # the old file must differ from every new one, else "old kept" proves nothing
+        mark_old(out)
     old = out.read_bytes()
     counts = dict(kills=0, during_write=0, old_kept=0, new_complete=0, truncated_or_invalid=0, first_write=None)
 
-    def one(delay=None, at_first_write=False):
+    def one(delay=None, at_first_write=False, after_write_starts=0.0):
         proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         if at_first_write:       # poll for the temporary sibling of the output: its first write
             deadline = time.perf_counter() + 5 * duration + 30
             while proc.poll() is None and time.perf_counter() < deadline:
                 if any(p.name.startswith(f".{out.stem}.part-") for p in out.parent.iterdir()):
                     break
-                time.sleep(0.0005)
+                time.sleep(0.0002)
+            time.sleep(after_write_starts)
         else:
             time.sleep(delay)
         proc.send_signal(signal.SIGKILL)
@@ -93,9 +112,11 @@ def run_kills(name, cmd, out: Path, is_valid, kills: int, rng: random.Random, cw
             state = "truncated_or_invalid"
         return during, state
 
-    for k in range(kills):   # half over the whole run, half over its write phase (where truncation could happen)
-        delay = rng.uniform(0.2, 1.05) * duration if k % 2 == 0 else rng.uniform(t_write, duration)
-        during, state = one(delay=delay)
+    for k in range(kills):   # half at random over the whole run, half at random just after the write began
+        if k % 2 == 0:
+            during, state = one(delay=rng.uniform(0.2, 1.05) * duration)
+        else:
+            during, state = one(at_first_write=True, after_write_starts=rng.uniform(0.0, 0.05))
         counts["kills"] += 1
         counts["during_write"] += during
         counts[state] += 1
@@ -119,19 +140,20 @@ def main(argv=None) -> int:
         subprocess.run(RWADIST + ["simulate-test", "ds", "--preset", "ithaco-e", "--speeds-rpm", "600:2400:600",
                                   "--samples", "4096"], cwd=tmp, check=True, capture_output=True)
         cases = {
-            "fit -o": (RWADIST + ["fit", "ds", "-o", "out/m.json"], tmp / "out" / "m.json", valid_model),
+            "fit -o": (RWADIST + ["fit", "ds", "-o", "out/m.json"], tmp / "out" / "m.json", valid_model,
+                       mark_model),
             "psd -o": (RWADIST + ["psd", "--preset", "ithaco-e", "--speed-rpm", "600:2400", "--empirical",
                                   "--n-freq", "20001", "-o", "out/psd.csv"], tmp / "out" / "psd.csv",
-                       lambda p: valid_psd(p, 20001)),
+                       lambda p: valid_psd(p, 20001), mark_psd),
             "fmu build -o": (RWADIST + ["fmu", "build", "--preset", "ithaco-e", "--native", "-o", "out/w.fmu"],
-                             tmp / "out" / "w.fmu", valid_fmu),
+                             tmp / "out" / "w.fmu", valid_fmu, None),     # each build has its own GUID
         }
         keys = {"fit": "fit -o", "psd": "psd -o", "fmu": "fmu build -o"}
         chosen = [keys[k] for k in a.only] if a.only else list(cases)
         bad = 0
         for name in chosen:
-            cmd, out, check = cases[name]
-            c = run_kills(name, cmd, out, check, a.kills, rng, tmp)
+            cmd, out, check, mark = cases[name]
+            c = run_kills(name, cmd, out, check, a.kills, rng, tmp, mark)
             bad += c["truncated_or_invalid"]
             print(f"{name:<13} {c['kills']} random kills (run {c['run_s']} s, write phase {c['write_s']} s): {c['during_write']} during the write, "
                   f"old kept {c['old_kept']}, new complete {c['new_complete']}, truncated/invalid "

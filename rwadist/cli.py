@@ -17,7 +17,7 @@ from .data import DataError
 from .outputs import (atomic_dataset_dir, atomic_dir, atomic_file, check_output_dir, check_output_file,
                       refuse_input_overwrite)
 from .units import RAD_S_TO_RPM, rpm_to_rad_s
-from .validate import MAX_RPM, MAX_SAMPLES, MAX_SPEEDS, check_grid_size, check_speeds_rpm, number, rpm
+from .validate import MAX_RPM, MAX_SAMPLES, MAX_SPEEDS, check_grid_size, check_parsed, check_speeds_rpm, number, rpm
 
 
 def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm") -> np.ndarray:
@@ -64,6 +64,9 @@ def cmd_simulate(args) -> int:
             raise DataError("--sweep-end-rpm", "value", f"{end:g}: equals --sweep-start-rpm; a sweep needs two "
                             "different speeds")
         n_sweep = args.duration * (args.sample_rate or 3840.0)
+        if n_sweep < 64:
+            raise DataError("--duration", "value", f"{args.duration:g} s at {args.sample_rate or 3840.0:g} Hz is "
+                            f"{n_sweep:.3g} samples: a sweep needs at least 64; lengthen --duration")
         if n_sweep > MAX_SAMPLES:
             raise DataError("--duration", "value", f"{args.duration:g} s at {args.sample_rate or 3840.0:g} Hz is "
                             f"{n_sweep:.3g} samples: at most {MAX_SAMPLES:.3g}; shorten --duration")
@@ -729,7 +732,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("out_dir")
     s.add_argument("--preset", required=True, help="wheel preset, e.g. ithaco-e, ithaco-b")
     s.add_argument("--speeds-rpm", help="'A,B,C', 'START:STOP:STEP' or 'START:STOP' with --n-speeds")
-    s.add_argument("--n-speeds", type=number(2, MAX_SPEEDS, integer=True), default=None)
+    s.add_argument("--n-speeds", type=number(1, MAX_SPEEDS, integer=True), default=None)
     s.add_argument("--sample-rate", type=number(0, 1e6, lo_open=True, unit="Hz"), default=None, help="Hz (default: the preset's test)")
     s.add_argument("--samples", type=number(64, MAX_SAMPLES, integer=True), default=8192, help="samples per steady run")
     s.add_argument("--noise", type=number(0, 10), default=0.01, help="sensor noise std as a fraction of the top-speed fundamental")
@@ -918,11 +921,14 @@ def main(argv=None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
+    except SystemExit as exc:      # argparse has printed the usage and the refused flag (or --help/--version)
+        return exc.code if isinstance(exc.code, int) else 2
     except KeyboardInterrupt:
         print("rwadist: interrupted", file=sys.stderr)
         return 130
     command = _command_name(args)
     try:
+        check_parsed(parser, args)
         return args.func(args)
     except KeyboardInterrupt:
         print(f"rwadist {command}: interrupted; outputs left as they were (no partial file written)",

@@ -71,7 +71,29 @@ def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, in
             raise argparse.ArgumentTypeError(str(exc).split(": ", 2)[-1]) from None
 
     parse.__name__ = "integer" if integer else "number"
+    parse.rwadist_checked = True
     return parse
+
+
+def check_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """After parsing: every flag typed by :func:`number` holds a number (argparse skips the type of some
+    values, e.g. ``--noise=--`` gives an empty list); :class:`DataError` naming the flag otherwise."""
+    def walk(p):
+        for action in p._actions:
+            if isinstance(action, argparse._SubParsersAction):     # only the command that was chosen
+                chosen = action.choices.get(getattr(args, action.dest, None) or "")
+                if chosen is not None:
+                    yield from walk(chosen)
+            elif getattr(action.type, "rwadist_checked", False):
+                yield action
+
+    for action in walk(parser):
+        value = getattr(args, action.dest, None)
+        if value is None or value is action.default:
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            flag = max(action.option_strings, key=len) if action.option_strings else action.dest
+            raise DataError(flag, "value", f"{value!r}: missing or not a number")
 
 
 def rpm(lo: float = -MAX_RPM, hi: float = MAX_RPM):
