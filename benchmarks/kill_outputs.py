@@ -81,12 +81,12 @@ def run_kills(name, cmd, out: Path, is_valid, kills: int, rng: random.Random, cw
     if proc.returncode != 0:
         raise SystemExit(f"{name}: the reference run failed (exit {proc.returncode})")
     t_write = duration if t_write is None else t_write
-    if mark_old is not None:     # the old file must differ from every new one, else "old kept" proves nothing
-        mark_old(out)
-    old = out.read_bytes()
     counts = dict(kills=0, during_write=0, old_kept=0, new_complete=0, truncated_or_invalid=0, first_write=None)
 
     def one(delay=None, at_first_write=False, after_write_starts=0.0):
+        if mark_old is not None:      # each kill starts from an old complete file unlike any new one
+            mark_old(out)
+        before = out.read_bytes()
         proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         if at_first_write:       # poll for the temporary sibling of the output: its first write
             deadline = time.perf_counter() + 5 * duration + 30
@@ -104,7 +104,7 @@ def run_kills(name, cmd, out: Path, is_valid, kills: int, rng: random.Random, cw
             if ".part-" in p.name:
                 shutil.rmtree(p) if p.is_dir() else p.unlink()
         data = out.read_bytes() if out.exists() else b""
-        if data == old:
+        if data == before:
             state = "old_kept"
         elif is_valid(out):
             state = "new_complete"

@@ -160,6 +160,9 @@ def cmd_fit(args) -> int:
     _write(args.output, lambda tmp: model_io.save(model, tmp))
     n = sum(len(v) for v in fit.model.empirical.values())
     print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
+    if n == 0:
+        print(f"WARNING: no harmonic passed the presence threshold ({args.presence:g} of the runs): the model is "
+              "empty; give more runs over the speed range, or lower --presence", file=sys.stderr)
     print(f"model:  {args.output}")
     print(f"report: {report_dir} ({len(files)} files)")
     return 0
@@ -416,6 +419,9 @@ def cmd_campbell(args) -> int:
     refuse_input_overwrite([("-o", out, "file"), ("-o", out.with_suffix(".png"), "file")], [args.model])
     params, lines, source = api.extended_source(args.model, preset=args.preset)
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
+    if np.ptp(np.abs(speeds)) == 0:
+        raise DataError("--speeds-rpm", "value", f"{args.speeds_rpm!r} gives one speed ({float(speeds[0]):g} rpm); "
+                        "a Campbell diagram needs a range, e.g. 0:3000:100")
     table, rows = api.campbell(args.model, speeds, preset=args.preset)
     bad = [k for k, v in table.items() if not np.all(np.isfinite(np.asarray(v, dtype=float)))]
     if bad:
@@ -601,6 +607,9 @@ def cmd_psd(args) -> int:
     except ValueError:
         raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: expected MIN:MAX in rpm") from None
     check_speeds_rpm([lo_rpm, hi_rpm], "--speed-rpm")
+    if not lo_rpm < hi_rpm:
+        raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: MIN must be below MAX (rpm; a negative "
+                        "range, e.g. -2400:-600, spins about -z)")
     law = bb.law_from_spec(args.dist, lo_rpm, hi_rpm, args.std_rpm)
 
     def default_lines():
