@@ -641,7 +641,11 @@ def cmd_psd(args) -> int:
     else:
         lines = default_lines()
         if fmax is None:
-            fmax = _default_fmax([(lines, law)])
+            try:
+                fmax = _default_fmax([(lines, law)])
+            except ValueError:      # no line to place the band by
+                raise DataError(args.model or args.preset, "empirical", "no harmonic lines: nothing to compute "
+                                "a PSD of; check the model with `rwadist model show`") from None
         res = bb.broadband_psd(lines, law, fmax, args.n_freq, args.n_speeds, progress=True)
         sources = [(lines, None)]
     _refuse_non_finite_psd(res, args.model or args.preset or args.wheels)
@@ -930,8 +934,6 @@ def main(argv=None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
-    except SystemExit as exc:      # argparse has printed the usage and the refused flag (or --help/--version)
-        return exc.code if isinstance(exc.code, int) else 2
     except KeyboardInterrupt:
         print("rwadist: interrupted", file=sys.stderr)
         return 130

@@ -1,8 +1,8 @@
 """One validation layer for command-line values: finite numbers, ranges, integers, speed lists.
 
-Each check is an argparse ``type`` (argparse then names the flag: ``argument --noise: 'nan': must be
-a finite number in [0, 10] (fraction of the top-speed fundamental)``) or a function raising
-:class:`DataError` naming the flag, the value and the allowed range.  rpm and Hz at this edge.
+Each check is an argparse ``type`` (a refused value is kept as :class:`Refused`, then
+:func:`check_parsed` raises ``--noise: value: 'nan': must be a finite number in [0, 10]``) or a function
+raising :class:`DataError` naming the flag, the value and the allowed range.  rpm and Hz at this edge.
 """
 from __future__ import annotations
 
@@ -60,6 +60,16 @@ def check_number(value, flag: str, lo=None, hi=None, *, lo_open: bool = False, h
     return x
 
 
+class Refused:
+    """A flag value :func:`number` refused: ``text`` as given and ``why`` (range, type)."""
+
+    def __init__(self, text: str, why: str):
+        self.text, self.why = text, why
+
+    def __repr__(self) -> str:
+        return repr(self.text)
+
+
 def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
            unit: str = ""):
     """An argparse ``type`` checking a finite number (or an integer) in a range."""
@@ -67,8 +77,8 @@ def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, in
         try:
             return check_number(text, "value", lo, hi, lo_open=lo_open, hi_open=hi_open, integer=integer,
                                 unit=unit)
-        except DataError as exc:
-            raise argparse.ArgumentTypeError(str(exc).split(": ", 2)[-1]) from None
+        except DataError as exc:       # refused by check_parsed, which knows the flag (exit 2 from main)
+            return Refused(text, str(exc).split(": ", 2)[-1])
 
     parse.__name__ = "integer" if integer else "number"
     parse.rwadist_checked = True
@@ -91,8 +101,10 @@ def check_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> N
         value = getattr(args, action.dest, None)
         if value is None or value is action.default:
             continue
+        flag = max(action.option_strings, key=len) if action.option_strings else action.dest
+        if isinstance(value, Refused):
+            raise DataError(flag, "value", value.why)
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            flag = max(action.option_strings, key=len) if action.option_strings else action.dest
             raise DataError(flag, "value", f"{value!r}: missing or not a number")
 
 
