@@ -608,8 +608,8 @@ def cmd_psd(args) -> int:
         raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: expected MIN:MAX in rpm") from None
     check_speeds_rpm([lo_rpm, hi_rpm], "--speed-rpm")
     if not lo_rpm < hi_rpm:
-        raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: MIN must be below MAX (rpm; a negative "
-                        "range, e.g. -2400:-600, spins about -z)")
+        raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: empty or inverted speed range; MIN must be "
+                        "below MAX (rpm; a negative range, e.g. -2400:-600, spins about -z)")
     law = bb.law_from_spec(args.dist, lo_rpm, hi_rpm, args.std_rpm)
 
     def default_lines():
