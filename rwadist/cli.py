@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -12,26 +13,52 @@ import numpy as np
 from . import api, catalogue
 from . import data as data_io
 from . import model as model_io
+from .cli_parser import _version
 from .data import DataError
+from .outputs import (
+    atomic_dataset_dir,
+    atomic_dir,
+    atomic_file,
+    check_output_dir,
+    check_output_file,
+    refuse_input_overwrite,
+)
 from .units import RAD_S_TO_RPM, rpm_to_rad_s
+from .validate import (
+    MAX_SAMPLES,
+    check_grid_size,
+    check_parsed,
+    check_speeds_rpm,
+    refuse_non_finite_model,
+    refuse_non_finite_psd,
+)
 
 
-def parse_speeds(text: str, n: int | None = None) -> np.ndarray:
-    """rpm list from 'A,B,C', 'START:STOP:STEP' (stop inclusive) or 'START:STOP' with ``n`` points."""
+def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm") -> np.ndarray:
+    """rpm list from 'A,B,C', 'START:STOP:STEP' (stop inclusive) or 'START:STOP' with ``n`` points;
+    every speed finite within +-MAX_RPM, at most MAX_SPEEDS of them (:class:`DataError` naming ``flag``)."""
     try:
         if ":" in text:
             parts = [float(p) for p in text.split(":")]
+            if not all(np.isfinite(parts)):
+                raise ValueError("every part must be a finite number of rpm")
             if len(parts) == 2:
                 if not n:
                     raise ValueError("START:STOP needs --n-speeds")
-                return np.linspace(parts[0], parts[1], int(n))
+                return check_speeds_rpm(np.linspace(parts[0], parts[1], int(n)), flag)
+            if len(parts) != 3:
+                raise ValueError("expected START:STOP:STEP or START:STOP")
             start, stop, step = parts
             if step <= 0:
                 raise ValueError("STEP must be > 0")
-            return np.arange(start, stop + 0.5 * step, step)
-        return np.array([float(p) for p in text.split(",") if p.strip()])
+            check_speeds_rpm([start, stop], flag)
+            check_grid_size(start, stop, step, flag)
+            return check_speeds_rpm(np.arange(start, stop + 0.5 * step, step), flag)
+        return check_speeds_rpm([float(p) for p in text.split(",") if p.strip()], flag)
     except ValueError as exc:
-        raise DataError("--speeds-rpm", "value", f"{text!r}: {exc}") from None
+        if isinstance(exc, DataError):
+            raise
+        raise DataError(flag, "value", f"{text!r}: {exc}") from None
 
 
 # --------------------------------------------------------------------------- simulate-test
@@ -47,18 +74,32 @@ def cmd_simulate(args) -> int:
     if args.sweep:
         wheel = preset(args.preset)
         end = args.sweep_end_rpm if args.sweep_end_rpm is not None else 2400.0
+        if end == args.sweep_start_rpm:
+            raise DataError("--sweep-end-rpm", "value", f"{end:g}: equals --sweep-start-rpm; a sweep needs two "
+                            "different speeds")
+        n_sweep = args.duration * (args.sample_rate or 3840.0)
+        if n_sweep < 64:
+            raise DataError("--duration", "value", f"{args.duration:g} s at {args.sample_rate or 3840.0:g} Hz is "
+                            f"{n_sweep:.3g} samples: a sweep needs at least 64; lengthen --duration")
+        if n_sweep > MAX_SAMPLES:
+            raise DataError("--duration", "value", f"{args.duration:g} s at {args.sample_rate or 3840.0:g} Hz is "
+                            f"{n_sweep:.3g} samples: at most {MAX_SAMPLES:.3g}; shorten --duration")
         sweep = simulate_sweep(wheel, rpm_start=args.sweep_start_rpm, rpm_end=end, duration=args.duration,
                                sample_rate=args.sample_rate or 3840.0, noise=args.noise, modes=not args.no_modes,
                                test_stand=not args.no_test_stand, seed=args.seed, profile=args.profile,
                                tach=not args.no_tach, physics=args.physics)
         if assumed_note:
             sweep.meta["modes_assumed"] = assumed_note
-        path = data_io.write_sweep(sweep, out / "sweep.csv")
+        path = _write(out / "sweep.csv", lambda tmp: data_io.write_sweep(sweep, tmp))
         print(f"wrote sweep {path} ({len(sweep.time)} samples, {sweep.sample_rate:g} Hz)")
         return 0
     if args.n_speeds and not args.speeds_rpm:
         raise DataError("--n-speeds", "value", "needs --speeds-rpm START:STOP")
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds) if args.speeds_rpm else None
+    n_runs = len(speeds) if speeds is not None else 20
+    if n_runs * args.samples > MAX_SAMPLES:
+        raise DataError("--samples", "value", f"{args.samples} samples x {n_runs} runs: at most {MAX_SAMPLES:.3g} "
+                        "samples in all; use fewer speeds or samples")
     test = api.simulate_test(args.preset, speeds, sample_rate=args.sample_rate, n_samples=args.samples,
                              noise=args.noise, modes=not args.no_modes, test_stand=not args.no_test_stand,
                              seed=args.seed, physics=args.physics, inject=args.inject)
@@ -68,7 +109,8 @@ def cmd_simulate(args) -> int:
     fs = test.runs[0].sample_rate
     if assumed_note:
         test.meta["modes_assumed"] = assumed_note
-    data_io.write_steady(test, out)
+    with atomic_dataset_dir(out) as tmp:
+        data_io.write_steady(test, tmp)
     print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g}-{speeds.max():g} rpm, {fs:g} Hz, "
           f"{args.samples} samples each)")
     return 0
@@ -107,6 +149,11 @@ def run_fit(test, args, name: str, progress: bool = True):
 def cmd_fit(args) -> int:
     from .report import write_report
 
+    check_output_file(args.output)
+    report_dir = Path(args.report) if args.report else Path(args.output).with_suffix("").parent / (
+        Path(args.output).stem + "_report")
+    check_output_dir(report_dir, "--report")
+    refuse_input_overwrite([("-o", args.output, "file"), ("--report", report_dir, "dir")], [args.data])
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
     fit = run_fit(test, args, name=Path(args.data).name)
@@ -115,18 +162,21 @@ def cmd_fit(args) -> int:
     efit = None
     if args.extended:
         efit, model = run_extended_fit(test, fit, args)
-    model_io.save(model, args.output)
-    report_dir = Path(args.report) if args.report else Path(args.output).with_suffix("").parent / (
-        Path(args.output).stem + "_report")
+    refuse_non_finite_model(model, "fit")
     print(f"writing report to {report_dir} ...", flush=True)
-    cum = parse_speeds(args.cumulative_rpm) if args.cumulative_rpm else None
-    files = write_report(fit, report_dir, cumulative_speeds_rpm=cum)
-    if efit is not None:
-        from .report import write_extended_report
+    cum = parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm") if args.cumulative_rpm else None
+    with atomic_dir(report_dir) as tmp_dir:     # the report replaces an old one only when complete
+        files = write_report(fit, tmp_dir, cumulative_speeds_rpm=cum)
+        if efit is not None:
+            from .report import write_extended_report
 
-        files += write_extended_report(efit, fit, report_dir)
+            files += write_extended_report(efit, fit, tmp_dir)
+    _write(args.output, lambda tmp: model_io.save(model, tmp))
     n = sum(len(v) for v in fit.model.empirical.values())
     print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
+    if n == 0:
+        print(f"WARNING: no harmonic passed the presence threshold ({args.presence:g} of the runs): the model is "
+              "empty; give more runs over the speed range, or lower --presence", file=sys.stderr)
     print(f"model:  {args.output}")
     print(f"report: {report_dir} ({len(files)} files)")
     return 0
@@ -181,25 +231,6 @@ def _warn_unconstrained(model, source, use) -> None:
     text = unconstrained_warning(model, str(source), use)
     if text:
         print(text, file=sys.stderr)
-
-
-def _add_fit_options(p):
-    p.add_argument("--f-lim", type=float, default=None, help="upper limit of good data, Hz (test-stand resonance)")
-    p.add_argument("--nperseg", type=int, default=None, help="FFT length (default: largest power of 2 in a run)")
-    p.add_argument("--presence", type=float, default=0.25, help="bin presence threshold P0, fraction (default 0.25)")
-    p.add_argument("--epsilon", type=float, default=0.02, help="binning tolerance on h (default 0.02)")
-    p.add_argument("--no-mode-exclusion", action="store_true", help="keep modally amplified speeds in the fit")
-    p.add_argument("--slice-samples", type=int, default=8192, help="sweep slice length, samples")
-    p.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
-                   help="speed of sweep slices: tach column, estimated from data, or auto")
-    p.add_argument("--extended", action="store_true",
-                   help="also fit the extended model (modes, damping, imbalances) into the model file")
-    p.add_argument("--mass", type=float, default=None,
-                   help="rotor mass, kg (extended fit; without --mass/--radius the fit is per unit mass/inertia)")
-    p.add_argument("--radius", type=float, default=None, help="rotor radius, m (extended fit; thin-disc inertias)")
-    p.add_argument("--height", type=float, default=0.0,
-                   help="lever arm from the rotor centre to the torque reference point, m (default 0)")
-    p.add_argument("--preset", default=None, help="take mass and radius (and unseen modes) from a wheel preset")
 
 
 # --------------------------------------------------------------------------- model show
@@ -296,15 +327,16 @@ def cmd_demo(args) -> int:
     test = simulate_steady(wheel, speeds, sample_rate=3840.0, n_samples=8192, noise=0.01, modes=True, seed=args.seed)
     from .hdf5 import read_hdf5, write_hdf5
 
-    data_path = write_hdf5(test, out / "data.h5", compression="gzip", precision="float32")
+    data_path = _write(out / "data.h5", lambda tmp: write_hdf5(test, tmp, compression="gzip", precision="float32"))
     print(f"2/4 wrote the test as HDF5: {data_path} ({data_path.stat().st_size / 1e6:.1f} MB; float32 samples, "
           "gzip; `rwadist convert` writes any other format)")
     test = read_hdf5(data_path)
     print("3/4 fitting the empirical model")
     ns = argparse.Namespace(f_lim=None, nperseg=None, presence=0.25, epsilon=0.02, no_mode_exclusion=False)
     fit = run_fit(test, ns, name="demo: " + wheel.name)
-    model_path = model_io.save(fit.model, out / "model.json")
-    files = write_report(fit, out / "report")
+    model_path = _write(out / "model.json", lambda tmp: model_io.save(fit.model, tmp))
+    with atomic_dir(out / "report") as tmp_dir:
+        files = write_report(fit, tmp_dir)
     print(f"4/4 model {model_path}, report {out / 'report'} ({len(files)} files)\n")
     truth = wheel.to_model()
     print(f"{'direction':<14} {'h fit':>7} {'h true':>7} {'C fit':>11} {'C true':>11} {'err':>7}  excluded rpm")
@@ -330,9 +362,13 @@ def cmd_convert(args) -> int:
     from .hdf5 import write_hdf5
 
     src, dst = Path(args.src), Path(args.output)
+    if str(args.output).strip() == "":
+        raise DataError("-o", "value", "empty: give the file or folder to write")
+    refuse_input_overwrite([("-o", dst, "file")], [src])
     obj = data_io.read_data(src, progress=True)
     if dst.suffix.lower() in (".h5", ".hdf5"):
-        write_hdf5(obj, dst, compression="gzip", precision=args.precision)
+        check_output_file(dst)
+        _write(dst, lambda tmp: write_hdf5(obj, tmp, compression="gzip", precision=args.precision))
         print(f"wrote {dst} (HDF5, {args.precision}, gzip; {dst.stat().st_size / 1e6:.2f} MB)")
         return 0
     if args.precision != "float64":
@@ -342,7 +378,9 @@ def cmd_convert(args) -> int:
         if dst.suffix.lower() in READ_EXTENSIONS:
             raise DataError(dst, "-o", f"a steady test is a directory (runs.csv + one {fmt} file per run) or an "
                             ".h5 file, not a {dst.suffix} file")
-        data_io.write_steady(obj, dst, fmt)
+        check_output_dir(dst)
+        with atomic_dataset_dir(dst) as tmp:
+            data_io.write_steady(obj, tmp, fmt)
         print(f"wrote {len(obj.runs)} runs to {dst} ({fmt}, runs.csv, meta.json)")
         return 0
     fmt = args.format
@@ -353,7 +391,16 @@ def cmd_convert(args) -> int:
         fmt = READ_EXTENSIONS[dst.suffix.lower()]
     if dst.suffix.lower() != EXTENSION[fmt]:
         raise DataError(dst, "-o", f"a {fmt} sweep file must end in {EXTENSION[fmt]}")
-    data_io.write_sweep(obj, dst, fmt, with_meta=True)
+    check_output_file(dst)
+
+    def write_with_meta(tmp):
+        data_io.write_sweep(obj, tmp, fmt, with_meta=True)
+        meta_tmp = tmp.with_suffix(".meta.json")
+        if meta_tmp.exists():   # the sidecar: complete before the data file appears
+            with atomic_file(dst.with_suffix(".meta.json")) as tmp_meta:
+                os.replace(meta_tmp, tmp_meta)
+
+    _write(dst, write_with_meta)
     print(f"wrote sweep {dst} ({fmt}, {len(obj.time)} samples)")
     return 0
 
@@ -365,12 +412,21 @@ def cmd_campbell(args) -> int:
     prints the harmonic/mode crossing speeds."""
     from .campbell import plot_campbell, write_campbell_csv
 
+    out = check_output_file(args.output)
+    refuse_input_overwrite([("-o", out, "file"), ("-o", out.with_suffix(".png"), "file")], [args.model])
     params, lines, source = api.extended_source(args.model, preset=args.preset)
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
+    if np.ptp(np.abs(speeds)) == 0:
+        raise DataError("--speeds-rpm", "value", f"{args.speeds_rpm!r} gives one speed ({float(speeds[0]):g} rpm); "
+                        "a Campbell diagram needs a range, e.g. 0:3000:100")
     table, rows = api.campbell(args.model, speeds, preset=args.preset)
-    csv_path = write_campbell_csv(table, args.output)
-    png_path = csv_path.with_suffix(".png")
-    plot_campbell(params, speeds, lines).savefig(png_path, dpi=120)
+    bad = [k for k, v in table.items() if not np.all(np.isfinite(np.asarray(v, dtype=float)))]
+    if bad:
+        raise DataError(args.model or args.preset, "campbell", f"non-finite frequencies in {', '.join(bad)}: "
+                        "the model's analytical parameters are out of range; check them with `rwadist model show`")
+    png_path = out.with_suffix(".png")
+    _write(png_path, lambda tmp: plot_campbell(params, speeds, lines).savefig(tmp, dpi=120))
+    csv_path = _write(out, lambda tmp: write_campbell_csv(table, tmp))
     print(f"Campbell table of {source}: {csv_path} ({len(speeds)} speeds), plot: {png_path}")
     print(f"{'h':>6} {'direction':<14} {'sense':<8} {'mode':<19} {'speed_rpm':>10} {'f_Hz':>8}  excites")
     for r in rows:
@@ -387,6 +443,10 @@ def cmd_fmu_build(args) -> int:
         from rwadist.fmu.runtime import ModelError
     except ImportError as exc:
         raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
+    out = check_output_file(args.output)
+    if out.suffix != ".fmu":
+        raise DataError("-o", "value", f"{str(out)!r} must end in .fmu")
+    refuse_input_overwrite([("-o", out, "file")], [args.model])
     if args.model:
         source = args.model
         _warn_unconstrained(model_io.load(args.model), args.model, "the FMU")
@@ -397,9 +457,9 @@ def cmd_fmu_build(args) -> int:
     try:
         if getattr(args, "native", False):
             from rwadist.fmu.native_build import build_native_fmu
-            path = build_native_fmu(source, args.output, assumed_modes=args.assumed_modes)
+            path = _write(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes))
         else:
-            path = build_fmu(source, args.output, assumed_modes=args.assumed_modes)
+            path = _write(out, lambda tmp: build_fmu(source, tmp, assumed_modes=args.assumed_modes))
     except ModelError as exc:
         if exc.field is not None:       # a bad model-file field: the schema's message names file and field
             raise
@@ -413,6 +473,23 @@ def cmd_fmu_build(args) -> int:
     return 0
 
 
+def _check_fmu_archive(path) -> None:
+    """Refuse a file that is not a complete FMU archive (a zip holding modelDescription.xml)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as z:
+            names = set(z.namelist())
+            broken = z.testzip()
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError) as exc:
+        raise DataError(path, "FMU", f"not an FMU archive (a zip file): {exc}; give the .fmu written by "
+                        "`rwadist fmu build`") from None
+    if "modelDescription.xml" not in names:
+        raise DataError(path, "FMU", "the archive has no modelDescription.xml: not an FMU")
+    if broken is not None:
+        raise DataError(path, "FMU", f"damaged archive (member {broken!r} fails its checksum); rebuild it")
+
+
 def cmd_fmu_check(args) -> int:
     try:
         from fmpy import simulate_fmu
@@ -421,7 +498,16 @@ def cmd_fmu_check(args) -> int:
         raise DataError(args.fmu, "check", f"needs fmpy ({exc})") from None
     if not Path(args.fmu).is_file():
         raise DataError(args.fmu, "file", "does not exist")
-    problems = validate_fmu(args.fmu)
+    _check_fmu_archive(args.fmu)
+    n_steps = args.stop_time / args.step_size
+    if n_steps < 1 or n_steps > 1e7:
+        raise DataError("--step-size", "value", f"{args.step_size:g} s over --stop-time {args.stop_time:g} s makes "
+                        f"{n_steps:.3g} steps: allowed 1 to 1e7 steps")
+    try:
+        problems = validate_fmu(args.fmu)
+    except Exception as exc:    # fmpy raises assorted errors on a damaged archive or XML
+        raise DataError(args.fmu, "FMU", f"cannot be read by fmpy ({type(exc).__name__}: {str(exc)[:160]}); "
+                        "rebuild it with `rwadist fmu build`") from None
     for prob in problems:
         print(f"validation: {prob}")
     print(f"fmpy validation: {len(problems)} problem(s)")
@@ -474,6 +560,8 @@ def cmd_diagnose(args) -> int:
 
     if args.preset and args.model:
         raise DataError("diagnose", "--model/--preset", "give a model file or --preset, not both")
+    check_output_dir(args.output)
+    refuse_input_overwrite([("-o", args.output, "dir")], [args.data, args.model])
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
     model = model_io.load(args.model) if args.model else None
@@ -494,7 +582,8 @@ def cmd_diagnose(args) -> int:
         raise
     except ValueError as exc:
         raise DataError("diagnose", "--base", str(exc)) from None
-    files = write_report(diag, args.output)
+    with atomic_dir(args.output) as tmp_dir:
+        files = [Path(args.output) / Path(f).name for f in write_report(diag, tmp_dir)]
     if assumed and diag.state_before.base == "extended":
         from .catalogue import write_assumed_note
         files.append(write_assumed_note(Path(args.output) / "ASSUMED_MODES.txt", [args.model or args.preset], files))
@@ -530,6 +619,10 @@ def cmd_psd(args) -> int:
         lo_rpm, hi_rpm = (float(x) for x in args.speed_rpm.split(":"))
     except ValueError:
         raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: expected MIN:MAX in rpm") from None
+    check_speeds_rpm([lo_rpm, hi_rpm], "--speed-rpm")
+    if not lo_rpm < hi_rpm:
+        raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: empty or inverted speed range; MIN must be "
+                        "below MAX (rpm; a negative range, e.g. -2400:-600, spins about -z)")
     law = bb.law_from_spec(args.dist, lo_rpm, hi_rpm, args.std_rpm)
 
     def default_lines():
@@ -544,8 +637,12 @@ def cmd_psd(args) -> int:
         print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); running it "
               "hard-mounted (Melody's model of its lines); --assumed-modes uses the assumed modes")
 
-    out = Path(args.output)
-    out.parent.mkdir(parents=True, exist_ok=True)
+    out = check_output_file(args.output)
+    stem = out.with_suffix("")
+    written = [out] + [stem.parent / (stem.name + s) for s in ("_cross.csv", "_cross.h5", "_envelope.csv", ".png",
+                                                               "_ASSUMED_MODES.txt")]
+    refuse_input_overwrite([("-o", p, "file") for p in written],
+                           [args.model, args.wheels, args.dist if Path(args.dist).suffix else None])
     t0 = time.perf_counter()
     fmax = args.fmax
     if args.wheels:
@@ -563,9 +660,14 @@ def cmd_psd(args) -> int:
     else:
         lines = default_lines()
         if fmax is None:
-            fmax = _default_fmax([(lines, law)])
+            try:
+                fmax = _default_fmax([(lines, law)])
+            except ValueError:      # no line to place the band by
+                raise DataError(args.model or args.preset, "empirical", "no harmonic lines: nothing to compute "
+                                "a PSD of; check the model with `rwadist model show`") from None
         res = bb.broadband_psd(lines, law, fmax, args.n_freq, args.n_speeds, progress=True)
         sources = [(lines, None)]
+    refuse_non_finite_psd(res, args.model or args.preset or args.wheels)
     kind = "empirical (Melody)" if hard_mounted else "extended (modal amplification)"
     on_assumed = ([args.model or args.preset] if assumed and not hard_mounted else []) + (
         [f"{w.name} ({w.model_ref})" for w in wheels if w.meta.get("modes_assumed") == "assumed modes used"]
@@ -579,24 +681,25 @@ def cmd_psd(args) -> int:
     if args.format == "nastran":
         from .nastran import write_deck
 
-        written = write_deck(res, out, fmt=args.nastran_fields, cross=args.nastran_cross)
-        print(f"wrote NASTRAN deck {out} ({len(written)} TABRND1 tables, {args.nastran_fields} field)")
+        tables = []
+        _write(out, lambda tmp: tables.extend(write_deck(res, tmp, fmt=args.nastran_fields, cross=args.nastran_cross)))
+        print(f"wrote NASTRAN deck {out} ({len(tables)} TABRND1 tables, {args.nastran_fields} field)")
     else:
-        bb.write_psd_csv(res, out)
+        _write(out, lambda tmp: bb.write_psd_csv(res, tmp))
         print(f"wrote PSD table {out}")
-    stem = out.with_suffix("")
     if args.cross == "csv":
-        p = bb.write_cross_csv(res, stem.parent / (stem.name + "_cross.csv"))
+        p = _write(stem.parent / (stem.name + "_cross.csv"), lambda tmp: bb.write_cross_csv(res, tmp))
         print(f"cross-spectra: {p}")
     elif args.cross == "h5":
-        p = bb.write_hdf5(res, stem.parent / (stem.name + "_cross.h5"), "csd")
+        p = _write(stem.parent / (stem.name + "_cross.h5"), lambda tmp: bb.write_hdf5(res, tmp, "csd"))
         print(f"cross-spectra: {p} (group /csd)")
     lo_w, hi_w = law.support if not args.wheels else (min(w.law.support[0] for w in wheels if w.law),
                                                        max(w.law.support[1] for w in wheels if w.law))
     env = bb.line_envelope(sources, (lo_w, hi_w), res.f)
-    p_env = bb.write_envelope_csv(env, stem.parent / (stem.name + "_envelope.csv"))
+    p_env = _write(stem.parent / (stem.name + "_envelope.csv"), lambda tmp: bb.write_envelope_csv(env, tmp))
     png = stem.parent / (stem.name + ".png")
-    bb.plot_psd(res, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm").savefig(png, dpi=110)
+    figure = bb.plot_psd(res, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm")
+    _write(png, lambda tmp: figure.savefig(tmp, dpi=110))
     rms = res.rms()
     print(f"{kind}, {res.frame} frame, {res.f.size} frequencies to {fmax:g} Hz, {time.perf_counter() - t0:.1f} s")
     print("RMS: " + ", ".join(f"{c} {v:.4g}" for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
@@ -607,174 +710,87 @@ def cmd_psd(args) -> int:
 _default_fmax = api.default_fmax
 
 
+# --------------------------------------------------------------------------- outputs
+
+def _write(path, writer):
+    """Run ``writer(tmp)`` on a temporary sibling of ``path`` and rename it onto ``path`` when complete
+    (:func:`rwadist.outputs.atomic_file`); returns ``path``."""
+    path = Path(path)
+    with atomic_file(path) as tmp:
+        writer(tmp)
+    return path
+
+
 # --------------------------------------------------------------------------- main
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="rwadist", description="Reaction wheel disturbance models from test data.")
-    sub = p.add_subparsers(dest="command", required=True)
+    """The argument parser of every command (:mod:`rwadist.cli_parser`)."""
+    from .cli_parser import build_parser as _build
 
-    s = sub.add_parser("simulate-test", help="virtual test stand: synthetic load-cell data in the interchange format")
-    s.add_argument("out_dir")
-    s.add_argument("--preset", required=True, help="wheel preset, e.g. ithaco-e, ithaco-b")
-    s.add_argument("--speeds-rpm", help="'A,B,C', 'START:STOP:STEP' or 'START:STOP' with --n-speeds")
-    s.add_argument("--n-speeds", type=int, default=None)
-    s.add_argument("--sample-rate", type=float, default=None, help="Hz (default: the preset's test)")
-    s.add_argument("--samples", type=int, default=8192, help="samples per steady run")
-    s.add_argument("--noise", type=float, default=0.01, help="sensor noise std as a fraction of the top-speed fundamental")
-    s.add_argument("--no-modes", action="store_true", help="switch the wheel's structural modes off")
-    s.add_argument("--no-test-stand", action="store_true", help="switch test-stand resonances off")
-    s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--sweep", action="store_true", help="one spin-up record instead of steady runs")
-    s.add_argument("--sweep-start-rpm", type=float, default=0.0)
-    s.add_argument("--sweep-end-rpm", type=float, default=None)
-    s.add_argument("--duration", type=float, default=390.0, help="sweep duration, s")
-    s.add_argument("--profile", choices=("linear", "exp"), default="linear")
-    s.add_argument("--no-tach", action="store_true", help="sweep without the speed_rpm tach column")
-    s.add_argument("--physics", choices=("simple", "extended"), default="simple",
-                   help="simple resonances (default) or the extended rotor model of the preset")
-    s.add_argument("--assumed-modes", action="store_true",
-                   help="allow --physics extended on a catalogue wheel whose suspension modes are assumed "
-                        "(the data's metadata then says so)")
-    s.add_argument("--inject", action="append", default=[], metavar="KIND:PARAM=VALUE,...",
-                   help="add a known effect to try diagnose on (repeatable; recorded in meta.json 'injected'): "
-                        "missing_harmonic, amplitude_law, broadband_floor, fixed_resonance, cross_coupling, "
-                        "sidebands, speed_ripple, counter_rotation (parameters: see rwadist/inject.py)")
-    s.set_defaults(func=cmd_simulate)
+    return _build(sys.modules[__name__])
 
-    f = sub.add_parser("fit", help="fit the empirical model to test data; writes the model file and a report")
-    f.add_argument("data", help="steady-state directory, sweep CSV, or .h5")
-    f.add_argument("-o", "--output", required=True, help="model file to write (JSON)")
-    f.add_argument("--report", help="report directory (default: <model>_report)")
-    f.add_argument("--cumulative-rpm", help="speeds of the cumulative-RMS plots, e.g. '600,1500,2400' "
-                   "(default: lowest, middle, top)")
-    _add_fit_options(f)
-    f.set_defaults(func=cmd_fit)
 
-    m = sub.add_parser("model", help="model file tools")
-    msub = m.add_subparsers(dest="model_command", required=True)
-    ms = msub.add_parser("show", help="print a model's harmonics")
-    ms.add_argument("model")
-    ms.add_argument("--format", choices=("table", "csv", "json"), default="table")
-    ms.set_defaults(func=cmd_model_show)
-    mc = msub.add_parser("compare", help="a fitted model next to a catalogue wheel (exit 1 if an imbalance "
-                         "exceeds the datasheet limit)")
-    mc.add_argument("model")
-    mc.add_argument("--preset", required=True, help="catalogue wheel, e.g. ithaco-e")
-    mc.set_defaults(func=cmd_model_compare)
+def _command_name(args) -> str:
+    """'fit', 'fmu build', ... of parsed ``args``, for messages."""
+    words = [args.command]
+    for sub in ("model_command", "catalogue_command", "fmu_command"):
+        if getattr(args, sub, None):
+            words.append(getattr(args, sub))
+    return " ".join(words)
 
-    cat = sub.add_parser("catalogue", help="catalogue of real wheels (presets for every command)")
-    csub = cat.add_subparsers(dest="catalogue_command", required=True)
-    cl = csub.add_parser("list", help="the catalogue wheels with their sources")
-    cl.set_defaults(func=cmd_catalogue_list)
-    cs = csub.add_parser("show", help="one catalogue wheel: source, what was measured, harmonics, parameters")
-    cs.add_argument("name")
-    cs.set_defaults(func=cmd_catalogue_show)
 
-    d = sub.add_parser("demo", help="simulate -> fit -> report on the bundled example wheel")
-    d.add_argument("--out", default="demo_out", help="output directory (default demo_out)")
-    d.add_argument("--n-speeds", type=int, default=120)
-    d.add_argument("--seed", type=int, default=0)
-    d.set_defaults(func=cmd_demo)
+def _write_crash_log(command: str) -> Path | None:
+    """Write the current exception's traceback to a file in the temp folder; its path (None if impossible)."""
+    import tempfile
+    import traceback
 
-    cv = sub.add_parser("convert", help="convert test data between formats: CSV interchange, HDF5, UFF 58, TDMS, "
-                        "MATLAB (docs/formats.md)")
-    cv.add_argument("src", help="a steady-test directory (runs.csv), a sweep file or an .h5 file")
-    cv.add_argument("-o", "--output", required=True, help="an .h5 file, a directory (steady test) or a sweep file")
-    cv.add_argument("--format", choices=["csv", "uff", "uff-binary", "tdms", "mat", "mat73"], default=None,
-                    help="run/sweep file format (default: csv for a directory, else from the extension)")
-    cv.add_argument("--precision", choices=["float64", "float32"], default="float64",
-                    help="HDF5 sample precision (default float64, lossless)")
-    cv.set_defaults(func=cmd_convert)
-
-    c = sub.add_parser("campbell", help="Campbell table and plot of the extended model; prints crossing speeds")
-    src = c.add_mutually_exclusive_group(required=True)
-    src.add_argument("model", nargs="?", help="model file (JSON) with an analytical section")
-    src.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
-    c.add_argument("--speeds-rpm", default="0:3000:100", help="'START:STOP:STEP', 'A,B,C' or 'START:STOP' "
-                   "with --n-speeds (default 0:3000:100)")
-    c.add_argument("--n-speeds", type=int, default=None)
-    c.add_argument("-o", "--output", default="campbell.csv", help="CSV to write; the plot goes next to it (.png)")
-    c.set_defaults(func=cmd_campbell)
-
-    q = sub.add_parser("psd", help="broadband disturbance PSD over a wheel-speed distribution (Melody's model / "
-                       "extended model), optionally several wheels in the spacecraft frame")
-    q.add_argument("model", nargs="?", help="model file (JSON)")
-    q.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
-    q.add_argument("--speed-rpm", required=True, help="MIN:MAX speed range, rpm (negative = spinning about -z)")
-    q.add_argument("--dist", default="uniform", help="uniform | normal | FILE.csv (speed_rpm,weight histogram, "
-                   "speed_rpm,pdf_per_rpm density, or time_s,speed_rpm profile)")
-    q.add_argument("--std-rpm", type=float, default=None, help="std of the normal law, rpm (default range/6)")
-    q.add_argument("--wheels", help="wheels.json: several wheels with mountings (spacecraft-frame 6x6 CSD)")
-    q.add_argument("--fmax", type=float, default=None, help="top frequency, Hz (default 1.2 x highest line)")
-    q.add_argument("--n-freq", type=int, default=20001, help="frequency points 0..fmax (default 20001)")
-    q.add_argument("--n-speeds", type=int, default=2000, help="speed cells of the law (default 2000)")
-    q.add_argument("--empirical", action="store_true", help="Melody's model from the harmonics alone, no modes")
-    q.add_argument("--assumed-modes", action="store_true",
-                   help="run a wheel with assumed (datasheet) suspension modes through them (default: hard-mounted); "
-                        "the outputs then carry a note that they rest on assumed values")
-    q.add_argument("--format", choices=("csv", "nastran"), default="csv")
-    q.add_argument("--nastran-fields", choices=("small", "free"), default="small")
-    q.add_argument("--nastran-cross", action="store_true", help="also RANDPS/TABRND1 of the cross-spectra")
-    q.add_argument("--cross", choices=("csv", "h5", "none"), default="csv",
-                   help="cross-spectra next to the output: <out>_cross.csv (default) or <out>_cross.h5")
-    q.add_argument("-o", "--output", default="psd.csv", help="output file (CSV or NASTRAN bulk data)")
-    q.set_defaults(func=cmd_psd)
-
-    dg = sub.add_parser("diagnose", help="residual of a model against test data; finds, adds and reports the "
-                        "effects the model lacks (missing harmonics, amplitude laws, broadband floors, resonances, "
-                        "coupling, sidebands, speed ripple, counter rotation)")
-    dg.add_argument("data", help="steady-test directory, sweep CSV or HDF5")
-    dsrc = dg.add_mutually_exclusive_group()
-    dsrc.add_argument("--model", help="model file to start from (default: the empirical fit of the data)")
-    dsrc.add_argument("--preset", help="start from a wheel preset's model, e.g. ithaco-e")
-    dg.add_argument("-o", "--output", required=True, help="report directory")
-    dg.add_argument("--nperseg", type=int, default=None, help="FFT length (default: power of 2 <= run length/4)")
-    dg.add_argument("--f-lim", type=float, default=None, help="upper limit of good data, Hz")
-    dg.add_argument("--k-sigma", type=float, default=4.0, help="held-out gain needed, noise standard errors (4)")
-    dg.add_argument("--min-gain", type=float, default=0.05,
-                    help="held-out gain needed, fraction of the unexplained power (0.05)")
-    dg.add_argument("--base", choices=("auto", "empirical", "extended"), default="auto",
-                    help="starting prediction of the lines: 'empirical' C*omega^2 hard mounted, 'extended' through "
-                         "the rotor's suspension modes of the model's analytical section (forward/backward whirl, "
-                         "rotation sense); auto (default): extended when the model (--model/--preset) has an "
-                         "analytical section and the data's meta.json does not say modes: false")
-    dg.add_argument("--slice-samples", type=int, default=8192, help="sweep slice length, samples")
-    dg.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
-                    help="speed of sweep slices: tach column, estimated from data, or auto")
-    dg.set_defaults(func=cmd_diagnose)
-
-    fm = sub.add_parser("fmu", help="FMI 2.0 co-simulation FMU of the extended model (build, check)")
-    fsub = fm.add_subparsers(dest="fmu_command", required=True)
-    fb = fsub.add_parser("build", help="build the FMU from a model file or a preset (default: ithaco-e)")
-    fsrc = fb.add_mutually_exclusive_group()
-    fsrc.add_argument("model", nargs="?", help="model file (JSON): empirical, extended or diagnosed")
-    fsrc.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
-    fb.add_argument("-o", "--output", default="wheel.fmu", help="FMU to write (default wheel.fmu)")
-    fb.add_argument("--native", action="store_true",
-                    help="write a pure-C FMU (no Python on the host; sources/ included) instead of pythonfmu's")
-    fb.add_argument("--assumed-modes", action="store_true",
-                    help="a wheel with assumed (datasheet) suspension modes runs them by default (modes = true); "
-                         "without it such a wheel is hard-mounted by default")
-    fb.set_defaults(func=cmd_fmu_build)
-    fc = fsub.add_parser("check", help="fmpy validation and a short spin-up simulation of an FMU")
-    fc.add_argument("fmu")
-    fc.add_argument("--stop-time", type=float, default=1.0, help="s (default 1)")
-    fc.add_argument("--step-size", type=float, default=1e-3, help="communication step, s (default 1e-3)")
-    fc.add_argument("--speed-rpm", type=float, default=1500.0, help="end speed of the ramp from 0 (default 1500)")
-    fc.set_defaults(func=cmd_fmu_check)
-    return p
+    try:
+        fd, name = tempfile.mkstemp(prefix="rwadist-crash-", suffix=".txt")
+        with os.fdopen(fd, "w") as fh:
+            fh.write(f"rwadist {_version()} {command}: {' '.join(sys.argv)}\n")
+            traceback.print_exc(file=fh)
+        return Path(name)
+    except OSError:
+        return None
 
 
 def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+    """Run one command; every failure ends in a one-line message: exit 2 for bad input, 130 on Ctrl-C,
+    3 for an internal error (its traceback goes to a file named in the message, never to the user)."""
+    parser = build_parser()
     try:
+        args = parser.parse_args(argv)
+    except KeyboardInterrupt:
+        print("rwadist: interrupted", file=sys.stderr)
+        return 130
+    command = _command_name(args)
+    try:
+        check_parsed(parser, args)
         return args.func(args)
-    except DataError as exc:
+    except KeyboardInterrupt:
+        print(f"rwadist {command}: interrupted; outputs left as they were (no partial file written)",
+              file=sys.stderr)
+        return 130
+    except (DataError, ValueError) as exc:
         print(f"rwadist: error: {exc}", file=sys.stderr)
         return 2
-    except ValueError as exc:
-        print(f"rwadist: error: {exc}", file=sys.stderr)
+    except MemoryError:
+        print(f"rwadist {command}: error: not enough memory for these settings; reduce the sizes given "
+              "(--n-freq, --n-speeds, --samples, --duration)", file=sys.stderr)
         return 2
+    except BrokenPipeError:     # the reader of our output went away (`| head`): nothing more to say
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
+    except OSError as exc:
+        where = exc.filename if exc.filename is not None else ""
+        print(f"rwadist {command}: error: {where}{': ' if where else ''}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except Exception as exc:    # last resort: no traceback reaches the user
+        log = _write_crash_log(command)
+        print(f"rwadist {command}: internal error ({type(exc).__name__}: {str(exc)[:200]}); "
+              f"{'full traceback in ' + str(log) if log else 'no traceback file could be written'}; "
+              "please report it", file=sys.stderr)
+        return 3
 
 
 if __name__ == "__main__":

@@ -36,6 +36,7 @@ directory -- raises :class:`DataError` naming the file, the field and the value.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 import os
@@ -47,7 +48,8 @@ from tqdm.auto import tqdm
 from .formats import registry
 from .formats.channels import SPEED_COLUMN, to_run, to_sweep
 from .formats.csv_table import TIME_COLUMN
-from .formats.records import DataError, RawRecord, Run, SteadyTest, Sweep, json_default, portable_meta, read_json
+from .formats.records import (DataError, RawRecord, Run, SteadyTest, Sweep, json_default, portable_meta, read_json,
+                              read_text)
 from .formats.timebase import sample_step
 from .hdf5 import read_hdf5
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm, rpm_to_rad_s  # noqa: F401 (re-exported)
@@ -114,7 +116,7 @@ def read_steady(directory, progress: bool = False) -> SteadyTest:
                         "with columns file,speed_rpm")
     meta_path = directory / META_FILE
     meta = _read_meta(meta_path)
-    with open(runs_path, newline="", encoding="utf-8-sig") as fh:
+    with io.StringIO(read_text(runs_path), newline="") as fh:
         reader = csv.DictReader(fh)
         if reader.fieldnames is None:
             raise DataError(runs_path, "header", "file is empty")

@@ -247,33 +247,45 @@ def read_hdf5(path):
     except OSError as exc:
         raise DataError(path, "file", f"cannot be opened ({exc})") from exc
     with fh:
-        fmt = _str_attr(path, fh, "format")
-        if fmt != FORMAT:
-            raise DataError(path, "format", f"{fmt!r} is not {FORMAT!r}")
-        version, _ = _attr(path, fh, "format_version")
         try:
-            version_int = int(np.asarray(version).item())
-            ok = version_int == np.asarray(version).item()
-        except (TypeError, ValueError):
-            ok = False
-        if not ok:
-            raise DataError(path, "format_version", f"{version!r} is not an integer version")
-        if version_int != FORMAT_VERSION:
-            raise DataError(path, "format_version", f"version {version_int} is not supported "
-                            f"(this reader knows version {FORMAT_VERSION})")
-        kind = _str_attr(path, fh, "kind")
-        meta = {}
-        if "meta" in fh.attrs:
-            text = _str_attr(path, fh, "meta")
-            try:
-                meta = json.loads(text)
-            except json.JSONDecodeError as exc:
-                raise DataError(path, "meta", f"not valid JSON ({exc.msg})") from exc
-            if not isinstance(meta, dict):
-                raise DataError(path, "meta", "must be a JSON object")
-        if kind == "steady":
-            return SteadyTest(_read_steady(path, fh), meta).sorted()
-        if kind == "sweep":
-            time, signals, fs, tach = _read_sweep(path, fh)
-            return Sweep(time=time, signals=signals, sample_rate=fs, tach=tach, meta=meta)
-        raise DataError(path, "kind", f"{kind!r} is neither 'steady' nor 'sweep'")
+            return _read_open(path, fh)
+        except DataError:
+            raise
+        except (KeyError, OSError, RuntimeError, ValueError, TypeError) as exc:
+            # h5py raises these on a damaged file (bad object headers, dangling links, flipped bytes)
+            raise DataError(path, "file", f"damaged HDF5 file: {str(exc)[:160]}; re-export it or "
+                            "`rwadist convert` the original data again") from None
+
+
+def _read_open(path, fh):
+    """The test in the open HDF5 file ``fh`` (see :func:`read_hdf5`)."""
+    fmt = _str_attr(path, fh, "format")
+    if fmt != FORMAT:
+        raise DataError(path, "format", f"{fmt!r} is not {FORMAT!r}")
+    version, _ = _attr(path, fh, "format_version")
+    try:
+        version_int = int(np.asarray(version).item())
+        ok = version_int == np.asarray(version).item()
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise DataError(path, "format_version", f"{version!r} is not an integer version")
+    if version_int != FORMAT_VERSION:
+        raise DataError(path, "format_version", f"version {version_int} is not supported "
+                        f"(this reader knows version {FORMAT_VERSION})")
+    kind = _str_attr(path, fh, "kind")
+    meta = {}
+    if "meta" in fh.attrs:
+        text = _str_attr(path, fh, "meta")
+        try:
+            meta = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise DataError(path, "meta", f"not valid JSON ({exc.msg})") from exc
+        if not isinstance(meta, dict):
+            raise DataError(path, "meta", "must be a JSON object")
+    if kind == "steady":
+        return SteadyTest(_read_steady(path, fh), meta).sorted()
+    if kind == "sweep":
+        time, signals, fs, tach = _read_sweep(path, fh)
+        return Sweep(time=time, signals=signals, sample_rate=fs, tach=tach, meta=meta)
+    raise DataError(path, "kind", f"{kind!r} is neither 'steady' nor 'sweep'")

@@ -22,6 +22,7 @@ keys and effect kinds this version does not interpret are carried through unchan
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -137,6 +138,11 @@ def from_json(doc: dict, source: str = "<model>") -> WheelModel:
     for key in ("wheel", "provenance"):
         if doc.get(key) is not None and not isinstance(doc[key], dict):
             raise err(source, key, f"must be an object, got {type(doc[key]).__name__}")
+    for key, value in (doc.get("wheel") or {}).items():
+        # the wheel's physical numbers (mass_kg, radius_m, max_speed_rpm, ...) feed presets and FMUs
+        if isinstance(value, bool) or (isinstance(value, (int, float)) and not (
+                math.isfinite(value) and value > 0)):
+            raise err(source, f"wheel.{key}", f"{value!r}: must be a finite number > 0")
     name = doc.get("name", "wheel")
     if not isinstance(name, str):
         raise err(source, "name", f"must be a string, got {name!r}")

@@ -107,8 +107,11 @@ def write_assumed_note(note_path, names, outputs):
     note_path = Path(note_path)
     note = "WARNING: " + ASSUMED_MODES_NOTE.format(name=", ".join(str(n) for n in names))
     print(note, file=sys.stderr)
+    from ..outputs import atomic_file
+
     note_path.parent.mkdir(parents=True, exist_ok=True)
-    note_path.write_text(note + "\n(this note belongs to " + ", ".join(str(p) for p in outputs) + ")\n")
+    with atomic_file(note_path) as tmp:
+        Path(tmp).write_text(note + "\n(this note belongs to " + ", ".join(str(p) for p in outputs) + ")\n")
     print(f"note written next to the outputs: {note_path}")
     return note_path
 

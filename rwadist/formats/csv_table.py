@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .records import DataError, RawRecord
+from .records import DataError, RawRecord, read_text
 
 TIME_COLUMN = "time_s"
 
@@ -21,12 +21,8 @@ TIME_COLUMN = "time_s"
 def read_numeric_csv(path: Path, required_first: str = TIME_COLUMN):
     """Read a numeric CSV with a header; return (column names, 2-D array, shape (n, n_columns)).
     Errors name the line."""
-    try:
-        with open(path, "r", newline="", encoding="utf-8-sig") as fh:
-            header_line = fh.readline()
-            body = fh.read()
-    except OSError as exc:
-        raise DataError(path, "file", f"cannot be read ({exc.strerror})") from exc
+    text = read_text(path)
+    header_line, _, body = text.partition("\n")
     header = [h.strip() for h in header_line.strip().split(",")] if header_line.strip() else []
     if not header:
         raise DataError(path, "header", "file is empty (no header line)")

@@ -95,15 +95,38 @@ class Sweep:
         return tuple(ch for ch in CHANNELS if ch in self.signals)
 
 
+def read_text(path) -> str:
+    """The UTF-8 text of ``path`` (a leading BOM dropped); DataError naming the file and the byte when it is
+    not UTF-8 (a UTF-16 export or a damaged file) or cannot be read."""
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise DataError(path, "file", f"cannot be read ({exc.strerror})") from None
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise DataError(path, "encoding", "the file is UTF-16 text; save it as UTF-8 (e.g. 'CSV UTF-8' in a "
+                        "spreadsheet, or `iconv -f UTF-16 -t UTF-8`)")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise DataError(path, f"byte {exc.start}", f"not UTF-8 text (byte 0x{raw[exc.start]:02x}): a damaged "
+                        "file or another encoding; save it as UTF-8") from None
+
+
 def read_json(path):
     """A JSON document; DataError naming the file (missing) or the line (invalid)."""
     path = Path(path)
     if not path.exists():
         raise DataError(path, "file", "does not exist")
+    if path.is_dir():
+        raise DataError(path, "file", "is a folder, not a JSON file")
+    text = read_text(path)
     try:
-        return json.loads(path.read_text())
+        return json.loads(text)
     except json.JSONDecodeError as exc:
         raise DataError(path, f"line {exc.lineno}", f"not valid JSON ({exc.msg})") from None
+    except RecursionError:
+        raise DataError(path, "structure", "nested too deeply to be a model or metadata file") from None
 
 
 #: meta.json keys that describe how a lab file is to be read; once read, the data are SI in our channels.

@@ -1,0 +1,198 @@
+"""The ``rwadist`` command line's argument parser: every command, flag, default and allowed range.
+
+The commands themselves live in :mod:`rwadist.cli`; each flag's value is checked here, at parse time,
+by :mod:`rwadist.validate` (a refused value names the flag, the value and the allowed range)."""
+from __future__ import annotations
+
+import argparse
+
+from .validate import MAX_RPM, MAX_SAMPLES, MAX_SPEEDS, number, rpm
+
+
+def _version() -> str:
+    try:
+        from importlib.metadata import version
+
+        return version("rwadist")
+    except Exception:   # not installed as a distribution (a bare source tree)
+        from . import __version__
+
+        return __version__
+
+
+def _add_fit_options(p):
+    p.add_argument("--f-lim", type=number(0, 1e6, lo_open=True, unit="Hz"), default=None, help="upper limit of good data, Hz (test-stand resonance)")
+    p.add_argument("--nperseg", type=number(16, 2**24, integer=True), default=None, help="FFT length (default: largest power of 2 in a run)")
+    p.add_argument("--presence", type=number(0, 1, lo_open=True), default=0.25, help="bin presence threshold P0, fraction (default 0.25)")
+    p.add_argument("--epsilon", type=number(0, 0.5, lo_open=True), default=0.02, help="binning tolerance on h (default 0.02)")
+    p.add_argument("--no-mode-exclusion", action="store_true", help="keep modally amplified speeds in the fit")
+    p.add_argument("--slice-samples", type=number(64, 2**24, integer=True), default=8192, help="sweep slice length, samples")
+    p.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
+                   help="speed of sweep slices: tach column, estimated from data, or auto")
+    p.add_argument("--extended", action="store_true",
+                   help="also fit the extended model (modes, damping, imbalances) into the model file")
+    p.add_argument("--mass", type=number(0, 1e4, lo_open=True, unit="kg"), default=None,
+                   help="rotor mass, kg (extended fit; without --mass/--radius the fit is per unit mass/inertia)")
+    p.add_argument("--radius", type=number(0, 10, lo_open=True, unit="m"), default=None, help="rotor radius, m (extended fit; thin-disc inertias)")
+    p.add_argument("--height", type=number(-10, 10, unit="m"), default=0.0,
+                   help="lever arm from the rotor centre to the torque reference point, m (default 0)")
+    p.add_argument("--preset", default=None, help="take mass and radius (and unseen modes) from a wheel preset")
+
+
+def build_parser(cli) -> argparse.ArgumentParser:
+    """The argument parser; ``cli`` is the :mod:`rwadist.cli` module, whose ``cmd_*`` functions run the
+    commands (passed in, not imported: the parser stays a leaf of the import graph)."""
+    p = argparse.ArgumentParser(prog="rwadist", description="Reaction wheel disturbance models from test data.")
+    p.add_argument("--version", action="version", version=f"rwadist {_version()}")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("simulate-test", help="virtual test stand: synthetic load-cell data in the interchange format")
+    s.add_argument("out_dir")
+    s.add_argument("--preset", required=True, help="wheel preset, e.g. ithaco-e, ithaco-b")
+    s.add_argument("--speeds-rpm", help="'A,B,C', 'START:STOP:STEP' or 'START:STOP' with --n-speeds")
+    s.add_argument("--n-speeds", type=number(1, MAX_SPEEDS, integer=True), default=None)
+    s.add_argument("--sample-rate", type=number(0, 1e6, lo_open=True, unit="Hz"), default=None, help="Hz (default: the preset's test)")
+    s.add_argument("--samples", type=number(64, MAX_SAMPLES, integer=True), default=8192, help="samples per steady run")
+    s.add_argument("--noise", type=number(0, 10), default=0.01, help="sensor noise std as a fraction of the top-speed fundamental")
+    s.add_argument("--no-modes", action="store_true", help="switch the wheel's structural modes off")
+    s.add_argument("--no-test-stand", action="store_true", help="switch test-stand resonances off")
+    s.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0)
+    s.add_argument("--sweep", action="store_true", help="one spin-up record instead of steady runs")
+    s.add_argument("--sweep-start-rpm", type=rpm(), default=0.0)
+    s.add_argument("--sweep-end-rpm", type=rpm(), default=None)
+    s.add_argument("--duration", type=number(0, 1e5, lo_open=True, unit="s"), default=390.0, help="sweep duration, s")
+    s.add_argument("--profile", choices=("linear", "exp"), default="linear")
+    s.add_argument("--no-tach", action="store_true", help="sweep without the speed_rpm tach column")
+    s.add_argument("--physics", choices=("simple", "extended"), default="simple",
+                   help="simple resonances (default) or the extended rotor model of the preset")
+    s.add_argument("--assumed-modes", action="store_true",
+                   help="allow --physics extended on a catalogue wheel whose suspension modes are assumed "
+                        "(the data's metadata then says so)")
+    s.add_argument("--inject", action="append", default=[], metavar="KIND:PARAM=VALUE,...",
+                   help="add a known effect to try diagnose on (repeatable; recorded in meta.json 'injected'): "
+                        "missing_harmonic, amplitude_law, broadband_floor, fixed_resonance, cross_coupling, "
+                        "sidebands, speed_ripple, counter_rotation (parameters: see rwadist/inject.py)")
+    s.set_defaults(func=cli.cmd_simulate)
+
+    f = sub.add_parser("fit", help="fit the empirical model to test data; writes the model file and a report")
+    f.add_argument("data", help="steady-state directory, sweep CSV, or .h5")
+    f.add_argument("-o", "--output", required=True, help="model file to write (JSON)")
+    f.add_argument("--report", help="report directory (default: <model>_report)")
+    f.add_argument("--cumulative-rpm", help="speeds of the cumulative-RMS plots, e.g. '600,1500,2400' "
+                   "(default: lowest, middle, top)")
+    _add_fit_options(f)
+    f.set_defaults(func=cli.cmd_fit)
+
+    m = sub.add_parser("model", help="model file tools")
+    msub = m.add_subparsers(dest="model_command", required=True)
+    ms = msub.add_parser("show", help="print a model's harmonics")
+    ms.add_argument("model")
+    ms.add_argument("--format", choices=("table", "csv", "json"), default="table")
+    ms.set_defaults(func=cli.cmd_model_show)
+    mc = msub.add_parser("compare", help="a fitted model next to a catalogue wheel (exit 1 if an imbalance "
+                         "exceeds the datasheet limit)")
+    mc.add_argument("model")
+    mc.add_argument("--preset", required=True, help="catalogue wheel, e.g. ithaco-e")
+    mc.set_defaults(func=cli.cmd_model_compare)
+
+    cat = sub.add_parser("catalogue", help="catalogue of real wheels (presets for every command)")
+    csub = cat.add_subparsers(dest="catalogue_command", required=True)
+    cl = csub.add_parser("list", help="the catalogue wheels with their sources")
+    cl.set_defaults(func=cli.cmd_catalogue_list)
+    cs = csub.add_parser("show", help="one catalogue wheel: source, what was measured, harmonics, parameters")
+    cs.add_argument("name")
+    cs.set_defaults(func=cli.cmd_catalogue_show)
+
+    d = sub.add_parser("demo", help="simulate -> fit -> report on the bundled example wheel")
+    d.add_argument("--out", default="demo_out", help="output directory (default demo_out)")
+    d.add_argument("--n-speeds", type=number(2, 10_000, integer=True), default=120)
+    d.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0)
+    d.set_defaults(func=cli.cmd_demo)
+
+    cv = sub.add_parser("convert", help="convert test data between formats: CSV interchange, HDF5, UFF 58, TDMS, "
+                        "MATLAB (docs/formats.md)")
+    cv.add_argument("src", help="a steady-test directory (runs.csv), a sweep file or an .h5 file")
+    cv.add_argument("-o", "--output", required=True, help="an .h5 file, a directory (steady test) or a sweep file")
+    cv.add_argument("--format", choices=["csv", "uff", "uff-binary", "tdms", "mat", "mat73"], default=None,
+                    help="run/sweep file format (default: csv for a directory, else from the extension)")
+    cv.add_argument("--precision", choices=["float64", "float32"], default="float64",
+                    help="HDF5 sample precision (default float64, lossless)")
+    cv.set_defaults(func=cli.cmd_convert)
+
+    c = sub.add_parser("campbell", help="Campbell table and plot of the extended model; prints crossing speeds")
+    src = c.add_mutually_exclusive_group(required=True)
+    src.add_argument("model", nargs="?", help="model file (JSON) with an analytical section")
+    src.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
+    c.add_argument("--speeds-rpm", default="0:3000:100", help="'START:STOP:STEP', 'A,B,C' or 'START:STOP' "
+                   "with --n-speeds (default 0:3000:100)")
+    c.add_argument("--n-speeds", type=number(2, MAX_SPEEDS, integer=True), default=None)
+    c.add_argument("-o", "--output", default="campbell.csv", help="CSV to write; the plot goes next to it (.png)")
+    c.set_defaults(func=cli.cmd_campbell)
+
+    q = sub.add_parser("psd", help="broadband disturbance PSD over a wheel-speed distribution (Melody's model / "
+                       "extended model), optionally several wheels in the spacecraft frame")
+    q.add_argument("model", nargs="?", help="model file (JSON)")
+    q.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
+    q.add_argument("--speed-rpm", required=True, help="MIN:MAX speed range, rpm (negative = spinning about -z)")
+    q.add_argument("--dist", default="uniform", help="uniform | normal | FILE.csv (speed_rpm,weight histogram, "
+                   "speed_rpm,pdf_per_rpm density, or time_s,speed_rpm profile)")
+    q.add_argument("--std-rpm", type=number(0, MAX_RPM, lo_open=True, unit="rpm"), default=None, help="std of the normal law, rpm (default range/6)")
+    q.add_argument("--wheels", help="wheels.json: several wheels with mountings (spacecraft-frame 6x6 CSD)")
+    q.add_argument("--fmax", type=number(0, 1e6, lo_open=True, unit="Hz"), default=None, help="top frequency, Hz (default 1.2 x highest line)")
+    q.add_argument("--n-freq", type=number(2, 200_001, integer=True), default=20001, help="frequency points 0..fmax (default 20001)")
+    q.add_argument("--n-speeds", type=number(2, 20_000, integer=True), default=2000, help="speed cells of the law (default 2000)")
+    q.add_argument("--empirical", action="store_true", help="Melody's model from the harmonics alone, no modes")
+    q.add_argument("--assumed-modes", action="store_true",
+                   help="run a wheel with assumed (datasheet) suspension modes through them (default: hard-mounted); "
+                        "the outputs then carry a note that they rest on assumed values")
+    q.add_argument("--format", choices=("csv", "nastran"), default="csv")
+    q.add_argument("--nastran-fields", choices=("small", "free"), default="small")
+    q.add_argument("--nastran-cross", action="store_true", help="also RANDPS/TABRND1 of the cross-spectra")
+    q.add_argument("--cross", choices=("csv", "h5", "none"), default="csv",
+                   help="cross-spectra next to the output: <out>_cross.csv (default) or <out>_cross.h5")
+    q.add_argument("-o", "--output", default="psd.csv", help="output file (CSV or NASTRAN bulk data)")
+    q.set_defaults(func=cli.cmd_psd)
+
+    dg = sub.add_parser("diagnose", help="residual of a model against test data; finds, adds and reports the "
+                        "effects the model lacks (missing harmonics, amplitude laws, broadband floors, resonances, "
+                        "coupling, sidebands, speed ripple, counter rotation)")
+    dg.add_argument("data", help="steady-test directory, sweep CSV or HDF5")
+    dsrc = dg.add_mutually_exclusive_group()
+    dsrc.add_argument("--model", help="model file to start from (default: the empirical fit of the data)")
+    dsrc.add_argument("--preset", help="start from a wheel preset's model, e.g. ithaco-e")
+    dg.add_argument("-o", "--output", required=True, help="report directory")
+    dg.add_argument("--nperseg", type=number(16, 2**24, integer=True), default=None, help="FFT length (default: power of 2 <= run length/4)")
+    dg.add_argument("--f-lim", type=number(0, 1e6, lo_open=True, unit="Hz"), default=None, help="upper limit of good data, Hz")
+    dg.add_argument("--k-sigma", type=number(0, 100, lo_open=True), default=4.0, help="held-out gain needed, noise standard errors (4)")
+    dg.add_argument("--min-gain", type=number(0, 1, lo_open=True, hi_open=True), default=0.05,
+                    help="held-out gain needed, fraction of the unexplained power (0.05)")
+    dg.add_argument("--base", choices=("auto", "empirical", "extended"), default="auto",
+                    help="starting prediction of the lines: 'empirical' C*omega^2 hard mounted, 'extended' through "
+                         "the rotor's suspension modes of the model's analytical section (forward/backward whirl, "
+                         "rotation sense); auto (default): extended when the model (--model/--preset) has an "
+                         "analytical section and the data's meta.json does not say modes: false")
+    dg.add_argument("--slice-samples", type=number(64, 2**24, integer=True), default=8192, help="sweep slice length, samples")
+    dg.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
+                    help="speed of sweep slices: tach column, estimated from data, or auto")
+    dg.set_defaults(func=cli.cmd_diagnose)
+
+    fm = sub.add_parser("fmu", help="FMI 2.0 co-simulation FMU of the extended model (build, check)")
+    fsub = fm.add_subparsers(dest="fmu_command", required=True)
+    fb = fsub.add_parser("build", help="build the FMU from a model file or a preset (default: ithaco-e)")
+    fsrc = fb.add_mutually_exclusive_group()
+    fsrc.add_argument("model", nargs="?", help="model file (JSON): empirical, extended or diagnosed")
+    fsrc.add_argument("--preset", help="wheel preset instead of a model file, e.g. ithaco-e")
+    fb.add_argument("-o", "--output", default="wheel.fmu", help="FMU to write (default wheel.fmu)")
+    fb.add_argument("--native", action="store_true",
+                    help="write a pure-C FMU (no Python on the host; sources/ included) instead of pythonfmu's")
+    fb.add_argument("--assumed-modes", action="store_true",
+                    help="a wheel with assumed (datasheet) suspension modes runs them by default (modes = true); "
+                         "without it such a wheel is hard-mounted by default")
+    fb.set_defaults(func=cli.cmd_fmu_build)
+    fc = fsub.add_parser("check", help="fmpy validation and a short spin-up simulation of an FMU")
+    fc.add_argument("fmu")
+    fc.add_argument("--stop-time", type=number(0, 1e5, lo_open=True, unit="s"), default=1.0, help="s (default 1)")
+    fc.add_argument("--step-size", type=number(0, 1e3, lo_open=True, unit="s"), default=1e-3, help="communication step, s (default 1e-3)")
+    fc.add_argument("--speed-rpm", type=rpm(), default=1500.0, help="end speed of the ramp from 0 (default 1500)")
+    fc.set_defaults(func=cli.cmd_fmu_check)
+    return p

@@ -1,0 +1,241 @@
+"""Outputs that are safe to keep: atomic files and folders, refusal to overwrite an input.
+
+Every file the command line writes goes first to a temporary sibling (same directory, so the final
+``os.replace`` is a rename on one file system) and replaces the destination only once complete: a
+kill at any instant leaves either the old complete file or the new complete one, never a truncated
+one.  A report folder is built in a temporary sibling folder and swapped in whole.  An interrupted
+or failed write removes its temporary file; only a SIGKILL can leave one behind (a hidden
+``.NAME.part-*`` sibling, never the output itself).
+"""
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import os
+import shutil
+import uuid
+from contextlib import contextmanager
+from pathlib import Path
+
+from .formats.records import DataError
+
+#: names a reader takes from a steady-test directory besides its run files
+_DATASET_INDEX_FILES = ("runs.csv", "meta.json")
+#: extensions of files a dataset reader may read (runs, sweeps, HDF5)
+_DATA_SUFFIXES = (".csv", ".h5", ".hdf5", ".uff", ".unv", ".tdms", ".mat", ".json")
+
+
+def _part_name(path: Path) -> Path:
+    """A hidden temporary sibling of ``path`` keeping its suffix (writers choose formats by suffix)."""
+    return path.parent / f".{path.stem}.part-{os.getpid()}-{uuid.uuid4().hex[:8]}{path.suffix}"
+
+
+def _fsync_file(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _fsync_dir(path: Path) -> None:
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:  # some file systems do not open directories; the rename is still atomic
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _writable(directory: Path) -> bool:
+    """True when a file can be created in ``directory`` (tried: permissions alone miss read-only mounts)."""
+    import tempfile
+
+    try:
+        with tempfile.NamedTemporaryFile(dir=directory, prefix=".rwadist-probe-"):
+            return True
+    except OSError:
+        return False
+
+
+def check_output_file(path, flag: str = "-o") -> Path:
+    """``path`` as an output file, refused (:class:`DataError` naming ``flag``) when it is empty, a
+    directory, or in a directory that cannot be created or written."""
+    if path is None or str(path).strip() == "":
+        raise DataError(flag, "value", "empty: give the path of the file to write")
+    path = Path(path)
+    if path.is_dir():
+        raise DataError(flag, "value", f"{str(path)!r} is a directory: give a file name inside it, "
+                        f"e.g. {str(path / ('out' + (path.suffix or '')))!r}")
+    parent = path.parent
+    existing = parent
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        raise DataError(flag, "value", f"{str(path)!r}: {str(existing)!r} is a file, not a directory")
+    if not _writable(existing):
+        raise DataError(flag, "value", f"{str(path)!r}: the directory {str(existing)!r} is not writable")
+    return path
+
+
+def check_output_dir(path, flag: str = "-o") -> Path:
+    """``path`` as an output folder, refused when it is empty, an existing file, or not creatable."""
+    if path is None or str(path).strip() == "":
+        raise DataError(flag, "value", "empty: give the path of the folder to write")
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise DataError(flag, "value", f"{str(path)!r} is a file, not a folder: give a folder path")
+    existing = path if path.exists() else path.parent
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        raise DataError(flag, "value", f"{str(path)!r}: {str(existing)!r} is a file, not a folder")
+    if not _writable(existing):
+        raise DataError(flag, "value", f"{str(path)!r}: {str(existing)!r} is not writable")
+    return path
+
+
+def _is_within(child: Path, parent: Path) -> bool:
+    try:
+        child.relative_to(parent)
+        return True
+    except ValueError:
+        return False
+
+
+def refuse_input_overwrite(outputs, inputs) -> None:
+    """Raise :class:`DataError` when an output would overwrite or delete something a command reads.
+
+    ``outputs``: ``(flag, path, kind)`` with kind ``"file"`` or ``"dir"`` (a folder that is replaced
+    whole).  ``inputs``: paths read (files or dataset folders; None entries skipped).  Refused: an
+    output file equal to an input file; an output file inside an input folder that is a file a dataset
+    reader reads (runs.csv, meta.json, a data file); an output folder equal to, or holding, an input or
+    the working directory."""
+    ins = [Path(p).resolve() for p in inputs if p is not None and str(p) != ""]
+    cwd = Path.cwd().resolve()
+    for flag, out, kind in outputs:
+        if out is None:
+            continue
+        o = Path(out).resolve()
+        for i in ins:
+            if kind == "dir":
+                if _is_within(i, o):
+                    raise DataError(flag, "value", f"{str(out)!r} holds the input {str(i)!r}; its report folder "
+                                    "is replaced whole, which would delete the input: choose another folder")
+                continue
+            if o == i:
+                raise DataError(flag, "value", f"{str(out)!r} is an input of this command; writing it would "
+                                "destroy the input: choose another output path")
+            if i.is_dir() and _is_within(o, i) and o.exists() and (
+                    o.name in _DATASET_INDEX_FILES or o.suffix.lower() in _DATA_SUFFIXES):
+                raise DataError(flag, "value", f"{str(out)!r} is a file of the input dataset {str(i)!r}; "
+                                "writing it would damage the dataset: choose another output path")
+            if i.is_file() and o == i.with_suffix(".meta.json"):
+                raise DataError(flag, "value", f"{str(out)!r} is the metadata of the input {str(i)!r}: "
+                                "choose another output path")
+        if kind == "dir" and _is_within(cwd, o):
+            raise DataError(flag, "value", f"{str(out)!r} holds the working directory; a report folder is "
+                            "replaced whole: choose a new or dedicated folder")
+
+
+@contextmanager
+def atomic_file(path):
+    """Yield a temporary sibling path to write; on success it replaces ``path`` (atomic rename),
+    on any exception (Ctrl-C included) it is removed and ``path`` is left as it was."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = _part_name(path)
+    try:
+        yield tmp
+        if not tmp.exists():
+            raise FileNotFoundError(f"{tmp}: the writer produced no file")
+        _fsync_file(tmp)
+        os.replace(tmp, path)
+        _fsync_dir(path.parent)
+    except BaseException:
+        _remove(tmp)
+        raise
+
+
+def _remove(p: Path) -> None:
+    try:
+        if p.is_dir() and not p.is_symlink():
+            shutil.rmtree(p, ignore_errors=True)
+        elif p.exists() or p.is_symlink():
+            p.unlink()
+    except OSError:
+        pass
+
+
+_RENAME_EXCHANGE = 2
+_AT_FDCWD = -100
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths atomically (Linux renameat2 RENAME_EXCHANGE); False where unsupported."""
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or None, use_errno=True)
+        fn = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+    return fn(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0
+
+
+@contextmanager
+def atomic_dir(path):
+    """Yield a temporary sibling folder to fill; on success it replaces the folder ``path`` whole
+    (an atomic exchange where the OS has one, else two renames), on any exception it is removed and
+    ``path`` is left as it was."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.parent / f".{path.name}.part-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    tmp.mkdir()
+    try:
+        yield tmp
+        if path.exists():
+            if _exchange(tmp, path):     # tmp now holds the old folder
+                _remove(tmp)
+            else:
+                old = path.parent / f".{path.name}.old-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+                os.replace(path, old)
+                os.replace(tmp, path)
+                _remove(old)
+        else:
+            os.replace(tmp, path)
+        _fsync_dir(path.parent)
+    except BaseException:
+        _remove(tmp)
+        raise
+
+
+@contextmanager
+def atomic_dataset_dir(path):
+    """Yield a temporary folder for a steady-test dataset; on success each file moves into ``path`` by
+    an atomic rename, the index files (runs.csv, meta.json) last, other files already in ``path`` kept.
+    A new folder is renamed into place whole."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise DataError(path, "output", "is a file, not a folder: give a folder for a steady test")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.parent / f".{path.name}.part-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    tmp.mkdir()
+    try:
+        yield tmp
+        if not path.exists():
+            os.replace(tmp, path)
+        else:
+            names = sorted(p.name for p in tmp.iterdir())
+            order = [n for n in names if n not in _DATASET_INDEX_FILES] + [
+                n for n in _DATASET_INDEX_FILES if n in names]
+            for name in order:
+                os.replace(tmp / name, path / name)
+            _remove(tmp)
+        _fsync_dir(path.parent)
+    except BaseException:
+        _remove(tmp)
+        raise

@@ -1,0 +1,153 @@
+"""One validation layer for command-line values: finite numbers, ranges, integers, speed lists.
+
+Each check is an argparse ``type`` (a refused value is kept as :class:`Refused`, then
+:func:`check_parsed` raises ``--noise: value: 'nan': must be a finite number in [0, 10]``) or a function
+raising :class:`DataError` naming the flag, the value and the allowed range.  rpm and Hz at this edge.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+
+import numpy as np
+
+from .formats.records import DataError
+
+#: highest wheel speed any command accepts, rpm (flight wheels run below ~10 000 rpm)
+MAX_RPM = 100_000.0
+#: most speeds in a list or grid (a Campbell grid, a simulated test)
+MAX_SPEEDS = 100_000
+#: most samples of a simulated record (memory: 6 channels x 8 bytes each)
+MAX_SAMPLES = 50_000_000
+
+
+def _fmt(x) -> str:
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def _range_text(lo, hi, lo_open: bool, hi_open: bool) -> str:
+    if lo is not None and hi is not None:
+        return f"{'(' if lo_open else '['}{_fmt(lo)}, {_fmt(hi)}{')' if hi_open else ']'}"
+    if lo is not None:
+        return f"{'>' if lo_open else '>='} {_fmt(lo)}"
+    if hi is not None:
+        return f"{'<' if hi_open else '<='} {_fmt(hi)}"
+    return "any finite value"
+
+
+def check_number(value, flag: str, lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False,
+                 integer: bool = False, unit: str = ""):
+    """``value`` as a float (or int) checked finite and in range; :class:`DataError` naming ``flag``
+    otherwise.  ``lo_open``/``hi_open``: the bound itself is excluded."""
+    text = value if isinstance(value, str) else repr(value)
+    kind = "an integer" if integer else "a finite number"
+    allowed = _range_text(lo, hi, lo_open, hi_open) + (f" {unit}" if unit else "")
+    if isinstance(value, bool):
+        raise DataError(flag, "value", f"{text}: must be {kind} in {allowed}")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise DataError(flag, "value", f"{text!r}: must be {kind} in {allowed}") from None
+    if not math.isfinite(x):
+        raise DataError(flag, "value", f"{text!r}: must be {kind} in {allowed}")
+    if integer:
+        if x != int(x):
+            raise DataError(flag, "value", f"{text!r}: must be {kind} in {allowed}")
+        x = int(x)
+    if (lo is not None and (x < lo or (lo_open and x == lo))) or (
+            hi is not None and (x > hi or (hi_open and x == hi))):
+        raise DataError(flag, "value", f"{text}: out of range; allowed {allowed}")
+    return x
+
+
+class Refused:
+    """A flag value :func:`number` refused: ``text`` as given and ``why`` (range, type)."""
+
+    def __init__(self, text: str, why: str):
+        self.text, self.why = text, why
+
+    def __repr__(self) -> str:
+        return repr(self.text)
+
+
+def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
+           unit: str = ""):
+    """An argparse ``type`` checking a finite number (or an integer) in a range."""
+    def parse(text):
+        try:
+            return check_number(text, "value", lo, hi, lo_open=lo_open, hi_open=hi_open, integer=integer,
+                                unit=unit)
+        except DataError as exc:       # refused by check_parsed, which knows the flag (exit 2 from main)
+            return Refused(text, str(exc).split(": ", 2)[-1])
+
+    parse.__name__ = "integer" if integer else "number"
+    parse.rwadist_checked = True
+    return parse
+
+
+def check_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """After parsing: every flag typed by :func:`number` holds a number (argparse skips the type of some
+    values, e.g. ``--noise=--`` gives an empty list); :class:`DataError` naming the flag otherwise."""
+    def walk(p):
+        for action in p._actions:
+            if isinstance(action, argparse._SubParsersAction):     # only the command that was chosen
+                chosen = action.choices.get(getattr(args, action.dest, None) or "")
+                if chosen is not None:
+                    yield from walk(chosen)
+            elif getattr(action.type, "rwadist_checked", False):
+                yield action
+
+    for action in walk(parser):
+        value = getattr(args, action.dest, None)
+        if value is None or value is action.default:
+            continue
+        flag = max(action.option_strings, key=len) if action.option_strings else action.dest
+        if isinstance(value, Refused):
+            raise DataError(flag, "value", value.why)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise DataError(flag, "value", f"{value!r}: missing or not a number")
+
+
+def rpm(lo: float = -MAX_RPM, hi: float = MAX_RPM):
+    """An argparse ``type``: a wheel speed in rpm within [lo, hi]."""
+    return number(lo, hi, unit="rpm")
+
+
+def check_speeds_rpm(speeds, flag: str) -> np.ndarray:
+    """A speed list (rpm) checked: non-empty, finite, |speed| <= MAX_RPM, at most MAX_SPEEDS entries."""
+    s = np.asarray(speeds, dtype=float).ravel()
+    if s.size == 0:
+        raise DataError(flag, "value", "no speeds: give at least one speed in rpm")
+    if s.size > MAX_SPEEDS:
+        raise DataError(flag, "value", f"{s.size} speeds: at most {MAX_SPEEDS}; use a coarser step")
+    bad = s[~np.isfinite(s) | (np.abs(s) > MAX_RPM)]
+    if bad.size:
+        raise DataError(flag, "value", f"speed {float(bad[0])!r} rpm: must be finite in [{-MAX_RPM:g}, {MAX_RPM:g}] rpm")
+    return s
+
+
+def check_grid_size(start: float, stop: float, step: float, flag: str) -> None:
+    """Refuse a START:STOP:STEP grid of more than MAX_SPEEDS points before it is allocated."""
+    n = (stop - start) / step + 1 if step > 0 else math.inf
+    if not math.isfinite(n) or n > MAX_SPEEDS:
+        raise DataError(flag, "value", f"{_fmt(start)}:{_fmt(stop)}:{_fmt(step)} makes "
+                        f"{'too many' if not math.isfinite(n) else int(n)} speeds: at most {MAX_SPEEDS}; "
+                        "use a larger step")
+
+
+def refuse_non_finite_psd(res, source) -> None:
+    """A PSD with NaN or infinite values is an error, never a result."""
+    bad = ~np.isfinite(res.psd)
+    if bad.any():
+        rows = int(bad.any(axis=1).sum())
+        raise DataError(source, "psd", f"{rows} of {res.f.size} frequencies give non-finite PSD values (a "
+                        "coefficient or parameter of the model overflows); nothing written: check the model's "
+                        "values with `rwadist model show`")
+
+
+def refuse_non_finite_model(model, source) -> None:
+    """A fitted model with a non-finite coefficient is an error, never a result."""
+    for d in model.empirical:
+        for h in model.harmonics(d):
+            if not (np.isfinite(h.h) and np.isfinite(h.C)):
+                raise DataError(source, d, f"harmonic h={h.h!r} has C={h.C!r}: the fit diverged; nothing written")

@@ -1,0 +1,148 @@
+"""Outputs safe to keep (issue 17): atomic files and folders, an output never overwrites an input,
+Ctrl-C stops cleanly, a kill during a write leaves the old complete file."""
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+from rwadist.cli import main
+from rwadist.data import DataError
+from rwadist.outputs import atomic_dir, atomic_file, refuse_input_overwrite
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_atomic_file_replaces_only_when_complete(tmp_path):
+    target = tmp_path / "model.json"
+    target.write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_file(target) as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("writer failed")
+    assert target.read_text() == "old" and os.listdir(tmp_path) == ["model.json"]
+    with atomic_file(target) as tmp:
+        assert tmp.parent == tmp_path and tmp.suffix == ".json" and tmp != target
+        tmp.write_text("new")
+        assert target.read_text() == "old"       # not visible until complete
+    assert target.read_text() == "new" and os.listdir(tmp_path) == ["model.json"]
+
+
+def test_atomic_dir_swaps_the_whole_folder(tmp_path):
+    target = tmp_path / "report"
+    target.mkdir()
+    (target / "stale.png").write_text("old")
+    with pytest.raises(KeyboardInterrupt):
+        with atomic_dir(target) as tmp:
+            (tmp / "summary.md").write_text("partial")
+            raise KeyboardInterrupt
+    assert sorted(os.listdir(target)) == ["stale.png"] and os.listdir(tmp_path) == ["report"]
+    with atomic_dir(target) as tmp:
+        (tmp / "summary.md").write_text("new")
+    assert sorted(os.listdir(target)) == ["summary.md"] and os.listdir(tmp_path) == ["report"]
+
+
+def test_refuse_input_overwrite(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    ds = tmp_path / "DS"
+    ds.mkdir()
+    (ds / "runs.csv").write_text("file,speed_rpm\n")
+    sweep = tmp_path / "sweep.csv"
+    sweep.write_text("t\n")
+    for outputs, inputs in (([("-o", sweep, "file")], [sweep]),
+                            ([("-o", ds / "runs.csv", "file")], [ds]),
+                            ([("-o", ds, "file")], [ds]),
+                            ([("--report", tmp_path, "dir")], [sweep]),          # holds the input
+                            ([("-o", tmp_path / "sweep.meta.json", "file")], [sweep])):
+        with pytest.raises(DataError) as err:
+            refuse_input_overwrite(outputs, inputs)
+        assert outputs[0][0] in str(err.value)
+    refuse_input_overwrite([("-o", ds / "model.json", "file"), ("--report", tmp_path / "r", "dir")], [ds, sweep])
+
+
+def test_output_equal_to_input_is_refused_and_untouched(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, _, _ = run(capsys, "simulate-test", "ds", "--preset", "ithaco-e", "--speeds-rpm", "600,1800",
+                     "--samples", "1024", "--no-modes")
+    assert code == 0
+    before = {p.name: p.read_bytes() for p in (tmp_path / "ds").iterdir()}
+    for argv in (("fit", "ds", "-o", "ds/runs.csv"), ("fit", "ds", "-o", "ds/run_0000.csv"),
+                 ("fit", "ds", "-o", "m.json", "--report", "ds"), ("fit", "ds", "-o", "ds"),
+                 ("convert", "ds", "-o", "ds")):
+        code, _, err = run(capsys, *argv)
+        assert code == 2 and "error" in err and "Traceback" not in err, argv
+    assert {p.name: p.read_bytes() for p in (tmp_path / "ds").iterdir()} == before
+    assert sorted(os.listdir(tmp_path)) == ["ds"]     # nothing else written, no temporary left
+
+
+def test_psd_refuses_non_finite_results(tmp_path, capsys):
+    import json
+
+    from rwadist import catalogue
+    from rwadist.model import save, to_json
+
+    doc = to_json(catalogue.load("ithaco-e"))
+    doc.pop("analytical", None)
+    doc["empirical"]["radial_force"][0]["C"] = 1e300     # finite in the file, overflows in the PSD
+    path = tmp_path / "m.json"
+    path.write_text(json.dumps(doc))
+    out = tmp_path / "psd.csv"
+    code, _, err = run(capsys, "psd", path, "--speed-rpm", "600:2400", "--empirical", "--n-freq", "501",
+                       "--n-speeds", "50", "-o", out)
+    assert code == 2 and "non-finite" in err and not out.exists(), err
+
+
+_SLOW_WRITER = textwrap.dedent("""
+    import sys, time
+    from rwadist.outputs import atomic_file
+    with atomic_file(sys.argv[1]) as tmp:
+        with open(tmp, "w") as fh:
+            fh.write("new-begin\\n"); fh.flush()
+            print("writing", flush=True)
+            time.sleep(30)
+            fh.write("new-end\\n")
+""")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT])
+def test_kill_during_the_write_keeps_the_old_file(tmp_path, sig):
+    target = tmp_path / "out.json"
+    target.write_text("old complete\n")
+    proc = subprocess.Popen([sys.executable, "-c", _SLOW_WRITER, str(target)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "writing"   # killed at its first write
+    proc.send_signal(sig)
+    proc.wait(timeout=20)
+    assert target.read_text() == "old complete\n"
+    left = [p for p in os.listdir(tmp_path) if p != "out.json"]
+    # SIGINT runs the clean-up; SIGKILL can leave only the hidden temporary, never a truncated output
+    assert left == [] if sig == signal.SIGINT else all(p.startswith(".out.part-") for p in left)
+
+
+def test_ctrl_c_is_one_line_exit_130(tmp_path):
+    out = tmp_path / "psd.csv"
+    out.write_text("old")
+    proc = subprocess.Popen([sys.executable, "-m", "rwadist.cli", "psd", "--preset", "ithaco-e", "--speed-rpm",
+                             "600:2400", "--empirical", "--n-freq", "200001", "--n-speeds", "20000", "-o", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(0.2)
+    deadline = time.time() + 60
+    while time.time() < deadline:       # wait past the imports: main() is running once it prints progress
+        if proc.poll() is not None:
+            break
+        line = proc.stderr.read(1)
+        if line:
+            break
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "interrupted" in err.strip().splitlines()[-1]
+    assert out.read_text() == "old" and os.listdir(tmp_path) == ["psd.csv"]
