@@ -81,22 +81,3 @@ def test_modes_off_record_and_explicit_empirical_base_keep_the_empirical_base():
     d = api.diagnose(test)
     assert d.state_after.base == "empirical"
     assert "suspension_modes" not in [e["kind"] for e in d.model.effects]
-
-
-@pytest.mark.slow
-def test_stand_resonance_is_fitted_beside_the_modes_not_into_them():
-    """E modal data with a 180 Hz fixture resonance on all six channels (rwadist.inject): the rocking mode stays
-    within 2 % of the thesis value, the resonance is found at 180 Hz as a fixed_resonance, and no suspension
-    mode is put on it."""
-    from rwadist.inject import parse, simulate_with_injections
-
-    test = simulate_with_injections(preset("ithaco-e"), [parse("fixed_resonance:f_hz=180")], SPEEDS,
-                                    physics="extended", sample_rate=3840.0, n_samples=8192, noise=0.01, seed=0)
-    d = api.diagnose(test)
-    kinds = [e["kind"] for e in d.model.effects]
-    assert kinds[0] == "suspension_modes"
-    modes = d.model.effects[0]
-    assert modes["rocking_Hz"] == pytest.approx(iw.TRUTH_HZ["rocking"], rel=0.02)
-    assert abs(modes["radial_translation_Hz"] / 180.0 - 1) > 0.05
-    stand = [e for e in d.model.effects if e["kind"] == "fixed_resonance"]
-    assert stand and all(e["f_Hz"] == pytest.approx(180.0, rel=0.02) for e in stand)
