@@ -22,7 +22,7 @@ def _off(R, eps):
 def test_one_tolerance_for_every_consumer():
     """A DCM 1e-7 off (as typed with 7 digits) passes psd mountings, coupling and the FMU runtime alike;
     1e-5 off fails all three (before: coupling refused at 1e-9, the others at 1e-6)."""
-    cp = pytest.importorskip("coupling")
+    cp = pytest.importorskip("rwadist.coupling")
     from rwadist.fmu import runtime as rt
 
     R = _rot(np.random.default_rng(1))
@@ -71,7 +71,7 @@ def test_lever_arm_transform_is_r_cross_f():
 def test_spin_axis_builders_are_one(axis):
     """Both spin-axis DCMs are proper rotations with z along the axis; coupling's is the home's with
     coupling's reference direction."""
-    cp = pytest.importorskip("coupling")
+    cp = pytest.importorskip("rwadist.coupling")
     z = np.asarray(axis, float) / np.linalg.norm(axis)
     for R in (geometry.spin_axis_dcm(axis), mounting.dcm_from_spin_axis(axis), cp.spin_axis_dcm(axis)):
         assert geometry.rotation_problem(R, 1e-12) is None
