@@ -21,8 +21,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from test_diagnose import (C1, FLOOR_LEVEL, NPERSEG, SPEEDS, TRUTH, W_MID, e_data, inject_floor,  # noqa: E402
-                           inject_line, spectra)
+from test_diagnose import C1, FLOOR_LEVEL, NPERSEG, SPEEDS, TRUTH, W_MID, e_data, inject_floor, inject_line, spectra  # noqa: E402
 
 from rwadist.diagnose import diagnose  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402

@@ -18,8 +18,8 @@ import numpy as np
 from scipy import signal
 
 from rwadist.empirical import fit_empirical
-from rwadist.spectra import compute_spectra
 from rwadist.presets import preset
+from rwadist.spectra import compute_spectra
 from rwadist.teststand import simulate_steady
 
 

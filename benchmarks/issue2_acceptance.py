@@ -12,8 +12,8 @@ import time
 import numpy as np
 
 from rwadist.empirical import fit_empirical
-from rwadist.spectra import compute_spectra
 from rwadist.presets import preset
+from rwadist.spectra import compute_spectra
 from rwadist.teststand import simulate_steady, simulate_sweep
 
 # Thesis speed ranges (rpm) where a mode amplified the harmonic: Tables 3.6 (radial force),

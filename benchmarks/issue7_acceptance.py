@@ -27,6 +27,7 @@ import test_diagnose as TD  # noqa: E402
 import test_diagnose_extended as TE  # noqa: E402
 import test_diagnose_modulation as TM  # noqa: E402
 import test_diagnose_sweep as TS  # noqa: E402
+
 from rwadist.diagnose import METRIC, diagnose  # noqa: E402
 from rwadist.presets import preset  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402

@@ -9,14 +9,39 @@ performance: line responses (speed ripple included), broadband floors, jitter RM
 sweep      : the same over speeds / wheel sets in parallel with dask (local or a cluster).
 """
 from .assemble import PRACTICES, Assembly, Attachment, assemble, practice_systems
-from .components import (Component, Plant, example_spacecraft, free_lines, frf, modal_plant, plant_from_statespace,
-                         random_modal_plant, rigid_mass, rigid_plant, spring_mass, spring_mass_plant, wheel,
-                         wheel_rigid_mass_matrix, with_isolator)
-from .errors import (CouplingError, InterfaceMismatchError, NotARotationError, SingularInterfaceError,
-                     UnstablePlantError)
+from .components import (
+                         Component,
+                         Plant,
+                         example_spacecraft,
+                         free_lines,
+                         frf,
+                         modal_plant,
+                         plant_from_statespace,
+                         random_modal_plant,
+                         rigid_mass,
+                         rigid_plant,
+                         spring_mass,
+                         spring_mass_plant,
+                         wheel,
+                         wheel_rigid_mass_matrix,
+                         with_isolator,
+)
+from .errors import CouplingError, InterfaceMismatchError, NotARotationError, SingularInterfaceError, UnstablePlantError
 from .geometry import Mount, check_dcm, load_transform, rotation, spin_axis_dcm
-from .performance import (Floor, FloorResponses, JitterResult, LineResponses, WheelSpec, floor_grid, floor_responses,
-                          floors_from_effects, jitter_vs_speed, line_responses, output_psd, wheel_spec_from_model)
+from .performance import (
+                         Floor,
+                         FloorResponses,
+                         JitterResult,
+                         LineResponses,
+                         WheelSpec,
+                         floor_grid,
+                         floor_responses,
+                         floors_from_effects,
+                         jitter_vs_speed,
+                         line_responses,
+                         output_psd,
+                         wheel_spec_from_model,
+)
 from .sweep import sweep
 
 __all__ = [n for n in dir() if not n.startswith("_")]

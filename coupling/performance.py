@@ -52,7 +52,6 @@ from .assemble import PRACTICES
 from .components import Plant, wheel_matrices, wheel_rigid_mass_matrix
 from .errors import CouplingError, SingularInterfaceError
 
-
 # ----------------------------------------------------------------------------- broadband floors
 
 @dataclass(frozen=True, eq=False)

@@ -9,7 +9,6 @@ outputs after initialisation.
 """
 from __future__ import annotations
 
-import ctypes
 import math
 
 import numpy as np
@@ -22,9 +21,13 @@ class HostLog:
         self.records = []
 
     def callbacks(self):
-        from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
-                               fmi2CallbackLoggerTYPE)
         from fmpy import calloc, free
+        from fmpy.fmi2 import (
+            fmi2CallbackAllocateMemoryTYPE,
+            fmi2CallbackFreeMemoryTYPE,
+            fmi2CallbackFunctions,
+            fmi2CallbackLoggerTYPE,
+        )
 
         def log(env, instance, status, category, message):
             self.records.append((instance.decode() if instance else "", int(status),

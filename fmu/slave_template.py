@@ -20,8 +20,17 @@ import os
 import sys
 from xml.etree.ElementTree import Element, SubElement
 
-from pythonfmu import (Boolean, DefaultExperiment, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer,
-                       Real, String)
+from pythonfmu import (
+    Boolean,
+    DefaultExperiment,
+    Fmi2Causality,
+    Fmi2Initial,
+    Fmi2Slave,
+    Fmi2Variability,
+    Integer,
+    Real,
+    String,
+)
 from pythonfmu.enums import Fmi2Status
 
 # Work around a pythonfmu bug (0.7.0; its sources to mid-2025 have it): on every fmi2Instantiate

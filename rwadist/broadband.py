@@ -65,8 +65,19 @@ from . import schema
 from .data import DataError
 from .model import WheelModel
 from .resonance import resonance
-from .speed_laws import (PDF_RTOL, Histogram, TruncatedNormal, Uniform, _check_range, _spread,  # noqa: F401
-                         from_time_profile, histogram_from_centres, law_from_csv, law_from_spec, speed_cells)
+from .speed_laws import (  # noqa: F401
+    PDF_RTOL,
+    Histogram,
+    TruncatedNormal,
+    Uniform,
+    _check_range,
+    _spread,
+    from_time_profile,
+    histogram_from_centres,
+    law_from_csv,
+    law_from_spec,
+    speed_cells,
+)
 from .units import CHANNELS, RAD_S_TO_RPM
 
 #: Upper-triangle channel pairs (a <= b), 21 of them.

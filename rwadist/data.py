@@ -48,8 +48,17 @@ from tqdm.auto import tqdm
 from .formats import registry
 from .formats.channels import SPEED_COLUMN, to_run, to_sweep
 from .formats.csv_table import TIME_COLUMN
-from .formats.records import (DataError, RawRecord, Run, SteadyTest, Sweep, json_default, portable_meta, read_json,
-                              read_text)
+from .formats.records import (
+    DataError,
+    RawRecord,
+    Run,
+    SteadyTest,
+    Sweep,
+    json_default,
+    portable_meta,
+    read_json,
+    read_text,
+)
 from .formats.timebase import sample_step
 from .hdf5 import read_hdf5
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm, rpm_to_rad_s  # noqa: F401 (re-exported)

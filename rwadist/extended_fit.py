@@ -42,9 +42,9 @@ from scipy import optimize, signal
 from . import extended as ext
 from .data import SteadyTest
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
+from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
 from .spectra import compute_spectra, welch_dof
-from .mode_scan import MODE_DIRECTION, scan_mode
 from .units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
 
 CHANNEL_INDEX = {c: i for i, c in enumerate(CHANNELS)}
@@ -316,7 +316,6 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                      f"inertia (I_rr = 1 kg·m²); I_zz/I_rr = {a_fit:.3f} "
                      + ("fitted from the whirls" if scans["rocking"].found else "ASSUMED (thin disc): the rocking "
                         "whirls do not constrain it"))
-    a = I_zz / I_rr
     f_modes = {m: (sc.f0_hz if sc.found else None) for m, sc in scans.items()}
     f_top = max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines), default=100.0)
 

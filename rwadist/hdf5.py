@@ -34,9 +34,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .formats.records import DataError, Run, SteadyTest, Sweep
+from .formats.records import DataError, Run, SteadyTest, Sweep, portable_meta
 from .formats.records import json_default as _json_default
-from .formats.records import portable_meta
 from .formats.timebase import sample_step
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm
 

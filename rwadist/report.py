@@ -24,8 +24,15 @@ from matplotlib.figure import Figure
 
 from . import compare
 from .spectra import cumulative_rms
-from .units import (CHANNEL_DIRECTION, CHANNEL_UNIT, DIRECTION_C_UNIT, DIRECTION_CHANNELS,
-                    RAD_S_TO_RPM, rad_s_to_rpm, rpm_to_rad_s)
+from .units import (
+    CHANNEL_DIRECTION,
+    CHANNEL_UNIT,
+    DIRECTION_C_UNIT,
+    DIRECTION_CHANNELS,
+    RAD_S_TO_RPM,
+    rad_s_to_rpm,
+    rpm_to_rad_s,
+)
 
 _UNIT_LABEL = {"N": "N", "Nm": "N·m"}
 _DPI = 110

@@ -9,8 +9,8 @@ import pytest
 
 from rwadist.empirical import fit_empirical
 from rwadist.model import DIRECTIONS
-from rwadist.spectra import compute_spectra
 from rwadist.presets import preset
+from rwadist.spectra import compute_spectra
 from rwadist.teststand import simulate_steady
 
 pytestmark = pytest.mark.slow

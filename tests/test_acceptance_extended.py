@@ -5,8 +5,8 @@ import pytest
 
 from rwadist.empirical import fit_empirical
 from rwadist.extended_fit import fit_extended, rms_comparison
-from rwadist.spectra import compute_spectra
 from rwadist.presets import preset
+from rwadist.spectra import compute_spectra
 from rwadist.teststand import simulate_steady
 
 pytestmark = pytest.mark.slow

@@ -3,7 +3,6 @@ NASTRAN output.  Every check is against an independent computation: scipy quadra
 pdf (Parseval), the pointwise closed form S(f) = Σ σ²(Ω) p(Ω) |dΩ/df|, a Monte Carlo of the
 virtual test stand at drawn speeds, pyNastran's reader."""
 import json
-from dataclasses import replace
 
 import numpy as np
 import pytest

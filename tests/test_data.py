@@ -13,8 +13,18 @@ import h5py
 import numpy as np
 import pytest
 
-from rwadist.data import (DataError, Run, SteadyTest, Sweep, read_data, read_run, read_steady, read_sweep,
-                          write_steady, write_sweep)
+from rwadist.data import (
+    DataError,
+    Run,
+    SteadyTest,
+    Sweep,
+    read_data,
+    read_run,
+    read_steady,
+    read_sweep,
+    write_steady,
+    write_sweep,
+)
 from rwadist.hdf5 import FORMAT, FORMAT_VERSION, read_hdf5, write_hdf5
 from rwadist.units import CHANNEL_COLUMN, CHANNELS, RAD_S_TO_RPM, rpm_to_rad_s
 

@@ -17,8 +17,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-
-from test_diagnose import FS, N, SPEEDS, TRUTH, kinds, spectra
+from test_diagnose import FS, SPEEDS, TRUTH, N, kinds, spectra
 
 from rwadist import cli
 from rwadist import extended as ext

@@ -7,15 +7,14 @@ import json
 
 import numpy as np
 import pytest
-from scipy import signal
-
 from rwadist.fmu import runtime as rt
-from rwadist import model as model_io
-from rwadist.diagnose import diagnose
-
+from scipy import signal
 from test_diagnose import C1, FS, SPEEDS, TRUTH, e_data, inject_floor, spectra
 from test_diagnose_modulation import RIPPLE, rippled_data
 from test_fmu_effects import ripple_coefficients_p2
+
+from rwadist import model as model_io
+from rwadist.diagnose import diagnose
 
 pytest.importorskip("pythonfmu")
 

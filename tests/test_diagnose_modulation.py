@@ -9,12 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from test_diagnose import FS, N, SPEEDS, TRUTH, e_data, kinds, spectra
+from test_diagnose import FS, SPEEDS, TRUTH, N, e_data, kinds, spectra
 
 from rwadist.diagnose import diagnose, ripple_sideband_powers
-from rwadist.teststand import simulate_steady
 from rwadist.presets import preset
+from rwadist.teststand import simulate_steady
 from rwadist.units import DIRECTION_CHANNELS
 
 #: Sidebands injected: carrier h = 2 of the radial force, f_mod 7 Hz, depth 0.4.

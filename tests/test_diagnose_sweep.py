@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from rwadist.diagnose import SpinAcceleration, diagnose
+from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
 from rwadist.sweep import slice_sweep
-from rwadist.presets import preset
 from rwadist.teststand import simulate_sweep
 
 RPM = 2 * np.pi / 60

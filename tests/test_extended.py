@@ -10,7 +10,7 @@ from scipy import linalg, signal
 from rwadist import extended as ex
 from rwadist.data import DataError
 from rwadist.model import WheelModel
-from rwadist.units import RAD_S_TO_RPM, RPM_TO_RAD_S
+from rwadist.units import RPM_TO_RAD_S
 
 DATA = Path(__file__).parent / "data"
 E = ex.from_table_4_2()

@@ -10,7 +10,6 @@ thesis (Table 4.2), not taken from rwadist.
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))

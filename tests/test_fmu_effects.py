@@ -8,15 +8,15 @@ import copy
 
 import numpy as np
 import pytest
+from rwadist.fmu import hosts
+from rwadist.fmu import runtime as rt
+from rwadist.fmu.build import build_fmu
 from scipy.signal import welch
 from scipy.special import jv
+from test_fmu import NATIVE_ONLY, assert_native_equals_numpy, kernel, slope, spin_up  # noqa: F401  (kernel: a fixture)
 
-from rwadist.fmu import hosts, runtime as rt
-from rwadist.fmu.build import build_fmu
 from rwadist import model as model_io
 from rwadist.presets import preset
-
-from test_fmu import NATIVE_ONLY, assert_native_equals_numpy, kernel, slope, spin_up  # noqa: F401  (kernel: a fixture)
 
 pytest.importorskip("pythonfmu")
 pytest.importorskip("fmpy")
@@ -337,6 +337,7 @@ def test_fmu_ripple_equals_the_coupling_kits_sidebands():
     (Tx, Ty are left out: ripple_lines neglects the ripple's modulation of the gyroscopic rocking, 8-12 % of
     the largest Tx/Ty line here, at sidebands near the rocking whirl.)"""
     from dataclasses import replace
+
     from rwadist import extended as ext
     m = preset("ithaco-e").to_model()
     rip_e = dict(RIPPLE, f_ripple_Hz=2.3, delta_omega_rad_s=3.0, speed_exponent=0.5)

@@ -7,9 +7,10 @@ import json
 
 import numpy as np
 import pytest
-
-from rwadist.fmu import hosts, runtime as rt
+from rwadist.fmu import hosts
+from rwadist.fmu import runtime as rt
 from rwadist.fmu.build import build_fmu
+
 from rwadist import catalogue
 
 pytest.importorskip("pythonfmu")

@@ -15,7 +15,6 @@ from rwadist.data import (
     DataError,
     read_data,
     read_steady,
-    read_sweep,
     write_steady,
     write_sweep,
 )

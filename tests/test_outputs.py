@@ -86,7 +86,7 @@ def test_psd_refuses_non_finite_results(tmp_path, capsys):
     import json
 
     from rwadist import catalogue
-    from rwadist.model import save, to_json
+    from rwadist.model import to_json
 
     doc = to_json(catalogue.load("ithaco-e"))
     doc.pop("analytical", None)

@@ -4,13 +4,12 @@ benchmarks/ross_loadcell.py).  The extended fit must find ROSS's own whirl frequ
 run_modal Campbell diagram stored with the data) within 1 % at three speeds."""
 import numpy as np
 import pytest
+from ross_dataset import campbell, load_doc, ross_test
 
 from rwadist import extended as ext
 from rwadist.empirical import fit_empirical
 from rwadist.extended_fit import fit_extended
 from rwadist.spectra import compute_spectra
-
-from ross_dataset import campbell, load_doc, ross_test
 
 
 @pytest.fixture(scope="module")

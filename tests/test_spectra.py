@@ -8,8 +8,17 @@ import pytest
 from scipy import stats
 
 from rwadist.data import DataError, Run, SteadyTest
-from rwadist.spectra import (compute_spectra, cumulative_rms, detection_threshold, find_lines, line_amplitude,
-                             line_power, noise_floor, rms, welch_dof)
+from rwadist.spectra import (
+    compute_spectra,
+    cumulative_rms,
+    detection_threshold,
+    find_lines,
+    line_amplitude,
+    line_power,
+    noise_floor,
+    rms,
+    welch_dof,
+)
 
 FS = 1024.0
 NPERSEG = 1024  # df = 1 Hz

@@ -14,7 +14,6 @@ from rwadist.hdf5 import read_hdf5, write_hdf5
 from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
 from rwadist.teststand import simulate_steady
-from rwadist.units import CHANNEL_COLUMN
 
 FS = 3840.0
 SPEEDS_RPM = np.linspace(600.0, 2400.0, 8)

@@ -11,7 +11,6 @@ Each file's ``provenance`` says where every number comes from: ``source`` (citat
 from __future__ import annotations
 
 from collections.abc import Mapping
-
 from pathlib import Path
 
 from ..data import DataError

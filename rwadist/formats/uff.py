@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..units import CHANNELS, CHANNEL_UNIT
+from ..units import CHANNEL_UNIT, CHANNELS
 from .records import DataError, RawRecord
 
 #: UFF function types by number, for error messages.

@@ -11,7 +11,6 @@ from ..measure import _measure
 from ..state import State
 from .base import register, schema_entry
 
-
 #: Standard errors an exponent must lie away from 2 (the model's C·Ω²) to be proposed as a law.
 EXPONENT_Z = 4.0
 

@@ -12,7 +12,6 @@ from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
 
-
 #: Smallest peak gain (or 1/gain, an anti-resonance) proposed: |H| within 10 % of 1 everywhere is the size of the
 #: fit's own model error near a mode (a per-unit extended base leaves ~1-3 % there), not a resonance.
 MIN_PEAK_GAIN = 1.1
