@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import copy
 import math
+from abc import abstractmethod
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
@@ -249,8 +250,26 @@ def _json_value(v: Any) -> Any:
 
 # =========================================================================== effects
 
+class _ReadsAsJson(Mapping):
+    """Read-only mapping view of a typed section: it reads as (and iterates like) its ``to_json()`` object,
+    so code written for the file's dicts reads the typed value unchanged."""
+
+    @abstractmethod
+    def to_json(self) -> dict:
+        """The section as the model file's JSON object."""
+
+    def __getitem__(self, key: str) -> Any:
+        return self.to_json()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.to_json())
+
+    def __len__(self) -> int:
+        return len(self.to_json())
+
+
 @dataclass(frozen=True, eq=False, kw_only=True)
-class Effect(Mapping):
+class Effect(_ReadsAsJson):
     """A diagnosed effect of the model file's ``effects`` list (base class; see the module docstring).
 
     extra : keys the class does not interpret (``evidence``, ``law`` texts, ...), carried through.
@@ -299,16 +318,6 @@ class Effect(Mapping):
                 out[key] = _json_value(v)
         out.update(copy.deepcopy(dict(self.extra)))
         return out
-
-    # ------------------------------------------------------------ read like the JSON object
-    def __getitem__(self, key: str) -> Any:
-        return self.to_json()[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.to_json())
-
-    def __len__(self) -> int:
-        return len(self.to_json())
 
     def __eq__(self, other: object) -> bool:
         if isinstance(other, Mapping):
@@ -614,7 +623,7 @@ class Harmonic:
 # =========================================================================== analytical section
 
 @dataclass(frozen=True, eq=False)
-class Analytical(Mapping):
+class Analytical(_ReadsAsJson):
     """The ``analytical`` section: the extended model's parameters (SI, keys of :data:`PARAM_KEYS`).
 
     params : parameter name -> value for the keys present (each finite; mass, inertias and stiffnesses
@@ -681,15 +690,6 @@ class Analytical(Mapping):
             out["unconstrained"] = list(self.unconstrained)
         out.update(copy.deepcopy(dict(self.extra)))
         return out
-
-    def __getitem__(self, key: str) -> Any:
-        return self.to_json()[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.to_json())
-
-    def __len__(self) -> int:
-        return len(self.to_json())
 
     def __eq__(self, other: object) -> bool:
         if isinstance(other, Mapping):
