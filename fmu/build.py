@@ -2,9 +2,9 @@
 
 :func:`build_fmu` renders ``slave_template.py`` under a module and class name unique to the
 build (two FMUs whose slave modules share a name cannot load in one process), and ships
-``runtime.py`` (as ``rwadist_fmu_runtime.py``), ``rwadist/schema.py`` (as
-``rwadist_model_schema.py``, the runtime's reader of the model file) and the model file (``wheel_model.json``) in the
-FMU's resources.  pythonfmu embeds itself there too, so a host needs Python + numpy only.
+``runtime.py`` (as ``rwadist_fmu_runtime.py``) with its sibling modules, ``rwadist/schema.py`` (as
+``rwadist_model_schema.py``, the runtime's reader of the model file; :func:`runtime_files`) and the model file
+(``wheel_model.json``) in the FMU's resources.  pythonfmu embeds itself there too, so a host needs Python + numpy only.
 
 Native layer (Linux x86-64, when a C compiler is found): ``native/rwadist_fmu_native.c`` is
 compiled into ``binaries/linux64/<id>.so`` in front of pythonfmu's library (renamed
@@ -52,7 +52,7 @@ def compile_native(output) -> Path:
     if cc is None:
         raise NativeBuildError(f"no C compiler ({os.environ.get('CC', 'cc')!r} not on PATH)")
     output = Path(output)
-    cmd = [cc, "-O2", "-fPIC", "-shared", "-o", str(output), str(NATIVE_SOURCE), "-ldl", "-lm"]
+    cmd = [cc, "-O2", "-fPIC", "-shared", "-o", str(output), str(NATIVE_SOURCE), "-ldl", "-lm", "-pthread"]
     res = subprocess.run(cmd, capture_output=True, text=True)
     if res.returncode != 0:
         raise NativeBuildError(f"{' '.join(cmd)} failed:\n{res.stderr.strip()}")
@@ -184,18 +184,16 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
         script.write_text(_render(src, cls, physics, modes_default))
         extra = tmp / "extra"
         extra.mkdir()
-        shutil.copy2(RUNTIME, extra / "rwadist_fmu_runtime.py")
-        schema_copy = extra / _runtime().SCHEMA_FILE
-        shutil.copyfile(_schema_source(), schema_copy)
+        project_files = runtime_files(extra)
         (extra / "wheel_model.json").write_text(json.dumps(doc, indent=1) + "\n")
         path_before = list(sys.path)
         try:
             out = FmuBuilder.build_FMU(script, dest=output,
-                                       project_files=[extra / "rwadist_fmu_runtime.py", schema_copy,
-                                                      extra / "wheel_model.json"])
+                                       project_files=project_files + [extra / "wheel_model.json"])
         finally:
             sys.path[:] = path_before
-            for name in (module, f"{module}_runtime"):
+            rt_name = f"{module}_runtime"
+            for name in (module, rt_name, *(f"{rt_name}_{stem}" for stem in _runtime().SIBLINGS)):
                 sys.modules.pop(name, None)
         if native is not False and native_supported():
             try:
@@ -206,6 +204,22 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
                 warnings.warn(f"rwadist FMU built without its native layer ({exc}): refused inputs are "
                               "reported as fmi2Discard and steps run in numpy", RuntimeWarning, stacklevel=2)
     return Path(out)
+
+
+def runtime_files(folder) -> list:
+    """Copy the FMU runtime into ``folder`` under its resource names: ``runtime.py`` as
+    ``rwadist_fmu_runtime.py``, each sibling module (``runtime.SIBLINGS``) as ``runtime.fmu_file_name``, and
+    ``rwadist/schema.py`` as ``runtime.SCHEMA_FILE``; returns the copies' paths (the FMU's project files)."""
+    rt = _runtime()
+    folder = Path(folder)
+    out = [folder / "rwadist_fmu_runtime.py"]
+    shutil.copy2(RUNTIME, out[0])
+    for stem in rt.SIBLINGS:
+        out.append(folder / rt.fmu_file_name(stem))
+        shutil.copy2(HERE / f"{stem}.py", out[-1])
+    out.append(folder / rt.SCHEMA_FILE)
+    shutil.copyfile(_schema_source(), out[-1])
+    return out
 
 
 def build_preset(name: str, output, **kw) -> Path:

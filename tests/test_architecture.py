@@ -22,17 +22,32 @@ KNOWN_CYCLES: set = set()
 KNOWN_LONG: set = set()
 
 
+#: source folders installed inside the package under another name (pyproject ``package-dir``): checked too
+MAPPED = {"fmu": "rwadist.fmu", "coupling": "rwadist.coupling"}
+
+
 def module_name(path: Path) -> str:
     rel = path.relative_to(PACKAGE.parent).with_suffix("")
     parts = list(rel.parts)
+    if parts[0] in MAPPED:
+        parts = MAPPED[parts[0]].split(".") + parts[1:]
     if parts[-1] == "__init__":
         parts.pop()
     return ".".join(parts)
 
 
+def source_files() -> list:
+    """Every .py file of the package: rwadist/ and the folders installed into it (:data:`MAPPED`)."""
+    files = list(PACKAGE.rglob("*.py"))
+    for folder in MAPPED:
+        if (PACKAGE.parent / folder / "__init__.py").is_file():
+            files += (PACKAGE.parent / folder).rglob("*.py")
+    return sorted(files)
+
+
 def modules() -> dict:
     """Dotted name -> path of every module of the package."""
-    return {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+    return {module_name(p): p for p in source_files()}
 
 
 def imports_of(name: str, path: Path, known: dict) -> set:
@@ -127,7 +142,7 @@ def test_no_import_cycle():
 
 def test_no_module_over_max_lines():
     long = {}
-    for p in PACKAGE.rglob("*.py"):
+    for p in source_files():
         n = len(p.read_text().splitlines())
         if n > MAX_LINES:
             long[p.relative_to(PACKAGE.parent).as_posix()] = n

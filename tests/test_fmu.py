@@ -298,6 +298,10 @@ def test_fmpy_validate_and_model_description(wheel_fmu):
     # the shipped runtime is this package's runtime, byte for byte
     shipped = zipfile.ZipFile(wheel_fmu).read("resources/rwadist_fmu_runtime.py")
     assert shipped == Path(rt.__file__).read_bytes()
+    # and so are its sibling modules, each under its resource name
+    for stem in rt.SIBLINGS:
+        source = Path(rt.__file__).with_name(f"{stem}.py")
+        assert zipfile.ZipFile(wheel_fmu).read(f"resources/{rt.fmu_file_name(stem)}") == source.read_bytes(), stem
     # and its reader of the model file is rwadist's one schema, byte for byte
     from rwadist import schema
     assert zipfile.ZipFile(wheel_fmu).read(f"resources/{rt.SCHEMA_FILE}") == Path(schema.__file__).read_bytes()

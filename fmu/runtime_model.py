@@ -1,0 +1,303 @@
+"""The model file as the FMU runtime reads it (part of :mod:`rwadist.fmu.runtime`; numpy only, no rwadist).
+
+Copied verbatim into the FMU's ``resources/`` (as ``rwadist_fmu_runtime_model.py``) beside the runtime, with a
+verbatim copy of :mod:`rwadist.schema` (``rwadist_model_schema.py``), the one reader of the model file, which this
+module imports from there (from rwadist itself when run from the source tree; a test pins the copies to the
+source byte for byte).  Here: the model's parameters and lines (:func:`load_model`, :func:`model_from_doc`), its
+diagnosed time-domain effects (:func:`effects_from_doc`), the expansion of lines by laws and sidebands
+(:func:`expand_lines`), a line's rotating components (:func:`components`) and the mounting check
+(:func:`rotation_check`).  Everything is SI: rad/s, N, N·m, kg, m.
+"""
+from __future__ import annotations
+
+import cmath
+import importlib.util
+import json
+import math
+import os
+import sys
+
+import numpy as np
+
+#: the schema's file name in the FMU's resources (``fmu/build.py`` copies rwadist/schema.py there)
+SCHEMA_FILE = "rwadist_model_schema.py"
+
+
+def _load_schema():
+    """The model-file schema: the copy next to this file (inside an FMU), else :mod:`rwadist.schema`."""
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), SCHEMA_FILE)
+    if not os.path.isfile(path):
+        from rwadist import schema
+        return schema
+    name = f"{__name__}_schema"          # unique per FMU: two FMUs may load side by side
+    mod = sys.modules.get(name)
+    if mod is None:
+        spec = importlib.util.spec_from_file_location(name, path)
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[name] = mod          # dataclasses look their module up while the class is made
+        spec.loader.exec_module(mod)
+    return mod
+
+
+_schema = _load_schema()
+SCHEMA = _schema.SCHEMA
+SCHEMA_VERSION = _schema.SCHEMA_VERSION
+ANALYTICAL_KIND = _schema.ANALYTICAL_KIND
+DIRECTIONS = _schema.DIRECTIONS
+CHANNELS = _schema.CHANNELS
+PARAM_KEYS = _schema.PARAM_KEYS
+
+#: Invalid or unreadable model file, parameter or input; the message names the problem.  The schema's
+#: one error type, so a bad model-file entry reads the same here as in rwadist and the coupling kit.
+ModelError = _schema.ModelError
+
+
+# ------------------------------------------------------------------ model file
+
+#: as rwadist.extended.IMBALANCE_H_TOL
+IMBALANCE_H_TOL = 0.02
+
+def read_document(path):
+    """The parsed JSON document of a model file; ModelError naming the file if unreadable."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return json.load(fh)
+    except OSError as exc:
+        raise ModelError(f"model file {path!r} cannot be read: {exc.strerror or exc}") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ModelError(f"model file {path!r} is not valid JSON: {exc}") from None
+
+
+#: |Δh| within which a diagnosed amplitude law belongs to a line (as rwadist.broadband.apply_effects)
+LAW_H_TOL = 1e-3
+
+
+def laws_from_doc(doc, source="<model>"):
+    """Diagnosed amplitude laws of a model document (``effects`` entries of kind
+    ``amplitude_law``, written by ``rwadist diagnose``): {(direction, h): (A_ref, Ω_ref, p)} with
+    the line's amplitude A_ref·(|Ω|/Ω_ref)^p (N or N·m, rad/s) in place of C·Ω².  Other effect
+    kinds are not time-domain forcing the FMU models and are ignored (missing harmonics are
+    already harmonics of ``empirical``).  The effects are read (all of them) by the schema."""
+    return {(e.direction, float(e.h)): e.law for e in _schema.of_kind(doc.get("effects"), _schema.AmplitudeLaw,
+                                                                      source)}
+
+
+def effects_from_doc(doc, source="<model>"):
+    """All time-domain forcing effects of a model document (``rwadist diagnose``), validated by the
+    schema (:func:`rwadist.schema.parse_effects`), as keyword arguments of :class:`WheelRuntime`:
+
+    * ``laws``: :func:`laws_from_doc`;
+    * ``resonances``: [(directions, f_r Hz, ζ, peak_gain)] of each ``fixed_resonance`` of role
+      ``wheel_mode`` (an unmodelled wheel mode): every component of every line of those directions
+      is multiplied by H(ν/2π) = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r), r = ν/(2π f_r) signed, at
+      its instantaneous whirl rate ν = σ(hΩ + 2π f_offset) -- QUASI-STATIC (exact at constant speed,
+      no ringing of that resonance in transients).  Role ``test_stand`` (a fixture resonance) is a
+      measurement artefact: left out, as are ``cross_coupling`` (load-cell offset) entries;
+    * ``sidebands``: [(direction, h, f_mod Hz, depth m)]: the matching lines (|Δh| < LAW_H_TOL) are
+      amplitude modulated, a(1 + m·cos 2πf_mod t) = the carrier + two lines of amplitude m·a/2 whose
+      phases advance by ±2πf_mod·t (exact in the time domain).
+
+    * ``floors``: [(channel index, f knots Hz, psd_ref knots unit²/Hz, Ω_ref rad/s, p)] of each
+      ``broadband_floor`` (one entry per channel it names): a blocked-load PSD
+      S(f, Ω) = psd_ref(f)·(|Ω|/Ω_ref)^p (linear between knots, 0 outside), added to the wheel-frame
+      output as a random-phase multisine (see :class:`WheelRuntime`);
+    * ``ripples``: [(ΔΩ_ref rad/s, Ω_ref rad/s, q, f_r Hz)] of the ``speed_ripple`` (at most one): the wheel
+      turns at Ω(t) + ΔΩ_ref·(|Ω|/Ω_ref)^q·sin(2π f_r t + θ) (see :class:`WheelRuntime`).
+
+    ModelError naming ``effects[i].<field>`` on a bad entry."""
+    effects = _schema.parse_effects(doc.get("effects"), source)
+    out = {"laws": laws_from_doc({"effects": effects}, source), "resonances": [], "sidebands": [], "floors": [],
+           "ripples": []}
+    for e in effects:
+        if isinstance(e, _schema.FixedResonance) and e.role == "wheel_mode":
+            out["resonances"].append((e.directions, *e.resonance))
+        elif isinstance(e, _schema.Sidebands):
+            out["sidebands"].append((e.direction, float(e.h), float(e.f_mod_Hz), float(e.depth)))
+        elif isinstance(e, _schema.BroadbandFloor):
+            out["floors"].extend(_floor_from_entry(e))
+        elif isinstance(e, _schema.SpeedRipple):
+            out["ripples"].append((float(e.delta_omega_rad_s), float(e.omega_ref_rad_s), float(e.speed_exponent),
+                                   float(e.f_ripple_Hz)))
+    return out
+
+
+def _floor_from_entry(e):
+    """[(channel index, f knots, psd knots, Ω_ref, p)] of one (typed, validated) ``broadband_floor``; a
+    channel named twice has one floor (as the coupling kit reads it)."""
+    return [(c, np.array(e.f_Hz), np.array(e.psd_ref), float(e.omega_ref_rad_s), float(e.exponent))
+            for c in e.channel_indices]
+
+
+def load_model(path):
+    """(params dict, lines) from a model file of schema rwadist.model v1.
+
+    lines: list of (direction, h, C, sense, imbalance) in the order of
+    ``rwadist.extended.lines_from_model``: the static and dynamic imbalance first (U_s, U_d of
+    the analytical section), then every empirical harmonic per direction except the radial
+    h = 1 ones.  ModelError naming the file and field on any problem."""
+    return model_from_doc(read_document(path), str(path))
+
+
+def _num(v, where):
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ModelError(f"{where}: must be a finite number, got {v!r}")
+    return float(v)
+
+
+def model_from_doc(doc, source="<model>"):
+    """Validated (params, lines) of a parsed model document (see :func:`load_model`)."""
+    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
+        raise ModelError(f"{source}: schema: not an rwadist model file")
+    if doc.get("schema_version") != SCHEMA_VERSION:
+        raise ModelError(f"{source}: schema_version: file has version {doc.get('schema_version')!r}; "
+                         f"this FMU reads version {SCHEMA_VERSION} only")
+    an = doc.get("analytical")
+    if an is None:
+        return _empirical_only(doc, source)
+    if not isinstance(an, dict):
+        raise ModelError(f"{source}: analytical: must be an object (the extended-model parameters), "
+                         f"got {type(an).__name__}")
+    if an.get("kind", ANALYTICAL_KIND) != ANALYTICAL_KIND:
+        raise ModelError(f"{source}: analytical.kind: {an.get('kind')!r} is not {ANALYTICAL_KIND!r}")
+    p = {}
+    for name, key in PARAM_KEYS.items():
+        if key not in an:
+            raise ModelError(f"{source}: analytical.{key}: missing")
+        p[name] = _num(an[key], f"{source}: analytical.{key}")
+    for name in ("mass", "I_zz", "I_rr", "k_r", "k_rock", "k_z"):
+        if p[name] <= 0:
+            raise ModelError(f"{source}: analytical.{PARAM_KEYS[name]}: must be > 0, got {p[name]!r}")
+    for name in ("c_r", "c_rock", "c_z", "U_s", "U_d"):
+        if p[name] < 0:
+            raise ModelError(f"{source}: analytical.{PARAM_KEYS[name]}: must be >= 0, got {p[name]!r}")
+    if p["I_zz"] > 2.0 * p["I_rr"] * (1 + 1e-12):
+        raise ModelError(f"{source}: analytical: I_zz exceeds 2·I_rr (no rigid body has that)")
+    for m, c, k, what in ((p["mass"], p["c_r"], p["k_r"], "radial"), (p["I_rr"], p["c_rock"], p["k_rock"], "rocking"),
+                          (p["mass"], p["c_z"], p["k_z"], "axial")):
+        if c / (2.0 * math.sqrt(k * m)) >= 1.0:
+            raise ModelError(f"{source}: analytical: the {what} mode is overdamped")
+    p["suspension"] = True
+    p["modes_assumed"] = _modes_assumed(an, source)
+    lines = [("radial_force", 1.0, p["U_s"], "co", True), ("radial_torque", 1.0, p["U_d"], "co", True)]
+    for d, h, C, sense, fundamental in _harmonics(doc, source):
+        if not fundamental:        # the imbalances U_s, U_d above replace the co-rotating radial fundamentals
+            lines.append((d, h, C, sense, False))
+    return p, lines
+
+
+def _modes_assumed(an, source):
+    """``analytical.modes_assumed`` (default false): the suspension modes are assumed, not measured."""
+    v = an.get("modes_assumed", False)
+    if not isinstance(v, bool):
+        raise ModelError(f"{source}: analytical.modes_assumed: must be true or false, got {v!r}")
+    return v
+
+
+def _harmonics(doc, source):
+    """[(direction, h, C, sense, co-rotating radial fundamental?)] of the ``empirical`` section, validated."""
+    emp = doc.get("empirical") or {}
+    if not isinstance(emp, dict):
+        raise ModelError(f"{source}: empirical: must be an object keyed by direction")
+    for d in emp:
+        if d not in DIRECTIONS:
+            raise ModelError(f"{source}: empirical.{d}: unknown direction")
+    out = []
+    for d in DIRECTIONS:
+        for i, item in enumerate(emp.get(d) or []):
+            where = f"{source}: empirical.{d}[{i}]"
+            if not isinstance(item, dict):
+                raise ModelError(f"{where}: must be an object")
+            h, C = _num(item.get("h"), where + ".h"), _num(item.get("C"), where + ".C")
+            if h <= 0 or C < 0:
+                raise ModelError(f"{where}: needs h > 0 and C >= 0, got h={h!r}, C={C!r}")
+            sense = item.get("sense")
+            if sense not in (None, "co", "counter", "planar"):
+                raise ModelError(f"{where}.sense: {sense!r}; expected co, counter or planar")
+            # the co-rotating radial fundamental is the imbalance (same rule as
+            # rwadist.extended.is_imbalance; the runtime is self-contained, a test pins the tolerance)
+            fundamental = d in ("radial_force", "radial_torque") and abs(h - 1.0) <= IMBALANCE_H_TOL \
+                and sense in (None, "co")
+            out.append((d, h, C, sense or "co", fundamental))
+    return out
+
+
+def _empirical_only(doc, source):
+    """(params, lines) of a model without an ``analytical`` section: every empirical harmonic is a
+    line of amplitude C·Ω² at its own h and sense, hard-mounted (the loads measured at the
+    interface reach it directly: no suspension, torques already about the interface, height 0).
+    The co-rotating radial fundamentals are the imbalance: they keep their tangential term −i·C·Ω̇
+    (zero at constant speed) and follow the ``imbalance`` switch.  params carry
+    ``suspension`` False and no modal values (0): :class:`WheelRuntime` refuses modes on."""
+    lines = [(d, h, C, sense, fundamental) for d, h, C, sense, fundamental in _harmonics(doc, source)]
+    if not lines:
+        raise ModelError(f"{source}: empirical: no harmonics and no analytical section; the model has no lines")
+    p = {name: 0.0 for name in PARAM_KEYS}
+    p["suspension"] = False
+    p["modes_assumed"] = False
+    return p, lines
+
+
+def physics_of(params, lines, effects=None) -> str:
+    """One sentence saying which physics a model carries (for the FMU's description and logs)."""
+    if not params.get("suspension", True):
+        what = f"empirical harmonics only ({len(lines)} lines, amplitude C*Omega^2), hard-mounted"
+    elif params.get("modes_assumed"):
+        what = ("extended model with ASSUMED suspension modes (datasheet wheel; hard-mounted unless "
+                "modes = true)")
+    else:
+        what = "extended model: harmonics through the measured suspension modes"
+    kinds = [k for k, v in (effects or {}).items() if v]
+    names = {"laws": "amplitude laws", "resonances": "wheel-mode resonances", "sidebands": "sidebands",
+             "floors": "broadband floors", "ripples": "speed ripple"}
+    if kinds:
+        what += "; diagnosed effects: " + ", ".join(names.get(k, k) for k in kinds)
+    return what
+
+
+def components(direction, sense, phase, angle=0.0):
+    """[(sigma, coef)] of a line, as ``rwadist.extended.Line.components``."""
+    if direction in ("axial_force", "axial_torque") or sense == "co":
+        return [(1, cmath.exp(1j * phase))]
+    if sense == "counter":
+        return [(-1, cmath.exp(-1j * phase))]
+    return [(1, 0.5 * cmath.exp(1j * (angle + phase))), (-1, 0.5 * cmath.exp(1j * (angle - phase)))]
+
+
+def rotation_check(R, tol=1e-6):
+    """ModelError unless R (3×3) is a proper rotation (RᵀR = I within ``tol``, det > 0)."""
+    R = np.asarray(R, dtype=float).reshape(3, 3)
+    if not np.all(np.isfinite(R)):
+        raise ModelError("mounting DCM has non-finite entries")
+    err = float(np.max(np.abs(R.T @ R - np.eye(3))))
+    if err > tol or np.linalg.det(R) <= 0:
+        raise ModelError(f"mounting DCM is not a proper rotation (max |RᵀR − I| = {err:.3g}, "
+                         f"det = {np.linalg.det(R):.6g})")
+    return R
+
+
+
+def expand_lines(lines, laws=None, sidebands=None):
+    """(full, laws_used, sidebands_used): every line of the model as (direction, h, C, sense, imbalance,
+    law (A_ref, Ω_ref, p) or None, f_offset Hz) -- the model's lines with their amplitude laws
+    (|Δh| < LAW_H_TOL), then per sideband effect, per matching carrier, the +f_mod and −f_mod copies
+    (C and A_ref times depth/2); the order of ``rwadist.extended.apply_line_effects`` (the seed's
+    phases are drawn over this list).  Used by :class:`WheelRuntime` and the native FMU builder."""
+    laws = dict(laws or {})
+    laws_used, sidebands_used = set(), set()
+    full = []
+    for d, h, c, sense, is_imb in lines:
+        key = next((k for k in laws if k[0] == d and abs(k[1] - h) < LAW_H_TOL), None)
+        if key is not None:
+            laws_used.add(key)
+        full.append((d, h, c, sense, is_imb, None if key is None else tuple(laws[key]), 0.0))
+    carriers = list(full)
+    for j, (sd, shh, f_mod, m) in enumerate(sidebands or []):
+        for d, h, c, sense, is_imb, lw, _ in carriers:
+            if d == sd and abs(h - shh) < LAW_H_TOL:
+                sidebands_used.add(j)
+                lw2 = None if lw is None else (lw[0] * 0.5 * m, lw[1], lw[2])
+                for off in (f_mod, -f_mod):
+                    full.append((d, h, c * 0.5 * m, sense, is_imb, lw2, off))
+    return full, laws_used, sidebands_used
+
+
