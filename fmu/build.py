@@ -9,9 +9,12 @@ build (two FMUs whose slave modules share a name cannot load in one process), an
 Native layer (Linux x86-64, when a C compiler is found): ``native/rwadist_fmu_native.c`` is
 compiled into ``binaries/linux64/<id>.so`` in front of pythonfmu's library (renamed
 ``<id>_pythonfmu.so``).  It forwards every FMI call, turns a refused input into fmi2Error
-(pythonfmu alone reports fmi2Discard or fmi2Fatal) and carries the C step kernel the slave
-uses instead of numpy.  Without a compiler the FMU is pythonfmu's plain one: same results,
-slower steps, refused inputs reported as fmi2Discard.
+(pythonfmu alone reports fmi2Discard or fmi2Fatal), refuses the FMU-state calls with fmi2Error (the
+modelDescription says canGetAndSetFMUstate = canSerializeFMUstate = false; pythonfmu's own would save the
+variables only, not the modal and phase state) and carries the C step kernel the slave uses instead of numpy.
+Without a compiler the FMU is pythonfmu's plain one: same results, slower steps, refused inputs reported as
+fmi2Discard, and pythonfmu's own FMU-state calls (they answer fmi2OK
+and restore the variables only: a host must not roll back with them; the capability flags say false).
 """
 from __future__ import annotations
 
@@ -133,10 +136,11 @@ def model_document(model) -> dict:
 def _render(src: str, cls: str, physics: str, modes_default: bool) -> str:
     """The slave template for one build: class renamed, physics and ``modes`` start value set."""
     for name, value in (("BUILD_PHYSICS", physics), ("BUILD_MODES_DEFAULT", modes_default)):
-        lines = [ln for ln in src.splitlines() if ln.startswith(f"{name} = ")]
+        lines = [ln for ln in src.splitlines() if ln.lstrip().startswith(f"{name} = ")]
         if len(lines) != 1:
             raise RuntimeError(f"slave template lost its {name} line")
-        src = src.replace(lines[0], f"{name} = {value!r}")
+        indent = lines[0][:len(lines[0]) - len(lines[0].lstrip())]
+        src = src.replace(lines[0], f"{indent}{name} = {value!r}")
     return src.replace(TEMPLATE_CLASS, cls)
 
 

@@ -473,18 +473,24 @@ class WheelRuntime:
                                  f"{self.max_accel:.6g} rad/s²")
 
     # ------------------------------------------------------------ step
-    def step(self, omega, alpha, h):
+    def step(self, omega, alpha, h, t=None):
         """Advance one communication step from speed ``omega`` (rad/s) with acceleration ``alpha``
         (rad/s²; None: derived as the previous step's mean rate, 0 on the first step) over ``h``
-        seconds.  Returns the wheel-frame outputs at the step's end (6,).  Raises ModelError
-        (state untouched) on bad input."""
-        return np.array(self.step12(omega, alpha, h)[:6])
+        seconds.  ``t``: the step's start as time since t0 (s): the host's communication point minus its
+        start time, so the sideband, ripple and floor phases follow the host's clock; None: the end of the
+        previous step (the sum of the steps, which drifts from the host's times by rounding, ~1e-13 s over
+        2000 steps).  Returns the wheel-frame outputs at the step's end (6,).  Raises ModelError (state
+        untouched) on bad input."""
+        return np.array(self.step12(omega, alpha, h, t)[:6])
 
-    def step12(self, omega, alpha, h):
+    def step12(self, omega, alpha, h, t=None):
         """As :meth:`step`, returning the 12 outputs (wheel frame, then spacecraft frame) as a list."""
         omega, h = float(omega), float(h)
         alpha = None if alpha is None else float(alpha)
         self.check_step(omega, alpha, h)
+        t0 = self.t if t is None else float(t)
+        if not math.isfinite(t0):
+            raise ModelError(f"step start time {t0!r} s is not finite")
         if alpha is None:
             if self.prev_end is None:
                 alpha = 0.0
@@ -496,9 +502,9 @@ class WheelRuntime:
                     raise ModelError(f"derived wheel acceleration {alpha:.6g} rad/s² exceeds max_acceleration = "
                                      f"{self.max_accel:.6g} rad/s²")
         w_in, w1_in = omega, omega + alpha * h
-        t_end = self.t + h
+        t_end = t0 + h
         if self.has_ripple:      # the rotor's speed: input + ripple, linear over the step
-            r0 = self.ripple(omega, self.t)
+            r0 = self.ripple(omega, t0)
             alpha = alpha + (self.ripple(w1_in, t_end) - r0) / h
             omega = omega + r0
         wd0 = alpha if self.prev_alpha is None else 0.5 * (self.prev_alpha + alpha)
@@ -511,6 +517,7 @@ class WheelRuntime:
         w1 = omega + alpha * h
         if self._kernel is not None:
             cfg, st, out = self._ptrs
+            self._st[1] = t0                 # the kernel's clock (its sideband phases) from the step's start
             self._kernel(cfg, st, out, omega, wd0, alpha, h)
             self._prev_start = w_in
             self.prev_alpha = alpha
@@ -619,8 +626,8 @@ class WheelRuntime:
 
     # ------------------------------------------------------------ convenience
     def run(self, t, omega, alpha="slope"):
-        """Step through a uniform profile (t, omega) as a host would; returns (n, 6) outputs with
-        row 0 the t0 outputs.  alpha: 'slope' (each step gets (Ω_{n+1} − Ω_n)/h as
+        """Step through a uniform profile (t, omega) as a host would (step n starts at n·h since t0, h the
+        mean spacing, like ``hosts.run_fmpy``); returns (n, 6) outputs with row 0 the t0 outputs.  alpha: 'slope' (each step gets (Ω_{n+1} − Ω_n)/h as
         wheel_acceleration), None (derived), or an array per sample."""
         t = np.asarray(t, dtype=float)
         w = np.asarray(omega, dtype=float)
@@ -634,5 +641,5 @@ class WheelRuntime:
         out = np.empty((t.size, 6))
         out[0] = self.outputs_now(w[0], 0.0 if acc[0] is None else acc[0])
         for n in range(t.size - 1):
-            out[n + 1] = self.step(w[n], acc[n], h)
+            out[n + 1] = self.step(w[n], acc[n], h, n * h)
         return out

@@ -5,16 +5,19 @@
  * exception as fmi2Fatal; the FMI way to refuse bad input is fmi2Error.  The Python slave calls
  * rwadist_fmu_flag_error() (through ctypes, on the calling thread) when it refuses an input; the
  * adapter then returns fmi2Error from the FMI call in progress.  Every fmi2 function is forwarded
- * to pythonfmu's library, shipped beside this one as <modelIdentifier>_pythonfmu.so.
+ * to pythonfmu's library, shipped beside this one as <modelIdentifier>_pythonfmu.so, except the FMU-state
+ * functions, refused here with fmi2Error (see fmi2GetFMUstate).
  *
  * rwadist_kernel_step() is WheelRuntime.step of fmu/runtime.py: the kernel of rwadist_kernel.h,
  * shared with the pure-C FMU (rwadist_wheel_fmu.c). */
 #define _GNU_SOURCE
 #include <dlfcn.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* ------------------------------------------------------------------ FMI 2.0 types (by value) */
@@ -110,6 +113,67 @@ static void *sym(const char *name)
         return POST(r);                                                  \
     }
 
+/* ------------------------------------------------------------------ instances' loggers (for refusals made here) */
+typedef struct Known {
+    fmi2Component c;
+    fmi2CallbackLogger logger;
+    fmi2ComponentEnvironment env;
+    char name[128];
+    struct Known *next;
+} Known;
+static Known *known;
+static pthread_mutex_t known_lock = PTHREAD_MUTEX_INITIALIZER;
+
+static void remember(fmi2Component c, const fmi2CallbackFunctions *f, fmi2String name)
+{
+    Known *k = calloc(1, sizeof *k);
+    if (!k)
+        return; /* refusals of this instance are then not logged; their status still says so */
+    k->c = c;
+    k->logger = f ? f->logger : NULL;
+    k->env = f ? f->componentEnvironment : NULL;
+    snprintf(k->name, sizeof k->name, "%s", name ? name : "");
+    pthread_mutex_lock(&known_lock);
+    k->next = known;
+    known = k;
+    pthread_mutex_unlock(&known_lock);
+}
+
+static void forget(fmi2Component c)
+{
+    pthread_mutex_lock(&known_lock);
+    for (Known **p = &known; *p; p = &(*p)->next)
+        if ((*p)->c == c) {
+            Known *k = *p;
+            *p = k->next;
+            free(k);
+            break;
+        }
+    pthread_mutex_unlock(&known_lock);
+}
+
+/* fmi2Error with ``message`` logged through instance c's logger (when it has one) */
+static fmi2Status refuse(fmi2Component c, const char *message)
+{
+    fmi2CallbackLogger logger = NULL;
+    fmi2ComponentEnvironment env = NULL;
+    char name[128] = "";
+    pthread_mutex_lock(&known_lock);
+    for (Known *k = known; k; k = k->next)
+        if (k->c == c && c) {
+            logger = k->logger;
+            env = k->env;
+            memcpy(name, k->name, sizeof name);
+            break;
+        }
+    pthread_mutex_unlock(&known_lock);
+    /* the message is the format itself (these messages hold no '%'): hosts whose logger cannot read varargs
+     * (ctypes callbacks, e.g. fmpy) still see it */
+    if (logger)
+        logger(env, name, fmi2Error, "logStatusError", message);
+    return fmi2Error;
+}
+
 EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
 EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
 
@@ -129,7 +193,10 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
         return NULL;
     }
     error_flag = 0;
-    return fn(instanceName, fmuType, guid, resourceLocation, functions, visible, loggingOn);
+    fmi2Component c = fn(instanceName, fmuType, guid, resourceLocation, functions, visible, loggingOn);
+    if (c)
+        remember(c, functions, instanceName);
+    return c;
 }
 
 EXPORT void fmi2FreeInstance(fmi2Component c)
@@ -137,6 +204,7 @@ EXPORT void fmi2FreeInstance(fmi2Component c)
     static void (*fn)(fmi2Component);
     if (!fn)
         fn = (void (*)(fmi2Component))sym("fmi2FreeInstance");
+    forget(c);
     if (fn)
         fn(c);
 }
@@ -168,15 +236,54 @@ FORWARD(fmi2Status, fmi2SetBoolean,
         adapt)
 FORWARD(fmi2Status, fmi2SetString, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]),
         (c, vr, n, v), fmi2Error, adapt)
-FORWARD(fmi2Status, fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s), fmi2Error, adapt)
-FORWARD(fmi2Status, fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate s), (c, s), fmi2Error, adapt)
-FORWARD(fmi2Status, fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate *s), (c, s), fmi2Error, adapt)
-FORWARD(fmi2Status, fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate s, size_t *n), (c, s, n), fmi2Error,
-        adapt)
-FORWARD(fmi2Status, fmi2SerializeFMUstate, (fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t n),
-        (c, s, b, n), fmi2Error, adapt)
-FORWARD(fmi2Status, fmi2DeSerializeFMUstate, (fmi2Component c, const fmi2Byte b[], size_t n, fmi2FMUstate *s),
-        (c, b, n, s), fmi2Error, adapt)
+/* FMU state is refused (the modelDescription says canGetAndSetFMUstate = canSerializeFMUstate = false):
+ * pythonfmu's own implementation saves the variables only, not the wheel's modal and phase states, so a
+ * host rolling back with it would get silently wrong results.  Nothing is forwarded. */
+#define STATE_REFUSED "the pythonfmu wheel FMU does not support FMU state (canGetAndSetFMUstate and " \
+                      "canSerializeFMUstate are false); use the native FMU (rwadist fmu build --native) to roll back"
+
+EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *s)
+{
+    if (s)
+        *s = NULL;
+    return refuse(c, "fmi2GetFMUstate: " STATE_REFUSED);
+}
+
+EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate s)
+{
+    (void)s;
+    return refuse(c, "fmi2SetFMUstate: " STATE_REFUSED);
+}
+
+EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *s)
+{
+    if (!s || !*s)
+        return fmi2OK; /* nothing was handed out: nothing to free */
+    return refuse(c, "fmi2FreeFMUstate: not a state of this FMU (it hands out none)");
+}
+
+EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t *n)
+{
+    (void)s;
+    if (n)
+        *n = 0;
+    return refuse(c, "fmi2SerializedFMUstateSize: " STATE_REFUSED);
+}
+
+EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t n)
+{
+    (void)s, (void)b, (void)n;
+    return refuse(c, "fmi2SerializeFMUstate: " STATE_REFUSED);
+}
+
+EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte b[], size_t n, fmi2FMUstate *s)
+{
+    (void)b, (void)n;
+    if (s)
+        *s = NULL;
+    return refuse(c, "fmi2DeSerializeFMUstate: " STATE_REFUSED);
+}
+
 FORWARD(fmi2Status, fmi2GetDirectionalDerivative,
         (fmi2Component c, const fmi2ValueReference u[], size_t nu, const fmi2ValueReference z[], size_t nz,
          const fmi2Real dv[], fmi2Real dz[]),

@@ -114,6 +114,7 @@ FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component c)
     const double t_host = w->mu.t_host, speed = w->mu.speed, accel = w->mu.accel;
     memset(&w->mu, 0, sizeof w->mu);
     w->mu.t_host = t_host;
+    w->mu.t_start = t_host;
     w->mu.speed = speed;
     w->mu.accel = accel;
     w->floor_warned = 0;
@@ -129,6 +130,13 @@ FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component c)
     if (isfinite(speed)) {
         const double a = w->par.use_accel ? accel : 0.0;
         outputs_now(w, speed, isfinite(a) ? a : 0.0);
+        for (int k = 0; k < 12; k++)
+            if (!isfinite(w->mu.y[k])) {
+                memset(w->mu.y, 0, sizeof w->mu.y);
+                w->mode = 4;
+                return fail(w, "initialisation failed: the outputs at the initial wheel_speed = %g rad/s are not "
+                               "finite", speed);
+            }
     }
     return fmi2OK;
 }

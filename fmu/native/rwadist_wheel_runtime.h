@@ -38,6 +38,7 @@ typedef struct {
 typedef struct {
     double speed, accel;             /* inputs */
     double t_host;                   /* host time of the next step's start */
+    double t_start;                  /* host start time (fmi2SetupExperiment), t0 */
     double t;                        /* model time since t0 (as runtime.py's self.t) */
     double prev_start, prev_alpha, prev_end_w, prev_end_h;
     int has_prev;                    /* a step has been taken (prev_* valid) */
@@ -634,6 +635,10 @@ static fmi2Status step(Wheel *w, double t_host, double h)
                                "max_acceleration = %.6g rad/s2", t_host, alpha, p->max_accel);
         }
     }
+    /* the model's clock is the host's: time since t0 from the communication point, not the sum of the steps
+     * (which drifts from it by rounding), as runtime.py's step12(..., t) */
+    mu->t = t_host - mu->t_start;
+    w->st[1] = mu->t;
     const double w_in = omega, w1_in = omega + alpha * h, t_end = mu->t + h;
     if (w->has_ripple) {
         const double r0 = ripple_at(w, omega, mu->t);
