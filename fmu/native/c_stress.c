@@ -5,11 +5,12 @@
  * replay from a saved state is bit-identical, resets it and frees it.  Every refusal must be fmi2Error; every
  * accepted step must give finite outputs.  Used by tests/test_fmu_memcheck.py and benchmarks/fmu_memory.py.
  *
- *   c_stress LIB.so GUID CYCLES [STATE [WARMUP]]
+ *   c_stress LIB.so GUID CYCLES [STATE [WARMUP [RESOURCES_URI]]]
  *
  * STATE 1 (default): the FMU supports FMU state (the native FMU); 0: it must refuse every state call with
  * fmi2Error (the pythonfmu FMU).  Prints "checks <n> failures <m>" and exits 0 only when m == 0; with WARMUP,
- * also "rss_growth_kB <g>": the resident set size at the end minus that after WARMUP cycles. */
+ * also "rss_growth_kB <g>": the resident set size at the end minus that after WARMUP cycles (-1: none).
+ * RESOURCES_URI: the fmi2Instantiate resource location (file:///.../resources; the pythonfmu FMU needs it). */
 #include <dlfcn.h>
 #include <math.h>
 #include <stdarg.h>
@@ -75,6 +76,7 @@ int main(int argc, char **argv)
     const int cycles = atoi(argv[3]);
     const int has_state = argc > 4 ? atoi(argv[4]) != 0 : 1;
     const int warmup = argc > 5 ? atoi(argv[5]) : -1;
+    const char *resources = argc > 6 ? argv[6] : "";
     long rss_warm = 0;
     void *lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
     if (!lib) {
@@ -109,9 +111,9 @@ int main(int argc, char **argv)
     for (int cycle = 0; cycle < cycles; cycle++) {
         if (cycle == warmup)
             rss_warm = rss_kb();
-        EXPECT(fmi2Instantiate("bad", fmi2CoSimulation, "not-the-guid", "", &cb, fmi2False, fmi2True) == NULL,
+        EXPECT(fmi2Instantiate("bad", fmi2CoSimulation, "not-the-guid", resources, &cb, fmi2False, fmi2True) == NULL,
                "a wrong GUID is refused");
-        fmi2Component c = fmi2Instantiate("stress", fmi2CoSimulation, argv[2], "", &cb, fmi2False, fmi2True);
+        fmi2Component c = fmi2Instantiate("stress", fmi2CoSimulation, argv[2], resources, &cb, fmi2False, fmi2True);
         if (!c) {
             fprintf(stderr, "instantiate failed\n");
             return 3;
