@@ -1,0 +1,98 @@
+"""Session-scoped generated datasets shared by the test files.
+
+The virtual test stand and the fits are deterministic for a given seed, so a dataset that several
+tests (or several files) build with the same arguments is built once per test process here.  Under
+``pytest -n 2`` each worker process builds its own copy the first time one of its tests asks.
+
+The fixtures hand out shared objects: a test must not change them.  The sample arrays of every
+dataset built here are made read-only, so a test that writes into one fails loudly instead of
+changing what the next test sees; a test that needs to edit data takes a copy (``copy_test``).
+"""
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+# rwadist is imported inside the fixtures, when a test first asks for one: collecting the suite imports
+# no more of the package than the test files themselves do
+
+#: the thesis's E-wheel steady test (§2.2.2): 120 speeds 300-2400 rpm, 3840 Hz, 8192 samples a run
+E_FULL_SPEEDS_RPM = np.linspace(300.0, 2400.0, 120)
+E_FULL = dict(sample_rate=3840.0, n_samples=8192, noise=0.01, seed=0)
+
+
+def read_only(test):
+    """Mark every sample array of ``test`` read-only (in place) and return it."""
+    for run in test.runs:
+        for x in run.signals.values():
+            x.flags.writeable = False
+    return test
+
+
+def copy_test(test):
+    """A deep, writeable copy of a shared dataset, for a test that edits its data."""
+    out = copy.deepcopy(test)
+    for run in out.runs:
+        for x in run.signals.values():
+            x.flags.writeable = True
+    return out
+
+
+@pytest.fixture(scope="session")
+def stand_steady():
+    """``stand_steady(preset_name, speeds_rpm, **simulate_steady_kwargs)`` -> a read-only ``SteadyTest``.
+
+    Memoised on its arguments for the session: two tests asking for the same preset, speeds (rpm)
+    and stand settings get the same object, built once.
+    """
+    from rwadist.presets import preset
+    from rwadist.teststand import simulate_steady
+
+    cache: dict = {}
+
+    def build(name: str, speeds_rpm, **kw):
+        key = (name, tuple(np.asarray(speeds_rpm, dtype=float).tolist()), tuple(sorted(kw.items())))
+        if key not in cache:
+            cache[key] = read_only(simulate_steady(preset(name), speeds_rpm, **kw))
+        return cache[key]
+
+    return build
+
+
+@pytest.fixture(scope="session")
+def e_full_modes_off(stand_steady):
+    """(wheel, empirical fit) of the full-size E-wheel test with the stand's modes off (issue 2 acceptance)."""
+    from rwadist.empirical import fit_empirical
+    from rwadist.presets import preset
+    from rwadist.spectra import compute_spectra
+
+    test = stand_steady("ithaco-e", E_FULL_SPEEDS_RPM, modes=False, **E_FULL)
+    return preset("ithaco-e"), fit_empirical(compute_spectra(test))
+
+
+@pytest.fixture(scope="session")
+def e_full_modes_on(stand_steady):
+    """(wheel, empirical fit) of the full-size E-wheel test with the stand's modes on (issue 2 acceptance)."""
+    from rwadist.empirical import fit_empirical
+    from rwadist.presets import preset
+    from rwadist.spectra import compute_spectra
+
+    test = stand_steady("ithaco-e", E_FULL_SPEEDS_RPM, modes=True, **E_FULL)
+    return preset("ithaco-e"), fit_empirical(compute_spectra(test))
+
+
+@pytest.fixture(scope="session")
+def e_full_extended_fit(stand_steady):
+    """(wheel, empirical fit, extended fit) of the full-size E-wheel test generated through the extended
+    model with its suspension modes (Table 4.2, height 0; issue 3 acceptance)."""
+    from rwadist.empirical import fit_empirical
+    from rwadist.extended_fit import fit_extended
+    from rwadist.presets import preset
+    from rwadist.spectra import compute_spectra
+
+    wheel = preset("ithaco-e")
+    test = stand_steady("ithaco-e", E_FULL_SPEEDS_RPM, modes=True, physics="extended", **E_FULL)
+    fit = fit_empirical(compute_spectra(test))
+    return wheel, fit, fit_extended(test, fit, wheel.mass_kg, wheel.radius_m)
