@@ -11,6 +11,8 @@ changing what the next test sees; a test that needs to edit data takes a copy (`
 from __future__ import annotations
 
 import copy
+import inspect
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -96,3 +98,42 @@ def e_full_extended_fit(stand_steady):
     test = stand_steady("ithaco-e", E_FULL_SPEEDS_RPM, modes=True, physics="extended", **E_FULL)
     fit = fit_empirical(compute_spectra(test))
     return wheel, fit, fit_extended(test, fit, wheel.mass_kg, wheel.radius_m)
+
+
+# --------------------------------------------------------------------------- order of the tests
+
+TESTS_DIR = Path(__file__).resolve().parent
+WIDE_SCOPES = ("class", "module", "package", "session")
+
+
+def _builds_shared_data(fixturedef) -> bool:
+    """A fixture of this test tree (a test file or this conftest) kept beyond one test."""
+    if fixturedef.scope not in WIDE_SCOPES:
+        return False
+    try:
+        return TESTS_DIR in Path(inspect.getfile(fixturedef.func)).resolve().parents
+    except TypeError:            # a builtin or C-level callable: not ours
+        return False
+
+
+def pytest_collection_modifyitems(config, items):
+    """The tests marked ``slow`` (full-size runs of several seconds each) first, in their order.
+
+    ``pytest -n 2`` (pytest-xdist, ``--dist load``) hands the tests out in collection order, in chunks that
+    shrink towards the end: a long test collected last keeps one worker busy while the other idles (the
+    slow sweeps of test_sweep.py and test_teststand.py sort near the end).  Handed out first, the long
+    tests overlap with the short ones.  A slow test that uses a fixture shared with its neighbours
+    (module or session scope, defined in this tree) stays where it is, so nothing is built twice in a
+    serial run either.
+
+    (Grouping the tests of a shared fixture onto one worker with ``--dist loadgroup`` would avoid a second
+    build on the other worker, but pytest-xdist 3.8 with pytest 9.2 drops the groups silently:
+    pytest-dev/pytest-xdist#1386.)
+    """
+    def stays(item) -> bool:
+        info = getattr(item, "_fixtureinfo", None)
+        shared = info is not None and any(_builds_shared_data(d) for defs in info.name2fixturedefs.values()
+                                          for d in defs)
+        return shared or item.get_closest_marker("slow") is None
+
+    items.sort(key=stays)
