@@ -64,6 +64,30 @@ def stand_steady():
 
 
 @pytest.fixture(scope="session")
+def stand_sweep():
+    """``stand_sweep(preset_name, rpm_start, rpm_end, **simulate_sweep_kwargs)`` -> a read-only ``Sweep``.
+
+    Memoised on its arguments for the session, as ``stand_steady``.
+    """
+    from rwadist.presets import preset
+    from rwadist.teststand import simulate_sweep
+
+    cache: dict = {}
+
+    def build(name: str, rpm_start: float, rpm_end: float, **kw):
+        key = (name, float(rpm_start), float(rpm_end), tuple(sorted(kw.items())))
+        if key not in cache:
+            sweep = simulate_sweep(preset(name), rpm_start, rpm_end, **kw)
+            for x in (sweep.time, sweep.tach, *sweep.signals.values()):
+                if x is not None:
+                    x.flags.writeable = False
+            cache[key] = sweep
+        return cache[key]
+
+    return build
+
+
+@pytest.fixture(scope="session")
 def e_full_modes_off(stand_steady):
     """(wheel, empirical fit) of the full-size E-wheel test with the stand's modes off (issue 2 acceptance)."""
     from rwadist.empirical import fit_empirical
