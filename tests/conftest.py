@@ -1,4 +1,4 @@
-"""Session-scoped generated datasets shared by the test files.
+"""Session-scoped generated datasets shared by the test files, and the order the tests run in.
 
 The virtual test stand and the fits are deterministic for a given seed, so a dataset that several
 tests (or several files) build with the same arguments is built once per test process here.  Under
@@ -6,11 +6,10 @@ tests (or several files) build with the same arguments is built once per test pr
 
 The fixtures hand out shared objects: a test must not change them.  The sample arrays of every
 dataset built here are made read-only, so a test that writes into one fails loudly instead of
-changing what the next test sees; a test that needs to edit data takes a copy (``copy_test``).
+changing what the next test sees; a test that edits its data builds its own.
 """
 from __future__ import annotations
 
-import copy
 import inspect
 from pathlib import Path
 
@@ -31,15 +30,6 @@ def read_only(test):
         for x in run.signals.values():
             x.flags.writeable = False
     return test
-
-
-def copy_test(test):
-    """A deep, writeable copy of a shared dataset, for a test that edits its data."""
-    out = copy.deepcopy(test)
-    for run in out.runs:
-        for x in run.signals.values():
-            x.flags.writeable = True
-    return out
 
 
 @pytest.fixture(scope="session")
