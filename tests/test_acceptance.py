@@ -1,8 +1,9 @@
 """Issue 2 acceptance on full-size datasets from the virtual test stand (marked slow; CI runs them).
 
 E wheel: 120 speeds 300-2400 rpm, 3840 Hz, 8192 samples a run, noise 1 % of the top-speed
-fundamental.  B wheel: 500-3400 rpm every 100 rpm, 1000 Hz, test-stand resonances at 300 and
-460 Hz, f_lim = 200 Hz.  Truth: thesis Tables 3.3/3.4; bin statistics: Table 3.2.
+fundamental (the datasets and their fits are session fixtures in tests/conftest.py).  B wheel:
+500-3400 rpm every 100 rpm, 1000 Hz, test-stand resonances at 300 and 460 Hz, f_lim = 200 Hz.
+Truth: thesis Tables 3.3/3.4; bin statistics: Table 3.2.
 """
 import numpy as np
 import pytest
@@ -14,15 +15,6 @@ from rwadist.spectra import compute_spectra
 from rwadist.teststand import simulate_steady
 
 pytestmark = pytest.mark.slow
-
-E_SPEEDS = np.linspace(300.0, 2400.0, 120)
-
-
-def _fit_e(modes: bool):
-    wheel = preset("ithaco-e")
-    test = simulate_steady(wheel, E_SPEEDS, sample_rate=3840.0, n_samples=8192, noise=0.01, modes=modes, seed=0)
-    return wheel, fit_empirical(compute_spectra(test))
-
 
 def _pair_up(wheel, fit, direction):
     """(true h, true C, fitted LineFit or None) for every true harmonic; plus the unmatched fits."""
@@ -40,18 +32,8 @@ def _pair_up(wheel, fit, direction):
     return pairs, extra
 
 
-@pytest.fixture(scope="module")
-def e_modes_off():
-    return _fit_e(modes=False)
-
-
-@pytest.fixture(scope="module")
-def e_modes_on():
-    return _fit_e(modes=True)
-
-
-def test_e_wheel_modes_off_every_table_3_4_harmonic(e_modes_off):
-    wheel, fit = e_modes_off
+def test_e_wheel_modes_off_every_table_3_4_harmonic(e_full_modes_off):
+    wheel, fit = e_full_modes_off
     for d in ("radial_force", "radial_torque", "axial_force"):
         pairs, extra = _pair_up(wheel, fit, d)
         for h, C, x in pairs:
@@ -65,11 +47,11 @@ def test_e_wheel_modes_off_every_table_3_4_harmonic(e_modes_off):
         h.C <= 0.05 * fit.model.harmonics("radial_torque")[0].C for h in fit.model.harmonics("axial_torque"))
 
 
-def test_e_wheel_modes_on_automatic_exclusion(e_modes_on):
+def test_e_wheel_modes_on_automatic_exclusion(e_full_modes_on):
     """Rocking whirls, radial and axial translation on: C within ±10 %; no measurement the fit
     used is amplified by more than 10 % (true gain of the stand's modes); every crossing near
     which the line was measured lies inside an excluded range."""
-    wheel, fit = e_modes_on
+    wheel, fit = e_full_modes_on
     for d in ("radial_force", "radial_torque", "axial_force"):
         pairs, _ = _pair_up(wheel, fit, d)
         chans = {"radial_force": "Fx", "radial_torque": "Tx", "axial_force": "Fz"}[d]
@@ -132,10 +114,10 @@ def test_b_wheel_band_limit_counts_as_table_3_2():
         assert not np.allclose(x.h * x.speed / (2 * np.pi), 300.0, atol=5.0)
 
 
-def test_excluded_ranges_reported_in_model_file(e_modes_on, tmp_path):
+def test_excluded_ranges_reported_in_model_file(e_full_modes_on, tmp_path):
     from rwadist import model as model_io
 
-    wheel, fit = e_modes_on
+    wheel, fit = e_full_modes_on
     path = model_io.save(fit.model, tmp_path / "m.json")
     back = model_io.load(path)
     for d in DIRECTIONS:

@@ -1,5 +1,6 @@
 """Issue 3 acceptance: fitting round trip on virtual-test-stand data generated through the
-extended model from the E-wheel parameters (Table 4.2, height 0), with noise (slow)."""
+extended model from the E-wheel parameters (Table 4.2, height 0), with noise (slow).  The dataset and its
+fits: the session fixture ``e_full_extended_fit`` (tests/conftest.py)."""
 import numpy as np
 import pytest
 
@@ -12,17 +13,8 @@ from rwadist.teststand import simulate_steady
 pytestmark = pytest.mark.slow
 
 
-@pytest.fixture(scope="module")
-def e_wheel_fit():
-    wheel = preset("ithaco-e")
-    test = simulate_steady(wheel, np.linspace(300, 2400, 120), sample_rate=3840.0, n_samples=8192, noise=0.01,
-                           modes=True, seed=0, physics="extended")
-    fit = fit_empirical(compute_spectra(test))
-    return wheel, fit, fit_extended(test, fit, wheel.mass_kg, wheel.radius_m)
-
-
-def test_parameters_recovered(e_wheel_fit):
-    wheel, _, ef = e_wheel_fit
+def test_parameters_recovered(e_full_extended_fit):
+    wheel, _, ef = e_full_extended_fit
     true, p = wheel.extended, ef.params
     print({k: f"{100 * (getattr(p, k) / getattr(true, k) - 1):+.2f} %" for k in ("k_r", "k_rock", "k_z", "U_s", "U_d")})
     assert p.k_r == pytest.approx(true.k_r, rel=0.02)
@@ -35,15 +27,15 @@ def test_parameters_recovered(e_wheel_fit):
     assert all(ef.identified.values()) and not ef.notes
 
 
-def test_senses_recovered(e_wheel_fit):
-    wheel, _, ef = e_wheel_fit
+def test_senses_recovered(e_full_extended_fit):
+    wheel, _, ef = e_full_extended_fit
     for (d, h), (sense, frac) in ef.senses.items():
         expected = wheel.senses.get((d, round(h, 2)), "co")
         assert sense == expected, (d, h, sense, frac)
 
 
-def test_extended_rms_error_3x_lower_where_modes_act(e_wheel_fit):
-    _, fit, ef = e_wheel_fit
+def test_extended_rms_error_3x_lower_where_modes_act(e_full_extended_fit):
+    _, fit, ef = e_full_extended_fit
     cmp = rms_comparison(ef, fit)
     for d, c in cmp.items():
         print(f"{d}: RMS error where modes act: empirical {100 * c['error_empirical']:.2f} %, "

@@ -35,13 +35,25 @@ def test_every_mode_found_within_2_percent_or_declared(cell):
     assert all(row[m]["found"] for m in matrix.MODES), matrix.format_row(row)
 
 
-def test_modes_no_line_reaches_are_declared_unconstrained(tmp_path):
+def test_modes_no_line_reaches_are_declared_unconstrained(tmp_path, monkeypatch):
     """300-1000 rpm: the highest line reaches 93 Hz; radial translation (228 Hz) is out of reach and the
     axial mode (70 Hz, crossed only by the weak h = 4.33 line near the top) may be too.  What is not found
     is listed in ``unconstrained`` and in the model file; the rocking whirls are crossed and found."""
+    from rwadist import empirical, extended_fit
     from rwadist import model as model_io
     from rwadist.extended_fit import to_model
 
+    # keep the fits run_cell makes, to write their model file (instead of generating and fitting again)
+    made = {}
+
+    def keeping(name, func):
+        def run(*args, **kwargs):
+            made[name] = func(*args, **kwargs)
+            return made[name]
+        return run
+
+    monkeypatch.setattr(empirical, "fit_empirical", keeping("fit", empirical.fit_empirical))
+    monkeypatch.setattr(extended_fit, "fit_extended", keeping("ef", extended_fit.fit_extended))
     cell = {"generator": "independent", "rpm": (300.0, 1000.0), "n_speeds": 30, "samples": 4096, "rate": 3840.0,
             "noise": 0.01, "seed": 5}
     row = matrix.run_cell(cell)
@@ -50,21 +62,18 @@ def test_modes_no_line_reaches_are_declared_unconstrained(tmp_path):
     assert not row["radial_translation"]["found"] and row["radial_translation"]["declared_unconstrained"]
     assert row["rocking"]["found"] and abs(row["rocking"]["error"]) < 0.02
     # the model file carries the list
-    from rwadist.empirical import fit_empirical
-    from rwadist.extended_fit import fit_extended
-    from rwadist.spectra import compute_spectra
-
-    test, _, mass, radius = matrix.generate(cell)
-    fit = fit_empirical(compute_spectra(test))
-    ef = fit_extended(test, fit, mass, radius)
+    fit, ef = made["fit"], made["ef"]
     m = model_io.load(model_io.save(to_model(ef, fit), tmp_path / "m.json"))
     assert "radial_translation" in m.analytical["unconstrained"]
     assert set(m.analytical["unconstrained"]) == set(ef.unconstrained)
 
 
 def test_per_unit_fit_without_mass_and_radius():
-    """Without mass and radius the fit is per unit mass/inertia and I_zz/I_rr comes from the whirls."""
-    cell = {"generator": "independent", "rpm": (300.0, 3000.0), "n_speeds": 40, "samples": 4096, "rate": 3840.0,
+    """Without mass and radius the fit is per unit mass/inertia and I_zz/I_rr comes from the whirls.
+    20 speeds (40 took 24 s of CPU, 20 take 2 s): every mode within 0.08 % of the truth for seeds 1-6 (0.03 %
+    with 40 speeds; tolerance 2 %); I_zz/I_rr = 2.0000 with 20, 24 and 40 speeds (tolerance 5 %; 2.0 is also
+    the top of the scan's I_zz/I_rr grid)."""
+    cell = {"generator": "independent", "rpm": (300.0, 3000.0), "n_speeds": 20, "samples": 4096, "rate": 3840.0,
             "noise": 0.01, "seed": 3}
     row = matrix.run_cell(cell, with_mass=False)
     print(matrix.format_row(row), row["inertia_ratio"])

@@ -85,11 +85,13 @@ def test_fixture_resonance_reaches_the_stand_and_meta(tmp_path, capsys):
 
 
 def test_diagnose_names_the_injected_missing_harmonic(tmp_path, capsys):
-    """End to end as a user would: simulate with an injection, diagnose against the preset, read it back."""
+    """End to end as a user would: simulate with an injection, diagnose against the preset, read it back.
+    16 speeds (24 took 8.5 s of CPU, 16 take 5.4 s): h = 0.5000 and C/C_true = 1.00002 (24 speeds: 0.5000,
+    0.99978; 12 speeds: 0.4999, 0.99995) against tolerances of 0.01 and 5 %."""
     import json
 
     data, rep = tmp_path / "d", tmp_path / "r"
-    assert main(["simulate-test", str(data), "--preset", "ithaco-e", "--speeds-rpm", "600:2400", "--n-speeds", "24",
+    assert main(["simulate-test", str(data), "--preset", "ithaco-e", "--speeds-rpm", "600:2400", "--n-speeds", "16",
                  "--sample-rate", "1920", "--samples", "4096", "--no-modes",
                  "--inject", "missing_harmonic:direction=radial_force,h=0.5,fraction=0.5"]) == 0
     assert main(["diagnose", str(data), "-o", str(rep), "--preset", "ithaco-e"]) == 0

@@ -9,8 +9,6 @@ import numpy as np
 import pytest
 
 from rwadist.data import DataError, read_steady, read_sweep
-from rwadist.presets import preset
-from rwadist.teststand import simulate_sweep
 from rwadist.units import rpm_to_rad_s
 
 FS = 25600.0  # a DAQ rate that resolves 60 pulses/rev at 2400 rpm (2.4 kHz pulse rate)
@@ -82,9 +80,8 @@ def test_missing_pulse_and_double_trigger_are_named(tmp_path, ppr, edit, what):
 
 
 @pytest.mark.parametrize("ppr", [1, 60])
-def test_sweep_speed_from_tach(tmp_path, ppr):
-    sweep = simulate_sweep(preset("ithaco-e"), rpm_start=0.0, rpm_end=2400.0, duration=20.0, sample_rate=FS,
-                           seed=2, tach=True)
+def test_sweep_speed_from_tach(tmp_path, ppr, stand_sweep):
+    sweep = stand_sweep("ithaco-e", rpm_start=0.0, rpm_end=2400.0, duration=20.0, sample_rate=FS, seed=2, tach=True)
     truth = sweep.tach
     angle = np.concatenate([[0.0], np.cumsum(0.5 * (truth[1:] + truth[:-1]) / FS)])
     path = tmp_path / "sweep.csv"

@@ -1,0 +1,175 @@
+"""Session-scoped generated datasets shared by the test files, and the order the tests run in.
+
+The virtual test stand and the fits are deterministic for a given seed, so a dataset that several
+tests (or several files) build with the same arguments is built once per test process here.  Under
+``pytest -n 2`` each worker process builds its own copy the first time one of its tests asks.
+
+The fixtures hand out shared objects: a test must not change them.  The sample arrays of every
+dataset built here are made read-only, so a test that writes into one fails loudly instead of
+changing what the next test sees; a test that edits its data builds its own.
+"""
+from __future__ import annotations
+
+import inspect
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+# rwadist is imported inside the fixtures, when a test first asks for one: collecting the suite imports
+# no more of the package than the test files themselves do
+
+#: the thesis's E-wheel steady test (§2.2.2): 120 speeds 300-2400 rpm, 3840 Hz, 8192 samples a run
+E_FULL_SPEEDS_RPM = np.linspace(300.0, 2400.0, 120)
+E_FULL = dict(sample_rate=3840.0, n_samples=8192, noise=0.01, seed=0)
+
+
+def read_only(test):
+    """Mark every sample array of ``test`` read-only (in place) and return it."""
+    for run in test.runs:
+        for x in run.signals.values():
+            x.flags.writeable = False
+    return test
+
+
+@pytest.fixture(scope="session")
+def stand_steady():
+    """``stand_steady(preset_name, speeds_rpm, **simulate_steady_kwargs)`` -> a read-only ``SteadyTest``.
+
+    Memoised on its arguments for the session: two tests asking for the same preset, speeds (rpm)
+    and stand settings get the same object, built once.
+    """
+    from rwadist.presets import preset
+    from rwadist.teststand import simulate_steady
+
+    cache: dict = {}
+
+    def build(name: str, speeds_rpm, **kw):
+        key = (name, tuple(np.asarray(speeds_rpm, dtype=float).tolist()), tuple(sorted(kw.items())))
+        if key not in cache:
+            cache[key] = read_only(simulate_steady(preset(name), speeds_rpm, **kw))
+        return cache[key]
+
+    return build
+
+
+@pytest.fixture(scope="session")
+def stand_sweep():
+    """``stand_sweep(preset_name, rpm_start, rpm_end, **simulate_sweep_kwargs)`` -> a read-only ``Sweep``.
+
+    Memoised on its arguments for the session, as ``stand_steady``.
+    """
+    from rwadist.presets import preset
+    from rwadist.teststand import simulate_sweep
+
+    cache: dict = {}
+
+    def build(name: str, rpm_start: float, rpm_end: float, **kw):
+        key = (name, float(rpm_start), float(rpm_end), tuple(sorted(kw.items())))
+        if key not in cache:
+            sweep = simulate_sweep(preset(name), rpm_start, rpm_end, **kw)
+            for x in (sweep.time, sweep.tach, *sweep.signals.values()):
+                if x is not None:
+                    x.flags.writeable = False
+            cache[key] = sweep
+        return cache[key]
+
+    return build
+
+
+@pytest.fixture(scope="session")
+def e_full_modes_off(stand_steady):
+    """(wheel, empirical fit) of the full-size E-wheel test with the stand's modes off (issue 2 acceptance)."""
+    from rwadist.empirical import fit_empirical
+    from rwadist.presets import preset
+    from rwadist.spectra import compute_spectra
+
+    test = stand_steady("ithaco-e", E_FULL_SPEEDS_RPM, modes=False, **E_FULL)
+    return preset("ithaco-e"), fit_empirical(compute_spectra(test))
+
+
+@pytest.fixture(scope="session")
+def e_full_modes_on(stand_steady):
+    """(wheel, empirical fit) of the full-size E-wheel test with the stand's modes on (issue 2 acceptance)."""
+    from rwadist.empirical import fit_empirical
+    from rwadist.presets import preset
+    from rwadist.spectra import compute_spectra
+
+    test = stand_steady("ithaco-e", E_FULL_SPEEDS_RPM, modes=True, **E_FULL)
+    return preset("ithaco-e"), fit_empirical(compute_spectra(test))
+
+
+@pytest.fixture(scope="session")
+def e_full_extended_fit(stand_steady):
+    """(wheel, empirical fit, extended fit) of the full-size E-wheel test generated through the extended
+    model with its suspension modes (Table 4.2, height 0; issue 3 acceptance)."""
+    from rwadist.empirical import fit_empirical
+    from rwadist.extended_fit import fit_extended
+    from rwadist.presets import preset
+    from rwadist.spectra import compute_spectra
+
+    wheel = preset("ithaco-e")
+    test = stand_steady("ithaco-e", E_FULL_SPEEDS_RPM, modes=True, physics="extended", **E_FULL)
+    fit = fit_empirical(compute_spectra(test))
+    return wheel, fit, fit_extended(test, fit, wheel.mass_kg, wheel.radius_m)
+
+
+# --------------------------------------------------------------------------- workers
+
+#: thread-count variables of the BLAS/OpenMP libraries numpy and scipy load
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def pytest_configure(config):
+    """``pytest -n N``: one BLAS thread per worker process (unless the caller set a count).
+
+    The workers already use every core; OpenBLAS would start one thread per core in each of them as
+    well, and the threads then wait on each other.  Measured on the 2-core machine of the README with
+    one extended fit (the per-unit cell of test_extended_fit_matrix.py, 20 speeds): 8.3 and 6.9 s wall,
+    4.8 and 4.3 s CPU with OpenBLAS's own threads; 3.6 and 3.3 s wall, 2.3 and 2.2 s CPU with one.  The
+    controller runs this before it starts the workers, which inherit the variables and read them when
+    they load numpy.
+    """
+    if getattr(config.option, "numprocesses", None):
+        for name in BLAS_THREAD_VARIABLES:
+            os.environ.setdefault(name, "1")
+
+
+# --------------------------------------------------------------------------- order of the tests
+
+TESTS_DIR = Path(__file__).resolve().parent
+WIDE_SCOPES = ("class", "module", "package", "session")
+
+
+def _builds_shared_data(fixturedef) -> bool:
+    """A fixture of this test tree (a test file or this conftest) kept beyond one test."""
+    if fixturedef.scope not in WIDE_SCOPES:
+        return False
+    try:
+        return TESTS_DIR in Path(inspect.getfile(fixturedef.func)).resolve().parents
+    except TypeError:            # a builtin or C-level callable: not ours
+        return False
+
+
+def pytest_collection_modifyitems(config, items):
+    """The tests marked ``slow`` (full-size runs of several seconds each) first, in their order.
+
+    ``pytest -n 2`` (pytest-xdist, ``--dist load``) hands the tests out in collection order, in chunks that
+    shrink towards the end: a long test collected last keeps one worker busy while the other idles (the
+    slow sweeps of test_sweep.py and test_teststand.py sort near the end).  Handed out first, the long
+    tests overlap with the short ones.  A slow test that uses a fixture shared with its neighbours
+    (module or session scope, defined in this tree) stays where it is, so nothing is built twice in a
+    serial run either.
+
+    (Grouping the tests of a shared fixture onto one worker with ``--dist loadgroup`` would avoid a second
+    build on the other worker, but pytest-xdist 3.8 with pytest 9.2 drops the groups silently:
+    pytest-dev/pytest-xdist#1386.)
+    """
+    def stays(item) -> bool:
+        info = getattr(item, "_fixtureinfo", None)
+        shared = info is not None and any(_builds_shared_data(d) for defs in info.name2fixturedefs.values()
+                                          for d in defs)
+        return shared or item.get_closest_marker("slow") is None
+
+    items.sort(key=stays)
