@@ -379,6 +379,7 @@ def cmd_convert(args) -> int:
             raise DataError(dst, "-o", f"a steady test is a directory (runs.csv + one {fmt} file per run) or an "
                             ".h5 file, not a {dst.suffix} file")
         check_output_dir(dst)
+        refuse_input_overwrite([("-o", dst, "dir")], [src])      # the folder is replaced whole
         with atomic_dataset_dir(dst) as tmp:
             data_io.write_steady(obj, tmp, fmt)
         print(f"wrote {len(obj.runs)} runs to {dst} ({fmt}, runs.csv, meta.json)")
