@@ -19,6 +19,7 @@ from .outputs import (
     atomic_dataset_dir,
     atomic_dir,
     atomic_file,
+    check_dataset_dir,
     check_output_dir,
     check_output_file,
     refuse_input_overwrite,
@@ -96,6 +97,7 @@ def cmd_simulate(args) -> int:
     if args.n_speeds and not args.speeds_rpm:
         raise DataError("--n-speeds", "value", "needs --speeds-rpm START:STOP")
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds) if args.speeds_rpm else None
+    check_dataset_dir(out, "OUT_DIR")      # before the simulation: the folder is replaced whole
     n_runs = len(speeds) if speeds is not None else 20
     if n_runs * args.samples > MAX_SAMPLES:
         raise DataError("--samples", "value", f"{args.samples} samples x {n_runs} runs: at most {MAX_SAMPLES:.3g} "
@@ -109,7 +111,7 @@ def cmd_simulate(args) -> int:
     fs = test.runs[0].sample_rate
     if assumed_note:
         test.meta["modes_assumed"] = assumed_note
-    with atomic_dataset_dir(out) as tmp:
+    with atomic_dataset_dir(out, "OUT_DIR") as tmp:
         data_io.write_steady(test, tmp)
     print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g}-{speeds.max():g} rpm, {fs:g} Hz, "
           f"{args.samples} samples each)")

@@ -244,7 +244,7 @@ def check_dataset_dir(path, flag: str = "-o") -> Path:
         other = sorted(p.name for p in path.iterdir() if not _is_dataset_entry(p, listed))
         if other:
             shown = ", ".join(other[:3]) + (f" and {len(other) - 3} more" if len(other) > 3 else "")
-            raise DataError(flag, "value", f"{str(path)!r} holds files that are not a steady-test dataset "
+            raise DataError(flag, "folder", f"{str(path)!r} holds files that are not a steady-test dataset "
                             f"({shown}); the folder is replaced whole: choose a new or dedicated folder")
     return path
 
