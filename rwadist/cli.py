@@ -249,12 +249,9 @@ def cmd_model_show(args) -> int:
             se = "" if h.C_stderr is None else repr(float(h.C_stderr))
             print(f"{d},{h.h!r},{h.C!r},{se}")
         return 0
-    print(f"model {m.name!r}  (C in SI per (rad/s)^2: kg·m for forces, kg·m² for torques)")
-    print(f"{'direction':<14} {'h':>7} {'C':>12} {'stderr':>10} {'points':>6}  excluded rpm")
-    for d, h in rows:
-        se = "" if h.C_stderr is None else f"{h.C_stderr:.2e}"
-        ex = " ".join(f"{lo:.0f}-{hi:.0f}" for lo, hi in h.excluded_rpm)
-        print(f"{d:<14} {h.h:7.3f} {h.C:12.4e} {se:>10} {h.n_points:6d}  {ex}")
+    from .effects_text import model_table
+
+    print("\n".join(model_table(m)))
     return 0
 
 
@@ -595,12 +592,9 @@ def cmd_diagnose(args) -> int:
         base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
           f"{base} base")
-    for e in diag.summary()["effects"]:
-        # key numbers only: no arrays (a floor's f_Hz knots, psd_ref), texts of laws or evidence
-        par = ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in e.items()
-                        if k not in ("kind", "evidence", "psd_ref", "channel", "whirl", "gain_law")
-                        and not isinstance(v, (list, tuple)) or k in ("directions", "unconstrained"))
-        print(f"  + {e['kind']}: {par} (held-out gain {e['evidence']['heldout_gain_fraction']:.1%})")
+    from .effects_text import diagnose_lines
+
+    print("\n".join(diagnose_lines(diag.summary()["effects"])) or "  no effect added (none passed the held-out test)")
     print(f"error ({diag.summary()['metric']}): {diag.error_before:.4g} -> {diag.error_after:.4g}")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")
     return 0
