@@ -13,6 +13,7 @@ import numpy as np
 from . import api, catalogue
 from . import data as data_io
 from . import model as model_io
+from .cli_catalogue import cmd_catalogue_list, cmd_catalogue_show, cmd_model_compare  # noqa: F401 (parser)
 from .cli_parser import _version
 from .data import DataError
 from .outputs import (
@@ -253,61 +254,6 @@ def cmd_model_show(args) -> int:
 
     print("\n".join(model_table(m)))
     return 0
-
-
-# --------------------------------------------------------------------------- catalogue
-
-def cmd_catalogue_list(args) -> int:
-    from . import catalogue
-
-    for name in catalogue.names():
-        m = catalogue.load(name)
-        n = sum(len(m.harmonics(d)) for d in model_io.DIRECTIONS)
-        src = str(m.provenance["source"])
-        print(f"{name:<20} {m.wheel.get('mass_kg', float('nan')):6.2f} kg  {n:3d} harmonics  "
-              f"{'analytical' if m.analytical else '          '}  {src[:70]}{'...' if len(src) > 70 else ''}")
-    return 0
-
-
-def cmd_catalogue_show(args) -> int:
-    from . import catalogue
-
-    m = catalogue.load(args.name)
-    print(f"{m.name}: {json.dumps(m.wheel)}")
-    print(f"source:   {m.provenance['source']}")
-    print(f"date:     {m.provenance['date']}")
-    print("measured:")
-    for k, v in m.provenance["measured"].items():
-        print(f"  {k}: {v}")
-    if m.provenance.get("datasheet_limits"):
-        print(f"datasheet limits: {json.dumps(m.provenance['datasheet_limits'])}")
-    print(f"{'direction':<14} {'h':>7} {'C (SI)':>12}  sense")
-    for d in model_io.DIRECTIONS:
-        for h in m.harmonics(d):
-            print(f"{d:<14} {h.h:7.3f} {h.C:12.4e}  {h.sense or ''}")
-    if m.analytical:
-        print("analytical: " + ", ".join(f"{k}={v:.4g}" for k, v in m.analytical.items() if isinstance(v, float)))
-    return 0
-
-
-def cmd_model_compare(args) -> int:
-    from . import catalogue
-
-    fitted = model_io.load(args.model)
-    ref = catalogue.load(args.preset)
-    res = catalogue.compare(fitted, ref)
-    print(f"{'direction':<14} {'h fit':>7} {'C fit':>11} {'h ' + args.preset:>14} {'C catalogue':>12} {'ratio':>6}")
-    for d, hf, cf, hr, cr in res["harmonics"]:
-        ratio = f"{cf / cr:6.2f}" if cf is not None and cr else "     -"
-        print(f"{d:<14} {'' if hf is None else f'{hf:7.3f}':>7} {'' if cf is None else f'{cf:11.3e}':>11} "
-              f"{'' if hr is None else f'{hr:14.3f}':>14} {'' if cr is None else f'{cr:12.3e}':>12} {ratio}")
-    flagged = False
-    for name, mine, limit, above in res["imbalance"]:
-        flagged |= above
-        mark = "  ABOVE the datasheet limit" if above else ""
-        print(f"{name}: fitted {mine if mine is None else f'{mine:.3e}'}, limit {limit if limit is None else f'{limit:.3e}'}"
-              f"{mark}")
-    return 1 if flagged else 0
 
 
 # --------------------------------------------------------------------------- demo
