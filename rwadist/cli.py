@@ -25,6 +25,7 @@ from .outputs import (
     check_output_file,
     refuse_input_overwrite,
 )
+from .progress import working
 from .units import RAD_S_TO_RPM, rpm_to_rad_s
 from .validate import (
     MAX_SAMPLES,
@@ -103,16 +104,17 @@ def cmd_simulate(args) -> int:
     if n_runs * args.samples > MAX_SAMPLES:
         raise DataError("--samples", "value", f"{args.samples} samples x {n_runs} runs: at most {MAX_SAMPLES:.3g} "
                         "samples in all; use fewer speeds or samples")
-    test = api.simulate_test(args.preset, speeds, sample_rate=args.sample_rate, n_samples=args.samples,
-                             noise=args.noise, modes=not args.no_modes, test_stand=not args.no_test_stand,
-                             seed=args.seed, physics=args.physics, inject=args.inject)
+    with working(f"rwadist simulate-test: simulating {n_runs} runs"):
+        test = api.simulate_test(args.preset, speeds, sample_rate=args.sample_rate, n_samples=args.samples,
+                                 noise=args.noise, modes=not args.no_modes, test_stand=not args.no_test_stand,
+                                 seed=args.seed, physics=args.physics, inject=args.inject)
     for e in test.meta.get("injected", []):
         print("injected " + e["kind"] + ": " + ", ".join(f"{k}={v}" for k, v in e.items() if k != "kind"))
     speeds = np.array([r.speed for r in test.runs]) * RAD_S_TO_RPM
     fs = test.runs[0].sample_rate
     if assumed_note:
         test.meta["modes_assumed"] = assumed_note
-    with atomic_dataset_dir(out, "OUT_DIR") as tmp:
+    with atomic_dataset_dir(out, "OUT_DIR") as tmp, working(f"writing {len(test.runs)} runs"):
         data_io.write_steady(test, tmp)
     print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g}-{speeds.max():g} rpm, {fs:g} Hz, "
           f"{args.samples} samples each)")
@@ -166,14 +168,14 @@ def cmd_fit(args) -> int:
     if args.extended:
         efit, model = run_extended_fit(test, fit, args)
     refuse_non_finite_model(model, "fit")
-    print(f"writing report to {report_dir} ...", flush=True)
     cum = parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm") if args.cumulative_rpm else None
     with atomic_dir(report_dir) as tmp_dir:     # the report replaces an old one only when complete
-        files = write_report(fit, tmp_dir, cumulative_speeds_rpm=cum)
+        files = write_report(fit, tmp_dir, cumulative_speeds_rpm=cum, progress=True)
         if efit is not None:
             from .report import write_extended_report
 
-            files += write_extended_report(efit, fit, tmp_dir)
+            with working("writing the extended report"):
+                files += write_extended_report(efit, fit, tmp_dir)
     _write(args.output, lambda tmp: model_io.save(model, tmp))
     n = sum(len(v) for v in fit.model.empirical.values())
     print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
@@ -269,7 +271,9 @@ def cmd_demo(args) -> int:
     speeds = np.linspace(300.0, 2400.0, args.n_speeds)
     print(f"1/4 virtual test stand: {wheel.name}, {len(speeds)} speeds 300-2400 rpm, 3840 Hz, 8192 samples, "
           "noise 1 %, wheel modes on")
-    test = simulate_steady(wheel, speeds, sample_rate=3840.0, n_samples=8192, noise=0.01, modes=True, seed=args.seed)
+    with working(f"simulating {len(speeds)} runs"):
+        test = simulate_steady(wheel, speeds, sample_rate=3840.0, n_samples=8192, noise=0.01, modes=True,
+                               seed=args.seed)
     from .hdf5 import read_hdf5, write_hdf5
 
     data_path = _write(out / "data.h5", lambda tmp: write_hdf5(test, tmp, compression="gzip", precision="float32"))
@@ -281,7 +285,7 @@ def cmd_demo(args) -> int:
     fit = run_fit(test, ns, name="demo: " + wheel.name)
     model_path = _write(out / "model.json", lambda tmp: model_io.save(fit.model, tmp))
     with atomic_dir(out / "report") as tmp_dir:
-        files = write_report(fit, tmp_dir)
+        files = write_report(fit, tmp_dir, progress=True)
     print(f"4/4 model {model_path}, report {out / 'report'} ({len(files)} files)\n")
     truth = wheel.to_model()
     print(f"{'direction':<14} {'h fit':>7} {'h true':>7} {'C fit':>11} {'C true':>11} {'err':>7}  excluded rpm")
@@ -403,9 +407,11 @@ def cmd_fmu_build(args) -> int:
     try:
         if getattr(args, "native", False):
             from rwadist.fmu.native_build import build_native_fmu
-            path = _write(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes))
+            with working("rwadist fmu build: compiling the native FMU"):
+                path = _write(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes))
         else:
-            path = _write(out, lambda tmp: build_fmu(source, tmp, assumed_modes=args.assumed_modes))
+            with working("rwadist fmu build: packaging the FMU"):
+                path = _write(out, lambda tmp: build_fmu(source, tmp, assumed_modes=args.assumed_modes))
     except ModelError as exc:
         if exc.field is not None:       # a bad model-file field: the schema's message names file and field
             raise
@@ -522,13 +528,14 @@ def cmd_diagnose(args) -> int:
         print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); the starting "
               "prediction is hard-mounted (C*omega^2); --base extended uses the assumed modes")
     try:
-        diag = api.diagnose(test, model, preset=args.preset, base=base, nperseg=args.nperseg,
-                            f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain)
+        with working("rwadist diagnose: searching the residual for effects"):
+            diag = api.diagnose(test, model, preset=args.preset, base=base, nperseg=args.nperseg,
+                                f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain)
     except DataError:
         raise
     except ValueError as exc:
         raise DataError("diagnose", "--base", str(exc)) from None
-    with atomic_dir(args.output) as tmp_dir:
+    with atomic_dir(args.output) as tmp_dir, working("writing the diagnose report"):
         files = [Path(args.output) / Path(f).name for f in write_report(diag, tmp_dir)]
     if assumed and diag.state_before.base == "extended":
         from .catalogue import write_assumed_note
@@ -641,11 +648,13 @@ def cmd_psd(args) -> int:
     env = bb.line_envelope(sources, (lo_w, hi_w), res.f)
     p_env = _write(stem.parent / (stem.name + "_envelope.csv"), lambda tmp: bb.write_envelope_csv(env, tmp))
     png = stem.parent / (stem.name + ".png")
-    figure = bb.plot_psd(res, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm")
-    _write(png, lambda tmp: figure.savefig(tmp, dpi=110))
+    with working("drawing the PSD plot"):
+        figure = bb.plot_psd(res, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm")
+        _write(png, lambda tmp: figure.savefig(tmp, dpi=110))
     rms = res.rms()
     print(f"{kind}, {res.frame} frame, {res.f.size} frequencies to {fmax:g} Hz, {time.perf_counter() - t0:.1f} s")
-    print("RMS: " + ", ".join(f"{c} {v:.4g}" for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
+    print("RMS: " + ", ".join(f"{c} {v:.4g} {'N' if c[0] == 'F' else 'N·m'}"
+                              for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
     print(f"worst-case line envelope: {p_env}; plots: {png}")
     return 0
 

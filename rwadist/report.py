@@ -500,7 +500,8 @@ def _summary_md(fit, rows, table, top, files) -> str:
     return "\n".join(out)
 
 
-def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None = None) -> list:
+def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None = None,
+                 progress: bool = False) -> list:
     """Write the validation report of ``fit`` to ``out_dir``; return the paths written.
 
     Files: ``waterfall_<ch>.png`` per channel, ``rms_vs_speed_<direction>.png`` and
@@ -508,8 +509,11 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
     per direction with fitted lines, ``harmonics.csv``, ``rms_vs_speed.csv``, ``bins.csv``,
     ``excluded_ranges.csv`` and ``summary.md``.  ``cumulative_speeds_rpm``: speeds of the
     cumulative-RMS panels (nearest runs), default low, middle and top speed.  ``f_max``: upper
-    band edge, Hz (default and ceiling: the spectra's band limit).
+    band edge, Hz (default and ceiling: the spectra's band limit).  ``progress``: a bar on stderr
+    over the figures and tables.
     """
+    from .progress import steps
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     sp, model = fit.spectra, fit.model
@@ -518,16 +522,20 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
     # RMS values still integrate the whole band
     view = content_top(sp, fit.lines) if f_max is None else top
     files = []
-    for ch in sp.channels:
-        if not has_signal(sp, ch):
-            continue
-        fig, _ = plot_waterfall(sp, ch, model=model, f_max=view, lines=fit.lines)
-        files.append(_save(fig, out / f"waterfall_{ch}.png"))
+    channels = [ch for ch in sp.channels if has_signal(sp, ch)]
     directions = [d for d in DIRECTION_CHANNELS if any(has_signal(sp, ch) for ch in DIRECTION_CHANNELS[d])]
     speeds = default_speeds_rpm(sp) if cumulative_speeds_rpm is None else [float(s) for s in cumulative_speeds_rpm]
+    fitted = [d for d in DIRECTION_CHANNELS if any(ln.direction == d for ln in fit.lines)]
+    bar = steps(len(channels) + len(directions) * (2 if speeds else 1) + len(fitted) + 1, "writing the report",
+                progress, unit="file")
+    for ch in channels:
+        fig, _ = plot_waterfall(sp, ch, model=model, f_max=view, lines=fit.lines)
+        files.append(_save(fig, out / f"waterfall_{ch}.png"))
+        bar.update()
     for d in directions:
         fig, _ = plot_rms_vs_speed(sp, model, d, f_max=top)
         files.append(_save(fig, out / f"rms_vs_speed_{d}.png"))
+        bar.update()
         if speeds:
             fig = _new_figure((4.6 * len(speeds) + 0.4, 7.0))
             axes = fig.subplots(2, len(speeds), sharex="col", squeeze=False)
@@ -535,10 +543,11 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
                 plot_cumulative_rms(sp, model, d, s, axes=(axes[0, k], axes[1, k]), f_max=view)
             fig.suptitle(f"{_direction_label(d)}: amplitude spectra and cumulative RMS, data vs model")
             files.append(_save(fig, out / f"cumulative_rms_{d}.png"))
-    for d in DIRECTION_CHANNELS:
-        if any(ln.direction == d for ln in fit.lines):
-            fig, _ = plot_coefficients(fit.lines, d)
-            files.append(_save(fig, out / f"coefficients_{d}.png"))
+            bar.update()
+    for d in fitted:
+        fig, _ = plot_coefficients(fit.lines, d)
+        files.append(_save(fig, out / f"coefficients_{d}.png"))
+        bar.update()
 
     rows = harmonic_rows(fit)
     files.append(_write_csv(out / "harmonics.csv", HARMONICS_COLUMNS, rows))
@@ -554,6 +563,9 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
     summary = out / "summary.md"
     summary.write_text(_summary_md(fit, rows, table, top, files))
     files.append(summary)
+    bar.update()
+    bar.refresh()                  # show the completed count even when the last update came fast
+    bar.close()
     return files
 
 

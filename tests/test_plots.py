@@ -119,8 +119,12 @@ def test_direction_without_model_has_no_model_artists(fit):
     _no_empty_axes(fig)
 
 
-def test_report_leaves_out_all_zero_channels(fit, tmp_path):
-    files = {p.name for p in report.write_report(fit, tmp_path)}
+def test_report_leaves_out_all_zero_channels_with_progress_over_every_file(fit, tmp_path, capsys):
+    written = report.write_report(fit, tmp_path, progress=True)
+    err = capsys.readouterr().err
+    n_figures = sum(1 for p in written if p.suffix == ".png")
+    assert "writing the report" in err and f"{n_figures + 1}/{n_figures + 1}" in err   # figures, then tables
+    files = {p.name for p in written}
     assert "waterfall_Tz.png" not in files and "waterfall_Fx.png" in files
     assert not any("axial_torque" in name for name in files)
     summary = (tmp_path / "summary.md").read_text()
@@ -188,3 +192,4 @@ def test_residual_waterfall_zoomed_to_the_lines():
     top = tops.pop()
     assert top < 0.5 * band_top                        # the E wheel's lines end near 230 Hz, Nyquist 1920
     assert top >= _top_line_hz(model, "radial_force")
+
