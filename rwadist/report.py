@@ -586,10 +586,10 @@ def plot_extended_rms(comparison: dict, direction: str, ax=None):
     if shade.any():
         ax.fill_between(rpm, 0, 1, where=shade, transform=ax.get_xaxis_transform(), color="tab:red", alpha=0.08,
                         label="modes act (empirical exclusion)")
-    ax.semilogy(rpm, c["data"][order], "o", ms=3, color="k", label="data (noise floor removed)")
-    ax.semilogy(rpm, c["empirical"][order], "-", color="tab:orange",
+    ax.semilogy(rpm, c["data"][order], "o", ms=3, color="k", zorder=DATA_ZORDER, label="data (noise floor removed)")
+    ax.semilogy(rpm, c["empirical"][order], "-", color="tab:orange", zorder=MODEL_ZORDER,
                 label=f"empirical model (error in modes {100 * c['error_empirical']:.1f} %)")
-    ax.semilogy(rpm, c["extended"][order], "-", color="tab:blue",
+    ax.semilogy(rpm, c["extended"][order], "-", color="tab:blue", zorder=MODEL_ZORDER,
                 label=f"extended model (error in modes {100 * c['error_extended']:.1f} %)")
     ax.set_xlabel("Wheel speed |Ω| (rpm)")
     ax.set_ylabel(f"RMS ({_direction_unit(direction)})")
@@ -622,17 +622,18 @@ def plot_extended_lines(efit, direction: str, fig=None):
         c_total = float(np.sqrt(sum(p.C**2 for p in parts)))
         rpm = w * RAD_S_TO_RPM
         sel = np.asarray(x.channel) == ch
-        ax.plot(np.abs(x.speed[sel]) * RAD_S_TO_RPM, x.amplitude[sel], ".", ms=3, color="k", label=f"data {ch}")
-        ax.plot(rpm, model_amp, "-", color="tab:blue", label="extended model")
-        ax.plot(rpm, c_total * w**2, "--", color="tab:orange", label="C·Ω² (hard-mounted)")
+        ax.plot(np.abs(x.speed[sel]) * RAD_S_TO_RPM, x.amplitude[sel], "o", ms=3, color="k", zorder=DATA_ZORDER,
+                label=f"data {ch}")
+        ax.plot(rpm, model_amp, "-", color="tab:blue", zorder=MODEL_ZORDER, label="extended model")
+        ax.plot(rpm, c_total * w**2, "--", color="tab:orange", zorder=MODEL_ZORDER, label="C·Ω² (hard-mounted)")
         ax.set_yscale("log")
         sense = "+".join(p.sense for p in parts)
         ax.set_title(f"h = {x.h:.2f} ({sense})", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         if i % cols == 0:
-            ax.set_ylabel(f"amplitude ({_direction_unit(direction)})")
+            ax.set_ylabel(f"Amplitude ({_direction_unit(direction)})")
         if i >= n - cols:
-            ax.set_xlabel("|Ω| (rpm)")
+            ax.set_xlabel("Wheel speed |Ω| (rpm)")
     fig.axes[0].legend(fontsize=7)
     fig.suptitle(f"{_direction_label(direction)}: line amplitudes, data vs extended model")
     return fig

@@ -193,3 +193,17 @@ def test_residual_waterfall_zoomed_to_the_lines():
     assert top < 0.5 * band_top                        # the E wheel's lines end near 230 Hz, Nyquist 1920
     assert top >= _top_line_hz(model, "radial_force")
 
+
+
+def test_extended_rms_data_over_both_models():
+    rpm = np.linspace(300.0, 2400.0, 12)
+    comparison = {"radial_force": {"speed_rpm": rpm, "in_modes": rpm > 1500.0, "data": 1e-8 * rpm ** 2,
+                                   "empirical": 1.1e-8 * rpm ** 2, "extended": 0.9e-8 * rpm ** 2,
+                                   "error_empirical": 0.1, "error_extended": 0.05}}
+    fig, ax = report.plot_extended_rms(comparison, "radial_force")
+    data = [ln for ln in ax.lines if ln.get_label().startswith("data")]
+    models = [ln for ln in ax.lines if "model" in ln.get_label()]
+    assert len(data) == 1 and len(models) == 2
+    assert data[0].get_zorder() > max(m.get_zorder() for m in models)
+    assert ax.get_ylabel() == "RMS (N)"
+    _legend_artists_are_drawn(fig)

@@ -168,14 +168,17 @@ def write_report(diag: Diagnosis, out_dir) -> list:
           f"- error before: {diag.error_before:.4g}", f"- error after: {diag.error_after:.4g}",
           f"- RMS-vs-speed relative error before / after: {diag.rms_error_before:.4g} / {diag.rms_error_after:.4g}",
           f"- iterations: {diag.iterations}", "", "## Effects added", ""]
+    from ..effects_text import describe_effect
+
     chosen = [h for h in diag.hypotheses if h.passed]
     if not chosen:
         md.append("None: nothing left in the residual passed the held-out test.")
     for h in chosen:
         par = ", ".join(f"{k} = {_fmt(v, '.5g')}"
                         for k, v in h.effect.params().items() if not (isinstance(v, list) and len(v) > 4))
-        md.append(f"- **{h.effect.kind}** ({par}): held-out gain {h.gain_fraction:.1%} of the unexplained "
-                  f"power, {h.t:.1f} noise standard errors")
+        words = describe_effect({"kind": h.effect.kind, **h.effect.params()})
+        md.append(f"- **{words}**: held-out gain {h.gain_fraction:.1%} of the unexplained "
+                  f"power, {h.t:.1f} noise standard errors (parameters: {par})")
     md += ["", "## Hypotheses (best five per iteration)", "", "see `hypotheses.csv`", "",
            "![residual](residual_waterfall.png)", "", "![rms](rms_vs_speed.png)", ""]
     p = out / "report.md"
