@@ -548,7 +548,8 @@ def cmd_diagnose(args) -> int:
     from .effects_text import diagnose_lines
 
     print("\n".join(diagnose_lines(diag.summary()["effects"])) or "  no effect added (none passed the held-out test)")
-    print(f"error ({diag.summary()['metric']}): {diag.error_before:.4g} -> {diag.error_after:.4g}")
+    print(f"unexplained fraction of the data's power (speed x frequency): {diag.error_before:.4g} -> "
+          f"{diag.error_after:.4g} (definition: report.md)")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")
     return 0
 
