@@ -21,6 +21,8 @@ from .formats.records import DataError
 
 #: names a reader takes from a steady-test directory besides its run files
 _DATASET_INDEX_FILES = ("runs.csv", "meta.json")
+#: what `rwadist simulate-test OUT_DIR --sweep` writes: replaced with the folder by a later steady test there
+_SIMULATE_OUTPUTS = ("sweep.csv", "sweep.meta.json")
 #: extensions of files a dataset reader may read (runs, sweeps, HDF5)
 _DATA_SUFFIXES = (".csv", ".h5", ".hdf5", ".uff", ".unv", ".tdms", ".mat", ".json")
 
@@ -224,12 +226,12 @@ def _listed_runs(folder: Path) -> set:
 
 def _is_dataset_entry(p: Path, listed: set) -> bool:
     """A file a steady-test folder holds: its index files, a run file (``run*`` or listed in
-    ``runs.csv``), or a writer's hidden leftover temporary."""
+    ``runs.csv``), a sweep simulate-test wrote there, or a writer's hidden leftover temporary."""
     if p.name.startswith("."):
         return True
     if not p.is_file():
         return False
-    return p.name in _DATASET_INDEX_FILES or p.name in listed or (
+    return p.name in _DATASET_INDEX_FILES or p.name in listed or p.name in _SIMULATE_OUTPUTS or (
         p.name.lower().startswith("run") and p.suffix.lower() in _DATA_SUFFIXES)
 
 
