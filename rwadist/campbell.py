@@ -85,6 +85,8 @@ def plot_campbell(params: ext.ExtendedParams, speeds_rpm, lines=None):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from .plot_util import spread_labels
+
     s = _speeds(speeds_rpm)
     grid = np.linspace(s.min(), s.max(), max(400, s.size))
     tab = campbell_table(params, grid)
@@ -96,15 +98,26 @@ def plot_campbell(params: ext.ExtendedParams, speeds_rpm, lines=None):
         color, ls = _STYLE[m]
         ax.plot(grid, tab[MODE_COLUMNS[m]], color=color, ls=ls, lw=2, label=m.replace("_", " "))
     fmax = 1.3 * max(float(np.max(tab[MODE_COLUMNS[m]])) for m in ext.MODES)
-    for h in sorted({ln.h for ln in lines}):
-        ax.plot(grid, h * np.abs(grid) / 60.0, color="0.55", lw=0.8)
-        w_end = float(np.abs(grid).max())
-        x_lab, f_lab = (grid[np.argmax(np.abs(grid))], h * w_end / 60.0)
-        if f_lab > fmax:                       # label where the line leaves the plot
-            f_lab = 0.97 * fmax
-            x_lab = np.sign(x_lab) * 60.0 * f_lab / h
-        ax.annotate(f"{h:g}×", (x_lab, f_lab), fontsize=7, color="0.35", xytext=(2, 0),
-                    textcoords="offset points", va="center")
+    x_end = float(grid[np.argmax(np.abs(grid))])
+    w_end = abs(x_end)
+    harmonics = sorted({ln.h for ln in lines})
+    for h in harmonics:
+        ax.plot(grid, h * np.abs(grid) / 60.0, color="0.55", lw=0.8, zorder=1)
+    # label each harmonic line where it leaves the plot (right edge or top), labels moved
+    # apart so close harmonics (2x and 1.98x) stay readable
+    right = [h for h in harmonics if h * w_end / 60.0 <= 0.97 * fmax]
+    top = [h for h in harmonics if h * w_end / 60.0 > 0.97 * fmax]
+    y_right = spread_labels([h * w_end / 60.0 for h in right], 0.035 * fmax)
+    for h, y in zip(right, y_right):
+        ax.annotate(f"{h:g}×", (x_end, h * w_end / 60.0), xytext=(x_end, y), textcoords="data",
+                    fontsize=7, color="0.35", va="center", ha="left", annotation_clip=False)
+    span = float(np.ptp(grid)) or 1.0
+    x_top = spread_labels([60.0 * 0.97 * fmax / h for h in top], 0.045 * span)
+    for h, x in zip(top, x_top):
+        x_at = np.sign(x_end) * 60.0 * 0.97 * fmax / h
+        ax.annotate(f"{h:g}×", (x_at, 0.97 * fmax), xytext=(np.sign(x_end) * abs(x), 1.005 * fmax),
+                    textcoords="data", fontsize=7, color="0.35", ha="center", va="bottom",
+                    annotation_clip=False)
     rows = campbell_crossings(params, s, lines)
     for r in sorted(rows, key=lambda r: r["excited"]):          # excitable crossings drawn on top
         sign = -1.0 if s.max() <= 0 else 1.0
@@ -115,7 +128,8 @@ def plot_campbell(params: ext.ExtendedParams, speeds_rpm, lines=None):
     ax.set_xlim(grid.min(), grid.max())
     ax.set_xlabel("wheel speed (rpm)")
     ax.set_ylabel("frequency (Hz)")
-    ax.set_title("Campbell diagram (filled: crossing the line can excite)")
+    ax.set_title("Campbell diagram: modes (coloured) and harmonic lines h×speed (grey, labelled h×);\n"
+                 "filled marker: the crossing can excite the mode", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()

@@ -13,16 +13,19 @@ import numpy as np
 from . import api, catalogue
 from . import data as data_io
 from . import model as model_io
+from .cli_catalogue import cmd_catalogue_list, cmd_catalogue_show, cmd_model_compare  # noqa: F401 (parser)
 from .cli_parser import _version
 from .data import DataError
 from .outputs import (
     atomic_dataset_dir,
     atomic_dir,
     atomic_file,
+    check_dataset_dir,
     check_output_dir,
     check_output_file,
     refuse_input_overwrite,
 )
+from .progress import working
 from .units import RAD_S_TO_RPM, rpm_to_rad_s
 from .validate import (
     MAX_SAMPLES,
@@ -96,20 +99,22 @@ def cmd_simulate(args) -> int:
     if args.n_speeds and not args.speeds_rpm:
         raise DataError("--n-speeds", "value", "needs --speeds-rpm START:STOP")
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds) if args.speeds_rpm else None
+    check_dataset_dir(out, "OUT_DIR")      # before the simulation: the folder is replaced whole
     n_runs = len(speeds) if speeds is not None else 20
     if n_runs * args.samples > MAX_SAMPLES:
         raise DataError("--samples", "value", f"{args.samples} samples x {n_runs} runs: at most {MAX_SAMPLES:.3g} "
                         "samples in all; use fewer speeds or samples")
-    test = api.simulate_test(args.preset, speeds, sample_rate=args.sample_rate, n_samples=args.samples,
-                             noise=args.noise, modes=not args.no_modes, test_stand=not args.no_test_stand,
-                             seed=args.seed, physics=args.physics, inject=args.inject)
+    with working(f"rwadist simulate-test: simulating {n_runs} runs"):
+        test = api.simulate_test(args.preset, speeds, sample_rate=args.sample_rate, n_samples=args.samples,
+                                 noise=args.noise, modes=not args.no_modes, test_stand=not args.no_test_stand,
+                                 seed=args.seed, physics=args.physics, inject=args.inject)
     for e in test.meta.get("injected", []):
         print("injected " + e["kind"] + ": " + ", ".join(f"{k}={v}" for k, v in e.items() if k != "kind"))
     speeds = np.array([r.speed for r in test.runs]) * RAD_S_TO_RPM
     fs = test.runs[0].sample_rate
     if assumed_note:
         test.meta["modes_assumed"] = assumed_note
-    with atomic_dataset_dir(out) as tmp:
+    with atomic_dataset_dir(out, "OUT_DIR") as tmp, working(f"writing {len(test.runs)} runs"):
         data_io.write_steady(test, tmp)
     print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g}-{speeds.max():g} rpm, {fs:g} Hz, "
           f"{args.samples} samples each)")
@@ -163,14 +168,14 @@ def cmd_fit(args) -> int:
     if args.extended:
         efit, model = run_extended_fit(test, fit, args)
     refuse_non_finite_model(model, "fit")
-    print(f"writing report to {report_dir} ...", flush=True)
     cum = parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm") if args.cumulative_rpm else None
     with atomic_dir(report_dir) as tmp_dir:     # the report replaces an old one only when complete
-        files = write_report(fit, tmp_dir, cumulative_speeds_rpm=cum)
+        files = write_report(fit, tmp_dir, cumulative_speeds_rpm=cum, progress=True)
         if efit is not None:
             from .report import write_extended_report
 
-            files += write_extended_report(efit, fit, tmp_dir)
+            with working("writing the extended report"):
+                files += write_extended_report(efit, fit, tmp_dir)
     _write(args.output, lambda tmp: model_io.save(model, tmp))
     n = sum(len(v) for v in fit.model.empirical.values())
     print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
@@ -247,68 +252,10 @@ def cmd_model_show(args) -> int:
             se = "" if h.C_stderr is None else repr(float(h.C_stderr))
             print(f"{d},{h.h!r},{h.C!r},{se}")
         return 0
-    print(f"model {m.name!r}  (C in SI per (rad/s)^2: kg·m for forces, kg·m² for torques)")
-    print(f"{'direction':<14} {'h':>7} {'C':>12} {'stderr':>10} {'points':>6}  excluded rpm")
-    for d, h in rows:
-        se = "" if h.C_stderr is None else f"{h.C_stderr:.2e}"
-        ex = " ".join(f"{lo:.0f}-{hi:.0f}" for lo, hi in h.excluded_rpm)
-        print(f"{d:<14} {h.h:7.3f} {h.C:12.4e} {se:>10} {h.n_points:6d}  {ex}")
+    from .effects_text import model_table
+
+    print("\n".join(model_table(m)))
     return 0
-
-
-# --------------------------------------------------------------------------- catalogue
-
-def cmd_catalogue_list(args) -> int:
-    from . import catalogue
-
-    for name in catalogue.names():
-        m = catalogue.load(name)
-        n = sum(len(m.harmonics(d)) for d in model_io.DIRECTIONS)
-        src = str(m.provenance["source"])
-        print(f"{name:<20} {m.wheel.get('mass_kg', float('nan')):6.2f} kg  {n:3d} harmonics  "
-              f"{'analytical' if m.analytical else '          '}  {src[:70]}{'...' if len(src) > 70 else ''}")
-    return 0
-
-
-def cmd_catalogue_show(args) -> int:
-    from . import catalogue
-
-    m = catalogue.load(args.name)
-    print(f"{m.name}: {json.dumps(m.wheel)}")
-    print(f"source:   {m.provenance['source']}")
-    print(f"date:     {m.provenance['date']}")
-    print("measured:")
-    for k, v in m.provenance["measured"].items():
-        print(f"  {k}: {v}")
-    if m.provenance.get("datasheet_limits"):
-        print(f"datasheet limits: {json.dumps(m.provenance['datasheet_limits'])}")
-    print(f"{'direction':<14} {'h':>7} {'C (SI)':>12}  sense")
-    for d in model_io.DIRECTIONS:
-        for h in m.harmonics(d):
-            print(f"{d:<14} {h.h:7.3f} {h.C:12.4e}  {h.sense or ''}")
-    if m.analytical:
-        print("analytical: " + ", ".join(f"{k}={v:.4g}" for k, v in m.analytical.items() if isinstance(v, float)))
-    return 0
-
-
-def cmd_model_compare(args) -> int:
-    from . import catalogue
-
-    fitted = model_io.load(args.model)
-    ref = catalogue.load(args.preset)
-    res = catalogue.compare(fitted, ref)
-    print(f"{'direction':<14} {'h fit':>7} {'C fit':>11} {'h ' + args.preset:>14} {'C catalogue':>12} {'ratio':>6}")
-    for d, hf, cf, hr, cr in res["harmonics"]:
-        ratio = f"{cf / cr:6.2f}" if cf is not None and cr else "     -"
-        print(f"{d:<14} {'' if hf is None else f'{hf:7.3f}':>7} {'' if cf is None else f'{cf:11.3e}':>11} "
-              f"{'' if hr is None else f'{hr:14.3f}':>14} {'' if cr is None else f'{cr:12.3e}':>12} {ratio}")
-    flagged = False
-    for name, mine, limit, above in res["imbalance"]:
-        flagged |= above
-        mark = "  ABOVE the datasheet limit" if above else ""
-        print(f"{name}: fitted {mine if mine is None else f'{mine:.3e}'}, limit {limit if limit is None else f'{limit:.3e}'}"
-              f"{mark}")
-    return 1 if flagged else 0
 
 
 # --------------------------------------------------------------------------- demo
@@ -324,7 +271,9 @@ def cmd_demo(args) -> int:
     speeds = np.linspace(300.0, 2400.0, args.n_speeds)
     print(f"1/4 virtual test stand: {wheel.name}, {len(speeds)} speeds 300-2400 rpm, 3840 Hz, 8192 samples, "
           "noise 1 %, wheel modes on")
-    test = simulate_steady(wheel, speeds, sample_rate=3840.0, n_samples=8192, noise=0.01, modes=True, seed=args.seed)
+    with working(f"simulating {len(speeds)} runs"):
+        test = simulate_steady(wheel, speeds, sample_rate=3840.0, n_samples=8192, noise=0.01, modes=True,
+                               seed=args.seed)
     from .hdf5 import read_hdf5, write_hdf5
 
     data_path = _write(out / "data.h5", lambda tmp: write_hdf5(test, tmp, compression="gzip", precision="float32"))
@@ -336,7 +285,7 @@ def cmd_demo(args) -> int:
     fit = run_fit(test, ns, name="demo: " + wheel.name)
     model_path = _write(out / "model.json", lambda tmp: model_io.save(fit.model, tmp))
     with atomic_dir(out / "report") as tmp_dir:
-        files = write_report(fit, tmp_dir)
+        files = write_report(fit, tmp_dir, progress=True)
     print(f"4/4 model {model_path}, report {out / 'report'} ({len(files)} files)\n")
     truth = wheel.to_model()
     print(f"{'direction':<14} {'h fit':>7} {'h true':>7} {'C fit':>11} {'C true':>11} {'err':>7}  excluded rpm")
@@ -379,6 +328,7 @@ def cmd_convert(args) -> int:
             raise DataError(dst, "-o", f"a steady test is a directory (runs.csv + one {fmt} file per run) or an "
                             ".h5 file, not a {dst.suffix} file")
         check_output_dir(dst)
+        refuse_input_overwrite([("-o", dst, "dir")], [src])      # the folder is replaced whole
         with atomic_dataset_dir(dst) as tmp:
             data_io.write_steady(obj, tmp, fmt)
         print(f"wrote {len(obj.runs)} runs to {dst} ({fmt}, runs.csv, meta.json)")
@@ -457,9 +407,11 @@ def cmd_fmu_build(args) -> int:
     try:
         if getattr(args, "native", False):
             from rwadist.fmu.native_build import build_native_fmu
-            path = _write(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes))
+            with working("rwadist fmu build: compiling the native FMU"):
+                path = _write(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes))
         else:
-            path = _write(out, lambda tmp: build_fmu(source, tmp, assumed_modes=args.assumed_modes))
+            with working("rwadist fmu build: packaging the FMU"):
+                path = _write(out, lambda tmp: build_fmu(source, tmp, assumed_modes=args.assumed_modes))
     except ModelError as exc:
         if exc.field is not None:       # a bad model-file field: the schema's message names file and field
             raise
@@ -576,13 +528,14 @@ def cmd_diagnose(args) -> int:
         print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); the starting "
               "prediction is hard-mounted (C*omega^2); --base extended uses the assumed modes")
     try:
-        diag = api.diagnose(test, model, preset=args.preset, base=base, nperseg=args.nperseg,
-                            f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain)
+        with working("rwadist diagnose: searching the residual for effects"):
+            diag = api.diagnose(test, model, preset=args.preset, base=base, nperseg=args.nperseg,
+                                f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain)
     except DataError:
         raise
     except ValueError as exc:
         raise DataError("diagnose", "--base", str(exc)) from None
-    with atomic_dir(args.output) as tmp_dir:
+    with atomic_dir(args.output) as tmp_dir, working("writing the diagnose report"):
         files = [Path(args.output) / Path(f).name for f in write_report(diag, tmp_dir)]
     if assumed and diag.state_before.base == "extended":
         from .catalogue import write_assumed_note
@@ -592,13 +545,11 @@ def cmd_diagnose(args) -> int:
         base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
           f"{base} base")
-    for e in diag.summary()["effects"]:
-        # key numbers only: no arrays (a floor's f_Hz knots, psd_ref), texts of laws or evidence
-        par = ", ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in e.items()
-                        if k not in ("kind", "evidence", "psd_ref", "channel", "whirl", "gain_law")
-                        and not isinstance(v, (list, tuple)) or k in ("directions", "unconstrained"))
-        print(f"  + {e['kind']}: {par} (held-out gain {e['evidence']['heldout_gain_fraction']:.1%})")
-    print(f"error ({diag.summary()['metric']}): {diag.error_before:.4g} -> {diag.error_after:.4g}")
+    from .effects_text import diagnose_lines
+
+    print("\n".join(diagnose_lines(diag.summary()["effects"])) or "  no effect added (none passed the held-out test)")
+    print(f"unexplained fraction of the data's power (speed x frequency): {diag.error_before:.4g} -> "
+          f"{diag.error_after:.4g} (definition: report.md)")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")
     return 0
 
@@ -698,11 +649,13 @@ def cmd_psd(args) -> int:
     env = bb.line_envelope(sources, (lo_w, hi_w), res.f)
     p_env = _write(stem.parent / (stem.name + "_envelope.csv"), lambda tmp: bb.write_envelope_csv(env, tmp))
     png = stem.parent / (stem.name + ".png")
-    figure = bb.plot_psd(res, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm")
-    _write(png, lambda tmp: figure.savefig(tmp, dpi=110))
+    with working("drawing the PSD plot"):
+        figure = bb.plot_psd(res, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm")
+        _write(png, lambda tmp: figure.savefig(tmp, dpi=110))
     rms = res.rms()
     print(f"{kind}, {res.frame} frame, {res.f.size} frequencies to {fmax:g} Hz, {time.perf_counter() - t0:.1f} s")
-    print("RMS: " + ", ".join(f"{c} {v:.4g}" for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
+    print("RMS: " + ", ".join(f"{c} {v:.4g} {'N' if c[0] == 'F' else 'N·m'}"
+                              for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
     print(f"worst-case line envelope: {p_env}; plots: {png}")
     return 0
 

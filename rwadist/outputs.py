@@ -21,6 +21,8 @@ from .formats.records import DataError
 
 #: names a reader takes from a steady-test directory besides its run files
 _DATASET_INDEX_FILES = ("runs.csv", "meta.json")
+#: what `rwadist simulate-test OUT_DIR --sweep` writes: replaced with the folder by a later steady test there
+_SIMULATE_OUTPUTS = ("sweep.csv", "sweep.meta.json")
 #: extensions of files a dataset reader may read (runs, sweeps, HDF5)
 _DATA_SUFFIXES = (".csv", ".h5", ".hdf5", ".uff", ".unv", ".tdms", ".mat", ".json")
 
@@ -213,29 +215,50 @@ def atomic_dir(path):
         raise
 
 
-@contextmanager
-def atomic_dataset_dir(path):
-    """Yield a temporary folder for a steady-test dataset; on success each file moves into ``path`` by
-    an atomic rename, the index files (runs.csv, meta.json) last, other files already in ``path`` kept.
-    A new folder is renamed into place whole."""
+def _listed_runs(folder: Path) -> set:
+    """File names an existing ``runs.csv`` in ``folder`` lists (first column); empty when unreadable."""
+    try:
+        lines = (folder / "runs.csv").read_text(errors="replace").splitlines()[1:]
+    except OSError:
+        return set()
+    return {ln.split(",")[0].strip() for ln in lines if ln.strip()}
+
+
+def _is_dataset_entry(p: Path, listed: set) -> bool:
+    """A file a steady-test folder holds: its index files, a run file (``run*`` or listed in
+    ``runs.csv``), a sweep simulate-test wrote there, or a writer's hidden leftover temporary."""
+    if p.name.startswith("."):
+        return True
+    if not p.is_file():
+        return False
+    return p.name in _DATASET_INDEX_FILES or p.name in listed or p.name in _SIMULATE_OUTPUTS or (
+        p.name.lower().startswith("run") and p.suffix.lower() in _DATA_SUFFIXES)
+
+
+def check_dataset_dir(path, flag: str = "-o") -> Path:
+    """Refuse (:class:`DataError` naming ``flag``) a folder ``path`` that exists and holds anything but a
+    steady-test dataset: the folder is replaced whole, so other files in it would be lost."""
     path = Path(path)
     if path.exists() and not path.is_dir():
-        raise DataError(path, "output", "is a file, not a folder: give a folder for a steady test")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.parent / f".{path.name}.part-{os.getpid()}-{uuid.uuid4().hex[:8]}"
-    tmp.mkdir()
-    try:
+        raise DataError(flag, "value", f"{str(path)!r} is a file, not a folder: give a folder for a steady test")
+    if path.is_dir():
+        listed = _listed_runs(path)
+        other = sorted(p.name for p in path.iterdir() if not _is_dataset_entry(p, listed))
+        if other:
+            shown = ", ".join(other[:3]) + (f" and {len(other) - 3} more" if len(other) > 3 else "")
+            raise DataError(flag, "folder", f"{str(path)!r} holds files that are not a steady-test dataset "
+                            f"({shown}); the folder is replaced whole: choose a new or dedicated folder")
+    return path
+
+
+@contextmanager
+def atomic_dataset_dir(path, flag: str = "-o"):
+    """Yield a temporary sibling folder for a steady-test dataset (run files, ``runs.csv``,
+    ``meta.json``); on success it replaces the folder ``path`` as ONE set (:func:`atomic_dir`: an
+    atomic exchange, else two renames), never file by file, so a reader sees the old complete
+    dataset or the new complete one, never runs of one with the index of the other.  An existing
+    folder that holds anything but a dataset is refused before anything is written
+    (:func:`check_dataset_dir`)."""
+    path = check_dataset_dir(path, flag)
+    with atomic_dir(path) as tmp:
         yield tmp
-        if not path.exists():
-            os.replace(tmp, path)
-        else:
-            names = sorted(p.name for p in tmp.iterdir())
-            order = [n for n in names if n not in _DATASET_INDEX_FILES] + [
-                n for n in _DATASET_INDEX_FILES if n in names]
-            for name in order:
-                os.replace(tmp / name, path / name)
-            _remove(tmp)
-        _fsync_dir(path.parent)
-    except BaseException:
-        _remove(tmp)
-        raise

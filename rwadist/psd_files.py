@@ -73,28 +73,49 @@ def write_hdf5(res: BroadbandPSD, path, group: str = "psd") -> Path:
 
 
 def plot_psd(res: BroadbandPSD, title: str = ""):
-    """Figure (Agg canvas, no pyplot): PSDs (top, log scale) and cumulative RMS (bottom)."""
+    """Figure (Agg canvas, no pyplot): PSDs (top, log scale) and cumulative RMS (bottom).
+
+    The frequency axis ends where the PSD content ends (``plot_util.content_top``), the log
+    axis spans 80 dB below the peak, all-zero channels are left out (named in the panel's
+    title) and identical channels share one legend entry (``Fx = Fy``).
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+
+    from .plot_util import content_top, group_identical, is_empty, log_floor
 
     fig = Figure(figsize=(10, 8))
     FigureCanvasAgg(fig)
     ax1, ax2 = fig.add_subplot(2, 2, 1), fig.add_subplot(2, 2, 2)
     ax3, ax4 = fig.add_subplot(2, 2, 3), fig.add_subplot(2, 2, 4)
     psd, cum, f = res.psd, res.cumulative_rms(), res.f
-    for c, ch in enumerate(CHANNELS):
-        ax = ax1 if c < 3 else ax2
-        y = np.where(psd[:, c] > 0, psd[:, c], np.nan)
-        ax.semilogy(f, y, lw=0.8, label=ch)
-        (ax3 if c < 3 else ax4).plot(f, cum[:, c], lw=1.0, label=ch)
-    ax1.set_ylabel("PSD, N²/Hz")
-    ax2.set_ylabel("PSD, (N·m)²/Hz")
-    ax3.set_ylabel("cumulative RMS, N")
-    ax4.set_ylabel("cumulative RMS, N·m")
+    shown = [c for c in range(len(CHANNELS)) if not is_empty(psd[:, c])]
+    f_top = content_top(f, psd[:, shown]) if shown else float(f[-1])
+    groups = [(range(0, 3), ax1, ax3, "N"), (range(3, 6), ax2, ax4, "N·m")]
+    for chans, ax_p, ax_c, unit in groups:
+        live = [c for c in chans if c in shown]
+        empty = [CHANNELS[c] for c in chans if c not in shown]
+        for c, label in group_identical(psd[:, live], [CHANNELS[k] for k in live]) if live else []:
+            k = live[c]
+            ax_p.semilogy(f, np.where(psd[:, k] > 0, psd[:, k], np.nan), lw=0.8, label=label)
+            ax_c.plot(f, cum[:, k], lw=1.0, label=label)
+        if live:
+            lo = log_floor(psd[:, live])
+            if lo is not None:
+                ax_p.set_ylim(bottom=lo)
+            ax_p.legend(fontsize=8)
+            ax_c.legend(fontsize=8)
+        if not live:                       # a whole group of zeros: no empty panels
+            ax_p.set_visible(False)
+            ax_c.set_visible(False)
+        elif empty:
+            ax_p.set_title(f"zero, not shown: {', '.join(empty)}", fontsize=9)
+        ax_p.set_ylabel(f"PSD ({unit}²/Hz)" if unit == "N" else f"PSD (({unit})²/Hz)")
+        ax_c.set_ylabel(f"cumulative RMS ({unit})")
     for ax in (ax1, ax2, ax3, ax4):
-        ax.set_xlabel("frequency, Hz")
+        ax.set_xlabel("frequency (Hz)")
+        ax.set_xlim(0.0, f_top)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
     fig.suptitle(title or f"broadband disturbance PSD ({res.frame} frame)")
     fig.tight_layout()
     return fig

@@ -36,6 +36,11 @@ from .units import (
 
 _UNIT_LABEL = {"N": "N", "Nm": "N·m"}
 _DPI = 110
+# drawing order: model markers and curves under the measured data, so the data stay readable
+MODEL_ZORDER = 2.0
+DATA_ZORDER = 3.0
+# relative half-width (2σ/C) below which the C ± 2σ band would be thinner than the curve's line
+COEFFICIENT_BAND_VISIBLE = 0.02
 
 
 def _unit(channel: str) -> str:
@@ -65,6 +70,28 @@ def _save(fig: Figure, path: Path) -> Path:
 def _band_top(spectra, f_max):
     top = float(spectra.band_limit)
     return top if f_max is None else min(float(f_max), top)
+
+
+def has_signal(spectra, channel: str) -> bool:
+    """True when ``channel`` was measured in some run and is not identically zero there
+    (absent and all-zero channels are left out of the plots)."""
+    if channel not in spectra.psd:
+        return False
+    have = np.asarray(spectra.available(channel), dtype=bool)
+    if not have.any():
+        return False
+    rows = np.asarray(spectra.psd[channel])[have]
+    return bool(np.any(np.isfinite(rows) & (rows > 0)))
+
+
+def content_top(spectra, lines, f_max: float | None = None) -> float:
+    """Upper frequency (Hz) of the band that holds the harmonic content: 1.5x the highest
+    fitted line at the top speed, capped by ``f_max`` and the band limit ``f_lim``; the band
+    limit itself when there are no lines."""
+    top = _band_top(spectra, f_max)
+    w_max = float(np.max(np.abs(spectra.speed))) if len(spectra.speed) else 0.0
+    line_top = max((float(x.h) * w_max / (2 * np.pi) for x in (lines or ())), default=0.0)
+    return min(top, 1.5 * line_top) if line_top > 0 else top
 
 
 def _is_modal(line) -> np.ndarray:
@@ -132,7 +159,7 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
     y_edges = _edges(u_rpm, 50.0)
     if z.count():
         vals = z.compressed()
-        mesh = ax.pcolormesh(f_edges, y_edges, z, cmap="viridis", shading="flat",
+        mesh = ax.pcolormesh(f_edges, y_edges, z, cmap="viridis", shading="flat", zorder=1,
                              vmin=np.percentile(vals, 2), vmax=vals.max(), rasterized=True)
         fig.colorbar(mesh, ax=ax, label=f"log10 PSD ({unit}²/Hz)")
     handles = []
@@ -142,8 +169,9 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
         if f_line.size:
             yy = np.broadcast_to(u_rpm[:, None], f_line.shape)
             m = (f_line <= top) & (yy > 0)
-            handles += ax.plot(f_line[m], yy[m], "o", mfc="none", mec="white", mew=0.8, ms=4,
-                               label="model lines h·Ω")
+            # hollow rings wide enough that the measured line shows through their centre
+            handles += ax.plot(f_line[m], yy[m], "o", mfc="none", mec="white", mew=0.6, ms=8, alpha=0.85,
+                               zorder=MODEL_ZORDER, label="model lines h·Ω")
     if lines is not None:
         fx, fy = [], []
         for ln in lines:
@@ -152,7 +180,7 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
             fy.append(np.abs(ln.speed[sel]) * RAD_S_TO_RPM)
         fx = np.concatenate(fx) if fx else np.empty(0)
         if fx.size:
-            handles += ax.plot(fx, np.concatenate(fy), "x", color="red", mew=1.5, ms=6,
+            handles += ax.plot(fx, np.concatenate(fy), "x", color="red", mew=1.2, ms=5, zorder=DATA_ZORDER,
                                label="excluded (modal) measurement")
     ax.set_xlim(max(f_edges[0], 0.0), min(f_edges[-1], top))
     ax.set_ylim(max(y_edges[0], 0.0), y_edges[-1])
@@ -172,13 +200,19 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
 
 def plot_rms_vs_speed(spectra, model, direction: str, ax=None, f_max: float | None = None):
     """Data RMS of each channel of ``direction`` and the model RMS (Eq. 3.19), band-limited
-    alike, vs |speed| (rpm).  With ``ax=None`` a second panel shows model/data.
-    Returns (figure, axes) -- axes a tuple (rms, ratio) when created here.
+    alike, vs |speed| (rpm).  With ``ax=None`` and a model with harmonics in ``direction`` a
+    second panel shows model/data (no ratio panel when the model has nothing to compare).
+    Channels absent or all zero are left out.
+    Returns (figure, axes) -- axes a tuple (rms, ratio) when the ratio panel is drawn.
     """
+    has_model = len(model.harmonics(direction)) > 0
     own = ax is None
-    if own:
+    if own and has_model:
         fig = _new_figure((8.0, 6.0))
         ax_rms, ax_ratio = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
+    elif own:
+        fig = _new_figure((8.0, 4.6))
+        ax_rms, ax_ratio = fig.add_subplot(), None
     else:
         fig, ax_rms, ax_ratio = ax.figure, ax, None
     top = _band_top(spectra, f_max)
@@ -186,31 +220,32 @@ def plot_rms_vs_speed(spectra, model, direction: str, ax=None, f_max: float | No
     omega = np.asarray(spectra.speed, dtype=float)
     rpm = np.abs(rad_s_to_rpm(omega))
     model_runs = compare.model_rms_vs_speed(model, direction, omega, top)
-    has_model = len(model.harmonics(direction)) > 0
     for ch, marker in zip(DIRECTION_CHANNELS[direction], ("o", "s")):
-        if ch not in spectra.psd:
+        if not has_signal(spectra, ch):
             continue
         d = compare.data_rms(spectra, ch, top)
         ok = np.isfinite(d) & (d > 0)
-        ax_rms.plot(rpm[ok], d[ok], marker, mfc="none", label=f"data {ch}")
-        if ax_ratio is not None and has_model:
+        ax_rms.plot(rpm[ok], d[ok], marker, mfc="none", zorder=DATA_ZORDER, label=f"data {ch}")
+        if ax_ratio is not None:
             r = np.where(ok, model_runs / np.where(ok, d, 1.0), np.nan)
             ax_ratio.plot(rpm[ok & (rpm > 0)], r[ok & (rpm > 0)], marker, mfc="none", label=ch)
     if has_model and rpm.max() > 0:
         grid = np.linspace(max(rpm[rpm > 0].min(), 1.0) * 0.5, rpm.max() * 1.02, 600)
         ax_rms.plot(grid, compare.model_rms_vs_speed(model, direction, rpm_to_rad_s(grid), top), "-",
-                    color="k", label=f"model (lines ≤ {top:g} Hz)")
+                    color="k", zorder=MODEL_ZORDER, label=f"model (lines ≤ {top:g} Hz)")
     ax_rms.set_yscale("log")
     ax_rms.set_ylabel(f"RMS 0–{top:g} Hz ({unit})")
-    ax_rms.set_title(f"{_direction_label(direction)}: RMS vs wheel speed, data vs model")
+    what = "data vs model" if has_model else "data (the model has no harmonics here)"
+    ax_rms.set_title(f"{_direction_label(direction)}: RMS vs wheel speed, {what}")
     ax_rms.grid(True, which="both", alpha=0.3)
-    ax_rms.legend()
+    if ax_rms.get_legend_handles_labels()[0]:
+        ax_rms.legend()
     if ax_ratio is not None:
         ax_ratio.axhline(1.0, color="k", lw=0.8)
         ax_ratio.set_ylabel("model / data")
         ax_ratio.set_xlabel("Wheel speed |Ω| (rpm)")
         ax_ratio.grid(True, alpha=0.3)
-        if has_model:
+        if ax_ratio.get_legend_handles_labels()[0]:
             ax_ratio.legend(fontsize="small")
         return fig, (ax_rms, ax_ratio)
     ax_rms.set_xlabel("Wheel speed |Ω| (rpm)")
@@ -244,8 +279,11 @@ def plot_cumulative_rms(spectra, model, direction: str, speed_rpm: float, axes=N
                         f_max: float | None = None):
     """At the run nearest ``speed_rpm``: data amplitude spectra of the direction's channels
     with the model amplitudes C·Ω² as stems (thesis Fig. 3-13, upper panel) and the data
-    cumulative RMS (Eq. 2.13) with the model's staircase (lower panel), over [0, band].
-    ``axes`` = (upper, lower) or None.  Returns (figure, (upper, lower)).
+    cumulative RMS (Eq. 2.13) with the model's staircase (lower panel), over [0, f_max]
+    (default and ceiling: the band limit; :func:`content_top` gives the band of the lines).
+    Data are drawn over the model; absent or all-zero channels and a model without
+    harmonics in ``direction`` are left out.  ``axes`` = (upper, lower) or None.
+    Returns (figure, (upper, lower)).
     """
     if axes is None:
         fig = _new_figure((7.0, 6.5))
@@ -254,7 +292,7 @@ def plot_cumulative_rms(spectra, model, direction: str, speed_rpm: float, axes=N
         ax_a, ax_c = axes
         fig = ax_a.figure
     top = _band_top(spectra, f_max)
-    chans = [ch for ch in DIRECTION_CHANNELS[direction] if ch in spectra.psd]
+    chans = [ch for ch in DIRECTION_CHANNELS[direction] if has_signal(spectra, ch)]
     j = nearest_run(spectra, chans, speed_rpm)
     omega = float(spectra.speed[j])
     rpm = abs(omega) * RAD_S_TO_RPM
@@ -266,24 +304,27 @@ def plot_cumulative_rms(spectra, model, direction: str, speed_rpm: float, axes=N
         if not spectra.available(ch)[j]:
             continue
         floor.append(np.median(spectra.amplitude[ch][j, keep]))
-        ax_a.plot(f, spectra.amplitude[ch][j, keep], lw=0.8, label=f"data {ch}")
-        ax_c.plot(f, cumulative_rms(spectra.psd[ch][j, keep], f), lw=1.2, label=f"data {ch}")
+        ax_a.plot(f, spectra.amplitude[ch][j, keep], lw=0.8, zorder=DATA_ZORDER, label=f"data {ch}")
+        ax_c.plot(f, cumulative_rms(spectra.psd[ch][j, keep], f), lw=1.2, zorder=DATA_ZORDER, label=f"data {ch}")
+    has_model = len(model.harmonics(direction)) > 0
     f_line, var = compare.model_psd_lines(model, direction, omega)
-    m = f_line[0] <= top
+    m = f_line[0] <= top if f_line.size else np.zeros(0, dtype=bool)
     if m.any():
         amp = np.sqrt(2.0 * var[0][m])
         base = 0.5 * min(floor) if floor and min(floor) > 0 else amp.min() * 1e-2
-        ax_a.vlines(f_line[0][m], np.minimum(base, amp), amp, color="k", lw=0.8)
-        ax_a.plot(f_line[0][m], amp, "o", mfc="none", color="k", label="model C·Ω²")
-    ax_c.plot(f, compare.model_cumulative_rms(model, direction, omega, f), "k--", lw=1.2,
-              drawstyle="steps-post", label="model (staircase)")
+        ax_a.vlines(f_line[0][m], np.minimum(base, amp), amp, color="0.45", lw=0.8, zorder=MODEL_ZORDER)
+        ax_a.plot(f_line[0][m], amp, "o", mfc="none", ms=8, color="k", zorder=MODEL_ZORDER, label="model C·Ω²")
+    if has_model:
+        ax_c.plot(f, compare.model_cumulative_rms(model, direction, omega, f), "k--", lw=1.2,
+                  drawstyle="steps-post", zorder=MODEL_ZORDER, label="model (staircase)")
     ax_a.set_yscale("log")
     ax_a.set_ylabel(f"Amplitude ({unit})")
     ax_a.set_title(f"{_direction_label(direction)} at {rpm:.0f} rpm")
     ax_a.legend(fontsize="small")
     ax_a.grid(True, which="both", alpha=0.3)
     ax_c.set_xlabel("Frequency (Hz)")
-    ax_c.set_ylabel(f"Cumulative RMS ({unit})")
+    ax_c.set_ylabel(f"Cumulative RMS 0–f ({unit})")
+    ax_a.set_xlim(0, top)
     ax_c.set_xlim(0, top)
     ax_c.legend(fontsize="small", loc="lower right")
     ax_c.grid(True, alpha=0.3)
@@ -302,19 +343,25 @@ def plot_coefficient(line, ax=None, rpm_max: float | None = None):
     used = np.asarray(line.used, dtype=bool)
     for k, (lo, hi) in enumerate(line.excluded_rpm):
         ax.axvspan(lo, hi, color="tab:red", alpha=0.08, lw=0, label="excluded speed range" if k == 0 else None)
-    ax.plot(rpm[~used], line.amplitude[~used], "o", color="tab:orange", mfc="none", alpha=0.8, ms=5,
-            label="left out of C")
-    ax.plot(rpm[used], line.amplitude[used], "x", color="tab:blue", ms=5, label="used")
+    if (~used).any():
+        ax.plot(rpm[~used], line.amplitude[~used], "o", color="tab:orange", mfc="none", alpha=0.8, ms=5,
+                zorder=DATA_ZORDER, label="left out of C")
+    if used.any():
+        ax.plot(rpm[used], line.amplitude[used], "x", color="tab:blue", ms=5, zorder=DATA_ZORDER, label="used")
     top = rpm_max if rpm_max is not None else (rpm.max() * 1.05 if rpm.size else 1.0)
     g = np.linspace(0.0, top, 300)
     w2 = rpm_to_rad_s(g) ** 2
     band = 2.0 * (line.C_stderr if np.isfinite(line.C_stderr) else 0.0)
-    ax.fill_between(g, np.maximum(line.C - band, 0.0) * w2, (line.C + band) * w2, color="k", alpha=0.15,
-                    lw=0, label="C ± 2σ")
-    ax.plot(g, line.C * w2, "k-", lw=1.2, label="C·Ω²")
-    ax.plot(g, line.C_all * w2, "--", color="tab:orange", lw=1.2, label="C_all·Ω² (all points)")
+    # the 2σ band is drawn (and named in the legend) only where it is wide enough to see;
+    # the title always gives its value
+    if line.C > 0 and band / line.C >= COEFFICIENT_BAND_VISIBLE:
+        ax.fill_between(g, np.maximum(line.C - band, 0.0) * w2, (line.C + band) * w2, color="k", alpha=0.2,
+                        lw=0, zorder=MODEL_ZORDER - 0.5, label="C ± 2σ")
+    ax.plot(g, line.C * w2, "k-", lw=1.2, zorder=MODEL_ZORDER, label="C·Ω²")
+    ax.plot(g, line.C_all * w2, "--", color="tab:orange", lw=1.2, zorder=MODEL_ZORDER, label="C_all·Ω² (all points)")
     cu = DIRECTION_C_UNIT[line.direction]
-    ax.set_title(f"h = {line.h:.4g}: C = {line.C:.3g} {cu}", fontsize="medium")
+    rel = f" ± {100 * band / line.C:.2g} % (2σ)" if line.C > 0 and band > 0 else ""
+    ax.set_title(f"h = {line.h:.4g}: C = {line.C:.3g} {cu}{rel}", fontsize="medium")
     ax.set_xlim(0.0, top)
     ax.set_ylim(bottom=0.0)
     ax.grid(True, alpha=0.3)
@@ -438,15 +485,23 @@ def _summary_md(fit, rows, table, top, files) -> str:
     out += ["", "## RMS model/data (median over spinning runs)", ""]
     spin = np.abs(table["speed_rpm"]) > 0
     for key, v in table.items():
-        if key.startswith("ratio_"):
-            vals = v[spin & np.isfinite(v)]
-            med = f"{np.median(vals):.3f}" if vals.size else "n/a"
-            out.append(f"- {key[6:]}: {med}")
+        if not key.startswith("ratio_"):
+            continue
+        ch = key[6:]
+        if ch in sp.psd and not has_signal(sp, ch):
+            continue                                 # all-zero channel: left out, as in the plots
+        if ch in CHANNEL_DIRECTION and not fit.model.harmonics(CHANNEL_DIRECTION[ch]):
+            out.append(f"- {ch}: n/a (the model has no {_direction_label(CHANNEL_DIRECTION[ch])} harmonics)")
+            continue
+        vals = v[spin & np.isfinite(v)]
+        med = f"{np.median(vals):.3f}" if vals.size else "n/a"
+        out.append(f"- {ch}: {med}")
     out += ["", "## Files", ""] + [f"- `{p.name}`" for p in files] + ["- `summary.md`", ""]
     return "\n".join(out)
 
 
-def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None = None) -> list:
+def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None = None,
+                 progress: bool = False) -> list:
     """Write the validation report of ``fit`` to ``out_dir``; return the paths written.
 
     Files: ``waterfall_<ch>.png`` per channel, ``rms_vs_speed_<direction>.png`` and
@@ -454,39 +509,45 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
     per direction with fitted lines, ``harmonics.csv``, ``rms_vs_speed.csv``, ``bins.csv``,
     ``excluded_ranges.csv`` and ``summary.md``.  ``cumulative_speeds_rpm``: speeds of the
     cumulative-RMS panels (nearest runs), default low, middle and top speed.  ``f_max``: upper
-    band edge, Hz (default and ceiling: the spectra's band limit).
+    band edge, Hz (default and ceiling: the spectra's band limit).  ``progress``: a bar on stderr
+    over the figures and tables.
     """
+    from .progress import steps
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     sp, model = fit.spectra, fit.model
     top = _band_top(sp, f_max)
-    # the waterfall is drawn up to 1.5x the highest model line (where the harmonics are),
+    # frequency axes are drawn up to 1.5x the highest fitted line (where the harmonics are);
     # RMS values still integrate the whole band
-    line_top = max((x.h * float(np.max(np.abs(sp.speed))) / (2 * np.pi) for x in fit.lines), default=top)
-    view = min(top, 1.5 * line_top) if f_max is None else top
+    view = content_top(sp, fit.lines) if f_max is None else top
     files = []
-    for ch in sp.channels:
-        if not sp.available(ch).any():
-            continue
+    channels = [ch for ch in sp.channels if has_signal(sp, ch)]
+    directions = [d for d in DIRECTION_CHANNELS if any(has_signal(sp, ch) for ch in DIRECTION_CHANNELS[d])]
+    speeds = default_speeds_rpm(sp) if cumulative_speeds_rpm is None else [float(s) for s in cumulative_speeds_rpm]
+    fitted = [d for d in DIRECTION_CHANNELS if any(ln.direction == d for ln in fit.lines)]
+    bar = steps(len(channels) + len(directions) * (2 if speeds else 1) + len(fitted) + 1, "writing the report",
+                progress, unit="file")
+    for ch in channels:
         fig, _ = plot_waterfall(sp, ch, model=model, f_max=view, lines=fit.lines)
         files.append(_save(fig, out / f"waterfall_{ch}.png"))
-    directions = [d for d in DIRECTION_CHANNELS
-                  if any(ch in sp.psd and sp.available(ch).any() for ch in DIRECTION_CHANNELS[d])]
-    speeds = default_speeds_rpm(sp) if cumulative_speeds_rpm is None else [float(s) for s in cumulative_speeds_rpm]
+        bar.update()
     for d in directions:
         fig, _ = plot_rms_vs_speed(sp, model, d, f_max=top)
         files.append(_save(fig, out / f"rms_vs_speed_{d}.png"))
+        bar.update()
         if speeds:
             fig = _new_figure((4.6 * len(speeds) + 0.4, 7.0))
             axes = fig.subplots(2, len(speeds), sharex="col", squeeze=False)
             for k, s in enumerate(speeds):
-                plot_cumulative_rms(sp, model, d, s, axes=(axes[0, k], axes[1, k]), f_max=top)
+                plot_cumulative_rms(sp, model, d, s, axes=(axes[0, k], axes[1, k]), f_max=view)
             fig.suptitle(f"{_direction_label(d)}: amplitude spectra and cumulative RMS, data vs model")
             files.append(_save(fig, out / f"cumulative_rms_{d}.png"))
-    for d in DIRECTION_CHANNELS:
-        if any(ln.direction == d for ln in fit.lines):
-            fig, _ = plot_coefficients(fit.lines, d)
-            files.append(_save(fig, out / f"coefficients_{d}.png"))
+            bar.update()
+    for d in fitted:
+        fig, _ = plot_coefficients(fit.lines, d)
+        files.append(_save(fig, out / f"coefficients_{d}.png"))
+        bar.update()
 
     rows = harmonic_rows(fit)
     files.append(_write_csv(out / "harmonics.csv", HARMONICS_COLUMNS, rows))
@@ -502,6 +563,9 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
     summary = out / "summary.md"
     summary.write_text(_summary_md(fit, rows, table, top, files))
     files.append(summary)
+    bar.update()
+    bar.refresh()                  # show the completed count even when the last update came fast
+    bar.close()
     return files
 
 
@@ -522,10 +586,10 @@ def plot_extended_rms(comparison: dict, direction: str, ax=None):
     if shade.any():
         ax.fill_between(rpm, 0, 1, where=shade, transform=ax.get_xaxis_transform(), color="tab:red", alpha=0.08,
                         label="modes act (empirical exclusion)")
-    ax.semilogy(rpm, c["data"][order], "o", ms=3, color="k", label="data (noise floor removed)")
-    ax.semilogy(rpm, c["empirical"][order], "-", color="tab:orange",
+    ax.semilogy(rpm, c["data"][order], "o", ms=3, color="k", zorder=DATA_ZORDER, label="data (noise floor removed)")
+    ax.semilogy(rpm, c["empirical"][order], "-", color="tab:orange", zorder=MODEL_ZORDER,
                 label=f"empirical model (error in modes {100 * c['error_empirical']:.1f} %)")
-    ax.semilogy(rpm, c["extended"][order], "-", color="tab:blue",
+    ax.semilogy(rpm, c["extended"][order], "-", color="tab:blue", zorder=MODEL_ZORDER,
                 label=f"extended model (error in modes {100 * c['error_extended']:.1f} %)")
     ax.set_xlabel("Wheel speed |Ω| (rpm)")
     ax.set_ylabel(f"RMS ({_direction_unit(direction)})")
@@ -558,17 +622,18 @@ def plot_extended_lines(efit, direction: str, fig=None):
         c_total = float(np.sqrt(sum(p.C**2 for p in parts)))
         rpm = w * RAD_S_TO_RPM
         sel = np.asarray(x.channel) == ch
-        ax.plot(np.abs(x.speed[sel]) * RAD_S_TO_RPM, x.amplitude[sel], ".", ms=3, color="k", label=f"data {ch}")
-        ax.plot(rpm, model_amp, "-", color="tab:blue", label="extended model")
-        ax.plot(rpm, c_total * w**2, "--", color="tab:orange", label="C·Ω² (hard-mounted)")
+        ax.plot(np.abs(x.speed[sel]) * RAD_S_TO_RPM, x.amplitude[sel], "o", ms=3, color="k", zorder=DATA_ZORDER,
+                label=f"data {ch}")
+        ax.plot(rpm, model_amp, "-", color="tab:blue", zorder=MODEL_ZORDER, label="extended model")
+        ax.plot(rpm, c_total * w**2, "--", color="tab:orange", zorder=MODEL_ZORDER, label="C·Ω² (hard-mounted)")
         ax.set_yscale("log")
         sense = "+".join(p.sense for p in parts)
         ax.set_title(f"h = {x.h:.2f} ({sense})", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         if i % cols == 0:
-            ax.set_ylabel(f"amplitude ({_direction_unit(direction)})")
+            ax.set_ylabel(f"Amplitude ({_direction_unit(direction)})")
         if i >= n - cols:
-            ax.set_xlabel("|Ω| (rpm)")
+            ax.set_xlabel("Wheel speed |Ω| (rpm)")
     fig.axes[0].legend(fontsize=7)
     fig.suptitle(f"{_direction_label(direction)}: line amplitudes, data vs extended model")
     return fig

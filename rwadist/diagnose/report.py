@@ -49,17 +49,29 @@ def _write_csv(path, cols: dict):
     np.savetxt(path, arr, delimiter=",", header=",".join(names), comments="", fmt="%.8g")
 
 
+_UNIT_LABEL = {"N": "N", "Nm": "N·m"}
+
+
 def _waterfall_figure(diag: Diagnosis):
+    """Residual data/model (dB of band power) before and after, speed × frequency, per channel;
+    the frequency axis ends where the data's lines end (1.2× the highest band standing 10 dB
+    above the noise floor in any channel), not at the band limit."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from ..plot_util import content_top_above_floor, is_empty
+
     ctx = diag.ctx
     runs = ctx.runs[np.argsort(ctx.omega[ctx.runs])]
-    chans = ctx.channels
-    fig = Figure(figsize=(3.2 * len(chans), 6.4))
-    FigureCanvasAgg(fig)
     fc = ctx.band_centres()
+    data = {c: ctx.band_sums(ctx.data(diag.state_before, c)[runs]) for c in ctx.channels}
+    chans = [c for c in ctx.channels if not is_empty(data[c])]
+    tops = [t for t in (content_top_above_floor(fc, data[c]) for c in chans) if t is not None]
+    f_top = max(tops) if tops else float(fc[-1])      # noise only everywhere: the whole band
+    fig = Figure(figsize=(3.2 * max(len(chans), 1), 6.4))
+    FigureCanvasAgg(fig)
     rpm = ctx.omega[runs] * RAD_S_TO_RPM
+    im = None
     for j, c in enumerate(chans):
         for i, (tag, st) in enumerate((("before", diag.state_before), ("after", diag.state_after))):
             D = ctx.band_sums(ctx.data(st, c)[runs])
@@ -68,12 +80,15 @@ def _waterfall_figure(diag: Diagnosis):
             with np.errstate(divide="ignore", invalid="ignore"):
                 r = 10 * np.log10(np.maximum(D, 1e-300) / np.maximum(M, 1e-300))
             im = ax.pcolormesh(fc, rpm, r, cmap="RdBu_r", vmin=-10, vmax=10, shading="nearest")
-            ax.set_title(f"{c} {tag}", fontsize=9)
+            ax.set_xlim(max(float(fc[0]) - 0.5 * float(fc[1] - fc[0]), 0.0) if len(fc) > 1 else 0.0, f_top)
+            ax.set_title(f"{c}, model {tag} diagnose", fontsize=9)
             if j == 0:
-                ax.set_ylabel("speed, rpm")
+                ax.set_ylabel("Wheel speed (rpm)")
             if i == 1:
-                ax.set_xlabel("f, Hz")
-    fig.colorbar(im, ax=fig.axes, label="data / model, dB (band power)")
+                ax.set_xlabel("Frequency (Hz)")
+    if im is not None:
+        fig.colorbar(im, ax=fig.axes, label="data / model (dB of band power)")
+    fig.suptitle(f"Residual waterfall, 0–{f_top:.0f} Hz (red: data above the model)", fontsize=10)
     return fig
 
 
@@ -81,18 +96,25 @@ def _rms_figure(diag: Diagnosis, cols: dict):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from ..plot_util import is_empty
+
     ctx = diag.ctx
+    chans = [c for c in ctx.channels if not is_empty(cols[f"data_{c}_rms_{CHANNEL_UNIT[c]}"])]
     fig = Figure(figsize=(12, 6))
     FigureCanvasAgg(fig)
     order = np.argsort(cols["speed_rpm"])
-    for j, c in enumerate(ctx.channels):
-        ax = fig.add_subplot(2, 3, j + 1)
+    n_col = 3
+    n_row = max(1, int(np.ceil(len(chans) / n_col)))
+    for j, c in enumerate(chans):
+        ax = fig.add_subplot(n_row, n_col, j + 1)
         u = CHANNEL_UNIT[c]
-        for key, style, lab in ((f"data_{c}_rms_{u}", "k.", "data"), (f"model_before_{c}_rms_{u}", "C0-", "before"),
-                                (f"model_after_{c}_rms_{u}", "C3--", "after")):
-            ax.plot(cols["speed_rpm"][order], cols[key][order], style, label=lab, ms=3)
-        ax.set_title(f"{c} RMS, {u}", fontsize=9)
-        ax.set_xlabel("speed, rpm")
+        for key, style, lab, z in ((f"model_before_{c}_rms_{u}", "C0-", "model before", 2),
+                                   (f"model_after_{c}_rms_{u}", "C3--", "model after", 2),
+                                   (f"data_{c}_rms_{u}", "k.", "data", 3)):
+            ax.plot(cols["speed_rpm"][order], cols[key][order], style, label=lab, ms=3, zorder=z)
+        ax.set_title(f"{c}", fontsize=9)
+        ax.set_ylabel(f"RMS ({_UNIT_LABEL.get(u, u)})")
+        ax.set_xlabel("Wheel speed (rpm)")
         if j == 0:
             ax.legend(fontsize=8)
     fig.tight_layout()
@@ -146,14 +168,17 @@ def write_report(diag: Diagnosis, out_dir) -> list:
           f"- error before: {diag.error_before:.4g}", f"- error after: {diag.error_after:.4g}",
           f"- RMS-vs-speed relative error before / after: {diag.rms_error_before:.4g} / {diag.rms_error_after:.4g}",
           f"- iterations: {diag.iterations}", "", "## Effects added", ""]
+    from ..effects_text import describe_effect
+
     chosen = [h for h in diag.hypotheses if h.passed]
     if not chosen:
         md.append("None: nothing left in the residual passed the held-out test.")
     for h in chosen:
         par = ", ".join(f"{k} = {_fmt(v, '.5g')}"
                         for k, v in h.effect.params().items() if not (isinstance(v, list) and len(v) > 4))
-        md.append(f"- **{h.effect.kind}** ({par}): held-out gain {h.gain_fraction:.1%} of the unexplained "
-                  f"power, {h.t:.1f} noise standard errors")
+        words = describe_effect({"kind": h.effect.kind, **h.effect.params()})
+        md.append(f"- **{words}**: held-out gain {h.gain_fraction:.1%} of the unexplained "
+                  f"power, {h.t:.1f} noise standard errors (parameters: {par})")
     md += ["", "## Hypotheses (best five per iteration)", "", "see `hypotheses.csv`", "",
            "![residual](residual_waterfall.png)", "", "![rms](rms_vs_speed.png)", ""]
     p = out / "report.md"

@@ -1,0 +1,132 @@
+"""Small helpers shared by the kit's plots: the band that holds the content, the log-axis floor,
+channels that are identical or empty, and label positions that do not overlap.
+
+Plots go into design reviews, so every frequency axis ends where the content ends (not at
+Nyquist), a log axis spans a readable dynamic range instead of round-off floors, an all-zero
+channel is left out, and two identical curves get one legend entry that names both.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: dynamic range shown on a log PSD axis below the largest value (1e-8 = 80 dB)
+LOG_DYNAMIC_RANGE = 1e-8
+
+
+def content_top(f, rows, dynamic_range: float = LOG_DYNAMIC_RANGE, margin: float = 1.05) -> float:
+    """Upper edge (Hz) of the band that holds the content of ``rows``.
+
+    Parameters
+    ----------
+    f : array, shape (n_f,)
+        Frequencies, Hz, ascending.
+    rows : array, shape (n_f,) or (n_f, n_channels)
+        Non-negative spectra (PSD or amplitude) over ``f``.
+    dynamic_range : float
+        A bin holds content when it exceeds ``dynamic_range`` times the largest value.
+    margin : float
+        Factor on the highest such frequency (the result never exceeds ``f[-1]``).
+
+    Returns
+    -------
+    float
+        ``f[-1]`` when nothing is above the threshold (or the array is empty of content).
+    """
+    f = np.asarray(f, dtype=float)
+    y = np.asarray(rows, dtype=float).reshape(len(f), -1)
+    y = np.where(np.isfinite(y), y, 0.0)
+    peak = float(y.max()) if y.size else 0.0
+    if peak <= 0.0:
+        return float(f[-1])
+    hot = np.nonzero(np.any(y > dynamic_range * peak, axis=1))[0]
+    return float(min(f[-1], margin * f[hot[-1]])) if hot.size else float(f[-1])
+
+
+def log_floor(rows, dynamic_range: float = LOG_DYNAMIC_RANGE) -> float | None:
+    """Lower limit of a log axis: the smallest positive value, raised to ``dynamic_range``
+    times the largest; None when there is no positive value."""
+    y = np.asarray(rows, dtype=float)
+    y = y[np.isfinite(y) & (y > 0)]
+    if not y.size:
+        return None
+    return float(max(y.min(), dynamic_range * y.max()))
+
+
+def is_empty(values) -> bool:
+    """True when ``values`` hold no finite non-zero number (an absent or all-zero channel)."""
+    v = np.asarray(values, dtype=float)
+    return not bool(np.any(np.isfinite(v) & (v != 0.0)))
+
+
+def group_identical(columns, names, rtol: float = 1e-6) -> list:
+    """Group curves that coincide on a plot (largest difference within ``rtol`` of the larger
+    curve's peak), so one legend entry names every channel it draws.
+
+    Parameters
+    ----------
+    columns : array, shape (n, n_curves)
+    names : sequence of str, length n_curves
+
+    Returns
+    -------
+    list of (column index, label)
+        One entry per distinct curve, label ``"Fx = Fy"`` for coinciding curves.
+    """
+    c = np.asarray(columns, dtype=float)
+    out, taken = [], set()
+    for i in range(c.shape[1]):
+        if i in taken:
+            continue
+        same = [j for j in range(i, c.shape[1]) if j not in taken and _coincide(c[:, i], c[:, j], rtol)]
+        taken.update(same)
+        out.append((i, " = ".join(names[j] for j in same)))
+    return out
+
+
+def _coincide(a: np.ndarray, b: np.ndarray, rtol: float) -> bool:
+    a, b = np.nan_to_num(a), np.nan_to_num(b)
+    scale = max(float(np.max(np.abs(a), initial=0.0)), float(np.max(np.abs(b), initial=0.0)))
+    return float(np.max(np.abs(a - b), initial=0.0)) <= rtol * scale
+
+
+def spread_labels(y, min_gap: float) -> np.ndarray:
+    """Positions for labels wanted at ``y`` moved apart to at least ``min_gap`` (same units),
+    keeping their order and staying as close to ``y`` as a one-pass push-up allows."""
+    y = np.asarray(y, dtype=float)
+    order = np.argsort(y, kind="stable")
+    placed = y[order].copy()
+    for k in range(1, len(placed)):
+        placed[k] = max(placed[k], placed[k - 1] + min_gap)
+    out = np.empty_like(placed)
+    out[order] = placed
+    return out
+
+
+def content_top_above_floor(f, rows, factor: float = 10.0, margin: float = 1.2) -> float | None:
+    """Upper edge (Hz) of the band that holds lines standing above a noise floor.
+
+    Parameters
+    ----------
+    f : array, shape (n_f,)
+        Frequencies, Hz, ascending.
+    rows : array, shape (n_runs, n_f)
+        Band powers or PSDs of measured data (noise included).
+    factor : float
+        A frequency holds content when some run exceeds ``factor`` times the floor (the
+        median of all finite positive values, which noise dominates in a line spectrum).
+    margin : float
+        Factor on the highest such frequency (capped at ``f[-1]``).
+
+    Returns
+    -------
+    float or None
+        None when nothing stands above the floor (a channel of noise only).
+    """
+    f = np.asarray(f, dtype=float)
+    y = np.asarray(rows, dtype=float).reshape(-1, len(f))
+    good = np.isfinite(y) & (y > 0)
+    if not good.any():
+        return None
+    floor = float(np.median(y[good]))
+    hot = np.nonzero(np.any(good & (y > factor * floor), axis=0))[0]
+    return float(min(f[-1], margin * f[hot[-1]])) if hot.size else None

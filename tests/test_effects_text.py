@@ -1,0 +1,81 @@
+"""Each diagnosed effect on one console line with its key numbers and units (issue 14 item 8):
+`rwadist model show` lists a model file's effects, `rwadist diagnose` names what it added.  The
+numbers are read back from the printed line and compared with the file's values (converted to the
+units printed: rpm, mm)."""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from rwadist import model as model_io
+from rwadist.cli import main
+from rwadist.effects_text import describe_effect, diagnose_lines
+from rwadist.model import Harmonic, WheelModel
+from rwadist.schema import EFFECT_KINDS
+
+EFFECTS = [
+    {"kind": "missing_harmonic", "direction": "radial_force", "h": 3.5, "C": 1.25e-7},
+    {"kind": "amplitude_law", "direction": "radial_force", "h": 2.0, "exponent": 2.77, "exponent_stderr": 0.04,
+     "amplitude_ref": 0.003, "omega_ref_rad_s": 200.0},
+    {"kind": "broadband_floor", "channel": ["Fx", "Fy"], "exponent": 1.5, "omega_ref_rad_s": 250.0,
+     "f_Hz": [0.0, 40.0, 500.0], "psd_ref": [2e-9, 5e-9, 1e-9]},
+    {"kind": "fixed_resonance", "f_Hz": 180.0, "zeta": 0.02, "peak_gain": 4.5, "role": "test_stand",
+     "directions": ["radial_force", "axial_force"]},
+    {"kind": "cross_coupling", "r_m": [0.0, 0.001, -0.058]},
+    {"kind": "sidebands", "direction": "radial_force", "h": 1.0, "f_mod_Hz": 2.5, "depth": 0.12},
+    {"kind": "speed_ripple", "f_ripple_Hz": 0.7, "delta_omega_rad_s": 0.5, "omega_ref_rad_s": 150.0},
+    {"kind": "counter_rotation", "direction": "radial_force", "h": 1.0, "counter_fraction": 0.3},
+    {"kind": "spin_acceleration", "alpha_rad_s2": 0.25},
+    {"kind": "suspension_modes", "radial_translation_Hz": 227.7, "rocking_Hz": 54.9, "axial_Hz": 70.0,
+     "zeta_radial_translation": 0.01, "zeta_rocking": 0.02, "zeta_axial": 0.015, "inertia_ratio": 1.9},
+]
+
+#: per kind, numbers that must appear on its line (in the printed units)
+EXPECTED = {"missing_harmonic": ["3.5", "1.250e-07 kg·m"], "amplitude_law": ["2.77", "±0.04", "0.003 N", "1910 rpm"],
+            "broadband_floor": ["Fx Fy", "1.5", "0–500 Hz", "5e-09"], "fixed_resonance": ["test stand", "180.00 Hz",
+            "0.02", "4.5", "radial force, axial force"], "cross_coupling": ["(0.0, 1.0, -58.0) mm"],
+            "sidebands": ["±2.5 Hz", "0.12"], "speed_ripple": ["0.7 Hz", "4.77 rpm", "1432 rpm"],
+            "counter_rotation": ["q 0.3"], "spin_acceleration": ["0.25 rad/s²"],
+            "suspension_modes": ["227.7 Hz", "54.9 Hz", "70 Hz", "1.9"]}
+
+
+def test_every_known_kind_has_its_numbers_on_one_line():
+    assert set(EXPECTED) == {e["kind"] for e in EFFECTS} <= set(EFFECT_KINDS)
+    for e in EFFECTS:
+        line = describe_effect(e)
+        assert "\n" not in line and line.startswith(e["kind"].replace("_", " ") + ":")
+        for token in EXPECTED[e["kind"]]:
+            assert token in line, (token, line)
+        assert "[" not in line and "'" not in line and "_" not in line.split(":", 1)[1].replace("I_zz/I_rr", "")
+    # a kind from a newer file: its scalar fields, still one line
+    assert describe_effect({"kind": "new_thing", "f_Hz": 12.5, "knots": [1, 2]}) == "new thing: f Hz 12.5"
+
+
+def test_speed_ripple_rpm_matches_the_conversion():
+    line = describe_effect(EFFECTS[6])
+    rpm = float(re.search(r"amplitude ([\d.]+) rpm", line).group(1))
+    assert rpm == pytest.approx(0.5 * 60 / (2 * np.pi), rel=1e-3)
+
+
+def test_model_show_lists_the_effects(tmp_path, capsys):
+    m = WheelModel(name="w", empirical={"radial_force": [Harmonic(h=1.0, C=1e-6)]}, effects=list(EFFECTS))
+    path = tmp_path / "m.json"
+    model_io.save(m, path)
+    assert main(["model", "show", str(path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    at = out.index(f"effects ({len(EFFECTS)}):")
+    lines = out[at + 1:]
+    assert len(lines) == len(EFFECTS)
+    for i, (line, e) in enumerate(zip(lines, EFFECTS)):
+        assert line.startswith(f"  {i + 1}. {e['kind'].replace('_', ' ')}:")
+    model_io.save(WheelModel(name="w", empirical={"radial_force": [Harmonic(h=1.0, C=1e-6)]}), path)
+    assert main(["model", "show", str(path)]) == 0
+    assert "effects: none" in capsys.readouterr().out
+
+
+def test_diagnose_lines_carry_the_held_out_gain():
+    e = dict(EFFECTS[3], evidence={"heldout_gain_fraction": 0.118})
+    (line,) = diagnose_lines([e])
+    assert line.startswith("  + fixed resonance: test stand, 180.00 Hz") and line.endswith("(held-out gain 11.8 %)")
