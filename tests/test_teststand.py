@@ -378,13 +378,12 @@ def test_steady_round_trip_through_interchange_format(tmp_path):
     assert meta["truth"]["radial_force"][0]["C"] == pytest.approx(wheel.harmonics["radial_force"][0][1])
 
 
-def test_steady_120_runs_is_fast():
+def test_steady_120_runs_shape():
+    """The default E test: 120 runs of 8192 samples on the six channels (its speed lives in
+    benchmarks/bench_teststand.py, not in a timed unit test)."""
     wheel = preset("ithaco-e")
-    t0 = time.perf_counter()
     test = simulate_steady(wheel, wheel.default_speeds_rpm, sample_rate=3840.0, n_samples=8192)
-    elapsed = time.perf_counter() - t0
     assert len(test.runs) == 120 and test.runs[0].n_samples == 8192 and test.channels == data.CHANNELS
-    assert elapsed < 10.0, elapsed      # measured ≈ 0.7 s
 
 
 @pytest.mark.slow
