@@ -25,7 +25,10 @@ cross_coupling r_x, r_y, r_z (0, 0, -0.06 m), force_noise (0): load-cell offset,
                Fx, Fy, Fz of std force_noise·C1·Ω_max² (C1 the radial-force fundamental), after the offset
 sidebands      direction (radial_force), h (2.0), depth (0.4), f_mod_hz (7.0) or per_rev (fraction of the
                wheel speed: speed-proportional sidebands at (h ± per_rev)·Ω): the line (d, h) amplitude
-               modulated C·Ω²·(1 + depth·cos(2π f_mod t + φ)); random carrier and modulation phases
+               modulated C·Ω²·(1 + depth·cos(2π f_mod t + φ)); random carrier and modulation phases; with
+               --physics extended on h = 1 the imbalance (through the modes) is the carrier and only
+               the two sidebands are added: with per_rev two co-rotating wheel loads (depth/2)·U·Ω² at
+               (1 ± per_rev)·Ω through the modes, with f_mod C·Ω²·depth·cos(2π f_mod t + φ)·(x cos, y sin)
 speed_ripple   f_ripple_hz (8.0), delta_omega (3.0 rad/s): Ω(t) = Ω0 + ΔΩ sin(2π f t + φ) on every line
                (amplitude C·Ω(t)², phase h·∫Ω dt); --physics simple
 counter_rotation  direction (radial_force), h (1.0), fraction (0.3): that share of the line's power
@@ -158,6 +161,11 @@ def prepare_wheel(wheel, specs: list, physics: str):
         elif k in ("amplitude_law", "sidebands", "counter_rotation"):
             h, C = _harmonic(wheel, s, s["direction"], s["h"])
             s["C"] = C
+            if k == "sidebands" and physics != "simple" and _is_imbalance(s["direction"], h):
+                # the imbalance stays in the simulation (through the modes); only its two sidebands are added
+                s["C"] = getattr(wheel.extended, "U_s" if s["direction"] == "radial_force" else "U_d")
+                s["sidebands_only"] = True
+                continue
             if physics != "simple" and _is_imbalance(s["direction"], h) and k != "counter_rotation":
                 raise DataError("--inject", "h", f"{k}: with --physics extended the radial h = 1 lines are the "
                                 "rotor's imbalances; pick another h or --physics simple")
@@ -182,12 +190,12 @@ def _add_line(run, direction, amp, phase, sense=1.0):
         run.signals[chans[1]] = run.signals[chans[1]] + sense * amp * np.sin(phase)
 
 
-def _add_modal_counter_line(run, params, direction, h, C, phase):
-    """A counter-rotating wheel load C·Ω² e^{−i(hφ + phase)} of ``direction`` through the suspension modes of
-    ``params`` (:func:`rwadist.extended.steady_lines`, the run's signed speed): every channel it reaches."""
+def _add_modal_line(run, params, direction, h, C, phase, sense="counter"):
+    """A wheel load C·Ω² e^{±i(hφ + phase)} (``sense`` co or counter) of ``direction`` through the suspension
+    modes of ``params`` (:func:`rwadist.extended.steady_lines`, the run's signed speed): every channel it reaches."""
     from . import extended as ext
 
-    f, A = ext.steady_lines(params, [ext.Line(direction, float(h), float(C), "counter")], [run.speed])
+    f, A = ext.steady_lines(params, [ext.Line(direction, float(h), float(C), sense)], [run.speed])
     if f[0, 0] >= 0.5 * run.sample_rate:
         return
     t = np.arange(run.n_samples) / run.sample_rate
@@ -214,7 +222,7 @@ def apply(test, wheel, specs: list, seed: int = 0, clean=None, physics: str = "s
             t = np.arange(r.n_samples) / r.sample_rate
             w = abs(r.speed)
             if k == "counter_rotation" and physics != "simple":
-                _add_modal_counter_line(r, wheel.extended, s["direction"], s["h"], s["C"] * math.sqrt(s["fraction"]),
+                _add_modal_line(r, wheel.extended, s["direction"], s["h"], s["C"] * math.sqrt(s["fraction"]),
                                         rng.uniform(0, 2 * np.pi))
             elif k in ("missing_harmonic", "amplitude_law", "counter_rotation"):
                 if k == "missing_harmonic":
@@ -225,9 +233,15 @@ def apply(test, wheel, specs: list, seed: int = 0, clean=None, physics: str = "s
                     a = s["C"] * math.sqrt(s["fraction"]) * w**2
                 _add_line(r, s["direction"], a, s["h"] * w * t + rng.uniform(0, 2 * np.pi),
                           -1.0 if k == "counter_rotation" else 1.0)
+            elif k == "sidebands" and s.get("sidebands_only") and s["per_rev"] is not None:
+                # the imbalance modulated at per_rev·Ω: a wheel load, its two sidebands through the modes
+                for side in (-1.0, 1.0):
+                    _add_modal_line(r, wheel.extended, s["direction"], s["h"] + side * s["per_rev"],
+                                    0.5 * s["depth"] * s["C"], rng.uniform(0, 2 * np.pi), "co")
             elif k == "sidebands":
                 f_mod = s["f_mod_hz"] if s["f_mod_hz"] is not None else s["per_rev"] * w / (2 * np.pi)
-                env = 1.0 + s["depth"] * np.cos(2 * np.pi * f_mod * t + rng.uniform(0, 2 * np.pi))
+                env = (0.0 if s.get("sidebands_only") else 1.0) + s["depth"] * np.cos(2 * np.pi * f_mod * t
+                                                                                      + rng.uniform(0, 2 * np.pi))
                 _add_line(r, s["direction"], s["C"] * w**2 * env, s["h"] * w * t + rng.uniform(0, 2 * np.pi))
             elif k == "broadband_floor":
                 b, a_ = signal.butter(2, s["fc_hz"], fs=r.sample_rate)
