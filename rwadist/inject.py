@@ -19,19 +19,28 @@ broadband_floor  channels (Fx+Fy+Fz), level (0.05), exponent (3.0), fc_hz (60): 
 fixed_resonance  f_hz (150), zeta (0.03), gain (5.0), channels (all six), role (test_stand | wheel_mode):
                  a fixed-frequency resonance H(f/f_r) on the lines of those channels (the stand's
                  fixture resonance / a wheel mode; wheel_mode needs --physics simple)
-cross_coupling r_x, r_y, r_z (0, 0, -0.06 m): load-cell offset, torques += r × F
+cross_coupling r_x, r_y, r_z (0, 0, -0.06 m), force_noise (0): load-cell offset, torques += r × F of the
+               noise-free forces (the sensors' noise comes after the geometry: correcting T − r × F
+               then moves the force noise into the torques); force_noise: extra white sensor noise on
+               Fx, Fy, Fz of std force_noise·C1·Ω_max² (C1 the radial-force fundamental), after the offset
 sidebands      direction (radial_force), h (2.0), depth (0.4), f_mod_hz (7.0) or per_rev (fraction of the
                wheel speed: speed-proportional sidebands at (h ± per_rev)·Ω): the line (d, h) amplitude
-               modulated C·Ω²·(1 + depth·cos(2π f_mod t + φ)); random carrier and modulation phases
+               modulated C·Ω²·(1 + depth·cos(2π f_mod t + φ)); random carrier and modulation phases; with
+               --physics extended on h = 1 the imbalance (through the modes) is the carrier and only
+               the two sidebands are added: with per_rev two co-rotating wheel loads (depth/2)·U·Ω² at
+               (1 ± per_rev)·Ω through the modes, with f_mod C·Ω²·depth·cos(2π f_mod t + φ)·(x cos, y sin)
 speed_ripple   f_ripple_hz (8.0), delta_omega (3.0 rad/s): Ω(t) = Ω0 + ΔΩ sin(2π f t + φ) on every line
                (amplitude C·Ω(t)², phase h·∫Ω dt); --physics simple
 counter_rotation  direction (radial_force), h (1.0), fraction (0.3): that share of the line's power
-                  turned against the spin (x cos, y −sin), the rest left co-rotating
+                  turned against the spin (x cos, y −sin), the rest left co-rotating; with --physics
+                  extended it is a wheel load: the counter part goes through the suspension modes
+                  (:func:`rwadist.extended.steady_lines`) and, on h = 1, the imbalance U_s or U_d keeps
+                  the co part (scaled by sqrt(1 − fraction))
 ============== ===================================================================================
 
 Lines added after the simulation reach the load cell directly (with --physics extended they do not
 pass through the rotor's suspension modes: they are foreign to the wheel, as the effects diagnose
-looks for).
+looks for), except the counter-rotating part of a wheel line (see counter_rotation).
 """
 from __future__ import annotations
 
@@ -54,7 +63,7 @@ KINDS = {
     "broadband_floor": {"channels": "Fx+Fy+Fz", "level": 0.05, "exponent": 3.0, "fc_hz": 60.0},
     "fixed_resonance": {"f_hz": 150.0, "zeta": 0.03, "gain": 5.0, "channels": "Fx+Fy+Fz+Tx+Ty+Tz",
                         "role": "test_stand"},
-    "cross_coupling": {"r_x": 0.0, "r_y": 0.0, "r_z": -0.06},
+    "cross_coupling": {"r_x": 0.0, "r_y": 0.0, "r_z": -0.06, "force_noise": 0.0},
     "sidebands": {"direction": "radial_force", "h": 2.0, "depth": 0.4, "f_mod_hz": None, "per_rev": None},
     "speed_ripple": {"f_ripple_hz": 8.0, "delta_omega": 3.0},
     "counter_rotation": {"direction": "radial_force", "h": 1.0, "fraction": 0.3},
@@ -152,10 +161,19 @@ def prepare_wheel(wheel, specs: list, physics: str):
         elif k in ("amplitude_law", "sidebands", "counter_rotation"):
             h, C = _harmonic(wheel, s, s["direction"], s["h"])
             s["C"] = C
-            if physics != "simple" and _is_imbalance(s["direction"], h):
+            if k == "sidebands" and physics != "simple" and _is_imbalance(s["direction"], h):
+                # the imbalance stays in the simulation (through the modes); only its two sidebands are added
+                s["C"] = getattr(wheel.extended, "U_s" if s["direction"] == "radial_force" else "U_d")
+                s["sidebands_only"] = True
+                continue
+            if physics != "simple" and _is_imbalance(s["direction"], h) and k != "counter_rotation":
                 raise DataError("--inject", "h", f"{k}: with --physics extended the radial h = 1 lines are the "
                                 "rotor's imbalances; pick another h or --physics simple")
-            if k == "counter_rotation":
+            if k == "counter_rotation" and physics != "simple" and _is_imbalance(s["direction"], h):
+                name = "U_s" if s["direction"] == "radial_force" else "U_d"
+                s["C"] = getattr(wheel.extended, name)
+                wheel = replace(wheel, extended=replace(wheel.extended, **{name: s["C"] * math.sqrt(1 - s["fraction"])}))
+            elif k == "counter_rotation":
                 wheel = replace(wheel, harmonics={d: [(hh, c * math.sqrt(1 - s["fraction"]) if d == s["direction"]
                                                        and hh == h else c) for hh, c in v]
                                                   for d, v in wheel.harmonics.items()})
@@ -172,11 +190,28 @@ def _add_line(run, direction, amp, phase, sense=1.0):
         run.signals[chans[1]] = run.signals[chans[1]] + sense * amp * np.sin(phase)
 
 
-def apply(test, wheel, specs: list, seed: int = 0, clean=None):
+def _add_modal_line(run, params, direction, h, C, phase, sense="counter"):
+    """A wheel load C·Ω² e^{±i(hφ + phase)} (``sense`` co or counter) of ``direction`` through the suspension
+    modes of ``params`` (:func:`rwadist.extended.steady_lines`, the run's signed speed): every channel it reaches."""
+    from . import extended as ext
+
+    f, A = ext.steady_lines(params, [ext.Line(direction, float(h), float(C), sense)], [run.speed])
+    if f[0, 0] >= 0.5 * run.sample_rate:
+        return
+    t = np.arange(run.n_samples) / run.sample_rate
+    z = np.exp(1j * (2 * np.pi * f[0, 0] * t + phase))
+    for j, c in enumerate(CHANNELS):
+        if c in run.signals and A[0, 0, j] != 0:
+            run.signals[c] = run.signals[c] + (A[0, 0, j] * z).real
+
+
+def apply(test, wheel, specs: list, seed: int = 0, clean=None, physics: str = "simple"):
     """Add the post-simulation parts of ``specs`` to ``test`` (in place) and record them in its meta.
 
     wheel : the preset as given (before :func:`prepare_wheel`).  clean : noise-free simulation of the
-    prepared wheel with the same seed (needed by speed_ripple only)."""
+    prepared wheel with the same seed (needed by speed_ripple and cross_coupling; without it
+    cross_coupling takes the noisy forces).  physics : that of the simulation ("extended": a
+    counter_rotation part goes through the suspension modes)."""
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 14]))
     speeds = np.array([abs(r.speed) for r in test.runs])
     w_max, w_mid = float(speeds.max()), float(np.median(speeds))
@@ -186,7 +221,10 @@ def apply(test, wheel, specs: list, seed: int = 0, clean=None):
         for run_i, r in enumerate(test.runs):
             t = np.arange(r.n_samples) / r.sample_rate
             w = abs(r.speed)
-            if k in ("missing_harmonic", "amplitude_law", "counter_rotation"):
+            if k == "counter_rotation" and physics != "simple":
+                _add_modal_line(r, wheel.extended, s["direction"], s["h"], s["C"] * math.sqrt(s["fraction"]),
+                                        rng.uniform(0, 2 * np.pi))
+            elif k in ("missing_harmonic", "amplitude_law", "counter_rotation"):
                 if k == "missing_harmonic":
                     a = s["fraction"] * wheel.fundamental_C(s["direction"]) * w**2
                 elif k == "amplitude_law":
@@ -195,9 +233,15 @@ def apply(test, wheel, specs: list, seed: int = 0, clean=None):
                     a = s["C"] * math.sqrt(s["fraction"]) * w**2
                 _add_line(r, s["direction"], a, s["h"] * w * t + rng.uniform(0, 2 * np.pi),
                           -1.0 if k == "counter_rotation" else 1.0)
+            elif k == "sidebands" and s.get("sidebands_only") and s["per_rev"] is not None:
+                # the imbalance modulated at per_rev·Ω: a wheel load, its two sidebands through the modes
+                for side in (-1.0, 1.0):
+                    _add_modal_line(r, wheel.extended, s["direction"], s["h"] + side * s["per_rev"],
+                                    0.5 * s["depth"] * s["C"], rng.uniform(0, 2 * np.pi), "co")
             elif k == "sidebands":
                 f_mod = s["f_mod_hz"] if s["f_mod_hz"] is not None else s["per_rev"] * w / (2 * np.pi)
-                env = 1.0 + s["depth"] * np.cos(2 * np.pi * f_mod * t + rng.uniform(0, 2 * np.pi))
+                env = (0.0 if s.get("sidebands_only") else 1.0) + s["depth"] * np.cos(2 * np.pi * f_mod * t
+                                                                                      + rng.uniform(0, 2 * np.pi))
                 _add_line(r, s["direction"], s["C"] * w**2 * env, s["h"] * w * t + rng.uniform(0, 2 * np.pi))
             elif k == "broadband_floor":
                 b, a_ = signal.butter(2, s["fc_hz"], fs=r.sample_rate)
@@ -207,10 +251,15 @@ def apply(test, wheel, specs: list, seed: int = 0, clean=None):
                     x /= np.sqrt(np.mean(x**2))
                     r.signals[c] = r.signals[c] + s["level"] * c1 * w_max**2 * (w / w_max) ** (s["exponent"] / 2) * x
             elif k == "cross_coupling":
-                F = np.column_stack([r.signals[c] for c in ("Fx", "Fy", "Fz")])
+                src = r if clean is None else clean.runs[run_i]
+                F = np.column_stack([src.signals[c] for c in ("Fx", "Fy", "Fz")])
                 T = np.cross(np.array([s["r_x"], s["r_y"], s["r_z"]])[None, :], F)
                 for j, c in enumerate(("Tx", "Ty", "Tz")):
                     r.signals[c] = r.signals[c] + T[:, j]
+                if s["force_noise"] > 0:
+                    std = s["force_noise"] * wheel.fundamental_C("radial_force") * w_max**2
+                    for c in ("Fx", "Fy", "Fz"):
+                        r.signals[c] = r.signals[c] + rng.normal(0.0, std, r.n_samples)
             elif k == "speed_ripple":
                 c_run = clean.runs[run_i]
                 for ch in r.signals:
@@ -241,6 +290,6 @@ def simulate_with_injections(wheel, specs: list, speeds_rpm, physics: str = "sim
     prepared = prepare_wheel(wheel, specs, physics)
     test = simulate_steady(prepared, speeds_rpm, physics=physics, seed=seed, **kwargs)
     clean = None
-    if any(s["kind"] == "speed_ripple" for s in specs):
+    if any(s["kind"] in ("speed_ripple", "cross_coupling") for s in specs):
         clean = simulate_steady(prepared, speeds_rpm, physics=physics, seed=seed, **{**kwargs, "noise": 0.0})
-    return apply(test, wheel, specs, seed=seed, clean=clean)
+    return apply(test, wheel, specs, seed=seed, clean=clean, physics=physics)

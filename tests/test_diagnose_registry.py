@@ -15,7 +15,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "rwadist" / "diagnose"
 def test_registry_holds_every_family_once_in_the_search_order():
     # the order the search has always asked for candidates (its ranking is a stable sort: ties keep it)
     assert [c.__name__ for c in EFFECT_CLASSES] == [
-        "MissingHarmonic", "AmplitudeLaw", "BroadbandFloor", "FixedResonance", "CrossCoupling", "Sidebands",
+        "MissingHarmonic", "SpeedSidebands", "AmplitudeLaw", "BroadbandFloor", "FixedResonance", "CrossCoupling",
+        "LeverArmNoise", "Sidebands",
         "SpeedRipple", "CounterRotation", "SpinAcceleration", "SuspensionModes"]
     kinds = [c.__dataclass_fields__["kind"].default for c in EFFECT_CLASSES]
     assert len(set(kinds)) == len(kinds) and set(REGISTRY) == set(kinds)

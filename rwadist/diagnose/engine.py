@@ -112,6 +112,20 @@ class Context(Metric):
             out[i][:, have] = 2.0 * (E @ x) / np.sum(w)
         return out
 
+    def data_floor(self, state: State, c: str) -> np.ndarray:
+        """Block floor (n_runs, n_f) of channel ``c`` as the state reads its data (:meth:`data`): a torque
+        channel corrected for the state's load-cell offset has its own (the correction moves noise)."""
+        if state.coupling is None or c not in TORQUE_CHANNELS:
+            return self.floor[c]
+        key = ("data_floor", tuple(float(x) for x in state.coupling), c)
+        if key not in self._memo:
+            psd = self.data(state, c)
+            fl = np.full_like(psd, np.nan)
+            ok = np.isfinite(psd[:, 0])
+            fl[ok] = block_floor(psd[ok], dof=self.dof)
+            self._memo[key] = fl
+        return self._memo[key]
+
     def _floor(self, c):
         psd = self.sp.psd[c]
         fl = np.full_like(psd, np.nan)
@@ -372,7 +386,7 @@ class Context(Metric):
                         pw = (amp * rel) ** 2 / 2 * rip[1][:, j]
                         big = pw > 0.1 * noise[rows, k].sum(1) * self.df
                         mask[rows, k] |= big[:, None]
-        z = D / np.maximum(self.floor[c][runs], 1e-300) - 1.0     # against the run's own block floor
+        z = D / np.maximum(self.data_floor(state, c)[runs], 1e-300) - 1.0     # against the run's own block floor
         thr = stats.chi2.isf(1e-4, self.dof) / self.dof - 1.0
         peak = z > thr
         for j in (-2, -1, 1, 2):

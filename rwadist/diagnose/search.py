@@ -80,6 +80,17 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration):
     when the change is larger), and changes at all only with probability P_b = 2·Q(z − |Δ|/σ).  Passes
     when gain > k_sigma·SE and gain ≥ min_gain × the held-out misplaced power."""
     runs = ctx.held_runs
+    own = getattr(effect, "heldout_evidence", None)
+    ev = own(ctx, state, runs) if own is not None else None
+    if ev is not None:
+        # an effect the PSDs cannot see (e.g. counter rotation of a radial-force line) brings its own held-out
+        # misplaced-power drop and standard error, in the metric's units
+        gain, se = ev
+        e0_all, all_tot = ctx.run_errors(state, runs)
+        t = gain / se if se > 0 else (np.inf if gain > 0 else 0.0)
+        frac = gain / max(float(e0_all.sum()), 1e-300)
+        return Hypothesis(effect, gain / max(float(all_tot.sum()), 1e-300), frac, float(t),
+                          bool(t > k_sigma and frac >= min_gain), iteration)
     chans = [c for c in effect.channels if c in ctx.channels]
     e0, _, p0 = ctx.run_errors(state, runs, chans, detail=True)
     e1, _, p1 = ctx.run_errors(effect.apply(state), runs, chans, detail=True)

@@ -44,7 +44,8 @@ class CounterRotation:
     Hard mounted the two parts have the same PSD; through the rotor's modes the co part meets the forward
     whirl and the counter part the backward one (:mod:`rwadist.extended`), so q is seen where
     |G₊| ≠ |G₋|, above all at the backward-whirl crossing.  The radial translation has no gyroscopic split
-    (|G₊| = |G₋|): q of a radial-force line is not seen in PSDs and the class does not propose it.
+    (|G₊| = |G₋|): q of a radial-force line is not seen in PSDs; it is fitted from the x/y phase alone
+    (:meth:`fit_phase`, needs the time series) and judged by :meth:`heldout_evidence`.
     ``counter_fraction_phase``: a second, independent estimate from the x/y phase of the time series
     (:meth:`fit`), NaN without them."""
 
@@ -169,6 +170,100 @@ class CounterRotation:
         return float(np.sum(ct[ok]) / tot) if tot > 0 else float("nan")
 
     @staticmethod
+    def _phase_powers(ctx, state, direction, h, runs):
+        """Per run of ``runs``: the co- and counter-rotating mean squares of the line (direction, h) from the x/y
+        phasors (co |X + iY|²/4, counter |X − iY|²/4, swapped for Ω < 0; their sum is the x + y line power),
+        the noise's expected share of each (white noise of the model floor S_x, S_y at the line through the
+        whole-run Hann window: (S_x + S_y)/2 · f_s·Σw²/(Σw)²), the modal power gains |G₊|², |G₋|² (times the
+        fixed resonances) of a unit co and counter load, and an in-band mask.  None without time series."""
+        chans = DIRECTION_CHANNELS[direction]
+        if ctx.test is None or not all(c in ctx.channels for c in chans):
+            return None
+        from scipy import signal
+
+        h0 = _sense_group(state, direction, h)[0]
+        f = h0 * ctx.omega[runs] / (2 * np.pi)
+        inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
+        X = ctx.phasors(runs, f[:, None])[:, 0, :]
+        x, y = X[:, CHANNELS.index(chans[0])], X[:, CHANNELS.index(chans[1])]
+        co, ct = np.abs(x + 1j * y) ** 2 / 4.0, np.abs(x - 1j * y) ** 2 / 4.0
+        neg = np.asarray(ctx.sp.speed, float)[runs] < 0
+        co, ct = np.where(neg, ct, co), np.where(neg, co, ct)
+        k = np.clip(np.rint(f / ctx.df).astype(int), 0, ctx.f.size - 1)[:, None]
+        S = sum(np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1)[:, 0] for c in chans) / 2.0
+        enbw = np.empty(runs.size)
+        for i, r in enumerate(runs):
+            run = ctx.test.runs[r]
+            w = signal.get_window(ctx.sp.window, run.n_samples)
+            enbw[i] = run.sample_rate * np.sum(w**2) / np.sum(w) ** 2
+        noise = S * enbw
+        Hc2 = ctx.gain(state, chans[0], f) ** 2
+        gp = ctx.unit_gain(state, chans[0], direction, h0, "co", runs) ** 2 * Hc2
+        gn = ctx.unit_gain(state, chans[0], direction, h0, "counter", runs) ** 2 * Hc2
+        ok = inb & np.isfinite(co) & np.isfinite(ct) & (gp > 0) & (gn > 0)
+        return co, ct, noise, gp, gn, ok
+
+    @staticmethod
+    def fit_phase(ctx: Context, state: State, direction: str, h: float, runs) -> "CounterRotation | None":
+        """q from the x/y phase alone, for a line whose PSD cannot tell the senses apart (a radial-force line:
+        the translation mode has no gyroscopic split).  Per run the noise's expected share is taken off the co
+        and counter mean squares and each is divided by its modal power gain (:meth:`_phase_powers`);
+        q = Σ counter / Σ (co + counter) over the runs (the high speeds weigh most: the load grows as Ω⁴).
+        Its standard error from the noise of each mean square (a line of power P in complex Gaussian noise
+        of mean n: variance n² + 2Pn).  None without time series or with fewer than 3 runs in band."""
+        pw = CounterRotation._phase_powers(ctx, state, direction, h, runs)
+        if pw is None:
+            return None
+        co, ct, noise, gp, gn, ok = pw
+        if ok.sum() < 3:
+            return None
+        co, ct, noise, gp, gn = (v[ok] for v in (co, ct, noise, gp, gn))
+        a, b = (co - noise) / gp, (ct - noise) / gn
+        tot = float(np.sum(a + b))
+        if not tot > 0:
+            return None
+        q = float(np.clip(np.sum(b) / tot, 0.0, 1.0))
+        var_a = np.sum((noise**2 + 2 * np.maximum(co - noise, 0) * noise) / gp**2)
+        var_b = np.sum((noise**2 + 2 * np.maximum(ct - noise, 0) * noise) / gn**2)
+        se = float(np.sqrt(var_b * (1 - q) ** 2 + var_a * q**2) / tot)
+        return CounterRotation(direction, float(h), q, se, q, int(ok.sum()))
+
+    def heldout_evidence(self, ctx: Context, state: State, runs):
+        """Held-out evidence of a split the PSDs cannot see (:meth:`fit_phase`): (drop, se), in the units of the
+        error metric (x + y power divided by the channels' group scale), of the misplaced rotating power
+        Σ_runs |co − n − M₊| + |counter − n − M₋|, M± the model's co and counter mean squares of the line
+        (its x + y power through the modal gains, before and after this effect); se as the search's judge
+        (Σ min(|ΔM|, σ)², σ² = n² + 2Pn).  None when the effect changes the PSDs (the search's own judge)."""
+        g = _sense_group(state, self.direction, self.h)
+        pw = CounterRotation._phase_powers(ctx, state, self.direction, self.h, runs)
+        if g is None or pw is None or CounterRotation._sees_senses(ctx, state, self.direction, self.h, runs):
+            return None
+        co, ct, noise, gp, gn, ok = pw
+        c_tot2 = g[1] ** 2 + g[2] ** 2
+        q0 = g[2] ** 2 / c_tot2
+        free = c_tot2 * ctx.omega[runs] ** 4                       # free x + y mean square of the harmonic
+        scale = ctx.scale(DIRECTION_CHANNELS[self.direction][0])
+        drop, var = 0.0, 0.0
+        for meas, gain, s0, s1 in ((co, gp, 1 - q0, 1 - self.counter_fraction), (ct, gn, q0, self.counter_fraction)):
+            r0 = meas - noise - s0 * free * gain
+            r1 = meas - noise - s1 * free * gain
+            sig = np.sqrt(noise**2 + 2 * np.maximum(meas - noise, 0) * noise)
+            dm = np.abs((s1 - s0) * free * gain)
+            drop += float(np.sum((np.abs(r0) - np.abs(r1))[ok]))
+            var += float(np.sum(np.minimum(dm, sig)[ok] ** 2))
+        return drop / scale, np.sqrt(var) / scale
+
+    @staticmethod
+    def _sees_senses(ctx, state, direction, h, runs) -> bool:
+        """True when the modes give the co and counter parts PSDs the data can tell apart (max |ln |G₋|²/|G₊|²|
+        >= 0.1 over the runs)."""
+        h0 = _sense_group(state, direction, h)[0]
+        c = DIRECTION_CHANNELS[direction][0]
+        gp = ctx.unit_gain(state, c, direction, h0, "co", runs) ** 2
+        gn = ctx.unit_gain(state, c, direction, h0, "counter", runs) ** 2
+        return bool(np.max(np.abs(np.log(np.maximum(gn, 1e-300) / np.maximum(gp, 1e-300)))) >= 0.1)
+
+    @staticmethod
     def fit(ctx: Context, state: State, direction: str, h: float, runs) -> "CounterRotation | None":
         """q by weighted least squares of ln(measured x + y line power) on ln(P_o + P₊ + q(P₋ − P₊)) over the
         runs where the line stands above the noise (:meth:`_points`; weights s²/(s² + SNR_KNEE²), s the line's
@@ -184,7 +279,8 @@ class CounterRotation:
             return None
         Pm, Po, Pp, Pn, wt = (v[ok] for v in (Pm, Po, Pp, Pn, wt))
         if np.max(np.abs(np.log(np.maximum(Pn, 1e-300) / np.maximum(Pp, 1e-300)))) < 0.1:
-            return None
+            # the PSDs cannot tell the senses apart (a radial-force line): the x/y phase can
+            return CounterRotation.fit_phase(ctx, state, direction, h, runs)
         y = np.log(Pm)
 
         def cost(q):

@@ -1,0 +1,176 @@
+"""``speed_sidebands``: a pair of lines at (h₀ ± δ)·|Ω| beside a strong model line (a modulation at a frequency
+proportional to the speed), searched on the speeds where they stand resolved from their carrier."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...model import Harmonic
+from ...units import DIRECTION_CHANNELS
+from ..constants import LINE_HALF
+from ..engine import Context
+from ..measure import _measure, refine_h
+from ..state import State
+from .base import register, schema_entry
+
+#: Smallest separation (Welch bins) between a sideband and its carrier for a run to count: the Hann main lobe
+#: is ±2 bins, so closer sidebands sit in the carrier's own kernel and are not measured there.
+MIN_BINS = 3.0
+#: Per-revolution offsets δ searched (fractions of the wheel speed).
+DELTA_GRID = np.arange(0.01, 0.30001, 0.0025)
+
+
+def resolvable_runs(ctx: Context, state: State, direction: str, h0: float, h_side: float, runs) -> np.ndarray:
+    """The runs of ``runs`` where the line h_side·|Ω| is in band, at least MIN_BINS bins from its carrier h0 and
+    2·LINE_HALF bins from every other line of the direction's model: there its window measures it alone."""
+    w = ctx.omega[runs] / (2 * np.pi)
+    f = h_side * w
+    ok = (np.abs(h_side - h0) * w >= MIN_BINS * ctx.df) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
+        & (f <= (ctx.k_hi - LINE_HALF) * ctx.df)
+    for x in state.model.harmonics(direction):
+        if abs(x.h - h0) > 1e-6:
+            ok &= np.abs(x.h - h_side) * w >= 2 * LINE_HALF * ctx.df
+    return runs[ok]
+
+
+@register(order=15)
+@dataclass
+class SpeedSidebands:
+    """Two co-rotating lines at h_lower·|Ω| and h_upper·|Ω| (h_lower < h₀ < h_upper) beside the carrier line h₀ of
+    a direction: an amplitude modulation of the carrier at δ·|Ω| (a cage or a bearing defect's once-per-δ-rev
+    beat, a tone ring) puts them at (h₀ ± δ)|Ω| with amplitudes (m/2)·C₀Ω² each.  They move with the speed, so
+    they are harmonics (``missing_harmonic`` would take each, if it could see them): the model file gets two
+    harmonics C_lower, C_upper (every consumer reads them) and this record.  Close to a strong line they are
+    resolved only at the higher speeds (δ|Ω|/2π >= MIN_BINS bins): the search and the fit use those runs
+    (:func:`resolvable_runs`); the prediction holds at every speed."""
+
+    direction: str
+    h0: float
+    h_lower: float
+    h_upper: float
+    C_lower: float
+    C_upper: float
+    C_carrier: float
+    n_points: int = 0
+    kind: str = "speed_sidebands"
+
+    @property
+    def channels(self):
+        return DIRECTION_CHANNELS[self.direction]
+
+    def apply(self, state: State) -> State:
+        s = state.copy()
+        new = [Harmonic(h=round(self.h_lower, 4), C=self.C_lower, n_points=self.n_points),
+               Harmonic(h=round(self.h_upper, 4), C=self.C_upper, n_points=self.n_points)]
+        s.model.empirical[self.direction] = sorted(s.model.harmonics(self.direction) + new, key=lambda x: x.h)
+        s.effects.append(self)
+        return s
+
+    def refit(self, ctx: Context, state: State) -> "SpeedSidebands":
+        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
+        return SpeedSidebands.fit(ctx, state, self.direction, self.h0, ctx.runs,
+                                  0.5 * (self.h_upper - self.h_lower)) or self
+
+    def to_schema(self) -> dict:
+        return schema_entry(self)
+
+    def params(self) -> dict:
+        c0 = self.C_carrier
+        return {"direction": self.direction, "h": round(self.h0, 4), "h_lower": round(self.h_lower, 4),
+                "h_upper": round(self.h_upper, 4), "per_rev": round(0.5 * (self.h_upper - self.h_lower), 4),
+                "C_lower": self.C_lower, "C_upper": self.C_upper,
+                "ratio_lower": self.C_lower / c0 if c0 > 0 else float("nan"),
+                "ratio_upper": self.C_upper / c0 if c0 > 0 else float("nan"),
+                "depth": (self.C_lower + self.C_upper) / c0 if c0 > 0 else float("nan"), "n_points": self.n_points,
+                "law": "co-rotating lines C_lower*omega^2 at h_lower*|omega| and C_upper*omega^2 at h_upper*|omega| "
+                       "(harmonics of the model); ratio = C/C of the carrier h, depth = ratio_lower + ratio_upper"}
+
+    @staticmethod
+    def _carrier_C(state: State, direction: str, h0: float) -> float:
+        """Free-load C of the carrier (an imbalance's U_s or U_d on the extended base)."""
+        if state.ext is not None:
+            from ... import extended as ext
+
+            g = [ln.C for ln in state.ext_lines() if ln.direction == direction and abs(ln.h - h0) < ext.LAW_H_TOL]
+            if g:
+                return float(np.sqrt(np.sum(np.square(g))))
+        return float(np.sqrt(sum(x.C**2 for x in state.model.harmonics(direction) if abs(x.h - h0) < 1e-6)))
+
+    @staticmethod
+    def fit(ctx: Context, state: State, direction: str, h0: float, runs, delta: float) -> "SpeedSidebands | None":
+        """Each side's h refined on its residual peaks (:func:`rwadist.diagnose.measure.refine_h`) and its C by
+        thesis Eq. 3.10 on the amplitudes measured (modal gain divided out), both on the runs where that side
+        is resolved (:func:`resolvable_runs`); None when a side has fewer than 3 measured points or no
+        positive C."""
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        out = []
+        for side in (-1.0, 1.0):
+            h = h0 + side * delta
+            sub = resolvable_runs(ctx, state, direction, h0, h, runs)
+            if sub.size < 3:
+                return None
+            h = refine_h(ctx, state, chans, sub, h)
+            if not (0 < side * (h - h0) and abs(h - (h0 + side * delta)) < 0.5 * delta):
+                return None
+            sub = resolvable_runs(ctx, state, direction, h0, h, runs)
+            d, w = _measure(ctx, state, direction, h, sub)
+            if d.size < 3:
+                return None
+            C = float(np.sum(d * w**2) / np.sum(w**4))
+            if not C > 0:
+                return None
+            out.append((h, C, d.size))
+        (hl, cl, nl), (hu, cu, nu) = out
+        return SpeedSidebands(direction, float(h0), float(hl), float(hu), cl, cu,
+                              SpeedSidebands._carrier_C(state, direction, h0), int(nl + nu))
+
+    @staticmethod
+    def scan(ctx: Context, state: State, direction: str, h0: float, runs) -> tuple:
+        """(δ grid, score): per δ of :data:`DELTA_GRID`, the median over the channels, resolved runs and both sides of
+        the residual PSD at (h₀ ± δ)|Ω|/2π (the largest of the bin and its neighbours) over the run's model floor,
+        i.e. how far above the noise a pair of lines at ±δ per revolution stands; 0 where fewer than 6 values.
+        Not clipped: beside a strong carrier the true pair stands out as the peak of a broad hump of skirts."""
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        z = {}
+        for c in chans:
+            R = ctx.data(state, c)[runs] - ctx.predict(state, c, runs)
+            zz = R / ctx.floor_psd(state, c, runs)
+            z[c] = np.maximum(np.maximum(zz, np.roll(zz, 1, axis=1)), np.roll(zz, -1, axis=1))
+        pos = {r: i for i, r in enumerate(runs)}
+        score = np.zeros(DELTA_GRID.size)
+        for j, dl in enumerate(DELTA_GRID):
+            vals = []
+            for side in (-1.0, 1.0):
+                sub = resolvable_runs(ctx, state, direction, h0, h0 + side * dl, runs)
+                if sub.size == 0:
+                    continue
+                rows = np.array([pos[r] for r in sub])
+                k = np.rint((h0 + side * dl) * ctx.omega[sub] / (2 * np.pi) / ctx.df).astype(int)
+                for c in chans:
+                    vals.append(z[c][rows, k])
+            vals = np.concatenate(vals) if vals else np.empty(0)
+            score[j] = float(np.median(vals)) if vals.size >= 6 else 0.0
+        return DELTA_GRID, score
+
+    @staticmethod
+    def candidates(ctx: Context, state: State, runs, n_carriers: int = 2) -> list:
+        """Per direction, its ``n_carriers`` strongest lines (largest free C): the δ
+        of the highest :meth:`scan` score when it clears 20 (the lines stand 20 × over the floor on half the
+        resolved points) and is a local maximum, fitted by :meth:`fit`."""
+        out = []
+        for d, chans in DIRECTION_CHANNELS.items():
+            if not any(c in ctx.channels for c in chans):
+                continue
+            done = {round(e.h0, 4) for e in state.effects if isinstance(e, SpeedSidebands) and e.direction == d}
+            hs = [x for x in state.model.harmonics(d) if round(x.h, 4) not in done]
+            top = sorted(hs, key=lambda x: -SpeedSidebands._carrier_C(state, d, x.h))[:n_carriers]
+            for x in top:
+                dl, sc = SpeedSidebands.scan(ctx, state, d, x.h, runs)
+                j = int(np.argmax(sc))
+                if not (0 < j < sc.size - 1 and sc[j] > 20.0 and sc[j] >= sc[j - 1] and sc[j] >= sc[j + 1]):
+                    continue
+                e = SpeedSidebands.fit(ctx, state, d, x.h, runs, float(dl[j]))
+                if e is not None:
+                    out.append(e)
+        return out
