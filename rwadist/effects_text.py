@@ -119,11 +119,27 @@ def _suspension_modes(e):
             f", I_zz/I_rr {_num(e['inertia_ratio'], '.3g')}{note}")
 
 
+def _speed_sidebands(e):
+    d = e["direction"]
+    return (f"{_words(d)}, lines at h {_num(e['h_lower'])} and {_num(e['h_upper'])} beside h {_num(e['h'])} "
+            f"(±{_num(e['per_rev'], '.3g')} per revolution), C/C of the carrier {_num(e['ratio_lower'], '.3g')} and "
+            f"{_num(e['ratio_upper'], '.3g')}")
+
+
+def _lever_arm_noise(e):
+    rise = e.get("floor_rise_dB") or {}
+    rises = ", ".join(f"{c} +{float(v):.2f} dB" for c, v in rise.items())
+    return (f"force-sensor noise moved into the corrected torques by the lever arm, transfer "
+            f"{_num(e['noise_transfer'], '.3g')}{_pm(e, 'noise_transfer_stderr')} (1 = the lever arm alone)"
+            + (f", noise floor {rises}" if rises else "") + " (measurement, not a wheel load)")
+
+
 _DESCRIBE = {"missing_harmonic": _missing_harmonic, "amplitude_law": _amplitude_law,
              "broadband_floor": _broadband_floor, "fixed_resonance": _fixed_resonance,
              "cross_coupling": _cross_coupling, "sidebands": _sidebands, "speed_ripple": _speed_ripple,
              "counter_rotation": _counter_rotation, "spin_acceleration": _spin_acceleration,
-             "suspension_modes": _suspension_modes}
+             "suspension_modes": _suspension_modes, "speed_sidebands": _speed_sidebands,
+             "lever_arm_noise": _lever_arm_noise}
 
 
 def diagnose_lines(effects) -> list:

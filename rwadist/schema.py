@@ -507,6 +507,37 @@ class SpinAcceleration(Effect):
 
 @register
 @dataclass(frozen=True, eq=False, kw_only=True)
+class SpeedSidebands(Effect):
+    """Lines at h_lower·|Ω| and h_upper·|Ω| beside the line h of ``direction`` (speed-proportional sidebands).
+    A record of what diagnose found: the two lines are the model's empirical harmonics (C_lower, C_upper in
+    kg·m or kg·m²), which every consumer applies; this entry adds nothing to them."""
+
+    KIND: ClassVar[str] = "speed_sidebands"
+    direction: str = field(metadata=check(choice(DIRECTIONS)))
+    h: float = field(metadata=check(_POS))
+    h_lower: float = field(metadata=check(_POS))
+    h_upper: float = field(metadata=check(_POS))
+    C_lower: float = field(metadata=check(_NONNEG))
+    C_upper: float = field(metadata=check(_NONNEG))
+    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class LeverArmNoise(Effect):
+    """The force sensors' noise that the lever-arm correction T − r × F moves into the torque channels:
+    S_T'(f) = S_T(f) + noise_transfer·Σ r_k² S_Fj(f).  Measurement only (not a wheel load): no consumer
+    applies it."""
+
+    KIND: ClassVar[str] = "lever_arm_noise"
+    r_m: np.ndarray = field(metadata=check(numbers(length=3)))
+    noise_transfer: float = field(metadata=check(_NONNEG))
+    noise_transfer_stderr: float | None = field(default=None, metadata=check(_STDERR))
+    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
 class SuspensionModes(Effect):
     """The wheel's own suspension modes as diagnose fitted them from the data (per unit mass and transverse
     inertia): frequencies at rest (Hz), damping ratios, I_zz/I_rr, and the modes the data do not locate.

@@ -30,6 +30,10 @@ EFFECTS = [
     {"kind": "spin_acceleration", "alpha_rad_s2": 0.25},
     {"kind": "suspension_modes", "radial_translation_Hz": 227.7, "rocking_Hz": 54.9, "axial_Hz": 70.0,
      "zeta_radial_translation": 0.01, "zeta_rocking": 0.02, "zeta_axial": 0.015, "inertia_ratio": 1.9},
+    {"kind": "speed_sidebands", "direction": "radial_force", "h": 1.0, "h_lower": 0.94, "h_upper": 1.06,
+     "per_rev": 0.06, "C_lower": 1e-7, "C_upper": 1.2e-7, "ratio_lower": 0.2, "ratio_upper": 0.24},
+    {"kind": "lever_arm_noise", "r_m": [0.0, 0.0, -0.06], "noise_transfer": 1.009, "noise_transfer_stderr": 0.005,
+     "floor_rise_dB": {"Tx": 2.52, "Ty": 2.54}},
 ]
 
 #: per kind, numbers that must appear on its line (in the printed units)
@@ -38,7 +42,9 @@ EXPECTED = {"missing_harmonic": ["3.5", "1.250e-07 kg·m"], "amplitude_law": ["2
             "0.02", "4.5", "radial force, axial force"], "cross_coupling": ["(0.0, 1.0, -58.0) mm"],
             "sidebands": ["±2.5 Hz", "0.12"], "speed_ripple": ["0.7 Hz", "4.77 rpm", "1432 rpm"],
             "counter_rotation": ["q 0.3"], "spin_acceleration": ["0.25 rad/s²"],
-            "suspension_modes": ["227.7 Hz", "54.9 Hz", "70 Hz", "1.9"]}
+            "suspension_modes": ["227.7 Hz", "54.9 Hz", "70 Hz", "1.9"],
+            "speed_sidebands": ["h 0.94 and 1.06", "±0.06", "0.2 and 0.24"],
+            "lever_arm_noise": ["1.01", "±0.005", "Tx +2.52 dB", "Ty +2.54 dB"]}
 
 
 def test_every_known_kind_has_its_numbers_on_one_line():

@@ -246,6 +246,10 @@ EVERY_KIND = [
     {"kind": "suspension_modes", "radial_translation_Hz": 227.0, "rocking_Hz": 55.0, "axial_Hz": 70.0,
      "zeta_radial_translation": 0.17, "zeta_rocking": 0.04, "zeta_axial": 0.05, "inertia_ratio": 2.0,
      "unconstrained": ["axial"], "per_unit": True, "n_runs": 60, "channel": ["Fx", "Fy", "Fz", "Tx", "Ty", "Tz"]},
+    {"kind": "speed_sidebands", "direction": "radial_force", "h": 1.0, "h_lower": 0.94, "h_upper": 1.06,
+     "C_lower": 1.0e-7, "C_upper": 1.1e-7, "n_points": 12, "per_rev": 0.06, "ratio_lower": 0.2},
+    {"kind": "lever_arm_noise", "r_m": [0.0, 0.0, -0.06], "noise_transfer": 1.01, "noise_transfer_stderr": 0.005,
+     "n_points": 40, "floor_rise_dB": {"Tx": 2.5, "Ty": 2.5}, "role": "measurement"},
 ]
 
 
