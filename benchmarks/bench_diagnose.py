@@ -1,6 +1,6 @@
 """Benchmark and acceptance tables of ``rwadist diagnose`` (issues 7 and 14).
 
-Run: ``.venv/bin/python benchmarks/bench_diagnose.py [--quick | --modes-on]``
+Run: ``.venv/bin/python benchmarks/bench_diagnose.py [--quick | --modes-on [GROUP ...]]``
 
 1. Acceptance table (modes off, issue 7): each effect class injected alone into E-wheel data (40
    speeds, 4096 samples at 1920 Hz, modes off), three seeds; the class named, the recovered parameter,
@@ -117,9 +117,11 @@ def _check(label, seed, d, checks, param):
     return not bad
 
 
-def modes_on_table(seeds):
+def modes_on_table(seeds, groups=None):
     """The acceptance cases of tests/test_diagnose.py and test_diagnose_modulation.py (sidebands) with the
-    modes on, from the truth model on the extended base, each with its test's tolerances."""
+    modes on, from the truth model on the extended base, each with its test's tolerances.  ``groups``: the
+    case groups to run (clean, missing_harmonic, amplitude_law, broadband_floor, fixed_resonance,
+    cross_coupling, sidebands, two), default all."""
     from test_diagnose import inject_coupling
     from test_diagnose_modulation import inject_sidebands
 
@@ -127,6 +129,10 @@ def modes_on_table(seeds):
     from rwadist.units import CHANNELS
 
     truth = preset("ithaco-e").to_model()
+
+    def want(group):
+        return groups is None or group in groups
+
     print("modes ON (physics='extended'), start: the preset's model on the extended base (base='auto')\n")
     print("| case | seed | named | parameter (truth) | error before -> after (cut) | test criteria |")
     print("|---|---|---|---|---|---|")
@@ -135,12 +141,12 @@ def modes_on_table(seeds):
     def run(t, with_test=False):
         return diagnose(spectra(t), truth, test=t if with_test else None, base="auto")
 
-    for s in seeds:
+    for s in (seeds if want("clean") else []):
         t = e_data_on(s)
         d = run(t, True)
         passed.append(_check("clean (time series given)", s, d, [("nothing added", d.model.effects == []),
                              ("error unchanged", d.error_after == d.error_before)], "-"))
-    for s, direction, h, ratio in [(0, "radial_force", 0.5, 0.5), (1, "radial_force", 0.5, 0.5),
+    for s, direction, h, ratio in [] if not want("missing_harmonic") else [(0, "radial_force", 0.5, 0.5), (1, "radial_force", 0.5, 0.5),
                                    (2, "radial_force", 0.5, 0.5), (0, "axial_force", 2.73, 0.3)]:
         C = ratio * C1
         t = e_data_on(s)
@@ -155,7 +161,7 @@ def modes_on_table(seeds):
             f"h={e.get('h', np.nan):.4f} ({h}), C/C_true={e.get('C', np.nan) / C:.3f}"))
     h, p = 4.42, 2.5
     C = dict(preset("ithaco-e").harmonics["radial_force"])[h]
-    for s in seeds:
+    for s in (seeds if want("amplitude_law") else []):
         t = e_data_on(s, drop=("radial_force", h))
         inject_line(t, "radial_force", h, lambda w: C * W_MID**2 * (w / W_MID) ** p, s)
         d = run(t)
@@ -170,7 +176,7 @@ def modes_on_table(seeds):
     wmax = np.abs(SPEEDS).max() * 2 * np.pi / 60
     from test_diagnose import FS
 
-    for s in seeds:
+    for s in (seeds if want("broadband_floor") else []):
         t = e_data_on(s)
         inject_floor(t, ("Fx", "Fy", "Fz"), {c: FLOOR_LEVEL * C1 * wmax**2 for c in ("Fx", "Fy", "Fz")},
                      p=3.0, fc=60.0, fs=FS, seed=s)
@@ -182,7 +188,7 @@ def modes_on_table(seeds):
             ("|dp| < 0.5", bool(ps) and all(abs(x - 3.0) < 0.5 for x in ps)),
             ("cut > 3x", d.error_before > 3 * d.error_after)], "p=" + ",".join(f"{x:.2f}" for x in ps)))
     for channels, role in [(CHANNELS, "test_stand"), (("Fx", "Fy"), "wheel_mode")]:
-        for s in seeds:
+        for s in (seeds if want("fixed_resonance") else []):
             t = e_data_on(s, stand_modes=[Mode("injected", 150.0, 0.03, 5.0, channels)])
             d = run(t)
             e = d.model.effects[0] if d.model.effects else {}
@@ -196,7 +202,7 @@ def modes_on_table(seeds):
                 f"f={e.get('f_Hz', np.nan):.2f}, zeta={e.get('zeta', np.nan):.4f}, g={e.get('peak_gain', np.nan):.3f}, "
                 f"{e.get('role')}"))
     for r in [(0.0, 0.0, 0.05), (0.03, -0.02, 0.05)]:
-        for s in seeds:
+        for s in (seeds if want("cross_coupling") else []):
             t = e_data_on(s)
             inject_coupling(t, r)
             d = run(t, True)
@@ -208,28 +214,34 @@ def modes_on_table(seeds):
                 ("cut > 3x", d.error_before > 3 * d.error_after)], "r_mm=" + ",".join(f"{1e3 * x:.2f}" for x in got)))
     import test_diagnose_modulation as tm
 
-    for s in seeds:
+    # with the modes on the radial h = 1 lines are the rotor's imbalances (U_s, U_d of the extended
+    # parameters): dropping h = 1 from the harmonics does not remove them, the test's h = 1 case would
+    # carry the carrier twice (rwadist.inject refuses it for that reason); the weak-line case h = 2 is used,
+    # with its test's criteria (cut > 2x)
+    for s in (seeds if want("sidebands") else []):
         orig = tm.e_data
         tm.e_data = e_data_on                   # the modulation test's generator with the modes on
         try:
-            t = inject_sidebands(s, h=1.0)
+            t = inject_sidebands(s, h=2.0)
         finally:
             tm.e_data = orig
         d = run(t)
         e = d.model.effects[0] if d.model.effects else {}
-        passed.append(_check("sidebands radial_force h=1 7 Hz m=0.4", s, d, [
+        passed.append(_check("sidebands radial_force h=2 7 Hz m=0.4", s, d, [
             ("only sidebands", [x["kind"] for x in d.model.effects] == ["sidebands"]),
             ("f_mod within 2 %", abs(e.get("f_mod_Hz", np.inf) / 7 - 1) < 0.02),
             ("depth within 15 %", abs(e.get("depth", np.inf) / 0.4 - 1) < 0.15),
-            ("cut > 3x", d.error_before > 3 * d.error_after)],
+            ("cut > 2x", d.error_before > 2 * d.error_after)],
             f"f_mod={e.get('f_mod_Hz', np.nan):.3f}, m={e.get('depth', np.nan):.3f}"))
-    t = e_data_on(4, drop=("radial_force", h))
-    inject_line(t, "radial_force", h, lambda w: C * W_MID**2 * (w / W_MID) ** p, 4)
-    inject_line(t, "radial_force", 0.5, lambda w: 0.5 * C1 * w**2, 5)
-    d = run(t)
-    passed.append(_check("two: h=0.5 + p=2.5", 4, d, [
-        ("amplitude_law + missing_harmonic", sorted(x["kind"] for x in d.model.effects)
-         == ["amplitude_law", "missing_harmonic"]), ("cut > 3x", d.error_before > 3 * d.error_after)], "see named"))
+    if want("two"):
+        t = e_data_on(4, drop=("radial_force", h))
+        inject_line(t, "radial_force", h, lambda w: C * W_MID**2 * (w / W_MID) ** p, 4)
+        inject_line(t, "radial_force", 0.5, lambda w: 0.5 * C1 * w**2, 5)
+        d = run(t)
+        passed.append(_check("two: h=0.5 + p=2.5", 4, d, [
+            ("amplitude_law + missing_harmonic", sorted(x["kind"] for x in d.model.effects)
+             == ["amplitude_law", "missing_harmonic"]), ("cut > 3x", d.error_before > 3 * d.error_after)],
+            "see named"))
     print(f"\nmodes on: {sum(passed)}/{len(passed)} cases pass every criterion of their test")
 
 
@@ -264,10 +276,13 @@ def timing():
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="timing only")
-    ap.add_argument("--modes-on", action="store_true", help="the acceptance cases re-measured on modes-on data only")
+    ap.add_argument("--modes-on", nargs="*", default=None, metavar="GROUP",
+                    help="the acceptance cases re-measured on modes-on data only (optionally only these groups: "
+                         "clean missing_harmonic amplitude_law broadband_floor fixed_resonance cross_coupling "
+                         "sidebands two)")
     a = ap.parse_args()
-    if a.modes_on:
-        modes_on_table([0, 1, 2])
+    if a.modes_on is not None:
+        modes_on_table([0, 1, 2], a.modes_on or None)
         sys.exit(0)
     if not a.quick:
         table([0, 1, 2])
