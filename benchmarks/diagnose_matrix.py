@@ -125,7 +125,7 @@ def generate(cell: dict, spec: str | None):
     speeds = np.linspace(*cell["rpm"], cell["n_speeds"])
     return simulate_with_injections(preset("ithaco-e"), specs, speeds, physics="extended", seed=cell["seed"],
                                     sample_rate=cell["rate"], n_samples=cell["samples"], noise=cell["noise"],
-                                    test_stand=False)
+                                    test_stand=True)    # the preset has no fixture modes: only the injected ones
 
 
 def _is_stand(e) -> bool:
