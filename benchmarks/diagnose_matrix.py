@@ -12,8 +12,9 @@ search must name ``suspension_modes`` and fit them from the data).  Per cell:
   :mod:`rwadist.inject` can inject, injected alone (its parameters below): found or missed, the
   fitted parameter against the injected one, and any other effect added beside it;
 * the modes: each of radial translation, rocking and axial either found within 2 % of the truth
-  (the thesis numbers of tests/independent_wheel.py) or listed in ``unconstrained`` -- a mode outside
-  2 % and not declared is a SILENT failure (the acceptance: no such cell).
+  (the thesis numbers of tests/independent_wheel.py), listed in ``unconstrained``, or outside 2 % with
+  the extended fit's misfit note for that mode in ``analytical.fit.notes`` ("misfit noted") -- a mode
+  outside 2 % with neither is a SILENT failure (the acceptance: no such cell).
 
 The matrix is NOT a full factorial (3^5·2 = 486 cells × 8 classes).  It is one factor at a time
 around a nominal cell (300-3000 rpm, 60 speeds, 8192 samples, 3840 Hz, noise 1 % of the top-speed
@@ -175,14 +176,19 @@ def modes_check(d) -> tuple:
         return "no suspension_modes", False
     e = sm[0]
     unc = set(e.get("unconstrained") or [])
+    notes = " ".join(((getattr(d.model, "analytical", None) or {}).get("fit") or {}).get("notes") or [])
     parts, silent = [], False
     for m in MODES:
         f = e[f"{m}_Hz"]
         err = 100 * (f / iw.TRUTH_HZ[m] - 1)
+        # the extended fit's own warning in the model file: the linear model misses the data near the mode
+        warned = f"{'axial_translation' if m == 'axial' else m}: the linear model misses" in notes
         if m in unc:
             parts.append(f"{m[:4]} declared")
         elif abs(err) <= 2.0:
             parts.append(f"{m[:4]} {err:+.1f}%")
+        elif warned:
+            parts.append(f"{m[:4]} {err:+.1f}% (misfit noted)")
         else:
             parts.append(f"{m[:4]} {err:+.1f}% SILENT")
             silent = True
