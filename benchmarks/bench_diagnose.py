@@ -99,8 +99,11 @@ def e_data_on(seed, drop=None, speeds=SPEEDS, stand_modes=None):
     w = preset("ithaco-e")
     if drop is not None:
         d0, h0 = drop
+        # the other lines keep their rotation sense (tests/test_diagnose.e_data clears every sense, which
+        # does not matter hard mounted but turns the preset's counter-rotating lines co-rotating through the modes)
         w = replace(w, harmonics={d: [(h, C) for h, C in v if not (d == d0 and abs(h - h0) < 1e-9)]
-                                  for d, v in w.harmonics.items()}, senses={})
+                                  for d, v in w.harmonics.items()},
+                    senses={k: v for k, v in w.senses.items() if not (k[0] == d0 and abs(k[1] - h0) < 1e-9)})
     if stand_modes is not None:
         w = replace(w, test_stand_modes=stand_modes)
     return simulate_steady(w, speeds, sample_rate=FS, n_samples=N, physics="extended", noise=0.01, seed=seed)
