@@ -71,7 +71,7 @@ SPECS = {
 NOT_INJECTED = {
     "suspension_modes": "the wheel's own modes: the base of every cell (checked in the modes column)",
     "spin_acceleration": "needs a spin-up/run-down sweep, not steady runs",
-    "speed_ripple": "rwadist.inject rebuilds the rippled lines hard mounted (the modes would be lost)",
+    "speed_ripple": "rwadist.inject refuses it with --physics extended (it rebuilds the preset's lines hard mounted)",
 }
 MODES = ("radial_translation", "rocking", "axial")
 
