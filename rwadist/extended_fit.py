@@ -97,6 +97,26 @@ class ExtendedFit:
 
 # --------------------------------------------------------------------------- 1. senses
 
+def windowed_dft(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128) -> np.ndarray:
+    """Σ_n x[n]·e^{−2πj f t_n} (t_n = n/sample_rate) of the columns of ``x`` (n, K) at frequencies ``f_hz``
+    (L,) Hz, any f (not on the FFT grid); returns (L, K) complex.
+
+    The samples are cut into blocks of ``block``: e^{−2πj f (t_b + t_j)} = e^{−2πj f t_b}·e^{−2πj f t_j}, so
+    only L·(block + n/block) exponentials are evaluated instead of L·n (a product of two unit phasors:
+    the same sum to rounding)."""
+    x = np.asarray(x, dtype=float)
+    n, k = x.shape
+    f_hz = np.asarray(f_hz, dtype=float)
+    n_blocks = -(-n // block)
+    xb = np.zeros((n_blocks * block, k))
+    xb[:n] = x
+    xb = xb.reshape(n_blocks, block, k)                                        # (J, B, K)
+    fine = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(block) / sample_rate))             # (L, B)
+    coarse = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(n_blocks) * block / sample_rate))  # (L, J)
+    inner = np.matmul(fine.real, xb) + 1j * np.matmul(fine.imag, xb)          # (J, L, K), real BLAS products
+    return np.einsum("lj,jlk->lk", coarse, inner)
+
+
 def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) -> dict:
     """Rotation sense of each radial line from the x/y phase, (direction, h) -> (sense, co_fraction).
 
@@ -118,13 +138,11 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             if cx not in run.signals or cy not in run.signals or run.speed == 0:
                 continue
             n = run.n_samples
-            t = np.arange(n) / run.sample_rate
             w = signal.windows.hann(n, sym=False)
             f = h * abs(run.speed) / (2 * np.pi)
             ok = f < 0.45 * run.sample_rate
-            e = np.exp(-2j * np.pi * f[ok, None] * t[None, :])
-            X = e @ (w * run.signals[cx])
-            Y = e @ (w * run.signals[cy])
+            X, Y = windowed_dft(np.column_stack([w * run.signals[cx], w * run.signals[cy]]), run.sample_rate,
+                                f[ok]).T
             co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
             if run.speed < 0:
                 co, ct = ct, co
@@ -241,6 +259,89 @@ def _radial_power(meas_lines):
     return np.array(li, int), np.array(sp), np.array(pw), np.array(dr)
 
 
+#: direction -> (mode, stiffness, damping, inertia, gyroscopic inertia or None) of the subsystem it loads
+_SUBSYSTEM = {"radial_force": ("radial_translation", "k_r", "c_r", "mass", None),
+              "radial_torque": ("rocking", "k_rock", "c_rock", "I_rr", "I_zz"),
+              "axial_force": ("axial_translation", "k_z", "c_z", "mass", None)}
+_SUB_MODES = tuple(v[0] for v in _SUBSYSTEM.values())
+
+
+class LinePower:
+    """Measured-line powers of the least squares' forcing lines, vectorised, with analytic derivatives.
+
+    Rows: first the non-radial measurements (one line, one channel: power |A|² of
+    :func:`rwadist.extended.steady_lines` in that channel), then the radial ones (the x² + y² power of the
+    co- and counter-rotating parts of one measured line, Σ_parts 2|T(ν)|²C²Ω⁴).  Exactly the model of
+    :func:`rwadist.extended.steady_lines` for lines without law, offset or resonance, at ``height`` 0 (the
+    fit removes the lever arm first), one component each ("co" or "counter"): a component of load C·Ω² at
+    whirl rate ν = ±hΩ meets T(ν) = (k + icν)/(k − mν² + I_zz Ω ν + icν) of its direction's subsystem.
+    Written out so that the least squares costs one vectorised evaluation per point and its Jacobian none
+    (the finite-difference Jacobian of the per-line model cost one evaluation per parameter).
+
+    lines : the fit's :class:`rwadist.extended.Line` list.  omega_ax, ax_line, ax_channel : (n_ax,) speed
+    (rad/s), line index and channel index of each non-radial measurement.  omega_rad, rad_parts : (n_rad,)
+    speed and (n_rad, 2) line indices of the two parts of each radial measurement.
+    """
+
+    def __init__(self, lines, omega_ax, ax_line, ax_channel, omega_rad, rad_parts):
+        for ln in lines:
+            if ln.law is not None or ln.f_offset != 0.0 or ln.resonances or ln.sense not in ("co", "counter"):
+                raise ValueError(f"LinePower: line {ln} is not a plain co- or counter-rotating harmonic")
+        own = {"axial_force": CHANNEL_INDEX["Fz"], "axial_torque": CHANNEL_INDEX["Tz"]}
+        n_ax, n_rad = len(ax_line), len(rad_parts)
+        ax_line, rad_parts = np.asarray(ax_line, int), np.asarray(rad_parts, int).reshape(-1, 2)
+        self.n_rows = n_ax + n_rad
+        self.row = np.concatenate([np.arange(n_ax), np.repeat(np.arange(n_ax, n_ax + n_rad), 2)])
+        self.line = np.concatenate([ax_line, rad_parts.ravel()])
+        omega = np.concatenate([np.asarray(omega_ax, float), np.repeat(np.asarray(omega_rad, float), 2)])
+        weight = np.concatenate([[1.0 if own.get(lines[j].direction) == c else 0.0
+                                  for j, c in zip(ax_line, np.asarray(ax_channel, int))], np.full(2 * n_rad, 2.0)])
+        sigma = np.array([1.0 if (ln.sense == "co" or ln.direction not in RADIAL) else -1.0 for ln in lines])
+        h = np.array([ln.h for ln in lines])
+        self.omega = omega
+        self.nu = sigma[self.line] * h[self.line] * omega
+        self.scale = weight * omega**4                     # |load|² per C² and the channels the term reaches
+        mode_of = np.array([_SUB_MODES.index(_SUBSYSTEM[ln.direction][0]) if ln.direction in _SUBSYSTEM else -1
+                            for ln in lines], int)
+        self.sub = mode_of[self.line]
+        self.n_lines = len(lines)
+
+    def log_residuals(self, vals: dict, log_C: np.ndarray, log_data: np.ndarray):
+        """(r, d_mode, d_C) at parameters ``vals`` (:class:`~rwadist.extended.ExtendedParams` fields) and line
+        coefficients exp(``log_C``): r = log_data − ½ ln(model power) (n_rows,); d_mode[mode] = (∂r/∂ln k,
+        ∂r/∂ln c) of each subsystem (n_rows,) each; d_C = ∂r/∂ln C (n_rows, n_lines)."""
+        t2 = np.ones(self.nu.size)
+        dlk = np.zeros(self.nu.size)
+        dlc = np.zeros(self.nu.size)
+        for i, (mode, kn, cn, mn, gn) in enumerate(_SUBSYSTEM.values()):
+            m = self.sub == i
+            if not m.any():
+                continue
+            k, c, mass = vals[kn], vals[cn], vals[mn]
+            gyro = vals[gn] if gn else 0.0
+            nu, om = self.nu[m], self.omega[m]
+            cnu2 = (c * nu) ** 2
+            num = k * k + cnu2
+            re = k - mass * nu**2 + gyro * om * nu
+            den = re**2 + cnu2
+            t2[m] = num / den
+            dlk[m] = 2.0 * k * (k / num - re / den)        # ∂ ln|T|² / ∂ ln k
+            dlc[m] = 2.0 * cnu2 * (1.0 / num - 1.0 / den)  # ∂ ln|T|² / ∂ ln c
+        p_term = t2 * np.exp(2.0 * log_C[self.line]) * self.scale
+        p_row = np.bincount(self.row, p_term, minlength=self.n_rows)
+        live = p_row > 1e-300
+        r = log_data - 0.5 * np.log(np.maximum(p_row, 1e-300))
+        share = np.where(live[self.row], p_term / np.where(live, p_row, 1.0)[self.row], 0.0)
+        d_mode = {}
+        for i, mode in enumerate(_SUB_MODES):
+            m = self.sub == i
+            d_mode[mode] = (-0.5 * np.bincount(self.row[m], (share * dlk)[m], minlength=self.n_rows),
+                            -0.5 * np.bincount(self.row[m], (share * dlc)[m], minlength=self.n_rows))
+        d_C = np.zeros((self.n_rows, self.n_lines))
+        np.add.at(d_C, (self.row, self.line), -share)
+        return r, d_mode, d_C
+
+
 def _scan_all(meas_lines, la, sa, aa, inertia_ratio, tolerance):
     """Profile scan (:mod:`rwadist.mode_scan`) of each mode on the measured lines."""
     lr, sr, pr, dr = _radial_power(meas_lines)
@@ -354,14 +455,11 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     owner = np.array(owner)
     # axial measurements: per channel amplitude; radial: x²+y² power per run
     lr, sr, pr, dr = _radial_power(meas.lines)
-    speeds, inv = np.unique(np.concatenate([sa, sr]), return_inverse=True)
-    ia, ir = inv[:sa.size], inv[sa.size:]
     line_of = {}
     for k, j in enumerate(owner):
         line_of.setdefault(int(j), []).append(k)
     ax_line = np.array([line_of[int(j)][0] for j in la], int)
     rad_parts = np.array([line_of[int(j)] for j in lr], int).reshape(-1, 2) if lr.size else np.zeros((0, 2), int)
-    rad_ch = np.array([[CHANNEL_INDEX[c] for c in DIRECTION_CHANNELS[d]] for d in dr], int).reshape(-1, 2)
 
     identified = {m: f_modes[m] is not None for m in _MODE_PARAMS}
     z_start = {m: (scans[m].zeta if identified[m] else zeta0) for m in _MODE_PARAMS}
@@ -370,6 +468,9 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                 c_rock=2 * z_start["rocking"] * math.sqrt(k_rock * I_rr),
                 c_z=2 * z_start["axial_translation"] * math.sqrt(k_z * mass), U_s=0.0, U_d=0.0)
     x_lines = np.log([ln.C for ln in lines])
+
+    power = LinePower(lines, sa, ax_line, ca, sr, rad_parts)
+    log_data = np.concatenate([np.log(np.maximum(aa, 1e-300)), 0.5 * np.log(np.maximum(pr, 1e-300))])
 
     def least_squares(free_modes):
         """Log-amplitude least squares with the stiffness and damping of ``free_modes`` free."""
@@ -393,17 +494,31 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
             vals["U_d"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_torque"), 0.0)
             return ext.ExtendedParams(**vals), lns
 
-        def residuals(theta):
-            p, lns = unpack(theta)
-            _, A = ext.steady_lines(p, lns, speeds)
-            P = np.abs(A) ** 2
-            r_ax = np.log(np.maximum(aa, 1e-300)) - 0.5 * np.log(np.maximum(P[ia, ax_line, ca], 1e-300))
-            pred = np.zeros(lr.size)
-            for part in range(2):
-                for c in range(2):
-                    pred += P[ir, rad_parts[:, part], rad_ch[:, c]]
-            r_rad = 0.5 * (np.log(np.maximum(pr, 1e-300)) - np.log(np.maximum(pred, 1e-300)))
-            return np.concatenate([r_ax, r_rad])
+        last = {}
+
+        def evaluate(theta):
+            """Residuals and their analytic Jacobian at ``theta`` (computed once per point: scipy asks for
+            the residuals and then the Jacobian at the same point)."""
+            key = theta.tobytes()
+            if last.get("key") != key:
+                vals = dict(base)
+                clamped = {}
+                for i, m in enumerate(free_modes):
+                    kn, cn, inertia = _MODE_PARAMS[m]
+                    vals[kn] = math.exp(theta[2 * i])
+                    crit = 1.9 * math.sqrt(vals[kn] * vals[inertia])
+                    clamped[m] = math.exp(theta[2 * i + 1]) > crit
+                    vals[cn] = min(math.exp(theta[2 * i + 1]), crit)
+                r, d_mode, d_C = power.log_residuals(vals, theta[n_mode:], log_data)
+                J = np.zeros((r.size, theta.size))
+                for i, m in enumerate(free_modes):
+                    dk, dc = d_mode[m]
+                    # a clamped damping follows the stiffness (c = 1.9·sqrt(k·inertia): d ln c / d ln k = 1/2)
+                    J[:, 2 * i] = dk + 0.5 * dc if clamped[m] else dk
+                    J[:, 2 * i + 1] = 0.0 if clamped[m] else dc
+                J[:, n_mode:] = d_C
+                last.update(key=key, r=r, J=J)
+            return last
 
         # bounds keep the search physical: stiffness within ±10 % of the scan's (frequency ±5 %),
         # damping ratio in [1e-4, 0.95], line coefficients within 1000x (down to 1e-4 of the line
@@ -416,7 +531,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
             hi += [math.log(base[kn] * 1.1), math.log(0.95 * crit * 2)]
         lo += list(x0[n_mode:] - math.log(1e4))
         hi += list(x0[n_mode:] + math.log(1e3))
-        res = optimize.least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
+        res = optimize.least_squares(lambda th: evaluate(th)["r"], x0, jac=lambda th: evaluate(th)["J"],
+                                     bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
                                      verbose=2 if progress else 0)
         dof = max(res.fun.size - res.x.size, 1)
         s2 = float(np.sum(res.fun**2) / dof)

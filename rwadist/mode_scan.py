@@ -66,15 +66,29 @@ class ModeScan:
 
 def transmissibility_sq(nu, omega, f0_hz, zeta, a):
     """|T(ν)|² on a grid: ``nu``, ``omega`` (rows,) rad/s; ``f0_hz``, ``zeta``, ``a`` (grid,) -> (grid, rows)."""
+    return _transmissibility_pair(nu, omega, f0_hz, zeta, a, both=False)[0]
+
+
+def _transmissibility_pair(nu, omega, f0_hz, zeta, a, both: bool):
+    """(|T(+ν)|², |T(−ν)|² or None) on a grid, in real arithmetic: |T|² = (ω0⁴ + d²)/((ω0² − ν² ± aΩν)² + d²)
+    with d = 2ζω0ν; the numerator, d² and ω0² − ν² are shared by the two senses."""
     w0 = 2 * np.pi * np.asarray(f0_hz, float)[:, None]
     z = np.asarray(zeta, float)[:, None]
     a = np.asarray(a, float)[:, None]
     nu = np.asarray(nu, float)[None, :]
     om = np.abs(np.asarray(omega, float))[None, :]
-    damp = 2 * z * w0 * nu
-    num = w0**2 + 1j * damp
-    den = w0**2 - nu**2 + a * om * nu + 1j * damp
-    return np.abs(num) ** 2 / np.abs(den) ** 2
+    w02 = w0**2
+    d2 = (2 * z * w0 * nu) ** 2
+    num = w02**2 + d2
+    rest = w02 - nu**2
+    gyro = a * om * nu
+    if not np.any(gyro):
+        # no gyroscopic term (translation modes, or a = 0): both senses see the same |T|²
+        t = num / (rest**2 + d2)
+        return t, (t if both else None)
+    u = num / ((rest + gyro) ** 2 + d2)
+    v = num / ((rest - gyro) ** 2 + d2) if both else None
+    return u, v
 
 
 def _profile_ssr(line, h, omega, power, f0, zeta, a, two_parts: bool):
@@ -86,12 +100,14 @@ def _profile_ssr(line, h, omega, power, f0, zeta, a, two_parts: bool):
     onehot = np.zeros((line.size, n_lines))
     onehot[np.arange(line.size), line] = 1.0
     scale = np.abs(omega) ** 4 / power                       # model/data per unit forcing power
-    u = transmissibility_sq(h * np.abs(omega), omega, f0, zeta, a) * scale
+    u, v = _transmissibility_pair(h * np.abs(omega), omega, f0, zeta, a, both=two_parts)
+    same = v is u            # no gyroscopic split: the two parts are one (their 2x2 system is singular)
+    u = u * scale
     s1 = onehot.sum(axis=0)[None, :]
     suu, su = (u * u) @ onehot, u @ onehot
-    if not two_parts:
+    if not two_parts or same:
         return np.sum(s1 - su**2 / suu, axis=1)
-    v = transmissibility_sq(-h * np.abs(omega), omega, f0, zeta, a) * scale
+    v = v * scale
     svv, sv, suv = (v * v) @ onehot, v @ onehot, (u * v) @ onehot
     det = suu * svv - suv**2
     safe = np.where(np.abs(det) > 1e-14 * suu * svv, det, np.nan)
@@ -104,7 +120,8 @@ def _profile_ssr(line, h, omega, power, f0, zeta, a, two_parts: bool):
     return np.sum(ssr, axis=1)
 
 
-def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, chunk=4096):
+def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, chunk=256):
+    # chunks of ~chunk·256 grid-point × row elements: the temporaries stay in cache (4x faster than 16x larger)
     F, Z, A = np.meshgrid(f0_grid, zeta_grid, a_grid, indexing="ij")
     F, Z, A = F.ravel(), Z.ravel(), A.ravel()
     ssr = np.empty(F.size)
