@@ -21,15 +21,96 @@ from ..state import State
 from .base import register, schema_entry
 
 
+#: Smallest mean log power gain (ln of measured / C·Ω² line power) a fixture resonance must show near one
+#: frequency in EVERY load direction to be divided out before the modes are located: a power gain of 2.  A
+#: wheel mode amplifies one direction's lines (translation the radial forces, rocking the radial torques,
+#: axial the axial force); only a resonance of the stand lifts them all at one frequency.
+STAND_MIN_LOG_GAIN = float(np.log(2.0))
+#: Half width of the window (relative to the frequency) in which a direction's log gains are averaged.
+STAND_WINDOW = 0.05
+
+
+def _line_log_gains(fit) -> dict:
+    """direction -> (f Hz, y) of every measured line amplitude of an empirical fit: f = h|Ω|/2π and
+    y = 2 ln(a / (C·Ω²)), the log power gain over the line's hard-mounted law."""
+    out = {}
+    for x in fit.lines:
+        w = np.abs(np.asarray(x.speed, dtype=float))
+        a = np.asarray(x.amplitude, dtype=float)
+        ok = np.isfinite(a) & (a > 0) & (w > 0)
+        if x.C <= 0 or not ok.any():
+            continue
+        f, y = out.setdefault(x.direction, ([], []))
+        f.append(x.h * w[ok] / (2 * np.pi))
+        y.append(2.0 * np.log(a[ok] / (x.C * w[ok] ** 2)))
+    return {d: (np.concatenate(f), np.concatenate(y)) for d, (f, y) in out.items()}
+
+
+def stand_resonance_start(fit, min_points: int = 2):
+    """(f_r Hz, ζ, peak gain) of a fixture resonance seen in the empirical fit ``fit``, or None.
+
+    The signature of a stand resonance is one frequency at which the lines of every load direction are
+    amplified over their C·Ω² law (a wheel mode lifts one direction only).  Score of a frequency f: the
+    smallest, over the directions with lines, of the mean log power gain of that direction's measurements
+    within ±:data:`STAND_WINDOW` of f (at least ``min_points`` of them); a stand resonance is proposed at
+    the best score when it reaches :data:`STAND_MIN_LOG_GAIN` in two directions or more.  ζ and the peak
+    gain: robust (soft-L1) least squares of ln|H|² (:func:`rwadist.resonance.resonance`) on every direction's
+    log gains within ±25 % of f, f_r free within ±10 %.  A start only: the search refits it beside the modes.
+    """
+    from scipy.optimize import least_squares
+
+    from ...resonance import resonance
+
+    pts = {d: fy for d, fy in _line_log_gains(fit).items() if fy[0].size >= 2 * min_points}
+    if len(pts) < 2:
+        return None
+    f_all = np.concatenate([fy[0] for fy in pts.values()])
+    lo, hi = float(np.min(f_all)), float(np.max(f_all))
+    if hi <= lo * (1 + 2 * STAND_WINDOW):
+        return None
+    grid = np.exp(np.arange(np.log(lo), np.log(hi), 0.005))                     # 0.5 % steps
+    score = np.full(grid.size, np.inf)
+    for f, y in pts.values():
+        inside = np.abs(f[None, :] / grid[:, None] - 1.0) <= STAND_WINDOW
+        cnt = inside.sum(1)
+        mean = np.where(cnt >= min_points, (inside * y[None, :]).sum(1) / np.maximum(cnt, 1), -np.inf)
+        score = np.minimum(score, mean)
+    i = int(np.argmax(score))
+    if not score[i] >= STAND_MIN_LOG_GAIN:
+        return None
+    f_s = float(grid[i])
+    f = np.concatenate([fy[0] for fy in pts.values()])
+    y = np.concatenate([fy[1] for fy in pts.values()])
+    near = np.abs(f / f_s - 1.0) <= 0.25
+    f, y = f[near], y[near]
+
+    def res(x):
+        return y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2)
+
+    lb, ub = np.log([0.9 * f_s, 1e-3, 1.1]), np.log([1.1 * f_s, 0.5, 200.0])
+    g0 = float(np.clip(np.exp(np.max(y) / 2.0), 1.2, 100.0))
+    best = None
+    for z0 in (0.01, 0.03, 0.1):
+        sol = least_squares(res, np.clip(np.log([f_s, z0, g0]), lb + 1e-9, ub - 1e-9), loss="soft_l1",
+                            f_scale=0.5, bounds=(lb, ub))
+        if best is None or sol.cost < best.cost:
+            best = sol
+    return tuple(float(v) for v in np.exp(best.x))
+
+
 def _fit_runs(ctx: Context, runs, state: State):
     """(SteadyTest, EmpiricalFit, ExtendedFit) of ``runs``, or None when the runs show no modal amplification
     (or the extended fit fails).
 
-    A fixture resonance on every channel is fitted beside the modes, never into them: after a first
-    extended fit, a ``fixed_resonance`` common to all channels (role test_stand) is fitted on that base;
-    when it is a resonance (:data:`MIN_PEAK_GAIN`), the extended fit is repeated with it divided out of the
-    measured lines (``stand`` of :func:`rwadist.extended_fit.fit_extended`).  The stand resonance itself is
-    left to the search (it is then a clear residual of the extended base: a ``fixed_resonance`` effect)."""
+    A fixture resonance on every channel is fitted beside the modes, never into them: when the empirical
+    fit shows lines of every direction amplified at one frequency (:func:`stand_resonance_start`), that
+    resonance is divided out of the measured lines before the modes are located (``stand`` of
+    :func:`rwadist.extended_fit.fit_extended`; a fixture resonance taken for a mode spoils every mode).
+    After the extended fit, a ``fixed_resonance`` common to all channels (role test_stand) is fitted on
+    that base; when it is a resonance (:data:`MIN_PEAK_GAIN`), the extended fit is repeated with it divided
+    out; when it is not while one was divided out, the stand was not confirmed and the fit is repeated
+    without it.  The stand resonance itself is left to the search (a clear residual of the extended base:
+    a ``fixed_resonance`` effect)."""
     from ...data import SteadyTest
     from ...empirical import fit_empirical
     from ...extended_fit import amplification_peaks, fit_extended
@@ -43,15 +124,19 @@ def _fit_runs(ctx: Context, runs, state: State):
     fit = fit_empirical(sp)
     if not amplification_peaks(fit):
         return None
+    stand0 = stand_resonance_start(fit) if len(ctx.channels) > 3 else None
     try:
-        efit = fit_extended(test, fit)
+        efit = fit_extended(test, fit, stand=stand0)
         if len(efit.unconstrained) < 3 and len(ctx.channels) > 3:
             from ..effects.fixed_resonance import MIN_PEAK_GAIN, FixedResonance
 
             st = SuspensionModes.from_fit(efit, fit, len(runs)).apply(state)
-            stand = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), role="test_stand")
+            stand = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs),
+                                       None if stand0 is None else stand0[0], role="test_stand")
             if stand is not None and abs(np.log(stand.peak_gain)) >= np.log(MIN_PEAK_GAIN):
                 efit = fit_extended(test, fit, stand=(stand.f_r, stand.zeta, stand.peak_gain))
+            elif stand0 is not None:
+                efit = fit_extended(test, fit)
     except ValueError:
         return None
     if len(efit.unconstrained) == 3:
