@@ -22,10 +22,12 @@ from .base import register, schema_entry
 
 
 #: Smallest mean log power gain (ln of measured / C·Ω² line power) a fixture resonance must show near one
-#: frequency in EVERY load direction to be divided out before the modes are located: a power gain of 2.  A
+#: frequency in EVERY load direction to be divided out before the modes are located: a power gain of 1.5.  A
 #: wheel mode amplifies one direction's lines (translation the radial forces, rocking the radial torques,
 #: axial the axial force); only a resonance of the stand lifts them all at one frequency.
-STAND_MIN_LOG_GAIN = float(np.log(2.0))
+STAND_MIN_LOG_GAIN = float(np.log(1.5))
+#: Rounds of (stand on the modes' base, modes with that stand divided out) at most.
+STAND_ROUNDS = 4
 #: Half width of the window (relative to the frequency) in which a direction's log gains are averaged.
 STAND_WINDOW = 0.05
 
@@ -98,9 +100,11 @@ def stand_resonance_start(fit, min_points: int = 2):
     return tuple(float(v) for v in np.exp(best.x))
 
 
-def _fit_runs(ctx: Context, runs, state: State):
-    """(SteadyTest, EmpiricalFit, ExtendedFit) of ``runs``, or None when the runs show no modal amplification
-    (or the extended fit fails).
+def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None):
+    """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
+    amplification (or the extended fit fails); ``stand`` is the fixture resonance (f_r Hz, ζ, peak gain)
+    divided out of the lines, or None.  ``stand_start``: the stand to start from (a refit on every run
+    starts from the one fitted on half of them), else the one :func:`stand_resonance_start` proposes.
 
     A fixture resonance on every channel is fitted beside the modes, never into them: when the empirical
     fit shows lines of every direction amplified at one frequency (:func:`stand_resonance_start`), that
@@ -108,9 +112,9 @@ def _fit_runs(ctx: Context, runs, state: State):
     :func:`rwadist.extended_fit.fit_extended`; a fixture resonance taken for a mode spoils every mode).
     After the extended fit, a ``fixed_resonance`` common to all channels (role test_stand) is fitted on
     that base; when it is a resonance (:data:`MIN_PEAK_GAIN`), the extended fit is repeated with it divided
-    out; when it is not while one was divided out, the stand was not confirmed and the fit is repeated
-    without it.  The stand resonance itself is left to the search (a clear residual of the extended base:
-    a ``fixed_resonance`` effect)."""
+    out (up to :data:`STAND_ROUNDS` rounds, until the stand settles); when it is not while one was divided
+    out, the stand was not confirmed and the fit is repeated without it.  The stand resonance itself is left
+    to the search (a clear residual of the extended base: a ``fixed_resonance`` effect)."""
     from ...data import SteadyTest
     from ...empirical import fit_empirical
     from ...extended_fit import amplification_peaks, fit_extended
@@ -124,24 +128,35 @@ def _fit_runs(ctx: Context, runs, state: State):
     fit = fit_empirical(sp)
     if not amplification_peaks(fit):
         return None
-    stand0 = stand_resonance_start(fit) if len(ctx.channels) > 3 else None
+    stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
     try:
-        efit = fit_extended(test, fit, stand=stand0)
-        if len(efit.unconstrained) < 3 and len(ctx.channels) > 3:
+        efit = fit_extended(test, fit, stand=stand)
+        for _ in range(STAND_ROUNDS):
+            if len(efit.unconstrained) == 3 or len(ctx.channels) <= 3:
+                break
             from ..effects.fixed_resonance import MIN_PEAK_GAIN, FixedResonance
 
+            # the stand on the modes' base: the lines are predicted without it, so this is the whole stand
             st = SuspensionModes.from_fit(efit, fit, len(runs)).apply(state)
-            stand = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs),
-                                       None if stand0 is None else stand0[0], role="test_stand")
-            if stand is not None and abs(np.log(stand.peak_gain)) >= np.log(MIN_PEAK_GAIN):
-                efit = fit_extended(test, fit, stand=(stand.f_r, stand.zeta, stand.peak_gain))
-            elif stand0 is not None:
-                efit = fit_extended(test, fit)
+            new = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), None if stand is None else stand[0],
+                                     role="test_stand")
+            if new is None or abs(np.log(new.peak_gain)) < np.log(MIN_PEAK_GAIN):
+                if stand is not None:           # the stand divided out is not confirmed: the fit without it
+                    efit = fit_extended(test, fit)
+                    stand = None
+                break
+            new = (new.f_r, new.zeta, new.peak_gain)
+            settled = (stand is not None and abs(new[0] / stand[0] - 1) < 0.002
+                       and abs(np.log(new[2] / stand[2])) < 0.02)
+            stand = new
+            efit = fit_extended(test, fit, stand=stand)
+            if settled:
+                break
     except ValueError:
         return None
     if len(efit.unconstrained) == 3:
         return None                     # no mode located: nothing to name
-    return test, fit, efit
+    return test, fit, efit, stand
 
 
 @register(order=100)
@@ -152,7 +167,9 @@ class SuspensionModes:
     model : the extended model (:func:`rwadist.extended_fit.to_model`: harmonics = forcing lines, with the
         ``analytical`` section).  f0_Hz : mode frequencies at rest, Hz ("radial_translation", "rocking",
         "axial"); zeta : damping ratios; inertia_ratio : I_zz/I_rr; unconstrained : modes the data do not
-        locate (starting values, as in ``analytical.unconstrained``); n_runs : runs fitted.
+        locate (starting values, as in ``analytical.unconstrained``); n_runs : runs fitted; stand : the fixture
+        resonance (f_r Hz, ζ, peak gain) divided out of the lines for the fit, or None (the search names it
+        as a ``fixed_resonance`` of its own; not part of this effect's parameters).
     """
 
     model: object = field(repr=False)
@@ -161,6 +178,7 @@ class SuspensionModes:
     inertia_ratio: float
     unconstrained: tuple
     n_runs: int
+    stand: tuple | None = None
     kind: str = "suspension_modes"
     #: the search takes a passing suspension_modes before any other effect: the wheel's own modes first
     first = True
@@ -170,7 +188,7 @@ class SuspensionModes:
         return ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")
 
     @staticmethod
-    def from_fit(efit, fit, n_runs: int) -> "SuspensionModes":
+    def from_fit(efit, fit, n_runs: int, stand: tuple | None = None) -> "SuspensionModes":
         from ...extended_fit import to_model
 
         p = efit.params
@@ -178,7 +196,7 @@ class SuspensionModes:
               "axial": float(np.sqrt(p.k_z / p.mass) / (2 * np.pi))}
         zeta = {"radial_translation": float(p.zeta_r), "rocking": float(p.zeta_rock), "axial": float(p.zeta_z)}
         return SuspensionModes(to_model(efit, fit), f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained),
-                               n_runs)
+                               n_runs, stand)
 
     def apply(self, state: State) -> State:
         import copy
@@ -195,8 +213,9 @@ class SuspensionModes:
         return s
 
     def refit(self, ctx: Context, state: State) -> "SuspensionModes":
-        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
-        return SuspensionModes.fit(ctx, state, ctx.runs) or self
+        """Refitted on every run (``ctx.runs``), starting from this fit's stand resonance; itself when that fit
+        fails."""
+        return SuspensionModes.fit(ctx, state, ctx.runs, self.stand) or self
 
     def whirl_Hz(self, omega_rad_s: float) -> dict:
         """Whirl frequencies (Hz) at wheel speed ``omega_rad_s``: translation, rocking forward/backward, axial."""
@@ -218,11 +237,11 @@ class SuspensionModes:
         return schema_entry(self)
 
     @staticmethod
-    def fit(ctx: Context, state: State, runs) -> "SuspensionModes | None":
+    def fit(ctx: Context, state: State, runs, stand_start: tuple | None = None) -> "SuspensionModes | None":
         """The modes fitted on ``runs`` (per unit mass and inertia), or None when those runs show no modal
-        amplification or no mode can be located."""
-        got = _fit_runs(ctx, runs, state)
-        return None if got is None else SuspensionModes.from_fit(got[2], got[1], len(runs))
+        amplification or no mode can be located; ``stand_start``: see :func:`_fit_runs`."""
+        got = _fit_runs(ctx, runs, state, stand_start)
+        return None if got is None else SuspensionModes.from_fit(got[2], got[1], len(runs), got[3])
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
