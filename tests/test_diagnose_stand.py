@@ -16,8 +16,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import independent_wheel as iw  # noqa: E402
 
-from rwadist import api  # noqa: E402
-from rwadist import catalogue  # noqa: E402
+from rwadist import api, catalogue  # noqa: E402
 from rwadist.data import SteadyTest  # noqa: E402
 from rwadist.diagnose import Context, MissingHarmonic, initial_state  # noqa: E402
 from rwadist.diagnose.effects.suspension_modes import stand_resonance_start  # noqa: E402

@@ -20,7 +20,6 @@ from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
 
-
 #: Smallest mean log power gain (ln of measured / C·Ω² line power) a fixture resonance must show near one
 #: frequency in EVERY load direction to be divided out before the modes are located: a power gain of 1.5.  A
 #: wheel mode amplifies one direction's lines (translation the radial forces, rocking the radial torques,
