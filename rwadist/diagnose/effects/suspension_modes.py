@@ -25,6 +25,9 @@ from .base import register, schema_entry
 #: wheel mode amplifies one direction's lines (translation the radial forces, rocking the radial torques,
 #: axial the axial force); only a resonance of the stand lifts them all at one frequency.
 STAND_MIN_LOG_GAIN = float(np.log(1.5))
+#: Largest damping ratio of a proposed fixture resonance: a fixture resonance is sharp; a "resonance" as wide as
+#: the fit allows (ζ → 0.5) is a broad tilt of the line gains (a wheel mode's skirt, model error), not a stand.
+STAND_MAX_ZETA = 0.2
 #: Rounds of (stand on the modes' base, modes with that stand divided out) at most.
 STAND_ROUNDS = 4
 #: Half width of the window (relative to the frequency) in which a direction's log gains are averaged.
@@ -56,7 +59,9 @@ def stand_resonance_start(fit, min_points: int = 2):
     within ±:data:`STAND_WINDOW` of f (at least ``min_points`` of them); a stand resonance is proposed at
     the best score when it reaches :data:`STAND_MIN_LOG_GAIN` in two directions or more.  ζ and the peak
     gain: robust (soft-L1) least squares of ln|H|² (:func:`rwadist.resonance.resonance`) on every direction's
-    log gains within ±25 % of f, f_r free within ±10 %.  A start only: the search refits it beside the modes.
+    log gains within ±25 % of f, f_r free within ±10 %; refused when ζ > :data:`STAND_MAX_ZETA` (a broad
+    tilt, not a resonance) or the peak gain is below 1 + :data:`STAND_MIN_LOG_GAIN`/2.  A start only: the
+    search refits it beside the modes.
     """
     from scipy.optimize import least_squares
 
@@ -96,7 +101,10 @@ def stand_resonance_start(fit, min_points: int = 2):
                             f_scale=0.5, bounds=(lb, ub))
         if best is None or sol.cost < best.cost:
             best = sol
-    return tuple(float(v) for v in np.exp(best.x))
+    f_r, zeta, gain = (float(v) for v in np.exp(best.x))
+    if zeta > STAND_MAX_ZETA or gain < 1.0 + STAND_MIN_LOG_GAIN / 2:
+        return None
+    return f_r, zeta, gain
 
 
 def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None):
