@@ -178,13 +178,19 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         passing = sorted((h for h in judged if h.passed), key=lambda h: not getattr(h.effect, "first", False))
         for h in judged:
             h.passed = False
-        if not passing:
-            hyps += judged[:5]
+        # refitted on every run, an effect must still be what its family proposes (an exponent that moved back
+        # to 2 within its standard errors is no new law): else the next passing hypothesis is taken
+        best = refit = None
+        for h in passing:
+            refit = h.effect.refit(ctx, state)
+            if getattr(refit, "significant", lambda: True)():
+                best = h
+                break
+        hyps += judged[:5] + ([best] if best is not None and best not in judged[:5] else [])
+        if best is None:
             break
-        best = passing[0]
         best.passed = True
-        hyps += judged[:5]
-        state = best.effect.refit(ctx, state).apply(state)
+        state = refit.apply(state)
         best.effect = state.effects[-1]
     else:
         it = max_iterations
