@@ -259,8 +259,11 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         Start from a preset's model instead (not with ``model``).
     base : {"auto", "empirical", "extended"}
         Line prediction: C·Ω² hard mounted, or through the suspension modes of the model's analytical
-        section; "auto" (:func:`rwadist.diagnose.resolve_base`): extended when the model has an analytical
-        section and the data's record does not say the wheel's modes were off.
+        section; "auto" (:func:`rwadist.diagnose.resolve_base`, the one rule of the library and the CLI):
+        extended when the model has an analytical section whose modes are not assumed (a catalogue
+        datasheet wheel's are) and the data's record does not say the wheel's modes were off; otherwise
+        empirical, and the search may name the wheel's ``suspension_modes`` fitted from the data and carry
+        on from them (:func:`rwadist.diagnose.search.fits_modes_from_data`).
     nperseg : int or None
         FFT length, samples; default :func:`diagnose_nperseg`.
     f_lim : float or None
@@ -286,6 +289,11 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         model = _as_model(model, "diagnose")
     elif preset:
         model = _preset_model(preset)
+        from .catalogue import source_modes_assumed
+
+        if model.analytical and source_modes_assumed(None, preset):
+            # a datasheet wheel of the catalogue: its modes are assumed, which resolve_base reads from the model
+            model.analytical = {**dict(model.analytical), "modes_assumed": True}
     spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))
     return _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base)
 

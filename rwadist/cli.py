@@ -520,13 +520,13 @@ def cmd_diagnose(args) -> int:
     if model is not None:
         _warn_unconstrained(model, args.model, "diagnose's extended base")
     # a starting model whose suspension modes are assumed (datasheet wheel) is hard-mounted unless
-    # --base extended asks for its assumed modes explicitly
+    # --base extended asks for its assumed modes explicitly: the rule is resolve_base's (api.diagnose)
     assumed = catalogue.source_modes_assumed(model, args.preset)
     base = args.base
     if assumed and base == "auto":
-        base = "empirical"
         print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); the starting "
-              "prediction is hard-mounted (C*omega^2); --base extended uses the assumed modes")
+              "prediction is hard-mounted (C*omega^2), modes the data show are fitted from them; --base extended "
+              "uses the assumed modes")
     try:
         with working("rwadist diagnose: searching the residual for effects"):
             diag = api.diagnose(test, model, preset=args.preset, base=base, nperseg=args.nperseg,

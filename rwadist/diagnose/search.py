@@ -114,23 +114,38 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration):
 BASES = ("empirical", "extended", "auto")
 
 
+def _modes_off(test) -> bool:
+    """True when the test's record says the wheel's modes were off (a virtual-stand test made with modes=False)."""
+    return test is not None and getattr(test, "meta", {}).get("modes") is False
+
+
 def resolve_base(model: WheelModel | None, base: str = "empirical", test=None) -> str:
     """'empirical' or 'extended' for a ``base`` request (the one rule of the library and the CLI).
 
-    'auto' is 'extended' when the model has an ``analytical`` section, unless the test's record says the
-    wheel's modes were off (``test.meta["modes"] is False``: a virtual-stand test made with modes=False is
+    'auto' is 'extended' when the model has an ``analytical`` section whose suspension modes are not
+    assumed (a catalogue datasheet wheel carries ``analytical.modes_assumed``: its modes are guesses, the
+    data's own are fitted instead, :func:`fits_modes_from_data`), unless the test's record says the wheel's
+    modes were off (``test.meta["modes"] is False``: a virtual-stand test made with modes=False is
     hard-mounted C·Ω² truth); else 'empirical'.  'extended' without an analytical section is a ValueError.
     ``test``: the SteadyTest (or None: no record)."""
+    from ..catalogue import modes_assumed
+
     if base not in BASES:
         raise ValueError(f"diagnose: base must be one of {BASES}, got {base!r}")
     has = model is not None and bool(getattr(model, "analytical", None))
     if base == "auto":
-        modes_off = test is not None and getattr(test, "meta", {}).get("modes") is False
-        return "extended" if has and not modes_off else "empirical"
+        return "extended" if has and not modes_assumed(model) and not _modes_off(test) else "empirical"
     if base == "extended" and not has:
         raise ValueError("diagnose: base 'extended' needs a model with an analytical section "
                          "(rwadist.extended.params_to_dict), e.g. preset('ithaco-e').to_model()")
     return base
+
+
+def fits_modes_from_data(model: WheelModel | None, base: str = "empirical", test=None) -> bool:
+    """True when the search may name the wheel's own ``suspension_modes``, fitted from the data, and carry on
+    from that extended base: the request is 'auto', it resolves to 'empirical' (:func:`resolve_base`: no
+    analytical model, or one whose modes are assumed) and the test does not record the modes off."""
+    return base == "auto" and resolve_base(model, base, test) == "empirical" and not _modes_off(test)
 
 
 def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float = 4.0, min_gain: float = 0.05,
@@ -141,7 +156,9 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     computed from (50 % overlap), needed for ``cross_coupling`` (phases); without it that class is not tried.
     base : 'empirical' (default; lines C·Ω², hard mounted), 'extended' (lines through the suspension modes of
     the model's ``analytical`` section, :func:`rwadist.extended.steady_lines`) or 'auto' (extended when the
-    model has an analytical section and ``test`` does not record the modes off); see :func:`resolve_base`.
+    model has an analytical section with modes not assumed and ``test`` does not record the modes off;
+    otherwise empirical, and the search may move to the wheel's suspension modes fitted from the data); see
+    :func:`resolve_base` and :func:`fits_modes_from_data`.
     Returns a :class:`Diagnosis` whose ``model`` carries the added harmonics in ``empirical`` and every
     effect in ``effects``.
     """
@@ -157,8 +174,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     ctx = Context(spectra, channels, test)
     # 'auto' on the empirical base (no analytical model) may move to the extended base: the wheel's own
     # suspension modes, fitted from the data (``suspension_modes``), unless the test records the modes off
-    ctx.base_switch = (request == "auto" and base == "empirical"
-                       and not (test is not None and getattr(test, "meta", {}).get("modes") is False))
+    ctx.base_switch = fits_modes_from_data(model, request, test)
     state0 = initial_state(ctx, model, ext_params)
     state = state0
     hyps = []
@@ -173,13 +189,19 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         passing = sorted((h for h in judged if h.passed), key=lambda h: not getattr(h.effect, "first", False))
         for h in judged:
             h.passed = False
-        if not passing:
-            hyps += judged[:5]
+        # refitted on every run, an effect must still be what its family proposes (an exponent that moved back
+        # to 2 within its standard errors is no new law): else the next passing hypothesis is taken
+        best = refit = None
+        for h in passing:
+            refit = h.effect.refit(ctx, state)
+            if getattr(refit, "significant", lambda: True)():
+                best = h
+                break
+        hyps += judged[:5] + ([best] if best is not None and best not in judged[:5] else [])
+        if best is None:
             break
-        best = passing[0]
         best.passed = True
-        hyps += judged[:5]
-        state = best.effect.refit(ctx, state).apply(state)
+        state = refit.apply(state)
         best.effect = state.effects[-1]
     else:
         it = max_iterations

@@ -42,6 +42,12 @@ class AmplitudeLaw:
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""
         return AmplitudeLaw.fit(ctx, state, self.direction, self.h, ctx.runs) or self
 
+    def significant(self) -> bool:
+        """False when the exponent lies within EXPONENT_Z standard errors of the model's 2 (no new law, only a
+        re-estimate of the line's C): what :meth:`candidates` proposes, checked again after the refit on
+        every run (:func:`rwadist.diagnose.search.diagnose`)."""
+        return not abs(self.exponent - 2.0) <= EXPONENT_Z * self.exponent_stderr
+
     def to_schema(self) -> dict:
         return schema_entry(self)
 
@@ -79,6 +85,6 @@ class AmplitudeLaw:
                 # an exponent within EXPONENT_Z standard errors of the model's 2 is no new law, only a
                 # re-estimate of the line's C (on the extended base the fit's C is a compromise across the
                 # modes, a few per mille off where the line is strong): not proposed
-                if e is not None and not abs(e.exponent - 2.0) <= EXPONENT_Z * e.exponent_stderr:
+                if e is not None and e.significant():
                     out.append(e)
         return out

@@ -20,16 +20,108 @@ from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
 
+#: Smallest mean log power gain (ln of measured / C·Ω² line power) a fixture resonance must show near one
+#: frequency in EVERY load direction to be divided out before the modes are located: a power gain of 1.5.  A
+#: wheel mode amplifies one direction's lines (translation the radial forces, rocking the radial torques,
+#: axial the axial force); only a resonance of the stand lifts them all at one frequency.
+STAND_MIN_LOG_GAIN = float(np.log(1.5))
+#: Largest damping ratio of a proposed fixture resonance: a fixture resonance is sharp; a "resonance" as wide as
+#: the fit allows (ζ → 0.5) is a broad tilt of the line gains (a wheel mode's skirt, model error), not a stand.
+STAND_MAX_ZETA = 0.2
+#: Rounds of (stand on the modes' base, modes with that stand divided out) at most.
+STAND_ROUNDS = 4
+#: Half width of the window (relative to the frequency) in which a direction's log gains are averaged.
+STAND_WINDOW = 0.05
 
-def _fit_runs(ctx: Context, runs, state: State):
-    """(SteadyTest, EmpiricalFit, ExtendedFit) of ``runs``, or None when the runs show no modal amplification
-    (or the extended fit fails).
 
-    A fixture resonance on every channel is fitted beside the modes, never into them: after a first
-    extended fit, a ``fixed_resonance`` common to all channels (role test_stand) is fitted on that base;
-    when it is a resonance (:data:`MIN_PEAK_GAIN`), the extended fit is repeated with it divided out of the
-    measured lines (``stand`` of :func:`rwadist.extended_fit.fit_extended`).  The stand resonance itself is
-    left to the search (it is then a clear residual of the extended base: a ``fixed_resonance`` effect)."""
+def _line_log_gains(fit) -> dict:
+    """direction -> (f Hz, y) of every measured line amplitude of an empirical fit: f = h|Ω|/2π and
+    y = 2 ln(a / (C·Ω²)), the log power gain over the line's hard-mounted law."""
+    out = {}
+    for x in fit.lines:
+        w = np.abs(np.asarray(x.speed, dtype=float))
+        a = np.asarray(x.amplitude, dtype=float)
+        ok = np.isfinite(a) & (a > 0) & (w > 0)
+        if x.C <= 0 or not ok.any():
+            continue
+        f, y = out.setdefault(x.direction, ([], []))
+        f.append(x.h * w[ok] / (2 * np.pi))
+        y.append(2.0 * np.log(a[ok] / (x.C * w[ok] ** 2)))
+    return {d: (np.concatenate(f), np.concatenate(y)) for d, (f, y) in out.items()}
+
+
+def stand_resonance_start(fit, min_points: int = 2):
+    """(f_r Hz, ζ, peak gain) of a fixture resonance seen in the empirical fit ``fit``, or None.
+
+    The signature of a stand resonance is one frequency at which the lines of every load direction are
+    amplified over their C·Ω² law (a wheel mode lifts one direction only).  Score of a frequency f: the
+    smallest, over the directions with lines, of the mean log power gain of that direction's measurements
+    within ±:data:`STAND_WINDOW` of f (at least ``min_points`` of them); a stand resonance is proposed at
+    the best score when it reaches :data:`STAND_MIN_LOG_GAIN` in two directions or more.  ζ and the peak
+    gain: robust (soft-L1) least squares of ln|H|² (:func:`rwadist.resonance.resonance`) on every direction's
+    log gains within ±25 % of f, f_r free within ±10 %; refused when ζ > :data:`STAND_MAX_ZETA` (a broad
+    tilt, not a resonance) or the peak gain is below 1 + :data:`STAND_MIN_LOG_GAIN`/2.  A start only: the
+    search refits it beside the modes.
+    """
+    from scipy.optimize import least_squares
+
+    from ...resonance import resonance
+
+    pts = {d: fy for d, fy in _line_log_gains(fit).items() if fy[0].size >= 2 * min_points}
+    if len(pts) < 2:
+        return None
+    f_all = np.concatenate([fy[0] for fy in pts.values()])
+    lo, hi = float(np.min(f_all)), float(np.max(f_all))
+    if hi <= lo * (1 + 2 * STAND_WINDOW):
+        return None
+    grid = np.exp(np.arange(np.log(lo), np.log(hi), 0.005))                     # 0.5 % steps
+    score = np.full(grid.size, np.inf)
+    for f, y in pts.values():
+        inside = np.abs(f[None, :] / grid[:, None] - 1.0) <= STAND_WINDOW
+        cnt = inside.sum(1)
+        mean = np.where(cnt >= min_points, (inside * y[None, :]).sum(1) / np.maximum(cnt, 1), -np.inf)
+        score = np.minimum(score, mean)
+    i = int(np.argmax(score))
+    if not score[i] >= STAND_MIN_LOG_GAIN:
+        return None
+    f_s = float(grid[i])
+    f = np.concatenate([fy[0] for fy in pts.values()])
+    y = np.concatenate([fy[1] for fy in pts.values()])
+    near = np.abs(f / f_s - 1.0) <= 0.25
+    f, y = f[near], y[near]
+
+    def res(x):
+        return y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2)
+
+    lb, ub = np.log([0.9 * f_s, 1e-3, 1.1]), np.log([1.1 * f_s, 0.5, 200.0])
+    g0 = float(np.clip(np.exp(np.max(y) / 2.0), 1.2, 100.0))
+    best = None
+    for z0 in (0.01, 0.03, 0.1):
+        sol = least_squares(res, np.clip(np.log([f_s, z0, g0]), lb + 1e-9, ub - 1e-9), loss="soft_l1",
+                            f_scale=0.5, bounds=(lb, ub))
+        if best is None or sol.cost < best.cost:
+            best = sol
+    f_r, zeta, gain = (float(v) for v in np.exp(best.x))
+    if zeta > STAND_MAX_ZETA or gain < 1.0 + STAND_MIN_LOG_GAIN / 2:
+        return None
+    return f_r, zeta, gain
+
+
+def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None):
+    """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
+    amplification (or the extended fit fails); ``stand`` is the fixture resonance (f_r Hz, ζ, peak gain)
+    divided out of the lines, or None.  ``stand_start``: the stand to start from (a refit on every run
+    starts from the one fitted on half of them), else the one :func:`stand_resonance_start` proposes.
+
+    A fixture resonance on every channel is fitted beside the modes, never into them: when the empirical
+    fit shows lines of every direction amplified at one frequency (:func:`stand_resonance_start`), that
+    resonance is divided out of the measured lines before the modes are located (``stand`` of
+    :func:`rwadist.extended_fit.fit_extended`; a fixture resonance taken for a mode spoils every mode).
+    After the extended fit, a ``fixed_resonance`` common to all channels (role test_stand) is fitted on
+    that base; when it is a resonance (:data:`MIN_PEAK_GAIN`), the extended fit is repeated with it divided
+    out (up to :data:`STAND_ROUNDS` rounds, until the stand settles); when it is not while one was divided
+    out, the stand was not confirmed and the fit is repeated without it.  The stand resonance itself is left
+    to the search (a clear residual of the extended base: a ``fixed_resonance`` effect)."""
     from ...data import SteadyTest
     from ...empirical import fit_empirical
     from ...extended_fit import amplification_peaks, fit_extended
@@ -43,20 +135,35 @@ def _fit_runs(ctx: Context, runs, state: State):
     fit = fit_empirical(sp)
     if not amplification_peaks(fit):
         return None
+    stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
     try:
-        efit = fit_extended(test, fit)
-        if len(efit.unconstrained) < 3 and len(ctx.channels) > 3:
+        efit = fit_extended(test, fit, stand=stand)
+        for _ in range(STAND_ROUNDS):
+            if len(efit.unconstrained) == 3 or len(ctx.channels) <= 3:
+                break
             from ..effects.fixed_resonance import MIN_PEAK_GAIN, FixedResonance
 
+            # the stand on the modes' base: the lines are predicted without it, so this is the whole stand
             st = SuspensionModes.from_fit(efit, fit, len(runs)).apply(state)
-            stand = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), role="test_stand")
-            if stand is not None and abs(np.log(stand.peak_gain)) >= np.log(MIN_PEAK_GAIN):
-                efit = fit_extended(test, fit, stand=(stand.f_r, stand.zeta, stand.peak_gain))
+            new = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), None if stand is None else stand[0],
+                                     role="test_stand")
+            if new is None or abs(np.log(new.peak_gain)) < np.log(MIN_PEAK_GAIN):
+                if stand is not None:           # the stand divided out is not confirmed: the fit without it
+                    efit = fit_extended(test, fit)
+                    stand = None
+                break
+            new = (new.f_r, new.zeta, new.peak_gain)
+            settled = (stand is not None and abs(new[0] / stand[0] - 1) < 0.002
+                       and abs(np.log(new[2] / stand[2])) < 0.02)
+            stand = new
+            efit = fit_extended(test, fit, stand=stand)
+            if settled:
+                break
     except ValueError:
         return None
     if len(efit.unconstrained) == 3:
         return None                     # no mode located: nothing to name
-    return test, fit, efit
+    return test, fit, efit, stand
 
 
 @register(order=100)
@@ -67,7 +174,9 @@ class SuspensionModes:
     model : the extended model (:func:`rwadist.extended_fit.to_model`: harmonics = forcing lines, with the
         ``analytical`` section).  f0_Hz : mode frequencies at rest, Hz ("radial_translation", "rocking",
         "axial"); zeta : damping ratios; inertia_ratio : I_zz/I_rr; unconstrained : modes the data do not
-        locate (starting values, as in ``analytical.unconstrained``); n_runs : runs fitted.
+        locate (starting values, as in ``analytical.unconstrained``); n_runs : runs fitted; stand : the fixture
+        resonance (f_r Hz, ζ, peak gain) divided out of the lines for the fit, or None (the search names it
+        as a ``fixed_resonance`` of its own; not part of this effect's parameters).
     """
 
     model: object = field(repr=False)
@@ -76,6 +185,7 @@ class SuspensionModes:
     inertia_ratio: float
     unconstrained: tuple
     n_runs: int
+    stand: tuple | None = None
     kind: str = "suspension_modes"
     #: the search takes a passing suspension_modes before any other effect: the wheel's own modes first
     first = True
@@ -85,7 +195,7 @@ class SuspensionModes:
         return ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")
 
     @staticmethod
-    def from_fit(efit, fit, n_runs: int) -> "SuspensionModes":
+    def from_fit(efit, fit, n_runs: int, stand: tuple | None = None) -> "SuspensionModes":
         from ...extended_fit import to_model
 
         p = efit.params
@@ -93,7 +203,7 @@ class SuspensionModes:
               "axial": float(np.sqrt(p.k_z / p.mass) / (2 * np.pi))}
         zeta = {"radial_translation": float(p.zeta_r), "rocking": float(p.zeta_rock), "axial": float(p.zeta_z)}
         return SuspensionModes(to_model(efit, fit), f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained),
-                               n_runs)
+                               n_runs, stand)
 
     def apply(self, state: State) -> State:
         import copy
@@ -110,8 +220,9 @@ class SuspensionModes:
         return s
 
     def refit(self, ctx: Context, state: State) -> "SuspensionModes":
-        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
-        return SuspensionModes.fit(ctx, state, ctx.runs) or self
+        """Refitted on every run (``ctx.runs``), starting from this fit's stand resonance; itself when that fit
+        fails."""
+        return SuspensionModes.fit(ctx, state, ctx.runs, self.stand) or self
 
     def whirl_Hz(self, omega_rad_s: float) -> dict:
         """Whirl frequencies (Hz) at wheel speed ``omega_rad_s``: translation, rocking forward/backward, axial."""
@@ -133,11 +244,11 @@ class SuspensionModes:
         return schema_entry(self)
 
     @staticmethod
-    def fit(ctx: Context, state: State, runs) -> "SuspensionModes | None":
+    def fit(ctx: Context, state: State, runs, stand_start: tuple | None = None) -> "SuspensionModes | None":
         """The modes fitted on ``runs`` (per unit mass and inertia), or None when those runs show no modal
-        amplification or no mode can be located."""
-        got = _fit_runs(ctx, runs, state)
-        return None if got is None else SuspensionModes.from_fit(got[2], got[1], len(runs))
+        amplification or no mode can be located; ``stand_start``: see :func:`_fit_runs`."""
+        got = _fit_runs(ctx, runs, state, stand_start)
+        return None if got is None else SuspensionModes.from_fit(got[2], got[1], len(runs), got[3])
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
