@@ -40,10 +40,6 @@ def test_clean_cell_adds_nothing_beyond_the_wheel_modes(name):
     assert r["error"][1] < 0.02 * r["error"][0]          # the modes explain the data
 
 
-@pytest.mark.xfail(strict=True, reason="open (issue 14): the stand detector (suspension_modes.stand_resonance_start) "
-                   "takes the Ω³ law on the radial-force h = 2 line, together with the modes' own amplification near "
-                   "95 Hz in the other directions, for a test-stand resonance at 95 Hz; the law is then missed. "
-                   "strict: this test fails as soon as that is fixed, so the marker must come off")
 def test_injected_amplitude_law_named():
     r = matrix.evaluate(CELLS["n_speeds=20"], "amplitude_law")
     assert r["found"], r

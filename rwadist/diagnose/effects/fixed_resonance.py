@@ -16,6 +16,11 @@ from .base import register, schema_entry
 #: fit's own model error near a mode (a per-unit extended base leaves ~1-3 % there), not a resonance.
 MIN_PEAK_GAIN = 1.1
 
+#: Largest damping ratio proposed: a "resonance" broader than this (the fit runs to its ζ bound of 0.5 on a
+#: gentle tilt of the residual across the band) is not located by the data; the same limit as a fixture
+#: resonance proposed by :func:`rwadist.diagnose.effects.suspension_modes.stand_resonance_start`.
+MAX_ZETA = 0.2
+
 
 def _line_gain_points(ctx, state, chans, runs):
     """(f Hz, y, weight) of every model line of ``chans`` on ``runs`` measured above the noise and at least
@@ -157,5 +162,7 @@ class FixedResonance:
                 out.append(e)
         # a "resonance" that changes no line by more than MIN_PEAK_GAIN is a patch on model error, not a mode
         out = [e for e in out if abs(np.log(e.peak_gain)) >= np.log(MIN_PEAK_GAIN)]
+        # nor is a tilt across the band that the fit can only bend by running ζ up to its bound
+        out = [e for e in out if e.zeta <= MAX_ZETA]
         return [e for e in out if not any(abs(e.f_r - r[0]) < 0.02 * r[0] and set(e.channels) & set(r[3])
                                           for r in state.resonances)]

@@ -34,9 +34,9 @@ STAND_ROUNDS = 4
 STAND_WINDOW = 0.05
 
 
-def _line_log_gains(fit) -> dict:
-    """direction -> (f Hz, y) of every measured line amplitude of an empirical fit: f = h|Ω|/2π and
-    y = 2 ln(a / (C·Ω²)), the log power gain over the line's hard-mounted law."""
+def _line_log_gains(fit, by_line: bool = False) -> dict:
+    """direction (or (direction, h) when ``by_line``) -> (f Hz, y) of every measured line amplitude of an
+    empirical fit: f = h|Ω|/2π and y = 2 ln(a / (C·Ω²)), the log power gain over the line's hard-mounted law."""
     out = {}
     for x in fit.lines:
         w = np.abs(np.asarray(x.speed, dtype=float))
@@ -44,10 +44,18 @@ def _line_log_gains(fit) -> dict:
         ok = np.isfinite(a) & (a > 0) & (w > 0)
         if x.C <= 0 or not ok.any():
             continue
-        f, y = out.setdefault(x.direction, ([], []))
+        f, y = out.setdefault((x.direction, float(x.h)) if by_line else x.direction, ([], []))
         f.append(x.h * w[ok] / (2 * np.pi))
         y.append(2.0 * np.log(a[ok] / (x.C * w[ok] ** 2)))
     return {d: (np.concatenate(f), np.concatenate(y)) for d, (f, y) in out.items()}
+
+
+def _window_means(f, y, grid, min_points):
+    """Mean of y over the points within ±STAND_WINDOW of each grid frequency; NaN where fewer than
+    ``min_points``."""
+    inside = np.abs(f[None, :] / grid[:, None] - 1.0) <= STAND_WINDOW
+    cnt = inside.sum(1)
+    return np.where(cnt >= min_points, (inside * y[None, :]).sum(1) / np.maximum(cnt, 1), np.nan)
 
 
 def stand_resonance_start(fit, min_points: int = 2):
@@ -56,7 +64,8 @@ def stand_resonance_start(fit, min_points: int = 2):
     The signature of a stand resonance is one frequency at which the lines of every load direction are
     amplified over their C·Ω² law (a wheel mode lifts one direction only).  Score of a frequency f: the
     smallest, over the directions with lines, of the mean log power gain of that direction's measurements
-    within ±:data:`STAND_WINDOW` of f (at least ``min_points`` of them); a stand resonance is proposed at
+    within ±:data:`STAND_WINDOW` of f (at least ``min_points`` of them), and over every single line (direction,
+    h) with ``min_points`` measurements there (a fixture lifts every harmonic at f alike); a stand resonance is proposed at
     the best score when it reaches :data:`STAND_MIN_LOG_GAIN` in two directions or more.  ζ and the peak
     gain: robust (soft-L1) least squares of ln|H|² (:func:`rwadist.resonance.resonance`) on every direction's
     log gains within ±25 % of f, f_r free within ±10 %; refused when ζ > :data:`STAND_MAX_ZETA` (a broad
@@ -77,10 +86,12 @@ def stand_resonance_start(fit, min_points: int = 2):
     grid = np.exp(np.arange(np.log(lo), np.log(hi), 0.005))                     # 0.5 % steps
     score = np.full(grid.size, np.inf)
     for f, y in pts.values():
-        inside = np.abs(f[None, :] / grid[:, None] - 1.0) <= STAND_WINDOW
-        cnt = inside.sum(1)
-        mean = np.where(cnt >= min_points, (inside * y[None, :]).sum(1) / np.maximum(cnt, 1), -np.inf)
-        score = np.minimum(score, mean)
+        score = np.minimum(score, np.nan_to_num(_window_means(f, y, grid, min_points), nan=-np.inf))
+    # a fixture amplifies every line at f, whatever its harmonic: a line (direction, h) with points near f
+    # that is not lifted there rules f out (an amplitude law lifts one harmonic at the top speeds only)
+    for (d, _h), (f, y) in _line_log_gains(fit, by_line=True).items():
+        if d in pts:
+            score = np.fmin(score, np.where(np.isnan(m := _window_means(f, y, grid, min_points)), np.inf, m))
     i = int(np.argmax(score))
     if not score[i] >= STAND_MIN_LOG_GAIN:
         return None
