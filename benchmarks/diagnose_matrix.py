@@ -64,8 +64,13 @@ SPECS = {
     "fixed_resonance": "fixed_resonance:f_hz=150,zeta=0.03,gain=5,role=test_stand",
     "cross_coupling": "cross_coupling:r_x=0,r_y=0,r_z=-0.06",
     "sidebands": "sidebands:direction=radial_force,h=2,depth=0.4,f_mod_hz=7",
-    # not h = 1: with the modes on the radial h = 1 lines are the rotor's imbalances (rwadist.inject refuses it)
-    "counter_rotation": "counter_rotation:direction=radial_force,h=3,fraction=0.3",
+    # the case: 30 % counter-rotating content on the radial-force fundamental (the imbalance line; the
+    # counter part goes through the suspension modes)
+    "counter_rotation": "counter_rotation:direction=radial_force,h=1,fraction=0.3",
+    # lines at 0.94 and 1.06 x the wheel speed beside the fundamental, 0.2 U_s each
+    "speed_sidebands": "sidebands:direction=radial_force,h=1,depth=0.4,per_rev=0.06",
+    # a load-cell reference 60 mm below the wheel, the force sensors noisier than the stand's 1 %
+    "lever_arm_noise": "cross_coupling:r_x=0,r_y=0,r_z=-0.06,force_noise=0.078",
 }
 #: why a registered family is not injected on modes-on data
 NOT_INJECTED = {
@@ -161,6 +166,12 @@ def parameter(kind: str, e: dict, truth: dict) -> str:
         return f"r_z {1000 * r[2]:.1f} mm (truth {1000 * truth['r_z']:g} mm), r_x {1000 * r[0]:.1f}, r_y {1000 * r[1]:.1f}"
     if kind == "sidebands":
         return rel(e["f_mod_Hz"], truth["f_mod_hz"], "f_mod") + f", m {e['depth']:.3g} (truth {truth['depth']:g})"
+    if kind == "speed_sidebands":
+        return (rel(e["h_lower"], 1 - truth["per_rev"], "h_lower") + ", " + rel(e["h_upper"], 1 + truth["per_rev"], "h_upper")
+                + f", C/C_carrier {e.get('ratio_lower', float('nan')):.3g}/{e.get('ratio_upper', float('nan')):.3g} "
+                  f"(truth {truth['depth'] / 2:g})")
+    if kind == "lever_arm_noise":
+        return rel(e["noise_transfer"], 1.0, "noise transfer") + f", r_z {1000 * e['r_m'][2]:.1f} mm"
     if kind == "counter_rotation":
         return rel(e["counter_fraction"], truth["fraction"], "q") + f" ({e.get('direction')} h={e.get('h')})"
     keys = [k for k in e if k not in ("kind", "evidence", "channel")]
