@@ -151,23 +151,12 @@ class CounterRotation:
         amplitudes X, Y of the direction's x and y channels at h|Ω|/2π (:meth:`Context.phasors`) split into the
         co-rotating |X + iY|²/4 and counter-rotating |X − iY|²/4 mean squares (swapped for Ω < 0), each divided
         by its modal power gain |G±|² (and the fixed resonances) to the free load; q = Σ counter / Σ both."""
-        chans = DIRECTION_CHANNELS[direction]
-        if ctx.test is None or not all(c in ctx.channels for c in chans):
+        pw = CounterRotation._phase_powers(ctx, state, direction, h, runs)
+        if pw is None:
             return float("nan")
-        h0 = _sense_group(state, direction, h)[0]
-        f = h0 * ctx.omega[runs] / (2 * np.pi)
-        inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
-        X = ctx.phasors(runs, f[:, None])[:, 0, :]
-        x, y = X[:, CHANNELS.index(chans[0])], X[:, CHANNELS.index(chans[1])]
-        co, ct = np.abs(x + 1j * y) ** 2 / 4.0, np.abs(x - 1j * y) ** 2 / 4.0
-        neg = np.asarray(ctx.sp.speed, float)[runs] < 0
-        co, ct = np.where(neg, ct, co), np.where(neg, co, ct)
-        Hc2 = ctx.gain(state, chans[0], f) ** 2
-        co = co / (ctx.unit_gain(state, chans[0], direction, h0, "co", runs) ** 2 * Hc2)
-        ct = ct / (ctx.unit_gain(state, chans[0], direction, h0, "counter", runs) ** 2 * Hc2)
-        ok = inb & np.isfinite(co) & np.isfinite(ct)
-        tot = float(np.sum(co[ok] + ct[ok]))
-        return float(np.sum(ct[ok]) / tot) if tot > 0 else float("nan")
+        co, ct, _noise, gp, gn, ok = pw
+        tot = float(np.sum(co[ok] / gp[ok] + ct[ok] / gn[ok]))
+        return float(np.sum(ct[ok] / gn[ok]) / tot) if tot > 0 else float("nan")
 
     @staticmethod
     def _phase_powers(ctx, state, direction, h, runs):
