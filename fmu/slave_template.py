@@ -36,6 +36,7 @@ else:
     import math
     import os
     import sys
+    import weakref
     from xml.etree.ElementTree import Element, SubElement
 
     from pythonfmu import (
@@ -84,19 +85,36 @@ else:
             return node
 
 
-    def _native_library(resources, model_identifier):
-        """The FMU's rwadist native library (ctypes.CDLL), or None where it is absent (plain
-        pythonfmu build, or a platform it was not built for)."""
+    #: library path -> (ctypes.CDLL or None, its rwadist_kernel_step or None): opened once per process.  A CDLL
+    #: defines a ctypes class of its own and is a reference cycle (it caches its functions, which refer back to
+    #: it): one per instance was garbage only a full collection frees (issue 17, benchmarks/fmu_memory.py).
+    _NATIVE_LAYERS = {}
+
+
+    def _native_layer(resources, model_identifier, rt):
+        """(library, kernel): the FMU's rwadist native library (ctypes.CDLL) and its step kernel, or (None, None)
+        where it is absent (plain pythonfmu build, or a platform it was not built for)."""
         if not sys.platform.startswith("linux"):
-            return None
+            return None, None
         path = os.path.join(os.path.dirname(os.path.abspath(resources)), "binaries", "linux64",
                             model_identifier + ".so")
-        try:
-            lib = ctypes.CDLL(path)
-            lib.rwadist_fmu_native_version
-        except (OSError, AttributeError):
-            return None
-        return lib
+        layer = _NATIVE_LAYERS.get(path)
+        if layer is None:
+            try:
+                lib = ctypes.CDLL(path)
+                lib.rwadist_fmu_native_version
+            except (OSError, AttributeError):
+                lib = None
+            layer = _NATIVE_LAYERS[path] = (lib, None if lib is None else rt.load_kernel(lib._name))
+        return layer
+
+
+    def _drop_duplicate_path(entry):
+        """Remove all but the first ``entry`` from sys.path: pythonfmu inserts the resources folder at its head at
+        every fmi2Instantiate (0.7.0), so sys.path grows by one entry per instance without this."""
+        at = [i for i, p in enumerate(sys.path) if p == entry]
+        for i in reversed(at[1:]):
+            del sys.path[i]
 
 
     def _load_runtime(resources):
@@ -116,8 +134,15 @@ else:
                        "Physics: " + BUILD_PHYSICS)
         default_experiment = DefaultExperiment(start_time=0.0, stop_time=1.0, step_size=1e-3)
 
+        # No reference cycle may lead to the instance: pythonfmu frees it with one Py_DECREF at fmi2FreeInstance, and
+        # an instance in a cycle (with its model's arrays) would wait for a full garbage collection, which a host
+        # with many objects runs rarely -- the process grew by MBs over 1000 instantiate/free cycles (issue 17).
+        # The variables' getters and setters therefore reach the instance through a weak reference.
         def __init__(self, **kwargs):
             super().__init__(**kwargs)
+            if self.resources is not None:
+                _drop_duplicate_path(self.resources)
+            me = weakref.ref(self)
             self.rt = _load_runtime(self.resources)
             self.wheel_speed = 0.0
             self.wheel_acceleration = 0.0
@@ -141,11 +166,8 @@ else:
             self.error = "not initialised"
             self._t_start = 0.0         # fmi2SetupExperiment's start time
             self._t_next = None         # the communication point the next step must start at
-            self._native = _native_library(self.resources, type(self).__name__)
+            self._native, self._kernel = _native_layer(self.resources, type(self).__name__, self.rt)
             self._flag_error = None if self._native is None else self._native.rwadist_fmu_flag_error
-            self._kernel = None
-            if self._native is not None:
-                self._kernel = self.rt.load_kernel(self._native._name)
 
             inp, par, out = Fmi2Causality.input, Fmi2Causality.parameter, Fmi2Causality.output
             fixed, cont = Fmi2Variability.fixed, Fmi2Variability.continuous
@@ -193,12 +215,12 @@ else:
                     self.register_variable(RealU(
                         f"dcm_{i + 1}{j + 1}", "1", causality=par, variability=fixed,
                         description=f"mounting DCM wheel -> spacecraft, row {i + 1} column {j + 1}",
-                        getter=lambda k=k: self.dcm[k], setter=lambda v, k=k: self.dcm.__setitem__(k, float(v))))
+                        getter=lambda k=k: me().dcm[k], setter=lambda v, k=k: me().dcm.__setitem__(k, float(v))))
             for i, ax in enumerate("xyz"):
                 self.register_variable(RealU(
                     f"r_{ax}", "m", causality=par, variability=fixed,
                     description=f"interface position in the spacecraft frame, {ax}",
-                    getter=lambda i=i: self.pos[i], setter=lambda v, i=i: self.pos.__setitem__(i, float(v))))
+                    getter=lambda i=i: me().pos[i], setter=lambda v, i=i: me().pos.__setitem__(i, float(v))))
             self._vr_speed = self.vars_by_name("wheel_speed")
             self._vr_accel = self.vars_by_name("wheel_acceleration")
             self._out_index = {}
@@ -209,9 +231,21 @@ else:
                     self.register_variable(RealU(
                         ch + suffix, unit, causality=out, variability=cont, initial=Fmi2Initial.exact,
                         description=desc if frame == "wheel" else f"{ch} in the {where}",
-                        getter=lambda k=k: self._y[k]))
+                        getter=lambda k=k: me()._y[k]))
                     self._out_index[self.vars_by_name(ch + suffix)] = k
             self._index_reals()
+
+        def register_variable(self, var, nested=True):
+            """pythonfmu's register_variable, with the default getter and setter of a plain (not nested) name
+            reaching the instance through a weak reference: pythonfmu's own close over the instance and the
+            variable, two reference cycles per variable (see __init__)."""
+            if not (nested and "." in var.name):
+                me, name = weakref.ref(self), var.local_name
+                if var.getter is None:
+                    var.getter = lambda: getattr(me(), name)
+                if var.setter is None and hasattr(self, name) and var.variability != Fmi2Variability.constant:
+                    var.setter = lambda v: setattr(me(), name, v)
+            super().register_variable(var, nested)
 
         def vars_by_name(self, name):
             """Value reference of the registered variable ``name``."""
