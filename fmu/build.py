@@ -1,8 +1,8 @@
 """Build the FMU of the extended wheel model with pythonfmu.
 
 :func:`build_fmu` renders ``slave_template.py`` under a module and class name unique to the
-build (two FMUs whose slave modules share a name cannot load in one process), and ships
-``runtime.py`` (as ``rwadist_fmu_runtime.py``) with its sibling modules, ``rwadist/schema.py`` (as
+build (two FMUs whose slave modules share a name cannot load in one process), and ships the slave it loads,
+``slave.py`` (as ``rwadist_fmu_slave.py``), ``runtime.py`` (as ``rwadist_fmu_runtime.py``) with its sibling modules, ``rwadist/schema.py`` (as
 ``rwadist_model_schema.py``, the runtime's reader of the model file; :func:`runtime_files`) and the model file
 (``wheel_model.json``) in the FMU's resources.  pythonfmu embeds itself there too, so a host needs Python + numpy only.
 
@@ -32,6 +32,9 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 TEMPLATE = HERE / "slave_template.py"
+#: the slave implementation, shipped verbatim as resources/SLAVE_RESOURCE (the template loads it)
+SLAVE = HERE / "slave.py"
+SLAVE_RESOURCE = "rwadist_fmu_slave.py"
 RUNTIME = HERE / "runtime.py"
 TEMPLATE_CLASS = "RwadistWheelSlave"
 NATIVE_SOURCE = HERE / "native" / "rwadist_fmu_native.c"
@@ -184,11 +187,14 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
     physics, modes_default = model_physics(doc, assumed_modes)
     with tempfile.TemporaryDirectory(prefix="rwadist_fmu_") as tmp:
         tmp = Path(tmp)
-        script = tmp / f"{module}.py"
-        script.write_text(_render(src, cls, physics, modes_default))
         extra = tmp / "extra"
         extra.mkdir()
+        # the slave module beside its project files: pythonfmu imports it from there to find its class
+        script = extra / f"{module}.py"
+        script.write_text(_render(src, cls, physics, modes_default))
         project_files = runtime_files(extra)
+        project_files.append(extra / SLAVE_RESOURCE)
+        shutil.copy2(SLAVE, project_files[-1])
         (extra / "wheel_model.json").write_text(json.dumps(doc, indent=1) + "\n")
         path_before = list(sys.path)
         try:
@@ -196,8 +202,8 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
                                        project_files=project_files + [extra / "wheel_model.json"])
         finally:
             sys.path[:] = path_before
-            rt_name = f"{module}_runtime"
-            for name in (module, rt_name, *(f"{rt_name}_{stem}" for stem in _runtime().SIBLINGS)):
+            rt_name = f"{module}_slave_runtime"
+            for name in (module, f"{module}_slave", rt_name, *(f"{rt_name}_{stem}" for stem in _runtime().SIBLINGS)):
                 sys.modules.pop(name, None)
         if native is not False and native_supported():
             try:
