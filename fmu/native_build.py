@@ -14,7 +14,7 @@ another platform can compile it (e.g. ``fmpy.build.build_platform_binary`` on th
 with ``complex.h``: gcc, clang).
 
 Its variables, value references, parameters, units and start values are those of the pythonfmu
-FMU (``fmu/slave_template.py``; tests compare the two modelDescriptions), except that
+FMU (``fmu/slave.py``; tests compare the two modelDescriptions), except that
 ``model_file`` accepts only the empty string: the native FMU's model is compiled in.
 """
 from __future__ import annotations
@@ -41,7 +41,7 @@ FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 PLATFORM = "linux64"
 
 #: (name, value reference, type, causality, variability, start, unit, description): the pythonfmu FMU's
-#: variables (fmu/slave_template.py registers them in this order; value references count from 0)
+#: variables (fmu/slave.py registers them in this order; value references count from 0)
 _PAR, _FIX = "parameter", "fixed"
 VARIABLES = [
     ("wheel_speed", "Real", "input", "continuous", "0", "rad/s",
