@@ -124,8 +124,9 @@ def _guard_pythonfmu_exit(library):
     destructor does, so its ELF destructor no longer frees it a second time (issue 17).
 
     pythonfmu 0.7 keeps a namespace-scope ``std::shared_ptr<PyState>``: at exit, ``__run_exit_handlers`` first
-    runs the C++ destructor of that shared_ptr (it frees the 128-byte control block when no instance holds a
-    copy, i.e. after every instance was freed), then ``_dl_fini`` runs the library's
+    runs the C++ destructor of that shared_ptr (it frees the 128-byte control block: no instance holds a copy,
+    since ``createInstance`` stores it in the instance's data only after constructing the instance from that
+    data; so with instances alive or all freed), then ``_dl_fini`` runs the library's
     ``__attribute__((destructor)) onLibraryUnload`` -> ``finalizePythonInterpreter`` -> ``pyState = nullptr`` on
     the destroyed shared_ptr, which releases the freed control block again: valgrind's "Invalid read of size 4
     ... in finalizePythonInterpreter ... 8 bytes inside a block of size 128 free'd", and with glibc's malloc a
