@@ -20,6 +20,7 @@ import ctypes
 import importlib.util
 import math
 import os
+import struct
 import sys
 import weakref
 from xml.etree.ElementTree import Element, SubElement
@@ -86,6 +87,70 @@ def _native_layer(resources, model_identifier, rt):
             lib = None
         layer = _NATIVE_LAYERS[path] = (lib, None if lib is None else rt.load_kernel(lib._name))
     return layer
+
+
+#: pythonfmu libraries whose exit is guarded (:func:`_guard_pythonfmu_exit`), once per process
+_EXIT_GUARDED = set()
+
+
+def _elf_function_offsets(path, names):
+    """{name: offset from the load base} of the functions ``names`` found in the ELF64 (little-endian) file's
+    ``.symtab`` section (a function pythonfmu builds with hidden visibility is there, not in ``.dynsym``);
+    empty for another format or a stripped file."""
+    with open(path, "rb") as fh:
+        data = fh.read()
+    if data[:4] != b"\x7fELF" or data[4] != 2 or data[5] != 1:
+        return {}
+    (shoff,) = struct.unpack_from("<Q", data, 0x28)
+    shentsize, shnum = struct.unpack_from("<HH", data, 0x3A)
+    sections = [struct.unpack_from("<IIQQQQIIQQ", data, shoff + i * shentsize) for i in range(shnum)]
+    for _, kind, _, _, offset, size, link, _, _, _ in sections:
+        if kind != 2:       # SHT_SYMTAB
+            continue
+        strings = sections[link][4]
+        found = {}
+        for name_at, info, _, _, value, _ in struct.iter_unpack("<IBBHQQ", data[offset:offset + size]):
+            if info & 0xF == 2 and value:       # STT_FUNC, defined
+                start = strings + name_at
+                name = data[start:data.index(b"\0", start)].decode("ascii", "replace")
+                if name in names:
+                    found[name] = value
+        return found
+    return {}
+
+
+def _guard_pythonfmu_exit(library):
+    """Make pythonfmu's library ``library`` release its interpreter state at process exit before its own static
+    destructor does, so its ELF destructor no longer frees it a second time (issue 17).
+
+    pythonfmu 0.7 keeps a namespace-scope ``std::shared_ptr<PyState>``: at exit, ``__run_exit_handlers`` first
+    runs the C++ destructor of that shared_ptr (it frees the 128-byte control block: no instance holds a copy,
+    since ``createInstance`` stores it in the instance's data only after constructing the instance from that
+    data; so with instances alive or all freed), then ``_dl_fini`` runs the library's
+    ``__attribute__((destructor)) onLibraryUnload`` -> ``finalizePythonInterpreter`` -> ``pyState = nullptr`` on
+    the destroyed shared_ptr, which releases the freed control block again: valgrind's "Invalid read of size 4
+    ... in finalizePythonInterpreter ... 8 bytes inside a block of size 128 free'd", and with glibc's malloc a
+    decrement inside a freed chunk (its free-list link): ``corrupted double-linked list`` /
+    ``free(): corrupted unsorted chunks`` at exit.  Registering ``finalizePythonInterpreter`` itself with
+    ``__cxa_atexit`` here (after the library's static constructors registered that destructor) runs it first:
+    the shared_ptr is released while alive and then holds null, so the static destructor and the ELF
+    destructor find nothing to release.  ``finalizePythonInterpreter`` is hidden, so its address is the
+    library's exported ``fmi2Instantiate`` moved by the two functions' distance in ``.symtab``.  Nothing is
+    done where that is not found (another platform or a stripped library)."""
+    if library in _EXIT_GUARDED or not sys.platform.startswith("linux") or not os.path.isfile(library):
+        return
+    _EXIT_GUARDED.add(library)
+    try:
+        offsets = _elf_function_offsets(library, {"finalizePythonInterpreter", "fmi2Instantiate"})
+        if len(offsets) != 2:
+            return
+        lib = ctypes.CDLL(library)  # loaded already (this call runs inside it); ctypes keeps it loaded to exit
+        base = ctypes.cast(lib.fmi2Instantiate, ctypes.c_void_p).value - offsets["fmi2Instantiate"]
+        at_exit = ctypes.CDLL(None).__cxa_atexit
+        at_exit.argtypes, at_exit.restype = [ctypes.c_void_p] * 3, ctypes.c_int
+        at_exit(base + offsets["finalizePythonInterpreter"], None, None)
+    except (OSError, AttributeError, ValueError, IndexError, struct.error):
+        return
 
 
 def _drop_duplicate_path(entry):
@@ -181,6 +246,9 @@ class WheelSlave(Fmi2Slave):
         self._t_start = 0.0         # fmi2SetupExperiment's start time
         self._t_next = None         # the communication point the next step must start at
         self._native, self._kernel = _native_layer(self.resources, type(self).__name__, self.rt)
+        binaries = os.path.join(os.path.dirname(os.path.abspath(self.resources)), "binaries", "linux64")
+        for stem in (type(self).__name__ + "_pythonfmu", type(self).__name__):   # with / without the native layer
+            _guard_pythonfmu_exit(os.path.join(binaries, stem + ".so"))
         self._flag_error = None if self._native is None else self._native.rwadist_fmu_flag_error
 
         inp, par, out = Fmi2Causality.input, Fmi2Causality.parameter, Fmi2Causality.output

@@ -3,11 +3,13 @@
  * tests/test_fmu_native.py (outputs of a host without Python) and benchmarks/bench_fmu_native.py
  * (steps per second of the native step alone).
  *
- *   c_host LIB.so GUID N_STEPS H W0 W1 [name=value ...]
+ *   c_host LIB.so GUID N_STEPS H W0 W1 [name=value ...] [resources=URI]
  *
  * The speed ramps linearly from W0 to W1 rad/s over the N steps (input value reference 0, the
  * acceleration input 1 gets the slope); name=value sets a parameter by value reference:
- * r<vr>=x (Real), i<vr>=n (Integer), b<vr>=0|1 (Boolean).  Prints the 12 outputs (value references
+ * r<vr>=x (Real), i<vr>=n (Integer), b<vr>=0|1 (Boolean).  resources=URI is the fmi2Instantiate resource
+ * location (file:///.../resources): the native C FMU needs none (default ""), the pythonfmu FMU needs it (it
+ * imports its slave from there; the host then needs libpython loaded, e.g. LD_PRELOAD).  Prints the 12 outputs (value references
  * 26..37) after the last step with %.17g, then "cpu_steps_per_s <rate>" (process CPU time) and
  * "steps_per_s <rate>" (wall clock) to stderr. */
 #include <dlfcn.h>
@@ -62,14 +64,20 @@ int main(int argc, char **argv)
     LOAD(fmi2FreeInstanceTYPE *, fmi2FreeInstance)
     const long n = atol(argv[3]);
     const double h = atof(argv[4]), w0 = atof(argv[5]), w1 = atof(argv[6]);
+    const char *resources = "";
+    for (int i = 7; i < argc; i++)
+        if (strncmp(argv[i], "resources=", 10) == 0)
+            resources = argv[i] + 10;
     fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
-    fmi2Component c = fmi2Instantiate("c_host", fmi2CoSimulation, argv[2], "", &cb, fmi2False, fmi2False);
+    fmi2Component c = fmi2Instantiate("c_host", fmi2CoSimulation, argv[2], resources, &cb, fmi2False, fmi2False);
     if (!c)
         return 3;
     if (fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) > fmi2Warning ||
         fmi2EnterInitializationMode(c) > fmi2Warning)
         return 3;
     for (int i = 7; i < argc; i++) {
+        if (strncmp(argv[i], "resources=", 10) == 0)
+            continue;
         const char kind = argv[i][0];
         char *eq = strchr(argv[i], '=');
         if (!eq)

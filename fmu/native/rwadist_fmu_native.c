@@ -177,6 +177,45 @@ static fmi2Status refuse(fmi2Component c, const char *message)
 EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
 EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
 
+/* The GUID of the FMU this library belongs to, from its modelDescription.xml (the library is
+ * <FMU>/binaries/linux64/<id>.so), into out; 0 where that file cannot be read or holds no guid.
+ * pythonfmu 0.7 does not compare the GUID a host passes to fmi2Instantiate with its own (FMI 2.0 2.1.5:
+ * a mismatch must return NULL), so this layer does. */
+static int own_guid(char *out, size_t size)
+{
+    Dl_info info;
+    if (!dladdr((void *)&rwadist_fmu_flag_error, &info) || !info.dli_fname)
+        return 0;
+    char path[4096];
+    snprintf(path, sizeof path, "%s", info.dli_fname);
+    for (int up = 0; up < 3; up++) { /* <id>.so, linux64, binaries */
+        char *slash = strrchr(path, '/');
+        if (!slash)
+            return 0;
+        *slash = '\0';
+    }
+    if (strlen(path) + sizeof "/modelDescription.xml" > sizeof path)
+        return 0;
+    strcat(path, "/modelDescription.xml");
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    char head[65536]; /* the guid attribute is on the root element, in the first lines */
+    size_t n = fread(head, 1, sizeof head - 1, f);
+    fclose(f);
+    head[n] = '\0';
+    const char *at = strstr(head, " guid=\"");
+    if (!at)
+        return 0;
+    at += strlen(" guid=\"");
+    const char *end = strchr(at, '"');
+    if (!end || (size_t)(end - at) >= size)
+        return 0;
+    memcpy(out, at, (size_t)(end - at));
+    out[end - at] = '\0';
+    return 1;
+}
+
 EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String guid,
                                      fmi2String resourceLocation, const fmi2CallbackFunctions *functions,
                                      fmi2Boolean visible, fmi2Boolean loggingOn)
@@ -190,6 +229,20 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
         if (functions && functions->logger)
             functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError", "%s",
                               inner_error[0] ? inner_error : "rwadist FMU: pythonfmu library lacks fmi2Instantiate");
+        return NULL;
+    }
+    char expected[256];
+    if (own_guid(expected, sizeof expected) && (!guid || strcmp(guid, expected) != 0)) {
+        if (functions && functions->logger) {
+            char message[1024];
+            snprintf(message, sizeof message,
+                     "fmi2Instantiate: GUID %s is not this FMU's (%s, in its modelDescription.xml): the host read "
+                     "another FMU's model description; load this FMU's", guid ? guid : "(null)", expected);
+            for (char *p = message; *p; p++) /* the message is the format (see refuse): no '%' from the host */
+                if (*p == '%')
+                    *p = '?';
+            functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError", message);
+        }
         return NULL;
     }
     error_flag = 0;
