@@ -702,14 +702,18 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
             z0 = (C * amp_scale) * np.exp(1j * (h * psi_b + a))
             if not recorded.all():
                 z0[~recorded] = 0.0
+            gains = {}                              # the x and y channels of a pair often share their modes
             for i, ch in enumerate(chans):
                 z = z0
                 if ch_modes[ch]:
-                    g = np.ones(len(w_b), dtype=complex)
-                    for m in ch_modes[ch]:
-                        g *= m.response(f_line / fm_b[id(m)])
-                    np.conjugate(g, out=g, where=neg_b)
-                    z = z0 * g
+                    key = tuple(id(m) for m in ch_modes[ch])
+                    if key not in gains:
+                        g = np.ones(len(w_b), dtype=complex)
+                        for m in ch_modes[ch]:
+                            g *= m.response(f_line / fm_b[id(m)])
+                        np.conjugate(g, out=g, where=neg_b)
+                        gains[key] = g
+                    z = z0 * gains[key]
                 signals[ch][sl] += z.imag if i == 1 else z.real
     _add_noise(signals, noise_std, noise_rng)
     extra["modal_gain"] = "quasi-steady (gain at the instantaneous line frequency and speed)"

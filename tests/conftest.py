@@ -10,8 +10,10 @@ changing what the next test sees; a test that edits its data builds its own.
 """
 from __future__ import annotations
 
+import fcntl
 import inspect
 import os
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -113,6 +115,61 @@ def e_full_extended_fit(stand_steady):
     test = stand_steady("ithaco-e", E_FULL_SPEEDS_RPM, modes=True, physics="extended", **E_FULL)
     fit = fit_empirical(compute_spectra(test))
     return wheel, fit, fit_extended(test, fit, wheel.mass_kg, wheel.radius_m)
+
+
+# --------------------------------------------------------------------------- built once per test run
+
+def once_per_run(tmp_path_factory, name: str, build) -> Path:
+    """A folder ``name`` filled by ``build(folder)`` once per pytest run, across the ``-n`` worker processes.
+
+    The first process to get here builds under an exclusive lock (``fcntl.flock``) and marks the folder
+    complete; a process arriving meanwhile waits for the lock, then reads the finished folder.  Without
+    xdist the folder lives in this session's own temporary directory.  A build that raised leaves no mark:
+    the next process to ask builds again (and fails the same way, in its own test).  Readers must not
+    change the folder.
+    """
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent                  # .../pytest-N/popen-gwK -> .../pytest-N, one per run, shared
+    folder = root / name
+    done = root / f"{name}.complete"
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            if not done.exists():
+                shutil.rmtree(folder, ignore_errors=True)
+                folder.mkdir()
+                build(folder)
+                done.touch()
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+    return folder
+
+
+#: the example notebook, executed by test_notebook.py and test_coupling.py
+EXAMPLE_NOTEBOOK = Path(__file__).resolve().parents[1] / "examples" / "coupling_study.ipynb"
+
+
+@pytest.fixture(scope="session")
+def executed_notebook(tmp_path_factory):
+    """(executed notebook, folder it ran in) of ``examples/coupling_study.ipynb``, executed once per run.
+
+    Executed as a user would run it: a Jupyter kernel driven by nbclient (per-cell timeout 300 s), with
+    the folder as its working directory, so the figures it saves land in ``folder``.  The executed
+    notebook is written to ``folder/executed.ipynb`` and read back here; the tests that check it
+    (the figures inline and saved, no error output) all read this one run.
+    """
+    nbformat = pytest.importorskip("nbformat")
+    nbclient = pytest.importorskip("nbclient")
+
+    def execute(folder: Path) -> None:
+        nb = nbformat.read(EXAMPLE_NOTEBOOK, as_version=4)
+        nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
+                                resources={"metadata": {"path": str(folder)}}).execute()
+        nbformat.write(nb, folder / "executed.ipynb")
+
+    folder = once_per_run(tmp_path_factory, "executed_notebook", execute)
+    return nbformat.read(folder / "executed.ipynb", as_version=4), folder
 
 
 # --------------------------------------------------------------------------- workers

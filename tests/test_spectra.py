@@ -294,3 +294,30 @@ def test_line_power_broadcasts_over_runs():
     sp = compute_spectra(SteadyTest(runs), nperseg=NPERSEG)
     np.testing.assert_allclose(line_amplitude(sp.psd["Fx"], sp.f, freqs), amps, rtol=0.01)
     np.testing.assert_allclose(line_power(sp.psd["Fx"], sp.f, freqs), amps**2 / 2, rtol=0.02)
+
+
+def test_running_median_equals_scipy_ndimage():
+    """spectra.running_median (the noise floor's median, selected from a window stack) gives exactly
+    scipy.ndimage.median_filter(mode="mirror") along the last axis: 1-, 2- and 3-D, odd widths, ties,
+    a row of NaN (a run without the channel), a NaN or inf among finite values (ndimage's own path)."""
+    from scipy import ndimage
+
+    from rwadist.spectra import running_median
+
+    rng = np.random.default_rng(5)
+    for shape, n in [((4097,), 31), ((12, 2047), 31), ((3, 4, 515), 85), ((5, 40), 33), ((2, 31), 31), ((6, 200), 3)]:
+        x = rng.chisquare(2, size=shape)
+        cases = [x, np.round(x, 1)]
+        if x.ndim > 1:
+            y = x.copy()
+            y.reshape(-1, shape[-1])[1] = np.nan
+            cases.append(y)
+        z = x.copy()
+        z.flat[7] = np.nan
+        z.flat[11] = np.inf
+        cases.append(z)
+        for c in cases:
+            ref = ndimage.median_filter(c, size=(1,) * (c.ndim - 1) + (n,), mode="mirror")
+            got = running_median(c, n)
+            assert got.shape == ref.shape and got.dtype == ref.dtype
+            assert np.array_equal(got, ref, equal_nan=True)
