@@ -15,8 +15,9 @@ from ..state import State
 from .base import register, schema_entry
 
 #: Smallest separation (Welch bins) between a sideband and its carrier for a run to count: the Hann main lobe
-#: is ±2 bins, so closer sidebands sit in the carrier's own kernel and are not measured there.
-MIN_BINS = 3.0
+#: is ±2 bins, so closer sidebands sit in the carrier's own kernel and are not measured there; half a bin more
+#: for the scalloping of lines that are not bin-centred (beyond 2.5 bins the carrier's leakage is < −30 dB).
+MIN_BINS = 2.5
 #: Per-revolution offsets δ searched (fractions of the wheel speed).
 DELTA_GRID = np.arange(0.01, 0.30001, 0.0025)
 
@@ -129,7 +130,8 @@ class SpeedSidebands:
     def scan(ctx: Context, state: State, direction: str, h0: float, runs) -> tuple:
         """(δ grid, score): per δ of :data:`DELTA_GRID`, the median over the channels, resolved runs and both sides of
         the residual PSD at (h₀ ± δ)|Ω|/2π (the largest of the bin and its neighbours) over the run's model floor,
-        i.e. how far above the noise a pair of lines at ±δ per revolution stands; 0 where fewer than 6 values.
+        i.e. how far above the noise a pair of lines at ±δ per revolution stands; 0 where a side is resolved in
+        fewer than 3 runs (:meth:`fit` needs 3) or fewer than 6 values.
         Not clipped: beside a strong carrier the true pair stands out as the peak of a broad hump of skirts."""
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         z = {}
@@ -143,8 +145,9 @@ class SpeedSidebands:
             vals = []
             for side in (-1.0, 1.0):
                 sub = resolvable_runs(ctx, state, direction, h0, h0 + side * dl, runs)
-                if sub.size == 0:
-                    continue
+                if sub.size < 3:                # as :meth:`fit`: a side resolved in fewer runs is not fitted
+                    vals = []
+                    break
                 rows = np.array([pos[r] for r in sub])
                 k = np.rint((h0 + side * dl) * ctx.omega[sub] / (2 * np.pi) / ctx.df).astype(int)
                 for c in chans:
