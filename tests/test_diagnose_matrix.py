@@ -110,3 +110,12 @@ def test_speed_sidebands_eligible_only_where_resolved_and_found_there():
     e = r["effect"]
     assert e["h_lower"] == pytest.approx(0.94, abs=0.002) and e["h_upper"] == pytest.approx(1.06, abs=0.002)
     assert e["ratio_lower"] == pytest.approx(0.2, rel=0.1) and e["ratio_upper"] == pytest.approx(0.2, rel=0.1)
+
+
+def test_counter_rotation_found_from_the_phase_at_coarse_bins():
+    """Cell samples=2048 (7.5 Hz Welch bins): the fundamental's PSD window (±3 bins) lies in band in 2 runs only,
+    but the line itself in 27 of 60 (the signature measure: eligible); the x/y phase needs only those, and
+    diagnose --model names q = 0.3 (it found nothing before: the PSD route returned None below 3 points)."""
+    r = matrix.evaluate(CELLS["samples=2048"], "counter_rotation", "model")
+    assert r["eligible"] and r["found"], r
+    assert r["effect"]["counter_fraction"] == pytest.approx(0.3, abs=0.01)
