@@ -2,15 +2,16 @@
 
 Every cell is E-wheel data from the virtual stand with the extended physics (radial translation,
 rocking with gyroscopic forward/backward whirl, axial mode ON: real wheels have modes), random
-phases and noise per run, and ``rwadist diagnose DATA`` as a user types it first (no model: the
-search must name ``suspension_modes`` and fit them from the data).  Per cell:
+phases and noise per run, diagnosed on one or both of two paths (below).  Per cell and path:
 
 * clean data (the stand resonance of the cell included when it has one): the effects diagnose adds
   beyond the wheel's own modes (and beyond a ``fixed_resonance`` of role test_stand at the stand's
   frequency when the cell has one) -- must be 0;
 * each effect family the registry lists (:data:`rwadist.diagnose.effects.EFFECT_CLASSES`) that
   :mod:`rwadist.inject` can inject, injected alone (its parameters below): found or missed, the
-  fitted parameter against the injected one, and any other effect added beside it;
+  fitted parameter against the injected one, and any other effect added beside it (for an injected lever
+  arm, its offset itself -- a ``cross_coupling`` within 10 mm of r_z -- is expected beside it);
+* a crash of diagnose is a row of the table ("DIAGNOSE CRASHED": a miss, or an addition on clean data);
 * the modes: each of radial translation, rocking and axial either found within 2 % of the truth
   (the thesis numbers of tests/independent_wheel.py), listed in ``unconstrained``, or outside 2 % with
   the extended fit's misfit note for that mode in ``analytical.fit.notes`` ("misfit noted") -- a mode
@@ -29,14 +30,16 @@ Two paths per row (``--paths``), because a user meets diagnose twice:
   (seed + REFERENCE_SEED_OFFSET).  This is the workflow that asks "what does this run hold that my wheel's model
   does not" (fit on the acceptance run, diagnose the next) and the path on which the issue measured the missed
   classes.  CLASS DETECTION IS COUNTED ON THIS PATH: an injected effect must be NAMED as what the new run adds
-  to the reference model.  Clean data on this path must get nothing (not even the stand: the reference run has
-  it too, so a ``test_stand`` at the stand frequency is tolerated as on path none).
+  to the reference model.  Clean data on this path must get nothing (a ``test_stand`` at the stand frequency
+  is tolerated as on path none: ``fit --extended`` has no stand resonance, so diagnose may name it).  The modes
+  column checks the reference model's modes.  Mass and radius are the preset's (a user knows the wheel's); no
+  starting values from the preset (``--preset`` would start the fit at the truth).
 
 "Signature above the noise" (:func:`signature`, the three classes added last: counter_rotation,
 speed_sidebands, lever_arm_noise): computed per cell from the injection's truth alone (its parameters, the
 wheel's modes through which :mod:`rwadist.inject` sends the load, the sensor noise std the stand records, the
-Welch segment diagnose uses), never from a detector: a counter-rotating line at least 10 dB over the noise in
-its bin in >= 3 speeds; both speed sidebands 10 dB over the noise plus the carrier's (and the other
+record length: a line is judged at the resolution the data hold, a Hann window over the whole record), never
+from a detector: a counter-rotating line at least 10 dB over the noise in its bin in >= 3 speeds; both speed sidebands 10 dB over the noise plus the carrier's (and the other
 sideband's) Hann-window leakage into their bin in >= 3 speeds; the corrected torque floor raised >= 1 dB by the
 force noise (and the r × F line over the torque noise).  The summary counts found / eligible per class and
 path (the acceptance: >= 90 % on path model), and prints the cells missed where eligible.
@@ -285,8 +288,8 @@ def _hann_leakage(n: int, delta_bins) -> np.ndarray:
 
 
 def _line_to_noise(amp, sigma, n):
-    """Power of a sinusoid of amplitude ``amp`` in its own Welch bin over that of white noise of std ``sigma``,
-    Hann segments of ``n`` samples: A²(Σw)²/(4σ²Σw²) = A²n/(6σ²)."""
+    """Power of a sinusoid of amplitude ``amp`` in its own bin over that of white noise of std ``sigma``, Hann
+    window of ``n`` samples (a Welch segment or the whole record): A²(Σw)²/(4σ²Σw²) = A²n/(6σ²)."""
     return np.abs(amp) ** 2 * n / (6.0 * sigma**2)
 
 
@@ -300,11 +303,12 @@ def _modal_amplitudes(direction, h, C, sense, omegas):
     return f[:, 0], A[:, 0, :]
 
 
-def signature(cell: dict, kind: str, test, nperseg: int) -> dict:
+def signature(cell: dict, kind: str, test) -> dict:
     """How far the injected component of ``kind`` stands above the noise in ``test`` (the cell's data), from the
     generator's truth alone (the injected parameters, the wheel's modes, the sensor noise std the stand records in
-    ``meta["noise_std"]``, the Welch segment the diagnosis uses), never from the detector.  Returns {"text",
-    "eligible"} (eligible None: no measure for this class).
+    ``meta["noise_std"]``, the record length), never from the detector.  A line is measured at the resolution the
+    data themselves hold: a Hann window over the whole record (fs/n bins; the time series are the data, a Welch
+    segment is an analysis choice).  Returns {"text", "eligible"} (eligible None: no measure for this class).
 
     * counter_rotation: per run, the counter-rotating part's line in Fx and Fy (its amplitude through the modes)
       over the noise in its bin; eligible when >= SIGNATURE_RATIO in SIGNATURE_RUNS runs in band (the x/y phase
@@ -324,13 +328,14 @@ def signature(cell: dict, kind: str, test, nperseg: int) -> dict:
     truth = parse(SPECS[kind])
     omegas = np.array([abs(r.speed) for r in test.runs])
     fs = float(np.median([r.sample_rate for r in test.runs]))
-    df = fs / nperseg
+    n_rec = int(np.median([r.n_samples for r in test.runs]))          # the whole record
+    df = fs / n_rec
     f_hi = min(float(test.meta.get("f_lim_hz") or np.inf), 0.5 * fs) - SIGNATURE_MIN_BIN * df
     noise = test.meta["noise_std"]
     if kind == "counter_rotation":
         f, A = _modal_amplitudes("radial_force", truth["h"], wheel.extended.U_s * np.sqrt(truth["fraction"]),
                                  "counter", omegas)
-        s = np.minimum(_line_to_noise(A[:, 0], noise["Fx"], nperseg), _line_to_noise(A[:, 1], noise["Fy"], nperseg))
+        s = np.minimum(_line_to_noise(A[:, 0], noise["Fx"], n_rec), _line_to_noise(A[:, 1], noise["Fy"], n_rec))
         s = np.where((f >= SIGNATURE_MIN_BIN * df) & (f <= f_hi), s, 0.0)
         n_ok = int(np.sum(s >= SIGNATURE_RATIO))
         return {"text": f"counter line/noise {_db(np.max(s))} dB max, {n_ok}/{s.size} runs >= {_db(SIGNATURE_RATIO)} dB",
@@ -343,11 +348,11 @@ def signature(cell: dict, kind: str, test, nperseg: int) -> dict:
         for j, (f, A) in enumerate(sides):
             fo, Ao = sides[1 - j]
             k = np.rint(f / df)
-            leak = (np.abs(Ac[:, 0]) ** 2 * _hann_leakage(nperseg, k - fc / df)
-                    + np.abs(Ao[:, 0]) ** 2 * _hann_leakage(nperseg, k - fo / df))
-            sig = np.abs(A[:, 0]) ** 2 * _hann_leakage(nperseg, k - f / df)
+            leak = (np.abs(Ac[:, 0]) ** 2 * _hann_leakage(n_rec, k - fc / df)
+                    + np.abs(Ao[:, 0]) ** 2 * _hann_leakage(n_rec, k - fo / df))
+            sig = np.abs(A[:, 0]) ** 2 * _hann_leakage(n_rec, k - f / df)
             # powers in units of a bin-centred line's bin power: the noise's is 6σ²/n (see _line_to_noise)
-            r = sig / (leak + 6.0 * noise["Fx"] ** 2 / nperseg)
+            r = sig / (leak + 6.0 * noise["Fx"] ** 2 / n_rec)
             ratio.append(np.where((f >= SIGNATURE_MIN_BIN * df) & (f <= f_hi), r, 0.0))
         both = np.minimum(*ratio)
         n_ok = int(np.sum(both >= SIGNATURE_RATIO))
@@ -359,7 +364,7 @@ def signature(cell: dict, kind: str, test, nperseg: int) -> dict:
     rho = truth["r_z"] ** 2 * sf2 / noise["Tx"] ** 2
     rise = 10 * np.log10(1 + rho)
     f, A = _modal_amplitudes("radial_force", 1.0, wheel.extended.U_s, "co", omegas)
-    line = _line_to_noise(truth["r_z"] * A[:, 0], noise["Tx"], nperseg)
+    line = _line_to_noise(truth["r_z"] * A[:, 0], noise["Tx"], n_rec)
     n_line = int(np.sum((line >= SIGNATURE_RATIO) & (f >= SIGNATURE_MIN_BIN * df) & (f <= f_hi)))
     return {"text": f"Tx/Ty floor rise {rise:.2f} dB; r x F line above torque noise in {n_line}/{line.size} runs",
             "eligible": bool(rise >= SIGNATURE_FLOOR_DB and n_line >= SIGNATURE_RUNS)}
@@ -427,7 +432,7 @@ def evaluate(cell: dict, kind: str, path: str = "none"):
     except DataError as exc:                             # an injection the generator refuses: said, not run
         return {"cell": cell["name"], "kind": kind, "path": path, "skipped": str(exc)}
     model = reference_model(cell) if path == "model" else None
-    sig = signature(cell, kind, test, api.diagnose_nperseg(test)) if kind != "clean" else {"text": "", "eligible": None}
+    sig = signature(cell, kind, test) if kind != "clean" else {"text": "", "eligible": None}
     t0 = time.perf_counter()
     try:
         d = api.diagnose(test, model)
