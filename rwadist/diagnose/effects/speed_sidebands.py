@@ -93,7 +93,8 @@ class SpeedSidebands:
     beat, a tone ring) puts them at (h₀ ± δ)|Ω| with amplitudes (m/2)·C₀Ω² each.  They move with the speed, so
     they are harmonics (``missing_harmonic`` would take each, if it could see them): the model file gets two
     harmonics C_lower, C_upper (every consumer reads them) and this record.  Close to a strong line they are
-    resolved only at the higher speeds (δ|Ω|/2π >= MIN_BINS bins): the search and the fit use those runs
+    resolved only at the higher speeds (δ|Ω|/2π >= MIN_BINS Welch bins, or RUN_MIN_BINS record bins on the
+    whole-run DFT when the time series are given): the search and the fit use those runs
     (:func:`resolvable_runs`); the prediction holds at every speed."""
 
     direction: str
