@@ -22,13 +22,15 @@ MIN_BINS = 2.5
 DELTA_GRID = np.arange(0.01, 0.30001, 0.0025)
 
 
-#: Window of the whole-run DFT the sidebands are measured with when the time series are given: the 4-term
-#: Blackman-Harris, sidelobes below −92 dB, so a carrier even 60 dB over the noise leaks nothing measurable
-#: beyond its main lobe (±4 bins of the record, fs/n each: 4× finer than the Welch bins of n/4 segments).
-RUN_WINDOW = "blackmanharris"
+#: Window of the whole-run DFT the sidebands are measured with when the time series are given: Hann, whose main
+#: lobe (±2 record bins of fs/n: 4× finer than the Welch bins of n/4 segments) keeps the pair apart at low speeds;
+#: the carrier's leakage beyond it (sidelobes from −31 dB) is subtracted with the carrier's own phasor
+#: (:func:`_run_line_power`).
+RUN_WINDOW = "hann"
 #: Smallest separation (record bins) of a sideband from its carrier and from every other line of the direction
-#: in the whole-run route: the main lobe ±4 bins plus half a bin of scalloping.
-RUN_MIN_BINS = 4.5
+#: in the whole-run route: the edge of the Hann main lobe (±2 bins; beyond it the transform is below −31 dB, and
+#: the carrier's part of it is subtracted).  No scalloping margin: the phasor is taken at the line's own frequency.
+RUN_MIN_BINS = 2.0
 
 
 def _record_df(ctx: Context, runs) -> np.ndarray:
@@ -37,52 +39,69 @@ def _record_df(ctx: Context, runs) -> np.ndarray:
 
 
 def resolvable_runs(ctx: Context, state: State, direction: str, h0: float, h_side: float, runs) -> np.ndarray:
-    """The runs of ``runs`` where the line h_side·|Ω| is in band and measured alone: with the time series
-    (``ctx.test``) at least RUN_MIN_BINS record bins from its carrier h0 and from every other line of the
-    direction's model (the whole-run DFT, :func:`_run_phasors`); else at least MIN_BINS Welch bins from h0 and
-    2·LINE_HALF from every other line (the residual PSD)."""
+    """The runs of ``runs`` where the line h_side·|Ω| is in band, at least MIN_BINS Welch bins from its carrier h0 and
+    2·LINE_HALF bins from every other line of the direction's model: there the residual PSD measures it alone."""
     w = ctx.omega[runs] / (2 * np.pi)
     f = h_side * w
-    if ctx.test is not None:
-        near = far = RUN_MIN_BINS * _record_df(ctx, runs)
-    else:
-        near, far = MIN_BINS * ctx.df, 2 * LINE_HALF * ctx.df
-    ok = (np.abs(h_side - h0) * w >= near) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
+    ok = (np.abs(h_side - h0) * w >= MIN_BINS * ctx.df) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
         & (f <= (ctx.k_hi - LINE_HALF) * ctx.df)
     for x in state.model.harmonics(direction):
         if abs(x.h - h0) > 1e-6:
-            ok &= np.abs(x.h - h_side) * w >= far
+            ok &= np.abs(x.h - h_side) * w >= 2 * LINE_HALF * ctx.df
     return runs[ok]
 
 
-def _run_phasors(ctx: Context, chans, runs, f_hz) -> tuple:
-    """(X, noise): complex amplitudes X (len(runs), L, len(chans)) of the channels at frequencies ``f_hz``
-    (len(runs), L) Hz, whole record, :data:`RUN_WINDOW` (x(t) ≈ Re(X e^{2πj f t}) for a line at f); and the
-    mean of |X|² white noise of the state's floor S would give, 2·S·fs·Σw²/(Σw)² per (run, L, channel) -- filled
-    by the caller (here the window's fs·Σw²/(Σw)² per run, (len(runs),))."""
+def record_resolvable_runs(ctx: Context, state: State, direction: str, h0: float, h_side: float,
+                           runs) -> np.ndarray:
+    """As :func:`resolvable_runs` for the whole-run DFT (time series given, :func:`_run_line_power`): the line in
+    band and at least RUN_MIN_BINS record bins (fs/n) from its carrier and from every other line of the direction."""
+    w = ctx.omega[runs] / (2 * np.pi)
+    f = h_side * w
+    sep = RUN_MIN_BINS * _record_df(ctx, runs)
+    ok = (np.abs(h_side - h0) * w >= sep) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
+        & (f <= (ctx.k_hi - LINE_HALF) * ctx.df)
+    for x in state.model.harmonics(direction):
+        if abs(x.h - h0) > 1e-6:
+            ok &= np.abs(x.h - h_side) * w >= sep
+    return runs[ok]
+
+
+def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: float) -> tuple:
+    """(|X|² (len(runs), L, n_chans), noise mean of |X|² same shape): the whole-run line powers of the direction's
+    channels at ``f_hz`` (len(runs), L) Hz, Hann-windowed (:data:`RUN_WINDOW`; X = 2·Σ w x e^{−2πj f t}/Σ w, so a line
+    a·cos(2π f t + φ) gives |X| = a), less the leakage of the carrier h0: X(f) − X(f_c)·W(f − f_c)/W(0), f_c =
+    h0|Ω|/2π, W the window's transform (a line at f_c puts X(f_c)·W(f − f_c)/W(0) at f); and the mean |X|² white
+    noise of the state's floor S gives there, 2·S·fs·Σw²/(Σw)²."""
     from scipy import signal
 
     from ...extended_fit import windowed_dft
 
+    chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
     X = np.zeros((runs.size, f_hz.shape[1], len(chans)), dtype=complex)
+    for i, r in enumerate(runs):
+        run = ctx.test.runs[r]
+        w = signal.get_window(RUN_WINDOW, run.n_samples)
+        f_c = h0 * ctx.omega[r] / (2 * np.pi)
+        x = np.column_stack([run.signals[c] for c in chans]) * w[:, None]
+        both = 2.0 * windowed_dft(x, run.sample_rate, np.concatenate([f_hz[i], [f_c]])) / np.sum(w)
+        leak = windowed_dft(w[:, None], run.sample_rate, f_hz[i] - f_c)[:, 0] / np.sum(w)       # W(f − f_c)/W(0)
+        X[i] = both[:-1] - leak[:, None] * both[-1][None, :]
+    return np.abs(X) ** 2, _run_noise(ctx, state, chans, runs, f_hz)
+
+
+def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
+    """Mean |X|² (len(runs), L, len(chans)) that white noise of the state's floor S puts into the whole-run phasor
+    at ``f_hz``: 2·S·fs·Σw²/(Σw)² (:data:`RUN_WINDOW`)."""
+    from scipy import signal
+
     enbw = np.empty(runs.size)
     for i, r in enumerate(runs):
         run = ctx.test.runs[r]
         w = signal.get_window(RUN_WINDOW, run.n_samples)
-        x = np.column_stack([run.signals[c] for c in chans]) * w[:, None]
-        X[i] = 2.0 * windowed_dft(x, run.sample_rate, f_hz[i]) / np.sum(w)
         enbw[i] = run.sample_rate * np.sum(w**2) / np.sum(w) ** 2
-    return X, enbw
-
-
-def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz) -> tuple:
-    """(|X|² (len(runs), L, n_chans), noise mean of |X|² same shape): the whole-run line powers of the direction's
-    channels at ``f_hz`` (len(runs), L), and what the state's noise floor alone would give there."""
-    chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
-    X, enbw = _run_phasors(ctx, chans, runs, f_hz)
     k = np.clip(np.rint(f_hz / ctx.df).astype(int), 0, ctx.f.size - 1)
     noise = np.stack([np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1) for c in chans], axis=-1)
-    return np.abs(X) ** 2, 2.0 * noise * enbw[:, None, None]
+    return 2.0 * noise * enbw[:, None, None]
 
 
 @register(order=15)
@@ -93,9 +112,9 @@ class SpeedSidebands:
     beat, a tone ring) puts them at (h₀ ± δ)|Ω| with amplitudes (m/2)·C₀Ω² each.  They move with the speed, so
     they are harmonics (``missing_harmonic`` would take each, if it could see them): the model file gets two
     harmonics C_lower, C_upper (every consumer reads them) and this record.  Close to a strong line they are
-    resolved only at the higher speeds (δ|Ω|/2π >= MIN_BINS Welch bins, or RUN_MIN_BINS record bins on the
-    whole-run DFT when the time series are given): the search and the fit use those runs
-    (:func:`resolvable_runs`); the prediction holds at every speed."""
+    resolved only at the higher speeds (δ|Ω|/2π >= MIN_BINS Welch bins, :func:`resolvable_runs`, or RUN_MIN_BINS
+    record bins on the whole-run DFT when the time series are given, :func:`record_resolvable_runs`): the search
+    and the fit use those runs; the prediction holds at every speed."""
 
     direction: str
     h0: float
@@ -182,31 +201,33 @@ class SpeedSidebands:
     @staticmethod
     def _fit_record(ctx: Context, state: State, direction: str, h0: float, runs, delta: float):
         """:meth:`fit` on the whole-run DFT (time series given): each side's h is the maximum of the summed line
-        power Σ|X|² over a grid h₀ ± δ ± 0.004 (step 0.0001, then a parabola through the top three) on the runs
-        where it is resolved; its C by thesis Eq. 3.10 on the amplitudes sqrt(|X|² − noise) of the points standing
+        power Σ|X|² over a grid h₀ ± δ ± 0.0125 (step 0.0005, then ± 0.0006 in steps of 0.00002, each refined by a
+        parabola through the top three) on the runs where it is resolved; its C by thesis Eq. 3.10 on the amplitudes sqrt(|X|² − noise) of the points standing
         10 × over the noise, divided by the fixed resonances' and the modal gain (the line before the mount)."""
         out = []
         for side in (-1.0, 1.0):
             h = h0 + side * delta
-            sub = resolvable_runs(ctx, state, direction, h0, h, runs)
+            sub = record_resolvable_runs(ctx, state, direction, h0, h, runs)
             if sub.size < 3:
                 return None
-            grid = h + np.arange(-0.004, 0.00401, 0.0001)
-            grid = grid[side * (grid - h0) > 0]
-            P, _ = _run_line_power(ctx, state, direction, sub, np.outer(ctx.omega[sub] / (2 * np.pi), grid))
-            tot = P.sum(axis=(0, 2))
-            i = int(np.argmax(tot))
-            if 0 < i < grid.size - 1:
-                lo, mid, hi = np.log(tot[i - 1:i + 2])
+            # coarse, then fine: the scan's δ can sit a grid step or two off the pair (its median favours the few
+            # fastest runs resolved at a larger δ, where the pair's own main lobe still lifts the score)
+            for half, step in ((0.0125, 0.0005), (0.0006, 0.00002)):
+                grid = h + np.arange(-half, half + 0.5 * step, step)
+                grid = grid[side * (grid - h0) > 0]
+                P, _ = _run_line_power(ctx, state, direction, sub, np.outer(ctx.omega[sub] / (2 * np.pi), grid), h0)
+                tot = P.sum(axis=(0, 2))
+                i = int(np.argmax(tot))
+                if not 0 < i < grid.size - 1:
+                    return None                         # the peak at the grid's edge: no line near h0 ± δ
+                lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
                 den = lo - 2 * mid + hi
-                h = float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * (grid[1] - grid[0]))
-            else:
-                return None                             # the peak at the grid's edge: no line near h0 ± δ
-            sub = resolvable_runs(ctx, state, direction, h0, h, runs)
+                h = float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * step)
+            sub = record_resolvable_runs(ctx, state, direction, h0, h, runs)
             if sub.size < 3:
                 return None
             f = (h * ctx.omega[sub] / (2 * np.pi))[:, None]
-            P, N = _run_line_power(ctx, state, direction, sub, f)
+            P, N = _run_line_power(ctx, state, direction, sub, f, h0)
             chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
             d, w = [], []
             for j, c in enumerate(chans):
@@ -230,20 +251,21 @@ class SpeedSidebands:
     @staticmethod
     def _scan_record(ctx: Context, state: State, direction: str, h0: float, runs) -> tuple:
         """:meth:`scan` on the whole-run DFT: per δ the median over channels, resolved runs and both sides of
-        |X|² over the noise's mean at (h₀ ± δ)|Ω|/2π (no residual needed: the window leaks nothing beyond its
-        main lobe, which :func:`resolvable_runs` keeps clear)."""
+        |X|² over the noise's mean at (h₀ ± δ)|Ω|/2π, the carrier's leakage taken off (:func:`_run_line_power`;
+        the main lobe itself is kept clear by :func:`record_resolvable_runs`)."""
         grid = np.concatenate([h0 - DELTA_GRID, h0 + DELTA_GRID])
+        f_hz = np.outer(ctx.omega[runs] / (2 * np.pi), grid)
         key = ("speed_sidebands_scan", direction, round(h0, 6), runs.tobytes())
-        if key not in ctx._memo:
-            P, N = _run_line_power(ctx, state, direction, runs, np.outer(ctx.omega[runs] / (2 * np.pi), grid))
-            ctx._memo[key] = P / np.maximum(N, 1e-300)
-        z = ctx._memo[key]                                                   # (runs, 2G, chans)
+        if key not in ctx._memo:                # the data's line powers: the same on every step of the search
+            ctx._memo[key] = _run_line_power(ctx, state, direction, runs, f_hz, h0)[0]
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        z = ctx._memo[key] / np.maximum(_run_noise(ctx, state, chans, runs, f_hz), 1e-300)   # (runs, 2G, chans)
         pos = {r: i for i, r in enumerate(runs)}
         score = np.zeros(DELTA_GRID.size)
         for j in range(DELTA_GRID.size):
             vals = []
             for col in (j, DELTA_GRID.size + j):
-                sub = resolvable_runs(ctx, state, direction, h0, grid[col], runs)
+                sub = record_resolvable_runs(ctx, state, direction, h0, grid[col], runs)
                 if sub.size < 3:
                     vals = []
                     break
