@@ -2,19 +2,47 @@
 
 Every cell is E-wheel data from the virtual stand with the extended physics (radial translation,
 rocking with gyroscopic forward/backward whirl, axial mode ON: real wheels have modes), random
-phases and noise per run, and ``rwadist diagnose DATA`` as a user types it first (no model: the
-search must name ``suspension_modes`` and fit them from the data).  Per cell:
+phases and noise per run, diagnosed on one or both of two paths (below).  Per cell and path:
 
 * clean data (the stand resonance of the cell included when it has one): the effects diagnose adds
   beyond the wheel's own modes (and beyond a ``fixed_resonance`` of role test_stand at the stand's
   frequency when the cell has one) -- must be 0;
 * each effect family the registry lists (:data:`rwadist.diagnose.effects.EFFECT_CLASSES`) that
   :mod:`rwadist.inject` can inject, injected alone (its parameters below): found or missed, the
-  fitted parameter against the injected one, and any other effect added beside it;
+  fitted parameter against the injected one, and any other effect added beside it (for an injected lever
+  arm, its offset itself -- a ``cross_coupling`` within 10 mm of r_z -- is expected beside it);
+* a crash of diagnose is a row of the table ("DIAGNOSE CRASHED": a miss, or an addition on clean data);
 * the modes: each of radial translation, rocking and axial either found within 2 % of the truth
   (the thesis numbers of tests/independent_wheel.py), listed in ``unconstrained``, or outside 2 % with
   the extended fit's misfit note for that mode in ``analytical.fit.notes`` ("misfit noted") -- a mode
   outside 2 % with neither is a SILENT failure (the acceptance: no such cell).
+
+Two paths per row (``--paths``), because a user meets diagnose twice:
+
+* ``none``: ``rwadist diagnose DATA`` with no model, what a user types first.  Its job is to name the wheel's own
+  ``suspension_modes`` and fit them from the data, then anything foreign to the wheel.  The extended fit behind
+  ``suspension_modes`` fits every line the data show with its own co/counter split, so an effect that is a
+  wheel load of the model's own form (the counter-rotating part of a line, lines at 0.94/1.06 × the speed)
+  lands in that fitted base: the model is right but the effect is not named ("in base fit, not named", with its
+  parameter read from the base).  Clean data must get nothing beyond the modes here too.
+* ``model``: ``rwadist diagnose DATA --model M``, M the extended model (``rwadist fit --extended --mass
+  --radius``) fitted on a separate CLEAN run of the same cell: the same stand settings, other phases and noise
+  (seed + REFERENCE_SEED_OFFSET).  This is the workflow that asks "what does this run hold that my wheel's model
+  does not" (fit on the acceptance run, diagnose the next) and the path on which the issue measured the missed
+  classes.  CLASS DETECTION IS COUNTED ON THIS PATH: an injected effect must be NAMED as what the new run adds
+  to the reference model.  Clean data on this path must get nothing (a ``test_stand`` at the stand frequency
+  is tolerated as on path none: ``fit --extended`` has no stand resonance, so diagnose may name it).  The modes
+  column checks the reference model's modes.  Mass and radius are the preset's (a user knows the wheel's); no
+  starting values from the preset (``--preset`` would start the fit at the truth).
+
+"Signature above the noise" (:func:`signature`, the three classes added last: counter_rotation,
+speed_sidebands, lever_arm_noise): computed per cell from the injection's truth alone (its parameters, the
+wheel's modes through which :mod:`rwadist.inject` sends the load, the sensor noise std the stand records, the
+record length: a line is judged at the resolution the data hold, a Hann window over the whole record), never
+from a detector: a counter-rotating line at least 10 dB over the noise in its bin in >= 3 speeds; both speed sidebands 10 dB over the noise plus the carrier's (and the other
+sideband's) Hann-window leakage into their bin in >= 3 speeds; the corrected torque floor raised >= 1 dB by the
+force noise (and the r × F line over the torque noise).  The summary counts found / eligible per class and
+path (the acceptance: >= 90 % on path model), and prints the cells missed where eligible.
 
 The matrix is NOT a full factorial (3^5·2 = 486 cells × 8 classes).  It is one factor at a time
 around a nominal cell (300-3000 rpm, 60 speeds, 8192 samples, 3840 Hz, noise 1 % of the top-speed
@@ -26,10 +54,14 @@ Factors: speed range 300-2400 / 300-3000 / 100-6000 rpm; 20 / 60 / 120 speeds; 2
 samples; 1000 / 3840 / 10000 Hz; noise 0.1 / 1 / 5 %; a test-stand resonance (180 Hz, ζ 0.03, peak
 gain 5, all six channels: the issue's case) in the band or not.
 
+Parameters compared with the truth: q against 0.3 (counter_rotation), h_lower/h_upper against 0.94/1.06 and
+C/C_carrier against 0.2 each (speed_sidebands), κ against 1 (lever_arm_noise, with r_z).
+
 Run (long: a few minutes per cell on one free core; give it a budget)::
 
     python benchmarks/diagnose_matrix.py                           # every cell, every class
     python benchmarks/diagnose_matrix.py --cells 0,1 --classes clean,cross_coupling
+    python benchmarks/diagnose_matrix.py --classes clean,counter_rotation,speed_sidebands,lever_arm_noise --paths model
     python benchmarks/diagnose_matrix.py --budget 1800             # stop starting rows after 30 min
 
 Rows run class by class (clean data in every cell first), so a run cut by its budget covers whole classes.
@@ -139,6 +171,12 @@ def _is_stand(e) -> bool:
     return e["kind"] == "fixed_resonance" and e.get("role") == "test_stand" and abs(e["f_Hz"] / STAND_HZ - 1) < 0.05
 
 
+def _is_offset(e, truth: dict) -> bool:
+    """The load-cell offset itself (``cross_coupling``, r_z within 10 mm) of an injected lever arm: the transfer
+    of its noise (``lever_arm_noise``) is only defined once the offset is found, so it is expected beside it."""
+    return e["kind"] == "cross_coupling" and abs(e["r_m"][2] - truth["r_z"]) < 0.01
+
+
 def _matches(e, kind: str, truth: dict) -> bool:
     """Whether diagnosed effect ``e`` is the injected one (the fixed resonance at its own frequency)."""
     if e["kind"] != kind:
@@ -178,20 +216,36 @@ def parameter(kind: str, e: dict, truth: dict) -> str:
     return ", ".join(f"{k}={e[k]}" for k in keys[:3])
 
 
-def modes_check(d) -> tuple:
+def _mode_frequencies(model) -> tuple:
+    """(f0 Hz per mode, unconstrained modes, fit notes) of a model file's analytical section."""
+    from rwadist import extended as ext
+
+    an = dict(getattr(model, "analytical", None) or {})
+    p = ext.params_from_model(model, "matrix")
+    f0 = {"radial_translation": float(p.omega_r / (2 * np.pi)), "rocking": float(p.omega_rock / (2 * np.pi)),
+          "axial": float(np.sqrt(p.k_z / p.mass) / (2 * np.pi))}
+    return f0, set(an.get("unconstrained") or []), " ".join((an.get("fit") or {}).get("notes") or [])
+
+
+def modes_check(d, model=None) -> tuple:
     """(text, silent): each mode found within 2 % of the truth, declared unconstrained, or SILENT (wrong and
-    not declared); silent is True when any mode is the last."""
+    not declared); silent is True when any mode is the last.  ``model``: the extended model diagnose was given
+    (path "model": its modes are checked), else the ``suspension_modes`` diagnose named from the data."""
     import independent_wheel as iw
 
-    sm = [e for e in d.model.effects if e["kind"] == "suspension_modes"]
-    if not sm:
-        return "no suspension_modes", False
-    e = sm[0]
-    unc = set(e.get("unconstrained") or [])
-    notes = " ".join(((getattr(d.model, "analytical", None) or {}).get("fit") or {}).get("notes") or [])
+    if model is not None:
+        f0, unc, notes = _mode_frequencies(model)
+    else:
+        sm = [e for e in d.model.effects if e["kind"] == "suspension_modes"]
+        if not sm:
+            return "no suspension_modes", False
+        e = sm[0]
+        f0 = {m: e[f"{m}_Hz"] for m in MODES}
+        unc = set(e.get("unconstrained") or [])
+        notes = " ".join(((getattr(d.model, "analytical", None) or {}).get("fit") or {}).get("notes") or [])
     parts, silent = [], False
     for m in MODES:
-        f = e[f"{m}_Hz"]
+        f = f0[m]
         err = 100 * (f / iw.TRUTH_HZ[m] - 1)
         # the extended fit's own warning in the model file: the linear model misses the data near the mode
         warned = f"{'axial_translation' if m == 'axial' else m}: the linear model misses" in notes
@@ -207,35 +261,197 @@ def modes_check(d) -> tuple:
     return ", ".join(parts), silent
 
 
-def evaluate(cell: dict, kind: str):
-    """Diagnose one row: ``kind`` = "clean" or a registry family.  Returns a dict (or None when the
-    family cannot be injected, with ``why``)."""
+# ------------------------------------------------------------------ signature above the noise (injection truth)
+#: a component stands above the noise in a run when its power in its own Welch bin is at least this many times
+#: the noise's (and, for a line beside a stronger one, that line's window leakage) in the same bin: 10 dB
+SIGNATURE_RATIO = 10.0
+#: runs a line-type signature must stand above the noise in: a speed law (C·Ω², a phase, an offset per
+#: revolution) is told from a fixed line or a fluke only over several speeds
+SIGNATURE_RUNS = 3
+#: lowest bin a line is measured in: below, the Hann window's DC lobe (±2 bins) and the mean overlap it
+SIGNATURE_MIN_BIN = 4
+#: torque-floor rise (dB) above which the lever-arm noise transfer counts as above the noise: a floor is itself
+#: noise; 1 dB (26 % in power) is several times the scatter of a floor level averaged over a band of bins
+SIGNATURE_FLOOR_DB = 1.0
+
+
+def _hann_leakage(n: int, delta_bins) -> np.ndarray:
+    """|Σ w e^{−2πiΔk/N}|² / (Σ w)² of the periodic Hann window of ``n`` samples at offsets Δ (bins): the share of a
+    line's bin power that a bin Δ away holds (1 at Δ = 0)."""
+    from scipy import signal
+
+    w = signal.get_window("hann", n)
+    d = np.atleast_1d(np.asarray(delta_bins, float))
+    k = np.arange(n)
+    out = np.abs(np.exp(-2j * np.pi * np.outer(d.ravel(), k) / n) @ w) ** 2 / np.sum(w) ** 2
+    return out.reshape(d.shape)
+
+
+def _line_to_noise(amp, sigma, n):
+    """Power of a sinusoid of amplitude ``amp`` in its own bin over that of white noise of std ``sigma``, Hann
+    window of ``n`` samples (a Welch segment or the whole record): A²(Σw)²/(4σ²Σw²) = A²n/(6σ²)."""
+    return np.abs(amp) ** 2 * n / (6.0 * sigma**2)
+
+
+def _modal_amplitudes(direction, h, C, sense, omegas):
+    """(f Hz (n,), amplitude (n, 6)) of the wheel load C·Ω² e^{±ihφ} through the E wheel's suspension modes at
+    speeds ``omegas`` (rad/s), as :mod:`rwadist.inject` adds it (:func:`rwadist.extended.steady_lines`)."""
+    from rwadist import extended as ext
+    from rwadist.presets import preset
+
+    f, A = ext.steady_lines(preset("ithaco-e").extended, [ext.Line(direction, float(h), float(C), sense)], omegas)
+    return f[:, 0], A[:, 0, :]
+
+
+def signature(cell: dict, kind: str, test) -> dict:
+    """How far the injected component of ``kind`` stands above the noise in ``test`` (the cell's data), from the
+    generator's truth alone (the injected parameters, the wheel's modes, the sensor noise std the stand records in
+    ``meta["noise_std"]``, the record length), never from the detector.  A line is measured at the resolution the
+    data themselves hold: a Hann window over the whole record (fs/n bins; the time series are the data, a Welch
+    segment is an analysis choice).  Returns {"text", "eligible"} (eligible None: no measure for this class).
+
+    * counter_rotation: per run, the counter-rotating part's line in Fx and Fy (its amplitude through the modes)
+      over the noise in its bin; eligible when >= SIGNATURE_RATIO in SIGNATURE_RUNS runs in band (the x/y phase
+      then separates it from the co part at the same frequency).
+    * speed_sidebands: per run and side, the sideband's power in its nearest bin over the noise plus the Hann
+      leakage of the carrier and of the other sideband into that bin (the window's exact transform); eligible
+      when both sides stand >= SIGNATURE_RATIO in SIGNATURE_RUNS runs.
+    * lever_arm_noise: the rise of the corrected Tx, Ty floor, 10·log10(1 + r_z²σ_F²/σ_T²) (σ_F² the stand's
+      and the injected force-sensor variances), eligible when >= SIGNATURE_FLOOR_DB, and the r × F line itself
+      above the torque noise (the offset must be found first)."""
+    from rwadist.inject import parse
+    from rwadist.presets import preset
+
+    if kind not in ("counter_rotation", "speed_sidebands", "lever_arm_noise"):
+        return {"text": "", "eligible": None}
+    wheel = preset("ithaco-e")
+    truth = parse(SPECS[kind])
+    omegas = np.array([abs(r.speed) for r in test.runs])
+    fs = float(np.median([r.sample_rate for r in test.runs]))
+    n_rec = int(np.median([r.n_samples for r in test.runs]))          # the whole record
+    df = fs / n_rec
+    f_hi = min(float(test.meta.get("f_lim_hz") or np.inf), 0.5 * fs) - SIGNATURE_MIN_BIN * df
+    noise = test.meta["noise_std"]
+    if kind == "counter_rotation":
+        f, A = _modal_amplitudes("radial_force", truth["h"], wheel.extended.U_s * np.sqrt(truth["fraction"]),
+                                 "counter", omegas)
+        s = np.minimum(_line_to_noise(A[:, 0], noise["Fx"], n_rec), _line_to_noise(A[:, 1], noise["Fy"], n_rec))
+        s = np.where((f >= SIGNATURE_MIN_BIN * df) & (f <= f_hi), s, 0.0)
+        n_ok = int(np.sum(s >= SIGNATURE_RATIO))
+        return {"text": f"counter line/noise {_db(np.max(s))} dB max, {n_ok}/{s.size} runs >= {_db(SIGNATURE_RATIO)} dB",
+                "eligible": n_ok >= SIGNATURE_RUNS}
+    if kind == "speed_sidebands":
+        dl, C_sb = truth["per_rev"], 0.5 * truth["depth"] * wheel.extended.U_s
+        fc, Ac = _modal_amplitudes("radial_force", 1.0, wheel.extended.U_s, "co", omegas)
+        sides = [_modal_amplitudes("radial_force", 1.0 + s * dl, C_sb, "co", omegas) for s in (-1.0, 1.0)]
+        ratio = []
+        for j, (f, A) in enumerate(sides):
+            fo, Ao = sides[1 - j]
+            k = np.rint(f / df)
+            leak = (np.abs(Ac[:, 0]) ** 2 * _hann_leakage(n_rec, k - fc / df)
+                    + np.abs(Ao[:, 0]) ** 2 * _hann_leakage(n_rec, k - fo / df))
+            sig = np.abs(A[:, 0]) ** 2 * _hann_leakage(n_rec, k - f / df)
+            # powers in units of a bin-centred line's bin power: the noise's is 6σ²/n (see _line_to_noise)
+            r = sig / (leak + 6.0 * noise["Fx"] ** 2 / n_rec)
+            ratio.append(np.where((f >= SIGNATURE_MIN_BIN * df) & (f <= f_hi), r, 0.0))
+        both = np.minimum(*ratio)
+        n_ok = int(np.sum(both >= SIGNATURE_RATIO))
+        return {"text": f"sideband/(noise+carrier leakage) {_db(np.max(both))} dB max, {n_ok}/{both.size} runs "
+                        f">= {_db(SIGNATURE_RATIO)} dB", "eligible": n_ok >= SIGNATURE_RUNS}
+    # lever_arm_noise
+    w_max = float(omegas.max())
+    sf2 = noise["Fx"] ** 2 + (truth["force_noise"] * wheel.fundamental_C("radial_force") * w_max**2) ** 2
+    rho = truth["r_z"] ** 2 * sf2 / noise["Tx"] ** 2
+    rise = 10 * np.log10(1 + rho)
+    f, A = _modal_amplitudes("radial_force", 1.0, wheel.extended.U_s, "co", omegas)
+    line = _line_to_noise(truth["r_z"] * A[:, 0], noise["Tx"], n_rec)
+    n_line = int(np.sum((line >= SIGNATURE_RATIO) & (f >= SIGNATURE_MIN_BIN * df) & (f <= f_hi)))
+    return {"text": f"Tx/Ty floor rise {rise:.2f} dB; r x F line above torque noise in {n_line}/{line.size} runs",
+            "eligible": bool(rise >= SIGNATURE_FLOOR_DB and n_line >= SIGNATURE_RUNS)}
+
+
+def _db(x) -> str:
+    return f"{10 * np.log10(max(float(x), 1e-30)):.0f}"
+
+
+#: seed offset of a cell's reference run (path "model"): the clean acceptance run the model is fitted on, other
+#: phases and noise than the diagnosed run of the same cell
+REFERENCE_SEED_OFFSET = 500
+PATHS = ("model", "none")
+_REFERENCE: dict = {}
+
+
+def reference_model(cell: dict):
+    """The extended model a user fits on the cell's clean acceptance run (``rwadist fit --extended --mass M
+    --radius R`` on the same stand settings, seed + REFERENCE_SEED_OFFSET), memoised per cell."""
+    from rwadist import api
+    from rwadist.presets import preset
+
+    if cell["name"] not in _REFERENCE:
+        wheel = preset("ithaco-e")
+        ref = generate(dict(cell, seed=cell["seed"] + REFERENCE_SEED_OFFSET), None)
+        _REFERENCE[cell["name"]] = api.fit_extended(ref, mass=wheel.mass_kg, radius=wheel.radius_m)[1]
+    return _REFERENCE[cell["name"]]
+
+
+def _in_base(kind: str, d, truth: dict) -> str:
+    """On path "none": the injected content the fitted base already carries without naming it (the extended fit of
+    ``suspension_modes`` takes every line and sense the data show), as text with its parameter, else ""."""
+    if kind == "missing_harmonic":
+        hit = [x for x in d.model.empirical.get(truth["direction"], []) if abs(x.h - truth["h"]) < 0.01]
+        return f"h {hit[0].h:.3f}" if hit else ""
+    if kind == "counter_rotation" and d.state_after.ext is not None:
+        from rwadist.diagnose.effects.counter_rotation import _sense_group
+
+        g = _sense_group(d.state_after, truth["direction"], truth["h"])
+        if g is not None and g[2] > 0:
+            q = g[2] ** 2 / (g[1] ** 2 + g[2] ** 2)
+            return f"q {q:.4g} (truth {truth['fraction']:g}, {100 * (q / truth['fraction'] - 1):+.1f} %)"
+        return ""
+    if kind == "speed_sidebands":
+        hs = [x.h for x in d.model.empirical.get("radial_force", [])]
+        pair = [min(hs, key=lambda h: abs(h - (1 + s * truth["per_rev"])), default=np.nan) for s in (-1, 1)]
+        if all(abs(h - (1 + s * truth["per_rev"])) < 0.01 for h, s in zip(pair, (-1, 1))):
+            return f"h {pair[0]:.4f}/{pair[1]:.4f}"
+    return ""
+
+
+def evaluate(cell: dict, kind: str, path: str = "none"):
+    """Diagnose one row: ``kind`` = "clean" or a registry family, ``path`` = "none" (``rwadist diagnose DATA``:
+    no model) or "model" (``--model`` the extended model fitted on the cell's clean reference run,
+    :func:`reference_model`).  Returns a dict (with ``skipped`` when the family cannot be injected)."""
     from rwadist import api
     from rwadist.data import DataError
     from rwadist.inject import parse
 
     spec, why = (None, None) if kind == "clean" else injection(kind)
     if kind != "clean" and spec is None:
-        return {"cell": cell["name"], "kind": kind, "skipped": why}
+        return {"cell": cell["name"], "kind": kind, "path": path, "skipped": why}
     try:
         test = generate(cell, spec)
     except DataError as exc:                             # an injection the generator refuses: said, not run
-        return {"cell": cell["name"], "kind": kind, "skipped": str(exc)}
+        return {"cell": cell["name"], "kind": kind, "path": path, "skipped": str(exc)}
+    model = reference_model(cell) if path == "model" else None
+    sig = signature(cell, kind, test) if kind != "clean" else {"text": "", "eligible": None}
     t0 = time.perf_counter()
-    d = api.diagnose(test)
+    try:
+        d = api.diagnose(test, model)
+    except Exception as exc:                             # a crash of diagnose is a row of the table (a miss, and a
+        return {"cell": cell["name"], "kind": kind, "path": path, "crashed": f"{type(exc).__name__}: {exc}",
+                "found": False if kind != "clean" else None, "eligible": sig["eligible"], "extra": ["CRASH"],
+                "silent": False, "modes": "-", "in_base": ""}         # failure on clean data), not its end
     elapsed = time.perf_counter() - t0
     truth = parse(spec) if spec else {}
     effects = list(d.model.effects)
-    expected = [e for e in effects if e["kind"] == "suspension_modes" or (cell["stand"] and _is_stand(e))]
+    expected = [e for e in effects if (e["kind"] == "suspension_modes" and path == "none")
+                or (cell["stand"] and _is_stand(e)) or (kind == "lever_arm_noise" and _is_offset(e, truth))]
     hit = [e for e in effects if kind != "clean" and _matches(e, kind, truth) and e not in expected]
     extra = [e for e in effects if e not in expected and e not in hit]
-    modes, silent = modes_check(d)
+    modes, silent = modes_check(d, model)
     stand_found = any(_is_stand(e) for e in effects) if cell["stand"] else None
-    # a missing harmonic the wheel's fitted base already carries (the extended fit of suspension_modes takes
-    # every line the data show): in the output model, but not named as an effect
-    in_base = (kind == "missing_harmonic" and not hit
-               and any(abs(x.h - truth["h"]) < 0.01 for x in d.model.empirical.get(truth["direction"], [])))
-    return {"cell": cell["name"], "kind": kind, "found": bool(hit) if kind != "clean" else None, "in_base": in_base,
+    in_base = _in_base(kind, d, truth) if (kind != "clean" and not hit and path == "none") else ""
+    return {"cell": cell["name"], "kind": kind, "path": path, "found": bool(hit) if kind != "clean" else None,
+            "in_base": in_base, "signature": sig["text"], "eligible": sig["eligible"],
             "param": parameter(kind, hit[0], truth) if hit else "-", "effect": hit[0] if hit else None,
             "extra": [e["kind"] + (f"({e.get('role')} {e['f_Hz']:.0f} Hz)" if e["kind"] == "fixed_resonance" else "")
                       for e in extra],
@@ -243,20 +459,31 @@ def evaluate(cell: dict, kind: str):
             "error": (d.error_before, d.error_after), "seconds": elapsed}
 
 
+HEADER = ("| cell | class | path | found | parameter (truth, error) | signature above noise (truth) | added beside it | "
+          "modes (vs truth) | error before -> after | s |")
+
+
 def row_text(r: dict) -> str:
     if "skipped" in r:
-        return f"| {r['cell']} | {r['kind']} | not injected: {r['skipped']} | | | | | |"
+        return f"| {r['cell']} | {r['kind']} | {r['path']} | not injected: {r['skipped']} | | | | | | |"
+    if "crashed" in r:
+        return f"| {r['cell']} | {r['kind']} | {r['path']} | DIAGNOSE CRASHED: {r['crashed']} | | | | | | |"
     found = "-" if r["found"] is None else ("FOUND" if r["found"] else
-                                            "in base fit, not named" if r.get("in_base") else "missed")
+                                            f"in base fit, not named: {r['in_base']}" if r.get("in_base") else "missed")
+    elig = "" if r["eligible"] is None else (" ELIGIBLE" if r["eligible"] else " below")
     stand = "" if r["stand_found"] is None else ("stand found" if r["stand_found"] else "stand MISSED")
-    return (f"| {r['cell']} | {r['kind']} | {found} | {r['param']} | {len(r['extra'])} {','.join(r['extra'])} | "
-            f"{r['modes']} {stand} | {r['error'][0]:.3f} -> {r['error'][1]:.4f} | {r['seconds']:.0f} |")
+    return (f"| {r['cell']} | {r['kind']} | {r['path']} | {found} | {r['param']} | {r['signature']}{elig} | "
+            f"{len(r['extra'])} {','.join(r['extra'])} | {r['modes']} {stand} | "
+            f"{r['error'][0]:.3f} -> {r['error'][1]:.4f} | {r['seconds']:.0f} |")
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--cells", default="all", help="comma-separated cell indices (see --list), or 'all'")
     ap.add_argument("--classes", default="all", help="comma-separated: 'clean' and registry kinds, or 'all'")
+    ap.add_argument("--paths", default="model,none",
+                    help="comma-separated: 'model' (diagnose --model, the extended model fitted on the cell's clean "
+                         "reference run) and/or 'none' (diagnose with no model)")
     ap.add_argument("--budget", type=float, default=None, help="seconds: start no new row after this")
     ap.add_argument("--list", action="store_true", help="print the cells and exit")
     a = ap.parse_args(argv)
@@ -267,41 +494,65 @@ def main(argv=None):
         return 0
     chosen = all_cells if a.cells == "all" else [all_cells[int(i)] for i in a.cells.split(",")]
     kinds = ["clean"] + registry_kinds() if a.classes == "all" else a.classes.split(",")
-    print("| cell | class | found | parameter (truth, error) | added beside it | modes (vs truth) | "
-          "error before -> after | s |")
-    print("|---|---|---|---|---|---|---|---|")
+    paths = a.paths.split(",")
+    bad = [p for p in paths if p not in PATHS]
+    if bad:
+        ap.error(f"--paths: {bad} not among {list(PATHS)}")
+    print(HEADER)
+    print("|---" * (HEADER.count("|") - 1) + "|")
     t_start = time.perf_counter()
     rows = []
     # class-major: clean data in every cell first (the 0-added acceptance), then each family over the cells,
     # so a run stopped by its budget still covers whole rows of the acceptance
     for kind in kinds:
+        skipped = False
         for cell in chosen:
-            if a.budget is not None and time.perf_counter() - t_start > a.budget:
-                print(f"\n(budget of {a.budget:g} s reached: the table stops here)")
-                return summary(rows)
-            r = evaluate(cell, kind)
-            rows.append(r)
-            print(row_text(r), flush=True)
-            if "skipped" in r:
-                break                                    # a family that cannot be injected: said once
+            for path in paths:
+                if a.budget is not None and time.perf_counter() - t_start > a.budget:
+                    print(f"\n(budget of {a.budget:g} s reached: the table stops here)")
+                    return summary(rows)
+                r = evaluate(cell, kind, path)
+                rows.append(r)
+                print(row_text(r), flush=True)
+                skipped = "skipped" in r
+                if skipped:
+                    break                                # a family that cannot be injected: said once
+            if skipped:
+                break
     return summary(rows)
 
 
 def summary(rows) -> int:
+    crashed = [r for r in rows if "crashed" in r]
     done = [r for r in rows if "skipped" not in r]
-    clean = [r for r in done if r["kind"] == "clean"]
+    print()
+    if crashed:
+        print(f"diagnose CRASHED in {len(crashed)} rows: {[(r['cell'], r['kind'], r['path']) for r in crashed]}")
+    for path in dict.fromkeys(r["path"] for r in done):
+        clean = [r for r in done if r["kind"] == "clean" and r["path"] == path]
+        if clean:
+            print(f"[{path}] clean rows: {len(clean)}, effects added to clean data: "
+                  f"{sum(len(r['extra']) for r in clean)} (cells with any: {[r['cell'] for r in clean if r['extra']]})")
     inj = [r for r in done if r["kind"] != "clean"]
-    print(f"\nclean rows: {len(clean)}, effects added to clean data: {sum(len(r['extra']) for r in clean)} "
-          f"(cells with any: {[r['cell'] for r in clean if r['extra']]})")
     for k in dict.fromkeys(r["kind"] for r in inj):
-        rk = [r for r in inj if r["kind"] == k]
-        base = sum(bool(r.get("in_base")) for r in rk)
-        print(f"{k}: found in {sum(r['found'] for r in rk)}/{len(rk)} cells"
-              + (f" (+{base} in the fitted base, not named)" if base else "") + "; "
-              f"other effects added beside it in {sum(bool(r['extra']) for r in rk)}")
+        for path in dict.fromkeys(r["path"] for r in inj if r["kind"] == k):
+            rk = [r for r in inj if r["kind"] == k and r["path"] == path]
+            base = sum(bool(r.get("in_base")) for r in rk)
+            found = sum(r["found"] for r in rk)
+            text = f"[{path}] {k}: found in {found}/{len(rk)} cells"
+            if any(r["eligible"] is not None for r in rk):
+                el = [r for r in rk if r["eligible"]]
+                fe = sum(r["found"] for r in el)
+                text += (f"; signature above the noise in {len(el)}: found in {fe}/{len(el)}"
+                         + (f" = {100 * fe / len(el):.0f} %" if el else "")
+                         + f" (missed where eligible: {[r['cell'] for r in el if not r['found']]})")
+            text += (f" (+{base} in the fitted base, not named)" if base else "")
+            text += f"; other effects added beside it in {sum(bool(r['extra']) for r in rk)}"
+            print(text)
     print(f"silent modes (outside 2 % and not declared unconstrained): {sum(r['silent'] for r in done)} rows "
-          f"{[(r['cell'], r['kind']) for r in done if r['silent']]}")
-    print(f"rows without suspension_modes: {[(r['cell'], r['kind']) for r in done if r['modes'] == 'no suspension_modes']}")
+          f"{[(r['cell'], r['kind'], r['path']) for r in done if r['silent']]}")
+    print("rows without suspension_modes (path none): "
+          f"{[(r['cell'], r['kind']) for r in done if r['modes'] == 'no suspension_modes']}")
     return 0
 
 

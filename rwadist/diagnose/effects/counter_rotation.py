@@ -265,7 +265,11 @@ class CounterRotation:
             return None
         Pm, Po, Pp, Pn, wt, ok = CounterRotation._points(ctx, state, direction, h, runs)
         if ok.sum() < 3:
-            return None
+            # too few runs hold the line's whole PSD window in band (coarse bins: a short record); the x/y phase
+            # needs only the line's own frequency in band, and is the estimate anyway where the PSDs are blind
+            if CounterRotation._sees_senses(ctx, state, direction, h, runs):
+                return None
+            return CounterRotation.fit_phase(ctx, state, direction, h, runs)
         Pm, Po, Pp, Pn, wt = (v[ok] for v in (Pm, Po, Pp, Pn, wt))
         if np.max(np.abs(np.log(np.maximum(Pn, 1e-300) / np.maximum(Pp, 1e-300)))) < 0.1:
             # the PSDs cannot tell the senses apart (a radial-force line): the x/y phase can

@@ -15,15 +15,32 @@ from ..state import State
 from .base import register, schema_entry
 
 #: Smallest separation (Welch bins) between a sideband and its carrier for a run to count: the Hann main lobe
-#: is ±2 bins, so closer sidebands sit in the carrier's own kernel and are not measured there.
-MIN_BINS = 3.0
+#: is ±2 bins, so closer sidebands sit in the carrier's own kernel and are not measured there; half a bin more
+#: for the scalloping of lines that are not bin-centred (beyond 2.5 bins the carrier's leakage is < −30 dB).
+MIN_BINS = 2.5
 #: Per-revolution offsets δ searched (fractions of the wheel speed).
 DELTA_GRID = np.arange(0.01, 0.30001, 0.0025)
 
 
+#: Window of the whole-run DFT the sidebands are measured with when the time series are given: Hann, whose main
+#: lobe (±2 record bins of fs/n: 4× finer than the Welch bins of n/4 segments) keeps the pair apart at low speeds;
+#: the carrier's leakage beyond it (sidelobes from −31 dB) is subtracted with the carrier's own phasor
+#: (:func:`_run_line_power`).
+RUN_WINDOW = "hann"
+#: Smallest separation (record bins) of a sideband from its carrier and from every other line of the direction
+#: in the whole-run route: the edge of the Hann main lobe (±2 bins; beyond it the transform is below −31 dB, and
+#: the carrier's part of it is subtracted).  No scalloping margin: the phasor is taken at the line's own frequency.
+RUN_MIN_BINS = 2.0
+
+
+def _record_df(ctx: Context, runs) -> np.ndarray:
+    """Frequency resolution fs/n (Hz) of each run's whole record."""
+    return np.array([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs], dtype=float)
+
+
 def resolvable_runs(ctx: Context, state: State, direction: str, h0: float, h_side: float, runs) -> np.ndarray:
-    """The runs of ``runs`` where the line h_side·|Ω| is in band, at least MIN_BINS bins from its carrier h0 and
-    2·LINE_HALF bins from every other line of the direction's model: there its window measures it alone."""
+    """The runs of ``runs`` where the line h_side·|Ω| is in band, at least MIN_BINS Welch bins from its carrier h0 and
+    2·LINE_HALF bins from every other line of the direction's model: there the residual PSD measures it alone."""
     w = ctx.omega[runs] / (2 * np.pi)
     f = h_side * w
     ok = (np.abs(h_side - h0) * w >= MIN_BINS * ctx.df) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
@@ -34,6 +51,59 @@ def resolvable_runs(ctx: Context, state: State, direction: str, h0: float, h_sid
     return runs[ok]
 
 
+def record_resolvable_runs(ctx: Context, state: State, direction: str, h0: float, h_side: float,
+                           runs) -> np.ndarray:
+    """As :func:`resolvable_runs` for the whole-run DFT (time series given, :func:`_run_line_power`): the line in
+    band and at least RUN_MIN_BINS record bins (fs/n) from its carrier and from every other line of the direction."""
+    w = ctx.omega[runs] / (2 * np.pi)
+    f = h_side * w
+    sep = RUN_MIN_BINS * _record_df(ctx, runs)
+    ok = (np.abs(h_side - h0) * w >= sep) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
+        & (f <= (ctx.k_hi - LINE_HALF) * ctx.df)
+    for x in state.model.harmonics(direction):
+        if abs(x.h - h0) > 1e-6:
+            ok &= np.abs(x.h - h_side) * w >= sep
+    return runs[ok]
+
+
+def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: float) -> tuple:
+    """(|X|² (len(runs), L, n_chans), noise mean of |X|² same shape): the whole-run line powers of the direction's
+    channels at ``f_hz`` (len(runs), L) Hz, Hann-windowed (:data:`RUN_WINDOW`; X = 2·Σ w x e^{−2πj f t}/Σ w, so a line
+    a·cos(2π f t + φ) gives |X| = a), less the leakage of the carrier h0: X(f) − X(f_c)·W(f − f_c)/W(0), f_c =
+    h0|Ω|/2π, W the window's transform (a line at f_c puts X(f_c)·W(f − f_c)/W(0) at f); and the mean |X|² white
+    noise of the state's floor S gives there, 2·S·fs·Σw²/(Σw)²."""
+    from scipy import signal
+
+    from ...extended_fit import windowed_dft
+
+    chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+    X = np.zeros((runs.size, f_hz.shape[1], len(chans)), dtype=complex)
+    for i, r in enumerate(runs):
+        run = ctx.test.runs[r]
+        w = signal.get_window(RUN_WINDOW, run.n_samples)
+        f_c = h0 * ctx.omega[r] / (2 * np.pi)
+        x = np.column_stack([run.signals[c] for c in chans]) * w[:, None]
+        both = 2.0 * windowed_dft(x, run.sample_rate, np.concatenate([f_hz[i], [f_c]])) / np.sum(w)
+        leak = windowed_dft(w[:, None], run.sample_rate, f_hz[i] - f_c)[:, 0] / np.sum(w)       # W(f − f_c)/W(0)
+        X[i] = both[:-1] - leak[:, None] * both[-1][None, :]
+    return np.abs(X) ** 2, _run_noise(ctx, state, chans, runs, f_hz)
+
+
+def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
+    """Mean |X|² (len(runs), L, len(chans)) that white noise of the state's floor S puts into the whole-run phasor
+    at ``f_hz``: 2·S·fs·Σw²/(Σw)² (:data:`RUN_WINDOW`)."""
+    from scipy import signal
+
+    enbw = np.empty(runs.size)
+    for i, r in enumerate(runs):
+        run = ctx.test.runs[r]
+        w = signal.get_window(RUN_WINDOW, run.n_samples)
+        enbw[i] = run.sample_rate * np.sum(w**2) / np.sum(w) ** 2
+    k = np.clip(np.rint(f_hz / ctx.df).astype(int), 0, ctx.f.size - 1)
+    noise = np.stack([np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1) for c in chans], axis=-1)
+    return 2.0 * noise * enbw[:, None, None]
+
+
 @register(order=15)
 @dataclass
 class SpeedSidebands:
@@ -42,8 +112,9 @@ class SpeedSidebands:
     beat, a tone ring) puts them at (h₀ ± δ)|Ω| with amplitudes (m/2)·C₀Ω² each.  They move with the speed, so
     they are harmonics (``missing_harmonic`` would take each, if it could see them): the model file gets two
     harmonics C_lower, C_upper (every consumer reads them) and this record.  Close to a strong line they are
-    resolved only at the higher speeds (δ|Ω|/2π >= MIN_BINS bins): the search and the fit use those runs
-    (:func:`resolvable_runs`); the prediction holds at every speed."""
+    resolved only at the higher speeds (δ|Ω|/2π >= MIN_BINS Welch bins, :func:`resolvable_runs`, or RUN_MIN_BINS
+    record bins on the whole-run DFT when the time series are given, :func:`record_resolvable_runs`): the search
+    and the fit use those runs; the prediction holds at every speed."""
 
     direction: str
     h0: float
@@ -103,6 +174,8 @@ class SpeedSidebands:
         thesis Eq. 3.10 on the amplitudes measured (modal gain divided out), both on the runs where that side
         is resolved (:func:`resolvable_runs`); None when a side has fewer than 3 measured points or no
         positive C."""
+        if ctx.test is not None:
+            return SpeedSidebands._fit_record(ctx, state, direction, h0, runs, delta)
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         out = []
         for side in (-1.0, 1.0):
@@ -126,11 +199,92 @@ class SpeedSidebands:
                               SpeedSidebands._carrier_C(state, direction, h0), int(nl + nu))
 
     @staticmethod
+    def _fit_record(ctx: Context, state: State, direction: str, h0: float, runs, delta: float):
+        """:meth:`fit` on the whole-run DFT (time series given): each side's h is the maximum of the summed line
+        power Σ|X|² over a grid h₀ ± δ ± 0.0125 (step 0.0005, then ± 0.0006 in steps of 0.00002, each refined by a
+        parabola through the top three) on the runs where it is resolved; its C by thesis Eq. 3.10 on the amplitudes sqrt(|X|² − noise) of the points standing
+        10 × over the noise, divided by the fixed resonances' and the modal gain (the line before the mount)."""
+        out = []
+        for side in (-1.0, 1.0):
+            h = h0 + side * delta
+            sub = record_resolvable_runs(ctx, state, direction, h0, h, runs)
+            if sub.size < 3:
+                return None
+            # coarse, then fine: the scan's δ can sit a grid step or two off the pair (its median favours the few
+            # fastest runs resolved at a larger δ, where the pair's own main lobe still lifts the score)
+            for half, step in ((0.0125, 0.0005), (0.0006, 0.00002)):
+                grid = h + np.arange(-half, half + 0.5 * step, step)
+                grid = grid[side * (grid - h0) > 0]
+                P, _ = _run_line_power(ctx, state, direction, sub, np.outer(ctx.omega[sub] / (2 * np.pi), grid), h0)
+                tot = P.sum(axis=(0, 2))
+                i = int(np.argmax(tot))
+                if not 0 < i < grid.size - 1:
+                    return None                         # the peak at the grid's edge: no line near h0 ± δ
+                lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
+                den = lo - 2 * mid + hi
+                h = float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * step)
+            sub = record_resolvable_runs(ctx, state, direction, h0, h, runs)
+            if sub.size < 3:
+                return None
+            f = (h * ctx.omega[sub] / (2 * np.pi))[:, None]
+            P, N = _run_line_power(ctx, state, direction, sub, f, h0)
+            chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+            d, w = [], []
+            for j, c in enumerate(chans):
+                ok = P[:, 0, j] > 10.0 * N[:, 0, j]
+                a = np.sqrt(np.maximum(P[:, 0, j] - N[:, 0, j], 0.0)) / ctx.gain(state, c, f[:, 0])
+                if state.ext is not None:
+                    a = a / ctx.modal_gain(state, c, h, sub)
+                d.append(a[ok])
+                w.append(ctx.omega[sub][ok])
+            d, w = np.concatenate(d), np.concatenate(w)
+            if d.size < 3:
+                return None
+            C = float(np.sum(d * w**2) / np.sum(w**4))
+            if not C > 0:
+                return None
+            out.append((h, C, d.size))
+        (hl, cl, nl), (hu, cu, nu) = out
+        return SpeedSidebands(direction, float(h0), float(hl), float(hu), cl, cu,
+                              SpeedSidebands._carrier_C(state, direction, h0), int(nl + nu))
+
+    @staticmethod
+    def _scan_record(ctx: Context, state: State, direction: str, h0: float, runs) -> tuple:
+        """:meth:`scan` on the whole-run DFT: per δ the median over channels, resolved runs and both sides of
+        |X|² over the noise's mean at (h₀ ± δ)|Ω|/2π, the carrier's leakage taken off (:func:`_run_line_power`;
+        the main lobe itself is kept clear by :func:`record_resolvable_runs`)."""
+        grid = np.concatenate([h0 - DELTA_GRID, h0 + DELTA_GRID])
+        f_hz = np.outer(ctx.omega[runs] / (2 * np.pi), grid)
+        key = ("speed_sidebands_scan", direction, round(h0, 6), runs.tobytes())
+        if key not in ctx._memo:                # the data's line powers: the same on every step of the search
+            ctx._memo[key] = _run_line_power(ctx, state, direction, runs, f_hz, h0)[0]
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        z = ctx._memo[key] / np.maximum(_run_noise(ctx, state, chans, runs, f_hz), 1e-300)   # (runs, 2G, chans)
+        pos = {r: i for i, r in enumerate(runs)}
+        score = np.zeros(DELTA_GRID.size)
+        for j in range(DELTA_GRID.size):
+            vals = []
+            for col in (j, DELTA_GRID.size + j):
+                sub = record_resolvable_runs(ctx, state, direction, h0, grid[col], runs)
+                if sub.size < 3:
+                    vals = []
+                    break
+                vals.append(z[[pos[r] for r in sub], col, :].ravel())
+            vals = np.concatenate(vals) if vals else np.empty(0)
+            score[j] = float(np.median(vals)) if vals.size >= 6 else 0.0
+        return DELTA_GRID, score
+
+    @staticmethod
     def scan(ctx: Context, state: State, direction: str, h0: float, runs) -> tuple:
         """(δ grid, score): per δ of :data:`DELTA_GRID`, the median over the channels, resolved runs and both sides of
         the residual PSD at (h₀ ± δ)|Ω|/2π (the largest of the bin and its neighbours) over the run's model floor,
-        i.e. how far above the noise a pair of lines at ±δ per revolution stands; 0 where fewer than 6 values.
-        Not clipped: beside a strong carrier the true pair stands out as the peak of a broad hump of skirts."""
+        i.e. how far above the noise a pair of lines at ±δ per revolution stands; 0 where a side is resolved in
+        fewer than 3 runs (:meth:`fit` needs 3) or fewer than 6 values.
+        Not clipped: beside a strong carrier the true pair stands out as the peak of a broad hump of skirts.
+        With the time series (``ctx.test``): :meth:`_scan_record`, the whole-run DFT (4× finer than the Welch bins:
+        the pair is resolved at lower speeds and shorter records)."""
+        if ctx.test is not None:
+            return SpeedSidebands._scan_record(ctx, state, direction, h0, runs)
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         z = {}
         for c in chans:
@@ -143,8 +297,9 @@ class SpeedSidebands:
             vals = []
             for side in (-1.0, 1.0):
                 sub = resolvable_runs(ctx, state, direction, h0, h0 + side * dl, runs)
-                if sub.size == 0:
-                    continue
+                if sub.size < 3:                # as :meth:`fit`: a side resolved in fewer runs is not fitted
+                    vals = []
+                    break
                 rows = np.array([pos[r] for r in sub])
                 k = np.rint((h0 + side * dl) * ctx.omega[sub] / (2 * np.pi) / ctx.df).astype(int)
                 for c in chans:
