@@ -101,18 +101,34 @@ class Context(Metric):
         """Complex amplitudes (len(runs), L, 6) of every channel at frequencies ``f_hz`` (len(runs), L), Hz:
         X = 2·Σ w x e^{−2πj f t}/Σ w over the whole run (Hann window), so x(t) ≈ Re(X e^{2πj f t});
         NaN for a channel the run lacks."""
-        from scipy import signal
-
         from ..extended_fit import windowed_dft
 
+        f_hz = np.asarray(f_hz, dtype=float)
+        key = ("phasors", runs.tobytes(), f_hz.tobytes(), f_hz.shape)
+        if key in self._memo:                             # the same lines are asked for at every search step
+            return self._memo[key].copy()
         out = np.full((runs.size, f_hz.shape[1], len(CHANNELS)), np.nan + 0j)
         for i, r in enumerate(runs):                      # one blocked DFT per run
-            run = self.test.runs[r]
+            have, x, wsum = self._windowed_run(int(r))
+            out[i][:, have] = 2.0 * windowed_dft(x, self.test.runs[r].sample_rate, f_hz[i]) / wsum
+        self._memo[key] = out
+        return out.copy()
+
+    def _windowed_run(self, r: int):
+        """(channel indices the run has, its signals (n_samples, K) times the whole-run window, Σ window) of run
+        ``r``; the window is computed once per record length (the windowed signals are not kept: a long test's
+        would double its memory)."""
+        from scipy import signal
+
+        run = self.test.runs[r]
+        wkey = ("window", run.n_samples)
+        if wkey not in self._memo:
             w = signal.get_window(self.sp.window, run.n_samples)
-            have = [j for j, c in enumerate(CHANNELS) if c in run.signals]
-            x = np.column_stack([run.signals[CHANNELS[j]] for j in have]) * w[:, None]
-            out[i][:, have] = 2.0 * windowed_dft(x, run.sample_rate, f_hz[i]) / np.sum(w)
-        return out
+            self._memo[wkey] = (w, float(np.sum(w)))
+        w, wsum = self._memo[wkey]
+        have = [j for j, c in enumerate(CHANNELS) if c in run.signals]
+        x = np.column_stack([run.signals[CHANNELS[j]] for j in have]) * w[:, None]
+        return have, x, wsum
 
     def data_floor(self, state: State, c: str) -> np.ndarray:
         """Block floor (n_runs, n_f) of channel ``c`` as the state reads its data (:meth:`data`): a torque
@@ -273,15 +289,32 @@ class Context(Metric):
             out += ref[None, :] * (self.omega[runs][:, None] / w_ref) ** p
         return out
 
-    def predict(self, state: State, c: str, runs: np.ndarray, skip=None) -> np.ndarray:
+    def predict(self, state: State, c: str, runs: np.ndarray, skip=None, only=None) -> np.ndarray:
         """Expected PSD of channel ``c`` on ``runs``; ``skip`` = h of a line to leave out (with its
-        sidebands).  A line's components (carrier and ``sidebands``, :meth:`State.line_components`) are
-        each multiplied by the resonance gain at their own frequency and, under a ``speed_ripple``,
-        spread over f + k·f_ripple with the power fractions of :meth:`ripple_powers`."""
-        out = self.floor_psd(state, c, runs)
+        sidebands); ``only`` = h of the one line to predict (with its sidebands; no noise floor).  A line's
+        components (carrier and ``sidebands``, :meth:`State.line_components`) are each multiplied by the
+        resonance gain at their own frequency and, under a ``speed_ripple``, spread over f + k·f_ripple with
+        the power fractions of :meth:`ripple_powers`.
+
+        The whole prediction (no ``skip``, no ``only``) is computed once per (channel, runs) and kept on the
+        state, read-only (a state is not changed once made: an effect's ``apply`` returns a new one, and every
+        family asks for the same state's prediction)."""
+        if skip is None and only is None:
+            key = ("predict", c, runs.tobytes())
+            if key not in state._cache:
+                full = self._predict(state, c, runs, None, None)
+                full.flags.writeable = False
+                state._cache[key] = full
+            return state._cache[key]
+        return self._predict(state, c, runs, skip, only)
+
+    def _predict(self, state: State, c: str, runs: np.ndarray, skip, only) -> np.ndarray:
+        out = self.floor_psd(state, c, runs) if only is None else np.zeros((runs.size, self.f.size))
         plain_f, plain_p = [], []           # lines without smear or ripple: one kernel pass for all of them
         for h, law, amp, _ in self.channel_lines(state, c, runs):
             if skip is not None and abs(h - skip) < 1e-9:
+                continue
+            if only is not None and abs(h - only) >= 1e-9:
                 continue
             f0 = h * self.omega[runs] / (2 * np.pi)
             rip = self.ripple_powers(state, h, law, runs)
@@ -411,7 +444,10 @@ class Context(Metric):
     def measure_line(self, state: State, c: str, h: float, runs: np.ndarray, skip=None):
         """Amplitude (unit) of a line h in the data of ``runs`` less everything else the state
         predicts (other lines, floors); NaN where the line is out of band or not above noise."""
-        R = self.data(state, c)[runs] - self.predict(state, c, runs, skip=skip)
+        # less the skipped line alone (the rest of the prediction is the state's, computed once): a line measured
+        # against every other costs one line, not all of them
+        P = self.predict(state, c, runs)
+        R = self.data(state, c)[runs] - (P if skip is None else P - self.predict(state, c, runs, only=skip))
         pos = h * self.omega[runs] / (2 * np.pi) / self.df
         k0 = np.rint(pos).astype(int)
         offs = np.arange(-LINE_HALF, LINE_HALF + 1)
