@@ -149,6 +149,13 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
     try:
         efit = fit_extended(test, fit, stand=stand)
+        if stand is not None and len(efit.unconstrained) == 3:
+            # the fixture resonance divided out locates no mode at all (a start pulled by a wheel mode beside it:
+            # its frequency, width and gain off): the modes are located without it, and the stand is fitted on
+            # their base below, as when none was proposed
+            efit_plain = fit_extended(test, fit)
+            if len(efit_plain.unconstrained) < 3:
+                efit, stand = efit_plain, None
         for _ in range(STAND_ROUNDS):
             if len(efit.unconstrained) == 3 or len(ctx.channels) <= 3:
                 break
