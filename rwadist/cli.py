@@ -547,7 +547,11 @@ def cmd_diagnose(args) -> int:
           f"{base} base")
     from .effects_text import diagnose_lines
 
-    print("\n".join(diagnose_lines(diag.summary()["effects"])) or "  no effect added (none passed the held-out test)")
+    summary = diag.summary()
+    print("\n".join(diagnose_lines(summary["effects"])) or "  no effect added (none passed the held-out test)")
+    for e in summary["base_lines"]:
+        print(f"  = {e['direction']} h = {e['h']:g}, C = {e['C']:.3g}: a line of the data the modes' fit did not "
+              "resolve, added to the fitted base (no model to miss it from)")
     print(f"unexplained fraction of the data's power (speed x frequency): {diag.error_before:.4g} -> "
           f"{diag.error_after:.4g} (definition: report.md)")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")

@@ -79,16 +79,19 @@ class Context(Metric):
             return self.sp.psd[c]
         key = tuple(float(x) for x in state.coupling)
         if key not in self._corrected:
+            from dataclasses import replace
+
+            from ..data import SteadyTest
             from ..spectra import compute_spectra
 
-            test = copy.deepcopy(self.test)
             r = np.asarray(key)
-            for run in test.runs:
+            runs = []
+            for run in self.test.runs:          # the corrected torques only (a copy of every signal is not needed)
                 F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
                 T = np.cross(r[None, :], F)
-                for j, k in enumerate(TORQUE_CHANNELS):
-                    if k in run.signals:
-                        run.signals[k] = run.signals[k] - T[:, j]
+                runs.append(replace(run, signals={k: run.signals[k] - T[:, j] for j, k in enumerate(TORQUE_CHANNELS)
+                                                  if k in run.signals}))
+            test = SteadyTest(runs, dict(self.test.meta))
             chans = [k for k in TORQUE_CHANNELS if k in self.sp.psd]
             sp = compute_spectra(test, nperseg=self.sp.nperseg, window=self.sp.window, f_lim=self.sp.f_lim,
                                  channels=chans)
@@ -101,18 +104,34 @@ class Context(Metric):
         """Complex amplitudes (len(runs), L, 6) of every channel at frequencies ``f_hz`` (len(runs), L), Hz:
         X = 2·Σ w x e^{−2πj f t}/Σ w over the whole run (Hann window), so x(t) ≈ Re(X e^{2πj f t});
         NaN for a channel the run lacks."""
-        from scipy import signal
-
         from ..extended_fit import windowed_dft
 
+        f_hz = np.asarray(f_hz, dtype=float)
+        key = ("phasors", runs.tobytes(), f_hz.tobytes(), f_hz.shape)
+        if key in self._memo:                             # the same lines are asked for at every search step
+            return self._memo[key].copy()
         out = np.full((runs.size, f_hz.shape[1], len(CHANNELS)), np.nan + 0j)
         for i, r in enumerate(runs):                      # one blocked DFT per run
-            run = self.test.runs[r]
+            have, x, wsum = self._windowed_run(int(r))
+            out[i][:, have] = 2.0 * windowed_dft(x, self.test.runs[r].sample_rate, f_hz[i]) / wsum
+        self._memo[key] = out
+        return out.copy()
+
+    def _windowed_run(self, r: int):
+        """(channel indices the run has, its signals (n_samples, K) times the whole-run window, Σ window) of run
+        ``r``; the window is computed once per record length (the windowed signals are not kept: a long test's
+        would double its memory)."""
+        from scipy import signal
+
+        run = self.test.runs[r]
+        wkey = ("window", run.n_samples)
+        if wkey not in self._memo:
             w = signal.get_window(self.sp.window, run.n_samples)
-            have = [j for j, c in enumerate(CHANNELS) if c in run.signals]
-            x = np.column_stack([run.signals[CHANNELS[j]] for j in have]) * w[:, None]
-            out[i][:, have] = 2.0 * windowed_dft(x, run.sample_rate, f_hz[i]) / np.sum(w)
-        return out
+            self._memo[wkey] = (w, float(np.sum(w)))
+        w, wsum = self._memo[wkey]
+        have = [j for j, c in enumerate(CHANNELS) if c in run.signals]
+        x = np.column_stack([run.signals[CHANNELS[j]] for j in have]) * w[:, None]
+        return have, x, wsum
 
     def data_floor(self, state: State, c: str) -> np.ndarray:
         """Block floor (n_runs, n_f) of channel ``c`` as the state reads its data (:meth:`data`): a torque
@@ -143,15 +162,22 @@ class Context(Metric):
         """PSD (len(runs), n_f) of one line h at amplitudes ``amp`` (per run)."""
         return self.psd_at(h * self.omega[runs] / (2 * np.pi), amp**2 / 2.0)
 
-    def psd_at(self, f_hz: np.ndarray, power: np.ndarray) -> np.ndarray:
+    def psd_at(self, f_hz: np.ndarray, power: np.ndarray, bins: np.ndarray | None = None) -> np.ndarray:
         """PSD (n_runs, n_f) of lines at frequencies ``f_hz`` (n_runs,) or (n_runs, n) Hz with mean squares
         ``power`` (same shape, unit²) through the line kernel; a line at negative frequency (a lower
-        sideband below 0 Hz) folds to |f|."""
+        sideband below 0 Hz) folds to |f|.  ``bins``: (n_runs, n_b) bin indices (in range): the PSD at those
+        bins only, (n_runs, n_b) -- the same kernel values, without the whole grid."""
         f_hz = np.asarray(f_hz, dtype=float)
         power = np.broadcast_to(np.asarray(power, dtype=float), f_hz.shape)
         if f_hz.ndim == 1:
             f_hz, power = f_hz[:, None], power[:, None]
         n_runs, n_l = f_hz.shape
+        if bins is not None:
+            pos = np.abs(f_hz) / self.df                                           # (n_runs, n_l)
+            dlt = bins[:, None, :] - pos[:, :, None]                               # (n_runs, n_l, n_b)
+            near = np.abs(bins[:, None, :] - np.rint(pos).astype(int)[:, :, None]) <= KERNEL_HALF
+            idx = np.clip(np.rint((dlt - self.delta[0]) * self.osmp).astype(int), 0, self.delta.size - 1)
+            return np.sum(np.where(near, power[:, :, None] * self.kernel[idx], 0.0), axis=1)
         out = np.zeros((n_runs, self.f.size))
         pos = (np.abs(f_hz) / self.df).ravel()                           # fractional bin
         k0 = np.rint(pos).astype(int)
@@ -267,21 +293,46 @@ class Context(Metric):
         return a_ref * (w / w_ref) ** p
 
     def floor_psd(self, state: State, c: str, runs: np.ndarray) -> np.ndarray:
-        out = np.broadcast_to(state.noise[c], (runs.size, self.f.size)).copy()
-        if c in state.floors:
-            ref, w_ref, p = state.floors[c]
-            out += ref[None, :] * (self.omega[runs][:, None] / w_ref) ** p
-        return out
+        key = ("floor", c, runs.tobytes())          # kept read-only on the state, as its prediction
+        if key not in state._cache:
+            out = np.broadcast_to(state.noise[c], (runs.size, self.f.size)).copy()
+            if c in state.floors:
+                ref, w_ref, p = state.floors[c]
+                out += ref[None, :] * (self.omega[runs][:, None] / w_ref) ** p
+            out.flags.writeable = False
+            state._cache[key] = out
+        return state._cache[key]
 
-    def predict(self, state: State, c: str, runs: np.ndarray, skip=None) -> np.ndarray:
+    def predict(self, state: State, c: str, runs: np.ndarray, skip=None, only=None) -> np.ndarray:
         """Expected PSD of channel ``c`` on ``runs``; ``skip`` = h of a line to leave out (with its
-        sidebands).  A line's components (carrier and ``sidebands``, :meth:`State.line_components`) are
-        each multiplied by the resonance gain at their own frequency and, under a ``speed_ripple``,
-        spread over f + k·f_ripple with the power fractions of :meth:`ripple_powers`."""
-        out = self.floor_psd(state, c, runs)
+        sidebands); ``only`` = h of the one line to predict (with its sidebands; no noise floor).  A line's
+        components (carrier and ``sidebands``, :meth:`State.line_components`) are each multiplied by the
+        resonance gain at their own frequency and, under a ``speed_ripple``, spread over f + k·f_ripple with
+        the power fractions of :meth:`ripple_powers`.
+
+        The whole prediction (no ``skip``, no ``only``) is computed once per (channel, runs) and kept on the
+        state, read-only (a state is not changed once made: an effect's ``apply`` returns a new one, and every
+        family asks for the same state's prediction)."""
+        if skip is None and only is None:
+            key = ("predict", c, runs.tobytes())
+            if key not in state._cache:
+                full = self._predict(state, c, runs, None, None)
+                full.flags.writeable = False
+                state._cache[key] = full
+            return state._cache[key]
+        return self._predict(state, c, runs, skip, only)
+
+    def _predict(self, state: State, c: str, runs: np.ndarray, skip, only, bins=None) -> np.ndarray:
+        """:meth:`predict` computed; ``bins`` (with ``only``): at those bins only (:meth:`psd_at`)."""
+        if only is None:
+            out = self.floor_psd(state, c, runs).copy()
+        else:
+            out = np.zeros((runs.size, self.f.size) if bins is None else bins.shape)
         plain_f, plain_p = [], []           # lines without smear or ripple: one kernel pass for all of them
         for h, law, amp, _ in self.channel_lines(state, c, runs):
             if skip is not None and abs(h - skip) < 1e-9:
+                continue
+            if only is not None and abs(h - only) >= 1e-9:
                 continue
             f0 = h * self.omega[runs] / (2 * np.pi)
             rip = self.ripple_powers(state, h, law, runs)
@@ -292,15 +343,15 @@ class Context(Metric):
                     a = a * self.gain(state, c, f)
                 if state.smear is not None:
                     du, wt = self.smear_offsets(state, h, runs)
-                    out += self.psd_at(f[:, None] + du, (a**2 / 2.0)[:, None] * wt)
+                    out += self.psd_at(f[:, None] + du, (a**2 / 2.0)[:, None] * wt, bins)
                 elif rip is None:
                     plain_f.append(f)
                     plain_p.append(a**2 / 2.0)
                 else:
                     k, P = rip
-                    out += self.psd_at(f[:, None] + k[None, :] * state.ripple[1], (a**2 / 2.0)[:, None] * P)
+                    out += self.psd_at(f[:, None] + k[None, :] * state.ripple[1], (a**2 / 2.0)[:, None] * P, bins)
         if plain_f:
-            out += self.psd_at(np.column_stack(plain_f), np.column_stack(plain_p))
+            out += self.psd_at(np.column_stack(plain_f), np.column_stack(plain_p), bins)
         return out
 
     def run_durations(self, runs: np.ndarray) -> np.ndarray:
@@ -411,14 +462,19 @@ class Context(Metric):
     def measure_line(self, state: State, c: str, h: float, runs: np.ndarray, skip=None):
         """Amplitude (unit) of a line h in the data of ``runs`` less everything else the state
         predicts (other lines, floors); NaN where the line is out of band or not above noise."""
-        R = self.data(state, c)[runs] - self.predict(state, c, runs, skip=skip)
         pos = h * self.omega[runs] / (2 * np.pi) / self.df
         k0 = np.rint(pos).astype(int)
         offs = np.arange(-LINE_HALF, LINE_HALF + 1)
         inband = (k0 - LINE_HALF >= self.k_lo) & (k0 + LINE_HALF <= self.k_hi)
         k = np.clip(k0[:, None] + offs, 0, self.f.size - 1)
-        p = np.take_along_axis(R, k, axis=1).sum(1) * self.df
-        noise = np.take_along_axis(self.floor_psd(state, c, runs), k, axis=1).sum(1) * self.df
+        rows = np.arange(runs.size)[:, None]
+        # the residual in the line's window only: the data less the state's whole prediction (computed once) plus
+        # the skipped line alone at those bins -- a line measured against every other costs a few bins of one line
+        R = self.data(state, c)[runs[:, None], k] - self.predict(state, c, runs)[rows, k]
+        if skip is not None:
+            R = R + self._predict(state, c, runs, None, skip, bins=k)
+        p = R.sum(1) * self.df
+        noise = self.floor_psd(state, c, runs)[rows, k].sum(1) * self.df
         # 3 standard deviations of the window's noise power: std of a bin mean·sqrt(2/ν), summed
         # over the window's bins with a factor 2 for the Hann correlation of neighbouring bins
         sig = 3.0 * 2.0 * noise * np.sqrt(2.0 / self.dof) / np.sqrt(2 * LINE_HALF + 1)

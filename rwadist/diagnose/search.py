@@ -27,6 +27,8 @@ class Hypothesis:
     t: float              # improvement in standard errors
     passed: bool
     iteration: int
+    #: a line of the wheel completed into a base fitted from the data (:func:`_base_lines`), not a foreign effect
+    base_line: bool = False
 
 
 @dataclass
@@ -47,7 +49,7 @@ class Diagnosis:
         return self.state_after.effects
 
     def summary(self) -> dict:
-        chosen = [h for h in self.hypotheses if h.passed]
+        chosen = [h for h in self.hypotheses if h.passed and not h.base_line]
         return {
             "metric": METRIC,
             "base": self.state_before.base,
@@ -57,6 +59,7 @@ class Diagnosis:
             "rms_relative_error_before": self.rms_error_before, "rms_relative_error_after": self.rms_error_after,
             "iterations": self.iterations,
             "effects": [effect_entry(h) for h in chosen],
+            "base_lines": [effect_entry(h) for h in self.hypotheses if h.passed and h.base_line],
             "hypotheses": [effect_entry(h) for h in self.hypotheses],
         }
 
@@ -70,7 +73,18 @@ def effect_entry(hyp: Hypothesis) -> dict:
     return d
 
 
-def _judge(ctx, state, effect, k_sigma, min_gain, iteration):
+def _state_errors(ctx, state, runs, chans, memo):
+    """:meth:`Context.run_errors` of ``state`` on ``runs`` over ``chans`` (None: every channel), with detail,
+    computed once per search step: every hypothesis of a step is judged against the same state."""
+    key = None if chans is None else tuple(chans)
+    if memo is None:
+        return ctx.run_errors(state, runs, None if key is None else list(key), detail=True)
+    if key not in memo:
+        memo[key] = ctx.run_errors(state, runs, None if key is None else list(key), detail=True)
+    return memo[key]
+
+
+def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
     """Held-out evidence of ``effect`` (fitted on the fit runs) added to ``state``.
 
     gain = Σ over held-out runs of the drop in misplaced power; its noise standard error is
@@ -78,7 +92,8 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration):
     D as read for a measurement correction such as ``cross_coupling``): if the data were M_0 plus
     Gaussian noise of std σ, a band's term max(|D − M| − zσ, 0) changes by at most |Δ| (and by about σ
     when the change is larger), and changes at all only with probability P_b = 2·Q(z − |Δ|/σ).  Passes
-    when gain > k_sigma·SE and gain ≥ min_gain × the held-out misplaced power."""
+    when gain > k_sigma·SE and gain ≥ min_gain × the held-out misplaced power.  ``memo``: a dict shared by the
+    hypotheses of one search step (the state's own errors, computed once), or None."""
     runs = ctx.held_runs
     own = getattr(effect, "heldout_evidence", None)
     ev = own(ctx, state, runs) if own is not None else None
@@ -86,15 +101,15 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration):
         # an effect the PSDs cannot see (e.g. counter rotation of a radial-force line) brings its own held-out
         # misplaced-power drop and standard error, in the metric's units
         gain, se = ev
-        e0_all, all_tot = ctx.run_errors(state, runs)
+        e0_all, all_tot, _ = _state_errors(ctx, state, runs, None, memo)
         t = gain / se if se > 0 else (np.inf if gain > 0 else 0.0)
         frac = gain / max(float(e0_all.sum()), 1e-300)
         return Hypothesis(effect, gain / max(float(all_tot.sum()), 1e-300), frac, float(t),
                           bool(t > k_sigma and frac >= min_gain), iteration)
     chans = [c for c in effect.channels if c in ctx.channels]
-    e0, _, p0 = ctx.run_errors(state, runs, chans, detail=True)
+    e0, _, p0 = _state_errors(ctx, state, runs, chans, memo)
     e1, _, p1 = ctx.run_errors(effect.apply(state), runs, chans, detail=True)
-    e0_all, all_tot = ctx.run_errors(state, runs)
+    e0_all, all_tot, _ = _state_errors(ctx, state, runs, None, memo)
     var = 0.0
     for c in chans:
         dm, sig = np.abs(p1[c][0] - p0[c][0]), p0[c][1]       # |Δ(D − M)|
@@ -109,6 +124,25 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration):
     frac = gain / max(float(e0_all.sum()), 1e-300)
     passed = bool(t > k_sigma and frac >= min_gain)
     return Hypothesis(effect, gain / max(float(all_tot.sum()), 1e-300), frac, float(t), passed, iteration)
+
+
+def _base_lines(hyps) -> None:
+    """Mark the passing ``missing_harmonic`` hypotheses added after a ``suspension_modes`` as lines of the wheel's
+    base (``Hypothesis.base_line``), not foreign effects.
+
+    Once the wheel's modes are fitted from the data, the base's harmonics are the data's own lines (the
+    extended fit of :class:`~rwadist.diagnose.effects.suspension_modes.SuspensionModes` replaces the starting
+    model's): there is no model a line could be missing from, so a line at a constant h that this fit did not
+    resolve (two close lines merged at a short record's resolution, a line below the fit's detection at the
+    low speeds) is the wheel's own content, completed into the base.  It stays in the improved model's
+    harmonics and is listed in its provenance (``diagnose.base_lines``) and the summary's ``base_lines``."""
+    modes_at = min((h.iteration for h in hyps if h.passed and getattr(h.effect, "kind", "") == "suspension_modes"),
+                   default=None)
+    if modes_at is None:
+        return
+    for h in hyps:
+        if h.passed and h.iteration > modes_at and getattr(h.effect, "kind", "") == "missing_harmonic":
+            h.base_line = True
 
 
 BASES = ("empirical", "extended", "auto")
@@ -183,7 +217,8 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         cands = []
         for cls in EFFECT_CLASSES:
             cands += cls.candidates(ctx, state, ctx.fit_runs)
-        judged = [_judge(ctx, state, e, k_sigma, min_gain, it) for e in cands]
+        memo = {}
+        judged = [_judge(ctx, state, e, k_sigma, min_gain, it, memo) for e in cands]
         judged.sort(key=lambda h: -h.gain)
         # a family marked ``first`` (the wheel's own modes) is taken before any other passing effect
         passing = sorted((h for h in judged if h.passed), key=lambda h: not getattr(h.effect, "first", False))
@@ -205,8 +240,14 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         best.effect = state.effects[-1]
     else:
         it = max_iterations
+    _base_lines(hyps)
     out = copy.deepcopy(state.model)
-    out.effects = list(model.effects) + [effect_entry(h) for h in hyps if h.passed]
-    out.provenance = dict(out.provenance, diagnose={"metric": METRIC, "base": state.base})
+    out.effects = list(model.effects) + [effect_entry(h) for h in hyps if h.passed and not h.base_line]
+    prov = {"metric": METRIC, "base": state.base}
+    base_lines = [{k: v for k, v in effect_entry(h).items() if k in ("direction", "h", "C")}
+                  for h in hyps if h.passed and h.base_line]
+    if base_lines:
+        prov["base_lines"] = base_lines
+    out.provenance = dict(out.provenance, diagnose=prov)
     return Diagnosis(out, state0, state, ctx.error(state0), ctx.error(state), ctx.rms_error(state0),
                      ctx.rms_error(state), hyps, it, ctx)
