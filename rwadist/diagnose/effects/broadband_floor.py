@@ -88,14 +88,26 @@ class BroadbandFloor:
             _, p, n, g = best
             expected = np.maximum(n[None, :] + g[None, :] * x0[:, None] ** p, 1e-300)
         _, p, n, g = best
+        # a band with no usable bin in any run (every bin taken by lines) constrains nothing, and a band whose
+        # fitted noise is 0 (its off-line data at or below the model's line skirts, as in noise_estimate) holds
+        # no noise estimate: a zero noise would divide every later noise-relative measure by zero.  The noise
+        # knots skip both, the growth knots the first; the floor there is interpolated from the bands either side
+        seen = wt.sum(0) > 0
+        has_noise = seen & (n > 0)
+        if not has_noise.any():
+            return None
         f = ctx.f
+        lo, hi = f[ctx.k_lo], f[ctx.k_lo + ctx.n_bands * BAND_BINS - 1]
+        centres = ctx.band_centres()
         # knots: the band centres, held flat out to the analysed band's first and last bins (a floor below
         # the first centre -- energy below 1x -- is there in the data too)
-        kf = np.concatenate([[f[ctx.k_lo]], ctx.band_centres(), [f[ctx.k_lo + ctx.n_bands * BAND_BINS - 1]]])
-        kg, kn = np.concatenate([[g[0]], g, [g[-1]]]), np.concatenate([[n[0]], n, [n[-1]]])
+        kf = np.concatenate([[lo], centres[seen], [hi]])
+        kg = np.concatenate([[g[seen][0]], g[seen], [g[seen][-1]]])
+        kf_n = np.concatenate([[lo], centres[has_noise], [hi]])
+        kn = np.concatenate([[n[has_noise][0]], n[has_noise], [n[has_noise][-1]]])
         n0 = np.array(state.noise[c], dtype=float)
-        band = (f >= kf[0]) & (f <= kf[-1])
-        n0[band] = np.interp(f[band], kf, kn)
+        band = (f >= lo) & (f <= hi)
+        n0[band] = np.interp(f[band], kf_n, kn)
         ref = np.interp(f, kf, kg, left=0.0, right=0.0)
         return BroadbandFloor(c, float(p), w_ref, f.copy(), ref, n0, knots_f=kf, knots_psd=kg)
 
