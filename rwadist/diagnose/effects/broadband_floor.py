@@ -89,11 +89,12 @@ class BroadbandFloor:
             expected = np.maximum(n[None, :] + g[None, :] * x0[:, None] ** p, 1e-300)
         _, p, n, g = best
         # a band with no usable bin in any run (every bin taken by lines) constrains nothing, and a band whose
-        # fitted noise is 0 (its off-line data at or below the model's line skirts, as in noise_estimate) holds
-        # no noise estimate: a zero noise would divide every later noise-relative measure by zero.  The noise
-        # knots skip both, the growth knots the first; the floor there is interpolated from the bands either side
+        # fitted noise and growth are both 0 (its off-line data at or below the model's line skirts, as in
+        # noise_estimate) holds no estimate of the floor: a zero floor would divide every later noise-relative
+        # measure by zero.  The noise knots skip both, the growth knots the first; the floor there is
+        # interpolated from the bands either side
         seen = wt.sum(0) > 0
-        has_noise = seen & (n > 0)
+        has_noise = seen & ((n > 0) | (g > 0))
         if not has_noise.any():
             return None
         f = ctx.f
