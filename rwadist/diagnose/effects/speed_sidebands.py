@@ -104,6 +104,15 @@ def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
     return 2.0 * noise * enbw[:, None, None]
 
 
+
+def _eq310_C(d: np.ndarray, w: np.ndarray):
+    """Thesis Eq. 3.10's least-squares C of amplitudes ``d`` (unit) against speeds ``w`` (rad/s), d = C·w²;
+    None with fewer than 3 points or a C that is not positive."""
+    if d.size < 3:
+        return None
+    C = float(np.sum(d * w**2) / np.sum(w**4))
+    return C if C > 0 else None
+
 @register(order=15)
 @dataclass
 class SpeedSidebands:
@@ -188,15 +197,11 @@ class SpeedSidebands:
                 return None
             sub = resolvable_runs(ctx, state, direction, h0, h, runs)
             d, w = _measure(ctx, state, direction, h, sub)
-            if d.size < 3:
-                return None
-            C = float(np.sum(d * w**2) / np.sum(w**4))
-            if not C > 0:
+            C = _eq310_C(d, w)
+            if C is None:
                 return None
             out.append((h, C, d.size))
-        (hl, cl, nl), (hu, cu, nu) = out
-        return SpeedSidebands(direction, float(h0), float(hl), float(hu), cl, cu,
-                              SpeedSidebands._carrier_C(state, direction, h0), int(nl + nu))
+        return SpeedSidebands._from_sides(state, direction, h0, out)
 
     @staticmethod
     def _fit_record(ctx: Context, state: State, direction: str, h0: float, runs, delta: float):
@@ -238,12 +243,15 @@ class SpeedSidebands:
                 d.append(a[ok])
                 w.append(ctx.omega[sub][ok])
             d, w = np.concatenate(d), np.concatenate(w)
-            if d.size < 3:
-                return None
-            C = float(np.sum(d * w**2) / np.sum(w**4))
-            if not C > 0:
+            C = _eq310_C(d, w)
+            if C is None:
                 return None
             out.append((h, C, d.size))
+        return SpeedSidebands._from_sides(state, direction, h0, out)
+
+    @staticmethod
+    def _from_sides(state: State, direction: str, h0: float, out) -> "SpeedSidebands":
+        """The effect from the two sides' (h, C, number of points), lower side first."""
         (hl, cl, nl), (hu, cu, nu) = out
         return SpeedSidebands(direction, float(h0), float(hl), float(hu), cl, cu,
                               SpeedSidebands._carrier_C(state, direction, h0), int(nl + nu))
