@@ -38,9 +38,17 @@ counter_rotation  direction (radial_force), h (1.0), fraction (0.3): that share 
                   the co part (scaled by sqrt(1 − fraction))
 ============== ===================================================================================
 
-Lines added after the simulation reach the load cell directly (with --physics extended they do not
-pass through the rotor's suspension modes: they are foreign to the wheel, as the effects diagnose
-looks for), except the counter-rotating part of a wheel line (see counter_rotation).
+Where each kind acts.  With --physics extended the wheel-load kinds (missing_harmonic, amplitude_law,
+sidebands, counter_rotation) are loads on the rotor: like every line of the simulation they reach the load
+cell through the suspension modes (:func:`rwadist.extended.steady_lines` at the run's speed, each component at
+its own whirl rate, the line's rotation sense from the preset: a line the wheel has keeps its sense,
+a missing harmonic is co-rotating) and then through the stand's fixture resonances (those the simulation
+applied); see :func:`_wheel_loads`.  The kinds that are not wheel loads stay where they physically act:
+fixed_resonance of role test_stand is a fixture filter applied by the simulation to everything it passes;
+cross_coupling is the load cell's own geometry, applied last, on the total force the cell measures (the
+simulation's and every noise-free content added here); broadband_floor stays a per-channel floor at the
+load cell (its channels are given, not its load direction).  With --physics simple every added line
+reaches the load cell as it is (the simple physics' resonances are not applied to it).
 """
 from __future__ import annotations
 
@@ -190,40 +198,92 @@ def _add_line(run, direction, amp, phase, sense=1.0):
         run.signals[chans[1]] = run.signals[chans[1]] + sense * amp * np.sin(phase)
 
 
-def _add_modal_line(run, params, direction, h, C, phase, sense="counter"):
-    """A wheel load C·Ω² e^{±i(hφ + phase)} (``sense`` co or counter) of ``direction`` through the suspension
-    modes of ``params`` (:func:`rwadist.extended.steady_lines`, the run's signed speed): every channel it reaches."""
+def _sense(wheel, direction, h):
+    """The rotation sense the preset gives the line (direction, h) ('co' when it has none; axial: 'co')."""
+    return next((v for (d, hh), v in wheel.senses.items() if d == direction and abs(hh - h) <= 1e-6), "co")
+
+
+def _wheel_loads(wheel, spec, w_mid, rng) -> list:
+    """The wheel loads (:class:`rwadist.extended.Line`, random phases from ``rng``) one run of ``spec`` adds with
+    extended physics; they reach the load cell through the suspension modes (:func:`_add_wheel_loads`).
+
+    missing_harmonic: a co-rotating line fraction·C1·Ω² at h (the model file's default sense).  amplitude_law: the
+    line taken out of the wheel (:func:`prepare_wheel`) with its own sense and the law A(Ω) =
+    fraction·C·Ω_mid²·(Ω/Ω_mid)^exponent.  counter_rotation: the counter part C·sqrt(fraction)·Ω² (the co part stays
+    in the simulation).  sidebands: the modulated line a(1 + depth·cos(ψ_m)) is the carrier a (with the line's
+    own sense; on h = 1 the imbalance is the carrier and stays in the simulation) and two lines of amplitude
+    depth·a/2 at a fixed offset ±f_mod (:attr:`rwadist.extended.Line.f_offset`) or at h ± per_rev, phases
+    φ_c ± φ_m: each meets the modes at its own whirl rate."""
     from . import extended as ext
 
-    f, A = ext.steady_lines(params, [ext.Line(direction, float(h), float(C), sense)], [run.speed])
-    if f[0, 0] >= 0.5 * run.sample_rate:
-        return
+    k, d, h = spec["kind"], spec["direction"], spec["h"]
+    if k == "missing_harmonic":
+        return [ext.Line(d, float(h), float(spec["fraction"] * wheel.fundamental_C(d)), "co", rng.uniform(0, 2 * np.pi))]
+    if k == "counter_rotation":
+        return [ext.Line(d, float(h), float(spec["C"] * math.sqrt(spec["fraction"])), "counter",
+                         rng.uniform(0, 2 * np.pi))]
+    sense = "co" if spec.get("sidebands_only") else _sense(wheel, d, h)
+    if k == "amplitude_law":
+        law = (spec["fraction"] * spec["C"] * w_mid**2, w_mid, spec["exponent"])
+        return [ext.Line(d, float(h), float(spec["C"]), sense, rng.uniform(0, 2 * np.pi), law=law)]
+    # sidebands
+    ph_c, ph_m = rng.uniform(0, 2 * np.pi, 2)
+    side_C = 0.5 * spec["depth"] * spec["C"]
+    out = [] if spec.get("sidebands_only") else [ext.Line(d, float(h), float(spec["C"]), sense, ph_c)]
+    for side in (1.0, -1.0):
+        if spec["per_rev"] is not None:
+            out.append(ext.Line(d, float(h + side * spec["per_rev"]), float(side_C), sense, ph_c + side * ph_m))
+        else:
+            out.append(ext.Line(d, float(h), float(side_C), sense, ph_c + side * ph_m, f_offset=side * spec["f_mod_hz"]))
+    return out
+
+
+def _add_wheel_loads(run, params, lines, fixture=()):
+    """Add wheel loads ``lines`` (:class:`rwadist.extended.Line`) to ``run`` through the suspension modes of
+    ``params`` (:func:`rwadist.extended.steady_lines` at the run's signed speed) and the stand's ``fixture``
+    resonances (as the simulation applies them to its own lines): every channel each line reaches; a line at
+    or above Nyquist is not recorded (as the simulation drops it)."""
+    from . import extended as ext
+    from .teststand import _fixture_gain
+
+    f, A = ext.steady_lines(params, lines, [run.speed])
+    f, A = f[0], A[0]                                           # (n_lines,), (n_lines, 6)
+    if fixture:
+        A = A * _fixture_gain(list(fixture), f)
     t = np.arange(run.n_samples) / run.sample_rate
-    z = np.exp(1j * (2 * np.pi * f[0, 0] * t + phase))
-    for j, c in enumerate(CHANNELS):
-        if c in run.signals and A[0, 0, j] != 0:
-            run.signals[c] = run.signals[c] + (A[0, 0, j] * z).real
+    for j in np.flatnonzero(f < 0.5 * run.sample_rate):
+        z = np.exp(2j * np.pi * f[j] * t)
+        for i, c in enumerate(CHANNELS):
+            if c in run.signals and A[j, i] != 0:
+                run.signals[c] = run.signals[c] + (A[j, i] * z).real
 
 
-def apply(test, wheel, specs: list, seed: int = 0, clean=None, physics: str = "simple"):
+def apply(test, wheel, specs: list, seed: int = 0, clean=None, physics: str = "simple", fixture=()):
     """Add the post-simulation parts of ``specs`` to ``test`` (in place) and record them in its meta.
 
     wheel : the preset as given (before :func:`prepare_wheel`).  clean : noise-free simulation of the
     prepared wheel with the same seed (needed by speed_ripple and cross_coupling; without it
-    cross_coupling takes the noisy forces).  physics : that of the simulation ("extended": a
-    counter_rotation part goes through the suspension modes)."""
+    cross_coupling takes the noisy forces).  physics : that of the simulation ("extended": every wheel
+    load -- missing_harmonic, amplitude_law, sidebands, counter_rotation -- goes through the suspension
+    modes, :func:`_add_wheel_loads`).  fixture : the stand's active fixture resonances
+    (:class:`rwadist.teststand.Mode`, those the simulation applied): with extended physics a wheel load
+    added here passes through them as the simulated lines do."""
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 14]))
+    extended = physics != "simple"
     speeds = np.array([abs(r.speed) for r in test.runs])
     w_max, w_mid = float(speeds.max()), float(np.median(speeds))
-    record = []
-    for s in specs:
+    record = [{key: (list(v) if isinstance(v, tuple) else v) for key, v in s.items()} for s in specs]
+    # the load-cell offset acts on the total force the cell measures: applied last, on the forces of the
+    # simulation plus every noise-free content added here before it (the sensors' noise stays out of r × F)
+    ordered = [s for s in specs if s["kind"] != "cross_coupling"] + [s for s in specs if s["kind"] == "cross_coupling"]
+    forces_before = [{c: r.signals[c].copy() for c in ("Fx", "Fy", "Fz")} for r in test.runs]
+    for s in ordered:
         k = s["kind"]
         for run_i, r in enumerate(test.runs):
             t = np.arange(r.n_samples) / r.sample_rate
             w = abs(r.speed)
-            if k == "counter_rotation" and physics != "simple":
-                _add_modal_line(r, wheel.extended, s["direction"], s["h"], s["C"] * math.sqrt(s["fraction"]),
-                                        rng.uniform(0, 2 * np.pi))
+            if extended and k in ("missing_harmonic", "amplitude_law", "counter_rotation", "sidebands"):
+                _add_wheel_loads(r, wheel.extended, _wheel_loads(wheel, s, w_mid, rng), fixture)
             elif k in ("missing_harmonic", "amplitude_law", "counter_rotation"):
                 if k == "missing_harmonic":
                     a = s["fraction"] * wheel.fundamental_C(s["direction"]) * w**2
@@ -233,15 +293,9 @@ def apply(test, wheel, specs: list, seed: int = 0, clean=None, physics: str = "s
                     a = s["C"] * math.sqrt(s["fraction"]) * w**2
                 _add_line(r, s["direction"], a, s["h"] * w * t + rng.uniform(0, 2 * np.pi),
                           -1.0 if k == "counter_rotation" else 1.0)
-            elif k == "sidebands" and s.get("sidebands_only") and s["per_rev"] is not None:
-                # the imbalance modulated at per_rev·Ω: a wheel load, its two sidebands through the modes
-                for side in (-1.0, 1.0):
-                    _add_modal_line(r, wheel.extended, s["direction"], s["h"] + side * s["per_rev"],
-                                    0.5 * s["depth"] * s["C"], rng.uniform(0, 2 * np.pi), "co")
             elif k == "sidebands":
                 f_mod = s["f_mod_hz"] if s["f_mod_hz"] is not None else s["per_rev"] * w / (2 * np.pi)
-                env = (0.0 if s.get("sidebands_only") else 1.0) + s["depth"] * np.cos(2 * np.pi * f_mod * t
-                                                                                      + rng.uniform(0, 2 * np.pi))
+                env = 1.0 + s["depth"] * np.cos(2 * np.pi * f_mod * t + rng.uniform(0, 2 * np.pi))
                 _add_line(r, s["direction"], s["C"] * w**2 * env, s["h"] * w * t + rng.uniform(0, 2 * np.pi))
             elif k == "broadband_floor":
                 b, a_ = signal.butter(2, s["fc_hz"], fs=r.sample_rate)
@@ -251,8 +305,11 @@ def apply(test, wheel, specs: list, seed: int = 0, clean=None, physics: str = "s
                     x /= np.sqrt(np.mean(x**2))
                     r.signals[c] = r.signals[c] + s["level"] * c1 * w_max**2 * (w / w_max) ** (s["exponent"] / 2) * x
             elif k == "cross_coupling":
-                src = r if clean is None else clean.runs[run_i]
-                F = np.column_stack([src.signals[c] for c in ("Fx", "Fy", "Fz")])
+                if clean is None:
+                    F = np.column_stack([r.signals[c] for c in ("Fx", "Fy", "Fz")])
+                else:
+                    F = np.column_stack([clean.runs[run_i].signals[c] + r.signals[c] - forces_before[run_i][c]
+                                         for c in ("Fx", "Fy", "Fz")])
                 T = np.cross(np.array([s["r_x"], s["r_y"], s["r_z"]])[None, :], F)
                 for j, c in enumerate(("Tx", "Ty", "Tz")):
                     r.signals[c] = r.signals[c] + T[:, j]
@@ -274,14 +331,13 @@ def apply(test, wheel, specs: list, seed: int = 0, clean=None, physics: str = "s
                             continue
                         sense = -1.0 if wheel.senses.get((d, h)) == "counter" else 1.0
                         _add_line(r, d, C * omega**2, h * psi + rng.uniform(0, 2 * np.pi), sense)
-        record.append({key: (list(v) if isinstance(v, tuple) else v) for key, v in s.items()})
     test.meta["injected"] = record
     return test
 
 
 def simulate_with_injections(wheel, specs: list, speeds_rpm, physics: str = "simple", seed: int = 0, **kwargs):
     """:func:`rwadist.teststand.simulate_steady` of ``wheel`` with ``specs`` (parsed) injected."""
-    from .teststand import simulate_steady
+    from .teststand import _fixture_modes, simulate_steady
 
     specs = [dict(s) for s in specs]
     if any(s["kind"] == "speed_ripple" for s in specs) and kwargs.get("modes", True) and physics == "simple":
@@ -292,4 +348,5 @@ def simulate_with_injections(wheel, specs: list, speeds_rpm, physics: str = "sim
     clean = None
     if any(s["kind"] in ("speed_ripple", "cross_coupling") for s in specs):
         clean = simulate_steady(prepared, speeds_rpm, physics=physics, seed=seed, **{**kwargs, "noise": 0.0})
-    return apply(test, wheel, specs, seed=seed, clean=clean, physics=physics)
+    fixture = _fixture_modes(prepared, kwargs.get("test_stand", True)) if physics != "simple" else ()
+    return apply(test, wheel, specs, seed=seed, clean=clean, physics=physics, fixture=fixture)
