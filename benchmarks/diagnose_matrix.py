@@ -8,7 +8,10 @@ phases and noise per run, diagnosed on one or both of two paths (below).  Per ce
   beyond the wheel's own modes (and beyond a ``fixed_resonance`` of role test_stand at the stand's
   frequency when the cell has one) -- must be 0;
 * each effect family the registry lists (:data:`rwadist.diagnose.effects.EFFECT_CLASSES`) that
-  :mod:`rwadist.inject` can inject, injected alone (its parameters below): found or missed, the
+  :mod:`rwadist.inject` can inject, injected alone (its parameters below; the wheel-load kinds -- missing
+  harmonic, amplitude law, sidebands, counter rotation -- are loads on the rotor that reach the load cell
+  through the suspension modes and the stand's fixture, as the wheel's own lines): found or missed (found =
+  an effect of that kind on the injected line, :func:`_matches`; one on another line is an addition), the
   fitted parameter against the injected one, and any other effect added beside it (for an injected lever
   arm, its offset itself -- a ``cross_coupling`` within 10 mm of r_z -- is expected beside it);
 * a crash of diagnose is a row of the table ("DIAGNOSE CRASHED": a miss, or an addition on clean data);
@@ -177,12 +180,26 @@ def _is_offset(e, truth: dict) -> bool:
     return e["kind"] == "cross_coupling" and abs(e["r_m"][2] - truth["r_z"]) < 0.01
 
 
+#: a diagnosed line is the injected one when its harmonic number is within this of the injection's
+H_MATCH = 0.02
+
+
 def _matches(e, kind: str, truth: dict) -> bool:
-    """Whether diagnosed effect ``e`` is the injected one (the fixed resonance at its own frequency)."""
+    """Whether diagnosed effect ``e`` is the injected one: same kind and, where the injection names them, the same
+    line (direction, h within H_MATCH: a missing harmonic at h 5.5 or a law on h = 4.42 is not the injected h = 0.5
+    or h = 2, it is an effect added beside it), the fixed resonance at its own frequency, the floor on an
+    injected channel, the sidebands at their own f_mod."""
     if e["kind"] != kind:
         return False
     if kind == "fixed_resonance":
         return abs(e["f_Hz"] / truth["f_hz"] - 1) < 0.05
+    if kind in ("missing_harmonic", "amplitude_law", "sidebands") and "h" in e:
+        same = e.get("direction", truth["direction"]) == truth["direction"] and abs(e["h"] - truth["h"]) < H_MATCH
+        if kind == "sidebands" and truth.get("f_mod_hz") is not None:
+            same = same and abs(e["f_mod_Hz"] / truth["f_mod_hz"] - 1) < 0.05
+        return same
+    if kind == "broadband_floor":
+        return bool(set(e.get("channel") or ()) & set(truth["channels"]))
     return True
 
 

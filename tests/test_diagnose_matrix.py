@@ -4,8 +4,8 @@ nominal cell plus two corners).
 
 The cheap cells (20 speeds): clean data get nothing beyond the wheel's own suspension modes, every mode
 found within 2 % of the thesis numbers (tests/independent_wheel.py) or declared unconstrained (never a
-silent wrong mode), and an injected amplitude law (h = 2 radial force as Ω³, lines added at the load cell)
-is named with its exponent.
+silent wrong mode), and an injected amplitude law (h = 2 radial force as Ω³, a load on the rotor:
+rwadist.inject sends it through the suspension modes) is named with its exponent.
 """
 import sys
 from pathlib import Path
