@@ -19,6 +19,16 @@ from ..measure import (
 from ..state import State
 from .base import register, schema_entry
 
+#: Runs scanned on the whole-run DFT per carrier (the fastest in band): the offset is the same at every speed, so a
+#: few runs tell it; the fit then takes every run.
+RECORD_SCAN_RUNS = 12
+#: Scan step of the whole-run route, record bins (fs/n).
+RECORD_STEP_BINS = 0.25
+#: A carrier's whole-run scan score (median |X|²/noise over runs, channels and both sides) a pair must clear:
+#: that of :meth:`rwadist.diagnose.effects.speed_sidebands.SpeedSidebands.candidates` (the lines 20 × over the
+#: noise on half the points).
+RECORD_SCORE = 20.0
+
 
 @register(order=60)
 @dataclass
@@ -45,7 +55,10 @@ class Sidebands:
         return s
 
     def refit(self, ctx: Context, state: State) -> "Sidebands":
-        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
+        """Refitted on every run (``ctx.runs``), on the whole-run DFT when the offset is below the Welch grid
+        (:meth:`fit_record`); itself when that fit fails."""
+        if self.f_mod < 2.5 * ctx.df and ctx.test is not None:
+            return Sidebands.fit_record(ctx, state, self.direction, self.h, ctx.runs, self.f_mod) or self
         return Sidebands.fit(ctx, state, self.direction, self.h, ctx.runs, self.f_mod) or self
 
     def to_schema(self) -> dict:
@@ -87,6 +100,106 @@ class Sidebands:
         return Sidebands(direction, float(h), float(f_mod), float(np.sqrt(m2)), int(P.size))
 
     @staticmethod
+    def _record_offsets(ctx: Context) -> np.ndarray:
+        """Offsets (Hz) only the whole-run DFT resolves: from RUN_MIN_BINS record bins (the Hann main lobe's edge)
+        up to where the Welch grid starts (:func:`_offset_grid`: 2.5 Welch bins); empty without the time series."""
+        from .speed_sidebands import RUN_MIN_BINS, _record_df
+
+        if ctx.test is None:
+            return np.empty(0)
+        df_rec = float(np.max(_record_df(ctx, ctx.runs)))
+        return np.arange(RUN_MIN_BINS * df_rec, 2.5 * ctx.df, RECORD_STEP_BINS * df_rec)
+
+    @staticmethod
+    def _record_valid(ctx: Context, state: State, direction: str, h: float, runs, f_hz) -> np.ndarray:
+        """(len(runs), L) mask: the sideband frequencies ``f_hz`` in band and at least RUN_MIN_BINS record bins from
+        every other line of the direction (the carrier's own leakage is subtracted, :func:`_run_line_power`)."""
+        from .speed_sidebands import RUN_MIN_BINS, _record_df
+
+        w = ctx.omega[runs][:, None] / (2 * np.pi)
+        sep = RUN_MIN_BINS * _record_df(ctx, runs)[:, None]
+        ok = (f_hz >= (ctx.k_lo + 1) * ctx.df) & (f_hz <= (ctx.k_hi - 1) * ctx.df)
+        for x in state.model.harmonics(direction):
+            if abs(x.h - h) > 1e-6:
+                ok &= np.abs(f_hz - x.h * w) >= sep
+        return ok
+
+    @staticmethod
+    def _record_power(ctx: Context, state: State, direction: str, h: float, runs, offsets) -> tuple:
+        """(f (runs, 2L), |X|² (runs, 2L, chans), noise (runs, 2L, chans), valid (runs, 2L)) of the lower then upper
+        sides f_c ∓ offsets on the whole-run DFT, the carrier's leakage taken off (:func:`_run_line_power`)."""
+        from .speed_sidebands import _run_line_power
+
+        fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
+        f = np.concatenate([fc - offsets[None, :], fc + offsets[None, :]], axis=1)
+        P, N = _run_line_power(ctx, state, direction, runs, f, h)
+        return f, P, N, Sidebands._record_valid(ctx, state, direction, h, runs, f)
+
+    @staticmethod
+    def fit_record(ctx: Context, state: State, direction: str, h: float, runs, f_mod: float) -> "Sidebands | None":
+        """The fit on the whole-run DFT (time series given) of sidebands closer to their carrier than the Welch bins
+        resolve: f_mod the maximum of Σ|X|² over both sides and every valid run on a grid ±RECORD_STEP_BINS record
+        bins around ``f_mod`` (step 1/50 bin); the sides' amplitudes sqrt(|X|² − noise) of the points 10 × over
+        the noise, on their prediction per unit depth q = a·g/2 (a the carrier's model amplitude in the channel, g
+        the fixed resonances' gain at the side): m by least squares, Σ A·q / Σ q²."""
+        from .speed_sidebands import _record_df
+
+        df_rec = float(np.max(_record_df(ctx, runs)))
+        grid = f_mod + np.arange(-RECORD_STEP_BINS, RECORD_STEP_BINS + 1e-9, 0.02) * df_rec
+        f, P, _, ok = Sidebands._record_power(ctx, state, direction, h, runs, grid)
+        both = ok[:, :grid.size] & ok[:, grid.size:]
+        tot = np.sum(np.where(both[:, :, None], P[:, :grid.size] + P[:, grid.size:], 0.0), axis=(0, 2))
+        i = int(np.argmax(tot))
+        if not 0 < i < grid.size - 1:
+            return None                                     # the maximum at the grid's edge: no pair near f_mod
+        f_mod = float(grid[i])
+        f, P, N, ok = Sidebands._record_power(ctx, state, direction, h, runs, np.array([f_mod]))
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        A, Q = [], []
+        for j, c in enumerate(chans):
+            a = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - h) < 1e-9), None)
+            if a is None:
+                return None
+            for col in (0, 1):
+                g = ctx.gain(state, c, f[:, col]) if state.resonances else 1.0
+                keep = ok[:, col] & (P[:, col, j] > 10.0 * N[:, col, j])
+                A.append(np.sqrt(np.maximum(P[:, col, j] - N[:, col, j], 0.0))[keep])
+                Q.append((0.5 * a * g * np.ones(runs.size))[keep])
+        A, Q = np.concatenate(A), np.concatenate(Q)
+        if A.size < 3 or not np.sum(Q * Q) > 0:
+            return None
+        m = float(np.sum(A * Q) / np.sum(Q * Q))
+        return Sidebands(direction, float(h), f_mod, m, int(A.size)) if m > 0 else None
+
+    @staticmethod
+    def record_candidates(ctx: Context, state: State, runs, direction: str, hs) -> list:
+        """[(score, h, f_mod)] of the carriers ``hs`` whose sidebands sit closer than the Welch grid reaches
+        (:meth:`_record_offsets`): per offset the median over the RECORD_SCAN_RUNS fastest runs, channels and both
+        sides of |X|²/noise on the whole-run DFT (valid points only, >= 6 of them), the best offset kept when it
+        clears RECORD_SCORE and is a local maximum.  The data's line powers are kept on the context."""
+        offsets = Sidebands._record_offsets(ctx)
+        if offsets.size < 3:
+            return []
+        sel = runs[np.argsort(ctx.omega[runs])[::-1][:RECORD_SCAN_RUNS]]
+        out = []
+        for h in hs:
+            key = ("sidebands_record_scan", direction, round(h, 6), sel.tobytes())
+            if key not in ctx._memo:
+                ctx._memo[key] = Sidebands._record_power(ctx, state, direction, h, sel, offsets)
+            f, P, N, ok = ctx._memo[key]
+            z = P / np.maximum(N, 1e-300)
+            L = offsets.size
+            score = np.zeros(L)
+            for j in range(L):
+                both = ok[:, j] & ok[:, L + j]
+                vals = np.concatenate([z[both, j, :].ravel(), z[both, L + j, :].ravel()])
+                score[j] = float(np.median(vals)) if vals.size >= 6 else 0.0
+            j = int(np.argmax(score))
+            if 0 < j < L - 1 and score[j] > RECORD_SCORE:
+                out.append((score[j], h, float(offsets[j])))
+        return out
+
+    @staticmethod
     def candidates(ctx: Context, state: State, runs, max_per_direction: int = 3) -> list:
         """Per direction, the carriers whose best constant-offset ridge pair (:func:`_offset_scores`) clears
         :func:`_offset_threshold`; at most ``max_per_direction``, strongest first."""
@@ -110,6 +223,13 @@ class Sidebands:
                     found.append((s[j], h, float(offsets[j])))
             for _, h, f_m in sorted(found, reverse=True)[:max_per_direction]:
                 e = Sidebands.fit(ctx, state, d, h, runs, f_m)
+                if e is not None:
+                    out.append(e)
+            # sidebands closer to the carrier than 2.5 Welch bins (a short record, a high sample rate: f_mod 7 Hz
+            # at 7.5-Hz Welch bins) are resolved by the whole record only
+            near = Sidebands.record_candidates(ctx, state, runs, d, hs)
+            for _, h, f_m in sorted(near, reverse=True)[:max_per_direction]:
+                e = Sidebands.fit_record(ctx, state, d, h, runs, f_m)
                 if e is not None:
                     out.append(e)
         return out
