@@ -7,6 +7,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 import diagnose_matrix as matrix  # noqa: E402
+
 from rwadist.inject import parse  # noqa: E402
 
 
