@@ -26,9 +26,9 @@ cross_coupling r_x, r_y, r_z (0, 0, -0.06 m), force_noise (0): load-cell offset,
 sidebands      direction (radial_force), h (2.0), depth (0.4), f_mod_hz (7.0) or per_rev (fraction of the
                wheel speed: speed-proportional sidebands at (h ± per_rev)·Ω): the line (d, h) amplitude
                modulated C·Ω²·(1 + depth·cos(2π f_mod t + φ)); random carrier and modulation phases; with
-               --physics extended on h = 1 the imbalance (through the modes) is the carrier and only
-               the two sidebands are added: with per_rev two co-rotating wheel loads (depth/2)·U·Ω² at
-               (1 ± per_rev)·Ω through the modes, with f_mod C·Ω²·depth·cos(2π f_mod t + φ)·(x cos, y sin)
+               --physics extended a wheel load: the carrier (the line's own sense) and two lines (depth/2)·C·Ω²
+               at f_c ± f_mod (or (h ± per_rev)·Ω) through the modes, each at its own frequency; on h = 1
+               the imbalance U (simulated through the modes) is the carrier and only the two sides are added
 speed_ripple   f_ripple_hz (8.0), delta_omega (3.0 rad/s): Ω(t) = Ω0 + ΔΩ sin(2π f t + φ) on every line
                (amplitude C·Ω(t)², phase h·∫Ω dt); --physics simple
 counter_rotation  direction (radial_force), h (1.0), fraction (0.3): that share of the line's power
