@@ -172,6 +172,31 @@ def executed_notebook(tmp_path_factory):
     return nbformat.read(folder / "executed.ipynb", as_version=4), folder
 
 
+#: what the fresh virtual environment holds: numpy and what fmpy imports (lxml, attrs), libcosimpy (the second
+#: FMU host); fmpy itself goes in with --no-deps (its other dependencies are for its GUI and are not imported)
+FRESH_VENV_PACKAGES = ("numpy", "lxml", "attrs", "libcosimpy")
+
+
+@pytest.fixture(scope="session")
+def fresh_fmpy_venv(tmp_path_factory) -> Path:
+    """Python of a new virtual environment with only FRESH_VENV_PACKAGES and fmpy -- no rwadist, no pythonfmu.
+
+    Built once per run (``python -m venv`` and two pip installs are ~10 s of CPU each time) and shared by the
+    fresh-venv tests of test_fmu.py and test_fmu_native.py, which only run scripts in it (their files go to
+    their own tmp_path) and each check that neither rwadist nor pythonfmu can be imported there.
+    """
+    import subprocess
+    import sys
+
+    def build(folder: Path) -> None:
+        subprocess.run([sys.executable, "-m", "venv", str(folder / "venv")], check=True)
+        py = folder / "venv" / "bin" / "python"
+        subprocess.run([str(py), "-m", "pip", "install", "--quiet", *FRESH_VENV_PACKAGES], check=True, timeout=300)
+        subprocess.run([str(py), "-m", "pip", "install", "--quiet", "--no-deps", "fmpy"], check=True, timeout=300)
+
+    return once_per_run(tmp_path_factory, "fresh_fmpy_venv", build) / "venv" / "bin" / "python"
+
+
 # --------------------------------------------------------------------------- workers
 
 #: thread-count variables of the BLAS/OpenMP libraries numpy and scipy load
