@@ -237,10 +237,11 @@ def _builds_shared_data(fixturedef) -> bool:
 def pytest_collection_modifyitems(config, items):
     """The tests marked ``slow`` (full-size runs of several seconds each) first, in their order.
 
-    ``pytest -n 2`` (pytest-xdist, ``--dist load``) hands the tests out in collection order, in chunks that
-    shrink towards the end: a long test collected last keeps one worker busy while the other idles (the
-    slow sweeps of test_sweep.py and test_teststand.py sort near the end).  Handed out first, the long
-    tests overlap with the short ones.  A slow test that uses a fixture shared with its neighbours
+    ``pytest -n 2`` (pytest-xdist, ``--dist worksteal`` from pyproject.toml) gives each worker one half of
+    the tests in this order, and a worker that runs dry takes half of what the other has not started, from
+    the end of its queue: a long test collected last could still keep one worker busy while the other idles
+    (the slow sweeps of test_sweep.py and test_teststand.py sort near the end).  At the start of the first
+    half, the long tests overlap with the short ones.  A slow test that uses a fixture shared with its neighbours
     (module or session scope, defined in this tree) stays where it is, so nothing is built twice in a
     serial run either.
 
