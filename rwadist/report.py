@@ -62,8 +62,9 @@ def _new_figure(figsize) -> Figure:
 
 
 def _save(fig: Figure, path: Path) -> Path:
+    # no fig.clear() afterwards: the figure is dropped by the caller, and clearing it rebuilt every
+    # axis's ticks only to throw them away (~10 % of write_report's CPU, same PNG bytes without it)
     fig.savefig(path, dpi=_DPI)
-    fig.clear()
     return path
 
 

@@ -172,6 +172,31 @@ def executed_notebook(tmp_path_factory):
     return nbformat.read(folder / "executed.ipynb", as_version=4), folder
 
 
+#: what the fresh virtual environment holds: numpy and what fmpy imports (lxml, attrs), libcosimpy (the second
+#: FMU host); fmpy itself goes in with --no-deps (its other dependencies are for its GUI and are not imported)
+FRESH_VENV_PACKAGES = ("numpy", "lxml", "attrs", "libcosimpy")
+
+
+@pytest.fixture(scope="session")
+def fresh_fmpy_venv(tmp_path_factory) -> Path:
+    """Python of a new virtual environment with only FRESH_VENV_PACKAGES and fmpy -- no rwadist, no pythonfmu.
+
+    Built once per run (``python -m venv`` and two pip installs are ~10 s of CPU each time) and shared by the
+    fresh-venv tests of test_fmu.py and test_fmu_native.py, which only run scripts in it (their files go to
+    their own tmp_path) and each check that neither rwadist nor pythonfmu can be imported there.
+    """
+    import subprocess
+    import sys
+
+    def build(folder: Path) -> None:
+        subprocess.run([sys.executable, "-m", "venv", str(folder / "venv")], check=True)
+        py = folder / "venv" / "bin" / "python"
+        subprocess.run([str(py), "-m", "pip", "install", "--quiet", *FRESH_VENV_PACKAGES], check=True, timeout=300)
+        subprocess.run([str(py), "-m", "pip", "install", "--quiet", "--no-deps", "fmpy"], check=True, timeout=300)
+
+    return once_per_run(tmp_path_factory, "fresh_fmpy_venv", build) / "venv" / "bin" / "python"
+
+
 # --------------------------------------------------------------------------- workers
 
 #: thread-count variables of the BLAS/OpenMP libraries numpy and scipy load
@@ -212,10 +237,11 @@ def _builds_shared_data(fixturedef) -> bool:
 def pytest_collection_modifyitems(config, items):
     """The tests marked ``slow`` (full-size runs of several seconds each) first, in their order.
 
-    ``pytest -n 2`` (pytest-xdist, ``--dist load``) hands the tests out in collection order, in chunks that
-    shrink towards the end: a long test collected last keeps one worker busy while the other idles (the
-    slow sweeps of test_sweep.py and test_teststand.py sort near the end).  Handed out first, the long
-    tests overlap with the short ones.  A slow test that uses a fixture shared with its neighbours
+    ``pytest -n 2`` (pytest-xdist, ``--dist worksteal`` from pyproject.toml) gives each worker one half of
+    the tests in this order, and a worker that runs dry takes half of what the other has not started, from
+    the end of its queue: a long test collected last could still keep one worker busy while the other idles
+    (the slow sweeps of test_sweep.py and test_teststand.py sort near the end).  At the start of the first
+    half, the long tests overlap with the short ones.  A slow test that uses a fixture shared with its neighbours
     (module or session scope, defined in this tree) stays where it is, so nothing is built twice in a
     serial run either.
 

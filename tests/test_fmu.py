@@ -7,7 +7,6 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 import zipfile
 from pathlib import Path
 
@@ -576,15 +575,11 @@ def test_cli_fmu_build_and_check(tmp_path, model_path, capsys):
 # ------------------------------------------------------------------ fresh venv, second host
 
 @pytest.mark.slow
-def test_fresh_venv_fmpy_and_libcosim(tmp_path, wheel_fmu, model):
+def test_fresh_venv_fmpy_and_libcosim(tmp_path, wheel_fmu, model, fresh_fmpy_venv):
     """A new virtual environment with only numpy, fmpy (+ its XML reader) and libcosimpy -- no
-    rwadist, no pythonfmu -- runs the FMU in both hosts and reproduces simulate_time."""
-    venv = tmp_path / "venv"
-    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
-    py = venv / "bin" / "python"
-    pkgs = ["numpy", "lxml", "attrs", "libcosimpy"]
-    subprocess.run([str(py), "-m", "pip", "install", "--quiet", *pkgs], check=True, timeout=300)
-    subprocess.run([str(py), "-m", "pip", "install", "--quiet", "--no-deps", "fmpy"], check=True, timeout=300)
+    rwadist, no pythonfmu -- runs the FMU in both hosts and reproduces simulate_time.
+    (The environment is built once per run in conftest.py and shared with test_fmu_native.py.)"""
+    py = fresh_fmpy_venv
     t, w = reversal(T=1.0)
     np.savez(tmp_path / "prof.npz", t=t, omega=w, alpha=slope(t, w), seed=8)
     script = tmp_path / "hosts.py"

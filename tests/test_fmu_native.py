@@ -8,7 +8,6 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 import zipfile
 
 import numpy as np
@@ -360,15 +359,12 @@ def test_rebuild_from_sources_gives_identical_outputs(fmus, tmp_path):
 
 
 @pytest.mark.slow
-def test_fresh_venv_without_rwadist(fmus, tmp_path):
+def test_fresh_venv_without_rwadist(fmus, tmp_path, fresh_fmpy_venv):
     """A new virtual environment with fmpy and what fmpy itself imports (numpy, lxml, attrs) -- no rwadist, no
-    pythonfmu -- simulates the native FMU and reproduces this process's outputs bit for bit."""
+    pythonfmu -- simulates the native FMU and reproduces this process's outputs bit for bit.  (The environment
+    is built once per run in conftest.py and shared with test_fmu.py, which adds libcosimpy to it.)"""
     _, native, _ = fmus
-    venv = tmp_path / "venv"
-    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
-    py = venv / "bin" / "python"
-    subprocess.run([str(py), "-m", "pip", "install", "--quiet", "numpy", "lxml", "attrs"], check=True, timeout=300)
-    subprocess.run([str(py), "-m", "pip", "install", "--quiet", "--no-deps", "fmpy"], check=True, timeout=300)
+    py = fresh_fmpy_venv
     t, w = reversal(T=1.0)
     np.savez(tmp_path / "prof.npz", t=t, omega=w, alpha=slope(t, w), seed=8)
     script = tmp_path / "hosts.py"
