@@ -72,6 +72,9 @@ class ExtendedFit:
         their values are starting values (written to ``analytical.unconstrained``).
     scans : per mode, the :class:`~rwadist.mode_scan.ModeScan` that located it or said why not.
     per_unit : True when mass/radius were not given (M = 1 kg, I_rr = 1 kg·m²).
+    stand : the fixture resonance (f_r Hz, ζ, peak gain) divided out of every line before the fit, or None.
+    line_residuals : (f Hz, r) of every measurement the least squares used: f = h|Ω|/2π the line's frequency
+        and r = ln(measured / model amplitude) (radial lines: of sqrt(x² + y²)), the stand divided out.
     """
 
     params: ext.ExtendedParams
@@ -88,6 +91,8 @@ class ExtendedFit:
     unconstrained: list = field(default_factory=list)
     scans: dict = field(default_factory=dict)
     per_unit: bool = False
+    stand: tuple | None = None
+    line_residuals: tuple = (np.empty(0), np.empty(0))
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -613,7 +618,9 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     unconstrained = [UNCONSTRAINED_NAME[m] for m in _MODE_PARAMS if not identified[m]]
     return ExtendedFit(params=params, lines=kept_lines, zeta=zeta, rel_stderr=rel_stderr, identified=identified,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
-                       unconstrained=unconstrained, scans=scans, per_unit=not physical)
+                       unconstrained=unconstrained, scans=scans, per_unit=not physical,
+                       stand=None if stand is None else tuple(float(v) for v in stand),
+                       line_residuals=(np.concatenate([f_ax, f_rd]), np.concatenate([r_ax, r_rad])))
 
 
 # --------------------------------------------------------------------------- 4. comparison
@@ -680,6 +687,10 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
                                     for (d, h), (s_, fr) in efit.senses.items()},
                          "notes": efit.notes}
     analytical["unconstrained"] = list(efit.unconstrained)
+    if efit.stand is not None:
+        # the fixture's resonance is not the wheel's: kept out of its model, recorded for the user
+        f_r, zeta, gain = efit.stand
+        analytical["fit"]["test_stand"] = {"f_Hz": f_r, "zeta": zeta, "peak_gain": gain}
     if efit.per_unit:
         analytical["fit"]["per_unit"] = ("mass and radius not given: mass_kg = 1 and I_rr = 1 are units, the "
                                          "stiffnesses and damping are per unit mass / transverse inertia")
