@@ -278,15 +278,10 @@ def _in_band(h, lines: _Lines, f_lo, f_hi):
     return (f_line >= f_lo) & (f_line <= f_hi)
 
 
-def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, direction: str,
-                       df: float | None = None):
+def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, direction: str):
     """Harmonic numbers of one direction: candidate bins from N_bin(h), each h
     refined by least squares of f = h·|Ω| over its lines (Eq. 3.2), kept when
-    P >= P_0.  Returns a list of :class:`BinStat` sorted by h.
-
-    df : the spectra's resolution, Hz, or None.  Given, candidates whose lines stay closer than a line's
-    power window ((2·line_half_width + 1) bins) at every speed of the test are one line at this resolution,
-    at their detections' centroid (see the code)."""
+    P >= P_0.  Returns a list of :class:`BinStat` sorted by h."""
     if lines.pair_run.size == 0:
         return []
     h_hi = min(s.h_range[1], f_hi / lines.pair_speed_hz.min())
@@ -299,27 +294,22 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
     cand, _ = signal.find_peaks(np.concatenate([[0], n_bin, [0]]), height=s.min_detections,
                                 distance=max(int(s.epsilon / step), 1))
     h = h_grid[cand - 1]
-
-    def refined_stats(h):
-        """Each h refined on its lines (Eq. 3.2) and its presence: BinStat list."""
-        for _ in range(2):
-            fpk = lines.match(h)
-            ok = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)
-            w = np.where(ok, lines.pair_speed_hz[None, :], 0.0)
-            num, den = np.sum(np.where(ok, fpk, 0.0) * w, axis=1), np.sum(w**2, axis=1)
-            h = np.where(den > 0, num / np.where(den > 0, den, 1), h)
-        ok = np.isfinite(lines.match(h)) & _in_band(h, lines, f_lo, f_hi)
-        n_b, n_p = ok.sum(axis=1), _in_band(h, lines, f_lo, f_hi).sum(axis=1)
-        out = []
-        for hk, nb, npss in zip(h, n_b, n_p):
-            presence = float(nb / npss) if npss else 0.0
-            kept = bool(presence >= s.presence_min and nb >= s.min_detections)
-            reason = "" if kept else (f"presence {presence:.0%} < P0 {s.presence_min:.0%}"
-                                      if presence < s.presence_min else f"only {int(nb)} detections")
-            out.append(BinStat(direction, float(hk), int(nb), int(npss), presence, kept, reason))
-        return out
-
-    stats_ = sorted(refined_stats(h), key=lambda b: b.h)
+    for _ in range(2):
+        fpk = lines.match(h)
+        ok = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)
+        w = np.where(ok, lines.pair_speed_hz[None, :], 0.0)
+        num, den = np.sum(np.where(ok, fpk, 0.0) * w, axis=1), np.sum(w**2, axis=1)
+        h = np.where(den > 0, num / np.where(den > 0, den, 1), h)
+    ok = np.isfinite(lines.match(h)) & _in_band(h, lines, f_lo, f_hi)
+    n_b, n_p = ok.sum(axis=1), _in_band(h, lines, f_lo, f_hi).sum(axis=1)
+    stats_ = []
+    for hk, nb, npss in zip(h, n_b, n_p):
+        presence = float(nb / npss) if npss else 0.0
+        kept = bool(presence >= s.presence_min and nb >= s.min_detections)
+        reason = "" if kept else (f"presence {presence:.0%} < P0 {s.presence_min:.0%}"
+                                  if presence < s.presence_min else f"only {int(nb)} detections")
+        stats_.append(BinStat(direction, float(hk), int(nb), int(npss), presence, kept, reason))
+    stats_.sort(key=lambda b: b.h)
     merged = []
     for b in stats_:  # two candidates refined onto one line: keep the better supported
         if merged and abs(b.h - merged[-1].h) < s.epsilon:
@@ -327,30 +317,7 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
                 merged[-1] = b
             continue
         merged.append(b)
-    if df is None or not lines.pair_speed_hz.size:
-        return merged
-    # lines that no run of the test separates by a line's power window ((2·line_half_width + 1) bins: a close
-    # pair, h = 5.37 and 5.57 of the E wheel on a short record, and a candidate at their merged peak): the
-    # record cannot measure them apart (every measurement of each holds the other, fit_direction would drop
-    # them all) -- at this resolution they are ONE line: a candidate at their detections' centroid, refined
-    # on the detections there (the merged peaks), its power window holding both; the better supported member
-    # when that centroid line is not present enough
-    close = (2 * s.line_half_width + 1) * df / float(lines.pair_speed_hz.max())
-    groups = []
-    for b in merged:
-        if groups and b.h - groups[-1][-1].h < close:
-            groups[-1].append(b)
-        else:
-            groups.append([b])
-    out = []
-    for g in groups:
-        best = max(g, key=lambda b: (b.kept, b.n_bin))
-        if len(g) > 1:
-            weight = np.array([max(b.n_bin, 1) for b in g], float)
-            centre = refined_stats(np.array([np.dot(weight, [b.h for b in g]) / weight.sum()]))[0]
-            best = centre if centre.kept or not best.kept else best
-        out.append(best)
-    return out
+    return merged
 
 
 # --------------------------------------------------------------------------- steps 3-5: coefficients
@@ -453,7 +420,7 @@ def fit_direction(spectra: Spectra, direction: str, s: FitSettings, floors: dict
     f, df = spectra.f, spectra.df
     f_lo, f_hi = s.f_min_bins * df, spectra.band_limit
     lines = collect_lines(spectra, chans, fit_runs, detected, s.epsilon)
-    bins = identify_harmonics(lines, f_lo, f_hi, s, direction, df)
+    bins = identify_harmonics(lines, f_lo, f_hi, s, direction)
     kept = [b for b in bins if b.kept]
     if not kept:
         return [], bins
