@@ -666,6 +666,33 @@ def rms_comparison(efit: ExtendedFit, fit: EmpiricalFit) -> dict:
     return out
 
 
+def unresolved_spans(fit: EmpiricalFit) -> list:
+    """Spans of h, per direction, where the empirical fit ``fit`` detected lines it could not measure apart:
+    candidate harmonics present in enough runs but dropped because no measurement was resolved from the other
+    lines (a close pair, h = 5.37 and 5.57 of the E wheel, on a short record: the fit's (2·line_half_width + 1)-bin
+    power windows overlap at every speed).  Candidates closer than that window at the top speed are one span;
+    each span is widened by the fit's tolerance ε on h.  Returns [{"direction", "h_min", "h_max"}]: the model
+    file's ``analytical.fit.unresolved_lines``, which ``rwadist diagnose`` reads (a line found there is the
+    wheel's own content the model's fit could not measure, not an effect)."""
+    eps = float(fit.settings.get("epsilon", FitSettings.epsilon))
+    half = int(fit.settings.get("line_half_width", FitSettings.line_half_width))
+    sp = fit.spectra
+    f_spin = float(np.max(np.abs(sp.speed))) / (2 * np.pi) if np.size(sp.speed) else 0.0
+    close = max(eps, (2 * half + 1) * sp.df / f_spin) if f_spin > 0 else eps
+    out = []
+    for d in sorted({b.direction for b in fit.bins}):
+        hs = sorted(b.h for b in fit.bins if b.direction == d and not b.kept
+                    and b.reason.startswith("no measurement resolved"))
+        spans = []
+        for h in hs:
+            if spans and h - spans[-1][1] < close:
+                spans[-1][1] = h
+            else:
+                spans.append([h, h])
+        out += [{"direction": d, "h_min": float(lo - eps), "h_max": float(hi + eps)} for lo, hi in spans]
+    return out
+
+
 def to_model(efit: ExtendedFit, fit: EmpiricalFit):
     """A model file for the extended fit: the analytical section, and as harmonics the fitted
     forcing lines (each radial one split into its co- and counter-rotating parts where both carry
@@ -687,6 +714,9 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
                                     for (d, h), (s_, fr) in efit.senses.items()},
                          "notes": efit.notes}
     analytical["unconstrained"] = list(efit.unconstrained)
+    unresolved = unresolved_spans(fit)
+    if unresolved:
+        analytical["fit"]["unresolved_lines"] = unresolved
     if efit.stand is not None:
         # the fixture's resonance is not the wheel's: kept out of its model, recorded for the user
         f_r, zeta, gain = efit.stand

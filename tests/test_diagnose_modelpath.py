@@ -75,23 +75,21 @@ def test_model_path_on_stand_data_names_only_the_stand(stand_reference):
     assert d.error_after < 0.1 * d.error_before
 
 
-def test_close_pair_on_a_short_record_is_one_line_of_the_reference():
+def test_close_pair_unresolved_by_the_reference_is_no_effect():
     """h = 5.37 and 5.57 (radial force) are 10 Hz apart at 3000 rpm: on a 2048-sample record (1.875 Hz bins) no
-    run separates them by a line's 7-bin power window.  The empirical fit now keeps them as one line between them
-    whose power is the pair's (the quadrature sum of the thesis's C's, within 35 %: modal exclusion and the
-    merged peaks' scalloping), where before it dropped both; diagnose --model on the next run adds nothing (before:
-    a missing harmonic at h 5.50)."""
+    run separates them by the empirical fit's 7-bin power window, so the reference fit drops both.  Its model now
+    says so (``analytical.fit.unresolved_lines``: a span holding both thesis h's), and diagnose --model on the next
+    run completes the line it finds there into the model as the wheel's own (``base_lines``) instead of naming
+    a missing harmonic (before: one ``missing_harmonic`` at h 5.50 on clean data)."""
     short = dict(n_samples=2048)
-    ref_test = _run(2505, **short)
-    fit = api.fit(ref_test)
-    pair = [x for x in fit.model.empirical["radial_force"] if 5.3 < x.h < 5.65]
-    assert len(pair) == 1, [x.h for x in fit.model.empirical["radial_force"]]
-    assert 5.37 <= pair[0].h <= 5.57
-    c_pair = np.hypot(0.0542, 0.0690) * iw.C_UNIT
-    assert pair[0].C == pytest.approx(c_pair, rel=0.35)
-    model = _reference(ref_test)
+    model = _reference(_run(2505, **short))
+    spans = [sp for sp in model.analytical["fit"]["unresolved_lines"] if sp["direction"] == "radial_force"]
+    assert any(sp["h_min"] <= 5.37 and 5.57 <= sp["h_max"] for sp in spans), spans
+    assert not any(sp["h_min"] <= 4.42 <= sp["h_max"] for sp in spans)     # a resolved line is no span
     d = api.diagnose(_run(2005, **short), model)
     assert [e["kind"] for e in d.model.effects] == []
+    (line,) = d.summary()["base_lines"]
+    assert line["direction"] == "radial_force" and 5.37 <= line["h"] <= 5.57
 
 
 def test_model_path_at_low_noise_adds_no_broadband_floor():
