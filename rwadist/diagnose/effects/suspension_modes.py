@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...stand_resonance import (STAND_MAX_ZETA, STAND_MIN_LOG_GAIN, STAND_ROUNDS, STAND_WINDOW,  # noqa: F401
-                                 stand_resonance_start)
+# the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
+from ...stand_resonance import STAND_ROUNDS, stand_resonance_start
 from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
