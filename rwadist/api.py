@@ -215,8 +215,8 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     model : WheelModel
         The model file's content: the empirical harmonics as forcing lines plus the analytical section.
     """
-    from .extended_fit import fit_extended as _fit_extended
     from .extended_fit import to_model
+    from .stand_resonance import fit_extended_beside_stand
 
     test = _as_test(data)
     if empirical is None:
@@ -235,7 +235,9 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     if mass is None or radius is None:
         # per unit mass and inertia: the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr, I_zz/I_rr
         mass = radius = None
-    efit = _fit_extended(test, empirical, mass, radius, height=height, start=start, progress=progress)
+    # a fixture resonance lifting every channel is fitted beside the wheel's modes, never into them
+    efit = fit_extended_beside_stand(test, empirical, mass=mass, radius=radius, height=height, start=start,
+                                     progress=progress)
     return efit, to_model(efit, empirical)
 
 

@@ -72,6 +72,9 @@ class ExtendedFit:
         their values are starting values (written to ``analytical.unconstrained``).
     scans : per mode, the :class:`~rwadist.mode_scan.ModeScan` that located it or said why not.
     per_unit : True when mass/radius were not given (M = 1 kg, I_rr = 1 kg·m²).
+    stand : the fixture resonance (f_r Hz, ζ, peak gain) divided out of every line before the fit, or None.
+    line_residuals : (f Hz, r) of every measurement the least squares used: f = h|Ω|/2π the line's frequency
+        and r = ln(measured / model amplitude) (radial lines: of sqrt(x² + y²)), the stand divided out.
     """
 
     params: ext.ExtendedParams
@@ -88,6 +91,8 @@ class ExtendedFit:
     unconstrained: list = field(default_factory=list)
     scans: dict = field(default_factory=dict)
     per_unit: bool = False
+    stand: tuple | None = None
+    line_residuals: tuple = (np.empty(0), np.empty(0))
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -613,7 +618,9 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     unconstrained = [UNCONSTRAINED_NAME[m] for m in _MODE_PARAMS if not identified[m]]
     return ExtendedFit(params=params, lines=kept_lines, zeta=zeta, rel_stderr=rel_stderr, identified=identified,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
-                       unconstrained=unconstrained, scans=scans, per_unit=not physical)
+                       unconstrained=unconstrained, scans=scans, per_unit=not physical,
+                       stand=None if stand is None else tuple(float(v) for v in stand),
+                       line_residuals=(np.concatenate([f_ax, f_rd]), np.concatenate([r_ax, r_rad])))
 
 
 # --------------------------------------------------------------------------- 4. comparison
@@ -659,6 +666,33 @@ def rms_comparison(efit: ExtendedFit, fit: EmpiricalFit) -> dict:
     return out
 
 
+def unresolved_spans(fit: EmpiricalFit) -> list:
+    """Spans of h, per direction, where the empirical fit ``fit`` detected lines it could not measure apart:
+    candidate harmonics present in enough runs but dropped because no measurement was resolved from the other
+    lines (a close pair, h = 5.37 and 5.57 of the E wheel, on a short record: the fit's (2·line_half_width + 1)-bin
+    power windows overlap at every speed).  Candidates closer than that window at the top speed are one span;
+    each span is widened by the fit's tolerance ε on h.  Returns [{"direction", "h_min", "h_max"}]: the model
+    file's ``analytical.fit.unresolved_lines``, which ``rwadist diagnose`` reads (a line found there is the
+    wheel's own content the model's fit could not measure, not an effect)."""
+    eps = float(fit.settings.get("epsilon", FitSettings.epsilon))
+    half = int(fit.settings.get("line_half_width", FitSettings.line_half_width))
+    sp = fit.spectra
+    f_spin = float(np.max(np.abs(sp.speed))) / (2 * np.pi) if np.size(sp.speed) else 0.0
+    close = max(eps, (2 * half + 1) * sp.df / f_spin) if f_spin > 0 else eps
+    out = []
+    for d in sorted({b.direction for b in fit.bins}):
+        hs = sorted(b.h for b in fit.bins if b.direction == d and not b.kept
+                    and b.reason.startswith("no measurement resolved"))
+        spans = []
+        for h in hs:
+            if spans and h - spans[-1][1] < close:
+                spans[-1][1] = h
+            else:
+                spans.append([h, h])
+        out += [{"direction": d, "h_min": float(lo - eps), "h_max": float(hi + eps)} for lo, hi in spans]
+    return out
+
+
 def to_model(efit: ExtendedFit, fit: EmpiricalFit):
     """A model file for the extended fit: the analytical section, and as harmonics the fitted
     forcing lines (each radial one split into its co- and counter-rotating parts where both carry
@@ -680,6 +714,13 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
                                     for (d, h), (s_, fr) in efit.senses.items()},
                          "notes": efit.notes}
     analytical["unconstrained"] = list(efit.unconstrained)
+    unresolved = unresolved_spans(fit)
+    if unresolved:
+        analytical["fit"]["unresolved_lines"] = unresolved
+    if efit.stand is not None:
+        # the fixture's resonance is not the wheel's: kept out of its model, recorded for the user
+        f_r, zeta, gain = efit.stand
+        analytical["fit"]["test_stand"] = {"f_Hz": f_r, "zeta": zeta, "peak_gain": gain}
     if efit.per_unit:
         analytical["fit"]["per_unit"] = ("mass and radius not given: mass_kg = 1 and I_rr = 1 are units, the "
                                          "stiffnesses and damping are per unit mass / transverse inertia")

@@ -126,7 +126,15 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
     return Hypothesis(effect, gain / max(float(all_tot.sum()), 1e-300), frac, float(t), passed, iteration)
 
 
-def _base_lines(hyps) -> None:
+def _unresolved(model, direction: str, h: float) -> bool:
+    """True when the model's extended fit recorded (direction, h) inside a span of lines it detected but could
+    not measure apart (``analytical.fit.unresolved_lines``, :func:`rwadist.extended_fit.unresolved_spans`)."""
+    fit = (getattr(model, "analytical", None) or {}).get("fit") or {}
+    return any(sp.get("direction") == direction and sp.get("h_min", np.inf) <= h <= sp.get("h_max", -np.inf)
+               for sp in fit.get("unresolved_lines") or [])
+
+
+def _base_lines(hyps, model=None) -> None:
     """Mark the passing ``missing_harmonic`` hypotheses added after a ``suspension_modes`` as lines of the wheel's
     base (``Hypothesis.base_line``), not foreign effects.
 
@@ -135,7 +143,17 @@ def _base_lines(hyps) -> None:
     model's): there is no model a line could be missing from, so a line at a constant h that this fit did not
     resolve (two close lines merged at a short record's resolution, a line below the fit's detection at the
     low speeds) is the wheel's own content, completed into the base.  It stays in the improved model's
-    harmonics and is listed in its provenance (``diagnose.base_lines``) and the summary's ``base_lines``."""
+    harmonics and is listed in its provenance (``diagnose.base_lines``) and the summary's ``base_lines``.
+
+    The same for a given ``model`` whose extended fit recorded lines it detected but could not measure apart
+    (``analytical.fit.unresolved_lines``: a close pair on the reference's short record): a missing harmonic found
+    inside such a span is the wheel's own content the model already said it could not measure, completed into the
+    model, not a foreign effect."""
+    for h in hyps:
+        e = h.effect
+        if (h.passed and getattr(e, "kind", "") == "missing_harmonic"
+                and _unresolved(model, getattr(e, "direction", ""), float(getattr(e, "h", np.nan)))):
+            h.base_line = True
     modes_at = min((h.iteration for h in hyps if h.passed and getattr(h.effect, "kind", "") == "suspension_modes"),
                    default=None)
     if modes_at is None:
@@ -240,7 +258,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         best.effect = state.effects[-1]
     else:
         it = max_iterations
-    _base_lines(hyps)
+    _base_lines(hyps, model)
     out = copy.deepcopy(state.model)
     out.effects = list(model.effects) + [effect_entry(h) for h in hyps if h.passed and not h.base_line]
     prov = {"metric": METRIC, "base": state.base}

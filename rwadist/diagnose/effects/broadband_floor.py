@@ -6,10 +6,40 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...units import CHANNEL_UNIT
-from ..constants import BAND_BINS, FLOOR_EXPONENTS
+from ..constants import BAND_BINS, FLOOR_EXPONENTS, LINE_HALF
 from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
+
+
+def skirt_dominated(ctx: Context, state: State, c: str, runs) -> np.ndarray:
+    """(n_runs, n_bands) bool: the bands of channel ``c`` whose off-line bins (away from every model line by more
+    than LINE_HALF bins) hold more of the model's own line skirts (the Hann kernel's leakage of the predicted
+    lines) than instrument noise.
+
+    There the data less the model is dominated by the lines' model error, not by a floor: a line predicted a few
+    per cent off (the extended base's accuracy near a mode) leaves that few per cent of its skirt in every
+    off-line bin, which grows with speed as the line does.  At a high line-to-noise ratio (0.1 % noise) that
+    residual is many times the noise and would be fitted as a "floor growing with speed".  Where the skirt is
+    below the noise, a skirt error of a few per cent is below the band's noise standard error (noise/sqrt(bins ·
+    segments): 1/7 of the noise for 8 bins and 7 Welch segments), so the floor fit is not misled."""
+    P = ctx.predict(state, c, runs)
+    N = ctx.floor_psd(state, c, runs)
+    skirt = np.maximum(P - N, 0.0)
+    on_line = np.zeros(skirt.shape, bool)
+    offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+    rows = np.arange(len(runs))[:, None]
+    for h, _, _, _ in ctx.channel_lines(state, c, runs):
+        k = np.clip(np.rint(h * ctx.omega[runs] / (2 * np.pi) / ctx.df).astype(int)[:, None] + offs, 0,
+                    ctx.f.size - 1)
+        on_line[rows, k] = True
+    lo, n = ctx.k_lo, ctx.n_bands * BAND_BINS
+    shape = (len(runs), ctx.n_bands, BAND_BINS)
+    off = ~on_line[:, lo:lo + n].reshape(shape)
+    cnt = np.maximum(off.sum(2), 1)
+    skirt_mean = np.where(off, skirt[:, lo:lo + n].reshape(shape), 0.0).sum(2) / cnt
+    noise_mean = np.where(off, N[:, lo:lo + n].reshape(shape), 0.0).sum(2) / cnt
+    return skirt_mean > noise_mean
 
 
 @register(order=30)
@@ -62,6 +92,9 @@ class BroadbandFloor:
         y, wt = ctx.offline_bands(state, c, runs)                       # (n_runs, n_bands) unit²/Hz
         if not np.isfinite(ctx.sp.psd[c][runs, 0]).all() or wt.sum(0).min() < 0:
             return None
+        # a run's band whose off-line bins hold more of the model's line skirts than noise says nothing of a
+        # floor (:func:`skirt_dominated`): no weight
+        wt = np.where(skirt_dominated(ctx, state, c, runs), 0, wt)
         w_ref = ctx.omega_ref()
         x0 = ctx.omega[runs] / w_ref
         level = np.maximum(np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300), 1e-300)
@@ -88,6 +121,14 @@ class BroadbandFloor:
             _, p, n, g = best
             expected = np.maximum(n[None, :] + g[None, :] * x0[:, None] ** p, 1e-300)
         _, p, n, g = best
+        # growth is measured only in a band whose usable runs reach the upper half of the speeds (Ω >= Ω_max/2):
+        # from lower speeds alone the law Ω^p is extrapolated to the top speed by 2^p or more (1.4 to 256 over the
+        # exponent grid) times its error -- e.g. a band near a mode whose high-speed runs are skirt dominated.
+        # Elsewhere the band's noise is its plain weighted mean and its growth is interpolated from its neighbours
+        grows = ((wt > 0) & (x0 >= 0.5 * x0.max())[:, None]).any(0)
+        flat = np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300)
+        n = np.where(grows, n, np.maximum(flat, 0.0))
+        g = np.where(grows, g, 0.0)
         # a band with no usable bin in any run (every bin taken by lines) constrains nothing, and a band whose
         # fitted noise and growth are both 0 (its off-line data at or below the model's line skirts, as in
         # noise_estimate) holds no estimate of the floor: a zero floor would divide every later noise-relative
@@ -95,8 +136,9 @@ class BroadbandFloor:
         # interpolated from the bands either side
         seen = wt.sum(0) > 0
         has_noise = seen & ((n > 0) | (g > 0))
-        if not has_noise.any():
+        if not has_noise.any() or not grows.any():
             return None
+        seen = grows
         f = ctx.f
         lo, hi = f[ctx.k_lo], f[ctx.k_lo + ctx.n_bands * BAND_BINS - 1]
         centres = ctx.band_centres()

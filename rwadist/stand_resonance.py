@@ -1,0 +1,222 @@
+"""A fixture (test-stand) resonance on every channel, told from the wheel's own suspension modes.
+
+A resonance of the stand lifts the lines of EVERY load direction at one frequency; a wheel mode lifts one
+direction (translation the radial forces, rocking the radial torques, axial the axial force).  Taken for a
+mode, a stand resonance near one spoils the modes' fit (the radial translation pulled to the stand and
+declared unconstrained, the other modes' damping widened).  This module detects one from an empirical fit
+(:func:`stand_resonance_start`), refines it on the residual of an extended fit that divided it out
+(:func:`stand_on_modes`), and fits the extended model beside it (:func:`fit_extended_beside_stand`, what
+``rwadist fit --extended`` runs); ``rwadist diagnose``'s ``suspension_modes`` uses the same detection.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: Smallest mean log power gain (ln of measured / C·Ω² line power) a fixture resonance must show near one
+#: frequency in EVERY load direction to be divided out before the modes are located: a power gain of 1.5.  A
+#: wheel mode amplifies one direction's lines (translation the radial forces, rocking the radial torques,
+#: axial the axial force); only a resonance of the stand lifts them all at one frequency.
+STAND_MIN_LOG_GAIN = float(np.log(1.5))
+#: Largest damping ratio of a proposed fixture resonance: a fixture resonance is sharp; a "resonance" as wide as
+#: the fit allows (ζ → 0.5) is a broad tilt of the line gains (a wheel mode's skirt, model error), not a stand.
+STAND_MAX_ZETA = 0.2
+#: Rounds of (stand on the modes' base, modes with that stand divided out) at most.
+STAND_ROUNDS = 4
+#: Half width of the window (relative to the frequency) in which a direction's log gains are averaged.
+STAND_WINDOW = 0.05
+
+
+def _line_log_gains(fit, by_line: bool = False) -> dict:
+    """direction (or (direction, h) when ``by_line``) -> (f Hz, y) of every measured line amplitude of an
+    empirical fit: f = h|Ω|/2π and y = 2 ln(a / (C·Ω²)), the log power gain over the line's hard-mounted law."""
+    out = {}
+    for x in fit.lines:
+        w = np.abs(np.asarray(x.speed, dtype=float))
+        a = np.asarray(x.amplitude, dtype=float)
+        ok = np.isfinite(a) & (a > 0) & (w > 0)
+        if x.C <= 0 or not ok.any():
+            continue
+        f, y = out.setdefault((x.direction, float(x.h)) if by_line else x.direction, ([], []))
+        f.append(x.h * w[ok] / (2 * np.pi))
+        y.append(2.0 * np.log(a[ok] / (x.C * w[ok] ** 2)))
+    return {d: (np.concatenate(f), np.concatenate(y)) for d, (f, y) in out.items()}
+
+
+def _window_means(f, y, grid, min_points):
+    """Mean of y over the points within ±STAND_WINDOW of each grid frequency; NaN where fewer than
+    ``min_points``."""
+    inside = np.abs(f[None, :] / grid[:, None] - 1.0) <= STAND_WINDOW
+    cnt = inside.sum(1)
+    return np.where(cnt >= min_points, (inside * y[None, :]).sum(1) / np.maximum(cnt, 1), np.nan)
+
+
+def stand_resonance_start(fit, min_points: int = 2):
+    """(f_r Hz, ζ, peak gain) of a fixture resonance seen in the empirical fit ``fit``, or None.
+
+    The signature of a stand resonance is one frequency at which the lines of every load direction are
+    amplified over their C·Ω² law (a wheel mode lifts one direction only).  Score of a frequency f: the
+    smallest, over the directions with lines, of the mean log power gain of that direction's measurements
+    within ±:data:`STAND_WINDOW` of f (at least ``min_points`` of them), and over every single line (direction,
+    h) with ``min_points`` measurements there (a fixture lifts every harmonic at f alike); a stand resonance is proposed at
+    the best score when it reaches :data:`STAND_MIN_LOG_GAIN` in two directions or more.  ζ and the peak
+    gain: robust (soft-L1) least squares of ln|H|² (:func:`rwadist.resonance.resonance`) on every direction's
+    log gains within ±25 % of f pooled, f_r free within ±10 %; refused when ζ > :data:`STAND_MAX_ZETA` (a broad
+    tilt, not a resonance) or the peak gain is below 1 + :data:`STAND_MIN_LOG_GAIN`/2.  A stand detected so is
+    refined by the same fit with a smooth trend a + b·ln f of each direction's own (a wheel mode's skirt beside
+    the stand pulls the pooled fit: 185 Hz, ζ 0.06-0.09, gain 7-13 for a 180 or 150 Hz, ζ 0.03, gain 5 stand
+    beside the radial translation mode), and refused again by the same rules.  A start only: the search refits
+    it beside the modes.
+    """
+    from scipy.optimize import least_squares
+
+    from .resonance import resonance
+
+    pts = {d: fy for d, fy in _line_log_gains(fit).items() if fy[0].size >= 2 * min_points}
+    if len(pts) < 2:
+        return None
+    f_all = np.concatenate([fy[0] for fy in pts.values()])
+    lo, hi = float(np.min(f_all)), float(np.max(f_all))
+    if hi <= lo * (1 + 2 * STAND_WINDOW):
+        return None
+    grid = np.exp(np.arange(np.log(lo), np.log(hi), 0.005))                     # 0.5 % steps
+    score = np.full(grid.size, np.inf)
+    for f, y in pts.values():
+        score = np.minimum(score, np.nan_to_num(_window_means(f, y, grid, min_points), nan=-np.inf))
+    # a fixture amplifies every line at f, whatever its harmonic: a line (direction, h) with points near f
+    # that is not lifted there rules f out (an amplitude law lifts one harmonic at the top speeds only)
+    for (d, _h), (f, y) in _line_log_gains(fit, by_line=True).items():
+        if d in pts:
+            score = np.fmin(score, np.where(np.isnan(m := _window_means(f, y, grid, min_points)), np.inf, m))
+    i = int(np.argmax(score))
+    if not score[i] >= STAND_MIN_LOG_GAIN:
+        return None
+    f_s = float(grid[i])
+    f, y, which = [], [], []
+    for j, (fd, yd) in enumerate(pts.values()):
+        near = np.abs(fd / f_s - 1.0) <= 0.25
+        f.append(fd[near])
+        y.append(yd[near])
+        which.append(np.full(int(near.sum()), j))
+    f, y, which = np.concatenate(f), np.concatenate(y), np.concatenate(which)
+    n_dir = len(pts)
+    lf = np.log(f / f_s)
+    lb3, ub3 = np.log([0.9 * f_s, 1e-3, 1.1]), np.log([1.1 * f_s, 0.5, 200.0])
+    g0 = float(np.clip(np.exp(np.max(y) / 2.0), 1.2, 100.0))
+
+    def pooled(x):
+        return y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2)
+
+    # detection: one resonance on every direction's points pooled (cheap); refused as below, nothing more is tried
+    det = min((least_squares(pooled, np.clip(np.log([f_s, z0, g0]), lb3 + 1e-9, ub3 - 1e-9), loss="soft_l1",
+                             f_scale=0.5, bounds=(lb3, ub3)) for z0 in (0.01, 0.03, 0.1)), key=lambda sol: sol.cost)
+    _, zeta_det, gain_det = (float(v) for v in np.exp(det.x))
+    if zeta_det > STAND_MAX_ZETA or gain_det < 1.0 + STAND_MIN_LOG_GAIN / 2:
+        return None
+
+    def res(x):
+        # the fixture's resonance, common to every direction, on a smooth trend of each direction's own (a + b·ln f:
+        # the skirt of a wheel mode beside the stand -- the radial translation lifting the radial forces, the axial
+        # mode below it lowering the axial force -- is one direction's, not the fixture's)
+        trend = x[3 + 2 * which] + x[4 + 2 * which] * lf
+        return y - trend - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2)
+
+    rows = np.arange(f.size)
+
+    def jac(x):
+        # analytic: ln|H|² = ln(b² + g²q²) − ln(b² + q²), b = 1 − r², q = 2ζr, r = f/f_r, parameters in logs
+        r = f / np.exp(x[0])
+        b, q, g = 1.0 - r * r, 2.0 * np.exp(x[1]) * r, np.exp(x[2])
+        A, B = b * b + (g * q) ** 2, b * b + q * q
+        J = np.zeros((f.size, x.size))
+        J[:, 0] = -((4 * b * r * r - 2 * (g * q) ** 2) / A - (4 * b * r * r - 2 * q * q) / B)
+        J[:, 1] = -(2 * (g * q) ** 2 / A - 2 * q * q / B)
+        J[:, 2] = -(2 * (g * q) ** 2 / A)
+        J[rows, 3 + 2 * which] = -1.0
+        J[rows, 4 + 2 * which] = -lf
+        return J
+
+    # refinement of a detected stand: the same resonance on each direction's own trend
+    lb = np.concatenate([lb3, np.full(2 * n_dir, -np.inf)])
+    ub = np.concatenate([ub3, np.full(2 * n_dir, np.inf)])
+    best = None
+    for z0 in (0.01, 0.03, 0.1):
+        x0 = np.concatenate([np.clip(np.log([f_s, z0, g0]), lb[:3] + 1e-9, ub[:3] - 1e-9), np.zeros(2 * n_dir)])
+        sol = least_squares(res, x0, jac=jac, loss="soft_l1", f_scale=0.5, bounds=(lb, ub))
+        if best is None or sol.cost < best.cost:
+            best = sol
+    f_r, zeta, gain = (float(v) for v in np.exp(best.x[:3]))
+    if zeta > STAND_MAX_ZETA or gain < 1.0 + STAND_MIN_LOG_GAIN / 2:
+        return None
+    return f_r, zeta, gain
+
+
+def stand_on_modes(efit, near_hz: float):
+    """(f_r Hz, ζ, peak gain) of the fixture resonance left on the residual of the extended fit ``efit``, or None.
+
+    The residual r = ln(measured / model amplitude) of every line measurement (:attr:`ExtendedFit.line_residuals`,
+    the stand ``efit.stand`` divided out) plus ln|H| of that stand is what a resonance common to every channel
+    must explain once the wheel's modes are modelled.  Fit as the detection of :func:`stand_resonance_start`
+    (robust soft-L1 least squares of ln|H|² on the points within ±25 % of ``near_hz``, f_r free within ±10 %);
+    refused by the same rules (ζ > :data:`STAND_MAX_ZETA`: a broad tilt of the modes' misfit; peak gain below
+    1 + :data:`STAND_MIN_LOG_GAIN`/2)."""
+    from scipy.optimize import least_squares
+
+    from .resonance import resonance
+
+    f, r = (np.asarray(v, dtype=float) for v in efit.line_residuals)
+    near = np.isfinite(r) & (f > 0) & (np.abs(f / near_hz - 1.0) <= 0.25)
+    if near.sum() < 6:
+        return None
+    f = f[near]
+    y = 2.0 * r[near]
+    if efit.stand is not None:
+        y = y + 2.0 * np.log(np.abs(resonance(f, *efit.stand)))
+    lb, ub = np.log([0.9 * near_hz, 1e-3, 1.1]), np.log([1.1 * near_hz, 0.5, 200.0])
+    g0 = float(np.clip(np.exp(np.max(y) / 2.0), 1.2, 100.0))
+
+    def res(x):
+        return y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2)
+
+    best = min((least_squares(res, np.clip(np.log([near_hz, z0, g0]), lb + 1e-9, ub - 1e-9), loss="soft_l1",
+                              f_scale=0.5, bounds=(lb, ub)) for z0 in (0.01, 0.03, 0.1)), key=lambda sol: sol.cost)
+    f_r, zeta, gain = (float(v) for v in np.exp(best.x))
+    if zeta > STAND_MAX_ZETA or gain < 1.0 + STAND_MIN_LOG_GAIN / 2:
+        return None
+    return f_r, zeta, gain
+
+
+def fit_extended_beside_stand(test, fit, **kwargs):
+    """:func:`rwadist.extended_fit.fit_extended` of ``test`` (empirical fit ``fit``; ``kwargs`` passed on) with a
+    fixture resonance fitted beside the wheel's modes, never into them.
+
+    When the empirical fit shows the lines of every load direction lifted at one frequency
+    (:func:`stand_resonance_start`; only with all six channels: a stand is told from a mode by lifting the
+    forces AND the torques), that resonance is divided out of every line before the modes are located, then
+    refitted on the residual of the modes' fit (:func:`stand_on_modes`) and the modes refitted with it, until it
+    settles (f_r within 0.2 %, gain within 2 %) or :data:`STAND_ROUNDS` rounds.  It is dropped (the plain fit
+    returned) when the residual confirms no resonance there, or when the fit with it locates fewer modes than
+    the fit without it.  The stand kept is in ``ExtendedFit.stand`` and a note; it is not part of the wheel's
+    model (``rwadist diagnose`` names it as a ``fixed_resonance`` of role test_stand)."""
+    from .extended_fit import fit_extended
+
+    channels = {c for r in test.runs for c in r.signals}
+    stand = stand_resonance_start(fit) if len(channels) >= 6 else None
+    if stand is None:
+        return fit_extended(test, fit, **kwargs)
+    plain = fit_extended(test, fit, **kwargs)
+    efit = fit_extended(test, fit, stand=stand, **kwargs)
+    for _ in range(STAND_ROUNDS):
+        new = stand_on_modes(efit, stand[0])
+        if new is None:
+            return plain                          # not confirmed on the modes' base: no stand
+        settled = abs(new[0] / stand[0] - 1) < 0.002 and abs(np.log(new[2] / stand[2])) < 0.02
+        stand = new
+        efit = fit_extended(test, fit, stand=stand, **kwargs)
+        if settled:
+            break
+    if len(efit.unconstrained) > len(plain.unconstrained):
+        return plain
+    efit.notes.append(f"test stand: a resonance at {stand[0]:.4g} Hz (ζ {stand[1]:.3g}, peak gain {stand[2]:.3g}) "
+                      "lifts the lines of every channel: a fixture resonance, divided out of the lines before the "
+                      "modes were fitted and not part of the wheel's model (analytical.fit.test_stand)")
+    return efit
