@@ -53,6 +53,41 @@ def _line_gain_points(ctx, state, chans, runs):
     return np.concatenate(fs), np.concatenate(ys), np.concatenate(ws)
 
 
+#: Evaluation limit of each least-squares fit: scipy's default for 'trf' with 3 parameters (100·n), written out
+#: because :class:`_FlatNoResonance` projects to it.
+MAX_NFEV = 300
+#: A fit is stopped as "no resonance" (:class:`_FlatNoResonance`) after FLAT_MIN_ITER iterations when ln g, projected
+#: linearly from its change over the last FLAT_WINDOW iterations to :data:`MAX_NFEV`, stays within NO_RESONANCE_FRACTION
+#: of ln :data:`MIN_PEAK_GAIN`: near g = 1 the Jacobian's f_r and ζ columns vanish with g − 1, so the solver creeps
+#: along a flat valley to its evaluation limit (ln g moves by ~0.01 in 250 iterations on clean data), and wherever it
+#: stops the result is no resonance.
+FLAT_MIN_ITER, FLAT_WINDOW, NO_RESONANCE_FRACTION = 40, 20, 0.8
+
+
+class _FlatNoResonance:
+    """least_squares ``callback``: StopIteration (status −2) once the iterate is a flat no-resonance (see
+    :data:`NO_RESONANCE_FRACTION`); x = (ln f_r, ln ζ, ln g)."""
+
+    def __init__(self):
+        self.log_gains = []
+
+    def __call__(self, intermediate_result):
+        self.log_gains.append(float(intermediate_result.x[2]))
+        n = len(self.log_gains)
+        if n < FLAT_MIN_ITER:
+            return
+        now = self.log_gains[-1]
+        pace = abs(now - self.log_gains[n - 1 - FLAT_WINDOW]) / FLAT_WINDOW       # per iteration (≥ 1 evaluation)
+        left = max(MAX_NFEV - int(intermediate_result.nfev), 0)
+        if abs(now) + pace * left < NO_RESONANCE_FRACTION * np.log(MIN_PEAK_GAIN):
+            raise StopIteration
+
+
+def _is_resonance(sol) -> bool:
+    """True when a least-squares solution's peak gain passes :data:`MIN_PEAK_GAIN` (either way)."""
+    return abs(sol.x[2]) >= np.log(MIN_PEAK_GAIN)
+
+
 @register(order=40)
 @dataclass
 class FixedResonance:
@@ -163,14 +198,21 @@ class FixedResonance:
             def jac(x):
                 # closed form (rwadist.resonance.log_power_gain_jacobian): 3 residual evaluations fewer per step
                 return -sw[:, None] * log_power_gain_jacobian(f, *np.exp(x))
+            def solve(x0, stop):
+                return least_squares(res, np.clip(x0, lb + 1e-9, ub - 1e-9), jac=jac, loss="soft_l1", f_scale=0.5,
+                                     bounds=(lb, ub), max_nfev=MAX_NFEV, callback=_FlatNoResonance() if stop else None)
+            sols = [solve(x0, True) for x0 in starts]
+            if any(s.status == -2 for s in sols) and any(s.status != -2 and _is_resonance(s) for s in sols):
+                # another start found a resonance: which one fits best is decided on the stopped starts run to the end
+                sols = [solve(x0, False) if s.status == -2 else s for x0, s in zip(starts, sols)]
             best = None
-            for x0 in starts:
-                sol = least_squares(res, np.clip(x0, lb + 1e-9, ub - 1e-9), jac=jac, loss="soft_l1", f_scale=0.5,
-                                    bounds=(lb, ub))
+            for sol in sols:
                 if best is None or sol.cost < best.cost:
                     best = sol
             f_r, zeta, g = (float(v) for v in np.exp(best.x))
             e = FixedResonance(f_r, zeta, g, tuple(channels), role, int(f.size))
+            if best.status == -2:
+                break           # no resonance here: re-measuring with a flat |H| ≈ 1 in the state changes nothing
         return e
 
     @staticmethod
