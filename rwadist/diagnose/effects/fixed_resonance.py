@@ -83,9 +83,25 @@ class _FlatNoResonance:
             raise StopIteration
 
 
+def _least_squares_has_callback() -> bool:
+    import inspect
+
+    from scipy.optimize import least_squares
+
+    return "callback" in inspect.signature(least_squares).parameters
+
+
+_HAS_CALLBACK = _least_squares_has_callback()
+
+
+def _is_resonance_gain(peak_gain: float) -> bool:
+    """True when a peak gain passes :data:`MIN_PEAK_GAIN` (either way: a peak or a notch)."""
+    return abs(np.log(peak_gain)) >= np.log(MIN_PEAK_GAIN)
+
+
 def _is_resonance(sol) -> bool:
-    """True when a least-squares solution's peak gain passes :data:`MIN_PEAK_GAIN` (either way)."""
-    return abs(sol.x[2]) >= np.log(MIN_PEAK_GAIN)
+    """:func:`_is_resonance_gain` of a least-squares solution x = (ln f_r, ln ζ, ln g)."""
+    return _is_resonance_gain(float(np.exp(sol.x[2])))
 
 
 @register(order=40)
@@ -199,8 +215,10 @@ class FixedResonance:
                 # closed form (rwadist.resonance.log_power_gain_jacobian): 3 residual evaluations fewer per step
                 return -sw[:, None] * log_power_gain_jacobian(f, *np.exp(x))
             def solve(x0, stop):
+                # least_squares takes a callback from scipy 1.16 on: before, every start runs to its end
+                stop = {"callback": _FlatNoResonance()} if stop and _HAS_CALLBACK else {}
                 return least_squares(res, np.clip(x0, lb + 1e-9, ub - 1e-9), jac=jac, loss="soft_l1", f_scale=0.5,
-                                     bounds=(lb, ub), max_nfev=MAX_NFEV, callback=_FlatNoResonance() if stop else None)
+                                     bounds=(lb, ub), max_nfev=MAX_NFEV, **stop)
             sols = [solve(x0, True) for x0 in starts]
             if any(s.status == -2 for s in sols) and any(s.status != -2 and _is_resonance(s) for s in sols):
                 # another start found a resonance: which one fits best is decided on the stopped starts run to the end
