@@ -354,6 +354,30 @@ class Context(Metric):
             out += self.psd_at(np.column_stack(plain_f), np.column_stack(plain_p), bins)
         return out
 
+    def content_key(self, state: State, chans, runs: np.ndarray) -> bytes:
+        """A digest of everything ``state`` predicts and reads on channels ``chans`` and ``runs``: per channel the
+        data it reads (the load-cell offset of a corrected torque), the whole prediction, the noise floor, every
+        line (h, law, amplitude, modal gain) with its sidebands, and the fixed resonances acting on it; with the
+        state's speed ripple and spin smear.  Two states with the same digest measure and predict every line of
+        those channels alike, so a fit made from them alone (e.g. ``fixed_resonance``) can be reused by a later
+        search step whose accepted effect touched other channels only."""
+        import hashlib
+
+        hsh = hashlib.blake2b(digest_size=20)
+        hsh.update(repr((np.asarray(runs).tobytes(), state.ripple, state.smear)).encode())
+        for c in chans:
+            coupling = tuple(float(x) for x in state.coupling) if state.coupling is not None \
+                and c in TORQUE_CHANNELS else None
+            res = [r[:3] for r in state.resonances if c in r[3]]
+            hsh.update(repr((c, coupling, res)).encode())
+            hsh.update(np.ascontiguousarray(self.predict(state, c, runs)).tobytes())
+            hsh.update(np.ascontiguousarray(self.floor_psd(state, c, runs)).tobytes())
+            for h, law, amp, g in self.channel_lines(state, c, runs):
+                hsh.update(repr((h, law, state.line_components(c, h))).encode())
+                hsh.update(np.ascontiguousarray(amp, dtype=float).tobytes())
+                hsh.update(np.ascontiguousarray(g, dtype=float).tobytes())
+        return hsh.digest()
+
     def run_durations(self, runs: np.ndarray) -> np.ndarray:
         """Length of each run's record, s: from the time series when known, else from the Welch
         segments (50 % overlap: (n_segments + 1)·nperseg/2 samples)."""

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...resonance import resonance
+from ...resonance import log_power_gain_jacobian, resonance
 from ...units import CHANNEL_DIRECTION, DIRECTION_CHANNELS
 from ..constants import LINE_HALF, SNR_KNEE
 from ..engine import Context
@@ -53,6 +53,57 @@ def _line_gain_points(ctx, state, chans, runs):
     return np.concatenate(fs), np.concatenate(ys), np.concatenate(ws)
 
 
+#: Evaluation limit of each least-squares fit: scipy's default for 'trf' with 3 parameters (100·n), written out
+#: because :class:`_FlatNoResonance` projects to it.
+MAX_NFEV = 300
+#: A fit is stopped as "no resonance" (:class:`_FlatNoResonance`) after FLAT_MIN_ITER iterations when ln g, projected
+#: linearly from its change over the last FLAT_WINDOW iterations to :data:`MAX_NFEV`, stays within NO_RESONANCE_FRACTION
+#: of ln :data:`MIN_PEAK_GAIN`: near g = 1 the Jacobian's f_r and ζ columns vanish with g − 1, so the solver creeps
+#: along a flat valley to its evaluation limit (ln g moves by ~0.01 in 250 iterations on clean data), and wherever it
+#: stops the result is no resonance.
+FLAT_MIN_ITER, FLAT_WINDOW, NO_RESONANCE_FRACTION = 40, 20, 0.8
+
+
+class _FlatNoResonance:
+    """least_squares ``callback``: StopIteration (status −2) once the iterate is a flat no-resonance (see
+    :data:`NO_RESONANCE_FRACTION`); x = (ln f_r, ln ζ, ln g)."""
+
+    def __init__(self):
+        self.log_gains = []
+
+    def __call__(self, intermediate_result):
+        self.log_gains.append(float(intermediate_result.x[2]))
+        n = len(self.log_gains)
+        if n < FLAT_MIN_ITER:
+            return
+        now = self.log_gains[-1]
+        pace = abs(now - self.log_gains[n - 1 - FLAT_WINDOW]) / FLAT_WINDOW       # per iteration (≥ 1 evaluation)
+        left = max(MAX_NFEV - int(intermediate_result.nfev), 0)
+        if abs(now) + pace * left < NO_RESONANCE_FRACTION * np.log(MIN_PEAK_GAIN):
+            raise StopIteration
+
+
+def _least_squares_has_callback() -> bool:
+    import inspect
+
+    from scipy.optimize import least_squares
+
+    return "callback" in inspect.signature(least_squares).parameters
+
+
+_HAS_CALLBACK = _least_squares_has_callback()
+
+
+def _is_resonance_gain(peak_gain: float) -> bool:
+    """True when a peak gain passes :data:`MIN_PEAK_GAIN` (either way: a peak or a notch)."""
+    return abs(np.log(peak_gain)) >= np.log(MIN_PEAK_GAIN)
+
+
+def _is_resonance(sol) -> bool:
+    """:func:`_is_resonance_gain` of a least-squares solution x = (ln f_r, ln ζ, ln g)."""
+    return _is_resonance_gain(float(np.exp(sol.x[2])))
+
+
 @register(order=40)
 @dataclass
 class FixedResonance:
@@ -96,9 +147,15 @@ class FixedResonance:
         if grid.size == 0 or f.size < 4:
             return None
         half = np.maximum(2.0 * df, 0.02 * grid)
-        inside = np.abs(f[None, :] - grid[:, None]) <= half[:, None]
-        cnt = inside.sum(1)
-        mean = np.where(cnt > 0, (inside * y[None, :]).sum(1) / np.maximum(cnt, 1), 0.0)
+        # the points within ±half of each grid frequency are a contiguous run of the sorted points: their count
+        # and sum from a cumulative sum (a (grid, points) mask costs O(grid·points) memory and time)
+        order = np.argsort(f, kind="stable")
+        f_sorted = f[order]
+        y_cum = np.concatenate([[0.0], np.cumsum(y[order])])
+        i0 = np.searchsorted(f_sorted, grid - half, side="left")
+        i1 = np.searchsorted(f_sorted, grid + half, side="right")
+        cnt = i1 - i0
+        mean = np.where(cnt > 0, (y_cum[i1] - y_cum[i0]) / np.maximum(cnt, 1), 0.0)
         score = np.where(cnt >= 4, np.abs(mean) * np.sqrt(cnt), 0.0)
         i = int(np.argmax(score))
         return (float(grid[i]), float(mean[i])) if score[i] > 0 else None
@@ -109,10 +166,25 @@ class FixedResonance:
         """f_r, ζ, g by robust (soft-L1) nonlinear least squares of ln|H(f)|² against the lines' log power
         gains (:func:`_line_gain_points`), parameters in logs (positive), started at the strongest excess
         (or ``f0``) with ζ ∈ {0.01, 0.03, 0.1}; ``n_iter`` passes, each re-measuring the lines with the
-        previous pass's resonance in the state."""
-        from scipy.optimize import least_squares
+        previous pass's resonance in the state.
+
+        The fit reads only what the state predicts and measures on ``chans``: it is kept on the context under
+        :meth:`Context.content_key`, and a later search step whose state is the same there (its accepted effect
+        touched other channels) gets it again instead of fitting anew."""
+        from dataclasses import replace
 
         chans = [c for c in channels if c in ctx.channels]
+        key = ("fixed_resonance.fit", tuple(channels), role, n_iter, f0, ctx.content_key(state, chans, runs))
+        if key not in ctx._memo:
+            ctx._memo[key] = FixedResonance._fit(ctx, state, channels, chans, runs, f0, role, n_iter)
+        e = ctx._memo[key]
+        return None if e is None else replace(e)       # a copy: the caller's effect is its own
+
+    @staticmethod
+    def _fit(ctx: Context, state: State, channels, chans, runs, f0, role, n_iter) -> "FixedResonance | None":
+        """:meth:`fit` computed (``chans``: the channels of ``channels`` the data have)."""
+        from scipy.optimize import least_squares
+
         f, y, wt = _line_gain_points(ctx, state, chans, runs)
         lo, hi = ctx.k_lo * ctx.df, ctx.k_hi * ctx.df
         pk = FixedResonance.peak(f, y, lo, hi, ctx.df)
@@ -134,16 +206,31 @@ class FixedResonance:
             if f.size < 6:
                 return None
 
+            sw = np.sqrt(wt)
+
             def res(x):
-                return np.sqrt(wt) * (y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2))
+                return sw * (y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2))
+
+            def jac(x):
+                # closed form (rwadist.resonance.log_power_gain_jacobian): 3 residual evaluations fewer per step
+                return -sw[:, None] * log_power_gain_jacobian(f, *np.exp(x))
+            def solve(x0, stop):
+                # least_squares takes a callback from scipy 1.16 on: before, every start runs to its end
+                stop = {"callback": _FlatNoResonance()} if stop and _HAS_CALLBACK else {}
+                return least_squares(res, np.clip(x0, lb + 1e-9, ub - 1e-9), jac=jac, loss="soft_l1", f_scale=0.5,
+                                     bounds=(lb, ub), max_nfev=MAX_NFEV, **stop)
+            sols = [solve(x0, True) for x0 in starts]
+            if any(s.status == -2 for s in sols) and any(s.status != -2 and _is_resonance(s) for s in sols):
+                # another start found a resonance: which one fits best is decided on the stopped starts run to the end
+                sols = [solve(x0, False) if s.status == -2 else s for x0, s in zip(starts, sols)]
             best = None
-            for x0 in starts:
-                sol = least_squares(res, np.clip(x0, lb + 1e-9, ub - 1e-9), loss="soft_l1", f_scale=0.5,
-                                    bounds=(lb, ub))
+            for sol in sols:
                 if best is None or sol.cost < best.cost:
                     best = sol
             f_r, zeta, g = (float(v) for v in np.exp(best.x))
             e = FixedResonance(f_r, zeta, g, tuple(channels), role, int(f.size))
+            if best.status == -2:
+                break           # no resonance here: re-measuring with a flat |H| ≈ 1 in the state changes nothing
         return e
 
     @staticmethod
