@@ -11,11 +11,19 @@ from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
 
+#: A band is skirt dominated (:func:`skirt_dominated`) when the model's line skirts in its off-line bins exceed
+#: this many times the noise.  A line predicted 2-3 % off in amplitude (the extended base near a mode) leaves 4-6 %
+#: of its skirt power in the residual; at 3x the noise that is 0.12-0.18 of the noise, the size of the band mean's
+#: own noise standard error (1/sqrt(8 bins x ~7 Welch segments) = 0.13).  Above it the floor fit would see the
+#: skirt's model error; below it that error is lost in the noise.  (At 1x, strong torque lines of a hard-mounted
+#: wheel mask whole high-speed bands, and what is left is fitted as a floor growing from lower speeds.)
+SKIRT_OVER_NOISE = 3.0
+
 
 def skirt_dominated(ctx: Context, state: State, c: str, runs) -> np.ndarray:
     """(n_runs, n_bands) bool: the bands of channel ``c`` whose off-line bins (away from every model line by more
     than LINE_HALF bins) hold more of the model's own line skirts (the Hann kernel's leakage of the predicted
-    lines) than instrument noise.
+    lines) than :data:`SKIRT_OVER_NOISE` times the instrument noise.
 
     There the data less the model is dominated by the lines' model error, not by a floor: a line predicted a few
     per cent off (the extended base's accuracy near a mode) leaves that few per cent of its skirt in every
@@ -39,7 +47,7 @@ def skirt_dominated(ctx: Context, state: State, c: str, runs) -> np.ndarray:
     cnt = np.maximum(off.sum(2), 1)
     skirt_mean = np.where(off, skirt[:, lo:lo + n].reshape(shape), 0.0).sum(2) / cnt
     noise_mean = np.where(off, N[:, lo:lo + n].reshape(shape), 0.0).sum(2) / cnt
-    return skirt_mean > noise_mean
+    return skirt_mean > SKIRT_OVER_NOISE * noise_mean
 
 
 @register(order=30)
