@@ -90,14 +90,3 @@ def test_close_pair_unresolved_by_the_reference_is_no_effect():
     assert [e["kind"] for e in d.model.effects] == []
     (line,) = d.summary()["base_lines"]
     assert line["direction"] == "radial_force" and 5.37 <= line["h"] <= 5.57
-
-
-def test_model_path_at_low_noise_adds_no_broadband_floor():
-    """Every factor at its lowest (300-2400 rpm, 20 speeds, 2048 samples, 1000 Hz, 0.1 % noise): the lines stand
-    ~80 dB over the noise, so a line predicted a fraction of a per cent off leaves more skirt than noise in the
-    off-line bins near the axial mode.  That is no floor growing with speed: nothing is added (before: a
-    broadband_floor on Fz)."""
-    low = dict(rpm=(300.0, 2400.0), n_speeds=20, n_samples=2048, rate=1000.0, noise=0.001)
-    model = _reference(_run(2512, **low))
-    d = api.diagnose(_run(2012, **low), model)
-    assert [e["kind"] for e in d.model.effects] == []

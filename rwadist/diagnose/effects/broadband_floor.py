@@ -6,48 +6,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...units import CHANNEL_UNIT
-from ..constants import BAND_BINS, FLOOR_EXPONENTS, LINE_HALF
+from ..constants import BAND_BINS, FLOOR_EXPONENTS
 from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
-
-#: A band is skirt dominated (:func:`skirt_dominated`) when the model's line skirts in its off-line bins exceed
-#: this many times the noise.  A line predicted 2-3 % off in amplitude (the extended base near a mode) leaves 4-6 %
-#: of its skirt power in the residual; at 3x the noise that is 0.12-0.18 of the noise, the size of the band mean's
-#: own noise standard error (1/sqrt(8 bins x ~7 Welch segments) = 0.13).  Above it the floor fit would see the
-#: skirt's model error; below it that error is lost in the noise.  (At 1x, strong torque lines of a hard-mounted
-#: wheel mask whole high-speed bands, and what is left is fitted as a floor growing from lower speeds.)
-SKIRT_OVER_NOISE = 3.0
-
-
-def skirt_dominated(ctx: Context, state: State, c: str, runs) -> np.ndarray:
-    """(n_runs, n_bands) bool: the bands of channel ``c`` whose off-line bins (away from every model line by more
-    than LINE_HALF bins) hold more of the model's own line skirts (the Hann kernel's leakage of the predicted
-    lines) than :data:`SKIRT_OVER_NOISE` times the instrument noise.
-
-    There the data less the model is dominated by the lines' model error, not by a floor: a line predicted a few
-    per cent off (the extended base's accuracy near a mode) leaves that few per cent of its skirt in every
-    off-line bin, which grows with speed as the line does.  At a high line-to-noise ratio (0.1 % noise) that
-    residual is many times the noise and would be fitted as a "floor growing with speed".  Where the skirt is
-    below the noise, a skirt error of a few per cent is below the band's noise standard error (noise/sqrt(bins ·
-    segments): 1/7 of the noise for 8 bins and 7 Welch segments), so the floor fit is not misled."""
-    P = ctx.predict(state, c, runs)
-    N = ctx.floor_psd(state, c, runs)
-    skirt = np.maximum(P - N, 0.0)
-    on_line = np.zeros(skirt.shape, bool)
-    offs = np.arange(-LINE_HALF, LINE_HALF + 1)
-    rows = np.arange(len(runs))[:, None]
-    for h, _, _, _ in ctx.channel_lines(state, c, runs):
-        k = np.clip(np.rint(h * ctx.omega[runs] / (2 * np.pi) / ctx.df).astype(int)[:, None] + offs, 0,
-                    ctx.f.size - 1)
-        on_line[rows, k] = True
-    lo, n = ctx.k_lo, ctx.n_bands * BAND_BINS
-    shape = (len(runs), ctx.n_bands, BAND_BINS)
-    off = ~on_line[:, lo:lo + n].reshape(shape)
-    cnt = np.maximum(off.sum(2), 1)
-    skirt_mean = np.where(off, skirt[:, lo:lo + n].reshape(shape), 0.0).sum(2) / cnt
-    noise_mean = np.where(off, N[:, lo:lo + n].reshape(shape), 0.0).sum(2) / cnt
-    return skirt_mean > SKIRT_OVER_NOISE * noise_mean
 
 
 @register(order=30)
@@ -100,9 +62,6 @@ class BroadbandFloor:
         y, wt = ctx.offline_bands(state, c, runs)                       # (n_runs, n_bands) unit²/Hz
         if not np.isfinite(ctx.sp.psd[c][runs, 0]).all() or wt.sum(0).min() < 0:
             return None
-        # a run's band whose off-line bins hold more of the model's line skirts than noise says nothing of a
-        # floor (:func:`skirt_dominated`): no weight
-        wt = np.where(skirt_dominated(ctx, state, c, runs), 0, wt)
         w_ref = ctx.omega_ref()
         x0 = ctx.omega[runs] / w_ref
         level = np.maximum(np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300), 1e-300)
