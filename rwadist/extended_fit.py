@@ -33,6 +33,7 @@ rotor centre).
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -102,6 +103,16 @@ class ExtendedFit:
 
 # --------------------------------------------------------------------------- 1. senses
 
+@functools.lru_cache(maxsize=16)
+def run_window(name, n: int) -> tuple:
+    """(w (n,), Σw, Σw²) of the window ``name`` (:func:`scipy.signal.get_window`, periodic) over a record of ``n``
+    samples, computed once per (name, n): every run of a test has the same length, and the whole-run phasors ask
+    for it on every search step.  ``w`` is read-only (it is shared)."""
+    w = signal.get_window(name, n)
+    w.flags.writeable = False
+    return w, float(np.sum(w)), float(np.sum(w**2))
+
+
 def windowed_dft(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128) -> np.ndarray:
     """Σ_n x[n]·e^{−2πj f t_n} (t_n = n/sample_rate) of the columns of ``x`` (n, K) at frequencies ``f_hz``
     (L,) Hz, any f (not on the FFT grid); returns (L, K) complex.
@@ -113,13 +124,20 @@ def windowed_dft(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int
     n, k = x.shape
     f_hz = np.asarray(f_hz, dtype=float)
     n_blocks = -(-n // block)
-    xb = np.zeros((n_blocks * block, k))
-    xb[:n] = x
-    xb = xb.reshape(n_blocks, block, k)                                        # (J, B, K)
+    if n == n_blocks * block:
+        xb = x.reshape(n_blocks, block, k)
+    else:
+        xb = np.zeros((n_blocks * block, k))
+        xb[:n] = x
+        xb = xb.reshape(n_blocks, block, k)                                    # (J, B, K)
+    # samples of a block along the rows, (block, channel) along the columns: the fine sums are then one (L, B) @
+    # (B, J·K) matrix product per real and imaginary part (not J small batched ones)
+    xt = xb.transpose(1, 0, 2).reshape(block, n_blocks * k)                   # (B, J·K)
     fine = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(block) / sample_rate))             # (L, B)
     coarse = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(n_blocks) * block / sample_rate))  # (L, J)
-    inner = np.matmul(fine.real, xb) + 1j * np.matmul(fine.imag, xb)          # (J, L, K), real BLAS products
-    return np.einsum("lj,jlk->lk", coarse, inner)
+    shape = (f_hz.size, n_blocks, k)
+    inner = (fine.real @ xt).reshape(shape) + 1j * (fine.imag @ xt).reshape(shape)        # (L, J, K)
+    return np.einsum("lj,ljk->lk", coarse, inner)
 
 
 def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) -> dict:
@@ -143,7 +161,7 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             if cx not in run.signals or cy not in run.signals or run.speed == 0:
                 continue
             n = run.n_samples
-            w = signal.windows.hann(n, sym=False)
+            w = run_window("hann", n)[0]             # = signal.windows.hann(n, sym=False)
             f = h * abs(run.speed) / (2 * np.pi)
             ok = f < 0.45 * run.sample_rate
             X, Y = windowed_dft(np.column_stack([w * run.signals[cx], w * run.signals[cy]]), run.sample_rate,

@@ -34,8 +34,11 @@ RUN_MIN_BINS = 2.0
 
 
 def _record_df(ctx: Context, runs) -> np.ndarray:
-    """Frequency resolution fs/n (Hz) of each run's whole record."""
-    return np.array([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs], dtype=float)
+    """Frequency resolution fs/n (Hz) of each run's whole record (all runs' computed once per context: the search
+    asks for it per δ and side)."""
+    if "record_df" not in ctx._memo:
+        ctx._memo["record_df"] = np.array([run.sample_rate / run.n_samples for run in ctx.test.runs], dtype=float)
+    return ctx._memo["record_df"][np.asarray(runs, dtype=int)]
 
 
 def resolvable_runs(ctx: Context, state: State, direction: str, h0: float, h_side: float, runs) -> np.ndarray:
@@ -72,19 +75,17 @@ def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: 
     a·cos(2π f t + φ) gives |X| = a), less the leakage of the carrier h0: X(f) − X(f_c)·W(f − f_c)/W(0), f_c =
     h0|Ω|/2π, W the window's transform (a line at f_c puts X(f_c)·W(f − f_c)/W(0) at f); and the mean |X|² white
     noise of the state's floor S gives there, 2·S·fs·Σw²/(Σw)²."""
-    from scipy import signal
-
-    from ...extended_fit import windowed_dft
+    from ...extended_fit import run_window, windowed_dft
 
     chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
     X = np.zeros((runs.size, f_hz.shape[1], len(chans)), dtype=complex)
     for i, r in enumerate(runs):
         run = ctx.test.runs[r]
-        w = signal.get_window(RUN_WINDOW, run.n_samples)
+        w, wsum, _ = run_window(RUN_WINDOW, run.n_samples)
         f_c = h0 * ctx.omega[r] / (2 * np.pi)
         x = np.column_stack([run.signals[c] for c in chans]) * w[:, None]
-        both = 2.0 * windowed_dft(x, run.sample_rate, np.concatenate([f_hz[i], [f_c]])) / np.sum(w)
-        leak = windowed_dft(w[:, None], run.sample_rate, f_hz[i] - f_c)[:, 0] / np.sum(w)       # W(f − f_c)/W(0)
+        both = 2.0 * windowed_dft(x, run.sample_rate, np.concatenate([f_hz[i], [f_c]])) / wsum
+        leak = windowed_dft(w[:, None], run.sample_rate, f_hz[i] - f_c)[:, 0] / wsum       # W(f − f_c)/W(0)
         X[i] = both[:-1] - leak[:, None] * both[-1][None, :]
     return np.abs(X) ** 2, _run_noise(ctx, state, chans, runs, f_hz)
 
@@ -92,13 +93,13 @@ def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: 
 def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
     """Mean |X|² (len(runs), L, len(chans)) that white noise of the state's floor S puts into the whole-run phasor
     at ``f_hz``: 2·S·fs·Σw²/(Σw)² (:data:`RUN_WINDOW`)."""
-    from scipy import signal
+    from ...extended_fit import run_window
 
     enbw = np.empty(runs.size)
     for i, r in enumerate(runs):
         run = ctx.test.runs[r]
-        w = signal.get_window(RUN_WINDOW, run.n_samples)
-        enbw[i] = run.sample_rate * np.sum(w**2) / np.sum(w) ** 2
+        _, wsum, w2sum = run_window(RUN_WINDOW, run.n_samples)
+        enbw[i] = run.sample_rate * w2sum / wsum ** 2
     k = np.clip(np.rint(f_hz / ctx.df).astype(int), 0, ctx.f.size - 1)
     noise = np.stack([np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1) for c in chans], axis=-1)
     return 2.0 * noise * enbw[:, None, None]
