@@ -33,6 +33,7 @@ rotor centre).
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -102,24 +103,51 @@ class ExtendedFit:
 
 # --------------------------------------------------------------------------- 1. senses
 
+@functools.lru_cache(maxsize=16)
+def run_window(name, n: int) -> tuple:
+    """(w (n,), Σw, Σw²) of the window ``name`` (:func:`scipy.signal.get_window`, periodic) over a record of ``n``
+    samples, computed once per (name, n): every run of a test has the same length, and the whole-run phasors ask
+    for it on every search step.  ``w`` is read-only (it is shared)."""
+    w = signal.get_window(name, n)
+    w.flags.writeable = False
+    return w, float(np.sum(w)), float(np.sum(w**2))
+
+
+def _unit_phasors(f_hz: np.ndarray, dt: float, count: int) -> np.ndarray:
+    """e^{−2πj f k·dt} (L, count) for k = 0 … count − 1 at ``f_hz`` (L,) Hz, ``dt`` s: as a product of two tables of
+    about √count exponentials each, k = k_lo + m·k_hi (complex exponentials cost far more than the product of two
+    unit phasors, which is the same number to rounding)."""
+    m = max(int(np.ceil(np.sqrt(count))), 1)
+    lo = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(m) * dt))                                # (L, m)
+    hi = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(-(-count // m)) * (m * dt)))          # (L, ⌈count/m⌉)
+    return (hi[:, :, None] * lo[:, None, :]).reshape(f_hz.size, -1)[:, :count]
+
+
 def windowed_dft(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128) -> np.ndarray:
     """Σ_n x[n]·e^{−2πj f t_n} (t_n = n/sample_rate) of the columns of ``x`` (n, K) at frequencies ``f_hz``
     (L,) Hz, any f (not on the FFT grid); returns (L, K) complex.
 
     The samples are cut into blocks of ``block``: e^{−2πj f (t_b + t_j)} = e^{−2πj f t_b}·e^{−2πj f t_j}, so
-    only L·(block + n/block) exponentials are evaluated instead of L·n (a product of two unit phasors:
-    the same sum to rounding)."""
+    only L·(block + n/block) exponentials are needed instead of L·n (a product of two unit phasors: the same sum to
+    rounding), and each of those two tables is itself such a product (:func:`_unit_phasors`)."""
     x = np.asarray(x, dtype=float)
     n, k = x.shape
     f_hz = np.asarray(f_hz, dtype=float)
     n_blocks = -(-n // block)
-    xb = np.zeros((n_blocks * block, k))
-    xb[:n] = x
-    xb = xb.reshape(n_blocks, block, k)                                        # (J, B, K)
-    fine = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(block) / sample_rate))             # (L, B)
-    coarse = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(n_blocks) * block / sample_rate))  # (L, J)
-    inner = np.matmul(fine.real, xb) + 1j * np.matmul(fine.imag, xb)          # (J, L, K), real BLAS products
-    return np.einsum("lj,jlk->lk", coarse, inner)
+    if n == n_blocks * block:
+        xb = x.reshape(n_blocks, block, k)
+    else:
+        xb = np.zeros((n_blocks * block, k))
+        xb[:n] = x
+        xb = xb.reshape(n_blocks, block, k)                                    # (J, B, K)
+    # samples of a block along the rows, (block, channel) along the columns: the fine sums are then one (L, B) @
+    # (B, J·K) matrix product per real and imaginary part (not J small batched ones)
+    xt = xb.transpose(1, 0, 2).reshape(block, n_blocks * k)                   # (B, J·K)
+    fine = _unit_phasors(f_hz, 1.0 / sample_rate, block)                          # (L, B)
+    coarse = _unit_phasors(f_hz, block / sample_rate, n_blocks)                     # (L, J)
+    shape = (f_hz.size, n_blocks, k)
+    inner = (fine.real @ xt).reshape(shape) + 1j * (fine.imag @ xt).reshape(shape)        # (L, J, K)
+    return np.einsum("lj,ljk->lk", coarse, inner)
 
 
 def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) -> dict:
@@ -143,7 +171,7 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             if cx not in run.signals or cy not in run.signals or run.speed == 0:
                 continue
             n = run.n_samples
-            w = signal.windows.hann(n, sym=False)
+            w = run_window("hann", n)[0]             # = signal.windows.hann(n, sym=False)
             f = h * abs(run.speed) / (2 * np.pi)
             ok = f < 0.45 * run.sample_rate
             X, Y = windowed_dft(np.column_stack([w * run.signals[cx], w * run.signals[cy]]), run.sample_rate,

@@ -168,7 +168,7 @@ class CounterRotation:
         chans = DIRECTION_CHANNELS[direction]
         if ctx.test is None or not all(c in ctx.channels for c in chans):
             return None
-        from scipy import signal
+        from ...extended_fit import run_window
 
         h0 = _sense_group(state, direction, h)[0]
         f = h0 * ctx.omega[runs] / (2 * np.pi)
@@ -183,8 +183,8 @@ class CounterRotation:
         enbw = np.empty(runs.size)
         for i, r in enumerate(runs):
             run = ctx.test.runs[r]
-            w = signal.get_window(ctx.sp.window, run.n_samples)
-            enbw[i] = run.sample_rate * np.sum(w**2) / np.sum(w) ** 2
+            _, wsum, w2sum = run_window(ctx.sp.window, run.n_samples)
+            enbw[i] = run.sample_rate * w2sum / wsum ** 2
         noise = S * enbw
         Hc2 = ctx.gain(state, chans[0], f) ** 2
         gp = ctx.unit_gain(state, chans[0], direction, h0, "co", runs) ** 2 * Hc2

@@ -34,8 +34,11 @@ RUN_MIN_BINS = 2.0
 
 
 def _record_df(ctx: Context, runs) -> np.ndarray:
-    """Frequency resolution fs/n (Hz) of each run's whole record."""
-    return np.array([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs], dtype=float)
+    """Frequency resolution fs/n (Hz) of each run's whole record (all runs' computed once per context: the search
+    asks for it per δ and side)."""
+    if "record_df" not in ctx._memo:
+        ctx._memo["record_df"] = np.array([run.sample_rate / run.n_samples for run in ctx.test.runs], dtype=float)
+    return ctx._memo["record_df"][np.asarray(runs, dtype=int)]
 
 
 def resolvable_runs(ctx: Context, state: State, direction: str, h0: float, h_side: float, runs) -> np.ndarray:
@@ -66,39 +69,43 @@ def record_resolvable_runs(ctx: Context, state: State, direction: str, h0: float
     return runs[ok]
 
 
-def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: float) -> tuple:
+def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: float, need=None) -> tuple:
     """(|X|² (len(runs), L, n_chans), noise mean of |X|² same shape): the whole-run line powers of the direction's
     channels at ``f_hz`` (len(runs), L) Hz, Hann-windowed (:data:`RUN_WINDOW`; X = 2·Σ w x e^{−2πj f t}/Σ w, so a line
     a·cos(2π f t + φ) gives |X| = a), less the leakage of the carrier h0: X(f) − X(f_c)·W(f − f_c)/W(0), f_c =
     h0|Ω|/2π, W the window's transform (a line at f_c puts X(f_c)·W(f − f_c)/W(0) at f); and the mean |X|² white
-    noise of the state's floor S gives there, 2·S·fs·Σw²/(Σw)²."""
-    from scipy import signal
-
-    from ...extended_fit import windowed_dft
+    noise of the state's floor S gives there, 2·S·fs·Σw²/(Σw)².  ``need`` (len(runs), L) bool, optional: only those
+    phasors are computed, the others are NaN (the scan's unresolvable points, which it never reads)."""
+    from ...extended_fit import run_window, windowed_dft
 
     chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
-    X = np.zeros((runs.size, f_hz.shape[1], len(chans)), dtype=complex)
+    if need is None:
+        need = np.ones(f_hz.shape, dtype=bool)
+    X = np.full((runs.size, f_hz.shape[1], len(chans)), np.nan + 0j)
     for i, r in enumerate(runs):
+        if not need[i].any():
+            continue
         run = ctx.test.runs[r]
-        w = signal.get_window(RUN_WINDOW, run.n_samples)
+        w, wsum, _ = run_window(RUN_WINDOW, run.n_samples)
         f_c = h0 * ctx.omega[r] / (2 * np.pi)
+        f_i = f_hz[i][need[i]]
         x = np.column_stack([run.signals[c] for c in chans]) * w[:, None]
-        both = 2.0 * windowed_dft(x, run.sample_rate, np.concatenate([f_hz[i], [f_c]])) / np.sum(w)
-        leak = windowed_dft(w[:, None], run.sample_rate, f_hz[i] - f_c)[:, 0] / np.sum(w)       # W(f − f_c)/W(0)
-        X[i] = both[:-1] - leak[:, None] * both[-1][None, :]
+        both = 2.0 * windowed_dft(x, run.sample_rate, np.concatenate([f_i, [f_c]])) / wsum
+        leak = windowed_dft(w[:, None], run.sample_rate, f_i - f_c)[:, 0] / wsum       # W(f − f_c)/W(0)
+        X[i, need[i]] = both[:-1] - leak[:, None] * both[-1][None, :]
     return np.abs(X) ** 2, _run_noise(ctx, state, chans, runs, f_hz)
 
 
 def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
     """Mean |X|² (len(runs), L, len(chans)) that white noise of the state's floor S puts into the whole-run phasor
     at ``f_hz``: 2·S·fs·Σw²/(Σw)² (:data:`RUN_WINDOW`)."""
-    from scipy import signal
+    from ...extended_fit import run_window
 
     enbw = np.empty(runs.size)
     for i, r in enumerate(runs):
         run = ctx.test.runs[r]
-        w = signal.get_window(RUN_WINDOW, run.n_samples)
-        enbw[i] = run.sample_rate * np.sum(w**2) / np.sum(w) ** 2
+        _, wsum, w2sum = run_window(RUN_WINDOW, run.n_samples)
+        enbw[i] = run.sample_rate * w2sum / wsum ** 2
     k = np.clip(np.rint(f_hz / ctx.df).astype(int), 0, ctx.f.size - 1)
     noise = np.stack([np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1) for c in chans], axis=-1)
     return 2.0 * noise * enbw[:, None, None]
@@ -265,7 +272,12 @@ class SpeedSidebands:
         f_hz = np.outer(ctx.omega[runs] / (2 * np.pi), grid)
         key = ("speed_sidebands_scan", direction, round(h0, 6), runs.tobytes())
         if key not in ctx._memo:                # the data's line powers: the same on every step of the search
-            ctx._memo[key] = _run_line_power(ctx, state, direction, runs, f_hz, h0)[0]
+            # only where a point can be resolved on any step: in band and RUN_MIN_BINS record bins from the carrier
+            # (the state-independent part of record_resolvable_runs; the same expressions, so the same booleans)
+            w = ctx.omega[runs] / (2 * np.pi)
+            need = (np.abs(grid - h0)[None, :] * w[:, None] >= RUN_MIN_BINS * _record_df(ctx, runs)[:, None]) \
+                & (f_hz >= (ctx.k_lo + LINE_HALF) * ctx.df) & (f_hz <= (ctx.k_hi - LINE_HALF) * ctx.df)
+            ctx._memo[key] = _run_line_power(ctx, state, direction, runs, f_hz, h0, need)[0]
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         z = ctx._memo[key] / np.maximum(_run_noise(ctx, state, chans, runs, f_hz), 1e-300)   # (runs, 2G, chans)
         pos = {r: i for i, r in enumerate(runs)}
