@@ -50,6 +50,34 @@ def _window_means(f, y, grid, min_points):
     return np.where(cnt >= min_points, (inside * y[None, :]).sum(1) / np.maximum(cnt, 1), np.nan)
 
 
+def _log_bounds_and_gain_start(f0: float, y: np.ndarray):
+    """Bounds of ln(f_r, ζ, g) for a fixture resonance near ``f0`` (Hz: ±10 %, ζ 0.001-0.5, g 1.1-200) and the
+    start gain from the largest log power gain in ``y``."""
+    lb, ub = np.log([0.9 * f0, 1e-3, 1.1]), np.log([1.1 * f0, 0.5, 200.0])
+    return lb, ub, float(np.clip(np.exp(np.max(y) / 2.0), 1.2, 100.0))
+
+
+def _one_resonance(f: np.ndarray, y: np.ndarray, f0: float):
+    """(f_r Hz, ζ, g) of one resonance fitted to the log power gains ``y`` at ``f`` (Hz) near ``f0``: robust
+    (soft-L1) least squares of ln|H|², parameters in logs, best of the starts ζ ∈ {0.01, 0.03, 0.1}; None when it
+    is broader than STAND_MAX_ZETA or lifts less than half of STAND_MIN_LOG_GAIN."""
+    from scipy.optimize import least_squares
+
+    from .resonance import resonance
+
+    lb, ub, g0 = _log_bounds_and_gain_start(f0, y)
+
+    def res(x):
+        return y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2)
+
+    best = min((least_squares(res, np.clip(np.log([f0, z0, g0]), lb + 1e-9, ub - 1e-9), loss="soft_l1",
+                              f_scale=0.5, bounds=(lb, ub)) for z0 in (0.01, 0.03, 0.1)), key=lambda sol: sol.cost)
+    f_r, zeta, gain = (float(v) for v in np.exp(best.x))
+    if zeta > STAND_MAX_ZETA or gain < 1.0 + STAND_MIN_LOG_GAIN / 2:
+        return None
+    return f_r, zeta, gain
+
+
 def stand_resonance_start(fit, min_points: int = 2):
     """(f_r Hz, ζ, peak gain) of a fixture resonance seen in the empirical fit ``fit``, or None.
 
@@ -100,17 +128,9 @@ def stand_resonance_start(fit, min_points: int = 2):
     f, y, which = np.concatenate(f), np.concatenate(y), np.concatenate(which)
     n_dir = len(pts)
     lf = np.log(f / f_s)
-    lb3, ub3 = np.log([0.9 * f_s, 1e-3, 1.1]), np.log([1.1 * f_s, 0.5, 200.0])
-    g0 = float(np.clip(np.exp(np.max(y) / 2.0), 1.2, 100.0))
-
-    def pooled(x):
-        return y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2)
-
+    lb3, ub3, g0 = _log_bounds_and_gain_start(f_s, y)
     # detection: one resonance on every direction's points pooled (cheap); refused as below, nothing more is tried
-    det = min((least_squares(pooled, np.clip(np.log([f_s, z0, g0]), lb3 + 1e-9, ub3 - 1e-9), loss="soft_l1",
-                             f_scale=0.5, bounds=(lb3, ub3)) for z0 in (0.01, 0.03, 0.1)), key=lambda sol: sol.cost)
-    _, zeta_det, gain_det = (float(v) for v in np.exp(det.x))
-    if zeta_det > STAND_MAX_ZETA or gain_det < 1.0 + STAND_MIN_LOG_GAIN / 2:
+    if _one_resonance(f, y, f_s) is None:
         return None
 
     def res(x):
@@ -159,7 +179,6 @@ def stand_on_modes(efit, near_hz: float):
     (robust soft-L1 least squares of ln|H|² on the points within ±25 % of ``near_hz``, f_r free within ±10 %);
     refused by the same rules (ζ > :data:`STAND_MAX_ZETA`: a broad tilt of the modes' misfit; peak gain below
     1 + :data:`STAND_MIN_LOG_GAIN`/2)."""
-    from scipy.optimize import least_squares
 
     from .resonance import resonance
 
@@ -171,18 +190,7 @@ def stand_on_modes(efit, near_hz: float):
     y = 2.0 * r[near]
     if efit.stand is not None:
         y = y + 2.0 * np.log(np.abs(resonance(f, *efit.stand)))
-    lb, ub = np.log([0.9 * near_hz, 1e-3, 1.1]), np.log([1.1 * near_hz, 0.5, 200.0])
-    g0 = float(np.clip(np.exp(np.max(y) / 2.0), 1.2, 100.0))
-
-    def res(x):
-        return y - np.log(np.abs(resonance(f, np.exp(x[0]), np.exp(x[1]), np.exp(x[2]))) ** 2)
-
-    best = min((least_squares(res, np.clip(np.log([near_hz, z0, g0]), lb + 1e-9, ub - 1e-9), loss="soft_l1",
-                              f_scale=0.5, bounds=(lb, ub)) for z0 in (0.01, 0.03, 0.1)), key=lambda sol: sol.cost)
-    f_r, zeta, gain = (float(v) for v in np.exp(best.x))
-    if zeta > STAND_MAX_ZETA or gain < 1.0 + STAND_MIN_LOG_GAIN / 2:
-        return None
-    return f_r, zeta, gain
+    return _one_resonance(f, y, near_hz)
 
 
 def fit_extended_beside_stand(test, fit, **kwargs):
