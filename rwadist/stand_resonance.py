@@ -57,6 +57,15 @@ def _log_bounds_and_gain_start(f0: float, y: np.ndarray):
     return lb, ub, float(np.clip(np.exp(np.max(y) / 2.0), 1.2, 100.0))
 
 
+def is_fixture_resonance(zeta: float, peak_gain: float) -> bool:
+    """True when a resonance of damping ratio ``zeta`` and peak gain ``peak_gain`` (|H| at f_r) can be a fixture's:
+    at most :data:`STAND_MAX_ZETA` wide (broader is a tilt of the line gains: a wheel mode's skirt, an amplitude
+    law's growth, model error) and lifting the lines by at least 1 + :data:`STAND_MIN_LOG_GAIN`/2.  The one rule of
+    the stand's detection (:func:`stand_resonance_start`), of its refit on the modes' residual
+    (:func:`stand_on_modes`) and of ``rwadist diagnose``'s ``suspension_modes`` rounds."""
+    return bool(zeta <= STAND_MAX_ZETA and peak_gain >= 1.0 + STAND_MIN_LOG_GAIN / 2)
+
+
 def _one_resonance(f: np.ndarray, y: np.ndarray, f0: float):
     """(f_r Hz, ζ, g) of one resonance fitted to the log power gains ``y`` at ``f`` (Hz) near ``f0``: robust
     (soft-L1) least squares of ln|H|², parameters in logs, best of the starts ζ ∈ {0.01, 0.03, 0.1}; None when it
@@ -73,9 +82,7 @@ def _one_resonance(f: np.ndarray, y: np.ndarray, f0: float):
     best = min((least_squares(res, np.clip(np.log([f0, z0, g0]), lb + 1e-9, ub - 1e-9), loss="soft_l1",
                               f_scale=0.5, bounds=(lb, ub)) for z0 in (0.01, 0.03, 0.1)), key=lambda sol: sol.cost)
     f_r, zeta, gain = (float(v) for v in np.exp(best.x))
-    if zeta > STAND_MAX_ZETA or gain < 1.0 + STAND_MIN_LOG_GAIN / 2:
-        return None
-    return f_r, zeta, gain
+    return (f_r, zeta, gain) if is_fixture_resonance(zeta, gain) else None
 
 
 def stand_resonance_start(fit, min_points: int = 2):
@@ -165,9 +172,7 @@ def stand_resonance_start(fit, min_points: int = 2):
         if best is None or sol.cost < best.cost:
             best = sol
     f_r, zeta, gain = (float(v) for v in np.exp(best.x[:3]))
-    if zeta > STAND_MAX_ZETA or gain < 1.0 + STAND_MIN_LOG_GAIN / 2:
-        return None
-    return f_r, zeta, gain
+    return (f_r, zeta, gain) if is_fixture_resonance(zeta, gain) else None
 
 
 def stand_on_modes(efit, near_hz: float):
