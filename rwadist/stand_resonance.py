@@ -22,6 +22,10 @@ STAND_MIN_LOG_GAIN = float(np.log(1.5))
 STAND_MAX_ZETA = 0.2
 #: Rounds of (stand on the modes' base, modes with that stand divided out) at most.
 STAND_ROUNDS = 4
+#: Largest relative move of a located mode in the last round of the stand's refit (stand on the modes' residual,
+#: modes with that stand divided out) for the mode to count as told apart from the stand: half the 2 % a mode must
+#: be found to.  A mode still moving more is coupled to the stand beyond what its standard error (stand fixed) says.
+STAND_SETTLED_MODE = 0.01
 #: Half width of the window (relative to the frequency) in which a direction's log gains are averaged.
 STAND_WINDOW = 0.05
 
@@ -196,6 +200,34 @@ def stand_on_modes(efit, near_hz: float):
     if efit.stand is not None:
         y = y + 2.0 * np.log(np.abs(resonance(f, *efit.stand)))
     return _one_resonance(f, y, near_hz)
+
+
+def _mode_hz(params) -> dict:
+    """Mode frequencies at rest (Hz) of :class:`~rwadist.extended.ExtendedParams`, by the fit's unconstrained names."""
+    return {"radial_translation": float(np.sqrt(params.k_r / params.mass) / (2 * np.pi)),
+            "rocking": float(np.sqrt(params.k_rock / params.I_rr) / (2 * np.pi)),
+            "axial": float(np.sqrt(params.k_z / params.mass) / (2 * np.pi))}
+
+
+def declare_unsettled_modes(before, after) -> list:
+    """Declare in ``after`` (an :class:`~rwadist.extended_fit.ExtendedFit`, the last round of the stand's refit) the
+    located modes that moved more than :data:`STAND_SETTLED_MODE` from ``before`` (the round before): the stand and
+    the mode are not told apart by these data (a mode beside the stand creeps with each round while the stand has
+    settled), so the mode's frequency is not known to the 2 % its standard error claims.  Each is added to
+    ``after.unconstrained`` (``analytical.unconstrained``: every consumer warns) with a note giving both values, its
+    value kept as the last round's.  Returns the names declared."""
+    f0, f1 = _mode_hz(before.params), _mode_hz(after.params)
+    out = []
+    for m in ("radial_translation", "rocking", "axial"):
+        if m in after.unconstrained or m in before.unconstrained or abs(f1[m] / f0[m] - 1) <= STAND_SETTLED_MODE:
+            continue
+        after.unconstrained.append(m)
+        after.identified[{"axial": "axial_translation"}.get(m, m)] = False
+        after.notes.append(f"{m}: NOT CONSTRAINED beside the test stand: it moved from {f0[m]:.4g} to {f1[m]:.4g} Hz "
+                           f"in the last round of the stand's refit (more than {100 * STAND_SETTLED_MODE:g} %): the "
+                           "stand and this mode are not told apart by these data; listed in analytical.unconstrained")
+        out.append(m)
+    return out
 
 
 def fit_extended_beside_stand(test, fit, **kwargs):

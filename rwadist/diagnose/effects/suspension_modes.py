@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 # the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
-from ...stand_resonance import STAND_ROUNDS, stand_resonance_start
+from ...stand_resonance import STAND_ROUNDS, declare_unsettled_modes, stand_resonance_start
 from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
@@ -50,11 +50,18 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     # E wheel) that diagnose's shorter Welch segments cannot separate are resolved here
     sp = compute_spectra(test, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
     fit = fit_empirical(sp)
-    if not amplification_peaks(fit) and not _data_show_amplification(ctx):
+    if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
         return None
     stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
     try:
         efit = fit_extended(test, fit, stand=stand)
+        if stand is None and efit.unconstrained and len(ctx.channels) > 3:
+            # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows:
+            # kept as the start when it locates more modes than the fit without it (refined in the rounds below)
+            whole = stand_resonance_start(_whole_data_fit(ctx))
+            efit_whole = None if whole is None else fit_extended(test, fit, stand=whole)
+            if efit_whole is not None and len(efit_whole.unconstrained) < len(efit.unconstrained):
+                efit, stand = efit_whole, whole
         if stand is not None and len(efit.unconstrained) == 3:
             # the fixture resonance divided out locates no mode at all (a start pulled by a wheel mode beside it:
             # its frequency, width and gain off): the modes are located without it, and the stand is fitted on
@@ -62,6 +69,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             efit_plain = fit_extended(test, fit)
             if len(efit_plain.unconstrained) < 3:
                 efit, stand = efit_plain, None
+        before = None                   # the modes of the round before the last (with a stand divided out)
         for _ in range(STAND_ROUNDS):
             if len(efit.unconstrained) == 3 or len(ctx.channels) <= 3:
                 break
@@ -77,15 +85,17 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             if new is None or not is_fixture_resonance(new.zeta, new.peak_gain):
                 if stand is not None:           # the stand divided out is not confirmed: the fit without it
                     efit = fit_extended(test, fit)
-                    stand = None
+                    stand, before = None, None
                 break
             new = (new.f_r, new.zeta, new.peak_gain)
             settled = (stand is not None and abs(new[0] / stand[0] - 1) < 0.002
                        and abs(np.log(new[2] / stand[2])) < 0.02)
             stand = new
-            efit = fit_extended(test, fit, stand=stand)
+            before, efit = efit, fit_extended(test, fit, stand=stand)
             if settled:
                 break
+        if stand is not None and before is not None:
+            declare_unsettled_modes(before, efit)
     except ValueError:
         return None
     if len(efit.unconstrained) == 3:
@@ -93,22 +103,21 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     return test, fit, efit, stand
 
 
-def _data_show_amplification(ctx: Context) -> bool:
-    """True when the empirical fit of EVERY run shows modal amplification (:func:`rwadist.extended_fit.
-    amplification_peaks`), computed once per diagnosis.  Asked when the fit runs alone show none: the empirical
-    fit marks a line amplified only over a speed range several of its speeds cover, and half of a short speed
-    grid (10 of 20 speeds) can leave every range too thin while the data as a whole show the modes; the
-    modes are still fitted on the fit runs and judged on the held-out ones."""
+def _whole_data_fit(ctx: Context):
+    """The empirical fit of EVERY run (at the fit's own resolution, as :func:`_fit_runs`), computed once per
+    diagnosis.  What the data as a whole show, asked only when the fit runs alone do not show it: the empirical
+    fit marks a line amplified only over a speed range several of its speeds cover, and a fixture resonance is
+    detected from the lines near it, so half of a short speed grid (10 of 20 speeds) can hide both while every
+    run shows them.  A detection only: the modes (and the stand) are still fitted on the fit runs and judged on
+    the held-out ones."""
     from ...data import SteadyTest
     from ...empirical import fit_empirical
-    from ...extended_fit import amplification_peaks
     from ...spectra import compute_spectra
 
-    key = ("suspension_modes.amplification_all_runs",)
+    key = ("suspension_modes.whole_data_fit",)
     if key not in ctx._memo:
         test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], dict(ctx.test.meta))
-        sp = compute_spectra(test, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
-        ctx._memo[key] = bool(amplification_peaks(fit_empirical(sp)))
+        ctx._memo[key] = fit_empirical(compute_spectra(test, window=ctx.sp.window, f_lim=ctx.sp.f_lim))
     return ctx._memo[key]
 
 
