@@ -20,6 +20,10 @@ STAND_MIN_LOG_GAIN = float(np.log(1.5))
 #: Largest damping ratio of a proposed fixture resonance: a fixture resonance is sharp; a "resonance" as wide as
 #: the fit allows (ζ → 0.5) is a broad tilt of the line gains (a wheel mode's skirt, model error), not a stand.
 STAND_MAX_ZETA = 0.2
+#: Smallest damping ratio of a fixture resonance: the fits' lower bound is 0.001 (:func:`_log_bounds_and_gain_start`,
+#: :class:`rwadist.diagnose.effects.fixed_resonance.FixedResonance`); a fit that ends there measured no width -- a
+#: "resonance" narrower than the lines resolve, one line's misfit at one speed lifted by a gain of 20-40.
+STAND_MIN_ZETA = 0.0015
 #: Rounds of (stand on the modes' base, modes with that stand divided out) at most.
 STAND_ROUNDS = 4
 #: Largest relative move of a located mode in the last round of the stand's refit (stand on the modes' residual,
@@ -64,10 +68,11 @@ def _log_bounds_and_gain_start(f0: float, y: np.ndarray):
 def is_fixture_resonance(zeta: float, peak_gain: float) -> bool:
     """True when a resonance of damping ratio ``zeta`` and peak gain ``peak_gain`` (|H| at f_r) can be a fixture's:
     at most :data:`STAND_MAX_ZETA` wide (broader is a tilt of the line gains: a wheel mode's skirt, an amplitude
-    law's growth, model error) and lifting the lines by at least 1 + :data:`STAND_MIN_LOG_GAIN`/2.  The one rule of
+    law's growth, model error), at least :data:`STAND_MIN_ZETA` (narrower is no measured width) and lifting the lines
+    by at least 1 + :data:`STAND_MIN_LOG_GAIN`/2.  The one rule of
     the stand's detection (:func:`stand_resonance_start`), of its refit on the modes' residual
     (:func:`stand_on_modes`) and of ``rwadist diagnose``'s ``suspension_modes`` rounds."""
-    return bool(zeta <= STAND_MAX_ZETA and peak_gain >= 1.0 + STAND_MIN_LOG_GAIN / 2)
+    return bool(STAND_MIN_ZETA <= zeta <= STAND_MAX_ZETA and peak_gain >= 1.0 + STAND_MIN_LOG_GAIN / 2)
 
 
 def _one_resonance(f: np.ndarray, y: np.ndarray, f0: float):

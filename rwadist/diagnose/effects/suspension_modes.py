@@ -46,29 +46,24 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
+    offset = None                       # a load-cell offset r (m) removed from the torques to locate the modes
     # the fit's own resolution (the longest segment, as ``rwadist fit``): close lines (h = 5.37, 5.57 of the
     # E wheel) that diagnose's shorter Welch segments cannot separate are resolved here
     sp = compute_spectra(test, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
     fit = fit_empirical(sp)
     if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
         return None
-    stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
     try:
-        efit = fit_extended(test, fit, stand=stand)
-        if stand is None and efit.unconstrained and len(ctx.channels) > 3:
-            # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows:
-            # kept as the start when it locates more modes than the fit without it (refined in the rounds below)
-            whole = stand_resonance_start(_whole_data_fit(ctx))
-            efit_whole = None if whole is None else fit_extended(test, fit, stand=whole)
-            if efit_whole is not None and len(efit_whole.unconstrained) < len(efit.unconstrained):
-                efit, stand = efit_whole, whole
-        if stand is not None and len(efit.unconstrained) == 3:
-            # the fixture resonance divided out locates no mode at all (a start pulled by a wheel mode beside it:
-            # its frequency, width and gain off): the modes are located without it, and the stand is fitted on
-            # their base below, as when none was proposed
-            efit_plain = fit_extended(test, fit)
-            if len(efit_plain.unconstrained) < 3:
-                efit, stand = efit_plain, None
+        efit, stand = _locate(ctx, test, fit, stand_start)
+        if (efit.unconstrained or stand is not None) and len(ctx.channels) == 6:
+            # a load-cell offset (T_measured = T + r × F) puts the forces' lines, amplified by the translation mode,
+            # into the torques (where they also pass for a fixture resonance lifting every direction at that mode):
+            # the modes are located on the torques corrected for it when that locates more of them (the offset
+            # itself is left to the search: a ``cross_coupling`` on the modes' base)
+            got = _beside_offset(ctx, SuspensionModes.from_fit(efit, fit, len(runs)).apply(state), runs, test,
+                                 stand_start, len(efit.unconstrained))
+            if got is not None:
+                test, fit, efit, stand, offset = got
         before = None                   # the modes of the round before the last (with a stand divided out)
         for _ in range(STAND_ROUNDS):
             if len(efit.unconstrained) == 3 or len(ctx.channels) <= 3:
@@ -78,6 +73,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
 
             # the stand on the modes' base: the lines are predicted without it, so this is the whole stand
             st = SuspensionModes.from_fit(efit, fit, len(runs)).apply(state)
+            st.coupling = offset                # the torque data read corrected, as the modes were located
             new = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), None if stand is None else stand[0],
                                      role="test_stand")
             # the rule of the stand's own detection: a broad "resonance" (an amplitude law's growth, a mode's skirt
@@ -101,6 +97,72 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     if len(efit.unconstrained) == 3:
         return None                     # no mode located: nothing to name
     return test, fit, efit, stand
+
+
+#: Standard errors a load-cell offset must lie from 0 (in its largest component) to be removed from the
+#: torques before the modes are located (:func:`_beside_offset`)
+OFFSET_Z = 4.0
+
+
+def _locate(ctx: Context, test, fit, stand_start):
+    """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``) before the stand's rounds: with the stand ``stand_start``
+    or the one the fit (else the whole data, :func:`_whole_data_fit`) proposes divided out, or without one when the
+    stand divided out locates no mode (see :func:`_fit_runs`)."""
+    from ...extended_fit import fit_extended
+
+    stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
+    efit = fit_extended(test, fit, stand=stand)
+    if stand is None and efit.unconstrained and len(ctx.channels) > 3:
+        # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows:
+        # kept as the start when it locates more modes than the fit without it (refined in the rounds below)
+        whole = stand_resonance_start(_whole_data_fit(ctx))
+        efit_whole = None if whole is None else fit_extended(test, fit, stand=whole)
+        if efit_whole is not None and len(efit_whole.unconstrained) < len(efit.unconstrained):
+            efit, stand = efit_whole, whole
+    if stand is not None and len(efit.unconstrained) == 3:
+        # the fixture resonance divided out locates no mode at all (a start pulled by a wheel mode beside it:
+        # its frequency, width and gain off): the modes are located without it, and the stand is fitted on
+        # their base below, as when none was proposed
+        efit_plain = fit_extended(test, fit)
+        if len(efit_plain.unconstrained) < 3:
+            efit, stand = efit_plain, None
+    return efit, stand
+
+
+def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_unconstrained: int):
+    """(test, fit, efit, stand, r) of the modes located (:func:`_locate`) on the torques of ``test`` corrected for a
+    load-cell offset r (m: the ``cross_coupling`` fit of ``runs`` on ``state``, the extended base of the uncorrected
+    data: its torque lines, the wheel's own, weigh the equations at their frequencies down; T − r × F), or None when no component
+    of r stands :data:`OFFSET_Z` standard errors from 0 or the corrected data do not locate more modes than the
+    ``n_unconstrained`` left unconstrained without the correction.  A note of the fit says the offset was removed."""
+    from dataclasses import replace
+
+    from ...data import SteadyTest
+    from ...empirical import fit_empirical
+    from ...spectra import compute_spectra
+    from ..constants import TORQUE_CHANNELS
+    from .cross_coupling import CrossCoupling
+
+    cc = CrossCoupling.fit(ctx, state, np.asarray(runs))
+    if cc is None or not np.any(np.abs(cc.r) > OFFSET_Z * np.maximum(cc.r_stderr, 1e-300)):
+        return None
+    r = np.asarray(cc.r, dtype=float)
+    corrected = []
+    for run in test.runs:
+        F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
+        T = np.cross(r[None, :], F)
+        corrected.append(replace(run, signals={**run.signals, **{k: run.signals[k] - T[:, j]
+                                                                 for j, k in enumerate(TORQUE_CHANNELS)
+                                                                 if k in run.signals}}))
+    test_c = SteadyTest(corrected, dict(test.meta))
+    fit_c = fit_empirical(compute_spectra(test_c, window=ctx.sp.window, f_lim=ctx.sp.f_lim))
+    efit_c, stand_c = _locate(ctx, test_c, fit_c, stand_start)
+    if len(efit_c.unconstrained) >= n_unconstrained:
+        return None
+    efit_c.notes.append("load-cell offset: r = (%s) mm removed from the torques (T − r × F) before the modes were "
+                        "located; not part of the wheel's model (diagnose names it as cross_coupling)"
+                        % ", ".join(f"{1000 * v:.1f}" for v in r))
+    return test_c, fit_c, efit_c, stand_c, tuple(float(v) for v in r)
 
 
 def _whole_data_fit(ctx: Context):
