@@ -16,7 +16,10 @@ harmonic takes part and the fit is a least-squares problem:
    mode.  The scan also gives the damping start and, without mass and radius, a.  A mode whose
    scan has an interior best point is *located*; it is *found* when the least squares below pins
    its frequency (1.5 standard errors within ``tolerance``, 2 %, and not at the ±5 % search
-   limit); otherwise it is declared not constrained and the least squares is repeated without it.
+   limit); otherwise it is declared not constrained and the least squares is repeated without it --
+   unless one line of another law than C·Ω² (an amplitude law on one harmonic) is what drags it off:
+   that line then gets an exponent of its own in the fit (:func:`rwadist.off_law_lines.off_law_line`, said
+   in the notes) and stays C·Ω² in the model, for ``rwadist diagnose`` to name.
 3. **Least squares** of log amplitude over every measured line at every speed
    (amplified or not): stiffnesses, damping of each mode and the forcing
    coefficient of each line (U_s and U_d are the h = 1 radial force and torque
@@ -45,6 +48,7 @@ from .data import SteadyTest
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
+from .off_law_lines import MAX_OFF_LAW_LINES, off_law_line
 from .spectra import compute_spectra, welch_dof
 from .units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
 
@@ -75,7 +79,8 @@ class ExtendedFit:
     per_unit : True when mass/radius were not given (M = 1 kg, I_rr = 1 kg·m²).
     stand : the fixture resonance (f_r Hz, ζ, peak gain) divided out of every line before the fit, or None.
     line_residuals : (f Hz, r) of every measurement the least squares used: f = h|Ω|/2π the line's frequency
-        and r = ln(measured / model amplitude) (radial lines: of sqrt(x² + y²)), the stand divided out.
+        and r = ln(measured / model amplitude) (radial lines: of sqrt(x² + y²)), the stand divided out (and a
+        line whose exponent the fit freed, :func:`rwadist.off_law_lines.off_law_line`, taken with its own growth).
     """
 
     params: ext.ExtendedParams
@@ -240,40 +245,6 @@ def mode_frequencies(peaks: list, senses: dict, inertia_ratio: float) -> dict:
 
 
 # --------------------------------------------------------------------------- 3. least squares
-
-#: Lines of a law other than C·Ω² whose exponent the least squares may free before a mode is declared not
-#: constrained (:func:`_off_law_line`): one such line (an amplitude law, a foreign load) is what drags a mode to the
-#: ±5 % limit while every other line places it.
-MAX_OFF_LAW_LINES = 2
-#: A line is off its C·Ω² law when the trend of its log residual in ln|Ω| (its exponent shift) lies at least this
-#: many standard errors from 0 ...
-OFF_LAW_Z = 4.0
-#: ... and is at least this large (the accuracy asked of a fitted exponent, as diagnose's ``amplitude_law``).
-OFF_LAW_MIN_SHIFT = 0.05
-
-
-def _off_law_line(r: np.ndarray, row_line: np.ndarray, log_w: np.ndarray, skip) -> int | None:
-    """The measured line whose log residuals ``r`` (one per row; ``row_line`` its line, ``log_w`` ln|Ω|) trend
-    most in ln|Ω| -- the line least like C·Ω² through the fitted modes -- or None when no line (outside ``skip``)
-    has a trend of at least :data:`OFF_LAW_MIN_SHIFT` and :data:`OFF_LAW_Z` standard errors.  Ranked by the RMS
-    of the trend itself (|b|·std ln|Ω|): the misfit an exponent of its own would take away."""
-    best, best_rms = None, 0.0
-    for j in np.unique(row_line):
-        m = row_line == j
-        if int(j) in skip or m.sum() < 5:
-            continue
-        L = log_w[m] - log_w[m].mean()
-        sxx = float(L @ L)
-        if sxx <= 0:
-            continue
-        b = float(L @ r[m]) / sxx
-        e = r[m] - r[m].mean() - b * L
-        se = math.sqrt(float(e @ e) / max(int(m.sum()) - 2, 1) / sxx)
-        trend_rms = abs(b) * math.sqrt(sxx / m.sum())
-        if abs(b) >= OFF_LAW_MIN_SHIFT and abs(b) >= OFF_LAW_Z * se and trend_rms > best_rms:
-            best, best_rms = int(j), trend_rms
-    return best
-
 
 _MODE_PARAMS = {"radial_translation": ("k_r", "c_r", "mass"), "rocking": ("k_rock", "c_rock", "I_rr"),
                 "axial_translation": ("k_z", "c_z", "mass")}
@@ -549,7 +520,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
 
     def least_squares(free_modes, off_law=()):
         """Log-amplitude least squares with the stiffness and damping of ``free_modes`` free, and an exponent of
-        their own for the measured lines ``off_law`` (indices into ``meas.lines``, :func:`_off_law_line`)."""
+        their own for the measured lines ``off_law`` (indices into ``meas.lines``,
+        :func:`rwadist.off_law_lines.off_law_line`)."""
         names = [p for m in free_modes for p in _MODE_PARAMS[m][:2]] + \
                 [f"C[{ln.direction},{ln.h:g},{ln.sense}]" for ln in lines] + \
                 [f"p-2[{meas.lines[j].direction},{meas.lines[j].h:g}]" for j in off_law]
@@ -652,7 +624,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         # exponent of its own (it then informs the modes only through its shape across them) when doing so pins
         # more modes; the line stays C·Ω² in the model, named in the notes (diagnose names its law)
         while loose and len(off_law) < MAX_OFF_LAW_LINES:
-            j = _off_law_line(res.fun, row_line, log_w, off_law)
+            j = off_law_line(res.fun, row_line, log_w, off_law)
             if j is None:
                 break
             trial = least_squares(free_modes, off_law + [j])

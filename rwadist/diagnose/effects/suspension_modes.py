@@ -105,9 +105,9 @@ OFFSET_Z = 4.0
 
 
 def _locate(ctx: Context, test, fit, stand_start):
-    """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``) before the stand's rounds: with the stand ``stand_start``
-    or the one the fit (else the whole data, :func:`_whole_data_fit`) proposes divided out, or without one when the
-    stand divided out locates no mode (see :func:`_fit_runs`)."""
+    """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``) before the stand's rounds: with the stand
+    ``stand_start`` or the one the fit (else the whole data, :func:`_whole_data_fit`) proposes divided out, or
+    without one when the stand divided out locates no mode (see :func:`_fit_runs`)."""
     from ...extended_fit import fit_extended
 
     stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
@@ -131,9 +131,9 @@ def _locate(ctx: Context, test, fit, stand_start):
 
 def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_unconstrained: int):
     """(test, fit, efit, stand, r) of the modes located (:func:`_locate`) on the torques of ``test`` corrected for a
-    load-cell offset r (m: the ``cross_coupling`` fit of ``runs`` on ``state``, the extended base of the uncorrected
-    data: its torque lines, the wheel's own, weigh the equations at their frequencies down; T − r × F), or None when no component
-    of r stands :data:`OFFSET_Z` standard errors from 0 or the corrected data do not locate more modes than the
+    load-cell offset r (m: the ``cross_coupling`` fit of ``runs`` on ``state``, the extended base of the
+    uncorrected data: its torque lines, the wheel's own, weigh the equations at their frequencies down; T − r × F),
+    or None when no component of r stands :data:`OFFSET_Z` standard errors from 0 or the corrected data do not locate more modes than the
     ``n_unconstrained`` left unconstrained without the correction.  A note of the fit says the offset was removed."""
     from dataclasses import replace
 
