@@ -16,10 +16,8 @@ harmonic takes part and the fit is a least-squares problem:
    mode.  The scan also gives the damping start and, without mass and radius, a.  A mode whose
    scan has an interior best point is *located*; it is *found* when the least squares below pins
    its frequency (1.5 standard errors within ``tolerance``, 2 %, and not at the ±5 % search
-   limit); otherwise it is declared not constrained and the least squares is repeated without it --
-   unless one line of another law than C·Ω² (an amplitude law on one harmonic) is what drags it off:
-   that line then gets an exponent of its own in the fit (:func:`rwadist.off_law_lines.off_law_line`, said
-   in the notes) and stays C·Ω² in the model, for ``rwadist diagnose`` to name.
+   limit); otherwise it is declared not constrained and the least squares is repeated without it,
+   unless one line of another law than C·Ω² drags it off (:mod:`rwadist.off_law_lines`).
 3. **Least squares** of log amplitude over every measured line at every speed
    (amplified or not): stiffnesses, damping of each mode and the forcing
    coefficient of each line (U_s and U_d are the h = 1 radial force and torque
@@ -48,7 +46,7 @@ from .data import SteadyTest
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
-from .off_law_lines import MAX_OFF_LAW_LINES, off_law_line
+from .off_law_lines import free_off_law_lines, line_regressors, off_law_note
 from .spectra import compute_spectra, welch_dof
 from .units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
 
@@ -510,13 +508,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     power = LinePower(lines, sa, ax_line, ca, sr, rad_parts)
     log_data = np.concatenate([np.log(np.maximum(aa, 1e-300)), 0.5 * np.log(np.maximum(pr, 1e-300))])
 
-    # per row (measurement): its measured line and ln|Ω| centred on that line's mean, the regressor of a line
-    # whose exponent is freed (r -= δ·L: amplitude ∝ C·Ω²·(|Ω|/Ω_line)^δ)
-    row_line = np.concatenate([la, lr]).astype(int)
-    log_w = np.log(np.maximum(np.abs(np.concatenate([sa, sr])), 1e-300))
-    centred_log_w = log_w.copy()
-    for j in np.unique(row_line):
-        centred_log_w[row_line == j] -= log_w[row_line == j].mean()
+    row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
 
     def least_squares(free_modes, off_law=()):
         """Log-amplitude least squares with the stiffness and damping of ``free_modes`` free, and an exponent of
@@ -615,24 +607,11 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         return loose
 
     free_modes = [m for m in _MODE_PARAMS if identified[m]]
-    off_law = []
+    off_law = []            # lines given an exponent of their own before a mode is declared (appended in place)
     while True:
-        res, names, rel_se, unpack, at_bound = least_squares(free_modes, off_law)
-        loose = loose_modes(res, rel_se, at_bound, free_modes)
-        # before a located mode is declared not constrained: is it one line of another law (an amplitude law on one
-        # harmonic, Ω³ where the model says Ω²) that drags it off while the other lines place it?  That line gets an
-        # exponent of its own (it then informs the modes only through its shape across them) when doing so pins
-        # more modes; the line stays C·Ω² in the model, named in the notes (diagnose names its law)
-        while loose and len(off_law) < MAX_OFF_LAW_LINES:
-            j = off_law_line(res.fun, row_line, log_w, off_law)
-            if j is None:
-                break
-            trial = least_squares(free_modes, off_law + [j])
-            trial_loose = loose_modes(trial[0], trial[2], trial[4], free_modes)
-            if len(trial_loose) >= len(loose):
-                break
-            off_law.append(j)
-            (res, names, rel_se, unpack, at_bound), loose = trial, trial_loose
+        (res, names, rel_se, unpack, at_bound), loose = free_off_law_lines(
+            lambda lns: least_squares(free_modes, lns), lambda t: loose_modes(t[0], t[2], t[4], free_modes),
+            off_law, row_line, log_w)
         if not loose:
             break
         for m, why in loose:
@@ -645,13 +624,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
             base[cn] = 2 * zeta0 * math.sqrt(base[kn] * base[inertia])
             free_modes.remove(m)
     params, fitted_lines = unpack(res.x)
-    n_fixed = res.x.size - len(off_law)
-    for i, j in enumerate(off_law):
-        x = meas.lines[j]
-        notes.append(f"{x.direction} h={x.h:.4g}: its amplitude grows as |Ω|^{2 + res.x[n_fixed + i]:.3g} "
-                     f"(±{rel_se[n_fixed + i]:.2g}), not as C·Ω² through the modes: its exponent was left free in the "
-                     "fit so that it does not pull the modes off; the model keeps the line as C·Ω² (a law the "
-                     "wheel's modes do not explain: `rwadist diagnose` names it)")
+    notes += [off_law_note(meas.lines[j], res.x[i - len(off_law)], rel_se[i - len(off_law)])
+              for i, j in enumerate(off_law)]
     params = replace(params, height=float(height))
     rel_stderr = {n: float(v) for n, v in zip(names, rel_se)}
     zeta = {"radial_translation": params.zeta_r, "rocking": params.zeta_rock, "axial_translation": params.zeta_z}

@@ -44,3 +44,46 @@ def off_law_line(r: np.ndarray, row_line: np.ndarray, log_w: np.ndarray, skip) -
         if abs(b) >= OFF_LAW_MIN_SHIFT and abs(b) >= OFF_LAW_Z * se and trend_rms > best_rms:
             best, best_rms = int(j), trend_rms
     return best
+
+
+def line_regressors(ax_line: np.ndarray, rad_line: np.ndarray, ax_omega: np.ndarray, rad_omega: np.ndarray):
+    """(row_line, log_w, centred) per least-squares row (the axial rows, then the radial ones): the measured line
+    (index), ln|Ω| and ln|Ω| less its mean over that line's rows, the regressor L of a freed exponent (residual
+    r −= δ·L: amplitude ∝ C·Ω²·(|Ω|/Ω_line)^δ, δ = p − 2, uncorrelated with the line's C).  Arrays (n_rows,)."""
+    row_line = np.concatenate([ax_line, rad_line]).astype(int)
+    log_w = np.log(np.maximum(np.abs(np.concatenate([ax_omega, rad_omega])), 1e-300))
+    centred = log_w.copy()
+    for j in np.unique(row_line):
+        centred[row_line == j] -= log_w[row_line == j].mean()
+    return row_line, log_w, centred
+
+
+def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, log_w: np.ndarray):
+    """(fit, loose) of the least squares ``fit_with(off_law)`` (a tuple whose first item is the scipy result) with
+    ``loose_of(fit)`` its modes not pinned; while some are and fewer than :data:`MAX_OFF_LAW_LINES` lines are freed,
+    the line :func:`off_law_line` picks is freed when that pins more modes (``off_law`` is appended in place).
+
+    Before a located mode is declared not constrained: is it one line of another law (an amplitude law on one
+    harmonic, Ω³ where the model says Ω²) that drags it off while the other lines place it?  That line then informs
+    the modes only through its shape across them; it stays C·Ω² in the model, said in the notes
+    (:func:`off_law_note`), for ``rwadist diagnose`` to name its law."""
+    fit = fit_with(off_law)
+    loose = loose_of(fit)
+    while loose and len(off_law) < MAX_OFF_LAW_LINES:
+        j = off_law_line(fit[0].fun, row_line, log_w, off_law)
+        if j is None:
+            break
+        trial = fit_with(off_law + [j])
+        trial_loose = loose_of(trial)
+        if len(trial_loose) >= len(loose):
+            break
+        off_law.append(j)
+        fit, loose = trial, trial_loose
+    return fit, loose
+
+
+def off_law_note(line, shift: float, stderr: float) -> str:
+    """The fit's note on a freed line (an empirical line: ``direction``, ``h``) of exponent 2 + ``shift`` (± ``stderr``)."""
+    return (f"{line.direction} h={line.h:.4g}: its amplitude grows as |Ω|^{2 + shift:.3g} (±{stderr:.2g}), not as "
+            "C·Ω² through the modes: its exponent was left free in the fit so that it does not pull the modes off; "
+            "the model keeps the line as C·Ω² (a law the wheel's modes do not explain: `rwadist diagnose` names it)")
