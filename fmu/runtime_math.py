@@ -60,7 +60,7 @@ def load_kernel(path):
 
 def frame12(o, R, r):
     """[wheel-frame 6] + [spacecraft-frame 6] as a list of floats (R 3×3 nested, r 3)."""
-    f0, f1, f2, t0, t1, t2 = (float(v) for v in o)
+    f0, f1, f2, t0, t1, t2 = o.tolist() if isinstance(o, np.ndarray) else (float(v) for v in o)
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R
     rx, ry, rz = r
     fx = r00 * f0 + r01 * f1 + r02 * f2

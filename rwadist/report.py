@@ -36,6 +36,8 @@ from .units import (
 
 _UNIT_LABEL = {"N": "N", "Nm": "N·m"}
 _DPI = 110
+#: zlib level of the report's PNG files (0-9; PIL's default 6 takes twice the CPU for ~7 % smaller files)
+PNG_COMPRESS_LEVEL = 3
 # drawing order: model markers and curves under the measured data, so the data stay readable
 MODEL_ZORDER = 2.0
 DATA_ZORDER = 3.0
@@ -64,7 +66,11 @@ def _new_figure(figsize) -> Figure:
 def _save(fig: Figure, path: Path) -> Path:
     # no fig.clear() afterwards: the figure is dropped by the caller, and clearing it rebuilt every
     # axis's ticks only to throw them away (~10 % of write_report's CPU, same PNG bytes without it)
-    fig.savefig(path, dpi=_DPI)
+    # One draw: Figure.draw runs the constrained layout, then renders (savefig on a figure with a layout
+    # engine draws it twice: a draw-disabled pass for the layout, then the real draw; same PNG bytes
+    # without it).  zlib level 3 instead of PIL's 6: the same pixels, half the encoding time, ~7 % larger files.
+    fig.set_dpi(_DPI)
+    fig.canvas.print_png(path, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
     return path
 
 
