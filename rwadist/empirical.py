@@ -130,6 +130,9 @@ class EmpiricalFit:
     lines: list
     bins: list
     settings: dict = field(default_factory=dict)
+    #: per channel (block floor, detected lines) and the detection settings they were made with: a second fit of
+    #: the same spectra (``reuse`` of :func:`fit_empirical`) takes them instead of computing them again
+    detections: dict = field(default_factory=dict, repr=False, compare=False)
 
 
 @dataclass
@@ -483,11 +486,14 @@ def fit_direction(spectra: Spectra, direction: str, s: FitSettings, floors: dict
 
 
 def fit_empirical(spectra: Spectra, settings: FitSettings | None = None, directions=None,
-                  name: str = "fitted wheel", progress: bool = False) -> EmpiricalFit:
+                  name: str = "fitted wheel", progress: bool = False, reuse: EmpiricalFit | None = None) -> EmpiricalFit:
     """Fit the empirical model to the spectra of a steady-state test.
 
     Runs at zero speed (noise runs) are not used.  Returns an
-    :class:`EmpiricalFit` whose ``model`` goes to the model file.
+    :class:`EmpiricalFit` whose ``model`` goes to the model file.  ``reuse``: an earlier fit of the same
+    ``spectra`` (the same object): its block floors and detected lines, which depend only on the spectra and on
+    ``p_false``, ``f_min_bins`` and ``sidelobe_db``, are taken when those settings are the same (e.g. the extended
+    fit's second pass without modal exclusion).
     """
     s = settings or FitSettings()
     directions = tuple(directions) if directions is not None else DIRECTIONS
@@ -504,13 +510,18 @@ def fit_empirical(spectra: Spectra, settings: FitSettings | None = None, directi
     floors, detected = {}, {}
     channels = [c for c in spectra.channels if any(c in DIRECTION_CHANNELS[d] for d in directions)]
     bar = tqdm(total=len(channels) + len(directions), desc="rwadist fit", disable=not progress, unit="step")
+    key = (s.p_false, s.f_min_bins, s.sidelobe_db)
+    known = reuse.detections if reuse is not None and reuse.spectra is spectra else {}
     for c in channels:
-        psd = spectra.psd[c]
-        fl = np.full_like(psd, np.nan)
-        ok = spectra.available(c)
-        fl[ok] = block_floor(psd[ok], dof=dof)
-        floors[c] = fl
-        detected[c] = detect_lines(psd, f, fl, threshold, f_lo, f_hi, s.sidelobe_db)
+        if c in known and known[c][0] == key:
+            floors[c], detected[c] = known[c][1:]
+        else:
+            psd = spectra.psd[c]
+            fl = np.full_like(psd, np.nan)
+            ok = spectra.available(c)
+            fl[ok] = block_floor(psd[ok], dof=dof)
+            floors[c] = fl
+            detected[c] = detect_lines(psd, f, fl, threshold, f_lo, f_hi, s.sidelobe_db)
         bar.update()
     model = WheelModel(name=name)
     lines, bins = [], []
@@ -533,4 +544,5 @@ def fit_empirical(spectra: Spectra, settings: FitSettings | None = None, directi
     settings_doc = {k: getattr(s, k) for k in s.__dataclass_fields__}
     settings_doc["detection_threshold"] = threshold
     settings_doc["dof"] = dof
-    return EmpiricalFit(model=model, spectra=spectra, lines=lines, bins=bins, settings=settings_doc)
+    return EmpiricalFit(model=model, spectra=spectra, lines=lines, bins=bins, settings=settings_doc,
+                        detections={c: (key, floors[c], detected[c]) for c in channels})

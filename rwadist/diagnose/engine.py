@@ -18,6 +18,9 @@ from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, TORQUE_CHA
 from .metric import Metric
 from .state import State
 
+#: Samples (runs × record length × channels) :meth:`Context.phasors` transforms together: a few tens of MB.
+PHASOR_CHUNK_SAMPLES = 1 << 21
+
 # --------------------------------------------------------------------------- line kernel
 
 def line_kernel(nperseg: int, fs: float, window: str = "hann", half: int = KERNEL_HALF, oversample: int = 64):
@@ -102,36 +105,50 @@ class Context(Metric):
 
     def phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> np.ndarray:
         """Complex amplitudes (len(runs), L, 6) of every channel at frequencies ``f_hz`` (len(runs), L), Hz:
-        X = 2·Σ w x e^{−2πj f t}/Σ w over the whole run (Hann window), so x(t) ≈ Re(X e^{2πj f t});
-        NaN for a channel the run lacks."""
-        from ..extended_fit import windowed_dft
+        X = 2·Σ w x e^{−2πj f t}/Σ w over the whole run (the spectra's window), so x(t) ≈ Re(X e^{2πj f t});
+        NaN for a channel the run lacks.  The runs of one record length and channel set are transformed together
+        (:func:`rwadist.dft.windowed_dfts`, chunks of :data:`PHASOR_CHUNK_SAMPLES` samples; the windowed signals
+        are not kept: a long test's would double its memory)."""
+        from ..dft import run_window, windowed_dfts
 
         f_hz = np.asarray(f_hz, dtype=float)
         key = ("phasors", runs.tobytes(), f_hz.tobytes(), f_hz.shape)
         if key in self._memo:                             # the same lines are asked for at every search step
             return self._memo[key].copy()
         out = np.full((runs.size, f_hz.shape[1], len(CHANNELS)), np.nan + 0j)
-        for i, r in enumerate(runs):                      # one blocked DFT per run
-            have, x, wsum = self._windowed_run(int(r))
-            out[i][:, have] = 2.0 * windowed_dft(x, self.test.runs[r].sample_rate, f_hz[i]) / wsum
+        groups = {}
+        for i, r in enumerate(runs):
+            run = self.test.runs[r]
+            have = tuple(j for j, c in enumerate(CHANNELS) if c in run.signals)
+            groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
+        for (n, fs, have), rows_all in groups.items():
+            w, wsum, _ = run_window(self.sp.window, n)
+            step = max(1, PHASOR_CHUNK_SAMPLES // (n * max(len(have), 1)))
+            for s in range(0, len(rows_all), step):
+                rows = np.asarray(rows_all[s:s + step])
+                x = np.stack([np.column_stack([self.test.runs[runs[i]].signals[CHANNELS[j]] for j in have])
+                              for i in rows]) * w[None, :, None]
+                out[rows[:, None], :, np.asarray(have)[None, :]] = \
+                    (2.0 * windowed_dfts(x, fs, f_hz[rows]) / wsum).transpose(0, 2, 1)
         self._memo[key] = out
         return out.copy()
 
-    def _windowed_run(self, r: int):
-        """(channel indices the run has, its signals (n_samples, K) times the whole-run window, Σ window) of run
-        ``r``; the window is computed once per record length (the windowed signals are not kept: a long test's
-        would double its memory)."""
-        from scipy import signal
-
-        run = self.test.runs[r]
-        wkey = ("window", run.n_samples)
-        if wkey not in self._memo:
-            w = signal.get_window(self.sp.window, run.n_samples)
-            self._memo[wkey] = (w, float(np.sum(w)))
-        w, wsum = self._memo[wkey]
-        have = [j for j, c in enumerate(CHANNELS) if c in run.signals]
-        x = np.column_stack([run.signals[CHANNELS[j]] for j in have]) * w[:, None]
-        return have, x, wsum
+    def prefetch_phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> None:
+        """:meth:`phasors` of every column of ``f_hz`` (len(runs), L) Hz computed in one pass over the records and
+        kept as if each column had been asked for alone (``f_hz[:, j:j + 1]``): a family that measures its lines one
+        at a time reads them without transforming every record again per line."""
+        f_hz = np.asarray(f_hz, dtype=float)
+        todo = [j for j in range(f_hz.shape[1])
+                if ("phasors", runs.tobytes(), np.ascontiguousarray(f_hz[:, j:j + 1]).tobytes(), (runs.size, 1))
+                not in self._memo]
+        if not todo:
+            return
+        cols = np.ascontiguousarray(f_hz[:, todo])
+        X = self.phasors(runs, cols)
+        del self._memo[("phasors", runs.tobytes(), cols.tobytes(), cols.shape)]   # kept per column only
+        for i, j in enumerate(todo):
+            col = np.ascontiguousarray(f_hz[:, j:j + 1])
+            self._memo[("phasors", runs.tobytes(), col.tobytes(), col.shape)] = X[:, i:i + 1].copy()
 
     def data_floor(self, state: State, c: str) -> np.ndarray:
         """Block floor (n_runs, n_f) of channel ``c`` as the state reads its data (:meth:`data`): a torque

@@ -23,6 +23,36 @@ from ..state import State
 from .base import register, schema_entry
 
 
+def _fit_spectra(ctx: Context, test, runs: list):
+    """The spectra of ``test`` (the context's runs ``runs``) at the fit's own resolution, as ``rwadist fit`` computes
+    them (:func:`rwadist.spectra.compute_spectra`'s default segment: the longest): close lines (h = 5.37, 5.57 of the
+    E wheel) that diagnose's shorter Welch segments cannot separate are resolved here.
+
+    A run's Welch PSD is its own: those of every run of the context are computed once (kept on the context) and
+    the rows of ``runs`` taken, so the fit on the fit runs and the refit on every run share them; computed on
+    ``test`` alone when the context's runs cannot be (a run shorter than the segment outside ``runs``)."""
+    from dataclasses import replace
+
+    from ...data import DataError
+    from ...spectra import _default_nperseg, compute_spectra
+
+    nperseg = _default_nperseg(int(np.median([r.n_samples for r in test.runs])))
+    key = ("suspension_modes.spectra", nperseg)
+    if key not in ctx._memo:
+        try:
+            ctx._memo[key] = compute_spectra(ctx.test, nperseg=nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
+        except DataError:
+            ctx._memo[key] = None
+    full = ctx._memo[key]
+    if full is None:
+        return compute_spectra(test, nperseg=nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
+    rows = np.asarray(runs, dtype=int)
+    chans = test.channels
+    return replace(full, speed=full.speed[rows], psd={c: full.psd[c][rows] for c in chans},
+                   amplitude={c: full.amplitude[c][rows] for c in chans}, n_segments=full.n_segments[rows],
+                   run_names=[full.run_names[r] for r in rows])
+
+
 def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None):
     """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
     amplification (or the extended fit fails); ``stand`` is the fixture resonance (f_r Hz, ζ, peak gain)
@@ -41,14 +71,10 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     from ...data import SteadyTest
     from ...empirical import fit_empirical
     from ...extended_fit import amplification_peaks, fit_extended
-    from ...spectra import compute_spectra
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
-    # the fit's own resolution (the longest segment, as ``rwadist fit``): close lines (h = 5.37, 5.57 of the
-    # E wheel) that diagnose's shorter Welch segments cannot separate are resolved here
-    sp = compute_spectra(test, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
-    fit = fit_empirical(sp)
+    fit = fit_empirical(_fit_spectra(ctx, test, runs))
     if not amplification_peaks(fit):
         return None
     stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
