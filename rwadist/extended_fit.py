@@ -395,7 +395,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         fit = fit_empirical(spectra, settings)
     # every line the data show, with every measurement: the empirical fit without modal
     # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped)
-    meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False), reuse=fit)
+    meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False),
+                         detections=fit.detections)
     if stand is not None:
         from .resonance import resonance
 

@@ -7,7 +7,7 @@ import numpy as np
 from scipy import optimize, signal
 
 from rwadist.dft import hann_transform, windowed_dfts
-from rwadist.empirical import fit_empirical
+from rwadist.empirical import fit_empirical, line_detections
 from rwadist.mode_scan import _grid_search, transmissibility_sq
 from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
@@ -93,12 +93,12 @@ def test_second_empirical_fit_reusing_the_detections_is_a_fresh_fit():
     sp = compute_spectra(_small_test())
     first = fit_empirical(sp)
     s = replace(FitSettings(), exclude_modes=False)
-    fresh, reused = fit_empirical(sp, s), fit_empirical(sp, s, reuse=first)
+    fresh, reused = fit_empirical(sp, s), fit_empirical(sp, s, detections=first.detections)
     assert [(x.direction, x.h, x.C) for x in fresh.lines] == [(x.direction, x.h, x.C) for x in reused.lines]
     for a, b in zip(fresh.lines, reused.lines):
         np.testing.assert_array_equal(a.amplitude, b.amplitude)
     # other detection settings: not reused (a lower false-alarm probability detects fewer lines)
-    strict = fit_empirical(sp, replace(s, p_false=1e-6), reuse=first)
+    strict = fit_empirical(sp, replace(s, p_false=1e-6), detections=first.detections)
     assert strict.detections["Fx"][0] != first.detections["Fx"][0]
 
 
@@ -111,9 +111,15 @@ def test_mode_fit_spectra_of_some_runs_are_those_runs_alone():
     ctx = Context(compute_spectra(test, nperseg=512), test=test)
     for runs in (ctx.fit_runs, ctx.runs):
         sub = SteadyTest([test.runs[r] for r in runs], dict(test.meta))
-        got, ref = _fit_spectra(ctx, sub, list(runs)), compute_spectra(sub, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
+        (got, det), ref = _fit_spectra(ctx, sub, list(runs)), compute_spectra(sub, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
         assert got.nperseg == ref.nperseg and got.channels == ref.channels and got.run_names == ref.run_names
         np.testing.assert_array_equal(got.speed, ref.speed)
         np.testing.assert_array_equal(got.n_segments, ref.n_segments)
         for c in ref.channels:
             np.testing.assert_allclose(got.psd[c], ref.psd[c], rtol=1e-13, atol=0)
+        # the floors and lines of those runs, renumbered, are those found on their spectra alone
+        own = line_detections(ref)
+        for c in ref.channels:
+            np.testing.assert_allclose(det[c][1], own[c][1], rtol=1e-13, atol=0)
+            np.testing.assert_array_equal(det[c][2][0], own[c][2][0])
+            np.testing.assert_allclose(det[c][2][1], own[c][2][1], rtol=1e-13, atol=0)

@@ -75,33 +75,47 @@ class Context(Metric):
         self._scale = {c: float(np.mean([power[k] for k in self.channels if CHANNEL_UNIT[k] == CHANNEL_UNIT[c]]))
                        for c in self.channels}
 
-    def data(self, state: State, c: str) -> np.ndarray:
+    def data(self, state: State, c: str, runs: np.ndarray | None = None) -> np.ndarray:
         """Measured PSD (n_runs, n_f) of channel ``c`` as the state reads it: a torque channel corrected for
-        the state's load-cell offset, T − r × F, its Welch PSD recomputed with the spectra's settings."""
+        the state's load-cell offset, T − r × F, its Welch PSD recomputed with the spectra's settings.  ``runs``:
+        the rows the caller reads; a corrected torque is computed for the runs asked for so far only (a run's
+        Welch PSD is its own: the held-out judge of a ``cross_coupling`` hypothesis reads half of them), the other
+        rows NaN until asked for; None: every run."""
         if state.coupling is None or c not in TORQUE_CHANNELS:
             return self.sp.psd[c]
         key = tuple(float(x) for x in state.coupling)
+        chans = [k for k in TORQUE_CHANNELS if k in self.sp.psd]
         if key not in self._corrected:
+            self._corrected[key] = ({k: np.full_like(self.sp.psd[k], np.nan) for k in chans},
+                                    np.zeros(len(self.test.runs), bool))
+        psd, done = self._corrected[key]
+        want = np.ones(done.size, bool)
+        if runs is not None:
+            want = np.zeros(done.size, bool)
+            want[np.asarray(runs, dtype=int)] = True
+        todo = np.flatnonzero(want & ~done)
+        if todo.size:
             from dataclasses import replace
 
             from ..data import SteadyTest
             from ..spectra import compute_spectra
 
             r = np.asarray(key)
-            runs = []
-            for run in self.test.runs:          # the corrected torques only (a copy of every signal is not needed)
+            sub = []
+            for i in todo:          # the corrected torques only (a copy of every signal is not needed)
+                run = self.test.runs[i]
                 F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
                 T = np.cross(r[None, :], F)
-                runs.append(replace(run, signals={k: run.signals[k] - T[:, j] for j, k in enumerate(TORQUE_CHANNELS)
-                                                  if k in run.signals}))
-            test = SteadyTest(runs, dict(self.test.meta))
-            chans = [k for k in TORQUE_CHANNELS if k in self.sp.psd]
-            sp = compute_spectra(test, nperseg=self.sp.nperseg, window=self.sp.window, f_lim=self.sp.f_lim,
-                                 channels=chans)
-            if not np.array_equal(sp.n_segments, self.sp.n_segments):
+                sub.append(replace(run, signals={k: run.signals[k] - T[:, j] for j, k in enumerate(TORQUE_CHANNELS)
+                                                 if k in run.signals}))
+            sp = compute_spectra(SteadyTest(sub, dict(self.test.meta)), nperseg=self.sp.nperseg,
+                                 window=self.sp.window, f_lim=self.sp.f_lim, channels=chans)
+            if not np.array_equal(sp.n_segments, np.asarray(self.sp.n_segments)[todo]):
                 raise ValueError("diagnose: the spectra were not computed with 50 % overlap; cannot correct them")
-            self._corrected[key] = sp.psd
-        return self._corrected[key][c]
+            for k in chans:
+                psd[k][todo] = sp.psd[k]
+            done[todo] = True
+        return psd[c]
 
     def phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> np.ndarray:
         """Complex amplitudes (len(runs), L, 6) of every channel at frequencies ``f_hz`` (len(runs), L), Hz:
