@@ -123,3 +123,24 @@ def test_mode_fit_spectra_of_some_runs_are_those_runs_alone():
             np.testing.assert_allclose(det[c][1], own[c][1], rtol=1e-13, atol=0)
             np.testing.assert_array_equal(det[c][2][0], own[c][2][0])
             np.testing.assert_allclose(det[c][2][1], own[c][2][1], rtol=1e-13, atol=0)
+
+
+def test_every_line_measured_at_once_is_each_measured_alone():
+    from rwadist.diagnose.effects.fixed_resonance import FixedResonance
+    from rwadist.diagnose.effects.sidebands import Sidebands
+    from rwadist.diagnose.engine import Context, initial_state
+
+    test = _small_test()
+    sp = compute_spectra(test, nperseg=512)
+    ctx = Context(sp, test=test)
+    plain = initial_state(ctx, fit_empirical(sp).model)
+    h2 = plain.model.harmonics("radial_force")[1].h
+    # with a fixed resonance on the lines and a pair of sidebands beside one of them
+    busy = Sidebands("radial_force", h2, 9.0, 0.4).apply(FixedResonance(150.0, 0.03, 5.0, ("Fx", "Fy"), "wheel_mode").apply(plain))
+    for state in (plain, busy):
+        for c in ("Fx", "Tx", "Fz"):
+            lines = ctx.channel_lines(state, c, ctx.runs)
+            together = ctx.measure_lines(state, c, ctx.runs)
+            assert together.shape == (len(lines), ctx.runs.size) and np.isfinite(together).any()
+            for (h, _, _, _), got in zip(lines, together):
+                np.testing.assert_allclose(got, ctx.measure_line(state, c, h, ctx.runs, skip=h), rtol=1e-13, atol=0)

@@ -525,7 +525,7 @@ class Context(Metric):
         rows = np.arange(runs.size)[:, None]
         # the residual in the line's window only: the data less the state's whole prediction (computed once) plus
         # the skipped line alone at those bins -- a line measured against every other costs a few bins of one line
-        R = self.data(state, c)[runs[:, None], k] - self.predict(state, c, runs)[rows, k]
+        R = self.data(state, c, runs)[runs[:, None], k] - self.predict(state, c, runs)[rows, k]
         if skip is not None:
             R = R + self._predict(state, c, runs, None, skip, bins=k)
         p = R.sum(1) * self.df
@@ -535,6 +535,50 @@ class Context(Metric):
         sig = 3.0 * 2.0 * noise * np.sqrt(2.0 / self.dof) / np.sqrt(2 * LINE_HALF + 1)
         amp = np.where(inband & (p > sig), np.sqrt(2 * np.maximum(p, 0)), np.nan)
         return amp
+
+
+    def measure_lines(self, state: State, c: str, runs: np.ndarray) -> np.ndarray:
+        """:meth:`measure_line` of every line h of :meth:`channel_lines` against all the others (``skip=h``), one row
+        per line (L, len(runs)): the same numbers, the windows of all lines gathered at once and each line's own PSD
+        at its window (:meth:`_predict` with ``only``) computed in one kernel pass.  Under a speed ripple or a spin
+        smear, line by line."""
+        cl = self.channel_lines(state, c, runs)
+        if state.smear is not None or state.ripple is not None or not cl:
+            return np.array([self.measure_line(state, c, h, runs, skip=h) for h, _, _, _ in cl]).reshape(len(cl), runs.size)
+        hs = np.array([x[0] for x in cl])
+        pos = hs[:, None] * self.omega[runs][None, :] / (2 * np.pi) / self.df                  # (L, R)
+        k0 = np.rint(pos).astype(int)
+        offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+        inband = (k0 - LINE_HALF >= self.k_lo) & (k0 + LINE_HALF <= self.k_hi)
+        k = np.clip(k0[:, :, None] + offs, 0, self.f.size - 1)                               # (L, R, W)
+        rows = np.arange(runs.size)[None, :, None]
+        R = self.data(state, c, runs)[runs[None, :, None], k] - self.predict(state, c, runs)[rows, k]
+        # each line's own PSD at its window: the components of the lines of its h (as _predict(only=h) collects
+        # them, in the same order), padded with powerless ones to a common count
+        comps = []
+        for h in hs:
+            fs, ps = [], []
+            for hh, _law, amp, _g in cl:
+                if abs(hh - h) >= 1e-9:
+                    continue
+                f0 = hh * self.omega[runs] / (2 * np.pi)
+                for shift, rel in state.line_components(c, hh):
+                    f = f0 + shift
+                    a = amp * rel
+                    if state.resonances:
+                        a = a * self.gain(state, c, f)
+                    fs.append(f)
+                    ps.append(a**2 / 2.0)
+            comps.append((fs, ps))
+        n = max(len(fs) for fs, _ in comps)
+        f_all = np.stack([np.column_stack(fs + [fs[0]] * (n - len(fs))) for fs, _ in comps])        # (L, R, n)
+        p_all = np.stack([np.column_stack(ps + [np.zeros(runs.size)] * (n - len(ps))) for _, ps in comps])
+        own = self.psd_at(f_all.reshape(-1, n), p_all.reshape(-1, n), bins=k.reshape(-1, k.shape[-1]))
+        R = R + (np.zeros(k.shape) + own.reshape(k.shape))
+        p = R.sum(-1) * self.df
+        noise = self.floor_psd(state, c, runs)[rows, k].sum(-1) * self.df
+        sig = 3.0 * 2.0 * noise * np.sqrt(2.0 / self.dof) / np.sqrt(2 * LINE_HALF + 1)
+        return np.where(inband & (p > sig), np.sqrt(2 * np.maximum(p, 0)), np.nan)
 
 
 
