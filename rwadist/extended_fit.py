@@ -41,8 +41,7 @@ from scipy import optimize
 
 from . import extended as ext
 from .data import SteadyTest
-# the whole-run DFT lives in rwadist.dft; imported here for the callers that know it as extended_fit's
-from .dft import run_window, windowed_dft, windowed_dfts  # noqa: F401
+from .dft import run_window, windowed_dft, windowed_dfts  # noqa: F401 (the whole-run DFT, now in rwadist.dft)
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic

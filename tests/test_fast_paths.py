@@ -62,7 +62,8 @@ def test_hann_transform_is_the_window_sum():
         w = signal.get_window("hann", n)
         df = fs / n
         # on and between bins, at 0 and at ±1 bin (the singular points of the closed form's terms), far out, negative
-        f = np.concatenate([[0.0, df, -df, 2 * df, 0.5 * df, 1e-9 * df], np.random.default_rng(n).uniform(-0.5, 0.5, 40) * fs])
+        f = np.concatenate([[0.0, df, -df, 2 * df, 0.5 * df, 1e-9 * df],
+                            np.random.default_rng(n).uniform(-0.5, 0.5, 40) * fs])
         ref = np.exp(-2j * np.pi * np.outer(f, np.arange(n)) / fs) @ w
         got = hann_transform(n, fs, f)
         np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * n)
@@ -104,14 +105,15 @@ def test_second_empirical_fit_reusing_the_detections_is_a_fresh_fit():
 
 def test_mode_fit_spectra_of_some_runs_are_those_runs_alone():
     from rwadist.data import SteadyTest
-    from rwadist.diagnose.engine import Context
     from rwadist.diagnose.effects.suspension_modes import _fit_spectra
+    from rwadist.diagnose.engine import Context
 
     test = _small_test()
     ctx = Context(compute_spectra(test, nperseg=512), test=test)
     for runs in (ctx.fit_runs, ctx.runs):
         sub = SteadyTest([test.runs[r] for r in runs], dict(test.meta))
-        (got, det), ref = _fit_spectra(ctx, sub, list(runs)), compute_spectra(sub, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
+        got, det = _fit_spectra(ctx, sub, list(runs))
+        ref = compute_spectra(sub, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
         assert got.nperseg == ref.nperseg and got.channels == ref.channels and got.run_names == ref.run_names
         np.testing.assert_array_equal(got.speed, ref.speed)
         np.testing.assert_array_equal(got.n_segments, ref.n_segments)
@@ -136,7 +138,8 @@ def test_every_line_measured_at_once_is_each_measured_alone():
     plain = initial_state(ctx, fit_empirical(sp).model)
     h2 = plain.model.harmonics("radial_force")[1].h
     # with a fixed resonance on the lines and a pair of sidebands beside one of them
-    busy = Sidebands("radial_force", h2, 9.0, 0.4).apply(FixedResonance(150.0, 0.03, 5.0, ("Fx", "Fy"), "wheel_mode").apply(plain))
+    busy = FixedResonance(150.0, 0.03, 5.0, ("Fx", "Fy"), "wheel_mode").apply(plain)
+    busy = Sidebands("radial_force", h2, 9.0, 0.4).apply(busy)
     for state in (plain, busy):
         for c in ("Fx", "Tx", "Fz"):
             lines = ctx.channel_lines(state, c, ctx.runs)

@@ -544,7 +544,8 @@ class Context(Metric):
         smear, line by line."""
         cl = self.channel_lines(state, c, runs)
         if state.smear is not None or state.ripple is not None or not cl:
-            return np.array([self.measure_line(state, c, h, runs, skip=h) for h, _, _, _ in cl]).reshape(len(cl), runs.size)
+            return np.array([self.measure_line(state, c, h, runs, skip=h)
+                             for h, _, _, _ in cl]).reshape(len(cl), runs.size)
         hs = np.array([x[0] for x in cl])
         pos = hs[:, None] * self.omega[runs][None, :] / (2 * np.pi) / self.df                  # (L, R)
         k0 = np.rint(pos).astype(int)

@@ -303,7 +303,8 @@ class CounterRotation:
         out = []
         if ctx.test is not None:
             # the x/y phasors of every line (:meth:`_phase_powers`) in one pass over the records
-            h0s = [g[0] for d in ("radial_force", "radial_torque") if all(c in ctx.channels for c in DIRECTION_CHANNELS[d])
+            h0s = [g[0] for d in ("radial_force", "radial_torque")
+                   if all(c in ctx.channels for c in DIRECTION_CHANNELS[d])
                    for h in sorted({round(ln.h, 4) for ln in state.ext_lines() if ln.direction == d})
                    if (g := _sense_group(state, d, h)) is not None and (d, round(h, 3)) not in done]
             if h0s:

@@ -65,7 +65,8 @@ def record_resolvable_runs(ctx: Context, state: State, direction: str, h0: float
 
 def _record_resolvable(ctx: Context, state: State, direction: str, h0: float, h_side: np.ndarray,
                        runs) -> np.ndarray:
-    """(len(runs), len(h_side)) mask of :func:`record_resolvable_runs` for every line h_side·|Ω| of ``h_side`` at once."""
+    """(len(runs), len(h_side)) mask of :func:`record_resolvable_runs` for every line h_side·|Ω| of ``h_side``
+    at once."""
     w = (ctx.omega[runs] / (2 * np.pi))[:, None]
     f = h_side[None, :] * w
     sep = RUN_MIN_BINS * _record_df(ctx, runs)[:, None]
