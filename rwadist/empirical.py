@@ -130,6 +130,9 @@ class EmpiricalFit:
     lines: list
     bins: list
     settings: dict = field(default_factory=dict)
+    #: per channel (inputs, block floor, detected lines) (:func:`line_detections`): a second fit of the same spectra
+    #: (``detections`` of :func:`fit_empirical`) takes them instead of computing them again
+    detections: dict = field(default_factory=dict, repr=False, compare=False)
 
 
 @dataclass
@@ -482,12 +485,56 @@ def fit_direction(spectra: Spectra, direction: str, s: FitSettings, floors: dict
     return out, bins
 
 
+def _detection_inputs(spectra: Spectra, s: FitSettings) -> tuple:
+    """(dof, threshold, f_lo, f_hi, sidelobe_db): everything a channel's block floor and detected lines depend on
+    besides its PSD rows."""
+    dof = welch_dof(int(np.min(spectra.n_segments)))
+    f = spectra.f
+    f_lo, f_hi = s.f_min_bins * spectra.df, spectra.band_limit
+    n_bins = int(np.sum((f >= f_lo) & (f <= f_hi)))
+    return dof, detection_threshold(dof, n_bins, s.p_false), f_lo, f_hi, s.sidelobe_db
+
+
+def line_detections(spectra: Spectra, settings: FitSettings | None = None, channels=None) -> dict:
+    """Per channel of ``channels`` (default every channel of the spectra): (key, block floor (n_runs, n_f) with NaN
+    rows where the run lacks the channel, detected lines (run index, Hz) of :func:`detect_lines`); ``key`` holds the
+    inputs besides the PSD rows (:func:`_detection_inputs`).  Each run's floor and lines are its own: those of some
+    runs are rows of these (:func:`detections_of_runs`)."""
+    s = settings or FitSettings()
+    key = _detection_inputs(spectra, s)
+    dof, threshold, f_lo, f_hi, sidelobe_db = key
+    out = {}
+    for c in (spectra.channels if channels is None else channels):
+        psd = spectra.psd[c]
+        fl = np.full_like(psd, np.nan)
+        ok = spectra.available(c)
+        fl[ok] = block_floor(psd[ok], dof=dof)
+        out[c] = (key, fl, detect_lines(psd, spectra.f, fl, threshold, f_lo, f_hi, sidelobe_db))
+    return out
+
+
+def detections_of_runs(detections: dict, rows) -> dict:
+    """:func:`line_detections` of the spectra's rows ``rows`` (increasing run indices) from those of every run: the
+    floors' rows and the lines of those runs, renumbered (in the same order as computed on those rows alone)."""
+    rows = np.asarray(rows, dtype=int)
+    out = {}
+    for c, (key, fl, (run, freq)) in detections.items():
+        new = -np.ones(fl.shape[0], int)
+        new[rows] = np.arange(rows.size)
+        keep = new[run] >= 0
+        out[c] = (key, fl[rows], (new[run[keep]], freq[keep]))
+    return out
+
+
 def fit_empirical(spectra: Spectra, settings: FitSettings | None = None, directions=None,
-                  name: str = "fitted wheel", progress: bool = False) -> EmpiricalFit:
+                  name: str = "fitted wheel", progress: bool = False, detections: dict | None = None) -> EmpiricalFit:
     """Fit the empirical model to the spectra of a steady-state test.
 
     Runs at zero speed (noise runs) are not used.  Returns an
-    :class:`EmpiricalFit` whose ``model`` goes to the model file.
+    :class:`EmpiricalFit` whose ``model`` goes to the model file.  ``detections``: block floors and detected lines of
+    THESE spectra (:func:`line_detections`, or an earlier fit's ``detections``): a channel's are taken when they
+    were made with the same inputs (the settings' p_false, f_min_bins, sidelobe_db; e.g. the extended fit's second
+    pass without modal exclusion), else computed.
     """
     s = settings or FitSettings()
     directions = tuple(directions) if directions is not None else DIRECTIONS
@@ -496,22 +543,15 @@ def fit_empirical(spectra: Spectra, settings: FitSettings | None = None, directi
     if fit_runs.size == 0:
         raise DataError(spectra.run_names[0] if spectra.run_names else "<test>", "speed_rpm",
                         "every run is at zero speed: nothing to fit (zero-speed runs are noise runs)")
-    dof = welch_dof(int(np.min(spectra.n_segments)))
-    f = spectra.f
-    f_lo, f_hi = s.f_min_bins * spectra.df, spectra.band_limit
-    n_bins = int(np.sum((f >= f_lo) & (f <= f_hi)))
-    threshold = detection_threshold(dof, n_bins, s.p_false)
-    floors, detected = {}, {}
+    key = _detection_inputs(spectra, s)
+    dof, threshold = key[0], key[1]
     channels = [c for c in spectra.channels if any(c in DIRECTION_CHANNELS[d] for d in directions)]
     bar = tqdm(total=len(channels) + len(directions), desc="rwadist fit", disable=not progress, unit="step")
-    for c in channels:
-        psd = spectra.psd[c]
-        fl = np.full_like(psd, np.nan)
-        ok = spectra.available(c)
-        fl[ok] = block_floor(psd[ok], dof=dof)
-        floors[c] = fl
-        detected[c] = detect_lines(psd, f, fl, threshold, f_lo, f_hi, s.sidelobe_db)
-        bar.update()
+    known = {c: v for c, v in (detections or {}).items() if v[0] == key and v[1].shape == spectra.psd[c].shape}
+    known.update(line_detections(spectra, s, [c for c in channels if c not in known]))
+    floors = {c: known[c][1] for c in channels}
+    detected = {c: known[c][2] for c in channels}
+    bar.update(len(channels))
     model = WheelModel(name=name)
     lines, bins = [], []
     for d in directions:
@@ -533,4 +573,5 @@ def fit_empirical(spectra: Spectra, settings: FitSettings | None = None, directi
     settings_doc = {k: getattr(s, k) for k in s.__dataclass_fields__}
     settings_doc["detection_threshold"] = threshold
     settings_doc["dof"] = dof
-    return EmpiricalFit(model=model, spectra=spectra, lines=lines, bins=bins, settings=settings_doc)
+    return EmpiricalFit(model=model, spectra=spectra, lines=lines, bins=bins, settings=settings_doc,
+                        detections={c: known[c] for c in channels})

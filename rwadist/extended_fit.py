@@ -34,15 +34,15 @@ rotor centre).
 """
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy import optimize, signal
+from scipy import optimize
 
 from . import extended as ext
 from .data import SteadyTest
+from .dft import run_window, windowed_dft, windowed_dfts  # noqa: F401 (the whole-run DFT, now in rwadist.dft)
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
@@ -51,6 +51,8 @@ from .spectra import compute_spectra, welch_dof
 from .units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
 
 CHANNEL_INDEX = {c: i for i, c in enumerate(CHANNELS)}
+#: samples (runs × record length) of the x/y records :func:`line_senses` transforms together
+SENSE_CHUNK_SAMPLES = 1 << 20
 RADIAL = ("radial_force", "radial_torque")
 #: mode key of the fit -> its name in the model file's ``analytical.unconstrained``
 UNCONSTRAINED_NAME = {"radial_translation": "radial_translation", "rocking": "rocking", "axial_translation": "axial"}
@@ -106,53 +108,6 @@ class ExtendedFit:
 
 # --------------------------------------------------------------------------- 1. senses
 
-@functools.lru_cache(maxsize=16)
-def run_window(name, n: int) -> tuple:
-    """(w (n,), Σw, Σw²) of the window ``name`` (:func:`scipy.signal.get_window`, periodic) over a record of ``n``
-    samples, computed once per (name, n): every run of a test has the same length, and the whole-run phasors ask
-    for it on every search step.  ``w`` is read-only (it is shared)."""
-    w = signal.get_window(name, n)
-    w.flags.writeable = False
-    return w, float(np.sum(w)), float(np.sum(w**2))
-
-
-def _unit_phasors(f_hz: np.ndarray, dt: float, count: int) -> np.ndarray:
-    """e^{−2πj f k·dt} (L, count) for k = 0 … count − 1 at ``f_hz`` (L,) Hz, ``dt`` s: as a product of two tables of
-    about √count exponentials each, k = k_lo + m·k_hi (complex exponentials cost far more than the product of two
-    unit phasors, which is the same number to rounding)."""
-    m = max(int(np.ceil(np.sqrt(count))), 1)
-    lo = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(m) * dt))                                # (L, m)
-    hi = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(-(-count // m)) * (m * dt)))          # (L, ⌈count/m⌉)
-    return (hi[:, :, None] * lo[:, None, :]).reshape(f_hz.size, -1)[:, :count]
-
-
-def windowed_dft(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128) -> np.ndarray:
-    """Σ_n x[n]·e^{−2πj f t_n} (t_n = n/sample_rate) of the columns of ``x`` (n, K) at frequencies ``f_hz``
-    (L,) Hz, any f (not on the FFT grid); returns (L, K) complex.
-
-    The samples are cut into blocks of ``block``: e^{−2πj f (t_b + t_j)} = e^{−2πj f t_b}·e^{−2πj f t_j}, so
-    only L·(block + n/block) exponentials are needed instead of L·n (a product of two unit phasors: the same sum to
-    rounding), and each of those two tables is itself such a product (:func:`_unit_phasors`)."""
-    x = np.asarray(x, dtype=float)
-    n, k = x.shape
-    f_hz = np.asarray(f_hz, dtype=float)
-    n_blocks = -(-n // block)
-    if n == n_blocks * block:
-        xb = x.reshape(n_blocks, block, k)
-    else:
-        xb = np.zeros((n_blocks * block, k))
-        xb[:n] = x
-        xb = xb.reshape(n_blocks, block, k)                                    # (J, B, K)
-    # samples of a block along the rows, (block, channel) along the columns: the fine sums are then one (L, B) @
-    # (B, J·K) matrix product per real and imaginary part (not J small batched ones)
-    xt = xb.transpose(1, 0, 2).reshape(block, n_blocks * k)                   # (B, J·K)
-    fine = _unit_phasors(f_hz, 1.0 / sample_rate, block)                          # (L, B)
-    coarse = _unit_phasors(f_hz, block / sample_rate, n_blocks)                     # (L, J)
-    shape = (f_hz.size, n_blocks, k)
-    inner = (fine.real @ xt).reshape(shape) + 1j * (fine.imag @ xt).reshape(shape)        # (L, J, K)
-    return np.einsum("lj,ljk->lk", coarse, inner)
-
-
 def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) -> dict:
     """Rotation sense of each radial line from the x/y phase, (direction, h) -> (sense, co_fraction).
 
@@ -170,20 +125,30 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
         h = np.array([x.h for x in lines])
         p_co = np.zeros(h.size)
         p_ct = np.zeros(h.size)
-        for run in test.runs:
-            if cx not in run.signals or cy not in run.signals or run.speed == 0:
-                continue
-            n = run.n_samples
+        use = [run for run in test.runs if cx in run.signals and cy in run.signals and run.speed != 0]
+        # consecutive runs of one record length are transformed together (rwadist.dft.windowed_dfts), and their
+        # powers added in the runs' order
+        batches = []
+        for run in use:
+            if batches and (batches[-1][0].n_samples, batches[-1][0].sample_rate) == (run.n_samples, run.sample_rate) \
+                    and len(batches[-1]) * run.n_samples < SENSE_CHUNK_SAMPLES:
+                batches[-1].append(run)
+            else:
+                batches.append([run])
+        for batch in batches:
+            n, fs = batch[0].n_samples, batch[0].sample_rate
             w = run_window("hann", n)[0]             # = signal.windows.hann(n, sym=False)
-            f = h * abs(run.speed) / (2 * np.pi)
-            ok = f < 0.45 * run.sample_rate
-            X, Y = windowed_dft(np.column_stack([w * run.signals[cx], w * run.signals[cy]]), run.sample_rate,
-                                f[ok]).T
-            co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
-            if run.speed < 0:
-                co, ct = ct, co
-            p_co[ok] += co
-            p_ct[ok] += ct
+            f = h[None, :] * np.abs([run.speed for run in batch])[:, None] / (2 * np.pi)
+            x = np.stack([np.column_stack([w * run.signals[cx], w * run.signals[cy]]) for run in batch])
+            XY = windowed_dfts(x, fs, f)
+            for i, run in enumerate(batch):
+                ok = f[i] < 0.45 * fs
+                X, Y = XY[i, ok].T
+                co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
+                if run.speed < 0:
+                    co, ct = ct, co
+                p_co[ok] += co
+                p_ct[ok] += ct
         frac = p_co / np.maximum(p_co + p_ct, 1e-300)
         for hk, fr in zip(h, frac):
             sense = "co" if fr >= threshold else ("counter" if fr <= 1 - threshold else "planar")
@@ -432,7 +397,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         fit = fit_empirical(spectra, settings)
     # every line the data show, with every measurement: the empirical fit without modal
     # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped)
-    meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False))
+    meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False),
+                         detections=fit.detections)
     if stand is not None:
         from .resonance import resonance
 

@@ -18,6 +18,9 @@ from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, TORQUE_CHA
 from .metric import Metric
 from .state import State
 
+#: Samples (runs × record length × channels) :meth:`Context.phasors` transforms together: a few tens of MB.
+PHASOR_CHUNK_SAMPLES = 1 << 21
+
 # --------------------------------------------------------------------------- line kernel
 
 def line_kernel(nperseg: int, fs: float, window: str = "hann", half: int = KERNEL_HALF, oversample: int = 64):
@@ -72,66 +75,94 @@ class Context(Metric):
         self._scale = {c: float(np.mean([power[k] for k in self.channels if CHANNEL_UNIT[k] == CHANNEL_UNIT[c]]))
                        for c in self.channels}
 
-    def data(self, state: State, c: str) -> np.ndarray:
+    def data(self, state: State, c: str, runs: np.ndarray | None = None) -> np.ndarray:
         """Measured PSD (n_runs, n_f) of channel ``c`` as the state reads it: a torque channel corrected for
-        the state's load-cell offset, T − r × F, its Welch PSD recomputed with the spectra's settings."""
+        the state's load-cell offset, T − r × F, its Welch PSD recomputed with the spectra's settings.  ``runs``:
+        the rows the caller reads; a corrected torque is computed for the runs asked for so far only (a run's
+        Welch PSD is its own: the held-out judge of a ``cross_coupling`` hypothesis reads half of them), the other
+        rows NaN until asked for; None: every run."""
         if state.coupling is None or c not in TORQUE_CHANNELS:
             return self.sp.psd[c]
         key = tuple(float(x) for x in state.coupling)
+        chans = [k for k in TORQUE_CHANNELS if k in self.sp.psd]
         if key not in self._corrected:
+            self._corrected[key] = ({k: np.full_like(self.sp.psd[k], np.nan) for k in chans},
+                                    np.zeros(len(self.test.runs), bool))
+        psd, done = self._corrected[key]
+        want = np.ones(done.size, bool)
+        if runs is not None:
+            want = np.zeros(done.size, bool)
+            want[np.asarray(runs, dtype=int)] = True
+        todo = np.flatnonzero(want & ~done)
+        if todo.size:
             from dataclasses import replace
 
             from ..data import SteadyTest
             from ..spectra import compute_spectra
 
             r = np.asarray(key)
-            runs = []
-            for run in self.test.runs:          # the corrected torques only (a copy of every signal is not needed)
+            sub = []
+            for i in todo:          # the corrected torques only (a copy of every signal is not needed)
+                run = self.test.runs[i]
                 F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
                 T = np.cross(r[None, :], F)
-                runs.append(replace(run, signals={k: run.signals[k] - T[:, j] for j, k in enumerate(TORQUE_CHANNELS)
-                                                  if k in run.signals}))
-            test = SteadyTest(runs, dict(self.test.meta))
-            chans = [k for k in TORQUE_CHANNELS if k in self.sp.psd]
-            sp = compute_spectra(test, nperseg=self.sp.nperseg, window=self.sp.window, f_lim=self.sp.f_lim,
-                                 channels=chans)
-            if not np.array_equal(sp.n_segments, self.sp.n_segments):
+                sub.append(replace(run, signals={k: run.signals[k] - T[:, j] for j, k in enumerate(TORQUE_CHANNELS)
+                                                 if k in run.signals}))
+            sp = compute_spectra(SteadyTest(sub, dict(self.test.meta)), nperseg=self.sp.nperseg,
+                                 window=self.sp.window, f_lim=self.sp.f_lim, channels=chans)
+            if not np.array_equal(sp.n_segments, np.asarray(self.sp.n_segments)[todo]):
                 raise ValueError("diagnose: the spectra were not computed with 50 % overlap; cannot correct them")
-            self._corrected[key] = sp.psd
-        return self._corrected[key][c]
+            for k in chans:
+                psd[k][todo] = sp.psd[k]
+            done[todo] = True
+        return psd[c]
 
     def phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> np.ndarray:
         """Complex amplitudes (len(runs), L, 6) of every channel at frequencies ``f_hz`` (len(runs), L), Hz:
-        X = 2·Σ w x e^{−2πj f t}/Σ w over the whole run (Hann window), so x(t) ≈ Re(X e^{2πj f t});
-        NaN for a channel the run lacks."""
-        from ..extended_fit import windowed_dft
+        X = 2·Σ w x e^{−2πj f t}/Σ w over the whole run (the spectra's window), so x(t) ≈ Re(X e^{2πj f t});
+        NaN for a channel the run lacks.  The runs of one record length and channel set are transformed together
+        (:func:`rwadist.dft.windowed_dfts`, chunks of :data:`PHASOR_CHUNK_SAMPLES` samples; the windowed signals
+        are not kept: a long test's would double its memory)."""
+        from ..dft import run_window, windowed_dfts
 
         f_hz = np.asarray(f_hz, dtype=float)
         key = ("phasors", runs.tobytes(), f_hz.tobytes(), f_hz.shape)
         if key in self._memo:                             # the same lines are asked for at every search step
             return self._memo[key].copy()
         out = np.full((runs.size, f_hz.shape[1], len(CHANNELS)), np.nan + 0j)
-        for i, r in enumerate(runs):                      # one blocked DFT per run
-            have, x, wsum = self._windowed_run(int(r))
-            out[i][:, have] = 2.0 * windowed_dft(x, self.test.runs[r].sample_rate, f_hz[i]) / wsum
+        groups = {}
+        for i, r in enumerate(runs):
+            run = self.test.runs[r]
+            have = tuple(j for j, c in enumerate(CHANNELS) if c in run.signals)
+            groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
+        for (n, fs, have), rows_all in groups.items():
+            w, wsum, _ = run_window(self.sp.window, n)
+            step = max(1, PHASOR_CHUNK_SAMPLES // (n * max(len(have), 1)))
+            for s in range(0, len(rows_all), step):
+                rows = np.asarray(rows_all[s:s + step])
+                x = np.stack([np.column_stack([self.test.runs[runs[i]].signals[CHANNELS[j]] for j in have])
+                              for i in rows]) * w[None, :, None]
+                out[rows[:, None], :, np.asarray(have)[None, :]] = \
+                    (2.0 * windowed_dfts(x, fs, f_hz[rows]) / wsum).transpose(0, 2, 1)
         self._memo[key] = out
         return out.copy()
 
-    def _windowed_run(self, r: int):
-        """(channel indices the run has, its signals (n_samples, K) times the whole-run window, Σ window) of run
-        ``r``; the window is computed once per record length (the windowed signals are not kept: a long test's
-        would double its memory)."""
-        from scipy import signal
-
-        run = self.test.runs[r]
-        wkey = ("window", run.n_samples)
-        if wkey not in self._memo:
-            w = signal.get_window(self.sp.window, run.n_samples)
-            self._memo[wkey] = (w, float(np.sum(w)))
-        w, wsum = self._memo[wkey]
-        have = [j for j, c in enumerate(CHANNELS) if c in run.signals]
-        x = np.column_stack([run.signals[CHANNELS[j]] for j in have]) * w[:, None]
-        return have, x, wsum
+    def prefetch_phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> None:
+        """:meth:`phasors` of every column of ``f_hz`` (len(runs), L) Hz computed in one pass over the records and
+        kept as if each column had been asked for alone (``f_hz[:, j:j + 1]``): a family that measures its lines one
+        at a time reads them without transforming every record again per line."""
+        f_hz = np.asarray(f_hz, dtype=float)
+        todo = [j for j in range(f_hz.shape[1])
+                if ("phasors", runs.tobytes(), np.ascontiguousarray(f_hz[:, j:j + 1]).tobytes(), (runs.size, 1))
+                not in self._memo]
+        if not todo:
+            return
+        cols = np.ascontiguousarray(f_hz[:, todo])
+        X = self.phasors(runs, cols)
+        del self._memo[("phasors", runs.tobytes(), cols.tobytes(), cols.shape)]   # kept per column only
+        for i, j in enumerate(todo):
+            col = np.ascontiguousarray(f_hz[:, j:j + 1])
+            self._memo[("phasors", runs.tobytes(), col.tobytes(), col.shape)] = X[:, i:i + 1].copy()
 
     def data_floor(self, state: State, c: str) -> np.ndarray:
         """Block floor (n_runs, n_f) of channel ``c`` as the state reads its data (:meth:`data`): a torque
@@ -494,7 +525,7 @@ class Context(Metric):
         rows = np.arange(runs.size)[:, None]
         # the residual in the line's window only: the data less the state's whole prediction (computed once) plus
         # the skipped line alone at those bins -- a line measured against every other costs a few bins of one line
-        R = self.data(state, c)[runs[:, None], k] - self.predict(state, c, runs)[rows, k]
+        R = self.data(state, c, runs)[runs[:, None], k] - self.predict(state, c, runs)[rows, k]
         if skip is not None:
             R = R + self._predict(state, c, runs, None, skip, bins=k)
         p = R.sum(1) * self.df
@@ -504,6 +535,51 @@ class Context(Metric):
         sig = 3.0 * 2.0 * noise * np.sqrt(2.0 / self.dof) / np.sqrt(2 * LINE_HALF + 1)
         amp = np.where(inband & (p > sig), np.sqrt(2 * np.maximum(p, 0)), np.nan)
         return amp
+
+
+    def measure_lines(self, state: State, c: str, runs: np.ndarray) -> np.ndarray:
+        """:meth:`measure_line` of every line h of :meth:`channel_lines` against all the others (``skip=h``), one row
+        per line (L, len(runs)): the same numbers, the windows of all lines gathered at once and each line's own PSD
+        at its window (:meth:`_predict` with ``only``) computed in one kernel pass.  Under a speed ripple or a spin
+        smear, line by line."""
+        cl = self.channel_lines(state, c, runs)
+        if state.smear is not None or state.ripple is not None or not cl:
+            return np.array([self.measure_line(state, c, h, runs, skip=h)
+                             for h, _, _, _ in cl]).reshape(len(cl), runs.size)
+        hs = np.array([x[0] for x in cl])
+        pos = hs[:, None] * self.omega[runs][None, :] / (2 * np.pi) / self.df                  # (L, R)
+        k0 = np.rint(pos).astype(int)
+        offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+        inband = (k0 - LINE_HALF >= self.k_lo) & (k0 + LINE_HALF <= self.k_hi)
+        k = np.clip(k0[:, :, None] + offs, 0, self.f.size - 1)                               # (L, R, W)
+        rows = np.arange(runs.size)[None, :, None]
+        R = self.data(state, c, runs)[runs[None, :, None], k] - self.predict(state, c, runs)[rows, k]
+        # each line's own PSD at its window: the components of the lines of its h (as _predict(only=h) collects
+        # them, in the same order), padded with powerless ones to a common count
+        comps = []
+        for h in hs:
+            fs, ps = [], []
+            for hh, _law, amp, _g in cl:
+                if abs(hh - h) >= 1e-9:
+                    continue
+                f0 = hh * self.omega[runs] / (2 * np.pi)
+                for shift, rel in state.line_components(c, hh):
+                    f = f0 + shift
+                    a = amp * rel
+                    if state.resonances:
+                        a = a * self.gain(state, c, f)
+                    fs.append(f)
+                    ps.append(a**2 / 2.0)
+            comps.append((fs, ps))
+        n = max(len(fs) for fs, _ in comps)
+        f_all = np.stack([np.column_stack(fs + [fs[0]] * (n - len(fs))) for fs, _ in comps])        # (L, R, n)
+        p_all = np.stack([np.column_stack(ps + [np.zeros(runs.size)] * (n - len(ps))) for _, ps in comps])
+        own = self.psd_at(f_all.reshape(-1, n), p_all.reshape(-1, n), bins=k.reshape(-1, k.shape[-1]))
+        R = R + (np.zeros(k.shape) + own.reshape(k.shape))
+        p = R.sum(-1) * self.df
+        noise = self.floor_psd(state, c, runs)[rows, k].sum(-1) * self.df
+        sig = 3.0 * 2.0 * noise * np.sqrt(2.0 / self.dof) / np.sqrt(2 * LINE_HALF + 1)
+        return np.where(inband & (p > sig), np.sqrt(2 * np.maximum(p, 0)), np.nan)
 
 
 

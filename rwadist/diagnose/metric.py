@@ -41,7 +41,7 @@ class Metric:
         tot = np.zeros(runs.size)
         parts = {}
         for c in channels or self.channels:
-            Dfull = self.data(state, c)[runs]
+            Dfull = self.data(state, c, runs)[runs]
             ok = np.isfinite(Dfull[:, 0])
             D = self.band_sums(Dfull)
             N = self.floor_psd(state, c, runs)

@@ -301,6 +301,14 @@ class CounterRotation:
             return []
         done = {(e.direction, round(e.h, 3)) for e in state.effects if isinstance(e, CounterRotation)}
         out = []
+        if ctx.test is not None:
+            # the x/y phasors of every line (:meth:`_phase_powers`) in one pass over the records
+            h0s = [g[0] for d in ("radial_force", "radial_torque")
+                   if all(c in ctx.channels for c in DIRECTION_CHANNELS[d])
+                   for h in sorted({round(ln.h, 4) for ln in state.ext_lines() if ln.direction == d})
+                   if (g := _sense_group(state, d, h)) is not None and (d, round(h, 3)) not in done]
+            if h0s:
+                ctx.prefetch_phasors(runs, np.outer(ctx.omega[runs], h0s) / (2 * np.pi))
         for d in ("radial_force", "radial_torque"):
             if not any(c in ctx.channels for c in DIRECTION_CHANNELS[d]):
                 continue

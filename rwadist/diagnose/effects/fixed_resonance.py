@@ -35,10 +35,10 @@ def _line_gain_points(ctx, state, chans, runs):
         noise = ctx.floor_psd(state, c, runs)
         cl = ctx.channel_lines(state, c, runs)
         hs = np.array([x[0] for x in cl])
-        for h, law, amp, _ in cl:
+        measured = ctx.measure_lines(state, c, runs)          # each line against all the others, all at once
+        for (h, law, amp, _), a in zip(cl, measured):
             f = h * ctx.omega[runs] / (2 * np.pi)
             a_pred = amp * ctx.gain(state, c, f)
-            a = ctx.measure_line(state, c, h, runs, skip=h)
             # a line within 2·LINE_HALF bins of another beats with it in the Welch estimate: left out
             sep = np.abs(hs[hs != h][:, None] - h) * ctx.omega[runs][None, :] / (2 * np.pi) / ctx.df
             alone = np.all(sep >= 2 * LINE_HALF, axis=0) if sep.size else np.ones(runs.size, bool)

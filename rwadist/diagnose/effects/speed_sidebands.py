@@ -25,12 +25,14 @@ DELTA_GRID = np.arange(0.01, 0.30001, 0.0025)
 #: Window of the whole-run DFT the sidebands are measured with when the time series are given: Hann, whose main
 #: lobe (±2 record bins of fs/n: 4× finer than the Welch bins of n/4 segments) keeps the pair apart at low speeds;
 #: the carrier's leakage beyond it (sidelobes from −31 dB) is subtracted with the carrier's own phasor
-#: (:func:`_run_line_power`).
+#: (:func:`_run_line_power`; the window's transform in closed form, :func:`rwadist.dft.hann_transform`: Hann only).
 RUN_WINDOW = "hann"
 #: Smallest separation (record bins) of a sideband from its carrier and from every other line of the direction
 #: in the whole-run route: the edge of the Hann main lobe (±2 bins; beyond it the transform is below −31 dB, and
 #: the carrier's part of it is subtracted).  No scalloping margin: the phasor is taken at the line's own frequency.
 RUN_MIN_BINS = 2.0
+#: Samples (runs × record length × channels) transformed together by :func:`_run_line_power`: a few tens of MB.
+RUN_CHUNK_SAMPLES = 1 << 20
 
 
 def _record_df(ctx: Context, runs) -> np.ndarray:
@@ -58,15 +60,22 @@ def record_resolvable_runs(ctx: Context, state: State, direction: str, h0: float
                            runs) -> np.ndarray:
     """As :func:`resolvable_runs` for the whole-run DFT (time series given, :func:`_run_line_power`): the line in
     band and at least RUN_MIN_BINS record bins (fs/n) from its carrier and from every other line of the direction."""
-    w = ctx.omega[runs] / (2 * np.pi)
-    f = h_side * w
-    sep = RUN_MIN_BINS * _record_df(ctx, runs)
-    ok = (np.abs(h_side - h0) * w >= sep) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
+    return runs[_record_resolvable(ctx, state, direction, h0, np.array([h_side]), runs)[:, 0]]
+
+
+def _record_resolvable(ctx: Context, state: State, direction: str, h0: float, h_side: np.ndarray,
+                       runs) -> np.ndarray:
+    """(len(runs), len(h_side)) mask of :func:`record_resolvable_runs` for every line h_side·|Ω| of ``h_side``
+    at once."""
+    w = (ctx.omega[runs] / (2 * np.pi))[:, None]
+    f = h_side[None, :] * w
+    sep = RUN_MIN_BINS * _record_df(ctx, runs)[:, None]
+    ok = (np.abs(h_side - h0)[None, :] * w >= sep) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
         & (f <= (ctx.k_hi - LINE_HALF) * ctx.df)
     for x in state.model.harmonics(direction):
         if abs(x.h - h0) > 1e-6:
-            ok &= np.abs(x.h - h_side) * w >= sep
-    return runs[ok]
+            ok &= np.abs(x.h - h_side)[None, :] * w >= sep
+    return ok
 
 
 def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: float, need=None) -> tuple:
@@ -75,31 +84,43 @@ def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: 
     a·cos(2π f t + φ) gives |X| = a), less the leakage of the carrier h0: X(f) − X(f_c)·W(f − f_c)/W(0), f_c =
     h0|Ω|/2π, W the window's transform (a line at f_c puts X(f_c)·W(f − f_c)/W(0) at f); and the mean |X|² white
     noise of the state's floor S gives there, 2·S·fs·Σw²/(Σw)².  ``need`` (len(runs), L) bool, optional: only those
-    phasors are computed, the others are NaN (the scan's unresolvable points, which it never reads)."""
-    from ...extended_fit import run_window, windowed_dft
+    phasors are computed, the others are NaN (the scan's unresolvable points, which it never reads).
+
+    The runs of one record length are transformed together (:func:`rwadist.dft.windowed_dfts`), each at its needed
+    frequencies (moved to the front of its row; the rest of the row padded with its carrier), in chunks of
+    :data:`RUN_CHUNK_SAMPLES` samples; W in closed form (:func:`rwadist.dft.hann_transform`)."""
+    from ...dft import hann_transform, run_window, windowed_dfts
 
     chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
     if need is None:
         need = np.ones(f_hz.shape, dtype=bool)
     X = np.full((runs.size, f_hz.shape[1], len(chans)), np.nan + 0j)
-    for i, r in enumerate(runs):
-        if not need[i].any():
-            continue
-        run = ctx.test.runs[r]
-        w, wsum, _ = run_window(RUN_WINDOW, run.n_samples)
-        f_c = h0 * ctx.omega[r] / (2 * np.pi)
-        f_i = f_hz[i][need[i]]
-        x = np.column_stack([run.signals[c] for c in chans]) * w[:, None]
-        both = 2.0 * windowed_dft(x, run.sample_rate, np.concatenate([f_i, [f_c]])) / wsum
-        leak = windowed_dft(w[:, None], run.sample_rate, f_i - f_c)[:, 0] / wsum       # W(f − f_c)/W(0)
-        X[i, need[i]] = both[:-1] - leak[:, None] * both[-1][None, :]
+    groups = {}
+    for i in np.flatnonzero(need.any(axis=1)):
+        run = ctx.test.runs[runs[i]]
+        groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
+    for (n, fs), rows_all in groups.items():
+        w, wsum, _ = run_window(RUN_WINDOW, n)
+        step = max(1, RUN_CHUNK_SAMPLES // (n * max(len(chans), 1)))
+        for s in range(0, len(rows_all), step):
+            rows = np.asarray(rows_all[s:s + step])
+            nd = need[rows]
+            pick = np.argsort(~nd, axis=1, kind="stable")[:, :int(nd.sum(1).max())]
+            valid = np.take_along_axis(nd, pick, axis=1)
+            f_c = h0 * ctx.omega[runs[rows]] / (2 * np.pi)
+            f_i = np.where(valid, np.take_along_axis(f_hz[rows], pick, axis=1), f_c[:, None])
+            x = np.stack([np.column_stack([ctx.test.runs[runs[i]].signals[c] for c in chans]) for i in rows])
+            both = 2.0 * windowed_dfts(x * w[None, :, None], fs, np.column_stack([f_i, f_c])) / wsum
+            leak = hann_transform(n, fs, f_i - f_c[:, None]) / wsum                  # W(f − f_c)/W(0)
+            r, j = np.nonzero(valid)
+            X[rows[r], pick[r, j]] = both[r, j] - leak[r, j, None] * both[r, -1]
     return np.abs(X) ** 2, _run_noise(ctx, state, chans, runs, f_hz)
 
 
 def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
     """Mean |X|² (len(runs), L, len(chans)) that white noise of the state's floor S puts into the whole-run phasor
     at ``f_hz``: 2·S·fs·Σw²/(Σw)² (:data:`RUN_WINDOW`)."""
-    from ...extended_fit import run_window
+    from ...dft import run_window
 
     enbw = np.empty(runs.size)
     for i, r in enumerate(runs):
@@ -280,17 +301,11 @@ class SpeedSidebands:
             ctx._memo[key] = _run_line_power(ctx, state, direction, runs, f_hz, h0, need)[0]
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         z = ctx._memo[key] / np.maximum(_run_noise(ctx, state, chans, runs, f_hz), 1e-300)   # (runs, 2G, chans)
-        pos = {r: i for i, r in enumerate(runs)}
-        score = np.zeros(DELTA_GRID.size)
-        for j in range(DELTA_GRID.size):
-            vals = []
-            for col in (j, DELTA_GRID.size + j):
-                sub = record_resolvable_runs(ctx, state, direction, h0, grid[col], runs)
-                if sub.size < 3:
-                    vals = []
-                    break
-                vals.append(z[[pos[r] for r in sub], col, :].ravel())
-            vals = np.concatenate(vals) if vals else np.empty(0)
+        ok = _record_resolvable(ctx, state, direction, h0, grid, runs)         # (runs, 2G): both sides of every δ
+        n = DELTA_GRID.size
+        score = np.zeros(n)
+        for j in np.flatnonzero((ok[:, :n].sum(0) >= 3) & (ok[:, n:].sum(0) >= 3)):
+            vals = np.concatenate([z[ok[:, j], j, :].ravel(), z[ok[:, n + j], n + j, :].ravel()])
             score[j] = float(np.median(vals)) if vals.size >= 6 else 0.0
         return DELTA_GRID, score
 

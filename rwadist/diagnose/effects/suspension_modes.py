@@ -23,6 +23,45 @@ from ..state import State
 from .base import register, schema_entry
 
 
+def _fit_spectra(ctx: Context, test, runs: list):
+    """(spectra, detections) of ``test`` (the context's runs ``runs``) at the fit's own resolution, as ``rwadist fit``
+    computes them (:func:`rwadist.spectra.compute_spectra`'s default segment: the longest): close lines (h = 5.37,
+    5.57 of the E wheel) that diagnose's shorter Welch segments cannot separate are resolved here; ``detections``
+    their block floors and detected lines (:func:`rwadist.empirical.line_detections`), or None.
+
+    A run's Welch PSD, block floor and lines are its own: those of every run of the context are computed once (kept
+    on the context) and the rows of ``runs`` taken, so the fit on the fit runs and the refit on every run share
+    them; computed on ``test`` alone when the context's runs cannot be (a run shorter than the segment outside
+    ``runs``)."""
+    from dataclasses import replace
+
+    from ...data import DataError
+    from ...empirical import detections_of_runs, line_detections
+    from ...spectra import _default_nperseg, compute_spectra
+
+    nperseg = _default_nperseg(int(np.median([r.n_samples for r in test.runs])))
+    key = ("suspension_modes.spectra", nperseg)
+    if key not in ctx._memo:
+        try:
+            full = compute_spectra(ctx.test, nperseg=nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
+            ctx._memo[key] = (full, line_detections(full))
+        except DataError:
+            ctx._memo[key] = None
+    if ctx._memo[key] is None:
+        return compute_spectra(test, nperseg=nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim), None
+    full, det = ctx._memo[key]
+    rows = np.asarray(runs, dtype=int)
+    chans = test.channels
+    # consecutive runs (every run with a speed): views, not copies
+    sel = slice(rows[0], rows[-1] + 1) if rows.size and np.all(np.diff(rows) == 1) else rows
+    sp = replace(full, speed=full.speed[sel], psd={c: full.psd[c][sel] for c in chans},
+                 amplitude={c: full.amplitude[c][sel] for c in chans}, n_segments=full.n_segments[sel],
+                 run_names=[full.run_names[r] for r in rows])
+    if rows.size and np.any(np.diff(rows) <= 0):
+        return sp, None                 # the lines' renumbering needs the runs in order
+    return sp, detections_of_runs({c: det[c] for c in chans if c in det}, rows)
+
+
 def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None):
     """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
     amplification (or the extended fit fails); ``stand`` is the fixture resonance (f_r Hz, ζ, peak gain)
@@ -42,15 +81,12 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     from ...data import SteadyTest
     from ...empirical import fit_empirical
     from ...extended_fit import amplification_peaks, fit_extended
-    from ...spectra import compute_spectra
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
     offset = None                       # a load-cell offset r (m) removed from the torques to locate the modes
-    # the fit's own resolution (the longest segment, as ``rwadist fit``): close lines (h = 5.37, 5.57 of the
-    # E wheel) that diagnose's shorter Welch segments cannot separate are resolved here
-    sp = compute_spectra(test, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
-    fit = fit_empirical(sp)
+    sp, detections = _fit_spectra(ctx, test, runs)
+    fit = fit_empirical(sp, detections=detections)
     if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
         return None
     try:
@@ -174,12 +210,13 @@ def _whole_data_fit(ctx: Context):
     the held-out ones."""
     from ...data import SteadyTest
     from ...empirical import fit_empirical
-    from ...spectra import compute_spectra
 
     key = ("suspension_modes.whole_data_fit",)
     if key not in ctx._memo:
-        test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], dict(ctx.test.meta))
-        ctx._memo[key] = fit_empirical(compute_spectra(test, window=ctx.sp.window, f_lim=ctx.sp.f_lim))
+        runs = [int(r) for r in ctx.runs]
+        test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
+        sp, detections = _fit_spectra(ctx, test, runs)
+        ctx._memo[key] = fit_empirical(sp, detections=detections)
     return ctx._memo[key]
 
 

@@ -1,0 +1,101 @@
+"""Whole-run discrete Fourier transforms at arbitrary frequencies (not on the FFT grid).
+
+The extended fit reads each radial line's rotation sense from the x/y phase of the whole record
+(:func:`rwadist.extended_fit.line_senses`), and ``rwadist diagnose`` measures lines, sidebands and phasors
+on the whole record of every run (:meth:`rwadist.diagnose.engine.Context.phasors`,
+:func:`rwadist.diagnose.effects.speed_sidebands._run_line_power`).  Those sums are computed here: one run
+(:func:`windowed_dft`) or a stack of equally long runs at once (:func:`windowed_dfts`: one batched matrix
+product per chunk of runs instead of a dozen small array operations per run), and the transform of the
+periodic Hann window in closed form (:func:`hann_transform`: the leakage of a line into its neighbours).
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+from scipy import signal
+
+#: elements (runs × frequencies × the larger of the block and blocks × channels) of one chunk of
+#: :func:`windowed_dfts`: the temporaries stay a few tens of MB however many runs are stacked
+CHUNK_ELEMENTS = 1 << 16
+
+
+@functools.lru_cache(maxsize=16)
+def run_window(name, n: int) -> tuple:
+    """(w (n,), Σw, Σw²) of the window ``name`` (:func:`scipy.signal.get_window`, periodic) over a record of ``n``
+    samples, computed once per (name, n): every run of a test has the same length, and the whole-run phasors ask
+    for it on every search step.  ``w`` is read-only (it is shared)."""
+    w = signal.get_window(name, n)
+    w.flags.writeable = False
+    return w, float(np.sum(w)), float(np.sum(w**2))
+
+
+def unit_phasors(f_hz: np.ndarray, dt: float, count: int) -> np.ndarray:
+    """e^{−2πj f k·dt} (L, count) for k = 0 … count − 1 at ``f_hz`` (L,) Hz, ``dt`` s: as a product of two tables of
+    about √count exponentials each, k = k_lo + m·k_hi (complex exponentials cost far more than the product of two
+    unit phasors, which is the same number to rounding)."""
+    m = max(int(np.ceil(np.sqrt(count))), 1)
+    lo = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(m) * dt))                                # (L, m)
+    hi = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(-(-count // m)) * (m * dt)))          # (L, ⌈count/m⌉)
+    return (hi[:, :, None] * lo[:, None, :]).reshape(f_hz.size, -1)[:, :count]
+
+
+def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128) -> np.ndarray:
+    """Σ_n x[r, n, k]·e^{−2πj f[r, l] t_n} (t_n = n/sample_rate) of a stack of R equally long records ``x``
+    (R, n, K) at frequencies ``f_hz`` (R, L) Hz, each record at its own frequencies; returns (R, L, K) complex.
+
+    The samples are cut into blocks of ``block``: e^{−2πj f (t_b + t_j)} = e^{−2πj f t_b}·e^{−2πj f t_j}, so
+    only L·(block + n/block) exponentials are needed per record instead of L·n (a product of two unit phasors:
+    the same sum to rounding), and each of those two tables is itself such a product (:func:`unit_phasors`).
+    With the samples of a block along the rows and (block, channel) along the columns the fine sums are one
+    (2L, B) @ (B, J·K) product per record (real and imaginary parts stacked), batched over the records of a
+    chunk (:data:`CHUNK_ELEMENTS`), and the coarse sums one (1, J) @ (J, K) product per frequency."""
+    x = np.asarray(x, dtype=float)
+    n_rec, n, k = x.shape
+    f_hz = np.asarray(f_hz, dtype=float).reshape(n_rec, -1)
+    n_f = f_hz.shape[1]
+    n_blocks = -(-n // block)
+    out = np.empty((n_rec, n_f, k), dtype=complex)
+    if n_rec == 0 or n_f == 0:
+        return out
+    step = max(1, CHUNK_ELEMENTS // (n_f * max(block, n_blocks * k)))
+    for s in range(0, n_rec, step):
+        xs = x[s:s + step]
+        r = xs.shape[0]
+        if n != n_blocks * block:
+            pad = np.zeros((r, n_blocks * block, k))
+            pad[:, :n] = xs
+            xs = pad
+        xt = xs.reshape(r, n_blocks, block, k).transpose(0, 2, 1, 3).reshape(r, block, n_blocks * k)   # (r, B, J·K)
+        f = f_hz[s:s + step].ravel()
+        fine = unit_phasors(f, 1.0 / sample_rate, block).reshape(r, n_f, block)                        # (r, L, B)
+        coarse = unit_phasors(f, block / sample_rate, n_blocks).reshape(r, n_f, 1, n_blocks)          # (r, L, 1, J)
+        parts = np.concatenate([fine.real, fine.imag], axis=1) @ xt                                    # (r, 2L, J·K)
+        inner = (parts[:, :n_f] + 1j * parts[:, n_f:]).reshape(r, n_f, n_blocks, k)                 # (r, L, J, K)
+        out[s:s + step] = (coarse @ inner)[:, :, 0, :]
+    return out
+
+
+def windowed_dft(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128) -> np.ndarray:
+    """Σ_n x[n]·e^{−2πj f t_n} (t_n = n/sample_rate) of the columns of ``x`` (n, K) at frequencies ``f_hz``
+    (L,) Hz, any f (not on the FFT grid); returns (L, K) complex (:func:`windowed_dfts` of one record)."""
+    x = np.asarray(x, dtype=float)
+    return windowed_dfts(x[None], sample_rate, np.asarray(f_hz, dtype=float).reshape(1, -1), block)[0]
+
+
+def hann_transform(n: int, sample_rate: float, f_hz: np.ndarray) -> np.ndarray:
+    """W(f) = Σ_{m<n} w[m]·e^{−2πj f m/sample_rate} of the periodic Hann window w[m] = ½ − ½cos(2πm/n)
+    (:func:`scipy.signal.get_window` ``"hann"``) at ``f_hz`` (any shape) Hz, in closed form: with θ = 2πf/f_s
+    and the Dirichlet sum D(θ) = Σ_{m<n} e^{−jθm} = e^{−jθ(n−1)/2}·sin(nθ/2)/sin(θ/2) (= n at θ ≡ 0 mod 2π),
+    W = ½D(θ) − ¼D(θ − 2π/n) − ¼D(θ + 2π/n).  W(0) = n/2 = Σw; complex (any shape of ``f_hz``)."""
+    theta = 2 * np.pi * np.asarray(f_hz, dtype=float) / sample_rate
+    out = np.zeros(theta.shape, dtype=complex)
+    for weight, shift in ((0.5, 0.0), (-0.25, -2 * np.pi / n), (-0.25, 2 * np.pi / n)):
+        th = theta + shift
+        half = np.sin(0.5 * th)
+        # θ ≡ 0 (mod 2π): every term of the sum is 1; sin(θ/2) is then 0 to rounding (relative to θ)
+        at_zero = np.abs(half) <= 1e-12 * np.maximum(np.abs(th), 1.0)
+        ratio = np.where(at_zero, n * np.cos(0.5 * th) ** (n - 1),
+                         np.sin(0.5 * n * th) / np.where(at_zero, 1.0, half))
+        out += weight * np.exp(-0.5j * th * (n - 1)) * ratio
+    return out

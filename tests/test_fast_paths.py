@@ -1,0 +1,149 @@
+"""The faster forms diagnose and the extended fit use, each against the direct form it replaces (issue 14's timing):
+the mode scan's product-grid SSR against a per-line non-negative least squares (scipy.optimize.nnls), the Hann
+window's closed-form transform against its plain sum, the batched whole-run DFT against the plain sum, a second
+empirical fit reusing the first one's detections against a fresh one, and the suspension-mode fit's spectra taken
+from every run's against those of its runs alone."""
+import numpy as np
+from scipy import optimize, signal
+
+from rwadist.dft import hann_transform, windowed_dfts
+from rwadist.empirical import fit_empirical, line_detections
+from rwadist.mode_scan import _grid_search, transmissibility_sq
+from rwadist.presets import preset
+from rwadist.spectra import compute_spectra
+from rwadist.teststand import simulate_steady
+
+
+def _scan_case(seed=3):
+    """A few lines measured at a few speeds through a rocking-like mode, with scatter."""
+    rng = np.random.default_rng(seed)
+    n_lines, n_speeds = 4, 9
+    line = np.repeat(np.arange(n_lines), n_speeds)
+    h = np.array([1.0, 2.0, 2.7, 4.4])[line]
+    omega = np.tile(np.linspace(40.0, 250.0, n_speeds), n_lines)
+    t_co = transmissibility_sq(h * omega, omega, [55.0], [0.04], [1.6])[0]
+    t_ct = transmissibility_sq(-h * omega, omega, [55.0], [0.04], [1.6])[0]
+    p_co, p_ct = rng.uniform(0.2, 1.0, n_lines), rng.uniform(0.0, 0.3, n_lines)
+    power = omega**4 * (p_co[line] * t_co + p_ct[line] * t_ct) * rng.lognormal(0.0, 0.2, line.size)
+    return line, h, omega, power
+
+
+def _ssr_direct(line, h, omega, power, f0, zeta, a, two_parts):
+    """Σ over lines of the non-negative least squares min ||A·P − 1||² of the relative power residual, A's columns
+    the co- and counter-rotating |T|²·Ω⁴/power (one column without two parts), by scipy.optimize.nnls."""
+    total = 0.0
+    for j in np.unique(line):
+        m = line == j
+        scale = omega[m] ** 4 / power[m]
+        cols = [transmissibility_sq(h[m] * omega[m], omega[m], [f0], [zeta], [a])[0] * scale]
+        if two_parts:
+            cols.append(transmissibility_sq(-h[m] * omega[m], omega[m], [f0], [zeta], [a])[0] * scale)
+        _, rnorm = optimize.nnls(np.column_stack(cols), np.ones(m.sum()))
+        total += rnorm**2
+    return total
+
+
+def test_scan_grid_is_the_per_line_nonnegative_least_squares():
+    line, h, omega, power = _scan_case()
+    f0, zeta = np.array([30.0, 54.0, 56.0, 120.0]), np.array([0.01, 0.04, 0.2])
+    # with a gyroscopic term (rocking), and without (translation: both senses alike, one forcing per line)
+    for a, two_parts in [(np.array([0.0, 1.0, 1.6]), True), (np.array([0.0, 1.0, 1.6]), False),
+                         (np.array([0.0]), True), (np.array([0.0]), False)]:
+        for chunk in (1, 128):                       # one f0 per chunk, and all at once
+            ssr = _grid_search(line, h, omega, power, f0, zeta, a, two_parts, chunk=chunk)
+            assert ssr.shape == (f0.size, zeta.size, a.size)
+            for i, j, k in np.ndindex(ssr.shape):
+                ref = _ssr_direct(line, h, omega, power, f0[i], zeta[j], a[k], two_parts and a[k] != 0)
+                assert abs(ssr[i, j, k] - ref) <= 1e-9 * max(ref, 1e-3 * line.size), (i, j, k, ssr[i, j, k], ref)
+
+
+def test_hann_transform_is_the_window_sum():
+    for n, fs in ((8192, 3840.0), (1001, 1000.0), (64, 10.0)):
+        w = signal.get_window("hann", n)
+        df = fs / n
+        # on and between bins, at 0 and at ±1 bin (the singular points of the closed form's terms), far out, negative
+        f = np.concatenate([[0.0, df, -df, 2 * df, 0.5 * df, 1e-9 * df],
+                            np.random.default_rng(n).uniform(-0.5, 0.5, 40) * fs])
+        ref = np.exp(-2j * np.pi * np.outer(f, np.arange(n)) / fs) @ w
+        got = hann_transform(n, fs, f)
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * n)
+        assert abs(got[0] - np.sum(w)) < 1e-9
+
+
+def test_batched_dft_is_the_plain_sum_per_record():
+    rng = np.random.default_rng(4)
+    for n, fs in ((4096, 3840.0), (1001, 1000.0)):
+        x = rng.normal(size=(5, n, 2))
+        f = rng.uniform(0.5, 0.45 * fs, (5, 7))
+        got = windowed_dfts(x, fs, f)
+        for r in range(5):
+            ref = np.exp(-2j * np.pi * np.outer(f[r], np.arange(n) / fs)) @ x[r]
+            np.testing.assert_allclose(got[r], ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+
+
+def _small_test():
+    return simulate_steady(preset("ithaco-e"), np.linspace(600.0, 3000.0, 12), sample_rate=1000.0, n_samples=2048,
+                           noise=0.01, seed=5, physics="extended", test_stand=False)
+
+
+def test_second_empirical_fit_reusing_the_detections_is_a_fresh_fit():
+    from dataclasses import replace
+
+    from rwadist.empirical import FitSettings
+
+    sp = compute_spectra(_small_test())
+    first = fit_empirical(sp)
+    s = replace(FitSettings(), exclude_modes=False)
+    fresh, reused = fit_empirical(sp, s), fit_empirical(sp, s, detections=first.detections)
+    assert [(x.direction, x.h, x.C) for x in fresh.lines] == [(x.direction, x.h, x.C) for x in reused.lines]
+    for a, b in zip(fresh.lines, reused.lines):
+        np.testing.assert_array_equal(a.amplitude, b.amplitude)
+    # other detection settings: not reused (a lower false-alarm probability detects fewer lines)
+    strict = fit_empirical(sp, replace(s, p_false=1e-6), detections=first.detections)
+    assert strict.detections["Fx"][0] != first.detections["Fx"][0]
+
+
+def test_mode_fit_spectra_of_some_runs_are_those_runs_alone():
+    from rwadist.data import SteadyTest
+    from rwadist.diagnose.effects.suspension_modes import _fit_spectra
+    from rwadist.diagnose.engine import Context
+
+    test = _small_test()
+    ctx = Context(compute_spectra(test, nperseg=512), test=test)
+    for runs in (ctx.fit_runs, ctx.runs):
+        sub = SteadyTest([test.runs[r] for r in runs], dict(test.meta))
+        got, det = _fit_spectra(ctx, sub, list(runs))
+        ref = compute_spectra(sub, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
+        assert got.nperseg == ref.nperseg and got.channels == ref.channels and got.run_names == ref.run_names
+        np.testing.assert_array_equal(got.speed, ref.speed)
+        np.testing.assert_array_equal(got.n_segments, ref.n_segments)
+        for c in ref.channels:
+            np.testing.assert_allclose(got.psd[c], ref.psd[c], rtol=1e-13, atol=0)
+        # the floors and lines of those runs, renumbered, are those found on their spectra alone
+        own = line_detections(ref)
+        for c in ref.channels:
+            np.testing.assert_allclose(det[c][1], own[c][1], rtol=1e-13, atol=0)
+            np.testing.assert_array_equal(det[c][2][0], own[c][2][0])
+            np.testing.assert_allclose(det[c][2][1], own[c][2][1], rtol=1e-13, atol=0)
+
+
+def test_every_line_measured_at_once_is_each_measured_alone():
+    from rwadist.diagnose.effects.fixed_resonance import FixedResonance
+    from rwadist.diagnose.effects.sidebands import Sidebands
+    from rwadist.diagnose.engine import Context, initial_state
+
+    test = _small_test()
+    sp = compute_spectra(test, nperseg=512)
+    ctx = Context(sp, test=test)
+    plain = initial_state(ctx, fit_empirical(sp).model)
+    h2 = plain.model.harmonics("radial_force")[1].h
+    # with a fixed resonance on the lines and a pair of sidebands beside one of them
+    busy = FixedResonance(150.0, 0.03, 5.0, ("Fx", "Fy"), "wheel_mode").apply(plain)
+    busy = Sidebands("radial_force", h2, 9.0, 0.4).apply(busy)
+    for state in (plain, busy):
+        for c in ("Fx", "Tx", "Fz"):
+            lines = ctx.channel_lines(state, c, ctx.runs)
+            together = ctx.measure_lines(state, c, ctx.runs)
+            assert together.shape == (len(lines), ctx.runs.size) and np.isfinite(together).any()
+            for (h, _, _, _), got in zip(lines, together):
+                np.testing.assert_allclose(got, ctx.measure_line(state, c, h, ctx.runs, skip=h), rtol=1e-13, atol=0)
