@@ -56,6 +56,22 @@ def _hann_transform(n: int, delta: np.ndarray) -> np.ndarray:
     return (0.5 * dirichlet(d) - 0.25 * dirichlet(d - 1.0) - 0.25 * dirichlet(d + 1.0)) / (0.5 * n)
 
 
+def record_line_evidence(ctx: Context, chans, P, N, ok, M1) -> tuple:
+    """(drop, se) of lines the state does not predict and an effect predicts with power M₁ (|X|² = a²), measured as
+    P with noise mean N on the whole-run DFT; all (len(chans), n_points), ``ok`` the points to use.  In the units of
+    the error metric (mean square a²/2, each channel divided by its group scale): drop = Σ |P − N| − |P − N − M₁|,
+    se = sqrt(Σ min(M₁, σ)²) with σ² = N² + 2(P − N)N, the variance of the power of a line in complex Gaussian
+    noise (the search's judge: a point's term changes by at most |ΔM|, and by about σ when the change is larger)."""
+    drop, var = 0.0, 0.0
+    for j, c in enumerate(chans):
+        p, n, v, m1 = P[j], N[j], ok[j], M1[j]
+        sig = np.sqrt(n**2 + 2.0 * np.maximum(p - n, 0.0) * n)
+        scale = 2.0 * ctx.scale(c)
+        drop += float(np.sum((np.abs(p - n) - np.abs(p - n - m1))[v])) / scale
+        var += float(np.sum(np.minimum(m1, sig)[v] ** 2)) / scale**2
+    return drop, float(np.sqrt(var))
+
+
 def welch_low_limit(ctx: Context) -> float:
     """Lowest frequency (Hz) whose line the Welch route measures: its window of ±LINE_HALF bins from the band's
     lowest bin k_lo up (:meth:`rwadist.diagnose.engine.Context.measure_line`)."""
@@ -309,15 +325,8 @@ class MissingHarmonic:
         if not self.record or ctx.test is None:
             return None
         P, N, ok, chans = MissingHarmonic._record_points(ctx, state, self.direction, runs, [self.h])
-        drop, var = 0.0, 0.0
-        for j, c in enumerate(chans):
-            m1 = MissingHarmonic._line_amplitude(ctx, state, c, self.direction, self.h, self.C, runs) ** 2
-            p, n, v = P[j, :, 0], N[j, :, 0], ok[j, :, 0]
-            sig = np.sqrt(n**2 + 2.0 * np.maximum(p - n, 0.0) * n)
-            scale = 2.0 * ctx.scale(c)                          # |X|² = a², the mean square a²/2
-            drop += float(np.sum((np.abs(p - n) - np.abs(p - n - m1))[v])) / scale
-            var += float(np.sum(np.minimum(m1, sig)[v] ** 2)) / scale**2
-        return drop, float(np.sqrt(var))
+        m1 = [MissingHarmonic._line_amplitude(ctx, state, c, self.direction, self.h, self.C, runs) ** 2 for c in chans]
+        return record_line_evidence(ctx, chans, P[:, :, 0], N[:, :, 0], ok[:, :, 0], np.array(m1))
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs, max_per_direction: int = 3) -> list:
