@@ -112,12 +112,13 @@ def _state_line_freqs(ctx: Context, state: State, c: str, runs) -> np.ndarray:
     return np.column_stack(out) if out else np.empty((runs.size, 0))
 
 
-def record_residual(ctx: Context, state: State, c: str, runs, f_hz) -> tuple:
+def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool = False) -> tuple:
     """(|X|² (len(runs), L), noise (len(runs), L), valid (len(runs), L)) of channel ``c`` at frequencies ``f_hz``
     (len(runs), L) on the whole-run DFT, less the leakage of every line the state predicts on the channel (each
     line's own phasor times the window's transform, :func:`_hann_transform`, its negative-frequency image too).
 
-    |X|² is read on the record grid at the nearest point (:func:`_record_grid`); the noise is the larger of the white
+    |X|² is read on the record grid at the nearest point (:func:`_record_grid`), or with ``exact`` at ``f_hz`` itself
+    (:func:`rwadist.extended_fit.windowed_dft`); the noise is the larger of the white
     noise of the state's floor there (2·S·fs·Σw²/(Σw)², S at the nearest Welch bin of the band) and the run's own
     median |X|² over the record route's range (/ln 2: the median of an exponential), so that a noise rising below the
     Welch band is not taken for lines.  Valid: in the record route's range (RECORD_MIN_BINS record bins up to
@@ -143,22 +144,29 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz) -> tuple:
         for f_l in fl:
             valid &= np.abs(f_hz[i] - f_l) >= RECORD_SEP_BINS * df_rec
         gi = np.clip(np.rint(f_hz[i] / (df_rec * RECORD_GRID_BINS)).astype(int), 0, grid.size - 1)
-        Xi = X[gi, j]
-        rng = (grid >= RECORD_MIN_BINS * df_rec) & (grid < f_top)
-        Xg = X[rng, j]
+        Xr = X[:, j]
+        clear = (grid >= RECORD_MIN_BINS * df_rec) & (grid < f_top)
         if fl.size:
+            # the leakage on the whole (short) grid once, then read at the points' nearest grid frequencies
             w, wsum, _ = run_window(ctx.sp.window, n)
             x = np.asarray(run.signals[c], dtype=float)
             A = 2.0 * windowed_dft(((x - x.mean()) * w)[:, None], run.sample_rate, fl)[:, 0] / wsum     # (L,)
-
-            def leak(f_pts):
-                return (_hann_transform(n, (f_pts[:, None] - fl[None, :]) / df_rec) * A[None, :]
-                        + _hann_transform(n, (f_pts[:, None] + fl[None, :]) / df_rec) * np.conj(A)[None, :]).sum(1)
-
-            Xi = Xi - leak(grid[gi])
-            fg = grid[rng]
-            clear = np.all(np.abs(fg[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
-            Xg = (Xg - leak(fg))[clear]
+            key = ("missing_harmonic_leak", n, df_rec, grid.size, fl.tobytes())   # the same lines at every step
+            if key not in ctx._memo:
+                ctx._memo[key] = (_hann_transform(n, (grid[:, None] - fl[None, :]) / df_rec),
+                                  _hann_transform(n, (grid[:, None] + fl[None, :]) / df_rec))
+            t_minus, t_plus = ctx._memo[key]
+            Xr = Xr - (t_minus * A[None, :] + t_plus * np.conj(A)[None, :]).sum(1)
+            clear &= np.all(np.abs(grid[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
+        Xi, Xg = Xr[gi], Xr[clear]
+        if exact:
+            # the points' own frequencies (a fit's h refined finer than the grid)
+            w, wsum, _ = run_window(ctx.sp.window, n)
+            x = np.asarray(run.signals[c], dtype=float)
+            Xi = 2.0 * windowed_dft(((x - x.mean()) * w)[:, None], run.sample_rate, f_hz[i])[:, 0] / wsum
+            if fl.size:
+                Xi = Xi - (_hann_transform(n, (f_hz[i][:, None] - fl[None, :]) / df_rec) * A[None, :]
+                           + _hann_transform(n, (f_hz[i][:, None] + fl[None, :]) / df_rec) * np.conj(A)[None, :]).sum(1)
         _, wsum, w2sum = run_window(ctx.sp.window, n)
         white = 2.0 * S[i] * run.sample_rate * w2sum / wsum**2
         local = float(np.median(np.abs(Xg) ** 2)) / np.log(2.0) if Xg.size >= 8 else 0.0
@@ -217,12 +225,12 @@ class MissingHarmonic:
 
     # ------------------------------------------------------------------ the record route (below the Welch band)
     @staticmethod
-    def _record_points(ctx: Context, state: State, direction: str, runs, h_grid) -> tuple:
+    def _record_points(ctx: Context, state: State, direction: str, runs, h_grid, exact: bool = False) -> tuple:
         """(|X|², noise, valid), each (len(chans), len(runs), len(h_grid)), of the lines h·|Ω|/2π of ``h_grid`` on the
         direction's channels (:func:`record_residual`), and the channels."""
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         f = np.outer(ctx.omega[runs] / (2 * np.pi), np.atleast_1d(h_grid))
-        out = [record_residual(ctx, state, c, runs, f) for c in chans]
+        out = [record_residual(ctx, state, c, runs, f, exact) for c in chans]
         return (np.array([o[0] for o in out]), np.array([o[1] for o in out]), np.array([o[2] for o in out]), chans)
 
     @staticmethod
@@ -238,7 +246,8 @@ class MissingHarmonic:
     @staticmethod
     def fit_record(ctx: Context, state: State, direction: str, h: float, runs) -> "MissingHarmonic | None":
         """The record route's fit: h the maximum of Σ|X|² over the valid points on a grid ±1 record-grid step (at the
-        fastest run) around ``h`` (step 1/40 of it, then a parabola through the top three), C by thesis Eq. 3.10 on
+        fastest run) around ``h`` (steps of 1/20 of it, then a parabola through the top three; the points' own
+        frequencies, :func:`record_residual` exact), C by thesis Eq. 3.10 on
         the amplitudes sqrt(|X|² − noise) of the points RECORD_FIT_SNR × over the noise, divided by the fixed
         resonances' and the modal gain (the line before the mount).  None with fewer than RECORD_MIN_POINTS such
         points or RECORD_MIN_RUNS runs, or no positive C."""
@@ -247,7 +256,7 @@ class MissingHarmonic:
         df_rec = float(np.max([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs]))
         step = RECORD_GRID_BINS * df_rec / max(float(ctx.omega[runs].max()) / (2 * np.pi), 1e-9)
         grid = h + np.arange(-20, 21) * step / 20.0
-        P, N, ok, chans = MissingHarmonic._record_points(ctx, state, direction, runs, grid)
+        P, N, ok, chans = MissingHarmonic._record_points(ctx, state, direction, runs, grid, exact=True)
         every = ok.all(axis=2)                                 # the points valid across the whole grid
         tot = np.sum(np.where(every[:, :, None], P, 0.0), axis=(0, 1))
         i = int(np.argmax(tot))
@@ -257,7 +266,7 @@ class MissingHarmonic:
             h = float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * (grid[1] - grid[0]))
         else:
             h = float(grid[i])
-        P, N, ok, chans = MissingHarmonic._record_points(ctx, state, direction, runs, [h])
+        P, N, ok, chans = MissingHarmonic._record_points(ctx, state, direction, runs, [h], exact=True)
         d, w, used = [], [], np.zeros(runs.size, bool)
         for j, c in enumerate(chans):
             keep = ok[j, :, 0] & (P[j, :, 0] > RECORD_FIT_SNR * N[j, :, 0])
@@ -294,11 +303,11 @@ class MissingHarmonic:
             if not any(c in ctx.channels for c in chans):
                 continue
             P, N, ok, _ = MissingHarmonic._record_points(ctx, state, d, runs, h_grid)
-            z = P / np.maximum(N, 1e-300)
+            z = np.where(ok, P / np.maximum(N, 1e-300), np.nan).reshape(-1, h_grid.size)
+            enough = (ok.sum(axis=(0, 1)) >= RECORD_MIN_POINTS) & (ok.any(axis=0).sum(axis=0) >= RECORD_MIN_RUNS)
             score = np.zeros(h_grid.size)
-            n_runs = ok.any(axis=0).sum(axis=0)
-            for i in np.nonzero((ok.sum(axis=(0, 1)) >= RECORD_MIN_POINTS) & (n_runs >= RECORD_MIN_RUNS))[0]:
-                score[i] = float(np.median(z[:, :, i][ok[:, :, i]]))
+            if enough.any():
+                score[enough] = np.nanmedian(z[:, enough], axis=0)
             peaks = np.nonzero((score[1:-1] > score[:-2]) & (score[1:-1] >= score[2:])
                                & (score[1:-1] > RECORD_SCORE))[0] + 1
             found = []
@@ -324,7 +333,7 @@ class MissingHarmonic:
         P in complex Gaussian noise of mean n."""
         if not self.record or ctx.test is None:
             return None
-        P, N, ok, chans = MissingHarmonic._record_points(ctx, state, self.direction, runs, [self.h])
+        P, N, ok, chans = MissingHarmonic._record_points(ctx, state, self.direction, runs, [self.h], exact=True)
         m1 = [MissingHarmonic._line_amplitude(ctx, state, c, self.direction, self.h, self.C, runs) ** 2 for c in chans]
         return record_line_evidence(ctx, chans, P[:, :, 0], N[:, :, 0], ok[:, :, 0], np.array(m1))
 
