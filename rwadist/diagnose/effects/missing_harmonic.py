@@ -287,9 +287,10 @@ class MissingHarmonic:
         and h of a grid (from 0.1 to where the slowest run's line reaches that frequency, steps of one record-grid step
         at the fastest run), the median over the valid points (runs, channels) of |X|²/noise (:func:`record_residual`),
         with at least RECORD_MIN_POINTS points in RECORD_MIN_RUNS runs; its local maxima above RECORD_SCORE, strongest
-        first, away from the state's harmonics, fitted by :meth:`fit_record`."""
-        if ctx.test is None:
-            return []
+        first, away from the state's harmonics, fitted by :meth:`fit_record`.  Nothing on a state with a spin smear or
+        a speed ripple (the record's lines are not steady there)."""
+        if ctx.test is None or state.smear is not None or state.ripple is not None:
+            return []                   # a swept or rippled speed: the record's lines are not steady ones
         w_hz = ctx.omega[runs] / (2 * np.pi)
         if w_hz.size < RECORD_MIN_RUNS or w_hz.min() <= 0:
             return []
@@ -330,8 +331,8 @@ class MissingHarmonic:
         power on the whole-run DFT, Σ |P − n − M₀| − |P − n − M₁| over the valid points of ``runs``, M₀ = 0 (the
         state predicts no line there: the points are clear of its lines) and M₁ the line's power as this effect
         predicts it (|X|² = a²); se as the search's judge, sqrt(Σ min(|ΔM|, σ)²), σ² = n² + 2Pn of a line of power
-        P in complex Gaussian noise of mean n."""
-        if not self.record or ctx.test is None:
+        P in complex Gaussian noise of mean n.  None on a state with a spin smear or a speed ripple."""
+        if not self.record or ctx.test is None or state.smear is not None or state.ripple is not None:
             return None
         P, N, ok, chans = MissingHarmonic._record_points(ctx, state, self.direction, runs, [self.h], exact=True)
         m1 = [MissingHarmonic._line_amplitude(ctx, state, c, self.direction, self.h, self.C, runs) ** 2 for c in chans]

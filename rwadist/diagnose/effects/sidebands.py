@@ -178,10 +178,13 @@ class Sidebands:
         (:meth:`_record_power`, the carrier's leakage taken off).  (drop, se) of the misplaced sideband power on the
         valid points of both sides (:func:`~rwadist.diagnose.effects.missing_harmonic.record_line_evidence`; the
         state predicts no sidebands on this carrier, the effect (m·a·g/2)² per side, a the carrier's model amplitude
-        in the channel, g the fixed resonances' gain at the side)."""
+        in the channel, g the fixed resonances' gain at the side).  Not on a state with a spin smear or a speed ripple
+        (their lines are no steady lines on the record)."""
         from .missing_harmonic import record_line_evidence
 
-        if ctx.test is None or self.f_mod >= 2.5 * ctx.df:
+        if ctx.test is None or self.f_mod >= 2.5 * ctx.df or state.smear is not None or state.ripple is not None:
+            # (a swept speed smears the carrier over the record, a speed ripple gives it sidebands of its own that the
+            # state predicts in its PSDs: the record's lines are not steady ones, and the search's judge decides)
             return None
         if any(d == self.direction and abs(h - self.h) < 1e-4 for d, h, _, _ in state.sidebands):
             return None
