@@ -209,7 +209,11 @@ def parameter(kind: str, e: dict, truth: dict) -> str:
         return f"{name} {got:.4g} (truth {want:g}, {100 * (got / want - 1):+.1f} %)"
 
     if kind == "missing_harmonic":
-        return rel(e["h"], truth["h"], "h")
+        from rwadist.presets import preset
+
+        # the injected load: fraction·C₁ of the direction's fundamental (rwadist.inject)
+        c_true = truth["fraction"] * preset("ithaco-e").fundamental_C(truth["direction"])
+        return rel(e["h"], truth["h"], "h") + ", " + rel(e["C"], c_true, "C")
     if kind == "amplitude_law":
         return f"h {e.get('h', float('nan')):.3g}, " + rel(e["exponent"], truth["exponent"], "p")
     if kind == "broadband_floor":
@@ -220,7 +224,7 @@ def parameter(kind: str, e: dict, truth: dict) -> str:
         r = e["r_m"]
         return f"r_z {1000 * r[2]:.1f} mm (truth {1000 * truth['r_z']:g} mm), r_x {1000 * r[0]:.1f}, r_y {1000 * r[1]:.1f}"
     if kind == "sidebands":
-        return rel(e["f_mod_Hz"], truth["f_mod_hz"], "f_mod") + f", m {e['depth']:.3g} (truth {truth['depth']:g})"
+        return rel(e["f_mod_Hz"], truth["f_mod_hz"], "f_mod") + ", " + rel(e["depth"], truth["depth"], "m")
     if kind == "speed_sidebands":
         return (rel(e["h_lower"], 1 - truth["per_rev"], "h_lower") + ", " + rel(e["h_upper"], 1 + truth["per_rev"], "h_upper")
                 + f", C/C_carrier {e.get('ratio_lower', float('nan')):.3g}/{e.get('ratio_upper', float('nan')):.3g} "

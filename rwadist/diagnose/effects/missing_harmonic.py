@@ -1,4 +1,13 @@
-"""``missing_harmonic``: a line at h·|Ω| the model lacks."""
+"""``missing_harmonic``: a line at h·|Ω| the model lacks.
+
+Two routes.  The Welch route (:meth:`MissingHarmonic.candidates`' ridges of the residual PSD) measures a line whose
+window of ±LINE_HALF Welch bins lies in the analysed band (from F_MIN_BINS Welch bins up).  Below that, where a short
+record or a high sample rate puts the Welch grid's lowest analysed bin above a low line (h = 0.5 at 300-3000 rpm is
+2.5-25 Hz; the lowest Welch bin measured is 52 Hz at 2048 samples and 3840 Hz, 34 Hz at 8192 samples and 10 kHz), the
+time series still resolve it: the whole-run DFT's bins are 4× finer than the Welch segments'.  The record route
+(:meth:`MissingHarmonic.record_candidates`) measures the line there, on the points the Welch route cannot, and judges
+it there too (:meth:`MissingHarmonic.heldout_evidence`: the error metric's bands start at the same lowest bin, so the
+PSDs cannot see it)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -7,21 +16,178 @@ import numpy as np
 
 from ...model import Harmonic
 from ...units import DIRECTION_CHANNELS
+from ..constants import LINE_HALF
 from ..engine import Context
 from ..measure import _measure, refine_h, ridge_peaks
 from ..state import State
 from .base import register, schema_entry
 
+#: Lowest frequency of a point of the record route, record bins (fs/n): the mean is taken off the record, and the
+#: Hann window's own lobe at 0 Hz is ±2 bins wide; 4 bins as the matrix's signature of a line (SIGNATURE_MIN_BIN).
+RECORD_MIN_BINS = 4.0
+#: Smallest separation (record bins) of a point from every line the state predicts on the channel: the edge of the
+#: Hann main lobe (beyond it the transform is below −31 dB, and those lines' leakage is subtracted with their phasors).
+RECORD_SEP_BINS = 2.0
+#: Grid of the record spectrum, record bins: the Hann-windowed record zero-padded 4× (a line between grid points
+#: loses at most 0.1 dB).
+RECORD_GRID_BINS = 0.25
+#: A ridge's score (median of |X|²/noise over its points) to clear: the line 20 × over the noise on half its points, as
+#: the whole-run scans of ``sidebands`` and ``speed_sidebands``.
+RECORD_SCORE = 20.0
+#: Fewest points (run, channel) and runs of a record-route ridge or fit.
+RECORD_MIN_POINTS = 6
+RECORD_MIN_RUNS = 3
+#: Points used for C stand this many times over the noise (as the whole-run fit of ``speed_sidebands``).
+RECORD_FIT_SNR = 10.0
+
+
+def _hann_transform(n: int, delta: np.ndarray) -> np.ndarray:
+    """W(δ)/W(0) of the periodic Hann window of ``n`` samples at offsets ``delta`` (record bins, any real): with
+    D(δ) = Σ_{k<n} e^{−2πjδk/n} = (1 − e^{−2πjδ})/(1 − e^{−2πjδ/n}) (n at δ = 0), W = D(δ)/2 − D(δ−1)/4 − D(δ+1)/4
+    and W(0) = n/2.  A line A·e^{2πj f_l t} puts A·W((f − f_l)/df)/W(0) into the whole-run phasor at f (the
+    convention of :func:`rwadist.extended_fit.windowed_dft`: Σ x e^{−2πj f t})."""
+    def dirichlet(d):
+        num = 1.0 - np.exp(-2j * np.pi * d)
+        den = 1.0 - np.exp(-2j * np.pi * d / n)
+        small = np.abs(den) < 1e-12
+        return np.where(small, n, num / np.where(small, 1.0, den))
+
+    d = np.asarray(delta, dtype=float)
+    return (0.5 * dirichlet(d) - 0.25 * dirichlet(d - 1.0) - 0.25 * dirichlet(d + 1.0)) / (0.5 * n)
+
+
+def record_line_evidence(ctx: Context, chans, P, N, ok, M1) -> tuple:
+    """(drop, se) of lines the state does not predict and an effect predicts with power M₁ (|X|² = a²), measured as
+    P with noise mean N on the whole-run DFT; all (len(chans), n_points), ``ok`` the points to use.  In the units of
+    the error metric (mean square a²/2, each channel divided by its group scale): drop = Σ |P − N| − |P − N − M₁|,
+    se = sqrt(Σ min(M₁, σ)²) with σ² = N² + 2(P − N)N, the variance of the power of a line in complex Gaussian
+    noise (the search's judge: a point's term changes by at most |ΔM|, and by about σ when the change is larger)."""
+    drop, var = 0.0, 0.0
+    for j, c in enumerate(chans):
+        p, n, v, m1 = P[j], N[j], ok[j], M1[j]
+        sig = np.sqrt(n**2 + 2.0 * np.maximum(p - n, 0.0) * n)
+        scale = 2.0 * ctx.scale(c)
+        drop += float(np.sum((np.abs(p - n) - np.abs(p - n - m1))[v])) / scale
+        var += float(np.sum(np.minimum(m1, sig)[v] ** 2)) / scale**2
+    return drop, float(np.sqrt(var))
+
+
+def welch_low_limit(ctx: Context) -> float:
+    """Lowest frequency (Hz) whose line the Welch route measures: its window of ±LINE_HALF bins from the band's
+    lowest bin k_lo up (:meth:`rwadist.diagnose.engine.Context.measure_line`)."""
+    return (ctx.k_lo + LINE_HALF) * ctx.df
+
+
+def _record_grid(ctx: Context, r: int) -> tuple:
+    """(f (G,) Hz, X (G, K) complex, record df Hz, n) of run ``r``: the whole-run phasors X = 2·Σ w x e^{−2πj f t}/Σ w
+    (Hann, the mean taken off; x ≈ Re(X e^{2πj f t})) of every channel of ``ctx.channels`` on a grid of
+    RECORD_GRID_BINS record bins up to the Welch route's lowest frequency plus 20 record bins (a 4× zero-padded FFT);
+    kept on the context (the data's, the same at every search step)."""
+    key = ("missing_harmonic_record", r)
+    if key not in ctx._memo:
+        from ...extended_fit import run_window
+
+        run = ctx.test.runs[r]
+        n = run.n_samples
+        w, wsum, _ = run_window(ctx.sp.window, n)
+        df_rec = run.sample_rate / n
+        pad = int(round(1.0 / RECORD_GRID_BINS))
+        n_keep = int(np.ceil((welch_low_limit(ctx) / df_rec + 20.0) / RECORD_GRID_BINS)) + 1
+        X = np.full((n_keep, len(ctx.channels)), np.nan + 0j)
+        for j, c in enumerate(ctx.channels):
+            if c in run.signals:
+                x = np.asarray(run.signals[c], dtype=float)
+                X[:, j] = 2.0 * np.fft.rfft((x - x.mean()) * w, pad * n)[:n_keep] / wsum
+        ctx._memo[key] = (np.arange(n_keep) * df_rec * RECORD_GRID_BINS, X, df_rec, n)
+    return ctx._memo[key]
+
+
+def _state_line_freqs(ctx: Context, state: State, c: str, runs) -> np.ndarray:
+    """(len(runs), L) frequencies (Hz, ≥ 0) of every line the state predicts on channel ``c`` (carriers and their
+    sidebands)."""
+    out = []
+    for h, _, _, _ in ctx.channel_lines(state, c, runs):
+        for shift, _ in state.line_components(c, h):
+            out.append(np.abs(h * ctx.omega[runs] / (2 * np.pi) + shift))
+    return np.column_stack(out) if out else np.empty((runs.size, 0))
+
+
+def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool = False) -> tuple:
+    """(|X|² (len(runs), L), noise (len(runs), L), valid (len(runs), L)) of channel ``c`` at frequencies ``f_hz``
+    (len(runs), L) on the whole-run DFT, less the leakage of every line the state predicts on the channel (each
+    line's own phasor times the window's transform, :func:`_hann_transform`, its negative-frequency image too).
+
+    |X|² is read on the record grid at the nearest point (:func:`_record_grid`), or with ``exact`` at ``f_hz`` itself
+    (:func:`rwadist.extended_fit.windowed_dft`); the noise is the larger of the white
+    noise of the state's floor there (2·S·fs·Σw²/(Σw)², S at the nearest Welch bin of the band) and the run's own
+    median |X|² over the record route's range (/ln 2: the median of an exponential), so that a noise rising below the
+    Welch band is not taken for lines.  Valid: in the record route's range (RECORD_MIN_BINS record bins up to
+    :func:`welch_low_limit`) and RECORD_SEP_BINS record bins from every line of the state on the channel."""
+    from ...extended_fit import run_window, windowed_dft
+
+    j = ctx.channels.index(c)
+    f_hz = np.asarray(f_hz, dtype=float)
+    P = np.full(f_hz.shape, np.nan)
+    N = np.full(f_hz.shape, np.nan)
+    ok = np.zeros(f_hz.shape, bool)
+    lines = _state_line_freqs(ctx, state, c, runs)
+    f_top = welch_low_limit(ctx)
+    k_w = np.clip(np.rint(f_hz / ctx.df).astype(int), ctx.k_lo, ctx.k_hi)
+    S = np.take_along_axis(ctx.floor_psd(state, c, runs), k_w, axis=1)
+    for i, r in enumerate(runs):
+        grid, X, df_rec, n = _record_grid(ctx, int(r))
+        if not np.all(np.isfinite(X[:, j])):
+            continue
+        run = ctx.test.runs[r]
+        fl = lines[i][lines[i] < f_top + 20.0 * df_rec]
+        valid = (f_hz[i] >= RECORD_MIN_BINS * df_rec) & (f_hz[i] < f_top)
+        for f_l in fl:
+            valid &= np.abs(f_hz[i] - f_l) >= RECORD_SEP_BINS * df_rec
+        gi = np.clip(np.rint(f_hz[i] / (df_rec * RECORD_GRID_BINS)).astype(int), 0, grid.size - 1)
+        Xr = X[:, j]
+        clear = (grid >= RECORD_MIN_BINS * df_rec) & (grid < f_top)
+        if fl.size:
+            # the leakage on the whole (short) grid once, then read at the points' nearest grid frequencies
+            w, wsum, _ = run_window(ctx.sp.window, n)
+            x = np.asarray(run.signals[c], dtype=float)
+            A = 2.0 * windowed_dft(((x - x.mean()) * w)[:, None], run.sample_rate, fl)[:, 0] / wsum     # (L,)
+            key = ("missing_harmonic_leak", n, df_rec, grid.size, fl.tobytes())   # the same lines at every step
+            if key not in ctx._memo:
+                ctx._memo[key] = (_hann_transform(n, (grid[:, None] - fl[None, :]) / df_rec),
+                                  _hann_transform(n, (grid[:, None] + fl[None, :]) / df_rec))
+            t_minus, t_plus = ctx._memo[key]
+            Xr = Xr - (t_minus * A[None, :] + t_plus * np.conj(A)[None, :]).sum(1)
+            clear &= np.all(np.abs(grid[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
+        Xi, Xg = Xr[gi], Xr[clear]
+        if exact:
+            # the points' own frequencies (a fit's h refined finer than the grid)
+            w, wsum, _ = run_window(ctx.sp.window, n)
+            x = np.asarray(run.signals[c], dtype=float)
+            Xi = 2.0 * windowed_dft(((x - x.mean()) * w)[:, None], run.sample_rate, f_hz[i])[:, 0] / wsum
+            if fl.size:
+                Xi = Xi - (_hann_transform(n, (f_hz[i][:, None] - fl[None, :]) / df_rec) * A[None, :]
+                           + _hann_transform(n, (f_hz[i][:, None] + fl[None, :]) / df_rec) * np.conj(A)[None, :]).sum(1)
+        _, wsum, w2sum = run_window(ctx.sp.window, n)
+        white = 2.0 * S[i] * run.sample_rate * w2sum / wsum**2
+        local = float(np.median(np.abs(Xg) ** 2)) / np.log(2.0) if Xg.size >= 8 else 0.0
+        P[i] = np.abs(Xi) ** 2
+        N[i] = np.maximum(white, local)
+        ok[i] = valid
+    return P, N, ok
+
 
 @register(order=10)
 @dataclass
 class MissingHarmonic:
-    """A line at h·|Ω| the model lacks; amplitude C·Ω² (C in SI per (rad/s)²)."""
+    """A line at h·|Ω| the model lacks; amplitude C·Ω² (C in SI per (rad/s)²).  ``record``: found and fitted on the
+    whole-run DFT below the Welch route's lowest frequency (:meth:`record_candidates`), judged there
+    (:meth:`heldout_evidence`)."""
 
     direction: str
     h: float
     C: float
     n_points: int = 0
+    record: bool = False
     kind: str = "missing_harmonic"
 
     @property
@@ -37,7 +203,10 @@ class MissingHarmonic:
         return s
 
     def refit(self, ctx: Context, state: State) -> "MissingHarmonic":
-        """Refitted on every run (``ctx.runs``); itself when that fit fails."""
+        """Refitted on every run (``ctx.runs``), on the whole-run DFT for a record-route line; itself when that fit
+        fails."""
+        if self.record:
+            return MissingHarmonic.fit_record(ctx, state, self.direction, self.h, ctx.runs) or self
         return MissingHarmonic.fit(ctx, state, self.direction, self.h, ctx.runs) or self
 
     def to_schema(self) -> dict:
@@ -54,8 +223,125 @@ class MissingHarmonic:
         C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
         return MissingHarmonic(direction, float(h), C, int(d.size))
 
+    # ------------------------------------------------------------------ the record route (below the Welch band)
+    @staticmethod
+    def _record_points(ctx: Context, state: State, direction: str, runs, h_grid, exact: bool = False) -> tuple:
+        """(|X|², noise, valid), each (len(chans), len(runs), len(h_grid)), of the lines h·|Ω|/2π of ``h_grid`` on the
+        direction's channels (:func:`record_residual`), and the channels."""
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        f = np.outer(ctx.omega[runs] / (2 * np.pi), np.atleast_1d(h_grid))
+        out = [record_residual(ctx, state, c, runs, f, exact) for c in chans]
+        return (np.array([o[0] for o in out]), np.array([o[1] for o in out]), np.array([o[2] for o in out]), chans)
+
+    @staticmethod
+    def _line_amplitude(ctx: Context, state: State, c: str, direction: str, h: float, C: float, runs) -> np.ndarray:
+        """Amplitude (unit, per run) in channel ``c`` of a line (direction, h) of free amplitude C·Ω²: through the
+        state's modes (extended base) and fixed resonances."""
+        w = ctx.omega[runs]
+        a = C * w**2 * ctx.gain(state, c, h * w / (2 * np.pi))
+        if state.ext is not None:
+            a = a * ctx.modal_gain(state, c, h, runs)
+        return a
+
+    @staticmethod
+    def fit_record(ctx: Context, state: State, direction: str, h: float, runs) -> "MissingHarmonic | None":
+        """The record route's fit: h the maximum of Σ|X|² over the valid points on a grid ±1 record-grid step (at the
+        fastest run) around ``h`` (steps of 1/20 of it, then a parabola through the top three; the points' own
+        frequencies, :func:`record_residual` exact), C by thesis Eq. 3.10 on
+        the amplitudes sqrt(|X|² − noise) of the points RECORD_FIT_SNR × over the noise, divided by the fixed
+        resonances' and the modal gain (the line before the mount).  None with fewer than RECORD_MIN_POINTS such
+        points or RECORD_MIN_RUNS runs, or no positive C."""
+        if ctx.test is None:
+            return None
+        df_rec = float(np.max([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs]))
+        step = RECORD_GRID_BINS * df_rec / max(float(ctx.omega[runs].max()) / (2 * np.pi), 1e-9)
+        grid = h + np.arange(-20, 21) * step / 20.0
+        P, N, ok, chans = MissingHarmonic._record_points(ctx, state, direction, runs, grid, exact=True)
+        every = ok.all(axis=2)                                 # the points valid across the whole grid
+        tot = np.sum(np.where(every[:, :, None], P, 0.0), axis=(0, 1))
+        i = int(np.argmax(tot))
+        if 0 < i < grid.size - 1:
+            lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
+            den = lo - 2 * mid + hi
+            h = float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * (grid[1] - grid[0]))
+        else:
+            h = float(grid[i])
+        P, N, ok, chans = MissingHarmonic._record_points(ctx, state, direction, runs, [h], exact=True)
+        d, w, used = [], [], np.zeros(runs.size, bool)
+        for j, c in enumerate(chans):
+            keep = ok[j, :, 0] & (P[j, :, 0] > RECORD_FIT_SNR * N[j, :, 0])
+            unit = MissingHarmonic._line_amplitude(ctx, state, c, direction, h, 1.0, runs)   # per unit C
+            a = np.sqrt(np.maximum(P[j, :, 0] - N[j, :, 0], 0.0)) / np.maximum(unit, 1e-300) * ctx.omega[runs] ** 2
+            d.append(a[keep])
+            w.append(ctx.omega[runs][keep])
+            used |= keep
+        d, w = np.concatenate(d), np.concatenate(w)
+        if d.size < RECORD_MIN_POINTS or used.sum() < RECORD_MIN_RUNS:
+            return None
+        C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
+        return MissingHarmonic(direction, h, C, int(d.size), record=True) if C > 0 else None
+
+    @staticmethod
+    def record_candidates(ctx: Context, state: State, runs, max_per_direction: int = 3) -> list:
+        """Lines below the Welch route's lowest frequency (:func:`welch_low_limit`) on the whole-run DFT: per direction
+        and h of a grid (from 0.1 to where the slowest run's line reaches that frequency, steps of one record-grid step
+        at the fastest run), the median over the valid points (runs, channels) of |X|²/noise (:func:`record_residual`),
+        with at least RECORD_MIN_POINTS points in RECORD_MIN_RUNS runs; its local maxima above RECORD_SCORE, strongest
+        first, away from the state's harmonics, fitted by :meth:`fit_record`.  Nothing on a state with a spin smear or
+        a speed ripple (the record's lines are not steady there)."""
+        if ctx.test is None or state.smear is not None or state.ripple is not None:
+            return []                   # a swept or rippled speed: the record's lines are not steady ones
+        w_hz = ctx.omega[runs] / (2 * np.pi)
+        if w_hz.size < RECORD_MIN_RUNS or w_hz.min() <= 0:
+            return []
+        df_rec = float(np.max([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs]))
+        h_top = welch_low_limit(ctx) / w_hz.min()
+        h_grid = np.arange(0.1, h_top, RECORD_GRID_BINS * df_rec / w_hz.max())
+        if h_grid.size < 3:
+            return []
+        out = []
+        for d, chans in DIRECTION_CHANNELS.items():
+            if not any(c in ctx.channels for c in chans):
+                continue
+            P, N, ok, _ = MissingHarmonic._record_points(ctx, state, d, runs, h_grid)
+            z = np.where(ok, P / np.maximum(N, 1e-300), np.nan).reshape(-1, h_grid.size)
+            enough = (ok.sum(axis=(0, 1)) >= RECORD_MIN_POINTS) & (ok.any(axis=0).sum(axis=0) >= RECORD_MIN_RUNS)
+            score = np.zeros(h_grid.size)
+            if enough.any():
+                score[enough] = np.nanmedian(z[:, enough], axis=0)
+            peaks = np.nonzero((score[1:-1] > score[:-2]) & (score[1:-1] >= score[2:])
+                               & (score[1:-1] > RECORD_SCORE))[0] + 1
+            found = []
+            for i in peaks[np.argsort(-score[peaks])]:
+                h = float(h_grid[i])
+                if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)) or \
+                        any(abs(h - x.h) < 0.03 for x in found):
+                    continue
+                e = MissingHarmonic.fit_record(ctx, state, d, h, runs)
+                if e is not None and not any(abs(e.h - x.h) < 0.03 for x in state.model.harmonics(d)):
+                    found.append(e)
+                if len(found) >= max_per_direction:
+                    break
+            out += found
+        return out
+
+    def heldout_evidence(self, ctx: Context, state: State, runs):
+        """Held-out evidence of a record-route line (None for a Welch-route one: the search's own judge): (drop, se)
+        in the units of the error metric (mean square, each channel divided by its group scale) of the misplaced line
+        power on the whole-run DFT, Σ |P − n − M₀| − |P − n − M₁| over the valid points of ``runs``, M₀ = 0 (the
+        state predicts no line there: the points are clear of its lines) and M₁ the line's power as this effect
+        predicts it (|X|² = a²); se as the search's judge, sqrt(Σ min(|ΔM|, σ)²), σ² = n² + 2Pn of a line of power
+        P in complex Gaussian noise of mean n.  None on a state with a spin smear or a speed ripple."""
+        if not self.record or ctx.test is None or state.smear is not None or state.ripple is not None:
+            return None
+        P, N, ok, chans = MissingHarmonic._record_points(ctx, state, self.direction, runs, [self.h], exact=True)
+        m1 = [MissingHarmonic._line_amplitude(ctx, state, c, self.direction, self.h, self.C, runs) ** 2 for c in chans]
+        return record_line_evidence(ctx, chans, P[:, :, 0], N[:, :, 0], ok[:, :, 0], np.array(m1))
+
     @staticmethod
     def candidates(ctx: Context, state: State, runs, max_per_direction: int = 3) -> list:
+        """The Welch route's ridges (:func:`rwadist.diagnose.measure.ridge_peaks`), then the record route's lines
+        below it (:meth:`record_candidates`, time series given)."""
         out = []
         for d, chans in DIRECTION_CHANNELS.items():
             chans = [c for c in chans if c in ctx.channels]
@@ -71,4 +357,7 @@ class MissingHarmonic:
                 e = MissingHarmonic.fit(ctx, state, d, h, runs)
                 if e is not None and e.C > 0:
                     out.append(e)
+        for e in MissingHarmonic.record_candidates(ctx, state, runs, max_per_direction):
+            if not any(abs(e.h - x.h) < 0.03 for x in out if x.direction == e.direction):
+                out.append(e)
         return out

@@ -171,6 +171,38 @@ class Sidebands:
         m = float(np.sum(A * Q) / np.sum(Q * Q))
         return Sidebands(direction, float(h), f_mod, m, int(A.size)) if m > 0 else None
 
+    def heldout_evidence(self, ctx: Context, state: State, runs):
+        """Held-out evidence of sidebands closer to their carrier than 2.5 Welch bins (None otherwise: the search's own
+        judge).  There the pair sits in the carrier's own Welch kernel, whose power the error metric's bands sum with
+        it: the PSDs hardly see it (at 2048 samples, f_mod 7 Hz is 0.9 Welch bin), the whole record does
+        (:meth:`_record_power`, the carrier's leakage taken off).  (drop, se) of the misplaced sideband power on the
+        valid points of both sides (:func:`~rwadist.diagnose.effects.missing_harmonic.record_line_evidence`; the
+        state predicts no sidebands on this carrier, the effect (m·a·g/2)² per side, a the carrier's model amplitude
+        in the channel, g the fixed resonances' gain at the side).  Not on a state with a spin smear or a speed ripple
+        (their lines are no steady lines on the record)."""
+        from .missing_harmonic import record_line_evidence
+
+        if ctx.test is None or self.f_mod >= 2.5 * ctx.df or state.smear is not None or state.ripple is not None:
+            # (a swept speed smears the carrier over the record, a speed ripple gives it sidebands of its own that the
+            # state predicts in its PSDs: the record's lines are not steady ones, and the search's judge decides)
+            return None
+        if any(d == self.direction and abs(h - self.h) < 1e-4 for d, h, _, _ in state.sidebands):
+            return None
+        f, P, N, ok = Sidebands._record_power(ctx, state, self.direction, self.h, runs, np.array([self.f_mod]))
+        chans = [c for c in DIRECTION_CHANNELS[self.direction] if c in ctx.channels]
+        M1 = []
+        for c in chans:
+            a = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - self.h) < 1e-9), None)
+            if a is None:
+                return None
+            g = np.column_stack([ctx.gain(state, c, f[:, col]) for col in (0, 1)]) if state.resonances else 1.0
+            M1.append((0.5 * self.depth * a[:, None] * g * np.ones((runs.size, 2))) ** 2)
+        M1 = np.array(M1).reshape(len(chans), -1)                        # (chans, runs·2)
+        P = np.moveaxis(P, 2, 0).reshape(len(chans), -1)
+        N = np.moveaxis(N, 2, 0).reshape(len(chans), -1)
+        ok = np.broadcast_to(ok.reshape(1, -1), P.shape)
+        return record_line_evidence(ctx, chans, P, N, ok, M1)
+
     @staticmethod
     def record_candidates(ctx: Context, state: State, runs, direction: str, hs) -> list:
         """[(score, h, f_mod)] of the carriers ``hs`` whose sidebands sit closer than the Welch grid reaches
