@@ -25,6 +25,7 @@ from .outputs import (
     check_output_file,
     refuse_input_overwrite,
 )
+from .plot_util import save_png
 from .progress import working
 from .units import RAD_S_TO_RPM, rpm_to_rad_s
 from .validate import (
@@ -375,7 +376,7 @@ def cmd_campbell(args) -> int:
         raise DataError(args.model or args.preset, "campbell", f"non-finite frequencies in {', '.join(bad)}: "
                         "the model's analytical parameters are out of range; check them with `rwadist model show`")
     png_path = out.with_suffix(".png")
-    _write(png_path, lambda tmp: plot_campbell(params, speeds, lines).savefig(tmp, dpi=120))
+    _write(png_path, lambda tmp: save_png(plot_campbell(params, speeds, lines), tmp, dpi=120))
     csv_path = _write(out, lambda tmp: write_campbell_csv(table, tmp))
     print(f"Campbell table of {source}: {csv_path} ({len(speeds)} speeds), plot: {png_path}")
     print(f"{'h':>6} {'direction':<14} {'sense':<8} {'mode':<19} {'speed_rpm':>10} {'f_Hz':>8}  excites")
@@ -655,7 +656,7 @@ def cmd_psd(args) -> int:
     png = stem.parent / (stem.name + ".png")
     with working("drawing the PSD plot"):
         figure = bb.plot_psd(res, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm")
-        _write(png, lambda tmp: figure.savefig(tmp, dpi=110))
+        _write(png, lambda tmp: save_png(figure, tmp, dpi=110))
     rms = res.rms()
     print(f"{kind}, {res.frame} frame, {res.f.size} frequencies to {fmax:g} Hz, {time.perf_counter() - t0:.1f} s")
     print("RMS: " + ", ".join(f"{c} {v:.4g} {'N' if c[0] == 'F' else 'N·m'}"

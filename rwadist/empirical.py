@@ -184,7 +184,11 @@ def block_floor(psd: np.ndarray, block: int = 32, dof: float = 2.0) -> np.ndarra
     """
     n_runs, n_f = psd.shape
     n_blocks = max(n_f // block, 1)
-    med = np.median(psd[:, :n_blocks * block].reshape(n_runs, n_blocks, block), axis=-1)
+    # np.median's values (the mean of the middle one or two of each sorted block, NaN where a block holds NaN),
+    # from one sort: several times faster than np.median's partition for these short blocks
+    ordered = np.sort(psd[:, :n_blocks * block].reshape(n_runs, n_blocks, block), axis=-1)
+    med = np.mean(ordered[..., (block - 1) // 2:block // 2 + 1], axis=-1)
+    med[np.isnan(ordered[..., -1])] = np.nan
     centres = (np.arange(n_blocks) + 0.5) * block
     # linear interpolation between block centres, flat beyond the end ones, all rows at once
     x = np.clip(np.arange(n_f), centres[0], centres[-1])

@@ -11,6 +11,25 @@ import numpy as np
 
 #: dynamic range shown on a log PSD axis below the largest value (1e-8 = 80 dB)
 LOG_DYNAMIC_RANGE = 1e-8
+#: zlib level of the kit's PNG files (0-9; PIL's default 6 takes twice the CPU for ~7 % smaller files, same pixels)
+PNG_COMPRESS_LEVEL = 3
+
+
+def save_png(fig, path, dpi: float):
+    """Write ``fig`` (a ``matplotlib.figure.Figure``) to the PNG file ``path`` at ``dpi`` dots per inch; returns ``path``.
+
+    One draw: ``Figure.draw`` runs the figure's layout engine, if any, then renders (``savefig`` on a figure with a
+    layout engine draws it twice: a draw-disabled pass for the layout, then the real draw), and zlib level
+    :data:`PNG_COMPRESS_LEVEL`: the pixels of ``fig.savefig(path, dpi=dpi)``, in less CPU.  The figure keeps ``dpi``
+    (it is meant to be dropped afterwards).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    if not isinstance(fig.canvas, FigureCanvasAgg):
+        FigureCanvasAgg(fig)
+    fig.set_dpi(dpi)
+    fig.canvas.print_png(path, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
+    return path
 
 
 def content_top(f, rows, dynamic_range: float = LOG_DYNAMIC_RANGE, margin: float = 1.05) -> float:

@@ -128,6 +128,7 @@ def write_report(diag: Diagnosis, out_dir) -> list:
     from pathlib import Path
 
     from ..model import save
+    from ..plot_util import save_png
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -144,10 +145,10 @@ def write_report(diag: Diagnosis, out_dir) -> list:
     _write_csv(p, cols)
     files.append(p)
     p = out / "rms_vs_speed.png"
-    _rms_figure(diag, cols).savefig(p, dpi=100)
+    save_png(_rms_figure(diag, cols), p, dpi=100)
     files.append(p)
     p = out / "residual_waterfall.png"
-    _waterfall_figure(diag).savefig(p, dpi=100)
+    save_png(_waterfall_figure(diag), p, dpi=100)
     files.append(p)
     p = out / "hypotheses.csv"
     lines = ["iteration,kind,channels,parameters,heldout_gain,heldout_gain_fraction,t,passed"]
