@@ -24,19 +24,19 @@ STAND_MAX_ZETA = 0.2
 #: :class:`rwadist.diagnose.effects.fixed_resonance.FixedResonance`); a fit that ends there measured no width -- a
 #: "resonance" narrower than the lines resolve, one line's misfit at one speed lifted by a gain of 20-40.
 STAND_MIN_ZETA = 0.0015
-#: Rounds of (stand on the modes' residual, modes with that stand divided out) at most, in the reference fit
-#: (:func:`fit_extended_beside_stand`, ``rwadist fit --extended``) and in ``rwadist diagnose``'s
-#: ``suspension_modes``.  The two are coupled (a stand a little too weak or too sharp is made up by the radial
-#: translation's mode moving towards it), so the alternation converges geometrically, each round removing only
-#: ~1/3 of what is left: 4 rounds with a loose settling rule (f_r 0.2 %, gain 2 %) left the 180 Hz, ζ 0.03, gain 5
-#: stand of the robustness matrix 2 % weak and sharp and the translation 0.4-0.6 % low (the lines above the stand
-#: 1-3 % off the reference model).
-STAND_ROUNDS = 25
-#: The stand has settled (:func:`stand_settled`) when a round moves ln f_r by less than this ...
-STAND_SETTLED_LOG_F = 2e-4
+#: Rounds of (stand on the modes' base, modes with that stand divided out) at most.
+STAND_ROUNDS = 4
+#: Rounds of (stand on the modes' residual, modes with that stand divided out) at most in the reference fit
+#: (:func:`fit_extended_beside_stand`, ``rwadist fit --extended``).  The two are coupled (a stand a little too weak or
+#: too sharp is made up by the radial translation's mode moving towards it), so this alternation converges
+#: geometrically, each round removing only ~1/3 of what is left: 4 rounds left the 180 Hz, ζ 0.03, gain 5 stand of
+#: the robustness matrix 2 % weak and the translation 0.6 % low (1-3 % misfit of the lines above the stand).
+REFERENCE_STAND_ROUNDS = 25
+#: The reference fit's stand has settled when a round moves ln f_r by less than this ...
+REFERENCE_SETTLED_LOG_F = 2e-4
 #: ... and ln ζ and ln(peak gain) by less than this: with the alternation's ratio of ~2/3 per round the stand is then
 #: within ~0.2 % of where the rounds converge, and the translation within ~0.1 %.
-STAND_SETTLED_LOG_SHAPE = 1e-3
+REFERENCE_SETTLED_LOG_SHAPE = 1e-3
 #: Largest relative move of a located mode in the last round of the stand's refit (stand on the modes' residual,
 #: modes with that stand divided out) for the mode to count as told apart from the stand: half the 2 % a mode must
 #: be found to.  A mode still moving more is coupled to the stand beyond what its standard error (stand fixed) says.
@@ -218,13 +218,6 @@ def stand_on_modes(efit, near_hz: float):
     return _one_resonance(f, y, near_hz)
 
 
-def stand_settled(before, after) -> bool:
-    """True when a round of the stand's refit moved it (``before`` -> ``after``, each (f_r Hz, ζ, peak gain)) by less
-    than :data:`STAND_SETTLED_LOG_F` in ln f_r and :data:`STAND_SETTLED_LOG_SHAPE` in ln ζ and ln g."""
-    step = np.abs(np.log(np.asarray(after, dtype=float) / np.asarray(before, dtype=float)))
-    return bool(step[0] < STAND_SETTLED_LOG_F and max(step[1], step[2]) < STAND_SETTLED_LOG_SHAPE)
-
-
 def _mode_hz(params) -> dict:
     """Mode frequencies at rest (Hz) of :class:`~rwadist.extended.ExtendedParams`, by the fit's unconstrained names."""
     return {"radial_translation": float(np.sqrt(params.k_r / params.mass) / (2 * np.pi)),
@@ -261,9 +254,9 @@ def fit_extended_beside_stand(test, fit, **kwargs):
     (:func:`stand_resonance_start`; only with all six channels: a stand is told from a mode by lifting the
     forces AND the torques), that resonance is divided out of every line before the modes are located, then
     refitted on the residual of the modes' fit (:func:`stand_on_modes`) and the modes refitted with it, until it
-    settles (a round moves ln f_r less than :data:`STAND_SETTLED_LOG_F`, ln ζ and ln g less than
-    :data:`STAND_SETTLED_LOG_SHAPE`) or :data:`STAND_ROUNDS` rounds (the stand and the radial translation's mode
-    are coupled: a loosely settled stand leaves the mode pulled towards it).  It is dropped (the plain fit
+    settles (a round moves ln f_r less than :data:`REFERENCE_SETTLED_LOG_F`, ln ζ and ln g less than
+    :data:`REFERENCE_SETTLED_LOG_SHAPE`) or :data:`REFERENCE_STAND_ROUNDS` rounds: the stand and the radial
+    translation's mode are coupled, so a loosely settled stand leaves the mode pulled towards it.  It is dropped (the plain fit
     returned) when the residual confirms no resonance there, or when the fit with it locates fewer modes than
     the fit without it.  The stand kept is in ``ExtendedFit.stand`` and a note; it is not part of the wheel's
     model (``rwadist diagnose`` names it as a ``fixed_resonance`` of role test_stand)."""
@@ -275,11 +268,12 @@ def fit_extended_beside_stand(test, fit, **kwargs):
         return fit_extended(test, fit, **kwargs)
     plain = fit_extended(test, fit, **kwargs)
     efit = fit_extended(test, fit, stand=stand, **kwargs)
-    for _ in range(STAND_ROUNDS):
+    for _ in range(REFERENCE_STAND_ROUNDS):
         new = stand_on_modes(efit, stand[0])
         if new is None:
             return plain                          # not confirmed on the modes' base: no stand
-        settled = stand_settled(stand, new)
+        step = np.abs(np.log(np.asarray(new) / np.asarray(stand)))
+        settled = step[0] < REFERENCE_SETTLED_LOG_F and max(step[1], step[2]) < REFERENCE_SETTLED_LOG_SHAPE
         stand = new
         efit = fit_extended(test, fit, stand=stand, **kwargs)
         if settled:

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 # the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
-from ...stand_resonance import STAND_ROUNDS, declare_unsettled_modes, stand_resonance_start, stand_settled
+from ...stand_resonance import STAND_ROUNDS, declare_unsettled_modes, stand_resonance_start
 from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
@@ -75,10 +75,9 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     After the extended fit, a ``fixed_resonance`` common to all channels (role test_stand) is fitted on
     that base; when it is a fixture's resonance (:func:`rwadist.stand_resonance.is_fixture_resonance`: sharp,
     lifting the lines), the extended fit is repeated with it divided
-    out (up to :data:`STAND_ROUNDS` rounds, until the stand settles: :func:`rwadist.stand_resonance.stand_settled`);
-    when it is not while one was divided out, the stand was not confirmed and the fit is repeated without it.  The
-    stand resonance itself is left to the search (a clear residual of the extended base: a ``fixed_resonance``
-    effect)."""
+    out (up to :data:`STAND_ROUNDS` rounds, until the stand settles); when it is not while one was divided
+    out, the stand was not confirmed and the fit is repeated without it.  The stand resonance itself is left
+    to the search (a clear residual of the extended base: a ``fixed_resonance`` effect)."""
     from ...data import SteadyTest
     from ...empirical import fit_empirical
     from ...extended_fit import amplification_peaks, fit_extended
@@ -121,7 +120,8 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
                     stand, before = None, None
                 break
             new = (new.f_r, new.zeta, new.peak_gain)
-            settled = stand is not None and stand_settled(stand, new)
+            settled = (stand is not None and abs(new[0] / stand[0] - 1) < 0.002
+                       and abs(np.log(new[2] / stand[2])) < 0.02)
             stand = new
             before, efit = efit, fit_extended(test, fit, stand=stand)
             if settled:
