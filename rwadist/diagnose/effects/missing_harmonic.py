@@ -42,18 +42,13 @@ RECORD_FIT_SNR = 10.0
 
 
 def _hann_transform(n: int, delta: np.ndarray) -> np.ndarray:
-    """W(δ)/W(0) of the periodic Hann window of ``n`` samples at offsets ``delta`` (record bins, any real): with
-    D(δ) = Σ_{k<n} e^{−2πjδk/n} = (1 − e^{−2πjδ})/(1 − e^{−2πjδ/n}) (n at δ = 0), W = D(δ)/2 − D(δ−1)/4 − D(δ+1)/4
-    and W(0) = n/2.  A line A·e^{2πj f_l t} puts A·W((f − f_l)/df)/W(0) into the whole-run phasor at f (the
-    convention of :func:`rwadist.extended_fit.windowed_dft`: Σ x e^{−2πj f t})."""
-    def dirichlet(d):
-        num = 1.0 - np.exp(-2j * np.pi * d)
-        den = 1.0 - np.exp(-2j * np.pi * d / n)
-        small = np.abs(den) < 1e-12
-        return np.where(small, n, num / np.where(small, 1.0, den))
+    """W(δ)/W(0) of the periodic Hann window of ``n`` samples at offsets ``delta`` (record bins, any real):
+    :func:`rwadist.dft.hann_transform` at f = δ·fs/n (taken with fs = n, so f is δ) over W(0) = Σw = n/2.  A line
+    A·e^{2πj f_l t} puts A·W((f − f_l)/df)/W(0) into the whole-run phasor at f (the convention of
+    :func:`rwadist.dft.windowed_dft`: Σ x e^{−2πj f t})."""
+    from ...dft import hann_transform
 
-    d = np.asarray(delta, dtype=float)
-    return (0.5 * dirichlet(d) - 0.25 * dirichlet(d - 1.0) - 0.25 * dirichlet(d + 1.0)) / (0.5 * n)
+    return hann_transform(n, float(n), np.asarray(delta, dtype=float)) / (0.5 * n)
 
 
 def record_line_evidence(ctx: Context, chans, P, N, ok, M1) -> tuple:
@@ -112,6 +107,60 @@ def _state_line_freqs(ctx: Context, state: State, c: str, runs) -> np.ndarray:
     return np.column_stack(out) if out else np.empty((runs.size, 0))
 
 
+def _record_dfts(ctx: Context, rows, c: str, f_hz: np.ndarray) -> np.ndarray:
+    """Whole-run phasors X = 2·Σ w (x − x̄) e^{−2πj f t}/Σ w (len(rows), L) of channel ``c`` of the runs ``rows`` at
+    ``f_hz`` (len(rows), L) Hz (the spectra's window): the runs of one record length transformed together
+    (:func:`rwadist.dft.windowed_dfts`: each record's sums are those of :func:`rwadist.dft.windowed_dft` of it
+    alone, the same numbers)."""
+    from ...dft import run_window, windowed_dfts
+
+    out = np.empty(f_hz.shape, dtype=complex)
+    groups = {}
+    for i, r in enumerate(rows):
+        run = ctx.test.runs[r]
+        groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
+    for (n, fs), idx in groups.items():
+        w, wsum, _ = run_window(ctx.sp.window, n)
+        xs = []
+        for i in idx:
+            x = np.asarray(ctx.test.runs[rows[i]].signals[c], dtype=float)
+            xs.append((x - x.mean()) * w)
+        out[idx] = 2.0 * windowed_dfts(np.stack(xs)[:, :, None], fs, f_hz[idx])[:, :, 0] / wsum
+    return out
+
+
+def _record_run_residual(ctx: Context, r: int, j: int, fl: np.ndarray, f_top: float, A=None) -> tuple:
+    """(X (G,) complex, A (L,) complex, local noise) of run ``r``, channel ``ctx.channels[j]`` on the record grid
+    (:func:`_record_grid`) less the leakage of the lines ``fl`` (L,) Hz (their whole-run phasors A times the
+    window's transform, the negative-frequency image too), and the median |X|²/ln 2 over the grid points of the
+    record route's range clear of those lines (0 with fewer than 8).  The data's and the lines' only: kept on the
+    context, so each search step and each caller that asks the same run, channel and lines reuses them.  ``A``: the
+    lines' phasors when already computed (:func:`_record_dfts` of several runs at once)."""
+    key = ("missing_harmonic_run", r, j, fl.tobytes(), f_top)
+    if key in ctx._memo:
+        return ctx._memo[key]
+    grid, X, df_rec, n = _record_grid(ctx, r)
+    c = ctx.channels[j]
+    Xr = X[:, j]
+    A = None
+    clear = (grid >= RECORD_MIN_BINS * df_rec) & (grid < f_top)
+    if fl.size:
+        # the leakage on the whole (short) grid once, then read at the points' nearest grid frequencies
+        if A is None:
+            A = _record_dfts(ctx, [r], c, fl[None, :])[0]                                              # (L,)
+        key_t = ("missing_harmonic_leak", n, df_rec, grid.size, fl.tobytes())   # the same lines at every step
+        if key_t not in ctx._memo:
+            ctx._memo[key_t] = (_hann_transform(n, (grid[:, None] - fl[None, :]) / df_rec),
+                                _hann_transform(n, (grid[:, None] + fl[None, :]) / df_rec))
+        t_minus, t_plus = ctx._memo[key_t]
+        Xr = Xr - (t_minus * A[None, :] + t_plus * np.conj(A)[None, :]).sum(1)
+        clear &= np.all(np.abs(grid[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
+    Xg = Xr[clear]
+    local = float(np.median(np.abs(Xg) ** 2)) / np.log(2.0) if Xg.size >= 8 else 0.0
+    ctx._memo[key] = (Xr, A, local)
+    return ctx._memo[key]
+
+
 def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool = False) -> tuple:
     """(|X|² (len(runs), L), noise (len(runs), L), valid (len(runs), L)) of channel ``c`` at frequencies ``f_hz``
     (len(runs), L) on the whole-run DFT, less the leakage of every line the state predicts on the channel (each
@@ -123,7 +172,7 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     median |X|² over the record route's range (/ln 2: the median of an exponential), so that a noise rising below the
     Welch band is not taken for lines.  Valid: in the record route's range (RECORD_MIN_BINS record bins up to
     :func:`welch_low_limit`) and RECORD_SEP_BINS record bins from every line of the state on the channel."""
-    from ...extended_fit import run_window, windowed_dft
+    from ...dft import run_window
 
     j = ctx.channels.index(c)
     f_hz = np.asarray(f_hz, dtype=float)
@@ -134,42 +183,59 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     f_top = welch_low_limit(ctx)
     k_w = np.clip(np.rint(f_hz / ctx.df).astype(int), ctx.k_lo, ctx.k_hi)
     S = np.take_along_axis(ctx.floor_psd(state, c, runs), k_w, axis=1)
+    todo = []                               # (i, r, fl, valid, gi) of the runs that have the channel
     for i, r in enumerate(runs):
         grid, X, df_rec, n = _record_grid(ctx, int(r))
         if not np.all(np.isfinite(X[:, j])):
             continue
-        run = ctx.test.runs[r]
         fl = lines[i][lines[i] < f_top + 20.0 * df_rec]
         valid = (f_hz[i] >= RECORD_MIN_BINS * df_rec) & (f_hz[i] < f_top)
         for f_l in fl:
             valid &= np.abs(f_hz[i] - f_l) >= RECORD_SEP_BINS * df_rec
         gi = np.clip(np.rint(f_hz[i] / (df_rec * RECORD_GRID_BINS)).astype(int), 0, grid.size - 1)
-        Xr = X[:, j]
-        clear = (grid >= RECORD_MIN_BINS * df_rec) & (grid < f_top)
+        todo.append((i, int(r), fl, valid, gi))
+    # the lines' phasors of the runs not yet on the context, runs of one number of lines transformed together
+    new_lines = {}
+    for i, r, fl, _, _ in todo:
+        if fl.size and ("missing_harmonic_run", r, j, fl.tobytes(), f_top) not in ctx._memo:
+            new_lines.setdefault(fl.size, []).append((r, fl))
+    A_new = {}
+    for items in new_lines.values():
+        A = _record_dfts(ctx, [r for r, _ in items], c, np.array([fl for _, fl in items]))
+        A_new.update({r: A[k] for k, (r, _) in enumerate(items)})
+    # with ``exact``: the data's phasors at the points' own frequencies (a fit's h refined finer than the grid), kept
+    # on the context (the fit's grid of h is asked again on the refit's runs and by the held-out evidence)
+    ex_key = {i: ("missing_harmonic_exact", r, j, fl.tobytes(), f_hz[i].tobytes()) for i, r, fl, _, _ in todo} \
+        if exact else {}
+    ex_new = [t for t in todo if exact and ex_key[t[0]] not in ctx._memo]
+    X_ex = _record_dfts(ctx, [t[1] for t in ex_new], c, f_hz[[t[0] for t in ex_new]]) if ex_new else None
+    ex_row = {t[0]: k for k, t in enumerate(ex_new)}
+    # their lines' leakage (the window's transform at the points less and plus each line, times its phasor), the runs
+    # of one record length and number of lines at once (elementwise: the numbers of one run at a time)
+    leak = {}
+    ex_groups = {}
+    for i, r, fl, _, _ in ex_new:
         if fl.size:
-            # the leakage on the whole (short) grid once, then read at the points' nearest grid frequencies
-            w, wsum, _ = run_window(ctx.sp.window, n)
-            x = np.asarray(run.signals[c], dtype=float)
-            A = 2.0 * windowed_dft(((x - x.mean()) * w)[:, None], run.sample_rate, fl)[:, 0] / wsum     # (L,)
-            key = ("missing_harmonic_leak", n, df_rec, grid.size, fl.tobytes())   # the same lines at every step
-            if key not in ctx._memo:
-                ctx._memo[key] = (_hann_transform(n, (grid[:, None] - fl[None, :]) / df_rec),
-                                  _hann_transform(n, (grid[:, None] + fl[None, :]) / df_rec))
-            t_minus, t_plus = ctx._memo[key]
-            Xr = Xr - (t_minus * A[None, :] + t_plus * np.conj(A)[None, :]).sum(1)
-            clear &= np.all(np.abs(grid[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
-        Xi, Xg = Xr[gi], Xr[clear]
+            run = ctx.test.runs[r]
+            ex_groups.setdefault((run.n_samples, run.sample_rate, fl.size), []).append((i, r, fl))
+    for (n, fs, _), items in ex_groups.items():
+        df_rec = fs / n
+        fi = f_hz[[i for i, _, _ in items]][:, :, None]                                   # (R, L, 1)
+        fls = np.array([fl for _, _, fl in items])[:, None, :]                             # (R, 1, nl)
+        A = np.array([_record_run_residual(ctx, r, j, fl, f_top, A_new.get(r))[1] for _, r, fl in items])[:, None, :]
+        d = (_hann_transform(n, (fi - fls) / df_rec) * A + _hann_transform(n, (fi + fls) / df_rec) * np.conj(A)).sum(2)
+        leak.update({i: d[k] for k, (i, _, _) in enumerate(items)})
+    for i, r, fl, valid, gi in todo:
+        grid, X, df_rec, n = _record_grid(ctx, r)
+        run = ctx.test.runs[r]
+        Xr, A, local = _record_run_residual(ctx, r, j, fl, f_top, A_new.get(r))
+        Xi = Xr[gi]
         if exact:
-            # the points' own frequencies (a fit's h refined finer than the grid)
-            w, wsum, _ = run_window(ctx.sp.window, n)
-            x = np.asarray(run.signals[c], dtype=float)
-            Xi = 2.0 * windowed_dft(((x - x.mean()) * w)[:, None], run.sample_rate, f_hz[i])[:, 0] / wsum
-            if fl.size:
-                Xi = Xi - (_hann_transform(n, (f_hz[i][:, None] - fl[None, :]) / df_rec) * A[None, :]
-                           + _hann_transform(n, (f_hz[i][:, None] + fl[None, :]) / df_rec) * np.conj(A)[None, :]).sum(1)
+            if ex_key[i] not in ctx._memo:
+                ctx._memo[ex_key[i]] = X_ex[ex_row[i]] - leak[i] if fl.size else X_ex[ex_row[i]]
+            Xi = ctx._memo[ex_key[i]]
         _, wsum, w2sum = run_window(ctx.sp.window, n)
         white = 2.0 * S[i] * run.sample_rate * w2sum / wsum**2
-        local = float(np.median(np.abs(Xg) ** 2)) / np.log(2.0) if Xg.size >= 8 else 0.0
         P[i] = np.abs(Xi) ** 2
         N[i] = np.maximum(white, local)
         ok[i] = valid
