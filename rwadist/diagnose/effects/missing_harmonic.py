@@ -107,6 +107,14 @@ def _state_line_freqs(ctx: Context, state: State, c: str, runs) -> np.ndarray:
     return np.column_stack(out) if out else np.empty((runs.size, 0))
 
 
+def _has_channel(ctx: Context, r: int, j: int) -> bool:
+    """Run ``r`` has channel ``ctx.channels[j]`` (its record grid is finite there)."""
+    key = ("missing_harmonic_has", r, j)
+    if key not in ctx._memo:
+        ctx._memo[key] = bool(np.all(np.isfinite(_record_grid(ctx, r)[1][:, j])))
+    return ctx._memo[key]
+
+
 def _record_dfts(ctx: Context, rows, c: str, f_hz: np.ndarray) -> np.ndarray:
     """Whole-run phasors X = 2·Σ w (x − x̄) e^{−2πj f t}/Σ w (len(rows), L) of channel ``c`` of the runs ``rows`` at
     ``f_hz`` (len(rows), L) Hz (the spectra's window): the runs of one record length transformed together
@@ -183,17 +191,17 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     f_top = welch_low_limit(ctx)
     k_w = np.clip(np.rint(f_hz / ctx.df).astype(int), ctx.k_lo, ctx.k_hi)
     S = np.take_along_axis(ctx.floor_psd(state, c, runs), k_w, axis=1)
-    todo = []                               # (i, r, fl, valid, gi) of the runs that have the channel
-    for i, r in enumerate(runs):
-        grid, X, df_rec, n = _record_grid(ctx, int(r))
-        if not np.all(np.isfinite(X[:, j])):
-            continue
-        fl = lines[i][lines[i] < f_top + 20.0 * df_rec]
-        valid = (f_hz[i] >= RECORD_MIN_BINS * df_rec) & (f_hz[i] < f_top)
-        for f_l in fl:
-            valid &= np.abs(f_hz[i] - f_l) >= RECORD_SEP_BINS * df_rec
-        gi = np.clip(np.rint(f_hz[i] / (df_rec * RECORD_GRID_BINS)).astype(int), 0, grid.size - 1)
-        todo.append((i, int(r), fl, valid, gi))
+    # every run's record grid, the points' validity and nearest grid points at once (the same expressions per run)
+    grids = [_record_grid(ctx, int(r)) for r in runs]
+    df_rec = np.array([g[2] for g in grids])
+    near = lines < (f_top + 20.0 * df_rec)[:, None]             # the lines whose leakage reaches the route's range
+    valid = (f_hz >= RECORD_MIN_BINS * df_rec[:, None]) & (f_hz < f_top)
+    for m in range(lines.shape[1]):
+        valid &= ~near[:, m:m + 1] | (np.abs(f_hz - lines[:, m:m + 1]) >= RECORD_SEP_BINS * df_rec[:, None])
+    gi = np.clip(np.rint(f_hz / (df_rec * RECORD_GRID_BINS)[:, None]).astype(int), 0,
+                 np.array([g[0].size for g in grids])[:, None] - 1)
+    todo = [(i, int(r), lines[i][near[i]], valid[i], gi[i])     # the runs that have the channel
+            for i, r in enumerate(runs) if _has_channel(ctx, int(r), j)]
     # the lines' phasors of the runs not yet on the context, runs of one number of lines transformed together
     new_lines = {}
     for i, r, fl, _, _ in todo:
@@ -219,26 +227,25 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
             run = ctx.test.runs[r]
             ex_groups.setdefault((run.n_samples, run.sample_rate, fl.size), []).append((i, r, fl))
     for (n, fs, _), items in ex_groups.items():
-        df_rec = fs / n
+        df_g = fs / n
         fi = f_hz[[i for i, _, _ in items]][:, :, None]                                   # (R, L, 1)
         fls = np.array([fl for _, _, fl in items])[:, None, :]                             # (R, 1, nl)
         A = np.array([_record_run_residual(ctx, r, j, fl, f_top, A_new.get(r))[1] for _, r, fl in items])[:, None, :]
-        d = (_hann_transform(n, (fi - fls) / df_rec) * A + _hann_transform(n, (fi + fls) / df_rec) * np.conj(A)).sum(2)
+        d = (_hann_transform(n, (fi - fls) / df_g) * A + _hann_transform(n, (fi + fls) / df_g) * np.conj(A)).sum(2)
         leak.update({i: d[k] for k, (i, _, _) in enumerate(items)})
-    for i, r, fl, valid, gi in todo:
-        grid, X, df_rec, n = _record_grid(ctx, r)
-        run = ctx.test.runs[r]
+    for i, r, fl, _, g in todo:
         Xr, A, local = _record_run_residual(ctx, r, j, fl, f_top, A_new.get(r))
-        Xi = Xr[gi]
+        Xi = Xr[g]
         if exact:
             if ex_key[i] not in ctx._memo:
                 ctx._memo[ex_key[i]] = X_ex[ex_row[i]] - leak[i] if fl.size else X_ex[ex_row[i]]
             Xi = ctx._memo[ex_key[i]]
-        _, wsum, w2sum = run_window(ctx.sp.window, n)
+        run = ctx.test.runs[r]
+        _, wsum, w2sum = run_window(ctx.sp.window, run.n_samples)
         white = 2.0 * S[i] * run.sample_rate * w2sum / wsum**2
         P[i] = np.abs(Xi) ** 2
         N[i] = np.maximum(white, local)
-        ok[i] = valid
+        ok[i] = valid[i]
     return P, N, ok
 
 
