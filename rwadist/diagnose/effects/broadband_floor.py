@@ -17,6 +17,45 @@ from .base import register, schema_entry
 GROWTH_T = 4.0
 
 
+def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
+    """(p, n (bands,), g (bands,)) of the floor law y = n + g·x0^p per band (``y`` (runs, bands) off-line band
+    means, unit²/Hz; ``wt`` (runs, bands) bins used; ``x0`` (runs,) Ω/Ω_ref): p the exponent of
+    :data:`FLOOR_EXPONENTS` with the smallest weighted SSE, n and g its weighted 2-parameter least squares per band,
+    in three passes of iteratively reweighted least squares.  Every exponent of a pass is solved at once (arrays
+    (P, runs, bands)): the same numbers as one exponent at a time (tests/test_fast_paths_floor.py)."""
+    level = np.maximum(np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300), 1e-300)
+    expected = np.broadcast_to(level, y.shape)
+    # x = (Ω/Ω_ref)^p of every exponent at once (P, runs, 1), each power as ``x0[:, None] ** p`` computes it
+    xs = np.stack([x0[:, None] ** p for p in FLOOR_EXPONENTS])
+    for _ in range(3):
+        # weights: bins used / expected value² (a band mean of chi² bins has variance ∝ mean²/bins),
+        # re-estimated from the previous pass (iteratively reweighted least squares)
+        # (relative to the largest level, floored at 1e-12 of it: squares of tiny PSDs underflow, and a
+        # band 12 decades down carries no information worth an astronomically large weight)
+        wts = wt / np.maximum(expected / float(np.max(level)), 1e-12) ** 2
+        # weighted 2-parameter least squares per band and exponent: y = n + g·x (sums over the runs, axis 1:
+        # the same order as each exponent's own (runs, bands) sums over axis 0)
+        wx = wts * xs
+        s0, s1, s2 = wts.sum(0), wx.sum(1), (wx * xs).sum(1)
+        t0, t1 = (wts * y).sum(0), (wx * y).sum(1)
+        det = s0 * s2 - s1 * s1
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g = np.maximum(np.where(det > 0, (s0 * t1 - s1 * t0) / det, 0.0), 0.0)
+        n = np.where(s0 > 0, np.maximum((t0 - g * s1) / np.maximum(s0, 1e-300), 0.0), 0.0)
+        # each exponent's SSE summed over its own (runs, bands) array, as the loop over exponents did
+        res = wts * (y - n[:, None, :] - g[:, None, :] * xs) ** 2
+        sse = [float(np.sum(r)) for r in res]
+        i = None
+        for k, v in enumerate(sse):             # the first smallest, as the loop over exponents took it
+            if i is None or v < sse[i]:
+                i = k
+        best = (sse[i], FLOOR_EXPONENTS[i], n[i], g[i])
+        _, p, n, g = best
+        expected = np.maximum(n[None, :] + g[None, :] * x0[:, None] ** p, 1e-300)
+    _, p, n, g = best
+    return p, n, g
+
+
 @register(order=30)
 @dataclass
 class BroadbandFloor:
@@ -133,30 +172,7 @@ class BroadbandFloor:
             return None
         w_ref = ctx.omega_ref()
         x0 = ctx.omega[runs] / w_ref
-        level = np.maximum(np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300), 1e-300)
-        expected = np.broadcast_to(level, y.shape)
-        for _ in range(3):
-            # weights: bins used / expected value² (a band mean of chi² bins has variance ∝ mean²/bins),
-            # re-estimated from the previous pass (iteratively reweighted least squares)
-            # (relative to the largest level, floored at 1e-12 of it: squares of tiny PSDs underflow, and a
-            # band 12 decades down carries no information worth an astronomically large weight)
-            wts = wt / np.maximum(expected / float(np.max(level)), 1e-12) ** 2
-            best = None
-            for p in FLOOR_EXPONENTS:
-                x = x0[:, None] ** p
-                # weighted 2-parameter least squares per band: y = n + g·x
-                s0, s1, s2 = wts.sum(0), (wts * x).sum(0), (wts * x * x).sum(0)
-                t0, t1 = (wts * y).sum(0), (wts * x * y).sum(0)
-                det = s0 * s2 - s1 * s1
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    g = np.maximum(np.where(det > 0, (s0 * t1 - s1 * t0) / det, 0.0), 0.0)
-                n = np.where(s0 > 0, np.maximum((t0 - g * s1) / np.maximum(s0, 1e-300), 0.0), 0.0)
-                sse = float(np.sum(wts * (y - n - g * x) ** 2))
-                if best is None or sse < best[0]:
-                    best = (sse, p, n, g)
-            _, p, n, g = best
-            expected = np.maximum(n[None, :] + g[None, :] * x0[:, None] ** p, 1e-300)
-        _, p, n, g = best
+        p, n, g = _floor_law(wt, y, x0)
         # growth is measured only in a band whose usable runs reach the upper half of the speeds (Ω >= Ω_max/2):
         # from lower speeds alone the law Ω^p is extrapolated to the top speed by 2^p or more (1.4 to 256 over the
         # exponent grid) times its error -- e.g. a band near a mode whose high-speed runs are skirt dominated.
