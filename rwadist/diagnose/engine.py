@@ -394,9 +394,21 @@ class Context(Metric):
         search step whose accepted effect touched other channels only."""
         import hashlib
 
+        runs = np.asarray(runs)
         hsh = hashlib.blake2b(digest_size=20)
-        hsh.update(repr((np.asarray(runs).tobytes(), state.ripple, state.smear)).encode())
+        hsh.update(repr((runs.tobytes(), state.ripple, state.smear)).encode())
         for c in chans:
+            hsh.update(self._channel_digest(state, c, runs))
+        return hsh.digest()
+
+    def _channel_digest(self, state: State, c: str, runs: np.ndarray) -> bytes:
+        """The part of :meth:`content_key` of one channel, kept on the state (read-only, as its prediction): the same
+        state is keyed for each direction's channels and for all of them."""
+        import hashlib
+
+        key = ("content_digest", c, runs.tobytes())
+        if key not in state._cache:
+            hsh = hashlib.blake2b(digest_size=20)
             coupling = tuple(float(x) for x in state.coupling) if state.coupling is not None \
                 and c in TORQUE_CHANNELS else None
             res = [r[:3] for r in state.resonances if c in r[3]]
@@ -407,7 +419,8 @@ class Context(Metric):
                 hsh.update(repr((h, law, state.line_components(c, h))).encode())
                 hsh.update(np.ascontiguousarray(amp, dtype=float).tobytes())
                 hsh.update(np.ascontiguousarray(g, dtype=float).tobytes())
-        return hsh.digest()
+            state._cache[key] = hsh.digest()
+        return state._cache[key]
 
     def run_durations(self, runs: np.ndarray) -> np.ndarray:
         """Length of each run's record, s: from the time series when known, else from the Welch

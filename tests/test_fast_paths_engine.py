@@ -1,0 +1,32 @@
+"""The diagnosis context's content key (:meth:`rwadist.diagnose.engine.Context.content_key`, which keys the reuse of
+``fixed_resonance`` fits between search steps) with its per-channel digests kept on the state: the key read back
+from the state is the key computed afresh, and it still tells states apart exactly where they differ."""
+import numpy as np
+
+from rwadist.diagnose.effects.fixed_resonance import FixedResonance
+from rwadist.diagnose.engine import Context, initial_state
+from rwadist.empirical import fit_empirical
+from rwadist.presets import preset
+from rwadist.spectra import compute_spectra
+from rwadist.teststand import simulate_steady
+
+
+def test_content_key_kept_on_the_state_is_the_fresh_one():
+    test = simulate_steady(preset("ithaco-e"), np.linspace(600.0, 3000.0, 8), sample_rate=1000.0, n_samples=2048,
+                           noise=0.01, seed=3, test_stand=False)
+    sp = compute_spectra(test, nperseg=512)
+    ctx = Context(sp, test=test)
+    plain = initial_state(ctx, fit_empirical(sp).model)
+    forces = FixedResonance(150.0, 0.03, 5.0, ("Fx", "Fy"), "wheel_mode").apply(plain)
+    runs = ctx.runs
+    for chans in (["Fx", "Fy"], ["Tx", "Ty"], list(ctx.channels)):
+        for state in (plain, forces):
+            first = ctx.content_key(state, chans, runs)
+            again = ctx.content_key(state, chans, runs)                  # read back from the state's cache
+            fresh_state = state.copy()                                   # the same content, nothing cached
+            fresh_state.noise, fresh_state.resonances = state.noise, list(state.resonances)
+            assert first == again == ctx.content_key(fresh_state, chans, runs)
+        touched = bool({"Fx", "Fy"} & set(chans))
+        assert (ctx.content_key(plain, chans, runs) != ctx.content_key(forces, chans, runs)) == touched
+    # other runs, other key
+    assert ctx.content_key(plain, ["Fx"], runs) != ctx.content_key(plain, ["Fx"], runs[1:])
