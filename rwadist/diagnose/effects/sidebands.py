@@ -209,6 +209,8 @@ class Sidebands:
         (:meth:`_record_offsets`): per offset the median over the RECORD_SCAN_RUNS fastest runs, channels and both
         sides of |X|²/noise on the whole-run DFT (valid points only, >= 6 of them), the best offset kept when it
         clears RECORD_SCORE and is a local maximum.  The data's line powers are kept on the context."""
+        from .speed_sidebands import side_pair_medians
+
         offsets = Sidebands._record_offsets(ctx)
         if offsets.size < 3:
             return []
@@ -221,11 +223,8 @@ class Sidebands:
             f, P, N, ok = ctx._memo[key]
             z = P / np.maximum(N, 1e-300)
             L = offsets.size
-            score = np.zeros(L)
-            for j in range(L):
-                both = ok[:, j] & ok[:, L + j]
-                vals = np.concatenate([z[both, j, :].ravel(), z[both, L + j, :].ravel()])
-                score[j] = float(np.median(vals)) if vals.size >= 6 else 0.0
+            both = ok[:, :L] & ok[:, L:]                # the runs whose two sides are both valid, per offset
+            score = side_pair_medians(z, np.concatenate([both, both], axis=1), np.arange(L))
             j = int(np.argmax(score))
             if 0 < j < L - 1 and score[j] > RECORD_SCORE:
                 out.append((score[j], h, float(offsets[j])))

@@ -78,6 +78,29 @@ def _record_resolvable(ctx: Context, state: State, direction: str, h0: float, h_
     return ok
 
 
+def side_pair_medians(z: np.ndarray, ok: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Per column j of ``cols``: the median of the values z[r, j, k] and z[r, L + j, k] over the runs r where ``ok``
+    holds there and every k (the lower and upper side of a pair: ``z`` (runs, 2L, K), ``ok`` (runs, 2L)), 0 with
+    fewer than 6 values, NaN when a value is NaN -- np.median of each column's values, for every column at once: the
+    values sorted per column (the unused ones +inf, after them), the middle one, or the mean (a + b)/2 of the middle
+    two as np.median takes it."""
+    n_side = z.shape[1] // 2
+    out = np.zeros(cols.size)
+    if cols.size == 0:
+        return out
+    vals = np.concatenate([z[:, cols, :], z[:, n_side + cols, :]], axis=0)          # (2·runs, J, K)
+    use = np.concatenate([ok[:, cols], ok[:, n_side + cols]], axis=0)[:, :, None]
+    vals = np.moveaxis(np.where(use, vals, np.inf), 1, 0).reshape(cols.size, -1)      # (J, 2·runs·K)
+    count = np.broadcast_to(use, (use.shape[0], cols.size, z.shape[2])).sum(axis=(0, 2))
+    has_nan = np.isnan(vals).any(axis=1)
+    srt = np.sort(vals, axis=1)
+    rows = np.arange(cols.size)
+    lo, hi = srt[rows, np.maximum((count - 1) // 2, 0)], srt[rows, np.minimum(count // 2, vals.shape[1] - 1)]
+    med = np.where(count % 2 == 1, lo, (srt[rows, np.maximum(count // 2 - 1, 0)] + hi) / 2.0)
+    out = np.where(count >= 6, np.where(has_nan, np.nan, med), 0.0)
+    return out
+
+
 def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: float, need=None) -> tuple:
     """(|X|² (len(runs), L, n_chans), noise mean of |X|² same shape): the whole-run line powers of the direction's
     channels at ``f_hz`` (len(runs), L) Hz, Hann-windowed (:data:`RUN_WINDOW`; X = 2·Σ w x e^{−2πj f t}/Σ w, so a line
@@ -304,9 +327,8 @@ class SpeedSidebands:
         ok = _record_resolvable(ctx, state, direction, h0, grid, runs)         # (runs, 2G): both sides of every δ
         n = DELTA_GRID.size
         score = np.zeros(n)
-        for j in np.flatnonzero((ok[:, :n].sum(0) >= 3) & (ok[:, n:].sum(0) >= 3)):
-            vals = np.concatenate([z[ok[:, j], j, :].ravel(), z[ok[:, n + j], n + j, :].ravel()])
-            score[j] = float(np.median(vals)) if vals.size >= 6 else 0.0
+        cols = np.flatnonzero((ok[:, :n].sum(0) >= 3) & (ok[:, n:].sum(0) >= 3))
+        score[cols] = side_pair_medians(z, ok, cols)
         return DELTA_GRID, score
 
     @staticmethod
