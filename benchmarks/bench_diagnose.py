@@ -337,7 +337,9 @@ def timing(fit_repeats: int = 5, diagnose_repeats: int = 2):
     print(f"  ratio: wall x{t_diag / t_fit:.1f}, cpu x{c_diag / c_fit:.1f}   (target <= 10x; 51x at issue 14, "
           "27.8x on modes-off data before the speed-up; cpu x33-37 on this data before the whole-run DFT speed-up; "
           "cpu x18.9, first calls x14.0, at a3db21a before the product-grid mode scan and the shared spectra and "
-          "line detections of the suspension-mode fits)")
+          "line detections of the suspension-mode fits; cpu x21.6 = 3.37 s / 0.16 s at 01677da, x19.8 = 2.83 s / "
+          "0.14 s after the same-number speed-ups of the record route, Welch PSDs, floor law and scan medians, "
+          "same run conditions, load 2.7 on 2 cores: the faster Welch PSDs speed the plain fit too)")
     print(f"  first calls only (each with its warm-up, the method of the earlier figures): cpu "
           f"x{c_diags[0] / c_fits[0]:.1f}")
     print(f"  {d.iterations} iterations, added "
