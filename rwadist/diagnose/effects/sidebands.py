@@ -30,6 +30,23 @@ RECORD_STEP_BINS = 0.25
 RECORD_SCORE = 20.0
 
 
+def _plateau_middle(score: np.ndarray, sd: np.ndarray) -> int:
+    """Index of the middle of the run of offsets around the best score whose scores lie within one noise standard
+    deviation ``sd`` (per offset) of it.  The offsets are a quarter-bin grid but the score reads whole bins (and
+    the largest of three, clipped): a sideband ridge is a plateau of equal scores some three bins wide, whose
+    first point is where the ridge's reach begins, not the ridge (20 speeds: ten fit runs do not round it off).
+    A score falling away from the grid's edge is still a plateau of one point there (no pair near)."""
+    j = int(np.argmax(score))
+    near = score >= score[j] - sd
+    lo = j
+    while lo > 0 and near[lo - 1]:
+        lo -= 1
+    hi = j
+    while hi < score.size - 1 and near[hi + 1]:
+        hi += 1
+    return (lo + hi) // 2
+
+
 @register(order=60)
 @dataclass
 class Sidebands:
@@ -250,7 +267,7 @@ class Sidebands:
             found = []
             for i, h in enumerate(hs):
                 s = score[i]
-                j = int(np.argmax(s))
+                j = _plateau_middle(s, np.sqrt(2.0 / ctx.dof) / np.sqrt(np.maximum(cnt[i], 1)))
                 if 0 < j < s.size - 1 and s[j] > _offset_threshold(ctx, cnt[i, j]):
                     found.append((s[j], h, float(offsets[j])))
             for _, h, f_m in sorted(found, reverse=True)[:max_per_direction]:
