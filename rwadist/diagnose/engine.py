@@ -6,18 +6,16 @@ Theory: docs/diagnose.md ("Prediction").
 from __future__ import annotations
 
 import copy
-import functools
 
 import numpy as np
 
-from ..dft import hann_transform
 from ..empirical import block_floor
 from ..model import WheelModel
 from ..resonance import resonance
 from ..spectra import Spectra, welch_dof
 from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
 from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, TORQUE_CHANNELS
-from .metric import Metric
+from .metric import Metric, hann_tables, read_table
 from .state import State
 
 #: Samples (runs × record length × channels) :meth:`Context.phasors` transforms together: a few tens of MB.
@@ -40,24 +38,6 @@ def line_kernel(nperseg: int, fs: float, window: str = "hann", half: int = KERNE
     # nperseg·oversample (the direct sum over the (δ, n) matrix cost seconds for long segments)
     W = np.fft.fft(w, nperseg * oversample)[steps % (nperseg * oversample)]
     return delta, np.abs(W) ** 2 / (fs * np.sum(w**2))
-
-
-#: Points per bin of :func:`hann_power_table`: the 4-point interpolation's error falls as its step⁴ (1/64: 3e-8
-#: of the peak, 1/256: 1.5e-10, a fraction of a noise level in the strongest line's bins at 0.1 % noise).
-HANN_OVERSAMPLE = 256
-
-
-@functools.lru_cache(maxsize=8)
-def hann_power_table(nperseg: int) -> tuple:
-    """(δ_0, |W|²) of the periodic Hann window of ``nperseg`` samples (:func:`rwadist.dft.hann_transform`, exact)
-    at δ = δ_0 + i/:data:`HANN_OVERSAMPLE` bins, over ±(:data:`KERNEL_HALF` + 3) bins: the table
-    :meth:`Context.kernel_at` interpolates.  Read-only (shared)."""
-    half = KERNEL_HALF + 3
-    delta = np.arange(-half * HANN_OVERSAMPLE, half * HANN_OVERSAMPLE + 1) / HANN_OVERSAMPLE
-    W = hann_transform(nperseg, float(nperseg), delta)                  # f_s = nperseg: the argument in bins
-    table = W.real**2 + W.imag**2
-    table.flags.writeable = False
-    return float(delta[0]), table
 
 
 class Context(Metric):
@@ -218,7 +198,7 @@ class Context(Metric):
         """The line kernel K(δ) = |W(δ)|²/(f_s·Σw²) (1/Hz) at offsets ``dlt`` (bins from the line, any shape).
 
         Periodic Hann window: |W|² of its closed-form transform (:func:`rwadist.dft.hann_transform`) tabulated
-        every 1/:data:`HANN_OVERSAMPLE` bin (:func:`hann_power_table`) and read by 4-point Lagrange interpolation:
+        every 1/:data:`~rwadist.diagnose.metric.HANN_OVERSAMPLE` bin (:func:`~rwadist.diagnose.metric.hann_tables`) and read by 4-point Lagrange interpolation:
         within 2e-10 of the peak (the closed form at every point costs ten times as much, and psd_at is the
         search's inner loop).  Other windows: the table of :func:`line_kernel`, linearly interpolated.  Read at
         the table's nearest 1/64-bin point (as before), a line's power was misplaced by up to 1/128 bin: a line
@@ -226,14 +206,7 @@ class Context(Metric):
         deviations for a line 80 dB over 1 % noise (most of the true model's error on modes-on data, issue 14)."""
         if self._hann:
             L = self.sp.nperseg
-            start, table = hann_power_table(L)
-            x = np.clip((dlt - start) * HANN_OVERSAMPLE, 1.0, table.size - 3.0)
-            i = x.astype(int)
-            u = x - i
-            p0, p1, p2, p3 = table[i - 1], table[i], table[i + 1], table[i + 2]
-            um, u1, u2 = u - 1.0, u + 1.0, u - 2.0
-            val = (u * um * (u1 * p3 - u2 * p0) / 6.0 + u1 * u2 * (um * p1 - u * p2) / 2.0)
-            return val / (self.sp.sample_rate * 3.0 * L / 8.0)                    # Σw² = 3L/8
+            return read_table(hann_tables(L)[1], dlt) / (self.sp.sample_rate * 3.0 * L / 8.0)   # Σw² = 3L/8
         x = np.clip((dlt - self.delta[0]) * self.osmp, 0.0, self.delta.size - 1.0)
         i0 = np.minimum(x.astype(int), self.delta.size - 2)
         frac = x - i0
