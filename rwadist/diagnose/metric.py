@@ -92,7 +92,7 @@ class Metric:
             for h, _, amp, _ in self.channel_lines(state, c, runs):
                 f0 = h * self.omega[runs] / (2 * np.pi)
                 for shift, rel in state.line_components(c, h):
-                    a = amp * rel
+                    a = amp * rel * self.sideband_gain(state, c, h, shift, runs)
                     if state.resonances:
                         a = a * self.gain(state, c, f0 + shift)
                     comps.append(((round(h, 9), shift), np.abs(f0 + shift) / self.df, a**2 / 2.0))

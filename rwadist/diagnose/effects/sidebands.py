@@ -105,7 +105,8 @@ class Sidebands:
                 f = h * ctx.omega[runs] / (2 * np.pi) + side * f_mod
                 p, _, _, inb = _window_power(ctx, state, c, runs, f, R)
                 ok = inb & _clear_of_lines(ctx, state, c, runs, f, h) & (f > 0)
-                g = ctx.gain(state, c, f) if state.resonances else 1.0
+                g = (ctx.gain(state, c, f) if state.resonances else 1.0) * \
+                    ctx.sideband_gain(state, c, h, side * f_mod, runs)            # through the modes at f
                 P.append(p[ok])
                 Q.append(((a * g) ** 2 / 8.0 * np.ones(runs.size))[ok])
         P, Q = np.concatenate(P), np.concatenate(Q)
@@ -177,8 +178,9 @@ class Sidebands:
             a = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - h) < 1e-9), None)
             if a is None:
                 return None
-            for col in (0, 1):
-                g = ctx.gain(state, c, f[:, col]) if state.resonances else 1.0
+            for col in (0, 1):                               # lower, upper
+                g = (ctx.gain(state, c, f[:, col]) if state.resonances else 1.0) * \
+                    ctx.sideband_gain(state, c, h, (2 * col - 1) * f_mod, runs)
                 keep = ok[:, col] & (P[:, col, j] > 10.0 * N[:, col, j])
                 A.append(np.sqrt(np.maximum(P[:, col, j] - N[:, col, j], 0.0))[keep])
                 Q.append((0.5 * a * g * np.ones(runs.size))[keep])
@@ -213,6 +215,7 @@ class Sidebands:
             if a is None:
                 return None
             g = np.column_stack([ctx.gain(state, c, f[:, col]) for col in (0, 1)]) if state.resonances else 1.0
+            g = g * np.column_stack([ctx.sideband_gain(state, c, self.h, side * self.f_mod, runs) for side in (-1, 1)])
             M1.append((0.5 * self.depth * a[:, None] * g * np.ones((runs.size, 2))) ** 2)
         M1 = np.array(M1).reshape(len(chans), -1)                        # (chans, runs·2)
         P = np.moveaxis(P, 2, 0).reshape(len(chans), -1)
