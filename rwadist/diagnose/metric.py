@@ -23,27 +23,32 @@ HANN_TABLE_HALF = KERNEL_HALF + 3
 
 @functools.lru_cache(maxsize=8)
 def hann_tables(nperseg: int) -> tuple:
-    """(V, |V|²) of the periodic Hann window of ``nperseg`` samples at δ = −HANN_TABLE_HALF + i/HANN_OVERSAMPLE
-    bins: V(δ) = W(δ)·e^{jπδ(L−1)/L}, the window's transform (:func:`rwadist.dft.hann_transform`, closed form)
-    without its linear phase (complex; |V| = |W|).  Read by :func:`read_table`.  Read-only (shared)."""
+    """(V, |V|²) of the periodic Hann window of ``nperseg`` samples as interpolation tables for :func:`read_table`:
+    V(δ) = W(δ)·e^{jπδ(L−1)/L}, the window's transform (:func:`rwadist.dft.hann_transform`, closed form) without
+    its linear phase (complex; |V| = |W|), at δ = −HANN_TABLE_HALF + i/HANN_OVERSAMPLE bins, each interval
+    stored as the coefficients of its cubic in the fraction u (the 4-point Lagrange cubic through the points
+    i − 1 … i + 2: one row read per value).  Read-only (shared)."""
     delta = np.arange(-HANN_TABLE_HALF * HANN_OVERSAMPLE, HANN_TABLE_HALF * HANN_OVERSAMPLE + 1) / HANN_OVERSAMPLE
     L = float(nperseg)
     V = hann_transform(nperseg, L, delta) * np.exp(1j * np.pi * delta * (L - 1.0) / L)    # f_s = L: δ in bins
-    power = V.real**2 + V.imag**2
-    for x in (V, power):
-        x.flags.writeable = False
-    return V, power
+    out = []
+    for y in (V, V.real**2 + V.imag**2):
+        p0, p1, p2, p3 = y[:-3], y[1:-2], y[2:-1], y[3:]
+        coef = np.ascontiguousarray(np.stack([p1, -p0 / 3.0 - p1 / 2.0 + p2 - p3 / 6.0, (p0 + p2) / 2.0 - p1,
+                                              (p3 - p0) / 6.0 + (p1 - p2) / 2.0], axis=1))
+        coef.flags.writeable = False
+        out.append(coef)
+    return tuple(out)
 
 
-def read_table(table: np.ndarray, dlt: np.ndarray) -> np.ndarray:
-    """``table`` of :func:`hann_tables` at offsets ``dlt`` (bins, any shape; clipped to the table's reach), by
-    4-point Lagrange interpolation."""
-    x = np.clip((dlt + HANN_TABLE_HALF) * HANN_OVERSAMPLE, 1.0, table.size - 3.0)
+def read_table(coef: np.ndarray, dlt: np.ndarray) -> np.ndarray:
+    """A table of :func:`hann_tables` at offsets ``dlt`` (bins, any shape; clipped to the table's reach): the cubic
+    of the interval holding each offset, evaluated at its fraction (Horner)."""
+    x = np.clip((dlt + HANN_TABLE_HALF) * HANN_OVERSAMPLE, 1.0, coef.shape[0])
     i = x.astype(int)
     u = x - i
-    p0, p1, p2, p3 = table[i - 1], table[i], table[i + 1], table[i + 2]
-    um, u1, u2 = u - 1.0, u + 1.0, u - 2.0
-    return u * um * (u1 * p3 - u2 * p0) / 6.0 + u1 * u2 * (um * p1 - u * p2) / 2.0
+    g = coef[i - 1]
+    return ((g[..., 3] * u + g[..., 2]) * u + g[..., 1]) * u + g[..., 0]
 
 
 class Metric:
@@ -96,17 +101,32 @@ class Metric:
                     if state.resonances:
                         a = a * self.gain(state, c, f0 + shift)
                     comps.append(((round(h, 9), shift), np.abs(f0 + shift) / self.df, a**2 / 2.0))
-            reach = 2 * KERNEL_HALF
-            for i in range(len(comps)):
-                ki, pi, Pi = comps[i]
-                for j in range(i, len(comps)):
-                    kj, pj, Pj = comps[j]
-                    for image in ((False, True) if j > i else (True,)):
-                        if not np.any(np.abs(pi + pj if image else pi - pj) <= reach):
-                            continue
-                        out += 2.0 * (Pi * Pj)[:, None] * self._beat_shape(ki, kj, image, pi, pj, runs)
+            if comps:
+                first, second, shapes = self._beat_pairs(comps, runs)
+                if first.size:
+                    P = np.array([x[2] for x in comps])                                    # (n, len(runs))
+                    out = np.einsum("pr,prb->rb", 2.0 * P[first] * P[second], shapes)
         state._cache[key] = out
         return out
+
+    def _beat_pairs(self, comps, runs):
+        """(i, j, shapes (n_pairs, len(runs), n_bands)) of the pairs of :meth:`beat_variance`'s line components
+        ``comps`` [(key, position, power)] within two kernel reaches of each other in some run (a line with a line,
+        i < j; a line with the image of a line, i ≤ j), their shapes (:meth:`_beat_shape`) stacked.  The pairs and
+        shapes depend on the lines' positions only: kept on the context per set of lines (every hypothesis that does
+        not move a line -- a floor, a resonance, a law -- reads them again)."""
+        key = ("beat_pairs", tuple(x[0] for x in comps), runs.tobytes())
+        if key not in self._memo:
+            pos = np.array([x[1] for x in comps])                                         # (n, len(runs))
+            reach = 2 * KERNEL_HALF
+            near = np.triu(np.any(np.abs(pos[:, None, :] - pos[None, :, :]) <= reach, axis=2), 1)
+            near_image = np.triu(np.any(pos[:, None, :] + pos[None, :, :] <= reach, axis=2))
+            pairs = [(i, j, self._beat_shape(comps[i][0], comps[j][0], image, pos[i], pos[j], runs))
+                     for image, mask in ((False, near), (True, near_image)) for i, j in zip(*np.nonzero(mask))]
+            shapes = np.array([x[2] for x in pairs]) if pairs else np.zeros((0, runs.size, self.n_bands))
+            self._memo[key] = (np.array([x[0] for x in pairs], dtype=int), np.array([x[1] for x in pairs], dtype=int),
+                               shapes)
+        return self._memo[key]
 
     def _beat_shape(self, ki, kj, image, pi, pj, runs):
         """c_ij²·|S|²·(Δf/(f_s·Σw²))² (len(runs), n_bands) of :meth:`beat_variance` for lines at bins ``pi``, ``pj``
