@@ -5,10 +5,50 @@ degrees of freedom, data and predictions.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
-from .constants import BAND_BINS, NOISE_Z
+from ..dft import hann_transform
+from .constants import BAND_BINS, KERNEL_HALF, NOISE_Z
 from .state import State
+
+#: Points per bin of :func:`hann_tables`: the 4-point interpolation's error falls as its step⁴ (measured on |W|²:
+#: 1/64 2.5e-8, 1/128 1.6e-9, 1/256 1e-10 of the peak; 1e-10 is a fraction of a noise level in the strongest
+#: line's bins at 0.1 % noise, where a line's peak PSD stands ~L/3·1e6 over the noise).
+HANN_OVERSAMPLE = 256
+#: Reach of :func:`hann_tables`, bins each side: the kernel's ±KERNEL_HALF, the interpolation's 2 points, margin.
+HANN_TABLE_HALF = KERNEL_HALF + 3
+
+
+@functools.lru_cache(maxsize=8)
+def hann_tables(nperseg: int) -> tuple:
+    """(V, |V|²) of the periodic Hann window of ``nperseg`` samples as interpolation tables for :func:`read_table`:
+    V(δ) = W(δ)·e^{jπδ(L−1)/L}, the window's transform (:func:`rwadist.dft.hann_transform`, closed form) without
+    its linear phase (complex; |V| = |W|), at δ = −HANN_TABLE_HALF + i/HANN_OVERSAMPLE bins, each interval
+    stored as the coefficients of its cubic in the fraction u (the 4-point Lagrange cubic through the points
+    i − 1 … i + 2: one row read per value).  Read-only (shared)."""
+    delta = np.arange(-HANN_TABLE_HALF * HANN_OVERSAMPLE, HANN_TABLE_HALF * HANN_OVERSAMPLE + 1) / HANN_OVERSAMPLE
+    L = float(nperseg)
+    V = hann_transform(nperseg, L, delta) * np.exp(1j * np.pi * delta * (L - 1.0) / L)    # f_s = L: δ in bins
+    out = []
+    for y in (V, V.real**2 + V.imag**2):
+        p0, p1, p2, p3 = y[:-3], y[1:-2], y[2:-1], y[3:]
+        coef = np.ascontiguousarray(np.stack([p1, -p0 / 3.0 - p1 / 2.0 + p2 - p3 / 6.0, (p0 + p2) / 2.0 - p1,
+                                              (p3 - p0) / 6.0 + (p1 - p2) / 2.0], axis=1))
+        coef.flags.writeable = False
+        out.append(coef)
+    return tuple(out)
+
+
+def read_table(coef: np.ndarray, dlt: np.ndarray) -> np.ndarray:
+    """A table of :func:`hann_tables` at offsets ``dlt`` (bins, any shape; clipped to the table's reach): the cubic
+    of the interval holding each offset, evaluated at its fraction (Horner)."""
+    x = np.clip((dlt + HANN_TABLE_HALF) * HANN_OVERSAMPLE, 1.0, coef.shape[0])
+    i = x.astype(int)
+    u = x - i
+    g = coef[i - 1]
+    return ((g[..., 3] * u + g[..., 2]) * u + g[..., 1]) * u + g[..., 0]
 
 
 class Metric:
@@ -19,24 +59,115 @@ class Metric:
         n = self.n_bands * BAND_BINS
         return x[:, lo:lo + n].reshape(x.shape[0], self.n_bands, BAND_BINS).sum(-1) * self.df
 
-    def band_sigma(self, state: State, c: str, runs: np.ndarray, floor=None, lines=None) -> np.ndarray:
+    def band_sigma(self, state: State, c: str, runs: np.ndarray, floor=None, lines=None,
+                   beat_state: State | None = None) -> np.ndarray:
         """Noise standard deviation (unit²) of the data power in every band if the model were right.
 
         A Welch PSD bin of noise N plus a deterministic line L has variance (N² + 2·L·N)·2/ν
         (ν = Welch degrees of freedom; the second term is the line × noise cross term); bins
         are summed as if independent and the result doubled for the Hann correlation of
-        neighbouring bins (an approximation, stated)."""
+        neighbouring bins (an approximation, stated); to that the variance of the model's lines beating
+        with one another (:meth:`beat_variance`, exact for the Hann window), of the lines of ``beat_state``
+        (default: ``state``)."""
         N = self.floor_psd(state, c, runs) if floor is None else floor
         L = (self.predict(state, c, runs) - N) if lines is None else lines
         var_bin = (N**2 + 2.0 * np.maximum(L, 0.0) * N) * 2.0 / self.dof
-        return np.sqrt(2.0 * self.band_sums(var_bin) * self.df)
+        beats = self.beat_variance(state if beat_state is None else beat_state, c, runs)
+        return np.sqrt(2.0 * self.band_sums(var_bin) * self.df + beats)
 
-    def run_errors(self, state: State, runs: np.ndarray, channels=None, detail: bool = False):
+    def beat_variance(self, state: State, c: str, runs: np.ndarray) -> np.ndarray:
+        """Variance (unit⁴, (len(runs), n_bands)) of the band powers from the model's lines beating.
+
+        Two lines i, j (mean squares P_i, P_j) within two kernel reaches of each other add to a Welch band the
+        cross term 2·√(P_i·P_j)·Re(S·e^{jΔφ})·c_ij·Δf/(f_s·Σw²), S = Σ_band V(k − p_i)·V(k − p_j)* (V of
+        :func:`hann_tables`, p the lines' positions in bins), whose phase difference Δφ the model does not know
+        (every line's phase is free): uniform Δφ gives the variance 2·P_i·P_j·c_ij²·|S|²·(Δf/(f_s·Σw²))².
+        c_ij = |sin(Mπx)/(M·sin(πx))|, x = (p_i − p_j)/2, is what is left of the term after averaging M
+        segments at 50 % overlap (the phase difference turns by 2πx from one segment to the next).  A line's
+        image at −f (a channel is a real signal) beats with the line itself and its neighbours near 0 Hz as a
+        line of phase −φ.  The lines and their sidebands as :meth:`predict` has them (each within ±KERNEL_HALF of
+        its bin); zero under a spin smear or a speed ripple (their lines are no steady lines) and for other
+        windows (the term is not modelled).  Cached on the state; each pair's shape on the context."""
+        key = ("beat", c, runs.tobytes())
+        if key in state._cache:
+            return state._cache[key]
+        out = np.zeros((runs.size, self.n_bands))
+        if state.smear is None and state.ripple is None and self.sp.window == "hann":
+            comps = []
+            for h, _, amp, _ in self.channel_lines(state, c, runs):
+                f0 = h * self.omega[runs] / (2 * np.pi)
+                for shift, rel in state.line_components(c, h):
+                    a = amp * rel * self.sideband_gain(state, c, h, shift, runs)
+                    if state.resonances:
+                        a = a * self.gain(state, c, f0 + shift)
+                    comps.append(((round(h, 9), shift), np.abs(f0 + shift) / self.df, a**2 / 2.0))
+            if comps:
+                first, second, shapes = self._beat_pairs(comps, runs)
+                if first.size:
+                    P = np.array([x[2] for x in comps])                                    # (n, len(runs))
+                    out = np.einsum("pr,prb->rb", 2.0 * P[first] * P[second], shapes)
+        state._cache[key] = out
+        return out
+
+    def _beat_pairs(self, comps, runs):
+        """(i, j, shapes (n_pairs, len(runs), n_bands)) of the pairs of :meth:`beat_variance`'s line components
+        ``comps`` [(key, position, power)] within two kernel reaches of each other in some run (a line with a line,
+        i < j; a line with the image of a line, i ≤ j), their shapes (:meth:`_beat_shape`) stacked.  The pairs and
+        shapes depend on the lines' positions only: kept on the context per set of lines (every hypothesis that does
+        not move a line -- a floor, a resonance, a law -- reads them again)."""
+        key = ("beat_pairs", tuple(x[0] for x in comps), runs.tobytes())
+        if key not in self._memo:
+            pos = np.array([x[1] for x in comps])                                         # (n, len(runs))
+            reach = 2 * KERNEL_HALF
+            near = np.triu(np.any(np.abs(pos[:, None, :] - pos[None, :, :]) <= reach, axis=2), 1)
+            near_image = np.triu(np.any(pos[:, None, :] + pos[None, :, :] <= reach, axis=2))
+            pairs = [(i, j, self._beat_shape(comps[i][0], comps[j][0], image, pos[i], pos[j], runs))
+                     for image, mask in ((False, near), (True, near_image)) for i, j in zip(*np.nonzero(mask))]
+            shapes = np.array([x[2] for x in pairs]) if pairs else np.zeros((0, runs.size, self.n_bands))
+            self._memo[key] = (np.array([x[0] for x in pairs], dtype=int), np.array([x[1] for x in pairs], dtype=int),
+                               shapes)
+        return self._memo[key]
+
+    def _beat_shape(self, ki, kj, image, pi, pj, runs):
+        """c_ij²·|S|²·(Δf/(f_s·Σw²))² (len(runs), n_bands) of :meth:`beat_variance` for lines at bins ``pi``, ``pj``
+        (len(runs),; ``image``: the image of j, at −pj), keyed by the lines' (h, shift) ``ki``, ``kj`` on the
+        context (the positions depend on h, shift and the runs only, not on the state)."""
+        key = ("beat_shape", ki, kj, image, runs.tobytes())
+        if key in self._memo:
+            return self._memo[key]
+        L = self.sp.nperseg
+        V = hann_tables(L)[0]
+        qj = -pj if image else pj
+        offs = np.arange(-2 * KERNEL_HALF, 2 * KERNEL_HALF + 1)
+        k = np.rint(0.5 * (pi + qj)).astype(int)[:, None] + offs                       # (runs, 4H+1)
+        lo, hi = self.k_lo, self.k_lo + self.n_bands * BAND_BINS
+        vi = np.where(np.abs(k - np.rint(pi)[:, None]) <= KERNEL_HALF, read_table(V, k - pi[:, None]), 0)
+        vj = np.where(np.abs(k - np.rint(qj)[:, None]) <= KERNEL_HALF, read_table(V, k - qj[:, None]), 0)
+        near = np.abs(pi - qj) <= 2 * KERNEL_HALF
+        prod = np.where(near[:, None] & (k >= lo) & (k < hi), vi * np.conj(vj), 0)
+        band = np.clip((k - lo) // BAND_BINS, 0, self.n_bands - 1)
+        flat = (np.arange(runs.size)[:, None] * self.n_bands + band).ravel()
+        size = runs.size * self.n_bands
+        S = (np.bincount(flat, prod.real.ravel(), size) + 1j * np.bincount(flat, prod.imag.ravel(), size))
+        x = 0.5 * (pi - qj)
+        m = np.asarray(self.sp.n_segments, dtype=float)[runs]
+        den = m * np.sin(np.pi * x)
+        small = np.abs(den) < 1e-12
+        coh = np.where(small, 1.0, np.abs(np.sin(m * np.pi * x)) / np.where(small, 1.0, np.abs(den)))
+        norm = (self.df / (self.sp.sample_rate * 3.0 * L / 8.0)) ** 2                 # Σw² = 3L/8
+        out = (coh**2)[:, None] * norm * np.abs(S.reshape(runs.size, -1)) ** 2
+        out.flags.writeable = False
+        self._memo[key] = out
+        return out
+
+    def run_errors(self, state: State, runs: np.ndarray, channels=None, detail: bool = False,
+                   beat_state: State | None = None):
         """Per run: (E_num, D_tot) summed over channels and bands, E_num = Σ max(|D − M| − 2σ, 0)
         (the misplaced power beyond two noise standard deviations), each channel divided by the mean
         data power of its unit group so forces and torques weigh alike.  ``detail``: also the per-band
         (channel -> (D − M, σ)) arrays (the residual: an effect may change the model M or, a measurement
-        correction, the data D as the state reads them)."""
+        correction, the data D as the state reads them).  ``beat_state``: the state whose lines' beats
+        the noise allows for (:meth:`band_sigma`; default ``state``)."""
         err = np.zeros(runs.size)
         tot = np.zeros(runs.size)
         parts = {}
@@ -47,7 +178,7 @@ class Metric:
             N = self.floor_psd(state, c, runs)
             Mfull = self.predict(state, c, runs)
             M = self.band_sums(Mfull)
-            sig = self.band_sigma(state, c, runs, N, Mfull - N)
+            sig = self.band_sigma(state, c, runs, N, Mfull - N, beat_state)
             scale = self.scale(c)
             e = np.maximum(np.abs(D - M) - NOISE_Z * sig, 0.0)
             err[ok] += e[ok].sum(1) / scale

@@ -108,7 +108,9 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
                           bool(t > k_sigma and frac >= min_gain), iteration)
     chans = [c for c in effect.channels if c in ctx.channels]
     e0, _, p0 = _state_errors(ctx, state, runs, chans, memo)
-    e1, _, p1 = ctx.run_errors(effect.apply(state), runs, chans, detail=True)
+    # judged against the noise of the lines it is proposed to: a line added beside another beats with it, and the
+    # allowance for that beat (Metric.beat_variance) is no evidence for the line
+    e1, _, p1 = ctx.run_errors(effect.apply(state), runs, chans, detail=True, beat_state=state)
     e0_all, all_tot, _ = _state_errors(ctx, state, runs, None, memo)
     var = 0.0
     for c in chans:

@@ -30,6 +30,23 @@ RECORD_STEP_BINS = 0.25
 RECORD_SCORE = 20.0
 
 
+def _plateau_middle(score: np.ndarray, sd: np.ndarray) -> int:
+    """Index of the middle of the run of offsets around the best score whose scores lie within one noise standard
+    deviation ``sd`` (per offset) of it.  The offsets are a quarter-bin grid but the score reads whole bins (and
+    the largest of three, clipped): a sideband ridge is a plateau of equal scores some three bins wide, whose
+    first point is where the ridge's reach begins, not the ridge (20 speeds: ten fit runs do not round it off).
+    A score falling away from the grid's edge is still a plateau of one point there (no pair near)."""
+    j = int(np.argmax(score))
+    near = score >= score[j] - sd
+    lo = j
+    while lo > 0 and near[lo - 1]:
+        lo -= 1
+    hi = j
+    while hi < score.size - 1 and near[hi + 1]:
+        hi += 1
+    return (lo + hi) // 2
+
+
 @register(order=60)
 @dataclass
 class Sidebands:
@@ -88,7 +105,8 @@ class Sidebands:
                 f = h * ctx.omega[runs] / (2 * np.pi) + side * f_mod
                 p, _, _, inb = _window_power(ctx, state, c, runs, f, R)
                 ok = inb & _clear_of_lines(ctx, state, c, runs, f, h) & (f > 0)
-                g = ctx.gain(state, c, f) if state.resonances else 1.0
+                g = (ctx.gain(state, c, f) if state.resonances else 1.0) * \
+                    ctx.sideband_gain(state, c, h, side * f_mod, runs)            # through the modes at f
                 P.append(p[ok])
                 Q.append(((a * g) ** 2 / 8.0 * np.ones(runs.size))[ok])
         P, Q = np.concatenate(P), np.concatenate(Q)
@@ -160,8 +178,9 @@ class Sidebands:
             a = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - h) < 1e-9), None)
             if a is None:
                 return None
-            for col in (0, 1):
-                g = ctx.gain(state, c, f[:, col]) if state.resonances else 1.0
+            for col in (0, 1):                               # lower, upper
+                g = (ctx.gain(state, c, f[:, col]) if state.resonances else 1.0) * \
+                    ctx.sideband_gain(state, c, h, (2 * col - 1) * f_mod, runs)
                 keep = ok[:, col] & (P[:, col, j] > 10.0 * N[:, col, j])
                 A.append(np.sqrt(np.maximum(P[:, col, j] - N[:, col, j], 0.0))[keep])
                 Q.append((0.5 * a * g * np.ones(runs.size))[keep])
@@ -196,6 +215,7 @@ class Sidebands:
             if a is None:
                 return None
             g = np.column_stack([ctx.gain(state, c, f[:, col]) for col in (0, 1)]) if state.resonances else 1.0
+            g = g * np.column_stack([ctx.sideband_gain(state, c, self.h, side * self.f_mod, runs) for side in (-1, 1)])
             M1.append((0.5 * self.depth * a[:, None] * g * np.ones((runs.size, 2))) ** 2)
         M1 = np.array(M1).reshape(len(chans), -1)                        # (chans, runs·2)
         P = np.moveaxis(P, 2, 0).reshape(len(chans), -1)
@@ -249,7 +269,7 @@ class Sidebands:
             found = []
             for i, h in enumerate(hs):
                 s = score[i]
-                j = int(np.argmax(s))
+                j = _plateau_middle(s, np.sqrt(2.0 / ctx.dof) / np.sqrt(np.maximum(cnt[i], 1)))
                 if 0 < j < s.size - 1 and s[j] > _offset_threshold(ctx, cnt[i, j]):
                     found.append((s[j], h, float(offsets[j])))
             for _, h, f_m in sorted(found, reverse=True)[:max_per_direction]:

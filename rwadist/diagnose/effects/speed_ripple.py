@@ -6,6 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...units import CHANNELS
+from ..constants import LINE_HALF
 from ..engine import Context, ripple_sideband_powers
 from ..measure import (
     _clear_of_lines,
@@ -64,7 +65,7 @@ class SpeedRipple:
         """Measured first-order ripple sidebands of every model line: (P window power, σ noise std, h, Ω,
         a carrier amplitude × gain, p amplitude exponent, side) over channels, lines and both sides, in band
         and clear of other lines."""
-        cols = {k: [] for k in ("P", "sig", "h", "w", "a", "p", "side")}
+        cols = {k: [] for k in ("P", "sig", "h", "w", "a", "p", "side", "leak")}
         for c in ctx.channels:
             if not np.isfinite(ctx.sp.psd[c][runs, 0]).all():
                 continue
@@ -76,9 +77,13 @@ class SpeedRipple:
                     p, _, sig, inb = _window_power(ctx, state, c, runs, f, R)
                     ok = inb & (f > 0) & _clear_of_lines(ctx, state, c, runs, f, h)
                     g = ctx.gain(state, c, f0) if state.resonances else np.ones(runs.size)
+                    # the fraction of the carrier's power the window holds: the ripple takes (1 − c_0²) of it away
+                    # (into the sidebands), a deficit the residual of the window shows beside the sideband
+                    k0 = np.rint(np.abs(f) / ctx.df).astype(int)[:, None] + np.arange(-LINE_HALF, LINE_HALF + 1)
+                    leak = ctx.psd_at(f0, np.ones(runs.size), k0).sum(1) * ctx.df
                     for k, v in (("P", p), ("sig", sig), ("h", np.full(runs.size, h)), ("w", ctx.omega[runs]),
                                  ("a", a * g), ("p", np.full(runs.size, 2.0 if law is None else law[2])),
-                                 ("side", np.full(runs.size, side))):
+                                 ("side", np.full(runs.size, side)), ("leak", leak)):
                         cols[k].append(np.asarray(v, float)[ok])
         return {k: np.concatenate(v) if v else np.empty(0) for k, v in cols.items()}
 
@@ -107,7 +112,7 @@ class SpeedRipple:
         def cost(x):
             dw = np.exp(x) * (pt["w"] / w_ref) ** exponent
             k, P = ripple_sideband_powers(pt["h"] * dw / (2 * np.pi * f_r), dw / pt["w"], pt["p"], k_max=4)
-            pred = P[np.arange(ki.size), ki + 4] * pt["a"] ** 2 / 2
+            pred = (P[np.arange(ki.size), ki + 4] + (P[:, 4] - 1.0) * pt["leak"]) * pt["a"] ** 2 / 2
             r = (y - np.log(np.maximum(pred, 1e-300))) / 0.5
             return float(np.sum(2.0 * (np.sqrt(1.0 + r * r) - 1.0)))        # soft-L1
 
