@@ -246,7 +246,7 @@ def declare_unsettled_modes(before, after) -> list:
     return out
 
 
-def fit_extended_beside_stand(test, fit, **kwargs):
+def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwargs):
     """:func:`rwadist.extended_fit.fit_extended` of ``test`` (empirical fit ``fit``; ``kwargs`` passed on) with a
     fixture resonance fitted beside the wheel's modes, never into them.
 
@@ -259,11 +259,13 @@ def fit_extended_beside_stand(test, fit, **kwargs):
     translation's mode are coupled, so a loosely settled stand leaves the mode pulled towards it.  It is dropped (the plain fit
     returned) when the residual confirms no resonance there, or when the fit with it locates fewer modes than
     the fit without it.  The stand kept is in ``ExtendedFit.stand`` and a note; it is not part of the wheel's
-    model (``rwadist diagnose`` names it as a ``fixed_resonance`` of role test_stand)."""
+    model (``rwadist diagnose`` names it as a ``fixed_resonance`` of role test_stand).  ``stand_start``: the
+    (f_r Hz, ζ, peak gain) to start the rounds from instead of :func:`stand_resonance_start`'s (the caller has
+    checked that every channel is there)."""
     from .extended_fit import fit_extended
 
     channels = {c for r in test.runs for c in r.signals}
-    stand = stand_resonance_start(fit) if len(channels) >= 6 else None
+    stand = stand_start or (stand_resonance_start(fit) if len(channels) >= 6 else None)
     if stand is None:
         return fit_extended(test, fit, **kwargs)
     plain = fit_extended(test, fit, **kwargs)
