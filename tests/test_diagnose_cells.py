@@ -116,3 +116,18 @@ def test_wide_speed_range_clean_adds_no_offset():
     (cc,) = [e for e in d.model.effects if e["kind"] == "cross_coupling"]
     assert cc["r_m"][2] == pytest.approx(r[2], rel=0.05)
     assert np.allclose(cc["r_m"][:2], 0.0, atol=1e-3)
+
+
+def test_short_record_stand_no_model_fits_stand_beside_modes():
+    """2048 samples through the 180 Hz stand, no model: the stand divided out before the modes were located was not
+    confirmed on diagnose's own line measurements (its Welch segments leave no line near 180 Hz measurable apart), so
+    the modes were refitted without it (radial translation pulled to the stand: -18.6 %, misfit noted) and the stand
+    was never named (error 0.98 -> 0.17).  Now the stand is confirmed on the modes' residual at the fit's resolution,
+    the modes are each within 2 % of the generator's, and the stand is named (role test_stand, within 1 %)."""
+    d = api.diagnose(iir_stand_test(np.linspace(300.0, 3000.0, 60), seed=3, n_samples=2048))
+    _assert_modes_within(d, 0.02)
+    stands = [e for e in d.model.effects if e["kind"] == "fixed_resonance"]
+    assert [e["role"] for e in stands] == ["test_stand"]
+    assert stands[0]["f_Hz"] == pytest.approx(STAND_HZ, rel=0.01)
+    assert stands[0]["peak_gain"] == pytest.approx(STAND_GAIN, rel=0.1)
+    assert d.error_after < 0.02 * d.error_before
