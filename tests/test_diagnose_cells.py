@@ -57,7 +57,9 @@ def _added(d):
 def test_short_record_stand_never_raises_the_error():
     """2048 samples through the stand, a fitted reference model: the search's refit of the stand on every run ran off
     (ζ to its bound 1e-3, peak gain 137: between the lines only ζ·g is measured) and was added unjudged, raising the
-    error 0.19 -> 6.4.  An accepted effect never raises the error on every run, and the stand is the one filtered in."""
+    error 0.19 -> 6.4.  An accepted effect never raises the error on every run, and the stand is the one filtered in
+    (diagnose's own fit of it on this record, 180.4 Hz, ζ 0.040, gain 3.9, left a false amplitude law on h = 4.42 beside
+    it: the reference fit's stand, located at the fit's resolution, is proposed too)."""
     speeds = np.linspace(300.0, 3000.0, 60)
     ref = _reference(iir_stand_test(speeds, seed=500, n_samples=2048))
     d = api.diagnose(iir_stand_test(speeds, seed=3, n_samples=2048), ref)
@@ -67,10 +69,12 @@ def test_short_record_stand_never_raises_the_error():
         nxt = e.apply(state)
         assert d.ctx.error(nxt) <= d.ctx.error(state) * (1 + 1e-9), e.kind
         state = nxt
-    (stand,) = [e for e in d.model.effects if e["kind"] == "fixed_resonance"]
+    assert _added(d) == ["fixed_resonance"]         # the stand and nothing else
+    (stand,) = d.model.effects
     assert stand["role"] == "test_stand"
-    assert stand["f_Hz"] == pytest.approx(STAND_HZ, rel=0.02)
-    assert stand["peak_gain"] == pytest.approx(STAND_GAIN, rel=0.25)
+    assert stand["f_Hz"] == pytest.approx(STAND_HZ, rel=0.01)
+    assert stand["zeta"] == pytest.approx(STAND_ZETA, rel=0.1)
+    assert stand["peak_gain"] == pytest.approx(STAND_GAIN, rel=0.1)
 
 
 def _assert_modes_within(d, rel):
@@ -126,6 +130,9 @@ def test_short_record_stand_no_model_fits_stand_beside_modes():
     the modes are each within 2 % of the generator's, and the stand is named (role test_stand, within 1 %)."""
     d = api.diagnose(iir_stand_test(np.linspace(300.0, 3000.0, 60), seed=3, n_samples=2048))
     _assert_modes_within(d, 0.02)
+    # and nothing else: the merged h = 5.37/5.57 pair (one h = 5.49 line at this resolution, listed unresolved) is
+    # no amplitude law
+    assert sorted(_added(d)) == ["fixed_resonance", "suspension_modes"]
     stands = [e for e in d.model.effects if e["kind"] == "fixed_resonance"]
     assert [e["role"] for e in stands] == ["test_stand"]
     assert stands[0]["f_Hz"] == pytest.approx(STAND_HZ, rel=0.01)
