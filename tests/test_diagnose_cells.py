@@ -138,3 +138,20 @@ def test_short_record_stand_no_model_fits_stand_beside_modes():
     assert stands[0]["f_Hz"] == pytest.approx(STAND_HZ, rel=0.01)
     assert stands[0]["peak_gain"] == pytest.approx(STAND_GAIN, rel=0.1)
     assert d.error_after < 0.02 * d.error_before
+
+
+def test_a_refit_that_raises_the_error_is_not_added(monkeypatch):
+    """The search adds a passing hypothesis refitted on every run; that refit is judged by nothing.  Made to run off as
+    the stand's did on this record (ζ at its bound 1e-3, peak gain 137 at 178.4 Hz: the error ×34), it is not added,
+    and no accepted effect raises the error."""
+    from dataclasses import replace
+
+    from rwadist.diagnose.effects.fixed_resonance import FixedResonance
+
+    speeds = np.linspace(300.0, 3000.0, 60)
+    ref = _reference(iir_stand_test(speeds, seed=500, n_samples=2048))
+    monkeypatch.setattr(FixedResonance, "refit", lambda self, ctx, state: replace(self, f_r=178.44, zeta=1e-3,
+                                                                                 peak_gain=137.0))
+    d = api.diagnose(iir_stand_test(speeds, seed=3, n_samples=2048), ref)
+    assert not [r for r in d.state_after.resonances if r[1] < 0.0015]      # the run-off refit is in no state
+    assert d.error_after <= d.error_before
