@@ -101,6 +101,15 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
                                  stand_start, len(efit.unconstrained))
             if got is not None:
                 test, fit, efit, stand, offset = got
+        if len(efit.unconstrained) == 3 and stand is not None and len(ctx.channels) > 3:
+            # neither the stand start nor the fit without it (nor the torques corrected for an offset) locates a mode
+            # (a stand inside the band lifts the lines the modes are located on): the stand refitted on the residual
+            # of the modes' fit from that start, until it settles, as ``rwadist fit --extended`` does
+            # (:func:`rwadist.stand_resonance.fit_extended_beside_stand`; 100-6000 rpm through a 180 Hz stand: a start
+            # at 187 Hz, gain 36 locates no mode, the rounds settle at 180.0 Hz, gain 5.0, all three found)
+            efit_rounds = fit_extended_beside_stand(test, fit, stand_start=stand)
+            if len(efit_rounds.unconstrained) < 3 and efit_rounds.stand is not None:
+                efit, stand = efit_rounds, tuple(efit_rounds.stand)
         before = None                   # the modes of the round before the last (with a stand divided out)
         for _ in range(STAND_ROUNDS):
             if len(efit.unconstrained) == 3 or len(ctx.channels) <= 3:
@@ -168,14 +177,6 @@ def _locate(ctx: Context, test, fit, stand_start):
         efit_plain = fit_extended(test, fit)
         if len(efit_plain.unconstrained) < 3:
             efit, stand = efit_plain, None
-        else:
-            # nor without it (a stand inside the band lifts the lines the modes are located on): the stand refitted
-            # on the residual of the modes' fit from that start, until it settles, as ``rwadist fit --extended``
-            # does (:func:`rwadist.stand_resonance.fit_extended_beside_stand`; 100-6000 rpm through a 180 Hz stand:
-            # a start at 187 Hz, gain 36 locates no mode, the rounds settle at 180.0 Hz, gain 5.0, all three found)
-            efit_rounds = fit_extended_beside_stand(test, fit, stand_start=stand)
-            if len(efit_rounds.unconstrained) < 3 and efit_rounds.stand is not None:
-                efit, stand = efit_rounds, tuple(efit_rounds.stand)
     return efit, stand
 
 
