@@ -165,6 +165,15 @@ def _base_lines(hyps, model=None) -> None:
             h.base_line = True
 
 
+def _no_worse(ctx, state, refit) -> bool:
+    """True when ``refit`` (a passing hypothesis refitted on every run) does not raise the error on every run
+    (:meth:`Context.error`).  The judge weighed the effect fitted on the fit runs on the held-out runs; the refit is a
+    new fit that nothing has judged, and a fit the data do not constrain can run off (a resonance whose peak falls
+    between the lines: only ζ·g is measured, and ζ → its bound with g ×30 raised the error 34×).  Such a hypothesis
+    is not added (the next passing one is taken), as one whose refit is not :meth:`significant`."""
+    return ctx.error(refit.apply(state)) <= ctx.error(state) * (1.0 + 1e-9)
+
+
 BASES = ("empirical", "extended", "auto")
 
 
@@ -249,7 +258,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         best = refit = None
         for h in passing:
             refit = h.effect.refit(ctx, state)
-            if getattr(refit, "significant", lambda: True)():
+            if getattr(refit, "significant", lambda: True)() and _no_worse(ctx, state, refit):
                 best = h
                 break
         hyps += judged[:5] + ([best] if best is not None and best not in judged[:5] else [])
