@@ -165,13 +165,19 @@ def _base_lines(hyps, model=None) -> None:
             h.base_line = True
 
 
+NO_WORSE_TOLERANCE = 1e-3   # relative rise of the error an accepted effect's refit may cause (see _no_worse)
+
+
 def _no_worse(ctx, state, refit) -> bool:
     """True when ``refit`` (a passing hypothesis refitted on every run) does not raise the error on every run
     (:meth:`Context.error`).  The judge weighed the effect fitted on the fit runs on the held-out runs; the refit is a
     new fit that nothing has judged, and a fit the data do not constrain can run off (a resonance whose peak falls
     between the lines: only ζ·g is measured, and ζ → its bound with g ×30 raised the error 34×).  Such a hypothesis
-    is not added (the next passing one is taken), as one whose refit is not :meth:`significant`."""
-    return ctx.error(refit.apply(state)) <= ctx.error(state) * (1.0 + 1e-9)
+    is not added (the next passing one is taken), as one whose refit is not :meth:`significant`.  "Raise" means by
+    more than ``NO_WORSE_TOLERANCE``: a line the Welch metric cannot measure (below its band, found on the whole
+    record) moves the error by its window's leakage only (+1e-6 relative for a subharmonic at 2048 samples), while a
+    refit that runs off raises it by factors."""
+    return ctx.error(refit.apply(state)) <= ctx.error(state) * (1.0 + NO_WORSE_TOLERANCE)
 
 
 BASES = ("empirical", "extended", "auto")
