@@ -5,10 +5,10 @@ subtracted with the Hann window's transform written as Dirichlet sums, the noise
 import numpy as np
 import pytest
 
+from rwadist.dft import run_window, windowed_dft
 from rwadist.diagnose.effects import missing_harmonic as mh
 from rwadist.diagnose.effects.sidebands import Sidebands
 from rwadist.diagnose.engine import Context, initial_state
-from rwadist.dft import run_window, windowed_dft
 from rwadist.empirical import fit_empirical
 from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
@@ -31,7 +31,6 @@ def _plain_record_residual(ctx, state, c, runs, f_hz, exact):
     """record_residual one run at a time, nothing kept: the 4× zero-padded FFT of the windowed record, each line's
     phasor by its own DFT and its leakage subtracted on the grid, |X|² read at the nearest grid point or (``exact``)
     the DFT at the point itself less the leakage there."""
-    j = ctx.channels.index(c)
     P, N, ok = np.full(f_hz.shape, np.nan), np.full(f_hz.shape, np.nan), np.zeros(f_hz.shape, bool)
     lines = mh._state_line_freqs(ctx, state, c, runs)
     f_top = mh.welch_low_limit(ctx)

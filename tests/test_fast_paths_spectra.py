@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from scipy import signal
 
+from rwadist.presets import preset
 from rwadist.spectra import compute_spectra, welch_psd
 from rwadist.teststand import simulate_steady
-from rwadist.presets import preset
 
 
 @pytest.mark.parametrize("n, nperseg, noverlap, window", [

@@ -11,7 +11,6 @@ from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
 
-
 #: Standard errors a load-cell offset must lie from 0, in its largest component, to be an offset (the same rule as
 #: the offset removed before the suspension modes are located, :data:`rwadist.diagnose.effects.suspension_modes.OFFSET_Z`)
 OFFSET_Z = 4.0

@@ -17,8 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 # the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
-from ...stand_resonance import (STAND_ROUNDS, declare_unsettled_modes, fit_extended_beside_stand,
-                                stand_resonance_start)
+from ...stand_resonance import STAND_ROUNDS, declare_unsettled_modes, fit_extended_beside_stand, stand_resonance_start
 from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
