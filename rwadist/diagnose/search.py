@@ -248,24 +248,30 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     state = state0
     hyps = []
     it = 0
+    # a family marked ``first`` (the wheel's own modes) is taken before any other passing effect: it is proposed
+    # and judged alone, and the other families only when it is not taken (the same choice as judging all together,
+    # without fitting every other family to a state about to change)
+    first = [cls for cls in EFFECT_CLASSES if getattr(cls, "first", False)]
+    rest = [cls for cls in EFFECT_CLASSES if not getattr(cls, "first", False)]
     for it in range(1, max_iterations + 1):
-        cands = []
-        for cls in EFFECT_CLASSES:
-            cands += cls.candidates(ctx, state, ctx.fit_runs)
-        memo = {}
-        judged = [_judge(ctx, state, e, k_sigma, min_gain, it, memo) for e in cands]
-        judged.sort(key=lambda h: -h.gain)
-        # a family marked ``first`` (the wheel's own modes) is taken before any other passing effect
-        passing = sorted((h for h in judged if h.passed), key=lambda h: not getattr(h.effect, "first", False))
-        for h in judged:
-            h.passed = False
-        # refitted on every run, an effect must still be what its family proposes (an exponent that moved back
-        # to 2 within its standard errors is no new law): else the next passing hypothesis is taken
+        memo: dict = {}
+        judged: list = []
         best = refit = None
-        for h in passing:
-            refit = h.effect.refit(ctx, state)
-            if getattr(refit, "significant", lambda: True)() and _no_worse(ctx, state, refit):
-                best = h
+        for families in (first, rest):
+            cands = [e for cls in families for e in cls.candidates(ctx, state, ctx.fit_runs)]
+            new = [_judge(ctx, state, e, k_sigma, min_gain, it, memo) for e in cands]
+            new.sort(key=lambda h: -h.gain)
+            for h in new:
+                passed = h.passed
+                h.passed = False                # set again on the one taken
+                if passed and best is None:
+                    # refitted on every run, an effect must still be what its family proposes (an exponent that
+                    # moved back to 2 within its standard errors is no new law): else the next passing one is taken
+                    refit = h.effect.refit(ctx, state)
+                    if getattr(refit, "significant", lambda: True)() and _no_worse(ctx, state, refit):
+                        best = h
+            judged = sorted(judged + new, key=lambda h: -h.gain)
+            if best is not None:
                 break
         hyps += judged[:5] + ([best] if best is not None and best not in judged[:5] else [])
         if best is None:

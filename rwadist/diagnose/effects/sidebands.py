@@ -228,16 +228,18 @@ class Sidebands:
         """[(score, h, f_mod)] of the carriers ``hs`` whose sidebands sit closer than the Welch grid reaches
         (:meth:`_record_offsets`): per offset the median over the RECORD_SCAN_RUNS fastest runs, channels and both
         sides of |X|²/noise on the whole-run DFT (valid points only, >= 6 of them), the best offset kept when it
-        clears RECORD_SCORE and is a local maximum.  The data's line powers are kept on the context."""
+        clears RECORD_SCORE and is a local maximum.  The line powers are kept on the context, per state prediction."""
         from .speed_sidebands import side_pair_medians
 
         offsets = Sidebands._record_offsets(ctx)
         if offsets.size < 3:
             return []
         sel = runs[np.argsort(ctx.omega[runs])[::-1][:RECORD_SCAN_RUNS]]
+        # the noise and the valid points read the state (its floor, its lines): keyed by what it predicts there
+        state_key = ctx.content_key(state, [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels], sel)
         out = []
         for h in hs:
-            key = ("sidebands_record_scan", direction, round(h, 6), sel.tobytes())
+            key = ("sidebands_record_scan", direction, round(h, 6), sel.tobytes(), state_key)
             if key not in ctx._memo:
                 ctx._memo[key] = Sidebands._record_power(ctx, state, direction, h, sel, offsets)
             f, P, N, ok = ctx._memo[key]
