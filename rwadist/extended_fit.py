@@ -362,7 +362,8 @@ def _scan_all(meas_lines, la, sa, aa, inertia_ratio, tolerance):
 
 def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None, radius: float | None = None,
                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
-                 progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None) -> ExtendedFit:
+                 progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
+                 more_stands: tuple = ()) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
     mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None:
@@ -377,7 +378,9 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     stand: (f_r Hz, ζ, peak gain) of a fixture resonance acting on every channel (``rwadist diagnose``'s
     ``fixed_resonance`` of role test_stand), or None: every measured line amplitude is divided by its |H|
     (:func:`rwadist.resonance.resonance`) before the modes are located and fitted, so that the fixture's
-    amplification is not taken for the wheel's.
+    amplification is not taken for the wheel's.  more_stands: further fixture resonances (each (f_r Hz, ζ,
+    peak gain), on every channel) divided out the same way (``rwadist diagnose`` checks the modes beside every
+    test-stand resonance it named); not recorded in ``ExtendedFit.stand``.
 
     Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
     measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
@@ -399,11 +402,15 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped)
     meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False),
                          detections=fit.detections)
-    if stand is not None:
+    stands = ([] if stand is None else [stand]) + list(more_stands)
+    if stands:
         from .resonance import resonance
 
-        meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / np.abs(resonance(
-            x.h * np.abs(x.speed) / (2 * np.pi), *stand))) for x in meas.lines])
+        def fixture_gain(x):
+            f = x.h * np.abs(x.speed) / (2 * np.pi)
+            return np.prod([np.abs(resonance(f, *s)) for s in stands], axis=0)
+
+        meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / fixture_gain(x)) for x in meas.lines])
     senses_xy = line_senses(test, meas)
     peaks = amplification_peaks(fit)
     la, sa, ca, aa = _measurements(meas)

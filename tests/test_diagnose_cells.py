@@ -155,3 +155,53 @@ def test_a_refit_that_raises_the_error_is_not_added(monkeypatch):
     d = api.diagnose(iir_stand_test(speeds, seed=3, n_samples=2048), ref)
     assert not [r for r in d.state_after.resonances if r[1] < 0.0015]      # the run-off refit is in no state
     assert d.error_after <= d.error_before
+
+
+def _through_stand(test, f_hz, zeta, gain):
+    """``test`` with every channel filtered through one more fixture resonance (as :func:`iir_stand_test`'s)."""
+    runs = []
+    for r in test.runs:
+        wd = 2 * r.sample_rate * np.tan(np.pi * f_hz / r.sample_rate)
+        bz, az = signal.bilinear([1, 2 * gain * zeta * wd, wd * wd], [1, 2 * zeta * wd, wd * wd], fs=r.sample_rate)
+        runs.append(Run(speed=r.speed, sample_rate=r.sample_rate, t0=0.0, name=r.name,
+                        signals={ch: signal.lfilter(bz, az, x) for ch, x in r.signals.items()}))
+    return SteadyTest(runs=runs, meta=dict(test.meta))
+
+
+@pytest.mark.slow
+def test_two_fixture_resonances_no_mode_wrong_without_a_word():
+    """100-6000 rpm through two fixture resonances (150 and 180 Hz, ζ 0.03, gain 5, every channel), no model: the
+    modes' fit divides out one resonance between them (167 Hz) and the search then names both fixtures; the radial
+    translation came out 2.7 % low with nothing said.  Every mode is now within 2 % of the generator's or declared
+    (the effect's and the model's ``unconstrained``, with a note giving its value with every fixture divided out)."""
+    test = _through_stand(iir_stand_test(np.linspace(100.0, 6000.0, 60), seed=3), 150.0, 0.03, 5.0)
+    d = api.diagnose(test)
+    (modes,) = [e for e in d.model.effects if e["kind"] == "suspension_modes"]
+    stands = [e["f_Hz"] for e in d.model.effects if e["kind"] == "fixed_resonance" and e["role"] == "test_stand"]
+    assert any(abs(f / 150.0 - 1) < 0.01 for f in stands)
+    notes = " ".join(d.model.analytical["fit"]["notes"])
+    for name, truth in iw.TRUTH_HZ.items():
+        if abs(modes[f"{name}_Hz"] / truth - 1) > 0.02:
+            assert name in modes["unconstrained"] and name in d.model.analytical["unconstrained"], name
+            assert f"{name}: NOT CONSTRAINED beside the fixture resonances" in notes
+
+
+def test_more_stands_divide_the_lines_as_the_stand():
+    """:func:`rwadist.extended_fit.fit_extended`: a fixture resonance given in ``more_stands`` is divided out of the
+    lines as the one given as ``stand`` (the same modes), and two given either way round give the same fit."""
+    from rwadist.empirical import fit_empirical
+    from rwadist.extended_fit import fit_extended
+    from rwadist.spectra import compute_spectra
+
+    test = iir_stand_test(np.linspace(300.0, 3000.0, 12), seed=5, n_samples=2048)
+    fit = fit_empirical(compute_spectra(test))
+    a = (STAND_HZ, STAND_ZETA, STAND_GAIN)
+    b = (150.0, 0.03, 2.0)
+    as_stand = fit_extended(test, fit, stand=a).params
+    as_more = fit_extended(test, fit, more_stands=(a,)).params
+    assert as_more == as_stand
+    ab = fit_extended(test, fit, stand=a, more_stands=(b,)).params
+    ba = fit_extended(test, fit, stand=b, more_stands=(a,)).params
+    for key in ("k_r", "k_rock", "k_z", "c_r", "c_rock", "c_z"):
+        assert getattr(ab, key) == pytest.approx(getattr(ba, key), rel=1e-9), key
+    assert ab.k_r != pytest.approx(as_stand.k_r, rel=1e-6)          # the second resonance is divided out too

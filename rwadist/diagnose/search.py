@@ -281,6 +281,16 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         best.effect = state.effects[-1]
     else:
         it = max_iterations
+    # a family may revise what it added in the light of what came after it (``finish``: the wheel's modes beside the
+    # fixture resonances named after them); the hypotheses report the revised effects
+    for cls in EFFECT_CLASSES:
+        finish = getattr(cls, "finish", None)
+        if finish is not None:
+            done = finish(ctx, state)
+            revised = {id(a): b for a, b in zip(state.effects, done.effects) if a is not b}
+            for h in hyps:
+                h.effect = revised.get(id(h.effect), h.effect)
+            state = done
     _base_lines(hyps, model)
     out = copy.deepcopy(state.model)
     out.effects = list(model.effects) + [effect_entry(h) for h in hyps if h.passed and not h.base_line]
