@@ -28,6 +28,11 @@ RECORD_MIN_BINS = 4.0
 #: Smallest separation (record bins) of a point from every line the state predicts on the channel: the edge of the
 #: Hann main lobe (beyond it the transform is below −31 dB, and those lines' leakage is subtracted with their phasors).
 RECORD_SEP_BINS = 2.0
+#: Half width of the Hann window's main lobe, Welch bins: a Welch-route ridge closer to a line of the model than this
+#: at the fastest run (where lines of different h lie furthest apart) is inside that line's lobe at every speed, so it
+#: is never resolved from it; its power there is the line's own shape (a misfit of its amplitude near a mode), not a
+#: line of its own.
+WELCH_LOBE_BINS = 2.0
 #: Grid of the record spectrum, record bins: the Hann-windowed record zero-padded 4× (a line between grid points
 #: loses at most 0.1 dB).
 RECORD_GRID_BINS = 0.25
@@ -416,15 +421,17 @@ class MissingHarmonic:
         """The Welch route's ridges (:func:`rwadist.diagnose.measure.ridge_peaks`), then the record route's lines
         below it (:meth:`record_candidates`, time series given)."""
         out = []
+        # ridges within the main lobe of a model line (:data:`WELCH_LOBE_BINS`, in h at the fastest run), or 0.03
+        lobe = max(0.03, WELCH_LOBE_BINS * ctx.df / max(float(np.max(np.abs(ctx.omega[runs]))) / (2 * np.pi), 1e-300))
         for d, chans in DIRECTION_CHANNELS.items():
             chans = [c for c in chans if c in ctx.channels]
             if not chans:
                 continue
             for h in ridge_peaks(ctx, state, chans, runs, max_per_direction):
-                if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
+                if any(abs(h - x.h) < lobe for x in state.model.harmonics(d)):
                     continue
                 h = refine_h(ctx, state, chans, runs, h)
-                if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)) or \
+                if any(abs(h - x.h) < lobe for x in state.model.harmonics(d)) or \
                         any(abs(h - x.h) < 0.005 for x in out if x.direction == d):
                     continue
                 e = MissingHarmonic.fit(ctx, state, d, h, runs)
