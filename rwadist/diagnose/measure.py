@@ -8,6 +8,14 @@ from ..units import DIRECTION_CHANNELS
 from .constants import LINE_HALF
 
 
+def in_unresolved_span(model, direction: str, h: float) -> bool:
+    """True when the model's extended fit recorded (direction, h) inside a span of lines it detected but could
+    not measure apart (``analytical.fit.unresolved_lines``, :func:`rwadist.extended_fit.unresolved_spans`)."""
+    fit = (getattr(model, "analytical", None) or {}).get("fit") or {}
+    return any(sp.get("direction") == direction and sp.get("h_min", np.inf) <= h <= sp.get("h_max", -np.inf)
+               for sp in fit.get("unresolved_lines") or [])
+
+
 def _measure(ctx, state, direction, h, runs, skip=None):
     """Line amplitudes of (direction, h) pooled over the direction's channels: (amplitude, omega)."""
     ds, ws = [], []

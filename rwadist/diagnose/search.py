@@ -14,6 +14,7 @@ from ..spectra import Spectra
 from .constants import BAND_BINS, METRIC, NOISE_Z
 from .effects import EFFECT_CLASSES
 from .engine import Context, initial_state
+from .measure import in_unresolved_span
 from .state import State
 
 
@@ -128,14 +129,6 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
     return Hypothesis(effect, gain / max(float(all_tot.sum()), 1e-300), frac, float(t), passed, iteration)
 
 
-def _unresolved(model, direction: str, h: float) -> bool:
-    """True when the model's extended fit recorded (direction, h) inside a span of lines it detected but could
-    not measure apart (``analytical.fit.unresolved_lines``, :func:`rwadist.extended_fit.unresolved_spans`)."""
-    fit = (getattr(model, "analytical", None) or {}).get("fit") or {}
-    return any(sp.get("direction") == direction and sp.get("h_min", np.inf) <= h <= sp.get("h_max", -np.inf)
-               for sp in fit.get("unresolved_lines") or [])
-
-
 def _base_lines(hyps, model=None) -> None:
     """Mark the passing ``missing_harmonic`` hypotheses added after a ``suspension_modes`` as lines of the wheel's
     base (``Hypothesis.base_line``), not foreign effects.
@@ -154,7 +147,7 @@ def _base_lines(hyps, model=None) -> None:
     for h in hyps:
         e = h.effect
         if (h.passed and getattr(e, "kind", "") == "missing_harmonic"
-                and _unresolved(model, getattr(e, "direction", ""), float(getattr(e, "h", np.nan)))):
+                and in_unresolved_span(model, getattr(e, "direction", ""), float(getattr(e, "h", np.nan)))):
             h.base_line = True
     modes_at = min((h.iteration for h in hyps if h.passed and getattr(h.effect, "kind", "") == "suspension_modes"),
                    default=None)

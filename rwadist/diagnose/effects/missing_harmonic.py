@@ -18,7 +18,7 @@ from ...model import Harmonic
 from ...units import DIRECTION_CHANNELS
 from ..constants import LINE_HALF
 from ..engine import Context
-from ..measure import _measure, refine_h, ridge_peaks
+from ..measure import _measure, in_unresolved_span, refine_h, ridge_peaks
 from ..state import State
 from .base import register, schema_entry
 
@@ -421,17 +421,24 @@ class MissingHarmonic:
         """The Welch route's ridges (:func:`rwadist.diagnose.measure.ridge_peaks`), then the record route's lines
         below it (:meth:`record_candidates`, time series given)."""
         out = []
-        # ridges within the main lobe of a model line (:data:`WELCH_LOBE_BINS`, in h at the fastest run), or 0.03
+        # a refined ridge within the main lobe of a model line (WELCH_LOBE_BINS, in h at the fastest run) is that
+        # line's shape, except inside a span the model's fit listed unresolved (a close pair it measured as one line:
+        # the other line is expected there and is completed into the base, search._base_lines)
         lobe = max(0.03, WELCH_LOBE_BINS * ctx.df / max(float(np.max(np.abs(ctx.omega[runs]))) / (2 * np.pi), 1e-300))
+
+        def near(d: str, h: float) -> bool:
+            sep = 0.03 if in_unresolved_span(state.model, d, h) else lobe
+            return any(abs(h - x.h) < sep for x in state.model.harmonics(d))
+
         for d, chans in DIRECTION_CHANNELS.items():
             chans = [c for c in chans if c in ctx.channels]
             if not chans:
                 continue
             for h in ridge_peaks(ctx, state, chans, runs, max_per_direction):
-                if any(abs(h - x.h) < lobe for x in state.model.harmonics(d)):
+                if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
                     continue
                 h = refine_h(ctx, state, chans, runs, h)
-                if any(abs(h - x.h) < lobe for x in state.model.harmonics(d)) or \
+                if near(d, h) or \
                         any(abs(h - x.h) < 0.005 for x in out if x.direction == d):
                     continue
                 e = MissingHarmonic.fit(ctx, state, d, h, runs)
