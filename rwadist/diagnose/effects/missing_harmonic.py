@@ -29,10 +29,14 @@ RECORD_MIN_BINS = 4.0
 #: Hann main lobe (beyond it the transform is below −31 dB, and those lines' leakage is subtracted with their phasors).
 RECORD_SEP_BINS = 2.0
 #: Half width of the Hann window's main lobe, Welch bins: a Welch-route ridge closer to a line of the model than this
-#: at the fastest run (where lines of different h lie furthest apart) is inside that line's lobe at every speed, so it
-#: is never resolved from it; its power there is the line's own shape (a misfit of its amplitude near a mode), not a
-#: line of its own.
+#: at the fastest run (where lines of different h lie furthest apart) is inside that line's lobe at every speed.
 WELCH_LOBE_BINS = 2.0
+#: Inside a model line's main lobe, the smallest C of a line of its own, relative to that line's C: a fitted line's C
+#: is known to 5-10 % (the foundation of issue 14: C within 5 % on clean data), and near a mode its shape a little
+#: worse, so a weaker "line" there is that line's own misfit (the independent wheel on 20 speeds: h 1.937 at 4 % of
+#: the 1.98 line beside it), while a missing line of its own is as strong as its neighbours (h 2.73 at 1.7 × the 2.96
+#: line, 1.5 Welch bins from it at 2048 samples, measured to 0.6 %).
+LOBE_MIN_RATIO = 0.2
 #: Grid of the record spectrum, record bins: the Hann-windowed record zero-padded 4× (a line between grid points
 #: loses at most 0.1 dB).
 RECORD_GRID_BINS = 0.25
@@ -421,14 +425,17 @@ class MissingHarmonic:
         """The Welch route's ridges (:func:`rwadist.diagnose.measure.ridge_peaks`), then the record route's lines
         below it (:meth:`record_candidates`, time series given)."""
         out = []
-        # a refined ridge within the main lobe of a model line (WELCH_LOBE_BINS, in h at the fastest run) is that
-        # line's shape, except inside a span the model's fit listed unresolved (a close pair it measured as one line:
-        # the other line is expected there and is completed into the base, search._base_lines)
-        lobe = max(0.03, WELCH_LOBE_BINS * ctx.df / max(float(np.max(np.abs(ctx.omega[runs]))) / (2 * np.pi), 1e-300))
+        # a line fitted within the main lobe of a model line (WELCH_LOBE_BINS, in h at the fastest run) weaker than
+        # LOBE_MIN_RATIO of it is that line's misfit, except inside a span the model's fit listed unresolved (a close
+        # pair it measured as one line: the other line is expected there and completed into the base,
+        # search._base_lines)
+        lobe = WELCH_LOBE_BINS * ctx.df / max(float(np.max(np.abs(ctx.omega[runs]))) / (2 * np.pi), 1e-300)
 
-        def near(d: str, h: float) -> bool:
-            sep = 0.03 if in_unresolved_span(state.model, d, h) else lobe
-            return any(abs(h - x.h) < sep for x in state.model.harmonics(d))
+        def misfit(e) -> bool:
+            if in_unresolved_span(state.model, e.direction, e.h):
+                return False
+            return any(abs(e.h - x.h) < lobe and e.C < LOBE_MIN_RATIO * abs(x.C)
+                       for x in state.model.harmonics(e.direction))
 
         for d, chans in DIRECTION_CHANNELS.items():
             chans = [c for c in chans if c in ctx.channels]
@@ -438,11 +445,11 @@ class MissingHarmonic:
                 if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
                     continue
                 h = refine_h(ctx, state, chans, runs, h)
-                if near(d, h) or \
+                if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)) or \
                         any(abs(h - x.h) < 0.005 for x in out if x.direction == d):
                     continue
                 e = MissingHarmonic.fit(ctx, state, d, h, runs)
-                if e is not None and e.C > 0:
+                if e is not None and e.C > 0 and not misfit(e):
                     out.append(e)
         for e in MissingHarmonic.record_candidates(ctx, state, runs, max_per_direction):
             if not any(abs(e.h - x.h) < 0.03 for x in out if x.direction == e.direction):
