@@ -25,16 +25,20 @@ from rwadist.presets import preset  # noqa: E402
 STAND_HZ, STAND_ZETA, STAND_GAIN = 180.0, 0.03, 5.0
 
 
+def stand_filter(f_hz, zeta, gain, sample_rate):
+    """(b, a) of the digital fixture resonance H(s) = (s² + 2gζω s + ω²)/(s² + 2ζω s + ω²), bilinear, prewarped so
+    that its peak sits at ``f_hz``."""
+    wd = 2 * sample_rate * np.tan(np.pi * f_hz / sample_rate)
+    return signal.bilinear([1, 2 * gain * zeta * wd, wd * wd], [1, 2 * zeta * wd, wd * wd], fs=sample_rate)
+
+
 def iir_stand_test(speeds_rpm, seed, n_samples=8192, sample_rate=3840.0, noise=0.01, stand=True, extra_lines=()):
     """Steady runs of the independent wheel (its lines and ``extra_lines``, as :data:`independent_wheel.E_LINES`),
     every channel filtered through the stand (when ``stand``), white noise of ``noise`` × the top-speed fundamental
     of each group added after it."""
     raw, _ = iw.generate(speeds_rpm, sample_rate=sample_rate, n_samples=2 * n_samples, noise=0.0, seed=seed,
                          lines=list(iw.E_LINES) + list(extra_lines))
-    w = 2 * np.pi * STAND_HZ
-    wd = 2 * sample_rate * np.tan(w / (2 * sample_rate))        # prewarped: the digital peak sits at f_r
-    bz, az = signal.bilinear([1, 2 * STAND_GAIN * STAND_ZETA * wd, wd * wd], [1, 2 * STAND_ZETA * wd, wd * wd],
-                             fs=sample_rate)
+    bz, az = stand_filter(STAND_HZ, STAND_ZETA, STAND_GAIN, sample_rate)
     rng = np.random.default_rng(seed + 77)
     w_top = max(abs(r.speed) for r in raw.runs)
     fund = {g: next(c for d, h, c, _ in iw.E_LINES if d == d0 and h == 1.0) * iw.C_UNIT * w_top**2
@@ -163,8 +167,7 @@ def _through_stand(test, f_hz, zeta, gain):
     """``test`` with every channel filtered through one more fixture resonance (as :func:`iir_stand_test`'s)."""
     runs = []
     for r in test.runs:
-        wd = 2 * r.sample_rate * np.tan(np.pi * f_hz / r.sample_rate)
-        bz, az = signal.bilinear([1, 2 * gain * zeta * wd, wd * wd], [1, 2 * zeta * wd, wd * wd], fs=r.sample_rate)
+        bz, az = stand_filter(f_hz, zeta, gain, r.sample_rate)
         runs.append(Run(speed=r.speed, sample_rate=r.sample_rate, t0=0.0, name=r.name,
                         signals={ch: signal.lfilter(bz, az, x) for ch, x in r.signals.items()}))
     return SteadyTest(runs=runs, meta=dict(test.meta))

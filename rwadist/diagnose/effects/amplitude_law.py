@@ -7,7 +7,7 @@ import numpy as np
 
 from ...units import DIRECTION_CHANNELS
 from ..engine import Context
-from ..measure import _measure
+from ..measure import _measure, in_unresolved_span
 from ..state import State
 from .base import register, schema_entry
 
@@ -82,14 +82,11 @@ class AmplitudeLaw:
         # lines the model's extended fit detected but could not measure apart (``analytical.fit.unresolved_lines``:
         # h = 5.37 and 5.57 merged as one h = 5.49 on a 2048-sample record) are not one line: the merged line's
         # level against speed is no law of either (through a 180 Hz stand it passed as p 2.26, t 25, on clean data)
-        spans = ((getattr(state.model, "analytical", None) or {}).get("fit") or {}).get("unresolved_lines") or []
         for d in DIRECTION_CHANNELS:
             if not any(c in ctx.channels for c in DIRECTION_CHANNELS[d]):
                 continue
             for hm in state.model.harmonics(d):
-                if (d, round(hm.h, 4)) in state.laws or any(
-                        sp.get("direction") == d and sp.get("h_min", np.inf) <= hm.h <= sp.get("h_max", -np.inf)
-                        for sp in spans):
+                if (d, round(hm.h, 4)) in state.laws or in_unresolved_span(state.model, d, hm.h):
                     continue
                 e = AmplitudeLaw.fit(ctx, state, d, hm.h, runs)
                 # an exponent within EXPONENT_Z standard errors of the model's 2 is no new law, only a

@@ -11,8 +11,8 @@ from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
 
-#: Standard errors a load-cell offset must lie from 0, in its largest component, to be an offset (the same rule as
-#: the offset removed before the suspension modes are located, :data:`rwadist.diagnose.effects.suspension_modes.OFFSET_Z`)
+#: Standard errors a load-cell offset must lie from 0, in its largest component, to be an offset (also the rule for
+#: the offset removed before the suspension modes are located, :func:`rwadist.diagnose.effects.suspension_modes._beside_offset`)
 OFFSET_Z = 4.0
 
 

@@ -149,9 +149,6 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     return test, fit, efit, stand
 
 
-#: Standard errors a load-cell offset must lie from 0 (in its largest component) to be removed from the
-#: torques before the modes are located (:func:`_beside_offset`)
-OFFSET_Z = 4.0
 
 
 def _locate(ctx: Context, test, fit, stand_start):
@@ -183,7 +180,7 @@ def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_uncons
     """(test, fit, efit, stand, r) of the modes located (:func:`_locate`) on the torques of ``test`` corrected for a
     load-cell offset r (m: the ``cross_coupling`` fit of ``runs`` on ``state``, the extended base of the
     uncorrected data: its torque lines, the wheel's own, weigh the equations at their frequencies down; T − r × F),
-    or None when no component of r stands :data:`OFFSET_Z` standard errors from 0 or the corrected data do not locate more modes than the
+    or None when the offset is not significant (:meth:`CrossCoupling.significant`: no component of r stands 4 standard errors from 0) or the corrected data do not locate more modes than the
     ``n_unconstrained`` left unconstrained without the correction.  A note of the fit says the offset was removed."""
     from dataclasses import replace
 
@@ -194,7 +191,7 @@ def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_uncons
     from .cross_coupling import CrossCoupling
 
     cc = CrossCoupling.fit(ctx, state, np.asarray(runs))
-    if cc is None or not np.any(np.abs(cc.r) > OFFSET_Z * np.maximum(cc.r_stderr, 1e-300)):
+    if cc is None or not cc.significant():
         return None
     r = np.asarray(cc.r, dtype=float)
     corrected = []
