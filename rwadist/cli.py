@@ -158,8 +158,15 @@ def cmd_fit(args) -> int:
     check_output_file(args.output)
     report_dir = Path(args.report) if args.report else Path(args.output).with_suffix("").parent / (
         Path(args.output).stem + "_report")
-    check_output_dir(report_dir, "--report")
-    refuse_input_overwrite([("-o", args.output, "file"), ("--report", report_dir, "dir")], [args.data])
+    if args.no_report and args.report:
+        raise DataError("--no-report", "--report", f"{args.report}: give one of the two (--no-report writes the model file "
+                        "only)")
+    if args.no_report:
+        report_dir = None
+    else:
+        check_output_dir(report_dir, "--report")
+    refuse_input_overwrite([("-o", args.output, "file")] + ([("--report", report_dir, "dir")] if report_dir else []),
+                           [args.data])
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
     fit = run_fit(test, args, name=Path(args.data).name)
@@ -170,13 +177,15 @@ def cmd_fit(args) -> int:
         efit, model = run_extended_fit(test, fit, args)
     refuse_non_finite_model(model, "fit")
     cum = parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm") if args.cumulative_rpm else None
-    with atomic_dir(report_dir) as tmp_dir:     # the report replaces an old one only when complete
-        files = write_report(fit, tmp_dir, cumulative_speeds_rpm=cum, progress=True)
-        if efit is not None:
-            from .report import write_extended_report
+    files = []
+    if report_dir is not None:
+        with atomic_dir(report_dir) as tmp_dir:     # the report replaces an old one only when complete
+            files = write_report(fit, tmp_dir, cumulative_speeds_rpm=cum, progress=True)
+            if efit is not None:
+                from .report import write_extended_report
 
-            with working("writing the extended report"):
-                files += write_extended_report(efit, fit, tmp_dir)
+                with working("writing the extended report"):
+                    files += write_extended_report(efit, fit, tmp_dir)
     _write(args.output, lambda tmp: model_io.save(model, tmp))
     n = sum(len(v) for v in fit.model.empirical.values())
     print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
@@ -184,7 +193,7 @@ def cmd_fit(args) -> int:
         print(f"WARNING: no harmonic passed the presence threshold ({args.presence:g} of the runs): the model is "
               "empty; give more runs over the speed range, or lower --presence", file=sys.stderr)
     print(f"model:  {args.output}")
-    print(f"report: {report_dir} ({len(files)} files)")
+    print(f"report: {report_dir} ({len(files)} files)" if report_dir is not None else "report: none (--no-report)")
     return 0
 
 

@@ -78,6 +78,8 @@ def build_parser(cli) -> argparse.ArgumentParser:
     f.add_argument("data", help="steady-state directory, sweep CSV, or .h5")
     f.add_argument("-o", "--output", required=True, help="model file to write (JSON)")
     f.add_argument("--report", help="report directory (default: <model>_report)")
+    f.add_argument("--no-report", action="store_true",
+                   help="write the model file only, no report (batch fits: the report's plots take most of a small fit's time)")
     f.add_argument("--cumulative-rpm", help="speeds of the cumulative-RMS plots, e.g. '600,1500,2400' "
                    "(default: lowest, middle, top)")
     _add_fit_options(f)

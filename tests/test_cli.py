@@ -55,8 +55,29 @@ def test_fit_a_sweep_file(tmp_path, capsys):
     assert code == 0
     sweep = read_sweep(out_dir / "sweep.csv")
     assert sweep.tach is not None
-    code, out, _ = run(capsys, "fit", out_dir / "sweep.csv", "-o", tmp_path / "s.json", "--slice-samples", "4096")
+    code, out, _ = run(capsys, "fit", out_dir / "sweep.csv", "-o", tmp_path / "s.json", "--slice-samples", "4096",
+                       "--no-report")
     assert code == 0 and "sliced sweep" in out
+
+
+def test_fit_no_report_writes_the_model_only(tmp_path, capsys):
+    """``--no-report``: the model file of the Python API's fit (what the report is drawn from), no report directory;
+    with ``--report`` refused."""
+    from rwadist import api
+    from rwadist import model as model_io
+
+    data = tmp_path / "e"
+    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "8",
+        "--samples", "2048", "--sample-rate", "1920", "--no-modes")
+    code, out, _ = run(capsys, "fit", data, "-o", tmp_path / "a.json", "--no-report")
+    assert code == 0 and "--no-report" in out and not (tmp_path / "a_report").exists()
+    assert {p.name for p in tmp_path.iterdir()} == {"e", "a.json"}
+    got = json.loads((tmp_path / "a.json").read_text())
+    want = json.loads(json.dumps(model_io.to_json(api.fit(api.read(data)).model)))
+    assert got["empirical"] == want["empirical"] and got["empirical"]
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "c.json", "--no-report", "--report", tmp_path / "r")
+    assert code == 2 and "--no-report" in err and "--report" in err
+    assert not (tmp_path / "c.json").exists() and not (tmp_path / "r").exists()
 
 
 def _one_run(text):
@@ -127,7 +148,7 @@ def test_fit_extended_without_mass_and_radius_is_per_unit(tmp_path, capsys):
     data = tmp_path / "e"
     run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "8",
         "--samples", "2048", "--sample-rate", "1920")
-    code, out, _ = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--extended")
+    code, out, _ = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--extended", "--no-report")
     assert code == 0 and "per unit mass" in out
     doc = json.loads((tmp_path / "m.json").read_text())
     assert doc["analytical"]["mass_kg"] == 1.0 and doc["analytical"]["unconstrained"]
