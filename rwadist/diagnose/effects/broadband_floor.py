@@ -56,6 +56,84 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
     return p, n, g
 
 
+#: False-alarm probability of a residual peak on the whole-run spectrum (a line the state lacks): its bin and
+#: RECORD_PEAK_BINS either side are not floor (as :meth:`Context.offline_bands` on the Welch PSD).
+RECORD_PEAK_FA = 1e-4
+RECORD_PEAK_BINS = 2
+
+
+def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, need: np.ndarray) -> tuple:
+    """(mean PSD unit²/Hz, bins used) per run and band (each (len(runs), n_bands)), and each run's bin width df_rec
+    (Hz, (len(runs),)), of channel ``c`` off the lines, on the whole-run spectrum, in the bands ``need``
+    ((len(runs), n_bands) bool; 0 bins elsewhere): where a short record's Welch bins are too coarse to leave any bin
+    between the lines (2048 samples at 3840 Hz: 7.5-Hz bins, ±LINE_HALF = ±22.5 Hz around each line, every bin of
+    26-266 Hz taken at 3000 rpm), the whole run's bins are 4× finer and leave room between them.
+
+    Per run: the Hann-windowed record's DFT X = 2·Σ w x e^{−2πj f t}/Σw (the mean taken off) less the leakage of every
+    line the state predicts on the channel (each line's own whole-run phasor times the window's transform, its
+    negative-frequency image too: the lines' sidelobes sit far above a floor), at the record bins RECORD_SEP_BINS or
+    more from each line and from RECORD_MIN_BINS up; bins of a residual peak (above RECORD_PEAK_FA false alarms on the
+    band's median level) and RECORD_PEAK_BINS either side dropped; the PSD |X|²·(Σw)²/(2·fs·Σw²) averaged per band of
+    the error metric.  No bin where the time series are unknown or lack the channel.  A whole-run bin has 2
+    degrees of freedom (a Welch bin ctx.dof).  Each run's numbers are kept on the context (the data's and the
+    lines', the same at every search step)."""
+    from ...dft import run_window
+    from .missing_harmonic import RECORD_MIN_BINS, RECORD_SEP_BINS, _hann_transform, _record_dfts, _state_line_freqs
+
+    y = np.zeros((runs.size, ctx.n_bands))
+    cnt_all = np.zeros((runs.size, ctx.n_bands))
+    df_all = np.ones(runs.size)
+    if ctx.test is None or not need.any():
+        return y, cnt_all, df_all
+    j = ctx.channels.index(c)
+    lines = _state_line_freqs(ctx, state, c, runs)
+    keys = [("broadband_floor_record", int(r), j, lines[i].tobytes(), need[i].tobytes()) for i, r in enumerate(runs)]
+    todo = [i for i, r in enumerate(runs)
+            if need[i].any() and keys[i] not in ctx._memo and c in ctx.test.runs[int(r)].signals]
+    A = (_record_dfts(ctx, [int(runs[i]) for i in todo], c, lines[todo]) if lines.shape[1] and todo
+         else np.zeros((len(todo), 0), complex))
+    lo_edge = float(ctx.f[ctx.k_lo] - 0.5 * ctx.df)
+    band_w = BAND_BINS * ctx.df
+    thr = -np.log(RECORD_PEAK_FA)                # |X|² of complex Gaussian noise is exponential: P(> t·mean) = e^{-t}
+    for a, i in enumerate(todo):
+        run = ctx.test.runs[int(runs[i])]
+        n, fs = run.n_samples, run.sample_rate
+        df_rec = fs / n
+        w, wsum, w2sum = run_window(ctx.sp.window, n)
+        x = np.asarray(run.signals[c], dtype=float)
+        X = 2.0 * np.fft.rfft((x - x.mean()) * w) / wsum
+        f = np.arange(X.size) * df_rec
+        band = np.floor((f - lo_edge) / band_w).astype(int)
+        sel = (f >= RECORD_MIN_BINS * df_rec) & (band >= 0) & (band < ctx.n_bands)
+        sel[sel] = need[i][band[sel]]
+        fk, Xk, band = f[sel], X[sel], band[sel]
+        keep = np.ones(fk.size, bool)
+        fl = lines[i]
+        if fl.size:
+            Xk = Xk - (_hann_transform(n, (fk[:, None] - fl[None, :]) / df_rec) * A[a][None, :]
+                       + _hann_transform(n, (fk[:, None] + fl[None, :]) / df_rec) * np.conj(A[a])[None, :]).sum(1)
+            keep = np.all(np.abs(fk[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
+        P = np.abs(Xk) ** 2 * wsum**2 / (2.0 * fs * w2sum)
+        # a residual peak: above thr times the band's level (median of its bins clear of lines / ln 2); a peak's
+        # neighbours are neighbours on the record grid (the bins kept are contiguous within a band)
+        level = np.zeros(ctx.n_bands)
+        for b in np.unique(band[keep]):
+            level[b] = np.median(P[keep & (band == b)]) / np.log(2.0)
+        peak = P > thr * level[band]
+        wide = peak.copy()
+        for s_ in range(1, RECORD_PEAK_BINS + 1):
+            wide[s_:] |= peak[:-s_]
+            wide[:-s_] |= peak[s_:]
+        use = keep & ~wide
+        cnt = np.bincount(band[use], minlength=ctx.n_bands).astype(float)
+        tot = np.bincount(band[use], P[use], minlength=ctx.n_bands)
+        ctx._memo[keys[i]] = (np.where(cnt > 0, tot / np.maximum(cnt, 1.0), 0.0), cnt, df_rec)
+    for i in range(runs.size):
+        if keys[i] in ctx._memo:
+            y[i], cnt_all[i], df_all[i] = ctx._memo[keys[i]]
+    return y, cnt_all, df_all
+
+
 @register(order=30)
 @dataclass
 class BroadbandFloor:
@@ -147,8 +225,15 @@ class BroadbandFloor:
             n0 = np.where(self.flat_noise > 0, self.flat_noise, n0)
         n1 = band_noise(self.apply(state))
         to_power = cnt * ctx.df                                       # unit²/Hz -> unit² of the band's off-line bins
-        r0, r1 = (y - n0) * to_power, (y - n1) * to_power
         sig = np.sqrt(2.0 * cnt * n0**2 * 2.0 / ctx.dof) * ctx.df         # the null's noise allowance
+        # a band whose Welch bins are all taken by the lines in a run: that run's whole-run bins between them (as the
+        # fit), each of its own width and 2 degrees of freedom
+        yr, cr, dfr = record_offline_bands(ctx, state, c, ok, cnt == 0)
+        fill = (cnt == 0) & (cr > 0)
+        y = np.where(fill, yr, y)
+        to_power = np.where(fill, cr * dfr[:, None], to_power)
+        sig = np.where(fill, np.sqrt(2.0 * cr * n0**2) * dfr[:, None], sig)
+        r0, r1 = (y - n0) * to_power, (y - n1) * to_power
         drop = np.maximum(np.abs(r0) - NOISE_Z * sig, 0.0) - np.maximum(np.abs(r1) - NOISE_Z * sig, 0.0)
         dm = np.abs(r1 - r0)
         p_change = np.minimum(2.0 * stats.norm.sf(np.maximum(NOISE_Z - dm / np.maximum(sig, 1e-300), 0.0)), 1.0)
@@ -170,6 +255,11 @@ class BroadbandFloor:
         y, wt = ctx.offline_bands(state, c, runs)                       # (n_runs, n_bands) unit²/Hz
         if not np.isfinite(ctx.sp.psd[c][runs, 0]).all() or wt.sum(0).min() < 0:
             return None
+        # a band whose Welch bins are all taken by the lines in a run: that run's whole-run bins between them
+        # (their bins weighed in Welch-bin equivalents, 2/ctx.dof each: a band mean's variance is mean²·2/(dof·bins))
+        yr, cr, _ = record_offline_bands(ctx, state, c, runs, wt == 0)
+        fill = (wt == 0) & (cr > 0)
+        y, wt = np.where(fill, yr, y), np.where(fill, cr * 2.0 / ctx.dof, wt)
         w_ref = ctx.omega_ref()
         x0 = ctx.omega[runs] / w_ref
         p, n, g = _floor_law(wt, y, x0)
