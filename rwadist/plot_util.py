@@ -25,8 +25,8 @@ def save_png(fig, path, dpi: float):
     - one draw: ``Figure.draw`` runs the figure's layout engine, if any, then renders (``savefig`` on a figure
       with a layout engine draws it twice: a draw-disabled pass for the layout, then the real draw);
     - zlib level :data:`PNG_COMPRESS_LEVEL`;
-    - during that draw, the draw-time caches of :func:`_draw_caches` (tick updates computed once per axis
-      position, math text parsed once per report).
+    - during that draw, the draw-time caches of :func:`_draw_caches` (tick updates and tick-label boxes computed
+      once per axis position, math text parsed once per report).
 
     The figure keeps ``dpi`` (it is meant to be dropped afterwards).
     """
@@ -61,12 +61,12 @@ def _draw_caches(fig):
 
     - The renderer the draw will use (Agg reuses it for the same size and dpi) parses math text
       with one parser shared by all figures (its results depend only on the text, font and dpi).
-    - Each axis computes its ticks once per (view limits, axes box, dpi): matplotlib recomputes
-      every tick's position and label each time a tick extent is asked for (the constrained
-      layout's two passes, the title position, the spines, the label alignment, then the draw:
-      ~17 times per axis), and the answer changes only when the axes move or rescale.  Nothing
-      else changes ticks while the figure is drawn; the cache is removed afterwards, so a later
-      change to the figure is drawn as usual.
+    - Each axis computes its ticks, and their labels' boxes, once per (view limits, axes box, dpi):
+      matplotlib recomputes every tick's position and label each time a tick extent is asked for
+      (the constrained layout's two passes, the title position, the spines, the label alignment,
+      then the draw: ~17 times per axis), and the answer changes only when the axes move or
+      rescale.  Nothing else changes ticks while the figure is drawn; the caches are removed
+      afterwards, so a later change to the figure is drawn as usual.
     """
     renderer = fig.canvas.get_renderer()
     if getattr(renderer, "mathtext_parser", None) is not None:
@@ -76,33 +76,52 @@ def _draw_caches(fig):
     patched = []
     for ax in axes_list:
         for axis in getattr(ax, "_axis_map", {}).values():
-            compute = getattr(type(axis), "_update_ticks", None)
-            if compute is None or "_update_ticks" in vars(axis):
+            cached = _axis_caches(axis)
+            if cached is None:
                 continue                # not the matplotlib this was written for, or already cached
-            axis._update_ticks = _ticks_once_per_geometry(axis, compute)
-            patched.append(axis)
+            for name, method in cached.items():
+                setattr(axis, name, method)
+            patched.append((axis, tuple(cached)))
     try:
         yield
     finally:
-        for axis in patched:
-            del axis._update_ticks
+        for axis, names in patched:
+            for name in names:
+                delattr(axis, name)
 
 
-def _ticks_once_per_geometry(axis, compute):
-    """``axis._update_ticks`` remembering its last answer for the same view limits, axes box and dpi."""
-    last = [None, None]
+def _axis_caches(axis) -> dict | None:
+    """Replacements for ``axis._update_ticks`` and ``axis._get_ticklabel_bboxes`` that remember their last
+    answer for the same view limits, axes box, dpi, locators and formatters (the tick labels' boxes: also
+    for the same ticks); None when ``axis`` lacks either method or already has them replaced."""
+    cls = type(axis)
+    update, boxes = getattr(cls, "_update_ticks", None), getattr(cls, "_get_ticklabel_bboxes", None)
+    if update is None or boxes is None or "_update_ticks" in vars(axis) or "_get_ticklabel_bboxes" in vars(axis):
+        return None
+    last_ticks = [None, None]
+    last_boxes = [None, None]
+
+    def geometry():
+        ax = axis.axes
+        return (tuple(axis.get_view_interval()), tuple(ax.bbox.bounds), ax.figure.dpi,
+                id(axis.get_major_locator()), id(axis.get_minor_locator()),
+                id(axis.get_major_formatter()), id(axis.get_minor_formatter()))
 
     def update_ticks():
-        ax = axis.axes
-        key = (tuple(axis.get_view_interval()), tuple(ax.bbox.bounds), ax.figure.dpi,
-               id(axis.get_major_locator()), id(axis.get_minor_locator()),
-               id(axis.get_major_formatter()), id(axis.get_minor_formatter()))
-        if last[0] != key:
-            last[1] = compute(axis)
-            last[0] = key
-        return list(last[1])
+        key = geometry()
+        if last_ticks[0] != key:
+            last_ticks[1] = update(axis)
+            last_ticks[0] = key
+        return list(last_ticks[1])
 
-    return update_ticks
+    def ticklabel_bboxes(ticks, renderer):
+        key = (geometry(), tuple(map(id, ticks)), id(renderer))
+        if last_boxes[0] != key:
+            last_boxes[1] = boxes(axis, ticks, renderer)
+            last_boxes[0] = key
+        return tuple(list(b) for b in last_boxes[1])
+
+    return {"_update_ticks": update_ticks, "_get_ticklabel_bboxes": ticklabel_bboxes}
 
 
 def content_top(f, rows, dynamic_range: float = LOG_DYNAMIC_RANGE, margin: float = 1.05) -> float:
