@@ -88,7 +88,9 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
     The grid is a product: d² = (2ζω0ν)² depends on (f0, ζ, row) only, ω0² − ν² ± aΩν on (f0, a, row) only, so
     those are computed on their own sub-grids and broadcast; the sums over each line's rows are segment sums of
     the rows sorted by line (:func:`numpy.add.reduceat`).  Chunks of f0 keep the temporaries near ``chunk``·256
-    elements per (ζ, a) slice in cache."""
+    elements per (ζ, a) slice in cache; the per-row terms u, v (each sense's |T|²·Ω⁴/power), their squares and
+    product are written into one buffer allocated once (fresh temporaries of this size cost a page-fault pass
+    each) and summed per line by one segment sum."""
     f0_grid, zeta_grid, a_grid = (np.asarray(x, float) for x in (f0_grid, zeta_grid, a_grid))
     order = np.argsort(line, kind="stable")
     line_s = np.asarray(line)[order]
@@ -105,25 +107,39 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
     n_z, n_a, n_rows = zeta_grid.size, a_grid.size, om.size
     out = np.empty((f0_grid.size, n_z, n_a))
     step = max(1, chunk * 256 // max(n_rows * n_z * n_a, 1))
+    both_senses = two_parts and not same
+    # u, u², (v, v², u·v): the terms summed per line, one buffer reused by every chunk
+    buf = np.empty((5 if both_senses else 2, min(step, f0_grid.size), n_z, 1 if same else n_a, n_rows))
     for s in range(0, f0_grid.size, step):
         w0 = 2 * np.pi * f0_grid[s:s + step]                                           # (F,)
+        n_f = w0.size
         w02 = w0**2
         d2 = ((2 * zeta_grid[None, :] * w0[:, None])[:, :, None] * nu[None, None, :]) ** 2   # (F, Z, rows)
         num = ((w02**2)[:, None, None] + d2) * scale                                  # |T|² numerator × scale
         rest = w02[:, None] - nu2[None, :]                                            # (F, rows)
-        if same:
-            u = (num / (rest[:, None, :] ** 2 + d2))[:, :, None, :]                  # (F, Z, 1, rows)
-        else:
-            u = num[:, :, None, :] / (((rest[:, None, :] + gyro[None]) ** 2)[:, None] + d2[:, :, None, :])
-        su = np.add.reduceat(u, starts, axis=-1)
-        suu = np.add.reduceat(u * u, starts, axis=-1)
-        if not two_parts or same:
+        b = buf[:, :n_f]
+        u = b[0]
+        if not both_senses:
+            if same:
+                np.divide(num, rest[:, None, :] ** 2 + d2, out=u[:, :, 0, :])         # (F, Z, 1, rows)
+            else:
+                np.add(((rest[:, None, :] + gyro[None]) ** 2)[:, None], d2[:, :, None, :], out=u)
+                np.divide(num[:, :, None, :], u, out=u)
+            np.multiply(u, u, out=b[1])
+            sums = np.add.reduceat(b, starts, axis=-1)
+            su, suu = sums[0], sums[1]
             out[s:s + step] = np.sum(counts - su**2 / suu, axis=-1)
             continue
-        v = num[:, :, None, :] / (((rest[:, None, :] - gyro[None]) ** 2)[:, None] + d2[:, :, None, :])
-        sv = np.add.reduceat(v, starts, axis=-1)
-        svv = np.add.reduceat(v * v, starts, axis=-1)
-        suv = np.add.reduceat(u * v, starts, axis=-1)
+        v = b[2]
+        np.add(((rest[:, None, :] + gyro[None]) ** 2)[:, None], d2[:, :, None, :], out=u)
+        np.divide(num[:, :, None, :], u, out=u)
+        np.add(((rest[:, None, :] - gyro[None]) ** 2)[:, None], d2[:, :, None, :], out=v)
+        np.divide(num[:, :, None, :], v, out=v)
+        np.multiply(u, u, out=b[1])
+        np.multiply(v, v, out=b[3])
+        np.multiply(u, v, out=b[4])
+        sums = np.add.reduceat(b, starts, axis=-1)
+        su, suu, sv, svv, suv = sums[0], sums[1], sums[2], sums[3], sums[4]
         det = suu * svv - suv**2
         safe = np.where(np.abs(det) > 1e-14 * suu * svv, det, np.nan)
         x = (svv * su - suv * sv) / safe

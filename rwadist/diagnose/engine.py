@@ -269,18 +269,24 @@ class Context(Metric):
         the lines of :meth:`State.ext_lines` through :func:`rwadist.extended.steady_lines` (suspension modes,
         gyroscopic whirl, rotation sense, lever arm), lines of one h acting on the channel merged into one entry
         of power Σ|A|²/2 (independent phases: the expected power; a co/counter pair of one h has a cross term
-        of zero mean that cancels between x and y).  Cached on the state per set of runs."""
+        of zero mean that cancels between x and y).  Cached on the state per set of runs, and on the context per
+        content (the extended parameters, the lines and the runs: every hypothesis that leaves them alone -- a
+        floor, a resonance, a sideband -- reads them again; read-only arrays)."""
         if state.ext is None:
             return [(h, law, self.amplitude(C, law, runs), np.ones(runs.size)) for h, C, law in state.lines(c)]
         key = ("lines", runs.tobytes())
         if key not in state._cache:
-            state._cache[key] = self._ext_lines(state, runs)
+            lines = tuple(state.ext_lines())
+            content = ("ext_lines", state.ext, lines, runs.tobytes())
+            if content not in self._memo:
+                self._memo[content] = self._ext_lines(state, runs, lines)
+            state._cache[key] = self._memo[content]
         return state._cache[key].get(c, [])
 
-    def _ext_lines(self, state: State, runs: np.ndarray) -> dict:
+    def _ext_lines(self, state: State, runs: np.ndarray, lines) -> dict:
+        """:meth:`channel_lines` of every channel on the extended base, computed (``lines``: ``state.ext_lines()``)."""
         from .. import extended as ext
 
-        lines = state.ext_lines()
         w = self.omega[runs]
         out = {c: [] for c in self.channels}
         if not lines:
@@ -306,6 +312,7 @@ class Context(Metric):
                 a_free = np.sqrt(np.sum(free[:, own] ** 2, axis=1)) if own else np.zeros(w.size)
                 a = np.sqrt(p)
                 gain = np.where(a_free > 0, a / np.where(a_free > 0, a_free, 1.0), 1.0)
+                a.flags.writeable = gain.flags.writeable = False          # shared by the states of one content
                 j0 = own[0] if own else g[0]
                 out[c].append((float(lines[j0].h), lines[j0].law, a, gain))
         return out

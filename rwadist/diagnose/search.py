@@ -161,16 +161,28 @@ def _base_lines(hyps, model=None) -> None:
 NO_WORSE_TOLERANCE = 1e-3   # relative rise of the error an accepted effect's refit may cause (see _no_worse)
 
 
-def _no_worse(ctx, state, refit) -> bool:
-    """True when ``refit`` (a passing hypothesis refitted on every run) does not raise the error on every run
-    (:meth:`Context.error`).  The judge weighed the effect fitted on the fit runs on the held-out runs; the refit is a
+def _state_error(ctx, state) -> float:
+    """:meth:`Context.error` of ``state`` on every run, kept on the state (a state is not changed once made): the
+    search asks for the current state's error at every accepted hypothesis and for the first and last states' at
+    the end."""
+    if "search_error" not in state._cache:
+        state._cache["search_error"] = ctx.error(state)
+    return state._cache["search_error"]
+
+
+def _no_worse(ctx, state, refit) -> tuple:
+    """(ok, refit.apply(state)): ok is True when ``refit`` (a passing hypothesis refitted on every run) does not raise
+    the error on every run (:meth:`Context.error`); the applied state is returned so that the search carries on from
+    it (its predictions and error computed here are kept on it).  The judge weighed the effect fitted on the fit runs
+    on the held-out runs; the refit is a
     new fit that nothing has judged, and a fit the data do not constrain can run off (a resonance whose peak falls
     between the lines: only ζ·g is measured, and ζ → its bound with g ×30 raised the error 34×).  Such a hypothesis
     is not added (the next passing one is taken), as one whose refit is not :meth:`significant`.  "Raise" means by
     more than ``NO_WORSE_TOLERANCE``: a line the Welch metric cannot measure (below its band, found on the whole
     record) moves the error by its window's leakage only (+1e-6 relative for a subharmonic at 2048 samples), while a
     refit that runs off raises it by factors."""
-    return ctx.error(refit.apply(state)) <= ctx.error(state) * (1.0 + NO_WORSE_TOLERANCE)
+    new = refit.apply(state)
+    return _state_error(ctx, new) <= _state_error(ctx, state) * (1.0 + NO_WORSE_TOLERANCE), new
 
 
 BASES = ("empirical", "extended", "auto")
@@ -249,7 +261,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     for it in range(1, max_iterations + 1):
         memo: dict = {}
         judged: list = []
-        best = refit = None
+        best = refit = applied = None
         for families in (first, rest):
             cands = [e for cls in families for e in cls.candidates(ctx, state, ctx.fit_runs)]
             new = [_judge(ctx, state, e, k_sigma, min_gain, it, memo) for e in cands]
@@ -261,8 +273,10 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
                     # refitted on every run, an effect must still be what its family proposes (an exponent that
                     # moved back to 2 within its standard errors is no new law): else the next passing one is taken
                     refit = h.effect.refit(ctx, state)
-                    if getattr(refit, "significant", lambda: True)() and _no_worse(ctx, state, refit):
-                        best = h
+                    if getattr(refit, "significant", lambda: True)():
+                        ok, applied = _no_worse(ctx, state, refit)
+                        if ok:
+                            best = h
             judged = sorted(judged + new, key=lambda h: -h.gain)
             if best is not None:
                 break
@@ -270,7 +284,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         if best is None:
             break
         best.passed = True
-        state = refit.apply(state)
+        state = applied                         # refit.apply(state), made by _no_worse
         best.effect = state.effects[-1]
     else:
         it = max_iterations
@@ -293,5 +307,5 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     if base_lines:
         prov["base_lines"] = base_lines
     out.provenance = dict(out.provenance, diagnose=prov)
-    return Diagnosis(out, state0, state, ctx.error(state0), ctx.error(state), ctx.rms_error(state0),
+    return Diagnosis(out, state0, state, _state_error(ctx, state0), _state_error(ctx, state), ctx.rms_error(state0),
                      ctx.rms_error(state), hyps, it, ctx)
