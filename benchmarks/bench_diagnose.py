@@ -341,7 +341,9 @@ def timing(fit_repeats: int = 5, diagnose_repeats: int = 2):
           "0.14 s after the same-number speed-ups of the record route, Welch PSDs, floor law and scan medians, "
           "same run conditions, load 2.7 on 2 cores: the faster Welch PSDs speed the plain fit too; cpu x21.8 = 3.10 s / "
           "0.14 s after the kernel and off-grid-cell fixes, x17.3 = 2.41 s / 0.14 s with the wheel's modes judged alone "
-          "first, same effects and exponent, quiet)")
+          "first, same effects and exponent, quiet; x17.3-17.4 -> x15.3-16.3 (2.60-2.65 s -> 2.46-2.50 s) after the same-number "
+          "speed-ups of the mode scan, the search's state errors, the kernel tables and the extended-base lines, "
+          "paired runs, load < 0.4)")
     print(f"  first calls only (each with its warm-up, the method of the earlier figures): cpu "
           f"x{c_diags[0] / c_fits[0]:.1f}")
     print(f"  {d.iterations} iterations, added "
