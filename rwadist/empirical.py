@@ -35,6 +35,7 @@ thesis toolbox did with a manual decision at every step:
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 from scipy import signal, stats
@@ -133,6 +134,15 @@ class EmpiricalFit:
     #: per channel (inputs, block floor, detected lines) (:func:`line_detections`): a second fit of the same spectra
     #: (``detections`` of :func:`fit_empirical`) takes them instead of computing them again
     detections: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @cached_property
+    def without_mode_exclusion(self) -> "EmpiricalFit":
+        """The fit of the same spectra, settings and detections with ``exclude_modes=False``: every line the data
+        show, at every speed (what :func:`rwadist.extended_fit.fit_extended` locates the modes on).  Computed once
+        per fit: the extended fit's stand rounds ask for it at every round (59 times in one diagnosis of 60 speeds
+        through a fixture resonance).  Read-only: the extended fit builds new lines from it, never changes it."""
+        settings = FitSettings(**{k: v for k, v in self.settings.items() if k in FitSettings.__dataclass_fields__})
+        return fit_empirical(self.spectra, replace(settings, exclude_modes=False), detections=self.detections)
 
 
 @dataclass

@@ -399,9 +399,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         spectra = compute_spectra(test, nperseg=sp0.nperseg, f_lim=sp0.f_lim, window=sp0.window)
         fit = fit_empirical(spectra, settings)
     # every line the data show, with every measurement: the empirical fit without modal
-    # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped)
-    meas = fit_empirical(fit.spectra, replace(settings, exclude_modes=False),
-                         detections=fit.detections)
+    # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped); once per fit
+    meas = fit.without_mode_exclusion
     stands = ([] if stand is None else [stand]) + list(more_stands)
     if stands:
         from .resonance import resonance
