@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from rwadist import api
-from rwadist.diagnose.effects.missing_harmonic import _hann_transform, welch_low_limit
+from rwadist.diagnose.effects.missing_harmonic import welch_low_limit
+from rwadist.diagnose.measure import hann_transform_ratio
 from rwadist.extended_fit import windowed_dft
 from rwadist.inject import parse, simulate_with_injections
 from rwadist.presets import preset
@@ -32,7 +33,7 @@ def test_hann_transform_is_the_windows_dft():
     w = signal.get_window("hann", n)
     delta = np.array([0.0, 0.3, 1.0, 1.7, 2.0, 2.5, 3.9, 7.25, 40.6])
     direct = windowed_dft(w[:, None], float(n), delta)[:, 0] / np.sum(w)          # fs = n: f in bins
-    assert np.allclose(_hann_transform(n, delta), direct, atol=1e-12)
+    assert np.allclose(hann_transform_ratio(n, delta), direct, atol=1e-12)
 
 
 def test_subharmonic_below_the_welch_band_found_on_the_whole_record():

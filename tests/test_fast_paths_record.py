@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from rwadist.dft import run_window, windowed_dft
+from rwadist.diagnose import measure
 from rwadist.diagnose.effects import missing_harmonic as mh
 from rwadist.diagnose.effects.sidebands import Sidebands
 from rwadist.diagnose.engine import Context, initial_state
@@ -32,7 +33,7 @@ def _plain_record_residual(ctx, state, c, runs, f_hz, exact):
     phasor by its own DFT and its leakage subtracted on the grid, |X|² read at the nearest grid point or (``exact``)
     the DFT at the point itself less the leakage there."""
     P, N, ok = np.full(f_hz.shape, np.nan), np.full(f_hz.shape, np.nan), np.zeros(f_hz.shape, bool)
-    lines = mh._state_line_freqs(ctx, state, c, runs)
+    lines = measure.state_line_freqs(ctx, state, c, runs)
     f_top = mh.welch_low_limit(ctx)
     k_w = np.clip(np.rint(f_hz / ctx.df).astype(int), ctx.k_lo, ctx.k_hi)
     S = np.take_along_axis(ctx.floor_psd(state, c, runs), k_w, axis=1)
@@ -105,7 +106,7 @@ def test_record_residual_is_the_plain_per_run_sum(record_case):
                 checked += int(got[2].sum())
     assert checked > 100                        # the points compared are the route's valid ones too
     # the leakage subtracted matters here (the comparison would not see a route that skipped it)
-    lines = mh._state_line_freqs(ctx, busy, "Fx", runs)
+    lines = measure.state_line_freqs(ctx, busy, "Fx", runs)
     assert np.any(lines < f_top)
 
 
@@ -114,7 +115,7 @@ def test_record_phasors_of_many_runs_are_each_run_alone(record_case):
     ctx = Context(sp, test=test)
     rows = [0, 3, 5, 9]                          # run 3 is shorter: its own group
     f = np.array([[3.0, 7.25, 11.0], [2.5, 6.0, 9.75], [4.0, 8.0, 12.5], [5.5, 9.0, 13.0]])
-    got = mh._record_dfts(ctx, rows, "Fy", f)
+    got = measure.record_dfts(ctx, rows, "Fy", f)
     for k, r in enumerate(rows):
         run = test.runs[r]
         w, wsum, _ = run_window(sp.window, run.n_samples)

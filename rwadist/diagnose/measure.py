@@ -2,10 +2,16 @@
 residual ridges along h·|Ω| and at constant frequency offsets, window powers."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..units import DIRECTION_CHANNELS
 from .constants import LINE_HALF
+
+if TYPE_CHECKING:                      # annotations only (the engine imports nothing from here at run time)
+    from .engine import Context
+    from .state import State
 
 
 def in_unresolved_span(model, direction: str, h: float) -> bool:
@@ -192,3 +198,46 @@ def _clear_of_lines(ctx, state, c, runs, f_hz, own_h):
             g = np.abs(h * ctx.omega[runs] / (2 * np.pi) + shift)
             ok &= np.abs(g - np.abs(f_hz)) >= 2 * LINE_HALF * ctx.df
     return ok
+
+
+# ------------------------------------------------------------------ whole-record helpers (missing_harmonic, broadband_floor)
+def hann_transform_ratio(n: int, delta: np.ndarray) -> np.ndarray:
+    """W(δ)/W(0) of the periodic Hann window of ``n`` samples at offsets ``delta`` (record bins, any real):
+    :func:`rwadist.dft.hann_transform` at f = δ·fs/n (taken with fs = n, so f is δ) over W(0) = Σw = n/2.  A line
+    A·e^{2πj f_l t} puts A·W((f − f_l)/df)/W(0) into the whole-run phasor at f (the convention of
+    :func:`rwadist.dft.windowed_dft`: Σ x e^{−2πj f t})."""
+    from ..dft import hann_transform
+
+    return hann_transform(n, float(n), np.asarray(delta, dtype=float)) / (0.5 * n)
+
+
+def state_line_freqs(ctx: Context, state: State, c: str, runs) -> np.ndarray:
+    """(len(runs), L) frequencies (Hz, ≥ 0) of every line the state predicts on channel ``c`` (carriers and their
+    sidebands)."""
+    out = []
+    for h, _, _, _ in ctx.channel_lines(state, c, runs):
+        for shift, _ in state.line_components(c, h):
+            out.append(np.abs(h * ctx.omega[runs] / (2 * np.pi) + shift))
+    return np.column_stack(out) if out else np.empty((runs.size, 0))
+
+
+def record_dfts(ctx: Context, rows, c: str, f_hz: np.ndarray) -> np.ndarray:
+    """Whole-run phasors X = 2·Σ w (x − x̄) e^{−2πj f t}/Σ w (len(rows), L) of channel ``c`` of the runs ``rows`` at
+    ``f_hz`` (len(rows), L) Hz (the spectra's window): the runs of one record length transformed together
+    (:func:`rwadist.dft.windowed_dfts`: each record's sums are those of :func:`rwadist.dft.windowed_dft` of it
+    alone, the same numbers)."""
+    from ..dft import run_window, windowed_dfts
+
+    out = np.empty(f_hz.shape, dtype=complex)
+    groups = {}
+    for i, r in enumerate(rows):
+        run = ctx.test.runs[r]
+        groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
+    for (n, fs), idx in groups.items():
+        w, wsum, _ = run_window(ctx.sp.window, n)
+        xs = []
+        for i in idx:
+            x = np.asarray(ctx.test.runs[rows[i]].signals[c], dtype=float)
+            xs.append((x - x.mean()) * w)
+        out[idx] = 2.0 * windowed_dfts(np.stack(xs)[:, :, None], fs, f_hz[idx])[:, :, 0] / wsum
+    return out

@@ -78,7 +78,8 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
     degrees of freedom (a Welch bin ctx.dof).  Each run's numbers are kept on the context (the data's and the
     lines', the same at every search step)."""
     from ...dft import run_window
-    from .missing_harmonic import RECORD_MIN_BINS, RECORD_SEP_BINS, _hann_transform, _record_dfts, _state_line_freqs
+    from ..measure import hann_transform_ratio, record_dfts, state_line_freqs
+    from .missing_harmonic import RECORD_MIN_BINS, RECORD_SEP_BINS
 
     y = np.zeros((runs.size, ctx.n_bands))
     cnt_all = np.zeros((runs.size, ctx.n_bands))
@@ -86,11 +87,11 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
     if ctx.test is None or not need.any():
         return y, cnt_all, df_all
     j = ctx.channels.index(c)
-    lines = _state_line_freqs(ctx, state, c, runs)
+    lines = state_line_freqs(ctx, state, c, runs)
     keys = [("broadband_floor_record", int(r), j, lines[i].tobytes(), need[i].tobytes()) for i, r in enumerate(runs)]
     todo = [i for i, r in enumerate(runs)
             if need[i].any() and keys[i] not in ctx._memo and c in ctx.test.runs[int(r)].signals]
-    A = (_record_dfts(ctx, [int(runs[i]) for i in todo], c, lines[todo]) if lines.shape[1] and todo
+    A = (record_dfts(ctx, [int(runs[i]) for i in todo], c, lines[todo]) if lines.shape[1] and todo
          else np.zeros((len(todo), 0), complex))
     lo_edge = float(ctx.f[ctx.k_lo] - 0.5 * ctx.df)
     band_w = BAND_BINS * ctx.df
@@ -110,8 +111,8 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
         keep = np.ones(fk.size, bool)
         fl = lines[i]
         if fl.size:
-            Xk = Xk - (_hann_transform(n, (fk[:, None] - fl[None, :]) / df_rec) * A[a][None, :]
-                       + _hann_transform(n, (fk[:, None] + fl[None, :]) / df_rec) * np.conj(A[a])[None, :]).sum(1)
+            Xk = Xk - (hann_transform_ratio(n, (fk[:, None] - fl[None, :]) / df_rec) * A[a][None, :]
+                       + hann_transform_ratio(n, (fk[:, None] + fl[None, :]) / df_rec) * np.conj(A[a])[None, :]).sum(1)
             keep = np.all(np.abs(fk[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
         P = np.abs(Xk) ** 2 * wsum**2 / (2.0 * fs * w2sum)
         # a residual peak: above thr times the band's level (median of its bins clear of lines / ln 2); a peak's

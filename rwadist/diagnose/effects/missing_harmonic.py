@@ -18,7 +18,15 @@ from ...model import Harmonic
 from ...units import DIRECTION_CHANNELS
 from ..constants import LINE_HALF
 from ..engine import Context
-from ..measure import _measure, in_unresolved_span, refine_h, ridge_peaks
+from ..measure import (
+    _measure,
+    hann_transform_ratio,
+    in_unresolved_span,
+    record_dfts,
+    refine_h,
+    ridge_peaks,
+    state_line_freqs,
+)
 from ..state import State
 from .base import register, schema_entry
 
@@ -48,16 +56,6 @@ RECORD_MIN_POINTS = 6
 RECORD_MIN_RUNS = 3
 #: Points used for C stand this many times over the noise (as the whole-run fit of ``speed_sidebands``).
 RECORD_FIT_SNR = 10.0
-
-
-def _hann_transform(n: int, delta: np.ndarray) -> np.ndarray:
-    """W(δ)/W(0) of the periodic Hann window of ``n`` samples at offsets ``delta`` (record bins, any real):
-    :func:`rwadist.dft.hann_transform` at f = δ·fs/n (taken with fs = n, so f is δ) over W(0) = Σw = n/2.  A line
-    A·e^{2πj f_l t} puts A·W((f − f_l)/df)/W(0) into the whole-run phasor at f (the convention of
-    :func:`rwadist.dft.windowed_dft`: Σ x e^{−2πj f t})."""
-    from ...dft import hann_transform
-
-    return hann_transform(n, float(n), np.asarray(delta, dtype=float)) / (0.5 * n)
 
 
 def record_line_evidence(ctx: Context, chans, P, N, ok, M1) -> tuple:
@@ -106,16 +104,6 @@ def _record_grid(ctx: Context, r: int) -> tuple:
     return ctx._memo[key]
 
 
-def _state_line_freqs(ctx: Context, state: State, c: str, runs) -> np.ndarray:
-    """(len(runs), L) frequencies (Hz, ≥ 0) of every line the state predicts on channel ``c`` (carriers and their
-    sidebands)."""
-    out = []
-    for h, _, _, _ in ctx.channel_lines(state, c, runs):
-        for shift, _ in state.line_components(c, h):
-            out.append(np.abs(h * ctx.omega[runs] / (2 * np.pi) + shift))
-    return np.column_stack(out) if out else np.empty((runs.size, 0))
-
-
 def _has_channel(ctx: Context, r: int, j: int) -> bool:
     """Run ``r`` has channel ``ctx.channels[j]`` (its record grid is finite there)."""
     key = ("missing_harmonic_has", r, j)
@@ -124,35 +112,13 @@ def _has_channel(ctx: Context, r: int, j: int) -> bool:
     return ctx._memo[key]
 
 
-def _record_dfts(ctx: Context, rows, c: str, f_hz: np.ndarray) -> np.ndarray:
-    """Whole-run phasors X = 2·Σ w (x − x̄) e^{−2πj f t}/Σ w (len(rows), L) of channel ``c`` of the runs ``rows`` at
-    ``f_hz`` (len(rows), L) Hz (the spectra's window): the runs of one record length transformed together
-    (:func:`rwadist.dft.windowed_dfts`: each record's sums are those of :func:`rwadist.dft.windowed_dft` of it
-    alone, the same numbers)."""
-    from ...dft import run_window, windowed_dfts
-
-    out = np.empty(f_hz.shape, dtype=complex)
-    groups = {}
-    for i, r in enumerate(rows):
-        run = ctx.test.runs[r]
-        groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
-    for (n, fs), idx in groups.items():
-        w, wsum, _ = run_window(ctx.sp.window, n)
-        xs = []
-        for i in idx:
-            x = np.asarray(ctx.test.runs[rows[i]].signals[c], dtype=float)
-            xs.append((x - x.mean()) * w)
-        out[idx] = 2.0 * windowed_dfts(np.stack(xs)[:, :, None], fs, f_hz[idx])[:, :, 0] / wsum
-    return out
-
-
 def _record_run_residual(ctx: Context, r: int, j: int, fl: np.ndarray, f_top: float, A=None) -> tuple:
     """(X (G,) complex, A (L,) complex, local noise) of run ``r``, channel ``ctx.channels[j]`` on the record grid
     (:func:`_record_grid`) less the leakage of the lines ``fl`` (L,) Hz (their whole-run phasors A times the
     window's transform, the negative-frequency image too), and the median |X|²/ln 2 over the grid points of the
     record route's range clear of those lines (0 with fewer than 8).  The data's and the lines' only: kept on the
     context, so each search step and each caller that asks the same run, channel and lines reuses them.  ``A``: the
-    lines' phasors when already computed (:func:`_record_dfts` of several runs at once)."""
+    lines' phasors when already computed (:func:`record_dfts` of several runs at once)."""
     key = ("missing_harmonic_run", r, j, fl.tobytes(), f_top)
     if key in ctx._memo:
         return ctx._memo[key]
@@ -164,11 +130,11 @@ def _record_run_residual(ctx: Context, r: int, j: int, fl: np.ndarray, f_top: fl
     if fl.size:
         # the leakage on the whole (short) grid once, then read at the points' nearest grid frequencies
         if A is None:
-            A = _record_dfts(ctx, [r], c, fl[None, :])[0]                                              # (L,)
+            A = record_dfts(ctx, [r], c, fl[None, :])[0]                                              # (L,)
         key_t = ("missing_harmonic_leak", n, df_rec, grid.size, fl.tobytes())   # the same lines at every step
         if key_t not in ctx._memo:
-            ctx._memo[key_t] = (_hann_transform(n, (grid[:, None] - fl[None, :]) / df_rec),
-                                _hann_transform(n, (grid[:, None] + fl[None, :]) / df_rec))
+            ctx._memo[key_t] = (hann_transform_ratio(n, (grid[:, None] - fl[None, :]) / df_rec),
+                                hann_transform_ratio(n, (grid[:, None] + fl[None, :]) / df_rec))
         t_minus, t_plus = ctx._memo[key_t]
         Xr = Xr - (t_minus * A[None, :] + t_plus * np.conj(A)[None, :]).sum(1)
         clear &= np.all(np.abs(grid[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
@@ -181,7 +147,7 @@ def _record_run_residual(ctx: Context, r: int, j: int, fl: np.ndarray, f_top: fl
 def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool = False) -> tuple:
     """(|X|² (len(runs), L), noise (len(runs), L), valid (len(runs), L)) of channel ``c`` at frequencies ``f_hz``
     (len(runs), L) on the whole-run DFT, less the leakage of every line the state predicts on the channel (each
-    line's own phasor times the window's transform, :func:`_hann_transform`, its negative-frequency image too).
+    line's own phasor times the window's transform, :func:`hann_transform_ratio`, its negative-frequency image too).
 
     |X|² is read on the record grid at the nearest point (:func:`_record_grid`), or with ``exact`` at ``f_hz`` itself
     (:func:`rwadist.extended_fit.windowed_dft`); the noise is the larger of the white
@@ -196,7 +162,7 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     P = np.full(f_hz.shape, np.nan)
     N = np.full(f_hz.shape, np.nan)
     ok = np.zeros(f_hz.shape, bool)
-    lines = _state_line_freqs(ctx, state, c, runs)
+    lines = state_line_freqs(ctx, state, c, runs)
     f_top = welch_low_limit(ctx)
     k_w = np.clip(np.rint(f_hz / ctx.df).astype(int), ctx.k_lo, ctx.k_hi)
     S = np.take_along_axis(ctx.floor_psd(state, c, runs), k_w, axis=1)
@@ -218,14 +184,14 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
             new_lines.setdefault(fl.size, []).append((r, fl))
     A_new = {}
     for items in new_lines.values():
-        A = _record_dfts(ctx, [r for r, _ in items], c, np.array([fl for _, fl in items]))
+        A = record_dfts(ctx, [r for r, _ in items], c, np.array([fl for _, fl in items]))
         A_new.update({r: A[k] for k, (r, _) in enumerate(items)})
     # with ``exact``: the data's phasors at the points' own frequencies (a fit's h refined finer than the grid), kept
     # on the context (the fit's grid of h is asked again on the refit's runs and by the held-out evidence)
     ex_key = {i: ("missing_harmonic_exact", r, j, fl.tobytes(), f_hz[i].tobytes()) for i, r, fl, _, _ in todo} \
         if exact else {}
     ex_new = [t for t in todo if exact and ex_key[t[0]] not in ctx._memo]
-    X_ex = _record_dfts(ctx, [t[1] for t in ex_new], c, f_hz[[t[0] for t in ex_new]]) if ex_new else None
+    X_ex = record_dfts(ctx, [t[1] for t in ex_new], c, f_hz[[t[0] for t in ex_new]]) if ex_new else None
     ex_row = {t[0]: k for k, t in enumerate(ex_new)}
     # their lines' leakage (the window's transform at the points less and plus each line, times its phasor), the runs
     # of one record length and number of lines at once (elementwise: the numbers of one run at a time)
@@ -240,7 +206,7 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
         fi = f_hz[[i for i, _, _ in items]][:, :, None]                                   # (R, L, 1)
         fls = np.array([fl for _, _, fl in items])[:, None, :]                             # (R, 1, nl)
         A = np.array([_record_run_residual(ctx, r, j, fl, f_top, A_new.get(r))[1] for _, r, fl in items])[:, None, :]
-        d = (_hann_transform(n, (fi - fls) / df_g) * A + _hann_transform(n, (fi + fls) / df_g) * np.conj(A)).sum(2)
+        d = (hann_transform_ratio(n, (fi - fls) / df_g) * A + hann_transform_ratio(n, (fi + fls) / df_g) * np.conj(A)).sum(2)
         leak.update({i: d[k] for k, (i, _, _) in enumerate(items)})
     for i, r, fl, _, g in todo:
         Xr, A, local = _record_run_residual(ctx, r, j, fl, f_top, A_new.get(r))
