@@ -5,7 +5,12 @@ The data share nothing with the fit: the wheel is tests/independent_wheel.py (th
 coordinates) and the stand is a real IIR filter run over the time series (scipy.signal.bilinear of
 H(s) = (s² + 2gζω s + ω²)/(s² + 2ζω s + ω²), prewarped at f_r, its transient discarded), not the per-line gain
 rwadist's virtual stand multiplies in.  The full cells print in benchmarks/diagnose_matrix.py.
+
+Several tests diagnose the same record or start from the same reference fit: those are built once per test process
+(:func:`shared_stand_test`, :func:`shared_reference`), their sample arrays read-only so that no test can change what
+the next one reads.
 """
+import functools
 import sys
 from pathlib import Path
 
@@ -56,6 +61,27 @@ def _reference(test):
     return api.fit_extended(test, mass=wheel.mass_kg, radius=wheel.radius_m)[1]
 
 
+@functools.lru_cache(maxsize=None)
+def shared_stand_test(speeds_rpm: tuple, seed: int, n_samples: int = 8192, stand: bool = True):
+    """:func:`iir_stand_test` of ``speeds_rpm`` (a tuple), built once per test process; its samples are read-only."""
+    test = iir_stand_test(np.asarray(speeds_rpm), seed, n_samples=n_samples, stand=stand)
+    for run in test.runs:
+        for x in run.signals.values():
+            x.flags.writeable = False
+    return test
+
+
+@functools.lru_cache(maxsize=None)
+def shared_reference(speeds_rpm: tuple, n_samples: int = 8192, stand: bool = True):
+    """The reference model fitted on the seed-500 record of ``speeds_rpm`` (:func:`_reference`), once per process."""
+    return _reference(shared_stand_test(speeds_rpm, 500, n_samples, stand))
+
+
+#: the short-record and wide speed grids (rpm) several tests share
+SHORT_GRID = tuple(np.linspace(300.0, 3000.0, 60).tolist())
+WIDE_GRID = tuple(np.linspace(100.0, 6000.0, 60).tolist())
+
+
 def _added(d):
     return [e["kind"] for e in d.model.effects]
 
@@ -66,9 +92,8 @@ def test_short_record_stand_never_raises_the_error():
     error 0.19 -> 6.4.  An accepted effect never raises the error on every run, and the stand is the one filtered in
     (diagnose's own fit of it on this record, 180.4 Hz, ζ 0.040, gain 3.9, left a false amplitude law on h = 4.42 beside
     it: the reference fit's stand, located at the fit's resolution, is proposed too)."""
-    speeds = np.linspace(300.0, 3000.0, 60)
-    ref = _reference(iir_stand_test(speeds, seed=500, n_samples=2048))
-    d = api.diagnose(iir_stand_test(speeds, seed=3, n_samples=2048), ref)
+    ref = shared_reference(SHORT_GRID, n_samples=2048)
+    d = api.diagnose(shared_stand_test(SHORT_GRID, 3, n_samples=2048), ref)
     assert d.error_after < d.error_before
     state = d.state_before
     for e in d.state_after.effects:                 # every accepted step lowers (or keeps) the error
@@ -94,7 +119,7 @@ def test_wide_speed_range_stand_names_the_modes_first():
     no mode, nor did the fit without it, so suspension_modes was never proposed and the wheel's modes were patched as
     a missing radial-torque fundamental, an amplitude law and a 192 Hz wheel_mode (error 0.88 -> 0.44).  Now: the
     modes (each within 2 % of the generator's) and the stand (role test_stand, f_r within 1 %), nothing else."""
-    d = api.diagnose(iir_stand_test(np.linspace(100.0, 6000.0, 60), seed=3))
+    d = api.diagnose(shared_stand_test(WIDE_GRID, 3))
     assert sorted(_added(d)) == ["fixed_resonance", "suspension_modes"]
     _assert_modes_within(d, 0.02)
     (stand,) = [e for e in d.model.effects if e["kind"] == "fixed_resonance"]
@@ -134,7 +159,7 @@ def test_short_record_stand_no_model_fits_stand_beside_modes():
     the modes were refitted without it (radial translation pulled to the stand: -18.6 %, misfit noted) and the stand
     was never named (error 0.98 -> 0.17).  Now the stand is confirmed on the modes' residual at the fit's resolution,
     the modes are each within 2 % of the generator's, and the stand is named (role test_stand, within 1 %)."""
-    d = api.diagnose(iir_stand_test(np.linspace(300.0, 3000.0, 60), seed=3, n_samples=2048))
+    d = api.diagnose(shared_stand_test(SHORT_GRID, 3, n_samples=2048))
     _assert_modes_within(d, 0.02)
     # and nothing else: the merged h = 5.37/5.57 pair (one h = 5.49 line at this resolution, listed unresolved) is
     # no amplitude law
@@ -154,11 +179,10 @@ def test_a_refit_that_raises_the_error_is_not_added(monkeypatch):
 
     from rwadist.diagnose.effects.fixed_resonance import FixedResonance
 
-    speeds = np.linspace(300.0, 3000.0, 60)
-    ref = _reference(iir_stand_test(speeds, seed=500, n_samples=2048))
+    ref = shared_reference(SHORT_GRID, n_samples=2048)
     monkeypatch.setattr(FixedResonance, "refit", lambda self, ctx, state: replace(self, f_r=178.44, zeta=1e-3,
                                                                                  peak_gain=137.0))
-    d = api.diagnose(iir_stand_test(speeds, seed=3, n_samples=2048), ref)
+    d = api.diagnose(shared_stand_test(SHORT_GRID, 3, n_samples=2048), ref)
     assert not [r for r in d.state_after.resonances if r[1] < 0.0015]      # the run-off refit is in no state
     assert d.error_after <= d.error_before
 
@@ -179,7 +203,7 @@ def test_two_fixture_resonances_no_mode_wrong_without_a_word():
     modes' fit divides out one resonance between them (167 Hz) and the search then names both fixtures; the radial
     translation came out 2.7 % low with nothing said.  Every mode is now within 2 % of the generator's or declared
     (the effect's and the model's ``unconstrained``, with a note giving its value with every fixture divided out)."""
-    test = _through_stand(iir_stand_test(np.linspace(100.0, 6000.0, 60), seed=3), 150.0, 0.03, 5.0)
+    test = _through_stand(shared_stand_test(WIDE_GRID, 3), 150.0, 0.03, 5.0)
     d = api.diagnose(test)
     (modes,) = [e for e in d.model.effects if e["kind"] == "suspension_modes"]
     stands = [e["f_Hz"] for e in d.model.effects if e["kind"] == "fixed_resonance" and e["role"] == "test_stand"]
