@@ -60,10 +60,10 @@ MAX_NFEV = 300
 #: linearly from its change over the last FLAT_WINDOW iterations to :data:`MAX_NFEV`, stays within NO_RESONANCE_FRACTION
 #: of ln :data:`MIN_PEAK_GAIN`: near g = 1 the Jacobian's f_r and ζ columns vanish with g − 1, so the solver creeps
 #: along a flat valley to its evaluation limit (ln g moves by ~0.01 in 250 iterations on clean data), and wherever it
-#: stops the result is no resonance.  20 iterations (a 10-iteration window) rather than 40 (20): on clean data the
+#: stops the result is no resonance.  12 iterations (a 6-iteration window) rather than 40 (20): on clean data the
 #: stopped starts were 90 % of a diagnosis's least-squares evaluations, and the robustness matrix
-#: (benchmarks/diagnose_matrix.py, both paths, every class) gives the same table either way.
-FLAT_MIN_ITER, FLAT_WINDOW, NO_RESONANCE_FRACTION = 20, 10, 0.8
+#: (benchmarks/diagnose_matrix.py, both paths, every class) gives the same table with 40/20, 20/10 and 12/6.
+FLAT_MIN_ITER, FLAT_WINDOW, NO_RESONANCE_FRACTION = 12, 6, 0.8
 
 
 class _FlatNoResonance:
