@@ -135,14 +135,19 @@ class EmpiricalFit:
     #: (``detections`` of :func:`fit_empirical`) takes them instead of computing them again
     detections: dict = field(default_factory=dict, repr=False, compare=False)
 
+    @property
+    def fit_settings(self) -> "FitSettings":
+        """The :class:`FitSettings` this fit was made with (``settings`` holds them as a plain dict, with extra keys
+        for the model file)."""
+        return FitSettings(**{k: v for k, v in self.settings.items() if k in FitSettings.__dataclass_fields__})
+
     @cached_property
     def without_mode_exclusion(self) -> "EmpiricalFit":
         """The fit of the same spectra, settings and detections with ``exclude_modes=False``: every line the data
         show, at every speed (what :func:`rwadist.extended_fit.fit_extended` locates the modes on).  Computed once
         per fit: the extended fit's stand rounds ask for it at every round (59 times in one diagnosis of 60 speeds
         through a fixture resonance).  Read-only: the extended fit builds new lines from it, never changes it."""
-        settings = FitSettings(**{k: v for k, v in self.settings.items() if k in FitSettings.__dataclass_fields__})
-        return fit_empirical(self.spectra, replace(settings, exclude_modes=False), detections=self.detections)
+        return fit_empirical(self.spectra, replace(self.fit_settings, exclude_modes=False), detections=self.detections)
 
 
 @dataclass

@@ -392,7 +392,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     """
     physical = mass is not None and radius is not None
     notes = []
-    settings = FitSettings(**{k: v for k, v in fit.settings.items() if k in FitSettings.__dataclass_fields__})
+    settings = fit.fit_settings
     if height:
         sp0 = fit.spectra
         test = remove_lever_arm(test, height)
