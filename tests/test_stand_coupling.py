@@ -1,0 +1,95 @@
+"""A mode coupled to the test stand: its standard error with the stand free, from the stand's refit rounds.
+
+:func:`rwadist.stand_resonance.fit_extended_beside_stand` alternates the modes' least squares (stand fixed) and the
+stand's (modes fixed).  The check here is the closed form of such block-coordinate rounds on a linear least-squares
+problem y = a·x1 + b·x2 + noise, independent of the fit: a's moves shrink by r² a round (r the correlation of x1 and
+x2), and its marginal standard error is σ/sqrt(x1·x1·(1 − r²)) while with b fixed it is σ/sqrt(x1·x1) (the Schur
+complement of (XᵀX)).  :func:`coupled_stderr`, given a's trajectory as a mode's ln f and the fixed-b standard error,
+must return the marginal one; :func:`declare_coupled_modes` declares the mode when 1.5 of those exceed the tolerance.
+"""
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from rwadist.stand_resonance import coupled_stderr, declare_coupled_modes
+
+MODES = ("radial_translation", "rocking", "axial")
+
+
+def _rounds(r: float, sigma: float, n_rounds: int = 12, n: int = 400, seed: int = 0):
+    """(trajectory of a over the rounds, se of a with b fixed, marginal se of a) for regressors of correlation r."""
+    rng = np.random.default_rng(seed)
+    u, v = rng.standard_normal(n), rng.standard_normal(n)
+    u, v = u / np.linalg.norm(u), v - (v @ u) / (u @ u) * u
+    v /= np.linalg.norm(v)
+    x1, x2 = u, r * u + np.sqrt(1 - r * r) * v           # unit norm, x1·x2 = r exactly
+    y = 5.3 * x1 - 2.0 * x2 + sigma * rng.standard_normal(n)
+    a, b, path = 0.0, 0.0, []
+    for _ in range(n_rounds):
+        a = x1 @ (y - b * x2) / (x1 @ x1)                 # the modes, stand fixed
+        b = x2 @ (y - a * x1) / (x2 @ x2)                 # the stand, modes fixed
+        path.append(a)
+    X = np.column_stack([x1, x2])
+    marginal = sigma * np.sqrt(np.linalg.inv(X.T @ X)[0, 0])
+    return np.array(path), sigma / np.sqrt(x1 @ x1), marginal
+
+
+def _as_modes(lnf):
+    """Round-by-round mode frequencies: the translation following exp(ln f), the others fixed."""
+    return [{"radial_translation": float(np.exp(x)), "rocking": 55.0, "axial": 70.0} for x in lnf]
+
+
+@pytest.mark.parametrize("r", [0.6, 0.9, 0.97])
+def test_stderr_with_the_stand_free_is_the_schur_complement(r):
+    path, se_fixed, marginal = _rounds(r, sigma=0.01)
+    lnf = np.log(200.0) + 0.01 * path                      # a small, geometric drift of ln f
+    got = coupled_stderr(_as_modes(lnf), {"k_r": 2 * 0.01 * se_fixed, "k_rock": 0.01, "k_z": 0.01})
+    assert set(got) == {"radial_translation"}            # the modes that did not move are not coupled
+    rho, fixed, free = got["radial_translation"]
+    assert rho == pytest.approx(r * r, rel=1e-6)
+    assert fixed == pytest.approx(0.01 * se_fixed, rel=1e-12)
+    assert free == pytest.approx(0.01 * marginal, rel=1e-6)
+
+
+def test_no_drift_or_noise_like_moves_are_not_coupled():
+    rng = np.random.default_rng(3)
+    noisy = np.log(200.0) + 1e-4 * rng.standard_normal(12)          # moves of both signs
+    assert coupled_stderr(_as_modes(noisy), {"k_r": 0.02}) == {}
+    # geometric but smaller in all than the fixed-stand standard error: nothing measurable moved
+    small = np.log(200.0) + 1e-4 * (1 - 0.5 ** np.arange(12))
+    assert coupled_stderr(_as_modes(small), {"k_r": 0.02}) == {}
+    # one sign and shrinking, but not at one rate (0.9, 0.33, 0.9): no rate of the rounds is measured
+    steps = 0.01 * np.array([1.0, 0.9, 0.3, 0.27])
+    uneven = np.log(200.0) + np.concatenate([[0.0], np.cumsum(steps)])
+    assert coupled_stderr(_as_modes(uneven), {"k_r": 0.002}) == {}
+    assert set(coupled_stderr(_as_modes(np.log(200.0) + np.concatenate([[0.0], np.cumsum(0.01 * 0.9 ** np.arange(4))])),
+                              {"k_r": 0.002})) == {"radial_translation"}
+    # too few rounds to measure a rate
+    assert coupled_stderr(_as_modes(np.log(200.0) + 0.01 * (1 - 0.9 ** np.arange(4))), {"k_r": 0.02}) == {}
+
+
+@pytest.mark.parametrize("r, declared", [(0.6, False), (0.97, True)])
+def test_a_mode_coupled_to_the_stand_is_declared(r, declared):
+    path, se_fixed, marginal = _rounds(r, sigma=0.01)
+    scale = 0.009 / se_fixed                                # the mode known to ±0.9 % with the stand fixed
+    lnf = np.log(220.0) + scale * path
+    last = _as_modes(lnf)[-1]
+    k = {m: (2 * np.pi * last[m]) ** 2 for m in MODES}            # per unit mass and inertia: f = sqrt(k)/2π
+    params = SimpleNamespace(k_r=k["radial_translation"], mass=1.0, k_rock=k["rocking"], I_rr=1.0, k_z=k["axial"])
+    efit = SimpleNamespace(params=params, unconstrained=[], notes=[],
+                           rel_stderr={"k_r": 2 * 0.009, "k_rock": 0.002, "k_z": 0.002},
+                           identified={"radial_translation": True, "rocking": True, "axial_translation": True})
+    out = declare_coupled_modes(efit, _as_modes(lnf), tolerance=0.02)
+    # 1.5 standard errors with the stand free against the 2 % tolerance: 1.5·0.9 %/sqrt(1 − r²) is 1.7 % at r 0.6
+    # and 5.5 % at r 0.97
+    assert (out == ["radial_translation"]) is declared
+    assert ("radial_translation" in efit.unconstrained) is declared
+    assert efit.identified["radial_translation"] is (not declared)
+    if declared:
+        (note,) = efit.notes
+        assert note.startswith("radial_translation: NOT CONSTRAINED beside the test stand")
+        assert f"±{100 * scale * marginal:.1f} % with it free" in note
+        assert f"located at {last['radial_translation']:.4g} Hz" in note
+    else:
+        assert efit.notes == []
