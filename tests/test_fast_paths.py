@@ -57,6 +57,18 @@ def test_scan_grid_is_the_per_line_nonnegative_least_squares():
                 assert abs(ssr[i, j, k] - ref) <= 1e-9 * max(ref, 1e-3 * line.size), (i, j, k, ssr[i, j, k], ref)
 
 
+def test_scan_grid_chunks_give_the_same_numbers():
+    # the chunk size only splits the f0 axis: every f0's sums are the same operations on the same rows, so the
+    # numbers are identical, bit for bit, however the grid is cut (one f0 at a time, a few, all at once)
+    line, h, omega, power = _scan_case(seed=5)
+    f0, zeta, a = np.exp(np.linspace(np.log(20.0), np.log(300.0), 57)), np.geomspace(0.002, 0.6, 9), np.linspace(0.2, 2, 10)
+    for two_parts in (True, False):
+        ref = _grid_search(line, h, omega, power, f0, zeta, a, two_parts, chunk=1)
+        for chunk in (3, 50, 512, 10**6):
+            assert np.array_equal(_grid_search(line, h, omega, power, f0, zeta, a, two_parts, chunk=chunk), ref,
+                                  equal_nan=True), chunk
+
+
 def test_hann_transform_is_the_window_sum():
     for n, fs in ((8192, 3840.0), (1001, 1000.0), (64, 10.0)):
         w = signal.get_window("hann", n)
