@@ -216,7 +216,7 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
         The model file's content: the empirical harmonics as forcing lines plus the analytical section.
     """
     from .extended_fit import to_model
-    from .stand_resonance import fit_extended_beside_stand
+    from .stand_resonance import declare_coupled_modes, fit_extended_beside_stand
 
     test = _as_test(data)
     if empirical is None:
@@ -238,6 +238,7 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     # a fixture resonance lifting every channel is fitted beside the wheel's modes, never into them
     efit = fit_extended_beside_stand(test, empirical, mass=mass, radius=radius, height=height, start=start,
                                      progress=progress)
+    declare_coupled_modes(efit)          # a mode the stand dragged along, not told apart from it: said
     return efit, to_model(efit, empirical)
 
 

@@ -234,7 +234,8 @@ def run_extended_fit(test, fit, args):
     for note in efit.notes:
         print(f"  note: {note}")
     if efit.unconstrained:
-        print(f"  UNCONSTRAINED by the data (starting values, listed in the model file): "
+        print(f"  UNCONSTRAINED by the data (starting values, or values not told apart from a test stand: see the "
+              f"notes; listed in the model file): "
               f"{', '.join(efit.unconstrained)}")
     return efit, model
 

@@ -74,7 +74,8 @@ class ExtendedFit:
     notes : what could not be fitted and why.
     measured : the line measurements the least squares used (LineFit list, every speed).
     unconstrained : modes the data do not constrain ("radial_translation", "rocking", "axial"):
-        their values are starting values (written to ``analytical.unconstrained``).
+        their values are starting values, or for a mode not told apart from a test stand its fitted value
+        (written to ``analytical.unconstrained``).
     scans : per mode, the :class:`~rwadist.mode_scan.ModeScan` that located it or said why not.
     per_unit : True when mass/radius were not given (M = 1 kg, I_rr = 1 kg·m²).
     stand : the fixture resonance (f_r Hz, ζ, peak gain) divided out of every line before the fit, or None.
@@ -99,6 +100,10 @@ class ExtendedFit:
     per_unit: bool = False
     stand: tuple | None = None
     line_residuals: tuple = (np.empty(0), np.empty(0))
+    #: the located modes the stand's refit rounds dragged along (:func:`rwadist.stand_resonance.coupled_stderr`:
+    #: mode name -> (ρ, relative standard error of f with the stand fixed, its bound with the stand free)); the
+    #: caller declares them (:func:`rwadist.stand_resonance.declare_coupled_modes`)
+    coupled: dict = field(default_factory=dict)
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -754,7 +759,8 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
 
 def unconstrained_warning(model, source: str, use: str) -> str | None:
     """The warning a command prints when it uses ``model`` whose ``analytical.unconstrained`` lists modes
-    (the extended fit could not identify them: their values are starting values); None otherwise.
+    (the extended fit could not identify them: their values are starting values, or values the fit could not tell
+    apart from a test-stand resonance, as its notes say); None otherwise.
 
     source : where the model came from (file name), for the message.  use : what the command does with it.
     """
@@ -764,5 +770,6 @@ def unconstrained_warning(model, source: str, use: str) -> str | None:
         return None
     return (f"warning: {source}: analytical.unconstrained = {list(modes)}: the extended fit could not identify "
             f"{'this mode' if len(modes) == 1 else 'these modes'} from the test data; {use} uses "
-            f"{'its' if len(modes) == 1 else 'their'} starting values (measure a speed range whose lines cross "
+            f"{'its' if len(modes) == 1 else 'their'} starting values or values not told apart from a test stand (see "
+            "the model's analytical.fit.notes; measure a speed range whose lines cross "
             "the mode, or give the mode from another source)")

@@ -661,7 +661,8 @@ class Analytical(_ReadsAsJson):
     > 0; dampings and imbalances >= 0; height signed).  A section may lack parameters (a partial
     model); :meth:`require` names the first missing one when the extended model needs them all.
     modes_assumed : the suspension modes are assumed (a datasheet wheel), not measured.
-    unconstrained : modes the extended fit could not identify (their values are starting values).
+    unconstrained : modes the extended fit could not identify (their values are starting values, or fitted values
+        not told apart from a test stand).
     extra : other keys (e.g. ``fit``), carried through.  Reads as (and equals) the JSON object."""
 
     kind: str = ANALYTICAL_KIND

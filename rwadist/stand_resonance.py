@@ -301,26 +301,31 @@ def coupled_stderr(modes: list, rel_stderr: dict) -> dict:
     return out
 
 
-def declare_coupled_modes(efit, modes: list, tolerance: float = 0.02) -> list:
-    """Declare in ``efit`` (the extended fit the stand's refit rounds ended with; ``modes``: :func:`_mode_hz` after
-    each round) the located modes whose frequency is not known to ``tolerance`` once the stand's uncertainty is
-    counted (:func:`coupled_stderr`): :data:`FOUND_STDERR_FACTOR` standard errors with the stand free exceed it, the
-    fit's own rule for "found" (:func:`rwadist.extended_fit.fit_extended`).  Each is added to ``efit.unconstrained``
-    (``analytical.unconstrained``: every consumer warns) with a note giving both standard errors, its value kept.
-    Returns the names declared.
+def declare_coupled_modes(efit, tolerance: float = 0.02) -> list:
+    """Declare in ``efit`` the located modes the stand's refit rounds dragged along (``efit.coupled``,
+    :func:`coupled_stderr`) whose frequency, the stand's uncertainty counted, is not shown to be known to
+    ``tolerance``: :data:`FOUND_STDERR_FACTOR` of its standard-error bound with the stand free exceed it (the fit's
+    own rule for "found", :func:`rwadist.extended_fit.fit_extended`).  Each is added to ``efit.unconstrained``
+    (``analytical.unconstrained``: every consumer warns) with a note, its fitted value kept.  Returns the names
+    declared.  Called on the fit a caller keeps (``rwadist fit --extended``, :func:`rwadist.api.fit_extended`; the
+    ``suspension_modes`` of ``rwadist diagnose`` once it has decided which modes it located), not inside the rounds:
+    a declared mode is still located.
 
-    On a 2048-sample record through a 180 Hz stand with noisy force sensors (the robustness matrix): ρ 0.89, the
-    radial translation ±0.9 % with the stand fixed and ±2.7 % with it free, 2.9 % low after 25 rounds, nothing said."""
+    On a 2048-sample record through a 180 Hz stand with noisy force sensors (the robustness matrix, samples=2048+stand,
+    lever_arm_noise): ρ 0.89, the radial translation ±0.9 % with the stand fixed and up to ±2.7 % with it free, 2.9 %
+    low after the rounds (their fixed point, extrapolated, 2.4 % low), nothing said before."""
     out = []
-    for m, (rho, se_fixed, se_free) in coupled_stderr(modes, efit.rel_stderr).items():
+    for m, (rho, se_fixed, se_free) in (getattr(efit, "coupled", None) or {}).items():
         if m in efit.unconstrained or FOUND_STDERR_FACTOR * se_free <= tolerance:
             continue
         efit.unconstrained.append(m)
         efit.identified[{"axial": "axial_translation"}.get(m, m)] = False
+        k = FOUND_STDERR_FACTOR
         efit.notes.append(f"{m}: NOT CONSTRAINED beside the test stand: located at {_mode_hz(efit.params)[m]:.4g} Hz, "
-                          f"±{100 * se_fixed:.1f} % with the stand fixed but ±{100 * se_free:.1f} % with it free (the "
-                          f"stand's refit rounds moved it from {modes[0][m]:.4g} Hz at a ratio of {rho:.2f} a round: "
-                          "the stand and this mode are not told apart by these data); listed in analytical.unconstrained")
+                          f"to ±{100 * k * se_fixed:.1f} % ({k:g} standard errors) with the stand fixed but up to "
+                          f"±{100 * k * se_free:.1f} % with it free (the stand's refit rounds dragged it along at a ratio of "
+                          f"{rho:.2f} a round): the stand and this mode are not told apart to {100 * tolerance:g} % by "
+                          "these data; listed in analytical.unconstrained")
         out.append(m)
     return out
 
@@ -337,9 +342,9 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwa
     :data:`REFERENCE_SETTLED_LOG_SHAPE`) or :data:`REFERENCE_STAND_ROUNDS` rounds: the stand and the radial
     translation's mode are coupled, so a loosely settled stand leaves the mode pulled towards it.  It is dropped (the plain fit
     returned) when the residual confirms no resonance there, or when the fit with it locates fewer modes than
-    the fit without it.  A mode the rounds dragged along is declared unconstrained when its frequency, the stand's
-    uncertainty counted, is not known to the tolerance (:func:`declare_coupled_modes`).  The stand kept is in
-    ``ExtendedFit.stand`` and a note; it is not part of the wheel's
+    the fit without it.  The modes the rounds dragged along are recorded in ``ExtendedFit.coupled`` with their
+    standard errors (:func:`coupled_stderr`), for the caller to declare (:func:`declare_coupled_modes`).  The stand
+    kept is in ``ExtendedFit.stand`` and a note; it is not part of the wheel's
     model (``rwadist diagnose`` names it as a ``fixed_resonance`` of role test_stand).  ``stand_start``: the
     (f_r Hz, ζ, peak gain) to start the rounds from instead of :func:`stand_resonance_start`'s (the caller has
     checked that every channel is there)."""
@@ -369,7 +374,7 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwa
         efit, stand = _extrapolated_rounds(test, fit, efit, history, kwargs)
     if len(efit.unconstrained) > len(plain.unconstrained):
         return plain
-    declare_coupled_modes(efit, modes, kwargs.get("tolerance", 0.02))
+    efit.coupled = coupled_stderr(modes, efit.rel_stderr)
     efit.notes.append(f"test stand: a resonance at {stand[0]:.4g} Hz (ζ {stand[1]:.3g}, peak gain {stand[2]:.3g}) "
                       "lifts the lines of every channel: a fixture resonance, divided out of the lines before the "
                       "modes were fitted and not part of the wheel's model (analytical.fit.test_stand)")

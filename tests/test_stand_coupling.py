@@ -77,10 +77,11 @@ def test_a_mode_coupled_to_the_stand_is_declared(r, declared):
     last = _as_modes(lnf)[-1]
     k = {m: (2 * np.pi * last[m]) ** 2 for m in MODES}            # per unit mass and inertia: f = sqrt(k)/2π
     params = SimpleNamespace(k_r=k["radial_translation"], mass=1.0, k_rock=k["rocking"], I_rr=1.0, k_z=k["axial"])
-    efit = SimpleNamespace(params=params, unconstrained=[], notes=[],
-                           rel_stderr={"k_r": 2 * 0.009, "k_rock": 0.002, "k_z": 0.002},
+    rel = {"k_r": 2 * 0.009, "k_rock": 0.002, "k_z": 0.002}
+    efit = SimpleNamespace(params=params, unconstrained=[], notes=[], rel_stderr=rel,
+                           coupled=coupled_stderr(_as_modes(lnf), rel),
                            identified={"radial_translation": True, "rocking": True, "axial_translation": True})
-    out = declare_coupled_modes(efit, _as_modes(lnf), tolerance=0.02)
+    out = declare_coupled_modes(efit, tolerance=0.02)
     # 1.5 standard errors with the stand free against the 2 % tolerance: 1.5·0.9 %/sqrt(1 − r²) is 1.7 % at r 0.6
     # and 5.5 % at r 0.97
     assert (out == ["radial_translation"]) is declared
@@ -89,7 +90,32 @@ def test_a_mode_coupled_to_the_stand_is_declared(r, declared):
     if declared:
         (note,) = efit.notes
         assert note.startswith("radial_translation: NOT CONSTRAINED beside the test stand")
-        assert f"±{100 * scale * marginal:.1f} % with it free" in note
+        assert f"up to ±{100 * 1.5 * scale * marginal:.1f} % with it free" in note
         assert f"located at {last['radial_translation']:.4g} Hz" in note
     else:
         assert efit.notes == []
+
+
+def test_the_reference_fit_declares_what_the_rounds_recorded(monkeypatch):
+    """``rwadist fit --extended`` (:func:`rwadist.api.fit_extended`) declares the modes its stand rounds recorded as
+    dragged along (``ExtendedFit.coupled``) when 1.5 of their stand-free standard errors exceed 2 %, in the model
+    file's ``analytical.unconstrained`` and a note; a mode within the tolerance is not declared."""
+    import rwadist.stand_resonance as sr
+    from rwadist import api
+    from rwadist.presets import preset
+    from rwadist.teststand import simulate_steady
+
+    real = sr.fit_extended_beside_stand
+
+    def recorded(*args, **kwargs):
+        efit = real(*args, **kwargs)
+        efit.coupled = {"rocking": (0.95, 0.003, 0.0134), "axial": (0.5, 0.002, 0.0028)}
+        return efit
+
+    monkeypatch.setattr(sr, "fit_extended_beside_stand", recorded)
+    w = preset("ithaco-e")
+    test = simulate_steady(w, np.linspace(600.0, 2400.0, 12), sample_rate=1920.0, n_samples=4096, physics="extended",
+                           noise=0.01, seed=4)
+    efit, model = api.fit_extended(test, mass=w.mass_kg, radius=w.radius_m)
+    assert "rocking" in model.analytical["unconstrained"] and "axial" not in model.analytical["unconstrained"]
+    assert any(n.startswith("rocking: NOT CONSTRAINED beside the test stand") for n in model.analytical["fit"]["notes"])

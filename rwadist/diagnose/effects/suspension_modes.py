@@ -17,7 +17,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 # the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
-from ...stand_resonance import STAND_ROUNDS, declare_unsettled_modes, fit_extended_beside_stand, stand_resonance_start
+from ...stand_resonance import (
+    STAND_ROUNDS,
+    declare_coupled_modes,
+    declare_unsettled_modes,
+    fit_extended_beside_stand,
+    stand_resonance_start,
+)
 from ..engine import Context
 from ..state import State
 from .base import register, schema_entry
@@ -84,6 +90,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
+    coupled: dict = {}                  # the modes the stand's refit rounds dragged along (ExtendedFit.coupled)
     offset = None                       # a load-cell offset r (m) removed from the torques to locate the modes
     sp, detections = _fit_spectra(ctx, test, runs)
     fit = fit_empirical(sp, detections=detections)
@@ -108,7 +115,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             # at 187 Hz, gain 36 locates no mode, the rounds settle at 180.0 Hz, gain 5.0, all three found)
             efit_rounds = fit_extended_beside_stand(test, fit, stand_start=stand)
             if len(efit_rounds.unconstrained) < 3 and efit_rounds.stand is not None:
-                efit, stand = efit_rounds, tuple(efit_rounds.stand)
+                efit, stand, coupled = efit_rounds, tuple(efit_rounds.stand), efit_rounds.coupled
         before = None                   # the modes of the round before the last (with a stand divided out)
         for _ in range(STAND_ROUNDS):
             if len(efit.unconstrained) == 3 or len(ctx.channels) <= 3:
@@ -131,7 +138,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
                     # ``rwadist fit --extended`` does (its rounds from this stand; the fit without it when the
                     # residual shows none); radial translation -18.6 % -> -1.8 % there
                     efit = fit_extended_beside_stand(test, fit, stand_start=stand)
-                    stand, before = (None if efit.stand is None else tuple(efit.stand)), None
+                    stand, before, coupled = (None if efit.stand is None else tuple(efit.stand)), None, efit.coupled
                 break
             new = (new.f_r, new.zeta, new.peak_gain)
             settled = (stand is not None and abs(new[0] / stand[0] - 1) < 0.002
@@ -146,6 +153,12 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
         return None
     if len(efit.unconstrained) == 3:
         return None                     # no mode located: nothing to name
+    # the modes the stand's refit rounds dragged along, declared on the fit kept (after the choices above, which
+    # count located modes: a declared mode is located, its frequency not told apart from the stand's); kept when a
+    # later round refitted the modes with the stand diagnose measured on their base
+    if stand is not None and coupled:
+        efit.coupled = dict(coupled)
+        declare_coupled_modes(efit)
     return test, fit, efit, stand
 
 
