@@ -119,3 +119,43 @@ def test_the_reference_fit_declares_what_the_rounds_recorded(monkeypatch):
     efit, model = api.fit_extended(test, mass=w.mass_kg, radius=w.radius_m)
     assert "rocking" in model.analytical["unconstrained"] and "axial" not in model.analytical["unconstrained"]
     assert any(n.startswith("rocking: NOT CONSTRAINED beside the test stand") for n in model.analytical["fit"]["notes"])
+
+
+def _drift(ratios, first=0.01):
+    """ln f of a mode whose successive moves are ``first`` times the running products of ``ratios``."""
+    moves = first * np.cumprod(np.r_[1.0, ratios])
+    return np.log(200.0) + np.concatenate([[0.0], np.cumsum(moves)])
+
+
+def test_each_mode_reads_its_own_rate_and_standard_error():
+    # rocking and axial drift at different, geometric rates; their stand-fixed errors are half of k_rock's and k_z's
+    lnr, lnz = _drift([0.85, 0.9, 0.95]), _drift([0.5, 0.5, 0.5])
+    modes = [{"radial_translation": 220.0, "rocking": float(np.exp(r)), "axial": float(np.exp(z))}
+             for r, z in zip(lnr, lnz)]
+    got = coupled_stderr(modes, {"k_r": 0.01, "k_rock": 0.004, "k_z": 0.006})
+    assert set(got) == {"rocking", "axial"}
+    assert got["rocking"][0] == pytest.approx(0.9) and got["axial"][0] == pytest.approx(0.5)   # the mean ratio
+    assert got["rocking"][1] == pytest.approx(0.002) and got["axial"][1] == pytest.approx(0.003)
+    assert got["rocking"][2] == pytest.approx(0.002 / np.sqrt(0.1))
+    # a drift that grows (ratios above 1) is no convergence: no rate
+    assert coupled_stderr(_as_modes(_drift([1.05, 1.1, 1.15])), {"k_r": 0.002}) == {}
+
+
+def _efit(coupled, unconstrained=()):
+    k = {m: (2 * np.pi * f) ** 2 for m, f in (("radial_translation", 220.0), ("rocking", 55.0), ("axial", 70.0))}
+    params = SimpleNamespace(k_r=k["radial_translation"], mass=1.0, k_rock=k["rocking"], I_rr=1.0, k_z=k["axial"])
+    return SimpleNamespace(params=params, unconstrained=list(unconstrained), notes=[], rel_stderr={}, coupled=coupled,
+                           identified={"radial_translation": True, "rocking": True, "axial_translation": True})
+
+
+def test_declared_at_one_and_a_half_bounds_over_the_tolerance():
+    # 1.5 × 1.6 % = 2.4 % > 2 %: declared; 1.5 × 1.3 % = 1.95 %: not (at 1 standard error both would pass)
+    efit = _efit({"axial": (0.9, 0.005, 0.016), "rocking": (0.9, 0.004, 0.013)})
+    assert declare_coupled_modes(efit, tolerance=0.02) == ["axial"]
+    assert efit.unconstrained == ["axial"] and efit.identified["axial_translation"] is False
+    assert efit.identified["rocking"] is True
+    (note,) = efit.notes
+    assert note.startswith("axial: NOT CONSTRAINED") and "up to ±2.4 % with it free" in note and "70 Hz" in note
+    # a mode already declared (by the fit or another rule) is not declared twice
+    again = _efit({"rocking": (0.95, 0.01, 0.045)}, unconstrained=["rocking"])
+    assert declare_coupled_modes(again) == [] and again.notes == [] and again.unconstrained == ["rocking"]
