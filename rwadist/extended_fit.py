@@ -56,6 +56,17 @@ SENSE_CHUNK_SAMPLES = 1 << 20
 RADIAL = ("radial_force", "radial_torque")
 #: mode key of the fit -> its name in the model file's ``analytical.unconstrained``
 UNCONSTRAINED_NAME = {"radial_translation": "radial_translation", "rocking": "rocking", "axial_translation": "axial"}
+#: ... and back: a name of ``analytical.unconstrained`` -> the fit's mode key (``identified``, ``scans``)
+MODE_KEY = {name: key for key, name in UNCONSTRAINED_NAME.items()}
+
+
+def declare_mode(efit, name: str, note: str) -> None:
+    """Declare the located mode ``name`` (as in ``analytical.unconstrained``: "radial_translation", "rocking",
+    "axial") of the extended fit ``efit`` not constrained by the data: listed in ``efit.unconstrained`` (every consumer
+    warns), no longer ``identified``, ``note`` added to its notes; its fitted value is kept."""
+    efit.unconstrained.append(name)
+    efit.identified[MODE_KEY[name]] = False
+    efit.notes.append(note)
 
 
 @dataclass

@@ -91,8 +91,8 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
     term: 512 rather than 128 (more numpy calls per f0 on the small grids of a few lines) or 1024 (more memory
     traffic), measured on the 450 scans of four diagnoses: 12-14 % less CPU than 128, the same numbers (each f0's
     sums are the same operations on the same rows).  The per-row terms u, v (each sense's |T|²·Ω⁴/power), their
-    squares and product are written into one buffer allocated once (fresh temporaries of this size cost a page-fault pass
-    each) and summed per line by one segment sum."""
+    squares and product are written into one buffer allocated once (fresh temporaries of this size cost a
+    page-fault pass each) and summed per line by one segment sum."""
     f0_grid, zeta_grid, a_grid = (np.asarray(x, float) for x in (f0_grid, zeta_grid, a_grid))
     order = np.argsort(line, kind="stable")
     line_s = np.asarray(line)[order]

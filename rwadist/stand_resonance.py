@@ -235,16 +235,16 @@ def declare_unsettled_modes(before, after) -> list:
     settled), so the mode's frequency is not known to the 2 % its standard error claims.  Each is added to
     ``after.unconstrained`` (``analytical.unconstrained``: every consumer warns) with a note giving both values, its
     value kept as the last round's.  Returns the names declared."""
+    from .extended_fit import declare_mode
+
     f0, f1 = _mode_hz(before.params), _mode_hz(after.params)
     out = []
     for m in ("radial_translation", "rocking", "axial"):
         if m in after.unconstrained or m in before.unconstrained or abs(f1[m] / f0[m] - 1) <= STAND_SETTLED_MODE:
             continue
-        after.unconstrained.append(m)
-        after.identified[{"axial": "axial_translation"}.get(m, m)] = False
-        after.notes.append(f"{m}: NOT CONSTRAINED beside the test stand: it moved from {f0[m]:.4g} to {f1[m]:.4g} Hz "
-                           f"in the last round of the stand's refit (more than {100 * STAND_SETTLED_MODE:g} %): the "
-                           "stand and this mode are not told apart by these data; listed in analytical.unconstrained")
+        declare_mode(after, m, f"{m}: NOT CONSTRAINED beside the test stand: it moved from {f0[m]:.4g} to "
+                     f"{f1[m]:.4g} Hz in the last round of the stand's refit (more than {100 * STAND_SETTLED_MODE:g} %): "
+                     "the stand and this mode are not told apart by these data; listed in analytical.unconstrained")
         out.append(m)
     return out
 
@@ -314,18 +314,18 @@ def declare_coupled_modes(efit, tolerance: float = 0.02) -> list:
     On a 2048-sample record through a 180 Hz stand with noisy force sensors (the robustness matrix, samples=2048+stand,
     lever_arm_noise): ρ 0.89, the radial translation ±0.9 % with the stand fixed and up to ±2.7 % with it free, 2.9 %
     low after the rounds (their fixed point, extrapolated, 2.4 % low), nothing said before."""
+    from .extended_fit import declare_mode
+
     out = []
-    for m, (rho, se_fixed, se_free) in (getattr(efit, "coupled", None) or {}).items():
-        if m in efit.unconstrained or FOUND_STDERR_FACTOR * se_free <= tolerance:
+    k = FOUND_STDERR_FACTOR
+    for m, (rho, se_fixed, se_free) in efit.coupled.items():
+        if m in efit.unconstrained or k * se_free <= tolerance:
             continue
-        efit.unconstrained.append(m)
-        efit.identified[{"axial": "axial_translation"}.get(m, m)] = False
-        k = FOUND_STDERR_FACTOR
-        efit.notes.append(f"{m}: NOT CONSTRAINED beside the test stand: located at {_mode_hz(efit.params)[m]:.4g} Hz, "
-                          f"to ±{100 * k * se_fixed:.1f} % ({k:g} standard errors) with the stand fixed but up to "
-                          f"±{100 * k * se_free:.1f} % with it free (the stand's refit rounds dragged it along at a ratio of "
-                          f"{rho:.2f} a round): the stand and this mode are not told apart to {100 * tolerance:g} % by "
-                          "these data; listed in analytical.unconstrained")
+        declare_mode(efit, m, f"{m}: NOT CONSTRAINED beside the test stand: located at "
+                     f"{_mode_hz(efit.params)[m]:.4g} Hz, to ±{100 * k * se_fixed:.1f} % ({k:g} standard errors) with "
+                     f"the stand fixed but up to ±{100 * k * se_free:.1f} % with it free (the stand's refit rounds "
+                     f"dragged it along at a ratio of {rho:.2f} a round): the stand and this mode are not told apart "
+                     f"to {100 * tolerance:g} % by these data; listed in analytical.unconstrained")
         out.append(m)
     return out
 
@@ -344,9 +344,9 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwa
     returned) when the residual confirms no resonance there, or when the fit with it locates fewer modes than
     the fit without it.  The modes the rounds dragged along are recorded in ``ExtendedFit.coupled`` with their
     standard errors (:func:`coupled_stderr`), for the caller to declare (:func:`declare_coupled_modes`).  The stand
-    kept is in ``ExtendedFit.stand`` and a note; it is not part of the wheel's
-    model (``rwadist diagnose`` names it as a ``fixed_resonance`` of role test_stand).  ``stand_start``: the
-    (f_r Hz, ζ, peak gain) to start the rounds from instead of :func:`stand_resonance_start`'s (the caller has
+    kept is in ``ExtendedFit.stand`` and a note; it is not part of the wheel's model (``rwadist diagnose`` names it
+    as a ``fixed_resonance`` of role test_stand).  ``stand_start``: the (f_r Hz, ζ, peak gain) to start the rounds
+    from instead of :func:`stand_resonance_start`'s (the caller has
     checked that every channel is there)."""
     from .extended_fit import fit_extended
 

@@ -373,7 +373,7 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
 
     from ...data import SteadyTest
     from ...empirical import fit_empirical
-    from ...extended_fit import fit_extended
+    from ...extended_fit import MODE_KEY, fit_extended
     from ...stand_resonance import STAND_SETTLED_MODE, _mode_hz
 
     modes = next((e for e in state.effects if e.kind == "suspension_modes"), None)
@@ -416,5 +416,5 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
         ident = fit_doc.get("identified")
         if isinstance(ident, dict):
             for m in moved:
-                ident[{"axial": "axial_translation"}.get(m, m)] = False
+                ident[MODE_KEY[m]] = False
     return out
