@@ -340,7 +340,9 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwa
     refitted on the residual of the modes' fit (:func:`stand_on_modes`) and the modes refitted with it, until it
     settles (a round moves ln f_r less than :data:`REFERENCE_SETTLED_LOG_F`, ln ζ and ln g less than
     :data:`REFERENCE_SETTLED_LOG_SHAPE`) or :data:`REFERENCE_STAND_ROUNDS` rounds: the stand and the radial
-    translation's mode are coupled, so a loosely settled stand leaves the mode pulled towards it.  It is dropped (the plain fit
+    translation's mode are coupled, so a loosely settled stand leaves the mode pulled towards it.  Once the stand
+    has moved :data:`COUPLED_MOVES` times at one rate the rounds jump to their limit (:func:`_aitken_step`, kept when
+    :func:`_checked_limit` confirms it) and go on from there.  It is dropped (the plain fit
     returned) when the residual confirms no resonance there, or when the fit with it locates fewer modes than
     the fit without it.  The modes the rounds dragged along are recorded in ``ExtendedFit.coupled`` with their
     standard errors (:func:`coupled_stderr`), for the caller to declare (:func:`declare_coupled_modes`).  The stand
@@ -356,8 +358,10 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwa
         return fit_extended(test, fit, **kwargs)
     plain = fit_extended(test, fit, **kwargs)
     efit = fit_extended(test, fit, stand=stand, **kwargs)
-    history = [stand]
-    modes = [_mode_hz(efit.params)]               # the located modes after each round
+    history = [stand]                             # the stand of each round, since the start or the last jump
+    modes = [_mode_hz(efit.params)]               # the located modes after each round, likewise
+    drift = None                                  # the modes of the rounds before the first jump
+    refused_at = 0                                # the round of the last limit refused by its check
     for _ in range(REFERENCE_STAND_ROUNDS):
         new = stand_on_modes(efit, stand[0])
         if new is None:
@@ -370,11 +374,22 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwa
         modes.append(_mode_hz(efit.params))
         if settled:
             break
+        aitken = _aitken_step(history, COUPLED_MOVES) if len(history) > refused_at + COUPLED_MOVES else None
+        jump = None if aitken is None else _checked_limit(test, fit, aitken[0], history, kwargs)
+        if aitken is not None and jump is None:
+            refused_at = len(history) - 1         # not asked again before as many new rounds
+        if jump is not None:
+            # the rounds converge geometrically: on to their limit (25 rounds at a ratio of 0.91 a round are 5 and
+            # the jump), and the rounds go on from there; the drift before the jump is what measures each mode's
+            # coupling to the stand (coupled_stderr)
+            drift = modes if drift is None else drift
+            efit, stand = jump, aitken[0]
+            history, modes, refused_at = [stand], [_mode_hz(efit.params)], 0
     else:
         efit, stand = _extrapolated_rounds(test, fit, efit, history, kwargs)
     if len(efit.unconstrained) > len(plain.unconstrained):
         return plain
-    efit.coupled = coupled_stderr(modes, efit.rel_stderr)
+    efit.coupled = coupled_stderr(modes if drift is None else drift, efit.rel_stderr)
     efit.notes.append(f"test stand: a resonance at {stand[0]:.4g} Hz (ζ {stand[1]:.3g}, peak gain {stand[2]:.3g}) "
                       "lifts the lines of every channel: a fixture resonance, divided out of the lines before the "
                       "modes were fitted and not part of the wheel's model (analytical.fit.test_stand)")
@@ -388,31 +403,61 @@ EXTRAPOLATE_MAX_RATIO = 0.98
 
 def _extrapolated_rounds(test, fit, efit, history, kwargs):
     """(ExtendedFit, stand) after :data:`REFERENCE_STAND_ROUNDS` rounds that did not settle: the rounds' limit
-    (Aitken's Δ² of the last three stands, each of ln f_r, ln ζ, ln g still moving alike) when a fit with that stand
-    divided out is closer to a fixed point of the rounds (its stand on the residual moves less than the last
-    round did), else ``efit`` and the last stand.
+    (:func:`_aitken_step` of the last three stands) when a fit with that stand divided out is closer to a fixed point
+    of the rounds (:func:`_checked_limit`), else ``efit`` and the last stand.
 
     The stand and the radial translation are coupled: when the stand's start is well below its gain, each round
     removes only a small part of what is left (a ratio of ~0.9 per round on a 2048-sample record: after 25 rounds the
     gain 4.88 of 5, the translation 1.8 % low and still moving 0.1 % a round)."""
-    from .extended_fit import fit_extended
-
     stand = history[-1]
-    if len(history) < 3:
+    step = _aitken_step(history)
+    efit_limit = None if step is None else _checked_limit(test, fit, step[0], history, kwargs)
+    if efit_limit is None:
         return efit, stand
-    x = np.log(np.asarray(history[-3:], dtype=float))
-    d1, d2 = x[1] - x[0], x[2] - x[1]
+    limit, ratio = step
+    efit_limit.notes.append(f"test stand: the refit rounds had not settled after {REFERENCE_STAND_ROUNDS} (stand "
+                            f"{stand[0]:.4g} Hz, ζ {stand[1]:.3g}, gain {stand[2]:.3g}, moving by a ratio up to "
+                            f"{ratio:.2f} a round): their limit (Aitken Δ²) taken")
+    return efit_limit, limit
+
+
+def _aitken_step(history, geometric_moves: int = 2):
+    """(limit stand, largest ratio) of the stand's refit rounds ``history`` (the stand of each round, (f_r Hz, ζ,
+    peak gain)), or None when the rounds do not converge geometrically.
+
+    The limit is Aitken's Δ² of the last three stands, each of ln f_r, ln ζ, ln g still moving (beyond the settle
+    steps :data:`REFERENCE_SETTLED_LOG_F`, :data:`REFERENCE_SETTLED_LOG_SHAPE`) at a ratio in (0,
+    :data:`EXTRAPOLATE_MAX_RATIO`) of the round before.  With ``geometric_moves`` > 2, each moving component's last
+    ``geometric_moves`` moves must also be of one sign with ratios within :data:`COUPLED_RATIO_SPREAD` of each other:
+    a rate the rounds keep, not noise (the test of :func:`coupled_stderr`)."""
+    moves = max(geometric_moves, 2)
+    if len(history) < moves + 1:
+        return None
+    x = np.log(np.asarray(history[-(moves + 1):], dtype=float))
+    d = np.diff(x, axis=0)
+    d1, d2 = d[-2], d[-1]
     moving = np.abs(d2) >= np.array([REFERENCE_SETTLED_LOG_F] + 2 * [REFERENCE_SETTLED_LOG_SHAPE])
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(moving, d2 / d1, 0.0)
+        ratios = d[1:] / d[:-1]
     if not moving.any() or np.any(moving & ~((ratio > 0) & (ratio < EXTRAPOLATE_MAX_RATIO))):
-        return efit, stand
-    limit = tuple(float(v) for v in np.exp(x[2] + d2 * ratio / (1 - ratio)))
+        return None
+    if moves > 2:
+        steady = (np.all(d > 0, axis=0) | np.all(d < 0, axis=0)) & (np.ptp(ratios, axis=0) <= COUPLED_RATIO_SPREAD)
+        if np.any(moving & ~steady):
+            return None
+    return tuple(float(v) for v in np.exp(x[-1] + d2 * ratio / (1 - ratio))), float(np.max(ratio))
+
+
+def _checked_limit(test, fit, limit, history, kwargs):
+    """The extended fit with the stand ``limit`` (:func:`_aitken_step` of the rounds ``history``) divided out, or None
+    when the stand it leaves on the residual (:func:`stand_on_modes`) moves from ``limit`` as much as the last round
+    moved or more (the limit is no closer to a fixed point of the rounds)."""
+    from .extended_fit import fit_extended
+
     efit_limit = fit_extended(test, fit, stand=limit, **kwargs)
     check = stand_on_modes(efit_limit, limit[0])
-    if check is None or np.max(np.abs(np.log(np.asarray(check) / np.asarray(limit)))) >= np.max(np.abs(d2)):
-        return efit, stand
-    efit_limit.notes.append(f"test stand: the refit rounds had not settled after {REFERENCE_STAND_ROUNDS} (stand "
-                            f"{stand[0]:.4g} Hz, ζ {stand[1]:.3g}, gain {stand[2]:.3g}, moving by a ratio up to "
-                            f"{float(np.max(ratio)):.2f} a round): their limit (Aitken Δ²) taken")
-    return efit_limit, limit
+    last = np.abs(np.log(np.asarray(history[-1], dtype=float) / np.asarray(history[-2], dtype=float)))
+    if check is None or np.max(np.abs(np.log(np.asarray(check) / np.asarray(limit)))) >= np.max(last):
+        return None
+    return efit_limit
