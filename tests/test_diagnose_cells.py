@@ -21,6 +21,7 @@ from scipy import signal
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import independent_wheel as iw  # noqa: E402
+from conftest import read_only  # noqa: E402
 
 from rwadist import api  # noqa: E402
 from rwadist.data import Run, SteadyTest  # noqa: E402
@@ -64,11 +65,7 @@ def _reference(test):
 @functools.lru_cache(maxsize=None)
 def shared_stand_test(speeds_rpm: tuple, seed: int, n_samples: int = 8192, stand: bool = True):
     """:func:`iir_stand_test` of ``speeds_rpm`` (a tuple), built once per test process; its samples are read-only."""
-    test = iir_stand_test(np.asarray(speeds_rpm), seed, n_samples=n_samples, stand=stand)
-    for run in test.runs:
-        for x in run.signals.values():
-            x.flags.writeable = False
-    return test
+    return read_only(iir_stand_test(np.asarray(speeds_rpm), seed, n_samples=n_samples, stand=stand))
 
 
 @functools.lru_cache(maxsize=None)
