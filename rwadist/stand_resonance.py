@@ -258,7 +258,7 @@ COUPLED_RATIO_SPREAD = 0.1
 FOUND_STDERR_FACTOR = 1.5
 
 
-def coupled_stderr(modes: list, rel_stderr: dict) -> dict:
+def coupled_stderr(modes: list, rel_stderr: dict, total: dict | None = None) -> dict:
     """Standard errors of the located modes' frequencies with the stand free, from the stand's refit rounds.
 
     The rounds alternate two least squares, the modes with the stand fixed and the stand with the modes fixed.  On a
@@ -266,8 +266,8 @@ def coupled_stderr(modes: list, rel_stderr: dict) -> dict:
     largest canonical correlation between the two blocks, and a parameter's marginal variance is at most 1/(1 − ρ)
     times its variance with the other block fixed (the Schur complement; equal for a parameter along the coupled
     direction).  A mode whose frequency drifts geometrically over the last :data:`COUPLED_MOVES` rounds (one sign,
-    ratios in (0, 1) within :data:`COUPLED_RATIO_SPREAD` of each other) by more than its standard error in all is
-    taken as dragged by the stand, and gets that bound.  The bound is conservative for a mode only weakly coupled:
+    ratios in (0, 1) within :data:`COUPLED_RATIO_SPREAD` of each other), and by more than its standard error over all
+    the rounds, is taken as dragged by the stand, and gets that bound.  The bound is conservative for a mode only weakly coupled:
     the stand of a reference fit that divided out one resonance where there were two (150 and 180 Hz, 2048 samples)
     dragged all three modes along at ρ 0.93, and all three are declared (the translation 18 % low, rocking and axial
     within 0.2 %).
@@ -276,6 +276,10 @@ def coupled_stderr(modes: list, rel_stderr: dict) -> dict:
         :func:`_mode_hz` after each round (Hz by mode name), first to last.
     rel_stderr : dict
         :attr:`ExtendedFit.rel_stderr` of the last round (relative standard errors of k_r, k_rock, k_z, stand fixed).
+    total : dict, optional
+        mode name -> its whole drift over the rounds, ln(f_last / f_first), for the drift rule when ``modes`` are only
+        the rounds before a jump to their limit (:func:`fit_extended_beside_stand`); default: ln(f_last / f_first)
+        of ``modes``.
 
     Returns
     -------
@@ -294,7 +298,8 @@ def coupled_stderr(modes: list, rel_stderr: dict) -> dict:
         if not (np.all(ratios < 1.0) and np.ptp(ratios) <= COUPLED_RATIO_SPREAD):
             continue
         se_fixed = 0.5 * float(rel_stderr.get(key, np.nan))      # of f = sqrt(k/m)/2π: half of k's
-        if not (np.isfinite(se_fixed) and abs(lf[-1] - lf[0]) > se_fixed):
+        drift = lf[-1] - lf[0] if total is None else total[m]
+        if not (np.isfinite(se_fixed) and abs(drift) > se_fixed):
             continue
         rho = float(np.mean(ratios))
         out[m] = (rho, se_fixed, se_fixed / float(np.sqrt(1.0 - rho)))
@@ -312,8 +317,8 @@ def declare_coupled_modes(efit, tolerance: float = 0.02) -> list:
     a declared mode is still located.
 
     On a 2048-sample record through a 180 Hz stand with noisy force sensors (the robustness matrix, samples=2048+stand,
-    lever_arm_noise): ρ 0.89, the radial translation ±0.9 % with the stand fixed and up to ±2.7 % with it free, 2.9 %
-    low after the rounds (their fixed point, extrapolated, 2.4 % low), nothing said before."""
+    lever_arm_noise): ρ 0.91, the radial translation ±0.9 % with the stand fixed and up to ±3.1 % with it free (one
+    standard error), 221.3 Hz, 2.8 % low; nothing was said before."""
     from .extended_fit import declare_mode
 
     out = []
@@ -360,9 +365,10 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwa
     efit = fit_extended(test, fit, stand=stand, **kwargs)
     history = [stand]                             # the stand of each round, since the start or the last jump
     modes = [_mode_hz(efit.params)]               # the located modes after each round, likewise
+    first = modes[0]
     drift = None                                  # the modes of the rounds before the first jump
-    refused_at = 0                                # the round of the last limit refused by its check
-    for _ in range(REFERENCE_STAND_ROUNDS):
+    refusals, refused_at = 0, 0                   # limits refused by their check; the round of the last
+    for k in range(REFERENCE_STAND_ROUNDS):
         new = stand_on_modes(efit, stand[0])
         if new is None:
             return plain                          # not confirmed on the modes' base: no stand
@@ -374,14 +380,17 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwa
         modes.append(_mode_hz(efit.params))
         if settled:
             break
-        aitken = _aitken_step(history, COUPLED_MOVES) if len(history) > refused_at + COUPLED_MOVES else None
+        # a limit is asked for while rounds are left (the last one's is _extrapolated_rounds'), at most twice in vain,
+        # and not again before as many new rounds as it needs
+        ask = k < REFERENCE_STAND_ROUNDS - 1 and refusals < 2 and len(history) > refused_at + COUPLED_MOVES
+        aitken = _aitken_step(history, COUPLED_MOVES) if ask else None
         jump = None if aitken is None else _checked_limit(test, fit, aitken[0], history, kwargs)
         if aitken is not None and jump is None:
-            refused_at = len(history) - 1         # not asked again before as many new rounds
+            refusals, refused_at = refusals + 1, len(history) - 1
         if jump is not None:
-            # the rounds converge geometrically: on to their limit (25 rounds at a ratio of 0.91 a round are 5 and
-            # the jump), and the rounds go on from there; the drift before the jump is what measures each mode's
-            # coupling to the stand (coupled_stderr)
+            # the rounds converge geometrically: on to their limit (the 25 rounds a ratio of 0.9 a round needs to
+            # settle become about 10 fits), and the rounds go on from there; each mode's rate of drift is read from the
+            # rounds before the jump (coupled_stderr)
             drift = modes if drift is None else drift
             efit, stand = jump, aitken[0]
             history, modes, refused_at = [stand], [_mode_hz(efit.params)], 0
@@ -389,7 +398,9 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, **kwa
         efit, stand = _extrapolated_rounds(test, fit, efit, history, kwargs)
     if len(efit.unconstrained) > len(plain.unconstrained):
         return plain
-    efit.coupled = coupled_stderr(modes if drift is None else drift, efit.rel_stderr)
+    last = _mode_hz(efit.params)
+    efit.coupled = coupled_stderr(modes, efit.rel_stderr) if drift is None else \
+        coupled_stderr(drift, efit.rel_stderr, total={m: float(np.log(last[m] / first[m])) for m in first})
     efit.notes.append(f"test stand: a resonance at {stand[0]:.4g} Hz (ζ {stand[1]:.3g}, peak gain {stand[2]:.3g}) "
                       "lifts the lines of every channel: a fixture resonance, divided out of the lines before the "
                       "modes were fitted and not part of the wheel's model (analytical.fit.test_stand)")
@@ -402,7 +413,8 @@ EXTRAPOLATE_MAX_RATIO = 0.98
 
 
 def _extrapolated_rounds(test, fit, efit, history, kwargs):
-    """(ExtendedFit, stand) after :data:`REFERENCE_STAND_ROUNDS` rounds that did not settle: the rounds' limit
+    """(ExtendedFit, stand) after :data:`REFERENCE_STAND_ROUNDS` rounds that did not settle (``history``: the stands
+    since the last jump to a limit, if any): the rounds' limit
     (:func:`_aitken_step` of the last three stands) when a fit with that stand divided out is closer to a fixed point
     of the rounds (:func:`_checked_limit`), else ``efit`` and the last stand.
 
@@ -422,14 +434,27 @@ def _extrapolated_rounds(test, fit, efit, history, kwargs):
 
 
 def _aitken_step(history, geometric_moves: int = 2):
-    """(limit stand, largest ratio) of the stand's refit rounds ``history`` (the stand of each round, (f_r Hz, ζ,
-    peak gain)), or None when the rounds do not converge geometrically.
+    """The limit of the stand's refit rounds by Aitken's Δ² of their last three stands, or None when the rounds do not
+    converge geometrically.
 
-    The limit is Aitken's Δ² of the last three stands, each of ln f_r, ln ζ, ln g still moving (beyond the settle
-    steps :data:`REFERENCE_SETTLED_LOG_F`, :data:`REFERENCE_SETTLED_LOG_SHAPE`) at a ratio in (0,
-    :data:`EXTRAPOLATE_MAX_RATIO`) of the round before.  With ``geometric_moves`` > 2, each moving component's last
-    ``geometric_moves`` moves must also be of one sign with ratios within :data:`COUPLED_RATIO_SPREAD` of each other:
-    a rate the rounds keep, not noise (the test of :func:`coupled_stderr`)."""
+    Each of ln f_r, ln ζ, ln g still moving in the last round (beyond the settle steps
+    :data:`REFERENCE_SETTLED_LOG_F`, :data:`REFERENCE_SETTLED_LOG_SHAPE`) must move at a ratio in (0,
+    :data:`EXTRAPOLATE_MAX_RATIO`) of the round before, and with ``geometric_moves`` > 2 so must each of its last
+    ``geometric_moves`` moves, the ratios within :data:`COUPLED_RATIO_SPREAD` of each other: a rate the rounds keep,
+    not noise (the test of :func:`coupled_stderr`).  A component not moving is kept at its last value.
+
+    Parameters
+    ----------
+    history : list of tuple
+        The stand (f_r Hz, ζ, peak gain) of each round, first to last.
+    geometric_moves : int
+        Moves the rate is read over (2: the last ratio only, the end-of-rounds use).
+
+    Returns
+    -------
+    tuple or None
+        ((f_r Hz, ζ, peak gain) of the limit, the largest of the moving components' last ratios), or None.
+    """
     moves = max(geometric_moves, 2)
     if len(history) < moves + 1:
         return None
@@ -443,16 +468,19 @@ def _aitken_step(history, geometric_moves: int = 2):
     if not moving.any() or np.any(moving & ~((ratio > 0) & (ratio < EXTRAPOLATE_MAX_RATIO))):
         return None
     if moves > 2:
-        steady = (np.all(d > 0, axis=0) | np.all(d < 0, axis=0)) & (np.ptp(ratios, axis=0) <= COUPLED_RATIO_SPREAD)
-        if np.any(moving & ~steady):
+        # every ratio in range (so every move of one sign), and within the spread of each other
+        kept = np.all((ratios > 0) & (ratios < EXTRAPOLATE_MAX_RATIO), axis=0) \
+            & (np.ptp(ratios, axis=0) <= COUPLED_RATIO_SPREAD)
+        if np.any(moving & ~kept):
             return None
     return tuple(float(v) for v in np.exp(x[-1] + d2 * ratio / (1 - ratio))), float(np.max(ratio))
 
 
 def _checked_limit(test, fit, limit, history, kwargs):
-    """The extended fit with the stand ``limit`` (:func:`_aitken_step` of the rounds ``history``) divided out, or None
-    when the stand it leaves on the residual (:func:`stand_on_modes`) moves from ``limit`` as much as the last round
-    moved or more (the limit is no closer to a fixed point of the rounds)."""
+    """The extended fit of ``test`` (empirical fit ``fit``, ``kwargs`` passed on) with the stand ``limit`` (f_r Hz, ζ,
+    peak gain; :func:`_aitken_step` of the rounds ``history``) divided out, or None when the stand that fit leaves on
+    the residual (:func:`stand_on_modes`) is no closer to ``limit`` than the last round's stand was to the one before
+    (in the largest of ln f_r, ln ζ, ln g): the limit is then no closer to a fixed point of the rounds."""
     from .extended_fit import fit_extended
 
     efit_limit = fit_extended(test, fit, stand=limit, **kwargs)
