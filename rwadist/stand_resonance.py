@@ -258,6 +258,16 @@ COUPLED_RATIO_SPREAD = 0.1
 FOUND_STDERR_FACTOR = 1.5
 
 
+def _keeps_rate(moves: np.ndarray, max_ratio: float):
+    """True where successive ``moves`` (along axis 0: a drift's steps, one column per quantity) keep one rate: every
+    ratio of a move to the one before in (0, ``max_ratio``) -- so every move of one sign -- and the ratios within
+    :data:`COUPLED_RATIO_SPREAD` of each other.  The geometric-drift rule of :func:`coupled_stderr` (a mode dragged
+    by the stand) and of :func:`_aitken_step` (rounds converging to a limit)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = moves[1:] / moves[:-1]
+        return np.all((ratios > 0) & (ratios < max_ratio), axis=0) & (np.ptp(ratios, axis=0) <= COUPLED_RATIO_SPREAD)
+
+
 def coupled_stderr(modes: list, rel_stderr: dict, total: dict | None = None) -> dict:
     """Standard errors of the located modes' frequencies with the stand free, from the stand's refit rounds.
 
@@ -292,11 +302,9 @@ def coupled_stderr(modes: list, rel_stderr: dict, total: dict | None = None) -> 
     for m, key in (("radial_translation", "k_r"), ("rocking", "k_rock"), ("axial", "k_z")):
         lf = np.log([h[m] for h in modes])
         d = np.diff(lf)[-COUPLED_MOVES:]
-        if not (np.all(d > 0) or np.all(d < 0)):
+        if not _keeps_rate(d, 1.0):
             continue
         ratios = d[1:] / d[:-1]
-        if not (np.all(ratios < 1.0) and np.ptp(ratios) <= COUPLED_RATIO_SPREAD):
-            continue
         se_fixed = 0.5 * float(rel_stderr.get(key, np.nan))      # of f = sqrt(k/m)/2π: half of k's
         drift = lf[-1] - lf[0] if total is None else total[m]
         if not (np.isfinite(se_fixed) and abs(drift) > se_fixed):
@@ -464,15 +472,10 @@ def _aitken_step(history, geometric_moves: int = 2):
     moving = np.abs(d2) >= np.array([REFERENCE_SETTLED_LOG_F] + 2 * [REFERENCE_SETTLED_LOG_SHAPE])
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(moving, d2 / d1, 0.0)
-        ratios = d[1:] / d[:-1]
     if not moving.any() or np.any(moving & ~((ratio > 0) & (ratio < EXTRAPOLATE_MAX_RATIO))):
         return None
-    if moves > 2:
-        # every ratio in range (so every move of one sign), and within the spread of each other
-        kept = np.all((ratios > 0) & (ratios < EXTRAPOLATE_MAX_RATIO), axis=0) \
-            & (np.ptp(ratios, axis=0) <= COUPLED_RATIO_SPREAD)
-        if np.any(moving & ~kept):
-            return None
+    if moves > 2 and np.any(moving & ~_keeps_rate(d, EXTRAPOLATE_MAX_RATIO)):
+        return None
     return tuple(float(v) for v in np.exp(x[-1] + d2 * ratio / (1 - ratio))), float(np.max(ratio))
 
 
