@@ -87,6 +87,7 @@ import numpy as np
 
 from . import extended as ext
 from .data import Run, SteadyTest, Sweep
+from .dft import unit_phasors
 from .model import Harmonic, WheelModel
 from .resonance import resonance_response
 from .units import CHANNELS, DIRECTION_CHANNELS, rad_s_to_hz, rad_s_to_rpm, rpm_to_rad_s
@@ -441,8 +442,10 @@ def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 38
             if not keep.any() or omega == 0.0:
                 continue
             amp = (C * omega**2)[keep]
-            # exp(j(h ψ + α)), ψ = Ω t: (n_lines × n_samples) complex
-            carrier = np.exp(1j * (np.outer(h[keep] * omega, t) + alpha[keep, None]))
+            # exp(j(h ψ + α)), ψ = Ω t: (n_lines × n_samples) complex, e^{jhΩt} as a product of two small tables of
+            # exponentials (rwadist.dft.unit_phasors: the same numbers to rounding, 5x faster than one exp per sample)
+            carrier = unit_phasors(-h[keep] * omega / (2.0 * np.pi), 1.0 / sample_rate, t.size) \
+                * np.exp(1j * alpha[keep])[:, None]
             for i, ch in enumerate(chans):
                 g = _line_gain(ch_modes[ch], f_line[keep], omega)
                 c = amp if g is None else amp * (g if omega > 0 else np.conj(g))
@@ -543,7 +546,7 @@ def _steady_extended(wheel, speeds, omegas, t, sample_rate, noise, test_stand, s
         if fixture:
             A = A * _fixture_gain(fixture, f)
         A = A[keep]
-        z = A.T @ np.exp(2j * np.pi * np.outer(f[keep], t))  # (6, n_samples)
+        z = A.T @ unit_phasors(-f[keep], 1.0 / sample_rate, t.size)   # (6, n_samples): Σ A e^{2πj f t}
         signals = {ch: z[i].real.copy() for i, ch in enumerate(CHANNELS)}
         _add_noise(signals, noise_std, noise_rng)
         runs.append(Run(speed=float(omega), sample_rate=float(sample_rate), signals=signals, t0=0.0,
