@@ -98,11 +98,12 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
         return None
     try:
         efit, stand = _locate(ctx, test, fit, stand_start)
-        if (efit.unconstrained or stand is not None) and len(ctx.channels) == 6:
+        if efit.unconstrained and len(ctx.channels) == 6:
             # a load-cell offset (T_measured = T + r × F) puts the forces' lines, amplified by the translation mode,
             # into the torques (where they also pass for a fixture resonance lifting every direction at that mode):
             # the modes are located on the torques corrected for it when that locates more of them (the offset
-            # itself is left to the search: a ``cross_coupling`` on the modes' base)
+            # itself is left to the search: a ``cross_coupling`` on the modes' base); with every mode located
+            # (a stand divided out or not) none can be located more, so the correction is not tried
             got = _beside_offset(ctx, SuspensionModes.from_fit(efit, fit, len(runs)).apply(state), runs, test,
                                  stand_start, len(efit.unconstrained))
             if got is not None:
