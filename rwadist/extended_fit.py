@@ -172,6 +172,17 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
     return out
 
 
+def _line_senses_once(test: SteadyTest, fit: EmpiricalFit) -> dict:
+    """:func:`line_senses` of ``test`` and ``fit``, computed once per (test, fit) and kept on the fit: a fixture
+    resonance's refit rounds fit the same test and empirical fit again and again with another stand divided out,
+    which changes the lines' amplitudes, never their directions, h or the time series the senses are read from."""
+    cached = fit.__dict__.get("_line_senses")
+    if cached is None or cached[0] is not test:
+        cached = (test, line_senses(test, fit))
+        fit.__dict__["_line_senses"] = cached
+    return cached[1]
+
+
 # --------------------------------------------------------------------------- 2. mode frequencies
 
 def amplification_peaks(fit: EmpiricalFit, min_gain: float = 1.25) -> list:
@@ -417,6 +428,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     # every line the data show, with every measurement: the empirical fit without modal
     # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped); once per fit
     meas = fit.without_mode_exclusion
+    senses_xy = _line_senses_once(test, meas)
     stands = ([] if stand is None else [stand]) + list(more_stands)
     if stands:
         from .resonance import resonance
@@ -426,7 +438,6 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
             return np.prod([np.abs(resonance(f, *s)) for s in stands], axis=0)
 
         meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / fixture_gain(x)) for x in meas.lines])
-    senses_xy = line_senses(test, meas)
     peaks = amplification_peaks(fit)
     la, sa, ca, aa = _measurements(meas)
     keep_ax = np.array([meas.lines[j].direction not in RADIAL for j in la], bool)

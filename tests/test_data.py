@@ -625,3 +625,21 @@ def test_hdf5_not_hdf5(tmp_path):
     write_csv(path, HEADER, run_table(n=8))
     expect_error(lambda: read_data(path), path, "file", "not an HDF5")
     expect_error(lambda: read_hdf5(tmp_path / "none.h5"), tmp_path / "none.h5", "file", "does not exist")
+
+
+def test_csv_body_is_the_text_numpy_savetxt_writes():
+    """The interchange CSV body (:func:`rwadist.formats.csv_table._format_table`, one ``%`` of the whole table) is
+    byte for byte what ``np.savetxt(fmt="%.17g", delimiter=",")`` writes, for extreme, subnormal, signed-zero and
+    non-finite values and for tables of 0, 1 and many rows."""
+    import io
+
+    from rwadist.formats.csv_table import _format_table
+
+    rng = np.random.default_rng(3)
+    cases = [[rng.normal(size=n) * 10.0 ** rng.integers(-300, 300) for _ in range(k)]
+             for n, k in ((0, 3), (1, 1), (7, 7), (2000, 4))]
+    cases.append([np.array([np.nan, np.inf, -np.inf, -0.0, 1e-310, 5e-324, 1 / 3, 1e300])] * 2)
+    for cols in cases:
+        buf = io.StringIO()
+        np.savetxt(buf, np.column_stack(cols), delimiter=",", fmt="%.17g")
+        assert _format_table(cols) == buf.getvalue()
