@@ -145,13 +145,22 @@ class Sidebands:
     @staticmethod
     def _record_power(ctx: Context, state: State, direction: str, h: float, runs, offsets) -> tuple:
         """(f (runs, 2L), |X|² (runs, 2L, chans), noise (runs, 2L, chans), valid (runs, 2L)) of the lower then upper
-        sides f_c ∓ offsets on the whole-run DFT, the carrier's leakage taken off (:func:`_run_line_power`)."""
-        from .speed_sidebands import _run_line_power
+        sides f_c ∓ offsets on the whole-run DFT, the carrier's leakage taken off (:func:`_run_line_power`).
+
+        |X|² is the data's alone (the noise and the valid points are the state's): kept on the context, so the search's
+        later steps (a new state of the same data) and the held-out judge of the same sidebands read it again."""
+        from .speed_sidebands import _run_line_power, _run_noise
 
         fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
         f = np.concatenate([fc - offsets[None, :], fc + offsets[None, :]], axis=1)
-        P, N = _run_line_power(ctx, state, direction, runs, f, h)
-        return f, P, N, Sidebands._record_valid(ctx, state, direction, h, runs, f)
+        key = ("sidebands_record_power", direction, float(h), np.asarray(runs).tobytes(), f.tobytes())
+        if key not in ctx._memo:
+            P = _run_line_power(ctx, state, direction, runs, f, h)[0]
+            P.flags.writeable = False                   # shared by every later reader
+            ctx._memo[key] = P
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        return f, ctx._memo[key], _run_noise(ctx, state, chans, runs, f), \
+            Sidebands._record_valid(ctx, state, direction, h, runs, f)
 
     @staticmethod
     def fit_record(ctx: Context, state: State, direction: str, h: float, runs, f_mod: float) -> "Sidebands | None":
