@@ -82,7 +82,7 @@ def plot_psd(res: BroadbandPSD, title: str = ""):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from .plot_util import content_top, group_identical, is_empty, log_floor
+    from .plot_util import content_top, group_identical, is_empty, log_axis, log_floor
 
     fig = Figure(figsize=(10, 8))
     FigureCanvasAgg(fig)
@@ -95,9 +95,11 @@ def plot_psd(res: BroadbandPSD, title: str = ""):
     for chans, ax_p, ax_c, unit in groups:
         live = [c for c in chans if c in shown]
         empty = [CHANNELS[c] for c in chans if c not in shown]
+        if live:
+            log_axis(ax_p)
         for c, label in group_identical(psd[:, live], [CHANNELS[k] for k in live]) if live else []:
             k = live[c]
-            ax_p.semilogy(f, np.where(psd[:, k] > 0, psd[:, k], np.nan), lw=0.8, label=label)
+            ax_p.plot(f, np.where(psd[:, k] > 0, psd[:, k], np.nan), lw=0.8, label=label)
             ax_c.plot(f, cum[:, k], lw=1.0, label=label)
         if live:
             lo = log_floor(psd[:, live])

@@ -23,7 +23,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from . import compare
-from .plot_util import PNG_COMPRESS_LEVEL, save_png  # noqa: F401 (PNG_COMPRESS_LEVEL: its old home)
+from .plot_util import PNG_COMPRESS_LEVEL, log_axis, save_png  # noqa: F401 (PNG_COMPRESS_LEVEL: its old home)
 from .spectra import cumulative_rms
 from .units import (
     CHANNEL_DIRECTION,
@@ -237,7 +237,7 @@ def plot_rms_vs_speed(spectra, model, direction: str, ax=None, f_max: float | No
         grid = np.linspace(max(rpm[rpm > 0].min(), 1.0) * 0.5, rpm.max() * 1.02, 600)
         ax_rms.plot(grid, compare.model_rms_vs_speed(model, direction, rpm_to_rad_s(grid), top), "-",
                     color="k", zorder=MODEL_ZORDER, label=f"model (lines ≤ {top:g} Hz)")
-    ax_rms.set_yscale("log")
+    log_axis(ax_rms)
     ax_rms.set_ylabel(f"RMS 0–{top:g} Hz ({unit})")
     what = "data vs model" if has_model else "data (the model has no harmonics here)"
     ax_rms.set_title(f"{_direction_label(direction)}: RMS vs wheel speed, {what}")
@@ -321,7 +321,7 @@ def plot_cumulative_rms(spectra, model, direction: str, speed_rpm: float, axes=N
     if has_model:
         ax_c.plot(f, compare.model_cumulative_rms(model, direction, omega, f), "k--", lw=1.2,
                   drawstyle="steps-post", zorder=MODEL_ZORDER, label="model (staircase)")
-    ax_a.set_yscale("log")
+    log_axis(ax_a)
     ax_a.set_ylabel(f"Amplitude ({unit})")
     ax_a.set_title(f"{_direction_label(direction)} at {rpm:.0f} rpm")
     ax_a.legend(fontsize="small")
@@ -590,11 +590,12 @@ def plot_extended_rms(comparison: dict, direction: str, ax=None):
     if shade.any():
         ax.fill_between(rpm, 0, 1, where=shade, transform=ax.get_xaxis_transform(), color="tab:red", alpha=0.08,
                         label="modes act (empirical exclusion)")
-    ax.semilogy(rpm, c["data"][order], "o", ms=3, color="k", zorder=DATA_ZORDER, label="data (noise floor removed)")
-    ax.semilogy(rpm, c["empirical"][order], "-", color="tab:orange", zorder=MODEL_ZORDER,
-                label=f"empirical model (error in modes {100 * c['error_empirical']:.1f} %)")
-    ax.semilogy(rpm, c["extended"][order], "-", color="tab:blue", zorder=MODEL_ZORDER,
-                label=f"extended model (error in modes {100 * c['error_extended']:.1f} %)")
+    log_axis(ax)
+    ax.plot(rpm, c["data"][order], "o", ms=3, color="k", zorder=DATA_ZORDER, label="data (noise floor removed)")
+    ax.plot(rpm, c["empirical"][order], "-", color="tab:orange", zorder=MODEL_ZORDER,
+            label=f"empirical model (error in modes {100 * c['error_empirical']:.1f} %)")
+    ax.plot(rpm, c["extended"][order], "-", color="tab:blue", zorder=MODEL_ZORDER,
+            label=f"extended model (error in modes {100 * c['error_extended']:.1f} %)")
     ax.set_xlabel("Wheel speed |Ω| (rpm)")
     ax.set_ylabel(f"RMS ({_direction_unit(direction)})")
     ax.set_title(f"{_direction_label(direction)}: data vs empirical and extended model")
@@ -630,7 +631,7 @@ def plot_extended_lines(efit, direction: str, fig=None):
                 label=f"data {ch}")
         ax.plot(rpm, model_amp, "-", color="tab:blue", zorder=MODEL_ZORDER, label="extended model")
         ax.plot(rpm, c_total * w**2, "--", color="tab:orange", zorder=MODEL_ZORDER, label="C·Ω² (hard-mounted)")
-        ax.set_yscale("log")
+        log_axis(ax)
         sense = "+".join(p.sense for p in parts)
         ax.set_title(f"h = {x.h:.2f} ({sense})", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)

@@ -207,3 +207,21 @@ def test_extended_rms_data_over_both_models():
     assert data[0].get_zorder() > max(m.get_zorder() for m in models)
     assert ax.get_ylabel() == "RMS (N)"
     _legend_artists_are_drawn(fig)
+
+
+def test_log_axes_carry_minor_ticks_at_2_and_5_of_each_decade():
+    """:func:`rwadist.plot_util.log_axis`: the kit's log axes span up to 8 decades; their minor ticks are 2 and 5 of
+    each decade (a tick at every integer cost half of a 6-panel report figure's drawing), on the axis asked for."""
+    from matplotlib.figure import Figure
+
+    from rwadist.plot_util import log_axis
+
+    ax = Figure().add_subplot()
+    ax.plot([1.0, 2.0], [1e-6, 1e2])
+    log_axis(ax)
+    assert ax.get_yscale() == "log" and ax.get_xscale() == "linear"
+    ax.set_ylim(1e-6, 1e2)
+    minor = ax.yaxis.get_minorticklocs()
+    minor = minor[(minor >= 1e-6) & (minor <= 1e2)]
+    mantissa = np.round(minor / 10.0 ** np.floor(np.log10(minor)), 6)
+    assert set(mantissa) == {2.0, 5.0} and minor.size == 16
