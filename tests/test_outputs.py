@@ -100,7 +100,9 @@ def test_psd_refuses_non_finite_results(tmp_path, capsys):
 
 
 _SLOW_WRITER = textwrap.dedent("""
-    import sys, time
+    import signal, sys, time
+    # Ctrl-C as in a terminal, however pytest was started (a background job inherits SIGINT ignored)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     from rwadist.outputs import atomic_file
     with atomic_file(sys.argv[1]) as tmp:
         with open(tmp, "w") as fh:
@@ -129,7 +131,11 @@ def test_kill_during_the_write_keeps_the_old_file(tmp_path, sig):
 def test_ctrl_c_is_one_line_exit_130(tmp_path):
     out = tmp_path / "psd.csv"
     out.write_text("old")
-    proc = subprocess.Popen([sys.executable, "-m", "rwadist.cli", "psd", "--preset", "ithaco-e", "--speed-rpm",
+    # ``python -m rwadist.cli`` with Ctrl-C as in a terminal, however pytest was started (a background job inherits
+    # SIGINT ignored, and Python then leaves it ignored)
+    as_in_a_terminal = ("import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+                        "runpy.run_module('rwadist.cli', run_name='__main__', alter_sys=True)")
+    proc = subprocess.Popen([sys.executable, "-c", as_in_a_terminal, "psd", "--preset", "ithaco-e", "--speed-rpm",
                              "600:2400", "--empirical", "--n-freq", "200001", "--n-speeds", "20000", "-o", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(0.2)

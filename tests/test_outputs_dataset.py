@@ -64,7 +64,9 @@ def test_failure_mid_write_keeps_the_old_set(old_dataset, monkeypatch):
 
 
 _KILLED_WRITER = textwrap.dedent("""
-    import sys, time
+    import signal, sys, time
+    # Ctrl-C as in a terminal, however pytest was started (a background job inherits SIGINT ignored)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     from rwadist import data as data_io
     from rwadist.cli import main
     real = data_io.write_run
