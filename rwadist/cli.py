@@ -337,7 +337,7 @@ def cmd_convert(args) -> int:
         fmt = args.format or "csv"
         if dst.suffix.lower() in READ_EXTENSIONS:
             raise DataError(dst, "-o", f"a steady test is a directory (runs.csv + one {fmt} file per run) or an "
-                            ".h5 file, not a {dst.suffix} file")
+                            f".h5 file, not a {dst.suffix} file")
         check_output_dir(dst)
         refuse_input_overwrite([("-o", dst, "dir")], [src])      # the folder is replaced whole
         with atomic_dataset_dir(dst) as tmp:

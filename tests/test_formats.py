@@ -287,6 +287,32 @@ def test_channel_map_force_unit_on_a_torque_refused(tmp_path, steady):
         read_steady(d)
 
 
+
+@pytest.mark.parametrize("unit,channel,factor", [
+    ("mN", "Fx", 1e-3), ("millinewton", "Fz", 1e-3), ("mN·m", "Tx", 1e-3), ("mNm", "Ty", 1e-3),
+    ("N·mm", "Tz", 1e-3), ("Nmm", "Tx", 1e-3), ("N", "Fy", 1.0), ("kN", "Fx", 1e3), ("Nm", "Tz", 1.0),
+    ("nm", "Tz", 1.0), ("LBF", "Fx", 4.4482216152605)])
+def test_unit_factors_by_the_si_prefixes(unit, channel, factor):
+    """SI: milli is 1e-3, kilo 1e3 (exact), the pound-force 4.4482216152605 N (exact by definition); a spelling
+    whose case is an SI prefix is read by its case ("mN" a millinewton, not N·m: a torque channel in "mN" was read
+    1000x too large)."""
+    from rwadist.formats.channels import unit_factor
+
+    assert unit_factor(unit, channel, "meta.json", "unit") == factor
+
+
+@pytest.mark.parametrize("unit,channel,message", [
+    ("mN", "Tx", r"'mN' is a force unit, but channel Tx is a torque"),
+    ("MN", "Fx", r"unit 'MN' is not known"),
+    ("mN·m", "Fy", r"'mN·m' is a torque unit, but channel Fy is a force"),
+    ("N·MM", "Tz", r"unit 'N·MM' is not known")])
+def test_unit_spellings_that_are_not_what_they_look_like_refused(unit, channel, message):
+    from rwadist.formats.channels import unit_factor
+
+    with pytest.raises(DataError, match=message):
+        unit_factor(unit, channel, "meta.json", "unit")
+
+
 # --------------------------------------------------------------------------- bad input per format
 
 def _one_run(steady):

@@ -27,13 +27,14 @@ from .records import DataError, RawRecord, Run, Sweep
 from .tach import steady_speed_from_tach, sweep_speed_from_tach
 from .timebase import check_rate, sample_step
 
-#: Unit spellings -> (kind, factor to SI).  Forces in N, torques in N·m.
+#: Unit spellings -> (kind, factor to SI).  Forces in N, torques in N·m.  Matched without regard to case, so no
+#: spelling whose case carries an SI prefix is here ("mN" is a millinewton, "MN" a meganewton: see UNITS_EXACT).
 UNITS = {}
 for _names, _kind, _factor in (
         (("N", "newton", "newtons"), "force", 1.0),
         (("kN", "kilonewton"), "force", 1000.0),
         (("lbf", "lb", "lbs", "pound-force"), "force", 4.4482216152605),
-        (("N·m", "Nm", "N*m", "N.m", "N m", "N-m", "m·N", "mN"), "torque", 1.0),
+        (("N·m", "Nm", "N*m", "N.m", "N m", "N-m", "m·N"), "torque", 1.0),
         (("in·lbf", "in-lbf", "in*lbf", "inlbf", "in.lbf", "in lbf", "lbf·in", "lbf-in", "lbf*in", "lbf.in",
           "lbf in", "in-lb", "lb-in"), "torque", 0.1129848290276167),
         (("ft·lbf", "ft-lbf", "ft*lbf", "ftlbf", "ft.lbf", "ft lbf", "lbf·ft", "lbf-ft", "lbf*ft", "lbf.ft",
@@ -41,6 +42,14 @@ for _names, _kind, _factor in (
 ):
     for _n in _names:
         UNITS[_n.lower()] = (_kind, _factor)
+#: Spellings with a milli prefix, matched exactly (their case is their meaning): checked before UNITS.
+UNITS_EXACT = {}
+for _names, _kind, _factor in (
+        (("mN", "millinewton"), "force", 1e-3),
+        (("mN·m", "mNm", "mN*m", "mN.m", "mN m", "mN-m", "N·mm", "Nmm", "N*mm", "N.mm", "N mm", "N-mm"), "torque", 1e-3),
+):
+    for _n in _names:
+        UNITS_EXACT[_n] = (_kind, _factor)
 CHANNEL_KIND = {ch: ("force" if ch.startswith("F") else "torque") for ch in CHANNELS}
 #: Column of a measured speed in rpm (interchange sweeps).
 SPEED_COLUMN = "speed_rpm"
@@ -50,11 +59,12 @@ MAX_CALIBRATION_CONDITION = 1e12
 
 def unit_factor(unit: str, channel: str, path, where: str) -> float:
     """SI factor of ``unit`` for our ``channel`` (N or N·m); DataError naming the channel otherwise."""
-    key = str(unit).strip().lower()
-    if key not in UNITS:
-        raise DataError(path, where, f"unit {unit!r} is not known; use one of N, kN, lbf (forces), "
-                        "N·m, in·lbf, ft·lbf (torques)")
-    kind, factor = UNITS[key]
+    exact = str(unit).strip()
+    key = exact.lower()
+    if exact not in UNITS_EXACT and key not in UNITS:
+        raise DataError(path, where, f"unit {unit!r} is not known; use one of N, mN, kN, lbf (forces), "
+                        "N·m, mN·m, in·lbf, ft·lbf (torques)")
+    kind, factor = UNITS_EXACT[exact] if exact in UNITS_EXACT else UNITS[key]
     if kind != CHANNEL_KIND[channel]:
         raise DataError(path, where, f"unit {unit!r} is a {kind} unit, but channel {channel} is a "
                         f"{CHANNEL_KIND[channel]}")
