@@ -61,6 +61,7 @@ from .formats.records import (
 )
 from .formats.timebase import sample_step
 from .hdf5 import read_hdf5
+from .outputs import WRITER, WRITER_KEY
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm, rpm_to_rad_s  # noqa: F401 (re-exported)
 
 __all__ = ["DataError", "Run", "SteadyTest", "Sweep", "RawRecord", "read_json", "read_run", "read_steady",
@@ -90,6 +91,8 @@ def _read_meta(path: Path) -> dict:
     fs = meta.get("sample_rate_hz")
     if fs is not None and not (isinstance(fs, (int, float)) and fs > 0 and math.isfinite(fs)):
         raise DataError(path, "sample_rate_hz", f"must be a positive number, got {fs!r}")
+    # who wrote the folder is the folder's, not the test's (write_steady sets it again): the test's meta round-trips
+    meta.pop(WRITER_KEY, None)
     return meta
 
 
@@ -220,6 +223,9 @@ def write_steady(test: SteadyTest, directory, fmt: str = "csv") -> Path:
     directory.mkdir(parents=True, exist_ok=True)
     rates = {r.sample_rate for r in test.runs}
     meta = portable_meta(test.meta)
+    # the writer, so that this folder may be replaced by rwadist's next dataset there (outputs.check_dataset_dir);
+    # a folder without it (a lab's runs) never is
+    meta[WRITER_KEY] = WRITER
     if len(rates) == 1:
         meta["sample_rate_hz"] = rates.pop()
     else:

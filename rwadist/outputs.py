@@ -21,6 +21,9 @@ from .formats.records import DataError
 
 #: names a reader takes from a steady-test directory besides its run files
 _DATASET_INDEX_FILES = ("runs.csv", "meta.json")
+#: The key of ``meta.json`` a steady-test folder rwadist writes records itself under (:func:`rwadist.data.write_steady`),
+#: and its value: only such a folder is replaced whole by a new dataset; any other (a lab's measured runs) is refused
+WRITER_KEY, WRITER = "written_by", "rwadist"
 #: what `rwadist simulate-test OUT_DIR --sweep` writes: replaced with the folder by a later steady test there
 _SIMULATE_OUTPUTS = ("sweep.csv", "sweep.meta.json")
 #: extensions of files a dataset reader may read (runs, sweeps, HDF5)
@@ -235,19 +238,41 @@ def _is_dataset_entry(p: Path, listed: set) -> bool:
         p.name.lower().startswith("run") and p.suffix.lower() in _DATA_SUFFIXES)
 
 
+def _written_by_rwadist(folder: Path) -> bool:
+    """True when ``folder``'s ``meta.json`` records that rwadist wrote the dataset: ``written_by`` (every dataset
+    :func:`rwadist.data.write_steady` writes), or the virtual stand's ``generator`` (simulate-test before that key)."""
+    import json
+
+    try:
+        meta = json.loads((folder / "meta.json").read_text(errors="replace"))
+    except (OSError, ValueError):
+        return False
+    if not isinstance(meta, dict):
+        return False
+    return any(isinstance(meta.get(k), str) and meta[k].split(" ")[0].split(".")[0] == WRITER
+               for k in (WRITER_KEY, "generator"))
+
+
 def check_dataset_dir(path, flag: str = "-o") -> Path:
     """Refuse (:class:`DataError` naming ``flag``) a folder ``path`` that exists and holds anything but a
-    steady-test dataset: the folder is replaced whole, so other files in it would be lost."""
+    steady-test dataset rwadist wrote: the folder is replaced whole, so other files in it -- or a dataset rwadist
+    did not write, a lab's measured runs -- would be lost."""
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise DataError(flag, "value", f"{str(path)!r} is a file, not a folder: give a folder for a steady test")
     if path.is_dir():
         listed = _listed_runs(path)
-        other = sorted(p.name for p in path.iterdir() if not _is_dataset_entry(p, listed))
+        entries = list(path.iterdir())
+        other = sorted(p.name for p in entries if not _is_dataset_entry(p, listed))
         if other:
             shown = ", ".join(other[:3]) + (f" and {len(other) - 3} more" if len(other) > 3 else "")
             raise DataError(flag, "folder", f"{str(path)!r} holds files that are not a steady-test dataset "
                             f"({shown}); the folder is replaced whole: choose a new or dedicated folder")
+        files = [p for p in entries if not p.name.startswith(".")]
+        if files and not _written_by_rwadist(path):
+            raise DataError(flag, "folder", f"{str(path)!r} holds a steady-test dataset ({len(files)} files) that "
+                            f"rwadist did not write (its meta.json does not say {WRITER_KEY}: {WRITER}); the folder "
+                            "is replaced whole, which would delete those runs: choose a new folder")
     return path
 
 

@@ -118,3 +118,47 @@ def test_convert_into_the_folder_of_its_input_is_refused(old_dataset, capsys):
     assert "input" in capsys.readouterr().err
     assert _snapshot(out) == old
     assert sweep.exists()
+
+
+def _lab_dataset(folder, n=4):
+    """A steady-test folder as a lab writes it by hand (docs/formats.md section 1): runs.csv, meta.json without
+    rwadist's ``written_by``, one CSV per run."""
+    import numpy as np
+
+    folder.mkdir()
+    t = np.arange(256) / 1024.0
+    lines = ["file,speed_rpm"]
+    for i in range(n):
+        x = np.sin(2 * np.pi * (10 + i) * t)
+        rows = ["time_s,Fx_N,Fy_N,Fz_N,Tx_Nm,Ty_Nm,Tz_Nm"] + [f"{a:.6f}" + f",{b:.6f}" * 6 for a, b in zip(t, x)]
+        (folder / f"r{i:02d}.csv").write_text("\n".join(rows) + "\n")
+        lines.append(f"r{i:02d}.csv,{600 + 60 * i}")
+    (folder / "runs.csv").write_text("\n".join(lines) + "\n")
+    (folder / "meta.json").write_text('{"sample_rate_hz": 1024, "notes": "bench 3, 2026-11-20"}\n')
+    return folder
+
+
+def test_a_dataset_rwadist_did_not_write_is_refused_untouched(tmp_path, capsys):
+    """A lab's measured runs in the output folder: simulate-test and convert refuse it (they replace the folder whole,
+    which deleted the runs and printed 'wrote 3 runs'), and leave every file as it was."""
+    lab = _lab_dataset(tmp_path / "lab")
+    before = _snapshot(lab)
+    assert len(data_io.read_steady(lab).runs) == 4
+    assert main(SIM + [str(lab), "--speeds-rpm", "600:2400", "--n-speeds", "3"]) == 2
+    err = capsys.readouterr().err
+    assert "OUT_DIR" in err and "rwadist did not write" in err and "choose a new folder" in err
+    assert _snapshot(lab) == before
+    sim = tmp_path / "sim"
+    assert main(SIM + [str(sim), "--speeds-rpm", "600:2400", "--n-speeds", "3"]) == 0
+    assert main(["convert", str(sim), "-o", str(lab)]) == 2
+    assert "-o" in capsys.readouterr().err
+    assert _snapshot(lab) == before
+
+
+def test_a_dataset_rwadist_wrote_is_replaced(tmp_path):
+    """What convert writes carries written_by: rwadist, so it may be written again (a lab's runs converted once)."""
+    lab = _lab_dataset(tmp_path / "lab")
+    out = tmp_path / "converted"
+    assert main(["convert", str(lab), "-o", str(out)]) == 0
+    assert main(["convert", str(lab), "-o", str(out)]) == 0
+    assert len(data_io.read_steady(out).runs) == 4
