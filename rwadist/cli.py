@@ -189,6 +189,18 @@ def cmd_fit(args) -> int:
     _write(args.output, lambda tmp: model_io.save(model, tmp))
     n = sum(len(v) for v in fit.model.empirical.values())
     print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
+    if efit is not None:
+        n_forcing = sum(len(v) for v in model.empirical.values())
+        print(f"extended model: {n_forcing} forcing lines through the fitted modes (every line the data show, "
+              "modally amplified or not)")
+    modal = [b for b in fit.bins if not b.kept and "outside modal ranges" in b.reason]
+    if modal and efit is None:
+        names = ", ".join(f"{b.direction} h={b.h:.4g}" for b in modal[:6]) + (
+            f" and {len(modal) - 6} more" if len(modal) > 6 else "")
+        where = "; the report's bins.csv gives the reasons" if report_dir is not None else ""
+        print(f"WARNING: {len(modal)} harmonic(s) the data show were left out of the model because their lines are "
+              f"modally amplified at nearly every speed ({names}{where}): C·Ω² does not describe them; fit the "
+              "wheel's modes with --extended, or keep them with --no-mode-exclusion", file=sys.stderr)
     if n == 0:
         print(f"WARNING: no harmonic passed the presence threshold ({args.presence:g} of the runs): the model is "
               "empty; give more runs over the speed range, or lower --presence", file=sys.stderr)
@@ -325,6 +337,8 @@ def cmd_convert(args) -> int:
     if str(args.output).strip() == "":
         raise DataError("-o", "value", "empty: give the file or folder to write")
     refuse_input_overwrite([("-o", dst, "file")], [src])
+    if dst.is_dir():
+        check_dataset_dir(dst, "-o")           # before reading: a folder that would be refused after it
     obj = data_io.read_data(src, progress=True)
     if dst.suffix.lower() in (".h5", ".hdf5"):
         check_output_file(dst)

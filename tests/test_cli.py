@@ -123,6 +123,26 @@ def test_demo_small(tmp_path, capsys):
     assert "h fit" in out and "radial_force" in out
 
 
+
+def test_fit_warns_of_harmonics_left_out_as_modally_amplified(tmp_path, capsys):
+    """Through the wheel's modes (extended physics, 300-3000 rpm) the rocking whirls lift the radial-torque lines at
+    nearly every speed: the plain fit leaves them out of the C·Ω² model (the file had 9 of the data's 18 lines and the
+    console said nothing); it now names them and what to do.  The extended fit keeps every line and says how many."""
+    from rwadist import model as model_io
+
+    data = tmp_path / "e"
+    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "300:3000", "--n-speeds", "40",
+        "--samples", "4096", "--physics", "extended")
+    code, out, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--no-report")
+    assert code == 0
+    fitted = model_io.load(tmp_path / "m.json")
+    assert ("radial_torque", 1.0) not in {(d, round(h.h, 2)) for d in fitted.empirical for h in fitted.empirical[d]}
+    assert "WARNING" in err and "radial_torque h=1," in err and "--extended" in err and "--no-mode-exclusion" in err
+    code, out, err = run(capsys, "fit", data, "-o", tmp_path / "x.json", "--no-report", "--extended")
+    n = sum(len(v) for v in model_io.load(tmp_path / "x.json").empirical.values())
+    assert code == 0 and f"extended model: {n} forcing lines" in out and "WARNING" not in err
+
+
 def test_fit_extended_then_campbell_from_the_fitted_model(tmp_path, capsys):
     """simulate (extended physics) -> fit --extended -> campbell on the fitted model file."""
     from rwadist import extended as ext
