@@ -15,8 +15,8 @@ harmonic takes part and the fit is a least-squares problem:
    the backward one, f± = sqrt((aΩ/2)² + f0²) ± aΩ/2, a = I_zz/I_rr), axial-force lines the axial
    mode.  The scan also gives the damping start and, without mass and radius, a.  A mode whose
    scan has an interior best point is *located*; it is *found* when the least squares below pins
-   its frequency (1.5 standard errors within ``tolerance``, 2 %, not at the ±5 % search
-   limit, its damping not at the fit's floor ζ = 5e-5); otherwise it is declared not constrained and the least squares is repeated without it,
+   its frequency (1.5 standard errors within ``tolerance``, 2 %, off the ±5 % limit, damping off its floor
+   ζ = 5e-5); otherwise it is declared not constrained and the least squares repeated without it,
    unless one line of another law than C·Ω² drags it off (:mod:`rwadist.off_law_lines`).
 3. **Least squares** of log amplitude over every measured line at every speed
    (amplified or not): stiffnesses, damping of each mode and the forcing
@@ -42,7 +42,7 @@ from scipy import optimize
 
 from . import extended as ext
 from .data import SteadyTest
-from .dft import run_window, windowed_dft, windowed_dfts  # noqa: F401 (the whole-run DFT, now in rwadist.dft)
+from .dft import run_window, windowed_dfts
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
@@ -586,30 +586,26 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
             rel_se = np.sqrt(np.clip(np.diag(np.linalg.pinv(res.jac.T @ res.jac) * s2), 0, None))
         except np.linalg.LinAlgError:
             rel_se = np.full(res.x.size, np.nan)
-        # a limit the fit runs to is what it was allowed, not what the data say: the stiffness at ±10 %, or the damping
-        # at its floor (ζ = 5e-5: a peak sharper than any damped mode, only the product ζ·gain placed by the lines
-        # near it -- a fixture resonance beside a load-cell offset was taken for the translation mode, -19 %)
+        # a limit is what the fit allowed, not what the data say: stiffness at ±10 %, damping at its floor ζ = 5e-5 (a
+        # stand beside a load-cell offset was taken for the translation so, -19 %)
         at_bound = {m: ("stiffness" if min(res.x[2 * i] - lo[2 * i], hi[2 * i] - res.x[2 * i]) < 0.01 else
                         "damping" if res.x[2 * i + 1] - lo[2 * i + 1] < 0.01 else "")
                     for i, m in enumerate(free_modes)}
         return res, names, rel_se, unpack, at_bound
 
-    # a located mode counts as found when the least squares pins its frequency: 1.5 standard errors
-    # (of f = sqrt(k/m)/2π, half the relative error of k) within the tolerance, away from the bounds;
-    # otherwise it goes back to its starting value, is declared, and the fit is repeated without it
+    # found: the least squares pins the frequency (1.5 standard errors of f = sqrt(k/m)/2π, half k's relative error,
+    # within the tolerance) away from the bounds; else back to its start, declared, and the fit repeated without it
     def loose_modes(res, rel_se, at_bound, free_modes):
         loose = []
         for i, m in enumerate(free_modes):
             se_f = 0.5 * float(rel_se[2 * i])
             if at_bound[m] or not (1.5 * se_f <= tolerance):
                 f_fit = math.sqrt(math.exp(res.x[2 * i]) / base[_MODE_PARAMS[m][2]]) / (2 * np.pi)
-                why = ("the best fit sits at the ±5 % limit around the scan's frequency" if at_bound[m] == "stiffness"
-                       else f"located at {f_fit:.4g} Hz but its damping runs to the fit's floor (ζ = 5e-05): the data "
-                       "show no damped peak there, only lines lifted near it (a resonance of the test stand?)"
-                       if at_bound[m] == "damping" else
-                       f"located at {f_fit:.4g} Hz but only to ±{100 * 1.5 * se_f:.1f} % (1.5 standard errors), "
-                       f"not {100 * tolerance:g} %")
-                loose.append((m, why))
+                loose.append((m, {"stiffness": "the best fit sits at the ±5 % limit around the scan's frequency",
+                                  "damping": f"located at {f_fit:.4g} Hz but its damping runs to the fit's floor (ζ = "
+                                  "5e-05): the data show no damped peak there (a resonance of the test stand?)"}.get(
+                    at_bound[m], f"located at {f_fit:.4g} Hz but only to ±{100 * 1.5 * se_f:.1f} % (1.5 standard "
+                                 f"errors), not {100 * tolerance:g} %")))
         return loose
 
     free_modes = [m for m in _MODE_PARAMS if identified[m]]

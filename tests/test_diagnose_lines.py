@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from rwadist import api
+from rwadist.dft import windowed_dft
 from rwadist.diagnose.effects.missing_harmonic import welch_low_limit
 from rwadist.diagnose.measure import hann_transform_ratio
-from rwadist.extended_fit import windowed_dft
 from rwadist.inject import parse, simulate_with_injections
 from rwadist.presets import preset
 

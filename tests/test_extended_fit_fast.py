@@ -9,8 +9,9 @@ import numpy as np
 from scipy import signal
 
 from rwadist import extended as ext
+from rwadist.dft import windowed_dft
 from rwadist.diagnose.engine import line_kernel
-from rwadist.extended_fit import CHANNEL_INDEX, LinePower, windowed_dft
+from rwadist.extended_fit import CHANNEL_INDEX, LinePower
 from rwadist.mode_scan import transmissibility_sq
 from rwadist.units import DIRECTION_CHANNELS
 

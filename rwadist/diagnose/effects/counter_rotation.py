@@ -168,7 +168,7 @@ class CounterRotation:
         chans = DIRECTION_CHANNELS[direction]
         if ctx.test is None or not all(c in ctx.channels for c in chans):
             return None
-        from ...extended_fit import run_window
+        from ...dft import run_window
 
         h0 = _sense_group(state, direction, h)[0]
         f = h0 * ctx.omega[runs] / (2 * np.pi)

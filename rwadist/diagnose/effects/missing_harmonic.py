@@ -87,7 +87,7 @@ def _record_grid(ctx: Context, r: int) -> tuple:
     kept on the context (the data's, the same at every search step)."""
     key = ("missing_harmonic_record", r)
     if key not in ctx._memo:
-        from ...extended_fit import run_window
+        from ...dft import run_window
 
         run = ctx.test.runs[r]
         n = run.n_samples
@@ -150,7 +150,7 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     line's own phasor times the window's transform, :func:`hann_transform_ratio`, its negative-frequency image too).
 
     |X|² is read on the record grid at the nearest point (:func:`_record_grid`), or with ``exact`` at ``f_hz`` itself
-    (:func:`rwadist.extended_fit.windowed_dft`); the noise is the larger of the white
+    (:func:`rwadist.dft.windowed_dft`); the noise is the larger of the white
     noise of the state's floor there (2·S·fs·Σw²/(Σw)², S at the nearest Welch bin of the band) and the run's own
     median |X|² over the record route's range (/ln 2: the median of an exponential), so that a noise rising below the
     Welch band is not taken for lines.  Valid: in the record route's range (RECORD_MIN_BINS record bins up to
