@@ -168,9 +168,11 @@ class Histogram:
         return list(self.edges)
 
 
-def histogram_from_centres(speeds, weights, source="histogram") -> Histogram:
+def histogram_from_centres(speeds, weights, source="histogram", bounds=None) -> Histogram:
     """Histogram from bin centres (rad/s, strictly increasing) and relative weights; edges halfway
-    between centres, the outer bins as wide as their neighbours."""
+    between centres, the outer bins as wide as their neighbours -- but never across zero speed when no
+    centre is on the other side (a wheel that never reverses), nor beyond ``bounds`` (lo, hi) rad/s, the
+    speed range the user gave (every centre must lie inside it)."""
     c = np.asarray(speeds, float)
     if c.ndim != 1 or c.size < 2:
         raise DataError(source, "speed_rpm", f"need at least 2 histogram rows, got {c.size}")
@@ -179,7 +181,21 @@ def histogram_from_centres(speeds, weights, source="histogram") -> Histogram:
         raise DataError(source, "speed_rpm", f"must be strictly increasing: row {i + 1} "
                         f"({c[i + 1] * RAD_S_TO_RPM:g} rpm) <= row {i} ({c[i] * RAD_S_TO_RPM:g} rpm)")
     mid = 0.5 * (c[1:] + c[:-1])
-    edges = np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
+    lo, hi = c[0] - (mid[0] - c[0]), c[-1] + (c[-1] - mid[-1])
+    if c[0] >= 0.0:
+        lo = max(lo, 0.0)
+    if c[-1] <= 0.0:
+        hi = min(hi, 0.0)
+    if bounds is not None:
+        b_lo, b_hi = (float(x) for x in bounds)
+        out = (c < b_lo * (1 + 1e-12) - 1e-12) | (c > b_hi * (1 + 1e-12) + 1e-12)
+        if np.any(out):
+            i = int(np.argmax(out))
+            raise DataError(source, "speed_rpm", f"row {i} ({c[i] * RAD_S_TO_RPM:g} rpm) is outside the speed range "
+                            f"{b_lo * RAD_S_TO_RPM:g}:{b_hi * RAD_S_TO_RPM:g} rpm (--speed-rpm): give the range the "
+                            "file covers")
+        lo, hi = max(lo, b_lo), min(hi, b_hi)
+    edges = np.concatenate([[lo], mid, [hi]])
     return Histogram.from_weights(edges, weights, source)
 
 
@@ -235,7 +251,8 @@ def law_from_spec(dist: str, min_rpm: float, max_rpm: float, std_rpm: float | No
                   source: str = "--dist") -> object:
     """Speed law from CLI-style arguments: 'uniform' on [min, max] rpm; 'normal' centred in the
     range, std ``std_rpm`` (default range/6, i.e. ±3σ), truncated to the range; otherwise a CSV file
-    (:func:`law_from_csv`; the range then only bounds nothing -- the file's own speeds are used)."""
+    (:func:`law_from_csv`: the file's speeds, within the range -- a row outside it is refused, the outer bins
+    end at it)."""
     if dist == "uniform":
         return Uniform(float(rpm_to_rad_s(min_rpm)), float(rpm_to_rad_s(max_rpm)))
     if dist == "normal":
@@ -243,13 +260,15 @@ def law_from_spec(dist: str, min_rpm: float, max_rpm: float, std_rpm: float | No
         _check_range("--speed-rpm", lo, hi)
         std = (hi - lo) / 6.0 if std_rpm is None else float(rpm_to_rad_s(std_rpm))
         return TruncatedNormal(0.5 * (lo + hi), std, lo, hi)
-    return law_from_csv(dist)
+    return law_from_csv(dist, bounds=(float(rpm_to_rad_s(min_rpm)), float(rpm_to_rad_s(max_rpm))))
 
 
-def law_from_csv(path, n_bins: int = 2000):
+def law_from_csv(path, n_bins: int = 2000, bounds=None):
     """Speed law from a CSV: columns (speed_rpm, weight) = histogram of relative weights at bin
     centres; (speed_rpm, pdf_per_rpm) = a density that must integrate to 1 over rpm; (time_s,
-    speed_rpm) = a mission time profile (:func:`from_time_profile`)."""
+    speed_rpm) = a mission time profile (:func:`from_time_profile`).  ``bounds``: (lo, hi) rad/s, the
+    speed range given beside the file: a speed of the file outside it is refused, and a histogram's
+    outer bins end at it (:func:`histogram_from_centres`)."""
     path = Path(path)
     if not path.exists():
         raise DataError(path, "file", "does not exist (expected uniform, normal or a CSV file)")
@@ -261,12 +280,17 @@ def law_from_csv(path, n_bins: int = 2000):
         raise DataError(path, "data", f"not numeric CSV ({exc})") from None
     col = {h: arr[:, i] for i, h in enumerate(header)}
     if "time_s" in col and "speed_rpm" in col:
-        return from_time_profile(col["time_s"], rpm_to_rad_s(col["speed_rpm"]), n_bins, str(path))
+        w = rpm_to_rad_s(col["speed_rpm"])
+        if bounds is not None and w.size and (w.min() < bounds[0] - 1e-9 or w.max() > bounds[1] + 1e-9):
+            raise DataError(path, "speed_rpm", f"the profile spans {w.min() * RAD_S_TO_RPM:g}:"
+                            f"{w.max() * RAD_S_TO_RPM:g} rpm, outside the speed range {bounds[0] * RAD_S_TO_RPM:g}:"
+                            f"{bounds[1] * RAD_S_TO_RPM:g} rpm (--speed-rpm): give the range the file covers")
+        return from_time_profile(col["time_s"], w, n_bins, str(path))
     if "speed_rpm" in col and "weight" in col:
-        return histogram_from_centres(rpm_to_rad_s(col["speed_rpm"]), col["weight"], str(path))
+        return histogram_from_centres(rpm_to_rad_s(col["speed_rpm"]), col["weight"], str(path), bounds)
     if "speed_rpm" in col and "pdf_per_rpm" in col:
         s, p = col["speed_rpm"], col["pdf_per_rpm"]
-        hist = histogram_from_centres(rpm_to_rad_s(s), np.maximum(p, 0), str(path))
+        hist = histogram_from_centres(rpm_to_rad_s(s), np.maximum(p, 0), str(path), bounds)
         widths = np.diff(np.asarray(hist.edges)) * RAD_S_TO_RPM
         total = float(np.sum(p * widths))
         if abs(total - 1.0) > PDF_RTOL:

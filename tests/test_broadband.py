@@ -263,3 +263,23 @@ def test_envelope_is_largest_line_amplitude():
     row = [r for r in env.table if r["h"] == 1.0 and r["channel"] == "Fx"][0]
     assert row["max_amplitude"] == pytest.approx(C[0] * (3000 * W) ** 2, rel=1e-9)
     assert row["speed_rpm"] == pytest.approx(3000.0)
+
+
+def test_histogram_file_within_the_speed_range_and_on_one_side_of_zero(tmp_path):
+    """A histogram's outer bins (as wide as their neighbours) end at the speed range given beside the file, and never
+    cross zero speed when every centre is on one side: centres 500 and 2500 rpm made a law over -500..3500 rpm (a
+    wheel that reverses) whatever the range, and a file at 5000-6000 rpm was taken with --speed-rpm 300:3000."""
+    q = tmp_path / "two.csv"
+    q.write_text("speed_rpm,weight\n500,1\n2500,3\n")
+    law = bb.law_from_spec(str(q), 300.0, 3000.0)
+    assert law.support == pytest.approx((300 * W, 3000 * W))
+    assert float(law.cdf(1500 * W)) == pytest.approx(0.25)          # the first bin, 300..1500 rpm, holds 1/4
+    assert bb.law_from_csv(q).support == pytest.approx((0.0, 3500 * W))
+    far = tmp_path / "far.csv"
+    far.write_text("speed_rpm,weight\n5000,1\n6000,1\n")
+    with pytest.raises(DataError, match=r"row 0 \(5000 rpm\) is outside the speed range 300:3000 rpm \(--speed-rpm\)"):
+        bb.law_from_spec(str(far), 300.0, 3000.0)
+    prof = tmp_path / "prof.csv"
+    prof.write_text("time_s,speed_rpm\n0,0\n10,3500\n")
+    with pytest.raises(DataError, match=r"the profile spans 0:3500 rpm, outside the speed range 0:3000 rpm"):
+        bb.law_from_spec(str(prof), 0.0, 3000.0)
