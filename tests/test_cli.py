@@ -174,3 +174,38 @@ def test_fit_extended_without_mass_and_radius_is_per_unit(tmp_path, capsys):
     assert doc["analytical"]["mass_kg"] == 1.0 and doc["analytical"]["unconstrained"]
     code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m2.json", "--extended", "--mass", "0", "--radius", "0.2")
     assert code == 2 and "--mass" in err
+
+
+
+def test_commands_run_with_one_blas_thread_unless_the_environment_says(monkeypatch, capsys):
+    """The command line limits BLAS to one thread (its least squares are small; on 2 busy cores OpenBLAS's threads
+    made fit --extended 23x slower), and leaves a count the user set alone."""
+    from contextlib import contextmanager
+
+    from threadpoolctl import threadpool_info
+
+    from rwadist import cli
+
+    def blas_threads():
+        return [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
+
+    for name in cli.BLAS_THREAD_VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+    with cli.one_blas_thread():
+        inside = blas_threads()
+    assert inside and all(n == 1 for n in inside)
+    monkeypatch.setenv("OMP_NUM_THREADS", "2")
+    before = blas_threads()
+    with cli.one_blas_thread():
+        assert blas_threads() == before
+    entered = []
+    real = cli.one_blas_thread
+
+    @contextmanager
+    def recording():
+        with real():
+            entered.append(True)
+            yield
+
+    monkeypatch.setattr(cli, "one_blas_thread", recording)
+    assert cli.main(["catalogue", "list"]) == 0 and entered == [True]
