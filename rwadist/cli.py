@@ -31,9 +31,11 @@ from .progress import working
 from .units import RAD_S_TO_RPM, rpm_to_rad_s
 from .validate import (
     MAX_SAMPLES,
+    check_extended_only,
     check_grid_size,
     check_parsed,
     check_speeds_rpm,
+    check_within_test,
     refuse_non_finite_model,
     refuse_non_finite_psd,
 )
@@ -166,10 +168,13 @@ def cmd_fit(args) -> int:
         report_dir = None
     else:
         check_output_dir(report_dir, "--report")
+    check_extended_only(args)
     refuse_input_overwrite([("-o", args.output, "file")] + ([("--report", report_dir, "dir")] if report_dir else []),
                            [args.data])
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
+    if args.cumulative_rpm and report_dir is not None:
+        check_within_test(parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm"), test, "--cumulative-rpm")
     fit = run_fit(test, args, name=Path(args.data).name)
     fit.model.provenance["data"] = str(args.data)
     model = fit.model
@@ -191,17 +196,14 @@ def cmd_fit(args) -> int:
     n = sum(len(v) for v in fit.model.empirical.values())
     print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
     if efit is not None:
-        n_forcing = sum(len(v) for v in model.empirical.values())
-        print(f"extended model: {n_forcing} forcing lines through the fitted modes (every line the data show, "
-              "modally amplified or not)")
-    modal = [b for b in fit.bins if not b.kept and "outside modal ranges" in b.reason]
+        print(f"extended model: {sum(len(v) for v in model.empirical.values())} forcing lines through the fitted "
+              "modes (every line the data show, modally amplified or not)")
+    modal = [f"{b.direction} h={b.h:.4g}" for b in fit.bins if not b.kept and "outside modal ranges" in b.reason]
     if modal and efit is None:
-        names = ", ".join(f"{b.direction} h={b.h:.4g}" for b in modal[:6]) + (
-            f" and {len(modal) - 6} more" if len(modal) > 6 else "")
-        where = "; the report's bins.csv gives the reasons" if report_dir is not None else ""
         print(f"WARNING: {len(modal)} harmonic(s) the data show were left out of the model because their lines are "
-              f"modally amplified at nearly every speed ({names}{where}): C·Ω² does not describe them; fit the "
-              "wheel's modes with --extended, or keep them with --no-mode-exclusion", file=sys.stderr)
+              f"modally amplified at nearly every speed ({', '.join(modal[:6])}{' and more' if modal[6:] else ''}"
+              f"{'; bins.csv in the report gives the reasons' if report_dir else ''}): C·Ω² does not describe them; "
+              "fit the wheel's modes with --extended, or keep them with --no-mode-exclusion", file=sys.stderr)
     if n == 0:
         print(f"WARNING: no harmonic passed the presence threshold ({args.presence:g} of the runs): the model is "
               "empty; give more runs over the speed range, or lower --presence", file=sys.stderr)
@@ -743,10 +745,8 @@ BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THR
 
 @contextmanager
 def one_blas_thread():
-    """One BLAS thread for a command, unless the environment sets a count.  The kit's linear algebra is many small
-    problems (least-squares Jacobians of a few hundred rows by tens of columns, their SVDs), which BLAS's threads
-    only slow down, and far more so on a busy machine, where they wait on each other: ``fit --extended`` of the
-    demo's data took 108 s of CPU beside two other jobs on 2 cores, 4.6 s with one thread."""
+    """One BLAS thread for a command unless the environment sets a count: the kit's least squares are small, and BLAS
+    threads only slow them (``fit --extended`` of the demo's data beside two jobs on 2 cores: 108 s CPU, 4.6 s)."""
     if any(os.environ.get(v) for v in BLAS_THREAD_VARIABLES):
         yield
         return

@@ -108,6 +108,27 @@ def check_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> N
             raise DataError(flag, "value", f"{value!r}: missing or not a number")
 
 
+def check_extended_only(args: argparse.Namespace) -> None:
+    """``rwadist fit``: --mass, --radius, --height and --preset feed the extended fit only; without --extended they
+    were ignored, silently."""
+    given = [f for f, v in (("--mass", args.mass), ("--radius", args.radius), ("--height", args.height or None),
+                            ("--preset", args.preset)) if v is not None]
+    if given and not args.extended:
+        raise DataError(given[0], "value", "applies to the extended fit only: add --extended (the plain fit of "
+                        "harmonics C·Ω² does not use it)")
+
+
+def check_within_test(speeds_rpm, test, flag: str) -> None:
+    """Speeds (rpm) a plot reads from the test's runs (the nearest run to each) must lie within the test's speeds:
+    --cumulative-rpm 5000 on a 300-2400 rpm test plotted 2400 rpm under a title of 5000."""
+    rpm = np.abs([r.speed for r in test.runs]) * 60.0 / (2.0 * math.pi)
+    lo, hi = float(rpm.min()), float(rpm.max())
+    for v in speeds_rpm:
+        if not lo - 1e-6 <= abs(v) <= hi + 1e-6:
+            raise DataError(flag, "value", f"{v:g} rpm is outside the test's speeds {lo:g}-{hi:g} rpm (the plot "
+                            "shows the run nearest each speed): give speeds the test covers")
+
+
 def rpm(lo: float = -MAX_RPM, hi: float = MAX_RPM):
     """An argparse ``type``: a wheel speed in rpm within [lo, hi]."""
     return number(lo, hi, unit="rpm")

@@ -209,3 +209,16 @@ def test_commands_run_with_one_blas_thread_unless_the_environment_says(monkeypat
 
     monkeypatch.setattr(cli, "one_blas_thread", recording)
     assert cli.main(["catalogue", "list"]) == 0 and entered == [True]
+
+
+def test_fit_refuses_flags_it_would_ignore(tmp_path, capsys):
+    """--mass (and --radius, --height, --preset) without --extended were ignored; --cumulative-rpm 5000 on a
+    600-2400 rpm test plotted the 2400 rpm run under a title of 5000."""
+    data = tmp_path / "e"
+    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "6",
+        "--samples", "1024", "--sample-rate", "1920", "--no-modes")
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--mass", "10")
+    assert code == 2 and "--mass" in err and "add --extended" in err
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--cumulative-rpm", "700,5000")
+    assert code == 2 and "--cumulative-rpm" in err and "5000 rpm is outside the test's speeds 600-2400 rpm" in err
+    assert not (tmp_path / "m.json").exists() and not (tmp_path / "m_report").exists()
