@@ -146,8 +146,7 @@ def _simulate_assumed_modes(args):
 
 def load_steady(path, args):
     """A steady test from a directory, a sweep CSV (sliced) or HDF5 (:func:`rwadist.read`)."""
-    return api.read(path, slice_samples=args.slice_samples, speed_source=args.speed_source, progress=True,
-                    log=print)
+    return api.read(path, slice_samples=args.slice_samples, speed_source=args.speed_source, progress=True, log=print)
 
 
 def run_fit(test, args, name: str, progress: bool = True):
@@ -393,6 +392,8 @@ def cmd_campbell(args) -> int:
     out = check_output_file(args.output)
     refuse_input_overwrite([("-o", out, "file"), ("-o", out.with_suffix(".png"), "file")], [args.model])
     params, lines, source = api.extended_source(args.model, preset=args.preset)
+    if args.model:
+        _warn_unconstrained(model_io.load(args.model), args.model, "the Campbell diagram")
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
     if np.ptp(np.abs(speeds)) == 0:
         raise DataError("--speeds-rpm", "value", f"{args.speeds_rpm!r} gives one speed ({float(speeds[0]):g} rpm); "
@@ -771,8 +772,7 @@ def main(argv=None) -> int:
         with one_blas_thread():
             return args.func(args)
     except KeyboardInterrupt:
-        print(f"rwadist {command}: interrupted; outputs left as they were (no partial file written)",
-              file=sys.stderr)
+        print(f"rwadist {command}: interrupted; outputs left as they were (no partial file written)", file=sys.stderr)
         return 130
     except (DataError, ValueError) as exc:
         print(f"rwadist: error: {exc}", file=sys.stderr)

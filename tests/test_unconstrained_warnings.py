@@ -1,4 +1,4 @@
-"""A model whose analytical.unconstrained lists modes: psd, fmu build and diagnose say so (stderr), once,
+"""A model whose analytical.unconstrained lists modes: psd, campbell, fmu build and diagnose say so (stderr), once,
 naming the file and the modes; a model without the list (or with it empty) gives no warning."""
 import pytest
 
@@ -46,3 +46,11 @@ def test_diagnose_warns(model_file, tmp_path, capsys):
     main(["diagnose", str(data), "-o", str(tmp_path / "r"), "--model", str(model_file)])
     err = capsys.readouterr().err
     assert err.count("analytical.unconstrained") == 1 and "diagnose" in err
+
+
+def test_campbell_warns(model_file, tmp_path, capsys):
+    """The Campbell diagram draws the modes the model file holds: one it lists as unconstrained is its starting value
+    (an all-unconstrained fitted model printed an empty crossing table and nothing else)."""
+    assert main(["campbell", str(model_file), "--speeds-rpm", "0:3000:500", "-o", str(tmp_path / "c.csv")]) == 0
+    err = capsys.readouterr().err
+    assert err.count("analytical.unconstrained") == 1 and "the Campbell diagram" in err
