@@ -188,7 +188,8 @@ def histogram_from_centres(speeds, weights, source="histogram", bounds=None) -> 
         hi = min(hi, 0.0)
     if bounds is not None:
         b_lo, b_hi = (float(x) for x in bounds)
-        out = (c < b_lo * (1 + 1e-12) - 1e-12) | (c > b_hi * (1 + 1e-12) + 1e-12)
+        tol = 1e-9 * max(abs(b_lo), abs(b_hi), 1.0)        # the same speed converted twice (rpm -> rad/s)
+        out = (c < b_lo - tol) | (c > b_hi + tol)
         if np.any(out):
             i = int(np.argmax(out))
             raise DataError(source, "speed_rpm", f"row {i} ({c[i] * RAD_S_TO_RPM:g} rpm) is outside the speed range "
@@ -290,8 +291,10 @@ def law_from_csv(path, n_bins: int = 2000, bounds=None):
         return histogram_from_centres(rpm_to_rad_s(col["speed_rpm"]), col["weight"], str(path), bounds)
     if "speed_rpm" in col and "pdf_per_rpm" in col:
         s, p = col["speed_rpm"], col["pdf_per_rpm"]
-        hist = histogram_from_centres(rpm_to_rad_s(s), np.maximum(p, 0), str(path), bounds)
-        widths = np.diff(np.asarray(hist.edges)) * RAD_S_TO_RPM
+        # a density: each bin's probability is its value times its width (bins end at the range, or are uneven)
+        edges = histogram_from_centres(rpm_to_rad_s(s), np.ones(np.size(s)), str(path), bounds).edges
+        widths = np.diff(np.asarray(edges)) * RAD_S_TO_RPM
+        hist = Histogram.from_weights(edges, np.maximum(p, 0) * widths, str(path))
         total = float(np.sum(p * widths))
         if abs(total - 1.0) > PDF_RTOL:
             raise DataError(path, "pdf_per_rpm", f"integrates to {total:.6g} over rpm, not 1 "
