@@ -297,6 +297,13 @@ class WheelDescription:
             empirical[d] = [Harmonic(h=h, C=C, sense=self.senses.get((d, h), "co") if radial else None)
                             for h, C in pairs]
         analytical = ext.params_to_dict(self.extended) if self.extended is not None else None
+        if analytical is not None:
+            from .catalogue import source_modes_assumed
+
+            # a catalogue datasheet wheel's modes are assumed: its model says so, whichever way it was made (the
+            # coupling notebook's preset(...).to_model() dropped it, and the wheel ran through guessed modes)
+            if source_modes_assumed(None, self.name):
+                analytical["modes_assumed"] = True
         return WheelModel(name=self.name, wheel=wheel, empirical=empirical, analytical=analytical,
                           provenance={"source": "rwadist.teststand.WheelDescription (simulation truth)",
                                       "notes": self.notes})

@@ -156,3 +156,16 @@ def test_diagnose_starts_hard_mounted_on_assumed_modes(tmp_path, capsys):
     cap = capsys.readouterr()
     assert "extended base" in cap.out and "ASSUMED" in cap.err
     assert "ASSUMED" in (tmp_path / "r2" / "ASSUMED_MODES.txt").read_text()
+
+
+def test_the_presets_model_of_a_datasheet_wheel_says_its_modes_are_assumed():
+    """The coupling notebook's route, rwadist.presets.preset(NAME).to_model(), carries analytical.modes_assumed as the
+    catalogue's model does (it dropped it: the HR16 ran through its guessed modes, LOS jitter +20 % at 6000 rpm,
+    without a warning); a wheel with measured modes stays without it."""
+    from rwadist.presets import preset
+
+    model = preset(HR16).to_model()
+    assert model.analytical["modes_assumed"] is True
+    with pytest.warns(RuntimeWarning, match="hard-mounted"):
+        assert wheel_spec_from_model(model).hard_mounted
+    assert "modes_assumed" not in preset("ithaco-e").to_model().analytical
