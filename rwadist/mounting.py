@@ -160,6 +160,24 @@ def _speed_law(spec, default_law, base: Path, where: str):
     return bb.law_from_csv(p if p.is_absolute() else base / p)
 
 
+#: the keys of a wheels.json wheel, its mounting and its tie: any other is refused (a typo of ``position_m`` put the
+#: wheel at the origin and took its r × F torques away, silently)
+WHEEL_KEYS = ("name", "model", "preset", "dcm", "position_m", "mounting", "speed", "tie")
+MOUNTING_KEYS = ("preset", "index", "radius_m", "elevation_deg")
+TIE_KEYS = ("to", "ratio", "phase_lock", "phase_offset_deg")
+
+
+def _check_keys(path, where: str, obj: dict, known: tuple) -> None:
+    """DataError naming the first key of ``obj`` not in ``known`` (with the closest known one)."""
+    import difflib
+
+    for k in obj:
+        if k not in known:
+            near = difflib.get_close_matches(str(k), known, n=1)
+            raise DataError(path, f"{where}.{k}", "unknown key" + (f" (did you mean {near[0]!r}?)" if near else "")
+                            + f"; known: {', '.join(known)}")
+
+
 def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bool = False,
                 assumed_modes: bool = False) -> list:
     """Read a wheels.json file into :class:`WheelSpec` objects.
@@ -189,6 +207,15 @@ def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bo
         where = f"wheels[{i}]"
         if not isinstance(w, dict):
             raise DataError(path, where, f"must be an object, got {w!r}")
+        _check_keys(path, where, w, WHEEL_KEYS)
+        for key, known in (("mounting", MOUNTING_KEYS), ("tie", TIE_KEYS)):
+            if isinstance(w.get(key), dict):
+                _check_keys(path, f"{where}.{key}", w[key], known)
+        if "tie" in w and "speed" in w:
+            raise DataError(path, f"{where}.speed", "a wheel tied to another runs at its speed: give 'tie' or 'speed', "
+                            "not both")
+        if names.count(names[i]) > 1:
+            raise DataError(path, f"{where}.name", f"{names[i]!r} names more than one wheel; names: {names}")
         # sources
         if "model" in w:
             mp = Path(w["model"])

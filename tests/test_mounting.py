@@ -108,3 +108,33 @@ def test_wheels_file_errors(tmp_path):
                               "tie": {"to": "nobody"}}]))
     with pytest.raises(DataError, match="tie.to"):
         mt.load_wheels(p)
+
+
+@pytest.mark.parametrize("wheel,field,message", [
+    ({"preset": "ithaco-e", "dcm": np.eye(3).tolist(), "positon_m": [1, 0, 0]}, r"wheels\[0\]\.positon_m",
+     r"unknown key \(did you mean 'position_m'\?\)"),
+    ({"preset": "ithaco-e", "dcm": np.eye(3).tolist(), "sped": {"dist": "uniform"}}, r"wheels\[0\]\.sped",
+     r"did you mean 'speed'"),
+    ({"preset": "ithaco-e", "mountng": {"preset": "pyramid-4"}}, r"wheels\[0\]\.mountng", r"did you mean 'mounting'"),
+    ({"preset": "ithaco-e", "mounting": {"preset": "pyramid-4", "indx": 1}}, r"wheels\[0\]\.mounting\.indx",
+     r"did you mean 'index'"),
+    ({"name": "B", "preset": "ithaco-e", "mounting": {"preset": "pyramid-4"}, "tie": {"to": "A"},
+      "speed": {"dist": "uniform", "min_rpm": 0, "max_rpm": 100}}, r"wheels\[0\]\.speed", r"'tie' or 'speed'"),
+])
+def test_wheels_file_keys_it_does_not_read_are_refused(tmp_path, wheel, field, message):
+    """A typo of position_m put the wheel at the origin (its r × F torques gone: Ty 0.048 instead of 0.098 N·m),
+    of speed took the command line's law, and speed beside tie was dropped: each is refused naming the key."""
+    p = tmp_path / "w.json"
+    p.write_text(json.dumps([{"name": "A", "preset": "ithaco-e", "mounting": {"preset": "pyramid-4", "index": 1},
+                              "speed": {"dist": "uniform", "min_rpm": 0, "max_rpm": 100}}, wheel]))
+    with pytest.raises(DataError, match=field.replace("0", "1") + ".*" + message):
+        mt.load_wheels(p)
+
+
+def test_wheels_file_names_are_unique(tmp_path):
+    p = tmp_path / "w.json"
+    w = {"name": "RW", "preset": "ithaco-e", "mounting": {"preset": "pyramid-4"},
+         "speed": {"dist": "uniform", "min_rpm": 0, "max_rpm": 100}}
+    p.write_text(json.dumps([w, w]))
+    with pytest.raises(DataError, match=r"wheels\[0\]\.name.*'RW' names more than one wheel"):
+        mt.load_wheels(p)
