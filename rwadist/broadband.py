@@ -477,7 +477,20 @@ def csd_groups(groups, f_max: float, n_freq: int = 20001, n_speeds: int = 2000, 
     csd = np.empty((f.size, 6, 6), dtype=complex)
     csd[:, _PAIR_A, _PAIR_B] = acc.T
     csd[:, _PAIR_B, _PAIR_A] = np.conj(acc.T)
-    return BroadbandPSD(f=f, csd=csd + floors, frame=frame)
+    return BroadbandPSD(f=f, csd=_rounding_clipped(csd + floors), frame=frame)
+
+
+def _rounding_clipped(csd: np.ndarray) -> np.ndarray:
+    """``csd`` (n, 6, 6) with what rounding left outside a cross-spectral matrix taken off: the ramps' second
+    differences leave ~-1e-18 on auto-spectra of bins without power (they reached psd.csv and the NASTRAN tables),
+    clipped to 0, and a cross term then larger than sqrt(S_aa·S_bb) (Cauchy-Schwarz) scaled down to it."""
+    auto = np.maximum(np.real(np.einsum("kaa->ka", csd)), 0.0)
+    bound = np.sqrt(auto[:, :, None] * auto[:, None, :])
+    mag = np.abs(csd)
+    out = csd * np.where(mag > bound, bound / np.where(mag > 0, mag, 1.0), 1.0)
+    idx = np.arange(csd.shape[1])
+    out[:, idx, idx] = auto
+    return out
 
 
 def broadband_psd(lines: WheelLines, law, f_max: float, n_freq: int = 20001, n_speeds: int = 2000,
