@@ -34,6 +34,7 @@ from .validate import (
     check_extended_only,
     check_grid_size,
     check_parsed,
+    check_psd_flags,
     check_speeds_rpm,
     check_within_test,
     refuse_non_finite_model,
@@ -249,8 +250,7 @@ def run_extended_fit(test, fit, args):
         print(f"  note: {note}")
     if efit.unconstrained:
         print(f"  UNCONSTRAINED by the data (starting values, or values not told apart from a test stand: see the "
-              f"notes; listed in the model file): "
-              f"{', '.join(efit.unconstrained)}")
+              f"notes; listed in the model file): {', '.join(efit.unconstrained)}")
     return efit, model
 
 
@@ -258,8 +258,7 @@ def _warn_unconstrained(model, source, use) -> None:
     """Print (stderr) that the model has modes the extended fit could not identify, if it has."""
     from .extended_fit import unconstrained_warning
 
-    text = unconstrained_warning(model, str(source), use)
-    if text:
+    if text := unconstrained_warning(model, str(source), use):
         print(text, file=sys.stderr)
 
 
@@ -597,6 +596,7 @@ def cmd_psd(args) -> int:
 
     if args.preset and args.model:
         raise DataError("psd", "model/--preset", "give a model file or --preset, not both")
+    check_psd_flags(args)
     if not args.speed_rpm:
         raise DataError("--speed-rpm", "value", "missing MIN:MAX (rpm)")
     try:

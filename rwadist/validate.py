@@ -129,6 +129,23 @@ def check_within_test(speeds_rpm, test, flag: str) -> None:
                             "shows the run nearest each speed): give speeds the test covers")
 
 
+def check_psd_flags(args: argparse.Namespace) -> None:
+    """``rwadist psd``: flags that the chosen output or law would ignore are refused, as is an output whose extension
+    names the other format (a NASTRAN deck written as x.csv, CSV as x.bdf)."""
+    from pathlib import Path
+
+    nastran = args.format == "nastran"
+    if not nastran and (args.nastran_cross or args.nastran_fields != "small"):
+        raise DataError("--nastran-cross" if args.nastran_cross else "--nastran-fields", "value",
+                        "applies to --format nastran only")
+    if args.std_rpm is not None and args.dist != "normal":
+        raise DataError("--std-rpm", "value", f"applies to --dist normal only (--dist is {args.dist!r})")
+    suffix = Path(args.output).suffix.lower()
+    if nastran and suffix == ".csv" or not nastran and suffix in (".bdf", ".dat", ".nas", ".blk"):
+        raise DataError("-o", "value", f"{args.output!r}: its extension names the other format than --format "
+                        f"{args.format}; give a {'.bdf' if nastran else '.csv'} file")
+
+
 def rpm(lo: float = -MAX_RPM, hi: float = MAX_RPM):
     """An argparse ``type``: a wheel speed in rpm within [lo, hi]."""
     return number(lo, hi, unit="rpm")

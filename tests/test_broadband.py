@@ -249,6 +249,13 @@ def test_cli_psd_outputs_and_errors(tmp_path, capsys):
     assert main(["psd", str(m), "--speed-rpm", "300:3000", "--wheels", str(wj), "-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert "wheels[0].model" in err and "nope.json" in err and "does not exist" in err
+    # flags the output or the law would ignore, and an extension naming the other format (each was taken silently)
+    for extra, flag in ((["--nastran-cross"], "--nastran-cross"), (["--std-rpm", "100"], "--std-rpm"),
+                        (["--format", "nastran"], "-o")):
+        assert main(["psd", str(m), "--speed-rpm", "300:3000", "-o", str(out)] + extra) == 2
+        assert f"{flag}: value:" in capsys.readouterr().err
+    assert main(["psd", str(m), "--speed-rpm", "300:3000", "-o", str(tmp_path / "p.bdf")]) == 2
+    assert "its extension names the other format" in capsys.readouterr().err
 
 
 def test_envelope_is_largest_line_amplitude():
