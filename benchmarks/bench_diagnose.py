@@ -296,8 +296,12 @@ def modes_on_table(seeds, groups=None):
     print(f"\nmodes on: {sum(passed)}/{len(passed)} cases pass every criterion of their test")
 
 
-def timing(fit_repeats: int = 5, diagnose_repeats: int = 2):
+def timing(fit_repeats: int = 5, diagnose_repeats: int = 5):
+    """The same estimator on both sides (the best of 5 calls each: until 2026-11-25 the best of 5 fits against the
+    best of 2 diagnoses, whose first call carries its warm-up), each call with one BLAS thread as the command line
+    runs it (:func:`rwadist.cli.one_blas_thread`)."""
     from rwadist import api
+    from rwadist.cli import one_blas_thread
     from rwadist.inject import parse, prepare_wheel
 
     w = preset("ithaco-e")
@@ -324,8 +328,9 @@ def timing(fit_repeats: int = 5, diagnose_repeats: int = 2):
             cpus.append(time.process_time() - c0)
         return min(walls), min(cpus), cpus, out
 
-    t_fit, c_fit, c_fits, _ = timed(lambda: api.fit(t), fit_repeats)
-    t_diag, c_diag, c_diags, d = timed(lambda: api.diagnose(t), diagnose_repeats)
+    with one_blas_thread():
+        t_fit, c_fit, c_fits, _ = timed(lambda: api.fit(t), fit_repeats)
+        t_diag, c_diag, c_diags, d = timed(lambda: api.diagnose(t), diagnose_repeats)
     print(f"\n{speeds.size} speeds ({speeds.min():g}-{speeds.max():g} rpm) x {n_ch} channels, "
           f"{w.default_n_samples} samples at {w.default_sample_rate:g} Hz, modes on, one effect "
           "(the wheel's h = 4.42 radial-force line as Omega^2.5, through the modes); best of "
