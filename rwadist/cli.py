@@ -32,6 +32,7 @@ from .units import RAD_S_TO_RPM, rpm_to_rad_s
 from .validate import (
     MAX_SAMPLES,
     check_extended_only,
+    check_fmu_ramp,
     check_grid_size,
     check_parsed,
     check_psd_flags,
@@ -479,10 +480,10 @@ def cmd_fmu_check(args) -> int:
     if not Path(args.fmu).is_file():
         raise DataError(args.fmu, "file", "does not exist")
     _check_fmu_archive(args.fmu)
-    n_steps = args.stop_time / args.step_size
-    if n_steps < 1 or n_steps > 1e7:
+    if not 1 <= (n_steps := args.stop_time / args.step_size) <= 1e7:
         raise DataError("--step-size", "value", f"{args.step_size:g} s over --stop-time {args.stop_time:g} s makes "
                         f"{n_steps:.3g} steps: allowed 1 to 1e7 steps")
+    check_fmu_ramp(args.fmu, args.speed_rpm, args.stop_time)
     try:
         problems = validate_fmu(args.fmu)
     except Exception as exc:    # fmpy raises assorted errors on a damaged archive or XML
@@ -524,8 +525,7 @@ def cmd_fmu_check(args) -> int:
     finite = all(np.all(np.isfinite(res[c])) for c in names)
     print(f"simulated 0 -> {args.speed_rpm:g} rpm over {t[-1]:g} s at {args.step_size:g} s steps in {wall:.2f} s "
           f"wall ({len(res)} samples)")
-    for c in names:
-        print(f"  {c:<6} max |.| = {np.max(np.abs(res[c])):.4g}")
+    print("\n".join(f"  {c:<6} max |.| = {np.max(np.abs(res[c])):.4g}" for c in names))
     if problems or not finite:
         print("rwadist: error: FMU check failed" + ("" if finite else " (non-finite outputs)"), file=sys.stderr)
         return 1

@@ -146,6 +146,21 @@ def check_psd_flags(args: argparse.Namespace) -> None:
                         f"{args.format}; give a {'.bdf' if nastran else '.csv'} file")
 
 
+def check_fmu_ramp(fmu_path, speed_rpm: float, stop_time: float) -> None:
+    """``rwadist fmu check``: the check's ramp 0 -> ``speed_rpm`` over ``stop_time`` s must stay within the FMU's
+    ``max_acceleration`` (its start value): 6000 rpm over the default 1 s is 628 rad/s², which the FMU refuses (500
+    rad/s² by default), and the check then failed (exit 1) as if the FMU were broken."""
+    from fmpy import read_model_description
+
+    var = next((v for v in read_model_description(str(fmu_path)).modelVariables if v.name == "max_acceleration"),
+               None)
+    accel = abs(speed_rpm) * 2.0 * math.pi / 60.0 / stop_time
+    if var is not None and var.start is not None and accel > float(var.start):
+        raise DataError("--stop-time", "value", f"{stop_time:g} s to {speed_rpm:g} rpm is {accel:.4g} rad/s², above the "
+                        f"FMU's max_acceleration of {float(var.start):g} rad/s²: give --stop-time "
+                        f"{math.ceil(100 * accel * stop_time / float(var.start)) / 100:g} s or more")
+
+
 def rpm(lo: float = -MAX_RPM, hi: float = MAX_RPM):
     """An argparse ``type``: a wheel speed in rpm within [lo, hi]."""
     return number(lo, hi, unit="rpm")

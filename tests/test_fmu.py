@@ -561,10 +561,12 @@ def test_cli_fmu_build_and_check(tmp_path, model_path, capsys):
     assert main(["fmu", "check", str(out), "--stop-time", "0.5"]) == 0
     text = capsys.readouterr().out
     assert "fmpy validation: 0 problem(s)" in text and "Fx_sc" in text and "(501 samples)" in text
-    # 1500 rpm in 0.2 s is 785 rad/s², above the FMU's max_acceleration (500): refused, reported
-    assert main(["fmu", "check", str(out), "--stop-time", "0.2"]) == 1
+    # 1500 rpm in 0.2 s is 785 rad/s², above the FMU's max_acceleration (500): the check's own ramp is refused before
+    # it runs, naming the flag and the shortest ramp (it ran, failed with exit 1, and read as a broken FMU)
+    assert main(["fmu", "check", str(out), "--stop-time", "0.2"]) == 2
     err = capsys.readouterr().err
-    assert "the FMU says" in err and "max_acceleration" in err
+    assert "--stop-time: value:" in err and "785.4 rad/s²" in err and "max_acceleration of 500" in err
+    assert "give --stop-time 0.32 s or more" in err
     assert main(["fmu", "build", "--preset", "ithaco-e", "-o", str(tmp_path / "e.fmu")]) == 0
     bad = tmp_path / "bad.json"
     bad.write_text("{}")
