@@ -15,6 +15,7 @@ from . import api, catalogue
 from . import data as data_io
 from . import model as model_io
 from .cli_catalogue import cmd_catalogue_list, cmd_catalogue_show, cmd_model_compare  # noqa: F401 (parser)
+from .cli_fmu import cmd_fmu_build, cmd_fmu_check  # noqa: F401 (parser)
 from .cli_parser import _version
 from .data import DataError
 from .outputs import (
@@ -26,13 +27,13 @@ from .outputs import (
     check_output_file,
     refuse_input_overwrite,
 )
+from .outputs import write_file as _write
 from .plot_util import save_png
 from .progress import working
-from .units import RAD_S_TO_RPM, rpm_to_rad_s
+from .units import RAD_S_TO_RPM
 from .validate import (
     MAX_SAMPLES,
     check_extended_only,
-    check_fmu_ramp,
     check_grid_size,
     check_parsed,
     check_psd_flags,
@@ -40,6 +41,8 @@ from .validate import (
     check_within_test,
     refuse_non_finite_model,
     refuse_non_finite_psd,
+    warn_beyond_rated_speed,
+    warn_unconstrained,
 )
 
 
@@ -255,14 +258,6 @@ def run_extended_fit(test, fit, args):
     return efit, model
 
 
-def _warn_unconstrained(model, source, use) -> None:
-    """Print (stderr) that the model has modes the extended fit could not identify, if it has."""
-    from .extended_fit import unconstrained_warning
-
-    if text := unconstrained_warning(model, str(source), use):
-        print(text, file=sys.stderr)
-
-
 # --------------------------------------------------------------------------- model show
 
 def cmd_model_show(args) -> int:
@@ -393,7 +388,7 @@ def cmd_campbell(args) -> int:
     refuse_input_overwrite([("-o", out, "file"), ("-o", out.with_suffix(".png"), "file")], [args.model])
     params, lines, source = api.extended_source(args.model, preset=args.preset)
     if args.model:
-        _warn_unconstrained(model_io.load(args.model), args.model, "the Campbell diagram")
+        warn_unconstrained(model_io.load(args.model), args.model, "the Campbell diagram")
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
     if np.ptp(np.abs(speeds)) == 0:
         raise DataError("--speeds-rpm", "value", f"{args.speeds_rpm!r} gives one speed ({float(speeds[0]):g} rpm); "
@@ -414,124 +409,6 @@ def cmd_campbell(args) -> int:
     return 0
 
 
-# --------------------------------------------------------------------------- fmu
-
-def cmd_fmu_build(args) -> int:
-    try:
-        from rwadist.fmu.build import build_fmu, has_native
-        from rwadist.fmu.runtime import ModelError
-    except ImportError as exc:
-        raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
-    out = check_output_file(args.output)
-    if out.suffix != ".fmu":
-        raise DataError("-o", "value", f"{str(out)!r} must end in .fmu")
-    refuse_input_overwrite([("-o", out, "file")], [args.model])
-    if args.model:
-        source = args.model
-        _warn_unconstrained(model_io.load(args.model), args.model, "the FMU")
-    else:
-        from . import catalogue
-        from .presets import preset
-        source = catalogue.preset_model(args.preset or "ithaco-e") or preset(args.preset or "ithaco-e").to_model()
-    try:
-        if getattr(args, "native", False):
-            from rwadist.fmu.native_build import build_native_fmu
-            with working("rwadist fmu build: compiling the native FMU"):
-                path = _write(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes))
-        else:
-            with working("rwadist fmu build: packaging the FMU"):
-                path = _write(out, lambda tmp: build_fmu(source, tmp, assumed_modes=args.assumed_modes))
-    except ModelError as exc:
-        if exc.field is not None:       # a bad model-file field: the schema's message names file and field
-            raise
-        raise DataError(args.model or args.preset, "model", str(exc)) from None
-    what = f"model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')}"
-    if getattr(args, "native", False):
-        print(f"wrote {path} ({what}; native FMU: C only, no Python needed by the host)")
-    else:
-        print(f"wrote {path} ({what}; native layer: "
-              f"{'yes' if has_native(path) else 'no, numpy steps and fmi2Discard on bad input'})")
-    return 0
-
-
-def _check_fmu_archive(path) -> None:
-    """Refuse a file that is not a complete FMU archive (a zip holding modelDescription.xml)."""
-    import zipfile
-
-    try:
-        with zipfile.ZipFile(path) as z:
-            names = set(z.namelist())
-            broken = z.testzip()
-    except (zipfile.BadZipFile, OSError, EOFError, ValueError) as exc:
-        raise DataError(path, "FMU", f"not an FMU archive (a zip file): {exc}; give the .fmu written by "
-                        "`rwadist fmu build`") from None
-    if "modelDescription.xml" not in names:
-        raise DataError(path, "FMU", "the archive has no modelDescription.xml: not an FMU")
-    if broken is not None:
-        raise DataError(path, "FMU", f"damaged archive (member {broken!r} fails its checksum); rebuild it")
-
-
-def cmd_fmu_check(args) -> int:
-    try:
-        from fmpy import simulate_fmu
-        from fmpy.validation import validate_fmu
-    except ImportError as exc:
-        raise DataError(args.fmu, "check", f"needs fmpy ({exc})") from None
-    if not Path(args.fmu).is_file():
-        raise DataError(args.fmu, "file", "does not exist")
-    _check_fmu_archive(args.fmu)
-    if not 1 <= (n_steps := args.stop_time / args.step_size) <= 1e7:
-        raise DataError("--step-size", "value", f"{args.step_size:g} s over --stop-time {args.stop_time:g} s makes "
-                        f"{n_steps:.3g} steps: allowed 1 to 1e7 steps")
-    check_fmu_ramp(args.fmu, args.speed_rpm, args.stop_time)
-    try:
-        problems = validate_fmu(args.fmu)
-    except Exception as exc:    # fmpy raises assorted errors on a damaged archive or XML
-        raise DataError(args.fmu, "FMU", f"cannot be read by fmpy ({type(exc).__name__}: {str(exc)[:160]}); "
-                        "rebuild it with `rwadist fmu build`") from None
-    for prob in problems:
-        print(f"validation: {prob}")
-    print(f"fmpy validation: {len(problems)} problem(s)")
-    try:
-        from rwadist.fmu.build import has_native
-        print(f"native layer (fmi2Error on bad input, C step kernel): {'yes' if has_native(args.fmu) else 'no'}")
-    except Exception:   # informational only; validation above already judged the file
-        pass
-    w_end = float(rpm_to_rad_s(args.speed_rpm))
-    n = int(round(args.stop_time / args.step_size))
-    t = np.linspace(0.0, n * args.step_size, n + 1)
-    sig = np.zeros(t.size, dtype=[("time", float), ("wheel_speed", float)])
-    sig["time"], sig["wheel_speed"] = t, w_end * t / t[-1]
-    errors = []
-
-    def fmu_log(component, instance, status, category, message):
-        if status >= 3:       # fmi2Error and worse: the FMU says why it refused
-            errors.append(message.decode(errors="replace") if isinstance(message, bytes) else str(message))
-
-    t0 = time.perf_counter()
-    try:
-        res = simulate_fmu(args.fmu, stop_time=float(t[-1]), step_size=args.step_size, input=sig,
-                           output_interval=args.step_size, logger=fmu_log, debug_logging=True)
-    except Exception as exc:   # fmpy raises FMICallException on a refused step; the FMU logged why
-        why = f"; the FMU says: {errors[-1]}" if errors else ""
-        print(f"rwadist: error: FMU check failed: the simulation stopped: {exc}{why}", file=sys.stderr)
-        return 1
-    wall = time.perf_counter() - t0
-    if len(res) < t.size:
-        print(f"rwadist: error: FMU check failed: the simulation stopped after {len(res)} of {t.size} samples",
-              file=sys.stderr)
-        return 1
-    names = [c for c in res.dtype.names if c != "time"]
-    finite = all(np.all(np.isfinite(res[c])) for c in names)
-    print(f"simulated 0 -> {args.speed_rpm:g} rpm over {t[-1]:g} s at {args.step_size:g} s steps in {wall:.2f} s "
-          f"wall ({len(res)} samples)")
-    print("\n".join(f"  {c:<6} max |.| = {np.max(np.abs(res[c])):.4g}" for c in names))
-    if problems or not finite:
-        print("rwadist: error: FMU check failed" + ("" if finite else " (non-finite outputs)"), file=sys.stderr)
-        return 1
-    return 0
-
-
 # --------------------------------------------------------------------------- diagnose
 
 def cmd_diagnose(args) -> int:
@@ -546,7 +423,7 @@ def cmd_diagnose(args) -> int:
     test = load_steady(args.data, args)
     model = model_io.load(args.model) if args.model else None
     if model is not None:
-        _warn_unconstrained(model, args.model, "diagnose's extended base")
+        warn_unconstrained(model, args.model, "diagnose's extended base")
     # a starting model whose suspension modes are assumed (datasheet wheel) is hard-mounted unless
     # --base extended asks for its assumed modes explicitly: the rule is resolve_base's (api.diagnose)
     assumed = catalogue.source_modes_assumed(model, args.preset)
@@ -608,10 +485,16 @@ def cmd_psd(args) -> int:
         raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: empty or inverted speed range; MIN must be "
                         "below MAX (rpm; a negative range, e.g. -2400:-600, spins about -z)")
     law = bb.law_from_spec(args.dist, lo_rpm, hi_rpm, args.std_rpm)
+    if args.model or args.preset:
+        from .presets import preset
+
+        rated = model_io.load(args.model) if args.model else (catalogue.preset_model(args.preset)
+                                                              or preset(args.preset).to_model())
+        warn_beyond_rated_speed(rated, args.model or args.preset, lo_rpm, hi_rpm)
 
     def default_lines():
         if args.model and not hard_mounted:
-            _warn_unconstrained(model_io.load(args.model), args.model, "the PSD")
+            warn_unconstrained(model_io.load(args.model), args.model, "the PSD")
         return api.wheel_lines(args.model, preset=args.preset, empirical=hard_mounted)
 
     # a wheel whose suspension modes are assumed (datasheet) runs hard-mounted unless --assumed-modes
@@ -694,17 +577,6 @@ def cmd_psd(args) -> int:
 
 
 _default_fmax = api.default_fmax
-
-
-# --------------------------------------------------------------------------- outputs
-
-def _write(path, writer):
-    """Run ``writer(tmp)`` on a temporary sibling of ``path`` and rename it onto ``path`` when complete
-    (:func:`rwadist.outputs.atomic_file`); returns ``path``."""
-    path = Path(path)
-    with atomic_file(path) as tmp:
-        writer(tmp)
-    return path
 
 
 # --------------------------------------------------------------------------- main

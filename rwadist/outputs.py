@@ -287,3 +287,12 @@ def atomic_dataset_dir(path, flag: str = "-o"):
     path = check_dataset_dir(path, flag)
     with atomic_dir(path) as tmp:
         yield tmp
+
+
+def write_file(path, writer):
+    """Run ``writer(tmp)`` on a temporary sibling of ``path`` and rename it onto ``path`` when complete
+    (:func:`atomic_file`); returns ``path`` (a :class:`pathlib.Path`)."""
+    path = Path(path)
+    with atomic_file(path) as tmp:
+        writer(tmp)
+    return path

@@ -317,3 +317,15 @@ def test_auto_spectra_are_never_negative():
         assert np.all(np.isfinite(r.rms())) and r.rms()[0] > 0
         S = r.psd
         assert np.all(np.abs(r.csd) ** 2 <= S[:, :, None] * S[:, None, :] * (1 + 1e-12) + 1e-300)   # Cauchy-Schwarz
+
+
+def test_cli_psd_warns_beyond_the_wheels_rated_speed(tmp_path, capsys):
+    """The E wheel is rated 3850 rpm (its model's wheel.max_speed_rpm): 0:10000 rpm is computed with a warning that
+    names the flag and the limit; within it, nothing is said."""
+    out = tmp_path / "p.csv"
+    argv = ["psd", "--preset", "ithaco-e", "--n-freq", "401", "--n-speeds", "50", "--empirical", "-o", str(out)]
+    assert main(argv + ["--speed-rpm", "0:10000"]) == 0
+    err = capsys.readouterr().err
+    assert "WARNING: --speed-rpm 0:10000 rpm reaches beyond the maximum speed of ithaco-e, 3850 rpm" in err
+    assert main(argv + ["--speed-rpm", "0:3000"]) == 0
+    assert "WARNING" not in capsys.readouterr().err

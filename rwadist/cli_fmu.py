@@ -1,0 +1,132 @@
+"""`rwadist fmu build` and `rwadist fmu check`: the FMU of a model file or preset, packaged (pythonfmu) or native
+(C), and its check by an independent host (fmpy: validation and a spin-up), kept out of cli.py."""
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import model as model_io
+from .data import DataError
+from .outputs import check_output_file, refuse_input_overwrite, write_file
+from .progress import working
+from .units import rpm_to_rad_s
+from .validate import check_fmu_ramp, warn_unconstrained
+
+
+def cmd_fmu_build(args) -> int:
+    try:
+        from rwadist.fmu.build import build_fmu, has_native
+        from rwadist.fmu.runtime import ModelError
+    except ImportError as exc:
+        raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
+    out = check_output_file(args.output)
+    if out.suffix != ".fmu":
+        raise DataError("-o", "value", f"{str(out)!r} must end in .fmu")
+    refuse_input_overwrite([("-o", out, "file")], [args.model])
+    if args.model:
+        source = args.model
+        warn_unconstrained(model_io.load(args.model), args.model, "the FMU")
+    else:
+        from . import catalogue
+        from .presets import preset
+        source = catalogue.preset_model(args.preset or "ithaco-e") or preset(args.preset or "ithaco-e").to_model()
+    try:
+        if getattr(args, "native", False):
+            from rwadist.fmu.native_build import build_native_fmu
+            with working("rwadist fmu build: compiling the native FMU"):
+                path = write_file(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes))
+        else:
+            with working("rwadist fmu build: packaging the FMU"):
+                path = write_file(out, lambda tmp: build_fmu(source, tmp, assumed_modes=args.assumed_modes))
+    except ModelError as exc:
+        if exc.field is not None:       # a bad model-file field: the schema's message names file and field
+            raise
+        raise DataError(args.model or args.preset, "model", str(exc)) from None
+    what = f"model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')}"
+    if getattr(args, "native", False):
+        print(f"wrote {path} ({what}; native FMU: C only, no Python needed by the host)")
+    else:
+        print(f"wrote {path} ({what}; native layer: "
+              f"{'yes' if has_native(path) else 'no, numpy steps and fmi2Discard on bad input'})")
+    return 0
+
+
+def _check_fmu_archive(path) -> None:
+    """Refuse a file that is not a complete FMU archive (a zip holding modelDescription.xml)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as z:
+            names = set(z.namelist())
+            broken = z.testzip()
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError) as exc:
+        raise DataError(path, "FMU", f"not an FMU archive (a zip file): {exc}; give the .fmu written by "
+                        "`rwadist fmu build`") from None
+    if "modelDescription.xml" not in names:
+        raise DataError(path, "FMU", "the archive has no modelDescription.xml: not an FMU")
+    if broken is not None:
+        raise DataError(path, "FMU", f"damaged archive (member {broken!r} fails its checksum); rebuild it")
+
+
+def cmd_fmu_check(args) -> int:
+    try:
+        from fmpy import simulate_fmu
+        from fmpy.validation import validate_fmu
+    except ImportError as exc:
+        raise DataError(args.fmu, "check", f"needs fmpy ({exc})") from None
+    if not Path(args.fmu).is_file():
+        raise DataError(args.fmu, "file", "does not exist")
+    _check_fmu_archive(args.fmu)
+    if not 1 <= (n_steps := args.stop_time / args.step_size) <= 1e7:
+        raise DataError("--step-size", "value", f"{args.step_size:g} s over --stop-time {args.stop_time:g} s makes "
+                        f"{n_steps:.3g} steps: allowed 1 to 1e7 steps")
+    check_fmu_ramp(args.fmu, args.speed_rpm, args.stop_time)
+    try:
+        problems = validate_fmu(args.fmu)
+    except Exception as exc:    # fmpy raises assorted errors on a damaged archive or XML
+        raise DataError(args.fmu, "FMU", f"cannot be read by fmpy ({type(exc).__name__}: {str(exc)[:160]}); "
+                        "rebuild it with `rwadist fmu build`") from None
+    for prob in problems:
+        print(f"validation: {prob}")
+    print(f"fmpy validation: {len(problems)} problem(s)")
+    try:
+        from rwadist.fmu.build import has_native
+        print(f"native layer (fmi2Error on bad input, C step kernel): {'yes' if has_native(args.fmu) else 'no'}")
+    except Exception:   # informational only; validation above already judged the file
+        pass
+    w_end = float(rpm_to_rad_s(args.speed_rpm))
+    n = int(round(args.stop_time / args.step_size))
+    t = np.linspace(0.0, n * args.step_size, n + 1)
+    sig = np.zeros(t.size, dtype=[("time", float), ("wheel_speed", float)])
+    sig["time"], sig["wheel_speed"] = t, w_end * t / t[-1]
+    errors = []
+
+    def fmu_log(component, instance, status, category, message):
+        if status >= 3:       # fmi2Error and worse: the FMU says why it refused
+            errors.append(message.decode(errors="replace") if isinstance(message, bytes) else str(message))
+
+    t0 = time.perf_counter()
+    try:
+        res = simulate_fmu(args.fmu, stop_time=float(t[-1]), step_size=args.step_size, input=sig,
+                           output_interval=args.step_size, logger=fmu_log, debug_logging=True)
+    except Exception as exc:   # fmpy raises FMICallException on a refused step; the FMU logged why
+        why = f"; the FMU says: {errors[-1]}" if errors else ""
+        print(f"rwadist: error: FMU check failed: the simulation stopped: {exc}{why}", file=sys.stderr)
+        return 1
+    wall = time.perf_counter() - t0
+    if len(res) < t.size:
+        print(f"rwadist: error: FMU check failed: the simulation stopped after {len(res)} of {t.size} samples",
+              file=sys.stderr)
+        return 1
+    names = [c for c in res.dtype.names if c != "time"]
+    finite = all(np.all(np.isfinite(res[c])) for c in names)
+    print(f"simulated 0 -> {args.speed_rpm:g} rpm over {t[-1]:g} s at {args.step_size:g} s steps in {wall:.2f} s "
+          f"wall ({len(res)} samples)")
+    print("\n".join(f"  {c:<6} max |.| = {np.max(np.abs(res[c])):.4g}" for c in names))
+    if problems or not finite:
+        print("rwadist: error: FMU check failed" + ("" if finite else " (non-finite outputs)"), file=sys.stderr)
+        return 1
+    return 0
