@@ -418,3 +418,16 @@ def test_kernel_sincos_is_libm_within_an_ulp(tmp_path):
     subprocess.run([cc, "-O2", f"-I{NATIVE}", "-o", str(tmp_path / "chk"), str(src), "-lm"], check=True)
     worst = float(subprocess.run([str(tmp_path / "chk")], capture_output=True, text=True, check=True).stdout)
     assert worst <= 1.0 + 1e-9, worst
+
+
+def test_fmu_check_says_which_fmu_it_checked(fmus, capsys):
+    """``rwadist fmu check`` of the native FMU says it is C only (it printed 'native layer ...: no', read as a missing
+    part); of the packaged one, whether its native layer is there."""
+    from rwadist.cli import main
+
+    _, native, python = fmus
+    assert main(["fmu", "check", str(native), "--stop-time", "0.5"]) == 0
+    out = capsys.readouterr().out
+    assert "native FMU: C only, no Python needed by the host" in out and "native layer" not in out
+    assert main(["fmu", "check", str(python), "--stop-time", "0.5"]) == 0
+    assert "native layer (fmi2Error on bad input, C step kernel):" in capsys.readouterr().out
