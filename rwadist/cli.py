@@ -34,6 +34,7 @@ from .units import RAD_S_TO_RPM
 from .validate import (
     MAX_SAMPLES,
     check_extended_only,
+    check_f_lim,
     check_grid_size,
     check_parsed,
     check_psd_flags,
@@ -119,6 +120,12 @@ def cmd_simulate(args) -> int:
                                  seed=args.seed, physics=args.physics, inject=args.inject)
     for e in test.meta.get("injected", []):
         print("injected " + e["kind"] + ": " + ", ".join(f"{k}={v}" for k, v in e.items() if k != "kind"))
+    if above := test.meta.get("lines_above_nyquist"):
+        lines = sorted({(x["direction"], x["h"]) for x in above})
+        named = ", ".join(f"{d} h={h:g}" for d, h in lines[:4]) + (" ..." if len(lines) > 4 else "")
+        print(f"note: {len(lines)} of the wheel's lines reach the Nyquist frequency in "
+              f"{len({x['speed_rpm'] for x in above})} run(s) and are not recorded there, as an anti-aliasing filter "
+              f"would ({named}; meta.json lines_above_nyquist); raise --sample-rate to keep them")
     speeds = np.array([r.speed for r in test.runs]) * RAD_S_TO_RPM
     fs = test.runs[0].sample_rate
     if assumed_note:
@@ -155,6 +162,7 @@ def load_steady(path, args):
 
 
 def run_fit(test, args, name: str, progress: bool = True):
+    check_f_lim(test, args.f_lim)
     return api.fit(test, f_lim=args.f_lim, nperseg=args.nperseg, presence=args.presence, epsilon=args.epsilon,
                    exclude_modes=not args.no_mode_exclusion, name=name, progress=progress)
 
@@ -432,6 +440,7 @@ def cmd_diagnose(args) -> int:
         print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); the starting "
               "prediction is hard-mounted (C*omega^2), modes the data show are fitted from them; --base extended "
               "uses the assumed modes")
+    check_f_lim(test, args.f_lim)
     try:
         with working("rwadist diagnose: searching the residual for effects"):
             diag = api.diagnose(test, model, preset=args.preset, base=base, nperseg=args.nperseg,

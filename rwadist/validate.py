@@ -173,6 +173,17 @@ def warn_beyond_rated_speed(model, source, lo_rpm: float, hi_rpm: float, flag: s
               file=sys.stderr)
 
 
+def check_f_lim(test, f_lim, flag: str = "--f-lim") -> None:
+    """``f_lim`` (Hz, or None) within (0, Nyquist] of every run of ``test``: refused naming the flag (the spectra's
+    own check named '<spectra>', which the user never typed)."""
+    if f_lim is None:
+        return
+    nyquist = 0.5 * min(r.sample_rate for r in test.runs)
+    if not 0.0 < f_lim <= nyquist:
+        raise DataError(flag, "value", f"{f_lim:g} Hz is above the data's Nyquist frequency {nyquist:g} Hz: give a "
+                        "limit below it (or leave it out)")
+
+
 def warn_unconstrained(model, source, use) -> None:
     """Print (stderr) that ``model`` has modes the extended fit could not identify, if it has (``use``: what rests on
     them, e.g. "the PSD")."""

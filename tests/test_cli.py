@@ -222,3 +222,20 @@ def test_fit_refuses_flags_it_would_ignore(tmp_path, capsys):
     code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--cumulative-rpm", "700,5000")
     assert code == 2 and "--cumulative-rpm" in err and "5000 rpm is outside the test's speeds 600-2400 rpm" in err
     assert not (tmp_path / "m.json").exists() and not (tmp_path / "m_report").exists()
+
+
+def test_f_lim_above_nyquist_names_the_flag(tmp_path, capsys):
+    """--f-lim above the data's Nyquist frequency: the error named '<spectra>: f_lim', which the user never typed."""
+    data = tmp_path / "e"
+    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "6",
+        "--samples", "1024", "--sample-rate", "1920", "--no-modes")
+    for argv in (["fit", data, "-o", tmp_path / "m.json", "--no-report"], ["diagnose", data, "-o", tmp_path / "r"]):
+        code, _, err = run(capsys, *argv, "--f-lim", "5000")
+        assert code == 2 and "--f-lim: value: 5000 Hz is above the data's Nyquist frequency 960 Hz" in err
+
+
+def test_simulate_test_says_which_lines_the_sample_rate_drops(tmp_path, capsys):
+    code, out, _ = run(capsys, "simulate-test", "--preset", "ithaco-e", tmp_path / "e", "--speeds-rpm", "600:1200",
+                       "--n-speeds", "3", "--samples", "1024", "--sample-rate", "100")
+    assert code == 0 and "note: 12 of the wheel's lines reach the Nyquist frequency in 3 run(s)" in out
+    assert "raise --sample-rate" in out
