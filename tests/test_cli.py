@@ -172,6 +172,9 @@ def test_fit_extended_without_mass_and_radius_is_per_unit(tmp_path, capsys):
     assert code == 0 and "per unit mass" in out
     doc = json.loads((tmp_path / "m.json").read_text())
     assert doc["analytical"]["mass_kg"] == 1.0 and doc["analytical"]["unconstrained"]
+    # an imbalance read through an unconstrained mode says it rests on that mode's starting value
+    loose = [u for u, m in (("U_s", "radial_translation"), ("U_d", "rocking")) if m in doc["analytical"]["unconstrained"]]
+    assert not loose or f"({' and '.join(loose)} read through a mode the data do not constrain" in out
     code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m2.json", "--extended", "--mass", "0", "--radius", "0.2")
     assert code == 2 and "--mass" in err
 
