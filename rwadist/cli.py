@@ -61,6 +61,8 @@ def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm") ->
                 return check_speeds_rpm(np.linspace(parts[0], parts[1], int(n)), flag)
             if len(parts) != 3:
                 raise ValueError("expected START:STOP:STEP or START:STOP")
+            if n:
+                raise ValueError("START:STOP:STEP gives its own number of speeds: drop --n-speeds, or give START:STOP")
             start, stop, step = parts
             if step <= 0:
                 raise ValueError("STEP must be > 0")

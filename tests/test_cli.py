@@ -25,6 +25,8 @@ def test_parse_speeds():
         parse_speeds("300:2400")          # needs --n-speeds
     with pytest.raises(DataError):
         parse_speeds("a,b")
+    with pytest.raises(DataError, match="gives its own number of speeds: drop --n-speeds"):
+        parse_speeds("0:3000:100", 5)          # --n-speeds beside a STEP was ignored
 
 
 def test_simulate_fit_show(tmp_path, capsys):
