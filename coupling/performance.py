@@ -400,6 +400,8 @@ def _setup(plant: Plant, wheels, practices, omega):
         if p not in PRACTICES:
             raise CouplingError(f"unknown practice {p!r}; use {PRACTICES}")
     om = np.atleast_1d(np.asarray(omega, dtype=float))
+    if om.size == 0:
+        raise CouplingError("no speeds: give at least one wheel speed (rad/s)")
     if not np.all(np.isfinite(om)):
         raise CouplingError("speeds must be finite")
     n_if = plant.n_interface

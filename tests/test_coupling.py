@@ -290,6 +290,9 @@ def test_bad_input_clear_errors():
         cp.Mount(0, np.diag([1.0, 1.0, -1.0]))
     with pytest.raises(cp.NotARotationError, match="orthonormal"):
         cp.Mount(0, 1.01 * np.eye(3))
+    # no speeds (was numpy's "need at least one array to concatenate")
+    with pytest.raises(cp.CouplingError, match="no speeds: give at least one wheel speed"):
+        cp.jitter_vs_speed(plant6, _e_specs(1), np.array([]))
 
 
 # ------------------------------------------------------------------ dask sweeps
