@@ -489,6 +489,7 @@ def cmd_psd(args) -> int:
 
     if args.preset and args.model:
         raise DataError("psd", "model/--preset", "give a model file or --preset, not both")
+    args.output = args.output or ("psd.bdf" if args.format == "nastran" else "psd.csv")
     check_psd_flags(args)
     if not args.speed_rpm:
         raise DataError("--speed-rpm", "value", "missing MIN:MAX (rpm)")

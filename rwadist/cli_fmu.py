@@ -83,9 +83,12 @@ def cmd_fmu_check(args) -> int:
     if not 1 <= (n_steps := args.stop_time / args.step_size) <= 1e7:
         raise DataError("--step-size", "value", f"{args.step_size:g} s over --stop-time {args.stop_time:g} s makes "
                         f"{n_steps:.3g} steps: allowed 1 to 1e7 steps")
-    check_fmu_ramp(args.fmu, args.speed_rpm, args.stop_time)
     try:
         problems = validate_fmu(args.fmu)
+        # the ramp ends at the last whole step (as simulated below), not at --stop-time
+        check_fmu_ramp(args.fmu, args.speed_rpm, round(args.stop_time / args.step_size) * args.step_size)
+    except DataError:
+        raise
     except Exception as exc:    # fmpy raises assorted errors on a damaged archive or XML
         raise DataError(args.fmu, "FMU", f"cannot be read by fmpy ({type(exc).__name__}: {str(exc)[:160]}); "
                         "rebuild it with `rwadist fmu build`") from None
@@ -96,7 +99,8 @@ def cmd_fmu_check(args) -> int:
         import zipfile
 
         from rwadist.fmu.build import has_native
-        if any(n.endswith("rwadist_wheel_fmu.c") for n in zipfile.ZipFile(args.fmu).namelist()):
+        from rwadist.fmu.native_build import C_SOURCE
+        if any(n.endswith(C_SOURCE) for n in zipfile.ZipFile(args.fmu).namelist()):
             print("native FMU: C only, no Python needed by the host")
         else:
             print(f"native layer (fmi2Error on bad input, C step kernel): {'yes' if has_native(args.fmu) else 'no'}")

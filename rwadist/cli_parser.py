@@ -152,7 +152,8 @@ def build_parser(cli) -> argparse.ArgumentParser:
     q.add_argument("--nastran-cross", action="store_true", help="also RANDPS/TABRND1 of the cross-spectra")
     q.add_argument("--cross", choices=("csv", "h5", "none"), default="csv",
                    help="cross-spectra next to the output: <out>_cross.csv (default) or <out>_cross.h5")
-    q.add_argument("-o", "--output", default="psd.csv", help="output file (CSV or NASTRAN bulk data)")
+    q.add_argument("-o", "--output", default=None,
+                   help="output file (CSV or NASTRAN bulk data; default psd.csv, or psd.bdf with --format nastran)")
     q.set_defaults(func=cli.cmd_psd)
 
     dg = sub.add_parser("diagnose", help="residual of a model against test data; finds, adds and reports the "

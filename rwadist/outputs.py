@@ -268,11 +268,12 @@ def check_dataset_dir(path, flag: str = "-o") -> Path:
             shown = ", ".join(other[:3]) + (f" and {len(other) - 3} more" if len(other) > 3 else "")
             raise DataError(flag, "folder", f"{str(path)!r} holds files that are not a steady-test dataset "
                             f"({shown}); the folder is replaced whole: choose a new or dedicated folder")
-        files = [p for p in entries if not p.name.startswith(".")]
+        files = [p for p in entries if not p.name.startswith(".") and p.name not in _SIMULATE_OUTPUTS]
         if files and not _written_by_rwadist(path):
             raise DataError(flag, "folder", f"{str(path)!r} holds a steady-test dataset ({len(files)} files) that "
                             f"rwadist did not write (its meta.json does not say {WRITER_KEY}: {WRITER}); the folder "
-                            "is replaced whole, which would delete those runs: choose a new folder")
+                            "is replaced whole, which would delete those runs: choose a new folder (if rwadist wrote "
+                            f"it, before this check existed, add \"{WRITER_KEY}\": \"{WRITER}\" to its meta.json)")
     return path
 
 

@@ -291,8 +291,12 @@ def law_from_csv(path, n_bins: int = 2000, bounds=None):
         return histogram_from_centres(rpm_to_rad_s(col["speed_rpm"]), col["weight"], str(path), bounds)
     if "speed_rpm" in col and "pdf_per_rpm" in col:
         s, p = col["speed_rpm"], col["pdf_per_rpm"]
-        # a density: each bin's probability is its value times its width (bins end at the range, or are uneven)
-        edges = histogram_from_centres(rpm_to_rad_s(s), np.ones(np.size(s)), str(path), bounds).edges
+        # a density sampled at the rows: it spans the first to the last row, each row's bin reaching halfway to its
+        # neighbours (on an even grid Σ p·width is the trapezoid rule), whatever range is given beside the file (the
+        # rows must lie in it); each bin's probability is its value times its width
+        c = histogram_from_centres(rpm_to_rad_s(s), np.ones(np.size(s)), str(path), bounds).edges   # the row checks
+        mid = 0.5 * (np.asarray(rpm_to_rad_s(s))[1:] + np.asarray(rpm_to_rad_s(s))[:-1])
+        edges = np.concatenate([[float(rpm_to_rad_s(s[0]))], mid, [float(rpm_to_rad_s(s[-1]))]]) if len(c) else c
         widths = np.diff(np.asarray(edges)) * RAD_S_TO_RPM
         hist = Histogram.from_weights(edges, np.maximum(p, 0) * widths, str(path))
         total = float(np.sum(p * widths))

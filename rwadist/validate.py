@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from .formats.records import DataError
+from .units import RAD_S_TO_RPM, rpm_to_rad_s
 
 #: highest wheel speed any command accepts, rpm (flight wheels run below ~10 000 rpm)
 MAX_RPM = 100_000.0
@@ -121,7 +122,7 @@ def check_extended_only(args: argparse.Namespace) -> None:
 def check_within_test(speeds_rpm, test, flag: str) -> None:
     """Speeds (rpm) a plot reads from the test's runs (the nearest run to each) must lie within the test's speeds:
     --cumulative-rpm 5000 on a 300-2400 rpm test plotted 2400 rpm under a title of 5000."""
-    rpm = np.abs([r.speed for r in test.runs]) * 60.0 / (2.0 * math.pi)
+    rpm = np.abs([r.speed for r in test.runs]) * RAD_S_TO_RPM
     lo, hi = float(rpm.min()), float(rpm.max())
     for v in speeds_rpm:
         if not lo - 1e-6 <= abs(v) <= hi + 1e-6:
@@ -154,7 +155,7 @@ def check_fmu_ramp(fmu_path, speed_rpm: float, stop_time: float) -> None:
 
     var = next((v for v in read_model_description(str(fmu_path)).modelVariables if v.name == "max_acceleration"),
                None)
-    accel = abs(speed_rpm) * 2.0 * math.pi / 60.0 / stop_time
+    accel = abs(float(rpm_to_rad_s(speed_rpm))) / stop_time
     if var is not None and var.start is not None and accel > float(var.start):
         raise DataError("--stop-time", "value", f"{stop_time:g} s to {speed_rpm:g} rpm is {accel:.4g} rad/s², above the "
                         f"FMU's max_acceleration of {float(var.start):g} rad/s²: give --stop-time "

@@ -822,3 +822,17 @@ def test_unmatched_sidebands_warn(model):
         model_document(doc)
     W = effects_runtime(doc)
     assert W.sidebands_used == set() and W.n_lines == len(rt.model_from_doc(doc)[1])
+
+
+def test_cli_fmu_check_a_damaged_description_is_bad_input(tmp_path, capsys):
+    """A zip whose modelDescription.xml is not XML: one line naming the file (exit 2), not an internal error (the
+    ramp check read the description before fmpy's validation caught it)."""
+    import zipfile
+
+    from rwadist.cli import main
+    bad = tmp_path / "bad.fmu"
+    with zipfile.ZipFile(bad, "w") as z:
+        z.writestr("modelDescription.xml", "<fmiModelDescription garbage")
+    assert main(["fmu", "check", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "bad.fmu" in err and "cannot be read by fmpy" in err and "internal error" not in err
