@@ -331,3 +331,11 @@ def test_cli_psd_warns_beyond_the_wheels_rated_speed(tmp_path, capsys):
     assert "WARNING: --speed-rpm 0:10000 rpm reaches beyond the maximum speed of ithaco-e, 3850 rpm" in err
     assert main(argv + ["--speed-rpm", "0:3000"]) == 0
     assert "WARNING" not in capsys.readouterr().err
+
+
+def test_cli_psd_nastran_without_output_writes_psd_bdf(tmp_path, monkeypatch):
+    """--format nastran without -o writes psd.bdf (the default psd.csv was refused as naming the other format)."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["psd", "--preset", "ithaco-e", "--speed-rpm", "300:3000", "--format", "nastran", "--n-freq", "201",
+                 "--n-speeds", "50", "--cross", "none"]) == 0
+    assert (tmp_path / "psd.bdf").exists() and not (tmp_path / "psd.csv").exists()

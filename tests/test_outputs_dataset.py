@@ -162,3 +162,12 @@ def test_a_dataset_rwadist_wrote_is_replaced(tmp_path):
     assert main(["convert", str(lab), "-o", str(out)]) == 0
     assert main(["convert", str(lab), "-o", str(out)]) == 0
     assert len(data_io.read_steady(out).runs) == 4
+
+
+def test_a_folder_holding_simulate_tests_sweep_is_replaced(tmp_path):
+    """simulate-test OUT --sweep, then simulate-test OUT: the sweep is simulate-test's own output (no meta.json)."""
+    out = tmp_path / "s"
+    assert main(["simulate-test", "--preset", "ithaco-e", str(out), "--sweep", "--duration", "2",
+                 "--sample-rate", "512"]) == 0
+    assert main(SIM + [str(out), "--speeds-rpm", "600:2400", "--n-speeds", "3"]) == 0
+    assert len(data_io.read_steady(out).runs) == 3
