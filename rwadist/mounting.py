@@ -165,6 +165,9 @@ def _speed_law(spec, default_law, base: Path, where: str):
 WHEEL_KEYS = ("name", "model", "preset", "dcm", "position_m", "mounting", "speed", "tie")
 MOUNTING_KEYS = ("preset", "index", "radius_m", "elevation_deg")
 TIE_KEYS = ("to", "ratio", "phase_lock", "phase_offset_deg")
+SPEED_KEYS = ("dist", "min_rpm", "max_rpm", "std_rpm")
+#: pairs of keys one wheel may not give together: the second would be ignored
+EXCLUSIVE_KEYS = (("model", "preset"), ("mounting", "dcm"), ("mounting", "position_m"), ("tie", "speed"))
 
 
 def _check_keys(path, where: str, obj: dict, known: tuple) -> None:
@@ -196,6 +199,8 @@ def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bo
 
     path = Path(path)
     doc = read_json(path)
+    if isinstance(doc, dict):
+        _check_keys(path, "document", doc, ("wheels",))
     items = doc.get("wheels") if isinstance(doc, dict) else doc
     if not isinstance(items, list) or not items:
         raise DataError(path, "wheels", "must be a non-empty list of wheel objects")
@@ -208,12 +213,15 @@ def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bo
         if not isinstance(w, dict):
             raise DataError(path, where, f"must be an object, got {w!r}")
         _check_keys(path, where, w, WHEEL_KEYS)
-        for key, known in (("mounting", MOUNTING_KEYS), ("tie", TIE_KEYS)):
-            if isinstance(w.get(key), dict):
+        for key, known in (("mounting", MOUNTING_KEYS), ("tie", TIE_KEYS), ("speed", SPEED_KEYS)):
+            if key in w:
+                if not isinstance(w[key], dict):
+                    raise DataError(path, f"{where}.{key}", f"must be an object with keys {', '.join(known)}; got "
+                                    f"{w[key]!r}")
                 _check_keys(path, f"{where}.{key}", w[key], known)
-        if "tie" in w and "speed" in w:
-            raise DataError(path, f"{where}.speed", "a wheel tied to another runs at its speed: give 'tie' or 'speed', "
-                            "not both")
+        for a, b in EXCLUSIVE_KEYS:
+            if a in w and b in w:
+                raise DataError(path, f"{where}.{b}", f"given beside '{a}', which decides it: give one of the two")
         if names.count(names[i]) > 1:
             raise DataError(path, f"{where}.name", f"{names[i]!r} names more than one wheel; names: {names}")
         # sources

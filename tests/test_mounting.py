@@ -119,7 +119,17 @@ def test_wheels_file_errors(tmp_path):
     ({"preset": "ithaco-e", "mounting": {"preset": "pyramid-4", "indx": 1}}, r"wheels\[0\]\.mounting\.indx",
      r"did you mean 'index'"),
     ({"name": "B", "preset": "ithaco-e", "mounting": {"preset": "pyramid-4"}, "tie": {"to": "A"},
-      "speed": {"dist": "uniform", "min_rpm": 0, "max_rpm": 100}}, r"wheels\[0\]\.speed", r"'tie' or 'speed'"),
+      "speed": {"dist": "uniform", "min_rpm": 0, "max_rpm": 100}}, r"wheels\[0\]\.speed",
+     r"given beside 'tie', which decides it"),
+    # each pair one of whose keys was ignored, the speed law's own keys, and objects that are not objects
+    ({"preset": "ithaco-e", "mounting": {"preset": "pyramid-4", "index": 0}, "position_m": [1, 0, 0]},
+     r"wheels\[0\]\.position_m", r"given beside 'mounting'"),
+    ({"model": "m.json", "preset": "ithaco-e", "mounting": {"preset": "pyramid-4"}}, r"wheels\[0\]\.preset",
+     r"given beside 'model'"),
+    ({"preset": "ithaco-e", "mounting": {"preset": "pyramid-4"}, "speed": {"dist": "normal", "min_rpm": 0,
+                                                                           "max_rpm": 100, "std_rmp": 10}},
+     r"wheels\[0\]\.speed\.std_rmp", r"did you mean 'std_rpm'"),
+    ({"preset": "ithaco-e", "mounting": "pyramid-4"}, r"wheels\[0\]\.mounting", r"must be an object"),
 ])
 def test_wheels_file_keys_it_does_not_read_are_refused(tmp_path, wheel, field, message):
     """A typo of position_m put the wheel at the origin (its r × F torques gone: Ty 0.048 instead of 0.098 N·m),
@@ -137,4 +147,13 @@ def test_wheels_file_names_are_unique(tmp_path):
          "speed": {"dist": "uniform", "min_rpm": 0, "max_rpm": 100}}
     p.write_text(json.dumps([w, w]))
     with pytest.raises(DataError, match=r"wheels\[0\]\.name.*'RW' names more than one wheel"):
+        mt.load_wheels(p)
+
+
+def test_wheels_file_top_level_keys_are_checked(tmp_path):
+    """A top-level key beside 'wheels' (a speed law meant for every wheel) was dropped without a word."""
+    p = tmp_path / "w.json"
+    p.write_text(json.dumps({"wheels": [{"preset": "ithaco-e", "mounting": {"preset": "pyramid-4"}}],
+                             "speed": {"dist": "uniform", "min_rpm": 0, "max_rpm": 100}}))
+    with pytest.raises(DataError, match=r"document\.speed.*unknown key"):
         mt.load_wheels(p)
