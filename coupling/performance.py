@@ -164,6 +164,9 @@ def _physical_params(model, p, mass_kg, radius_m, name):
 
     per_unit = ((getattr(model, "analytical", None) or {}).get("fit") or {}).get("per_unit")
     if not per_unit:
+        if mass_kg is not None or radius_m is not None:
+            raise CouplingModelError(f"{name}: mass_kg and radius_m rescale a model fitted per unit mass; this one is "
+                                     f"in SI already (mass {p.mass:g} kg): leave them out")
         return p
     if mass_kg is None or radius_m is None:
         raise CouplingModelError(f"{name}: analytical.fit.per_unit: the suspension was fitted per unit mass and "

@@ -382,3 +382,5 @@ def test_a_model_fitted_per_unit_mass_needs_the_rotor_mass_to_be_coupled():
     for k in ("k_r", "k_rock", "k_z", "I_rr"):
         assert getattr(spec.params, k) == pytest.approx(getattr(truth, k), rel=0.04), k   # k ∝ f²: 2 % in f
     assert spec.params.U_s == pytest.approx(model.analytical["U_s_kg_m"])
+    with pytest.raises(cp.CouplingError, match="in SI already"):       # they were ignored for a model in SI
+        wheel_spec_from_model(wheel.to_model(), mass_kg=1.0, radius_m=0.05)
