@@ -33,8 +33,8 @@ from .progress import working
 from .units import RAD_S_TO_RPM
 from .validate import (
     MAX_SAMPLES,
-    check_extended_only,
     check_f_lim,
+    check_fit_flags,
     check_grid_size,
     check_parsed,
     check_psd_flags,
@@ -182,7 +182,7 @@ def cmd_fit(args) -> int:
         report_dir = None
     else:
         check_output_dir(report_dir, "--report")
-    check_extended_only(args)
+    check_fit_flags(args)
     refuse_input_overwrite([("-o", args.output, "file")] + ([("--report", report_dir, "dir")] if report_dir else []),
                            [args.data])
     t0 = time.perf_counter()

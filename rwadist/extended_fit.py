@@ -567,7 +567,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
             return last
 
         # bounds keep the search physical: stiffness within ±10 % of the scan's (frequency ±5 %),
-        # damping ratio in [1e-4, 0.95], line coefficients within 1000x (down to 1e-4 of the line
+        # damping ratio in [5e-5, 0.95], line coefficients within 1000x (down to 1e-4 of the line
         # for the sense parts, which may vanish)
         lo, hi = [], []
         for m in free_modes:

@@ -109,14 +109,21 @@ def check_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> N
             raise DataError(flag, "value", f"{value!r}: missing or not a number")
 
 
-def check_extended_only(args: argparse.Namespace) -> None:
-    """``rwadist fit``: --mass, --radius, --height and --preset feed the extended fit only; without --extended they
-    were ignored, silently."""
+def check_fit_flags(args: argparse.Namespace) -> None:
+    """``rwadist fit``: flags it would ignore are refused: --mass, --radius, --height and --preset without
+    --extended (they feed the extended fit only), --mass without --radius or the reverse (the fit is then per unit
+    mass), and --cumulative-rpm with --no-report (it picks the report's plots)."""
     given = [f for f, v in (("--mass", args.mass), ("--radius", args.radius), ("--height", args.height or None),
                             ("--preset", args.preset)) if v is not None]
     if given and not args.extended:
         raise DataError(given[0], "value", "applies to the extended fit only: add --extended (the plain fit of "
                         "harmonics C·Ω² does not use it)")
+    if (args.mass is None) != (args.radius is None):
+        raise DataError("--mass" if args.radius is None else "--radius", "value", "needs "
+                        f"{'--radius' if args.radius is None else '--mass'} too (the rotor's inertias come from both; "
+                        "with neither the fit is per unit mass and inertia)")
+    if args.cumulative_rpm and args.no_report:
+        raise DataError("--cumulative-rpm", "value", "picks the report's plots: drop it, or drop --no-report")
 
 
 def check_within_test(speeds_rpm, test, flag: str) -> None:

@@ -244,3 +244,15 @@ def test_simulate_test_says_which_lines_the_sample_rate_drops(tmp_path, capsys):
                        "--n-speeds", "3", "--samples", "1024", "--sample-rate", "100")
     assert code == 0 and "note: 12 of the wheel's lines reach the Nyquist frequency in 3 run(s)" in out
     assert "raise --sample-rate" in out
+
+
+def test_fit_mass_needs_radius_and_cumulative_needs_the_report(tmp_path, capsys):
+    """--mass alone (or --radius alone) gave a per-unit fit with a note only; --cumulative-rpm with --no-report did
+    nothing."""
+    data = tmp_path / "e"
+    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "6",
+        "--samples", "1024", "--sample-rate", "1920", "--no-modes")
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--extended", "--mass", "10.6")
+    assert code == 2 and "--mass: value: needs --radius too" in err
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--no-report", "--cumulative-rpm", "700")
+    assert code == 2 and "--cumulative-rpm: value: picks the report's plots" in err
