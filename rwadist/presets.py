@@ -186,6 +186,7 @@ def from_model(model) -> WheelDescription:
     carries no simple resonances, so ``physics="simple"`` gives the harmonics alone; use
     ``physics="extended"`` for the modes."""
     from . import extended as ext
+    from .catalogue import modes_assumed
 
     harmonics = {d: [(h.h, h.C) for h in model.harmonics(d)] for d in model.empirical if model.harmonics(d)}
     senses = {(d, h.h): h.sense for d in ("radial_force", "radial_torque") for h in model.harmonics(d) if h.sense}
@@ -195,7 +196,8 @@ def from_model(model) -> WheelDescription:
         name=model.name, harmonics=harmonics, modes=[], test_stand_modes=[],
         max_speed_rpm=float(wheel.get("max_speed_rpm", 6000.0)),
         mass_kg=wheel.get("mass_kg"), radius_m=wheel.get("radius_m"),
-        notes=str(model.provenance.get("source", "")), extended=params, senses=senses)
+        notes=str(model.provenance.get("source", "")), extended=params, senses=senses,
+        modes_assumed=modes_assumed(model))
 
 
 def names() -> list:

@@ -206,6 +206,8 @@ class WheelDescription:
         extended physics (missing: 'co').  Keys use the harmonic numbers of ``harmonics``.
     imbalance_phase : fixed angle (rad) of the dynamic imbalance ahead of the static one; a property
         of the rotor (same in every run).
+    modes_assumed : the suspension modes of ``extended`` are assumed (a catalogue datasheet wheel), not measured:
+        :meth:`to_model` says so (``analytical.modes_assumed``).
     """
 
     name: str
@@ -224,6 +226,7 @@ class WheelDescription:
     extended: ext.ExtendedParams | None = None
     senses: dict = field(default_factory=dict)
     imbalance_phase: float = 0.0
+    modes_assumed: bool = False
 
     def __post_init__(self):
         clean = {}
@@ -297,13 +300,9 @@ class WheelDescription:
             empirical[d] = [Harmonic(h=h, C=C, sense=self.senses.get((d, h), "co") if radial else None)
                             for h, C in pairs]
         analytical = ext.params_to_dict(self.extended) if self.extended is not None else None
-        if analytical is not None:
-            from .catalogue import source_modes_assumed
-
-            # a catalogue datasheet wheel's modes are assumed: its model says so, whichever way it was made (the
-            # coupling notebook's preset(...).to_model() dropped it, and the wheel ran through guessed modes)
-            if source_modes_assumed(None, self.name):
-                analytical["modes_assumed"] = True
+        if analytical is not None and self.modes_assumed:
+            # the coupling notebook's preset(...).to_model() dropped it, and a datasheet wheel ran through guessed modes
+            analytical["modes_assumed"] = True
         return WheelModel(name=self.name, wheel=wheel, empirical=empirical, analytical=analytical,
                           provenance={"source": "rwadist.teststand.WheelDescription (simulation truth)",
                                       "notes": self.notes})
