@@ -173,7 +173,8 @@ def read_steady(directory, progress: bool = False) -> SteadyTest:
         if runs[-1].sample_rate != runs[0].sample_rate:
             raise DataError(directory / fname, "sample rate", f"{runs[-1].sample_rate!r} Hz differs from "
                             f"{runs[0].name}'s {runs[0].sample_rate!r} Hz (mixed sample rates across runs); "
-                            "resample the runs to one rate, or state it as sample_rate_hz in meta.json")
+                            "one test holds one sample rate: resample the runs to one rate (or split them into "
+                            "one test per rate)")
     files_read = {f.rsplit(":", 1)[0] if ".tdms:" in f.lower() else f for f in files_seen}
     listed = files_read | {RUNS_FILE, META_FILE}
     unlisted = sorted(p.name for p in directory.iterdir() if p.is_file() and p.name not in listed)

@@ -456,3 +456,14 @@ def test_mat_time_vector_and_sample_rate_must_agree(tmp_path, steady):
     with pytest.raises(DataError, match=r"s\.mat: variable time_s: sample rate from the time stamps .*disagrees with "
                                         r"variable sample_rate_hz"):
         read_data(path)
+
+
+def test_a_nan_sample_is_named_as_a_reader_reads_it(tmp_path, steady):
+    """A NaN in a MATLAB file: the message names the variable, the index and 'nan' (it showed 'np.float64(nan)')."""
+    sig = _one_run(steady)
+    sig = {c: v.copy() for c, v in sig.items()}
+    sig["Fz"][17] = np.nan
+    path = tmp_path / "r.mat"
+    write_mat5(path, sig, FS)
+    with pytest.raises(DataError, match=r"non-finite sample at index 17, value nan$"):
+        read_data(path)

@@ -61,7 +61,7 @@ def _vector(path, name, value) -> np.ndarray:
     bad = ~np.isfinite(x)
     if bad.any():
         i = int(np.argmax(bad))
-        raise DataError(path, f"variable {name}", f"non-finite sample at index {i}, value {x[i]!r}")
+        raise DataError(path, f"variable {name}", f"non-finite sample at index {i}, value {float(x[i])!r}")
     return x
 
 

@@ -66,7 +66,7 @@ def read_record(path, group_name: str | None = None) -> RawRecord:
         bad = ~np.isfinite(x)
         if bad.any():
             i = int(np.argmax(bad))
-            raise DataError(path, loc, f"non-finite sample at index {i}, value {x[i]!r}")
+            raise DataError(path, loc, f"non-finite sample at index {i}, value {float(x[i])!r}")
         columns[channel.name] = np.ascontiguousarray(x)
         units[channel.name] = str(props.get("unit_string", "") or "")
         where[channel.name] = loc

@@ -106,7 +106,7 @@ def read_record(path, tach_names=()) -> RawRecord:
         bad = ~np.isfinite(x)
         if bad.any():
             i = int(np.argmax(bad))
-            raise DataError(path, f"{loc} ({key})", f"non-finite sample at index {i}, value {x[i]!r}")
+            raise DataError(path, f"{loc} ({key})", f"non-finite sample at index {i}, value {float(x[i])!r}")
         columns[key], where[key] = np.ascontiguousarray(x), f"{loc} ({key})"
         units[key] = _unit(dset) if key in CHANNELS else ""
         lengths.append((len(x), loc))
