@@ -168,11 +168,13 @@ class Histogram:
         return list(self.edges)
 
 
-def histogram_from_centres(speeds, weights, source="histogram", bounds=None) -> Histogram:
-    """Histogram from bin centres (rad/s, strictly increasing) and relative weights; edges halfway
-    between centres, the outer bins as wide as their neighbours -- but never across zero speed when no
-    centre is on the other side (a wheel that never reverses), nor beyond ``bounds`` (lo, hi) rad/s, the
-    speed range the user gave (every centre must lie inside it)."""
+def row_edges(speeds, source="histogram", bounds=None, ends: str = "centres") -> np.ndarray:
+    """Bin edges (rad/s) of a speed table's rows (rad/s, strictly increasing), halfway between rows, every row
+    checked (at least 2, increasing, inside ``bounds`` (lo, hi) rad/s: the speed range the user gave).  ``ends``:
+    "centres" -- the rows are bin centres, the outer bins as wide as their neighbours but never across zero speed
+    when no row is on the other side (a wheel that never reverses) nor beyond ``bounds``; "rows" -- the table spans
+    its first to its last row (a density sampled at the rows: on an even grid, Σ value·width is the trapezoid rule).
+    :class:`DataError` naming ``source``, ``speed_rpm`` and the row."""
     c = np.asarray(speeds, float)
     if c.ndim != 1 or c.size < 2:
         raise DataError(source, "speed_rpm", f"need at least 2 histogram rows, got {c.size}")
@@ -181,11 +183,14 @@ def histogram_from_centres(speeds, weights, source="histogram", bounds=None) -> 
         raise DataError(source, "speed_rpm", f"must be strictly increasing: row {i + 1} "
                         f"({c[i + 1] * RAD_S_TO_RPM:g} rpm) <= row {i} ({c[i] * RAD_S_TO_RPM:g} rpm)")
     mid = 0.5 * (c[1:] + c[:-1])
-    lo, hi = c[0] - (mid[0] - c[0]), c[-1] + (c[-1] - mid[-1])
-    if c[0] >= 0.0:
-        lo = max(lo, 0.0)
-    if c[-1] <= 0.0:
-        hi = min(hi, 0.0)
+    if ends == "rows":
+        lo, hi = c[0], c[-1]
+    else:
+        lo, hi = c[0] - (mid[0] - c[0]), c[-1] + (c[-1] - mid[-1])
+        if c[0] >= 0.0:
+            lo = max(lo, 0.0)
+        if c[-1] <= 0.0:
+            hi = min(hi, 0.0)
     if bounds is not None:
         b_lo, b_hi = (float(x) for x in bounds)
         tol = 1e-9 * max(abs(b_lo), abs(b_hi), 1.0)        # the same speed converted twice (rpm -> rad/s)
@@ -196,8 +201,12 @@ def histogram_from_centres(speeds, weights, source="histogram", bounds=None) -> 
                             f"{b_lo * RAD_S_TO_RPM:g}:{b_hi * RAD_S_TO_RPM:g} rpm (--speed-rpm): give the range the "
                             "file covers")
         lo, hi = max(lo, b_lo), min(hi, b_hi)
-    edges = np.concatenate([[lo], mid, [hi]])
-    return Histogram.from_weights(edges, weights, source)
+    return np.concatenate([[lo], mid, [hi]])
+
+
+def histogram_from_centres(speeds, weights, source="histogram", bounds=None) -> Histogram:
+    """Histogram from bin centres (rad/s, strictly increasing) and relative weights (:func:`row_edges`, "centres")."""
+    return Histogram.from_weights(row_edges(speeds, source, bounds), weights, source)
 
 
 def from_time_profile(t, omega, n_bins: int = 2000, source="time profile") -> Histogram:
@@ -291,12 +300,9 @@ def law_from_csv(path, n_bins: int = 2000, bounds=None):
         return histogram_from_centres(rpm_to_rad_s(col["speed_rpm"]), col["weight"], str(path), bounds)
     if "speed_rpm" in col and "pdf_per_rpm" in col:
         s, p = col["speed_rpm"], col["pdf_per_rpm"]
-        # a density sampled at the rows: it spans the first to the last row, each row's bin reaching halfway to its
-        # neighbours (on an even grid Σ p·width is the trapezoid rule), whatever range is given beside the file (the
+        # a density sampled at the rows spans the first to the last row whatever range is given beside the file (the
         # rows must lie in it); each bin's probability is its value times its width
-        c = histogram_from_centres(rpm_to_rad_s(s), np.ones(np.size(s)), str(path), bounds).edges   # the row checks
-        mid = 0.5 * (np.asarray(rpm_to_rad_s(s))[1:] + np.asarray(rpm_to_rad_s(s))[:-1])
-        edges = np.concatenate([[float(rpm_to_rad_s(s[0]))], mid, [float(rpm_to_rad_s(s[-1]))]]) if len(c) else c
+        edges = row_edges(rpm_to_rad_s(s), str(path), bounds, ends="rows")
         widths = np.diff(np.asarray(edges)) * RAD_S_TO_RPM
         hist = Histogram.from_weights(edges, np.maximum(p, 0) * widths, str(path))
         total = float(np.sum(p * widths))
