@@ -42,6 +42,7 @@ from .validate import (
     check_within_test,
     refuse_non_finite_model,
     refuse_non_finite_psd,
+    speed_scale_warning,
     warn_beyond_rated_speed,
     warn_unconstrained,
 )
@@ -212,6 +213,8 @@ def cmd_fit(args) -> int:
     if efit is not None:
         print(f"extended model: {sum(len(v) for v in model.empirical.values())} forcing lines through the fitted "
               "modes (every line the data show, modally amplified or not)")
+    if scale := speed_scale_warning(fit, test.meta):
+        print(scale, file=sys.stderr)
     modal = [f"{b.direction} h={b.h:.4g}" for b in fit.bins if not b.kept and "outside modal ranges" in b.reason]
     if modal and efit is None:
         print(f"WARNING: {len(modal)} harmonic(s) the data show were left out of the model because their lines are "

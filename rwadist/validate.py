@@ -246,3 +246,46 @@ def refuse_non_finite_model(model, source) -> None:
         for h in model.harmonics(d):
             if not (np.isfinite(h.h) and np.isfinite(h.C)):
                 raise DataError(source, d, f"harmonic h={h.h!r} has C={h.C!r}: the fit diverged; nothing written")
+
+
+def speed_scale_warning(fit, meta: dict | None = None) -> str | None:
+    """A warning (text) when the empirical ``fit``'s lines sit where speeds given k times the wheel's put them, or None.
+
+    A reaction wheel's strongest radial-force line is nearly always its static imbalance, once per revolution
+    (Masterson's E wheel; not the thesis's B wheel, whose lines near h = 8-10 are stronger).  Speeds scaled by a
+    factor k move every line to h/k and the fit is self-consistent at the wrong h.  Flagged when the strongest
+    radial-force line (largest C) is where such a scaling puts the imbalance and no line at h = 1 has 0.3 of its C
+    (the E wheel's h = 2, which a 2-pulse tach read as 1 moves to h = 1: 0.20 of it): at h = 1/k, k = 2 … 8 (a tach
+    with k times the ``pulses_per_rev`` given), at h = k with a ``pulses_per_rev`` k times too many, or at
+    h = 60/2π = 9.55 (a runs.csv speed_rpm column holding rad/s).  ``meta``: the test's meta.json (its ``tach``)."""
+    lines = [ln for ln in fit.lines if ln.direction == "radial_force" and np.isfinite(ln.C) and ln.C > 0]
+    if not lines:
+        return None
+    top = max(lines, key=lambda ln: ln.C)
+    at_one = max((ln.C for ln in lines if abs(ln.h - 1.0) <= 0.02), default=0.0)
+    if abs(top.h - 1.0) <= 0.02 or at_one >= 0.3 * top.C:
+        return None
+    tach = meta.get("tach") if isinstance(meta, dict) else None
+    ppr = tach.get("pulses_per_rev", 1) if isinstance(tach, dict) else None
+    ppr = ppr if isinstance(ppr, int) and not isinstance(ppr, bool) and ppr >= 1 else None
+
+    def near(x, y):
+        return abs(x / y - 1.0) <= 0.01
+
+    sub = next((k for k in range(2, 9) if near(top.h, 1.0 / k)), None)
+    over = next((k for k in range(2, 9) if near(top.h, k) and ppr is not None and ppr % k == 0), None)
+    if sub is not None and ppr is not None:
+        hint = (f"the speeds come from the tach channel {tach.get('channel')!r} with meta.json tach.pulses_per_rev = "
+                f"{ppr}; {ppr * sub} pulses per revolution would put it at h = 1")
+    elif over is not None:
+        hint = (f"the speeds come from the tach channel {tach.get('channel')!r} with meta.json tach.pulses_per_rev = "
+                f"{ppr}; {ppr // over} would put it at h = 1")
+    elif sub is not None:
+        hint = f"check the speeds given (runs.csv speed_rpm, rpm): they may be {sub} times the wheel's"
+    elif near(top.h, 60.0 / (2 * np.pi)):
+        hint = "runs.csv speed_rpm may hold rad/s: in rpm the imbalance would be at h = 1"
+    else:
+        return None
+    return (f"WARNING: the strongest radial-force line is at h = {top.h:.4g} of the speeds given, not at h = 1 (a "
+            f"wheel's imbalance, nearly always its strongest radial line), and no line at h = 1 comes near it: "
+            f"{hint}.  If this wheel's imbalance is not its strongest line, ignore this")

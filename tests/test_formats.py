@@ -467,3 +467,40 @@ def test_a_nan_sample_is_named_as_a_reader_reads_it(tmp_path, steady):
     write_mat5(path, sig, FS)
     with pytest.raises(DataError, match=r"non-finite sample at index 17, value nan$"):
         read_data(path)
+
+
+def _tdms_lab(tmp_path, steady, unit_string, map_unit):
+    """One TDMS run (written by npTDMS) with its load channels named LC1..LC6, each stating ``unit_string`` (force
+    channels; torques 'N·m'), mapped to Fx..Tz in meta.json with unit ``map_unit`` for LC1 (None: no 'unit')."""
+    d = tmp_path / "lab"
+    d.mkdir(parents=True)
+    run = steady.runs[0]
+    objects = [RootObject(), GroupObject("g")]
+    for k, ch in enumerate(CHANNELS):
+        objects.append(ChannelObject("g", f"LC{k + 1}", run.signals[ch], properties={
+            "wf_increment": 1 / FS, "wf_start_offset": 0.0, "unit_string": unit_string if ch[0] == "F" else "N·m"}))
+    with TdmsWriter(str(d / "s.tdms")) as w:
+        w.write_segment(objects)
+    (d / "runs.csv").write_text(f"file,speed_rpm\ns.tdms:g,{float(rad_s_to_rpm(run.speed))!r}\n")
+    entries = {f"LC{k + 1}": {"channel": ch, "unit": unit_string if ch[0] == "F" else "N·m"}
+               for k, ch in enumerate(CHANNELS)}
+    if map_unit is None:
+        del entries["LC1"]["unit"]
+    else:
+        entries["LC1"]["unit"] = map_unit
+    (d / "meta.json").write_text(json.dumps({"channel_map": {"channels": entries}}))
+    return d
+
+
+def test_channel_map_unit_against_the_unit_the_file_states(tmp_path, steady):
+    # a map unit that contradicts the file's own (lbf over a channel the file says is in N) scaled the channel 4.45x
+    # without a word: refused naming both; the map may leave the unit out and take the file's; the same unit in
+    # another spelling is no contradiction
+    d = _tdms_lab(tmp_path, steady, "N", "lbf")
+    with pytest.raises(DataError, match=r"meta\.json: channel_map\.channels\.LC1\.unit: 'lbf' \(x4\.44822 to SI\) "
+                                        r"contradicts the unit the file states for channel 'LC1', 'N' \(x1\) at .*s\.tdms"):
+        read_steady(d)
+    for unit_string, map_unit, factor in (("lbf", None, LBF), ("N", "newton", 1.0)):
+        d = _tdms_lab(tmp_path / unit_string, steady, unit_string, map_unit)
+        got = read_steady(d).runs[0].signals["Fx"]
+        np.testing.assert_allclose(got, steady.runs[0].signals["Fx"] * factor, rtol=1e-15)

@@ -92,3 +92,48 @@ def test_sweep_speed_from_tach(tmp_path, ppr, stand_sweep):
     moving = truth >= rpm_to_rad_s(60.0)  # from the first second of the spin-up on
     err = np.abs(back.tach[moving] / truth[moving] - 1)
     assert err.max() < 5e-4, err.max()
+
+
+def test_tach_channel_under_another_name_is_named_as_such(tmp_path):
+    # meta.json names the pulse channel "tach", the file calls it "TACH1": the unknown column is named, and so is
+    # the tach channel the file lacks (before: only "unknown column")
+    d = write_steady_with_tach(tmp_path / "t", 1)
+    meta = json.loads((d / "meta.json").read_text())
+    meta["tach"]["channel"] = "TACH1"
+    (d / "meta.json").write_text(json.dumps(meta))
+    with pytest.raises(DataError, match=r"r0\.csv: tach: unknown column; allowed: .*meta\.json tach\.channel "
+                                        r"'TACH1' is not in the file either: if this channel is the tach pulse, name it "
+                                        r"there \(file channels: \['Fx_N', 'tach'\]\)"):
+        read_steady(d)
+
+
+@pytest.mark.parametrize("factor", [2, 3])
+def test_a_tach_read_with_too_few_pulses_per_rev_is_flagged(tmp_path, factor):
+    # a wheel whose tach gives 2 (3) pulses per revolution, read as 1: every speed is 2 (3) times the wheel's and the
+    # imbalance fits at h = 1/2 (1/3); the warning names the setting and the value that puts it back at h = 1.  The
+    # loads are the E wheel's (Masterson Table 3.4: its imbalance is the strongest radial line), simulated by the
+    # stand, the pulses written at the true speed.  The same data read with the right setting: no warning.
+    from dataclasses import replace
+
+    from rwadist.api import fit
+    from rwadist.data import SteadyTest
+    from rwadist.presets import preset
+    from rwadist.teststand import simulate_steady
+    from rwadist.validate import speed_scale_warning
+
+    sim = simulate_steady(preset("ithaco-e"), np.linspace(600, 2400, 10), sample_rate=2048.0, n_samples=8192,
+                          modes=False, noise=0.01, seed=4)
+    meta = {"tach": {"channel": "tach", "pulses_per_rev": 1}}
+    wrong = SteadyTest([replace(r, speed=r.speed * factor) for r in sim.runs], meta)
+    text = speed_scale_warning(fit(wrong), meta)
+    assert text is not None and f"h = {1 / factor:.4g} of the speeds given" in text, text
+    assert f"tach.pulses_per_rev = 1; {factor} pulses per revolution would put it at h = 1" in text, text
+    assert speed_scale_warning(fit(sim), {"tach": {"channel": "tach", "pulses_per_rev": factor}}) is None
+    # too many pulses per revolution given (6 for a 6/factor-pulse tach): the imbalance at h = factor
+    slow = SteadyTest([replace(r, speed=r.speed / factor) for r in sim.runs], {})
+    text = speed_scale_warning(fit(slow), {"tach": {"channel": "tach", "pulses_per_rev": 6}})
+    assert text is not None and f"pulses_per_rev = 6; {6 // factor} would put it at h = 1" in text, text
+    # the thesis's B wheel: its strongest radial line is h = 8.83, its imbalance 0.61 of it: no warning
+    b = simulate_steady(preset("ithaco-b"), np.linspace(600, 3400, 10), sample_rate=1000.0, n_samples=8192,
+                        modes=False, noise=0.01, seed=4)
+    assert speed_scale_warning(fit(b), None) is None

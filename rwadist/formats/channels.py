@@ -20,6 +20,8 @@ the ``tach`` pulse channel named in ``meta.json``).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rpm_to_rad_s
@@ -71,12 +73,28 @@ def unit_factor(unit: str, channel: str, path, where: str) -> float:
     return factor
 
 
+def _known_unit(unit: str) -> bool:
+    """``unit`` is a spelling :func:`unit_factor` knows."""
+    return bool(unit) and (unit in UNITS_EXACT or unit.lower() in UNITS)
+
+
 def _tach_names(meta: dict) -> set:
     tach = meta.get("tach") if isinstance(meta, dict) else None
     names = {SPEED_COLUMN}
     if isinstance(tach, dict) and isinstance(tach.get("channel"), str):
         names.add(tach["channel"])
     return names
+
+
+def _tach_hint(record: RawRecord, meta: dict, meta_path) -> str:
+    """The end of an unknown-channel error when ``meta`` names a tach pulse channel the file does not have (the
+    unknown channel is then likely the tach under another name), else ''."""
+    tach = meta.get("tach") if isinstance(meta, dict) else None
+    name = tach.get("channel") if isinstance(tach, dict) else None
+    if isinstance(name, str) and name not in record.columns:
+        return (f"; {meta_path} tach.channel {name!r} is not in the file either: if this channel is the tach pulse, "
+                f"name it there (file channels: {sorted(record.columns)})")
+    return ""
 
 
 def _calibrate(record: RawRecord, cal, meta_path) -> dict:
@@ -138,12 +156,14 @@ def map_channels(record: RawRecord, meta: dict, meta_path="meta.json") -> tuple:
                     hint = (f" (expected {CHANNEL_COLUMN[stem]!r}: values must be SI, N or N·m; or map it "
                             "in meta.json channel_map)")
                 allowed = sorted(set(COLUMN_CHANNEL) | tach_names)
-                raise DataError(record.path, record.locate(name), f"unknown column{hint}; allowed: {allowed}")
+                raise DataError(record.path, record.locate(name), f"unknown column{hint}; allowed: {allowed}"
+                                + _tach_hint(record, meta, meta_path))
     else:
         if not isinstance(cmap, dict) or not isinstance(cmap.get("channels"), dict):
             raise DataError(meta_path, "channel_map", "must be an object with 'channels' "
                             "(file channel -> {channel, unit, sign})")
         columns = _calibrate(record, cmap["calibration"], meta_path) if "calibration" in cmap else record.columns
+        calibrated = set(cmap["calibration"]["inputs"]) if "calibration" in cmap else set()
         entries = cmap["channels"]
         for name, x in columns.items():
             if name in tach_names and name not in entries:
@@ -151,7 +171,7 @@ def map_channels(record: RawRecord, meta: dict, meta_path="meta.json") -> tuple:
                 continue
             if name not in entries:
                 raise DataError(record.path, record.locate(name), f"file channel {name!r} is not in meta.json "
-                                f"channel_map.channels (mapped: {sorted(entries)})")
+                                f"channel_map.channels (mapped: {sorted(entries)})" + _tach_hint(record, meta, meta_path))
             entry = entries[name]
             field = f"channel_map.channels.{name}"
             if not isinstance(entry, dict) or entry.get("channel") not in CHANNELS:
@@ -162,9 +182,22 @@ def map_channels(record: RawRecord, meta: dict, meta_path="meta.json") -> tuple:
             sign = entry.get("sign", 1)
             if sign not in (1, -1):
                 raise DataError(meta_path, f"{field}.sign", f"{sign!r}: must be 1 or -1")
-            if "unit" not in entry:
-                raise DataError(meta_path, f"{field}.unit", "missing (N, kN, lbf, N·m, in·lbf, ft·lbf)")
-            factor = unit_factor(entry["unit"], ch, meta_path, f"{field}.unit (file channel {name!r})")
+            # the unit the file states for the channel (a TDMS unit_string, a UFF label), unless the calibration
+            # made the channel (its raw inputs' unit is not the calibrated one's)
+            stated = "" if name in calibrated else str(record.units.get(name, "") or "").strip()
+            if "unit" not in entry and not _known_unit(stated):
+                raise DataError(meta_path, f"{field}.unit", "missing (N, kN, lbf, N·m, in·lbf, ft·lbf)"
+                                + (f"; the file states {stated!r}, not a unit known here" if stated else ""))
+            unit = entry.get("unit", stated)
+            factor = unit_factor(unit, ch, meta_path, f"{field}.unit (file channel {name!r})")
+            if _known_unit(stated):
+                # a map unit that contradicts the file's own would scale the channel silently (lbf over N: 4.45x)
+                file_factor = unit_factor(stated, ch, record.path, record.locate(name))
+                if not math.isclose(file_factor, factor, rel_tol=1e-12):
+                    raise DataError(meta_path, f"{field}.unit", f"{unit!r} (x{factor:.6g} to SI) contradicts the unit "
+                                    f"the file states for channel {name!r}, {stated!r} (x{file_factor:.6g}) at "
+                                    f"{record.path}: {record.locate(name)}; give the file's unit, or leave 'unit' "
+                                    "out to take it")
             signals[ch] = x * (sign * factor)
         for name in entries:
             if name not in columns:
