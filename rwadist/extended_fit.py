@@ -370,8 +370,8 @@ class LinePower:
         return r, d_mode, d_C
 
 
-def _scan_all(meas_lines, la, sa, aa, inertia_ratio, tolerance):
-    """Profile scan (:mod:`rwadist.mode_scan`) of each mode on the measured lines."""
+def _scan_all(meas_lines, la, sa, aa, inertia_ratio, tolerance, near=None):
+    """Profile scan (:mod:`rwadist.mode_scan`) of each mode on the measured lines (``near``: :func:`fit_extended`)."""
     lr, sr, pr, dr = _radial_power(meas_lines)
     h_of = np.array([x.h for x in meas_lines]) if meas_lines else np.zeros(0)
     scans = {}
@@ -383,14 +383,14 @@ def _scan_all(meas_lines, la, sa, aa, inertia_ratio, tolerance):
             line, omega, power = lr[m], sr[m], pr[m]
         scans[mode] = scan_mode(mode, line, h_of[line] if line.size else np.zeros(0), omega, power,
                                 inertia_ratio=inertia_ratio if mode == "rocking" else None, tolerance=tolerance,
-                                min_log_lr=-math.inf)
+                                min_log_lr=-math.inf, **(near or {}).get(mode, {}))
     return scans
 
 
 def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None, radius: float | None = None,
                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
                  progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
-                 more_stands: tuple = ()) -> ExtendedFit:
+                 more_stands: tuple = (), near: dict | None = None) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
     mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None:
@@ -407,7 +407,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     (:func:`rwadist.resonance.resonance`) before the modes are located and fitted, so that the fixture's
     amplification is not taken for the wheel's.  more_stands: further fixture resonances (each (f_r Hz, ζ,
     peak gain), on every channel) divided out the same way (``rwadist diagnose`` checks the modes beside every
-    test-stand resonance it named); not recorded in ``ExtendedFit.stand``.
+    test-stand resonance it named); not recorded in ``ExtendedFit.stand``.  near: mode -> ``near_hz``/``near_a`` of
+    :func:`rwadist.mode_scan.scan_mode` (where an earlier fit of the same wheel located it), or None.
 
     Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
     measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
@@ -442,7 +443,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     la, sa, ca, aa = _measurements(meas)
     keep_ax = np.array([meas.lines[j].direction not in RADIAL for j in la], bool)
     la, sa, ca, aa = la[keep_ax], sa[keep_ax], ca[keep_ax], aa[keep_ax]
-    scans = _scan_all(meas.lines, la, sa, aa, 2.0 if physical else None, tolerance)
+    scans = _scan_all(meas.lines, la, sa, aa, 2.0 if physical else None, tolerance, near)
     if physical:
         I_zz, I_rr = ext.thin_disc(mass, radius)
     else:
@@ -763,8 +764,7 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
     analytical["fit"] = {"zeta": efit.zeta, "identified": efit.identified,
                          "rel_stderr": efit.rel_stderr, "residual_db_near_mode": efit.residual_db,
                          "senses": {f"{d} h={h:.4g}": {"sense": s_, "co_fraction": fr}
-                                    for (d, h), (s_, fr) in efit.senses.items()},
-                         "notes": efit.notes}
+                                    for (d, h), (s_, fr) in efit.senses.items()}, "notes": efit.notes}
     analytical["unconstrained"] = list(efit.unconstrained)
     unresolved = unresolved_spans(fit)
     if unresolved:

@@ -153,14 +153,62 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
     return out
 
 
+def _window(grid: np.ndarray, centre: float | None, lo: float, hi: float) -> np.ndarray:
+    """Indices of the points of ``grid`` (increasing) within [lo, hi]·``centre`` (all of them when ``centre`` is
+    None or no point falls there)."""
+    if centre is None or not np.isfinite(centre):
+        return np.arange(grid.size)
+    idx = np.flatnonzero((grid >= lo * centre) & (grid <= hi * centre))
+    return idx if idx.size else np.arange(grid.size)
+
+
+def _windowed_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, near_hz, near_a):
+    """:func:`_grid_search` on the whole product grid, or -- with ``near_hz`` (and ``near_a`` for the rocking
+    mode's I_zz/I_rr) -- first on the grid's points within ×/÷ :data:`NEAR_SPAN` of ``near_hz`` (and
+    ±:data:`NEAR_A_SPAN` of ``near_a``), the others NaN: kept when the best point lies inside that window (a point of
+    the same grid, so the same best point as the whole grid's whenever the whole grid's best lies there), the whole
+    grid searched when it lies on an edge the whole grid goes beyond (the data's best lies outside the window)."""
+    fi = _window(f0_grid, near_hz, 1.0 / NEAR_SPAN, NEAR_SPAN)
+    ai = np.arange(a_grid.size) if near_a is None or a_grid.size == 1 else \
+        np.flatnonzero(np.abs(a_grid - near_a) <= NEAR_A_SPAN + 1e-9)
+    if ai.size == 0:
+        ai = np.arange(a_grid.size)
+    if fi.size == f0_grid.size and ai.size == a_grid.size:
+        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+    sub = _grid_search(line, h, omega, power, f0_grid[fi], zeta_grid, a_grid[ai], two_parts)
+    if np.all(np.isnan(sub)):
+        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+    i, _, k = np.unravel_index(np.nanargmin(sub), sub.shape)
+    on_edge = ((i == 0 and fi[0] > 0) or (i == fi.size - 1 and fi[-1] < f0_grid.size - 1)
+               or (k == 0 and ai[0] > 0) or (k == ai.size - 1 and ai[-1] < a_grid.size - 1))
+    if on_edge:
+        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+    out = np.full((f0_grid.size, zeta_grid.size, a_grid.size), np.nan)
+    out[np.ix_(fi, np.arange(zeta_grid.size), ai)] = sub
+    return out
+
+
+#: Half-width (a factor) of the f0 window a scan with ``near_hz`` searches first (:func:`scan_mode`)
+NEAR_SPAN = 1.25
+#: Half-width of the I_zz/I_rr window a rocking scan with ``near_a`` searches first
+NEAR_A_SPAN = 0.4
+
+
 def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = None, tolerance: float = 0.02,
-              min_log_lr: float = 2.0) -> ModeScan:
+              min_log_lr: float = 2.0, near_hz: float | None = None, near_a: float | None = None) -> ModeScan:
     """Profile scan of one mode (see the module docstring).
 
     line : (n,) int, index of the line each measurement belongs to.  h : (n,) harmonic number.
     omega : (n,) wheel speed, rad/s.  power : (n,) measured x² + y² (radial, N² or N²m²) or the
     squared axial amplitude.  inertia_ratio : I_zz/I_rr for rocking when known (mass and radius
     given); None scans it over (0.05, 2].  tolerance : relative f0 error the data must exclude.
+    min_log_lr : see the module docstring; ``-inf`` (a locate-only scan, as the extended fit asks) skips the
+    distant competitor's refinement (``log_lr_off`` is then NaN: nothing compares with it).
+    near_hz, near_a : where an earlier fit of the same wheel located the mode (Hz) and its I_zz/I_rr (the refit of
+    ``rwadist diagnose``'s suspension modes on every run, from the fit on half of them), or None: the coarse grid
+    is searched within ×/÷ :data:`NEAR_SPAN` (and ±:data:`NEAR_A_SPAN`) of it first and over its whole range only
+    when the best point lies on that window's edge; the result is the whole grid's whenever its best point lies
+    inside the window.  ``interval_hz`` and ``log_lr_off`` are then those of the profile inside the window.
     """
     line, h, omega, power = (np.asarray(x) for x in (line, h, omega, power))
     ok = (power > 0) & np.isfinite(power) & (np.abs(omega) > 0)
@@ -187,7 +235,8 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     f_step = 0.01 if a_grid.size == 1 else 0.02
     f0_grid = np.exp(np.arange(math.log(f_lo), math.log(f_hi), f_step))
     zeta_grid = np.exp(np.linspace(math.log(0.002), math.log(0.6), 13 if a_grid.size == 1 else 9))
-    ssr = _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+    ssr = _windowed_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, near_hz,
+                           near_a if rocking and inertia_ratio is None else None)
     i, j, k = np.unravel_index(np.nanargmin(ssr), ssr.shape)
     # refine around the best point: f0 to 0.1 %, ζ and a finer
     f_fine = f0_grid[i] * np.exp(np.arange(-2 * f_step - 0.01, 2 * f_step + 0.0101, 0.001))
@@ -197,11 +246,16 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     fi, fj, fk = np.unravel_index(np.nanargmin(fine), fine.shape)
     best = float(fine[fi, fj, fk])
     f_best, z_best, a_best = float(f_fine[fi]), float(z_fine[fj]), float(a_fine[fk])
-    profile = np.nanmin(ssr, axis=(1, 2))
+    profile = np.full(f0_grid.size, np.nan)
+    scanned = ~np.all(np.isnan(ssr), axis=(1, 2))     # every f0 but those a windowed search left out
+    profile[scanned] = np.nanmin(ssr[scanned], axis=(1, 2))
     log_lr = 0.5 * n * np.log(np.maximum(profile, 1e-300) / max(best, 1e-300))
     off = np.abs(np.log(f0_grid / f_best)) > math.log1p(tolerance)
     log_lr_off = math.inf
-    if off.any():
+    off &= np.isfinite(log_lr)          # the grid points a windowed search left out
+    if min_log_lr == -math.inf:
+        log_lr_off = math.nan           # a locate-only scan: no competitor is weighed
+    elif off.any():
         # the competitor farther than the tolerance gets the same refinement as the best point (a coarse
         # ζ grid would make it look worse than it is and the mode look pinned when it is not)
         io = np.nonzero(off)[0][np.argmin(log_lr[off])]

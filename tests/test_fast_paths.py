@@ -1,14 +1,15 @@
 """The faster forms diagnose and the extended fit use, each against the direct form it replaces (issue 14's timing):
 the mode scan's product-grid SSR against a per-line non-negative least squares (scipy.optimize.nnls), the Hann
 window's closed-form transform against its plain sum, the batched whole-run DFT against the plain sum, a second
-empirical fit reusing the first one's detections against a fresh one, and the suspension-mode fit's spectra taken
-from every run's against those of its runs alone."""
+empirical fit reusing the first one's detections against a fresh one, the suspension-mode fit's spectra taken
+from every run's against those of its runs alone, and the mode scan searched first near an earlier fit's mode against
+the scan of its whole grid."""
 import numpy as np
 from scipy import optimize, signal
 
 from rwadist.dft import hann_transform, windowed_dfts
 from rwadist.empirical import fit_empirical, line_detections
-from rwadist.mode_scan import _grid_search, transmissibility_sq
+from rwadist.mode_scan import _grid_search, scan_mode, transmissibility_sq
 from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
 from rwadist.teststand import simulate_steady
@@ -67,6 +68,22 @@ def test_scan_grid_chunks_give_the_same_numbers():
         for chunk in (3, 50, 512, 10**6):
             assert np.array_equal(_grid_search(line, h, omega, power, f0, zeta, a, two_parts, chunk=chunk), ref,
                                   equal_nan=True), chunk
+
+
+def test_scan_near_an_earlier_fit_is_the_whole_grid_scan():
+    # diagnose's refit on every run searches each mode first within x/÷1.25 of where the fit on half the runs put it
+    # (and ±0.4 of its I_zz/I_rr): the same best point as the whole grid's when that lies inside the window, and the
+    # whole grid searched when the window's best lies on its edge (a start 1.6x off: the data's mode is outside)
+    line, h, omega, power = _scan_case(seed=7)
+    for mode, two in (("rocking", True), ("radial_translation", True), ("axial_translation", False)):
+        whole = scan_mode(mode, line, h, omega, power if two else np.sqrt(power), min_log_lr=-np.inf)
+        for near_hz, near_a in ((whole.f0_hz * 1.03, whole.inertia_ratio + 0.1), (whole.f0_hz * 1.6, 0.5),
+                                (whole.f0_hz / 1.6, None)):
+            got = scan_mode(mode, line, h, omega, power if two else np.sqrt(power), min_log_lr=-np.inf,
+                            near_hz=near_hz, near_a=near_a)
+            assert (got.found, got.f0_hz, got.zeta, got.inertia_ratio, got.reason) == \
+                (whole.found, whole.f0_hz, whole.zeta, whole.inertia_ratio, whole.reason), (mode, near_hz, near_a)
+    assert 50.0 < scan_mode("rocking", line, h, omega, power, min_log_lr=-np.inf).f0_hz < 60.0    # the case's 55 Hz
 
 
 def test_hann_transform_is_the_window_sum():

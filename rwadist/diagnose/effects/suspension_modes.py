@@ -68,11 +68,12 @@ def _fit_spectra(ctx: Context, test, runs: list):
     return sp, detections_of_runs({c: det[c] for c in chans if c in det}, rows)
 
 
-def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None):
+def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None, near: dict | None = None):
     """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
     amplification (or the extended fit fails); ``stand`` is the fixture resonance (f_r Hz, ζ, peak gain)
     divided out of the lines, or None.  ``stand_start``: the stand to start from (a refit on every run
-    starts from the one fitted on half of them), else the one :func:`stand_resonance_start` proposes.
+    starts from the one fitted on half of them), else the one :func:`stand_resonance_start` proposes.  ``near``: the
+    modes that fit located, searched first (``near`` of :func:`rwadist.extended_fit.fit_extended`), or None.
 
     A fixture resonance on every channel is fitted beside the modes, never into them: when the empirical
     fit shows lines of every direction amplified at one frequency (:func:`stand_resonance_start`), that
@@ -97,7 +98,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
         return None
     try:
-        efit, stand = _locate(ctx, test, fit, stand_start)
+        efit, stand = _locate(ctx, test, fit, stand_start, near)
         if efit.unconstrained and len(ctx.channels) == 6:
             # a load-cell offset (T_measured = T + r × F) puts the forces' lines, amplified by the translation mode,
             # into the torques (where they also pass for a fixture resonance lifting every direction at that mode):
@@ -105,7 +106,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             # itself is left to the search: a ``cross_coupling`` on the modes' base); with every mode located
             # (a stand divided out or not) none can be located more, so the correction is not tried
             got = _beside_offset(ctx, SuspensionModes.from_fit(efit, fit, len(runs)).apply(state), runs, test,
-                                 stand_start, len(efit.unconstrained))
+                                 stand_start, len(efit.unconstrained), near)
             if got is not None:
                 test, fit, efit, stand, offset = got
         if len(efit.unconstrained) == 3 and stand is not None and len(ctx.channels) > 3:
@@ -114,7 +115,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             # of the modes' fit from that start, until it settles, as ``rwadist fit --extended`` does
             # (:func:`rwadist.stand_resonance.fit_extended_beside_stand`; 100-6000 rpm through a 180 Hz stand: a start
             # at 187 Hz, gain 36 locates no mode, the rounds settle at 180.0 Hz, gain 5.0, all three found)
-            efit_rounds = fit_extended_beside_stand(test, fit, stand_start=stand)
+            efit_rounds = fit_extended_beside_stand(test, fit, stand_start=stand, near=near)
             if len(efit_rounds.unconstrained) < 3 and efit_rounds.stand is not None:
                 efit, stand, coupled = efit_rounds, tuple(efit_rounds.stand), efit_rounds.coupled
         before = None                   # the modes of the round before the last (with a stand divided out)
@@ -138,14 +139,14 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
                     # stand): confirmed or not on the residual of the modes' fit at the fit's own resolution, as
                     # ``rwadist fit --extended`` does (its rounds from this stand; the fit without it when the
                     # residual shows none); radial translation -18.6 % -> -1.8 % there
-                    efit = fit_extended_beside_stand(test, fit, stand_start=stand)
+                    efit = fit_extended_beside_stand(test, fit, stand_start=stand, near=near)
                     stand, before, coupled = (None if efit.stand is None else tuple(efit.stand)), None, efit.coupled
                 break
             new = (new.f_r, new.zeta, new.peak_gain)
             settled = (stand is not None and abs(new[0] / stand[0] - 1) < 0.002
                        and abs(np.log(new[2] / stand[2])) < 0.02)
             stand = new
-            before, efit = efit, fit_extended(test, fit, stand=stand)
+            before, efit = efit, fit_extended(test, fit, stand=stand, near=near)
             if settled:
                 break
         if stand is not None and before is not None:
@@ -165,32 +166,32 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
 
 
 
-def _locate(ctx: Context, test, fit, stand_start):
+def _locate(ctx: Context, test, fit, stand_start, near=None):
     """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``) before the stand's rounds: with the stand
     ``stand_start`` or the one the fit (else the whole data, :func:`_whole_data_fit`) proposes divided out, or
     without one when the stand divided out locates no mode (see :func:`_fit_runs`)."""
     from ...extended_fit import fit_extended
 
     stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
-    efit = fit_extended(test, fit, stand=stand)
+    efit = fit_extended(test, fit, stand=stand, near=near)
     if stand is None and efit.unconstrained and len(ctx.channels) > 3:
         # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows:
         # kept as the start when it locates more modes than the fit without it (refined in the rounds below)
         whole = stand_resonance_start(_whole_data_fit(ctx))
-        efit_whole = None if whole is None else fit_extended(test, fit, stand=whole)
+        efit_whole = None if whole is None else fit_extended(test, fit, stand=whole, near=near)
         if efit_whole is not None and len(efit_whole.unconstrained) < len(efit.unconstrained):
             efit, stand = efit_whole, whole
     if stand is not None and len(efit.unconstrained) == 3:
         # the fixture resonance divided out locates no mode at all (a start pulled by a wheel mode beside it:
         # its frequency, width and gain off): the modes are located without it, and the stand is fitted on
         # their base below, as when none was proposed
-        efit_plain = fit_extended(test, fit)
+        efit_plain = fit_extended(test, fit, near=near)
         if len(efit_plain.unconstrained) < 3:
             efit, stand = efit_plain, None
     return efit, stand
 
 
-def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_unconstrained: int):
+def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_unconstrained: int, near=None):
     """(test, fit, efit, stand, r) of the modes located (:func:`_locate`) on the torques of ``test`` corrected for a
     load-cell offset r (m: the ``cross_coupling`` fit of ``runs`` on ``state``, the extended base of the
     uncorrected data: its torque lines, the wheel's own, weigh the equations at their frequencies down; T − r × F),
@@ -217,7 +218,7 @@ def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_uncons
                                                                  if k in run.signals}}))
     test_c = SteadyTest(corrected, dict(test.meta))
     fit_c = fit_empirical(compute_spectra(test_c, window=ctx.sp.window, f_lim=ctx.sp.f_lim))
-    efit_c, stand_c = _locate(ctx, test_c, fit_c, stand_start)
+    efit_c, stand_c = _locate(ctx, test_c, fit_c, stand_start, near)
     if len(efit_c.unconstrained) >= n_unconstrained:
         return None
     efit_c.notes.append("load-cell offset: r = (%s) mm removed from the torques (T − r × F) before the modes were "
@@ -302,11 +303,26 @@ class SuspensionModes:
         return s
 
     def refit(self, ctx: Context, state: State) -> "SuspensionModes":
-        """Refitted on every run (``ctx.runs``), starting from this fit's stand resonance; itself when that fit
-        fails."""
+        """Refitted on every run (``ctx.runs``), starting from this fit's stand resonance, each mode it located
+        searched first near it (:meth:`near`); itself when that fit fails."""
         from dataclasses import replace
 
-        return replace(SuspensionModes.fit(ctx, state, ctx.runs, self.stand) or self, stand_fit_runs=self.stand)
+        return replace(SuspensionModes.fit(ctx, state, ctx.runs, self.stand, self.near()) or self,
+                       stand_fit_runs=self.stand)
+
+    def near(self) -> dict:
+        """``near`` of :func:`rwadist.extended_fit.fit_extended`: the modes this fit located (not those left
+        unconstrained), with the rocking mode's I_zz/I_rr.  The refit on every run is the same effect measured on
+        twice the runs: its scans start where this one's ended (a scan of the rocking mode over its whole grid of
+        f0, ζ and I_zz/I_rr is most of an extended fit's cost), and search the whole range when the best point
+        lies on the window's edge."""
+        from ...extended_fit import UNCONSTRAINED_NAME
+
+        out = {mode: {"near_hz": self.f0_Hz[name]} for mode, name in UNCONSTRAINED_NAME.items()
+               if name not in self.unconstrained}
+        if "rocking" in out:
+            out["rocking"]["near_a"] = self.inertia_ratio
+        return out
 
     def whirl_Hz(self, omega_rad_s: float) -> dict:
         """Whirl frequencies (Hz) at wheel speed ``omega_rad_s``: translation, rocking forward/backward, axial."""
@@ -328,10 +344,11 @@ class SuspensionModes:
         return schema_entry(self)
 
     @staticmethod
-    def fit(ctx: Context, state: State, runs, stand_start: tuple | None = None) -> "SuspensionModes | None":
+    def fit(ctx: Context, state: State, runs, stand_start: tuple | None = None,
+            near: dict | None = None) -> "SuspensionModes | None":
         """The modes fitted on ``runs`` (per unit mass and inertia), or None when those runs show no modal
-        amplification or no mode can be located; ``stand_start``: see :func:`_fit_runs`."""
-        got = _fit_runs(ctx, runs, state, stand_start)
+        amplification or no mode can be located; ``stand_start``, ``near``: see :func:`_fit_runs`."""
+        got = _fit_runs(ctx, runs, state, stand_start, near)
         return None if got is None else SuspensionModes.from_fit(got[2], got[1], len(runs), got[3])
 
     @staticmethod
