@@ -162,3 +162,25 @@ def test_hdf5_sweep_time_stored_as_float32(tmp_path):
         fh["time_s"] = np.delete(np.arange(n + 1) / FS, 2000).astype(np.float32)
     with pytest.raises(DataError, match=r"/time_s: sampling is not uniform: .*index 2000 .*1 dropped sample"):
         read_hdf5(path)
+
+
+@pytest.mark.parametrize("duration_s, fmt", [(390.0, "%.17g"), (390.0, "%.10g"), (390.0, "%.6f"), (4.0, "%.17g")])
+def test_a_long_record_of_exact_time_stamps_is_uniform(duration_s, fmt):
+    # the default sweep of `rwadist simulate-test --sweep` (390 s at 3840 Hz: 1 497 600 samples, time printed to 17
+    # significant digits) was refused as "a gap in the sampling" at its third step: the least-squares step, summed
+    # directly over time stamps up to 390 s, came out 6.5e-13 off, 17 times the 17-digit rounding the check allows.
+    # Exact time stamps i/f_s, parsed back from the printed text as a reader does, must give f_s; the same column
+    # with one sample dropped is still refused naming its line
+    from rwadist.formats.timebase import sample_step
+
+    n = int(round(duration_s * FS))
+    t = np.arange(n) / FS
+    if fmt == "%.6f":         # rounded as a DAQ prints (vectorised: a text round trip of 1.5 M values is slow)
+        t = np.round(t, 6)
+    elif fmt == "%.10g":      # 10 significant digits
+        scale = 10.0 ** (9 - np.floor(np.log10(np.where(t > 0, t, 1.0))))
+        t = np.round(t * scale) / scale
+    step = sample_step("x.csv", "time_s", t)
+    assert abs(step * FS - 1.0) <= (1e-13 if fmt == "%.17g" else 1e-9), step * FS - 1.0
+    with pytest.raises(DataError, match=r"x\.csv: time_s: sampling is not uniform: .* at line 1003 .*1 dropped sample"):
+        sample_step("x.csv", "time_s", np.delete(t, 1001))
