@@ -192,6 +192,21 @@ def test_residual_waterfall_zoomed_to_the_lines():
     top = tops.pop()
     assert top < 0.5 * band_top                        # the E wheel's lines end near 230 Hz, Nyquist 1920
     assert top >= _top_line_hz(model, "radial_force")
+    # laid out for a review: no panel's labels, ticks or title run into another's, and the panels with the colour
+    # bar fill the width (the figure before 2026-11-25: tick labels against the neighbour's frame, a fifth empty)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    boxes = [ax.get_tightbbox(renderer) for ax in fig.axes]
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            overlap_w = min(a.x1, b.x1) - max(a.x0, b.x0)
+            overlap_h = min(a.y1, b.y1) - max(a.y0, b.y0)
+            assert overlap_w <= 1.0 or overlap_h <= 1.0, (a, b)        # pixels
+    width = fig.bbox.width
+    assert min(b.x0 for b in boxes) < 0.05 * width and max(b.x1 for b in boxes) > 0.95 * width
 
 
 

@@ -6,7 +6,7 @@ import copy
 import numpy as np
 
 from ..units import CHANNEL_UNIT, RAD_S_TO_RPM
-from .constants import METRIC, NOISE_Z
+from .constants import BAND_BINS, METRIC, NOISE_Z
 from .search import Diagnosis
 
 
@@ -68,27 +68,35 @@ def _waterfall_figure(diag: Diagnosis):
     chans = [c for c in ctx.channels if not is_empty(data[c])]
     tops = [t for t in (content_top_above_floor(fc, data[c]) for c in chans) if t is not None]
     f_top = max(tops) if tops else float(fc[-1])      # noise only everywhere: the whole band
-    fig = Figure(figsize=(3.2 * max(len(chans), 1), 6.4))
+    n = max(len(chans), 1)
+    # one column per channel, the speed and frequency axes shared (tick labels on the outer panels only), the rows
+    # named once on their left, the colour bar beside the panels: laid out by matplotlib's constrained layout so no
+    # label overlaps a neighbour and no margin is left empty
+    fig = Figure(figsize=(2.3 * n + 1.6, 5.6), layout="constrained")
     FigureCanvasAgg(fig)
+    axes = fig.subplots(2, n, sharex=True, sharey=True, squeeze=False)
     rpm = ctx.omega[runs] * RAD_S_TO_RPM
     im = None
     for j, c in enumerate(chans):
         for i, (tag, st) in enumerate((("before", diag.state_before), ("after", diag.state_after))):
             D = ctx.band_sums(ctx.data(st, c)[runs])
-            ax = fig.add_subplot(2, len(chans), i * len(chans) + j + 1)
+            ax = axes[i, j]
             M = ctx.band_sums(ctx.predict(st, c, runs))
             with np.errstate(divide="ignore", invalid="ignore"):
                 r = 10 * np.log10(np.maximum(D, 1e-300) / np.maximum(M, 1e-300))
-            im = ax.pcolormesh(fc, rpm, r, cmap="RdBu_r", vmin=-10, vmax=10, shading="nearest")
+            im = ax.pcolormesh(fc, rpm, r, cmap="RdBu_r", vmin=-10, vmax=10, shading="nearest", rasterized=True)
             ax.set_xlim(max(float(fc[0]) - 0.5 * float(fc[1] - fc[0]), 0.0) if len(fc) > 1 else 0.0, f_top)
-            ax.set_title(f"{c}, model {tag} diagnose", fontsize=9)
+            if i == 0:
+                ax.set_title(c, fontsize=10)
             if j == 0:
-                ax.set_ylabel("Wheel speed (rpm)")
+                ax.set_ylabel(f"model {tag} diagnose\nwheel speed (rpm)", fontsize=9)
             if i == 1:
-                ax.set_xlabel("Frequency (Hz)")
+                ax.set_xlabel("frequency (Hz)", fontsize=9)
+            ax.tick_params(labelsize=8)
     if im is not None:
-        fig.colorbar(im, ax=fig.axes, label="data / model (dB of band power)")
-    fig.suptitle(f"Residual waterfall, 0–{f_top:.0f} Hz (red: data above the model)", fontsize=10)
+        fig.colorbar(im, ax=axes, label="data / model (dB of band power)", shrink=0.9, pad=0.01)
+    fig.suptitle(f"Residual waterfall, 0–{f_top:.0f} Hz: data over model in {BAND_BINS}-bin bands "
+                 "(red: data above the model, blue: below)", fontsize=10)
     return fig
 
 
