@@ -128,11 +128,16 @@ def _edges(centres: np.ndarray, default_half: float) -> np.ndarray:
     return np.concatenate([[centres[0] - (mid[0] - centres[0])], mid, [centres[-1] + (centres[-1] - mid[-1])]])
 
 
+#: Most markers drawn along one line of a waterfall (:func:`plot_waterfall`): ~11 px rings 540 px apart at most
+MAX_MARKERS_PER_LINE = 40
+
+
 def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | None = None,
                    lines=None, max_columns: int = 1500):
     """Data PSD of ``channel`` as a |speed| (rpm) × frequency (Hz) image, log10 colour, up to
     min(f_max, band limit); the model's lines h·|Ω| (Eq. 3.12) overlaid as circles, and the
-    measurements ``lines`` (LineFit list) left out as modal amplification as red crosses.
+    measurements ``lines`` (LineFit list) left out as modal amplification as red crosses, both at no more than
+    :data:`MAX_MARKERS_PER_LINE` evenly spaced speeds per line (the data stay visible between them).
 
     Runs at the same |speed| are averaged; when the band holds more than ``max_columns``
     bins, adjacent bins are merged by their maximum so narrow lines stay visible.
@@ -167,11 +172,15 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
                              vmin=np.percentile(vals, 2), vmax=vals.max(), rasterized=True)
         fig.colorbar(mesh, ax=ax, label=f"log10 PSD ({unit}²/Hz)")
     handles = []
+    # markers on at most MAX_MARKERS_PER_LINE speeds of each line: a sweep sliced into 170 runs drew rings and crosses
+    # so close that they merged into tubes hiding the lines they mark
+    stride = max(1, int(np.ceil(len(u_rpm) / MAX_MARKERS_PER_LINE)))
+    marked = u_rpm[::stride]
     if model is not None and channel in CHANNEL_DIRECTION:
         direction = CHANNEL_DIRECTION[channel]
-        f_line, _ = compare.model_psd_lines(model, direction, rpm_to_rad_s(u_rpm))
+        f_line, _ = compare.model_psd_lines(model, direction, rpm_to_rad_s(marked))
         if f_line.size:
-            yy = np.broadcast_to(u_rpm[:, None], f_line.shape)
+            yy = np.broadcast_to(marked[:, None], f_line.shape)
             m = (f_line <= top) & (yy > 0)
             # hollow rings wide enough that the measured line shows through their centre
             handles += ax.plot(f_line[m], yy[m], "o", mfc="none", mec="white", mew=0.6, ms=8, alpha=0.85,
@@ -179,7 +188,8 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
     if lines is not None:
         fx, fy = [], []
         for ln in lines:
-            sel = (np.asarray(ln.channel) == channel) & _is_modal(ln)
+            sel = (np.asarray(ln.channel) == channel) & _is_modal(ln) \
+                & np.isin(np.round(np.abs(ln.speed) * RAD_S_TO_RPM, 6), np.round(marked, 6))
             fx.append(ln.h * np.abs(ln.speed[sel]) / (2 * np.pi))
             fy.append(np.abs(ln.speed[sel]) * RAD_S_TO_RPM)
         fx = np.concatenate(fx) if fx else np.empty(0)

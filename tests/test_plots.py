@@ -96,6 +96,25 @@ def test_waterfall_data_under_hollow_model_rings_and_band_of_content(fit):
     _legend_artists_are_drawn(fig)
 
 
+def test_waterfall_of_a_dense_speed_grid_leaves_the_data_visible_between_markers():
+    # a sweep sliced into ~170 runs drew a ring at every speed of every line: the rings (11 px) merged into tubes
+    # that hid the lines.  On 150 speeds the rings of each model line are no closer than the axis height over
+    # MAX_MARKERS_PER_LINE, and every ring still sits on a line h·Ω of the model at a speed of the data
+    test = rwadist.simulate_test("ithaco-e", speeds_rpm=np.linspace(300.0, 2400.0, 150), n_samples=1024, seed=2)
+    f = rwadist.fit(test)
+    fig, ax = report.plot_waterfall(f.spectra, "Fx", model=f.model, lines=f.lines)
+    rings = [ln for ln in ax.lines if ln.get_label() == "model lines h·Ω"][0]
+    y = np.asarray(rings.get_ydata())
+    x = np.asarray(rings.get_xdata())
+    hs = f.model.h_and_C("radial_force")[0]
+    per_line = [np.sort(y[np.isclose(x, h * y / 60.0, rtol=1e-9)]) for h in hs]
+    assert all(0 < v.size <= report.MAX_MARKERS_PER_LINE for v in per_line), [v.size for v in per_line]
+    assert sum(v.size for v in per_line) == x.size                     # every ring on a model line
+    span = 2400.0 - 300.0
+    assert all(np.all(np.diff(v) >= span / report.MAX_MARKERS_PER_LINE * 0.9) for v in per_line)
+    assert np.all(np.isin(np.round(y, 6), np.round(np.abs(f.spectra.speed) * 60 / (2 * np.pi), 6)))
+
+
 def test_cumulative_rms_zoomed_and_data_over_model(fit):
     view = report.content_top(fit.spectra, fit.lines)
     fig, (ax_a, ax_c) = report.plot_cumulative_rms(fit.spectra, fit.model, "radial_force", 2400.0, f_max=view)
