@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from .data import DataError, SteadyTest, Sweep
+from .formats.records import reading_provenance
 from .model import WheelModel
 from .model import load as load_model
 from .model import save as save_model
@@ -183,7 +184,9 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
         name = Path(data).name if isinstance(data, (str, Path)) else "fitted wheel"
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
-    return fit_empirical(spectra, settings, name=name, progress=progress)
+    result = fit_empirical(spectra, settings, name=name, progress=progress)
+    result.model.provenance.update(reading_provenance(getattr(test, "meta", None)))
+    return result
 
 
 def fit_extended(data, empirical=None, *, mass: float | None = None, radius: float | None = None,
@@ -298,7 +301,12 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
             # a datasheet wheel of the catalogue: its modes are assumed, which resolve_base reads from the model
             model.analytical = {**dict(model.analytical), "modes_assumed": True}
     spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))
-    return _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base)
+    diagnosis = _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base)
+    reading = reading_provenance(getattr(test, "meta", None))
+    if reading:
+        diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(
+            diagnosis.model.provenance.get("diagnose", {}), **reading))
+    return diagnosis
 
 
 def wheel_lines(model=None, *, preset: str | None = None, empirical: bool = False):

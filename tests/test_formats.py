@@ -504,3 +504,28 @@ def test_channel_map_unit_against_the_unit_the_file_states(tmp_path, steady):
         d = _tdms_lab(tmp_path / unit_string, steady, unit_string, map_unit)
         got = read_steady(d).runs[0].signals["Fx"]
         np.testing.assert_allclose(got, steady.runs[0].signals["Fx"] * factor, rtol=1e-15)
+
+
+def test_model_records_how_its_data_were_read(tmp_path, steady):
+    # the model file says how the data were read: the channel map (names, units, signs, calibration) and the tach
+    # channel of meta.json, which the data themselves no longer show once converted to SI; saved and loaded back
+    from rwadist.api import fit
+    from rwadist.model import load, save
+
+    d = write_mapped(steady, tmp_path / "lab", calibration_matrix())
+    meta = json.loads((d / "meta.json").read_text())
+    model = fit(d).model
+    assert model.provenance["reading"] == {"channel_map": meta["channel_map"]}
+    back = load(save(model, tmp_path / "m.json"))
+    assert back.provenance["reading"] == {"channel_map": meta["channel_map"]}
+    assert "reading" not in fit(steady).model.provenance           # in memory, read from nothing: nothing said
+
+
+def test_model_of_a_sliced_sweep_records_the_slicing(tmp_path, sweep):
+    from rwadist.api import fit, read
+
+    path = write_sweep(sweep, tmp_path / "sweep.csv")
+    test = read(path, slice_samples=2048, speed_source="tach")
+    slicing = fit(test).model.provenance["reading"]["slicing"]
+    assert slicing["slice_samples"] == 2048 and slicing["speed_source"] == "tach"
+    assert slicing["n_kept"] == len(test.runs)

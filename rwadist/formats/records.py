@@ -133,6 +133,15 @@ def read_json(path):
 READING_KEYS = ("channel_map", "tach", "unlisted_files")
 
 
+def reading_provenance(meta) -> dict:
+    """What a model fitted to data with test metadata ``meta`` records of how the data were read (its provenance's
+    ``reading``): the channel map and tach pulse channel of ``meta.json`` and a sweep's slicing (slice length, speed
+    source, slices kept and dropped), those present; {} when none is."""
+    meta = dict(meta or {})
+    got = {k: meta[k] for k in ("channel_map", "tach", "slicing") if k in meta}
+    return {"reading": got} if got else {}
+
+
 def portable_meta(meta) -> dict:
     """``meta`` without the keys that only describe the source files (channel map, tach pulse channel)."""
     return {k: v for k, v in dict(meta or {}).items() if k not in READING_KEYS}
