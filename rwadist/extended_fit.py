@@ -44,6 +44,7 @@ from . import extended as ext
 from .data import SteadyTest
 from .dft import run_window, windowed_dfts
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
+from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
 from .off_law_lines import free_off_law_lines, line_regressors, off_law_note
@@ -250,19 +251,6 @@ def _measurements(fit: EmpiricalFit):
         ch.append(np.array([CHANNEL_INDEX[c] for c in x.channel]))
         amp.append(x.amplitude)
     return np.concatenate(li), np.concatenate(sp), np.concatenate(ch), np.concatenate(amp)
-
-
-def remove_lever_arm(test: SteadyTest, height: float) -> SteadyTest:
-    """Torques about the rotor centre from torques about the interface: T_rotor = T_int − i·height·F,
-    i.e. Tx += height·Fy, Ty −= height·Fx (runs lacking a channel are left as they are)."""
-    runs = []
-    for r in test.runs:
-        sig = dict(r.signals)
-        if all(c in sig for c in ("Fx", "Fy", "Tx", "Ty")):
-            sig["Tx"] = sig["Tx"] + height * sig["Fy"]
-            sig["Ty"] = sig["Ty"] - height * sig["Fx"]
-        runs.append(replace(r, signals=sig))
-    return SteadyTest(runs, dict(test.meta))
 
 
 def _radial_power(meas_lines):
@@ -755,10 +743,16 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
 
     model = deepcopy(fit.model)
     se = efit.rel_stderr
+
+    def n_points(ln) -> int:
+        """Measurements of the line the least squares fitted ``ln`` to (an imbalance's h is 1 exactly)."""
+        near = [x for x in efit.measured if x.direction == ln.direction and abs(x.h - ln.h) <= ext.IMBALANCE_H_TOL]
+        return int(min(near, key=lambda x: abs(x.h - ln.h)).speed.size) if near else 0
+
     for d in model.empirical:
         model.empirical[d] = [
             Harmonic(h=round(ln.h, 4), C=ln.C, C_stderr=ln.C * se.get(f"C[{ln.direction},{ln.h:g},{ln.sense}]", np.nan),
-                     sense=ln.sense if d in RADIAL else None)
+                     sense=ln.sense if d in RADIAL else None, n_points=n_points(ln))
             for ln in efit.lines if ln.direction == d]
     analytical = ext.params_to_dict(efit.params)
     analytical["fit"] = {"zeta": efit.zeta, "identified": efit.identified,

@@ -1,4 +1,5 @@
-"""Mounting geometry, one home: the DCM check, the lever-arm load transform and the spin-axis DCM.
+"""Mounting geometry, one home: the DCM check, the lever-arm load transform (and its removal from a test's torques)
+and the spin-axis DCM.
 
 Convention (``docs/formats.md``): a mounting is a direction-cosine matrix R (wheel frame ->
 spacecraft frame, ``v_sc = R @ v_wheel``) and the interface position r (m, spacecraft frame, from the
@@ -86,3 +87,20 @@ def spin_axis_dcm(axis, ref=(0.0, 0.0, 1.0)) -> np.ndarray:
             x = np.array([0.0, 1.0, 0.0]) - z[1] * z
     x = x / np.linalg.norm(x)
     return np.column_stack([x, np.cross(z, x), z])
+
+
+def remove_lever_arm(test, height: float):
+    """Torques about the rotor centre from torques about the interface, for every run of the steady test ``test``
+    (a :class:`rwadist.data.SteadyTest`; a new one is returned): T_rotor = T_int − i·height·F, i.e.
+    Tx += height·Fy, Ty −= height·Fx, ``height`` (m) the rotor centre's z above the interface (runs lacking a
+    channel are left as they are)."""
+    from dataclasses import replace
+
+    runs = []
+    for r in test.runs:
+        sig = dict(r.signals)
+        if all(c in sig for c in ("Fx", "Fy", "Tx", "Ty")):
+            sig["Tx"] = sig["Tx"] + height * sig["Fy"]
+            sig["Ty"] = sig["Ty"] - height * sig["Fx"]
+        runs.append(replace(r, signals=sig))
+    return type(test)(runs, dict(test.meta))
