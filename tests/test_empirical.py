@@ -108,6 +108,29 @@ def test_modal_amplification_is_excluded_automatically():
     assert abs(raw.C / C - 1) > abs(x.C / C - 1)
 
 
+
+def test_fit_without_exclusion_reuses_the_identification_with_the_same_numbers():
+    """:attr:`EmpiricalFit.without_mode_exclusion` takes the fit's own identification and measurements: its lines,
+    harmonics and bins are those of a fit of its own with exclude_modes=False (a second, independent computation);
+    the excluded fit's bins are untouched by it (a line dropped as modal there is kept without exclusion)."""
+    import dataclasses
+
+    h, C, f_mode = 3.0, 1.0e-6, 120.0
+    test = make_test([(1.0, 4.0e-6), (h, C), (4.4, 0.8e-6)], np.linspace(600, 3000, 61), mode=(f_mode, 0.02, 6.0))
+    sp = compute_spectra(test)
+    fit = fit_empirical(sp)
+    bins_before = [dataclasses.astuple(b) for b in fit.bins]
+    reused = fit.without_mode_exclusion
+    fresh = fit_empirical(sp, FitSettings(exclude_modes=False))
+    assert reused.model.empirical == fresh.model.empirical
+    assert [dataclasses.astuple(b) for b in reused.bins] == [dataclasses.astuple(b) for b in fresh.bins]
+    for a, b in zip(reused.lines, fresh.lines, strict=True):
+        assert (a.h, a.C, a.C_stderr, a.C_all) == (b.h, b.C, b.C_stderr, b.C_all)
+        assert np.array_equal(a.used, b.used) and np.array_equal(a.amplitude, b.amplitude)
+    assert not any(np.any(~x.used) for x in reused.lines)
+    assert any(np.any(~x.used) for x in fit.lines)            # the excluded fit did exclude a range
+    assert [dataclasses.astuple(b) for b in fit.bins] == bins_before
+
 def test_negative_zero_and_duplicate_speeds():
     """Negative speeds fit by |Ω|; the zero-speed noise run is skipped; duplicate speeds count twice."""
     speeds = np.concatenate([-SPEEDS[::2], [0.0], SPEEDS[1::2], [SPEEDS[-1]]])
