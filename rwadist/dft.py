@@ -87,17 +87,39 @@ def hann_transform(n: int, sample_rate: float, f_hz: np.ndarray) -> np.ndarray:
     """W(f) = Σ_{m<n} w[m]·e^{−2πj f m/sample_rate} of the periodic Hann window w[m] = ½ − ½cos(2πm/n)
     (:func:`scipy.signal.get_window` ``"hann"``) at ``f_hz`` (any shape) Hz, in closed form: with θ = 2πf/f_s
     and the Dirichlet sum D(θ) = Σ_{m<n} e^{−jθm} = e^{−jθ(n−1)/2}·sin(nθ/2)/sin(θ/2) (= n at θ ≡ 0 mod 2π),
-    W = ½D(θ) − ¼D(θ − 2π/n) − ¼D(θ + 2π/n).  W(0) = n/2 = Σw; complex (any shape of ``f_hz``)."""
+    W = ½D(θ) − ¼D(θ − 2π/n) − ¼D(θ + 2π/n).  W(0) = n/2 = Σw; complex (any shape of ``f_hz``).
+
+    The three kernels share their phase and numerator: with φ = θ/2, sin(n(φ ∓ π/n)) = −sin(nφ) and
+    e^{−j(φ ∓ π/n)(n−1)} = e^{−jφ(n−1)}·e^{±jπ(n−1)/n}, so W = e^{−jφ(n−1)}·sin(nφ)·(½/sin φ + ¼e^{jπ(n−1)/n}/sin(φ − π/n)
+    + ¼e^{−jπ(n−1)/n}/sin(φ + π/n)), sin(φ ∓ π/n) = sin φ·cos(π/n) ∓ cos φ·sin(π/n): five functions of φ per point
+    instead of twelve.  Where a denominator vanishes (θ ≡ 0 or ±2π/n, mod 2π) that kernel's limit is taken, term by
+    term as :func:`_hann_transform_terms` sums it."""
     theta = 2 * np.pi * np.asarray(f_hz, dtype=float) / sample_rate
+    phi = 0.5 * theta
+    s, c = np.sin(phi), np.cos(phi)
+    sp, cp = np.sin(np.pi / n), np.cos(np.pi / n)
+    below, above = s * cp - c * sp, s * cp + c * sp                      # sin(φ − π/n), sin(φ + π/n)
+    tol = 1e-12 * np.maximum(np.abs(phi) + np.pi / n, 1.0)
+    singular = (np.abs(s) <= tol) | (np.abs(below) <= tol) | (np.abs(above) <= tol)
+    turn = np.exp(1j * np.pi * (n - 1) / n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.exp(-1j * phi * (n - 1)) * np.sin(n * phi) * (0.5 / s + 0.25 * turn / below + 0.25 * np.conj(turn) / above)
+    if np.any(singular):
+        out = np.where(singular, _hann_transform_terms(n, theta, singular), out)
+    return out
+
+
+def _hann_transform_terms(n: int, theta: np.ndarray, where: np.ndarray) -> np.ndarray:
+    """:func:`hann_transform` at the angles θ of ``where`` (0 elsewhere) as the sum of its three Dirichlet kernels, each
+    at θ ≡ 0 (mod 2π) by its limit n·cos(θ/2)^(n−1) (every term of its sum is 1 there)."""
     out = np.zeros(theta.shape, dtype=complex)
+    th0 = theta[where]
+    part = np.zeros(th0.shape, dtype=complex)
     for weight, shift in ((0.5, 0.0), (-0.25, -2 * np.pi / n), (-0.25, 2 * np.pi / n)):
-        th = theta + shift
+        th = th0 + shift
         half = np.sin(0.5 * th)
-        # θ ≡ 0 (mod 2π): every term of the sum is 1; sin(θ/2) is then 0 to rounding (relative to θ)
         at_zero = np.abs(half) <= 1e-12 * np.maximum(np.abs(th), 1.0)
-        ratio = np.sin(0.5 * n * th) / np.where(at_zero, 1.0, half)
-        if np.any(at_zero):
-            # the limit n·cos(θ/2)^(n−1) only where it applies: a power of n − 1 costs ~9 sines per element
-            ratio = np.where(at_zero, n * np.cos(0.5 * th) ** (n - 1), ratio)
-        out += weight * np.exp(-0.5j * th * (n - 1)) * ratio
+        ratio = np.where(at_zero, n * np.cos(0.5 * th) ** (n - 1), np.sin(0.5 * n * th) / np.where(at_zero, 1.0, half))
+        part += weight * np.exp(-0.5j * th * (n - 1)) * ratio
+    out[where] = part
     return out

@@ -255,24 +255,27 @@ def _measurements(fit: EmpiricalFit):
 
 def _radial_power(meas_lines):
     """Per radial line and run, the measured x and y amplitudes combined: d_x² + d_y² (only runs
-    where both are measured).  Returns (line index, speed, power, direction) arrays."""
+    where both are measured; a channel measured twice at one speed counts by its first measurement).  Returns (line
+    index, speed, power, direction) arrays, each line's speeds in increasing order."""
     li, sp, pw, dr = [], [], [], []
     for j, x in enumerate(meas_lines):
         if x.direction not in RADIAL:
             continue
         cx, cy = DIRECTION_CHANNELS[x.direction]
-        speeds = np.unique(x.speed)
-        for w in speeds:
-            m = x.speed == w
-            chans = list(x.channel[m])
-            if cx in chans and cy in chans:
-                dx = x.amplitude[m][chans.index(cx)]
-                dy = x.amplitude[m][chans.index(cy)]
-                li.append(j)
-                sp.append(w)
-                pw.append(dx**2 + dy**2)
-                dr.append(x.direction)
-    return np.array(li, int), np.array(sp), np.array(pw), np.array(dr)
+        chan = np.asarray(x.channel)
+        on_x, on_y = chan == cx, chan == cy
+        # each speed's first measurement on each channel (np.unique's first occurrences), paired on the speeds both have
+        wx, ix = np.unique(x.speed[on_x], return_index=True)
+        wy, iy = np.unique(x.speed[on_y], return_index=True)
+        both, kx, ky = np.intersect1d(wx, wy, assume_unique=True, return_indices=True)
+        dx, dy = x.amplitude[on_x][ix[kx]], x.amplitude[on_y][iy[ky]]
+        li.append(np.full(both.size, j))
+        sp.append(both)
+        pw.append(dx**2 + dy**2)
+        dr.append(np.full(both.size, x.direction))
+    if not li:
+        return np.array([], int), np.array([]), np.array([]), np.array([])
+    return np.concatenate(li).astype(int), np.concatenate(sp), np.concatenate(pw), np.concatenate(dr)
 
 
 #: direction -> (mode, stiffness, damping, inertia, gyroscopic inertia or None) of the subsystem it loads
@@ -358,9 +361,10 @@ class LinePower:
         return r, d_mode, d_C
 
 
-def _scan_all(meas_lines, la, sa, aa, inertia_ratio, tolerance, near=None):
-    """Profile scan (:mod:`rwadist.mode_scan`) of each mode on the measured lines (``near``: :func:`fit_extended`)."""
-    lr, sr, pr, dr = _radial_power(meas_lines)
+def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=None):
+    """Profile scan (:mod:`rwadist.mode_scan`) of each mode on the measured lines (``radial``: their
+    :func:`_radial_power`; ``near``: :func:`fit_extended`)."""
+    lr, sr, pr, dr = radial
     h_of = np.array([x.h for x in meas_lines]) if meas_lines else np.zeros(0)
     scans = {}
     for mode, direction in MODE_DIRECTION.items():
@@ -431,7 +435,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     la, sa, ca, aa = _measurements(meas)
     keep_ax = np.array([meas.lines[j].direction not in RADIAL for j in la], bool)
     la, sa, ca, aa = la[keep_ax], sa[keep_ax], ca[keep_ax], aa[keep_ax]
-    scans = _scan_all(meas.lines, la, sa, aa, 2.0 if physical else None, tolerance, near)
+    radial = _radial_power(meas.lines)
+    scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near)
     if physical:
         I_zz, I_rr = ext.thin_disc(mass, radius)
     else:
@@ -478,7 +483,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         raise ValueError("the empirical fit has no harmonics: nothing to fit the extended model to")
     owner = np.array(owner)
     # axial measurements: per channel amplitude; radial: x²+y² power per run
-    lr, sr, pr, dr = _radial_power(meas.lines)
+    lr, sr, pr, dr = radial
     line_of = {}
     for k, j in enumerate(owner):
         line_of.setdefault(int(j), []).append(k)

@@ -30,3 +30,16 @@ def test_content_key_kept_on_the_state_is_the_fresh_one():
         assert (ctx.content_key(plain, chans, runs) != ctx.content_key(forces, chans, runs)) == touched
     # other runs, other key
     assert ctx.content_key(plain, ["Fx"], runs) != ctx.content_key(plain, ["Fx"], runs[1:])
+
+
+def test_band_sums_are_numpys_sums_of_each_band():
+    """:meth:`Metric.band_sums` written as numpy's pairwise order of its 8 bins: bit for bit ``reshape(...).sum(-1)``
+    on numbers spread over many decades (where another order of the adds would differ in the last bits)."""
+    test = simulate_steady(preset("ithaco-e"), np.linspace(600.0, 3000.0, 4), sample_rate=1000.0, n_samples=2048,
+                           noise=0.01, seed=3, test_stand=False)
+    ctx = Context(compute_spectra(test, nperseg=512), test=test)
+    rng = np.random.default_rng(0)
+    x = rng.standard_normal((7, ctx.f.size)) * np.exp(5.0 * rng.standard_normal((7, ctx.f.size)))
+    lo, n = ctx.k_lo, ctx.n_bands * 8
+    plain = x[:, lo:lo + n].reshape(7, ctx.n_bands, 8).sum(-1) * ctx.df
+    assert np.array_equal(ctx.band_sums(x), plain)

@@ -280,7 +280,8 @@ class CounterRotation:
             return float(np.sum(wt * (y - np.log(np.maximum(Po + Pp + q * (Pn - Pp), 1e-300))) ** 2))
 
         grid = np.linspace(0.0, 1.0, 201)
-        vals = [cost(q) for q in grid]
+        # cost at every grid point at once (each row the same operations as cost(q) and summed as np.sum sums it)
+        vals = np.sum(wt * (y - np.log(np.maximum(Po + Pp + grid[:, None] * (Pn - Pp), 1e-300))) ** 2, axis=1).tolist()
         i = int(np.argmin(vals))
         sol = minimize_scalar(cost, bounds=(grid[max(i - 1, 0)], grid[min(i + 1, 200)]), method="bounded",
                               options={"xatol": 1e-6})

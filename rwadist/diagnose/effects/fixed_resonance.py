@@ -174,7 +174,7 @@ class FixedResonance:
 
     @staticmethod
     def fit(ctx: Context, state: State, channels, runs, f0: float | None = None,
-            role: str = "wheel_mode", n_iter: int = 3) -> "FixedResonance | None":
+            role: str = "wheel_mode", n_iter: int = 3, reuse: bool = True) -> "FixedResonance | None":
         """f_r, ζ, g by robust (soft-L1) nonlinear least squares of ln|H(f)|² against the lines' log power
         gains (:func:`_line_gain_points`), parameters in logs (positive), started at the strongest excess
         (or ``f0``) with ζ ∈ {0.01, 0.03, 0.1}; ``n_iter`` passes, each re-measuring the lines with the
@@ -182,10 +182,14 @@ class FixedResonance:
 
         The fit reads only what the state predicts and measures on ``chans``: it is kept on the context under
         :meth:`Context.content_key`, and a later search step whose state is the same there (its accepted effect
-        touched other channels) gets it again instead of fitting anew."""
+        touched other channels) gets it again instead of fitting anew.  ``reuse`` False: fitted without that key (a
+        state no later step can meet again, such as the stand check of a suspension-modes fit: the digest of every
+        channel's prediction costs more than it saves there)."""
         from dataclasses import replace
 
         chans = [c for c in channels if c in ctx.channels]
+        if not reuse:
+            return FixedResonance._fit(ctx, state, channels, chans, runs, f0, role, n_iter)
         key = ("fixed_resonance.fit", tuple(channels), role, n_iter, f0, ctx.content_key(state, chans, runs))
         if key not in ctx._memo:
             ctx._memo[key] = FixedResonance._fit(ctx, state, channels, chans, runs, f0, role, n_iter)

@@ -129,7 +129,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             st = SuspensionModes.from_fit(efit, fit, len(runs)).apply(state)
             st.coupling = offset                # the torque data read corrected, as the modes were located
             new = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), None if stand is None else stand[0],
-                                     role="test_stand")
+                                     role="test_stand", reuse=False)
             # the rule of the stand's own detection: a broad "resonance" (an amplitude law's growth, a mode's skirt
             # left on the base) divided out as a stand would pull the modes to explain it, silently
             if new is None or not is_fixture_resonance(new.zeta, new.peak_gain):
