@@ -436,6 +436,22 @@ class Context(Metric):
             out += self.psd_at(np.column_stack(plain_f), np.column_stack(plain_p), bins)
         return out
 
+    def reuse(self, family: str, state: State, chans, runs: np.ndarray, compute, part: str = "") -> list:
+        """The effects ``compute()`` proposes (a list) from channels ``chans`` of ``runs`` alone, kept on the context
+        under the state's :meth:`content_key` of those channels and the family's own effects already in the state
+        (``family`` is their ``kind``: one that leaves the prediction as it was, a counter-rotating part of a line no
+        mode tells apart, still changes what the family proposes): a later search step whose accepted effect touched
+        other channels only gets them again, as copies, instead of fitting anew.  ``part``: which of the family's
+        searches (one family may propose from several)."""
+        from dataclasses import replace
+
+        own = tuple(repr(e.params()) for e in state.effects if getattr(e, "kind", None) == family)
+        key = ("reuse", family, part, tuple(chans), np.asarray(runs).tobytes(), own,
+               self.content_key(state, chans, runs))
+        if key not in self._memo:
+            self._memo[key] = compute()
+        return [replace(e) for e in self._memo[key]]
+
     def content_key(self, state: State, chans, runs: np.ndarray) -> bytes:
         """A digest of everything ``state`` predicts and reads on channels ``chans`` and ``runs``: per channel the
         data it reads (the load-cell offset of a corrected torque), the whole prediction, the noise floor, every

@@ -300,11 +300,10 @@ class BroadbandFloor:
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
-        out = []
-        for c in ctx.channels:
-            if c in state.floors:
-                continue
+        """A floor law per channel without one; each channel's from that channel alone (:meth:`Context.reuse`)."""
+        def one(c):
             e = BroadbandFloor.fit(ctx, state, c, runs)
-            if e is not None and e.psd_ref.max() > 0:
-                out.append(e)
-        return out
+            return [e] if e is not None and e.psd_ref.max() > 0 else []
+
+        return [e for c in ctx.channels if c not in state.floors
+                for e in ctx.reuse("broadband_floor", state, [c], runs, lambda c=c: one(c))]

@@ -310,16 +310,21 @@ class CounterRotation:
                    if (g := _sense_group(state, d, h)) is not None and (d, round(h, 3)) not in done]
             if h0s:
                 ctx.prefetch_phasors(runs, np.outer(ctx.omega[runs], h0s) / (2 * np.pi))
-        for d in ("radial_force", "radial_torque"):
-            if not any(c in ctx.channels for c in DIRECTION_CHANNELS[d]):
-                continue
-            hs = sorted({round(ln.h, 4) for ln in state.ext_lines() if ln.direction == d})
-            for h in hs:
+        def split(d) -> list:
+            found = []
+            for h in sorted({round(ln.h, 4) for ln in state.ext_lines() if ln.direction == d}):
                 g = _sense_group(state, d, h)
                 if g is None or (d, round(h, 3)) in done:
                     continue
                 q0 = g[2] ** 2 / (g[1] ** 2 + g[2] ** 2)
                 e = CounterRotation.fit(ctx, state, d, h, runs)
                 if e is not None and abs(e.counter_fraction - q0) > max(0.01, 2 * e.counter_fraction_stderr):
-                    out.append(e)
+                    found.append(e)
+            return found
+
+        for d in ("radial_force", "radial_torque"):
+            chans = [c for c in DIRECTION_CHANNELS[d] if c in ctx.channels]
+            if chans:
+                # a direction's split from its own channels alone (Context.reuse)
+                out += ctx.reuse("counter_rotation", state, chans, runs, lambda d=d: split(d))
         return out

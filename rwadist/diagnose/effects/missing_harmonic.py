@@ -330,13 +330,13 @@ class MissingHarmonic:
         return MissingHarmonic(direction, h, C, int(d.size), record=True) if C > 0 else None
 
     @staticmethod
-    def record_candidates(ctx: Context, state: State, runs, max_per_direction: int = 3) -> list:
+    def record_candidates(ctx: Context, state: State, runs, max_per_direction: int = 3, directions=None) -> list:
         """Lines below the Welch route's lowest frequency (:func:`welch_low_limit`) on the whole-run DFT: per direction
         and h of a grid (from 0.1 to where the slowest run's line reaches that frequency, steps of one record-grid step
         at the fastest run), the median over the valid points (runs, channels) of |X|²/noise (:func:`record_residual`),
         with at least RECORD_MIN_POINTS points in RECORD_MIN_RUNS runs; its local maxima above RECORD_SCORE, strongest
         first, away from the state's harmonics, fitted by :meth:`fit_record`.  Nothing on a state with a spin smear or
-        a speed ripple (the record's lines are not steady there)."""
+        a speed ripple (the record's lines are not steady there).  ``directions``: only these (default every one)."""
         if ctx.test is None or state.smear is not None or state.ripple is not None:
             return []                   # a swept or rippled speed: the record's lines are not steady ones
         w_hz = ctx.omega[runs] / (2 * np.pi)
@@ -349,7 +349,7 @@ class MissingHarmonic:
             return []
         out = []
         for d, chans in DIRECTION_CHANNELS.items():
-            if not any(c in ctx.channels for c in chans):
+            if not any(c in ctx.channels for c in chans) or (directions is not None and d not in directions):
                 continue
             P, N, ok, _ = MissingHarmonic._record_points(ctx, state, d, runs, h_grid)
             z = np.where(ok, P / np.maximum(N, 1e-300), np.nan).reshape(-1, h_grid.size)
@@ -403,21 +403,30 @@ class MissingHarmonic:
             return any(abs(e.h - x.h) < lobe and e.C < LOBE_MIN_RATIO * abs(x.C)
                        for x in state.model.harmonics(e.direction))
 
-        for d, chans in DIRECTION_CHANNELS.items():
-            chans = [c for c in chans if c in ctx.channels]
-            if not chans:
-                continue
+        def welch(d, chans) -> list:
+            found = []
             for h in ridge_peaks(ctx, state, chans, runs, max_per_direction):
                 if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
                     continue
                 h = refine_h(ctx, state, chans, runs, h)
                 if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)) or \
-                        any(abs(h - x.h) < 0.005 for x in out if x.direction == d):
+                        any(abs(h - x.h) < 0.005 for x in found):
                     continue
                 e = MissingHarmonic.fit(ctx, state, d, h, runs)
                 if e is not None and e.C > 0 and not misfit(e):
+                    found.append(e)
+            return found
+
+        # each direction's lines from its own channels alone (Context.reuse): the Welch route's first, then the record
+        # route's (below the Welch band) of every direction, a line the Welch route found not proposed again
+        lanes = {d: [c for c in chans if c in ctx.channels] for d, chans in DIRECTION_CHANNELS.items()}
+        lanes = {d: chans for d, chans in lanes.items() if chans}
+        for d, chans in lanes.items():
+            out += ctx.reuse("missing_harmonic", state, chans, runs, lambda d=d, chans=chans: welch(d, chans))
+        for d, chans in lanes.items():
+            for e in ctx.reuse("missing_harmonic", state, chans, runs,
+                               lambda d=d: MissingHarmonic.record_candidates(ctx, state, runs, max_per_direction, (d,)),
+                               part="record"):
+                if not any(abs(e.h - x.h) < 0.03 for x in out if x.direction == e.direction):
                     out.append(e)
-        for e in MissingHarmonic.record_candidates(ctx, state, runs, max_per_direction):
-            if not any(abs(e.h - x.h) < 0.03 for x in out if x.direction == e.direction):
-                out.append(e)
         return out

@@ -145,20 +145,20 @@ class Sidebands:
     @staticmethod
     def _record_power(ctx: Context, state: State, direction: str, h: float, runs, offsets) -> tuple:
         """(f (runs, 2L), |X|² (runs, 2L, chans), noise (runs, 2L, chans), valid (runs, 2L)) of the lower then upper
-        sides f_c ∓ offsets on the whole-run DFT, the carrier's leakage taken off (:func:`_run_line_power`).
+        sides f_c ∓ offsets on the whole-run DFT, the carrier's leakage taken off (:func:`_line_powers`).
 
         |X|² is the data's alone (the noise and the valid points are the state's): kept on the context, so the search's
         later steps (a new state of the same data) and the held-out judge of the same sidebands read it again."""
-        from .speed_sidebands import _run_line_power, _run_noise
+        from .speed_sidebands import _line_powers, _run_noise
 
         fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
         f = np.concatenate([fc - offsets[None, :], fc + offsets[None, :]], axis=1)
         key = ("sidebands_record_power", direction, float(h), np.asarray(runs).tobytes(), f.tobytes())
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         if key not in ctx._memo:
-            P = _run_line_power(ctx, state, direction, runs, f, h)[0]
+            P = _line_powers(ctx, chans, runs, f, h)
             P.flags.writeable = False                   # shared by every later reader
             ctx._memo[key] = P
-        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         return f, ctx._memo[key], _run_noise(ctx, state, chans, runs, f), \
             Sidebands._record_valid(ctx, state, direction, h, runs, f)
 
@@ -275,23 +275,34 @@ class Sidebands:
                   if not any(dd == d and abs(hh - x.h) < 1e-4 for dd, hh, _, _ in state.sidebands)]
             if not chans or not hs:
                 continue
-            tot, cnt = _offset_scores(ctx, state, chans, runs, hs, offsets)
-            score = np.where(cnt >= 6, tot / np.maximum(cnt, 1), 0.0)
-            found = []
-            for i, h in enumerate(hs):
-                s = score[i]
-                j = _plateau_middle(s, np.sqrt(2.0 / ctx.dof) / np.sqrt(np.maximum(cnt[i], 1)))
-                if 0 < j < s.size - 1 and s[j] > _offset_threshold(ctx, cnt[i, j]):
-                    found.append((s[j], h, float(offsets[j])))
-            for _, h, f_m in sorted(found, reverse=True)[:max_per_direction]:
-                e = Sidebands.fit(ctx, state, d, h, runs, f_m)
-                if e is not None:
-                    out.append(e)
-            # sidebands closer to the carrier than 2.5 Welch bins (a short record, a high sample rate: f_mod 7 Hz
-            # at 7.5-Hz Welch bins) are resolved by the whole record only
-            near = Sidebands.record_candidates(ctx, state, runs, d, hs)
-            for _, h, f_m in sorted(near, reverse=True)[:max_per_direction]:
-                e = Sidebands.fit_record(ctx, state, d, h, runs, f_m)
-                if e is not None:
-                    out.append(e)
+            # a direction's sidebands from its own channels alone (Context.reuse)
+            out += ctx.reuse("sidebands", state, chans, runs,
+                             lambda d=d, chans=chans, hs=hs: Sidebands._direction_candidates(
+                                 ctx, state, runs, d, chans, hs, offsets, max_per_direction))
+        return out
+
+    @staticmethod
+    def _direction_candidates(ctx: Context, state: State, runs, d: str, chans, hs, offsets,
+                              max_per_direction: int) -> list:
+        """:meth:`candidates` of direction ``d`` (its channels ``chans``, carriers ``hs``)."""
+        out = []
+        tot, cnt = _offset_scores(ctx, state, chans, runs, hs, offsets)
+        score = np.where(cnt >= 6, tot / np.maximum(cnt, 1), 0.0)
+        found = []
+        for i, h in enumerate(hs):
+            s = score[i]
+            j = _plateau_middle(s, np.sqrt(2.0 / ctx.dof) / np.sqrt(np.maximum(cnt[i], 1)))
+            if 0 < j < s.size - 1 and s[j] > _offset_threshold(ctx, cnt[i, j]):
+                found.append((s[j], h, float(offsets[j])))
+        for _, h, f_m in sorted(found, reverse=True)[:max_per_direction]:
+            e = Sidebands.fit(ctx, state, d, h, runs, f_m)
+            if e is not None:
+                out.append(e)
+        # sidebands closer to the carrier than 2.5 Welch bins (a short record, a high sample rate: f_mod 7 Hz
+        # at 7.5-Hz Welch bins) are resolved by the whole record only
+        near = Sidebands.record_candidates(ctx, state, runs, d, hs)
+        for _, h, f_m in sorted(near, reverse=True)[:max_per_direction]:
+            e = Sidebands.fit_record(ctx, state, d, h, runs, f_m)
+            if e is not None:
+                out.append(e)
         return out

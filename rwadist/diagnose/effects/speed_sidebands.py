@@ -35,6 +35,11 @@ RUN_MIN_BINS = 2.0
 RUN_CHUNK_SAMPLES = 1 << 20
 
 
+def _scan_key(direction: str, h0: float, runs) -> tuple:
+    """Key of the data's line powers of :meth:`SpeedSidebands._scan_record` on the context."""
+    return ("speed_sidebands_scan", direction, round(h0, 6), np.asarray(runs).tobytes())
+
+
 def _record_df(ctx: Context, runs) -> np.ndarray:
     """Frequency resolution fs/n (Hz) of each run's whole record (all runs' computed once per context: the search
     asks for it per δ and side)."""
@@ -103,18 +108,25 @@ def side_pair_medians(z: np.ndarray, ok: np.ndarray, cols: np.ndarray) -> np.nda
 
 def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: float, need=None) -> tuple:
     """(|X|² (len(runs), L, n_chans), noise mean of |X|² same shape): the whole-run line powers of the direction's
-    channels at ``f_hz`` (len(runs), L) Hz, Hann-windowed (:data:`RUN_WINDOW`; X = 2·Σ w x e^{−2πj f t}/Σ w, so a line
-    a·cos(2π f t + φ) gives |X| = a), less the leakage of the carrier h0: X(f) − X(f_c)·W(f − f_c)/W(0), f_c =
-    h0|Ω|/2π, W the window's transform (a line at f_c puts X(f_c)·W(f − f_c)/W(0) at f); and the mean |X|² white
-    noise of the state's floor S gives there, 2·S·fs·Σw²/(Σw)².  ``need`` (len(runs), L) bool, optional: only those
-    phasors are computed, the others are NaN (the scan's unresolvable points, which it never reads).
+    channels at ``f_hz`` (len(runs), L) Hz (:func:`_line_powers`) and the mean |X|² white noise of the state's floor S
+    gives there, 2·S·fs·Σw²/(Σw)² (:func:`_run_noise`)."""
+    chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+    return _line_powers(ctx, chans, runs, f_hz, h0, need), _run_noise(ctx, state, chans, runs, f_hz)
 
-    The runs of one record length are transformed together (:func:`rwadist.dft.windowed_dfts`), each at its needed
-    frequencies (moved to the front of its row; the rest of the row padded with its carrier), in chunks of
-    :data:`RUN_CHUNK_SAMPLES` samples; W in closed form (:func:`rwadist.dft.hann_transform`)."""
+
+def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None) -> np.ndarray:
+    """|X|² (len(runs), L, len(chans)): the whole-run line powers of channels ``chans`` at ``f_hz`` (len(runs), L) Hz,
+    Hann-windowed (:data:`RUN_WINDOW`; X = 2·Σ w x e^{−2πj f t}/Σ w, so a line a·cos(2π f t + φ) gives |X| = a), less
+    the leakage of the carrier h0: X(f) − X(f_c)·W(f − f_c)/W(0), f_c = h0|Ω|/2π, W the window's transform (a line at
+    f_c puts X(f_c)·W(f − f_c)/W(0) at f).  ``need`` (len(runs), L) bool, optional: only those phasors are computed,
+    the others are NaN (the scan's unresolvable points, which it never reads).  The data's alone (no state).
+
+    The runs of one record length are transformed together (:func:`rwadist.dft.windowed_dfts`: every channel of
+    ``chans`` with one table of phasors), each at its needed frequencies (moved to the front of its row; the rest of
+    the row padded with its carrier), in chunks of :data:`RUN_CHUNK_SAMPLES` samples; W in closed form
+    (:func:`rwadist.dft.hann_transform`)."""
     from ...dft import hann_transform, run_window, windowed_dfts
 
-    chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
     if need is None:
         need = np.ones(f_hz.shape, dtype=bool)
     X = np.full((runs.size, f_hz.shape[1], len(chans)), np.nan + 0j)
@@ -137,7 +149,7 @@ def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: 
             leak = hann_transform(n, fs, f_i - f_c[:, None]) / wsum                  # W(f − f_c)/W(0)
             r, j = np.nonzero(valid)
             X[rows[r], pick[r, j]] = both[r, j] - leak[r, j, None] * both[r, -1]
-    return np.abs(X) ** 2, _run_noise(ctx, state, chans, runs, f_hz)
+    return np.abs(X) ** 2
 
 
 def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
@@ -314,22 +326,39 @@ class SpeedSidebands:
         the main lobe itself is kept clear by :func:`record_resolvable_runs`)."""
         grid = np.concatenate([h0 - DELTA_GRID, h0 + DELTA_GRID])
         f_hz = np.outer(ctx.omega[runs] / (2 * np.pi), grid)
-        key = ("speed_sidebands_scan", direction, round(h0, 6), runs.tobytes())
-        if key not in ctx._memo:                # the data's line powers: the same on every step of the search
-            # only where a point can be resolved on any step: in band and RUN_MIN_BINS record bins from the carrier
-            # (the state-independent part of record_resolvable_runs; the same expressions, so the same booleans)
-            w = ctx.omega[runs] / (2 * np.pi)
-            need = (np.abs(grid - h0)[None, :] * w[:, None] >= RUN_MIN_BINS * _record_df(ctx, runs)[:, None]) \
-                & (f_hz >= (ctx.k_lo + LINE_HALF) * ctx.df) & (f_hz <= (ctx.k_hi - LINE_HALF) * ctx.df)
-            ctx._memo[key] = _run_line_power(ctx, state, direction, runs, f_hz, h0, need)[0]
+        SpeedSidebands._prefetch_scans(ctx, [(direction, h0)], runs)
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
-        z = ctx._memo[key] / np.maximum(_run_noise(ctx, state, chans, runs, f_hz), 1e-300)   # (runs, 2G, chans)
+        z = ctx._memo[_scan_key(direction, h0, runs)] / np.maximum(_run_noise(ctx, state, chans, runs, f_hz), 1e-300)
         ok = _record_resolvable(ctx, state, direction, h0, grid, runs)         # (runs, 2G): both sides of every δ
         n = DELTA_GRID.size
         score = np.zeros(n)
         cols = np.flatnonzero((ok[:, :n].sum(0) >= 3) & (ok[:, n:].sum(0) >= 3))
         score[cols] = side_pair_medians(z, ok, cols)
         return DELTA_GRID, score
+
+    @staticmethod
+    def _prefetch_scans(ctx: Context, jobs, runs) -> None:
+        """The data's line powers of :meth:`_scan_record` for every (direction, h₀) of ``jobs`` not yet kept on the
+        context (the same at every step of the search): the directions that share a carrier h₀ (an imbalance at h = 1
+        in the radial forces, the radial torques and the axial force) transformed together, with one table of
+        phasors for all their channels (:func:`_line_powers`), then kept per direction."""
+        by_h0 = {}
+        for d, h0 in jobs:
+            if _scan_key(d, h0, runs) not in ctx._memo:
+                by_h0.setdefault(round(h0, 6), (h0, []))[1].append(d)
+        for h0, dirs in by_h0.values():
+            grid = np.concatenate([h0 - DELTA_GRID, h0 + DELTA_GRID])
+            f_hz = np.outer(ctx.omega[runs] / (2 * np.pi), grid)
+            # only where a point can be resolved on any step: in band and RUN_MIN_BINS record bins from the carrier
+            # (the state-independent part of record_resolvable_runs; the same expressions, so the same booleans)
+            w = ctx.omega[runs] / (2 * np.pi)
+            need = (np.abs(grid - h0)[None, :] * w[:, None] >= RUN_MIN_BINS * _record_df(ctx, runs)[:, None]) \
+                & (f_hz >= (ctx.k_lo + LINE_HALF) * ctx.df) & (f_hz <= (ctx.k_hi - LINE_HALF) * ctx.df)
+            chans = {d: [c for c in DIRECTION_CHANNELS[d] if c in ctx.channels] for d in dirs}
+            every = [c for d in dirs for c in chans[d]]
+            P = _line_powers(ctx, every, runs, f_hz, h0, need)
+            for d in dirs:
+                ctx._memo[_scan_key(d, h0, runs)] = P[:, :, [every.index(c) for c in chans[d]]]
 
     @staticmethod
     def scan(ctx: Context, state: State, direction: str, h0: float, runs) -> tuple:
@@ -371,12 +400,16 @@ class SpeedSidebands:
         of the highest :meth:`scan` score when it clears 20 (the lines stand 20 × over the floor on half the
         resolved points) and is a local maximum, fitted by :meth:`fit`."""
         out = []
+        tops = {}
         for d, chans in DIRECTION_CHANNELS.items():
             if not any(c in ctx.channels for c in chans):
                 continue
             done = {round(e.h0, 4) for e in state.effects if isinstance(e, SpeedSidebands) and e.direction == d}
             hs = [x for x in state.model.harmonics(d) if round(x.h, 4) not in done]
-            top = sorted(hs, key=lambda x: -SpeedSidebands._carrier_C(state, d, x.h))[:n_carriers]
+            tops[d] = sorted(hs, key=lambda x: -SpeedSidebands._carrier_C(state, d, x.h))[:n_carriers]
+        if ctx.test is not None:
+            SpeedSidebands._prefetch_scans(ctx, [(d, x.h) for d, top in tops.items() for x in top], runs)
+        for d, top in tops.items():
             for x in top:
                 dl, sc = SpeedSidebands.scan(ctx, state, d, x.h, runs)
                 j = int(np.argmax(sc))
