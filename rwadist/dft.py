@@ -30,17 +30,39 @@ def run_window(name, n: int) -> tuple:
     return w, float(np.sum(w)), float(np.sum(w**2))
 
 
-def unit_phasors(f_hz: np.ndarray, dt: float, count: int) -> np.ndarray:
+def unit_phasors(f_hz: np.ndarray, dt: float, count: int, running: bool = False) -> np.ndarray:
     """e^{−2πj f k·dt} (L, count) for k = 0 … count − 1 at ``f_hz`` (L,) Hz, ``dt`` s: as a product of two tables of
     about √count exponentials each, k = k_lo + m·k_hi (complex exponentials cost far more than the product of two
-    unit phasors, which is the same number to rounding)."""
+    unit phasors, which is the same number to rounding).
+
+    ``running``: each of the two tables as the running product of its one step e^{−2πj f dt} (or e^{−2πj f m·dt}), two
+    exponentials per frequency instead of ~2√count (a cumulative product ~√count deep: the same numbers to ~1e-14),
+    and a power-of-two ``count`` split into powers of two (the product is then the table itself, no copy cut from
+    it): 35-40 % less time for :func:`windowed_dfts`'s short tables.  Off for the virtual test stand's
+    record-long carriers, whose numbers stay those of the exponentials."""
+    f = np.asarray(f_hz, dtype=float)
     m = max(int(np.ceil(np.sqrt(count))), 1)
-    lo = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(m) * dt))                                # (L, m)
-    hi = np.exp(-2j * np.pi * np.outer(f_hz, np.arange(-(-count // m)) * (m * dt)))          # (L, ⌈count/m⌉)
-    return (hi[:, :, None] * lo[:, None, :]).reshape(f_hz.size, -1)[:, :count]
+    if not running:
+        lo = np.exp(-2j * np.pi * np.outer(f, np.arange(m) * dt))                                # (L, m)
+        hi = np.exp(-2j * np.pi * np.outer(f, np.arange(-(-count // m)) * (m * dt)))          # (L, ⌈count/m⌉)
+        return (hi[:, :, None] * lo[:, None, :]).reshape(f.size, -1)[:, :count]
+    if count & (count - 1) == 0:
+        m = 1 << (m - 1).bit_length()                  # 128 = 16·8, 64 = 8·8
+
+    def powers(step: np.ndarray, k: int) -> np.ndarray:
+        table = np.empty((f.size, k), dtype=complex)
+        table[:, 0] = 1.0
+        table[:, 1:] = step[:, None]
+        return np.cumprod(table, axis=1)
+
+    lo = powers(np.exp(-2j * np.pi * dt * f), m)                                    # (L, m)
+    hi = powers(np.exp(-2j * np.pi * (m * dt) * f), -(-count // m))                 # (L, ⌈count/m⌉)
+    out = (hi[:, :, None] * lo[:, None, :]).reshape(f.size, -1)
+    return out if out.shape[1] == count else out[:, :count]
 
 
-def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128) -> np.ndarray:
+def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128,
+                  single: bool = False) -> np.ndarray:
     """Σ_n x[r, n, k]·e^{−2πj f[r, l] t_n} (t_n = n/sample_rate) of a stack of R equally long records ``x``
     (R, n, K) at frequencies ``f_hz`` (R, L) Hz, each record at its own frequencies; returns (R, L, K) complex.
 
@@ -49,7 +71,12 @@ def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: in
     the same sum to rounding), and each of those two tables is itself such a product (:func:`unit_phasors`).
     With the samples of a block along the rows and (block, channel) along the columns the fine sums are one
     (2L, B) @ (B, J·K) product per record (real and imaginary parts stacked), batched over the records of a
-    chunk (:data:`CHUNK_ELEMENTS`), and the coarse sums one (1, J) @ (J, K) product per frequency."""
+    chunk (:data:`CHUNK_ELEMENTS`), and the coarse sums one (1, J) @ (J, K) product per frequency.
+
+    ``single``: the fine sums in single precision (float32 phasors and samples: the product, most of the time, in
+    half of it).  Each phasor then carries ~1e-7 of the record's strongest line (measured: 9e-8 of a Hann-windowed
+    carrier's |X| at 8192 samples): for a scan that compares line powers with the noise, not for a fit's amplitude
+    read to the last digit."""
     x = np.asarray(x, dtype=float)
     n_rec, n, k = x.shape
     f_hz = np.asarray(f_hz, dtype=float).reshape(n_rec, -1)
@@ -68,9 +95,14 @@ def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: in
             xs = pad
         xt = xs.reshape(r, n_blocks, block, k).transpose(0, 2, 1, 3).reshape(r, block, n_blocks * k)   # (r, B, J·K)
         f = f_hz[s:s + step].ravel()
-        fine = unit_phasors(f, 1.0 / sample_rate, block).reshape(r, n_f, block)                        # (r, L, B)
-        coarse = unit_phasors(f, block / sample_rate, n_blocks).reshape(r, n_f, 1, n_blocks)          # (r, L, 1, J)
-        parts = np.concatenate([fine.real, fine.imag], axis=1) @ xt                                    # (r, 2L, J·K)
+        fine = unit_phasors(f, 1.0 / sample_rate, block, running=True).reshape(r, n_f, block)          # (r, L, B)
+        coarse = unit_phasors(f, block / sample_rate, n_blocks, running=True).reshape(r, n_f, 1, n_blocks)
+        if single:
+            table = np.empty((r, 2 * n_f, block), dtype=np.float32)
+            table[:, :n_f], table[:, n_f:] = fine.real, fine.imag
+            parts = (table @ xt.astype(np.float32)).astype(float)
+        else:
+            parts = np.concatenate([fine.real, fine.imag], axis=1) @ xt                                # (r, 2L, J·K)
         inner = (parts[:, :n_f] + 1j * parts[:, n_f:]).reshape(r, n_f, n_blocks, k)                 # (r, L, J, K)
         out[s:s + step] = (coarse @ inner)[:, :, 0, :]
     return out

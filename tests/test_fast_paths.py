@@ -176,3 +176,33 @@ def test_every_line_measured_at_once_is_each_measured_alone():
             assert together.shape == (len(lines), ctx.runs.size) and np.isfinite(together).any()
             for (h, _, _, _), got in zip(lines, together):
                 np.testing.assert_allclose(got, ctx.measure_line(state, c, h, ctx.runs, skip=h), rtol=1e-13, atol=0)
+
+
+def test_running_phasor_tables_are_the_exponentials():
+    """unit_phasors(..., running=True) (running products, power-of-two splits) against one exponential per entry, for a
+    power-of-two and an odd count, short and record-long tables (the reference's own rounding grows with k·dt·f)."""
+    from rwadist.dft import unit_phasors
+
+    f = np.random.default_rng(7).uniform(0.5, 900.0, 40)
+    for count, dt in ((128, 1 / 3840), (64, 128 / 3840), (100, 1 / 1000), (8192, 1 / 3840)):
+        ref = np.exp(-2j * np.pi * np.outer(f, np.arange(count)) * dt)
+        tol = 1e-14 * max(np.pi * f.max() * count * dt, 100.0)
+        np.testing.assert_allclose(unit_phasors(f, dt, count, running=True), ref, rtol=0, atol=tol)
+        assert np.array_equal(unit_phasors(f, dt, count), unit_phasors(f, dt, count, running=False))
+
+
+def test_single_precision_dft_is_the_double_one_to_1e_7_of_the_strongest_line():
+    """windowed_dfts(single=True): a carrier 60 dB over white noise, the phasors at random frequencies near it within
+    3e-7 of the carrier's |X| of the double-precision sums (a scan's line powers over the noise: 1 % of its |X|)."""
+    rng = np.random.default_rng(5)
+    n, fs = 8192, 3840.0
+    t = np.arange(n) / fs
+    w = signal.get_window("hann", n)
+    x = (np.cos(2 * np.pi * 40.0 * t)[None, :, None] + 1e-3 * rng.standard_normal((6, n, 2))) * w[None, :, None]
+    f = 40.0 + rng.uniform(-12.0, 12.0, (6, 50))
+    ref = windowed_dfts(x, fs, f)
+    got = windowed_dfts(x, fs, f, single=True)
+    carrier = np.sum(w) / 2
+    assert np.max(np.abs(got - ref)) < 3e-7 * carrier
+    assert np.max(np.abs(got - ref)) < 0.01 * 1e-3 * np.sqrt(np.sum(w**2))   # 1 % of the noise's |X|
+    assert not np.array_equal(got, ref)                                       # the single path was taken

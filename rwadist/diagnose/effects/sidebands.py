@@ -143,20 +143,22 @@ class Sidebands:
         return ok
 
     @staticmethod
-    def _record_power(ctx: Context, state: State, direction: str, h: float, runs, offsets) -> tuple:
+    def _record_power(ctx: Context, state: State, direction: str, h: float, runs, offsets,
+                      single: bool = False) -> tuple:
         """(f (runs, 2L), |X|² (runs, 2L, chans), noise (runs, 2L, chans), valid (runs, 2L)) of the lower then upper
         sides f_c ∓ offsets on the whole-run DFT, the carrier's leakage taken off (:func:`_line_powers`).
 
         |X|² is the data's alone (the noise and the valid points are the state's): kept on the context, so the search's
-        later steps (a new state of the same data) and the held-out judge of the same sidebands read it again."""
+        later steps (a new state of the same data) and the held-out judge of the same sidebands read it again.
+        ``single``: the sums in single precision (:func:`_line_powers`), for the scan of :meth:`record_candidates`."""
         from .speed_sidebands import _line_powers, _run_noise
 
         fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
         f = np.concatenate([fc - offsets[None, :], fc + offsets[None, :]], axis=1)
-        key = ("sidebands_record_power", direction, float(h), np.asarray(runs).tobytes(), f.tobytes())
+        key = ("sidebands_record_power", direction, float(h), np.asarray(runs).tobytes(), f.tobytes(), single)
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         if key not in ctx._memo:
-            P = _line_powers(ctx, chans, runs, f, h)
+            P = _line_powers(ctx, chans, runs, f, h, single=single)
             P.flags.writeable = False                   # shared by every later reader
             ctx._memo[key] = P
         return f, ctx._memo[key], _run_noise(ctx, state, chans, runs, f), \
@@ -250,7 +252,7 @@ class Sidebands:
         for h in hs:
             key = ("sidebands_record_scan", direction, round(h, 6), sel.tobytes(), state_key)
             if key not in ctx._memo:
-                ctx._memo[key] = Sidebands._record_power(ctx, state, direction, h, sel, offsets)
+                ctx._memo[key] = Sidebands._record_power(ctx, state, direction, h, sel, offsets, single=True)
             f, P, N, ok = ctx._memo[key]
             z = P / np.maximum(N, 1e-300)
             L = offsets.size

@@ -114,12 +114,15 @@ def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: 
     return _line_powers(ctx, chans, runs, f_hz, h0, need), _run_noise(ctx, state, chans, runs, f_hz)
 
 
-def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None) -> np.ndarray:
+def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: bool = False) -> np.ndarray:
     """|X|² (len(runs), L, len(chans)): the whole-run line powers of channels ``chans`` at ``f_hz`` (len(runs), L) Hz,
     Hann-windowed (:data:`RUN_WINDOW`; X = 2·Σ w x e^{−2πj f t}/Σ w, so a line a·cos(2π f t + φ) gives |X| = a), less
     the leakage of the carrier h0: X(f) − X(f_c)·W(f − f_c)/W(0), f_c = h0|Ω|/2π, W the window's transform (a line at
     f_c puts X(f_c)·W(f − f_c)/W(0) at f).  ``need`` (len(runs), L) bool, optional: only those phasors are computed,
     the others are NaN (the scan's unresolvable points, which it never reads).  The data's alone (no state).
+    ``single``: the sums in single precision (:func:`rwadist.dft.windowed_dfts`), for a scan: a phasor is then exact to
+    ~1e-7 of the record's strongest line, the carrier's leakage taken off with it (measured: 3e-3 of the noise's |X|
+    beside a carrier 60 dB over the samples' noise, the matrix's 0.1 % noise; 1e-5 of the noise's power).
 
     The runs of one record length are transformed together (:func:`rwadist.dft.windowed_dfts`: every channel of
     ``chans`` with one table of phasors), each at its needed frequencies (moved to the front of its row; the rest of
@@ -145,7 +148,7 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None) -> np.nd
             f_c = h0 * ctx.omega[runs[rows]] / (2 * np.pi)
             f_i = np.where(valid, np.take_along_axis(f_hz[rows], pick, axis=1), f_c[:, None])
             x = np.stack([np.column_stack([ctx.test.runs[runs[i]].signals[c] for c in chans]) for i in rows])
-            both = 2.0 * windowed_dfts(x * w[None, :, None], fs, np.column_stack([f_i, f_c])) / wsum
+            both = 2.0 * windowed_dfts(x * w[None, :, None], fs, np.column_stack([f_i, f_c]), single=single) / wsum
             leak = hann_transform(n, fs, f_i - f_c[:, None]) / wsum                  # W(f − f_c)/W(0)
             r, j = np.nonzero(valid)
             X[rows[r], pick[r, j]] = both[r, j] - leak[r, j, None] * both[r, -1]
@@ -356,7 +359,7 @@ class SpeedSidebands:
                 & (f_hz >= (ctx.k_lo + LINE_HALF) * ctx.df) & (f_hz <= (ctx.k_hi - LINE_HALF) * ctx.df)
             chans = {d: [c for c in DIRECTION_CHANNELS[d] if c in ctx.channels] for d in dirs}
             every = [c for d in dirs for c in chans[d]]
-            P = _line_powers(ctx, every, runs, f_hz, h0, need)
+            P = _line_powers(ctx, every, runs, f_hz, h0, need, single=True)
             for d in dirs:
                 ctx._memo[_scan_key(d, h0, runs)] = P[:, :, [every.index(c) for c in chans[d]]]
 
