@@ -62,6 +62,29 @@ RECORD_PEAK_FA = 1e-4
 RECORD_PEAK_BINS = 2
 
 
+def _record_spectra(ctx: Context, c: str, rows) -> list:
+    """X = 2·rfft((x − x̄)·w)/Σw of channel ``c`` of each run of ``rows`` (the spectra's window): the runs of one record
+    length in one call (scipy.fft: the numbers of numpy.fft's, run by run, in about half the time)."""
+    from scipy import fft as sp_fft
+
+    from ...dft import run_window
+
+    out: list = [None] * len(rows)
+    groups: dict = {}
+    for a, r in enumerate(rows):
+        groups.setdefault(ctx.test.runs[r].n_samples, []).append(a)
+    for n, idx in groups.items():
+        w, wsum, _ = run_window(ctx.sp.window, n)
+        xs = np.empty((len(idx), n))
+        for k, a in enumerate(idx):
+            x = np.asarray(ctx.test.runs[rows[a]].signals[c], dtype=float)
+            xs[k] = (x - x.mean()) * w
+        X = 2.0 * sp_fft.rfft(xs, axis=-1) / wsum
+        for k, a in enumerate(idx):
+            out[a] = X[k]
+    return out
+
+
 def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, need: np.ndarray) -> tuple:
     """(mean PSD unit²/Hz, bins used) per run and band (each (len(runs), n_bands)), and each run's bin width df_rec
     (Hz, (len(runs),)), of channel ``c`` off the lines, on the whole-run spectrum, in the bands ``need``
@@ -96,13 +119,13 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
     lo_edge = float(ctx.f[ctx.k_lo] - 0.5 * ctx.df)
     band_w = BAND_BINS * ctx.df
     thr = -np.log(RECORD_PEAK_FA)                # |X|² of complex Gaussian noise is exponential: P(> t·mean) = e^{-t}
+    spectra = _record_spectra(ctx, c, [int(runs[i]) for i in todo])
     for a, i in enumerate(todo):
         run = ctx.test.runs[int(runs[i])]
         n, fs = run.n_samples, run.sample_rate
         df_rec = fs / n
         w, wsum, w2sum = run_window(ctx.sp.window, n)
-        x = np.asarray(run.signals[c], dtype=float)
-        X = 2.0 * np.fft.rfft((x - x.mean()) * w) / wsum
+        X = spectra[a]
         f = np.arange(X.size) * df_rec
         band = np.floor((f - lo_edge) / band_w).astype(int)
         sel = (f >= RECORD_MIN_BINS * df_rec) & (band >= 0) & (band < ctx.n_bands)

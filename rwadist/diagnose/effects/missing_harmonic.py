@@ -87,6 +87,8 @@ def _record_grid(ctx: Context, r: int) -> tuple:
     kept on the context (the data's, the same at every search step)."""
     key = ("missing_harmonic_record", r)
     if key not in ctx._memo:
+        from scipy import fft as sp_fft
+
         from ...dft import run_window
 
         run = ctx.test.runs[r]
@@ -96,10 +98,14 @@ def _record_grid(ctx: Context, r: int) -> tuple:
         pad = int(round(1.0 / RECORD_GRID_BINS))
         n_keep = int(np.ceil((welch_low_limit(ctx) / df_rec + 20.0) / RECORD_GRID_BINS)) + 1
         X = np.full((n_keep, len(ctx.channels)), np.nan + 0j)
-        for j, c in enumerate(ctx.channels):
-            if c in run.signals:
-                x = np.asarray(run.signals[c], dtype=float)
-                X[:, j] = 2.0 * np.fft.rfft((x - x.mean()) * w, pad * n)[:n_keep] / wsum
+        have = [j for j, c in enumerate(ctx.channels) if c in run.signals]
+        if have:
+            xs = np.empty((len(have), n))
+            for i, j in enumerate(have):
+                x = np.asarray(run.signals[ctx.channels[j]], dtype=float)
+                xs[i] = (x - x.mean()) * w
+            # every channel in one call (scipy.fft: the numbers of numpy.fft's, channel by channel, in half the time)
+            X[:, have] = (2.0 * sp_fft.rfft(xs, pad * n, axis=-1)[:, :n_keep] / wsum).T
         ctx._memo[key] = (np.arange(n_keep) * df_rec * RECORD_GRID_BINS, X, df_rec, n)
     return ctx._memo[key]
 
