@@ -199,19 +199,43 @@ class Metric:
         tot = np.zeros(runs.size)
         parts = {}
         for c in channels or self.channels:
-            Dfull = self.data(state, c, runs)[runs]
-            ok = np.isfinite(Dfull[:, 0])
-            D = self.band_sums(Dfull)
-            N = self.floor_psd(state, c, runs)
-            Mfull = self.predict(state, c, runs)
-            M = self.band_sums(Mfull)
-            sig = self.band_sigma(state, c, runs, N, Mfull - N, beat_state)
-            scale = self.scale(c)
-            e = np.maximum(np.abs(D - M) - NOISE_Z * sig, 0.0)
-            err[ok] += e[ok].sum(1) / scale
-            tot[ok] += D[ok].sum(1) / scale
-            parts[c] = ((D - M) / scale, sig / scale)
+            ok, e_run, t_run, resid, sig = self._channel_terms(state, c, runs, beat_state)
+            err[ok] += e_run[ok]
+            tot[ok] += t_run[ok]
+            parts[c] = (resid, sig)
         return (err, tot, parts) if detail else (err, tot)
+
+    def _channel_terms(self, state: State, c: str, runs: np.ndarray, beat_state: State | None) -> tuple:
+        """One channel's part of :meth:`run_errors`: (ok (runs,), Σ_bands e / scale (runs,), D_tot / scale (runs,),
+        (D − M)/scale and σ/scale (runs, n_bands)), e = max(|D − M| − NOISE_Z·σ, 0).  Each run's terms are its own
+        (no sum across runs): with the state's own beats they are kept on the state (read-only, as its prediction), and
+        a subset of the runs whose terms on every run are kept (the search's held-out runs of a state whose error on
+        every run the search asked for first) reads its rows of those."""
+        own = beat_state is None or beat_state is state
+        key = ("channel_terms", c, runs.tobytes())
+        if own:
+            if key in state._cache:
+                return state._cache[key]
+            whole = state._cache.get(("channel_terms", c, self.runs.tobytes()))
+            if whole is not None and runs.size < self.runs.size:
+                pos = np.searchsorted(self.runs, runs)
+                if np.all(pos < self.runs.size) and np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
+                    return tuple(x[pos] for x in whole)
+        Dfull = self.data(state, c, runs)[runs]
+        ok = np.isfinite(Dfull[:, 0])
+        D = self.band_sums(Dfull)
+        N = self.floor_psd(state, c, runs)
+        Mfull = self.predict(state, c, runs)
+        M = self.band_sums(Mfull)
+        sig = self.band_sigma(state, c, runs, N, Mfull - N, beat_state)
+        scale = self.scale(c)
+        e = np.maximum(np.abs(D - M) - NOISE_Z * sig, 0.0)
+        out = (ok, e.sum(1) / scale, D.sum(1) / scale, (D - M) / scale, sig / scale)
+        if own:
+            for x in out:
+                x.flags.writeable = False
+            state._cache[key] = out
+        return out
 
     def scale(self, c):
         return self._scale[c]
