@@ -14,7 +14,7 @@ from ..model import WheelModel
 from ..resonance import resonance
 from ..spectra import Spectra, welch_dof
 from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
-from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, TORQUE_CHANNELS
+from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, NOISE_Z, TORQUE_CHANNELS
 from .metric import Metric, hann_tables, read_table
 from .state import State
 
@@ -53,6 +53,9 @@ class Context(Metric):
             raise ValueError("diagnose: the test's runs are not those of the spectra (count or speeds differ)")
         self.test = test
         self._memo = {}
+        #: the search step under way (:func:`rwadist.diagnose.search.diagnose`): (state, its held-out errors on a set of
+        #: channels, min_gain), read by :meth:`can_pass`; None outside a search
+        self.step = None
         self._corrected = {}
         self.f = spectra.f
         self.df = spectra.df
@@ -435,6 +438,38 @@ class Context(Metric):
         if plain_f:
             out += self.psd_at(np.column_stack(plain_f), np.column_stack(plain_p), bins)
         return out
+
+    def can_pass(self, state: State, chans, bands: np.ndarray | None = None) -> bool:
+        """False when no effect that changes the prediction of ``chans`` only (and there only in ``bands``, (len(held
+        runs), n_bands) bool: the bands its lines can reach) and is judged by the error metric can pass the search
+        step's ``min_gain`` rule: its held-out gain is the drop of misplaced power there, at most the state's own
+        misplaced power there (the new state's is ≥ 0), and that is below ``min_gain`` of the held-out misplaced power
+        on every channel.  A family skips such a fit (nothing it could propose there would be taken).  True outside a
+        search step, for another state than the step's, and for an effect that brings its own held-out evidence (it
+        must not ask)."""
+        if self.step is None or self.step[0] is not state:
+            return True
+        _, errors, min_gain = self.step
+        chans = [c for c in chans if c in self.channels]
+        e_all = float(errors(None)[0].sum())
+        if not chans or not (min_gain > 0 and e_all > 0):
+            return True
+        e0, _, parts = errors(chans)
+        if bands is None:
+            here = float(e0.sum())
+        else:
+            here = sum(float(np.sum(np.maximum(np.abs(parts[c][0]) - NOISE_Z * parts[c][1], 0.0)[bands])) for c in chans)
+        # a hair over the bound: the band sums and the run sums round differently
+        return here * (1.0 + 1e-9) >= min_gain * e_all
+
+    def reach_bands(self, f_lo: np.ndarray, f_hi: np.ndarray) -> np.ndarray:
+        """(len(f_lo), n_bands) bool: the metric's bands a line between ``f_lo`` and ``f_hi`` Hz (per held-out run) can
+        change -- its kernel reaches ±KERNEL_HALF bins, its band one more (a band is BAND_BINS bins from k_lo)."""
+        lo = np.floor(np.asarray(f_lo) / self.df) - KERNEL_HALF - 1
+        hi = np.ceil(np.asarray(f_hi) / self.df) + KERNEL_HALF + 1
+        first = self.k_lo + np.arange(self.n_bands) * BAND_BINS
+        last = first + BAND_BINS - 1
+        return (last[None, :] >= lo[:, None]) & (first[None, :] <= hi[:, None])
 
     def reuse(self, family: str, state: State, chans, runs: np.ndarray, compute, part: str = "") -> list:
         """The effects ``compute()`` proposes (a list) from channels ``chans`` of ``runs`` alone, kept on the context

@@ -261,6 +261,9 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     for it in range(1, max_iterations + 1):
         memo: dict = {}
         judged: list = []
+        # what a family's fit could at most gain on the held-out runs (Context.can_pass): the step's own errors
+        ctx.step = (state, lambda chans, state=state, memo=memo: _state_errors(ctx, state, ctx.held_runs, chans, memo),
+                    min_gain)
         best = refit = applied = None
         for families in (first, rest):
             cands = [e for cls in families for e in cls.candidates(ctx, state, ctx.fit_runs)]
@@ -288,6 +291,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         best.effect = state.effects[-1]
     else:
         it = max_iterations
+    ctx.step = None
     # a family may revise what it added in the light of what came after it (``finish``: the wheel's modes beside the
     # fixture resonances named after them); the hypotheses report the revised effects
     for cls in EFFECT_CLASSES:

@@ -323,10 +323,11 @@ class BroadbandFloor:
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
-        """A floor law per channel without one; each channel's from that channel alone (:meth:`Context.reuse`)."""
+        """A floor law per channel without one; each channel's from that channel alone (:meth:`Context.reuse`), and
+        only where it could pass (:meth:`Context.can_pass`)."""
         def one(c):
             e = BroadbandFloor.fit(ctx, state, c, runs)
             return [e] if e is not None and e.psd_ref.max() > 0 else []
 
-        return [e for c in ctx.channels if c not in state.floors
+        return [e for c in ctx.channels if c not in state.floors and ctx.can_pass(state, [c])
                 for e in ctx.reuse("broadband_floor", state, [c], runs, lambda c=c: one(c))]

@@ -256,6 +256,8 @@ class FixedResonance:
         dirs = [d for d, ch in DIRECTION_CHANNELS.items()
                 if any(c in ctx.channels for c in ch) and state.model.harmonics(d)]
         for d in dirs:
+            if not ctx.can_pass(state, DIRECTION_CHANNELS[d]):
+                continue                # a resonance of these channels alone could not pass this step
             e = FixedResonance.fit(ctx, state, DIRECTION_CHANNELS[d], runs, role="wheel_mode")
             if e is not None:
                 out.append(e)

@@ -428,7 +428,10 @@ class MissingHarmonic:
         lanes = {d: [c for c in chans if c in ctx.channels] for d, chans in DIRECTION_CHANNELS.items()}
         lanes = {d: chans for d, chans in lanes.items() if chans}
         for d, chans in lanes.items():
-            out += ctx.reuse("missing_harmonic", state, chans, runs, lambda d=d, chans=chans: welch(d, chans))
+            # a Welch-route line is judged by the error metric on the direction's channels: only where it could pass
+            # (Context.can_pass); the record route's lines bring their own held-out evidence
+            if ctx.can_pass(state, chans):
+                out += ctx.reuse("missing_harmonic", state, chans, runs, lambda d=d, chans=chans: welch(d, chans))
         for d, chans in lanes.items():
             for e in ctx.reuse("missing_harmonic", state, chans, runs,
                                lambda d=d: MissingHarmonic.record_candidates(ctx, state, runs, max_per_direction, (d,)),

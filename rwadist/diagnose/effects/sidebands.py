@@ -277,16 +277,21 @@ class Sidebands:
                   if not any(dd == d and abs(hh - x.h) < 1e-4 for dd, hh, _, _ in state.sidebands)]
             if not chans or not hs:
                 continue
-            # a direction's sidebands from its own channels alone (Context.reuse)
+            # a direction's sidebands from its own channels alone (Context.reuse); not skipped where a metric-judged
+            # effect could not pass (Context.can_pass): a Welch-route pair refined below 2.5 bins brings its own
+            # held-out evidence
             out += ctx.reuse("sidebands", state, chans, runs,
-                             lambda d=d, chans=chans, hs=hs: Sidebands._direction_candidates(
+                             lambda d=d, chans=chans, hs=hs: Sidebands._welch_candidates(
                                  ctx, state, runs, d, chans, hs, offsets, max_per_direction))
+            out += ctx.reuse("sidebands", state, chans, runs,
+                             lambda d=d, hs=hs: Sidebands._record_candidates_fitted(ctx, state, runs, d, hs,
+                                                                                    max_per_direction),
+                             part="record")
         return out
 
     @staticmethod
-    def _direction_candidates(ctx: Context, state: State, runs, d: str, chans, hs, offsets,
-                              max_per_direction: int) -> list:
-        """:meth:`candidates` of direction ``d`` (its channels ``chans``, carriers ``hs``)."""
+    def _welch_candidates(ctx: Context, state: State, runs, d: str, chans, hs, offsets, max_per_direction: int) -> list:
+        """:meth:`candidates` of direction ``d`` (its channels ``chans``, carriers ``hs``) on the Welch PSDs."""
         out = []
         tot, cnt = _offset_scores(ctx, state, chans, runs, hs, offsets)
         score = np.where(cnt >= 6, tot / np.maximum(cnt, 1), 0.0)
@@ -300,8 +305,13 @@ class Sidebands:
             e = Sidebands.fit(ctx, state, d, h, runs, f_m)
             if e is not None:
                 out.append(e)
-        # sidebands closer to the carrier than 2.5 Welch bins (a short record, a high sample rate: f_mod 7 Hz
-        # at 7.5-Hz Welch bins) are resolved by the whole record only
+        return out
+
+    @staticmethod
+    def _record_candidates_fitted(ctx: Context, state: State, runs, d: str, hs, max_per_direction: int) -> list:
+        """Sidebands of direction ``d`` closer to the carrier than 2.5 Welch bins (a short record, a high sample rate:
+        f_mod 7 Hz at 7.5-Hz Welch bins), resolved by the whole record only: :meth:`record_candidates`, fitted."""
+        out = []
         near = Sidebands.record_candidates(ctx, state, runs, d, hs)
         for _, h, f_m in sorted(near, reverse=True)[:max_per_direction]:
             e = Sidebands.fit_record(ctx, state, d, h, runs, f_m)

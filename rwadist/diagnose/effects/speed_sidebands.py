@@ -20,6 +20,9 @@ from .base import register, schema_entry
 MIN_BINS = 2.5
 #: Per-revolution offsets δ searched (fractions of the wheel speed).
 DELTA_GRID = np.arange(0.01, 0.30001, 0.0025)
+#: Farthest a fitted side's h lies from its carrier: the Welch route refines a side within half its δ (1.5·δ), the
+#: record route within its grids' ±0.0131 of h₀ ± δ.
+REACH = 1.5 * float(DELTA_GRID[-1])
 
 
 #: Window of the whole-run DFT the sidebands are measured with when the time series are given: Hann, whose main
@@ -409,7 +412,12 @@ class SpeedSidebands:
                 continue
             done = {round(e.h0, 4) for e in state.effects if isinstance(e, SpeedSidebands) and e.direction == d}
             hs = [x for x in state.model.harmonics(d) if round(x.h, 4) not in done]
-            tops[d] = sorted(hs, key=lambda x: -SpeedSidebands._carrier_C(state, d, x.h))[:n_carriers]
+            top = sorted(hs, key=lambda x: -SpeedSidebands._carrier_C(state, d, x.h))[:n_carriers]
+            # a pair beside h0 changes the direction's channels within (h0 ± REACH)|Ω|/2π only: no pair there can pass
+            # when the held-out misplaced power there is below min_gain of it all (Context.can_pass); not scanned
+            w = ctx.omega[ctx.held_runs] / (2 * np.pi)
+            tops[d] = [x for x in top
+                       if ctx.can_pass(state, chans, ctx.reach_bands((x.h - REACH) * w, (x.h + REACH) * w))]
         if ctx.test is not None:
             SpeedSidebands._prefetch_scans(ctx, [(d, x.h) for d, top in tops.items() for x in top], runs)
         for d, top in tops.items():
