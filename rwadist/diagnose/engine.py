@@ -401,7 +401,13 @@ class Context(Metric):
         if skip is None and only is None:
             key = ("predict", c, runs.tobytes())
             if key not in state._cache:
-                full = self._predict(state, c, runs, None, None)
+                whole = state._cache.get(("predict", c, self.runs.tobytes()))
+                pos = np.searchsorted(self.runs, runs) if whole is not None and runs.size < self.runs.size else None
+                if pos is not None and np.all(pos < self.runs.size) and \
+                        np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
+                    full = whole[pos]           # each run's prediction is its own: the rows of every run's
+                else:
+                    full = self._predict(state, c, runs, None, None)
                 full.flags.writeable = False
                 state._cache[key] = full
             return state._cache[key]

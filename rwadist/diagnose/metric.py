@@ -99,10 +99,17 @@ class Metric:
         image at −f (a channel is a real signal) beats with the line itself and its neighbours near 0 Hz as a
         line of phase −φ.  The lines and their sidebands as :meth:`predict` has them (each within ±KERNEL_HALF of
         its bin); zero under a spin smear or a speed ripple (their lines are no steady lines) and for other
-        windows (the term is not modelled).  Cached on the state; each pair's shape on the context."""
+        windows (the term is not modelled).  Cached on the state; each pair's shape on the context; a subset of the
+        runs whose variance on every run is kept reads its rows (a pair near only in other runs adds exact zeros)."""
         key = ("beat", c, runs.tobytes())
         if key in state._cache:
             return state._cache[key]
+        whole = state._cache.get(("beat", c, self.runs.tobytes()))
+        if whole is not None and runs.size < self.runs.size:
+            pos = np.searchsorted(self.runs, runs)
+            if np.all(pos < self.runs.size) and np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
+                state._cache[key] = whole[pos]
+                return state._cache[key]
         out = np.zeros((runs.size, self.n_bands))
         if state.smear is None and state.ripple is None and self.sp.window == "hann":
             comps = []
