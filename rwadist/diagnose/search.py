@@ -250,6 +250,8 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     # suspension modes, fitted from the data (``suspension_modes``), unless the test records the modes off
     ctx.base_switch = fits_modes_from_data(model, request, test)
     state0 = initial_state(ctx, model, ext_params)
+    # its error on every run first (the diagnosis reports it): the held-out and fit runs' terms are then its rows
+    _state_error(ctx, state0)
     state = state0
     hyps = []
     it = 0
