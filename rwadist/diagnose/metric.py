@@ -161,8 +161,8 @@ class Metric:
         the bincount, in the same order), and kept."""
         keys = [("beat_shape", ki, kj, image, runs.tobytes()) for ki, kj, image, _, _ in wanted]
         missing = [i for i, k in enumerate(keys) if k not in self._memo]
-        # a few MB of temporaries per chunk of pairs (each pair: len(runs) × (4·KERNEL_HALF + 1) complex numbers)
-        per_chunk = max(1, BEAT_CHUNK_ELEMENTS // max(runs.size * (4 * KERNEL_HALF + 1), 1))
+        # a few MB of temporaries per chunk of pairs (each pair: len(runs) × (2·KERNEL_HALF + 1) complex numbers)
+        per_chunk = max(1, BEAT_CHUNK_ELEMENTS // max(runs.size * (2 * KERNEL_HALF + 1), 1))
         for c0 in range(0, len(missing), per_chunk):
             todo = missing[c0:c0 + per_chunk]
             L = self.sp.nperseg
@@ -170,11 +170,13 @@ class Metric:
             pi = np.array([wanted[i][3] for i in todo])                                   # (P, runs)
             qj = np.array([-wanted[i][4] if wanted[i][2] else wanted[i][4] for i in todo])
             n_p = len(todo)
-            offs = np.arange(-2 * KERNEL_HALF, 2 * KERNEL_HALF + 1)
-            k = np.rint(0.5 * (pi + qj)).astype(int)[:, :, None] + offs                 # (P, runs, 4H+1)
+            # the bins both kernels reach (each ±KERNEL_HALF of its line's bin): from the later line's first bin on,
+            # 2·KERNEL_HALF + 1 of them (the other products are zero; their sums add the same terms in the same order)
+            bi, bj = np.rint(pi), np.rint(qj)
+            k = (np.maximum(bi, bj).astype(int) - KERNEL_HALF)[:, :, None] + np.arange(2 * KERNEL_HALF + 1)
             lo, hi = self.k_lo, self.k_lo + self.n_bands * BAND_BINS
-            vi = np.where(np.abs(k - np.rint(pi)[:, :, None]) <= KERNEL_HALF, read_table(V, k - pi[:, :, None]), 0)
-            vj = np.where(np.abs(k - np.rint(qj)[:, :, None]) <= KERNEL_HALF, read_table(V, k - qj[:, :, None]), 0)
+            vi = np.where(np.abs(k - bi[:, :, None]) <= KERNEL_HALF, read_table(V, k - pi[:, :, None]), 0)
+            vj = np.where(np.abs(k - bj[:, :, None]) <= KERNEL_HALF, read_table(V, k - qj[:, :, None]), 0)
             near = np.abs(pi - qj) <= 2 * KERNEL_HALF
             prod = np.where(near[:, :, None] & (k >= lo) & (k < hi), vi * np.conj(vj), 0)
             band = np.clip((k - lo) // BAND_BINS, 0, self.n_bands - 1)
