@@ -48,3 +48,25 @@ def test_both_sides_mask_as_the_record_scan_of_sidebands():
         ref[j] = float(np.median(vals)) if vals.size >= 6 else 0.0
     both = ok[:, :L] & ok[:, L:]
     np.testing.assert_array_equal(side_pair_medians(z, np.concatenate([both, both], axis=1), np.arange(L)), ref)
+
+
+def test_column_nanmedian_is_numpys():
+    """rwadist.diagnose.measure.column_nanmedian against np.nanmedian(axis=0): odd and even counts of valid values,
+    NaN-free columns, infinities, a column of one value, and an all-NaN column (NaN)."""
+    import warnings
+
+    from rwadist.diagnose.measure import column_nanmedian
+
+    rng = np.random.default_rng(11)
+    for rows in (1, 2, 7, 120, 700):
+        z = rng.exponential(size=(rows, 50)) * np.exp(3 * rng.standard_normal((1, 50)))
+        z[rng.random(z.shape) < 0.3] = np.nan
+        z[:, 0] = 1.5                                      # no NaN
+        z[:, 1] = np.nan                                   # nothing valid
+        if rows > 2:
+            z[0, 2], z[1, 2] = np.inf, -np.inf
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            ref = np.nanmedian(z, axis=0)
+        got = column_nanmedian(z)
+        assert np.array_equal(got, ref, equal_nan=True)

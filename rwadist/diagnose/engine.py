@@ -15,6 +15,7 @@ from ..resonance import resonance
 from ..spectra import Spectra, welch_dof
 from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
 from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, NOISE_Z, TORQUE_CHANNELS
+from .measure import column_nanmedian
 from .metric import Metric, hann_tables, read_table
 from .state import State
 
@@ -731,7 +732,7 @@ def initial_state(ctx: Context, model: WheelModel, ext_params=None) -> State:
     (:meth:`Context.offline_bands`) averaged over every run, interpolated between the centres of the
     bands with a positive mean (the median block floor of the data outside them).  ``ext_params``:
     the :class:`rwadist.extended.ExtendedParams` of the extended base, or None (empirical base)."""
-    rough = {c: np.nanmedian(ctx.floor[c][ctx.runs], axis=0) for c in ctx.channels}
+    rough = {c: column_nanmedian(ctx.floor[c][ctx.runs]) for c in ctx.channels}
     state = State(copy.deepcopy(model), rough, ext=ext_params)
     return State(state.model, noise_estimate(ctx, state), ext=ext_params)
 

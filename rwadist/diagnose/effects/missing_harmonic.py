@@ -20,6 +20,7 @@ from ..constants import LINE_HALF
 from ..engine import Context
 from ..measure import (
     _measure,
+    column_nanmedian,
     hann_transform_ratio,
     in_unresolved_span,
     record_dfts,
@@ -362,7 +363,7 @@ class MissingHarmonic:
             enough = (ok.sum(axis=(0, 1)) >= RECORD_MIN_POINTS) & (ok.any(axis=0).sum(axis=0) >= RECORD_MIN_RUNS)
             score = np.zeros(h_grid.size)
             if enough.any():
-                score[enough] = np.nanmedian(z[:, enough], axis=0)
+                score[enough] = column_nanmedian(z[:, enough])
             peaks = np.nonzero((score[1:-1] > score[:-2]) & (score[1:-1] >= score[2:])
                                & (score[1:-1] > RECORD_SCORE))[0] + 1
             found = []
