@@ -125,49 +125,46 @@ class Context(Metric):
     def phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> np.ndarray:
         """Complex amplitudes (len(runs), L, 6) of every channel at frequencies ``f_hz`` (len(runs), L), Hz:
         X = 2·Σ w x e^{−2πj f t}/Σ w over the whole run (the spectra's window), so x(t) ≈ Re(X e^{2πj f t});
-        NaN for a channel the run lacks.  The runs of one record length and channel set are transformed together
-        (:func:`rwadist.dft.windowed_dfts`, chunks of :data:`PHASOR_CHUNK_SAMPLES` samples; the windowed signals
-        are not kept: a long test's would double its memory)."""
+        NaN for a channel the run lacks.  Kept on the context per column (a line's frequency at every run): the
+        columns not yet known, each once, are computed in one pass over the records -- the runs of one record length
+        and channel set transformed together (:func:`rwadist.dft.windowed_dfts`, whose sums at a frequency do not
+        depend on the others asked with it; chunks of :data:`PHASOR_CHUNK_SAMPLES` samples; the windowed signals are
+        not kept: a long test's would double its memory)."""
         from ..dft import run_window, windowed_dfts
 
-        f_hz = np.asarray(f_hz, dtype=float)
-        key = ("phasors", runs.tobytes(), f_hz.tobytes(), f_hz.shape)
-        if key in self._memo:                             # the same lines are asked for at every search step
-            return self._memo[key].copy()
-        out = np.full((runs.size, f_hz.shape[1], len(CHANNELS)), np.nan + 0j)
-        groups = {}
-        for i, r in enumerate(runs):
-            run = self.test.runs[r]
-            have = tuple(j for j, c in enumerate(CHANNELS) if c in run.signals)
-            groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
-        for (n, fs, have), rows_all in groups.items():
-            w, wsum, _ = run_window(self.sp.window, n)
-            step = max(1, PHASOR_CHUNK_SAMPLES // (n * max(len(have), 1)))
-            for s in range(0, len(rows_all), step):
-                rows = np.asarray(rows_all[s:s + step])
-                x = np.stack([np.column_stack([self.test.runs[runs[i]].signals[CHANNELS[j]] for j in have])
-                              for i in rows]) * w[None, :, None]
-                out[rows[:, None], :, np.asarray(have)[None, :]] = \
-                    (2.0 * windowed_dfts(x, fs, f_hz[rows]) / wsum).transpose(0, 2, 1)
-        self._memo[key] = out
-        return out.copy()
+        f_hz = np.asarray(f_hz, dtype=float).reshape(runs.size, -1)
+        cols = [np.ascontiguousarray(f_hz[:, j:j + 1]) for j in range(f_hz.shape[1])]
+        keys = [("phasors", runs.tobytes(), col.tobytes()) for col in cols]
+        todo = list(dict.fromkeys(k for k in keys if k not in self._memo))        # each missing column once
+        if todo:
+            first = {k: keys.index(k) for k in todo}
+            f_new = np.column_stack([cols[first[k]] for k in todo])
+            out = np.full((runs.size, f_new.shape[1], len(CHANNELS)), np.nan + 0j)
+            groups = {}
+            for i, r in enumerate(runs):
+                run = self.test.runs[r]
+                have = tuple(j for j, c in enumerate(CHANNELS) if c in run.signals)
+                groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
+            for (n, fs, have), rows_all in groups.items():
+                w, wsum, _ = run_window(self.sp.window, n)
+                step = max(1, PHASOR_CHUNK_SAMPLES // (n * max(len(have), 1)))
+                for s in range(0, len(rows_all), step):
+                    rows = np.asarray(rows_all[s:s + step])
+                    x = np.stack([np.column_stack([self.test.runs[runs[i]].signals[CHANNELS[j]] for j in have])
+                                  for i in rows]) * w[None, :, None]
+                    out[rows[:, None], :, np.asarray(have)[None, :]] = \
+                        (2.0 * windowed_dfts(x, fs, f_new[rows]) / wsum).transpose(0, 2, 1)
+            for i, k in enumerate(todo):
+                col = out[:, i:i + 1].copy()
+                col.flags.writeable = False
+                self._memo[k] = col
+        return np.concatenate([self._memo[k] for k in keys], axis=1) if keys else \
+            np.full((runs.size, 0, len(CHANNELS)), np.nan + 0j)
 
     def prefetch_phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> None:
-        """:meth:`phasors` of every column of ``f_hz`` (len(runs), L) Hz computed in one pass over the records and
-        kept as if each column had been asked for alone (``f_hz[:, j:j + 1]``): a family that measures its lines one
-        at a time reads them without transforming every record again per line."""
-        f_hz = np.asarray(f_hz, dtype=float)
-        todo = [j for j in range(f_hz.shape[1])
-                if ("phasors", runs.tobytes(), np.ascontiguousarray(f_hz[:, j:j + 1]).tobytes(), (runs.size, 1))
-                not in self._memo]
-        if not todo:
-            return
-        cols = np.ascontiguousarray(f_hz[:, todo])
-        X = self.phasors(runs, cols)
-        del self._memo[("phasors", runs.tobytes(), cols.tobytes(), cols.shape)]   # kept per column only
-        for i, j in enumerate(todo):
-            col = np.ascontiguousarray(f_hz[:, j:j + 1])
-            self._memo[("phasors", runs.tobytes(), col.tobytes(), col.shape)] = X[:, i:i + 1].copy()
+        """:meth:`phasors` of every column of ``f_hz`` (len(runs), L) Hz computed in one pass over the records and kept:
+        a family that measures its lines one at a time reads them without transforming every record again per line."""
+        self.phasors(runs, f_hz)
 
     def data_floor(self, state: State, c: str) -> np.ndarray:
         """Block floor (n_runs, n_f) of channel ``c`` as the state reads its data (:meth:`data`): a torque
@@ -191,7 +188,10 @@ class Context(Metric):
         return fl
 
     def omega_ref(self) -> float:
-        return float(np.median(self.omega[self.runs]))
+        """Reference speed of the amplitude and floor laws, rad/s: the median of the runs' |Ω| (computed once)."""
+        if "omega_ref" not in self._memo:
+            self._memo["omega_ref"] = float(np.median(self.omega[self.runs]))
+        return self._memo["omega_ref"]
 
     # ---- predictions
     def line_psd(self, h: float, amp: np.ndarray, runs: np.ndarray) -> np.ndarray:
