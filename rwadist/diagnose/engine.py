@@ -16,7 +16,7 @@ from ..spectra import Spectra, welch_dof
 from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
 from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, NOISE_Z, TORQUE_CHANNELS
 from .measure import column_nanmedian
-from .metric import Metric, hann_tables, read_table
+from .metric import Metric, bin_sums, hann_tables, read_table
 from .state import State
 
 #: Samples (runs × record length × channels) :meth:`Context.phasors` transforms together: a few tens of MB.
@@ -632,7 +632,7 @@ class Context(Metric):
         keep = ~mask[:, lo:lo + n].reshape(runs.size, self.n_bands, BAND_BINS)
         vals = D[:, lo:lo + n].reshape(runs.size, self.n_bands, BAND_BINS)
         cnt = keep.sum(-1)
-        mean = np.where(cnt > 0, (vals * keep).sum(-1) / np.maximum(cnt, 1), 0.0)
+        mean = np.where(cnt > 0, bin_sums(vals * keep) / np.maximum(cnt, 1), 0.0)
         return mean, cnt.astype(float)
 
 

@@ -141,8 +141,15 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
         # a residual peak: above thr times the band's level (median of its bins clear of lines / ln 2); a peak's
         # neighbours are neighbours on the record grid (the bins kept are contiguous within a band)
         level = np.zeros(ctx.n_bands)
-        for b in np.unique(band[keep]):
-            level[b] = np.median(P[keep & (band == b)]) / np.log(2.0)
+        bk, pk = band[keep], P[keep]
+        if bk.size:
+            # each band's median (np.median's: the middle value, or the mean of the middle two) from one sort by band
+            # and value
+            srt = pk[np.lexsort((pk, bk))]
+            b_u, first, cnt_b = np.unique(bk, return_index=True, return_counts=True)
+            hi = first + cnt_b // 2
+            lo = np.where(cnt_b % 2 == 1, hi, hi - 1)
+            level[b_u] = (srt[lo] + srt[hi]) / 2.0 / np.log(2.0)
         peak = P > thr * level[band]
         wide = peak.copy()
         for s_ in range(1, RECORD_PEAK_BINS + 1):

@@ -151,6 +151,37 @@ def _record_run_residual(ctx: Context, r: int, j: int, fl: np.ndarray, f_top: fl
     return ctx._memo[key]
 
 
+def _record_run_residuals(ctx: Context, j: int, items, f_top: float, A_of: dict) -> None:
+    """:func:`_record_run_residual` of every (run, lines) of ``items`` not yet kept, the runs of one record length and
+    number of lines at once, kept as each would be: the same operations on each run's own rows (the leakage's sum over
+    the lines per grid point, the median of the clear points' |X|²: :func:`column_nanmedian`).  ``A_of``: run ->
+    its lines' phasors, where already computed."""
+    groups: dict = {}
+    for r, fl in items:
+        if ("missing_harmonic_run", r, j, fl.tobytes(), f_top) in ctx._memo or not fl.size:
+            continue
+        run = ctx.test.runs[r]
+        groups.setdefault((run.n_samples, run.sample_rate, fl.size), []).append((r, fl))
+    c = ctx.channels[j]
+    for group in groups.values():
+        rows = [r for r, _ in group]
+        grid, _, df_rec, n = _record_grid(ctx, rows[0])
+        fls = np.array([fl for _, fl in group])                                              # (R, L)
+        missing = [k for k, r in enumerate(rows) if r not in A_of]
+        A_new = record_dfts(ctx, [rows[k] for k in missing], c, fls[missing]) if missing else None
+        A = np.array([A_of[r] if r in A_of else A_new[missing.index(k)] for k, r in enumerate(rows)])   # (R, L)
+        X = np.array([_record_grid(ctx, r)[1][:, j] for r in rows])                          # (R, G)
+        t_minus = hann_transform_ratio(n, (grid[None, :, None] - fls[:, None, :]) / df_rec)
+        t_plus = hann_transform_ratio(n, (grid[None, :, None] + fls[:, None, :]) / df_rec)
+        Xr = X - (t_minus * A[:, None, :] + t_plus * np.conj(A)[:, None, :]).sum(2)
+        clear = ((grid >= RECORD_MIN_BINS * df_rec) & (grid < f_top))[None, :] \
+            & np.all(np.abs(grid[None, :, None] - fls[:, None, :]) >= RECORD_SEP_BINS * df_rec, axis=2)
+        med = column_nanmedian(np.where(clear, np.abs(Xr) ** 2, np.nan).T)
+        local = np.where(clear.sum(1) >= 8, med / np.log(2.0), 0.0)
+        for k, (r, fl) in enumerate(group):
+            ctx._memo[("missing_harmonic_run", r, j, fl.tobytes(), f_top)] = (Xr[k], A[k], float(local[k]))
+
+
 def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool = False) -> tuple:
     """(|X|² (len(runs), L), noise (len(runs), L), valid (len(runs), L)) of channel ``c`` at frequencies ``f_hz``
     (len(runs), L) on the whole-run DFT, less the leakage of every line the state predicts on the channel (each
@@ -193,6 +224,7 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     for items in new_lines.values():
         A = record_dfts(ctx, [r for r, _ in items], c, np.array([fl for _, fl in items]))
         A_new.update({r: A[k] for k, (r, _) in enumerate(items)})
+    _record_run_residuals(ctx, j, [(r, fl) for _, r, fl, _, _ in todo], f_top, A_new)
     # with ``exact``: the data's phasors at the points' own frequencies (a fit's h refined finer than the grid), kept
     # on the context (the fit's grid of h is asked again on the refit's runs and by the held-out evidence)
     ex_key = {i: ("missing_harmonic_exact", r, j, fl.tobytes(), f_hz[i].tobytes()) for i, r, fl, _, _ in todo} \
