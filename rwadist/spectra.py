@@ -164,6 +164,16 @@ def welch_psd(x: np.ndarray, fs: float, win: np.ndarray, noverlap: int) -> np.nd
     for s in range(0, x.shape[0], step):
         seg = np.lib.stride_tricks.sliding_window_view(x[s:s + step], nperseg, axis=-1)[:, ::hop][:, :n_seg]
         S = sp_fft.rfft((seg - np.mean(seg, -1, keepdims=True)) * w, n=nperseg, axis=-1)     # (r, P, F)
+        if 1 < n_seg < 8:
+            # the mean over fewer than 8 segments as numpy sums them, one after the other from the first, as whole-array
+            # adds over the segment axis where it lies (no copy of the powers with it last); doubling is exact, so
+            # before the sum or after it is the same number
+            P = S[:, 0].real ** 2 + S[:, 0].imag ** 2
+            for k in range(1, n_seg):
+                P += S[:, k].real ** 2 + S[:, k].imag ** 2
+            P[..., 1:-1 if nperseg % 2 == 0 else None] *= 2
+            out[s:s + step] = P / n_seg
+            continue
         P = np.ascontiguousarray(np.moveaxis(S.real**2 + S.imag**2, 1, -1))                # (r, F, P) as scipy
         P[..., 1:-1 if nperseg % 2 == 0 else None, :] *= 2
         out[s:s + step] = P.mean(axis=-1) if n_seg > 1 else P[..., 0]
