@@ -55,6 +55,21 @@ class State:
         (same direction, |Δh| < LAW_H_TOL)."""
         from .. import extended as ext
 
+        # kept on the state, under what they are made from (a state is not changed once searched, but one being made
+        # is: the harmonics, senses, laws and extended parameters are read again, which costs little)
+        made_of = (self.ext, tuple(sorted(self.laws.items())),
+                   tuple((d, x.h, x.C, x.sense) for d, v in self.model.empirical.items() for x in v))
+        kept = self._cache.get("ext_lines")
+        if kept is not None and kept[0] == made_of:
+            return list(kept[1])
+        out = self._make_ext_lines()
+        self._cache["ext_lines"] = (made_of, tuple(out))
+        return out
+
+    def _make_ext_lines(self) -> list:
+        """:meth:`ext_lines` computed."""
+        from .. import extended as ext
+
         out = ext.lines_from_model(self.model, self.ext, effects=False)
         if self.laws:
             laws = [(d, h, law) for (d, h), law in self.laws.items()]
