@@ -61,6 +61,16 @@ def unit_phasors(f_hz: np.ndarray, dt: float, count: int, running: bool = False)
     return out if out.shape[1] == count else out[:, :count]
 
 
+def windowed_records(records, w: np.ndarray) -> np.ndarray:
+    """(R, n, K) array of ``records`` (R lists of K equally long 1-D signals, n samples each) times the window ``w``
+    (n,): the input of :func:`windowed_dfts`, written in place (one array, not a stack of per-record copies)."""
+    out = np.empty((len(records), w.size, len(records[0]) if records else 0))
+    for i, chans in enumerate(records):
+        for k, x in enumerate(chans):
+            np.multiply(x, w, out=out[i, :, k])
+    return out
+
+
 def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128,
                   single: bool = False) -> np.ndarray:
     """Σ_n x[r, n, k]·e^{−2πj f[r, l] t_n} (t_n = n/sample_rate) of a stack of R equally long records ``x``

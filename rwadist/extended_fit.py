@@ -158,14 +158,15 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             f = h[None, :] * np.abs([run.speed for run in batch])[:, None] / (2 * np.pi)
             x = np.stack([np.column_stack([w * run.signals[cx], w * run.signals[cy]]) for run in batch])
             XY = windowed_dfts(x, fs, f)
-            for i, run in enumerate(batch):
-                ok = f[i] < 0.45 * fs
-                X, Y = XY[i, ok].T
-                co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
-                if run.speed < 0:
-                    co, ct = ct, co
-                p_co[ok] += co
-                p_ct[ok] += ct
+            # every run's powers at once, added run after run in the batch's order (a cumulative sum along the runs:
+            # the adds of a loop over them; a line out of a run's band adds 0 there)
+            X, Y = XY[..., 0], XY[..., 1]
+            co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
+            back = np.array([run.speed < 0 for run in batch])[:, None]
+            co, ct = np.where(back, ct, co), np.where(back, co, ct)
+            ok = f < 0.45 * fs
+            p_co = np.cumsum(np.vstack([p_co, np.where(ok, co, 0.0)]), axis=0)[-1]
+            p_ct = np.cumsum(np.vstack([p_ct, np.where(ok, ct, 0.0)]), axis=0)[-1]
         frac = p_co / np.maximum(p_co + p_ct, 1e-300)
         for hk, fr in zip(h, frac):
             sense = "co" if fr >= threshold else ("counter" if fr <= 1 - threshold else "planar")

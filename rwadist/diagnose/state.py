@@ -53,7 +53,6 @@ class State:
         """The :class:`rwadist.extended.Line` objects of the extended base: :func:`rwadist.extended.lines_from_model`
         of the model (imbalances from ``ext``, senses from the harmonics) with the state's amplitude laws attached
         (same direction, |Δh| < LAW_H_TOL)."""
-        from .. import extended as ext
 
         # kept on the state, under what they are made from (a state is not changed once searched, but one being made
         # is: the harmonics, senses, laws and extended parameters are read again, which costs little)

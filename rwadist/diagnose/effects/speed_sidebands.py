@@ -131,7 +131,7 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
     ``chans`` with one table of phasors), each at its needed frequencies (moved to the front of its row; the rest of
     the row padded with its carrier), in chunks of :data:`RUN_CHUNK_SAMPLES` samples; W in closed form
     (:func:`rwadist.dft.hann_transform`)."""
-    from ...dft import hann_transform, run_window, windowed_dfts
+    from ...dft import hann_transform, run_window, windowed_dfts, windowed_records
 
     if need is None:
         need = np.ones(f_hz.shape, dtype=bool)
@@ -150,8 +150,8 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
             valid = np.take_along_axis(nd, pick, axis=1)
             f_c = h0 * ctx.omega[runs[rows]] / (2 * np.pi)
             f_i = np.where(valid, np.take_along_axis(f_hz[rows], pick, axis=1), f_c[:, None])
-            x = np.stack([np.column_stack([ctx.test.runs[runs[i]].signals[c] for c in chans]) for i in rows])
-            both = 2.0 * windowed_dfts(x * w[None, :, None], fs, np.column_stack([f_i, f_c]), single=single) / wsum
+            x = windowed_records([[ctx.test.runs[runs[i]].signals[c] for c in chans] for i in rows], w)
+            both = 2.0 * windowed_dfts(x, fs, np.column_stack([f_i, f_c]), single=single) / wsum
             leak = hann_transform(n, fs, f_i - f_c[:, None]) / wsum                  # W(f − f_c)/W(0)
             r, j = np.nonzero(valid)
             X[rows[r], pick[r, j]] = both[r, j] - leak[r, j, None] * both[r, -1]
