@@ -59,13 +59,14 @@ def _ridge_score(ctx, state, chans, runs, h_grid):
     """Mean normalised residual along f = h|Ω|/2π for every h of ``h_grid`` (pairs in band only)."""
     score = np.zeros(h_grid.size)
     count = np.zeros(h_grid.size)
+    k = np.rint(np.outer(h_grid, ctx.omega[runs]) / (2 * np.pi) / ctx.df).astype(int)       # (n_h, n_runs)
+    inb = (k >= ctx.k_lo) & (k <= ctx.k_hi)
+    flat = np.arange(runs.size)[None, :] * ctx.f.size + np.clip(k, 0, ctx.f.size - 1)      # the same for every channel
     for c in chans:
         R = ctx.data(state, c)[runs] - ctx.predict(state, c, runs)
         z = R / ctx.floor_psd(state, c, runs)
         zmax = np.maximum(np.maximum(z, np.roll(z, 1, axis=1)), np.roll(z, -1, axis=1))
-        k = np.rint(np.outer(h_grid, ctx.omega[runs]) / (2 * np.pi) / ctx.df).astype(int)   # (n_h, n_runs)
-        inb = (k >= ctx.k_lo) & (k <= ctx.k_hi)
-        vals = zmax[np.arange(runs.size)[None, :], np.clip(k, 0, ctx.f.size - 1)]
+        vals = np.ravel(zmax).take(flat)
         vals = np.clip(vals, -5.0, 20.0)          # a presence-like score: strong lines count alike
         score += np.where(inb, vals, 0).sum(1)
         count += inb.sum(1)
