@@ -10,7 +10,7 @@ import functools
 import numpy as np
 
 from ..dft import hann_transform
-from .constants import BAND_BINS, KERNEL_HALF, NOISE_Z
+from .constants import BAND_BINS, KERNEL_HALF, NOISE_Z, TORQUE_CHANNELS
 from .state import State
 
 #: Points per bin of :func:`hann_tables`: the 4-point interpolation's error falls as its step⁴ (measured on |W|²:
@@ -233,9 +233,7 @@ class Metric:
                 pos = np.searchsorted(self.runs, runs)
                 if np.all(pos < self.runs.size) and np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
                     return tuple(x[pos] for x in whole)
-        Dfull = self.data(state, c, runs)[runs]
-        ok = np.isfinite(Dfull[:, 0])
-        D = self.band_sums(Dfull)
+        ok, D = self._data_bands(state, c, runs)
         N = self.floor_psd(state, c, runs)
         Mfull = self.predict(state, c, runs)
         M = self.band_sums(Mfull)
@@ -248,6 +246,21 @@ class Metric:
                 x.flags.writeable = False
             state._cache[key] = out
         return out
+
+    def _data_bands(self, state: State, c: str, runs: np.ndarray) -> tuple:
+        """(runs with data (len(runs),), band sums of the data as the state reads it (len(runs), n_bands)) of channel
+        ``c``: the data's alone (a torque corrected for the state's load-cell offset is keyed by it), kept on the
+        context, read-only."""
+        offset = tuple(float(x) for x in state.coupling) if state.coupling is not None and c in TORQUE_CHANNELS \
+            else None
+        key = ("data_bands", c, offset, runs.tobytes())
+        if key not in self._memo:
+            Dfull = self.data(state, c, runs)[runs]
+            out = (np.isfinite(Dfull[:, 0]), self.band_sums(Dfull))
+            for x in out:
+                x.flags.writeable = False
+            self._memo[key] = out
+        return self._memo[key]
 
     def scale(self, c):
         return self._scale[c]
