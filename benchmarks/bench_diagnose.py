@@ -15,6 +15,19 @@ Run: ``.venv/bin/python benchmarks/bench_diagnose.py [--quick | --modes-on [GROU
    radial-force line growing as Ω^2.5, a load through the suspension modes): ``rwadist fit`` (:func:`rwadist.api.fit`) and ``rwadist diagnose
    DATA`` without a model (:func:`rwadist.api.diagnose`: the wheel's suspension modes fitted first), same
    run, wall-clock and CPU (process) time -- on a shared machine the CPU ratio is the stable figure.
+
+History of the timing figure (cpu ratio, diagnose / plain fit): 51x when issue 14 was filed; 27.8x on modes-off data
+before the first speed-up; x33-37 on this data before the whole-run DFT speed-up; x18.9 (first calls x14.0) at a3db21a
+before the product-grid mode scan and the shared spectra and line detections of the suspension-mode fits; x21.6 =
+3.37 s / 0.16 s at 01677da, x19.8 = 2.83 s / 0.14 s after the same-number speed-ups of the record route, Welch PSDs,
+floor law and scan medians (load 2.7 on 2 cores: the faster Welch PSDs speed the plain fit too); x21.8 = 3.10 s /
+0.14 s after the kernel and off-grid-cell fixes, x17.3 = 2.41 s / 0.14 s with the wheel's modes judged alone first;
+x15.3-16.3 after the same-number speed-ups of the mode scan, the search's state errors, the kernel tables and the
+extended-base lines; x13.4-14.9 (2.26 s / 0.15-0.17 s) with the same estimator on both sides (best of 5 each, one BLAS
+thread); 2026-11-28: x13.1-13.6 (1.40 s / 0.10-0.11 s, a faster machine) -> x8.9-9.4 (0.99-1.07 s / 0.11-0.12 s)
+after the reuse of the fit's identification without modal exclusion, the per-direction reuse and min_gain bound of
+the family search, the subsets of runs read from every run's terms, single-precision scans, batched record
+transforms and medians, with the same effects and errors on every check case.
 """
 from __future__ import annotations
 
@@ -339,16 +352,8 @@ def timing(fit_repeats: int = 5, diagnose_repeats: int = 5):
           f"(cpu of each: {', '.join(f'{x:.2f}' for x in c_fits)})")
     print(f"  diagnose (rwadist diagnose DATA): wall {t_diag:7.2f} s   cpu {c_diag:7.2f} s   "
           f"(cpu of each: {', '.join(f'{x:.2f}' for x in c_diags)})")
-    print(f"  ratio: wall x{t_diag / t_fit:.1f}, cpu x{c_diag / c_fit:.1f}   (target <= 10x; 51x at issue 14, "
-          "27.8x on modes-off data before the speed-up; cpu x33-37 on this data before the whole-run DFT speed-up; "
-          "cpu x18.9, first calls x14.0, at a3db21a before the product-grid mode scan and the shared spectra and "
-          "line detections of the suspension-mode fits; cpu x21.6 = 3.37 s / 0.16 s at 01677da, x19.8 = 2.83 s / "
-          "0.14 s after the same-number speed-ups of the record route, Welch PSDs, floor law and scan medians, "
-          "same run conditions, load 2.7 on 2 cores: the faster Welch PSDs speed the plain fit too; cpu x21.8 = 3.10 s / "
-          "0.14 s after the kernel and off-grid-cell fixes, x17.3 = 2.41 s / 0.14 s with the wheel's modes judged alone "
-          "first, same effects and exponent, quiet; x17.3-17.4 -> x15.3-16.3 (2.60-2.65 s -> 2.46-2.50 s) after the same-number "
-          "speed-ups of the mode scan, the search's state errors, the kernel tables and the extended-base lines, "
-          "paired runs, load < 0.4)")
+    print(f"  ratio: wall x{t_diag / t_fit:.1f}, cpu x{c_diag / c_fit:.1f}   (target <= 10x; 51x when issue 14 was filed; "
+          "the figure's history is in this file's docstring)")
     print(f"  first calls only (each with its warm-up, the method of the earlier figures): cpu "
           f"x{c_diags[0] / c_fits[0]:.1f}")
     print(f"  {d.iterations} iterations, added "
