@@ -55,7 +55,7 @@ def test_column_nanmedian_is_numpys():
     NaN-free columns, infinities, a column of one value, and an all-NaN column (NaN)."""
     import warnings
 
-    from rwadist.diagnose.measure import column_nanmedian
+    from rwadist.diagnose.reduce import column_nanmedian
 
     rng = np.random.default_rng(11)
     for rows in (1, 2, 7, 120, 700):

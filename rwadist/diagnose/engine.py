@@ -15,8 +15,8 @@ from ..resonance import resonance
 from ..spectra import Spectra, welch_dof
 from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
 from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, NOISE_Z, TORQUE_CHANNELS
-from .measure import column_nanmedian
-from .metric import Metric, bin_sums, hann_tables, read_table
+from .metric import Metric, hann_tables, read_table
+from .reduce import bin_sums, column_nanmedian
 from .state import State
 
 #: Samples (runs × record length × channels) :meth:`Context.phasors` transforms together: a few tens of MB.

@@ -9,7 +9,7 @@ import numpy as np
 from ..units import DIRECTION_CHANNELS
 from .constants import LINE_HALF
 
-if TYPE_CHECKING:                      # annotations only (the engine imports column_nanmedian from here)
+if TYPE_CHECKING:                      # annotations only (the engine imports nothing from here at run time)
     from .engine import Context
     from .state import State
 
@@ -20,23 +20,6 @@ def in_unresolved_span(model, direction: str, h: float) -> bool:
     fit = (getattr(model, "analytical", None) or {}).get("fit") or {}
     return any(sp.get("direction") == direction and sp.get("h_min", np.inf) <= h <= sp.get("h_max", -np.inf)
                for sp in fit.get("unresolved_lines") or [])
-
-
-def column_nanmedian(z: np.ndarray) -> np.ndarray:
-    """Median of each column of ``z`` (rows, cols) over its non-NaN values, NaN for a column with none:
-    ``np.nanmedian(z, axis=0)``'s numbers (the middle value, or the mean (a + b)/2 of the middle two, of the sorted
-    values), from one sort of the columns -- numpy takes masked arrays for fewer than 600 rows, 50x slower here."""
-    z = np.asarray(z, dtype=float)
-    if z.shape[0] == 0:
-        return np.full(z.shape[1:], np.nan)
-    srt = np.sort(z, axis=0)                                                # NaN sorted after every value
-    cnt = np.sum(~np.isnan(z), axis=0)
-    hi = cnt // 2
-    lo = np.where(cnt % 2 == 1, hi, hi - 1)
-    cols = np.arange(z.shape[1])
-    last = z.shape[0] - 1
-    mid = (srt[np.clip(lo, 0, last), cols] + srt[np.clip(hi, 0, last), cols]) / 2.0
-    return np.where(cnt > 0, mid, np.nan)
 
 
 def _measure(ctx, state, direction, h, runs, skip=None):

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..dft import hann_transform
 from .constants import BAND_BINS, KERNEL_HALF, NOISE_Z, TORQUE_CHANNELS
+from .reduce import bin_sums
 from .state import State
 
 #: Points per bin of :func:`hann_tables`: the 4-point interpolation's error falls as its step⁴ (measured on |W|²:
@@ -54,15 +55,6 @@ def read_table(coef: np.ndarray, dlt: np.ndarray) -> np.ndarray:
     i -= 1
     c0, c1, c2, c3 = (row.take(i) for row in coef)
     return ((c3 * u + c2) * u + c1) * u + c0
-
-
-def bin_sums(v: np.ndarray) -> np.ndarray:
-    """``v.sum(-1)`` of a (..., BAND_BINS) array of each band's bins: for 8 bins numpy's own pairwise order,
-    ((x0 + x1) + (x2 + x3)) + ((x4 + x5) + (x6 + x7)), as 7 adds of whole arrays -- the same sums (numpy's
-    reduction over a short strided axis costs 2.4x as much)."""
-    if v.shape[-1] != 8:
-        return v.sum(-1)
-    return ((v[..., 0] + v[..., 1]) + (v[..., 2] + v[..., 3])) + ((v[..., 4] + v[..., 5]) + (v[..., 6] + v[..., 7]))
 
 
 class Metric:

@@ -20,7 +20,6 @@ from ..constants import LINE_HALF
 from ..engine import Context
 from ..measure import (
     _measure,
-    column_nanmedian,
     hann_transform_ratio,
     in_unresolved_span,
     record_dfts,
@@ -28,6 +27,7 @@ from ..measure import (
     ridge_peaks,
     state_line_freqs,
 )
+from ..reduce import column_nanmedian
 from ..state import State
 from .base import register, schema_entry
 
