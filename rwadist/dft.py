@@ -134,14 +134,16 @@ def hann_transform(n: int, sample_rate: float, f_hz: np.ndarray) -> np.ndarray:
     The three kernels share their phase and numerator: with φ = θ/2, sin(n(φ ∓ π/n)) = −sin(nφ) and
     e^{−j(φ ∓ π/n)(n−1)} = e^{−jφ(n−1)}·e^{±jπ(n−1)/n}, so W = e^{−jφ(n−1)}·sin(nφ)·(½/sin φ + ¼e^{jπ(n−1)/n}/sin(φ − π/n)
     + ¼e^{−jπ(n−1)/n}/sin(φ + π/n)), sin(φ ∓ π/n) = sin φ·cos(π/n) ∓ cos φ·sin(π/n): five functions of φ per point
-    instead of twelve.  Where a denominator vanishes (θ ≡ 0 or ±2π/n, mod 2π) that kernel's limit is taken, term by
-    term as :func:`_hann_transform_terms` sums it."""
+    instead of twelve.  Near a vanishing denominator (θ ≡ 0 or ±2π/n, mod 2π: the window's own bin and its neighbours)
+    the three kernels are summed as they are (:func:`_hann_transform_terms`, each kernel's limit at its own zero)."""
     theta = 2 * np.pi * np.asarray(f_hz, dtype=float) / sample_rate
     phi = 0.5 * theta
     s, c = np.sin(phi), np.cos(phi)
     sp, cp = np.sin(np.pi / n), np.cos(np.pi / n)
     below, above = s * cp - c * sp, s * cp + c * sp                      # sin(φ − π/n), sin(φ + π/n)
-    tol = 1e-12 * np.maximum(np.abs(phi) + np.pi / n, 1.0)
+    # within 1e-6 of a kernel's singular point its denominator loses digits (1e-6 of them just 1e-9 bins beside it):
+    # there the three kernels are summed as they are
+    tol = 1e-6 * np.maximum(np.abs(phi) + np.pi / n, 1.0)
     singular = (np.abs(s) <= tol) | (np.abs(below) <= tol) | (np.abs(above) <= tol)
     turn = np.exp(1j * np.pi * (n - 1) / n)
     with np.errstate(divide="ignore", invalid="ignore"):

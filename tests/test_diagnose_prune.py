@@ -75,3 +75,81 @@ def test_the_bound_changes_no_decision(monkeypatch):
     assert (bounded.error_before, bounded.error_after) == (plain.error_before, plain.error_after)
     assert bounded.model.empirical == plain.model.empirical
     assert n_bounded < len(judged) - n_bounded                           # the bound skipped hypotheses
+
+
+def test_record_lines_beside_a_skipped_welch_line_are_still_dropped(monkeypatch):
+    """A line h = 0.5 (below the Welch band at the slow runs, in it at the fast ones) is found by both routes; the
+    record route's is not proposed beside the Welch route's.  Skipping the Welch route (nothing there could pass)
+    must leave the record route's proposals as they were: the Welch line still tells the record line apart."""
+    from rwadist.diagnose.effects.missing_harmonic import MissingHarmonic
+
+    t = e_data(8)
+    inject_line(t, "radial_force", 0.5, lambda w: 0.5 * TRUTH.empirical["radial_force"][0].C * w**2, 8)
+    ctx = engine.Context(spectra(t), test=t)
+    state = engine.initial_state(ctx, replace(TRUTH))
+    every = MissingHarmonic.candidates(ctx, state, ctx.fit_runs)
+    assert any(not e.record and abs(e.h - 0.5) < 0.01 for e in every)         # the Welch route found it
+    ctx2 = engine.Context(spectra(t), test=t)
+    state2 = engine.initial_state(ctx2, replace(TRUTH))
+    ctx2.step = (state2, None, 0.05)
+    monkeypatch.setattr(engine.Context, "can_pass", lambda self, state, chans, bands=None: self.step is None)
+    skipped = MissingHarmonic.candidates(ctx2, state2, ctx2.fit_runs)
+    assert not any(not e.record for e in skipped)                             # the Welch route skipped
+    assert [(e.direction, e.h, e.C) for e in skipped] == [(e.direction, e.h, e.C) for e in every if e.record]
+
+
+def test_the_bound_leaves_out_runs_without_the_channel():
+    """A held-out run lacking a channel (a NaN row of its PSD) adds nothing to the bound, as it adds nothing to the
+    judge: with it, the bound over bands is still the bound without bands when every band is asked."""
+    t = _law_data(seed=7)
+    sp = spectra(t)
+    sp.psd["Fy"] = sp.psd["Fy"].copy()
+    ctx = engine.Context(sp, test=t)
+    sp.psd["Fy"][ctx.held_runs[0]] = np.nan
+    state = engine.initial_state(ctx, replace(TRUTH))
+    memo: dict = {}
+    ctx.step = (state, lambda chans: search._state_errors(ctx, state, ctx.held_runs, chans, memo), 0.05)
+    every_band = np.ones((ctx.held_runs.size, ctx.n_bands), bool)
+    assert ctx.can_pass(state, ["Fx", "Fy"])
+    assert ctx.can_pass(state, ["Fx", "Fy"], every_band)
+
+
+def test_held_out_predictions_under_a_smear_are_their_own():
+    """Under a spin smear the lines' spreading depends on the runs asked together (the longest run sets the smear's
+    points): a prediction on the held-out runs is computed for them, never read from every run's."""
+    t = _law_data(seed=9)
+    longest = int(engine.Context(spectra(t), test=t).fit_runs[0])
+    run = t.runs[longest]                                      # one fit run twice as long as the others
+    run.signals.update({c: np.concatenate([x, x]) for c, x in run.signals.items()})
+    ctx = engine.Context(spectra(t), test=t)
+    assert longest in ctx.fit_runs and ctx.run_durations(ctx.runs).max() > ctx.run_durations(ctx.held_runs).max()
+    direct = engine.initial_state(ctx, replace(TRUTH)).copy()
+    direct.smear = 100.0
+    first = ctx.predict(direct, "Fx", ctx.held_runs).copy()
+    after = engine.initial_state(ctx, replace(TRUTH)).copy()
+    after.smear = 100.0
+    ctx.predict(after, "Fx", ctx.runs)                        # every run first, as after an accepted refit
+    assert np.array_equal(ctx.predict(after, "Fx", ctx.held_runs), first)
+
+
+def test_reuse_tells_apart_what_a_fit_reads_beside_the_prediction():
+    """A channel without lines predicts the same on the empirical and the extended base, but a line fitted there is
+    divided by the base's modal gain; a counter-rotating split leaves a radial force's prediction as it was but
+    rewrites the harmonics: either way a family's fit is made again, not read back."""
+    t = _law_data(seed=10)
+    ctx = engine.Context(spectra(t), test=t)
+    base = engine.initial_state(ctx, replace(TRUTH))
+    calls = []
+    ctx.reuse("x", base, ["Fx"], ctx.fit_runs, lambda: calls.append(1) or [])
+    ctx.reuse("x", base, ["Fx"], ctx.fit_runs, lambda: calls.append(1) or [])
+    assert len(calls) == 1                                    # read back
+    other = base.copy()
+    other.ext = preset("ithaco-e").extended                   # another base, the same lines of Fx read as before?
+    other._cache = {}
+    ctx.reuse("x", other, ["Fx"], ctx.fit_runs, lambda: calls.append(1) or [])
+    assert len(calls) == 2
+    split = base.copy()
+    h1 = split.model.empirical["radial_force"][0]
+    split.model.empirical["radial_force"][0] = replace(h1, sense="counter")
+    ctx.reuse("x", split, ["Fx"], ctx.fit_runs, lambda: calls.append(1) or [])
+    assert len(calls) == 3

@@ -91,7 +91,8 @@ def test_hann_transform_is_the_window_sum():
         w = signal.get_window("hann", n)
         df = fs / n
         # on and between bins, at 0 and at ±1 bin (the singular points of the closed form's terms), far out, negative
-        f = np.concatenate([[0.0, df, -df, 2 * df, 0.5 * df, 1e-9 * df],
+        f = np.concatenate([[0.0, df, -df, 2 * df, 0.5 * df, 1e-9 * df, (1 + 1e-9) * df, (1 + 1e-7) * df,
+                             -(1 + 1e-8) * df, (1 - 1e-6) * df],
                             np.random.default_rng(n).uniform(-0.5, 0.5, 40) * fs])
         ref = np.exp(-2j * np.pi * np.outer(f, np.arange(n)) / fs) @ w
         got = hann_transform(n, fs, f)

@@ -401,7 +401,9 @@ class Context(Metric):
         if skip is None and only is None:
             key = ("predict", c, runs.tobytes())
             if key not in state._cache:
-                whole = state._cache.get(("predict", c, self.runs.tobytes()))
+                # under a spin smear or a speed ripple the lines' spreading is set by the runs asked together
+                whole = state._cache.get(("predict", c, self.runs.tobytes())) \
+                    if state.smear is None and state.ripple is None else None
                 pos = np.searchsorted(self.runs, runs) if whole is not None and runs.size < self.runs.size else None
                 if pos is not None and np.all(pos < self.runs.size) and \
                         np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
@@ -464,7 +466,9 @@ class Context(Metric):
         if bands is None:
             here = float(e0.sum())
         else:
-            here = sum(float(np.sum(np.maximum(np.abs(parts[c][0]) - NOISE_Z * parts[c][1], 0.0)[bands])) for c in chans)
+            # a run without the channel's data (a NaN row) adds nothing, as in the judge
+            here = sum(float(np.sum(np.nan_to_num(np.maximum(np.abs(parts[c][0]) - NOISE_Z * parts[c][1], 0.0),
+                                                  nan=0.0)[bands])) for c in chans)
         # a hair over the bound: the band sums and the run sums round differently
         return here * (1.0 + 1e-9) >= min_gain * e_all
 
@@ -487,7 +491,13 @@ class Context(Metric):
         from dataclasses import replace
 
         own = tuple(repr(e.params()) for e in state.effects if getattr(e, "kind", None) == family)
-        key = ("reuse", family, part, tuple(chans), np.asarray(runs).tobytes(), own,
+        # and what a fit reads besides the prediction: the extended parameters (a line's modal gain, also where the
+        # channel has no line yet), the directions' harmonics (a counter-rotating split leaves a radial force's
+        # prediction as it was) and the spans of lines the model's fit could not measure apart
+        dirs = sorted({CHANNEL_DIRECTION[c] for c in chans})
+        harmonics = tuple((d, x.h, x.C, getattr(x, "sense", None)) for d in dirs for x in state.model.harmonics(d))
+        spans = repr(((getattr(state.model, "analytical", None) or {}).get("fit") or {}).get("unresolved_lines"))
+        key = ("reuse", family, part, tuple(chans), np.asarray(runs).tobytes(), own, state.ext, harmonics, spans,
                self.content_key(state, chans, runs))
         if key not in self._memo:
             self._memo[key] = compute()

@@ -220,7 +220,9 @@ class Metric:
         if own:
             if key in state._cache:
                 return state._cache[key]
-            whole = state._cache.get(("channel_terms", c, self.runs.tobytes()))
+            # not under a spin smear or a speed ripple: there the lines' spreading is set by the runs asked together
+            whole = state._cache.get(("channel_terms", c, self.runs.tobytes())) \
+                if state.smear is None and state.ripple is None else None
             if whole is not None and runs.size < self.runs.size:
                 pos = np.searchsorted(self.runs, runs)
                 if np.all(pos < self.runs.size) and np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):

@@ -460,15 +460,24 @@ class MissingHarmonic:
         # route's (below the Welch band) of every direction, a line the Welch route found not proposed again
         lanes = {d: [c for c in chans if c in ctx.channels] for d, chans in DIRECTION_CHANNELS.items()}
         lanes = {d: chans for d, chans in lanes.items() if chans}
+        def welch_lines(d):
+            return ctx.reuse("missing_harmonic", state, lanes[d], runs, lambda: welch(d, lanes[d]))
+
+        # a Welch-route line is judged by the error metric on the direction's channels: proposed only where it could
+        # pass (Context.can_pass); the record route's lines bring their own held-out evidence, and one within 0.03 of a
+        # Welch-route line of its direction is not proposed (that line still found, where skipped, to tell)
+        skipped = set()
         for d, chans in lanes.items():
-            # a Welch-route line is judged by the error metric on the direction's channels: only where it could pass
-            # (Context.can_pass); the record route's lines bring their own held-out evidence
             if ctx.can_pass(state, chans):
-                out += ctx.reuse("missing_harmonic", state, chans, runs, lambda d=d, chans=chans: welch(d, chans))
+                out += welch_lines(d)
+            else:
+                skipped.add(d)
         for d, chans in lanes.items():
-            for e in ctx.reuse("missing_harmonic", state, chans, runs,
-                               lambda d=d: MissingHarmonic.record_candidates(ctx, state, runs, max_per_direction, (d,)),
-                               part="record"):
-                if not any(abs(e.h - x.h) < 0.03 for x in out if x.direction == e.direction):
+            found = ctx.reuse("missing_harmonic", state, chans, runs,
+                              lambda d=d: MissingHarmonic.record_candidates(ctx, state, runs, max_per_direction, (d,)),
+                              part="record")
+            told = welch_lines(d) if found and d in skipped else []
+            for e in found:
+                if not any(abs(e.h - x.h) < 0.03 for x in out + told if x.direction == e.direction):
                     out.append(e)
         return out

@@ -415,9 +415,11 @@ class SpeedSidebands:
             top = sorted(hs, key=lambda x: -SpeedSidebands._carrier_C(state, d, x.h))[:n_carriers]
             # a pair beside h0 changes the direction's channels within (h0 ± REACH)|Ω|/2π only: no pair there can pass
             # when the held-out misplaced power there is below min_gain of it all (Context.can_pass); not scanned
+            # (under a speed ripple or a spin smear the lines spread further: the whole channels' bound)
             w = ctx.omega[ctx.held_runs] / (2 * np.pi)
-            tops[d] = [x for x in top
-                       if ctx.can_pass(state, chans, ctx.reach_bands((x.h - REACH) * w, (x.h + REACH) * w))]
+            spread = state.ripple is not None or state.smear is not None
+            tops[d] = [x for x in top if ctx.can_pass(
+                state, chans, None if spread else ctx.reach_bands((x.h - REACH) * w, (x.h + REACH) * w))]
         if ctx.test is not None:
             SpeedSidebands._prefetch_scans(ctx, [(d, x.h) for d, top in tops.items() for x in top], runs)
         for d, top in tops.items():
