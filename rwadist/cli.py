@@ -74,7 +74,10 @@ def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm") ->
     except ValueError as exc:
         if isinstance(exc, DataError):
             raise
-        raise DataError(flag, "value", f"{text!r}: {exc}") from None
+        why = str(exc)
+        if why.startswith("could not convert"):
+            why = "not a number; give speeds in rpm as A,B,C or START:STOP:STEP, or START:STOP with --n-speeds"
+        raise DataError(flag, "value", f"{text!r}: {why}") from None
 
 
 # --------------------------------------------------------------------------- simulate-test
@@ -458,6 +461,10 @@ def cmd_diagnose(args) -> int:
     except DataError:
         raise
     except ValueError as exc:
+        if base == "extended" and not getattr(model, "analytical", None) and not args.preset:
+            raise DataError(args.model or "diagnose", "--base", "extended needs a model with the wheel's suspension "
+                            "modes (an analytical section): give one made by `rwadist fit --extended`, or a --preset, "
+                            "or leave --base at auto") from None
         raise DataError("diagnose", "--base", str(exc)) from None
     with atomic_dir(args.output) as tmp_dir, working("writing the diagnose report"):
         files = [Path(args.output) / Path(f).name for f in write_report(diag, tmp_dir)]
@@ -476,6 +483,14 @@ def cmd_diagnose(args) -> int:
     for e in summary["base_lines"]:
         print(f"  = {e['direction']} h = {e['h']:g}, C = {e['C']:.3g}: a line of the data the modes' fit did not "
               "resolve, added to the fitted base (no model to miss it from)")
+    missing = summary["lines_missing_from_given_model"]
+    if diag.model_given and diag.state_after.base != diag.state_before.base:
+        print(f"  note: {args.model or args.preset} has no suspension modes the data could be read through (none, or "
+              "assumed ones): its harmonics were replaced by those fitted with the wheel's modes from the data"
+              + ("; lines of the data it lacks:" if missing else "; it lacks none of the data's lines"))
+        for e in missing:
+            part = f" ({e['sense']}-rotating part)" if e.get("sense") in ("co", "counter") else ""
+            print(f"  - {e['direction']} h = {e['h']:g}{part}, C = {e['C']:.3g}")
     print(f"unexplained fraction of the data's power (speed x frequency): {diag.error_before:.4g} -> "
           f"{diag.error_after:.4g} (definition: report.md)")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")
@@ -649,6 +664,31 @@ def one_blas_thread():
         yield
 
 
+@contextmanager
+def _model_key_warnings():
+    """A model file's unread keys (:class:`rwadist.model.ModelKeyWarning`) each printed once as one line on stderr,
+    ``rwadist: warning: <file>: <key>: ...``, not in Python's warning format."""
+    import warnings
+
+    from .model import ModelKeyWarning
+
+    seen: set = set()
+    shown = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, ModelKeyWarning):
+            if str(message) not in seen:
+                seen.add(str(message))
+                print(f"rwadist: warning: {message}", file=sys.stderr)
+            return
+        shown(message, category, filename, lineno, file, line)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", ModelKeyWarning)
+        warnings.showwarning = show
+        yield
+
+
 def main(argv=None) -> int:
     """Run one command; every failure ends in a one-line message: exit 2 for bad input, 130 on Ctrl-C,
     3 for an internal error (its traceback goes to a file named in the message, never to the user)."""
@@ -661,7 +701,7 @@ def main(argv=None) -> int:
     command = _command_name(args)
     try:
         check_parsed(parser, args)
-        with one_blas_thread():
+        with one_blas_thread(), _model_key_warnings():
             return args.func(args)
     except KeyboardInterrupt:
         print(f"rwadist {command}: interrupted; outputs left as they were (no partial file written)", file=sys.stderr)

@@ -124,8 +124,10 @@ def read_steady(directory, progress: bool = False) -> SteadyTest:
     if not runs_path.exists():
         content = sorted(p.name for p in directory.iterdir())
         what = "is empty" if not content else f"has no {RUNS_FILE} (found {content[:5]})"
+        sweeps = [n for n in content if "sweep" in n.lower() and not n.lower().endswith(".json")]
+        hint = f"; for a spin-up/run-down record give the file itself, e.g. {directory / sweeps[0]}" if sweeps else ""
         raise DataError(directory, RUNS_FILE, f"directory {what}; a steady-state test needs {RUNS_FILE} "
-                        "with columns file,speed_rpm")
+                        f"with columns file,speed_rpm{hint}")
     meta_path = directory / META_FILE
     meta = _read_meta(meta_path)
     with io.StringIO(read_text(runs_path), newline="") as fh:

@@ -74,7 +74,16 @@ def _broadband_floor(e):
     psd = np.asarray(e["psd_ref"], dtype=float)
     chans = " ".join(e["channel"]) if isinstance(e["channel"], (list, tuple)) else str(e["channel"])
     return (f"{chans}, PSD ∝ |Ω|^{_num(e['exponent'], '.3g')}, {f.min():.0f}–{f.max():.0f} Hz, "
-            f"peak {psd.max():.3g} unit²/Hz at {_rpm(e['omega_ref_rad_s'])}")
+            f"peak {psd.max():.3g} {_psd_unit(e)} at {_rpm(e['omega_ref_rad_s'])}")
+
+
+def _psd_unit(e) -> str:
+    """The floor's PSD unit: its channel's unit squared per Hz (N²/Hz or (N·m)²/Hz)."""
+    from .units import CHANNEL_UNIT
+
+    chans = e["channel"] if isinstance(e["channel"], (list, tuple)) else [e["channel"]]
+    unit = CHANNEL_UNIT.get(chans[0]) if chans else None
+    return {"N": "N²/Hz", "Nm": "(N·m)²/Hz"}.get(unit, f"({unit})²/Hz" if unit else "unit²/Hz")
 
 
 def _fixed_resonance(e):
@@ -87,7 +96,8 @@ def _cross_coupling(e):
     r = np.asarray(e["r_m"], dtype=float) * 1e3
     se = e.get("r_stderr_m")
     err = "" if se is None else " ±(" + ", ".join(f"{x:.1f}" for x in np.asarray(se, dtype=float) * 1e3) + ")"
-    return "load-cell reference offset r = (" + ", ".join(f"{x:.1f}" for x in r) + f"){err} mm"
+    # + 0.0: a component that rounds to zero is written 0.0, not -0.0
+    return "load-cell reference offset r = (" + ", ".join(f"{float(f'{x:.1f}') + 0.0:.1f}" for x in r) + f"){err} mm"
 
 
 def _sidebands(e):

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -154,5 +155,59 @@ def from_json(doc: dict, source: str = "<model>") -> WheelModel:
                       provenance=doc.get("provenance", {}) or {})
 
 
+#: The keys of a model document (``units`` is a note for readers, written and not read).
+DOCUMENT_KEYS = ("schema", "schema_version", "name", "units", "wheel", "empirical", "analytical", "effects",
+                 "provenance")
+#: Keys of the ``analytical`` section besides the parameters (:data:`PARAM_KEYS`): the model's kind, the flags and
+#: the extended fit's own record
+ANALYTICAL_KEYS = ("kind", "modes_assumed", "unconstrained", "fit")
+
+
+def unread_keys(doc: Any) -> list:
+    """Notes ``(path, what)`` on what of a model document this version does not read (a misspelt key is read as
+    absent: ``"empirial"`` leaves the model without harmonics): keys of the document, of a harmonic and of the
+    ``analytical`` section it does not know, and effect kinds it does not know (kept, as a newer writer's would be,
+    but used by nothing); each with the closest known name.  Keys an effect carries besides its fields (evidence,
+    law texts) are not listed: a writer may add them."""
+    import difflib
+
+    def like(key, known) -> str:
+        close = difflib.get_close_matches(str(key), list(known), n=1, cutoff=0.6)
+        return f" (did you mean {close[0]!r}?)" if close else ""
+
+    if not isinstance(doc, dict):
+        return []
+    out = [(str(k), f"unknown key, not read{like(k, DOCUMENT_KEYS)}") for k in doc if k not in DOCUMENT_KEYS]
+    emp = doc.get("empirical")
+    if isinstance(emp, dict):
+        known_h = (*schema.HARMONIC_CHECKS, "excluded_rpm")
+        for d, items in emp.items():
+            for i, item in enumerate(items if isinstance(items, list) else []):
+                if isinstance(item, dict):
+                    out += [(f"empirical.{d}[{i}].{k}", f"unknown key, not read{like(k, known_h)}")
+                            for k in item if k not in known_h]
+    ana = doc.get("analytical")
+    if isinstance(ana, dict):
+        known_a = (*schema.PARAM_KEYS.values(), *ANALYTICAL_KEYS)
+        out += [(f"analytical.{k}", f"unknown key, not read{like(k, known_a)}") for k in ana if k not in known_a]
+    effects = doc.get("effects")
+    for i, e in enumerate(effects if isinstance(effects, list) else []):
+        kind = e.get("kind") if isinstance(e, dict) else None
+        if isinstance(kind, str) and kind not in schema.EFFECT_KINDS:
+            out.append((f"effects[{i}].kind", f"{kind!r} is no effect kind this version knows{like(kind, schema.EFFECT_KINDS)}: "
+                        "kept in the file, used by nothing"))
+    return out
+
+
+class ModelKeyWarning(UserWarning):
+    """A model file holds a key or effect kind this version does not read (:func:`unread_keys`)."""
+
+
 def load(path) -> WheelModel:
-    return from_json(read_json(path), str(path))
+    """The model file at ``path``, parsed and validated; a :class:`ModelKeyWarning` per key or effect kind of the file
+    this version does not read (the command line prints each as one line)."""
+    doc = read_json(path)
+    model = from_json(doc, str(path))
+    for where, what in unread_keys(doc):
+        warnings.warn(f"{path}: {where}: {what}", ModelKeyWarning, stacklevel=2)
+    return model

@@ -40,6 +40,10 @@ def _fmt(v, spec: str) -> str:
     """A parameter for the report: floats with ``spec``, short lists space-separated (no commas: CSV)."""
     if isinstance(v, (list, tuple)):
         return "[" + " ".join(_fmt(x, spec) for x in v) + "]"
+    if v is None:
+        return "none"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
     return format(v, spec) if isinstance(v, float) else str(v)
 
 
@@ -173,7 +177,9 @@ def write_report(diag: Diagnosis, out_dir) -> list:
           f"{NOISE_Z:g} noise standard deviations.", "",
           f"- base: {diag.state_before.base} (lines "
           + ("through the suspension modes of the model's analytical section)" if diag.state_before.ext is not None
-             else "C·Ω², hard mounted)"),
+             else "C·Ω², hard mounted)")
+          + (f" -> {diag.state_after.base} (through the wheel's suspension modes fitted from the data)"
+             if diag.state_after.base != diag.state_before.base else ""),
           f"- error before: {diag.error_before:.4g}", f"- error after: {diag.error_after:.4g}",
           f"- RMS-vs-speed relative error before / after: {diag.rms_error_before:.4g} / {diag.rms_error_after:.4g}",
           f"- iterations: {diag.iterations}", "", "## Effects added", ""]
@@ -188,6 +194,15 @@ def write_report(diag: Diagnosis, out_dir) -> list:
         words = describe_effect({"kind": h.effect.kind, **h.effect.params()})
         md.append(f"- **{words}**: held-out gain {h.gain_fraction:.1%} of the unexplained "
                   f"power, {h.t:.1f} noise standard errors (parameters: {par})")
+    if diag.model_given and diag.state_after.base != diag.state_before.base:
+        missing = diag.lines_missing_from_given_model()
+        md += ["", "## The given model's harmonics", "",
+               "The given model has no suspension modes the data could be read through (none, or assumed ones): its "
+               "harmonics were replaced by those fitted with the wheel's modes from the data."
+               + (" Lines of the data it lacks (in the improved model's harmonics, named as no effect):" if missing
+                  else " It lacks none of the data's lines."), ""]
+        md += [f"- {d} h = {h:.4g}" + (f" ({sense}-rotating part)" if sense in ("co", "counter") else "")
+               + f", C = {C:.4g}" for d, h, C, sense in missing]
     md += ["", "## Hypotheses (best five per iteration)", "", "see `hypotheses.csv`", "",
            "![residual](residual_waterfall.png)", "", "![rms](rms_vs_speed.png)", ""]
     p = out / "report.md"

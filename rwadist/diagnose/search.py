@@ -44,10 +44,26 @@ class Diagnosis:
     hypotheses: list
     iterations: int
     ctx: Context
+    #: True when the search started from a model the caller gave (not the empirical fit of the data)
+    model_given: bool = False
 
     @property
     def effects(self) -> list:
         return self.state_after.effects
+
+    def lines_missing_from_given_model(self) -> list:
+        """[(direction, h, C, sense)] of the lines of the improved model that the given model lacks (no harmonic within
+        0.03 in h), when the search replaced the given model's harmonics by those fitted with the wheel's suspension
+        modes (a given model without modes, or with assumed ones, on data that show modes): those lines are in the
+        fitted base, named as no effect; empty otherwise.  ``sense``: 'co' or 'counter' of a radial line's part, or
+        None."""
+        if not self.model_given or self.state_before.base == self.state_after.base:
+            return []
+        from ..model import DIRECTIONS
+
+        given = self.state_before.model
+        return [(d, float(x.h), float(x.C), getattr(x, "sense", None)) for d in DIRECTIONS
+                for x in self.model.harmonics(d) if not any(abs(x.h - y.h) < 0.03 for y in given.harmonics(d))]
 
     def summary(self) -> dict:
         chosen = [h for h in self.hypotheses if h.passed and not h.base_line]
@@ -61,6 +77,8 @@ class Diagnosis:
             "iterations": self.iterations,
             "effects": [effect_entry(h) for h in chosen],
             "base_lines": [effect_entry(h) for h in self.hypotheses if h.passed and h.base_line],
+            "lines_missing_from_given_model": [{"direction": d, "h": h, "C": C, "sense": sense}
+                                               for d, h, C, sense in self.lines_missing_from_given_model()],
             "hypotheses": [effect_entry(h) for h in self.hypotheses],
         }
 
@@ -236,6 +254,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     Returns a :class:`Diagnosis` whose ``model`` carries the added harmonics in ``empirical`` and every
     effect in ``effects``.
     """
+    given = model is not None
     if model is None:
         model = fit_empirical(spectra).model
     request = base
@@ -314,4 +333,4 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         prov["base_lines"] = base_lines
     out.provenance = dict(out.provenance, diagnose=prov)
     return Diagnosis(out, state0, state, _state_error(ctx, state0), _state_error(ctx, state), ctx.rms_error(state0),
-                     ctx.rms_error(state), hyps, it, ctx)
+                     ctx.rms_error(state), hyps, it, ctx, model_given=given)

@@ -82,6 +82,12 @@ def _least_squares_step(time: np.ndarray) -> tuple:
     return step, float(t[0] + r.mean() - slope * 0.5 * (n - 1))
 
 
+def _what_to_do(ratio: float) -> str:
+    """The advice of a non-uniform time column: a run with lost or repeated samples is no steady record."""
+    return ("; export the run again without the loss (or leave it out: a steady run's lines need an unbroken "
+            "record)" if ratio > 0 else "; export the run again with increasing time stamps (or leave it out)")
+
+
 def _kind_of_step(ratio: float) -> str:
     if ratio < 0.5:
         return "a repeated sample (time stamp written twice)" if ratio > -0.5 else "time going backwards"
@@ -139,7 +145,7 @@ def sample_step(path, field_name: str, time, declared_rate: float | None = None,
         raise DataError(path, field_name, f"sampling is not uniform: step {dt[i]:.9g} s at {position(i)} is "
                         f"{ratio:.4g} sampling steps ({_kind_of_step(ratio)}); sampling step {step:.9g} s "
                         f"from a least-squares line through all {n} time stamps, printed rounding "
-                        f"explains ±{tolerance[i]:.2g} s{hint}")
+                        f"explains ±{tolerance[i]:.2g} s{hint or _what_to_do(ratio)}")
     if declared_rate is not None:
         declared_step = 1.0 / float(declared_rate)
         if abs(declared_step - step) > step_error * 1.01 + FLOAT_MARGIN * step:
