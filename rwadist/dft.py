@@ -71,6 +71,16 @@ def windowed_records(records, w: np.ndarray) -> np.ndarray:
     return out
 
 
+def demeaned_windowed(signals, w: np.ndarray) -> np.ndarray:
+    """(R, n) array of each of ``signals`` (R 1-D signals, n samples each) less its mean, times the window ``w``
+    (n,): (x − x̄)·w, the records of a spectrum or a whole-run phasor."""
+    out = np.empty((len(signals), w.size))
+    for i, x in enumerate(signals):
+        x = np.asarray(x, dtype=float)
+        out[i] = (x - x.mean()) * w
+    return out
+
+
 def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128,
                   single: bool = False) -> np.ndarray:
     """Σ_n x[r, n, k]·e^{−2πj f[r, l] t_n} (t_n = n/sample_rate) of a stack of R equally long records ``x``

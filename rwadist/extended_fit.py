@@ -42,7 +42,7 @@ from scipy import optimize
 
 from . import extended as ext
 from .data import SteadyTest
-from .dft import run_window, windowed_dfts
+from .dft import run_window, windowed_dfts, windowed_records
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
@@ -156,7 +156,7 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             n, fs = batch[0].n_samples, batch[0].sample_rate
             w = run_window("hann", n)[0]             # = signal.windows.hann(n, sym=False)
             f = h[None, :] * np.abs([run.speed for run in batch])[:, None] / (2 * np.pi)
-            x = np.stack([np.column_stack([w * run.signals[cx], w * run.signals[cy]]) for run in batch])
+            x = windowed_records([[run.signals[cx], run.signals[cy]] for run in batch], w)
             XY = windowed_dfts(x, fs, f)
             # every run's powers at once, added run after run in the batch's order (a cumulative sum along the runs:
             # the adds of a loop over them; a line out of a run's band adds 0 there)

@@ -402,11 +402,10 @@ class Context(Metric):
             key = ("predict", c, runs.tobytes())
             if key not in state._cache:
                 # under a spin smear or a speed ripple the lines' spreading is set by the runs asked together
-                whole = state._cache.get(("predict", c, self.runs.tobytes())) \
+                kept = self.rows_of_every_run(state, "predict", c, runs) \
                     if state.smear is None and state.ripple is None else None
-                pos = np.searchsorted(self.runs, runs) if whole is not None and runs.size < self.runs.size else None
-                if pos is not None and np.all(pos < self.runs.size) and \
-                        np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
+                if kept is not None:
+                    whole, pos = kept
                     full = whole[pos]           # each run's prediction is its own: the rows of every run's
                 else:
                     full = self._predict(state, c, runs, None, None)

@@ -227,7 +227,7 @@ def record_dfts(ctx: Context, rows, c: str, f_hz: np.ndarray) -> np.ndarray:
     ``f_hz`` (len(rows), L) Hz (the spectra's window): the runs of one record length transformed together
     (:func:`rwadist.dft.windowed_dfts`: each record's sums are those of :func:`rwadist.dft.windowed_dft` of it
     alone, the same numbers)."""
-    from ..dft import run_window, windowed_dfts
+    from ..dft import demeaned_windowed, run_window, windowed_dfts
 
     out = np.empty(f_hz.shape, dtype=complex)
     groups = {}
@@ -236,9 +236,6 @@ def record_dfts(ctx: Context, rows, c: str, f_hz: np.ndarray) -> np.ndarray:
         groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
     for (n, fs), idx in groups.items():
         w, wsum, _ = run_window(ctx.sp.window, n)
-        xs = []
-        for i in idx:
-            x = np.asarray(ctx.test.runs[rows[i]].signals[c], dtype=float)
-            xs.append((x - x.mean()) * w)
-        out[idx] = 2.0 * windowed_dfts(np.stack(xs)[:, :, None], fs, f_hz[idx])[:, :, 0] / wsum
+        xs = demeaned_windowed([ctx.test.runs[rows[i]].signals[c] for i in idx], w)
+        out[idx] = 2.0 * windowed_dfts(xs[:, :, None], fs, f_hz[idx])[:, :, 0] / wsum
     return out

@@ -60,6 +60,18 @@ def read_table(coef: np.ndarray, dlt: np.ndarray) -> np.ndarray:
 class Metric:
     """Band powers, their noise standard deviations and the misplaced power (methods of a Context)."""
 
+    def rows_of_every_run(self, state: State, name: str, c: str, runs: np.ndarray) -> tuple | None:
+        """(what ``state`` keeps under ``(name, c)`` for every run, the positions of ``runs`` in it), or None when
+        nothing is kept for every run or ``runs`` is not a proper subset of the runs (sorted, as ``self.runs``).
+        For terms each run has on its own: a subset's are the rows of every run's."""
+        whole = state._cache.get((name, c, self.runs.tobytes()))
+        if whole is None or runs.size >= self.runs.size:
+            return None
+        pos = np.searchsorted(self.runs, runs)
+        if np.all(pos < self.runs.size) and np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
+            return whole, pos
+        return None
+
     def band_sums(self, x: np.ndarray) -> np.ndarray:
         """Σ of each band's BAND_BINS bins of ``x`` (rows, n_f), times df: (rows, n_bands)."""
         lo = self.k_lo
@@ -99,12 +111,11 @@ class Metric:
         key = ("beat", c, runs.tobytes())
         if key in state._cache:
             return state._cache[key]
-        whole = state._cache.get(("beat", c, self.runs.tobytes()))
-        if whole is not None and runs.size < self.runs.size:
-            pos = np.searchsorted(self.runs, runs)
-            if np.all(pos < self.runs.size) and np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
-                state._cache[key] = whole[pos]
-                return state._cache[key]
+        kept = self.rows_of_every_run(state, "beat", c, runs)
+        if kept is not None:
+            whole, pos = kept
+            state._cache[key] = whole[pos]
+            return state._cache[key]
         out = np.zeros((runs.size, self.n_bands))
         if state.smear is None and state.ripple is None and self.sp.window == "hann":
             comps = []
@@ -221,12 +232,11 @@ class Metric:
             if key in state._cache:
                 return state._cache[key]
             # not under a spin smear or a speed ripple: there the lines' spreading is set by the runs asked together
-            whole = state._cache.get(("channel_terms", c, self.runs.tobytes())) \
+            kept = self.rows_of_every_run(state, "channel_terms", c, runs) \
                 if state.smear is None and state.ripple is None else None
-            if whole is not None and runs.size < self.runs.size:
-                pos = np.searchsorted(self.runs, runs)
-                if np.all(pos < self.runs.size) and np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
-                    return tuple(x[pos] for x in whole)
+            if kept is not None:
+                whole, pos = kept
+                return tuple(x[pos] for x in whole)
         ok, D = self._data_bands(state, c, runs)
         N = self.floor_psd(state, c, runs)
         Mfull = self.predict(state, c, runs)

@@ -67,7 +67,7 @@ def _record_spectra(ctx: Context, c: str, rows) -> list:
     length in one call (scipy.fft: the numbers of numpy.fft's, run by run, in about half the time)."""
     from scipy import fft as sp_fft
 
-    from ...dft import run_window
+    from ...dft import demeaned_windowed, run_window
 
     out: list = [None] * len(rows)
     groups: dict = {}
@@ -75,10 +75,7 @@ def _record_spectra(ctx: Context, c: str, rows) -> list:
         groups.setdefault(ctx.test.runs[r].n_samples, []).append(a)
     for n, idx in groups.items():
         w, wsum, _ = run_window(ctx.sp.window, n)
-        xs = np.empty((len(idx), n))
-        for k, a in enumerate(idx):
-            x = np.asarray(ctx.test.runs[rows[a]].signals[c], dtype=float)
-            xs[k] = (x - x.mean()) * w
+        xs = demeaned_windowed([ctx.test.runs[rows[a]].signals[c] for a in idx], w)
         X = 2.0 * sp_fft.rfft(xs, axis=-1) / wsum
         for k, a in enumerate(idx):
             out[a] = X[k]

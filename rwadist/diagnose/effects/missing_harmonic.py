@@ -90,7 +90,7 @@ def _record_grid(ctx: Context, r: int) -> tuple:
     if key not in ctx._memo:
         from scipy import fft as sp_fft
 
-        from ...dft import run_window
+        from ...dft import demeaned_windowed, run_window
 
         run = ctx.test.runs[r]
         n = run.n_samples
@@ -101,10 +101,7 @@ def _record_grid(ctx: Context, r: int) -> tuple:
         X = np.full((n_keep, len(ctx.channels)), np.nan + 0j)
         have = [j for j, c in enumerate(ctx.channels) if c in run.signals]
         if have:
-            xs = np.empty((len(have), n))
-            for i, j in enumerate(have):
-                x = np.asarray(run.signals[ctx.channels[j]], dtype=float)
-                xs[i] = (x - x.mean()) * w
+            xs = demeaned_windowed([run.signals[ctx.channels[j]] for j in have], w)
             # every channel in one call (scipy.fft: the numbers of numpy.fft's, channel by channel, in half the time)
             X[:, have] = (2.0 * sp_fft.rfft(xs, pad * n, axis=-1)[:, :n_keep] / wsum).T
         ctx._memo[key] = (np.arange(n_keep) * df_rec * RECORD_GRID_BINS, X, df_rec, n)
