@@ -491,6 +491,8 @@ def cmd_diagnose(args) -> int:
         for e in missing:
             part = f" ({e['sense']}-rotating part)" if e.get("sense") in ("co", "counter") else ""
             print(f"  - {e['direction']} h = {e['h']:g}{part}, C = {e['C']:.3g}")
+    for u in diag.unexplained:
+        print(f"  ? {u.text()}")
     print(f"unexplained fraction of the data's power (speed x frequency): {diag.error_before:.4g} -> "
           f"{diag.error_after:.4g} (definition: report.md)")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")

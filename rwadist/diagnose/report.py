@@ -133,6 +133,26 @@ def _rms_figure(diag: Diagnosis, cols: dict):
     return fig
 
 
+def unexplained_section(diag: Diagnosis) -> list:
+    """report.md's lines on what the residual holds that no class explains (docs/diagnose.md, "Unexplained
+    residual"): one item per record, its signature, where, strength, share, causes and what would tell."""
+    if not diag.unexplained:
+        return ["Nothing: no structure the classes leave stands above the noise in the residual."]
+    out = ["Structure the residual holds above the noise that no effect class explains (described, not added to "
+           "the model; marked on the residual waterfall):", ""]
+    for i, u in enumerate(diag.unexplained, 1):
+        out.append(f"{i}. **{u.signature}** ({u.description}): {u.where()}; {u.level_dB:+.1f} dB over the model, "
+                   f"{100.0 * u.share:.0f} % of the misplaced power left, {u.n_runs} runs.")
+        par = ", ".join(f"{k} = {_fmt(v, '.5g')}" for k, v in u.parameters.items())
+        if par:
+            out.append(f"   Parameters: {par}.")
+        if u.causes:
+            out.append("   Could be: " + "; ".join(u.causes) + ".")
+        if u.would_tell:
+            out.append(f"   What would tell: {u.would_tell}.")
+    return out
+
+
 def write_report(diag: Diagnosis, out_dir) -> list:
     """summary.json, model.json (the improved model), rms_vs_speed.csv/.png, residual_waterfall.png,
     hypotheses.csv and report.md into ``out_dir``; returns the paths."""
@@ -203,6 +223,7 @@ def write_report(diag: Diagnosis, out_dir) -> list:
                   else " It lacks none of the data's lines."), ""]
         md += [f"- {d} h = {h:.4g}" + (f" ({sense}-rotating part)" if sense in ("co", "counter") else "")
                + f", C = {C:.4g}" for d, h, C, sense in missing]
+    md += ["", "## Unexplained residual", ""] + unexplained_section(diag)
     md += ["", "## Hypotheses (best five per iteration)", "", "see `hypotheses.csv`", "",
            "![residual](residual_waterfall.png)", "", "![rms](rms_vs_speed.png)", ""]
     p = out / "report.md"

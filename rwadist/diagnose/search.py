@@ -46,6 +46,8 @@ class Diagnosis:
     ctx: Context
     #: True when the search started from a model the caller gave (not the empirical fit of the data)
     model_given: bool = False
+    #: what the residual holds that no class explains (:class:`~rwadist.diagnose.unexplained.Unexplained` records)
+    unexplained: tuple = ()
 
     @property
     def effects(self) -> list:
@@ -79,6 +81,7 @@ class Diagnosis:
             "base_lines": [effect_entry(h) for h in self.hypotheses if h.passed and h.base_line],
             "lines_missing_from_given_model": [{"direction": d, "h": h, "C": C, "sense": sense}
                                                for d, h, C, sense in self.lines_missing_from_given_model()],
+            "unexplained": [u.to_json() for u in self.unexplained],
             "hypotheses": [effect_entry(h) for h in self.hypotheses],
         }
 

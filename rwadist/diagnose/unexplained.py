@@ -1,0 +1,148 @@
+"""What the residual holds that no effect class explains (issue 33, item 3): the typed record of one description.
+
+After the search, structured residual that stands above the noise and that no class explains is described, never
+dropped and never forced into a class: by its signature (:data:`SIGNATURES`), where it is (channels, speed range,
+frequency), its strength and its share of what is left, what it could physically be and which data would tell.
+:class:`Unexplained` is one such description; summary.json's ``unexplained`` list holds their JSON form
+(:meth:`Unexplained.to_json`, documented in docs/diagnose.md, "Unexplained residual"), which
+:meth:`Unexplained.from_json` reads back.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+#: Signature -> what it is, in words (the JSON form's ``description``).
+SIGNATURES = {
+    "fixed_line": "a line at one fixed frequency in every run",
+    "speed_line": "a line at a constant ratio of the speed that no model line has",
+    "line_property": "what the data's lines have in common that the model's lines do not",
+    "channel_copy": "a channel that carries a copy of another channel's content",
+    "moving_resonance": "a resonance whose frequency changes with speed in a way the gyroscopic whirl does not explain",
+    "broadband_hump": "a broadband hump above the noise floor",
+    "run_change": "a run-to-run change",
+}
+
+
+def _number(x) -> float | None:
+    """A finite float, or None (JSON's null) for None, NaN and infinities."""
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _plain(v):
+    """JSON types of a parameter value: numbers as float/int (non-finite as None), sequences as lists."""
+    if isinstance(v, bool) or v is None or isinstance(v, str):
+        return v
+    if isinstance(v, int):
+        return v
+    if isinstance(v, Mapping):
+        return {str(k): _plain(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_plain(x) for x in v]
+    try:
+        return _number(v)
+    except (TypeError, ValueError):
+        return str(v)
+
+
+@dataclass(frozen=True)
+class Unexplained:
+    """One description of structured residual no effect class explains.
+
+    signature : a key of :data:`SIGNATURES`.
+    channels : the channels where it stands above the noise (names of :data:`rwadist.units.CHANNELS`).
+    speed_rpm : (lowest, highest) wheel speed of the runs where it stands above the noise, rpm.
+    f_Hz : (lowest, highest) frequency where it is, Hz (a fixed line: its frequency twice).
+    level_dB : how far the data stand above (or below) the model where it is: the median over its cells of
+        10·log10(data / model), dB.
+    share : its share of what is left, 0..1: the misplaced power of its cells (the error metric's numerator
+        over them) over the misplaced power of every cell after the search.
+    n_runs : runs in which it stands above the noise.
+    h : the ratio to the speed of a ``speed_line`` (and of a ``line_property`` of a line), else None.
+    parameters : the signature's own numbers (docs/diagnose.md lists them per signature); read-only.
+    causes : what it could physically be, where a known cause fits (each a short sentence); may be empty.
+    would_tell : which data would tell the causes apart (or confirm the one named).
+    """
+
+    signature: str
+    channels: tuple
+    speed_rpm: tuple
+    f_Hz: tuple
+    level_dB: float
+    share: float
+    n_runs: int
+    h: float | None = None
+    parameters: Mapping = field(default_factory=dict)
+    causes: tuple = ()
+    would_tell: str = ""
+
+    def __post_init__(self):
+        if self.signature not in SIGNATURES:
+            raise ValueError(f"unexplained: signature must be one of {sorted(SIGNATURES)}, got {self.signature!r}")
+        object.__setattr__(self, "channels", tuple(str(c) for c in self.channels))
+        object.__setattr__(self, "speed_rpm", (float(self.speed_rpm[0]), float(self.speed_rpm[1])))
+        object.__setattr__(self, "f_Hz", (float(self.f_Hz[0]), float(self.f_Hz[1])))
+        object.__setattr__(self, "causes", tuple(str(c) for c in self.causes))
+        object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
+
+    def __hash__(self):          # parameters is a mapping: hashed by its items
+        return hash((self.signature, self.channels, self.speed_rpm, self.f_Hz, self.h,
+                     tuple(sorted((k, repr(v)) for k, v in self.parameters.items()))))
+
+    @property
+    def description(self) -> str:
+        """The signature in words (:data:`SIGNATURES`)."""
+        return SIGNATURES[self.signature]
+
+    def where(self) -> str:
+        """Where it is, in words: frequency (or ratio), channels, speeds."""
+        lo, hi = self.f_Hz
+        if self.h is not None:
+            f = f"h = {self.h:.4g} ({lo:.4g}-{hi:.4g} Hz)"
+        elif abs(hi - lo) <= 1e-6 * max(abs(hi), 1.0):
+            f = f"{lo:.4g} Hz"
+        else:
+            f = f"{lo:.4g}-{hi:.4g} Hz"
+        return f"{f} in {' '.join(self.channels) or 'no channel'}, {self.speed_rpm[0]:.0f}-{self.speed_rpm[1]:.0f} rpm"
+
+    def text(self) -> str:
+        """The console's one line: signature, where, strength, share, the first cause and what would tell."""
+        out = f"{self.signature}: {self.where()}, {self.level_dB:+.1f} dB over the model, " \
+              f"{100.0 * self.share:.0f} % of what is left"
+        if self.causes:
+            out += f"; could be {self.causes[0]}"
+        if self.would_tell:
+            out += f"; {self.would_tell}"
+        return out
+
+    def to_json(self) -> dict:
+        """The JSON form (summary.json's ``unexplained`` entries; docs/diagnose.md)."""
+        return {"signature": self.signature, "description": self.description, "channels": list(self.channels),
+                "speed_rpm": [_number(x) for x in self.speed_rpm], "f_Hz": [_number(x) for x in self.f_Hz],
+                "h": _number(self.h), "level_dB": _number(self.level_dB), "share": _number(self.share),
+                "n_runs": int(self.n_runs), "parameters": _plain(dict(self.parameters)),
+                "causes": list(self.causes), "would_tell": self.would_tell, "text": self.text()}
+
+    @classmethod
+    def from_json(cls, doc: Mapping) -> "Unexplained":
+        """The record of a JSON form (:meth:`to_json`); ``description`` and ``text`` are derived, not read.  A
+        ValueError naming the key on a missing or malformed one."""
+        try:
+            nan = float("nan")
+            return cls(signature=doc["signature"], channels=tuple(doc["channels"]),
+                       speed_rpm=tuple(nan if x is None else x for x in doc["speed_rpm"]),
+                       f_Hz=tuple(nan if x is None else x for x in doc["f_Hz"]),
+                       level_dB=nan if doc["level_dB"] is None else float(doc["level_dB"]),
+                       share=nan if doc["share"] is None else float(doc["share"]),
+                       n_runs=int(doc["n_runs"]), h=None if doc.get("h") is None else float(doc["h"]),
+                       parameters=dict(doc.get("parameters") or {}), causes=tuple(doc.get("causes") or ()),
+                       would_tell=str(doc.get("would_tell") or ""))
+        except KeyError as exc:
+            raise ValueError(f"unexplained record: {exc.args[0]!r} missing") from None
+        except (TypeError, IndexError) as exc:
+            raise ValueError(f"unexplained record: malformed ({exc})") from None

@@ -1,0 +1,42 @@
+"""The record of what no effect class explains (issue 33, item 3): its JSON form round-trips and is checked."""
+import json
+
+import pytest
+
+from rwadist.diagnose.unexplained import SIGNATURES, Unexplained
+
+
+def _record(**kw):
+    base = dict(signature="fixed_line", channels=("Fx", "Tz"), speed_rpm=(600, 6000), f_Hz=(50.0, 50.0),
+                level_dB=14.2, share=0.41, n_runs=30, parameters={"family_Hz": 50.0, "orders": [1, 3]},
+                causes=("electrical pickup (the 50 Hz mains family)",), would_tell="a run with the wheel still")
+    base.update(kw)
+    return Unexplained(**base)
+
+
+def test_json_form_round_trips_through_a_file_and_keeps_every_field():
+    u = _record()
+    doc = json.loads(json.dumps(u.to_json()))
+    assert doc["signature"] == "fixed_line" and doc["description"] == SIGNATURES["fixed_line"]
+    assert doc["speed_rpm"] == [600.0, 6000.0] and doc["h"] is None and doc["parameters"]["orders"] == [1, 3]
+    back = Unexplained.from_json(doc)
+    assert back == u and back.text() == doc["text"]
+    assert "50 Hz in Fx Tz, 600-6000 rpm" in u.text() and "41 % of what is left" in u.text()
+
+
+def test_record_is_read_only_and_rejects_unknown_signatures_and_bad_documents():
+    u = _record()
+    with pytest.raises(AttributeError):
+        u.share = 0.5
+    with pytest.raises(TypeError):
+        u.parameters["family_Hz"] = 60.0
+    with pytest.raises(ValueError, match="signature must be one of"):
+        _record(signature="mystery")
+    with pytest.raises(ValueError, match="'n_runs' missing"):
+        Unexplained.from_json({k: v for k, v in u.to_json().items() if k != "n_runs"})
+
+
+def test_non_finite_numbers_are_null_in_json():
+    doc = _record(level_dB=float("nan"), h=float("inf"), parameters={"x": float("nan")}).to_json()
+    assert doc["level_dB"] is None and doc["h"] is None and doc["parameters"]["x"] is None
+    json.dumps(doc, allow_nan=False)
