@@ -1,0 +1,188 @@
+"""Rolling-bearing kinematics: the ratios of a bearing's lines to the shaft speed, as candidate causes of lines.
+
+A ball bearing of n balls of diameter d on a pitch circle of diameter D, contact angle α, one race turning at the
+wheel's speed and the other still, rolling without slip (every ratio is a line's frequency over the speed, the ``h``
+of a harmonic; γ = (d/D)·cos α):
+
+- cage (fundamental train, FTF): ½(1 − γ) with the inner race turning, ½(1 + γ) with the outer race turning;
+- ball pass over the outer race (BPFO): (n/2)(1 − γ); over the inner race (BPFI): (n/2)(1 + γ) -- for either race
+  turning (the balls pass the turning race at n·|ω_race − ω_cage|, the still one at n·ω_cage);
+- ball spin (BSF, one ball's spin relative to the cage): (D/2d)(1 − γ²); a flaw on one ball meets both races each
+  turn, at 2·BSF.
+
+Derivation (no slip at either contact, cage frame): the contacts lie at radii (D ∓ d·cos α)/2 from the axis; the ball
+centre moves at the mean of the races' surface speeds.  ``tests/test_bearings.py`` checks these closed forms against
+the no-slip conditions solved as a linear system and against a bearing's published ratios.
+
+Without geometry, the ranges the ratios can take (:data:`RATIO_RANGES`) from d/D in [0.05, 0.30] (ball bearings)
+and α in [0°, 40°]: γ in [0.038, 0.30], the cage 0.35-0.48 of the speed (inner race turning) or 0.52-0.65 (outer race
+turning).  :func:`line_causes` names the candidates for a line's ratio: a given bearing's ratios (and their 2nd and
+3rd multiples) within the resolution, else the ranges, and relations among the lines (a ball pass n × the cage, an
+outer/inner ball-pass pair summing to n).
+
+Where the user gives the geometry (docs/diagnose.md, "Physical causes for lines"): the model file's ``wheel``
+section (``"bearings": [{"balls": 9, "ball_diameter_m": ..., "pitch_diameter_m": ..., "contact_angle_deg": 15,
+"name": "front", "rotating_race": "inner"}]``) or ``rwadist diagnose --bearing
+balls=9,ball_diameter_m=0.00794,pitch_diameter_m=0.03904[,contact_angle_deg=15][,name=front][,rotating_race=inner]``
+(repeatable; the flag's bearings replace the model file's).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+#: Ranges of γ = (d/D)·cos α without geometry: d/D in [0.05, 0.30], α in [0°, 40°].
+GAMMA_RANGE = (0.05 * math.cos(math.radians(40.0)), 0.30)
+#: Ball counts a bearing's ball-pass relations are searched over.
+BALL_COUNTS = (5, 40)
+#: The ratios' ranges without geometry (name -> (lo, hi, what)).
+RATIO_RANGES = {
+    "FTF": (0.5 * (1 - GAMMA_RANGE[1]), 0.5 * (1 - GAMMA_RANGE[0]),
+            "the cage of a ball bearing whose inner race turns with the wheel (FTF = ½(1 − (d/D)·cos α))"),
+    "FTF_outer": (0.5 * (1 + GAMMA_RANGE[0]), 0.5 * (1 + GAMMA_RANGE[1]),
+                  "the cage of a ball bearing whose outer race turns with the wheel (FTF = ½(1 + (d/D)·cos α))"),
+}
+#: Keys of a bearing's description (model file ``wheel.bearings[i]`` and ``--bearing``).
+KEYS = ("balls", "ball_diameter_m", "pitch_diameter_m", "contact_angle_deg", "name", "rotating_race")
+RATIO_NAMES = {"FTF": "cage (FTF)", "BPFO": "ball pass, outer race (BPFO)", "BPFI": "ball pass, inner race (BPFI)",
+               "BSF": "ball spin (BSF)", "2BSF": "ball flaw meeting both races (2·BSF)"}
+
+
+class BearingError(ValueError):
+    """A bearing description that is not one: ``source: field: problem``."""
+
+    def __init__(self, source: str, field: str, problem: str):
+        self.source, self.field, self.problem = str(source), field, problem
+        super().__init__(f"{source}: {field}: {problem}")
+
+
+@dataclass(frozen=True)
+class Bearing:
+    """One ball bearing of the wheel (lengths in m, the contact angle in degrees as catalogues give it).
+
+    balls : number of balls n (>= 3).  ball_diameter_m, pitch_diameter_m : d and D (0 < d < D).
+    contact_angle_deg : α (0 <= α < 90).  name : a label for the report.  rotating_race : 'inner' (the shaft
+    turns, the housing is still) or 'outer' (the housing turns about a still shaft)."""
+
+    balls: int
+    ball_diameter_m: float
+    pitch_diameter_m: float
+    contact_angle_deg: float = 0.0
+    name: str = ""
+    rotating_race: str = "inner"
+
+    @property
+    def gamma(self) -> float:
+        """γ = (d/D)·cos α."""
+        return self.ball_diameter_m / self.pitch_diameter_m * math.cos(math.radians(self.contact_angle_deg))
+
+    def ratios(self) -> dict:
+        """Line frequency over shaft speed of each bearing line: FTF, BPFO, BPFI, BSF and 2BSF (dimensionless)."""
+        g, n = self.gamma, self.balls
+        ftf = 0.5 * (1.0 - g) if self.rotating_race == "inner" else 0.5 * (1.0 + g)
+        bsf = self.pitch_diameter_m / (2.0 * self.ball_diameter_m) * (1.0 - g * g)
+        return {"FTF": ftf, "BPFO": 0.5 * n * (1.0 - g), "BPFI": 0.5 * n * (1.0 + g), "BSF": bsf, "2BSF": 2.0 * bsf}
+
+    def label(self) -> str:
+        return f"bearing {self.name!r}" if self.name else "the bearing"
+
+
+def parse_bearing(spec, source: str = "--bearing", field: str = "bearing") -> Bearing:
+    """A :class:`Bearing` from a mapping (model file) or ``key=value,...`` text (the CLI flag); a
+    :class:`BearingError` naming ``source``, the field and the value on anything missing, unknown or out of range."""
+    if isinstance(spec, str):
+        items = {}
+        for part in (p.strip() for p in spec.split(",") if p.strip()):
+            key, sep, value = part.partition("=")
+            if not sep:
+                raise BearingError(source, field, f"{part!r} is no key=value pair (keys: {', '.join(KEYS)})")
+            items[key.strip()] = value.strip()
+        spec = items
+    if not isinstance(spec, Mapping):
+        raise BearingError(source, field, f"must be an object of {', '.join(KEYS)}, got {spec!r}")
+    unknown = [k for k in spec if k not in KEYS]
+    if unknown:
+        raise BearingError(source, f"{field}.{unknown[0]}", f"unknown key (keys: {', '.join(KEYS)})")
+
+    def num(key, default=None):
+        v = spec.get(key, default)
+        if v is None:
+            raise BearingError(source, f"{field}.{key}", "missing")
+        try:
+            if isinstance(v, bool):
+                raise ValueError
+            x = float(v)
+        except (TypeError, ValueError):
+            raise BearingError(source, f"{field}.{key}", f"{v!r} is no number") from None
+        if not math.isfinite(x):
+            raise BearingError(source, f"{field}.{key}", f"{v!r} is no finite number")
+        return x
+
+    balls = num("balls")
+    if balls != int(balls) or balls < 3:
+        raise BearingError(source, f"{field}.balls", f"{spec['balls']!r}: must be a whole number >= 3")
+    d, D, a = num("ball_diameter_m"), num("pitch_diameter_m"), num("contact_angle_deg", 0.0)
+    if not 0 < d < D:
+        raise BearingError(source, f"{field}.ball_diameter_m", f"{d!r}: must be > 0 and below pitch_diameter_m ({D!r})")
+    if not 0 <= a < 90:
+        raise BearingError(source, f"{field}.contact_angle_deg", f"{a!r}: must be in [0, 90) degrees")
+    if balls * d > math.pi * D:
+        raise BearingError(source, f"{field}.balls", f"{int(balls)} balls of {d:g} m do not fit on a pitch circle "
+                           f"of {D:g} m (n·d must be below π·D)")
+    race = str(spec.get("rotating_race", "inner"))
+    if race not in ("inner", "outer"):
+        raise BearingError(source, f"{field}.rotating_race", f"{race!r}: must be 'inner' or 'outer'")
+    return Bearing(int(balls), d, D, a, str(spec.get("name", "")), race)
+
+
+def bearings_of(wheel: Mapping | None, source: str = "<model>") -> tuple:
+    """The bearings of a model's ``wheel`` section (``wheel["bearings"]``: a list of bearing objects), () without."""
+    items = (wheel or {}).get("bearings")
+    if items is None:
+        return ()
+    if not isinstance(items, (list, tuple)):
+        raise BearingError(source, "wheel.bearings", f"must be a list of bearing objects, got {items!r}")
+    return tuple(parse_bearing(b, source, f"wheel.bearings[{i}]") for i, b in enumerate(items))
+
+
+def line_causes(h: float, resolution: float, bearings=(), others=()) -> list:
+    """Candidate bearing causes (sentences) of a line at ratio ``h`` to the speed, resolved to ``resolution`` (in h).
+
+    With ``bearings``: each bearing ratio (and its 2nd and 3rd multiple) within the resolution of h.  Without (or
+    none within it): the ranges of :data:`RATIO_RANGES` that hold h.  ``others``: the ratios of the other lines
+    (the model's and the data's): h = n × a cage-range line (a ball pass over the still race), h = n × (1 − a
+    cage-range line) (over the turning race), or h + another non-integer line = n (an outer/inner ball-pass pair,
+    whose cage ratio is then the smaller over n), n in :data:`BALL_COUNTS`."""
+    out = []
+    for b in bearings:
+        for key, r in b.ratios().items():
+            for k in (1, 2, 3):
+                if abs(h - k * r) <= resolution:
+                    mult = "" if k == 1 else f"{k}× "
+                    out.append(f"{mult}{RATIO_NAMES[key]} of {b.label()} ({k * r:.4g}, {b.balls} balls)")
+    if out:
+        return out
+    for lo, hi, what in RATIO_RANGES.values():
+        if lo - resolution <= h <= hi + resolution:
+            out.append(f"{what}: h in {lo:.2f}-{hi:.2f} without the bearing's geometry")
+    n_lo, n_hi = BALL_COUNTS
+    if abs(h - round(h)) <= 2 * resolution:
+        return out                              # a harmonic of the speed: no ball-pass relation to name
+    cage = [RATIO_RANGES[k][:2] for k in ("FTF", "FTF_outer")]
+    for o in others:
+        if abs(o - h) <= resolution:
+            continue
+        if any(lo <= o <= hi for lo, hi in cage) and h > 1.5:
+            for name, base in (("over the still race", o), ("over the turning race", 1.0 - o)):
+                n = round(h / base)
+                if n_lo <= n <= n_hi and abs(h - n * base) <= resolution * (1 + n):
+                    out.append(f"ball pass {name} of a {n}-ball bearing whose cage is the line h = {o:.4g} "
+                               f"({n} × {base:.4g} = {n * base:.4g})")
+        s = h + o
+        n = round(s)
+        if n_lo <= n <= n_hi and abs(s - n) <= 2 * resolution and abs(o - round(o)) > 2 * resolution \
+                and RATIO_RANGES["FTF"][0] <= min(h, o) / n <= RATIO_RANGES["FTF"][1]:
+            out.append(f"an outer/inner ball-pass pair of a {n}-ball bearing with the line h = {o:.4g} "
+                       f"(BPFO + BPFI = n; cage {min(h, o) / n:.4g})")
+    return out

@@ -1,0 +1,99 @@
+"""Bearing kinematics (issue 33, item 6): the closed forms against first principles and a published bearing.
+
+First principles: rolling without slip at both contacts of one ball, written as vectors in the cage frame (race
+material velocity ω × p against the ball's w·e × (p − c), e the rolling axis perpendicular to the contact line) and
+solved as a linear system for the cage speed and the ball's spin -- no closed form used.  Published: the Case Western
+Reserve University bearing data centre's SKF 6205-2RS (9 balls, d 0.3126 in, D 1.537 in, α 0): inner ring 5.4152,
+outer ring 3.5848, cage 0.39828, rolling element 4.7135 (a ball flaw, 2·BSF) × the shaft speed (the cage as
+published is 3e-5 below ½(1 − d/D) = 0.39831 of its own dimensions: compared to 5e-5).
+"""
+import math
+
+import numpy as np
+import pytest
+
+from rwadist.bearings import RATIO_RANGES, Bearing, BearingError, bearings_of, line_causes, parse_bearing
+
+
+def _no_slip(d, D, alpha_deg, turning):
+    """(cage speed, ball spin relative to the cage, ball-pass rate over the outer race, over the inner race) per unit
+    speed of the turning race, from the no-slip conditions solved as a 2x2 system in the cage frame."""
+    a = math.radians(alpha_deg)
+    c = np.array([D / 2, 0.0, 0.0])
+    u = np.array([math.cos(a), 0.0, math.sin(a)])          # ball centre -> outer contact
+    e = np.array([-math.sin(a), 0.0, math.cos(a)])         # rolling axis, perpendicular to the contact line
+    z = np.array([0.0, 0.0, 1.0])
+    w_in, w_out = (1.0, 0.0) if turning == "inner" else (0.0, 1.0)
+    rows, rhs = [], []
+    for p, w_race in ((c + d / 2 * u, w_out), (c - d / 2 * u, w_in)):
+        # tangential (y) velocity: race (w_race − w_c) z × p  ==  ball w e × (p − c); unknowns (w_c, w)
+        rows.append([-np.cross(z, p)[1], -np.cross(e, p - c)[1]])
+        rhs.append(-w_race * np.cross(z, p)[1])
+    w_c, w = np.linalg.solve(np.array(rows), np.array(rhs))
+    return w_c, abs(w), abs(w_out - w_c), abs(w_in - w_c)
+
+
+@pytest.mark.parametrize("d,D,alpha,turning", [(0.00794, 0.03904, 0.0, "inner"), (0.0072, 0.046, 15.0, "inner"),
+                                               (0.011, 0.040, 40.0, "inner"), (0.0072, 0.046, 25.0, "outer")])
+def test_closed_forms_match_the_no_slip_conditions_solved_as_vectors(d, D, alpha, turning):
+    n = 11
+    b = Bearing(n, d, D, alpha, rotating_race=turning)
+    r = b.ratios()
+    w_c, spin, rel_out, rel_in = _no_slip(d, D, alpha, turning)
+    assert r["FTF"] == pytest.approx(w_c, rel=1e-12)
+    assert r["BSF"] == pytest.approx(spin, rel=1e-12) and r["2BSF"] == pytest.approx(2 * spin, rel=1e-12)
+    assert r["BPFO"] == pytest.approx(n * rel_out, rel=1e-12)
+    assert r["BPFI"] == pytest.approx(n * rel_in, rel=1e-12)
+
+
+def test_published_ratios_of_a_skf_6205():
+    r = Bearing(9, 0.3126 * 0.0254, 1.537 * 0.0254).ratios()
+    assert r["BPFI"] == pytest.approx(5.4152, abs=1e-4) and r["BPFO"] == pytest.approx(3.5848, abs=1e-4)
+    assert r["FTF"] == pytest.approx(0.39828, abs=5e-5) and r["2BSF"] == pytest.approx(4.7135, abs=1e-4)
+
+
+def test_ranges_without_geometry_span_the_cage_of_real_ball_bearings():
+    lo, hi, _ = RATIO_RANGES["FTF"]
+    assert lo == pytest.approx(0.35) and 0.47 < hi < 0.49
+    # every bearing with d/D in [0.05, 0.3] and alpha in [0, 40] degrees has its cage inside the range
+    for dD in (0.05, 0.15, 0.3):
+        for a in (0.0, 20.0, 40.0):
+            assert lo - 1e-12 <= Bearing(8, dD, 1.0, a).ratios()["FTF"] <= hi + 1e-12
+            assert RATIO_RANGES["FTF_outer"][0] - 1e-12 <= Bearing(8, dD, 1.0, a, rotating_race="outer").ratios()[
+                "FTF"] <= RATIO_RANGES["FTF_outer"][1] + 1e-12
+
+
+def test_line_causes_name_a_ratio_within_the_resolution_only():
+    b = Bearing(9, 0.00794, 0.03904, name="front")
+    named = line_causes(3.586, 0.005, [b])
+    assert len(named) == 1 and "BPFO" in named[0] and "'front'" in named[0]
+    assert any("2× cage" in x for x in line_causes(2 * 0.39828 + 0.001, 0.005, [b]))
+    assert line_causes(3.60, 0.005, [b]) == []                      # 0.4 % off: not named, no range holds it
+    # without geometry: the cage range, and the ball-pass relations among the lines
+    assert any("cage" in x for x in line_causes(0.41, 0.005))
+    rel = line_causes(3.69, 0.005, others=[0.41, 1.0])
+    assert any("9-ball" in x and "still race" in x for x in rel)
+    pair = line_causes(5.31, 0.005, others=[3.69])
+    assert any("9-ball" in x and "pair" in x for x in pair)
+    assert line_causes(3.0, 0.005, others=[0.41]) == []               # a harmonic of the speed: no relation
+
+
+def test_parser_reads_the_flag_and_the_model_file_and_names_what_is_wrong():
+    b = parse_bearing("balls=9, ball_diameter_m=0.00794,pitch_diameter_m=0.03904,contact_angle_deg=15,name=front")
+    assert b == Bearing(9, 0.00794, 0.03904, 15.0, "front")
+    assert bearings_of({"mass_kg": 4.2, "bearings": [{"balls": 9, "ball_diameter_m": 0.00794,
+                                                      "pitch_diameter_m": 0.03904}]})[0].balls == 9
+    assert bearings_of({"mass_kg": 4.2}) == ()
+    for bad, where in (("balls=9,ball_diameter_m=0.05,pitch_diameter_m=0.04", "ball_diameter_m"),
+                       ("balls=2.5,ball_diameter_m=0.005,pitch_diameter_m=0.04", "balls"),
+                       ("balls=40,ball_diameter_m=0.005,pitch_diameter_m=0.04", "balls"),
+                       ("balls=9,ball_diameter_m=0.005", "pitch_diameter_m"),
+                       ("balls=9,ball_diameter_m=x,pitch_diameter_m=0.04", "ball_diameter_m"),
+                       ("balls=9,ball_diam=0.005,pitch_diameter_m=0.04", "ball_diam"),
+                       ("balls=9,ball_diameter_m=0.005,pitch_diameter_m=0.04,contact_angle_deg=95", "contact_angle"),
+                       ("balls=9,ball_diameter_m=0.005,pitch_diameter_m=0.04,rotating_race=cage", "rotating_race"),
+                       ("balls 9", "bearing")):
+        with pytest.raises(BearingError, match=where):
+            parse_bearing(bad)
+    with pytest.raises(BearingError, match=r"model.json: wheel.bearings\[0\].balls: missing"):
+        bearings_of({"bearings": [{"ball_diameter_m": 0.005, "pitch_diameter_m": 0.04}]}, "model.json")
