@@ -91,8 +91,12 @@ class FmpyInstance:
         return self.fmu.getReal(self.outputs)
 
     def close(self):
+        """Terminate (where FMI allows it: an instance stepping) and free the instance."""
+        from fmpy.fmi1 import FMICallException
         try:
             self.fmu.terminate()
+        except FMICallException:    # not stepping (initialisation failed or never ended): nothing to terminate
+            pass
         finally:
             self.fmu.freeInstance()
 

@@ -36,7 +36,7 @@ from .build import NativeBuildError, model_document, model_physics, native_suppo
 HERE = Path(__file__).resolve().parent
 NATIVE = HERE / "native"
 C_SOURCE = "rwadist_wheel_fmu.c"
-SOURCES = (C_SOURCE, "rwadist_wheel_runtime.h", "rwadist_kernel.h", "rwadist_rng.h")
+SOURCES = (C_SOURCE, "rwadist_wheel_instance.h", "rwadist_wheel_runtime.h", "rwadist_kernel.h", "rwadist_rng.h")
 FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 PLATFORM = "linux64"
 

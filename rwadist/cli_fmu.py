@@ -109,8 +109,9 @@ def cmd_fmu_check(args) -> int:
     w_end = float(rpm_to_rad_s(args.speed_rpm))
     n = int(round(args.stop_time / args.step_size))
     t = np.linspace(0.0, n * args.step_size, n + 1)
-    sig = np.zeros(t.size, dtype=[("time", float), ("wheel_speed", float)])
-    sig["time"], sig["wheel_speed"] = t, w_end * t / t[-1]
+    # every input gets its signal (fmpy warns of a missing one): the speed ramp and its slope
+    sig = np.zeros(t.size, dtype=[("time", float), ("wheel_speed", float), ("wheel_acceleration", float)])
+    sig["time"], sig["wheel_speed"], sig["wheel_acceleration"] = t, w_end * t / t[-1], w_end / t[-1]
     errors = []
 
     def fmu_log(component, instance, status, category, message):

@@ -1,6 +1,8 @@
 /* rwadist wheel FMU in C: the model runtime (WheelRuntime of fmu/runtime.py): instance data, model set-up
  * from the compiled model (wheel_model.h) and the parameters, input checks, ripple, floors, one step.
- * Included once, by rwadist_wheel_fmu.c (the FMI 2.0 API and the FMU state). */
+ * Independent of the FMI version: statuses are RwStatus (the values of fmi2Status and fmi3Status) and messages
+ * go to the logger the wrapper installs.  Included once per FMU, through rwadist_wheel_instance.h, by
+ * rwadist_wheel_fmu.c (FMI 2.0) or rwadist_wheel_fmi3.c (FMI 3.0). */
 #ifndef RWADIST_WHEEL_RUNTIME_H
 #define RWADIST_WHEEL_RUNTIME_H
 #include <complex.h>
@@ -11,7 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi2Functions.h"
 #include "rwadist_kernel.h"
 #include "rwadist_rng.h"
 #include "wheel_model.h"
@@ -22,6 +23,11 @@
 #define FLOOR_DEFAULT_SEED 20251122u
 #define RIPPLE_STEPS_PER_PERIOD 20
 #define STATE_MAGIC 0x52574653u /* "RWFS" */
+
+/* the values of fmi2Status and fmi3Status (OK .. Fatal) */
+typedef enum { RW_OK = 0, RW_WARNING = 1, RW_DISCARD = 2, RW_ERROR = 3, RW_FATAL = 4 } RwStatus;
+/* the wrapper's logger: one plain message (no format), the instance's environment */
+typedef void (*RwLogger)(void *env, RwStatus status, const char *category, const char *message);
 
 enum { VR_SPEED = 0, VR_ACCEL = 1, VR_MODEL_FILE = 2, VR_USE_ACCEL = 3, VR_SEED = 4, VR_IMBALANCE = 5,
        VR_HARMONICS = 6, VR_MODES = 7, VR_START_STEADY = 8, VR_SPEED_RIPPLE = 9, VR_BROADBAND = 10,
@@ -38,7 +44,7 @@ typedef struct {
 typedef struct {
     double speed, accel;             /* inputs */
     double t_host;                   /* host time of the next step's start */
-    double t_start;                  /* host start time (fmi2SetupExperiment), t0 */
+    double t_start;                  /* host start time t0 (SetupExperiment / EnterInitializationMode) */
     double t;                        /* model time since t0 (as runtime.py's self.t) */
     double prev_start, prev_alpha, prev_end_w, prev_end_h;
     int has_prev;                    /* a step has been taken (prev_* valid) */
@@ -48,8 +54,8 @@ typedef struct {
 } Mutable;
 
 typedef struct {
-    fmi2CallbackFunctions cb;
-    char name[256];
+    RwLogger logger;                 /* the FMI wrapper's adapter to the host's logger (may be NULL) */
+    void *log_env;                   /* its argument */
     int mode;                        /* 0 instantiated, 1 initialisation, 2 stepping, 3 terminated, 4 failed */
     Params par;
     Mutable mu;
@@ -68,42 +74,32 @@ typedef struct {
     double *seg_ref, *seg_half_p;
     double floor_f_max;
     int floor_warned;
-    int logging_on;                  /* fmi2Instantiate's loggingOn / fmi2SetDebugLogging: fmi2OK messages */
+    int logging_on;                  /* loggingOn / SetDebugLogging: OK-status messages */
 } Wheel;
 
 /* ------------------------------------------------------------------ logging */
-static void logf_(Wheel *w, fmi2Status status, const char *category, const char *fmt, ...)
+static void logf_(Wheel *w, RwStatus status, const char *category, const char *fmt, ...)
 {
     char buf[1024];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
-    if (status == fmi2OK && !(w && w->logging_on))
+    if (status == RW_OK && !(w && w->logging_on))
         return;
-    /* the message is the format itself ('%' doubled): hosts whose logger cannot read varargs (ctypes
-     * callbacks, e.g. fmpy) still see it */
-    char msg[2048];
-    size_t j = 0;
-    for (size_t i = 0; buf[i] && j + 2 < sizeof msg; i++) {
-        if (buf[i] == '%')
-            msg[j++] = '%';
-        msg[j++] = buf[i];
-    }
-    msg[j] = 0;
-    if (w && w->cb.logger)
-        w->cb.logger(w->cb.componentEnvironment, w->name, status, category, msg);
+    if (w && w->logger)
+        w->logger(w->log_env, status, category, buf);
 }
 
-static fmi2Status fail(Wheel *w, const char *fmt, ...)
+static RwStatus fail(Wheel *w, const char *fmt, ...)
 {
     char buf[1024];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
-    logf_(w, fmi2Error, "logStatusError", "rwadist wheel: %s", buf);
-    return fmi2Error;
+    logf_(w, RW_ERROR, "logStatusError", "rwadist wheel: %s", buf);
+    return RW_ERROR;
 }
 
 /* ------------------------------------------------------------------ model set-up */
@@ -592,8 +588,8 @@ static void outputs_now(Wheel *w, double w_in, double alpha)
     frame12(o, w->par.dcm, w->par.pos, w->mu.y);
 }
 
-/* one communication step (runtime.step12); fmi2Error with the state untouched on bad input */
-static fmi2Status step(Wheel *w, double t_host, double h)
+/* one communication step (runtime.step12); RW_ERROR with the state untouched on bad input */
+static RwStatus step(Wheel *w, double t_host, double h)
 {
     Mutable *mu = &w->mu;
     const Params *p = &w->par;
@@ -666,7 +662,7 @@ static fmi2Status step(Wheel *w, double t_host, double h)
         frame12(o, p->dcm, p->pos, mu->y);
         if (!w->floor_warned && w->floor_f_max * 2 * h > 1) {
             w->floor_warned = 1;
-            logf_(w, fmi2Warning, "logStatusWarning", "rwadist wheel: the broadband floors reach %g Hz, above the "
+            logf_(w, RW_WARNING, "logStatusWarning", "rwadist wheel: the broadband floors reach %g Hz, above the "
                   "%g Hz a %g-s step samples; that content folds back", w->floor_f_max, 0.5 / h, h);
         }
     } else {
@@ -676,7 +672,7 @@ static fmi2Status step(Wheel *w, double t_host, double h)
         if (!isfinite(mu->y[k]))
             return fail(w, "step at t = %.9g s produced a non-finite output (%s)", t_host, k < 6 ? "wheel frame" :
                         "spacecraft frame");
-    return fmi2OK;
+    return RW_OK;
 }
 
 #endif
