@@ -1,21 +1,26 @@
-"""Build the rwadist wheel FMU in pure C (FMI 2.0 co-simulation, no Python on the host).
+"""Build the rwadist wheel FMU in pure C (FMI 2.0 or 3.0 co-simulation, no Python on the host).
 
 :func:`build_native_fmu` reads the model file with the FMU runtime's own readers
 (:func:`fmu.runtime.model_from_doc`, :func:`fmu.runtime.effects_from_doc`,
 :func:`fmu.runtime.expand_lines`), writes the parsed model as C data (``wheel_model.h``: every
 number as a C99 hexadecimal float literal, so the C model holds the very doubles Python holds),
-and compiles ``native/rwadist_wheel_fmu.c`` (FMI 2.0 API, FMU state) with
-``native/rwadist_wheel_runtime.h`` (model set-up from the parameters, input checks, ripple, floors), the step
+and compiles the FMI API -- ``native/rwadist_wheel_fmu.c`` (FMI 2.0) or ``native/rwadist_wheel_fmi3.c`` (FMI 3.0) --
+with the wrapper layer both share, ``native/rwadist_wheel_instance.h`` (the FMI state machine, variables by value
+reference, FMU state), ``native/rwadist_wheel_runtime.h`` (model set-up from the parameters, input checks, ripple,
+floors), the step
 kernel ``native/rwadist_kernel.h`` (shared with the pythonfmu FMU's native layer) and
 ``native/rwadist_rng.h`` (numpy's ``default_rng`` in C: the same seed gives the same line, ripple
-and floor phases as the Python FMU) into ``binaries/linux64/<id>.so``.  The FMU ships those
-sources and the FMI 2.0 headers in ``sources/`` (listed in ``<SourceFiles>``), so a host on
-another platform can compile it (e.g. ``fmpy.build.build_platform_binary`` on the unzipped FMU; needs a C99 compiler
-with ``complex.h``: gcc, clang).
+and floor phases as the Python FMU) into ``binaries/linux64/<id>.so`` and, with mingw-w64
+(``x86_64-w64-mingw32-gcc``, Debian's ``gcc-mingw-w64-x86-64``), ``binaries/win64/<id>.dll`` (FMI 3.0:
+``x86_64-linux``, ``x86_64-windows``); without mingw-w64 the FMU is Linux-only (a warning says how to get it).  The
+FMU ships those sources and the FMI headers in ``sources/`` (FMI 2.0: listed in ``<SourceFiles>``; FMI 3.0:
+``sources/buildDescription.xml``), so a host on another platform can compile it (e.g.
+``fmpy.build.build_platform_binary`` on the unzipped FMU; needs a C99 compiler with ``complex.h``: gcc, clang).
 
 Its variables, value references, parameters, units and start values are those of the pythonfmu
 FMU (``fmu/slave.py``; tests compare the two modelDescriptions), except that
-``model_file`` accepts only the empty string: the native FMU's model is compiled in.
+``model_file`` accepts only the empty string: the native FMU's model is compiled in.  The FMI 3.0 FMU has the same
+variables and value references (Real as Float64, Integer as Int32) and the independent variable ``time``.
 """
 from __future__ import annotations
 
@@ -25,6 +30,7 @@ import shutil
 import subprocess
 import tempfile
 import uuid
+import warnings
 import zipfile
 from datetime import datetime, timezone
 from pathlib import Path
@@ -35,10 +41,22 @@ from .build import NativeBuildError, model_document, model_physics, native_suppo
 
 HERE = Path(__file__).resolve().parent
 NATIVE = HERE / "native"
-C_SOURCE = "rwadist_wheel_fmu.c"
-SOURCES = (C_SOURCE, "rwadist_wheel_instance.h", "rwadist_wheel_runtime.h", "rwadist_kernel.h", "rwadist_rng.h")
+#: the FMI API source of each FMI version (C_SOURCE: FMI 2.0's, the one every native FMU ships)
+C_SOURCES = {2: "rwadist_wheel_fmu.c", 3: "rwadist_wheel_fmi3.c"}
+C_SOURCE = C_SOURCES[2]
+#: what every native FMU compiles besides its API source: wrapper layer, runtime, kernel, random numbers
+COMMON_SOURCES = ("rwadist_wheel_instance.h", "rwadist_wheel_runtime.h", "rwadist_kernel.h", "rwadist_rng.h")
+SOURCES = (C_SOURCE, *COMMON_SOURCES)
 FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
+FMI3_HEADERS = ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")
+FMI_HEADERS = {2: ("fmi2", FMI2_HEADERS), 3: ("fmi3", FMI3_HEADERS)}
 PLATFORM = "linux64"
+#: binaries/ folder of each FMI version and target
+PLATFORMS = {2: {"linux": "linux64", "windows": "win64"}, 3: {"linux": "x86_64-linux", "windows": "x86_64-windows"}}
+#: the mingw-w64 cross compiler (``$RWADIST_MINGW_CC`` overrides it) and how to get it
+MINGW = "x86_64-w64-mingw32-gcc"
+MINGW_HINT = ("install Debian's gcc-mingw-w64-x86-64 (apt-get install gcc-mingw-w64-x86-64) or point "
+              "RWADIST_MINGW_CC at another x86_64 mingw-w64 gcc")
 
 #: (name, value reference, type, causality, variability, start, unit, description): the pythonfmu FMU's
 #: variables (fmu/slave.py registers them in this order; value references count from 0)
@@ -166,17 +184,8 @@ def model_description(model_identifier: str, guid: str, physics: str, modes_defa
          'canNotUseMemoryManagementFunctions="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true" '
          'providesDirectionalDerivative="false">',
          f'    <SourceFiles>\n      <File name="{C_SOURCE}"/>\n    </SourceFiles>',
-         '  </CoSimulation>', '  <UnitDefinitions>']
-    for name, exps in UNITS.items():
-        base = " ".join(f'{k}="{v}"' for k, v in exps.items())
-        x.append(f'    <Unit name="{name}"><BaseUnit {base}/></Unit>' if base else
-                 f'    <Unit name="{name}"><BaseUnit/></Unit>')
-    x += ['  </UnitDefinitions>', '  <LogCategories>',
-          '    <Category name="logStatusWarning" description="Log messages with fmi2Warning status."/>',
-          '    <Category name="logStatusError" description="Log messages with fmi2Error status."/>',
-          '    <Category name="logAll" description="Log all messages."/>',
-          '  </LogCategories>',
-          '  <DefaultExperiment startTime="0.0" stopTime="1.0" stepSize="0.001"/>', '  <ModelVariables>']
+         '  </CoSimulation>']
+    x += _unit_definitions() + ['  <ModelVariables>']
     outputs = []
     for vr, (name, typ, caus, var, start, unit, desc) in enumerate(VARIABLES):
         if name == "modes":
@@ -193,37 +202,132 @@ def model_description(model_identifier: str, guid: str, physics: str, modes_defa
     return "\n".join(x) + "\n"
 
 
-def compile_sources(src_dir, output) -> Path:
-    """Compile the FMU's ``sources/`` (``src_dir``) into the shared library ``output`` with ``$CC``/``cc``;
-    NativeBuildError on failure.  Only the fmi2 functions are exported; libm is linked (no libpython).
+def windows_compiler() -> str | None:
+    """Path of the mingw-w64 cross compiler (``$RWADIST_MINGW_CC`` or x86_64-w64-mingw32-gcc), None when absent."""
+    return shutil.which(os.environ.get("RWADIST_MINGW_CC", MINGW))
+
+
+def compile_sources(src_dir, output, *, source: str = C_SOURCE, windows: bool = False) -> Path:
+    """Compile the FMU's ``sources/`` (``src_dir``; the API file ``source``) into the shared library ``output``:
+    with ``$CC``/``cc`` for Linux, or the mingw-w64 cross compiler for a Windows DLL (``windows``);
+    NativeBuildError on failure.  Only the fmi functions are exported; libm is linked (no libpython; the DLL imports
+    KERNEL32 and msvcrt only, libgcc linked in).
     ``-fcx-limited-range``: complex products without the NaN/infinity recovery branch (the kernel's values are
     finite; checked after every step) -- the same finite results, ~9 % fewer instructions per step;
     ``-ffp-contract=off``: no fused multiply-adds where the target has them, so a build on another platform
     (aarch64, ``-march=native``) gives the same bits as this one."""
-    cc = shutil.which(os.environ.get("CC", "cc"))
-    if cc is None:
-        raise NativeBuildError(f"no C compiler ({os.environ.get('CC', 'cc')!r} not on PATH)")
-    cmd = [cc, "-std=gnu11", "-O2", "-fcx-limited-range", "-ffp-contract=off", "-fPIC", "-shared",
-           "-fvisibility=hidden", f"-I{src_dir}", "-o", str(output), str(Path(src_dir) / C_SOURCE), "-lm"]
+    if windows:
+        cc = windows_compiler()
+        if cc is None:
+            raise NativeBuildError(f"no Windows cross compiler ({os.environ.get('RWADIST_MINGW_CC', MINGW)!r} not on "
+                                   f"PATH): {MINGW_HINT}")
+        target = ["-static-libgcc"]
+    else:
+        cc = shutil.which(os.environ.get("CC", "cc"))
+        if cc is None:
+            raise NativeBuildError(f"no C compiler ({os.environ.get('CC', 'cc')!r} not on PATH)")
+        target = ["-fPIC", "-fvisibility=hidden"]
+    cmd = [cc, "-std=gnu11", "-O2", "-fcx-limited-range", "-ffp-contract=off", "-shared", *target,
+           f"-I{src_dir}", "-o", str(output), str(Path(src_dir) / source), "-lm"]
     res = subprocess.run(cmd, capture_output=True, text=True)
     if res.returncode != 0:
         raise NativeBuildError(f"{' '.join(cmd)} failed:\n{res.stderr.strip()}")
     return Path(output)
 
 
-def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bool = False) -> Path:
+def binary_platforms(fmu_path) -> list:
+    """The binaries/ folders of the FMU at ``fmu_path`` that hold a library (e.g. ['linux64', 'win64'])."""
+    with zipfile.ZipFile(fmu_path) as z:
+        return sorted({n.split("/")[1] for n in z.namelist()
+                       if n.startswith("binaries/") and n.count("/") == 2 and n.endswith((".so", ".dll"))})
+
+
+FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "String": "String"}
+#: value reference of FMI 3.0's independent variable ``time`` (after the FMI 2.0 variables; VR_TIME in C)
+VR_TIME = len(VARIABLES)
+
+
+def _unit_definitions() -> list:
+    x = ['  <UnitDefinitions>']
+    for name, exps in UNITS.items():
+        base = " ".join(f'{k}="{v}"' for k, v in exps.items())
+        x.append(f'    <Unit name="{name}"><BaseUnit {base}/></Unit>' if base else
+                 f'    <Unit name="{name}"><BaseUnit/></Unit>')
+    return x + ['  </UnitDefinitions>', '  <LogCategories>',
+                '    <Category name="logStatusWarning" description="Log messages with Warning status."/>',
+                '    <Category name="logStatusError" description="Log messages with Error status."/>',
+                '    <Category name="logAll" description="Log all messages."/>', '  </LogCategories>',
+                '  <DefaultExperiment startTime="0.0" stopTime="1.0" stepSize="0.001"/>']
+
+
+def model_description3(model_identifier: str, guid: str, physics: str, modes_default: bool) -> str:
+    """modelDescription.xml of the FMI 3.0 native FMU: the FMI 2.0 FMU's variables and value references (Real as
+    Float64, Integer as Int32) and the independent variable ``time``."""
+    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    x = ['<?xml version="1.0" encoding="UTF-8"?>',
+         f'<fmiModelDescription fmiVersion="3.0" modelName="{model_identifier}" instantiationToken="{guid}" '
+         f'description={quoteattr("Reaction-wheel micro-vibration, time domain; outputs in wheel and spacecraft frames. Physics: " + physics)} '
+         'generationTool="rwadist native FMU builder (fmu/native_build.py)" '
+         f'generationDateAndTime="{now}" variableNamingConvention="structured">',
+         f'  <CoSimulation modelIdentifier="{model_identifier}" needsExecutionTool="false" '
+         'canBeInstantiatedOnlyOncePerProcess="false" canGetAndSetFMUState="true" canSerializeFMUState="true" '
+         'providesDirectionalDerivatives="false" providesAdjointDerivatives="false" '
+         'canHandleVariableCommunicationStepSize="true" maxOutputDerivativeOrder="0" hasEventMode="false" '
+         'providesIntermediateUpdate="false" canReturnEarlyAfterIntermediateUpdate="false"/>']
+    x += _unit_definitions() + ['  <ModelVariables>',
+                                f'    <Float64 name="time" valueReference="{VR_TIME}" causality="independent" '
+                                'variability="continuous" unit="s" description="simulation time"/>']
+    outputs = []
+    for vr, (name, typ, caus, var, start, unit, desc) in enumerate(VARIABLES):
+        if name == "modes":
+            start = "true" if modes_default else "false"
+        if caus == "output":
+            outputs.append(vr)
+        attrs = (f'name="{name}" valueReference="{vr}" description={quoteattr(desc)} causality="{caus}" '
+                 f'variability="{var}"' + (' initial="exact"' if caus == "output" else ""))
+        if typ == "String":
+            x.append(f'    <String {attrs}><Start value="{start}"/></String>')
+        else:
+            x.append(f'    <{FMI3_TYPES[typ]} {attrs} start="{start}"' + (f' unit="{unit}"' if unit else "") + '/>')
+    x += ['  </ModelVariables>', '  <ModelStructure>']
+    x += [f'    <Output valueReference="{vr}"/>' for vr in outputs]
+    x += ['  </ModelStructure>', '</fmiModelDescription>']
+    return "\n".join(x) + "\n"
+
+
+def build_description3(model_identifier: str) -> str:
+    """sources/buildDescription.xml of the FMI 3.0 native FMU (FMI 3.0 section 2.5.1)."""
+    return "\n".join([
+        '<?xml version="1.0" encoding="UTF-8"?>', '<fmiBuildDescription fmiVersion="3.0">',
+        f'  <BuildConfiguration modelIdentifier="{model_identifier}" description="C11 with complex.h (gcc, clang); '
+        'link libm">', '    <SourceFileSet language="C11">',
+        f'      <SourceFile name="{C_SOURCES[3]}"/>', '    </SourceFileSet>', '  </BuildConfiguration>',
+        '</fmiBuildDescription>']) + "\n"
+
+
+def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bool = False, fmi_version: int = 2,
+                     windows: bool | None = None) -> Path:
     """Write the pure-C FMU of ``model`` (path, dict or WheelModel) to ``output`` (.fmu); returns its path.
 
     ``tag`` (default random) makes the model identifier ``RwadistWheelC_<tag>``.  ``assumed_modes``: as
-    :func:`fmu.build.build_fmu` (the start value of ``modes`` for a wheel with assumed modes).  The binary is
-    built for Linux x86-64 (NativeBuildError elsewhere or without a C compiler); ``sources/`` lets other
-    platforms build their own."""
+    :func:`fmu.build.build_fmu` (the start value of ``modes`` for a wheel with assumed modes).  ``fmi_version``: 2
+    (FMI 2.0 co-simulation) or 3 (FMI 3.0).  The binary is built for Linux x86-64 (NativeBuildError elsewhere or
+    without a C compiler) and, ``windows`` True or None, cross-compiled for Windows x86-64 with mingw-w64: None adds it
+    where the cross compiler is found and warns (RuntimeWarning, saying how to get it) where it is not, True raises
+    NativeBuildError there, False builds Linux only.  ``sources/`` lets other platforms build their own."""
+    if fmi_version not in C_SOURCES:
+        raise ValueError(f"fmi_version must be 2 or 3, got {fmi_version!r}")
     doc = model_document(model)
     output = Path(output)
     if output.suffix != ".fmu":
         raise ValueError(f"output {str(output)!r} must end in .fmu")
     if not native_supported():
         raise NativeBuildError("the native FMU's binary is built on Linux x86-64 only (its sources/ build elsewhere)")
+    if windows is None:
+        windows = windows_compiler() is not None
+        if not windows:
+            warnings.warn(f"no Windows binary in the FMU ({os.environ.get('RWADIST_MINGW_CC', MINGW)} not found): "
+                          f"{MINGW_HINT}", RuntimeWarning, stacklevel=2)
     tag = tag or uuid.uuid4().hex[:12]
     if not ("x" + tag).isidentifier():
         raise ValueError(f"tag {tag!r} must be alphanumeric")
@@ -235,39 +339,53 @@ def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bo
         root = Path(tmp) / "fmu"
         src = root / "sources"
         src.mkdir(parents=True)
-        for name in SOURCES:
+        source = C_SOURCES[fmi_version]
+        for name in (source, *COMMON_SOURCES):
             shutil.copy2(NATIVE / name, src / name)
-        for name in FMI2_HEADERS:
-            shutil.copy2(NATIVE / "fmi2" / name, src / name)
+        folder, headers = FMI_HEADERS[fmi_version]
+        for name in headers:
+            shutil.copy2(NATIVE / folder / name, src / name)
         (src / "wheel_model.h").write_text(model_header(doc, guid, physics, modes_default))
-        (root / "modelDescription.xml").write_text(model_description(model_identifier, guid, physics,
-                                                                     modes_default))
-        bindir = root / "binaries" / PLATFORM
-        bindir.mkdir(parents=True)
-        compile_sources(src, bindir / f"{model_identifier}.so")
+        describe = model_description if fmi_version == 2 else model_description3
+        (root / "modelDescription.xml").write_text(describe(model_identifier, guid, physics, modes_default))
+        if fmi_version == 3:
+            (src / "buildDescription.xml").write_text(build_description3(model_identifier))
+        platforms = PLATFORMS[fmi_version]
+        for win in ((False, True) if windows else (False,)):
+            bindir = root / "binaries" / platforms["windows" if win else "linux"]
+            bindir.mkdir(parents=True)
+            compile_sources(src, bindir / f"{model_identifier}.{'dll' if win else 'so'}", source=source, windows=win)
         (root / "documentation").mkdir()
         (root / "documentation" / "index.txt").write_text(
-            f"rwadist wheel FMU (native C, FMI 2.0 co-simulation).\nPhysics: {physics}\n"
-            "Build on another platform: compile sources/rwadist_wheel_fmu.c (C11 with complex.h) into a shared\n"
+            f"rwadist wheel FMU (native C, FMI {fmi_version}.0 co-simulation).\nPhysics: {physics}\n"
+            f"Binaries: {', '.join(sorted(p.name for p in (root / 'binaries').iterdir()))}.\n"
+            f"Build on another platform: compile sources/{source} (C11 with complex.h) into a shared\n"
             f"library named {model_identifier} (e.g. fmpy.build.build_platform_binary on the unzipped FMU).\n")
         tmp_out = output.with_suffix(".fmu.tmp")
         with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
             for f in sorted(root.rglob("*")):
                 if f.is_file():
                     info = zipfile.ZipInfo(f.relative_to(root).as_posix(), date_time=(2026, 1, 1, 0, 0, 0))
-                    info.external_attr = (0o755 if f.suffix == ".so" else 0o644) << 16
+                    info.external_attr = (0o755 if f.suffix in (".so", ".dll") else 0o644) << 16
                     z.writestr(info, f.read_bytes(), compress_type=zipfile.ZIP_DEFLATED)
         os.replace(tmp_out, output)
     return output
 
 
-def compile_c_host(output) -> Path:
-    """Compile ``native/c_host.c`` (an FMI 2.0 host in C, no Python: dlopen, fmi2DoStep over a speed ramp)
-    into the executable ``output``; NativeBuildError on failure."""
-    cc = shutil.which(os.environ.get("CC", "cc"))
-    if cc is None:
-        raise NativeBuildError(f"no C compiler ({os.environ.get('CC', 'cc')!r} not on PATH)")
-    cmd = [cc, "-O2", f"-I{NATIVE}", "-o", str(output), str(NATIVE / "c_host.c"), "-ldl"]
+def compile_c_host(output, *, windows: bool = False) -> Path:
+    """Compile ``native/c_host.c`` (an FMI 2.0 host in C, no Python: dlopen or LoadLibrary, fmi2DoStep over a speed
+    ramp) into the executable ``output``: for Linux with ``$CC``/``cc``, or for Windows (``windows``: a static .exe
+    for Wine) with the mingw-w64 cross compiler; NativeBuildError on failure."""
+    if windows:
+        cc = windows_compiler()
+        if cc is None:
+            raise NativeBuildError(f"no Windows cross compiler: {MINGW_HINT}")
+        cmd = [cc, "-O2", f"-I{NATIVE}", "-o", str(output), str(NATIVE / "c_host.c"), "-static"]
+    else:
+        cc = shutil.which(os.environ.get("CC", "cc"))
+        if cc is None:
+            raise NativeBuildError(f"no C compiler ({os.environ.get('CC', 'cc')!r} not on PATH)")
+        cmd = [cc, "-O2", f"-I{NATIVE}", "-o", str(output), str(NATIVE / "c_host.c"), "-ldl"]
     res = subprocess.run(cmd, capture_output=True, text=True)
     if res.returncode != 0:
         raise NativeBuildError(f"{' '.join(cmd)} failed:\n{res.stderr.strip()}")

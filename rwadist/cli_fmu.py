@@ -16,6 +16,46 @@ from .units import rpm_to_rad_s
 from .validate import check_fmu_ramp, warn_unconstrained
 
 
+def _windows_note() -> str:
+    """'' where the native FMU gets its win64 binary, else the note saying how to get one."""
+    from rwadist.fmu.native_build import MINGW_HINT, windows_compiler
+    return "" if windows_compiler() else f"no Windows binary (mingw-w64 not found): {MINGW_HINT}"
+
+
+def _build_assembly(args, out: Path) -> int:
+    """rwadist fmu build --native --wheels wheels.json -o assembly.ssp"""
+    import warnings
+
+    from rwadist.fmu.ssp import build_assembly_ssp
+    if out.suffix != ".ssp":
+        raise DataError("-o", "value", f"{str(out)!r} must end in .ssp with --wheels (an SSP 1.0 file)")
+    if not getattr(args, "native", False):
+        raise DataError("--wheels", "value", "the assembly SSP holds native FMUs: add --native")
+    if args.fmi_version != 2:
+        raise DataError("--fmi-version", "value", "the assembly SSP holds FMI 2.0 FMUs (libcosim, the SSP host, runs "
+                        "FMI 2.0): leave --fmi-version at 2")
+    refuse_input_overwrite([("-o", out, "file")], [args.wheels, args.model])
+    default = args.model or (None if args.preset is None else _preset_source(args.preset))
+    with working("rwadist fmu build: compiling one native FMU per wheel model"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # the Windows note is printed below, once
+        notes: list = []
+        path = write_file(out, lambda tmp: notes.extend(build_assembly_ssp(
+            args.wheels, tmp, name=out.stem, default_model=default, assumed_modes=args.assumed_modes)[1]))
+    for note in notes:
+        print(f"rwadist: note: {note}")
+    if note := _windows_note():
+        print(f"rwadist: note: {note}")
+    print(f"wrote {path} (SSP 1.0 of the wheels in {args.wheels}: one native FMU component per wheel; each "
+          "component's Fx_sc .. Tz_sc are its loads at the spacecraft reference point, the assembly's are their sum)")
+    return 0
+
+
+def _preset_source(name: str):
+    from . import catalogue
+    from .presets import preset
+    return catalogue.preset_model(name) or preset(name).to_model()
+
+
 def cmd_fmu_build(args) -> int:
     try:
         from rwadist.fmu.build import build_fmu, has_native
@@ -23,21 +63,34 @@ def cmd_fmu_build(args) -> int:
     except ImportError as exc:
         raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
     out = check_output_file(args.output)
+    if getattr(args, "wheels", None):
+        try:
+            return _build_assembly(args, out)
+        except ModelError as exc:
+            if exc.field is not None:
+                raise
+            raise DataError(args.wheels, "model", str(exc)) from None
     if out.suffix != ".fmu":
         raise DataError("-o", "value", f"{str(out)!r} must end in .fmu")
+    fmi_version = getattr(args, "fmi_version", 2)
+    if fmi_version != 2 and not getattr(args, "native", False):
+        raise DataError("--fmi-version", "value", f"{fmi_version}: the pythonfmu FMU is FMI 2.0 only; add --native "
+                        "for the FMI 3.0 FMU")
     refuse_input_overwrite([("-o", out, "file")], [args.model])
     if args.model:
         source = args.model
         warn_unconstrained(model_io.load(args.model), args.model, "the FMU")
     else:
-        from . import catalogue
-        from .presets import preset
-        source = catalogue.preset_model(args.preset or "ithaco-e") or preset(args.preset or "ithaco-e").to_model()
+        source = _preset_source(args.preset or "ithaco-e")
     try:
         if getattr(args, "native", False):
-            from rwadist.fmu.native_build import build_native_fmu
-            with working("rwadist fmu build: compiling the native FMU"):
-                path = write_file(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes))
+            import warnings
+
+            from rwadist.fmu.native_build import binary_platforms, build_native_fmu
+            with working("rwadist fmu build: compiling the native FMU"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)     # the Windows note is printed below
+                path = write_file(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes,
+                                                                    fmi_version=fmi_version))
         else:
             with working("rwadist fmu build: packaging the FMU"):
                 path = write_file(out, lambda tmp: build_fmu(source, tmp, assumed_modes=args.assumed_modes))
@@ -47,7 +100,10 @@ def cmd_fmu_build(args) -> int:
         raise DataError(args.model or args.preset, "model", str(exc)) from None
     what = f"model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')}"
     if getattr(args, "native", False):
-        print(f"wrote {path} ({what}; native FMU: C only, no Python needed by the host)")
+        if note := _windows_note():
+            print(f"rwadist: note: {note}")
+        print(f"wrote {path} ({what}; native FMU, FMI {fmi_version}.0: C only, no Python needed by the host; "
+              f"binaries: {', '.join(binary_platforms(path))})")
     else:
         print(f"wrote {path} ({what}; native layer: "
               f"{'yes' if has_native(path) else 'no, numpy steps and fmi2Discard on bad input'})")
@@ -99,8 +155,8 @@ def cmd_fmu_check(args) -> int:
         import zipfile
 
         from rwadist.fmu.build import has_native
-        from rwadist.fmu.native_build import C_SOURCE
-        if any(n.endswith(C_SOURCE) for n in zipfile.ZipFile(args.fmu).namelist()):
+        from rwadist.fmu.native_build import C_SOURCES
+        if any(n.endswith(tuple(C_SOURCES.values())) for n in zipfile.ZipFile(args.fmu).namelist()):
             print("native FMU: C only, no Python needed by the host")
         else:
             print(f"native layer (fmi2Error on bad input, C step kernel): {'yes' if has_native(args.fmu) else 'no'}")
@@ -114,7 +170,8 @@ def cmd_fmu_check(args) -> int:
     sig["time"], sig["wheel_speed"], sig["wheel_acceleration"] = t, w_end * t / t[-1], w_end / t[-1]
     errors = []
 
-    def fmu_log(component, instance, status, category, message):
+    def fmu_log(*args):     # FMI 2.0: (component, instance, status, category, message); FMI 3.0: (env, status, ...)
+        status, message = args[-3], args[-1]
         if status >= 3:       # fmi2Error and worse: the FMU says why it refused
             errors.append(message.decode(errors="replace") if isinstance(message, bytes) else str(message))
 

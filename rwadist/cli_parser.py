@@ -179,7 +179,8 @@ def build_parser(cli) -> argparse.ArgumentParser:
                     help="speed of sweep slices: tach column, estimated from data, or auto")
     dg.set_defaults(func=cli.cmd_diagnose)
 
-    fm = sub.add_parser("fmu", help="FMI 2.0 co-simulation FMU of the extended model (build, check)")
+    fm = sub.add_parser("fmu", help="FMI 2.0/3.0 co-simulation FMU of the extended model, SSP of an assembly "
+                        "(build, check)")
     fsub = fm.add_subparsers(dest="fmu_command", required=True)
     fb = fsub.add_parser("build", help="build the FMU from a model file or a preset (default: ithaco-e)")
     fsrc = fb.add_mutually_exclusive_group()
@@ -191,6 +192,11 @@ def build_parser(cli) -> argparse.ArgumentParser:
     fb.add_argument("--assumed-modes", action="store_true",
                     help="a wheel with assumed (datasheet) suspension modes runs them by default (modes = true); "
                          "without it such a wheel is hard-mounted by default")
+    fb.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+                    help="FMI version of the --native FMU: 2 (default) or 3 (FMI 3.0 co-simulation)")
+    fb.add_argument("--wheels", metavar="WHEELS_JSON",
+                    help="with --native: an SSP 1.0 file of the assembly in this wheels.json (the file of rwadist psd "
+                         "--wheels), one wheel FMU per wheel with its mounting and speed law; -o must end in .ssp")
     fb.set_defaults(func=cli.cmd_fmu_build)
     fc = fsub.add_parser("check", help="fmpy validation and a short spin-up simulation of an FMU")
     fc.add_argument("fmu")

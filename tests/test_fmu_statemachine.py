@@ -1,6 +1,6 @@
-"""The FMI 2.0 state machine of both wheel FMUs (issue 35): random call orders against an independent model of
-the co-simulation state machine (FMI 2.0.4 section 4.2.4, written here from the standard's table, not from the
-FMUs' code).
+"""The FMI state machine of the wheel FMUs (issue 35): native C FMI 2.0 and FMI 3.0, pythonfmu with its native
+layer.  Random call orders against an independent model of the co-simulation state machine (FMI 2.0.4 section
+4.2.4; FMI 3.0 section 4.2 without event mode), written here from the standards' tables, not from the FMUs' code.
 
 Each order instantiates one FMU and makes 6-30 calls: mostly calls the standard allows in the model's state (so
 the orders reach initialisation, stepping, termination, reset, a failed initialisation and FMU state restores),
@@ -13,7 +13,9 @@ setupExperiment after instantiation [and a stop time before the start], enter/ex
 turn, terminate before initialisation or twice, doStep outside stepping, get before initialisation, set after
 termination, a fixed parameter set after initialisation, an unknown value reference or an output set, cancelStep
 (steps are synchronous), getRealStatus before stepping, [setFMUstate into a terminated instance].
-The pythonfmu FMU refuses every FMU-state call (its capability flags are false).
+FMI 3.0 adds: a stop time before the start in EnterInitializationMode, EnterEventMode and EnterStepMode (no event
+mode: ExitInitializationMode leads to Step Mode).  The pythonfmu FMU refuses every FMU-state call (its capability
+flags are false).
 """
 from __future__ import annotations
 
@@ -30,6 +32,9 @@ READABLE = {INIT, STEP, TERM, FAILED}
 SETTABLE = {INST, INIT, STEP}
 OPS = ("setup", "setup_stop_before_start", "enter", "exit", "bad_exit", "step", "terminate", "reset", "get_outputs",
        "set_speed", "set_seed", "get_state", "set_state", "cancel", "real_status", "get_unknown", "set_output")
+#: FMI 3.0: the start time comes with EnterInitializationMode; no event mode (hasEventMode false), no Step Mode entry
+OPS3 = ("enter", "enter_stop_before_start", "exit", "bad_exit", "step", "terminate", "reset", "get_outputs",
+        "set_speed", "set_seed", "get_state", "set_state", "event_mode", "step_mode", "get_unknown", "set_output")
 H = 1e-3
 
 
@@ -44,9 +49,9 @@ class Model:
         return {"setup": s == INST, "setup_stop_before_start": False, "enter": s == INST, "exit": s == INIT,
                 "bad_exit": s == INIT, "step": s == STEP, "terminate": s == STEP, "reset": True,
                 "get_outputs": s in READABLE, "set_speed": s in SETTABLE, "set_seed": s in (INST, INIT),
-                "get_state": self.kind == "native", "set_state": self.kind == "native" and s != TERM and
+                "get_state": self.kind != "python", "set_state": self.kind != "python" and s != TERM and
                 bool(self.saved), "cancel": False, "real_status": s in (STEP, TERM), "get_unknown": False,
-                "set_output": False}[op]
+                "set_output": False, "enter_stop_before_start": False, "event_mode": False, "step_mode": False}[op]
 
     def after(self, op: str) -> None:
         """The state after a legal ``op`` answered as the standard says."""
@@ -64,18 +69,79 @@ class Model:
             self.state, self.t = INST, 0.0
 
 
+class Log3:
+    """The messages of an FMI 3.0 instance (fmpy's logMessage callback)."""
+
+    def __init__(self):
+        self.records = []
+
+    def callback(self, env, status, category, message):
+        self.records.append((int(status), message.decode() if message else ""))
+
+    def messages(self, min_status=0):
+        return [m for s, m in self.records if s >= min_status]
+
+
+def act3(f, op, model, outputs, states, rng):
+    """One call of ``op`` on the FMI 3.0 instance ``f`` (fmpy FMU3Slave)."""
+    if op in ("enter", "enter_stop_before_start"):
+        f.enterInitializationMode(startTime=0.0, stopTime=-1.0 if op == "enter_stop_before_start" else None)
+    elif op in ("exit", "bad_exit"):
+        if op == "bad_exit" and model.state == INIT:
+            f.setInt32([4], [-5])
+        f.exitInitializationMode()
+    elif op == "step":
+        f.doStep(model.t, H)
+    elif op == "terminate":
+        f.terminate()
+    elif op == "reset":
+        f.reset()
+    elif op == "get_outputs":
+        f.getFloat64(outputs)
+    elif op == "set_speed":
+        f.setFloat64([0], [50.0])
+    elif op == "set_seed":
+        f.setInt32([4], [3])
+    elif op == "get_state":
+        states[len(states)] = (f.getFMUState(), model.state, model.t)
+        model.saved = list(states)
+    elif op == "set_state":
+        key = rng.choice(model.saved) if model.saved else None
+        s, st, t = states[key] if key is not None else (None, None, None)
+        f.setFMUState(s)
+        if model.legal("set_state"):
+            model.state, model.t = st, t
+    elif op == "event_mode":
+        f.enterEventMode()
+    elif op == "step_mode":
+        f.enterStepMode()
+    elif op == "get_unknown":
+        f.getFloat64([9999])
+    elif op == "set_output":
+        f.setFloat64([26], [1.0])
+
+
 def run_order(path: str, kind: str, seed: int) -> dict:
     """One random call order on a fresh instance; counts of legal/illegal calls and how they were answered."""
     from fmpy import read_model_description
     from fmpy.fmi1 import FMICallException
     from fmpy.fmi2 import FMU2Slave, fmi2LastSuccessfulTime
+    from fmpy.fmi3 import FMU3Slave
     from rwadist.fmu import hosts
     rng = random.Random(seed)
-    log = hosts.HostLog()
     md = read_model_description(path)
-    f = FMU2Slave(guid=md.guid, unzipDirectory=_unzipped(path), modelIdentifier=md.coSimulation.modelIdentifier,
-                  instanceName=f"order{seed}")
-    f.instantiate(callbacks=log.callbacks(), loggingOn=True)   # pythonfmu passes its messages on only so
+    fmi3 = md.fmiVersion == "3.0"
+    ops = OPS3 if fmi3 else OPS
+    kw = dict(guid=md.guid, unzipDirectory=_unzipped(path), modelIdentifier=md.coSimulation.modelIdentifier,
+              instanceName=f"order{seed}")
+    if fmi3:
+        log = Log3()
+        f = FMU3Slave(**kw)
+        f.instantiate(loggingOn=True, logMessage=log.callback)
+    else:
+        log = hosts.HostLog()
+        f = FMU2Slave(**kw)
+        f.instantiate(callbacks=log.callbacks(), loggingOn=True)   # pythonfmu passes its messages on only so
     outputs = [v.valueReference for v in md.modelVariables if v.causality == "output"]
     model = Model(kind)
     out = {"calls": 0, "illegal": 0, "illegal_ok": [], "illegal_unlogged": [], "legal_not_ok": [], "ops": []}
@@ -83,6 +149,8 @@ def run_order(path: str, kind: str, seed: int) -> dict:
 
     def act(op):
         c = f.component
+        if fmi3:
+            return act3(f, op, model, outputs, states, rng)
         if op == "setup":
             f.setupExperiment(startTime=0.0)
         elif op == "setup_stop_before_start":
@@ -128,8 +196,8 @@ def run_order(path: str, kind: str, seed: int) -> dict:
 
     try:
         for _ in range(rng.randint(6, 30)):
-            legal_ops = [op for op in OPS if model.legal(op)]
-            op = rng.choice(legal_ops) if rng.random() < 0.6 and legal_ops else rng.choice(OPS)
+            legal_ops = [op for op in ops if model.legal(op)]
+            op = rng.choice(legal_ops) if rng.random() < 0.6 and legal_ops else rng.choice(ops)
             legal = model.legal(op)
             n_err = len(log.messages(3))
             before = (model.state, model.t)
@@ -156,7 +224,7 @@ def run_order(path: str, kind: str, seed: int) -> dict:
     finally:
         for s, _, _ in states.values():
             try:
-                f.freeFMUstate(s)
+                (f.freeFMUState if fmi3 else f.freeFMUstate)(s)
             except FMICallException:
                 pass
         f.freeInstance()
@@ -219,14 +287,15 @@ pytestmark = pytest.mark.skipif(not shutil.which(os.environ.get("CC", "cc")),
 
 
 def test_random_call_orders_follow_the_fmi_state_machine(tmp_path):
-    """100 random call orders per FMU (native C and pythonfmu with its native layer): 0 calls out of order answered
-    fmi2OK, each refusal logged, 0 calls in order refused, 0 crashes; the orders reach every state."""
+    """100 random call orders per FMU (native C FMI 2.0 and FMI 3.0, pythonfmu with its native layer): 0 calls out of
+    order answered OK, each refusal logged, 0 calls in order refused, 0 crashes; the orders reach every state."""
     from rwadist.fmu.build import build_fmu
     from rwadist.fmu.native_build import build_native_fmu
 
     from rwadist.presets import preset
     model = preset("ithaco-e").to_model()
-    fmus = {"native": str(build_native_fmu(model, tmp_path / "sm_c.fmu")),
+    fmus = {"native": str(build_native_fmu(model, tmp_path / "sm_c.fmu", windows=False)),
+            "native3": str(build_native_fmu(model, tmp_path / "sm_c3.fmu", fmi_version=3, windows=False)),
             "python": str(build_fmu(model, tmp_path / "sm_py.fmu"))}
     res = run_orders(fmus, 100, tmp_path)
     assert not res["crashes"], res["crashes"]
