@@ -37,7 +37,7 @@ def _build_assembly(args, out: Path) -> int:
     refuse_input_overwrite([("-o", out, "file")], [args.wheels, args.model])
     default = args.model or (None if args.preset is None else _preset_source(args.preset))
     with working("rwadist fmu build: compiling one native FMU per wheel model"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)     # the Windows note is printed below, once
+        warnings.filterwarnings("ignore", "no Windows binary", RuntimeWarning)    # noted below, once
         notes: list = []
         path = write_file(out, lambda tmp: notes.extend(build_assembly_ssp(
             args.wheels, tmp, name=out.stem, default_model=default, assumed_modes=args.assumed_modes)[1]))
@@ -88,7 +88,7 @@ def cmd_fmu_build(args) -> int:
 
             from rwadist.fmu.native_build import binary_platforms, build_native_fmu
             with working("rwadist fmu build: compiling the native FMU"), warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)     # the Windows note is printed below
+                warnings.filterwarnings("ignore", "no Windows binary", RuntimeWarning)    # noted below
                 path = write_file(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes,
                                                                     fmi_version=fmi_version))
         else:

@@ -119,3 +119,13 @@ def test_folder_names_and_linux_only_fallback(tmp_path, monkeypatch):
         fmu = build_native_fmu(model, tmp_path / "linux_only.fmu")
     names = zipfile.ZipFile(fmu).namelist()
     assert any(n.startswith("binaries/linux64/") for n in names) and not any("win64" in n for n in names)
+
+
+def test_cli_says_how_to_get_the_windows_binary(tmp_path, monkeypatch, capsys):
+    """Without mingw-w64, `rwadist fmu build --native` writes the Linux-only FMU and a note naming the Debian package;
+    the line it prints lists the binaries the FMU carries."""
+    from rwadist.cli import main
+    monkeypatch.setenv("RWADIST_MINGW_CC", "no-such-mingw-gcc")
+    assert main(["fmu", "build", "--native", "--preset", "ithaco-e", "-o", str(tmp_path / "w.fmu")]) == 0
+    out = capsys.readouterr().out
+    assert "note: no Windows binary" in out and "gcc-mingw-w64-x86-64" in out and "binaries: linux64)" in out
