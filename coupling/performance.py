@@ -44,6 +44,7 @@ import numpy as np
 
 from rwadist import extended as ext
 from rwadist import schema
+from rwadist.effects.broadband_floor import BroadbandFloor
 from rwadist.schema import ModelError
 from rwadist.units import CHANNELS, RAD_S_TO_RPM
 
@@ -111,7 +112,7 @@ def floors_from_effects(effects, source: str = "<model>") -> tuple:
     the schema (:func:`rwadist.schema.parse_effects`): :class:`CouplingModelError` naming
     ``effects[i].<field>`` on a bad entry."""
     out = []
-    for e in schema.of_kind(effects, schema.BroadbandFloor, source, CouplingModelError):
+    for e in schema.of_kind(effects, BroadbandFloor, source, CouplingModelError):
         for c in e.channel_indices:
             out.append(Floor(c, e.f_Hz, e.psd_ref, float(e.omega_ref_rad_s), float(e.exponent)))
     return tuple(out)

@@ -3,7 +3,8 @@
 :func:`build_fmu` renders ``slave_template.py`` under a module and class name unique to the
 build (two FMUs whose slave modules share a name cannot load in one process), and ships the slave it loads,
 ``slave.py`` (as ``rwadist_fmu_slave.py``), ``runtime.py`` (as ``rwadist_fmu_runtime.py``) with its sibling modules, ``rwadist/schema.py`` (as
-``rwadist_model_schema.py``, the runtime's reader of the model file; :func:`runtime_files`) and the model file
+``rwadist_model_schema.py``, the runtime's reader of the model file, with the effect elements of
+:mod:`rwadist.effects` in ``rwadist_model_effects/``; :func:`runtime_files`) and the model file
 (``wheel_model.json``) in the FMU's resources.  pythonfmu embeds itself there too, so a host needs Python + numpy only.
 
 Native layer (Linux x86-64, when a C compiler is found): ``native/rwadist_fmu_native.c`` is
@@ -219,8 +220,8 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
                                        project_files=project_files + [extra / "wheel_model.json"])
         finally:
             sys.path[:] = path_before
-            rt_name = f"{module}_slave_runtime"
-            for name in (module, f"{module}_slave", rt_name, *(f"{rt_name}_{stem}" for stem in _runtime().SIBLINGS)):
+            # the slave module and everything it loaded under names made from it (runtime, siblings, model reader)
+            for name in [n for n in sys.modules if n == module or n.startswith(f"{module}_slave")]:
                 sys.modules.pop(name, None)
         if native is not False and native_supported():
             try:
@@ -235,8 +236,9 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
 
 def runtime_files(folder) -> list:
     """Copy the FMU runtime into ``folder`` under its resource names: ``runtime.py`` as
-    ``rwadist_fmu_runtime.py``, each sibling module (``runtime.SIBLINGS``) as ``runtime.fmu_file_name``, and
-    ``rwadist/schema.py`` as ``runtime.SCHEMA_FILE``; returns the copies' paths (the FMU's project files)."""
+    ``rwadist_fmu_runtime.py``, each sibling module (``runtime.SIBLINGS``) as ``runtime.fmu_file_name``,
+    ``rwadist/schema.py`` as ``runtime.SCHEMA_FILE`` and the effect elements (:func:`rwadist.effects.shipped_files`)
+    into the folder ``runtime.EFFECTS_DIR``; returns the copies' paths (the FMU's project files)."""
     rt = _runtime()
     folder = Path(folder)
     out = [folder / "rwadist_fmu_runtime.py"]
@@ -246,6 +248,13 @@ def runtime_files(folder) -> list:
         shutil.copy2(HERE / f"{stem}.py", out[-1])
     out.append(folder / rt.SCHEMA_FILE)
     shutil.copyfile(_schema_source(), out[-1])
+    # the effect elements, read by the schema copy (the runtime loads them as its package; rwadist.effects)
+    from rwadist import effects
+
+    out.append(folder / rt.EFFECTS_DIR)
+    out[-1].mkdir()
+    for f in effects.shipped_files():
+        shutil.copyfile(f, out[-1] / f.name)
     return out
 
 

@@ -75,6 +75,7 @@ _math = _load_sibling("runtime_math")
 _schema = _model._schema
 # the split-off modules' public names, importable from here as before the split
 SCHEMA_FILE = _model.SCHEMA_FILE
+EFFECTS_DIR = _model.EFFECTS_DIR
 SCHEMA = _model.SCHEMA
 SCHEMA_VERSION = _model.SCHEMA_VERSION
 ANALYTICAL_KIND = _model.ANALYTICAL_KIND

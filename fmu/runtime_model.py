@@ -16,26 +16,50 @@ import json
 import math
 import os
 import sys
+import types
 
 import numpy as np
 
 #: the schema's file name in the FMU's resources (``fmu/build.py`` copies rwadist/schema.py there)
 SCHEMA_FILE = "rwadist_model_schema.py"
+#: the folder of the effect elements in the FMU's resources (``fmu/build.py`` copies rwadist/effects/ there:
+#: :func:`rwadist.effects.shipped_files`)
+EFFECTS_DIR = "rwadist_model_effects"
+
+
+def _exec_module(name, path, package_dir=None):
+    """Module ``name`` executed from the file ``path`` (a package's ``__init__.py`` with ``package_dir``)."""
+    spec = importlib.util.spec_from_file_location(
+        name, path, submodule_search_locations=None if package_dir is None else [package_dir])
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod              # dataclasses look their module up while the class is made
+    try:
+        spec.loader.exec_module(mod)
+    except BaseException:
+        sys.modules.pop(name, None)
+        raise
+    return mod
 
 
 def _load_schema():
-    """The model-file schema: the copy next to this file (inside an FMU), else :mod:`rwadist.schema`."""
-    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), SCHEMA_FILE)
+    """The model-file schema with every effect element registered: the copies next to this file (inside an FMU),
+    else :mod:`rwadist.schema` and :mod:`rwadist.effects`.
+
+    In an FMU both are loaded as the modules ``schema`` and ``effects`` of a package named after this module (two
+    FMUs load side by side), so the elements' ``from ..schema import ...`` reads this schema copy."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    path = os.path.join(here, SCHEMA_FILE)
     if not os.path.isfile(path):
-        from rwadist import schema
+        from rwadist import effects, schema  # noqa: F401  (effects: imports every element)
         return schema
-    name = f"{__name__}_schema"          # unique per FMU: two FMUs may load side by side
-    mod = sys.modules.get(name)
+    pkg = f"{__name__}_reader"          # unique per FMU
+    mod = sys.modules.get(f"{pkg}.schema")
     if mod is None:
-        spec = importlib.util.spec_from_file_location(name, path)
-        mod = importlib.util.module_from_spec(spec)
-        sys.modules[name] = mod          # dataclasses look their module up while the class is made
-        spec.loader.exec_module(mod)
+        parent = sys.modules.setdefault(pkg, types.ModuleType(pkg))
+        parent.__path__ = []             # a package: its two modules are loaded from their files below
+        mod = _exec_module(f"{pkg}.schema", path)
+        folder = os.path.join(here, EFFECTS_DIR)
+        _exec_module(f"{pkg}.effects", os.path.join(folder, "__init__.py"), folder)
     return mod
 
 
@@ -78,8 +102,8 @@ def laws_from_doc(doc, source="<model>"):
     the line's amplitude A_ref·(|Ω|/Ω_ref)^p (N or N·m, rad/s) in place of C·Ω².  Other effect
     kinds are not time-domain forcing the FMU models and are ignored (missing harmonics are
     already harmonics of ``empirical``).  The effects are read (all of them) by the schema."""
-    return {(e.direction, float(e.h)): e.law for e in _schema.of_kind(doc.get("effects"), _schema.AmplitudeLaw,
-                                                                      source)}
+    return {(e.direction, float(e.h)): e.law
+            for e in _schema.of_kind(doc.get("effects"), _schema.EFFECT_KINDS["amplitude_law"], source)}
 
 
 def effects_from_doc(doc, source="<model>"):
@@ -109,13 +133,13 @@ def effects_from_doc(doc, source="<model>"):
     out = {"laws": laws_from_doc({"effects": effects}, source), "resonances": [], "sidebands": [], "floors": [],
            "ripples": []}
     for e in effects:
-        if isinstance(e, _schema.FixedResonance) and e.role == "wheel_mode":
+        if isinstance(e, _schema.EFFECT_KINDS["fixed_resonance"]) and e.role == "wheel_mode":
             out["resonances"].append((e.directions, *e.resonance))
-        elif isinstance(e, _schema.Sidebands):
+        elif isinstance(e, _schema.EFFECT_KINDS["sidebands"]):
             out["sidebands"].append((e.direction, float(e.h), float(e.f_mod_Hz), float(e.depth)))
-        elif isinstance(e, _schema.BroadbandFloor):
+        elif isinstance(e, _schema.EFFECT_KINDS["broadband_floor"]):
             out["floors"].extend(_floor_from_entry(e))
-        elif isinstance(e, _schema.SpeedRipple):
+        elif isinstance(e, _schema.EFFECT_KINDS["speed_ripple"]):
             out["ripples"].append((float(e.delta_omega_rad_s), float(e.omega_ref_rad_s), float(e.speed_exponent),
                                    float(e.f_ripple_Hz)))
     return out

@@ -63,6 +63,11 @@ import numpy as np
 from . import extended as ext
 from . import schema
 from .data import DataError
+from .effects.amplitude_law import AmplitudeLaw
+from .effects.broadband_floor import BroadbandFloor
+from .effects.fixed_resonance import FixedResonance
+from .effects.sidebands import Sidebands
+from .effects.speed_ripple import SpeedRipple
 from .model import WheelModel
 from .resonance import resonance
 from .speed_laws import (  # noqa: F401
@@ -241,21 +246,21 @@ def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
     entry, as every other consumer."""
     later = []
     for e in schema.parse_effects(model.effects):
-        if isinstance(e, schema.AmplitudeLaw):
+        if isinstance(e, AmplitudeLaw):
             for i in range(len(src)):
                 if _source_direction(src, i) == e.direction and abs(src.h[i] - float(e.h)) < 1e-3:
                     src.laws[i] = e.law
-        elif isinstance(e, schema.BroadbandFloor):
+        elif isinstance(e, BroadbandFloor):
             for c in e.channel_indices:
                 src.floors.append((c, np.array(e.f_Hz), np.array(e.psd_ref), float(e.omega_ref_rad_s),
                                    float(e.exponent)))
-        elif isinstance(e, schema.FixedResonance) and e.role == "wheel_mode":
+        elif isinstance(e, FixedResonance) and e.role == "wheel_mode":
             src.resonances.append((list(e.directions), *e.resonance))
-        elif isinstance(e, (schema.Sidebands, schema.SpeedRipple)):
+        elif isinstance(e, (Sidebands, SpeedRipple)):
             later.append(e)
-    for e in sorted(later, key=lambda x: not isinstance(x, schema.Sidebands)):
+    for e in sorted(later, key=lambda x: not isinstance(x, Sidebands)):
         n0 = len(src)
-        if isinstance(e, schema.Sidebands):
+        if isinstance(e, Sidebands):
             m, f_m = float(e.depth), float(e.f_mod_Hz)
             for i in range(n0):
                 if _source_direction(src, i) == e.direction and abs(src.h[i] - float(e.h)) < 1e-3:

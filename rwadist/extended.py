@@ -74,6 +74,9 @@ import numpy as np
 from scipy import optimize
 
 from . import schema
+from .effects.amplitude_law import AmplitudeLaw
+from .effects.fixed_resonance import FixedResonance
+from .effects.sidebands import Sidebands
 from .resonance import resonance_gain
 from .units import G_CM2_TO_KG_M2, G_CM_TO_KG_M, RAD_S_TO_RPM
 
@@ -354,11 +357,11 @@ def line_effects(effects, source: str = "<model>") -> dict:
     ``effects[i].<field>`` on a bad entry."""
     out: dict = {"laws": [], "resonances": [], "sidebands": []}
     for e in schema.parse_effects(effects, source):
-        if isinstance(e, schema.AmplitudeLaw):
+        if isinstance(e, AmplitudeLaw):
             out["laws"].append((e.direction, float(e.h), e.law))
-        elif isinstance(e, schema.FixedResonance) and e.role == "wheel_mode":
+        elif isinstance(e, FixedResonance) and e.role == "wheel_mode":
             out["resonances"].append((e.directions, e.resonance))
-        elif isinstance(e, schema.Sidebands):
+        elif isinstance(e, Sidebands):
             out["sidebands"].append((e.direction, float(e.h), float(e.f_mod_Hz), float(e.depth)))
     return out
 

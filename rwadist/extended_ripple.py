@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import schema
+from .effects.speed_ripple import SpeedRipple
 from .extended import ExtendedParams, Line, _add_to_channels, _omega_array, transmissibility
 
 
@@ -45,7 +46,7 @@ def ripple_from_effects(effects, source: str = "<model>"):
     (:func:`rwadist.schema.parse_effects`): :class:`rwadist.schema.ModelError` (a ValueError) naming
     ``effects[i].<field>`` on a bad entry, and on a second ``speed_ripple`` (one per wheel)."""
     for e in schema.parse_effects(effects, source):
-        if isinstance(e, schema.SpeedRipple):
+        if isinstance(e, SpeedRipple):
             return Ripple(float(e.f_ripple_Hz), float(e.delta_omega_rad_s), float(e.omega_ref_rad_s),
                           float(e.speed_exponent))
     return None

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from . import effects as _effects  # noqa: F401  (imports every element: the schema reads every kind)
 from . import schema
 from .data import DataError, read_json
 from .schema import Analytical, Effect, Harmonic, ModelError

@@ -8,18 +8,19 @@ effects[2].amplitude_ref: missing``).
 This module imports numpy only (never rwadist): ``rwadist fmu build`` copies it byte for byte
 into the FMU's resources, where the runtime imports the copy (a test pins the copy to this file).
 
-Effects.  Every diagnosed effect kind (``rwadist diagnose``) is a frozen dataclass registered
-under its ``kind`` in :data:`EFFECT_KINDS`; its fields are the file's keys, each declared with
-its check (:func:`number`, :func:`choice`, ...).  Adding a kind is one small class::
+Effects.  Every diagnosed effect kind (``rwadist diagnose``) is an element of :mod:`rwadist.effects`
+(one module per kind, shipped into the FMU beside this one): a frozen dataclass derived from
+:class:`Effect` and registered under its ``kind`` in :data:`EFFECT_KINDS`; its fields are the file's
+keys, each declared with its check (:func:`number`, :func:`choice`, ...)::
 
     @register
     @dataclass(frozen=True, eq=False, kw_only=True)
     class NewKind(Effect):
         KIND: ClassVar[str] = "new_kind"
         direction: str = field(metadata=check(choice(DIRECTIONS)))
-        h: float = field(metadata=check(number(gt=0)))
+        h: float = field(metadata=check(POSITIVE))
 
-Keys a class does not declare (the ``evidence`` of the search, ``law`` texts, ``unit``) are
+This module knows no kind: it reads the kinds registered when it parses.  Keys a class does not declare (the ``evidence`` of the search, ``law`` texts, ``unit``) are
 carried through unchanged, and an entry parsed from a file is written back exactly as read
 (:meth:`Effect.to_json`), so loading and saving a file changes no byte.  An effect kind this
 version does not know is kept as an :class:`UnknownEffect` (read by no consumer), as a
@@ -276,6 +277,8 @@ class Effect(_ReadsAsJson):
     Reads as the JSON object it came from (a read-only Mapping) and equals it."""
 
     KIND: ClassVar[str] = ""
+    #: True for a kind a wheel has at most one of (:func:`parse_effects` refuses a second)
+    ONE_PER_WHEEL: ClassVar[bool] = False
     extra: Mapping = field(default_factory=dict, repr=False)
 
     # the document this effect was parsed from, written back unchanged (not an init field, so
@@ -365,196 +368,12 @@ class UnknownEffect(Effect):
         return {"kind": self.unknown_kind, **copy.deepcopy(dict(self.extra))}
 
 
-_POS = number(gt=0)
-_NONNEG = number(ge=0)
-_N_POINTS = optional(integer(ge=0))
-_STDERR = statistic(ge=0.0)
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class MissingHarmonic(Effect):
-    """A harmonic the fit missed: C·Ω² at h·|Ω|/2π (C in kg·m or kg·m²)."""
-
-    KIND: ClassVar[str] = "missing_harmonic"
-    direction: str = field(metadata=check(choice(DIRECTIONS)))
-    h: float = field(metadata=check(_POS))
-    C: float = field(metadata=check(_NONNEG))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class AmplitudeLaw(Effect):
-    """A line's amplitude amplitude_ref·(|Ω|/omega_ref_rad_s)^exponent (N or N·m) instead of C·Ω²."""
-
-    KIND: ClassVar[str] = "amplitude_law"
-    direction: str = field(metadata=check(choice(DIRECTIONS)))
-    h: float = field(metadata=check(_POS))
-    exponent: float = field(metadata=check(_NONNEG))
-    exponent_stderr: float | None = field(default=None, metadata=check(_STDERR))
-    amplitude_ref: float = field(metadata=check(_NONNEG))
-    omega_ref_rad_s: float = field(metadata=check(_POS))
-
-    @property
-    def law(self) -> tuple:
-        """(A_ref N or N·m, Ω_ref rad/s, exponent)."""
-        return (float(self.amplitude_ref), float(self.omega_ref_rad_s), float(self.exponent))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class BroadbandFloor(Effect):
-    """A blocked-load PSD S(f, Ω) = psd_ref(f)·(|Ω|/omega_ref_rad_s)^exponent on each of its channels,
-    psd_ref linear between the knots f_Hz (Hz, >= 0, increasing), 0 outside; unit²/Hz."""
-
-    KIND: ClassVar[str] = "broadband_floor"
-    channel: tuple = field(metadata=check(names(CHANNELS)))
-    exponent: float = field(metadata=check(_NONNEG))
-    omega_ref_rad_s: float = field(metadata=check(_POS))
-    f_Hz: np.ndarray = field(metadata=check(numbers(min_len=2, ge=0.0, increasing=True)))
-    psd_ref: np.ndarray = field(metadata=check(numbers(ge=0.0)))
-
-    def _validate(self, source, path, error):
-        if self.psd_ref.size != self.f_Hz.size:
-            raise error(source, f"{path}.psd_ref", f"has {self.psd_ref.size} values for {self.f_Hz.size} "
-                        "f_Hz knots (one per knot)")
-
-    @property
-    def channel_indices(self) -> tuple:
-        return tuple(CHANNELS.index(c) for c in self.channel)
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class FixedResonance(Effect):
-    """A resonance at f_Hz (damping ratio zeta, gain peak_gain at f_Hz) of role ``wheel_mode`` (the
-    wheel's loads of ``directions`` pass through it) or ``test_stand`` (a fixture: measurement only)."""
-
-    KIND: ClassVar[str] = "fixed_resonance"
-    f_Hz: float = field(metadata=check(_POS))
-    zeta: float = field(metadata=check(_POS))
-    peak_gain: float = field(metadata=check(_POS))
-    role: str = field(metadata=check(choice(("wheel_mode", "test_stand"))))
-    directions: tuple = field(metadata=check(names(DIRECTIONS)))
-    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
-
-    @property
-    def resonance(self) -> tuple:
-        """(f_r Hz, ζ, peak gain)."""
-        return (float(self.f_Hz), float(self.zeta), float(self.peak_gain))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class CrossCoupling(Effect):
-    """A load-cell offset r (m, wheel frame): T_measured = T + r × F.  Measurement only."""
-
-    KIND: ClassVar[str] = "cross_coupling"
-    r_m: np.ndarray = field(metadata=check(numbers(length=3)))
-    r_stderr_m: np.ndarray | None = field(default=None, metadata=check(optional(numbers(length=3, ge=0.0))))
-    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class Sidebands(Effect):
-    """Amplitude modulation a(1 + depth·cos 2π f_mod_Hz t) of the lines (direction, h)."""
-
-    KIND: ClassVar[str] = "sidebands"
-    direction: str = field(metadata=check(choice(DIRECTIONS)))
-    h: float = field(metadata=check(_POS))
-    f_mod_Hz: float = field(metadata=check(_POS))
-    depth: float = field(metadata=check(_NONNEG))
-    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class SpeedRipple(Effect):
-    """Ω(t) = Ω0 + ΔΩ sin 2π f_ripple_Hz t, ΔΩ = delta_omega_rad_s·(|Ω0|/omega_ref_rad_s)^speed_exponent."""
-
-    KIND: ClassVar[str] = "speed_ripple"
-    f_ripple_Hz: float = field(metadata=check(_POS))
-    delta_omega_rad_s: float = field(metadata=check(_NONNEG))
-    omega_ref_rad_s: float = field(metadata=check(_POS))
-    speed_exponent: float = field(default=0.0, metadata=check(optional(_NONNEG, 0.0)))
-    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class CounterRotation(Effect):
-    """A radial line with a counter-rotating part: fraction counter_fraction (0..1) of its power."""
-
-    KIND: ClassVar[str] = "counter_rotation"
-    direction: str = field(metadata=check(choice(("radial_force", "radial_torque"))))
-    h: float = field(metadata=check(_POS))
-    counter_fraction: float = field(metadata=check(number(ge=0, le=1)))
-    counter_fraction_stderr: float | None = field(default=None, metadata=check(_STDERR))
-    counter_fraction_phase: float | None = field(default=None, metadata=check(statistic(ge=None)))
-    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class SpinAcceleration(Effect):
-    """The runs were recorded while the wheel accelerated at alpha_rad_s2 (rad/s²).  Measurement only."""
-
-    KIND: ClassVar[str] = "spin_acceleration"
-    alpha_rad_s2: float = field(metadata=check(number()))
-    alpha_track_rad_s2: float | None = field(default=None, metadata=check(statistic(ge=None)))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class SpeedSidebands(Effect):
-    """Lines at h_lower·|Ω| and h_upper·|Ω| beside the line h of ``direction`` (speed-proportional sidebands).
-    A record of what diagnose found: the two lines are the model's empirical harmonics (C_lower, C_upper in
-    kg·m or kg·m²), which every consumer applies; this entry adds nothing to them."""
-
-    KIND: ClassVar[str] = "speed_sidebands"
-    direction: str = field(metadata=check(choice(DIRECTIONS)))
-    h: float = field(metadata=check(_POS))
-    h_lower: float = field(metadata=check(_POS))
-    h_upper: float = field(metadata=check(_POS))
-    C_lower: float = field(metadata=check(_NONNEG))
-    C_upper: float = field(metadata=check(_NONNEG))
-    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class LeverArmNoise(Effect):
-    """The force sensors' noise that the lever-arm correction T − r × F moves into the torque channels:
-    S_T'(f) = S_T(f) + noise_transfer·Σ r_k² S_Fj(f).  Measurement only (not a wheel load): no consumer
-    applies it."""
-
-    KIND: ClassVar[str] = "lever_arm_noise"
-    r_m: np.ndarray = field(metadata=check(numbers(length=3)))
-    noise_transfer: float = field(metadata=check(_NONNEG))
-    noise_transfer_stderr: float | None = field(default=None, metadata=check(_STDERR))
-    n_points: int | None = field(default=None, metadata=check(_N_POINTS))
-
-
-@register
-@dataclass(frozen=True, eq=False, kw_only=True)
-class SuspensionModes(Effect):
-    """The wheel's own suspension modes as diagnose fitted them from the data (per unit mass and transverse
-    inertia): frequencies at rest (Hz), damping ratios, I_zz/I_rr, and the modes the data do not locate.
-    The fitted parameters themselves are the model's ``analytical`` section."""
-
-    KIND: ClassVar[str] = "suspension_modes"
-    radial_translation_Hz: float = field(metadata=check(_POS))
-    rocking_Hz: float = field(metadata=check(_POS))
-    axial_Hz: float = field(metadata=check(_POS))
-    zeta_radial_translation: float = field(metadata=check(_NONNEG))
-    zeta_rocking: float = field(metadata=check(_NONNEG))
-    zeta_axial: float = field(metadata=check(_NONNEG))
-    inertia_ratio: float = field(metadata=check(_POS))
-    unconstrained: tuple = field(default=(), metadata=check(optional(names(("radial_translation", "rocking",
-                                                                               "axial")), ())))
-    per_unit: bool = field(default=True, metadata=check(optional(boolean(), True)))
-    n_runs: int | None = field(default=None, metadata=check(_N_POINTS))
+#: Checks the elements' fields share: a number > 0, a number >= 0, a count (an integer >= 0 or absent), a
+#: standard error (absent, NaN or >= 0).
+POSITIVE = number(gt=0)
+NON_NEGATIVE = number(ge=0)
+COUNT = optional(integer(ge=0))
+STDERR = statistic(ge=0.0)
 
 
 def parse_effect(doc: Any, source: str = "<model>", path: str = "effects[0]", error: type = ModelError) -> Effect:
@@ -578,17 +397,21 @@ def parse_effect(doc: Any, source: str = "<model>", path: str = "effects[0]", er
 
 def parse_effects(effects: Any, source: str = "<model>", error: type = ModelError) -> tuple:
     """The typed effects of a model file's ``effects`` list (None or absent: none), validated: every
-    entry by its kind's class, and at most one ``speed_ripple`` per wheel.  ``error`` (a
-    :class:`ModelError` subclass) is raised naming ``effects[i].<field>``."""
+    entry by its kind's class, and at most one effect of a kind that says so (:attr:`Effect.ONE_PER_WHEEL`).
+    ``error`` (a :class:`ModelError` subclass) is raised naming ``effects[i].<field>``."""
     if effects is None:
         return ()
     if not isinstance(effects, (list, tuple)):
         raise error(source, "effects", f"must be a list, got {type(effects).__name__}")
     out = tuple(parse_effect(e, source, f"effects[{i}]", error) for i, e in enumerate(effects))
-    ripples = [i for i, e in enumerate(out) if isinstance(e, SpeedRipple)]
-    if len(ripples) > 1:
-        raise error(source, f"effects[{ripples[1]}].kind", f"a second speed_ripple (the first is "
-                    f"effects[{ripples[0]}]); one speed ripple per wheel is supported")
+    first: dict = {}
+    for i, e in enumerate(out):
+        if not type(e).ONE_PER_WHEEL:
+            continue
+        if e.kind in first:
+            raise error(source, f"effects[{i}].kind", f"a second {e.kind} (the first is effects[{first[e.kind]}]); "
+                        f"one {e.kind.replace('_', ' ')} per wheel is supported")
+        first[e.kind] = i
     return out
 
 
@@ -601,7 +424,7 @@ def of_kind(effects: Any, cls: type, source: str = "<model>", error: type = Mode
 # =========================================================================== empirical harmonics
 
 #: Checks of an empirical harmonic's keys (``excluded_rpm``, a list of [lo, hi] rpm pairs, is checked apart).
-HARMONIC_CHECKS = {"h": _POS, "C": _NONNEG, "C_stderr": _STDERR, "n_points": optional(integer(), 0),
+HARMONIC_CHECKS = {"h": POSITIVE, "C": NON_NEGATIVE, "C_stderr": STDERR, "n_points": optional(integer(), 0),
                    "presence": optional(number(ge=0, le=1)), "sense": optional(choice(SENSES))}
 
 

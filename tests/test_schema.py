@@ -16,6 +16,10 @@ from rwadist import model as model_io
 from rwadist import schema
 from rwadist.cli import main
 from rwadist.data import DataError
+from rwadist.effects.amplitude_law import AmplitudeLaw
+from rwadist.effects.broadband_floor import BroadbandFloor
+from rwadist.effects.sidebands import Sidebands
+from rwadist.effects.speed_ripple import SpeedRipple
 
 CATALOGUE = sorted((Path(schema.__file__).parent / "catalogue").glob("*.json"))
 BASE = CATALOGUE[[p.name for p in CATALOGUE].index("ithaco-e.json")]
@@ -59,15 +63,15 @@ def test_effects_round_trip_typed_and_equal_to_their_json(tmp_path):
     p, doc = write(tmp_path, [ok_law, dict(FLOOR, psd_ref=[1e-6, 2e-6]), rip, other])
     m = model_io.load(p)
     law, floor, ripple, unknown = m.effects
-    assert isinstance(law, schema.AmplitudeLaw) and law.law == (0.01, 200.0, 2.5) and law["h"] == 2
-    assert isinstance(floor, schema.BroadbandFloor) and floor.channel_indices == (0,)
-    assert isinstance(ripple, schema.SpeedRipple) and ripple.speed_exponent == 0.0 and "speed_exponent" not in ripple
+    assert isinstance(law, AmplitudeLaw) and law.law == (0.01, 200.0, 2.5) and law["h"] == 2
+    assert isinstance(floor, BroadbandFloor) and floor.channel_indices == (0,)
+    assert isinstance(ripple, SpeedRipple) and ripple.speed_exponent == 0.0 and "speed_exponent" not in ripple
     assert isinstance(unknown, schema.UnknownEffect) and unknown.kind == other["kind"]
     assert m.effects == doc["effects"]                           # effects equal the JSON they came from
     back = model_io.save(m, tmp_path / "back.json")
     assert json.loads(back.read_text()) == doc
     # an effect made in code serialises from its fields
-    made = schema.Sidebands(direction="axial_force", h=1.0, f_mod_Hz=3.0, depth=0.1)
+    made = Sidebands(direction="axial_force", h=1.0, f_mod_Hz=3.0, depth=0.1)
     assert made.to_json() == {"kind": "sidebands", "direction": "axial_force", "h": 1.0, "f_mod_Hz": 3.0,
                               "depth": 0.1}
     assert schema.parse_effect(made.to_json()) == made
@@ -311,8 +315,8 @@ def test_mutated_documents_are_refused_by_both(validator, path, value):
 
 
 def test_fmu_runtime_reads_through_its_own_copy_without_rwadist(tmp_path):
-    """Inside a built FMU the runtime imports the shipped schema copy (rwadist blocked from import) and
-    refuses the bad entry with the same message."""
+    """Inside a built FMU the runtime imports the shipped schema copy and the shipped effect elements (rwadist
+    blocked from import), reads every kind and refuses the bad entry with the same message."""
     pytest.importorskip("pythonfmu")
     import subprocess
     import sys
@@ -330,6 +334,10 @@ sys.modules["rwadist"] = None                      # any 'import rwadist' fails
 spec = importlib.util.spec_from_file_location("fmu_rt", {str(res / "rwadist_fmu_runtime.py")!r})
 rt = importlib.util.module_from_spec(spec); spec.loader.exec_module(rt)
 assert rt._schema.__file__ == {str(res / "rwadist_model_schema.py")!r}, rt._schema.__file__
+# every element the schema copy reads is a shipped copy (rwadist/effects/<kind>.py)
+kinds = rt._schema.EFFECT_KINDS
+assert all(sys.modules[c.__module__].__file__.startswith({str(res / "rwadist_model_effects")!r}) for c in kinds.values())
+print(json.dumps(sorted(kinds)))
 doc = json.load(open({str(p)!r}))
 try:
     rt.effects_from_doc(doc, {str(p)!r})
@@ -338,4 +346,13 @@ except rt.ModelError as exc:
 """
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == f"{p}: effects[0].amplitude_ref: missing"
+    kinds, message = out.stdout.strip().splitlines()
+    assert json.loads(kinds) == sorted(schema.EFFECT_KINDS)
+    assert message == f"{p}: effects[0].amplitude_ref: missing"
+    # the shipped elements are rwadist's, byte for byte
+    from rwadist import effects
+
+    shipped = sorted((res / "rwadist_model_effects").iterdir())
+    assert [f.name for f in shipped] == sorted(f.name for f in effects.shipped_files())
+    for f in effects.shipped_files():
+        assert (res / "rwadist_model_effects" / f.name).read_bytes() == f.read_bytes(), f.name

@@ -1,0 +1,24 @@
+"""``speed_sidebands``: speed-proportional sidebands of a line (a record: the lines are harmonics)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+from ..schema import COUNT, DIRECTIONS, NON_NEGATIVE, POSITIVE, Effect, check, choice, register
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class SpeedSidebands(Effect):
+    """Lines at h_lower·|Ω| and h_upper·|Ω| beside the line h of ``direction`` (speed-proportional sidebands).
+    A record of what diagnose found: the two lines are the model's empirical harmonics (C_lower, C_upper in
+    kg·m or kg·m²), which every consumer applies; this entry adds nothing to them."""
+
+    KIND: ClassVar[str] = "speed_sidebands"
+    direction: str = field(metadata=check(choice(DIRECTIONS)))
+    h: float = field(metadata=check(POSITIVE))
+    h_lower: float = field(metadata=check(POSITIVE))
+    h_upper: float = field(metadata=check(POSITIVE))
+    C_lower: float = field(metadata=check(NON_NEGATIVE))
+    C_upper: float = field(metadata=check(NON_NEGATIVE))
+    n_points: int | None = field(default=None, metadata=check(COUNT))

@@ -1,0 +1,17 @@
+"""``spin_acceleration``: lines smeared by the wheel's acceleration during the runs of a sweep."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+from ..schema import Effect, check, number, register, statistic
+
+
+@register
+@dataclass(frozen=True, eq=False, kw_only=True)
+class SpinAcceleration(Effect):
+    """The runs were recorded while the wheel accelerated at alpha_rad_s2 (rad/s²).  Measurement only."""
+
+    KIND: ClassVar[str] = "spin_acceleration"
+    alpha_rad_s2: float = field(metadata=check(number()))
+    alpha_track_rad_s2: float | None = field(default=None, metadata=check(statistic(ge=None)))
