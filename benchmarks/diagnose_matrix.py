@@ -163,13 +163,13 @@ def registry_kinds() -> list:
 
 def injection(kind: str):
     """(spec string, None) of a family, or (None, why not)."""
-    from rwadist.inject import KINDS
+    from rwadist.inject import kinds
 
     if kind in NOT_INJECTED:
         return None, NOT_INJECTED[kind]
     if kind in SPECS:
         return SPECS[kind], None
-    if kind in KINDS:
+    if kind in kinds():
         return kind, None                        # a family added since: rwadist.inject's defaults
     return None, "rwadist.inject has no such kind"
 

@@ -4,7 +4,8 @@
 build (two FMUs whose slave modules share a name cannot load in one process), and ships the slave it loads,
 ``slave.py`` (as ``rwadist_fmu_slave.py``), ``runtime.py`` (as ``rwadist_fmu_runtime.py``) with its sibling modules, ``rwadist/schema.py`` (as
 ``rwadist_model_schema.py``, the runtime's reader of the model file, with the effect elements of
-:mod:`rwadist.effects` in ``rwadist_model_effects/``; :func:`runtime_files`) and the model file
+:mod:`rwadist.effects` in ``rwadist_model_effects/`` and the units they read, ``rwadist_model_units.py``;
+:func:`runtime_files`) and the model file
 (``wheel_model.json``) in the FMU's resources.  pythonfmu embeds itself there too, so a host needs Python + numpy only.
 
 Native layer (Linux x86-64, when a C compiler is found): ``native/rwadist_fmu_native.c`` is
@@ -237,8 +238,8 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
 def runtime_files(folder) -> list:
     """Copy the FMU runtime into ``folder`` under its resource names: ``runtime.py`` as
     ``rwadist_fmu_runtime.py``, each sibling module (``runtime.SIBLINGS``) as ``runtime.fmu_file_name``,
-    ``rwadist/schema.py`` as ``runtime.SCHEMA_FILE`` and the effect elements (:func:`rwadist.effects.shipped_files`)
-    into the folder ``runtime.EFFECTS_DIR``; returns the copies' paths (the FMU's project files)."""
+    ``rwadist/schema.py`` as ``runtime.SCHEMA_FILE``, ``rwadist/units.py`` as ``runtime.UNITS_FILE`` and the effect
+    elements (:func:`rwadist.effects.shipped_files`) into the folder ``runtime.EFFECTS_DIR``; returns the copies' paths (the FMU's project files)."""
     rt = _runtime()
     folder = Path(folder)
     out = [folder / "rwadist_fmu_runtime.py"]
@@ -248,8 +249,11 @@ def runtime_files(folder) -> list:
         shutil.copy2(HERE / f"{stem}.py", out[-1])
     out.append(folder / rt.SCHEMA_FILE)
     shutil.copyfile(_schema_source(), out[-1])
-    # the effect elements, read by the schema copy (the runtime loads them as its package; rwadist.effects)
-    from rwadist import effects
+    # the effect elements, read by the schema copy, and the units they read (the runtime loads them as its package)
+    from rwadist import effects, units
+
+    out.append(folder / rt.UNITS_FILE)
+    shutil.copyfile(units.__file__, out[-1])
 
     out.append(folder / rt.EFFECTS_DIR)
     out[-1].mkdir()

@@ -76,6 +76,7 @@ _schema = _model._schema
 # the split-off modules' public names, importable from here as before the split
 SCHEMA_FILE = _model.SCHEMA_FILE
 EFFECTS_DIR = _model.EFFECTS_DIR
+UNITS_FILE = _model.UNITS_FILE
 SCHEMA = _model.SCHEMA
 SCHEMA_VERSION = _model.SCHEMA_VERSION
 ANALYTICAL_KIND = _model.ANALYTICAL_KIND

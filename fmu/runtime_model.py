@@ -22,6 +22,8 @@ import numpy as np
 
 #: the schema's file name in the FMU's resources (``fmu/build.py`` copies rwadist/schema.py there)
 SCHEMA_FILE = "rwadist_model_schema.py"
+#: the units module's file name in the FMU's resources (rwadist/units.py: the elements read their units there)
+UNITS_FILE = "rwadist_model_units.py"
 #: the folder of the effect elements in the FMU's resources (``fmu/build.py`` copies rwadist/effects/ there:
 #: :func:`rwadist.effects.shipped_files`)
 EFFECTS_DIR = "rwadist_model_effects"
@@ -45,8 +47,8 @@ def _load_schema():
     """The model-file schema with every effect element registered: the copies next to this file (inside an FMU),
     else :mod:`rwadist.schema` and :mod:`rwadist.effects`.
 
-    In an FMU both are loaded as the modules ``schema`` and ``effects`` of a package named after this module (two
-    FMUs load side by side), so the elements' ``from ..schema import ...`` reads this schema copy."""
+    In an FMU the copies are loaded as the modules ``schema``, ``units`` and ``effects`` of a package named after
+    this module (two FMUs load side by side), so the elements' ``from ..schema import ...`` reads this schema copy."""
     here = os.path.dirname(os.path.abspath(__file__))
     path = os.path.join(here, SCHEMA_FILE)
     if not os.path.isfile(path):
@@ -58,6 +60,7 @@ def _load_schema():
         parent = sys.modules.setdefault(pkg, types.ModuleType(pkg))
         parent.__path__ = []             # a package: its two modules are loaded from their files below
         mod = _exec_module(f"{pkg}.schema", path)
+        _exec_module(f"{pkg}.units", os.path.join(here, UNITS_FILE))
         folder = os.path.join(here, EFFECTS_DIR)
         _exec_module(f"{pkg}.effects", os.path.join(folder, "__init__.py"), folder)
     return mod

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 
+from .effects import elements
 from .validate import MAX_RPM, MAX_SAMPLES, MAX_SPEEDS, number, rpm
 
 
@@ -70,8 +71,8 @@ def build_parser(cli) -> argparse.ArgumentParser:
                         "(the data's metadata then says so)")
     s.add_argument("--inject", action="append", default=[], metavar="KIND:PARAM=VALUE,...",
                    help="add a known effect to try diagnose on (repeatable; recorded in meta.json 'injected'): "
-                        "missing_harmonic, amplitude_law, broadband_floor, fixed_resonance, cross_coupling, "
-                        "sidebands, speed_ripple, counter_rotation (parameters: see rwadist/inject.py)")
+                        + ", ".join(c.KIND for c in elements() if c.INJECT is not None)
+                        + " (parameters: see rwadist/effects/KIND.py)")
     s.set_defaults(func=cli.cmd_simulate)
 
     f = sub.add_parser("fit", help="fit the empirical model to test data; writes the model file and a report")

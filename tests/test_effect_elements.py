@@ -34,12 +34,13 @@ def test_every_registered_kind_is_an_element_module_of_its_own():
 
 def test_shipped_element_files_import_numpy_and_the_schema_only():
     """The files the pythonfmu FMU ships (the elements and this package's __init__) run on a host with Python and
-    numpy alone: no scipy, no rwadist module but the schema (read as the sibling package's ``..schema``)."""
+    numpy alone: no scipy, no rwadist module but the schema and the units (read as the sibling package's
+    ``..schema``, ``..units``)."""
     stdlib = set(sys.stdlib_module_names)
     files = effects.shipped_files()
     assert {f.name for f in files} >= {"__init__.py", "speed_ripple.py"}
     for f in files:
         for name in _imports(f):
-            ok = name in stdlib or name == "numpy" or name == "..schema" or (name.startswith(".") and
-                                                                              not name.startswith(".."))
+            ok = name in stdlib or name in ("numpy", "..schema", "..units") or (name.startswith(".") and
+                                                                                 not name.startswith(".."))
             assert ok, (f.name, name)

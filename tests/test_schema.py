@@ -356,3 +356,6 @@ except rt.ModelError as exc:
     assert [f.name for f in shipped] == sorted(f.name for f in effects.shipped_files())
     for f in effects.shipped_files():
         assert (res / "rwadist_model_effects" / f.name).read_bytes() == f.read_bytes(), f.name
+    from rwadist import units
+
+    assert (res / "rwadist_model_units.py").read_bytes() == Path(units.__file__).read_bytes()

@@ -16,9 +16,10 @@ file, each kind is one element, ``rwadist/effects/<kind>.py``: a frozen dataclas
   runtime, and the C kernel, which gets them compiled in when the FMU is built) apply the actions;
 - its injection into the virtual test stand (``rwadist simulate-test --inject KIND:PARAM=VALUE``).
 
-The element file imports numpy and :mod:`rwadist.schema` only (and modules of this package that do the same): the
-pythonfmu FMU ships these files byte for byte beside its copy of the schema (``rwadist fmu build``, a test pins the
-copies), where they read a model file given to the FMU at run time on a host with Python and numpy alone.
+The element file imports numpy, :mod:`rwadist.schema` and :mod:`rwadist.units` only (and modules of this package
+that do the same; :mod:`rwadist.effects.element` is the elements' base): the pythonfmu FMU ships these files byte for
+byte beside its copies of the schema and the units (``rwadist fmu build``, a test pins the copies), where they read
+a model file given to the FMU at run time on a host with Python and numpy alone.
 
 Its diagnose hypothesis -- the family that proposes the kind from the residual of test data, fits it and is judged
 on held-out speeds -- needs scipy and the diagnose engine, so it cannot live in the shipped file: it is the module
@@ -29,10 +30,10 @@ Adding a kind is one new file (two when ``rwadist diagnose`` should find it) plu
 a kind.  A kind registered from anywhere else (a test's toy kind, a user's own) is read, written, shown and applied
 the same way (tests/test_effect_elements.py).
 
-Status of the move (landed in steps): the fields and checks are here (from ``rwadist/schema.py``); the text,
-injection, actions, their consumers and the diagnose hypotheses still live in the modules that name the kinds
-(``effects_text``, ``inject``, ``broadband``, ``extended``, ``coupling.performance``, ``fmu``, ``diagnose``) and
-move here next.
+Status of the move (landed in steps): the fields and checks (from ``rwadist/schema.py``), the texts (from
+``rwadist/effects_text.py``, which now dispatches) and the injections (from ``rwadist/inject.py``, now the stand's
+generic side) are here; the actions, their consumers and the diagnose hypotheses still live in the modules that name
+the kinds (``broadband``, ``extended``, ``coupling.performance``, ``fmu``, ``diagnose``) and move here next.
 
 Importing this package imports every element module of it (so the schema reads every kind); elements registered
 by other modules are read once those are imported.
@@ -51,6 +52,16 @@ def element_module_names() -> list:
     """Names of this package's modules that hold elements (numpy only): every module but the diagnose ones."""
     return [m.name for m in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name)
             if not m.ispkg and not m.name.endswith(DIAGNOSE_SUFFIX)]
+
+
+def elements() -> list:
+    """Every registered element class (:class:`~rwadist.effects.element.Element`, built in or registered elsewhere),
+    in their ``ORDER``."""
+    from ..schema import EFFECT_KINDS
+    from .element import Element
+
+    found = [c for c in EFFECT_KINDS.values() if isinstance(c, type) and issubclass(c, Element)]
+    return sorted(found, key=lambda c: c.ORDER)
 
 
 def shipped_files() -> list:

@@ -1,18 +1,23 @@
 """``amplitude_law``: a line whose amplitude goes as |Ω|^p instead of Ω²."""
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from ..schema import DIRECTIONS, NON_NEGATIVE, POSITIVE, STDERR, Effect, check, choice, register
+import numpy as np
+
+from ..schema import DIRECTIONS, NON_NEGATIVE, POSITIVE, STDERR, check, choice, register
+from .element import Element, num, plus_minus, rpm, words
 
 
 @register
 @dataclass(frozen=True, eq=False, kw_only=True)
-class AmplitudeLaw(Effect):
+class AmplitudeLaw(Element):
     """A line's amplitude amplitude_ref·(|Ω|/omega_ref_rad_s)^exponent (N or N·m) instead of C·Ω²."""
 
     KIND: ClassVar[str] = "amplitude_law"
+    ORDER: ClassVar[int] = 20
     direction: str = field(metadata=check(choice(DIRECTIONS)))
     h: float = field(metadata=check(POSITIVE))
     exponent: float = field(metadata=check(NON_NEGATIVE))
@@ -24,3 +29,42 @@ class AmplitudeLaw(Effect):
     def law(self) -> tuple:
         """(A_ref N or N·m, Ω_ref rad/s, exponent)."""
         return (float(self.amplitude_ref), float(self.omega_ref_rad_s), float(self.exponent))
+
+    #: unit of the amplitude of a line of each direction
+    AMPLITUDE_UNIT: ClassVar[dict] = {"radial_force": "N", "axial_force": "N", "radial_torque": "N·m",
+                                      "axial_torque": "N·m"}
+
+    @classmethod
+    def describe(cls, e: Mapping) -> str:
+        d = e["direction"]
+        return (f"{words(d)}, h {num(e['h'])}, amplitude ∝ |Ω|^{num(e['exponent'], '.3g')}"
+                f"{plus_minus(e, 'exponent_stderr')}, {num(e['amplitude_ref'], '.3g')} {cls.AMPLITUDE_UNIT[d]} at "
+                f"{rpm(e['omega_ref_rad_s'])}")
+
+    # ------------------------------------------------------------------ injection
+    #: ``amplitude_law:direction=radial_force,h=2,exponent=3,fraction=1``: the line (d, h) of the wheel replaced by
+    #: A(Ω) = fraction·C_h·Ω_mid²·(Ω/Ω_mid)^exponent (Ω_mid the median speed); with --physics extended a wheel load
+    #: with the line's own sense through the suspension modes
+    INJECT: ClassVar[Mapping] = {"direction": "radial_force", "h": 2.0, "exponent": 3.0, "fraction": 1.0}
+    INJECT_TEXT: ClassVar[tuple] = ("direction",)
+    INJECT_POSITIVE: ClassVar[tuple] = ("h",)
+
+    @classmethod
+    def inject_prepare(cls, wheel, spec, stand):
+        h, spec["C"] = stand.harmonic(wheel, spec, spec["direction"], spec["h"])
+        if stand.extended and stand.is_imbalance(spec["direction"], h):
+            raise stand.error("h", f"{cls.KIND}: with --physics extended the radial h = 1 lines are the rotor's "
+                              "imbalances; pick another h or --physics simple")
+        return stand.without(wheel, spec["direction"], h)
+
+    @classmethod
+    def inject_run(cls, spec, run, index, stand):
+        w, w_mid = abs(run.speed), stand.w_mid
+        if stand.extended:
+            law = (spec["fraction"] * spec["C"] * w_mid**2, w_mid, spec["exponent"])
+            line = stand.line(spec["direction"], float(spec["h"]), float(spec["C"]),
+                              stand.sense(spec["direction"], spec["h"]), stand.rng.uniform(0, 2 * np.pi), law=law)
+            stand.add_wheel_loads(run, [line])
+            return
+        a = spec["fraction"] * spec["C"] * w_mid**2 * (w / w_mid) ** spec["exponent"]
+        stand.add_line(run, spec["direction"], a, spec["h"] * w * stand.time(run) + stand.rng.uniform(0, 2 * np.pi))

@@ -1,21 +1,25 @@
 """``broadband_floor``: a broadband (noise-like) load floor of some channels, growing with speed."""
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
 
-from ..schema import CHANNELS, NON_NEGATIVE, POSITIVE, Effect, check, names, numbers, register
+from ..schema import CHANNELS, NON_NEGATIVE, POSITIVE, check, names, numbers, register
+from ..units import CHANNEL_UNIT
+from .element import Element, num, rpm
 
 
 @register
 @dataclass(frozen=True, eq=False, kw_only=True)
-class BroadbandFloor(Effect):
+class BroadbandFloor(Element):
     """A blocked-load PSD S(f, Ω) = psd_ref(f)·(|Ω|/omega_ref_rad_s)^exponent on each of its channels,
     psd_ref linear between the knots f_Hz (Hz, >= 0, increasing), 0 outside; unit²/Hz."""
 
     KIND: ClassVar[str] = "broadband_floor"
+    ORDER: ClassVar[int] = 30
     channel: tuple = field(metadata=check(names(CHANNELS)))
     exponent: float = field(metadata=check(NON_NEGATIVE))
     omega_ref_rad_s: float = field(metadata=check(POSITIVE))
@@ -30,3 +34,35 @@ class BroadbandFloor(Effect):
     @property
     def channel_indices(self) -> tuple:
         return tuple(CHANNELS.index(c) for c in self.channel)
+
+    @classmethod
+    def describe(cls, e: Mapping) -> str:
+        f = np.asarray(e["f_Hz"], dtype=float)
+        psd = np.asarray(e["psd_ref"], dtype=float)
+        chans = " ".join(e["channel"]) if isinstance(e["channel"], (list, tuple)) else str(e["channel"])
+        return (f"{chans}, PSD ∝ |Ω|^{num(e['exponent'], '.3g')}, {f.min():.0f}–{f.max():.0f} Hz, "
+                f"peak {psd.max():.3g} {cls._psd_unit(e)} at {rpm(e['omega_ref_rad_s'])}")
+
+    @staticmethod
+    def _psd_unit(e) -> str:
+        """The floor's PSD unit: its channel's unit squared per Hz (N²/Hz or (N·m)²/Hz)."""
+        chans = e["channel"] if isinstance(e["channel"], (list, tuple)) else [e["channel"]]
+        unit = CHANNEL_UNIT.get(chans[0]) if chans else None
+        return {"N": "N²/Hz", "Nm": "(N·m)²/Hz"}.get(unit, f"({unit})²/Hz" if unit else "unit²/Hz")
+
+    # ------------------------------------------------------------------ injection
+    #: ``broadband_floor:channels=Fx+Fy+Fz,level=0.05,exponent=3,fc_hz=60``: Gaussian noise low-passed at fc
+    #: (2nd-order Butterworth), RMS level·C1·Ω_max²·(Ω/Ω_max)^(exponent/2) (its PSD grows as Ω^exponent); a floor
+    #: at the load cell on the channels given (not a load direction), with either physics
+    INJECT: ClassVar[Mapping] = {"channels": "Fx+Fy+Fz", "level": 0.05, "exponent": 3.0, "fc_hz": 60.0}
+    INJECT_TEXT: ClassVar[tuple] = ("channels",)
+    INJECT_POSITIVE: ClassVar[tuple] = ("fc_hz",)
+
+    @classmethod
+    def inject_run(cls, spec, run, index, stand):
+        w, w_max = abs(run.speed), stand.w_max
+        for c in spec["channels"]:
+            c1 = stand.wheel.fundamental_C("radial_force" if c.startswith("F") else "radial_torque")
+            x = stand.lowpass_noise(spec["fc_hz"], run)
+            x /= np.sqrt(np.mean(x**2))
+            run.signals[c] = run.signals[c] + spec["level"] * c1 * w_max**2 * (w / w_max) ** (spec["exponent"] / 2) * x

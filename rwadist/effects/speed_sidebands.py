@@ -1,20 +1,23 @@
 """``speed_sidebands``: speed-proportional sidebands of a line (a record: the lines are harmonics)."""
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from ..schema import COUNT, DIRECTIONS, NON_NEGATIVE, POSITIVE, Effect, check, choice, register
+from ..schema import COUNT, DIRECTIONS, NON_NEGATIVE, POSITIVE, check, choice, register
+from .element import Element, num, words
 
 
 @register
 @dataclass(frozen=True, eq=False, kw_only=True)
-class SpeedSidebands(Effect):
+class SpeedSidebands(Element):
     """Lines at h_lower·|Ω| and h_upper·|Ω| beside the line h of ``direction`` (speed-proportional sidebands).
     A record of what diagnose found: the two lines are the model's empirical harmonics (C_lower, C_upper in
     kg·m or kg·m²), which every consumer applies; this entry adds nothing to them."""
 
     KIND: ClassVar[str] = "speed_sidebands"
+    ORDER: ClassVar[int] = 15
     direction: str = field(metadata=check(choice(DIRECTIONS)))
     h: float = field(metadata=check(POSITIVE))
     h_lower: float = field(metadata=check(POSITIVE))
@@ -22,3 +25,9 @@ class SpeedSidebands(Effect):
     C_lower: float = field(metadata=check(NON_NEGATIVE))
     C_upper: float = field(metadata=check(NON_NEGATIVE))
     n_points: int | None = field(default=None, metadata=check(COUNT))
+
+    @classmethod
+    def describe(cls, e: Mapping) -> str:
+        return (f"{words(e['direction'])}, lines at h {num(e['h_lower'])} and {num(e['h_upper'])} beside h "
+                f"{num(e['h'])} (±{num(e['per_rev'], '.3g')} per revolution), C/C of the carrier "
+                f"{num(e['ratio_lower'], '.3g')} and {num(e['ratio_upper'], '.3g')}")

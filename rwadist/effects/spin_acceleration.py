@@ -1,17 +1,24 @@
 """``spin_acceleration``: lines smeared by the wheel's acceleration during the runs of a sweep."""
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from ..schema import Effect, check, number, register, statistic
+from ..schema import check, number, register, statistic
+from .element import Element, num
 
 
 @register
 @dataclass(frozen=True, eq=False, kw_only=True)
-class SpinAcceleration(Effect):
+class SpinAcceleration(Element):
     """The runs were recorded while the wheel accelerated at alpha_rad_s2 (rad/s²).  Measurement only."""
 
     KIND: ClassVar[str] = "spin_acceleration"
+    ORDER: ClassVar[int] = 90
     alpha_rad_s2: float = field(metadata=check(number()))
     alpha_track_rad_s2: float | None = field(default=None, metadata=check(statistic(ge=None)))
+
+    @classmethod
+    def describe(cls, e: Mapping) -> str:
+        return f"α {num(e['alpha_rad_s2'], '.3g')} rad/s²"

@@ -1,6 +1,7 @@
 """``suspension_modes``: the wheel's own suspension modes as diagnose fitted them (a record)."""
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -9,23 +10,24 @@ from ..schema import (
     NON_NEGATIVE,
     POSITIVE,
     UNCONSTRAINED_MODES,
-    Effect,
     boolean,
     check,
     names,
     optional,
     register,
 )
+from .element import Element, directions, num
 
 
 @register
 @dataclass(frozen=True, eq=False, kw_only=True)
-class SuspensionModes(Effect):
+class SuspensionModes(Element):
     """The wheel's own suspension modes as diagnose fitted them from the data (per unit mass and transverse
     inertia): frequencies at rest (Hz), damping ratios, I_zz/I_rr, and the modes the data do not locate.
     The fitted parameters themselves are the model's ``analytical`` section."""
 
     KIND: ClassVar[str] = "suspension_modes"
+    ORDER: ClassVar[int] = 100
     radial_translation_Hz: float = field(metadata=check(POSITIVE))
     rocking_Hz: float = field(metadata=check(POSITIVE))
     axial_Hz: float = field(metadata=check(POSITIVE))
@@ -36,3 +38,12 @@ class SuspensionModes(Effect):
     unconstrained: tuple = field(default=(), metadata=check(optional(names(UNCONSTRAINED_MODES), ())))
     per_unit: bool = field(default=True, metadata=check(optional(boolean(), True)))
     n_runs: int | None = field(default=None, metadata=check(COUNT))
+
+    @classmethod
+    def describe(cls, e: Mapping) -> str:
+        free = e.get("unconstrained") or ()
+        note = f"; not located by the data: {directions(free)}" if free else ""
+        return (f"radial translation {num(e['radial_translation_Hz'], '.4g')} Hz "
+                f"(ζ {num(e['zeta_radial_translation'], '.2g')}), rocking at rest {num(e['rocking_Hz'], '.4g')} Hz "
+                f"(ζ {num(e['zeta_rocking'], '.2g')}), axial {num(e['axial_Hz'], '.4g')} Hz "
+                f"(ζ {num(e['zeta_axial'], '.2g')}), I_zz/I_rr {num(e['inertia_ratio'], '.3g')}{note}")
