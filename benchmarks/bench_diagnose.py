@@ -268,7 +268,7 @@ def modes_on_table(seeds, groups=None):
     # with its test's criteria (cut > 2x).  The wheel's load C·Ω²·(1 + m·cos(2π f_mod t + φ_m))·e^{±i(hφ + φ_c)}
     # (the preset's sense of h = 2) is a carrier and two lines at f_offset = ±f_mod of C·m/2, each through the
     # modes at its own whirl rate (test_diagnose_modulation.inject_sidebands adds it at the load cell)
-    from rwadist.diagnose.effects.sidebands import Sidebands
+    from rwadist.effects.sidebands_diagnose import Sidebands
 
     C2 = dict(preset("ithaco-e").harmonics["radial_force"])[2.0]
     sense2 = preset("ithaco-e").senses.get(("radial_force", 2.0), "co")

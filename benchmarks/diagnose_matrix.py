@@ -7,7 +7,7 @@ phases and noise per run, diagnosed on one or both of two paths (below).  Per ce
 * clean data (the stand resonance of the cell included when it has one): the effects diagnose adds
   beyond the wheel's own modes (and beyond a ``fixed_resonance`` of role test_stand at the stand's
   frequency when the cell has one) -- must be 0;
-* each effect family the registry lists (:data:`rwadist.diagnose.effects.EFFECT_CLASSES`) that
+* each effect family the registry lists (:func:`rwadist.diagnose.effects.family_classes`) that
   :mod:`rwadist.inject` can inject, injected alone (its parameters below; the wheel-load kinds -- missing
   harmonic, amplitude law, sidebands, counter rotation -- are loads on the rotor that reach the load cell
   through the suspension modes and the stand's fixture, as the wheel's own lines): found or missed (found =
@@ -156,9 +156,9 @@ def _fmt(factor, v):
 
 def registry_kinds() -> list:
     """Every effect family the diagnose registry lists, in its order."""
-    from rwadist.diagnose.effects import EFFECT_CLASSES
+    from rwadist.diagnose.effects import family_classes
 
-    return [getattr(c, "kind", c.__name__) for c in EFFECT_CLASSES]
+    return [getattr(c, "kind", c.__name__) for c in family_classes()]
 
 
 def injection(kind: str):
@@ -438,7 +438,7 @@ def _in_base(kind: str, d, truth: dict) -> str:
         hit = [x for x in d.model.empirical.get(truth["direction"], []) if abs(x.h - truth["h"]) < 0.01]
         return f"h {hit[0].h:.3f}" if hit else ""
     if kind == "counter_rotation" and d.state_after.ext is not None:
-        from rwadist.diagnose.effects.counter_rotation import _sense_group
+        from rwadist.effects.counter_rotation_diagnose import _sense_group
 
         g = _sense_group(d.state_after, truth["direction"], truth["h"])
         if g is not None and g[2] > 0:

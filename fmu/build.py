@@ -239,7 +239,8 @@ def runtime_files(folder) -> list:
     """Copy the FMU runtime into ``folder`` under its resource names: ``runtime.py`` as
     ``rwadist_fmu_runtime.py``, each sibling module (``runtime.SIBLINGS``) as ``runtime.fmu_file_name``,
     ``rwadist/schema.py`` as ``runtime.SCHEMA_FILE``, ``rwadist/units.py`` as ``runtime.UNITS_FILE`` and the effect
-    elements (:func:`rwadist.effects.shipped_files`) into the folder ``runtime.EFFECTS_DIR``; returns the copies' paths (the FMU's project files)."""
+    elements (:func:`rwadist.effects.shipped_files`) into the folder ``runtime.EFFECTS_DIR``; returns the copies'
+    paths (the FMU's project files)."""
     rt = _runtime()
     folder = Path(folder)
     out = [folder / "rwadist_fmu_runtime.py"]

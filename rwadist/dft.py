@@ -3,7 +3,7 @@
 The extended fit reads each radial line's rotation sense from the x/y phase of the whole record
 (:func:`rwadist.extended_fit.line_senses`), and ``rwadist diagnose`` measures lines, sidebands and phasors
 on the whole record of every run (:meth:`rwadist.diagnose.engine.Context.phasors`,
-:func:`rwadist.diagnose.effects.speed_sidebands._run_line_power`).  Those sums are computed here: one run
+:func:`rwadist.effects.speed_sidebands_diagnose._run_line_power`).  Those sums are computed here: one run
 (:func:`windowed_dft`) or a stack of equally long runs at once (:func:`windowed_dfts`: one batched matrix
 product per chunk of runs instead of a dozen small array operations per run), and the transform of the
 periodic Hann window in closed form (:func:`hann_transform`: the leakage of a line into its neighbours).

@@ -21,7 +21,7 @@ STAND_MIN_LOG_GAIN = float(np.log(1.5))
 #: the fit allows (ζ → 0.5) is a broad tilt of the line gains (a wheel mode's skirt, model error), not a stand.
 STAND_MAX_ZETA = 0.2
 #: Smallest damping ratio of a fixture resonance: the fits' lower bound is 0.001 (:func:`_log_bounds_and_gain_start`,
-#: :class:`rwadist.diagnose.effects.fixed_resonance.FixedResonance`); a fit that ends there measured no width -- a
+#: :class:`rwadist.effects.fixed_resonance_diagnose.FixedResonance`); a fit that ends there measured no width -- a
 #: "resonance" narrower than the lines resolve, one line's misfit at one speed lifted by a gain of 20-40.
 STAND_MIN_ZETA = 0.0015
 #: Rounds of (stand on the modes' base, modes with that stand divided out) at most.

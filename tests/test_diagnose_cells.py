@@ -174,7 +174,7 @@ def test_a_refit_that_raises_the_error_is_not_added(monkeypatch):
     and no accepted effect raises the error."""
     from dataclasses import replace
 
-    from rwadist.diagnose.effects.fixed_resonance import FixedResonance
+    from rwadist.effects.fixed_resonance_diagnose import FixedResonance
 
     ref = shared_reference(SHORT_GRID, n_samples=2048)
     monkeypatch.setattr(FixedResonance, "refit", lambda self, ctx, state: replace(self, f_r=178.44, zeta=1e-3,

@@ -23,7 +23,8 @@ from rwadist import cli
 from rwadist import extended as ext
 from rwadist import model as model_io
 from rwadist.data import Run, SteadyTest, write_steady
-from rwadist.diagnose import Context, CounterRotation, diagnose, initial_state, resolve_base
+from rwadist.diagnose import Context, diagnose, initial_state, resolve_base
+from rwadist.effects.counter_rotation_diagnose import CounterRotation
 from rwadist.presets import preset
 from rwadist.teststand import simulate_steady
 from rwadist.units import CHANNELS, rpm_to_rad_s

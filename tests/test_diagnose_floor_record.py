@@ -3,7 +3,7 @@
 At 2048 samples and 3840 Hz diagnose's Welch bins are 7.5 Hz wide; with ±LINE_HALF bins masked around each line,
 no bin between 26 and 266 Hz is left at the top speeds, where a floor low-passed at 60 Hz lives.  The floor is
 measured there on each run's whole-record spectrum, between the lines
-(:func:`rwadist.diagnose.effects.broadband_floor.record_offline_bands`).  Checked against closed forms: the
+(:func:`rwadist.effects.broadband_floor_diagnose.record_offline_bands`).  Checked against closed forms: the
 white sensor noise's PSD 2σ²/fs under strong lines, and the injected floor's PSD (a 2nd-order Butterworth
 low-pass of white noise of known RMS, :mod:`rwadist.inject`).
 """
@@ -15,7 +15,7 @@ from scipy import signal
 
 from rwadist import api
 from rwadist.diagnose.constants import BAND_BINS
-from rwadist.diagnose.effects.broadband_floor import record_offline_bands
+from rwadist.effects.broadband_floor_diagnose import record_offline_bands
 from rwadist.inject import parse, simulate_with_injections
 from rwadist.presets import preset
 

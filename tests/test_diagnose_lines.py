@@ -14,8 +14,8 @@ import pytest
 
 from rwadist import api
 from rwadist.dft import windowed_dft
-from rwadist.diagnose.effects.missing_harmonic import welch_low_limit
 from rwadist.diagnose.measure import hann_transform_ratio
+from rwadist.effects.missing_harmonic_diagnose import welch_low_limit
 from rwadist.inject import parse, simulate_with_injections
 from rwadist.presets import preset
 

@@ -91,7 +91,8 @@ def test_ripple_sideband_powers_are_bessel_and_conserve_power():
 def test_ripple_prediction_matches_welch_of_a_rippled_line():
     """Context.predict of one line under a speed ripple is the Welch PSD of the synthesised rippled line
     (independent synthesis: cumulative phase h·ψ(t) sampled, scipy Welch) to a few per cent where it matters."""
-    from rwadist.diagnose import Context, SpeedRipple, State
+    from rwadist.diagnose import Context, State
+    from rwadist.effects.speed_ripple_diagnose import SpeedRipple
     from rwadist.model import Harmonic, WheelModel
 
     test = e_data(0, speeds=np.array([1500.0]))

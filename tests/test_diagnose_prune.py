@@ -13,8 +13,9 @@ import numpy as np
 from test_diagnose import TRUTH, W_MID, e_data, inject_line, spectra
 
 from rwadist.diagnose import engine, search
-from rwadist.diagnose.effects import EFFECT_CLASSES
-from rwadist.diagnose.effects.speed_sidebands import REACH, SpeedSidebands
+from rwadist.diagnose.effects import family_classes
+from rwadist.effects.speed_sidebands_diagnose import REACH, SpeedSidebands
+from rwadist.effects.spin_acceleration_diagnose import SpinAcceleration
 from rwadist.presets import preset
 
 
@@ -34,7 +35,7 @@ def test_no_hypothesis_the_bound_skips_could_pass():
     memo: dict = {}
     ctx.step = (state, lambda chans: search._state_errors(ctx, state, ctx.held_runs, chans, memo), 0.05)
     checked = 0
-    for cls in EFFECT_CLASSES:
+    for cls in family_classes():
         for e in _unbounded(cls, ctx, state):
             own = getattr(e, "heldout_evidence", None)
             if own is not None and own(ctx, state, ctx.held_runs) is not None:
@@ -81,7 +82,7 @@ def test_record_lines_beside_a_skipped_welch_line_are_still_dropped(monkeypatch)
     """A line h = 0.5 (below the Welch band at the slow runs, in it at the fast ones) is found by both routes; the
     record route's is not proposed beside the Welch route's.  Skipping the Welch route (nothing there could pass)
     must leave the record route's proposals as they were: the Welch line still tells the record line apart."""
-    from rwadist.diagnose.effects.missing_harmonic import MissingHarmonic
+    from rwadist.effects.missing_harmonic_diagnose import MissingHarmonic
 
     t = e_data(8)
     inject_line(t, "radial_force", 0.5, lambda w: 0.5 * TRUTH.empirical["radial_force"][0].C * w**2, 8)
@@ -123,11 +124,9 @@ def test_held_out_predictions_under_a_smear_are_their_own():
     run.signals.update({c: np.concatenate([x, x]) for c, x in run.signals.items()})
     ctx = engine.Context(spectra(t), test=t)
     assert longest in ctx.fit_runs and ctx.run_durations(ctx.runs).max() > ctx.run_durations(ctx.held_runs).max()
-    direct = engine.initial_state(ctx, replace(TRUTH)).copy()
-    direct.smear = 100.0
+    direct = engine.initial_state(ctx, replace(TRUTH)).plus(SpinAcceleration(100.0))
     first = ctx.predict(direct, "Fx", ctx.held_runs).copy()
-    after = engine.initial_state(ctx, replace(TRUTH)).copy()
-    after.smear = 100.0
+    after = engine.initial_state(ctx, replace(TRUTH)).plus(SpinAcceleration(100.0))
     ctx.predict(after, "Fx", ctx.runs)                        # every run first, as after an accepted refit
     assert np.array_equal(ctx.predict(after, "Fx", ctx.held_runs), first)
 

@@ -6,7 +6,9 @@ from pathlib import Path
 import numpy as np
 
 from rwadist import model as model_io
-from rwadist.diagnose import EFFECT_CLASSES, REGISTRY, Effect, MissingHarmonic, SpeedRipple
+from rwadist.diagnose import REGISTRY, Effect, family_classes
+from rwadist.effects.missing_harmonic_diagnose import MissingHarmonic
+from rwadist.effects.speed_ripple_diagnose import SpeedRipple
 from rwadist.presets import preset
 
 PACKAGE = Path(__file__).resolve().parents[1] / "rwadist" / "diagnose"
@@ -14,6 +16,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "rwadist" / "diagnose"
 
 def test_registry_holds_every_family_once_in_the_search_order():
     # the order the search has always asked for candidates (its ranking is a stable sort: ties keep it)
+    EFFECT_CLASSES = family_classes()
     assert [c.__name__ for c in EFFECT_CLASSES] == [
         "MissingHarmonic", "SpeedSidebands", "AmplitudeLaw", "BroadbandFloor", "FixedResonance", "CrossCoupling",
         "LeverArmNoise", "Sidebands",
@@ -27,10 +30,13 @@ def test_registry_holds_every_family_once_in_the_search_order():
 
 
 def test_one_module_per_family_and_no_dispatch_on_concrete_classes():
-    """Every family module registers exactly one class; the search names no concrete family."""
-    mods = sorted(p.stem for p in (PACKAGE / "effects").glob("*.py") if p.stem not in ("__init__", "base"))
+    """Every family module (``rwadist/effects/<kind>_diagnose.py``, beside its kind's element) registers exactly one
+    class of its kind; the search names no concrete family."""
+    EFFECT_CLASSES = family_classes()
+    mods = sorted(p.stem for p in (PACKAGE.parent / "effects").glob("*_diagnose.py"))
     assert len(mods) == len(EFFECT_CLASSES)
     assert sorted(c.__module__.rsplit(".", 1)[1] for c in EFFECT_CLASSES) == mods
+    assert all(c.__module__ == f"rwadist.effects.{c.kind}_diagnose" for c in EFFECT_CLASSES)
     names = {c.__name__ for c in EFFECT_CLASSES}
     tree = ast.parse((PACKAGE / "search.py").read_text())
     used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} | \

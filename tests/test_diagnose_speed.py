@@ -44,7 +44,7 @@ def _peak_by_mask(f, y, lo, hi, df):
 
 
 def test_peak_locator_matches_the_window_mask():
-    from rwadist.diagnose.effects.fixed_resonance import FixedResonance
+    from rwadist.effects.fixed_resonance_diagnose import FixedResonance
 
     rng = np.random.default_rng(3)
     for _ in range(60):
@@ -65,7 +65,9 @@ def test_fixed_resonance_fit_reused_only_for_the_same_channels_content():
     in between) and equals a fresh fit; a state that differs on its channels is fitted anew."""
     from dataclasses import replace
 
-    from rwadist.diagnose import Context, FixedResonance, MissingHarmonic, initial_state
+    from rwadist.diagnose import Context, initial_state
+    from rwadist.effects.fixed_resonance_diagnose import FixedResonance
+    from rwadist.effects.missing_harmonic_diagnose import MissingHarmonic
     from rwadist.presets import preset
     from rwadist.spectra import compute_spectra
     from rwadist.teststand import Mode, simulate_steady
@@ -97,8 +99,9 @@ def test_flat_no_resonance_stop_keeps_the_decision(monkeypatch):
     fixture resonance both give the same f_r, ζ, g."""
     from dataclasses import replace
 
-    from rwadist.diagnose import Context, FixedResonance, initial_state
-    from rwadist.diagnose.effects import fixed_resonance as fr
+    from rwadist.diagnose import Context, initial_state
+    from rwadist.effects import fixed_resonance_diagnose as fr
+    from rwadist.effects.fixed_resonance_diagnose import FixedResonance
     from rwadist.presets import preset
     from rwadist.spectra import compute_spectra
     from rwadist.teststand import Mode, simulate_steady

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from rwadist.diagnose import diagnose
-from rwadist.diagnose.effects.speed_sidebands import MIN_BINS, resolvable_runs
+from rwadist.effects.speed_sidebands_diagnose import MIN_BINS, resolvable_runs
 from rwadist.inject import parse, simulate_with_injections
 from rwadist.presets import preset
 from rwadist.spectra import compute_spectra

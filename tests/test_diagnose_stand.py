@@ -18,9 +18,10 @@ import independent_wheel as iw  # noqa: E402
 
 from rwadist import api, catalogue  # noqa: E402
 from rwadist.data import SteadyTest  # noqa: E402
-from rwadist.diagnose import Context, MissingHarmonic, initial_state  # noqa: E402
-from rwadist.diagnose.effects.suspension_modes import stand_resonance_start  # noqa: E402
+from rwadist.diagnose import Context, initial_state  # noqa: E402
 from rwadist.diagnose.search import _judge, fits_modes_from_data, resolve_base  # noqa: E402
+from rwadist.effects.missing_harmonic_diagnose import MissingHarmonic  # noqa: E402
+from rwadist.effects.suspension_modes_diagnose import stand_resonance_start  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402
 from rwadist.inject import parse, simulate_with_injections  # noqa: E402
 from rwadist.presets import preset  # noqa: E402

@@ -50,7 +50,7 @@ def test_virtual_stand_extended_physics_only_the_suspension_modes(tmp_path):
     half = 0.5 * (iw.I_ZZ / iw.I_RR) * w_top / (2 * np.pi)
     f_fwd = np.sqrt(half**2 + iw.TRUTH_HZ["rocking"] ** 2) + half
     assert e["inertia_ratio"] == pytest.approx(iw.I_ZZ / iw.I_RR, rel=0.02)
-    from rwadist.diagnose import SuspensionModes
+    from rwadist.effects.suspension_modes_diagnose import SuspensionModes
     fitted = d.state_after.effects[0]
     assert isinstance(fitted, SuspensionModes)
     assert fitted.whirl_Hz(w_top)["rocking_forward"] == pytest.approx(f_fwd, rel=0.02)

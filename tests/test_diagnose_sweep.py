@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rwadist.diagnose import SpinAcceleration, diagnose
+from rwadist.diagnose import diagnose
+from rwadist.effects.spin_acceleration_diagnose import SpinAcceleration
 from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
 from rwadist.sweep import slice_sweep
@@ -47,10 +48,10 @@ def test_smear_prediction_conserves_power_and_spreads_with_h():
     spreads over h|α|T/2π Hz (plus ⅓ of a segment's own sweep on each side): twice as wide for h = 2."""
     wheel, test, sp = sweep_data(40.0, 1)
     from rwadist.diagnose import Context, initial_state
+    from rwadist.effects.spin_acceleration_diagnose import SpinAcceleration
 
     ctx = Context(sp, test=test)
-    st = initial_state(ctx, wheel.to_model())
-    st.smear = 5.0
+    st = initial_state(ctx, wheel.to_model()).plus(SpinAcceleration(5.0))
     runs = ctx.runs[:4]
     T = ctx.run_durations(runs)
     for h in (1.0, 2.0):

@@ -135,8 +135,8 @@ def test_second_empirical_fit_reusing_the_detections_is_a_fresh_fit():
 
 def test_mode_fit_spectra_of_some_runs_are_those_runs_alone():
     from rwadist.data import SteadyTest
-    from rwadist.diagnose.effects.suspension_modes import _fit_spectra
     from rwadist.diagnose.engine import Context
+    from rwadist.effects.suspension_modes_diagnose import _fit_spectra
 
     test = _small_test()
     ctx = Context(compute_spectra(test, nperseg=512), test=test)
@@ -158,9 +158,9 @@ def test_mode_fit_spectra_of_some_runs_are_those_runs_alone():
 
 
 def test_every_line_measured_at_once_is_each_measured_alone():
-    from rwadist.diagnose.effects.fixed_resonance import FixedResonance
-    from rwadist.diagnose.effects.sidebands import Sidebands
     from rwadist.diagnose.engine import Context, initial_state
+    from rwadist.effects.fixed_resonance_diagnose import FixedResonance
+    from rwadist.effects.sidebands_diagnose import Sidebands
 
     test = _small_test()
     sp = compute_spectra(test, nperseg=512)

@@ -3,8 +3,8 @@
 from the state is the key computed afresh, and it still tells states apart exactly where they differ."""
 import numpy as np
 
-from rwadist.diagnose.effects.fixed_resonance import FixedResonance
 from rwadist.diagnose.engine import Context, initial_state
+from rwadist.effects.fixed_resonance_diagnose import FixedResonance
 from rwadist.empirical import fit_empirical
 from rwadist.presets import preset
 from rwadist.spectra import compute_spectra
@@ -23,8 +23,8 @@ def test_content_key_kept_on_the_state_is_the_fresh_one():
         for state in (plain, forces):
             first = ctx.content_key(state, chans, runs)
             again = ctx.content_key(state, chans, runs)                  # read back from the state's cache
-            fresh_state = state.copy()                                   # the same content, nothing cached
-            fresh_state.noise, fresh_state.resonances = state.noise, list(state.resonances)
+            fresh_state = state.copy()              # the same content (its effects, hence its resonances), no cache
+            fresh_state.noise = state.noise
             assert first == again == ctx.content_key(fresh_state, chans, runs)
         touched = bool({"Fx", "Fy"} & set(chans))
         assert (ctx.content_key(plain, chans, runs) != ctx.content_key(forces, chans, runs)) == touched

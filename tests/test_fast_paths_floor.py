@@ -1,11 +1,11 @@
-"""``broadband_floor``'s floor law (:func:`rwadist.diagnose.effects.broadband_floor._floor_law`: every exponent of an
+"""``broadband_floor``'s floor law (:func:`rwadist.effects.broadband_floor_diagnose._floor_law`: every exponent of an
 IRLS pass solved at once) against the plain loop over the exponents it replaces, on floors that grow (with scatter,
 empty bands and bands of zero data) and on flat noise."""
 import numpy as np
 import pytest
 
 from rwadist.diagnose.constants import FLOOR_EXPONENTS
-from rwadist.diagnose.effects.broadband_floor import _floor_law
+from rwadist.effects.broadband_floor_diagnose import _floor_law
 
 
 def _plain_floor_law(wt, y, x0):

@@ -1,10 +1,10 @@
-"""The sideband scans' per-offset medians (:func:`rwadist.diagnose.effects.speed_sidebands.side_pair_medians`, every
+"""The sideband scans' per-offset medians (:func:`rwadist.effects.speed_sidebands_diagnose.side_pair_medians`, every
 offset at once) against np.median of each offset's values one at a time, as the scans computed them: odd and even
 counts, fewer than 6 values, a NaN among them, repeated values, one and several channels."""
 import numpy as np
 import pytest
 
-from rwadist.diagnose.effects.speed_sidebands import side_pair_medians
+from rwadist.effects.speed_sidebands_diagnose import side_pair_medians
 
 
 def _loop(z, ok, cols):

@@ -1,4 +1,4 @@
-"""The record route of ``missing_harmonic`` (:func:`rwadist.diagnose.effects.missing_harmonic.record_residual`) with its
+"""The record route of ``missing_harmonic`` (:func:`rwadist.effects.missing_harmonic_diagnose.record_residual`) with its
 whole-run phasors kept on the context and computed for many runs at once, against the plain per-run sums it replaces:
 each run's windowed record transformed alone (:func:`rwadist.dft.windowed_dft`), the state's lines' leakage
 subtracted with the Hann window's transform written as Dirichlet sums, the noise from the run's own median."""
@@ -7,9 +7,9 @@ import pytest
 
 from rwadist.dft import run_window, windowed_dft
 from rwadist.diagnose import measure
-from rwadist.diagnose.effects import missing_harmonic as mh
-from rwadist.diagnose.effects.sidebands import Sidebands
 from rwadist.diagnose.engine import Context, initial_state
+from rwadist.effects import missing_harmonic_diagnose as mh
+from rwadist.effects.sidebands_diagnose import Sidebands
 from rwadist.empirical import fit_empirical
 from rwadist.presets import preset
 from rwadist.spectra import compute_spectra

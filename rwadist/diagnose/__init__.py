@@ -2,8 +2,9 @@
 
 :func:`diagnose` starts from a model (the empirical fit of the data, or a given model file / preset),
 predicts the expected Welch PSD of every run and channel, and looks at the residual on the speed ×
-frequency plane.  Effect families (one module each in :mod:`rwadist.diagnose.effects`, one protocol,
-one registry) propose hypotheses from the residual, fit them on half of the speeds and are ranked on
+frequency plane.  Effect families (the diagnose hypothesis of each effect kind, beside its element in
+:mod:`rwadist.effects`; one protocol, one registry, :mod:`rwadist.diagnose.effects`) propose hypotheses from
+the residual, fit them on half of the speeds and are ranked on
 the other half; the best one passing the held-out test is added and the search repeats until nothing
 passes.  :func:`write_report` writes what was found.
 
@@ -13,7 +14,8 @@ in ``docs/diagnose.md``; the package's modules:
 - :mod:`~rwadist.diagnose.engine` the prediction engine (:class:`Context`, :func:`line_kernel`),
   :mod:`~rwadist.diagnose.state` the :class:`State`, :mod:`~rwadist.diagnose.metric` the error metric;
 - :mod:`~rwadist.diagnose.measure` residual measurements shared by effect families;
-- :mod:`~rwadist.diagnose.effects` the effect families and their registry;
+- :mod:`~rwadist.diagnose.effects` the effect families' protocol and registry (the families themselves:
+  ``rwadist/effects/<kind>_diagnose.py``);
 - :mod:`~rwadist.diagnose.search` the greedy search (:func:`diagnose`, :func:`resolve_base`);
 - :mod:`~rwadist.diagnose.report` the report (:func:`write_report`).
 """
@@ -31,17 +33,7 @@ from .constants import (
                         SNR_KNEE,
                         TORQUE_CHANNELS,
 )
-from .effects import EFFECT_CLASSES, REGISTRY, Effect
-from .effects.amplitude_law import AmplitudeLaw
-from .effects.broadband_floor import BroadbandFloor
-from .effects.counter_rotation import CounterRotation
-from .effects.cross_coupling import CrossCoupling
-from .effects.fixed_resonance import FixedResonance
-from .effects.missing_harmonic import MissingHarmonic
-from .effects.sidebands import Sidebands
-from .effects.speed_ripple import SpeedRipple
-from .effects.spin_acceleration import SpinAcceleration
-from .effects.suspension_modes import SuspensionModes
+from .effects import REGISTRY, Effect, family_classes
 from .engine import Context, initial_state, line_kernel, noise_estimate, ripple_sideband_powers
 from .measure import refine_h, ridge_peaks
 from .report import rms_vs_speed, write_report
@@ -49,10 +41,8 @@ from .search import BASES, Diagnosis, Hypothesis, diagnose, effect_entry, resolv
 from .state import State
 
 __all__ = [
-    "BAND_BINS", "BASES", "EFFECT_CLASSES", "F_MIN_BINS", "FLOOR_EXPONENTS", "KERNEL_HALF", "LINE_HALF", "METRIC",
-    "NOISE_Z", "REGISTRY", "SNR_KNEE", "TORQUE_CHANNELS", "AmplitudeLaw", "BroadbandFloor", "Context",
-    "CounterRotation", "CrossCoupling", "Diagnosis", "Effect", "FixedResonance", "Hypothesis", "MissingHarmonic",
-    "Sidebands", "SpeedRipple", "SpinAcceleration", "State", "SuspensionModes", "diagnose", "effect_entry", "initial_state",
-    "line_kernel", "noise_estimate", "refine_h", "resonance", "resolve_base", "ridge_peaks",
-    "ripple_sideband_powers", "rms_vs_speed", "write_report",
+    "BAND_BINS", "BASES", "F_MIN_BINS", "FLOOR_EXPONENTS", "KERNEL_HALF", "LINE_HALF", "METRIC", "NOISE_Z", "REGISTRY",
+    "SNR_KNEE", "TORQUE_CHANNELS", "Context", "Diagnosis", "Effect", "Hypothesis", "State", "diagnose", "effect_entry",
+    "family_classes", "initial_state", "line_kernel", "noise_estimate", "refine_h", "resonance", "resolve_base",
+    "ridge_peaks", "ripple_sideband_powers", "rms_vs_speed", "write_report",
 ]

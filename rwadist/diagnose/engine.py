@@ -86,9 +86,9 @@ class Context(Metric):
         the rows the caller reads; a corrected torque is computed for the runs asked for so far only (a run's
         Welch PSD is its own: the held-out judge of a ``cross_coupling`` hypothesis reads half of them), the other
         rows NaN until asked for; None: every run."""
-        if state.coupling is None or c not in TORQUE_CHANNELS:
+        if state.load_cell_offset is None or c not in TORQUE_CHANNELS:
             return self.sp.psd[c]
-        key = tuple(float(x) for x in state.coupling)
+        key = tuple(float(x) for x in state.load_cell_offset)
         chans = [k for k in TORQUE_CHANNELS if k in self.sp.psd]
         if key not in self._corrected:
             self._corrected[key] = ({k: np.full_like(self.sp.psd[k], np.nan) for k in chans},
@@ -168,9 +168,9 @@ class Context(Metric):
     def data_floor(self, state: State, c: str) -> np.ndarray:
         """Block floor (n_runs, n_f) of channel ``c`` as the state reads its data (:meth:`data`): a torque
         channel corrected for the state's load-cell offset has its own (the correction moves noise)."""
-        if state.coupling is None or c not in TORQUE_CHANNELS:
+        if state.load_cell_offset is None or c not in TORQUE_CHANNELS:
             return self.floor[c]
-        key = ("data_floor", tuple(float(x) for x in state.coupling), c)
+        key = ("data_floor", tuple(float(x) for x in state.load_cell_offset), c)
         if key not in self._memo:
             psd = self.data(state, c)
             fl = np.full_like(psd, np.nan)
@@ -247,9 +247,9 @@ class Context(Metric):
     def ripple_powers(self, state: State, h: float, law, runs: np.ndarray):
         """(k, P) of the state's speed ripple for a line h: sideband orders k (2K+1,) and their power
         fractions P (len(runs), 2K+1) (:func:`ripple_sideband_powers`), or None without a ripple."""
-        if state.ripple is None:
+        if state.speed_modulation is None:
             return None
-        d_ref, f_r, w_ref, q = state.ripple
+        d_ref, f_r, w_ref, q = state.speed_modulation
         w = self.omega[runs]
         dw = d_ref * (w / w_ref) ** q
         p_amp = 2.0 if law is None else law[2]
@@ -391,8 +391,8 @@ class Context(Metric):
     def predict(self, state: State, c: str, runs: np.ndarray, skip=None, only=None) -> np.ndarray:
         """Expected PSD of channel ``c`` on ``runs``; ``skip`` = h of a line to leave out (with its
         sidebands); ``only`` = h of the one line to predict (with its sidebands; no noise floor).  A line's
-        components (carrier and ``sidebands``, :meth:`State.line_components`) are each multiplied by the
-        resonance gain at their own frequency and, under a ``speed_ripple``, spread over f + k·f_ripple with
+        components (carrier and amplitude-modulation sidebands, :meth:`State.line_components`) are each multiplied by
+        the resonance gain at their own frequency and, under a speed modulation, spread over f + k·f_ripple with
         the power fractions of :meth:`ripple_powers`.
 
         The whole prediction (no ``skip``, no ``only``) is computed once per (channel, runs) and kept on the
@@ -403,7 +403,7 @@ class Context(Metric):
             if key not in state._cache:
                 # under a spin smear or a speed ripple the lines' spreading is set by the runs asked together
                 kept = self.rows_of_every_run(state, "predict", c, runs) \
-                    if state.smear is None and state.ripple is None else None
+                    if state.smear is None and state.speed_modulation is None else None
                 if kept is not None:
                     whole, pos = kept
                     full = whole[pos]           # each run's prediction is its own: the rows of every run's
@@ -441,7 +441,8 @@ class Context(Metric):
                     plain_p.append(a**2 / 2.0)
                 else:
                     k, P = rip
-                    out += self.psd_at(f[:, None] + k[None, :] * state.ripple[1], (a**2 / 2.0)[:, None] * P, bins)
+                    f_r = state.speed_modulation[1]
+                    out += self.psd_at(f[:, None] + k[None, :] * f_r, (a**2 / 2.0)[:, None] * P, bins)
         if plain_f:
             out += self.psd_at(np.column_stack(plain_f), np.column_stack(plain_p), bins)
         return out
@@ -513,7 +514,7 @@ class Context(Metric):
 
         runs = np.asarray(runs)
         hsh = hashlib.blake2b(digest_size=20)
-        hsh.update(repr((runs.tobytes(), state.ripple, state.smear)).encode())
+        hsh.update(repr((runs.tobytes(), state.speed_modulation, state.smear)).encode())
         for c in chans:
             hsh.update(self._channel_digest(state, c, runs))
         return hsh.digest()
@@ -526,7 +527,7 @@ class Context(Metric):
         key = ("content_digest", c, runs.tobytes())
         if key not in state._cache:
             hsh = hashlib.blake2b(digest_size=20)
-            coupling = tuple(float(x) for x in state.coupling) if state.coupling is not None \
+            coupling = tuple(float(x) for x in state.load_cell_offset) if state.load_cell_offset is not None \
                 and c in TORQUE_CHANNELS else None
             res = [r[:3] for r in state.resonances if c in r[3]]
             hsh.update(repr((c, coupling, res)).encode())
@@ -614,7 +615,7 @@ class Context(Metric):
                 kc = h * self.omega[runs] / (2 * np.pi) / self.df
                 kk = np.arange(self.f.size)[None, :]
                 mask |= (kk >= (kc - half)[:, None]) & (kk <= (kc + half)[:, None])
-        if state.sidebands or state.ripple is not None:
+        if state.modulations or state.speed_modulation is not None:
             # the model's sideband and ripple lines too, where their power is above a tenth of the noise
             # power in their window
             noise = self.floor_psd(state, c, runs)
@@ -625,7 +626,7 @@ class Context(Metric):
                     for j, kk in enumerate(rip[0]):
                         if shift == 0.0 and kk == 0:
                             continue
-                        f = np.abs(f0 + shift + kk * (state.ripple[1] if state.ripple else 0.0))
+                        f = np.abs(f0 + shift + kk * (state.speed_modulation[1] if state.speed_modulation else 0.0))
                         k = np.clip(np.rint(f / self.df).astype(int)[:, None] + offs, 0, self.f.size - 1)
                         pw = (amp * rel) ** 2 / 2 * rip[1][:, j]
                         big = pw > 0.1 * noise[rows, k].sum(1) * self.df
@@ -673,7 +674,7 @@ class Context(Metric):
         at its window (:meth:`_predict` with ``only``) computed in one kernel pass.  Under a speed ripple or a spin
         smear, line by line."""
         cl = self.channel_lines(state, c, runs)
-        if state.smear is not None or state.ripple is not None or not cl:
+        if state.smear is not None or state.speed_modulation is not None or not cl:
             return np.array([self.measure_line(state, c, h, runs, skip=h)
                              for h, _, _, _ in cl]).reshape(len(cl), runs.size)
         hs = np.array([x[0] for x in cl])

@@ -117,7 +117,7 @@ class Metric:
             state._cache[key] = whole[pos]
             return state._cache[key]
         out = np.zeros((runs.size, self.n_bands))
-        if state.smear is None and state.ripple is None and self.sp.window == "hann":
+        if state.smear is None and state.speed_modulation is None and self.sp.window == "hann":
             comps = []
             for h, _, amp, _ in self.channel_lines(state, c, runs):
                 f0 = h * self.omega[runs] / (2 * np.pi)
@@ -233,7 +233,7 @@ class Metric:
                 return state._cache[key]
             # not under a spin smear or a speed ripple: there the lines' spreading is set by the runs asked together
             kept = self.rows_of_every_run(state, "channel_terms", c, runs) \
-                if state.smear is None and state.ripple is None else None
+                if state.smear is None and state.speed_modulation is None else None
             if kept is not None:
                 whole, pos = kept
                 return tuple(x[pos] for x in whole)
@@ -255,7 +255,8 @@ class Metric:
         """(runs with data (len(runs),), band sums of the data as the state reads it (len(runs), n_bands)) of channel
         ``c``: the data's alone (a torque corrected for the state's load-cell offset is keyed by it), kept on the
         context, read-only."""
-        offset = tuple(float(x) for x in state.coupling) if state.coupling is not None and c in TORQUE_CHANNELS \
+        r = state.load_cell_offset
+        offset = tuple(float(x) for x in r) if r is not None and c in TORQUE_CHANNELS \
             else None
         key = ("data_bands", c, offset, runs.tobytes())
         if key not in self._memo:

@@ -12,7 +12,7 @@ from ..empirical import fit_empirical
 from ..model import WheelModel
 from ..spectra import Spectra
 from .constants import BAND_BINS, METRIC, NOISE_Z
-from .effects import EFFECT_CLASSES
+from .effects import family_classes
 from .engine import Context, initial_state
 from .measure import in_unresolved_span
 from .state import State
@@ -155,7 +155,7 @@ def _base_lines(hyps, model=None) -> None:
     base (``Hypothesis.base_line``), not foreign effects.
 
     Once the wheel's modes are fitted from the data, the base's harmonics are the data's own lines (the
-    extended fit of :class:`~rwadist.diagnose.effects.suspension_modes.SuspensionModes` replaces the starting
+    extended fit of :class:`~rwadist.effects.suspension_modes_diagnose.SuspensionModes` replaces the starting
     model's): there is no model a line could be missing from, so a line at a constant h that this fit did not
     resolve (two close lines merged at a short record's resolution, a line below the fit's detection at the
     low speeds) is the wheel's own content, completed into the base.  It stays in the improved model's
@@ -280,8 +280,8 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     # a family marked ``first`` (the wheel's own modes) is taken before any other passing effect: it is proposed
     # and judged alone, and the other families only when it is not taken (the same choice as judging all together,
     # without fitting every other family to a state about to change)
-    first = [cls for cls in EFFECT_CLASSES if getattr(cls, "first", False)]
-    rest = [cls for cls in EFFECT_CLASSES if not getattr(cls, "first", False)]
+    first = [cls for cls in family_classes() if getattr(cls, "first", False)]
+    rest = [cls for cls in family_classes() if not getattr(cls, "first", False)]
     for it in range(1, max_iterations + 1):
         memo: dict = {}
         judged: list = []
@@ -318,7 +318,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     ctx.step = None
     # a family may revise what it added in the light of what came after it (``finish``: the wheel's modes beside the
     # fixture resonances named after them); the hypotheses report the revised effects
-    for cls in EFFECT_CLASSES:
+    for cls in family_classes():
         finish = getattr(cls, "finish", None)
         if finish is not None:
             done = finish(ctx, state)

@@ -9,40 +9,99 @@ from ..units import CHANNEL_DIRECTION
 
 
 @dataclass
-class State:
-    """What the model predicts: harmonics, their amplitude laws, noise and broadband floors.
+class Prediction:
+    """What the effects of a state add to its prediction, in the engine's terms (no effect kind): each effect object
+    of the state puts its part here (its ``contribute``), in the order the effects were added.
 
-    model : WheelModel (harmonics in ``empirical``).  laws : (direction, h) -> (amp_ref, omega_ref, p).
-    noise : channel -> N_c(f), unit²/Hz.  floors : channel -> (psd_ref(f) unit²/Hz, omega_ref rad/s, p).
-    resonances : (f_r Hz, ζ, g, channels) fixed-frequency resonances multiplying the lines of their channels.
-    coupling : load-cell offset r (m, 3-vector) of a ``cross_coupling`` effect, or None: the torque data are
-        then read corrected, T − r × F (:meth:`Context.data`).
-    sidebands : (direction, h, f_mod Hz, depth m) of ``sidebands`` effects: the line h of that direction
-        carries two more lines at h|Ω|/2π ± f_mod of amplitude m·a/2.
-    ripple : (ΔΩ_ref rad/s, f_ripple Hz, Ω_ref rad/s, q) of a ``speed_ripple`` effect, or None: every line
-        is spread over f_i + k·f_ripple with the powers of :func:`ripple_sideband_powers`.
-    smear : |dΩ/dt| (rad/s²) of a ``spin_acceleration`` effect, or None: every line of a run is spread
-        uniformly over the frequencies its harmonic sweeps during the run (:meth:`Context.smear_offsets`).
-    effects : effect objects added so far.
-    """
+    laws : (direction, h rounded to 4 places) -> (A_ref, Ω_ref rad/s, p): the line's amplitude A_ref·(|Ω|/Ω_ref)^p
+        instead of C·Ω².  floors : channel -> (psd_ref(f) unit²/Hz on the grid, Ω_ref rad/s, p): a broadband floor
+        psd_ref·(|Ω|/Ω_ref)^p added to the channel.  resonances : (f_r Hz, ζ, g, channels): fixed-frequency
+        resonances multiplying the lines of their channels.  load_cell_offset : r (m, 3-vector) or None: the torque
+        data are read corrected, T − r × F (:meth:`Context.data`).  modulations : (direction, h, f_mod Hz, depth m):
+        the line h of that direction carries two more lines at h|Ω|/2π ± f_mod of amplitude m·a/2.
+        speed_modulation : (ΔΩ_ref rad/s, f_r Hz, Ω_ref rad/s, q) or None: a periodic speed ripple
+        Ω0 + ΔΩ sin 2πf_r t, ΔΩ = ΔΩ_ref·(|Ω0|/Ω_ref)^q; every line is spread over f_i + k·f_r with the powers of
+        :func:`~rwadist.diagnose.engine.ripple_sideband_powers`.  smear : |dΩ/dt| (rad/s²) or None: every line of a
+        run is spread uniformly over the frequencies its harmonic sweeps during the run
+        (:meth:`Context.smear_offsets`)."""
+
+    laws: dict = field(default_factory=dict)
+    floors: dict = field(default_factory=dict)
+    resonances: list = field(default_factory=list)
+    load_cell_offset: tuple | None = None
+    modulations: list = field(default_factory=list)
+    speed_modulation: tuple | None = None
+    smear: float | None = None
+
+
+@dataclass
+class State:
+    """What the model predicts: its harmonics, the instrument noise and the effects added so far.
+
+    model : WheelModel (harmonics in ``empirical``).  noise : channel -> N_c(f), unit²/Hz.  effects : the effect
+    objects added so far (the families' hypotheses, :mod:`rwadist.diagnose.effects`), in order; their part of the
+    prediction is :attr:`prediction` (read through :attr:`laws`, :attr:`floors`, ...).  ext : the extended
+    parameters when the lines go through the rotor's suspension modes, else None.
+
+    A state is made once and not changed after (an effect's ``apply`` returns a new one: :meth:`plus`); its
+    predictions are kept on it."""
 
     model: WheelModel
     noise: dict
-    laws: dict = field(default_factory=dict)
-    floors: dict = field(default_factory=dict)
     effects: list = field(default_factory=list)
-    resonances: list = field(default_factory=list)
-    coupling: tuple | None = None
-    sidebands: list = field(default_factory=list)
-    ripple: tuple | None = None
     ext: object = None
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
-    smear: float | None = None
 
     def copy(self) -> "State":
-        return State(copy.deepcopy(self.model), self.noise, dict(self.laws), dict(self.floors), list(self.effects),
-                     list(self.resonances), self.coupling, list(self.sidebands), self.ripple, self.ext,
-                     smear=self.smear)
+        return State(copy.deepcopy(self.model), self.noise, list(self.effects), self.ext)
+
+    def plus(self, effect) -> "State":
+        """A new state with ``effect`` added after the others (this state is not changed)."""
+        s = self.copy()
+        s.effects.append(effect)
+        return s
+
+    @property
+    def prediction(self) -> Prediction:
+        """The effects' parts of the prediction (:class:`Prediction`), made once per list of effects."""
+        key = tuple(map(id, self.effects))
+        kept = self._cache.get("prediction")
+        if kept is None or kept[0] != key:
+            parts = Prediction()
+            for e in self.effects:
+                contribute = getattr(e, "contribute", None)
+                if contribute is not None:
+                    contribute(parts)
+            kept = self._cache["prediction"] = (key, parts)
+        return kept[1]
+
+    @property
+    def laws(self) -> dict:
+        return self.prediction.laws
+
+    @property
+    def floors(self) -> dict:
+        return self.prediction.floors
+
+    @property
+    def resonances(self) -> list:
+        return self.prediction.resonances
+
+    @property
+    def load_cell_offset(self) -> tuple | None:
+        return self.prediction.load_cell_offset
+
+    @property
+    def modulations(self) -> list:
+        return self.prediction.modulations
+
+    @property
+    def speed_modulation(self) -> tuple | None:
+        return self.prediction.speed_modulation
+
+    @property
+    def smear(self) -> float | None:
+        return self.prediction.smear
 
     @property
     def base(self) -> str:
@@ -79,10 +138,10 @@ class State:
 
     def line_components(self, channel: str, h: float):
         """(frequency shift Hz, relative amplitude) of the line h of ``channel``: the carrier (0, 1) and the
-        pairs (±f_mod, m/2) of its ``sidebands`` effects."""
+        pairs (±f_mod, m/2) of its amplitude modulations (:attr:`modulations`)."""
         d = CHANNEL_DIRECTION[channel]
         out = [(0.0, 1.0)]
-        for dd, hh, f_m, m in self.sidebands:
+        for dd, hh, f_m, m in self.modulations:
             if dd == d and abs(hh - h) < 1e-4:
                 out += [(f_m, 0.5 * m), (-f_m, 0.5 * m)]
         return out

@@ -35,8 +35,13 @@ class Effect(Protocol):
     def candidates(ctx: Context, state: State, runs) -> list: ...
 
     def apply(self, state: State) -> State:
-        """A new state with this effect in it (``state`` is not changed)."""
+        """A new state with this effect in it (``state`` is not changed): :meth:`State.plus`, and what the effect
+        changes besides (the model's harmonics, the noise estimate)."""
         ...
+
+    # optional: ``contribute(parts)`` puts the effect's part of the prediction in ``parts`` (a
+    # :class:`~rwadist.diagnose.state.Prediction`: an amplitude law, a floor, a resonance, ...); the state's
+    # prediction is every effect's part, in order
 
     def refit(self, ctx: Context, state: State) -> "Effect":
         """This effect refitted on every run (``ctx.runs``) in ``state``; itself when that fit fails."""

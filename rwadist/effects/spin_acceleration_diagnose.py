@@ -5,10 +5,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...units import CHANNELS
-from ..engine import Context, noise_estimate
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context, noise_estimate
+from ..diagnose.state import State
+from ..units import CHANNELS
 
 
 @register(order=90)
@@ -29,12 +29,13 @@ class SpinAcceleration:
         return CHANNELS
 
     def apply(self, state: State) -> State:
-        s = state.copy()
-        s.smear = self.alpha
+        s = state.plus(self)
         if self.noise is not None:
             s.noise = self.noise
-        s.effects.append(self)
         return s
+
+    def contribute(self, parts) -> None:
+        parts.smear = self.alpha
 
     def refit(self, ctx: Context, state: State) -> "SpinAcceleration":
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""
@@ -77,16 +78,14 @@ class SpinAcceleration:
         a_max = max(2 * np.pi * 16 * ctx.df / (h_max * T), 3.0 * track)
 
         def cost(a):
-            trial = state.copy()
-            trial.smear = float(a)
+            trial = state.plus(SpinAcceleration(float(a)))
             return float(ctx.run_errors(trial, runs)[0].sum())
 
         res = optimize.minimize_scalar(cost, bounds=(0.0, a_max), method="bounded",
                                        options={"xatol": 1e-3 * a_max})
         if not (res.x > 1e-3 * a_max and res.fun < cost(0.0)):
             return None
-        trial = state.copy()
-        trial.smear = float(res.x)
+        trial = state.plus(SpinAcceleration(float(res.x)))
         return SpinAcceleration(float(res.x), track, noise_estimate(ctx, trial))
 
     @staticmethod

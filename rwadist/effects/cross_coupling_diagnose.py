@@ -5,14 +5,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...units import CHANNELS
-from ..constants import TORQUE_CHANNELS
-from ..engine import Context
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.constants import TORQUE_CHANNELS
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.state import State
+from ..units import CHANNELS
 
 #: Standard errors a load-cell offset must lie from 0, in its largest component, to be an offset (also the rule for
-#: the offset removed before the suspension modes are located, :func:`rwadist.diagnose.effects.suspension_modes._beside_offset`)
+#: the offset removed before the suspension modes are located, :func:`rwadist.effects.suspension_modes_diagnose._beside_offset`)
 OFFSET_Z = 4.0
 
 
@@ -34,10 +34,10 @@ class CrossCoupling:
         return TORQUE_CHANNELS
 
     def apply(self, state: State) -> State:
-        s = state.copy()
-        s.coupling = tuple(float(x) for x in self.r)
-        s.effects.append(self)
-        return s
+        return state.plus(self)
+
+    def contribute(self, parts) -> None:
+        parts.load_cell_offset = tuple(float(x) for x in self.r)
 
     def refit(self, ctx: Context, state: State) -> "CrossCoupling":
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""
@@ -69,7 +69,7 @@ class CrossCoupling:
         the state predicts at the line (its torque lines and noise), so lines shared with the torque
         harmonics weigh little.  Unbiased when T0 and F have independent phases (as the test stand's
         random phases); standard errors from the weighted residual."""
-        if ctx.test is None or state.coupling is not None:
+        if ctx.test is None or state.load_cell_offset is not None:
             return None
         tq = [c for c in TORQUE_CHANNELS if c in ctx.channels]
         if not tq or not all(c in ctx.channels for c in ("Fx", "Fy", "Fz")):

@@ -5,11 +5,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...units import DIRECTION_CHANNELS
-from ..engine import Context
-from ..measure import _measure, in_unresolved_span
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.measure import _measure, in_unresolved_span
+from ..diagnose.state import State
+from ..units import DIRECTION_CHANNELS
 
 #: Standard errors an exponent must lie away from 2 (the model's C·Ω²) to be proposed as a law.
 EXPONENT_Z = 4.0
@@ -37,10 +37,10 @@ class AmplitudeLaw:
         return DIRECTION_CHANNELS[self.direction]
 
     def apply(self, state: State) -> State:
-        s = state.copy()
-        s.laws[(self.direction, round(self.h, 4))] = (self.amplitude_ref, self.omega_ref, self.exponent)
-        s.effects.append(self)
-        return s
+        return state.plus(self)
+
+    def contribute(self, parts) -> None:
+        parts.laws[(self.direction, round(self.h, 4))] = (self.amplitude_ref, self.omega_ref, self.exponent)
 
     def refit(self, ctx: Context, state: State) -> "AmplitudeLaw":
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""

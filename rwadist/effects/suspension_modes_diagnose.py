@@ -16,17 +16,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.state import State
+
 # the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
-from ...stand_resonance import (
+from ..stand_resonance import (
     STAND_ROUNDS,
     declare_coupled_modes,
     declare_unsettled_modes,
     fit_extended_beside_stand,
     stand_resonance_start,
 )
-from ..engine import Context
-from ..state import State
-from .base import register, schema_entry
 
 
 def _fit_spectra(ctx: Context, test, runs: list):
@@ -41,9 +42,9 @@ def _fit_spectra(ctx: Context, test, runs: list):
     ``runs``)."""
     from dataclasses import replace
 
-    from ...data import DataError
-    from ...empirical import detections_of_runs, line_detections
-    from ...spectra import _default_nperseg, compute_spectra
+    from ..data import DataError
+    from ..empirical import detections_of_runs, line_detections
+    from ..spectra import _default_nperseg, compute_spectra
 
     nperseg = _default_nperseg(int(np.median([r.n_samples for r in test.runs])))
     key = ("suspension_modes.spectra", nperseg)
@@ -85,9 +86,9 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     out (up to :data:`STAND_ROUNDS` rounds, until the stand settles); when it is not while one was divided
     out, the stand was not confirmed and the fit is repeated without it.  The stand resonance itself is left
     to the search (a clear residual of the extended base: a ``fixed_resonance`` effect)."""
-    from ...data import SteadyTest
-    from ...empirical import fit_empirical
-    from ...extended_fit import amplification_peaks, fit_extended
+    from ..data import SteadyTest
+    from ..empirical import fit_empirical
+    from ..extended_fit import amplification_peaks, fit_extended
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
@@ -122,12 +123,12 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
         for _ in range(STAND_ROUNDS):
             if len(efit.unconstrained) == 3 or len(ctx.channels) <= 3:
                 break
-            from ...stand_resonance import is_fixture_resonance
-            from ..effects.fixed_resonance import FixedResonance
+            from ..stand_resonance import is_fixture_resonance
+            from .fixed_resonance_diagnose import FixedResonance
 
             # the stand on the modes' base: the lines are predicted without it, so this is the whole stand
             st = SuspensionModes.from_fit(efit, fit, len(runs)).apply(state)
-            st.coupling = offset                # the torque data read corrected, as the modes were located
+            st = st.plus(_ReadCorrected(offset))     # the torque data read corrected, as the modes were located
             new = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), None if stand is None else stand[0],
                                      role="test_stand", reuse=False)
             # the rule of the stand's own detection: a broad "resonance" (an amplitude law's growth, a mode's skirt
@@ -170,7 +171,7 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
     """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``) before the stand's rounds: with the stand
     ``stand_start`` or the one the fit (else the whole data, :func:`_whole_data_fit`) proposes divided out, or
     without one when the stand divided out locates no mode (see :func:`_fit_runs`)."""
-    from ...extended_fit import fit_extended
+    from ..extended_fit import fit_extended
 
     stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
     efit = fit_extended(test, fit, stand=stand, near=near)
@@ -199,11 +200,11 @@ def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_uncons
     ``n_unconstrained`` left unconstrained without the correction.  A note of the fit says the offset was removed."""
     from dataclasses import replace
 
-    from ...data import SteadyTest
-    from ...empirical import fit_empirical
-    from ...spectra import compute_spectra
-    from ..constants import TORQUE_CHANNELS
-    from .cross_coupling import CrossCoupling
+    from ..data import SteadyTest
+    from ..diagnose.constants import TORQUE_CHANNELS
+    from ..empirical import fit_empirical
+    from ..spectra import compute_spectra
+    from .cross_coupling_diagnose import CrossCoupling
 
     cc = CrossCoupling.fit(ctx, state, np.asarray(runs))
     if cc is None or not cc.significant():
@@ -234,8 +235,8 @@ def _whole_data_fit(ctx: Context):
     detected from the lines near it, so half of a short speed grid (10 of 20 speeds) can hide both while every
     run shows them.  A detection only: the modes (and the stand) are still fitted on the fit runs and judged on
     the held-out ones."""
-    from ...data import SteadyTest
-    from ...empirical import fit_empirical
+    from ..data import SteadyTest
+    from ..empirical import fit_empirical
 
     key = ("suspension_modes.whole_data_fit",)
     if key not in ctx._memo:
@@ -244,6 +245,17 @@ def _whole_data_fit(ctx: Context):
         sp, detections = _fit_spectra(ctx, test, runs)
         ctx._memo[key] = fit_empirical(sp, detections=detections)
     return ctx._memo[key]
+
+
+@dataclass
+class _ReadCorrected:
+    """Not an effect of the wheel: a state's torque data read corrected for the load-cell offset ``r`` (m) the modes
+    were located with, or uncorrected (None), whatever the state read before."""
+
+    r: tuple | None
+
+    def contribute(self, parts) -> None:
+        parts.load_cell_offset = self.r
 
 
 @register(order=100)
@@ -279,7 +291,7 @@ class SuspensionModes:
 
     @staticmethod
     def from_fit(efit, fit, n_runs: int, stand: tuple | None = None) -> "SuspensionModes":
-        from ...extended_fit import to_model
+        from ..extended_fit import to_model
 
         p = efit.params
         f0 = {"radial_translation": float(p.omega_r / (2 * np.pi)), "rocking": float(p.omega_rock / (2 * np.pi)),
@@ -291,16 +303,16 @@ class SuspensionModes:
     def apply(self, state: State) -> State:
         import copy
 
-        from ...extended import params_from_model
+        from ..extended import params_from_model
 
-        s = state.copy()
+        s = state.plus(self)
         s.model = copy.deepcopy(self.model)
         s.model.effects = list(state.model.effects)
         s.ext = params_from_model(s.model, "suspension_modes")
-        s.laws = {}
-        s._cache = {}
-        s.effects.append(self)
         return s
+
+    def contribute(self, parts) -> None:
+        parts.laws.clear()              # the laws fitted on the other base do not carry over
 
     def refit(self, ctx: Context, state: State) -> "SuspensionModes":
         """Refitted on every run (``ctx.runs``), starting from this fit's stand resonance, each mode it located
@@ -316,7 +328,7 @@ class SuspensionModes:
         twice the runs: its scans start where this one's ended (a scan of the rocking mode over its whole grid of
         f0, ζ and I_zz/I_rr is most of an extended fit's cost), and search the whole range when the best point
         lies on the window's edge."""
-        from ...extended_fit import UNCONSTRAINED_NAME
+        from ..extended_fit import UNCONSTRAINED_NAME
 
         out = {mode: {"near_hz": self.f0_Hz[name]} for mode, name in UNCONSTRAINED_NAME.items()
                if name not in self.unconstrained}
@@ -389,10 +401,10 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
     import copy
     from dataclasses import replace
 
-    from ...data import SteadyTest
-    from ...empirical import fit_empirical
-    from ...extended_fit import MODE_KEY, fit_extended
-    from ...stand_resonance import STAND_SETTLED_MODE, _mode_hz
+    from ..data import SteadyTest
+    from ..empirical import fit_empirical
+    from ..extended_fit import MODE_KEY, fit_extended
+    from ..stand_resonance import STAND_SETTLED_MODE, _mode_hz
 
     modes = next((e for e in state.effects if e.kind == "suspension_modes"), None)
     if modes is None or ctx.test is None or len(ctx.channels) < 6:

@@ -6,13 +6,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...model import Harmonic
-from ...units import DIRECTION_CHANNELS
-from ..constants import LINE_HALF
-from ..engine import Context
-from ..measure import _measure, refine_h
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.constants import LINE_HALF
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.measure import _measure, refine_h
+from ..diagnose.state import State
+from ..model import Harmonic
+from ..units import DIRECTION_CHANNELS
 
 #: Smallest separation (Welch bins) between a sideband and its carrier for a run to count: the Hann main lobe
 #: is ±2 bins, so closer sidebands sit in the carrier's own kernel and are not measured there; half a bin more
@@ -131,7 +131,7 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
     ``chans`` with one table of phasors), each at its needed frequencies (moved to the front of its row; the rest of
     the row padded with its carrier), in chunks of :data:`RUN_CHUNK_SAMPLES` samples; W in closed form
     (:func:`rwadist.dft.hann_transform`)."""
-    from ...dft import hann_transform, run_window, windowed_dfts, windowed_records
+    from ..dft import hann_transform, run_window, windowed_dfts, windowed_records
 
     if need is None:
         need = np.ones(f_hz.shape, dtype=bool)
@@ -161,7 +161,7 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
 def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
     """Mean |X|² (len(runs), L, len(chans)) that white noise of the state's floor S puts into the whole-run phasor
     at ``f_hz``: 2·S·fs·Σw²/(Σw)² (:data:`RUN_WINDOW`)."""
-    from ...dft import run_window
+    from ..dft import run_window
 
     enbw = np.empty(runs.size)
     for i, r in enumerate(runs):
@@ -239,7 +239,7 @@ class SpeedSidebands:
     def _carrier_C(state: State, direction: str, h0: float) -> float:
         """Free-load C of the carrier (an imbalance's U_s or U_d on the extended base)."""
         if state.ext is not None:
-            from ... import extended as ext
+            from .. import extended as ext
 
             g = [ln.C for ln in state.ext_lines() if ln.direction == direction and abs(ln.h - h0) < ext.LAW_H_TOL]
             if g:
@@ -417,7 +417,7 @@ class SpeedSidebands:
             # when the held-out misplaced power there is below min_gain of it all (Context.can_pass); not scanned
             # (under a speed ripple or a spin smear the lines spread further: the whole channels' bound)
             w = ctx.omega[ctx.held_runs] / (2 * np.pi)
-            spread = state.ripple is not None or state.smear is not None
+            spread = state.speed_modulation is not None or state.smear is not None
             tops[d] = [x for x in top if ctx.can_pass(
                 state, chans, None if spread else ctx.reach_bands((x.h - REACH) * w, (x.h + REACH) * w))]
         if ctx.test is not None:

@@ -5,10 +5,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...units import CHANNELS
-from ..constants import LINE_HALF
-from ..engine import Context, ripple_sideband_powers
-from ..measure import (
+from ..diagnose.constants import LINE_HALF
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context, ripple_sideband_powers
+from ..diagnose.measure import (
     _clear_of_lines,
     _offset_grid,
     _offset_scores,
@@ -17,8 +17,8 @@ from ..measure import (
     _residual_z,
     _window_power,
 )
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.state import State
+from ..units import CHANNELS
 
 
 @register(order=70)
@@ -41,10 +41,10 @@ class SpeedRipple:
         return CHANNELS
 
     def apply(self, state: State) -> State:
-        s = state.copy()
-        s.ripple = (self.delta_omega, self.f_ripple, self.omega_ref, self.exponent)
-        s.effects.append(self)
-        return s
+        return state.plus(self)
+
+    def contribute(self, parts) -> None:
+        parts.speed_modulation = (self.delta_omega, self.f_ripple, self.omega_ref, self.exponent)
 
     def refit(self, ctx: Context, state: State) -> "SpeedRipple":
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""
@@ -129,7 +129,7 @@ class SpeedRipple:
     def candidates(ctx: Context, state: State, runs) -> list:
         """The strongest constant offset of residual ridges around every line of every channel pooled
         (:func:`_offset_scores`), fitted with q = 0 and q = 1 (two hypotheses judged on held-out speeds)."""
-        if state.ripple is not None:
+        if state.speed_modulation is not None:
             return []
         offsets = _offset_grid(ctx)
         tot = np.zeros(offsets.size)

@@ -5,11 +5,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..constants import BAND_BINS, TORQUE_CHANNELS
-from ..engine import Context
-from ..state import State
-from .base import register, schema_entry
-from .cross_coupling import CrossCoupling
+from ..diagnose.constants import BAND_BINS, TORQUE_CHANNELS
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.state import State
+from .cross_coupling_diagnose import CrossCoupling
 
 #: (torque channel, ((force channel, index of r whose square weighs it), ...)) of (r × F)_c:
 #: Tx = r_y·Fz − r_z·Fy, Ty = r_z·Fx − r_x·Fz, Tz = r_x·Fy − r_y·Fx.
@@ -81,9 +81,9 @@ class LeverArmNoise:
         of the state's torque noise and of :func:`transfer_psd`, pooled over the torque channels (weights:
         bins used / N_T², a band mean of chi² bins having a variance ∝ mean²/bins); standard error from the
         weighted residual.  The new torque floors: the noise re-estimated from the corrected data.  None without a coupling, once done, or when no torque channel gets any transfer."""
-        if state.coupling is None or any(isinstance(e, LeverArmNoise) for e in state.effects):
+        if state.load_cell_offset is None or any(isinstance(e, LeverArmNoise) for e in state.effects):
             return None
-        X = transfer_psd(state, state.coupling)
+        X = transfer_psd(state, state.load_cell_offset)
         chans = [c for c in TORQUE_CHANNELS if c in ctx.channels and c in X
                  and np.any(ctx.band_sums(X[c][None, :]) > 0)]
         if not chans:
@@ -110,7 +110,7 @@ class LeverArmNoise:
         cur.noise = dict(state.noise, **{c: np.asarray(state.noise[c], float) + kappa * X[c] for c in chans})
         if kappa <= 0:
             return None
-        from ..engine import noise_estimate
+        from ..diagnose.engine import noise_estimate
 
         fresh = noise_estimate(ctx, cur)
         noise, rise = {}, {}
@@ -120,7 +120,7 @@ class LeverArmNoise:
             noise[c] = fresh[c]
             with np.errstate(divide="ignore", invalid="ignore"):
                 rise[c] = float(np.nanmedian(10 * np.log10(noise[c][band] / n0[band])))
-        return LeverArmNoise(np.asarray(state.coupling, float), float(kappa), se, noise, rise, n)
+        return LeverArmNoise(np.asarray(state.load_cell_offset, float), float(kappa), se, noise, rise, n)
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:

@@ -5,19 +5,19 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...model import Harmonic
-from ...units import CHANNELS, DIRECTION_CHANNELS
-from ..constants import LINE_HALF, SNR_KNEE
-from ..engine import Context
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.constants import LINE_HALF, SNR_KNEE
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.state import State
+from ..model import Harmonic
+from ..units import CHANNELS, DIRECTION_CHANNELS
 
 
 def _sense_group(state: State, direction: str, h: float):
     """The state's extended lines of (direction, h) (|Δh| < LAW_H_TOL) when they are all co- or counter-rotating and
     carry no amplitude law: (h of the group, C_co, C_counter, imbalance?) with C the root-sum-square of the lines'
     C (kg·m or kg·m², per (rad/s)²; an imbalance's C is U_s or U_d of the analytical section); else None."""
-    from ... import extended as ext
+    from .. import extended as ext
 
     if state.ext is None:
         return None
@@ -71,7 +71,7 @@ class CounterRotation:
         return c_tot * np.sqrt(1.0 - q), c_tot * np.sqrt(q)
 
     def apply(self, state: State) -> State:
-        from ... import extended as ext
+        from .. import extended as ext
 
         h0, c_co0, c_ct0, imb = _sense_group(state, self.direction, self.h)
         c_co, c_ct = self.split(state)
@@ -168,7 +168,7 @@ class CounterRotation:
         chans = DIRECTION_CHANNELS[direction]
         if ctx.test is None or not all(c in ctx.channels for c in chans):
             return None
-        from ...dft import run_window
+        from ..dft import run_window
 
         h0 = _sense_group(state, direction, h)[0]
         f = h0 * ctx.omega[runs] / (2 * np.pi)

@@ -5,12 +5,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...resonance import log_power_gain_jacobian, resonance
-from ...units import CHANNEL_DIRECTION, DIRECTION_CHANNELS
-from ..constants import LINE_HALF, SNR_KNEE
-from ..engine import Context
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.constants import LINE_HALF, SNR_KNEE
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.state import State
+from ..resonance import log_power_gain_jacobian, resonance
+from ..units import CHANNEL_DIRECTION, DIRECTION_CHANNELS
 
 #: Smallest peak gain (or 1/gain, an anti-resonance) proposed: |H| within 10 % of 1 everywhere is the size of the
 #: fit's own model error near a mode (a per-unit extended base leaves ~1-3 % there), not a resonance.
@@ -18,7 +18,7 @@ MIN_PEAK_GAIN = 1.1
 
 #: Largest damping ratio proposed: a "resonance" broader than this (the fit runs to its ζ bound of 0.5 on a
 #: gentle tilt of the residual across the band) is not located by the data; the same limit as a fixture
-#: resonance proposed by :func:`rwadist.diagnose.effects.suspension_modes.stand_resonance_start`.
+#: resonance proposed by :func:`rwadist.effects.suspension_modes_diagnose.stand_resonance_start`.
 MAX_ZETA = 0.2
 
 
@@ -127,10 +127,10 @@ class FixedResonance:
     extended_stand: tuple | None = None
 
     def apply(self, state: State) -> State:
-        s = state.copy()
-        s.resonances.append((self.f_r, self.zeta, self.peak_gain, tuple(self.channels)))
-        s.effects.append(self)
-        return s
+        return state.plus(self)
+
+    def contribute(self, parts) -> None:
+        parts.resonances.append((self.f_r, self.zeta, self.peak_gain, tuple(self.channels)))
 
     def refit(self, ctx: Context, state: State) -> "FixedResonance":
         """Refitted on every run (``ctx.runs``); itself when that fit fails.  One proposed from the modes' stand is

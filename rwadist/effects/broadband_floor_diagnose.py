@@ -6,11 +6,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from ...units import CHANNEL_UNIT
-from ..constants import BAND_BINS, FLOOR_EXPONENTS, NOISE_Z
-from ..engine import Context
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.constants import BAND_BINS, FLOOR_EXPONENTS, NOISE_Z
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.state import State
+from ..units import CHANNEL_UNIT
 
 #: Standard errors of held-out evidence the floor's growth needs (:meth:`BroadbandFloor.significant`): the
 #: search's default k_sigma (:func:`rwadist.diagnose.search.diagnose`).
@@ -67,7 +67,7 @@ def _record_spectra(ctx: Context, c: str, rows) -> list:
     length in one call (scipy.fft: the numbers of numpy.fft's, run by run, in about half the time)."""
     from scipy import fft as sp_fft
 
-    from ...dft import demeaned_windowed, run_window
+    from ..dft import demeaned_windowed, run_window
 
     out: list = [None] * len(rows)
     groups: dict = {}
@@ -97,9 +97,9 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
     the error metric.  No bin where the time series are unknown or lack the channel.  A whole-run bin has 2
     degrees of freedom (a Welch bin ctx.dof).  Each run's numbers are kept on the context (the data's and the
     lines', the same at every search step)."""
-    from ...dft import run_window
-    from ..measure import hann_transform_ratio, record_dfts, state_line_freqs
-    from .missing_harmonic import RECORD_MIN_BINS, RECORD_SEP_BINS
+    from ..dft import run_window
+    from ..diagnose.measure import hann_transform_ratio, record_dfts, state_line_freqs
+    from .missing_harmonic_diagnose import RECORD_MIN_BINS, RECORD_SEP_BINS
 
     y = np.zeros((runs.size, ctx.n_bands))
     cnt_all = np.zeros((runs.size, ctx.n_bands))
@@ -189,12 +189,13 @@ class BroadbandFloor:
         return (self.channel,)
 
     def apply(self, state: State) -> State:
-        s = state.copy()
+        s = state.plus(self)
         s.noise = dict(s.noise)
         s.noise[self.channel] = self.noise
-        s.floors[self.channel] = (self.psd_ref, self.omega_ref, self.exponent)
-        s.effects.append(self)
         return s
+
+    def contribute(self, parts) -> None:
+        parts.floors[self.channel] = (self.psd_ref, self.omega_ref, self.exponent)
 
     def refit(self, ctx: Context, state: State) -> "BroadbandFloor":
         """Refitted on every run (``ctx.runs``); itself when that fit fails.  ``self`` is the hypothesis the search

@@ -5,9 +5,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...units import DIRECTION_CHANNELS
-from ..engine import Context
-from ..measure import (
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.measure import (
     _clear_of_lines,
     _offset_grid,
     _offset_scores,
@@ -16,8 +16,8 @@ from ..measure import (
     _residual_z,
     _window_power,
 )
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.state import State
+from ..units import DIRECTION_CHANNELS
 
 #: Runs scanned on the whole-run DFT per carrier (the fastest in band): the offset is the same at every speed, so a
 #: few runs tell it; the fit then takes every run.
@@ -25,7 +25,7 @@ RECORD_SCAN_RUNS = 12
 #: Scan step of the whole-run route, record bins (fs/n).
 RECORD_STEP_BINS = 0.25
 #: A carrier's whole-run scan score (median |X|²/noise over runs, channels and both sides) a pair must clear:
-#: that of :meth:`rwadist.diagnose.effects.speed_sidebands.SpeedSidebands.candidates` (the lines 20 × over the
+#: that of :meth:`rwadist.effects.speed_sidebands_diagnose.SpeedSidebands.candidates` (the lines 20 × over the
 #: noise on half the points).
 RECORD_SCORE = 20.0
 
@@ -66,10 +66,10 @@ class Sidebands:
         return DIRECTION_CHANNELS[self.direction]
 
     def apply(self, state: State) -> State:
-        s = state.copy()
-        s.sidebands.append((self.direction, round(self.h, 4), self.f_mod, self.depth))
-        s.effects.append(self)
-        return s
+        return state.plus(self)
+
+    def contribute(self, parts) -> None:
+        parts.modulations.append((self.direction, round(self.h, 4), self.f_mod, self.depth))
 
     def refit(self, ctx: Context, state: State) -> "Sidebands":
         """Refitted on every run (``ctx.runs``), on the whole-run DFT when the offset is below the Welch grid
@@ -121,7 +121,7 @@ class Sidebands:
     def _record_offsets(ctx: Context) -> np.ndarray:
         """Offsets (Hz) only the whole-run DFT resolves: from RUN_MIN_BINS record bins (the Hann main lobe's edge)
         up to where the Welch grid starts (:func:`_offset_grid`: 2.5 Welch bins); empty without the time series."""
-        from .speed_sidebands import RUN_MIN_BINS, _record_df
+        from .speed_sidebands_diagnose import RUN_MIN_BINS, _record_df
 
         if ctx.test is None:
             return np.empty(0)
@@ -132,7 +132,7 @@ class Sidebands:
     def _record_valid(ctx: Context, state: State, direction: str, h: float, runs, f_hz) -> np.ndarray:
         """(len(runs), L) mask: the sideband frequencies ``f_hz`` in band and at least RUN_MIN_BINS record bins from
         every other line of the direction (the carrier's own leakage is subtracted, :func:`_run_line_power`)."""
-        from .speed_sidebands import RUN_MIN_BINS, _record_df
+        from .speed_sidebands_diagnose import RUN_MIN_BINS, _record_df
 
         w = ctx.omega[runs][:, None] / (2 * np.pi)
         sep = RUN_MIN_BINS * _record_df(ctx, runs)[:, None]
@@ -151,7 +151,7 @@ class Sidebands:
         |X|² is the data's alone (the noise and the valid points are the state's): kept on the context, so the search's
         later steps (a new state of the same data) and the held-out judge of the same sidebands read it again.
         ``single``: the sums in single precision (:func:`_line_powers`), for the scan of :meth:`record_candidates`."""
-        from .speed_sidebands import _line_powers, _run_noise
+        from .speed_sidebands_diagnose import _line_powers, _run_noise
 
         fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
         f = np.concatenate([fc - offsets[None, :], fc + offsets[None, :]], axis=1)
@@ -171,7 +171,7 @@ class Sidebands:
         bins around ``f_mod`` (step 1/50 bin); the sides' amplitudes sqrt(|X|² − noise) of the points 10 × over
         the noise, on their prediction per unit depth q = a·g/2 (a the carrier's model amplitude in the channel, g
         the fixed resonances' gain at the side): m by least squares, Σ A·q / Σ q²."""
-        from .speed_sidebands import _record_df
+        from .speed_sidebands_diagnose import _record_df
 
         df_rec = float(np.max(_record_df(ctx, runs)))
         grid = f_mod + np.arange(-RECORD_STEP_BINS, RECORD_STEP_BINS + 1e-9, 0.02) * df_rec
@@ -206,17 +206,18 @@ class Sidebands:
         judge).  There the pair sits in the carrier's own Welch kernel, whose power the error metric's bands sum with
         it: the PSDs hardly see it (at 2048 samples, f_mod 7 Hz is 0.9 Welch bin), the whole record does
         (:meth:`_record_power`, the carrier's leakage taken off).  (drop, se) of the misplaced sideband power on the
-        valid points of both sides (:func:`~rwadist.diagnose.effects.missing_harmonic.record_line_evidence`; the
+        valid points of both sides (:func:`~rwadist.effects.missing_harmonic_diagnose.record_line_evidence`; the
         state predicts no sidebands on this carrier, the effect (m·a·g/2)² per side, a the carrier's model amplitude
         in the channel, g the fixed resonances' gain at the side).  Not on a state with a spin smear or a speed ripple
         (their lines are no steady lines on the record)."""
-        from .missing_harmonic import record_line_evidence
+        from .missing_harmonic_diagnose import record_line_evidence
 
-        if ctx.test is None or self.f_mod >= 2.5 * ctx.df or state.smear is not None or state.ripple is not None:
+        if ctx.test is None or self.f_mod >= 2.5 * ctx.df or state.smear is not None \
+                or state.speed_modulation is not None:
             # (a swept speed smears the carrier over the record, a speed ripple gives it sidebands of its own that the
             # state predicts in its PSDs: the record's lines are not steady ones, and the search's judge decides)
             return None
-        if any(d == self.direction and abs(h - self.h) < 1e-4 for d, h, _, _ in state.sidebands):
+        if any(d == self.direction and abs(h - self.h) < 1e-4 for d, h, _, _ in state.modulations):
             return None
         f, P, N, ok = Sidebands._record_power(ctx, state, self.direction, self.h, runs, np.array([self.f_mod]))
         chans = [c for c in DIRECTION_CHANNELS[self.direction] if c in ctx.channels]
@@ -240,7 +241,7 @@ class Sidebands:
         (:meth:`_record_offsets`): per offset the median over the RECORD_SCAN_RUNS fastest runs, channels and both
         sides of |X|²/noise on the whole-run DFT (valid points only, >= 6 of them), the best offset kept when it
         clears RECORD_SCORE and is a local maximum.  The line powers are kept on the context, per state prediction."""
-        from .speed_sidebands import side_pair_medians
+        from .speed_sidebands_diagnose import side_pair_medians
 
         offsets = Sidebands._record_offsets(ctx)
         if offsets.size < 3:
@@ -274,7 +275,7 @@ class Sidebands:
         for d, chans in DIRECTION_CHANNELS.items():
             chans = [c for c in chans if c in ctx.channels]
             hs = [x.h for x in state.model.harmonics(d)
-                  if not any(dd == d and abs(hh - x.h) < 1e-4 for dd, hh, _, _ in state.sidebands)]
+                  if not any(dd == d and abs(hh - x.h) < 1e-4 for dd, hh, _, _ in state.modulations)]
             if not chans or not hs:
                 continue
             # a direction's sidebands from its own channels alone (Context.reuse); not skipped where a metric-judged

@@ -14,11 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...model import Harmonic
-from ...units import DIRECTION_CHANNELS
-from ..constants import LINE_HALF
-from ..engine import Context
-from ..measure import (
+from ..diagnose.constants import LINE_HALF
+from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.engine import Context
+from ..diagnose.measure import (
     _measure,
     hann_transform_ratio,
     in_unresolved_span,
@@ -27,9 +26,10 @@ from ..measure import (
     ridge_peaks,
     state_line_freqs,
 )
-from ..reduce import column_nanmedian
-from ..state import State
-from .base import register, schema_entry
+from ..diagnose.reduce import column_nanmedian
+from ..diagnose.state import State
+from ..model import Harmonic
+from ..units import DIRECTION_CHANNELS
 
 #: Lowest frequency of a point of the record route, record bins (fs/n): the mean is taken off the record, and the
 #: Hann window's own lobe at 0 Hz is ±2 bins wide; 4 bins as the matrix's signature of a line (SIGNATURE_MIN_BIN).
@@ -90,7 +90,7 @@ def _record_grid(ctx: Context, r: int) -> tuple:
     if key not in ctx._memo:
         from scipy import fft as sp_fft
 
-        from ...dft import demeaned_windowed, run_window
+        from ..dft import demeaned_windowed, run_window
 
         run = ctx.test.runs[r]
         n = run.n_samples
@@ -190,7 +190,7 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     median |X|² over the record route's range (/ln 2: the median of an exponential), so that a noise rising below the
     Welch band is not taken for lines.  Valid: in the record route's range (RECORD_MIN_BINS record bins up to
     :func:`welch_low_limit`) and RECORD_SEP_BINS record bins from every line of the state on the channel."""
-    from ...dft import run_window
+    from ..dft import run_window
 
     j = ctx.channels.index(c)
     f_hz = np.asarray(f_hz, dtype=float)
@@ -373,7 +373,7 @@ class MissingHarmonic:
         with at least RECORD_MIN_POINTS points in RECORD_MIN_RUNS runs; its local maxima above RECORD_SCORE, strongest
         first, away from the state's harmonics, fitted by :meth:`fit_record`.  Nothing on a state with a spin smear or
         a speed ripple (the record's lines are not steady there).  ``directions``: only these (default every one)."""
-        if ctx.test is None or state.smear is not None or state.ripple is not None:
+        if ctx.test is None or state.smear is not None or state.speed_modulation is not None:
             return []                   # a swept or rippled speed: the record's lines are not steady ones
         w_hz = ctx.omega[runs] / (2 * np.pi)
         if w_hz.size < RECORD_MIN_RUNS or w_hz.min() <= 0:
@@ -416,7 +416,7 @@ class MissingHarmonic:
         state predicts no line there: the points are clear of its lines) and M₁ the line's power as this effect
         predicts it (|X|² = a²); se as the search's judge, sqrt(Σ min(|ΔM|, σ)²), σ² = n² + 2Pn of a line of power
         P in complex Gaussian noise of mean n.  None on a state with a spin smear or a speed ripple."""
-        if not self.record or ctx.test is None or state.smear is not None or state.ripple is not None:
+        if not self.record or ctx.test is None or state.smear is not None or state.speed_modulation is not None:
             return None
         P, N, ok, chans = MissingHarmonic._record_points(ctx, state, self.direction, runs, [self.h], exact=True)
         m1 = [MissingHarmonic._line_amplitude(ctx, state, c, self.direction, self.h, self.C, runs) ** 2 for c in chans]
