@@ -1,7 +1,9 @@
-"""Errors of the coupling package (all ValueError subclasses)."""
+"""Errors of the coupling package: bad values given to a coupling computation, :class:`rwadist.ParameterError`
+(so ``except rwadist.RwadistError`` and ``except ValueError`` catch them)."""
+from rwadist.errors import ParameterError
 
 
-class CouplingError(ValueError):
+class CouplingError(ParameterError):
     """Bad input to a coupling computation."""
 
 

@@ -171,9 +171,9 @@ def _physical_params(model, p, mass_kg, radius_m, name):
         return p
     if mass_kg is None or radius_m is None:
         raise CouplingModelError(f"{name}: analytical.fit.per_unit: the suspension was fitted per unit mass and "
-                                 "inertia (no --mass/--radius): coupling to a structure needs the rotor's mass and "
-                                 "inertias; pass mass_kg= and radius_m= (thin-disc inertias, the fitted I_zz/I_rr "
-                                 "kept), or refit with rwadist fit --extended --mass M --radius R")
+                                 "inertia (no rotor mass and radius given): coupling to a structure needs the "
+                                 "rotor's mass and inertias; pass mass_kg= and radius_m= (thin-disc inertias, the "
+                                 "fitted I_zz/I_rr kept), or refit the extended model with the rotor's mass and radius")
     if not (mass_kg > 0 and radius_m > 0 and np.isfinite(mass_kg) and np.isfinite(radius_m)):
         raise CouplingModelError(f"{name}: mass_kg and radius_m must be positive, got {mass_kg!r}, {radius_m!r}")
     _, i_rr = ext.thin_disc(float(mass_kg), float(radius_m))

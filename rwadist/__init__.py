@@ -9,11 +9,15 @@ The way in from Python (each with units and shapes in its docstring)::
     diag = rwadist.diagnose(test, fit.model)   # effects the model lacks, judged on held-out speeds
     res = rwadist.psd(fit.model, (600, 2400), empirical=True)   # broadband PSD over a speed range
 
-- :func:`read`, :func:`simulate_test`: test data (steady runs; sweeps are sliced);
+- :func:`read`, :func:`simulate_test`, :func:`simulate_sweep`: test data (steady runs; sweeps are sliced);
 - :func:`fit`, :func:`fit_extended`: the empirical and extended models;
 - :func:`diagnose`: what a model leaves out of the data;
-- :func:`psd`, :func:`campbell`: broadband PSD over a speed distribution, Campbell diagram;
-- :class:`WheelModel`, :func:`load_model`, :func:`save_model`: the versioned model file.
+- :func:`psd`, :func:`write_nastran`, :func:`campbell`: broadband PSD over a speed distribution (one wheel, or
+  several in the spacecraft frame), its NASTRAN cards, the Campbell diagram;
+- :func:`build_fmu`: the FMU of a model;
+- :class:`WheelModel`, :func:`load_model`, :func:`save_model`: the versioned model file;
+- :class:`RwadistError` and its kinds :class:`DataError`, :class:`ModelError`, :class:`ParameterError`,
+  :class:`MissingDependencyError` (:mod:`rwadist.errors`); :class:`RwadistWarning`.
 
 Under it, one module per step: ``data`` (interchange format) -> ``sweep`` (quasi-steady slices) ->
 ``spectra`` (Welch PSDs) -> ``empirical`` (fitted harmonic model) -> ``compare``/``report`` and
@@ -23,7 +27,22 @@ Under it, one module per step: ``data`` (interchange format) -> ``sweep`` (quasi
 import sys as _sys
 import types as _types
 
-from .api import WheelModel, campbell, diagnose, fit, fit_extended, load_model, psd, read, save_model, simulate_test
+from .api import (
+    WheelModel,
+    build_fmu,
+    campbell,
+    diagnose,
+    fit,
+    fit_extended,
+    load_model,
+    psd,
+    read,
+    save_model,
+    simulate_sweep,
+    simulate_test,
+    write_nastran,
+)
+from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistError, RwadistWarning
 
 __version__ = "0.1.0"
 
@@ -45,5 +64,6 @@ class _Package(_types.ModuleType):
 
 _sys.modules[__name__].__class__ = _Package
 
-__all__ = ["read", "simulate_test", "fit", "fit_extended", "diagnose", "psd", "campbell", "WheelModel",
-           "load_model", "save_model", "__version__"]
+__all__ = ["read", "simulate_test", "simulate_sweep", "fit", "fit_extended", "diagnose", "psd", "write_nastran",
+           "campbell", "build_fmu", "WheelModel", "load_model", "save_model", "RwadistError", "DataError", "ModelError", "ParameterError",
+           "MissingDependencyError", "RwadistWarning", "__version__"]

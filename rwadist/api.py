@@ -1,46 +1,74 @@
 """The Python way in: read data, fit, diagnose, PSD, Campbell, simulate (re-exported by :mod:`rwadist`).
 
-Every default lives here; the ``rwadist`` command line (:mod:`rwadist.cli`) calls these functions and
-only parses flags and prints.  SI units inside, rpm at this edge (parameters named ``*_rpm``), as the
-CLI.  The heavy modules (scipy, matplotlib) are imported inside the functions, so ``import rwadist``
-stays light.
+Every default and every check lives here (the ranges in :data:`rwadist.validate.LIMITS`), and the rules that
+decide what a request means -- a datasheet wheel's assumed suspension modes run hard-mounted unless asked
+for (:mod:`rwadist.wheel_source`), diagnose's starting base (:func:`rwadist.diagnose.resolve_base`); the
+``rwadist`` command line (:mod:`rwadist.cli`) calls these functions and only parses flags and prints, so the
+same request gives the same numbers both ways.  A refused value is a :class:`rwadist.ParameterError` naming
+the parameter; warnings are :class:`rwadist.RwadistWarning`.  SI units inside, rpm at this edge (parameters
+named ``*_rpm``), as the CLI.  The heavy modules (scipy, matplotlib) are imported inside the functions, so
+``import rwadist`` stays light.
 """
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from .data import DataError, SteadyTest, Sweep
+from .api_psd import psd, write_nastran
+from .data import SteadyTest, Sweep
+from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistWarning
 from .formats.records import reading_provenance
 from .model import WheelModel
 from .model import load as load_model
 from .model import save as save_model
+from .validate import (
+    MAX_SAMPLES,
+    check_f_lim,
+    check_parameter,
+    check_speeds_rpm,
+    refuse_non_finite_model,
+    speed_scale_warning,
+    warn_unconstrained,
+)
 
-__all__ = ["read", "simulate_test", "fit", "fit_extended", "diagnose", "psd", "campbell", "WheelModel",
-           "load_model", "save_model"]
+__all__ = ["read", "simulate_test", "simulate_sweep", "fit", "fit_extended", "diagnose", "psd", "write_nastran",
+           "campbell", "build_fmu", "WheelModel", "load_model", "save_model"]
 
 #: Default FFT length rule of :func:`diagnose`: a power of 2 at most a quarter of the median run length, so
 #: every PSD averages several Welch segments (the residual needs noise statistics).
 DIAGNOSE_SEGMENTS = 4
+#: What :func:`read` may take each sweep slice's speed from.
+SPEED_SOURCES = ("auto", "tach", "data")
+#: Physics of the virtual test stand (:func:`simulate_test`, :func:`simulate_sweep`).
+PHYSICS = ("simple", "extended")
 
 
-def _as_model(model, what: str) -> WheelModel:
+def _choice(parameter: str, value, allowed: tuple):
+    if value not in allowed:
+        raise ParameterError(parameter, f"{value!r}: must be one of {', '.join(map(repr, allowed))}")
+    return value
+
+
+def _as_model(model) -> WheelModel:
     """A WheelModel from a WheelModel or a model-file path."""
     if isinstance(model, WheelModel):
         return model
     if isinstance(model, (str, Path)):
         return load_model(model)
-    raise DataError(what, "model", f"expected a WheelModel or a model-file path, got {type(model).__name__}")
+    raise ParameterError("model", f"a {type(model).__name__}: expected a WheelModel or a model-file path")
+
+
+def _model_name(model) -> str:
+    return str(model) if isinstance(model, (str, Path)) else getattr(model, "name", "<model>")
 
 
 def _preset_model(name: str) -> WheelModel:
+    """The model of preset ``name`` (a catalogue datasheet wheel's carries ``analytical.modes_assumed``)."""
     from .presets import preset
 
-    try:
-        return preset(name).to_model()
-    except (KeyError, ValueError) as exc:
-        raise DataError("--preset", "name", str(exc)) from None
+    return preset(name).to_model()
 
 
 def read(path, *, slice_samples: int = 8192, speed_source: str = "auto", progress: bool = False,
@@ -64,9 +92,18 @@ def read(path, *, slice_samples: int = 8192, speed_source: str = "auto", progres
     -------
     SteadyTest
         Runs of load-cell signals (N, N·m) at their speeds (rad/s, signed) and sample rates (Hz).
+
+    Raises
+    ------
+    DataError
+        A file that cannot be read as test data (naming the file and the field).
+    ParameterError
+        ``slice_samples`` or ``speed_source`` out of range.
     """
     from . import data as data_io
 
+    check_parameter("slice_samples", slice_samples)
+    _choice("speed_source", speed_source, SPEED_SOURCES)
     obj = data_io.read_data(path, progress=progress)
     if isinstance(obj, Sweep):
         from .sweep import slice_sweep
@@ -86,9 +123,30 @@ def _as_test(data, **read_options) -> SteadyTest:
     return data if isinstance(data, SteadyTest) else read(data, **read_options)
 
 
+def _stand_wheel(preset: str, physics: str, assumed_modes: bool) -> tuple:
+    """(WheelDescription, assumed-modes note or None) of a preset simulated with ``physics``: a catalogue wheel
+    whose suspension modes are assumed runs hard-mounted (simple physics, its default) unless ``assumed_modes``
+    asks to simulate through them (the note then goes into the data's meta and a warning)."""
+    from . import catalogue
+    from .presets import preset as get_preset
+
+    _choice("physics", physics, PHYSICS)
+    wheel = get_preset(preset)
+    m = catalogue.preset_model(preset)
+    if physics != "extended" or m is None or not catalogue.modes_assumed(m):
+        return wheel, None
+    if not assumed_modes:
+        raise ParameterError("physics", f"'extended': {preset}: its suspension modes are assumed (datasheet wheel), "
+                             "not measured; it runs hard-mounted by default (`physics` 'simple'), or give "
+                             "`assumed_modes` to simulate through the assumed modes")
+    note = catalogue.ASSUMED_MODES_NOTE.format(name=preset)
+    warnings.warn(RwadistWarning(note), stacklevel=3)
+    return wheel, note
+
+
 def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: float | None = None,
                   n_samples: int = 8192, noise: float = 0.01, modes: bool = True, test_stand: bool = True,
-                  seed: int = 0, physics: str = "simple", inject=()) -> SteadyTest:
+                  seed: int = 0, physics: str = "simple", inject=(), assumed_modes: bool = False) -> SteadyTest:
     """Steady runs of a preset wheel on the virtual test stand.
 
     Parameters
@@ -101,7 +159,7 @@ def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: flo
     sample_rate : float or None
         Hz; default the preset's reference test (3840 Hz).
     n_samples : int
-        Samples per run.
+        Samples per run (64 or more; at most 5e7 samples over all runs).
     noise : float
         Sensor noise standard deviation as a fraction of the top-speed fundamental amplitude.
     modes, test_stand : bool
@@ -113,19 +171,33 @@ def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: flo
     inject : sequence of str or dict
         Known effects to add, ``"KIND:PARAM=VALUE,..."`` or parsed dicts (:mod:`rwadist.inject`);
         recorded in ``meta["injected"]``.
+    assumed_modes : bool
+        Allow ``physics="extended"`` on a catalogue wheel whose suspension modes are assumed (datasheet);
+        the data's ``meta["modes_assumed"]`` then says so.  Without it such a wheel is refused with
+        extended physics: it runs hard-mounted, as its datasheet states.
 
     Returns
     -------
     SteadyTest
         Forces (N) and torques (N·m) per run; ``meta["f_lim_hz"]`` (Hz) set when the stand resonates.
+
+    Raises
+    ------
+    ParameterError
+        A value out of range (naming it), an unknown preset, extended physics on assumed modes.
     """
-    from .presets import preset as get_preset
     from .teststand import simulate_steady
 
-    wheel = get_preset(preset)
+    for name, value in (("sample_rate", sample_rate), ("n_samples", n_samples), ("noise", noise), ("seed", seed)):
+        check_parameter(name, value)
+    wheel, assumed_note = _stand_wheel(preset, physics, assumed_modes)
     if speeds_rpm is None:
         default = getattr(wheel, "default_speeds_rpm", None)
         speeds_rpm = np.linspace(300.0, 2400.0, 120) if default is None else np.asarray(default, float)
+    speeds_rpm = check_speeds_rpm(speeds_rpm, "speeds_rpm")
+    if speeds_rpm.size * n_samples > MAX_SAMPLES:
+        raise ParameterError("n_samples", f"{n_samples} samples x {speeds_rpm.size} runs: at most {MAX_SAMPLES:.3g} "
+                             "samples in all; use fewer speeds or samples")
     fs = sample_rate or getattr(wheel, "default_sample_rate", None) or 3840.0
     if inject:
         from .inject import parse, simulate_with_injections
@@ -139,11 +211,64 @@ def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: flo
     if wheel.f_lim_hz is not None and test_stand:
         # the test engineer's record of where the fixture corrupts the data; `fit` uses it
         test.meta["f_lim_hz"] = wheel.f_lim_hz
+    if assumed_note:
+        test.meta["modes_assumed"] = assumed_note
     return test
 
 
+def simulate_sweep(preset: str = "ithaco-e", start_rpm: float = 0.0, end_rpm: float = 2400.0, *,
+                   duration: float = 390.0, sample_rate: float | None = None, noise: float = 0.01,
+                   modes: bool = True, test_stand: bool = True, seed: int = 0, profile: str = "linear",
+                   tach: bool = True, physics: str = "simple", assumed_modes: bool = False) -> Sweep:
+    """One record of a preset wheel through a speed change (spin-up or run-down) on the virtual test stand.
+
+    Parameters
+    ----------
+    preset : str
+        Wheel preset (:func:`rwadist.presets.names`).
+    start_rpm, end_rpm : float
+        Speeds at the start and the end of the record, rpm (signed; different).
+    duration : float
+        Record length, s (64 samples or more, at most 5e7).
+    sample_rate : float or None
+        Hz; default 3840 Hz.
+    noise, modes, test_stand, seed, physics, assumed_modes
+        As :func:`simulate_test`.
+    profile : {"linear", "exp"}
+        Speed against time.
+    tach : bool
+        Record the speed (the ``speed_rpm`` tach column).
+
+    Returns
+    -------
+    Sweep
+        Time (s), forces (N) and torques (N·m), the tach (rad/s) when recorded.
+    """
+    from .teststand import simulate_sweep as stand_sweep
+
+    for name, value in (("sample_rate", sample_rate), ("noise", noise), ("seed", seed)):
+        check_parameter(name, value)
+    _choice("profile", profile, ("linear", "exp"))
+    check_speeds_rpm([start_rpm, end_rpm], "end_rpm")
+    if end_rpm == start_rpm:
+        raise ParameterError("end_rpm", f"{end_rpm:g}: equals `start_rpm`; a sweep needs two different speeds")
+    fs = sample_rate or 3840.0
+    n = duration * fs if np.isfinite(duration) and duration > 0 else -1.0
+    if not 64 <= n <= MAX_SAMPLES:
+        raise ParameterError("duration", f"{duration:g} s at {fs:g} Hz is {max(n, 0):.3g} samples: a sweep needs 64 to "
+                             f"{MAX_SAMPLES:.3g}; {'lengthen' if n < 64 else 'shorten'} `duration`")
+    wheel, assumed_note = _stand_wheel(preset, physics, assumed_modes)
+    sweep = stand_sweep(wheel, rpm_start=start_rpm, rpm_end=end_rpm, duration=duration, sample_rate=fs, noise=noise,
+                        modes=modes, test_stand=test_stand, seed=seed, profile=profile, tach=tach, physics=physics)
+    if assumed_note:
+        sweep.meta["modes_assumed"] = assumed_note
+    return sweep
+
+
 def _f_lim(test: SteadyTest, f_lim):
-    """The upper limit of good data, Hz: the one given, else the test's record (meta ``f_lim_hz``)."""
+    """The upper limit of good data, Hz: the one given (checked below the data's Nyquist frequency), else the
+    test's record (meta ``f_lim_hz``)."""
+    check_f_lim(test, f_lim)
     return test.meta.get("f_lim_hz") if f_lim is None else f_lim
 
 
@@ -156,13 +281,14 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     data : SteadyTest, str or pathlib.Path
         The test, or a path :func:`read` takes.
     f_lim : float or None
-        Upper limit of good data, Hz (a test-stand resonance above it); default the test's record.
+        Upper limit of good data, Hz (a test-stand resonance above it; at most the Nyquist frequency);
+        default the test's record.
     nperseg : int or None
-        FFT length, samples; default the largest power of 2 in a run.
+        FFT length, samples (16 to 2**24); default the largest power of 2 in a run.
     presence : float
-        Bin presence threshold P0, a fraction (0..1).
+        Bin presence threshold P0, a fraction in (0, 1].
     epsilon : float
-        Binning tolerance on the harmonic number h, dimensionless.
+        Binning tolerance on the harmonic number h, dimensionless, in (0, 0.5].
     exclude_modes : bool
         Leave modally amplified speeds out of each harmonic's C.
     name : str or None
@@ -175,18 +301,63 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     rwadist.empirical.EmpiricalFit
         ``.model`` is the :class:`WheelModel` (C in kg·m for forces, kg·m² for torques, per (rad/s)²:
         amplitude C·Ω² in N or N·m); ``.spectra`` the Welch PSDs it was fitted on.
+
+    Raises
+    ------
+    ParameterError
+        A value out of range, naming the parameter (``presence=2.0``, ``f_lim`` above the Nyquist frequency).
+    DataError
+        Data that cannot be read or fitted; a fit that diverged (a non-finite C).
+
+    Warns
+    -----
+    RwadistWarning
+        The strongest radial line sits where speeds given k times the wheel's would put the imbalance; no
+        harmonic passed the presence threshold (the model is empty).
     """
     from .empirical import FitSettings, fit_empirical
     from .spectra import compute_spectra
 
+    for parameter, value in (("f_lim", f_lim), ("nperseg", nperseg), ("presence", presence), ("epsilon", epsilon)):
+        check_parameter(parameter, value)
     test = _as_test(data)
     if name is None:
         name = Path(data).name if isinstance(data, (str, Path)) else "fitted wheel"
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
     result = fit_empirical(spectra, settings, name=name, progress=progress)
+    refuse_non_finite_model(result.model, "fit")
     result.model.provenance.update(reading_provenance(getattr(test, "meta", None)))
+    if text := speed_scale_warning(result, test.meta):
+        warnings.warn(RwadistWarning(text.removeprefix("WARNING: ")), stacklevel=2)
+    if not any(result.model.empirical.values()):
+        warnings.warn(RwadistWarning(f"no harmonic passed the presence threshold ({presence:g} of the runs): the model "
+                                     "is empty; give more runs over the speed range, or lower `presence`"),
+                      stacklevel=2)
     return result
+
+
+def extended_options(mass: float | None = None, radius: float | None = None, height: float = 0.0,
+                     preset: str | None = None) -> tuple:
+    """(mass kg, radius m, starting ExtendedParams or None) of an extended fit: those given, the rest the preset's.
+
+    Both None: the fit is per unit mass and inertia.  :class:`ParameterError` for a value out of range, or one of
+    mass and radius without the other (the rotor's inertias come from both)."""
+    for parameter, value in (("mass", mass), ("radius", radius), ("height", height)):
+        check_parameter(parameter, value)
+    start = None
+    if preset:
+        from .presets import preset as get_preset
+
+        wheel = get_preset(preset)
+        mass = mass if mass is not None else wheel.mass_kg
+        radius = radius if radius is not None else wheel.radius_m
+        start = getattr(wheel, "extended", None)
+    if (mass is None) != (radius is None):
+        given, missing = ("mass", "radius") if radius is None else ("radius", "mass")
+        raise ParameterError(given, f"needs `{missing}` too (the rotor's inertias come from both; with neither the fit "
+                             "is per unit mass and inertia)")
+    return mass, radius, start
 
 
 def fit_extended(data, empirical=None, *, mass: float | None = None, radius: float | None = None,
@@ -200,10 +371,10 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     empirical : rwadist.empirical.EmpiricalFit or None
         Its empirical fit; default :func:`fit` of ``data`` with default settings.
     mass : float or None
-        Rotor mass, kg; default the preset's.  Without mass or radius the fit is per unit mass and
+        Rotor mass, kg; default the preset's.  Without mass and radius the fit is per unit mass and
         inertia (the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr and I_zz/I_rr).
     radius : float or None
-        Rotor radius, m (thin-disc inertias); default the preset's.
+        Rotor radius, m (thin-disc inertias); default the preset's.  Give both or neither.
     height : float
         Lever arm from the rotor centre to the torque reference point, m.
     preset : str or None
@@ -217,38 +388,50 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
         Fitted parameters (stiffness N/m and N·m/rad, damping ratios, imbalances kg·m and kg·m²).
     model : WheelModel
         The model file's content: the empirical harmonics as forcing lines plus the analytical section.
+
+    Raises
+    ------
+    ParameterError
+        mass, radius or height out of range, or one of mass and radius without the other.
     """
     from .extended_fit import to_model
     from .stand_resonance import declare_coupled_modes, fit_extended_beside_stand
 
+    mass, radius, start = extended_options(mass, radius, height, preset)
     test = _as_test(data)
     if empirical is None:
         empirical = fit(test)
-    start = None
-    if preset:
-        from .presets import preset as get_preset
-
-        wheel = get_preset(preset)
-        mass = mass if mass is not None else wheel.mass_kg
-        radius = radius if radius is not None else wheel.radius_m
-        start = getattr(wheel, "extended", None)
-    for flag, value in (("--mass", mass), ("--radius", radius)):
-        if value is not None and not (np.isfinite(value) and value > 0):
-            raise DataError(flag, "value", f"{value!r}: must be a positive number (kg / m)")
-    if mass is None or radius is None:
-        # per unit mass and inertia: the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr, I_zz/I_rr
-        mass = radius = None
     # a fixture resonance lifting every channel is fitted beside the wheel's modes, never into them
     efit = fit_extended_beside_stand(test, empirical, mass=mass, radius=radius, height=height, start=start,
                                      progress=progress)
     declare_coupled_modes(efit)          # a mode the stand dragged along, not told apart from it: said
-    return efit, to_model(efit, empirical)
+    model = to_model(efit, empirical)
+    refuse_non_finite_model(model, "fit")
+    return efit, model
 
 
 def diagnose_nperseg(test: SteadyTest) -> int:
     """Default FFT length of :func:`diagnose`, samples: the largest power of 2 at most 1/4 of the median run."""
     n = int(np.median([r.n_samples for r in test.runs]))
     return int(2 ** np.floor(np.log2(max(n // DIAGNOSE_SEGMENTS, 16))))
+
+
+def _diagnose_model(model, preset: str | None, base: str):
+    """The starting model of :func:`diagnose` (None: the data's empirical fit) and the base it asks for, checked."""
+    from .diagnose import BASES
+
+    _choice("base", base, BASES)
+    if preset and model is not None:
+        raise ParameterError("preset", f"{preset!r} given beside a model: give a model or a preset, not both")
+    if model is not None:
+        name, model = _model_name(model), _as_model(model)
+        warn_unconstrained(model, name, "diagnose's extended base")
+    elif preset:
+        model = _preset_model(preset)
+    if base == "extended" and not getattr(model, "analytical", None):
+        raise ParameterError("base", "'extended' needs a model with the wheel's suspension modes (an analytical "
+                             "section, as the extended fit writes), or a `preset`; or leave `base` at 'auto'")
+    return model
 
 
 def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto", nperseg: int | None = None,
@@ -275,31 +458,28 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     f_lim : float or None
         Upper limit of good data, Hz; default the test's record.
     k_sigma : float
-        Held-out gain needed, in noise standard errors.
+        Held-out gain needed, in noise standard errors, in (0, 100].
     min_gain : float
-        Held-out gain needed, fraction of the unexplained power (0..1).
+        Held-out gain needed, fraction of the unexplained power, in (0, 1).
 
     Returns
     -------
     rwadist.diagnose.Diagnosis
         ``.model`` the improved :class:`WheelModel` (effects added), ``.summary()`` the metric before and
         after and every hypothesis; :func:`rwadist.diagnose.write_report` writes it out.
+
+    Raises
+    ------
+    ParameterError
+        A value out of range; a model and a preset; base "extended" without the wheel's modes.
     """
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
-    if preset and model is not None:
-        raise DataError("diagnose", "--model/--preset", "give a model file or --preset, not both")
+    for parameter, value in (("nperseg", nperseg), ("f_lim", f_lim), ("k_sigma", k_sigma), ("min_gain", min_gain)):
+        check_parameter(parameter, value)
+    model = _diagnose_model(model, preset, base)
     test = _as_test(data)
-    if model is not None:
-        model = _as_model(model, "diagnose")
-    elif preset:
-        model = _preset_model(preset)
-        from .catalogue import source_modes_assumed
-
-        if model.analytical and source_modes_assumed(None, preset):
-            # a datasheet wheel of the catalogue: its modes are assumed, which resolve_base reads from the model
-            model.analytical = {**dict(model.analytical), "modes_assumed": True}
     spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))
     diagnosis = _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base)
     reading = reading_provenance(getattr(test, "meta", None))
@@ -309,86 +489,12 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     return diagnosis
 
 
-def wheel_lines(model=None, *, preset: str | None = None, empirical: bool = False):
-    """The disturbance sources of one wheel for :func:`psd`: from a model (file) or a preset.
-
-    Returns a :class:`rwadist.broadband.WheelLines` (harmonic numbers h, coefficients C in SI per (rad/s)²,
-    load directions); ``empirical``: Melody's hard-mounted lines, else the extended model's.
-    """
-    from . import broadband as bb
-
-    if preset and model is not None:
-        raise DataError("psd", "model/--preset", "give a model file or --preset, not both")
-    if preset:
-        try:
-            return bb.preset_lines(preset, empirical)
-        except ValueError as exc:
-            raise DataError("--preset", "name", str(exc)) from None
-    if model is None:
-        raise DataError("psd", "model", "give a model file or --preset NAME")
-    source = str(model) if isinstance(model, (str, Path)) else getattr(model, "name", "<model>")
-    m = _as_model(model, "psd")
-    return bb.empirical_lines(m) if empirical else bb.extended_lines_from_model(m, source)
-
-
-def default_fmax(pairs) -> float:
-    """Default top frequency of :func:`psd`, Hz: 1.2 × the highest line frequency over the speed laws.
-
-    ``pairs`` : [(WheelLines, speed law)], the law's support in rad/s."""
-    top = max(float(lines.h.max()) * max(abs(law.support[0]), abs(law.support[1])) for lines, law in pairs)
-    return 1.2 * top / (2 * np.pi)
-
-
-def psd(model=None, speed_rpm=(0.0, 3000.0), *, preset: str | None = None, dist: str = "uniform",
-        std_rpm: float | None = None, empirical: bool = False, fmax: float | None = None, n_freq: int = 20001,
-        n_speeds: int = 2000, progress: bool = False):
-    """Broadband disturbance PSD of one wheel over a wheel-speed distribution (wheel frame).
-
-    Parameters
-    ----------
-    model : WheelModel, str, pathlib.Path or None
-        The wheel's model (or model file); or give ``preset``.
-    speed_rpm : (float, float)
-        MIN, MAX speed, rpm (negative = spinning about −z).
-    preset : str or None
-        Wheel preset instead of a model.
-    dist : str
-        "uniform", "normal" (centred, truncated to the range) or a CSV file (histogram, density or time
-        profile of the speed).
-    std_rpm : float or None
-        Standard deviation of the normal law, rpm; default range/6.
-    empirical : bool
-        Melody's model from the harmonics alone (hard mounted), else the extended model (modal amplification
-        inside the speed integral).
-    fmax : float or None
-        Top frequency, Hz; default :func:`default_fmax`.
-    n_freq : int
-        Frequency points from 0 to ``fmax``.
-    n_speeds : int
-        Speed cells of the law.
-    progress : bool
-        Print progress.
-
-    Returns
-    -------
-    rwadist.broadband.BroadbandPSD
-        ``.f`` frequencies (n_freq,), Hz; ``.psd`` auto-spectra (n_freq, 6) in N²/Hz and (N·m)²/Hz of
-        Fx, Fy, Fz, Tx, Ty, Tz; ``.rms()`` (6,) in N and N·m.
-    """
-    from . import broadband as bb
-
-    lo_rpm, hi_rpm = (float(x) for x in speed_rpm)
-    law = bb.law_from_spec(dist, lo_rpm, hi_rpm, std_rpm)
-    lines = wheel_lines(model, preset=preset, empirical=empirical)
-    if fmax is None:
-        fmax = default_fmax([(lines, law)])
-    return bb.broadband_psd(lines, law, fmax, n_freq, n_speeds, progress=progress)
-
-
 def extended_source(model=None, *, preset: str | None = None) -> tuple:
     """(ExtendedParams, lines, description) of a model (file) with an analytical section, or of a preset."""
     from . import extended
 
+    if preset and model is not None:
+        raise ParameterError("preset", f"{preset!r} given beside a model: give a model or a preset, not both")
     if preset:
         from .presets import preset as get_preset
 
@@ -397,9 +503,9 @@ def extended_source(model=None, *, preset: str | None = None) -> tuple:
             raise DataError(preset, "extended", "this preset has no extended (analytical) parameters")
         return wheel.extended, wheel.extended_lines(), f"preset {wheel.name}"
     if model is None:
-        raise DataError("campbell", "model", "give a model file or --preset NAME")
-    source = str(model) if isinstance(model, (str, Path)) else getattr(model, "name", "<model>")
-    m = _as_model(model, "campbell")
+        raise ParameterError("model", "missing: give a model (a WheelModel or a model-file path) or a preset")
+    source = _model_name(model)
+    m = _as_model(model)
     params = extended.params_from_model(m, source)
     return params, extended.lines_from_model(m, params), source
 
@@ -412,7 +518,7 @@ def campbell(model=None, speeds_rpm=None, *, preset: str | None = None) -> tuple
     model : WheelModel, str, pathlib.Path or None
         Model (file) with an analytical section; or give ``preset``.
     speeds_rpm : array_like of float, shape (n,), or None
-        Wheel speeds, rpm; default 0 to 3000 rpm in steps of 100.
+        Wheel speeds, rpm, spanning a range of |speed|; default 0 to 3000 rpm in steps of 100.
     preset : str or None
         Wheel preset instead of a model.
 
@@ -424,9 +530,102 @@ def campbell(model=None, speeds_rpm=None, *, preset: str | None = None) -> tuple
     crossings : list of dict
         Each harmonic/mode crossing: ``h``, ``direction``, ``sense``, ``mode``, ``speed_rpm``, ``f_Hz``,
         ``excited``, sorted by speed.
+
+    Raises
+    ------
+    ParameterError
+        Speeds that are not a range of finite speeds within ±1e5 rpm; a model and a preset, or neither.
+    DataError
+        A model without an analytical section, or whose modes come out non-finite.
     """
     from .campbell import campbell_crossings, campbell_table
 
-    params, lines, _ = extended_source(model, preset=preset)
-    speeds = np.arange(0.0, 3000.0 + 50.0, 100.0) if speeds_rpm is None else np.asarray(speeds_rpm, float)
-    return campbell_table(params, speeds), campbell_crossings(params, speeds, lines)
+    params, lines, source = extended_source(model, preset=preset)
+    if model is not None:
+        warn_unconstrained(_as_model(model), source, "the Campbell diagram")
+    speeds = np.arange(0.0, 3000.0 + 50.0, 100.0) if speeds_rpm is None else check_speeds_rpm(speeds_rpm,
+                                                                                                 "speeds_rpm")
+    if np.ptp(np.abs(speeds)) == 0:
+        raise ParameterError("speeds_rpm", f"gives one speed ({float(speeds[0]):g} rpm); a Campbell diagram needs "
+                             "a range, e.g. 0 to 3000 rpm in steps of 100")
+    table = campbell_table(params, speeds)
+    bad = [k for k, v in table.items() if not np.all(np.isfinite(np.asarray(v, dtype=float)))]
+    if bad:
+        raise DataError(source, "campbell", f"non-finite frequencies in {', '.join(bad)}: the model's analytical "
+                        "parameters are out of range; check them (`rwadist model show`)")
+    return table, campbell_crossings(params, speeds, lines)
+
+
+def build_fmu(model=None, path="wheel.fmu", *, preset: str | None = None, native: bool = False,
+              fmi_version: int = 2, assumed_modes: bool = False, progress: bool = False) -> Path:
+    """Build the FMI 2.0 co-simulation FMU of a wheel model, written atomically to ``path``.
+
+    Parameters
+    ----------
+    model : WheelModel, str, pathlib.Path or None
+        The model (file): empirical, extended or diagnosed; or give ``preset`` (default ``"ithaco-e"``).
+    path : str or pathlib.Path
+        The ``.fmu`` file to write.
+    preset : str or None
+        Wheel preset instead of a model: its catalogue entry, else its virtual-stand model.
+    native : bool
+        A pure-C FMU (no Python on the host; sources included) instead of pythonfmu's.
+    fmi_version : {2, 3}
+        FMI 2.0, or FMI 3.0 (the native FMU only).
+    assumed_modes : bool
+        A wheel with assumed (datasheet) suspension modes runs them by default (the FMU's ``modes`` start
+        value); without it such a wheel is hard-mounted by default.
+    progress : bool
+        An elapsed-time line on stderr while the FMU is built.
+
+    Returns
+    -------
+    pathlib.Path
+        The FMU written.
+
+    Raises
+    ------
+    ParameterError
+        A path not ending in .fmu; a model and a preset; FMI 3.0 without ``native``.
+    ModelError
+        A model the FMU cannot run (naming the file and field, or the model).
+    MissingDependencyError
+        pythonfmu (the ``fmu`` extra) not installed.
+    """
+    from . import catalogue
+    from .outputs import write_file
+    from .presets import preset as get_preset
+    from .progress import working
+
+    if Path(path).suffix != ".fmu":
+        raise ParameterError("path", f"{str(path)!r} must end in .fmu")
+    if preset and model is not None:
+        raise ParameterError("preset", f"{preset!r} given beside a model: give a model or a preset, not both")
+    _choice("fmi_version", fmi_version, (2, 3))
+    if fmi_version != 2 and not native:
+        raise ParameterError("fmi_version", f"{fmi_version}: the pythonfmu FMU is FMI 2.0 only; add `native` for the "
+                             "FMI 3.0 FMU")
+    if model is not None:
+        source, name = (model if isinstance(model, (str, Path)) else _as_model(model)), _model_name(model)
+        warn_unconstrained(_as_model(model), name, "the FMU")
+    else:
+        name = preset or "ithaco-e"
+        source = catalogue.preset_model(name) or get_preset(name).to_model()
+    if native:
+        from rwadist.fmu.native_build import build_native_fmu
+
+        def build(source, tmp, assumed_modes):
+            return build_native_fmu(source, tmp, assumed_modes=assumed_modes, fmi_version=fmi_version)
+    else:
+        import importlib.util
+
+        if importlib.util.find_spec("pythonfmu") is None:
+            raise MissingDependencyError("pythonfmu", "building an FMU", "fmu")
+        from rwadist.fmu.build import build_fmu as build
+    try:
+        with working("compiling the native FMU" if native else "packaging the FMU", enabled=progress):
+            return write_file(path, lambda tmp: build(source, tmp, assumed_modes=assumed_modes))
+    except ModelError as exc:
+        if exc.field is not None:       # a bad model-file field: the schema's message names file and field
+            raise
+        raise DataError(name, "model", str(exc)) from None

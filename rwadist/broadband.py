@@ -334,7 +334,8 @@ def preset_lines(name: str, empirical: bool = False) -> WheelLines:
         src = empirical_lines(wheel.to_model())
     else:
         if wheel.extended is None:
-            raise DataError(name, "extended", "this preset has no extended parameters; use --empirical")
+            raise DataError(name, "extended", "this preset has no extended parameters; use the empirical model "
+                            "(`empirical`)")
         lines = [ext.Line(ln.direction, ln.h, ln.C, ln.sense,
                           wheel.imbalance_phase if (ln.imbalance and ln.direction == "radial_torque") else ln.phase,
                           ln.angle, ln.imbalance) for ln in wheel.extended_lines()]
@@ -418,7 +419,7 @@ def _check_fmax(groups, f_max):
     if f_max < f_first:
         raise DataError("frequency grid", "fmax", f"{f_max:g} Hz is below the first harmonic's highest "
                         f"frequency ({f_first:g} Hz: h = {h_min:g} at {w_max * RAD_S_TO_RPM:g} rpm); "
-                        "the PSD would miss lines -- raise --fmax")
+                        "the PSD would miss lines -- raise `fmax`")
 
 
 def csd_groups(groups, f_max: float, n_freq: int = 20001, n_speeds: int = 2000, progress: bool = False,

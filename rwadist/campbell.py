@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from . import extended as ext
+from .errors import ParameterError
 from .units import RPM_TO_RAD_S
 
 #: Column of each mode in a Campbell table (Hz): mode and whirl in the name.
@@ -25,7 +26,7 @@ _STYLE = {"radial_translation": ("tab:blue", "-"), "rocking_forward": ("tab:red"
 def _speeds(speeds_rpm) -> np.ndarray:
     s = np.atleast_1d(np.asarray(speeds_rpm, dtype=float))
     if s.ndim != 1 or s.size == 0 or not np.all(np.isfinite(s)):
-        raise ValueError(f"speeds_rpm must be a non-empty 1-D list of finite speeds, got {speeds_rpm!r}")
+        raise ParameterError("speeds_rpm", f"{speeds_rpm!r}: must be a non-empty 1-D list of finite speeds")
     return s
 
 
@@ -60,7 +61,7 @@ def speed_range_rad_s(speeds_rpm) -> tuple:
     hi = float(np.abs(s).max())
     lo = 0.0 if s.min() <= 0.0 <= s.max() else float(np.abs(s).min())
     if not hi > lo:
-        raise ValueError(f"speeds_rpm must span a range of |speed|, got {speeds_rpm!r}")
+        raise ParameterError("speeds_rpm", f"{speeds_rpm!r}: must span a range of |speed|")
     return lo * RPM_TO_RAD_S, hi * RPM_TO_RAD_S
 
 

@@ -16,8 +16,9 @@ from . import data as data_io
 from . import model as model_io
 from .cli_catalogue import cmd_catalogue_list, cmd_catalogue_show, cmd_model_compare  # noqa: F401 (parser)
 from .cli_fmu import cmd_fmu_build, cmd_fmu_check  # noqa: F401 (parser)
-from .cli_parser import _version
+from .cli_parser import _version, check_fit_flags, check_parsed, check_psd_flags
 from .data import DataError
+from .errors import ParameterError, RwadistError
 from .outputs import (
     atomic_dataset_dir,
     atomic_dir,
@@ -31,21 +32,7 @@ from .outputs import write_file as _write
 from .plot_util import save_png
 from .progress import working
 from .units import RAD_S_TO_RPM
-from .validate import (
-    MAX_SAMPLES,
-    check_f_lim,
-    check_fit_flags,
-    check_grid_size,
-    check_parsed,
-    check_psd_flags,
-    check_speeds_rpm,
-    check_within_test,
-    refuse_non_finite_model,
-    refuse_non_finite_psd,
-    speed_scale_warning,
-    warn_beyond_rated_speed,
-    warn_unconstrained,
-)
+from .validate import check_grid_size, check_speeds_rpm, check_within_test
 
 
 def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm") -> np.ndarray:
@@ -82,48 +69,35 @@ def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm") ->
 
 # --------------------------------------------------------------------------- simulate-test
 
-def cmd_simulate(args) -> int:
-    from .presets import preset
-    from .teststand import simulate_sweep
-
-    out = Path(args.out_dir)
-    assumed_note = _simulate_assumed_modes(args)
-    if args.sweep and args.inject:
+def _simulate_sweep(args, out: Path) -> int:
+    """``simulate-test --sweep``: one spin-up record (:func:`rwadist.simulate_sweep`)."""
+    if args.inject:
         raise DataError("--inject", "--sweep", "injections apply to steady runs; leave out --sweep")
+    sweep = api.simulate_sweep(args.preset, args.sweep_start_rpm, 2400.0 if args.sweep_end_rpm is None else
+                               args.sweep_end_rpm, duration=args.duration, sample_rate=args.sample_rate,
+                               noise=args.noise, modes=not args.no_modes, test_stand=not args.no_test_stand,
+                               seed=args.seed, profile=args.profile, tach=not args.no_tach, physics=args.physics,
+                               assumed_modes=args.assumed_modes)
+    path = _write(out / "sweep.csv", lambda tmp: data_io.write_sweep(sweep, tmp))
+    print(f"wrote sweep {path} ({len(sweep.time)} samples, {sweep.sample_rate:g} Hz)")
+    return 0
+
+
+def cmd_simulate(args) -> int:
+    """Synthetic load-cell data of a preset wheel (:func:`rwadist.simulate_test`, :func:`rwadist.simulate_sweep`)."""
+    out = Path(args.out_dir)
     if args.sweep:
-        wheel = preset(args.preset)
-        end = args.sweep_end_rpm if args.sweep_end_rpm is not None else 2400.0
-        if end == args.sweep_start_rpm:
-            raise DataError("--sweep-end-rpm", "value", f"{end:g}: equals --sweep-start-rpm; a sweep needs two "
-                            "different speeds")
-        n_sweep = args.duration * (args.sample_rate or 3840.0)
-        if n_sweep < 64:
-            raise DataError("--duration", "value", f"{args.duration:g} s at {args.sample_rate or 3840.0:g} Hz is "
-                            f"{n_sweep:.3g} samples: a sweep needs at least 64; lengthen --duration")
-        if n_sweep > MAX_SAMPLES:
-            raise DataError("--duration", "value", f"{args.duration:g} s at {args.sample_rate or 3840.0:g} Hz is "
-                            f"{n_sweep:.3g} samples: at most {MAX_SAMPLES:.3g}; shorten --duration")
-        sweep = simulate_sweep(wheel, rpm_start=args.sweep_start_rpm, rpm_end=end, duration=args.duration,
-                               sample_rate=args.sample_rate or 3840.0, noise=args.noise, modes=not args.no_modes,
-                               test_stand=not args.no_test_stand, seed=args.seed, profile=args.profile,
-                               tach=not args.no_tach, physics=args.physics)
-        if assumed_note:
-            sweep.meta["modes_assumed"] = assumed_note
-        path = _write(out / "sweep.csv", lambda tmp: data_io.write_sweep(sweep, tmp))
-        print(f"wrote sweep {path} ({len(sweep.time)} samples, {sweep.sample_rate:g} Hz)")
-        return 0
+        return _simulate_sweep(args, out)
     if args.n_speeds and not args.speeds_rpm:
         raise DataError("--n-speeds", "value", "needs --speeds-rpm START:STOP")
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds) if args.speeds_rpm else None
     check_dataset_dir(out, "OUT_DIR")      # before the simulation: the folder is replaced whole
     n_runs = len(speeds) if speeds is not None else 20
-    if n_runs * args.samples > MAX_SAMPLES:
-        raise DataError("--samples", "value", f"{args.samples} samples x {n_runs} runs: at most {MAX_SAMPLES:.3g} "
-                        "samples in all; use fewer speeds or samples")
     with working(f"rwadist simulate-test: simulating {n_runs} runs"):
         test = api.simulate_test(args.preset, speeds, sample_rate=args.sample_rate, n_samples=args.samples,
                                  noise=args.noise, modes=not args.no_modes, test_stand=not args.no_test_stand,
-                                 seed=args.seed, physics=args.physics, inject=args.inject)
+                                 seed=args.seed, physics=args.physics, inject=args.inject,
+                                 assumed_modes=args.assumed_modes)
     for e in test.meta.get("injected", []):
         print("injected " + e["kind"] + ": " + ", ".join(f"{k}={v}" for k, v in e.items() if k != "kind"))
     if above := test.meta.get("lines_above_nyquist"):
@@ -134,30 +108,11 @@ def cmd_simulate(args) -> int:
               f"would ({named}; meta.json lines_above_nyquist); raise --sample-rate to keep them")
     speeds = np.array([r.speed for r in test.runs]) * RAD_S_TO_RPM
     fs = test.runs[0].sample_rate
-    if assumed_note:
-        test.meta["modes_assumed"] = assumed_note
     with atomic_dataset_dir(out, "OUT_DIR") as tmp, working(f"writing {len(test.runs)} runs"):
         data_io.write_steady(test, tmp)
     print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g}-{speeds.max():g} rpm, {fs:g} Hz, "
           f"{args.samples} samples each)")
     return 0
-
-
-def _simulate_assumed_modes(args):
-    """The note for a catalogue wheel with assumed modes simulated through them (--physics extended with
-    --assumed-modes), else None.  Without --assumed-modes such a wheel is refused with --physics extended:
-    its default (simple physics: its lines, no modes) is hard-mounted, as its datasheet states."""
-    from . import catalogue
-    m = catalogue.preset_model(args.preset)
-    if args.physics != "extended" or m is None or not catalogue.modes_assumed(m):
-        return None
-    if not args.assumed_modes:
-        raise DataError("--physics", "extended", f"{args.preset}: its suspension modes are assumed (datasheet "
-                        "wheel), not measured; it runs hard-mounted by default (drop --physics extended), or add "
-                        "--assumed-modes to simulate through the assumed modes")
-    note = catalogue.ASSUMED_MODES_NOTE.format(name=args.preset)
-    print("WARNING: " + note, file=sys.stderr)
-    return note
 
 
 # --------------------------------------------------------------------------- fit
@@ -168,7 +123,6 @@ def load_steady(path, args):
 
 
 def run_fit(test, args, name: str, progress: bool = True):
-    check_f_lim(test, args.f_lim)
     return api.fit(test, f_lim=args.f_lim, nperseg=args.nperseg, presence=args.presence, epsilon=args.epsilon,
                    exclude_modes=not args.no_mode_exclusion, name=name, progress=progress)
 
@@ -187,19 +141,20 @@ def cmd_fit(args) -> int:
     else:
         check_output_dir(report_dir, "--report")
     check_fit_flags(args)
+    if args.extended:
+        api.extended_options(args.mass, args.radius, args.height, args.preset)    # refused before the data are read
     refuse_input_overwrite([("-o", args.output, "file")] + ([("--report", report_dir, "dir")] if report_dir else []),
                            [args.data])
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
     if args.cumulative_rpm and report_dir is not None:
-        check_within_test(parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm"), test, "--cumulative-rpm")
+        check_within_test(parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm"), test, "cumulative_rpm")
     fit = run_fit(test, args, name=Path(args.data).name)
     fit.model.provenance["data"] = str(args.data)
     model = fit.model
     efit = None
     if args.extended:
         efit, model = run_extended_fit(test, fit, args)
-    refuse_non_finite_model(model, "fit")
     cum = parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm") if args.cumulative_rpm else None
     files = []
     if report_dir is not None:
@@ -216,17 +171,12 @@ def cmd_fit(args) -> int:
     if efit is not None:
         print(f"extended model: {sum(len(v) for v in model.empirical.values())} forcing lines through the fitted "
               "modes (every line the data show, modally amplified or not)")
-    if scale := speed_scale_warning(fit, test.meta):
-        print(scale, file=sys.stderr)
     modal = [f"{b.direction} h={b.h:.4g}" for b in fit.bins if not b.kept and "outside modal ranges" in b.reason]
     if modal and efit is None:
         print(f"WARNING: {len(modal)} harmonic(s) the data show were left out of the model because their lines are "
               f"modally amplified at nearly every speed ({', '.join(modal[:6])}{' and more' if modal[6:] else ''}"
               f"{'; bins.csv in the report gives the reasons' if report_dir else ''}): C·Ω² does not describe them; "
               "fit the wheel's modes with --extended, or keep them with --no-mode-exclusion", file=sys.stderr)
-    if n == 0:
-        print(f"WARNING: no harmonic passed the presence threshold ({args.presence:g} of the runs): the model is "
-              "empty; give more runs over the speed range, or lower --presence", file=sys.stderr)
     print(f"model:  {args.output}")
     print(f"report: {report_dir} ({len(files)} files)" if report_dir is not None else "report: none (--no-report)")
     return 0
@@ -234,17 +184,8 @@ def cmd_fit(args) -> int:
 
 def run_extended_fit(test, fit, args):
     """The extended model fitted on top of the empirical fit; mass and radius from the options or a preset."""
-    mass, radius = args.mass, args.radius
-    if args.preset:
-        from .presets import preset
-
-        wheel = preset(args.preset)
-        mass = mass if mass is not None else wheel.mass_kg
-        radius = radius if radius is not None else wheel.radius_m
-    for flag, value in (("--mass", mass), ("--radius", radius)):
-        if value is not None and not (np.isfinite(value) and value > 0):
-            raise DataError(flag, "value", f"{value!r}: must be a positive number (kg / m)")
-    if mass is None or radius is None:
+    mass, radius, _ = api.extended_options(args.mass, args.radius, args.height, args.preset)
+    if mass is None:
         print("fitting the extended model per unit mass and inertia (no --mass/--radius: the interface loads "
               f"depend only on k/M, c/M, k_theta/I_rr, c_theta/I_rr, I_zz/I_rr; height = {args.height:g} m) ...",
               flush=True)
@@ -407,18 +348,9 @@ def cmd_campbell(args) -> int:
 
     out = check_output_file(args.output)
     refuse_input_overwrite([("-o", out, "file"), ("-o", out.with_suffix(".png"), "file")], [args.model])
-    params, lines, source = api.extended_source(args.model, preset=args.preset)
-    if args.model:
-        warn_unconstrained(model_io.load(args.model), args.model, "the Campbell diagram")
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
-    if np.ptp(np.abs(speeds)) == 0:
-        raise DataError("--speeds-rpm", "value", f"{args.speeds_rpm!r} gives one speed ({float(speeds[0]):g} rpm); "
-                        "a Campbell diagram needs a range, e.g. 0:3000:100")
     table, rows = api.campbell(args.model, speeds, preset=args.preset)
-    bad = [k for k, v in table.items() if not np.all(np.isfinite(np.asarray(v, dtype=float)))]
-    if bad:
-        raise DataError(args.model or args.preset, "campbell", f"non-finite frequencies in {', '.join(bad)}: "
-                        "the model's analytical parameters are out of range; check them with `rwadist model show`")
+    params, lines, source = api.extended_source(args.model, preset=args.preset)
     png_path = out.with_suffix(".png")
     _write(png_path, lambda tmp: save_png(plot_campbell(params, speeds, lines), tmp, dpi=120))
     csv_path = _write(out, lambda tmp: write_campbell_csv(table, tmp))
@@ -442,35 +374,29 @@ def cmd_diagnose(args) -> int:
     refuse_input_overwrite([("-o", args.output, "dir")], [args.data, args.model])
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
-    model = model_io.load(args.model) if args.model else None
-    if model is not None:
-        warn_unconstrained(model, args.model, "diagnose's extended base")
     # a starting model whose suspension modes are assumed (datasheet wheel) is hard-mounted unless
     # --base extended asks for its assumed modes explicitly: the rule is resolve_base's (api.diagnose)
-    assumed = catalogue.source_modes_assumed(model, args.preset)
-    base = args.base
-    if assumed and base == "auto":
+    assumed = catalogue.source_modes_assumed(args.model, args.preset)
+    if assumed and args.base == "auto":
         print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); the starting "
               "prediction is hard-mounted (C*omega^2), modes the data show are fitted from them; --base extended "
               "uses the assumed modes")
-    check_f_lim(test, args.f_lim)
     try:
         with working("rwadist diagnose: searching the residual for effects"):
-            diag = api.diagnose(test, model, preset=args.preset, base=base, nperseg=args.nperseg,
+            diag = api.diagnose(test, args.model, preset=args.preset, base=args.base, nperseg=args.nperseg,
                                 f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain)
-    except DataError:
-        raise
-    except ValueError as exc:
-        if base == "extended" and not getattr(model, "analytical", None) and not args.preset:
-            raise DataError(args.model or "diagnose", "--base", "extended needs a model with the wheel's suspension "
-                            "modes (an analytical section): give one made by `rwadist fit --extended`, or a --preset, "
-                            "or leave --base at auto") from None
-        raise DataError("diagnose", "--base", str(exc)) from None
+    except ParameterError as exc:
+        if exc.parameter != "base":
+            raise
+        raise DataError(args.model or "diagnose", "--base", "extended needs a model with the wheel's suspension "
+                        "modes (an analytical section): give one made by `rwadist fit --extended`, or a --preset, "
+                        "or leave --base at auto") from None
     with atomic_dir(args.output) as tmp_dir, working("writing the diagnose report"):
         files = [Path(args.output) / Path(f).name for f in write_report(diag, tmp_dir)]
     if assumed and diag.state_before.base == "extended":
         from .catalogue import write_assumed_note
-        files.append(write_assumed_note(Path(args.output) / "ASSUMED_MODES.txt", [args.model or args.preset], files))
+        files.append(write_assumed_note(Path(args.output) / "ASSUMED_MODES.txt", [args.model or args.preset], files,
+                                        with_flags))
     base = diag.state_before.base
     if diag.state_after.base != base:
         base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
@@ -501,92 +427,47 @@ def cmd_diagnose(args) -> int:
 
 # --------------------------------------------------------------------------- psd
 
-def cmd_psd(args) -> int:
-    """Broadband PSD over a speed distribution (Melody's model, or the extended model with the modal
-    amplification inside the speed integral); one wheel or a wheels.json set in the spacecraft frame."""
-    from . import broadband as bb
-    from .mounting import load_wheels, spacecraft_csd
-
-    if args.preset and args.model:
-        raise DataError("psd", "model/--preset", "give a model file or --preset, not both")
-    args.output = args.output or ("psd.bdf" if args.format == "nastran" else "psd.csv")
-    check_psd_flags(args)
-    if not args.speed_rpm:
+def _speed_range_flag(text: str) -> tuple:
+    """(MIN, MAX) rpm of ``--speed-rpm MIN:MAX`` (the range itself is checked by :func:`rwadist.psd`)."""
+    if not text:
         raise DataError("--speed-rpm", "value", "missing MIN:MAX (rpm)")
     try:
-        lo_rpm, hi_rpm = (float(x) for x in args.speed_rpm.split(":"))
+        lo_rpm, hi_rpm = (float(x) for x in text.split(":"))
     except ValueError:
-        raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: expected MIN:MAX in rpm") from None
-    check_speeds_rpm([lo_rpm, hi_rpm], "--speed-rpm")
-    if not lo_rpm < hi_rpm:
-        raise DataError("--speed-rpm", "value", f"{args.speed_rpm!r}: empty or inverted speed range; MIN must be "
-                        "below MAX (rpm; a negative range, e.g. -2400:-600, spins about -z)")
-    law = bb.law_from_spec(args.dist, lo_rpm, hi_rpm, args.std_rpm)
-    if args.model or args.preset:
-        from .presets import preset
+        raise DataError("--speed-rpm", "value", f"{text!r}: expected MIN:MAX in rpm") from None
+    return lo_rpm, hi_rpm
 
-        rated = model_io.load(args.model) if args.model else (catalogue.preset_model(args.preset)
-                                                              or preset(args.preset).to_model())
-        warn_beyond_rated_speed(rated, args.model or args.preset, lo_rpm, hi_rpm)
 
-    def default_lines():
-        if args.model and not hard_mounted:
-            warn_unconstrained(model_io.load(args.model), args.model, "the PSD")
-        return api.wheel_lines(args.model, preset=args.preset, empirical=hard_mounted)
-
-    # a wheel whose suspension modes are assumed (datasheet) runs hard-mounted unless --assumed-modes
-    assumed = catalogue.source_modes_assumed(args.model, args.preset)
-    hard_mounted = args.empirical or (assumed and not args.assumed_modes)
-    if assumed and hard_mounted and not args.empirical:
+def _psd_kind(res, args) -> str:
+    """What the PSD rests on, for the console and the plot; notes where assumed modes ran hard-mounted, and the note
+    file next to the outputs where they were used."""
+    source = res.meta["source"]
+    if source and source["modes_assumed"] and source["hard_mounted"] and not args.empirical:
         print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); running it "
               "hard-mounted (Melody's model of its lines); --assumed-modes uses the assumed modes")
-
-    out = check_output_file(args.output)
-    stem = out.with_suffix("")
-    written = [out] + [stem.parent / (stem.name + s) for s in ("_cross.csv", "_cross.h5", "_envelope.csv", ".png",
-                                                               "_ASSUMED_MODES.txt")]
-    refuse_input_overwrite([("-o", p, "file") for p in written],
-                           [args.model, args.wheels, args.dist if Path(args.dist).suffix else None])
-    t0 = time.perf_counter()
-    fmax = args.fmax
-    if args.wheels:
-        wheels = load_wheels(args.wheels, default_lines if (args.model or args.preset) else None, law, args.empirical,
-                             assumed_modes=args.assumed_modes)
-        rigid_set = [w.name for w in wheels if w.meta.get("modes_assumed") == "hard-mounted"]
-        if rigid_set:
-            print(f"note: {args.wheels}: wheels {', '.join(rigid_set)} have assumed suspension modes (datasheet "
-                  "wheels); running them hard-mounted (Melody's model of their lines); --assumed-modes uses the "
-                  "assumed modes")
-        if fmax is None:
-            fmax = _default_fmax([(w.lines, w.law or wheels[w.tie.to].law) for w in wheels])
-        res = spacecraft_csd(wheels, fmax, args.n_freq, args.n_speeds, progress=True)
-        sources = [(w.lines, w.mounting) for w in wheels]
-    else:
-        lines = default_lines()
-        if fmax is None:
-            try:
-                fmax = _default_fmax([(lines, law)])
-            except ValueError:      # no line to place the band by
-                raise DataError(args.model or args.preset, "empirical", "no harmonic lines: nothing to compute "
-                                "a PSD of; check the model with `rwadist model show`") from None
-        res = bb.broadband_psd(lines, law, fmax, args.n_freq, args.n_speeds, progress=True)
-        sources = [(lines, None)]
-    refuse_non_finite_psd(res, args.model or args.preset or args.wheels)
-    kind = "empirical (Melody)" if hard_mounted else "extended (modal amplification)"
-    on_assumed = ([args.model or args.preset] if assumed and not hard_mounted else []) + (
-        [f"{w.name} ({w.model_ref})" for w in wheels if w.meta.get("modes_assumed") == "assumed modes used"]
-        if args.wheels else [])
-    if on_assumed:
-        kind += " on ASSUMED modes"
-        stem0 = out.with_suffix("")
+    if res.meta["hard_mounted_wheels"]:
+        print(f"note: {args.wheels}: wheels {', '.join(res.meta['hard_mounted_wheels'])} have assumed suspension modes "
+              "(datasheet wheels); running them hard-mounted (Melody's model of their lines); --assumed-modes uses "
+              "the assumed modes")
+    kind = "empirical (Melody)" if res.meta["model"] == "empirical" else "extended (modal amplification)"
+    if res.meta["on_assumed_modes"]:
         from .catalogue import write_assumed_note
-        write_assumed_note(stem0.parent / (stem0.name + "_ASSUMED_MODES.txt"), on_assumed,
-                           [stem0.parent / (stem0.name + s) for s in (out.suffix, "_cross.csv", "_envelope.csv", ".png")])
-    if args.format == "nastran":
-        from .nastran import write_deck
 
-        tables = []
-        _write(out, lambda tmp: tables.extend(write_deck(res, tmp, fmt=args.nastran_fields, cross=args.nastran_cross)))
+        stem = Path(args.output).with_suffix("")
+        write_assumed_note(stem.parent / (stem.name + "_ASSUMED_MODES.txt"), res.meta["on_assumed_modes"],
+                           [stem.parent / (stem.name + s) for s in (Path(args.output).suffix, "_cross.csv",
+                                                                    "_envelope.csv", ".png")], with_flags)
+        kind += " on ASSUMED modes"
+    return kind
+
+
+def _write_psd(res, out: Path, args, title: str) -> tuple:
+    """The PSD's files: the table (CSV or NASTRAN), the cross-spectra, the line envelope, the plot; (envelope, png)."""
+    from . import broadband as bb
+
+    stem = out.with_suffix("")
+    if args.format == "nastran":
+        tables = api.write_nastran(res, out, fields=args.nastran_fields, cross=args.nastran_cross)
         print(f"wrote NASTRAN deck {out} ({len(tables)} TABRND1 tables, {args.nastran_fields} field)")
     else:
         _write(out, lambda tmp: bb.write_psd_csv(res, tmp))
@@ -597,23 +478,45 @@ def cmd_psd(args) -> int:
     elif args.cross == "h5":
         p = _write(stem.parent / (stem.name + "_cross.h5"), lambda tmp: bb.write_hdf5(res, tmp, "csd"))
         print(f"cross-spectra: {p} (group /csd)")
-    lo_w, hi_w = law.support if not args.wheels else (min(w.law.support[0] for w in wheels if w.law),
-                                                       max(w.law.support[1] for w in wheels if w.law))
-    env = bb.line_envelope(sources, (lo_w, hi_w), res.f)
-    p_env = _write(stem.parent / (stem.name + "_envelope.csv"), lambda tmp: bb.write_envelope_csv(env, tmp))
+    p_env = _write(stem.parent / (stem.name + "_envelope.csv"),
+                   lambda tmp: bb.write_envelope_csv(res.meta["envelope"], tmp))
     png = stem.parent / (stem.name + ".png")
     with working("drawing the PSD plot"):
-        figure = bb.plot_psd(res, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm")
+        figure = bb.plot_psd(res, title)
         _write(png, lambda tmp: save_png(figure, tmp, dpi=110))
+    return p_env, png
+
+
+def cmd_psd(args) -> int:
+    """Broadband PSD over a speed distribution (Melody's model, or the extended model with the modal
+    amplification inside the speed integral); one wheel or a wheels.json set in the spacecraft frame
+    (:func:`rwadist.psd`)."""
+    if args.preset and args.model:
+        raise DataError("psd", "model/--preset", "give a model file or --preset, not both")
+    args.output = args.output or ("psd.bdf" if args.format == "nastran" else "psd.csv")
+    check_psd_flags(args)
+    lo_rpm, hi_rpm = _speed_range_flag(args.speed_rpm)
+    out = check_output_file(args.output)
+    stem = out.with_suffix("")
+    written = [out] + [stem.parent / (stem.name + s) for s in ("_cross.csv", "_cross.h5", "_envelope.csv", ".png",
+                                                               "_ASSUMED_MODES.txt")]
+    refuse_input_overwrite([("-o", p, "file") for p in written],
+                           [args.model, args.wheels, args.dist if Path(args.dist).suffix else None])
+    t0 = time.perf_counter()
+    res = api.psd(args.model, (lo_rpm, hi_rpm), preset=args.preset, wheels=args.wheels, dist=args.dist,
+                  std_rpm=args.std_rpm, empirical=args.empirical, assumed_modes=args.assumed_modes, fmax=args.fmax,
+                  n_freq=args.n_freq, n_speeds=args.n_speeds, envelope=True, progress=True)
+    kind = _psd_kind(res, args)
+    p_env, png = _write_psd(res, out, args, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm")
     rms = res.rms()
-    print(f"{kind}, {res.frame} frame, {res.f.size} frequencies to {fmax:g} Hz, {time.perf_counter() - t0:.1f} s")
+    print(f"{kind}, {res.frame} frame, {res.f.size} frequencies to {res.meta['fmax_hz']:g} Hz, "
+          f"{time.perf_counter() - t0:.1f} s")
     print("RMS: " + ", ".join(f"{c} {v:.4g} {'N' if c[0] == 'F' else 'N·m'}"
                               for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
     print(f"worst-case line envelope: {p_env}; plots: {png}")
     return 0
 
 
-_default_fmax = api.default_fmax
 
 
 # --------------------------------------------------------------------------- main
@@ -623,6 +526,39 @@ def build_parser() -> argparse.ArgumentParser:
     from .cli_parser import build_parser as _build
 
     return _build(sys.modules[__name__])
+
+
+#: API parameters given on the command line under another name than ``--`` + the name with ``-`` for ``_``
+PARAMETER_FLAGS = {"n_samples": "--samples", "exclude_modes": "--no-mode-exclusion", "model": "MODEL",
+                   "data": "DATA", "path": "-o", "fields": "--nastran-fields", "cross": "--nastran-cross",
+                   "start_rpm": "--sweep-start-rpm", "end_rpm": "--sweep-end-rpm", "modes": "--no-modes",
+                   "test_stand": "--no-test-stand", "tach": "--no-tach"}
+
+
+#: per command, API parameters given by a positional argument there (``catalogue show NAME``)
+COMMAND_FLAGS = {"catalogue show": {"preset": "NAME"}}
+
+
+def flag_of(parameter: str, command: str = "") -> str:
+    """The command-line flag that gives the API's ``parameter`` (``speed_rpm`` -> ``--speed-rpm``) in ``command``."""
+    named = COMMAND_FLAGS.get(command, {}).get(parameter) or PARAMETER_FLAGS.get(parameter)
+    return named or "--" + parameter.replace("_", "-")
+
+
+def with_flags(text: str, command: str = "") -> str:
+    """A library message with the parameters it names in backquotes (```radius```) named by their flags."""
+    import re
+
+    return re.sub(r"`([a-z][a-z0-9_]*)`", lambda m: flag_of(m.group(1), command), text)
+
+
+def user_message(exc: RwadistError, command: str = "") -> str:
+    """The one-line message of a library error as the command line says it: a :class:`ParameterError` names the
+    flag of its parameter (``--presence: value: 2.0: ...``) and of those it mentions, every other error its file and
+    field as raised."""
+    if isinstance(exc, ParameterError) and exc.parameter is not None:
+        return f"{flag_of(exc.parameter, command)}: value: {with_flags(exc.problem, command)}"
+    return with_flags(str(exc), command)
 
 
 def _command_name(args) -> str:
@@ -667,26 +603,32 @@ def one_blas_thread():
 
 
 @contextmanager
-def _model_key_warnings():
-    """A model file's unread keys (:class:`rwadist.model.ModelKeyWarning`) each printed once as one line on stderr,
-    ``rwadist: warning: <file>: <key>: ...``, not in Python's warning format."""
+def _library_warnings():
+    """The library's warnings (:class:`rwadist.RwadistWarning`) each printed once as one line on stderr, with the
+    parameters they name given by their flags, not in Python's warning format: ``WARNING: --speed-rpm 0:10000 rpm
+    reaches ...``; a model file's unread keys (:class:`rwadist.model.ModelKeyWarning`) as ``rwadist: warning: ...``."""
     import warnings
 
+    from .errors import RwadistWarning
     from .model import ModelKeyWarning
 
     seen: set = set()
     shown = warnings.showwarning
 
     def show(message, category, filename, lineno, file=None, line=None):
-        if issubclass(category, ModelKeyWarning):
-            if str(message) not in seen:
-                seen.add(str(message))
-                print(f"rwadist: warning: {message}", file=sys.stderr)
+        if not issubclass(category, RwadistWarning):
+            shown(message, category, filename, lineno, file, line)
             return
-        shown(message, category, filename, lineno, file, line)
+        parameter = getattr(message, "parameter", None)
+        text = with_flags(message.text if parameter else str(message))
+        text = (f"rwadist: warning: {text}" if issubclass(category, ModelKeyWarning) else
+                f"WARNING: {flag_of(parameter) + ' ' if parameter else ''}{text}")
+        if text not in seen:
+            seen.add(text)
+            print(text, file=sys.stderr)
 
     with warnings.catch_warnings():
-        warnings.simplefilter("always", ModelKeyWarning)
+        warnings.simplefilter("always", RwadistWarning)
         warnings.showwarning = show
         yield
 
@@ -703,13 +645,13 @@ def main(argv=None) -> int:
     command = _command_name(args)
     try:
         check_parsed(parser, args)
-        with one_blas_thread(), _model_key_warnings():
+        with one_blas_thread(), _library_warnings():
             return args.func(args)
     except KeyboardInterrupt:
         print(f"rwadist {command}: interrupted; outputs left as they were (no partial file written)", file=sys.stderr)
         return 130
-    except (DataError, ValueError) as exc:
-        print(f"rwadist: error: {exc}", file=sys.stderr)
+    except RwadistError as exc:     # bad input, said by the library: a parameter is named by its flag here
+        print(f"rwadist: error: {user_message(exc, command)}", file=sys.stderr)
         return 2
     except MemoryError:
         print(f"rwadist {command}: error: not enough memory for these settings; reduce the sizes given "

@@ -8,12 +8,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import model as model_io
-from .data import DataError
+from .cli_parser import check_fmu_ramp
+from .errors import DataError, MissingDependencyError, ModelError
 from .outputs import check_output_file, refuse_input_overwrite, write_file
 from .progress import working
 from .units import rpm_to_rad_s
-from .validate import check_fmu_ramp, warn_unconstrained
 
 
 def _windows_note() -> str:
@@ -57,11 +56,11 @@ def _preset_source(name: str):
 
 
 def cmd_fmu_build(args) -> int:
-    try:
-        from rwadist.fmu.build import build_fmu, has_native
-        from rwadist.fmu.runtime import ModelError
-    except ImportError as exc:
-        raise DataError("fmu", "build", f"needs the fmu package and pythonfmu ({exc})") from None
+    """The FMU of a model file or preset (:func:`rwadist.build_fmu`), or the SSP of a wheels set."""
+    import warnings
+
+    from . import api
+
     out = check_output_file(args.output)
     if getattr(args, "wheels", None):
         try:
@@ -73,38 +72,22 @@ def cmd_fmu_build(args) -> int:
     if out.suffix != ".fmu":
         raise DataError("-o", "value", f"{str(out)!r} must end in .fmu")
     fmi_version = getattr(args, "fmi_version", 2)
-    if fmi_version != 2 and not getattr(args, "native", False):
-        raise DataError("--fmi-version", "value", f"{fmi_version}: the pythonfmu FMU is FMI 2.0 only; add --native "
-                        "for the FMI 3.0 FMU")
     refuse_input_overwrite([("-o", out, "file")], [args.model])
-    if args.model:
-        source = args.model
-        warn_unconstrained(model_io.load(args.model), args.model, "the FMU")
-    else:
-        source = _preset_source(args.preset or "ithaco-e")
-    try:
-        if getattr(args, "native", False):
-            import warnings
-
-            from rwadist.fmu.native_build import binary_platforms, build_native_fmu
-            with working("rwadist fmu build: compiling the native FMU"), warnings.catch_warnings():
-                warnings.filterwarnings("ignore", "no Windows binary", RuntimeWarning)    # noted below
-                path = write_file(out, lambda tmp: build_native_fmu(source, tmp, assumed_modes=args.assumed_modes,
-                                                                    fmi_version=fmi_version))
-        else:
-            with working("rwadist fmu build: packaging the FMU"):
-                path = write_file(out, lambda tmp: build_fmu(source, tmp, assumed_modes=args.assumed_modes))
-    except ModelError as exc:
-        if exc.field is not None:       # a bad model-file field: the schema's message names file and field
-            raise
-        raise DataError(args.model or args.preset, "model", str(exc)) from None
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "no Windows binary", RuntimeWarning)    # noted below
+        path = api.build_fmu(args.model, out, preset=args.preset, native=getattr(args, "native", False),
+                             fmi_version=fmi_version, assumed_modes=args.assumed_modes, progress=True)
     what = f"model {'file ' + args.model if args.model else 'preset ' + (args.preset or 'ithaco-e')}"
     if getattr(args, "native", False):
+        from rwadist.fmu.native_build import binary_platforms
+
         if note := _windows_note():
             print(f"rwadist: note: {note}")
         print(f"wrote {path} ({what}; native FMU, FMI {fmi_version}.0: C only, no Python needed by the host; "
               f"binaries: {', '.join(binary_platforms(path))})")
     else:
+        from rwadist.fmu.build import has_native
+
         print(f"wrote {path} ({what}; native layer: "
               f"{'yes' if has_native(path) else 'no, numpy steps and fmi2Discard on bad input'})")
     return 0
@@ -131,8 +114,8 @@ def cmd_fmu_check(args) -> int:
     try:
         from fmpy import simulate_fmu
         from fmpy.validation import validate_fmu
-    except ImportError as exc:
-        raise DataError(args.fmu, "check", f"needs fmpy ({exc})") from None
+    except ImportError:
+        raise MissingDependencyError("fmpy", "checking an FMU", "fmu") from None
     if not Path(args.fmu).is_file():
         raise DataError(args.fmu, "file", "does not exist")
     _check_fmu_archive(args.fmu)

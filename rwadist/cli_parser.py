@@ -1,13 +1,19 @@
-"""The ``rwadist`` command line's argument parser: every command, flag, default and allowed range.
+"""The ``rwadist`` command line's argument parser: every command, flag and default.
 
-The commands themselves live in :mod:`rwadist.cli`; each flag's value is checked here, at parse time,
-by :mod:`rwadist.validate` (a refused value names the flag, the value and the allowed range)."""
+The commands themselves live in :mod:`rwadist.cli`.  A flag that gives an API parameter is checked at parse
+time against that parameter's range, decided once in :data:`rwadist.validate.LIMITS` (:func:`limited`; a refused
+value names the flag, the value and the allowed range); flags the chosen command would ignore are refused here
+too (:func:`check_fit_flags`, :func:`check_psd_flags`)."""
 from __future__ import annotations
 
 import argparse
+import math
+from pathlib import Path
 
 from .effects import elements
-from .validate import MAX_RPM, MAX_SAMPLES, MAX_SPEEDS, number, rpm
+from .errors import DataError, ParameterError
+from .units import rpm_to_rad_s
+from .validate import LIMITS, MAX_RPM, MAX_SPEEDS, check_number
 
 
 def _version() -> str:
@@ -21,21 +27,121 @@ def _version() -> str:
         return __version__
 
 
+class Refused:
+    """A flag value :func:`number` refused: ``text`` as given and ``why`` (range, type)."""
+
+    def __init__(self, text: str, why: str):
+        self.text, self.why = text, why
+
+    def __repr__(self) -> str:
+        return repr(self.text)
+
+
+def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
+           unit: str = ""):
+    """An argparse ``type`` checking a finite number (or an integer) in a range."""
+    def parse(text):
+        try:
+            return check_number(text, "value", lo, hi, lo_open=lo_open, hi_open=hi_open, integer=integer,
+                                unit=unit)
+        except ParameterError as exc:       # refused by check_parsed, which knows the flag (exit 2 from main)
+            return Refused(text, exc.problem)
+
+    parse.__name__ = "integer" if integer else "number"
+    parse.rwadist_checked = True
+    return parse
+
+
+def check_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """After parsing: every flag typed by :func:`number` holds a number (argparse skips the type of some
+    values, e.g. ``--noise=--`` gives an empty list); :class:`DataError` naming the flag otherwise."""
+    def walk(p):
+        for action in p._actions:
+            if isinstance(action, argparse._SubParsersAction):     # only the command that was chosen
+                chosen = action.choices.get(getattr(args, action.dest, None) or "")
+                if chosen is not None:
+                    yield from walk(chosen)
+            elif getattr(action.type, "rwadist_checked", False):
+                yield action
+
+    for action in walk(parser):
+        value = getattr(args, action.dest, None)
+        if value is None or value is action.default:
+            continue
+        flag = max(action.option_strings, key=len) if action.option_strings else action.dest
+        if isinstance(value, Refused):
+            raise DataError(flag, "value", value.why)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise DataError(flag, "value", f"{value!r}: missing or not a number")
+
+
+def check_fit_flags(args: argparse.Namespace) -> None:
+    """``rwadist fit``: flags it would ignore are refused: --mass, --radius, --height and --preset without
+    --extended (they feed the extended fit only) and --cumulative-rpm with --no-report (it picks the report's
+    plots).  The values themselves are :func:`rwadist.api.extended_options`'s to judge."""
+    given = [f for f, v in (("--mass", args.mass), ("--radius", args.radius), ("--height", args.height or None),
+                            ("--preset", args.preset)) if v is not None]
+    if given and not args.extended:
+        raise DataError(given[0], "value", "applies to the extended fit only: add --extended (the plain fit of "
+                        "harmonics C·Ω² does not use it)")
+    if args.cumulative_rpm and args.no_report:
+        raise DataError("--cumulative-rpm", "value", "picks the report's plots: drop it, or drop --no-report")
+
+
+def check_psd_flags(args: argparse.Namespace) -> None:
+    """``rwadist psd``: flags that the chosen output would ignore are refused, as is an output whose extension
+    names the other format (a NASTRAN deck written as x.csv, CSV as x.bdf)."""
+    nastran = args.format == "nastran"
+    if not nastran and (args.nastran_cross or args.nastran_fields != "small"):
+        raise DataError("--nastran-cross" if args.nastran_cross else "--nastran-fields", "value",
+                        "applies to --format nastran only")
+    suffix = Path(args.output).suffix.lower()
+    if nastran and suffix == ".csv" or not nastran and suffix in (".bdf", ".dat", ".nas", ".blk"):
+        raise DataError("-o", "value", f"{args.output!r}: its extension names the other format than --format "
+                        f"{args.format}; give a {'.bdf' if nastran else '.csv'} file")
+
+
+def check_fmu_ramp(fmu_path, speed_rpm: float, stop_time: float) -> None:
+    """``rwadist fmu check``: the check's ramp 0 -> ``speed_rpm`` over ``stop_time`` s must stay within the FMU's
+    ``max_acceleration`` (its start value): 6000 rpm over the default 1 s is 628 rad/s², which the FMU refuses (500
+    rad/s² by default), and the check then failed (exit 1) as if the FMU were broken."""
+    from fmpy import read_model_description
+
+    var = next((v for v in read_model_description(str(fmu_path)).modelVariables if v.name == "max_acceleration"),
+               None)
+    accel = abs(float(rpm_to_rad_s(speed_rpm))) / stop_time
+    if var is not None and var.start is not None and accel > float(var.start):
+        raise DataError("--stop-time", "value", f"{stop_time:g} s to {speed_rpm:g} rpm is {accel:.4g} rad/s², above the "
+                        f"FMU's max_acceleration of {float(var.start):g} rad/s²: give --stop-time "
+                        f"{math.ceil(100 * accel * stop_time / float(var.start)) / 100:g} s or more")
+
+
+def rpm(lo: float = -MAX_RPM, hi: float = MAX_RPM):
+    """An argparse ``type``: a wheel speed in rpm within [lo, hi]."""
+    return number(lo, hi, unit="rpm")
+
+
+def limited(parameter: str):
+    """The argparse ``type`` of the flag giving the API parameter ``parameter``: its range in
+    :data:`rwadist.validate.LIMITS`."""
+    return number(**LIMITS[parameter])
+
+
 def _add_fit_options(p):
-    p.add_argument("--f-lim", type=number(0, 1e6, lo_open=True, unit="Hz"), default=None, help="upper limit of good data, Hz (test-stand resonance)")
-    p.add_argument("--nperseg", type=number(16, 2**24, integer=True), default=None, help="FFT length (default: largest power of 2 in a run)")
-    p.add_argument("--presence", type=number(0, 1, lo_open=True), default=0.25, help="bin presence threshold P0, fraction (default 0.25)")
-    p.add_argument("--epsilon", type=number(0, 0.5, lo_open=True), default=0.02, help="binning tolerance on h (default 0.02)")
+    p.add_argument("--f-lim", type=limited("f_lim"), default=None, help="upper limit of good data, Hz (test-stand resonance)")
+    p.add_argument("--nperseg", type=limited("nperseg"), default=None, help="FFT length (default: largest power of 2 in a run)")
+    p.add_argument("--presence", type=limited("presence"), default=0.25, help="bin presence threshold P0, fraction (default 0.25)")
+    p.add_argument("--epsilon", type=limited("epsilon"), default=0.02, help="binning tolerance on h (default 0.02)")
     p.add_argument("--no-mode-exclusion", action="store_true", help="keep modally amplified speeds in the fit")
-    p.add_argument("--slice-samples", type=number(64, 2**24, integer=True), default=8192, help="sweep slice length, samples")
+    p.add_argument("--slice-samples", type=limited("slice_samples"), default=8192, help="sweep slice length, samples")
     p.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
                    help="speed of sweep slices: tach column, estimated from data, or auto")
     p.add_argument("--extended", action="store_true",
                    help="also fit the extended model (modes, damping, imbalances) into the model file")
-    p.add_argument("--mass", type=number(0, 1e4, lo_open=True, unit="kg"), default=None,
+    p.add_argument("--mass", type=limited("mass"), default=None,
                    help="rotor mass, kg (extended fit; without --mass/--radius the fit is per unit mass/inertia)")
-    p.add_argument("--radius", type=number(0, 10, lo_open=True, unit="m"), default=None, help="rotor radius, m (extended fit; thin-disc inertias)")
-    p.add_argument("--height", type=number(-10, 10, unit="m"), default=0.0,
+    p.add_argument("--radius", type=limited("radius"), default=None, help="rotor radius, m (extended fit; thin-disc inertias)")
+    p.add_argument("--height", type=limited("height"), default=0.0,
                    help="lever arm from the rotor centre to the torque reference point, m (default 0)")
     p.add_argument("--preset", default=None, help="take mass and radius (and unseen modes) from a wheel preset")
 
@@ -52,12 +158,12 @@ def build_parser(cli) -> argparse.ArgumentParser:
     s.add_argument("--preset", required=True, help="wheel preset, e.g. ithaco-e, ithaco-b")
     s.add_argument("--speeds-rpm", help="'A,B,C', 'START:STOP:STEP' or 'START:STOP' with --n-speeds")
     s.add_argument("--n-speeds", type=number(1, MAX_SPEEDS, integer=True), default=None)
-    s.add_argument("--sample-rate", type=number(0, 1e6, lo_open=True, unit="Hz"), default=None, help="Hz (default: the preset's test)")
-    s.add_argument("--samples", type=number(64, MAX_SAMPLES, integer=True), default=8192, help="samples per steady run")
-    s.add_argument("--noise", type=number(0, 10), default=0.01, help="sensor noise std as a fraction of the top-speed fundamental")
+    s.add_argument("--sample-rate", type=limited("sample_rate"), default=None, help="Hz (default: the preset's test)")
+    s.add_argument("--samples", type=limited("n_samples"), default=8192, help="samples per steady run")
+    s.add_argument("--noise", type=limited("noise"), default=0.01, help="sensor noise std as a fraction of the top-speed fundamental")
     s.add_argument("--no-modes", action="store_true", help="switch the wheel's structural modes off")
     s.add_argument("--no-test-stand", action="store_true", help="switch test-stand resonances off")
-    s.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0)
+    s.add_argument("--seed", type=limited("seed"), default=0)
     s.add_argument("--sweep", action="store_true", help="one spin-up record instead of steady runs")
     s.add_argument("--sweep-start-rpm", type=rpm(), default=0.0)
     s.add_argument("--sweep-end-rpm", type=rpm(), default=None)
@@ -139,11 +245,11 @@ def build_parser(cli) -> argparse.ArgumentParser:
     q.add_argument("--speed-rpm", required=True, help="MIN:MAX speed range, rpm (negative = spinning about -z)")
     q.add_argument("--dist", default="uniform", help="uniform | normal | FILE.csv (speed_rpm,weight histogram, "
                    "speed_rpm,pdf_per_rpm density, or time_s,speed_rpm profile)")
-    q.add_argument("--std-rpm", type=number(0, MAX_RPM, lo_open=True, unit="rpm"), default=None, help="std of the normal law, rpm (default range/6)")
+    q.add_argument("--std-rpm", type=limited("std_rpm"), default=None, help="std of the normal law, rpm (default range/6)")
     q.add_argument("--wheels", help="wheels.json: several wheels with mountings (spacecraft-frame 6x6 CSD)")
-    q.add_argument("--fmax", type=number(0, 1e6, lo_open=True, unit="Hz"), default=None, help="top frequency, Hz (default 1.2 x highest line)")
-    q.add_argument("--n-freq", type=number(2, 200_001, integer=True), default=20001, help="frequency points 0..fmax (default 20001)")
-    q.add_argument("--n-speeds", type=number(2, 20_000, integer=True), default=2000, help="speed cells of the law (default 2000)")
+    q.add_argument("--fmax", type=limited("fmax"), default=None, help="top frequency, Hz (default 1.2 x highest line)")
+    q.add_argument("--n-freq", type=limited("n_freq"), default=20001, help="frequency points 0..fmax (default 20001)")
+    q.add_argument("--n-speeds", type=limited("n_speeds"), default=2000, help="speed cells of the law (default 2000)")
     q.add_argument("--empirical", action="store_true", help="Melody's model from the harmonics alone, no modes")
     q.add_argument("--assumed-modes", action="store_true",
                    help="run a wheel with assumed (datasheet) suspension modes through them (default: hard-mounted); "
@@ -165,17 +271,17 @@ def build_parser(cli) -> argparse.ArgumentParser:
     dsrc.add_argument("--model", help="model file to start from (default: the empirical fit of the data)")
     dsrc.add_argument("--preset", help="start from a wheel preset's model, e.g. ithaco-e")
     dg.add_argument("-o", "--output", required=True, help="report directory")
-    dg.add_argument("--nperseg", type=number(16, 2**24, integer=True), default=None, help="FFT length (default: power of 2 <= run length/4)")
-    dg.add_argument("--f-lim", type=number(0, 1e6, lo_open=True, unit="Hz"), default=None, help="upper limit of good data, Hz")
-    dg.add_argument("--k-sigma", type=number(0, 100, lo_open=True), default=4.0, help="held-out gain needed, noise standard errors (4)")
-    dg.add_argument("--min-gain", type=number(0, 1, lo_open=True, hi_open=True), default=0.05,
+    dg.add_argument("--nperseg", type=limited("nperseg"), default=None, help="FFT length (default: power of 2 <= run length/4)")
+    dg.add_argument("--f-lim", type=limited("f_lim"), default=None, help="upper limit of good data, Hz")
+    dg.add_argument("--k-sigma", type=limited("k_sigma"), default=4.0, help="held-out gain needed, noise standard errors (4)")
+    dg.add_argument("--min-gain", type=limited("min_gain"), default=0.05,
                     help="held-out gain needed, fraction of the unexplained power (0.05)")
     dg.add_argument("--base", choices=("auto", "empirical", "extended"), default="auto",
                     help="starting prediction of the lines: 'empirical' C*omega^2 hard mounted, 'extended' through "
                          "the rotor's suspension modes of the model's analytical section (forward/backward whirl, "
                          "rotation sense); auto (default): extended when the model (--model/--preset) has an "
                          "analytical section and the data's meta.json does not say modes: false")
-    dg.add_argument("--slice-samples", type=number(64, 2**24, integer=True), default=8192, help="sweep slice length, samples")
+    dg.add_argument("--slice-samples", type=limited("slice_samples"), default=8192, help="sweep slice length, samples")
     dg.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
                     help="speed of sweep slices: tach column, estimated from data, or auto")
     dg.set_defaults(func=cli.cmd_diagnose)

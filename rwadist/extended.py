@@ -216,8 +216,8 @@ def params_from_dict(d, source="<model>") -> ExtendedParams:
 
     if d is None:
         raise ModelFileError(source, "analytical", "missing: the model file has no analytical parameters (suspension "
-                             "modes); add them with `rwadist fit DATA --extended --mass KG --radius M` or use a wheel "
-                             "preset (--preset NAME); `rwadist psd --empirical` needs only the harmonics")
+                             "modes); add them with the extended fit (with the rotor's `mass` and `radius`) or use a "
+                             "wheel `preset`; the empirical PSD (`empirical`) needs only the harmonics")
     vals = schema.Analytical.from_json(d, source, ModelFileError).require(source, ModelFileError)
     try:
         return ExtendedParams(**vals)

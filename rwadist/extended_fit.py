@@ -41,7 +41,7 @@ import numpy as np
 from scipy import optimize
 
 from . import extended as ext
-from .data import SteadyTest
+from .data import DataError, SteadyTest
 from .dft import run_window, windowed_dfts, windowed_records
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .geometry import remove_lever_arm
@@ -481,7 +481,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
             lines.append(ext.Line(x.direction, float(x.h), float(x.C), "co"))
             owner.append(j)
     if not lines:
-        raise ValueError("the empirical fit has no harmonics: nothing to fit the extended model to")
+        raise DataError("empirical fit", "harmonics", "none: nothing to fit the extended model to (lower `presence`)")
     owner = np.array(owner)
     # axial measurements: per channel amplitude; radial: x²+y² power per run
     lr, sr, pr, dr = radial

@@ -43,7 +43,7 @@ def kinds() -> dict:
 
 
 def _bad(spec, field, why):
-    return DataError("--inject", field, f"{spec!r}: {why}")
+    return DataError("`inject`", field, f"{spec!r}: {why}")
 
 
 def parse(spec: str) -> dict:
@@ -108,8 +108,9 @@ class Stand:
 
     @staticmethod
     def error(field, why) -> DataError:
-        """The error of a wrong injection (``--inject``, the field, what to do)."""
-        return DataError("--inject", field, why)
+        """The error of a wrong injection (the parameter ``inject``, the field, what to do; a parameter it names is
+        in backquotes, for the command line to name its flag)."""
+        return DataError("`inject`", field, why)
 
     @staticmethod
     def time(run) -> np.ndarray:
@@ -123,7 +124,7 @@ class Stand:
             if abs(hh - h) <= 1e-6:
                 return hh, C
         known = ", ".join(f"{hh:g}" for hh, _ in wheel.harmonics.get(direction, []))
-        raise DataError("--inject", "h", f"{spec['kind']}: the wheel has no {direction} line at h = {h:g} "
+        raise DataError("`inject`", "h", f"{spec['kind']}: the wheel has no {direction} line at h = {h:g} "
                         f"(it has h = {known})")
 
     @staticmethod

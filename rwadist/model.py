@@ -33,6 +33,7 @@ import numpy as np
 from . import effects as _effects  # noqa: F401  (imports every element: the schema reads every kind)
 from . import schema
 from .data import DataError, read_json
+from .errors import RwadistWarning
 from .schema import Analytical, Effect, Harmonic, ModelError
 from .units import DIRECTION_C_UNIT, DIRECTION_CHANNELS
 
@@ -200,7 +201,7 @@ def unread_keys(doc: Any) -> list:
     return out
 
 
-class ModelKeyWarning(UserWarning):
+class ModelKeyWarning(RwadistWarning):
     """A model file holds a key or effect kind this version does not read (:func:`unread_keys`)."""
 
 

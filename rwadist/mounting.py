@@ -146,7 +146,7 @@ def _speed_law(spec, default_law, base: Path, where: str):
 
     if spec is None:
         if default_law is None:
-            raise DataError(where, "speed", "no speed law: give one here or on the command line")
+            raise DataError(where, "speed", "no speed law: give one here or a default speed range for the set")
         return default_law
     if not isinstance(spec, dict):
         raise DataError(where, "speed", f"must be an object, got {spec!r}")
@@ -181,127 +181,151 @@ def _check_keys(path, where: str, obj: dict, known: tuple) -> None:
                             + f"; known: {', '.join(known)}")
 
 
-def load_wheels(path, default_lines_loader=None, default_law=None, empirical: bool = False,
-                assumed_modes: bool = False) -> list:
-    """Read a wheels.json file into :class:`WheelSpec` objects.
-
-    default_lines_loader : callable() -> WheelLines used for wheels without ``model``/``preset``.
-    default_law : speed law for wheels without ``speed`` (rad/s).  empirical : Melody's model
-    (harmonics only) instead of the extended model.  assumed_modes : run a wheel whose suspension modes
-    are assumed (``analytical.modes_assumed``: a catalogue datasheet wheel) through those modes; without
-    it such a wheel is hard-mounted (Melody's model of its lines), as its datasheet states.  Either way
-    the wheel's ``meta["modes_assumed"]`` says which ('hard-mounted' or 'assumed modes used').
-    DataError names the file and the field (missing model file, bad DCM, unknown tie, ...).
-    """
-    from . import broadband as bb
-    from . import catalogue
-    from . import model as model_io
-
-    path = Path(path)
-    doc = read_json(path)
+def _wheel_items(wheels) -> tuple:
+    """(source, wheel objects, folder model and speed-file paths are relative to) of a wheels.json path or of its
+    parsed content (a list of wheel objects, or ``{"wheels": [...]}``; paths then relative to the working folder)."""
+    if isinstance(wheels, (str, Path)):
+        path, base = Path(wheels), Path(wheels).parent
+        doc = read_json(path)
+    else:
+        path, base, doc = "wheels", Path("."), wheels
     if isinstance(doc, dict):
         _check_keys(path, "document", doc, ("wheels",))
     items = doc.get("wheels") if isinstance(doc, dict) else doc
-    if not isinstance(items, list) or not items:
+    if not isinstance(items, (list, tuple)) or not items:
         raise DataError(path, "wheels", "must be a non-empty list of wheel objects")
-    base = path.parent
-    names = [str(w.get("name", f"wheel{i}")) if isinstance(w, dict) else "" for i, w in enumerate(items)]
-    out = []
-    cache = {}
-    for i, w in enumerate(items):
-        where = f"wheels[{i}]"
-        if not isinstance(w, dict):
-            raise DataError(path, where, f"must be an object, got {w!r}")
-        _check_keys(path, where, w, WHEEL_KEYS)
-        for key, known in (("mounting", MOUNTING_KEYS), ("tie", TIE_KEYS), ("speed", SPEED_KEYS)):
-            if key in w:
-                if not isinstance(w[key], dict):
-                    raise DataError(path, f"{where}.{key}", f"must be an object with keys {', '.join(known)}; got "
-                                    f"{w[key]!r}")
-                _check_keys(path, f"{where}.{key}", w[key], known)
-        for a, b in EXCLUSIVE_KEYS:
-            if a in w and b in w:
-                raise DataError(path, f"{where}.{b}", f"given beside '{a}', which decides it: give one of the two")
-        if names.count(names[i]) > 1:
-            raise DataError(path, f"{where}.name", f"{names[i]!r} names more than one wheel; names: {names}")
-        # sources
-        if "model" in w:
-            mp = Path(w["model"])
-            mp = mp if mp.is_absolute() else base / mp
-            if not mp.exists():
-                raise DataError(path, f"{where}.model", f"model file {str(mp)!r} does not exist")
-            key = ("model", str(mp))
-            if key not in cache:
-                m = model_io.load(mp)
-                assumed = catalogue.modes_assumed(m)
-                rigid = empirical or (assumed and not assumed_modes)
-                cache[key] = (bb.empirical_lines(m) if rigid else bb.extended_lines_from_model(m, str(mp)), assumed)
-            (lines, assumed), ref = cache[key], str(mp)
-        elif "preset" in w:
-            key = ("preset", w["preset"])
-            try:
-                if key not in cache:
-                    cm = catalogue.preset_model(w["preset"])
-                    assumed = cm is not None and catalogue.modes_assumed(cm)
-                    cache[key] = (bb.preset_lines(w["preset"], empirical or (assumed and not assumed_modes)), assumed)
-            except ValueError as exc:
-                raise DataError(path, f"{where}.preset", str(exc)) from None
-            (lines, assumed), ref = cache[key], f"preset {w['preset']}"
-        else:
-            if default_lines_loader is None:
-                raise DataError(path, f"{where}.model", "no model: give 'model' or 'preset' (or a model on the "
-                                "command line)")
-            if "default" not in cache:
-                cache["default"] = default_lines_loader()
-            lines, ref, assumed = cache["default"], "command-line model", False   # the caller notes its own
-        # mounting
+    return path, list(items), base
+
+
+def _check_wheel(path, where: str, w, names: list, i: int) -> None:
+    """The keys of wheel object ``w``: known, objects where objects go, no pair of which one would be ignored, its
+    name its own."""
+    if not isinstance(w, dict):
+        raise DataError(path, where, f"must be an object, got {w!r}")
+    _check_keys(path, where, w, WHEEL_KEYS)
+    for key, known in (("mounting", MOUNTING_KEYS), ("tie", TIE_KEYS), ("speed", SPEED_KEYS)):
+        if key in w:
+            if not isinstance(w[key], dict):
+                raise DataError(path, f"{where}.{key}", f"must be an object with keys {', '.join(known)}; got "
+                                f"{w[key]!r}")
+            _check_keys(path, f"{where}.{key}", w[key], known)
+    for a, b in EXCLUSIVE_KEYS:
+        if a in w and b in w:
+            raise DataError(path, f"{where}.{b}", f"given beside '{a}', which decides it: give one of the two")
+    if names.count(names[i]) > 1:
+        raise DataError(path, f"{where}.name", f"{names[i]!r} names more than one wheel; names: {names}")
+
+
+def _wheel_lines(path, where: str, w: dict, base: Path, cache: dict, default_lines_loader, empirical: bool,
+                 assumed_modes: bool) -> tuple:
+    """(lines, model reference, modes assumed) of wheel object ``w``: its model file or preset, under the
+    assumed-modes rule of :func:`rwadist.wheel_source.wheel_source` (one source read once per set)."""
+    from .wheel_source import wheel_source
+
+    if "model" in w:
+        mp = Path(w["model"])
+        mp = mp if mp.is_absolute() else base / mp
+        if not mp.exists():
+            raise DataError(path, f"{where}.model", f"model file {str(mp)!r} does not exist")
+        key, ref, ask = ("model", str(mp)), str(mp), {"model": mp}
+    elif "preset" in w:
+        key, ref, ask = ("preset", w["preset"]), f"preset {w['preset']}", {"preset": w["preset"]}
+    else:
+        if default_lines_loader is None:
+            raise DataError(path, f"{where}.model", "no model: give 'model' or 'preset' here, or a default model "
+                            "for the set")
+        if "default" not in cache:
+            cache["default"] = default_lines_loader()
+        return cache["default"], "command-line model", False   # the caller notes its own
+    if key not in cache:
         try:
-            if "mounting" in w:
-                mspec = w["mounting"]
-                ms = preset_mountings(mspec.get("preset", ""), **{k: v for k, v in mspec.items()
-                                                                    if k in ("radius_m", "elevation_deg")})
-                idx = int(mspec.get("index", i))
-                if not 0 <= idx < len(ms):
-                    raise DataError(path, f"{where}.mounting.index", f"{idx} out of range 0..{len(ms) - 1}")
-                mount = ms[idx]
-            else:
-                if "dcm" not in w:
-                    raise DataError(path, f"{where}.dcm", "missing (give 'dcm' and 'position_m' or 'mounting')")
-                mount = Mounting(w["dcm"], w.get("position_m", (0.0, 0.0, 0.0)), names[i])
-        except DataError as exc:
-            if exc.file == str(path):
+            src = wheel_source(**ask, empirical=empirical, assumed_modes=assumed_modes)
+        except ValueError as exc:
+            if "model" in ask:
                 raise
-            raise DataError(path, f"{where}.{exc.field}", str(exc).split(": ", 2)[-1]) from None
-        # speed or tie
-        tie, law = None, None
-        if "tie" in w:
-            t = w["tie"]
-            to = t.get("to")
-            if isinstance(to, str):
-                if to not in names:
-                    raise DataError(path, f"{where}.tie.to", f"no wheel named {to!r}; names: {names}")
-                to = names.index(to)
-            if not isinstance(to, int) or not 0 <= to < len(items) or to == i:
-                raise DataError(path, f"{where}.tie.to", f"must name or index another wheel, got {t.get('to')!r}")
-            ratio = float(t.get("ratio", 1.0))
-            if ratio not in (1.0, -1.0):
-                raise DataError(path, f"{where}.tie.ratio", f"must be +1 or -1, got {ratio!r}")
-            tie = Tie(to, ratio, bool(t.get("phase_lock", False)), math.radians(float(t.get("phase_offset_deg", 0))))
-        else:
-            law = _speed_law(w.get("speed"), default_law, base, f"{path}: {where}")
-        meta = {}
-        if assumed and not empirical:
-            meta["modes_assumed"] = "assumed modes used" if assumed_modes else "hard-mounted"
-        out.append(WheelSpec(names[i], lines, mount, law, tie, ref, meta))
-    # resolve chains of ties to their root
-    for i, ws in enumerate(out):
+            raise DataError(path, f"{where}.preset", getattr(exc, "problem", None) or str(exc)) from None
+        cache[key] = (src.lines, src.modes_assumed)
+    lines, assumed = cache[key]
+    return lines, ref, assumed
+
+
+def _wheel_mounting(path, where: str, w: dict, i: int, name: str) -> Mounting:
+    """The mounting of wheel object ``w`` (index ``i``): a preset's ``index``-th, or its ``dcm`` and ``position_m``."""
+    try:
+        if "mounting" in w:
+            mspec = w["mounting"]
+            ms = preset_mountings(mspec.get("preset", ""), **{k: v for k, v in mspec.items()
+                                                                if k in ("radius_m", "elevation_deg")})
+            idx = int(mspec.get("index", i))
+            if not 0 <= idx < len(ms):
+                raise DataError(path, f"{where}.mounting.index", f"{idx} out of range 0..{len(ms) - 1}")
+            return ms[idx]
+        if "dcm" not in w:
+            raise DataError(path, f"{where}.dcm", "missing (give 'dcm' and 'position_m' or 'mounting')")
+        return Mounting(w["dcm"], w.get("position_m", (0.0, 0.0, 0.0)), name)
+    except DataError as exc:
+        if exc.file == str(path):
+            raise
+        raise DataError(path, f"{where}.{exc.field}", str(exc).split(": ", 2)[-1]) from None
+
+
+def _wheel_tie(path, where: str, t: dict, i: int, names: list) -> Tie:
+    """The :class:`Tie` of a wheel object's ``tie`` (wheel ``i`` of those named ``names``)."""
+    to = t.get("to")
+    if isinstance(to, str):
+        if to not in names:
+            raise DataError(path, f"{where}.tie.to", f"no wheel named {to!r}; names: {names}")
+        to = names.index(to)
+    if not isinstance(to, int) or not 0 <= to < len(names) or to == i:
+        raise DataError(path, f"{where}.tie.to", f"must name or index another wheel, got {t.get('to')!r}")
+    ratio = float(t.get("ratio", 1.0))
+    if ratio not in (1.0, -1.0):
+        raise DataError(path, f"{where}.tie.ratio", f"must be +1 or -1, got {ratio!r}")
+    return Tie(to, ratio, bool(t.get("phase_lock", False)), math.radians(float(t.get("phase_offset_deg", 0))))
+
+
+def _check_tie_cycles(path, wheels: list) -> None:
+    """DataError when ties lead from a wheel back to itself (every chain of ties must end at a wheel with a law)."""
+    for i in range(len(wheels)):
         seen = {i}
         j = i
-        while out[j].tie is not None:
-            j = out[j].tie.to
+        while wheels[j].tie is not None:
+            j = wheels[j].tie.to
             if j in seen:
                 raise DataError(path, f"wheels[{i}].tie", "ties form a cycle")
             seen.add(j)
+
+
+def load_wheels(wheels, default_lines_loader=None, default_law=None, empirical: bool = False,
+                assumed_modes: bool = False) -> list:
+    """Read a set of wheels into :class:`WheelSpec` objects.
+
+    wheels : a wheels.json path, or its content: a list of wheel objects (or ``{"wheels": [...]}``) whose model
+    and speed-file paths are relative to the working folder.  default_lines_loader : callable() -> WheelLines used
+    for wheels without ``model``/``preset``.  default_law : speed law for wheels without ``speed`` (rad/s).
+    empirical : Melody's model (harmonics only) instead of the extended model.  assumed_modes : run a wheel whose
+    suspension modes are assumed (``analytical.modes_assumed``: a catalogue datasheet wheel) through those modes;
+    without it such a wheel is hard-mounted (Melody's model of its lines), as its datasheet states.  Either way
+    the wheel's ``meta["modes_assumed"]`` says which ('hard-mounted' or 'assumed modes used').
+    DataError names the file (or ``wheels``) and the field (missing model file, bad DCM, unknown tie, ...).
+    """
+    path, items, base = _wheel_items(wheels)
+    names = [str(w.get("name", f"wheel{i}")) if isinstance(w, dict) else "" for i, w in enumerate(items)]
+    out, cache = [], {}
+    for i, w in enumerate(items):
+        where = f"wheels[{i}]"
+        _check_wheel(path, where, w, names, i)
+        lines, ref, assumed = _wheel_lines(path, where, w, base, cache, default_lines_loader, empirical,
+                                           assumed_modes)
+        mount = _wheel_mounting(path, where, w, i, names[i])
+        if "tie" in w:
+            tie, law = _wheel_tie(path, where, w["tie"], i, names), None
+        else:
+            tie, law = None, _speed_law(w.get("speed"), default_law, base, f"{path}: {where}")
+        meta = {"modes_assumed": "assumed modes used" if assumed_modes else "hard-mounted"} if (
+            assumed and not empirical) else {}
+        out.append(WheelSpec(names[i], lines, mount, law, tie, ref, meta))
+    _check_tie_cycles(path, out)
     return out
 
 

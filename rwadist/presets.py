@@ -52,6 +52,7 @@ from dataclasses import replace
 import numpy as np
 
 from . import extended as ext
+from .errors import ParameterError
 from .teststand import Mode, WheelDescription
 from .units import THESIS_C_TO_SI
 
@@ -217,4 +218,4 @@ def preset(name: str) -> WheelDescription:
         return _FACTORIES[key]()
     if key in catalogue.names():
         return from_model(catalogue.load(key))
-    raise ValueError(f"unknown wheel preset {name!r}; available: {', '.join(names())}")
+    raise ParameterError("preset", f"{name!r}: unknown wheel preset; available: {', '.join(names())}")

@@ -62,7 +62,14 @@ POSITIVE_PARAMS = ("mass", "I_zz", "I_rr", "k_r", "k_rock", "k_z")
 NONNEGATIVE_PARAMS = ("c_r", "c_rock", "c_z", "U_s", "U_d")
 
 
-class ModelError(ValueError):
+class RwadistError(Exception):
+    """The root of every error rwadist raises on purpose (:mod:`rwadist.errors` has the hierarchy).
+
+    Defined here, not in :mod:`rwadist.errors`, because this module is copied alone into the FMU (numpy
+    only): the FMU runtime's :class:`ModelError` needs its base beside it."""
+
+
+class ModelError(RwadistError, ValueError):
     """An invalid model file or entry.
 
     ``ModelError(source, field, problem)`` reads ``"<source>: <field>: <problem>"``; the parts are kept

@@ -198,7 +198,7 @@ def row_edges(speeds, source="histogram", bounds=None, ends: str = "centres") ->
         if np.any(out):
             i = int(np.argmax(out))
             raise DataError(source, "speed_rpm", f"row {i} ({c[i] * RAD_S_TO_RPM:g} rpm) is outside the speed range "
-                            f"{b_lo * RAD_S_TO_RPM:g}:{b_hi * RAD_S_TO_RPM:g} rpm (--speed-rpm): give the range the "
+                            f"{b_lo * RAD_S_TO_RPM:g}:{b_hi * RAD_S_TO_RPM:g} rpm (`speed_rpm`): give the range the "
                             "file covers")
         lo, hi = max(lo, b_lo), min(hi, b_hi)
     return np.concatenate([[lo], mid, [hi]])
@@ -258,7 +258,7 @@ def speed_cells(law, n_speeds: int):
 
 
 def law_from_spec(dist: str, min_rpm: float, max_rpm: float, std_rpm: float | None = None,
-                  source: str = "--dist") -> object:
+                  source: str = "dist") -> object:
     """Speed law from CLI-style arguments: 'uniform' on [min, max] rpm; 'normal' centred in the
     range, std ``std_rpm`` (default range/6, i.e. ±3σ), truncated to the range; otherwise a CSV file
     (:func:`law_from_csv`: the file's speeds, within the range -- a row outside it is refused, the outer bins
@@ -267,7 +267,7 @@ def law_from_spec(dist: str, min_rpm: float, max_rpm: float, std_rpm: float | No
         return Uniform(float(rpm_to_rad_s(min_rpm)), float(rpm_to_rad_s(max_rpm)))
     if dist == "normal":
         lo, hi = float(rpm_to_rad_s(min_rpm)), float(rpm_to_rad_s(max_rpm))
-        _check_range("--speed-rpm", lo, hi)
+        _check_range("speed_rpm", lo, hi)
         std = (hi - lo) / 6.0 if std_rpm is None else float(rpm_to_rad_s(std_rpm))
         return TruncatedNormal(0.5 * (lo + hi), std, lo, hi)
     return law_from_csv(dist, bounds=(float(rpm_to_rad_s(min_rpm)), float(rpm_to_rad_s(max_rpm))))
@@ -294,7 +294,7 @@ def law_from_csv(path, n_bins: int = 2000, bounds=None):
         if bounds is not None and w.size and (w.min() < bounds[0] - 1e-9 or w.max() > bounds[1] + 1e-9):
             raise DataError(path, "speed_rpm", f"the profile spans {w.min() * RAD_S_TO_RPM:g}:"
                             f"{w.max() * RAD_S_TO_RPM:g} rpm, outside the speed range {bounds[0] * RAD_S_TO_RPM:g}:"
-                            f"{bounds[1] * RAD_S_TO_RPM:g} rpm (--speed-rpm): give the range the file covers")
+                            f"{bounds[1] * RAD_S_TO_RPM:g} rpm (`speed_rpm`): give the range the file covers")
         return from_time_profile(col["time_s"], w, n_bins, str(path))
     if "speed_rpm" in col and "weight" in col:
         return histogram_from_centres(rpm_to_rad_s(col["speed_rpm"]), col["weight"], str(path), bounds)

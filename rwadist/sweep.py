@@ -420,8 +420,8 @@ def estimate_speeds(sweep: Sweep, slice_samples: int = 8192, hop: int | None = N
         f_lo = max(f_lo, lo / 60.0)
         f_hi = min(0.98 * nyq / h_arr.min(), hi / 60.0)
     if not f_hi > f_lo:
-        raise ValueError(f"empty speed search range: {f_lo:g}..{f_hi:g} Hz "
-                         f"(slice resolution {df:g} Hz, Nyquist {nyq:g} Hz)")
+        raise DataError("sweep", "speed", f"empty speed search range: {f_lo:g}..{f_hi:g} Hz (slice resolution "
+                        f"{df:g} Hz, Nyquist {nyq:g} Hz): lengthen the slices (`slice_samples`) or record the speed")
     # uniform candidate grid: every tooth moves <= df/2 between neighbours
     step = df / (2.0 * h_arr.max())
     f_grid = np.arange(f_lo, f_hi + step, step)

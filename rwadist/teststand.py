@@ -88,6 +88,7 @@ import numpy as np
 from . import extended as ext
 from .data import Run, SteadyTest, Sweep
 from .dft import unit_phasors
+from .errors import ParameterError
 from .model import Harmonic, WheelModel
 from .resonance import resonance_response
 from .units import CHANNELS, DIRECTION_CHANNELS, rad_s_to_hz, rad_s_to_rpm, rpm_to_rad_s
@@ -131,17 +132,17 @@ class Mode:
         self.channels = tuple(self.channels)
         bad = [c for c in self.channels if c not in CHANNELS]
         if bad:
-            raise ValueError(f"mode {self.name!r}: unknown channel(s) {bad}; expected some of {list(CHANNELS)}")
+            raise ParameterError(f"mode {self.name!r}: unknown channel(s) {bad}; expected some of {list(CHANNELS)}")
         if not (np.isfinite(self.f0_hz) and self.f0_hz > 0):
-            raise ValueError(f"mode {self.name!r}: f0_hz must be > 0, got {self.f0_hz!r}")
+            raise ParameterError(f"mode {self.name!r}: f0_hz must be > 0, got {self.f0_hz!r}")
         if not (np.isfinite(self.zeta) and self.zeta > 0):
-            raise ValueError(f"mode {self.name!r}: zeta must be > 0, got {self.zeta!r}")
+            raise ParameterError(f"mode {self.name!r}: zeta must be > 0, got {self.zeta!r}")
         if not (np.isfinite(self.peak_gain) and self.peak_gain > 0):
-            raise ValueError(f"mode {self.name!r}: peak_gain must be > 0, got {self.peak_gain!r}")
+            raise ParameterError(f"mode {self.name!r}: peak_gain must be > 0, got {self.peak_gain!r}")
         if self.whirl not in (-1, 0, 1):
-            raise ValueError(f"mode {self.name!r}: whirl must be -1, 0 or +1, got {self.whirl!r}")
+            raise ParameterError(f"mode {self.name!r}: whirl must be -1, 0 or +1, got {self.whirl!r}")
         if self.whirl and not self.inertia_ratio >= 0:
-            raise ValueError(f"mode {self.name!r}: inertia_ratio must be >= 0, got {self.inertia_ratio!r}")
+            raise ParameterError(f"mode {self.name!r}: inertia_ratio must be >= 0, got {self.inertia_ratio!r}")
 
     def frequency_hz(self, omega):
         """Natural frequency (Hz) at wheel speed ``omega`` (rad/s, sign ignored); vectorised."""
@@ -232,11 +233,11 @@ class WheelDescription:
         clean = {}
         for d, items in self.harmonics.items():
             if d not in DIRECTION_CHANNELS:
-                raise ValueError(f"wheel {self.name!r}: unknown direction {d!r}; expected {list(DIRECTION_CHANNELS)}")
+                raise ParameterError(f"wheel {self.name!r}: unknown direction {d!r}; expected {list(DIRECTION_CHANNELS)}")
             pairs = [(float(h), float(C)) for h, C in items]
             for h, C in pairs:
                 if not (np.isfinite(h) and h > 0 and np.isfinite(C) and C >= 0):
-                    raise ValueError(f"wheel {self.name!r}: {d}: need h > 0 and C >= 0, got h={h!r}, C={C!r}")
+                    raise ParameterError(f"wheel {self.name!r}: {d}: need h > 0 and C >= 0, got h={h!r}, C={C!r}")
             clean[d] = pairs
         self.harmonics = clean
         senses = {}
@@ -245,19 +246,19 @@ class WheelDescription:
                 d, h = key
                 h = float(h)
             except (TypeError, ValueError):
-                raise ValueError(f"wheel {self.name!r}: senses key {key!r} must be (direction, h)") from None
+                raise ParameterError(f"wheel {self.name!r}: senses key {key!r} must be (direction, h)") from None
             if d not in DIRECTION_CHANNELS:
-                raise ValueError(f"wheel {self.name!r}: senses: unknown direction {d!r}")
+                raise ParameterError(f"wheel {self.name!r}: senses: unknown direction {d!r}")
             if sense not in ext.SENSES:
-                raise ValueError(f"wheel {self.name!r}: senses[{key!r}] = {sense!r}; expected one of {ext.SENSES}")
+                raise ParameterError(f"wheel {self.name!r}: senses[{key!r}] = {sense!r}; expected one of {ext.SENSES}")
             senses[(d, h)] = sense
         self.senses = senses
         if self.extended is not None and not isinstance(self.extended, ext.ExtendedParams):
-            raise ValueError(f"wheel {self.name!r}: extended must be an ExtendedParams, got "
+            raise ParameterError(f"wheel {self.name!r}: extended must be an ExtendedParams, got "
                              f"{type(self.extended).__name__}")
         self.imbalance_phase = float(self.imbalance_phase)
         if not np.isfinite(self.imbalance_phase):
-            raise ValueError(f"wheel {self.name!r}: imbalance_phase must be finite, got {self.imbalance_phase!r}")
+            raise ParameterError(f"wheel {self.name!r}: imbalance_phase must be finite, got {self.imbalance_phase!r}")
         if self.default_speeds_rpm is not None:
             self.default_speeds_rpm = np.asarray(self.default_speeds_rpm, dtype=float)
 
@@ -312,7 +313,7 @@ class WheelDescription:
         the harmonics with the radial h ≈ 1 ones (|h − 1| <= IMBALANCE_H_TOL) replaced by the
         imbalances of ``extended``, senses from ``senses``.  ValueError without ``extended``."""
         if self.extended is None:
-            raise ValueError(f"wheel {self.name!r} has no extended parameters (WheelDescription.extended); "
+            raise ParameterError(f"wheel {self.name!r} has no extended parameters (WheelDescription.extended); "
                              "physics='extended' needs them")
         return ext.lines_from_model(self.to_model(), self.extended, self.senses)
 
@@ -415,12 +416,12 @@ def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 38
     _check_physics(wheel, physics, modes)
     speeds = np.atleast_1d(np.asarray(speeds_rpm, dtype=float))
     if speeds.ndim != 1 or speeds.size == 0 or not np.all(np.isfinite(speeds)):
-        raise ValueError(f"speeds_rpm must be a non-empty 1-D list of finite speeds, got {speeds_rpm!r}")
+        raise ParameterError(f"speeds_rpm must be a non-empty 1-D list of finite speeds, got {speeds_rpm!r}")
     if not sample_rate > 0:
-        raise ValueError(f"sample_rate must be > 0 Hz, got {sample_rate!r}")
+        raise ParameterError(f"sample_rate must be > 0 Hz, got {sample_rate!r}")
     n_samples = int(n_samples)
     if n_samples < 2:
-        raise ValueError(f"n_samples must be >= 2, got {n_samples!r}")
+        raise ParameterError(f"n_samples must be >= 2, got {n_samples!r}")
     omegas = rpm_to_rad_s(speeds)
     omega_max = float(np.abs(omegas).max())
     noise_std = _noise_std(wheel, omega_max, noise)
@@ -470,13 +471,13 @@ def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 38
 
 def _check_physics(wheel: WheelDescription, physics: str, modes: bool):
     if physics not in PHYSICS:
-        raise ValueError(f"physics must be one of {PHYSICS}, got {physics!r}")
+        raise ParameterError(f"physics must be one of {PHYSICS}, got {physics!r}")
     if physics == "extended":
         if wheel.extended is None:
-            raise ValueError(f"wheel {wheel.name!r} has no extended parameters (WheelDescription.extended); "
+            raise ParameterError(f"wheel {wheel.name!r} has no extended parameters (WheelDescription.extended); "
                              "physics='extended' needs them")
         if not modes:
-            raise ValueError("modes=False applies to physics='simple' only: with physics='extended' the wheel's "
+            raise ParameterError("modes=False applies to physics='simple' only: with physics='extended' the wheel's "
                              "modes are its suspension (ExtendedParams)")
 
 
@@ -485,7 +486,7 @@ def _fixture_modes(wheel: WheelDescription, test_stand: bool) -> list:
     out = list(wheel.test_stand_modes) if test_stand else []
     for m in out:
         if m.whirl != 0:
-            raise ValueError(f"test-stand mode {m.name!r} has whirl {m.whirl}; fixture resonances must be "
+            raise ParameterError(f"test-stand mode {m.name!r} has whirl {m.whirl}; fixture resonances must be "
                              "fixed-frequency (whirl 0)")
     return out
 
@@ -614,7 +615,7 @@ def speed_profile(t, rpm_start: float, rpm_end: float, duration: float, profile=
     if profile == "exp":
         tau = duration / 5.0
         return w1 + (w0 - w1) * np.exp(-t / tau)
-    raise ValueError(f"unknown sweep profile {profile!r}; expected 'linear', 'exp' or a callable t -> rpm")
+    raise ParameterError(f"unknown sweep profile {profile!r}; expected 'linear', 'exp' or a callable t -> rpm")
 
 
 def _cumtrapz(y: np.ndarray, dt: float) -> np.ndarray:
@@ -649,12 +650,12 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
     """
     _check_physics(wheel, physics, modes)
     if not duration > 0:
-        raise ValueError(f"duration must be > 0 s, got {duration!r}")
+        raise ParameterError(f"duration must be > 0 s, got {duration!r}")
     if not sample_rate > 0:
-        raise ValueError(f"sample_rate must be > 0 Hz, got {sample_rate!r}")
+        raise ParameterError(f"sample_rate must be > 0 Hz, got {sample_rate!r}")
     n = int(round(duration * sample_rate))
     if n < 2:
-        raise ValueError(f"duration × sample_rate gives {n} samples; need at least 2")
+        raise ParameterError(f"duration × sample_rate gives {n} samples; need at least 2")
     dt = 1.0 / sample_rate
     t = np.arange(n) * dt
     omega = speed_profile(t, rpm_start, rpm_end, duration, profile)

@@ -1,18 +1,21 @@
-"""One validation layer for command-line values: finite numbers, ranges, integers, speed lists.
+"""The library's checks of values given to it: finite numbers in their ranges, speed lists, frequency limits.
 
-Each check is an argparse ``type`` (a refused value is kept as :class:`Refused`, then
-:func:`check_parsed` raises ``--noise: value: 'nan': must be a finite number in [0, 10]``) or a function
-raising :class:`DataError` naming the flag, the value and the allowed range.  rpm and Hz at this edge.
+Every numeric parameter of the API has its allowed range once, in :data:`LIMITS`; the functions of
+:mod:`rwadist.api` check their arguments against it (:func:`check_parameter`) and the command line's parser
+builds its flags' checks from it (:mod:`rwadist.cli_parser`), so a value refused on one side is refused on
+the other.  A refused value is a :class:`rwadist.ParameterError` naming the parameter, the value and the
+allowed range (``presence: 2.0: out of range; allowed (0, 1]``); the command line names the flag instead.
+rpm and Hz at this edge.
 """
 from __future__ import annotations
 
-import argparse
 import math
+import warnings
 
 import numpy as np
 
-from .formats.records import DataError
-from .units import RAD_S_TO_RPM, rpm_to_rad_s
+from .errors import DataError, ParameterError, RwadistWarning
+from .units import RAD_S_TO_RPM
 
 #: highest wheel speed any command accepts, rpm (flight wheels run below ~10 000 rpm)
 MAX_RPM = 100_000.0
@@ -20,6 +23,29 @@ MAX_RPM = 100_000.0
 MAX_SPEEDS = 100_000
 #: most samples of a simulated record (memory: 6 channels x 8 bytes each)
 MAX_SAMPLES = 50_000_000
+
+#: The allowed range of every numeric parameter of the API, by name: the keyword arguments of
+#: :func:`check_number` (``lo``/``hi`` bounds, ``lo_open``/``hi_open`` bound excluded, ``integer``, ``unit``).
+LIMITS = {
+    "f_lim": dict(lo=0, hi=1e6, lo_open=True, unit="Hz"),
+    "nperseg": dict(lo=16, hi=2**24, integer=True),
+    "presence": dict(lo=0, hi=1, lo_open=True),
+    "epsilon": dict(lo=0, hi=0.5, lo_open=True),
+    "slice_samples": dict(lo=64, hi=2**24, integer=True),
+    "mass": dict(lo=0, hi=1e4, lo_open=True, unit="kg"),
+    "radius": dict(lo=0, hi=10, lo_open=True, unit="m"),
+    "height": dict(lo=-10, hi=10, unit="m"),
+    "k_sigma": dict(lo=0, hi=100, lo_open=True),
+    "min_gain": dict(lo=0, hi=1, lo_open=True, hi_open=True),
+    "std_rpm": dict(lo=0, hi=MAX_RPM, lo_open=True, unit="rpm"),
+    "fmax": dict(lo=0, hi=1e6, lo_open=True, unit="Hz"),
+    "n_freq": dict(lo=2, hi=200_001, integer=True),
+    "n_speeds": dict(lo=2, hi=20_000, integer=True),       # speed cells of the PSD's law
+    "sample_rate": dict(lo=0, hi=1e6, lo_open=True, unit="Hz"),
+    "n_samples": dict(lo=64, hi=MAX_SAMPLES, integer=True),
+    "noise": dict(lo=0, hi=10),
+    "seed": dict(lo=0, hi=2**32 - 1, integer=True),
+}
 
 
 def _fmt(x) -> str:
@@ -36,198 +62,115 @@ def _range_text(lo, hi, lo_open: bool, hi_open: bool) -> str:
     return "any finite value"
 
 
-def check_number(value, flag: str, lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False,
+def check_number(value, parameter: str, lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False,
                  integer: bool = False, unit: str = ""):
-    """``value`` as a float (or int) checked finite and in range; :class:`DataError` naming ``flag``
+    """``value`` as a float (or int) checked finite and in range; :class:`ParameterError` naming ``parameter``
     otherwise.  ``lo_open``/``hi_open``: the bound itself is excluded."""
     text = value if isinstance(value, str) else repr(value)
     kind = "an integer" if integer else "a finite number"
     allowed = _range_text(lo, hi, lo_open, hi_open) + (f" {unit}" if unit else "")
-    if isinstance(value, bool):
-        raise DataError(flag, "value", f"{text}: must be {kind} in {allowed}")
+    if isinstance(value, (bool, np.bool_)):
+        raise ParameterError(parameter, f"{text}: must be {kind} in {allowed}")
     try:
         x = float(value)
     except (TypeError, ValueError):
-        raise DataError(flag, "value", f"{text!r}: must be {kind} in {allowed}") from None
+        raise ParameterError(parameter, f"{value!r}: must be {kind} in {allowed}") from None
     if not math.isfinite(x):
-        raise DataError(flag, "value", f"{text!r}: must be {kind} in {allowed}")
+        raise ParameterError(parameter, f"{value!r}: must be {kind} in {allowed}")
     if integer:
         if x != int(x):
-            raise DataError(flag, "value", f"{text!r}: must be {kind} in {allowed}")
+            raise ParameterError(parameter, f"{value!r}: must be {kind} in {allowed}")
         x = int(x)
     if (lo is not None and (x < lo or (lo_open and x == lo))) or (
             hi is not None and (x > hi or (hi_open and x == hi))):
-        raise DataError(flag, "value", f"{text}: out of range; allowed {allowed}")
+        raise ParameterError(parameter, f"{text}: out of range; allowed {allowed}")
     return x
 
 
-class Refused:
-    """A flag value :func:`number` refused: ``text`` as given and ``why`` (range, type)."""
-
-    def __init__(self, text: str, why: str):
-        self.text, self.why = text, why
-
-    def __repr__(self) -> str:
-        return repr(self.text)
+def check_parameter(name: str, value):
+    """``value`` of the API parameter ``name`` checked against :data:`LIMITS` (None, a default left to the
+    function, passes as None); :class:`ParameterError` naming ``name`` otherwise."""
+    return None if value is None else check_number(value, name, **LIMITS[name])
 
 
-def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
-           unit: str = ""):
-    """An argparse ``type`` checking a finite number (or an integer) in a range."""
-    def parse(text):
-        try:
-            return check_number(text, "value", lo, hi, lo_open=lo_open, hi_open=hi_open, integer=integer,
-                                unit=unit)
-        except DataError as exc:       # refused by check_parsed, which knows the flag (exit 2 from main)
-            return Refused(text, str(exc).split(": ", 2)[-1])
-
-    parse.__name__ = "integer" if integer else "number"
-    parse.rwadist_checked = True
-    return parse
-
-
-def check_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
-    """After parsing: every flag typed by :func:`number` holds a number (argparse skips the type of some
-    values, e.g. ``--noise=--`` gives an empty list); :class:`DataError` naming the flag otherwise."""
-    def walk(p):
-        for action in p._actions:
-            if isinstance(action, argparse._SubParsersAction):     # only the command that was chosen
-                chosen = action.choices.get(getattr(args, action.dest, None) or "")
-                if chosen is not None:
-                    yield from walk(chosen)
-            elif getattr(action.type, "rwadist_checked", False):
-                yield action
-
-    for action in walk(parser):
-        value = getattr(args, action.dest, None)
-        if value is None or value is action.default:
-            continue
-        flag = max(action.option_strings, key=len) if action.option_strings else action.dest
-        if isinstance(value, Refused):
-            raise DataError(flag, "value", value.why)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise DataError(flag, "value", f"{value!r}: missing or not a number")
-
-
-def check_fit_flags(args: argparse.Namespace) -> None:
-    """``rwadist fit``: flags it would ignore are refused: --mass, --radius, --height and --preset without
-    --extended (they feed the extended fit only), --mass without --radius or the reverse (the fit is then per unit
-    mass), and --cumulative-rpm with --no-report (it picks the report's plots)."""
-    given = [f for f, v in (("--mass", args.mass), ("--radius", args.radius), ("--height", args.height or None),
-                            ("--preset", args.preset)) if v is not None]
-    if given and not args.extended:
-        raise DataError(given[0], "value", "applies to the extended fit only: add --extended (the plain fit of "
-                        "harmonics C·Ω² does not use it)")
-    if (args.mass is None) != (args.radius is None):
-        raise DataError("--mass" if args.radius is None else "--radius", "value", "needs "
-                        f"{'--radius' if args.radius is None else '--mass'} too (the rotor's inertias come from both; "
-                        "with neither the fit is per unit mass and inertia)")
-    if args.cumulative_rpm and args.no_report:
-        raise DataError("--cumulative-rpm", "value", "picks the report's plots: drop it, or drop --no-report")
-
-
-def check_within_test(speeds_rpm, test, flag: str) -> None:
+def check_within_test(speeds_rpm, test, parameter: str) -> None:
     """Speeds (rpm) a plot reads from the test's runs (the nearest run to each) must lie within the test's speeds:
     --cumulative-rpm 5000 on a 300-2400 rpm test plotted 2400 rpm under a title of 5000."""
     rpm = np.abs([r.speed for r in test.runs]) * RAD_S_TO_RPM
     lo, hi = float(rpm.min()), float(rpm.max())
     for v in speeds_rpm:
         if not lo - 1e-6 <= abs(v) <= hi + 1e-6:
-            raise DataError(flag, "value", f"{v:g} rpm is outside the test's speeds {lo:g}-{hi:g} rpm (the plot "
-                            "shows the run nearest each speed): give speeds the test covers")
+            raise ParameterError(parameter, f"{v:g} rpm is outside the test's speeds {lo:g}-{hi:g} rpm (the plot "
+                                 "shows the run nearest each speed): give speeds the test covers")
 
 
-def check_psd_flags(args: argparse.Namespace) -> None:
-    """``rwadist psd``: flags that the chosen output or law would ignore are refused, as is an output whose extension
-    names the other format (a NASTRAN deck written as x.csv, CSV as x.bdf)."""
-    from pathlib import Path
-
-    nastran = args.format == "nastran"
-    if not nastran and (args.nastran_cross or args.nastran_fields != "small"):
-        raise DataError("--nastran-cross" if args.nastran_cross else "--nastran-fields", "value",
-                        "applies to --format nastran only")
-    if args.std_rpm is not None and args.dist != "normal":
-        raise DataError("--std-rpm", "value", f"applies to --dist normal only (--dist is {args.dist!r})")
-    suffix = Path(args.output).suffix.lower()
-    if nastran and suffix == ".csv" or not nastran and suffix in (".bdf", ".dat", ".nas", ".blk"):
-        raise DataError("-o", "value", f"{args.output!r}: its extension names the other format than --format "
-                        f"{args.format}; give a {'.bdf' if nastran else '.csv'} file")
-
-
-def check_fmu_ramp(fmu_path, speed_rpm: float, stop_time: float) -> None:
-    """``rwadist fmu check``: the check's ramp 0 -> ``speed_rpm`` over ``stop_time`` s must stay within the FMU's
-    ``max_acceleration`` (its start value): 6000 rpm over the default 1 s is 628 rad/s², which the FMU refuses (500
-    rad/s² by default), and the check then failed (exit 1) as if the FMU were broken."""
-    from fmpy import read_model_description
-
-    var = next((v for v in read_model_description(str(fmu_path)).modelVariables if v.name == "max_acceleration"),
-               None)
-    accel = abs(float(rpm_to_rad_s(speed_rpm))) / stop_time
-    if var is not None and var.start is not None and accel > float(var.start):
-        raise DataError("--stop-time", "value", f"{stop_time:g} s to {speed_rpm:g} rpm is {accel:.4g} rad/s², above the "
-                        f"FMU's max_acceleration of {float(var.start):g} rad/s²: give --stop-time "
-                        f"{math.ceil(100 * accel * stop_time / float(var.start)) / 100:g} s or more")
-
-
-def warn_beyond_rated_speed(model, source, lo_rpm: float, hi_rpm: float, flag: str = "--speed-rpm") -> None:
-    """Print (stderr) a warning when a speed range reaches beyond the wheel's rated maximum (``wheel.max_speed_rpm``
+def warn_beyond_rated_speed(model, source, lo_rpm: float, hi_rpm: float, parameter: str = "speed_rpm") -> None:
+    """A :class:`RwadistWarning` when a speed range reaches beyond the wheel's rated maximum (``wheel.max_speed_rpm``
     of its model, when it states one): the Ithaco E over 0:10000 rpm (rated 3850) gave Fx RMS 2.19 N without a word."""
-    import sys
-
     top = (getattr(model, "wheel", None) or {}).get("max_speed_rpm")
     if isinstance(top, (int, float)) and top > 0 and max(abs(lo_rpm), abs(hi_rpm)) > top * (1 + 1e-9):
-        print(f"WARNING: {flag} {lo_rpm:g}:{hi_rpm:g} rpm reaches beyond the maximum speed of {source}, {top:g} rpm "
-              "(its model's wheel.max_speed_rpm): the results extrapolate its lines to speeds it does not run at",
-              file=sys.stderr)
+        warnings.warn(RwadistWarning(f"{lo_rpm:g}:{hi_rpm:g} rpm reaches beyond the maximum speed of {source}, "
+                                     f"{top:g} rpm (its model's wheel.max_speed_rpm): the results extrapolate its "
+                                     "lines to speeds it does not run at", parameter), stacklevel=3)
 
 
-def check_f_lim(test, f_lim, flag: str = "--f-lim") -> None:
-    """``f_lim`` (Hz, or None) within (0, Nyquist] of every run of ``test``: refused naming the flag (the spectra's
-    own check named '<spectra>', which the user never typed)."""
+def check_f_lim(test, f_lim, parameter: str = "f_lim") -> None:
+    """``f_lim`` (Hz, or None) within (0, Nyquist] of every run of ``test``: refused naming the parameter (the
+    spectra's own check named '<spectra>', which the user never typed)."""
     if f_lim is None:
         return
     nyquist = 0.5 * min(r.sample_rate for r in test.runs)
     if not 0.0 < f_lim <= nyquist:
-        raise DataError(flag, "value", f"{f_lim:g} Hz is above the data's Nyquist frequency {nyquist:g} Hz: give a "
-                        "limit below it (or leave it out)")
+        raise ParameterError(parameter, f"{f_lim:g} Hz is above the data's Nyquist frequency {nyquist:g} Hz: give "
+                             "a limit below it (or leave it out)")
 
 
 def warn_unconstrained(model, source, use) -> None:
-    """Print (stderr) that ``model`` has modes the extended fit could not identify, if it has (``use``: what rests on
-    them, e.g. "the PSD")."""
-    import sys
-
+    """A :class:`RwadistWarning` that ``model`` has modes the extended fit could not identify, if it has (``use``:
+    what rests on them, e.g. "the PSD")."""
     from .extended_fit import unconstrained_warning
 
     if text := unconstrained_warning(model, str(source), use):
-        print(text, file=sys.stderr)
+        warnings.warn(RwadistWarning(text.removeprefix("warning: ")), stacklevel=3)
 
 
-def rpm(lo: float = -MAX_RPM, hi: float = MAX_RPM):
-    """An argparse ``type``: a wheel speed in rpm within [lo, hi]."""
-    return number(lo, hi, unit="rpm")
-
-
-def check_speeds_rpm(speeds, flag: str) -> np.ndarray:
+def check_speeds_rpm(speeds, parameter: str) -> np.ndarray:
     """A speed list (rpm) checked: non-empty, finite, |speed| <= MAX_RPM, at most MAX_SPEEDS entries."""
-    s = np.asarray(speeds, dtype=float).ravel()
+    try:
+        s = np.asarray(speeds, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ParameterError(parameter, f"{speeds!r}: not a list of numbers (rpm)") from None
     if s.size == 0:
-        raise DataError(flag, "value", "no speeds: give at least one speed in rpm")
+        raise ParameterError(parameter, "no speeds: give at least one speed in rpm")
     if s.size > MAX_SPEEDS:
-        raise DataError(flag, "value", f"{s.size} speeds: at most {MAX_SPEEDS}; use a coarser step")
+        raise ParameterError(parameter, f"{s.size} speeds: at most {MAX_SPEEDS}; use a coarser step")
     bad = s[~np.isfinite(s) | (np.abs(s) > MAX_RPM)]
     if bad.size:
-        raise DataError(flag, "value", f"speed {float(bad[0])!r} rpm: must be finite in [{-MAX_RPM:g}, {MAX_RPM:g}] rpm")
+        raise ParameterError(parameter, f"speed {float(bad[0])!r} rpm: must be finite in [{-MAX_RPM:g}, "
+                             f"{MAX_RPM:g}] rpm")
     return s
 
 
-def check_grid_size(start: float, stop: float, step: float, flag: str) -> None:
+def check_speed_range(speed_rpm, parameter: str = "speed_rpm") -> tuple:
+    """(MIN, MAX) rpm of a speed range: two finite speeds within +-MAX_RPM, MIN below MAX."""
+    try:
+        lo, hi = (float(x) for x in speed_rpm)
+    except (TypeError, ValueError):
+        raise ParameterError(parameter, f"{speed_rpm!r}: expected (MIN, MAX) in rpm") from None
+    check_speeds_rpm([lo, hi], parameter)
+    if not lo < hi:
+        raise ParameterError(parameter, f"{lo:g}:{hi:g}: empty or inverted speed range; MIN must be below MAX (rpm; "
+                             "a negative range, e.g. -2400:-600, spins about -z)")
+    return lo, hi
+
+
+def check_grid_size(start: float, stop: float, step: float, parameter: str) -> None:
     """Refuse a START:STOP:STEP grid of more than MAX_SPEEDS points before it is allocated."""
     n = (stop - start) / step + 1 if step > 0 else math.inf
     if not math.isfinite(n) or n > MAX_SPEEDS:
-        raise DataError(flag, "value", f"{_fmt(start)}:{_fmt(stop)}:{_fmt(step)} makes "
-                        f"{'too many' if not math.isfinite(n) else int(n)} speeds: at most {MAX_SPEEDS}; "
-                        "use a larger step")
+        raise ParameterError(parameter, f"{_fmt(start)}:{_fmt(stop)}:{_fmt(step)} makes "
+                             f"{'too many' if not math.isfinite(n) else int(n)} speeds: at most {MAX_SPEEDS}; "
+                             "use a larger step")
 
 
 def refuse_non_finite_psd(res, source) -> None:

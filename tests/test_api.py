@@ -48,6 +48,52 @@ def test_readme_example_runs(tmp_path, monkeypatch, capsys):
     want = bb.expected_mean_square(lines, law, f_max=res.f[-1])
     assert np.allclose(res.rms() ** 2, want, rtol=0.02)
     assert ns["diag"].error_after <= ns["diag"].error_before
+    _check_the_wheel_set(ns)
+
+
+def _check_the_wheel_set(ns):
+    """The example's four wheels on the pyramid: their spacecraft-frame CSD is Σ T_i S T_iᵀ of the one wheel's S, with
+    T_i = [[R, 0], [[r]× R, R]] built here from the pyramid's geometry (spin axes at azimuth 45° + 90° i, elevation
+    arctan(1/√2), interfaces 0.3 m out at those azimuths); the wheels are independent, and a wheel's S does not depend
+    on where its x axis points about the spin axis (co-rotating and planar lines, no force-torque coherence).  The
+    NASTRAN file, read by pyNastran, holds the auto-spectra."""
+    sc = ns["sc"]
+    one = rwadist.psd(ns["model"], speed_rpm=(600, 2400), empirical=True, n_freq=2001, n_speeds=200)
+    el = np.arctan(1 / np.sqrt(2))
+    want = np.zeros_like(sc.csd)
+    for i in range(4):
+        az = np.radians(45.0 + 90.0 * i)
+        z = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+        x = np.cross([0.0, 0.0, 1.0], z)
+        x /= np.linalg.norm(x)
+        R = np.column_stack([x, np.cross(z, x), z])
+        r = 0.3 * np.array([np.cos(az), np.sin(az), 0.0])
+        rx = np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
+        T = np.block([[R, np.zeros((3, 3))], [rx @ R, R]])
+        want += T @ one.csd @ T.T
+    assert sc.frame == "spacecraft" and sc.csd.shape == (2001, 6, 6)
+    np.testing.assert_allclose(sc.csd, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
+    try:
+        BDF = _pynastran_bdf()
+    except pytest.skip.Exception:
+        return
+    full = Path("full.bdf")
+    full.write_text("CEND\nBEGIN BULK\n" + Path("wheels.bdf").read_text() + "ENDDATA\n")
+    deck = BDF(debug=None)
+    deck.read_bdf(str(full), xref=False)
+    assert len(deck.random_tables) == len(ns["tables"])
+    for e in deck.dload_entries[1]:
+        if e.j == e.k:
+            np.testing.assert_allclose(deck.random_tables[e.tid].y, sc.psd[:, e.j - 1], rtol=1e-4,
+                                       atol=1e-4 * sc.psd[:, e.j - 1].max())
+
+
+def _pynastran_bdf():
+    pytest.importorskip("pyNastran")
+    if not hasattr(np, "in1d"):               # pyNastran 1.4 uses np.in1d, removed in numpy 2.4
+        np.in1d = np.isin
+    from pyNastran.bdf.bdf import BDF
+    return BDF
 
 
 @pytest.mark.parametrize("name", ["read", "simulate_test", "fit", "fit_extended", "diagnose", "psd", "campbell"])

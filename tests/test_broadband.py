@@ -285,7 +285,7 @@ def test_histogram_file_within_the_speed_range_and_on_one_side_of_zero(tmp_path)
     assert bb.law_from_csv(q).support == pytest.approx((0.0, 3500 * W))
     far = tmp_path / "far.csv"
     far.write_text("speed_rpm,weight\n5000,1\n6000,1\n")
-    with pytest.raises(DataError, match=r"row 0 \(5000 rpm\) is outside the speed range 300:3000 rpm \(--speed-rpm\)"):
+    with pytest.raises(DataError, match=r"row 0 \(5000 rpm\) is outside the speed range 300:3000 rpm \(`speed_rpm`\)"):
         bb.law_from_spec(str(far), 300.0, 3000.0)
     prof = tmp_path / "prof.csv"
     prof.write_text("time_s,speed_rpm\n0,0\n10,3500\n")

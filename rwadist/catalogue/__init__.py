@@ -14,6 +14,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ..data import DataError
+from ..errors import ParameterError
 from ..model import WheelModel
 from ..model import load as _load_model
 
@@ -30,7 +31,7 @@ def path(name: str) -> Path:
     key = str(name).strip().lower()
     p = HERE / f"{key}.json"
     if not p.exists():
-        raise DataError("--preset", "name", f"unknown wheel {name!r}; known: {', '.join(names())}")
+        raise ParameterError("preset", f"{name!r}: unknown wheel; known: {', '.join(names())}")
     return p
 
 
@@ -93,18 +94,19 @@ def compare(fitted: WheelModel, reference: WheelModel, h_tol: float = 0.03) -> d
 
 #: what every output built on assumed suspension modes says (psd note files, FMU log, simulate-test meta)
 ASSUMED_MODES_NOTE = ("the suspension modes of {name} are ASSUMED (datasheet wheel: analytical.modes_assumed), "
-                      "not measured; outputs with the modes are built on assumed values -- without "
-                      "--assumed-modes the wheel runs hard-mounted, as its datasheet states")
+                      "not measured; outputs with the modes are built on assumed values -- unless they are asked "
+                      "for (`assumed_modes`) the wheel runs hard-mounted, as its datasheet states")
 
 
-def write_assumed_note(note_path, names, outputs):
+def write_assumed_note(note_path, names, outputs, wording=str):
     """Say on stderr and in ``note_path`` (a text file next to ``outputs``) that the outputs of wheels
-    ``names`` rest on assumed (datasheet) suspension modes (:data:`ASSUMED_MODES_NOTE`).  Returns the path."""
+    ``names`` rest on assumed (datasheet) suspension modes (:data:`ASSUMED_MODES_NOTE`, passed through
+    ``wording``: the command line names its flags).  Returns the path."""
     import sys
     from pathlib import Path
 
     note_path = Path(note_path)
-    note = "WARNING: " + ASSUMED_MODES_NOTE.format(name=", ".join(str(n) for n in names))
+    note = "WARNING: " + wording(ASSUMED_MODES_NOTE.format(name=", ".join(str(n) for n in names)))
     print(note, file=sys.stderr)
     from ..outputs import atomic_file
 

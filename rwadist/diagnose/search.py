@@ -9,6 +9,7 @@ import numpy as np
 from scipy import stats
 
 from ..empirical import fit_empirical
+from ..errors import ParameterError
 from ..model import WheelModel
 from ..spectra import Spectra
 from .constants import BAND_BINS, METRIC, NOISE_Z
@@ -226,13 +227,13 @@ def resolve_base(model: WheelModel | None, base: str = "empirical", test=None) -
     from ..catalogue import modes_assumed
 
     if base not in BASES:
-        raise ValueError(f"diagnose: base must be one of {BASES}, got {base!r}")
+        raise ParameterError(f"diagnose: base must be one of {BASES}, got {base!r}")
     has = model is not None and bool(getattr(model, "analytical", None))
     if base == "auto":
         return "extended" if has and not modes_assumed(model) and not _modes_off(test) else "empirical"
     if base == "extended" and not has:
-        raise ValueError("diagnose: base 'extended' needs a model with an analytical section "
-                         "(rwadist.extended.params_to_dict), e.g. preset('ithaco-e').to_model()")
+        raise ParameterError("base", "'extended' needs a model with an analytical section "
+                             "(rwadist.extended.params_to_dict), e.g. preset('ithaco-e').to_model()")
     return base
 
 

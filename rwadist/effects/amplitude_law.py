@@ -53,8 +53,8 @@ class AmplitudeLaw(Element):
     def inject_prepare(cls, wheel, spec, stand):
         h, spec["C"] = stand.harmonic(wheel, spec, spec["direction"], spec["h"])
         if stand.extended and stand.is_imbalance(spec["direction"], h):
-            raise stand.error("h", f"{cls.KIND}: with --physics extended the radial h = 1 lines are the rotor's "
-                              "imbalances; pick another h or --physics simple")
+            raise stand.error("h", f"{cls.KIND}: with `physics` 'extended' the radial h = 1 lines are the rotor's "
+                              "imbalances; pick another h or `physics` 'simple'")
         return stand.without(wheel, spec["direction"], h)
 
     @classmethod

@@ -56,6 +56,6 @@ class FixedResonance(Element):
         if spec["role"] == "test_stand":
             return replace(wheel, test_stand_modes=list(wheel.test_stand_modes) + [mode])
         if stand.extended:
-            raise stand.error("role", "fixed_resonance role=wheel_mode needs --physics simple "
+            raise stand.error("role", "fixed_resonance role=wheel_mode needs `physics` 'simple' "
                               "(with extended physics the wheel's modes are its suspension)")
         return replace(wheel, modes=list(wheel.modes) + [mode])

@@ -43,13 +43,13 @@ class SpeedRipple(Element):
     @classmethod
     def inject_requires(cls, spec, physics, modes, stand):
         if modes and physics == "simple":
-            raise stand.error(cls.KIND, "needs --no-modes (the rippled lines are rebuilt without the wheel's "
-                              "resonances)")
+            raise stand.error(cls.KIND, "needs the wheel's modes off (`modes`: the rippled lines are rebuilt without "
+                              "the wheel's resonances)")
 
     @classmethod
     def inject_prepare(cls, wheel, spec, stand):
         if stand.extended:
-            raise stand.error(cls.KIND, "needs --physics simple (the ripple is applied to the preset's lines)")
+            raise stand.error(cls.KIND, "needs `physics` 'simple' (the ripple is applied to the preset's lines)")
         return wheel
 
     @classmethod

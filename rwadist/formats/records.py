@@ -13,16 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import DataError  # noqa: F401  (its home is rwadist.errors; re-exported)
 from ..units import CHANNELS
-
-
-class DataError(ValueError):
-    """Bad input data; the message names the file, the field and the value."""
-
-    def __init__(self, file, field_name, message):
-        self.file = str(file)
-        self.field = field_name
-        super().__init__(f"{file}: {field_name}: {message}")
 
 
 @dataclass

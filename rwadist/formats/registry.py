@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..units import CHANNEL_COLUMN, rad_s_to_rpm
 from . import csv_table, matlab, tdms, uff
 from .channels import SPEED_COLUMN
@@ -75,4 +76,4 @@ def write_record(path, fmt: str, signals: dict, sample_rate: float, t0: float = 
         columns.update({CHANNEL_COLUMN[c]: x for c, x in signals.items()})
         columns.update(extra)
         return matlab.write(path, columns, v73=fmt == "mat73")
-    raise DataError("--format", "value", f"{fmt!r} is not one of {list(RUN_FORMATS)}")
+    raise ParameterError("format", f"{fmt!r} is not one of {list(RUN_FORMATS)}")
