@@ -417,6 +417,9 @@ def cmd_diagnose(args) -> int:
         for e in missing:
             part = f" ({e['sense']}-rotating part)" if e.get("sense") in ("co", "counter") else ""
             print(f"  - {e['direction']} h = {e['h']:g}{part}, C = {e['C']:.3g}")
+    for h in diag.hypotheses:
+        if getattr(h, "forced_by", None):
+            print(f"  - {h.effect.kind} taken back: the search fitted it to the {h.forced_by} described below")
     for u in diag.unexplained:
         print(f"  ? {u.text()}")
     print(f"unexplained fraction of the data's power (speed x frequency): {diag.error_before:.4g} -> "

@@ -97,11 +97,53 @@ def _waterfall_figure(diag: Diagnosis):
             if i == 1:
                 ax.set_xlabel("frequency (Hz)", fontsize=9)
             ax.tick_params(labelsize=8)
+            if i == 1:
+                _mark_unexplained(ax, c, diag, rpm)
     if im is not None:
         fig.colorbar(im, ax=axes, label="data / model (dB of band power)", shrink=0.9, pad=0.01)
     fig.suptitle(f"Residual waterfall, 0–{f_top:.0f} Hz: data over model in {BAND_BINS}-bin bands "
                  "(red: data above the model, blue: below)", fontsize=10)
     return fig
+
+
+#: Colour of the marks of what no class explains on the residual waterfall (stands out of the red/blue scale).
+MARK_COLOUR = "#1b7837"
+
+
+def _mark_unexplained(ax, c: str, diag: Diagnosis, rpm: np.ndarray) -> None:
+    """Marks on one "after" panel (channel ``c``) of the records of ``diag.unexplained`` that hold the channel, each
+    labelled with its number in report.md: a fixed line a dashed vertical, a speed line its ray f = h·rpm/60, a
+    moving resonance its track, a hump a shaded frequency span, a copy and a run-to-run change a note (and short
+    ticks at the runs' speeds)."""
+    hi = float(np.max(rpm))
+    style = dict(color=MARK_COLOUR, lw=1.2, zorder=5)
+    for n, u in enumerate(diag.unexplained, 1):
+        if c not in u.channels:
+            continue
+        tag = dict(color=MARK_COLOUR, fontsize=7, fontweight="bold", zorder=6)
+        s0, s1 = u.speed_rpm
+        if u.signature == "fixed_line":
+            ax.axvline(u.f_Hz[0], ls="--", **style)
+            ax.text(u.f_Hz[0], hi, f" {n}", va="top", **tag)
+        elif u.signature == "speed_line" and u.h is not None:
+            s = np.array([s0, s1])
+            ax.plot(u.h * s / 60.0, s, ls=":", **style)
+            ax.text(u.h * s1 / 60.0, s1, f" {n}", va="top", **tag)
+        elif u.signature == "moving_resonance":
+            fa = u.parameters.get("f_at_lowest_speed_Hz", u.f_Hz[0])
+            fb = u.parameters.get("f_at_highest_speed_Hz", u.f_Hz[1])
+            ax.plot([fa, fb], [s0, s1], ls="-.", **style)
+            ax.text(fb, s1, f" {n}", va="top", **tag)
+        elif u.signature == "broadband_hump":
+            ax.axvspan(u.f_Hz[0], u.f_Hz[1], color=MARK_COLOUR, alpha=0.15, lw=0, zorder=4)
+            ax.text(0.5 * (u.f_Hz[0] + u.f_Hz[1]), hi, f"{n}", ha="center", va="top", **tag)
+        else:
+            words = {"channel_copy": f"{n}: copy of {u.parameters.get('source', '?')}",
+                     "run_change": f"{n}: runs differ"}.get(u.signature, f"{n}: {u.signature}")
+            ax.text(0.02, 0.02, words, transform=ax.transAxes, va="bottom", **tag)
+            if u.signature == "run_change":
+                for r in u.parameters.get("run_speeds_rpm", []):
+                    ax.plot([0.0, 0.04], [r, r], transform=ax.get_yaxis_transform(), **style)
 
 
 def _rms_figure(diag: Diagnosis, cols: dict):
@@ -223,6 +265,10 @@ def write_report(diag: Diagnosis, out_dir) -> list:
                   else " It lacks none of the data's lines."), ""]
         md += [f"- {d} h = {h:.4g}" + (f" ({sense}-rotating part)" if sense in ("co", "counter") else "")
                + f", C = {C:.4g}" for d, h, C, sense in missing]
+    back = [h for h in diag.hypotheses if getattr(h, "forced_by", None)]
+    if back:
+        md += ["", "Taken back (the search fitted them to content described below as no class explains it):", ""]
+        md += [f"- {describe_effect({'kind': h.effect.kind, **h.effect.params()})} (to the {h.forced_by})" for h in back]
     md += ["", "## Unexplained residual", ""] + unexplained_section(diag)
     md += ["", "## Hypotheses (best five per iteration)", "", "see `hypotheses.csv`", "",
            "![residual](residual_waterfall.png)", "", "![rms](rms_vs_speed.png)", ""]

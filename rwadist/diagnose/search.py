@@ -12,6 +12,7 @@ from ..empirical import fit_empirical
 from ..errors import ParameterError
 from ..model import WheelModel
 from ..spectra import Spectra
+from . import describe
 from .constants import BAND_BINS, METRIC, NOISE_Z
 from .effects import family_classes
 from .engine import Context, initial_state
@@ -31,6 +32,9 @@ class Hypothesis:
     iteration: int
     #: a line of the wheel completed into a base fitted from the data (:func:`_base_lines`), not a foreign effect
     base_line: bool = False
+    #: the signature of what the residual holds that no class explains this effect was fitted to (it was taken back:
+    #: :func:`rwadist.diagnose.describe.forced_effects`), or None
+    forced_by: str | None = None
 
 
 @dataclass
@@ -93,6 +97,8 @@ def effect_entry(hyp: Hypothesis) -> dict:
     d = {**e.to_schema(),
          "evidence": {"heldout_gain": hyp.gain, "heldout_gain_fraction": hyp.gain_fraction,
                       "t": hyp.t, "passed": hyp.passed, "iteration": hyp.iteration}}
+    if hyp.forced_by:
+        d["evidence"]["taken_back"] = f"fitted to content described as {hyp.forced_by}"
     return d
 
 
@@ -259,8 +265,13 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     effect in ``effects``.
     """
     given = model is not None
+    # the open world (docs/diagnose.md, "Unexplained residual"): lines at one fixed frequency in every run and a
+    # channel's copy of another's content taken out of the records everything after reads, the empirical fit of a
+    # model not given included (no class explains them; left in, a class is forced onto them), described after
+    opened = describe.start(Context(spectra, channels, test))
+    ctx = opened.ctx
     if model is None:
-        model = fit_empirical(spectra).model
+        model = fit_empirical(ctx.sp).model
     request = base
     base = resolve_base(model, base, test)
     ext_params = None
@@ -268,7 +279,6 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         from ..extended import params_from_model
 
         ext_params = params_from_model(model, getattr(model, "name", "<model>"))
-    ctx = Context(spectra, channels, test)
     # 'auto' on the empirical base (no analytical model) may move to the extended base: the wheel's own
     # suspension modes, fitted from the data (``suspension_modes``), unless the test records the modes off
     ctx.base_switch = fits_modes_from_data(model, request, test)
@@ -328,6 +338,17 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
                 h.effect = revised.get(id(h.effect), h.effect)
             state = done
     _base_lines(hyps, model)
+    out = improved_model(model, state, hyps)
+    diag = Diagnosis(out, state0, state, _state_error(ctx, state0), _state_error(ctx, state), ctx.rms_error(state0),
+                     ctx.rms_error(state), hyps, it, ctx, model_given=given)
+    # measured on the data as given, what the residual holds that no class explains described (and an effect the
+    # search fitted to that content taken back: the model made again without it)
+    return describe.finish(diag, opened, rebuild=lambda st, hs: improved_model(model, st, hs))
+
+
+def improved_model(model: WheelModel, state: State, hyps) -> WheelModel:
+    """The model file of the search's ``state``: its model with the starting ``model``'s effects and every passing
+    hypothesis's entry (:func:`effect_entry`; a line completed into the base listed in the provenance instead)."""
     out = copy.deepcopy(state.model)
     out.effects = list(model.effects) + [effect_entry(h) for h in hyps if h.passed and not h.base_line]
     prov = {"metric": METRIC, "base": state.base}
@@ -336,5 +357,4 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     if base_lines:
         prov["base_lines"] = base_lines
     out.provenance = dict(out.provenance, diagnose=prov)
-    return Diagnosis(out, state0, state, _state_error(ctx, state0), _state_error(ctx, state), ctx.rms_error(state0),
-                     ctx.rms_error(state), hyps, it, ctx, model_given=given)
+    return out

@@ -12,7 +12,21 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from types import MappingProxyType
+
+
+class FrozenMapping(dict):
+    """A dict that refuses changes (a record's ``parameters``): read like a dict, pickled and copied as one."""
+
+    def _refuse(self, *args, **kwargs):
+        raise TypeError("an Unexplained record's parameters are read-only")
+
+    __setitem__ = __delitem__ = clear = pop = popitem = setdefault = update = _refuse   # type: ignore[assignment]
+
+    def __reduce__(self):
+        return (FrozenMapping, (dict(self),))
+
+    def __hash__(self):
+        return hash(tuple(sorted((k, repr(v)) for k, v in self.items())))
 
 #: Signature -> what it is, in words (the JSON form's ``description``).
 SIGNATURES = {
@@ -23,6 +37,12 @@ SIGNATURES = {
     "moving_resonance": "a resonance whose frequency changes with speed in a way the gyroscopic whirl does not explain",
     "broadband_hump": "a broadband hump above the noise floor",
     "run_change": "a run-to-run change",
+}
+
+#: How ``level_dB`` reads for the signatures whose level is not the data over the model in their cells.
+LEVEL_WORDS = {
+    "broadband_hump": "{:+.1f} dB over the floor's smooth course",
+    "run_change": "±{:.2f} dB from run to run",
 }
 
 
@@ -58,8 +78,9 @@ class Unexplained:
     channels : the channels where it stands above the noise (names of :data:`rwadist.units.CHANNELS`).
     speed_rpm : (lowest, highest) wheel speed of the runs where it stands above the noise, rpm.
     f_Hz : (lowest, highest) frequency where it is, Hz (a fixed line: its frequency twice).
-    level_dB : how far the data stand above (or below) the model where it is: the median over its cells of
-        10·log10(data / model), dB.
+    level_dB : how far it stands out, dB: the median over its cells of 10·log10(data / model); for a
+        ``broadband_hump`` (which the model takes as noise) its peak over the floor's smooth course, for a
+        ``run_change`` the runs' robust scatter about a smooth trend with speed (:data:`LEVEL_WORDS`).
     share : its share of what is left, 0..1: the misplaced power of its cells (the error metric's numerator
         over them) over the misplaced power of every cell after the search.
     n_runs : runs in which it stands above the noise.
@@ -88,11 +109,10 @@ class Unexplained:
         object.__setattr__(self, "speed_rpm", (float(self.speed_rpm[0]), float(self.speed_rpm[1])))
         object.__setattr__(self, "f_Hz", (float(self.f_Hz[0]), float(self.f_Hz[1])))
         object.__setattr__(self, "causes", tuple(str(c) for c in self.causes))
-        object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
+        object.__setattr__(self, "parameters", FrozenMapping(self.parameters))
 
-    def __hash__(self):          # parameters is a mapping: hashed by its items
-        return hash((self.signature, self.channels, self.speed_rpm, self.f_Hz, self.h,
-                     tuple(sorted((k, repr(v)) for k, v in self.parameters.items()))))
+    def __hash__(self):
+        return hash((self.signature, self.channels, self.speed_rpm, self.f_Hz, self.h, self.parameters))
 
     @property
     def description(self) -> str:
@@ -110,10 +130,13 @@ class Unexplained:
             f = f"{lo:.4g}-{hi:.4g} Hz"
         return f"{f} in {' '.join(self.channels) or 'no channel'}, {self.speed_rpm[0]:.0f}-{self.speed_rpm[1]:.0f} rpm"
 
+    def strength(self) -> str:
+        """``level_dB`` in words: over the model, or (:data:`LEVEL_WORDS`) what it is for the signature."""
+        return LEVEL_WORDS.get(self.signature, "{:+.1f} dB over the model").format(self.level_dB)
+
     def text(self) -> str:
         """The console's one line: signature, where, strength, share, the first cause and what would tell."""
-        out = f"{self.signature}: {self.where()}, {self.level_dB:+.1f} dB over the model, " \
-              f"{100.0 * self.share:.0f} % of what is left"
+        out = f"{self.signature}: {self.where()}, {self.strength()}, {100.0 * self.share:.0f} % of what is left"
         if self.causes:
             out += f"; could be {self.causes[0]}"
         if self.would_tell:

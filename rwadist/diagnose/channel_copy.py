@@ -1,0 +1,246 @@
+"""A channel that carries a copy of another channel's content (load-cell or amplifier crosstalk, a wiring fault, a
+calibration matrix without its off-diagonal term): found in the data before the search, described, and taken out of
+the records the fits read (issue 33, item 3).
+
+Left in, a copy is forced into classes: Fz holding 0.2 × Fy's lines shows the radial lines, amplified by the radial
+translation mode, in the axial direction too, which the fixture-resonance detection reads as one resonance lifting
+every direction (a test stand at the translation mode, which spoilt the wheel's modes).
+
+Signature: at the frequencies of the source channel's lines, the target's whole-record transform is the source's
+times one complex constant κ, in every run and for every line the target does not carry itself (a physical pair of
+channels shares a line's phase only through the wheel's geometry and its modes, which change with the speed and
+from line to line).  Found on each run's Hann-windowed FFT (the same bin of both channels: a copy has the source's
+leakage too, so the ratio holds whatever the line's place between bins): points (run, line) of the source standing
+:data:`MIN_LINE_DB` over its noise, κ the centre of the densest cluster of their ratios (the point with the most
+others within :data:`CLUSTER_TOLERANCE`, then the mean of the points within it, then the least squares of the
+target on the source over those points), a copy when the points near κ hold at least :data:`MIN_COPIED_LINES` different lines (ratios h to the speed), each in at
+least :data:`MIN_RUN_FRACTION` of the runs where the copy would stand :data:`CLEAR_COPY_DB` over the target's
+noise, and κ times the source stands over the target's
+noise.  Pairs of channels of one direction (Fx-Fy, Tx-Ty: a rotating line fixes their phase) are not tried, nor a
+torque carrying a force of a load-cell offset's r × F (the ``cross_coupling`` class; :data:`LEVER_ARM_PAIRS`);
+and a radial pair reading the other radial pair alike (Tx = κ·Fx with Ty = κ·Fy: a rotating source's force and
+moment in phase) is the rotor's own pattern, not a copy.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..units import CHANNEL_DIRECTION, RAD_S_TO_RPM
+
+#: (force, torque) pairs of a load-cell offset's r × F (Tx = r_y·Fz − r_z·Fy, ...): the ``cross_coupling`` class
+#: explains a torque carrying such a force, so those pairs are left to it
+LEVER_ARM_PAIRS = {("Fy", "Tx"), ("Fz", "Tx"), ("Fx", "Ty"), ("Fz", "Ty"), ("Fx", "Tz"), ("Fy", "Tz")}
+#: The other channel of a radial pair.
+PARTNER = {"Fx": "Fy", "Fy": "Fx", "Tx": "Ty", "Ty": "Tx"}
+#: A source line's power over the noise in its record bin, at least (dB).
+MIN_LINE_DB = 25.0
+#: Lines per run and channel taken as sources (the strongest).
+LINES_PER_RUN = 12
+#: Relative distance to κ within which a point belongs to the copy.
+CLUSTER_TOLERANCE = 0.15
+#: Points of one line: their ratios h to the speed rounded to this step (a record bin is 0.06 in h at 600 rpm and
+#: 0.6 Hz bins).
+LINE_H_STEP = 0.1
+#: Different lines (h, to LINE_H_STEP) the copy must hold, and the fraction of their runs each must hold.
+MIN_COPIED_LINES = 2
+MIN_RUN_FRACTION = 0.6
+#: Runs at least, and at most (spread over the speeds) the copy is looked for in.
+MIN_RUNS = 4
+MAX_RUNS = 24
+#: The copied content's power over the target's noise in those points, at least (dB).
+MIN_COPY_DB = 10.0
+#: A line's run counts where the copy there would stand this far over the target's noise (dB).
+CLEAR_COPY_DB = 20.0
+
+
+@dataclass(frozen=True)
+class ChannelCopy:
+    """``target`` carries κ × ``source`` (complex ``kappa``, the target's unit per the source's): the lines it was
+    found on (h), the runs (indices), its median power over the target's noise at those points (dB)."""
+
+    source: str
+    target: str
+    kappa: complex
+    lines_h: tuple
+    runs: tuple
+    level_dB: float
+    alternatives: tuple = ()
+
+
+def _run_points(run, chans, window: str):
+    """(f (P,) Hz, X (P, K) complex, noise (K,)) of one run: the record's Hann FFT of every channel of ``chans`` at
+    the peaks of each channel's spectrum standing MIN_LINE_DB over the channel's median (the LINES_PER_RUN
+    strongest of each), with the source channel's index (P,)."""
+    from scipy import fft as sp_fft
+
+    from ..dft import demeaned_windowed, run_window
+
+    n = run.n_samples
+    w, wsum, _ = run_window(window, n)
+    x = demeaned_windowed([run.signals[c] for c in chans], w)
+    X = 2.0 * sp_fft.rfft(x, axis=-1).T / wsum                            # (F, K)
+    P = np.abs(X) ** 2
+    noise = np.median(P[2:], axis=0) / np.log(2.0)                          # (K,) exponential median -> mean
+    f = np.arange(X.shape[0]) * run.sample_rate / n
+    rows, src = [], []
+    for j in range(len(chans)):
+        p = P[:, j]
+        peak = np.flatnonzero((p[1:-1] > p[:-2]) & (p[1:-1] >= p[2:]) & (p[1:-1] > noise[j] * 10 ** (MIN_LINE_DB / 10))) + 1
+        peak = peak[f[peak] > 4 * run.sample_rate / n]
+        peak = peak[np.argsort(-p[peak])][:LINES_PER_RUN]
+        rows += list(peak)
+        src += [j] * peak.size
+    rows = np.asarray(rows, dtype=int)
+    return f[rows], X[rows], noise, np.asarray(src, dtype=int)
+
+
+def find_channel_copies(ctx, test=None) -> list:
+    """The :class:`ChannelCopy` of ``test`` (default the context's; the context's runs and speeds), [] without the
+    time series."""
+    test = ctx.test if test is None else test
+    if test is None or ctx.runs.size < MIN_RUNS:
+        return []
+    chans = tuple(c for c in ctx.channels if all(c in test.runs[r].signals for r in ctx.runs))
+    if len(chans) < 2:
+        return []
+    # an instrument's copy is in every run: up to MAX_RUNS of them, spread over the speeds, tell
+    order = ctx.runs[np.argsort(ctx.omega[ctx.runs], kind="stable")]
+    runs = order[np.unique(np.linspace(0, order.size - 1, min(MAX_RUNS, order.size)).round().astype(int))]
+    parts = [_run_points(test.runs[r], chans, ctx.sp.window) for r in runs]
+    run_of = np.concatenate([np.full(p[0].size, r) for p, r in zip(parts, runs)])
+    f = np.concatenate([p[0] for p in parts])
+    X = np.concatenate([p[1] for p in parts])                               # (P, K)
+    noise = np.concatenate([np.broadcast_to(p[2], (p[0].size, len(chans))) for p in parts])
+    src = np.concatenate([p[3] for p in parts])
+    h = np.round(f * 2 * np.pi / np.maximum(ctx.omega[run_of], 1e-12) / LINE_H_STEP) * LINE_H_STEP
+    found = []
+    for s, cs in enumerate(chans):
+        mine = src == s
+        if mine.sum() < MIN_RUNS:
+            continue
+        for t, ct in enumerate(chans):
+            if t == s or CHANNEL_DIRECTION[ct] == CHANNEL_DIRECTION[cs] or (cs, ct) in LEVER_ARM_PAIRS:
+                continue
+            got = _pair(X[mine, s], X[mine, t], noise[mine, t], run_of[mine], h[mine], cs, ct)
+            if got is not None:
+                found.append(got)
+    # a radial pair carrying the other radial pair's content alike (Tx = κ·Fx and Ty = κ·Fy) is the rotor's own
+    # pattern (a force and a moment of one rotating source, in phase; the virtual stand's wheel without modes), not a
+    # copy: a cross-sensitive channel reads one other channel, not its pair's partner too
+    found = [x for x in found if not any(y.source == PARTNER.get(x.source) and y.target == PARTNER.get(x.target)
+                                         for y in found)]
+    # one copy per target: its source the pair whose points hold the most lines (Fz = κ·Fy also matches Fx on
+    # purely co-rotating lines, at ∓jκ), a copy weaker than what it copies (|κ| < 1: the other way round of a pair
+    # is the same copy read backwards)
+    out = []
+    for ct in dict.fromkeys(x.target for x in found):
+        cands = sorted((x for x in found if x.target == ct and abs(x.kappa) < 1.0),
+                       key=lambda x: (-len(x.lines_h), -len(x.runs)))
+        if cands:
+            out.append(replace(cands[0], alternatives=tuple(x.source for x in cands[1:])))
+    return out
+
+
+def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str) -> ChannelCopy | None:
+    """The copy of channel ``cs`` in ``ct`` from the source's points: their transforms ``X_s``, ``X_t``, the target's
+    noise there, their runs and line ratios ``h``; or None."""
+    k = X_t / X_s
+    ok = np.isfinite(k) & (np.abs(k) > 0)
+    if ok.sum() < MIN_RUNS:
+        return None
+    # the densest cluster of ratios: the point with the most others within the tolerance (a copy's share of the
+    # points may be small: the target's own lines at the source's ratios scatter), then its mean, three times
+    kk = k[ok]
+    support = np.sum(np.abs(kk[:, None] - kk[None, :]) <= CLUSTER_TOLERANCE * np.abs(kk)[:, None], axis=1)
+    kappa = complex(kk[int(np.argmax(support))])
+    for _ in range(3):
+        near = ok & (np.abs(k - kappa) <= CLUSTER_TOLERANCE * max(abs(kappa), 1e-300))
+        if near.sum() < MIN_RUNS:
+            return None
+        kappa = complex(np.mean(k[near]))
+    if abs(kappa) == 0:
+        return None
+    near = ok & (np.abs(k - kappa) <= CLUSTER_TOLERANCE * abs(kappa))
+    # κ to the precision the strongest lines give (a copy 80 dB over the noise needs it to 1e-4 to be taken out): the
+    # least squares of X_t on X_s over the copy's points, weighted by the lines' power (the ratio's own mean is pulled
+    # by the weak lines, whose source carries noise the copy does not)
+    kappa = complex(np.sum(X_t[near] * np.conj(X_s[near])) / np.sum(np.abs(X_s[near]) ** 2))
+    # a line counts in the runs where the copy would stand clear of the target's noise (a weaker copy's ratio is
+    # the noise's as much as the copy's)
+    strong = np.abs(kappa * X_s) ** 2 >= 10 ** (CLEAR_COPY_DB / 10) * noise_t
+    lines = []
+    for hv in np.unique(h[near]):
+        sel = (h == hv) & strong
+        n_runs = np.unique(runs[sel]).size
+        if n_runs >= MIN_RUNS and np.unique(runs[sel & near]).size >= MIN_RUN_FRACTION * n_runs:
+            lines.append(float(hv))
+    if len(lines) < MIN_COPIED_LINES:
+        return None
+    keep = near & np.isin(h, lines)
+    # κ again from the copy's cleanest lines: a line the target also carries itself (a ratio the two directions share)
+    # scatters about κ from run to run, one it only copies does not; within the wide cluster such lines pulled κ
+    # 10 % off in phase, which left the copy's strongest lines 20 dB down, still over the noise
+    spread = {}
+    for hv in lines:
+        sel = keep & strong & (h == hv)
+        if sel.sum() >= 3:
+            k_line = np.sum(X_t[sel] * np.conj(X_s[sel])) / np.sum(np.abs(X_s[sel]) ** 2)
+            spread[hv] = float(np.median(np.abs(k[sel] - k_line)) / abs(k_line))
+    if spread:
+        best = min(spread.values())
+        clean = [hv for hv, sp in spread.items() if sp <= max(2.0 * best, 1e-3)]
+        sel = keep & strong & np.isin(h, clean)
+        kappa = complex(np.sum(X_t[sel] * np.conj(X_s[sel])) / np.sum(np.abs(X_s[sel]) ** 2))
+    level = 10 * np.log10(np.median(np.abs(kappa * X_s[keep]) ** 2 / np.maximum(noise_t[keep], 1e-300)))
+    if level < MIN_COPY_DB:
+        return None
+    return ChannelCopy(cs, ct, kappa, tuple(lines), tuple(sorted(set(int(r) for r in runs[keep]))), float(level))
+
+
+def remove_channel_copies(test, copies):
+    """A copy of ``test`` with each target less κ × its source: x_t − Re(κ·(x_s + j·H[x_s])) (H the Hilbert
+    transform: a complex κ is a gain and a phase of the source's every component).  New arrays; the input is not
+    changed."""
+    from scipy.signal import hilbert
+
+    from ..data import SteadyTest
+
+    runs = []
+    for run in test.runs:
+        sig = dict(run.signals)
+        for cp in copies:
+            if cp.source in run.signals and cp.target in run.signals:
+                xs = np.asarray(run.signals[cp.source], dtype=float)
+                analytic = hilbert(xs - xs.mean()) + xs.mean()
+                sig[cp.target] = sig[cp.target] - np.real(cp.kappa * analytic)
+        runs.append(replace(run, signals=sig))
+    return SteadyTest(runs, dict(test.meta))
+
+
+def describe_channel_copies(ctx, copies, shares: dict) -> list:
+    """:class:`~rwadist.diagnose.unexplained.Unexplained` records (signature ``channel_copy``) of ``copies``;
+    ``shares``: index -> (share, level dB) on the data as given."""
+    from .unexplained import Unexplained
+
+    out = []
+    for i, cp in enumerate(copies):
+        speeds = ctx.omega[list(cp.runs)] * RAD_S_TO_RPM
+        f = np.array([h * ctx.omega[r] / (2 * np.pi) for h in cp.lines_h for r in cp.runs])
+        share, level = shares.get(i, (float("nan"), cp.level_dB))
+        gain, phase = abs(cp.kappa), float(np.degrees(np.angle(cp.kappa)))
+        alt = f" ({' or '.join((cp.source,) + cp.alternatives)}: their lines share a phase)" if cp.alternatives else ""
+        out.append(Unexplained(
+            signature="channel_copy", channels=(cp.target,), speed_rpm=(float(speeds.min()), float(speeds.max())),
+            f_Hz=(float(f.min()), float(f.max())), level_dB=level, share=share, n_runs=len(cp.runs),
+            parameters={"source": cp.source, "target": cp.target, "gain": gain, "phase_deg": phase,
+                        "lines_h": list(cp.lines_h), "copy_over_noise_dB": cp.level_dB,
+                        "other_sources": list(cp.alternatives), "removed_before_the_search": True},
+            causes=(f"crosstalk: {cp.target} reads {gain:.3g} × {cp.source}{alt} (the load cell's {cp.target} bridge or "
+                    f"its amplifier picking up {cp.source}, a calibration matrix missing that off-diagonal term, "
+                    "or a wiring fault)",),
+            would_tell=f"a calibration check loading {cp.source} alone (a known force or moment along it) shows "
+                       f"{cp.target} respond by {gain:.3g}; swapping the two channels' amplifiers tells the cell from "
+                       "the electronics"))
+    return out

@@ -1,0 +1,292 @@
+"""The open world of ``rwadist diagnose`` (issue 33, item 3): what the residual holds above the noise that no effect
+class explains is described (:class:`~rwadist.diagnose.unexplained.Unexplained`), never dropped and never forced
+into a class.
+
+Two steps around the search (:func:`rwadist.diagnose.search.diagnose`):
+
+- :func:`start`, before it: lines at one fixed frequency in every run are found in the data and taken out of the
+  records the search reads (:mod:`~rwadist.diagnose.fixed_lines`: left in, they were fitted as a test-stand
+  resonance that spoilt the wheel's modes);
+- :func:`finish`, after it: the error metric measured on the data as given, and the
+  residual of the final model described by signature (the detectors of :mod:`~rwadist.diagnose.describe_lines` and
+  :mod:`~rwadist.diagnose.describe_structure`), each description with its share of the misplaced power left.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .engine import Context
+from .fixed_lines import describe_fixed_lines, find_fixed_lines, remove_fixed_lines
+from .state import State
+
+
+@dataclass
+class Opened:
+    """What :func:`start` found: ``ctx`` the context the search reads (the data with the fixed lines taken out, or
+    the data as given), ``raw`` the context of the data as given, ``fixed`` the fixed lines
+    (:class:`~rwadist.diagnose.fixed_lines.FixedLine`), ``copies`` the channel copies
+    (:class:`~rwadist.diagnose.channel_copy.ChannelCopy`)."""
+
+    ctx: Context
+    raw: Context
+    fixed: list = field(default_factory=list)
+    copies: list = field(default_factory=list)
+
+
+def start(ctx: Context) -> Opened:
+    """The context the search reads: ``ctx`` itself, or, when the data hold lines at one fixed frequency in every run
+    (:func:`~rwadist.diagnose.fixed_lines.find_fixed_lines`) or a channel carrying a copy of another's content
+    (:func:`~rwadist.diagnose.channel_copy.find_channel_copies`, looked for once the fixed lines, common to every
+    channel, are out), a context of the same settings on the records with those taken out."""
+    from .channel_copy import find_channel_copies, remove_channel_copies
+
+    fixed = find_fixed_lines(ctx)
+    test = remove_fixed_lines(ctx, fixed) if fixed else ctx.test
+    copies = find_channel_copies(ctx, test)
+    if copies:
+        test = remove_channel_copies(test, copies)
+    if not fixed and not copies:
+        return Opened(ctx, ctx)
+    from ..spectra import compute_spectra
+
+    sp = compute_spectra(test, nperseg=ctx.sp.nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
+    return Opened(Context(sp, ctx.channels, test), ctx, fixed, copies)
+
+
+@dataclass
+class Residual:
+    """The residual of ``state`` on ``ctx`` in the error metric's bands: per channel the misplaced power ``e``
+    (max(|D − M| − 2σ, 0), divided by the unit group's scale), the data's and the model's band powers ``D``, ``M``
+    (runs × bands, every run of the context), and ``total`` = Σ e (the metric's numerator)."""
+
+    ctx: Context
+    state: State
+    e: dict
+    D: dict
+    M: dict
+    total: float
+
+    @staticmethod
+    def of(ctx: Context, state: State) -> "Residual":
+        from .constants import NOISE_Z
+
+        _, _, parts = ctx.run_errors(state, ctx.runs, detail=True)
+        e, D, M = {}, {}, {}
+        for c, (resid, sig) in parts.items():
+            scale = ctx.scale(c)
+            e[c] = np.maximum(np.abs(resid) - NOISE_Z * sig, 0.0)
+            D[c] = ctx._data_bands(state, c, ctx.runs)[1]
+            M[c] = D[c] - resid * scale
+        total = float(sum(np.nansum(x) for x in e.values()))
+        return Residual(ctx, state, e, D, M, total)
+
+    def band_of(self, f_hz) -> np.ndarray:
+        """Band index (clipped to the bands) of frequencies ``f_hz`` (Hz, any shape)."""
+        from .constants import BAND_BINS
+
+        k = np.rint(np.asarray(f_hz, dtype=float) / self.ctx.df).astype(int)
+        return np.clip((k - self.ctx.k_lo) // BAND_BINS, 0, self.ctx.n_bands - 1)
+
+    def measure(self, cells: dict) -> tuple:
+        """(share of the misplaced power, median level 10·log10(D/M) dB) over ``cells`` (channel -> bool mask (runs,
+        bands) over the context's runs)."""
+        got, levels = 0.0, []
+        for c, mask in cells.items():
+            if c not in self.e or not np.any(mask):
+                continue
+            got += float(np.nansum(self.e[c][mask]))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                levels.append(10 * np.log10(self.D[c][mask] / self.M[c][mask]))
+        lv = np.concatenate(levels) if levels else np.empty(0)
+        lv = lv[np.isfinite(lv)]
+        return got / self.total if self.total > 0 else 0.0, float(np.median(lv)) if lv.size else float("nan")
+
+    def mask(self, c: str) -> np.ndarray:
+        return np.zeros(self.e[c].shape, bool)
+
+
+def fixed_line_shares(res: Residual, lines) -> dict:
+    """Line index -> (share, level dB) of each fixed line on the data as given: the cells of its band in the runs
+    where it is lit, in the channels that carry it."""
+    pos = {int(r): i for i, r in enumerate(res.ctx.runs)}
+    out = {}
+    for i, ln in enumerate(lines):
+        b = int(res.band_of(ln.f_Hz))
+        cells = {}
+        for c in ln.channels:
+            if c not in res.e:
+                continue
+            m = res.mask(c)
+            m[[pos[r] for r in ln.runs if r in pos], b] = True
+            cells[c] = m
+        out[i] = res.measure(cells)
+    return out
+
+
+def channel_copy_shares(res: Residual, copies) -> dict:
+    """Copy index -> (share, level dB) of each channel copy on the data as given: the target's bands where the copy,
+    |κ|² × the source's band power, is at least a tenth of the target's own."""
+    out = {}
+    for i, cp in enumerate(copies):
+        if cp.target not in res.e or cp.source not in res.D:
+            continue
+        out[i] = res.measure({cp.target: abs(cp.kappa) ** 2 * res.D[cp.source] >= 0.1 * res.D[cp.target]})
+    return out
+
+
+def describe_residual(searched: Residual, res: Residual | None = None) -> list:
+    """The records of the final model's residual on ``searched`` (the detectors of :mod:`.describe_structure` and
+    :mod:`.describe_lines`), each with its share of the misplaced power and its level measured on ``res`` (default
+    ``searched``: the same runs and bands)."""
+    from .describe_lines import speed_lines
+    from .describe_structure import broadband_hump, line_ratios, moving_resonance, run_change
+
+    res = searched if res is None else res
+    ctx, state = searched.ctx, searched.state
+    pos = {int(r): i for i, r in enumerate(ctx.runs)}
+    spin = ctx.omega[ctx.runs] / (2 * np.pi)
+
+    def of_runs(runs):
+        return res.measure({c: np.isin(ctx.runs, runs)[:, None] & np.ones(res.e[c].shape, bool) for c in res.e})
+
+    def of_band(chans, f0, f1):
+        b0, b1 = int(res.band_of(f0)), int(res.band_of(f1))
+        cells = {}
+        for c in chans:
+            if c in res.e:
+                m = res.mask(c)
+                m[:, b0:b1 + 1] = True
+                cells[c] = m
+        return res.measure(cells)
+
+    def of_track(chans, track, zeta):
+        f = track(spin)
+        lo, hi = res.band_of(f * (1 - 3 * zeta)), res.band_of(f * (1 + 3 * zeta))
+        cells = {}
+        for c in chans:
+            if c in res.e:
+                m = res.mask(c)
+                for i in range(spin.size):
+                    m[i, lo[i]:hi[i] + 1] = True
+                cells[c] = m
+        return res.measure(cells)
+
+    def of_line(chans, h, runs):
+        cells = {}
+        for c in chans:
+            if c in res.e:
+                m = res.mask(c)
+                for r in runs:
+                    m[pos[int(r)], res.band_of(h * ctx.omega[int(r)] / (2 * np.pi))] = True
+                cells[c] = m
+        return res.measure(cells)
+
+    ratios = line_ratios(ctx, state)
+    others = [x.h for d in ("radial_force", "radial_torque", "axial_force", "axial_torque")
+              for x in state.model.harmonics(d)]
+    out = broadband_hump(ctx, state, of_band)
+    out += moving_resonance(ctx, state, ratios, of_track)
+    out += run_change(ctx, ratios, of_runs)
+    out += speed_lines(ctx, state, of_line, others=others)
+    return out
+
+
+def _described(diag, opened: Opened, search_after: State) -> tuple:
+    """(records, the residual on the data as given) of the search's final state ``search_after`` (on ``opened.ctx``):
+    ``diag``'s context, final state (a copy on the data as given when those differ: its cached error terms were the
+    cleaned data's) and error after set to those of the data as given."""
+    searched = Residual.of(opened.ctx, search_after) if opened.ctx is not opened.raw else None
+    after = search_after.copy() if searched is not None else search_after
+    diag.ctx, diag.state_after = opened.raw, after
+    diag.error_after, diag.rms_error_after = opened.raw.error(after), opened.raw.rms_error(after)
+    res = Residual.of(opened.raw, after)
+    from .channel_copy import describe_channel_copies
+
+    found = describe_fixed_lines(opened.raw, opened.fixed, fixed_line_shares(res, opened.fixed))
+    found += describe_channel_copies(opened.raw, opened.copies, channel_copy_shares(res, opened.copies))
+    # the final model's residual on the data the search read (the fixed lines and copies out), shares on the data
+    found += describe_residual(searched or res, res)
+    return found, res
+
+
+def cells_of(u, res: Residual) -> dict:
+    """The waterfall cells (channel -> bool mask (runs, bands)) a record covers: its channels, the runs within its
+    speed range (a ``run_change``: its runs), the bands of its frequency range."""
+    rpm = res.ctx.omega[res.ctx.runs] * 60.0 / (2 * np.pi)
+    if u.signature == "run_change" and u.parameters.get("run_speeds_rpm"):
+        runs = np.isin(np.round(rpm, 6), np.round(np.asarray(u.parameters["run_speeds_rpm"]), 6))
+    else:
+        runs = (rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6)
+    b0, b1 = int(res.band_of(u.f_Hz[0])), int(res.band_of(u.f_Hz[1]))
+    out = {}
+    for c in u.channels:
+        if c in res.e:
+            m = res.mask(c)
+            m[np.ix_(runs, np.arange(b0, b1 + 1))] = True
+            out[c] = m
+    return out
+
+
+#: An effect the search added is taken back when at least this share of what it gains (misplaced power, on the data
+#: as given) lies in the cells of what the residual holds that no class explains: it was fitted to that content.
+FORCED_SHARE = 0.5
+
+
+def forced_effects(diag, opened: Opened, search_before: State, search_after: State, found, res: Residual) -> list:
+    """[(effect, signature)] of the effects the search added after its base (not the wheel's ``suspension_modes``,
+    not the lines completed into the base) whose gain lies for :data:`FORCED_SHARE` or more in the cells of a record
+    of ``found`` (:func:`cells_of`): each effect's gain is the drop of misplaced power from the final state with it
+    taken out (the other effects applied again to the starting state, in their order) to the final state, cell by
+    cell, on the data as given."""
+    base = {id(h.effect) for h in diag.hypotheses if h.passed and (h.base_line or h.effect.kind == "suspension_modes")}
+    cells = [(u, cells_of(u, res)) for u in found]
+    out = []
+    for e in search_after.effects:
+        if id(e) in base:
+            continue
+        without = search_before
+        for other in search_after.effects:
+            if other is not e:
+                without = other.apply(without)
+        res0 = Residual.of(opened.raw, without.copy())
+        gain = {c: res0.e[c] - res.e[c] for c in res.e}
+        total = float(sum(np.nansum(g) for g in gain.values()))
+        if total <= 0:
+            continue
+        for u, m in cells:
+            inside = float(sum(np.nansum(gain[c][mask]) for c, mask in m.items()))
+            if inside >= FORCED_SHARE * total:
+                out.append((e, u.signature))
+                break
+    return out
+
+
+def finish(diag, opened: Opened, rebuild=None):
+    """``diag`` (a :class:`~rwadist.diagnose.search.Diagnosis` of the search on ``opened.ctx``) measured on the data
+    as given and described: its context, states and errors those of the data as given (where the fixed lines and
+    copies taken out before the search stay unexplained); its ``unexplained`` records (fixed lines and copies first,
+    then what the final model's residual on the data the search read holds, :func:`describe_residual`); the effects
+    the search fitted to that content taken back (:func:`forced_effects`: their hypotheses marked ``forced_by``, the
+    model made again by ``rebuild(state, hypotheses)``, the content described on the state without them)."""
+    search_before, search_after = diag.state_before, diag.state_after
+    if opened.ctx is not opened.raw:
+        s0 = search_before.copy()
+        diag.state_before = s0
+        diag.error_before, diag.rms_error_before = opened.raw.error(s0), opened.raw.rms_error(s0)
+    found, res = _described(diag, opened, search_after)
+    forced = forced_effects(diag, opened, search_before, search_after, found, res) if found and rebuild else []
+    if forced:
+        gone = {id(e): sig for e, sig in forced}
+        state = search_before
+        for e in search_after.effects:
+            if id(e) not in gone:
+                state = e.apply(state)
+        for h in diag.hypotheses:
+            if id(h.effect) in gone:
+                h.passed, h.forced_by = False, gone[id(h.effect)]
+        diag.model = rebuild(state, diag.hypotheses)
+        found, res = _described(diag, opened, state)
+    diag.unexplained = tuple(found)
+    return diag

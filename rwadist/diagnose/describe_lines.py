@@ -1,0 +1,131 @@
+"""Detector of the open world (issue 33, item 3) on the final model's residual: a line at a constant ratio of the
+speed that no model line has (a ``speed_line``), with its rotation sense and its candidate bearing causes.
+
+A ``missing_harmonic`` takes such a line when it passes the held-out judge; what is left after the search is a line
+the class could not fit (its strength erratic from run to run, present over part of the speeds only).  Found as a
+ridge of lit bins along f = h·|Ω|/2π: a bin is lit when the data stand over the model beyond a 1e-3 false-alarm
+level of the Welch estimate (or a neighbour does), away from the model's lines (where they stand over the noise); a
+ridge is an h lit in at least :data:`RIDGE_FRACTION` of the runs where it lies in the band, at least
+:data:`RIDGE_RUNS` of them, more than :data:`MODEL_LINE_BINS` Welch bins (at the top speed) from every model line of
+the channel's direction.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
+from .unexplained import Unexplained
+
+RIDGE_FRACTION = 0.6
+RIDGE_RUNS = 5
+MODEL_LINE_BINS = 3.0
+#: Step of the h grid, Welch bins at the top speed.
+H_STEP_BINS = 0.25
+#: False-alarm probability of a lit bin.
+LIT_FALSE_ALARM = 1e-3
+
+
+def ratio_resolution(ctx) -> float:
+    """The resolution of a line's ratio h to the speed: one bin of the whole record (the finest the data resolve)
+    at the top speed, in h."""
+    if ctx.test is not None:
+        n = float(np.median([ctx.test.runs[r].n_samples for r in ctx.runs]))
+        df = ctx.sp.sample_rate / n
+    else:
+        df = ctx.df
+    return float(df * 2 * np.pi / max(float(ctx.omega[ctx.runs].max()), 1e-12))
+
+
+def _lit(ctx, state, c: str) -> np.ndarray:
+    """Bins (runs, n_f) of channel ``c`` where the data stand over the model beyond the χ² level, or a neighbour does,
+    away from the model's lines (bins where the lines' predicted PSD exceeds the floor)."""
+    from scipy import stats
+
+    runs = ctx.runs
+    D = ctx.data(state, c, runs)[runs]
+    M = ctx.predict(state, c, runs)
+    N = ctx.floor_psd(state, c, runs)
+    thr = stats.chi2.isf(LIT_FALSE_ALARM, ctx.dof) / ctx.dof
+    lit = (D > thr * M) & (M - N < N)
+    out = lit.copy()
+    out[:, 1:] |= lit[:, :-1]
+    out[:, :-1] |= lit[:, 1:]
+    out[~np.isfinite(D[:, 0])] = False
+    return out
+
+
+def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
+    """``speed_line`` records of the residual ridges at a constant h no model line of the direction has, pooled over
+    the direction's channels; each with its ratio refined on the residual peaks, its rotation sense on a radial
+    direction (from the x/y phase of the whole-run transforms, with the time series), its amplitude's power law in
+    the speed and its candidate bearing causes (:func:`rwadist.bearings.line_causes`)."""
+    from ..bearings import line_causes
+    from .measure import refine_h
+
+    runs = ctx.runs
+    om = ctx.omega[runs]
+    if runs.size < RIDGE_RUNS:
+        return []
+    dh = H_STEP_BINS * ctx.df * 2 * np.pi / om.max()
+    h_grid = np.arange(0.1, min(ctx.k_hi * ctx.df * 2 * np.pi / om.min(), 40.0), dh)
+    k = np.rint(np.outer(h_grid, om) / (2 * np.pi) / ctx.df).astype(int)                      # (H, R)
+    inb = (k >= ctx.k_lo) & (k <= ctx.k_hi)
+    rows = np.arange(runs.size)[None, :]
+    out = []
+    for d, chans in DIRECTION_CHANNELS.items():
+        chans = [c for c in chans if c in ctx.channels]
+        if not chans:
+            continue
+        hit = np.zeros(k.shape, bool)
+        for c in chans:
+            hit |= _lit(ctx, state, c)[rows, np.clip(k, 0, ctx.f.size - 1)]
+        n_in = inb.sum(1)
+        frac = np.where(n_in >= RIDGE_RUNS, (hit & inb).sum(1) / np.maximum(n_in, 1), 0.0)
+        model_h = np.array([x.h for x in state.model.harmonics(d)])
+        near_model = np.any(np.abs(h_grid[:, None] - model_h[None, :]) <= MODEL_LINE_BINS * dh / H_STEP_BINS,
+                            axis=1) if model_h.size else np.zeros(h_grid.size, bool)
+        cand = (frac >= RIDGE_FRACTION) & ~near_model
+        peaks = np.flatnonzero(cand & (frac >= np.roll(frac, 1)) & (frac >= np.roll(frac, -1)))
+        taken = []
+        for i in peaks[np.argsort(-frac[peaks])]:
+            if any(abs(h_grid[i] - t) <= 4 * dh for t in taken):
+                continue
+            taken.append(h_grid[i])
+            h = refine_h(ctx, state, chans, runs, float(h_grid[i]))
+            if any(u.parameters["direction"] == d and abs(u.h - h) <= 4 * dh for u in out) or \
+                    (model_h.size and np.min(np.abs(model_h - h)) <= MODEL_LINE_BINS * dh / H_STEP_BINS):
+                continue                    # refined onto a line already described, or onto a model line
+            lit_runs = runs[hit[i] & inb[i]]
+            rpm = ctx.omega[lit_runs] * RAD_S_TO_RPM
+            share, level = shares(chans, h, lit_runs)
+            sense = _sense(ctx, d, h, lit_runs)
+            causes = tuple(line_causes(h, ratio_resolution(ctx), bearings, others))
+            f = h * ctx.omega[lit_runs] / (2 * np.pi)
+            out.append(Unexplained(
+                signature="speed_line", channels=tuple(chans), speed_rpm=(float(rpm.min()), float(rpm.max())),
+                f_Hz=(float(f.min()), float(f.max())), level_dB=level, share=share, n_runs=int(lit_runs.size),
+                h=float(h), parameters={"direction": d, "h": float(h), "counter_fraction": sense,
+                                        "lit_fraction": float(frac[i])},
+                causes=causes + ("a line of the wheel the classes could not fit (its strength erratic from run to "
+                                 "run, or present over part of the speeds only)",),
+                would_tell="runs repeated at a few speeds (a steady line repeats; an intermittent one, e.g. a "
+                           "cage's instability or a rub, does not) and the bearings' geometry to name "
+                           "the ratio"))
+    return out
+
+
+def _sense(ctx, direction: str, h: float, runs) -> float | None:
+    """Counter-rotating share Σ|X − jY|²/Σ(|X + jY|² + |X − jY|²) of a radial line h over ``runs`` from the whole-run
+    transforms of its two channels (co-rotating x + jy ∝ e^{+jhφ}), or None (an axial direction, no time series)."""
+    chans = DIRECTION_CHANNELS[direction]
+    if len(chans) != 2 or ctx.test is None or not all(c in ctx.channels for c in chans) or not len(runs):
+        return None
+    from ..units import CHANNELS
+
+    runs = np.asarray(runs)
+    P = ctx.phasors(runs, (h * ctx.omega[runs] / (2 * np.pi))[:, None])[:, 0, :]            # (R, 6)
+    X, Y = P[:, CHANNELS.index(chans[0])], P[:, CHANNELS.index(chans[1])]
+    co, counter = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
+    tot = np.nansum(co + counter)
+    return float(np.nansum(counter) / tot) if tot > 0 else None
+

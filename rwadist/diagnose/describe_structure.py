@@ -1,0 +1,434 @@
+"""Detectors of the open world (issue 33, item 3) on the final model's residual: a broadband hump above the noise,
+a run-to-run change of the lines, a resonance whose frequency moves with the speed (docs/diagnose.md, "Unexplained
+residual").  Each returns :class:`~rwadist.diagnose.unexplained.Unexplained` records; :mod:`.describe` runs them.
+
+The lines' measured-over-predicted ratios (:func:`line_ratios`) are read per direction (the power of the direction's
+channels summed: a radial line's x and y powers differ run by run by the random co/counter cross term, their sum
+does not), for the lines standing :data:`LINE_SNR_DB` over the noise in their window.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
+from .constants import LINE_HALF
+from .unexplained import Unexplained
+
+#: A line's predicted power over the noise in its window, at least, for its ratio to be read (dB).
+LINE_SNR_DB = 20.0
+
+
+@dataclass
+class LineRatios:
+    """Measured over predicted power of the model's lines, per direction: ``q`` dB, frequency ``f`` Hz, the run's
+    position ``run`` in the context's runs, its spin frequency ``spin`` Hz, the line's index ``line`` and ratio
+    ``h``, and the weight ``w`` (the line's SNR, capped at 40 dB: the ratio's own noise is then far below the
+    model's misfits)."""
+
+    direction: str
+    q: np.ndarray
+    f: np.ndarray
+    run: np.ndarray
+    spin: np.ndarray
+    line: np.ndarray
+    h: np.ndarray
+    w: np.ndarray
+
+
+def line_ratios(ctx, state) -> list:
+    """The :class:`LineRatios` of every direction with lines (the context's runs)."""
+    runs = ctx.runs
+    out = []
+    for d, chans in DIRECTION_CHANNELS.items():
+        chans = [c for c in chans if c in ctx.channels]
+        if not chans:
+            continue
+        meas, pred, noise, hs = None, None, None, None
+        for c in chans:
+            cl = ctx.channel_lines(state, c, runs)
+            if not cl:
+                break
+            h = np.array([x[0] for x in cl])
+            if hs is not None and (h.size != hs.size or np.any(np.abs(h - hs) > 1e-9)):
+                break
+            hs = h
+            f = h[:, None] * ctx.omega[runs][None, :] / (2 * np.pi)                        # (L, R)
+            a = np.array([x[2] for x in cl]) * ctx.gain(state, c, f)
+            m = ctx.measure_lines(state, c, runs)                                           # (L, R) amplitude
+            k = np.clip(np.rint(f / ctx.df).astype(int), 0, ctx.f.size - 1)
+            nz = ctx.floor_psd(state, c, runs)[np.arange(runs.size)[None, :], k] * ctx.df * (2 * LINE_HALF + 1)
+            ok = np.isfinite(ctx.sp.psd[c][runs, 0])[None, :]
+            mp, pp = np.where(ok, np.nan_to_num(m) ** 2 / 2, np.nan), np.where(ok, a**2 / 2, np.nan)
+            meas = mp if meas is None else meas + mp
+            pred = pp if pred is None else pred + pp
+            noise = nz if noise is None else noise + nz
+        else:
+            if hs is None:
+                continue
+            snr = pred / np.maximum(noise, 1e-300)
+            good = np.isfinite(meas) & (meas > 0) & (snr >= 10 ** (LINE_SNR_DB / 10))
+            if good.sum() < 3:
+                continue
+            L, R = good.shape
+            li, ri = np.nonzero(good)
+            f = hs[li] * ctx.omega[runs][ri] / (2 * np.pi)
+            out.append(LineRatios(d, 10 * np.log10(meas[good] / pred[good]), f, ri, ctx.omega[runs][ri] / (2 * np.pi),
+                                  li, hs[li], np.minimum(snr[good], 1e4)))
+    return out
+
+
+# ----------------------------------------------------------------------------------------------- run-to-run change
+#: The runs' common factor must scatter about a smooth trend with speed by at least this much (dB, robust std; on
+#: clean data of the wheel family it scatters by 0.004 dB) ...
+RUN_SCATTER_DB = 0.25
+#: ... with at least this many runs (and this fraction of them) beyond it, each with RUN_MIN_LINES lines at least.
+RUN_MIN_RUNS = 3
+RUN_MIN_FRACTION = 0.2
+RUN_MIN_LINES = 2
+
+
+def _smooth_trend(x: np.ndarray, y: np.ndarray, half: int = 3) -> np.ndarray:
+    """A running median of ``y`` over the ``half`` neighbours on either side in the order of ``x``."""
+    order = np.argsort(x)
+    ys = y[order]
+    out = np.empty_like(ys)
+    for i in range(ys.size):
+        out[i] = np.median(ys[max(0, i - half):i + half + 1])
+    back = np.empty_like(out)
+    back[order] = out
+    return back
+
+
+def run_change(ctx, ratios: list, shares) -> list:
+    """A run-to-run change: every line of a run (all directions together) off the model by a common factor that
+    scatters from run to run about a smooth trend with speed (a load cell's gain drifting over the test, a wheel
+    re-mounted between runs, an amplifier's range switched).  Per run the weighted median of its lines' ratios;
+    the trend a running median over the neighbouring speeds; described when the robust scatter about it exceeds
+    :data:`RUN_SCATTER_DB` and :data:`RUN_MIN_RUNS` runs (a fifth of them at least) stand beyond it."""
+    if not ratios:
+        return []
+    q = np.concatenate([r.q for r in ratios])
+    run = np.concatenate([r.run for r in ratios])
+    R = ctx.runs.size
+    per, n_lines = np.full(R, np.nan), np.bincount(run, minlength=R)
+    for i in np.flatnonzero(n_lines >= RUN_MIN_LINES):
+        per[i] = np.median(q[run == i])
+    ok = np.isfinite(per)
+    if ok.sum() < 2 * RUN_MIN_RUNS + 1:
+        return []
+    speed = ctx.omega[ctx.runs][ok]
+    dev = per[ok] - _smooth_trend(speed, per[ok])
+    scatter = 1.4826 * np.median(np.abs(dev - np.median(dev)))
+    off = np.abs(dev) > RUN_SCATTER_DB
+    if scatter < RUN_SCATTER_DB or off.sum() < max(RUN_MIN_RUNS, RUN_MIN_FRACTION * dev.size):
+        return []
+    idx = np.flatnonzero(ok)[off]
+    rpm = ctx.omega[ctx.runs[idx]] * RAD_S_TO_RPM
+    names = [ctx.sp.run_names[int(r)] if r < len(ctx.sp.run_names) else str(int(r)) for r in ctx.runs[idx]]
+    share, _ = shares(ctx.runs[idx])
+    timed = _time_order_note(ctx)
+    return [Unexplained(
+        signature="run_change", channels=tuple(ctx.channels), speed_rpm=(float(rpm.min()), float(rpm.max())),
+        f_Hz=(float(np.min(np.concatenate([r.f for r in ratios]))), float(np.max(np.concatenate([r.f for r in ratios])))),
+        level_dB=float(scatter), share=share, n_runs=int(idx.size),
+        parameters={"scatter_dB": float(scatter), "largest_dB": float(np.max(np.abs(dev))),
+                    "runs": names, "run_speeds_rpm": [float(x) for x in rpm],
+                    "run_offsets_dB": [float(x) for x in dev[off]], **timed},
+        causes=("the load cell's or its amplifier's gain drifting over the test (temperature, a bridge supply)",
+                "the wheel or the fixture re-mounted or re-torqued between runs",
+                "an amplifier range or filter switched between runs"),
+        would_tell="the runs in the order they were recorded (a drift grows with time; a re-mounting is a step) and a "
+                   "repeated run at one speed at the start and the end of the test")]
+
+
+def _time_order_note(ctx) -> dict:
+    """{"recorded_order": "known"} and the runs' order by start time when the runs carry distinct start times,
+    else {"recorded_order": "unknown"}."""
+    test = ctx.test
+    if test is None:
+        return {"recorded_order": "unknown"}
+    t0 = np.array([getattr(test.runs[r], "t0", 0.0) for r in ctx.runs], dtype=float)
+    if np.unique(t0).size < t0.size:
+        return {"recorded_order": "unknown"}
+    return {"recorded_order": "known"}
+
+
+# ----------------------------------------------------------------------------------------------- broadband hump
+#: A hump stands this far over the floor's smooth course (dB) at its peak, over at least HUMP_MIN_BINS bins
+#: (wider than a line's main lobe) and at most a quarter of the band.
+HUMP_PEAK_DB = 4.0
+HUMP_EDGE_DB = 2.0
+HUMP_MIN_BINS = 4
+#: The floor's smooth course: a running median over this fraction of the band's bins.
+HUMP_BASELINE_FRACTION = 0.125
+#: A bin is clear of the model's lines in a run where their predicted PSD is below this fraction of the floor.
+CLEAN_LINE_FRACTION = 0.01
+
+
+def _running_median(x: np.ndarray, half: int) -> np.ndarray:
+    """Running median of ``x`` (1-D) over ±``half`` points (shrinking at the ends)."""
+    from scipy.ndimage import median_filter
+
+    return median_filter(x, size=2 * half + 1, mode="nearest")
+
+
+def _humps(excess_db: np.ndarray, k_lo: int, k_hi: int) -> list:
+    """(k0, k1, peak bin) of every run of bins in [k_lo, k_hi] standing HUMP_EDGE_DB over the course and
+    HUMP_PEAK_DB at its peak, HUMP_MIN_BINS to a quarter of the band wide."""
+    above = excess_db >= HUMP_EDGE_DB
+    above[:k_lo] = False
+    above[k_hi + 1:] = False
+    out = []
+    k = k_lo
+    while k <= k_hi:
+        if not above[k]:
+            k += 1
+            continue
+        k1 = k
+        while k1 + 1 <= k_hi and above[k1 + 1]:
+            k1 += 1
+        width = k1 - k + 1
+        if HUMP_MIN_BINS <= width <= (k_hi - k_lo) // 4:
+            pk = k + int(np.argmax(excess_db[k:k1 + 1]))
+            if excess_db[pk] >= HUMP_PEAK_DB:
+                out.append((k, k1, pk))
+        k = k1 + 1
+    return out
+
+
+def clean_floor(ctx, state, c: str) -> np.ndarray:
+    """The data's own noise floor of channel ``c`` per bin (n_f,): the median over the runs of the data's PSD at the
+    bins where the model's lines stand below :data:`CLEAN_LINE_FRACTION` of its floor in that run (the noise alone,
+    clear of every line's leakage and of a misfit of it), NaN where fewer than a quarter of the runs (and 3) are."""
+    from .reduce import column_nanmedian
+
+    runs = ctx.runs
+    ok = np.isfinite(ctx.sp.psd[c][runs, 0])
+    runs = runs[ok]
+    D = ctx.data(state, c, runs)[runs]
+    N = ctx.floor_psd(state, c, runs)
+    clean = (ctx.predict(state, c, runs) - N) < CLEAN_LINE_FRACTION * N
+    count = clean.sum(0)
+    med = column_nanmedian(np.where(clean, D, np.nan))
+    return np.where(count >= max(3, runs.size // 4), med, np.nan)
+
+
+def broadband_hump(ctx, state, shares) -> list:
+    """A broadband hump: the data's own noise floor (:func:`clean_floor`, 3-bin means of its dB) standing over its
+    smooth course (a running median over an eighth of the band) by :data:`HUMP_PEAK_DB` at its peak, over a
+    frequency range wider than a line and narrower than a quarter of the band, in one channel or several (one
+    record, the channels listed).  The model takes such a hump as instrument noise (at every speed) or, growing with
+    speed as a power law, as the ``broadband_floor`` class (whose floor is not counted here: it is the data's
+    floor less the class's).  What it could be: a fixture or sensor resonance excited by the surroundings, a pump
+    or fan of the stand, the electronics' own noise shape."""
+    k_lo, k_hi = ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1)
+    found = {}
+    half = max(int(HUMP_BASELINE_FRACTION * (k_hi - k_lo) / 2), 3 * HUMP_MIN_BINS)
+    floors = {}
+    for c in ctx.channels:
+        fl = clean_floor(ctx, state, c)
+        if c in state.floors:                   # a floor the broadband_floor class holds is explained
+            ref, w_ref, p = state.floors[c]
+            fl = fl - ref * (np.median(ctx.omega[ctx.runs]) / w_ref) ** p
+        valid = np.isfinite(fl) & (fl > 0)
+        if valid[k_lo:k_hi + 1].sum() < 4 * HUMP_MIN_BINS:
+            continue
+        k = np.arange(fl.size)
+        lf = np.interp(k, k[valid], 10 * np.log10(fl[valid]))
+        lf = np.convolve(lf, np.ones(3) / 3.0, mode="same")
+        excess = np.where(valid, lf - _running_median(lf, half), -np.inf)
+        floors[c] = (fl, lf)
+        for k0, k1, pk in _humps(excess, k_lo, k_hi):
+            key = next((x for x in found if abs(x - pk) <= max(3, (k1 - k0) // 2)), pk)
+            found.setdefault(key, []).append((c, k0, k1, pk, float(excess[pk])))
+    out = []
+    for items in found.values():
+        chans = tuple(x[0] for x in items)
+        k0, k1 = min(x[1] for x in items), max(x[2] for x in items)
+        peak = max(items, key=lambda x: x[4])
+        f0, f1, fp = ctx.f[k0], ctx.f[k1], ctx.f[peak[3]]
+        if _at_a_fitted_resonance(ctx, state, fp, chans):
+            continue
+        share, level = shares(chans, f0, f1)
+        rpm = ctx.omega[ctx.runs] * RAD_S_TO_RPM
+        out.append(Unexplained(
+            signature="broadband_hump", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
+            f_Hz=(float(f0), float(f1)), level_dB=peak[4], share=share, n_runs=int(ctx.runs.size),
+            parameters={"peak_Hz": float(fp), "peak_over_floor_dB": peak[4], "over_the_model_dB": level,
+                        "half_power_width_Hz": float(_half_power_width(ctx, floors[peak[0]][1], peak[3])),
+                        "in_every_run": True},
+            causes=("a resonance of the fixture or the load cell excited by the surroundings (the floor, pumps, "
+                    "air) at every speed",
+                    "a pump, fan or compressor of the stand (broadband, at one frequency whatever the wheel does)",
+                    "the shape of the sensor or amplifier noise (a filter's peaking)"),
+            would_tell="a record with the wheel still (stand running, then stopped) shows a hump of the stand or its "
+                       "surroundings; one in the electronics stays with the cell unloaded; a tap test of the fixture "
+                       "finds a resonance there"))
+    return out
+
+
+#: A hump peaking within this many half-power half-widths (ζ·f_r) of a fitted fixed resonance (plus a band's width)
+#: is that resonance: a fixture's resonance lifts the noise passing through the stand as it lifts the lines.
+RESONANCE_HALF_WIDTHS = 3.0
+
+
+def _at_a_fitted_resonance(ctx, state, f_peak: float, chans) -> bool:
+    """True when a fixed resonance of ``state`` (the ``fixed_resonance`` class: a test stand's or a wheel mode's) on
+    one of ``chans`` peaks within :data:`RESONANCE_HALF_WIDTHS` ζ·f_r (and a band) of ``f_peak``: the hump is the
+    noise through that resonance, which the class names."""
+    from .constants import BAND_BINS
+
+    for f_r, zeta, _, on in state.resonances:
+        if set(on) & set(chans) and abs(f_peak - f_r) <= RESONANCE_HALF_WIDTHS * zeta * f_r + BAND_BINS * ctx.df:
+            return True
+    return False
+
+
+def _half_power_width(ctx, log_floor: np.ndarray, pk: int) -> float:
+    """Width (Hz) over which a floor (dB per bin) stays within 3 dB of its value at bin ``pk``."""
+    k0 = k1 = pk
+    while k0 > 0 and log_floor[k0 - 1] >= log_floor[pk] - 3.0:
+        k0 -= 1
+    while k1 + 1 < log_floor.size and log_floor[k1 + 1] >= log_floor[pk] - 3.0:
+        k1 += 1
+    return (k1 - k0 + 1) * ctx.df
+
+
+# ----------------------------------------------------------------------------------------------- moving resonance
+#: A direction's lines must be lifted this much (dB) in two runs at least for a resonance to be looked for (a
+#: resonance of peak gain 2 lifts the lines that cross it by 6 dB), and the lifted points (this much) bound its track.
+MOVING_PEAK_DB = 6.0
+MOVING_GATE_DB = 3.0
+#: The moving track must drop the misfit a fixed resonance leaves by this many times the misfit per degree of freedom
+#: (an F statistic of its one more parameter: 23 and 57 on the wheel family's moving resonances, at most 10 on its
+#: other cases), leave at most MOVING_RATIO of that misfit and MOVING_NULL_RATIO of the misfit without a resonance.
+MOVING_F = 15.0
+MOVING_RATIO = 0.8
+MOVING_NULL_RATIO = 0.5
+#: Grids: the track's slope (Hz per Hz of spin), damping ratios, peak gains.
+SLOPES = np.round(np.arange(-3.0, 3.0001, 0.1), 2)
+ZETAS = (0.01, 0.02, 0.04, 0.08)
+GAINS = (2.0, 3.5, 6.0, 10.0)
+
+
+def _resonance_db(f: np.ndarray, f_r: np.ndarray, zeta: float, gain: float) -> np.ndarray:
+    """20·log10 |H| of the simple resonance (:func:`rwadist.resonance.resonance_response`) at ``f`` over ``f_r``."""
+    from ..resonance import resonance_response
+
+    return 20 * np.log10(np.abs(resonance_response(f / f_r, zeta, gain)))
+
+
+def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray) -> tuple:
+    """(sse, f0, slope, zeta, gain) of the best track f_r = f0 + slope·(spin − spin_mid) over the grids, each line's
+    own offset (its C's misfit) taken out: the least squares of q on the resonance's dB gain per line."""
+    mid = 0.5 * (r.spin.min() + r.spin.max())
+    lines = np.unique(r.line)
+    onehot = (r.line[None, :] == lines[:, None]).astype(float)                       # (L, N)
+    count = onehot.sum(1)
+    best = (np.inf, np.nan, np.nan, np.nan, np.nan)
+    for b in slopes:
+        fr = f0s[:, None] + b * (r.spin[None, :] - mid)                               # (F, N)
+        valid = np.all(fr > 0, axis=1)
+        if not valid.any():
+            continue
+        fr = np.where(fr > 0, fr, 1.0)
+        for z in ZETAS:
+            for g in GAINS:
+                G = _resonance_db(r.f[None, :], fr, z, g)                             # (F, N)
+                res = r.q[None, :] - G
+                off = (res @ onehot.T) / count                                        # (F, L) per-line offsets
+                e = res - off @ onehot
+                sse = np.where(valid, np.sum(e * e, axis=1), np.inf)
+                i = int(np.argmin(sse))
+                if sse[i] < best[0]:
+                    best = (float(sse[i]), float(f0s[i]), float(b), z, g)
+    return best
+
+
+def _offsets_only(r: LineRatios) -> float:
+    """The misfit left with each line's own offset only (no resonance)."""
+    sse = 0.0
+    for ln in np.unique(r.line):
+        x = r.q[r.line == ln]
+        sse += float(np.sum((x - x.mean()) ** 2))
+    return sse
+
+
+def moving_resonance(ctx, state, ratios: list, shares) -> list:
+    """A resonance lifting the lines of one direction whose frequency moves with the speed.
+
+    Where the lines of a direction are lifted by :data:`MOVING_PEAK_DB` in two runs at least, their dB ratios are fitted with
+    a resonance on a track f_r = f0 + b·(spin − spin_mid) (spin the rotation frequency, Hz; each line's own offset
+    taken out), over grids of f0, the slope b, ζ and the peak gain (coarse, then fine around the best); the same
+    with b = 0 (a fixed resonance).  Described when the moving track's one more parameter pays (:data:`MOVING_F`),
+    it leaves at most :data:`MOVING_RATIO` of the misfit the fixed one leaves (and :data:`MOVING_NULL_RATIO` of the
+    misfit without any) and it moves by more than its own half-power width over the speeds.  The gyroscopic whirl explains a moving resonance only on the radial torques (the rocking mode: forward
+    whirl slope between 0 and I_zz/I_rr ≤ 2, backward falling): on a translation direction or faster than 2 Hz per
+    Hz of spin, no whirl does."""
+    modes = next((e for e in state.effects if getattr(e, "kind", "") == "suspension_modes"), None)
+    out = []
+    for r in ratios:
+        if r.q.size < 8 or np.unique(r.run[r.q >= MOVING_PEAK_DB]).size < 2 or np.unique(r.line).size < 2:
+            continue
+        lifted = r.f[r.q >= MOVING_GATE_DB]
+        f_lo, f_hi = 0.7 * lifted.min(), 1.3 * lifted.max()
+        coarse = np.exp(np.arange(np.log(f_lo), np.log(f_hi), 0.03))
+        sse0 = _offsets_only(r)
+        mov = _track_fit(r, coarse, SLOPES[::2])
+        fix = _track_fit(r, coarse, np.array([0.0]))
+        fine = lambda f0, b: (np.exp(np.arange(np.log(f0) - 0.04, np.log(f0) + 0.0401, 0.005)),   # noqa: E731
+                              np.round(np.arange(b - 0.2, b + 0.2001, 0.05), 3))
+        mov = min(mov, _track_fit(r, *fine(mov[1], mov[2])))
+        f0f, _ = fine(fix[1], 0.0)
+        fix = min(fix, _track_fit(r, f0f, np.array([0.0])))
+        sse_m, f0, b, zeta, gain = mov
+        span = r.spin.max() - r.spin.min()
+        # the moving track's one more parameter must pay: its drop of the misfit over the misfit per degree of freedom
+        dof = max(r.q.size - np.unique(r.line).size - 4, 1)
+        f_stat = (fix[0] - sse_m) / max(sse_m / dof, 1e-300)
+        if not (f_stat >= MOVING_F and sse_m <= MOVING_RATIO * fix[0] and sse_m <= MOVING_NULL_RATIO * sse0
+                and abs(b) * span > 2 * zeta * f0):
+            continue
+        mid = 0.5 * (r.spin.min() + r.spin.max())
+        f_low, f_high = f0 + b * (r.spin.min() - mid), f0 + b * (r.spin.max() - mid)
+        chans = tuple(c for c in DIRECTION_CHANNELS[r.direction] if c in ctx.channels)
+        whirl, explained = _whirl_note(r.direction, b, modes, r.spin.min(), r.spin.max(), f_low, f_high)
+        if explained:
+            continue
+        share, level = shares(chans, lambda spin: f0 + b * (spin - mid), zeta)
+        rpm = np.array([r.spin.min(), r.spin.max()]) * 60.0
+        sign = "stiffening" if b > 0 else "softening"
+        out.append(Unexplained(
+            signature="moving_resonance", channels=chans, speed_rpm=(float(rpm[0]), float(rpm[1])),
+            f_Hz=(float(min(f_low, f_high)), float(max(f_low, f_high))), level_dB=level, share=share,
+            n_runs=int(np.unique(r.run).size),
+            parameters={"direction": r.direction, "f_at_lowest_speed_Hz": float(f_low),
+                        "f_at_highest_speed_Hz": float(f_high), "slope_Hz_per_Hz_of_spin": float(b),
+                        "zeta": float(zeta), "peak_gain": float(gain), "fixed_resonance_misfit_ratio":
+                        float(sse_m / max(fix[0], 1e-300)), "f_statistic": float(f_stat), "whirl": whirl},
+            causes=(f"a mode of the rotor {sign} with speed (centrifugal {sign} of the disc or rim: an umbrella or "
+                    "diaphragm mode, or the bearings' preload changing with speed)",
+                    "a resonance of the motor's drive or speed loop whose frequency follows the speed"),
+            would_tell="a slow run-up recorded with its speed tracks the resonance continuously; a tap test of the "
+                       "rotor at rest gives its frequency at zero speed"))
+    return out
+
+
+def _whirl_note(direction: str, slope: float, modes, s_lo: float, s_hi: float, f_lo: float, f_hi: float) -> tuple:
+    """(words on what the gyroscopic whirl would do, True when the track is the fitted rocking whirl within 5 %)."""
+    if direction != "radial_torque":
+        return (f"no gyroscopic whirl moves a {direction.replace('_', ' ')} mode (the whirl splits the rocking mode "
+                "only)"), False
+    if abs(slope) > 2.0:
+        return "faster than any rigid rotor's whirl (at most I_zz/I_rr ≤ 2 Hz per Hz of spin)", False
+    if modes is None:
+        return "a rocking whirl with I_zz/I_rr ≈ %.2g could move so; no suspension modes were fitted" % abs(slope), False
+    a, f0 = modes.inertia_ratio, modes.f0_Hz["rocking"]
+    branch = lambda s, sgn: np.sqrt((0.5 * a * s) ** 2 + f0**2) + sgn * 0.5 * a * s   # noqa: E731
+    for sgn, name in ((1, "forward"), (-1, "backward")):
+        if abs(branch(s_lo, sgn) / f_lo - 1) < 0.05 and abs(branch(s_hi, sgn) / f_hi - 1) < 0.05:
+            return f"the fitted rocking {name} whirl", True
+    return (f"the fitted rocking whirl (I_zz/I_rr = {a:.3g}) runs {branch(s_lo, 1):.4g} -> {branch(s_hi, 1):.4g} Hz "
+            f"forward and {branch(s_lo, -1):.4g} -> {branch(s_hi, -1):.4g} Hz backward"), False
