@@ -424,6 +424,8 @@ def cmd_diagnose(args) -> int:
         print(f"  ? {u.text()}")
     print(f"unexplained fraction of the data's power (speed x frequency): {diag.error_before:.4g} -> "
           f"{diag.error_after:.4g} (definition: report.md)")
+    print(f"band-by-band misfit, every band alike (narrow lines count as on the waterfall): "
+          f"{diag.contrast_error_before:.4g} -> {diag.contrast_error_after:.4g}")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")
     return 0
 

@@ -21,3 +21,7 @@ METRIC = "waterfall_unexplained_fraction"
 SNR_KNEE = 10.0
 #: Noise standard deviations forgiven per band by the error metric.
 NOISE_Z = 2.0
+#: The second figure of merit, beside METRIC: every band of the waterfall weighs alike (docs/diagnose.md).
+CONTRAST_METRIC = "waterfall_band_contrast"
+#: Noise standard deviations forgiven per band by CONTRAST_METRIC: what a reviewer does not see as a feature.
+CONTRAST_NOISE_Z = 3.0

@@ -7,7 +7,7 @@ Two steps around the search (:func:`rwadist.diagnose.search.diagnose`):
 - :func:`start`, before it: lines at one fixed frequency in every run are found in the data and taken out of the
   records the search reads (:mod:`~rwadist.diagnose.fixed_lines`: left in, they were fitted as a test-stand
   resonance that spoilt the wheel's modes);
-- :func:`finish`, after it: the error metric measured on the data as given, and the
+- :func:`finish`, after it: the error metric (and the narrow-line metric) measured on the data as given, and the
   residual of the final model described by signature (the detectors of :mod:`~rwadist.diagnose.describe_lines` and
   :mod:`~rwadist.diagnose.describe_structure`), each description with its share of the misplaced power left.
 """
@@ -196,11 +196,12 @@ def describe_residual(searched: Residual, res: Residual | None = None) -> list:
 def _described(diag, opened: Opened, search_after: State) -> tuple:
     """(records, the residual on the data as given) of the search's final state ``search_after`` (on ``opened.ctx``):
     ``diag``'s context, final state (a copy on the data as given when those differ: its cached error terms were the
-    cleaned data's) and error after set to those of the data as given."""
+    cleaned data's), error after and narrow-line error after set to those of the data as given."""
     searched = Residual.of(opened.ctx, search_after) if opened.ctx is not opened.raw else None
     after = search_after.copy() if searched is not None else search_after
     diag.ctx, diag.state_after = opened.raw, after
     diag.error_after, diag.rms_error_after = opened.raw.error(after), opened.raw.rms_error(after)
+    diag.contrast_error_after = opened.raw.contrast_error(after)
     res = Residual.of(opened.raw, after)
     from .channel_copy import describe_channel_copies
 
@@ -269,12 +270,14 @@ def finish(diag, opened: Opened, rebuild=None):
     copies taken out before the search stay unexplained); its ``unexplained`` records (fixed lines and copies first,
     then what the final model's residual on the data the search read holds, :func:`describe_residual`); the effects
     the search fitted to that content taken back (:func:`forced_effects`: their hypotheses marked ``forced_by``, the
-    model made again by ``rebuild(state, hypotheses)``, the content described on the state without them)."""
+    model made again by ``rebuild(state, hypotheses)``, the content described on the state without them); the
+    narrow-line metric and the lines' candidate causes."""
     search_before, search_after = diag.state_before, diag.state_after
     if opened.ctx is not opened.raw:
         s0 = search_before.copy()
         diag.state_before = s0
         diag.error_before, diag.rms_error_before = opened.raw.error(s0), opened.raw.rms_error(s0)
+    diag.contrast_error_before = opened.raw.contrast_error(diag.state_before)
     found, res = _described(diag, opened, search_after)
     forced = forced_effects(diag, opened, search_before, search_after, found, res) if found and rebuild else []
     if forced:

@@ -6,7 +6,7 @@ import copy
 import numpy as np
 
 from ..units import CHANNEL_UNIT, RAD_S_TO_RPM
-from .constants import BAND_BINS, METRIC, NOISE_Z
+from .constants import BAND_BINS, CONTRAST_METRIC, METRIC, NOISE_Z
 from .search import Diagnosis
 
 
@@ -243,6 +243,8 @@ def write_report(diag: Diagnosis, out_dir) -> list:
           + (f" -> {diag.state_after.base} (through the wheel's suspension modes fitted from the data)"
              if diag.state_after.base != diag.state_before.base else ""),
           f"- error before: {diag.error_before:.4g}", f"- error after: {diag.error_after:.4g}",
+          f"- narrow-line error (`{CONTRAST_METRIC}`: {summary['narrow_line_metric_definition']}) before / after: "
+          f"{diag.contrast_error_before:.4g} / {diag.contrast_error_after:.4g}",
           f"- RMS-vs-speed relative error before / after: {diag.rms_error_before:.4g} / {diag.rms_error_after:.4g}",
           f"- iterations: {diag.iterations}", "", "## Effects added", ""]
     from ..effects_text import describe_effect

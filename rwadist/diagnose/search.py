@@ -13,7 +13,7 @@ from ..errors import ParameterError
 from ..model import WheelModel
 from ..spectra import Spectra
 from . import describe
-from .constants import BAND_BINS, METRIC, NOISE_Z
+from .constants import BAND_BINS, CONTRAST_METRIC, CONTRAST_NOISE_Z, METRIC, NOISE_Z
 from .effects import family_classes
 from .engine import Context, initial_state
 from .measure import in_unresolved_span
@@ -53,6 +53,9 @@ class Diagnosis:
     model_given: bool = False
     #: what the residual holds that no class explains (:class:`~rwadist.diagnose.unexplained.Unexplained` records)
     unexplained: tuple = ()
+    #: the narrow-line figure of merit (``waterfall_band_contrast``, :meth:`Context.contrast_error`) before and after
+    contrast_error_before: float = float("nan")
+    contrast_error_after: float = float("nan")
 
     @property
     def effects(self) -> list:
@@ -80,6 +83,13 @@ class Diagnosis:
             "metric_definition": "sum over channels, runs and %d-bin bands of |data - model| power / sum of "
                                  "data power (each channel divided by the mean power of its unit group)" % BAND_BINS,
             "error_before": self.error_before, "error_after": self.error_after,
+            "narrow_line_metric": CONTRAST_METRIC,
+            "narrow_line_metric_definition": "mean over every channel, run and %d-bin band of max(|data - model| - "
+                                             "%g sigma, 0) / max(data, model): every band weighs alike, so a narrow "
+                                             "line standing out of the noise counts as on the waterfall"
+                                             % (BAND_BINS, CONTRAST_NOISE_Z),
+            "narrow_line_error_before": self.contrast_error_before,
+            "narrow_line_error_after": self.contrast_error_after,
             "rms_relative_error_before": self.rms_error_before, "rms_relative_error_after": self.rms_error_after,
             "iterations": self.iterations,
             "effects": [effect_entry(h) for h in chosen],
