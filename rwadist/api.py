@@ -435,7 +435,7 @@ def _diagnose_model(model, preset: str | None, base: str):
 
 
 def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto", nperseg: int | None = None,
-             f_lim: float | None = None, k_sigma: float = 4.0, min_gain: float = 0.05):
+             f_lim: float | None = None, k_sigma: float = 4.0, min_gain: float = 0.05, bearings=None):
     """Find what a model leaves out of test data, name the effects, add those that pass a held-out test.
 
     Parameters
@@ -461,6 +461,10 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         Held-out gain needed, in noise standard errors, in (0, 100].
     min_gain : float
         Held-out gain needed, fraction of the unexplained power, in (0, 1).
+    bearings : sequence or None
+        The wheel's bearings (:class:`rwadist.bearings.Bearing`, or their descriptions as the model file's
+        ``wheel.bearings`` objects or ``--bearing`` texts): their cage, ball-pass and ball-spin ratios are named as
+        candidate causes of lines; None: those of the model's ``wheel`` section, if any.
 
     Returns
     -------
@@ -479,9 +483,15 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     for parameter, value in (("nperseg", nperseg), ("f_lim", f_lim), ("k_sigma", k_sigma), ("min_gain", min_gain)):
         check_parameter(parameter, value)
     model = _diagnose_model(model, preset, base)
+    if bearings is not None:
+        from .bearings import Bearing, parse_bearing
+
+        bearings = tuple(b if isinstance(b, Bearing) else parse_bearing(b, "diagnose", f"bearings[{i}]")
+                         for i, b in enumerate(bearings))
     test = _as_test(data)
     spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))
-    diagnosis = _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base)
+    diagnosis = _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base,
+                          bearings=bearings)
     reading = reading_provenance(getattr(test, "meta", None))
     if reading:
         diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(

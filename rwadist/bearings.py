@@ -32,6 +32,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from .errors import DataError
+
 #: Ranges of γ = (d/D)·cos α without geometry: d/D in [0.05, 0.30], α in [0°, 40°].
 GAMMA_RANGE = (0.05 * math.cos(math.radians(40.0)), 0.30)
 #: Ball counts a bearing's ball-pass relations are searched over.
@@ -49,12 +51,13 @@ RATIO_NAMES = {"FTF": "cage (FTF)", "BPFO": "ball pass, outer race (BPFO)", "BPF
                "BSF": "ball spin (BSF)", "2BSF": "ball flaw meeting both races (2·BSF)"}
 
 
-class BearingError(ValueError):
-    """A bearing description that is not one: ``source: field: problem``."""
+class BearingError(DataError):
+    """A bearing description that is not one: ``source: field: problem`` (a :class:`~rwadist.errors.DataError`: the
+    CLI says it and exits 2)."""
 
     def __init__(self, source: str, field: str, problem: str):
-        self.source, self.field, self.problem = str(source), field, problem
-        super().__init__(f"{source}: {field}: {problem}")
+        self.source, self.problem = str(source), problem
+        super().__init__(source, field, problem)
 
 
 @dataclass(frozen=True)

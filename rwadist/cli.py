@@ -372,6 +372,10 @@ def cmd_diagnose(args) -> int:
         raise DataError("diagnose", "--model/--preset", "give a model file or --preset, not both")
     check_output_dir(args.output)
     refuse_input_overwrite([("-o", args.output, "dir")], [args.data, args.model])
+    from .bearings import parse_bearing
+
+    bearings = None if not args.bearing else tuple(parse_bearing(b, "--bearing", f"bearing {i + 1}")
+                                                   for i, b in enumerate(args.bearing))
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
     # a starting model whose suspension modes are assumed (datasheet wheel) is hard-mounted unless
@@ -384,7 +388,7 @@ def cmd_diagnose(args) -> int:
     try:
         with working("rwadist diagnose: searching the residual for effects"):
             diag = api.diagnose(test, args.model, preset=args.preset, base=args.base, nperseg=args.nperseg,
-                                f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain)
+                                f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain, bearings=bearings)
     except ParameterError as exc:
         if exc.parameter != "base":
             raise
@@ -422,6 +426,9 @@ def cmd_diagnose(args) -> int:
             print(f"  - {h.effect.kind} taken back: the search fitted it to the {h.forced_by} described below")
     for u in diag.unexplained:
         print(f"  ? {u.text()}")
+    for lc in diag.line_causes:
+        more = f" (+{len(lc['causes']) - 1} more in report.md)" if len(lc["causes"]) > 1 else ""
+        print(f"  ~ {lc['direction']} h = {lc['h']:.4g}: could be {lc['causes'][0]}{more}")
     print(f"unexplained fraction of the data's power (speed x frequency): {diag.error_before:.4g} -> "
           f"{diag.error_after:.4g} (definition: report.md)")
     print(f"band-by-band misfit, every band alike (narrow lines count as on the waterfall): "

@@ -284,6 +284,11 @@ def build_parser(cli) -> argparse.ArgumentParser:
     dg.add_argument("--slice-samples", type=limited("slice_samples"), default=8192, help="sweep slice length, samples")
     dg.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
                     help="speed of sweep slices: tach column, estimated from data, or auto")
+    dg.add_argument("--bearing", action="append", default=None, metavar="KEY=VALUE,...",
+                    help="a bearing of the wheel, e.g. balls=9,ball_diameter_m=0.00794,pitch_diameter_m=0.03904"
+                         "[,contact_angle_deg=15][,name=front][,rotating_race=inner|outer]: its cage, ball-pass and "
+                         "ball-spin ratios are named as causes of lines (repeat for each bearing; replaces the model "
+                         "file's wheel.bearings)")
     dg.set_defaults(func=cli.cmd_diagnose)
 
     fm = sub.add_parser("fmu", help="FMI 2.0/3.0 co-simulation FMU of the extended model, SSP of an assembly "

@@ -142,10 +142,18 @@ def from_json(doc: dict, source: str = "<model>") -> WheelModel:
         if doc.get(key) is not None and not isinstance(doc[key], dict):
             raise err(source, key, f"must be an object, got {type(doc[key]).__name__}")
     for key, value in (doc.get("wheel") or {}).items():
+        if key == "bearings":
+            continue                    # the bearings' geometry, checked below
         # the wheel's physical numbers (mass_kg, radius_m, max_speed_rpm, ...) feed presets and FMUs
         if isinstance(value, bool) or (isinstance(value, (int, float)) and not (
                 math.isfinite(value) and value > 0)):
             raise err(source, f"wheel.{key}", f"{value!r}: must be a finite number > 0")
+    from .bearings import BearingError, bearings_of
+
+    try:
+        bearings_of(doc.get("wheel"), source)
+    except BearingError as exc:
+        raise err(source, exc.field, exc.problem) from None
     name = doc.get("name", "wheel")
     if not isinstance(name, str):
         raise err(source, "name", f"must be a string, got {name!r}")

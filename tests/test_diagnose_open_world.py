@@ -122,6 +122,47 @@ def test_summary_report_and_console_carry_the_descriptions(tmp_path, capsys):
     assert (out / "residual_waterfall.png").stat().st_size > 10_000
 
 
+def test_bearing_ratios_name_the_lines_within_the_resolution():
+    """The E wheel's radial line h = 4.42 is the outer-race ball pass of a 10-ball bearing with d/D = 0.116 (n/2·(1 −
+    d/D) = 4.42); named from that geometry, and from the ranges and the lines' relations without it."""
+    from rwadist.bearings import Bearing
+    from rwadist.diagnose.describe import line_causes
+    from rwadist.diagnose.describe_lines import ratio_resolution
+
+    _, _, d = diagnosed("clean")
+    b = Bearing(10, 0.116, 1.0, name="front")
+    got = {(x["direction"], round(x["h"], 2)): x for x in line_causes(d, [b])}
+    hit = got[("radial_force", 4.42)]
+    assert hit["source"] == "base" and any("BPFO" in c and "'front'" in c for c in hit["causes"])
+    res = ratio_resolution(d.ctx)
+    assert 0.001 < res < 0.05
+    # without geometry: 4.42 + 5.58 (radial torque) = 10, an outer/inner pair (cage 0.442, in the cage's range)
+    plain = line_causes(d)
+    assert any("10-ball" in c and "pair" in c for x in plain for c in x["causes"])
+    # an integer harmonic is never given a bearing cause
+    assert all(abs(x["h"] - round(x["h"])) > 2 * res for x in plain)
+
+
+def test_bearings_from_the_flag_and_the_model_file(tmp_path, capsys):
+    from rwadist import model as model_io
+    from rwadist.cli import main
+    from rwadist.data import write_steady
+    from rwadist.model import ModelFileError
+    from rwadist.presets import preset
+
+    doc = model_io.to_json(preset("ithaco-e").to_model())
+    doc["wheel"] = {**doc["wheel"], "bearings": [{"balls": 9, "ball_diameter_m": 0.05, "pitch_diameter_m": 0.04}]}
+    with pytest.raises(ModelFileError, match=r"wheel.bearings\[0\].ball_diameter_m"):
+        model_io.from_json(doc, "m.json")
+    doc["wheel"]["bearings"][0]["ball_diameter_m"] = 0.005
+    assert model_io.from_json(doc, "m.json").wheel["bearings"][0]["balls"] == 9
+    test, _, _ = diagnosed("clean")
+    data = write_steady(test, tmp_path / "data")
+    assert main(["diagnose", str(data), "-o", str(tmp_path / "r"), "--bearing", "balls=10,ball_diameter_m=0.1"]) == 2
+    assert "--bearing: bearing 1.pitch_diameter_m: missing" in capsys.readouterr().err
+    assert not (tmp_path / "r").exists()
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("kind,signature", [("pickup", "fixed_line"), ("crosstalk", "channel_copy")])
 def test_the_new_wheel_of_the_family_on_the_command_line(kind, signature, tmp_path):

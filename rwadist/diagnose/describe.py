@@ -136,7 +136,34 @@ def channel_copy_shares(res: Residual, copies) -> dict:
     return out
 
 
-def describe_residual(searched: Residual, res: Residual | None = None) -> list:
+def line_causes(diag, bearings=(), extra_h=()) -> list:
+    """Candidate physical causes (:func:`rwadist.bearings.line_causes`) of the improved model's lines whose ratio h is
+    not a whole number (within twice the resolution, :func:`ratio_resolution`): [{"direction", "h", "source",
+    "causes"}] for those with at least one; ``source`` is "effect" for a line a ``missing_harmonic`` added, "base"
+    for a line of a base fitted from the data, "model" for one of the given model.  ``extra_h``: ratios of lines
+    described but not in the model (the relations among lines read them too)."""
+    from ..bearings import line_causes as causes_of
+    from ..model import DIRECTIONS
+    from .describe_lines import ratio_resolution
+
+    res = ratio_resolution(diag.ctx)
+    added = {(getattr(h.effect, "direction", None), round(float(getattr(h.effect, "h", np.nan)), 3))
+             for h in diag.hypotheses if h.passed and not h.base_line}
+    fitted = not diag.model_given or diag.state_after.base != diag.state_before.base
+    lines = [(d, float(x.h)) for d in DIRECTIONS for x in diag.model.harmonics(d)]
+    every = sorted({h for _, h in lines} | {float(h) for h in extra_h})
+    out = []
+    for d, h in lines:
+        if abs(h - round(h)) <= 2 * res:
+            continue
+        got = causes_of(h, res, bearings, [o for o in every if abs(o - h) > res])
+        if got:
+            src = "effect" if (d, round(h, 3)) in added else ("base" if fitted else "model")
+            out.append({"direction": d, "h": h, "source": src, "causes": got})
+    return out
+
+
+def describe_residual(searched: Residual, bearings=(), res: Residual | None = None) -> list:
     """The records of the final model's residual on ``searched`` (the detectors of :mod:`.describe_structure` and
     :mod:`.describe_lines`), each with its share of the misplaced power and its level measured on ``res`` (default
     ``searched``: the same runs and bands)."""
@@ -189,11 +216,11 @@ def describe_residual(searched: Residual, res: Residual | None = None) -> list:
     out = broadband_hump(ctx, state, of_band)
     out += moving_resonance(ctx, state, ratios, of_track)
     out += run_change(ctx, ratios, of_runs)
-    out += speed_lines(ctx, state, of_line, others=others)
+    out += speed_lines(ctx, state, of_line, bearings, others)
     return out
 
 
-def _described(diag, opened: Opened, search_after: State) -> tuple:
+def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
     """(records, the residual on the data as given) of the search's final state ``search_after`` (on ``opened.ctx``):
     ``diag``'s context, final state (a copy on the data as given when those differ: its cached error terms were the
     cleaned data's), error after and narrow-line error after set to those of the data as given."""
@@ -208,7 +235,7 @@ def _described(diag, opened: Opened, search_after: State) -> tuple:
     found = describe_fixed_lines(opened.raw, opened.fixed, fixed_line_shares(res, opened.fixed))
     found += describe_channel_copies(opened.raw, opened.copies, channel_copy_shares(res, opened.copies))
     # the final model's residual on the data the search read (the fixed lines and copies out), shares on the data
-    found += describe_residual(searched or res, res)
+    found += describe_residual(searched or res, bearings, res)
     return found, res
 
 
@@ -264,7 +291,7 @@ def forced_effects(diag, opened: Opened, search_before: State, search_after: Sta
     return out
 
 
-def finish(diag, opened: Opened, rebuild=None):
+def finish(diag, opened: Opened, bearings=(), rebuild=None):
     """``diag`` (a :class:`~rwadist.diagnose.search.Diagnosis` of the search on ``opened.ctx``) measured on the data
     as given and described: its context, states and errors those of the data as given (where the fixed lines and
     copies taken out before the search stay unexplained); its ``unexplained`` records (fixed lines and copies first,
@@ -272,13 +299,14 @@ def finish(diag, opened: Opened, rebuild=None):
     the search fitted to that content taken back (:func:`forced_effects`: their hypotheses marked ``forced_by``, the
     model made again by ``rebuild(state, hypotheses)``, the content described on the state without them); the
     narrow-line metric and the lines' candidate causes."""
+    bearings = tuple(bearings or ())
     search_before, search_after = diag.state_before, diag.state_after
     if opened.ctx is not opened.raw:
         s0 = search_before.copy()
         diag.state_before = s0
         diag.error_before, diag.rms_error_before = opened.raw.error(s0), opened.raw.rms_error(s0)
     diag.contrast_error_before = opened.raw.contrast_error(diag.state_before)
-    found, res = _described(diag, opened, search_after)
+    found, res = _described(diag, opened, search_after, bearings)
     forced = forced_effects(diag, opened, search_before, search_after, found, res) if found and rebuild else []
     if forced:
         gone = {id(e): sig for e, sig in forced}
@@ -290,6 +318,8 @@ def finish(diag, opened: Opened, rebuild=None):
             if id(h.effect) in gone:
                 h.passed, h.forced_by = False, gone[id(h.effect)]
         diag.model = rebuild(state, diag.hypotheses)
-        found, res = _described(diag, opened, state)
+        found, res = _described(diag, opened, state, bearings)
     diag.unexplained = tuple(found)
+    diag.line_causes = line_causes(diag, bearings, [u.h for u in found if u.h is not None])
+    diag.bearings = bearings
     return diag

@@ -109,7 +109,7 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
                 causes=causes + ("a line of the wheel the classes could not fit (its strength erratic from run to "
                                  "run, or present over part of the speeds only)",),
                 would_tell="runs repeated at a few speeds (a steady line repeats; an intermittent one, e.g. a "
-                           "cage's instability or a rub, does not) and the bearings' geometry to name "
+                           "cage's instability or a rub, does not) and the bearings' geometry (--bearing) to name "
                            "the ratio"))
     return out
 

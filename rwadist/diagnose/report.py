@@ -195,6 +195,25 @@ def unexplained_section(diag: Diagnosis) -> list:
     return out
 
 
+def line_causes_section(diag: Diagnosis) -> list:
+    """report.md's lines on the candidate physical causes of the model's non-integer lines (bearing ratios: named
+    from the bearings' geometry within the resolution, else the ranges they can take)."""
+    if diag.bearings:
+        head = "Bearings given: " + "; ".join(
+            f"{b.label()}: {b.balls} balls, d {1000 * b.ball_diameter_m:.4g} mm, D {1000 * b.pitch_diameter_m:.4g} mm, "
+            f"contact {b.contact_angle_deg:g}°, {b.rotating_race} race turning (FTF {r['FTF']:.4g}, BPFO {r['BPFO']:.4g}, "
+            f"BPFI {r['BPFI']:.4g}, BSF {r['BSF']:.4g})" for b in diag.bearings for r in (b.ratios(),)) + "."
+    else:
+        head = ("No bearing geometry given (`--bearing` or the model file's `wheel.bearings`): the ranges bearing "
+                "ratios can take, and the relations among the lines, are named.")
+    if not diag.line_causes:
+        return [head, "", "No line of the model at a non-integer ratio has a candidate cause."]
+    out = [head, ""]
+    for lc in diag.line_causes:
+        out.append(f"- {lc['direction']} h = {lc['h']:.5g} ({lc['source']}): " + "; ".join(lc["causes"]))
+    return out
+
+
 def write_report(diag: Diagnosis, out_dir) -> list:
     """summary.json, model.json (the improved model), rms_vs_speed.csv/.png, residual_waterfall.png,
     hypotheses.csv and report.md into ``out_dir``; returns the paths."""
@@ -272,6 +291,7 @@ def write_report(diag: Diagnosis, out_dir) -> list:
         md += ["", "Taken back (the search fitted them to content described below as no class explains it):", ""]
         md += [f"- {describe_effect({'kind': h.effect.kind, **h.effect.params()})} (to the {h.forced_by})" for h in back]
     md += ["", "## Unexplained residual", ""] + unexplained_section(diag)
+    md += ["", "## Physical causes for lines", ""] + line_causes_section(diag)
     md += ["", "## Hypotheses (best five per iteration)", "", "see `hypotheses.csv`", "",
            "![residual](residual_waterfall.png)", "", "![rms](rms_vs_speed.png)", ""]
     p = out / "report.md"

@@ -3,7 +3,7 @@ held-out speeds, the best passing one refitted on every run and added (docs/diag
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import stats
@@ -56,6 +56,10 @@ class Diagnosis:
     #: the narrow-line figure of merit (``waterfall_band_contrast``, :meth:`Context.contrast_error`) before and after
     contrast_error_before: float = float("nan")
     contrast_error_after: float = float("nan")
+    #: candidate physical causes of the model's non-integer lines ([{"direction", "h", "source", "causes"}])
+    line_causes: list = field(default_factory=list)
+    #: the wheel's bearings those causes were named from (:class:`rwadist.bearings.Bearing`)
+    bearings: tuple = ()
 
     @property
     def effects(self) -> list:
@@ -97,6 +101,8 @@ class Diagnosis:
             "lines_missing_from_given_model": [{"direction": d, "h": h, "C": C, "sense": sense}
                                                for d, h, C, sense in self.lines_missing_from_given_model()],
             "unexplained": [u.to_json() for u in self.unexplained],
+            "line_causes": list(self.line_causes),
+            "bearings": [dict(vars(b)) for b in self.bearings],
             "hypotheses": [effect_entry(h) for h in self.hypotheses],
         }
 
@@ -261,7 +267,7 @@ def fits_modes_from_data(model: WheelModel | None, base: str = "empirical", test
 
 
 def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float = 4.0, min_gain: float = 0.05,
-             max_iterations: int = 8, channels=None, test=None, base: str = "empirical") -> Diagnosis:
+             max_iterations: int = 8, channels=None, test=None, base: str = "empirical", bearings=None) -> Diagnosis:
     """Greedy effect search on ``spectra`` starting from ``model`` (default: the empirical fit).
 
     k_sigma, min_gain : acceptance rule (docs/diagnose.md).  test : the SteadyTest ``spectra`` were
@@ -270,11 +276,17 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     the model's ``analytical`` section, :func:`rwadist.extended.steady_lines`) or 'auto' (extended when the
     model has an analytical section with modes not assumed and ``test`` does not record the modes off;
     otherwise empirical, and the search may move to the wheel's suspension modes fitted from the data); see
-    :func:`resolve_base` and :func:`fits_modes_from_data`.
+    :func:`resolve_base` and :func:`fits_modes_from_data`.  bearings : the wheel's bearings
+    (:class:`rwadist.bearings.Bearing`), candidate causes of the lines (docs/diagnose.md, "Physical causes for
+    lines"); None: those of the model's ``wheel`` section, if any.
     Returns a :class:`Diagnosis` whose ``model`` carries the added harmonics in ``empirical`` and every
     effect in ``effects``.
     """
     given = model is not None
+    if bearings is None:
+        from ..bearings import bearings_of
+
+        bearings = bearings_of(getattr(model, "wheel", None) if given else None)
     # the open world (docs/diagnose.md, "Unexplained residual"): lines at one fixed frequency in every run and a
     # channel's copy of another's content taken out of the records everything after reads, the empirical fit of a
     # model not given included (no class explains them; left in, a class is forced onto them), described after
@@ -353,7 +365,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
                      ctx.rms_error(state), hyps, it, ctx, model_given=given)
     # measured on the data as given, what the residual holds that no class explains described (and an effect the
     # search fitted to that content taken back: the model made again without it)
-    return describe.finish(diag, opened, rebuild=lambda st, hs: improved_model(model, st, hs))
+    return describe.finish(diag, opened, bearings, rebuild=lambda st, hs: improved_model(model, st, hs))
 
 
 def improved_model(model: WheelModel, state: State, hyps) -> WheelModel:
