@@ -21,16 +21,16 @@ taken as incoherent (powers add): RMS = sqrt(Σ |Y|²/2).  Each group is evaluat
 frequency (plant, wheel dynamic mass and blocked loads alike).
 
 Diagnosed effects that are not lines of the extended model (``rwadist diagnose``, read by
-:func:`wheel_spec_from_model`):
+:func:`wheel_spec_from_model` as their elements' actions, :mod:`rwadist.effects.actions`):
 
-* ``speed_ripple`` (:class:`rwadist.extended.Ripple`): the wheel speed is Ω0 + ΔΩ sin 2πf_r t; every line
+* a speed modulation (:class:`rwadist.extended.Ripple`): the wheel speed is Ω0 + ΔΩ sin 2πf_r t; every line
   becomes lines at its frequency + m·f_r with the complex coefficients of
   :func:`rwadist.extended.ripple_lines` (phase modulation of the rotor angle, amplitude modulation of
   a(|Ω|)), each evaluated through the wheel's modes and the coupled plant at its own frequency.  The
   coefficients act per line before the lines of one (h, offset) group are summed (they share the ripple);
   the groups are then (h, offset, m).  Neglected: the imbalance's tangential term and the ripple's
   modulation of the gyroscopic dynamics (see ripple_lines).
-* ``broadband_floor`` (:class:`Floor`): a blocked (hard-mounted) load PSD S_c(f, Ω) on channel c of the
+* a broadband floor (:class:`Floor`): a blocked (hard-mounted) load PSD S_c(f, Ω) on channel c of the
   wheel, incoherent with everything.  Its output PSD is Σ_wheels Σ_c |T_{y,c}(f)|² S_c(f, Ω·speed_scale),
   T the same interface equation with F_k = e_c (:func:`floor_responses`); its mean square adds to the
   lines' in :func:`jitter_vs_speed` and its PSD to :func:`output_psd`.
@@ -44,7 +44,7 @@ import numpy as np
 
 from rwadist import extended as ext
 from rwadist import schema
-from rwadist.effects.broadband_floor import BroadbandFloor
+from rwadist.effects.actions import NoiseFloor, of_effects
 from rwadist.schema import ModelError
 from rwadist.units import CHANNELS, RAD_S_TO_RPM
 
@@ -57,7 +57,7 @@ from .errors import CouplingError, SingularInterfaceError
 
 @dataclass(frozen=True, eq=False)
 class Floor:
-    """A broadband floor of one load channel of a wheel (a diagnosed ``broadband_floor``): the blocked
+    """A broadband floor of one load channel of a wheel (a diagnosed noise floor): the blocked
     load PSD S(f, Ω) = interp(f; f_hz, psd_ref; 0 outside)·(|Ω|/omega_ref)^exponent, one-sided, unit²/Hz.
 
     channel : 0..5 (Fx, Fy, Fz, Tx, Ty, Tz, wheel frame).  f_hz : knots, Hz (>= 0, increasing, >= 2).
@@ -106,16 +106,13 @@ class CouplingModelError(ModelError, CouplingError):
 
 
 def floors_from_effects(effects, source: str = "<model>") -> tuple:
-    """The :class:`Floor` s of a model file's ``effects`` list (dicts or typed effects): each
-    ``broadband_floor`` entry {"channel": name or list of names, "exponent", "omega_ref_rad_s",
-    "f_Hz": [...], "psd_ref": [...]} gives one Floor per channel (a channel named twice, one).  Read by
-    the schema (:func:`rwadist.schema.parse_effects`): :class:`CouplingModelError` naming
+    """The :class:`Floor` s of a model file's ``effects`` list (dicts or typed effects): one per broadband floor its
+    elements say the wheel has (:class:`rwadist.effects.actions.NoiseFloor`: one per channel an entry names, a channel
+    named twice once).  Read by the schema (:func:`rwadist.schema.parse_effects`): :class:`CouplingModelError` naming
     ``effects[i].<field>`` on a bad entry."""
-    out = []
-    for e in schema.of_kind(effects, BroadbandFloor, source, CouplingModelError):
-        for c in e.channel_indices:
-            out.append(Floor(c, e.f_Hz, e.psd_ref, float(e.omega_ref_rad_s), float(e.exponent)))
-    return tuple(out)
+    actions = of_effects(schema.parse_effects(effects, source, CouplingModelError))
+    return tuple(Floor(a.channel, a.f_hz, a.psd_ref, a.omega_ref, a.exponent) for a in actions
+                 if isinstance(a, NoiseFloor))
 
 
 # ----------------------------------------------------------------------------- wheels
@@ -186,10 +183,11 @@ def wheel_spec_from_model(model, mount=None, *, assumed_modes: bool = False, mas
                           radius_m: float | None = None, **kw) -> WheelSpec:
     """A WheelSpec from a :class:`rwadist.model.WheelModel` with an analytical section (a fitted
     model file or ``preset(...).to_model()``): lines via :func:`rwadist.extended.lines_from_model`,
-    with the diagnosed effects of ``model.effects`` applied (``rwadist diagnose``; amplitude laws,
-    wheel-mode resonances, sidebands: :func:`rwadist.extended.apply_line_effects`), its
-    ``broadband_floor`` entries as :attr:`WheelSpec.floors` (:func:`floors_from_effects`) and its
-    ``speed_ripple`` as :attr:`WheelSpec.ripple` (:func:`rwadist.extended.ripple_from_effects`).
+    with the diagnosed effects of ``model.effects`` applied as their elements' actions
+    (:mod:`rwadist.effects.actions`: amplitude laws, wheel-mode resonances, sidebands on the lines,
+    :func:`rwadist.extended.apply_line_effects`), its broadband floors as :attr:`WheelSpec.floors`
+    (:func:`floors_from_effects`) and its speed modulation as :attr:`WheelSpec.ripple`
+    (:func:`rwadist.extended.ripple_from_effects`).
     A bad entry raises :class:`CouplingModelError` (a CouplingError) naming ``effects[i].<field>``.
 
     A wheel whose suspension modes are assumed (``analytical.modes_assumed``: a catalogue datasheet wheel)

@@ -44,8 +44,9 @@ def _exec_module(name, path, package_dir=None):
 
 
 def _load_schema():
-    """The model-file schema with every effect element registered: the copies next to this file (inside an FMU),
-    else :mod:`rwadist.schema` and :mod:`rwadist.effects`.
+    """(schema, actions): the model-file schema with every effect element registered, and the elements' generic
+    actions (:mod:`rwadist.effects.actions`): the copies next to this file (inside an FMU), else
+    :mod:`rwadist.schema` and :mod:`rwadist.effects`.
 
     In an FMU the copies are loaded as the modules ``schema``, ``units`` and ``effects`` of a package named after
     this module (two FMUs load side by side), so the elements' ``from ..schema import ...`` reads this schema copy."""
@@ -53,7 +54,8 @@ def _load_schema():
     path = os.path.join(here, SCHEMA_FILE)
     if not os.path.isfile(path):
         from rwadist import effects, schema  # noqa: F401  (effects: imports every element)
-        return schema
+        from rwadist.effects import actions
+        return schema, actions
     pkg = f"{__name__}_reader"          # unique per FMU
     mod = sys.modules.get(f"{pkg}.schema")
     if mod is None:
@@ -63,10 +65,10 @@ def _load_schema():
         _exec_module(f"{pkg}.units", os.path.join(here, UNITS_FILE))
         folder = os.path.join(here, EFFECTS_DIR)
         _exec_module(f"{pkg}.effects", os.path.join(folder, "__init__.py"), folder)
-    return mod
+    return mod, sys.modules[f"{pkg}.effects.actions"]
 
 
-_schema = _load_schema()
+_schema, _actions = _load_schema()
 SCHEMA = _schema.SCHEMA
 SCHEMA_VERSION = _schema.SCHEMA_VERSION
 ANALYTICAL_KIND = _schema.ANALYTICAL_KIND
@@ -100,59 +102,51 @@ LAW_H_TOL = 1e-3
 
 
 def laws_from_doc(doc, source="<model>"):
-    """Diagnosed amplitude laws of a model document (``effects`` entries of kind
-    ``amplitude_law``, written by ``rwadist diagnose``): {(direction, h): (A_ref, Ω_ref, p)} with
-    the line's amplitude A_ref·(|Ω|/Ω_ref)^p (N or N·m, rad/s) in place of C·Ω².  Other effect
-    kinds are not time-domain forcing the FMU models and are ignored (missing harmonics are
-    already harmonics of ``empirical``).  The effects are read (all of them) by the schema."""
-    return {(e.direction, float(e.h)): e.law
-            for e in _schema.of_kind(doc.get("effects"), _schema.EFFECT_KINDS["amplitude_law"], source)}
+    """Diagnosed amplitude laws of a model document (the line laws its effects' elements give,
+    :mod:`rwadist.effects.actions`): {(direction, h): (A_ref, Ω_ref, p)} with the line's amplitude
+    A_ref·(|Ω|/Ω_ref)^p (N or N·m, rad/s) in place of C·Ω².  The effects are read (all of them) by the schema."""
+    return {(a.direction, a.h): a.law for a in _doc_actions(doc, source) if isinstance(a, _actions.LineLaw)}
+
+
+def _doc_actions(doc, source):
+    """The actions of a model document's effects (:func:`rwadist.effects.actions.of_effects`), validated."""
+    return _actions.of_effects(_schema.parse_effects(doc.get("effects"), source))
 
 
 def effects_from_doc(doc, source="<model>"):
     """All time-domain forcing effects of a model document (``rwadist diagnose``), validated by the
-    schema (:func:`rwadist.schema.parse_effects`), as keyword arguments of :class:`WheelRuntime`:
+    schema (:func:`rwadist.schema.parse_effects`), as the generic actions their elements give
+    (:mod:`rwadist.effects.actions`; a measurement artefact or a record gives none), as keyword arguments of
+    :class:`WheelRuntime`:
 
-    * ``laws``: :func:`laws_from_doc`;
-    * ``resonances``: [(directions, f_r Hz, ζ, peak_gain)] of each ``fixed_resonance`` of role
-      ``wheel_mode`` (an unmodelled wheel mode): every component of every line of those directions
-      is multiplied by H(ν/2π) = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r), r = ν/(2π f_r) signed, at
-      its instantaneous whirl rate ν = σ(hΩ + 2π f_offset) -- QUASI-STATIC (exact at constant speed,
-      no ringing of that resonance in transients).  Role ``test_stand`` (a fixture resonance) is a
-      measurement artefact: left out, as are ``cross_coupling`` (load-cell offset) entries;
-    * ``sidebands``: [(direction, h, f_mod Hz, depth m)]: the matching lines (|Δh| < LAW_H_TOL) are
-      amplitude modulated, a(1 + m·cos 2πf_mod t) = the carrier + two lines of amplitude m·a/2 whose
-      phases advance by ±2πf_mod·t (exact in the time domain).
-
-    * ``floors``: [(channel index, f knots Hz, psd_ref knots unit²/Hz, Ω_ref rad/s, p)] of each
-      ``broadband_floor`` (one entry per channel it names): a blocked-load PSD
-      S(f, Ω) = psd_ref(f)·(|Ω|/Ω_ref)^p (linear between knots, 0 outside), added to the wheel-frame
-      output as a random-phase multisine (see :class:`WheelRuntime`);
-    * ``ripples``: [(ΔΩ_ref rad/s, Ω_ref rad/s, q, f_r Hz)] of the ``speed_ripple`` (at most one): the wheel
+    * ``laws``: :func:`laws_from_doc` (line laws);
+    * ``resonances``: [(directions, f_r Hz, ζ, peak_gain)] of each line filter (an unmodelled wheel mode): every
+      component of every line of those directions is multiplied by H(ν/2π) = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r),
+      r = ν/(2π f_r) signed, at its instantaneous whirl rate ν = σ(hΩ + 2π f_offset) -- QUASI-STATIC (exact at
+      constant speed, no ringing of that resonance in transients);
+    * ``sidebands``: [(direction, h, f_mod Hz, depth m)] of each line modulation: the matching lines
+      (|Δh| < LAW_H_TOL) are amplitude modulated, a(1 + m·cos 2πf_mod t) = the carrier + two lines of amplitude
+      m·a/2 whose phases advance by ±2πf_mod·t (exact in the time domain);
+    * ``floors``: [(channel index, f knots Hz, psd_ref knots unit²/Hz, Ω_ref rad/s, p)] of each noise floor: a
+      blocked-load PSD S(f, Ω) = psd_ref(f)·(|Ω|/Ω_ref)^p (linear between knots, 0 outside), added to the
+      wheel-frame output as a random-phase multisine (see :class:`WheelRuntime`);
+    * ``ripples``: [(ΔΩ_ref rad/s, Ω_ref rad/s, q, f_r Hz)] of the speed modulation (at most one): the wheel
       turns at Ω(t) + ΔΩ_ref·(|Ω|/Ω_ref)^q·sin(2π f_r t + θ) (see :class:`WheelRuntime`).
 
     ModelError naming ``effects[i].<field>`` on a bad entry."""
-    effects = _schema.parse_effects(doc.get("effects"), source)
-    out = {"laws": laws_from_doc({"effects": effects}, source), "resonances": [], "sidebands": [], "floors": [],
-           "ripples": []}
-    for e in effects:
-        if isinstance(e, _schema.EFFECT_KINDS["fixed_resonance"]) and e.role == "wheel_mode":
-            out["resonances"].append((e.directions, *e.resonance))
-        elif isinstance(e, _schema.EFFECT_KINDS["sidebands"]):
-            out["sidebands"].append((e.direction, float(e.h), float(e.f_mod_Hz), float(e.depth)))
-        elif isinstance(e, _schema.EFFECT_KINDS["broadband_floor"]):
-            out["floors"].extend(_floor_from_entry(e))
-        elif isinstance(e, _schema.EFFECT_KINDS["speed_ripple"]):
-            out["ripples"].append((float(e.delta_omega_rad_s), float(e.omega_ref_rad_s), float(e.speed_exponent),
-                                   float(e.f_ripple_Hz)))
+    acts = _doc_actions(doc, source)
+    out = {"laws": {(a.direction, a.h): a.law for a in acts if isinstance(a, _actions.LineLaw)}, "resonances": [],
+           "sidebands": [], "floors": [], "ripples": []}
+    for a in acts:
+        if isinstance(a, _actions.LineFilter):
+            out["resonances"].append((a.directions, *a.resonance))
+        elif isinstance(a, _actions.LineModulation):
+            out["sidebands"].append((a.direction, a.h, a.f_mod_hz, a.depth))
+        elif isinstance(a, _actions.NoiseFloor):
+            out["floors"].append((a.channel, a.f_hz, a.psd_ref, a.omega_ref, a.exponent))
+        elif isinstance(a, _actions.SpeedModulation):
+            out["ripples"].append((a.delta_omega, a.omega_ref, a.exponent, a.f_hz))
     return out
-
-
-def _floor_from_entry(e):
-    """[(channel index, f knots, psd knots, Ω_ref, p)] of one (typed, validated) ``broadband_floor``; a
-    channel named twice has one floor (as the coupling kit reads it)."""
-    return [(c, np.array(e.f_Hz), np.array(e.psd_ref), float(e.omega_ref_rad_s), float(e.exponent))
-            for c in e.channel_indices]
 
 
 def load_model(path):

@@ -63,11 +63,7 @@ import numpy as np
 from . import extended as ext
 from . import schema
 from .data import DataError
-from .effects.amplitude_law import AmplitudeLaw
-from .effects.broadband_floor import BroadbandFloor
-from .effects.fixed_resonance import FixedResonance
-from .effects.sidebands import Sidebands
-from .effects.speed_ripple import SpeedRipple
+from .effects.actions import LineFilter, LineLaw, LineModulation, NoiseFloor, SpeedModulation, of_effects
 from .model import WheelModel
 from .resonance import resonance
 from .speed_laws import (  # noqa: F401
@@ -220,54 +216,45 @@ def _source_direction(src: WheelLines, i: int) -> str:
 
 
 def apply_effects(src: WheelLines, model: WheelModel) -> WheelLines:
-    """Attach a model file's diagnosed effects (``rwadist diagnose``) to its sources: an
-    ``amplitude_law`` rescales the matching harmonic (same direction, |Δh| < 1e-3), a
-    ``broadband_floor`` adds its floor to its channel, a ``fixed_resonance`` of role ``wheel_mode``
-    amplifies its directions' lines.  Missing harmonics are already harmonics; a ``test_stand``
-    resonance and a ``cross_coupling`` load-cell offset are measurement artefacts, not disturbance.
+    """Attach a model file's diagnosed effects (``rwadist diagnose``) to its sources, as the generic actions their
+    elements say they are (:mod:`rwadist.effects.actions`; an effect that is a measurement artefact or a record --
+    a test stand's resonance, a load-cell offset, a missing harmonic already among the harmonics -- has none):
 
-    Modulation effects, after those (so a carrier's amplitude law carries over to its sidebands):
-
-    * ``sidebands`` (depth m, f_mod_Hz): the matching sources get two copies of amplitude m/2 each, with
-      their own random phases (lines at different frequencies: no cross-spectrum with the carrier) and the
-      carrier's channel pattern (an amplitude-modulated rotating vector still rotates), at h|Ω|/2π ± f_mod
-      (:attr:`WheelLines.offsets`; a lower sideband below 0 Hz folds to |f|).  The added mean square m²/2
-      of the carrier's is exact (Parseval).
-    * ``speed_ripple`` (ΔΩ(|Ω|) = delta_omega_rad_s·(|Ω|/omega_ref)^q, f_ripple_Hz): the phase modulation
-      only moves each line's power to f_i + k·f_ripple (Σ_k J_k(β)² = 1), a redistribution over a few
-      f_ripple that a PSD over a speed law does not resolve: nothing is moved.  The amplitude modulation
-      of an empirical line C·Ω(t)² raises its mean square by the factor E_θ[(1 + ε sin θ)⁴] =
-      1 + 3ε² + 3ε⁴/8, ε = ΔΩ/|Ω|; that is added exactly, as two sources per line with amplitude laws
-      √3·C·ΔΩ·|Ω| (exponent 1 + q) and √(3/8)·C·ΔΩ² (exponent 2q).  Sources with an amplitude law or of
-      the extended model (not ∝ Ω²) get no amplitude term (it is O(ε²): 3·10⁻⁴ at ε = 1 %).
+    * a line law (an amplitude law) rescales the matching harmonic (same direction, |Δh| < 1e-3), a noise floor
+      adds its floor to its channel, a line filter (a wheel mode) amplifies its directions' lines;
+    * then (so a carrier's amplitude law carries over to its sidebands) a line modulation (depth m, f_mod): the
+      matching sources get two copies of amplitude m/2 each, with their own random phases (lines at different
+      frequencies: no cross-spectrum with the carrier) and the carrier's channel pattern (an amplitude-modulated
+      rotating vector still rotates), at h|Ω|/2π ± f_mod (:attr:`WheelLines.offsets`; a lower sideband below 0 Hz
+      folds to |f|).  The added mean square m²/2 of the carrier's is exact (Parseval);
+    * then a speed modulation (ΔΩ(|Ω|) = delta_omega·(|Ω|/omega_ref)^q at f): the phase modulation only moves each
+      line's power to f_i + k·f (Σ_k J_k(β)² = 1), a redistribution over a few f that a PSD over a speed law does not
+      resolve: nothing is moved.  The amplitude modulation of an empirical line C·Ω(t)² raises its mean square by the
+      factor E_θ[(1 + ε sin θ)⁴] = 1 + 3ε² + 3ε⁴/8, ε = ΔΩ/|Ω|; that is added exactly, as two sources per line with
+      amplitude laws √3·C·ΔΩ·|Ω| (exponent 1 + q) and √(3/8)·C·ΔΩ² (exponent 2q).  Sources with an amplitude law or
+      of the extended model (not ∝ Ω²) get no amplitude term (it is O(ε²): 3·10⁻⁴ at ε = 1 %).
 
     The effects are read by the schema (:func:`rwadist.schema.parse_effects`; typed already when the
     model came from a file): :class:`rwadist.schema.ModelError` naming ``effects[i].<field>`` on a bad
     entry, as every other consumer."""
-    later = []
-    for e in schema.parse_effects(model.effects):
-        if isinstance(e, AmplitudeLaw):
-            for i in range(len(src)):
-                if _source_direction(src, i) == e.direction and abs(src.h[i] - float(e.h)) < 1e-3:
-                    src.laws[i] = e.law
-        elif isinstance(e, BroadbandFloor):
-            for c in e.channel_indices:
-                src.floors.append((c, np.array(e.f_Hz), np.array(e.psd_ref), float(e.omega_ref_rad_s),
-                                   float(e.exponent)))
-        elif isinstance(e, FixedResonance) and e.role == "wheel_mode":
-            src.resonances.append((list(e.directions), *e.resonance))
-        elif isinstance(e, (Sidebands, SpeedRipple)):
-            later.append(e)
-    for e in sorted(later, key=lambda x: not isinstance(x, Sidebands)):
+    for a in of_effects(schema.parse_effects(model.effects)):
         n0 = len(src)
-        if isinstance(e, Sidebands):
-            m, f_m = float(e.depth), float(e.f_mod_Hz)
+        if isinstance(a, LineLaw):
+            for i in range(len(src)):
+                if _source_direction(src, i) == a.direction and abs(src.h[i] - a.h) < 1e-3:
+                    src.laws[i] = a.law
+        elif isinstance(a, NoiseFloor):
+            src.floors.append((a.channel, a.f_hz, a.psd_ref, a.omega_ref, a.exponent))
+        elif isinstance(a, LineFilter):
+            src.resonances.append((list(a.directions), *a.resonance))
+        elif isinstance(a, LineModulation):
+            m, f_m = a.depth, a.f_mod_hz
             for i in range(n0):
-                if _source_direction(src, i) == e.direction and abs(src.h[i] - float(e.h)) < 1e-3:
+                if _source_direction(src, i) == a.direction and abs(src.h[i] - a.h) < 1e-3:
                     for sgn in (1.0, -1.0):
                         _copy_source(src, i, f"{src.labels[i]} sideband {sgn * f_m:+g} Hz", 0.5 * m, f_off=sgn * f_m)
-        elif src.kind == "empirical":
-            dw, w_ref, q = float(e.delta_omega_rad_s), float(e.omega_ref_rad_s), float(e.speed_exponent)
+        elif isinstance(a, SpeedModulation) and src.kind == "empirical":
+            dw, w_ref, q = a.delta_omega, a.omega_ref, a.exponent
             for i in range(n0):
                 if i in src.laws:
                     continue

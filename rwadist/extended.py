@@ -74,9 +74,7 @@ import numpy as np
 from scipy import optimize
 
 from . import schema
-from .effects.amplitude_law import AmplitudeLaw
-from .effects.fixed_resonance import FixedResonance
-from .effects.sidebands import Sidebands
+from .effects.actions import LineFilter, LineLaw, LineModulation, of_effects
 from .resonance import resonance_gain
 from .units import G_CM2_TO_KG_M2, G_CM_TO_KG_M, RAD_S_TO_RPM
 
@@ -347,32 +345,32 @@ LAW_H_TOL = 1e-3
 
 
 def line_effects(effects, source: str = "<model>") -> dict:
-    """The time-domain forcing effects of a model file's ``effects`` list (``rwadist diagnose``; dicts
-    or typed :class:`rwadist.schema.Effect` s), validated by the schema (:func:`rwadist.schema.parse_effects`):
+    """The line actions of a model file's ``effects`` list (``rwadist diagnose``; dicts or typed
+    :class:`rwadist.schema.Effect` s), validated by the schema (:func:`rwadist.schema.parse_effects`), as their
+    elements say they act on the wheel's lines (:mod:`rwadist.effects.actions`):
     {'laws': [(direction, h, (A_ref, Ω_ref, p))], 'resonances': [(directions, (f_r, ζ, g))],
-    'sidebands': [(direction, h, f_mod Hz, depth)]} in file order.  A ``fixed_resonance`` of role
-    ``test_stand`` (a fixture resonance) and a ``cross_coupling`` (load-cell offset) are measurement
-    artefacts and are left out; ``missing_harmonic`` is already a harmonic; ``broadband_floor`` and
-    ``speed_ripple`` are not line forcing.  :class:`rwadist.schema.ModelError` (a ValueError) naming
-    ``effects[i].<field>`` on a bad entry."""
+    'sidebands': [(direction, h, f_mod Hz, depth)]} in file order.  Effects that are measurement artefacts (a test
+    stand's resonance, a load-cell offset) or records (a missing harmonic is already a harmonic) have no line action;
+    broadband floors and a speed modulation are not line forcing.  :class:`rwadist.schema.ModelError` (a ValueError)
+    naming ``effects[i].<field>`` on a bad entry."""
     out: dict = {"laws": [], "resonances": [], "sidebands": []}
-    for e in schema.parse_effects(effects, source):
-        if isinstance(e, AmplitudeLaw):
-            out["laws"].append((e.direction, float(e.h), e.law))
-        elif isinstance(e, FixedResonance) and e.role == "wheel_mode":
-            out["resonances"].append((e.directions, e.resonance))
-        elif isinstance(e, Sidebands):
-            out["sidebands"].append((e.direction, float(e.h), float(e.f_mod_Hz), float(e.depth)))
+    for a in of_effects(schema.parse_effects(effects, source)):
+        if isinstance(a, LineLaw):
+            out["laws"].append((a.direction, a.h, a.law))
+        elif isinstance(a, LineFilter):
+            out["resonances"].append((a.directions, a.resonance))
+        elif isinstance(a, LineModulation):
+            out["sidebands"].append((a.direction, a.h, a.f_mod_hz, a.depth))
     return out
 
 
 def apply_line_effects(lines, effects) -> list:
     """``lines`` with the forcing effects of :func:`line_effects` (a model file's ``effects`` list):
 
-    1. ``amplitude_law`` -> :attr:`Line.law` of the lines of its direction with |Δh| < LAW_H_TOL;
-    2. ``fixed_resonance`` (role ``wheel_mode``) -> appended to :attr:`Line.resonances` of every line of
+    1. a line law (an amplitude law) -> :attr:`Line.law` of the lines of its direction with |Δh| < LAW_H_TOL;
+    2. a line filter (a wheel mode's resonance) -> appended to :attr:`Line.resonances` of every line of
        its directions (quasi-static gain, see :class:`Line`);
-    3. ``sidebands`` -> for each matching line (as 1; carriers only, in line order) two copies appended
+    3. a line modulation (sidebands) -> for each matching line (as 1; carriers only, in line order) two copies appended
        after all lines, f_offset = +f_mod then −f_mod, C and A_ref times depth/2, everything else (phase,
        sense, imbalance with its tangential term, resonances) the carrier's.  The FMU runtime builds the
        same list in the same order (its random phases are drawn over it)."""

@@ -1,4 +1,4 @@
-"""The extended model's periodic wheel-speed ripple (a diagnosed ``speed_ripple``): its Bessel-type
+"""The extended model's periodic wheel-speed ripple (a diagnosed speed modulation): its Bessel-type
 sideband coefficients and its lines through the rotor's modes.  Part of the extended model
 (:mod:`rwadist.extended`, which re-exports these names); physics and conventions there."""
 from __future__ import annotations
@@ -9,13 +9,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import schema
-from .effects.speed_ripple import SpeedRipple
+from .effects.actions import SpeedModulation, of_effects
 from .extended import ExtendedParams, Line, _add_to_channels, _omega_array, transmissibility
 
 
 @dataclass(frozen=True)
 class Ripple:
-    """A periodic wheel-speed ripple (a diagnosed ``speed_ripple``): Ω(t) = Ω0 + ΔΩ·sin(2π f_r t) with
+    """A periodic wheel-speed ripple (a diagnosed speed modulation, :class:`rwadist.effects.actions.SpeedModulation`):
+    Ω(t) = Ω0 + ΔΩ·sin(2π f_r t) with
     ΔΩ(Ω0) = delta_omega·(|Ω0|/omega_ref)^exponent.
 
     f_hz : ripple frequency f_r, Hz (> 0).  delta_omega : ΔΩ at omega_ref, rad/s (>= 0).  omega_ref : rad/s
@@ -41,14 +42,13 @@ class Ripple:
 
 
 def ripple_from_effects(effects, source: str = "<model>"):
-    """The :class:`Ripple` of a model file's ``effects`` list (its ``speed_ripple`` entry: f_ripple_Hz,
-    delta_omega_rad_s, omega_ref_rad_s, speed_exponent (default 0)), or None.  Read by the schema
+    """The :class:`Ripple` of a model file's ``effects`` list: the speed modulation its elements say the wheel has
+    (:class:`rwadist.effects.actions.SpeedModulation`, at most one per wheel), or None.  Read by the schema
     (:func:`rwadist.schema.parse_effects`): :class:`rwadist.schema.ModelError` (a ValueError) naming
-    ``effects[i].<field>`` on a bad entry, and on a second ``speed_ripple`` (one per wheel)."""
-    for e in schema.parse_effects(effects, source):
-        if isinstance(e, SpeedRipple):
-            return Ripple(float(e.f_ripple_Hz), float(e.delta_omega_rad_s), float(e.omega_ref_rad_s),
-                          float(e.speed_exponent))
+    ``effects[i].<field>`` on a bad entry, and on a second one."""
+    for a in of_effects(schema.parse_effects(effects, source)):
+        if isinstance(a, SpeedModulation):
+            return Ripple(a.f_hz, a.delta_omega, a.omega_ref, a.exponent)
     return None
 
 

@@ -8,6 +8,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..schema import DIRECTIONS, NON_NEGATIVE, POSITIVE, STDERR, check, choice, register
+from .actions import LineLaw
 from .element import Element, num, plus_minus, rpm, words
 
 
@@ -33,6 +34,9 @@ class AmplitudeLaw(Element):
     #: unit of the amplitude of a line of each direction
     AMPLITUDE_UNIT: ClassVar[dict] = {"radial_force": "N", "axial_force": "N", "radial_torque": "N·m",
                                       "axial_torque": "N·m"}
+
+    def actions(self) -> tuple:
+        return (LineLaw(self.direction, float(self.h), self.law),)
 
     @classmethod
     def describe(cls, e: Mapping) -> str:

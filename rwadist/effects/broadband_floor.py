@@ -9,6 +9,7 @@ import numpy as np
 
 from ..schema import CHANNELS, NON_NEGATIVE, POSITIVE, check, names, numbers, register
 from ..units import CHANNEL_UNIT
+from .actions import NoiseFloor
 from .element import Element, num, rpm
 
 
@@ -34,6 +35,11 @@ class BroadbandFloor(Element):
     @property
     def channel_indices(self) -> tuple:
         return tuple(CHANNELS.index(c) for c in self.channel)
+
+    def actions(self) -> tuple:
+        """One floor per channel it names (a channel named twice has one)."""
+        return tuple(NoiseFloor(c, np.array(self.f_Hz), np.array(self.psd_ref), float(self.omega_ref_rad_s),
+                                float(self.exponent)) for c in self.channel_indices)
 
     @classmethod
     def describe(cls, e: Mapping) -> str:

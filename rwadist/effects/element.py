@@ -5,6 +5,7 @@ derives from :class:`Element`, which adds the hooks the kit's consumers call, ea
 registered as a bare :class:`~rwadist.schema.Effect` is read, written and shown, and acts on nothing):
 
 - :meth:`Element.describe`: its one line of words and numbers for the console;
+- :meth:`Element.actions`: what it does to the wheel's loads, as generic actions (:mod:`rwadist.effects.actions`);
 - the ``INJECT`` table and the ``inject_*`` hooks: its injection into the virtual test stand, called by
   :mod:`rwadist.inject` with a :class:`rwadist.inject.Stand` (the stand's services: its wheel, random numbers, adding
   a line to a run, a wheel load through the rotor's modes, low-passed noise).
@@ -39,6 +40,12 @@ class Element(Effect):
         None: the generic line of its scalar fields.  KeyError, TypeError or ValueError (fields of another version)
         also give the generic line."""
         return None
+
+    # ------------------------------------------------------------------ what it does to the wheel's loads
+    def actions(self) -> tuple:
+        """What this effect does to the loads the wheel exerts, as generic actions (:mod:`rwadist.effects.actions`)
+        every consumer of a model applies; none by default (a measurement artefact, a record of the search)."""
+        return ()
 
     # ------------------------------------------------------------------ injection into the virtual stand
     #: ``--inject KIND:PARAM=VALUE,...`` parameters {name: default} (None: an optional parameter without default);

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 from ..schema import COUNT, DIRECTIONS, POSITIVE, check, choice, names, register
+from .actions import LineFilter
 from .element import Element, directions, num
 
 
@@ -28,6 +29,10 @@ class FixedResonance(Element):
     def resonance(self) -> tuple:
         """(f_r Hz, ζ, peak gain)."""
         return (float(self.f_Hz), float(self.zeta), float(self.peak_gain))
+
+    def actions(self) -> tuple:
+        """A wheel mode filters the lines of its directions; a test stand's resonance is a measurement artefact."""
+        return (LineFilter(tuple(self.directions), *self.resonance),) if self.role == "wheel_mode" else ()
 
     @classmethod
     def describe(cls, e: Mapping) -> str:

@@ -8,6 +8,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..schema import COUNT, DIRECTIONS, NON_NEGATIVE, POSITIVE, check, choice, register
+from .actions import LineModulation
 from .element import Element, num, words
 
 
@@ -23,6 +24,9 @@ class Sidebands(Element):
     f_mod_Hz: float = field(metadata=check(POSITIVE))
     depth: float = field(metadata=check(NON_NEGATIVE))
     n_points: int | None = field(default=None, metadata=check(COUNT))
+
+    def actions(self) -> tuple:
+        return (LineModulation(self.direction, float(self.h), float(self.f_mod_Hz), float(self.depth)),)
 
     @classmethod
     def describe(cls, e: Mapping) -> str:

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..schema import COUNT, NON_NEGATIVE, POSITIVE, check, optional, register
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
+from .actions import SpeedModulation
 from .element import Element, num, rpm
 
 
@@ -25,6 +26,10 @@ class SpeedRipple(Element):
     omega_ref_rad_s: float = field(metadata=check(POSITIVE))
     speed_exponent: float = field(default=0.0, metadata=check(optional(NON_NEGATIVE, 0.0)))
     n_points: int | None = field(default=None, metadata=check(COUNT))
+
+    def actions(self) -> tuple:
+        return (SpeedModulation(float(self.f_ripple_Hz), float(self.delta_omega_rad_s), float(self.omega_ref_rad_s),
+                                float(self.speed_exponent)),)
 
     @classmethod
     def describe(cls, e: Mapping) -> str:
