@@ -155,6 +155,22 @@ def model_document(model) -> dict:
     return doc
 
 
+def _check_shipped(doc, source: str = "<model>") -> None:
+    """ModelError unless every effect of ``doc`` is of a kind the FMU's shipped elements read (rwadist/effects/): a
+    kind registered elsewhere (a user's own module) would be read as unknown inside the FMU, and its actions
+    silently left out."""
+    from rwadist import effects, schema
+
+    shipped = {f"{effects.__name__}.{p.stem}" for p in effects.shipped_files()}
+    for i, e in enumerate(schema.parse_effects(doc.get("effects"), source)):
+        module = type(e).__module__
+        if not isinstance(e, schema.UnknownEffect) and module not in shipped:
+            raise _runtime().ModelError(source, f"effects[{i}].kind", f"{e.kind!r} is registered by {module}, which "
+                                        "the pythonfmu FMU does not ship (it reads the model file with rwadist's own "
+                                        "elements); build the native FMU (rwadist fmu build --native), which compiles "
+                                        "the kind's actions in")
+
+
 def _render(src: str, cls: str, physics: str, modes_default: bool) -> str:
     """The slave template for one build: class renamed, physics and ``modes`` start value set."""
     for name, value in (("BUILD_PHYSICS", physics), ("BUILD_MODES_DEFAULT", modes_default)):
@@ -190,6 +206,7 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
     from pythonfmu import FmuBuilder
 
     doc = model_document(model)
+    _check_shipped(doc)
     tag = tag or uuid.uuid4().hex[:12]
     if not tag.isidentifier() and not ("x" + tag).isidentifier():
         raise ValueError(f"tag {tag!r} must be alphanumeric")

@@ -78,11 +78,10 @@ VARIABLES = [
      "suspension modes on (off: internal loads reach the interface directly)"),
     ("start_steady", "Boolean", _PAR, _FIX, "false", None,
      "start from the steady state at the first speed instead of rest"),
-    ("speed_ripple", "Boolean", _PAR, _FIX, "true", None,
-     "diagnosed wheel-speed ripple (model file effects) added to wheel_speed; off when wheel_speed is a measured "
-     "speed that already carries it"),
-    ("broadband_floor", "Boolean", _PAR, _FIX, "true", None,
-     "diagnosed broadband floors (model file effects) added to the outputs as random-phase multisines"),
+] + [
+    # the effect switches: their elements name and describe them (rwadist.effects, runtime.fmu_switches)
+    (name, "Boolean", _PAR, _FIX, "true", None, description) for name, description in rt.fmu_switches()
+] + [
     ("floor_resolution", "Real", _PAR, _FIX, "0.1", "Hz",
      "frequency spacing of the broadband-floor multisine (it repeats after 1/floor_resolution s)"),
     ("max_acceleration", "Real", _PAR, _FIX, "500", "rad/s2",
@@ -129,7 +128,7 @@ def model_header(doc, guid: str, physics: str, modes_default: bool) -> str:
            "#ifndef RWADIST_WHEEL_MODEL_H", "#define RWADIST_WHEEL_MODEL_H",
            "typedef struct { int dir; double h, C; int sense, imbalance, has_law; double a_ref, w_ref, p, f_off; } RwLine;",
            "typedef struct { unsigned dirmask; double f_hz, zeta, g; } RwRes;",
-           "typedef struct { int channel, at, n; double w_ref, p; } RwFloor;",
+           "typedef struct { int channel, at, n, sw; double w_ref, p; } RwFloor;",
            f"#define RW_GUID {_c_string(guid)}", f"#define RW_PHYSICS {_c_string(physics)}",
            f"#define RW_SUSPENSION {int(susp)}", f"#define RW_MODES_ASSUMED {int(bool(params['modes_assumed']))}",
            f"#define RW_MODES_DEFAULT {int(modes_default)}",
@@ -152,13 +151,22 @@ def model_header(doc, guid: str, physics: str, modes_default: bool) -> str:
         mask = sum(1 << rt.DIRECTIONS.index(d) for d in set(dirs))
         out.append(f"    {{{mask}u, {_f(f_r)}, {_f(z)}, {_f(g)}}},")
     out += (["    {0}"] if not res else []) + ["};"]
+    # the effect switches (value references RW_VR_SWITCH + slot) and the slot that turns each ripple and floor off
+    switches = [name for name, _ in rt.fmu_switches()]
+    slot = {name: i for i, name in enumerate(switches)}
+    slot[None] = -1                     # an element without a switch: always on
+    out += [f"#define RW_N_SWITCHES {len(switches)}",
+            "static const char *const RW_SWITCH_NAMES[" + str(max(1, len(switches))) + "] = {"
+            + (", ".join(_c_string(n) for n in switches) or "0") + "};"]
     rip = eff["ripples"]
     out += [f"#define RW_N_RIPPLES {len(rip)}", f"#define RW_N_RIPPLES_ALLOC {max(1, len(rip))}",
             "static const double RW_RIPPLES[RW_N_RIPPLES_ALLOC][4] = {"]
     out += ["    {" + ", ".join(_f(v) for v in r) + "}," for r in rip] + (["    {0}"] if not rip else []) + ["};"]
+    out += ["static const int RW_RIPPLE_SWITCH[RW_N_RIPPLES_ALLOC] = {"
+            + (", ".join(str(slot[s]) for s in eff["switch_of"]["ripples"]) or "0") + "};"]
     floors, f_knots, p_knots = [], [], []
-    for ch, f_k, psd_k, w_ref, p in eff["floors"]:
-        floors.append(f"    {{{ch}, {len(f_knots)}, {len(f_k)}, {_f(w_ref)}, {_f(p)}}},")
+    for (ch, f_k, psd_k, w_ref, p), sw in zip(eff["floors"], eff["switch_of"]["floors"]):
+        floors.append(f"    {{{ch}, {len(f_knots)}, {len(f_k)}, {slot[sw]}, {_f(w_ref)}, {_f(p)}}},")
         f_knots += list(f_k)
         p_knots += list(psd_k)
     out += [f"#define RW_N_FLOORS {len(floors)}", "static const RwFloor RW_FLOORS[" + str(max(1, len(floors))) + "] = {"]

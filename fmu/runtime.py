@@ -95,6 +95,8 @@ physics_of = _model.physics_of
 components = _model.components
 rotation_check = _model.rotation_check
 expand_lines = _model.expand_lines
+fmu_switches = _model.fmu_switches
+SWITCH_SLOTS = _model.SWITCH_SLOTS
 quad_roots = _math.quad_roots
 to_spacecraft = _math.to_spacecraft
 frame12 = _math.frame12
@@ -118,6 +120,17 @@ RIPPLE_STEPS_PER_PERIOD = 20
 
 
 
+def _switched(items, switch_of, key, off):
+    """(items kept, the switches of those kept): ``items`` (ripples or floors of :func:`effects_from_doc`) without
+    those whose FMU switch (``switch_of[key]``) is in ``off``."""
+    items = list(items or [])
+    names = list((switch_of or {}).get(key) or [None] * len(items))
+    if off and items and switch_of is None:
+        raise ModelError(f"effect switches {sorted(off)} off, but the {key} carry no switch_of (effects_from_doc)")
+    kept = [(x, n) for x, n in zip(items, names) if n not in off]
+    return [x for x, _ in kept], list(dict.fromkeys(n for _, n in kept if n is not None))
+
+
 class WheelRuntime:
     """The extended wheel model as a stepping state machine.
 
@@ -138,7 +151,8 @@ class WheelRuntime:
     order of ``rwadist.extended.apply_line_effects``) and the seed's phases are drawn over that
     whole list; they follow their carrier's imbalance/harmonics switch.
 
-    ripples : diagnosed speed ripples (:func:`effects_from_doc`), used when ``speed_ripple``: the rotor
+    ripples : diagnosed speed ripples (:func:`effects_from_doc`), each unless the FMU switch of its element is off
+    (``switch_of``, ``**switches``: :func:`fmu_switches`, e.g. a speed ripple's): the rotor
     turns at the input speed plus r(t) = Σ ΔΩ_ref·(|Ω(t)|/Ω_ref)^q·sin(2π f_r t + θ) (t since t0; θ = 0
     without a seed, else uniform from ``default_rng((seed, 1))``).  Each step runs from Ω_n + r(t_n) to
     Ω_{n+1} + r(t_{n+1}) (linear in between, like any step), so the lines are phase and amplitude
@@ -146,7 +160,7 @@ class WheelRuntime:
     speed with the slope as acceleration (tested).  Switch it off when the input is a measured speed that
     already carries the ripple.  Input checks (finite, max_acceleration, jumps) apply to the input speed.
 
-    floors : diagnosed broadband floors (:func:`effects_from_doc`), used when ``broadband_floor``: each is
+    floors : diagnosed broadband floors (:func:`effects_from_doc`), each unless its element's switch is off: each is
     added to its wheel-frame output channel (a blocked load, like the measurement it was fitted to) as
     g(Ω)·Σ_k a_k cos(2π f_k t + φ_k) with f_k = k·``floor_resolution`` (Hz) over the knots' span,
     a_k = sqrt(2·psd_ref(f_k)·df) and g = (|Ω|/Ω_ref)^{p/2} at the step's end speed: over one period
@@ -161,9 +175,15 @@ class WheelRuntime:
 
     def __init__(self, params, lines, *, seed=None, imbalance=True, harmonics=True, modes=True,
                  start_steady=False, max_accel=500.0, max_step=0.01, dcm=None, position=None, kernel=None,
-                 laws=None, resonances=None, sidebands=None, ripples=None, floors=None, speed_ripple=True,
-                 broadband_floor=True, floor_resolution=0.1):
+                 laws=None, resonances=None, sidebands=None, ripples=None, floors=None, switch_of=None,
+                 floor_resolution=0.1, **switches):
         self.p = dict(params)
+        names = [name for name, _ in fmu_switches()]
+        unknown = sorted(set(switches) - set(names))
+        if unknown:
+            raise TypeError(f"WheelRuntime() got an unexpected keyword argument {unknown[0]!r} (effect switches: "
+                            f"{', '.join(names)})")
+        switched_off = {name for name in names if not switches.get(name, True)}
         if not (math.isfinite(max_accel) and max_accel > 0):
             raise ModelError(f"max_acceleration must be finite and > 0, got {max_accel!r}")
         if not (math.isfinite(max_step) and max_step > 0):
@@ -268,8 +288,10 @@ class WheelRuntime:
             self._st = np.zeros(2 + 2 * n + 12)
             self._kout = np.zeros(12)
             self._ptrs = (cfg.ctypes.data, self._st.ctypes.data, self._kout.ctypes.data)
-        self._init_ripple(ripples if speed_ripple else None, seed)
-        self._init_floor(floors if broadband_floor else None, seed, floor_resolution)
+        ripples, self.ripple_switches = _switched(ripples, switch_of, "ripples", switched_off)
+        floors, _ = _switched(floors, switch_of, "floors", switched_off)
+        self._init_ripple(ripples, seed)
+        self._init_floor(floors, seed, floor_resolution)
         self.reset()
 
     def _init_ripple(self, ripples, seed):
@@ -459,8 +481,8 @@ class WheelRuntime:
         if self.has_ripple and h * self.ripple_f_max * RIPPLE_STEPS_PER_PERIOD > 1 + 1e-12:
             raise ModelError(f"communication step size {h:.6g} s does not resolve the speed ripple of "
                              f"{self.ripple_f_max:.6g} Hz (at most {1 / (RIPPLE_STEPS_PER_PERIOD * self.ripple_f_max):.6g}"
-                             f" s: {RIPPLE_STEPS_PER_PERIOD} steps per period); use smaller steps or speed_ripple = "
-                             "false")
+                             f" s: {RIPPLE_STEPS_PER_PERIOD} steps per period); use smaller steps"
+                             + "".join(f" or {name} = false" for name in self.ripple_switches))
         if not math.isfinite(omega):
             raise ModelError(f"wheel_speed is not finite: {omega!r} rad/s")
         if alpha is not None and not math.isfinite(alpha):

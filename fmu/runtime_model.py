@@ -108,9 +108,25 @@ def laws_from_doc(doc, source="<model>"):
     return {(a.direction, a.h): a.law for a in _doc_actions(doc, source) if isinstance(a, _actions.LineLaw)}
 
 
-def _doc_actions(doc, source):
+def _doc_actions(doc, source, sources=False):
     """The actions of a model document's effects (:func:`rwadist.effects.actions.of_effects`), validated."""
-    return _actions.of_effects(_schema.parse_effects(doc.get("effects"), source))
+    return _actions.of_effects(_schema.parse_effects(doc.get("effects"), source), sources)
+
+
+#: The FMUs' effect switches: Boolean parameters whose value references follow ``start_steady`` (9, 10), one per
+#: element that names one (``FMU_SWITCH``, :class:`rwadist.effects.element.FmuSwitch`), in slot order.
+SWITCH_SLOTS = 2
+
+
+def fmu_switches():
+    """[(name, description)] of the FMUs' effect switches, in slot order (their value references follow
+    ``start_steady``), from the registered elements; ModelError unless every slot is named once."""
+    named = sorted((c.FMU_SWITCH for c in _schema.EFFECT_KINDS.values() if getattr(c, "FMU_SWITCH", None) is not None),
+                   key=lambda s: s.slot)
+    if [s.slot for s in named] != list(range(SWITCH_SLOTS)):
+        raise ModelError(f"the FMU's effect switches are slots 0..{SWITCH_SLOTS - 1}, one element each; the "
+                         f"elements name {[(s.slot, s.name) for s in named]}")
+    return [(s.name, s.description) for s in named]
 
 
 def effects_from_doc(doc, source="<model>"):
@@ -131,21 +147,27 @@ def effects_from_doc(doc, source="<model>"):
       blocked-load PSD S(f, Ω) = psd_ref(f)·(|Ω|/Ω_ref)^p (linear between knots, 0 outside), added to the
       wheel-frame output as a random-phase multisine (see :class:`WheelRuntime`);
     * ``ripples``: [(ΔΩ_ref rad/s, Ω_ref rad/s, q, f_r Hz)] of the speed modulation (at most one): the wheel
-      turns at Ω(t) + ΔΩ_ref·(|Ω|/Ω_ref)^q·sin(2π f_r t + θ) (see :class:`WheelRuntime`).
+      turns at Ω(t) + ΔΩ_ref·(|Ω|/Ω_ref)^q·sin(2π f_r t + θ) (see :class:`WheelRuntime`);
+    * ``switch_of``: {"floors": [...], "ripples": [...]}: per floor and ripple, the name of the FMU switch that turns
+      it off (its element's ``FMU_SWITCH``, :func:`fmu_switches`), or None.
 
     ModelError naming ``effects[i].<field>`` on a bad entry."""
-    acts = _doc_actions(doc, source)
+    pairs = _doc_actions(doc, source, sources=True)
+    acts = [a for _, a in pairs]
     out = {"laws": {(a.direction, a.h): a.law for a in acts if isinstance(a, _actions.LineLaw)}, "resonances": [],
-           "sidebands": [], "floors": [], "ripples": []}
-    for a in acts:
+           "sidebands": [], "floors": [], "ripples": [], "switch_of": {"floors": [], "ripples": []}}
+    for e, a in pairs:
+        switch = getattr(getattr(e, "FMU_SWITCH", None), "name", None)
         if isinstance(a, _actions.LineFilter):
             out["resonances"].append((a.directions, *a.resonance))
         elif isinstance(a, _actions.LineModulation):
             out["sidebands"].append((a.direction, a.h, a.f_mod_hz, a.depth))
         elif isinstance(a, _actions.NoiseFloor):
             out["floors"].append((a.channel, a.f_hz, a.psd_ref, a.omega_ref, a.exponent))
+            out["switch_of"]["floors"].append(switch)
         elif isinstance(a, _actions.SpeedModulation):
             out["ripples"].append((a.delta_omega, a.omega_ref, a.exponent, a.f_hz))
+            out["switch_of"]["ripples"].append(switch)
     return out
 
 
@@ -267,7 +289,7 @@ def physics_of(params, lines, effects=None) -> str:
                 "modes = true)")
     else:
         what = "extended model: harmonics through the measured suspension modes"
-    kinds = [k for k, v in (effects or {}).items() if v]
+    kinds = [k for k, v in (effects or {}).items() if v and k != "switch_of"]
     names = {"laws": "amplitude laws", "resonances": "wheel-mode resonances", "sidebands": "sidebands",
              "floors": "broadband floors", "ripples": "speed ripple"}
     if kinds:

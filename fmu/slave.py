@@ -232,8 +232,10 @@ class WheelSlave(Fmi2Slave):
         self.harmonics = True
         self.modes = self.modes_default
         self.start_steady = False
-        self.speed_ripple = True
-        self.broadband_floor = True
+        # the effect switches (their elements name them: rt.fmu_switches()), all on
+        self._switches = self.rt.fmu_switches()
+        for name, _ in self._switches:
+            setattr(self, name, True)
         self.floor_resolution = 0.1
         self.max_acceleration = 500.0
         self.max_step_size = 0.01
@@ -277,13 +279,8 @@ class WheelSlave(Fmi2Slave):
         self.register_variable(Boolean("start_steady", causality=par, variability=fixed,
                                        description="start from the steady state at the first speed instead "
                                                    "of rest"))
-        self.register_variable(Boolean("speed_ripple", causality=par, variability=fixed,
-                                       description="diagnosed wheel-speed ripple (model file effects) added to "
-                                                   "wheel_speed; off when wheel_speed is a measured speed that "
-                                                   "already carries it"))
-        self.register_variable(Boolean("broadband_floor", causality=par, variability=fixed,
-                                       description="diagnosed broadband floors (model file effects) added to the "
-                                                   "outputs as random-phase multisines"))
+        for name, description in self._switches:
+            self.register_variable(Boolean(name, causality=par, variability=fixed, description=description))
         self.register_variable(RealU("floor_resolution", "Hz", causality=par, variability=fixed,
                                      description="frequency spacing of the broadband-floor multisine (it repeats "
                                                  "after 1/floor_resolution s)"))
@@ -471,8 +468,8 @@ class WheelSlave(Fmi2Slave):
                 params, lines, seed=None if seed == -1 else seed, imbalance=bool(self.imbalance),
                 harmonics=bool(self.harmonics), modes=bool(self.modes), start_steady=bool(self.start_steady),
                 max_accel=float(self.max_acceleration), max_step=float(self.max_step_size),
-                dcm=self.dcm, position=self.pos, kernel=self._kernel, speed_ripple=bool(self.speed_ripple),
-                broadband_floor=bool(self.broadband_floor), floor_resolution=float(self.floor_resolution), **effects)
+                dcm=self.dcm, position=self.pos, kernel=self._kernel, floor_resolution=float(self.floor_resolution),
+                **{name: bool(getattr(self, name)) for name, _ in self._switches}, **effects)
             for d, h in sorted(set(laws) - self.model.laws_used):
                 self.log(f"rwadist wheel: amplitude_law of {d} h={h:g} matches no line of the model; ignored",
                          Fmi2Status.warning)

@@ -4,7 +4,7 @@
 Run ``python -m rwadist.schema_json docs/model.schema.json`` after changing the typed schema.
 
 A JSON Schema cannot say everything the typed parser checks: knots strictly increasing, as many
-``psd_ref`` values as ``f_Hz`` knots, lo <= hi in ``excluded_rpm``, one ``speed_ripple`` per wheel,
+``psd_ref`` values as ``f_Hz`` knots, lo <= hi in ``excluded_rpm``, at most one effect of a kind a wheel has one of,
 the physical bounds of the analytical parameters taken together (an overdamped mode), and integers
 written as 3.0 (JSON Schema counts them as integers) are refused by :mod:`rwadist.schema` only.
 """

@@ -54,7 +54,9 @@ static void set_defaults(Wheel *w)
     p->max_step = 0.01;
     p->dcm[0] = p->dcm[4] = p->dcm[8] = 1.0;
     p->seed = -1;
-    p->imbalance = p->harmonics = p->speed_ripple = p->broadband = 1;
+    p->imbalance = p->harmonics = 1;
+    for (int i = 0; i < N_SWITCH; i++)
+        p->sw[i] = 1;
     p->modes = RW_MODES_DEFAULT;
     memset(&w->mu, 0, sizeof w->mu);
 }
@@ -143,9 +145,7 @@ static int *bool_slot(Wheel *w, unsigned vr)
     case VR_HARMONICS: return &w->par.harmonics;
     case VR_MODES: return &w->par.modes;
     case VR_START_STEADY: return &w->par.start_steady;
-    case VR_SPEED_RIPPLE: return &w->par.speed_ripple;
-    case VR_BROADBAND: return &w->par.broadband;
-    default: return NULL;
+    default: return vr >= VR_SWITCH && vr < VR_SWITCH + N_SWITCH ? &w->par.sw[vr - VR_SWITCH] : NULL;
     }
 }
 

@@ -29,15 +29,22 @@ typedef enum { RW_OK = 0, RW_WARNING = 1, RW_DISCARD = 2, RW_ERROR = 3, RW_FATAL
 /* the wrapper's logger: one plain message (no format), the instance's environment */
 typedef void (*RwLogger)(void *env, RwStatus status, const char *category, const char *message);
 
+/* VR_SWITCH .. VR_SWITCH + N_SWITCH - 1: the effect switches (Booleans named by the effect elements that own them,
+   RW_SWITCH_NAMES of wheel_model.h; each turns its element's ripples and floors off) */
+#define N_SWITCH 2
 enum { VR_SPEED = 0, VR_ACCEL = 1, VR_MODEL_FILE = 2, VR_USE_ACCEL = 3, VR_SEED = 4, VR_IMBALANCE = 5,
-       VR_HARMONICS = 6, VR_MODES = 7, VR_START_STEADY = 8, VR_SPEED_RIPPLE = 9, VR_BROADBAND = 10,
+       VR_HARMONICS = 6, VR_MODES = 7, VR_START_STEADY = 8, VR_SWITCH = 9,
        VR_FLOOR_RES = 11, VR_MAX_ACCEL = 12, VR_MAX_STEP = 13, VR_DCM = 14, VR_POS = 23, VR_OUT = 26,
        N_VR = 38 };
+
+#if RW_N_SWITCHES != N_SWITCH
+#error "wheel_model.h names another number of effect switches than the FMU has (fmu.runtime.SWITCH_SLOTS)"
+#endif
 
 /* parameters: everything the host sets before initialisation (also saved with a state) */
 typedef struct {
     double floor_res, max_accel, max_step, dcm[9], pos[3];
-    int use_accel, seed, imbalance, harmonics, modes, start_steady, speed_ripple, broadband;
+    int use_accel, seed, imbalance, harmonics, modes, start_steady, sw[N_SWITCH];
 } Params;
 
 /* everything a step changes (the FMU state besides the arrays) */
@@ -62,8 +69,9 @@ typedef struct {
     /* built at initialisation */
     int n;                           /* kernel components */
     double *cfg, *st, kout[12];
-    int has_ripple;
+    int has_ripple, n_ripple;        /* the ripples on (their switches on) */
     double ripple[RW_N_RIPPLES_ALLOC][5]; /* ΔΩ_ref, Ω_ref, q, 2π f_r, θ */
+    const char *ripple_switch;       /* the switch that turns them off (for the step-size message), or NULL */
     double ripple_f_max;
     int n_floor;                     /* sinusoids */
     int n_seg;                       /* floor segments */
@@ -297,29 +305,42 @@ static int build_model(Wheel *w)
         }
     }
 
-    /* speed ripple: θ from default_rng((seed, 1)) */
-    w->has_ripple = p->speed_ripple && RW_N_RIPPLES > 0;
+    /* speed ripples whose switch is on (as runtime.py: θ from default_rng((seed, 1)), one per ripple on) */
+    w->n_ripple = 0;
     w->ripple_f_max = 0.0;
+    w->ripple_switch = NULL;
     if (p->seed >= 0)
         rw_rng_seed(&g, (uint32_t)p->seed, 1);
     for (int i = 0; i < RW_N_RIPPLES; i++) {
-        w->ripple[i][0] = RW_RIPPLES[i][0];
-        w->ripple[i][1] = RW_RIPPLES[i][1];
-        w->ripple[i][2] = RW_RIPPLES[i][2];
-        w->ripple[i][3] = 2.0 * 3.14159265358979311600 * RW_RIPPLES[i][3];
-        w->ripple[i][4] = p->seed >= 0 ? rw_uniform(&g, 0.0, RW_TWO_PI) : 0.0;
+        const int sw = RW_RIPPLE_SWITCH[i];
+        if (sw >= 0 && !p->sw[sw])
+            continue;
+        double *q = w->ripple[w->n_ripple++];
+        q[0] = RW_RIPPLES[i][0];
+        q[1] = RW_RIPPLES[i][1];
+        q[2] = RW_RIPPLES[i][2];
+        q[3] = 2.0 * 3.14159265358979311600 * RW_RIPPLES[i][3];
+        q[4] = p->seed >= 0 ? rw_uniform(&g, 0.0, RW_TWO_PI) : 0.0;
         /* as runtime.py: the largest ripple rate in rad/s sets the step-size check */
-        if (w->has_ripple)
-            w->ripple_f_max = fmax(w->ripple_f_max, RW_RIPPLES[i][3]);
+        w->ripple_f_max = fmax(w->ripple_f_max, RW_RIPPLES[i][3]);
+        if (sw >= 0 && !w->ripple_switch)
+            w->ripple_switch = RW_SWITCH_NAMES[sw];
     }
+    w->has_ripple = w->n_ripple > 0;
 
-    /* broadband floors: multisine at floor_resolution, phases from default_rng((seed or default, 2)) */
+    /* broadband floors whose switch is on: multisine at floor_resolution, phases from
+       default_rng((seed or default, 2)) */
     w->floor_f_max = 0.0;
-    if (p->broadband && RW_N_FLOORS > 0) {
+    int any_floor = 0;
+    for (int f = 0; f < RW_N_FLOORS; f++)
+        any_floor |= RW_FLOORS[f].sw < 0 || p->sw[RW_FLOORS[f].sw];
+    if (any_floor) {
         const double df = p->floor_res;
         long n_max = 0;
         for (int f = 0; f < RW_N_FLOORS; f++) {
             const RwFloor *fl = &RW_FLOORS[f];
+            if (fl->sw >= 0 && !p->sw[fl->sw])
+                continue;
             const long k0 = (long)fmax(1.0, ceil(RW_FLOOR_F[fl->at] / df)), k1 = (long)floor(RW_FLOOR_F[fl->at + fl->n - 1] / df);
             n_max += k1 >= k0 ? k1 - k0 + 1 : 0;
         }
@@ -340,6 +361,8 @@ static int build_model(Wheel *w)
         int m = 0;
         for (int f = 0; f < RW_N_FLOORS; f++) {
             const RwFloor *fl = &RW_FLOORS[f];
+            if (fl->sw >= 0 && !p->sw[fl->sw])
+                continue;
             const double *xp = RW_FLOOR_F + fl->at, *fp = RW_FLOOR_PSD + fl->at;
             const long k0 = (long)fmax(1.0, ceil(xp[0] / df)), k1 = (long)floor(xp[fl->n - 1] / df);
             const int start = m;
@@ -384,7 +407,7 @@ static int build_model(Wheel *w)
 static double ripple_at(const Wheel *w, double omega, double t)
 {
     double r = 0.0;
-    for (int i = 0; i < RW_N_RIPPLES; i++) {
+    for (int i = 0; i < w->n_ripple; i++) {
         const double *q = w->ripple[i];
         r += (q[2] != 0.0 ? q[0] * pow(fabs(omega) / q[1], q[2]) : q[0]) * sin(q[3] * t + q[4]);
     }
@@ -394,7 +417,7 @@ static double ripple_at(const Wheel *w, double omega, double t)
 static double ripple_rate(const Wheel *w, double omega, double t)
 {
     double r = 0.0;
-    for (int i = 0; i < RW_N_RIPPLES; i++) {
+    for (int i = 0; i < w->n_ripple; i++) {
         const double *q = w->ripple[i];
         r += (q[2] != 0.0 ? q[0] * pow(fabs(omega) / q[1], q[2]) : q[0]) * q[3] * cos(q[3] * t + q[4]);
     }
@@ -607,8 +630,9 @@ static RwStatus step(Wheel *w, double t_host, double h)
                        "resolves", t_host, h);
     if (w->has_ripple && h * w->ripple_f_max * RIPPLE_STEPS_PER_PERIOD > 1 + 1e-12)
         return fail(w, "step at t = %.9g s rejected: communication step size %.6g s does not resolve the speed "
-                       "ripple of %.6g Hz (%d steps per period); use smaller steps or speed_ripple = false",
-                    t_host, h, w->ripple_f_max, RIPPLE_STEPS_PER_PERIOD);
+                       "ripple of %.6g Hz (%d steps per period); use smaller steps%s%s%s",
+                    t_host, h, w->ripple_f_max, RIPPLE_STEPS_PER_PERIOD, w->ripple_switch ? " or " : "",
+                    w->ripple_switch ? w->ripple_switch : "", w->ripple_switch ? " = false" : "");
     if (!isfinite(omega))
         return fail(w, "step at t = %.9g s rejected: wheel_speed is not finite: %g rad/s", t_host, omega);
     if (have_alpha && !isfinite(alpha))

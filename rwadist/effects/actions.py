@@ -92,9 +92,11 @@ class SpeedModulation:
     STAGE = 2
 
 
-def of_effects(effects) -> list:
+def of_effects(effects, sources: bool = False) -> list:
     """The actions of typed effects (:func:`rwadist.schema.parse_effects`), in the order consumers apply them:
     by stage (line laws, filters and floors; then amplitude modulations; then a speed modulation), in file order
-    within a stage.  An effect without actions (a bare :class:`rwadist.schema.Effect`, an unknown kind) adds none."""
-    out = [a for e in effects for a in (e.actions() if hasattr(e, "actions") else ())]
-    return sorted(out, key=lambda a: a.STAGE)
+    within a stage.  An effect without actions (a bare :class:`rwadist.schema.Effect`, an unknown kind) adds none.
+    ``sources``: pairs (effect, action), the effect each action comes from."""
+    out = [(e, a) for e in effects for a in (e.actions() if hasattr(e, "actions") else ())]
+    out.sort(key=lambda p: p[1].STAGE)
+    return out if sources else [a for _, a in out]

@@ -10,7 +10,7 @@ import numpy as np
 from ..schema import CHANNELS, NON_NEGATIVE, POSITIVE, check, names, numbers, register
 from ..units import CHANNEL_UNIT
 from .actions import NoiseFloor
-from .element import Element, num, rpm
+from .element import Element, FmuSwitch, num, rpm
 
 
 @register
@@ -20,6 +20,8 @@ class BroadbandFloor(Element):
     psd_ref linear between the knots f_Hz (Hz, >= 0, increasing), 0 outside; unit²/Hz."""
 
     KIND: ClassVar[str] = "broadband_floor"
+    FMU_SWITCH: ClassVar[FmuSwitch] = FmuSwitch(1, "broadband_floor", "diagnosed broadband floors (model file "
+                                                "effects) added to the outputs as random-phase multisines")
     ORDER: ClassVar[int] = 30
     channel: tuple = field(metadata=check(names(CHANNELS)))
     exponent: float = field(metadata=check(NON_NEGATIVE))

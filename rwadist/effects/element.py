@@ -5,7 +5,8 @@ derives from :class:`Element`, which adds the hooks the kit's consumers call, ea
 registered as a bare :class:`~rwadist.schema.Effect` is read, written and shown, and acts on nothing):
 
 - :meth:`Element.describe`: its one line of words and numbers for the console;
-- :meth:`Element.actions`: what it does to the wheel's loads, as generic actions (:mod:`rwadist.effects.actions`);
+- :meth:`Element.actions`: what it does to the wheel's loads, as generic actions (:mod:`rwadist.effects.actions`),
+  and the FMU parameter that turns them off (``FMU_SWITCH``, a :class:`FmuSwitch`);
 - the ``INJECT`` table and the ``inject_*`` hooks: its injection into the virtual test stand, called by
   :mod:`rwadist.inject` with a :class:`rwadist.inject.Stand` (the stand's services: its wheel, random numbers, adding
   a line to a run, a wheel load through the rotor's modes, low-passed noise).
@@ -25,6 +26,18 @@ from ..schema import Effect
 from ..units import RAD_S_TO_RPM
 
 
+@dataclass(frozen=True)
+class FmuSwitch:
+    """A Boolean parameter of the wheel FMUs that turns an element's actions on the FMU's outputs off (its noise
+    floors, its speed modulation: what the runtime adds on top of the lines).  ``slot``: which of the FMUs' effect
+    switches it is (their value references follow ``start_steady``, in slot order; the FMUs have
+    ``rwadist.fmu.runtime.SWITCH_SLOTS`` of them); ``name``, ``description``: the variable's."""
+
+    slot: int
+    name: str
+    description: str
+
+
 @dataclass(frozen=True, eq=False, kw_only=True)
 class Element(Effect):
     """An effect kind of :mod:`rwadist.effects` (base class; the hooks' defaults do nothing)."""
@@ -42,6 +55,9 @@ class Element(Effect):
         return None
 
     # ------------------------------------------------------------------ what it does to the wheel's loads
+    #: the FMU parameter that turns this kind's floors and speed modulation off (:class:`FmuSwitch`), or None
+    FMU_SWITCH: ClassVar[FmuSwitch | None] = None
+
     def actions(self) -> tuple:
         """What this effect does to the loads the wheel exerts, as generic actions (:mod:`rwadist.effects.actions`)
         every consumer of a model applies; none by default (a measurement artefact, a record of the search)."""

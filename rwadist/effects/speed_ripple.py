@@ -10,7 +10,7 @@ import numpy as np
 from ..schema import COUNT, NON_NEGATIVE, POSITIVE, check, optional, register
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .actions import SpeedModulation
-from .element import Element, num, rpm
+from .element import Element, FmuSwitch, num, rpm
 
 
 @register
@@ -21,6 +21,9 @@ class SpeedRipple(Element):
     KIND: ClassVar[str] = "speed_ripple"
     ORDER: ClassVar[int] = 70
     ONE_PER_WHEEL: ClassVar[bool] = True
+    FMU_SWITCH: ClassVar[FmuSwitch] = FmuSwitch(0, "speed_ripple", "diagnosed wheel-speed ripple (model file effects) "
+                                                "added to wheel_speed; off when wheel_speed is a measured speed that "
+                                                "already carries it")
     f_ripple_Hz: float = field(metadata=check(POSITIVE))
     delta_omega_rad_s: float = field(metadata=check(NON_NEGATIVE))
     omega_ref_rad_s: float = field(metadata=check(POSITIVE))
