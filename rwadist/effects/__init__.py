@@ -30,10 +30,15 @@ Adding a kind is one new file (two when ``rwadist diagnose`` should find it) plu
 a kind.  A kind registered from anywhere else (a test's toy kind, a user's own) is read, written, shown and applied
 the same way (tests/test_effect_elements.py).
 
-Status of the move (landed in steps): the fields and checks (from ``rwadist/schema.py``), the texts (from
-``rwadist/effects_text.py``, which now dispatches) and the injections (from ``rwadist/inject.py``, now the stand's
-generic side) are here; the actions, their consumers and the diagnose hypotheses still live in the modules that name
-the kinds (``broadband``, ``extended``, ``coupling.performance``, ``fmu``, ``diagnose``) and move here next.
+The package: one module per kind (its element) and, beside it, ``<kind>_diagnose.py`` (its diagnose family);
+:mod:`~rwadist.effects.element`, the elements' base (the hooks with their defaults, ``FMU_SWITCH``, the texts'
+helpers) and :mod:`~rwadist.effects.actions`, the generic actions.  The modules that used to name the kinds
+dispatch instead: :mod:`rwadist.schema` reads every registered kind; :mod:`rwadist.effects_text` shows the element's
+line; :mod:`rwadist.inject` parses and applies the element's injection; :mod:`rwadist.broadband`,
+:mod:`rwadist.extended`, ``rwadist.coupling.performance`` and ``rwadist.fmu`` apply the actions (the FMUs' effect
+switches are named by the elements' ``FMU_SWITCH``; the pythonfmu FMU refuses a kind its shipped elements do not
+read); :mod:`rwadist.diagnose` finds the families here and its ``State`` holds the effect objects, reading its
+prediction from their ``contribute``.
 
 Importing this package imports every element module of it (so the schema reads every kind); elements registered
 by other modules are read once those are imported.
