@@ -5,13 +5,13 @@
 :func:`fmu.runtime.expand_lines`), writes the parsed model as C data (``wheel_model.h``: every
 number as a C99 hexadecimal float literal, so the C model holds the very doubles Python holds),
 and compiles the FMI API -- ``native/rwadist_wheel_fmu.c`` (FMI 2.0) or ``native/rwadist_wheel_fmi3.c`` (FMI 3.0) --
-with the wrapper layer both share, ``native/rwadist_wheel_instance.h`` (the FMI state machine, variables by value
-reference, FMU state), ``native/rwadist_wheel_runtime.h`` (model set-up from the parameters, input checks, ripple,
+with the wrapper layer both share, ``native/rwadist_wheel_instance.h`` (every call's work: the state machine of
+``native/rwadist_fmi_rules.h``, variables by value reference, FMU state), ``native/rwadist_wheel_runtime.h`` (model set-up from the parameters, input checks, ripple,
 floors), the step
 kernel ``native/rwadist_kernel.h`` (shared with the pythonfmu FMU's native layer) and
 ``native/rwadist_rng.h`` (numpy's ``default_rng`` in C: the same seed gives the same line, ripple
 and floor phases as the Python FMU) into ``binaries/linux64/<id>.so`` and, with mingw-w64
-(``x86_64-w64-mingw32-gcc``, Debian's ``gcc-mingw-w64-x86-64``), ``binaries/win64/<id>.dll`` (FMI 3.0:
+(``x86_64-w64-mingw32-gcc``, Debian's ``gcc-mingw-w64-x86-64-win32``), ``binaries/win64/<id>.dll`` (FMI 3.0:
 ``x86_64-linux``, ``x86_64-windows``); without mingw-w64 the FMU is Linux-only (a warning says how to get it).  The
 FMU ships those sources and the FMI headers in ``sources/`` (FMI 2.0: listed in ``<SourceFiles>``; FMI 3.0:
 ``sources/buildDescription.xml``), so a host on another platform can compile it (e.g.
@@ -24,6 +24,8 @@ variables and value references (Real as Float64, Integer as Int32) and the indep
 """
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 import os
 import shutil
@@ -45,7 +47,8 @@ NATIVE = HERE / "native"
 C_SOURCES = {2: "rwadist_wheel_fmu.c", 3: "rwadist_wheel_fmi3.c"}
 C_SOURCE = C_SOURCES[2]
 #: what every native FMU compiles besides its API source: wrapper layer, runtime, kernel, random numbers
-COMMON_SOURCES = ("rwadist_wheel_instance.h", "rwadist_wheel_runtime.h", "rwadist_kernel.h", "rwadist_rng.h")
+COMMON_SOURCES = ("rwadist_wheel_instance.h", "rwadist_fmi_rules.h", "rwadist_wheel_runtime.h", "rwadist_kernel.h",
+                  "rwadist_rng.h")
 SOURCES = (C_SOURCE, *COMMON_SOURCES)
 FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 FMI3_HEADERS = ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")
@@ -55,7 +58,7 @@ PLATFORM = "linux64"
 PLATFORMS = {2: {"linux": "linux64", "windows": "win64"}, 3: {"linux": "x86_64-linux", "windows": "x86_64-windows"}}
 #: the mingw-w64 cross compiler (``$RWADIST_MINGW_CC`` overrides it) and how to get it
 MINGW = "x86_64-w64-mingw32-gcc"
-MINGW_HINT = ("install Debian's gcc-mingw-w64-x86-64 (apt-get install gcc-mingw-w64-x86-64) or point "
+MINGW_HINT = ("install Debian's gcc-mingw-w64-x86-64-win32 (apt-get install gcc-mingw-w64-x86-64-win32) or point "
               "RWADIST_MINGW_CC at another x86_64 mingw-w64 gcc")
 
 #: (name, value reference, type, causality, variability, start, unit, description): the pythonfmu FMU's
@@ -178,14 +181,21 @@ def model_header(doc, guid: str, physics: str, modes_default: bool) -> str:
     return "\n".join(out) + "\n"
 
 
-def model_description(model_identifier: str, guid: str, physics: str, modes_default: bool) -> str:
-    """modelDescription.xml of the native FMU."""
-    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+def _generated_now() -> str:
+    """The modelDescription's generationDateAndTime attribute (with its leading space): now, UTC."""
+    return f' generationDateAndTime="{datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")}"'
+
+
+def model_description(model_identifier: str, guid: str, physics: str, modes_default: bool,
+                      generated: str | None = None) -> str:
+    """modelDescription.xml of the native FMU (``generated``: the generationDateAndTime attribute, '' for none;
+    default now)."""
+    now = _generated_now() if generated is None else generated
     x = ['<?xml version="1.0" encoding="UTF-8"?>',
          f'<fmiModelDescription fmiVersion="2.0" modelName="{model_identifier}" guid="{guid}" '
          f'description={quoteattr("Reaction-wheel micro-vibration, time domain; outputs in wheel and spacecraft frames. Physics: " + physics)} '
-         'generationTool="rwadist native FMU builder (fmu/native_build.py)" '
-         f'generationDateAndTime="{now}" variableNamingConvention="structured" numberOfEventIndicators="0">',
+         'generationTool="rwadist native FMU builder (fmu/native_build.py)"'
+         f'{now} variableNamingConvention="structured" numberOfEventIndicators="0">',
          f'  <CoSimulation modelIdentifier="{model_identifier}" needsExecutionTool="false" '
          'canHandleVariableCommunicationStepSize="true" canInterpolateInputs="false" maxOutputDerivativeOrder="0" '
          'canRunAsynchronuously="false" canBeInstantiatedOnlyOncePerProcess="false" '
@@ -223,21 +233,25 @@ def compile_sources(src_dir, output, *, source: str = C_SOURCE, windows: bool = 
     ``-fcx-limited-range``: complex products without the NaN/infinity recovery branch (the kernel's values are
     finite; checked after every step) -- the same finite results, ~9 % fewer instructions per step;
     ``-ffp-contract=off``: no fused multiply-adds where the target has them, so a build on another platform
-    (aarch64, ``-march=native``) gives the same bits as this one."""
+    (aarch64, ``-march=native``) gives the same bits as this one.  The build is reproducible: the same sources give
+    the same bytes."""
     if windows:
         cc = windows_compiler()
         if cc is None:
             raise NativeBuildError(f"no Windows cross compiler ({os.environ.get('RWADIST_MINGW_CC', MINGW)!r} not on "
                                    f"PATH): {MINGW_HINT}")
-        target = ["-static-libgcc"]
+        # no build time in the PE header, an image base that does not hash the (temporary) output path
+        target = ["-static-libgcc", "-Wl,--no-insert-timestamp,--disable-auto-image-base"]
     else:
         cc = shutil.which(os.environ.get("CC", "cc"))
         if cc is None:
             raise NativeBuildError(f"no C compiler ({os.environ.get('CC', 'cc')!r} not on PATH)")
         target = ["-fPIC", "-fvisibility=hidden"]
+    # run in src_dir, the source named relative to it: no build folder in the binary (the same sources give the
+    # same bytes, whichever temporary folder they were built in)
     cmd = [cc, "-std=gnu11", "-O2", "-fcx-limited-range", "-ffp-contract=off", "-shared", *target,
-           f"-I{src_dir}", "-o", str(output), str(Path(src_dir) / source), "-lm"]
-    res = subprocess.run(cmd, capture_output=True, text=True)
+           "-I.", "-o", str(Path(output).resolve()), source, "-lm"]
+    res = subprocess.run(cmd, capture_output=True, text=True, cwd=src_dir)
     if res.returncode != 0:
         raise NativeBuildError(f"{' '.join(cmd)} failed:\n{res.stderr.strip()}")
     return Path(output)
@@ -268,15 +282,16 @@ def _unit_definitions() -> list:
                 '  <DefaultExperiment startTime="0.0" stopTime="1.0" stepSize="0.001"/>']
 
 
-def model_description3(model_identifier: str, guid: str, physics: str, modes_default: bool) -> str:
+def model_description3(model_identifier: str, guid: str, physics: str, modes_default: bool,
+                       generated: str | None = None) -> str:
     """modelDescription.xml of the FMI 3.0 native FMU: the FMI 2.0 FMU's variables and value references (Real as
-    Float64, Integer as Int32) and the independent variable ``time``."""
-    now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    Float64, Integer as Int32) and the independent variable ``time`` (``generated``: as :func:`model_description`)."""
+    now = _generated_now() if generated is None else generated
     x = ['<?xml version="1.0" encoding="UTF-8"?>',
          f'<fmiModelDescription fmiVersion="3.0" modelName="{model_identifier}" instantiationToken="{guid}" '
          f'description={quoteattr("Reaction-wheel micro-vibration, time domain; outputs in wheel and spacecraft frames. Physics: " + physics)} '
-         'generationTool="rwadist native FMU builder (fmu/native_build.py)" '
-         f'generationDateAndTime="{now}" variableNamingConvention="structured">',
+         'generationTool="rwadist native FMU builder (fmu/native_build.py)"'
+         f'{now} variableNamingConvention="structured">',
          f'  <CoSimulation modelIdentifier="{model_identifier}" needsExecutionTool="false" '
          'canBeInstantiatedOnlyOncePerProcess="false" canGetAndSetFMUState="true" canSerializeFMUState="true" '
          'providesDirectionalDerivatives="false" providesAdjointDerivatives="false" '
@@ -313,8 +328,47 @@ def build_description3(model_identifier: str) -> str:
         '</fmiBuildDescription>']) + "\n"
 
 
+def zip_fmu(root, output) -> Path:
+    """Zip the FMU folder ``root`` into ``output`` (written beside it, then moved: never half a file); the entries
+    sorted, with fixed times and modes, so the same folder gives the same bytes."""
+    output = Path(output)
+    tmp_out = output.with_name(output.name + ".tmp")
+    with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
+        for f in sorted(Path(root).rglob("*")):
+            if f.is_file():
+                info = zipfile.ZipInfo(f.relative_to(root).as_posix(), date_time=(2026, 1, 1, 0, 0, 0))
+                info.external_attr = (0o755 if f.suffix in (".so", ".dll") else 0o644) << 16
+                z.writestr(info, f.read_bytes(), compress_type=zipfile.ZIP_DEFLATED)
+    os.replace(tmp_out, output)
+    return output
+
+
+def content_identity(*parts) -> tuple:
+    """(tag, GUID) from a digest of ``parts`` (text or bytes) and of the native sources: the same content gives the same
+    identity (a reproducible build), other content another."""
+    digest = hashlib.sha256()
+    for part in (*parts, *(f.read_bytes() for f in sorted(NATIVE.rglob("*.[ch]")))):
+        data = part if isinstance(part, bytes) else str(part).encode()
+        digest.update(len(data).to_bytes(8, "little") + data)
+    h = digest.hexdigest()
+    return h[:12], "{" + str(uuid.UUID(h[:32])) + "}"
+
+
+def _identity(doc, fmi_version, assumed_modes, windows, tag, reproducible) -> tuple:
+    """(model identifier, GUID, generationDateAndTime attribute) of a build: random and now, or (``reproducible``)
+    from the content and none."""
+    if reproducible:
+        auto_tag, guid = content_identity(json.dumps(doc, sort_keys=True), fmi_version, assumed_modes, windows)
+        tag, generated = tag or auto_tag, ""
+    else:
+        tag, guid, generated = tag or uuid.uuid4().hex[:12], "{" + str(uuid.uuid4()) + "}", None
+    if not ("x" + tag).isidentifier():
+        raise ValueError(f"tag {tag!r} must be alphanumeric")
+    return f"RwadistWheelC_{tag}", guid, generated
+
+
 def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bool = False, fmi_version: int = 2,
-                     windows: bool | None = None) -> Path:
+                     windows: bool | None = None, reproducible: bool = False) -> Path:
     """Write the pure-C FMU of ``model`` (path, dict or WheelModel) to ``output`` (.fmu); returns its path.
 
     ``tag`` (default random) makes the model identifier ``RwadistWheelC_<tag>``.  ``assumed_modes``: as
@@ -322,7 +376,10 @@ def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bo
     (FMI 2.0 co-simulation) or 3 (FMI 3.0).  The binary is built for Linux x86-64 (NativeBuildError elsewhere or
     without a C compiler) and, ``windows`` True or None, cross-compiled for Windows x86-64 with mingw-w64: None adds it
     where the cross compiler is found and warns (RuntimeWarning, saying how to get it) where it is not, True raises
-    NativeBuildError there, False builds Linux only.  ``sources/`` lets other platforms build their own."""
+    NativeBuildError there, False builds Linux only (~2.5 s less per build: the test suite's choice where it does not
+    test Windows; a user's ``rwadist fmu build --native`` keeps None, so the FMU ships win64 wherever mingw-w64 is).
+    ``reproducible``: tag (unless given) and GUID from the content, no generation time: the same model, options and
+    sources give the same bytes (the SSP's FMUs).  ``sources/`` lets other platforms build their own."""
     if fmi_version not in C_SOURCES:
         raise ValueError(f"fmi_version must be 2 or 3, got {fmi_version!r}")
     doc = model_document(model)
@@ -336,11 +393,7 @@ def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bo
         if not windows:
             warnings.warn(f"no Windows binary in the FMU ({os.environ.get('RWADIST_MINGW_CC', MINGW)} not found): "
                           f"{MINGW_HINT}", RuntimeWarning, stacklevel=2)
-    tag = tag or uuid.uuid4().hex[:12]
-    if not ("x" + tag).isidentifier():
-        raise ValueError(f"tag {tag!r} must be alphanumeric")
-    model_identifier = f"RwadistWheelC_{tag}"
-    guid = "{" + str(uuid.uuid4()) + "}"
+    model_identifier, guid, generated = _identity(doc, fmi_version, assumed_modes, windows, tag, reproducible)
     physics, modes_default = model_physics(doc, assumed_modes)
     output.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="rwadist_cfmu_") as tmp:
@@ -348,52 +401,60 @@ def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bo
         src = root / "sources"
         src.mkdir(parents=True)
         source = C_SOURCES[fmi_version]
-        for name in (source, *COMMON_SOURCES):
-            shutil.copy2(NATIVE / name, src / name)
-        folder, headers = FMI_HEADERS[fmi_version]
-        for name in headers:
-            shutil.copy2(NATIVE / folder / name, src / name)
+        copy_sources(src, fmi_version, (source, *COMMON_SOURCES))
         (src / "wheel_model.h").write_text(model_header(doc, guid, physics, modes_default))
         describe = model_description if fmi_version == 2 else model_description3
-        (root / "modelDescription.xml").write_text(describe(model_identifier, guid, physics, modes_default))
+        (root / "modelDescription.xml").write_text(describe(model_identifier, guid, physics, modes_default, generated))
         if fmi_version == 3:
             (src / "buildDescription.xml").write_text(build_description3(model_identifier))
-        platforms = PLATFORMS[fmi_version]
-        for win in ((False, True) if windows else (False,)):
-            bindir = root / "binaries" / platforms["windows" if win else "linux"]
-            bindir.mkdir(parents=True)
-            compile_sources(src, bindir / f"{model_identifier}.{'dll' if win else 'so'}", source=source, windows=win)
+        compile_binaries(root, model_identifier, fmi_version, source, windows)
         (root / "documentation").mkdir()
         (root / "documentation" / "index.txt").write_text(
             f"rwadist wheel FMU (native C, FMI {fmi_version}.0 co-simulation).\nPhysics: {physics}\n"
             f"Binaries: {', '.join(sorted(p.name for p in (root / 'binaries').iterdir()))}.\n"
             f"Build on another platform: compile sources/{source} (C11 with complex.h) into a shared\n"
             f"library named {model_identifier} (e.g. fmpy.build.build_platform_binary on the unzipped FMU).\n")
-        tmp_out = output.with_suffix(".fmu.tmp")
-        with zipfile.ZipFile(tmp_out, "w", zipfile.ZIP_DEFLATED) as z:
-            for f in sorted(root.rglob("*")):
-                if f.is_file():
-                    info = zipfile.ZipInfo(f.relative_to(root).as_posix(), date_time=(2026, 1, 1, 0, 0, 0))
-                    info.external_attr = (0o755 if f.suffix in (".so", ".dll") else 0o644) << 16
-                    z.writestr(info, f.read_bytes(), compress_type=zipfile.ZIP_DEFLATED)
-        os.replace(tmp_out, output)
-    return output
+        return zip_fmu(root, output)
 
 
-def compile_c_host(output, *, windows: bool = False) -> Path:
-    """Compile ``native/c_host.c`` (an FMI 2.0 host in C, no Python: dlopen or LoadLibrary, fmi2DoStep over a speed
-    ramp) into the executable ``output``: for Linux with ``$CC``/``cc``, or for Windows (``windows``: a static .exe
-    for Wine) with the mingw-w64 cross compiler; NativeBuildError on failure."""
+def copy_sources(src, fmi_version: int, names) -> None:
+    """Copy the native sources ``names`` and the FMI headers of ``fmi_version`` into the FMU's folder ``src``."""
+    for name in names:
+        shutil.copy2(NATIVE / name, src / name)
+    folder, headers = FMI_HEADERS[fmi_version]
+    for name in headers:
+        shutil.copy2(NATIVE / folder / name, src / name)
+
+
+def compile_binaries(root, model_identifier: str, fmi_version: int, source: str, windows: bool) -> None:
+    """binaries/<platform>/<model_identifier>.so (and .dll with ``windows``) of the FMU folder ``root`` from its
+    sources/ (the API file ``source``)."""
+    platforms = PLATFORMS[fmi_version]
+    for win in ((False, True) if windows else (False,)):
+        bindir = Path(root) / "binaries" / platforms["windows" if win else "linux"]
+        bindir.mkdir(parents=True)
+        compile_sources(Path(root) / "sources", bindir / f"{model_identifier}.{'dll' if win else 'so'}",
+                        source=source, windows=win)
+
+
+def compile_c_host(output, *, windows: bool = False, fmi_version: int = 2) -> Path:
+    """Compile ``native/c_host.c`` (a co-simulation host in C, no Python: dlopen or LoadLibrary, DoStep over a speed
+    ramp; FMI 2.0, or FMI 3.0 with ``fmi_version`` 3) into the executable ``output``: for Linux with ``$CC``/``cc``,
+    or for Windows (``windows``: a static .exe for Wine) with the mingw-w64 cross compiler; NativeBuildError on
+    failure."""
+    if fmi_version not in C_SOURCES:
+        raise ValueError(f"fmi_version must be 2 or 3, got {fmi_version!r}")
+    version = ["-DFMI3"] if fmi_version == 3 else []
     if windows:
         cc = windows_compiler()
         if cc is None:
             raise NativeBuildError(f"no Windows cross compiler: {MINGW_HINT}")
-        cmd = [cc, "-O2", f"-I{NATIVE}", "-o", str(output), str(NATIVE / "c_host.c"), "-static"]
+        cmd = [cc, "-O2", *version, f"-I{NATIVE}", "-o", str(output), str(NATIVE / "c_host.c"), "-static"]
     else:
         cc = shutil.which(os.environ.get("CC", "cc"))
         if cc is None:
             raise NativeBuildError(f"no C compiler ({os.environ.get('CC', 'cc')!r} not on PATH)")
-        cmd = [cc, "-O2", f"-I{NATIVE}", "-o", str(output), str(NATIVE / "c_host.c"), "-ldl"]
+        cmd = [cc, "-O2", *version, f"-I{NATIVE}", "-o", str(output), str(NATIVE / "c_host.c"), "-ldl"]
     res = subprocess.run(cmd, capture_output=True, text=True)
     if res.returncode != 0:
         raise NativeBuildError(f"{' '.join(cmd)} failed:\n{res.stderr.strip()}")

@@ -84,13 +84,14 @@ fmu.setupExperiment(startTime=0.0); fmu.enterInitializationMode(); fmu.exitIniti
 steps(fmu, outs, 3); fmu.terminate(); fmu.fmi2FreeInstance(fmu.component)
 start(fmu, vr); t = steps(fmu, outs, 3)                                                           # bad input
 fmu.setReal([vr["wheel_speed"]], [float("nan")]); refused(fmu.doStep, t, 1e-3)
-fmu.setReal([vr["wheel_speed"]], [100.0])
+refused(fmu.setReal, [vr["wheel_speed"]], [100.0])                                                # error state
 refused(fmu.doStep, t - 1e-3, 1e-3); refused(fmu.doStep, float("nan"), 1e-3); refused(fmu.doStep, t, -1.0)
 refused(fmu.getReal, [99999]); refused(fmu.setReal, [99999], [1.0])
-steps(fmu, outs, 2, t)
+fmu.reset(); fmu.setupExperiment(startTime=0.0); fmu.enterInitializationMode()                    # error state:
+fmu.setReal([vr["wheel_speed"]], [100.0]); fmu.exitInitializationMode(); steps(fmu, outs, 2)     # a new run
 refused(fmu.getFMUstate); refused(fmu.setFMUstate, fmi2FMUstate())                               # FMU state
 refused(fmu.serializeFMUstate, fmi2FMUstate()); refused(fmu.deSerializeFMUstate, bytes(16))
-fmu.terminate(); fmu.fmi2FreeInstance(fmu.component)
+refused(fmu.terminate); fmu.fmi2FreeInstance(fmu.component)                                       # (error state)
 start(fmu, vr); steps(fmu, outs, 3); fmu.fmi2FreeInstance(fmu.component)                          # no terminate
 fmu.instantiate(); fmu.fmi2FreeInstance(fmu.component)                                            # uninitialised
 

@@ -1,8 +1,10 @@
-"""The native FMU under memory checkers (issue 17): a hostile C host (fmu/native/c_stress.c: instantiate, step, bad
-input, get/set/serialize/deserialize state from good, truncated, corrupted and NULL data, reset, free; many cycles)
-runs the FMU's own sources/ compiled with AddressSanitizer + UndefinedBehaviorSanitizer (always, wherever gcc or
-clang has them) and, where valgrind is installed, the shipped binary under valgrind: no invalid read, write or free,
-no leak, and every expectation of the host met (refusals are fmi2Error, the replay from a saved state is bit-identical).
+"""The native FMU under memory checkers (issues 17, 35): a hostile C host (fmu/native/c_stress.c: instantiate, step,
+bad input, get/set/serialize/deserialize state from good, truncated, corrupted and NULL data, reset, free; many
+cycles) and random call orders over the FMI state machine (fmu/native/c_orders.c, FMI 2.0 and FMI 3.0: every call in
+and out of order from every state, FMU states through errors and restores) run the FMU's own sources/ compiled with
+AddressSanitizer + UndefinedBehaviorSanitizer (always, wherever gcc or clang has them) and, where valgrind is
+installed, the shipped binaries under valgrind: no invalid read, write or free, no leak, and every expectation of the
+hosts met (refusals are Error and logged, never Fatal; the replay from a saved state is bit-identical).
 """
 from __future__ import annotations
 
@@ -20,7 +22,9 @@ CC = shutil.which(os.environ.get("CC", "cc"))
 pytestmark = pytest.mark.skipif(not (native_supported() and CC),
                                 reason="the native FMU's binary is built on Linux x86-64 with a C compiler")
 
-from rwadist.fmu.native_build import build_native_fmu  # noqa: E402
+import random  # noqa: E402
+
+from rwadist.fmu.native_build import C_SOURCES, PLATFORMS, build_native_fmu  # noqa: E402
 from test_fmu_native import wheel_doc  # noqa: E402
 
 NATIVE = Path(__file__).resolve().parents[1] / "fmu" / "native"
@@ -32,7 +36,7 @@ def unpacked(tmp_path_factory):
     """(folder of the extracted native FMU with every effect class, its GUID, its binary)."""
     from fmpy import read_model_description
     d = tmp_path_factory.mktemp("memcheck")
-    fmu = build_native_fmu(wheel_doc(), d / "wheel.fmu")
+    fmu = build_native_fmu(wheel_doc(), d / "wheel.fmu", windows=False)
     with zipfile.ZipFile(fmu) as z:
         z.extractall(d / "x")
     md = read_model_description(fmu)
@@ -89,3 +93,65 @@ def test_c_stress_host_under_valgrind(unpacked, tmp_path):
     assert res.returncode == 0, res.stdout + res.stderr[-4000:]
     assert summary and " 0 errors from 0 contexts" in summary[-1], summary
     assert res.stdout.split()[3] == "0"
+
+
+@pytest.fixture(scope="module")
+def both_versions(tmp_path_factory):
+    """{FMI version: (sources/ folder, GUID, shipped Linux binary)} of the wheel with every effect class."""
+    from fmpy import read_model_description
+    d = tmp_path_factory.mktemp("orders")
+    out = {}
+    for v in (2, 3):
+        fmu = build_native_fmu(wheel_doc(), d / f"wheel{v}.fmu", fmi_version=v, windows=False)
+        with zipfile.ZipFile(fmu) as z:
+            z.extractall(d / f"x{v}")
+        md = read_model_description(fmu)
+        out[v] = (d / f"x{v}" / "sources", md.guid,
+                  d / f"x{v}" / "binaries" / PLATFORMS[v]["linux"] / f"{md.coSimulation.modelIdentifier}.so")
+    return out
+
+
+def _orders_result(res) -> dict:
+    assert res.returncode == 0, res.stdout + res.stderr[-4000:]
+    words = res.stdout.split()
+    return dict(zip(words[::2], map(int, words[1::2])))
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_call_orders_under_address_sanitizer(both_versions, tmp_path, version):
+    """400 random call orders (c_orders.c) on the FMU's sources built with ASan + UBSan: every Error logged, none
+    Fatal, and no sanitizer report; the orders step the wheel and meet errors (the state machine's paths)."""
+    src, guid, _ = both_versions[version]
+    if not _sanitizers_work(tmp_path):
+        pytest.skip(f"{CC} cannot build or run AddressSanitizer programs here")
+    lib, host = tmp_path / "wheel_asan.so", tmp_path / "c_orders_asan"
+    _cc([*SANITIZE, "-std=gnu11", "-fPIC", "-shared", "-fvisibility=hidden", f"-I{src}", "-o", str(lib),
+         str(src / C_SOURCES[version]), "-lm"], "the FMU's sources with sanitizers")
+    _cc([*SANITIZE, *(["-DFMI3"] if version == 3 else []), f"-I{NATIVE}", "-o", str(host), str(NATIVE / "c_orders.c"),
+         "-ldl", "-lm"], "the call-order host")
+    seed = random.SystemRandom().randrange(1_000_000)
+    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=0", UBSAN_OPTIONS="print_stacktrace=1")
+    res = subprocess.run([str(host), str(lib), guid, "400", str(seed)], capture_output=True, text=True, timeout=600,
+                         env=env)
+    assert "Sanitizer" not in res.stderr and "runtime error" not in res.stderr, (seed, res.stderr[-4000:])
+    got = _orders_result(res)
+    print(f"FMI {version}.0, seed {seed}: {got}")
+    assert got["failures"] == 0 and got["steps"] > 50 and got["errors"] > 1000, (seed, got)
+
+
+@pytest.mark.skipif(shutil.which("valgrind") is None, reason="valgrind is not installed (ASan runs above)")
+@pytest.mark.parametrize("version", [2, 3])
+def test_call_orders_under_valgrind(both_versions, tmp_path, version):
+    """The shipped binaries under valgrind memcheck through 100 random call orders: 0 errors, no definite or
+    indirect leak."""
+    _, guid, lib = both_versions[version]
+    host = tmp_path / "c_orders"
+    _cc(["-O1", "-g", *(["-DFMI3"] if version == 3 else []), f"-I{NATIVE}", "-o", str(host),
+         str(NATIVE / "c_orders.c"), "-ldl", "-lm"], "the call-order host")
+    seed = random.SystemRandom().randrange(1_000_000)
+    res = subprocess.run(["valgrind", "--error-exitcode=9", "--leak-check=full", "--show-leak-kinds=definite,indirect",
+                          "--errors-for-leak-kinds=definite,indirect", str(host), str(lib), guid, "100", str(seed)],
+                         capture_output=True, text=True, timeout=900)
+    summary = [ln for ln in res.stderr.splitlines() if "ERROR SUMMARY" in ln]
+    assert summary and " 0 errors from 0 contexts" in summary[-1], (seed, summary, res.stderr[-3000:])
+    assert _orders_result(res)["failures"] == 0

@@ -1,7 +1,9 @@
 """Both FMUs (pythonfmu and native C) against the FMI time rules, non-finite results and FMU state (issue 17):
 
 * a communication point must be the previous one plus the previous step: one that goes backwards, is NaN, skips
-  ahead or jumps by 1e9 s is refused with fmi2Error (logged), the outputs keep their values, and the host goes on;
+  ahead or jumps by 1e9 s is refused with fmi2Error (logged), the outputs keep their values, the instance is in
+  FMI 2.0's error state (a step at the right point is refused too) and a stored FMU state (native FMU) or a reset
+  (both) lead on;
 * outputs that are not finite are never reported with fmi2OK (an initial speed of 1e300 rad/s; a step to a speed
   whose Ω² overflows);
 * FMU state: the capability flags of the modelDescription and the behaviour agree -- the native FMU declares and
@@ -37,7 +39,7 @@ def fmus(tmp_path_factory):
     """{"python": pythonfmu FMU, "native": native C FMU} of the E-wheel preset."""
     d = tmp_path_factory.mktemp("safety")
     doc = preset("ithaco-e").to_model()
-    out = {"python": build_fmu(doc, d / "py.fmu"), "native": build_native_fmu(doc, d / "c.fmu")}
+    out = {"python": build_fmu(doc, d / "py.fmu"), "native": build_native_fmu(doc, d / "c.fmu", windows=False)}
     assert has_native(out["python"])
     return out
 
@@ -55,6 +57,7 @@ def test_communication_point_must_continue(fmus, kind, case):
         for n in range(3):
             inst.fmu.doStep(n * h, h)
         y = inst.get()
+        stored = inst.fmu.getFMUstate() if kind == "native" else None
         t = {"backwards": 1 * h, "nan": float("nan"), "skips_ahead": 4 * h, "jump_1e9": 3 * h + 1e9,
              "inf": float("inf")}[case]
         with pytest.raises(FMICallException) as exc:
@@ -62,7 +65,19 @@ def test_communication_point_must_continue(fmus, kind, case):
         assert exc.value.status == ERROR
         assert any("does not continue the last step" in m for m in log.messages(ERROR)), log.records
         assert inst.get() == y
-        inst.fmu.doStep(3 * h, h)            # the right communication point: the host goes on
+        with pytest.raises(FMICallException):
+            inst.fmu.doStep(3 * h, h)        # FMI 2.0: after fmi2Error the instance is in the error state
+        assert "in the error state" in log.messages(ERROR)[-1], log.records[-1]
+        if kind == "native":                 # a state stored before the error restores the run
+            inst.fmu.setFMUstate(stored)
+            inst.fmu.doStep(3 * h, h)
+        else:                                # no FMU state: a reset starts a new run
+            inst.fmu.reset()
+            inst.fmu.setupExperiment(startTime=0.0)
+            inst.fmu.enterInitializationMode()
+            inst.set("wheel_speed", 100.0)
+            inst.fmu.exitInitializationMode()
+            inst.fmu.doStep(0.0, h)
         assert all(np.isfinite(inst.get())) and inst.get() != y
     finally:
         inst.close()
@@ -85,6 +100,10 @@ def test_start_time_is_the_first_communication_point(fmus, kind):
         fmu.exitInitializationMode()
         with pytest.raises(FMICallException):
             fmu.doStep(0.0, 1e-3)
+        fmu.reset()                     # the refusal put it in the error state: a new run
+        fmu.setupExperiment(startTime=2.5)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
         fmu.doStep(2.5, 1e-3)
         fmu.doStep(2.501, 1e-3)
         fmu.terminate()
@@ -141,7 +160,8 @@ def test_step_with_non_finite_outputs_is_an_error(fmus, kind):
 def test_pythonfmu_fmu_state_flags_false_and_every_state_call_refused(fmus):
     """The pythonfmu FMU saves no modal or phase state: its modelDescription says canGetAndSetFMUstate and
     canSerializeFMUstate false, and each state call -- get, set (also NULL), size, serialize, deserialize -- is
-    fmi2Error with a logged message, the instance stepping on afterwards; freeing no state is a no-op."""
+    fmi2Error with a logged message (the instance then in FMI 2.0's error state, a reset leading on); freeing no
+    state is a no-op."""
     md = fmpy.read_model_description(fmus["python"])
     assert md.coSimulation.canGetAndSetFMUstate is False and md.coSimulation.canSerializeFMUstate is False
     log = hosts.HostLog()
@@ -166,7 +186,14 @@ def test_pythonfmu_fmu_state_flags_false_and_every_state_call_refused(fmus):
             assert any(m.startswith(name) and "does not support FMU state" in m for m in log.messages(ERROR)), name
         assert state.value is None and size.value == 0
         assert f.fmi2FreeFMUstate(f.component, ctypes.byref(ctypes.c_void_p())) == 0
-        f.doStep(1e-3, 1e-3)
+        with pytest.raises(FMICallException):
+            f.doStep(1e-3, 1e-3)             # the refusals put it in FMI 2.0's error state: a reset leads on
+        f.reset()
+        f.setupExperiment(startTime=0.0)
+        f.enterInitializationMode()
+        inst.set("wheel_speed", 100.0)
+        f.exitInitializationMode()
+        f.doStep(0.0, 1e-3)
         assert all(np.isfinite(inst.get()))
     finally:
         inst.close()

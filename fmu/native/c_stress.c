@@ -1,6 +1,7 @@
 /* A hostile FMI 2.0 host in C for memory checkers (valgrind, AddressSanitizer): loads a wheel FMU's shared library
  * with dlopen and, CYCLES times, instantiates it, steps a speed ramp, feeds it bad input (non-finite speed, a
- * communication point that goes backwards, is NaN or skips ahead, bad step sizes, an unknown value reference), gets,
+ * communication point that goes backwards, is NaN or skips ahead, bad step sizes, an unknown value reference; each
+ * puts it in FMI 2.0's error state, where it must refuse to step, and a stored FMU state restores the run), gets,
  * sets, serializes and deserializes its FMU state (also from truncated and corrupted bytes, and NULL), checks the
  * replay from a saved state is bit-identical, resets it and frees it.  Every refusal must be fmi2Error; every
  * accepted step must give finite outputs.  Used by tests/test_fmu_memcheck.py and benchmarks/fmu_memory.py.
@@ -129,7 +130,7 @@ int main(int argc, char **argv)
         fmi2Byte *blob = NULL;
         size_t size = 0;
         for (int k = 0; k < N; k++) {
-            if (k == SAVE) {
+            if (k == SAVE && has_state) { /* (a refused state call would end the run: they come later) */
                 fmi2Status s = fmi2GetFMUstate(c, &saved);
                 EXPECT(has_state ? (s == fmi2OK && saved) : s == fmi2Error, "fmi2GetFMUstate");
                 s = fmi2SerializedFMUstateSize(c, saved, &size);
@@ -138,6 +139,7 @@ int main(int argc, char **argv)
                     blob = malloc(size);
                     EXPECT(fmi2SerializeFMUstate(c, saved, blob, size) == fmi2OK, "fmi2SerializeFMUstate");
                     EXPECT(fmi2SerializeFMUstate(c, saved, blob, size / 2) == fmi2Error, "a short buffer is refused");
+                    EXPECT(fmi2SetFMUstate(c, saved) == fmi2OK, "the state just stored ends the error state");
                 }
             }
             u[0] = 10.0 + 0.2 * k;
@@ -146,10 +148,14 @@ int main(int argc, char **argv)
             for (int j = 0; j < 12; j++)
                 EXPECT(isfinite(first[k][j]), "finite outputs");
         }
-        /* bad input: each refused with fmi2Error, outputs unchanged, then the host goes on */
+        /* bad input: each refused with fmi2Error, outputs unchanged; FMI 2.0 then puts the instance in its error
+         * state: a state stored before restores the run (the native FMU), else only a reset leads on */
         const double tn = N * h, nan = NAN, inf = INFINITY;
         double y0[12];
         fmi2GetReal(c, out_vr, 12, y0);
+        fmi2FMUstate before = NULL;
+        if (has_state)
+            EXPECT(fmi2GetFMUstate(c, &before) == fmi2OK, "a checkpoint before the bad input");
         const struct { double t, h, w; const char *what; } bad[] = {
             {tn, h, nan, "a NaN speed"},          {tn, h, inf, "an infinite speed"},
             {tn, h, 1e308, "a speed jump to 1e308"}, {tn - h, h, 22.0, "a communication point going backwards"},
@@ -162,12 +168,19 @@ int main(int argc, char **argv)
             fmi2SetReal(c, in, 2, v);
             EXPECT(fmi2DoStep(c, bad[i].t, bad[i].h, fmi2True) == fmi2Error, bad[i].what);
             EXPECT(fmi2GetReal(c, out_vr, 12, y) == fmi2OK && memcmp(y, y0, sizeof y) == 0, "outputs unchanged");
+            EXPECT(fmi2DoStep(c, tn, h, fmi2True) == fmi2Error, "no step in the error state");
+            if (has_state)
+                EXPECT(fmi2SetFMUstate(c, before) == fmi2OK, "the checkpoint restores the run");
         }
         const double one = 1.0;
         EXPECT(fmi2SetReal(c, &vr_bad, 1, &one) == fmi2Error, "an unknown value reference is refused");
         EXPECT(fmi2GetReal(c, &vr_bad, 1, y) == fmi2Error, "an unknown value reference is refused (get)");
         u[0] = 22.0;
-        EXPECT(fmi2SetReal(c, in, 2, u) == fmi2OK && fmi2DoStep(c, tn, h, fmi2True) == fmi2OK, "the host goes on");
+        if (has_state) {
+            EXPECT(fmi2SetFMUstate(c, before) == fmi2OK, "the checkpoint restores the run");
+            EXPECT(fmi2SetReal(c, in, 2, u) == fmi2OK && fmi2DoStep(c, tn, h, fmi2True) == fmi2OK, "the host goes on");
+            EXPECT(fmi2FreeFMUstate(c, &before) == fmi2OK, "free the checkpoint");
+        }
         /* FMU state: replay from the saved state; hostile states refused */
         EXPECT(fmi2SetFMUstate(c, NULL) == fmi2Error, "fmi2SetFMUstate(NULL) is refused");
         if (has_state) {
@@ -198,7 +211,7 @@ int main(int argc, char **argv)
         }
         free(blob);
         EXPECT(fmi2FreeFMUstate(c, NULL) == fmi2OK, "freeing no state is a no-op");
-        if (cycle % 2) {
+        if (cycle % 2 || !has_state) { /* without FMU state, the error state leaves a reset only */
             EXPECT(fmi2Reset(c) == fmi2OK, "reset");
             EXPECT(fmi2SetupExperiment(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK &&
                        fmi2EnterInitializationMode(c) == fmi2OK && fmi2SetInteger(c, &vr_seed, 1, &seed) == fmi2OK,

@@ -10,11 +10,13 @@
  *
  * It also keeps the FMI 2.0 state machine of each instance (pythonfmu 0.7 keeps none: it answered
  * fmi2ExitInitializationMode without fmi2EnterInitializationMode, fmi2DoStep after fmi2Terminate, a fixed
- * parameter set after initialisation (silently not applied) and an unknown value reference with fmi2OK): a call
- * out of order, a fixed parameter set after initialisation, an output set, or a value reference that is not a
- * variable of the wheel FMU's type asked is answered with fmi2Error and a logged message, without reaching
- * pythonfmu; the instance stays in its state.  The variables are those of fmu/slave.py (VARIABLES of
- * fmu/native_build.py; tests/test_fmu_statemachine.py checks every one).
+ * parameter set after initialisation (silently not applied) and an unknown value reference with fmi2OK), by the
+ * rules of rwadist_fmi_rules.h (the native FMU's too): a call out of order, a fixed parameter set after
+ * initialisation, an output set, or a value reference that is not a variable of the wheel FMU's type asked is
+ * answered with fmi2Error and a logged message, without reaching pythonfmu; any fmi2Error (refused here or by the
+ * slave) then moves the instance to FMI 2.0's error state, from which fmi2Reset and fmi2FreeInstance lead on (this
+ * FMU has no FMU state).  The variables are those of fmu/slave.py (VARIABLES of fmu/native_build.py; a test
+ * compares them with rwadist_fmi_rules.h).
  *
  * rwadist_kernel_step() is WheelRuntime.step of fmu/runtime.py: the kernel of rwadist_kernel.h,
  * shared with the pure-C FMU (rwadist_wheel_fmu.c). */
@@ -121,35 +123,8 @@ static void *sym(const char *name)
         return POST(r);                                                  \
     }
 
-/* ------------------------------------------------------------------ instances' loggers (for refusals made here) */
-/* instance states (as the native FMU's rwadist_wheel_instance.h) */
-enum { ST_INSTANTIATED = 0, ST_INIT = 1, ST_STEP = 2, ST_TERMINATED = 3, ST_FAILED = 4, N_ST = 5 };
-#define IN(s) (1u << (s))
-#define ANY_STATE (IN(ST_INSTANTIATED) | IN(ST_INIT) | IN(ST_STEP) | IN(ST_TERMINATED) | IN(ST_FAILED))
-#define SETTABLE (IN(ST_INSTANTIATED) | IN(ST_INIT) | IN(ST_STEP))
-#define READABLE (IN(ST_INIT) | IN(ST_STEP) | IN(ST_TERMINATED) | IN(ST_FAILED))
-static const char *const STATE_NAMES[N_ST] = {"instantiated", "initialization mode", "stepping", "terminated",
-                                             "failed (initialisation failed)"};
-static const char *const STATE_NEXT[N_ST] = {
-    "enter initialization mode first", "exit initialization mode first", "the instance is stepping",
-    "the instance is terminated: reset it (or free it) to run again",
-    "initialisation failed (see the error logged then): reset the instance or free it"};
-
-/* the wheel FMU's variables by type (value references of fmu/slave.py) */
-enum { T_REAL, T_INTEGER, T_BOOLEAN, T_STRING };
-static int var_type(fmi2ValueReference vr)
-{
-    if (vr <= 1 || (vr >= 11 && vr <= 37))
-        return T_REAL;
-    if (vr == 4)
-        return T_INTEGER;
-    if (vr == 3 || (vr >= 5 && vr <= 10))
-        return T_BOOLEAN;
-    if (vr == 2)
-        return T_STRING;
-    return -1;
-}
-static const char *const TYPE_NAMES[4] = {"Real", "Integer", "Boolean", "String"};
+/* ------------------------------------------------------------------ instances' states and loggers */
+#include "rwadist_fmi_rules.h"
 
 typedef struct Known {
     fmi2Component c;
@@ -190,6 +165,31 @@ static void forget(fmi2Component c)
     pthread_mutex_unlock(&known_lock);
 }
 
+/* the state of instance c (-1: not an instance of this library) */
+static int mode_of(fmi2Component c)
+{
+    int mode = -1;
+    pthread_mutex_lock(&known_lock);
+    for (Known *k = known; k; k = k->next)
+        if (k->c == c && c) {
+            mode = k->mode;
+            break;
+        }
+    pthread_mutex_unlock(&known_lock);
+    return mode;
+}
+
+static void set_mode(fmi2Component c, int mode)
+{
+    pthread_mutex_lock(&known_lock);
+    for (Known *k = known; k; k = k->next)
+        if (k->c == c && c) {
+            k->mode = mode;
+            break;
+        }
+    pthread_mutex_unlock(&known_lock);
+}
+
 /* fmi2Error with a message (printf format) logged through instance c's logger (when it has one) */
 static fmi2Status refuse(fmi2Component c, const char *fmt, ...)
 {
@@ -217,79 +217,48 @@ static fmi2Status refuse(fmi2Component c, const char *fmt, ...)
             *q = '?';
     if (logger)
         logger(env, name, fmi2Error, "logStatusError", message);
+    set_mode(c, rw_error_state(2, mode_of(c)));
     return fmi2Error;
 }
 
-/* the state of instance c (-1: not an instance of this library) */
-static int mode_of(fmi2Component c)
-{
-    int mode = -1;
-    pthread_mutex_lock(&known_lock);
-    for (Known *k = known; k; k = k->next)
-        if (k->c == c && c) {
-            mode = k->mode;
-            break;
-        }
-    pthread_mutex_unlock(&known_lock);
-    return mode;
-}
-
-static void set_mode(fmi2Component c, int mode)
-{
-    pthread_mutex_lock(&known_lock);
-    for (Known *k = known; k; k = k->next)
-        if (k->c == c && c) {
-            k->mode = mode;
-            break;
-        }
-    pthread_mutex_unlock(&known_lock);
-}
-
-/* 1 when `fn` is allowed in c's state (mask of IN(state)); else fmi2Error logged, 0 */
-static int allowed(fmi2Component c, unsigned mask, const char *fn)
+/* 1 when `call` (the FMI function fn) is allowed in c's state; else fmi2Error logged (error state), 0 */
+static int allowed(fmi2Component c, RwCall call, const char *fn)
 {
     const int mode = mode_of(c);
     if (mode < 0)
         return 0; /* not an instance of this FMU (NULL or freed): nothing to log to */
-    if (mask & IN(mode))
+    if (rw_allowed(2, mode, call))
         return 1;
-    char states[160] = "";
-    for (int st = 0; st < N_ST; st++)
-        if (mask & IN(st)) {
-            const size_t len = strlen(states);
-            snprintf(states + len, sizeof states - len, "%s%s", len ? ", " : "", STATE_NAMES[st]);
-        }
-    refuse(c, "rwadist wheel: %s: illegal call sequence: the instance is %s; %s is allowed when %s (%s)", fn,
-           STATE_NAMES[mode], fn, states[0] ? states : "never", STATE_NEXT[mode]);
+    char message[768];
+    rw_refusal(message, sizeof message, 2, call, mode, fn);
+    refuse(c, "rwadist wheel: %s", message);
     return 0;
 }
 
-/* value references of type `type` (set: inputs always, fixed parameters before the end of initialisation) */
-static int vrs_ok(fmi2Component c, const char *fn, const fmi2ValueReference vr[], size_t n, const void *v, int type,
+/* n value references of `type` to get or set (set: settable ones, in a state their causality allows) */
+static int vrs_ok(fmi2Component c, const char *fn, const fmi2ValueReference vr[], size_t n, const void *v, RwType type,
                   int set)
 {
     if (n && (!vr || !v)) {
         refuse(c, "rwadist wheel: %s: %zu values asked with a NULL array", fn, n);
         return 0;
     }
-    const int mode = mode_of(c);
+    int parameters = 0;
     for (size_t i = 0; i < n; i++) {
-        if (var_type(vr[i]) != type) {
-            refuse(c, "rwadist wheel: %s: value reference %u is not a%s %s variable of this FMU", fn, vr[i],
-                   type == T_INTEGER ? "n" : "", TYPE_NAMES[type]);
+        RwCausality causality;
+        const RwType t = rw_variable(2, vr[i], &causality);
+        const char *why = set ? rw_not_settable(2, vr[i], type) : NULL;
+        if (!why && t != type)
+            why = t == RW_NO_TYPE ? "is no variable of this FMU" : "is a variable of another type";
+        if (why) {
+            refuse(c, "rwadist wheel: %s: value reference %u%s%s%s %s (this call %s %s variables)", fn, vr[i],
+                   vr[i] < N_VR ? " (" : "", vr[i] < N_VR ? RW_VAR_NAMES[vr[i]] : "", vr[i] < N_VR ? ")" : "", why,
+                   set ? "sets" : "gets", RW_TYPE_NAMES[0][type]);
             return 0;
         }
-        if (set && vr[i] >= 26) {
-            refuse(c, "rwadist wheel: %s: value reference %u is an output", fn, vr[i]);
-            return 0;
-        }
-        if (set && vr[i] > 1 && mode != ST_INSTANTIATED && mode != ST_INIT) {
-            refuse(c, "rwadist wheel: %s: value reference %u is a fixed parameter; set it before the end of "
-                      "initialisation (the instance is %s)", fn, vr[i], STATE_NAMES[mode]);
-            return 0;
-        }
+        parameters |= causality == RW_PARAMETER;
     }
-    return 1;
+    return allowed(c, !set ? RW_GET : parameters ? RW_SET_PARAMETER : RW_SET_INPUT, fn);
 }
 
 EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
@@ -384,8 +353,8 @@ FORWARD(fmi2Status, fmi2SetDebugLogging, (fmi2Component c, fmi2Boolean on, size_
         (c, on, n, cat), fmi2Error, adapt)
 
 /* forward NAME(args) to the inner library when CHECK holds (else fmi2Error, logged by CHECK); after an OK
- * (or Warning) answer the instance moves to state NEXT (-1: stays), after an Error to state ON_ERROR (-1: stays) */
-#define CHECKED(NAME, PARAMS, ARGS, CHECK, NEXT, ON_ERROR)                                                        \
+ * (or Warning) answer the instance moves to state NEXT (-1: stays), after an Error to FMI 2.0's error state */
+#define CHECKED(NAME, PARAMS, ARGS, CHECK, NEXT)                                                                  \
     EXPORT fmi2Status NAME PARAMS                                                                                 \
     {                                                                                                             \
         static fmi2Status(*fn) PARAMS;                                                                            \
@@ -397,52 +366,45 @@ FORWARD(fmi2Status, fmi2SetDebugLogging, (fmi2Component c, fmi2Boolean on, size_
         const fmi2Status r = adapt(fn ARGS);                                                                      \
         if (r <= 1 && (NEXT) >= 0)                                                                                \
             set_mode(c, NEXT);                                                                                    \
-        else if (r >= fmi2Error && (ON_ERROR) >= 0)                                                               \
-            set_mode(c, ON_ERROR);                                                                                \
+        else if (r >= fmi2Error)                                                                                  \
+            set_mode(c, rw_error_state(2, mode_of(c)));                                                           \
         return r;                                                                                                 \
     }
 
 static int setup_ok(fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real t0, fmi2Boolean stopDef, fmi2Real stop)
 {
-    if (!allowed(c, IN(ST_INSTANTIATED), "fmi2SetupExperiment"))
+    const char *fn = "rwadist wheel: fmi2SetupExperiment";
+    if (!allowed(c, RW_SETUP_EXPERIMENT, "fmi2SetupExperiment"))
         return 0;
     if (!isfinite(t0))
-        return !refuse(c, "rwadist wheel: fmi2SetupExperiment: start time %g is not finite", t0);
+        return !refuse(c, "%s: start time %g is not finite: give the run's start time in s", fn, t0);
     if (stopDef && !(stop >= t0))
-        return !refuse(c, "rwadist wheel: fmi2SetupExperiment: stop time %g s is before the start time %g s", stop, t0);
+        return !refuse(c, "%s: stop time %g s is before the start time %g s: give a stop time after the start, or "
+                          "none", fn, stop, t0);
     if (tolDef && !(tol > 0 && isfinite(tol)))
-        return !refuse(c, "rwadist wheel: fmi2SetupExperiment: tolerance %g is not a positive number", tol);
+        return !refuse(c, "%s: tolerance %g is not a positive number: give one > 0, or none", fn, tol);
     return 1;
 }
 
 CHECKED(fmi2SetupExperiment,
         (fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real t0, fmi2Boolean stopDef, fmi2Real stop),
-        (c, tolDef, tol, t0, stopDef, stop), setup_ok(c, tolDef, tol, t0, stopDef, stop), -1, -1)
+        (c, tolDef, tol, t0, stopDef, stop), setup_ok(c, tolDef, tol, t0, stopDef, stop), -1)
 CHECKED(fmi2EnterInitializationMode, (fmi2Component c), (c),
-        allowed(c, IN(ST_INSTANTIATED), "fmi2EnterInitializationMode"), ST_INIT, -1)
-CHECKED(fmi2ExitInitializationMode, (fmi2Component c), (c), allowed(c, IN(ST_INIT), "fmi2ExitInitializationMode"),
-        ST_STEP, ST_FAILED)
-CHECKED(fmi2Terminate, (fmi2Component c), (c), allowed(c, IN(ST_STEP), "fmi2Terminate"), ST_TERMINATED, -1)
-CHECKED(fmi2Reset, (fmi2Component c), (c), allowed(c, ANY_STATE, "fmi2Reset"), ST_INSTANTIATED, -1)
-CHECKED(fmi2GetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[]), (c, vr, n, v),
-        allowed(c, READABLE, "fmi2GetReal") && vrs_ok(c, "fmi2GetReal", vr, n, v, T_REAL, 0), -1, -1)
-CHECKED(fmi2GetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]), (c, vr, n, v),
-        allowed(c, READABLE, "fmi2GetInteger") && vrs_ok(c, "fmi2GetInteger", vr, n, v, T_INTEGER, 0), -1, -1)
-CHECKED(fmi2GetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]), (c, vr, n, v),
-        allowed(c, READABLE, "fmi2GetBoolean") && vrs_ok(c, "fmi2GetBoolean", vr, n, v, T_BOOLEAN, 0), -1, -1)
-CHECKED(fmi2GetString, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]), (c, vr, n, v),
-        allowed(c, READABLE, "fmi2GetString") && vrs_ok(c, "fmi2GetString", vr, n, v, T_STRING, 0), -1, -1)
-CHECKED(fmi2SetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[]), (c, vr, n, v),
-        allowed(c, SETTABLE, "fmi2SetReal") && vrs_ok(c, "fmi2SetReal", vr, n, v, T_REAL, 1), -1, -1)
-CHECKED(fmi2SetInteger, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]),
-        (c, vr, n, v), allowed(c, SETTABLE, "fmi2SetInteger") && vrs_ok(c, "fmi2SetInteger", vr, n, v, T_INTEGER, 1),
-        -1, -1)
-CHECKED(fmi2SetBoolean, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean v[]),
-        (c, vr, n, v), allowed(c, SETTABLE, "fmi2SetBoolean") && vrs_ok(c, "fmi2SetBoolean", vr, n, v, T_BOOLEAN, 1),
-        -1, -1)
-CHECKED(fmi2SetString, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]),
-        (c, vr, n, v), allowed(c, SETTABLE, "fmi2SetString") && vrs_ok(c, "fmi2SetString", vr, n, v, T_STRING, 1),
-        -1, -1)
+        allowed(c, RW_ENTER_INIT, "fmi2EnterInitializationMode"), ST_INIT)
+CHECKED(fmi2ExitInitializationMode, (fmi2Component c), (c), allowed(c, RW_EXIT_INIT, "fmi2ExitInitializationMode"),
+        ST_STEP)
+CHECKED(fmi2Terminate, (fmi2Component c), (c), allowed(c, RW_TERMINATE, "fmi2Terminate"), ST_TERMINATED)
+CHECKED(fmi2Reset, (fmi2Component c), (c), allowed(c, RW_RESET, "fmi2Reset"), ST_INSTANTIATED)
+/* the getters and setters of each type (vrs_ok checks the references and the state) */
+#define VARIABLES_OF(T, RW)                                                                                       \
+    CHECKED(fmi2Get##T, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2##T v[]), (c, vr, n, v),  \
+            vrs_ok(c, "fmi2Get" #T, vr, n, v, RW, 0), -1)                                                         \
+    CHECKED(fmi2Set##T, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2##T v[]),          \
+            (c, vr, n, v), vrs_ok(c, "fmi2Set" #T, vr, n, v, RW, 1), -1)
+VARIABLES_OF(Real, RW_REAL)
+VARIABLES_OF(Integer, RW_INTEGER)
+VARIABLES_OF(Boolean, RW_BOOLEAN)
+VARIABLES_OF(String, RW_STRING)
 /* FMU state is refused (the modelDescription says canGetAndSetFMUstate = canSerializeFMUstate = false):
  * pythonfmu's own implementation saves the variables only, not the wheel's modal and phase states, so a
  * host rolling back with it would get silently wrong results.  Nothing is forwarded. */
@@ -511,25 +473,23 @@ EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueR
     (void)vr, (void)n, (void)order, (void)v;
     return refuse(c, "rwadist wheel: fmi2GetRealOutputDerivatives: not supported (maxOutputDerivativeOrder = 0)");
 }
-/* a refused step: the slave flags it and returns False, which pythonfmu reports as Discard.  After a failed
- * initialisation the slave refuses every step itself, repeating why initialisation failed */
+/* a refused step: the slave flags it and returns False, which pythonfmu reports as Discard (fmi2Error here) */
 CHECKED(fmi2DoStep, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noPrior), (c, t, h, noPrior),
-        allowed(c, IN(ST_STEP) | IN(ST_FAILED), "fmi2DoStep"), -1, -1)
+        allowed(c, RW_DO_STEP, "fmi2DoStep"), -1)
 EXPORT fmi2Status fmi2CancelStep(fmi2Component c)
 {
     return refuse(c, "rwadist wheel: fmi2CancelStep: illegal call sequence: steps are synchronous, no step is in "
                      "progress to cancel");
 }
+#define STATUS(T)                                                                                                 \
+    CHECKED(fmi2Get##T##Status, (fmi2Component c, const fmi2StatusKind k, fmi2##T * v), (c, k, v),                \
+            allowed(c, RW_GET_STATUS, "fmi2Get" #T "Status"), -1)
 CHECKED(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v), (c, k, v),
-        allowed(c, IN(ST_STEP) | IN(ST_TERMINATED), "fmi2GetStatus"), -1, -1)
-CHECKED(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v), (c, k, v),
-        allowed(c, IN(ST_STEP) | IN(ST_TERMINATED), "fmi2GetRealStatus"), -1, -1)
-CHECKED(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v), (c, k, v),
-        allowed(c, IN(ST_STEP) | IN(ST_TERMINATED), "fmi2GetIntegerStatus"), -1, -1)
-CHECKED(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v), (c, k, v),
-        allowed(c, IN(ST_STEP) | IN(ST_TERMINATED), "fmi2GetBooleanStatus"), -1, -1)
-CHECKED(fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v), (c, k, v),
-        allowed(c, IN(ST_STEP) | IN(ST_TERMINATED), "fmi2GetStringStatus"), -1, -1)
+        allowed(c, RW_GET_STATUS, "fmi2GetStatus"), -1)
+STATUS(Real)
+STATUS(Integer)
+STATUS(Boolean)
+STATUS(String)
 
 /* ------------------------------------------------------------------ step kernel (rwadist_kernel.h) */
 #include "rwadist_kernel.h"

@@ -6,19 +6,16 @@
  * as the FMI 2.0 FMU (Float64 for Real, Int32 for Integer) plus the independent variable `time`; co-simulation
  * without event mode, intermediate update or clocks (ExitInitializationMode leads to Step Mode).  Every function
  * of the FMI 3.0 API is exported; those of model exchange, scheduled execution, clocks and the types this FMU has no
- * variable of answer fmi3Error with a logged message. */
+ * variable of answer fmi3Error with a logged message.  As FMI 3.0 says, any fmi3Error moves the instance to
+ * Terminated (rwadist_fmi_rules.h); fmi3SetFMUState with a state stored before, or fmi3Reset, lead on from there. */
 #include "fmi3Functions.h"
 #include "rwadist_wheel_instance.h"
-
-#define VR_TIME N_VR /* the independent variable (FMI 3.0 asks for one) */
 
 typedef struct {
     Wheel w;                         /* first: an fmi3Instance is a Wheel * */
     fmi3InstanceEnvironment env;
     fmi3LogMessageCallback log;
 } Fmi3Wheel;
-
-static Wheel *as_wheel(fmi3Instance c) { return (Wheel *)c; }
 
 static void log_fmi3(void *env, RwStatus status, const char *category, const char *message)
 {
@@ -27,19 +24,15 @@ static void log_fmi3(void *env, RwStatus status, const char *category, const cha
         f->log(f->env, (fmi3Status)status, category, message);
 }
 
+/* the instance c (its Wheel as w), or fmi3Error for NULL; CALL(c, expr): the body of a function returning expr's
+ * status as an fmi3Status */
 #define WHEEL_OR_ERROR(c)                                                                                         \
-    Wheel *w = as_wheel(c);                                                                                       \
+    Wheel *w = (Wheel *)(c);                                                                                      \
     if (!w)                                                                                                       \
         return fmi3Error;
-
-/* a value array of the length of the value-reference array (every variable is a scalar) */
-static int scalars(Wheel *w, const char *fn, size_t nvr, size_t nv)
-{
-    if (nvr == nv)
-        return 1;
-    fail(w, "%s: %zu values for %zu value references: every variable of this FMU is a scalar", fn, nv, nvr);
-    return 0;
-}
+#define CALL(c, expr)                                                                                             \
+    WHEEL_OR_ERROR(c)                                                                                             \
+    return (fmi3Status)(expr)
 
 FMI3_Export const char *fmi3GetVersion(void) { return fmi3Version; }
 
@@ -49,6 +42,21 @@ FMI3_Export fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean on, size_
     WHEEL_OR_ERROR(c)
     w->logging_on = on != fmi3False;
     return fmi3OK;
+}
+
+/* why an instantiation is refused (NULL: it is not) */
+static const char *instantiation_refused(fmi3String token, fmi3Boolean eventModeUsed, size_t nRequired)
+{
+    if (!token || strcmp(token, RW_GUID) != 0)
+        return "the instantiation token does not match this FMU's: the host read another FMU's model description; "
+               "load this FMU's";
+    if (eventModeUsed)
+        return "eventModeUsed = true, but this FMU has no event mode (hasEventMode = false): instantiate it with "
+               "eventModeUsed = false";
+    if (nRequired)
+        return "required intermediate variables given, but this FMU provides no intermediate update "
+               "(providesIntermediateUpdate = false): give none";
+    return NULL;
 }
 
 FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
@@ -65,19 +73,9 @@ FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String
     tmp.log = logMessage;
     tmp.w.logger = log_fmi3;
     tmp.w.log_env = &tmp;
-    if (!token || strcmp(token, RW_GUID) != 0) {
-        fail(&tmp.w, "fmi3InstantiateCoSimulation: instantiation token %s does not match this FMU's %s",
-             token ? token : "(null)", RW_GUID);
-        return NULL;
-    }
-    if (eventModeUsed) {
-        fail(&tmp.w, "fmi3InstantiateCoSimulation: eventModeUsed = true, but this FMU has no event mode "
-                     "(hasEventMode = false): instantiate it with eventModeUsed = false");
-        return NULL;
-    }
-    if (nRequired) {
-        fail(&tmp.w, "fmi3InstantiateCoSimulation: %zu required intermediate variables, but this FMU provides no "
-                     "intermediate update (providesIntermediateUpdate = false)", nRequired);
+    const char *why = instantiation_refused(token, eventModeUsed, nRequired);
+    if (why) {
+        fail(&tmp.w, "fmi3InstantiateCoSimulation: %s", why);
         return NULL;
     }
     Fmi3Wheel *f = calloc(1, sizeof *f);
@@ -86,48 +84,28 @@ FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String
         return NULL;
     }
     *f = tmp;
-    Wheel *w = &f->w;
-    w->log_env = f;
-    w->logging_on = loggingOn != fmi3False;
-    w->mode = ST_INSTANTIATED;
-    set_defaults(w);
-    logf_(w, RW_OK, "logAll", "rwadist wheel (native C FMU, FMI 3.0): %s", RW_PHYSICS);
+    f->w.log_env = f;
+    instantiated(&f->w, 3, loggingOn != fmi3False);
     return f;
 }
 
-FMI3_Export fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
-                                                      fmi3Boolean visible, fmi3Boolean loggingOn,
-                                                      fmi3InstanceEnvironment env, fmi3LogMessageCallback logMessage)
+/* the instantiations of the other interface types: NULL, logged */
+static fmi3Instance not_cosimulation(fmi3InstanceEnvironment env, fmi3LogMessageCallback logMessage, const char *fn)
 {
-    (void)name, (void)token, (void)resources, (void)visible, (void)loggingOn;
+    char message[256];
+    snprintf(message, sizeof message, "rwadist wheel: %s: this FMU is for co-simulation only: instantiate it with "
+             "fmi3InstantiateCoSimulation", fn);
     if (logMessage)
-        logMessage(env, fmi3Error, "logStatusError", "rwadist wheel: fmi3InstantiateModelExchange: this FMU is for "
-                                                     "co-simulation only");
+        logMessage(env, fmi3Error, "logStatusError", message);
     return NULL;
 }
 
-FMI3_Export fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
-                                                           fmi3Boolean visible, fmi3Boolean loggingOn,
-                                                           fmi3InstanceEnvironment env,
-                                                           fmi3LogMessageCallback logMessage,
-                                                           fmi3ClockUpdateCallback clockUpdate,
-                                                           fmi3LockPreemptionCallback lockPreemption,
-                                                           fmi3UnlockPreemptionCallback unlockPreemption)
-{
-    (void)name, (void)token, (void)resources, (void)visible, (void)loggingOn, (void)clockUpdate;
-    (void)lockPreemption, (void)unlockPreemption;
-    if (logMessage)
-        logMessage(env, fmi3Error, "logStatusError", "rwadist wheel: fmi3InstantiateScheduledExecution: this FMU is "
-                                                     "for co-simulation only");
-    return NULL;
-}
-
+/* ------------------------------------------------------------------ the run */
 FMI3_Export void fmi3FreeInstance(fmi3Instance c)
 {
-    Wheel *w = as_wheel(c);
-    if (!w)
+    if (!c)
         return;
-    free_model(w);
+    free_model((Wheel *)c);
     free(c);
 }
 
@@ -135,201 +113,26 @@ FMI3_Export fmi3Status fmi3EnterInitializationMode(fmi3Instance c, fmi3Boolean t
                                                    fmi3Float64 t0, fmi3Boolean stopDef, fmi3Float64 stop)
 {
     WHEEL_OR_ERROR(c)
-    if (!allowed(w, IN(ST_INSTANTIATED), "fmi3EnterInitializationMode"))
-        return fmi3Error;
-    if (!isfinite(t0))
-        return (fmi3Status)fail(w, "fmi3EnterInitializationMode: start time %g is not finite", t0);
-    if (stopDef && !(stop >= t0))
-        return (fmi3Status)fail(w, "fmi3EnterInitializationMode: stop time %g s is before the start time %g s", stop,
-                                t0);
-    if (tolDef && !(tol > 0 && isfinite(tol)))
-        return (fmi3Status)fail(w, "fmi3EnterInitializationMode: tolerance %g is not a positive number", tol);
-    w->mu.t_host = t0;
-    w->mode = ST_INIT;
-    return fmi3OK;
+    const char *fn = "fmi3EnterInitializationMode";
+    const RwStatus s = setup_experiment(w, fn, tolDef, tol, t0, stopDef, stop);
+    return (fmi3Status)(s == RW_OK ? enter_initialization(w, fn) : s);
 }
 
 FMI3_Export fmi3Status fmi3ExitInitializationMode(fmi3Instance c)
 {
-    WHEEL_OR_ERROR(c)
-    if (!allowed(w, IN(ST_INIT), "fmi3ExitInitializationMode"))
-        return fmi3Error;
-    return (fmi3Status)exit_initialization(w);
+    CALL(c, exit_initialization(w, "fmi3ExitInitializationMode"));
 }
 
-FMI3_Export fmi3Status fmi3EnterEventMode(fmi3Instance c)
-{
-    WHEEL_OR_ERROR(c)
-    return (fmi3Status)fail(w, "fmi3EnterEventMode: illegal call sequence: this FMU has no event mode "
-                               "(hasEventMode = false)");
-}
+FMI3_Export fmi3Status fmi3Terminate(fmi3Instance c) { CALL(c, terminate(w, "fmi3Terminate")); }
+FMI3_Export fmi3Status fmi3Reset(fmi3Instance c) { CALL(c, reset(w, "fmi3Reset")); }
 
-FMI3_Export fmi3Status fmi3EnterStepMode(fmi3Instance c)
-{
-    WHEEL_OR_ERROR(c)
-    return (fmi3Status)fail(w, "fmi3EnterStepMode: illegal call sequence: without event mode, "
-                               "fmi3ExitInitializationMode leads to Step Mode directly");
-}
-
-FMI3_Export fmi3Status fmi3Terminate(fmi3Instance c)
-{
-    WHEEL_OR_ERROR(c)
-    if (!allowed(w, IN(ST_STEP), "fmi3Terminate"))
-        return fmi3Error;
-    w->mode = ST_TERMINATED;
-    return fmi3OK;
-}
-
-FMI3_Export fmi3Status fmi3Reset(fmi3Instance c)
-{
-    WHEEL_OR_ERROR(c)
-    free_model(w);
-    set_defaults(w);
-    w->mode = ST_INSTANTIATED;
-    return fmi3OK;
-}
-
-/* ------------------------------------------------------------------ variables */
-FMI3_Export fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 v[],
-                                      size_t nv)
-{
-    WHEEL_OR_ERROR(c)
-    if (!scalars(w, "fmi3GetFloat64", nvr, nv))
-        return fmi3Error;
-    if (!allowed(w, READABLE, "fmi3GetFloat64") || !arrays_ok(w, "fmi3GetFloat64", nvr, vr, v))
-        return fmi3Error;
-    for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == VR_TIME)
-            v[i] = w->mu.t_host;
-        else if (get_reals(w, "fmi3GetFloat64", &vr[i], 1, &v[i]) != RW_OK)
-            return fmi3Error;
-    }
-    return fmi3OK;
-}
-
-FMI3_Export fmi3Status fmi3SetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,
-                                      const fmi3Float64 v[], size_t nv)
-{
-    WHEEL_OR_ERROR(c)
-    if (!scalars(w, "fmi3SetFloat64", nvr, nv))
-        return fmi3Error;
-    for (size_t i = 0; i < nvr && vr; i++)
-        if (vr[i] == VR_TIME)
-            return (fmi3Status)fail(w, "fmi3SetFloat64: value reference %u is the independent variable time", vr[i]);
-    return (fmi3Status)set_reals(w, "fmi3SetFloat64", vr, nvr, v);
-}
-
-FMI3_Export fmi3Status fmi3GetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Int32 v[],
-                                    size_t nv)
-{
-    WHEEL_OR_ERROR(c)
-    return scalars(w, "fmi3GetInt32", nvr, nv) ? (fmi3Status)get_seed(w, "fmi3GetInt32", vr, nvr, v) : fmi3Error;
-}
-
-FMI3_Export fmi3Status fmi3SetInt32(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 v[],
-                                    size_t nv)
-{
-    WHEEL_OR_ERROR(c)
-    return scalars(w, "fmi3SetInt32", nvr, nv) ? (fmi3Status)set_seed(w, "fmi3SetInt32", vr, nvr, v) : fmi3Error;
-}
-
-FMI3_Export fmi3Status fmi3GetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean v[],
-                                      size_t nv)
-{
-    WHEEL_OR_ERROR(c)
-    _Static_assert(sizeof(fmi3Boolean) == 1, "fmi3Boolean is one byte");
-    return scalars(w, "fmi3GetBoolean", nvr, nv) ? (fmi3Status)get_bools(w, "fmi3GetBoolean", vr, nvr, v, 0)
-                                                 : fmi3Error;
-}
-
-FMI3_Export fmi3Status fmi3SetBoolean(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,
-                                      const fmi3Boolean v[], size_t nv)
-{
-    WHEEL_OR_ERROR(c)
-    return scalars(w, "fmi3SetBoolean", nvr, nv) ? (fmi3Status)set_bools(w, "fmi3SetBoolean", vr, nvr, v, 0)
-                                                 : fmi3Error;
-}
-
-FMI3_Export fmi3Status fmi3GetString(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3String v[],
-                                     size_t nv)
-{
-    WHEEL_OR_ERROR(c)
-    return scalars(w, "fmi3GetString", nvr, nv) ? (fmi3Status)get_strings(w, "fmi3GetString", vr, nvr, v)
-                                                : fmi3Error;
-}
-
-FMI3_Export fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,
-                                     const fmi3String v[], size_t nv)
-{
-    WHEEL_OR_ERROR(c)
-    return scalars(w, "fmi3SetString", nvr, nv) ? (fmi3Status)set_strings(w, "fmi3SetString", vr, nvr, v)
-                                                : fmi3Error;
-}
-
-/* the types this FMU has no variable of: every value reference is refused */
-static fmi3Status no_variable(fmi3Instance c, const char *fn, size_t nvr, const fmi3ValueReference vr[])
-{
-    WHEEL_OR_ERROR(c)
-    if (!nvr)
-        return fmi3OK;
-    return (fmi3Status)fail(w, "%s: value reference %u: this FMU has no variable of this type", fn, vr ? vr[0] : 0u);
-}
-
-#define NO_TYPE(T)                                                                                                \
-    FMI3_Export fmi3Status fmi3Get##T(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3##T v[],    \
-                                      size_t nv)                                                                  \
-    {                                                                                                             \
-        (void)v, (void)nv;                                                                                        \
-        return no_variable(c, "fmi3Get" #T, nvr, vr);                                                             \
-    }                                                                                                             \
-    FMI3_Export fmi3Status fmi3Set##T(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,                  \
-                                      const fmi3##T v[], size_t nv)                                               \
-    {                                                                                                             \
-        (void)v, (void)nv;                                                                                        \
-        return no_variable(c, "fmi3Set" #T, nvr, vr);                                                             \
-    }
-NO_TYPE(Float32)
-NO_TYPE(Int8)
-NO_TYPE(UInt8)
-NO_TYPE(Int16)
-NO_TYPE(UInt16)
-NO_TYPE(UInt32)
-NO_TYPE(Int64)
-NO_TYPE(UInt64)
-
-FMI3_Export fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, size_t sizes[],
-                                     fmi3Binary v[], size_t nv)
-{
-    (void)sizes, (void)v, (void)nv;
-    return no_variable(c, "fmi3GetBinary", nvr, vr);
-}
-FMI3_Export fmi3Status fmi3SetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const size_t sizes[],
-                                     const fmi3Binary v[], size_t nv)
-{
-    (void)sizes, (void)v, (void)nv;
-    return no_variable(c, "fmi3SetBinary", nvr, vr);
-}
-FMI3_Export fmi3Status fmi3GetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Clock v[])
-{
-    (void)v;
-    return no_variable(c, "fmi3GetClock", nvr, vr);
-}
-FMI3_Export fmi3Status fmi3SetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock v[])
-{
-    (void)v;
-    return no_variable(c, "fmi3SetClock", nvr, vr);
-}
-
-/* ------------------------------------------------------------------ stepping */
 FMI3_Export fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 t, fmi3Float64 h, fmi3Boolean noSetPrior,
                                   fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
                                   fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime)
 {
     (void)noSetPrior;
     WHEEL_OR_ERROR(c)
-    fmi3Status s = fmi3Error;
-    if (allowed(w, IN(ST_STEP), "fmi3DoStep"))
-        s = (fmi3Status)do_step(w, t, h);
+    const fmi3Status s = (fmi3Status)do_step(w, "fmi3DoStep", t, h);
     if (eventHandlingNeeded)
         *eventHandlingNeeded = fmi3False;
     if (terminateSimulation)
@@ -341,71 +144,136 @@ FMI3_Export fmi3Status fmi3DoStep(fmi3Instance c, fmi3Float64 t, fmi3Float64 h, 
     return s;
 }
 
-FMI3_Export fmi3Status fmi3GetOutputDerivatives(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,
-                                                const fmi3Int32 orders[], fmi3Float64 v[], size_t nv)
-{
-    (void)vr, (void)nvr, (void)orders, (void)v, (void)nv;
-    WHEEL_OR_ERROR(c)
-    return (fmi3Status)fail(w, "fmi3GetOutputDerivatives: not supported (maxOutputDerivativeOrder = 0)");
-}
+/* ------------------------------------------------------------------ variables (rwadist_wheel_instance.h) */
+_Static_assert(sizeof(fmi3Boolean) == 1, "fmi3Boolean is one byte");
+_Static_assert(sizeof(fmi3Int32) == sizeof(int), "fmi3Int32 is an int");
+
+/* fmi3Get##T / fmi3Set##T of the variables of type RW (value arrays of C type C) */
+#define VARIABLES_OF(T, RW, C)                                                                                    \
+    FMI3_Export fmi3Status fmi3Get##T(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, C v[], size_t nv) \
+    {                                                                                                             \
+        CALL(c, get_vars(w, "fmi3Get" #T, RW, vr, nvr, (void *)v, nv));                                          \
+    }                                                                                                             \
+    FMI3_Export fmi3Status fmi3Set##T(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const C v[],    \
+                                      size_t nv)                                                                  \
+    {                                                                                                             \
+        CALL(c, set_vars(w, "fmi3Set" #T, RW, vr, nvr, (const void *)v, nv));                                    \
+    }
+VARIABLES_OF(Float64, RW_REAL, fmi3Float64)
+VARIABLES_OF(Int32, RW_INTEGER, fmi3Int32)
+VARIABLES_OF(Boolean, RW_BOOLEAN, fmi3Boolean)
+VARIABLES_OF(String, RW_STRING, fmi3String)
 
 /* ------------------------------------------------------------------ FMU state (rwadist_wheel_instance.h) */
 FMI3_Export fmi3Status fmi3GetFMUState(fmi3Instance c, fmi3FMUState *s)
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi3Status)get_state(w, "fmi3GetFMUState", s);
+    CALL(c, get_state(w, "fmi3GetFMUState", s));
 }
 
 FMI3_Export fmi3Status fmi3SetFMUState(fmi3Instance c, fmi3FMUState s)
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi3Status)set_state(w, "fmi3SetFMUState", s);
+    CALL(c, set_state(w, "fmi3SetFMUState", s));
 }
 
 FMI3_Export fmi3Status fmi3FreeFMUState(fmi3Instance c, fmi3FMUState *s)
 {
-    (void)c;
-    if (s) {
-        free(*s);
-        *s = NULL;
-    }
-    return fmi3OK;
+    CALL(c, free_state(w, "fmi3FreeFMUState", s));
 }
 
 FMI3_Export fmi3Status fmi3SerializedFMUStateSize(fmi3Instance c, fmi3FMUState s, size_t *size)
 {
-    WHEEL_OR_ERROR(c)
-    if (!s || !size)
-        return (fmi3Status)fail(w, "fmi3SerializedFMUStateSize: no state or no size pointer given");
-    *size = ((const Blob *)s)->size;
-    return fmi3OK;
+    CALL(c, serialized_size(w, "fmi3SerializedFMUStateSize", s, size));
 }
 
 FMI3_Export fmi3Status fmi3SerializeFMUState(fmi3Instance c, fmi3FMUState s, fmi3Byte buf[], size_t size)
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi3Status)serialize_state(w, "fmi3SerializeFMUState", s, (char *)buf, size);
+    CALL(c, serialize_state(w, "fmi3SerializeFMUState", s, (char *)buf, size));
 }
 
 FMI3_Export fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte buf[], size_t size, fmi3FMUState *s)
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi3Status)deserialize_state(w, "fmi3DeserializeFMUState", (const char *)buf, size, s);
+    CALL(c, deserialize_state(w, "fmi3DeserializeFMUState", (const char *)buf, size, s));
 }
 
-/* ------------------------------------------------------------------ not supported by this FMU */
+/* ------------------------------------------------------------------ not supported by this FMU: fmi3Error, logged.
+ * These functions ignore their arguments by design (no unused-parameter warnings for them). */
+#if defined(__GNUC__)
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#endif
+FMI3_Export fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
+                                                      fmi3Boolean visible, fmi3Boolean loggingOn,
+                                                      fmi3InstanceEnvironment env, fmi3LogMessageCallback logMessage)
+{
+    return not_cosimulation(env, logMessage, "fmi3InstantiateModelExchange");
+}
+
+FMI3_Export fmi3Instance fmi3InstantiateScheduledExecution(fmi3String name, fmi3String token, fmi3String resources,
+                                                           fmi3Boolean visible, fmi3Boolean loggingOn,
+                                                           fmi3InstanceEnvironment env,
+                                                           fmi3LogMessageCallback logMessage,
+                                                           fmi3ClockUpdateCallback clockUpdate,
+                                                           fmi3LockPreemptionCallback lockPreemption,
+                                                           fmi3UnlockPreemptionCallback unlockPreemption)
+{
+    return not_cosimulation(env, logMessage, "fmi3InstantiateScheduledExecution");
+}
+
+/* the types this FMU has no variable of */
+#define NO_VARIABLES_OF(T)                                                                                        \
+    FMI3_Export fmi3Status fmi3Get##T(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3##T v[],    \
+                                      size_t nv)                                                                  \
+    {                                                                                                             \
+        CALL(c, no_variable(w, "fmi3Get" #T, 0, nvr, vr));                                                        \
+    }                                                                                                             \
+    FMI3_Export fmi3Status fmi3Set##T(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr,                  \
+                                      const fmi3##T v[], size_t nv)                                               \
+    {                                                                                                             \
+        CALL(c, no_variable(w, "fmi3Set" #T, 1, nvr, vr));                                                        \
+    }
+NO_VARIABLES_OF(Float32)
+NO_VARIABLES_OF(Int8)
+NO_VARIABLES_OF(UInt8)
+NO_VARIABLES_OF(Int16)
+NO_VARIABLES_OF(UInt16)
+NO_VARIABLES_OF(UInt32)
+NO_VARIABLES_OF(Int64)
+NO_VARIABLES_OF(UInt64)
+
+FMI3_Export fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, size_t sizes[],
+                                     fmi3Binary v[], size_t nv)
+{
+    CALL(c, no_variable(w, "fmi3GetBinary", 0, nvr, vr));
+}
+FMI3_Export fmi3Status fmi3SetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const size_t sizes[],
+                                     const fmi3Binary v[], size_t nv)
+{
+    CALL(c, no_variable(w, "fmi3SetBinary", 1, nvr, vr));
+}
+FMI3_Export fmi3Status fmi3GetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Clock v[])
+{
+    CALL(c, no_variable(w, "fmi3GetClock", 0, nvr, vr));
+}
+FMI3_Export fmi3Status fmi3SetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const fmi3Clock v[])
+{
+    CALL(c, no_variable(w, "fmi3SetClock", 1, nvr, vr));
+}
+
+FMI3_Export fmi3Status fmi3EnterEventMode(fmi3Instance c)
+{
+    CALL(c, REFUSE(w, "fmi3EnterEventMode: illegal call sequence: this FMU has no event mode (hasEventMode = "
+                      "false): step it with fmi3DoStep"));
+}
+
+FMI3_Export fmi3Status fmi3EnterStepMode(fmi3Instance c)
+{
+    CALL(c, REFUSE(w, "fmi3EnterStepMode: illegal call sequence: without event mode, fmi3ExitInitializationMode "
+                      "leads to Step Mode directly"));
+}
+
 #define UNSUPPORTED(NAME, WHY, ...)                                                                               \
-    FMI3_Export fmi3Status NAME(fmi3Instance c, __VA_ARGS__)                                                      \
-    {                                                                                                             \
-        WHEEL_OR_ERROR(c)                                                                                         \
-        return (fmi3Status)fail(w, #NAME ": not supported (" WHY ")");                                            \
-    }
+    FMI3_Export fmi3Status NAME(fmi3Instance c, __VA_ARGS__) { CALL(c, unsupported(w, #NAME, WHY)); }
 #define UNSUPPORTED0(NAME, WHY)                                                                                   \
-    FMI3_Export fmi3Status NAME(fmi3Instance c)                                                                   \
-    {                                                                                                             \
-        WHEEL_OR_ERROR(c)                                                                                         \
-        return (fmi3Status)fail(w, #NAME ": not supported (" WHY ")");                                            \
-    }
+    FMI3_Export fmi3Status NAME(fmi3Instance c) { CALL(c, unsupported(w, #NAME, WHY)); }
 #define CS_ONLY "a co-simulation FMU without event mode"
 #define NO_CLOCKS "this FMU has no clocks"
 
@@ -453,3 +321,5 @@ UNSUPPORTED(fmi3GetNumberOfEventIndicators, CS_ONLY, size_t *n)
 UNSUPPORTED(fmi3GetNumberOfContinuousStates, CS_ONLY, size_t *n)
 UNSUPPORTED(fmi3ActivateModelPartition, "not a scheduled-execution FMU", fmi3ValueReference clock,
             fmi3Float64 activationTime)
+UNSUPPORTED(fmi3GetOutputDerivatives, "maxOutputDerivativeOrder = 0", const fmi3ValueReference vr[], size_t nvr,
+            const fmi3Int32 orders[], fmi3Float64 v[], size_t nv)

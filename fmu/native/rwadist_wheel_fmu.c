@@ -9,11 +9,13 @@
  * parameters and units are those of the pythonfmu FMU (fmu/slave_template.py), so a host can swap
  * one FMU for the other.
  *
- * FMI state machine: rwadist_wheel_instance.h (a call out of order is answered with fmi2Error and a logged
- * message; the instance stays in its state).  Bad input (non-finite speed, a step the model does not resolve, a time that does not continue the
- * last step, a parameter out of range) is logged and answered with fmi2Error; the state stays at the
- * last good step, so the host may go on.  FMU state: get/set and serialize/deserialize (the
- * parameters travel with the state: a state restores the run it was taken from, bit for bit). */
+ * FMI state machine: rwadist_fmi_rules.h and rwadist_wheel_instance.h (a call out of order is answered with fmi2Error
+ * and a logged message).  Bad input (non-finite speed, a step the model does not resolve, a time that does not
+ * continue the last step, a parameter out of range) is logged and answered with fmi2Error; the kernel state stays at
+ * the last good step and, as FMI 2.0 says, the instance is then in the error state: fmi2SetFMUstate with a state
+ * stored before (the run goes on from there) or fmi2Reset lead on.  FMU state: get/set and serialize/deserialize
+ * (the parameters travel with the state: a state restores the run it was taken from, bit for bit).  This file only
+ * adapts the FMI 2.0 types and names to the wrapper layer. */
 #include "fmi2Functions.h"
 #include "rwadist_wheel_instance.h"
 
@@ -23,8 +25,6 @@ typedef struct {
     fmi2CallbackFunctions cb;
     char name[256];
 } Fmi2Wheel;
-
-static Wheel *as_wheel(fmi2Component c) { return (Wheel *)c; }
 
 /* the runtime's logger -> the host's fmi2CallbackLogger (the message is its format: '%' doubled, so hosts whose
  * logger cannot read varargs, ctypes callbacks e.g. fmpy, still see it) */
@@ -43,10 +43,15 @@ static void log_fmi2(void *env, RwStatus status, const char *category, const cha
         f->cb.logger(f->cb.componentEnvironment, f->name, (fmi2Status)status, category, msg);
 }
 
+/* the instance c (its Wheel as w), or fmi2Error for NULL; CALL(c, expr): the body of a function returning expr's
+ * status as an fmi2Status */
 #define WHEEL_OR_ERROR(c)                                                                                         \
-    Wheel *w = as_wheel(c);                                                                                       \
+    Wheel *w = (Wheel *)(c);                                                                                      \
     if (!w)                                                                                                       \
         return fmi2Error;
+#define CALL(c, expr)                                                                                             \
+    WHEEL_OR_ERROR(c)                                                                                             \
+    return (fmi2Status)(expr)
 
 FMI2_Export const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 FMI2_Export const char *fmi2GetVersion(void) { return fmi2Version; }
@@ -73,11 +78,12 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     tmp.w.logger = log_fmi2;
     tmp.w.log_env = &tmp;
     if (type != fmi2CoSimulation) {
-        fail(&tmp.w, "fmi2Instantiate: this FMU is for co-simulation only");
+        fail(&tmp.w, "fmi2Instantiate: this FMU is for co-simulation only: instantiate it with fmi2CoSimulation");
         return NULL;
     }
     if (!guid || strcmp(guid, RW_GUID) != 0) {
-        fail(&tmp.w, "fmi2Instantiate: GUID %s does not match this FMU's %s", guid ? guid : "(null)", RW_GUID);
+        fail(&tmp.w, "fmi2Instantiate: GUID %s does not match this FMU's %s: the host read another FMU's model "
+                     "description; load this FMU's", guid ? guid : "(null)", RW_GUID);
         return NULL;
     }
     Fmi2Wheel *f = calloc(1, sizeof *f);
@@ -86,237 +92,166 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         return NULL;
     }
     *f = tmp;
-    Wheel *w = &f->w;
-    w->log_env = f;
-    w->logging_on = loggingOn != fmi2False;
-    w->mode = ST_INSTANTIATED;
-    set_defaults(w);
-    logf_(w, RW_OK, "logAll", "rwadist wheel (native C FMU): %s", RW_PHYSICS);
+    f->w.log_env = f;
+    instantiated(&f->w, 2, loggingOn != fmi2False);
     return f;
 }
 
 FMI2_Export void fmi2FreeInstance(fmi2Component c)
 {
-    Wheel *w = as_wheel(c);
-    if (!w)
+    if (!c)
         return;
-    free_model(w);
+    free_model((Wheel *)c);
     free(c);
 }
 
 FMI2_Export fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real t0,
                                            fmi2Boolean stopDef, fmi2Real stop)
 {
-    WHEEL_OR_ERROR(c)
-    if (!allowed(w, IN(ST_INSTANTIATED), "fmi2SetupExperiment"))
-        return fmi2Error;
-    if (!isfinite(t0))
-        return (fmi2Status)fail(w, "fmi2SetupExperiment: start time %g is not finite", t0);
-    if (stopDef && !(stop >= t0))
-        return (fmi2Status)fail(w, "fmi2SetupExperiment: stop time %g s is before the start time %g s", stop, t0);
-    if (tolDef && !(tol > 0 && isfinite(tol)))
-        return (fmi2Status)fail(w, "fmi2SetupExperiment: tolerance %g is not a positive number", tol);
-    w->mu.t_host = t0;
-    return fmi2OK;
+    CALL(c, setup_experiment(w, "fmi2SetupExperiment", tolDef, tol, t0, stopDef, stop));
 }
 
 FMI2_Export fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 {
-    WHEEL_OR_ERROR(c)
-    if (!allowed(w, IN(ST_INSTANTIATED), "fmi2EnterInitializationMode"))
-        return fmi2Error;
-    w->mode = ST_INIT;
-    return fmi2OK;
+    CALL(c, enter_initialization(w, "fmi2EnterInitializationMode"));
 }
 
 FMI2_Export fmi2Status fmi2ExitInitializationMode(fmi2Component c)
 {
-    WHEEL_OR_ERROR(c)
-    if (!allowed(w, IN(ST_INIT), "fmi2ExitInitializationMode"))
-        return fmi2Error;
-    return (fmi2Status)exit_initialization(w);
+    CALL(c, exit_initialization(w, "fmi2ExitInitializationMode"));
 }
 
-FMI2_Export fmi2Status fmi2Terminate(fmi2Component c)
-{
-    WHEEL_OR_ERROR(c)
-    if (!allowed(w, IN(ST_STEP), "fmi2Terminate"))
-        return fmi2Error;
-    w->mode = ST_TERMINATED;
-    return fmi2OK;
-}
-
-FMI2_Export fmi2Status fmi2Reset(fmi2Component c)
-{
-    WHEEL_OR_ERROR(c)
-    free_model(w);
-    set_defaults(w);
-    w->mode = ST_INSTANTIATED;
-    return fmi2OK;
-}
+FMI2_Export fmi2Status fmi2Terminate(fmi2Component c) { CALL(c, terminate(w, "fmi2Terminate")); }
+FMI2_Export fmi2Status fmi2Reset(fmi2Component c) { CALL(c, reset(w, "fmi2Reset")); }
 
 FMI2_Export fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[])
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)get_reals(w, "fmi2GetReal", vr, n, v);
+    CALL(c, get_vars(w, "fmi2GetReal", RW_REAL, vr, n, v, n));
 }
 
 FMI2_Export fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[])
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)set_reals(w, "fmi2SetReal", vr, n, v);
+    CALL(c, set_vars(w, "fmi2SetReal", RW_REAL, vr, n, v, n));
 }
 
 FMI2_Export fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[])
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)get_seed(w, "fmi2GetInteger", vr, n, v);
+    CALL(c, get_vars(w, "fmi2GetInteger", RW_INTEGER, vr, n, v, n));
 }
 
 FMI2_Export fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[])
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)set_seed(w, "fmi2SetInteger", vr, n, v);
+    CALL(c, set_vars(w, "fmi2SetInteger", RW_INTEGER, vr, n, v, n));
 }
 
 FMI2_Export fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[])
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)get_bools(w, "fmi2GetBoolean", vr, n, v, 1);
+    CALL(c, get_vars(w, "fmi2GetBoolean", RW_BOOLEAN, vr, n, v, n));
 }
 
 FMI2_Export fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean v[])
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)set_bools(w, "fmi2SetBoolean", vr, n, v, 1);
+    CALL(c, set_vars(w, "fmi2SetBoolean", RW_BOOLEAN, vr, n, v, n));
 }
 
 FMI2_Export fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[])
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)get_strings(w, "fmi2GetString", vr, n, v);
+    CALL(c, get_vars(w, "fmi2GetString", RW_STRING, vr, n, v, n));
 }
 
 FMI2_Export fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[])
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)set_strings(w, "fmi2SetString", vr, n, v);
+    CALL(c, set_vars(w, "fmi2SetString", RW_STRING, vr, n, v, n));
 }
 
 FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior)
 {
     (void)noSetPrior;
-    WHEEL_OR_ERROR(c)
-    if (!allowed(w, IN(ST_STEP), "fmi2DoStep"))
-        return fmi2Error;
-    return (fmi2Status)do_step(w, t, h);
+    CALL(c, do_step(w, "fmi2DoStep", t, h));
 }
 
-FMI2_Export fmi2Status fmi2CancelStep(fmi2Component c)
-{
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)fail(w, "fmi2CancelStep: illegal call sequence: steps are synchronous, no step is in "
-                               "progress to cancel");
-}
-
-FMI2_Export fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind k, fmi2Status *v)
-{
-    (void)k, (void)v;
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)fail(w, "fmi2GetStatus: not supported (steps are synchronous)");
-}
 FMI2_Export fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi2Real *v)
 {
     WHEEL_OR_ERROR(c)
-    if (!allowed(w, IN(ST_STEP) | IN(ST_TERMINATED), "fmi2GetRealStatus"))
+    if (!admit(w, RW_GET_STATUS, "fmi2GetRealStatus"))
         return fmi2Error;
     if (k == fmi2LastSuccessfulTime && v) {
         *v = w->mu.t_host;
         return fmi2OK;
     }
-    return (fmi2Status)fail(w, "fmi2GetRealStatus: status kind %d not supported", (int)k);
-}
-FMI2_Export fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind k, fmi2Integer *v)
-{
-    (void)k, (void)v;
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)fail(w, "fmi2GetIntegerStatus: not supported");
-}
-FMI2_Export fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v)
-{
-    (void)k, (void)v;
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)fail(w, "fmi2GetBooleanStatus: not supported");
-}
-FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind k, fmi2String *v)
-{
-    (void)k, (void)v;
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)fail(w, "fmi2GetStringStatus: not supported");
-}
-FMI2_Export fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
-                                                   const fmi2Integer order[], const fmi2Real v[])
-{
-    (void)vr, (void)n, (void)order, (void)v;
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)fail(w, "fmi2SetRealInputDerivatives: not supported (canInterpolateInputs = false)");
-}
-FMI2_Export fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
-                                                    const fmi2Integer order[], fmi2Real v[])
-{
-    (void)vr, (void)n, (void)order, (void)v;
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)fail(w, "fmi2GetRealOutputDerivatives: not supported (maxOutputDerivativeOrder = 0)");
-}
-FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
-                                                    const fmi2ValueReference z[], size_t nz, const fmi2Real dv[],
-                                                    fmi2Real dz[])
-{
-    (void)u, (void)nu, (void)z, (void)nz, (void)dv, (void)dz;
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)fail(w, "fmi2GetDirectionalDerivative: not supported");
+    return (fmi2Status)REFUSE(w, "fmi2GetRealStatus: status kind %d not supported: ask fmi2LastSuccessfulTime", (int)k);
 }
 
 /* ------------------------------------------------------------------ FMU state (rwadist_wheel_instance.h) */
 FMI2_Export fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *s)
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)get_state(w, "fmi2GetFMUstate", s);
+    CALL(c, get_state(w, "fmi2GetFMUstate", s));
 }
 
 FMI2_Export fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate s)
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)set_state(w, "fmi2SetFMUstate", s);
+    CALL(c, set_state(w, "fmi2SetFMUstate", s));
 }
 
 FMI2_Export fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *s)
 {
-    (void)c;
-    if (s) {
-        free(*s);
-        *s = NULL;
-    }
-    return fmi2OK;
+    CALL(c, free_state(w, "fmi2FreeFMUstate", s));
 }
 
 FMI2_Export fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t *size)
 {
-    WHEEL_OR_ERROR(c)
-    if (!s || !size)
-        return (fmi2Status)fail(w, "fmi2SerializedFMUstateSize: no state or no size pointer given");
-    *size = ((const Blob *)s)->size;
-    return fmi2OK;
+    CALL(c, serialized_size(w, "fmi2SerializedFMUstateSize", s, size));
 }
 
 FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte buf[], size_t size)
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)serialize_state(w, "fmi2SerializeFMUstate", s, buf, size);
+    CALL(c, serialize_state(w, "fmi2SerializeFMUstate", s, buf, size));
 }
 
 FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte buf[], size_t size, fmi2FMUstate *s)
 {
-    WHEEL_OR_ERROR(c)
-    return (fmi2Status)deserialize_state(w, "fmi2DeSerializeFMUstate", buf, size, s);
+    CALL(c, deserialize_state(w, "fmi2DeSerializeFMUstate", buf, size, s));
+}
+
+/* ------------------------------------------------------------------ not supported by this FMU: fmi2Error, logged.
+ * These functions ignore their arguments by design (no unused-parameter warnings for them). */
+#if defined(__GNUC__)
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#endif
+FMI2_Export fmi2Status fmi2CancelStep(fmi2Component c)
+{
+    CALL(c, REFUSE(w, "fmi2CancelStep: illegal call sequence: steps are synchronous, no step is in progress to "
+                      "cancel"));
+}
+FMI2_Export fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind k, fmi2Status *v)
+{
+    CALL(c, unsupported(w, "fmi2GetStatus", "steps are synchronous: no step is pending"));
+}
+FMI2_Export fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind k, fmi2Integer *v)
+{
+    CALL(c, unsupported(w, "fmi2GetIntegerStatus", "this FMU has no integer status"));
+}
+FMI2_Export fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v)
+{
+    CALL(c, unsupported(w, "fmi2GetBooleanStatus", "fmi2DoStep never returns fmi2Discard"));
+}
+FMI2_Export fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind k, fmi2String *v)
+{
+    CALL(c, unsupported(w, "fmi2GetStringStatus", "steps are synchronous: no step is pending"));
+}
+FMI2_Export fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                                   const fmi2Integer order[], const fmi2Real v[])
+{
+    CALL(c, unsupported(w, "fmi2SetRealInputDerivatives", "canInterpolateInputs = false"));
+}
+FMI2_Export fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                                    const fmi2Integer order[], fmi2Real v[])
+{
+    CALL(c, unsupported(w, "fmi2GetRealOutputDerivatives", "maxOutputDerivativeOrder = 0"));
+}
+FMI2_Export fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                                    const fmi2ValueReference z[], size_t nz, const fmi2Real dv[],
+                                                    fmi2Real dz[])
+{
+    CALL(c, unsupported(w, "fmi2GetDirectionalDerivative", "providesDirectionalDerivative = false"));
 }

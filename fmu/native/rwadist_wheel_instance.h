@@ -1,48 +1,45 @@
 /* rwadist wheel FMU in C: the FMI wrapper layer common to FMI 2.0 (rwadist_wheel_fmu.c) and FMI 3.0
- * (rwadist_wheel_fmi3.c): the FMI state machine, parameter defaults, variable access by value reference and
- * the FMU state (get/set, serialize).  The physics is rwadist_wheel_runtime.h; nothing here computes a load.
+ * (rwadist_wheel_fmi3.c): every FMI call's work, version-neutral -- the state machine of rwadist_fmi_rules.h (the
+ * standards' tables: which call each state allows, where an error leads), parameter defaults, variables by value
+ * reference, one step, the FMU state (get/set, serialize).  The API files only adapt types and names.  The physics is
+ * rwadist_wheel_runtime.h; nothing here computes a load.
  *
- * State machine (FMI 2.0 section 4.2.4, FMI 3.0 section 4.2; co-simulation without event mode): an instance is
- * INSTANTIATED, in INITIALIZATION mode, STEPPING (FMI 2.0 stepComplete, FMI 3.0 Step Mode), TERMINATED, or
- * FAILED (initialisation failed: FMI's error state).  Every entry point names the states it is allowed in; a call
- * in another state is answered with Error and a logged message naming the call, the state and what to call
- * first, and changes nothing (the instance stays in its state, so the host can go on in order).  A refused value
- * (bad input, bad parameter) leaves the instance in its state as well; only a failed initialisation moves it to
- * FAILED, from which Reset, a stored FMU state or FreeInstance lead on. */
+ * Every call is admitted by its row of the table (admit) and ends through finish: a call not allowed in the
+ * instance's state is answered with Error and a logged message naming the call, the state, the states it is allowed
+ * in and what to call next; any Error (refused call, bad value, failed initialisation or step) then moves the
+ * instance as its FMI version says (FMI 2.0: to the error state, from terminated nowhere; FMI 3.0: to Terminated).
+ * From there the getters (values for debugging), Reset, the FMU-state functions (a state stored before the error
+ * restores the run) and FreeInstance lead on. */
 #ifndef RWADIST_WHEEL_INSTANCE_H
 #define RWADIST_WHEEL_INSTANCE_H
+#include "rwadist_fmi_rules.h"
 #include "rwadist_wheel_runtime.h"
 
-/* Wheel.mode: the numbers are stored in a serialized FMU state, keep them */
-enum { ST_INSTANTIATED = 0, ST_INIT = 1, ST_STEP = 2, ST_TERMINATED = 3, ST_FAILED = 4, N_ST = 5 };
-#define IN(s) (1u << (s))
-#define ANY_STATE (IN(ST_INSTANTIATED) | IN(ST_INIT) | IN(ST_STEP) | IN(ST_TERMINATED) | IN(ST_FAILED))
-#define SETTABLE (IN(ST_INSTANTIATED) | IN(ST_INIT) | IN(ST_STEP))
-#define READABLE (IN(ST_INIT) | IN(ST_STEP) | IN(ST_TERMINATED) | IN(ST_FAILED))
-
-static const char *const STATE_NAMES[N_ST] = {"instantiated", "initialization mode", "stepping", "terminated",
-                                             "failed (initialisation failed)"};
-/* what leads out of each state */
-static const char *const STATE_NEXT[N_ST] = {
-    "enter initialization mode first", "exit initialization mode first", "the instance is stepping",
-    "the instance is terminated: reset it (or free it) to run again",
-    "initialisation failed (see the error logged then): reset the instance, set a stored FMU state, or free it"};
-
-/* 1 when the call `fn` is allowed in the instance's state (mask of IN(state)); else a logged error, 0 */
-static int allowed(Wheel *w, unsigned mask, const char *fn)
+/* the status of a call, after FMI's transition on Error */
+static RwStatus finish(Wheel *w, RwStatus s)
 {
-    if (w->mode >= 0 && w->mode < N_ST && (mask & IN(w->mode)))
+    if (s >= RW_ERROR)
+        w->mode = rw_error_state(w->fmi, w->mode);
+    return s;
+}
+
+/* Error, logged (printf format), after FMI's transition */
+#define REFUSE(w, ...) finish((w), fail((w), __VA_ARGS__))
+
+/* 1 when `call` (the FMI function fn) is allowed in w's state; else it is refused (logged, transition made), 0 */
+static int admit(Wheel *w, RwCall call, const char *fn)
+{
+    if (rw_allowed(w->fmi, w->mode, call))
         return 1;
-    char states[160] = "";
-    for (int s = 0; s < N_ST; s++)
-        if (mask & IN(s)) {
-            const size_t len = strlen(states);
-            snprintf(states + len, sizeof states - len, "%s%s", len ? ", " : "", STATE_NAMES[s]);
-        }
-    fail(w, "%s: illegal call sequence: the instance is %s; %s is allowed when %s (%s)", fn,
-         w->mode >= 0 && w->mode < N_ST ? STATE_NAMES[w->mode] : "in an unknown state", fn,
-         states[0] ? states : "never", w->mode >= 0 && w->mode < N_ST ? STATE_NEXT[w->mode] : "free it");
+    char message[768];
+    rw_refusal(message, sizeof message, w->fmi, call, w->mode, fn);
+    REFUSE(w, "%s", message);
     return 0;
+}
+
+static RwStatus unsupported(Wheel *w, const char *fn, const char *why)
+{
+    return REFUSE(w, "%s: not supported (%s)", fn, why);
 }
 
 static void set_defaults(Wheel *w)
@@ -61,10 +58,47 @@ static void set_defaults(Wheel *w)
     memset(&w->mu, 0, sizeof w->mu);
 }
 
-/* leave initialization mode: build the model from the parameters, outputs at the initial inputs (both FMI
- * versions' ExitInitializationMode); RW_ERROR and the FAILED state on a bad parameter */
-static RwStatus exit_initialization(Wheel *w)
+/* a new instance (after the wrapper installed its logger) */
+static void instantiated(Wheel *w, int fmi, int logging_on)
 {
+    w->fmi = fmi;
+    w->logging_on = logging_on;
+    w->mode = ST_INSTANTIATED;
+    set_defaults(w);
+    logf_(w, RW_OK, "logAll", "rwadist wheel (native C FMU, FMI %d.0): %s", fmi, RW_PHYSICS);
+}
+
+/* ------------------------------------------------------------------ the run: set-up, initialisation, steps */
+/* start time, stop time, tolerance (fmi2SetupExperiment; the arguments of fmi3EnterInitializationMode) */
+static RwStatus setup_experiment(Wheel *w, const char *fn, int tol_def, double tol, double t0, int stop_def,
+                                 double stop)
+{
+    if (!admit(w, RW_SETUP_EXPERIMENT, fn))
+        return RW_ERROR;
+    if (!isfinite(t0))
+        return REFUSE(w, "%s: start time %g is not finite: give the run's start time in s", fn, t0);
+    if (stop_def && !(stop >= t0))
+        return REFUSE(w, "%s: stop time %g s is before the start time %g s: give a stop time after the start, or "
+                         "none", fn, stop, t0);
+    if (tol_def && !(tol > 0 && isfinite(tol)))
+        return REFUSE(w, "%s: tolerance %g is not a positive number: give one > 0, or none", fn, tol);
+    w->mu.t_host = t0;
+    return RW_OK;
+}
+
+static RwStatus enter_initialization(Wheel *w, const char *fn)
+{
+    if (!admit(w, RW_ENTER_INIT, fn))
+        return RW_ERROR;
+    w->mode = ST_INIT;
+    return RW_OK;
+}
+
+/* leave initialization mode: build the model from the parameters, outputs at the initial inputs */
+static RwStatus exit_initialization(Wheel *w, const char *fn)
+{
+    if (!admit(w, RW_EXIT_INIT, fn))
+        return RW_ERROR;
     const double t_host = w->mu.t_host, speed = w->mu.speed, accel = w->mu.accel;
     memset(&w->mu, 0, sizeof w->mu);
     w->mu.t_host = t_host;
@@ -72,10 +106,8 @@ static RwStatus exit_initialization(Wheel *w)
     w->mu.speed = speed;
     w->mu.accel = accel;
     w->floor_warned = 0;
-    if (!build_model(w)) {
-        w->mode = ST_FAILED;
-        return RW_ERROR;
-    }
+    if (!build_model(w))
+        return finish(w, RW_ERROR);
     if (RW_MODES_ASSUMED && w->par.modes)
         logf_(w, RW_WARNING, "logStatusWarning", "rwadist wheel: the suspension modes of this wheel are ASSUMED "
               "(datasheet wheel, not measured); the outputs with modes = true are built on assumed values "
@@ -87,20 +119,21 @@ static RwStatus exit_initialization(Wheel *w)
         for (int k = 0; k < 12; k++)
             if (!isfinite(w->mu.y[k])) {
                 memset(w->mu.y, 0, sizeof w->mu.y);
-                w->mode = ST_FAILED;
-                return fail(w, "initialisation failed: the outputs at the initial wheel_speed = %g rad/s are not "
-                               "finite", speed);
+                return REFUSE(w, "initialisation failed: the outputs at the initial wheel_speed = %g rad/s are not "
+                                 "finite", speed);
             }
     }
     return RW_OK;
 }
 
-/* one communication step at host time t (both versions' DoStep; the state is checked by the caller) */
-static RwStatus do_step(Wheel *w, double t, double h)
+/* one communication step at host time t */
+static RwStatus do_step(Wheel *w, const char *fn, double t, double h)
 {
+    if (!admit(w, RW_DO_STEP, fn))
+        return RW_ERROR;
     if (!isfinite(t) || fabs(t - w->mu.t_host) > 1e-9 * fmax(1.0, fabs(t)))
-        return fail(w, "step rejected: communication point %.12g s does not continue the last step (expected "
-                       "%.12g s)", t, w->mu.t_host);
+        return REFUSE(w, "step rejected: communication point %.12g s does not continue the last step (expected "
+                         "%.12g s)", t, w->mu.t_host);
     Mutable saved = w->mu;
     const RwStatus s = step(w, t, h);
     if (s != RW_OK) {
@@ -108,26 +141,51 @@ static RwStatus do_step(Wheel *w, double t, double h)
          * a non-finite output: roll the scalars back; the kernel state then holds the bad step) */
         if (w->mu.t != saved.t)
             w->mu = saved;
-        return s;
+        return finish(w, s);
     }
     w->mu.t_host = t + h;
     return RW_OK;
 }
 
-/* ------------------------------------------------------------------ variables by value reference */
-static int is_real_vr(unsigned vr) { return vr == VR_SPEED || vr == VR_ACCEL || (vr >= VR_FLOOR_RES && vr < N_VR); }
-static int is_input_vr(unsigned vr) { return vr == VR_SPEED || vr == VR_ACCEL; }
+static RwStatus terminate(Wheel *w, const char *fn)
+{
+    if (!admit(w, RW_TERMINATE, fn))
+        return RW_ERROR;
+    w->mode = ST_TERMINATED;
+    return RW_OK;
+}
 
-static double *real_slot(Wheel *w, unsigned vr)
+static RwStatus reset(Wheel *w, const char *fn)
+{
+    if (!admit(w, RW_RESET, fn))
+        return RW_ERROR;
+    free_model(w);
+    set_defaults(w);
+    w->mode = ST_INSTANTIATED;
+    return RW_OK;
+}
+
+/* ------------------------------------------------------------------ variables by value reference */
+/* where value reference vr is kept (double for Real, int for Integer and Boolean; NULL: model_file, kept nowhere) */
+static void *slot(Wheel *w, unsigned vr)
 {
     switch (vr) {
     case VR_SPEED: return &w->mu.speed;
     case VR_ACCEL: return &w->mu.accel;
+    case VR_USE_ACCEL: return &w->par.use_accel;
+    case VR_SEED: return &w->par.seed;
+    case VR_IMBALANCE: return &w->par.imbalance;
+    case VR_HARMONICS: return &w->par.harmonics;
+    case VR_MODES: return &w->par.modes;
+    case VR_START_STEADY: return &w->par.start_steady;
     case VR_FLOOR_RES: return &w->par.floor_res;
     case VR_MAX_ACCEL: return &w->par.max_accel;
     case VR_MAX_STEP: return &w->par.max_step;
+    case VR_TIME: return &w->mu.t_host;
     default: break;
     }
+    if (vr >= VR_SWITCH && vr < VR_SWITCH + N_SWITCH)
+        return &w->par.sw[vr - VR_SWITCH];
     if (vr >= VR_DCM && vr < VR_DCM + 9)
         return &w->par.dcm[vr - VR_DCM];
     if (vr >= VR_POS && vr < VR_POS + 3)
@@ -137,160 +195,118 @@ static double *real_slot(Wheel *w, unsigned vr)
     return NULL;
 }
 
-static int *bool_slot(Wheel *w, unsigned vr)
+/* n value references and nv values given (every variable is a scalar: nv == n), NULL arrays only when n == 0 */
+static int arrays_ok(Wheel *w, const char *fn, size_t n, size_t nv, const void *vr, const void *v)
 {
-    switch (vr) {
-    case VR_USE_ACCEL: return &w->par.use_accel;
-    case VR_IMBALANCE: return &w->par.imbalance;
-    case VR_HARMONICS: return &w->par.harmonics;
-    case VR_MODES: return &w->par.modes;
-    case VR_START_STEADY: return &w->par.start_steady;
-    default: return vr >= VR_SWITCH && vr < VR_SWITCH + N_SWITCH ? &w->par.sw[vr - VR_SWITCH] : NULL;
-    }
+    if (nv != n)
+        REFUSE(w, "%s: %zu values for %zu value references: every variable of this FMU is a scalar, give one value "
+                  "each", fn, nv, n);
+    else if (n && (!vr || !v))
+        REFUSE(w, "%s: %zu values asked with a NULL %s array", fn, n, vr ? "value" : "value reference");
+    else
+        return 1;
+    return 0;
 }
 
-/* a value-reference array the host gave: n > 0 needs both arrays */
-static int arrays_ok(Wheel *w, const char *fn, size_t n, const void *vr, const void *v)
+static const char *type_name(const Wheel *w, RwType type) { return RW_TYPE_NAMES[w->fmi == 3][type]; }
+
+/* fmiXGet{type}: values of n variables into v (Boolean: int for FMI 2.0, one byte for FMI 3.0) */
+static RwStatus get_vars(Wheel *w, const char *fn, RwType type, const unsigned vr[], size_t n, void *v, size_t nv)
 {
-    if (n && (!vr || !v)) {
-        fail(w, "%s: %zu values asked with a NULL %s array", fn, n, vr ? "value" : "value reference");
-        return 0;
+    if (!admit(w, RW_GET, fn) || !arrays_ok(w, fn, n, nv, vr, v))
+        return RW_ERROR;
+    for (size_t i = 0; i < n; i++) {
+        if (rw_variable(w->fmi, vr[i], NULL) != type)
+            return REFUSE(w, "%s: value reference %u is not a%s %s variable of this FMU", fn, vr[i],
+                          type == RW_INTEGER ? "n" : "", type_name(w, type));
+        const void *s = slot(w, vr[i]);
+        if (type == RW_REAL)
+            ((double *)v)[i] = *(const double *)s;
+        else if (type == RW_INTEGER)
+            ((int *)v)[i] = *(const int *)s;
+        else if (type == RW_BOOLEAN && w->fmi == 2)
+            ((int *)v)[i] = *(const int *)s != 0;
+        else if (type == RW_BOOLEAN)
+            ((unsigned char *)v)[i] = *(const int *)s != 0;
+        else
+            ((const char **)v)[i] = "";
+    }
+    return RW_OK;
+}
+
+#if N_SWITCH != N_SWITCH_VR
+#error "the model's effect switches (N_SWITCH) do not fill the FMU's switch value references (N_SWITCH_VR)"
+#endif
+
+/* the name of value reference vr <= N_VR: an effect switch by the name its element gives it */
+static const char *var_name(unsigned vr)
+{
+    return vr >= VR_SWITCH && vr < VR_SWITCH + N_SWITCH ? RW_SWITCH_NAMES[vr - VR_SWITCH] : RW_VAR_NAMES[vr];
+}
+
+/* whether the n references of a set are all settable variables of `type`; *parameters: one is a parameter */
+static int settable(Wheel *w, const char *fn, RwType type, const unsigned vr[], size_t n, const void *v,
+                    int *parameters)
+{
+    *parameters = 0;
+    for (size_t i = 0; i < n; i++) {
+        RwCausality c;
+        const char *why = rw_not_settable(w->fmi, vr[i], type);
+        if (why) {
+            REFUSE(w, "%s: value reference %u%s%s%s %s (this call sets %s variables)", fn, vr[i],
+                   vr[i] <= N_VR ? " (" : "", vr[i] <= N_VR ? var_name(vr[i]) : "", vr[i] <= N_VR ? ")" : "",
+                   why, type_name(w, type));
+            return 0;
+        }
+        rw_variable(w->fmi, vr[i], &c);
+        *parameters |= c == RW_PARAMETER;
+        if (type == RW_STRING && ((const char *const *)v)[i] && ((const char *const *)v)[i][0]) {
+            REFUSE(w, "%s: model_file = '%s': the native FMU carries its model compiled in; build another FMU from "
+                      "that model file (rwadist fmu build --native FILE)", fn, ((const char *const *)v)[i]);
+            return 0;
+        }
     }
     return 1;
 }
 
-/* a fixed parameter may change in INSTANTIATED and INITIALIZATION mode only */
-static int parameter_settable(Wheel *w, const char *fn, unsigned vr)
+/* fmiXSet{type}: n values from v; nothing is written when a reference or the state refuses the call */
+static RwStatus set_vars(Wheel *w, const char *fn, RwType type, const unsigned vr[], size_t n, const void *v,
+                         size_t nv)
 {
-    if (w->mode == ST_INSTANTIATED || w->mode == ST_INIT)
-        return 1;
-    fail(w, "%s: value reference %u is a fixed parameter; set it before the end of initialisation (the "
-            "instance is %s)", fn, vr, STATE_NAMES[w->mode]);
-    return 0;
-}
-
-static RwStatus get_reals(Wheel *w, const char *fn, const unsigned vr[], size_t n, double v[])
-{
-    if (!allowed(w, READABLE, fn) || !arrays_ok(w, fn, n, vr, v))
+    int parameters;
+    if (!arrays_ok(w, fn, n, nv, vr, v) || !settable(w, fn, type, vr, n, v, &parameters) ||
+        !admit(w, parameters ? RW_SET_PARAMETER : RW_SET_INPUT, fn))
         return RW_ERROR;
     for (size_t i = 0; i < n; i++) {
-        double *s = is_real_vr(vr[i]) ? real_slot(w, vr[i]) : NULL;
-        if (!s)
-            return fail(w, "%s: value reference %u is not a Real (Float64) variable of this FMU", fn, vr[i]);
-        v[i] = *s;
+        void *s = slot(w, vr[i]);
+        if (type == RW_REAL)
+            *(double *)s = ((const double *)v)[i];
+        else if (type == RW_INTEGER)
+            *(int *)s = ((const int *)v)[i];
+        else if (type == RW_BOOLEAN)
+            *(int *)s = w->fmi == 2 ? ((const int *)v)[i] != 0 : ((const unsigned char *)v)[i] != 0;
     }
     return RW_OK;
 }
 
-static RwStatus set_reals(Wheel *w, const char *fn, const unsigned vr[], size_t n, const double v[])
+/* fmiXGet/Set of a type this FMU has no variable of: every value reference is refused */
+static RwStatus no_variable(Wheel *w, const char *fn, int set, size_t n, const unsigned vr[])
 {
-    if (!allowed(w, SETTABLE, fn) || !arrays_ok(w, fn, n, vr, v))
+    if (!admit(w, set ? RW_SET_INPUT : RW_GET, fn))
         return RW_ERROR;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] >= VR_OUT && vr[i] < VR_OUT + 12)
-            return fail(w, "%s: value reference %u is an output", fn, vr[i]);
-        double *s = is_real_vr(vr[i]) ? real_slot(w, vr[i]) : NULL;
-        if (!s)
-            return fail(w, "%s: value reference %u is not a Real (Float64) variable of this FMU", fn, vr[i]);
-        if (!is_input_vr(vr[i]) && !parameter_settable(w, fn, vr[i]))
-            return RW_ERROR;
-        *s = v[i];
-    }
-    return RW_OK;
-}
-
-static RwStatus get_seed(Wheel *w, const char *fn, const unsigned vr[], size_t n, int v[])
-{
-    if (!allowed(w, READABLE, fn) || !arrays_ok(w, fn, n, vr, v))
-        return RW_ERROR;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != VR_SEED)
-            return fail(w, "%s: value reference %u is not an Integer (Int32) variable of this FMU", fn, vr[i]);
-        v[i] = w->par.seed;
-    }
-    return RW_OK;
-}
-
-static RwStatus set_seed(Wheel *w, const char *fn, const unsigned vr[], size_t n, const int v[])
-{
-    if (!allowed(w, SETTABLE, fn) || !arrays_ok(w, fn, n, vr, v))
-        return RW_ERROR;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != VR_SEED)
-            return fail(w, "%s: value reference %u is not an Integer (Int32) variable of this FMU", fn, vr[i]);
-        if (!parameter_settable(w, fn, vr[i]))
-            return RW_ERROR;
-        w->par.seed = v[i];
-    }
-    return RW_OK;
-}
-
-/* Booleans as ints (fmi2Boolean) or bytes (fmi3Boolean): `wide` says which */
-static RwStatus get_bools(Wheel *w, const char *fn, const unsigned vr[], size_t n, void *v, int wide)
-{
-    if (!allowed(w, READABLE, fn) || !arrays_ok(w, fn, n, vr, v))
-        return RW_ERROR;
-    for (size_t i = 0; i < n; i++) {
-        int *s = bool_slot(w, vr[i]);
-        if (!s)
-            return fail(w, "%s: value reference %u is not a Boolean variable of this FMU", fn, vr[i]);
-        if (wide)
-            ((int *)v)[i] = *s != 0;
-        else
-            ((unsigned char *)v)[i] = *s != 0;
-    }
-    return RW_OK;
-}
-
-static RwStatus set_bools(Wheel *w, const char *fn, const unsigned vr[], size_t n, const void *v, int wide)
-{
-    if (!allowed(w, SETTABLE, fn) || !arrays_ok(w, fn, n, vr, v))
-        return RW_ERROR;
-    for (size_t i = 0; i < n; i++) {
-        int *s = bool_slot(w, vr[i]);
-        if (!s)
-            return fail(w, "%s: value reference %u is not a Boolean variable of this FMU", fn, vr[i]);
-        if (!parameter_settable(w, fn, vr[i]))
-            return RW_ERROR;
-        *s = wide ? ((const int *)v)[i] != 0 : ((const unsigned char *)v)[i] != 0;
-    }
-    return RW_OK;
-}
-
-static RwStatus get_strings(Wheel *w, const char *fn, const unsigned vr[], size_t n, const char *v[])
-{
-    if (!allowed(w, READABLE, fn) || !arrays_ok(w, fn, n, vr, v))
-        return RW_ERROR;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != VR_MODEL_FILE)
-            return fail(w, "%s: value reference %u is not a String variable of this FMU", fn, vr[i]);
-        v[i] = "";
-    }
-    return RW_OK;
-}
-
-static RwStatus set_strings(Wheel *w, const char *fn, const unsigned vr[], size_t n, const char *const v[])
-{
-    if (!allowed(w, SETTABLE, fn) || !arrays_ok(w, fn, n, vr, v))
-        return RW_ERROR;
-    for (size_t i = 0; i < n; i++) {
-        if (vr[i] != VR_MODEL_FILE)
-            return fail(w, "%s: value reference %u is not a String variable of this FMU", fn, vr[i]);
-        if (!parameter_settable(w, fn, vr[i]))
-            return RW_ERROR;
-        if (v[i] && v[i][0])
-            return fail(w, "%s: model_file = '%s': the native FMU carries its model compiled in; build another FMU "
-                           "from that model file (rwadist fmu build --native FILE)", fn, v[i]);
-    }
-    return RW_OK;
+    if (!n)
+        return RW_OK;
+    return REFUSE(w, "%s: value reference %u: this FMU has no variable of this type", fn, vr ? vr[0] : 0u);
 }
 
 /* ------------------------------------------------------------------ FMU state
- * Layout (native byte order): header {magic, version, sizeof(Params), sizeof(Mutable), n, n_floor, mode},
- * Params, Mutable, the kernel state (2 + 2n + 12 doubles), the floor phasors (n_floor complex). */
+ * Layout (native byte order): header {magic, version, sizeof(Params), sizeof(Mutable), n, n_floor, mode,
+ * floor_warned, built}, Params, Mutable, the kernel state (2 + 2n + 12 doubles), the floor phasors (n_floor complex).
+ * `built`: the model was built (after initialisation; its kernel state follows), whatever the state. */
+#define STATE_VERSION 2
 typedef struct {
     uint32_t magic, version, size_par, size_mu;
-    int32_t n, n_floor, mode, floor_warned;
+    int32_t n, n_floor, mode, floor_warned, built;
 } StateHeader;
 
 typedef struct {
@@ -306,7 +322,8 @@ static size_t state_size(int n, int n_floor)
 
 static void write_state(const Wheel *w, char *buf)
 {
-    StateHeader hd = {STATE_MAGIC, 1, sizeof(Params), sizeof(Mutable), w->n, w->n_floor, w->mode, w->floor_warned};
+    StateHeader hd = {STATE_MAGIC, STATE_VERSION, sizeof(Params), sizeof(Mutable), w->n, w->n_floor, w->mode,
+                      w->floor_warned, w->cfg != NULL};
     char *p = buf;
     memcpy(p, &hd, sizeof hd), p += sizeof hd;
     memcpy(p, &w->par, sizeof w->par), p += sizeof w->par;
@@ -326,39 +343,37 @@ static int state_header_ok(const char *buf, size_t size, StateHeader *hd)
     if (size < sizeof *hd)
         return 0;
     memcpy(hd, buf, sizeof *hd);
-    return hd->magic == STATE_MAGIC && hd->version == 1 && hd->size_par == sizeof(Params) &&
-           hd->size_mu == sizeof(Mutable) && hd->n >= 0 && hd->n_floor >= 0 && hd->mode >= 0 && hd->mode < N_ST &&
-           size == state_size(hd->n, hd->n_floor);
+    return hd->magic == STATE_MAGIC && hd->version == STATE_VERSION && hd->size_par == sizeof(Params) &&
+           hd->size_mu == sizeof(Mutable) && hd->n >= 0 && hd->n_floor >= 0 && rw_state_ok(hd->mode) &&
+           (hd->built == 0 || hd->built == 1) && size == state_size(hd->n, hd->n_floor);
 }
 
-static RwStatus read_state(Wheel *w, const char *buf, size_t size, const char *what)
+static RwStatus read_state(Wheel *w, const char *buf, size_t size, const char *fn)
 {
     StateHeader hd;
     if (!state_header_ok(buf, size, &hd))
-        return fail(w, "%s: not a state of this FMU (wrong magic, version or size)", what);
+        return fail(w, "%s: not a state of this FMU (wrong magic, version or size): give a state this FMU stored", fn);
     Params par;
     memcpy(&par, buf + sizeof hd, sizeof par);
-    /* a state taken after initialisation carries the kernel state: the state's parameters rebuild the model
-     * when they differ from the instance's; a state from before carries parameters and inputs only */
-    const int built = hd.mode == ST_STEP || hd.mode == ST_TERMINATED;
-    if (built && (memcmp(&par, &w->par, sizeof par) != 0 || !w->cfg)) {
+    /* a state with a built model carries the kernel state: the state's parameters rebuild the model when they
+     * differ from the instance's; a state from before initialisation carries parameters and inputs only */
+    if (hd.built && (memcmp(&par, &w->par, sizeof par) != 0 || !w->cfg)) {
         const Params old = w->par;
         w->par = par;
         if (!build_model(w)) {
             w->par = old;
-            if (w->mode == ST_STEP || w->mode == ST_TERMINATED)
-                build_model(w);
-            return fail(w, "%s: the state's parameters do not build the model", what);
+            free_model(w);
+            return fail(w, "%s: the state's parameters do not build the model", fn);
         }
     }
-    if (built && (hd.n != w->n || hd.n_floor != w->n_floor))
-        return fail(w, "%s: the state's model size does not match this FMU", what);
-    if (!built)
+    if (hd.built && (hd.n != w->n || hd.n_floor != w->n_floor))
+        return fail(w, "%s: the state's model size does not match this FMU", fn);
+    if (!hd.built)
         free_model(w);
     w->par = par;
     const char *p = buf + sizeof hd + sizeof par;
     memcpy(&w->mu, p, sizeof w->mu), p += sizeof w->mu;
-    if (built) {
+    if (hd.built) {
         memcpy(w->st, p, sizeof(double) * (size_t)(2 + 2 * w->n + 12));
         p += sizeof(double) * (size_t)(2 + 2 * w->n + 12);
         if (w->n_floor)
@@ -373,8 +388,10 @@ static RwStatus read_state(Wheel *w, const char *buf, size_t size, const char *w
 /* GetFMUstate: a new blob, or the host's previous one (*s) reused when its size fits */
 static RwStatus get_state(Wheel *w, const char *fn, void **s)
 {
+    if (!admit(w, RW_FMU_STATE, fn))
+        return RW_ERROR;
     if (!s)
-        return fail(w, "%s: NULL state pointer", fn);
+        return REFUSE(w, "%s: NULL state pointer", fn);
     const size_t size = state_size(w->n, w->n_floor);
     Blob *b = *s ? (Blob *)*s : NULL;
     if (b && b->size != size) {
@@ -384,7 +401,7 @@ static RwStatus get_state(Wheel *w, const char *fn, void **s)
     if (!b) {
         b = malloc(sizeof(Blob) + size);
         if (!b)
-            return fail(w, "%s: out of memory", fn);
+            return REFUSE(w, "%s: out of memory", fn);
         b->size = size;
     }
     write_state(w, b->data);
@@ -392,24 +409,48 @@ static RwStatus get_state(Wheel *w, const char *fn, void **s)
     return RW_OK;
 }
 
-/* SetFMUstate: not into a terminated instance (it would step again without a reset) */
+/* SetFMUstate: allowed in every state (the run it was stored from goes on from where it was stored) */
 static RwStatus set_state(Wheel *w, const char *fn, const void *s)
 {
-    if (!allowed(w, ANY_STATE & ~IN(ST_TERMINATED), fn))
+    if (!admit(w, RW_FMU_STATE, fn))
         return RW_ERROR;
     if (!s)
-        return fail(w, "%s: no state given", fn);
+        return REFUSE(w, "%s: no state given: give a state from GetFMUstate or DeserializeFMUstate", fn);
     const Blob *b = (const Blob *)s;
-    return read_state(w, b->data, b->size, fn);
+    return finish(w, read_state(w, b->data, b->size, fn));
+}
+
+static RwStatus free_state(Wheel *w, const char *fn, void **s)
+{
+    if (!admit(w, RW_FMU_STATE, fn))
+        return RW_ERROR;
+    if (s) {
+        free(*s);
+        *s = NULL;
+    }
+    return RW_OK;
+}
+
+static RwStatus serialized_size(Wheel *w, const char *fn, const void *s, size_t *size)
+{
+    if (!admit(w, RW_FMU_STATE, fn))
+        return RW_ERROR;
+    if (!s || !size)
+        return REFUSE(w, "%s: no state or no size pointer given", fn);
+    *size = ((const Blob *)s)->size;
+    return RW_OK;
 }
 
 static RwStatus serialize_state(Wheel *w, const char *fn, const void *s, char *buf, size_t size)
 {
+    if (!admit(w, RW_FMU_STATE, fn))
+        return RW_ERROR;
     if (!s || (size && !buf))
-        return fail(w, "%s: no state or no buffer given", fn);
+        return REFUSE(w, "%s: no state or no buffer given", fn);
     const Blob *b = (const Blob *)s;
     if (size < b->size)
-        return fail(w, "%s: buffer of %zu bytes is smaller than the state (%zu)", fn, size, b->size);
+        return REFUSE(w, "%s: buffer of %zu bytes is smaller than the state (%zu): ask SerializedFMUstateSize first",
+                      fn, size, b->size);
     memcpy(buf, b->data, b->size);
     return RW_OK;
 }
@@ -417,13 +458,15 @@ static RwStatus serialize_state(Wheel *w, const char *fn, const void *s, char *b
 static RwStatus deserialize_state(Wheel *w, const char *fn, const char *buf, size_t size, void **s)
 {
     StateHeader hd;
+    if (!admit(w, RW_FMU_STATE, fn))
+        return RW_ERROR;
     if (!s || (size && !buf))
-        return fail(w, "%s: no buffer or no state pointer given", fn);
+        return REFUSE(w, "%s: no buffer or no state pointer given", fn);
     if (!state_header_ok(buf, size, &hd))
-        return fail(w, "%s: %zu bytes are not a state of this FMU (wrong magic, version or size)", fn, size);
+        return REFUSE(w, "%s: %zu bytes are not a state of this FMU (wrong magic, version or size)", fn, size);
     Blob *b = malloc(sizeof(Blob) + size);
     if (!b)
-        return fail(w, "%s: out of memory", fn);
+        return REFUSE(w, "%s: out of memory", fn);
     b->size = size;
     memcpy(b->data, buf, size);
     *s = b;

@@ -29,14 +29,8 @@ typedef enum { RW_OK = 0, RW_WARNING = 1, RW_DISCARD = 2, RW_ERROR = 3, RW_FATAL
 /* the wrapper's logger: one plain message (no format), the instance's environment */
 typedef void (*RwLogger)(void *env, RwStatus status, const char *category, const char *message);
 
-/* VR_SWITCH .. VR_SWITCH + N_SWITCH - 1: the effect switches (Booleans named by the effect elements that own them,
-   RW_SWITCH_NAMES of wheel_model.h; each turns its element's ripples and floors off) */
+/* the effect switches (value references VR_SWITCH ..): each turns its element's ripples and floors off */
 #define N_SWITCH 2
-enum { VR_SPEED = 0, VR_ACCEL = 1, VR_MODEL_FILE = 2, VR_USE_ACCEL = 3, VR_SEED = 4, VR_IMBALANCE = 5,
-       VR_HARMONICS = 6, VR_MODES = 7, VR_START_STEADY = 8, VR_SWITCH = 9,
-       VR_FLOOR_RES = 11, VR_MAX_ACCEL = 12, VR_MAX_STEP = 13, VR_DCM = 14, VR_POS = 23, VR_OUT = 26,
-       N_VR = 38 };
-
 #if RW_N_SWITCHES != N_SWITCH
 #error "wheel_model.h names another number of effect switches than the FMU has (fmu.runtime.SWITCH_SLOTS)"
 #endif
@@ -63,7 +57,8 @@ typedef struct {
 typedef struct {
     RwLogger logger;                 /* the FMI wrapper's adapter to the host's logger (may be NULL) */
     void *log_env;                   /* its argument */
-    int mode;                        /* 0 instantiated, 1 initialisation, 2 stepping, 3 terminated, 4 failed */
+    int fmi;                         /* FMI version of the wrapper: 2 or 3 */
+    int mode;                        /* state of the FMI state machine (ST_* of rwadist_fmi_rules.h) */
     Params par;
     Mutable mu;
     /* built at initialisation */
