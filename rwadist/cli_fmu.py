@@ -44,8 +44,9 @@ def _build_assembly(args, out: Path) -> int:
         print(f"rwadist: note: {note}")
     if note := _windows_note():
         print(f"rwadist: note: {note}")
-    print(f"wrote {path} (SSP 1.0 of the wheels in {args.wheels}: one native FMU component per wheel; each "
-          "component's Fx_sc .. Tz_sc are its loads at the spacecraft reference point, the assembly's are their sum)")
+    print(f"wrote {path} (SSP 1.0 of the wheels in {args.wheels}: one native FMU component per wheel, driven by the "
+          "speed_command component's inputs, rad/s; each wheel's Fx_sc .. Tz_sc are its loads at the spacecraft "
+          "reference point, the assembly's are their sum)")
     return 0
 
 

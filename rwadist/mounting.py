@@ -155,6 +155,9 @@ def _speed_law(spec, default_law, base: Path, where: str):
         for k in ("min_rpm", "max_rpm"):
             if not isinstance(spec.get(k), (int, float)):
                 raise DataError(where, f"speed.{k}", f"must be a number (rpm), got {spec.get(k)!r}")
+        if not spec["min_rpm"] < spec["max_rpm"]:
+            raise DataError(where, "speed.min_rpm/max_rpm", f"{spec['min_rpm']!r} rpm / {spec['max_rpm']!r} rpm: an "
+                            "empty or inverted speed range; give min_rpm < max_rpm")
         return bb.law_from_spec(dist, spec["min_rpm"], spec["max_rpm"], spec.get("std_rpm"), f"{where}.speed")
     p = Path(dist)
     return bb.law_from_csv(p if p.is_absolute() else base / p)
