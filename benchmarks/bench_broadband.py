@@ -1,12 +1,29 @@
-"""Benchmark: 4 wheels × 20 harmonics × 1e5 frequencies × 2000-point speed grid (spacecraft-frame CSD).
+"""Benchmark (issue 37): the spacecraft CSD of 4 wheels × 20 harmonics × 1e5 frequencies, against its peers.
 
-Prints wall time and peak traced memory (tracemalloc) of the CSD, and the same for a baseline
-measured in this run: one numpy pass over an output-sized array (n_freq × 6 × 6 complex).
-Usage: .venv/bin/python benchmarks/bench_broadband.py [n_freq] [n_speeds]
+Printed in one run, with the load average:
+
+* baseline: one numpy pass over an output-sized array (n_freq × 6 × 6 complex: allocated and written once);
+* the project's CSD (:func:`rwadist.mounting.spacecraft_csd`);
+* the peer: Melody's closed form written plainly here -- one scalar density per wheel, line class and spin sign,
+  each line's bin integral from its antiderivative over the whole grid (uniform law: C²Ω⁴ is a polynomial; normal
+  law: the normal's partial moments), then one (n_f × K)·(K × 36) product; checked equal to the project's within
+  1e-9 of the largest channel's mean square (Σ_k |ΔS_k|·df);
+* the project at 500 and 8000 speed cells (``n_speeds``; the closed form needs none: flat).
+
+Timings are interleaved (baseline, project, peer; then 500/8000 cells), ``--repeats`` times (default 5), min and
+median printed.  Peak memory comes from separate runs in child processes (tracemalloc's peak of the call, and the
+maximum RSS over the child's RSS before the call), never during a timing run.
+
+Usage: python benchmarks/bench_broadband.py [--n-freq N] [--repeats R]
 """
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import subprocess
 import sys
 import time
-import tracemalloc
 
 import numpy as np
 
@@ -14,6 +31,10 @@ from rwadist import broadband as bb
 from rwadist import mounting as mt
 from rwadist.model import Harmonic, WheelModel
 from rwadist.units import rpm_to_rad_s
+
+W = float(rpm_to_rad_s(1.0))
+F_MAX = 1.2 * 8.0 * 3000 * W / (2 * np.pi)
+_BASE = {"radial_force": 0, "radial_torque": 3, "axial_force": 2, "axial_torque": 5}
 
 
 def wheel_model(n_harm=20):
@@ -26,39 +47,170 @@ def wheel_model(n_harm=20):
     return WheelModel(name="bench", empirical=emp)
 
 
-def measure(fn):
-    tracemalloc.start()
+def wheels():
+    model = wheel_model()
+    lines = bb.empirical_lines(model)
+    laws = [bb.Uniform(-3000 * W, 3000 * W), bb.TruncatedNormal(1500 * W, 400 * W, 0.0, 3000 * W),
+            bb.Uniform(300 * W, 2500 * W), bb.Uniform(-2500 * W, 2500 * W)]
+    return model, [mt.WheelSpec(f"RW{i}", lines, m, law)
+                   for i, (m, law) in enumerate(zip(mt.preset_mountings("pyramid-4"), laws))]
+
+
+# ------------------------------------------------------------------ the peer: the closed form, plainly
+
+def _moment4_antiderivative(z, mu, sigma):
+    """∫ (μ + σz)^4 φ(z) dz as a function of z (up to a constant), from M_k = ∫ z^k φ: M_0 = Φ, M_1 = −φ,
+    M_k = −z^{k−1}φ + (k−1)·M_{k−2}."""
+    from scipy.special import ndtr
+
+    phi = np.exp(-0.5 * z * z) / np.sqrt(2 * np.pi)
+    Phi = ndtr(z)
+    M = [Phi, -phi, -z * phi + Phi, -(z * z + 2) * phi, -(z**3 + 3 * z) * phi + 3 * Phi]
+    coef = [mu**4, 4 * mu**3 * sigma, 6 * mu**2 * sigma**2, 4 * mu * sigma**3, sigma**4]
+    return sum(c * m for c, m in zip(coef, M))
+
+
+def _line_bin_powers(h, C, law, sign, f_edges):
+    """Σ over the bins of (1/df)∫ S(f) df for one line on one spin sign: S(f) = ½C²Ω⁴p(Ω)·2π/h, Ω = sign·2πf/h,
+    from the antiderivative at every bin edge of the grid (0 outside the law's support)."""
+    lo, hi = law.support
+    a, b = (max(lo, 0.0), hi) if sign > 0 else (max(-hi, 0.0), -lo)
+    if not b > a:
+        return None
+    u = np.clip(2 * np.pi * np.maximum(f_edges, 0.0) / h, a, b)            # |Ω| at the edges, clipped to the support
+    if isinstance(law, bb.Uniform):
+        F = u**5 / 5 / (law.hi - law.lo)
+    else:
+        from scipy.special import ndtr
+
+        mass = ndtr((law.hi - law.mean) / law.std) - ndtr((law.lo - law.mean) / law.std)
+        F = sign * _moment4_antiderivative((sign * u - law.mean) / law.std, law.mean, law.std) / mass
+    return 0.5 * C**2 * np.diff(F)
+
+
+def _pattern(direction, mode, sign):
+    v = np.zeros(6, complex)
+    base = _BASE[direction]
+    v[base] = 1.0
+    if mode in ("co", "counter"):
+        v[base + 1] = (-1j if mode == "co" else 1j) * sign
+    return v
+
+
+def peer_csd(model, wheel_specs, f_max, n_freq):
+    """The plain closed form: columns per (wheel, class, sign), then one product."""
+    f = np.linspace(0.0, f_max, n_freq)
+    df = f[1] - f[0]
+    edges = np.append(f - df / 2, f[-1] + df / 2)
+    cols, mats = [], []
+    for ws in wheel_specs:
+        T = ws.mounting.transform
+        for d in _BASE:
+            mode = "axial" if d.startswith("axial") else "co"
+            for sign in (1.0, -1.0):
+                acc = None
+                for hm in model.harmonics(d):
+                    p = _line_bin_powers(hm.h, hm.C, ws.law, sign, edges)
+                    if p is not None:
+                        acc = p if acc is None else acc + p
+                if acc is not None:
+                    v = T @ _pattern(d, mode, sign)
+                    cols.append(acc / df)
+                    mats.append(np.outer(v, np.conj(v)).ravel())
+    D = np.array(cols).T                                             # (n_f, K)
+    return f, (D @ np.array(mats)).reshape(n_freq, 6, 6)             # (n_f × K)·(K × 36)
+
+
+# ------------------------------------------------------------------ timing and memory
+
+def baseline(n_freq):
+    a = np.zeros((n_freq, 6, 6), dtype=complex)
+    a += 1.0                                          # one numpy pass over the output array
+    return a
+
+
+def _timed(fn):
     t0 = time.perf_counter()
     out = fn()
-    dt = time.perf_counter() - t0
+    return time.perf_counter() - t0, out
+
+
+def memory_child(which, n_freq):
+    """In a fresh process: (tracemalloc peak of the call, max RSS growth over the process before the call), bytes."""
+    import tracemalloc
+
+    model, ws = wheels()
+    fn = {"project": lambda: mt.spacecraft_csd(ws, F_MAX, n_freq, 2000),
+          "peer": lambda: peer_csd(model, ws, F_MAX, n_freq),
+          "baseline": lambda: baseline(n_freq)}[which]
+    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    tracemalloc.start()
+    out = fn()
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
-    return out, dt, peak
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 - rss0
+    del out
+    print(peak, rss)
 
 
-def main(n_freq=100_000, n_speeds=2000):
-    lines = bb.empirical_lines(wheel_model())
-    w = float(rpm_to_rad_s(1.0))
-    laws = [bb.Uniform(-3000 * w, 3000 * w), bb.TruncatedNormal(1500 * w, 400 * w, 0.0, 3000 * w),
-            bb.Uniform(300 * w, 2500 * w), bb.Uniform(-2500 * w, 2500 * w)]
-    wheels = [mt.WheelSpec(f"RW{i}", lines, m, law)
-              for i, (m, law) in enumerate(zip(mt.preset_mountings("pyramid-4"), laws))]
-    f_max = 1.2 * 8.0 * 3000 * w / (2 * np.pi)
+def _memory(which, n_freq):
+    r = subprocess.run([sys.executable, __file__, "--memory-child", which, "--n-freq", str(n_freq)],
+                       capture_output=True, text=True, check=True)
+    peak, rss = (int(x) for x in r.stdout.split())
+    return peak, rss
 
-    def baseline():
-        a = np.zeros((n_freq, 6, 6), dtype=complex)
-        a += 1.0                                    # one numpy pass over the output array
-        return a
 
-    _, tb, pb = measure(baseline)
-    res, t, p = measure(lambda: mt.spacecraft_csd(wheels, f_max, n_freq, n_speeds))
-    out_mb = res.csd.nbytes / 1e6
-    print(f"4 wheels x {len(lines)} harmonics x {n_freq} frequencies x {n_speeds} speeds (f_max {f_max:.1f} Hz)")
-    print(f"baseline (one pass over the {out_mb:.1f} MB output array): {tb * 1e3:8.1f} ms, peak {pb / 1e6:7.1f} MB")
-    print(f"spacecraft CSD:                                          {t * 1e3:8.1f} ms, peak {p / 1e6:7.1f} MB "
-          f"({t / tb:.0f}x time, {p / pb:.1f}x memory of the baseline)")
-    print(f"check: RMS Fx..Tz = {np.array2string(res.rms(), precision=4)}")
+def stats(xs):
+    return min(xs), float(np.median(xs))
+
+
+def main(n_freq=100_000, repeats=5):
+    model, ws = wheels()
+    out_mb = n_freq * 36 * 16 / 1e6
+    print(f"4 wheels x {len(ws[0].lines)} harmonics x {n_freq} frequencies (f_max {F_MAX:.1f} Hz), output {out_mb:.1f} MB;"
+          f" load average {os.getloadavg()[0]:.2f} at start")
+    t = {"baseline": [], "project": [], "peer": [], "cells500": [], "cells8000": []}
+    res = peer = None
+    for _ in range(repeats):
+        dt, _b = _timed(lambda: baseline(n_freq))
+        t["baseline"].append(dt)
+        del _b
+        dt, res = _timed(lambda: mt.spacecraft_csd(ws, F_MAX, n_freq, 2000))
+        t["project"].append(dt)
+        dt, peer = _timed(lambda: peer_csd(model, ws, F_MAX, n_freq))
+        t["peer"].append(dt)
+        for cells in (500, 8000):
+            dt, _r = _timed(lambda: mt.spacecraft_csd(ws, F_MAX, n_freq, cells))
+            t[f"cells{cells}"].append(dt)
+            del _r
+    load = os.getloadavg()[0]
+    for k in ("baseline", "project", "peer", "cells500", "cells8000"):
+        lo, med = stats(t[k])
+        print(f"  {k:10s} min {lo * 1e3:8.1f} ms   median {med * 1e3:8.1f} ms")
+    (bl, bm), (pl, pm), (ql, qm) = stats(t["baseline"]), stats(t["project"]), stats(t["peer"])
+    (c5l, c5m), (c8l, c8m) = stats(t["cells500"]), stats(t["cells8000"])
+    print(f"project / one pass over the output: {pl / bl:5.1f}x (min)  {pm / bm:5.1f}x (median)   target <= 20x")
+    print(f"project / plain closed form (peer): {pl / ql:5.2f}x (min)  {pm / qm:5.2f}x (median)   target <= 0.5x")
+    print(f"8000 / 500 speed cells:             {c8l / c5l:5.2f}x (min)  {c8m / c5m:5.2f}x (median)   target 0.8-1.2x")
+    print(f"load average at end {load:.2f}")
+    df = res.f[1] - res.f[0]
+    ms = res.mean_square()
+    diff = np.abs(res.csd - peer[1]).sum(axis=0) * df / ms.max()
+    print(f"check: project vs peer, max over channel pairs of sum|dS|*df / max mean square = {diff.max():.2e} "
+          f"({'OK' if diff.max() <= 1e-9 else 'FAIL'}: <= 1e-9); RMS Fx..Tz = {np.array2string(res.rms(), precision=4)}")
+    for which in ("baseline", "project", "peer"):
+        peak, rss = _memory(which, n_freq)
+        print(f"memory ({which:8s}, separate run): tracemalloc peak {peak / 1e6:7.1f} MB = {peak / 1e6 / out_mb:4.2f}x "
+              f"the output; max RSS growth {rss / 1e6:7.1f} MB")
 
 
 if __name__ == "__main__":
-    main(*(int(a) for a in sys.argv[1:]))
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n-freq", type=int, default=100_000)
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--memory-child", choices=("project", "peer", "baseline"))
+    a = ap.parse_args()
+    if a.memory_child:
+        memory_child(a.memory_child, a.n_freq)
+    else:
+        main(a.n_freq, a.repeats)

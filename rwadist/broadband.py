@@ -22,18 +22,18 @@ uses A = C Ω² (no modes); the extended model puts the modal amplification insi
 integral: A_i(Ω) = :func:`rwadist.extended.steady_lines`, which carries |H(f, Ω)|² of the
 rotor's speed-dependent whirl modes -- Melody's model cannot.
 
-Discretisation (power-conserving).  The speed support is cut into cells (split at Ω = 0);
-each cell has its exact probability P_c (from the law's CDF) and amplitudes evaluated at
-its midpoint.  The cell's line power σ·P_c is spread uniformly over the frequency interval
-[h|Ω_lo|, h|Ω_hi|]/2π the cell maps to, and integrated exactly over the frequency bins
-(bins centred on f_k = k·df, width df): a uniform density on [a, b] contributes to bin k
-the length of the overlap, which is the first difference of a ramp; the ramp's second
-difference is two cloud-in-cell (linear-split) deposits, so bin powers are one cumsum of
-deposits made with ``np.bincount``.  Cells narrower than 1e-6·df (a point mass in speed)
-deposit their power with linear splitting between the two neighbouring bin centres.
-Σ_k S_k df equals Σ (line powers) inside [0, f_max] to rounding.  Memory: the output
-(n_freq × 21 complex upper-triangle pairs) plus one chunk of (speeds × lines) deposits;
-never a dense speeds × frequencies × harmonics array.
+Evaluation (exact per bin, no speed grid; :mod:`rwadist.broadband_bins`).  The PSD of bin k
+(centred on f_k = k·df, width df) is the closed form's mean over the bin, (1/df)∫_bin S(f) df: the
+line power of the speeds whose line falls in the bin.  On a branch of constant spin sign a line's
+amplitude is fixed channel patterns times scalar functions of |Ω|, so the CSD is a sum of fixed
+Hermitian matrices times scalar densities, evaluated as one matrix product; each density's bin
+values are exact (a power law C·Ω² on a uniform or histogram law in closed form; otherwise
+Gauss–Legendre below the narrowest resonance and the law's scale, relative error < 1e-12).
+Σ_k S_k df equals the speed-averaged mean square of the lines inside [0, f_max + df/2] to rounding.
+Cost O(n_freq × lines); memory the output and the densities (at most half its size), never a
+speeds × frequencies array.  (Until issue 37 the speed support was cut into cells whose power was
+spread over their frequency interval: 2000 cells left ~1e-7 of the mean square and ~1e-3 of a
+bin; that result converges to this one as 1/cells².)
 
 Coherence.  Within one wheel the channels of a line are coherent (radial x and y 90°
 apart from the complex amplitudes; in the extended model a radial force line also gives
@@ -72,7 +72,6 @@ from .speed_laws import (  # noqa: F401
     TruncatedNormal,
     Uniform,
     _check_range,
-    _spread,
     from_time_profile,
     histogram_from_centres,
     law_from_csv,
@@ -409,81 +408,30 @@ def _check_fmax(groups, f_max):
                         "the PSD would miss lines -- raise `fmax`")
 
 
-def csd_groups(groups, f_max: float, n_freq: int = 20001, n_speeds: int = 2000, progress: bool = False,
-               chunk: int = 20000, frame: str = "wheel", check_fmax: bool = True) -> BroadbandPSD:
-    """The CSD of independent groups of coherent wheels.
+def csd_groups(groups, f_max: float, n_freq: int = 20001, n_speeds: int | None = None, progress: bool = False,
+               frame: str = "wheel", check_fmax: bool = True) -> BroadbandPSD:
+    """The CSD of independent groups of coherent wheels: Melody's closed form integrated exactly over each
+    frequency bin (:mod:`rwadist.broadband_bins`), no speed grid.
 
     groups : list of (members, law): ``members`` a list of :class:`Member` sharing one speed
         (each at ratio·Ω) and, when more than one, phase-locked (amplitudes add before the outer
         product); ``law`` the group's speed law (rad/s).
-    f_max : top of the grid, Hz; n_freq : grid points (0 .. f_max).  n_speeds : speed cells per law.
-    chunk : speeds × sources evaluated at once (bounds memory).
+    f_max : top of the grid, Hz; n_freq : grid points (0 .. f_max).
+    n_speeds : not used (every speed law has a density, integrated exactly); accepted so that callers written
+        for the speed-cell method keep working.
     Raises DataError when f_max is below the top frequency of the lowest harmonic (``check_fmax``).
     """
-    from tqdm.auto import tqdm
+    from .broadband_bins import closed_form_csd
 
     f = _freq_grid(f_max, n_freq)
-    df = f[1] - f[0]
     if check_fmax:
         _check_fmax(groups, f_max)
-    acc = np.zeros((len(PAIRS), f.size), dtype=complex)
-    floors = np.zeros((f.size, 6, 6), dtype=complex)
-    work = []
-    for members, law in groups:
-        lo_e, hi_e, mid, P = speed_cells(law, n_speeds)
-        for m in members:   # broadband floors: incoherent, E_Ω[(|Ω|/Ω_ref)^p]·psd_ref(f) per channel
-            T = _transform_of(m.transform)
-            for c, f_k, psd_k, w_ref, p in m.lines.floors:
-                gain = float(np.sum(P * (np.abs(m.ratio * mid) / w_ref) ** p))
-                S = gain * np.interp(f, f_k, psd_k, left=0.0, right=0.0)
-                floors += S[:, None, None] * np.outer(T[:, c], T[:, c])[None, :, :]
+    for members, _ in groups:
         n_src = len(members[0].lines)
         if len(members) > 1 and any(len(m.lines) != n_src or not np.allclose(m.lines.h, members[0].lines.h)
                                     or m.lines.offsets != members[0].lines.offsets for m in members):
             raise DataError("wheels", "tie", "phase-locked wheels must use the same wheel model (same lines)")
-        per = max(1, chunk // max(1, mid.size))
-        for s0 in range(0, n_src, per):
-            work.append((members, lo_e, hi_e, mid, P, np.arange(s0, min(n_src, s0 + per))))
-    bar = tqdm(work, desc="broadband PSD", unit="chunk", disable=not progress or len(work) < 4, leave=False)
-    for members, lo_e, hi_e, mid, P, idx in bar:
-        h = members[0].lines.h[idx]
-        A = np.zeros((mid.size, idx.size, 6), dtype=complex)
-        for m in members:
-            T = _transform_of(m.transform)
-            w = m.ratio * mid
-            Am = m.lines.amplitudes(w, idx) @ T.T
-            if len(members) > 1 and m.phase_offset:
-                Am = Am * np.exp(1j * np.sign(w)[:, None] * h[None, :] * m.phase_offset)[..., None]
-            A += Am
-        wl = np.minimum(np.abs(lo_e), np.abs(hi_e))[:, None]
-        wh = np.maximum(np.abs(lo_e), np.abs(hi_e))[:, None]
-        off = np.array([members[0].lines.offsets.get(int(i), 0.0) for i in idx])[None, :]
-        fa = np.abs(h[None, :] * wl / (2 * np.pi) + off)     # a sideband below 0 Hz folds to |f|
-        fb = np.abs(h[None, :] * wh / (2 * np.pi) + off)
-        a = np.minimum(fa, fb) / df
-        b = np.maximum(fa, fb) / df
-        Q = 0.5 * A[..., _PAIR_A] * np.conj(A[..., _PAIR_B]) * P[:, None, None]     # (S, n, 21)
-        acc += _spread(a, b, np.moveaxis(Q, -1, 0), f.size)
-    acc /= df
-    diag = _PAIR_A == _PAIR_B
-    acc[diag] = acc[diag].real                 # auto-spectra are real (rounding leaves ~1e-33 j)
-    csd = np.empty((f.size, 6, 6), dtype=complex)
-    csd[:, _PAIR_A, _PAIR_B] = acc.T
-    csd[:, _PAIR_B, _PAIR_A] = np.conj(acc.T)
-    return BroadbandPSD(f=f, csd=_rounding_clipped(csd + floors), frame=frame)
-
-
-def _rounding_clipped(csd: np.ndarray) -> np.ndarray:
-    """``csd`` (n, 6, 6) with what rounding left outside a cross-spectral matrix taken off: the ramps' second
-    differences leave ~-1e-18 on auto-spectra of bins without power (they reached psd.csv and the NASTRAN tables),
-    clipped to 0, and a cross term then larger than sqrt(S_aa·S_bb) (Cauchy-Schwarz) scaled down to it."""
-    auto = np.maximum(np.real(np.einsum("kaa->ka", csd)), 0.0)
-    bound = np.sqrt(auto[:, :, None] * auto[:, None, :])
-    mag = np.abs(csd)
-    out = csd * np.where(mag > bound, bound / np.where(mag > 0, mag, 1.0), 1.0)
-    idx = np.arange(csd.shape[1])
-    out[:, idx, idx] = auto
-    return out
+    return BroadbandPSD(f=f, csd=closed_form_csd(groups, f, _transform_of, progress), frame=frame)
 
 
 def broadband_psd(lines: WheelLines, law, f_max: float, n_freq: int = 20001, n_speeds: int = 2000,

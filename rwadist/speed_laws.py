@@ -9,7 +9,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy import stats
 
 from .data import DataError
 from .units import RAD_S_TO_RPM, rpm_to_rad_s
@@ -53,6 +52,10 @@ class Uniform:
     def breakpoints(self):
         return [self.lo, self.hi]
 
+    def pieces(self):
+        """(edges (2,), densities (1,)): the density is constant between the edges (rad/s, 1/(rad/s))."""
+        return np.array([self.lo, self.hi], float), np.array([1.0 / (self.hi - self.lo)])
+
 
 @dataclass(frozen=True)
 class TruncatedNormal:
@@ -76,20 +79,51 @@ class TruncatedNormal:
 
     @property
     def _dist(self):
+        from scipy import stats  # 0.7 s to import: only where a sample is drawn
+
         a, b = (self.lo - self.mean) / self.std, (self.hi - self.mean) / self.std
         return stats.truncnorm(a, b, loc=self.mean, scale=self.std)
 
+    def _mass(self) -> float:
+        """Φ(b) − Φ(a) of the standardised ends, from the tail nearer to them (no cancellation in a far tail)."""
+        from scipy.special import ndtr
+
+        a, b = (self.lo - self.mean) / self.std, (self.hi - self.mean) / self.std
+        return float(ndtr(b) - ndtr(a)) if a < 0 else float(ndtr(-a) - ndtr(-b))
+
     def pdf(self, omega):
-        return self._dist.pdf(np.asarray(omega, float))
+        """φ((Ω − mean)/std)/(std·mass) inside [lo, hi], 0 outside (scipy.stats.truncnorm's, without its import)."""
+        w = np.asarray(omega, float)
+        return np.where((w >= self.lo) & (w <= self.hi), self.pdf_inside(w), 0.0)
+
+    def pdf_inside(self, omega):
+        """The density at speeds known to lie in [lo, hi] (no test of the range: the PSD's quadrature nodes)."""
+        z = np.array(omega, dtype=float)
+        z -= self.mean
+        z *= 1.0 / self.std
+        z *= z
+        z *= -0.5
+        np.exp(z, out=z)
+        z *= 1.0 / (math.sqrt(2.0 * math.pi) * self.std * self._mass())
+        return z
 
     def cdf(self, omega):
-        return self._dist.cdf(np.asarray(omega, float))
+        from scipy.special import ndtr
+
+        a = (self.lo - self.mean) / self.std
+        z = (np.clip(np.asarray(omega, float), self.lo, self.hi) - self.mean) / self.std
+        below = ndtr(z) - ndtr(a) if a < 0 else ndtr(-a) - ndtr(-z)
+        return np.clip(below / self._mass(), 0.0, 1.0)
 
     def sample(self, rng, n):
         return self._dist.rvs(size=n, random_state=rng)
 
     def breakpoints(self):
         return [self.lo, self.hi]
+
+    def pieces(self):
+        """None: a smooth density (its scale :attr:`std`), not piecewise constant."""
+        return None
 
 
 @dataclass(frozen=True)
@@ -166,6 +200,10 @@ class Histogram:
 
     def breakpoints(self):
         return list(self.edges)
+
+    def pieces(self):
+        """(edges (n+1,), densities (n,)): the density is constant between edges (rad/s, 1/(rad/s))."""
+        return np.asarray(self.edges, float), np.asarray(self.pdf_values, float)
 
 
 def row_edges(speeds, source="histogram", bounds=None, ends: str = "centres") -> np.ndarray:
@@ -255,6 +293,28 @@ def speed_cells(law, n_speeds: int):
         edges = np.linspace(lo, hi, n_speeds + 1)
     P = np.diff(law.cdf(edges))
     return edges[:-1], edges[1:], 0.5 * (edges[:-1] + edges[1:]), np.maximum(P, 0.0)
+
+
+def abs_power_mean(law, p: float) -> float:
+    """E[|Ω|^p] over the law (rad/s)^p, exact: in closed form on each piece of a piecewise-constant density
+    (:meth:`Uniform.pieces`, :meth:`Histogram.pieces`), else by adaptive quadrature (relative 1e-13) split at
+    zero speed, where |Ω|^p has its kink."""
+    pieces = law.pieces() if hasattr(law, "pieces") else None
+    if pieces is not None:
+        edges, rho = pieces
+        total = 0.0
+        for lo, hi, r in zip(edges[:-1], edges[1:], rho):
+            for a, b in ((max(lo, 0.0), max(hi, 0.0)), (max(-hi, 0.0), max(-lo, 0.0))):   # Ω > 0, Ω < 0 as |Ω|
+                if b > a:
+                    total += r * (b ** (p + 1) - a ** (p + 1)) / (p + 1)
+        return float(total)
+    from scipy import integrate
+
+    lo, hi = law.support
+    pts = sorted({float(x) for x in law.breakpoints() if lo < x < hi} | ({0.0} if lo < 0.0 < hi else set()))
+    edges = [lo, *pts, hi]
+    return float(sum(integrate.quad(lambda w: abs(w) ** p * float(law.pdf(w)), a, b, epsabs=0.0, epsrel=1e-13,
+                                    limit=200)[0] for a, b in zip(edges[:-1], edges[1:])))
 
 
 def law_from_spec(dist: str, min_rpm: float, max_rpm: float, std_rpm: float | None = None,
