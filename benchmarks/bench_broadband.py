@@ -14,13 +14,14 @@ Timings are interleaved (baseline, project, peer; then 500/8000 cells), ``--repe
 median printed.  Peak memory comes from separate runs in child processes (tracemalloc's peak of the call, and the
 maximum RSS over the child's RSS before the call), never during a timing run.
 
+BLAS and OpenMP are held to one thread, as every rwadist command runs.
+
 Usage: python benchmarks/bench_broadband.py [--n-freq N] [--repeats R]
 """
 from __future__ import annotations
 
 import argparse
 import os
-import resource
 import subprocess
 import sys
 import time
@@ -130,26 +131,40 @@ def baseline(n_freq):
 
 
 def _timed(fn):
-    t0 = time.perf_counter()
+    """(wall s, CPU s of this process, result)."""
+    t0, c0 = time.perf_counter(), time.process_time()
     out = fn()
-    return time.perf_counter() - t0, out
+    return (time.perf_counter() - t0, time.process_time() - c0), out
+
+
+def _status_kb(field):
+    with open("/proc/self/status") as fh:
+        return next(int(line.split()[1]) for line in fh if line.startswith(field + ":"))
 
 
 def memory_child(which, n_freq):
-    """In a fresh process: (tracemalloc peak of the call, max RSS growth over the process before the call), bytes."""
+    """In a fresh process, two calls: tracemalloc's peak of the first, the peak RSS (VmHWM, reset before the call)
+    over the RSS before the second (Linux), bytes."""
     import tracemalloc
 
     model, ws = wheels()
     fn = {"project": lambda: mt.spacecraft_csd(ws, F_MAX, n_freq, 2000),
           "peer": lambda: peer_csd(model, ws, F_MAX, n_freq),
           "baseline": lambda: baseline(n_freq)}[which]
-    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     tracemalloc.start()
     out = fn()
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 - rss0
     del out
+    try:
+        with open("/proc/self/clear_refs", "w") as fh:
+            fh.write("5")                                   # reset VmHWM to the current RSS
+        rss0 = _status_kb("VmRSS")
+        again = fn()
+        rss = (_status_kb("VmHWM") - rss0) * 1024
+        del again
+    except OSError:
+        rss = -1
     print(peak, rss)
 
 
@@ -169,7 +184,8 @@ def main(n_freq=100_000, repeats=5):
     out_mb = n_freq * 36 * 16 / 1e6
     print(f"4 wheels x {len(ws[0].lines)} harmonics x {n_freq} frequencies (f_max {F_MAX:.1f} Hz), output {out_mb:.1f} MB;"
           f" load average {os.getloadavg()[0]:.2f} at start")
-    t = {"baseline": [], "project": [], "peer": [], "cells500": [], "cells8000": []}
+    names = ("baseline", "project", "peer", "cells500", "cells8000")
+    t: dict = {k: [] for k in names}
     res = peer = None
     for _ in range(repeats):
         dt, _b = _timed(lambda: baseline(n_freq))
@@ -184,14 +200,16 @@ def main(n_freq=100_000, repeats=5):
             t[f"cells{cells}"].append(dt)
             del _r
     load = os.getloadavg()[0]
-    for k in ("baseline", "project", "peer", "cells500", "cells8000"):
-        lo, med = stats(t[k])
-        print(f"  {k:10s} min {lo * 1e3:8.1f} ms   median {med * 1e3:8.1f} ms")
-    (bl, bm), (pl, pm), (ql, qm) = stats(t["baseline"]), stats(t["project"]), stats(t["peer"])
-    (c5l, c5m), (c8l, c8m) = stats(t["cells500"]), stats(t["cells8000"])
-    print(f"project / one pass over the output: {pl / bl:5.1f}x (min)  {pm / bm:5.1f}x (median)   target <= 20x")
-    print(f"project / plain closed form (peer): {pl / ql:5.2f}x (min)  {pm / qm:5.2f}x (median)   target <= 0.5x")
-    print(f"8000 / 500 speed cells:             {c8l / c5l:5.2f}x (min)  {c8m / c5m:5.2f}x (median)   target 0.8-1.2x")
+    for k in names:
+        (wl, wm), (cl, cm) = stats([x[0] for x in t[k]]), stats([x[1] for x in t[k]])
+        print(f"  {k:10s} wall min {wl * 1e3:8.1f} ms  median {wm * 1e3:8.1f} ms   CPU min {cl * 1e3:8.1f} ms  "
+              f"median {cm * 1e3:8.1f} ms")
+    for label, num, den, target in (("project / one pass over the output", "project", "baseline", "<= 20x"),
+                                    ("project / plain closed form (peer)", "project", "peer", "<= 0.5x"),
+                                    ("8000 / 500 speed cells", "cells8000", "cells500", "0.8-1.2x")):
+        r = [stats([x[j] for x in t[num]])[q] / stats([x[j] for x in t[den]])[q] for j in (0, 1) for q in (0, 1)]
+        print(f"{label:36s} wall {r[0]:5.2f}x (min) {r[1]:5.2f}x (median)   CPU {r[2]:5.2f}x (min) {r[3]:5.2f}x "
+              f"(median)   target {target}")
     print(f"load average at end {load:.2f}")
     df = res.f[1] - res.f[0]
     ms = res.mean_square()
@@ -201,7 +219,7 @@ def main(n_freq=100_000, repeats=5):
     for which in ("baseline", "project", "peer"):
         peak, rss = _memory(which, n_freq)
         print(f"memory ({which:8s}, separate run): tracemalloc peak {peak / 1e6:7.1f} MB = {peak / 1e6 / out_mb:4.2f}x "
-              f"the output; max RSS growth {rss / 1e6:7.1f} MB")
+              f"the output; peak RSS growth {rss / 1e6:7.1f} MB = {rss / 1e6 / out_mb:4.2f}x")
 
 
 if __name__ == "__main__":
@@ -213,4 +231,7 @@ if __name__ == "__main__":
     if a.memory_child:
         memory_child(a.memory_child, a.n_freq)
     else:
-        main(a.n_freq, a.repeats)
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(limits=1):          # as every rwadist command runs (rwadist.cli.one_blas_thread)
+            main(a.n_freq, a.repeats)
