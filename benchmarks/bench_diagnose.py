@@ -1,6 +1,7 @@
 """Benchmark and acceptance tables of ``rwadist diagnose`` (issues 7 and 14).
 
-Run: ``.venv/bin/python benchmarks/bench_diagnose.py [--quick | --modes-on [GROUP ...]]``
+Run: ``.venv/bin/python benchmarks/bench_diagnose.py [--quick [--sets benchmark sixty] [--repeats N] [--busy K] |
+--modes-on [GROUP ...]]``
 
 1. Acceptance table (modes off, issue 7): each effect class injected alone into E-wheel data (40
    speeds, 4096 samples at 1920 Hz, modes off), three seeds; the class named, the recovered parameter,
@@ -10,11 +11,14 @@ Run: ``.venv/bin/python benchmarks/bench_diagnose.py [--quick | --modes-on [GROU
    same generator with ``physics="extended"``: radial translation, rocking whirls, axial mode), starting
    from the preset's model on the extended base (what the tests do with the truth model), each test's
    own tolerances checked and printed PASS/FAIL.
-3. Timing (issue 14 acceptance, target <= 10x): the 120-speed, 6-channel E dataset (300-2400 rpm,
-   3840 Hz, 8192 samples), modes ON (``physics="extended"``), one effect (the wheel's h = 4.42
-   radial-force line growing as Ω^2.5, a load through the suspension modes): ``rwadist fit`` (:func:`rwadist.api.fit`) and ``rwadist diagnose
-   DATA`` without a model (:func:`rwadist.api.diagnose`: the wheel's suspension modes fitted first), same
-   run, wall-clock and CPU (process) time -- on a shared machine the CPU ratio is the stable figure.
+3. Timing (issues 14 and 37, target <= 10x): modes ON (``physics="extended"``), one effect (the wheel's h = 4.42
+   radial-force line growing as Ω^2.5, a load through the suspension modes), ``--sets``: ``benchmark``, the 120-speed,
+   6-channel E dataset (300-2400 rpm, 3840 Hz, 8192 samples); ``sixty``, the robustness matrix's nominal cell (60
+   speeds over 300-3000 rpm).  ``rwadist fit`` (:func:`rwadist.api.fit`) and ``rwadist diagnose DATA`` without a
+   model (:func:`rwadist.api.diagnose`: the wheel's suspension modes fitted first) in a fresh process that runs
+   them as the command line does (its module first, everything inside :func:`rwadist.cli.one_blas_thread`, so a
+   thread pool loaded during the calls counts), ``--repeats`` interleaved (fit, diagnose) pairs, min and median of
+   wall-clock and CPU time with the load average, the thread pools printed; ``--busy K`` spins K processes beside.
 
 History of the timing figure (cpu ratio, diagnose / plain fit): 51x when issue 14 was filed; 27.8x on modes-off data
 before the first speed-up; x33-37 on this data before the whole-run DFT speed-up; x18.9 (first calls x14.0) at a3db21a
@@ -33,7 +37,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -309,19 +312,20 @@ def modes_on_table(seeds, groups=None):
     print(f"\nmodes on: {sum(passed)}/{len(passed)} cases pass every criterion of their test")
 
 
-def timing(fit_repeats: int = 5, diagnose_repeats: int = 5):
-    """The same estimator on both sides (the best of 5 calls each: until 2026-11-25 the best of 5 fits against the
-    best of 2 diagnoses, whose first call carries its warm-up), each call with one BLAS thread as the command line
-    runs it (:func:`rwadist.cli.one_blas_thread`)."""
-    from rwadist import api
-    from rwadist.cli import one_blas_thread
+#: the timing sets: the benchmark's 120 speeds over 300-2400 rpm (the preset's default test) and the robustness
+#: matrix's nominal cell, 60 speeds over 300-3000 rpm (benchmarks/diagnose_matrix.py), both 8192 samples at 3840 Hz
+TIMING_SETS = {"benchmark": None, "sixty": np.linspace(300.0, 3000.0, 60)}
+
+
+def timing_data(which: str):
+    """The timing set ``which``, modes ON (``physics="extended"``), one effect: the wheel's own h = 4.42 radial-force
+    line follows Ω^2.5 instead of Ω², a load on the rotor reaching the load cell through the suspension modes
+    (add_wheel_lines; rwadist.inject would add it at the load cell after the modes, which the no-model path reads as a
+    different line through the modes)."""
     from rwadist.inject import parse, prepare_wheel
 
     w = preset("ithaco-e")
-    speeds = np.asarray(w.default_speeds_rpm, dtype=float)
-    # the wheel's own h = 4.42 radial-force line follows Ω^2.5 instead of Ω²: a load on the rotor, so it reaches the
-    # load cell through the suspension modes like every other line (add_wheel_lines; rwadist.inject would add it
-    # at the load cell after the modes, which the no-model path reads as a different line through the modes)
+    speeds = np.asarray(w.default_speeds_rpm if TIMING_SETS[which] is None else TIMING_SETS[which], dtype=float)
     spec = parse("amplitude_law:direction=radial_force,h=4.42,exponent=2.5")
     prepared = prepare_wheel(w, [spec], "extended")          # the line taken out of the wheel; spec["C"] = its C
     t = simulate_steady(prepared, speeds, physics="extended", seed=11, sample_rate=w.default_sample_rate,
@@ -329,41 +333,83 @@ def timing(fit_repeats: int = 5, diagnose_repeats: int = 5):
     w_mid = float(np.median(np.abs(speeds))) * 2 * np.pi / 60
     law = (spec["C"] * w_mid**2, w_mid, spec["exponent"])
     add_wheel_lines(t, lambda rng: [_line("radial_force", spec["h"], spec["C"], rng, law=law)], 11)
-    n_ch = len(t.runs[0].signals)
-    def timed(f, n):
-        """(best wall s, best cpu s, all cpu s, result) of ``n`` calls: on a shared machine one call of a
-        0.4-s fit varies by half; the best of several is the stable figure."""
-        walls, cpus = [], []
-        for _ in range(n):
-            t0, c0 = time.perf_counter(), time.process_time()
-            out = f()
-            walls.append(time.perf_counter() - t0)
-            cpus.append(time.process_time() - c0)
-        return min(walls), min(cpus), cpus, out
+    return t
 
-    with one_blas_thread():
-        t_fit, c_fit, c_fits, _ = timed(lambda: api.fit(t), fit_repeats)
-        t_diag, c_diag, c_diags, d = timed(lambda: api.diagnose(t), diagnose_repeats)
-    print(f"\n{speeds.size} speeds ({speeds.min():g}-{speeds.max():g} rpm) x {n_ch} channels, "
-          f"{w.default_n_samples} samples at {w.default_sample_rate:g} Hz, modes on, one effect "
-          "(the wheel's h = 4.42 radial-force line as Omega^2.5, through the modes); best of "
-          f"{fit_repeats} fits and {diagnose_repeats} diagnoses:")
-    print(f"  plain fit (rwadist fit):          wall {t_fit:7.2f} s   cpu {c_fit:7.2f} s   "
-          f"(cpu of each: {', '.join(f'{x:.2f}' for x in c_fits)})")
-    print(f"  diagnose (rwadist diagnose DATA): wall {t_diag:7.2f} s   cpu {c_diag:7.2f} s   "
-          f"(cpu of each: {', '.join(f'{x:.2f}' for x in c_diags)})")
-    print(f"  ratio: wall x{t_diag / t_fit:.1f}, cpu x{c_diag / c_fit:.1f}   (target <= 10x; 51x when issue 14 was filed; "
-          "the figure's history is in this file's docstring)")
-    print(f"  first calls only (each with its warm-up, the method of the earlier figures): cpu "
-          f"x{c_diags[0] / c_fits[0]:.1f}")
-    print(f"  {d.iterations} iterations, added "
-          f"{[(e['kind'], e.get('h'), e.get('exponent')) for e in d.model.effects]}, error {d.error_before:.4f} -> "
-          f"{d.error_after:.5f}")
+
+#: the timing child: a fresh interpreter that runs the calls as ``rwadist fit`` / ``rwadist diagnose`` do -- the command
+#: line's module imported first, the data read and every call made inside rwadist.cli.one_blas_thread, so that a library
+#: loaded during the calls (scipy.linalg's OpenBLAS) loads there; interleaved (fit, diagnose) pairs; JSON out: wall and CPU
+#: seconds of each call, the thread pools at the end (threadpoolctl).  Not this file: its imports load scipy first.
+TIMING_CHILD = """
+import json, sys, time
+from pathlib import Path
+from rwadist import cli
+path, repeats = sys.argv[1], int(sys.argv[2])
+with cli.one_blas_thread():
+    from threadpoolctl import threadpool_info
+    from rwadist import api
+    t = api.read(path)
+    out = {"fit": [], "diagnose": []}
+    for _ in range(repeats):
+        for name, fn in (("fit", lambda: api.fit(t)), ("diagnose", lambda: api.diagnose(t))):
+            t0, c0 = time.perf_counter(), time.process_time()
+            fn()
+            out[name].append((time.perf_counter() - t0, time.process_time() - c0))
+    out["pools"] = [(i["internal_api"], Path(i["filepath"]).name, i["num_threads"]) for i in threadpool_info()]
+print(json.dumps(out))
+"""
+
+
+def timing(sets=("benchmark",), repeats: int = 5, busy: int = 0):
+    """Diagnose / fit, each set in a fresh process (:data:`TIMING_CHILD`), ``repeats`` interleaved pairs, min and
+    median of wall and CPU with the load average; ``busy`` processes spinning beside (``python -c "while 1:
+    pass"``, ended by their pid afterwards)."""
+    import json
+    import os
+    import subprocess
+    import tempfile
+
+    from rwadist.hdf5 import write_hdf5
+
+    spinners = [subprocess.Popen([sys.executable, "-c", "while 1: pass"]) for _ in range(busy)]
+    try:
+        for which in sets:
+            with tempfile.TemporaryDirectory() as tmp:
+                t = timing_data(which)
+                path = write_hdf5(t, Path(tmp) / f"{which}.h5")
+                load0 = os.getloadavg()[0]
+                r = subprocess.run([sys.executable, "-c", TIMING_CHILD, str(path), str(repeats)],
+                                   capture_output=True, text=True, check=True)
+                res = json.loads(r.stdout.strip().splitlines()[-1])
+                load1 = os.getloadavg()[0]
+            speeds = np.abs([rr.speed for rr in t.runs]) * 60 / (2 * np.pi)
+            print(f"\n{which}: {len(t.runs)} speeds ({speeds.min():.0f}-{speeds.max():.0f} rpm) x "
+                  f"{len(t.runs[0].signals)} channels, {t.runs[0].n_samples} samples at {t.runs[0].sample_rate:g} Hz, "
+                  f"modes on, one effect; {repeats} interleaved (fit, diagnose) pairs in one process, "
+                  f"{busy} busy processes beside; load average {load0:.2f} -> {load1:.2f}")
+            stat = {}
+            for name in ("fit", "diagnose"):
+                wall, cpu = np.array(res[name]).T
+                stat[name] = (wall.min(), float(np.median(wall)), cpu.min(), float(np.median(cpu)))
+                print(f"  {name:8s} wall min {wall.min():6.2f} s  median {np.median(wall):6.2f} s   "
+                      f"cpu min {cpu.min():6.2f} s  median {np.median(cpu):6.2f} s   (first call cpu {cpu[0]:.2f} s)")
+            f, d = stat["fit"], stat["diagnose"]
+            print(f"  diagnose / fit: wall x{d[0] / f[0]:.1f} (min) x{d[1] / f[1]:.1f} (median), cpu x{d[2] / f[2]:.1f} "
+                  f"(min) x{d[3] / f[3]:.1f} (median)   target <= 10x")
+            print(f"  thread pools after the calls: {res['pools']}")
+    finally:
+        for p in spinners:
+            p.terminate()
+            p.wait()
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="timing only")
+    ap.add_argument("--sets", nargs="+", default=["benchmark"], choices=sorted(TIMING_SETS),
+                    help="timing sets (default: benchmark)")
+    ap.add_argument("--repeats", type=int, default=5, help="interleaved (fit, diagnose) pairs per set (default 5)")
+    ap.add_argument("--busy", type=int, default=0, help="busy processes spinning beside the timing (default 0)")
     ap.add_argument("--modes-on", nargs="*", default=None, metavar="GROUP",
                     help="the acceptance cases re-measured on modes-on data only (optionally only these groups: "
                          "clean missing_harmonic amplitude_law broadband_floor fixed_resonance cross_coupling "
@@ -374,4 +420,4 @@ if __name__ == "__main__":
         sys.exit(0)
     if not a.quick:
         table([0, 1, 2])
-    timing()
+    timing(a.sets, a.repeats, a.busy)

@@ -484,6 +484,11 @@ def line_envelope(wheels, speed_range, f: np.ndarray, n_speeds: int = 4000) -> E
     lo, hi = float(speed_range[0]), float(speed_range[1])
     _check_range("envelope speed range", lo, hi)
     f = np.asarray(f, float)
+    if np.any(np.diff(f) < 0):                   # the line ranges are searched on an ascending grid
+        order = np.argsort(f, kind="stable")
+        env_sorted = line_envelope(wheels, speed_range, f[order], n_speeds)
+        env_sorted.amplitude[order] = env_sorted.amplitude.copy()
+        return Envelope(f=f, amplitude=env_sorted.amplitude, table=env_sorted.table)
     env = np.zeros((f.size, 6))
     table = []
     branches = []
@@ -498,16 +503,18 @@ def line_envelope(wheels, speed_range, f: np.ndarray, n_speeds: int = 4000) -> E
         for w in branches:
             A = np.abs(lines.amplitudes(w) @ T.T)                      # (S, L, 6)
             fw = lines.freqs(w)                                        # (S, L), increasing in S
+            A_lines = np.ascontiguousarray(A.transpose(1, 0, 2))       # (L, S, 6): rows gathered per line
             for i in range(len(lines)):
-                sel = (f >= fw[0, i]) & (f <= fw[-1, i])
-                for c in range(6):
-                    if sel.any() and fw[-1, i] > fw[0, i]:
-                        env[sel, c] = np.maximum(env[sel, c], np.interp(f[sel], fw[:, i], A[:, i, c]))
-                k = np.argmax(A[:, i, :], axis=0)
-                val = A[k, i, np.arange(6)]
-                upd = val > best[i]
-                best[i] = np.where(upd, val, best[i])
-                best_w[i] = np.where(upd, w[k], best_w[i])
+                if not fw[-1, i] > fw[0, i]:
+                    continue
+                a, b = np.searchsorted(f, fw[0, i], side="left"), np.searchsorted(f, fw[-1, i], side="right")
+                if b > a:
+                    np.maximum(env[a:b], _interp_columns(f[a:b], fw[:, i], A_lines[i]), out=env[a:b])
+            k = np.argmax(A, axis=0)                                   # (L, 6): speed of each line's peak
+            val = np.take_along_axis(A, k[None], axis=0)[0]
+            upd = val > best
+            best = np.where(upd, val, best)
+            best_w = np.where(upd, w[k], best_w)
         for i in range(len(lines)):
             for c, ch in enumerate(CHANNELS):
                 if best[i, c] > 0:
@@ -516,6 +523,24 @@ def line_envelope(wheels, speed_range, f: np.ndarray, n_speeds: int = 4000) -> E
                                   "speed_rpm": float(best_w[i, c] * RAD_S_TO_RPM),
                                   "f_Hz": float(lines.freqs([best_w[i, c]], [i])[0, 0])})
     return Envelope(f=f, amplitude=env, table=table)
+
+
+def _interp_columns(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
+    """np.interp(x, xp, fp[:, c]) of every column c at once (numpy's formula: the same numbers); ``x`` inside
+    [xp[0], xp[-1]].  A non-increasing ``xp`` (a line folded below 0 Hz by an offset) goes to np.interp itself."""
+    if np.any(np.diff(xp) <= 0):
+        return np.stack([np.interp(x, xp, fp[:, c]) for c in range(fp.shape[1])], axis=1)
+    j = np.searchsorted(xp, x, side="right")
+    np.clip(j, 1, xp.size - 1, out=j)
+    x0 = xp[j - 1]
+    f0 = fp[j - 1]
+    out = fp[j]                                   # ((f1 − f0) / (x1 − x0)) · (x − x0) + f0, in place
+    out -= f0
+    out /= (xp[j] - x0)[:, None]
+    out *= (x - x0)[:, None]
+    out += f0
+    out[x == xp[-1]] = fp[-1]
+    return out
 
 
 # =========================================================================== files and plots

@@ -71,7 +71,6 @@ import math
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-from scipy import optimize
 
 from . import schema
 from .effects.actions import LineFilter, LineLaw, LineModulation, of_effects
@@ -509,6 +508,8 @@ def crossings(p: ExtendedParams, lines, speed_range) -> list:
     lo, hi = float(speed_range[0]), float(speed_range[1])
     if not (0 <= lo < hi and math.isfinite(hi)):
         raise ValueError(f"speed_range must be 0 <= lo < hi, got {speed_range!r}")
+    from scipy import optimize  # 0.7 s to import: only where a crossing is solved
+
     grid = np.linspace(lo, hi, 2001)
     out = []
     for ln in lines:

@@ -3,11 +3,13 @@ Part of :mod:`rwadist.broadband`, which re-exports these names."""
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 
 import numpy as np
 
 from .broadband import _CROSS_UNIT, PAIRS, BroadbandPSD, Envelope
+from .text_table import write_csv
 from .units import CHANNELS, PSD_COLUMN
 
 
@@ -17,8 +19,7 @@ def write_psd_csv(res: BroadbandPSD, path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     data = np.column_stack([res.f, res.psd])
     header = ",".join(["f_Hz"] + [PSD_COLUMN[c] for c in CHANNELS])
-    np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.10e")
-    return path
+    return write_csv(path, header, data, 10)
 
 
 def cross_columns() -> list:
@@ -35,14 +36,12 @@ def cross_columns() -> list:
 
 def write_cross_csv(res: BroadbandPSD, path) -> Path:
     """Cross-spectra csd[a, b] (a < b) as real and imaginary columns; csd[b, a] is the conjugate."""
-    path = Path(path)
-    cols = [res.f]
-    for a, b in PAIRS:
-        if a != b:
-            cols += [res.csd[:, a, b].real, res.csd[:, a, b].imag]
-    np.savetxt(path, np.column_stack(cols), delimiter=",", header=",".join(["f_Hz"] + cross_columns()),
-               comments="", fmt="%.10e")
-    return path
+    off = [(a, b) for a, b in PAIRS if a != b]
+    data = np.empty((res.f.size, 1 + 2 * len(off)))
+    data[:, 0] = res.f
+    data[:, 1::2] = res.csd[:, [a for a, _ in off], [b for _, b in off]].real
+    data[:, 2::2] = res.csd[:, [a for a, _ in off], [b for _, b in off]].imag
+    return write_csv(path, ",".join(["f_Hz"] + cross_columns()), data, 10)
 
 
 def read_psd_csv(path) -> tuple:
@@ -72,6 +71,26 @@ def write_hdf5(res: BroadbandPSD, path, group: str = "psd") -> Path:
     return path
 
 
+#: a plotted curve keeps at most this many buckets across the visible band (a panel is ~500 px wide): each holds the
+#: smallest and the largest value of its frequencies, so every peak and notch is drawn
+PLOT_BUCKETS = 2000
+
+
+def _peaks_kept(f: np.ndarray, y: np.ndarray, visible_hz: float):
+    """(f, y) reduced to two points per bucket of width ``visible_hz``/PLOT_BUCKETS (first frequency with the
+    bucket's minimum, last with its maximum; NaN, a zero on a log axis, ignored unless the bucket has nothing
+    else); unchanged when there are not many more points than that.  Drawing 1e5 points per curve took ~1 s."""
+    n_buckets = int(min(f.size // 4, math.ceil(PLOT_BUCKETS * (f[-1] - f[0]) / max(visible_hz, 1e-300))))
+    if n_buckets < PLOT_BUCKETS // 2 or f.size <= 4 * n_buckets:
+        return f, y
+    start = np.unique(np.linspace(0, f.size, n_buckets + 1).astype(np.int64)[:-1])
+    end = np.append(start[1:], f.size) - 1
+    x = np.column_stack([f[start], f[end]]).ravel()
+    with np.errstate(invalid="ignore"):
+        v = np.column_stack([np.fmin.reduceat(y, start), np.fmax.reduceat(y, start)]).ravel()
+    return x, v
+
+
 def plot_psd(res: BroadbandPSD, title: str = ""):
     """Figure (Agg canvas, no pyplot): PSDs (top, log scale) and cumulative RMS (bottom).
 
@@ -99,8 +118,8 @@ def plot_psd(res: BroadbandPSD, title: str = ""):
             log_axis(ax_p)
         for c, label in group_identical(psd[:, live], [CHANNELS[k] for k in live]) if live else []:
             k = live[c]
-            ax_p.plot(f, np.where(psd[:, k] > 0, psd[:, k], np.nan), lw=0.8, label=label)
-            ax_c.plot(f, cum[:, k], lw=1.0, label=label)
+            ax_p.plot(*_peaks_kept(f, np.where(psd[:, k] > 0, psd[:, k], np.nan), f_top), lw=0.8, label=label)
+            ax_c.plot(*_peaks_kept(f, cum[:, k], f_top), lw=1.0, label=label)
         if live:
             lo = log_floor(psd[:, live])
             if lo is not None:
@@ -125,6 +144,4 @@ def plot_psd(res: BroadbandPSD, title: str = ""):
 
 def write_envelope_csv(env: Envelope, path) -> Path:
     cols = ["f_Hz"] + [f"{c}_{'N' if c.startswith('F') else 'Nm'}" for c in CHANNELS]
-    np.savetxt(path, np.column_stack([env.f, env.amplitude]), delimiter=",", header=",".join(cols),
-               comments="", fmt="%.8e")
-    return Path(path)
+    return write_csv(path, ",".join(cols), np.column_stack([env.f, env.amplitude]), 8)

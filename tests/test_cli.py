@@ -216,6 +216,38 @@ def test_commands_run_with_one_blas_thread_unless_the_environment_says(monkeypat
     assert cli.main(["catalogue", "list"]) == 0 and entered == [True]
 
 
+def test_a_pool_loaded_during_a_command_runs_one_thread_too():
+    """scipy.linalg loads its own OpenBLAS at its first use, after the command started: limited where it stood, it ran
+    a thread per core beside busy neighbours (issue 37).  In a fresh interpreter without the thread variables: every
+    pool has one thread inside one_blas_thread (numpy's, limited there; scipy's, loaded there), none after."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    from rwadist import cli
+
+    code = """
+import json
+from threadpoolctl import threadpool_info
+from rwadist import cli
+def pools():
+    return sorted((i["filepath"], i["num_threads"]) for i in threadpool_info())
+with cli.one_blas_thread():
+    import scipy.linalg
+    scipy.linalg.lu_factor([[2.0, 1.0], [1.0, 3.0]])
+    inside = pools()
+print(json.dumps({"inside": inside, "after": pools()}))
+"""
+    env = {k: v for k, v in os.environ.items() if k not in cli.ONE_THREAD_ENVIRONMENT}
+    out = json.loads(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                                    check=True).stdout)
+    assert len(out["inside"]) >= 2                                  # numpy's OpenBLAS and scipy's
+    assert all(n == 1 for _, n in out["inside"]), out
+    cores = len(os.sched_getaffinity(0))
+    assert all(n == cores for _, n in out["after"]), out
+
+
 def test_fit_refuses_flags_it_would_ignore(tmp_path, capsys):
     """--mass (and --radius, --height, --preset) without --extended were ignored; --cumulative-rpm 5000 on a
     600-2400 rpm test plotted the 2400 rpm run under a title of 5000."""
