@@ -52,6 +52,7 @@ from . import geometry
 from .assemble import PRACTICES
 from .components import Plant, wheel_matrices, wheel_rigid_mass_matrix
 from .errors import CouplingError, SingularInterfaceError
+from .gyro_split import FloorSolver, wheel_split
 
 # ----------------------------------------------------------------------------- broadband floors
 
@@ -417,6 +418,34 @@ def _setup(plant: Plant, wheels, practices, omega):
     return om, Mts, Zm
 
 
+def _line_group(plant, wheels, Mts, Zm, practices, o, fe, ks, lines, cache) -> list:
+    """[(coupled loads (S, J, 6), {practice: outputs (S, J, n_perf)})] of wheels ``ks``, whose lines all sit at
+    the frequencies ``fe`` (S, J) Hz at speeds ``o``: the plant, the wheels' dynamic masses and the interface
+    matrix once, each practice's solve with every wheel's right-hand side at once."""
+    G, P = plant.frf(fe)
+    parts, Bs = [], {}
+    for i, wi in enumerate(wheels):
+        Zc, Bw = cache.get(wi, o, fe)
+        parts.append((Mts[i], Zc))
+        if i in ks:
+            Bs[i] = (Zc, Bw)
+    rhs = np.concatenate([Mts[k].T @ lines[k][1][..., None] for k in ks], axis=-1)          # (S, J, n_if, |ks|)
+    Lc = _interface_matrix(G, parts)                                                        # coupled interface
+    u = {"coupled": np.linalg.solve(Lc, rhs), "i": rhs}
+    if "ii" in practices:
+        u["ii"] = np.linalg.solve(np.eye(G.shape[-1]) - Zm @ G, rhs)
+    if "iii" in practices:
+        u["iii"] = np.linalg.solve(Lc, np.concatenate([Mts[k].T @ (Bs[k][1] @ lines[k][1][..., None]) for k in ks],
+                                                       axis=-1))
+    out = []
+    for j, k in enumerate(ks):
+        live = (lines[k][0] > 0)[..., None]
+        Fk, uc = lines[k][1], u["coupled"][..., j:j + 1]
+        load = np.where(live, (Fk[..., None] + Bs[k][0] @ (Mts[k] @ (G @ uc)))[..., 0], 0)
+        out.append((load, {p: np.where(live, (P @ u[p][..., j:j + 1])[..., 0], 0) for p in practices}))
+    return out
+
+
 def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int = 250,
                    floor_f_hz=None) -> LineResponses:
     """Steady line responses of the performance outputs for every wheel and practice at sweep
@@ -427,43 +456,34 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
     in :attr:`LineResponses.floor`."""
     wheels = list(wheels)
     om, Mts, Zm = _setup(plant, wheels, practices, omega)
-    n_if = plant.n_interface
     kmax = [0 if w.ripple is None else ext.ripple_order(w.lines, om * w.speed_scale, w.ripple) for w in wheels]
     nw = len(wheels)
     hs, offs, orders = [None] * nw, [None] * nw, [None] * nw
     fs, hms, loads = ([[] for _ in range(nw)] for _ in range(3))
     ys = {p: [[] for _ in range(nw)] for p in practices}
-    eye = np.eye(n_if)
     for i0 in range(0, om.size, chunk):
         o = om[i0:i0 + chunk]
         cache = _FrfCache()
+        lines = []
         for k, wk in enumerate(wheels):
             hs[k], offs[k], orders[k], f, Fk = _grouped_lines(wk, o * wk.speed_scale, kmax[k])
-            live = f > 0
-            fe = np.where(live, f, 1.0)
-            G, P = plant.frf(fe)
-            parts = []
-            for i, wi in enumerate(wheels):
-                Zc, Bw = cache.get(wi, o, fe)
-                parts.append((Mts[i], Zc))
-                if i == k:
-                    Zck, Bk = Zc, Bw
-            rhs = (Mts[k].T @ Fk[..., None])                     # (S, J, n_if, 1)
-            Lc = _interface_matrix(G, parts)                      # coupled interface equation
-            uc = np.linalg.solve(Lc, rhs)
-            loads[k].append(np.where(live[..., None], (Fk[..., None] + Zck @ (Mts[k] @ (G @ uc)))[..., 0], 0))
-            for p in practices:
-                if p == "coupled":
-                    u = uc
-                elif p == "i":
-                    u = rhs
-                elif p == "ii":
-                    u = np.linalg.solve(eye - Zm @ G, rhs)
-                else:
-                    u = np.linalg.solve(Lc, Mts[k].T @ (Bk @ Fk[..., None]))
-                ys[p][k].append(np.where(live[..., None], (P @ u)[..., 0], 0))
+            lines.append((f, Fk, np.where(f > 0, f, 1.0)))
             fs[k].append(f)
             hms[k].append(Fk)
+        # wheels whose lines sit at the same frequencies (equal wheels) share the plant, the interface matrix and
+        # its factorisation: one solve with all their right-hand sides
+        groups: list = []
+        for k, (_, _, fe) in enumerate(lines):
+            same = [g for g in groups if g[0].shape == fe.shape and np.array_equal(g[0], fe)]
+            if same:
+                same[0][1].append(k)
+            else:
+                groups.append((fe, [k]))
+        for fe, ks in groups:
+            for k, (ld, y) in zip(ks, _line_group(plant, wheels, Mts, Zm, practices, o, fe, ks, lines, cache)):
+                loads[k].append(ld)
+                for p in practices:
+                    ys[p][k].append(y[p])
     fs, hms, loads = ([np.concatenate(x) for x in lst] for lst in (fs, hms, loads))
     ys = {p: [np.concatenate(x) for x in v] for p, v in ys.items()}
     floor = None
@@ -632,28 +652,21 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
             psd["ii"][:, fs] = (np.abs(Y) ** 2 @ Sin[:, fs][..., None])[..., 0]
         if not dyn:
             continue
+        # the wheels' speeds enter only through their rank-2 gyroscopic terms: one factorisation per frequency
+        # (coupling.gyro_split), then a 2w x 2w solve per speed and frequency
+        splits: dict = {}
+        for w in wheels:
+            key = _wheel_key(w)[:3] + (bool(w.hard_mounted),)
+            if key not in splits:
+                splits[key] = wheel_split(w, fc)
+        solver = FloorSolver(G, P, Mts, [splits[_wheel_key(w)[:3] + (bool(w.hard_mounted),)] for w in wheels], R,
+                             cols)
         step = max(1, int(chunk_points) // fc.size)
         for i0 in range(0, om.size, step):
             o = om[i0:i0 + step]
-            fe = np.broadcast_to(fc, (o.size, fc.size))
-            parts, Bs = [], {}
-            cache = _FrfCache()
-            for i, wi in enumerate(wheels):
-                Zc, Bw = cache.get(wi, o, fe)
-                parts.append((Mts[i], Zc))
-                if wi.floors:
-                    Bs[i] = Bw
-            Lc = _interface_matrix(G, parts)
             Sc = Sin[i0:i0 + o.size, fs][..., None]
-            # P·Lc⁻¹ once, by the transposed system (n_perf right-hand sides, usually fewer than the loads;
-            # one factorisation serves 'coupled' and 'iii')
-            PT = np.broadcast_to(np.swapaxes(P, -1, -2), Lc.shape[:-2] + (n_if, plant.n_perf))
-            PL = np.swapaxes(np.linalg.solve(np.swapaxes(Lc, -1, -2), PT), -1, -2)     # (s, f, n_perf, n_if)
-            if "coupled" in dyn:
-                psd["coupled"][i0:i0 + o.size, fs] = (np.abs(PL @ R) ** 2 @ Sc)[..., 0]
-            if "iii" in dyn:
-                R3 = np.stack([_apply_left(Mts[k].T, Bs[k][..., :, c]) for k, c in cols], axis=-1)
-                psd["iii"][i0:i0 + o.size, fs] = (np.abs(PL @ R3) ** 2 @ Sc)[..., 0]
+            for p, Y in solver.solve(solver.gains([o * w.speed_scale for w in wheels]), dyn).items():
+                psd[p][i0:i0 + o.size, fs] = (np.abs(Y) ** 2 @ Sc)[..., 0]
     psd = {p: psd[p] for p in practices}
     ms = {p: _trapz(v, f, axis=1) for p, v in psd.items()}
     return FloorResponses(om, plant.perf_names, f, psd, ms)

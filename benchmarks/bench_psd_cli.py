@@ -1,0 +1,80 @@
+"""Benchmark (issue 37): ``rwadist psd --wheels wheels.json --n-freq 100000`` end to end, as a user types it.
+
+The case of the issue: 4 wheels (pyramid-4 mountings, the laws of bench_broadband.py) of a 20-harmonic model file
+(Melody's model, ``--empirical``), 1e5 frequencies, every output (psd.csv, the cross-spectra CSV, the envelope CSV,
+the plot).  Timed in fresh processes, interleaved with the peer -- the same interpreter importing what the command
+imports before it computes anything (``rwadist.cli``, numpy, matplotlib's Figure): the floor no command goes under --
+``--repeats`` rounds (default 3), min and median of wall-clock and CPU (the child's user + system time) with the
+load average.  Target: <= 2 s idle.
+
+Run: python benchmarks/bench_psd_cli.py [--repeats R] [--n-freq N]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from bench_broadband import wheel_model  # noqa: E402
+
+from rwadist.model import save  # noqa: E402
+
+LAWS = [("uniform", -3000, 3000), ("normal", 0, 3000), ("uniform", 300, 2500), ("uniform", -2500, 2500)]
+PEER = "import numpy, matplotlib.figure, matplotlib.backends.backend_agg; from rwadist.cli import main"
+
+
+def write_case(d: Path) -> Path:
+    save(wheel_model(), d / "bench_wheel.json")
+    wheels = [{"name": f"RW{i}", "model": "bench_wheel.json", "mounting": {"preset": "pyramid-4", "index": i},
+               "speed": {"dist": dist, "min_rpm": lo, "max_rpm": hi}} for i, (dist, lo, hi) in enumerate(LAWS)]
+    (d / "wheels.json").write_text(json.dumps({"wheels": wheels}, indent=1))
+    return d / "wheels.json"
+
+
+def run(argv) -> tuple:
+    """(wall s, CPU s of the child) of one subprocess."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    subprocess.run(argv, check=True, capture_output=True)
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+
+
+def main(repeats=3, n_freq=100_000):
+    rwadist = str(Path(sys.executable).with_name("rwadist"))
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        wheels = write_case(d)
+        cmd = [rwadist, "psd", "--wheels", str(wheels), "--speed-rpm", "0:3000", "--n-freq", str(n_freq), "--empirical",
+               "-o", str(d / "out" / "psd.csv")]
+        print(f"{' '.join(['rwadist'] + cmd[1:])}\nload average {os.getloadavg()[0]:.2f} at start")
+        t = {"rwadist psd": [], "peer (imports)": []}
+        for _ in range(repeats):
+            t["rwadist psd"].append(run(cmd))
+            t["peer (imports)"].append(run([sys.executable, "-c", PEER]))
+        sizes = {p.name: p.stat().st_size for p in (d / "out").iterdir()}
+    for k, v in t.items():
+        w, c = np.array(v).T
+        print(f"  {k:15s} wall min {w.min():6.2f} s  median {np.median(w):6.2f} s   CPU min {c.min():6.2f} s  "
+              f"median {np.median(c):6.2f} s")
+    print(f"load average at end {os.getloadavg()[0]:.2f}; target <= 2 s idle; outputs: "
+          + ", ".join(f"{k} {v / 1e6:.1f} MB" for k, v in sorted(sizes.items())))
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--n-freq", type=int, default=100_000)
+    a = ap.parse_args()
+    main(a.repeats, a.n_freq)
