@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from .components import wheel_matrices
+from .interface import _interface_matrix, rigid_wheel_frf
 
 
 def _gyro_vectors():
@@ -43,8 +44,6 @@ def wheel_split(spec, f: np.ndarray) -> dict:
     s = 2j * np.pi * np.asarray(f, dtype=float)
     p = spec.params
     if spec.hard_mounted:
-        from .performance import rigid_wheel_frf
-
         Zc0, B = rigid_wheel_frf(p, np.zeros(1), f[None, :], spec.housing_mass, spec.housing_inertia)
         e = np.zeros((6, 2))
         e[3, 0] = e[4, 1] = 1.0
@@ -86,8 +85,6 @@ class FloorSolver:
     def __init__(self, G, P, Mts, splits, loads, cols):
         """G (F, n, n), P (F, n_perf, n) the plant on the chunk; Mts the wheels' mount selectors (6, n); splits
         their :func:`wheel_split` on the chunk; loads R (n, N) the unit blocked loads; cols [(wheel, channel)]."""
-        from .performance import _interface_matrix
-
         nw = len(Mts)
         L0 = _interface_matrix(G, [(Mt, sp["Zc0"]) for Mt, sp in zip(Mts, splits)])     # (F, n, n)
         U = np.concatenate([np.einsum("ji,fjk->fik", Mt, sp["a"]) for Mt, sp in zip(Mts, splits)], axis=-1)

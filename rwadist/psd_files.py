@@ -80,7 +80,9 @@ def _peaks_kept(f: np.ndarray, y: np.ndarray, visible_hz: float):
     """(f, y) reduced to two points per bucket of width ``visible_hz``/PLOT_BUCKETS (first frequency with the
     bucket's minimum, last with its maximum; NaN, a zero on a log axis, ignored unless the bucket has nothing
     else); unchanged when there are not many more points than that.  Drawing 1e5 points per curve took ~1 s."""
-    n_buckets = int(min(f.size // 4, math.ceil(PLOT_BUCKETS * (f[-1] - f[0]) / max(visible_hz, 1e-300))))
+    with np.errstate(over="ignore"):
+        wanted = PLOT_BUCKETS * float(np.float64(f[-1] - f[0]) / max(visible_hz, 1e-300))
+    n_buckets = int(f.size // 4 if not wanted < f.size // 4 else math.ceil(wanted))
     if n_buckets < PLOT_BUCKETS // 2 or f.size <= 4 * n_buckets:
         return f, y
     start = np.unique(np.linspace(0, f.size, n_buckets + 1).astype(np.int64)[:-1])

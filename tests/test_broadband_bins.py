@@ -180,3 +180,16 @@ def test_truncated_normal_without_scipy_stats_is_scipys():
     far = bb.TruncatedNormal(0.0, 1.0, 6.0, 9.0)                     # a far tail: no cancellation in its mass
     df = stats.truncnorm(6.0, 9.0)
     np.testing.assert_allclose(far.pdf([6.0, 7.0]), df.pdf([6.0, 7.0]), rtol=1e-10)
+
+
+def test_a_normal_law_narrower_than_rounding_is_its_mean_speed():
+    """std from 1e-300 to 1e-5 rpm: the PSD's power is the lines' at the mean speed (to (std/mean)·q); at 1e-300 the
+    density's nodes were all zero (no power, silently) and at 1e-12 its breakpoints fell within a few ulps."""
+    lines = bb.extended_lines_from_model(_model(analytical=True, planar=True))
+    for mean in (1500.0, -900.0):
+        A = lines.amplitudes([mean * W])
+        ref = np.sqrt((np.abs(A) ** 2 / 2).sum(axis=1))[0]
+        for std in (1e-300, 1e-12, 1e-5):
+            law = bb.TruncatedNormal(mean * W, std * W, -2400 * W, 2400 * W)
+            rms = bb.broadband_psd(lines, law, 200.0, 2001).rms()
+            np.testing.assert_allclose(rms, ref, rtol=1e-9, atol=1e-12 * ref.max())

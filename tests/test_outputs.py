@@ -1,5 +1,6 @@
 """Outputs safe to keep (issue 17): atomic files and folders, an output never overwrites an input,
 Ctrl-C stops cleanly, a kill during a write leaves the old complete file."""
+import json
 import os
 import signal
 import subprocess
@@ -131,12 +132,17 @@ def test_kill_during_the_write_keeps_the_old_file(tmp_path, sig):
 def test_ctrl_c_is_one_line_exit_130(tmp_path):
     out = tmp_path / "psd.csv"
     out.write_text("old")
+    # four wheels of the extended model on 200001 frequencies: a CSD long enough to be interrupted while its
+    # progress bar runs (one empirical wheel took 1 s before issue 37's closed form, 0.1 s after)
+    wheels = tmp_path / "wheels.json"
+    wheels.write_text(json.dumps({"wheels": [{"name": f"RW{i}", "preset": "ithaco-e",
+                                              "mounting": {"preset": "pyramid-4", "index": i}} for i in range(4)]}))
     # ``python -m rwadist.cli`` with Ctrl-C as in a terminal, however pytest was started (a background job inherits
     # SIGINT ignored, and Python then leaves it ignored)
     as_in_a_terminal = ("import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
                         "runpy.run_module('rwadist.cli', run_name='__main__', alter_sys=True)")
-    proc = subprocess.Popen([sys.executable, "-c", as_in_a_terminal, "psd", "--preset", "ithaco-e", "--speed-rpm",
-                             "600:2400", "--empirical", "--n-freq", "200001", "--n-speeds", "20000", "-o", str(out)],
+    proc = subprocess.Popen([sys.executable, "-c", as_in_a_terminal, "psd", "--wheels", str(wheels), "--speed-rpm",
+                             "600:2400", "--n-freq", "200001", "-o", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(0.2)
     deadline = time.time() + 60
@@ -151,4 +157,4 @@ def test_ctrl_c_is_one_line_exit_130(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert "Traceback" not in err and "interrupted" in err.strip().splitlines()[-1]
-    assert out.read_text() == "old" and os.listdir(tmp_path) == ["psd.csv"]
+    assert out.read_text() == "old" and sorted(os.listdir(tmp_path)) == ["psd.csv", "wheels.json"]

@@ -1,0 +1,67 @@
+"""The coupled interface equation's pieces shared by the line and floor responses (:mod:`coupling.performance`,
+:mod:`coupling.gyro_split`): a hard-mounted wheel's dynamic mass, the congruences of constant selectors, and
+I − Σ_i Mt_iᵀ Zc_i Mt_i G."""
+from __future__ import annotations
+
+import numpy as np
+
+from rwadist import extended as ext
+
+from .components import wheel_rigid_mass_matrix
+
+
+def rigid_wheel_frf(p: ext.ExtendedParams, omega, f, housing_mass: float = 0.0, housing_inertia=(0.0, 0.0, 0.0)):
+    """(Zc, B) of a hard-mounted (rigid-suspension) wheel at speeds omega (S,) rad/s and frequencies f (S, J)
+    Hz: Zc (S, J, 6, 6), B (6, 6).  The limit of :func:`coupling.components.wheel_matrices` as the suspension
+    stiffnesses grow without bound (test): the rotor moves with the housing, so
+    f = −M6 a + (gyroscopic) + B w with M6 the rigid wheel's mass matrix
+    (:func:`coupling.components.wheel_rigid_mass_matrix`), the rotor's angular momentum I_zz·Ω giving
+    Tx = −I_zz Ω ω_y, Ty = +I_zz Ω ω_x (ω = α/s, s = i2πf), and B passing the free loads with the radial
+    force's lever arm h (Tx −= h·wFy, Ty += h·wFx)."""
+    om = np.asarray(omega, dtype=float)
+    s = 2j * np.pi * np.asarray(f, dtype=float)
+    M6 = wheel_rigid_mass_matrix(p, housing_mass, housing_inertia)
+    Zc = np.broadcast_to(-M6, s.shape + (6, 6)).astype(complex)
+    gyro = p.I_zz * om.reshape(om.shape + (1,) * (s.ndim - om.ndim)) / s
+    Zc[..., 3, 4] -= gyro
+    Zc[..., 4, 3] += gyro
+    B = np.eye(6)
+    B[3, 1], B[4, 0] = -p.height, p.height
+    return Zc, B
+
+
+def _congruence(T, Z) -> np.ndarray:
+    """Tᵀ Z T for a constant real T (6, 6) and stacked complex Z (..., 6, 6), as one matrix product over all
+    of them: (TᵀZT)_cd = Σ_ab T_ac Z_ab T_bd, i.e. vec(Z) times kron(T, T) (real and imaginary parts apart)."""
+    K = np.kron(T, T)
+    Zf = np.ascontiguousarray(Z).reshape(-1, K.shape[0])
+    return (Zf.real @ K + 1j * (Zf.imag @ K)).reshape(Z.shape[:-2] + (T.shape[1], T.shape[1]))
+
+
+def _apply_left(M, x) -> np.ndarray:
+    """M @ x[..., :] for a constant real M (a, b) and stacked complex vectors x (..., b): one matrix product."""
+    xf = np.ascontiguousarray(x).reshape(-1, M.shape[1])
+    return (xf.real @ M.T + 1j * (xf.imag @ M.T)).reshape(x.shape[:-1] + (M.shape[0],))
+
+
+def _interface_matrix(G, parts) -> np.ndarray:
+    """The coupled interface matrix I − Σ_i Mt_iᵀ Zc_i Mt_i G for plant accelerances G (..., n, n) and wheels
+    ``parts`` = [(Mt_i (6, n) mount selector, Zc_i (..., 6, 6) dynamic mass)], broadcast together.  Each
+    wheel touches only the interface DOFs its selector reaches (its non-zero columns: one node's six), so
+    its term is Tᵀ Zc T·G[those rows] with T the selector's non-zero block -- a 6×6 and a 6×n product per
+    point instead of n×n ones."""
+    n = G.shape[-1]
+    L = None
+    for Mt, Z in parts:
+        cols = np.nonzero(np.any(Mt != 0, axis=0))[0]
+        T = Mt[:, cols]
+        if cols.size and np.all(np.diff(cols) == 1):
+            cols = slice(int(cols[0]), int(cols[-1]) + 1)      # a node's DOFs: a view (fancy indexing copies)
+        term = _congruence(T, Z) @ G[..., cols, :]
+        if L is None:
+            L = np.zeros(np.broadcast_shapes(term.shape[:-2], G.shape[:-2]) + (n, n), dtype=complex)
+        L[..., cols, :] -= term
+    if L is None:
+        L = np.zeros(G.shape, dtype=complex)
+    L.reshape(L.shape[:-2] + (n * n,))[..., :: n + 1] += 1.0      # the diagonal, in place
+    return L
