@@ -468,7 +468,8 @@ def _add_power_pairs(cols, pairs, span, pieces, bps, smooth, rho_fn, line, f, ca
     (sa, sb), (h, off), df, n = span, line, float(f[1] - f[0]), f.size
     by_q: dict = {}
     for cj, ck in pairs:
-        kappa = 0.5 * cj.power[0] * np.conj(ck.power[0])
+        with np.errstate(over="ignore", invalid="ignore"):     # a non-finite result is refused by the caller
+            kappa = 0.5 * cj.power[0] * np.conj(ck.power[0])
         by_q.setdefault(cj.power[1] + ck.power[1], []).append((cj, ck, kappa))
     for q, items in by_q.items():
         if pieces is not None and off == 0.0:
@@ -588,7 +589,8 @@ def _add_product(out: np.ndarray, X: np.ndarray, matrices: list, first: bool) ->
     H = np.array([np.ascontiguousarray(m).view(np.float64).ravel() for m in matrices])      # (K, 72)
     flat = out.view(np.float64).reshape(out.shape[0], 72)
     if first:
-        np.matmul(X.T, H, out=flat)
+        with np.errstate(over="ignore", invalid="ignore"):
+            np.matmul(X.T, H, out=flat)
         return
     for s0 in range(0, out.shape[0], _BLOCK):
         flat[s0:s0 + _BLOCK] += X[:, s0:s0 + _BLOCK].T @ H
