@@ -106,11 +106,11 @@ def read(path, *, slice_samples: int = 8192, speed_source: str = "auto", progres
     _choice("speed_source", speed_source, SPEED_SOURCES)
     obj = data_io.read_data(path, progress=progress)
     if isinstance(obj, Sweep):
-        from .sweep import slice_sweep
+        from .sweep import slice_sweep, speed_note
 
         test, _ = slice_sweep(obj, slice_samples=slice_samples, speed_source=speed_source)
         if log is not None:
-            log(f"sliced sweep into {len(test.runs)} quasi-steady runs (speed from {speed_source})")
+            log(speed_note(test.meta["slicing"]))
         return test
     names = obj.meta.get("unlisted_files")
     if names and log is not None:

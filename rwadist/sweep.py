@@ -4,39 +4,41 @@ The E-wheel test of the thesis was one 390 s record at 3840 Hz through a
 spin-up; it was cut into 8192-sample slices (2.133 s), each treated as a steady
 run at the slice's mean speed.  The thesis took the frequency of the largest
 peak of each slice as the wheel speed.  That fails whenever a structural mode
-lifts another line above the 1× line, so the speed is found here by a harmonic
-comb with a continuity constraint, then refined on the detected lines:
+lifts another line above the 1× line, and a harmonic comb (1, 2, 3, 4 × f0)
+fails on a wheel whose strongest lines are bearing lines near the integers
+(a ball-pass line at 3.08 read as 3×: every h 2.6 % low).  So the speed is
+found from physics alone, assuming no line set:
 
 1. **Spectra.**  Each slice (a 2-D array of slices, one FFT call) gets a
-   Hann periodogram zero-padded ``PAD`` times.  Each radial channel's PSD is
+   Hann periodogram zero-padded ``PAD`` times.  Each channel's PSD is
    divided by one number, its median noise floor in that slice
    (:func:`rwadist.spectra.noise_floor`), and the channels are averaged (P),
    so no channel dominates by its unit; the same average of the local floors
-   is F, and ``R = P / F`` is a signal-to-noise ratio, 1 in pure noise.
-2. **Comb.**  A candidate fundamental ``f0`` scores
-   ``sum_k clip(ln R(k·f0), 0, ln COMB_CAP)`` over ``harmonics``.  The cap
-   keeps one very strong line (a mode) from outscoring a comb of several
-   moderate lines: a fixed-frequency modal peak scores at k = 1 only, a true
-   speed at several k.  Candidates lie on a uniform grid fine enough that every
-   comb tooth moves by at most half a bin between neighbours.
-3. **Continuity.**  The scores are max-pooled onto cells uniform in ln f0
-   (width ``LOG_CELL``) and a Viterbi path is run over the slices with a cost
-   ``JUMP_COST`` per e-fold of speed change between slices, plus a "no line"
-   state whose score is the largest comb that white noise reaches on the same
-   grid (calibrated on generated noise, fixed seed).  Slices on that state
-   (the wheel near rest) get ``speed = nan``.  The best candidate inside the
-   chosen cell (±1 cell) is then taken.
-4. **Refinement.**  The lines near k·f0 are found and their frequencies
+   is F, and ``R = P / F`` is a signal-to-noise ratio, 1 in pure noise.  A
+   slice whose largest R does not pass the largest that white noise reaches
+   on the same grid (calibrated on generated noise, fixed seed) shows no line
+   (the wheel near rest): ``speed = nan``.
+2. **Shape and scale** (:mod:`rwadist.speed_scale`).  Every line sits at a
+   fixed ratio of the speed, so the line pattern moves rigidly in ln f: the
+   slices registered against each other and against their common template
+   give ln|Ω| up to one constant.  The template's peaks are the wheel's lines;
+   the 1× line is the imbalance -- one rotation sense in the radial force and
+   the same in the radial torque (the static and dynamic imbalances turn with
+   the rotor), with the most line strength on its integer multiples (itself
+   included); every other line keeps its ratio h_i to it.
+3. **Refinement.**  The lines near h_i·f0 are found and their frequencies
    refined with :func:`rwadist.spectra.find_lines` on P (log-parabolic
    interpolation on the zero-padded spectrum; P has no frequency-dependent
-   normalisation, so the peak is not shifted).  The lines vote for f0 (f_k/k);
+   normalisation, so the peak is not shifted).  The lines vote for f0 (f_i/h_i);
    the largest agreeing set is kept (a line pulled by a mode it is crossing is
-   outvoted) and f0 is their weighted least-squares fit of f_k = k·f0, weights
-   1/σ_k², σ_k ≈ 0.4·df/sqrt(n_channels·SNR_k).  Then each slice is fused with
+   outvoted) and f0 is their weighted least-squares fit of f_i = h_i·f0, weights
+   1/σ_i², σ_i ≈ 0.4·df/sqrt(n_channels·SNR_i).  Then each slice is fused with
    the leave-one-out quadratic prediction of its neighbours (inverse-variance
    mean, model error estimated from the data, outliers excluded), so slices
    whose lines are near the noise borrow from the smooth speed track while
-   precise slices keep their own value.
+   precise slices keep their own value.  How the speed was obtained and how
+   well the lines agree with it (RMS of f_i/(h_i·f0) − 1) go to the test's
+   ``meta["slicing"]["speed_scale"]``.
 5. **Sign.**  A spectrum sees only |Ω|.  For positive spin a rotating radial
    vector is Fx = A cos φ, Fy = A sin φ (counter-clockwise about +z), so Fy
    lags Fx by 90° and the cross-spectrum conj(X)·Y at the 1× line has phase
@@ -48,27 +50,20 @@ Units: SI inside (rad/s for wheel speed, Hz for frequencies); rpm only in the
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import fft as sfft
 from scipy import signal
 
+from . import speed_scale as scale
 from .data import TACH_COLUMN, DataError, Run, SteadyTest, Sweep
 from .spectra import find_lines, noise_floor
 from .units import rad_s_to_rpm, rpm_to_rad_s
 
 #: Zero-padding factor of the slice periodograms (sub-bin sampling of the comb and the peaks).
 PAD = 4
-#: Upper clip of one comb tooth's SNR ratio (a single line cannot score more than ln of this).
-COMB_CAP = 1.0e3
-#: Width of the continuity cells, in e-folds of f0 (1 %).
-LOG_CELL = 0.01
-#: Viterbi cost of a speed change between consecutive slices, comb-score units per e-fold.
-JUMP_COST = 4.0
-#: Viterbi cost of entering or leaving the "no line" state.
-SILENT_COST = 2.0
-#: Slices of white noise used to calibrate the "no line" level of the comb (fixed seed: deterministic).
+#: Slices of white noise used to calibrate the "no line" level of R (fixed seed: deterministic).
 NOISE_CAL_SLICES = 48
 NOISE_CAL_SEED = 20240611
 #: Weight cap (SNR ratio) of one line in the least-squares refinement.
@@ -189,88 +184,16 @@ def _snr_spectra(sweep: Sweep, starts, slice_samples: int, channels) -> tuple:
     return f_pad, P / n, np.maximum(F / n, tiny), fs / slice_samples
 
 
-def _interp_rows(R: np.ndarray, f_pad: np.ndarray, f_query: np.ndarray) -> np.ndarray:
-    """Linear interpolation of every row of R at f_query (Hz); 0 beyond the spectrum."""
-    dfp = f_pad[1] - f_pad[0]
-    pos = f_query / dfp
-    i0 = np.floor(pos).astype(int)
-    w = pos - i0
-    inside = (i0 >= 0) & (i0 + 1 < R.shape[1])
-    i0c = np.clip(i0, 0, R.shape[1] - 2)
-    vals = R[:, i0c] * (1.0 - w) + R[:, i0c + 1] * w
-    return np.where(inside, vals, 0.0)
-
-
-def _comb_scores(R, f_pad, f_grid, harmonics) -> np.ndarray:
-    """Harmonic-comb score of every candidate f0 (n_slices, n_grid)."""
-    cap = np.log(COMB_CAP)
-    C = np.zeros((R.shape[0], len(f_grid)))
-    for h in harmonics:
-        v = _interp_rows(R, f_pad, h * f_grid)
-        C += np.clip(np.log(np.maximum(v, 1e-300)), 0.0, cap)
-    return C
-
-
-def _noise_comb_level(n_channels: int, slice_samples: int, fs: float, f_grid, harmonics) -> float:
-    """Largest comb score that white noise reaches in ``NOISE_CAL_SLICES`` slices on the same grid
-    (about its 98th percentile per slice): the "no line" level of the Viterbi path."""
+def _noise_line_level(n_channels: int, slice_samples: int, fs: float) -> float:
+    """Largest R = P/F that white noise reaches in ``NOISE_CAL_SLICES`` slices of the same length and number of
+    channels (about its 98th percentile per slice): a slice whose largest R is below it shows no line."""
     rng = np.random.default_rng(NOISE_CAL_SEED)
     n = NOISE_CAL_SLICES * slice_samples
     names = tuple(f"noise{i}" for i in range(max(n_channels, 1)))
     fake = Sweep(time=np.arange(n) / fs, signals={c: rng.standard_normal(n) for c in names}, sample_rate=fs)
     starts = np.arange(NOISE_CAL_SLICES) * slice_samples
     f_pad, P, F, _ = _snr_spectra(fake, starts, slice_samples, names)
-    return float(_comb_scores(P / F, f_pad, f_grid, harmonics).max())
-
-
-def _running_argmax(a: np.ndarray) -> tuple:
-    """Running max of a 1-D array and the index where it was attained (last on ties)."""
-    cm = np.maximum.accumulate(a)
-    idx = np.maximum.accumulate(np.where(a == cm, np.arange(len(a)), 0))
-    return cm, idx
-
-
-def _viterbi(E: np.ndarray, silent: np.ndarray, step_cost: float, silent_cost: float) -> np.ndarray:
-    """Best path over (n_slices, n_cells) emission scores with cost ``step_cost`` per cell of jump,
-    plus a "silent" state of emission ``silent`` per slice.  Returns cell per slice, -1 for silent.
-
-    max_j D[j] - c|i - j| is computed for all i in O(n) with running maxima from both sides.
-    """
-    n_s, n_c = E.shape
-    j = np.arange(n_c)
-    back = np.empty((n_s, n_c), dtype=np.int64)      # previous cell (or -1 for silent)
-    back_sil = np.empty(n_s, dtype=np.int64)          # previous state of the silent state
-    D = E[0].copy()
-    Ds = float(silent[0])
-    back[0] = -2
-    back_sil[0] = -2
-    for s in range(1, n_s):
-        lv, li = _running_argmax(D + step_cost * j)          # j <= i: D[j] - c(i - j)
-        left = lv - step_cost * j
-        rv, ri = _running_argmax((D - step_cost * j)[::-1])  # j >= i
-        right = rv[::-1] + step_cost * j
-        ri = (n_c - 1 - ri)[::-1]
-        best = np.where(left >= right, left, right)
-        arg = np.where(left >= right, li, ri)
-        from_sil = Ds - silent_cost
-        take_sil = from_sil > best
-        back[s] = np.where(take_sil, -1, arg)
-        best = np.where(take_sil, from_sil, best)
-        k = int(np.argmax(D))
-        if D[k] - silent_cost > Ds:
-            Ds_new, back_sil[s] = D[k] - silent_cost, k
-        else:
-            Ds_new, back_sil[s] = Ds, -1
-        D = best + E[s]
-        Ds = Ds_new + float(silent[s])
-    path = np.empty(n_s, dtype=np.int64)
-    k = int(np.argmax(D))
-    state = -1 if Ds >= D[k] else k
-    for s in range(n_s - 1, -1, -1):
-        path[s] = state
-        prev = back_sil[s] if state == -1 else back[s, state]
-        state = int(prev)
-    return path
+    return float(np.max(P[:, 1:-1] / F[:, 1:-1]))
 
 
 def _refine(P_row, F_row, f_pad, f0: float, harmonics, df: float, threshold: float, n_channels: int = 1) -> tuple:
@@ -278,7 +201,8 @@ def _refine(P_row, F_row, f_pad, f0: float, harmonics, df: float, threshold: flo
 
     Lines are found and their frequencies refined by :func:`rwadist.spectra.find_lines` on P_row
     (no frequency-dependent normalisation, so the log-parabolic peak is unbiased) against F_row.
-    Returns (f0 Hz, standard error Hz, number of lines used).
+    Returns (f0 Hz, standard error Hz, number of lines used, their f/(h·f0) − 1); f0 and its error nan
+    when no line is found.
     """
     h_arr = np.asarray(harmonics, dtype=float)
     tol = max(df, 0.01 * f0)
@@ -296,7 +220,7 @@ def _refine(P_row, F_row, f_pad, f0: float, harmonics, df: float, threshold: flo
             fk.append(f_lines[i])
             snr.append(P_row[idx[i]] / F_row[idx[i]])
     if not hs:
-        return f0, df / 4.0, 0
+        return float("nan"), float("nan"), 0, np.empty(0)
     hs, fk, snr = np.array(hs), np.array(fk), np.array(snr)
     # Cramér-Rao-like scatter of a line frequency: about 0.4·df/sqrt(SNR) (Hann, one segment), the
     # SNR of the channel average being n_channels times that of one channel
@@ -318,7 +242,7 @@ def _refine(P_row, F_row, f_pad, f0: float, harmonics, df: float, threshold: flo
         resid = (fk - hs * f_est)[keep]
         chi2 = np.sum(w[keep] * resid**2) / (n_used - 1)
         stderr *= np.sqrt(max(chi2, 1.0))
-    return float(f_est), float(stderr), n_used
+    return float(f_est), float(stderr), n_used, (fk / (hs * f_est) - 1.0)[keep]
 
 
 def _predict_from_neighbours(f0, sigma, usable, half_width: int) -> tuple:
@@ -395,62 +319,107 @@ def _rotation_sign(sweep: Sweep, starts, slice_samples: int, f1: np.ndarray) -> 
 
 
 def estimate_speeds(sweep: Sweep, slice_samples: int = 8192, hop: int | None = None, channels=None,
-                    rpm_range=None, harmonics=(1, 2, 3, 4)) -> list:
+                    rpm_range=None) -> list:
     """Wheel speed of every slice of ``sweep`` from the data alone (the tach is ignored).
 
     slice_samples : samples per slice; hop : samples between slice starts (default slice_samples).
-    channels : channels used (default the radial ones present, Fx Fy Tx Ty; else all).
-    rpm_range : (lo, hi) |speed| search range, rpm (default from 2 frequency bins to
-        Nyquist / max(harmonics)).
-    harmonics : harmonic numbers of the comb (any positive numbers; 1 should be among them).
+    channels : channels whose lines are followed (default the radial ones present, Fx Fy Tx Ty, with Fz;
+        else all); the rotation senses are read from the Fx/Fy and Tx/Ty pairs present.
+    rpm_range : (lo, hi) |speed| range, rpm: a 1× line whose speed track falls outside it is not taken.
     Returns one :class:`SliceInfo` per slice in time order; speed rad/s (signed by the x/y phase),
-    nan where the slice shows no line above its noise (confidence 0).
+    nan where the slice shows no line above its noise (confidence 0).  How the speed scale was found:
+    :func:`estimate_speed_track`.
     """
+    return estimate_speed_track(sweep, slice_samples, hop, channels, rpm_range)[0]
+
+
+def _track_channels(sweep: Sweep, channels) -> tuple:
+    if channels is not None:
+        return _estimation_channels(sweep, channels)
+    chans = tuple(c for c in RADIAL + ("Fz",) if c in sweep.signals)
+    return chans if chans else sweep.channels
+
+
+def _complex_spectra(sweep: Sweep, starts, slice_samples: int) -> dict:
+    """Zero-padded (``PAD``) Hann-windowed complex spectra of the slices of each radial channel present."""
+    win = signal.get_window("hann", slice_samples)
+    out = {}
+    for c in RADIAL:
+        if c in sweep.signals:
+            block = _slices(sweep.signals[c], starts, slice_samples)
+            out[c] = sfft.rfft((block - block.mean(axis=1, keepdims=True)) * win, n=PAD * slice_samples, axis=1)
+    return out
+
+
+def _scale_lines(sweep, starts, slice_samples, f_pad, P, F, df, active, rpm_range, threshold) -> tuple:
+    """The line pattern's relative track and the 1× line (:mod:`rwadist.speed_scale`): (rough rotor frequency
+    per slice Hz (nan where inactive), ratios of the lines found, SpeedScale without agreement)."""
+    fs = float(sweep.sample_rate)
+    f_lo, f_hi = 2.0 * df, 0.98 * fs / 2.0
+    u, L = scale.log_content(P / F, f_pad, f_lo, f_hi)
+    shifts = scale.relative_track(L, u, active)
+    o, T = scale.template(L, shifts, u)
+    o_lines, strength = scale.template_lines(o, T)
+    if o_lines.size == 0:
+        return np.full(len(starts), np.nan), np.array([1.0]), None
+    f_lines = np.exp(o_lines[None, :] + shifts[:, None])
+    f_lines = np.where((f_lines >= f_lo) & (f_lines <= f_hi), f_lines, np.nan)
+    f_meas = scale.measured_lines(P, F, f_pad, f_lines, threshold, df)
+    # a line of the wheel is found where the pattern puts it in most slices; a bump of the template left by
+    # content at a fixed frequency crossing it is not
+    keep = np.sum(np.isfinite(f_meas), axis=0) >= scale.PRESENCE * np.sum(np.isfinite(f_lines), axis=0)
+    if not keep.any():
+        return np.full(len(starts), np.nan), np.array([1.0]), None
+    o_lines, strength, f_lines, f_meas = o_lines[keep], strength[keep], f_lines[:, keep], f_meas[:, keep]
+    orders = scale.line_orders(f_meas, np.exp(o_lines))
+    f_lines = np.where(np.isfinite(f_meas), f_meas, f_lines)
+    senses = scale.pair_senses(_complex_spectra(sweep, starts, slice_samples), f_pad, PAD, f_lines)
+    if rpm_range is not None:
+        lo, hi = sorted(abs(float(v)) / 60.0 for v in rpm_range)
+        med = np.nanmedian(np.exp(shifts))
+        inside = (orders * med >= lo) & (orders * med <= hi)
+        strength = np.where(inside, strength, 0.0)
+    best, sense, evidence, reason = scale.imbalance_line(orders, strength, senses)
+    ratios = orders / orders[best]
+    f1 = np.exp(shifts) * orders[best]
+    share = {k: v[0] for k, v in senses.items()}
+    spd = scale.SpeedScale(method=f"speed from the data: {reason}; {ratios.size} lines, each at its own ratio",
+                           ratios=tuple(np.sort(ratios)), one_x=evidence, sense=sense, n_lines=int(ratios.size),
+                           senses=tuple(zip(*(share.get(k, np.full(ratios.size, np.nan)) for k in ("F", "T")))))
+    return f1, ratios, spd
+
+
+def estimate_speed_track(sweep: Sweep, slice_samples: int = 8192, hop: int | None = None, channels=None,
+                         rpm_range=None) -> tuple:
+    """(:func:`estimate_speeds`'s infos, :class:`rwadist.speed_scale.SpeedScale` or None when no line was found):
+    the speed of every slice from the data alone, and how it was obtained (module docstring, steps 1-3)."""
     starts, hop = _slice_starts(sweep, slice_samples, hop)
-    h_arr = np.asarray(sorted(set(float(h) for h in harmonics)), dtype=float)
-    if h_arr.size == 0 or np.any(h_arr <= 0):
-        raise ValueError(f"harmonics must be positive numbers, got {harmonics!r}")
-    chans = _estimation_channels(sweep, channels)
+    chans = _track_channels(sweep, channels)
     fs = float(sweep.sample_rate)
     f_pad, P, F, df = _snr_spectra(sweep, starts, slice_samples, chans)
-    nyq = fs / 2.0
-    f_lo, f_hi = 2.0 * df, 0.98 * nyq / h_arr.max()
-    if rpm_range is not None:
-        lo, hi = sorted(abs(float(v)) for v in rpm_range)
-        f_lo = max(f_lo, lo / 60.0)
-        f_hi = min(0.98 * nyq / h_arr.min(), hi / 60.0)
-    if not f_hi > f_lo:
-        raise DataError("sweep", "speed", f"empty speed search range: {f_lo:g}..{f_hi:g} Hz (slice resolution "
-                        f"{df:g} Hz, Nyquist {nyq:g} Hz): lengthen the slices (`slice_samples`) or record the speed")
-    # uniform candidate grid: every tooth moves <= df/2 between neighbours
-    step = df / (2.0 * h_arr.max())
-    f_grid = np.arange(f_lo, f_hi + step, step)
-    C = _comb_scores(P / F, f_pad, f_grid, h_arr)
-    # cells uniform in ln f0 for the continuity path
-    n_cells = max(int(np.ceil(np.log(f_grid[-1] / f_grid[0]) / LOG_CELL)), 1)
-    edges = f_grid[0] * np.exp(LOG_CELL * np.arange(n_cells + 1))
-    cell_lo = np.minimum(np.searchsorted(f_grid, edges[:-1], side="left"), len(f_grid) - 1)
-    cell_hi = np.maximum(np.minimum(np.searchsorted(f_grid, edges[1:], side="left"), len(f_grid)), cell_lo + 1)
-    E = np.maximum.reduceat(C, cell_lo, axis=1)
-    silent = np.full(len(starts), _noise_comb_level(len(chans), slice_samples, fs, f_grid, h_arr))
-    path = _viterbi(E, silent, JUMP_COST * LOG_CELL, SILENT_COST)
-
+    active = (P / F)[:, PAD:-PAD].max(axis=1) > _noise_line_level(len(chans), slice_samples, fs)
     n_s = len(starts)
     f0 = np.full(n_s, np.nan)
     sigma = np.full(n_s, np.nan)
     conf = np.zeros(n_s)
-    threshold = 1.0 + 4.0 / np.sqrt(len(chans))    # ~ 4 sigma of a noise-normalised averaged PSD bin
-    for s in np.nonzero(path >= 0)[0]:
-        c = path[s]
-        a, b = cell_lo[max(c - 1, 0)], cell_hi[min(c + 1, n_cells - 1)]
-        g = a + int(np.argmax(C[s, a:b]))
-        far = np.abs(np.log(f_grid / f_grid[g])) > 0.05
-        best, alt = C[s, g], (C[s, far].max() if far.any() else 0.0)
-        conf[s] = float(np.clip((best - alt) / best, 0.0, 1.0)) if best > 0 else 0.0
-        f0[s], sigma[s], _ = _refine(P[s], F[s], f_pad, f_grid[g], h_arr, df, threshold, len(chans))
+    spd = None
+    if active.any():
+        threshold = 1.0 + 4.0 / np.sqrt(len(chans))    # ~ 4 sigma of a noise-normalised averaged PSD bin
+        f1, ratios, spd = _scale_lines(sweep, starts, slice_samples, f_pad, P, F, df, active, rpm_range, threshold)
+        resid = []
+        for s in np.flatnonzero(active & np.isfinite(f1)):
+            f0[s], sigma[s], n_used, r = _refine(P[s], F[s], f_pad, f1[s], ratios, df, threshold, len(chans))
+            in_band = np.sum((ratios * f1[s] >= 2 * df) & (ratios * f1[s] <= 0.98 * fs / 2))
+            conf[s] = n_used / max(int(in_band), 1)
+            resid.append(r)
+        if spd is not None:
+            allr = np.concatenate(resid) if resid else np.empty(0)
+            spd = replace(spd, agreement=float(np.sqrt(np.mean(allr**2))) if allr.size else float("nan"))
     f0, sigma = _fuse_track(f0, sigma)
     sign = _rotation_sign(sweep, starts, slice_samples, f0)
     omega = sign * 2.0 * np.pi * f0
+    if spd is not None and np.isfinite(omega).any():
+        spd = replace(spd, sense=float(np.sign(np.nanmedian(omega)) or 1.0))
     # change of the speed track across one slice (finite differences over detected neighbours)
     grad = np.full(n_s, np.nan)
     good = np.isfinite(f0)
@@ -459,13 +428,29 @@ def estimate_speeds(sweep: Sweep, slice_samples: int = 8192, hop: int | None = N
         grad[idx] = np.abs(np.gradient(2.0 * np.pi * f0[idx], idx))
     drift = np.nan_to_num(grad) * (slice_samples / hop)
     spread = np.hypot(2.0 * 2.0 * np.pi * sigma, drift)
-    return [SliceInfo(start=int(st), stop=int(st + slice_samples), speed=float(omega[i]), speed_source="data",
-                      speed_spread=float(spread[i]), confidence=float(conf[i]),
-                      speed_stderr=float(2.0 * np.pi * sigma[i]))
-            for i, st in enumerate(starts)]
+    infos = [SliceInfo(start=int(st), stop=int(st + slice_samples), speed=float(omega[i]), speed_source="data",
+                       speed_spread=float(spread[i]), confidence=float(np.clip(conf[i], 0.0, 1.0)),
+                       speed_stderr=float(2.0 * np.pi * sigma[i]))
+             for i, st in enumerate(starts)]
+    return infos, spd
 
 
 # --------------------------------------------------------------------------- slicing into a steady test
+
+def speed_note(slicing: dict) -> str:
+    """One line for the console: how the slices' speeds were obtained (``test.meta["slicing"]``), and for a speed
+    from the data, which line is 1× and how well the lines agree with it."""
+    n = slicing.get("n_kept", 0)
+    if slicing.get("speed_source") != "data":
+        return f"sliced sweep into {n} quasi-steady runs (speed from the tach column)"
+    sc = slicing.get("speed_scale") or {}
+    agree = sc.get("agreement_rel_rms")
+    text = f"sliced sweep into {n} quasi-steady runs; {sc.get('method', 'speed from the data')}"
+    if agree is not None:
+        text += (f"; ratios {', '.join(f'{h:.4g}' for h in sc.get('ratios', []))}; the lines agree with the speed "
+                 f"to {100 * agree:.3f} % RMS")
+    return text
+
 
 def _tach_infos(sweep: Sweep, starts, slice_samples: int) -> list:
     if sweep.tach is None:
@@ -505,10 +490,11 @@ def slice_sweep(sweep: Sweep, slice_samples: int = 8192, hop: int | None = None,
         raise ValueError(f"speed_source must be 'auto', 'tach' or 'data', got {speed_source!r}")
     starts, hop = _slice_starts(sweep, slice_samples, hop)
     source = ("tach" if sweep.tach is not None else "data") if speed_source == "auto" else speed_source
+    spd = None
     if source == "tach":
         infos = _tach_infos(sweep, starts, slice_samples)
     else:
-        infos = estimate_speeds(sweep, slice_samples, hop, channels=channels)
+        infos, spd = estimate_speed_track(sweep, slice_samples, hop, channels=channels)
     speeds = np.array([i.speed for i in infos])
     found = np.isfinite(speeds)
     if min_speed_rpm is None:
@@ -548,6 +534,9 @@ def slice_sweep(sweep: Sweep, slice_samples: int = 8192, hop: int | None = None,
                            else f"{MIN_SPEED_FRACTION:g} x largest |speed| found"),
         "dropped_slices": [int(i) for i in np.nonzero(~keep)[0]],
     }
+    if source == "data":
+        meta["slicing"]["speed_scale"] = (spd.to_meta() if spd is not None else
+                                          {"method": "speed from the data: no line above the noise in any slice"})
     order = np.argsort(speeds[kept], kind="stable")
     test = SteadyTest([runs[k] for k in order], meta)
     return test, [infos[kept[k]] for k in order]

@@ -505,49 +505,62 @@ BLOCK_SPEED_CHANGE = 1e-3
 BLOCK_DECAY = 20.0
 
 
-def _integrate(wheel, direction, comps, om, dt, x0):
+def _block_starts(om: np.ndarray, dt: float, decay: float, gyro: bool) -> np.ndarray:
+    """Start indices of the integration blocks over the n = len(om) − 1 intervals: a new block each
+    BLOCK_SPEED_CHANGE of travel in ln|Ω| (rocking only), and none longer than the decay limit."""
+    n = om.size - 1
+    starts = np.array([0])
+    if gyro:
+        lw = np.log(np.abs(om[:-1]))
+        travel = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(lw)))])
+        key = np.floor(travel / BLOCK_SPEED_CHANGE)
+        starts = np.flatnonzero(np.diff(key, prepend=-1.0))
+    max_len = max(int(BLOCK_DECAY / (decay * dt)), 1)
+    bounds = np.append(starts, n)
+    out = [np.arange(a, b, max_len) for a, b in zip(bounds[:-1], bounds[1:])]
+    return np.concatenate(out)
+
+
+def _integrate(wheel, direction, comps, om, dt, x0, chunk: int = 16384):
     """Reaction (n_samples, n_out) of one direction to load components comps = [(pattern (n_in,), u (n+1,)
     complex amplitude at the samples, θ (n+1,) phase at the samples)], the load Re(pattern·u·e^{iθ}), exactly
     integrated over each interval for an input u·e^{iθ} whose phase grows linearly across it; initial state
-    x0 (complex)."""
+    x0 (complex).  Modal coordinates per block (A is affine in Ω: one batched eigendecomposition); inside a
+    block q_{n+1} = e^{λ_n dt} q_n + g_n with λ_n first order in the interval's speed, solved by cumulative
+    products and sums."""
     n = om.size - 1
-    A0, _, B, C = _state_space(wheel, direction, float(om[0]))
-    decay = np.max(-np.linalg.eigvals(A0).real)
-    max_len = max(int(BLOCK_DECAY / (decay * dt)), 1)
+    gyro = direction == "radial_torque"
+    A0, dA, B, C = _state_space(wheel, direction, 0.0)
+    decay = float(np.max(-np.linalg.eigvals(_state_space(wheel, direction, float(om[0]))[0]).real))
+    starts = _block_starts(om, dt, decay, gyro)
+    stops = np.append(starts[1:], n)
+    mids = (starts + stops) // 2
+    lam, V = np.linalg.eig(A0[None] + om[mids][:, None, None] * dA[None])            # (blocks, s), (blocks, s, s)
+    Vi = np.linalg.inv(V)
+    slope = np.einsum("bij,jk,bki->bi", Vi, dA, V) if gyro else np.zeros(lam.shape)
+    patterns = np.array([p for p, _, _ in comps])                                     # (c, n_in)
+    beta = np.einsum("bij,jk,ck->bic", Vi, B, patterns)                               # (blocks, s, c)
+    block_of = np.repeat(np.arange(starts.size), stops - starts)
+    w_int = 0.5 * (om[:-1] + om[1:])
+    L = lam[block_of] + slope[block_of] * (w_int - om[mids][block_of])[:, None]      # (n, s)
+    g = np.zeros(L.shape, dtype=complex)
+    for a in range(0, n, chunk):
+        sl = slice(a, min(a + chunk, n))
+        dth = np.array([th[sl.start + 1:sl.stop + 1] - th[sl] for _, _, th in comps])            # (c, m)
+        u_mid = np.array([0.5 * (u[sl] + u[sl.start + 1:sl.stop + 1]) * np.exp(1j * th[sl]) for _, u, th in comps])
+        Ld = L[sl] * dt                                                                           # (m, s)
+        z = 1j * dth.T[:, None, :] - Ld[:, :, None]                                               # (m, s, c)
+        phi1 = np.where(np.abs(z) < 1e-8, 1.0 + 0.5 * z, np.expm1(z) / np.where(z == 0, 1.0, z))
+        g[sl] = np.exp(Ld) * dt * np.einsum("msc,cm,msc->ms", beta[block_of[sl]], u_mid, phi1)
     out = np.zeros((n, C.shape[0]))
     x = x0.astype(complex)
-    start = 0
-    gyro = direction == "radial_torque"
-    while start < n:
-        stop = min(start + max_len, n)
-        if gyro:
-            rel = np.abs(om[start:stop + 1] / om[start] - 1.0)
-            over = np.flatnonzero(rel > BLOCK_SPEED_CHANGE)
-            stop = start + max(int(over[0]) - 1, 1) if over.size else stop
-        mid = (start + stop) // 2
-        A, dA, _, _ = _state_space(wheel, direction, float(om[mid]))
-        lam, V = np.linalg.eig(A)
-        Vi = np.linalg.inv(V)
-        slope = np.einsum("ij,jk,ki->i", Vi, dA, V) if gyro else np.zeros(lam.size)
-        # eigenvalue of each interval: at the interval's mid speed, first order about the block's
-        w_int = 0.5 * (om[start:stop] + om[start + 1:stop + 1])
-        L = lam[:, None] + slope[:, None] * (w_int - om[mid])[None, :]          # (modes, len)
-        g = np.zeros_like(L)
-        for pattern, u, th in comps:
-            beta = Vi @ B @ pattern                                               # (modes,)
-            dth = th[start + 1:stop + 1] - th[start:stop]
-            u_mid = 0.5 * (u[start:stop] + u[start + 1:stop + 1]) * np.exp(1j * th[start:stop])
-            z = 1j * dth[None, :] - L * dt
-            phi1 = np.where(np.abs(z) < 1e-8, 1.0 + 0.5 * z, np.expm1(z) / np.where(z == 0, 1.0, z))
-            g += beta[:, None] * u_mid[None, :] * np.exp(L * dt) * dt * phi1
-        q0 = Vi @ x
-        cum = np.concatenate([np.zeros((lam.size, 1)), np.cumsum(L * dt, axis=1)], axis=1)   # log P_0..P_len
-        P = np.exp(cum)
-        q = P * (q0[:, None] + np.concatenate([np.zeros((lam.size, 1)), np.cumsum(g / P[:, 1:], axis=1)], axis=1))
-        xs = V @ q                                                                 # (states, len + 1)
-        out[start:stop] = np.real(C @ xs[:, :-1]).T
-        x = xs[:, -1]
-        start = stop
+    for b, (a, e) in enumerate(zip(starts, stops)):
+        logp = np.concatenate([np.zeros((1, lam.shape[1])), np.cumsum(L[a:e] * dt, axis=0)])     # log P_0..P_len
+        P = np.exp(logp)
+        q = P * (Vi[b] @ x + np.concatenate([np.zeros((1, lam.shape[1])), np.cumsum(g[a:e] / P[1:], axis=0)]))
+        xs = q @ V[b].T                                                                           # (len + 1, states)
+        out[a:e] = np.real(xs[:-1] @ C.T)
+        x = xs[-1]
     return out
 
 

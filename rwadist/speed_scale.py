@@ -1,0 +1,279 @@
+"""The speed of a record with no trustworthy speed, from physics (issue 33, item 5).
+
+Every line of a wheel sits at a fixed ratio h of the rotor speed, so between two quasi-steady slices of a sweep
+the whole line pattern moves rigidly in ln f by the change of ln|Ω|, whatever the lines are.  The speed is
+therefore found in two steps that assume no line set:
+
+1. **Shape** (:func:`relative_track`).  Each slice's spectrum, as a signal-to-noise ratio R over its local
+   floor, is read on a uniform grid in u = ln f and clipped to its clear lines, L = clip(ln(R/R_LINE), 0,
+   L_CAP).  Consecutive slices are registered by the lag of the largest cross-correlation of L (within
+   ±MAX_STEP_LAG: a harmonic comb also correlates at ln 2), then every slice again against the template of all
+   slices shifted into one frame (no accumulated drift).  This gives ln|Ω| up to one constant: the relative
+   track r(t).  Content at a fixed frequency (a fixture's ringing, an electrical line) does not move with the
+   pattern and is smeared out of the template.
+2. **Scale** (:func:`imbalance_line`).  The template's peaks are the wheel's lines, at orders O_i (in units of
+   r).  Their rotation sense is read per slice from the x/y phase of each radial pair (co-rotating with +z:
+   F_y lags F_x by 90°, |X + iY|² against |X − iY|²).  The imbalance is at exactly 1× the rotor speed, static
+   in the radial force and dynamic in the radial torque, both turning with the rotor: the candidates are the
+   lines with one sense in the radial-force pair and the same sense in the radial-torque pair (one pair when
+   only one is recorded).  Among them the 1× line is the one whose integer multiples 1..INTEGER_ORDERS (the
+   integer harmonics: misalignment, looseness) carry the most line strength -- the imbalance itself counted,
+   so a wheel with no 2× or 3× line still has its strongest such line; a bearing line's multiples are
+   non-integer in the rotor's units.  Its sense is the sign of the speed.  The other lines keep their ratios,
+   h_i = O_i/O_1.
+
+The caller (:func:`rwadist.sweep.estimate_speeds`) then refines each slice's speed on every line found, each
+at its own h_i, and reports how well they agree (:class:`SpeedScale`).
+
+Units: Hz for frequencies, dimensionless orders and ratios, ln of Hz on the registration grid.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import signal
+
+from .spectra import find_lines
+
+#: step of the registration grid in u = ln f (0.02 %)
+LOG_STEP = 2.0e-4
+#: a spectrum point counts as line content above this signal-to-noise ratio (R = PSD / local floor)
+R_LINE = 4.0
+#: cap of one point's log content (a mode-amplified line must not outweigh the pattern)
+L_CAP = 6.0
+#: largest change of ln|Ω| searched between consecutive slices (below ln 2, where a harmonic comb correlates
+#: with itself an octave away)
+MAX_STEP_LAG = 0.6
+#: window of the re-registration of each slice against the template, in ln units
+TEMPLATE_LAG = 0.02
+#: multiples of a 1× candidate counted as the rotor's integer lines
+INTEGER_ORDERS = 4
+#: relative tolerance of "an integer multiple"
+INTEGER_TOL = 0.004
+#: a line has a rotation sense in a pair when this share of its power turns one way
+POLARIZED = 0.6
+#: a line counts in a pair when its power there is this many times the local noise's
+PAIR_SNR = 10.0
+#: a template peak is a line when it is found where the pattern puts it in this share of the slices
+PRESENCE = 0.5
+#: template peaks: minimum mean log content and prominence
+PEAK_HEIGHT = 0.3
+PEAK_PROMINENCE = 0.2
+
+
+@dataclass(frozen=True)
+class SpeedScale:
+    """How a speed was obtained from the data.
+
+    method : one line of text.  ratios : h of every line found, in units of the rotor speed (sorted).
+    one_x : the 1× line's evidence (co shares in force and torque pairs, multiples found).  sense : +1 or −1
+    (the sign of the speed).  agreement : RMS over lines and slices of f_line/(h·f_rotor) − 1 after the
+    per-slice fit (relative).  n_lines : lines found.  senses : per line, (share co-rotating with +z in the
+    radial-force pair, in the radial-torque pair), nan where the line is not in the pair.
+    """
+
+    method: str
+    ratios: tuple
+    one_x: dict
+    sense: float
+    agreement: float = float("nan")
+    n_lines: int = 0
+    senses: tuple = field(default_factory=tuple)
+
+    def to_meta(self) -> dict:
+        """JSON-ready record for the test's ``meta['slicing']['speed_scale']``."""
+        def num(x):
+            return None if x is None or not np.isfinite(x) else float(x)
+
+        return {"method": self.method, "ratios": [round(float(h), 6) for h in self.ratios],
+                "one_x": {k: (num(v) if isinstance(v, float) else v) for k, v in self.one_x.items()},
+                "sense": int(self.sense), "agreement_rel_rms": num(self.agreement), "n_lines": int(self.n_lines)}
+
+
+# ------------------------------------------------------------------------------------------ registration
+def log_content(R: np.ndarray, f_pad: np.ndarray, f_lo: float, f_hi: float) -> tuple:
+    """(u grid ln Hz (n_u,), L (n_slices, n_u)): each row of the SNR spectra R (on the uniform grid f_pad) read
+    at e^u by linear interpolation, as clip(ln(R/R_LINE), 0, L_CAP)."""
+    u = np.arange(np.log(f_lo), np.log(f_hi), LOG_STEP)
+    pos = np.exp(u) / (f_pad[1] - f_pad[0])
+    i0 = np.clip(np.floor(pos).astype(int), 0, R.shape[1] - 2)
+    w = pos - i0
+    vals = R[:, i0] * (1.0 - w) + R[:, i0 + 1] * w
+    return u, np.clip(np.log(np.maximum(vals, 1e-300) / R_LINE), 0.0, L_CAP)
+
+
+def _best_lag(a: np.ndarray, b: np.ndarray, max_lag: int, center: int = 0) -> tuple:
+    """Lag (grid steps, sub-step by a parabola) of b against a maximising Σ a(u)·b(u + lag) within
+    center ± max_lag, and that maximum.  b(u + lag) = a(u) for a pattern that moved up by lag."""
+    n = a.size
+    nfft = 1 << int(np.ceil(np.log2(2 * n)))
+    corr = np.fft.irfft(np.conj(np.fft.rfft(a, nfft)) * np.fft.rfft(b, nfft), nfft)
+    lags = np.arange(center - max_lag, center + max_lag + 1)
+    vals = corr[lags % nfft]
+    j = int(np.argmax(vals))
+    best = float(lags[j])
+    if 0 < j < len(vals) - 1:
+        lo, mid, hi = vals[j - 1], vals[j], vals[j + 1]
+        den = lo - 2 * mid + hi
+        if den < 0:
+            best += float(np.clip(0.5 * (lo - hi) / den, -0.5, 0.5))
+    return best, float(vals[j])
+
+
+def template(L: np.ndarray, shifts: np.ndarray, u: np.ndarray) -> tuple:
+    """(o grid, T): the slices' content moved into one frame, o = u − shift, averaged where covered."""
+    ok = np.isfinite(shifts)
+    o = np.arange(u[0] - np.max(shifts[ok]), u[-1] - np.min(shifts[ok]) + LOG_STEP, LOG_STEP)
+    total = np.zeros(o.size)
+    count = np.zeros(o.size)
+    for k in np.flatnonzero(ok):
+        v = np.interp(o + shifts[k], u, L[k], left=np.nan, right=np.nan)
+        m = np.isfinite(v)
+        total[m] += v[m]
+        count[m] += 1
+    with np.errstate(invalid="ignore"):
+        return o, np.where(count > 0, total / np.maximum(count, 1), 0.0)
+
+
+def relative_track(L: np.ndarray, u: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """ln of the relative speed of every slice (nan where not ``active``): consecutive registration, then two
+    passes against the template (module docstring).  The first active slice is 0."""
+    shifts = np.full(L.shape[0], np.nan)
+    idx = np.flatnonzero(active)
+    if idx.size == 0:
+        return shifts
+    max_lag = int(MAX_STEP_LAG / LOG_STEP)
+    shifts[idx[0]] = 0.0
+    for prev, k in zip(idx[:-1], idx[1:]):
+        lag, _ = _best_lag(L[prev], L[k], max_lag)
+        shifts[k] = shifts[prev] + lag * LOG_STEP
+    small = int(TEMPLATE_LAG / LOG_STEP)
+    for _ in range(2):
+        o, T = template(L, shifts, u)
+        new = shifts.copy()
+        for k in idx:
+            # T read on the slice's own grid at its current shift: the residual lag is a correction
+            ref = np.interp(u - shifts[k], o, T, left=0.0, right=0.0)
+            lag, _ = _best_lag(ref, L[k], small)
+            new[k] = shifts[k] + lag * LOG_STEP
+        shifts = new - new[idx[0]]
+    return shifts
+
+
+def template_lines(o: np.ndarray, T: np.ndarray) -> tuple:
+    """(orders ln (n,), strength (n,)): the template's peaks (the wheel's lines), refined by a parabola."""
+    idx, _ = signal.find_peaks(T, height=PEAK_HEIGHT, prominence=PEAK_PROMINENCE, distance=5)
+    idx = idx[(idx > 0) & (idx < T.size - 1)]
+    lo, mid, hi = T[idx - 1], T[idx], T[idx + 1]
+    den = lo - 2 * mid + hi
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = np.where(den < 0, np.clip(0.5 * (lo - hi) / den, -0.5, 0.5), 0.0)
+    return o[idx] + d * LOG_STEP, mid
+
+
+def measured_lines(P: np.ndarray, F: np.ndarray, f_pad: np.ndarray, f_guess: np.ndarray, threshold: float,
+                   df: float) -> np.ndarray:
+    """(n_slices, n_lines) Hz: each line's peak in each slice (:func:`rwadist.spectra.find_lines` on P against F,
+    log-parabolic), the nearest within 1.5 native bins of its guess ``f_guess`` (nan where none)."""
+    out = np.full(f_guess.shape, np.nan)
+    for k in range(f_guess.shape[0]):
+        g = f_guess[k]
+        ok = np.isfinite(g)
+        if not ok.any():
+            continue
+        f_found, _ = find_lines(P[k], f_pad, F[k], threshold, f_max=np.nanmax(g) + 2 * df,
+                                f_min=max(np.nanmin(g) - 2 * df, 0.0))
+        if f_found.size == 0:
+            continue
+        j = np.argmin(np.abs(f_found[None, :] - g[ok][:, None]), axis=1)
+        near = np.abs(f_found[j] - g[ok]) <= 1.5 * df
+        out[k, np.flatnonzero(ok)[near]] = f_found[j][near]
+    return out
+
+
+def line_orders(f_meas: np.ndarray, orders0: np.ndarray, passes: int = 3) -> np.ndarray:
+    """Orders of the lines (in the template's units) from their measured frequencies (n_slices, n_lines): each
+    slice's scale is the median over its lines of f/O, each order the median over slices of f/scale; the common
+    error of a slice's registration cancels."""
+    orders = orders0.astype(float).copy()
+    for _ in range(passes):
+        with np.errstate(invalid="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)                # slices without any line: nan
+            c = np.nanmedian(f_meas / orders[None, :], axis=1)
+            new = np.nanmedian(f_meas / c[:, None], axis=0)
+        orders = np.where(np.isfinite(new), new, orders)
+    return orders
+
+
+# ------------------------------------------------------------------------------------------ rotation sense
+def pair_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray) -> dict:
+    """Per radial pair present: (co share (n_lines,), snr (n_slices, n_lines)); the co share is the median over
+    the slices where the line stands PAIR_SNR over the local noise in the pair of |X + iY|²/(|X + iY|² +
+    |X − iY|²) (nan where it never does): a median, so a slice where a fixed-frequency line crosses it cannot
+    outweigh the others.  ``spectra``: channel -> complex
+    Hann-windowed spectra (n_slices, n_f) zero-padded ``pad`` times on ``f_pad``; ``f_lines`` (n_slices,
+    n_lines) Hz (nan: not in that slice), read at the nearest padded bin (an eighth of a bin off at most,
+    which scales X and Y alike).  Co-rotating with +z: F_x = a cos, F_y = a sin, so Y = −iX: co |X + iY|²,
+    counter |X − iY|².  The local noise is the median |X|² + |Y|² at ±4..8 native bins off the line."""
+    dfp = f_pad[1] - f_pad[0]
+    n_f = f_pad.size
+    ok = np.isfinite(f_lines)
+    k = np.clip(np.rint(np.where(ok, f_lines, 0.0) / dfp).astype(int), 0, n_f - 1)
+    rows = np.arange(f_lines.shape[0])[:, None]
+    offsets = pad * np.array([-8, -6, -4, 4, 6, 8])
+    out = {}
+    for pair in (("Fx", "Fy"), ("Tx", "Ty")):
+        if not all(c in spectra for c in pair):
+            continue
+        X, Y = (spectra[c][rows, k] for c in pair)
+        line = np.abs(X) ** 2 + np.abs(Y) ** 2
+        ko = np.clip(k[..., None] + offsets, 0, n_f - 1)
+        off = sum(np.abs(spectra[c][rows[..., None], ko]) ** 2 for c in pair)
+        snr = np.where(ok, line / np.maximum(np.median(off, axis=-1), 1e-300), 0.0)
+        co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
+        share = np.where(snr >= PAIR_SNR, co / np.maximum(co + ct, 1e-300), np.nan)
+        with np.errstate(invalid="ignore"):
+            med = np.full(share.shape[1], np.nan)
+            seen = np.isfinite(share).any(axis=0)
+            med[seen] = np.nanmedian(share[:, seen], axis=0)
+        out[pair[0][0]] = (med, snr)
+    return out
+
+
+def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tuple:
+    """(index of the 1× line, its sense ±1, evidence dict, reason text) among lines at relative orders
+    ``orders`` (linear) with template ``strength``; ``senses`` from :func:`pair_senses` ("F", "T" -> (co share,
+    snr)).  Candidates: one sense in every recorded radial pair, the same in all (module docstring);
+    with no such line, every line (said in the reason)."""
+    share = {key: v[0] for key, v in senses.items()}
+    n = orders.size
+    sense = np.zeros(n)
+    cand = np.ones(n, dtype=bool)
+    for s in share.values():
+        pol = np.where(s >= POLARIZED, 1.0, np.where(s <= 1 - POLARIZED, -1.0, 0.0))
+        pol = np.where(np.isfinite(s), pol, 0.0)
+        cand &= pol != 0
+        sense = np.where(sense == 0, pol, np.where(sense == pol, sense, 0.0))
+    cand &= sense != 0
+    how = ("one sense in " + " and ".join({"F": "radial force", "T": "radial torque"}[k] for k in share)
+           if share else "no radial x/y pair recorded: every line a candidate")
+    if not cand.any():
+        cand = np.ones(n, dtype=bool)
+        sense = np.ones(n)
+        how = "no line with one rotation sense in the radial pairs: every line a candidate"
+    score = np.zeros(n)
+    multiples = []
+    for c in np.flatnonzero(cand):
+        ratio = orders / orders[c]
+        k = np.rint(ratio)
+        hit = (k >= 1) & (k <= INTEGER_ORDERS) & (np.abs(ratio - k) <= INTEGER_TOL * np.maximum(k, 1))
+        score[c] = np.sum(strength[hit])
+        multiples.append((c, sorted(int(x) for x in k[hit])))
+    best = int(np.flatnonzero(cand)[np.argmax(score[cand])])
+    mult = dict(multiples)[best]
+    evidence = {"order": float(orders[best]), "multiples_found": mult,
+                **{f"co_share_{'force' if k == 'F' else 'torque'}": float(v[best]) for k, v in share.items()}}
+    reason = f"the 1x line: {how}, with the most integer multiples (found {mult})"
+    return best, float(sense[best]), evidence, reason
