@@ -67,11 +67,11 @@ PEAK_PROMINENCE = 0.2
 class SpeedScale:
     """How a speed was obtained from the data.
 
-    method : one line of text.  ratios : h of every line found, in units of the rotor speed (sorted).
+    method : one line of text.  ratios : h of every line found, in units of the rotor speed (ascending).
     one_x : the 1× line's evidence (co shares in force and torque pairs, multiples found).  sense : +1 or −1
     (the sign of the speed).  agreement : RMS over lines and slices of f_line/(h·f_rotor) − 1 after the
-    per-slice fit (relative).  n_lines : lines found.  senses : per line, (share co-rotating with +z in the
-    radial-force pair, in the radial-torque pair), nan where the line is not in the pair.
+    per-slice fit (relative).  n_lines : lines found.  senses : per line of ``ratios``, (share co-rotating with
+    +z in the radial-force pair, in the radial-torque pair), nan where the line is not in the pair.
     """
 
     method: str
@@ -88,6 +88,7 @@ class SpeedScale:
             return None if x is None or not np.isfinite(x) else float(x)
 
         return {"method": self.method, "ratios": [round(float(h), 6) for h in self.ratios],
+                "co_share": [[num(float(v)) for v in pair] for pair in self.senses],
                 "one_x": {k: (num(v) if isinstance(v, float) else v) for k, v in self.one_x.items()},
                 "sense": int(self.sense), "agreement_rel_rms": num(self.agreement), "n_lines": int(self.n_lines)}
 

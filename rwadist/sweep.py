@@ -382,10 +382,11 @@ def _scale_lines(sweep, starts, slice_samples, f_pad, P, F, df, active, rpm_rang
     best, sense, evidence, reason = scale.imbalance_line(orders, strength, senses)
     ratios = orders / orders[best]
     f1 = np.exp(shifts) * orders[best]
-    share = {k: v[0] for k, v in senses.items()}
+    order = np.argsort(ratios)
+    share = [senses[k][0][order] if k in senses else np.full(ratios.size, np.nan) for k in ("F", "T")]
     spd = scale.SpeedScale(method=f"speed from the data: {reason}; {ratios.size} lines, each at its own ratio",
-                           ratios=tuple(np.sort(ratios)), one_x=evidence, sense=sense, n_lines=int(ratios.size),
-                           senses=tuple(zip(*(share.get(k, np.full(ratios.size, np.nan)) for k in ("F", "T")))))
+                           ratios=tuple(ratios[order]), one_x=evidence, sense=sense, n_lines=int(ratios.size),
+                           senses=tuple(zip(*share)))
     return f1, ratios, spd
 
 
