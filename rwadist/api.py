@@ -71,7 +71,7 @@ def _preset_model(name: str) -> WheelModel:
     return preset(name).to_model()
 
 
-def read(path, *, slice_samples: int = 8192, speed_source: str = "auto", progress: bool = False,
+def read(path, *, slice_samples: int | None = None, speed_source: str = "auto", progress: bool = False,
          log=None) -> SteadyTest:
     """Read test data as a steady test: a run directory, a sweep CSV (cut into quasi-steady slices) or HDF5.
 
@@ -79,8 +79,9 @@ def read(path, *, slice_samples: int = 8192, speed_source: str = "auto", progres
     ----------
     path : str or pathlib.Path
         A steady-test directory (``runs.csv`` + one CSV per run), a sweep CSV, or a ``.h5`` file.
-    slice_samples : int
-        Samples per quasi-steady slice of a sweep (default 8192).
+    slice_samples : int or None
+        Samples per quasi-steady slice of a sweep; None (default): the longest power of two up to 8192 over
+        which the speed changes by at most 5 % (:func:`rwadist.sweep.slice_sweep`).
     speed_source : {"auto", "tach", "data"}
         Speed of each sweep slice: the tach column, estimated from the data, or the tach when present.
     progress : bool

@@ -133,7 +133,8 @@ def _add_fit_options(p):
     p.add_argument("--presence", type=limited("presence"), default=0.25, help="bin presence threshold P0, fraction (default 0.25)")
     p.add_argument("--epsilon", type=limited("epsilon"), default=0.02, help="binning tolerance on h (default 0.02)")
     p.add_argument("--no-mode-exclusion", action="store_true", help="keep modally amplified speeds in the fit")
-    p.add_argument("--slice-samples", type=limited("slice_samples"), default=8192, help="sweep slice length, samples")
+    p.add_argument("--slice-samples", type=limited("slice_samples"), default=None,
+                   help="sweep slice length, samples (default: the longest power of two up to 8192 over which the speed changes by at most 5 %%)")
     p.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
                    help="speed of sweep slices: tach column, estimated from data, or auto")
     p.add_argument("--extended", action="store_true",
@@ -281,7 +282,8 @@ def build_parser(cli) -> argparse.ArgumentParser:
                          "the rotor's suspension modes of the model's analytical section (forward/backward whirl, "
                          "rotation sense); auto (default): extended when the model (--model/--preset) has an "
                          "analytical section and the data's meta.json does not say modes: false")
-    dg.add_argument("--slice-samples", type=limited("slice_samples"), default=8192, help="sweep slice length, samples")
+    dg.add_argument("--slice-samples", type=limited("slice_samples"), default=None,
+                    help="sweep slice length, samples (default: the longest power of two up to 8192 over which the speed changes by at most 5 %%)")
     dg.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
                     help="speed of sweep slices: tach column, estimated from data, or auto")
     dg.add_argument("--bearing", action="append", default=None, metavar="KEY=VALUE,...",

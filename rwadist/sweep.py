@@ -72,6 +72,11 @@ WEIGHT_CAP = 1.0e4
 AGREE_REL = 5.0e-4
 #: Neighbours (slices either side) of the continuity fusion of the speed track.
 FUSE_HALF_WIDTH = 4
+#: Automatic slice length: powers of two from AUTO_SLICE_MAX down to AUTO_SLICE_MIN samples ...
+AUTO_SLICE_MAX = 8192
+AUTO_SLICE_MIN = 1024
+#: ... the longest over which the speed changes by at most this share of itself (median over the slices).
+AUTO_SLICE_CHANGE = 0.05
 #: Default drop level: fraction of the largest |speed| found.
 MIN_SPEED_FRACTION = 0.05
 RADIAL = ("Fx", "Fy", "Tx", "Ty")
@@ -467,12 +472,54 @@ def _tach_infos(sweep: Sweep, starts, slice_samples: int) -> list:
             for i, st in enumerate(starts)]
 
 
-def slice_sweep(sweep: Sweep, slice_samples: int = 8192, hop: int | None = None, speed_source: str = "auto",
+def _slice_change(infos: list, fs: float) -> float:
+    """Median over the slices with a speed of |dΩ/dt|·T/|Ω|: the share by which the speed changes across one
+    slice of T seconds (dΩ/dt from the slices' speeds against their centre times)."""
+    t = np.array([0.5 * (i.start + i.stop) / fs for i in infos])
+    w = np.array([i.speed for i in infos])
+    ok = np.isfinite(w) & (w != 0)
+    if ok.sum() < 3:
+        return 0.0
+    rate = np.abs(np.gradient(w[ok], t[ok]))
+    return float(np.median(rate * (infos[0].stop - infos[0].start) / fs / np.abs(w[ok])))
+
+
+def _speed_infos(sweep, slice_samples, hop, source, channels) -> tuple:
+    """(slice starts, hop, infos, SpeedScale or None) at one slice length."""
+    starts, hop = _slice_starts(sweep, slice_samples, hop)
+    if source == "tach":
+        return starts, hop, _tach_infos(sweep, starts, slice_samples), None
+    infos, spd = estimate_speed_track(sweep, slice_samples, hop, channels=channels)
+    return starts, hop, infos, spd
+
+
+def _auto_slices(sweep, source, channels) -> tuple:
+    """The longest power-of-two slice (AUTO_SLICE_MAX down to AUTO_SLICE_MIN samples, and at most an eighth of
+    the record) over which the speed changes by at most AUTO_SLICE_CHANGE of itself (median over the slices):
+    (slice_samples, starts, hop, infos, SpeedScale, rule text)."""
+    n_total = _n_samples(sweep)
+    n = int(min(AUTO_SLICE_MAX, max(2 ** int(np.floor(np.log2(max(n_total // 8, 1)))), AUTO_SLICE_MIN)))
+    tried = []
+    while True:
+        starts, hop, infos, spd = _speed_infos(sweep, n, None, source, channels)
+        change = _slice_change(infos, float(sweep.sample_rate))
+        tried.append(f"{n} samples: {100 * change:.1f} %")
+        if change <= AUTO_SLICE_CHANGE or n // 2 < AUTO_SLICE_MIN:
+            rule = (f"auto: the longest slice (<= {AUTO_SLICE_MAX} samples) over which the speed changes by <= "
+                    f"{100 * AUTO_SLICE_CHANGE:g} % (median over the slices); " + "; ".join(tried))
+            return n, starts, hop, infos, spd, rule
+        n //= 2
+
+
+def slice_sweep(sweep: Sweep, slice_samples: int | None = None, hop: int | None = None, speed_source: str = "auto",
                 min_speed_rpm: float | None = None, channels=None, max_speed_error: float = 0.005) -> tuple:
     """Cut ``sweep`` into quasi-steady slices: a :class:`SteadyTest` plus one :class:`SliceInfo` per run.
 
     slice_samples, hop : samples per slice and between slice starts (default hop = slice_samples,
-        non-overlapping, as the thesis).
+        non-overlapping, as the thesis).  slice_samples None (default): the longest power of two up to
+        8192 samples (the thesis's) over which the speed changes by at most 5 % of itself (median over the
+        slices): a fast sweep's lines are smeared over a long slice and their peaks pulled (a 30-s run-up
+        300 -> 3000 rpm at 3840 Hz in 8192-sample slices put h = 3 at 3.04, with the tach too).
     speed_source : "auto" (tach if the sweep has one, else data), "tach" (mean of the tach over
         the slice; DataError naming ``speed_rpm`` without one) or "data" (:func:`estimate_speeds`).
     min_speed_rpm : slices with |speed| below this (rpm) are dropped; default 5 % of the largest
@@ -489,13 +536,15 @@ def slice_sweep(sweep: Sweep, slice_samples: int = 8192, hop: int | None = None,
     """
     if speed_source not in ("auto", "tach", "data"):
         raise ValueError(f"speed_source must be 'auto', 'tach' or 'data', got {speed_source!r}")
-    starts, hop = _slice_starts(sweep, slice_samples, hop)
     source = ("tach" if sweep.tach is not None else "data") if speed_source == "auto" else speed_source
-    spd = None
-    if source == "tach":
-        infos = _tach_infos(sweep, starts, slice_samples)
+    if source == "tach" and sweep.tach is None:
+        raise DataError(_sweep_name(sweep), TACH_COLUMN,
+                        "speed_source='tach' but the sweep has no tach column; use 'data' or 'auto'")
+    if slice_samples is None:
+        slice_samples, starts, hop, infos, spd, rule = _auto_slices(sweep, source, channels)
     else:
-        infos, spd = estimate_speed_track(sweep, slice_samples, hop, channels=channels)
+        starts, hop, infos, spd = _speed_infos(sweep, slice_samples, hop, source, channels)
+        rule = "given"
     speeds = np.array([i.speed for i in infos])
     found = np.isfinite(speeds)
     if min_speed_rpm is None:
@@ -520,6 +569,7 @@ def slice_sweep(sweep: Sweep, slice_samples: int = 8192, hop: int | None = None,
     meta = {k: v for k, v in (sweep.meta or {}).items()}
     meta["slicing"] = {
         "slice_samples": int(slice_samples),
+        "slice_rule": rule,
         "hop_samples": int(hop),
         "slice_duration_s": slice_samples / fs,
         "speed_source": source,
