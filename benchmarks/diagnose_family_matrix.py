@@ -335,7 +335,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--budget", type=float, default=None, help="seconds: start no new cell after this")
     ap.add_argument("--keep", default=None, help="directory to keep the generated data and reports in")
-    ap.add_argument("--json", default=None, help="write every row to this JSON file")
+    ap.add_argument("--json", default=None, help="write every row to this JSON file (after each cell)")
+    ap.add_argument("--resume", action="store_true", help="with --json: keep the rows already in it, run the rest")
     a = ap.parse_args(argv)
     all_wheels = wheels()
     idx = list(QUICK["wheels"]) if a.quick else (range(len(all_wheels)) if a.wheels == "all"
@@ -346,12 +347,20 @@ def main(argv=None) -> int:
     print(HEADER)
     print("|---" * (HEADER.count("|") - 1) + "|")
     rows, t_start = [], time.perf_counter()
+    if a.resume and a.json and Path(a.json).exists():
+        rows = json.loads(Path(a.json).read_text())
+        for r in rows:
+            print(row_text(r), flush=True)
+    done = {(r["wheel"], r["cell"]) for r in rows}
     try:
         for i in idx:
             wheel = all_wheels[i]
-            clean_error = None
+            clean_error = next((r["error"][1] for r in rows if r["wheel"] == i and r["label"] == "clean"
+                                and "crashed" not in r), None)
             for name, label, effects in cells(i, wheel):
                 if labels is not None and label not in labels and label != "clean":
+                    continue
+                if (i, name) in done:
                     continue
                 if a.budget is not None and time.perf_counter() - t_start > a.budget:
                     print(f"\n(budget of {a.budget:g} s reached: the table stops here)")
@@ -363,6 +372,10 @@ def main(argv=None) -> int:
                     r["error_ratio"] = 1.0
                 rows.append(r)
                 print(row_text(r), flush=True)
+                if a.json:                                  # after every cell: a run cut short keeps its rows
+                    tmp = Path(a.json + ".tmp")
+                    tmp.write_text(json.dumps(rows, indent=1, default=str))
+                    tmp.replace(a.json)
                 if not a.keep:
                     shutil.rmtree(work / f"w{i}_{name.replace(' ', '_').replace('+', '_')}", ignore_errors=True)
     finally:

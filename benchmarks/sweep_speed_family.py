@@ -134,11 +134,13 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="the issue's case only (wheel 0 up, 120 s)")
     ap.add_argument("--wheels", default="all")
+    ap.add_argument("--durations", default="all", help="comma-separated sweep durations (s) to run, or 'all'")
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--keep", default=None, help="directory to keep the sweeps and reports in")
     ap.add_argument("--json", default=None)
     a = ap.parse_args(argv)
-    sweeps = QUICK if a.quick else [s for s in SWEEPS if a.wheels == "all" or str(s[0]) in a.wheels.split(",")]
+    sweeps = QUICK if a.quick else [s for s in SWEEPS if (a.wheels == "all" or str(s[0]) in a.wheels.split(","))
+                                    and (a.durations == "all" or f"{s[2]:g}" in a.durations.split(","))]
     work = Path(a.keep) if a.keep else Path(tempfile.mkdtemp(prefix="sweep_speed_"))
     print(HEADER)
     print("|---" * (HEADER.count("|") - 1) + "|")
