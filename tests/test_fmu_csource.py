@@ -16,6 +16,7 @@ CC = shutil.which(os.environ.get("CC", "cc"))
 pytestmark = pytest.mark.skipif(not (native_supported() and CC), reason="needs a C compiler on Linux x86-64")
 
 from rwadist.fmu.native_build import C_SOURCES, VARIABLES, VR_TIME, build_native_fmu  # noqa: E402
+from rwadist.fmu.runtime import SWITCH_SLOTS, fmu_switches  # noqa: E402
 
 NATIVE = Path(__file__).resolve().parents[1] / "fmu" / "native"
 PRINT_TABLE = r"""
@@ -46,8 +47,11 @@ def test_rules_header_variables_are_the_model_descriptions(tmp_path):
     for line in subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout.splitlines():
         fmi, vr, name, typ, caus = line.split()
         got[int(fmi), int(vr)] = (name, typ, caus)
+    # the effect switches are named by their elements (wheel_model.h RW_SWITCH_NAMES), the rules only know the slots
+    switches = {name for name, _ in fmu_switches()}
+    assert len(switches) == SWITCH_SLOTS
     for fmi in (2, 3):
-        want = {vr: (name, typ, "parameter" if caus == "parameter" else caus)
+        want = {vr: ("effect_switch" if name in switches else name, typ, "parameter" if caus == "parameter" else caus)
                 for vr, (name, typ, caus, *_rest) in enumerate(VARIABLES)}
         if fmi == 3:
             want[VR_TIME] = ("time", "Real", "independent")

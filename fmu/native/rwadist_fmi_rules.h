@@ -131,7 +131,7 @@ static const char *const RW_TYPE_NAMES[2][4] = {{"Real", "Integer", "Boolean", "
 
 static const char *const RW_VAR_NAMES[N_VR + 1] = {
     "wheel_speed", "wheel_acceleration", "model_file", "use_wheel_acceleration", "seed", "imbalance", "harmonics",
-    "modes", "start_steady", "effect switch", "effect switch", "floor_resolution", "max_acceleration",
+    "modes", "start_steady", "effect_switch", "effect_switch", "floor_resolution", "max_acceleration",
     "max_step_size", "dcm_11", "dcm_12", "dcm_13", "dcm_21", "dcm_22", "dcm_23", "dcm_31", "dcm_32", "dcm_33", "r_x",
     "r_y", "r_z", "Fx", "Fy", "Fz", "Tx", "Ty", "Tz", "Fx_sc", "Fy_sc", "Fz_sc", "Tx_sc", "Ty_sc", "Tz_sc", "time"};
 
