@@ -37,8 +37,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
-import math
 import os
 from pathlib import Path
 
@@ -48,13 +46,16 @@ from tqdm.auto import tqdm
 from .formats import registry
 from .formats.channels import SPEED_COLUMN, to_run, to_sweep
 from .formats.csv_table import TIME_COLUMN
+from .formats.meta import check_f_lim_meta, check_meta
 from .formats.records import (
     DataError,
     RawRecord,
     Run,
     SteadyTest,
     Sweep,
+    check_speed_rpm,
     json_default,
+    json_text,
     portable_meta,
     read_json,
     read_text,
@@ -85,12 +86,7 @@ def _read_meta(path: Path) -> dict:
     """A test's meta.json (or a sweep's sidecar), {} when absent; checks the keys the readers use."""
     if not path.exists():
         return {}
-    meta = read_json(path)
-    if not isinstance(meta, dict):
-        raise DataError(path, "document", "must be a JSON object")
-    fs = meta.get("sample_rate_hz")
-    if fs is not None and not (isinstance(fs, (int, float)) and fs > 0 and math.isfinite(fs)):
-        raise DataError(path, "sample_rate_hz", f"must be a positive number, got {fs!r}")
+    meta = check_meta(read_json(path), path)
     # who wrote the folder is the folder's, not the test's (write_steady sets it again): the test's meta round-trips
     meta.pop(WRITER_KEY, None)
     return meta
@@ -165,8 +161,7 @@ def read_steady(directory, progress: bool = False) -> SteadyTest:
                 rpm = float(speed_text)
             except ValueError:
                 raise DataError(runs_path, f"speed_rpm (line {lineno})", f"{speed_text!r} is not a number") from None
-            if not math.isfinite(rpm):
-                raise DataError(runs_path, f"speed_rpm (line {lineno})", f"{speed_text!r} is not finite")
+            check_speed_rpm(runs_path, f"speed_rpm (line {lineno})", rpm)
             speed = float(rpm_to_rad_s(rpm))
         file_name = fname.rsplit(":", 1)[0] if ".tdms:" in fname.lower() else fname
         if not (directory / file_name).is_file():
@@ -183,6 +178,7 @@ def read_steady(directory, progress: bool = False) -> SteadyTest:
     if unlisted:
         # kept in meta so nothing goes unnoticed; the CLI prints it
         meta = dict(meta, unlisted_files=unlisted)
+    check_f_lim_meta(meta, runs[0].sample_rate, meta_path)
     return SteadyTest(runs, meta).sorted()
 
 
@@ -200,7 +196,9 @@ def read_sweep(path, sample_rate: float | None = None) -> Sweep:
     meta_path = file.with_suffix(".meta.json")
     meta = _read_meta(meta_path)
     record = registry.read_record(path, meta)
-    return to_sweep(record, meta, meta_path, declared_rate=sample_rate)
+    sweep = to_sweep(record, meta, meta_path, declared_rate=sample_rate)
+    check_f_lim_meta(meta, sweep.sample_rate, meta_path)
+    return sweep
 
 
 def read_data(path, progress: bool = False):
@@ -249,7 +247,7 @@ def write_steady(test: SteadyTest, directory, fmt: str = "csv") -> Path:
         writer.writerow(["file", "speed_rpm"])
         for name, run in zip(names, test.runs):
             writer.writerow([name, repr(float(rad_s_to_rpm(run.speed)))])
-    (directory / META_FILE).write_text(json.dumps(meta, indent=2, default=json_default) + os.linesep)
+    (directory / META_FILE).write_text(json_text(meta, indent=2) + os.linesep)
     return directory
 
 
@@ -272,5 +270,5 @@ def write_sweep(sweep: Sweep, path, fmt: str | None = None, with_meta: bool = Fa
                               float(sweep.time[0]), sweep.tach)
     meta = dict(portable_meta(sweep.meta), sample_rate_hz=float(sweep.sample_rate))
     if with_meta:
-        path.with_suffix(".meta.json").write_text(json.dumps(meta, indent=2, default=json_default) + os.linesep)
+        path.with_suffix(".meta.json").write_text(json_text(meta, indent=2) + os.linesep)
     return path

@@ -648,6 +648,9 @@ def _fit_empirical(spectra: Spectra, settings: FitSettings | None = None, direct
         "nperseg": spectra.nperseg,
         "sample_rate_hz": spectra.sample_rate,
     }
+    idle = [str(spectra.run_names[i]) for i in np.nonzero(speed == 0)[0]] if spectra.run_names else []
+    if idle:        # never a run left out without saying which and why
+        model.provenance["runs_not_fitted"] = {"runs": idle, "why": "zero speed: noise runs, no harmonic to fit"}
     settings_doc = {k: getattr(s, k) for k in s.__dataclass_fields__}
     settings_doc["detection_threshold"] = threshold
     settings_doc["dof"] = dof

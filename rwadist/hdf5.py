@@ -29,13 +29,24 @@ from __future__ import annotations
 
 import json
 import math
+from contextlib import contextmanager
 from pathlib import Path
 
 import h5py
 import numpy as np
 
-from .formats.records import DataError, Run, SteadyTest, Sweep, portable_meta
-from .formats.records import json_default as _json_default
+from .formats.meta import check_f_lim_meta, check_meta
+from .formats.records import (
+    DataError,
+    Run,
+    SteadyTest,
+    Sweep,
+    check_loads,
+    check_rate_bound,
+    check_speed_rpm,
+    json_text,
+    portable_meta,
+)
 from .formats.timebase import sample_step
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm
 
@@ -47,6 +58,28 @@ TACH_DATASET = "speed_rad_s"
 
 
 # --------------------------------------------------------------------------- writing
+
+@contextmanager
+def file_in_memory(path, header: bytes = b""):
+    """Yield a new HDF5 file (``h5py.File``) built in memory; when the block ends it is written to ``path`` in one
+    plain write (``header``, a user block of 512·2^k bytes, first), never when the block raises.
+
+    HDF5 writing its own file on a full disk printed a traceback from each h5py destructor and then crashed the
+    process (exit 139), leaving a part file; in memory, a full disk is one ``OSError`` from the final write
+    (the command's one-line error, its temporary removed).  Memory: the file's size (compressed), once."""
+    import uuid
+
+    fh = h5py.File(f"rwadist-{uuid.uuid4().hex}.h5", "w", driver="core", backing_store=False)
+    try:
+        yield fh
+        fh.flush()
+        image = fh.id.get_file_image()
+    finally:
+        fh.close()
+    with open(path, "wb") as out:
+        out.write(header)
+        out.write(image)
+
 
 def _float_dataset(group, name, values, compression, dtype=np.float64):
     data = np.ascontiguousarray(values, dtype=dtype)
@@ -75,11 +108,11 @@ def write_hdf5(obj, path, *, compression: str | None = None, precision: str = "f
     else:
         raise TypeError(f"write_hdf5 takes a SteadyTest or a Sweep, not {type(obj).__name__}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    with h5py.File(path, "w") as fh:
+    with file_in_memory(path) as fh:
         fh.attrs["format"] = FORMAT
         fh.attrs["format_version"] = FORMAT_VERSION
         fh.attrs["kind"] = kind
-        fh.attrs["meta"] = json.dumps(portable_meta(obj.meta), default=_json_default)
+        fh.attrs["meta"] = json_text(portable_meta(obj.meta))
         if kind == "steady":
             runs = fh.create_group(RUNS_GROUP)
             width = max(4, len(str(len(obj.runs))))
@@ -195,9 +228,12 @@ def _read_run(path, group) -> Run:
             raise DataError(path, f"{where}/speed_rpm", f"{rpm!r} rpm disagrees with speed_rad_s {speed!r} "
                             f"({float(rad_s_to_rpm(speed))!r} rpm)")
     fs = _float_attr(path, group, "sample_rate_hz", where, positive=True)
+    check_speed_rpm(path, f"{where}/speed_rad_s", rad_s_to_rpm(speed))
+    check_rate_bound(path, f"{where}/sample_rate_hz", fs)
     t0 = _float_attr(path, group, "t0", where) if "t0" in group.attrs else 0.0
     name = _str_attr(path, group, "name", where) if "name" in group.attrs else group.name.rsplit("/", 1)[-1]
     signals = _channels(path, group)
+    check_loads(path, signals, {c: f"{where}/{CHANNEL_COLUMN[c]}" for c in signals})
     return Run(speed=speed, sample_rate=fs, signals=signals, t0=t0, name=name)
 
 
@@ -219,8 +255,10 @@ def _read_steady(path, fh) -> SteadyTest:
 
 def _read_sweep(path, fh) -> Sweep:
     fs = _float_attr(path, fh, "sample_rate_hz", positive=True)
+    check_rate_bound(path, "sample_rate_hz", fs)
     time = _samples(path, fh, TIME_DATASET)
     signals = _channels(path, fh, skip=(TIME_DATASET, TACH_DATASET))
+    check_loads(path, signals, {c: f"/{CHANNEL_COLUMN[c]}" for c in signals})
     n = len(time)
     for ch, x in signals.items():
         if len(x) != n:
@@ -229,6 +267,7 @@ def _read_sweep(path, fh) -> Sweep:
     tach = None
     if TACH_DATASET in fh:
         tach = _samples(path, fh, TACH_DATASET)
+        check_speed_rpm(path, f"/{TACH_DATASET}", rad_s_to_rpm(tach))
         if len(tach) != n:
             raise DataError(path, f"/{TACH_DATASET}", f"{len(tach)} samples, {TIME_DATASET} has {n}")
     return time, signals, fs, tach
@@ -280,11 +319,13 @@ def _read_open(path, fh):
             meta = json.loads(text)
         except json.JSONDecodeError as exc:
             raise DataError(path, "meta", f"not valid JSON ({exc.msg})") from exc
-        if not isinstance(meta, dict):
-            raise DataError(path, "meta", "must be a JSON object")
+        check_meta(meta, path, "meta.")
     if kind == "steady":
-        return SteadyTest(_read_steady(path, fh), meta).sorted()
+        runs = _read_steady(path, fh)
+        check_f_lim_meta(meta, runs[0].sample_rate, path, "meta.")
+        return SteadyTest(runs, meta).sorted()
     if kind == "sweep":
         time, signals, fs, tach = _read_sweep(path, fh)
+        check_f_lim_meta(meta, fs, path, "meta.")
         return Sweep(time=time, signals=signals, sample_rate=fs, tach=tach, meta=meta)
     raise DataError(path, "kind", f"{kind!r} is neither 'steady' nor 'sweep'")

@@ -54,13 +54,12 @@ def read_psd_csv(path) -> tuple:
 
 
 def write_hdf5(res: BroadbandPSD, path, group: str = "psd") -> Path:
-    """HDF5 group with datasets f_Hz (n), psd (n, 6) and csd (n, 6, 6) complex; attrs channels, frame."""
-    import h5py
+    """A new HDF5 file ``path`` with one group: datasets f_Hz (n), psd (n, 6) and csd (n, 6, 6) complex; attrs
+    channels, frame."""
+    from .hdf5 import file_in_memory
 
     path = Path(path)
-    with h5py.File(path, "a") as fh:
-        if group in fh:
-            del fh[group]
+    with file_in_memory(path) as fh:       # a full disk: one OSError, never HDF5's crash
         g = fh.create_group(group)
         g.create_dataset("f_Hz", data=res.f)
         g.create_dataset("psd", data=res.psd)

@@ -346,12 +346,25 @@ def law_from_csv(path, n_bins: int = 2000, bounds=None):
     path = Path(path)
     if not path.exists():
         raise DataError(path, "file", "does not exist (expected uniform, normal or a CSV file)")
-    with open(path, newline="") as fh:
-        header = [h.strip() for h in next(csv.reader(fh))]
+    expected = "speed_rpm,weight or speed_rpm,pdf_per_rpm or time_s,speed_rpm"
     try:
-        arr = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        with open(path, newline="") as fh:
+            first = next(csv.reader(fh), None)
+        header = [h.strip() for h in first or []]
+        arr = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2) if any(header) else np.empty((0, 0))
+    except UnicodeDecodeError:
+        raise DataError(path, "encoding", "not a UTF-8 text CSV file") from None
     except ValueError as exc:
         raise DataError(path, "data", f"not numeric CSV ({exc})") from None
+    if not any(header):
+        raise DataError(path, "header", f"empty file: expected a header line ({expected}) and rows")
+    if arr.size == 0:
+        raise DataError(path, "rows", f"no data rows under the header {header}")
+    if arr.shape[1] != len(header):
+        raise DataError(path, "columns", f"{arr.shape[1]} values per row, the header {header} names {len(header)}")
+    if not np.all(np.isfinite(arr)):
+        row, c = np.argwhere(~np.isfinite(arr))[0]
+        raise DataError(path, f"{header[c]} (data row {row + 1})", f"{float(arr[row, c])!r}: not a finite number")
     col = {h: arr[:, i] for i, h in enumerate(header)}
     if "time_s" in col and "speed_rpm" in col:
         w = rpm_to_rad_s(col["speed_rpm"])
@@ -427,3 +440,16 @@ def _spread(a, b, weights, n_bins):
             else:
                 out[p] += 1j * binned
     return out
+
+
+def law_text(law) -> str:
+    """A speed law in words for plot titles and reports: its kind and range in rpm (a file's name for a histogram)."""
+    if isinstance(law, Uniform):
+        return f"uniform {law.lo * RAD_S_TO_RPM:.6g}..{law.hi * RAD_S_TO_RPM:.6g} rpm"
+    if isinstance(law, TruncatedNormal):
+        return (f"normal {law.mean * RAD_S_TO_RPM:.6g} ± {law.std * RAD_S_TO_RPM:.4g} rpm in "
+                f"{law.lo * RAD_S_TO_RPM:.6g}..{law.hi * RAD_S_TO_RPM:.6g}")
+    if isinstance(law, Histogram):
+        lo, hi = law.support
+        return f"{Path(str(law.source)).name} ({lo * RAD_S_TO_RPM:.6g}..{hi * RAD_S_TO_RPM:.6g} rpm)"
+    return repr(law)

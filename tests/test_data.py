@@ -31,7 +31,8 @@ from rwadist.units import CHANNEL_COLUMN, CHANNELS, RAD_S_TO_RPM, rpm_to_rad_s
 N = 1024
 FS = 2048.0
 #: Values that a lossy float->text->float path would mangle.
-AWKWARD = np.array([-0.0, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308, 0.1, 1 / 3, -2.0**-1074 * 3])
+# (the largest: the readers refuse a load beyond 1e9 N or N·m, rwadist.formats.records.MAX_LOAD)
+AWKWARD = np.array([-0.0, 5e-324, 2.2250738585072014e-308, 999999999.99999988, 0.1, 1 / 3, -2.0**-1074 * 3])
 
 
 def bits(x):

@@ -5,6 +5,7 @@ import copy
 
 import numpy as np
 
+from ..formats.records import json_text
 from ..units import CHANNEL_UNIT, RAD_S_TO_RPM
 from .constants import BAND_BINS, CONTRAST_METRIC, METRIC, NOISE_Z
 from .search import Diagnosis
@@ -171,6 +172,10 @@ def _rms_figure(diag: Diagnosis, cols: dict):
         ax.set_xlabel("Wheel speed (rpm)")
         if j == 0:
             ax.legend(fontsize=8)
+    lo = float(ctx.f[ctx.k_lo]) - 0.5 * ctx.df
+    hi = float(ctx.f[ctx.k_lo + ctx.n_bands * BAND_BINS - 1]) + 0.5 * ctx.df
+    fig.suptitle(f"RMS vs wheel speed over {max(lo, 0.0):.3g}–{hi:.0f} Hz (the metric's band): data and the model "
+                 "before and after diagnose")
     fig.tight_layout()
     return fig
 
@@ -217,7 +222,6 @@ def line_causes_section(diag: Diagnosis) -> list:
 def write_report(diag: Diagnosis, out_dir) -> list:
     """summary.json, model.json (the improved model), rms_vs_speed.csv/.png, residual_waterfall.png,
     hypotheses.csv and report.md into ``out_dir``; returns the paths."""
-    import json
     from pathlib import Path
 
     from ..model import save
@@ -228,7 +232,7 @@ def write_report(diag: Diagnosis, out_dir) -> list:
     files = []
     summary = _clean(diag.summary())
     p = out / "summary.json"
-    p.write_text(json.dumps(summary, indent=2) + "\n")
+    p.write_text(json_text(summary, indent=2) + "\n")       # valid JSON: a NaN as null
     files.append(p)
     model = copy.deepcopy(diag.model)
     model.effects = _clean(model.effects)

@@ -24,8 +24,8 @@ import math
 
 import numpy as np
 
-from ..units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rpm_to_rad_s
-from .records import DataError, RawRecord, Run, Sweep
+from ..units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm, rpm_to_rad_s
+from .records import MAX_T0_S, DataError, RawRecord, Run, Sweep, check_loads, check_rate_bound, check_speed_rpm
 from .tach import steady_speed_from_tach, sweep_speed_from_tach
 from .timebase import check_rate, sample_step
 
@@ -227,6 +227,9 @@ def record_rate(record: RawRecord, declared_rate, declared_by="meta.json sample_
         return 1.0 / step, float(record.time[0])
     if record.sample_rate is None:
         raise DataError(record.path, record.time_field, "neither time stamps nor a sample rate stored")
+    if not math.isfinite(record.t0) or abs(record.t0) > MAX_T0_S:
+        raise DataError(record.path, record.t0_field or "t0", f"start time {record.t0!r} s: must be finite within "
+                        f"+-{MAX_T0_S:g} s")
     return check_rate(record.path, record.rate_field, record.sample_rate, record.rate_rtol, declared_rate,
                       declared_by), float(record.t0)
 
@@ -234,24 +237,32 @@ def record_rate(record: RawRecord, declared_rate, declared_by="meta.json sample_
 def to_run(record: RawRecord, speed, meta: dict, meta_path="meta.json", name: str = "") -> Run:
     """A :class:`Run` from a record: ``speed`` rad/s, or None to take it from the tach channel."""
     signals, extras = map_channels(record, meta, meta_path)
+    check_loads(record.path, signals)
     fs, t0 = record_rate(record, meta.get("sample_rate_hz") if isinstance(meta, dict) else None)
+    check_rate_bound(record.path, record.time_field if record.time is not None else record.rate_field, fs)
     if speed is None:
         speed = steady_speed_from_tach(record.path, extras, fs, meta, meta_path)
+        check_speed_rpm(record.path, "speed from the tach channel", rad_s_to_rpm(speed))
     return Run(speed=float(speed), sample_rate=fs, signals=signals, t0=t0, name=name or record.path.name)
 
 
 def to_sweep(record: RawRecord, meta: dict, meta_path="meta.json", declared_rate=None) -> Sweep:
     """A :class:`Sweep` from a record (tach from a ``speed_rpm`` column or a pulse channel)."""
     signals, extras = map_channels(record, meta, meta_path)
+    check_loads(record.path, signals)
     if declared_rate is None and isinstance(meta, dict):
         declared_rate = meta.get("sample_rate_hz")
     fs, t0 = record_rate(record, declared_rate)
+    check_rate_bound(record.path, record.time_field if record.time is not None else record.rate_field, fs)
     n = len(next(iter(signals.values())))
     time = record.time if record.time is not None else t0 + np.arange(n) / fs
     tach = None
     if SPEED_COLUMN in extras:
+        check_speed_rpm(record.path, record.where.get(SPEED_COLUMN, SPEED_COLUMN), extras[SPEED_COLUMN])
         tach = rpm_to_rad_s(extras[SPEED_COLUMN])
     else:
         tach = sweep_speed_from_tach(record.path, extras, time, fs, meta, meta_path)
+        if tach is not None:
+            check_speed_rpm(record.path, "speed from the tach channel", rad_s_to_rpm(tach))
     return Sweep(time=np.asarray(time, dtype=float), signals=signals, sample_rate=fs, tach=tach,
                  meta=dict(meta) if isinstance(meta, dict) else {})

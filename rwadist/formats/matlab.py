@@ -35,8 +35,11 @@ def _variables(path: Path) -> tuple:
         try:
             with h5py.File(path, "r") as fh:
                 for name, obj in fh.items():
-                    if name.startswith("#") or not isinstance(obj, h5py.Dataset):
+                    if name.startswith("#"):        # MATLAB's own (#refs#, #subsystem#)
                         continue
+                    if not isinstance(obj, h5py.Dataset):
+                        raise DataError(path, f"variable {name}", "is a MATLAB struct or cell array (an HDF5 group), "
+                                        "not a numeric vector: store each channel as a vector of its own")
                     out[name] = np.asarray(obj[()])
         except OSError as exc:
             raise DataError(path, "file", f"cannot be read as MATLAB v7.3 (HDF5): {exc}") from None
@@ -109,13 +112,13 @@ def write(path, columns: dict, v73: bool = False) -> Path:
         savemat(str(path), {k: (np.asarray(v, dtype=float).reshape(-1, 1) if np.ndim(v) else float(v))
                             for k, v in columns.items()})
         return path
-    import h5py
+    from ..hdf5 import file_in_memory
 
-    with h5py.File(path, "w", userblock_size=512) as fh:
+    # MATLAB's 128-byte header in a 512-byte user block before the HDF5 superblock (found there by HDF5)
+    header = (V73_HEADER.ljust(116, b" ") + b"\x00" * 8 + b"\x00\x02" + b"IM").ljust(512, b"\x00")
+    with file_in_memory(path, header) as fh:
         for name, value in columns.items():
             data = np.asarray(value, dtype=np.float64)
             ds = fh.create_dataset(name, data=data.reshape(1, -1) if data.ndim else data.reshape(1, 1))
             ds.attrs["MATLAB_class"] = np.bytes_("double")
-    with open(path, "r+b") as fh:
-        fh.write(V73_HEADER.ljust(116, b" ") + b"\x00" * 8 + b"\x00\x02" + b"IM")
     return path

@@ -8,6 +8,7 @@
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -134,9 +135,70 @@ def reading_provenance(meta) -> dict:
     return {"reading": got} if got else {}
 
 
+#: highest wheel speed a test may record, rpm (as the command line's and the model file's: flight wheels run below
+#: ~10 000 rpm): a speed beyond is a unit slip or a corrupted file
+MAX_RPM = 100_000.0
+#: largest load sample a test may record after its channel map, N or N·m (a load cell under a wheel reads below
+#: ~1e3): a sample beyond is a corrupted file or a unit slip, whose square would overflow the spectra
+MAX_LOAD = 1e9
+#: largest start time of a record, s (a year: a time stamp in s since an epoch is converted to the record's own)
+MAX_T0_S = 3.2e7
+#: highest sample rate a test's metadata may declare, Hz (load-cell systems sample at most ~100 kHz)
+MAX_SAMPLE_RATE_HZ = 1e7
+#: most tach pulses per revolution (an optical encoder has at most a few thousand)
+MAX_PULSES_PER_REV = 100_000
+
+
+def check_speed_rpm(path, field: str, rpm) -> None:
+    """Speeds (rpm, a number or an array) finite and within +-:data:`MAX_RPM`; :class:`DataError` naming ``path``,
+    ``field`` and the first bad value (with its index for an array)."""
+    a = np.atleast_1d(np.asarray(rpm, dtype=float))
+    bad = ~np.isfinite(a) | (np.abs(a) > MAX_RPM)
+    if bad.any():
+        i = int(np.argmax(bad))
+        where = f" at index {i}" if a.size > 1 else ""
+        raise DataError(path, field, f"speed {float(a[i])!r} rpm{where}: must be finite within +-{MAX_RPM:g} rpm "
+                        "(a unit slip? speeds are in rpm)")
+
+
+def check_rate_bound(path, field: str, rate: float) -> None:
+    """A sample rate (Hz) at most :data:`MAX_SAMPLE_RATE_HZ`; :class:`DataError` naming ``path`` and ``field``."""
+    if not rate <= MAX_SAMPLE_RATE_HZ:
+        raise DataError(path, field, f"{rate!r} Hz: at most {MAX_SAMPLE_RATE_HZ:g} Hz (a unit slip? Hz, not kHz)")
+
+
+def check_loads(path, signals: dict, where: dict | None = None) -> None:
+    """Load samples (SI, after the channel map) within +-:data:`MAX_LOAD`: :class:`DataError` naming ``path``, the
+    channel (where the file keeps it) and the first bad sample -- never a run dropped later because its spectrum
+    overflowed."""
+    for ch, x in signals.items():
+        a = np.asarray(x)
+        if a.size and float(np.max(np.abs(a))) > MAX_LOAD:
+            i = int(np.argmax(np.abs(a) > MAX_LOAD))
+            loc = (where or {}).get(ch, f"channel {ch}")
+            raise DataError(path, loc, f"sample {float(a[i])!r} at index {i} is beyond any load a wheel test "
+                            f"records (|x| <= {MAX_LOAD:g} N or N·m): a corrupted file or a unit slip")
+
+
 def portable_meta(meta) -> dict:
     """``meta`` without the keys that only describe the source files (channel map, tach pulse channel)."""
     return {k: v for k, v in dict(meta or {}).items() if k not in READING_KEYS}
+
+
+def json_text(doc, **kw) -> str:
+    """``doc`` as valid JSON text: numpy values as Python numbers, every non-finite number (NaN is no JSON) as null --
+    the free-form places of metadata carry what a lab wrote; the keys a reader uses are refused when not finite."""
+    def safe(x):
+        if isinstance(x, dict):
+            return {k: safe(v) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [safe(v) for v in x]
+        if isinstance(x, np.ndarray):
+            return safe(x.tolist())
+        if isinstance(x, np.generic):
+            x = x.item()
+        return None if isinstance(x, float) and not math.isfinite(x) else x
+    return json.dumps(safe(doc), allow_nan=False, default=json_default, **kw)
 
 
 def json_default(obj):
@@ -168,6 +230,7 @@ class RawRecord:
     rate_field : where the rate is stored, for errors.
     t0 : time of the first sample, s, when ``time`` is None.
     channels_field : what errors about the set of channels name (a CSV's ``header``).
+    t0_field : where ``t0`` is stored, for errors.
     """
 
     path: Path
@@ -182,6 +245,7 @@ class RawRecord:
     rate_field: str = "sample_rate"
     t0: float = 0.0
     channels_field: str = "channels"
+    t0_field: str = "t0"
 
     def locate(self, name: str) -> str:
         """Where channel ``name`` sits in the file (for error messages)."""

@@ -70,8 +70,8 @@ def read_record(path, group_name: str | None = None) -> RawRecord:
         columns[channel.name] = np.ascontiguousarray(x)
         units[channel.name] = str(props.get("unit_string", "") or "")
         where[channel.name] = loc
-        increments.append((float(props["wf_increment"]), loc))
-        offsets.append(float(props.get("wf_start_offset", 0.0)))
+        increments.append((_property(path, loc, props, "wf_increment"), loc))
+        offsets.append((_property(path, loc, props, "wf_start_offset", 0.0), loc))
     if not columns:
         raise DataError(path, f"/{gname}", "holds no channels; expected some of Fx..Tz or "
                         + ",".join(CHANNEL_COLUMN.values()))
@@ -85,8 +85,26 @@ def read_record(path, group_name: str | None = None) -> RawRecord:
                             "(mixed sample rates in one record)")
     if not (np.isfinite(inc) and inc > 0):
         raise DataError(path, f"{first_loc}/wf_increment", f"{inc!r} s is not a positive step")
+    t0, t0_loc = offsets[0]
+    for other, loc in offsets:
+        if not np.isfinite(other):
+            raise DataError(path, f"{loc}/wf_start_offset", f"{other!r} s: the start time must be a finite number")
+        if other != t0:
+            raise DataError(path, f"{loc}/wf_start_offset", f"{other!r} s differs from {t0_loc}'s {t0!r} s (channels "
+                            "that start at different times are not one record)")
     return RawRecord(path=path, columns=columns, units=units, where=where, sample_rate=1.0 / inc,
-                     rate_field=f"{first_loc}/wf_increment ({inc!r} s)", t0=offsets[0], channels_field=f"/{gname}")
+                     rate_field=f"{first_loc}/wf_increment ({inc!r} s)", t0=t0, channels_field=f"/{gname}",
+                     t0_field=f"{t0_loc}/wf_start_offset")
+
+
+def _property(path, loc, props, key, default=None) -> float:
+    """A channel's numeric waveform property ``key`` (``default`` when absent); :class:`DataError` naming it when
+    it is no number."""
+    v = props.get(key, default)
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        raise DataError(path, f"{loc}/{key}", f"{v!r} is not a number") from None
 
 
 def write(path, signals: dict, sample_rate: float, t0: float = 0.0, group: str = "run",
