@@ -24,25 +24,50 @@ Under it, one module per step: ``data`` (interchange format) -> ``sweep`` (quasi
 ``model`` (the model file); ``extended`` (rotor model), ``diagnose``, ``broadband`` (PSD),
 ``teststand``/``presets`` (synthetic tests).  SI units inside; rpm only at the edges.
 """
+import importlib as _importlib
 import sys as _sys
 import types as _types
+from typing import TYPE_CHECKING as _TYPE_CHECKING
 
-from .api import (
-    WheelModel,
-    build_fmu,
-    campbell,
-    diagnose,
-    fit,
-    fit_extended,
-    load_model,
-    psd,
-    read,
-    save_model,
-    simulate_sweep,
-    simulate_test,
-    write_nastran,
-)
-from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistError, RwadistWarning
+#: The public names and the module each lives in, imported on first use (PEP 562): ``import rwadist`` loads no
+#: numpy or scipy, so the command's first instruction (:mod:`rwadist.__main__`) runs before them and a Ctrl-C
+#: during those imports is one line, not a traceback.
+_LAZY = {**dict.fromkeys(("WheelModel", "build_fmu", "campbell", "diagnose", "fit", "fit_extended", "load_model",
+                          "psd", "read", "save_model", "simulate_sweep", "simulate_test", "write_nastran"), "api"),
+         **dict.fromkeys(("DataError", "MissingDependencyError", "ModelError", "ParameterError", "RwadistError",
+                          "RwadistWarning"), "errors")}
+
+if _TYPE_CHECKING:
+    from .api import (
+        WheelModel,
+        build_fmu,
+        campbell,
+        diagnose,
+        fit,
+        fit_extended,
+        load_model,
+        psd,
+        read,
+        save_model,
+        simulate_sweep,
+        simulate_test,
+        write_nastran,
+    )
+    from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistError, RwadistWarning
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'rwadist' has no attribute {name!r}")
+    value = getattr(_importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value         # once: later reads find it without this function
+    return value
+
+
+def __dir__() -> list:
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __version__ = "0.1.0"
 

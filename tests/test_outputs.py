@@ -12,7 +12,7 @@ import pytest
 
 from rwadist.cli import main
 from rwadist.data import DataError
-from rwadist.outputs import atomic_dir, atomic_file, refuse_input_overwrite
+from rwadist.outputs import MANIFEST, atomic_dir, atomic_file, refuse_input_overwrite
 
 
 def run(capsys, *argv):
@@ -47,7 +47,8 @@ def test_atomic_dir_swaps_the_whole_folder(tmp_path):
     assert sorted(os.listdir(target)) == ["stale.png"] and os.listdir(tmp_path) == ["report"]
     with atomic_dir(target) as tmp:
         (tmp / "summary.md").write_text("new")
-    assert sorted(os.listdir(target)) == ["summary.md"] and os.listdir(tmp_path) == ["report"]
+    # the folder's record of what rwadist wrote (outputs.MANIFEST) beside the new file
+    assert sorted(os.listdir(target)) == [MANIFEST, "summary.md"] and os.listdir(tmp_path) == ["report"]
 
 
 def test_refuse_input_overwrite(tmp_path, monkeypatch):

@@ -98,10 +98,11 @@ ASSUMED_MODES_NOTE = ("the suspension modes of {name} are ASSUMED (datasheet whe
                       "for (`assumed_modes`) the wheel runs hard-mounted, as its datasheet states")
 
 
-def write_assumed_note(note_path, names, outputs, wording=str):
+def write_assumed_note(note_path, names, outputs, wording=str, write_to=None):
     """Say on stderr and in ``note_path`` (a text file next to ``outputs``) that the outputs of wheels
     ``names`` rest on assumed (datasheet) suspension modes (:data:`ASSUMED_MODES_NOTE`, passed through
-    ``wording``: the command line names its flags).  Returns the path."""
+    ``wording``: the command line names its flags).  Returns the path.  ``write_to``: the temporary of
+    ``note_path`` in a set of outputs (:func:`rwadist.outputs.output_set`) to write instead, swapped in with the set."""
     import sys
     from pathlib import Path
 
@@ -110,9 +111,13 @@ def write_assumed_note(note_path, names, outputs, wording=str):
     print(note, file=sys.stderr)
     from ..outputs import atomic_file
 
-    note_path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_file(note_path) as tmp:
-        Path(tmp).write_text(note + "\n(this note belongs to " + ", ".join(str(p) for p in outputs) + ")\n")
+    text = note + "\n(this note belongs to " + ", ".join(str(p) for p in outputs) + ")\n"
+    if write_to is not None:
+        Path(write_to).write_text(text)
+    else:
+        note_path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_file(note_path) as tmp:
+            Path(tmp).write_text(text)
     print(f"note written next to the outputs: {note_path}")
     return note_path
 
