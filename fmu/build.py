@@ -140,6 +140,9 @@ def model_document(model) -> dict:
     else:
         from rwadist import model as model_io
         doc, source = model_io.to_json(model), "<model>"
+    from rwadist.model import from_json
+
+    from_json(doc, source)      # the kit's one validation of the model file (keys, sections, physical ranges)
     rt = _runtime()
     params, lines = rt.model_from_doc(doc, source)
     effects = rt.effects_from_doc(doc, source)

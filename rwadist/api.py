@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import model as model_io
 from .api_psd import psd, write_nastran
 from .data import SteadyTest, Sweep
 from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistWarning
@@ -53,8 +54,8 @@ def _choice(parameter: str, value, allowed: tuple):
 
 def _as_model(model) -> WheelModel:
     """A WheelModel from a WheelModel or a model-file path."""
-    if isinstance(model, WheelModel):
-        return model
+    if isinstance(model, WheelModel):       # valid everywhere or nowhere: a model built in code as a file's
+        return model_io.validate(model, f"<model {getattr(model, 'name', '')!r}>")
     if isinstance(model, (str, Path)):
         return load_model(model)
     raise ParameterError("model", f"a {type(model).__name__}: expected a WheelModel or a model-file path")
@@ -329,6 +330,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     result = fit_empirical(spectra, settings, name=name, progress=progress)
     refuse_non_finite_model(result.model, "fit")
     result.model.provenance.update(reading_provenance(getattr(test, "meta", None)))
+    result.model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))
     if text := speed_scale_warning(result, test.meta):
         warnings.warn(RwadistWarning(text.removeprefix("WARNING: ")), stacklevel=2)
     if not any(result.model.empirical.values()):
@@ -408,6 +410,7 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     declare_coupled_modes(efit)          # a mode the stand dragged along, not told apart from it: said
     model = to_model(efit, empirical)
     refuse_non_finite_model(model, "fit")
+    model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))
     return efit, model
 
 
@@ -497,6 +500,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     if reading:
         diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(
             diagnosis.model.provenance.get("diagnose", {}), **reading))
+    diagnosis.model.provenance = dict(diagnosis.model.provenance,
+                                      **model_io.stamp(data if isinstance(data, (str, Path)) else test))
     return diagnosis
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 import math
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -34,7 +35,29 @@ from . import effects as _effects  # noqa: F401  (imports every element: the sch
 from . import schema
 from .data import DataError, read_json
 from .errors import RwadistWarning
-from .schema import Analytical, Effect, Harmonic, ModelError
+from .schema import (
+    _ABSENT,
+    COEFFICIENT,
+    HARMONIC_NUMBER,
+    MAX_COUNT,
+    MAX_FREQ_HZ,
+    MAX_HARMONICS,
+    MAX_LENGTH_M,
+    MAX_RPM,
+    PARAM_MAX,
+    SENSES,
+    STDERR,
+    Analytical,
+    Effect,
+    ModelError,
+    _is_number,
+    _refuse_unknown,
+    choice,
+    integer,
+    number,
+    optional,
+    parse_effects,
+)
 from .units import DIRECTION_C_UNIT, DIRECTION_CHANNELS
 
 SCHEMA = schema.SCHEMA
@@ -43,6 +66,149 @@ DIRECTIONS = tuple(DIRECTION_CHANNELS)
 
 __all__ = ["Analytical", "Effect", "Harmonic", "ModelError", "ModelFileError", "WheelModel", "from_json", "load",
            "line_amplitudes", "model_rms", "save", "to_json"]
+
+
+# --------------------------------------------------------------------------- the document: harmonics, wheel, keys
+
+#: Checks of an empirical harmonic's keys (``excluded_rpm``, a list of [lo, hi] rpm pairs, is checked apart).
+HARMONIC_CHECKS = {"h": HARMONIC_NUMBER, "C": COEFFICIENT, "C_stderr": STDERR,
+                   "n_points": optional(integer(le=MAX_COUNT), 0),
+                   "presence": optional(number(ge=0, le=1)), "sense": optional(choice(SENSES))}
+
+
+@dataclass
+class Harmonic:
+    """One empirical harmonic: amplitude C·Ω² at frequency h·|Ω|.
+
+    h : harmonic number (dimensionless, > 0).  C : SI per (rad/s)² (>= 0; kg·m forces, kg·m² torques).
+    C_stderr : standard error of C (same unit, >= 0), None if unknown.
+    n_points : measurements the fit used (integer >= 0).  presence : fraction (0..1) of possible speeds
+    where the line was detected.  excluded_rpm : speed ranges left out of the fit because a structural
+    mode amplified the line, [[lo, hi], ...] in rpm, lo <= hi.  sense : 'co', 'counter', 'planar' or None.
+    """
+
+    h: float
+    C: float
+    C_stderr: float | None = None
+    n_points: int = 0
+    presence: float | None = None
+    excluded_rpm: list = field(default_factory=list)
+    sense: str | None = None
+
+    def to_json(self) -> dict:
+        # a standard error that could not be computed (NaN) is written null: NaN is no JSON
+        stderr = None if self.C_stderr is None or not math.isfinite(self.C_stderr) else self.C_stderr
+        d = {"h": self.h, "C": self.C, "C_stderr": stderr, "n_points": self.n_points,
+             "presence": self.presence, "excluded_rpm": [list(p) for p in self.excluded_rpm], "sense": self.sense}
+        return {k: v for k, v in d.items() if v is not None}
+
+    @classmethod
+    def from_json(cls, item: Any, source: str, path: str, error: type = ModelError) -> "Harmonic":
+        if not isinstance(item, Mapping):
+            raise error(source, path, f"must be an object, got {type(item).__name__}")
+        _refuse_unknown(item, (*HARMONIC_CHECKS, "excluded_rpm"), source, f"{path}.", error)
+        kw: dict = {}
+        for key, fn in HARMONIC_CHECKS.items():
+            v = fn(item.get(key, _ABSENT), (source, f"{path}.{key}"), error)
+            if key in item:
+                kw[key] = v
+        ex = item.get("excluded_rpm", [])
+        where = f"{path}.excluded_rpm"
+        if not isinstance(ex, list):
+            raise error(source, where, f"must be a list of [lo, hi] rpm pairs, got {ex!r}")
+        for j, pair in enumerate(ex):
+            if not isinstance(pair, (list, tuple)) or len(pair) != 2 or not all(
+                    _is_number(x) and math.isfinite(x) and abs(x) <= MAX_RPM for x in pair) or pair[0] > pair[1]:
+                raise error(source, f"{where}[{j}]", f"must be a pair [lo, hi] of finite speeds in rpm, |speed| <= "
+                            f"{MAX_RPM:g}, with lo <= hi, got {pair!r}")
+        kw["excluded_rpm"] = [list(p) for p in ex]
+        return cls(**kw)
+
+
+#: The keys of a model document (``units`` is a note for readers, written and not read).
+DOCUMENT_KEYS = ("schema", "schema_version", "name", "units", "wheel", "empirical", "analytical", "effects",
+                 "provenance")
+#: The sections a model document must have (a wheel without harmonics has ``"empirical": {}``): a misspelt one
+#: (``"empirial"``) is then an unknown key AND a missing section, never a model read without its harmonics.
+REQUIRED_KEYS = ("schema", "schema_version", "empirical")
+#: The ``wheel`` section: the wheel's datasheet numbers, each checked (a key not listed is an error: free-form notes
+#: belong in ``provenance``).
+WHEEL_CHECKS = {"mass_kg": optional(number(gt=0, le=PARAM_MAX["mass"])),
+                "radius_m": optional(number(gt=0, le=MAX_LENGTH_M)),
+                "max_speed_rpm": optional(number(gt=0, le=MAX_RPM)),
+                "spin_inertia_kg_m2": optional(number(gt=0, le=PARAM_MAX["I_zz"])),
+                "max_momentum_Nms": optional(number(gt=0, le=1e6)),
+                "f_lim_hz": optional(number(gt=0, le=MAX_FREQ_HZ))}
+
+
+def parse_document(doc: Any, source: str = "<model>", error: type = ModelError) -> dict:
+    """The one validation of a model document, shared by every consumer: the header, every key known (or an
+    extension, :data:`EXTENSION_PREFIX`), the required sections present, and every value of every section within
+    its physical range (:data:`MAX_H` ...).  Returns the typed sections: ``name`` (str), ``wheel`` (dict),
+    ``empirical`` ({direction: [Harmonic]}), ``analytical`` (:class:`Analytical` or None), ``effects`` (tuple of
+    :class:`Effect`) and ``provenance`` (dict); ``error(source, field, problem)`` on the first bad one."""
+    check_header(doc, source, error)
+    _refuse_unknown(doc, DOCUMENT_KEYS, source, "", error, extensions=True)
+    for key in REQUIRED_KEYS:
+        if key not in doc:
+            raise error(source, key, "missing: every model file has this section (a wheel without harmonics: "
+                        '"empirical": {})')
+    for key in ("wheel", "provenance", "units"):
+        if doc.get(key) is not None and not isinstance(doc[key], Mapping):
+            raise error(source, key, f"must be an object, got {type(doc[key]).__name__}")
+    name = doc.get("name", "wheel")
+    if not isinstance(name, str):
+        raise error(source, "name", f"must be a string, got {name!r}")
+    wheel = dict(doc.get("wheel") or {})
+    _refuse_unknown(wheel, (*WHEEL_CHECKS, "bearings"), source, "wheel.", error)
+    for key, fn in WHEEL_CHECKS.items():
+        if key in wheel:
+            fn(wheel[key], (source, f"wheel.{key}"), error)
+    from .bearings import BearingError, bearings_of
+
+    try:
+        bearings_of(wheel, source)          # the bearings' geometry (rwadist.bearings)
+    except BearingError as exc:
+        raise error(source, exc.field, exc.problem) from None
+    analytical = doc.get("analytical")
+    return {"name": name, "wheel": wheel, "empirical": parse_empirical(doc["empirical"], source, error),
+            "analytical": None if analytical is None else Analytical.from_json(analytical, source, error),
+            "effects": parse_effects(doc.get("effects"), source, error), "provenance": dict(doc.get("provenance") or {})}
+
+
+def check_header(doc: Any, source: str = "<model>", error: type = ModelError, reader: str = "this rwadist") -> None:
+    """``error`` unless ``doc`` is a JSON object of schema rwadist.model, version :data:`SCHEMA_VERSION`."""
+    if not isinstance(doc, Mapping):
+        raise error(source, "document", "must be a JSON object")
+    if doc.get("schema") != SCHEMA:
+        raise error(source, "schema", f"{doc.get('schema')!r} is not {SCHEMA!r}; not an rwadist model file")
+    version = doc.get("schema_version")
+    if version != SCHEMA_VERSION:
+        raise error(source, "schema_version", f"file has version {version!r}; {reader} reads version "
+                    f"{SCHEMA_VERSION} only")
+
+
+def parse_empirical(emp: Any, source: str = "<model>", error: type = ModelError) -> dict:
+    """{direction: [Harmonic]} of the ``empirical`` section (every direction present, maybe empty)."""
+    if emp is None:
+        emp = {}
+    if not isinstance(emp, Mapping):
+        raise error(source, "empirical", "must be an object keyed by direction")
+    out: dict = {}
+    for d, items in emp.items():
+        if d not in DIRECTIONS:
+            raise error(source, f"empirical.{d}", f"unknown direction; expected one of {list(DIRECTIONS)}")
+        if items is None:
+            items = []
+        if not isinstance(items, list):
+            raise error(source, f"empirical.{d}", f"must be a list of harmonics, got {type(items).__name__}")
+        if len(items) > MAX_HARMONICS:
+            raise error(source, f"empirical.{d}", f"{len(items)} harmonics: at most {MAX_HARMONICS} per direction "
+                        "(a real wheel shows tens)")
+        out[d] = [Harmonic.from_json(item, source, f"empirical.{d}[{i}]", error) for i, item in enumerate(items)]
+    for d in DIRECTIONS:
+        out.setdefault(d, [])
+    return out
 
 
 class ModelFileError(ModelError, DataError):
@@ -119,93 +285,84 @@ def to_json(model: WheelModel) -> dict:
         "wheel": model.wheel,
         "empirical": {d: [h.to_json() for h in model.empirical.get(d, [])] for d in DIRECTIONS},
         "effects": [_json(e) for e in model.effects],
-        "provenance": model.provenance,
+        "provenance": _json_safe(model.provenance),
     }
     if model.analytical is not None:
         doc["analytical"] = _json(model.analytical)
     return doc
 
 
+def _json_safe(x: Any) -> Any:
+    """A copy of a free-form JSON section (``provenance``) with every non-finite number as null (NaN is no JSON)."""
+    if isinstance(x, dict):
+        return {k: _json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_json_safe(v) for v in x]
+    if isinstance(x, (float, np.floating)) and not math.isfinite(x):
+        return None
+    return x
+
+
+def validate(model: WheelModel, source: str = "<model>") -> WheelModel:
+    """``model`` (a :class:`WheelModel` built in code or read from a file) through the one validation of the model
+    file (:func:`rwadist.schema.parse_document`): :class:`ModelFileError` naming ``source`` and the field when a
+    consumer reading its file would refuse it; ``model`` itself otherwise."""
+    from_json(to_json(model), source)
+    return model
+
+
 def save(model: WheelModel, path) -> Path:
+    """Write ``model`` as a model file (valid JSON: no NaN); a model that :func:`from_json` would refuse is refused
+    (:class:`ModelFileError` naming ``path`` and the field), nothing written."""
     path = Path(path)
+    doc = to_json(model)
+    from_json(doc, str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(to_json(model), indent=2) + "\n")
+    path.write_text(json.dumps(doc, indent=2, allow_nan=False) + "\n")
     return path
 
 
+def stamp(data: Any = None) -> dict:
+    """What a model made now records of its making (its ``provenance``): the rwadist version, the date (UTC, ISO
+    8601) and the data it came from (a path, or a description of a test built in memory)."""
+    import datetime
+
+    from .outputs import _version
+    if isinstance(data, (str, Path)):
+        source = str(data)
+    elif data is not None and hasattr(data, "runs"):
+        rpm = [abs(r.speed) * 60.0 / (2.0 * math.pi) for r in data.runs]
+        source = (f"a test built in memory ({len(rpm)} runs, {min(rpm):.0f}-{max(rpm):.0f} rpm)" if rpm
+                  else "a test built in memory")
+    else:
+        source = None
+    out = {"rwadist": _version(), "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
+    return out if source is None else dict(out, data=source)
+
+
 def from_json(doc: dict, source: str = "<model>") -> WheelModel:
-    """The typed, validated model of a parsed model document; :class:`ModelFileError` naming
-    ``source`` and the field (``effects[2].amplitude_ref: missing``) on any bad entry."""
-    err = ModelFileError
-    schema.check_header(doc, source, err)
-    for key in ("wheel", "provenance"):
-        if doc.get(key) is not None and not isinstance(doc[key], dict):
-            raise err(source, key, f"must be an object, got {type(doc[key]).__name__}")
-    for key, value in (doc.get("wheel") or {}).items():
-        if key == "bearings":
-            continue                    # the bearings' geometry, checked below
-        # the wheel's physical numbers (mass_kg, radius_m, max_speed_rpm, ...) feed presets and FMUs
-        if isinstance(value, bool) or (isinstance(value, (int, float)) and not (
-                math.isfinite(value) and value > 0)):
-            raise err(source, f"wheel.{key}", f"{value!r}: must be a finite number > 0")
-    from .bearings import BearingError, bearings_of
-
-    try:
-        bearings_of(doc.get("wheel"), source)
-    except BearingError as exc:
-        raise err(source, exc.field, exc.problem) from None
-    name = doc.get("name", "wheel")
-    if not isinstance(name, str):
-        raise err(source, "name", f"must be a string, got {name!r}")
-    analytical = doc.get("analytical")
-    return WheelModel(name=name, wheel=doc.get("wheel", {}) or {},
-                      empirical=schema.parse_empirical(doc.get("empirical", {}), source, err),
-                      analytical=None if analytical is None else Analytical.from_json(analytical, source, err),
-                      effects=list(schema.parse_effects(doc.get("effects", []), source, err)),
-                      provenance=doc.get("provenance", {}) or {})
-
-
-#: The keys of a model document (``units`` is a note for readers, written and not read).
-DOCUMENT_KEYS = ("schema", "schema_version", "name", "units", "wheel", "empirical", "analytical", "effects",
-                 "provenance")
-#: Keys of the ``analytical`` section besides the parameters (:data:`PARAM_KEYS`): the model's kind, the flags and
-#: the extended fit's own record
-ANALYTICAL_KEYS = ("kind", "modes_assumed", "unconstrained", "fit")
+    """The typed, validated model of a parsed model document (:func:`rwadist.schema.parse_document`, the one
+    validation of every consumer); :class:`ModelFileError` naming ``source`` and the field
+    (``effects[2].amplitude_ref: missing``, ``empirial: unknown key (did you mean 'empirical'?)``) on any bad entry."""
+    parts = parse_document(doc, source, ModelFileError)
+    return WheelModel(name=parts["name"], wheel=parts["wheel"], empirical=parts["empirical"],
+                      analytical=parts["analytical"], effects=list(parts["effects"]), provenance=parts["provenance"])
 
 
 def unread_keys(doc: Any) -> list:
-    """Notes ``(path, what)`` on what of a model document this version does not read (a misspelt key is read as
-    absent: ``"empirial"`` leaves the model without harmonics): keys of the document, of a harmonic and of the
-    ``analytical`` section it does not know, and effect kinds it does not know (kept, as a newer writer's would be,
-    but used by nothing); each with the closest known name.  Keys an effect carries besides its fields (evidence,
-    law texts) are not listed: a writer may add them."""
-    import difflib
-
-    def like(key, known) -> str:
-        close = difflib.get_close_matches(str(key), list(known), n=1, cutoff=0.6)
-        return f" (did you mean {close[0]!r}?)" if close else ""
-
+    """Notes ``(path, what)`` on what of a valid model document no consumer reads: extension keys and effect kinds
+    (:data:`rwadist.schema.EXTENSION_PREFIX`), kept in the file and used by nothing.  (Any other key or kind a
+    version does not know is an error of :func:`from_json`.)"""
     if not isinstance(doc, dict):
         return []
-    out = [(str(k), f"unknown key, not read{like(k, DOCUMENT_KEYS)}") for k in doc if k not in DOCUMENT_KEYS]
-    emp = doc.get("empirical")
-    if isinstance(emp, dict):
-        known_h = (*schema.HARMONIC_CHECKS, "excluded_rpm")
-        for d, items in emp.items():
-            for i, item in enumerate(items if isinstance(items, list) else []):
-                if isinstance(item, dict):
-                    out += [(f"empirical.{d}[{i}].{k}", f"unknown key, not read{like(k, known_h)}")
-                            for k in item if k not in known_h]
-    ana = doc.get("analytical")
-    if isinstance(ana, dict):
-        known_a = (*schema.PARAM_KEYS.values(), *ANALYTICAL_KEYS)
-        out += [(f"analytical.{k}", f"unknown key, not read{like(k, known_a)}") for k in ana if k not in known_a]
+    out = [(str(k), "an extension key: kept in the file, read by no consumer") for k in doc
+           if str(k).startswith(schema.EXTENSION_PREFIX)]
     effects = doc.get("effects")
     for i, e in enumerate(effects if isinstance(effects, list) else []):
         kind = e.get("kind") if isinstance(e, dict) else None
-        if isinstance(kind, str) and kind not in schema.EFFECT_KINDS:
-            out.append((f"effects[{i}].kind", f"{kind!r} is no effect kind this version knows{like(kind, schema.EFFECT_KINDS)}: "
-                        "kept in the file, used by nothing"))
+        if isinstance(kind, str) and kind.startswith(schema.EXTENSION_PREFIX):
+            out.append((f"effects[{i}].kind", f"{kind!r} is an extension's effect kind: kept in the file, used by "
+                        "nothing"))
     return out
 
 

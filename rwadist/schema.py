@@ -60,6 +60,10 @@ PARAM_KEYS = {
 #: Parameters that must be > 0 (the others >= 0, except the signed ``height``).
 POSITIVE_PARAMS = ("mass", "I_zz", "I_rr", "k_r", "k_rock", "k_z")
 NONNEGATIVE_PARAMS = ("c_r", "c_rock", "c_z", "U_s", "U_d")
+#: The largest magnitude of each parameter (SI; a per-unit model's k/M and c/M are far below): a value beyond is a
+#: unit slip or a corrupted file (the ranges of the whole file: "physical ranges" below)
+PARAM_MAX = {"mass": 1e4, "I_zz": 1e4, "I_rr": 1e4, "k_r": 1e13, "c_r": 1e10, "k_rock": 1e13, "c_rock": 1e10,
+             "k_z": 1e13, "c_z": 1e10, "height": 10.0, "U_s": 1.0, "U_d": 1.0}
 
 
 class RwadistError(Exception):
@@ -129,15 +133,18 @@ def number(gt: float | None = None, ge: float | None = None, le: float | None = 
     return run
 
 
-def integer(ge: int = 0) -> Check:
-    """An integer >= ``ge`` (a float with an integral value, as JSON may write it, is refused)."""
+def integer(ge: int = 0, le: int | None = None) -> Check:
+    """An integer >= ``ge`` (and <= ``le``); a float with an integral value, as JSON may write it, is refused."""
+    text = f"an integer >= {ge}" + (f" and <= {le}" if le is not None else "")
+
     def run(v, where, err):
         if v is _ABSENT:
             _fail(where, err, "missing")
-        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < ge:
-            _fail(where, err, f"must be an integer >= {ge}, got {v!r}")
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < ge \
+                or (le is not None and v > le):
+            _fail(where, err, f"must be {text}, got {v!r}")
         return int(v)
-    run.json = {"type": "integer", "minimum": ge}  # type: ignore[attr-defined]
+    run.json = {"type": "integer", "minimum": ge, **({"maximum": le} if le is not None else {})}  # type: ignore[attr-defined]
     return run
 
 
@@ -152,16 +159,17 @@ def optional(inner: Check, default: Any = None) -> Check:
     return run
 
 
-def statistic(ge: float | None = 0.0) -> Check:
-    """A fitted statistic (a standard error, a phase): null or absent -> None, NaN (could not be
-    computed; kept as written) or a finite number >= ``ge``."""
-    inner = number(ge=ge)
+def statistic(ge: float | None = 0.0, le: float | None = None) -> Check:
+    """A fitted statistic (a standard error, a phase): null or absent -> None (unknown, or could not be computed),
+    else a finite number in [``ge``, ``le``].  NaN is refused: it is not JSON (other tools cannot read the file),
+    and null says the same."""
+    inner = number(ge=ge, le=le)
 
     def run(v, where, err):
         if v is _ABSENT or v is None:
             return None
         if _is_number(v) and math.isnan(v):
-            return _plain(v)
+            _fail(where, err, "NaN is not a JSON number: write null for a statistic that could not be computed")
         return inner(v, where, err)
     run.json = {"anyOf": [inner.json, {"type": "null"}]}  # type: ignore[attr-defined]
     run.optional = True  # type: ignore[attr-defined]
@@ -195,8 +203,8 @@ def names(options: tuple) -> Check:
 
 
 def numbers(min_len: int = 0, length: int | None = None, ge: float | None = None,
-            increasing: bool = False) -> Check:
-    """A list of finite numbers -> float array (read-only)."""
+            increasing: bool = False, le: float | None = None, max_len: int | None = None) -> Check:
+    """A list of finite numbers (each in [``ge``, ``le``], at most ``max_len`` of them) -> float array (read-only)."""
     def run(v, where, err):
         if v is _ABSENT:
             _fail(where, err, "missing")
@@ -209,14 +217,19 @@ def numbers(min_len: int = 0, length: int | None = None, ge: float | None = None
             _fail(where, err, f"must have at least {min_len} values, got {a.size}")
         if length is not None and a.size != length:
             _fail(where, err, f"must have {length} values, got {a.size}")
+        if max_len is not None and a.size > max_len:
+            _fail(where, err, f"must have at most {max_len} values, got {a.size}")
         if ge is not None and a.size and a.min() < ge:
             _fail(where, err, f"values must be >= {ge:g}, got {float(a.min())!r}")
+        if le is not None and a.size and a.max() > le:
+            _fail(where, err, f"values must be <= {le:g}, got {float(a.max())!r}")
         if increasing and np.any(np.diff(a) <= 0):
             _fail(where, err, f"must be strictly increasing, got {v!r}")
         a.setflags(write=False)
         return a
-    run.json = {"type": "array", "items": {"type": "number", **({"minimum": ge} if ge is not None else {})},  # type: ignore[attr-defined]
-                **({"minItems": min_len} if min_len else {}),
+    run.json = {"type": "array", "items": {"type": "number", **({"minimum": ge} if ge is not None else {}),  # type: ignore[attr-defined]
+                                           **({"maximum": le} if le is not None else {})},
+                **({"minItems": min_len} if min_len else {}), **({"maxItems": max_len} if max_len else {}),
                 **({"minItems": length, "maxItems": length} if length is not None else {})}
     return run
 
@@ -253,7 +266,8 @@ def _json_value(v: Any) -> Any:
         return [float(x) for x in v]
     if isinstance(v, tuple):
         return [_json_value(x) for x in v]
-    return _plain(v)
+    v = _plain(v)
+    return None if isinstance(v, float) and math.isnan(v) else v    # NaN is no JSON: null (refused where required)
 
 
 # =========================================================================== effects
@@ -375,12 +389,49 @@ class UnknownEffect(Effect):
         return {"kind": self.unknown_kind, **copy.deepcopy(dict(self.extra))}
 
 
+# =========================================================================== physical ranges
+#
+# The widest values a real reaction wheel shows, with a wide margin: a value beyond one is a unit slip, a corrupted
+# file or an overflow, and every consumer (show, psd, campbell, the FMU, diagnose, coupling, the API) refuses it
+# alike, naming the field (docs/formats.md, "Value ranges").  Real wheels: h 0.1-100, C 1e-9-1e-4 kg·m (kg·m²),
+# speeds to ~10 000 rpm, resonances below a few kHz with gains below ~200, amplitude exponents 0-4.
+
+MAX_H = 1000.0                      #: harmonic number h (bearing and motor harmonics reach a few hundred)
+MAX_C = 1.0                         #: C, kg·m (forces) or kg·m² (torques): 1 gives 1e6 N at 1000 rad/s
+MAX_RPM = 100_000.0                 #: wheel speed, rpm (as the command line's speeds)
+MAX_OMEGA_RAD_S = MAX_RPM * 2.0 * math.pi / 60.0
+MAX_FREQ_HZ = 1e6                   #: a frequency of the model (mode, modulation, ripple, knots), Hz
+MAX_EXPONENT = 10.0                 #: amplitude ∝ |Ω|^exponent (C·Ω² is 2; measured laws 0-4)
+MAX_GAIN = 1e4                      #: a resonance's peak gain (Q = 1/2ζ)
+MAX_ZETA = 10.0                     #: a damping ratio
+MAX_DEPTH = 10.0                    #: a sideband's modulation depth (relative to its carrier)
+MAX_AMPLITUDE = 1e6                 #: a line's amplitude, N or N·m
+MAX_PSD = 1e12                      #: a blocked-load PSD, N²/Hz or (N·m)²/Hz
+MAX_LENGTH_M = 10.0                 #: a length (lever arm, height), m
+MAX_ALPHA_RAD_S2 = 1e5              #: a spin acceleration, rad/s²
+MAX_TRANSFER = 1e6                  #: a noise transfer factor
+MAX_COUNT = 10**9                   #: a count of points or runs
+MAX_HARMONICS = 1000                #: harmonics per direction
+MAX_EFFECTS = 1000                  #: entries of ``effects``
+MAX_KNOTS = 100_000                 #: knots of a broadband floor
+
 #: Checks the elements' fields share: a number > 0, a number >= 0, a count (an integer >= 0 or absent), a
-#: standard error (absent, NaN or >= 0).
+#: standard error (absent or >= 0), and the physical ranges (a field names the one it is: h, C, a frequency, ...).
 POSITIVE = number(gt=0)
 NON_NEGATIVE = number(ge=0)
-COUNT = optional(integer(ge=0))
-STDERR = statistic(ge=0.0)
+COUNT = optional(integer(ge=0, le=MAX_COUNT))
+STDERR = statistic(ge=0.0, le=MAX_C)
+HARMONIC_NUMBER = number(gt=0, le=MAX_H)
+COEFFICIENT = number(ge=0, le=MAX_C)
+FREQUENCY = number(gt=0, le=MAX_FREQ_HZ)
+SPEED = number(gt=0, le=MAX_OMEGA_RAD_S)
+SPEED_AMPLITUDE = number(ge=0, le=MAX_OMEGA_RAD_S)
+EXPONENT = number(ge=0, le=MAX_EXPONENT)
+GAIN = number(gt=0, le=MAX_GAIN)
+ZETA = number(ge=0, le=MAX_ZETA)
+DEPTH = number(ge=0, le=MAX_DEPTH)
+AMPLITUDE = number(ge=0, le=MAX_AMPLITUDE)
+LEVER_ARM = numbers(length=3, ge=-MAX_LENGTH_M, le=MAX_LENGTH_M)
 
 
 def parse_effect(doc: Any, source: str = "<model>", path: str = "effects[0]", error: type = ModelError) -> Effect:
@@ -395,10 +446,14 @@ def parse_effect(doc: Any, source: str = "<model>", path: str = "effects[0]", er
     if not isinstance(kind, str):
         raise error(source, f"{path}.kind", f"must be a string, got {kind!r}")
     cls = EFFECT_KINDS.get(kind)
-    if cls is None:
+    if cls is None and kind.startswith(EXTENSION_PREFIX):   # an extension: carried through, applied by no consumer
         out: Effect = UnknownEffect(unknown_kind=kind, extra={k: v for k, v in doc.items() if k != "kind"})
         object.__setattr__(out, "_source_json", _plain_doc(doc))
         return out
+    if cls is None:     # a consumer would leave it out of every prediction, silently
+        raise error(source, f"{path}.kind", f"{kind!r} is no effect kind this version knows{_like(kind, EFFECT_KINDS)}; "
+                    f"its effect would be left out of every prediction (a newer rwadist's file? an extension's kind "
+                    f"starts with {EXTENSION_PREFIX!r})")
     return cls.from_json(doc, source, path, error)
 
 
@@ -410,6 +465,8 @@ def parse_effects(effects: Any, source: str = "<model>", error: type = ModelErro
         return ()
     if not isinstance(effects, (list, tuple)):
         raise error(source, "effects", f"must be a list, got {type(effects).__name__}")
+    if len(effects) > MAX_EFFECTS:
+        raise error(source, "effects", f"{len(effects)} entries: at most {MAX_EFFECTS}")
     out = tuple(parse_effect(e, source, f"effects[{i}]", error) for i, e in enumerate(effects))
     first: dict = {}
     for i, e in enumerate(out):
@@ -426,59 +483,6 @@ def of_kind(effects: Any, cls: type, source: str = "<model>", error: type = Mode
     """The effects of class ``cls`` in ``effects`` (parsed and validated as a whole, see
     :func:`parse_effects`), in file order."""
     return [e for e in parse_effects(effects, source, error) if isinstance(e, cls)]
-
-
-# =========================================================================== empirical harmonics
-
-#: Checks of an empirical harmonic's keys (``excluded_rpm``, a list of [lo, hi] rpm pairs, is checked apart).
-HARMONIC_CHECKS = {"h": POSITIVE, "C": NON_NEGATIVE, "C_stderr": STDERR, "n_points": optional(integer(), 0),
-                   "presence": optional(number(ge=0, le=1)), "sense": optional(choice(SENSES))}
-
-
-@dataclass
-class Harmonic:
-    """One empirical harmonic: amplitude C·Ω² at frequency h·|Ω|.
-
-    h : harmonic number (dimensionless, > 0).  C : SI per (rad/s)² (>= 0; kg·m forces, kg·m² torques).
-    C_stderr : standard error of C (same unit, >= 0), None if unknown.
-    n_points : measurements the fit used (integer >= 0).  presence : fraction (0..1) of possible speeds
-    where the line was detected.  excluded_rpm : speed ranges left out of the fit because a structural
-    mode amplified the line, [[lo, hi], ...] in rpm, lo <= hi.  sense : 'co', 'counter', 'planar' or None.
-    """
-
-    h: float
-    C: float
-    C_stderr: float | None = None
-    n_points: int = 0
-    presence: float | None = None
-    excluded_rpm: list = field(default_factory=list)
-    sense: str | None = None
-
-    def to_json(self) -> dict:
-        d = {"h": self.h, "C": self.C, "C_stderr": self.C_stderr, "n_points": self.n_points,
-             "presence": self.presence, "excluded_rpm": [list(p) for p in self.excluded_rpm], "sense": self.sense}
-        return {k: v for k, v in d.items() if v is not None}
-
-    @classmethod
-    def from_json(cls, item: Any, source: str, path: str, error: type = ModelError) -> "Harmonic":
-        if not isinstance(item, Mapping):
-            raise error(source, path, f"must be an object, got {type(item).__name__}")
-        kw: dict = {}
-        for key, fn in HARMONIC_CHECKS.items():
-            v = fn(item.get(key, _ABSENT), (source, f"{path}.{key}"), error)
-            if key in item:
-                kw[key] = v
-        ex = item.get("excluded_rpm", [])
-        where = f"{path}.excluded_rpm"
-        if not isinstance(ex, list):
-            raise error(source, where, f"must be a list of [lo, hi] rpm pairs, got {ex!r}")
-        for j, pair in enumerate(ex):
-            if not isinstance(pair, (list, tuple)) or len(pair) != 2 or not all(_is_number(x) and math.isfinite(x)
-                                                                              for x in pair) or pair[0] > pair[1]:
-                raise error(source, f"{where}[{j}]", f"must be a pair [lo, hi] of finite speeds in rpm with "
-                            f"lo <= hi, got {pair!r}")
-        kw["excluded_rpm"] = [list(p) for p in ex]
-        return cls(**kw)
 
 
 # =========================================================================== analytical section
@@ -511,6 +515,7 @@ class Analytical(_ReadsAsJson):
         kind = doc.get("kind", ANALYTICAL_KIND)
         if kind != ANALYTICAL_KIND:
             raise error(source, "analytical.kind", f"{kind!r} is not {ANALYTICAL_KIND!r}")
+        _refuse_unknown(doc, (*PARAM_KEYS.values(), *ANALYTICAL_KEYS), source, "analytical.", error)
         params = {}
         for name, key in PARAM_KEYS.items():
             if key not in doc:
@@ -519,6 +524,9 @@ class Analytical(_ReadsAsJson):
             if (name in POSITIVE_PARAMS and not v > 0) or (name in NONNEGATIVE_PARAMS and not v >= 0):
                 raise error(source, "analytical", f"{name} must be {'> 0' if name in POSITIVE_PARAMS else '>= 0'}, "
                             f"got {v!r} ({key})")
+            if abs(v) > PARAM_MAX[name]:
+                raise error(source, f"analytical.{key}", f"{v!r} is beyond any real wheel's (|value| <= "
+                            f"{PARAM_MAX[name]:g} SI): a unit slip?")
             params[name] = v
         assumed = optional(boolean())(doc.get("modes_assumed", _ABSENT), (source, "analytical.modes_assumed"), error)
         unc = doc.get("unconstrained", _ABSENT)
@@ -561,35 +569,29 @@ class Analytical(_ReadsAsJson):
     __hash__ = None  # type: ignore[assignment]
 
 
-# =========================================================================== the document
+# =========================================================================== keys
 
-def check_header(doc: Any, source: str = "<model>", error: type = ModelError, reader: str = "this rwadist") -> None:
-    """``error`` unless ``doc`` is a JSON object of schema rwadist.model, version :data:`SCHEMA_VERSION`."""
-    if not isinstance(doc, Mapping):
-        raise error(source, "document", "must be a JSON object")
-    if doc.get("schema") != SCHEMA:
-        raise error(source, "schema", f"{doc.get('schema')!r} is not {SCHEMA!r}; not an rwadist model file")
-    version = doc.get("schema_version")
-    if version != SCHEMA_VERSION:
-        raise error(source, "schema_version", f"file has version {version!r}; {reader} reads version "
-                    f"{SCHEMA_VERSION} only")
+#: The forward-compatibility rule: a key (top level) or an effect kind starting with this prefix is an extension,
+#: carried through unchanged and read by no consumer; any other key or kind a version does not know is an error.
+#: A change that readers must understand (a new section, a new meaning) raises ``schema_version`` instead.
+EXTENSION_PREFIX = "x-"
+#: Keys of the ``analytical`` section besides the parameters (:data:`PARAM_KEYS`): the model's kind, the flags and
+#: the extended fit's own record (``fit``, free-form)
+ANALYTICAL_KEYS = ("kind", "modes_assumed", "unconstrained", "fit")
 
 
-def parse_empirical(emp: Any, source: str = "<model>", error: type = ModelError) -> dict:
-    """{direction: [Harmonic]} of the ``empirical`` section (every direction present, maybe empty)."""
-    if emp is None:
-        emp = {}
-    if not isinstance(emp, Mapping):
-        raise error(source, "empirical", "must be an object keyed by direction")
-    out: dict = {}
-    for d, items in emp.items():
-        if d not in DIRECTIONS:
-            raise error(source, f"empirical.{d}", f"unknown direction; expected one of {list(DIRECTIONS)}")
-        if items is None:
-            items = []
-        if not isinstance(items, list):
-            raise error(source, f"empirical.{d}", f"must be a list of harmonics, got {type(items).__name__}")
-        out[d] = [Harmonic.from_json(item, source, f"empirical.{d}[{i}]", error) for i, item in enumerate(items)]
-    for d in DIRECTIONS:
-        out.setdefault(d, [])
-    return out
+def _like(key: Any, known) -> str:
+    """`` (did you mean 'x'?)`` for the known name closest to ``key``, or ''."""
+    import difflib
+
+    close = difflib.get_close_matches(str(key), [str(k) for k in known], n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def _refuse_unknown(doc: Mapping, known, source: str, prefix: str, error: type, extensions: bool = False) -> None:
+    """``error`` naming the first key of ``doc`` not in ``known`` (and, with ``extensions``, not an extension)."""
+    for key in doc:
+        if key not in known and not (extensions and str(key).startswith(EXTENSION_PREFIX)):
+            raise error(source, f"{prefix}{key}", f"unknown key{_like(key, known)}; this version reads "
+                        f"{', '.join(known)}" + (f" (an extension's key starts with {EXTENSION_PREFIX!r})"
+                                                 if extensions else ""))

@@ -39,7 +39,9 @@ def effect_schema(cls: type) -> dict:
 
 def json_schema() -> dict:
     """The model file's JSON Schema (a dict)."""
-    harmonic = _object(schema.HARMONIC_CHECKS, ["h", "C"])
+    from .model import HARMONIC_CHECKS
+
+    harmonic = _object(HARMONIC_CHECKS, ["h", "C"])
     harmonic["properties"]["excluded_rpm"] = {"type": "array", "items": {
         "type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}}
     params = {key: ({"type": "number", "exclusiveMinimum": 0} if name in schema.POSITIVE_PARAMS

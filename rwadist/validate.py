@@ -90,6 +90,10 @@ def check_number(value, parameter: str, lo=None, hi=None, *, lo_open: bool = Fal
 def check_parameter(name: str, value):
     """``value`` of the API parameter ``name`` checked against :data:`LIMITS` (None, a default left to the
     function, passes as None); :class:`ParameterError` naming ``name`` otherwise."""
+    if isinstance(value, (str, bytes)):     # the API takes numbers ('3' passed check_number, then broke a sum)
+        lim = LIMITS[name]
+        allowed = _range_text(lim.get("lo"), lim.get("hi"), lim.get("lo_open", False), lim.get("hi_open", False))
+        raise ParameterError(name, f"{value!r}: a string; must be a number in {allowed}")
     return None if value is None else check_number(value, name, **LIMITS[name])
 
 
@@ -136,6 +140,9 @@ def warn_unconstrained(model, source, use) -> None:
 
 def check_speeds_rpm(speeds, parameter: str) -> np.ndarray:
     """A speed list (rpm) checked: non-empty, finite, |speed| <= MAX_RPM, at most MAX_SPEEDS entries."""
+    items = np.asarray(speeds, dtype=object).ravel() if not isinstance(speeds, np.ndarray) else speeds.ravel()
+    if isinstance(speeds, (str, bytes)) or any(isinstance(x, (str, bytes, bool, np.bool_)) for x in items):
+        raise ParameterError(parameter, f"{speeds!r}: not a list of numbers (rpm)")
     try:
         s = np.asarray(speeds, dtype=float).ravel()
     except (TypeError, ValueError):

@@ -291,8 +291,11 @@ def test_floor_resolution_and_effect_rules():
         runtime(doc, floor_resolution=1e-4)
     huge = doc_with([dict(FLOOR, f_Hz=[5.0, 2.0e9], psd_ref=[1e-6, 1e-6])])
     t0 = time.perf_counter()
-    with pytest.raises(rt.ModelError, match="coarser floor_resolution"):
+    with pytest.raises(rt.ModelError, match=r"f_Hz: values must be <= 1e\+06"):    # beyond the schema's range
         runtime(huge)
+    wide = doc_with([dict(FLOOR, f_Hz=[5.0, 9.0e5], psd_ref=[1e-6, 1e-6])])       # within it, still too many
+    with pytest.raises(rt.ModelError, match="coarser floor_resolution"):
+        runtime(wide, floor_resolution=1e-3)
     assert time.perf_counter() - t0 < 1.0
     with pytest.raises(rt.ModelError, match="finer floor_resolution"):
         runtime(doc_with([dict(FLOOR, f_Hz=[10.01, 10.05], psd_ref=[1e-6, 1e-6])]))

@@ -14,8 +14,8 @@ def _model():
     m.empirical["radial_force"] = [Harmonic(1.0, 3.79e-6, 1e-9, 200, 1.0, [[1600.0, 2200.0]]),
                                    Harmonic(2.0, 7.6e-7, None, 0, None, [])]
     m.empirical["axial_force"] = [Harmonic(1.98, 2.57e-6)]
-    m.analytical = {"k_r": 2.17e7}
-    m.effects = [{"kind": "free_exponent", "h": 2.0}]
+    m.analytical = {"k_r_N_per_m": 2.17e7}
+    m.effects = [{"kind": "x-free_exponent", "h": 2.0}]          # an extension's kind: carried through
     return m
 
 

@@ -20,25 +20,43 @@ from rwadist.presets import preset
 from rwadist.teststand import simulate_steady
 
 
-def test_misspelt_model_keys_are_named_with_the_likely_key(tmp_path, capsys):
+def test_misspelt_model_keys_are_refused_with_the_likely_key(tmp_path, capsys):
+    """A misspelt key was read as absent ('empirial': a model without harmonics, `psd` and `fmu build` exit 0 with an
+    imbalance-only PSD and an FMU without harmonics), first silently, then with a warning: now each is an error naming
+    the key and the one it most likely meant (issue 36), in every consumer alike."""
     m = preset("ithaco-e").to_model()
     good = model_io.save(m, tmp_path / "good.json")
     assert main(["model", "show", str(good)]) == 0
     assert "warning" not in capsys.readouterr().err            # a file rwadist wrote: nothing unread
-    doc = json.loads(good.read_text())
-    doc["empirial"] = doc.pop("empirical")
-    doc["analytical"]["k_r_N_per_mm"] = doc["analytical"].pop("k_r_N_per_m")
-    doc["effects"] = [{"kind": "fixed_resonence", "f_Hz": 150.0}]
-    doc["wheel"]["mass_kg"] = 10.6
-    bad = tmp_path / "bad.json"
-    bad.write_text(json.dumps(doc))
-    with pytest.warns(model_io.ModelKeyWarning):
-        model_io.load(bad)
-    main(["model", "show", str(bad)])
-    err = capsys.readouterr().err.splitlines()
-    assert f"rwadist: warning: {bad}: empirial: unknown key, not read (did you mean 'empirical'?)" in err
-    assert any("analytical.k_r_N_per_mm" in ln and "'k_r_N_per_m'" in ln for ln in err)
-    assert any("effects[0].kind" in ln and "'fixed_resonance'" in ln for ln in err)
+    base = json.loads(good.read_text())
+    cases = {"empirial": ("empirial", "'empirical'"),
+             "k_r": ("analytical.k_r_N_per_mm", "'k_r_N_per_m'"),
+             "kind": ("effects[0].kind", "'fixed_resonance'"),
+             "C": ("empirical.radial_force[0].C_stdev", "'C_stderr'"),
+             "wheel": ("wheel.max_sped_rpm", "'max_speed_rpm'")}
+    for what, (field, likely) in cases.items():
+        doc = json.loads(json.dumps(base))
+        if what == "empirial":
+            doc["empirial"] = doc.pop("empirical")
+        elif what == "k_r":
+            doc["analytical"]["k_r_N_per_mm"] = doc["analytical"].pop("k_r_N_per_m")
+        elif what == "kind":
+            doc["effects"] = [{"kind": "fixed_resonence", "f_Hz": 150.0}]
+        elif what == "C":
+            doc["empirical"]["radial_force"][0]["C_stdev"] = 1e-8
+        else:
+            doc["wheel"]["max_sped_rpm"] = 3000.0
+        bad = tmp_path / f"bad_{what}.json"
+        bad.write_text(json.dumps(doc))
+        with pytest.raises(model_io.ModelFileError, match=re.escape(f"{field}: ")):
+            model_io.load(bad)
+        for argv in (["model", "show", str(bad)],
+                     ["psd", str(bad), "--speed-rpm", "600:2400", "--empirical", "--n-freq", "201", "-o",
+                      str(tmp_path / "p.csv")]):
+            assert main(argv) == 2
+            err = capsys.readouterr().err.strip().splitlines()[-1]
+            assert f"{bad}: {field}: " in err and likely in err, err
+        assert not (tmp_path / "p.csv").exists()
 
 
 @pytest.fixture(scope="module")

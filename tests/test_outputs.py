@@ -84,7 +84,9 @@ def test_output_equal_to_input_is_refused_and_untouched(tmp_path, capsys, monkey
     assert sorted(os.listdir(tmp_path)) == ["ds"]     # nothing else written, no temporary left
 
 
-def test_psd_refuses_non_finite_results(tmp_path, capsys):
+def test_psd_refuses_a_coefficient_that_overflows(tmp_path, capsys):
+    """C = 1e300 gave non-finite PSD values (refused after the work); the model file's physical ranges now refuse it
+    on reading, naming the field (issue 36)."""
     import json
 
     from rwadist import catalogue
@@ -98,7 +100,7 @@ def test_psd_refuses_non_finite_results(tmp_path, capsys):
     out = tmp_path / "psd.csv"
     code, _, err = run(capsys, "psd", path, "--speed-rpm", "600:2400", "--empirical", "--n-freq", "501",
                        "--n-speeds", "50", "-o", out)
-    assert code == 2 and "non-finite" in err and not out.exists(), err
+    assert code == 2 and "empirical.radial_force[0].C" in err and "<= 1" in err and not out.exists(), err
 
 
 _SLOW_WRITER = textwrap.dedent("""

@@ -59,7 +59,7 @@ def test_effects_round_trip_typed_and_equal_to_their_json(tmp_path):
     ok_law = dict(LAW, amplitude_ref=0.01, h=2)                   # an int h stays an int in the file
     rip = {"kind": "speed_ripple", "f_ripple_Hz": 4.0, "delta_omega_rad_s": 0.5, "omega_ref_rad_s": 200.0,
            "law": "text kept"}
-    other = {"kind": "suspension_modes_from_the_future", "x": [1, 2]}
+    other = {"kind": "x-suspension_modes_from_the_future", "x": [1, 2]}     # an extension: carried, unused
     p, doc = write(tmp_path, [ok_law, dict(FLOOR, psd_ref=[1e-6, 2e-6]), rip, other])
     m = model_io.load(p)
     law, floor, ripple, unknown = m.effects

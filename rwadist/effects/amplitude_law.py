@@ -7,7 +7,18 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..schema import DIRECTIONS, NON_NEGATIVE, POSITIVE, STDERR, check, choice, register
+from ..schema import (
+    AMPLITUDE,
+    DIRECTIONS,
+    EXPONENT,
+    HARMONIC_NUMBER,
+    MAX_EXPONENT,
+    SPEED,
+    check,
+    choice,
+    register,
+    statistic,
+)
 from .actions import LineLaw
 from .element import Element, num, plus_minus, rpm, words
 
@@ -20,11 +31,11 @@ class AmplitudeLaw(Element):
     KIND: ClassVar[str] = "amplitude_law"
     ORDER: ClassVar[int] = 20
     direction: str = field(metadata=check(choice(DIRECTIONS)))
-    h: float = field(metadata=check(POSITIVE))
-    exponent: float = field(metadata=check(NON_NEGATIVE))
-    exponent_stderr: float | None = field(default=None, metadata=check(STDERR))
-    amplitude_ref: float = field(metadata=check(NON_NEGATIVE))
-    omega_ref_rad_s: float = field(metadata=check(POSITIVE))
+    h: float = field(metadata=check(HARMONIC_NUMBER))
+    exponent: float = field(metadata=check(EXPONENT))
+    exponent_stderr: float | None = field(default=None, metadata=check(statistic(ge=0.0, le=MAX_EXPONENT)))
+    amplitude_ref: float = field(metadata=check(AMPLITUDE))
+    omega_ref_rad_s: float = field(metadata=check(SPEED))
 
     @property
     def law(self) -> tuple:

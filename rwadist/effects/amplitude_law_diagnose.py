@@ -71,8 +71,10 @@ class AmplitudeLaw:
         r = np.log(d) - X @ coef
         s2 = float(r @ r) / max(d.size - 2, 1)
         cov = s2 * np.linalg.inv(X.T @ X)
-        if state.ext is not None and coef[1] < 0:
-            return None         # rwadist.extended.Line takes laws of exponent >= 0 only (extended base)
+        if coef[1] < 0:
+            # a law of exponent < 0 grows without bound as the speed falls to 0 (a psd over a law through zero speed,
+            # an FMU spinning up): the model file takes exponents >= 0 only (rwadist.schema), on either base
+            return None
         return AmplitudeLaw(direction, float(h), float(coef[1]), float(np.exp(coef[0])), w_ref,
                             float(np.sqrt(cov[1, 1])))
 

@@ -7,7 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..schema import CHANNELS, NON_NEGATIVE, POSITIVE, check, names, numbers, register
+from ..schema import CHANNELS, EXPONENT, MAX_FREQ_HZ, MAX_KNOTS, MAX_PSD, SPEED, check, names, numbers, register
 from ..units import CHANNEL_UNIT
 from .actions import NoiseFloor
 from .element import Element, FmuSwitch, num, rpm
@@ -24,10 +24,11 @@ class BroadbandFloor(Element):
                                                 "effects) added to the outputs as random-phase multisines")
     ORDER: ClassVar[int] = 30
     channel: tuple = field(metadata=check(names(CHANNELS)))
-    exponent: float = field(metadata=check(NON_NEGATIVE))
-    omega_ref_rad_s: float = field(metadata=check(POSITIVE))
-    f_Hz: np.ndarray = field(metadata=check(numbers(min_len=2, ge=0.0, increasing=True)))
-    psd_ref: np.ndarray = field(metadata=check(numbers(ge=0.0)))
+    exponent: float = field(metadata=check(EXPONENT))
+    omega_ref_rad_s: float = field(metadata=check(SPEED))
+    f_Hz: np.ndarray = field(metadata=check(numbers(min_len=2, ge=0.0, increasing=True, le=MAX_FREQ_HZ,
+                                                    max_len=MAX_KNOTS)))
+    psd_ref: np.ndarray = field(metadata=check(numbers(ge=0.0, le=MAX_PSD, max_len=MAX_KNOTS)))
 
     def _validate(self, source, path, error):
         if self.psd_ref.size != self.f_Hz.size:

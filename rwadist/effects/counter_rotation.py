@@ -8,7 +8,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..schema import COUNT, POSITIVE, STDERR, check, choice, number, register, statistic
+from ..schema import COUNT, HARMONIC_NUMBER, check, choice, number, register, statistic
 from .element import Element, num, plus_minus, words
 
 
@@ -20,10 +20,10 @@ class CounterRotation(Element):
     KIND: ClassVar[str] = "counter_rotation"
     ORDER: ClassVar[int] = 80
     direction: str = field(metadata=check(choice(("radial_force", "radial_torque"))))
-    h: float = field(metadata=check(POSITIVE))
+    h: float = field(metadata=check(HARMONIC_NUMBER))
     counter_fraction: float = field(metadata=check(number(ge=0, le=1)))
-    counter_fraction_stderr: float | None = field(default=None, metadata=check(STDERR))
-    counter_fraction_phase: float | None = field(default=None, metadata=check(statistic(ge=None)))
+    counter_fraction_stderr: float | None = field(default=None, metadata=check(statistic(ge=0.0, le=1.0)))
+    counter_fraction_phase: float | None = field(default=None, metadata=check(statistic(ge=-4 * math.pi, le=4 * math.pi)))
     n_points: int | None = field(default=None, metadata=check(COUNT))
 
     @classmethod

@@ -7,7 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..schema import COUNT, check, numbers, optional, register
+from ..schema import COUNT, LEVER_ARM, MAX_LENGTH_M, check, numbers, optional, register
 from .element import Element
 
 
@@ -18,8 +18,8 @@ class CrossCoupling(Element):
 
     KIND: ClassVar[str] = "cross_coupling"
     ORDER: ClassVar[int] = 50
-    r_m: np.ndarray = field(metadata=check(numbers(length=3)))
-    r_stderr_m: np.ndarray | None = field(default=None, metadata=check(optional(numbers(length=3, ge=0.0))))
+    r_m: np.ndarray = field(metadata=check(LEVER_ARM))
+    r_stderr_m: np.ndarray | None = field(default=None, metadata=check(optional(numbers(length=3, ge=0.0, le=MAX_LENGTH_M))))
     n_points: int | None = field(default=None, metadata=check(COUNT))
 
     @classmethod

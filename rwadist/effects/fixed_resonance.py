@@ -5,7 +5,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
-from ..schema import COUNT, DIRECTIONS, POSITIVE, check, choice, names, register
+from ..schema import COUNT, DIRECTIONS, FREQUENCY, GAIN, MAX_ZETA, check, choice, names, number, register
 from .actions import LineFilter
 from .element import Element, directions, num
 
@@ -18,9 +18,9 @@ class FixedResonance(Element):
 
     KIND: ClassVar[str] = "fixed_resonance"
     ORDER: ClassVar[int] = 40
-    f_Hz: float = field(metadata=check(POSITIVE))
-    zeta: float = field(metadata=check(POSITIVE))
-    peak_gain: float = field(metadata=check(POSITIVE))
+    f_Hz: float = field(metadata=check(FREQUENCY))
+    zeta: float = field(metadata=check(number(gt=0, le=MAX_ZETA)))
+    peak_gain: float = field(metadata=check(GAIN))
     role: str = field(metadata=check(choice(("wheel_mode", "test_stand"))))
     directions: tuple = field(metadata=check(names(DIRECTIONS)))
     n_points: int | None = field(default=None, metadata=check(COUNT))

@@ -7,7 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..schema import COUNT, NON_NEGATIVE, STDERR, check, numbers, register
+from ..schema import COUNT, LEVER_ARM, MAX_TRANSFER, check, number, register, statistic
 from .element import Element, num, plus_minus
 
 
@@ -20,9 +20,9 @@ class LeverArmNoise(Element):
 
     KIND: ClassVar[str] = "lever_arm_noise"
     ORDER: ClassVar[int] = 55
-    r_m: np.ndarray = field(metadata=check(numbers(length=3)))
-    noise_transfer: float = field(metadata=check(NON_NEGATIVE))
-    noise_transfer_stderr: float | None = field(default=None, metadata=check(STDERR))
+    r_m: np.ndarray = field(metadata=check(LEVER_ARM))
+    noise_transfer: float = field(metadata=check(number(ge=0, le=MAX_TRANSFER)))
+    noise_transfer_stderr: float | None = field(default=None, metadata=check(statistic(ge=0.0, le=MAX_TRANSFER)))
     n_points: int | None = field(default=None, metadata=check(COUNT))
 
     @classmethod

@@ -7,7 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..schema import DIRECTIONS, NON_NEGATIVE, POSITIVE, check, choice, register
+from ..schema import COEFFICIENT, DIRECTIONS, HARMONIC_NUMBER, check, choice, register
 from ..units import DIRECTION_C_UNIT
 from .element import Element, num, words
 
@@ -20,8 +20,8 @@ class MissingHarmonic(Element):
     KIND: ClassVar[str] = "missing_harmonic"
     ORDER: ClassVar[int] = 10
     direction: str = field(metadata=check(choice(DIRECTIONS)))
-    h: float = field(metadata=check(POSITIVE))
-    C: float = field(metadata=check(NON_NEGATIVE))
+    h: float = field(metadata=check(HARMONIC_NUMBER))
+    C: float = field(metadata=check(COEFFICIENT))
 
     @classmethod
     def describe(cls, e: Mapping) -> str:

@@ -7,7 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..schema import COUNT, DIRECTIONS, NON_NEGATIVE, POSITIVE, check, choice, register
+from ..schema import COUNT, DEPTH, DIRECTIONS, FREQUENCY, HARMONIC_NUMBER, check, choice, register
 from .actions import LineModulation
 from .element import Element, num, words
 
@@ -20,9 +20,9 @@ class Sidebands(Element):
     KIND: ClassVar[str] = "sidebands"
     ORDER: ClassVar[int] = 60
     direction: str = field(metadata=check(choice(DIRECTIONS)))
-    h: float = field(metadata=check(POSITIVE))
-    f_mod_Hz: float = field(metadata=check(POSITIVE))
-    depth: float = field(metadata=check(NON_NEGATIVE))
+    h: float = field(metadata=check(HARMONIC_NUMBER))
+    f_mod_Hz: float = field(metadata=check(FREQUENCY))
+    depth: float = field(metadata=check(DEPTH))
     n_points: int | None = field(default=None, metadata=check(COUNT))
 
     def actions(self) -> tuple:

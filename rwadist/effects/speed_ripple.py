@@ -7,7 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..schema import COUNT, NON_NEGATIVE, POSITIVE, check, optional, register
+from ..schema import COUNT, EXPONENT, FREQUENCY, SPEED, SPEED_AMPLITUDE, check, optional, register
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .actions import SpeedModulation
 from .element import Element, FmuSwitch, num, rpm
@@ -24,10 +24,10 @@ class SpeedRipple(Element):
     FMU_SWITCH: ClassVar[FmuSwitch] = FmuSwitch(0, "speed_ripple", "diagnosed wheel-speed ripple (model file effects) "
                                                 "added to wheel_speed; off when wheel_speed is a measured speed that "
                                                 "already carries it")
-    f_ripple_Hz: float = field(metadata=check(POSITIVE))
-    delta_omega_rad_s: float = field(metadata=check(NON_NEGATIVE))
-    omega_ref_rad_s: float = field(metadata=check(POSITIVE))
-    speed_exponent: float = field(default=0.0, metadata=check(optional(NON_NEGATIVE, 0.0)))
+    f_ripple_Hz: float = field(metadata=check(FREQUENCY))
+    delta_omega_rad_s: float = field(metadata=check(SPEED_AMPLITUDE))
+    omega_ref_rad_s: float = field(metadata=check(SPEED))
+    speed_exponent: float = field(default=0.0, metadata=check(optional(EXPONENT, 0.0)))
     n_points: int | None = field(default=None, metadata=check(COUNT))
 
     def actions(self) -> tuple:

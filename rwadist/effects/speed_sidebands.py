@@ -5,7 +5,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from ..schema import COUNT, DIRECTIONS, NON_NEGATIVE, POSITIVE, check, choice, register
+from ..schema import COEFFICIENT, COUNT, DIRECTIONS, HARMONIC_NUMBER, check, choice, register
 from .element import Element, num, words
 
 
@@ -19,11 +19,11 @@ class SpeedSidebands(Element):
     KIND: ClassVar[str] = "speed_sidebands"
     ORDER: ClassVar[int] = 15
     direction: str = field(metadata=check(choice(DIRECTIONS)))
-    h: float = field(metadata=check(POSITIVE))
-    h_lower: float = field(metadata=check(POSITIVE))
-    h_upper: float = field(metadata=check(POSITIVE))
-    C_lower: float = field(metadata=check(NON_NEGATIVE))
-    C_upper: float = field(metadata=check(NON_NEGATIVE))
+    h: float = field(metadata=check(HARMONIC_NUMBER))
+    h_lower: float = field(metadata=check(HARMONIC_NUMBER))
+    h_upper: float = field(metadata=check(HARMONIC_NUMBER))
+    C_lower: float = field(metadata=check(COEFFICIENT))
+    C_upper: float = field(metadata=check(COEFFICIENT))
     n_points: int | None = field(default=None, metadata=check(COUNT))
 
     @classmethod

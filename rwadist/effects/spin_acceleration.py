@@ -5,7 +5,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from ..schema import check, number, register, statistic
+from ..schema import MAX_ALPHA_RAD_S2, check, number, register, statistic
 from .element import Element, num
 
 
@@ -16,8 +16,8 @@ class SpinAcceleration(Element):
 
     KIND: ClassVar[str] = "spin_acceleration"
     ORDER: ClassVar[int] = 90
-    alpha_rad_s2: float = field(metadata=check(number()))
-    alpha_track_rad_s2: float | None = field(default=None, metadata=check(statistic(ge=None)))
+    alpha_rad_s2: float = field(metadata=check(number(ge=-MAX_ALPHA_RAD_S2, le=MAX_ALPHA_RAD_S2)))
+    alpha_track_rad_s2: float | None = field(default=None, metadata=check(statistic(ge=-MAX_ALPHA_RAD_S2, le=MAX_ALPHA_RAD_S2)))
 
     @classmethod
     def describe(cls, e: Mapping) -> str:

@@ -5,17 +5,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from ..schema import (
-    COUNT,
-    NON_NEGATIVE,
-    POSITIVE,
-    UNCONSTRAINED_MODES,
-    boolean,
-    check,
-    names,
-    optional,
-    register,
-)
+from ..schema import COUNT, FREQUENCY, UNCONSTRAINED_MODES, ZETA, boolean, check, names, number, optional, register
 from .element import Element, directions, num
 
 
@@ -28,13 +18,13 @@ class SuspensionModes(Element):
 
     KIND: ClassVar[str] = "suspension_modes"
     ORDER: ClassVar[int] = 100
-    radial_translation_Hz: float = field(metadata=check(POSITIVE))
-    rocking_Hz: float = field(metadata=check(POSITIVE))
-    axial_Hz: float = field(metadata=check(POSITIVE))
-    zeta_radial_translation: float = field(metadata=check(NON_NEGATIVE))
-    zeta_rocking: float = field(metadata=check(NON_NEGATIVE))
-    zeta_axial: float = field(metadata=check(NON_NEGATIVE))
-    inertia_ratio: float = field(metadata=check(POSITIVE))
+    radial_translation_Hz: float = field(metadata=check(FREQUENCY))
+    rocking_Hz: float = field(metadata=check(FREQUENCY))
+    axial_Hz: float = field(metadata=check(FREQUENCY))
+    zeta_radial_translation: float = field(metadata=check(ZETA))
+    zeta_rocking: float = field(metadata=check(ZETA))
+    zeta_axial: float = field(metadata=check(ZETA))
+    inertia_ratio: float = field(metadata=check(number(gt=0, le=2.0)))
     unconstrained: tuple = field(default=(), metadata=check(optional(names(UNCONSTRAINED_MODES), ())))
     per_unit: bool = field(default=True, metadata=check(optional(boolean(), True)))
     n_runs: int | None = field(default=None, metadata=check(COUNT))
