@@ -20,7 +20,7 @@ from unittest import mock
 
 import numpy as np
 
-from rwadist import api, report
+from rwadist import api, report, report_extended
 from rwadist.plot_util import PNG_COMPRESS_LEVEL
 
 
@@ -37,7 +37,7 @@ def baseline_save_png(fig, path, dpi: float):
 
 def write_both(fit, efit, out: Path) -> list:
     files = report.write_report(fit, out)
-    files += report.write_extended_report(efit, fit, out)
+    files += report_extended.write_extended_report(efit, fit, out)
     return files
 
 

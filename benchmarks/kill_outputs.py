@@ -1,16 +1,30 @@
-"""Kill test of the command line's outputs (issue 17): SIGKILL `rwadist fit -o`, `psd -o` and
-`fmu build -o` at random instants (and once at the first write of the output) and check that the
-output path holds the old complete file or a new complete one, never a truncated one.
+"""Kill matrix of the command line's outputs (issues 17, 36): every writing command killed with SIGKILL and with
+SIGINT (Ctrl-C) at random instants -- a quarter of them in the first 0.5 s, a quarter just after its first
+temporary output appears, the rest over the whole run -- each kill starting from an old complete set of outputs
+unlike any new one.  After each kill the command's output SET is classed:
 
-    python benchmarks/kill_outputs.py [--kills 20] [--seed 0]
+- ``old``: every member byte for byte the old one;
+- ``new``: every member present, valid (parsed by its reader) and new;
+- ``partial``: members absent, the rest all old or all new (a SIGKILL inside the few renames of a set's swap);
+- ``MIXED``: old and new members side by side -- a failure;
+- ``BAD``: a member truncated or invalid -- a failure.
 
-Prints per command: kills, how many landed while the output's temporary file existed (the write
-phase), old kept, new complete, truncated/invalid (must be 0).  Baseline before issue 17: the outputs
-were opened with truncate, a kill at the first write left a 0-byte file (2 of 2 tries).
+For SIGINT also: the exit code (130), stderr's last line (one line, "interrupted"), no traceback, no temporary
+left behind; a SIGINT never leaves a partial set (it waits for the swap).  ``pre`` counts the kills that landed
+before rwadist's first instruction (the Python interpreter's own start, ~10-60 ms, more on a loaded machine, which
+no Python program controls: the process dies of the signal, exit -2, or Python prints "Fatal Python error:
+init_import_site" with its traceback, counted apart as ``pre-tb``); their output sets are classed as any other.  Must be 0 MIXED, 0 BAD, 0 tracebacks, every SIGINT exit 130 with one line.
+
+    python benchmarks/kill_outputs.py [--kills 20] [--seed 0] [--only fit --only psd ...]
+
+The command run is the installed ``rwadist`` (the console script a user types).  Baseline before issue 17: a kill at
+the first write left a 0-byte output (2 of 2); before issue 36: the psd set was not swapped as a set (p.csv new beside
+p_cross.csv old after a kill), and 10 of 39 early Ctrl-C printed a KeyboardInterrupt traceback.
 """
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import random
 import shutil
@@ -22,143 +36,269 @@ import time
 import zipfile
 from pathlib import Path
 
-RWADIST = [sys.executable, "-m", "rwadist.cli"]
+
+def _rwadist() -> list:
+    exe = Path(sys.executable).parent / "rwadist"
+    return [str(exe)] if exe.exists() else [shutil.which("rwadist") or "rwadist"]
 
 
-def valid_model(path: Path) -> bool:
-    from rwadist.model import from_json
+# --------------------------------------------------------------------------- validity of one member
+
+def _valid_file(p: Path) -> bool:
     try:
-        from_json(json.loads(path.read_text()), str(path))
+        if p.suffix == ".json":
+            doc = json.loads(p.read_text())
+            if isinstance(doc, dict) and doc.get("schema") == "rwadist.model":
+                from rwadist.model import from_json
+                from_json(doc, str(p))
+            return True
+        if p.suffix == ".csv":
+            rows = list(csv.reader(p.read_text().splitlines()))
+            return len(rows) >= 1 and p.read_text().endswith("\n") and len({len(r) for r in rows[1:]} | {len(rows[0])}) == 1
+        if p.suffix == ".png":
+            from PIL import Image
+            with Image.open(p) as im:
+                im.load()
+            return True
+        if p.suffix in (".h5", ".hdf5"):
+            import h5py
+            with h5py.File(p, "r") as fh:
+                fh.visit(lambda name: None)
+            return True
+        if p.suffix == ".fmu":
+            with zipfile.ZipFile(p) as z:
+                return z.testzip() is None and "modelDescription.xml" in z.namelist()
+        if p.suffix == ".bdf":
+            text = p.read_text()
+            return text.endswith("\n") and text.count("TABRND1") == text.count("ENDT") > 0
+        if p.suffix in (".md", ".txt"):
+            return p.read_text().endswith("\n")
+        return p.stat().st_size > 0
+    except Exception:
+        return False
+
+
+def _snapshot(p: Path):
+    """The bytes of a member: a file's, or {relative path: bytes} of a folder's visible files."""
+    if not p.exists():
+        return None
+    if p.is_dir():
+        return {q.relative_to(p).as_posix(): q.read_bytes() for q in sorted(p.rglob("*")) if q.is_file()}
+    return p.read_bytes()
+
+
+def _valid_member(p: Path) -> bool:
+    if p.is_dir():
+        listed = json.loads((p / ".rwadist-files.json").read_text())["files"] if (p / ".rwadist-files.json").exists() \
+            else None
+        files = sorted(q.relative_to(p).as_posix() for q in p.rglob("*") if q.is_file() and q.name != ".rwadist-files.json")
+        return listed == files and all(_valid_file(p / f) for f in files)
+    return _valid_file(p)
+
+
+def classify(members: list, old: dict) -> str:
+    """The state of an output set after a kill (see the module docstring)."""
+    states = []
+    for m in members:
+        now = _snapshot(m)
+        if now is None:
+            states.append("absent")
+        elif now == old[m]:
+            states.append("old")
+        elif _valid_member(m):
+            states.append("new")
+        else:
+            return "BAD"
+    kinds = set(states)
+    if kinds == {"old"}:
+        return "old"
+    if kinds == {"new"}:
+        return "new"
+    if "old" in kinds and "new" in kinds:
+        return "MIXED"
+    return "partial"
+
+
+# --------------------------------------------------------------------------- the commands
+
+def cases(tmp: Path) -> dict:
+    """name -> (argv of the old run, argv of the killed run, the set's members)."""
+    psd = ["psd", "--preset", "ithaco-e", "--speed-rpm", "600:2400", "--empirical", "--n-speeds", "400"]
+    o = tmp / "out"
+    return {
+        "simulate-test": (["simulate-test", str(o / "sim"), "--preset", "ithaco-e", "--speeds-rpm", "600:2400:600",
+                           "--samples", "2048", "--seed", "1"],
+                          ["simulate-test", str(o / "sim"), "--preset", "ithaco-e", "--speeds-rpm", "600:2400:300",
+                           "--samples", "4096", "--seed", "2"], [o / "sim"]),
+        "fit": (["fit", str(tmp / "ds"), "-o", str(o / "m.json"), "--presence", "0.5"],
+                ["fit", str(tmp / "ds"), "-o", str(o / "m.json")], [o / "m.json", o / "m_report"]),
+        "psd": (psd + ["--n-freq", "2001", "-o", str(o / "p.csv")], psd + ["--n-freq", "8001", "-o", str(o / "p.csv")],
+                [o / "p.csv", o / "p_cross.csv", o / "p_envelope.csv", o / "p.png"]),
+        "psd nastran": (psd + ["--n-freq", "201", "--format", "nastran", "-o", str(o / "d.bdf")],
+                        psd + ["--n-freq", "2001", "--format", "nastran", "-o", str(o / "d.bdf")],
+                        [o / "d.bdf", o / "d_cross.csv", o / "d_envelope.csv", o / "d.png"]),
+        "campbell": (["campbell", "--preset", "ithaco-e", "--speeds-rpm", "0:3000:500", "-o", str(o / "c.csv")],
+                     ["campbell", "--preset", "ithaco-e", "--speeds-rpm", "0:6000:20", "-o", str(o / "c.csv")],
+                     [o / "c.csv", o / "c.png"]),
+        "convert h5": (["convert", str(tmp / "ds_small"), "-o", str(o / "x.h5")],
+                       ["convert", str(tmp / "ds"), "-o", str(o / "x.h5")], [o / "x.h5"]),
+        "convert sweep": (["convert", str(tmp / "sw_small.csv"), "-o", str(o / "s.tdms")],
+                          ["convert", str(tmp / "sw.csv"), "-o", str(o / "s.tdms")],
+                          [o / "s.tdms", o / "s.meta.json"]),
+        "diagnose": (["diagnose", str(tmp / "ds_small"), "-o", str(o / "diag")],
+                     ["diagnose", str(tmp / "ds"), "-o", str(o / "diag")], [o / "diag"]),
+        "fmu build": (["fmu", "build", "--preset", "ithaco-b", "--native", "-o", str(o / "w.fmu")],
+                      ["fmu", "build", "--preset", "ithaco-e", "--native", "-o", str(o / "w.fmu")], [o / "w.fmu"]),
+        "demo": (["demo", "--out", str(o / "demo"), "--n-speeds", "6", "--seed", "1"],
+                 ["demo", "--out", str(o / "demo"), "--n-speeds", "12"],
+                 [o / "demo" / "data.h5", o / "demo" / "model.json", o / "demo" / "report"]),
+    }
+
+
+def _prepare(tmp: Path) -> None:
+    run = lambda *a: subprocess.run(_rwadist() + list(a), cwd=tmp, check=True, capture_output=True)  # noqa: E731
+    run("simulate-test", "ds", "--preset", "ithaco-e", "--speeds-rpm", "600:2400:150", "--samples", "4096")
+    run("simulate-test", "ds_small", "--preset", "ithaco-e", "--speeds-rpm", "600:2400:600", "--samples", "2048")
+    run("simulate-test", "swd", "--preset", "ithaco-e", "--sweep", "--duration", "20", "--sweep-end-rpm", "1200")
+    shutil.copy(tmp / "swd" / "sweep.csv", tmp / "sw.csv")
+    run("simulate-test", "swd2", "--preset", "ithaco-e", "--sweep", "--duration", "5", "--sweep-end-rpm", "900")
+    shutil.copy(tmp / "swd2" / "sweep.csv", tmp / "sw_small.csv")
+
+
+def _rwadist_started(pid: int) -> bool:
+    """True once the process runs rwadist's own code: its entry point (``rwadist.__main__``) catches SIGTERM from its
+    first lines (/proc/PID/status SigCgt); before that the Python interpreter itself is starting."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
         return True
-    except Exception:
-        return False
+    caught = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("SigCgt:")), 16)
+    return bool(caught >> (signal.SIGTERM - 1) & 1)
 
 
-def mark_model(path: Path) -> None:
-    """The old model: the reference fit renamed (still a complete, valid model file)."""
-    doc = json.loads(path.read_text())
-    doc["name"] = "OLD reference"
-    path.write_text(json.dumps(doc, indent=2) + "\n")
+def _temporaries(members: list) -> list:
+    out = []
+    for parent in {m.parent for m in members}:
+        if parent.exists():
+            out += [p for p in parent.iterdir() if ".part-" in p.name or ".old-" in p.name]
+    return out
 
 
-def mark_psd(path: Path) -> None:
-    """The old PSD table: the reference one with a different first value (still complete, 20001 rows)."""
-    lines = path.read_text().splitlines()
-    cells = lines[1].split(",")
-    cells[1] = "1.2345678900e-30"
-    lines[1] = ",".join(cells)
-    path.write_text("\n".join(lines) + "\n")
+def _clean(members: list) -> None:
+    for p in _temporaries(members):
+        shutil.rmtree(p) if p.is_dir() else p.unlink()
 
 
-def valid_psd(path: Path, n_freq: int) -> bool:
-    from rwadist.broadband import read_psd_csv
-    try:
-        f, cols = read_psd_csv(path)
-        return f.size == n_freq and len(cols) == 6
-    except Exception:
-        return False
+def _restore(members: list, saved: Path) -> None:
+    for i, m in enumerate(members):
+        if m.is_dir():
+            shutil.rmtree(m)
+        elif m.exists():
+            m.unlink()
+        src = saved / str(i)
+        if src.is_dir():
+            shutil.copytree(src, m)
+        elif src.exists():
+            m.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, m)
 
 
-def valid_fmu(path: Path) -> bool:
-    try:
-        with zipfile.ZipFile(path) as z:
-            return z.testzip() is None and "modelDescription.xml" in z.namelist()
-    except Exception:
-        return False
-
-
-def run_kills(name, cmd, out: Path, is_valid, kills: int, rng: random.Random, cwd: Path, mark_old=None) -> dict:
-    t0 = time.perf_counter()      # a complete output ("the old file"); when its temporary file appears
-    proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    t_write = None
-    while proc.poll() is None:
-        if t_write is None and out.parent.exists() and any(
-                p.name.startswith(f".{out.stem}.part-") for p in out.parent.iterdir()):
-            t_write = time.perf_counter() - t0
-        time.sleep(0.001)
-    duration = time.perf_counter() - t0
+def run_matrix(name, old_argv, argv, members, kills, rng, tmp: Path) -> dict:
+    t0 = time.perf_counter()
+    subprocess.run(_rwadist() + old_argv, cwd=tmp, check=True, capture_output=True)
+    saved = tmp / f"saved_{name.replace(' ', '_')}"
+    saved.mkdir()
+    for i, m in enumerate(members):
+        if m.is_dir():
+            shutil.copytree(m, saved / str(i))
+        elif m.exists():
+            shutil.copy2(m, saved / str(i))
+    old = {m: _snapshot(m) for m in members}
+    t1 = time.perf_counter()     # the reference run of the killed command: its duration and its first temporary
+    proc = subprocess.run(_rwadist() + argv, cwd=tmp, capture_output=True, text=True)
+    duration = time.perf_counter() - t1
     if proc.returncode != 0:
-        raise SystemExit(f"{name}: the reference run failed (exit {proc.returncode})")
-    t_write = duration if t_write is None else t_write
-    counts = dict(kills=0, during_write=0, old_kept=0, new_complete=0, truncated_or_invalid=0, first_write=None)
-
-    def one(delay=None, at_first_write=False, after_write_starts=0.0):
-        if mark_old is not None:      # each kill starts from an old complete file unlike any new one
-            mark_old(out)
-        before = out.read_bytes()
-        proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        if at_first_write:       # poll for the temporary sibling of the output: its first write
-            deadline = time.perf_counter() + 5 * duration + 30
-            while proc.poll() is None and time.perf_counter() < deadline:
-                if any(p.name.startswith(f".{out.stem}.part-") for p in out.parent.iterdir()):
-                    break
-                time.sleep(0.0002)
-            time.sleep(after_write_starts)
-        else:
-            time.sleep(delay)
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
-        during = any(p.name.startswith(f".{out.stem}.part-") for p in out.parent.iterdir())
-        for p in out.parent.iterdir():      # leftovers of the kill (hidden temporaries)
-            if ".part-" in p.name:
-                shutil.rmtree(p) if p.is_dir() else p.unlink()
-        data = out.read_bytes() if out.exists() else b""
-        if data == before:
-            state = "old_kept"
-        elif is_valid(out):
-            state = "new_complete"
-        else:
-            state = "truncated_or_invalid"
-        return during, state
-
-    for k in range(kills):   # half at random over the whole run, half at random just after the write began
-        if k % 2 == 0:
-            during, state = one(delay=rng.uniform(0.2, 1.05) * duration)
-        else:
-            during, state = one(at_first_write=True, after_write_starts=rng.uniform(0.0, 0.05))
-        counts["kills"] += 1
-        counts["during_write"] += during
-        counts[state] += 1
-    during, state = one(at_first_write=True)
-    counts["first_write"] = f"{state} (temporary file present: {during})"
-    counts["truncated_or_invalid"] += state == "truncated_or_invalid"
+        raise SystemExit(f"{name}: the reference run failed (exit {proc.returncode}): {proc.stderr[-500:]}")
+    counts = {sig: {"old": 0, "new": 0, "partial": 0, "MIXED": 0, "BAD": 0, "traceback": 0, "exit_not_130": 0,
+                    "not_one_line": 0, "temporaries_left": 0, "early": 0, "before_rwadist": 0,
+                    "pre_traceback": 0}
+              for sig in ("SIGKILL", "SIGINT")}
+    for sig_name, sig in (("SIGKILL", signal.SIGKILL), ("SIGINT", signal.SIGINT)):
+        c = counts[sig_name]
+        for k in range(kills):
+            _restore(members, saved)
+            mode = k % 4
+            proc = subprocess.Popen(_rwadist() + argv, cwd=tmp, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                    text=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+            start = time.perf_counter()
+            if mode == 0:                      # the first 0.5 s: imports, checks, the first reads
+                time.sleep(rng.uniform(0.0, 0.5))
+                c["early"] += 1
+            elif mode == 1:                    # just after the first temporary appears: the write and the swap
+                deadline = start + 3 * duration + 30
+                while proc.poll() is None and time.perf_counter() < deadline and not _temporaries(members):
+                    time.sleep(0.0005)
+                time.sleep(rng.uniform(0.0, 0.02))
+            else:
+                time.sleep(rng.uniform(0.0, 1.1) * duration)
+            pre = not _rwadist_started(proc.pid)      # Python's own start: before rwadist's first instruction
+            proc.send_signal(sig)
+            _, err = proc.communicate(timeout=600)
+            state = classify(members, old)
+            c[state] += 1
+            if sig == signal.SIGINT and state == "partial":     # Ctrl-C waits for a set's swap: never partial
+                c["MIXED"] += 1
+            printed = "Traceback" in err or "internal error" in err or "Fatal Python error" in err
+            if pre:         # the interpreter's own reaction (no program runs yet): counted apart
+                c["before_rwadist"] += 1
+                c["pre_traceback"] += printed
+                continue
+            c["traceback"] += printed
+            if sig == signal.SIGINT and proc.returncode is not None and proc.returncode != 0:
+                lines = [ln for ln in err.replace("\r", "\n").splitlines() if ln.strip() and "%|" not in ln
+                         and "elapsed" not in ln and not ln.startswith(("WARNING", "note", "rwadist: warning"))]
+                c["exit_not_130"] += proc.returncode not in (130, -signal.SIGINT)
+                # -SIGINT: killed before Python itself ran (the interpreter's start), nothing printed
+                if proc.returncode == 130 and (len(lines) != 1 or "interrupted" not in lines[0]):
+                    c["not_one_line"] += 1
+                if _temporaries(members):
+                    c["temporaries_left"] += 1
+            _clean(members)
     counts["run_s"] = round(duration, 1)
-    counts["write_s"] = round(duration - t_write, 2)
+    counts["prep_s"] = round(t1 - t0, 1)
     return counts
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--kills", type=int, default=20)
+    ap.add_argument("--kills", type=int, default=20, help="kills per signal and command (default 20)")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--only", choices=("fit", "psd", "fmu"), action="append")
+    ap.add_argument("--only", action="append", help="a command of the matrix (repeatable)")
     a = ap.parse_args(argv)
     rng = random.Random(a.seed)
+    bad = 0
     with tempfile.TemporaryDirectory(prefix="rwadist_kill_") as tmp:
         tmp = Path(tmp)
-        subprocess.run(RWADIST + ["simulate-test", "ds", "--preset", "ithaco-e", "--speeds-rpm", "600:2400:600",
-                                  "--samples", "4096"], cwd=tmp, check=True, capture_output=True)
-        cases = {
-            "fit -o": (RWADIST + ["fit", "ds", "-o", "out/m.json"], tmp / "out" / "m.json", valid_model,
-                       mark_model),
-            "psd -o": (RWADIST + ["psd", "--preset", "ithaco-e", "--speed-rpm", "600:2400", "--empirical",
-                                  "--n-freq", "20001", "-o", "out/psd.csv"], tmp / "out" / "psd.csv",
-                       lambda p: valid_psd(p, 20001), mark_psd),
-            "fmu build -o": (RWADIST + ["fmu", "build", "--preset", "ithaco-e", "--native", "-o", "out/w.fmu"],
-                             tmp / "out" / "w.fmu", valid_fmu, None),     # each build has its own GUID
-        }
-        keys = {"fit": "fit -o", "psd": "psd -o", "fmu": "fmu build -o"}
-        chosen = [keys[k] for k in a.only] if a.only else list(cases)
-        bad = 0
+        _prepare(tmp)
+        table = cases(tmp)
+        chosen = a.only or list(table)
+        print(f"{'command':<14} {'signal':<8} {'kills':>5} {'<0.5s':>5} {'pre':>3} {'pre-tb':>6} {'old':>4} {'new':>4} "
+              f"{'partial':>7} {'MIXED':>5} {'BAD':>4} {'tb':>3} {'!130':>4} {'!1line':>6} {'temps':>5}  run s")
         for name in chosen:
-            cmd, out, check, mark = cases[name]
-            c = run_kills(name, cmd, out, check, a.kills, rng, tmp, mark)
-            bad += c["truncated_or_invalid"]
-            print(f"{name:<13} {c['kills']} random kills (run {c['run_s']} s, write phase {c['write_s']} s): {c['during_write']} during the write, "
-                  f"old kept {c['old_kept']}, new complete {c['new_complete']}, truncated/invalid "
-                  f"{c['truncated_or_invalid']}; kill at the first write: {c['first_write']}", flush=True)
-    print(f"baseline (before issue 17): a kill at the first write left a 0-byte output (2 of 2); now: "
-          f"{bad} truncated or invalid outputs")
+            old_argv, argv_, members = table[name]
+            c = run_matrix(name, old_argv, argv_, members, a.kills, rng, tmp)
+            for sig in ("SIGKILL", "SIGINT"):
+                r = c[sig]
+                fail = r["MIXED"] + r["BAD"] + r["traceback"] + r["exit_not_130"] + r["not_one_line"] + \
+                    r["temporaries_left"]
+                bad += fail
+                print(f"{name:<14} {sig:<8} {a.kills:>5} {r['early']:>5} {r['before_rwadist']:>3} "
+                      f"{r['pre_traceback']:>6} {r['old']:>4} "
+                      f"{r['new']:>4} {r['partial']:>7} "
+                      f"{r['MIXED']:>5} {r['BAD']:>4} {r['traceback']:>3} {r['exit_not_130']:>4} "
+                      f"{r['not_one_line']:>6} {r['temporaries_left']:>5}  {c['run_s']}", flush=True)
+    print(f"failures (MIXED + BAD + tracebacks + SIGINT not 130 / not one line / temporaries left): {bad}; baseline "
+          "(before issue 36): psd sets mixed after a kill, 10 of 39 early Ctrl-C with a traceback")
     return 1 if bad else 0
 
 

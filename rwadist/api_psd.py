@@ -51,6 +51,7 @@ def _wheel_set(wheels, default, law, empirical: bool, assumed_modes: bool, fmax,
     """The spacecraft-frame CSD of a set of wheels (:func:`rwadist.mounting.load_wheels`; ``meta`` names those whose
     assumed modes were run hard-mounted or used), its line sources and its speed support (rad/s)."""
     from .mounting import load_wheels, spacecraft_csd
+    from .speed_laws import law_text
 
     ws = load_wheels(wheels, (lambda: default.lines) if default is not None else None, law, empirical,
                      assumed_modes=assumed_modes)
@@ -61,6 +62,8 @@ def _wheel_set(wheels, default, law, empirical: bool, assumed_modes: bool, fmax,
     res.meta["on_assumed_modes"] = [f"{w.name} ({w.model_ref})" for w in ws
                                     if w.meta.get("modes_assumed") == "assumed modes used"]
     support = (min(w.law.support[0] for w in ws if w.law), max(w.law.support[1] for w in ws if w.law))
+    res.meta["speed_laws"] = [(w.name, law_text(w.law) if w.law is not None else
+                               f"tied to {ws[w.tie.to].name} ×{w.tie.ratio:g}") for w in ws]
     return res, [(w.lines, w.mounting) for w in ws], support
 
 
@@ -107,7 +110,8 @@ def psd(model=None, speed_rpm=(0.0, 3000.0), *, preset: str | None = None, wheel
         N²/Hz, N·N·m/Hz and (N·m)²/Hz of Fx, Fy, Fz, Tx, Ty, Tz; ``.rms()`` (6,) in N and N·m; ``.frame``
         "wheel" or "spacecraft".  ``meta``: ``model`` ("empirical" or "extended"), ``source`` (the one wheel's
         or the default wheel's name, modes_assumed, hard_mounted; or None), ``hard_mounted_wheels`` and
-        ``on_assumed_modes`` (names), ``speed_rpm``, ``fmax_hz``.
+        ``on_assumed_modes`` (names), ``speed_rpm``, ``fmax_hz``, ``speed_laws`` ([(wheel name or None, the
+        law in words)]: each wheel's own law, or its tie).
 
     Raises
     ------
@@ -133,7 +137,10 @@ def psd(model=None, speed_rpm=(0.0, 3000.0), *, preset: str | None = None, wheel
             "on_assumed_modes": [source.name] if source is not None and source.on_assumed_modes else [],
             "hard_mounted_wheels": []}
     if wheels is None:
+        from .speed_laws import law_text
+
         res, sources, support = _one_wheel(source, law, fmax, n_freq, n_speeds, progress)
+        res.meta["speed_laws"] = [(None, law_text(law))]
     else:
         res, sources, support = _wheel_set(wheels, source, law, empirical, assumed_modes, fmax, n_freq, n_speeds,
                                            progress)
@@ -172,7 +179,7 @@ def _default_source(model, preset, empirical: bool, assumed_modes: bool, lo_rpm:
     return source
 
 
-def write_nastran(result, path, *, fields: str = "small", cross: bool = False) -> dict:
+def write_nastran(result, path, *, fields: str = "small", cross: bool = True) -> dict:
     """Write a PSD's RANDPS/TABRND1 bulk-data entries (NASTRAN random analysis), atomically, to ``path``.
 
     Parameters
@@ -184,7 +191,8 @@ def write_nastran(result, path, *, fields: str = "small", cross: bool = False) -
     fields : {"small", "free"}
         Small (8-character) or free field format.
     cross : bool
-        Also the cross-spectra (real and imaginary RANDPS entries), not only the auto-spectra.
+        The cross-spectra too (real and imaginary RANDPS entries): the full 6×6 matrix (default).  False: the
+        auto-spectra only, and the deck's header names each pair left out with the largest coherence it carries.
 
     Returns
     -------

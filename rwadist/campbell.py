@@ -129,8 +129,8 @@ def plot_campbell(params: ext.ExtendedParams, speeds_rpm, lines=None):
     ax.set_xlim(grid.min(), grid.max())
     ax.set_xlabel("wheel speed (rpm)")
     ax.set_ylabel("frequency (Hz)")
-    ax.set_title("Campbell diagram: modes (coloured) and harmonic lines h×speed (grey, labelled h×);\n"
-                 "filled marker: the crossing can excite the mode", fontsize=10)
+    ax.set_title(f"Campbell diagram, 0–{fmax:.0f} Hz, {grid.min():g}–{grid.max():g} rpm: modes (coloured) and harmonic "
+                 "lines h×speed (grey, labelled h×);\nfilled marker: the crossing can excite the mode", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import json
 import os
 import sys
@@ -21,15 +22,17 @@ from .data import DataError
 from .errors import ParameterError, RwadistError
 from .outputs import (
     atomic_dataset_dir,
-    atomic_dir,
-    atomic_file,
     check_dataset_dir,
     check_output_dir,
     check_output_file,
+    exit_on_interrupt,
+    interrupt_message,
+    output_set,
     refuse_input_overwrite,
+    refuse_special_base,
 )
 from .outputs import write_file as _write
-from .plot_util import save_png
+from .plot_util import psd_title, save_png
 from .progress import working
 from .units import RAD_S_TO_RPM
 from .validate import check_grid_size, check_speeds_rpm, check_within_test
@@ -139,6 +142,9 @@ def cmd_fit(args) -> int:
     if args.no_report:
         report_dir = None
     else:
+        if not args.report:
+            refuse_special_base(args.output, "-o", f"its report folder {report_dir.name}",
+                                "give --report DIR or --no-report")
         check_output_dir(report_dir, "--report")
     check_fit_flags(args)
     if args.extended:
@@ -157,17 +163,22 @@ def cmd_fit(args) -> int:
         efit, model = run_extended_fit(test, fit, args)
     cum = parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm") if args.cumulative_rpm else None
     files = []
-    if report_dir is not None:
-        with atomic_dir(report_dir) as tmp_dir:     # the report replaces an old one only when complete
+    with output_set() as outs:      # the model and its report replace the old ones together, once both are complete
+        if report_dir is not None:
+            tmp_dir = outs.folder(report_dir)
             files = write_report(fit, tmp_dir, cumulative_speeds_rpm=cum, progress=True)
             if efit is not None:
-                from .report import write_extended_report
+                from .report_extended import write_extended_report
 
                 with working("writing the extended report"):
-                    files += write_extended_report(efit, fit, tmp_dir)
-    _write(args.output, lambda tmp: model_io.save(model, tmp))
+                    files += write_extended_report(efit, fit, tmp_dir, model=model, report_files=files)
+        model_io.save(model, outs.file(args.output))
     n = sum(len(v) for v in fit.model.empirical.values())
-    print(f"fitted {n} harmonics from {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s")
+    idle = fit.model.provenance.get("runs_not_fitted", {}).get("runs", [])
+    print(f"fitted {n} harmonics from {len(test.runs) - len(idle)} runs in {time.perf_counter() - t0:.1f} s")
+    if idle:
+        print(f"note: {len(idle)} run(s) at zero speed not fitted (noise runs): {', '.join(idle[:5])}"
+              f"{' ...' if len(idle) > 5 else ''} (the model's provenance.runs_not_fitted)")
     if efit is not None:
         print(f"extended model: {sum(len(v) for v in model.empirical.values())} forcing lines through the fitted "
               "modes (every line the data show, modally amplified or not)")
@@ -249,6 +260,9 @@ def cmd_demo(args) -> int:
     from .teststand import simulate_steady
 
     out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise DataError("--out", "value", f"{str(out)!r} is a file, not a folder: give a folder for the demo's outputs")
+    check_output_dir(out / "report", "--out")       # its report folder is replaced whole
     wheel = preset("ithaco-e")
     speeds = np.linspace(300.0, 2400.0, args.n_speeds)
     print(f"1/4 virtual test stand: {wheel.name}, {len(speeds)} speeds 300-2400 rpm, 3840 Hz, 8192 samples, "
@@ -258,17 +272,20 @@ def cmd_demo(args) -> int:
                                seed=args.seed)
     from .hdf5 import read_hdf5, write_hdf5
 
-    data_path = _write(out / "data.h5", lambda tmp: write_hdf5(test, tmp, compression="gzip", precision="float32"))
-    print(f"2/4 wrote the test as HDF5: {data_path} ({data_path.stat().st_size / 1e6:.1f} MB; float32 samples, "
-          "gzip; `rwadist convert` writes any other format)")
-    test = read_hdf5(data_path)
-    print("3/4 fitting the empirical model")
-    ns = argparse.Namespace(f_lim=None, nperseg=None, presence=0.25, epsilon=0.02, no_mode_exclusion=False)
-    fit = run_fit(test, ns, name="demo: " + wheel.name)
-    model_path = _write(out / "model.json", lambda tmp: model_io.save(fit.model, tmp))
-    with atomic_dir(out / "report") as tmp_dir:
-        files = write_report(fit, tmp_dir, progress=True)
-    print(f"4/4 model {model_path}, report {out / 'report'} ({len(files)} files)\n")
+    data_path, model_path = out / "data.h5", out / "model.json"
+    with output_set() as outs:      # data, model and report: swapped in together once all are complete
+        data_tmp = outs.file(data_path, "--out")
+        write_hdf5(test, data_tmp, compression="gzip", precision="float32")
+        print(f"2/4 the test as HDF5: {data_path} ({data_tmp.stat().st_size / 1e6:.1f} MB; float32 samples, "
+              "gzip; `rwadist convert` writes any other format)")
+        test = read_hdf5(data_tmp)
+        print("3/4 fitting the empirical model")
+        ns = argparse.Namespace(f_lim=None, nperseg=None, presence=0.25, epsilon=0.02, no_mode_exclusion=False)
+        fit = run_fit(test, ns, name="demo: " + wheel.name)
+        fit.model.provenance["data"] = str(data_path)
+        model_io.save(fit.model, outs.file(model_path, "--out"))
+        files = write_report(fit, outs.folder(out / "report"), progress=True)
+    print(f"4/4 wrote data {data_path}, model {model_path}, report {out / 'report'} ({len(files)} files)\n")
     truth = wheel.to_model()
     print(f"{'direction':<14} {'h fit':>7} {'h true':>7} {'C fit':>11} {'C true':>11} {'err':>7}  excluded rpm")
     for d in model_io.DIRECTIONS:
@@ -326,15 +343,15 @@ def cmd_convert(args) -> int:
     if dst.suffix.lower() != EXTENSION[fmt]:
         raise DataError(dst, "-o", f"a {fmt} sweep file must end in {EXTENSION[fmt]}")
     check_output_file(dst)
-
-    def write_with_meta(tmp):
+    refuse_special_base(dst, "-o", f"its metadata {dst.with_suffix('.meta.json').name}")
+    with output_set() as outs:      # the sweep and its metadata sidecar replace the old pair together
+        tmp = outs.file(dst)
         data_io.write_sweep(obj, tmp, fmt, with_meta=True)
         meta_tmp = tmp.with_suffix(".meta.json")
-        if meta_tmp.exists():   # the sidecar: complete before the data file appears
-            with atomic_file(dst.with_suffix(".meta.json")) as tmp_meta:
-                os.replace(meta_tmp, tmp_meta)
-
-    _write(dst, write_with_meta)
+        if meta_tmp.exists():
+            os.replace(meta_tmp, outs.file(dst.with_suffix(".meta.json")))
+        else:       # an older sidecar would describe another sweep
+            outs.remove(dst.with_suffix(".meta.json"))
     print(f"wrote sweep {dst} ({fmt}, {len(obj.time)} samples)")
     return 0
 
@@ -348,12 +365,14 @@ def cmd_campbell(args) -> int:
 
     out = check_output_file(args.output)
     refuse_input_overwrite([("-o", out, "file"), ("-o", out.with_suffix(".png"), "file")], [args.model])
+    refuse_special_base(out, "-o", f"its plot {out.with_suffix('.png').name}")
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
     table, rows = api.campbell(args.model, speeds, preset=args.preset)
     params, lines, source = api.extended_source(args.model, preset=args.preset)
-    png_path = out.with_suffix(".png")
-    _write(png_path, lambda tmp: save_png(plot_campbell(params, speeds, lines), tmp, dpi=120))
-    csv_path = _write(out, lambda tmp: write_campbell_csv(table, tmp))
+    png_path, csv_path = out.with_suffix(".png"), out
+    with output_set() as outs:      # the table and its plot replace the old pair together
+        save_png(plot_campbell(params, speeds, lines), outs.file(png_path), dpi=120)
+        write_campbell_csv(table, outs.file(csv_path))
     print(f"Campbell table of {source}: {csv_path} ({len(speeds)} speeds), plot: {png_path}")
     print(f"{'h':>6} {'direction':<14} {'sense':<8} {'mode':<19} {'speed_rpm':>10} {'f_Hz':>8}  excites")
     for r in rows:
@@ -395,12 +414,13 @@ def cmd_diagnose(args) -> int:
         raise DataError(args.model or "diagnose", "--base", "extended needs a model with the wheel's suspension "
                         "modes (an analytical section): give one made by `rwadist fit --extended`, or a --preset, "
                         "or leave --base at auto") from None
-    with atomic_dir(args.output) as tmp_dir, working("writing the diagnose report"):
+    with output_set() as outs, working("writing the diagnose report"):
+        tmp_dir = outs.folder(args.output)
         files = [Path(args.output) / Path(f).name for f in write_report(diag, tmp_dir)]
-    if assumed and diag.state_before.base == "extended":
-        from .catalogue import write_assumed_note
-        files.append(write_assumed_note(Path(args.output) / "ASSUMED_MODES.txt", [args.model or args.preset], files,
-                                        with_flags))
+        if assumed and diag.state_before.base == "extended":
+            from .catalogue import write_assumed_note
+            files.append(write_assumed_note(Path(args.output) / "ASSUMED_MODES.txt", [args.model or args.preset],
+                                            files, with_flags, write_to=tmp_dir / "ASSUMED_MODES.txt"))
     base = diag.state_before.base
     if diag.state_after.base != base:
         base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
@@ -451,8 +471,7 @@ def _speed_range_flag(text: str) -> tuple:
 
 
 def _psd_kind(res, args) -> str:
-    """What the PSD rests on, for the console and the plot; notes where assumed modes ran hard-mounted, and the note
-    file next to the outputs where they were used."""
+    """What the PSD rests on, for the console and the plot; notes where assumed modes ran hard-mounted."""
     source = res.meta["source"]
     if source and source["modes_assumed"] and source["hard_mounted"] and not args.empirical:
         print(f"note: {args.model or args.preset}: suspension modes are assumed (datasheet wheel); running it "
@@ -462,41 +481,52 @@ def _psd_kind(res, args) -> str:
               "(datasheet wheels); running them hard-mounted (Melody's model of their lines); --assumed-modes uses "
               "the assumed modes")
     kind = "empirical (Melody)" if res.meta["model"] == "empirical" else "extended (modal amplification)"
-    if res.meta["on_assumed_modes"]:
-        from .catalogue import write_assumed_note
-
-        stem = Path(args.output).with_suffix("")
-        write_assumed_note(stem.parent / (stem.name + "_ASSUMED_MODES.txt"), res.meta["on_assumed_modes"],
-                           [stem.parent / (stem.name + s) for s in (Path(args.output).suffix, "_cross.csv",
-                                                                    "_envelope.csv", ".png")], with_flags)
-        kind += " on ASSUMED modes"
-    return kind
+    return kind + (" on ASSUMED modes" if res.meta["on_assumed_modes"] else "")
 
 
 def _write_psd(res, out: Path, args, title: str) -> tuple:
-    """The PSD's files: the table (CSV or NASTRAN), the cross-spectra, the line envelope, the plot; (envelope, png)."""
+    """The PSD's files, swapped in as ONE set (a kill never leaves a new table beside old cross-spectra): the table
+    (CSV or NASTRAN), the cross-spectra, the line envelope, the plot and, on assumed modes, the note; an older
+    companion this run does not write is removed with the set.  Returns (envelope, png)."""
     from . import broadband as bb
+    from .nastran import left_out_text
 
     stem = out.with_suffix("")
-    if args.format == "nastran":
-        tables = api.write_nastran(res, out, fields=args.nastran_fields, cross=args.nastran_cross)
-        print(f"wrote NASTRAN deck {out} ({len(tables)} TABRND1 tables, {args.nastran_fields} field)")
-    else:
-        _write(out, lambda tmp: bb.write_psd_csv(res, tmp))
-        print(f"wrote PSD table {out}")
-    if args.cross == "csv":
-        p = _write(stem.parent / (stem.name + "_cross.csv"), lambda tmp: bb.write_cross_csv(res, tmp))
-        print(f"cross-spectra: {p}")
-    elif args.cross == "h5":
-        p = _write(stem.parent / (stem.name + "_cross.h5"), lambda tmp: bb.write_hdf5(res, tmp, "csd"))
-        print(f"cross-spectra: {p} (group /csd)")
-    p_env = _write(stem.parent / (stem.name + "_envelope.csv"),
-                   lambda tmp: bb.write_envelope_csv(res.meta["envelope"], tmp))
-    png = stem.parent / (stem.name + ".png")
-    with working("drawing the PSD plot"):
-        figure = bb.plot_psd(res, title)
-        _write(png, lambda tmp: save_png(figure, tmp, dpi=110))
-    return p_env, png
+    sibling = {s: stem.parent / (stem.name + s) for s in ("_cross.csv", "_cross.h5", "_envelope.csv", ".png",
+                                                           "_ASSUMED_MODES.txt")}
+    cross_path = {"csv": sibling["_cross.csv"], "h5": sibling["_cross.h5"]}
+    with output_set() as outs:
+        note = sibling["_ASSUMED_MODES.txt"]
+        if res.meta["on_assumed_modes"]:
+            from .catalogue import write_assumed_note
+
+            write_assumed_note(note, res.meta["on_assumed_modes"], [out, sibling["_cross.csv"],
+                               sibling["_envelope.csv"], sibling[".png"]], with_flags, write_to=outs.file(note))
+        else:
+            outs.remove(note)
+        if args.format == "nastran":
+            auto_only = args.nastran_auto_only
+            tables = api.write_nastran(res, outs.file(out), fields=args.nastran_fields, cross=not auto_only)
+            wrote = (f"wrote NASTRAN deck {out} ({len(tables)} TABRND1 tables, {args.nastran_fields} field, "
+                     + ("AUTO-SPECTRA ONLY: " + left_out_text(res) if auto_only else
+                        "auto- and cross-spectra: the full 6x6") + ")")
+        else:
+            bb.write_psd_csv(res, outs.file(out))
+            wrote = f"wrote PSD table {out}"
+        for fmt, path in cross_path.items():        # one cross-spectra file, or none: an older one is removed
+            if args.cross != fmt:
+                outs.remove(path)
+        if args.cross == "csv":
+            bb.write_cross_csv(res, outs.file(cross_path["csv"]))
+        elif args.cross == "h5":
+            bb.write_hdf5(res, outs.file(cross_path["h5"]), "csd")
+        bb.write_envelope_csv(res.meta["envelope"], outs.file(sibling["_envelope.csv"]))
+        with working("drawing the PSD plot"):
+            save_png(bb.plot_psd(res, title), outs.file(sibling[".png"]), dpi=110)
+    print(wrote)
+    if args.cross in cross_path:
+        print(f"cross-spectra: {cross_path[args.cross]}" + (" (group /csd)" if args.cross == "h5" else ""))
+    return sibling["_envelope.csv"], sibling[".png"]
 
 
 def cmd_psd(args) -> int:
@@ -509,6 +539,7 @@ def cmd_psd(args) -> int:
     check_psd_flags(args)
     lo_rpm, hi_rpm = _speed_range_flag(args.speed_rpm)
     out = check_output_file(args.output)
+    refuse_special_base(out, "-o", "its companions (_envelope.csv, .png)")
     stem = out.with_suffix("")
     written = [out] + [stem.parent / (stem.name + s) for s in ("_cross.csv", "_cross.h5", "_envelope.csv", ".png",
                                                                "_ASSUMED_MODES.txt")]
@@ -519,7 +550,7 @@ def cmd_psd(args) -> int:
                   std_rpm=args.std_rpm, empirical=args.empirical, assumed_modes=args.assumed_modes, fmax=args.fmax,
                   n_freq=args.n_freq, n_speeds=args.n_speeds, envelope=True, progress=True)
     kind = _psd_kind(res, args)
-    p_env, png = _write_psd(res, out, args, f"{kind}, {res.frame} frame, {args.dist} {lo_rpm:g}..{hi_rpm:g} rpm")
+    p_env, png = _write_psd(res, out, args, psd_title(kind, res))
     rms = res.rms()
     print(f"{kind}, {res.frame} frame, {res.f.size} frequencies to {res.meta['fmax_hz']:g} Hz, "
           f"{time.perf_counter() - t0:.1f} s")
@@ -527,8 +558,6 @@ def cmd_psd(args) -> int:
                               for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
     print(f"worst-case line envelope: {p_env}; plots: {png}")
     return 0
-
-
 
 
 # --------------------------------------------------------------------------- main
@@ -667,21 +696,28 @@ def _library_warnings():
 
 
 def main(argv=None) -> int:
-    """Run one command; every failure ends in a one-line message: exit 2 for bad input, 130 on Ctrl-C,
-    3 for an internal error (its traceback goes to a file named in the message, never to the user)."""
+    """Run one command; every failure ends in a one-line message: exit 2 for bad input, 130 on Ctrl-C (at any
+    moment: :func:`rwadist.outputs.exit_on_interrupt`), 3 for an internal error (its traceback goes to a file named in
+    the message, never to the user)."""
+    state = {"command": ""}
+    with exit_on_interrupt(lambda: state["command"]):
+        return _run(argv, state)
+
+
+def _run(argv, state: dict) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
-    except KeyboardInterrupt:
-        print("rwadist: interrupted", file=sys.stderr)
+    except KeyboardInterrupt:       # raised, not signalled (the handler ends the process itself)
+        print(interrupt_message(""), file=sys.stderr)
         return 130
-    command = _command_name(args)
+    command = state["command"] = _command_name(args)
     try:
         check_parsed(parser, args)
         with one_blas_thread(), _library_warnings():
             return args.func(args)
     except KeyboardInterrupt:
-        print(f"rwadist {command}: interrupted; outputs left as they were (no partial file written)", file=sys.stderr)
+        print(interrupt_message(command), file=sys.stderr)
         return 130
     except RwadistError as exc:     # bad input, said by the library: a parameter is named by its flag here
         print(f"rwadist: error: {user_message(exc, command)}", file=sys.stderr)
@@ -695,7 +731,10 @@ def main(argv=None) -> int:
         return 141
     except OSError as exc:
         where = exc.filename if exc.filename is not None else ""
-        print(f"rwadist {command}: error: {where}{': ' if where else ''}{exc.strerror or exc}", file=sys.stderr)
+        why = exc.strerror or str(exc)
+        if exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+            why += "; nothing written (the old outputs are kept): free some space or write elsewhere"
+        print(f"rwadist {command}: error: {where}{': ' if where else ''}{why}", file=sys.stderr)
         return 2
     except Exception as exc:    # last resort: no traceback reaches the user
         log = _write_crash_log(command)

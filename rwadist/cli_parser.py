@@ -92,9 +92,12 @@ def check_psd_flags(args: argparse.Namespace) -> None:
     """``rwadist psd``: flags that the chosen output would ignore are refused, as is an output whose extension
     names the other format (a NASTRAN deck written as x.csv, CSV as x.bdf)."""
     nastran = args.format == "nastran"
-    if not nastran and (args.nastran_cross or args.nastran_fields != "small"):
-        raise DataError("--nastran-cross" if args.nastran_cross else "--nastran-fields", "value",
-                        "applies to --format nastran only")
+    given = [f for f, on in (("--nastran-cross", args.nastran_cross), ("--nastran-auto-only", args.nastran_auto_only),
+                             ("--nastran-fields", args.nastran_fields != "small")) if on]
+    if not nastran and given:
+        raise DataError(given[0], "value", "applies to --format nastran only")
+    if args.nastran_cross and args.nastran_auto_only:
+        raise DataError("--nastran-auto-only", "value", "contradicts --nastran-cross: give one")
     suffix = Path(args.output).suffix.lower()
     if nastran and suffix == ".csv" or not nastran and suffix in (".bdf", ".dat", ".nas", ".blk"):
         raise DataError("-o", "value", f"{args.output!r}: its extension names the other format than --format "
@@ -257,7 +260,11 @@ def build_parser(cli) -> argparse.ArgumentParser:
                         "the outputs then carry a note that they rest on assumed values")
     q.add_argument("--format", choices=("csv", "nastran"), default="csv")
     q.add_argument("--nastran-fields", choices=("small", "free"), default="small")
-    q.add_argument("--nastran-cross", action="store_true", help="also RANDPS/TABRND1 of the cross-spectra")
+    q.add_argument("--nastran-cross", action="store_true",
+                   help="RANDPS/TABRND1 of the cross-spectra too (the default; kept for scripts that give it)")
+    q.add_argument("--nastran-auto-only", action="store_true",
+                   help="leave the cross-spectra out of the deck (auto-spectra only); the console and the deck name "
+                        "the coherence each pair left out carries")
     q.add_argument("--cross", choices=("csv", "h5", "none"), default="csv",
                    help="cross-spectra next to the output: <out>_cross.csv (default) or <out>_cross.h5")
     q.add_argument("-o", "--output", default=None,

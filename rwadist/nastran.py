@@ -7,13 +7,16 @@ channel in the user's deck)::
     RANDPS  SID  J  K  X  Y  TID          S_jk(f) = (X + iY)·G_TID(f)
     TABRND1 TID  LINEAR LINEAR  f1 g1 f2 g2 ... ENDT
 
-Auto-spectra: one RANDPS (J = K, X = 1, Y = 0) per channel.  Cross-spectra (``cross=True``):
-for j < k two entries with the same J, K -- (1, 0) on the table of Re S_jk and (0, 1) on the
-table of Im S_jk -- assuming the solver sums RANDPS entries of one SID and pair (check this
-against your solver's manual; the sign convention of the imaginary part is S_jk = E[X_j X_k*]).
+Auto-spectra: one RANDPS (J = K, X = 1, Y = 0) per channel.  Cross-spectra (``cross=True``, the
+default: the full 6×6 matrix): for j < k two entries with the same J, K -- (1, 0) on the table of
+Re S_jk and (0, 1) on the table of Im S_jk -- assuming the solver sums RANDPS entries of one SID and
+pair (check this against your solver's manual; the sign convention of the imaginary part is
+S_jk = E[X_j X_k*]).  Without them (``cross=False``) the deck says so in its header, with the
+largest coherence |S_jk|²/(S_jj·S_kk) each left-out pair carries (:func:`coherence_left_out`).
 Table IDs: ``tid0 + n`` in the order written.  Formats: 'small' (8-character fixed fields;
 numbers rounded to fit, about 5 significant digits) or 'free' (comma separated, 10 significant
-digits).  Frequencies in Hz, PSDs in N²/Hz, N·N·m/Hz, (N·m)²/Hz.
+digits).  Frequencies in Hz, PSDs in N²/Hz, N·N·m/Hz, (N·m)²/Hz.  The conventions in full (subcases,
+SID, TIDs, the real/imaginary pairs, what the user's deck must hold): docs/nastran.md.
 """
 from __future__ import annotations
 
@@ -99,12 +102,43 @@ def randps(sid: int, j: int, k: int, x: float, y: float, tid: int, fmt: str = "s
     return _card("RANDPS", [int(sid), int(j), int(k), float(x), float(y), int(tid)], fmt)
 
 
-def write_deck(res, path, sid: int = 1, tid0: int = 1000, fmt: str = "small", cross: bool = False,
+def coherence_left_out(res, channels=CHANNELS) -> list:
+    """[(coherence, channel j, channel k, f Hz)] of every pair of live channels (j before k), largest first: the
+    largest ordinary coherence |S_jk|²/(S_jj·S_kk) over frequency (0..1) and where it peaks -- what a deck without
+    cross-spectra leaves out (1: the two channels move together; 0: independent)."""
+    idx = [CHANNELS.index(c) for c in channels]
+    live = [a for a in idx if np.any(res.psd[:, a] > 0)]
+    out = []
+    for i, a in enumerate(live):
+        for b in live[i + 1:]:
+            den = res.psd[:, a] * res.psd[:, b]
+            ok = den > 0
+            if not ok.any():
+                continue
+            coh = np.zeros(res.f.size)
+            coh[ok] = np.abs(res.csd[ok, a, b]) ** 2 / den[ok]
+            k = int(np.argmax(coh))
+            out.append((float(min(coh[k], 1.0)), CHANNELS[a], CHANNELS[b], float(res.f[k])))
+    return sorted(out, reverse=True)
+
+
+def left_out_text(res) -> str:
+    """What a deck without cross-spectra leaves out, for the console: the pairs of largest coherence."""
+    left = [c for c in coherence_left_out(res) if c[0] > 0.0]
+    if not left:
+        return "the channels are uncorrelated, nothing left out"
+    shown = ", ".join(f"{j}-{k} {coh:.2f} at {f:.4g} Hz" for coh, j, k, f in left[:4])
+    return f"cross-spectra left out, largest coherence {shown}{' ...' if len(left) > 4 else ''} (listed in the deck)"
+
+
+def write_deck(res, path, sid: int = 1, tid0: int = 1000, fmt: str = "small", cross: bool = True,
                subcases=None, channels=CHANNELS) -> dict:
     """Write the RANDPS/TABRND1 bulk entries of ``res`` (a :class:`rwadist.broadband.BroadbandPSD`).
 
     Returns {table id: (j_channel, k_channel, 're'|'im'|'auto')} of what was written.  ``channels``
     selects the channels (default all six; channels whose PSD is identically zero are skipped).
+    ``cross``: the cross-spectra too (the full 6×6 matrix, default); without them the deck's header names
+    every pair left out with the largest coherence it carries (:func:`coherence_left_out`).
     """
     if fmt not in ("small", "free"):
         raise ValueError(f"fmt must be 'small' or 'free', got {fmt!r}")
@@ -112,7 +146,15 @@ def write_deck(res, path, sid: int = 1, tid0: int = 1000, fmt: str = "small", cr
     idx = [CHANNELS.index(c) for c in channels]
     lines = [f"$ rwadist broadband disturbance PSD ({res.frame} frame), one-sided, S_jk = E[X_j X_k*]",
              "$ subcases: " + ", ".join(f"{c}={subcases[c]}" for c in channels),
-             "$ units: Hz; N^2/Hz, N*Nm/Hz, Nm^2/Hz"]
+             "$ units: Hz; N^2/Hz, N*Nm/Hz, Nm^2/Hz",
+             f"$ RANDPS SID {sid}; TABRND1 TIDs from {tid0}, LINEAR/LINEAR; conventions: rwadist docs/nastran.md"]
+    if cross:
+        lines.append("$ cross-spectra: included (full 6x6; each pair j<k as Re (X=1,Y=0) and Im (X=0,Y=1) tables)")
+    else:
+        left = [c for c in coherence_left_out(res, channels) if c[0] > 0.0]
+        lines.append("$ CROSS-SPECTRA LEFT OUT (auto-spectra only): the channels are treated as uncorrelated; "
+                     "largest coherence of each pair left out:")
+        lines += [f"$   {j}-{k}: {coh:.3f} at {f:.4g} Hz" for coh, j, k, f in left] or ["$   none (all zero)"]
     written = {}
     tid = tid0
     live = [a for a in idx if np.any(res.psd[:, a] > 0)]

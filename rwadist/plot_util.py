@@ -254,3 +254,12 @@ def content_top_above_floor(f, rows, factor: float = 10.0, margin: float = 1.2) 
     floor = float(np.median(y[good]))
     hot = np.nonzero(np.any(good & (y > factor * floor), axis=0))[0]
     return float(min(f[-1], margin * f[hot[-1]])) if hot.size else None
+
+
+def psd_title(kind: str, res) -> str:
+    """The PSD plot's title: the model kind, the frame, the band and each wheel's own speed law
+    (``res.meta["speed_laws"]``: a set's wheels each have theirs, or a tie), wrapped to the figure's width."""
+    import textwrap
+
+    laws = "; ".join(law if name is None else f"{name}: {law}" for name, law in res.meta.get("speed_laws", []))
+    return textwrap.fill(f"{kind}, {res.frame} frame, 0–{float(res.f[-1]):g} Hz; speed: {laws}", 110)

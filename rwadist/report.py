@@ -176,15 +176,20 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
     # so close that they merged into tubes hiding the lines they mark
     stride = max(1, int(np.ceil(len(u_rpm) / MAX_MARKERS_PER_LINE)))
     marked = u_rpm[::stride]
+    # every marker is a pair of ticks either side of the line, never on it: the measured ridge stays visible
+    # between them (rings and crosses centred on the line covered it)
+    gap = ridge_gap(f_edges, top, ax.get_position().width * fig.get_figwidth() * _DPI)
+    labelled: list = []
     if model is not None and channel in CHANNEL_DIRECTION:
         direction = CHANNEL_DIRECTION[channel]
         f_line, _ = compare.model_psd_lines(model, direction, rpm_to_rad_s(marked))
         if f_line.size:
             yy = np.broadcast_to(marked[:, None], f_line.shape)
             m = (f_line <= top) & (yy > 0)
-            # hollow rings wide enough that the measured line shows through their centre
-            handles += ax.plot(f_line[m], yy[m], "o", mfc="none", mec="white", mew=0.6, ms=8, alpha=0.85,
-                               zorder=MODEL_ZORDER, label="model lines h·Ω")
+            handles += ax.plot(np.concatenate([f_line[m] - gap, f_line[m] + gap]), np.concatenate([yy[m], yy[m]]),
+                               "|", color="white", mew=1.1, ms=7, alpha=0.9, zorder=MODEL_ZORDER,
+                               label="model lines h·Ω (ticks either side)")
+            labelled = [hm.h for hm in model.harmonics(direction)]
     if lines is not None:
         fx, fy = [], []
         for ln in lines:
@@ -194,20 +199,64 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
             fy.append(np.abs(ln.speed[sel]) * RAD_S_TO_RPM)
         fx = np.concatenate(fx) if fx else np.empty(0)
         if fx.size:
-            handles += ax.plot(fx, np.concatenate(fy), "x", color="red", mew=1.2, ms=5, zorder=DATA_ZORDER,
-                               label="excluded (modal) measurement")
+            fy = np.concatenate(fy)
+            handles += ax.plot(np.concatenate([fx - 1.6 * gap, fx + 1.6 * gap]), np.concatenate([fy, fy]), "|",
+                               color="red", mew=1.4, ms=5, zorder=DATA_ZORDER,
+                               label="excluded (modal) measurement (red ticks)")
     ax.set_xlim(max(f_edges[0], 0.0), min(f_edges[-1], top))
     ax.set_ylim(max(y_edges[0], 0.0), y_edges[-1])
+    _label_lines(ax, labelled, float(u_rpm.max()), float(y_edges[-1]), min(f_edges[-1], top))
     ax.set_xlabel("Frequency (Hz)")
     ax.set_ylabel("Wheel speed |Ω| (rpm)")
     name = f" vs model '{model.name}'" if model is not None else ""
-    ax.set_title(f"{channel} PSD waterfall{name} (0–{top:.0f} Hz)")
+    ax.set_title(f"{channel} PSD waterfall{name} (0–{top:.0f} Hz)", pad=16 if labelled else 6)
     if handles:
         leg = ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=len(handles),
                         facecolor="0.35", framealpha=1.0, fontsize="small")
         for t in leg.get_texts():
             t.set_color("white")
     return fig, ax
+
+
+#: the least clearance between a line's ticks and its ridge on a waterfall, pixels of the saved figure
+RIDGE_CLEARANCE_PX = 3.5
+
+
+def ridge_gap(f_edges, top: float, width_px: float = 700.0) -> float:
+    """Half the distance (Hz) between the two ticks that mark a line on a waterfall: clear of the ridge -- 2.5 image
+    columns (merged bins included), and at least :data:`RIDGE_CLEARANCE_PX` pixels of a band drawn ``width_px``
+    wide."""
+    col = float(np.max(np.diff(f_edges))) if len(f_edges) > 1 else 0.0
+    return max(2.5 * col, RIDGE_CLEARANCE_PX * (top - max(float(f_edges[0]), 0.0)) / width_px)
+
+
+def _label_lines(ax, hs, rpm_top: float, y_top: float, f_top: float) -> None:
+    """Each model line labelled by its h where it leaves the plot: at the top edge (its frequency at the top speed),
+    or on the right edge where it reaches the band's top; labels spread so that none overlaps another."""
+    from .plot_util import spread_labels
+
+    hs = sorted({round(float(h), 4) for h in hs if h > 0})
+    top_x, side_y, top_h, side_h = [], [], [], []
+    for h in hs:
+        f = h * rpm_top / 60.0
+        if f <= f_top:
+            top_x.append(f)
+            top_h.append(h)
+        else:
+            side_y.append(f_top * 60.0 / h)
+            side_h.append(h)
+    style = dict(fontsize=6.5, color="white", zorder=DATA_ZORDER + 1, clip_on=False,
+                 bbox=dict(boxstyle="round,pad=0.15", fc="0.25", ec="none", alpha=0.8))
+    if top_x:
+        xs = spread_labels(np.asarray(top_x), 0.045 * f_top)
+        for x, h in zip(xs, top_h):
+            ax.text(x, y_top, f"{h:.3g}", ha="center", va="bottom", **style)
+    if side_y:
+        ys = spread_labels(np.asarray(side_y), 0.04 * rpm_top)
+        for y, h in zip(ys, side_h):
+            ax.text(f_top, y, f"{h:.3g}", ha="left", va="center", **style)
+    if hs:
+        ax.text(0.0, 1.0, "h =", transform=ax.transAxes, ha="right", va="bottom", **style)
 
 
 # --------------------------------------------------------------------------- RMS vs speed
@@ -250,7 +299,7 @@ def plot_rms_vs_speed(spectra, model, direction: str, ax=None, f_max: float | No
     log_axis(ax_rms)
     ax_rms.set_ylabel(f"RMS 0–{top:g} Hz ({unit})")
     what = "data vs model" if has_model else "data (the model has no harmonics here)"
-    ax_rms.set_title(f"{_direction_label(direction)}: RMS vs wheel speed, {what}")
+    ax_rms.set_title(f"{_direction_label(direction)}: RMS over 0–{top:g} Hz vs wheel speed, {what}")
     ax_rms.grid(True, which="both", alpha=0.3)
     if ax_rms.get_legend_handles_labels()[0]:
         ax_rms.legend()
@@ -333,7 +382,7 @@ def plot_cumulative_rms(spectra, model, direction: str, speed_rpm: float, axes=N
                   drawstyle="steps-post", zorder=MODEL_ZORDER, label="model (staircase)")
     log_axis(ax_a)
     ax_a.set_ylabel(f"Amplitude ({unit})")
-    ax_a.set_title(f"{_direction_label(direction)} at {rpm:.0f} rpm")
+    ax_a.set_title(f"{_direction_label(direction)} at {rpm:.0f} rpm, 0–{top:.0f} Hz")
     ax_a.legend(fontsize="small")
     ax_a.grid(True, which="both", alpha=0.3)
     ax_c.set_xlabel("Frequency (Hz)")
@@ -346,6 +395,34 @@ def plot_cumulative_rms(spectra, model, direction: str, speed_rpm: float, axes=N
 
 
 # --------------------------------------------------------------------------- coefficient curve fits
+
+#: What the two uncertainties of a coefficient cover (the coefficient plots and summary.md say it)
+UNCERTAINTY_NOTE = ("±2σ: the fit's statistical error of C (measurement noise, run to run). Held-out: the RMS error of "
+                    "C·Ω² fitted on every other speed, at the speeds left out (the model's form: a line that does not "
+                    "grow as Ω²). Neither covers a bias common to every speed kept (a mode above or below the speed "
+                    "range amplifying every point, which an empirical fit takes into C): fit the modes with --extended")
+
+
+def model_form_error(line) -> float:
+    """Held-out error of C·Ω² for ``line`` (a :class:`rwadist.empirical.LineFit`), relative: C fitted by Eq. 3.10 on
+    every other speed of the measurements the fit used (sorted by speed), the RMS of (measured − predicted) at the
+    others over the RMS predicted, both ways, the larger; NaN with fewer than 4 points.  The noise is in it too:
+    compare with 2σ/C (a pure C·Ω² line gives about the noise's scatter)."""
+    used = np.asarray(line.used, dtype=bool)
+    d, w = np.asarray(line.amplitude, float)[used], np.abs(np.asarray(line.speed, float)[used])
+    if d.size < 4:
+        return float("nan")
+    order = np.argsort(w, kind="stable")
+    worst = 0.0
+    for fit_idx, test_idx in ((order[::2], order[1::2]), (order[1::2], order[::2])):
+        C = np.sum(d[fit_idx] * w[fit_idx] ** 2) / np.sum(w[fit_idx] ** 4)
+        pred = C * w[test_idx] ** 2
+        den = np.sqrt(np.mean(pred ** 2))
+        if not den > 0:
+            return float("nan")
+        worst = max(worst, float(np.sqrt(np.mean((d[test_idx] - pred) ** 2)) / den))
+    return worst
+
 
 def plot_coefficient(line, ax=None, rpm_max: float | None = None):
     """One harmonic's curve fit (thesis Figs. 3-7, 3-9): measured amplitudes vs |speed| (used: dark
@@ -374,8 +451,10 @@ def plot_coefficient(line, ax=None, rpm_max: float | None = None):
     ax.plot(g, line.C * w2, "k-", lw=1.2, zorder=MODEL_ZORDER, label="C·Ω²")
     ax.plot(g, line.C_all * w2, "--", color="tab:orange", lw=1.2, zorder=MODEL_ZORDER, label="C_all·Ω² (all points)")
     cu = DIRECTION_C_UNIT[line.direction]
-    rel = f" ± {100 * band / line.C:.2g} % (2σ)" if line.C > 0 and band > 0 else ""
-    ax.set_title(f"h = {line.h:.4g}: C = {line.C:.3g} {cu}{rel}", fontsize="medium")
+    rel = f" ± {100 * band / line.C:.2g} % (2σ noise)" if line.C > 0 and band > 0 else ""
+    held = model_form_error(line)
+    form = f"\nheld-out error {100 * held:.2g} % (model form)" if np.isfinite(held) else ""
+    ax.set_title(f"h = {line.h:.4g}: C = {line.C:.3g} {cu}{rel}{form}", fontsize="medium")
     ax.set_xlim(0.0, top)
     ax.set_ylim(bottom=0.0)
     ax.grid(True, alpha=0.3)
@@ -411,7 +490,14 @@ def plot_coefficients(lines, direction: str, fig=None):
             handles.setdefault(lb, hd)
     fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncol=min(len(handles), 6),
                fontsize="small")
-    fig.suptitle(f"{_direction_label(direction)}: amplitude coefficient curve fits")
+    f_lines = [ln.h * np.abs(ln.speed) / (2 * np.pi) for ln in sel if ln.speed.size]
+    band = f", lines at {min(f.min() for f in f_lines):.3g}–{max(f.max() for f in f_lines):.3g} Hz" if f_lines else ""
+    fig.suptitle(f"{_direction_label(direction)}: amplitude coefficient curve fits (line amplitudes at every speed "
+                 f"of the data{band})")
+    import textwrap
+
+    fig.text(0.5, 0.995, "\n".join(textwrap.wrap(UNCERTAINTY_NOTE, 150)), ha="center", va="top", fontsize=6.5,
+             color="0.3")
     return fig, axes[:n]
 
 
@@ -436,7 +522,7 @@ def harmonic_rows(fit) -> list:
                      "C_stderr_SI": float(ln.C_stderr), "C_all_SI": float(ln.C_all),
                      "n_points": int(np.count_nonzero(ln.used)), "presence": float(ln.presence),
                      "excluded_rpm": [[float(a), float(b)] for a, b in ln.excluded_rpm],
-                     "in_model": bool(hit)})
+                     "in_model": bool(hit), "heldout_rel": model_form_error(ln)})
     for d in DIRECTION_CHANNELS:
         for i, hm in enumerate(fit.model.harmonics(d)):
             if i in matched[d]:
@@ -446,7 +532,7 @@ def harmonic_rows(fit) -> list:
                          "C_all_SI": np.nan, "n_points": int(hm.n_points),
                          "presence": float(hm.presence) if hm.presence is not None else np.nan,
                          "excluded_rpm": [[float(a), float(b)] for a, b in hm.excluded_rpm],
-                         "in_model": True})
+                         "in_model": True, "heldout_rel": np.nan})
     order = {d: i for i, d in enumerate(DIRECTION_CHANNELS)}
     rows.sort(key=lambda r: (order.get(r["direction"], 99), r["h"]))
     return rows
@@ -474,29 +560,40 @@ def _write_csv(path: Path, columns: list, rows) -> Path:
 
 
 HARMONICS_COLUMNS = ["direction", "h", "C_SI", "C_stderr_SI", "C_all_SI", "n_points", "presence",
-                     "excluded_rpm", "in_model"]
+                     "excluded_rpm", "in_model", "heldout_rel"]
 BINS_COLUMNS = ["direction", "h", "n_bin", "n_possible", "presence", "kept", "reason"]
 EXCLUDED_COLUMNS = ["direction", "h", "lo_rpm", "hi_rpm"]
 
 
-def _summary_md(fit, rows, table, top, files) -> str:
+def _summary_md(fit, rows, table, top, files, extended=None) -> str:
+    """summary.md of the report: the empirical fit (its harmonics, what their uncertainties cover, model/data RMS);
+    with ``extended`` (:func:`_extended_md`'s lines) the extended model first, the empirical fit as its start."""
     sp = fit.spectra
     rpm = np.abs(rad_s_to_rpm(sp.speed))
-    out = [f"# Empirical fit report: {fit.model.name}", "",
+    prov = getattr(fit.model, "provenance", {}) or {}
+    made = ", ".join(f"{k} {prov[k]}" for k in ("rwadist", "created_utc", "data") if prov.get(k))
+    title = "Extended fit report" if extended else "Empirical fit report"
+    out = [f"# {title}: {fit.model.name}", ""] + ([f"- made by: {made}"] if made else []) + [
            f"- runs: {len(sp.speed)}, |speed| {rpm.min():.0f}–{rpm.max():.0f} rpm; channels: "
            f"{', '.join(sp.channels)}",
            f"- sample rate {sp.sample_rate:g} Hz, resolution {sp.df:.4g} Hz, band used 0–{top:g} Hz", ""]
+    if extended:
+        out += extended + ["", "# The empirical fit (the extended fit's starting point)", ""]
     out += ["## Harmonics (amplitude = C·Ω², Ω in rad/s)", "",
-            "| direction | h | C (SI) | ±σ | C_all (SI) | points | presence | excluded rpm | in model |",
-            "|---|---|---|---|---|---|---|---|---|"]
+            "| direction | h | C (SI) | ±2σ noise | held-out (model form) | C_all (SI) | points | presence | "
+            "excluded rpm | in model |",
+            "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         exc = "; ".join(f"{a:.0f}–{b:.0f}" for a, b in r["excluded_rpm"]) or "–"
+        two = f"{200 * r['C_stderr_SI'] / r['C_SI']:.2g} %" if r["C_SI"] > 0 and np.isfinite(r["C_stderr_SI"]) else "–"
+        held = f"{100 * r['heldout_rel']:.2g} %" if np.isfinite(r["heldout_rel"]) else "–"
         out.append(f"| {r['direction']} | {r['h']:.4g} | {r['C_SI']:.4g} {DIRECTION_C_UNIT[r['direction']]} | "
-                   f"{r['C_stderr_SI']:.2g} | {r['C_all_SI']:.4g} | {r['n_points']} | {r['presence']:.2f} | "
+                   f"{two} | {held} | {r['C_all_SI']:.4g} | {r['n_points']} | {r['presence']:.2f} | "
                    f"{exc} | {'yes' if r['in_model'] else 'no'} |")
     if not rows:
-        out.append("| (none) | | | | | | | | |")
-    out += ["", "## RMS model/data (median over spinning runs)", ""]
+        out.append("| (none) | | | | | | | | | |")
+    out += ["", f"What they cover: {UNCERTAINTY_NOTE}.", ""]
+    out += ["## RMS empirical model/data (median over spinning runs)", ""]
     spin = np.abs(table["speed_rpm"]) > 0
     for key, v in table.items():
         if not key.startswith("ratio_"):
@@ -555,7 +652,8 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
             axes = fig.subplots(2, len(speeds), sharex="col", squeeze=False)
             for k, s in enumerate(speeds):
                 plot_cumulative_rms(sp, model, d, s, axes=(axes[0, k], axes[1, k]), f_max=view)
-            fig.suptitle(f"{_direction_label(d)}: amplitude spectra and cumulative RMS, data vs model")
+            fig.suptitle(f"{_direction_label(d)}: amplitude spectra and cumulative RMS over 0–{view:.0f} Hz, "
+                         "data vs model")
             files.append(_save(fig, out / f"cumulative_rms_{d}.png"))
             bar.update()
     for d in fitted:
@@ -580,118 +678,4 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
     bar.update()
     bar.refresh()                  # show the completed count even when the last update came fast
     bar.close()
-    return files
-
-
-# --------------------------------------------------------------------------- extended model
-
-def plot_extended_rms(comparison: dict, direction: str, ax=None):
-    """RMS vs speed of the data (noise floor removed), the empirical and the extended model;
-    speeds where modes act (excluded ranges of the empirical fit) shaded."""
-    c = comparison[direction]
-    if ax is None:
-        fig = _new_figure((8.0, 4.8))
-        ax = fig.add_subplot(1, 1, 1)
-    else:
-        fig = ax.figure
-    order = np.argsort(c["speed_rpm"])
-    rpm = c["speed_rpm"][order]
-    shade = c["in_modes"][order]
-    if shade.any():
-        ax.fill_between(rpm, 0, 1, where=shade, transform=ax.get_xaxis_transform(), color="tab:red", alpha=0.08,
-                        label="modes act (empirical exclusion)")
-    log_axis(ax)
-    ax.plot(rpm, c["data"][order], "o", ms=3, color="k", zorder=DATA_ZORDER, label="data (noise floor removed)")
-    ax.plot(rpm, c["empirical"][order], "-", color="tab:orange", zorder=MODEL_ZORDER,
-            label=f"empirical model (error in modes {100 * c['error_empirical']:.1f} %)")
-    ax.plot(rpm, c["extended"][order], "-", color="tab:blue", zorder=MODEL_ZORDER,
-            label=f"extended model (error in modes {100 * c['error_extended']:.1f} %)")
-    ax.set_xlabel("Wheel speed |Ω| (rpm)")
-    ax.set_ylabel(f"RMS ({_direction_unit(direction)})")
-    ax.set_title(f"{_direction_label(direction)}: data vs empirical and extended model")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    return fig, ax
-
-
-def plot_extended_lines(efit, direction: str, fig=None):
-    """One panel per harmonic of ``direction``: measured line amplitude vs speed (every speed),
-    the extended model's |A| (modal amplification included) and the hard-mounted C·Ω²."""
-    from .extended import steady_lines
-
-    pairs = [x for x in efit.measured if x.direction == direction]
-    if not pairs:
-        return None
-    n = len(pairs)
-    cols = min(3, n)
-    rows_ = int(np.ceil(n / cols))
-    fig = fig if fig is not None else _new_figure((4.2 * cols, 3.2 * rows_))
-    ch = DIRECTION_CHANNELS[direction][0]
-    k_ch = ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz").index(ch)
-    for i, x in enumerate(pairs):
-        ax = fig.add_subplot(rows_, cols, i + 1)
-        parts = efit.parts_of(direction, x.h)
-        w = np.linspace(np.abs(x.speed).min(), np.abs(x.speed).max(), 400)
-        _, A = steady_lines(efit.params, parts, w)
-        model_amp = np.sqrt(np.sum(np.abs(A[:, :, k_ch]) ** 2, axis=1))   # parts add in power
-        c_total = float(np.sqrt(sum(p.C**2 for p in parts)))
-        rpm = w * RAD_S_TO_RPM
-        sel = np.asarray(x.channel) == ch
-        ax.plot(np.abs(x.speed[sel]) * RAD_S_TO_RPM, x.amplitude[sel], "o", ms=3, color="k", zorder=DATA_ZORDER,
-                label=f"data {ch}")
-        ax.plot(rpm, model_amp, "-", color="tab:blue", zorder=MODEL_ZORDER, label="extended model")
-        ax.plot(rpm, c_total * w**2, "--", color="tab:orange", zorder=MODEL_ZORDER, label="C·Ω² (hard-mounted)")
-        log_axis(ax)
-        sense = "+".join(p.sense for p in parts)
-        ax.set_title(f"h = {x.h:.2f} ({sense})", fontsize=9)
-        ax.grid(True, which="both", alpha=0.3)
-        if i % cols == 0:
-            ax.set_ylabel(f"Amplitude ({_direction_unit(direction)})")
-        if i >= n - cols:
-            ax.set_xlabel("Wheel speed |Ω| (rpm)")
-    fig.axes[0].legend(fontsize=7)
-    fig.suptitle(f"{_direction_label(direction)}: line amplitudes, data vs extended model")
-    return fig
-
-
-def write_extended_report(efit, fit, out_dir) -> list:
-    """Extended-model part of the report: ``extended_rms_<direction>.png``,
-    ``extended_lines_<direction>.png``, ``extended_rms_vs_speed.csv`` and ``extended_params.csv``."""
-    from .extended import params_to_dict
-    from .extended_fit import rms_comparison
-
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    comparison = rms_comparison(efit, fit)
-    files = []
-    for d in comparison:
-        fig, _ = plot_extended_rms(comparison, d)
-        files.append(_save(fig, out / f"extended_rms_{d}.png"))
-        fig = plot_extended_lines(efit, d)
-        if fig is not None:
-            files.append(_save(fig, out / f"extended_lines_{d}.png"))
-    path = out / "extended_rms_vs_speed.csv"
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["direction", "speed_rpm", "data_rms", "empirical_rms", "extended_rms", "modes_act"])
-        for d, c in comparison.items():
-            for k in np.argsort(c["speed_rpm"]):
-                w.writerow([d, _fmt(c["speed_rpm"][k]), _fmt(c["data"][k]), _fmt(c["empirical"][k]),
-                            _fmt(c["extended"][k]), int(c["in_modes"][k])])
-    files.append(path)
-    path = out / "extended_params.csv"
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["parameter", "value", "rel_stderr"])
-        for key, value in params_to_dict(efit.params).items():
-            if key == "kind":
-                continue
-            name = key.split("_")[0] + ("_" + key.split("_")[1] if key.startswith(("k_", "c_", "U_", "I_")) else "")
-            w.writerow([key, _fmt(value), _fmt(efit.rel_stderr.get(name, float("nan")))])
-        for mode, z in efit.zeta.items():
-            w.writerow([f"zeta_{mode}", _fmt(z), ""])
-        for d, c in comparison.items():
-            w.writerow([f"rms_error_in_modes_empirical_{d}", _fmt(c["error_empirical"]), ""])
-            w.writerow([f"rms_error_in_modes_extended_{d}", _fmt(c["error_extended"]), ""])
-    files.append(path)
     return files

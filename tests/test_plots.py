@@ -12,7 +12,7 @@ from matplotlib.collections import PolyCollection, QuadMesh
 from matplotlib.lines import Line2D
 
 import rwadist
-from rwadist import api, plot_util, report
+from rwadist import api, plot_util, report, report_extended
 from rwadist.campbell import plot_campbell
 from rwadist.psd_files import plot_psd
 
@@ -83,33 +83,34 @@ def test_content_band_helpers():
     assert np.all(np.diff(np.sort(y)) >= 1.0 - 1e-12) and y[2] == 50.0
 
 
-def test_waterfall_data_under_hollow_model_rings_and_band_of_content(fit):
+def test_waterfall_data_under_model_ticks_and_band_of_content(fit):
     view = report.content_top(fit.spectra, fit.lines)
     assert view < fit.spectra.f[-1]                     # not Nyquist
     assert view >= _top_line_hz(fit.model, "radial_force")
     fig, ax = report.plot_waterfall(fit.spectra, "Fx", model=fit.model, f_max=view, lines=fit.lines)
     assert ax.get_xlim()[1] == pytest.approx(view, rel=0.02)
     mesh = [c for c in ax.collections if isinstance(c, QuadMesh)][0]
-    rings = [ln for ln in ax.lines if ln.get_label() == "model lines h·Ω"][0]
-    assert rings.get_markerfacecolor() == "none" and rings.get_markersize() >= 7
-    assert mesh.get_zorder() < rings.get_zorder()
+    ticks = [ln for ln in ax.lines if ln.get_label().startswith("model lines h·Ω")][0]
+    assert ticks.get_marker() == "|" and ticks.get_markersize() >= 5     # beside the ridge, not on it
+    assert mesh.get_zorder() < ticks.get_zorder()
     _legend_artists_are_drawn(fig)
 
 
 def test_waterfall_of_a_dense_speed_grid_leaves_the_data_visible_between_markers():
     # a sweep sliced into ~170 runs drew a ring at every speed of every line: the rings (11 px) merged into tubes
-    # that hid the lines.  On 150 speeds the rings of each model line are no closer than the axis height over
-    # MAX_MARKERS_PER_LINE, and every ring still sits on a line h·Ω of the model at a speed of the data
+    # that hid the lines.  On 150 speeds the markers of each model line are no closer than the axis height over
+    # MAX_MARKERS_PER_LINE, and every pair of ticks still flanks a line h·Ω of the model at a speed of the data
     test = rwadist.simulate_test("ithaco-e", speeds_rpm=np.linspace(300.0, 2400.0, 150), n_samples=1024, seed=2)
     f = rwadist.fit(test)
     fig, ax = report.plot_waterfall(f.spectra, "Fx", model=f.model, lines=f.lines)
-    rings = [ln for ln in ax.lines if ln.get_label() == "model lines h·Ω"][0]
-    y = np.asarray(rings.get_ydata())
-    x = np.asarray(rings.get_xdata())
+    ticks = [ln for ln in ax.lines if ln.get_label().startswith("model lines h·Ω")][0]
+    y_all, x_all = np.asarray(ticks.get_ydata()), np.asarray(ticks.get_xdata())
+    half = x_all.size // 2              # the left ticks, then the right ones: a pair per line and speed
+    y, x = y_all[:half], 0.5 * (x_all[:half] + x_all[half:])
     hs = f.model.h_and_C("radial_force")[0]
     per_line = [np.sort(y[np.isclose(x, h * y / 60.0, rtol=1e-9)]) for h in hs]
     assert all(0 < v.size <= report.MAX_MARKERS_PER_LINE for v in per_line), [v.size for v in per_line]
-    assert sum(v.size for v in per_line) == x.size                     # every ring on a model line
+    assert sum(v.size for v in per_line) == x.size                     # every pair flanks a model line
     span = 2400.0 - 300.0
     assert all(np.all(np.diff(v) >= span / report.MAX_MARKERS_PER_LINE * 0.9) for v in per_line)
     assert np.all(np.isin(np.round(y, 6), np.round(np.abs(f.spectra.speed) * 60 / (2 * np.pi), 6)))
@@ -234,7 +235,7 @@ def test_extended_rms_data_over_both_models():
     comparison = {"radial_force": {"speed_rpm": rpm, "in_modes": rpm > 1500.0, "data": 1e-8 * rpm ** 2,
                                    "empirical": 1.1e-8 * rpm ** 2, "extended": 0.9e-8 * rpm ** 2,
                                    "error_empirical": 0.1, "error_extended": 0.05}}
-    fig, ax = report.plot_extended_rms(comparison, "radial_force")
+    fig, ax = report_extended.plot_extended_rms(comparison, "radial_force")
     data = [ln for ln in ax.lines if ln.get_label().startswith("data")]
     models = [ln for ln in ax.lines if "model" in ln.get_label()]
     assert len(data) == 1 and len(models) == 2

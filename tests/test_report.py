@@ -296,19 +296,20 @@ def test_plot_functions_return_axes_with_units(data):
     sp = fit.spectra
     fig, ax = report.plot_waterfall(sp, "Fx", model=fit.model, lines=fit.lines)
     assert ax.get_xlabel() == "Frequency (Hz)" and "rpm" in ax.get_ylabel()
-    modal = [l for l in ax.get_lines() if l.get_label() == "excluded (modal) measurement"]
+    modal = [l for l in ax.get_lines() if l.get_label().startswith("excluded (modal) measurement")]
     (ln,) = [x for x in fit.lines if x.excluded_rpm]
     n_modal = int(np.sum((ln.channel == "Fx") & ~ln.used))
-    assert n_modal > 0 and len(modal) == 1 and len(modal[0].get_xdata()) == n_modal
-    # modal markers sit at h·Ω of their runs
-    np.testing.assert_allclose(np.sort(modal[0].get_xdata()),
+    # a pair of ticks either side of each: their midpoints sit at h·Ω of their runs
+    assert n_modal > 0 and len(modal) == 1 and len(modal[0].get_xdata()) == 2 * n_modal
+    x = np.asarray(modal[0].get_xdata())
+    np.testing.assert_allclose(np.sort(0.5 * (x[:n_modal] + x[n_modal:])),
                                np.sort(ln.h * ln.speed[(ln.channel == "Fx") & ~ln.used] / (2 * np.pi)))
-    # model markers: one per harmonic and speed with the line inside the band
-    (mk,) = [l for l in ax.get_lines() if l.get_label() == "model lines h·Ω"]
+    # model markers: a pair of ticks per harmonic and speed with the line inside the band
+    (mk,) = [l for l in ax.get_lines() if l.get_label().startswith("model lines h·Ω")]
     w = np.unique(np.abs(sp.speed))
     w = w[w > 0]  # no markers for the noise run
     n_in = sum(int(np.sum(h * w / (2 * np.pi) <= F_LIM)) for h, _ in TRUE["radial_force"])
-    assert len(mk.get_xdata()) == n_in
+    assert len(mk.get_xdata()) == 2 * n_in
 
     fig, (a_rms, a_ratio) = report.plot_rms_vs_speed(sp, fit.model, "radial_force")
     assert "(N)" in a_rms.get_ylabel() and a_ratio.get_ylabel() == "model / data"

@@ -1,0 +1,278 @@
+"""Outputs never destroy (issue 36 item 1): a folder holding files rwadist did not write is refused, untouched; a
+device or FIFO is written into, never replaced; a set of outputs is swapped in as a set; a full disk is one line and
+no part file; Ctrl-C at any moment from the command's first instruction is one line and exit 130."""
+from __future__ import annotations
+
+import os
+import resource
+import shutil
+import signal
+import stat
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from rwadist import outputs
+from rwadist.cli import main
+from rwadist.data import DataError
+
+SIM = ["simulate-test", "--preset", "ithaco-e", "--samples", "1024", "--speeds-rpm", "600,1200,1800,2400",
+       "--no-modes"]
+PSD = ["psd", "--preset", "ithaco-e", "--speed-rpm", "600:2400", "--empirical", "--n-freq", "401", "--n-speeds", "40"]
+
+
+def _rwadist() -> str:
+    """The installed command (the console script), as a user types it."""
+    exe = Path(sys.executable).parent / "rwadist"
+    return str(exe) if exe.exists() else shutil.which("rwadist")
+
+
+def _as_in_a_terminal():
+    """Ctrl-C reaches the child as from a terminal, however pytest was started (a background job's SIGINT is
+    ignored, and an ignored signal stays ignored across exec)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ds") / "ds"
+    assert main(SIM + [str(out)]) == 0
+    return out
+
+
+def _visible(folder: Path) -> dict:
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir()) if p.is_file() and not p.name.startswith(".")}
+
+
+# --------------------------------------------------------------------------- folders with files rwadist did not write
+
+@pytest.mark.parametrize("how", ["--report", "default", "diagnose"])
+def test_a_folder_holding_a_users_file_is_refused_untouched(dataset, tmp_path, capsys, how):
+    """`fit --report DIR`, its default `<model>_report` and `diagnose -o DIR` deleted a reviewer's notes in DIR."""
+    folder = tmp_path / ("m_report" if how == "default" else "rep")
+    folder.mkdir()
+    (folder / "reviewer_notes.txt").write_text("checked page 3\n")
+    argv = {"--report": ["fit", dataset, "-o", tmp_path / "m.json", "--report", folder],
+            "default": ["fit", dataset, "-o", tmp_path / "m.json"],
+            "diagnose": ["diagnose", dataset, "-o", folder]}[how]
+    assert main([str(a) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert "reviewer_notes.txt" in err and "rwadist did not write" in err
+    assert [p.name for p in folder.iterdir()] == ["reviewer_notes.txt"]
+    assert not (tmp_path / "m.json").exists()
+
+
+def test_a_report_rwadist_wrote_is_replaced_and_a_file_added_later_stops_it(dataset, tmp_path, capsys):
+    rep = tmp_path / "rep"
+    argv = ["fit", str(dataset), "-o", str(tmp_path / "m.json"), "--report", str(rep)]
+    assert main(argv) == 0 and main(argv) == 0          # its own report: replaced
+    assert outputs.foreign_files(rep) == []
+    (rep / "notes.md").write_text("mine")
+    capsys.readouterr()
+    assert main(argv) == 2 and "notes.md" in capsys.readouterr().err
+    assert (rep / "notes.md").read_text() == "mine"
+
+
+# --------------------------------------------------------------------------- devices and FIFOs
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="mknod needs root")
+def test_a_device_is_written_into_never_replaced(dataset, tmp_path, capsys):
+    """As root, `fit -o /dev/null` replaced the device with a regular file (its copy here: the same device)."""
+    null, full = tmp_path / "null", tmp_path / "full"
+    os.mknod(null, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+    os.mknod(full, 0o666 | stat.S_IFCHR, os.makedev(1, 7))
+    assert main(["fit", str(dataset), "-o", str(null), "--no-report"]) == 0
+    assert stat.S_ISCHR(os.stat(null).st_mode)
+    capsys.readouterr()
+    assert main(["fit", str(dataset), "-o", str(full), "--no-report"]) == 2
+    err = capsys.readouterr().err
+    assert "No space left on device" in err and str(full) in err
+    assert stat.S_ISCHR(os.stat(full).st_mode)
+    # companions named after a device would land beside it: refused before any work
+    for argv in (["fit", str(dataset), "-o", str(null)], PSD + ["-o", str(null)],
+                 ["campbell", "--preset", "ithaco-e", "--speeds-rpm", "0:3000:500", "-o", str(null)]):
+        assert main(argv) == 2
+        assert "not a regular file" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["full", "null"]
+
+
+def test_a_fifo_is_written_into(dataset, tmp_path):
+    fifo = tmp_path / "pipe.json"
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()))
+    reader.start()
+    assert main(["fit", str(dataset), "-o", str(fifo), "--no-report"]) == 0
+    reader.join(30)
+    assert got and '"schema": "rwadist.model"' in got[0]
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)
+
+
+def test_a_symbolic_link_is_followed_and_a_loop_refused(dataset, tmp_path, capsys):
+    real = tmp_path / "real.json"
+    real.write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to(real)
+    assert main(["fit", str(dataset), "-o", str(link), "--no-report"]) == 0
+    assert link.is_symlink() and '"rwadist.model"' in real.read_text()
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    a.symlink_to(b)
+    b.symlink_to(a)
+    capsys.readouterr()
+    assert main(["fit", str(dataset), "-o", str(a), "--no-report"]) == 2
+    assert "loop" in capsys.readouterr().err
+
+
+def test_a_block_device_is_refused(tmp_path):
+    if os.geteuid() != 0:
+        pytest.skip("mknod needs root")
+    disk = tmp_path / "disk"
+    os.mknod(disk, 0o600 | stat.S_IFBLK, os.makedev(7, 200))     # a loop-device number: never opened
+    with pytest.raises(DataError, match="block device"):
+        outputs.check_output_file(disk)
+
+
+# --------------------------------------------------------------------------- sets
+
+def _psd_set(stem: Path) -> dict:
+    return {s: (stem.parent / (stem.name + s)) for s in (".csv", "_cross.csv", "_envelope.csv", ".png")}
+
+
+def test_psd_outputs_are_replaced_as_a_set(tmp_path, monkeypatch, capsys):
+    """A failure while the set is swapped in (the second new member's rename) leaves the whole old set; a run with
+    --cross none removes the older cross-spectra, which belonged to another run."""
+    stem = tmp_path / "p"
+    assert main(PSD + ["-o", str(stem) + ".csv", "--cross", "csv"]) == 0
+    old = {s: p.read_bytes() for s, p in _psd_set(stem).items()}
+    real, calls = os.rename, []
+
+    def failing(a, b):
+        calls.append((a, b))
+        if len(calls) == 6:     # 4 old members moved aside, then the 2nd new one moved in
+            raise OSError(5, "Input/output error", str(b))
+        return real(a, b)
+
+    monkeypatch.setattr(os, "rename", failing)
+    assert main(PSD + ["--n-freq", "301", "-o", str(stem) + ".csv", "--cross", "csv"]) == 2
+    monkeypatch.setattr(os, "rename", real)
+    assert {s: p.read_bytes() for s, p in _psd_set(stem).items()} == old
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in _psd_set(stem).values())
+    assert main(PSD + ["--n-freq", "301", "-o", str(stem) + ".csv", "--cross", "none"]) == 0
+    assert not _psd_set(stem)["_cross.csv"].exists()
+    assert all(_psd_set(stem)[s].read_bytes() != old[s] for s in (".csv", "_envelope.csv"))
+
+
+def test_ctrl_c_during_the_swap_waits_for_it(tmp_path):
+    """Ctrl-C arriving between the renames of a set runs after the last one: both members new, then the interrupt."""
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    a.write_text("old a")
+    b.write_text("old b")
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    real = os.rename
+    try:
+        def rename_then_interrupt(src, dst):
+            real(src, dst)
+            if Path(dst) == a:
+                os.kill(os.getpid(), signal.SIGINT)
+        os.rename = rename_then_interrupt
+        with pytest.raises(KeyboardInterrupt):
+            with outputs.output_set() as s:
+                s.file(a).write_text("new a")
+                s.file(b).write_text("new b")
+    finally:
+        os.rename = real
+        signal.signal(signal.SIGINT, previous)
+    assert (a.read_text(), b.read_text()) == ("new a", "new b")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.txt"]
+
+
+def test_stale_temporaries_of_a_killed_write_are_removed(tmp_path):
+    out = tmp_path / "m.json"
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()
+    left = tmp_path / f".m.part-{dead}-0123abcd.json"
+    left.write_text("half")
+    other = tmp_path / f".n.part-{dead}-0123abcd.json"        # another output's: not this write's business
+    other.write_text("half")
+    with outputs.atomic_file(out) as tmp:
+        tmp.write_text("new")
+    assert not left.exists() and other.exists() and out.read_text() == "new"
+
+
+# --------------------------------------------------------------------------- a full disk
+
+def _file_size_limit(limit: int):
+    def apply():
+        _as_in_a_terminal()
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)       # a write past the limit fails (EFBIG), as on a full disk
+    return apply
+
+
+@pytest.mark.parametrize("what", ["convert", "fit", "psd"])
+def test_a_full_disk_is_one_line_and_leaves_no_part_file(dataset, tmp_path, what):
+    """`convert -o x.h5` on a full disk printed HDF5 tracebacks and crashed (exit 139), leaving `.x.part-*.h5`."""
+    out = tmp_path / "out"
+    out.mkdir()
+    argv = {"convert": ["convert", str(dataset), "-o", str(out / "x.h5")],
+            "fit": ["fit", str(dataset), "-o", str(out / "m.json")],
+            "psd": PSD + ["-o", str(out / "p.csv")]}[what]
+    proc = subprocess.run([_rwadist()] + argv, capture_output=True, text=True, timeout=600,
+                          preexec_fn=_file_size_limit(20_000))
+    err = [ln for ln in proc.stderr.replace("\r", "\n").splitlines() if "error" in ln]
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    assert "Traceback" not in proc.stderr and len(err) == 1 and "File too large" in err[0]
+    assert list(out.iterdir()) == [], list(out.iterdir())
+
+
+# --------------------------------------------------------------------------- Ctrl-C
+
+def _rwadist_started(pid: int) -> bool:
+    """True once the process runs rwadist's first instruction: its entry point (``rwadist.__main__``) has installed
+    its SIGTERM handler (Python itself catches SIGINT only; before that, the interpreter is starting, which no
+    program can take over)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return True
+    caught = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("SigCgt:")), 16)
+    return bool(caught >> (signal.SIGTERM - 1) & 1)
+
+
+def _interrupt(argv, delay: float, cwd) -> tuple:
+    """Ctrl-C ``delay`` s after rwadist's first instruction; (exit code, stderr, its lines without progress)."""
+    proc = subprocess.Popen([_rwadist()] + argv, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            text=True, preexec_fn=_as_in_a_terminal)
+    while proc.poll() is None and not _rwadist_started(proc.pid):
+        time.sleep(0.0002)
+    time.sleep(delay)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    lines = [ln for ln in err.replace("\r", "\n").splitlines() if ln.strip() and "%|" not in ln
+             and "elapsed" not in ln and not ln.startswith(("WARNING", "note"))]
+    return proc.returncode, err, lines
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="reads /proc")
+@pytest.mark.parametrize("delay", [0.0, 0.01, 0.05, 0.15, 0.3, 0.6])
+def test_ctrl_c_from_the_first_instruction_is_one_line_and_130(tmp_path, delay):
+    """In the first 0.1-0.7 s (the imports) a Ctrl-C printed a KeyboardInterrupt traceback (10 of 39 tries)."""
+    code, err, lines = _interrupt(["campbell", "--preset", "ithaco-e", "--speeds-rpm", "0:3000:10",
+                                   "-o", "c.csv"], delay, tmp_path)
+    assert code == 130 and "Traceback" not in err and len(lines) == 1 and "interrupted" in lines[0], err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_ctrl_c_during_the_demo_is_never_swallowed(tmp_path):
+    """During `demo` a Ctrl-C was sometimes swallowed (`Exception ignored in: WeakValueDictionary`) and the demo ran
+    on to exit 0."""
+    for delay in (1.0, 2.0, 3.5):
+        code, err, lines = _interrupt(["demo", "--out", "d", "--n-speeds", "12"], delay, tmp_path)
+        assert code == 130 and "Exception ignored" not in err and "Traceback" not in err, err
+        assert len(lines) == 1 and "interrupted" in lines[0], err
+        left = [p.name for p in (tmp_path / "d").iterdir()] if (tmp_path / "d").exists() else []
+        assert all(not n.startswith(".") for n in left), left      # no temporary left behind
