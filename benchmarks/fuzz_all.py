@@ -1,16 +1,28 @@
-"""Fuzz every edge of the command line (issue 17): >= 300 seeded cases per surface (CLI values, model
-files through show/psd/campbell/fmu build, damaged data files through the readers), in-process; and the FMU
-surface (tests/test_fuzz_fmu.py: hostile parameters, inputs, communication points and state calls through fmpy
-into both wheel FMUs, --n cases per FMU, in child processes restarted after a crash).
+"""Fuzz every edge of the kit (issues 17, 36): >= 300 seeded cases per surface, in-process, and a table.
 
-    python benchmarks/fuzz_all.py [--n 300] [--seed 17] [--surface cli|models|readers|fmu] [-v]
+Surfaces:
 
-Prints per surface the counts: ok (accepted, may be valid), clear errors (naming the file or flag),
-unclear errors, silent (a known-invalid value accepted with exit 0) and tracebacks.  Must be 0
-tracebacks and 0 silent.  Baseline (the audit of issue 17, before this work): readers 3 tracebacks /
-14 unclear of 360; model files 45 tracebacks / 30 silent of 480; CLI 21 tracebacks / 18 silent of 174; FMU (its
-audit through fmpy): an initial speed of 1e300 stepped with fmi2OK and non-finite outputs, backwards/NaN/1e9-s
-communication points accepted, FMU state answered fmi2OK with the flag false (replay off by 0.0136).
+- ``cli``: mutated numeric flags and output paths of every command (tests/fuzz_cases.py);
+- ``readers``: damaged data files (flipped bytes, truncation, UTF-16, NaN samples, HDF5 dangling links) and bad
+  values of the fields the readers read (meta.json tach/f_lim_hz/sample_rate_hz, runs.csv speeds, a 1e308 sample,
+  TDMS wf_start_offset NaN, a MATLAB v7.3 channel stored as a group), through `convert` and `fit`;
+- ``models``: mutated model files (values beyond any real wheel's, NaN, strings, misspelt keys, a missing section,
+  unknown effect kinds, absurd effect parameters, 20 000 harmonics, extensions) through EVERY consumer: model show,
+  psd, campbell, the Python API, the coupling kit on each case, fmu build --native and diagnose on every 4th/6th;
+  a file `model show` refuses and another consumer accepts counts as silent (valid everywhere or nowhere);
+- ``api``: the public API's arguments (NaN, inf, negatives, 1e308, strings, booleans, lists, None) of
+  simulate_test, fit, psd, campbell, diagnose, load_model, save_model (tests/fuzz_surfaces.py);
+- ``fmu``: hostile parameters, inputs, communication points and state calls through fmpy into both FMUs
+  (tests/test_fuzz_fmu.py).
+
+    python benchmarks/fuzz_all.py [--n 300] [--seed 17] [--surface cli|readers|models|api|fmu] [-v]
+
+Prints per surface (per consumer for ``models``) the counts: ok (accepted, may be valid), clear (an error naming the
+file, flag or argument), unclear (refused without naming it), silent (a known-invalid value accepted, or accepted
+by one consumer and refused by another) and traceback.  Must be 0 tracebacks and 0 silent.  Baseline (before
+issue 36, its audit of 2,163 cases): 43 reader cases and 69 model-file cases silent; C = 1e308 passed model show,
+campbell and fmu build; the API checked no argument.  Before issue 17: readers 3 tracebacks / 14 unclear of 360;
+model files 45 tracebacks / 30 silent of 480; CLI 21 tracebacks / 18 silent of 174.
 """
 from __future__ import annotations
 
@@ -18,22 +30,29 @@ import argparse
 import sys
 import tempfile
 import time
+from collections import Counter, defaultdict
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import fuzz_cases as fz  # noqa: E402
+import fuzz_surfaces as fs  # noqa: E402
 import test_fuzz_fmu as fzf  # noqa: E402
+
+
+def _line(name: str, n: int, seconds: float, counts: dict) -> str:
+    return f"{name:<18} {n:>5} {seconds:>6.0f} " + " ".join(f"{counts.get(k, 0):>9}" for k in fz.OUTCOMES)
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--n", type=int, default=300)
     ap.add_argument("--seed", type=int, default=17)
-    ap.add_argument("--surface", choices=("cli", "models", "readers", "fmu"), action="append")
+    ap.add_argument("--surface", choices=("cli", "readers", "models", "api", "fmu"), action="append")
     ap.add_argument("-v", "--verbose", action="store_true", help="print every case that is not ok/clear")
     a = ap.parse_args(argv)
-    surfaces = a.surface or ["cli", "models", "readers", "fmu"]
+    surfaces = a.surface or ["cli", "readers", "models", "api", "fmu"]
     bad = 0
+    print(f"{'surface':<18} {'cases':>5} {'s':>6} " + " ".join(f"{k:>9}" for k in fz.OUTCOMES), flush=True)
     with tempfile.TemporaryDirectory(prefix="rwadist_fuzz_") as tmp:
         tmp = Path(tmp)
         for surface in surfaces:
@@ -51,27 +70,48 @@ def main(argv=None) -> int:
                                 print(f"  {r[0]:<9} {kind} {cs['params']} {cs['ops']}\n            {r[1]}")
                     c = fzf.tally(mine)
                     bad += c["traceback"] + c["silent"]
-                    print(f"fmu/{kind:<6} {len(mine)} cases in {time.perf_counter() - t0:.0f} s: " +
-                          ", ".join(f"{k} {v}" for k, v in c.items()), flush=True)
+                    print(_line(f"fmu/{kind}", len(mine), time.perf_counter() - t0, c), flush=True)
                 continue
-            if surface == "cli":
-                cases = [c + ("",) for c in fz.cli_cases(a.n, a.seed, work)]
-            elif surface == "models":
-                cases = fz.model_cases(a.n, a.seed, work)
+            if surface == "models":
+                sets = fz.make_datasets(work)
+                per = defaultdict(Counter)
+                cases = fs.model_consumer_cases(a.n, a.seed, work, sets["steady"])
+                for path, invalid, what, consumers, data in cases:
+                    out = fs.run_model_case(path, invalid, consumers, data, work)
+                    for consumer, (outcome, detail) in out.items():
+                        per[consumer][outcome] += 1
+                        if a.verbose and outcome not in ("ok", "clear"):
+                            print(f"  {outcome:<9} {consumer} {what}\n            {detail}")
+                for consumer in fs.CONSUMERS:
+                    c = per[consumer]
+                    bad += c["traceback"] + c["silent"]
+                    print(_line(f"models/{consumer}", sum(c.values()), time.perf_counter() - t0, c), flush=True)
+                continue
+            if surface == "api":
+                cases = fs.api_cases(a.n, a.seed, work)
+                results = [fs.run_api_case(c) for c in cases]
+                if a.verbose:
+                    for c, r in zip(cases, results):
+                        if r[0] not in ("ok", "clear"):
+                            print(f"  {r[0]:<9} {c[3]}\n            {r[1]}")
             else:
-                cases = fz.reader_cases(a.n, a.seed, work, fz.make_datasets(work))
-            results = []
-            for argv, names, invalid, what in cases:
-                res = fz.run_case(argv, names, invalid)
-                results.append(res)
-                if a.verbose and res[0] not in ("ok", "clear"):
-                    print(f"  {res[0]:<9} {what} | {' '.join(map(str, argv))[:160]}\n            {res[1]}")
+                if surface == "cli":
+                    cases = [c + ("",) for c in fz.cli_cases(a.n, a.seed, work)]
+                else:
+                    sets = fz.make_datasets(work)
+                    cases = fz.reader_cases(a.n // 2, a.seed, work, sets) + \
+                        fs.reader_field_cases(a.n - a.n // 2, a.seed, work, sets["steady"])
+                results = []
+                for argv_, names, invalid, what in cases:
+                    res = fz.run_case(argv_, names, invalid)
+                    results.append(res)
+                    if a.verbose and res[0] not in ("ok", "clear"):
+                        print(f"  {res[0]:<9} {what} | {' '.join(map(str, argv_))[:160]}\n            {res[1]}")
             c = fz.tally(results)
             bad += c["traceback"] + c["silent"]
-            print(f"{surface:<8} {len(cases)} cases in {time.perf_counter() - t0:.0f} s: " +
-                  ", ".join(f"{k} {v}" for k, v in c.items()), flush=True)
-    print("baseline (issue 17 audit): readers 3 tracebacks/14 unclear of 360; model files 45 tracebacks/"
-          "30 silent of 480; CLI 21 tracebacks/18 silent of 174")
+            print(_line(surface, len(cases), time.perf_counter() - t0, c), flush=True)
+    print(f"tracebacks + silent: {bad} (must be 0).  Baseline before issue 36: 43 reader and 69 model-file cases "
+          "silent of 2,163; C = 1e308 passed model show, campbell and fmu build; the API checked no argument")
     return 1 if bad else 0
 
 
