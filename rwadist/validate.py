@@ -87,9 +87,18 @@ def check_number(value, parameter: str, lo=None, hi=None, *, lo_open: bool = Fal
     return x
 
 
+#: The API parameters whose default is None (the function decides: the data's record, a default FFT length, per
+#: unit mass ...): None passes for them only; for any other, None is refused by name, not met later as a TypeError
+NONE_IS_DEFAULT = frozenset({"f_lim", "nperseg", "mass", "radius", "std_rpm", "fmax", "sample_rate", "slice_samples"})
+
+
 def check_parameter(name: str, value):
-    """``value`` of the API parameter ``name`` checked against :data:`LIMITS` (None, a default left to the
-    function, passes as None); :class:`ParameterError` naming ``name`` otherwise."""
+    """``value`` of the API parameter ``name`` checked against :data:`LIMITS` (None passes as None for the
+    parameters of :data:`NONE_IS_DEFAULT`); :class:`ParameterError` naming ``name`` otherwise."""
+    if value is None and name not in NONE_IS_DEFAULT:
+        lim = LIMITS[name]
+        allowed = _range_text(lim.get("lo"), lim.get("hi"), lim.get("lo_open", False), lim.get("hi_open", False))
+        raise ParameterError(name, f"None: must be a number in {allowed}")
     if isinstance(value, (str, bytes)):     # the API takes numbers ('3' passed check_number, then broke a sum)
         lim = LIMITS[name]
         allowed = _range_text(lim.get("lo"), lim.get("hi"), lim.get("lo_open", False), lim.get("hi_open", False))

@@ -12,3 +12,21 @@ def test_fuzz_api_arguments(tmp_path):
     bad = [(r, what) for r, what in results if r[0] not in ("ok", "clear")]
     assert not bad, bad[:5]
     assert sum(r[0] == "clear" for r, _ in results) >= 20
+
+
+def test_none_for_a_number_without_a_none_default_is_refused_by_name():
+    """None passed the API's checks as "a default left to the function" for every number, then failed inside as a
+    TypeError (psd(n_freq=None), fit(presence=None), diagnose(k_sigma=None), simulate_test(n_samples=None))."""
+    import pytest
+
+    import rwadist
+
+    test = rwadist.simulate_test("ithaco-e", [600.0, 1200.0, 1800.0, 2400.0], n_samples=1024, seed=1)
+    calls = {"n_freq": lambda: rwadist.psd(None, (600, 2400), preset="ithaco-e", n_freq=None),
+             "n_speeds": lambda: rwadist.psd(None, (600, 2400), preset="ithaco-e", n_speeds=None),
+             "presence": lambda: rwadist.fit(test, presence=None),
+             "k_sigma": lambda: rwadist.diagnose(test, k_sigma=None),
+             "n_samples": lambda: rwadist.simulate_test("ithaco-e", [600.0], n_samples=None)}
+    for name, call in calls.items():
+        with pytest.raises(rwadist.ParameterError, match=f"^{name}: None: must be a number"):
+            call()
