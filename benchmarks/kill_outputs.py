@@ -70,7 +70,10 @@ def _valid_file(p: Path) -> bool:
                 return z.testzip() is None and "modelDescription.xml" in z.namelist()
         if p.suffix == ".bdf":
             text = p.read_text()
-            return text.endswith("\n") and text.count("TABRND1") == text.count("ENDT") > 0
+            cards = [ln.split()[0] for ln in text.splitlines() if ln.strip() and not ln.startswith("$")]
+            # every table complete (its ENDT), one RANDPS per table; the deck's comments name the cards too
+            return text.endswith("\n") and cards.count("TABRND1") == cards.count("RANDPS") == \
+                sum(ln.rstrip().endswith("ENDT") for ln in text.splitlines() if not ln.startswith("$")) > 0
         if p.suffix in (".md", ".txt"):
             return p.read_text().endswith("\n")
         return p.stat().st_size > 0
