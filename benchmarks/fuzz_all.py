@@ -16,6 +16,7 @@ Surfaces:
   (tests/test_fuzz_fmu.py).
 
     python benchmarks/fuzz_all.py [--n 300] [--seed 17] [--surface cli|readers|models|api|fmu] [-v]
+    python benchmarks/fuzz_all.py --surface models --consumers fmu,diagnose     # the slow consumers on every case
 
 Prints per surface (per consumer for ``models``) the counts: ok (accepted, may be valid), clear (an error naming the
 file, flag or argument), unclear (refused without naming it), silent (a known-invalid value accepted, or accepted
@@ -49,6 +50,9 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=17)
     ap.add_argument("--surface", choices=("cli", "readers", "models", "api", "fmu"), action="append")
     ap.add_argument("-v", "--verbose", action="store_true", help="print every case that is not ok/clear")
+    ap.add_argument("--consumers", help="models: these consumers (comma separated, of "
+                    f"{','.join(fs.CONSUMERS)}) on every case; default the fast ones on every case, fmu on every "
+                    "4th, diagnose on every 6th")
     a = ap.parse_args(argv)
     surfaces = a.surface or ["cli", "readers", "models", "api", "fmu"]
     bad = 0
@@ -75,14 +79,15 @@ def main(argv=None) -> int:
             if surface == "models":
                 sets = fz.make_datasets(work)
                 per = defaultdict(Counter)
-                cases = fs.model_consumer_cases(a.n, a.seed, work, sets["steady"])
+                cases = fs.model_consumer_cases(a.n, a.seed, work, sets["steady"],
+                                                a.consumers.split(",") if a.consumers else None)
                 for path, invalid, what, consumers, data in cases:
                     out = fs.run_model_case(path, invalid, consumers, data, work)
                     for consumer, (outcome, detail) in out.items():
                         per[consumer][outcome] += 1
                         if a.verbose and outcome not in ("ok", "clear"):
                             print(f"  {outcome:<9} {consumer} {what}\n            {detail}")
-                for consumer in fs.CONSUMERS:
+                for consumer in [c for c in fs.CONSUMERS if c in per]:
                     c = per[consumer]
                     bad += c["traceback"] + c["silent"]
                     print(_line(f"models/{consumer}", sum(c.values()), time.perf_counter() - t0, c), flush=True)

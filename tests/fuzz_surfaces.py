@@ -119,9 +119,10 @@ def _mutate(doc: dict, rng: random.Random) -> tuple:
     return doc, True, "C_stderr NaN"
 
 
-def model_consumer_cases(n: int, seed: int, tmp: Path, data_dir: Path) -> list:
+def model_consumer_cases(n: int, seed: int, tmp: Path, data_dir: Path, consumers=None) -> list:
     """``n`` seeded cases: (doc file, invalid?, what, [consumers to run]).  ``data_dir``: a small steady test for
-    diagnose."""
+    diagnose.  ``consumers``: run these on every case (default: the fast ones on every case, the slow ones on every
+    ``SLOW[c]``-th)."""
     rng = random.Random(seed)
     base = fz.model_document()
     cases = []
@@ -129,7 +130,8 @@ def model_consumer_cases(n: int, seed: int, tmp: Path, data_dir: Path) -> list:
         doc, invalid, what = _mutate(copy.deepcopy(base), rng)
         path = tmp / f"mc_{seed}_{i}.json"
         path.write_text(json.dumps(doc, allow_nan=True))
-        chosen = ["show", "psd", "campbell", "api", "coupling"] + [c for c, every in SLOW.items() if i % every == 0]
+        chosen = list(consumers) if consumers else \
+            ["show", "psd", "campbell", "api", "coupling"] + [c for c, every in SLOW.items() if i % every == 0]
         cases.append((path, invalid, what, chosen, data_dir))
     return cases
 
