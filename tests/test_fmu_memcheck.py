@@ -129,11 +129,11 @@ def test_call_orders_under_address_sanitizer(both_versions, tmp_path, version):
          str(src / C_SOURCES[version]), "-lm"], "the FMU's sources with sanitizers")
     _cc([*SANITIZE, *(["-DFMI3"] if version == 3 else []), f"-I{NATIVE}", "-o", str(host), str(NATIVE / "c_orders.c"),
          "-ldl", "-lm"], "the call-order host")
-    seed = random.SystemRandom().randrange(1_000_000)
+    seed = int(os.environ.get("RWADIST_FUZZ_SEED", random.SystemRandom().randrange(1_000_000)))
     env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1:abort_on_error=0", UBSAN_OPTIONS="print_stacktrace=1")
     res = subprocess.run([str(host), str(lib), guid, "400", str(seed)], capture_output=True, text=True, timeout=600,
                          env=env)
-    assert "Sanitizer" not in res.stderr and "runtime error" not in res.stderr, (seed, res.stderr[-4000:])
+    assert "Sanitizer" not in res.stderr and "runtime error" not in res.stderr, (f"RWADIST_FUZZ_SEED={seed}", res.stderr[-4000:])
     got = _orders_result(res)
     print(f"FMI {version}.0, seed {seed}: {got}")
     assert got["failures"] == 0 and got["steps"] > 50 and got["errors"] > 1000, (seed, got)
@@ -148,7 +148,7 @@ def test_call_orders_under_valgrind(both_versions, tmp_path, version):
     host = tmp_path / "c_orders"
     _cc(["-O1", "-g", *(["-DFMI3"] if version == 3 else []), f"-I{NATIVE}", "-o", str(host),
          str(NATIVE / "c_orders.c"), "-ldl", "-lm"], "the call-order host")
-    seed = random.SystemRandom().randrange(1_000_000)
+    seed = int(os.environ.get("RWADIST_FUZZ_SEED", random.SystemRandom().randrange(1_000_000)))
     res = subprocess.run(["valgrind", "--error-exitcode=9", "--leak-check=full", "--show-leak-kinds=definite,indirect",
                           "--errors-for-leak-kinds=definite,indirect", str(host), str(lib), guid, "100", str(seed)],
                          capture_output=True, text=True, timeout=900)

@@ -314,10 +314,13 @@ typedef struct {
     char data[];
 } Blob;
 
-static size_t state_size(int n, int n_floor)
+/* doubles of the kernel state of n lines; in size_t: a stored header's n may be anything (no int overflow) */
+static size_t kernel_doubles(int32_t n) { return (size_t)2 + 2 * (size_t)(uint32_t)n + 12; }
+
+static size_t state_size(int32_t n, int32_t n_floor)
 {
-    return sizeof(StateHeader) + sizeof(Params) + sizeof(Mutable) + sizeof(double) * (size_t)(2 + 2 * n + 12) +
-           sizeof(double complex) * (size_t)n_floor;
+    return sizeof(StateHeader) + sizeof(Params) + sizeof(Mutable) + sizeof(double) * kernel_doubles(n) +
+           sizeof(double complex) * (size_t)(uint32_t)n_floor;
 }
 
 static void write_state(const Wheel *w, char *buf)
@@ -329,10 +332,10 @@ static void write_state(const Wheel *w, char *buf)
     memcpy(p, &w->par, sizeof w->par), p += sizeof w->par;
     memcpy(p, &w->mu, sizeof w->mu), p += sizeof w->mu;
     if (w->st)
-        memcpy(p, w->st, sizeof(double) * (size_t)(2 + 2 * w->n + 12));
+        memcpy(p, w->st, sizeof(double) * kernel_doubles(w->n));
     else
-        memset(p, 0, sizeof(double) * (size_t)(2 + 2 * w->n + 12));
-    p += sizeof(double) * (size_t)(2 + 2 * w->n + 12);
+        memset(p, 0, sizeof(double) * kernel_doubles(w->n));
+    p += sizeof(double) * kernel_doubles(w->n);
     if (w->n_floor)
         memcpy(p, w->floor_Z, sizeof(double complex) * (size_t)w->n_floor);
 }
@@ -374,8 +377,8 @@ static RwStatus read_state(Wheel *w, const char *buf, size_t size, const char *f
     const char *p = buf + sizeof hd + sizeof par;
     memcpy(&w->mu, p, sizeof w->mu), p += sizeof w->mu;
     if (hd.built) {
-        memcpy(w->st, p, sizeof(double) * (size_t)(2 + 2 * w->n + 12));
-        p += sizeof(double) * (size_t)(2 + 2 * w->n + 12);
+        memcpy(w->st, p, sizeof(double) * kernel_doubles(w->n));
+        p += sizeof(double) * kernel_doubles(w->n);
         if (w->n_floor)
             memcpy(w->floor_Z, p, sizeof(double complex) * (size_t)w->n_floor);
         w->floor_rot_h = -1.0;      /* the rotations are recomputed for the next step size */
