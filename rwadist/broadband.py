@@ -65,6 +65,7 @@ from . import schema
 from .data import DataError
 from .effects.actions import LineFilter, LineLaw, LineModulation, NoiseFloor, SpeedModulation, of_effects
 from .model import WheelModel
+from .presets import preset
 from .resonance import resonance
 from .speed_laws import (  # noqa: F401
     PDF_RTOL,
@@ -313,8 +314,6 @@ def preset_lines(name: str, empirical: bool = False) -> WheelLines:
     """Sources of a virtual-stand preset (:func:`rwadist.presets.preset`): empirical from its
     harmonics, or extended from its ``extended_lines()`` with the dynamic imbalance at the preset's
     ``imbalance_phase`` ahead of the static one."""
-    from .presets import preset
-
     wheel = preset(name)
     if empirical:
         src = empirical_lines(wheel.to_model())

@@ -53,8 +53,8 @@ import numpy as np
 
 from . import extended as ext
 from .errors import ParameterError
-from .teststand import Mode, WheelDescription
 from .units import THESIS_C_TO_SI
+from .wheel_description import Mode, WheelDescription
 
 #: Assumed angle of the dynamic imbalance ahead of the static one, rad (not in the thesis).
 IMBALANCE_PHASE = 0.6

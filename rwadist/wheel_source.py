@@ -15,6 +15,7 @@ from . import catalogue
 from .errors import ParameterError
 from .model import WheelModel
 from .model import load as load_model
+from .presets import preset as preset_description
 
 
 @dataclass(frozen=True)
@@ -50,8 +51,6 @@ def source_model(model=None, preset: str | None = None) -> tuple:
 
     A preset's model is its catalogue entry (with its provenance and ``modes_assumed``), else the virtual
     stand's description of it.  :class:`ParameterError` for both or neither, or an unknown preset."""
-    from .presets import preset as preset_description
-
     if preset and model is not None:
         raise ParameterError("preset", f"{preset!r} given beside a model: give a model or a preset, not both")
     if preset:

@@ -1,6 +1,8 @@
 """`rwadist psd`'s outputs written fast and unchanged: CSV text character for character printf's (np.savetxt's), the
 envelope as np.interp gives it, the plotted curves reduced without losing a peak."""
 import io
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -110,3 +112,12 @@ def test_plotted_curves_keep_every_peak():
     assert ok.all()
     short = np.linspace(0.0, 1.0, 3000)
     assert _peaks_kept(short, short, 1.0)[0] is short           # few points: drawn as they are
+
+
+def test_psd_command_loads_no_signal_stack():
+    """`rwadist psd`'s modules, the wheel-source rule and the presets load neither scipy.signal nor scipy.stats (0.8 s
+    of a 2 s command): the wheel description's dataclasses live apart from the test stand that needs them."""
+    code = ("import sys, rwadist.cli, rwadist.wheel_source, rwadist.presets, rwadist.mounting, rwadist.psd_files; "
+            "print(sorted(m for m in ('scipy.signal', 'scipy.stats') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
