@@ -525,20 +525,20 @@ def line_envelope(wheels, speed_range, f: np.ndarray, n_speeds: int = 4000) -> E
 
 
 def _interp_columns(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
-    """np.interp(x, xp, fp[:, c]) of every column c at once (numpy's formula: the same numbers); ``x`` inside
-    [xp[0], xp[-1]].  A non-increasing ``xp`` (a line folded below 0 Hz by an offset) goes to np.interp itself."""
+    """np.interp(x, xp, fp[:, c]) of every column c at once (numpy's formula, its slopes computed once per interval:
+    the same numbers); ``x`` ascending inside [xp[0], xp[-1]].  A non-increasing ``xp`` (a line folded below 0 Hz by
+    an offset) goes to np.interp itself."""
     if np.any(np.diff(xp) <= 0):
         return np.stack([np.interp(x, xp, fp[:, c]) for c in range(fp.shape[1])], axis=1)
-    j = np.searchsorted(xp, x, side="right")
-    np.clip(j, 1, xp.size - 1, out=j)
-    x0 = xp[j - 1]
-    f0 = fp[j - 1]
-    out = fp[j]                                   # ((f1 − f0) / (x1 − x0)) · (x − x0) + f0, in place
-    out -= f0
-    out /= (xp[j] - x0)[:, None]
-    out *= (x - x0)[:, None]
-    out += f0
-    out[x == xp[-1]] = fp[-1]
+    # interval of each x (xp[j] <= x < xp[j + 1]) by merging the two sorted grids: j + 1 counts the xp <= x
+    starts = np.bincount(np.searchsorted(x, xp[1:-1], side="left"), minlength=x.size + 1)[:x.size]
+    j = np.cumsum(starts)
+    slope = np.diff(fp, axis=0)
+    slope /= np.diff(xp)[:, None]
+    out = np.take(slope, j, axis=0)                     # np.take: rows gathered faster than by fancy indexing
+    out *= (x - np.take(xp, j))[:, None]
+    out += np.take(fp, j, axis=0)
+    out[x.size - np.count_nonzero(x == xp[-1]):] = fp[-1]     # x at the grid's end (the last ones: x ascending)
     return out
 
 
