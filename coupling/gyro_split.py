@@ -18,6 +18,15 @@ K block-diagonal in the wheels, and every output needed, P·Lc⁻¹·X, is
 so L0 is factorised once per frequency and each (speed, frequency) point costs a 2w × 2w solve instead of an
 n_if × n_if one (w wheels; the same numbers to rounding: tests against the direct solves and against the assembled
 state-space system).
+
+The speed ω of the sweep enters K linearly in every wheel, K_i = ω·Γ_i·(I − ω·Q_i·Γ_i)⁻¹ (flexible: Γ_i = the
+inertia ratio × speed scale, a scalar; hard-mounted: Γ_i = I_zz·scale/s·[[0, −1], [1, 0]], Q_i = 0), so with
+H = Γ·(Q + Y) (2w × 2w, one per frequency; Γ, Q block-diagonal)::
+
+    K·(I − Y·K)⁻¹ = ω·(I − ω·H)⁻¹·Γ = Σ_k ω/(1 − ω·λ_k) · v_k·u_kᵀ·Γ,     H = Σ_k λ_k v_k u_kᵀ (eigenvectors)
+
+and every speed costs a sum over the 2w eigenvalues (:meth:`FloorSolver.responses`); frequencies whose eigenvector
+matrix is ill-conditioned (> :data:`EIG_COND`) keep the 2w × 2w solve per speed.
 """
 from __future__ import annotations
 
@@ -78,6 +87,22 @@ def gyro_gain(split: dict, omega: np.ndarray) -> np.ndarray:
     return g * inv / det[..., None, None]
 
 
+def gyro_rate(split: dict, scale: float) -> np.ndarray:
+    """Γ (F, 2, 2) of a wheel whose speed is ``scale`` × the sweep's speed ω: K = ω·Γ·(I − ω·Q·Γ)⁻¹
+    (:func:`gyro_gain` at ω·scale)."""
+    F = split["s"].size
+    if split["kind"] == "rigid":
+        k = split["I_zz"] * scale / split["s"]
+        out = np.zeros((F, 2, 2), dtype=complex)
+        out[:, 0, 1], out[:, 1, 0] = -k, k
+        return out
+    return np.broadcast_to(split["ratio"] * scale * np.eye(2), (F, 2, 2)).astype(complex)
+
+
+#: Eigenvector-matrix condition number above which :meth:`FloorSolver.responses` solves per speed at a frequency.
+EIG_COND = 1e6
+
+
 class FloorSolver:
     """P·Lc⁻¹·X of the coupled interface equation at any speeds on one frequency chunk (see the module doc):
     ``setup`` once per chunk (one solve with L0ᵀ per frequency), then :meth:`coupled` and :meth:`iii` per speeds."""
@@ -99,6 +124,7 @@ class FloorSolver:
         # 'iii': the blocked loads through each wheel's free-load transmissibility, B = B0 + a·K·bw
         R3 = np.stack([np.einsum("jn,fj->fn", Mts[k], splits[k]["B0"][..., :, c]) for k, c in cols], axis=-1)
         self.PR3, self.VR3 = QP @ R3, QV @ R3
+        self._modal: tuple | None = None                                     # responses()'s terms, per scales
         self.W = np.zeros((G.shape[0], 2 * nw, len(cols)), dtype=complex)  # bw's column c in wheel k's rows
         for j, (k, c) in enumerate(cols):
             self.W[:, 2 * k:2 * k + 2, j] = splits[k]["bw"][..., :, c]
@@ -130,3 +156,58 @@ class FloorSolver:
         if "iii" in practices:
             out["iii"] = self.PR3[None] + self.A1[None] @ KW + AK @ z[..., -n:]
         return out
+
+    def responses(self, omega, scales, practices) -> dict:
+        """{practice: P·Lc⁻¹·X (S, F, n_perf, N)} at the sweep's speeds ``omega`` (S,) rad/s, wheel i at
+        ``scales[i]`` × omega, for 'coupled' and 'iii': :meth:`solve`'s numbers from one eigen-decomposition of
+        H = Γ·(Q + Y) per frequency (module doc; computed on the first call and kept for the same scales), the
+        2w × 2w solves kept where its eigenvectors are ill-conditioned."""
+        om = np.asarray(omega, dtype=float)
+        key = (tuple(float(sc) for sc in scales), tuple(practices))
+        if self._modal is None or self._modal[0] != key:
+            self._modal = (key, self._modal_terms(scales, practices))
+        lam, terms, bad = self._modal[1]
+        phi = om[None, :, None] / (1.0 - om[None, :, None] * lam[:, None, :])   # (F, S, 2w)
+        out = {}
+        for p, (T, base, shape) in terms.items():
+            Y = (phi @ T).reshape((lam.shape[0], om.size) + shape)
+            Y += base[:, None]
+            out[p] = np.moveaxis(Y, 1, 0)
+        if bad.size:
+            sub = self._at(bad)
+            direct = sub.solve(sub.gains([om * sc for sc in scales]), practices)
+            for p in practices:
+                out[p][:, bad] = direct[p]
+        return out
+
+    def _modal_terms(self, scales, practices) -> tuple:
+        """(λ (F, 2w), {practice: (Σ_k terms (F, 2w, n_perf·N), P·L0⁻¹·X (F, n_perf, N), (n_perf, N))}, frequencies
+        to solve per speed) of :meth:`responses`."""
+        nw, F = self.nw, self.Y.shape[0]
+        Gam = np.zeros((F, 2 * nw, 2 * nw), dtype=complex)
+        Qb = np.zeros_like(Gam)
+        for i, (sp, sc) in enumerate(zip(self.splits, scales)):
+            Gam[:, 2 * i:2 * i + 2, 2 * i:2 * i + 2] = gyro_rate(sp, sc)
+            Qb[:, 2 * i:2 * i + 2, 2 * i:2 * i + 2] = sp["Q"]
+        lam, V = np.linalg.eig(Gam @ (Qb + self.Y))
+        ok = np.linalg.cond(V) < EIG_COND
+        Vi = np.linalg.inv(np.where(ok[:, None, None], V, np.eye(2 * nw)))
+        alpha = self.A1 @ V                                                # (F, n_perf, 2w)
+        terms = {}
+        for p in practices:
+            X, base = (self.VR, self.PR) if p == "coupled" else (self.VR3 + self.W, self.PR3)
+            beta = Vi @ (Gam @ X)                                          # (F, 2w, N)
+            T = alpha[:, :, :, None] * beta[:, None, :, :]                 # (F, n_perf, 2w, N)
+            shape = (T.shape[1], T.shape[3])
+            terms[p] = (np.moveaxis(T, 2, 1).reshape(F, 2 * nw, -1), base, shape)
+        return lam, terms, np.nonzero(~ok)[0]
+
+    def _at(self, idx) -> "FloorSolver":
+        """This solver on the frequencies ``idx`` only."""
+        sub = object.__new__(FloorSolver)
+        sub.nw, sub._modal = self.nw, None
+        sub.splits = [{k: (v[idx] if isinstance(v, np.ndarray) and v.ndim and v.shape[0] == self.Y.shape[0] else v)
+                       for k, v in sp.items()} for sp in self.splits]
+        for name in ("A1", "Y", "PR", "VR", "PR3", "VR3", "W"):
+            setattr(sub, name, getattr(self, name)[idx])
+        return sub

@@ -609,7 +609,7 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
         for i0 in range(0, om.size, step):
             o = om[i0:i0 + step]
             Sc = Sin[i0:i0 + o.size, fs][..., None]
-            for p, Y in solver.solve(solver.gains([o * w.speed_scale for w in wheels]), dyn).items():
+            for p, Y in solver.responses(o, [w.speed_scale for w in wheels], dyn).items():
                 psd[p][i0:i0 + o.size, fs] = (np.abs(Y) ** 2 @ Sc)[..., 0]
     psd = {p: psd[p] for p in practices}
     ms = {p: _trapz(v, f, axis=1) for p, v in psd.items()}
