@@ -362,7 +362,7 @@ def _setup(plant: Plant, wheels, practices, omega):
     return om, Mts, Zm
 
 
-def _line_group(plant, wheels, Mts, Zm, practices, o, fe, ks, lines, cache) -> list:
+def _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache) -> list:
     """[(coupled loads (S, J, 6), {practice: outputs (S, J, n_perf)})] of wheels ``ks``, whose lines all sit at
     the frequencies ``fe`` (S, J) Hz at speeds ``o``: the plant, the wheels' dynamic masses and the interface
     matrix once, each practice's solve with every wheel's right-hand side at once."""
@@ -375,12 +375,18 @@ def _line_group(plant, wheels, Mts, Zm, practices, o, fe, ks, lines, cache) -> l
             Bs[i] = (Zc, Bw)
     rhs = np.concatenate([Mts[k].T @ lines[k][1][..., None] for k in ks], axis=-1)          # (S, J, n_if, |ks|)
     Lc = _interface_matrix(G, parts)                                                        # coupled interface
-    u = {"coupled": np.linalg.solve(Lc, rhs), "i": rhs}
-    if "ii" in practices:
-        u["ii"] = np.linalg.solve(np.eye(G.shape[-1]) - Zm @ G, rhs)
-    if "iii" in practices:
-        u["iii"] = np.linalg.solve(Lc, np.concatenate([Mts[k].T @ (Bs[k][1] @ lines[k][1][..., None]) for k in ks],
-                                                       axis=-1))
+    n = len(ks)
+    if "iii" in practices:               # one factorisation of Lc for both practices
+        rhs3 = np.concatenate([Mts[k].T @ (Bs[k][1] @ lines[k][1][..., None]) for k in ks], axis=-1)
+        both = np.linalg.solve(Lc, np.concatenate([rhs, rhs3], axis=-1))
+        u = {"coupled": both[..., :n], "iii": both[..., n:]}
+    else:
+        u = {"coupled": np.linalg.solve(Lc, rhs)}
+    u["i"] = rhs
+    if "ii" in practices:                # I − Zm·G, wheel by wheel on its node's rows (Zm = −Σ Mtᵀ M6 Mt)
+        rigid = [(Mt, -wheel_rigid_mass_matrix(w.params, w.housing_mass, w.housing_inertia))
+                 for Mt, w in zip(Mts, wheels)]
+        u["ii"] = np.linalg.solve(_interface_matrix(G, rigid), rhs)
     out = []
     for j, k in enumerate(ks):
         live = (lines[k][0] > 0)[..., None]
@@ -390,17 +396,26 @@ def _line_group(plant, wheels, Mts, Zm, practices, o, fe, ks, lines, cache) -> l
     return out
 
 
+#: Most (speed, line group) points :func:`line_responses` evaluates at once.
+LINE_POINTS = 3000
+
+
 def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int = 250,
                    floor_f_hz=None) -> LineResponses:
     """Steady line responses of the performance outputs for every wheel and practice at sweep
-    speeds ``omega`` (rad/s, (S,)).  Processes ``chunk`` speeds at a time.  A wheel with a speed
+    speeds ``omega`` (rad/s, (S,)).  Processes ``chunk`` speeds at a time (fewer when that makes more than
+    :data:`LINE_POINTS` line points).  A wheel with a speed
     ripple gets its sideband orders m = −K..K, K = :func:`rwadist.extended.ripple_order` over all the
     speeds (so every chunk has the same groups).  When a wheel has broadband floors, their responses
     are computed too (:func:`floor_responses` on ``floor_f_hz``, default :func:`floor_grid`) and kept
     in :attr:`LineResponses.floor`."""
     wheels = list(wheels)
-    om, Mts, Zm = _setup(plant, wheels, practices, omega)
+    om, Mts, _ = _setup(plant, wheels, practices, omega)
     kmax = [0 if w.ripple is None else ext.ripple_order(w.lines, om * w.speed_scale, w.ripple) for w in wheels]
+    # at most ~LINE_POINTS (speed, line) points at once: a speed ripple's sidebands multiply the lines, and work
+    # arrays of n_if x n_if per point beyond the caches cost more than the arithmetic
+    groups_max = max(len({(ln.h, ln.f_offset) for ln in w.lines}) * (2 * k + 1) for w, k in zip(wheels, kmax))
+    chunk = max(1, min(int(chunk), LINE_POINTS // max(groups_max, 1)))
     nw = len(wheels)
     hs, offs, orders = [None] * nw, [None] * nw, [None] * nw
     fs, hms, loads = ([[] for _ in range(nw)] for _ in range(3))
@@ -424,7 +439,7 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
             else:
                 groups.append((fe, [k]))
         for fe, ks in groups:
-            for k, (ld, y) in zip(ks, _line_group(plant, wheels, Mts, Zm, practices, o, fe, ks, lines, cache)):
+            for k, (ld, y) in zip(ks, _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache)):
                 loads[k].append(ld)
                 for p in practices:
                     ys[p][k].append(y[p])
