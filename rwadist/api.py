@@ -398,16 +398,16 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
         mass, radius or height out of range, or one of mass and radius without the other.
     """
     from .extended_fit import to_model
-    from .stand_resonance import declare_coupled_modes, fit_extended_beside_stand
+    from .stand_resonance import fit_extended_beside_stand
 
     mass, radius, start = extended_options(mass, radius, height, preset)
     test = _as_test(data)
     if empirical is None:
         empirical = fit(test)
-    # a fixture resonance lifting every channel is fitted beside the wheel's modes, never into them
+    # a fixture resonance lifting every channel is fitted with the wheel's modes, never into them (a mode the data do
+    # not tell apart from it is declared by the joint fit's standard errors)
     efit = fit_extended_beside_stand(test, empirical, mass=mass, radius=radius, height=height, start=start,
                                      progress=progress)
-    declare_coupled_modes(efit)          # a mode the stand dragged along, not told apart from it: said
     model = to_model(efit, empirical)
     refuse_non_finite_model(model, "fit")
     model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))

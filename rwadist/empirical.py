@@ -148,8 +148,8 @@ class EmpiricalFit:
     def without_mode_exclusion(self) -> "EmpiricalFit":
         """The fit of the same spectra, settings and detections with ``exclude_modes=False``: every line the data
         show, at every speed (what :func:`rwadist.extended_fit.fit_extended` locates the modes on).  Computed once
-        per fit: the extended fit's stand rounds ask for it at every round (59 times in one diagnosis of 60 speeds
-        through a fixture resonance).  Read-only: the extended fit builds new lines from it, never changes it.
+        per fit: the extended fit's passes beside a fixture resonance ask for it at every pass (59 times in one
+        diagnosis of 60 speeds through a fixture resonance, when the stand was refitted in rounds).  Read-only: the extended fit builds new lines from it, never changes it.
         The harmonics are identified and measured once: this fit's measurements (:attr:`measured`, which do not depend
         on ``exclude_modes``) are taken, only the lines are made again without the exclusion (the same numbers as a
         fit of its own, for 5 % of its CPU: 1.5 ms against 27 ms on 120 speeds)."""

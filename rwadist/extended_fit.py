@@ -44,17 +44,17 @@ from . import extended as ext
 from .data import DataError, SteadyTest
 from .dft import run_window, windowed_dfts, windowed_records
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
+from .extended_fit_close import with_close_lines
+from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower
 from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
 from .off_law_lines import free_off_law_lines, line_regressors, off_law_note
 from .spectra import compute_spectra, welch_dof
-from .units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
+from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 
-CHANNEL_INDEX = {c: i for i, c in enumerate(CHANNELS)}
 #: samples (runs × record length) of the x/y records :func:`line_senses` transforms together
 SENSE_CHUNK_SAMPLES = 1 << 20
-RADIAL = ("radial_force", "radial_torque")
 #: mode key of the fit -> its name in the model file's ``analytical.unconstrained``
 UNCONSTRAINED_NAME = {"radial_translation": "radial_translation", "rocking": "rocking", "axial_translation": "axial"}
 #: ... and back: a name of ``analytical.unconstrained`` -> the fit's mode key (``identified``, ``scans``)
@@ -90,7 +90,8 @@ class ExtendedFit:
         (written to ``analytical.unconstrained``).
     scans : per mode, the :class:`~rwadist.mode_scan.ModeScan` that located it or said why not.
     per_unit : True when mass/radius were not given (M = 1 kg, I_rr = 1 kg·m²).
-    stand : the fixture resonance (f_r Hz, ζ, peak gain) divided out of every line before the fit, or None.
+    stand : the fixture resonance (f_r Hz, ζ, peak gain[, gain above]) divided out of every line, or None: the start
+        given, or the stand fitted with the modes (``fit_stand``).
     line_residuals : (f Hz, r) of every measurement the least squares used: f = h|Ω|/2π the line's frequency
         and r = ln(measured / model amplitude) (radial lines: of sqrt(x² + y²)), the stand divided out (and a
         line whose exponent the fit freed, :func:`rwadist.off_law_lines.off_law_line`, taken with its own growth).
@@ -112,10 +113,6 @@ class ExtendedFit:
     per_unit: bool = False
     stand: tuple | None = None
     line_residuals: tuple = (np.empty(0), np.empty(0))
-    #: the located modes the stand's refit rounds dragged along (:func:`rwadist.stand_resonance.coupled_stderr`:
-    #: mode name -> (ρ, relative standard error of f with the stand fixed, its bound with the stand free)); the
-    #: caller declares them (:func:`rwadist.stand_resonance.declare_coupled_modes`)
-    coupled: dict = field(default_factory=dict)
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -176,7 +173,8 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
 
 def _line_senses_once(test: SteadyTest, fit: EmpiricalFit) -> dict:
     """:func:`line_senses` of ``test`` and ``fit``, computed once per (test, fit) and kept on the fit: a fixture
-    resonance's refit rounds fit the same test and empirical fit again and again with another stand divided out,
+    resonance's joint fit (:func:`rwadist.stand_resonance.fit_extended_beside_stand`) fits the same test and empirical
+    fit again and again with another stand divided out,
     which changes the lines' amplitudes, never their directions, h or the time series the senses are read from."""
     cached = fit.__dict__.get("_line_senses")
     if cached is None or cached[0] is not test:
@@ -279,89 +277,6 @@ def _radial_power(meas_lines):
     return np.concatenate(li).astype(int), np.concatenate(sp), np.concatenate(pw), np.concatenate(dr)
 
 
-#: direction -> (mode, stiffness, damping, inertia, gyroscopic inertia or None) of the subsystem it loads
-_SUBSYSTEM = {"radial_force": ("radial_translation", "k_r", "c_r", "mass", None),
-              "radial_torque": ("rocking", "k_rock", "c_rock", "I_rr", "I_zz"),
-              "axial_force": ("axial_translation", "k_z", "c_z", "mass", None)}
-_SUB_MODES = tuple(v[0] for v in _SUBSYSTEM.values())
-
-
-class LinePower:
-    """Measured-line powers of the least squares' forcing lines, vectorised, with analytic derivatives.
-
-    Rows: first the non-radial measurements (one line, one channel: power |A|² of
-    :func:`rwadist.extended.steady_lines` in that channel), then the radial ones (the x² + y² power of the
-    co- and counter-rotating parts of one measured line, Σ_parts 2|T(ν)|²C²Ω⁴).  Exactly the model of
-    :func:`rwadist.extended.steady_lines` for lines without law, offset or resonance, at ``height`` 0 (the
-    fit removes the lever arm first), one component each ("co" or "counter"): a component of load C·Ω² at
-    whirl rate ν = ±hΩ meets T(ν) = (k + icν)/(k − mν² + I_zz Ω ν + icν) of its direction's subsystem.
-    Written out so that the least squares costs one vectorised evaluation per point and its Jacobian none
-    (the finite-difference Jacobian of the per-line model cost one evaluation per parameter).
-
-    lines : the fit's :class:`rwadist.extended.Line` list.  omega_ax, ax_line, ax_channel : (n_ax,) speed
-    (rad/s), line index and channel index of each non-radial measurement.  omega_rad, rad_parts : (n_rad,)
-    speed and (n_rad, 2) line indices of the two parts of each radial measurement.
-    """
-
-    def __init__(self, lines, omega_ax, ax_line, ax_channel, omega_rad, rad_parts):
-        for ln in lines:
-            if ln.law is not None or ln.f_offset != 0.0 or ln.resonances or ln.sense not in ("co", "counter"):
-                raise ValueError(f"LinePower: line {ln} is not a plain co- or counter-rotating harmonic")
-        own = {"axial_force": CHANNEL_INDEX["Fz"], "axial_torque": CHANNEL_INDEX["Tz"]}
-        n_ax, n_rad = len(ax_line), len(rad_parts)
-        ax_line, rad_parts = np.asarray(ax_line, int), np.asarray(rad_parts, int).reshape(-1, 2)
-        self.n_rows = n_ax + n_rad
-        self.row = np.concatenate([np.arange(n_ax), np.repeat(np.arange(n_ax, n_ax + n_rad), 2)])
-        self.line = np.concatenate([ax_line, rad_parts.ravel()])
-        omega = np.concatenate([np.asarray(omega_ax, float), np.repeat(np.asarray(omega_rad, float), 2)])
-        weight = np.concatenate([[1.0 if own.get(lines[j].direction) == c else 0.0
-                                  for j, c in zip(ax_line, np.asarray(ax_channel, int))], np.full(2 * n_rad, 2.0)])
-        sigma = np.array([1.0 if (ln.sense == "co" or ln.direction not in RADIAL) else -1.0 for ln in lines])
-        h = np.array([ln.h for ln in lines])
-        self.omega = omega
-        self.nu = sigma[self.line] * h[self.line] * omega
-        self.scale = weight * omega**4                     # |load|² per C² and the channels the term reaches
-        mode_of = np.array([_SUB_MODES.index(_SUBSYSTEM[ln.direction][0]) if ln.direction in _SUBSYSTEM else -1
-                            for ln in lines], int)
-        self.sub = mode_of[self.line]
-        self.n_lines = len(lines)
-
-    def log_residuals(self, vals: dict, log_C: np.ndarray, log_data: np.ndarray):
-        """(r, d_mode, d_C) at parameters ``vals`` (:class:`~rwadist.extended.ExtendedParams` fields) and line
-        coefficients exp(``log_C``): r = log_data − ½ ln(model power) (n_rows,); d_mode[mode] = (∂r/∂ln k,
-        ∂r/∂ln c) of each subsystem (n_rows,) each; d_C = ∂r/∂ln C (n_rows, n_lines)."""
-        t2 = np.ones(self.nu.size)
-        dlk = np.zeros(self.nu.size)
-        dlc = np.zeros(self.nu.size)
-        for i, (mode, kn, cn, mn, gn) in enumerate(_SUBSYSTEM.values()):
-            m = self.sub == i
-            if not m.any():
-                continue
-            k, c, mass = vals[kn], vals[cn], vals[mn]
-            gyro = vals[gn] if gn else 0.0
-            nu, om = self.nu[m], self.omega[m]
-            cnu2 = (c * nu) ** 2
-            num = k * k + cnu2
-            re = k - mass * nu**2 + gyro * om * nu
-            den = re**2 + cnu2
-            t2[m] = num / den
-            dlk[m] = 2.0 * k * (k / num - re / den)        # ∂ ln|T|² / ∂ ln k
-            dlc[m] = 2.0 * cnu2 * (1.0 / num - 1.0 / den)  # ∂ ln|T|² / ∂ ln c
-        p_term = t2 * np.exp(2.0 * log_C[self.line]) * self.scale
-        p_row = np.bincount(self.row, p_term, minlength=self.n_rows)
-        live = p_row > 1e-300
-        r = log_data - 0.5 * np.log(np.maximum(p_row, 1e-300))
-        share = np.where(live[self.row], p_term / np.where(live, p_row, 1.0)[self.row], 0.0)
-        d_mode = {}
-        for i, mode in enumerate(_SUB_MODES):
-            m = self.sub == i
-            d_mode[mode] = (-0.5 * np.bincount(self.row[m], (share * dlk)[m], minlength=self.n_rows),
-                            -0.5 * np.bincount(self.row[m], (share * dlc)[m], minlength=self.n_rows))
-        d_C = np.zeros((self.n_rows, self.n_lines))
-        np.add.at(d_C, (self.row, self.line), -share)
-        return r, d_mode, d_C
-
-
 def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=None):
     """Profile scan (:mod:`rwadist.mode_scan`) of each mode on the measured lines (``radial``: their
     :func:`_radial_power`; ``near``: :func:`fit_extended`)."""
@@ -383,7 +298,8 @@ def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=Non
 def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None, radius: float | None = None,
                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
                  progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
-                 more_stands: tuple = (), near: dict | None = None) -> ExtendedFit:
+                 more_stands: tuple = (), near: dict | None = None, fit_stand: bool = False,
+                 declare: bool = True) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
     mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None:
@@ -395,13 +311,19 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     data before the fit and put back in the model.  start: parameters for modes the data do not
     constrain (default: modes at 3x the top line frequency, ζ = zeta0).  tolerance: relative
     frequency error the data must exclude for a mode to count as found (:func:`scan_mode`).
-    stand: (f_r Hz, ζ, peak gain) of a fixture resonance acting on every channel (``rwadist diagnose``'s
-    ``fixed_resonance`` of role test_stand), or None: every measured line amplitude is divided by its |H|
+    stand: (f_r Hz, ζ, peak gain[, gain above]) of a fixture resonance acting on every channel (``rwadist diagnose``'s
+    ``fixed_resonance`` of role test_stand; :func:`rwadist.resonance.resonance`), or None: every measured line
+    amplitude is divided by its |H|
     (:func:`rwadist.resonance.resonance`) before the modes are located and fitted, so that the fixture's
     amplification is not taken for the wheel's.  more_stands: further fixture resonances (each (f_r Hz, ζ,
     peak gain), on every channel) divided out the same way (``rwadist diagnose`` checks the modes beside every
     test-stand resonance it named); not recorded in ``ExtendedFit.stand``.  near: mode -> ``near_hz``/``near_a`` of
     :func:`rwadist.mode_scan.scan_mode` (where an earlier fit of the same wheel located it), or None.
+    fit_stand: the modes are located with ``stand`` divided out, and its parameters (f_r, ζ, the numerator's damping
+    and the gain above, :class:`rwadist.resonance.FittedResonance`) are fitted in the modes' least squares, from it:
+    the modes' standard errors are those with the stand free (what the stand could take of their lines is counted).
+    declare: False keeps every located mode in the least squares, however loose (the joint fit's passes, whose next
+    scans start from the stand it fits: a mode dropped there leaves its lines to the stand alone).
 
     Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
     measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
@@ -421,7 +343,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         fit = fit_empirical(spectra, settings)
     # every line the data show, with every measurement: the empirical fit without modal
     # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped); once per fit
-    meas = fit.without_mode_exclusion
+    meas = with_close_lines(test, fit.without_mode_exclusion)      # close lines measured together on the records
     senses_xy = _line_senses_once(test, meas)
     stands = ([] if stand is None else [stand]) + list(more_stands)
     if stands:
@@ -501,6 +423,14 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
 
     power = LinePower(lines, sa, ax_line, ca, sr, rad_parts)
     log_data = np.concatenate([np.log(np.maximum(aa, 1e-300)), 0.5 * np.log(np.maximum(pr, 1e-300))])
+    h_meas = np.array([x.h for x in meas.lines]) if meas.lines else np.zeros(0)
+    f_rows = np.concatenate([h_meas[la] * np.abs(sa), h_meas[lr] * np.abs(sr)]) / (2 * np.pi)
+    joint = None
+    if fit_stand and stand is not None:
+        from .resonance import FittedResonance
+        joint = FittedResonance(stand, f_rows)
+        # the start stand multiplied back: the least squares divides out its own
+        log_data = log_data + 0.5 * joint.start_log_gain
 
     row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
 
@@ -510,9 +440,11 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         :func:`rwadist.off_law_lines.off_law_line`)."""
         names = [p for m in free_modes for p in _MODE_PARAMS[m][:2]] + \
                 [f"C[{ln.direction},{ln.h:g},{ln.sense}]" for ln in lines] + \
-                [f"p-2[{meas.lines[j].direction},{meas.lines[j].h:g}]" for j in off_law]
+                [f"p-2[{meas.lines[j].direction},{meas.lines[j].h:g}]" for j in off_law] + \
+                (list(joint.NAMES) if joint else [])
         x0 = np.concatenate([np.log([base[n] for m in free_modes for n in _MODE_PARAMS[m][:2]]), x_lines,
-                             np.zeros(len(off_law))])
+                             np.zeros(len(off_law))] + ([joint.x0] if joint else []))
+        n_off = len(off_law)
         n_mode = 2 * len(free_modes)
         n_c = len(lines)
         off_rows = [np.where(row_line == j, centred_log_w, 0.0) for j in off_law]
@@ -547,8 +479,15 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                     crit = 1.9 * math.sqrt(vals[kn] * vals[inertia])
                     clamped[m] = math.exp(theta[2 * i + 1]) > crit
                     vals[cn] = min(math.exp(theta[2 * i + 1]), crit)
-                r, d_mode, d_C = power.log_residuals(vals, theta[n_mode:n_mode + n_c], log_data)
-                J = np.zeros((r.size, theta.size))
+                if joint is None:
+                    r, d_mode, d_C = power.log_residuals(vals, theta[n_mode:n_mode + n_c], log_data)
+                    J = np.zeros((r.size, theta.size))
+                else:
+                    # the stand divided out at its own parameters: r = ln data − ln|H| − ½ ln P
+                    y_s, dy_s = joint.log_gain(theta[n_mode + n_c + n_off:])
+                    r, d_mode, d_C = power.log_residuals(vals, theta[n_mode:n_mode + n_c], log_data - 0.5 * y_s)
+                    J = np.zeros((r.size, theta.size))
+                    J[:, n_mode + n_c + n_off:] = -0.5 * dy_s
                 for i, L in enumerate(off_rows):      # a freed line's own growth (|Ω|/Ω_line)^δ
                     r = r - theta[n_mode + n_c + i] * L
                     J[:, n_mode + n_c + i] = -L
@@ -570,8 +509,10 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
             crit = 2 * math.sqrt(base[kn] * base[inertia])
             lo += [math.log(base[kn] / 1.1), math.log(1e-4 * crit / 2)]
             hi += [math.log(base[kn] * 1.1), math.log(0.95 * crit * 2)]
-        lo += list(x0[n_mode:n_mode + n_c] - math.log(1e4)) + [-3.0] * len(off_law)
-        hi += list(x0[n_mode:n_mode + n_c] + math.log(1e3)) + [3.0] * len(off_law)
+        lo += list(x0[n_mode:n_mode + n_c] - math.log(1e4)) + [-3.0] * len(off_law) + \
+            (list(joint.lower) if joint else [])
+        hi += list(x0[n_mode:n_mode + n_c] + math.log(1e3)) + [3.0] * len(off_law) + \
+            (list(joint.upper) if joint else [])
         res = optimize.least_squares(lambda th: evaluate(th)["r"], x0, jac=lambda th: evaluate(th)["J"],
                                      bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
                                      verbose=2 if progress else 0)
@@ -609,7 +550,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         (res, names, rel_se, unpack, at_bound), loose = free_off_law_lines(
             lambda lns: least_squares(free_modes, lns), lambda t: loose_modes(t[0], t[2], t[4], free_modes),
             off_law, row_line, log_w)
-        if not loose:
+        if not loose or not declare:
             break
         for m, why in loose:
             scans[m].reason = why
@@ -621,8 +562,12 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
             base[cn] = 2 * zeta0 * math.sqrt(base[kn] * base[inertia])
             free_modes.remove(m)
     params, fitted_lines = unpack(res.x)
-    notes += [off_law_note(meas.lines[j], res.x[i - len(off_law)], rel_se[i - len(off_law)])
+    n_st = len(joint.NAMES) if joint else 0
+    n_x = res.x.size - n_st
+    notes += [off_law_note(meas.lines[j], res.x[n_x + i - len(off_law)], rel_se[n_x + i - len(off_law)])
               for i, j in enumerate(off_law)]
+    if joint is not None:
+        stand = joint.stand(res.x[n_x:])
     params = replace(params, height=float(height))
     rel_stderr = {n: float(v) for n, v in zip(names, rel_se)}
     zeta = {"radial_translation": params.zeta_r, "rocking": params.zeta_rock, "axial_translation": params.zeta_z}
@@ -771,8 +716,9 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
         analytical["fit"]["unresolved_lines"] = unresolved
     if efit.stand is not None:
         # the fixture's resonance is not the wheel's: kept out of its model, recorded for the user
-        f_r, zeta, gain = efit.stand
-        analytical["fit"]["test_stand"] = {"f_Hz": f_r, "zeta": zeta, "peak_gain": gain}
+        f_r, zeta, gain, *above = efit.stand
+        analytical["fit"]["test_stand"] = {"f_Hz": f_r, "zeta": zeta, "peak_gain": gain,
+                                           "gain_above": above[0] if above else 1.0}
     if efit.per_unit:
         analytical["fit"]["per_unit"] = ("mass and radius not given: mass_kg = 1 and I_rr = 1 are units, the "
                                          "stiffnesses and damping are per unit mass / transverse inertia")

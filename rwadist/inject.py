@@ -143,11 +143,12 @@ class Stand:
         return next((v for (d, hh), v in self.wheel.senses.items() if d == direction and abs(hh - h) <= 1e-6), "co")
 
     @staticmethod
-    def mode(name, f_hz, zeta, gain, channels):
-        """A fixed-frequency resonance of the stand's simulation (:class:`rwadist.teststand.Mode`)."""
+    def mode(name, f_hz, zeta, gain, channels, gain_above=1.0):
+        """A fixed-frequency resonance of the stand's simulation (:class:`rwadist.teststand.Mode`; ``gain_above``: H far
+        above it, :mod:`rwadist.resonance`)."""
         from .teststand import Mode
 
-        return Mode(name, f_hz, zeta, gain, channels)
+        return Mode(name, f_hz, zeta, gain, channels, gain_above=gain_above)
 
     @staticmethod
     def add_line(run, direction, amp, phase, sense=1.0) -> None:

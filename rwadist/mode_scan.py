@@ -8,12 +8,12 @@ complex-coordinate load e^{iνt} (ν > 0 with the spin, ν < 0 against it) at wh
     T(ν) = (ω0² + 2iζω0ν) / (ω0² − ν² + aΩν + 2iζω0ν)      (a = 0 for translation and axial)
 
 A radial line's measured power x² + y² is Ω⁴(P_co|T(+hΩ)|² + P_counter|T(−hΩ)|²): for a given
-(f0, ζ, a) linear in the two non-negative forcing powers, solved per line in closed form (a 2-variable
-non-negative least squares).  Both whirls therefore enter: co-rotating content meets the forward
+(f0, ζ, a) the two non-negative forcing powers are solved per line in closed form (:func:`_grid_search`).  Both
+whirls therefore enter: co-rotating content meets the forward
 whirl, counter-rotating content the backward whirl, over whatever speeds the data cover.  An axial
 line has one coefficient.
 
-The scan evaluates the relative power residual Σ(model/data − 1)² on a grid of (f0, ζ, a) and keeps
+The scan evaluates the log power residual Σ ln²(model/data) on a grid of (f0, ζ, a) and keeps
 the profile over f0 (minimum over ζ, a and the forcing).  A mode is **found** when its profile has
 an interior minimum that is sharp: every f0 more than ``tolerance`` away from the best one fits
 worse by a log-likelihood ratio of at least ``min_log_lr`` (n/2·ln(SSR/SSR_best), n measurements;
@@ -78,21 +78,62 @@ def transmissibility_sq(nu, omega, f0_hz, zeta, a):
     return (w02**2 + d2) / ((w02 - nu**2 + a * om * nu) ** 2 + d2)
 
 
+#: A line of the scan may take an exponent of its own (its log residual detrended in ln|Ω|) at the cost of a trend this
+#: many standard errors from 0 (a likelihood ratio of OFF_LAW_Z², as :mod:`rwadist.off_law_lines` frees one in the fit)
+OFF_LAW_Z = 4.0
+
+
+class _Trend:
+    """Per-row ln|Ω| less its line's mean (``lc``), per line Σ lc² (``lc2``) and the factor e^{Z²/n} (``factor``) of
+    :func:`_line_log_ssr`'s off-law option, the rows sorted by line."""
+
+    def __init__(self, om, starts, counts):
+        lw = np.log(om)
+        mean = np.add.reduceat(lw, starts) / counts
+        self.lc = lw - np.repeat(mean, counts.astype(int))
+        self.lc2 = np.add.reduceat(self.lc**2, starts)
+        self.factor = np.exp(OFF_LAW_Z**2 / counts)
+
+
+def _line_log_ssr(lw, starts, counts, trend=None):
+    """Per line (along the last axis, its rows from ``starts``, ``counts`` of them) Σ(lw − mean lw)²: the log least
+    squares of the line's rows with its scale free (closed form: the scale is the mean).  With ``trend``
+    (:class:`_Trend`), the least of that and the line with an exponent of its own (lw detrended in ln|Ω|, closed form)
+    times e^{Z²/n}, the likelihood ratio a trend must earn: one line of another law (an Ω³ amplitude law across the
+    band) then weighs in the scan as one such line, not as a mode's skirt (the E wheel's translation placed 7 % low)."""
+    s1 = np.add.reduceat(lw, starts, axis=-1)
+    s2 = np.add.reduceat(lw * lw, starts, axis=-1)
+    ssr = np.maximum(s2 - s1 * s1 / counts, 0.0)
+    if trend is None:
+        return ssr
+    sl = np.add.reduceat(lw * trend.lc, starts, axis=-1)
+    free = np.maximum(ssr - np.where(trend.lc2 > 0, sl * sl / np.where(trend.lc2 > 0, trend.lc2, 1.0), 0.0), 0.0)
+    return np.minimum(ssr, free * trend.factor)
+
+
 def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, chunk=512):
-    """SSR of the relative power residual (f0_grid.size, zeta_grid.size, a_grid.size) on the grid, the forcing
-    solved per line: Σ over lines of min over P ≥ 0 of Σ_rows (P·|T|²·Ω⁴/power − 1)², P = (P_co, P_counter) of a
-    radial line (``two_parts``; a 2-variable non-negative least squares in closed form) or one P of an axial one.
+    """SSR of the log power residual (f0_grid.size, zeta_grid.size, a_grid.size) on the grid, each line's forcing
+    solved per line: Σ over lines of min over its forcing of Σ_rows ln²(P·|T|²·Ω⁴/power).
+
+    One forcing P (an axial line, or no gyroscopic term: both senses meet the same |T|²): ln P is minus the mean of
+    ln u, u = |T|²Ω⁴/power, in closed form.  Two (a radial line through the rocking whirls: P_co through T(+hΩ), P_ct
+    through T(−hΩ)): the least of co-rotating only, counter-rotating only, and both at the split the relative-power
+    non-negative least squares gives (min Σ(P_co·u + P_ct·v − 1)², 2 variables in closed form), their common scale
+    free.  Log rather than relative powers: a mode placed a little off a sharp peak overpredicts some rows tenfold, which
+    a relative residual squares (81) where it forgives an underprediction (at most 1), so a coarse grid preferred broad
+    modes far from every line (the rocking mode of a wheel at 258 Hz, ζ 0.1, put at 314 Hz, a = 0.42); the least
+    squares that follows the scan is in logs too.
 
     line (rows,) int line index; h, omega (rows,); power (rows,) measured x²+y² (radial) or amp² (axial).
+    two_parts : a radial line's forcing has a co- and a counter-rotating part (not restricted by the sense measured at
+    the load cell: the whirls amplify one sense more than the other, so a line forced 80 % co-rotating reads 95 %
+    co-rotating near the forward whirl, and scanned as co-rotating only it put the family's new wheel's rocking mode at
+    87 Hz, truth 95).
 
     The grid is a product: d² = (2ζω0ν)² depends on (f0, ζ, row) only, ω0² − ν² ± aΩν on (f0, a, row) only, so
     those are computed on their own sub-grids and broadcast; the sums over each line's rows are segment sums of
     the rows sorted by line (:func:`numpy.add.reduceat`).  Chunks of f0 hold about ``chunk``·256 elements per
-    term: 512 rather than 128 (more numpy calls per f0 on the small grids of a few lines) or 1024 (more memory
-    traffic), measured on the 450 scans of four diagnoses: 12-14 % less CPU than 128, the same numbers (each f0's
-    sums are the same operations on the same rows).  The per-row terms u, v (each sense's |T|²·Ω⁴/power), their
-    squares and product are written into one buffer allocated once (fresh temporaries of this size cost a
-    page-fault pass each) and summed per line by one segment sum."""
+    term."""
     f0_grid, zeta_grid, a_grid = (np.asarray(x, float) for x in (f0_grid, zeta_grid, a_grid))
     order = np.argsort(line, kind="stable")
     line_s = np.asarray(line)[order]
@@ -104,52 +145,44 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
     nu2 = nu**2
     gyro = (a_grid[:, None] * om[None, :]) * nu[None, :]                 # (A, rows)
     # no gyroscopic term (translation modes, or a = 0): both senses see the same |T|² and the two parts are one
-    # (their 2x2 system is singular)
     same = not np.any(gyro)
+    both_senses = two_parts and not same
+    trend = _Trend(om, starts, counts)
     n_z, n_a, n_rows = zeta_grid.size, a_grid.size, om.size
     out = np.empty((f0_grid.size, n_z, n_a))
     step = max(1, chunk * 256 // max(n_rows * n_z * n_a, 1))
-    both_senses = two_parts and not same
-    # u, u², (v, v², u·v): the terms summed per line, one buffer reused by every chunk
-    buf = np.empty((5 if both_senses else 2, min(step, f0_grid.size), n_z, 1 if same else n_a, n_rows))
     for s in range(0, f0_grid.size, step):
         w0 = 2 * np.pi * f0_grid[s:s + step]                                           # (F,)
-        n_f = w0.size
         w02 = w0**2
         d2 = ((2 * zeta_grid[None, :] * w0[:, None])[:, :, None] * nu[None, None, :]) ** 2   # (F, Z, rows)
         num = ((w02**2)[:, None, None] + d2) * scale                                  # |T|² numerator × scale
         rest = w02[:, None] - nu2[None, :]                                            # (F, rows)
-        b = buf[:, :n_f]
-        u = b[0]
-        if not both_senses:
-            if same:
-                np.divide(num, rest[:, None, :] ** 2 + d2, out=u[:, :, 0, :])         # (F, Z, 1, rows)
-            else:
-                np.add(((rest[:, None, :] + gyro[None]) ** 2)[:, None], d2[:, :, None, :], out=u)
-                np.divide(num[:, :, None, :], u, out=u)
-            np.multiply(u, u, out=b[1])
-            sums = np.add.reduceat(b, starts, axis=-1)
-            su, suu = sums[0], sums[1]
-            out[s:s + step] = np.sum(counts - su**2 / suu, axis=-1)
+        lnum = np.log(num)
+        if same:
+            lw = (lnum - np.log(rest[:, None, :] ** 2 + d2))[:, :, None, :]           # (F, Z, 1, rows)
+            out[s:s + step] = np.sum(_line_log_ssr(lw, starts, counts, trend), axis=-1)
             continue
-        v = b[2]
-        np.add(((rest[:, None, :] + gyro[None]) ** 2)[:, None], d2[:, :, None, :], out=u)
-        np.divide(num[:, :, None, :], u, out=u)
-        np.add(((rest[:, None, :] - gyro[None]) ** 2)[:, None], d2[:, :, None, :], out=v)
-        np.divide(num[:, :, None, :], v, out=v)
-        np.multiply(u, u, out=b[1])
-        np.multiply(v, v, out=b[3])
-        np.multiply(u, v, out=b[4])
-        sums = np.add.reduceat(b, starts, axis=-1)
-        su, suu, sv, svv, suv = sums[0], sums[1], sums[2], sums[3], sums[4]
+        lnum = lnum[:, :, None, :]
+        den_u = ((rest[:, None, :] + gyro[None]) ** 2)[:, None] + d2[:, :, None, :]    # (F, Z, A, rows)
+        if not both_senses:
+            out[s:s + step] = np.sum(_line_log_ssr(lnum - np.log(den_u), starts, counts, trend), axis=-1)
+            continue
+        den_v = ((rest[:, None, :] - gyro[None]) ** 2)[:, None] + d2[:, :, None, :]
+        ssr = np.minimum(_line_log_ssr(lnum - np.log(den_u), starts, counts, trend),
+                         _line_log_ssr(lnum - np.log(den_v), starts, counts, trend))
+        u, v = num[:, :, None, :] / den_u, num[:, :, None, :] / den_v
+        su, suu, sv, svv, suv = (np.add.reduceat(t, starts, axis=-1) for t in (u, u * u, v, v * v, u * v))
         det = suu * svv - suv**2
         safe = np.where(np.abs(det) > 1e-14 * suu * svv, det, np.nan)
         x = (svv * su - suv * sv) / safe
         y = (suu * sv - suv * su) / safe
-        both = counts - (su * x + sv * y)
-        only_u, only_v = counts - su**2 / suu, counts - sv**2 / svv
-        ok = (x >= 0) & (y >= 0) & np.isfinite(both)
-        out[s:s + step] = np.sum(np.where(ok, both, np.minimum(only_u, only_v)), axis=-1)
+        ok = (x > 0) & (y > 0)
+        if np.any(ok):
+            reps = counts.astype(int)
+            mix = np.repeat(np.where(ok, x, 1.0), reps, axis=-1) * u + np.repeat(np.where(ok, y, 0.0), reps,
+                                                                                    axis=-1) * v
+            ssr = np.where(ok, np.minimum(ssr, _line_log_ssr(np.log(mix), starts, counts)), ssr)
+        out[s:s + step] = np.sum(ssr, axis=-1)
     return out
 
 

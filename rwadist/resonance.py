@@ -6,7 +6,16 @@ is multiplied by::
     H(r) = (1 − r² + 2j·g·ζ·r) / (1 − r² + 2j·ζ·r),   r = f / f_r
 
 so H(0) = 1, |H(1)| = g and H → 1 far above the mode (the line is amplified near f_r only).  For g > 1
-it amplifies, for g < 1 it notches.  Used by the test-stand simulator (:class:`rwadist.teststand.Mode`),
+it amplifies, for g < 1 it notches.
+
+A fixture resonance need not return to 1 above f_r: the force a load cell reads through a fixture spring falls
+as 2ζ/r above it (the transmissibility (1 + 2jζr)/(1 − r² + 2jζr)), one without the damper's path as 1/r².  The
+general single-mode gain with H(0) = 1 (the static load passes whole) and H → β far above is::
+
+    H(r) = (1 − β·r² + 2j·γ·ζ·r) / (1 − r² + 2j·ζ·r),   |H(1)| = g = sqrt((1 − β)² + (2γζ)²) / (2ζ)
+
+(β = 1, γ = g: the form above; β = 0, γ = 1: the transmissibility; β = γ = 0: the bare single mode).  A model file
+gives it by f_r, ζ, the peak gain g and ``gain_above`` β (default 1); γ follows from them (:func:`numerator_damping`).  Used by the test-stand simulator (:class:`rwadist.teststand.Mode`),
 ``rwadist diagnose`` (``fixed_resonance`` effects), the extended model and ``rwadist psd`` (wheel-mode
 resonances of a model file).  The FMU runtime (``fmu/runtime.py``) keeps its own inline copy on
 purpose, so that it stays self-contained for simulation hosts; ``tests/test_resonance.py`` pins that
@@ -17,7 +26,26 @@ from __future__ import annotations
 import numpy as np
 
 
-def resonance_response(r, zeta: float, peak_gain: float) -> np.ndarray:
+def numerator_damping(zeta: float, peak_gain: float, gain_above: float = 1.0) -> float:
+    """γ of the general gain (module docstring) with |H(1)| = ``peak_gain`` and H → ``gain_above`` far above:
+    sqrt((2ζg)² − (1 − β)²)/(2ζ), 0 when g is below |1 − β|/(2ζ) (no such gain has that peak); g itself when β = 1."""
+    if gain_above == 1.0:
+        return float(peak_gain)
+    two_z = 2.0 * zeta
+    return float(np.sqrt(max((two_z * peak_gain) ** 2 - (1.0 - gain_above) ** 2, 0.0)) / two_z)
+
+
+def smallest_peak(zeta: float, gain_above: float) -> float:
+    """The least |H(1)| a gain of damping ``zeta`` reaching ``gain_above`` far above can have: |1 − β|/(2ζ) (γ = 0)."""
+    return abs(1.0 - gain_above) / (2.0 * zeta)
+
+
+def peak_of(zeta: float, gamma: float, gain_above: float) -> float:
+    """|H(1)| of the general gain (module docstring) of numerator damping ``gamma``: sqrt((1 − β)² + (2γζ)²)/(2ζ)."""
+    return float(np.hypot(1.0 - gain_above, 2.0 * gamma * zeta) / (2.0 * zeta))
+
+
+def resonance_response(r, zeta: float, peak_gain: float, gain_above: float = 1.0) -> np.ndarray:
     """H(r) at frequency ratio ``r`` (any shape, SIGNED: a negative r gives the complex conjugate).
 
     Parameters
@@ -28,6 +56,8 @@ def resonance_response(r, zeta: float, peak_gain: float) -> np.ndarray:
         Damping ratio, dimensionless (> 0).
     peak_gain : float
         |H| at r = ±1, dimensionless.
+    gain_above : float
+        H far above the resonance (β of the module docstring), dimensionless; 1 (default): H → 1 on both sides.
 
     Returns
     -------
@@ -37,11 +67,14 @@ def resonance_response(r, zeta: float, peak_gain: float) -> np.ndarray:
     r = np.asarray(r, dtype=float)
     base = 1.0 - r * r
     two_zr = 2.0 * zeta * r
-    return (base + 1j * peak_gain * two_zr) / (base + 1j * two_zr)
+    if gain_above == 1.0:
+        return (base + 1j * peak_gain * two_zr) / (base + 1j * two_zr)
+    gamma = numerator_damping(zeta, peak_gain, gain_above)
+    return (1.0 - gain_above * r * r + 1j * gamma * two_zr) / (base + 1j * two_zr)
 
 
-def resonance(f_hz, f_r: float, zeta: float, peak_gain: float) -> np.ndarray:
-    """Complex gain H(r), r = |f|/f_r, of a simple resonance at ``f_r`` with H → 1 far from it.
+def resonance(f_hz, f_r: float, zeta: float, peak_gain: float, gain_above: float = 1.0) -> np.ndarray:
+    """Complex gain H(r), r = |f|/f_r, of a simple resonance at ``f_r``, H(0) = 1 and H → ``gain_above`` far above.
 
     Parameters
     ----------
@@ -53,13 +86,15 @@ def resonance(f_hz, f_r: float, zeta: float, peak_gain: float) -> np.ndarray:
         Damping ratio, dimensionless (> 0).
     peak_gain : float
         |H(f_r)|, dimensionless.
+    gain_above : float
+        H far above f_r, dimensionless (default 1).
 
     Returns
     -------
     numpy.ndarray
         Complex gain, dimensionless, the shape of ``f_hz``.
     """
-    return resonance_response(np.abs(np.asarray(f_hz, dtype=float)) / f_r, zeta, peak_gain)
+    return resonance_response(np.abs(np.asarray(f_hz, dtype=float)) / f_r, zeta, peak_gain, gain_above)
 
 
 def resonance_gain(nu, resonances) -> np.ndarray:
@@ -72,8 +107,8 @@ def resonance_gain(nu, resonances) -> np.ndarray:
     ----------
     nu : array_like
         Whirl rates, rad/s, any shape, signed.
-    resonances : iterable of (float, float, float)
-        (f_r Hz, ζ, peak gain) of each resonance; empty gives ones.
+    resonances : iterable of (float, float, float[, float])
+        (f_r Hz, ζ, peak gain[, gain above]) of each resonance; empty gives ones.
 
     Returns
     -------
@@ -82,8 +117,8 @@ def resonance_gain(nu, resonances) -> np.ndarray:
     """
     nu = np.asarray(nu, dtype=float)
     out = np.ones(nu.shape, dtype=complex)
-    for f_r, zeta, g in resonances:
-        out = out * resonance_response(nu / (2.0 * np.pi * f_r), zeta, g)
+    for f_r, zeta, g, *above in resonances:
+        out = out * resonance_response(nu / (2.0 * np.pi * f_r), zeta, g, *above)
     return out
 
 
@@ -127,3 +162,83 @@ def log_power_gain_jacobian(f_hz, f_r: float, zeta: float, peak_gain: float) -> 
     out[..., 2] = 2.0 * g2a2 / N
     out[..., 1] = out[..., 2] - 2.0 * a2 / D
     return out
+
+
+def general_log_power_gain(f_hz, f_r: float, zeta: float, gamma: float, gain_above: float):
+    """(ln|H|², its derivatives) of the general gain (module docstring) in its least-squares parameters.
+
+    With B = 1 − βr², b = 1 − r², A = 2ζr, r = |f|/f_r: ln|H|² = ln(B² + γ²A²) − ln(b² + A²) =: ln N − ln D, and::
+
+        ∂/∂ln f_r = (4Bβr² − 2γ²A²)/N − (4br² − 2A²)/D
+        ∂/∂ln ζ   = 2γ²A²/N − 2A²/D
+        ∂/∂γ      = 2γA²/N
+        ∂/∂β      = −2Br²/N
+
+    (β = 1, γ = g: γ·∂/∂γ is :func:`log_power_gain_jacobian`'s ∂/∂ln g).
+
+    Parameters
+    ----------
+    f_hz : array_like
+        Line frequencies, Hz, shape (n,) (the sign is ignored).
+    f_r : float
+        Resonance frequency, Hz (> 0).
+    zeta : float
+        Damping ratio, dimensionless (> 0).
+    gamma : float
+        Numerator damping γ, dimensionless (>= 0).
+    gain_above : float
+        β, H far above f_r, dimensionless.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ln|H|² (n,) and its derivatives (n, 4) with respect to (ln f_r, ln ζ, γ, β).
+    """
+    r = np.abs(np.asarray(f_hz, dtype=float)) / f_r
+    r2 = r * r
+    B = 1.0 - gain_above * r2
+    b = 1.0 - r2
+    A2 = (2.0 * zeta * r) ** 2
+    gA2 = gamma * gamma * A2
+    N = np.maximum(B * B + gA2, 1e-300)
+    D = b * b + A2
+    out = np.empty(r.shape + (4,))
+    out[..., 0] = (4.0 * B * gain_above * r2 - 2.0 * gA2) / N - (4.0 * b * r2 - 2.0 * A2) / D
+    out[..., 1] = 2.0 * gA2 / N - 2.0 * A2 / D
+    out[..., 2] = 2.0 * gamma * A2 / N
+    out[..., 3] = -2.0 * B * r2 / N
+    return np.log(N) - np.log(D), out
+
+
+class FittedResonance:
+    """A fixture resonance's parameters in a least squares of log line amplitudes (the extended fit's, fitted with the
+    wheel's modes: :func:`rwadist.extended_fit.fit_extended` with ``fit_stand``).
+
+    Parameters θ = (ln f_r, ln ζ, γ, β) of the general single-mode gain H(r) = (1 − βr² + 2jγζr)/(1 − r² + 2jζr)
+    (:mod:`rwadist.resonance`), the same on every channel; each least-squares row (a line at f Hz) divides it out:
+    r = ln(measured) − ln|H(f)| − ln(model), so the modes' standard errors are those with the stand free.
+    ``start``: (f_r Hz, ζ, peak gain[, gain above]); ``f_rows``: each row's line frequency, Hz.  Bounds: f_r within
+    ±10 % of the start, ζ in [0.001, 0.3], γ in [0, 200], β in [−1, 3]."""
+
+    NAMES = ("stand_ln_f", "stand_ln_zeta", "stand_gamma", "stand_gain_above")
+
+    def __init__(self, start, f_rows):
+        f_r, zeta, gain, *above = (float(v) for v in start)
+        beta = above[0] if above else 1.0
+        self.f_rows = np.asarray(f_rows, dtype=float)
+        self.x0 = np.array([np.log(f_r), np.log(np.clip(zeta, 0.0011, 0.29)),
+                            min(numerator_damping(zeta, gain, beta), 199.0), np.clip(beta, -0.99, 2.99)])
+        self.lower = np.array([np.log(0.9 * f_r), np.log(1e-3), 0.0, -1.0])
+        self.upper = np.array([np.log(1.1 * f_r), np.log(0.3), 200.0, 3.0])
+        self.start_log_gain = np.log(np.abs(resonance(self.f_rows, f_r, zeta, gain, beta)) ** 2)
+
+    def log_gain(self, theta):
+        """(ln|H|² at every row (rows,), its derivatives (rows, 4) in θ)."""
+        return general_log_power_gain(self.f_rows, float(np.exp(theta[0])), float(np.exp(theta[1])),
+                                      float(theta[2]), float(theta[3]))
+
+    @staticmethod
+    def stand(theta) -> tuple:
+        """(f_r Hz, ζ, peak gain, gain above) of θ."""
+        zeta = float(np.exp(theta[1]))
+        return (float(np.exp(theta[0])), zeta, peak_of(zeta, float(theta[2]), float(theta[3])), float(theta[3]))

@@ -12,7 +12,7 @@ import numpy as np
 from . import extended as ext
 from .errors import ParameterError
 from .model import Harmonic, WheelModel
-from .resonance import resonance_response
+from .resonance import resonance_response, smallest_peak
 from .units import CHANNELS, DIRECTION_CHANNELS, rad_s_to_hz
 
 # --------------------------------------------------------------------------- modes
@@ -28,6 +28,8 @@ class Mode:
     channels : channels it acts on (subset of Fx, Fy, Fz, Tx, Ty, Tz).
     whirl : 0 fixed frequency; +1 forward whirl; -1 backward whirl.
     inertia_ratio : a = I_zz/I_rr of the gyroscopic whirl law (thin disc: 2).
+    gain_above : H far above the resonance (1: back to 1 on both sides; 0: a fixture spring's transmissibility,
+        :mod:`rwadist.resonance`); peak_gain must then be at least |1 − gain_above|/(2ζ).
     """
 
     name: str
@@ -37,6 +39,7 @@ class Mode:
     channels: tuple
     whirl: int = 0
     inertia_ratio: float = 2.0
+    gain_above: float = 1.0
 
     def __post_init__(self):
         self.channels = tuple(self.channels)
@@ -53,6 +56,13 @@ class Mode:
             raise ParameterError(f"mode {self.name!r}: whirl must be -1, 0 or +1, got {self.whirl!r}")
         if self.whirl and not self.inertia_ratio >= 0:
             raise ParameterError(f"mode {self.name!r}: inertia_ratio must be >= 0, got {self.inertia_ratio!r}")
+        if not np.isfinite(self.gain_above):
+            raise ParameterError(f"mode {self.name!r}: gain_above must be a finite number, got {self.gain_above!r}")
+        least = smallest_peak(self.zeta, self.gain_above)
+        if self.peak_gain < least * (1 - 1e-9):
+            raise ParameterError(f"mode {self.name!r}: peak_gain {self.peak_gain!r} is below {least:.6g}, the least a "
+                                 f"resonance of zeta {self.zeta!r} reaching gain_above {self.gain_above!r} far above "
+                                 "can have (|1 - gain_above|/(2 zeta))")
 
     def frequency_hz(self, omega):
         """Natural frequency (Hz) at wheel speed ``omega`` (rad/s, sign ignored); vectorised."""
@@ -69,8 +79,9 @@ class Mode:
         return self.response(np.abs(np.asarray(f_hz, dtype=float)) / self.frequency_hz(omega))
 
     def response(self, r):
-        """H(r) = (1 - r² + 2j·g·ζ·r) / (1 - r² + 2j·ζ·r) at frequency ratio r = f / f_mode."""
-        return resonance_response(r, self.zeta, self.peak_gain)
+        """H(r) at frequency ratio r = f / f_mode (:func:`rwadist.resonance.resonance_response`): (1 − r² + 2j·g·ζ·r) /
+        (1 − r² + 2j·ζ·r) when ``gain_above`` is 1."""
+        return resonance_response(r, self.zeta, self.peak_gain, self.gain_above)
 
     def crossing_speed_hz(self, h: float) -> float | None:
         """Wheel speed |Ω|/2π (Hz) at which harmonic ``h`` meets this mode (h·Ω_hz = f_mode), or None.
@@ -91,7 +102,7 @@ class Mode:
     def to_json(self) -> dict:
         return {"name": self.name, "f0_hz": float(self.f0_hz), "zeta": float(self.zeta),
                 "peak_gain": float(self.peak_gain), "channels": list(self.channels), "whirl": int(self.whirl),
-                "inertia_ratio": float(self.inertia_ratio)}
+                "inertia_ratio": float(self.inertia_ratio), "gain_above": float(self.gain_above)}
 
 
 # --------------------------------------------------------------------------- wheel

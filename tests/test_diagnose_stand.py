@@ -21,11 +21,11 @@ from rwadist.data import SteadyTest  # noqa: E402
 from rwadist.diagnose import Context, initial_state  # noqa: E402
 from rwadist.diagnose.search import _judge, fits_modes_from_data, resolve_base  # noqa: E402
 from rwadist.effects.missing_harmonic_diagnose import MissingHarmonic  # noqa: E402
-from rwadist.effects.suspension_modes_diagnose import stand_resonance_start  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402
 from rwadist.inject import parse, simulate_with_injections  # noqa: E402
 from rwadist.presets import preset  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
+from rwadist.stand_resonance import stand_resonance_start  # noqa: E402
 from rwadist.teststand import simulate_steady  # noqa: E402
 
 F_STAND = 180.0

@@ -1,5 +1,5 @@
 """The vectorised pieces that make the extended fit and diagnose fast, each against the direct form it replaces:
-the least squares' line powers and Jacobian (:class:`rwadist.extended_fit.LinePower`) against
+the least squares' line powers and Jacobian (:class:`rwadist.extended_fit_power.LinePower`) against
 :func:`rwadist.extended.steady_lines` and central differences, the blocked DFT against the plain sum, the
 tabulated line kernel against the direct window transform, the real-arithmetic scan against the complex
 transmissibility."""
@@ -11,7 +11,7 @@ from scipy import signal
 from rwadist import extended as ext
 from rwadist.dft import windowed_dft
 from rwadist.diagnose.engine import line_kernel
-from rwadist.extended_fit import CHANNEL_INDEX, LinePower
+from rwadist.extended_fit_power import CHANNEL_INDEX, LinePower
 from rwadist.mode_scan import transmissibility_sq
 from rwadist.units import DIRECTION_CHANNELS
 

@@ -80,10 +80,11 @@ def test_reference_fit_beside_a_stand_settles_the_stand_and_the_translation():
     (inj,) = [x for x in test.meta["injected"] if x["kind"] == "fixed_resonance"]
     efit, model = api.fit_extended(test, mass=wheel.mass_kg, radius=wheel.radius_m)
     assert efit.stand is not None
-    f_r, zeta, gain = efit.stand
+    f_r, zeta, gain, above = efit.stand
     assert f_r == pytest.approx(inj["f_hz"], rel=1e-3)
     assert zeta == pytest.approx(inj["zeta"], rel=0.015)
     assert gain == pytest.approx(inj["gain"], rel=0.01)
+    assert above == pytest.approx(1.0, abs=0.02)            # the injected form returns to 1 above the stand
     p = efit.params
     f_tr = np.sqrt(p.k_r / p.mass) / (2 * np.pi)
     assert f_tr == pytest.approx(iw.TRUTH_HZ["radial_translation"], rel=0.002)
@@ -95,8 +96,9 @@ def test_a_stand_beside_a_load_cell_offset_is_not_taken_for_the_translation_sile
     """E wheel, 40 speeds 300-2400 rpm, 2048 samples: the 180 Hz stand with the load cell's reference 60 mm below the
     wheel (torques + r × F).  The stand is not confirmed on the modes' residual (the offset's torques), and the fit
     without it put the radial translation at 184.5 Hz (the thesis's is 227.7 Hz: -19 %) with its damping at the fit's
-    floor (ζ = 5e-5) and said nothing.  A mode whose damping runs to that floor is not located: the translation is
-    either within 2 % of the thesis's or declared (analytical.unconstrained, a note saying why)."""
+    floor (ζ = 5e-5) and said nothing.  A mode whose damping runs to that floor is not located, nor one the stand
+    fitted with the modes leaves known to more than 2 % only: the translation is either within 2 % of the thesis's or
+    declared (analytical.unconstrained, a note saying why)."""
     test = simulate_with_injections(preset("ithaco-e"), [parse(STAND), parse("cross_coupling:r_z=-0.06")],
                                     np.linspace(300.0, 2400.0, 40), physics="extended", sample_rate=3840.0,
                                     n_samples=2048, noise=0.01, seed=1)
@@ -105,5 +107,5 @@ def test_a_stand_beside_a_load_cell_offset_is_not_taken_for_the_translation_sile
     f_tr = np.sqrt(p.k_r / p.mass) / (2 * np.pi)
     located = abs(f_tr / iw.TRUTH_HZ["radial_translation"] - 1) <= 0.02
     assert located or "radial_translation" in model.analytical["unconstrained"]
-    assert located or any("radial_translation: NOT CONSTRAINED" in n and "damping runs to the fit's floor" in n
-                          for n in efit.notes)
+    assert located or any(n.startswith("radial_translation: NOT CONSTRAINED") and ("damping runs to the fit's floor"
+                          in n or "standard errors" in n) for n in efit.notes)

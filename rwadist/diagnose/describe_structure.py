@@ -280,7 +280,7 @@ def _at_a_fitted_resonance(ctx, state, f_peak: float, chans) -> bool:
     noise through that resonance, which the class names."""
     from .constants import BAND_BINS
 
-    for f_r, zeta, _, on in state.resonances:
+    for f_r, zeta, _, on, *_ in state.resonances:        # (f_r, ζ, g, channels[, gain above])
         if set(on) & set(chans) and abs(f_peak - f_r) <= RESONANCE_HALF_WIDTHS * zeta * f_r + BAND_BINS * ctx.df:
             return True
     return False

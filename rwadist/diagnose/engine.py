@@ -258,9 +258,9 @@ class Context(Metric):
     def gain(self, state: State, c: str, f_hz) -> np.ndarray:
         """|H| of the state's fixed resonances acting on channel ``c`` at line frequencies ``f_hz`` (Hz)."""
         g = np.ones_like(np.asarray(f_hz, dtype=float))
-        for f_r, zeta, peak, chans in state.resonances:
+        for f_r, zeta, peak, chans, *above in state.resonances:
             if c in chans:
-                g = g * np.abs(resonance(f_hz, f_r, zeta, peak))
+                g = g * np.abs(resonance(f_hz, f_r, zeta, peak, *above))
         return g
 
     def channel_lines(self, state: State, c: str, runs: np.ndarray) -> list:
@@ -277,6 +277,20 @@ class Context(Metric):
         floor, a resonance, a sideband -- reads them again; read-only arrays)."""
         if state.ext is None:
             return [(h, law, self.amplitude(C, law, runs), np.ones(runs.size)) for h, C, law in state.lines(c)]
+        return self._ext_lines_of(state, runs)[0].get(c, [])
+
+    def line_mixing(self, state: State, c: str, runs: np.ndarray) -> list:
+        """Per entry of :meth:`channel_lines` of channel ``c``: the share of its power squared that the cross terms of
+        its parts carry in variance, Σ_{i<j} 2·P_i·P_j / (Σ P)² per run (parts of one h acting on the channel with
+        independent phases: a co/counter pair of one radial line, whose cross term 2·√(P₊P₋)·cos Δφ is constant over a
+        run's Welch segments, of zero mean and variance 2·P₊·P₋ over the runs' phases); zeros on the empirical base
+        (one part per line)."""
+        if state.ext is None:
+            return [np.zeros(runs.size) for _ in state.lines(c)]
+        return self._ext_lines_of(state, runs)[1].get(c, [])
+
+    def _ext_lines_of(self, state: State, runs: np.ndarray) -> tuple:
+        """(lines, mixing) by channel of :meth:`channel_lines` and :meth:`line_mixing` on the extended base, cached."""
         key = ("lines", runs.tobytes())
         if key not in state._cache:
             lines = tuple(state.ext_lines())
@@ -284,16 +298,18 @@ class Context(Metric):
             if content not in self._memo:
                 self._memo[content] = self._ext_lines(state, runs, lines)
             state._cache[key] = self._memo[content]
-        return state._cache[key].get(c, [])
+        return state._cache[key]
 
-    def _ext_lines(self, state: State, runs: np.ndarray, lines) -> dict:
-        """:meth:`channel_lines` of every channel on the extended base, computed (``lines``: ``state.ext_lines()``)."""
+    def _ext_lines(self, state: State, runs: np.ndarray, lines) -> tuple:
+        """(:meth:`channel_lines`, :meth:`line_mixing`) of every channel on the extended base, computed (``lines``:
+        ``state.ext_lines()``)."""
         from .. import extended as ext
 
         w = self.omega[runs]
         out = {c: [] for c in self.channels}
+        mixing = {c: [] for c in self.channels}
         if not lines:
-            return out
+            return out, mixing
         _, A = ext.steady_lines(state.ext, lines, w)                  # (S, L, 6)
         P = np.abs(A) ** 2                                             # 2 × mean square
         hs = np.array([ln.h for ln in lines])
@@ -318,7 +334,10 @@ class Context(Metric):
                 a.flags.writeable = gain.flags.writeable = False          # shared by the states of one content
                 j0 = own[0] if own else g[0]
                 out[c].append((float(lines[j0].h), lines[j0].law, a, gain))
-        return out
+                mix = np.where(p > 0, 1.0 - np.sum(P[:, g, k] ** 2, axis=1) / np.where(p > 0, p, 1.0) ** 2, 0.0)
+                mix.flags.writeable = False
+                mixing[c].append(mix)
+        return out, mixing
 
     def unit_gain(self, state: State, c: str, direction: str, h: float, sense: str, runs: np.ndarray) -> np.ndarray:
         """|amplitude in channel ``c``| per unit load amplitude of a line (direction, h, sense) through the state's
@@ -529,7 +548,7 @@ class Context(Metric):
             hsh = hashlib.blake2b(digest_size=20)
             coupling = tuple(float(x) for x in state.load_cell_offset) if state.load_cell_offset is not None \
                 and c in TORQUE_CHANNELS else None
-            res = [r[:3] for r in state.resonances if c in r[3]]
+            res = [r[:3] + tuple(r[4:]) for r in state.resonances if c in r[3]]
             hsh.update(repr((c, coupling, res)).encode())
             hsh.update(np.ascontiguousarray(self.predict(state, c, runs)).tobytes())
             hsh.update(np.ascontiguousarray(self.floor_psd(state, c, runs)).tobytes())

@@ -118,19 +118,27 @@ class Metric:
             return state._cache[key]
         out = np.zeros((runs.size, self.n_bands))
         if state.smear is None and state.speed_modulation is None and self.sp.window == "hann":
-            comps = []
-            for h, _, amp, _ in self.channel_lines(state, c, runs):
+            comps, mixed = [], []
+            for (h, _, amp, _), mix in zip(self.channel_lines(state, c, runs), self.line_mixing(state, c, runs)):
                 f0 = h * self.omega[runs] / (2 * np.pi)
                 for shift, rel in state.line_components(c, h):
                     a = amp * rel * self.sideband_gain(state, c, h, shift, runs)
                     if state.resonances:
                         a = a * self.gain(state, c, f0 + shift)
                     comps.append(((round(h, 9), shift), np.abs(f0 + shift) / self.df, a**2 / 2.0))
+                    if shift == 0 and np.any(mix > 0):
+                        mixed.append((len(comps) - 1, mix))
             if comps:
                 first, second, shapes = self._beat_pairs(comps, runs)
                 if first.size:
                     P = np.array([x[2] for x in comps])                                    # (n, len(runs))
                     out = np.einsum("pr,prb->rb", 2.0 * P[first] * P[second], shapes)
+            # a line of parts with independent phases at one frequency (a co/counter pair) beats with itself: the
+            # variance mix·P² spread as the line's own kernel squared (the pair shape at one position, coherence 1)
+            for i, mix in mixed:
+                own, pos, p = comps[i]
+                (shape,) = self._beat_shapes([(own, own, False, pos, pos)], runs)
+                out = out + (mix * p**2)[:, None] * shape
         state._cache[key] = out
         return out
 

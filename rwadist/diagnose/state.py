@@ -15,8 +15,8 @@ class Prediction:
 
     laws : (direction, h rounded to 4 places) -> (A_ref, Ω_ref rad/s, p): the line's amplitude A_ref·(|Ω|/Ω_ref)^p
         instead of C·Ω².  floors : channel -> (psd_ref(f) unit²/Hz on the grid, Ω_ref rad/s, p): a broadband floor
-        psd_ref·(|Ω|/Ω_ref)^p added to the channel.  resonances : (f_r Hz, ζ, g, channels): fixed-frequency
-        resonances multiplying the lines of their channels.  load_cell_offset : r (m, 3-vector) or None: the torque
+        psd_ref·(|Ω|/Ω_ref)^p added to the channel.  resonances : (f_r Hz, ζ, g, channels[, gain above]):
+        fixed-frequency resonances multiplying the lines of their channels (:func:`rwadist.resonance.resonance`).  load_cell_offset : r (m, 3-vector) or None: the torque
         data are read corrected, T − r × F (:meth:`Context.data`).  modulations : (direction, h, f_mod Hz, depth m):
         the line h of that direction carries two more lines at h|Ω|/2π ± f_mod of amplitude m·a/2.
         speed_modulation : (ΔΩ_ref rad/s, f_r Hz, Ω_ref rad/s, q) or None: a periodic speed ripple

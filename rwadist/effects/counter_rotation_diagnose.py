@@ -98,6 +98,18 @@ class CounterRotation:
         s.effects.append(self)
         return s
 
+    def significant(self) -> bool:
+        """Where the time series give the x/y phase estimate (``counter_fraction_phase``, independent of the PSD fit),
+        it must see the same split: within half the smaller of q and 1 − q (plus 2 standard errors) of the fitted q.
+        A PSD fit of a few per cent is the modes' own misfit at a whirl crossing (clean data of a wheel whose rocking
+        mode the per-unit fit places 0.5 % off: q 0.017 ± 0.002 on its torque imbalance, the phase 0.000)."""
+        qp = self.counter_fraction_phase
+        if not np.isfinite(qp):
+            return True
+        q = self.counter_fraction
+        se = self.counter_fraction_stderr if np.isfinite(self.counter_fraction_stderr) else 0.0
+        return bool(abs(qp - q) <= 0.5 * min(q, 1.0 - q) + 2.0 * se)
+
     def refit(self, ctx: Context, state: State) -> "CounterRotation":
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""
         return CounterRotation.fit(ctx, state, self.direction, self.h, ctx.runs) or self

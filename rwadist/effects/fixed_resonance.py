@@ -5,7 +5,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
-from ..schema import COUNT, DIRECTIONS, FREQUENCY, GAIN, MAX_ZETA, check, choice, names, number, register
+from ..schema import COUNT, DIRECTIONS, FREQUENCY, GAIN, MAX_ZETA, check, choice, names, number, optional, register
 from .actions import LineFilter
 from .element import Element, directions, num
 
@@ -13,8 +13,9 @@ from .element import Element, directions, num
 @register
 @dataclass(frozen=True, eq=False, kw_only=True)
 class FixedResonance(Element):
-    """A resonance at f_Hz (damping ratio zeta, gain peak_gain at f_Hz) of role ``wheel_mode`` (the
-    wheel's loads of ``directions`` pass through it) or ``test_stand`` (a fixture: measurement only)."""
+    """A resonance at f_Hz (damping ratio zeta, gain peak_gain at f_Hz, gain_above far above it:
+    :func:`rwadist.resonance.resonance`) of role ``wheel_mode`` (the wheel's loads of ``directions`` pass through it)
+    or ``test_stand`` (a fixture: measurement only)."""
 
     KIND: ClassVar[str] = "fixed_resonance"
     ORDER: ClassVar[int] = 40
@@ -24,11 +25,28 @@ class FixedResonance(Element):
     role: str = field(metadata=check(choice(("wheel_mode", "test_stand"))))
     directions: tuple = field(metadata=check(names(DIRECTIONS)))
     n_points: int | None = field(default=None, metadata=check(COUNT))
+    gain_above: float = field(default=1.0, metadata=check(optional(number(ge=-1.0, le=3.0), 1.0)))
+
+    def _validate(self, source, path, error):
+        if self.gain_above != 1.0 and self.role != "test_stand":
+            raise error(source, f"{path}.gain_above", f"is {self.gain_above!r}: a gain other than 1 above the resonance "
+                        "is a fixture's (role test_stand); a wheel_mode resonance returns to 1 (leave it out)")
+        least = self.smallest_peak(self.zeta, self.gain_above)
+        if self.peak_gain < least * (1 - 1e-9):
+            raise error(source, f"{path}.peak_gain", f"is {self.peak_gain!r}: a resonance of zeta {self.zeta!r} whose "
+                        f"gain far above is {self.gain_above!r} peaks at least at {least:.6g} (|1 - gain_above|/(2 zeta))")
+
+    @staticmethod
+    def smallest_peak(zeta: float, gain_above: float) -> float:
+        """|H(f_r)| = sqrt((1 − β)² + (2γζ)²)/(2ζ) >= |1 − β|/(2ζ) (:func:`rwadist.resonance.smallest_peak`, written
+        here: the element is read without rwadist by the FMU)."""
+        return abs(1.0 - gain_above) / (2.0 * zeta)
 
     @property
     def resonance(self) -> tuple:
-        """(f_r Hz, ζ, peak gain)."""
-        return (float(self.f_Hz), float(self.zeta), float(self.peak_gain))
+        """(f_r Hz, ζ, peak gain), and the gain above when it is not 1."""
+        out = (float(self.f_Hz), float(self.zeta), float(self.peak_gain))
+        return out if self.gain_above == 1.0 else out + (float(self.gain_above),)
 
     def actions(self) -> tuple:
         """A wheel mode filters the lines of its directions; a test stand's resonance is a measurement artefact."""
@@ -37,15 +55,18 @@ class FixedResonance(Element):
     @classmethod
     def describe(cls, e: Mapping) -> str:
         role = "test stand" if e["role"] == "test_stand" else "wheel mode"
+        above = e.get("gain_above", 1.0)
+        below = "" if above == 1.0 else f", {num(above, '.2g')} of the load far above"
         return (f"{role}, {num(e['f_Hz'], '.2f')} Hz, ζ {num(e['zeta'], '.3g')}, peak gain "
-                f"{num(e['peak_gain'], '.3g')}, on {directions(e['directions'])}")
+                f"{num(e['peak_gain'], '.3g')}{below}, on {directions(e['directions'])}")
 
     # ------------------------------------------------------------------ injection
-    #: ``fixed_resonance:f_hz=150,zeta=0.03,gain=5,channels=Fx+Fy+Fz+Tx+Ty+Tz,role=test_stand``: a fixed-frequency
-    #: resonance H(f/f_r) on the lines of those channels (the stand's fixture resonance, or a wheel mode: role
-    #: wheel_mode, --physics simple only)
+    #: ``fixed_resonance:f_hz=150,zeta=0.03,gain=5,channels=Fx+Fy+Fz+Tx+Ty+Tz,role=test_stand,gain_above=1``: a
+    #: fixed-frequency resonance H(f/f_r) on the lines of those channels (the stand's fixture resonance, or a wheel mode:
+    #: role wheel_mode, --physics simple only), |H| = gain at f_hz and H -> gain_above far above it (test_stand only:
+    #: 0 is the force through a fixture spring, whose gain is then at least 1/(2 zeta); rwadist.resonance)
     INJECT: ClassVar[Mapping] = {"f_hz": 150.0, "zeta": 0.03, "gain": 5.0, "channels": "Fx+Fy+Fz+Tx+Ty+Tz",
-                                 "role": "test_stand"}
+                                 "role": "test_stand", "gain_above": 1.0}
     INJECT_TEXT: ClassVar[tuple] = ("channels", "role")
     INJECT_POSITIVE: ClassVar[tuple] = ("f_hz", "zeta", "gain")
     ROLES: ClassVar[tuple] = ("test_stand", "wheel_mode")
@@ -54,10 +75,17 @@ class FixedResonance(Element):
     def inject_check(cls, spec, bad):
         if spec["role"] not in cls.ROLES:
             raise bad("role", f"{spec['role']!r}; expected one of {', '.join(cls.ROLES)}")
+        if spec["gain_above"] != 1.0 and spec["role"] != "test_stand":
+            raise bad("gain_above", "a gain other than 1 above the resonance is a fixture's: role=test_stand")
+        least = cls.smallest_peak(spec["zeta"], spec["gain_above"])
+        if spec["gain"] < least * (1 - 1e-9):
+            raise bad("gain", f"{spec['gain']!r}: with zeta={spec['zeta']!r} and gain_above={spec['gain_above']!r} the "
+                      f"peak gain is at least {least:.4g} (|1 - gain_above|/(2 zeta))")
 
     @classmethod
     def inject_prepare(cls, wheel, spec, stand):
-        mode = stand.mode(f"injected_{spec['role']}", spec["f_hz"], spec["zeta"], spec["gain"], spec["channels"])
+        mode = stand.mode(f"injected_{spec['role']}", spec["f_hz"], spec["zeta"], spec["gain"], spec["channels"],
+                          spec["gain_above"])
         if spec["role"] == "test_stand":
             return replace(wheel, test_stand_modes=list(wheel.test_stand_modes) + [mode])
         if stand.extended:

@@ -106,13 +106,48 @@ def _is_resonance(sol) -> bool:
     return _is_resonance_gain(float(np.exp(sol.x[2])))
 
 
+def _general_refit(e: "FixedResonance", f, y, sw, lo: float, hi: float) -> "FixedResonance":
+    """``e`` refitted in the general form of :mod:`rwadist.resonance` (f_r, ζ, the numerator's damping γ and the gain
+    above β free) on the log power gains ``y`` at ``f`` (weights ``sw``): robust (soft-L1) least squares from ``e``
+    itself (β = 1, γ = g) and from a transmissibility (β = 0, γ = 1); ``e`` kept unless the general fit is better."""
+    from scipy.optimize import least_squares
+
+    from ..resonance import general_log_power_gain, peak_of
+
+    lb = np.array([np.log(lo), np.log(1e-3), 0.0, -1.0])
+    ub = np.array([np.log(hi), np.log(0.5), 200.0, 3.0])
+
+    def res_jac(x):
+        lg, d = general_log_power_gain(f, float(np.exp(x[0])), float(np.exp(x[1])), float(x[2]), float(x[3]))
+        return sw * (y - lg), -sw[:, None] * d
+
+    base = res_jac(np.array([np.log(e.f_r), np.log(e.zeta), e.peak_gain, 1.0]))[0]
+    base_cost = float(np.sum(2.0 * (np.sqrt(1.0 + (base / 0.5) ** 2) - 1.0))) * 0.125   # soft-L1 as least_squares
+    best = None
+    for gamma, beta in ((min(e.peak_gain, 199.0), 1.0), (1.0, 0.0)):
+        x0 = np.clip([np.log(e.f_r), np.log(e.zeta), gamma, beta], lb + 1e-9, ub - 1e-9)
+        sol = least_squares(lambda x: res_jac(x)[0], x0, jac=lambda x: res_jac(x)[1], loss="soft_l1", f_scale=0.5,
+                            bounds=(lb, ub), max_nfev=MAX_NFEV)
+        if best is None or sol.cost < best.cost:
+            best = sol
+    if best.cost >= base_cost:
+        return e
+    from dataclasses import replace
+
+    zeta = float(np.exp(best.x[1]))
+    return replace(e, f_r=float(np.exp(best.x[0])), zeta=zeta, peak_gain=peak_of(zeta, float(best.x[2]),
+                                                                                  float(best.x[3])),
+                   gain_above=float(best.x[3]))
+
+
 @register(order=40)
 @dataclass
 class FixedResonance:
     """A resonance at a fixed frequency f_r (Hz, the same at every speed) multiplying every line of its
-    channels by H(f/f_r) (:func:`resonance`; ζ damping ratio, g = |H| at f_r).  ``role``: "test_stand" when
-    it acts on every channel alike (a fixture resonance, to be excluded from the wheel's model),
-    "wheel_mode" when on one direction's channels only (an unmodelled wheel mode, to be added)."""
+    channels by H(f/f_r) (:func:`resonance`; ζ damping ratio, g = |H| at f_r, ``gain_above`` H far above f_r).
+    ``role``: "test_stand" when it acts on every channel alike (a fixture resonance, to be excluded from the wheel's
+    model; its gain above f_r is fitted: the force through a fixture spring falls there), "wheel_mode" when on one
+    direction's channels only (an unmodelled wheel mode, to be added; H → 1 above)."""
 
     f_r: float
     zeta: float
@@ -125,12 +160,14 @@ class FixedResonance:
     #: ``suspension_modes`` on every run, or the given model's reference fit), for a resonance proposed from it
     #: (:meth:`candidates`): its refit; None for one fitted on diagnose's own line measurements
     extended_stand: tuple | None = None
+    #: H far above f_r (1: the gain returns to 1 on both sides; 0: a transmissibility, :mod:`rwadist.resonance`)
+    gain_above: float = 1.0
 
     def apply(self, state: State) -> State:
         return state.plus(self)
 
     def contribute(self, parts) -> None:
-        parts.resonances.append((self.f_r, self.zeta, self.peak_gain, tuple(self.channels)))
+        parts.resonances.append((self.f_r, self.zeta, self.peak_gain, tuple(self.channels), self.gain_above))
 
     def refit(self, ctx: Context, state: State) -> "FixedResonance":
         """Refitted on every run (``ctx.runs``); itself when that fit fails.  One proposed from the modes' stand is
@@ -138,8 +175,8 @@ class FixedResonance:
         if self.extended_stand is not None:
             from dataclasses import replace
 
-            f_r, zeta, gain = self.extended_stand
-            return replace(self, f_r=f_r, zeta=zeta, peak_gain=gain)
+            f_r, zeta, gain, *above = self.extended_stand
+            return replace(self, f_r=f_r, zeta=zeta, peak_gain=gain, gain_above=above[0] if above else 1.0)
         return FixedResonance.fit(ctx, state, self.channels, ctx.runs, self.f_r, self.role) or self
 
     def to_schema(self) -> dict:
@@ -147,9 +184,18 @@ class FixedResonance:
 
     def params(self) -> dict:
         dirs = sorted({CHANNEL_DIRECTION[c] for c in self.channels})
-        return {"f_Hz": self.f_r, "zeta": self.zeta, "peak_gain": self.peak_gain, "role": self.role,
-                "directions": dirs, "n_points": self.n_points,
-                "gain_law": "H = (1 - r^2 + 2j*peak_gain*zeta*r)/(1 - r^2 + 2j*zeta*r) with r = f/f_Hz"}
+        return {"f_Hz": self.f_r, "zeta": self.zeta, "peak_gain": self.peak_gain, "gain_above": self.gain_above,
+                "role": self.role, "directions": dirs, "n_points": self.n_points,
+                "gain_law": "H = (1 - gain_above*r^2 + 2j*c*zeta*r)/(1 - r^2 + 2j*zeta*r) with r = f/f_Hz and "
+                            "c = sqrt((2*zeta*peak_gain)^2 - (1 - gain_above)^2)/(2*zeta) (|H| = peak_gain at f_Hz)"}
+
+    @staticmethod
+    def of_stand(held, channels, stand) -> "FixedResonance":
+        """The test-stand resonance ``held`` (f_r Hz, ζ, peak gain[, gain above]: what the held-out runs judge) of an
+        extended fit, refitted as ``stand`` (the same fitted on every run)."""
+        f_r, zeta, gain, *above = (float(v) for v in held)
+        return FixedResonance(f_r, zeta, gain, tuple(channels), "test_stand", gain_above=above[0] if above else 1.0,
+                              extended_stand=tuple(float(v) for v in stand))
 
     @staticmethod
     def peak(f: np.ndarray, y: np.ndarray, lo: float, hi: float, df: float):
@@ -246,7 +292,14 @@ class FixedResonance:
             f_r, zeta, g = (float(v) for v in np.exp(best.x))
             e = FixedResonance(f_r, zeta, g, tuple(channels), role, int(f.size))
             if best.status == -2:
-                break           # no resonance here: re-measuring with a flat |H| ≈ 1 in the state changes nothing
+                return e        # no resonance here: re-measuring with a flat |H| ≈ 1 in the state changes nothing
+        if role == "test_stand" and e is not None:
+            # a fixture's gain need not return to 1 above it: the general form, its gain above free, on the lines
+            # re-measured with the resonance in place
+            f, y, wt = _line_gain_points(ctx, e.apply(state), chans, runs)
+            y = y + np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain)) ** 2)
+            if f.size >= 6:
+                e = _general_refit(e, f, y, np.sqrt(wt), lo, hi)
         return e
 
     @staticmethod
@@ -265,8 +318,8 @@ class FixedResonance:
             e = FixedResonance.fit(ctx, state, ctx.channels, runs, role="test_stand")
             if e is not None:
                 out.append(e)
-            # the stand the wheel's suspension_modes divided out, located at the extended fit's own resolution and
-            # confirmed on its residual (:func:`rwadist.stand_resonance.fit_extended_beside_stand`): on a short
+            # the stand the wheel's suspension_modes fitted with the modes at the extended fit's own resolution and
+            # confirmed there (:func:`rwadist.stand_resonance.fit_extended_beside_stand`): on a short
             # record diagnose's Welch segments leave no line near it measurable apart (2048 samples: h = 4 and 4.42
             # within 4 bins of each other around a 180 Hz stand), so the fit above cannot see it; proposed with
             # the stand of the modes' fit on the fit runs, judged on the held-out runs like any effect
@@ -274,16 +327,14 @@ class FixedResonance:
                      and getattr(x, "stand", None) is not None]
             if modes:
                 m = modes[-1]
-                held = m.stand_fit_runs or m.stand
-                out.append(FixedResonance(*(float(v) for v in held), tuple(ctx.channels), "test_stand",
-                                          extended_stand=tuple(float(v) for v in m.stand)))
+                out.append(FixedResonance.of_stand(m.stand_fit_runs or m.stand, ctx.channels, m.stand))
             # the same from the given model: the stand its reference fit divided out (``analytical.fit.test_stand``,
             # another run on the same fixture): 2048 samples, diagnose's own fit gave 180.4 Hz, ζ 0.040, gain 3.9 for
             # the 180 Hz, ζ 0.03, gain 5 stand the reference located at 180.0 Hz, ζ 0.030, gain 5.02
             ref = ((getattr(state.model, "analytical", None) or {}).get("fit") or {}).get("test_stand")
             if ref and not modes:
-                given = tuple(float(ref[k]) for k in ("f_Hz", "zeta", "peak_gain"))
-                out.append(FixedResonance(*given, tuple(ctx.channels), "test_stand", extended_stand=given))
+                given = tuple(float(ref[k]) for k in ("f_Hz", "zeta", "peak_gain")) + (float(ref.get("gain_above", 1.0)),)
+                out.append(FixedResonance.of_stand(given, ctx.channels, given))
         # a "resonance" that changes no line by more than MIN_PEAK_GAIN is a patch on model error, not a mode
         out = [e for e in out if abs(np.log(e.peak_gain)) >= np.log(MIN_PEAK_GAIN)]
         # nor is a tilt across the band that the fit can only bend by running ζ up to its bound

@@ -16,18 +16,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+# the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.state import State
-
-# the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
-from ..stand_resonance import (
-    STAND_ROUNDS,
-    declare_coupled_modes,
-    declare_unsettled_modes,
-    fit_extended_beside_stand,
-    stand_resonance_start,
-)
+from ..stand_resonance import fit_extended_beside_stand, stand_starts
 
 
 def _fit_spectra(ctx: Context, test, runs: list):
@@ -71,29 +64,21 @@ def _fit_spectra(ctx: Context, test, runs: list):
 
 def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None, near: dict | None = None):
     """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
-    amplification (or the extended fit fails); ``stand`` is the fixture resonance (f_r Hz, ζ, peak gain)
-    divided out of the lines, or None.  ``stand_start``: the stand to start from (a refit on every run
-    starts from the one fitted on half of them), else the one :func:`stand_resonance_start` proposes.  ``near``: the
-    modes that fit located, searched first (``near`` of :func:`rwadist.extended_fit.fit_extended`), or None.
+    amplification (or the extended fit fails, or locates no mode); ``stand`` is the fixture resonance (f_r Hz, ζ, peak
+    gain, gain above) fitted with the modes, or None.  ``stand_start``: the stand to start from (a refit on every run
+    starts from the one fitted on half of them), else those :func:`rwadist.stand_resonance.stand_starts` proposes.
+    ``near``: the modes that fit located, searched first (``near`` of :func:`rwadist.extended_fit.fit_extended`), or
+    None.
 
-    A fixture resonance on every channel is fitted beside the modes, never into them: when the empirical
-    fit shows lines of every direction amplified at one frequency (:func:`stand_resonance_start`), that
-    resonance is divided out of the measured lines before the modes are located (``stand`` of
-    :func:`rwadist.extended_fit.fit_extended`; a fixture resonance taken for a mode spoils every mode).
-    After the extended fit, a ``fixed_resonance`` common to all channels (role test_stand) is fitted on
-    that base; when it is a fixture's resonance (:func:`rwadist.stand_resonance.is_fixture_resonance`: sharp,
-    lifting the lines), the extended fit is repeated with it divided
-    out (up to :data:`STAND_ROUNDS` rounds, until the stand settles); when it is not while one was divided
-    out, the stand was not confirmed and the fit is repeated without it.  The stand resonance itself is left
-    to the search (a clear residual of the extended base: a ``fixed_resonance`` effect)."""
+    A fixture resonance on every channel is fitted with the modes, never into them (:func:`_locate`); the stand
+    itself is left to the search (a ``fixed_resonance`` of role test_stand proposed from this fit's stand).  When
+    modes stay unconstrained, a load-cell offset is tried (:func:`_beside_offset`)."""
     from ..data import SteadyTest
     from ..empirical import fit_empirical
-    from ..extended_fit import amplification_peaks, fit_extended
+    from ..extended_fit import amplification_peaks
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
-    coupled: dict = {}                  # the modes the stand's refit rounds dragged along (ExtendedFit.coupled)
-    offset = None                       # a load-cell offset r (m) removed from the torques to locate the modes
     sp, detections = _fit_spectra(ctx, test, runs)
     fit = fit_empirical(sp, detections=detections)
     if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
@@ -109,87 +94,28 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             got = _beside_offset(ctx, SuspensionModes.from_fit(efit, fit, len(runs)).apply(state), runs, test,
                                  stand_start, len(efit.unconstrained), near)
             if got is not None:
-                test, fit, efit, stand, offset = got
-        if len(efit.unconstrained) == 3 and stand is not None and len(ctx.channels) > 3:
-            # neither the stand start nor the fit without it (nor the torques corrected for an offset) locates a mode
-            # (a stand inside the band lifts the lines the modes are located on): the stand refitted on the residual
-            # of the modes' fit from that start, until it settles, as ``rwadist fit --extended`` does
-            # (:func:`rwadist.stand_resonance.fit_extended_beside_stand`; 100-6000 rpm through a 180 Hz stand: a start
-            # at 187 Hz, gain 36 locates no mode, the rounds settle at 180.0 Hz, gain 5.0, all three found)
-            efit_rounds = fit_extended_beside_stand(test, fit, stand_start=stand, near=near)
-            if len(efit_rounds.unconstrained) < 3 and efit_rounds.stand is not None:
-                efit, stand, coupled = efit_rounds, tuple(efit_rounds.stand), efit_rounds.coupled
-        before = None                   # the modes of the round before the last (with a stand divided out)
-        for _ in range(STAND_ROUNDS):
-            if len(efit.unconstrained) == 3 or len(ctx.channels) <= 3:
-                break
-            from ..stand_resonance import is_fixture_resonance
-            from .fixed_resonance_diagnose import FixedResonance
-
-            # the stand on the modes' base: the lines are predicted without it, so this is the whole stand
-            st = SuspensionModes.from_fit(efit, fit, len(runs)).apply(state)
-            st = st.plus(_ReadCorrected(offset))     # the torque data read corrected, as the modes were located
-            new = FixedResonance.fit(ctx, st, ctx.channels, np.asarray(runs), None if stand is None else stand[0],
-                                     role="test_stand", reuse=False)
-            # the rule of the stand's own detection: a broad "resonance" (an amplitude law's growth, a mode's skirt
-            # left on the base) divided out as a stand would pull the modes to explain it, silently
-            if new is None or not is_fixture_resonance(new.zeta, new.peak_gain):
-                if stand is not None:
-                    # the stand divided out is not confirmed on diagnose's own line measurements (a short record's
-                    # Welch segments resolve few lines near it: 2048 samples gave a 258 Hz notch for a 180 Hz, gain 5
-                    # stand): confirmed or not on the residual of the modes' fit at the fit's own resolution, as
-                    # ``rwadist fit --extended`` does (its rounds from this stand; the fit without it when the
-                    # residual shows none); radial translation -18.6 % -> -1.8 % there
-                    efit = fit_extended_beside_stand(test, fit, stand_start=stand, near=near)
-                    stand, before, coupled = (None if efit.stand is None else tuple(efit.stand)), None, efit.coupled
-                break
-            new = (new.f_r, new.zeta, new.peak_gain)
-            settled = (stand is not None and abs(new[0] / stand[0] - 1) < 0.002
-                       and abs(np.log(new[2] / stand[2])) < 0.02)
-            stand = new
-            before, efit = efit, fit_extended(test, fit, stand=stand, near=near)
-            if settled:
-                break
-        if stand is not None and before is not None:
-            declare_unsettled_modes(before, efit)
+                test, fit, efit, stand, _ = got
     except ValueError:
         return None
     if len(efit.unconstrained) == 3:
         return None                     # no mode located: nothing to name
-    # the modes the stand's refit rounds dragged along, declared on the fit kept (after the choices above, which
-    # count located modes: a declared mode is located, its frequency not told apart from the stand's); kept when a
-    # later round refitted the modes with the stand diagnose measured on their base
-    if stand is not None and coupled:
-        efit.coupled = dict(coupled)
-        declare_coupled_modes(efit)
     return test, fit, efit, stand
 
 
-
-
 def _locate(ctx: Context, test, fit, stand_start, near=None):
-    """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``) before the stand's rounds: with the stand
-    ``stand_start`` or the one the fit (else the whole data, :func:`_whole_data_fit`) proposes divided out, or
-    without one when the stand divided out locates no mode (see :func:`_fit_runs`)."""
+    """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``): the modes fitted jointly with a fixture resonance
+    (:func:`rwadist.stand_resonance.fit_extended_beside_stand`, from ``stand_start`` or the stands the fit -- else the
+    whole data, :func:`_whole_data_fit` -- proposes) when that is confirmed over the fit without one, else the modes
+    alone (stand None).  Only with six channels: a stand is told from a mode by lifting the forces AND the torques."""
     from ..extended_fit import fit_extended
 
-    stand = None if len(ctx.channels) <= 3 else (stand_start or stand_resonance_start(fit))
-    efit = fit_extended(test, fit, stand=stand, near=near)
-    if stand is None and efit.unconstrained and len(ctx.channels) > 3:
-        # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows:
-        # kept as the start when it locates more modes than the fit without it (refined in the rounds below)
-        whole = stand_resonance_start(_whole_data_fit(ctx))
-        efit_whole = None if whole is None else fit_extended(test, fit, stand=whole, near=near)
-        if efit_whole is not None and len(efit_whole.unconstrained) < len(efit.unconstrained):
-            efit, stand = efit_whole, whole
-    if stand is not None and len(efit.unconstrained) == 3:
-        # the fixture resonance divided out locates no mode at all (a start pulled by a wheel mode beside it:
-        # its frequency, width and gain off): the modes are located without it, and the stand is fitted on
-        # their base below, as when none was proposed
-        efit_plain = fit_extended(test, fit, near=near)
-        if len(efit_plain.unconstrained) < 3:
-            efit, stand = efit_plain, None
-    return efit, stand
+    if len(ctx.channels) <= 3:
+        return fit_extended(test, fit, near=near), None
+    # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows
+    starts = [stand_start] if stand_start is not None else \
+        (stand_starts(fit) or stand_starts(_whole_data_fit(ctx)))
+    efit = fit_extended_beside_stand(test, fit, starts=starts, near=near)
+    return efit, efit.stand
 
 
 def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_unconstrained: int, near=None):
@@ -247,15 +173,78 @@ def _whole_data_fit(ctx: Context):
     return ctx._memo[key]
 
 
-@dataclass
-class _ReadCorrected:
-    """Not an effect of the wheel: a state's torque data read corrected for the load-cell offset ``r`` (m) the modes
-    were located with, or uncorrected (None), whatever the state read before."""
+#: Largest offset per revolution of a pair of lines beside a carrier that :func:`wheel_base` leaves to the search as
+#: speed sidebands (the ``speed_sidebands`` family's own search range, 0.01-0.30 per rev)
+SIDEBAND_MAX_PER_REV = 0.30
+#: Two lines h0 − δ₁, h0 + δ₂ beside a carrier h0 are a speed-sideband pair when |δ₁ − δ₂| is within this fraction
+#: of δ (plus 0.002 in h, the extended fit's own precision on h)
+SIDEBAND_SYMMETRY = 0.05
 
-    r: tuple | None
 
-    def contribute(self, parts) -> None:
-        parts.load_cell_offset = self.r
+def wheel_base(model) -> tuple:
+    """(model, pairs): the wheel's model fitted from the data (:func:`rwadist.extended_fit.to_model`) without the loads
+    of an effect's form, which the search is left to name (issue 33: an effect that is a wheel load of the model's own form is named,
+    not absorbed into the fitted base):
+
+    * the counter-rotating part of an imbalance (h = 1 of the radial force or torque): an imbalance rotates with the
+      rotor, so a counter part there is a ``counter_rotation`` (support anisotropy, a planar load); its power goes
+      back to the imbalance (U_s, U_d: the total free power kept, as ``counter_rotation`` splits it);
+    * a pair of lines at h0 − δ and h0 + δ beside a stronger line h0 of the same direction and sense (δ up to
+      :data:`SIDEBAND_MAX_PER_REV`, the two offsets within :data:`SIDEBAND_SYMMETRY`): ``speed_sidebands``, an
+      amplitude modulation of h0 at δ times the speed.
+
+    The other lines and their senses are the wheel's own content.  ``pairs``: the sideband pairs taken out, (direction,
+    h0, h_lower, h_upper, C_lower, C_upper, number of measurements) each, as the extended fit measured them (close lines measured together on
+    the records, :mod:`rwadist.extended_fit_close`: the ``speed_sidebands`` family proposes them as they are where its
+    own search cannot resolve them from the carrier).  A model without an analytical section is returned as is."""
+    import copy
+    from dataclasses import replace
+
+    from .. import extended as ext
+    from ..schema import PARAM_KEYS
+
+    analytical = getattr(model, "analytical", None)
+    if not analytical:
+        return model, ()
+    out = copy.deepcopy(model)
+    for d, key in (("radial_force", "U_s"), ("radial_torque", "U_d")):
+        lines = out.empirical.get(d) or []
+        counter = [x for x in lines if x.sense == "counter" and abs(x.h - 1.0) <= ext.IMBALANCE_H_TOL]
+        if not counter:
+            continue
+        u = float(out.analytical[PARAM_KEYS[key]])
+        total = float(np.sqrt(u**2 + sum(x.C**2 for x in counter)))
+        scale = total / u if u > 0 else 0.0
+        out.analytical[PARAM_KEYS[key]] = total
+        out.empirical[d] = [replace(x, C=x.C * scale) if ext.is_imbalance(d, x.h, x.sense) else x
+                            for x in lines if not any(x is c for c in counter)]
+    pairs = []
+    for d, lines in out.empirical.items():
+        found = _sideband_pairs(lines)
+        for (c, a, b) in found:
+            pairs.append((d, float(c.h), float(a.h), float(b.h), float(a.C), float(b.C),
+                          int((a.n_points or 0) + (b.n_points or 0))))
+        out.empirical[d] = [x for x in lines if not any(x is y for _, a, b in found for y in (a, b))]
+    return out, tuple(pairs)
+
+
+def _sideband_pairs(lines) -> list:
+    """(carrier, lower, upper) of the harmonics of one direction's ``lines`` that are speed-sideband pairs beside a
+    stronger line of theirs (:func:`wheel_base`)."""
+    out, taken = [], []
+    for c in sorted(lines, key=lambda x: -x.C):
+        if any(c is y for y in taken):
+            continue
+        lo = [x for x in lines if x.sense == c.sense and x.C < c.C and 0 < c.h - x.h <= SIDEBAND_MAX_PER_REV]
+        hi = [x for x in lines if x.sense == c.sense and x.C < c.C and 0 < x.h - c.h <= SIDEBAND_MAX_PER_REV]
+        for a in lo:
+            b = min(hi, key=lambda x: abs((x.h - c.h) - (c.h - a.h)), default=None)
+            if b is not None and abs((b.h - c.h) - (c.h - a.h)) <= SIDEBAND_SYMMETRY * (c.h - a.h) + 0.002 \
+                    and not any(a is y or b is y for y in taken):
+                out.append((c, a, b))
+                taken += [c, a, b]
+                break
+    return out
 
 
 @register(order=100)
@@ -278,6 +267,9 @@ class SuspensionModes:
     unconstrained: tuple
     n_runs: int
     stand: tuple | None = None
+    #: the speed-sideband pairs :func:`wheel_base` left out of the base, (direction, h0, h_lower, h_upper, C_lower,
+    #: C_upper, number of measurements) each
+    sideband_pairs: tuple = field(default=(), repr=False)
     kind: str = "suspension_modes"
     #: the stand of the fit on the fit runs this effect was refitted from (:meth:`refit`), or None: what a
     #: ``fixed_resonance`` proposed from the modes' stand is judged with on the held-out runs
@@ -297,8 +289,9 @@ class SuspensionModes:
         f0 = {"radial_translation": float(p.omega_r / (2 * np.pi)), "rocking": float(p.omega_rock / (2 * np.pi)),
               "axial": float(np.sqrt(p.k_z / p.mass) / (2 * np.pi))}
         zeta = {"radial_translation": float(p.zeta_r), "rocking": float(p.zeta_rock), "axial": float(p.zeta_z)}
-        return SuspensionModes(to_model(efit, fit), f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained),
-                               n_runs, stand)
+        base, pairs = wheel_base(to_model(efit, fit))
+        return SuspensionModes(base, f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained), n_runs, stand,
+                               sideband_pairs=pairs)
 
     def apply(self, state: State) -> State:
         import copy
@@ -393,9 +386,9 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
     resonance between them, and the search named both), the modes are fitted again on every run with all of them
     divided out, from the same data and empirical fit as with the modes' stand alone; a located mode that moves more
     than :data:`rwadist.stand_resonance.STAND_SETTLED_MODE` between the two is not told apart from those fixtures by
-    these data (corner-high cell: the radial translation 2.4 % low, nothing said).  It is declared as the stand's
-    rounds declare one (:func:`rwadist.stand_resonance.declare_unsettled_modes`): listed in ``unconstrained`` (the
-    effect's and ``analytical.unconstrained``: every consumer warns) with a note giving both values.  The state's
+    these data (corner-high cell: the radial translation 2.4 % low, nothing said).  It is declared: listed in
+    ``unconstrained`` (the effect's and ``analytical.unconstrained``: every consumer warns) with a note giving both
+    values.  The state's
     predictions are unchanged (the declaration is the model's metadata); the state is returned as is when nothing
     moves or no other fixture was named."""
     import copy
@@ -410,7 +403,7 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
     if modes is None or ctx.test is None or len(ctx.channels) < 6:
         return state
     own = modes.stand
-    others = [(e.f_r, e.zeta, e.peak_gain) for e in state.effects
+    others = [(e.f_r, e.zeta, e.peak_gain, e.gain_above) for e in state.effects
               if e.kind == "fixed_resonance" and e.role == "test_stand" and len(e.channels) == 6
               and (own is None or abs(e.f_r / own[0] - 1) > SAME_STAND)]
     if not others:
@@ -429,7 +422,7 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
              and m not in one.unconstrained and abs(f_every[m] / f_one[m] - 1) > STAND_SETTLED_MODE]
     if not moved:
         return state
-    named = ", ".join(f"{f:.4g} Hz" for f, _, _ in others)
+    named = ", ".join(f"{s[0]:.4g} Hz" for s in others)
     notes = [f"{m}: NOT CONSTRAINED beside the fixture resonances the search named ({named}, besides the modes' own "
              f"stand): with them divided out too it moves from {f_one[m]:.4g} to {f_every[m]:.4g} Hz (more than "
              f"{100 * STAND_SETTLED_MODE:g} %); listed in analytical.unconstrained" for m in moved]

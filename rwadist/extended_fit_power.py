@@ -1,0 +1,91 @@
+"""The extended fit's measured-line powers and their derivatives (:func:`rwadist.extended_fit.fit_extended`)."""
+from __future__ import annotations
+
+import numpy as np
+
+from .units import CHANNELS
+
+CHANNEL_INDEX = {c: i for i, c in enumerate(CHANNELS)}
+RADIAL = ("radial_force", "radial_torque")
+
+#: direction -> (mode, stiffness, damping, inertia, gyroscopic inertia or None) of the subsystem it loads
+_SUBSYSTEM = {"radial_force": ("radial_translation", "k_r", "c_r", "mass", None),
+              "radial_torque": ("rocking", "k_rock", "c_rock", "I_rr", "I_zz"),
+              "axial_force": ("axial_translation", "k_z", "c_z", "mass", None)}
+_SUB_MODES = tuple(v[0] for v in _SUBSYSTEM.values())
+
+
+class LinePower:
+    """Measured-line powers of the least squares' forcing lines, vectorised, with analytic derivatives.
+
+    Rows: first the non-radial measurements (one line, one channel: power |A|² of
+    :func:`rwadist.extended.steady_lines` in that channel), then the radial ones (the x² + y² power of the
+    co- and counter-rotating parts of one measured line, Σ_parts 2|T(ν)|²C²Ω⁴).  Exactly the model of
+    :func:`rwadist.extended.steady_lines` for lines without law, offset or resonance, at ``height`` 0 (the
+    fit removes the lever arm first), one component each ("co" or "counter"): a component of load C·Ω² at
+    whirl rate ν = ±hΩ meets T(ν) = (k + icν)/(k − mν² + I_zz Ω ν + icν) of its direction's subsystem.
+    Written out so that the least squares costs one vectorised evaluation per point and its Jacobian none
+    (the finite-difference Jacobian of the per-line model cost one evaluation per parameter).
+
+    lines : the fit's :class:`rwadist.extended.Line` list.  omega_ax, ax_line, ax_channel : (n_ax,) speed
+    (rad/s), line index and channel index of each non-radial measurement.  omega_rad, rad_parts : (n_rad,)
+    speed and (n_rad, 2) line indices of the two parts of each radial measurement.
+    """
+
+    def __init__(self, lines, omega_ax, ax_line, ax_channel, omega_rad, rad_parts):
+        for ln in lines:
+            if ln.law is not None or ln.f_offset != 0.0 or ln.resonances or ln.sense not in ("co", "counter"):
+                raise ValueError(f"LinePower: line {ln} is not a plain co- or counter-rotating harmonic")
+        own = {"axial_force": CHANNEL_INDEX["Fz"], "axial_torque": CHANNEL_INDEX["Tz"]}
+        n_ax, n_rad = len(ax_line), len(rad_parts)
+        ax_line, rad_parts = np.asarray(ax_line, int), np.asarray(rad_parts, int).reshape(-1, 2)
+        self.n_rows = n_ax + n_rad
+        self.row = np.concatenate([np.arange(n_ax), np.repeat(np.arange(n_ax, n_ax + n_rad), 2)])
+        self.line = np.concatenate([ax_line, rad_parts.ravel()])
+        omega = np.concatenate([np.asarray(omega_ax, float), np.repeat(np.asarray(omega_rad, float), 2)])
+        weight = np.concatenate([[1.0 if own.get(lines[j].direction) == c else 0.0
+                                  for j, c in zip(ax_line, np.asarray(ax_channel, int))], np.full(2 * n_rad, 2.0)])
+        sigma = np.array([1.0 if (ln.sense == "co" or ln.direction not in RADIAL) else -1.0 for ln in lines])
+        h = np.array([ln.h for ln in lines])
+        self.omega = omega
+        self.nu = sigma[self.line] * h[self.line] * omega
+        self.scale = weight * omega**4                     # |load|² per C² and the channels the term reaches
+        mode_of = np.array([_SUB_MODES.index(_SUBSYSTEM[ln.direction][0]) if ln.direction in _SUBSYSTEM else -1
+                            for ln in lines], int)
+        self.sub = mode_of[self.line]
+        self.n_lines = len(lines)
+
+    def log_residuals(self, vals: dict, log_C: np.ndarray, log_data: np.ndarray):
+        """(r, d_mode, d_C) at parameters ``vals`` (:class:`~rwadist.extended.ExtendedParams` fields) and line
+        coefficients exp(``log_C``): r = log_data − ½ ln(model power) (n_rows,); d_mode[mode] = (∂r/∂ln k,
+        ∂r/∂ln c) of each subsystem (n_rows,) each; d_C = ∂r/∂ln C (n_rows, n_lines)."""
+        t2 = np.ones(self.nu.size)
+        dlk = np.zeros(self.nu.size)
+        dlc = np.zeros(self.nu.size)
+        for i, (mode, kn, cn, mn, gn) in enumerate(_SUBSYSTEM.values()):
+            m = self.sub == i
+            if not m.any():
+                continue
+            k, c, mass = vals[kn], vals[cn], vals[mn]
+            gyro = vals[gn] if gn else 0.0
+            nu, om = self.nu[m], self.omega[m]
+            cnu2 = (c * nu) ** 2
+            num = k * k + cnu2
+            re = k - mass * nu**2 + gyro * om * nu
+            den = re**2 + cnu2
+            t2[m] = num / den
+            dlk[m] = 2.0 * k * (k / num - re / den)        # ∂ ln|T|² / ∂ ln k
+            dlc[m] = 2.0 * cnu2 * (1.0 / num - 1.0 / den)  # ∂ ln|T|² / ∂ ln c
+        p_term = t2 * np.exp(2.0 * log_C[self.line]) * self.scale
+        p_row = np.bincount(self.row, p_term, minlength=self.n_rows)
+        live = p_row > 1e-300
+        r = log_data - 0.5 * np.log(np.maximum(p_row, 1e-300))
+        share = np.where(live[self.row], p_term / np.where(live, p_row, 1.0)[self.row], 0.0)
+        d_mode = {}
+        for i, mode in enumerate(_SUB_MODES):
+            m = self.sub == i
+            d_mode[mode] = (-0.5 * np.bincount(self.row[m], (share * dlk)[m], minlength=self.n_rows),
+                            -0.5 * np.bincount(self.row[m], (share * dlc)[m], minlength=self.n_rows))
+        d_C = np.zeros((self.n_rows, self.n_lines))
+        np.add.at(d_C, (self.row, self.line), -share)
+        return r, d_mode, d_C
