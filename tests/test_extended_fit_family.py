@@ -1,0 +1,44 @@
+"""The extended fit locates the suspension modes of wheels of the family generated without rwadist's physics
+(tests/family_wheel.py: masses 2-12 kg, I_zz/I_rr 1.2-2.0, modes 54-600 Hz, bearing-like lines with random rotation
+senses), on a short test (16 speeds, 4096 samples): every mode within 2 %, none declared unconstrained.
+
+The case that failed: a scan that took a radial line measured >= 90 % co-rotating at the load cell for a purely
+co-rotating load.  The whirls amplify one sense more than the other, so a line forced 80 % co-rotating reads more
+co-rotating near the forward whirl; scanned co-rotating only, the rocking mode of wheel #0 (95 Hz) came out at 87 Hz
+and the least squares then ran off to 1848 Hz (#3: 70 Hz -> 2409 Hz).  The family's wheels #2 and #7 (I_zz/I_rr 2.2 and
+2.1) are left out: a rigid rotor about its centre of mass has I_zz <= 2 I_rr, the bound the extended model holds.
+"""
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import family_wheel as fw  # noqa: E402
+
+from rwadist.data import Run, SteadyTest  # noqa: E402
+from rwadist.empirical import fit_empirical  # noqa: E402
+from rwadist.extended_fit import fit_extended  # noqa: E402
+from rwadist.spectra import compute_spectra  # noqa: E402
+from rwadist.stand_resonance import _mode_hz  # noqa: E402
+
+
+def _test_of(wheel, n_speeds=16, n_samples=4096, seed=1) -> SteadyTest:
+    data = fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, n_speeds), n_samples=n_samples,
+                     noise=0.01, seed=seed)
+    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
+                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
+    return SteadyTest(runs=runs, meta={})
+
+
+@pytest.mark.parametrize("index", [0, 1, 3, 4, 5, 6])
+def test_family_wheel_modes_are_located(index):
+    wheel = fw.family()[index]
+    test = _test_of(wheel)
+    efit = fit_extended(test, fit_empirical(compute_spectra(test)))
+    assert not efit.unconstrained
+    got = _mode_hz(efit.params)
+    for name, truth in wheel.modes_hz().items():
+        assert got[name] == pytest.approx(truth, rel=0.02), (name, got[name], truth)
