@@ -152,7 +152,8 @@ def assemble(plant: Plant, attachments, name: str = "coupled") -> Assembly:
         C = np.vstack([Cy_x, Ka_x, Kf_x])
         D = np.vstack([np.hstack([Dy_w, Dy_u]), np.hstack([Ka_w, Ka_u]), np.hstack([Kf_w, Kf_u])])
     else:
-        Ap, Bp, Cp, Dp = (np.asarray(x) for x in (plant.sys.A, plant.sys.B, plant.sys.C, plant.sys.D))
+        sys = plant.state_space()
+        Ap, Bp, Cp, Dp = (np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
         nxp = Ap.shape[0]
         Ca, Cy, Da, Dy = Cp[:n_if], Cp[n_if:], Dp[:n_if], Dp[n_if:]
         L = np.eye(n_if) - Da @ Zmt

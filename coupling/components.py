@@ -132,7 +132,8 @@ class Component:
         if rm.shape != (self.n_interface, self.n_interface):
             raise CouplingError(f"{self.name}: rigid_mass must be {self.n_interface}×{self.n_interface}")
 
-    def matrices(self):
+    def matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(A, B, C, D) of ``sys`` as arrays."""
         return (np.asarray(self.sys.A), np.asarray(self.sys.B), np.asarray(self.sys.C), np.asarray(self.sys.D))
 
     def frf(self, f_hz):
@@ -399,6 +400,13 @@ class Plant:
     def n_perf(self) -> int:
         return len(self.perf_names)
 
+    def state_space(self) -> control.StateSpace:
+        """``sys``, the state-space model of an accelerance plant; CouplingError for a plant without one (a rigid
+        plant: its mass matrix)."""
+        if self.sys is None:
+            raise CouplingError(f"{self.name}: a {self.kind} plant has no state-space model")
+        return self.sys
+
     def frf(self, f_hz):
         """(G, P) at frequencies f_hz (Hz, any shape ...): G (..., n_if, n_if) interface
         accelerance, P (..., n_perf, n_if) performance outputs per interface load."""
@@ -421,7 +429,8 @@ class Plant:
             G = (ha.real @ KG + 1j * (ha.imag @ KG)).reshape(f.shape + (n, n))
             P = (hd.real @ KP + 1j * (hd.imag @ KP)).reshape(f.shape + (Phip.shape[0], n))
             return G, P
-        A, B, C, D = (np.asarray(x) for x in (self.sys.A, self.sys.B, self.sys.C, self.sys.D))
+        sys = self.state_space()
+        A, B, C, D = (np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
         s = 2j * np.pi * f
         if self._eig is not None:
             lam, CV, VinvB = self._eig

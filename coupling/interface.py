@@ -53,10 +53,11 @@ def _interface_matrix(G, parts) -> np.ndarray:
     n = G.shape[-1]
     L = None
     for Mt, Z in parts:
-        cols = np.nonzero(np.any(Mt != 0, axis=0))[0]
-        T = Mt[:, cols]
-        if cols.size and np.all(np.diff(cols) == 1):
-            cols = slice(int(cols[0]), int(cols[-1]) + 1)      # a node's DOFs: a view (fancy indexing copies)
+        reached = np.nonzero(np.any(Mt != 0, axis=0))[0]
+        T = Mt[:, reached]
+        cols: np.ndarray | slice = reached
+        if reached.size and np.all(np.diff(reached) == 1):
+            cols = slice(int(reached[0]), int(reached[-1]) + 1)      # a node's DOFs: a view (fancy indexing copies)
         term = _congruence(T, Z) @ G[..., cols, :]
         if L is None:
             L = np.zeros(np.broadcast_shapes(term.shape[:-2], G.shape[:-2]) + (n, n), dtype=complex)

@@ -104,7 +104,18 @@ class Floor:
 
 class CouplingModelError(ModelError, CouplingError):
     """A bad model-file entry read by the coupling kit: the schema's one :class:`rwadist.schema.ModelError`
-    (same message in every consumer), also a :class:`CouplingError`."""
+    (same message in every consumer), also a :class:`CouplingError`.
+
+    Raised as a ModelError (``CouplingModelError(source, field, problem)`` or ``CouplingModelError(message)``), it
+    keeps the attributes a :class:`rwadist.ParameterError` promises: ``parameter`` None (a file's entry, no
+    function parameter to blame) and ``problem`` always a string (the message when no field is named)."""
+
+    problem: str
+
+    def __init__(self, source: object, field: str | None = None, problem: str | None = None):
+        super().__init__(source, field, problem)
+        self.parameter = None
+        self.problem = str(self) if problem is None else problem
 
 
 def floors_from_effects(effects, source: str = "<model>") -> tuple:
@@ -418,8 +429,11 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
     chunk = max(1, min(int(chunk), LINE_POINTS // max(groups_max, 1)))
     nw = len(wheels)
     hs, offs, orders = [None] * nw, [None] * nw, [None] * nw
-    fs, hms, loads = ([[] for _ in range(nw)] for _ in range(3))
-    ys = {p: [[] for _ in range(nw)] for p in practices}
+    # per wheel, the chunks' arrays: line frequencies, loads on the hard mount, interface loads, outputs
+    f_parts: list[list[np.ndarray]] = [[] for _ in range(nw)]
+    hm_parts: list[list[np.ndarray]] = [[] for _ in range(nw)]
+    load_parts: list[list[np.ndarray]] = [[] for _ in range(nw)]
+    y_parts: dict[str, list[list[np.ndarray]]] = {p: [[] for _ in range(nw)] for p in practices}
     for i0 in range(0, om.size, chunk):
         o = om[i0:i0 + chunk]
         cache = _FrfCache()
@@ -427,8 +441,8 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
         for k, wk in enumerate(wheels):
             hs[k], offs[k], orders[k], f, Fk = _grouped_lines(wk, o * wk.speed_scale, kmax[k])
             lines.append((f, Fk, np.where(f > 0, f, 1.0)))
-            fs[k].append(f)
-            hms[k].append(Fk)
+            f_parts[k].append(f)
+            hm_parts[k].append(Fk)
         # wheels whose lines sit at the same frequencies (equal wheels) share the plant, the interface matrix and
         # its factorisation: one solve with all their right-hand sides
         groups: list = []
@@ -440,11 +454,11 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
                 groups.append((fe, [k]))
         for fe, ks in groups:
             for k, (ld, y) in zip(ks, _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache)):
-                loads[k].append(ld)
+                load_parts[k].append(ld)
                 for p in practices:
-                    ys[p][k].append(y[p])
-    fs, hms, loads = ([np.concatenate(x) for x in lst] for lst in (fs, hms, loads))
-    ys = {p: [np.concatenate(x) for x in v] for p, v in ys.items()}
+                    y_parts[p][k].append(y[p])
+    fs, hms, loads = ([np.concatenate(x) for x in lst] for lst in (f_parts, hm_parts, load_parts))
+    ys = {p: [np.concatenate(x) for x in v] for p, v in y_parts.items()}
     floor = None
     if any(w.floors for w in wheels):
         floor = floor_responses(plant, wheels, om, practices, f_hz=floor_f_hz)
@@ -497,7 +511,7 @@ def _pole_damping(plant: Plant, wheels, omega):
     from .assemble import Attachment, assemble
     from .components import rigid_mass, wheel
 
-    lams = [np.linalg.eigvals(np.asarray(plant.sys.A))]
+    lams = [np.linalg.eigvals(np.asarray(plant.state_space().A))]
     rig = [Attachment(rigid_mass(wheel_rigid_mass_matrix(w.params, w.housing_mass, w.housing_inertia)), w.mount)
            for w in wheels]
     lams.append(np.linalg.eigvals(np.asarray(assemble(plant, rig).sys.A)))

@@ -65,7 +65,7 @@ def sweep(plant, wheel_sets, omega, practices=PRACTICES, chunk: int = 100, sched
     finally:
         if own_client is not None:
             own_client.close()
-    out = {}
+    out: dict[str, list] = {}
     for (name, _), r in zip(pieces, results):
         out.setdefault(name, []).append(r)
     return {n: _merge(parts) for n, parts in out.items()}

@@ -224,8 +224,8 @@ def build_fmu(model, output, *, tag: str | None = None, native: bool | None = No
     if src.count(f"class {TEMPLATE_CLASS}(") != 1:
         raise RuntimeError("slave template lost its class")
     physics, modes_default = model_physics(doc, assumed_modes)
-    with tempfile.TemporaryDirectory(prefix="rwadist_fmu_") as tmp:
-        tmp = Path(tmp)
+    with tempfile.TemporaryDirectory(prefix="rwadist_fmu_") as tmp_dir:
+        tmp = Path(tmp_dir)
         extra = tmp / "extra"
         extra.mkdir()
         # the slave module beside its project files: pythonfmu imports it from there to find its class

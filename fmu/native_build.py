@@ -167,7 +167,9 @@ def model_header(doc, guid: str, physics: str, modes_default: bool) -> str:
     out += ["    {" + ", ".join(_f(v) for v in r) + "}," for r in rip] + (["    {0}"] if not rip else []) + ["};"]
     out += ["static const int RW_RIPPLE_SWITCH[RW_N_RIPPLES_ALLOC] = {"
             + (", ".join(str(slot[s]) for s in eff["switch_of"]["ripples"]) or "0") + "};"]
-    floors, f_knots, p_knots = [], [], []
+    floors: list[str] = []
+    f_knots: list[float] = []
+    p_knots: list[float] = []
     for (ch, f_k, psd_k, w_ref, p), sw in zip(eff["floors"], eff["switch_of"]["floors"]):
         floors.append(f"    {{{ch}, {len(f_knots)}, {len(f_k)}, {slot[sw]}, {_f(w_ref)}, {_f(p)}}},")
         f_knots += list(f_k)

@@ -59,6 +59,8 @@ def _load_sibling(stem):
     mod = sys.modules.get(name)
     if mod is None:
         spec = importlib.util.spec_from_file_location(name, path)
+        if spec is None or spec.loader is None:
+            raise ImportError(f"rwadist FMU: cannot load the runtime module {path}")
         mod = importlib.util.module_from_spec(spec)
         sys.modules[name] = mod
         try:
@@ -173,6 +175,8 @@ class WheelRuntime:
     back (the FMU slave warns once).
     """
 
+    _floor_count: int           # steps since the floor phasors were set from the time (reset, floor_now)
+
     def __init__(self, params, lines, *, seed=None, imbalance=True, harmonics=True, modes=True,
                  start_steady=False, max_accel=500.0, max_step=0.01, dcm=None, position=None, kernel=None,
                  laws=None, resonances=None, sidebands=None, ripples=None, floors=None, switch_of=None,
@@ -194,12 +198,28 @@ class WheelRuntime:
         if self.modes and not self.suspension:
             raise ModelError("modes: on, but the model has no suspension (analytical: missing -- an empirical "
                              "fit, harmonics only); it runs hard-mounted: set modes = false")
-        resonances = list(resonances or [])
+        self._init_components(lines, laws, sidebands, list(resonances or []), seed, imbalance, harmonics)
+        self._init_poles()
+        self._cache: dict[float, tuple] = {}
+        self._init_mounting(dcm, position)
+        self._kernel = kernel
+        if kernel is not None:
+            self._init_kernel()
+        ripples, self.ripple_switches = _switched(ripples, switch_of, "ripples", switched_off)
+        floors, _ = _switched(floors, switch_of, "floors", switched_off)
+        self._init_ripple(ripples, seed)
+        self._init_floor(floors, seed, floor_resolution)
+        self.reset()
+
+    def _init_components(self, lines, laws, sidebands, resonances, seed, imbalance, harmonics):
+        """The model's lines (with the laws' and sidebands' changes, :func:`expand_lines`) as rotating components,
+        one per whirl sense of a line that the imbalance/harmonics switches keep: their arrays (speed factor σh,
+        frequency offset, coefficient, C, direction, law) and the resonance table acting on them."""
         full, self.laws_used, self.sidebands_used = expand_lines(lines, laws, sidebands)
         n = len(full)
         self.n_lines = n
         ph = (np.random.default_rng(int(seed)).uniform(0, 2 * np.pi, n) if seed is not None else np.zeros(n))
-        sh, woff, coef, C, imb, dirs, law, res = [], [], [], [], [], [], [], []
+        sh, woff, coef, C, imb, dirs, law_rows, res = [], [], [], [], [], [], [], []
         for (d, h, c, sense, is_imb, lw, off), q in zip(full, ph):
             if (is_imb and not imbalance) or (not is_imb and not harmonics):
                 continue
@@ -211,7 +231,7 @@ class WheelRuntime:
                 C.append(c)
                 imb.append(is_imb)
                 dirs.append(DIRECTIONS.index(d))
-                law.append((1.0, *lw) if lw is not None else (0.0, 0.0, 1.0, 0.0))
+                law_rows.append((1.0, *lw) if lw is not None else (0.0, 0.0, 1.0, 0.0))
                 res.append(rs)
         self.sh = np.array(sh, dtype=float)
         self.woff = np.array(woff, dtype=float)
@@ -231,13 +251,17 @@ class WheelRuntime:
         self.ish = 1j * self.sh
         self.cC = self.coef * self.C
         self.cCi = -1j * self.coef * self.C * self.imb
-        law = np.array(law, dtype=float).reshape(-1, 4)
+        law = np.array(law_rows, dtype=float).reshape(-1, 4)
         self.law_idx = np.nonzero(law[:, 0] > 0)[0]             # components with a diagnosed law
         self.law_scale = self.coef[self.law_idx] * law[self.law_idx, 1]
         self.law_ref = law[self.law_idx, 2]
         self.law_p = law[self.law_idx, 3]
         self.cC[self.law_idx] = 0.0                              # C·Ω² replaced by the law
         self.rock = np.nonzero(self.dirs == 1)[0]
+
+    def _init_poles(self):
+        """The suspension's radial and axial poles, and the poles of every component's direction (λ per
+        component, (n, 2))."""
         p = self.p
         if self.suspension:
             self.lam_r = quad_roots(p["mass"], p["c_r"], p["k_r"])
@@ -251,48 +275,49 @@ class WheelRuntime:
         # finite so that 0·x in the direction sums stays 0
         lam[self.dirs == 3] = -1.0
         self._lam_static = lam
-        self._cache = {}
+
+    def _init_mounting(self, dcm, position):
+        """The mounting of the spacecraft-frame outputs: DCM wheel -> spacecraft (checked rotation, default
+        identity) and interface position (m, finite, default 0), as plain lists."""
         R = np.eye(3) if dcm is None else rotation_check(dcm)
         pos = np.zeros(3) if position is None else np.asarray(position, dtype=float).reshape(3)
         if not np.all(np.isfinite(pos)):
             raise ModelError(f"interface position r = {pos.tolist()!r} m is not finite")
         self.R = [list(map(float, row)) for row in R]
         self.pos = [float(v) for v in pos]
-        self._kernel = kernel
-        if kernel is not None:
-            n = self.sh.size
-            cfg = np.zeros(KERNEL_COMP + KERNEL_STRIDE * n + KERNEL_RES * self.res_comp.size)
-            cfg[0], cfg[1] = n, float(self.modes)
-            cfg[2:12] = [p[k] for k in KERNEL_PARAMS]
-            cfg[12:16] = np.array(self.lam_r, dtype=complex).view(float)
-            cfg[16:20] = np.array(self.lam_z, dtype=complex).view(float)
-            cfg[20:29] = np.ravel(self.R)
-            cfg[29:32] = self.pos
-            comp = cfg[KERNEL_COMP:KERNEL_COMP + KERNEL_STRIDE * n].reshape(n, KERNEL_STRIDE)
-            comp[:, 0], comp[:, 1] = self.sh, self.dirs
-            comp[:, 2:4] = self.cC.view(float).reshape(n, 2)
-            comp[:, 4:6] = self.cCi.view(float).reshape(n, 2)
-            comp[:, 8] = 1.0
-            comp[self.law_idx, 6:8] = self.law_scale.view(float).reshape(-1, 2)
-            comp[self.law_idx, 8] = self.law_ref
-            comp[self.law_idx, 9] = self.law_p
-            comp[:, 10] = self.woff
-            base = KERNEL_COMP + KERNEL_STRIDE * n
-            table = cfg[base:].reshape(-1, KERNEL_RES)
-            table[:, 0], table[:, 1], table[:, 2] = self.res_w, self.res_2gz, self.res_2z
-            for i in range(n):
-                rows = np.nonzero(self.res_comp == i)[0]
-                comp[i, 11] = rows.size
-                comp[i, 12] = base + KERNEL_RES * rows[0] if rows.size else 0.0
-            self._cfg = cfg
-            self._st = np.zeros(2 + 2 * n + 12)
-            self._kout = np.zeros(12)
-            self._ptrs = (cfg.ctypes.data, self._st.ctypes.data, self._kout.ctypes.data)
-        ripples, self.ripple_switches = _switched(ripples, switch_of, "ripples", switched_off)
-        floors, _ = _switched(floors, switch_of, "floors", switched_off)
-        self._init_ripple(ripples, seed)
-        self._init_floor(floors, seed, floor_resolution)
-        self.reset()
+
+    def _init_kernel(self):
+        """The native kernel's configuration array (its layout: :mod:`runtime_math`'s KERNEL_ constants, fmu/native/rwadist_fmu_native.c), state and output
+        arrays, and their addresses."""
+        p = self.p
+        n = self.sh.size
+        cfg = np.zeros(KERNEL_COMP + KERNEL_STRIDE * n + KERNEL_RES * self.res_comp.size)
+        cfg[0], cfg[1] = n, float(self.modes)
+        cfg[2:12] = [p[k] for k in KERNEL_PARAMS]
+        cfg[12:16] = np.array(self.lam_r, dtype=complex).view(float)
+        cfg[16:20] = np.array(self.lam_z, dtype=complex).view(float)
+        cfg[20:29] = np.ravel(self.R)
+        cfg[29:32] = self.pos
+        comp = cfg[KERNEL_COMP:KERNEL_COMP + KERNEL_STRIDE * n].reshape(n, KERNEL_STRIDE)
+        comp[:, 0], comp[:, 1] = self.sh, self.dirs
+        comp[:, 2:4] = self.cC.view(float).reshape(n, 2)
+        comp[:, 4:6] = self.cCi.view(float).reshape(n, 2)
+        comp[:, 8] = 1.0
+        comp[self.law_idx, 6:8] = self.law_scale.view(float).reshape(-1, 2)
+        comp[self.law_idx, 8] = self.law_ref
+        comp[self.law_idx, 9] = self.law_p
+        comp[:, 10] = self.woff
+        base = KERNEL_COMP + KERNEL_STRIDE * n
+        table = cfg[base:].reshape(-1, KERNEL_RES)
+        table[:, 0], table[:, 1], table[:, 2] = self.res_w, self.res_2gz, self.res_2z
+        for i in range(n):
+            rows = np.nonzero(self.res_comp == i)[0]
+            comp[i, 11] = rows.size
+            comp[i, 12] = base + KERNEL_RES * rows[0] if rows.size else 0.0
+        self._cfg = cfg
+        self._st = np.zeros(2 + 2 * n + 12)
+        self._kout = np.zeros(12)
+        self._ptrs = (cfg.ctypes.data, self._st.ctypes.data, self._kout.ctypes.data)
 
     def _init_ripple(self, ripples, seed):
         rip = [tuple(float(v) for v in r) for r in (ripples or [])]
@@ -330,7 +355,9 @@ class WheelRuntime:
         if n_max > FLOOR_MAX_COMPONENTS:
             raise ModelError(f"broadband floors need {n_max} sinusoids at floor_resolution = {df:g} Hz (limit "
                              f"{FLOOR_MAX_COMPONENTS}); use a coarser floor_resolution")
-        amp, wk, chan, ref, expo, starts = [], [], [], [], [], []
+        amp: list[np.ndarray] = []
+        wk: list[np.ndarray] = []
+        chan, ref, expo, starts = [], [], [], []
         for (c, f_k, psd_k, w_ref, p), (k0, k1) in zip(floors, spans):
             k = np.arange(k0, k1 + 1)
             S = np.interp(k * df, f_k, psd_k, left=0.0, right=0.0)
@@ -407,6 +434,7 @@ class WheelRuntime:
         self.out = np.zeros(6)
         self.y = [0.0] * 12
         self._floor_count = FLOOR_RESYNC      # the first floor value is set from t
+        self._prev_start = 0.0      # the previous step's input start speed (read once prev_end is set)
 
     def _amp(self, w, wdot):
         """coef·C·(Ω² − iΩ̇·[imbalance]) per component (coef·A_ref·(|Ω|/Ω_ref)^p in place of
@@ -518,15 +546,7 @@ class WheelRuntime:
         if not math.isfinite(t0):
             raise ModelError(f"step start time {t0!r} s is not finite")
         if alpha is None:
-            if self.prev_end is None:
-                alpha = 0.0
-            else:
-                w_end, h_prev = self.prev_end
-                # previous step's start speed -> this step's start speed
-                alpha = (omega - self._prev_start) / h_prev
-                if abs(alpha) > self.max_accel:
-                    raise ModelError(f"derived wheel acceleration {alpha:.6g} rad/s² exceeds max_acceleration = "
-                                     f"{self.max_accel:.6g} rad/s²")
+            alpha = self._derived_acceleration(omega)
         w_in, w1_in = omega, omega + alpha * h
         t_end = t0 + h
         if self.has_ripple:      # the rotor's speed: input + ripple, linear over the step
@@ -540,7 +560,6 @@ class WheelRuntime:
             self.started = True
             if self._kernel is not None:
                 self._pack()
-        w1 = omega + alpha * h
         if self._kernel is not None:
             cfg, st, out = self._ptrs
             self._st[1] = t0                 # the kernel's clock (its sideband phases) from the step's start
@@ -555,58 +574,15 @@ class WheelRuntime:
             else:
                 self.y = y = self._kout.tolist()
             return y
-        p = self.p
+        w1 = omega + alpha * h
         dphi = 0.5 * (omega + w1) * h
         phi1 = self.phi + dphi
-        S0 = self.S
         S1 = self._phase(phi1, t_end)
         a0 = self._amp(omega, wd0)
         a1 = self._amp(w1, alpha)
         loads1 = self.sel @ (a1 * S1)
         if self.modes and self.sh.size:
-            w_mid = 0.5 * (omega + w1)
-            lk1, lk2 = quad_roots(p["I_rr"], p["c_rock"] - 1j * p["I_zz"] * w_mid, p["k_rock"])
-            lamh0, X0, min_re, Xr, Xz = self._lti_consts(h)
-            e1, e2 = cmath.exp(lk1 * h), cmath.exp(lk2 * h)
-            lamh, X = lamh0.copy(), X0.copy()
-            lamh[self.rock] = (lk1 * h, lk2 * h)
-            X[self.rock] = (e1, e2)
-            z = ((1j * (self.sh * dphi + self.woff * h)) if self.has_off else (self.ish * dphi))[:, None] - lamh
-            XS0 = X * S0[:, None]
-            S1c = S1[:, None]
-            # |z| >= |Re z| = |Re λh|: the series is needed only if some |Re λh| < SMALL_Z
-            if min(min_re, abs(lk1.real * h), abs(lk2.real * h)) >= SMALL_Z:
-                t0 = (S1c - XS0) / z
-                t1 = (S1c - t0) / z
-            else:
-                small = np.abs(z) < SMALL_Z
-                zb = np.where(small, 1.0, z)
-                t0 = (S1c - XS0) / zb
-                t1 = (S1c - t0) / zb
-                if small.any():
-                    zs = z[small]
-                    e0s = 1 + zs * (1 / 2 + zs * (1 / 6 + zs * (1 / 24 + zs / 120)))
-                    e1s = 1 / 2 + zs * (1 / 3 + zs * (1 / 8 + zs * (1 / 30 + zs / 144)))
-                    t0[small] = XS0[small] * e0s
-                    t1[small] = XS0[small] * e1s
-            W = ((self.sel @ (a0[:, None] * t0 + (a1 - a0)[:, None] * t1)) * h).tolist()   # (4, 2)
-            # radial and axial translation: eigen-coordinates η_j' = pole η_j + w_j/(m(λ_j − λ_k))
-            for eta, (l1, l2), Xp, row, (m, c, k) in (
-                    (self.eta_r, self.lam_r, Xr, 0, (p["mass"], p["c_r"], p["k_r"])),
-                    (self.eta_z, self.lam_z, Xz, 2, (p["mass"], p["c_z"], p["k_z"]))):
-                eta[0] = Xp[0] * eta[0] + W[row][0] / (m * (l1 - l2))
-                eta[1] = Xp[1] * eta[1] + W[row][1] / (m * (l2 - l1))
-            # rocking: exact transition at the mean speed of the step
-            dl = lk1 - lk2
-            q, qd = self.x_rock
-            kI = p["k_rock"] / p["I_rr"]
-            P00 = (e1 * (-lk2) - e2 * (-lk1)) / dl
-            P01 = (e1 - e2) / dl
-            P10 = (-kI) * (e1 - e2) / dl
-            P11 = (e1 * lk1 - e2 * lk2) / dl
-            w1r = W[1][0] / (p["I_rr"] * dl)
-            w2r = W[1][1] / (-p["I_rr"] * dl)
-            self.x_rock = [P00 * q + P01 * qd + w1r + w2r, P10 * q + P11 * qd + lk1 * w1r + lk2 * w2r]
+            self._advance_modes(0.5 * (omega + w1), dphi, h, S1, a0, a1)
         self.phi = phi1
         self.t = t_end
         self.S = S1
@@ -618,6 +594,67 @@ class WheelRuntime:
             self.out = self.out + self.floor_now(w1_in, t_end, h)
         self.y = frame12(self.out, self.R, self.pos)
         return self.y
+
+    def _derived_acceleration(self, omega):
+        """The acceleration (rad/s²) of a step given none: the previous step's start speed to this step's start
+        speed ``omega`` over the previous step (0 on the first step); ModelError above max_acceleration."""
+        if self.prev_end is None:
+            return 0.0
+        _, h_prev = self.prev_end
+        alpha = (omega - self._prev_start) / h_prev
+        if abs(alpha) > self.max_accel:
+            raise ModelError(f"derived wheel acceleration {alpha:.6g} rad/s² exceeds max_acceleration = "
+                             f"{self.max_accel:.6g} rad/s²")
+        return alpha
+
+    def _advance_modes(self, w_mid, dphi, h, S1, a0, a1):
+        """The suspension's modal states over one step of size ``h`` (s): the components' loads (amplitudes
+        ``a0`` at the start, ``a1`` at the end, linear in between; phasors from ``self.S`` to ``S1``, rotor angle
+        advancing by ``dphi`` rad) integrated exactly through the radial and axial modes' eigen-coordinates, and
+        the rocking mode through its exact transition at the mean speed ``w_mid`` (rad/s)."""
+        p = self.p
+        lk1, lk2 = quad_roots(p["I_rr"], p["c_rock"] - 1j * p["I_zz"] * w_mid, p["k_rock"])
+        lamh0, X0, min_re, Xr, Xz = self._lti_consts(h)
+        e1, e2 = cmath.exp(lk1 * h), cmath.exp(lk2 * h)
+        lamh, X = lamh0.copy(), X0.copy()
+        lamh[self.rock] = (lk1 * h, lk2 * h)
+        X[self.rock] = (e1, e2)
+        z = ((1j * (self.sh * dphi + self.woff * h)) if self.has_off else (self.ish * dphi))[:, None] - lamh
+        XS0 = X * self.S[:, None]
+        S1c = S1[:, None]
+        # |z| >= |Re z| = |Re λh|: the series is needed only if some |Re λh| < SMALL_Z
+        if min(min_re, abs(lk1.real * h), abs(lk2.real * h)) >= SMALL_Z:
+            t0 = (S1c - XS0) / z
+            t1 = (S1c - t0) / z
+        else:
+            small = np.abs(z) < SMALL_Z
+            zb = np.where(small, 1.0, z)
+            t0 = (S1c - XS0) / zb
+            t1 = (S1c - t0) / zb
+            if small.any():
+                zs = z[small]
+                e0s = 1 + zs * (1 / 2 + zs * (1 / 6 + zs * (1 / 24 + zs / 120)))
+                e1s = 1 / 2 + zs * (1 / 3 + zs * (1 / 8 + zs * (1 / 30 + zs / 144)))
+                t0[small] = XS0[small] * e0s
+                t1[small] = XS0[small] * e1s
+        W = ((self.sel @ (a0[:, None] * t0 + (a1 - a0)[:, None] * t1)) * h).tolist()   # (4, 2)
+        # radial and axial translation: eigen-coordinates η_j' = pole η_j + w_j/(m(λ_j − λ_k))
+        for eta, (l1, l2), Xp, row, (m, c, k) in (
+                (self.eta_r, self.lam_r, Xr, 0, (p["mass"], p["c_r"], p["k_r"])),
+                (self.eta_z, self.lam_z, Xz, 2, (p["mass"], p["c_z"], p["k_z"]))):
+            eta[0] = Xp[0] * eta[0] + W[row][0] / (m * (l1 - l2))
+            eta[1] = Xp[1] * eta[1] + W[row][1] / (m * (l2 - l1))
+        # rocking: exact transition at the mean speed of the step
+        dl = lk1 - lk2
+        q, qd = self.x_rock
+        kI = p["k_rock"] / p["I_rr"]
+        P00 = (e1 * (-lk2) - e2 * (-lk1)) / dl
+        P01 = (e1 - e2) / dl
+        P10 = (-kI) * (e1 - e2) / dl
+        P11 = (e1 * lk1 - e2 * lk2) / dl
+        w1r = W[1][0] / (p["I_rr"] * dl)
+        w2r = W[1][1] / (-p["I_rr"] * dl)
+        self.x_rock = [P00 * q + P01 * qd + w1r + w2r, P10 * q + P11 * qd + lk1 * w1r + lk2 * w2r]
 
     def outputs_now(self, omega, alpha=0.0):
         """Outputs at the current state for speed ``omega`` (used at t0 before the first step)."""
@@ -658,6 +695,7 @@ class WheelRuntime:
         t = np.asarray(t, dtype=float)
         w = np.asarray(omega, dtype=float)
         h = (t[-1] - t[0]) / (t.size - 1)
+        acc: np.ndarray | list[None]
         if isinstance(alpha, str):
             acc = np.append(np.diff(w) / h, 0.0)
         elif alpha is None:

@@ -33,6 +33,8 @@ def _exec_module(name, path, package_dir=None):
     """Module ``name`` executed from the file ``path`` (a package's ``__init__.py`` with ``package_dir``)."""
     spec = importlib.util.spec_from_file_location(
         name, path, submodule_search_locations=None if package_dir is None else [package_dir])
+    if spec is None or spec.loader is None:
+        raise ImportError(f"rwadist FMU: cannot load the model module {path}")
     mod = importlib.util.module_from_spec(spec)
     sys.modules[name] = mod              # dataclasses look their module up while the class is made
     try:
@@ -154,21 +156,26 @@ def effects_from_doc(doc, source="<model>"):
     ModelError naming ``effects[i].<field>`` on a bad entry."""
     pairs = _doc_actions(doc, source, sources=True)
     acts = [a for _, a in pairs]
-    out = {"laws": {(a.direction, a.h): a.law for a in acts if isinstance(a, _actions.LineLaw)}, "resonances": [],
-           "sidebands": [], "floors": [], "ripples": [], "switch_of": {"floors": [], "ripples": []}}
+    resonances: list[tuple] = []
+    sidebands: list[tuple] = []
+    floors: list[tuple] = []
+    ripples: list[tuple] = []
+    switch_of: dict[str, list[str | None]] = {"floors": [], "ripples": []}
     for e, a in pairs:
         switch = getattr(getattr(e, "FMU_SWITCH", None), "name", None)
         if isinstance(a, _actions.LineFilter):
-            out["resonances"].append((a.directions, *a.resonance))
+            resonances.append((a.directions, *a.resonance))
         elif isinstance(a, _actions.LineModulation):
-            out["sidebands"].append((a.direction, a.h, a.f_mod_hz, a.depth))
+            sidebands.append((a.direction, a.h, a.f_mod_hz, a.depth))
         elif isinstance(a, _actions.NoiseFloor):
-            out["floors"].append((a.channel, a.f_hz, a.psd_ref, a.omega_ref, a.exponent))
-            out["switch_of"]["floors"].append(switch)
+            floors.append((a.channel, a.f_hz, a.psd_ref, a.omega_ref, a.exponent))
+            switch_of["floors"].append(switch)
         elif isinstance(a, _actions.SpeedModulation):
-            out["ripples"].append((a.delta_omega, a.omega_ref, a.exponent, a.f_hz))
-            out["switch_of"]["ripples"].append(switch)
-    return out
+            ripples.append((a.delta_omega, a.omega_ref, a.exponent, a.f_hz))
+            switch_of["ripples"].append(switch)
+    return {"laws": {(a.direction, a.h): a.law for a in acts if isinstance(a, _actions.LineLaw)},
+            "resonances": resonances, "sidebands": sidebands, "floors": floors, "ripples": ripples,
+            "switch_of": switch_of}
 
 
 def load_model(path):

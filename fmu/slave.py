@@ -68,7 +68,7 @@ class RealU(Real):
 #: library path -> (ctypes.CDLL or None, its rwadist_kernel_step or None): opened once per process.  A CDLL
 #: defines a ctypes class of its own and is a reference cycle (it caches its functions, which refer back to
 #: it): one per instance was garbage only a full collection frees (issue 17, benchmarks/fmu_memory.py).
-_NATIVE_LAYERS = {}
+_NATIVE_LAYERS: dict[str, tuple] = {}
 
 
 def _native_layer(resources, model_identifier, rt):
@@ -90,7 +90,7 @@ def _native_layer(resources, model_identifier, rt):
 
 
 #: pythonfmu libraries whose exit is guarded (:func:`_guard_pythonfmu_exit`), once per process
-_EXIT_GUARDED = set()
+_EXIT_GUARDED: set[str] = set()
 
 
 def _elf_function_offsets(path, names):
@@ -165,11 +165,23 @@ def _load_runtime(resources):
     name = f"{__name__}_runtime"
     mod = sys.modules.get(name)
     if mod is None:
-        spec = importlib.util.spec_from_file_location(name, os.path.join(resources, RUNTIME_FILE))
+        path = os.path.join(resources, RUNTIME_FILE)
+        spec = importlib.util.spec_from_file_location(name, path)
+        if spec is None or spec.loader is None:
+            raise ImportError(f"rwadist FMU: cannot load the wheel runtime {path}")
         mod = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(mod)
         sys.modules[name] = mod
     return mod
+
+
+def _live(ref: "weakref.ref[WheelSlave]") -> "WheelSlave":
+    """The slave a variable's getter or setter reaches through the weak reference ``ref`` (see
+    WheelSlave.__init__); ReferenceError once the instance is gone."""
+    slave = ref()
+    if slave is None:
+        raise ReferenceError("rwadist wheel: the FMU instance this variable belongs to was freed")
+    return slave
 
 
 class _FixedRepr:
@@ -186,6 +198,8 @@ class _FixedRepr:
 class _FindClassView(type):
     """Metaclass of :func:`find_class_stand_in`: its classes' ``__mro__`` attribute is a fixed tuple of
     :class:`_FixedRepr` (their method resolution itself is type's, untouched)."""
+
+    _find_class_mro: tuple      # set in each class's namespace by find_class_stand_in
 
     @property
     def __mro__(cls):
@@ -244,7 +258,7 @@ class WheelSlave(Fmi2Slave):
         self._y = [0.0] * 12
         self.model = None       # WheelRuntime once initialised without error
         self._floor_warned = False
-        self.error = "not initialised"
+        self.error: str | None = "not initialised"
         self._t_start = 0.0         # fmi2SetupExperiment's start time
         self._t_next = None         # the communication point the next step must start at
         self._native, self._kernel = _native_layer(self.resources, type(self).__name__, self.rt)
@@ -294,12 +308,12 @@ class WheelSlave(Fmi2Slave):
                 self.register_variable(RealU(
                     f"dcm_{i + 1}{j + 1}", "1", causality=par, variability=fixed,
                     description=f"mounting DCM wheel -> spacecraft, row {i + 1} column {j + 1}",
-                    getter=lambda k=k: me().dcm[k], setter=lambda v, k=k: me().dcm.__setitem__(k, float(v))))
+                    getter=lambda k=k: _live(me).dcm[k], setter=lambda v, k=k: _live(me).dcm.__setitem__(k, float(v))))
         for i, ax in enumerate("xyz"):
             self.register_variable(RealU(
                 f"r_{ax}", "m", causality=par, variability=fixed,
                 description=f"interface position in the spacecraft frame, {ax}",
-                getter=lambda i=i: me().pos[i], setter=lambda v, i=i: me().pos.__setitem__(i, float(v))))
+                getter=lambda i=i: _live(me).pos[i], setter=lambda v, i=i: _live(me).pos.__setitem__(i, float(v))))
         self._vr_speed = self.vars_by_name("wheel_speed")
         self._vr_accel = self.vars_by_name("wheel_acceleration")
         self._out_index = {}
@@ -310,7 +324,7 @@ class WheelSlave(Fmi2Slave):
                 self.register_variable(RealU(
                     ch + suffix, unit, causality=out, variability=cont, initial=Fmi2Initial.exact,
                     description=desc if frame == "wheel" else f"{ch} in the {where}",
-                    getter=lambda k=k: me()._y[k]))
+                    getter=lambda k=k: _live(me)._y[k]))
                 self._out_index[self.vars_by_name(ch + suffix)] = k
         self._index_reals()
 
@@ -339,7 +353,8 @@ class WheelSlave(Fmi2Slave):
     # (inputs, parameters) and _set_outputs, which keep the list current.
     def _index_reals(self):
         vrs = sorted(self.vars)
-        self._rv = rv = [None] * (vrs[-1] + 1)
+        self._rv: list[float | None] = [None] * (vrs[-1] + 1)
+        rv = self._rv
         for vr, var in self.vars.items():
             if isinstance(var, Real):
                 rv[vr] = float(var.getter())

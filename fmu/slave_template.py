@@ -33,6 +33,7 @@ else:
     import importlib.util
     import os
     import sys
+    from typing import TYPE_CHECKING
 
     #: set by fmu/build.py for each build (this line is rewritten): the physics the model file carries
     BUILD_PHYSICS = "extended model: harmonics through the measured suspension modes"
@@ -46,8 +47,10 @@ else:
         name = f"{__name__}_slave"
         mod = sys.modules.get(name)
         if mod is None:
-            spec = importlib.util.spec_from_file_location(
-                name, os.path.join(os.path.dirname(os.path.abspath(__file__)), SLAVE_FILE))
+            path = os.path.join(os.path.dirname(os.path.abspath(__file__)), SLAVE_FILE)
+            spec = importlib.util.spec_from_file_location(name, path)
+            if spec is None or spec.loader is None:
+                raise ImportError(f"rwadist FMU: cannot load the slave implementation {path}")
             mod = importlib.util.module_from_spec(spec)
             sys.modules[name] = mod
             try:
@@ -57,7 +60,10 @@ else:
                 raise
         return mod
 
-    _slave = _load_slave()
+    if TYPE_CHECKING:            # the type checker reads the slave's source module (fmu/slave.py)
+        from . import slave as _slave
+    else:
+        _slave = _load_slave()
 
     class RwadistWheelSlave(_slave.WheelSlave):
         description = _slave.DESCRIPTION_HEAD + BUILD_PHYSICS

@@ -176,6 +176,8 @@ class WheelLines:
                     out[:, j, base] = a
                     out[:, j, base + 1] = (-1j if mode == "co" else 1j) * s * a
             return out * self._law_factor(w, idx)[..., None] if (self.laws or self.resonances) else out
+        if self.params is None:
+            raise ValueError(f"{self.name}: extended line sources without their ExtendedParams (params)")
         flat, owner = [], []
         for j, i in enumerate(idx):
             for ln in self.groups[i]:

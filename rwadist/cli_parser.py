@@ -37,19 +37,31 @@ class Refused:
         return repr(self.text)
 
 
-def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
-           unit: str = ""):
-    """An argparse ``type`` checking a finite number (or an integer) in a range."""
-    def parse(text):
+class CheckedNumber:
+    """An argparse ``type`` checking a finite number (or an integer) in a range (:func:`number`): the value, or a
+    :class:`Refused` that :func:`check_parsed` reports naming the flag."""
+
+    #: marks the flags check_parsed looks at
+    rwadist_checked = True
+
+    def __init__(self, lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
+                 unit: str = ""):
+        self.lo, self.hi, self.lo_open, self.hi_open = lo, hi, lo_open, hi_open
+        self.integer, self.unit = integer, unit
+        self.__name__ = "integer" if integer else "number"      # argparse names the type by it
+
+    def __call__(self, text):
         try:
-            return check_number(text, "value", lo, hi, lo_open=lo_open, hi_open=hi_open, integer=integer,
-                                unit=unit)
+            return check_number(text, "value", self.lo, self.hi, lo_open=self.lo_open, hi_open=self.hi_open,
+                                integer=self.integer, unit=self.unit)
         except ParameterError as exc:       # refused by check_parsed, which knows the flag (exit 2 from main)
             return Refused(text, exc.problem)
 
-    parse.__name__ = "integer" if integer else "number"
-    parse.rwadist_checked = True
-    return parse
+
+def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
+           unit: str = "") -> CheckedNumber:
+    """An argparse ``type`` checking a finite number (or an integer) in a range."""
+    return CheckedNumber(lo, hi, lo_open=lo_open, hi_open=hi_open, integer=integer, unit=unit)
 
 
 def check_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:

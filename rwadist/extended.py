@@ -200,7 +200,7 @@ def from_table_4_2(zeta_z: float = 0.05) -> ExtendedParams:
 
 def params_to_dict(p: ExtendedParams) -> dict:
     """The ``analytical`` section of the model file (flat, units in the key names)."""
-    d = {"kind": ANALYTICAL_KIND}
+    d: dict[str, str | float] = {"kind": ANALYTICAL_KIND}
     d.update({key: float(getattr(p, name)) for name, key in _DICT_KEYS.items()})
     return d
 
@@ -521,7 +521,7 @@ def crossings(p: ExtendedParams, lines, speed_range) -> list:
                 return line.h * w / (2 * np.pi) - whirl_frequencies(p, w)[mode]
             gv = g(grid)
             idx = np.nonzero(np.sign(gv[:-1]) * np.sign(gv[1:]) <= 0)[0]
-            seen = []
+            seen: list[float] = []        # crossing speeds found, rad/s
             for i in idx:
                 if gv[i] == 0 and gv[i + 1] == 0:
                     continue

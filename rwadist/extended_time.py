@@ -221,7 +221,8 @@ def simulate_time(p: ExtendedParams, lines, t, omega, *, seed=None, phases=None,
     tau = t - t[0]
     wdot = np.gradient(w, T)
     out = np.zeros((t.size, 6))
-    groups = {d: [] for d in DIRECTIONS}
+    # per direction: (σh, frequency offset rad/s, coefficient, amplitude per sample) of each component
+    groups: dict[str, list[tuple]] = {d: [] for d in DIRECTIONS}
     for ln in lines:
         amp = ln.amplitude(w) - 1j * ln.C * wdot if ln.imbalance else ln.amplitude(w)
         for sigma, coef in ln.components():

@@ -54,8 +54,8 @@ def parse(spec: str) -> dict:
     if kind not in known:
         raise _bad(spec, "kind", f"unknown kind {kind!r}; known: {', '.join(known)}")
     cls = known[kind]
-    out = {"kind": kind}
-    given = {}
+    out: dict[str, str | float | tuple[str, ...]] = {"kind": kind}
+    given: dict[str, str | float] = {}
     for item in filter(None, (x.strip() for x in rest.split(","))):
         key, eq, value = item.partition("=")
         key = key.strip()
@@ -80,7 +80,7 @@ def parse(spec: str) -> dict:
     if "direction" in out and out["direction"] not in _DIRS:
         raise _bad(spec, "direction", f"{out['direction']!r}; expected one of {', '.join(_DIRS)}")
     if "channels" in out:
-        chans = tuple(c.strip() for c in out["channels"].split("+") if c.strip())
+        chans = tuple(c.strip() for c in str(out["channels"]).split("+") if c.strip())
         bad = [c for c in chans if c not in CHANNELS]
         if bad or not chans:
             raise _bad(spec, "channels", f"{out['channels']!r}; give channels joined by '+', from {'+'.join(CHANNELS)}")

@@ -187,6 +187,7 @@ def _check_keys(path, where: str, obj: dict, known: tuple) -> None:
 def _wheel_items(wheels) -> tuple:
     """(source, wheel objects, folder model and speed-file paths are relative to) of a wheels.json path or of its
     parsed content (a list of wheel objects, or ``{"wheels": [...]}``; paths then relative to the working folder)."""
+    path: str | Path
     if isinstance(wheels, (str, Path)):
         path, base = Path(wheels), Path(wheels).parent
         doc = read_json(path)
@@ -230,9 +231,9 @@ def _wheel_lines(path, where: str, w: dict, base: Path, cache: dict, default_lin
         mp = mp if mp.is_absolute() else base / mp
         if not mp.exists():
             raise DataError(path, f"{where}.model", f"model file {str(mp)!r} does not exist")
-        key, ref, ask = ("model", str(mp)), str(mp), {"model": mp}
+        key, ref, model, preset = ("model", str(mp)), str(mp), mp, None
     elif "preset" in w:
-        key, ref, ask = ("preset", w["preset"]), f"preset {w['preset']}", {"preset": w["preset"]}
+        key, ref, model, preset = ("preset", w["preset"]), f"preset {w['preset']}", None, w["preset"]
     else:
         if default_lines_loader is None:
             raise DataError(path, f"{where}.model", "no model: give 'model' or 'preset' here, or a default model "
@@ -242,9 +243,9 @@ def _wheel_lines(path, where: str, w: dict, base: Path, cache: dict, default_lin
         return cache["default"], "command-line model", False   # the caller notes its own
     if key not in cache:
         try:
-            src = wheel_source(**ask, empirical=empirical, assumed_modes=assumed_modes)
+            src = wheel_source(model, preset=preset, empirical=empirical, assumed_modes=assumed_modes)
         except ValueError as exc:
-            if "model" in ask:
+            if model is not None:
                 raise
             raise DataError(path, f"{where}.preset", getattr(exc, "problem", None) or str(exc)) from None
         cache[key] = (src.lines, src.modes_assumed)
@@ -314,7 +315,8 @@ def load_wheels(wheels, default_lines_loader=None, default_law=None, empirical: 
     """
     path, items, base = _wheel_items(wheels)
     names = [str(w.get("name", f"wheel{i}")) if isinstance(w, dict) else "" for i, w in enumerate(items)]
-    out, cache = [], {}
+    out: list[WheelSpec] = []
+    cache: dict[tuple[str, str] | str, object] = {}      # one read per model file or preset of the set, and the default
     for i, w in enumerate(items):
         where = f"wheels[{i}]"
         _check_wheel(path, where, w, names, i)
@@ -349,7 +351,7 @@ def wheel_groups(wheels: list) -> list:
     root wheel's law (a ratio −1 shows as the member's ratio)."""
     from .broadband import Member
 
-    groups = {}
+    groups: dict[int | tuple[str, int], tuple[list, object]] = {}
     order = []
     for i, ws in enumerate(wheels):
         root, ratio, offset, lock = _root(wheels, i)

@@ -22,7 +22,7 @@ def _object(checks: dict, required: list, extra: bool = True) -> dict:
             "properties": {k: fn.json for k, fn in checks.items()}, "additionalProperties": extra}
 
 
-def effect_schema(cls: type) -> dict:
+def effect_schema(cls: type[schema.Effect]) -> dict:
     """The JSON Schema of one effect kind (keys the class does not declare are allowed: carried through)."""
     checks, required = {}, ["kind"]
     for f in fields(cls):

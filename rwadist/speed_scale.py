@@ -271,7 +271,7 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
         k = np.rint(ratio)
         hit = (k >= 1) & (k <= INTEGER_ORDERS) & (np.abs(ratio - k) <= INTEGER_TOL * np.maximum(k, 1))
         score[c] = np.sum(strength[hit])
-        multiples.append((c, sorted(int(x) for x in k[hit])))
+        multiples.append((int(c), sorted(int(x) for x in k[hit])))
     best = int(np.flatnonzero(cand)[np.argmax(score[cand])])
     mult = dict(multiples)[best]
     evidence = {"order": float(orders[best]), "multiples_found": mult,

@@ -214,19 +214,19 @@ def _refine(P_row, F_row, f_pad, f0: float, harmonics, df: float, threshold: flo
     lo = max(h_arr.min() * f0 - tol - 2 * df, 0.0)
     hi = h_arr.max() * f0 + tol + 2 * df
     f_lines, idx = find_lines(P_row, f_pad, F_row, threshold, f_max=hi, f_min=lo)
-    hs, fk, snr = [], [], []
+    h_found, f_found, snr_found = [], [], []      # each harmonic found: h, its line's frequency (Hz) and SNR
     for h in h_arr:
         if f_lines.size == 0:
             break
         d = np.abs(f_lines - h * f0)
         i = int(np.argmin(d))
         if d[i] <= tol:
-            hs.append(h)
-            fk.append(f_lines[i])
-            snr.append(P_row[idx[i]] / F_row[idx[i]])
-    if not hs:
+            h_found.append(h)
+            f_found.append(f_lines[i])
+            snr_found.append(P_row[idx[i]] / F_row[idx[i]])
+    if not h_found:
         return float("nan"), float("nan"), 0, np.empty(0)
-    hs, fk, snr = np.array(hs), np.array(fk), np.array(snr)
+    hs, fk, snr = np.array(h_found), np.array(f_found), np.array(snr_found)
     # Cramér-Rao-like scatter of a line frequency: about 0.4·df/sqrt(SNR) (Hann, one segment), the
     # SNR of the channel average being n_channels times that of one channel
     sig = 0.4 * df / np.sqrt(n_channels * np.minimum(snr, WEIGHT_CAP))

@@ -188,7 +188,7 @@ def simulate_steady(wheel: WheelDescription, speeds_rpm, sample_rate: float = 38
         return _steady_extended(wheel, speeds, omegas, t, sample_rate, noise, test_stand, seed, noise_std,
                                 phase_rng, noise_rng)
     hc = {d: wheel.h_and_C(d) for d in DIRECTION_CHANNELS}
-    dropped = []
+    dropped: list[dict] = []   # lines above the Nyquist frequency left out, per run
     runs = []
     for k, omega in enumerate(omegas):
         signals = {ch: np.zeros(n_samples) for ch in CHANNELS}
@@ -281,6 +281,8 @@ def _with_phases(lines: list, phases) -> list:
 
 
 def _extended_meta(wheel: WheelDescription, lines: list) -> dict:
+    if wheel.extended is None:
+        raise ValueError(f"{wheel.name}: the extended physics' meta of a wheel without an extended model")
     return {"physics": "extended",
             "extended": ext.params_to_dict(wheel.extended),
             "imbalance_phase_rad": float(wheel.imbalance_phase),
@@ -297,7 +299,8 @@ def _steady_extended(wheel, speeds, omegas, t, sample_rate, noise, test_stand, s
     fixture = _fixture_modes(wheel, test_stand)
     nyquist = 0.5 * sample_rate
     n_samples = t.size
-    dropped, runs = [], []
+    dropped: list[dict] = []   # lines above the Nyquist frequency left out, per run
+    runs = []
     for k, omega in enumerate(omegas):
         lines = _with_phases(base, _extended_phases(wheel, base, phase_rng))
         f, A = ext.steady_lines(wheel.extended, lines, [omega])

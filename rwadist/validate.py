@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import TypedDict
 
 import numpy as np
 
@@ -26,7 +27,18 @@ MAX_SAMPLES = 50_000_000
 
 #: The allowed range of every numeric parameter of the API, by name: the keyword arguments of
 #: :func:`check_number` (``lo``/``hi`` bounds, ``lo_open``/``hi_open`` bound excluded, ``integer``, ``unit``).
-LIMITS = {
+class Limit(TypedDict, total=False):
+    """The keyword arguments of :func:`check_number` that give a parameter's range."""
+
+    lo: float
+    hi: float
+    lo_open: bool
+    hi_open: bool
+    integer: bool
+    unit: str
+
+
+LIMITS: dict[str, Limit] = {
     "f_lim": dict(lo=0, hi=1e6, lo_open=True, unit="Hz"),
     "nperseg": dict(lo=16, hi=2**24, integer=True),
     "presence": dict(lo=0, hi=1, lo_open=True),
@@ -224,8 +236,9 @@ def speed_scale_warning(fit, meta: dict | None = None) -> str | None:
     at_one = max((ln.C for ln in lines if abs(ln.h - 1.0) <= 0.02), default=0.0)
     if abs(top.h - 1.0) <= 0.02 or at_one >= 0.3 * top.C:
         return None
-    tach = meta.get("tach") if isinstance(meta, dict) else None
-    ppr = tach.get("pulses_per_rev", 1) if isinstance(tach, dict) else None
+    tach_meta = meta.get("tach") if isinstance(meta, dict) else None
+    tach: dict = tach_meta if isinstance(tach_meta, dict) else {}
+    ppr = tach.get("pulses_per_rev", 1) if isinstance(tach_meta, dict) else None
     ppr = ppr if isinstance(ppr, int) and not isinstance(ppr, bool) and ppr >= 1 else None
 
     def near(x, y):
@@ -236,7 +249,7 @@ def speed_scale_warning(fit, meta: dict | None = None) -> str | None:
     if sub is not None and ppr is not None:
         hint = (f"the speeds come from the tach channel {tach.get('channel')!r} with meta.json tach.pulses_per_rev = "
                 f"{ppr}; {ppr * sub} pulses per revolution would put it at h = 1")
-    elif over is not None:
+    elif over is not None and ppr is not None:         # over is only found with ppr given
         hint = (f"the speeds come from the tach channel {tach.get('channel')!r} with meta.json tach.pulses_per_rev = "
                 f"{ppr}; {ppr // over} would put it at h = 1")
     elif sub is not None:

@@ -216,7 +216,7 @@ class WheelDescription:
         """The truth as a :class:`rwadist.model.WheelModel`: harmonics (no simple modes); with
         ``extended`` set also its ``analytical`` section and each radial harmonic's sense."""
         wheel = {k: v for k, v in self.wheel_json().items() if k != "name"}
-        empirical = {d: [] for d in DIRECTION_CHANNELS}
+        empirical: dict[str, list[Harmonic]] = {d: [] for d in DIRECTION_CHANNELS}
         for d, pairs in self.harmonics.items():
             radial = self.extended is not None and d in ("radial_force", "radial_torque")
             empirical[d] = [Harmonic(h=h, C=C, sense=self.senses.get((d, h), "co") if radial else None)

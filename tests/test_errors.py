@@ -122,3 +122,18 @@ def test_a_parameter_is_named_by_its_flag(tmp_path, capsys):
     assert "rwadist: error: --speed-rpm: value: 3000:300: empty or inverted" in capsys.readouterr().err
     with pytest.warns(rwadist.RwadistWarning, match=r"^speed_rpm: 0:10000 rpm reaches beyond the maximum speed"):
         rwadist.psd(preset="ithaco-e", speed_rpm=(0, 10000), empirical=True, n_freq=101, n_speeds=20)
+
+
+def test_coupling_model_error_keeps_both_contracts():
+    """A CouplingModelError is a ModelError and a ParameterError: it has ParameterError's ``parameter`` (None: a file's
+    entry, no function parameter) and a string ``problem``, so the command line words it as the file's error."""
+    from rwadist.coupling.performance import CouplingModelError
+
+    from rwadist.cli import user_message
+
+    e = CouplingModelError("<model>", "effects[0].f_Hz", "-1.0: must be > 0")
+    assert (e.parameter, e.field, e.problem) == (None, "effects[0].f_Hz", "-1.0: must be > 0")
+    assert user_message(e) == str(e) == "<model>: effects[0].f_Hz: -1.0: must be > 0"
+    whole = CouplingModelError("wheel: mass_kg and radius_m must be positive, got 0, 0.1")
+    assert (whole.parameter, whole.field, whole.problem) == (None, None, str(whole))
+    assert user_message(whole) == str(whole)

@@ -53,11 +53,11 @@ class Context(Metric):
                 [r.speed for r in test.runs], spectra.speed)):
             raise ValueError("diagnose: the test's runs are not those of the spectra (count or speeds differ)")
         self.test = test
-        self._memo = {}
+        self._memo: dict = {}        # computed values of several kinds, each under what it is made of
         #: the search step under way (:func:`rwadist.diagnose.search.diagnose`): (state, its held-out errors on a set of
         #: channels, min_gain), read by :meth:`can_pass`; None outside a search
         self.step = None
-        self._corrected = {}
+        self._corrected: dict = {}
         self.f = spectra.f
         self.df = spectra.df
         self.omega = np.abs(np.asarray(spectra.speed, dtype=float))
@@ -140,7 +140,7 @@ class Context(Metric):
             first = {k: keys.index(k) for k in todo}
             f_new = np.column_stack([cols[first[k]] for k in todo])
             out = np.full((runs.size, f_new.shape[1], len(CHANNELS)), np.nan + 0j)
-            groups = {}
+            groups: dict[tuple, list[int]] = {}
             for i, r in enumerate(runs):
                 run = self.test.runs[r]
                 have = tuple(j for j, c in enumerate(CHANNELS) if c in run.signals)
@@ -305,6 +305,9 @@ class Context(Metric):
         ``state.ext_lines()``)."""
         from .. import extended as ext
 
+        if state.ext is None:
+            raise ValueError("extended lines asked of a state on the empirical base (ext is None)")
+        out: dict[str, list[tuple]]         # channel -> (h, law, amplitude, modal gain) per line
         w = self.omega[runs]
         out = {c: [] for c in self.channels}
         mixing = {c: [] for c in self.channels}
@@ -314,7 +317,7 @@ class Context(Metric):
         P = np.abs(A) ** 2                                             # 2 × mean square
         hs = np.array([ln.h for ln in lines])
         free = np.array([ln.amplitude(w) for ln in lines]).T           # (S, L) load amplitudes
-        groups = []
+        groups: list[list[int]] = []
         for j in np.argsort(hs, kind="stable"):
             if groups and abs(hs[j] - hs[groups[-1][0]]) < ext.LAW_H_TOL:
                 groups[-1].append(j)
@@ -455,7 +458,7 @@ class Context(Metric):
                 if state.smear is not None:
                     du, wt = self.smear_offsets(state, h, runs)
                     out += self.psd_at(f[:, None] + du, (a**2 / 2.0)[:, None] * wt, bins)
-                elif rip is None:
+                elif rip is None or state.speed_modulation is None:       # a ripple's powers come with one
                     plain_f.append(f)
                     plain_p.append(a**2 / 2.0)
                 else:
@@ -573,6 +576,8 @@ class Context(Metric):
         half a bin cover that range, each weighted by the instantaneous power (Ω(τ)/Ω)⁴ (a C·Ω² line) and
         by how much its part of the record weighs in the Welch estimate (:meth:`_welch_weights`), each
         point split in three across a segment's own sweep (see the comment in the code)."""
+        if state.smear is None:
+            raise ValueError("smear_offsets: the state has no spin acceleration (smear)")
         alpha = float(state.smear)
         T = self.run_durations(runs)
         width = h * alpha * T / (2 * np.pi)                                  # Hz swept during the run

@@ -150,7 +150,7 @@ def _refine_offset(ctx, state, chans, runs, hs, off, n_iter: int = 2):
     bins and kept when > 20 × floor; the offset is the median of side·(f_peak − f_i).  Returns (offset, count)."""
     n = 0
     for _ in range(n_iter):
-        est = []
+        found = []            # per channel and side: the offsets measured, Hz
         for c in chans:
             R, _ = _residual_z(ctx, state, c, runs)
             z = R / ctx.floor_psd(state, c, runs)
@@ -166,8 +166,8 @@ def _refine_offset(ctx, state, chans, runs, hs, off, n_iter: int = 2):
                     den = lo - 2 * mid + hi
                     with np.errstate(divide="ignore", invalid="ignore"):
                         dl = np.clip(np.where(den < 0, 0.5 * (lo - hi) / den, 0.0), -0.5, 0.5)
-                    est.append((side * ((kp + dl) * ctx.df - f0))[ok])
-        est = np.concatenate(est) if est else np.empty(0)
+                    found.append((side * ((kp + dl) * ctx.df - f0))[ok])
+        est = np.concatenate(found) if found else np.empty(0)
         n = est.size
         if n < 3:
             return off, n
@@ -230,7 +230,7 @@ def record_dfts(ctx: Context, rows, c: str, f_hz: np.ndarray) -> np.ndarray:
     from ..dft import demeaned_windowed, run_window, windowed_dfts
 
     out = np.empty(f_hz.shape, dtype=complex)
-    groups = {}
+    groups: dict[tuple[int, float], list[int]] = {}       # rows by (record length, sample rate)
     for i, r in enumerate(rows):
         run = ctx.test.runs[r]
         groups.setdefault((run.n_samples, run.sample_rate), []).append(i)

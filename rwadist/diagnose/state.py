@@ -3,9 +3,13 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 from ..model import WheelModel
 from ..units import CHANNEL_DIRECTION
+
+if TYPE_CHECKING:
+    from ..extended import ExtendedParams
 
 
 @dataclass
@@ -49,7 +53,7 @@ class State:
     model: WheelModel
     noise: dict
     effects: list = field(default_factory=list)
-    ext: object = None
+    ext: ExtendedParams | None = None
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def copy(self) -> "State":
@@ -128,6 +132,8 @@ class State:
         """:meth:`ext_lines` computed."""
         from .. import extended as ext
 
+        if self.ext is None:
+            raise ValueError("extended lines asked of a state on the empirical base (ext is None)")
         out = ext.lines_from_model(self.model, self.ext, effects=False)
         if self.laws:
             laws = [(d, h, law) for (d, h), law in self.laws.items()]

@@ -57,7 +57,7 @@ class BroadbandFloor(Element):
         """The floor's PSD unit: its channel's unit squared per Hz (N²/Hz or (N·m)²/Hz)."""
         chans = e["channel"] if isinstance(e["channel"], (list, tuple)) else [e["channel"]]
         unit = CHANNEL_UNIT.get(chans[0]) if chans else None
-        return {"N": "N²/Hz", "Nm": "(N·m)²/Hz"}.get(unit, f"({unit})²/Hz" if unit else "unit²/Hz")
+        return {"N": "N²/Hz", "Nm": "(N·m)²/Hz"}.get(unit or "", f"({unit})²/Hz" if unit else "unit²/Hz")
 
     # ------------------------------------------------------------------ injection
     #: ``broadband_floor:channels=Fx+Fy+Fz,level=0.05,exponent=3,fc_hz=60``: Gaussian noise low-passed at fc

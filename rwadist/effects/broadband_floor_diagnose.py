@@ -45,9 +45,9 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
         # each exponent's SSE summed over its own (runs, bands) array, as the loop over exponents did
         res = wts * (y - n[:, None, :] - g[:, None, :] * xs) ** 2
         sse = [float(np.sum(r)) for r in res]
-        i = None
+        i = 0
         for k, v in enumerate(sse):             # the first smallest, as the loop over exponents took it
-            if i is None or v < sse[i]:
+            if v < sse[i]:
                 i = k
         best = (sse[i], FLOOR_EXPONENTS[i], n[i], g[i])
         _, p, n, g = best

@@ -86,6 +86,8 @@ class CounterRotation:
             # the co part is the imbalance of the analytical section; the model's co harmonic (its empirical
             # coefficient, read by the hard-mounted consumers) is scaled alike
             name = "U_s" if d == "radial_force" else "U_d"
+            if s.ext is None:       # an imbalance line is one of the extended base's (_sense_group)
+                raise ValueError("counter_rotation: an imbalance line on a state without extended parameters")
             s.ext = replace(s.ext, **{name: c_co})
             s.model.analytical = dict(s.model.analytical or {}, **ext.params_to_dict(s.ext))
             scale = c_co / c_co0 if c_co0 > 0 else 0.0

@@ -165,7 +165,8 @@ def _record_run_residuals(ctx: Context, j: int, items, f_top: float, A_of: dict)
         grid, _, df_rec, n = _record_grid(ctx, rows[0])
         fls = np.array([fl for _, fl in group])                                              # (R, L)
         missing = [k for k, r in enumerate(rows) if r not in A_of]
-        A_new = record_dfts(ctx, [rows[k] for k in missing], c, fls[missing]) if missing else None
+        A_new = record_dfts(ctx, [rows[k] for k in missing], c, fls[missing]) if missing else \
+            np.empty((0, fls.shape[1]), dtype=complex)
         A = np.array([A_of[r] if r in A_of else A_new[missing.index(k)] for k, r in enumerate(rows)])   # (R, L)
         X = np.array([_record_grid(ctx, r)[1][:, j] for r in rows])                          # (R, G)
         t_minus = hann_transform_ratio(n, (grid[None, :, None] - fls[:, None, :]) / df_rec)
@@ -213,7 +214,7 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     todo = [(i, int(r), lines[i][near[i]], valid[i], gi[i])     # the runs that have the channel
             for i, r in enumerate(runs) if _has_channel(ctx, int(r), j)]
     # the lines' phasors of the runs not yet on the context, runs of one number of lines transformed together
-    new_lines = {}
+    new_lines: dict[int, list[tuple[int, np.ndarray]]] = {}
     for i, r, fl, _, _ in todo:
         if fl.size and ("missing_harmonic_run", r, j, fl.tobytes(), f_top) not in ctx._memo:
             new_lines.setdefault(fl.size, []).append((r, fl))
@@ -227,23 +228,25 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     ex_key = {i: ("missing_harmonic_exact", r, j, fl.tobytes(), f_hz[i].tobytes()) for i, r, fl, _, _ in todo} \
         if exact else {}
     ex_new = [t for t in todo if exact and ex_key[t[0]] not in ctx._memo]
-    X_ex = record_dfts(ctx, [t[1] for t in ex_new], c, f_hz[[t[0] for t in ex_new]]) if ex_new else None
+    X_ex = record_dfts(ctx, [t[1] for t in ex_new], c, f_hz[[t[0] for t in ex_new]]) if ex_new else \
+        np.empty((0, f_hz.shape[1]), dtype=complex)
     ex_row = {t[0]: k for k, t in enumerate(ex_new)}
     # their lines' leakage (the window's transform at the points less and plus each line, times its phasor), the runs
     # of one record length and number of lines at once (elementwise: the numbers of one run at a time)
     leak = {}
-    ex_groups = {}
+    ex_groups: dict[tuple[int, float, int], list[tuple[int, int, np.ndarray]]] = {}
     for i, r, fl, _, _ in ex_new:
         if fl.size:
             run = ctx.test.runs[r]
             ex_groups.setdefault((run.n_samples, run.sample_rate, fl.size), []).append((i, r, fl))
-    for (n, fs, _), items in ex_groups.items():
+    for (n, fs, _), ex_items in ex_groups.items():
         df_g = fs / n
-        fi = f_hz[[i for i, _, _ in items]][:, :, None]                                   # (R, L, 1)
-        fls = np.array([fl for _, _, fl in items])[:, None, :]                             # (R, 1, nl)
-        A = np.array([_record_run_residual(ctx, r, j, fl, f_top, A_new.get(r))[1] for _, r, fl in items])[:, None, :]
+        fi = f_hz[[i for i, _, _ in ex_items]][:, :, None]                                # (R, L, 1)
+        fls = np.array([fl for _, _, fl in ex_items])[:, None, :]                          # (R, 1, nl)
+        A = np.array([_record_run_residual(ctx, r, j, fl, f_top, A_new.get(r))[1]
+                      for _, r, fl in ex_items])[:, None, :]
         d = (hann_transform_ratio(n, (fi - fls) / df_g) * A + hann_transform_ratio(n, (fi + fls) / df_g) * np.conj(A)).sum(2)
-        leak.update({i: d[k] for k, (i, _, _) in enumerate(items)})
+        leak.update({i: d[k] for k, (i, _, _) in enumerate(ex_items)})
     for i, r, fl, _, g in todo:
         Xr, A, local = _record_run_residual(ctx, r, j, fl, f_top, A_new.get(r))
         Xi = Xr[g]
@@ -351,15 +354,15 @@ class MissingHarmonic:
         else:
             h = float(grid[i])
         P, N, ok, chans = MissingHarmonic._record_points(ctx, state, direction, runs, [h], exact=True)
-        d, w, used = [], [], np.zeros(runs.size, bool)
+        d_parts, w_parts, used = [], [], np.zeros(runs.size, bool)     # per channel: amplitudes, speeds (rad/s)
         for j, c in enumerate(chans):
             keep = ok[j, :, 0] & (P[j, :, 0] > RECORD_FIT_SNR * N[j, :, 0])
             unit = MissingHarmonic._line_amplitude(ctx, state, c, direction, h, 1.0, runs)   # per unit C
             a = np.sqrt(np.maximum(P[j, :, 0] - N[j, :, 0], 0.0)) / np.maximum(unit, 1e-300) * ctx.omega[runs] ** 2
-            d.append(a[keep])
-            w.append(ctx.omega[runs][keep])
+            d_parts.append(a[keep])
+            w_parts.append(ctx.omega[runs][keep])
             used |= keep
-        d, w = np.concatenate(d), np.concatenate(w)
+        d, w = np.concatenate(d_parts), np.concatenate(w_parts)
         if d.size < RECORD_MIN_POINTS or used.sum() < RECORD_MIN_RUNS:
             return None
         C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
@@ -395,7 +398,7 @@ class MissingHarmonic:
                 score[enough] = column_nanmedian(z[:, enough])
             peaks = np.nonzero((score[1:-1] > score[:-2]) & (score[1:-1] >= score[2:])
                                & (score[1:-1] > RECORD_SCORE))[0] + 1
-            found = []
+            found: list[MissingHarmonic] = []
             for i in peaks[np.argsort(-score[peaks])]:
                 h = float(h_grid[i])
                 if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)) or \
@@ -440,7 +443,7 @@ class MissingHarmonic:
                        for x in state.model.harmonics(e.direction))
 
         def welch(d, chans) -> list:
-            found = []
+            found: list[MissingHarmonic] = []
             for h in ridge_peaks(ctx, state, chans, runs, max_per_direction):
                 if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
                     continue

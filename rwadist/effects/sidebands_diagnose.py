@@ -95,7 +95,7 @@ class Sidebands:
         f_mod, n = _refine_offset(ctx, state, chans, runs, [h], f_mod)
         if n < 3 or f_mod <= 0:
             return None
-        P, Q = [], []
+        P_parts, Q_parts = [], []        # per channel and side: measured and model powers of the runs kept
         for c in chans:
             R, _ = _residual_z(ctx, state, c, runs)
             a = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - h) < 1e-9), None)
@@ -107,9 +107,9 @@ class Sidebands:
                 ok = inb & _clear_of_lines(ctx, state, c, runs, f, h) & (f > 0)
                 g = (ctx.gain(state, c, f) if state.resonances else 1.0) * \
                     ctx.sideband_gain(state, c, h, side * f_mod, runs)            # through the modes at f
-                P.append(p[ok])
-                Q.append(((a * g) ** 2 / 8.0 * np.ones(runs.size))[ok])
-        P, Q = np.concatenate(P), np.concatenate(Q)
+                P_parts.append(p[ok])
+                Q_parts.append(((a * g) ** 2 / 8.0 * np.ones(runs.size))[ok])
+        P, Q = np.concatenate(P_parts), np.concatenate(Q_parts)
         if P.size < 3 or not np.sum(Q * Q) > 0:
             return None
         m2 = float(np.sum(P * Q) / np.sum(Q * Q))
@@ -184,7 +184,7 @@ class Sidebands:
         f_mod = float(grid[i])
         f, P, N, ok = Sidebands._record_power(ctx, state, direction, h, runs, np.array([f_mod]))
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
-        A, Q = [], []
+        A_parts, Q_parts = [], []        # per channel and side: measured and model amplitudes of the runs kept
         for j, c in enumerate(chans):
             a = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - h) < 1e-9), None)
             if a is None:
@@ -193,9 +193,9 @@ class Sidebands:
                 g = (ctx.gain(state, c, f[:, col]) if state.resonances else 1.0) * \
                     ctx.sideband_gain(state, c, h, (2 * col - 1) * f_mod, runs)
                 keep = ok[:, col] & (P[:, col, j] > 10.0 * N[:, col, j])
-                A.append(np.sqrt(np.maximum(P[:, col, j] - N[:, col, j], 0.0))[keep])
-                Q.append((0.5 * a * g * np.ones(runs.size))[keep])
-        A, Q = np.concatenate(A), np.concatenate(Q)
+                A_parts.append(np.sqrt(np.maximum(P[:, col, j] - N[:, col, j], 0.0))[keep])
+                Q_parts.append((0.5 * a * g * np.ones(runs.size))[keep])
+        A, Q = np.concatenate(A_parts), np.concatenate(Q_parts)
         if A.size < 3 or not np.sum(Q * Q) > 0:
             return None
         m = float(np.sum(A * Q) / np.sum(Q * Q))
@@ -221,15 +221,15 @@ class Sidebands:
             return None
         f, P, N, ok = Sidebands._record_power(ctx, state, self.direction, self.h, runs, np.array([self.f_mod]))
         chans = [c for c in DIRECTION_CHANNELS[self.direction] if c in ctx.channels]
-        M1 = []
+        m1_rows = []
         for c in chans:
             a = next((x[2] for x in ctx.channel_lines(state, c, runs) if abs(x[0] - self.h) < 1e-9), None)
             if a is None:
                 return None
             g = np.column_stack([ctx.gain(state, c, f[:, col]) for col in (0, 1)]) if state.resonances else 1.0
             g = g * np.column_stack([ctx.sideband_gain(state, c, self.h, side * self.f_mod, runs) for side in (-1, 1)])
-            M1.append((0.5 * self.depth * a[:, None] * g * np.ones((runs.size, 2))) ** 2)
-        M1 = np.array(M1).reshape(len(chans), -1)                        # (chans, runs·2)
+            m1_rows.append((0.5 * self.depth * a[:, None] * g * np.ones((runs.size, 2))) ** 2)
+        M1 = np.array(m1_rows).reshape(len(chans), -1)                        # (chans, runs·2)
         P = np.moveaxis(P, 2, 0).reshape(len(chans), -1)
         N = np.moveaxis(N, 2, 0).reshape(len(chans), -1)
         ok = np.broadcast_to(ok.reshape(1, -1), P.shape)
@@ -268,12 +268,12 @@ class Sidebands:
     def candidates(ctx: Context, state: State, runs, max_per_direction: int = 3) -> list:
         """Per direction, the carriers whose best constant-offset ridge pair (:func:`_offset_scores`) clears
         :func:`_offset_threshold`; at most ``max_per_direction``, strongest first."""
-        out = []
+        out: list[Sidebands] = []
         offsets = _offset_grid(ctx)
         if offsets.size < 3:
             return out
-        for d, chans in DIRECTION_CHANNELS.items():
-            chans = [c for c in chans if c in ctx.channels]
+        for d, direction_chans in DIRECTION_CHANNELS.items():
+            chans = [c for c in direction_chans if c in ctx.channels]
             hs = [x.h for x in state.model.harmonics(d)
                   if not any(dd == d and abs(hh - x.h) < 1e-4 for dd, hh, _, _ in state.modulations)]
             if not chans or not hs:

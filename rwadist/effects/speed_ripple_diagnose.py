@@ -65,7 +65,7 @@ class SpeedRipple:
         """Measured first-order ripple sidebands of every model line: (P window power, σ noise std, h, Ω,
         a carrier amplitude × gain, p amplitude exponent, side) over channels, lines and both sides, in band
         and clear of other lines."""
-        cols = {k: [] for k in ("P", "sig", "h", "w", "a", "p", "side", "leak")}
+        cols: dict[str, list] = {k: [] for k in ("P", "sig", "h", "w", "a", "p", "side", "leak")}
         for c in ctx.channels:
             if not np.isfinite(ctx.sp.psd[c][runs, 0]).all():
                 continue

@@ -136,7 +136,7 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
     if need is None:
         need = np.ones(f_hz.shape, dtype=bool)
     X = np.full((runs.size, f_hz.shape[1], len(chans)), np.nan + 0j)
-    groups = {}
+    groups: dict[tuple[int, float], list[np.intp]] = {}       # rows by (record length, sample rate)
     for i in np.flatnonzero(need.any(axis=1)):
         run = ctx.test.runs[runs[i]]
         groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
@@ -303,15 +303,15 @@ class SpeedSidebands:
             f = (h * ctx.omega[sub] / (2 * np.pi))[:, None]
             P, N = _run_line_power(ctx, state, direction, sub, f, h0)
             chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
-            d, w = [], []
+            d_parts, w_parts = [], []           # per channel: line amplitudes and speeds (rad/s) of the runs kept
             for j, c in enumerate(chans):
                 ok = P[:, 0, j] > 10.0 * N[:, 0, j]
                 a = np.sqrt(np.maximum(P[:, 0, j] - N[:, 0, j], 0.0)) / ctx.gain(state, c, f[:, 0])
                 if state.ext is not None:
                     a = a / ctx.modal_gain(state, c, h, sub)
-                d.append(a[ok])
-                w.append(ctx.omega[sub][ok])
-            d, w = np.concatenate(d), np.concatenate(w)
+                d_parts.append(a[ok])
+                w_parts.append(ctx.omega[sub][ok])
+            d, w = np.concatenate(d_parts), np.concatenate(w_parts)
             C = _eq310_C(d, w)
             if C is None:
                 return None
@@ -348,7 +348,7 @@ class SpeedSidebands:
         context (the same at every step of the search): the directions that share a carrier h₀ (an imbalance at h = 1
         in the radial forces, the radial torques and the axial force) transformed together, with one table of
         phasors for all their channels (:func:`_line_powers`), then kept per direction."""
-        by_h0 = {}
+        by_h0: dict[float, tuple[float, list[str]]] = {}
         for d, h0 in jobs:
             if _scan_key(d, h0, runs) not in ctx._memo:
                 by_h0.setdefault(round(h0, 6), (h0, []))[1].append(d)
@@ -386,17 +386,17 @@ class SpeedSidebands:
         pos = {r: i for i, r in enumerate(runs)}
         score = np.zeros(DELTA_GRID.size)
         for j, dl in enumerate(DELTA_GRID):
-            vals = []
+            parts: list[np.ndarray] = []        # per side and channel: the z of the sideband's bin per run
             for side in (-1.0, 1.0):
                 sub = resolvable_runs(ctx, state, direction, h0, h0 + side * dl, runs)
                 if sub.size < 3:                # as :meth:`fit`: a side resolved in fewer runs is not fitted
-                    vals = []
+                    parts = []
                     break
                 rows = np.array([pos[r] for r in sub])
                 k = np.rint((h0 + side * dl) * ctx.omega[sub] / (2 * np.pi) / ctx.df).astype(int)
                 for c in chans:
-                    vals.append(z[c][rows, k])
-            vals = np.concatenate(vals) if vals else np.empty(0)
+                    parts.append(z[c][rows, k])
+            vals = np.concatenate(parts) if parts else np.empty(0)
             score[j] = float(np.median(vals)) if vals.size >= 6 else 0.0
         return DELTA_GRID, score
 
