@@ -168,7 +168,15 @@ def build_parser(cli) -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="rwadist", description="Reaction wheel disturbance models from test data.")
     p.add_argument("--version", action="version", version=f"rwadist {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
+    # the commands in the order ``rwadist --help`` lists them
+    for add_command in (_add_simulate_test, _add_fit, _add_model_tools, _add_catalogue, _add_demo, _add_convert,
+                        _add_campbell, _add_psd, _add_diagnose, _add_fmu):
+        add_command(sub, cli)
+    return p
 
+
+def _add_simulate_test(sub, cli) -> None:
+    """``rwadist simulate-test``: the virtual test stand."""
     s = sub.add_parser("simulate-test", help="virtual test stand: synthetic load-cell data in the interchange format")
     s.add_argument("out_dir")
     s.add_argument("--preset", required=True, help="wheel preset, e.g. ithaco-e, ithaco-b")
@@ -197,6 +205,9 @@ def build_parser(cli) -> argparse.ArgumentParser:
                         + " (parameters: see rwadist/effects/KIND.py)")
     s.set_defaults(func=cli.cmd_simulate)
 
+
+def _add_fit(sub, cli) -> None:
+    """``rwadist fit``: the empirical (or extended) fit of test data."""
     f = sub.add_parser("fit", help="fit the empirical model to test data; writes the model file and a report")
     f.add_argument("data", help="steady-state directory, sweep CSV, or .h5")
     f.add_argument("-o", "--output", required=True, help="model file to write (JSON)")
@@ -208,6 +219,9 @@ def build_parser(cli) -> argparse.ArgumentParser:
     _add_fit_options(f)
     f.set_defaults(func=cli.cmd_fit)
 
+
+def _add_model_tools(sub, cli) -> None:
+    """``rwadist model show`` and ``rwadist model compare``."""
     m = sub.add_parser("model", help="model file tools")
     msub = m.add_subparsers(dest="model_command", required=True)
     ms = msub.add_parser("show", help="print a model's harmonics")
@@ -220,6 +234,9 @@ def build_parser(cli) -> argparse.ArgumentParser:
     mc.add_argument("--preset", required=True, help="catalogue wheel, e.g. ithaco-e")
     mc.set_defaults(func=cli.cmd_model_compare)
 
+
+def _add_catalogue(sub, cli) -> None:
+    """``rwadist catalogue list`` and ``rwadist catalogue show``."""
     cat = sub.add_parser("catalogue", help="catalogue of real wheels (presets for every command)")
     csub = cat.add_subparsers(dest="catalogue_command", required=True)
     cl = csub.add_parser("list", help="the catalogue wheels with their sources")
@@ -228,12 +245,18 @@ def build_parser(cli) -> argparse.ArgumentParser:
     cs.add_argument("name")
     cs.set_defaults(func=cli.cmd_catalogue_show)
 
+
+def _add_demo(sub, cli) -> None:
+    """``rwadist demo``: simulate, fit and report on the example wheel."""
     d = sub.add_parser("demo", help="simulate -> fit -> report on the bundled example wheel")
     d.add_argument("--out", default="demo_out", help="output directory (default demo_out)")
     d.add_argument("--n-speeds", type=number(2, 10_000, integer=True), default=120)
     d.add_argument("--seed", type=number(0, 2**32 - 1, integer=True), default=0)
     d.set_defaults(func=cli.cmd_demo)
 
+
+def _add_convert(sub, cli) -> None:
+    """``rwadist convert``: test data between formats."""
     cv = sub.add_parser("convert", help="convert test data between formats: CSV interchange, HDF5, UFF 58, TDMS, "
                         "MATLAB (docs/formats.md)")
     cv.add_argument("src", help="a steady-test directory (runs.csv), a sweep file or an .h5 file")
@@ -244,6 +267,9 @@ def build_parser(cli) -> argparse.ArgumentParser:
                     help="HDF5 sample precision (default float64, lossless)")
     cv.set_defaults(func=cli.cmd_convert)
 
+
+def _add_campbell(sub, cli) -> None:
+    """``rwadist campbell``: the extended model's Campbell table and plot."""
     c = sub.add_parser("campbell", help="Campbell table and plot of the extended model; prints crossing speeds")
     src = c.add_mutually_exclusive_group(required=True)
     src.add_argument("model", nargs="?", help="model file (JSON) with an analytical section")
@@ -254,6 +280,9 @@ def build_parser(cli) -> argparse.ArgumentParser:
     c.add_argument("-o", "--output", default="campbell.csv", help="CSV to write; the plot goes next to it (.png)")
     c.set_defaults(func=cli.cmd_campbell)
 
+
+def _add_psd(sub, cli) -> None:
+    """``rwadist psd``: the broadband PSD over a wheel-speed distribution."""
     q = sub.add_parser("psd", help="broadband disturbance PSD over a wheel-speed distribution (Melody's model / "
                        "extended model), optionally several wheels in the spacecraft frame")
     q.add_argument("model", nargs="?", help="model file (JSON)")
@@ -283,6 +312,9 @@ def build_parser(cli) -> argparse.ArgumentParser:
                    help="output file (CSV or NASTRAN bulk data; default psd.csv, or psd.bdf with --format nastran)")
     q.set_defaults(func=cli.cmd_psd)
 
+
+def _add_diagnose(sub, cli) -> None:
+    """``rwadist diagnose``: the effects a model lacks against test data."""
     dg = sub.add_parser("diagnose", help="residual of a model against test data; finds, adds and reports the "
                         "effects the model lacks (missing harmonics, amplitude laws, broadband floors, resonances, "
                         "coupling, sidebands, speed ripple, counter rotation)")
@@ -312,6 +344,9 @@ def build_parser(cli) -> argparse.ArgumentParser:
                          "file's wheel.bearings)")
     dg.set_defaults(func=cli.cmd_diagnose)
 
+
+def _add_fmu(sub, cli) -> None:
+    """``rwadist fmu build`` and ``rwadist fmu check``."""
     fm = sub.add_parser("fmu", help="FMI 2.0/3.0 co-simulation FMU of the extended model, SSP of an assembly "
                         "(build, check)")
     fsub = fm.add_subparsers(dest="fmu_command", required=True)
@@ -337,4 +372,3 @@ def build_parser(cli) -> argparse.ArgumentParser:
     fc.add_argument("--step-size", type=number(0, 1e3, lo_open=True, unit="s"), default=1e-3, help="communication step, s (default 1e-3)")
     fc.add_argument("--speed-rpm", type=rpm(), default=1500.0, help="end speed of the ramp from 0 (default 1500)")
     fc.set_defaults(func=cli.cmd_fmu_check)
-    return p

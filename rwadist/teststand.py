@@ -418,9 +418,7 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
     t = np.arange(n) * dt
     omega = speed_profile(t, rpm_start, rpm_end, duration, profile)
     psi = _cumtrapz(omega, dt)                          # signed rotation angle, rad
-    w_abs = np.abs(omega)
-    negative = omega < 0
-    omega_max = float(w_abs.max())
+    omega_max = float(np.abs(omega).max())
     noise_std = _noise_std(wheel, omega_max, noise)
     ch_modes = _channel_modes(wheel, modes, test_stand)
     active = wheel.all_modes(modes, test_stand)
@@ -440,8 +438,20 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
         meta["active_modes"] = [m.to_json() for m in _fixture_modes(wheel, test_stand)]
         return Sweep(time=t, signals=signals, sample_rate=float(sample_rate), tach=omega if tach else None,
                      meta=meta)
-    signals = {ch: np.zeros(n) for ch in CHANNELS}
-    dropped = []
+    lines, dropped = _sweep_lines(wheel, phase_rng, omega_max, nyquist)
+    signals = _sweep_simple_signals(omega, psi, lines, active, ch_modes, nyquist)
+    _add_noise(signals, noise_std, noise_rng)
+    extra["modal_gain"] = "quasi-steady (gain at the instantaneous line frequency and speed)"
+    extra["physics"] = "simple"
+    meta = _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, dropped, extra)
+    return Sweep(time=t, signals=signals, sample_rate=float(sample_rate), tach=omega if tach else None, meta=meta)
+
+
+def _sweep_lines(wheel: WheelDescription, phase_rng, omega_max: float, nyquist: float) -> tuple[list, list]:
+    """The harmonics of a simple-physics sweep, direction by direction: (channels, h, C, phase α rad) each, the
+    phases drawn from ``phase_rng`` in that order, and the entries of those whose frequency rises above
+    ``nyquist`` (Hz) at the sweep's largest speed ``omega_max`` (rad/s) (meta ``dropped_lines``)."""
+    dropped: list[dict] = []
     lines = []                                          # (channels, h, C, alpha) per harmonic
     for d, chans in DIRECTION_CHANNELS.items():
         h_arr, C_arr = wheel.h_and_C(d)
@@ -454,6 +464,19 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
                 dropped.append({"direction": d, "h": float(h),
                                 "above_rpm": float(rad_s_to_rpm(2.0 * np.pi * nyquist / h))})
             lines.append((chans, float(h), float(C), float(a)))
+    return lines, dropped
+
+
+def _sweep_simple_signals(omega: np.ndarray, psi: np.ndarray, lines: list, active: list, ch_modes: dict,
+                          nyquist: float) -> dict:
+    """The six channels of a simple-physics sweep (noise-free): every line of :func:`_sweep_lines` at speed
+    ``omega`` (rad/s) and rotation angle ``psi`` (rad) per sample, C·Ω² with phase h·ψ + α, left out above
+    ``nyquist`` (Hz), through the channels' modes (``ch_modes``, of ``active``) at each sample's frequency
+    (quasi-steady)."""
+    n = omega.size
+    w_abs = np.abs(omega)
+    negative = omega < 0
+    signals = {ch: np.zeros(n) for ch in CHANNELS}
     # Blocks of samples bound the temporaries (a 390 s record at 3840 Hz is 1.5 M samples);
     # within a block, one harmonic at a time.
     for start in range(0, n, _SWEEP_BLOCK):
@@ -483,9 +506,5 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
                         gains[key] = g
                     z = z0 * gains[key]
                 signals[ch][sl] += z.imag if i == 1 else z.real
-    _add_noise(signals, noise_std, noise_rng)
-    extra["modal_gain"] = "quasi-steady (gain at the instantaneous line frequency and speed)"
-    extra["physics"] = "simple"
-    meta = _meta(wheel, sample_rate, seed, noise, modes, test_stand, noise_std, dropped, extra)
-    return Sweep(time=t, signals=signals, sample_rate=float(sample_rate), tach=omega if tach else None, meta=meta)
+    return signals
 
