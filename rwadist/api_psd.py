@@ -146,8 +146,8 @@ def psd(model=None, speed_rpm=(0.0, 3000.0), *, preset: str | None = None, wheel
                                            progress)
         meta["on_assumed_modes"] += res.meta.pop("on_assumed_modes")
         meta["hard_mounted_wheels"] = res.meta.pop("hard_mounted_wheels")
-    refuse_non_finite_psd(res, source.name if wheels is None else str(wheels) if isinstance(wheels, (str, Path))
-                          else "wheels")
+    refuse_non_finite_psd(res, source.name if source is not None and wheels is None
+                          else str(wheels) if isinstance(wheels, (str, Path)) else "wheels")
     hard = empirical or (source is not None and source.hard_mounted)
     res.meta.update(meta, model="empirical" if hard else "extended", speed_rpm=(lo_rpm, hi_rpm),
                     fmax_hz=float(res.f[-1]))
