@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rwadist import extended as ext
+from rwadist import extended_ripple as ripple_mod
 from rwadist import schema
 from rwadist.effects.actions import NoiseFloor, of_effects
 from rwadist.schema import ModelError
@@ -150,7 +151,7 @@ class WheelSpec:
     speed_scale: float = 1.0
     name: str = "wheel"
     floors: tuple = ()
-    ripple: ext.Ripple | None = None
+    ripple: ripple_mod.Ripple | None = None
     hard_mounted: bool = False
 
     def __post_init__(self):
@@ -160,7 +161,7 @@ class WheelSpec:
             raise CouplingError(f"{self.name}: no forcing lines")
         if any(not isinstance(f, Floor) for f in self.floors):
             raise CouplingError(f"{self.name}: floors must be coupling.performance.Floor objects")
-        if self.ripple is not None and not isinstance(self.ripple, ext.Ripple):
+        if self.ripple is not None and not isinstance(self.ripple, ripple_mod.Ripple):
             raise CouplingError(f"{self.name}: ripple must be a rwadist.extended.Ripple or None")
 
 
@@ -229,7 +230,7 @@ def wheel_spec_from_model(model, mount=None, *, assumed_modes: bool = False, mas
                           "assumed_modes=True runs the assumed modes", RuntimeWarning, stacklevel=2)
     try:
         lines = tuple(ext.lines_from_model(model, p))
-        ripple = ext.ripple_from_effects(effects)
+        ripple = ripple_mod.ripple_from_effects(effects)
     except ValueError as exc:
         raise CouplingError(str(exc)) from exc
     kw.setdefault("floors", floors_from_effects(effects))
@@ -283,7 +284,7 @@ def _grouped_lines(spec: WheelSpec, omega, k_max: int = 0):
         f_all, amp = ext.steady_lines(spec.params, spec.lines, omega, rigid=spec.hard_mounted)
         f_all, amp = f_all[:, :, None], amp[:, :, None, :]
     else:
-        m, f_all, amp = ext.ripple_lines(spec.params, spec.lines, omega, spec.ripple, k_max, rigid=spec.hard_mounted)
+        m, f_all, amp = ripple_mod.ripple_lines(spec.params, spec.lines, omega, spec.ripple, k_max, rigid=spec.hard_mounted)
     L, M = len(spec.lines), m.size
     keys = np.array([(ln.h, ln.f_offset, mm) for ln in spec.lines for mm in m], dtype=float)
     ku, first, inv = np.unique(keys, axis=0, return_index=True, return_inverse=True)
@@ -422,7 +423,7 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
     in :attr:`LineResponses.floor`."""
     wheels = list(wheels)
     om, Mts, _ = _setup(plant, wheels, practices, omega)
-    kmax = [0 if w.ripple is None else ext.ripple_order(w.lines, om * w.speed_scale, w.ripple) for w in wheels]
+    kmax = [0 if w.ripple is None else ripple_mod.ripple_order(w.lines, om * w.speed_scale, w.ripple) for w in wheels]
     # at most ~LINE_POINTS (speed, line) points at once: a speed ripple's sidebands multiply the lines, and work
     # arrays of n_if x n_if per point beyond the caches cost more than the arithmetic
     groups_max = max(len({(ln.h, ln.f_offset) for ln in w.lines}) * (2 * k + 1) for w, k in zip(wheels, kmax))

@@ -87,6 +87,7 @@ from . import extended as ext
 from .data import Run, SteadyTest, Sweep
 from .dft import unit_phasors
 from .errors import ParameterError
+from .extended_time import simulate_time
 from .units import CHANNELS, DIRECTION_CHANNELS, rad_s_to_rpm, rpm_to_rad_s
 from .wheel_description import Mode, WheelDescription  # noqa: F401  (the stand's inputs, defined apart: light)
 
@@ -334,13 +335,13 @@ def _sweep_extended(wheel, t, omega, sample_rate, test_stand, phase_rng) -> tupl
     above = [ln for ln in lines if ln.h * w_max / (2.0 * np.pi) >= nyquist]
     out = np.zeros((t.size, len(CHANNELS)))
     if below:
-        out += ext.simulate_time(p, below, t, omega, start="steady")
+        out += simulate_time(p, below, t, omega, start="steady")
     dropped = []
     for ln in above:
         # superposition: a line reaching Nyquist runs alone and is not recorded while at or above it
         dropped.append({"direction": ln.direction, "h": ln.h,
                         "above_rpm": float(rad_s_to_rpm(2.0 * np.pi * nyquist / ln.h))})
-        x = ext.simulate_time(p, [ln], t, omega, start="steady")
+        x = simulate_time(p, [ln], t, omega, start="steady")
         x[ln.h * w_abs / (2.0 * np.pi) >= nyquist] = 0.0
         out += x
     fixture = _fixture_modes(wheel, test_stand)

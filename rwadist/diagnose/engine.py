@@ -754,7 +754,7 @@ def ripple_sideband_powers(beta, eps, p=2.0, k_max: int | None = None):
     beta, eps : broadcastable arrays (shape S); p : amplitude exponent (scalar or broadcastable).
     Returns (k (2K+1,), P (S + (2K+1,))), P = |c_k|².
     """
-    from ..extended import ripple_coefficients
+    from ..extended_ripple import ripple_coefficients
 
     k, c = ripple_coefficients(beta, eps, p, k_max)
     return k, np.abs(c) ** 2
