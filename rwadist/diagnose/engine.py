@@ -310,7 +310,7 @@ class Context(Metric):
         out: dict[str, list[tuple]]         # channel -> (h, law, amplitude, modal gain) per line
         w = self.omega[runs]
         out = {c: [] for c in self.channels}
-        mixing = {c: [] for c in self.channels}
+        mixing: dict[str, list[np.ndarray]] = {c: [] for c in self.channels}
         if not lines:
             return out, mixing
         _, A = ext.steady_lines(state.ext, lines, w)                  # (S, L, 6)
