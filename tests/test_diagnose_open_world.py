@@ -186,3 +186,31 @@ def test_the_new_wheel_of_the_family_on_the_command_line(kind, signature, tmp_pa
     modes = summary["effects"][0]
     for key, truth in (("radial_translation_Hz", 310.0), ("rocking_Hz", 95.0), ("axial_Hz", 140.0)):
         assert modes[key] == pytest.approx(truth, rel=0.01)
+
+
+def test_run_change_flags_the_switched_runs_and_not_a_resonance_crossing():
+    """Lines' measured-over-predicted ratios (dB) of 21 runs: every third run 3.5 dB up on all its lines (a range
+    switched) is a run_change of exactly those runs; one line lifted 8 dB in one run (a resonance crossing it) and
+    a smooth trend with speed are not."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose.describe_structure import LineRatios, run_change
+
+    R, L = 21, 4
+    spin = np.linspace(5.0, 50.0, R)
+    run, line = np.tile(np.arange(R), L), np.repeat(np.arange(L), R)
+    q = 0.02 * spin[run] + 0.01 * np.sin(3.0 * run + line)             # a smooth trend and a little scatter
+    q[(line == 2) & (run == 10)] += 8.0                                   # one line through a resonance
+    ctx = SimpleNamespace(runs=np.arange(R), omega=2 * np.pi * spin, channels=("Fx", "Fy"), test=None,
+                          sp=SimpleNamespace(run_names=[f"run_{i}" for i in range(R)]))
+
+    def ratios(q):
+        return [LineRatios("radial_force", q, spin[run] * (line + 1), run, spin[run], line, line + 1.0,
+                           np.ones(run.size))]
+
+    shares = lambda runs: (0.5, 1.0)                                      # noqa: E731
+    assert run_change(ctx, ratios(q), shares) == []
+    stepped = run % 3 == 1
+    (u,) = run_change(ctx, ratios(q + 3.5 * stepped), shares)
+    assert sorted(u.parameters["runs"]) == sorted(f"run_{i}" for i in range(R) if i % 3 == 1)
+    assert u.level_dB == pytest.approx(3.5, abs=0.1)

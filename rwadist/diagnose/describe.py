@@ -240,19 +240,41 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
 
 
 def cells_of(u, res: Residual) -> dict:
-    """The waterfall cells (channel -> bool mask (runs, bands)) a record covers: its channels, the runs within its
-    speed range (a ``run_change``: its runs), the bands of its frequency range."""
-    rpm = res.ctx.omega[res.ctx.runs] * 60.0 / (2 * np.pi)
-    if u.signature == "run_change" and u.parameters.get("run_speeds_rpm"):
-        runs = np.isin(np.round(rpm, 6), np.round(np.asarray(u.parameters["run_speeds_rpm"]), 6))
+    """The waterfall cells (channel -> bool mask (runs, bands)) a record covers, in its channels and the runs within
+    its speed range: a ``speed_line`` the band of f = h·Ω/2π in each run (and its neighbours), a
+    ``moving_resonance`` the bands of its track ±3ζ, a ``channel_copy`` the target's bands where the copy is at
+    least a tenth of the target's power, the others the bands of their frequency range; a ``run_change`` none (it is
+    a change of whole runs: a class gaining in those runs is not fitted to it)."""
+    if u.signature == "run_change":
+        return {}
+    ctx = res.ctx
+    rpm = ctx.omega[ctx.runs] * 60.0 / (2 * np.pi)
+    runs = (rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6)
+    spin = rpm / 60.0
+    rows = np.flatnonzero(runs)
+    p = u.parameters
+    if u.signature == "channel_copy":
+        src, dst = p.get("source"), p.get("target")
+        if src not in res.D or dst not in res.e:
+            return {}
+        return {dst: float(p.get("gain", 0.0)) ** 2 * res.D[src] >= 0.1 * res.D[dst]}
+    if u.signature == "speed_line" and u.h is not None:
+        b = res.band_of(u.h * spin[rows])
+        lo, hi = np.maximum(b - 1, 0), np.minimum(b + 1, ctx.n_bands - 1)
+    elif u.signature == "moving_resonance" and "slope_Hz_per_Hz_of_spin" in p:
+        f_lo, f_hi = p["f_at_lowest_speed_Hz"], p["f_at_highest_speed_Hz"]
+        s_lo, s_hi = u.speed_rpm[0] / 60.0, u.speed_rpm[1] / 60.0
+        f = f_lo + (f_hi - f_lo) * (spin[rows] - s_lo) / max(s_hi - s_lo, 1e-12)
+        lo, hi = res.band_of(f * (1 - 3 * p["zeta"])), res.band_of(f * (1 + 3 * p["zeta"]))
     else:
-        runs = (rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6)
-    b0, b1 = int(res.band_of(u.f_Hz[0])), int(res.band_of(u.f_Hz[1]))
+        lo = np.full(rows.size, int(res.band_of(u.f_Hz[0])))
+        hi = np.full(rows.size, int(res.band_of(u.f_Hz[1])))
     out = {}
     for c in u.channels:
         if c in res.e:
             m = res.mask(c)
-            m[np.ix_(runs, np.arange(b0, b1 + 1))] = True
+            for r, a, z in zip(rows, lo, hi):
+                m[r, a:z + 1] = True
             out[c] = m
     return out
 
@@ -260,6 +282,18 @@ def cells_of(u, res: Residual) -> dict:
 #: An effect the search added is taken back when at least this share of what it gains (misplaced power, on the data
 #: as given) lies in the cells of what the residual holds that no class explains: it was fitted to that content.
 FORCED_SHARE = 0.5
+
+
+def _on_a_moving_track(effect, found) -> str | None:
+    """"moving_resonance" when ``effect`` is a fixed resonance (the ``fixed_resonance`` class) on a channel of a
+    described moving resonance, at a frequency its track passes: one frame of the moving resonance, fitted as fixed."""
+    f_r, chans = getattr(effect, "f_r", None), set(getattr(effect, "channels", ()) or ())
+    if f_r is None:
+        return None
+    for u in found:
+        if u.signature == "moving_resonance" and chans & set(u.channels) and u.f_Hz[0] <= f_r <= u.f_Hz[1]:
+            return u.signature
+    return None
 
 
 def forced_effects(diag, opened: Opened, search_before: State, search_after: State, found, res: Residual) -> list:
@@ -273,6 +307,10 @@ def forced_effects(diag, opened: Opened, search_before: State, search_after: Sta
     out = []
     for e in search_after.effects:
         if id(e) in base:
+            continue
+        on_track = _on_a_moving_track(e, found)
+        if on_track:
+            out.append((e, on_track))
             continue
         without = search_before
         for other in search_after.effects:

@@ -101,28 +101,47 @@ def _smooth_trend(x: np.ndarray, y: np.ndarray, half: int = 3) -> np.ndarray:
     return back
 
 
+def _run_deviations(ctx, ratios: list) -> np.ndarray:
+    """Per run of the context (R,): the median over its lines of each line's dB ratio less that line's own smooth
+    trend with speed (:func:`_smooth_trend` over the line's runs), NaN for a run with fewer than
+    :data:`RUN_MIN_LINES` such lines.  Each line detrended on its own: a resonance crossing lifts one line in a run
+    (a bump on that line's trend), a change of the run lifts all of them alike."""
+    devs, runs = [], []
+    for r in ratios:
+        for ln in np.unique(r.line):
+            m = r.line == ln
+            if m.sum() < 2 * RUN_MIN_RUNS + 1:
+                continue
+            devs.append(r.q[m] - _smooth_trend(r.spin[m], r.q[m]))
+            runs.append(r.run[m])
+    R = ctx.runs.size
+    per = np.full(R, np.nan)
+    if not devs:
+        return per
+    dev, run = np.concatenate(devs), np.concatenate(runs)
+    n_lines = np.bincount(run, minlength=R)
+    for i in np.flatnonzero(n_lines >= RUN_MIN_LINES):
+        per[i] = np.median(dev[run == i])
+    return per
+
+
 def run_change(ctx, ratios: list, shares) -> list:
-    """A run-to-run change: every line of a run (all directions together) off the model by a common factor that
-    scatters from run to run about a smooth trend with speed (a load cell's gain drifting over the test, a wheel
-    re-mounted between runs, an amplifier's range switched).  Per run the weighted median of its lines' ratios;
-    the trend a running median over the neighbouring speeds; described when the robust scatter about it exceeds
-    :data:`RUN_SCATTER_DB` and :data:`RUN_MIN_RUNS` runs (a fifth of them at least) stand beyond it."""
+    """A run-to-run change: every line of a run (all directions together) off the model by a common factor (a load
+    cell's gain drifting over the test, a wheel re-mounted between runs, an amplifier's range switched).  Each
+    line's dB ratio less its own smooth trend with speed, the median over the run's lines (:func:`_run_deviations`);
+    described when :data:`RUN_MIN_RUNS` runs (a fifth of them at least) stand beyond :data:`RUN_SCATTER_DB` and
+    beyond 3 × the runs' robust scatter (a few runs switched: the others stay on the trend), or the robust scatter
+    itself exceeds :data:`RUN_SCATTER_DB` (a drift in the order of recording, the speeds shuffled)."""
     if not ratios:
         return []
-    q = np.concatenate([r.q for r in ratios])
-    run = np.concatenate([r.run for r in ratios])
-    R = ctx.runs.size
-    per, n_lines = np.full(R, np.nan), np.bincount(run, minlength=R)
-    for i in np.flatnonzero(n_lines >= RUN_MIN_LINES):
-        per[i] = np.median(q[run == i])
+    per = _run_deviations(ctx, ratios)
     ok = np.isfinite(per)
     if ok.sum() < 2 * RUN_MIN_RUNS + 1:
         return []
-    speed = ctx.omega[ctx.runs][ok]
-    dev = per[ok] - _smooth_trend(speed, per[ok])
-    scatter = 1.4826 * np.median(np.abs(dev - np.median(dev)))
-    off = np.abs(dev) > RUN_SCATTER_DB
-    if scatter < RUN_SCATTER_DB or off.sum() < max(RUN_MIN_RUNS, RUN_MIN_FRACTION * dev.size):
+    dev = per[ok] - np.median(per[ok])
+    scatter = 1.4826 * np.median(np.abs(dev))
+    off = np.abs(dev) > max(RUN_SCATTER_DB, (1.0 if scatter >= RUN_SCATTER_DB else 3.0) * scatter)
+    if off.sum() < max(RUN_MIN_RUNS, RUN_MIN_FRACTION * dev.size):
         return []
     idx = np.flatnonzero(ok)[off]
     rpm = ctx.omega[ctx.runs[idx]] * RAD_S_TO_RPM
@@ -132,7 +151,7 @@ def run_change(ctx, ratios: list, shares) -> list:
     return [Unexplained(
         signature="run_change", channels=tuple(ctx.channels), speed_rpm=(float(rpm.min()), float(rpm.max())),
         f_Hz=(float(np.min(np.concatenate([r.f for r in ratios]))), float(np.max(np.concatenate([r.f for r in ratios])))),
-        level_dB=float(scatter), share=share, n_runs=int(idx.size),
+        level_dB=float(np.median(np.abs(dev[off]))), share=share, n_runs=int(idx.size),
         parameters={"scatter_dB": float(scatter), "largest_dB": float(np.max(np.abs(dev))),
                     "runs": names, "run_speeds_rpm": [float(x) for x in rpm],
                     "run_offsets_dB": [float(x) for x in dev[off]], **timed},
@@ -299,8 +318,8 @@ def _half_power_width(ctx, log_floor: np.ndarray, pk: int) -> float:
 # ----------------------------------------------------------------------------------------------- moving resonance
 #: A direction's lines must be lifted this much (dB) in two runs at least for a resonance to be looked for (a
 #: resonance of peak gain 2 lifts the lines that cross it by 6 dB), and the lifted points (this much) bound its track.
-MOVING_PEAK_DB = 6.0
-MOVING_GATE_DB = 3.0
+MOVING_PEAK_DB = 3.0
+MOVING_GATE_DB = 2.0
 #: The moving track must drop the misfit a fixed resonance leaves by this many times the misfit per degree of freedom
 #: (an F statistic of its one more parameter: 23 and 57 on the wheel family's moving resonances, at most 10 on its
 #: other cases), leave at most MOVING_RATIO of that misfit and MOVING_NULL_RATIO of the misfit without a resonance.

@@ -42,7 +42,7 @@ SIGNATURES = {
 #: How ``level_dB`` reads for the signatures whose level is not the data over the model in their cells.
 LEVEL_WORDS = {
     "broadband_hump": "{:+.1f} dB over the floor's smooth course",
-    "run_change": "±{:.2f} dB from run to run",
+    "run_change": "the changed runs ±{:.2f} dB off the others",
 }
 
 
@@ -80,7 +80,7 @@ class Unexplained:
     f_Hz : (lowest, highest) frequency where it is, Hz (a fixed line: its frequency twice).
     level_dB : how far it stands out, dB: the median over its cells of 10·log10(data / model); for a
         ``broadband_hump`` (which the model takes as noise) its peak over the floor's smooth course, for a
-        ``run_change`` the runs' robust scatter about a smooth trend with speed (:data:`LEVEL_WORDS`).
+        ``run_change`` the median offset of the changed runs from the lines' smooth trends with speed (:data:`LEVEL_WORDS`).
     share : its share of what is left, 0..1: the misplaced power of its cells (the error metric's numerator
         over them) over the misplaced power of every cell after the search.
     n_runs : runs in which it stands above the noise.
