@@ -285,6 +285,17 @@ def main(argv=None) -> int:
         n = sum(r["ok"] for r in unknown)
         print(f"  all effects       {n}/{len(unknown)} = {100.0 * n / len(unknown):.0f} % (acceptance >= 90 %), "
               f"classes added in {sum(bool(r['added']) for r in unknown)} cells (acceptance 0)")
+        n = sum(bool(r.get("right")) for r in unknown)
+        print(f"  right signature where injected, whatever else: {n}/{len(unknown)} = {100.0 * n / len(unknown):.0f} %")
+        # a wheel whose clean cell already gets a class (the default path's own miss, not the effect's) apart
+        sound = {r["wheel"] for r in rows if r["kind"] == "clean" and not r["added"]}
+        on = [r for r in unknown if r["wheel"] in sound]
+        if on and len(on) < len(unknown):
+            n = sum(r["ok"] for r in on)
+            print(f"  on the wheels whose clean cell gets no class ({', '.join(str(w) for w in sorted(sound))}): "
+                  f"{n}/{len(on)} = {100.0 * n / len(on):.0f} %; per effect: " + ", ".join(
+                      f"{k} {sum(r['ok'] for r in on if r['kind'] == k)}/{sum(r['kind'] == k for r in on)}"
+                      for k in dict.fromkeys(r["kind"] for r in on)))
     vs = [r["vs_clean"] for r in rows if "vs_clean" in r]
     if vs:
         a = np.array(vs)
