@@ -314,6 +314,22 @@ def _remove(p: Path) -> None:
         pass
 
 
+def _remove_temporary(tmp: Path) -> None:
+    """Remove the temporary ``tmp`` and the companions its writer made beside it under its unique name: a writer's
+    own temporary (``.w.part-PID-x.fmu.tmp``, the FMU zip written before its rename) or sidecar
+    (``.s.part-PID-x.meta.json``) -- after a Ctrl-C, none is left."""
+    _remove(tmp)
+    name, suffix = tmp.name, tmp.suffix
+    base = name[:-len(suffix)] if suffix and ".part-" in name[:-len(suffix)] else name
+    try:
+        entries = list(tmp.parent.iterdir())
+    except OSError:
+        return
+    for q in entries:
+        if q.name != name and q.name.startswith(base + "."):
+            _remove(q)
+
+
 def _fsync_file(path: Path) -> None:
     fd = os.open(path, os.O_RDONLY)
     try:
@@ -440,7 +456,7 @@ class OutputSet:
 
     def discard(self) -> None:
         for _, tmp, _ in self.members:
-            _remove(tmp)
+            _remove_temporary(tmp)
             _LIVE.pop(tmp, None)
 
     def commit(self) -> None:
@@ -683,7 +699,7 @@ def exit_on_interrupt(command):
 
     def handler(signum, frame):
         for p in list(_LIVE):
-            _remove(p)
+            _remove_temporary(p)
         line = interrupt_message(command() if callable(command) else command, signum)
         try:
             sys.stdout.flush()

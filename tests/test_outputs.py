@@ -161,3 +161,19 @@ def test_ctrl_c_is_one_line_exit_130(tmp_path):
     assert proc.returncode == 130, err
     assert "Traceback" not in err and "interrupted" in err.strip().splitlines()[-1]
     assert out.read_text() == "old" and sorted(os.listdir(tmp_path)) == ["psd.csv", "wheels.json"]
+
+
+def test_a_failed_set_removes_the_companions_its_writers_made_beside_a_temporary(tmp_path):
+    """The native FMU's zip is written to ``<temporary>.tmp`` and renamed: after a Ctrl-C at that moment the
+    ``.w.part-PID-x.fmu.tmp`` stayed (5 of 20 Ctrl-C of `fmu build` in the kill matrix).  Whatever a writer makes under
+    the temporary's unique name goes with it; another file beside it stays."""
+    from rwadist.outputs import output_set
+
+    keep = tmp_path / ".w.partial-notes.txt"
+    keep.write_text("mine")
+    with pytest.raises(KeyboardInterrupt), output_set() as outs:
+        tmp = outs.file(tmp_path / "w.fmu")
+        tmp.with_name(tmp.name + ".tmp").write_text("zip being written")
+        tmp.with_suffix(".meta.json").write_text("{}")
+        raise KeyboardInterrupt
+    assert sorted(os.listdir(tmp_path)) == [keep.name]
