@@ -164,7 +164,10 @@ def _prepare(tmp: Path) -> None:
     run("simulate-test", "ds_small", "--preset", "ithaco-e", "--speeds-rpm", "600:2400:600", "--samples", "2048")
     run("simulate-test", "swd", "--preset", "ithaco-e", "--sweep", "--duration", "20", "--sweep-end-rpm", "1200")
     shutil.copy(tmp / "swd" / "sweep.csv", tmp / "sw.csv")
-    run("simulate-test", "swd2", "--preset", "ithaco-e", "--sweep", "--duration", "5", "--sweep-end-rpm", "900")
+    # another sample rate: the old set's sidecar (sample_rate_hz) unlike the new one's, or a complete new set with an
+    # identical sidecar would count as MIXED (3-7 of 20 kills did)
+    run("simulate-test", "swd2", "--preset", "ithaco-e", "--sweep", "--duration", "5", "--sweep-end-rpm", "900",
+        "--sample-rate", "3000")
     shutil.copy(tmp / "swd2" / "sweep.csv", tmp / "sw_small.csv")
 
 
