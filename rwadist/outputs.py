@@ -442,8 +442,8 @@ class OutputSet:
         final.parent.mkdir(parents=True, exist_ok=True)
         remove_stale_temporaries(final)
         tmp = final.parent / f".{final.name}.part-{_token()}"
+        _LIVE[tmp] = None           # before it exists: a Ctrl-C between the two left the folder behind
         tmp.mkdir()
-        _LIVE[tmp] = None
         self.members.append((final, tmp, "dir"))
         return tmp
 
