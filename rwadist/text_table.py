@@ -113,6 +113,10 @@ _EXPONENTS = np.frombuffer("".join(f"{'-' if k < 0 else '+'}{abs(k):03d}" for k 
                            .encode(), np.uint8).reshape(-1, 4)
 
 
+#: the two characters of each number 00..99, as one 16-bit item each (in memory order, whatever the byte order)
+_PAIRS = np.frombuffer("".join(f"{i:02d}" for i in range(100)).encode(), np.uint16)
+
+
 def format_rows(values: np.ndarray, digits: int) -> bytes:
     """The rows of ``values`` (n, c) as CSV text: each number as printf's ``%.{digits}e``, ',' between columns,
     '\\n' after each row."""
@@ -128,22 +132,16 @@ def format_rows(values: np.ndarray, digits: int) -> bytes:
     a = np.abs(flat)
     fast = np.isfinite(a) & (a < 10.0**digits)
     m, e = _digits_and_exponent(np.where(fast, a, 1.0), digits)
-    # the d + 1 significant digits, one contiguous row each, from 32-bit pieces of at most 5 digits
-    digit_rows = np.empty((digits + 1, flat.size), np.uint8)
-    part = np.empty(flat.size, np.int32)
-    rest = np.empty(flat.size, np.int32)
-    row = digits
-    while row >= 0:
-        part[:] = m % 100000
-        m //= 100000
-        for _ in range(min(5, row + 1)):
-            np.remainder(part, 10, out=rest)
-            digit_rows[row] = rest
-            np.floor_divide(part, 10, out=part)
-            row -= 1
-    digit_rows += ord("0")
-    slot[:, 1] = digit_rows[0]
-    slot[:, 3:digits + 3] = digit_rows[1:].T
+    # the d + 1 significant digits two at a time (the characters of 00..99 from a table), a '0' ahead when d + 1 is odd
+    n_pairs = (digits + 2) // 2
+    pad = 2 * n_pairs - (digits + 1)
+    pairs = np.empty((flat.size, n_pairs), np.uint16)
+    for k in range(n_pairs - 1, -1, -1):
+        m, r = np.divmod(m, 100)
+        np.take(_PAIRS, r, out=pairs[:, k], mode="wrap")         # r is 0..99; 'wrap' writes straight into out
+    chars = pairs.view(np.uint8)
+    slot[:, 1] = chars[:, pad]
+    slot[:, 3:digits + 3] = chars[:, pad + 1:]
     slot[:, digits + 4:digits + 8] = _EXPONENTS[e - _E_MIN]
     keep = np.ones(slot.shape, bool)
     keep[:, 0] = np.signbit(flat)
