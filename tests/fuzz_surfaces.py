@@ -130,7 +130,8 @@ def model_consumer_cases(n: int, seed: int, tmp: Path, data_dir: Path, consumers
         doc, invalid, what = _mutate(copy.deepcopy(base), rng)
         path = tmp / f"mc_{seed}_{i}.json"
         path.write_text(json.dumps(doc, allow_nan=True))
-        chosen = list(consumers) if consumers else \
+        # `show` always: a file it refuses and another consumer accepts is the silent case sought
+        chosen = ["show"] + [c for c in consumers if c != "show"] if consumers else \
             ["show", "psd", "campbell", "api", "coupling"] + [c for c, every in SLOW.items() if i % every == 0]
         cases.append((path, invalid, what, chosen, data_dir))
     return cases
