@@ -48,7 +48,9 @@ def _direct(plant, wheels, om, f, practice):
     return P @ np.linalg.solve(Lc, X)
 
 
-def test_woodbury_split_is_the_direct_solve():
+def _solver_case():
+    """The floor solver's test case: a 30-mode plant, the test wheels, four speeds (both senses and rest), 301
+    frequencies; the wheels' interface rows, the floor columns, their right-hand sides and the plant FRF."""
     plant = cp.random_modal_plant(n_modes=30, n_nodes=2, n_perf=2, seed=4)
     wheels = _wheels()
     om = np.array([-2500.0, 0.0, 300.0, 3000.0]) * RPM_TO_RAD_S
@@ -57,6 +59,11 @@ def test_woodbury_split_is_the_direct_solve():
     cols = [(k, c) for k, w in enumerate(wheels) for c in sorted({fl.channel for fl in w.floors})]
     R = np.stack([Mts[k].T[:, c] for k, c in cols], axis=1)
     G, P = plant.frf(f)
+    return plant, wheels, om, f, Mts, cols, R, G, P
+
+
+def test_woodbury_split_is_the_direct_solve():
+    plant, wheels, om, f, Mts, cols, R, G, P = _solver_case()
     from rwadist.coupling.gyro_split import FloorSolver
 
     solver = FloorSolver(G, P, Mts, [wheel_split(w, f) for w in wheels], R, cols)
@@ -87,14 +94,7 @@ def test_eigen_sum_over_speeds_is_the_direct_solve():
     per-speed fallback where the eigenvectors are ill-conditioned (forced here)."""
     from rwadist.coupling import gyro_split
 
-    plant = cp.random_modal_plant(n_modes=30, n_nodes=2, n_perf=2, seed=4)
-    wheels = _wheels()
-    om = np.array([-2500.0, 0.0, 300.0, 3000.0]) * RPM_TO_RAD_S
-    f = np.geomspace(2.0, 400.0, 301)
-    _, Mts, _ = perf._setup(plant, wheels, ("coupled",), om)
-    cols = [(k, c) for k, w in enumerate(wheels) for c in sorted({fl.channel for fl in w.floors})]
-    R = np.stack([Mts[k].T[:, c] for k, c in cols], axis=1)
-    G, P = plant.frf(f)
+    plant, wheels, om, f, Mts, cols, R, G, P = _solver_case()
     scales = [w.speed_scale for w in wheels]
     for cond in (gyro_split.EIG_COND, 0.0):
         gyro_split.EIG_COND, keep = cond, gyro_split.EIG_COND
