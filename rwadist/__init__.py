@@ -24,10 +24,12 @@ Under it, one module per step: ``data`` (interchange format) -> ``sweep`` (quasi
 ``model`` (the model file); ``extended`` (rotor model), ``diagnose``, ``broadband`` (PSD),
 ``teststand``/``presets`` (synthetic tests).  SI units inside; rpm only at the edges.
 """
-import importlib as _importlib
 import sys as _sys
 import types as _types
-from typing import TYPE_CHECKING as _TYPE_CHECKING
+
+# not ``from typing import TYPE_CHECKING``: importing typing takes ~7 ms, a window in which a Ctrl-C would still
+# be Python's traceback (mypy reads any name TYPE_CHECKING as True)
+TYPE_CHECKING = False
 
 #: The public names and the module each lives in, imported on first use (PEP 562): ``import rwadist`` loads no
 #: numpy or scipy, so the command's first instruction (:mod:`rwadist.__main__`) runs before them and a Ctrl-C
@@ -37,7 +39,7 @@ _LAZY = {**dict.fromkeys(("WheelModel", "build_fmu", "campbell", "diagnose", "fi
          **dict.fromkeys(("DataError", "MissingDependencyError", "ModelError", "ParameterError", "RwadistError",
                           "RwadistWarning"), "errors")}
 
-if _TYPE_CHECKING:
+if TYPE_CHECKING:
     from .api import (
         WheelModel,
         build_fmu,
@@ -54,13 +56,16 @@ if _TYPE_CHECKING:
         write_nastran,
     )
     from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistError, RwadistWarning
+del TYPE_CHECKING
 
 
 def __getattr__(name: str):
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'rwadist' has no attribute {name!r}")
-    value = getattr(_importlib.import_module(f".{module}", __name__), name)
+    import importlib  # here, not at the top: see TYPE_CHECKING
+
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
     globals()[name] = value         # once: later reads find it without this function
     return value
 

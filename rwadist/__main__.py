@@ -7,6 +7,9 @@ traceback.  ``import rwadist`` loads nothing heavy (its API is imported on first
 before any import, a handler that ends the process with one line and exit 130 (143 on SIGTERM); nothing is written
 yet.  :func:`rwadist.cli.main` then installs the one that knows the command and its outputs
 (:func:`rwadist.outputs.exit_on_interrupt`).  A signal ignored at start (a background job's SIGINT) stays ignored.
+Loading this module imports ``rwadist`` (nothing heavy) and ``signal`` only.  Before it runs, the interpreter
+starts and the console script pip writes imports ``re`` (a few ms): a Ctrl-C there is still Python's own
+traceback, which no program can take over; nothing has been written then.
 """
 import os
 import signal

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import errno
 import json
 import os
 import re
@@ -88,13 +89,20 @@ def _target(path: Path, flag: str) -> Path:
     return target
 
 
-def _stat(path: Path):
+def _stat(path: Path, flag: str | None = None):
+    """``os.stat(path)``, None when it does not exist; any other failure (ELOOP, EACCES on a parent, a name too
+    long, a parent that is a file) is a :class:`DataError` naming ``flag`` (the option that gave the path)."""
     try:
         return os.stat(path)
     except FileNotFoundError:
         return None
-    except OSError as exc:          # ELOOP, EACCES on a parent, a name too long
-        raise DataError(str(path), "path", exc.strerror or str(exc)) from None
+    except OSError as exc:
+        why = exc.strerror or str(exc)
+        if exc.errno == errno.ENOTDIR:
+            why += " (a folder on the way to it is a file)"
+        if flag is None:
+            raise DataError(str(path), "path", why) from None
+        raise DataError(flag, "value", f"{str(path)!r}: {why}: give a path in a folder you can write") from None
 
 
 def is_special(path) -> bool:
@@ -132,7 +140,7 @@ def check_output_file(path, flag: str = "-o") -> Path:
         raise DataError(flag, "value", "empty: give the path of the file to write")
     path = Path(path)
     target = _target(path, flag)
-    st = _stat(target)
+    st = _stat(target, flag)
     if st is not None and stat.S_ISDIR(st.st_mode):
         raise DataError(flag, "value", f"{str(path)!r} is a directory: give a file name inside it, "
                         f"e.g. {str(path / ('out' + (path.suffix or '')))!r}")

@@ -127,6 +127,20 @@ def test_a_symbolic_link_is_followed_and_a_loop_refused(dataset, tmp_path, capsy
     assert "loop" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("what", ["fit", "psd", "fmu"])
+def test_an_output_below_a_file_names_the_flag(dataset, tmp_path, capsys, what):
+    """`fmu build -o FILE/w.fmu` said "FILE/w.fmu: path: Not a directory", naming no option."""
+    (tmp_path / "FILE").write_text("a user's file\n")
+    out = str(tmp_path / "FILE" / {"fit": "m.json", "psd": "p.csv", "fmu": "w.fmu"}[what])
+    argv = {"fit": ["fit", str(dataset), "-o", out, "--no-report"], "psd": PSD + ["-o", out],
+            "fmu": ["fmu", "build", "--preset", "ithaco-e", "-o", out]}[what]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("rwadist: error: -o: ") and "FILE" in err[0], err
+    assert "a folder on the way to it is a file" in err[0]
+    assert (tmp_path / "FILE").read_text() == "a user's file\n"
+
+
 def test_a_block_device_is_refused(tmp_path):
     if os.geteuid() != 0:
         pytest.skip("mknod needs root")
@@ -188,6 +202,30 @@ def test_ctrl_c_during_the_swap_waits_for_it(tmp_path):
         signal.signal(signal.SIGINT, previous)
     assert (a.read_text(), b.read_text()) == ("new a", "new b")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.txt"]
+
+
+_CTRL_C_AFTER_MKDIR = """
+import os, pathlib, signal, sys
+from rwadist import outputs
+real = pathlib.Path.mkdir
+def mkdir_then_interrupt(self, *args, **kwargs):
+    real(self, *args, **kwargs)
+    if ".part-" in self.name:
+        os.kill(os.getpid(), signal.SIGINT)     # Ctrl-C the instant the temporary exists
+pathlib.Path.mkdir = mkdir_then_interrupt
+with outputs.exit_on_interrupt("diagnose"):
+    with outputs.output_set() as s:
+        s.folder(pathlib.Path(sys.argv[1]) / "report")
+"""
+
+
+def test_ctrl_c_the_instant_a_report_folders_temporary_exists_leaves_nothing(tmp_path):
+    """A Ctrl-C between the temporary folder's mkdir and its registration for the clean-up left .report.part-*
+    behind (1 of 20 Ctrl-C of diagnose in the kill matrix); here the interrupt lands exactly there."""
+    proc = subprocess.run([sys.executable, "-c", _CTRL_C_AFTER_MKDIR, str(tmp_path)], capture_output=True,
+                          text=True, timeout=120, preexec_fn=_as_in_a_terminal)
+    assert proc.returncode == 130 and "Traceback" not in proc.stderr, proc.stderr
+    assert list(tmp_path.iterdir()) == [], list(tmp_path.iterdir())
 
 
 def test_stale_temporaries_of_a_killed_write_are_removed(tmp_path):
@@ -255,6 +293,14 @@ def _interrupt(argv, delay: float, cwd) -> tuple:
     lines = [ln for ln in err.replace("\r", "\n").splitlines() if ln.strip() and "%|" not in ln
              and "elapsed" not in ln and not ln.startswith(("WARNING", "note"))]
     return proc.returncode, err, lines
+
+
+def test_the_entry_point_imports_nothing_before_its_handler():
+    """Until :mod:`rwadist.__main__` installs its handler a Ctrl-C is Python's traceback: loading the entry point
+    imports the package and ``signal``, nothing else (``typing`` alone was a 7 ms window)."""
+    code = "import sys; before = set(sys.modules); import rwadist.__main__; print(sorted(set(sys.modules) - before))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
+    assert out.stdout.strip() == "['rwadist', 'rwadist.__main__', 'signal']", out.stdout
 
 
 @pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="reads /proc")
