@@ -501,11 +501,17 @@ def line_envelope(wheels, speed_range, f: np.ndarray, n_speeds: int = 4000) -> E
         T = _transform_of(mounting)
         best = np.zeros((len(lines), 6))
         best_w = np.zeros((len(lines), 6))
+        first = None
         for w in branches:
             A = np.abs(lines.amplitudes(w) @ T.T)                      # (S, L, 6)
             fw = lines.freqs(w)                                        # (S, L), increasing in S
             A_lines = np.ascontiguousarray(A.transpose(1, 0, 2))       # (L, S, 6): rows gathered per line
-            for i in range(len(lines)):
+            # a line the other sign of speed puts at the same frequencies with the same amplitudes (bit for bit:
+            # Melody's lines, whose amplitudes at -Ω are the conjugates of those at Ω) adds nothing to the envelope
+            drawn = np.ones(len(lines), bool) if first is None else ~(
+                np.all(fw == first[0], axis=0) & np.all(A == first[1], axis=(0, 2)))
+            first = (fw, A) if first is None else first
+            for i in np.flatnonzero(drawn).tolist():
                 if not fw[-1, i] > fw[0, i]:
                     continue
                 a, b = np.searchsorted(f, fw[0, i], side="left"), np.searchsorted(f, fw[-1, i], side="right")

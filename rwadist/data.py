@@ -61,7 +61,6 @@ from .formats.records import (
     read_text,
 )
 from .formats.timebase import sample_step
-from .hdf5 import read_hdf5
 from .outputs import WRITER, WRITER_KEY
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm, rpm_to_rad_s  # noqa: F401 (re-exported)
 
@@ -207,6 +206,8 @@ def read_data(path, progress: bool = False):
     if path.is_dir():
         return read_steady(path, progress=progress)
     if path.suffix.lower() in (".h5", ".hdf5"):
+        from .hdf5 import read_hdf5  # h5py only when a file needs it: every command imports this module
+
         return read_hdf5(path)
     return read_sweep(path)
 

@@ -104,7 +104,7 @@ def plot_psd(res: BroadbandPSD, title: str = ""):
 
     from .plot_util import content_top, group_identical, is_empty, log_axis, log_floor
 
-    fig = Figure(figsize=(10, 8))
+    fig = Figure(figsize=(10, 8), layout="tight")   # laid out when drawn: save_png's draw caches serve the layout too
     FigureCanvasAgg(fig)
     ax1, ax2 = fig.add_subplot(2, 2, 1), fig.add_subplot(2, 2, 2)
     ax3, ax4 = fig.add_subplot(2, 2, 3), fig.add_subplot(2, 2, 4)
@@ -139,7 +139,6 @@ def plot_psd(res: BroadbandPSD, title: str = ""):
         ax.set_xlim(0.0, f_top)
         ax.grid(True, which="both", alpha=0.3)
     fig.suptitle(title or f"broadband disturbance PSD ({res.frame} frame)")
-    fig.tight_layout()
     return fig
 
 

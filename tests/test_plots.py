@@ -260,3 +260,38 @@ def test_log_axes_carry_minor_ticks_at_2_and_5_of_each_decade():
     minor = minor[(minor >= 1e-6) & (minor <= 1e2)]
     mantissa = np.round(minor / 10.0 ** np.floor(np.log10(minor)), 6)
     assert set(mantissa) == {2.0, 5.0} and minor.size == 16
+
+
+@pytest.mark.parametrize("lo, hi", [(1e-11, 1e-2), (2e-4, 3e-3), (0.3, 40.0)])
+def test_log_axis_labels_are_plain_text_naming_their_tick(lo, hi):
+    """:func:`rwadist.plot_util.log_axis` labels ticks as matplotlib's scientific notation does, in plain text
+    (``10⁻⁵``, ``2×10⁻³``: no math-text parser): read back, each label is its tick's value; a tick matplotlib leaves
+    unlabelled stays unlabelled."""
+    from matplotlib.figure import Figure
+
+    from rwadist.plot_util import log_axis
+
+    def value(label):
+        coeff, _, power = label.translate(str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹", "-0123456789")).rpartition("×")
+        number = 10.0 ** int(power[2:]) if label.rpartition("×")[2][2:] else float(power)
+        return float(coeff or 1.0) * number
+
+    ours, theirs = Figure().add_subplot(), Figure().add_subplot()
+    log_axis(ours)
+    theirs.set_yscale("log")
+    theirs.yaxis.set_minor_locator(ours.yaxis.get_minor_locator())
+    for ax in (ours, theirs):
+        ax.set_ylim(lo, hi)
+        ax.figure.canvas.draw()
+    labelled = set()
+    for which in ("major", "minor"):
+        got = [t.get_text() for t in ours.yaxis.get_ticklabels(which=which)]
+        ref = [t.get_text() for t in theirs.yaxis.get_ticklabels(which=which)]
+        locs = ours.yaxis.get_minorticklocs() if which == "minor" else ours.yaxis.get_majorticklocs()
+        assert [bool(t) for t in got] == [bool(t) for t in ref] and (any(got) or which == "minor")
+        labelled.update(t for t in got if t)
+        for text, loc in zip(got, locs):
+            assert "$" not in text
+            if text:
+                assert value(text) == pytest.approx(loc, rel=1e-9), (text, loc)
+    assert hi / lo > 100 or any("×" in t for t in labelled)      # a narrow range labels its minor ticks: 2×10⁻⁴

@@ -75,18 +75,10 @@ def test_psd_files_are_what_savetxt_wrote(tmp_path):
     assert e.read_bytes() == savetxt(np.column_stack([env.f, env.amplitude]), e.read_text().splitlines()[0], "%.8e")
 
 
-def test_envelope_is_np_interp_of_each_channel():
-    """The envelope's interpolation of all channels at once gives np.interp's numbers, bit for bit, on a sideband
-    folded below 0 Hz too (its frequencies do not increase with the speed)."""
-    m = WheelModel(name="t")
-    m.empirical["radial_force"] = [Harmonic(1.0, 3e-7), Harmonic(2.0, 1e-6)]
-    m.effects = [{"kind": "sidebands", "direction": "radial_force", "h": 2.0, "f_mod_Hz": 9.0, "depth": 0.4}]
-    lines = bb.empirical_lines(m)
-    T = mt.preset_mountings("pyramid-4")[2]
-    f = np.linspace(0.0, 150.0, 7001)
-    env = bb.line_envelope([(lines, T)], (-600 * W, 2400 * W), f, n_speeds=500)
-    ref = np.zeros_like(env.amplitude)
-    for w in (np.linspace(0.0, 2400 * W, 500), np.linspace(0.0, -600 * W, 500)):
+def _envelope_by_np_interp(lines, T, f, lo, hi, n_speeds):
+    """The envelope line by line, channel by channel, both signs of speed: np.interp of each on its own."""
+    ref = np.zeros((f.size, 6))
+    for w in (np.linspace(0.0, hi, n_speeds), np.linspace(0.0, lo, n_speeds)):
         A = np.abs(lines.amplitudes(w) @ T.transform.T)
         fw = lines.freqs(w)
         for i in range(len(lines)):
@@ -94,7 +86,34 @@ def test_envelope_is_np_interp_of_each_channel():
             for c in range(6):
                 if sel.any() and fw[-1, i] > fw[0, i]:
                     ref[sel, c] = np.maximum(ref[sel, c], np.interp(f[sel], fw[:, i], A[:, i, c]))
-    assert np.array_equal(env.amplitude, ref)
+    return ref
+
+
+@pytest.mark.parametrize("lo_rpm, hi_rpm", [(-600, 2400), (-1500, 1500)])
+def test_envelope_is_np_interp_of_each_channel(lo_rpm, hi_rpm):
+    """The envelope's interpolation of all channels at once gives np.interp's numbers, bit for bit, on a sideband
+    folded below 0 Hz too (its frequencies do not increase with the speed); over a range symmetric about 0 rpm, where
+    the lines the negative speeds repeat are drawn once, too."""
+    m = WheelModel(name="t")
+    m.empirical["radial_force"] = [Harmonic(1.0, 3e-7), Harmonic(2.0, 1e-6), Harmonic(2.7, 4e-7, sense="counter")]
+    m.effects = [{"kind": "sidebands", "direction": "radial_force", "h": 2.0, "f_mod_Hz": 9.0, "depth": 0.4}]
+    lines = bb.empirical_lines(m)
+    T = mt.preset_mountings("pyramid-4")[2]
+    f = np.linspace(0.0, 150.0, 7001)
+    env = bb.line_envelope([(lines, T)], (lo_rpm * W, hi_rpm * W), f, n_speeds=500)
+    assert np.array_equal(env.amplitude, _envelope_by_np_interp(lines, T, f, lo_rpm * W, hi_rpm * W, 500))
+
+
+def test_envelope_of_lines_unlike_at_negative_speeds():
+    """The extended model's lines differ between +Ω and −Ω (gyroscopic whirl modes split): over a symmetric range
+    the envelope still holds both signs' lines, np.interp's numbers bit for bit."""
+    lines = bb.preset_lines("ithaco-e")
+    T = mt.preset_mountings("pyramid-4")[1]
+    w = np.linspace(0.0, 1500 * W, 300)
+    assert not np.array_equal(np.abs(lines.amplitudes(w) @ T.transform.T), np.abs(lines.amplitudes(-w) @ T.transform.T))
+    f = np.linspace(0.0, 200.0, 4001)
+    env = bb.line_envelope([(lines, T)], (-1500 * W, 1500 * W), f, n_speeds=300)
+    assert np.array_equal(env.amplitude, _envelope_by_np_interp(lines, T, f, -1500 * W, 1500 * W, 300))
 
 
 def test_plotted_curves_keep_every_peak():
