@@ -332,7 +332,7 @@ def _feature_breaks(ua: float, ub: float, peaks, law) -> list:
 
 def _gauss_bins(edges, k, keep, steps: np.ndarray, weight, terms, dtype=complex) -> tuple:
     """Per-bin Gauss–Legendre sums of ``weight(u)``·term(u) over sub-intervals (``steps[i]`` equal parts each).
-    terms: list of callables u (m, 3) -> values.  Returns (k0, [values over bins k0.. per term])."""
+    terms: list of callables u (3, m) -> values.  Returns (k0, [values over bins k0.. per term])."""
     a, b, kk, st = edges[:-1][keep], edges[1:][keep], k[keep], steps[keep]
     if kk.size == 0:
         return 0, [np.zeros(0, dtype) for _ in terms]
@@ -355,10 +355,15 @@ def _gauss_bins(edges, k, keep, steps: np.ndarray, weight, terms, dtype=complex)
             half = width / 2
             centre = aa[idx] + width * (part + 0.5)
             kc = kc[idx]
-        u = centre[:, None] + half[:, None] * _GL_X[None, :]                           # (m, 3)
-        w = weight(u) * (half[:, None] * _GL_W[None, :])
+        # nodes along the first axis: numpy's loops then run along the m parts (an (m, 3) layout runs them 3 long)
+        u = _GL_X[:, None] * half
+        u += centre                                                                    # (3, m)
+        w = weight(u)
+        w *= _GL_W[:, None] * half
         for s, term in zip(sums, terms):
-            v = np.einsum("ij,ij->i", term(u), w)
+            tw = term(u) * w
+            v = tw[0] + tw[1]
+            v += tw[2]
             if direct:
                 s[kc[0] - k0:kc[-1] - k0 + 1] += v
             else:
