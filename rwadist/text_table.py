@@ -113,8 +113,23 @@ _EXPONENTS = np.frombuffer("".join(f"{'-' if k < 0 else '+'}{abs(k):03d}" for k 
                            .encode(), np.uint8).reshape(-1, 4)
 
 
-#: the two characters of each number 00..99, as one 16-bit item each (in memory order, whatever the byte order)
-_PAIRS = np.frombuffer("".join(f"{i:02d}" for i in range(100)).encode(), np.uint16)
+#: the four characters of each number 0000..9999, as one 32-bit item each (in memory order, whatever the byte order)
+_QUADS = np.frombuffer("".join(f"{i:04d}" for i in range(10000)).encode(), np.uint32)
+#: :data:`_EXPONENTS` as one 4-byte item each
+_EXPONENT_ITEMS = np.ascontiguousarray(_EXPONENTS).view("V4")[:, 0]
+
+
+def _slot_type(digits: int) -> np.dtype:
+    """One number's fixed-width slot as a record of byte fields: '-', the leading digit, '.', the other ``digits``
+    digits, 'e', the exponent's sign and three digits, the separator.  Whole fields are copied per number (a 2-D byte
+    array's column ranges are copied a few bytes at a time)."""
+    names, formats, offsets = ["sign", "lead", "point"], ["u1", "u1", "u1"], [0, 1, 2]
+    if digits:
+        names, formats, offsets = names + ["frac"], formats + [f"V{digits}"], offsets + [3]
+    names += ["e", "exponent", "sep"]
+    formats += ["u1", "V4", "u1"]
+    offsets += [digits + 3, digits + 4, digits + 8]
+    return np.dtype({"names": names, "formats": formats, "offsets": offsets, "itemsize": digits + 9})
 
 
 def format_rows(values: np.ndarray, digits: int) -> bytes:
@@ -126,23 +141,25 @@ def format_rows(values: np.ndarray, digits: int) -> bytes:
     n, c = x.shape
     flat = x.ravel()
     width = digits + 8                       # '-', d, '.', digits, 'e', '±', e2, e1, e0 ... and the separator
-    slot = np.empty((flat.size, width + 1), np.uint8)
-    slot[:] = np.frombuffer(("-0." + "0" * digits + "e+000,").encode(), np.uint8)
-    slot.reshape(n, c, width + 1)[:, -1, width] = ord("\n")
     a = np.abs(flat)
     fast = np.isfinite(a) & (a < 10.0**digits)
     m, e = _digits_and_exponent(np.where(fast, a, 1.0), digits)
-    # the d + 1 significant digits two at a time (the characters of 00..99 from a table), a '0' ahead when d + 1 is odd
-    n_pairs = (digits + 2) // 2
-    pad = 2 * n_pairs - (digits + 1)
-    pairs = np.empty((flat.size, n_pairs), np.uint16)
-    for k in range(n_pairs - 1, -1, -1):
-        m, r = np.divmod(m, 100)
-        np.take(_PAIRS, r, out=pairs[:, k], mode="wrap")         # r is 0..99; 'wrap' writes straight into out
-    chars = pairs.view(np.uint8)
-    slot[:, 1] = chars[:, pad]
-    slot[:, 3:digits + 3] = chars[:, pad + 1:]
-    slot[:, digits + 4:digits + 8] = _EXPONENTS[e - _E_MIN]
+    # the d + 1 significant digits four at a time (the characters of 0000..9999 from a table), '0's ahead to fill
+    n_quads = (digits + 4) // 4
+    pad = 4 * n_quads - (digits + 1)
+    quads = np.empty((flat.size, n_quads), np.uint32)
+    for k in range(n_quads - 1, -1, -1):
+        m, r = np.divmod(m, 10000)
+        np.take(_QUADS, r, out=quads[:, k], mode="wrap")        # r is 0..9999; 'wrap' writes straight into out
+    chars = quads.view(np.uint8)
+    rec = np.empty(flat.size, _slot_type(digits))
+    rec["sign"], rec["point"], rec["e"], rec["sep"] = ord("-"), ord("."), ord("e"), ord(",")
+    rec.reshape(n, c)["sep"][:, -1] = ord("\n")
+    rec["lead"] = chars[:, pad]
+    if digits:
+        rec["frac"] = chars[:, pad + 1:].view(f"V{digits}")[:, 0]
+    rec["exponent"] = _EXPONENT_ITEMS[e - _E_MIN]
+    slot = rec.view(np.uint8).reshape(flat.size, width + 1)
     keep = np.ones(slot.shape, bool)
     keep[:, 0] = np.signbit(flat)
     keep[:, 2] = digits > 0                  # printf's %.0e has no point
