@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+
 from rwadist.fmu import hosts
 from rwadist.fmu.build import build_preset
 
@@ -68,7 +69,6 @@ def main(argv=None) -> int:
         wheel = build_preset("ithaco-e", tmp / "wheel.fmu")
         trivial = build_trivial(tmp)
         from rwadist.fmu.build import build_fmu
-
         from rwadist.presets import preset
         model = preset("ithaco-e").to_model()
         model.effects = [{"kind": "broadband_floor", "channel": ["Fx", "Fy", "Fz"], "exponent": 3.0,

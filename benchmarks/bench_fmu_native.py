@@ -5,7 +5,7 @@
    first wave's comparison) and once for all 12 (the same fmpy marshalling as the wheel's), 60 s at 1 kHz each
    (set input, doStep, read outputs), interleaved repeats, best of each, wall and process-CPU time; ratio
    target <= 1.2.  The load average is printed with the figures (the machine may be shared).
-2. The native step alone: a small C program (fmu/native/c_host.c) dlopens the FMU's library and calls
+2. The native step alone: a small C program (rwadist/fmu/native/c_host.c) dlopens the FMU's library and calls
    fmi2DoStep in a loop (speed ramp 0 -> 3000 rpm, acceleration input): steps per second for the E wheel
    with modes (target >= 1 M) and for the same with broadband floors on three channels (Fx, Fy, Fz,
    2-500 Hz at 0.1 Hz: 14 970 sinusoids; target >= 50 k).
@@ -26,6 +26,8 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
+
+from rwadist import model as model_io
 from rwadist.fmu.native_build import (
     FMI2_HEADERS,
     NATIVE,
@@ -33,8 +35,6 @@ from rwadist.fmu.native_build import (
     compile_c_host,
     compile_sources,
 )
-
-from rwadist import model as model_io
 from rwadist.presets import preset
 
 TRIVIAL_C = r'''

@@ -5,7 +5,7 @@ initialisation, 10 steps, fmi2Terminate, fmi2FreeInstance.  The resident set siz
 read after WARMUP cycles and after WARMUP + CYCLES; the growth is printed against the 1 MB target.  FMUs: the
 pythonfmu FMU (``rwadist fmu build``'s default) of the E wheel with a speed ripple and broadband floors (numpy
 multisine tables per instance), the same without floors, and the native C FMU of the first model.  The native FMU
-is also run by the C stress host (fmu/native/c_stress.c: no Python in the process; instantiate, steps, bad input,
+is also run by the C stress host (rwadist/fmu/native/c_stress.c: no Python in the process; instantiate, steps, bad input,
 state get/set/serialize, reset, free), which prints its own RSS growth after its warm-up cycles.
 
     .venv/bin/python benchmarks/fmu_memory.py [--cycles 1000] [--warmup 50]
@@ -17,10 +17,10 @@ work-around.  What grew, measured (tracemalloc, gc, /proc/self/smaps, sys._debug
 
 * each freed slave instance sat in reference cycles (pythonfmu's variable getters/setters close over it; a ctypes
   CDLL per instance is a cycle and defines a class) until a full garbage collection, with its model's arrays --
-  fixed: weak references, the native library opened once per process (fmu/slave.py);
+  fixed: weak references, the native library opened once per process (rwadist/fmu/slave.py);
 * pythonfmu 0.7 compiles the slave module again at every fmi2Instantiate: 1.3 MB of transient allocations per
   instance for the whole slave, fragmenting pymalloc's arenas around the objects pythonfmu leaks -- fixed: that
-  module is a short shim (fmu/slave_template.py), 0.1 MB;
+  module is a short shim (rwadist/fmu/slave_template.py), 0.1 MB;
 * pythonfmu's own leaks per fmi2Instantiate: sys.path grew by one entry (now dropped); findClass's list of the
   slave class's __mro__ with a repr and a bytes object per entry and the name's bytes, ~0.9 kB -- now it is shown
   a stand-in, and leaks 219 bytes per instance (a two-entry list 56 + 16 B, one 72-B bytes object, the 75-B
@@ -105,6 +105,7 @@ def fmpy_growth(fmu: Path, cycles: int, warmup: int) -> tuple[float, float, floa
 def c_host_growth(fmu: Path, cycles: int, warmup: int, tmp: Path) -> tuple[float, str]:
     """(RSS growth in MB after ``warmup`` cycles, the host's check line) of the C stress host on the native FMU."""
     from fmpy import read_model_description
+
     from rwadist.fmu.native_build import NATIVE
     md = read_model_description(fmu)
     with zipfile.ZipFile(fmu) as z:
@@ -128,10 +129,9 @@ def main(argv=None) -> int:
     ap.add_argument("--cycles", type=int, default=1000)
     ap.add_argument("--warmup", type=int, default=50)
     args = ap.parse_args(argv)
+    from rwadist import model as model_io
     from rwadist.fmu.build import build_fmu
     from rwadist.fmu.native_build import build_native_fmu
-
-    from rwadist import model as model_io
     from rwadist.presets import preset
     plain = model_io.to_json(preset("ithaco-e").to_model())
     doc = json.loads(json.dumps(plain))

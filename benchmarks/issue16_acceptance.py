@@ -24,9 +24,6 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from rwadist.fmu import hosts  # noqa: E402
-from rwadist.fmu.build import build_fmu  # noqa: E402
-from rwadist.fmu.native_build import build_native_fmu  # noqa: E402
 from test_fmu_models import closed_form_lines, empirical_only  # noqa: E402
 from test_fmu_native import (  # noqa: E402
     EFFECTS,
@@ -42,6 +39,9 @@ from test_fmu_native import (  # noqa: E402
 from rwadist import catalogue  # noqa: E402
 from rwadist import extended as ext  # noqa: E402
 from rwadist import model as model_io  # noqa: E402
+from rwadist.fmu import hosts  # noqa: E402
+from rwadist.fmu.build import build_fmu  # noqa: E402
+from rwadist.fmu.native_build import build_native_fmu  # noqa: E402
 
 RPM = 2 * np.pi / 60
 
@@ -90,10 +90,10 @@ def main() -> int:
 
         import warnings
 
-        from rwadist.coupling.performance import wheel_spec_from_model
         from test_assumed_modes_default import _fundamental, _plant, _wheels_file
 
         from rwadist import coupling as cp
+        from rwadist.coupling.performance import wheel_spec_from_model
         from rwadist.mounting import load_wheels
         omega = np.array([3000.0, 6000.0]) * RPM
         U_s, U_d = an["U_s_kg_m"], an["U_d_kg_m2"]

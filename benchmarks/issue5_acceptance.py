@@ -18,11 +18,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import test_fmu as T  # noqa: E402  (the tests' reference, profiles and helpers)
+
+from rwadist import model as model_io  # noqa: E402
 from rwadist.fmu import hosts  # noqa: E402
 from rwadist.fmu import runtime as rt
 from rwadist.fmu.build import build_fmu, has_native  # noqa: E402
-
-from rwadist import model as model_io  # noqa: E402
 
 
 def main() -> int:

@@ -11,7 +11,7 @@ i.e. the 6×6 :func:`load_transform` [[R, 0], [[r]× R, R]] acting on (Fx, Fy, F
 matrix transforms as T S Tᵀ, and by virtual work the interface accelerations as Tᵀ.
 
 Used by :mod:`rwadist.mounting` (``rwadist psd --wheels``), :mod:`coupling.geometry` and, as a
-self-contained copy pinned by tests/test_geometry.py, the FMU runtime (``fmu/runtime.py``
+self-contained copy pinned by tests/test_geometry.py, the FMU runtime (``rwadist/fmu/runtime.py``
 ``rotation_check`` and ``to_spacecraft``).  Each caller raises its own error type with the message
 :func:`rotation_problem` gives.
 """

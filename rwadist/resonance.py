@@ -17,7 +17,7 @@ general single-mode gain with H(0) = 1 (the static load passes whole) and H → 
 (β = 1, γ = g: the form above; β = 0, γ = 1: the transmissibility; β = γ = 0: the bare single mode).  A model file
 gives it by f_r, ζ, the peak gain g and ``gain_above`` β (default 1); γ follows from them (:func:`numerator_damping`).  Used by the test-stand simulator (:class:`rwadist.teststand.Mode`),
 ``rwadist diagnose`` (``fixed_resonance`` effects), the extended model and ``rwadist psd`` (wheel-mode
-resonances of a model file).  The FMU runtime (``fmu/runtime.py``) keeps its own inline copy on
+resonances of a model file).  The FMU runtime (``rwadist/fmu/runtime.py``) keeps its own inline copy on
 purpose, so that it stays self-contained for simulation hosts; ``tests/test_resonance.py`` pins that
 copy to this one numerically.
 """

@@ -37,27 +37,17 @@ KNOWN_LONG: set = set()
 KNOWN_LONG_FUNCTIONS: set = {"rwadist/extended_fit.py::fit_extended"}
 
 
-#: source folders installed inside the package under another name (pyproject ``package-dir``): checked too
-MAPPED = {"fmu": "rwadist.fmu", "coupling": "rwadist.coupling"}
-
-
 def module_name(path: Path) -> str:
     rel = path.relative_to(PACKAGE.parent).with_suffix("")
     parts = list(rel.parts)
-    if parts[0] in MAPPED:
-        parts = MAPPED[parts[0]].split(".") + parts[1:]
     if parts[-1] == "__init__":
         parts.pop()
     return ".".join(parts)
 
 
 def source_files() -> list:
-    """Every .py file of the package: rwadist/ and the folders installed into it (:data:`MAPPED`)."""
-    files = list(PACKAGE.rglob("*.py"))
-    for folder in MAPPED:
-        if (PACKAGE.parent / folder / "__init__.py").is_file():
-            files += (PACKAGE.parent / folder).rglob("*.py")
-    return sorted(files)
+    """Every .py file of the package (rwadist.fmu and rwadist.coupling included: they live in rwadist/)."""
+    return sorted(PACKAGE.rglob("*.py"))
 
 
 def modules() -> dict:
@@ -236,18 +226,29 @@ def test_no_module_over_max_lines():
 
 
 def test_installed_packages_are_the_source_packages():
-    """pyproject lists every package of the source tree, fmu/ and coupling/ installed as rwadist.fmu and
-    rwadist.coupling (a package missing from the list would install without its modules)."""
+    """pyproject lists every package of the source tree (a package missing from the list would install without its
+    modules), and installs each from the folder of its name, so the repository root imports the same package as an
+    installed copy (fmu/ and coupling/ sat at the top level and were mapped in: from the root
+    ``from rwadist import coupling`` failed)."""
     import tomllib
 
     root = PACKAGE.parent
     cfg = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]
-    listed = set(cfg["packages"])
-    dirs = {"rwadist": "rwadist", **cfg["package-dir"]}
-    found = set()
-    for name, folder in dirs.items():
-        for init in (root / folder).rglob("__init__.py"):
-            rel = init.parent.relative_to(root / folder).parts
-            found.add(".".join((name, *rel)))
-    assert found == listed
-    assert set(cfg["package-dir"]) == {"rwadist.fmu", "rwadist.coupling"}
+    found = {".".join(init.parent.relative_to(root).parts) for init in PACKAGE.rglob("__init__.py")}
+    assert found == set(cfg["packages"])
+    assert "package-dir" not in cfg
+    assert not (root / "fmu").exists() and not (root / "coupling").exists()
+
+
+def test_the_subpackages_import_from_the_repository_root():
+    """``from rwadist import coupling, fmu`` run in the repository root imports them from the source tree's rwadist/
+    (the package Python finds first there)."""
+    import subprocess
+
+    root = PACKAGE.parent
+    code = ("import rwadist.fmu.native_build as nb; from rwadist import coupling, fmu; "
+            "print(coupling.__file__); print(fmu.__file__); print(nb.__file__)")
+    out = subprocess.run([sys.executable, "-c", code], cwd=root, capture_output=True, text=True, check=True)
+    files = [Path(line) for line in out.stdout.split()]
+    assert files == [PACKAGE / "coupling" / "__init__.py", PACKAGE / "fmu" / "__init__.py",
+                     PACKAGE / "fmu" / "native_build.py"]

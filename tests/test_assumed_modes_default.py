@@ -6,13 +6,13 @@ import json
 
 import numpy as np
 import pytest
-from rwadist.coupling.components import wheel_matrices
-from rwadist.coupling.performance import rigid_wheel_frf, wheel_spec_from_model
 
 from rwadist import catalogue
 from rwadist import coupling as cp
 from rwadist import extended as ext
 from rwadist.cli import main
+from rwadist.coupling.components import wheel_matrices
+from rwadist.coupling.performance import rigid_wheel_frf, wheel_spec_from_model
 from rwadist.mounting import load_wheels
 
 HR16 = "honeywell-hr16-75"

@@ -369,7 +369,6 @@ def test_diagnosed_resonance_and_sidebands_reach_the_coupled_prediction():
     equals the one where every sideband is replaced, at that speed, by a plain harmonic of the same
     whirl rate h' = h ± 2πf_mod/Ω -- an independent route to the frequency the plant is evaluated at."""
     from rwadist.coupling.performance import wheel_spec_from_model
-
     from rwadist.diagnose import resonance
     model = preset("ithaco-e").to_model()
     model.effects = [dict(e) for e in EFFECTS]

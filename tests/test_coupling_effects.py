@@ -9,12 +9,12 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from rwadist.coupling.performance import wheel_spec_from_model
 from scipy import integrate, linalg
 from scipy.special import jv
 
 from rwadist import coupling as cp
 from rwadist import extended as ext
+from rwadist.coupling.performance import wheel_spec_from_model
 from rwadist.diagnose import ripple_sideband_powers
 from rwadist.presets import preset
 from rwadist.units import RPM_TO_RAD_S

@@ -5,11 +5,11 @@ speed and frequency, for flexible and hard-mounted wheels, reversed and scaled s
 from dataclasses import replace
 
 import numpy as np
-from rwadist.coupling import performance as perf
-from rwadist.coupling.gyro_split import gyro_gain, wheel_split
 
 from rwadist import coupling as cp
 from rwadist import extended as ext
+from rwadist.coupling import performance as perf
+from rwadist.coupling.gyro_split import gyro_gain, wheel_split
 from rwadist.presets import preset
 from rwadist.units import RPM_TO_RAD_S
 

@@ -7,7 +7,6 @@ import json
 
 import numpy as np
 import pytest
-from rwadist.fmu import runtime as rt
 from scipy import signal
 from test_diagnose import C1, FS, SPEEDS, TRUTH, e_data, inject_floor, spectra
 from test_diagnose_modulation import RIPPLE, rippled_data
@@ -15,6 +14,7 @@ from test_fmu_effects import ripple_coefficients_p2
 
 from rwadist import model as model_io
 from rwadist.diagnose import diagnose
+from rwadist.fmu import runtime as rt
 
 pytest.importorskip("pythonfmu")
 

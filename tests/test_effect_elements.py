@@ -83,11 +83,10 @@ def test_a_toy_kind_from_one_file_runs_through_stand_diagnose_file_text_psd_and_
     apply it -- each equal to the same model with that line's coefficient scaled by the fitted gain (a second way
     to the same loads); the pythonfmu FMU, which reads model files with the shipped elements alone, refuses it by
     name."""
-    from rwadist.fmu import runtime as rt
-
     import rwadist
     from rwadist import model as model_io
     from rwadist.effects_text import describe_effect
+    from rwadist.fmu import runtime as rt
     from rwadist.inject import parse, simulate_with_injections
     from rwadist.presets import preset
 
@@ -135,6 +134,7 @@ def test_a_toy_kind_from_one_file_runs_through_stand_diagnose_file_text_psd_and_
     if native_supported():
         pytest.importorskip("fmpy")
         from fmpy import simulate_fmu
+
         from rwadist.fmu.native_build import build_native_fmu
 
         sig = np.array(list(zip(t, speed)), dtype=[("time", float), ("wheel_speed", float)])

@@ -1,5 +1,5 @@
-"""The native FMUs' C sources (issue 35): one table of the FMI rules and variables (fmu/native/rwadist_fmi_rules.h)
-that agrees with the modelDescriptions' variables (fmu/native_build.py VARIABLES), and no compiler warning under
+"""The native FMUs' C sources (issue 35): one table of the FMI rules and variables (rwadist/fmu/native/rwadist_fmi_rules.h)
+that agrees with the modelDescriptions' variables (rwadist/fmu/native_build.py VARIABLES), and no compiler warning under
 -Wall -Wextra in either FMI version's sources or the pythonfmu FMU's native layer."""
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+
 from rwadist.fmu.build import native_supported
 
 CC = shutil.which(os.environ.get("CC", "cc"))
@@ -18,7 +19,7 @@ pytestmark = pytest.mark.skipif(not (native_supported() and CC), reason="needs a
 from rwadist.fmu.native_build import C_SOURCES, VARIABLES, VR_TIME, build_native_fmu  # noqa: E402
 from rwadist.fmu.runtime import SWITCH_SLOTS, fmu_switches  # noqa: E402
 
-NATIVE = Path(__file__).resolve().parents[1] / "fmu" / "native"
+NATIVE = Path(__file__).resolve().parents[1] / "rwadist" / "fmu" / "native"
 PRINT_TABLE = r"""
 #include <stdio.h>
 #include "rwadist_fmi_rules.h"
@@ -65,7 +66,6 @@ def test_sources_compile_without_warnings(tmp_path, version):
     """The FMU's sources/ (its API file with the wrapper layer, runtime and kernel) under -Wall -Wextra -Werror with
     the host compiler and, where installed, mingw-w64; the pythonfmu FMU's native layer too."""
     from rwadist.fmu.native_build import windows_compiler
-
     from rwadist.presets import preset
     fmu = build_native_fmu(preset("ithaco-e").to_model(), tmp_path / "w.fmu", fmi_version=version, windows=False)
     with zipfile.ZipFile(fmu) as z:

@@ -8,14 +8,14 @@ import copy
 
 import numpy as np
 import pytest
-from rwadist.fmu import hosts
-from rwadist.fmu import runtime as rt
-from rwadist.fmu.build import build_fmu
 from scipy.signal import welch
 from scipy.special import jv
 from test_fmu import NATIVE_ONLY, assert_native_equals_numpy, kernel, slope, spin_up  # noqa: F401  (kernel: a fixture)
 
 from rwadist import model as model_io
+from rwadist.fmu import hosts
+from rwadist.fmu import runtime as rt
+from rwadist.fmu.build import build_fmu
 from rwadist.presets import preset
 
 pytest.importorskip("pythonfmu")

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from rwadist.fmu import hosts
 from rwadist.fmu.build import native_supported
 

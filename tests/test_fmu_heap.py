@@ -1,15 +1,15 @@
 """The pythonfmu FMU (the default of ``rwadist fmu build``) under a memory checker, on every exit path (issue 17).
 
-Hosts: fmpy (the slave runs in the host's own interpreter) and the C hosts of fmu/native (no Python of their own:
+Hosts: fmpy (the slave runs in the host's own interpreter) and the C hosts of rwadist/fmu/native (no Python of their own:
 pythonfmu starts an interpreter in the process; libpython is preloaded, the resource location is a file:// URI).
 
 * valgrind memcheck over fmpy: instantiate, setup, initialise, steps, terminate, free; reset and a second run;
   refused inputs (a non-finite speed, a communication point that goes backwards or is NaN, a negative step,
   unknown value references); the refused FMU-state calls; free without terminate; free before initialisation;
   then process exit with every instance of one FMU freed and two instances of a second FMU still alive.  No
-  invalid read, write or free may be reported (fmu/native/valgrind-host.supp lists the one loader report
+  invalid read, write or free may be reported (rwadist/fmu/native/valgrind-host.supp lists the one loader report
   suppressed, and why); an overflow planted through ctypes shows the checker is live.  Before the fix in
-  fmu/slave.py (_guard_pythonfmu_exit) valgrind reported pythonfmu's exit-time use-after-free here: "Invalid
+  rwadist/fmu/slave.py (_guard_pythonfmu_exit) valgrind reported pythonfmu's exit-time use-after-free here: "Invalid
   read of size 4 at finalizePythonInterpreter ... 8 bytes inside a block of size 128 free'd".
 * The same exit in the C hosts aborted with ``free(): corrupted unsorted chunks`` (3 of 3 runs without
   PYTHONPATH; with it the corruption stayed silent): c_host steps the pythonfmu FMU, must exit 0 with fmpy's
@@ -33,12 +33,11 @@ import pytest
 pytest.importorskip("pythonfmu")
 pytest.importorskip("fmpy")
 
-from rwadist.fmu.build import build_fmu, native_supported  # noqa: E402
-
 from rwadist import model as model_io  # noqa: E402
+from rwadist.fmu.build import build_fmu, native_supported  # noqa: E402
 from rwadist.presets import preset  # noqa: E402
 
-NATIVE = Path(__file__).resolve().parents[1] / "fmu" / "native"
+NATIVE = Path(__file__).resolve().parents[1] / "rwadist" / "fmu" / "native"
 SUPPRESSIONS = NATIVE / "valgrind-host.supp"
 CC = shutil.which(os.environ.get("CC", "cc"))
 #: kinds of memcheck report that are heap corruption (addressability and allocation errors)

@@ -1,6 +1,6 @@
-"""The native FMU under memory checkers (issues 17, 35): a hostile C host (fmu/native/c_stress.c: instantiate, step,
+"""The native FMU under memory checkers (issues 17, 35): a hostile C host (rwadist/fmu/native/c_stress.c: instantiate, step,
 bad input, get/set/serialize/deserialize state from good, truncated, corrupted and NULL data, reset, free; many
-cycles) and random call orders over the FMI state machine (fmu/native/c_orders.c, FMI 2.0 and FMI 3.0: every call in
+cycles) and random call orders over the FMI state machine (rwadist/fmu/native/c_orders.c, FMI 2.0 and FMI 3.0: every call in
 and out of order from every state, FMU states through errors and restores) run the FMU's own sources/ compiled with
 AddressSanitizer + UndefinedBehaviorSanitizer (always, wherever gcc or clang has them) and, where valgrind is
 installed, the shipped binaries under valgrind: no invalid read, write or free, no leak, and every expectation of the
@@ -15,6 +15,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+
 from rwadist.fmu.build import native_supported
 
 pytest.importorskip("fmpy")
@@ -24,10 +25,11 @@ pytestmark = pytest.mark.skipif(not (native_supported() and CC),
 
 import random  # noqa: E402
 
-from rwadist.fmu.native_build import C_SOURCES, PLATFORMS, build_native_fmu  # noqa: E402
 from test_fmu_native import wheel_doc  # noqa: E402
 
-NATIVE = Path(__file__).resolve().parents[1] / "fmu" / "native"
+from rwadist.fmu.native_build import C_SOURCES, PLATFORMS, build_native_fmu  # noqa: E402
+
+NATIVE = Path(__file__).resolve().parents[1] / "rwadist" / "fmu" / "native"
 SANITIZE = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer", "-g", "-O1"]
 
 

@@ -7,7 +7,7 @@ Counted, not timed, in a fresh fmpy process per FMU (the slave runs in that proc
 * no reference cycle holds a freed instance: with the garbage collector off, no slave instance is alive after its
   fmi2FreeInstance (before, each stayed, with its model's arrays, until a full collection);
 * what pythonfmu's findClass leaks per instance: no list of the slave class's __mro__ (the stand-in of
-  fmu/slave_template.py is all it sees), and the Python heap grows by less than :data:`MAX_BYTES_PER_CYCLE` per
+  rwadist/fmu/slave_template.py is all it sees), and the Python heap grows by less than :data:`MAX_BYTES_PER_CYCLE` per
   cycle (tracemalloc; pythonfmu's own leak is now 219 B: a two-entry list, one bytes object and the sys.path
   string; 1.1 kB per cycle before).  Each of these four fails on the FMU of the code before the fix.
 
@@ -26,9 +26,8 @@ import pytest
 pytest.importorskip("pythonfmu")
 pytest.importorskip("fmpy")
 
-from rwadist.fmu.build import SLAVE, SLAVE_RESOURCE, build_fmu  # noqa: E402
-
 from rwadist import model as model_io  # noqa: E402
+from rwadist.fmu.build import SLAVE, SLAVE_RESOURCE, build_fmu  # noqa: E402
 from rwadist.presets import preset  # noqa: E402
 
 #: Python-heap bytes one instantiate/free cycle may leave: measured here ~0.45 kB (pythonfmu's own leak, 219 B,

@@ -7,11 +7,11 @@ import json
 
 import numpy as np
 import pytest
+
+from rwadist import catalogue
 from rwadist.fmu import hosts
 from rwadist.fmu import runtime as rt
 from rwadist.fmu.build import build_fmu
-
-from rwadist import catalogue
 
 pytest.importorskip("pythonfmu")
 fmpy = pytest.importorskip("fmpy")

@@ -12,12 +12,12 @@ import zipfile
 
 import numpy as np
 import pytest
-from rwadist.fmu import hosts
-from rwadist.fmu import runtime as rt
-from rwadist.fmu.build import build_fmu, native_supported
 
 from rwadist import extended as ext
 from rwadist import model as model_io
+from rwadist.fmu import hosts
+from rwadist.fmu import runtime as rt
+from rwadist.fmu.build import build_fmu, native_supported
 from rwadist.presets import preset
 
 pytest.importorskip("pythonfmu")

@@ -18,9 +18,9 @@ import shutil
 
 import numpy as np
 import pytest
+
 from rwadist.fmu import hosts
 from rwadist.fmu.build import build_fmu, has_native, native_supported
-
 from rwadist.presets import preset
 
 pytest.importorskip("pythonfmu")
@@ -29,6 +29,7 @@ pytestmark = pytest.mark.skipif(not (native_supported() and shutil.which(os.envi
                                 reason="fmi2Error from both FMUs needs their native layers (Linux x86-64, a C compiler)")
 
 from fmpy.fmi1 import FMICallException  # noqa: E402
+
 from rwadist.fmu.native_build import build_native_fmu  # noqa: E402
 
 ERROR = 3

@@ -15,7 +15,7 @@ asynchronous steps or fmi2Discard can be in:
   fmi3Reset everywhere, fmi3Set{Type} of inputs in Instantiated, Initialization Mode and Step Mode, of parameters in
   Instantiated and Initialization Mode, never in Terminated.
 
-One leniency of the FMUs, documented in fmu/native/rwadist_fmi_rules.h, is in the model: an FMI 2.0 input set in
+One leniency of the FMUs, documented in rwadist/fmu/native/rwadist_fmi_rules.h, is in the model: an FMI 2.0 input set in
 instantiated is accepted (FMI 3.0 allows it; fmpy's simulate_fmu does it).  Cross-checked against the Modelica
 Association's Reference FMUs (src/fmi2Functions.c, src/fmi3Functions.c: their MASK_* tables): the same rows, except
 that they allow fmi3Set{Type} in Terminated (the standard lists only the getters there) and take FMI 2.0's error
@@ -140,6 +140,7 @@ class Order:
         from fmpy import read_model_description
         from fmpy.fmi2 import FMU2Slave
         from fmpy.fmi3 import FMU3Slave
+
         from rwadist.fmu import hosts
         self.rng = random.Random(seed)
         md = read_model_description(path)
@@ -333,7 +334,6 @@ def test_random_call_orders_follow_the_fmi_state_machine(tmp_path):
     the orders reach every state of the standard's table."""
     from rwadist.fmu.build import build_fmu
     from rwadist.fmu.native_build import build_native_fmu
-
     from rwadist.presets import preset
     first = int(os.environ.get("RWADIST_FUZZ_SEED", random.SystemRandom().randrange(1_000_000)))
     print(f"first seed {first} (RWADIST_FUZZ_SEED={first} replays these orders)")

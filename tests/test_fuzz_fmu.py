@@ -121,6 +121,7 @@ def run_fmu_case(case: dict, fmus: dict) -> tuple:
     """(outcome, detail) of one case, in this process."""
     import numpy as np
     from fmpy.fmi1 import FMICallException
+
     from rwadist.fmu import hosts
     from rwadist.fmu import runtime as rt
     log = hosts.HostLog()

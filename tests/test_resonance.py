@@ -49,7 +49,7 @@ def test_teststand_mode_uses_the_home():
 
 @pytest.mark.parametrize("rpm", [1500.0, -900.0])
 def test_fmu_runtime_copy_matches_the_home(rpm):
-    """fmu/runtime.py applies H inline (self-contained for hosts): each component's amplitude with the
+    """rwadist/fmu/runtime.py applies H inline (self-contained for hosts): each component's amplitude with the
     resonances over the one without is resonance_gain at its whirl rate ν = σhΩ + ω_off, to 1e-12."""
     from rwadist.fmu.runtime import WheelRuntime, model_from_doc
 

@@ -8,7 +8,7 @@ actions, in the order of :func:`ordered`:
   (:func:`rwadist.extended.apply_line_effects`, :func:`rwadist.extended.ripple_from_effects`), the coupling kit
   (:func:`rwadist.coupling.performance.wheel_spec_from_model`);
 - the FMUs: the numpy runtime (:func:`rwadist.fmu.runtime.effects_from_doc`) and the C kernel, which gets them
-  compiled in when the FMU is built (``fmu/native_build.py``).
+  compiled in when the FMU is built (``rwadist/fmu/native_build.py``).
 
 Units SI: Hz, rad/s, N or N·m.  Numpy only (shipped into the FMU with the elements).
 """

@@ -236,7 +236,7 @@ def system_description(name: str, wheels, sources: list, params: list, command_s
     system = system_parameters(wheels, params, tables)
     x = ['<?xml version="1.0" encoding="UTF-8"?>',
          f'<ssd:SystemStructureDescription {SSD_NS} version="1.0" name={quoteattr(name)} '
-         'generationTool="rwadist (fmu/ssp.py)">',
+         'generationTool="rwadist (rwadist/fmu/ssp.py)">',
          f'  <ssd:System name={quoteattr(name)} description="Reaction-wheel assembly: speed_command\'s inputs drive '
          'the wheels; each wheel\'s Fx_sc .. Tz_sc are its loads at the spacecraft reference point in the spacecraft '
          'frame; the assembly\'s loads are their sum">', '    <ssd:Connectors>']

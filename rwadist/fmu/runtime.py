@@ -24,7 +24,7 @@ One communication step [t_n, t_n + h] with wheel speed Ω_n and acceleration α 
   their spacecraft-frame image F_sc = R F, T_sc = R T + r × F_sc.
 
 The step runs in numpy, or, when the FMU carries its native library (built from
-``fmu/native/rwadist_fmu_native.c`` by ``rwadist fmu build`` where a C compiler is found), in
+``rwadist/fmu/native/rwadist_fmu_native.c`` by ``rwadist fmu build`` where a C compiler is found), in
 that library's ``rwadist_kernel_step`` -- the same equations in C, ~10× faster per step, tested
 against this numpy code (:func:`load_kernel`, :data:`KERNEL_PARAMS`).
 """
@@ -38,8 +38,8 @@ import sys
 
 import numpy as np
 
-#: the runtime's sibling modules (``fmu/<stem>.py``): the model file and the closed forms / native kernel
-#: interface; ``fmu/build.py`` ships each in the FMU's resources as :func:`fmu_file_name` (no import cycle:
+#: the runtime's sibling modules (``rwadist/fmu/<stem>.py``): the model file and the closed forms / native kernel
+#: interface; ``rwadist/fmu/build.py`` ships each in the FMU's resources as :func:`fmu_file_name` (no import cycle:
 #: neither imports the other, both are imported here)
 SIBLINGS = ("runtime_model", "runtime_math")
 
@@ -287,7 +287,7 @@ class WheelRuntime:
         self.pos = [float(v) for v in pos]
 
     def _init_kernel(self):
-        """The native kernel's configuration array (its layout: :mod:`runtime_math`'s KERNEL_ constants, fmu/native/rwadist_fmu_native.c), state and output
+        """The native kernel's configuration array (its layout: :mod:`runtime_math`'s KERNEL_ constants, rwadist/fmu/native/rwadist_fmu_native.c), state and output
         arrays, and their addresses."""
         p = self.p
         n = self.sh.size

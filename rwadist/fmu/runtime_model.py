@@ -20,11 +20,11 @@ import types
 
 import numpy as np
 
-#: the schema's file name in the FMU's resources (``fmu/build.py`` copies rwadist/schema.py there)
+#: the schema's file name in the FMU's resources (``rwadist/fmu/build.py`` copies rwadist/schema.py there)
 SCHEMA_FILE = "rwadist_model_schema.py"
 #: the units module's file name in the FMU's resources (rwadist/units.py: the elements read their units there)
 UNITS_FILE = "rwadist_model_units.py"
-#: the folder of the effect elements in the FMU's resources (``fmu/build.py`` copies rwadist/effects/ there:
+#: the folder of the effect elements in the FMU's resources (``rwadist/fmu/build.py`` copies rwadist/effects/ there:
 #: :func:`rwadist.effects.shipped_files`)
 EFFECTS_DIR = "rwadist_model_effects"
 

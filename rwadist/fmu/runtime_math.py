@@ -34,7 +34,7 @@ def to_spacecraft(out, R, r):
 
 # ------------------------------------------------------------------ native kernel
 
-#: cfg layout of ``rwadist_kernel_step`` (fmu/native/rwadist_fmu_native.c): parameter order,
+#: cfg layout of ``rwadist_kernel_step`` (rwadist/fmu/native/rwadist_fmu_native.c): parameter order,
 #: offsets of the fixed poles, mounting, and the per-component block (σh, direction, coef·C,
 #: −i·coef·C·[imbalance], coef·A_ref, Ω_ref, p of an amplitude law, ω_off (rad/s, sidebands),
 #: number of resonances, cfg index of its resonance entries), then the resonance table

@@ -1,4 +1,4 @@
-/* The step kernel of the rwadist wheel FMU: WheelRuntime.step of fmu/runtime.py in C (same equations,
+/* The step kernel of the rwadist wheel FMU: WheelRuntime.step of rwadist/fmu/runtime.py in C (same equations,
  * same order of operations where it matters; tested against it and against
  * rwadist.extended.simulate_time).  Shared by the pythonfmu FMU's native layer (rwadist_fmu_native.c)
  * and the pure-C FMU (rwadist_wheel_fmu.c).  Memory layouts are defined in runtime.py (KernelLayout). */

@@ -1,5 +1,5 @@
 /* Native layer of the rwadist wheel FMU (Linux): an FMI 2.0 status adapter in front of
- * pythonfmu's library, and the step kernel of fmu/runtime.py in C.
+ * pythonfmu's library, and the step kernel of rwadist/fmu/runtime.py in C.
  *
  * Why: pythonfmu 0.7 reports a do_step that returns False as fmi2Discard and any Python
  * exception as fmi2Fatal; the FMI way to refuse bad input is fmi2Error.  The Python slave calls
@@ -15,10 +15,10 @@
  * initialisation, an output set, or a value reference that is not a variable of the wheel FMU's type asked is
  * answered with fmi2Error and a logged message, without reaching pythonfmu; any fmi2Error (refused here or by the
  * slave) then moves the instance to FMI 2.0's error state, from which fmi2Reset and fmi2FreeInstance lead on (this
- * FMU has no FMU state).  The variables are those of fmu/slave.py (VARIABLES of fmu/native_build.py; a test
+ * FMU has no FMU state).  The variables are those of rwadist/fmu/slave.py (VARIABLES of rwadist/fmu/native_build.py; a test
  * compares them with rwadist_fmi_rules.h).
  *
- * rwadist_kernel_step() is WheelRuntime.step of fmu/runtime.py: the kernel of rwadist_kernel.h,
+ * rwadist_kernel_step() is WheelRuntime.step of rwadist/fmu/runtime.py: the kernel of rwadist_kernel.h,
  * shared with the pure-C FMU (rwadist_wheel_fmu.c). */
 #define _GNU_SOURCE
 #include <dlfcn.h>

@@ -115,7 +115,7 @@ static void rw_refusal(char *buf, size_t size, int fmi, RwCall call, int state, 
 }
 
 /* ------------------------------------------------------------------ variables by value reference
- * The variables of both wheel FMUs (fmu/native_build.py VARIABLES; a test compares the two), FMI 3.0 adds `time`. */
+ * The variables of both wheel FMUs (rwadist/fmu/native_build.py VARIABLES; a test compares the two), FMI 3.0 adds `time`. */
 /* VR_SWITCH .. VR_SWITCH + N_SWITCH_VR - 1: the effect switches, Booleans that the effect elements own and name
    (fmu.runtime.fmu_switches; wheel_model.h RW_SWITCH_NAMES in the native FMU) */
 #define N_SWITCH_VR 2

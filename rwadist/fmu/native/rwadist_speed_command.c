@@ -1,4 +1,4 @@
-/* rwadist speed command: the speed inputs of a wheel-assembly SSP (fmu/ssp.py), an FMI 2.0 co-simulation FMU in C.
+/* rwadist speed command: the speed inputs of a wheel-assembly SSP (rwadist/fmu/ssp.py), an FMI 2.0 co-simulation FMU in C.
  *
  * One input per independently driven wheel, `speed_<wheel>` (rad/s, its commanded speed), and one output each,
  * `wheel_speed_<wheel>`, that the SSP connects to the wheel FMUs' `wheel_speed` (a tied wheel through an
@@ -8,7 +8,7 @@
  * the wheel FMU's (rwadist_fmi_rules.h): a call out of order or with a bad value is fmi2Error, logged, and moves the
  * instance to FMI 2.0's error state; it has no FMU state (canGetAndSetFMUstate = false).
  *
- * speed_command.h (written by fmu/ssp.py) defines RW_GUID, RW_N_SPEEDS and RW_START[RW_N_SPEEDS] (the inputs' start
+ * speed_command.h (written by rwadist/fmu/ssp.py) defines RW_GUID, RW_N_SPEEDS and RW_START[RW_N_SPEEDS] (the inputs' start
  * values, rad/s).  Value references: inputs 0 .. N-1, outputs N .. 2N-1. */
 #include <math.h>
 #include <stdarg.h>

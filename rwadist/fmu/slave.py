@@ -1,17 +1,17 @@
 """The pythonfmu co-simulation slave of the rwadist wheel FMU (:class:`WheelSlave`).
 
-``fmu/build.py`` ships this file verbatim in the FMU's ``resources/`` as ``rwadist_fmu_slave.py``, beside the
-physics (``rwadist_fmu_runtime.py``, a copy of ``fmu/runtime.py``, numpy only) and the wheel
-(``wheel_model.json``); rwadist itself is not needed by the host.  The FMU's slave module (``fmu/slave_template.py``
+``rwadist/fmu/build.py`` ships this file verbatim in the FMU's ``resources/`` as ``rwadist_fmu_slave.py``, beside the
+physics (``rwadist_fmu_runtime.py``, a copy of ``rwadist/fmu/runtime.py``, numpy only) and the wheel
+(``wheel_model.json``); rwadist itself is not needed by the host.  The FMU's slave module (``rwadist/fmu/slave_template.py``
 rendered per build under a module name unique to the build) loads this file under a name unique to that module and
 subclasses :class:`WheelSlave` under the build's class name, so FMUs of different builds load side by side in one
 process.  The slave lives here, not in that module, because pythonfmu 0.7 compiles that module's source again at
-every fmi2Instantiate (fmu/slave_template.py): ~1.3 MB of transient allocations per instance for the whole slave,
+every fmi2Instantiate (rwadist/fmu/slave_template.py): ~1.3 MB of transient allocations per instance for the whole slave,
 which fragmented the host's heap (issue 17, benchmarks/fmu_memory.py).
 
 Bad input never raises out of ``do_step`` (pythonfmu turns an exception into fmi2Fatal): the
 slave logs the problem with status fmi2Error (category logStatusError), flags it to the FMU's
-native layer (``binaries/linux64/<id>.so``, see fmu/build.py) and returns False; the native
+native layer (``binaries/linux64/<id>.so``, see rwadist/fmu/build.py) and returns False; the native
 layer then returns fmi2Error from the FMI call (pythonfmu alone would report fmi2Discard).  The
 state is left at the last good step, so the host may retry (e.g. with a smaller step or a
 corrected input).  The same native library carries the C step kernel the runtime uses.
@@ -207,7 +207,7 @@ class _FindClassView(type):
 
 
 def find_class_stand_in():
-    """The class a build's slave module shows pythonfmu's findClass (fmu/slave_template.py): its ``__mro__``
+    """The class a build's slave module shows pythonfmu's findClass (rwadist/fmu/slave_template.py): its ``__mro__``
     has two entries whose reprs are strings made here once, the first empty, the second Fmi2Slave's."""
     return _FindClassView("FindClassStandIn", (), {
         "_find_class_mro": (_FixedRepr(""), _FixedRepr(repr(Fmi2Slave)))})

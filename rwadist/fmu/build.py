@@ -170,8 +170,8 @@ def _check_shipped(doc, source: str = "<model>") -> None:
         if not isinstance(e, schema.UnknownEffect) and module not in shipped:
             raise _runtime().ModelError(source, f"effects[{i}].kind", f"{e.kind!r} is registered by {module}, which "
                                         "the pythonfmu FMU does not ship (it reads the model file with rwadist's own "
-                                        "elements); build the native FMU (rwadist fmu build --native), which compiles "
-                                        "the kind's actions in")
+                                        "elements); build the native FMU (`native`), which compiles the kind's "
+                                        "actions in")
 
 
 def _render(src: str, cls: str, physics: str, modes_default: bool) -> str:

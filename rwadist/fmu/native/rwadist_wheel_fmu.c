@@ -1,12 +1,12 @@
 /* rwadist wheel FMU in C: FMI 2.0 co-simulation, no Python anywhere.
  *
  * The model (lines, amplitude laws, senses, suspension, diagnosed effects) is compiled in from
- * wheel_model.h, which fmu/native_build.py generates from the model file.  One step is
- * WheelRuntime.step12 of fmu/runtime.py: input checks, derived acceleration, speed ripple, the
+ * wheel_model.h, which rwadist/fmu/native_build.py generates from the model file.  One step is
+ * WheelRuntime.step12 of rwadist/fmu/runtime.py: input checks, derived acceleration, speed ripple, the
  * step kernel of rwadist_kernel.h (shared with the pythonfmu FMU's native layer), broadband-floor
  * multisine, spacecraft frame.  Random phases come from numpy's default_rng re-implemented in
  * rwadist_rng.h, so a `seed` gives the phases of the Python FMU.  Variables, value references,
- * parameters and units are those of the pythonfmu FMU (fmu/slave_template.py), so a host can swap
+ * parameters and units are those of the pythonfmu FMU (rwadist/fmu/slave_template.py), so a host can swap
  * one FMU for the other.
  *
  * FMI state machine: rwadist_fmi_rules.h and rwadist_wheel_instance.h (a call out of order is answered with fmi2Error

@@ -1,9 +1,9 @@
 """pythonfmu slave module of the rwadist wheel FMU (template).
 
-``fmu/build.py`` copies this file into the FMU under a module name unique to each build and renames the class
+``rwadist/fmu/build.py`` copies this file into the FMU under a module name unique to each build and renames the class
 ``RwadistWheelSlave`` to a unique name as well (the FMU's model identifier), so FMUs of different builds load side
 by side in one process; it also rewrites the two BUILD_ lines.  The slave itself is ``rwadist_fmu_slave.py`` in
-the FMU's ``resources/`` (a copy of ``fmu/slave.py``), loaded here under a name unique to this module; this file
+the FMU's ``resources/`` (a copy of ``rwadist/fmu/slave.py``), loaded here under a name unique to this module; this file
 stays short because pythonfmu 0.7 compiles it again at every fmi2Instantiate (below).
 """
 import ctypes
@@ -24,7 +24,7 @@ ctypes.pythonapi.Py_IncRef(ctypes.py_object(globals()))
 # __mro__ would leave ~1 kB per instance.  So on such a re-execution (the module's dict, here globals(), already
 # holds the slave class, and locals() is another dict) only a stand-in made at import is bound, under the
 # one-letter name W (the UTF-8 bytes of a one-letter name are a shared constant): its metaclass shows findClass a
-# two-entry __mro__ whose reprs are strings made once (fmu/slave.py, find_class_stand_in); the module's W is the
+# two-entry __mro__ whose reprs are strings made once (rwadist/fmu/slave.py, find_class_stand_in); the module's W is the
 # slave class.  What pythonfmu leaks per instance is then a two-entry list, one bytes object and the resources
 # path it inserts into sys.path: 219 bytes with a 26-character path (tests/test_fmu_memory.py).
 if "RwadistWheelSlave" in globals() and globals() is not locals():
@@ -35,9 +35,9 @@ else:
     import sys
     from typing import TYPE_CHECKING
 
-    #: set by fmu/build.py for each build (this line is rewritten): the physics the model file carries
+    #: set by rwadist/fmu/build.py for each build (this line is rewritten): the physics the model file carries
     BUILD_PHYSICS = "extended model: harmonics through the measured suspension modes"
-    #: set by fmu/build.py (this line is rewritten): start value of the ``modes`` parameter -- False for a model
+    #: set by rwadist/fmu/build.py (this line is rewritten): start value of the ``modes`` parameter -- False for a model
     #: without suspension and for assumed (datasheet) modes unless the build opted in (--assumed-modes)
     BUILD_MODES_DEFAULT = True
     SLAVE_FILE = "rwadist_fmu_slave.py"
@@ -60,7 +60,7 @@ else:
                 raise
         return mod
 
-    if TYPE_CHECKING:            # the type checker reads the slave's source module (fmu/slave.py)
+    if TYPE_CHECKING:            # the type checker reads the slave's source module (rwadist/fmu/slave.py)
         from . import slave as _slave
     else:
         _slave = _load_slave()

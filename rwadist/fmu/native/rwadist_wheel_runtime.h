@@ -1,4 +1,4 @@
-/* rwadist wheel FMU in C: the model runtime (WheelRuntime of fmu/runtime.py): instance data, model set-up
+/* rwadist wheel FMU in C: the model runtime (WheelRuntime of rwadist/fmu/runtime.py): instance data, model set-up
  * from the compiled model (wheel_model.h) and the parameters, input checks, ripple, floors, one step.
  * Independent of the FMI version: statuses are RwStatus (the values of fmi2Status and fmi3Status) and messages
  * go to the logger the wrapper installs.  Included once per FMU, through rwadist_wheel_instance.h, by
