@@ -11,7 +11,9 @@ named ``*_rpm``), as the CLI.  The heavy modules (scipy, matplotlib) are importe
 """
 from __future__ import annotations
 
+import functools
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -627,11 +629,11 @@ def build_fmu(model=None, path="wheel.fmu", *, preset: str | None = None, native
     else:
         name = preset or "ithaco-e"
         source = catalogue.preset_model(name) or get_preset(name).to_model()
+    build: Callable[..., Path]      # (model, output, assumed_modes=) -> the FMU written
     if native:
         from rwadist.fmu.native_build import build_native_fmu
 
-        def build(source, tmp, assumed_modes):
-            return build_native_fmu(source, tmp, assumed_modes=assumed_modes, fmi_version=fmi_version)
+        build = functools.partial(build_native_fmu, fmi_version=fmi_version)
     else:
         import importlib.util
 

@@ -134,14 +134,13 @@ def cmd_fit(args) -> int:
     from .report import write_report
 
     check_output_file(args.output)
-    report_dir = Path(args.report) if args.report else Path(args.output).with_suffix("").parent / (
-        Path(args.output).stem + "_report")
     if args.no_report and args.report:
         raise DataError("--no-report", "--report", f"{args.report}: give one of the two (--no-report writes the model file "
                         "only)")
-    if args.no_report:
-        report_dir = None
-    else:
+    report_dir: Path | None = None
+    if not args.no_report:
+        report_dir = Path(args.report) if args.report else Path(args.output).with_suffix("").parent / (
+            Path(args.output).stem + "_report")
         if not args.report:
             refuse_special_base(args.output, "-o", f"its report folder {report_dir.name}",
                                 "give --report DIR or --no-report")
@@ -278,10 +277,10 @@ def cmd_demo(args) -> int:
         write_hdf5(test, data_tmp, compression="gzip", precision="float32")
         print(f"2/4 the test as HDF5: {data_path} ({data_tmp.stat().st_size / 1e6:.1f} MB; float32 samples, "
               "gzip; `rwadist convert` writes any other format)")
-        test = read_hdf5(data_tmp)
+        stored = read_hdf5(data_tmp)        # the fit reads what the file holds (float32 samples)
         print("3/4 fitting the empirical model")
         ns = argparse.Namespace(f_lim=None, nperseg=None, presence=0.25, epsilon=0.02, no_mode_exclusion=False)
-        fit = run_fit(test, ns, name="demo: " + wheel.name)
+        fit = run_fit(stored, ns, name="demo: " + wheel.name)
         fit.model.provenance["data"] = str(data_path)
         model_io.save(fit.model, outs.file(model_path, "--out"))
         files = write_report(fit, outs.folder(out / "report"), progress=True)

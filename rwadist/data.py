@@ -144,7 +144,8 @@ def read_steady(directory, progress: bool = False) -> SteadyTest:
             rows.append((reader.line_num, {k.strip(): (v or "").strip() for k, v in row.items()}))
     if not rows:
         raise DataError(runs_path, "rows", "no runs listed")
-    runs, files_seen = [], {}
+    runs: list[Run] = []
+    files_seen: dict[str, int] = {}     # file -> line of runs.csv naming it
     for lineno, row in tqdm(rows, desc="reading runs", unit="run", disable=not progress, leave=False):
         fname, speed_text = row.get("file", ""), row.get("speed_rpm", "")
         if not fname:

@@ -339,7 +339,7 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
                                   if presence < s.presence_min else f"only {int(nb)} detections")
         stats_.append(BinStat(direction, float(hk), int(nb), int(npss), presence, kept, reason))
     stats_.sort(key=lambda b: b.h)
-    merged = []
+    merged: list[BinStat] = []
     for b in stats_:  # two candidates refined onto one line: keep the better supported
         if merged and abs(b.h - merged[-1].h) < s.epsilon:
             if b.n_bin > merged[-1].n_bin:
@@ -441,19 +441,27 @@ def modal_exclusion(d, w, run, sigma_noise, s: FitSettings):
 
 
 @dataclass
+class _LineMeasurements:
+    """Every valid (harmonic, pair) measurement of the kept harmonics' lines ``lines``: harmonic index ``hi`` and
+    pair index ``pi`` (shape (m,) each), amplitude ``d`` (SI) and relative noise ``sig``."""
+
+    lines: _Lines
+    hi: np.ndarray
+    pi: np.ndarray
+    d: np.ndarray
+    sig: np.ndarray
+
+
+@dataclass
 class _DirectionMeasurements:
     """What :func:`fit_direction` measures of one direction before any modal exclusion: the harmonics identified
-    (``bins``, as identified: the line step marks its own copies) and every valid (harmonic, pair) measurement,
-    amplitude ``d`` and relative noise ``sig``, of the kept harmonics' lines ``lines``.  It depends on the settings'
-    identification and measurement fields only, not on ``exclude_modes``: a fit without modal exclusion of the same
-    spectra (:attr:`EmpiricalFit.without_mode_exclusion`) takes it instead of identifying the harmonics again."""
+    (``bins``, as identified: the line step marks its own copies) and their line measurements (None when no harmonic
+    was kept).  It depends on the settings' identification and measurement fields only, not on ``exclude_modes``: a
+    fit without modal exclusion of the same spectra (:attr:`EmpiricalFit.without_mode_exclusion`) takes it instead of
+    identifying the harmonics again."""
 
     bins: list
-    lines: _Lines | None = None
-    hi: np.ndarray | None = None
-    pi: np.ndarray | None = None
-    d: np.ndarray | None = None
-    sig: np.ndarray | None = None
+    measured: _LineMeasurements | None = None
 
 
 def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: dict, detected: dict,
@@ -502,7 +510,7 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
         power = np.maximum(p - noise, 0.0)
         d[m] = np.sqrt(2 * power)
         sig[m] = np.sqrt(noise / np.maximum(2 * power, 1e-300))
-    return _DirectionMeasurements(bins, lines, hi_, pi_, d, sig)
+    return _DirectionMeasurements(bins, _LineMeasurements(lines, hi_, pi_, d, sig))
 
 
 def direction_lines(direction: str, meas: _DirectionMeasurements, s: FitSettings):
@@ -510,9 +518,10 @@ def direction_lines(direction: str, meas: _DirectionMeasurements, s: FitSettings
     the measurements' (a harmonic left without measurements is marked not kept on its copy)."""
     bins = [replace(b) for b in meas.bins]
     kept = [b for b in bins if b.kept]
-    if not kept or meas.lines is None:
+    if not kept or meas.measured is None:
         return [], bins
-    lines, hi_, pi_, d, sig = meas.lines, meas.hi, meas.pi, meas.d, meas.sig
+    lines, hi_, pi_, d, sig = (meas.measured.lines, meas.measured.hi, meas.measured.pi, meas.measured.d,
+                               meas.measured.sig)
     w_all = 2 * np.pi * lines.pair_speed_hz[pi_]
     out = []
     for k, b in enumerate(kept):

@@ -64,7 +64,7 @@ def _spans(fit, close: float) -> dict:
             continue
         hs = sorted(set(lost) | {x.h for x in fit.lines if x.direction == d
                                  and any(abs(x.h - h) < close for h in lost)})
-        spans = []
+        spans: list[list[float]] = []      # runs of lines closer than ``close`` per rev
         for h in hs:
             if spans and h - spans[-1][-1] < close:
                 spans[-1].append(h)
@@ -158,12 +158,12 @@ class _Span:
                 self.h[j] = 1.0         # the rotation itself: h is 1, whatever its neighbours make of the fit's grid
                 continue
             grid = self.h[j] + np.linspace(-self.eps, self.eps, 2 * H_STEPS + 1)
-            costs = []
+            grid_costs = []
             for hj in grid:
                 h = self.h.copy()
                 h[j] = hj
-                costs.append(self._costs(h))
-            costs = np.array(costs)                                                   # (grid, runs)
+                grid_costs.append(self._costs(h))
+            costs = np.array(grid_costs)                                              # (grid, runs)
             common = np.all(np.isfinite(costs), axis=0)
             if common.any():
                 self.h[j] = grid[int(np.argmin(costs[:, common].sum(axis=1)))]

@@ -237,14 +237,15 @@ def _read_run(path, group) -> Run:
     return Run(speed=speed, sample_rate=fs, signals=signals, t0=t0, name=name)
 
 
-def _read_steady(path, fh) -> SteadyTest:
+def _read_steady(path, fh) -> list[Run]:
+    """The runs of a steady test's file, in the order of their group names."""
     runs_group = fh.get(RUNS_GROUP)
     if runs_group is None or not isinstance(runs_group, h5py.Group):
         raise DataError(path, f"/{RUNS_GROUP}", "group missing; a steady test keeps one group per run there")
     names = sorted(runs_group)
     if not names:
         raise DataError(path, f"/{RUNS_GROUP}", "no runs")
-    runs = []
+    runs: list[Run] = []
     for name in names:
         g = runs_group[name]
         if not isinstance(g, h5py.Group):
@@ -253,7 +254,8 @@ def _read_steady(path, fh) -> SteadyTest:
     return runs
 
 
-def _read_sweep(path, fh) -> Sweep:
+def _read_sweep(path, fh) -> tuple[np.ndarray, dict[str, np.ndarray], float, np.ndarray | None]:
+    """(time s, channel -> SI samples, sample rate Hz, tach speed rad/s or None) of a sweep's file, checked."""
     fs = _float_attr(path, fh, "sample_rate_hz", positive=True)
     check_rate_bound(path, "sample_rate_hz", fs)
     time = _samples(path, fh, TIME_DATASET)
@@ -273,7 +275,7 @@ def _read_sweep(path, fh) -> Sweep:
     return time, signals, fs, tach
 
 
-def read_hdf5(path):
+def read_hdf5(path) -> SteadyTest | Sweep:
     """Read a file written by :func:`write_hdf5`: a :class:`SteadyTest` or a :class:`Sweep`."""
     path = Path(path)
     if not path.exists():
@@ -295,7 +297,7 @@ def read_hdf5(path):
                             "`rwadist convert` the original data again") from None
 
 
-def _read_open(path, fh):
+def _read_open(path, fh) -> SteadyTest | Sweep:
     """The test in the open HDF5 file ``fh`` (see :func:`read_hdf5`)."""
     fmt = _str_attr(path, fh, "format")
     if fmt != FORMAT:

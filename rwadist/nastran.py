@@ -35,7 +35,7 @@ def field8(x: float) -> str:
         return "0."
     if not np.isfinite(x):
         raise ValueError(f"cannot write non-finite value {x!r} to a NASTRAN field")
-    best = None
+    best: tuple[float, str] | None = None      # (relative error, field)
     for p in range(7, -1, -1):
         # fixed notation
         s = f"{x:.{p}f}"
@@ -45,8 +45,8 @@ def field8(x: float) -> str:
             if best is None or err < best[0]:
                 best = (err, cand)
         # exponent notation without 'E'
-        m, e = f"{x:.{p}E}".split("E")
-        e = int(e)
+        m, exponent = f"{x:.{p}E}".split("E")
+        e = int(exponent)
         if "." not in m:
             m += "."
         cand = f"{m}{'+' if e >= 0 else '-'}{abs(e)}"

@@ -295,11 +295,11 @@ def _pid_alive(pid: int) -> bool:
     return True
 
 
-def remove_stale_temporaries(path) -> list:
+def remove_stale_temporaries(path) -> list[str]:
     """Remove the hidden temporaries (``.NAME.part-PID-*``, ``.NAME.old-PID-*``) a killed earlier write of ``path``
     left beside it -- those of processes no longer running; returns their names."""
     path = Path(path)
-    gone = []
+    gone: list[str] = []
     try:
         entries = list(path.parent.iterdir())
     except OSError:
@@ -425,7 +425,7 @@ class OutputSet:
     committed when the block ends without an error."""
 
     def __init__(self) -> None:
-        self.members: list = []     # (final, temporary, kind: "file" | "dir" | "device")
+        self.members: list[tuple[Path, Path, str]] = []     # (final, temporary, kind: "file" | "dir" | "device")
         self.stale: list = []       # finals to remove with the commit (a companion this run does not write)
 
     def file(self, path, flag: str = "-o") -> Path:
@@ -481,7 +481,7 @@ class OutputSet:
         regular = [m for m in self.members if m[2] != "device"]
         with _signals_held():
             if len(regular) == 1 and not self.stale:
-                _replace_one(*regular[0][:2], regular[0][2])
+                _replace_one(*regular[0])
             else:
                 for old in _replace_set(regular, self.stale):
                     _remove(old)

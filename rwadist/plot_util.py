@@ -104,8 +104,10 @@ def _axis_caches(axis) -> dict | None:
     update, boxes = getattr(cls, "_update_ticks", None), getattr(cls, "_get_ticklabel_bboxes", None)
     if update is None or boxes is None or "_update_ticks" in vars(axis) or "_get_ticklabel_bboxes" in vars(axis):
         return None
-    last_ticks = [None, None]
-    last_boxes = [None, None]
+    ticks_key: tuple | None = None      # the geometry the cached ticks were made for
+    ticks: list = []
+    boxes_key: tuple | None = None
+    tick_boxes: tuple = ()
 
     def geometry():
         ax = axis.axes
@@ -114,18 +116,20 @@ def _axis_caches(axis) -> dict | None:
                 id(axis.get_major_formatter()), id(axis.get_minor_formatter()))
 
     def update_ticks():
+        nonlocal ticks_key, ticks
         key = geometry()
-        if last_ticks[0] != key:
-            last_ticks[1] = update(axis)
-            last_ticks[0] = key
-        return list(last_ticks[1])
+        if ticks_key != key:
+            ticks = update(axis)
+            ticks_key = key
+        return list(ticks)
 
-    def ticklabel_bboxes(ticks, renderer):
-        key = (geometry(), tuple(map(id, ticks)), id(renderer))
-        if last_boxes[0] != key:
-            last_boxes[1] = boxes(axis, ticks, renderer)
-            last_boxes[0] = key
-        return tuple(list(b) for b in last_boxes[1])
+    def ticklabel_bboxes(shown_ticks, renderer):
+        nonlocal boxes_key, tick_boxes
+        key = (geometry(), tuple(map(id, shown_ticks)), id(renderer))
+        if boxes_key != key:
+            tick_boxes = boxes(axis, shown_ticks, renderer)
+            boxes_key = key
+        return tuple(list(b) for b in tick_boxes)
 
     return {"_update_ticks": update_ticks, "_get_ticklabel_bboxes": ticklabel_bboxes}
 

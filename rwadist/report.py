@@ -19,6 +19,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -191,15 +192,16 @@ def plot_waterfall(spectra, channel: str, ax=None, model=None, f_max: float | No
                                label="model lines h·Ω (ticks either side)")
             labelled = [hm.h for hm in model.harmonics(direction)]
     if lines is not None:
-        fx, fy = [], []
+        fx_parts: list[np.ndarray] = []     # per line: Hz, rpm of its excluded (modal) points
+        fy_parts: list[np.ndarray] = []
         for ln in lines:
             sel = (np.asarray(ln.channel) == channel) & _is_modal(ln) \
                 & np.isin(np.round(np.abs(ln.speed) * RAD_S_TO_RPM, 6), np.round(marked, 6))
-            fx.append(ln.h * np.abs(ln.speed[sel]) / (2 * np.pi))
-            fy.append(np.abs(ln.speed[sel]) * RAD_S_TO_RPM)
-        fx = np.concatenate(fx) if fx else np.empty(0)
+            fx_parts.append(ln.h * np.abs(ln.speed[sel]) / (2 * np.pi))
+            fy_parts.append(np.abs(ln.speed[sel]) * RAD_S_TO_RPM)
+        fx = np.concatenate(fx_parts) if fx_parts else np.empty(0)
         if fx.size:
-            fy = np.concatenate(fy)
+            fy = np.concatenate(fy_parts)
             handles += ax.plot(np.concatenate([fx - 1.6 * gap, fx + 1.6 * gap]), np.concatenate([fy, fy]), "|",
                                color="red", mew=1.4, ms=5, zorder=DATA_ZORDER,
                                label="excluded (modal) measurement (red ticks)")
@@ -484,7 +486,7 @@ def plot_coefficients(lines, direction: str, fig=None):
             ax.set_ylabel(f"Amplitude ({unit})")
         if i >= n - ncol:
             ax.set_xlabel("Wheel speed |Ω| (rpm)")
-    handles = {}
+    handles: dict[str, Artist] = {}     # label -> its first handle
     for ax in axes[:n]:
         for hd, lb in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(lb, hd)
@@ -514,7 +516,7 @@ def harmonic_rows(fit) -> list:
     are added from the model (C_all unknown: NaN)."""
     model_h = {d: [float(hm.h) for hm in fit.model.harmonics(d)] for d in DIRECTION_CHANNELS}
     rows = []
-    matched = {d: set() for d in DIRECTION_CHANNELS}
+    matched: dict[str, set[int]] = {d: set() for d in DIRECTION_CHANNELS}    # indices into model_h[d] with a line
     for ln in fit.lines:
         hit = [i for i, h in enumerate(model_h.get(ln.direction, [])) if _same_h(ln.h, h)]
         matched.setdefault(ln.direction, set()).update(hit)

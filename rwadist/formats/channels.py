@@ -31,8 +31,7 @@ from .timebase import check_rate, sample_step
 
 #: Unit spellings -> (kind, factor to SI).  Forces in N, torques in N·m.  Matched without regard to case, so no
 #: spelling whose case carries an SI prefix is here ("mN" is a millinewton, "MN" a meganewton: see UNITS_EXACT).
-UNITS = {}
-for _names, _kind, _factor in (
+_UNIT_SPELLINGS: tuple[tuple[tuple[str, ...], str, float], ...] = (
         (("N", "newton", "newtons"), "force", 1.0),
         (("kN", "kilonewton"), "force", 1000.0),
         (("lbf", "lb", "lbs", "pound-force"), "force", 4.4482216152605),
@@ -41,17 +40,15 @@ for _names, _kind, _factor in (
           "lbf in", "in-lb", "lb-in"), "torque", 0.1129848290276167),
         (("ft·lbf", "ft-lbf", "ft*lbf", "ftlbf", "ft.lbf", "ft lbf", "lbf·ft", "lbf-ft", "lbf*ft", "lbf.ft",
           "lbf ft", "ft-lb", "lb-ft"), "torque", 1.3558179483314004),
-):
-    for _n in _names:
-        UNITS[_n.lower()] = (_kind, _factor)
+)
+UNITS: dict[str, tuple[str, float]] = {n.lower(): (kind, factor) for names, kind, factor in _UNIT_SPELLINGS
+                                       for n in names}
 #: Spellings with a milli prefix, matched exactly (their case is their meaning): checked before UNITS.
-UNITS_EXACT = {}
-for _names, _kind, _factor in (
+_MILLI_SPELLINGS: tuple[tuple[tuple[str, ...], str, float], ...] = (
         (("mN", "millinewton"), "force", 1e-3),
         (("mN·m", "mNm", "mN*m", "mN.m", "mN m", "mN-m", "N·mm", "Nmm", "N*mm", "N.mm", "N mm", "N-mm"), "torque", 1e-3),
-):
-    for _n in _names:
-        UNITS_EXACT[_n] = (_kind, _factor)
+)
+UNITS_EXACT: dict[str, tuple[str, float]] = {n: (kind, factor) for names, kind, factor in _MILLI_SPELLINGS for n in names}
 CHANNEL_KIND = {ch: ("force" if ch.startswith("F") else "torque") for ch in CHANNELS}
 #: Column of a measured speed in rpm (interchange sweeps).
 SPEED_COLUMN = "speed_rpm"
@@ -216,14 +213,14 @@ def map_channels(record: RawRecord, meta: dict, meta_path="meta.json") -> tuple:
 def record_rate(record: RawRecord, declared_rate, declared_by="meta.json sample_rate_hz") -> tuple:
     """(sample rate Hz, t0 s) of a record, checked against a declared rate."""
     if record.time is not None:
-        kw = {} if record.time_position is None else {"position": record.time_position}
         if record.sample_rate is not None:  # the file stores both: its rate is checked like a declared one
             if declared_rate is None:
                 declared_rate, declared_by = record.sample_rate, record.rate_field
             else:
                 declared_rate = check_rate(record.path, record.rate_field, record.sample_rate, record.rate_rtol,
                                            declared_rate, declared_by)
-        step = sample_step(record.path, record.time_field, record.time, declared_rate, declared_by, **kw)
+        step = sample_step(record.path, record.time_field, record.time, declared_rate, declared_by,
+                           position=record.time_position)
         return 1.0 / step, float(record.time[0])
     if record.sample_rate is None:
         raise DataError(record.path, record.time_field, "neither time stamps nor a sample rate stored")

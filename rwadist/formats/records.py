@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -239,7 +240,7 @@ class RawRecord:
     where: dict = field(default_factory=dict)
     time: np.ndarray | None = None
     time_field: str = "time_s"
-    time_position: object = None
+    time_position: Callable[[int], str] | None = None
     sample_rate: float | None = None
     rate_rtol: float = 0.0
     rate_field: str = "sample_rate"

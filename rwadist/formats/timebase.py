@@ -11,6 +11,8 @@ HDF5, UFF, TDMS, MATLAB) uses :func:`sample_step`.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from .records import DataError
@@ -97,9 +99,14 @@ def _kind_of_step(ratio: float) -> str:
     return "a gap in the sampling"
 
 
+def _csv_line(i: int) -> str:
+    """Where the step from sample i to i+1 ends in a CSV with a header line."""
+    return f"line {i + 3}"
+
+
 def sample_step(path, field_name: str, time, declared_rate: float | None = None,
                 declared_by: str = "meta.json sample_rate_hz",
-                position=lambda i: f"line {i + 3}", stored_rtol: float = 0.0) -> float:
+                position: Callable[[int], str] | None = None, stored_rtol: float = 0.0) -> float:
     """The sampling step of a time column, s; DataError unless it is uniform up to its printed rounding.
 
     Parameters
@@ -109,8 +116,8 @@ def sample_step(path, field_name: str, time, declared_rate: float | None = None,
     time : array, shape (n,), s, as read from the file.
     declared_rate : Hz, a sample rate stated elsewhere (meta.json, an attribute), or None.
     declared_by : how errors name where ``declared_rate`` comes from.
-    position : ``position(i)`` names where the step from sample i to i+1 ends in the file
-        (a CSV line by default: header on line 1, sample 0 on line 2).
+    position : ``position(i)`` names where the step from sample i to i+1 ends in the file; None: a CSV line
+        (header on line 1, sample 0 on line 2).
     stored_rtol : relative precision of the storage beyond printing (float32: its epsilon).
 
     Returns
@@ -142,7 +149,8 @@ def sample_step(path, field_name: str, time, declared_rate: float | None = None,
         if q_max > MAX_RESOLUTION_FRACTION * step:
             hint = (f"; the time stamps are printed to {q_max:.3g} s, too coarse for this step: write more digits "
                     "(%.10g or 17 significant digits)")
-        raise DataError(path, field_name, f"sampling is not uniform: step {dt[i]:.9g} s at {position(i)} is "
+        where = _csv_line(i) if position is None else position(i)
+        raise DataError(path, field_name, f"sampling is not uniform: step {dt[i]:.9g} s at {where} is "
                         f"{ratio:.4g} sampling steps ({_kind_of_step(ratio)}); sampling step {step:.9g} s "
                         f"from a least-squares line through all {n} time stamps, printed rounding "
                         f"explains ±{tolerance[i]:.2g} s{hint or _what_to_do(ratio)}")

@@ -76,8 +76,12 @@ def _read_sets(path: Path) -> list:
 def read_record(path, tach_names=()) -> RawRecord:
     """A UFF file of dataset-58 time responses as a :class:`RawRecord` (channels named Fx..Tz)."""
     path = Path(path)
-    columns, units, where = {}, {}, {}
-    increments, starts, lengths = [], [], []
+    columns: dict[str, np.ndarray] = {}
+    units: dict[str, str] = {}
+    where: dict[str, str] = {}
+    increments: list[tuple[float | None, str]] = []     # (abscissa increment s, None: uneven; dataset)
+    starts: list[float | np.ndarray] = []               # abscissa start s, or every sample's time when uneven
+    lengths: list[tuple[int, str]] = []
     for index, (set_type, dset) in enumerate(_read_sets(path)):
         loc = f"dataset {index + 1}"
         if int(set_type) != 58:
@@ -122,12 +126,15 @@ def read_record(path, tach_names=()) -> RawRecord:
         raise DataError(path, lengths[-1][1], f"channels differ in length: {[n for n, _ in lengths]}")
     first_inc, first_loc = increments[0]
     for inc, loc in increments[1:]:
-        if (inc is None) != (first_inc is None) or (inc is not None and abs(inc - first_inc) > 2 * INCREMENT_RTOL
-                                                        * first_inc):
+        if inc is None or first_inc is None:
+            mixed = (inc is None) != (first_inc is None)
+        else:
+            mixed = abs(inc - first_inc) > 2 * INCREMENT_RTOL * first_inc
+        if mixed:
             raise DataError(path, loc, f"abscissa increment {inc!r} s differs from {first_loc}'s {first_inc!r} s "
                             "(mixed sample rates in one record)")
     if first_inc is None:  # uneven abscissa: the time of every sample is stored
-        return RawRecord(path=path, columns=columns, units=units, where=where, time=starts[0],
+        return RawRecord(path=path, columns=columns, units=units, where=where, time=np.asarray(starts[0]),
                          time_field=f"{first_loc} abscissa", time_position=lambda i: f"sample {i + 1}")
     if not first_inc > 0:
         raise DataError(path, f"{first_loc} abscissa increment", f"{first_inc!r} s is not positive")
