@@ -35,21 +35,23 @@ rotor centre).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy import optimize
 
 from . import extended as ext
-from .data import DataError, SteadyTest
+from .data import DataError, Run, SteadyTest
 from .dft import run_window, windowed_dfts, windowed_records
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .extended_fit_close import with_close_lines
+from .extended_fit_lsq import MODE_PARAMS, LogAmplitudeProblem, Solution, loose_modes
 from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower
 from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
 from .off_law_lines import free_off_law_lines, line_regressors, off_law_note
+from .resonance import FittedResonance, resonance
 from .spectra import compute_spectra, welch_dof
 from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 
@@ -142,7 +144,7 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
         use = [run for run in test.runs if cx in run.signals and cy in run.signals and run.speed != 0]
         # consecutive runs of one record length are transformed together (rwadist.dft.windowed_dfts), and their
         # powers added in the runs' order
-        batches = []
+        batches: list[list[Run]] = []
         for run in use:
             if batches and (batches[-1][0].n_samples, batches[-1][0].sample_rate) == (run.n_samples, run.sample_rate) \
                     and len(batches[-1]) * run.n_samples < SENSE_CHUNK_SAMPLES:
@@ -210,7 +212,7 @@ def amplification_peaks(fit: EmpiricalFit, min_gain: float = 1.25) -> list:
 
 def mode_frequencies(peaks: list, senses: dict, inertia_ratio: float) -> dict:
     """Starting mode frequencies (Hz at rest) from amplification peaks; None where none seen."""
-    out = {"radial_translation": None, "rocking": None, "axial_translation": None}
+    out: dict[str, float | None] = {"radial_translation": None, "rocking": None, "axial_translation": None}
     trans = [p["f_hz"] for p in peaks if p["direction"] == "radial_force" and not p["at_range_edge"]]
     trans = trans or [p["f_hz"] for p in peaks if p["direction"] == "radial_force"]
     if trans:
@@ -235,10 +237,6 @@ def mode_frequencies(peaks: list, senses: dict, inertia_ratio: float) -> dict:
 
 
 # --------------------------------------------------------------------------- 3. least squares
-
-_MODE_PARAMS = {"radial_translation": ("k_r", "c_r", "mass"), "rocking": ("k_rock", "c_rock", "I_rr"),
-                "axial_translation": ("k_z", "c_z", "mass")}
-
 
 def _measurements(fit: EmpiricalFit):
     """Flat arrays of every measured line amplitude: line index (position in ``fit.lines``),
@@ -295,6 +293,181 @@ def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=Non
     return scans
 
 
+def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: list):
+    """(test, empirical fit, measured lines, x/y senses) the extended fit works on: the lever-arm torque ``height`` × F
+    removed from the test and its fit (:func:`rwadist.geometry.remove_lever_arm`); every line the data show, with
+    every measurement (the empirical fit without modal exclusion: with it, lines that are amplified or attenuated at
+    most speeds are dropped; close lines measured together on the records); the fixture resonances ``stands`` divided
+    out of their amplitudes."""
+    if height:
+        sp0 = fit.spectra
+        test = remove_lever_arm(test, height)
+        spectra = compute_spectra(test, nperseg=sp0.nperseg, f_lim=sp0.f_lim, window=sp0.window)
+        fit = fit_empirical(spectra, fit.fit_settings)
+    meas = with_close_lines(test, fit.without_mode_exclusion)
+    senses_xy = _line_senses_once(test, meas)
+    if stands:
+        def fixture_gain(x):
+            f = x.h * np.abs(x.speed) / (2 * np.pi)
+            return np.prod([np.abs(resonance(f, *s)) for s in stands], axis=0)
+
+        meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / fixture_gain(x)) for x in meas.lines])
+    return test, fit, meas, senses_xy
+
+
+def _inertias(mass: float | None, radius: float | None, rocking_scan, notes: list) -> tuple[float, float, float]:
+    """(M kg, I_rr kg·m², I_zz kg·m²): the thin disc of the datasheet's mass and radius, or per unit (M = 1 kg,
+    I_rr = 1 kg·m², I_zz/I_rr from the rocking whirls when its scan found them, else 2; said in ``notes``)."""
+    if mass is not None and radius is not None:
+        I_zz, I_rr = ext.thin_disc(mass, radius)
+        return mass, I_rr, I_zz
+    a_fit = rocking_scan.inertia_ratio if rocking_scan.found else 2.0
+    notes.append("mass/radius not given: parameters are per unit mass (M = 1 kg) and per unit transverse "
+                 f"inertia (I_rr = 1 kg·m²); I_zz/I_rr = {a_fit:.3f} "
+                 + ("fitted from the whirls" if rocking_scan.found else "ASSUMED (thin disc): the rocking "
+                    "whirls do not constrain it"))
+    return 1.0, 1.0, float(a_fit)
+
+
+@dataclass
+class _StartStiffness:
+    """A mode's starting stiffness (N/m, N·m/rad): from the frequency its scan found (``f_modes``); a mode without
+    one is NOT CONSTRAINED (said in ``notes``): from ``start`` in a physical fit, else at 3x the top line frequency
+    ``f_top`` Hz."""
+
+    f_modes: dict
+    scans: dict
+    start: ext.ExtendedParams | None
+    physical: bool
+    f_top: float
+    notes: list
+
+    def __call__(self, mode: str, inertia: float, attr: str) -> float:
+        f = self.f_modes[mode]
+        if f is not None:
+            return inertia * (2 * np.pi * f) ** 2
+        if self.start is not None and self.physical:
+            k = getattr(self.start, attr)
+        else:
+            k = inertia * (2 * np.pi * 3 * self.f_top) ** 2
+        f_start = math.sqrt(k / inertia) / (2 * np.pi)
+        self.notes.append(f"{mode}: NOT CONSTRAINED by the data ({self.scans[mode].reason}); its {f_start:.4g} Hz is "
+                          "a starting value, listed in analytical.unconstrained")
+        return k
+
+
+def _forcing_lines(meas_lines: list, senses_xy: dict) -> tuple[list[ext.Line], np.ndarray]:
+    """(forcing lines at their start, per forcing line its measured line): an axial line one coefficient, a radial
+    line a co- and a counter-rotating part started from the x/y-phase split (floored so both can grow)."""
+    lines, owner = [], []
+    for j, x in enumerate(meas_lines):
+        if x.direction in RADIAL:
+            fr = senses_xy.get((x.direction, float(x.h)), ("co", 1.0))[1]
+            c_co, c_ct = x.C * max(math.sqrt(fr), 0.03), x.C * max(math.sqrt(1 - fr), 0.03)
+            imb = abs(x.h - 1.0) <= ext.IMBALANCE_H_TOL
+            lines.append(ext.Line(x.direction, 1.0 if imb else float(x.h), float(c_co), "co", imbalance=imb))
+            lines.append(ext.Line(x.direction, float(x.h), float(c_ct), "counter"))
+            owner += [j, j]
+        else:
+            lines.append(ext.Line(x.direction, float(x.h), float(x.C), "co"))
+            owner.append(j)
+    if not lines:
+        raise DataError("empirical fit", "harmonics", "none: nothing to fit the extended model to (lower `presence`)")
+    return lines, np.array(owner)
+
+
+def _rows_of_lines(owner: np.ndarray, la: np.ndarray, lr: np.ndarray) -> tuple[dict, np.ndarray, np.ndarray]:
+    """(measured line -> its forcing lines, per axial row its forcing line, per radial row its two parts) of the
+    forcing lines' measured lines ``owner`` and the rows' measured lines ``la`` (axial), ``lr`` (radial)."""
+    line_of: dict[int, list[int]] = {}
+    for k, j in enumerate(owner):
+        line_of.setdefault(int(j), []).append(k)
+    ax_line = np.array([line_of[int(j)][0] for j in la], dtype=int)
+    rad_parts = np.array([line_of[int(j)] for j in lr], dtype=int).reshape(-1, 2) if lr.size else np.zeros((0, 2), int)
+    return line_of, ax_line, rad_parts
+
+
+def _log_data(meas_lines: list, la: np.ndarray, sa: np.ndarray, aa: np.ndarray, lr: np.ndarray, sr: np.ndarray,
+              pr: np.ndarray, joint_stand: tuple | None) -> tuple[np.ndarray, FittedResonance | None]:
+    """(log amplitude per least-squares row, the stand fitted with the modes or None): the axial rows (line ``la``,
+    speed ``sa`` rad/s, amplitude ``aa`` per channel), then the radial ones (``lr``, ``sr``, x²+y² power ``pr`` per
+    run); with ``joint_stand`` (its start, divided out of the lines) multiplied back: the least squares divides out
+    its own."""
+    log_data = np.concatenate([np.log(np.maximum(aa, 1e-300)), 0.5 * np.log(np.maximum(pr, 1e-300))])
+    if joint_stand is None:
+        return log_data, None
+    h_meas = np.array([x.h for x in meas_lines]) if meas_lines else np.zeros(0)
+    joint = FittedResonance(joint_stand, np.concatenate([h_meas[la] * np.abs(sa), h_meas[lr] * np.abs(sr)]) / (2 * np.pi))
+    return log_data + 0.5 * joint.start_log_gain, joint
+
+
+def _fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tolerance: float, off_law: list,
+               log_w: np.ndarray, declared: Callable[[str, str], None]) -> Solution:
+    """The least squares with ``free_modes``, lines of another law freed (``off_law``, appended in place; ``log_w``
+    ln|Ω| per row: :func:`rwadist.off_law_lines.free_off_law_lines`); with ``declare``, each mode it does not pin is
+    given to ``declared(mode, why)`` (which resets it in ``problem.base``), dropped from ``free_modes`` and the fit
+    repeated."""
+    while True:
+        solution, loose = free_off_law_lines(
+            lambda lns: problem.solve(free_modes, lns), lambda sol: loose_modes(sol, free_modes, problem.base, tolerance),
+            off_law, problem.row_line, log_w)
+        if not loose or not declare:
+            return solution
+        for m, why in loose:
+            declared(m, why)
+            free_modes.remove(m)
+
+
+def _fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple[dict, list]:
+    """(senses, kept lines): the rotation sense of each radial line from its fitted forcing, (direction, h) ->
+    (sense, co-rotating fraction of its power); negligible parts (< 1 % of the line's power) dropped."""
+    senses, kept_lines = {}, []
+    for j, x in enumerate(meas_lines):
+        parts = [fitted_lines[k] for k in line_of[j]]
+        if x.direction not in RADIAL:
+            kept_lines += parts
+            continue
+        p_co, p_ct = parts[0].C ** 2, parts[1].C ** 2
+        fr = p_co / (p_co + p_ct)
+        sense = "co" if fr >= 0.99 else ("counter" if fr <= 0.01 else "co+counter")
+        senses[(x.direction, float(x.h))] = (sense, float(fr))
+        kept_lines += [ln for ln, pw in zip(parts, (p_co, p_ct)) if pw >= 0.01 * (p_co + p_ct) or ln.imbalance]
+    return senses, kept_lines
+
+
+def _residuals_near_modes(params: ext.ExtendedParams, lines: list, ax_line: np.ndarray, rad_parts: np.ndarray,
+                          sa: np.ndarray, sr: np.ndarray, dr: np.ndarray, r: np.ndarray,
+                          notes: list) -> tuple[dict[str, float], tuple[np.ndarray, np.ndarray]]:
+    """(per mode the RMS log residual (dB) of the measurements within ±10 % of its frequency at their speed, (f Hz, r)
+    of every row: :attr:`ExtendedFit.line_residuals`) of the least squares' residuals ``r`` (the axial rows: forcing
+    line ``ax_line``, speed ``sa`` rad/s; then the radial rows: parts ``rad_parts``, speed ``sr``, direction ``dr``);
+    over 1 dB said in ``notes``."""
+    f_ax = np.array([lines[k].h for k in ax_line]) * np.abs(sa) / (2 * np.pi)
+    f_rd = np.array([lines[k].h for k in rad_parts[:, 0]]) * np.abs(sr) / (2 * np.pi) if sr.size else np.empty(0)
+    r_ax, r_rad = r[:sa.size], r[sa.size:]
+    resid_db = {}
+    for m, keys, use_rad, dirs in (("radial_translation", ("radial_translation",), True, ("radial_force",)),
+                                   ("rocking", ("rocking_forward", "rocking_backward"), True, ("radial_torque",)),
+                                   ("axial_translation", ("axial_translation",), False, ("axial_force",))):
+        if use_rad:
+            fm = ext.whirl_frequencies(params, sr)
+            near = np.zeros(sr.size, bool)
+            for key in keys:
+                near |= np.abs(f_rd / fm[key] - 1) < 0.1
+            near &= np.isin(dr, dirs)
+            rr = r_rad[near]
+        else:
+            fm = ext.whirl_frequencies(params, sa)
+            rr = r_ax[np.abs(f_ax / fm[keys[0]] - 1) < 0.1]
+        if rr.size:
+            resid_db[m] = float(20 / np.log(10) * np.sqrt(np.mean(rr**2)))
+            if resid_db[m] > 1.0:
+                notes.append(f"{m}: the linear model misses the data near this mode by {resid_db[m]:.1f} dB RMS "
+                             "(a fixture resonance inside the band -- set f_lim --, nonlinear damping, or a "
+                             "mode the model lacks)")
+    return resid_db, (np.concatenate([f_ax, f_rd]), np.concatenate([r_ax, r_rad]))
+
+
 def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None, radius: float | None = None,
                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
                  progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
@@ -334,285 +507,64 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     more than the other, so the response alone would mislabel a planar load).
     """
     physical = mass is not None and radius is not None
-    notes = []
-    settings = fit.fit_settings
-    if height:
-        sp0 = fit.spectra
-        test = remove_lever_arm(test, height)
-        spectra = compute_spectra(test, nperseg=sp0.nperseg, f_lim=sp0.f_lim, window=sp0.window)
-        fit = fit_empirical(spectra, settings)
-    # every line the data show, with every measurement: the empirical fit without modal
-    # exclusion (with it, lines that are amplified or attenuated at most speeds are dropped); once per fit
-    meas = with_close_lines(test, fit.without_mode_exclusion)      # close lines measured together on the records
-    senses_xy = _line_senses_once(test, meas)
-    stands = ([] if stand is None else [stand]) + list(more_stands)
-    if stands:
-        from .resonance import resonance
-
-        def fixture_gain(x):
-            f = x.h * np.abs(x.speed) / (2 * np.pi)
-            return np.prod([np.abs(resonance(f, *s)) for s in stands], axis=0)
-
-        meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / fixture_gain(x)) for x in meas.lines])
+    notes: list[str] = []
+    test, fit, meas, senses_xy = _measured_lines(test, fit, height, ([] if stand is None else [stand]) + list(more_stands))
     peaks = amplification_peaks(fit)
     la, sa, ca, aa = _measurements(meas)
     keep_ax = np.array([meas.lines[j].direction not in RADIAL for j in la], bool)
     la, sa, ca, aa = la[keep_ax], sa[keep_ax], ca[keep_ax], aa[keep_ax]
     radial = _radial_power(meas.lines)
     scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near)
-    if physical:
-        I_zz, I_rr = ext.thin_disc(mass, radius)
-    else:
-        a_fit = scans["rocking"].inertia_ratio if scans["rocking"].found else 2.0
-        mass, I_rr, I_zz = 1.0, 1.0, float(a_fit)
-        notes.append("mass/radius not given: parameters are per unit mass (M = 1 kg) and per unit transverse "
-                     f"inertia (I_rr = 1 kg·m²); I_zz/I_rr = {a_fit:.3f} "
-                     + ("fitted from the whirls" if scans["rocking"].found else "ASSUMED (thin disc): the rocking "
-                        "whirls do not constrain it"))
+    mass_kg, I_rr, I_zz = _inertias(mass, radius, scans["rocking"], notes)
     f_modes = {m: (sc.f0_hz if sc.found else None) for m, sc in scans.items()}
     f_top = max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines), default=100.0)
-
-    def start_k(mode, inertia, attr):
-        f = f_modes[mode]
-        if f is not None:
-            return inertia * (2 * np.pi * f) ** 2
-        if start is not None and physical:
-            k = getattr(start, attr)
-        else:
-            k = inertia * (2 * np.pi * 3 * f_top) ** 2
-        f_start = math.sqrt(k / inertia) / (2 * np.pi)
-        notes.append(f"{mode}: NOT CONSTRAINED by the data ({scans[mode].reason}); its {f_start:.4g} Hz is a "
-                     "starting value, listed in analytical.unconstrained")
-        return k
-
-    k_r = start_k("radial_translation", mass, "k_r")
+    start_k = _StartStiffness(f_modes, scans, start, physical, f_top, notes)
+    k_r = start_k("radial_translation", mass_kg, "k_r")
     k_rock = start_k("rocking", I_rr, "k_rock")
-    k_z = start_k("axial_translation", mass, "k_z")
-    # forcing lines: axial one coefficient; radial a co- and a counter-rotating part, started
-    # from the x/y-phase split (floored so both can grow)
-    lines, owner = [], []
-    for j, x in enumerate(meas.lines):
-        if x.direction in RADIAL:
-            fr = senses_xy.get((x.direction, float(x.h)), ("co", 1.0))[1]
-            c_co, c_ct = x.C * max(math.sqrt(fr), 0.03), x.C * max(math.sqrt(1 - fr), 0.03)
-            imb = abs(x.h - 1.0) <= ext.IMBALANCE_H_TOL
-            lines.append(ext.Line(x.direction, 1.0 if imb else float(x.h), float(c_co), "co", imbalance=imb))
-            lines.append(ext.Line(x.direction, float(x.h), float(c_ct), "counter"))
-            owner += [j, j]
-        else:
-            lines.append(ext.Line(x.direction, float(x.h), float(x.C), "co"))
-            owner.append(j)
-    if not lines:
-        raise DataError("empirical fit", "harmonics", "none: nothing to fit the extended model to (lower `presence`)")
-    owner = np.array(owner)
-    # axial measurements: per channel amplitude; radial: x²+y² power per run
+    k_z = start_k("axial_translation", mass_kg, "k_z")
+    lines, owner = _forcing_lines(meas.lines, senses_xy)
     lr, sr, pr, dr = radial
-    line_of = {}
-    for k, j in enumerate(owner):
-        line_of.setdefault(int(j), []).append(k)
-    ax_line = np.array([line_of[int(j)][0] for j in la], int)
-    rad_parts = np.array([line_of[int(j)] for j in lr], int).reshape(-1, 2) if lr.size else np.zeros((0, 2), int)
-
-    identified = {m: f_modes[m] is not None for m in _MODE_PARAMS}
-    z_start = {m: (scans[m].zeta if identified[m] else zeta0) for m in _MODE_PARAMS}
-    base = dict(mass=mass, I_zz=I_zz, I_rr=I_rr, k_r=k_r, k_rock=k_rock, k_z=k_z, height=0.0,
-                c_r=2 * z_start["radial_translation"] * math.sqrt(k_r * mass),
-                c_rock=2 * z_start["rocking"] * math.sqrt(k_rock * I_rr),
-                c_z=2 * z_start["axial_translation"] * math.sqrt(k_z * mass), U_s=0.0, U_d=0.0)
-    x_lines = np.log([ln.C for ln in lines])
-
-    power = LinePower(lines, sa, ax_line, ca, sr, rad_parts)
-    log_data = np.concatenate([np.log(np.maximum(aa, 1e-300)), 0.5 * np.log(np.maximum(pr, 1e-300))])
-    h_meas = np.array([x.h for x in meas.lines]) if meas.lines else np.zeros(0)
-    f_rows = np.concatenate([h_meas[la] * np.abs(sa), h_meas[lr] * np.abs(sr)]) / (2 * np.pi)
-    joint = None
-    if fit_stand and stand is not None:
-        from .resonance import FittedResonance
-        joint = FittedResonance(stand, f_rows)
-        # the start stand multiplied back: the least squares divides out its own
-        log_data = log_data + 0.5 * joint.start_log_gain
-
+    line_of, ax_line, rad_parts = _rows_of_lines(owner, la, lr)
+    identified = {m: f_modes[m] is not None for m in MODE_PARAMS}
+    z_start = {m: (scans[m].zeta if identified[m] else zeta0) for m in MODE_PARAMS}
+    base = dict(mass=mass_kg, I_zz=I_zz, I_rr=I_rr, k_r=k_r, k_rock=k_rock, k_z=k_z, height=0.0, U_s=0.0, U_d=0.0)
+    for m, (kn, cn, inertia) in MODE_PARAMS.items():        # damping ratio z_start[m]
+        base[cn] = 2 * z_start[m] * math.sqrt(base[kn] * base[inertia])
+    log_data, joint = _log_data(meas.lines, la, sa, aa, lr, sr, pr, stand if fit_stand else None)
     row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
+    problem = LogAmplitudeProblem(base, lines, LinePower(lines, sa, ax_line, ca, sr, rad_parts), log_data, joint,
+                                  row_line, centred_log_w, meas.lines, progress)
 
-    def least_squares(free_modes, off_law=()):
-        """Log-amplitude least squares with the stiffness and damping of ``free_modes`` free, and an exponent of
-        their own for the measured lines ``off_law`` (indices into ``meas.lines``,
-        :func:`rwadist.off_law_lines.off_law_line`)."""
-        names = [p for m in free_modes for p in _MODE_PARAMS[m][:2]] + \
-                [f"C[{ln.direction},{ln.h:g},{ln.sense}]" for ln in lines] + \
-                [f"p-2[{meas.lines[j].direction},{meas.lines[j].h:g}]" for j in off_law] + \
-                (list(joint.NAMES) if joint else [])
-        x0 = np.concatenate([np.log([base[n] for m in free_modes for n in _MODE_PARAMS[m][:2]]), x_lines,
-                             np.zeros(len(off_law))] + ([joint.x0] if joint else []))
-        n_off = len(off_law)
-        n_mode = 2 * len(free_modes)
-        n_c = len(lines)
-        off_rows = [np.where(row_line == j, centred_log_w, 0.0) for j in off_law]
+    def declared(m: str, why: str) -> None:
+        """Mode ``m`` not pinned by the least squares: back to its start, NOT CONSTRAINED."""
+        scans[m].reason = why
+        scans[m].found = False
+        identified[m] = False
+        f_modes[m] = None
+        kn, cn, inertia = MODE_PARAMS[m]
+        base[kn] = start_k(m, base[inertia], kn)
+        base[cn] = 2 * zeta0 * math.sqrt(base[kn] * base[inertia])
 
-        def unpack(theta):
-            vals = dict(base)
-            k = 0
-            for m in free_modes:
-                kn, cn, inertia = _MODE_PARAMS[m]
-                vals[kn] = math.exp(theta[k])
-                # damping stays below critical (the model refuses overdamped modes)
-                vals[cn] = min(math.exp(theta[k + 1]), 1.9 * math.sqrt(vals[kn] * vals[inertia]))
-                k += 2
-            C = np.exp(theta[n_mode:n_mode + n_c])
-            lns = [replace(ln, C=float(c)) for ln, c in zip(lines, C)]
-            vals["U_s"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_force"), 0.0)
-            vals["U_d"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_torque"), 0.0)
-            return ext.ExtendedParams(**vals), lns
-
-        last = {}
-
-        def evaluate(theta):
-            """Residuals and their analytic Jacobian at ``theta`` (computed once per point: scipy asks for
-            the residuals and then the Jacobian at the same point)."""
-            key = theta.tobytes()
-            if last.get("key") != key:
-                vals = dict(base)
-                clamped = {}
-                for i, m in enumerate(free_modes):
-                    kn, cn, inertia = _MODE_PARAMS[m]
-                    vals[kn] = math.exp(theta[2 * i])
-                    crit = 1.9 * math.sqrt(vals[kn] * vals[inertia])
-                    clamped[m] = math.exp(theta[2 * i + 1]) > crit
-                    vals[cn] = min(math.exp(theta[2 * i + 1]), crit)
-                if joint is None:
-                    r, d_mode, d_C = power.log_residuals(vals, theta[n_mode:n_mode + n_c], log_data)
-                    J = np.zeros((r.size, theta.size))
-                else:
-                    # the stand divided out at its own parameters: r = ln data − ln|H| − ½ ln P
-                    y_s, dy_s = joint.log_gain(theta[n_mode + n_c + n_off:])
-                    r, d_mode, d_C = power.log_residuals(vals, theta[n_mode:n_mode + n_c], log_data - 0.5 * y_s)
-                    J = np.zeros((r.size, theta.size))
-                    J[:, n_mode + n_c + n_off:] = -0.5 * dy_s
-                for i, L in enumerate(off_rows):      # a freed line's own growth (|Ω|/Ω_line)^δ
-                    r = r - theta[n_mode + n_c + i] * L
-                    J[:, n_mode + n_c + i] = -L
-                for i, m in enumerate(free_modes):
-                    dk, dc = d_mode[m]
-                    # a clamped damping follows the stiffness (c = 1.9·sqrt(k·inertia): d ln c / d ln k = 1/2)
-                    J[:, 2 * i] = dk + 0.5 * dc if clamped[m] else dk
-                    J[:, 2 * i + 1] = 0.0 if clamped[m] else dc
-                J[:, n_mode:n_mode + n_c] = d_C
-                last.update(key=key, r=r, J=J)
-            return last
-
-        # bounds keep the search physical: stiffness within ±10 % of the scan's (frequency ±5 %),
-        # damping ratio in [5e-5, 0.95], line coefficients within 1000x (down to 1e-4 of the line
-        # for the sense parts, which may vanish)
-        lo, hi = [], []
-        for m in free_modes:
-            kn, cn, inertia = _MODE_PARAMS[m]
-            crit = 2 * math.sqrt(base[kn] * base[inertia])
-            lo += [math.log(base[kn] / 1.1), math.log(1e-4 * crit / 2)]
-            hi += [math.log(base[kn] * 1.1), math.log(0.95 * crit * 2)]
-        lo += list(x0[n_mode:n_mode + n_c] - math.log(1e4)) + [-3.0] * len(off_law) + \
-            (list(joint.lower) if joint else [])
-        hi += list(x0[n_mode:n_mode + n_c] + math.log(1e3)) + [3.0] * len(off_law) + \
-            (list(joint.upper) if joint else [])
-        res = optimize.least_squares(lambda th: evaluate(th)["r"], x0, jac=lambda th: evaluate(th)["J"],
-                                     bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
-                                     verbose=2 if progress else 0)
-        dof = max(res.fun.size - res.x.size, 1)
-        s2 = float(np.sum(res.fun**2) / dof)
-        try:
-            rel_se = np.sqrt(np.clip(np.diag(np.linalg.pinv(res.jac.T @ res.jac) * s2), 0, None))
-        except np.linalg.LinAlgError:
-            rel_se = np.full(res.x.size, np.nan)
-        # a limit is what the fit allowed, not what the data say: stiffness at ±10 %, damping at its floor ζ = 5e-5 (a
-        # stand beside a load-cell offset was taken for the translation so, -19 %)
-        at_bound = {m: ("stiffness" if min(res.x[2 * i] - lo[2 * i], hi[2 * i] - res.x[2 * i]) < 0.01 else
-                        "damping" if res.x[2 * i + 1] - lo[2 * i + 1] < 0.01 else "")
-                    for i, m in enumerate(free_modes)}
-        return res, names, rel_se, unpack, at_bound
-
-    # found: the least squares pins the frequency (1.5 standard errors of f = sqrt(k/m)/2π, half k's relative error,
-    # within the tolerance) away from the bounds; else back to its start, declared, and the fit repeated without it
-    def loose_modes(res, rel_se, at_bound, free_modes):
-        loose = []
-        for i, m in enumerate(free_modes):
-            se_f = 0.5 * float(rel_se[2 * i])
-            if at_bound[m] or not (1.5 * se_f <= tolerance):
-                f_fit = math.sqrt(math.exp(res.x[2 * i]) / base[_MODE_PARAMS[m][2]]) / (2 * np.pi)
-                loose.append((m, {"stiffness": "the best fit sits at the ±5 % limit around the scan's frequency",
-                                  "damping": f"located at {f_fit:.4g} Hz but its damping runs to the fit's floor (ζ = "
-                                  "5e-05): the data show no damped peak there (a resonance of the test stand?)"}.get(
-                    at_bound[m], f"located at {f_fit:.4g} Hz but only to ±{100 * 1.5 * se_f:.1f} % (1.5 standard "
-                                 f"errors), not {100 * tolerance:g} %")))
-        return loose
-
-    free_modes = [m for m in _MODE_PARAMS if identified[m]]
-    off_law = []            # lines given an exponent of their own before a mode is declared (appended in place)
-    while True:
-        (res, names, rel_se, unpack, at_bound), loose = free_off_law_lines(
-            lambda lns: least_squares(free_modes, lns), lambda t: loose_modes(t[0], t[2], t[4], free_modes),
-            off_law, row_line, log_w)
-        if not loose or not declare:
-            break
-        for m, why in loose:
-            scans[m].reason = why
-            scans[m].found = False
-            identified[m] = False
-            f_modes[m] = None
-            kn, cn, inertia = _MODE_PARAMS[m]
-            base[kn] = start_k(m, base[inertia], kn)
-            base[cn] = 2 * zeta0 * math.sqrt(base[kn] * base[inertia])
-            free_modes.remove(m)
+    off_law: list[int] = []     # lines given an exponent of their own before a mode is declared (appended in place)
+    res, names, rel_se, unpack, _ = _fit_modes(problem, [m for m in MODE_PARAMS if identified[m]], declare,
+                                               tolerance, off_law, log_w, declared)
     params, fitted_lines = unpack(res.x)
-    n_st = len(joint.NAMES) if joint else 0
-    n_x = res.x.size - n_st
+    n_x = res.x.size - (len(joint.NAMES) if joint is not None else 0)
     notes += [off_law_note(meas.lines[j], res.x[n_x + i - len(off_law)], rel_se[n_x + i - len(off_law)])
               for i, j in enumerate(off_law)]
     if joint is not None:
         stand = joint.stand(res.x[n_x:])
     params = replace(params, height=float(height))
-    rel_stderr = {n: float(v) for n, v in zip(names, rel_se)}
-    zeta = {"radial_translation": params.zeta_r, "rocking": params.zeta_rock, "axial_translation": params.zeta_z}
-    # rotation sense from the fitted forcing; negligible parts (< 1 % of the line's power) dropped
-    senses, kept_lines = {}, []
-    for j, x in enumerate(meas.lines):
-        parts = [fitted_lines[k] for k in line_of[j]]
-        if x.direction not in RADIAL:
-            kept_lines += parts
-            continue
-        p_co, p_ct = parts[0].C ** 2, parts[1].C ** 2
-        fr = p_co / (p_co + p_ct)
-        sense = "co" if fr >= 0.99 else ("counter" if fr <= 0.01 else "co+counter")
-        senses[(x.direction, float(x.h))] = (sense, float(fr))
-        kept_lines += [ln for ln, pw in zip(parts, (p_co, p_ct)) if pw >= 0.01 * (p_co + p_ct) or ln.imbalance]
-    # residual near each mode: measurements within ±10 % of the mode frequency at their speed
-    resid_db = {}
-    f_ax = np.array([lines[k].h for k in ax_line]) * np.abs(sa) / (2 * np.pi)
-    f_rd = np.array([lines[k].h for k in rad_parts[:, 0]]) * np.abs(sr) / (2 * np.pi) if lr.size else np.empty(0)
-    r_ax, r_rad = res.fun[:sa.size], res.fun[sa.size:]
-    for m, keys, use_rad, dirs in (("radial_translation", ("radial_translation",), True, ("radial_force",)),
-                                   ("rocking", ("rocking_forward", "rocking_backward"), True, ("radial_torque",)),
-                                   ("axial_translation", ("axial_translation",), False, ("axial_force",))):
-        if use_rad:
-            fm = ext.whirl_frequencies(params, sr)
-            near = np.zeros(sr.size, bool)
-            for key in keys:
-                near |= np.abs(f_rd / fm[key] - 1) < 0.1
-            near &= np.isin(dr, dirs)
-            rr = r_rad[near]
-        else:
-            fm = ext.whirl_frequencies(params, sa)
-            rr = r_ax[np.abs(f_ax / fm[keys[0]] - 1) < 0.1]
-        if rr.size:
-            resid_db[m] = float(20 / np.log(10) * np.sqrt(np.mean(rr**2)))
-            if resid_db[m] > 1.0:
-                notes.append(f"{m}: the linear model misses the data near this mode by {resid_db[m]:.1f} dB RMS "
-                             "(a fixture resonance inside the band -- set f_lim --, nonlinear damping, or a "
-                             "mode the model lacks)")
-    unconstrained = [UNCONSTRAINED_NAME[m] for m in _MODE_PARAMS if not identified[m]]
-    return ExtendedFit(params=params, lines=kept_lines, zeta=zeta, rel_stderr=rel_stderr, identified=identified,
+    senses, kept_lines = _fitted_senses(meas.lines, fitted_lines, line_of)
+    resid_db, line_residuals = _residuals_near_modes(params, lines, ax_line, rad_parts, sa, sr, dr, res.fun, notes)
+    return ExtendedFit(params=params, lines=kept_lines,
+                       zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
+                             "axial_translation": params.zeta_z},
+                       rel_stderr={n: float(v) for n, v in zip(names, rel_se)}, identified=identified,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
-                       unconstrained=unconstrained, scans=scans, per_unit=not physical,
-                       stand=None if stand is None else tuple(float(v) for v in stand),
-                       line_residuals=(np.concatenate([f_ax, f_rd]), np.concatenate([r_ax, r_rad])))
+                       unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not identified[m]], scans=scans,
+                       per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
+                       line_residuals=line_residuals)
 
 
 # --------------------------------------------------------------------------- 4. comparison
@@ -675,7 +627,7 @@ def unresolved_spans(fit: EmpiricalFit) -> list:
     for d in sorted({b.direction for b in fit.bins}):
         hs = sorted(b.h for b in fit.bins if b.direction == d and not b.kept
                     and b.reason.startswith("no measurement resolved"))
-        spans = []
+        spans: list[list[float]] = []      # [h_min, h_max] of each run of close lost lines
         for h in hs:
             if spans and h - spans[-1][1] < close:
                 spans[-1][1] = h

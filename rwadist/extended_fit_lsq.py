@@ -1,0 +1,202 @@
+"""Step 3 of the extended fit (:func:`rwadist.extended_fit.fit_extended`): the least squares of log line amplitudes.
+
+The stiffness and damping of each mode left free, the forcing coefficient of each line (a radial line: its co- and
+counter-rotating parts), an exponent of its own for a line of another law than C·Ω² (:mod:`rwadist.off_law_lines`) and,
+when fitted with the modes, the fixture resonance's parameters (:class:`rwadist.resonance.FittedResonance`) are
+adjusted together on every measured line at every speed; standard errors come from the Jacobian.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import NamedTuple
+
+import numpy as np
+from scipy import optimize
+
+from . import extended as ext
+from .extended_fit_power import LinePower
+from .resonance import FittedResonance
+
+#: mode -> (its stiffness, its damping, the inertia they act on): fields of :class:`rwadist.extended.ExtendedParams`
+MODE_PARAMS = {"radial_translation": ("k_r", "c_r", "mass"), "rocking": ("k_rock", "c_rock", "I_rr"),
+               "axial_translation": ("k_z", "c_z", "mass")}
+
+
+class Solution(NamedTuple):
+    """One least squares of :meth:`LogAmplitudeProblem.solve`.
+
+    res : scipy's result (``res.x`` θ: ln k, ln c of each free mode, ln C of each line, the freed lines' exponent
+        shifts, the stand's parameters; ``res.fun`` the log residuals, the axial rows then the radial ones).
+    names : the name of each entry of θ.
+    rel_se : relative standard error of each entry of θ (the standard error of its logarithm), shape like ``res.x``.
+    unpack : θ -> (:class:`~rwadist.extended.ExtendedParams`, fitted lines).
+    at_bound : per free mode, the limit its best fit sits at ("stiffness", "damping") or "".
+    """
+
+    res: optimize.OptimizeResult
+    names: list[str]
+    rel_se: np.ndarray
+    unpack: Callable[[np.ndarray], tuple[ext.ExtendedParams, list[ext.Line]]]
+    at_bound: dict[str, str]
+
+
+@dataclass
+class LogAmplitudeProblem:
+    """What the least squares fits, fixed across its repetitions (a mode declared not constrained is reset in
+    ``base`` and left out of the next).
+
+    base : the :class:`~rwadist.extended.ExtendedParams` fields at the start (SI).
+    lines : the forcing lines at their starting coefficients (a radial line: a co- and a counter-rotating part).
+    power : the model's line power at every measured row (:class:`rwadist.extended_fit_power.LinePower`).
+    log_data : the rows' measured log amplitudes, shape (rows,) (with ``joint``: the start stand multiplied back).
+    joint : the fixture resonance fitted with the modes, or None.
+    row_line, centred_log_w : per row its measured line and centred ln|Ω| (:func:`rwadist.off_law_lines.line_regressors`).
+    meas_lines : the measured lines (LineFit list), named by the exponents freed.
+    progress : scipy's iteration printout.
+    """
+
+    base: dict
+    lines: list
+    power: LinePower
+    log_data: np.ndarray
+    joint: FittedResonance | None
+    row_line: np.ndarray
+    centred_log_w: np.ndarray
+    meas_lines: list
+    progress: bool = False
+
+    def solve(self, free_modes: list[str], off_law: Sequence[int] = ()) -> Solution:
+        """Log-amplitude least squares with the stiffness and damping of ``free_modes`` free, and an exponent of
+        their own for the measured lines ``off_law`` (indices into ``meas_lines``,
+        :func:`rwadist.off_law_lines.off_law_line`)."""
+        base, lines, joint = self.base, self.lines, self.joint
+        names = [p for m in free_modes for p in MODE_PARAMS[m][:2]] + \
+                [f"C[{ln.direction},{ln.h:g},{ln.sense}]" for ln in lines] + \
+                [f"p-2[{self.meas_lines[j].direction},{self.meas_lines[j].h:g}]" for j in off_law] + \
+                (list(joint.NAMES) if joint is not None else [])
+        x0 = np.concatenate([np.log([base[n] for m in free_modes for n in MODE_PARAMS[m][:2]]),
+                             np.log([ln.C for ln in lines]), np.zeros(len(off_law))]
+                            + ([joint.x0] if joint is not None else []))
+        n_mode = 2 * len(free_modes)
+        n_c = len(lines)
+        residuals = _Residuals(self, free_modes, [np.where(self.row_line == j, self.centred_log_w, 0.0)
+                                                  for j in off_law])
+        # bounds keep the search physical: stiffness within ±10 % of the scan's (frequency ±5 %),
+        # damping ratio in [5e-5, 0.95], line coefficients within 1000x (down to 1e-4 of the line
+        # for the sense parts, which may vanish)
+        lo, hi = [], []
+        for m in free_modes:
+            kn, cn, inertia = MODE_PARAMS[m]
+            crit = 2 * math.sqrt(base[kn] * base[inertia])
+            lo += [math.log(base[kn] / 1.1), math.log(1e-4 * crit / 2)]
+            hi += [math.log(base[kn] * 1.1), math.log(0.95 * crit * 2)]
+        lo += list(x0[n_mode:n_mode + n_c] - math.log(1e4)) + [-3.0] * len(off_law) + \
+            (list(joint.lower) if joint is not None else [])
+        hi += list(x0[n_mode:n_mode + n_c] + math.log(1e3)) + [3.0] * len(off_law) + \
+            (list(joint.upper) if joint is not None else [])
+        res = optimize.least_squares(residuals.residuals, x0, jac=residuals.jacobian,
+                                     bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
+                                     verbose=2 if self.progress else 0)
+        dof = max(res.fun.size - res.x.size, 1)
+        s2 = float(np.sum(res.fun**2) / dof)
+        try:
+            rel_se = np.sqrt(np.clip(np.diag(np.linalg.pinv(res.jac.T @ res.jac) * s2), 0, None))
+        except np.linalg.LinAlgError:
+            rel_se = np.full(res.x.size, np.nan)
+        # a limit is what the fit allowed, not what the data say: stiffness at ±10 %, damping at its floor ζ = 5e-5 (a
+        # stand beside a load-cell offset was taken for the translation so, -19 %)
+        at_bound = {m: ("stiffness" if min(res.x[2 * i] - lo[2 * i], hi[2 * i] - res.x[2 * i]) < 0.01 else
+                        "damping" if res.x[2 * i + 1] - lo[2 * i + 1] < 0.01 else "")
+                    for i, m in enumerate(free_modes)}
+        modes = list(free_modes)        # as solved (the caller's list loses the modes it declares next)
+        return Solution(res, names, rel_se, lambda theta: self.unpack(modes, theta), at_bound)
+
+    def unpack(self, free_modes: list[str], theta: np.ndarray) -> tuple[ext.ExtendedParams, list[ext.Line]]:
+        """(parameters, fitted lines) of θ of the least squares with ``free_modes`` free."""
+        vals = dict(self.base)
+        k = 0
+        for m in free_modes:
+            kn, cn, inertia = MODE_PARAMS[m]
+            vals[kn] = math.exp(theta[k])
+            # damping stays below critical (the model refuses overdamped modes)
+            vals[cn] = min(math.exp(theta[k + 1]), 1.9 * math.sqrt(vals[kn] * vals[inertia]))
+            k += 2
+        n_mode, n_c = 2 * len(free_modes), len(self.lines)
+        C = np.exp(theta[n_mode:n_mode + n_c])
+        lns = [replace(ln, C=float(c)) for ln, c in zip(self.lines, C)]
+        vals["U_s"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_force"), 0.0)
+        vals["U_d"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_torque"), 0.0)
+        return ext.ExtendedParams(**vals), lns
+
+
+class _Residuals:
+    """The log residuals of a :class:`LogAmplitudeProblem` and their analytic Jacobian at θ, computed once per point
+    (scipy asks for the residuals and then the Jacobian at the same point); ``off_rows``: the regressor of each freed
+    exponent."""
+
+    def __init__(self, problem: LogAmplitudeProblem, free_modes: list[str], off_rows: list[np.ndarray]):
+        self.problem, self.free_modes, self.off_rows = problem, free_modes, off_rows
+        self.key: bytes | None = None
+        self.r = np.empty(0)
+        self.J = np.empty((0, 0))
+
+    def residuals(self, theta: np.ndarray) -> np.ndarray:
+        self._at(theta)
+        return self.r
+
+    def jacobian(self, theta: np.ndarray) -> np.ndarray:
+        self._at(theta)
+        return self.J
+
+    def _at(self, theta: np.ndarray) -> None:
+        key = theta.tobytes()
+        if self.key == key:
+            return
+        p, free_modes = self.problem, self.free_modes
+        n_mode, n_c, n_off = 2 * len(free_modes), len(p.lines), len(self.off_rows)
+        vals = dict(p.base)
+        clamped = {}
+        for i, m in enumerate(free_modes):
+            kn, cn, inertia = MODE_PARAMS[m]
+            vals[kn] = math.exp(theta[2 * i])
+            crit = 1.9 * math.sqrt(vals[kn] * vals[inertia])
+            clamped[m] = math.exp(theta[2 * i + 1]) > crit
+            vals[cn] = min(math.exp(theta[2 * i + 1]), crit)
+        if p.joint is None:
+            r, d_mode, d_C = p.power.log_residuals(vals, theta[n_mode:n_mode + n_c], p.log_data)
+            J = np.zeros((r.size, theta.size))
+        else:
+            # the stand divided out at its own parameters: r = ln data − ln|H| − ½ ln P
+            y_s, dy_s = p.joint.log_gain(theta[n_mode + n_c + n_off:])
+            r, d_mode, d_C = p.power.log_residuals(vals, theta[n_mode:n_mode + n_c], p.log_data - 0.5 * y_s)
+            J = np.zeros((r.size, theta.size))
+            J[:, n_mode + n_c + n_off:] = -0.5 * dy_s
+        for i, L in enumerate(self.off_rows):      # a freed line's own growth (|Ω|/Ω_line)^δ
+            r = r - theta[n_mode + n_c + i] * L
+            J[:, n_mode + n_c + i] = -L
+        for i, m in enumerate(free_modes):
+            dk, dc = d_mode[m]
+            # a clamped damping follows the stiffness (c = 1.9·sqrt(k·inertia): d ln c / d ln k = 1/2)
+            J[:, 2 * i] = dk + 0.5 * dc if clamped[m] else dk
+            J[:, 2 * i + 1] = 0.0 if clamped[m] else dc
+        J[:, n_mode:n_mode + n_c] = d_C
+        self.key, self.r, self.J = key, r, J
+
+
+def loose_modes(solution: Solution, free_modes: list[str], base: dict, tolerance: float) -> list[tuple[str, str]]:
+    """(mode, why) of each free mode the least squares does not pin: found means its frequency pinned (1.5 standard
+    errors of f = sqrt(k/m)/2π, half k's relative error, within ``tolerance``) away from the bounds."""
+    res, rel_se, at_bound = solution.res, solution.rel_se, solution.at_bound
+    loose = []
+    for i, m in enumerate(free_modes):
+        se_f = 0.5 * float(rel_se[2 * i])
+        if at_bound[m] or not (1.5 * se_f <= tolerance):
+            f_fit = math.sqrt(math.exp(res.x[2 * i]) / base[MODE_PARAMS[m][2]]) / (2 * np.pi)
+            loose.append((m, {"stiffness": "the best fit sits at the ±5 % limit around the scan's frequency",
+                              "damping": f"located at {f_fit:.4g} Hz but its damping runs to the fit's floor (ζ = "
+                              "5e-05): the data show no damped peak there (a resonance of the test stand?)"}.get(
+                at_bound[m], f"located at {f_fit:.4g} Hz but only to ±{100 * 1.5 * se_f:.1f} % (1.5 standard "
+                             f"errors), not {100 * tolerance:g} %")))
+    return loose
