@@ -4,7 +4,7 @@
 2. HR16-75: fundamental |F|/(U_s·Ω²) and |T|/(U_d·Ω²) at 3000 and 6000 rpm, by default and with
    --assumed-modes, in both FMUs, in `rwadist psd` (line envelope), in the coupling kit (blocked lines of
    coupling.wheel_spec_from_model) and in a `psd --wheels` set (rwadist.mounting.load_wheels);
-3. native FMU vs pythonfmu FMU vs rwadist.extended.simulate_time, spin-up 0→3000 rpm and reversal ±1500 rpm,
+3. native FMU vs pythonfmu FMU vs rwadist.extended_time.simulate_time, spin-up 0→3000 rpm and reversal ±1500 rpm,
    every effect class on (simulate_time: the line effects; it has no ripple or floor);
 4. floor multisine, native vs pythonfmu, same seed;
 5. fmpy validate problems and ldd of the native binary.
@@ -39,6 +39,7 @@ from test_fmu_native import (  # noqa: E402
 from rwadist import catalogue  # noqa: E402
 from rwadist import extended as ext  # noqa: E402
 from rwadist import model as model_io  # noqa: E402
+from rwadist.extended_time import simulate_time  # noqa: E402
 from rwadist.fmu import hosts  # noqa: E402
 from rwadist.fmu.build import build_fmu  # noqa: E402
 from rwadist.fmu.native_build import build_native_fmu  # noqa: E402
@@ -126,7 +127,7 @@ def main() -> int:
             inputs = {"wheel_speed": w, "wheel_acceleration": slope(tt, w)}
             a = hosts.run_fmpy(native, tt, inputs, mount_params(5))
             b = hosts.run_fmpy(python, tt, inputs, mount_params(5))
-            ref = ext.simulate_time(p, ext.lines_from_model(m, p), tt, w, seed=5)
+            ref = simulate_time(p, ext.lines_from_model(m, p), tt, w, seed=5)
             c = hosts.run_fmpy(native_l, tt, inputs, {"use_wheel_acceleration": True, "seed": 5})
             print(f"3. {profile.__name__:8s}: native vs pythonfmu (every effect) {np.max(worst(a, b)):.2e}; "
                   f"native vs simulate_time (line effects) {np.max(worst(c[:, :6], ref)):.2e} (relative to peak)")

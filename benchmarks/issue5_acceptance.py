@@ -3,7 +3,7 @@
     python benchmarks/issue5_acceptance.py
 
 FMU (built here, with its native layer where a C compiler is found) against
-rwadist.extended.simulate_time through fmpy and libcosim; constant-speed line amplitudes against
+rwadist.extended_time.simulate_time through fmpy and libcosim; constant-speed line amplitudes against
 C·Ω²·|modal gain|; fmpy validation; step-size convergence; the FMI status and message of each bad
 input.  The timing benchmark is benchmarks/bench_fmu.py.
 """

@@ -54,7 +54,6 @@ Units: N²/Hz, N·(N·m)/Hz, (N·m)²/Hz; frequencies Hz; speeds rad/s.
 """
 from __future__ import annotations
 
-import importlib
 import math
 from dataclasses import dataclass, field
 
@@ -548,23 +547,3 @@ def _interp_columns(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray
     out += np.take(fp, j, axis=0)
     out[x.size - np.count_nonzero(x == xp[-1]):] = fp[-1]     # x at the grid's end (the last ones: x ascending)
     return out
-
-
-# =========================================================================== files and plots
-# in rwadist.psd_files (it builds on this module); its public names stay importable from here
-
-_MOVED = {name: "psd_files" for name in ("write_psd_csv", "cross_columns", "write_cross_csv", "read_psd_csv",
-                                        "write_hdf5", "plot_psd", "write_envelope_csv")}
-
-
-def __getattr__(name: str):
-    """The public names of :mod:`rwadist.psd_files` (PEP 562: imported on first use, so that module
-    imports this one and not the other way round)."""
-    module = _MOVED.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f".{module}", __package__), name)
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_MOVED))

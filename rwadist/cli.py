@@ -487,7 +487,7 @@ def _write_psd(res, out: Path, args, title: str) -> tuple:
     """The PSD's files, swapped in as ONE set (a kill never leaves a new table beside old cross-spectra): the table
     (CSV or NASTRAN), the cross-spectra, the line envelope, the plot and, on assumed modes, the note; an older
     companion this run does not write is removed with the set.  Returns (envelope, png)."""
-    from . import broadband as bb
+    from . import psd_files
     from .nastran import left_out_text
 
     stem = out.with_suffix("")
@@ -510,18 +510,18 @@ def _write_psd(res, out: Path, args, title: str) -> tuple:
                      + ("AUTO-SPECTRA ONLY: " + left_out_text(res) if auto_only else
                         "auto- and cross-spectra: the full 6x6") + ")")
         else:
-            bb.write_psd_csv(res, outs.file(out))
+            psd_files.write_psd_csv(res, outs.file(out))
             wrote = f"wrote PSD table {out}"
         for fmt, path in cross_path.items():        # one cross-spectra file, or none: an older one is removed
             if args.cross != fmt:
                 outs.remove(path)
         if args.cross == "csv":
-            bb.write_cross_csv(res, outs.file(cross_path["csv"]))
+            psd_files.write_cross_csv(res, outs.file(cross_path["csv"]))
         elif args.cross == "h5":
-            bb.write_hdf5(res, outs.file(cross_path["h5"]), "csd")
-        bb.write_envelope_csv(res.meta["envelope"], outs.file(sibling["_envelope.csv"]))
+            psd_files.write_hdf5(res, outs.file(cross_path["h5"]), "csd")
+        psd_files.write_envelope_csv(res.meta["envelope"], outs.file(sibling["_envelope.csv"]))
         with working("drawing the PSD plot"):
-            save_png(bb.plot_psd(res, title), outs.file(sibling[".png"]), dpi=110)
+            save_png(psd_files.plot_psd(res, title), outs.file(sibling[".png"]), dpi=110)
     print(wrote)
     if args.cross in cross_path:
         print(f"cross-spectra: {cross_path[args.cross]}" + (" (group /csd)" if args.cross == "h5" else ""))

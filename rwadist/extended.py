@@ -66,7 +66,6 @@ frequencies returned as Hz.
 """
 from __future__ import annotations
 
-import importlib
 import math
 from dataclasses import dataclass, fields, replace
 
@@ -617,27 +616,3 @@ def steady_rms(p: ExtendedParams, lines, omega, f_max: float | None = None) -> n
     f, a = steady_lines(p, lines, omega)
     keep = np.ones_like(f, dtype=bool) if f_max is None else f <= f_max
     return np.sqrt(np.sum(np.abs(a) ** 2 * keep[..., None] / 2.0, axis=1))
-
-
-# ---------------------------------------------------------------- the rest of the extended model
-# The speed ripple (rwadist.extended_ripple) and the time-domain simulation (rwadist.extended_time)
-# live in their own modules, which build on this one; their public names stay importable from here.
-
-_MOVED = {
-    **{name: "extended_ripple" for name in ("Ripple", "ripple_from_effects", "ripple_k_max", "ripple_coefficients",
-                                            "ripple_order", "ripple_lines")},
-    **{name: "extended_time" for name in ("simulate_time", "channel_index")},
-}
-
-
-def __getattr__(name: str):
-    """The public names of :mod:`rwadist.extended_ripple` and :mod:`rwadist.extended_time` (PEP 562;
-    imported on first use, so the modules import this one and not the other way round)."""
-    module = _MOVED.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f".{module}", __package__), name)
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_MOVED))

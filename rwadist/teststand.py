@@ -62,7 +62,7 @@ closed form :func:`rwadist.extended.steady_lines` at each run speed with, per ru
 a uniform random phase for each non-imbalance line and *one* random phase β
 shared by the two imbalances: static at β, dynamic at β + ``imbalance_phase``
 (a fixed property of the rotor), so the 1× torque/force ratio is the same in
-every run.  Sweeps are :func:`rwadist.extended.simulate_time` (exact modal
+every run.  Sweeps are :func:`rwadist.extended_time.simulate_time` (exact modal
 integration, phases h·∫Ω dt, tangential imbalance force U·Ω̇, closed-form steady
 state at the first sample) with one set of phases drawn per sweep.  Fixture
 resonances (``test_stand_modes``, fixed frequency) act in both physics; with
@@ -401,7 +401,7 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
     noise : relative sensor noise, std = noise · C_1 · Ω_max², Ω_max the sweep's largest |Ω|.
     tach : store Ω(t) (rad/s) in ``Sweep.tach``; else None.
     Lines are built one harmonic at a time (memory ~ a few arrays of the record length).
-    physics : "simple" (above, the default) or "extended": :func:`rwadist.extended.simulate_time` of
+    physics : "simple" (above, the default) or "extended": :func:`rwadist.extended_time.simulate_time` of
         ``wheel.extended`` (exact modal integration incl. transients and the tangential imbalance force,
         started in the closed-form steady state at the first sample; one phase per line per sweep,
         imbalances β and β + imbalance_phase); |dΩ/dt| must stay below
@@ -433,7 +433,7 @@ def simulate_sweep(wheel: WheelDescription, rpm_start: float = 0.0, rpm_end: flo
         signals, dropped, base = _sweep_extended(wheel, t, omega, sample_rate, test_stand, phase_rng)
         _add_noise(signals, noise_std, noise_rng)
         extra.update(_extended_meta(wheel, base))
-        extra["modal_gain"] = ("exact modal integration (rwadist.extended.simulate_time, start: steady state); "
+        extra["modal_gain"] = ("exact modal integration (rwadist.extended_time.simulate_time, start: steady state); "
                                "fixture resonances as LTI filters (FFT, circular)")
         meta = _meta(wheel, sample_rate, seed, noise, True, test_stand, noise_std, dropped, extra)
         meta["active_modes"] = [m.to_json() for m in _fixture_modes(wheel, test_stand)]

@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 
 import rwadist
-from rwadist import broadband as bb
-from rwadist import catalogue
+from rwadist import catalogue, psd_files
 from rwadist import model as model_io
 from rwadist.cli import main
 
@@ -168,8 +167,8 @@ def test_psd_of_the_datasheet_wheel(tmp_path, capsys, assumed):
     assert code == 0
     res = rwadist.psd(preset=HR16, speed_rpm=(0, 6000), n_freq=401, n_speeds=100, assumed_modes=assumed)
     assert res.meta["model"] == ("extended" if assumed else "empirical")
-    _same_file(out, res, bb.write_psd_csv, tmp_path)
-    _same_file(tmp_path / "p_cross.csv", res, bb.write_cross_csv, tmp_path)
+    _same_file(out, res, psd_files.write_psd_csv, tmp_path)
+    _same_file(tmp_path / "p_cross.csv", res, psd_files.write_cross_csv, tmp_path)
     rms = re.search(r"RMS: Fx ([\d.e+-]+) N, Fy [\d.e+-]+ N, Fz [\d.e+-]+ N, Tx ([\d.e+-]+) N·m", text)
     assert rms.groups() == (f"{res.rms()[0]:.4g}", f"{res.rms()[3]:.4g}")
     # hard-mounted, every line is C·Ω² with its own random phase: a radial channel's mean square is Σ C² E[Ω⁴]/2 over
@@ -197,7 +196,7 @@ def test_psd_of_a_wheel_set_and_its_nastran_cards(tmp_path, capsys):
     res = rwadist.psd(wheels=wj, speed_rpm=(300, 2400), n_freq=401, n_speeds=100)
     assert res.frame == "spacecraft" and res.meta["hard_mounted_wheels"] == ["B"]
     _same_file(out, res, lambda r, p: (rwadist.write_nastran(r, p, cross=True), p)[1], tmp_path)
-    _same_file(tmp_path / "set_cross.csv", res, bb.write_cross_csv, tmp_path)
+    _same_file(tmp_path / "set_cross.csv", res, psd_files.write_cross_csv, tmp_path)
     # the same set given as Python objects
     inline = rwadist.psd(wheels=wheels, speed_rpm=(300, 2400), n_freq=401, n_speeds=100)
     np.testing.assert_array_equal(inline.csd, res.csd)

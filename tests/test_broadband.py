@@ -10,6 +10,7 @@ from scipy import integrate, signal
 
 from rwadist import broadband as bb
 from rwadist import extended as ext
+from rwadist import psd_files
 from rwadist.cli import main
 from rwadist.data import DataError
 from rwadist.model import Harmonic, WheelModel, save
@@ -211,7 +212,7 @@ def test_nastran_read_back_by_pynastran(tmp_path, fmt, rtol):
             "--n-speeds", "400", "--cross", "none"]
     assert main(argv + ["-o", str(out)]) == 0
     assert main(argv + ["--format", "nastran", "--nastran-fields", fmt, "--nastran-cross", "-o", str(deck)]) == 0
-    f, psd = bb.read_psd_csv(out)
+    f, psd = psd_files.read_psd_csv(out)
     full = tmp_path / "full.bdf"
     full.write_text("CEND\nBEGIN BULK\n" + deck.read_text() + "ENDDATA\n")
     model = BDF(debug=None)

@@ -16,6 +16,8 @@ from rwadist import coupling as cp
 from rwadist import extended as ext
 from rwadist.coupling.performance import wheel_spec_from_model
 from rwadist.diagnose import ripple_sideband_powers
+from rwadist.extended_ripple import Ripple, ripple_coefficients, ripple_lines
+from rwadist.extended_time import simulate_time
 from rwadist.presets import preset
 from rwadist.units import RPM_TO_RAD_S
 
@@ -132,7 +134,7 @@ def test_ripple_coefficients_closed_form_and_parseval():
     diagnose's ripple_sideband_powers is |c_k|²."""
     beta = np.array([0.0, 0.3, 1.7, 4.0])
     for eps in (0.2, -0.35, 0.0):
-        k, c = ext.ripple_coefficients(beta, eps, 2.0)
+        k, c = ripple_coefficients(beta, eps, 2.0)
         a = {0: 1 + eps**2 / 2, 1: -1j * eps, -1: 1j * eps, 2: -eps**2 / 4, -2: -eps**2 / 4}
         ref = np.zeros((beta.size, k.size), dtype=complex)
         for i, kk in enumerate(k):
@@ -142,7 +144,7 @@ def test_ripple_coefficients_closed_form_and_parseval():
         _, P = ripple_sideband_powers(beta, eps, 2.0)
         assert np.array_equal(P, np.abs(c) ** 2)
     for p, eps, b in ((2.6, 0.3, 0.8), (2.6, -0.3, 2.5), (1.3, 0.9, 0.1)):
-        _, c = ext.ripple_coefficients(b, eps, p, k_max=60)    # non-integer p: (1 + ε sin θ)^p has all orders
+        _, c = ripple_coefficients(b, eps, p, k_max=60)    # non-integer p: (1 + ε sin θ)^p has all orders
         mean = integrate.quad(lambda t: abs(1 + eps * np.sin(t)) ** (2 * p), 0, 2 * np.pi, epsabs=0,
                               epsrel=1e-13)[0] / (2 * np.pi)
         assert np.sum(np.abs(c) ** 2) == pytest.approx(mean, rel=1e-10)
@@ -163,17 +165,17 @@ def _ripple_lines(p):
 @pytest.mark.parametrize("rpm", [1500.0, -1100.0])
 def test_rippled_hard_mounted_lines_match_time_simulation(rpm):
     """line_responses' hard-mounted sidebands of a rippled wheel (modes on) = complex line amplitudes at
-    f + m·f_r fitted by least squares to rwadist.extended.simulate_time driven by the rippled speed
+    f + m·f_r fitted by least squares to rwadist.extended_time.simulate_time driven by the rippled speed
     Ω0 + ΔΩ sin 2πf_r t (20 s after a 2 s settling, 2 kHz; the same rotor-angle origin).  Fx, Fy, Fz,
     Tz: the only neglected term there is none (no imbalance tangential term in these lines): < 1e-4 of
     the channel's largest line.  Tx, Ty: the ripple's modulation of the gyroscopic rocking dynamics,
     neglected by design, is what differs: the error stays within 2× its first-order size
     |carrier|·I_zz·ΔΩ·|ν|/(2|den(ν)|) -- for the real E wheel and for I_zz / 100 (error 100× smaller)."""
     p0 = replace(preset("ithaco-e").extended, height=0.05)
-    rip = ext.Ripple(3.1, 4.0, 150.0)
+    rip = Ripple(3.1, 4.0, 150.0)
     om = rpm * RPM_TO_RAD_S
     # with ΔΩ = 0 the order-0 lines are the steady lines
-    m0, f0, a0 = ext.ripple_lines(p0, _ripple_lines(p0), [om], ext.Ripple(3.1, 0.0, 150.0), k_max=2)
+    m0, f0, a0 = ripple_lines(p0, _ripple_lines(p0), [om], Ripple(3.1, 0.0, 150.0), k_max=2)
     fs_, as_ = ext.steady_lines(p0, _ripple_lines(p0), [om])
     assert np.array_equal(a0[:, :, 2], as_) and np.array_equal(f0[:, :, 2], fs_)
     assert np.all(a0[:, :, [0, 1, 3, 4]] == 0)
@@ -190,7 +192,7 @@ def test_rippled_hard_mounted_lines_match_time_simulation(rpm):
         t = np.arange(int(22.0 * fsamp)) / fsamp
         w = om + rip.delta(om) * np.sin(2 * np.pi * rip.f_hz * t)
         d = rip.delta(om) / (2 * np.pi * rip.f_hz)          # simulate_time has φ(0) = 0, ripple_lines −ΔΩ/2πf_r
-        y = ext.simulate_time(p, lines, t, w, phases=[ln.phase - ln.h * d for ln in lines], start="steady")
+        y = simulate_time(p, lines, t, w, phases=[ln.phase - ln.h * d for ln in lines], start="steady")
         sel = t >= 2.0
         E = np.exp(2j * np.pi * fu[None, :] * t[sel, None])
         X = np.hstack([E.real, -E.imag])                 # near-orthogonal columns: normal equations
@@ -228,7 +230,7 @@ def test_ripple_in_coupled_path_equals_explicit_sideband_lines():
     the line's amplitude law) through the plant at each sideband's own frequency, at both speed signs."""
     p = replace(preset("ithaco-e").extended, height=0.05)
     lines = _ripple_lines(p)
-    rip = ext.Ripple(2.3, 3.0, 150.0, 0.5)
+    rip = Ripple(2.3, 3.0, 150.0, 0.5)
     plant = cp.example_spacecraft()
     for rpm in (1800.0, -2400.0):
         om = rpm * RPM_TO_RAD_S
@@ -238,7 +240,7 @@ def test_ripple_in_coupled_path_equals_explicit_sideband_lines():
         explicit = []
         for ln in lines:
             pe = 2.0 if ln.law is None else ln.law[2]
-            k, c = ext.ripple_coefficients(ln.h * dW / (2 * np.pi * rip.f_hz), dW / om, pe, K)
+            k, c = ripple_coefficients(ln.h * dW / (2 * np.pi * rip.f_hz), dW / om, pe, K)
             for kk, ck in zip(k, c):
                 law = None if ln.law is None else (ln.law[0] * abs(ck), ln.law[1], ln.law[2])
                 explicit.append(replace(ln, C=ln.C * abs(ck), law=law, phase=ln.phase + np.angle(ck),
@@ -275,7 +277,7 @@ def test_model_file_floor_and_ripple_reach_jitter_and_output_psd():
     model = preset("ithaco-e").to_model()
     model.effects = [dict(FLOOR), dict(RIPPLE)]
     spec = _mounted(model)
-    assert [f.channel for f in spec.floors] == [0, 4] and spec.ripple == ext.Ripple(2.3, 3.0, 200.0, 0.0)
+    assert [f.channel for f in spec.floors] == [0, 4] and spec.ripple == Ripple(2.3, 3.0, 200.0, 0.0)
     plant = cp.example_spacecraft()
     speeds = np.linspace(300, 3000, 12) * RPM_TO_RAD_S
     t0 = time.perf_counter()
@@ -291,7 +293,7 @@ def test_model_file_floor_and_ripple_reach_jitter_and_output_psd():
     # ripple: present (sidebands raise the RMS) and, vanishing, the plain lines
     plain = cp.jitter_vs_speed(plant, [replace(spec, floors=(), ripple=None)], speeds)
     assert np.max(np.abs(bare.rms["coupled"] / plain.rms["coupled"] - 1)) > 1e-3
-    tiny = cp.jitter_vs_speed(plant, [replace(spec, floors=(), ripple=ext.Ripple(2.3, 0.0, 200.0))], speeds)
+    tiny = cp.jitter_vs_speed(plant, [replace(spec, floors=(), ripple=Ripple(2.3, 0.0, 200.0))], speeds)
     assert np.allclose(tiny.rms["coupled"], plain.rms["coupled"], rtol=1e-12, atol=0)
     # output PSD: integral = Σ_s w_s (lines in band + floor)
     lr = cp.line_responses(plant, [spec], speeds, practices=("coupled", "ii"))

@@ -9,6 +9,7 @@ from scipy import linalg, signal
 
 from rwadist import extended as ex
 from rwadist.data import DataError
+from rwadist.extended_time import simulate_time
 from rwadist.model import WheelModel
 from rwadist.units import RPM_TO_RAD_S
 
@@ -176,7 +177,7 @@ def test_sense_selects_whirl_time_domain():
     amps = {}
     for sense in ("co", "counter"):
         line = ex.Line("radial_torque", 1.0, 1e-6, sense)
-        x = ex.simulate_time(p, [line], t, np.full(t.size, w), start="steady")
+        x = simulate_time(p, [line], t, np.full(t.size, w), start="steady")
         z = x[:, 3] + 1j * x[:, 4]
         plus, minus = _whirl_content(z, w / (2 * np.pi), t)
         _, A = ex.steady_lines(p, [line], [w])
@@ -208,7 +209,7 @@ def _closed_form_signal(p, lines, w, t):
 @pytest.mark.parametrize("w", [150.0, -230.0])
 def test_time_domain_equals_closed_form_after_transients(w):
     t = np.arange(int(7 * FS)) / FS
-    x = ex.simulate_time(E, LINES, t, np.full(t.size, w), start="rest")
+    x = simulate_time(E, LINES, t, np.full(t.size, w), start="rest")
     ref = _closed_form_signal(E, LINES, w, t)
     late = t > 6.0                    # slowest mode (backward whirl) decays by e^-30 by then
     err = np.abs(x[late] - ref[late]).max(0) / np.abs(ref[late]).max(0)
@@ -221,7 +222,7 @@ def test_time_domain_equals_closed_form_after_transients(w):
 def test_parseval_psd_vs_variance():
     w = 200.0
     t = np.arange(int(16 * FS)) / FS
-    x = ex.simulate_time(E, LINES, t, np.full(t.size, w), start="steady")
+    x = simulate_time(E, LINES, t, np.full(t.size, w), start="steady")
     f, psd = signal.welch(x, fs=FS, window="hann", nperseg=8192, axis=0)
     ms_psd = np.sum(psd, axis=0) * (f[1] - f[0])
     var = np.mean(x**2, axis=0)
@@ -261,7 +262,7 @@ def test_tangential_imbalance_force_during_acceleration():
     t = np.arange(int(2 * FS)) / FS
     alpha = 20.0
     w = -30.0 + alpha * t                    # passes through zero at t = 1.5 s
-    x = ex.simulate_time(stiff, [ex.imbalance_lines(stiff)[0]], t, w, start="steady")
+    x = simulate_time(stiff, [ex.imbalance_lines(stiff)[0]], t, w, start="steady")
     phi = -30.0 * t + 0.5 * alpha * t**2
     F = stiff.U_s * (w**2 - 1j * alpha) * np.exp(1j * phi)
     late = t > 0.2
@@ -273,7 +274,7 @@ def test_reversal_through_zero_converges():
     """Speed through zero (−60 -> +60 rad/s in 4 s): halving the step changes nothing (< 1e-6 of peak)."""
     def run(fs):
         t = np.arange(int(4 * fs)) / fs
-        return t, ex.simulate_time(E, LINES, t, -60.0 + 30.0 * t, seed=3)
+        return t, simulate_time(E, LINES, t, -60.0 + 30.0 * t, seed=3)
     t1, x1 = run(FS)
     t2, x2 = run(2 * FS)
     assert np.all(np.isfinite(x1))
@@ -306,13 +307,13 @@ def test_bad_speed_profiles():
     w_nan = w.copy()
     w_nan[500] = np.nan
     with pytest.raises(ValueError, match="not finite at sample 500"):
-        ex.simulate_time(E, LINES, t, w_nan)
+        simulate_time(E, LINES, t, w_nan)
     w_jump = w.copy()
     w_jump[600:] = 200.0
     with pytest.raises(ValueError, match="jumps between samples 599 and 600"):
-        ex.simulate_time(E, LINES, t, w_jump)
+        simulate_time(E, LINES, t, w_jump)
     with pytest.raises(ValueError, match="uniformly"):
-        ex.simulate_time(E, LINES, t**1.5, w)
+        simulate_time(E, LINES, t**1.5, w)
 
 
 def test_model_file_round_trip_and_missing_field():
@@ -379,7 +380,7 @@ def test_sidebands_are_amplitude_modulation_and_resonance_a_real_filter():
     for effects in (EFFECTS[5:], EFFECTS[1:2] + EFFECTS[5:]):
         lines = ex.apply_line_effects([carrier], effects)
         assert [ln.f_offset for ln in lines] == [0.0, 4.0, -4.0]
-        tz = ex.simulate_time(E, lines, t, w)[:, 5]
+        tz = simulate_time(E, lines, t, w)[:, 5]
         f = 1.5 * w / (2 * np.pi)
         wm = 2 * np.pi * 4.0 * t
         if len(effects) == 1:
@@ -419,7 +420,7 @@ def test_effects_time_domain_equals_closed_form(w):
     lines = ex.apply_line_effects(LINES, EFFECTS)
     assert len(lines) == len(LINES) + 6 and sum(bool(ln.resonances) for ln in lines) == 7 + 6
     t = np.arange(int(1.0 * FS)) / FS
-    x = ex.simulate_time(E, lines, t, np.full(t.size, w), start="steady")
+    x = simulate_time(E, lines, t, np.full(t.size, w), start="steady")
     ref = _closed_form_signal(E, lines, w, t)
     err = np.abs(x - ref).max(0) / np.abs(ref).max(0)
     assert err.max() < 1e-9, err

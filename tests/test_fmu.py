@@ -1,4 +1,4 @@
-"""The FMU of the extended wheel model (issue 5): runtime vs rwadist.extended.simulate_time,
+"""The FMU of the extended wheel model (issue 5): runtime vs rwadist.extended_time.simulate_time,
 steady amplitudes vs the closed-form modal gain, fmpy validation, four instances, bad input
 through the host, step-size convergence, CLI, and (slow) a fresh venv without rwadist."""
 from __future__ import annotations
@@ -15,6 +15,7 @@ import pytest
 
 from rwadist import extended as ext
 from rwadist import model as model_io
+from rwadist.extended_time import simulate_time
 from rwadist.fmu import hosts
 from rwadist.fmu import runtime as rt
 from rwadist.fmu.build import build_fmu, has_native, native_supported
@@ -55,7 +56,7 @@ def wheel_fmu(tmp_path_factory, model):
 
 def reference(model, t, w, seed):
     p = ext.params_from_model(model)
-    return ext.simulate_time(p, ext.lines_from_model(model, p), t, w, seed=seed)
+    return simulate_time(p, ext.lines_from_model(model, p), t, w, seed=seed)
 
 
 def spin_up(dt=1e-3, T=8.0):
@@ -670,7 +671,7 @@ def test_get_real_of_parameters_inputs_and_outputs(wheel_fmu):
 
 @pytest.mark.parametrize("profile", [spin_up, reversal])
 def test_fmu_with_laws_equals_simulate_time_with_laws(tmp_path, model, profile):
-    """A diagnosed model file through fmpy equals rwadist.extended.simulate_time of the lines
+    """A diagnosed model file through fmpy equals rwadist.extended_time.simulate_time of the lines
     lines_from_model builds from the same file (laws attached), 1e-9 relative."""
     doc = model_io.to_json(model)
     doc["effects"] = LAWS
@@ -679,7 +680,7 @@ def test_fmu_with_laws_equals_simulate_time_with_laws(tmp_path, model, profile):
     lines = ext.lines_from_model(improved, p)
     assert sum(ln.law is not None for ln in lines) == 3
     t, w = profile(T=4.0)
-    ref = ext.simulate_time(p, lines, t, w, seed=8)
+    ref = simulate_time(p, lines, t, w, seed=8)
     out = hosts.run_fmpy(build_fmu(doc, tmp_path / "laws.fmu"), t,
                          {"wheel_speed": w, "wheel_acceleration": slope(t, w)},
                          {"use_wheel_acceleration": True, "seed": 8})
@@ -717,7 +718,7 @@ def effects_runtime(doc, **kw):
 @pytest.mark.parametrize("profile", [spin_up, reversal])
 def test_fmu_with_resonances_and_sidebands_equals_simulate_time(tmp_path, model, profile):
     """A model file with wheel-mode resonances and sidebands (round-tripped through the model-file
-    JSON) through fmpy and through the numpy runtime equals rwadist.extended.simulate_time of the
+    JSON) through fmpy and through the numpy runtime equals rwadist.extended_time.simulate_time of the
     lines lines_from_model builds from it, 1e-9 relative; the test-stand resonance is left out."""
     doc = effects_doc(model)
     improved = model_io.from_json(json.loads(json.dumps(doc)))
@@ -728,7 +729,7 @@ def test_fmu_with_resonances_and_sidebands_equals_simulate_time(tmp_path, model,
     assert all(res[0] != 70.0 for ln in lines for res in ln.resonances)
     t, w = profile(T=4.0)
     for seed in (None, 8):
-        ref = ext.simulate_time(p, lines, t, w, seed=seed)
+        ref = simulate_time(p, lines, t, w, seed=seed)
         out = effects_runtime(doc, seed=seed).run(t, w)
         assert np.all(rel_err(out, ref) < 1e-9), rel_err(out, ref)
     fmu_path = build_fmu(doc, tmp_path / "effects.fmu")

@@ -334,7 +334,7 @@ def test_cli_fmu_check_reports_the_fmus_reason(tmp_path, capsys):
 
 def test_fmu_ripple_equals_the_coupling_kits_sidebands():
     """Two independent implementations: the FMU's time-domain ripple (the rotor's speed rippled step by step,
-    modes on, steady start) and rwadist.extended.ripple_lines (closed-form sideband coefficients through the
+    modes on, steady start) and rwadist.extended_ripple.ripple_lines (closed-form sideband coefficients through the
     rotor's modes, used by the coupling kit) agree on every line's sidebands in Fx, Fy, Fz to 1e-4 of the
     channel's largest line, at +1700 and −2000 rpm, with counter-rotating lines and a speed law q = 0.5.
     (Tx, Ty are left out: ripple_lines neglects the ripple's modulation of the gyroscopic rocking, 8-12 % of
@@ -342,13 +342,14 @@ def test_fmu_ripple_equals_the_coupling_kits_sidebands():
     from dataclasses import replace
 
     from rwadist import extended as ext
+    from rwadist.extended_ripple import ripple_from_effects, ripple_lines
     m = preset("ithaco-e").to_model()
     rip_e = dict(RIPPLE, f_ripple_Hz=2.3, delta_omega_rad_s=3.0, speed_exponent=0.5)
     m.effects = [rip_e]
     doc = doc_with([rip_e], m)
     pe = ext.params_from_model(m)
     lines = [ln for ln in ext.lines_from_model(m, pe) if not ln.imbalance]   # imbalance: tangential term
-    rip = ext.ripple_from_effects(m.effects)
+    rip = ripple_from_effects(m.effects)
     h, T = 5e-4, 24.0
     t = np.arange(int(T / h) + 1) * h
     sel = t >= 8.0                             # the start transient of the modes decays
@@ -357,7 +358,7 @@ def test_fmu_ripple_equals_the_coupling_kits_sidebands():
         # the FMU's rotor angle is 0 at t0; ripple_lines' mean angle is: shift each line's phase by hΔΩ/(2πf_r)
         d = float(rip.delta(om)) / (2 * np.pi * rip.f_hz)
         shifted = [replace(ln, phase=ln.phase + ln.h * d) for ln in lines]
-        _, f, A = ext.ripple_lines(pe, shifted, [om], rip)
+        _, f, A = ripple_lines(pe, shifted, [om], rip)
         f, A = f[0].ravel(), A[0].reshape(-1, 6)
         fu, idx = np.unique(np.round(f, 9), return_inverse=True)
         pred = np.zeros((fu.size, 6), complex)

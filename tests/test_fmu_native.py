@@ -1,4 +1,4 @@
-"""The native C FMU (issue 16): the same numbers as the pythonfmu FMU and rwadist.extended.simulate_time
+"""The native C FMU (issue 16): the same numbers as the pythonfmu FMU and rwadist.extended_time.simulate_time
 with every effect class on, the same floor multisine for a seed, FMI conformance (fmpy validate, the
 pythonfmu FMU's variables), FMU state that restores a run bit for bit, fmi2Error on bad input, four
 instances, libcosim, a C host without Python, a rebuild from the FMU's sources/, no libpython."""
@@ -15,6 +15,7 @@ import pytest
 
 from rwadist import extended as ext
 from rwadist import model as model_io
+from rwadist.extended_time import simulate_time
 from rwadist.fmu import hosts
 from rwadist.fmu import runtime as rt
 from rwadist.fmu.build import build_fmu, native_supported
@@ -124,14 +125,14 @@ def test_native_equals_pythonfmu_with_every_effect(fmus, profile):
 @pytest.mark.parametrize("profile", [spin_up, reversal])
 def test_native_equals_simulate_time(line_fmus, profile):
     """With the line effects (amplitude law, resonances, sidebands; simulate_time has no ripple or floor):
-    native FMU = rwadist.extended.simulate_time of lines_from_model, seed 5, to 1e-12 of each channel's peak
+    native FMU = rwadist.extended_time.simulate_time of lines_from_model, seed 5, to 1e-12 of each channel's peak
     (simulate_time integrates the same equations by another route, lfilter and a blocked scan; the FMU's clock is
     the host's communication point, as simulate_time's t − t0, not a sum of steps)."""
     doc, native = line_fmus
     t, w = profile()
     m = model_io.from_json(doc)
     p = ext.params_from_model(m)
-    ref = ext.simulate_time(p, ext.lines_from_model(m, p), t, w, seed=5)
+    ref = simulate_time(p, ext.lines_from_model(m, p), t, w, seed=5)
     out = hosts.run_fmpy(native, t, {"wheel_speed": w, "wheel_acceleration": slope(t, w)},
                          {"use_wheel_acceleration": True, "seed": 5})
     err = worst(out[:, :6], ref)

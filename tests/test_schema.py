@@ -20,6 +20,7 @@ from rwadist.effects.amplitude_law import AmplitudeLaw
 from rwadist.effects.broadband_floor import BroadbandFloor
 from rwadist.effects.sidebands import Sidebands
 from rwadist.effects.speed_ripple import SpeedRipple
+from rwadist.extended_ripple import ripple_from_effects
 
 CATALOGUE = sorted((Path(schema.__file__).parent / "catalogue").glob("*.json"))
 BASE = CATALOGUE[[p.name for p in CATALOGUE].index("ithaco-e.json")]
@@ -112,7 +113,7 @@ def test_extended_kit_refuses(entry, tail):
     m = model_io.load(BASE)
     m.effects = [entry]
     for read in (lambda: ext.lines_from_model(m, ext.params_from_model(m)), lambda: ext.line_effects(m.effects),
-                 lambda: ext.ripple_from_effects(m.effects)):
+                 lambda: ripple_from_effects(m.effects)):
         with pytest.raises(schema.ModelError) as info:
             read()
         _assert_same(info.value, "<model>", tail)

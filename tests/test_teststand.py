@@ -415,6 +415,7 @@ from dataclasses import asdict, replace  # noqa: E402
 
 from rwadist import extended as ex  # noqa: E402
 from rwadist.cli import main as cli_main  # noqa: E402
+from rwadist.extended_time import simulate_time  # noqa: E402
 from rwadist.units import THESIS_C_TO_SI  # noqa: E402
 
 
@@ -540,7 +541,7 @@ def test_extended_sweep_is_simulate_time_and_matches_steady_at_constant_speed():
     others = list(rng.uniform(0, TWO_PI, size=len(lines) - 2))
     phases = [beta, beta + wheel.imbalance_phase] + others
     assert [ln.imbalance for ln in lines[:2]] == [True, True]
-    ref = ex.simulate_time(p, lines, sw.time, sw.tach, phases=phases, start="steady")
+    ref = simulate_time(p, lines, sw.time, sw.tach, phases=phases, start="steady")
     for i, ch in enumerate(data.CHANNELS):
         np.testing.assert_allclose(sw.signals[ch], ref[:, i], rtol=0, atol=1e-12 * np.abs(ref).max())
     # constant speed: time-domain sweep (started in steady state) = closed-form steady run with the same seed

@@ -23,9 +23,9 @@ frequency (plant, wheel dynamic mass and blocked loads alike).
 Diagnosed effects that are not lines of the extended model (``rwadist diagnose``, read by
 :func:`wheel_spec_from_model` as their elements' actions, :mod:`rwadist.effects.actions`):
 
-* a speed modulation (:class:`rwadist.extended.Ripple`): the wheel speed is Ω0 + ΔΩ sin 2πf_r t; every line
+* a speed modulation (:class:`rwadist.extended_ripple.Ripple`): the wheel speed is Ω0 + ΔΩ sin 2πf_r t; every line
   becomes lines at its frequency + m·f_r with the complex coefficients of
-  :func:`rwadist.extended.ripple_lines` (phase modulation of the rotor angle, amplitude modulation of
+  :func:`rwadist.extended_ripple.ripple_lines` (phase modulation of the rotor angle, amplitude modulation of
   a(|Ω|)), each evaluated through the wheel's modes and the coupled plant at its own frequency.  The
   coefficients act per line before the lines of one (h, offset) group are summed (they share the ripple);
   the groups are then (h, offset, m).  Neglected: the imbalance's tangential term and the ripple's
@@ -138,7 +138,7 @@ class WheelSpec:
     (kg·m², about the interface point); speed_scale: this wheel's speed = speed_scale × the
     sweep speed (e.g. −1 for a wheel spinning the other way, 0.9 for a slower one).
     floors: its broadband floors (:class:`Floor`, blocked loads, incoherent); ripple: its speed
-    ripple (:class:`rwadist.extended.Ripple`) or None.  hard_mounted: the suspension is rigid (the rotor
+    ripple (:class:`rwadist.extended_ripple.Ripple`) or None.  hard_mounted: the suspension is rigid (the rotor
     moves with the housing; a datasheet wheel whose modes are only assumed runs so by default): its blocked
     loads are the lines' free loads (C·Ω², U_s·Ω², U_d·Ω², the radial force with its lever arm ``height``)
     and its dynamic mass the rigid wheel's with the rotor's gyroscopic coupling (:func:`rigid_wheel_frf`)."""
@@ -162,7 +162,7 @@ class WheelSpec:
         if any(not isinstance(f, Floor) for f in self.floors):
             raise CouplingError(f"{self.name}: floors must be coupling.performance.Floor objects")
         if self.ripple is not None and not isinstance(self.ripple, ripple_mod.Ripple):
-            raise CouplingError(f"{self.name}: ripple must be a rwadist.extended.Ripple or None")
+            raise CouplingError(f"{self.name}: ripple must be a rwadist.extended_ripple.Ripple or None")
 
 
 def _physical_params(model, p, mass_kg, radius_m, name):
@@ -201,7 +201,7 @@ def wheel_spec_from_model(model, mount=None, *, assumed_modes: bool = False, mas
     (:mod:`rwadist.effects.actions`: amplitude laws, wheel-mode resonances, sidebands on the lines,
     :func:`rwadist.extended.apply_line_effects`), its broadband floors as :attr:`WheelSpec.floors`
     (:func:`floors_from_effects`) and its speed modulation as :attr:`WheelSpec.ripple`
-    (:func:`rwadist.extended.ripple_from_effects`).
+    (:func:`rwadist.extended_ripple.ripple_from_effects`).
     A bad entry raises :class:`CouplingModelError` (a CouplingError) naming ``effects[i].<field>``.
 
     A wheel whose suspension modes are assumed (``analytical.modes_assumed``: a catalogue datasheet wheel)
@@ -417,7 +417,7 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
     """Steady line responses of the performance outputs for every wheel and practice at sweep
     speeds ``omega`` (rad/s, (S,)).  Processes ``chunk`` speeds at a time (fewer when that makes more than
     :data:`LINE_POINTS` line points).  A wheel with a speed
-    ripple gets its sideband orders m = −K..K, K = :func:`rwadist.extended.ripple_order` over all the
+    ripple gets its sideband orders m = −K..K, K = :func:`rwadist.extended_ripple.ripple_order` over all the
     speeds (so every chunk has the same groups).  When a wheel has broadband floors, their responses
     are computed too (:func:`floor_responses` on ``floor_f_hz``, default :func:`floor_grid`) and kept
     in :attr:`LineResponses.floor`."""

@@ -747,7 +747,7 @@ def ripple_sideband_powers(beta, eps, p=2.0, k_max: int | None = None):
     ε = ΔΩ/|Ω0|, and g = Σ_k c_k e^{jkθ}: lines at f_i + k·f_r of amplitude |c_k|·a.  Without the amplitude
     term (ε = 0) c_k = J_k(β)e^{-jkπ/2}, |c_k|² = J_k(β)² and Σ_k |c_k|² = 1 (Parseval); with it Σ|c_k|² is the
     mean of (1 + ε sin θ)^{2p} (1 + 3ε² + 3ε⁴/8 for p = 2).  c_k by an FFT over one period of θ: the complex
-    coefficients are :func:`rwadist.extended.ripple_coefficients` (which the coupling kit applies per line);
+    coefficients are :func:`rwadist.extended_ripple.ripple_coefficients` (which the coupling kit applies per line);
     this returns their squared moduli.  (For ε > 1, a speed reversal within the ripple, the amplitude is
     |1 + ε sin θ|^p, the exact |Ω(t)|^p.)
 

@@ -5,7 +5,7 @@ the classes below; a measurement artefact or a record does nothing to them); the
 actions, in the order of :func:`ordered`:
 
 - the line spectrum and PSD (:func:`rwadist.broadband.apply_effects`), the extended model's lines
-  (:func:`rwadist.extended.apply_line_effects`, :func:`rwadist.extended.ripple_from_effects`), the coupling kit
+  (:func:`rwadist.extended.apply_line_effects`, :func:`rwadist.extended_ripple.ripple_from_effects`), the coupling kit
   (:func:`rwadist.coupling.performance.wheel_spec_from_model`);
 - the FMUs: the numpy runtime (:func:`rwadist.fmu.runtime.effects_from_doc`) and the C kernel, which gets them
   compiled in when the FMU is built (``rwadist/fmu/native_build.py``).

@@ -33,6 +33,8 @@ import warnings
 import zipfile
 from pathlib import Path
 
+from rwadist.presets import preset
+
 HERE = Path(__file__).resolve().parent
 TEMPLATE = HERE / "slave_template.py"
 #: the slave implementation, shipped verbatim as resources/SLAVE_RESOURCE (the template loads it)
@@ -285,5 +287,4 @@ def runtime_files(folder) -> list:
 
 def build_preset(name: str, output, **kw) -> Path:
     """FMU of a test-stand preset (e.g. 'ithaco-e'): ``rwadist.presets.preset(name).to_model()``."""
-    from rwadist.presets import preset
     return build_fmu(preset(name).to_model(), output, **kw)

@@ -6,7 +6,7 @@ only Python and numpy; next to them goes a verbatim copy of :mod:`rwadist.schema
 the one reader of the model file (a test pins the copies to the sources byte for byte).  This module holds the
 stepping model, :class:`WheelRuntime`, and re-exports the siblings' public names.  It re-implements, step by step, the equations of :mod:`rwadist.extended` (rigid rotor
 on a flexible suspension; see that module's docstring for the physics and sign conventions)
-and is tested against :func:`rwadist.extended.simulate_time` to 1e-9 relative
+and is tested against :func:`rwadist.extended_time.simulate_time` to 1e-9 relative
 (tests/test_fmu.py).  Everything is SI: rad/s, rad/s², s, N, N·m, kg, m.
 
 One communication step [t_n, t_n + h] with wheel speed Ω_n and acceleration α (rad/s²):

@@ -36,6 +36,8 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from rwadist.presets import preset
+
 from .native_build import VARIABLES, build_native_fmu, windows_compiler
 from .speed_command import build_speed_command, variable_names
 
@@ -258,7 +260,7 @@ def system_description(name: str, wheels, sources: list, params: list, command_s
 def _build_fmus(wheels, tmp: Path, default_model, assumed_modes: bool, windows: bool) -> list:
     """resources/<name>.fmu of each wheel's model (one per distinct model), built in ``tmp``."""
     from rwadist import catalogue
-    from rwadist.presets import preset
+
     fmus: dict = {}             # model reference -> resources/<name>.fmu
     sources = []
     for ws in wheels:
