@@ -6,6 +6,7 @@ degrees of freedom, data and predictions.
 from __future__ import annotations
 
 import functools
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,6 +14,9 @@ from ..dft import hann_transform
 from .constants import BAND_BINS, CONTRAST_NOISE_Z, KERNEL_HALF, NOISE_Z, TORQUE_CHANNELS
 from .reduce import bin_sums
 from .state import State
+
+if TYPE_CHECKING:
+    from ..spectra import Spectra
 
 #: Points per bin of :func:`hann_tables`: the 4-point interpolation's error falls as its step⁴ (measured on |W|²:
 #: 1/64 2.5e-8, 1/128 1.6e-9, 1/256 1e-10 of the peak; 1e-10 is a fraction of a noise level in the strongest
@@ -59,6 +63,33 @@ def read_table(coef: np.ndarray, dlt: np.ndarray) -> np.ndarray:
 
 class Metric:
     """Band powers, their noise standard deviations and the misplaced power (methods of a Context)."""
+
+    # what the methods read of their Context (:class:`rwadist.diagnose.engine.Context` sets and defines these)
+    sp: Spectra
+    omega: np.ndarray                   # |Ω| per run of the spectra, rad/s
+    runs: np.ndarray                    # the runs at a speed (|Ω| > 0), indices, sorted
+    channels: tuple[str, ...]
+    df: float                           # Hz per bin
+    dof: float                          # Welch degrees of freedom of a bin
+    k_lo: int                           # first bin of the bands
+    n_bands: int
+    _memo: dict
+    _scale: dict[str, float]            # per channel, the mean data power of its unit group
+
+    if TYPE_CHECKING:
+        def data(self, state: State, c: str, runs: np.ndarray | None = None) -> np.ndarray: ...
+
+        def gain(self, state: State, c: str, f_hz) -> np.ndarray: ...
+
+        def channel_lines(self, state: State, c: str, runs: np.ndarray) -> list: ...
+
+        def line_mixing(self, state: State, c: str, runs: np.ndarray) -> list: ...
+
+        def sideband_gain(self, state: State, c: str, h: float, shift: float, runs: np.ndarray) -> np.ndarray: ...
+
+        def floor_psd(self, state: State, c: str, runs: np.ndarray) -> np.ndarray: ...
+
+        def predict(self, state: State, c: str, runs: np.ndarray, skip=None, only=None) -> np.ndarray: ...
 
     def rows_of_every_run(self, state: State, name: str, c: str, runs: np.ndarray) -> tuple | None:
         """(what ``state`` keeps under ``(name, c)`` for every run, the positions of ``runs`` in it), or None when
