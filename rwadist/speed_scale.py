@@ -278,3 +278,28 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
                 **{f"co_share_{'force' if k == 'F' else 'torque'}": float(v[best]) for k, v in share.items()}}
     reason = f"the 1x line: {how}, with the most integer multiples (found {mult})"
     return best, float(sense[best]), evidence, reason
+
+
+# ------------------------------------------------------------------------------------------ the lines' ratios
+def sweep_ratios(meta) -> np.ndarray:
+    """The ratios h (ascending) of the lines a sweep's speed scale found (``meta["slicing"]["speed_scale"]
+    ["ratios"]`` of a test sliced from a sweep with the speed from the data, :meth:`SpeedScale.to_meta`); empty
+    for any other test (steady runs, a tach column)."""
+    scale = ((meta or {}).get("slicing") or {}).get("speed_scale") or {}
+    return np.asarray(scale.get("ratios") or (), dtype=float)
+
+
+def ratios_near(h: float, ratios: np.ndarray, tol: float) -> list:
+    """The ratios of ``ratios`` within ``tol`` of ``h`` (both in units of the rotor speed), nearest first; ``[h]``
+    when none is (or there are no ratios).
+
+    The speed scale measured every line's ratio on the whole slices (zero-padded) of every speed, registered into
+    one frame.  Where a diagnosis reads a line from shorter spectra (``tol``: the main lobe at the fastest run), two
+    lines closer than that blend into one peak between them at the low speeds (a 30-s run-up of the family's wheel
+    4: 6.09 and 6.38 read as 6.15), and a line smeared over its slice leaves a ridge beside itself (a 30-s run-down
+    of wheel 6: 2.038 beside 2.000): what is there is the wheel's lines of the speed scale's ratios."""
+    if ratios.size == 0 or not np.isfinite(h):
+        return [h]
+    d = np.abs(ratios - h)
+    near = np.argsort(d)[: int(np.sum(d <= tol))]
+    return [float(ratios[j]) for j in near] if near.size else [h]

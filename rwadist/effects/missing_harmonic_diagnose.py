@@ -29,6 +29,7 @@ from ..diagnose.measure import (
 from ..diagnose.reduce import column_nanmedian
 from ..diagnose.state import State
 from ..model import Harmonic
+from ..speed_scale import ratios_near, sweep_ratios
 from ..units import DIRECTION_CHANNELS
 
 #: Lowest frequency of a point of the record route, record bins (fs/n): the mean is taken off the record, and the
@@ -442,18 +443,22 @@ class MissingHarmonic:
             return any(abs(e.h - x.h) < lobe and e.C < LOBE_MIN_RATIO * abs(x.C)
                        for x in state.model.harmonics(e.direction))
 
+        ratios = sweep_ratios(ctx.test.meta if ctx.test is not None else None)
+
         def welch(d, chans) -> list:
             found: list[MissingHarmonic] = []
             for h in ridge_peaks(ctx, state, chans, runs, max_per_direction):
                 if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
                     continue
-                h = refine_h(ctx, state, chans, runs, h)
-                if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)) or \
-                        any(abs(h - x.h) < 0.005 for x in found):
-                    continue
-                e = MissingHarmonic.fit(ctx, state, d, h, runs)
-                if e is not None and e.C > 0 and not misfit(e):
-                    found.append(e)
+                # on a sweep whose speed came from the data, the wheel's lines of the speed scale's ratios within the
+                # ridge's lobe (a blend of two close lines, a smeared line's ridge beside itself), else the ridge's h
+                for h in ratios_near(refine_h(ctx, state, chans, runs, h), ratios, lobe):
+                    if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)) or \
+                            any(abs(h - x.h) < 0.005 for x in found):
+                        continue
+                    e = MissingHarmonic.fit(ctx, state, d, h, runs)
+                    if e is not None and e.C > 0 and not misfit(e):
+                        found.append(e)
             return found
 
         # each direction's lines from its own channels alone (Context.reuse): the Welch route's first, then the record
