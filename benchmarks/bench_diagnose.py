@@ -14,11 +14,12 @@ Run: ``.venv/bin/python benchmarks/bench_diagnose.py [--quick [--sets benchmark 
 3. Timing (issues 14 and 37, target <= 10x): modes ON (``physics="extended"``), one effect (the wheel's h = 4.42
    radial-force line growing as Ω^2.5, a load through the suspension modes), ``--sets``: ``benchmark``, the 120-speed,
    6-channel E dataset (300-2400 rpm, 3840 Hz, 8192 samples); ``sixty``, the robustness matrix's nominal cell (60
-   speeds over 300-3000 rpm).  ``rwadist fit`` (:func:`rwadist.api.fit`) and ``rwadist diagnose DATA`` without a
+   speeds over 300-3000 rpm; both by default).  ``rwadist fit`` (:func:`rwadist.api.fit`) and ``rwadist diagnose DATA`` without a
    model (:func:`rwadist.api.diagnose`: the wheel's suspension modes fitted first) in a fresh process that runs
    them as the command line does (its module first, everything inside :func:`rwadist.cli.one_blas_thread`, so a
    thread pool loaded during the calls counts), ``--repeats`` interleaved (fit, diagnose) pairs, min and median of
-   wall-clock and CPU time with the load average, the thread pools printed; ``--busy K`` spins K processes beside.
+   wall-clock and CPU time with the load average, the thread pools printed; each set timed as the machine is, then
+   beside ``--busy K`` spinning processes (default 2), and every ratio summarised at the end.
 
 History of the timing figure (cpu ratio, diagnose / plain fit): 51x when issue 14 was filed; 27.8x on modes-off data
 before the first speed-up; x33-37 on this data before the whole-run DFT speed-up; x18.9 (first calls x14.0) at a3db21a
@@ -360,56 +361,74 @@ print(json.dumps(out))
 """
 
 
-def timing(sets=("benchmark",), repeats: int = 5, busy: int = 0):
-    """Diagnose / fit, each set in a fresh process (:data:`TIMING_CHILD`), ``repeats`` interleaved pairs, min and
-    median of wall and CPU with the load average; ``busy`` processes spinning beside (``python -c "while 1:
-    pass"``, ended by their pid afterwards)."""
+def _timing_run(which: str, path, repeats: int, busy: int) -> dict:
+    """One timing child (:data:`TIMING_CHILD`) on the set written at ``path``, ``busy`` processes spinning beside
+    (``python -c "while 1: pass"``, ended by their pid afterwards): its JSON and the load average before and after."""
     import json
     import os
     import subprocess
-    import tempfile
-
-    from rwadist.hdf5 import write_hdf5
 
     spinners = [subprocess.Popen([sys.executable, "-c", "while 1: pass"]) for _ in range(busy)]
     try:
-        for which in sets:
-            with tempfile.TemporaryDirectory() as tmp:
-                t = timing_data(which)
-                path = write_hdf5(t, Path(tmp) / f"{which}.h5")
-                load0 = os.getloadavg()[0]
-                r = subprocess.run([sys.executable, "-c", TIMING_CHILD, str(path), str(repeats)],
-                                   capture_output=True, text=True, check=True)
-                res = json.loads(r.stdout.strip().splitlines()[-1])
-                load1 = os.getloadavg()[0]
-            speeds = np.abs([rr.speed for rr in t.runs]) * 60 / (2 * np.pi)
-            print(f"\n{which}: {len(t.runs)} speeds ({speeds.min():.0f}-{speeds.max():.0f} rpm) x "
-                  f"{len(t.runs[0].signals)} channels, {t.runs[0].n_samples} samples at {t.runs[0].sample_rate:g} Hz, "
-                  f"modes on, one effect; {repeats} interleaved (fit, diagnose) pairs in one process, "
-                  f"{busy} busy processes beside; load average {load0:.2f} -> {load1:.2f}")
-            stat = {}
-            for name in ("fit", "diagnose"):
-                wall, cpu = np.array(res[name]).T
-                stat[name] = (wall.min(), float(np.median(wall)), cpu.min(), float(np.median(cpu)))
-                print(f"  {name:8s} wall min {wall.min():6.2f} s  median {np.median(wall):6.2f} s   "
-                      f"cpu min {cpu.min():6.2f} s  median {np.median(cpu):6.2f} s   (first call cpu {cpu[0]:.2f} s)")
-            f, d = stat["fit"], stat["diagnose"]
-            print(f"  diagnose / fit: wall x{d[0] / f[0]:.1f} (min) x{d[1] / f[1]:.1f} (median), cpu x{d[2] / f[2]:.1f} "
-                  f"(min) x{d[3] / f[3]:.1f} (median)   target <= 10x")
-            print(f"  thread pools after the calls: {res['pools']}")
+        load0 = os.getloadavg()[0]
+        r = subprocess.run([sys.executable, "-c", TIMING_CHILD, str(path), str(repeats)],
+                           capture_output=True, text=True, check=True)
+        res = json.loads(r.stdout.strip().splitlines()[-1])
+        res["load"] = (load0, os.getloadavg()[0])
     finally:
         for p in spinners:
             p.terminate()
             p.wait()
+    return res
+
+
+def timing(sets=("benchmark", "sixty"), repeats: int = 5, busy: int = 2):
+    """Diagnose / fit, each set in a fresh process (:data:`TIMING_CHILD`), ``repeats`` interleaved pairs, min and
+    median of wall and CPU with the load average; each set on the machine as it is, then (``busy`` > 0) beside
+    ``busy`` processes spinning; a summary of every ratio at the end."""
+    import tempfile
+
+    from rwadist.hdf5 import write_hdf5
+
+    summary = []
+    for which in sets:
+        with tempfile.TemporaryDirectory() as tmp:
+            t = timing_data(which)
+            path = write_hdf5(t, Path(tmp) / f"{which}.h5")
+            speeds = np.abs([rr.speed for rr in t.runs]) * 60 / (2 * np.pi)
+            for n_busy in sorted({0, busy}):
+                res = _timing_run(which, path, repeats, n_busy)
+                print(f"\n{which}: {len(t.runs)} speeds ({speeds.min():.0f}-{speeds.max():.0f} rpm) x "
+                      f"{len(t.runs[0].signals)} channels, {t.runs[0].n_samples} samples at "
+                      f"{t.runs[0].sample_rate:g} Hz, modes on, one effect; {repeats} interleaved (fit, diagnose) "
+                      f"pairs in one process, {n_busy} busy processes beside; load average {res['load'][0]:.2f} -> "
+                      f"{res['load'][1]:.2f}")
+                stat = {}
+                for name in ("fit", "diagnose"):
+                    wall, cpu = np.array(res[name]).T
+                    stat[name] = (wall.min(), float(np.median(wall)), cpu.min(), float(np.median(cpu)))
+                    print(f"  {name:8s} wall min {wall.min():6.2f} s  median {np.median(wall):6.2f} s   "
+                          f"cpu min {cpu.min():6.2f} s  median {np.median(cpu):6.2f} s   (first call cpu {cpu[0]:.2f} s)")
+                f, d = stat["fit"], stat["diagnose"]
+                ratios = [d[i] / f[i] for i in range(4)]
+                print(f"  diagnose / fit: wall x{ratios[0]:.1f} (min) x{ratios[1]:.1f} (median), cpu x{ratios[2]:.1f} "
+                      f"(min) x{ratios[3]:.1f} (median)   target <= 10x")
+                print(f"  thread pools after the calls: {res['pools']}")
+                summary.append((which, n_busy, res["load"], ratios))
+    print("\nsummary, diagnose / fit (target <= 10x in every row):")
+    for which, n_busy, (l0, l1), r in summary:
+        print(f"  {which:9s} {n_busy} busy beside (load {l0:5.2f} -> {l1:5.2f}): wall x{r[0]:5.1f} (min) x{r[1]:5.1f} "
+              f"(median)   cpu x{r[2]:5.1f} (min) x{r[3]:5.1f} (median)   {'met' if max(r) <= 10 else 'NOT met'}")
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="timing only")
-    ap.add_argument("--sets", nargs="+", default=["benchmark"], choices=sorted(TIMING_SETS),
-                    help="timing sets (default: benchmark)")
+    ap.add_argument("--sets", nargs="+", default=["benchmark", "sixty"], choices=sorted(TIMING_SETS),
+                    help="timing sets (default: both)")
     ap.add_argument("--repeats", type=int, default=5, help="interleaved (fit, diagnose) pairs per set (default 5)")
-    ap.add_argument("--busy", type=int, default=0, help="busy processes spinning beside the timing (default 0)")
+    ap.add_argument("--busy", type=int, default=2, help="each set is timed as the machine is, then beside this many "
+                    "busy processes (default 2; 0: the first only)")
     ap.add_argument("--modes-on", nargs="*", default=None, metavar="GROUP",
                     help="the acceptance cases re-measured on modes-on data only (optionally only these groups: "
                          "clean missing_harmonic amplitude_law broadband_floor fixed_resonance cross_coupling "
