@@ -238,16 +238,18 @@ def mode_frequencies(peaks: list, senses: dict, inertia_ratio: float) -> dict:
 
 # --------------------------------------------------------------------------- 3. least squares
 
-def _measurements(fit: EmpiricalFit):
-    """Flat arrays of every measured line amplitude: line index (position in ``fit.lines``),
-    speed, channel index, amplitude."""
+def _axial_measurements(fit: EmpiricalFit):
+    """Flat arrays of every measured amplitude of the axial lines: line index (position in ``fit.lines``), speed,
+    channel index, amplitude."""
     li, sp, ch, amp = [], [], [], []
     for j, x in enumerate(fit.lines):
         li.append(np.full(x.speed.size, j))
         sp.append(x.speed)
         ch.append(np.array([CHANNEL_INDEX[c] for c in x.channel]))
         amp.append(x.amplitude)
-    return np.concatenate(li), np.concatenate(sp), np.concatenate(ch), np.concatenate(amp)
+    la, sa, ca, aa = np.concatenate(li), np.concatenate(sp), np.concatenate(ch), np.concatenate(amp)
+    keep = np.array([fit.lines[j].direction not in RADIAL for j in la], bool)
+    return la[keep], sa[keep], ca[keep], aa[keep]
 
 
 def _radial_power(meas_lines):
@@ -330,19 +332,27 @@ def _inertias(mass: float | None, radius: float | None, rocking_scan, notes: lis
 
 
 @dataclass
-class _StartStiffness:
-    """A mode's starting stiffness (N/m, N·m/rad): from the frequency its scan found (``f_modes``); a mode without
-    one is NOT CONSTRAINED (said in ``notes``): from ``start`` in a physical fit, else at 3x the top line frequency
-    ``f_top`` Hz."""
+class _ModeStarts:
+    """The modes' starting point.  Per mode the frequency its scan found (``f_modes``, Hz at rest; None: not found)
+    and whether the data identify it; a mode without a frequency is NOT CONSTRAINED (said in ``notes``): its
+    stiffness from ``start`` in a physical fit, else at 3x the top line frequency ``f_top`` Hz, its damping ratio
+    ``zeta0``."""
 
-    f_modes: dict
     scans: dict
     start: ext.ExtendedParams | None
     physical: bool
     f_top: float
+    zeta0: float
     notes: list
+    f_modes: dict = field(init=False)
+    identified: dict = field(init=False)
 
-    def __call__(self, mode: str, inertia: float, attr: str) -> float:
+    def __post_init__(self) -> None:
+        self.f_modes = {m: (sc.f0_hz if sc.found else None) for m, sc in self.scans.items()}
+        self.identified = {m: self.f_modes[m] is not None for m in MODE_PARAMS}
+
+    def stiffness(self, mode: str, inertia: float, attr: str) -> float:
+        """The starting stiffness of ``mode`` (``attr`` of ExtendedParams), N/m or N·m/rad."""
         f = self.f_modes[mode]
         if f is not None:
             return inertia * (2 * np.pi * f) ** 2
@@ -354,6 +364,28 @@ class _StartStiffness:
         self.notes.append(f"{mode}: NOT CONSTRAINED by the data ({self.scans[mode].reason}); its {f_start:.4g} Hz is "
                           "a starting value, listed in analytical.unconstrained")
         return k
+
+    def params(self, mass: float, I_rr: float, I_zz: float) -> dict:
+        """The ExtendedParams fields at the start (SI): each mode's stiffness and damping (the scan's damping ratio
+        when identified, else ``zeta0``), no forcing yet."""
+        k_r = self.stiffness("radial_translation", mass, "k_r")
+        k_rock = self.stiffness("rocking", I_rr, "k_rock")
+        k_z = self.stiffness("axial_translation", mass, "k_z")
+        base = dict(mass=mass, I_zz=I_zz, I_rr=I_rr, k_r=k_r, k_rock=k_rock, k_z=k_z, height=0.0, U_s=0.0, U_d=0.0)
+        for m, (kn, cn, inertia) in MODE_PARAMS.items():
+            zeta = self.scans[m].zeta if self.identified[m] else self.zeta0
+            base[cn] = 2 * zeta * math.sqrt(base[kn] * base[inertia])
+        return base
+
+    def declare(self, base: dict, mode: str, why: str) -> None:
+        """``mode`` not pinned by the least squares: NOT CONSTRAINED (``why``), back to its start in ``base``."""
+        self.scans[mode].reason = why
+        self.scans[mode].found = False
+        self.identified[mode] = False
+        self.f_modes[mode] = None
+        kn, cn, inertia = MODE_PARAMS[mode]
+        base[kn] = self.stiffness(mode, base[inertia], kn)
+        base[cn] = 2 * self.zeta0 * math.sqrt(base[kn] * base[inertia])
 
 
 def _forcing_lines(meas_lines: list, senses_xy: dict) -> tuple[list[ext.Line], np.ndarray]:
@@ -510,44 +542,23 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     notes: list[str] = []
     test, fit, meas, senses_xy = _measured_lines(test, fit, height, ([] if stand is None else [stand]) + list(more_stands))
     peaks = amplification_peaks(fit)
-    la, sa, ca, aa = _measurements(meas)
-    keep_ax = np.array([meas.lines[j].direction not in RADIAL for j in la], bool)
-    la, sa, ca, aa = la[keep_ax], sa[keep_ax], ca[keep_ax], aa[keep_ax]
+    la, sa, ca, aa = _axial_measurements(meas)
     radial = _radial_power(meas.lines)
     scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near)
     mass_kg, I_rr, I_zz = _inertias(mass, radius, scans["rocking"], notes)
-    f_modes = {m: (sc.f0_hz if sc.found else None) for m, sc in scans.items()}
-    f_top = max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines), default=100.0)
-    start_k = _StartStiffness(f_modes, scans, start, physical, f_top, notes)
-    k_r = start_k("radial_translation", mass_kg, "k_r")
-    k_rock = start_k("rocking", I_rr, "k_rock")
-    k_z = start_k("axial_translation", mass_kg, "k_z")
+    starts = _ModeStarts(scans, start, physical, max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines),
+                                                     default=100.0), zeta0, notes)
+    base = starts.params(mass_kg, I_rr, I_zz)
     lines, owner = _forcing_lines(meas.lines, senses_xy)
     lr, sr, pr, dr = radial
     line_of, ax_line, rad_parts = _rows_of_lines(owner, la, lr)
-    identified = {m: f_modes[m] is not None for m in MODE_PARAMS}
-    z_start = {m: (scans[m].zeta if identified[m] else zeta0) for m in MODE_PARAMS}
-    base = dict(mass=mass_kg, I_zz=I_zz, I_rr=I_rr, k_r=k_r, k_rock=k_rock, k_z=k_z, height=0.0, U_s=0.0, U_d=0.0)
-    for m, (kn, cn, inertia) in MODE_PARAMS.items():        # damping ratio z_start[m]
-        base[cn] = 2 * z_start[m] * math.sqrt(base[kn] * base[inertia])
     log_data, joint = _log_data(meas.lines, la, sa, aa, lr, sr, pr, stand if fit_stand else None)
     row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
     problem = LogAmplitudeProblem(base, lines, LinePower(lines, sa, ax_line, ca, sr, rad_parts), log_data, joint,
                                   row_line, centred_log_w, meas.lines, progress)
-
-    def declared(m: str, why: str) -> None:
-        """Mode ``m`` not pinned by the least squares: back to its start, NOT CONSTRAINED."""
-        scans[m].reason = why
-        scans[m].found = False
-        identified[m] = False
-        f_modes[m] = None
-        kn, cn, inertia = MODE_PARAMS[m]
-        base[kn] = start_k(m, base[inertia], kn)
-        base[cn] = 2 * zeta0 * math.sqrt(base[kn] * base[inertia])
-
     off_law: list[int] = []     # lines given an exponent of their own before a mode is declared (appended in place)
-    res, names, rel_se, unpack, _ = _fit_modes(problem, [m for m in MODE_PARAMS if identified[m]], declare,
-                                               tolerance, off_law, log_w, declared)
+    res, names, rel_se, unpack, _ = _fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare,
+                                               tolerance, off_law, log_w, lambda m, why: starts.declare(base, m, why))
     params, fitted_lines = unpack(res.x)
     n_x = res.x.size - (len(joint.NAMES) if joint is not None else 0)
     notes += [off_law_note(meas.lines[j], res.x[n_x + i - len(off_law)], rel_se[n_x + i - len(off_law)])
@@ -560,9 +571,9 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     return ExtendedFit(params=params, lines=kept_lines,
                        zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
                              "axial_translation": params.zeta_z},
-                       rel_stderr={n: float(v) for n, v in zip(names, rel_se)}, identified=identified,
+                       rel_stderr={n: float(v) for n, v in zip(names, rel_se)}, identified=starts.identified,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
-                       unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not identified[m]], scans=scans,
+                       unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
                        line_residuals=line_residuals)
 
