@@ -8,6 +8,9 @@ imports before it computes anything (``rwadist.cli``, numpy, matplotlib's Figure
 load average; the children cache their bytecode (:data:`CHILD_ENV`).  Target: <= 2 s idle.
 
 Run: python benchmarks/bench_psd_cli.py [--repeats R] [--n-freq N]
+On a shared, loaded machine the wall-clock figure is mostly the other jobs' (at load 11 on 2 cores: 3.8 s wall for
+1.5 s of CPU); ``chrt -f 10 python benchmarks/bench_psd_cli.py`` (root: real-time priority, inherited by the children,
+a few seconds) gives the idle machine's figure -- wall = CPU within 2 %.
 """
 from __future__ import annotations
 
