@@ -301,6 +301,30 @@ def test_overdamped_mode_rejected(cname):
         ex.ExtendedParams(**{**d, cname: 1.01 * crit})
 
 
+def test_effective_inertia_ratio_above_two_is_a_model_kit_and_fmu_alike():
+    """I_zz/I_rr above 2 (no rigid rotor about its centre of mass has it, but the whirls of a measured or generated
+    wheel can: the issue-33 family goes to 2.2) is a valid model up to rwadist.schema.MAX_INERTIA_RATIO, in the kit
+    and in the FMU's own reader alike; beyond it both refuse the file, naming the field."""
+    from rwadist.fmu import runtime_model as rt
+
+    from rwadist.model import to_json
+    from rwadist.schema import MAX_INERTIA_RATIO, ModelError
+
+    d = asdict(E)
+    for ratio, valid in ((2.2, True), (MAX_INERTIA_RATIO, True), (1.01 * MAX_INERTIA_RATIO, False)):
+        params = {**d, "I_zz": ratio * E.I_rr}
+        doc = to_json(WheelModel(name="e", analytical=ex.params_to_dict(E)))
+        doc["analytical"]["I_zz_kg_m2"] = params["I_zz"]
+        if valid:
+            assert ex.ExtendedParams(**params).inertia_ratio == pytest.approx(ratio)
+            assert rt.model_from_doc(doc)[0]["I_zz"] == pytest.approx(ratio * E.I_rr)
+        else:
+            with pytest.raises(ValueError, match="I_zz"):
+                ex.ExtendedParams(**params)
+            with pytest.raises(ModelError, match="I_zz"):
+                rt.model_from_doc(doc)
+
+
 def test_bad_speed_profiles():
     t = np.arange(1000) / FS
     w = np.full(t.size, 100.0)

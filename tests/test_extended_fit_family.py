@@ -5,8 +5,12 @@ senses), on a short test (16 speeds, 4096 samples): every mode within 2 %, none 
 The case that failed: a scan that took a radial line measured >= 90 % co-rotating at the load cell for a purely
 co-rotating load.  The whirls amplify one sense more than the other, so a line forced 80 % co-rotating reads more
 co-rotating near the forward whirl; scanned co-rotating only, the rocking mode of wheel #0 (95 Hz) came out at 87 Hz
-and the least squares then ran off to 1848 Hz (#3: 70 Hz -> 2409 Hz).  The family's wheels #2 and #7 (I_zz/I_rr 2.2 and
-2.1) are left out: a rigid rotor about its centre of mass has I_zz <= 2 I_rr, the bound the extended model holds.
+and the least squares then ran off to 1848 Hz (#3: 70 Hz -> 2409 Hz).
+
+The family's wheels #2 and #7 have I_zz/I_rr 2.2 and 2.1, above the 2 of a rigid rotor about its centre of mass: a
+scan capped at 2 put their rocking mode 4.1 % and 2.8 % high to make up the whirl (and diagnose then invented an
+amplitude law on the imbalance).  The ratio is an effective one (rwadist.schema.MAX_INERTIA_RATIO): it is fitted
+there too, within 5 % of the generator's.
 """
 import sys
 from pathlib import Path
@@ -33,7 +37,7 @@ def _test_of(wheel, n_speeds=16, n_samples=4096, seed=1) -> SteadyTest:
     return SteadyTest(runs=runs, meta={})
 
 
-@pytest.mark.parametrize("index", [0, 1, 3, 4, 5, 6])
+@pytest.mark.parametrize("index", range(8))
 def test_family_wheel_modes_are_located(index):
     wheel = fw.family()[index]
     test = _test_of(wheel)
@@ -42,3 +46,4 @@ def test_family_wheel_modes_are_located(index):
     got = _mode_hz(efit.params)
     for name, truth in wheel.modes_hz().items():
         assert got[name] == pytest.approx(truth, rel=0.02), (name, got[name], truth)
+    assert efit.params.inertia_ratio == pytest.approx(wheel.inertia_ratio, rel=0.05)

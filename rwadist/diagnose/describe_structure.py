@@ -440,14 +440,16 @@ def _whirl_note(direction: str, slope: float, modes, s_lo: float, s_hi: float, f
     if direction != "radial_torque":
         return (f"no gyroscopic whirl moves a {direction.replace('_', ' ')} mode (the whirl splits the rocking mode "
                 "only)"), False
+    if modes is not None:
+        # the fitted whirl first: its I_zz/I_rr may exceed 2 (an effective ratio, rwadist.schema.MAX_INERTIA_RATIO)
+        a, f0 = modes.inertia_ratio, modes.f0_Hz["rocking"]
+        branch = lambda s, sgn: np.sqrt((0.5 * a * s) ** 2 + f0**2) + sgn * 0.5 * a * s   # noqa: E731
+        for sgn, name in ((1, "forward"), (-1, "backward")):
+            if abs(branch(s_lo, sgn) / f_lo - 1) < 0.05 and abs(branch(s_hi, sgn) / f_hi - 1) < 0.05:
+                return f"the fitted rocking {name} whirl", True
     if abs(slope) > 2.0:
         return "faster than any rigid rotor's whirl (at most I_zz/I_rr ≤ 2 Hz per Hz of spin)", False
     if modes is None:
         return "a rocking whirl with I_zz/I_rr ≈ %.2g could move so; no suspension modes were fitted" % abs(slope), False
-    a, f0 = modes.inertia_ratio, modes.f0_Hz["rocking"]
-    branch = lambda s, sgn: np.sqrt((0.5 * a * s) ** 2 + f0**2) + sgn * 0.5 * a * s   # noqa: E731
-    for sgn, name in ((1, "forward"), (-1, "backward")):
-        if abs(branch(s_lo, sgn) / f_lo - 1) < 0.05 and abs(branch(s_hi, sgn) / f_hi - 1) < 0.05:
-            return f"the fitted rocking {name} whirl", True
     return (f"the fitted rocking whirl (I_zz/I_rr = {a:.3g}) runs {branch(s_lo, 1):.4g} -> {branch(s_hi, 1):.4g} Hz "
             f"forward and {branch(s_lo, -1):.4g} -> {branch(s_hi, -1):.4g} Hz backward"), False

@@ -5,8 +5,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
+from .. import schema
 from ..schema import COUNT, FREQUENCY, UNCONSTRAINED_MODES, ZETA, boolean, check, names, number, optional, register
 from .element import Element, directions, num
+
+#: I_zz/I_rr of a thin disc, the most a rigid rotor has about its centre of mass (I_zz <= I_xx + I_yy)
+RIGID_INERTIA_RATIO = 2.0
 
 
 @register
@@ -24,7 +28,7 @@ class SuspensionModes(Element):
     zeta_radial_translation: float = field(metadata=check(ZETA))
     zeta_rocking: float = field(metadata=check(ZETA))
     zeta_axial: float = field(metadata=check(ZETA))
-    inertia_ratio: float = field(metadata=check(number(gt=0, le=2.0)))
+    inertia_ratio: float = field(metadata=check(number(gt=0, le=schema.MAX_INERTIA_RATIO)))
     unconstrained: tuple = field(default=(), metadata=check(optional(names(UNCONSTRAINED_MODES), ())))
     per_unit: bool = field(default=True, metadata=check(optional(boolean(), True)))
     n_runs: int | None = field(default=None, metadata=check(COUNT))
@@ -33,6 +37,11 @@ class SuspensionModes(Element):
     def describe(cls, e: Mapping) -> str:
         free = e.get("unconstrained") or ()
         note = f"; not located by the data: {directions(free)}" if free else ""
+        a = e.get("inertia_ratio")
+        if isinstance(a, (int, float)) and a > RIGID_INERTIA_RATIO:
+            note = (f" (above {RIGID_INERTIA_RATIO:g}, which no rigid rotor rocking about its centre of mass exceeds: "
+                    "an effective ratio of the whirls, from a flexible rotor or rocking coupled with other motion)"
+                    + note)
         return (f"radial translation {num(e['radial_translation_Hz'], '.4g')} Hz "
                 f"(ζ {num(e['zeta_radial_translation'], '.2g')}), rocking at rest {num(e['rocking_Hz'], '.4g')} Hz "
                 f"(ζ {num(e['zeta_rocking'], '.2g')}), axial {num(e['axial_Hz'], '.4g')} Hz "

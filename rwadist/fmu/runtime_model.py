@@ -220,8 +220,9 @@ def model_from_doc(doc, source="<model>"):
     for name in ("c_r", "c_rock", "c_z", "U_s", "U_d"):
         if p[name] < 0:
             raise ModelError(f"{source}: analytical.{PARAM_KEYS[name]}: must be >= 0, got {p[name]!r}")
-    if p["I_zz"] > 2.0 * p["I_rr"] * (1 + 1e-12):
-        raise ModelError(f"{source}: analytical: I_zz exceeds 2·I_rr (no rigid body has that)")
+    if p["I_zz"] > _schema.MAX_INERTIA_RATIO * p["I_rr"] * (1 + 1e-12):
+        raise ModelError(f"{source}: analytical: I_zz exceeds {_schema.MAX_INERTIA_RATIO:g}·I_rr "
+                         "(a rigid rotor has I_zz <= 2·I_rr)")
     for m, c, k, what in ((p["mass"], p["c_r"], p["k_r"], "radial"), (p["I_rr"], p["c_rock"], p["k_rock"], "rocking"),
                           (p["mass"], p["c_z"], p["k_z"], "axial")):
         if c / (2.0 * math.sqrt(k * m)) >= 1.0:
