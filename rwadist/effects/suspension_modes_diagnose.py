@@ -115,7 +115,60 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
     starts = [stand_start] if stand_start is not None else \
         (stand_starts(fit) or stand_starts(_whole_data_fit(ctx)))
     efit = fit_extended_beside_stand(test, fit, starts=starts, near=near)
+    if efit.stand is None and stand_start is None:
+        held = _beside_whole_data_stand(ctx, test, fit, efit, near)
+        if held is not None:
+            efit = held
     return efit, efit.stand
+
+
+def _beside_whole_data_stand(ctx: Context, test, fit, plain, near=None):
+    """The extended fit of ``test`` (empirical fit ``fit``) with the fixture resonance fitted jointly with the modes on
+    EVERY run (:func:`_whole_data_stand`) divided out at its parameters, held fixed, or None when every run shows no
+    stand or the fit runs do not confirm it over ``plain`` (the fit runs' own fit, no stand kept:
+    :func:`rwadist.stand_resonance.stand_confirmed`).
+
+    Half of a short speed grid may put no line within the stand's width: the lines near it then tell neither its
+    width nor its frequency from a mode's on the same spot (family wheel 0, a fixture at its radial translation's
+    310 Hz, 8 of 16 speeds: no line between 290 and 330 Hz; the joint fit ran to ζ 0.001, no fixture resonance,
+    and the fit without a stand located no mode).  Every run shows it; held at what they show, the fit runs locate
+    the modes (the search then judges them on the held-out runs, as any effect)."""
+    from ..extended_fit import fit_extended
+    from ..stand_resonance import stand_confirmed
+
+    whole = _whole_data_stand(ctx)
+    if whole is None:
+        return None
+    held = fit_extended(test, fit, stand=whole, near=near)
+    if not stand_confirmed(held, plain):
+        return None
+    f_r, zeta, gain, above = whole
+    held.notes.append(f"test stand: a resonance at {f_r:.4g} Hz (ζ {zeta:.3g}, peak gain {gain:.3g}, {above:.3g} of the "
+                      "load far above it) lifts the lines of every channel: a fixture resonance, fitted with the modes "
+                      "on every run (these runs alone do not resolve it) and divided out here; not part of the "
+                      "wheel's model (analytical.fit.test_stand)")
+    return held
+
+
+def _whole_data_stand(ctx: Context):
+    """The fixture resonance (f_r Hz, ζ, peak gain, gain above) fitted jointly with the modes on every run
+    (:func:`rwadist.stand_resonance.fit_extended_beside_stand` of the whole data's empirical fit,
+    :func:`_whole_data_fit`) when that fit confirms one, else None; computed once per diagnosis."""
+    from ..data import SteadyTest
+
+    key = ("suspension_modes.whole_data_stand",)
+    if key not in ctx._memo:
+        ctx._memo[key] = None
+        whole_fit = _whole_data_fit(ctx)
+        starts = stand_starts(whole_fit)
+        if starts:
+            test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], dict(ctx.test.meta))
+            try:
+                stand = fit_extended_beside_stand(test, whole_fit, starts=starts).stand
+            except ValueError:
+                stand = None
+            ctx._memo[key] = None if stand is None else tuple(float(v) for v in stand)
+    return ctx._memo[key]
 
 
 def _beside_offset(ctx: Context, state: State, runs, test, stand_start, n_unconstrained: int, near=None):
