@@ -47,6 +47,15 @@ def _plateau_middle(score: np.ndarray, sd: np.ndarray) -> int:
     return (lo + hi) // 2
 
 
+def _depth_ok(m: float) -> bool:
+    """True for a modulation depth a model holds, 0 < m <= :data:`rwadist.schema.MAX_DEPTH`: lines beside a carrier
+    that many times stronger than it are no modulation of it (family wheel 2 with a fixture at 46.5 Hz: depth 78 on a
+    weak carrier, and the model diagnose wrote was refused on writing)."""
+    from ..schema import MAX_DEPTH
+
+    return bool(0.0 < m <= MAX_DEPTH)
+
+
 @register(order=60)
 @dataclass
 class Sidebands:
@@ -112,10 +121,8 @@ class Sidebands:
         P, Q = np.concatenate(P_parts), np.concatenate(Q_parts)
         if P.size < 3 or not np.sum(Q * Q) > 0:
             return None
-        m2 = float(np.sum(P * Q) / np.sum(Q * Q))
-        if m2 <= 0:
-            return None
-        return Sidebands(direction, float(h), float(f_mod), float(np.sqrt(m2)), int(P.size))
+        m = float(np.sqrt(max(float(np.sum(P * Q) / np.sum(Q * Q)), 0.0)))
+        return Sidebands(direction, float(h), float(f_mod), m, int(P.size)) if _depth_ok(m) else None
 
     @staticmethod
     def _record_offsets(ctx: Context) -> np.ndarray:
@@ -199,7 +206,7 @@ class Sidebands:
         if A.size < 3 or not np.sum(Q * Q) > 0:
             return None
         m = float(np.sum(A * Q) / np.sum(Q * Q))
-        return Sidebands(direction, float(h), f_mod, m, int(A.size)) if m > 0 else None
+        return Sidebands(direction, float(h), f_mod, m, int(A.size)) if _depth_ok(m) else None
 
     def heldout_evidence(self, ctx: Context, state: State, runs):
         """Held-out evidence of sidebands closer to their carrier than 2.5 Welch bins (None otherwise: the search's own
