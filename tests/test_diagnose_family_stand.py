@@ -8,6 +8,11 @@ same spot by neither width nor frequency (the joint fit ran to ζ 0.001, no fixt
 mode was located) and diagnose named nothing.  Every run shows the stand; held at what they show, the fit runs
 locate the modes.  Checked against the generator's truth: every mode within 2 % (or declared unconstrained), the
 stand named as a test-stand resonance within 2 % of its frequency, nothing else added.
+
+Family wheel 3 with a fixture at 1.25x its radial translation (288 Hz): the stand's held-out evidence summed over the
+channels was diluted by the radial forces' imprecisely measured strong lines (t 3.97 < 4, while the torques alone gave
+20 and the axial force 69) and the search named a wheel-mode resonance of the torques at the stand's frequency
+instead.  A test-stand resonance is also read per load direction (rwadist.diagnose.search._by_direction_t).
 """
 import sys
 from pathlib import Path
@@ -35,9 +40,9 @@ def _diagnosis(index, mode, factor, n_speeds=16, n_samples=4096, seed=1):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("index", [0, 3])
-def test_fixture_on_the_translation_mode_is_named_beside_the_modes(index):
-    wheel, f_fix, d = _diagnosis(index, "radial_translation", 1.0)
+@pytest.mark.parametrize("index, factor", [(0, 1.0), (3, 1.0), (3, 1.25)])
+def test_fixture_at_or_near_the_translation_mode_is_named_beside_the_modes(index, factor):
+    wheel, f_fix, d = _diagnosis(index, "radial_translation", factor)
     kinds = [e["kind"] for e in d.model.effects]
     assert kinds[:1] == ["suspension_modes"], kinds
     modes = d.model.effects[0]
