@@ -329,6 +329,8 @@ class SuspensionModes:
     stand_fit_runs: tuple | None = field(default=None, repr=False)
     #: the search takes a passing suspension_modes before any other effect: the wheel's own modes first
     first = True
+    #: the runs this fit is judged on when it was fitted on the held-out runs (:meth:`other_fold`), else None
+    judge_runs: tuple | None = field(default=None, repr=False)
 
     @property
     def channels(self) -> tuple:
@@ -366,7 +368,12 @@ class SuspensionModes:
         from dataclasses import replace
 
         return replace(SuspensionModes.fit(ctx, state, ctx.runs, self.stand, self.near()) or self,
-                       stand_fit_runs=self.stand)
+                       stand_fit_runs=self.stand if self.judge_runs is None else None, judge_runs=None)
+
+    def other_fold(self, ctx: Context, state: State) -> "SuspensionModes | None":
+        """The modes fitted on the held-out runs, judged on the fit runs (``judge_runs``): the search's other fold
+        when this fit did not pass (:func:`rwadist.diagnose.search._other_folds`), or None; one fit per state."""
+        return _held_out_fold(ctx, state)
 
     def near(self) -> dict:
         """``near`` of :func:`rwadist.extended_fit.fit_extended`: the modes this fit located (not those left
@@ -424,7 +431,23 @@ class SuspensionModes:
         if any(e.kind == "suspension_modes" for e in state.effects):
             return []
         e = SuspensionModes.fit(ctx, state, runs)
+        if e is None:
+            # half of a short speed grid can miss a sharp mode's peak (its damping runs to the fit's floor and no mode
+            # is located) while the other half holds it: the other fold, judged on these runs
+            e = _held_out_fold(ctx, state)
         return [] if e is None else [e]
+
+
+def _held_out_fold(ctx: Context, state: State) -> "SuspensionModes | None":
+    """:class:`SuspensionModes` fitted on the held-out runs, to be judged on the fit runs (``judge_runs``), or None;
+    kept on the context for ``state``."""
+    from dataclasses import replace
+
+    key = ("suspension_modes.held_out_fold", id(state))
+    if key not in ctx._memo or ctx._memo[key][0] is not state:
+        e = SuspensionModes.fit(ctx, state, ctx.held_runs)
+        ctx._memo[key] = (state, None if e is None else replace(e, judge_runs=tuple(int(r) for r in ctx.fit_runs)))
+    return ctx._memo[key][1]
 
 
 #: Relative distance in frequency under which a test-stand resonance the search named is the modes' own stand

@@ -1,0 +1,37 @@
+"""The wheel's suspension modes on clean data of a short speed grid, diagnosed with no model (issue 33: 0 effects
+added to clean data on every wheel), on a wheel of the family generated without rwadist's physics
+(tests/family_wheel.py, seed 2 of the family: the same design table, other dampings, inertias and lines).
+
+The case that failed: family wheel 3 of seed 2, 16 speeds of 4096 samples.  The search fits on every other speed;
+those 8 speeds miss the rocking mode's peak and leave it unconstrained, and the modes so fitted predicted the held-out
+runs worse than the empirical base (no suspension_modes; two missing harmonics and an amplitude law named on clean
+data).  The split of the speeds is arbitrary: the modes are also fitted on the held-out half and judged on the fit
+half (rwadist.diagnose.search._other_folds), which locates all three.  Checked against the generator's truth: only
+``suspension_modes``, every mode within 2 %.
+"""
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import family_wheel as fw  # noqa: E402
+
+from rwadist import api  # noqa: E402
+from rwadist.data import Run, SteadyTest  # noqa: E402
+
+
+@pytest.mark.slow
+def test_clean_wheel_whose_fit_half_misses_a_mode_gets_its_modes_and_nothing_else():
+    wheel = fw.family(seed=2)[3]
+    data = fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, 16), n_samples=4096, noise=0.01,
+                     seed=7)
+    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
+                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
+    d = api.diagnose(SteadyTest(runs=runs, meta={}))
+    assert [e["kind"] for e in d.model.effects] == ["suspension_modes"], [e["kind"] for e in d.model.effects]
+    modes = d.model.effects[0]
+    for name, truth in wheel.modes_hz().items():
+        assert modes[f"{name}_Hz"] == pytest.approx(truth, rel=0.02), (name, modes[f"{name}_Hz"], truth)
