@@ -6,8 +6,11 @@ The case that failed: family wheel 3 of seed 2, 16 speeds of 4096 samples.  The 
 those 8 speeds miss the rocking mode's peak and leave it unconstrained, and the modes so fitted predicted the held-out
 runs worse than the empirical base (no suspension_modes; two missing harmonics and an amplitude law named on clean
 data).  The split of the speeds is arbitrary: the modes are also fitted on the held-out half and judged on the fit
-half (rwadist.diagnose.search._other_folds), which locates all three.  Checked against the generator's truth: only
-``suspension_modes``, every mode within 2 %.
+half (rwadist.diagnose.search._other_folds), which locates all three.  Wheel 0 of seed 2: the fit half ran the
+translation's damping to the fit's floor and located no mode (two fixed resonances, an amplitude law and a missing
+harmonic named); the other fold locates the modes, and a wheel-mode "resonance" of gain 0.02 at 489 Hz patching one
+radial-force line was then named: a wheel mode amplifies (a dip is no wheel mode, only a test stand's gain may fall).
+Checked against the generator's truth: only ``suspension_modes``, every mode within 2 %.
 """
 import sys
 from pathlib import Path
@@ -24,8 +27,9 @@ from rwadist.data import Run, SteadyTest  # noqa: E402
 
 
 @pytest.mark.slow
-def test_clean_wheel_whose_fit_half_misses_a_mode_gets_its_modes_and_nothing_else():
-    wheel = fw.family(seed=2)[3]
+@pytest.mark.parametrize("index", [0, 3])
+def test_clean_wheel_whose_fit_half_misses_a_mode_gets_its_modes_and_nothing_else(index):
+    wheel = fw.family(seed=2)[index]
     data = fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, 16), n_samples=4096, noise=0.01,
                      seed=7)
     runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",

@@ -12,7 +12,7 @@ from ..diagnose.state import State
 from ..resonance import log_power_gain_jacobian, resonance
 from ..units import CHANNEL_DIRECTION, DIRECTION_CHANNELS
 
-#: Smallest peak gain (or 1/gain, an anti-resonance) proposed: |H| within 10 % of 1 everywhere is the size of the
+#: Smallest peak gain (or 1/gain, an anti-resonance of a test stand) proposed: |H| within 10 % of 1 everywhere is the size of the
 #: fit's own model error near a mode (a per-unit extended base leaves ~1-3 % there), not a resonance.
 MIN_PEAK_GAIN = 1.1
 
@@ -335,8 +335,13 @@ class FixedResonance:
             if ref and not modes:
                 given = tuple(float(ref[k]) for k in ("f_Hz", "zeta", "peak_gain")) + (float(ref.get("gain_above", 1.0)),)
                 out.append(FixedResonance.of_stand(given, ctx.channels, given))
-        # a "resonance" that changes no line by more than MIN_PEAK_GAIN is a patch on model error, not a mode
-        out = [e for e in out if abs(np.log(e.peak_gain)) >= np.log(MIN_PEAK_GAIN)]
+        # a "resonance" that changes no line by more than MIN_PEAK_GAIN is a patch on model error, not a mode; nor is a
+        # wheel mode that lowers the lines at its frequency: a mode of the wheel's structure amplifies what passes it
+        # (docs/diagnose.md), and a dip fitted on one direction's lines is a patch on the misfit of the few lines there
+        # (family wheel 0 of seed 2, clean: gain 0.02, ζ 0.0045 at 489 Hz on one radial-force line at the top
+        # speeds; the E-like wheel beside a 180 Hz stand: gain 0.89 at 96 Hz on the radial torques)
+        out = [e for e in out if abs(np.log(e.peak_gain)) >= np.log(MIN_PEAK_GAIN)
+               and (e.role != "wheel_mode" or e.peak_gain >= MIN_PEAK_GAIN)]
         # nor is a tilt across the band that the fit can only bend by running ζ up to its bound
         out = [e for e in out if e.zeta <= MAX_ZETA]
         return [e for e in out if not any(abs(e.f_r - r[0]) < 0.02 * r[0] and set(e.channels) & set(r[3])
