@@ -13,6 +13,11 @@ Family wheel 3 with a fixture at 1.25x its radial translation (288 Hz): the stan
 channels was diluted by the radial forces' imprecisely measured strong lines (t 3.97 < 4, while the torques alone gave
 20 and the axial force 69) and the search named a wheel-mode resonance of the torques at the stand's frequency
 instead.  A test-stand resonance is also read per load direction (rwadist.diagnose.search._by_direction_t).
+
+Family wheel 0 with a fixture at 0.75x its radial translation (232 Hz): the fit half's translation damping (ζ 0.0088;
+truth 0.021, the held-out half 0.021) put a line of the held-out top speed on a peak 1.7x too high, the modes were
+refused and an amplitude law and two missing harmonics named; the modes fitted on the other half and judged on the
+fit half are taken (rwadist.diagnose.search._other_folds).
 """
 import sys
 from pathlib import Path
@@ -40,7 +45,7 @@ def _diagnosis(index, mode, factor, n_speeds=16, n_samples=4096, seed=1):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("index, factor", [(0, 1.0), (3, 1.0), (3, 1.25)])
+@pytest.mark.parametrize("index, factor", [(0, 0.75), (0, 1.0), (3, 1.0), (3, 1.25)])
 def test_fixture_at_or_near_the_translation_mode_is_named_beside_the_modes(index, factor):
     wheel, f_fix, d = _diagnosis(index, "radial_translation", factor)
     kinds = [e["kind"] for e in d.model.effects]
