@@ -47,3 +47,15 @@ def test_family_wheel_modes_are_located(index):
     for name, truth in wheel.modes_hz().items():
         assert got[name] == pytest.approx(truth, rel=0.02), (name, got[name], truth)
     assert efit.params.inertia_ratio == pytest.approx(wheel.inertia_ratio, rel=0.05)
+
+
+def test_a_fitted_ratio_above_two_is_reported_as_an_effective_one():
+    """The fitted I_zz/I_rr of wheel #7 (2.1) is described as above a rigid rotor's bound, #0's (1.56) is not."""
+    from rwadist.effects.suspension_modes import SuspensionModes
+
+    for index, above in ((7, True), (0, False)):
+        test = _test_of(fw.family()[index])
+        p = fit_extended(test, fit_empirical(compute_spectra(test))).params
+        entry = {"radial_translation_Hz": 1.0, "rocking_Hz": 1.0, "axial_Hz": 1.0, "zeta_radial_translation": 0.01,
+                 "zeta_rocking": 0.01, "zeta_axial": 0.01, "inertia_ratio": p.inertia_ratio}
+        assert ("no rigid rotor" in SuspensionModes.describe(entry)) is above, (index, p.inertia_ratio)
