@@ -5,8 +5,19 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from .. import schema
-from ..schema import COUNT, FREQUENCY, UNCONSTRAINED_MODES, ZETA, boolean, check, names, number, optional, register
+from ..schema import (
+    COUNT,
+    FREQUENCY,
+    MAX_INERTIA_RATIO,
+    UNCONSTRAINED_MODES,
+    ZETA,
+    boolean,
+    check,
+    names,
+    number,
+    optional,
+    register,
+)
 from .element import Element, directions, num
 
 #: I_zz/I_rr of a thin disc, the most a rigid rotor has about its centre of mass (I_zz <= I_xx + I_yy)
@@ -28,7 +39,7 @@ class SuspensionModes(Element):
     zeta_radial_translation: float = field(metadata=check(ZETA))
     zeta_rocking: float = field(metadata=check(ZETA))
     zeta_axial: float = field(metadata=check(ZETA))
-    inertia_ratio: float = field(metadata=check(number(gt=0, le=schema.MAX_INERTIA_RATIO)))
+    inertia_ratio: float = field(metadata=check(number(gt=0, le=MAX_INERTIA_RATIO)))
     unconstrained: tuple = field(default=(), metadata=check(optional(names(UNCONSTRAINED_MODES), ())))
     per_unit: bool = field(default=True, metadata=check(optional(boolean(), True)))
     n_runs: int | None = field(default=None, metadata=check(COUNT))
