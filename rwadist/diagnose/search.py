@@ -170,6 +170,16 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
     return Hypothesis(effect, gain / max(float(all_tot.sum()), 1e-300), frac, float(t), passed, iteration)
 
 
+def _judge_families(ctx, state, families, k_sigma, min_gain, iteration, memo, other_folds=False) -> list:
+    """The hypotheses of the candidates of ``families`` on ``state`` (:func:`_judge`), best held-out gain first; with
+    ``other_folds``, when none passes, also those of their other folds (:func:`_other_folds`)."""
+    cands = [e for cls in families for e in cls.candidates(ctx, state, ctx.fit_runs)]
+    new = [_judge(ctx, state, e, k_sigma, min_gain, iteration, memo) for e in cands]
+    if other_folds and not any(h.passed for h in new):
+        new += [_judge(ctx, state, e, k_sigma, min_gain, iteration, memo) for e in _other_folds(ctx, state, new)]
+    return sorted(new, key=lambda h: -h.gain)
+
+
 def _other_folds(ctx, state, judged) -> list:
     """The effects of the judged hypotheses ``judged`` (none of which passed) fitted on the held-out runs instead, to
     be judged on the fit runs (``judge_runs``): ``effect.other_fold(ctx, state)`` where a family has it (the wheel's
@@ -379,11 +389,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
                     min_gain)
         best = refit = applied = None
         for families in (first, rest):
-            cands = [e for cls in families for e in cls.candidates(ctx, state, ctx.fit_runs)]
-            new = [_judge(ctx, state, e, k_sigma, min_gain, it, memo) for e in cands]
-            if families is first and not any(h.passed for h in new):
-                new += [_judge(ctx, state, e, k_sigma, min_gain, it, memo) for e in _other_folds(ctx, state, new)]
-            new.sort(key=lambda h: -h.gain)
+            new = _judge_families(ctx, state, families, k_sigma, min_gain, it, memo, other_folds=families is first)
             for h in new:
                 passed = h.passed
                 h.passed = False                # set again on the one taken
