@@ -306,7 +306,6 @@ def test_effective_inertia_ratio_above_two_is_a_model_kit_and_fmu_alike():
     wheel can: the issue-33 family goes to 2.2) is a valid model up to rwadist.schema.MAX_INERTIA_RATIO, in the kit
     and in the FMU's own reader alike; beyond it both refuse the file, naming the field."""
     from rwadist.fmu import runtime_model as rt
-
     from rwadist.model import to_json
     from rwadist.schema import MAX_INERTIA_RATIO, ModelError
 
