@@ -214,3 +214,55 @@ def test_run_change_flags_the_switched_runs_and_not_a_resonance_crossing():
     (u,) = run_change(ctx, ratios(q + 3.5 * stepped), shares)
     assert sorted(u.parameters["runs"]) == sorted(f"run_{i}" for i in range(R) if i % 3 == 1)
     assert u.level_dB == pytest.approx(3.5, abs=0.1)
+
+
+def _lines_through(spin_hz, hs, gain_db):
+    """The :class:`LineRatios` of radial-force lines ``hs`` at ``spin_hz`` whose measured/predicted ratio (dB) is
+    ``gain_db(f)`` plus each line's own offset (a C fitted off by the resonances), with 0.05 dB of scatter."""
+    from rwadist.diagnose.describe_structure import LineRatios
+
+    rng = np.random.default_rng(5)
+    spin, h = np.meshgrid(spin_hz, hs)
+    line = np.meshgrid(spin_hz, np.arange(len(hs)))[1].ravel()
+    f = (h * spin).ravel()
+    q = gain_db(f, spin.ravel()) + rng.normal(0.0, 1.0, len(hs))[line] + rng.normal(0.0, 0.05, f.size)
+    return LineRatios("radial_force", q, f, np.tile(np.arange(spin_hz.size), len(hs)), spin.ravel(), line,
+                      h.ravel(), np.full(f.size, 1e4))
+
+
+def _transmissibility_db(f, f_n, zeta):
+    r = f / f_n
+    return 20 * np.log10(np.abs((1 + 2j * zeta * r) / (1 - r**2 + 2j * zeta * r)))
+
+
+def _softening_db(f, spin, f0=420.0, drop=0.4, spin_max=100.0, zeta=0.03, gain=5.0):
+    r = f / (f0 * (1 - drop * spin / spin_max))
+    return 20 * np.log10(np.abs((1 - r**2 + 2j * gain * zeta * r) / (1 - r**2 + 2j * zeta * r)))
+
+
+def test_a_moving_resonance_beside_a_mode_the_model_lacks_is_described():
+    """Radial-force lines (h 0.37, 1, 2, 3, 5.67; 16 speeds to 6000 rpm) lifted by a translation mode the model lacks
+    (520 Hz, ζ 0.02: the wheel's suspension modes not fitted) and by a resonance softening with speed (f_r = 420 ×
+    (1 − 0.4 Ω/Ω_max), ζ 0.03, peak gain 5): the moving one is described, falling through its true frequencies, the
+    fixed one beside it named; the mode alone is no moving resonance; the moving one alone is found alone."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose.describe_structure import moving_resonance
+
+    spin = np.linspace(10.0, 100.0, 16)
+    hs = (0.37, 1.0, 2.0, 3.0, 5.67)
+    ctx, state = SimpleNamespace(channels=("Fx", "Fy")), SimpleNamespace(effects=[])
+
+    def described(gain_db):
+        return moving_resonance(ctx, state, [_lines_through(spin, hs, gain_db)], lambda *a: (0.0, 0.0))
+
+    both = described(lambda f, s: _transmissibility_db(f, 520.0, 0.02) + _softening_db(f, s))
+    assert len(both) == 1 and both[0].channels == ("Fx", "Fy")
+    p = both[0].parameters
+    assert p["slope_Hz_per_Hz_of_spin"] < 0
+    assert p["f_at_lowest_speed_Hz"] == pytest.approx(420 * (1 - 0.4 * 0.1), rel=0.1)
+    assert p["f_at_highest_speed_Hz"] == pytest.approx(420 * 0.6, rel=0.1)
+    assert p["beside_fixed_resonance_Hz"] == pytest.approx(520.0, rel=0.05)
+    assert described(lambda f, s: _transmissibility_db(f, 520.0, 0.02)) == []
+    alone = described(lambda f, s: _softening_db(f, s))
+    assert len(alone) == 1 and "beside_fixed_resonance_Hz" not in alone[0].parameters

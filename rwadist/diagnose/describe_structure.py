@@ -330,39 +330,42 @@ MOVING_NULL_RATIO = 0.5
 SLOPES = np.round(np.arange(-3.0, 3.0001, 0.1), 2)
 ZETAS = (0.01, 0.02, 0.04, 0.08)
 GAINS = (2.0, 3.5, 6.0, 10.0)
+#: ... and the gain far above it: 1 (a resonance of the stand or the rotor, H -> 1 on both sides) or 0 (a wheel mode
+#: seen through its suspension, the transmissibility falling above it), for the moving and the fixed alike
+GAINS_ABOVE = (1.0, 0.0)
 
 
-def _resonance_db(f: np.ndarray, f_r: np.ndarray, zeta: float, gain: float) -> np.ndarray:
-    """20·log10 |H| of the simple resonance (:func:`rwadist.resonance.resonance_response`) at ``f`` over ``f_r``."""
+def _resonance_db(f: np.ndarray, f_r: np.ndarray, zeta: float, gain: float, above: float = 1.0) -> np.ndarray:
+    """20·log10 |H| of the resonance (:func:`rwadist.resonance.resonance_response`, gain ``above`` far above it) at
+    ``f`` over ``f_r``."""
     from ..resonance import resonance_response
 
-    return 20 * np.log10(np.abs(resonance_response(f / f_r, zeta, gain)))
+    return 20 * np.log10(np.maximum(np.abs(resonance_response(f / f_r, zeta, gain, above)), 1e-12))
 
 
 def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray) -> tuple:
-    """(sse, f0, slope, zeta, gain) of the best track f_r = f0 + slope·(spin − spin_mid) over the grids, each line's
-    own offset (its C's misfit) taken out: the least squares of q on the resonance's dB gain per line."""
+    """(sse, f0, slope, zeta, gain, gain above) of the best track f_r = f0 + slope·(spin − spin_mid) over the grids,
+    each line's own offset (its C's misfit) taken out: the least squares of q on the resonance's dB gain per line."""
     mid = 0.5 * (r.spin.min() + r.spin.max())
     lines = np.unique(r.line)
     onehot = (r.line[None, :] == lines[:, None]).astype(float)                       # (L, N)
     count = onehot.sum(1)
-    best = (np.inf, np.nan, np.nan, np.nan, np.nan)
+    best = (np.inf, np.nan, np.nan, np.nan, np.nan, np.nan)
     for b in slopes:
         fr = f0s[:, None] + b * (r.spin[None, :] - mid)                               # (F, N)
         valid = np.all(fr > 0, axis=1)
         if not valid.any():
             continue
         fr = np.where(fr > 0, fr, 1.0)
-        for z in ZETAS:
-            for g in GAINS:
-                G = _resonance_db(r.f[None, :], fr, z, g)                             # (F, N)
-                res = r.q[None, :] - G
-                off = (res @ onehot.T) / count                                        # (F, L) per-line offsets
-                e = res - off @ onehot
-                sse = np.where(valid, np.sum(e * e, axis=1), np.inf)
-                i = int(np.argmin(sse))
-                if sse[i] < best[0]:
-                    best = (float(sse[i]), float(f0s[i]), float(b), z, g)
+        for z, g, above in ((z, g, a) for z in ZETAS for g in GAINS for a in GAINS_ABOVE):
+            G = _resonance_db(r.f[None, :], fr, z, g, above)                      # (F, N)
+            res = r.q[None, :] - G
+            off = (res @ onehot.T) / count                                        # (F, L) per-line offsets
+            e = res - off @ onehot
+            sse = np.where(valid, np.sum(e * e, axis=1), np.inf)
+            i = int(np.argmin(sse))
+            if sse[i] < best[0]:
+                best = (float(sse[i]), float(f0s[i]), float(b), z, g, above)
     return best
 
 
@@ -375,41 +378,92 @@ def _offsets_only(r: LineRatios) -> float:
     return sse
 
 
+def _track_db(r: LineRatios, f0: float, slope: float, zeta: float, gain: float, above: float) -> np.ndarray:
+    """The dB gain at every point of ``r`` of the resonance on the track f_r = f0 + slope·(spin − spin_mid)."""
+    mid = 0.5 * (r.spin.min() + r.spin.max())
+    return _resonance_db(r.f, np.maximum(f0 + slope * (r.spin - mid), 1e-6), zeta, gain, above)
+
+
+def _best_track(r: LineRatios, coarse: np.ndarray, slopes: np.ndarray, q: np.ndarray | None = None) -> tuple:
+    """:func:`_track_fit` over the ``coarse`` f0 grid and ``slopes`` (every other one), then finely around the best
+    (f0 to 0.5 %, the slope to 0.05 Hz/Hz; a fixed resonance, ``slopes`` = [0], stays fixed); ``q``: the dB ratios
+    fitted instead of ``r.q`` (what another resonance leaves)."""
+    from dataclasses import replace
+
+    rr = r if q is None else replace(r, q=q)
+    fixed = slopes.size == 1 and slopes[0] == 0.0
+    best = _track_fit(rr, coarse, slopes if fixed else slopes[::2])
+    f0s = np.exp(np.arange(np.log(best[1]) - 0.04, np.log(best[1]) + 0.0401, 0.005))
+    near = slopes if fixed else np.round(np.arange(best[2] - 0.2, best[2] + 0.2001, 0.05), 3)
+    return min(best, _track_fit(rr, f0s, near))
+
+
+#: Rounds of the fit of a track beside a fixed resonance, each fitted in turn on what the other leaves.
+PAIR_ROUNDS = 2
+FIXED = np.array([0.0])
+
+
+def _beside_fixed(r: LineRatios, coarse: np.ndarray, slopes: np.ndarray, fixed: tuple) -> tuple:
+    """(sse, track, fixed) of a track of ``slopes`` fitted together with a fixed resonance (starting from ``fixed``),
+    each in turn on what the other leaves (:data:`PAIR_ROUNDS`): a wheel mode the model lacks (its suspension modes
+    not fitted) lifts the lines it crosses beside the moving resonance."""
+    track = fixed
+    for _ in range(PAIR_ROUNDS):
+        track = _best_track(r, coarse, slopes, r.q - _track_db(r, *fixed[1:]))
+        fixed = _best_track(r, coarse, FIXED, r.q - _track_db(r, *track[1:]))
+    return fixed[0], track, fixed
+
+
+def _moving_fit(r: LineRatios) -> tuple | None:
+    """(track (sse, f0, slope, ζ, gain), misfit ratio to the fixed alternative, F statistic, fixed companion or None)
+    of the resonance moving with speed that the dB ratios of ``r`` hold, or None (:func:`moving_resonance`): alone
+    against one fixed resonance, else beside a fixed resonance against two fixed ones."""
+    lifted = r.f[r.q >= MOVING_GATE_DB]
+    coarse = np.exp(np.arange(np.log(0.7 * lifted.min()), np.log(1.3 * lifted.max()), 0.03))
+    sse0 = _offsets_only(r)
+    span = r.spin.max() - r.spin.min()
+    n_lines = np.unique(r.line).size
+    fix = _best_track(r, coarse, FIXED)
+
+    def judged(mov, null_sse, companion, n_par):
+        sse_m, f0, b, zeta = mov[:4]
+        # the moving track's one more parameter must pay: its drop of the misfit over the misfit per degree of freedom
+        dof = max(r.q.size - n_lines - n_par, 1)
+        f_stat = (null_sse - sse_m) / max(sse_m / dof, 1e-300)
+        if (f_stat >= MOVING_F and sse_m <= MOVING_RATIO * null_sse and sse_m <= MOVING_NULL_RATIO * sse0
+                and abs(b) * span > 2 * zeta * f0):
+            return mov, sse_m / max(null_sse, 1e-300), f_stat, companion
+        return None
+
+    got = judged(_best_track(r, coarse, SLOPES), fix[0], None, 4)
+    if got is None:                     # beside a fixed resonance, against two fixed ones
+        sse, mov, companion = _beside_fixed(r, coarse, SLOPES, fix)
+        got = judged((sse,) + mov[1:], _beside_fixed(r, coarse, FIXED, fix)[0], companion, 8)
+    return got
+
+
 def moving_resonance(ctx, state, ratios: list, shares) -> list:
     """A resonance lifting the lines of one direction whose frequency moves with the speed.
 
-    Where the lines of a direction are lifted by :data:`MOVING_PEAK_DB` in two runs at least, their dB ratios are fitted with
-    a resonance on a track f_r = f0 + b·(spin − spin_mid) (spin the rotation frequency, Hz; each line's own offset
-    taken out), over grids of f0, the slope b, ζ and the peak gain (coarse, then fine around the best); the same
-    with b = 0 (a fixed resonance).  Described when the moving track's one more parameter pays (:data:`MOVING_F`),
-    it leaves at most :data:`MOVING_RATIO` of the misfit the fixed one leaves (and :data:`MOVING_NULL_RATIO` of the
-    misfit without any) and it moves by more than its own half-power width over the speeds.  The gyroscopic whirl explains a moving resonance only on the radial torques (the rocking mode: forward
-    whirl slope between 0 and I_zz/I_rr ≤ 2, backward falling): on a translation direction or faster than 2 Hz per
-    Hz of spin, no whirl does."""
+    Where the lines of a direction are lifted by :data:`MOVING_PEAK_DB` in two runs at least, their dB ratios are
+    fitted with a resonance on a track f_r = f0 + b·(spin − spin_mid) (spin the rotation frequency, Hz; each line's
+    own offset taken out), over grids of f0, the slope b, ζ and the peak gain (coarse, then fine around the best);
+    the same with b = 0 (a fixed resonance).  Described when the moving track's one more parameter pays
+    (:data:`MOVING_F`), it leaves at most :data:`MOVING_RATIO` of the misfit the fixed one leaves (and
+    :data:`MOVING_NULL_RATIO` of the misfit without any) and it moves by more than its own half-power width over the
+    speeds.  When it does not, the same beside a fixed resonance against two fixed ones (:func:`_beside_fixed`: a
+    wheel mode the model lacks lifts other lines of the direction).  The gyroscopic whirl explains a moving
+    resonance only on the radial torques (the rocking mode: forward whirl slope between 0 and I_zz/I_rr, backward
+    falling): on a translation direction, no whirl does."""
     modes = next((e for e in state.effects if getattr(e, "kind", "") == "suspension_modes"), None)
     out = []
     for r in ratios:
         if r.q.size < 8 or np.unique(r.run[r.q >= MOVING_PEAK_DB]).size < 2 or np.unique(r.line).size < 2:
             continue
-        lifted = r.f[r.q >= MOVING_GATE_DB]
-        f_lo, f_hi = 0.7 * lifted.min(), 1.3 * lifted.max()
-        coarse = np.exp(np.arange(np.log(f_lo), np.log(f_hi), 0.03))
-        sse0 = _offsets_only(r)
-        mov = _track_fit(r, coarse, SLOPES[::2])
-        fix = _track_fit(r, coarse, np.array([0.0]))
-        fine = lambda f0, b: (np.exp(np.arange(np.log(f0) - 0.04, np.log(f0) + 0.0401, 0.005)),   # noqa: E731
-                              np.round(np.arange(b - 0.2, b + 0.2001, 0.05), 3))
-        mov = min(mov, _track_fit(r, *fine(mov[1], mov[2])))
-        f0f, _ = fine(fix[1], 0.0)
-        fix = min(fix, _track_fit(r, f0f, np.array([0.0])))
-        sse_m, f0, b, zeta, gain = mov
-        span = r.spin.max() - r.spin.min()
-        # the moving track's one more parameter must pay: its drop of the misfit over the misfit per degree of freedom
-        dof = max(r.q.size - np.unique(r.line).size - 4, 1)
-        f_stat = (fix[0] - sse_m) / max(sse_m / dof, 1e-300)
-        if not (f_stat >= MOVING_F and sse_m <= MOVING_RATIO * fix[0] and sse_m <= MOVING_NULL_RATIO * sse0
-                and abs(b) * span > 2 * zeta * f0):
+        got = _moving_fit(r)
+        if got is None:
             continue
+        (sse_m, f0, b, zeta, gain, _), misfit_ratio, f_stat, companion = got
         mid = 0.5 * (r.spin.min() + r.spin.max())
         f_low, f_high = f0 + b * (r.spin.min() - mid), f0 + b * (r.spin.max() - mid)
         chans = tuple(c for c in DIRECTION_CHANNELS[r.direction] if c in ctx.channels)
@@ -419,6 +473,8 @@ def moving_resonance(ctx, state, ratios: list, shares) -> list:
         share, level = shares(chans, lambda spin: f0 + b * (spin - mid), zeta)
         rpm = np.array([r.spin.min(), r.spin.max()]) * 60.0
         sign = "stiffening" if b > 0 else "softening"
+        beside = {} if companion is None else {"beside_fixed_resonance_Hz": float(companion[1]),
+                                               "beside_fixed_resonance_peak_gain": float(companion[4])}
         out.append(Unexplained(
             signature="moving_resonance", channels=chans, speed_rpm=(float(rpm[0]), float(rpm[1])),
             f_Hz=(float(min(f_low, f_high)), float(max(f_low, f_high))), level_dB=level, share=share,
@@ -426,7 +482,7 @@ def moving_resonance(ctx, state, ratios: list, shares) -> list:
             parameters={"direction": r.direction, "f_at_lowest_speed_Hz": float(f_low),
                         "f_at_highest_speed_Hz": float(f_high), "slope_Hz_per_Hz_of_spin": float(b),
                         "zeta": float(zeta), "peak_gain": float(gain), "fixed_resonance_misfit_ratio":
-                        float(sse_m / max(fix[0], 1e-300)), "f_statistic": float(f_stat), "whirl": whirl},
+                        float(misfit_ratio), "f_statistic": float(f_stat), "whirl": whirl, **beside},
             causes=(f"a mode of the rotor {sign} with speed (centrifugal {sign} of the disc or rim: an umbrella or "
                     "diaphragm mode, or the bearings' preload changing with speed)",
                     "a resonance of the motor's drive or speed loop whose frequency follows the speed"),
