@@ -18,6 +18,10 @@ Family wheel 0 with a fixture at 0.75x its radial translation (232 Hz): the fit 
 truth 0.021, the held-out half 0.021) put a line of the held-out top speed on a peak 1.7x too high, the modes were
 refused and an amplitude law and two missing harmonics named; the modes fitted on the other half and judged on the
 fit half are taken (rwadist.diagnose.search._other_folds).
+
+Family wheel 5 with a fixture on its 600 Hz translation: the stand passed the held-out test but the radial forces'
+own resonance gained a little more (0.93 against 0.87 of the misfit), and two wheel-mode resonances were named
+instead; a passing stand is taken before a one-direction resonance at its frequency.
 """
 import sys
 from pathlib import Path
@@ -45,7 +49,7 @@ def _diagnosis(index, mode, factor, n_speeds=16, n_samples=4096, seed=1):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("index, factor", [(0, 0.75), (0, 1.0), (3, 1.0), (3, 1.25)])
+@pytest.mark.parametrize("index, factor", [(0, 0.75), (0, 1.0), (3, 1.0), (3, 1.25), (5, 1.0)])
 def test_fixture_at_or_near_the_translation_mode_is_named_beside_the_modes(index, factor):
     wheel, f_fix, d = _diagnosis(index, "radial_translation", factor)
     kinds = [e["kind"] for e in d.model.effects]
