@@ -4,13 +4,16 @@
 tables).  Here the digits come from numpy arithmetic on the whole array, the same characters printf writes:
 
 * x = m·10^e with m rounded to d + 1 significant digits: v = |x|·10^(d−e) as a double-double (Dekker's exact
-  product of |x| and 10^k, k = d − e, whose double-double value is exact for k <= 22 and within 2^-106 above);
+  product of |x| and 10^k, k = d − e, whose double-double value is exact for k <= 22 and within ~2^-104·v above);
   m = v rounded to nearest, ties to even (the exact decimal value's tie, as glibc's printf under the default
-  rounding mode; for k <= 22 the product is exact, for k > 22 no tie can occur at these magnitudes);
+  rounding mode; for k <= 22 the product is exact, for k > 22 no tie can occur at these magnitudes, but v can lie
+  closer to one than the double-double's error: 2.378016066134295e-28 at 14 digits is ...429.4999999999999999998
+  units of the last digit; such a number is left to Python);
 * e from log10, corrected by one where v fell outside [10^d, 10^(d+1)) or rounded up to 10^(d+1);
 * each number in a fixed-width slot of bytes, the absent minus sign and third exponent digit squeezed out.
 
-Numbers the double-double does not serve (|x| >= 10^d, inf, nan) are formatted by Python itself.
+Numbers the double-double does not serve (|x| >= 10^d, inf, nan, a product too near a tie) are formatted by Python
+itself.
 Checked character for character against ``"%.{d}e" % x`` (tests/test_psd_output.py).
 """
 from __future__ import annotations
@@ -62,10 +65,11 @@ def _scaled(a: np.ndarray, k: np.ndarray) -> tuple:
 
 
 def _digits_and_exponent(a: np.ndarray, d: int) -> tuple:
-    """For |x| = ``a`` (finite, below 10^d): (m, e) with m·10^(e−d) = a rounded to d + 1 significant digits, ties
-    to even; m integer in [10^d, 10^(d+1)) (0 for a = 0).  A plain product a·10^k (relative error < 2.3e-16)
-    decides every number whose rounding it cannot get wrong; the others, near a tie or a power of ten, take the
-    exact double-double path."""
+    """For |x| = ``a`` (finite, below 10^d): (m, e, undecided) with m·10^(e−d) = a rounded to d + 1 significant
+    digits, ties to even; m integer in [10^d, 10^(d+1)) (0 for a = 0); ``undecided`` (bool) marks the numbers whose
+    rounding even the double-double cannot decide (their m is one of two).  A plain product a·10^k (relative error
+    < 2.3e-16) decides every number whose rounding it cannot get wrong; the others, near a tie or a power of ten,
+    take the double-double path."""
     zero = a == 0
     safe = np.where(zero, 1.0, a)
     e = np.floor(np.log10(safe)).astype(np.int64)
@@ -80,14 +84,16 @@ def _digits_and_exponent(a: np.ndarray, d: int) -> tuple:
     carry = m >= hi_bound                          # 9.99...96 rounded up: 1.0 of the next decade
     m[carry] = lo_bound
     e += carry
+    undecided = np.zeros(a.shape, bool)
     idx = np.nonzero(unsure & ~zero)[0]
     if idx.size:
-        m[idx], e[idx] = _exact(safe[idx], e[idx], d)
-    return np.where(zero, 0, m).astype(np.int64), np.where(zero, 0, e)
+        m[idx], e[idx], undecided[idx] = _exact(safe[idx], e[idx], d)
+    return np.where(zero, 0, m).astype(np.int64), np.where(zero, 0, e), undecided
 
 
 def _exact(a: np.ndarray, e: np.ndarray, d: int) -> tuple:
-    """(m, e) of :func:`_digits_and_exponent` from the double-double a·10^(d−e), the exponent settled first."""
+    """(m, e, undecided) of :func:`_digits_and_exponent` from the double-double a·10^(d−e), the exponent settled
+    first."""
     lo_bound, hi_bound = 10.0**d, 10.0 ** (d + 1)
     for _ in range(3):                       # log10 may be one off next to a power of ten
         vh, vl = _scaled(a, d - e)
@@ -102,9 +108,12 @@ def _exact(a: np.ndarray, e: np.ndarray, d: int) -> tuple:
     # nearest integer to vh + vl: |vl| <= ulp(vh) <= 1/8, so m or m + 1; vh − m − 0.5 is exact and the sign of a
     # rounded sum is the sign of the exact one
     past_half = (vh - m - 0.5) + vl
+    # for k > 22 the double-double is within ~2^-104·v of v (10^k's two halves, a times the low one, their sum),
+    # and v may lie nearer a tie than that: such a number's rounding is not decided here
+    undecided = (d - e > 22) & (np.abs(past_half) <= 2.0**-100 * hi_bound)
     m = m + ((past_half > 0) | ((past_half == 0) & (np.fmod(m, 2.0) == 1.0)))
     carry = m >= hi_bound
-    return np.where(carry, lo_bound, m), e + carry
+    return np.where(carry, lo_bound, m), e + carry, undecided
 
 
 _E_MIN, _E_MAX = -340, 340
@@ -139,11 +148,14 @@ def format_rows(values: np.ndarray, digits: int) -> bytes:
         raise ValueError(f"digits must be 0..14 (the mantissa must fit a double exactly), got {digits}")
     x = np.ascontiguousarray(values, dtype=float)
     n, c = x.shape
+    if c == 0:                               # np.savetxt's empty line per row
+        return b"\n" * n
     flat = x.ravel()
     width = digits + 8                       # '-', d, '.', digits, 'e', '±', e2, e1, e0 ... and the separator
     a = np.abs(flat)
     fast = np.isfinite(a) & (a < 10.0**digits)
-    m, e = _digits_and_exponent(np.where(fast, a, 1.0), digits)
+    m, e, undecided = _digits_and_exponent(np.where(fast, a, 1.0), digits)
+    fast &= ~undecided
     # the d + 1 significant digits four at a time (the characters of 0000..9999 from a table), '0's ahead to fill
     n_quads = (digits + 4) // 4
     pad = 4 * n_quads - (digits + 1)

@@ -40,6 +40,23 @@ def test_numbers_are_printfs_characters(digits):
     assert len(got) == len(ref) and not bad, bad[:5]
 
 
+def test_a_product_nearer_a_tie_than_the_double_doubles_error_is_printfs():
+    # 2.378016066134295e-28·10^42 = 237801606613429.49999999999999999954 exactly (Fraction): printf rounds down; the
+    # double-double of a·10^42 (error ~2^-104·v, 1.4e-17 here) rounded it up to ...430 (found by a lattice search for
+    # doubles whose a·10^k, k > 22, lies within 1e-16 of a half-integer at 15 digits)
+    hard = 2.378016066134295e-28
+    assert _formatted([hard, -hard, 1.0, hard * 10], 14) == _printf([hard, -hard, 1.0, hard * 10], 14)
+    assert _formatted([hard], 14) == ["2.37801606613429e-28"]
+
+
+@pytest.mark.parametrize("shape", [(0, 3), (3, 0), (0, 0), (1, 1)])
+def test_empty_and_single_tables_are_savetxts(shape):
+    x = np.full(shape, -0.5)
+    buf = io.BytesIO()
+    np.savetxt(buf, x, delimiter=",", fmt="%.3e")
+    assert format_rows(x, 3) == buf.getvalue()
+
+
 def test_digits_beyond_a_doubles_mantissa_are_refused():
     with pytest.raises(ValueError, match="digits"):
         format_rows(np.ones((1, 1)), 15)
