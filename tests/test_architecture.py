@@ -237,7 +237,10 @@ def test_installed_packages_are_the_source_packages():
 
     root = PACKAGE.parent
     cfg = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]
-    found = {".".join(init.parent.relative_to(root).parts) for init in PACKAGE.rglob("__init__.py")}
+    # every folder that holds a file (a package, or the native FMU's C sources: namespace packages to setuptools,
+    # which warns "Package would be ignored" at each build for one not listed)
+    found = {".".join(f.parent.relative_to(root).parts) for f in PACKAGE.rglob("*")
+             if f.is_file() and "__pycache__" not in f.parts}
     assert found == set(cfg["packages"])
     assert "package-dir" not in cfg
     assert not (root / "fmu").exists() and not (root / "coupling").exists()
