@@ -386,3 +386,16 @@ def test_a_model_fitted_per_unit_mass_needs_the_rotor_mass_to_be_coupled():
     assert spec.params.U_s == pytest.approx(model.analytical["U_s_kg_m"])
     with pytest.raises(cp.CouplingError, match="in SI already"):       # they were ignored for a model in SI
         wheel_spec_from_model(wheel.to_model(), mass_kg=1.0, radius_m=0.05)
+
+
+def test_a_floor_of_another_type_is_refused_naming_the_class_to_use():
+    """The message names the class by an import path that works (it named coupling.performance.Floor, the
+    package's path before it moved into rwadist)."""
+    import importlib
+
+    p = preset("ithaco-e").extended
+    with pytest.raises(cp.CouplingError, match="floors must be") as info:
+        cp.WheelSpec(p, (ext.Line("radial_force", 1.0, p.U_s),), floors=(object(),))
+    path = str(info.value).split("floors must be ")[1].split()[0]
+    module, name = path.rsplit(".", 1)
+    assert getattr(importlib.import_module(module), name) is cp.Floor

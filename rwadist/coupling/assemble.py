@@ -3,7 +3,7 @@ of its Table 5.1.
 
 The five steps as done here:
 
-(i)   components and arrangement: one plant, attachments (component + :class:`~coupling.geometry.Mount`);
+(i)   components and arrangement: one plant, attachments (component + :class:`~rwadist.coupling.geometry.Mount`);
 (ii)  free-free models with force inputs and acceleration outputs: the plant's accelerance;
 (iii) one attachment point inverted per component: attached components are given in the
       inverted form, interface acceleration in -> load out (``f = Zc a + B w``), which is
@@ -45,7 +45,7 @@ SINGULAR_COND = 1e12
 
 @dataclass(frozen=True)
 class Attachment:
-    """A component bolted to the plant: ``mount`` a :class:`~coupling.geometry.Mount` (6-axis) or
+    """A component bolted to the plant: ``mount`` a :class:`~rwadist.coupling.geometry.Mount` (6-axis) or
     None (component interface = plant interface, same size)."""
 
     component: Component

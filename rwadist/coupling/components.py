@@ -552,7 +552,7 @@ def example_spacecraft(total_mass: float = 1800.0, first_mode_hz: float = 10.0, 
     rigid payload (slender cylinder of length ``payload_length`` along +z, radius 0.4 m, centre
     at (0, 0, bus_size/2 + length/2)) joined at the bus top face by a 6-axis elastic joint.
 
-    Interface: one node, the bus centre (6 DOFs); wheels go on it with :class:`~coupling.geometry.Mount`
+    Interface: one node, the bus centre (6 DOFs); wheels go on it with :class:`~rwadist.coupling.geometry.Mount`
     lever arms.  Performance outputs: line of sight 'LOS_x', 'LOS_y' = the payload's rotation
     about x and y, rad.  The joint's stiffnesses (translation k_t, rotation k_r with
     k_r = k_t·(length/2)²) are scaled so that the lowest flexible mode is exactly first_mode_hz;

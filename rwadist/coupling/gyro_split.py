@@ -2,12 +2,12 @@
 
 A wheel's speed enters its dynamic mass only through the rotor's gyroscopic coupling, a rank-2 term:
 A(Ω) = A0 + g·E·N (g = I_zz·Ω/I_rr; E = the two rocking-rate states' columns, N their gyroscopic rows, see
-:func:`coupling.components.wheel_matrices`), so by Woodbury, with R0 = (sI − A0)⁻¹::
+:func:`rwadist.coupling.components.wheel_matrices`), so by Woodbury, with R0 = (sI − A0)⁻¹::
 
     Zc(s, Ω) = Zc0(s) + a(s)·K(s, Ω)·b(s),     K = g·(I − g·Q(s))⁻¹,   a = C R0 E,  b = N R0 B_a,  Q = N R0 E
 
 (B_a the acceleration inputs; the free-load transmissibility likewise, B = B0 + a·K·b_w).  A hard-mounted wheel's
-gyroscopic torque is Ω·I_zz/s on its two rocking DOFs (:func:`coupling.performance.rigid_wheel_frf`): the same form,
+gyroscopic torque is Ω·I_zz/s on its two rocking DOFs (:func:`rwadist.coupling.performance.rigid_wheel_frf`): the same form,
 a = b^T = [e_Tx, e_Ty], K = (Ω·I_zz/s)·[[0, −1], [1, 0]].
 
 The coupled interface matrix is then Lc = L0(f) − U·K·V, U = [Mt_iᵀ a_i] (n_if × 2w), V = [b_i Mt_i G] (2w × n_if),
@@ -37,7 +37,7 @@ from .interface import _interface_matrix, rigid_wheel_frf
 
 
 def _gyro_vectors():
-    """E (12, 2), N (2, 12) with A(Ω) − A(0) = g·E·N in :func:`coupling.components.wheel_matrices` (states 8, 9 the
+    """E (12, 2), N (2, 12) with A(Ω) − A(0) = g·E·N in :func:`rwadist.coupling.components.wheel_matrices` (states 8, 9 the
     rotor's rocking rates, 10, 11 the housing's rates)."""
     E = np.zeros((12, 2))
     E[8, 0] = E[9, 1] = 1.0

@@ -1,5 +1,5 @@
-"""The coupled interface equation's pieces shared by the line and floor responses (:mod:`coupling.performance`,
-:mod:`coupling.gyro_split`): a hard-mounted wheel's dynamic mass, the congruences of constant selectors, and
+"""The coupled interface equation's pieces shared by the line and floor responses (:mod:`rwadist.coupling.performance`,
+:mod:`rwadist.coupling.gyro_split`): a hard-mounted wheel's dynamic mass, the congruences of constant selectors, and
 I − Σ_i Mt_iᵀ Zc_i Mt_i G."""
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ from .components import wheel_rigid_mass_matrix
 
 def rigid_wheel_frf(p: ext.ExtendedParams, omega, f, housing_mass: float = 0.0, housing_inertia=(0.0, 0.0, 0.0)):
     """(Zc, B) of a hard-mounted (rigid-suspension) wheel at speeds omega (S,) rad/s and frequencies f (S, J)
-    Hz: Zc (S, J, 6, 6), B (6, 6).  The limit of :func:`coupling.components.wheel_matrices` as the suspension
+    Hz: Zc (S, J, 6, 6), B (6, 6).  The limit of :func:`rwadist.coupling.components.wheel_matrices` as the suspension
     stiffnesses grow without bound (test): the rotor moves with the housing, so
     f = −M6 a + (gyroscopic) + B w with M6 the rigid wheel's mass matrix
-    (:func:`coupling.components.wheel_rigid_mass_matrix`), the rotor's angular momentum I_zz·Ω giving
+    (:func:`rwadist.coupling.components.wheel_rigid_mass_matrix`), the rotor's angular momentum I_zz·Ω giving
     Tx = −I_zz Ω ω_y, Ty = +I_zz Ω ω_x (ω = α/s, s = i2πf), and B passing the free loads with the radial
     force's lever arm h (Tx −= h·wFy, Ty += h·wFx)."""
     om = np.asarray(omega, dtype=float)

@@ -2,7 +2,7 @@
 spacecraft, side by side with the three practices of thesis Table 5.1.
 
 Method (frequency domain, exact for steady lines; the same physics as
-:func:`coupling.assemble.assemble`, checked against it in the tests).  At a line of wheel k at
+:func:`rwadist.coupling.assemble.assemble`, checked against it in the tests).  At a line of wheel k at
 frequency f, with plant accelerance G(f) and performance map P(f) (per interface load), each
 wheel i's inverted component ``f_i = Zc_i a_i + B_i w_i`` mounted by Mt_i, the plant interface
 loads u solve::
@@ -160,7 +160,7 @@ class WheelSpec:
         if not self.lines:
             raise CouplingError(f"{self.name}: no forcing lines")
         if any(not isinstance(f, Floor) for f in self.floors):
-            raise CouplingError(f"{self.name}: floors must be coupling.performance.Floor objects")
+            raise CouplingError(f"{self.name}: floors must be rwadist.coupling.performance.Floor objects")
         if self.ripple is not None and not isinstance(self.ripple, ripple_mod.Ripple):
             raise CouplingError(f"{self.name}: ripple must be a rwadist.extended_ripple.Ripple or None")
 
@@ -544,7 +544,7 @@ def floor_grid(plant: Plant, wheels, omega, points_per_halfwidth: float = 2.0, p
     geometric, Δf/f = ζ_min/``points_per_halfwidth`` (and at least ``per_decade`` points per decade),
     ζ_min the smallest damping ratio of the oscillatory poles near the band (lo/2 .. 2·hi) of every system
     the practices solve -- the plant alone, the plant with rigid wheel masses, the coupled assembly
-    (:func:`coupling.assemble.assemble`, at up to GRID_SPEEDS of the speeds) -- and of the wheels' blocked
+    (:func:`rwadist.coupling.assemble.assemble`, at up to GRID_SPEEDS of the speeds) -- and of the wheels' blocked
     rotor modes at all the speeds (:func:`rwadist.extended.damped_modes`).  (The coupled poles are needed:
     mass loading lowers a mode's damping ratio, ζ_c ≈ ζ·f_c/f, below its constituents'.)  A resonance of
     half-power half-width ζf then gets ``points_per_halfwidth`` points per half-width.  The mean square is

@@ -4,7 +4,7 @@ Local by default with no setup (dask's threaded scheduler in this process); pass
 ``scheduler="processes"``/``"sync"`` for the other local schedulers, ``address="tcp://host:8786"``
 to run on a dask.distributed cluster, or ``client=`` an existing ``distributed.Client`` (e.g. on
 a ``LocalCluster``).  Work is split into (wheel set, speed chunk) tasks; each task runs
-:func:`coupling.performance.jitter_vs_speed` on its chunk, so results are identical to a serial
+:func:`rwadist.coupling.performance.jitter_vs_speed` on its chunk, so results are identical to a serial
 call whatever the scheduler (test).
 """
 from __future__ import annotations
