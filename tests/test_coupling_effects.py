@@ -399,3 +399,16 @@ def test_a_floor_of_another_type_is_refused_naming_the_class_to_use():
     path = str(info.value).split("floors must be ")[1].split()[0]
     module, name = path.rsplit(".", 1)
     assert getattr(importlib.import_module(module), name) is cp.Floor
+
+
+def test_the_kit_without_python_control_says_which_extra_installs_it():
+    """``from rwadist import coupling`` with python-control missing (sys.modules entry None: its import fails) names
+    the package and the extra (it was a bare "No module named 'control'" from a module inside the kit)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; sys.modules['control'] = None\n"
+            "try:\n    from rwadist import coupling\nexcept ImportError as e:\n"
+            "    print(type(e).__name__, e.name, e)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.startswith("MissingDependencyError control ") and "pip install 'rwadist[coupling]'" in out, out

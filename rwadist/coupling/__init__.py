@@ -8,6 +8,13 @@ performance: line responses (speed ripple included), broadband floors, jitter RM
              errors, speed-averaged PSD.
 sweep      : the same over speeds / wheel sets in parallel with dask (local or a cluster).
 """
+try:
+    import control as _control  # noqa: F401  (python-control: every component is a control.StateSpace)
+except ImportError:
+    from ..errors import MissingDependencyError
+
+    raise MissingDependencyError("control", "the coupling kit (rwadist.coupling)", "coupling") from None
+
 from .assemble import PRACTICES, Assembly, Attachment, assemble, practice_systems
 from .components import (
                          Component,
