@@ -36,7 +36,7 @@ STAND_WINDOW = 0.05
 def _line_log_gains(fit) -> dict:
     """(direction, h) -> (f Hz, y) of every measured line amplitude of an empirical fit: f = h|Ω|/2π and
     y = 2 ln(a / (C·Ω²)), the log power gain over the line's hard-mounted law."""
-    out = {}
+    out: dict[tuple[str, float], tuple[list[np.ndarray], list[np.ndarray]]] = {}
     for x in fit.lines:
         w = np.abs(np.asarray(x.speed, dtype=float))
         a = np.asarray(x.amplitude, dtype=float)
@@ -166,15 +166,18 @@ def _fit_on_lines(by_line: dict, f_s: float):
 
     from .resonance import general_log_power_gain, peak_of
 
-    f, y, line, which = [], [], [], []
+    fs: list[np.ndarray] = []
+    ys: list[np.ndarray] = []
+    lines: list[np.ndarray] = []
+    whichs: list[np.ndarray] = []
     dirs = sorted({d for d, _ in by_line})
     for j, ((d, _h), (fd, yd)) in enumerate(by_line.items()):
         near = (fd >= GENERAL_WINDOW[0] * f_s) & (fd <= GENERAL_WINDOW[1] * f_s)
-        f.append(fd[near])
-        y.append(yd[near])
-        line.append(np.full(int(near.sum()), j))
-        which.append(np.full(int(near.sum()), dirs.index(d)))
-    f, y, line, which = (np.concatenate(v) for v in (f, y, line, which))
+        fs.append(fd[near])
+        ys.append(yd[near])
+        lines.append(np.full(int(near.sum()), j))
+        whichs.append(np.full(int(near.sum()), dirs.index(d)))
+    f, y, line, which = (np.concatenate(v) for v in (fs, ys, lines, whichs))
     if f.size < 8:
         return None
     _, line = np.unique(line, return_inverse=True)
@@ -198,14 +201,13 @@ def _fit_on_lines(by_line: dict, f_s: float):
                     else np.median(y[line == k]) for k in range(n_line)])
     near = np.abs(lf) <= 0.05
     g0 = float(np.clip(np.exp(np.max(y[near] - off[line[near]]) / 2.0) if near.any() else 3.0, 1.2, 100.0))
-    best = None
+    sols = []
     for zeta in (0.01, 0.03, 0.1):
         for gamma, beta in ((g0, 1.0), (1.0, 0.0)):
             x0 = np.concatenate([[np.log(f_s), np.log(zeta), gamma, beta], off, np.zeros(n_dir)])
-            sol = least_squares(lambda x: res_jac(x)[0], x0, jac=lambda x: res_jac(x)[1], loss="soft_l1",
-                                f_scale=0.5, bounds=(lb, ub))
-            if best is None or sol.cost < best.cost:
-                best = sol
+            sols.append(least_squares(lambda x: res_jac(x)[0], x0, jac=lambda x: res_jac(x)[1], loss="soft_l1",
+                                      f_scale=0.5, bounds=(lb, ub)))
+    best = min(sols, key=lambda sol: sol.cost)      # the first of the lowest cost
     zeta = float(np.exp(best.x[1]))
     out = (float(np.exp(best.x[0])), zeta, peak_of(zeta, float(best.x[2]), float(best.x[3])), float(best.x[3]))
     return out if is_fixture_resonance(out[1], out[2]) else None
@@ -243,6 +245,7 @@ def _joint_from(test, fit, start, kwargs):
         # alone to explain its lines, and the stand runs off: ζ to its bound, gain 450); declared in the last fit only
         efit = fit_extended(test, fit, stand=stand, fit_stand=True, declare=False, **kwargs)
         new = efit.stand
+        assert new is not None, "fit_extended with fit_stand=True returns the stand it fitted"
         settled = abs(np.log(new[0] / stand[0])) < JOINT_SETTLED_LOG_F and \
             abs(np.log(new[1] / stand[1])) < 10 * JOINT_SETTLED_LOG_F
         stand = new

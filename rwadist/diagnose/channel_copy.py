@@ -92,8 +92,8 @@ def _run_points(run, chans, window: str):
         peak = peak[np.argsort(-p[peak])][:LINES_PER_RUN]
         rows += list(peak)
         src += [j] * peak.size
-    rows = np.asarray(rows, dtype=int)
-    return f[rows], X[rows], noise, np.asarray(src, dtype=int)
+    bins = np.asarray(rows, dtype=int)
+    return f[bins], X[bins], noise, np.asarray(src, dtype=int)
 
 
 def find_channel_copies(ctx, test=None) -> list:

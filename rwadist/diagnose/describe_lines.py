@@ -75,9 +75,9 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
     k = np.rint(np.outer(h_grid, om) / (2 * np.pi) / ctx.df).astype(int)                      # (H, R)
     inb = (k >= ctx.k_lo) & (k <= ctx.k_hi)
     rows = np.arange(runs.size)[None, :]
-    out = []
-    for d, chans in DIRECTION_CHANNELS.items():
-        chans = [c for c in chans if c in ctx.channels]
+    out: list[Unexplained] = []
+    for d, direction_chans in DIRECTION_CHANNELS.items():
+        chans = [c for c in direction_chans if c in ctx.channels]
         if not chans:
             continue
         hit = np.zeros(k.shape, bool)
@@ -90,7 +90,7 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
                             axis=1) if model_h.size else np.zeros(h_grid.size, bool)
         cand = (frac >= RIDGE_FRACTION) & ~near_model
         peaks = np.flatnonzero(cand & (frac >= np.roll(frac, 1)) & (frac >= np.roll(frac, -1)))
-        taken = []
+        taken: list[float] = []
         for i in peaks[np.argsort(-frac[peaks])]:
             if any(abs(h_grid[i] - t) <= 4 * dh for t in taken):
                 continue

@@ -41,8 +41,8 @@ def line_ratios(ctx, state) -> list:
     """The :class:`LineRatios` of every direction with lines (the context's runs)."""
     runs = ctx.runs
     out = []
-    for d, chans in DIRECTION_CHANNELS.items():
-        chans = [c for c in chans if c in ctx.channels]
+    for d, direction_chans in DIRECTION_CHANNELS.items():
+        chans = [c for c in direction_chans if c in ctx.channels]
         if not chans:
             continue
         meas, pred, noise, hs = None, None, None, None
@@ -65,7 +65,7 @@ def line_ratios(ctx, state) -> list:
             pred = pp if pred is None else pred + pp
             noise = nz if noise is None else noise + nz
         else:
-            if hs is None:
+            if hs is None or meas is None or pred is None or noise is None:     # (set together, by the first channel)
                 continue
             snr = pred / np.maximum(noise, 1e-300)
             good = np.isfinite(meas) & (meas > 0) & (snr >= 10 ** (LINE_SNR_DB / 10))
@@ -243,7 +243,7 @@ def broadband_hump(ctx, state, shares) -> list:
     floor less the class's).  What it could be: a fixture or sensor resonance excited by the surroundings, a pump
     or fan of the stand, the electronics' own noise shape."""
     k_lo, k_hi = ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1)
-    found = {}
+    found: dict[int, list[tuple[str, int, int, int, float]]] = {}     # peak bin -> (channel, k0, k1, peak, excess dB)
     half = max(int(HUMP_BASELINE_FRACTION * (k_hi - k_lo) / 2), 3 * HUMP_MIN_BINS)
     floors = {}
     for c in ctx.channels:

@@ -6,6 +6,7 @@ Theory: docs/diagnose.md ("Prediction").
 from __future__ import annotations
 
 import copy
+from collections.abc import Callable
 
 import numpy as np
 
@@ -56,7 +57,10 @@ class Context(Metric):
         self._memo: dict = {}        # computed values of several kinds, each under what it is made of
         #: the search step under way (:func:`rwadist.diagnose.search.diagnose`): (state, its held-out errors on a set of
         #: channels, min_gain), read by :meth:`can_pass`; None outside a search
-        self.step = None
+        self.step: tuple[State, Callable[[list | None], tuple], float] | None = None
+        #: the search may move the 'auto' base to the wheel's suspension modes fitted from the data (set by
+        #: :func:`rwadist.diagnose.search.diagnose`, read by the ``suspension_modes`` family)
+        self.base_switch = False
         self._corrected: dict = {}
         self.f = spectra.f
         self.df = spectra.df

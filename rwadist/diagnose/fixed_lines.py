@@ -21,10 +21,14 @@ others) and narrow, at a frequency where a line at a constant ratio of the speed
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..units import RAD_S_TO_RPM
+
+if TYPE_CHECKING:
+    from ..data import SteadyTest
 
 #: Fraction of the runs in which a fixed line's bin (or a neighbour) is lit, in some channel.
 MIN_LIT_FRACTION = 0.75
@@ -137,7 +141,7 @@ def find_fixed_lines(ctx) -> list:
     hit[ctx.k_hi + 1:] = False
     # one line per peak of the summed level: the strongest lit bin within PEAK_SEPARATION_BINS (a strong line lights
     # its whole main lobe and first side lobes), narrow as a line (not a hump of noise: PEAKINESS)
-    out = []
+    out: list[FixedLine] = []
     for k0 in np.flatnonzero(hit)[np.argsort(-score[hit])]:
         k0 = int(k0)
         if any(abs(k0 - int(round(x.f_Hz / ctx.df))) <= PEAK_SEPARATION_BINS for x in out):
@@ -308,7 +312,7 @@ def _tone_amplitudes(X: np.ndarray, offsets: np.ndarray, n: int) -> np.ndarray:
     return np.where(misfit <= TONE_MISFIT, np.where(two, a0b, a1), np.nan + 0j)
 
 
-def remove_fixed_lines(ctx, lines) -> object:
+def remove_fixed_lines(ctx, lines) -> SteadyTest:
     """A copy of the context's test with every line of ``lines`` subtracted from each run's records: x − Re(A·e^{2πj f
     t}), A the line's amplitude in that run and channel (:attr:`FixedLine.amplitudes`), in every channel that carries
     it, except in a run whose amplitude is more than :data:`SAME_AMPLITUDE` times from the median over the runs (a
@@ -351,9 +355,10 @@ def describe_fixed_lines(ctx, lines, shares: dict) -> list:
     for i, ln in enumerate(lines):
         speeds = ctx.omega[list(ln.runs)] * RAD_S_TO_RPM if ln.runs else np.array([np.nan])
         share, level = shares.get(i, (np.nan, ln.level_dB))
-        own = mains_family([ln.f_Hz])
-        if family is not None or own is not None:
-            m, orders = family if family is not None else own
+        mains = family if family is not None else mains_family([ln.f_Hz])
+        causes: tuple[str, ...]
+        if mains is not None:
+            m, orders = mains
             k = int(round(ln.f_Hz / m))
             causes = (f"electrical pickup: order {k} of the {m:g} Hz mains" + (
                 f" (the fixed lines found are orders {', '.join(map(str, orders))} of it)" if family and len(

@@ -15,6 +15,7 @@ from ..spectra import Spectra
 from . import describe
 from .constants import BAND_BINS, CONTRAST_METRIC, CONTRAST_NOISE_Z, METRIC, NOISE_Z
 from .effects import family_classes
+from .effects.base import Effect
 from .engine import Context, initial_state
 from .measure import in_unresolved_span
 from .state import State
@@ -24,7 +25,7 @@ from .state import State
 class Hypothesis:
     """A fitted effect judged on held-out speeds."""
 
-    effect: object
+    effect: Effect
     gain: float           # held-out improvement / held-out data power
     gain_fraction: float  # improvement / held-out unexplained power
     t: float              # improvement in standard errors
@@ -293,7 +294,7 @@ def _state_error(ctx, state) -> float:
     return state._cache["search_error"]
 
 
-def _no_worse(ctx, state, refit) -> tuple:
+def _no_worse(ctx, state, refit) -> tuple[bool, State]:
     """(ok, refit.apply(state)): ok is True when ``refit`` (a passing hypothesis refitted on every run) does not raise
     the error on every run (:meth:`Context.error`); the applied state is returned so that the search carries on from
     it (its predictions and error computed here are kept on it).  The judge weighed the effect fitted on the fit runs
@@ -418,7 +419,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
             if best is not None:
                 break
         hyps += judged[:5] + ([best] if best is not None and best not in judged[:5] else [])
-        if best is None:
+        if best is None or applied is None:     # (set together: applied is the state best was taken into)
             break
         best.passed = True
         state = applied                         # refit.apply(state), made by _no_worse
@@ -450,7 +451,7 @@ def improved_model(model: WheelModel, state: State, hyps) -> WheelModel:
     hypothesis's entry (:func:`effect_entry`; a line completed into the base listed in the provenance instead)."""
     out = copy.deepcopy(state.model)
     out.effects = list(model.effects) + [effect_entry(h) for h in hyps if h.passed and not h.base_line]
-    prov = {"metric": METRIC, "base": state.base}
+    prov: dict[str, object] = {"metric": METRIC, "base": state.base}
     base_lines = [{k: v for k, v in effect_entry(h).items() if k in ("direction", "h", "C")}
                   for h in hyps if h.passed and h.base_line]
     if base_lines:

@@ -20,13 +20,17 @@ class FrozenMapping(dict):
     def _refuse(self, *args, **kwargs):
         raise TypeError("an Unexplained record's parameters are read-only")
 
-    __setitem__ = __delitem__ = clear = pop = popitem = setdefault = update = _refuse   # type: ignore[assignment]
+    __setitem__ = __delitem__ = clear = pop = popitem = setdefault = update = _refuse
 
     def __reduce__(self):
         return (FrozenMapping, (dict(self),))
 
-    def __hash__(self):
-        return hash(tuple(sorted((k, repr(v)) for k, v in self.items())))
+
+def _parameters_key(parameters: Mapping) -> tuple:
+    """The hashable form of a record's ``parameters``: its (key, repr(value)) pairs, sorted (a dict subclass cannot
+    override dict's ``__hash__ = None`` in the type system, so the record hashes this instead of the mapping)."""
+    return tuple(sorted((k, repr(v)) for k, v in parameters.items()))
+
 
 #: Signature -> what it is, in words (the JSON form's ``description``).
 SIGNATURES = {
@@ -112,7 +116,8 @@ class Unexplained:
         object.__setattr__(self, "parameters", FrozenMapping(self.parameters))
 
     def __hash__(self):
-        return hash((self.signature, self.channels, self.speed_rpm, self.f_Hz, self.h, self.parameters))
+        return hash((self.signature, self.channels, self.speed_rpm, self.f_Hz, self.h,
+                     _parameters_key(self.parameters)))
 
     @property
     def description(self) -> str:

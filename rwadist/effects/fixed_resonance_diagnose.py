@@ -123,13 +123,12 @@ def _general_refit(e: "FixedResonance", f, y, sw, lo: float, hi: float) -> "Fixe
 
     base = res_jac(np.array([np.log(e.f_r), np.log(e.zeta), e.peak_gain, 1.0]))[0]
     base_cost = float(np.sum(2.0 * (np.sqrt(1.0 + (base / 0.5) ** 2) - 1.0))) * 0.125   # soft-L1 as least_squares
-    best = None
+    sols = []
     for gamma, beta in ((min(e.peak_gain, 199.0), 1.0), (1.0, 0.0)):
         x0 = np.clip([np.log(e.f_r), np.log(e.zeta), gamma, beta], lb + 1e-9, ub - 1e-9)
-        sol = least_squares(lambda x: res_jac(x)[0], x0, jac=lambda x: res_jac(x)[1], loss="soft_l1", f_scale=0.5,
-                            bounds=(lb, ub), max_nfev=MAX_NFEV)
-        if best is None or sol.cost < best.cost:
-            best = sol
+        sols.append(least_squares(lambda x: res_jac(x)[0], x0, jac=lambda x: res_jac(x)[1], loss="soft_l1",
+                                  f_scale=0.5, bounds=(lb, ub), max_nfev=MAX_NFEV))
+    best = min(sols, key=lambda sol: sol.cost)      # the first of the lowest cost
     if best.cost >= base_cost:
         return e
     from dataclasses import replace
@@ -298,10 +297,7 @@ class FixedResonance:
             if any(s.status == -2 for s in sols) and any(s.status != -2 and _is_resonance(s) for s in sols):
                 # another start found a resonance: which one fits best is decided on the stopped starts run to the end
                 sols = [solve(x0, False) if s.status == -2 else s for x0, s in zip(starts, sols)]
-            best = None
-            for sol in sols:
-                if best is None or sol.cost < best.cost:
-                    best = sol
+            best = min(sols, key=lambda sol: sol.cost)      # the first of the lowest cost
             f_r, zeta, g = (float(v) for v in np.exp(best.x))
             e = FixedResonance(f_r, zeta, g, tuple(channels), role, int(f.size))
             if best.status == -2:

@@ -20,6 +20,7 @@ import numpy as np
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.state import State
+from ..model import Harmonic, WheelModel
 from ..stand_resonance import fit_extended_beside_stand, stand_starts
 
 
@@ -284,7 +285,8 @@ def wheel_base(model) -> tuple:
 def _sideband_pairs(lines) -> list:
     """(carrier, lower, upper) of the harmonics of one direction's ``lines`` that are speed-sideband pairs beside a
     stronger line of theirs (:func:`wheel_base`)."""
-    out, taken = [], []
+    out: list[tuple[Harmonic, Harmonic, Harmonic]] = []
+    taken: list[Harmonic] = []
     for c in sorted(lines, key=lambda x: -x.C):
         if any(c is y for y in taken):
             continue
@@ -313,7 +315,7 @@ class SuspensionModes:
         as a ``fixed_resonance`` of its own; not part of this effect's parameters).
     """
 
-    model: object = field(repr=False)
+    model: WheelModel = field(repr=False)
     f0_Hz: dict
     zeta: dict
     inertia_ratio: float
