@@ -10,7 +10,7 @@ reference point the loads are moved to).  Loads move as::
 i.e. the 6×6 :func:`load_transform` [[R, 0], [[r]× R, R]] acting on (Fx, Fy, Fz, Tx, Ty, Tz); a CSD
 matrix transforms as T S Tᵀ, and by virtual work the interface accelerations as Tᵀ.
 
-Used by :mod:`rwadist.mounting` (``rwadist psd --wheels``), :mod:`coupling.geometry` and, as a
+Used by :mod:`rwadist.mounting` (``rwadist psd --wheels``), :mod:`rwadist.coupling.geometry` and, as a
 self-contained copy pinned by tests/test_geometry.py, the FMU runtime (``rwadist/fmu/runtime.py``
 ``rotation_check`` and ``to_spacecraft``).  Each caller raises its own error type with the message
 :func:`rotation_problem` gives.

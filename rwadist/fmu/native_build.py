@@ -1,8 +1,8 @@
 """Build the rwadist wheel FMU in pure C (FMI 2.0 or 3.0 co-simulation, no Python on the host).
 
 :func:`build_native_fmu` reads the model file with the FMU runtime's own readers
-(:func:`fmu.runtime.model_from_doc`, :func:`fmu.runtime.effects_from_doc`,
-:func:`fmu.runtime.expand_lines`), writes the parsed model as C data (``wheel_model.h``: every
+(:func:`rwadist.fmu.runtime.model_from_doc`, :func:`rwadist.fmu.runtime.effects_from_doc`,
+:func:`rwadist.fmu.runtime.expand_lines`), writes the parsed model as C data (``wheel_model.h``: every
 number as a C99 hexadecimal float literal, so the C model holds the very doubles Python holds),
 and compiles the FMI API -- ``native/rwadist_wheel_fmu.c`` (FMI 2.0) or ``native/rwadist_wheel_fmi3.c`` (FMI 3.0) --
 with the wrapper layer both share, ``native/rwadist_wheel_instance.h`` (every call's work: the state machine of
@@ -374,7 +374,7 @@ def build_native_fmu(model, output, *, tag: str | None = None, assumed_modes: bo
     """Write the pure-C FMU of ``model`` (path, dict or WheelModel) to ``output`` (.fmu); returns its path.
 
     ``tag`` (default random) makes the model identifier ``RwadistWheelC_<tag>``.  ``assumed_modes``: as
-    :func:`fmu.build.build_fmu` (the start value of ``modes`` for a wheel with assumed modes).  ``fmi_version``: 2
+    :func:`rwadist.fmu.build.build_fmu` (the start value of ``modes`` for a wheel with assumed modes).  ``fmi_version``: 2
     (FMI 2.0 co-simulation) or 3 (FMI 3.0).  The binary is built for Linux x86-64 (NativeBuildError elsewhere or
     without a C compiler) and, ``windows`` True or None, cross-compiled for Windows x86-64 with mingw-w64: None adds it
     where the cross compiler is found and warns (RuntimeWarning, saying how to get it) where it is not, True raises

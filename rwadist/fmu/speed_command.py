@@ -1,4 +1,4 @@
-"""The speed-command FMU of a wheel-assembly SSP (:mod:`fmu.ssp`): the assembly's speed inputs.
+"""The speed-command FMU of a wheel-assembly SSP (:mod:`rwadist.fmu.ssp`): the assembly's speed inputs.
 
 One input ``speed_<wheel>`` per independently driven wheel (rad/s; start: the mean of its speed law) and one output
 ``wheel_speed_<wheel>`` each, holding the input set before the last step (at the end of initialisation: the initial

@@ -117,7 +117,7 @@ static void rw_refusal(char *buf, size_t size, int fmi, RwCall call, int state, 
 /* ------------------------------------------------------------------ variables by value reference
  * The variables of both wheel FMUs (rwadist/fmu/native_build.py VARIABLES; a test compares the two), FMI 3.0 adds `time`. */
 /* VR_SWITCH .. VR_SWITCH + N_SWITCH_VR - 1: the effect switches, Booleans that the effect elements own and name
-   (fmu.runtime.fmu_switches; wheel_model.h RW_SWITCH_NAMES in the native FMU) */
+   (rwadist.fmu.runtime.fmu_switches; wheel_model.h RW_SWITCH_NAMES in the native FMU) */
 #define N_SWITCH_VR 2
 enum { VR_SPEED = 0, VR_ACCEL = 1, VR_MODEL_FILE = 2, VR_USE_ACCEL = 3, VR_SEED = 4, VR_IMBALANCE = 5,
        VR_HARMONICS = 6, VR_MODES = 7, VR_START_STEADY = 8, VR_SWITCH = 9,

@@ -32,7 +32,7 @@ typedef void (*RwLogger)(void *env, RwStatus status, const char *category, const
 /* the effect switches (value references VR_SWITCH ..): each turns its element's ripples and floors off */
 #define N_SWITCH 2
 #if RW_N_SWITCHES != N_SWITCH
-#error "wheel_model.h names another number of effect switches than the FMU has (fmu.runtime.SWITCH_SLOTS)"
+#error "wheel_model.h names another number of effect switches than the FMU has (rwadist.fmu.runtime.SWITCH_SLOTS)"
 #endif
 
 /* parameters: everything the host sets before initialisation (also saved with a state) */
