@@ -6,7 +6,11 @@ load average):
     frequency points the plain sweep visits (each wheel's distinct line frequencies at each speed);
   * the plain coupled sweep (:func:`rwadist.coupling.jitter_vs_speed`, all four practices), serial;
   * the same wheels with diagnosed effects (a broadband floor on Fx, Fy, Fz and a speed ripple of 3 rad/s at 8 Hz,
-    read from a model file's effects list as rwadist diagnose writes it): target <= 3x the plain sweep.
+    read from a model file's effects list as rwadist diagnose writes it): target <= 3x the plain sweep;
+  * its two parts apart: the ripple alone (the same sweep without the floors) and the floors alone
+    (:func:`rwadist.coupling.floor_responses` on its default grid), with the work each does against the plain
+    sweep's: line points (speed x line group; a ripple's sideband orders m = -K..K multiply the groups by 2K + 1,
+    each at its own frequency, i.e. one coupled interface solve per point) and floor points (speed x grid frequency).
 ``--dask``: the plain sweep on a 2-worker local dask cluster (processes, 1 thread each) as well.
 BLAS is pinned to one thread so serial and parallel compare like for like.
 
@@ -19,6 +23,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("MKL_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import dataclasses  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -49,6 +54,21 @@ def setup(n_speeds=1000, n_modes=200):
     return plant, wheels, eff, np.linspace(1.0, 3000.0, n_speeds) * RPM_TO_RAD_S
 
 
+def without_floors(wheels):
+    """The wheels with their speed ripple and no broadband floors."""
+    return [dataclasses.replace(w, floors=()) for w in wheels]
+
+
+def line_points(wheels, speeds):
+    """Speed x line-group points the line sweep evaluates for ``wheels`` (one wheel: they are equal but for the
+    mount and share them)."""
+    from rwadist import extended_ripple
+    w = wheels[0]
+    groups = len({(ln.h, ln.f_offset) for ln in w.lines})
+    k = 0 if w.ripple is None else extended_ripple.ripple_order(w.lines, speeds * w.speed_scale, w.ripple)
+    return speeds.size * groups * (2 * k + 1), k
+
+
 def _timed(fn):
     t0, c0 = time.perf_counter(), time.process_time()
     out = fn()
@@ -63,8 +83,9 @@ def main(n_speeds=1000, repeats=3, dask=False):
     print(f"plant: {plant.sys.nstates} states, {plant.n_interface} interface DOFs, {plant.n_perf} outputs; 4 wheels x "
           f"{len(lines)} lines ({hu.size} distinct h); {n_speeds} speeds -> {f_pts.size} frequency points per wheel; "
           f"load average {os.getloadavg()[0]:.2f} at start")
-    t = {"python-control": [], "plain": [], "effects": []}
-    plain = with_eff = None
+    ripple_only = without_floors(eff)
+    t: dict = {"python-control": [], "plain": [], "effects": [], "ripple alone": [], "floors alone": []}
+    plain = with_eff = floors = None
     for _ in range(repeats):
         dt, H = _timed(lambda: plant.sys.frequency_response(2 * np.pi * f_pts))
         t["python-control"].append(dt)
@@ -72,6 +93,10 @@ def main(n_speeds=1000, repeats=3, dask=False):
         t["plain"].append(dt)
         dt, with_eff = _timed(lambda: cp.jitter_vs_speed(plant, eff, speeds))
         t["effects"].append(dt)
+        dt, _ = _timed(lambda: cp.jitter_vs_speed(plant, ripple_only, speeds))
+        t["ripple alone"].append(dt)
+        dt, floors = _timed(lambda: cp.floor_responses(plant, eff, speeds))
+        t["floors alone"].append(dt)
     load = os.getloadavg()[0]
     st = {}
     for k, v in t.items():
@@ -79,11 +104,18 @@ def main(n_speeds=1000, repeats=3, dask=False):
         st[k] = (w.min(), float(np.median(w)), c.min(), float(np.median(c)))
         print(f"  {k:15s} wall min {w.min():7.2f} s  median {np.median(w):7.2f} s   CPU min {c.min():7.2f} s  "
               f"median {np.median(c):7.2f} s")
-    for label, a, b, target in (("plain sweep / python-control FRF", "plain", "python-control", ""),
-                                ("with effects / plain sweep", "effects", "plain", "   target <= 3x")):
+    pts_plain, _ = line_points(wheels, speeds)
+    pts_eff, k_rip = line_points(eff, speeds)
+    work = {"effects": "   target <= 3x",
+            "ripple alone": f"   line points {pts_eff / pts_plain:.1f}x ({pts_eff} vs {pts_plain}: orders +-{k_rip})",
+            "floors alone": f"   floor points {speeds.size * floors.f_hz.size} ({floors.f_hz.size} frequencies)"}
+    for label, a, b in (("plain sweep / python-control FRF", "plain", "python-control"),
+                        ("with effects / plain sweep", "effects", "plain"),
+                        ("  ripple alone / plain sweep", "ripple alone", "plain"),
+                        ("  floors alone / plain sweep", "floors alone", "plain")):
         r = [st[a][i] / st[b][i] for i in range(4)]
         print(f"{label:34s} wall {r[0]:6.2f}x (min) {r[1]:6.2f}x (median)   CPU {r[2]:6.2f}x (min) {r[3]:6.2f}x "
-              f"(median){target}")
+              f"(median){work.get(a, '')}")
     print(f"load average at end {load:.2f}")
     G, P = plant.frf(f_pts)
     Hc = np.asarray(H.fresp)                       # (n_out, n_in, F)

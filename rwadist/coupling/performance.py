@@ -423,7 +423,15 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
     in :attr:`LineResponses.floor`."""
     wheels = list(wheels)
     om, Mts, _ = _setup(plant, wheels, practices, omega)
-    kmax = [0 if w.ripple is None else ripple_mod.ripple_order(w.lines, om * w.speed_scale, w.ripple) for w in wheels]
+    # wheels that differ only in their mount (a wheel set of one type) have the same lines in their own frame:
+    # their sideband orders and grouped blocked loads are computed once
+    line_key = [(w.params, tuple(map(id, w.lines)), w.ripple, float(w.speed_scale), bool(w.hard_mounted))
+                for w in wheels]
+    orders_of: dict = {}
+    for w, key in zip(wheels, line_key):
+        if key not in orders_of:
+            orders_of[key] = 0 if w.ripple is None else ripple_mod.ripple_order(w.lines, om * w.speed_scale, w.ripple)
+    kmax = [orders_of[key] for key in line_key]
     # at most ~LINE_POINTS (speed, line) points at once: a speed ripple's sidebands multiply the lines, and work
     # arrays of n_if x n_if per point beyond the caches cost more than the arithmetic
     groups_max = max(len({(ln.h, ln.f_offset) for ln in w.lines}) * (2 * k + 1) for w, k in zip(wheels, kmax))
@@ -439,8 +447,11 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
         o = om[i0:i0 + chunk]
         cache = _FrfCache()
         lines = []
+        grouped: dict = {}
         for k, wk in enumerate(wheels):
-            hs[k], offs[k], orders[k], f, Fk = _grouped_lines(wk, o * wk.speed_scale, kmax[k])
+            if line_key[k] not in grouped:
+                grouped[line_key[k]] = _grouped_lines(wk, o * wk.speed_scale, kmax[k])
+            hs[k], offs[k], orders[k], f, Fk = grouped[line_key[k]]
             lines.append((f, Fk, np.where(f > 0, f, 1.0)))
             f_parts[k].append(f)
             hm_parts[k].append(Fk)
