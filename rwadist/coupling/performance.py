@@ -399,12 +399,15 @@ def _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache) -> list:
         rigid = [(Mt, -wheel_rigid_mass_matrix(w.params, w.housing_mass, w.housing_inertia))
                  for Mt, w in zip(Mts, wheels)]
         u["ii"] = np.linalg.solve(_interface_matrix(G, rigid), rhs)
+    # every wheel's outputs and interface accelerations in one product per practice (columns = wheels)
+    Y = {p: P @ u[p] for p in practices}                                                   # (S, J, n_perf, |ks|)
+    acc = G @ u["coupled"]                                                                  # (S, J, n_if, |ks|)
     out = []
     for j, k in enumerate(ks):
         live = (lines[k][0] > 0)[..., None]
-        Fk, uc = lines[k][1], u["coupled"][..., j:j + 1]
-        load = np.where(live, (Fk[..., None] + Bs[k][0] @ (Mts[k] @ (G @ uc)))[..., 0], 0)
-        out.append((load, {p: np.where(live, (P @ u[p][..., j:j + 1])[..., 0], 0) for p in practices}))
+        a_k = _apply_left(Mts[k], acc[..., j])[..., None]                                  # its mount's (S, J, 6, 1)
+        load = np.where(live, lines[k][1] + (Bs[k][0] @ a_k)[..., 0], 0)
+        out.append((load, {p: np.where(live, Y[p][..., j], 0) for p in practices}))
     return out
 
 
@@ -496,8 +499,13 @@ class FloorResponses:
 
 
 def _trapz(y, x, axis=-1):
-    y = np.moveaxis(y, axis, -1)
-    return np.sum(0.5 * (y[..., 1:] + y[..., :-1]) * np.diff(x), axis=-1)
+    """Trapezoid integral of ``y`` over ``x`` (F,) along ``axis``: one product with the rule's weights
+    (Δx_{j-1} + Δx_j)/2, no temporaries of y's size."""
+    dx = np.diff(x)
+    w = np.zeros(x.size)
+    w[:-1] += 0.5 * dx
+    w[1:] += 0.5 * dx
+    return np.tensordot(y, w, axes=([axis], [0]))
 
 
 def _floor_band(wheels):
