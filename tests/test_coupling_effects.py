@@ -256,6 +256,31 @@ def test_ripple_in_coupled_path_equals_explicit_sideband_lines():
         assert max(np.abs(ours[f] - theirs.get(f, 0)).max() for f in ours) < 1e-9 * scale
 
 
+def test_wheels_sharing_their_lines_keep_their_own_ripple_speed_and_mount():
+    """A wheel set built from one lines tuple (as wheel_spec_from_model's callers do) shares the sideband orders
+    and blocked loads only between wheels equal but for the mount: responses equal to those of the same wheels
+    each given its own copy of the lines (nothing shared), for a wheel with another ripple and one reversed at 0.9 x
+    the speed beside two that differ only in their mount."""
+    p = replace(preset("ithaco-e").extended, height=0.05)
+    lines = tuple(_ripple_lines(p))
+    plant = cp.example_spacecraft()
+    specs = [(Ripple(2.3, 3.0, 150.0, 0.5), 1.0, cp.Mount(0, cp.spin_axis_dcm((1, 0, 0)), (0.3, 0.0, 0.1))),
+             (Ripple(2.3, 3.0, 150.0, 0.5), 1.0, cp.Mount(0, cp.spin_axis_dcm((0, 1, 0)), (0.0, 0.3, 0.1))),
+             (Ripple(5.0, 1.0, 150.0, 0.0), -0.9, cp.Mount(0, cp.spin_axis_dcm((0, 0, 1)), (0.0, 0.0, 0.4)))]
+    speeds = np.array([300.0, 1800.0, 2900.0]) * RPM_TO_RAD_S
+    shared = cp.line_responses(plant, [cp.WheelSpec(p, lines, m, ripple=r, speed_scale=sc) for r, sc, m in specs],
+                               speeds)
+    own = cp.line_responses(plant, [cp.WheelSpec(p, tuple(replace(ln) for ln in lines), m, ripple=r, speed_scale=sc)
+                                    for r, sc, m in specs], speeds)
+    assert shared.ripple_order[2].max() != shared.ripple_order[0].max()       # the third wheel has its own orders
+    for prac in ("coupled", "i", "ii", "iii"):
+        for k in range(3):
+            assert np.array_equal(shared.y[prac][k], own.y[prac][k])
+    for k in range(3):
+        assert np.array_equal(shared.loads[k], own.loads[k]) and np.array_equal(shared.f_hz[k], own.f_hz[k])
+    assert not np.allclose(shared.y["coupled"][0], shared.y["coupled"][1], rtol=1e-3, atol=0)   # mounts differ
+
+
 # ------------------------------------------------------------------ from the model file
 
 FLOOR = {"kind": "broadband_floor", "channel": ["Fx", "Ty"], "exponent": 2.0, "omega_ref_rad_s": 200.0,
