@@ -80,8 +80,11 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
-    sp, detections = _fit_spectra(ctx, test, runs)
-    fit = fit_empirical(sp, detections=detections)
+    if runs == [int(r) for r in ctx.runs]:
+        fit = _whole_data_fit(ctx)      # the refit on every run: the same empirical fit, computed once
+    else:
+        sp, detections = _fit_spectra(ctx, test, runs)
+        fit = fit_empirical(sp, detections=detections)
     if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
         return None
     try:
@@ -114,13 +117,23 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
         return fit_extended(test, fit, near=near), None
     # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows
     starts = [stand_start] if stand_start is not None else \
-        (stand_starts(fit) or stand_starts(_whole_data_fit(ctx)))
+        (_stand_starts_once(ctx, fit) or _stand_starts_once(ctx, _whole_data_fit(ctx)))
     efit = fit_extended_beside_stand(test, fit, starts=starts, near=near)
     if efit.stand is None and stand_start is None:
         held = _beside_whole_data_stand(ctx, test, fit, efit, near)
         if held is not None:
             efit = held
     return efit, efit.stand
+
+
+def _stand_starts_once(ctx: Context, fit) -> list:
+    """:func:`rwadist.stand_resonance.stand_starts` of the empirical fit ``fit``, computed once per fit and diagnosis
+    (the whole data's fit is asked by the fit on the fit runs, by the whole data's stand and by the refit on every
+    run, which fits the same empirical fit)."""
+    key = ("suspension_modes.stand_starts", id(fit))
+    if key not in ctx._memo or ctx._memo[key][0] is not fit:
+        ctx._memo[key] = (fit, stand_starts(fit))
+    return list(ctx._memo[key][1])
 
 
 def _beside_whole_data_stand(ctx: Context, test, fit, plain, near=None):
@@ -161,7 +174,7 @@ def _whole_data_stand(ctx: Context):
     if key not in ctx._memo:
         ctx._memo[key] = None
         whole_fit = _whole_data_fit(ctx)
-        starts = stand_starts(whole_fit)
+        starts = _stand_starts_once(ctx, whole_fit)
         if starts:
             test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], dict(ctx.test.meta))
             try:
