@@ -85,6 +85,27 @@ def transmissibility_sq(nu, omega, f0_hz, zeta, a):
 OFF_LAW_Z = 4.0
 
 
+class _Segments:
+    """Per-line sums over the last axis (the rows sorted by line: ``starts``, ``counts`` rows each).  In double precision
+    segment sums (:func:`numpy.add.reduceat`: each point's sums the same numbers whichever grid holds it); in single
+    precision (the screen of :func:`_screened_search`) one matrix product with the rows' line indicator."""
+
+    def __init__(self, starts, counts, dtype):
+        self.starts, self.counts = starts, counts
+        self.indicator = None
+        if dtype != np.float64:
+            n_rows = int(counts.sum())
+            self.indicator = np.zeros((n_rows, starts.size), dtype)
+            self.indicator[np.arange(n_rows), np.repeat(np.arange(starts.size), counts.astype(int))] = 1
+
+    def sum(self, x, weights=None):
+        """Σ over each line's rows of ``x`` (× ``weights`` per row, or 1), shape x.shape[:-1] + (lines,)."""
+        if self.indicator is None:
+            return np.add.reduceat(x if weights is None else x * weights, self.starts, axis=-1)
+        e = self.indicator if weights is None else self.indicator * weights[:, None]
+        return (x.reshape(-1, x.shape[-1]) @ e).reshape(x.shape[:-1] + (e.shape[1],))
+
+
 class _Trend:
     """Per-row ln|Ω| less its line's mean (``lc``), per line Σ lc² (``lc2``) and the factor e^{Z²/n} (``factor``) of
     :func:`_line_log_ssr`'s off-law option, the rows sorted by line."""
@@ -97,23 +118,24 @@ class _Trend:
         self.factor = np.exp(OFF_LAW_Z**2 / counts)
 
 
-def _line_log_ssr(lw, starts, counts, trend=None):
-    """Per line (along the last axis, its rows from ``starts``, ``counts`` of them) Σ(lw − mean lw)²: the log least
+def _line_log_ssr(lw, seg, trend=None):
+    """Per line (along the last axis, its rows summed by ``seg``, :class:`_Segments`) Σ(lw − mean lw)²: the log least
     squares of the line's rows with its scale free (closed form: the scale is the mean).  With ``trend``
     (:class:`_Trend`), the least of that and the line with an exponent of its own (lw detrended in ln|Ω|, closed form)
     times e^{Z²/n}, the likelihood ratio a trend must earn: one line of another law (an Ω³ amplitude law across the
     band) then weighs in the scan as one such line, not as a mode's skirt (the E wheel's translation placed 7 % low)."""
-    s1 = np.add.reduceat(lw, starts, axis=-1)
-    s2 = np.add.reduceat(lw * lw, starts, axis=-1)
+    counts = seg.counts
+    s1 = seg.sum(lw)
+    s2 = seg.sum(lw * lw)
     ssr = np.maximum(s2 - s1 * s1 / counts, 0.0)
     if trend is None:
         return ssr
-    sl = np.add.reduceat(lw * trend.lc, starts, axis=-1)
+    sl = seg.sum(lw, trend.lc)
     free = np.maximum(ssr - np.where(trend.lc2 > 0, sl * sl / np.where(trend.lc2 > 0, trend.lc2, 1.0), 0.0), 0.0)
     return np.minimum(ssr, free * trend.factor)
 
 
-def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, chunk=512):
+def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, chunk=512, dtype=np.float64):
     """SSR of the log power residual (f0_grid.size, zeta_grid.size, a_grid.size) on the grid, each line's forcing
     solved per line: Σ over lines of min over its forcing of Σ_rows ln²(P·|T|²·Ω⁴/power).
 
@@ -146,10 +168,16 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
     scale = om**4 / np.asarray(power, float)[order]                     # model/data per unit forcing power
     nu2 = nu**2
     gyro = (a_grid[:, None] * om[None, :]) * nu[None, :]                 # (A, rows)
+    if dtype != np.float64:
+        # a line's scale is free: divided by its geometric mean (every SSR the same) its rows stay near 1
+        scale = scale / np.exp(np.repeat(np.add.reduceat(np.log(scale), starts) / counts, counts.astype(int)))
+        f0_grid, zeta_grid, om, nu, nu2, scale, gyro = (np.asarray(x, dtype) for x in (
+            f0_grid, zeta_grid, om, nu, nu2, scale, gyro))
     # no gyroscopic term (translation modes, or a = 0): both senses see the same |T|² and the two parts are one
     same = not np.any(gyro)
     both_senses = two_parts and not same
     trend = _Trend(om, starts, counts)
+    seg = _Segments(starts, counts, dtype)
     n_z, n_a, n_rows = zeta_grid.size, a_grid.size, om.size
     out = np.empty((f0_grid.size, n_z, n_a))
     step = max(1, chunk * 256 // max(n_rows * n_z * n_a, 1))
@@ -162,18 +190,18 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
         lnum = np.log(num)
         if same:
             lw = (lnum - np.log(rest[:, None, :] ** 2 + d2))[:, :, None, :]           # (F, Z, 1, rows)
-            out[s:s + step] = np.sum(_line_log_ssr(lw, starts, counts, trend), axis=-1)
+            out[s:s + step] = np.sum(_line_log_ssr(lw, seg, trend), axis=-1)
             continue
         lnum = lnum[:, :, None, :]
         den_u = ((rest[:, None, :] + gyro[None]) ** 2)[:, None] + d2[:, :, None, :]    # (F, Z, A, rows)
         if not both_senses:
-            out[s:s + step] = np.sum(_line_log_ssr(lnum - np.log(den_u), starts, counts, trend), axis=-1)
+            out[s:s + step] = np.sum(_line_log_ssr(lnum - np.log(den_u), seg, trend), axis=-1)
             continue
         den_v = ((rest[:, None, :] - gyro[None]) ** 2)[:, None] + d2[:, :, None, :]
-        ssr = np.minimum(_line_log_ssr(lnum - np.log(den_u), starts, counts, trend),
-                         _line_log_ssr(lnum - np.log(den_v), starts, counts, trend))
+        ssr = np.minimum(_line_log_ssr(lnum - np.log(den_u), seg, trend),
+                         _line_log_ssr(lnum - np.log(den_v), seg, trend))
         u, v = num[:, :, None, :] / den_u, num[:, :, None, :] / den_v
-        su, suu, sv, svv, suv = (np.add.reduceat(t, starts, axis=-1) for t in (u, u * u, v, v * v, u * v))
+        su, suu, sv, svv, suv = (seg.sum(t) for t in (u, u * u, v, v * v, u * v))
         det = suu * svv - suv**2
         safe = np.where(np.abs(det) > 1e-14 * suu * svv, det, np.nan)
         x = (svv * su - suv * sv) / safe
@@ -183,7 +211,7 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
             reps = counts.astype(int)
             mix = np.repeat(np.where(ok, x, 1.0), reps, axis=-1) * u + np.repeat(np.where(ok, y, 0.0), reps,
                                                                                     axis=-1) * v
-            ssr = np.where(ok, np.minimum(ssr, _line_log_ssr(np.log(mix), starts, counts)), ssr)
+            ssr = np.where(ok, np.minimum(ssr, _line_log_ssr(np.log(mix), seg)), ssr)
         out[s:s + step] = np.sum(ssr, axis=-1)
     return out
 
@@ -197,27 +225,58 @@ def _window(grid: np.ndarray, centre: float | None, lo: float, hi: float) -> np.
     return idx if idx.size else np.arange(grid.size)
 
 
-def _windowed_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, near_hz, near_a):
+#: The single-precision screen of :func:`_screened_search` keeps every f0 whose least SSR lies within this fraction of
+#: (1 + the least SSR) of the least: 70x the largest difference from the double-precision SSR measured near the best
+#: points of the benchmark's and the family's scans (1.4e-4 of it)
+SCREEN_MARGIN = 1e-2
+
+
+def _screened_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts):
+    """:func:`_grid_search`'s SSR on the grid for a scan that only locates its best point: the whole grid first in
+    single precision (each line's scale divided by its geometric mean, the per-line sums one matrix product: about
+    half the time), then every f0 whose single-precision least SSR lies within :data:`SCREEN_MARGIN`·(1 + least) of the
+    least again in double precision -- the numbers of the double-precision search there, the others the single
+    precision's.  The best point is the double-precision search's (the same number: a point's SSR does not depend on
+    the grid it is computed in) whenever the two precisions differ by less than half the margin near it; the whole
+    grid is searched in double precision when the screen is not finite or its kept points do not come within half
+    the margin of its least."""
+    approx = _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, dtype=np.float32)
+    if approx.size == 0 or not np.all(np.isfinite(approx)):
+        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+    least = float(approx.min())
+    margin = SCREEN_MARGIN * (1.0 + abs(least))
+    keep = np.flatnonzero(approx.min(axis=(1, 2)) <= least + margin)
+    exact = _grid_search(line, h, omega, power, np.asarray(f0_grid, float)[keep], zeta_grid, a_grid, two_parts)
+    if not np.nanmin(exact) <= least + 0.5 * margin:
+        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+    approx[keep] = exact
+    return approx
+
+
+def _windowed_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, near_hz, near_a,
+                     search=None):
     """:func:`_grid_search` on the whole product grid, or -- with ``near_hz`` (and ``near_a`` for the rocking
     mode's I_zz/I_rr) -- first on the grid's points within ×/÷ :data:`NEAR_SPAN` of ``near_hz`` (and
     ±:data:`NEAR_A_SPAN` of ``near_a``), the others NaN: kept when the best point lies inside that window (a point of
     the same grid, so the same best point as the whole grid's whenever the whole grid's best lies there), the whole
-    grid searched when it lies on an edge the whole grid goes beyond (the data's best lies outside the window)."""
+    grid searched when it lies on an edge the whole grid goes beyond (the data's best lies outside the window).
+    ``search``: the grid search (default :func:`_grid_search`; :func:`_screened_search` for a locate-only scan)."""
+    search = search or _grid_search
     fi = _window(f0_grid, near_hz, 1.0 / NEAR_SPAN, NEAR_SPAN)
     ai = np.arange(a_grid.size) if near_a is None or a_grid.size == 1 else \
         np.flatnonzero(np.abs(a_grid - near_a) <= NEAR_A_SPAN + 1e-9)
     if ai.size == 0:
         ai = np.arange(a_grid.size)
     if fi.size == f0_grid.size and ai.size == a_grid.size:
-        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
-    sub = _grid_search(line, h, omega, power, f0_grid[fi], zeta_grid, a_grid[ai], two_parts)
+        return search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+    sub = search(line, h, omega, power, f0_grid[fi], zeta_grid, a_grid[ai], two_parts)
     if np.all(np.isnan(sub)):
-        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+        return search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
     i, _, k = np.unravel_index(np.nanargmin(sub), sub.shape)
     on_edge = ((i == 0 and fi[0] > 0) or (i == fi.size - 1 and fi[-1] < f0_grid.size - 1)
                or (k == 0 and ai[0] > 0) or (k == ai.size - 1 and ai[-1] < a_grid.size - 1))
     if on_edge:
-        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+        return search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
     out = np.full((f0_grid.size, zeta_grid.size, a_grid.size), np.nan)
     out[np.ix_(fi, np.arange(zeta_grid.size), ai)] = sub
     return out
@@ -318,8 +377,10 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     f_step = 0.01 if a_grid.size == 1 else 0.02
     f0_grid = np.exp(np.arange(math.log(f_lo), math.log(f_hi), f_step))
     zeta_grid = np.exp(np.linspace(math.log(0.002), math.log(0.6), 13 if a_grid.size == 1 else 9))
+    # a locate-only scan reads its grid's best point alone: screened in single precision first
     ssr = _windowed_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, near_hz,
-                           near_a if rocking and inertia_ratio is None else None)
+                           near_a if rocking and inertia_ratio is None else None,
+                           _screened_search if min_log_lr == -math.inf else _grid_search)
     i, j, k = np.unravel_index(np.nanargmin(ssr), ssr.shape)
     # refine around the best point: f0 to 0.1 %, ζ and a finer
     f_fine = f0_grid[i] * np.exp(np.arange(-2 * f_step - 0.01, 2 * f_step + 0.0101, 0.001))

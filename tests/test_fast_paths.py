@@ -246,3 +246,24 @@ def test_scan_refinement_coarse_to_fine_is_the_whole_refinement_grid(monkeypatch
     whole = _grid_search(line, h, omega, power, *grids, True)
     i, j, k, value = ms._refine(line, h, omega, power, grids, True)
     assert (i, j, k) == np.unravel_index(np.nanargmin(whole), whole.shape) and value == whole[i, j, k]
+
+
+def test_screened_scan_grid_has_the_double_precision_best_point():
+    # a locate-only scan screens its grid in single precision and searches the f0 near the screen's best again in double
+    # precision (mode_scan._screened_search): the best point and its SSR are the double-precision grid's, bit for bit,
+    # and so is every f0 kept; the others are within the screen's error of it
+    from rwadist.mode_scan import _screened_search
+
+    for seed in (3, 5, 7, 11):
+        line, h, omega, power = _scan_case(seed=seed)
+        f0 = np.exp(np.arange(np.log(10.0), np.log(1000.0), 0.02))
+        for zeta, a, two in ((np.geomspace(0.002, 0.6, 9), np.arange(0.2, 3.01, 0.2), True),
+                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), True),
+                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), False)):
+            p = power if two else np.sqrt(power)
+            whole = _grid_search(line, h, omega, p, f0, zeta, a, two)
+            got = _screened_search(line, h, omega, p, f0, zeta, a, two)
+            best = np.unravel_index(np.argmin(whole), whole.shape)
+            assert np.unravel_index(np.argmin(got), got.shape) == best and got[best] == whole[best], (seed, a.size)
+            same = np.all(got == whole, axis=(1, 2))
+            assert same[best[0]] and np.allclose(got, whole, rtol=1e-3, atol=1e-3), (seed, a.size)
