@@ -102,7 +102,7 @@ class _Segments:
         """Σ over each line's rows of ``x`` (× ``weights`` per row, or 1), shape x.shape[:-1] + (lines,)."""
         if self.indicator is None:
             return np.add.reduceat(x if weights is None else x * weights, self.starts, axis=-1)
-        e = self.indicator if weights is None else self.indicator * weights[:, None]
+        e = self.indicator if weights is None else (self.indicator * weights[:, None]).astype(self.indicator.dtype)
         return (x.reshape(-1, x.shape[-1]) @ e).reshape(x.shape[:-1] + (e.shape[1],))
 
 
