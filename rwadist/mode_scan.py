@@ -295,8 +295,8 @@ def _refine(line, h, omega, power, grids, two_parts):
     A point's SSR is the same number whichever grid it is computed in (the sums are per point), so the result is the
     whole grid's best point whenever that lies in the basin the sub-lattice finds: the refinement spans a few % of f0,
     ×/÷2 of ζ and ±0.2 of I_zz/I_rr around a coarse best point, where the SSR is smooth (the benchmark's and the
-    family wheels' scans: the same best point as the whole grid's, from 1/10 to 1/17 of its points).  Ties go to the
-    first point in the whole grid's order, as :func:`numpy.nanargmin` there."""
+    family wheels' scans: the same best point as the whole grid's, from 1/5 (ζ and f0) to 1/17 (with I_zz/I_rr) of its
+    points).  Ties go to the first point in the whole grid's order, as :func:`numpy.nanargmin` there."""
     sizes = tuple(g.size for g in grids)
     seen: dict[tuple, float] = {}
 
