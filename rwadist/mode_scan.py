@@ -282,46 +282,6 @@ def _windowed_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_part
     return out
 
 
-#: Strides (f0, ζ, I_zz/I_rr) of the sub-lattice :func:`_refine` searches first
-REFINE_STRIDE = (4, 2, 4)
-
-
-def _refine(line, h, omega, power, grids, two_parts):
-    """(i, j, k, SSR) of the least :func:`_grid_search` SSR on the product of ``grids`` (f0, ζ, a: the refinement
-    around a coarse best point), coarse to fine: first every :data:`REFINE_STRIDE`-th point of each axis (the last
-    included), then every point within one stride of the best point so far, that box moved to its own best point
-    while that lies on one of its edges inside the grid and improves on the box's centre.
-
-    A point's SSR is the same number whichever grid it is computed in (the sums are per point), so the result is the
-    whole grid's best point whenever that lies in the basin the sub-lattice finds: the refinement spans a few % of f0,
-    ×/÷2 of ζ and ±0.2 of I_zz/I_rr around a coarse best point, where the SSR is smooth (the benchmark's and the
-    family wheels' scans: the same best point as the whole grid's, from 1/5 (ζ and f0) to 1/17 (with I_zz/I_rr) of its
-    points).  Ties go to the first point in the whole grid's order, as :func:`numpy.nanargmin` there."""
-    sizes = tuple(g.size for g in grids)
-    seen: dict[tuple, float] = {}
-
-    def evaluate(index):
-        f0, zeta, a = (g[i] for g, i in zip(grids, index))
-        vals = _grid_search(line, h, omega, power, f0, zeta, a, two_parts)
-        for ix in np.ndindex(vals.shape):
-            seen[tuple(int(i[q]) for i, q in zip(index, ix))] = float(vals[ix])
-        return vals
-
-    sub = [np.unique(np.r_[np.arange(0, n, s), n - 1]) for n, s in zip(sizes, REFINE_STRIDE)]
-    vals = evaluate(sub)
-    centre = tuple(int(i[q]) for i, q in zip(sub, np.unravel_index(np.nanargmin(vals), vals.shape)))
-    while True:
-        box = [np.arange(max(c - s, 0), min(c + s, n - 1) + 1) for c, s, n in zip(centre, REFINE_STRIDE, sizes)]
-        vals = evaluate(box)
-        best = tuple(int(b[q]) for b, q in zip(box, np.unravel_index(np.nanargmin(vals), vals.shape)))
-        on_edge = any(best[d] in (box[d][0], box[d][-1]) and 0 < best[d] < sizes[d] - 1 for d in range(3))
-        if not on_edge or not seen[best] < seen[centre]:
-            break
-        centre = best
-    value, point = min((v, p) for p, v in seen.items() if not math.isnan(v))
-    return (*point, value)
-
-
 #: Largest I_zz/I_rr the rocking scan tries.  A rigid rotor about its centre of mass has I_zz <= 2 I_rr, but the
 #: ratio the whirls show is an effective one (a flexible rotor or rim, rocking coupled with other motion, a test
 #: generator outside that bound): measured wheels and the family's (I_zz/I_rr up to 2.2) go beyond 2, and a scan
@@ -386,7 +346,10 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     f_fine = f0_grid[i] * np.exp(np.arange(-2 * f_step - 0.01, 2 * f_step + 0.0101, 0.001))
     z_fine = zeta_grid[j] * np.exp(np.linspace(-0.5, 0.5, 11) * (1 if a_grid.size == 1 else 1.5))
     a_fine = a_grid if a_grid.size == 1 else np.unique(np.clip(a_grid[k] + np.linspace(-0.2, 0.2, 21), 0.02, A_MAX))
-    fi, fj, fk, best = _refine(line, h, omega, power, (f_fine, z_fine, a_fine), two_parts)
+    # the refinement grid screened in single precision too: its best point is the double-precision grid's
+    fine = _screened_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
+    fi, fj, fk = np.unravel_index(np.nanargmin(fine), fine.shape)
+    best = float(fine[fi, fj, fk])
     f_best, z_best, a_best = float(f_fine[fi]), float(z_fine[fj]), float(a_fine[fk])
     profile = np.full(f0_grid.size, np.nan)
     scanned = ~np.all(np.isnan(ssr), axis=(1, 2))     # every f0 but those a windowed search left out

@@ -224,28 +224,26 @@ def test_single_precision_dft_is_the_double_one_to_1e_7_of_the_strongest_line():
     assert not np.array_equal(got, ref)                                       # the single path was taken
 
 
-def test_scan_refinement_coarse_to_fine_is_the_whole_refinement_grid(monkeypatch):
-    # the refinement around the coarse best point searches a sub-lattice first, then the points around its best
-    # (mode_scan._refine): the same best point, SSR and damping/inertia ratio as searching every point of the
-    # refinement grid (strides of 1: the sub-lattice is the whole grid), on rocking (three axes), translation and axial
+def test_scan_screened_is_the_double_precision_scan(monkeypatch):
+    # the coarse grid of a locate-only scan and every refinement grid are screened in single precision
+    # (mode_scan._screened_search): the scan's results are those of the double-precision grids, bit for bit, on rocking
+    # (three axes), translation and axial, locate-only and with the distant competitor weighed
     import rwadist.mode_scan as ms
 
     for seed in (3, 5, 7, 11):
         line, h, omega, power = _scan_case(seed=seed)
         for mode, two in (("rocking", True), ("radial_translation", True), ("axial_translation", False)):
-            args = (mode, line, h, omega, power if two else np.sqrt(power))
-            monkeypatch.setattr(ms, "REFINE_STRIDE", (1, 1, 1))
-            whole = scan_mode(*args, min_log_lr=-np.inf)
-            monkeypatch.undo()
-            got = scan_mode(*args, min_log_lr=-np.inf)
-            assert (got.found, got.f0_hz, got.zeta, got.inertia_ratio, got.reason) == \
-                (whole.found, whole.f0_hz, whole.zeta, whole.inertia_ratio, whole.reason), (seed, mode)
-    # a point's SSR is the same number in any sub-grid (per-point sums): the refinement's value is the whole grid's
-    line, h, omega, power = _scan_case(seed=5)
-    grids = (np.exp(np.linspace(np.log(45.0), np.log(65.0), 41)), np.geomspace(0.01, 0.1, 11), np.linspace(1.0, 2.2, 13))
-    whole = _grid_search(line, h, omega, power, *grids, True)
-    i, j, k, value = ms._refine(line, h, omega, power, grids, True)
-    assert (i, j, k) == np.unravel_index(np.nanargmin(whole), whole.shape) and value == whole[i, j, k]
+            for min_log_lr in (-np.inf, 2.0):
+                args = (mode, line, h, omega, power if two else np.sqrt(power))
+                monkeypatch.setattr(ms, "_screened_search", ms._grid_search)
+                whole = scan_mode(*args, min_log_lr=min_log_lr)
+                monkeypatch.undo()
+                got = scan_mode(*args, min_log_lr=min_log_lr)
+                assert (got.found, got.f0_hz, got.zeta, got.inertia_ratio, got.reason, got.log_lr_off) == \
+                    (whole.found, whole.f0_hz, whole.zeta, whole.inertia_ratio, whole.reason, whole.log_lr_off) \
+                    or (np.isnan(got.log_lr_off) and np.isnan(whole.log_lr_off)
+                        and (got.found, got.f0_hz, got.zeta, got.inertia_ratio, got.reason)
+                        == (whole.found, whole.f0_hz, whole.zeta, whole.inertia_ratio, whole.reason)), (seed, mode)
 
 
 def test_screened_scan_grid_has_the_double_precision_best_point():
