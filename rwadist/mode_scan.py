@@ -198,9 +198,12 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
             out[s:s + step] = np.sum(_line_log_ssr(lnum - np.log(den_u), seg, trend), axis=-1)
             continue
         den_v = ((rest[:, None, :] - gyro[None]) ** 2)[:, None] + d2[:, :, None, :]
-        ssr = np.minimum(_line_log_ssr(lnum - np.log(den_u), seg, trend),
-                         _line_log_ssr(lnum - np.log(den_v), seg, trend))
         u, v = num[:, :, None, :] / den_u, num[:, :, None, :] / den_v
+        if seg.indicator is None:       # double precision: the logs of numerator and denominator, as ever
+            lu, lv = lnum - np.log(den_u), lnum - np.log(den_v)
+        else:                           # the screen: the logs of the ratios (no subtraction broadcast over a)
+            lu, lv = np.log(u), np.log(v)
+        ssr = np.minimum(_line_log_ssr(lu, seg, trend), _line_log_ssr(lv, seg, trend))
         su, suu, sv, svv, suv = (seg.sum(t) for t in (u, u * u, v, v * v, u * v))
         det = suu * svv - suv**2
         safe = np.where(np.abs(det) > 1e-14 * suu * svv, det, np.nan)
