@@ -33,13 +33,16 @@ class Opened:
     raw: Context
     fixed: list = field(default_factory=list)
     copies: list = field(default_factory=list)
+    #: run index -> dB: the common factor of those runs taken out of the records the search reads (:func:`run_steps`)
+    steps: dict = field(default_factory=dict)
 
 
-def start(ctx: Context) -> Opened:
+def start(ctx: Context, steps: dict | None = None) -> Opened:
     """The context the search reads: ``ctx`` itself, or, when the data hold lines at one fixed frequency in every run
     (:func:`~rwadist.diagnose.fixed_lines.find_fixed_lines`) or a channel carrying a copy of another's content
     (:func:`~rwadist.diagnose.channel_copy.find_channel_copies`, looked for once the fixed lines, common to every
-    channel, are out), a context of the same settings on the records with those taken out."""
+    channel, are out), a context of the same settings on the records with those taken out.  ``steps`` (run index ->
+    dB, from a first search's :func:`run_steps`): those runs' records also divided by their common factor."""
     from .channel_copy import find_channel_copies, remove_channel_copies
 
     fixed = find_fixed_lines(ctx)
@@ -47,12 +50,50 @@ def start(ctx: Context) -> Opened:
     copies = find_channel_copies(ctx, test)
     if copies:
         test = remove_channel_copies(test, copies)
-    if not fixed and not copies:
+    steps = dict(steps or {})
+    if steps and test is not None:
+        test = scale_runs(test, steps)
+    if not fixed and not copies and not steps:
         return Opened(ctx, ctx)
     from ..spectra import compute_spectra
 
     sp = compute_spectra(test, nperseg=ctx.sp.nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
-    return Opened(Context(sp, ctx.channels, test), ctx, fixed, copies)
+    return Opened(Context(sp, ctx.channels, test), ctx, fixed, copies, steps)
+
+
+def scale_runs(test, steps: dict):
+    """A copy of ``test`` with the records of each run r of ``steps`` multiplied by 10^(−steps[r]/20) (every channel:
+    the run's common factor, a power ratio in dB, taken out); new arrays, the input unchanged."""
+    from dataclasses import replace
+
+    from ..data import SteadyTest
+
+    runs = [replace(run, signals={c: x * 10.0 ** (-steps[i] / 20.0) for c, x in run.signals.items()})
+            if i in steps else run for i, run in enumerate(test.runs)]
+    return SteadyTest(runs, dict(test.meta))
+
+
+def run_steps(diag) -> dict:
+    """Run index -> dB: the runs a ``run_change`` record of ``diag`` holds apart from the others (a few runs changed
+    by a common factor: a re-mounting, a range switch) and their offsets, when the search may have been led by them:
+    it added an effect beyond its base, or, on the default path (no model given), did not fit the wheel's
+    ``suspension_modes`` (left in the records, a changed run's lines were fitted as a test-stand resonance of gain
+    7.5 or an amplitude law Ω^1.4, and the modes were not located, on two wheels of the family with every third run
+    3.5 dB up).  Empty otherwise, or without the time series."""
+    ctx = diag.ctx
+    if ctx.test is None:
+        return {}
+    recs = [u for u in diag.unexplained if u.signature == "run_change"]
+    if not recs:
+        return {}
+    added = [h for h in diag.hypotheses if h.passed and not h.base_line and h.effect.kind != "suspension_modes"]
+    modes = any(getattr(e, "kind", "") == "suspension_modes" for e in diag.state_after.effects)
+    if not added and (modes or diag.model_given):
+        return {}
+    index = {name: i for i, name in enumerate(ctx.sp.run_names)}
+    p = recs[0].parameters
+    return {index[n]: float(dB) for n, dB in zip(p.get("runs", ()), p.get("run_offsets_dB", ()))
+            if n in index and np.isfinite(dB)}
 
 
 @dataclass
@@ -163,10 +204,11 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
     return out
 
 
-def describe_residual(searched: Residual, bearings=(), res: Residual | None = None) -> list:
+def describe_residual(searched: Residual, bearings=(), res: Residual | None = None, changes: bool = False) -> list:
     """The records of the final model's residual on ``searched`` (the detectors of :mod:`.describe_structure` and
     :mod:`.describe_lines`), each with its share of the misplaced power and its level measured on ``res`` (default
-    ``searched``: the same runs and bands)."""
+    ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
+    the records the search read had the changed runs' factor taken out, :func:`run_steps`)."""
     from .describe_lines import speed_lines
     from .describe_structure import broadband_hump, line_ratios, moving_resonance, run_change
 
@@ -215,7 +257,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
               for x in state.model.harmonics(d)]
     out = broadband_hump(ctx, state, of_band)
     out += moving_resonance(ctx, state, ratios, of_track)
-    out += run_change(ctx, ratios, of_runs)
+    out += run_change(ctx, line_ratios(res.ctx, res.state) if changes else ratios, of_runs)
     out += speed_lines(ctx, state, of_line, bearings, others)
     return out
 
@@ -235,7 +277,7 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
     found = describe_fixed_lines(opened.raw, opened.fixed, fixed_line_shares(res, opened.fixed))
     found += describe_channel_copies(opened.raw, opened.copies, channel_copy_shares(res, opened.copies))
     # the final model's residual on the data the search read (the fixed lines and copies out), shares on the data
-    found += describe_residual(searched or res, bearings, res)
+    found += describe_residual(searched or res, bearings, res, changes=bool(opened.steps))
     return found, res
 
 

@@ -367,10 +367,24 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         from ..bearings import bearings_of
 
         bearings = bearings_of(getattr(model, "wheel", None) if given else None)
+    args = (spectra, model, k_sigma, min_gain, max_iterations, channels, test, base, bearings)
+    diag = _search(*args)
+    # a run-to-run change (a re-mounting, a range switch) left in the records is forced into classes and spoils the
+    # wheel's modes: when one is described and the search added more than its base (or could not fit the modes), the
+    # search is run again on the records with the changed runs' common factor taken out (docs/diagnose.md)
+    steps = describe.run_steps(diag)
+    return _search(*args, steps=steps) if steps else diag
+
+
+def _search(spectra: Spectra, model: WheelModel | None, k_sigma: float, min_gain: float, max_iterations: int,
+            channels, test, base: str, bearings, steps: dict | None = None) -> Diagnosis:
+    """:func:`diagnose` of its arguments, ``bearings`` resolved; ``steps`` (run index -> dB, or None): the common
+    factor of those runs taken out of the records the search reads (:func:`rwadist.diagnose.describe.start`)."""
+    given = model is not None
     # the open world (docs/diagnose.md, "Unexplained residual"): lines at one fixed frequency in every run and a
     # channel's copy of another's content taken out of the records everything after reads, the empirical fit of a
     # model not given included (no class explains them; left in, a class is forced onto them), described after
-    opened = describe.start(Context(spectra, channels, test))
+    opened = describe.start(Context(spectra, channels, test), steps)
     ctx = opened.ctx
     if model is None:
         model = fit_empirical(ctx.sp).model
