@@ -96,10 +96,11 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
                 continue
             taken.append(h_grid[i])
             h = refine_h(ctx, state, chans, runs, float(h_grid[i]))
-            if any(u.parameters["direction"] == d and abs(u.h - h) <= 4 * dh for u in out) or \
+            lit_runs = runs[hit[i] & inb[i]]
+            h = _record_h(ctx, chans, lit_runs, h)
+            if any(u.parameters["direction"] == d and u.h is not None and abs(u.h - h) <= 4 * dh for u in out) or \
                     (model_h.size and np.min(np.abs(model_h - h)) <= MODEL_LINE_BINS * dh / H_STEP_BINS):
                 continue                    # refined onto a line already described, or onto a model line
-            lit_runs = runs[hit[i] & inb[i]]
             rpm = ctx.omega[lit_runs] * RAD_S_TO_RPM
             share, level = shares(chans, h, lit_runs)
             if not level >= MIN_LEVEL_DB:
@@ -118,6 +119,41 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
                            "cage's instability or a rub, does not) and the bearings' geometry (--bearing) to name "
                            "the ratio"))
     return out
+
+
+#: :func:`_record_h` looks this many Welch bins (at the top speed of the runs) either side of a ridge's h ...
+RECORD_H_BINS = 2.0
+#: ... on a grid of this fraction of the ratio's resolution (:func:`ratio_resolution`)
+RECORD_H_STEP = 0.25
+
+
+def _record_h(ctx, chans, runs, h: float) -> float:
+    """The ratio of the line a ridge near ``h`` holds, on the whole records of ``runs``: the maximum of Σ|X|² over
+    the runs and the channels ``chans`` (whole-run transforms, :meth:`Context.phasors`) on a grid within
+    :data:`RECORD_H_BINS` Welch bins of h·|Ω|/2π at the runs' top speed, refined by a parabola through the top three
+    points (in log power); ``h`` itself without the time series, with fewer than 3 runs or with the maximum at the
+    grid's edge.  A line too weak for :func:`rwadist.diagnose.measure.refine_h` (its residual peaks under 20 × the
+    floor in a Welch bin) lights a ridge as wide as a Welch bin is at the lowest speeds: family wheel 2's h 9.139
+    line, 1.3 dB over the model, was read as four ridges at h 9.055-9.182, each described."""
+    from ..units import CHANNELS
+
+    runs = np.asarray(runs)
+    if ctx.test is None or runs.size < 3:
+        return h
+    w = ctx.omega[runs] / (2 * np.pi)
+    half = RECORD_H_BINS * ctx.df / float(w.max())
+    step = RECORD_H_STEP * ratio_resolution(ctx)
+    grid = h + np.arange(-half, half + 0.5 * step, step)
+    if grid.size < 3:
+        return h
+    X = ctx.phasors(runs, np.outer(w, grid))[:, :, [CHANNELS.index(c) for c in chans]]
+    tot = np.nansum(np.abs(X) ** 2, axis=(0, 2))
+    j = int(np.argmax(tot))
+    if not 0 < j < grid.size - 1:
+        return h
+    lo, mid, hi = np.log(np.maximum(tot[j - 1:j + 2], 1e-300))
+    den = lo - 2 * mid + hi
+    return float(grid[j] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * step)
 
 
 def _sense(ctx, direction: str, h: float, runs) -> float | None:
