@@ -32,7 +32,13 @@ extended-base lines; x13.4-14.9 (2.26 s / 0.15-0.17 s) with the same estimator o
 thread); 2026-11-28: x13.1-13.6 (1.40 s / 0.10-0.11 s, a faster machine) -> x8.9-9.4 (0.99-1.07 s / 0.11-0.12 s)
 after the reuse of the fit's identification without modal exclusion, the per-direction reuse and min_gain bound of
 the family search, the subsets of runs read from every run's terms, single-precision scans, batched record
-transforms and medians, with the same effects and errors on every check case.
+transforms and medians, with the same effects and errors on every check case.  2026-11-29 (issue 37, 2 cores at load
+12-15): at 85394ba (the two-fold modes fit, I_zz/I_rr scanned to 3) cpu x14.3 (benchmark) and x15.3-15.7 (sixty) -> at
+d2e0f8e x10.4-10.5 and x11.5-11.7 (min; diagnose 2.2 s / fit 0.21 s, 1.3 s / 0.11 s idle) with the mode scan's grids
+screened in single precision and their best f0 searched again in double precision (the same best points) and the
+suspension-mode refit reusing the whole data's empirical fit: diagnoses of both sets and of family wheels 0, 2, 4, 7
+(clean, fixtures) bit-identical.  What is left is spread over the families (``--quick`` under a profiler): the first
+modes fit ~25 %, the other families' two search steps ~40 %, the refit ~10 %.
 """
 from __future__ import annotations
 
