@@ -73,6 +73,14 @@ def scale_runs(test, steps: dict):
     return SteadyTest(runs, dict(test.meta))
 
 
+def search_standing(diag) -> tuple:
+    """(the wheel's ``suspension_modes`` in the model, minus the number of effects added beyond the base): what a
+    search run again with a run change taken out must improve on (:func:`run_steps`), compared as a tuple."""
+    added = [h for h in diag.hypotheses if h.passed and not h.base_line and h.effect.kind != "suspension_modes"]
+    modes = any(getattr(e, "kind", "") == "suspension_modes" for e in diag.state_after.effects)
+    return (modes, -len(added))
+
+
 def run_steps(diag) -> dict:
     """Run index -> dB: the runs a ``run_change`` record of ``diag`` holds apart from the others (a few runs changed
     by a common factor: a re-mounting, a range switch) and their offsets, when the search may have been led by them:
@@ -86,9 +94,8 @@ def run_steps(diag) -> dict:
     recs = [u for u in diag.unexplained if u.signature == "run_change"]
     if not recs:
         return {}
-    added = [h for h in diag.hypotheses if h.passed and not h.base_line and h.effect.kind != "suspension_modes"]
-    modes = any(getattr(e, "kind", "") == "suspension_modes" for e in diag.state_after.effects)
-    if not added and (modes or diag.model_given):
+    modes, minus_added = search_standing(diag)
+    if not minus_added and (modes or diag.model_given):
         return {}
     index = {name: i for i, name in enumerate(ctx.sp.run_names)}
     p = recs[0].parameters
