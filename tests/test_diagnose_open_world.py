@@ -342,3 +342,24 @@ def test_a_moving_resonance_beside_a_mode_the_model_lacks_is_described():
     assert described(lambda f, s: _transmissibility_db(f, 520.0, 0.02)) == []
     alone = described(lambda f, s: _softening_db(f, s))
     assert len(alone) == 1 and "beside_fixed_resonance_Hz" not in alone[0].parameters
+
+
+def test_an_effect_a_later_one_needs_is_not_taken_back_alone():
+    """Taking an effect back re-applies the others in their order; when one of them cannot be applied without it (a
+    counter_rotation splitting a line the taken-back effect made), :func:`describe._without` says so (None) instead of
+    raising: a 60-s run-up of family wheel 7 ended diagnose with an internal error there."""
+    from rwadist.diagnose.describe import _without
+
+    class Add:
+        def __init__(self, name, needs=None):
+            self.name, self.needs = name, needs
+
+        def apply(self, state):
+            if self.needs is not None and self.needs not in state:
+                raise ValueError(f"no {self.needs} in the state")
+            return state + (self.name,)
+
+    a, b, c = Add("a"), Add("b"), Add("c", needs="b")
+    assert _without((), [a, b, c], a) == ("b", "c")
+    assert _without((), [a, b, c], c) == ("a", "b")
+    assert _without((), [a, b, c], b) is None
