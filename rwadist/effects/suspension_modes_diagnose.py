@@ -404,6 +404,14 @@ class SuspensionModes:
             out["rocking"]["near_a"] = self.inertia_ratio
         return out
 
+    def stand_effect(self, channels):
+        """The fixture resonance fitted jointly with these modes (``stand``) as the test-stand effect on ``channels``
+        (a :class:`~rwadist.effects.fixed_resonance_diagnose.FixedResonance`) the search names after them, or None:
+        what the modes are judged beside when they do not pass alone (:func:`rwadist.diagnose.search._judge_beside_stand`)."""
+        from .fixed_resonance_diagnose import FixedResonance
+
+        return None if self.stand is None else FixedResonance.of_stand(self.stand, channels, self.stand)
+
     def whirl_Hz(self, omega_rad_s: float) -> dict:
         """Whirl frequencies (Hz) at wheel speed ``omega_rad_s``: translation, rocking forward/backward, axial."""
         half = 0.5 * self.inertia_ratio * abs(omega_rad_s) / (2 * np.pi)
