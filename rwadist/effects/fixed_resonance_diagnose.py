@@ -139,69 +139,6 @@ def _general_refit(e: "FixedResonance", f, y, sw, lo: float, hi: float) -> "Fixe
                    gain_above=float(best.x[3]))
 
 
-#: Damping ratios of the profile of a wheel mode whose width the lines do not resolve (:func:`_widest_width`): log
-#: spaced from :data:`rwadist.stand_resonance.STAND_MIN_ZETA` to :data:`MAX_ZETA`
-PROFILE_ZETAS = 24
-#: A width is allowed by the lines while the fit's cost rises by at most PROFILE_SIGMA² / 2 residual variances
-#: (a PROFILE_SIGMA-sigma profile bound on one parameter)
-PROFILE_SIGMA = 2.0
-
-
-def _widest_width(e: "FixedResonance", f, y, sw, lo: float, hi: float, cost_floor: float) -> "FixedResonance":
-    """``e`` (a fit whose damping ran to its floor: no line of ``f`` falls within its half-power band, so the lines
-    fix f_r and the product g·ζ -- away from its peak |H|² ≈ 1 + (2gζr/(1 − r²))² -- but not ζ) refitted at the
-    largest damping ratio the lines allow: for each ζ of a log grid (:data:`PROFILE_ZETAS`, from
-    :data:`rwadist.stand_resonance.STAND_MIN_ZETA` to :data:`MAX_ZETA`) f_r and g are fitted with ζ held; from the
-    grid's best ζ, the widest ζ reached through costs within :data:`PROFILE_SIGMA` standard errors of the best (of it
-    and ``cost_floor``, the floor fit's) is taken: the smallest peak gain consistent with the lines, never a peak no
-    line showed.  ``e`` itself when no ζ of the grid is allowed.
-
-    Parameters
-    ----------
-    e : FixedResonance
-        The fit at the damping floor.
-    f, y, sw : numpy.ndarray
-        Line frequencies (Hz), log power gains (dimensionless) and square-root weights of the fit, shape (n,).
-    lo, hi : float
-        Bounds of f_r, Hz.
-    cost_floor : float
-        The floor fit's cost (``least_squares``' soft-L1 cost, dimensionless).
-    """
-    from dataclasses import replace
-
-    from scipy.optimize import least_squares
-
-    from ..stand_resonance import STAND_MIN_ZETA
-
-    n = f.size
-    if n <= 3:
-        return e
-    lb, ub = np.log([lo, MIN_PEAK_GAIN]), np.log([hi, 200.0])
-    product = e.zeta * e.peak_gain
-    zetas = np.geomspace(STAND_MIN_ZETA, MAX_ZETA, PROFILE_ZETAS)
-    fits = []
-    for zeta in zetas:
-        def res(x, zeta=zeta):
-            return sw * (y - np.log(np.abs(resonance(f, np.exp(x[0]), zeta, np.exp(x[1]))) ** 2))
-
-        def jac(x, zeta=zeta):
-            d = log_power_gain_jacobian(f, float(np.exp(x[0])), zeta, float(np.exp(x[1])))
-            return -sw[:, None] * d[:, [0, 2]]
-
-        x0 = np.clip([np.log(e.f_r), np.log(max(product / zeta, MIN_PEAK_GAIN))], lb + 1e-9, ub - 1e-9)
-        fits.append(least_squares(res, x0, jac=jac, loss="soft_l1", f_scale=0.5, bounds=(lb, ub), max_nfev=MAX_NFEV))
-    costs = np.array([sol.cost for sol in fits])
-    low = min(cost_floor, float(costs.min()))
-    # the residual variance of the best fit (cost = ½ Σ ρ(r²)): a one-parameter profile bound of PROFILE_SIGMA
-    allowed = low + 0.5 * PROFILE_SIGMA**2 * (2.0 * low / (n - 3))
-    i = int(np.argmin(costs))
-    if costs[i] > allowed:
-        return e
-    while i + 1 < zetas.size and costs[i + 1] <= allowed:
-        i += 1                  # wider, and the lines still allow it
-    return replace(e, f_r=float(np.exp(fits[i].x[0])), zeta=float(zetas[i]), peak_gain=float(np.exp(fits[i].x[1])))
-
-
 @register(order=40)
 @dataclass
 class FixedResonance:
@@ -365,10 +302,6 @@ class FixedResonance:
             e = FixedResonance(f_r, zeta, g, tuple(channels), role, int(f.size))
             if best.status == -2:
                 return e        # no resonance here: re-measuring with a flat |H| ≈ 1 in the state changes nothing
-        if role == "wheel_mode" and e is not None and e.zeta < 1.5e-3 and e.peak_gain >= MIN_PEAK_GAIN:
-            # its width not resolved by the lines (a housing mode's peak between two speeds' lines): the widest width
-            # the last pass's lines allow
-            e = _widest_width(e, f, y, sw, lo, hi, float(best.cost))
         if role == "test_stand" and e is not None:
             # a fixture's gain need not return to 1 above it: the general form, its gain above free, on the lines
             # re-measured with the resonance in place
