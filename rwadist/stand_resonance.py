@@ -283,31 +283,31 @@ def stand_confirmed(joint, plain) -> bool:
 
 
 def lifts_every_direction(joint, plain) -> bool:
-    """True when the joint fit's stand explains the lines of every load direction it lifts: over the measurements
-    where its power gain reaches :data:`STAND_MIN_LOG_GAIN` (a factor 1.5, the detection's own threshold), the joint
-    fit's squared log residuals are below the fit without a stand's in each direction with such measurements, and
-    there are two directions or more.
+    """True when the joint fit's stand makes no load direction it lifts worse: over the measurements where its power
+    gain reaches :data:`STAND_MIN_LOG_GAIN` (a factor 1.5, the detection's own threshold), each direction's squared log
+    residuals are not above the fit without a stand's by more than that direction's number of such measurements times
+    the joint fit's mean squared residual (its own scatter), and two directions or more have such measurements.
 
-    A fixture resonance lifts every line near it on every channel; a resonance of one direction beside a wheel mode of
-    another looks like one to the overall cost (family wheel 2: a resonance on the axial force moving from 76 to 107
-    Hz with speed, and its 90 Hz radial translation: a "stand" at 88 Hz, ζ 0.09, gain 1.9 passed the criterion and
-    put the rocking mode 3.1 % off) but leaves the other direction's lines no better."""
+    A fixture resonance lifts every line near it on every channel; a resonance of one direction beside a wheel mode
+    of another passed the overall criterion on what it explained there alone (family wheel 2, a resonance moving from
+    76 to 107 Hz with speed on the axial force beside the 90 Hz translation: a "stand" at 79-88 Hz lowered the axial
+    residuals from 12.2 to 6.1 and raised the radial forces' from 0.005 to 6.0 and the torques' from 0.002 to 2.4,
+    and put the rocking mode 3.1 % off).  Not "each direction better": a fit without the stand can pull a mode onto
+    it and explain that direction as well (the E wheel with a 180 Hz stand and a load-cell offset: the translation at
+    184.5 Hz, the radial forces' residuals 0.017 against the joint fit's 0.035 over 15 measurements)."""
     from .resonance import resonance
 
     f1, r1, d1 = (np.asarray(v) for v in joint.line_residuals)
     _, r0, d0 = (np.asarray(v) for v in plain.line_residuals)
     if r1.shape != r0.shape or not np.array_equal(d1, d0):
         return True                     # not the same rows: the overall criterion decides alone
-    lifted = np.log(np.abs(resonance(f1, *joint.stand)) ** 2) >= STAND_MIN_LOG_GAIN
-    seen = 0
-    for d in np.unique(d1[lifted]):
-        m = lifted & (d1 == d) & np.isfinite(r1) & np.isfinite(r0)
-        if not m.any():
-            continue
-        seen += 1
-        if np.sum(r1[m] ** 2) >= np.sum(r0[m] ** 2):
-            return False
-    return seen >= 2
+    ok = np.isfinite(r1) & np.isfinite(r0)
+    scatter = float(np.mean(r1[ok] ** 2)) if ok.any() else 0.0
+    lifted = ok & (np.log(np.abs(resonance(f1, *joint.stand)) ** 2) >= STAND_MIN_LOG_GAIN)
+    dirs = np.unique(d1[lifted])
+    worse = [d for d in dirs if np.sum(r1[lifted & (d1 == d)] ** 2) - np.sum(r0[lifted & (d1 == d)] ** 2)
+             > np.sum(lifted & (d1 == d)) * scatter]
+    return dirs.size >= 2 and not worse
 
 
 def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, starts: list | None = None, **kwargs):
