@@ -476,7 +476,7 @@ def _fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple
 
 def _residuals_near_modes(params: ext.ExtendedParams, lines: list, ax_line: np.ndarray, rad_parts: np.ndarray,
                           sa: np.ndarray, sr: np.ndarray, dr: np.ndarray, r: np.ndarray,
-                          notes: list) -> tuple[dict[str, float], tuple[np.ndarray, np.ndarray]]:
+                          notes: list) -> tuple[dict[str, float], tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """(per mode the RMS log residual (dB) of the measurements within ±10 % of its frequency at their speed, (f Hz, r)
     of every row: :attr:`ExtendedFit.line_residuals`) of the least squares' residuals ``r`` (the axial rows: forcing
     line ``ax_line``, speed ``sa`` rad/s; then the radial rows: parts ``rad_parts``, speed ``sr``, direction ``dr``);
