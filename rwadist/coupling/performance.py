@@ -91,9 +91,15 @@ class Floor:
 
     def psd(self, f_hz, omega) -> np.ndarray:
         """S (n_speeds, n_f) at frequencies ``f_hz`` (Hz) and wheel speeds ``omega`` (rad/s)."""
-        shape = np.interp(np.asarray(f_hz, dtype=float), self.f_hz, self.psd_ref, left=0.0, right=0.0)
-        gain = (np.abs(np.atleast_1d(np.asarray(omega, dtype=float))) / self.omega_ref) ** self.exponent
-        return gain[:, None] * shape[None, :]
+        return self.gain(omega)[:, None] * self.shape(f_hz)[None, :]
+
+    def shape(self, f_hz) -> np.ndarray:
+        """The PSD at omega_ref at frequencies ``f_hz`` (Hz): the knots' piecewise-linear interpolant, 0 outside."""
+        return np.interp(np.asarray(f_hz, dtype=float), self.f_hz, self.psd_ref, left=0.0, right=0.0)
+
+    def gain(self, omega) -> np.ndarray:
+        """(|Ω|/omega_ref)^exponent (n_speeds,) at wheel speeds ``omega`` (rad/s): S(f, Ω) = gain(Ω)·shape(f)."""
+        return (np.abs(np.atleast_1d(np.asarray(omega, dtype=float))) / self.omega_ref) ** self.exponent
 
     def support(self):
         """(lo, hi) Hz outside which the floor is zero, or None for an all-zero floor."""
@@ -601,6 +607,27 @@ def floor_grid(plant: Plant, wheels, omega, points_per_halfwidth: float = 2.0, p
     return np.unique(np.concatenate([np.geomspace(lo, hi, max(n, 2)), knots]))
 
 
+def _floor_terms(wheels, cols, f, omega):
+    """The floors as separable terms S_t(f, Ω) = gain_t(Ω)·shape_t(f) (:meth:`Floor.psd`): gains (S, T) at the
+    sweep speeds ``omega`` (each wheel's speed scale applied), shapes (T, F) on ``f`` Hz, and each term's column
+    in ``cols`` [(wheel, channel)] (T,)."""
+    gains, shapes, col = [], [], []
+    for j, (k, c) in enumerate(cols):
+        for fl in wheels[k].floors:
+            if fl.channel == c:
+                gains.append(fl.gain(omega * wheels[k].speed_scale))
+                shapes.append(fl.shape(f))
+                col.append(j)
+    return np.stack(gains, axis=1), np.stack(shapes), np.array(col)
+
+
+def _speed_free_psd(A, gains, shapes, col) -> np.ndarray:
+    """Σ_n A[f, p, n]·S_n(f, Ω) (S, F, n_perf) for a response A (F, n_perf, N) that does not depend on the speed,
+    the floors as :func:`_floor_terms`: one (S, T) × (T, F·n_perf) product."""
+    W = A[:, :, col] * shapes.T[:, None, :]                                  # (F, n_perf, T)
+    return (gains @ np.moveaxis(W, -1, 0).reshape(col.size, -1)).reshape(gains.shape[0], A.shape[0], A.shape[1])
+
+
 def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
                     chunk_points: int = 20000) -> FloorResponses:
     """The wheels' broadband floors through the plant for each practice at sweep speeds ``omega`` (rad/s).
@@ -629,11 +656,10 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
         if f.size < 2 or not np.all(np.isfinite(f)) or f[0] <= 0 or np.any(np.diff(f) <= 0):
             raise CouplingError("f_hz must be >= 2 finite, positive, strictly increasing frequencies")
     R = np.stack([Mts[k].T[:, c] for k, c in cols], axis=1)                 # (n_if, N) unit blocked loads
-    Sin = np.zeros((om.size, f.size, len(cols)))
-    for j, (k, c) in enumerate(cols):
-        for fl in wheels[k].floors:
-            if fl.channel == c:
-                Sin[:, :, j] += fl.psd(f, om * wheels[k].speed_scale)
+    gains, shapes, col = _floor_terms(wheels, cols, f, om)
+    # S_n(f, Ω) = Σ_{t on column n} gain_t(Ω)·shape_t(f): each chunk's (speeds, frequencies, columns) in one product
+    H = np.zeros((col.size, f.size, len(cols)))
+    H[np.arange(col.size), :, col] = shapes
     psd = {p: np.zeros((om.size, f.size, plant.n_perf)) for p in practices}
     dyn = [p for p in ("coupled", "iii") if p in practices]
     eye = np.eye(n_if)
@@ -644,11 +670,12 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
         G, P = plant.frf(fc)
         if not (np.all(np.isfinite(G)) and np.all(np.isfinite(P))):
             raise CouplingError(f"the plant's response is not finite on the floor grid ({f[0]:.6g}-{f[-1]:.6g} Hz)")
+        # 'i' and 'ii' do not depend on the speed: Σ_t gain_t(Ω)·(|T_{y,n_t}(f)|²·shape_t(f)), one product
         if "i" in practices:
-            psd["i"][:, fs] = (np.abs(P @ R) ** 2 @ Sin[:, fs][..., None])[..., 0]
+            psd["i"][:, fs] = _speed_free_psd(np.abs(P @ R) ** 2, gains, shapes[:, fs], col)
         if "ii" in practices:
             Y = P @ np.linalg.solve(eye - Zm @ G, np.broadcast_to(R, (fc.size,) + R.shape))
-            psd["ii"][:, fs] = (np.abs(Y) ** 2 @ Sin[:, fs][..., None])[..., 0]
+            psd["ii"][:, fs] = _speed_free_psd(np.abs(Y) ** 2, gains, shapes[:, fs], col)
         if not dyn:
             continue
         # the wheels' speeds enter only through their rank-2 gyroscopic terms: one factorisation per frequency
@@ -661,11 +688,12 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
         solver = FloorSolver(G, P, Mts, [splits[_wheel_key(w)[:3] + (bool(w.hard_mounted),)] for w in wheels], R,
                              cols)
         step = max(1, int(chunk_points) // fc.size)
+        Hc = H[:, fs].reshape(col.size, -1)
         for i0 in range(0, om.size, step):
             o = om[i0:i0 + step]
-            Sc = Sin[i0:i0 + o.size, fs][..., None]
+            Sc = (gains[i0:i0 + o.size] @ Hc).reshape(o.size, fc.size, len(cols), 1)
             for p, Y in solver.responses(o, [w.speed_scale for w in wheels], dyn).items():
-                psd[p][i0:i0 + o.size, fs] = (np.abs(Y) ** 2 @ Sc)[..., 0]
+                psd[p][i0:i0 + o.size, fs] = ((Y.real ** 2 + Y.imag ** 2) @ Sc)[..., 0]
     psd = {p: psd[p] for p in practices}
     ms = {p: _trapz(v, f, axis=1) for p, v in psd.items()}
     return FloorResponses(om, plant.perf_names, f, psd, ms)
