@@ -49,7 +49,7 @@ from rwadist.effects.actions import NoiseFloor, of_effects
 from rwadist.schema import ModelError
 from rwadist.units import CHANNELS, RAD_S_TO_RPM
 
-from . import geometry
+from . import geometry, rigid_practice
 from .assemble import PRACTICES
 from .components import Plant, wheel_matrices, wheel_rigid_mass_matrix
 from .errors import CouplingError, SingularInterfaceError
@@ -380,10 +380,11 @@ def _setup(plant: Plant, wheels, practices, omega):
     return om, Mts, Zm
 
 
-def _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache) -> list:
+def _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache, rigid_form=None) -> list:
     """[(coupled loads (S, J, 6), {practice: outputs (S, J, n_perf)})] of wheels ``ks``, whose lines all sit at
     the frequencies ``fe`` (S, J) Hz at speeds ``o``: the plant, the wheels' dynamic masses and the interface
-    matrix once, each practice's solve with every wheel's right-hand side at once."""
+    matrix once, each practice's solve with every wheel's right-hand side at once; practice 'ii' from
+    ``rigid_form`` (:class:`rwadist.coupling.rigid_practice.RigidPractice`) when given."""
     G, P = plant.frf(fe)
     parts, Bs = [], {}
     for i, wi in enumerate(wheels):
@@ -401,12 +402,14 @@ def _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache) -> list:
     else:
         u = {"coupled": np.linalg.solve(Lc, rhs)}
     u["i"] = rhs
-    if "ii" in practices:                # I − Zm·G, wheel by wheel on its node's rows (Zm = −Σ Mtᵀ M6 Mt)
+    if "ii" in practices and rigid_form is None:    # I − Zm·G, wheel by wheel on its node's rows (Zm = −Σ Mtᵀ M6 Mt)
         rigid = [(Mt, -wheel_rigid_mass_matrix(w.params, w.housing_mass, w.housing_inertia))
                  for Mt, w in zip(Mts, wheels)]
         u["ii"] = np.linalg.solve(_interface_matrix(G, rigid), rhs)
     # every wheel's outputs and interface accelerations in one product per practice (columns = wheels)
-    Y = {p: P @ u[p] for p in practices}                                                   # (S, J, n_perf, |ks|)
+    Y = {p: P @ u[p] for p in practices if p in u}                                         # (S, J, n_perf, |ks|)
+    if "ii" in practices and rigid_form is not None:
+        Y["ii"] = rigid_form.outputs(fe, [Mts[k] for k in ks], [lines[k][1] for k in ks])
     acc = G @ u["coupled"]                                                                  # (S, J, n_if, |ks|)
     out = []
     for j, k in enumerate(ks):
@@ -435,9 +438,13 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
     Cost: one coupled interface solve (n_if × n_if) per (speed, line group) point, each at its own frequency (the
     plant, the wheels' dynamic masses and the interface matrix change with it); a ripple's 2K + 1 orders multiply
     the points, and its sidebands at f + m·f_r meet no other point's frequency, so the time grows with them
-    (bench_coupling: K = 6, 13.0× the plain sweep's points)."""
+    (bench_coupling: K = 6, 13.0× the plain sweep's points).  Practice 'ii' (speed-free) of a modal plant is the
+    mass-loaded structure's closed form (:mod:`rwadist.coupling.rigid_practice`: one eigen-decomposition, then a
+    product over its modes per point) instead of a second interface solve."""
     wheels = list(wheels)
-    om, Mts, _ = _setup(plant, wheels, practices, omega)
+    om, Mts, Zm = _setup(plant, wheels, practices, omega)
+    # practice 'ii' does not depend on the speed: for a modal plant, one closed form for every point
+    rigid_form = rigid_practice.rigid_practice(plant, -Zm) if "ii" in practices else None
     # wheels that differ only in their mount (a wheel set of one type) have the same lines in their own frame:
     # their sideband orders and grouped blocked loads are computed once
     line_key = [(w.params, tuple(map(id, w.lines)), w.ripple, float(w.speed_scale), bool(w.hard_mounted))
@@ -480,7 +487,8 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
             else:
                 groups.append((fe, [k]))
         for fe, ks in groups:
-            for k, (ld, y) in zip(ks, _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache)):
+            for k, (ld, y) in zip(ks, _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache,
+                                                  rigid_form)):
                 load_parts[k].append(ld)
                 for p in practices:
                     y_parts[p][k].append(y[p])
