@@ -12,8 +12,9 @@ decouple (FᵀM'R = 0, FᵀKF = K_ff, FᵀDF = D_ff):
 
     y = Φ_p R M_RR⁻¹ RᵀΦᵀ X / s²  +  Φ_p F (s² M_FF + s D_ff + K_ff)⁻¹ FᵀΦᵀ X,
 
-and the flexible part, non-defective, is one eigen-decomposition of its state matrix (in M_FF-normalised coordinates,
-M_FF = L Lᵀ): y_flex = Σ_j c_j (w_j·X)/(s − λ_j).  Every (speed, line) point then costs a few products over the modes
+and the flexible part, non-defective, is one eigen-decomposition of its state matrix (states [ω·ζ, ζ̇], ω the plant's
+flexible frequencies, where the eigenvectors of a lightly damped structure are near-orthogonal):
+y_flex = Σ_j c_j (w_j·X)/(s − λ_j).  Every (speed, line) point then costs a few products over the modes
 instead of an n_if × n_if interface matrix and its factorisation; one decomposition serves every speed and frequency.
 Where the eigenvectors are ill-conditioned (> :data:`EIG_COND`), or the plant too large for one decomposition to pay
 (> :data:`MAX_STATES`), :func:`rigid_practice` returns None and the caller keeps the solves.
@@ -91,13 +92,16 @@ def rigid_practice(plant: Plant, M_r: np.ndarray) -> RigidPractice | None:
         L = np.linalg.cholesky(0.5 * (Mff + Mff.T))
     except np.linalg.LinAlgError:
         return None
-    Li = np.linalg.inv(L)
-    Kt = Li @ np.diag(wn[flex] ** 2) @ Li.T
-    Dt = Li @ np.diag(2 * zeta[flex] * wn[flex]) @ Li.T
+    # states [W·ζ, ζ̇] (W = the plant's own flexible frequencies, K_ff = W²): the state matrix's scale is ω_max, not
+    # ω_max², and for a mass loading that leaves M_FF near I its eigenvectors are near-orthogonal ([ζ, ζ̇] makes their
+    # condition number ~ ω_max/ω_min, and an eigen-decomposition of M_FF⁻¹K_ff loses the low modes' relative accuracy)
+    W = wn[flex]
     n = flex.size
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Kt, -Dt]])
-    B = np.vstack([np.zeros((n, Phi.shape[0])), Li @ Fm.T @ Phi.T])
-    C = np.hstack([Phip @ Fm @ Li.T, np.zeros((Phip.shape[0], n))])
+    MinvW = np.linalg.solve(L.T, np.linalg.solve(L, np.diag(W)))
+    MinvD = np.linalg.solve(L.T, np.linalg.solve(L, np.diag(2 * zeta[flex] * W)))
+    A = np.block([[np.zeros((n, n)), np.diag(W)], [-MinvW, -MinvD]])
+    B = np.vstack([np.zeros((n, Phi.shape[0])), np.linalg.solve(L.T, np.linalg.solve(L, Fm.T @ Phi.T))])
+    C = np.hstack([(Phip @ Fm) / W, np.zeros((Phip.shape[0], n))])
     lam, V = np.linalg.eig(A)
     if not np.all(np.isfinite(lam)):
         return None
