@@ -50,7 +50,7 @@ from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower
 from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
-from .off_law_lines import free_off_law_lines, line_regressors, off_law_note
+from .off_law_lines import free_off_law_lines, lawful_lines, line_regressors, off_law_note
 from .resonance import FittedResonance, resonance
 from .spectra import compute_spectra, welch_dof
 from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
@@ -449,7 +449,7 @@ def _fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, to
     while True:
         solution, loose = free_off_law_lines(
             lambda lns: problem.solve(free_modes, lns), lambda sol: loose_modes(sol, free_modes, problem.base, tolerance),
-            off_law, problem.row_line, log_w)
+            off_law, problem.row_line, log_w, lawful_lines(problem.meas_lines))
         if not loose or not declare:
             return solution
         for m, why in loose:

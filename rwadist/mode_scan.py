@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .extended import IMBALANCE_H_TOL
 from .schema import MAX_INERTIA_RATIO
 
 #: modes scanned and the measured direction that shows each
@@ -108,14 +109,26 @@ class _Segments:
 
 class _Trend:
     """Per-row ln|Ω| less its line's mean (``lc``), per line Σ lc² (``lc2``) and the factor e^{Z²/n} (``factor``) of
-    :func:`_line_log_ssr`'s off-law option, the rows sorted by line."""
+    :func:`_line_log_ssr`'s off-law option, the rows sorted by line; ``lawful`` (per line, bool): the lines that have
+    no such option (the imbalance: :func:`_imbalance_lines`)."""
 
-    def __init__(self, om, starts, counts):
+    def __init__(self, om, starts, counts, lawful):
         lw = np.log(om)
         mean = np.add.reduceat(lw, starts) / counts
         self.lc = lw - np.repeat(mean, counts.astype(int))
         self.lc2 = np.add.reduceat(self.lc**2, starts)
         self.factor = np.exp(OFF_LAW_Z**2 / counts)
+        self.lawful = np.asarray(lawful, bool)
+
+
+def _imbalance_lines(h_line, radial: bool) -> np.ndarray:
+    """Per line (its harmonic number ``h_line``), whether it is the imbalance: a radial line within
+    :data:`rwadist.extended.IMBALANCE_H_TOL` of h = 1.  Its load is U·Ω² by its physics (a mass off the spin axis),
+    so its speed trend through the modes is the information it carries, never a law of its own: with an exponent of
+    its own allowed, the rocking whirl of a wheel with I_zz/I_rr > 2 (whose forward whirl the 1x line never crosses:
+    its transmissibility 1/(1 + (a − 1)(Ω/ω0)²) is a smooth trend) traded off f0 against a (family wheel 2: 46.3 Hz at
+    a = 2.54 for 50 Hz at 2.2) and an amplitude law on the imbalance was invented to make up the trend."""
+    return radial & (np.abs(np.asarray(h_line, float) - 1.0) <= IMBALANCE_H_TOL)
 
 
 def _line_log_ssr(lw, seg, trend=None):
@@ -132,7 +145,7 @@ def _line_log_ssr(lw, seg, trend=None):
         return ssr
     sl = seg.sum(lw, trend.lc)
     free = np.maximum(ssr - np.where(trend.lc2 > 0, sl * sl / np.where(trend.lc2 > 0, trend.lc2, 1.0), 0.0), 0.0)
-    return np.minimum(ssr, free * trend.factor)
+    return np.where(trend.lawful, ssr, np.minimum(ssr, free * trend.factor))
 
 
 def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, chunk=512, dtype=np.float64):
@@ -176,7 +189,7 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
     # no gyroscopic term (translation modes, or a = 0): both senses see the same |T|² and the two parts are one
     same = not np.any(gyro)
     both_senses = two_parts and not same
-    trend = _Trend(om, starts, counts)
+    trend = _Trend(om, starts, counts, _imbalance_lines(np.asarray(h, float)[order][starts], two_parts))
     seg = _Segments(starts, counts, dtype)
     n_z, n_a, n_rows = zeta_grid.size, a_grid.size, om.size
     out = np.empty((f0_grid.size, n_z, n_a))

@@ -12,6 +12,8 @@ import math
 
 import numpy as np
 
+from .extended import IMBALANCE_H_TOL
+
 #: Lines of a law other than C·Ω² whose exponent the least squares may free before a mode is declared not
 #: constrained (:func:`off_law_line`): one such line (an amplitude law, a foreign load) is what drags a mode to the
 #: ±5 % limit while every other line places it.
@@ -58,11 +60,13 @@ def line_regressors(ax_line: np.ndarray, rad_line: np.ndarray, ax_omega: np.ndar
     return row_line, log_w, centred
 
 
-def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, log_w: np.ndarray):
+def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, log_w: np.ndarray,
+                       lawful: tuple = ()):
     """(fit, loose) of the least squares ``fit_with(off_law)`` (a tuple whose first item is the scipy result) with
     ``loose_of(fit)`` its modes not pinned; while fewer than :data:`MAX_OFF_LAW_LINES` lines are freed, the line
-    :func:`off_law_line` picks is freed when that pins more modes, or as many and explains the lines better by more
-    than its one parameter (:func:`_explains_more`; ``off_law`` is appended in place).
+    :func:`off_law_line` picks (never one of ``lawful``: the imbalances, whose U·Ω² is their physics,
+    :func:`lawful_lines`) is freed when that pins more modes, or as many and explains the lines better by more than
+    its one parameter (:func:`_explains_more`; ``off_law`` is appended in place).
 
     Is one line of another law (an amplitude law on one harmonic, Ω³ where the model says Ω²) dragging the modes off
     while the other lines place them?  Before a located mode is declared not constrained, and also when every mode is
@@ -73,7 +77,7 @@ def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, 
     fit = fit_with(off_law)
     loose = loose_of(fit)
     while len(off_law) < MAX_OFF_LAW_LINES:
-        j = off_law_line(fit[0].fun, row_line, log_w, off_law)
+        j = off_law_line(fit[0].fun, row_line, log_w, list(off_law) + list(lawful))
         if j is None:
             break
         trial = fit_with(off_law + [j])
@@ -84,6 +88,16 @@ def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, 
         off_law.append(j)
         fit, loose = trial, trial_loose
     return fit, loose
+
+
+def lawful_lines(meas_lines: list) -> tuple:
+    """Indices of the measured lines (``direction``, ``h``) whose law is known: the imbalances (a radial line within
+    :data:`rwadist.extended.IMBALANCE_H_TOL` of h = 1, a mass off the spin axis: U·Ω²).  Their trend in speed is what
+    the modes make of them, so it is never freed: freed, the imbalance of a wheel with I_zz/I_rr > 2 (its forward
+    whirl never crossed by the 1x line, whose transmissibility is then a smooth trend in speed) no longer told the
+    rocking f0 from I_zz/I_rr, and an amplitude law was invented on it (family wheel 2)."""
+    return tuple(j for j, x in enumerate(meas_lines)
+                 if x.direction in ("radial_force", "radial_torque") and abs(x.h - 1.0) <= IMBALANCE_H_TOL)
 
 
 def _explains_more(r0: np.ndarray, r1: np.ndarray) -> bool:
