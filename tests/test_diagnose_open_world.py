@@ -74,6 +74,33 @@ def test_channel_copy_names_source_target_and_gain():
     assert abs(u.parameters["phase_deg"]) < 3.0
 
 
+def _one_line(kappa_of, law_of, n_runs=16, seed=0):
+    """The Tx line h = 1 of ``n_runs`` runs at 5-50 Hz of spin, |X| = Ω²·law_of(Ω) with a random phase per run, and
+    Tz = kappa_of(Ω)·Tx, 20-60 dB over Tz's noise: the keyword arguments of :func:`rwadist.diagnose.channel_copy._pair`."""
+    rng = np.random.default_rng(seed)
+    omega = 2 * np.pi * np.linspace(5.0, 50.0, n_runs)
+    x_s = omega**2 * law_of(omega) * np.exp(2j * np.pi * rng.uniform(size=n_runs))
+    x_t = kappa_of(omega) * x_s
+    noise_t = np.full(n_runs, np.min(np.abs(0.3 * x_s)) ** 2 / 100.0)
+    return dict(X_s=x_s, X_t=x_t, noise_t=noise_t, runs=np.arange(n_runs), h=np.ones(n_runs), cs="Tx", ct="Tz",
+                omega=omega)
+
+
+def test_one_line_copy_is_a_copy_only_when_the_target_follows_the_sources_departure_from_its_law():
+    """One line at one complex ratio in every run: a copy when the source's line departs from C·Ω² (here through a
+    rigid rotor's rocking whirl with I_zz/I_rr 2.2, 1/(1 + 1.2·(Ω/ω0)²), 0.99 -> 0.45) and the target follows it;
+    not when the source keeps its law (a load of the wheel's own in a fixed phase to it, both ∝ Ω², cannot be told
+    from a copy), nor when the ratio itself changes with the speed (the target's own transfer)."""
+    from rwadist.diagnose.channel_copy import _pair
+
+    w0 = 2 * np.pi * 50.0
+    whirl = lambda om: 1.0 / (1.0 + 1.2 * (om / w0) ** 2)      # noqa: E731
+    got = _pair(**_one_line(lambda om: 0.3 + 0.0j, whirl))
+    assert got is not None and got.lines_h == (1.0,) and got.kappa == pytest.approx(0.3, rel=1e-6)
+    assert _pair(**_one_line(lambda om: 0.3 + 0.0j, lambda om: np.ones_like(om))) is None
+    assert _pair(**_one_line(lambda om: 0.3 / whirl(om), whirl)) is None
+
+
 def test_hump_where_it_is():
     _, truth, d = diagnosed("broadband_hump")
     (u,) = d.unexplained

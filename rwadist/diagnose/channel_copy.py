@@ -53,6 +53,11 @@ MAX_RUNS = 24
 MIN_COPY_DB = 10.0
 #: A line's run counts where the copy there would stand this far over the target's noise (dB).
 CLEAR_COPY_DB = 20.0
+#: One line alone is a copy when κ holds in at least this many of its clear runs (and MIN_SINGLE_FRACTION of them)
+#: while the source's line departs from its own law by at least SINGLE_LAW_DB over those runs (:func:`_one_line_copy`)
+MIN_SINGLE_RUNS = 8
+MIN_SINGLE_FRACTION = 0.8
+SINGLE_LAW_DB = 3.0
 
 
 @dataclass(frozen=True)
@@ -123,7 +128,8 @@ def find_channel_copies(ctx, test=None) -> list:
         for t, ct in enumerate(chans):
             if t == s or CHANNEL_DIRECTION[ct] == CHANNEL_DIRECTION[cs] or (cs, ct) in LEVER_ARM_PAIRS:
                 continue
-            got = _pair(X[mine, s], X[mine, t], noise[mine, t], run_of[mine], h[mine], cs, ct)
+            got = _pair(X[mine, s], X[mine, t], noise[mine, t], run_of[mine], h[mine], cs, ct,
+                        ctx.omega[run_of[mine]])
             if got is not None:
                 found.append(got)
     # a radial pair carrying the other radial pair's content alike (Tx = κ·Fx and Ty = κ·Fy) is the rotor's own
@@ -143,9 +149,32 @@ def find_channel_copies(ctx, test=None) -> list:
     return out
 
 
-def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str) -> ChannelCopy | None:
+def _one_line_copy(X_s, omega, runs, h, near, strong) -> list:
+    """[h] of the one line whose κ holds in at least :data:`MIN_SINGLE_RUNS` runs where the copy stands clear
+    (``strong``), :data:`MIN_SINGLE_FRACTION` of them, while the source's line there departs from C·Ω² by at least
+    :data:`SINGLE_LAW_DB` (its |X|/Ω² over those runs, max over min), else [].
+
+    One line at one complex ratio in every run can be the wheel's own geometry (an axial runout turning with the
+    imbalance: the two loads in a fixed phase, both ∝ Ω² below their modes); but a target following the source's own
+    departure from its law -- the source's modes shaping it, which the target's direction does not share -- at one
+    gain and phase is a copy of that channel (family wheel 2: Tz = 0.3·Tx; Tx's imbalance line, attenuated from 0.96
+    to 0.45 of C·Ω² by its rocking whirl, the one torque line that stands clear)."""
+    best: list = []
+    for hv in np.unique(h[near]):
+        sel = (h == hv) & strong
+        n_runs = np.unique(runs[sel]).size
+        hit = sel & near
+        if n_runs < MIN_SINGLE_RUNS or np.unique(runs[hit]).size < max(MIN_SINGLE_FRACTION * n_runs, MIN_SINGLE_RUNS):
+            continue
+        law = np.abs(X_s[hit]) / np.maximum(np.abs(omega[hit]), 1e-12) ** 2
+        if 20 * np.log10(law.max() / law.min()) >= SINGLE_LAW_DB and (not best or hit.sum() > best[1]):
+            best = [float(hv), int(hit.sum())]
+    return best[:1]
+
+
+def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str, omega) -> ChannelCopy | None:
     """The copy of channel ``cs`` in ``ct`` from the source's points: their transforms ``X_s``, ``X_t``, the target's
-    noise there, their runs and line ratios ``h``; or None."""
+    noise there, their runs, line ratios ``h`` and speeds ``omega`` (rad/s); or None."""
     k = X_t / X_s
     ok = np.isfinite(k) & (np.abs(k) > 0)
     if ok.sum() < MIN_RUNS:
@@ -177,7 +206,9 @@ def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str) -> ChannelCopy | None:
         if n_runs >= MIN_RUNS and np.unique(runs[sel & near]).size >= MIN_RUN_FRACTION * n_runs:
             lines.append(float(hv))
     if len(lines) < MIN_COPIED_LINES:
-        return None
+        lines = _one_line_copy(X_s, omega, runs, h, near, strong)
+        if not lines:
+            return None
     keep = near & np.isin(h, lines)
     # κ again from the copy's cleanest lines: a line the target also carries itself (a ratio the two directions share)
     # scatters about κ from run to run, one it only copies does not; within the wide cluster such lines pulled κ
