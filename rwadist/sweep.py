@@ -589,5 +589,8 @@ def slice_sweep(sweep: Sweep, slice_samples: int | None = None, hop: int | None 
         meta["slicing"]["speed_scale"] = (spd.to_meta() if spd is not None else
                                           {"method": "speed from the data: no line above the noise in any slice"})
     order = np.argsort(speeds[kept], kind="stable")
+    # how far the speed moves within each kept slice (in the runs' order): a line is smeared over h × that, which no
+    # finer feature of the slice's spectrum (a sideband closer to its carrier) can be told from
+    meta["slicing"]["speed_spread_rpm"] = [float(rad_s_to_rpm(infos[kept[k]].speed_spread)) for k in order]
     test = SteadyTest([runs[k] for k in order], meta)
     return test, [infos[kept[k]] for k in order]

@@ -86,3 +86,27 @@ def test_pair_inside_the_welch_kernel_judged_on_the_whole_record(tmp_path):
     for h in (0.94, 1.06):
         assert resolvable_runs(d.ctx, d.state_before, "radial_force", 1.0, h, d.ctx.runs).size == 0
     assert d.error_after < 0.01 * d.error_before
+
+
+def test_a_side_inside_its_carriers_smear_over_a_sweeps_slice_is_not_resolvable():
+    """A sweep's slice moves the speed by ΔΩ within its record: the carrier h0 is smeared over h0·ΔΩ/2π, and a side
+    closer than that plus the resolution is not measured apart from it (family wheel 7's 60-s run-up: h 3.42 over
+    ~12 Hz per slice, a pair at ±0.0116 in h invented there).  Steady runs (no slicing) keep the resolution alone."""
+    from types import SimpleNamespace
+
+    from rwadist.data import Run, SteadyTest
+
+    omega = 2 * np.pi * np.array([20.0, 40.0, 80.0])                    # rad/s
+    runs = [Run(speed=float(w), sample_rate=2048.0, signals={"Fx": np.zeros(8192)}) for w in omega]
+    state = SimpleNamespace(model=SimpleNamespace(harmonics=lambda d: []))
+
+    def ctx(meta):
+        return SimpleNamespace(omega=omega, df=1.0, k_lo=0, k_hi=1000, test=SteadyTest(runs, meta), _memo={})
+
+    idx = np.arange(3)
+    # side 0.1 in h from h0 = 3: 2, 4, 8 Hz from the carrier; MIN_BINS (2.5 bins of 1 Hz) passes the two fast runs
+    steady = resolvable_runs(ctx({}), state, "radial_force", 3.0, 3.1, idx)
+    assert list(steady) == [1, 2]
+    # a slice whose speed moves 60 rpm (1 Hz of spin): the carrier spans 3 Hz, the side must be 5.5 Hz away
+    swept = ctx({"slicing": {"speed_spread_rpm": [60.0, 60.0, 60.0]}})
+    assert list(resolvable_runs(swept, state, "radial_force", 3.0, 3.1, idx)) == [2]

@@ -118,6 +118,9 @@ def test_tach_slices_are_tach_means_and_round_trip(tmp_path):
         assert info.speed_source == "tach" and info.confidence == 1.0
         assert run.speed == pytest.approx(seg.sum() / len(seg), rel=1e-12)
         assert info.speed_spread == pytest.approx(seg.max() - seg.min(), rel=1e-12)
+        # each run's speed change over its slice, in the runs' order (rpm): what a line is smeared over
+        assert test.meta["slicing"]["speed_spread_rpm"][test.runs.index(run)] == pytest.approx(
+            (seg.max() - seg.min()) * 60.0 / (2 * np.pi), rel=1e-12)
         k = info.start // N_SLICE
         assert run.name == f"slice_{k:04d}.csv"
         assert run.t0 == sw.time[info.start]

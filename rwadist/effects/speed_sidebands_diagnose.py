@@ -51,12 +51,28 @@ def _record_df(ctx: Context, runs) -> np.ndarray:
     return ctx._memo["record_df"][np.asarray(runs, dtype=int)]
 
 
+def _smear_hz(ctx: Context, runs, h0: float) -> np.ndarray:
+    """How far (Hz) the line h0·|Ω| moves within each run of ``runs``: h0 × the speed's change over the run's record
+    (a sweep's slice, ``meta["slicing"]["speed_spread_rpm"]``, :func:`rwadist.sweep.slice_sweep`), 0 for steady runs.
+    A side closer to its carrier than that lies in the carrier's own smear: family wheel 7's 60-s run-up (speed from
+    the data, 150 rpm/s: h 3.42 smeared over ~12 Hz per slice) got a speed_sidebands pair at ±0.0116 in h (1 Hz)
+    and a counter_rotation on each side -- one line three times in the model."""
+    if "speed_spread_hz" not in ctx._memo:
+        spread = ((getattr(ctx.test, "meta", None) or {}).get("slicing") or {}).get("speed_spread_rpm")
+        n = len(ctx.test.runs) if ctx.test is not None else ctx.omega.size
+        ok = spread is not None and len(spread) == n
+        ctx._memo["speed_spread_hz"] = np.asarray(spread, float) / 60.0 if ok else np.zeros(n)
+    return abs(h0) * ctx._memo["speed_spread_hz"][np.asarray(runs, dtype=int)]
+
+
 def resolvable_runs(ctx: Context, state: State, direction: str, h0: float, h_side: float, runs) -> np.ndarray:
-    """The runs of ``runs`` where the line h_side·|Ω| is in band, at least MIN_BINS Welch bins from its carrier h0 and
-    2·LINE_HALF bins from every other line of the direction's model: there the residual PSD measures it alone."""
+    """The runs of ``runs`` where the line h_side·|Ω| is in band, at least MIN_BINS Welch bins from its carrier h0
+    beyond the carrier's smear over the run (:func:`_smear_hz`) and 2·LINE_HALF bins from every other line of the
+    direction's model: there the residual PSD measures it alone."""
     w = ctx.omega[runs] / (2 * np.pi)
     f = h_side * w
-    ok = (np.abs(h_side - h0) * w >= MIN_BINS * ctx.df) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
+    ok = (np.abs(h_side - h0) * w >= MIN_BINS * ctx.df + _smear_hz(ctx, runs, h0)) \
+        & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
         & (f <= (ctx.k_hi - LINE_HALF) * ctx.df)
     for x in state.model.harmonics(direction):
         if abs(x.h - h0) > 1e-6:
@@ -78,7 +94,8 @@ def _record_resolvable(ctx: Context, state: State, direction: str, h0: float, h_
     w = (ctx.omega[runs] / (2 * np.pi))[:, None]
     f = h_side[None, :] * w
     sep = RUN_MIN_BINS * _record_df(ctx, runs)[:, None]
-    ok = (np.abs(h_side - h0)[None, :] * w >= sep) & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
+    ok = (np.abs(h_side - h0)[None, :] * w >= sep + _smear_hz(ctx, runs, h0)[:, None]) \
+        & (f >= (ctx.k_lo + LINE_HALF) * ctx.df) \
         & (f <= (ctx.k_hi - LINE_HALF) * ctx.df)
     for x in state.model.harmonics(direction):
         if abs(x.h - h0) > 1e-6:
