@@ -65,8 +65,8 @@ def _ripple_grid(k_max: int):
     return n, 2 * np.pi * np.arange(n) / n
 
 
-def ripple_coefficients(beta, eps, p=2.0, k_max: int | None = None):
-    """Complex Fourier coefficients c_k of g(θ) = |1 + ε sin θ|^p · exp(−jβ cos θ) = Σ_k c_k e^{jkθ}.
+def ripple_coefficients(beta, eps, p=2.0, k_max: int | None = None, tau=0.0):
+    """Complex Fourier coefficients c_k of g(θ) = (|1 + ε sin θ|^p − jτ cos θ) · exp(−jβ cos θ) = Σ_k c_k e^{jkθ}.
 
     With Ω(t) = Ω0 + ΔΩ sin θ, θ = 2π f_r t, the rotor angle is φ = Ω0 t − (ΔΩ/2πf_r) cos θ, so a co-rotating
     (or axial) line of harmonic h and amplitude a(Ω) ∝ |Ω|^p becomes a(Ω0)·g(θ)·e^{jhΩ0 t} with β = h·ΔΩ/(2πf_r)
@@ -75,14 +75,23 @@ def ripple_coefficients(beta, eps, p=2.0, k_max: int | None = None):
     |1 + ε sin θ|^{2p} (Parseval).  The modulus |·| makes it exact through a speed reversal (|ε| > 1).
     By an FFT over one ripple period.
 
-    beta, eps : broadcastable arrays (shape S); p : scalar or broadcastable.  k_max : highest order
+    τ: an imbalance's tangential force.  The mass m at radius e on the rotor angle φ loads the rotor with
+    −m·d²(e·e^{jφ})/dt² = m·e·(φ̇² − jφ̈)·e^{jφ}: beside m·e·Ω(t)² (the amplitude term, p = 2) it pushes m·e·Ω̇
+    along the rim, Ω̇ = 2πf_r·ΔΩ·cos θ, i.e. −jτ cos θ relative to m·e·Ω0² with τ = ΔΩ·2πf_r/Ω0² (signed as β for
+    a counter-rotating component).  With ε = 0 the coefficients are c_k = (−j)^k (J_k(β) + τ·J_k'(β)); to first
+    order the sidebands are (pε/2 ± (β + τ)/2) above and below.  Default 0: lines that are no imbalance.
+
+    beta, eps, tau : broadcastable arrays (shape S); p : scalar or broadcastable.  k_max : highest order
     (default :func:`ripple_k_max` of the largest |β| and p).  Returns (k (2K+1,), c (S + (2K+1,)) complex)."""
-    beta, eps, p = np.broadcast_arrays(np.asarray(beta, float), np.asarray(eps, float), np.asarray(p, float))
+    beta, eps, p, tau = np.broadcast_arrays(np.asarray(beta, float), np.asarray(eps, float), np.asarray(p, float),
+                                            np.asarray(tau, float))
     if k_max is None:
         k_max = ripple_k_max(float(np.max(np.abs(beta))) if beta.size else 0.0,
                              float(np.max(np.abs(p))) if p.size else 2.0)
     n, th = _ripple_grid(k_max)
     g = np.abs(1.0 + eps[..., None] * np.sin(th)) ** p[..., None] * np.exp(-1j * beta[..., None] * np.cos(th))
+    if np.any(tau):
+        g = g - 1j * tau[..., None] * np.cos(th) * np.exp(-1j * beta[..., None] * np.cos(th))
     c = np.fft.fft(g, axis=-1) / n
     k = np.arange(-k_max, k_max + 1)
     return k, c[..., k % n]
