@@ -307,10 +307,70 @@ def _in_band(h, lines: _Lines, f_lo, f_hi):
     return (f_line >= f_lo) & (f_line <= f_hi)
 
 
-def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, direction: str):
+#: A candidate line is a pair of fixed-offset sidebands of a stronger line, not a harmonic, when its detections
+#: scatter about f = h·|Ω| by more than this many frequency bins (median) ...
+OFFSET_SCATTER_BINS = 0.3
+#: ... and about f = h₀·|Ω| ± Δ (a constant offset Δ Hz from the stronger line h₀) by less than this fraction of that.
+OFFSET_BETTER = 0.5
+
+
+def _fixed_offset_sidebands(bins: list, lines: _Lines, df: float, f_lo: float, f_hi: float) -> None:
+    """Mark not kept (in place) the kept candidates of ``bins`` whose detections follow a stronger kept line h₀ at a
+    constant offset in Hz rather than a constant ratio of the speed: the sidebands of a modulation at a fixed
+    frequency (a speed ripple puts them beside every line, an amplitude modulation beside one).  Near the top speed
+    h₀ ± Δ/|Ω| changes slowly, so their detections there gather at one h and pass the presence test (family wheel 0,
+    a 5-Hz ripple at 600-6000 rpm: lines at h 0.94 and 1.06 in 42 % of the spectra, and the wheel's modes fitted on
+    them went wrong); they are no harmonic: ``sidebands`` and ``speed_ripple`` describe them.  Judged on the median
+    absolute scatter of the detections matched to the candidate about each law (a true harmonic is detected within a
+    small fraction of a bin of h·|Ω|; sidebands of a constant offset scatter about it by Δ − (h₀ − h)|Ω|).  Then, the
+    offsets Δ so found known, a candidate whose detections sit at whole multiples k·Δ (k ≠ 0) of a stronger line
+    (higher orders of a deep ripple, matched at one order at some speeds and another at others: family wheel 5,
+    β = 0.75 at h 5.64)."""
+    kept = [b for b in bins if b.kept]
+    if len(kept) < 2:
+        return
+    h = np.array([b.h for b in kept])
+    fpk = lines.match(h)
+    speed = lines.pair_speed_hz
+    ok = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)
+    tol = OFFSET_SCATTER_BINS * df
+    steps: list[float] = []                  # the offsets Δ (Hz) of the sidebands found
+    for multiples in (False, True):
+        for i, b in enumerate(kept):
+            if not b.kept or ok[i].sum() < 5:
+                continue
+            f, w = fpk[i, ok[i]], speed[ok[i]]
+            ratio = float(np.median(np.abs(f - b.h * w)))
+            if ratio <= tol:
+                continue
+            for a in kept:
+                if a is b or not a.kept or a.n_bin <= b.n_bin:
+                    continue
+                dev = f - a.h * w
+                if not multiples:
+                    offset = float(np.median(dev))
+                    if float(np.median(np.abs(dev - offset))) < OFFSET_BETTER * ratio:
+                        steps.append(abs(offset))
+                        b.kept = False
+                        b.reason = (f"sidebands of h {a.h:.4g} at a fixed offset of {offset:+.3g} Hz (not a constant "
+                                    "ratio of the speed)")
+                        break
+                    continue
+                hit = next((d for d in steps if d > 2 * tol and np.all(np.rint(dev / d) != 0)
+                            and float(np.median(np.abs(dev - d * np.rint(dev / d)))) < min(tol, OFFSET_BETTER * ratio)),
+                           None)
+                if hit is not None:
+                    b.kept = False
+                    b.reason = f"sidebands of h {a.h:.4g} at multiples of a fixed offset of {hit:.3g} Hz"
+                    break
+
+
+def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, direction: str,
+                       df: float | None = None):
     """Harmonic numbers of one direction: candidate bins from N_bin(h), each h
     refined by least squares of f = h·|Ω| over its lines (Eq. 3.2), kept when
-    P >= P_0.  Returns a list of :class:`BinStat` sorted by h."""
+    P >= P_0 and, given the spectra's resolution ``df`` (Hz), not the sidebands of a stronger line at a fixed offset
+    (:func:`_fixed_offset_sidebands`).  Returns a list of :class:`BinStat` sorted by h."""
     if lines.pair_run.size == 0:
         return []
     h_hi = min(s.h_range[1], f_hi / lines.pair_speed_hz.min())
@@ -346,6 +406,8 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
                 merged[-1] = b
             continue
         merged.append(b)
+    if df is not None:
+        _fixed_offset_sidebands(merged, lines, df, f_lo, f_hi)
     return merged
 
 
@@ -473,7 +535,7 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
     f, df = spectra.f, spectra.df
     f_lo, f_hi = s.f_min_bins * df, spectra.band_limit
     lines = collect_lines(spectra, chans, fit_runs, detected, s.epsilon)
-    bins = identify_harmonics(lines, f_lo, f_hi, s, direction)
+    bins = identify_harmonics(lines, f_lo, f_hi, s, direction, df)
     kept = [b for b in bins if b.kept]
     if not kept:
         return _DirectionMeasurements(bins)

@@ -248,16 +248,39 @@ class Context(Metric):
                            minlength=n_runs * self.f.size).reshape(n_runs, self.f.size)
         return out
 
-    def ripple_powers(self, state: State, h: float, law, runs: np.ndarray):
+    def ripple_powers(self, state: State, h: float, law, runs: np.ndarray, c: str | None = None):
         """(k, P) of the state's speed ripple for a line h: sideband orders k (2K+1,) and their power
-        fractions P (len(runs), 2K+1) (:func:`ripple_sideband_powers`), or None without a ripple."""
+        fractions P (len(runs), 2K+1) (:func:`ripple_sideband_powers`), or None without a ripple.  ``c``: the channel,
+        whose line h = 1 of a radial direction (C·Ω², no law) is an imbalance, also pushed along the rim by the
+        ripple's Ω̇ (τ = ΔΩ·2πf_r/Ω0², :func:`rwadist.extended_ripple.ripple_coefficients`)."""
         if state.speed_modulation is None:
             return None
         d_ref, f_r, w_ref, q = state.speed_modulation
         w = self.omega[runs]
         dw = d_ref * (w / w_ref) ** q
         p_amp = 2.0 if law is None else law[2]
-        return ripple_sideband_powers(h * dw / (2 * np.pi * f_r), dw / np.maximum(w, 1e-12), p_amp)
+        imbalance = c is not None and CHANNEL_DIRECTION.get(c) in RIPPLE_IMBALANCE_DIRECTIONS and abs(h - 1.0) < 1e-6 \
+            and law is None
+        tau = dw * 2 * np.pi * f_r / np.maximum(w, 1e-12) ** 2 if imbalance else 0.0
+        return ripple_sideband_powers(h * dw / (2 * np.pi * f_r), dw / np.maximum(w, 1e-12), p_amp, tau=tau)
+
+    def _ripple_gains(self, state: State, c: str, h: float, shift: float, f: np.ndarray, k: np.ndarray,
+                      runs: np.ndarray) -> np.ndarray:
+        """(len(runs), len(k)) amplitude of the ripple's order k of the component ``shift`` (at ``f`` Hz) of line h
+        in channel ``c`` relative to the component itself: its orders up to RIPPLE_OWN_GAIN_ORDERS go through the
+        suspension modes (:meth:`sideband_gain`) and the fixed resonances at their own frequency f + k·f_r (5-Hz
+        sidebands beside a rocking whirl of ζ 0.02 at 95 Hz differ from the carrier's gain by factors); the higher
+        orders, which carry (β/2)^{2|k|}/(|k|!)² of the line's power, take the component's."""
+        f_r = float(state.speed_modulation[1]) if state.speed_modulation is not None else 0.0
+        out = np.ones((runs.size, k.size))
+        g0 = self.sideband_gain(state, c, h, shift, runs)
+        r0 = self.gain(state, c, f) if state.resonances else 1.0
+        for j in np.flatnonzero((np.abs(k) <= RIPPLE_OWN_GAIN_ORDERS) & (k != 0)):
+            g = self.sideband_gain(state, c, h, shift + k[j] * f_r, runs) / np.where(g0 > 0, g0, 1.0)
+            if state.resonances:
+                g = g * self.gain(state, c, f + k[j] * f_r) / np.where(r0 > 0, r0, 1.0)
+            out[:, j] = g
+        return out
 
     def gain(self, state: State, c: str, f_hz) -> np.ndarray:
         """|H| of the state's fixed resonances acting on channel ``c`` at line frequencies ``f_hz`` (Hz)."""
@@ -453,7 +476,7 @@ class Context(Metric):
             if only is not None and abs(h - only) >= 1e-9:
                 continue
             f0 = h * self.omega[runs] / (2 * np.pi)
-            rip = self.ripple_powers(state, h, law, runs)
+            rip = self.ripple_powers(state, h, law, runs, c)
             for shift, rel in state.line_components(c, h):
                 f = f0 + shift
                 a = amp * rel * self.sideband_gain(state, c, h, shift, runs)
@@ -468,6 +491,7 @@ class Context(Metric):
                 else:
                     k, P = rip
                     f_r = state.speed_modulation[1]
+                    P = P * self._ripple_gains(state, c, h, shift, f, k, runs) ** 2
                     out += self.psd_at(f[:, None] + k[None, :] * f_r, (a**2 / 2.0)[:, None] * P, bins)
         if plain_f:
             out += self.psd_at(np.column_stack(plain_f), np.column_stack(plain_p), bins)
@@ -742,7 +766,14 @@ class Context(Metric):
 
 
 
-def ripple_sideband_powers(beta, eps, p=2.0, k_max: int | None = None):
+#: Directions whose line h = 1 is an imbalance (its tangential force rides on a speed ripple's Ω̇).
+RIPPLE_IMBALANCE_DIRECTIONS = ("radial_force", "radial_torque")
+#: Orders of a speed ripple's lines predicted through the modes and resonances at their own frequency
+#: (:meth:`Context._ripple_gains`).
+RIPPLE_OWN_GAIN_ORDERS = 2
+
+
+def ripple_sideband_powers(beta, eps, p=2.0, k_max: int | None = None, tau=0.0):
     """Power fractions of the lines a periodic speed ripple makes of one harmonic line.
 
     With Ω(t) = Ω0 + ΔΩ·sin θ, θ = 2π f_r t, the rotation angle is ψ = Ω0 t − (ΔΩ/2πf_r)·cos θ, so the line
@@ -755,12 +786,13 @@ def ripple_sideband_powers(beta, eps, p=2.0, k_max: int | None = None):
     this returns their squared moduli.  (For ε > 1, a speed reversal within the ripple, the amplitude is
     |1 + ε sin θ|^p, the exact |Ω(t)|^p.)
 
-    beta, eps : broadcastable arrays (shape S); p : amplitude exponent (scalar or broadcastable).
+    beta, eps : broadcastable arrays (shape S); p : amplitude exponent (scalar or broadcastable); tau : an
+    imbalance's tangential term (:func:`rwadist.extended_ripple.ripple_coefficients`), 0 for other lines.
     Returns (k (2K+1,), P (S + (2K+1,))), P = |c_k|².
     """
     from ..extended_ripple import ripple_coefficients
 
-    k, c = ripple_coefficients(beta, eps, p, k_max)
+    k, c = ripple_coefficients(beta, eps, p, k_max, tau=tau)
     return k, np.abs(c) ** 2
 
 

@@ -91,6 +91,11 @@ class Metric:
 
         def predict(self, state: State, c: str, runs: np.ndarray, skip=None, only=None) -> np.ndarray: ...
 
+        def ripple_powers(self, state: State, h: float, law, runs: np.ndarray, c: str | None = None): ...
+
+        def _ripple_gains(self, state: State, c: str, h: float, shift: float, f: np.ndarray, k: np.ndarray,
+                          runs: np.ndarray) -> np.ndarray: ...
+
     def rows_of_every_run(self, state: State, name: str, c: str, runs: np.ndarray) -> tuple | None:
         """(what ``state`` keeps under ``(name, c)`` for every run, the positions of ``runs`` in it), or None when
         nothing is kept for every run or ``runs`` is not a proper subset of the runs (sorted, as ``self.runs``).
@@ -136,8 +141,8 @@ class Metric:
         segments at 50 % overlap (the phase difference turns by 2πx from one segment to the next).  A line's
         image at −f (a channel is a real signal) beats with the line itself and its neighbours near 0 Hz as a
         line of phase −φ.  The lines and their sidebands as :meth:`predict` has them (each within ±KERNEL_HALF of
-        its bin); zero under a spin smear or a speed ripple (their lines are no steady lines) and for other
-        windows (the term is not modelled).  Cached on the state; each pair's shape on the context; a subset of the
+        its bin), under a speed ripple with its orders near the line (:meth:`_ripple_parts`); zero under a spin smear
+        (its lines are no steady lines) and for other windows (the term is not modelled).  Cached on the state; each pair's shape on the context; a subset of the
         runs whose variance on every run is kept reads its rows (a pair near only in other runs adds exact zeros)."""
         key = ("beat", c, runs.tobytes())
         if key in state._cache:
@@ -148,17 +153,19 @@ class Metric:
             state._cache[key] = whole[pos]
             return state._cache[key]
         out = np.zeros((runs.size, self.n_bands))
-        if state.smear is None and state.speed_modulation is None and self.sp.window == "hann":
+        if state.smear is None and self.sp.window == "hann":
             comps, mixed = [], []
-            for (h, _, amp, _), mix in zip(self.channel_lines(state, c, runs), self.line_mixing(state, c, runs)):
+            for (h, law, amp, _), mix in zip(self.channel_lines(state, c, runs), self.line_mixing(state, c, runs)):
                 f0 = h * self.omega[runs] / (2 * np.pi)
                 for shift, rel in state.line_components(c, h):
                     a = amp * rel * self.sideband_gain(state, c, h, shift, runs)
                     if state.resonances:
                         a = a * self.gain(state, c, f0 + shift)
-                    comps.append(((round(h, 9), shift), np.abs(f0 + shift) / self.df, a**2 / 2.0))
-                    if shift == 0 and np.any(mix > 0):
-                        mixed.append((len(comps) - 1, mix))
+                    for extra, p in self._ripple_parts(state, c, h, law, shift, f0 + shift, runs):
+                        comps.append(((round(h, 9), shift + extra), np.abs(f0 + shift + extra) / self.df,
+                                      a**2 / 2.0 * p))
+                        if shift == 0 and extra == 0 and np.any(mix > 0):
+                            mixed.append((len(comps) - 1, mix))
             if comps:
                 first, second, shapes = self._beat_pairs(comps, runs)
                 if first.size:
@@ -172,6 +179,21 @@ class Metric:
                 out = out + (mix * p**2)[:, None] * shape
         state._cache[key] = out
         return out
+
+    def _ripple_parts(self, state: State, c: str, h: float, law, shift: float, f: np.ndarray, runs: np.ndarray):
+        """[(offset Hz, power fraction (len(runs),) or 1.0)] of a line component at ``f`` for :meth:`beat_variance`: itself
+        without a speed ripple; under one, its orders |k| <= RIPPLE_OWN_GAIN_ORDERS at k·f_r, each with its share of the
+        power through the modes at its own frequency (as :meth:`predict` has them: a ripple's lines beat with their
+        carrier and its neighbours as steady lines do, their phases unknown)."""
+        from .engine import RIPPLE_OWN_GAIN_ORDERS
+
+        rip = self.ripple_powers(state, h, law, runs, c)
+        if rip is None or state.speed_modulation is None:
+            return [(0.0, 1.0)]
+        k, P = rip
+        G = self._ripple_gains(state, c, h, shift, f, k, runs)
+        f_r = float(state.speed_modulation[1])
+        return [(float(k[j] * f_r), P[:, j] * G[:, j] ** 2) for j in np.flatnonzero(np.abs(k) <= RIPPLE_OWN_GAIN_ORDERS)]
 
     def _beat_pairs(self, comps, runs):
         """(i, j, shapes (n_pairs, len(runs), n_bands)) of the pairs of :meth:`beat_variance`'s line components

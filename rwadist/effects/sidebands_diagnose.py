@@ -243,14 +243,16 @@ class Sidebands:
         return record_line_evidence(ctx, chans, P, N, ok, M1)
 
     @staticmethod
-    def record_candidates(ctx: Context, state: State, runs, direction: str, hs) -> list:
+    def record_candidates(ctx: Context, state: State, runs, direction: str, hs, offsets=None) -> list:
         """[(score, h, f_mod)] of the carriers ``hs`` whose sidebands sit closer than the Welch grid reaches
-        (:meth:`_record_offsets`): per offset the median over the RECORD_SCAN_RUNS fastest runs, channels and both
-        sides of |X|²/noise on the whole-run DFT (valid points only, >= 6 of them), the best offset kept when it
-        clears RECORD_SCORE and is a local maximum.  The line powers are kept on the context, per state prediction."""
+        (:meth:`_record_offsets`, or the ``offsets`` Hz given): per offset the median over the RECORD_SCAN_RUNS fastest
+        runs, channels and both sides of |X|²/noise on the whole-run DFT (valid points only, >= 6 of them), the best
+        offset kept when it clears RECORD_SCORE and is a local maximum.  The line powers are kept on the context, per
+        state prediction."""
         from .speed_sidebands_diagnose import side_pair_medians
 
-        offsets = Sidebands._record_offsets(ctx)
+        given = offsets is not None
+        offsets = np.asarray(offsets, float) if given else Sidebands._record_offsets(ctx)
         if offsets.size < 3:
             return []
         sel = runs[np.argsort(ctx.omega[runs])[::-1][:RECORD_SCAN_RUNS]]
@@ -258,7 +260,8 @@ class Sidebands:
         state_key = ctx.content_key(state, [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels], sel)
         out = []
         for h in hs:
-            key = ("sidebands_record_scan", direction, round(h, 6), sel.tobytes(), state_key)
+            key = ("sidebands_record_scan", direction, round(h, 6), sel.tobytes(), state_key) + \
+                ((offsets.tobytes(),) if given else ())
             if key not in ctx._memo:
                 ctx._memo[key] = Sidebands._record_power(ctx, state, direction, h, sel, offsets, single=True)
             f, P, N, ok = ctx._memo[key]

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..diagnose.constants import LINE_HALF
 from ..diagnose.effects.base import register, schema_entry
-from ..diagnose.engine import Context, ripple_sideband_powers
+from ..diagnose.engine import RIPPLE_IMBALANCE_DIRECTIONS, Context, ripple_sideband_powers
 from ..diagnose.measure import (
     _clear_of_lines,
     _offset_grid,
@@ -20,9 +20,6 @@ from ..diagnose.measure import (
 from ..diagnose.state import State
 from ..units import CHANNELS, DIRECTION_CHANNELS
 
-#: Directions whose line at h = 1 is an imbalance, U·(Ω² − jΩ̇): the ripple's Ω̇ pushes it along the rim too
-#: (:func:`rwadist.extended_ripple.ripple_coefficients`, τ = ΔΩ·2πf_r/Ω0²).
-IMBALANCE_DIRECTIONS = ("radial_force", "radial_torque")
 #: A ripple is proposed on the whole record when this many carriers (lines of any direction) show sidebands at one
 #: offset (within a record bin): an amplitude modulation of one line (``sidebands``) shows them on one.
 RECORD_MIN_CARRIERS = 3
@@ -32,23 +29,29 @@ RECORD_MIN_CARRIERS = 3
 RECORD_CARRIER_SNR = 1.0e4
 #: Carriers whose offsets refine f_ripple on the whole record (the strongest sidebands of :meth:`record_candidates`).
 RECORD_REFINE_CARRIERS = 4
+#: A ripple closer to its lines than this many Welch bins is searched, fitted and judged on the whole record: there
+#: its sidebands share their carrier's band of the error metric (BAND_BINS = 8 bins) and Welch kernel, and a ripple
+#: just past the Welch grid's first offset (2.5 bins: family wheel 3, 5 Hz at 1.95-Hz bins) is no local maximum of it.
+RECORD_WELCH_BINS = 4.0
+
+
+def _on_record(ctx: Context, f_r: float) -> bool:
+    """A ripple of ``f_r`` Hz is handled on the whole record (time series given, f_r < RECORD_WELCH_BINS bins)."""
+    return ctx.test is not None and f_r < RECORD_WELCH_BINS * ctx.df
 
 
 def _imbalance(direction: str, h: float) -> bool:
-    """The line (direction, h) is an imbalance (its tangential force rides on the ripple's Ω̇)."""
-    return direction in IMBALANCE_DIRECTIONS and abs(h - 1.0) < 1e-6
+    """The line (direction, h) is an imbalance, U·(Ω² − jΩ̇): the ripple's Ω̇ pushes it along the rim too."""
+    return direction in RIPPLE_IMBALANCE_DIRECTIONS and abs(h - 1.0) < 1e-6
 
 
 def sideband_fractions(h, dw, w, f_r, p, tangential) -> tuple:
     """(lower, upper, carrier) power fractions |c_∓1|², |c_0|² of a line h (amplitude ∝ |Ω|^p, ``tangential``: an imbalance) under
-    the ripple ΔΩ = ``dw`` at mean speeds ``w`` (rad/s): :func:`rwadist.extended_ripple.ripple_coefficients` with
+    the ripple ΔΩ = ``dw`` at mean speeds ``w`` (rad/s): :func:`rwadist.diagnose.engine.ripple_sideband_powers` with
     β = h·ΔΩ/2πf_r, ε = ΔΩ/Ω0 and τ = ΔΩ·2πf_r/Ω0² on an imbalance (0 else).  All broadcastable."""
-    from ..extended_ripple import ripple_coefficients
-
     w = np.maximum(np.asarray(w, float), 1e-12)
     tau = np.where(tangential, dw * 2 * np.pi * f_r / w**2, 0.0)
-    k, c = ripple_coefficients(h * dw / (2 * np.pi * f_r), dw / w, p, k_max=4, tau=tau)
-    P = np.abs(c) ** 2
+    _, P = ripple_sideband_powers(h * dw / (2 * np.pi * f_r), dw / w, p, k_max=4, tau=tau)
     return P[..., 3], P[..., 5], P[..., 4]
 
 
@@ -72,14 +75,30 @@ class SpeedRipple:
         return CHANNELS
 
     def apply(self, state: State) -> State:
-        return state.plus(self)
+        """The state with the ripple; on a base the wheel's ``suspension_modes`` measured from these data, each line's
+        C divided by its carrier coefficient |c_0| (:meth:`carrier_factor`): measured under the ripple, a line's C holds
+        the carrier as the ripple left it (J_0(β)² of the power at β = hΔΩ/2πf_r: 0.82 at h 4.6 on family wheel 5),
+        and the ripple takes that share off again in the prediction; the model file gets the free load's C."""
+        s = state.plus(self)
+        if any(getattr(e, "kind", "") == "suspension_modes" for e in state.effects):
+            from dataclasses import replace
+
+            s.model.empirical = {d: [replace(x, C=x.C / self.carrier_factor(x.h)) for x in v]
+                                 for d, v in s.model.empirical.items()}
+        return s
+
+    def carrier_factor(self, h: float) -> float:
+        """|c_0| of a line h (C·Ω²) under this ripple at Ω_ref (:func:`sideband_fractions`): the carrier's share of the
+        line's amplitude."""
+        _, _, c0 = sideband_fractions(h, self.delta_omega, self.omega_ref, self.f_ripple, 2.0, False)
+        return float(np.sqrt(max(float(c0), 1e-12)))
 
     def contribute(self, parts) -> None:
         parts.speed_modulation = (self.delta_omega, self.f_ripple, self.omega_ref, self.exponent)
 
     def refit(self, ctx: Context, state: State) -> "SpeedRipple":
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""
-        if self.f_ripple < 2.5 * ctx.df and ctx.test is not None:
+        if _on_record(ctx, self.f_ripple):
             return SpeedRipple.fit_record(ctx, state, ctx.runs, self.f_ripple, self.exponent) or self
         return SpeedRipple.fit(ctx, state, ctx.runs, self.f_ripple, self.exponent) or self
 
@@ -202,7 +221,7 @@ class SpeedRipple:
                 out.append(e)
         return out
 
-    # ------------------------------------------------------------------ the whole record (ripple below 2.5 Welch bins)
+    # ------------------------------------------------------------------ the whole record (ripple within RECORD_WELCH_BINS)
     @staticmethod
     def _carriers(ctx: Context, state: State) -> list:
         """[(direction, h, channels)] of every line of the state's model on the context's channels."""
@@ -220,19 +239,20 @@ class SpeedRipple:
         that :meth:`rwadist.effects.sidebands_diagnose.Sidebands.record_candidates` scans (kept on the context: the
         ``sidebands`` family reads the same), the offset RECORD_MIN_CARRIERS carriers or more share within a record
         bin, fitted with q = 0 and q = 1 (:meth:`fit_record`)."""
-        from .sidebands_diagnose import Sidebands
-        from .speed_sidebands_diagnose import _record_df
+        from .sidebands_diagnose import RECORD_STEP_BINS, Sidebands
+        from .speed_sidebands_diagnose import RUN_MIN_BINS, _record_df
 
         if ctx.test is None:
             return []
+        df_rec = float(np.max(_record_df(ctx, ctx.runs)))
+        offsets = np.arange(RUN_MIN_BINS * df_rec, RECORD_WELCH_BINS * ctx.df, RECORD_STEP_BINS * df_rec)
         found = []                      # (score, direction, h, offset Hz)
         for d in DIRECTION_CHANNELS:
             hs = [h for dd, h, _ in SpeedRipple._carriers(ctx, state) if dd == d]
             if hs:
-                found += [(sc, d, h, f) for sc, h, f in Sidebands.record_candidates(ctx, state, runs, d, hs)]
+                found += [(sc, d, h, f) for sc, h, f in Sidebands.record_candidates(ctx, state, runs, d, hs, offsets)]
         if len(found) < RECORD_MIN_CARRIERS:
             return []
-        df_rec = float(np.max(_record_df(ctx, runs)))
         offs = np.array([f for *_, f in found])
         near = np.abs(offs[:, None] - offs[None, :]) <= df_rec
         j = int(np.argmax(near.sum(1) + 1e-9 * np.array([sc for sc, *_ in found])))
@@ -348,8 +368,8 @@ class SpeedRipple:
                                       lambda dw: SpeedRipple._record_powers(pt, dw, f_r, measured=True) + pt["N"])
 
     def heldout_evidence(self, ctx: Context, state: State, runs):
-        """Held-out evidence of a ripple closer to its lines than 2.5 Welch bins (None otherwise: the search's own
-        judge), as :meth:`rwadist.effects.sidebands_diagnose.Sidebands.heldout_evidence` for one line's sidebands: there
+        """Held-out evidence of a ripple closer to its lines than RECORD_WELCH_BINS Welch bins (None otherwise: the
+        search's own judge), as :meth:`rwadist.effects.sidebands_diagnose.Sidebands.heldout_evidence` for one line's sidebands: there
         they sit in their carrier's Welch kernel, whose power the error metric's bands sum with it (the true ripple
         of family wheel 0, 5 Hz at 2.4-Hz Welch bins, changed the error by 1e-4 of it), and the whole record resolves
         them.  (drop, se) of the misplaced power at the first-order sidebands of every line, over the points of
@@ -358,7 +378,7 @@ class SpeedRipple:
         or a speed ripple."""
         from .missing_harmonic_diagnose import record_line_evidence
 
-        if ctx.test is None or self.f_ripple >= 2.5 * ctx.df or state.smear is not None \
+        if not _on_record(ctx, self.f_ripple) or state.smear is not None \
                 or state.speed_modulation is not None:
             return None
         pt = SpeedRipple._record_points(ctx, state, runs, self.f_ripple)
