@@ -34,9 +34,10 @@ from .constants import (
                         TORQUE_CHANNELS,
 )
 from .effects import REGISTRY, Effect, family_classes
-from .engine import Context, initial_state, line_kernel, noise_estimate, ripple_sideband_powers
+from .engine import Context, initial_state, line_kernel, noise_estimate
 from .measure import refine_h, ridge_peaks
 from .report import rms_vs_speed, write_report
+from .ripple import ripple_sideband_powers
 from .search import BASES, Diagnosis, Hypothesis, diagnose, effect_entry, resolve_base
 from .state import State
 

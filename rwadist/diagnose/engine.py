@@ -18,6 +18,7 @@ from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
 from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, NOISE_Z, TORQUE_CHANNELS
 from .metric import Metric, hann_tables, read_table
 from .reduce import bin_sums, column_nanmedian
+from .ripple import RIPPLE_IMBALANCE_DIRECTIONS, RIPPLE_OWN_GAIN_ORDERS, ripple_sideband_powers
 from .state import State
 
 #: Samples (runs × record length × channels) :meth:`Context.phasors` transforms together: a few tens of MB.
@@ -764,36 +765,6 @@ class Context(Metric):
         sig = 3.0 * 2.0 * noise * np.sqrt(2.0 / self.dof) / np.sqrt(2 * LINE_HALF + 1)
         return np.where(inband & (p > sig), np.sqrt(2 * np.maximum(p, 0)), np.nan)
 
-
-
-#: Directions whose line h = 1 is an imbalance (its tangential force rides on a speed ripple's Ω̇).
-RIPPLE_IMBALANCE_DIRECTIONS = ("radial_force", "radial_torque")
-#: Orders of a speed ripple's lines predicted through the modes and resonances at their own frequency
-#: (:meth:`Context._ripple_gains`).
-RIPPLE_OWN_GAIN_ORDERS = 2
-
-
-def ripple_sideband_powers(beta, eps, p=2.0, k_max: int | None = None, tau=0.0):
-    """Power fractions of the lines a periodic speed ripple makes of one harmonic line.
-
-    With Ω(t) = Ω0 + ΔΩ·sin θ, θ = 2π f_r t, the rotation angle is ψ = Ω0 t − (ΔΩ/2πf_r)·cos θ, so the line
-    h of amplitude a(Ω) ∝ |Ω|^p becomes a·g(θ)·e^{j2πf_i t} with
-    g(θ) = (1 + ε sin θ)^p · exp(−jβ cos θ),  β = h·ΔΩ/(2π f_r) (phase-modulation index, rad),
-    ε = ΔΩ/|Ω0|, and g = Σ_k c_k e^{jkθ}: lines at f_i + k·f_r of amplitude |c_k|·a.  Without the amplitude
-    term (ε = 0) c_k = J_k(β)e^{-jkπ/2}, |c_k|² = J_k(β)² and Σ_k |c_k|² = 1 (Parseval); with it Σ|c_k|² is the
-    mean of (1 + ε sin θ)^{2p} (1 + 3ε² + 3ε⁴/8 for p = 2).  c_k by an FFT over one period of θ: the complex
-    coefficients are :func:`rwadist.extended_ripple.ripple_coefficients` (which the coupling kit applies per line);
-    this returns their squared moduli.  (For ε > 1, a speed reversal within the ripple, the amplitude is
-    |1 + ε sin θ|^p, the exact |Ω(t)|^p.)
-
-    beta, eps : broadcastable arrays (shape S); p : amplitude exponent (scalar or broadcastable); tau : an
-    imbalance's tangential term (:func:`rwadist.extended_ripple.ripple_coefficients`), 0 for other lines.
-    Returns (k (2K+1,), P (S + (2K+1,))), P = |c_k|².
-    """
-    from ..extended_ripple import ripple_coefficients
-
-    k, c = ripple_coefficients(beta, eps, p, k_max, tau=tau)
-    return k, np.abs(c) ** 2
 
 
 def initial_state(ctx: Context, model: WheelModel, ext_params=None) -> State:

@@ -13,6 +13,7 @@ import numpy as np
 from ..dft import hann_transform
 from .constants import BAND_BINS, CONTRAST_NOISE_Z, KERNEL_HALF, NOISE_Z, TORQUE_CHANNELS
 from .reduce import bin_sums
+from .ripple import RIPPLE_OWN_GAIN_ORDERS
 from .state import State
 
 if TYPE_CHECKING:
@@ -185,8 +186,6 @@ class Metric:
         without a speed ripple; under one, its orders |k| <= RIPPLE_OWN_GAIN_ORDERS at k·f_r, each with its share of the
         power through the modes at its own frequency (as :meth:`predict` has them: a ripple's lines beat with their
         carrier and its neighbours as steady lines do, their phases unknown)."""
-        from .engine import RIPPLE_OWN_GAIN_ORDERS
-
         rip = self.ripple_powers(state, h, law, runs, c)
         if rip is None or state.speed_modulation is None:
             return [(0.0, 1.0)]

@@ -25,7 +25,7 @@ class Prediction:
         the line h of that direction carries two more lines at h|Ω|/2π ± f_mod of amplitude m·a/2.
         speed_modulation : (ΔΩ_ref rad/s, f_r Hz, Ω_ref rad/s, q) or None: a periodic speed ripple
         Ω0 + ΔΩ sin 2πf_r t, ΔΩ = ΔΩ_ref·(|Ω0|/Ω_ref)^q; every line is spread over f_i + k·f_r with the powers of
-        :func:`~rwadist.diagnose.engine.ripple_sideband_powers`.  smear : |dΩ/dt| (rad/s²) or None: every line of a
+        :func:`~rwadist.diagnose.ripple.ripple_sideband_powers`.  smear : |dΩ/dt| (rad/s²) or None: every line of a
         run is spread uniformly over the frequencies its harmonic sweeps during the run
         (:meth:`Context.smear_offsets`)."""
 

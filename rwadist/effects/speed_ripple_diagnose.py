@@ -7,7 +7,7 @@ import numpy as np
 
 from ..diagnose.constants import LINE_HALF
 from ..diagnose.effects.base import register, schema_entry
-from ..diagnose.engine import RIPPLE_IMBALANCE_DIRECTIONS, Context, ripple_sideband_powers
+from ..diagnose.engine import Context
 from ..diagnose.measure import (
     _clear_of_lines,
     _offset_grid,
@@ -17,6 +17,7 @@ from ..diagnose.measure import (
     _residual_z,
     _window_power,
 )
+from ..diagnose.ripple import RIPPLE_IMBALANCE_DIRECTIONS, ripple_sideband_powers
 from ..diagnose.state import State
 from ..units import CHANNELS, DIRECTION_CHANNELS
 
@@ -47,7 +48,7 @@ def _imbalance(direction: str, h: float) -> bool:
 
 def sideband_fractions(h, dw, w, f_r, p, tangential) -> tuple:
     """(lower, upper, carrier) power fractions |c_∓1|², |c_0|² of a line h (amplitude ∝ |Ω|^p, ``tangential``: an imbalance) under
-    the ripple ΔΩ = ``dw`` at mean speeds ``w`` (rad/s): :func:`rwadist.diagnose.engine.ripple_sideband_powers` with
+    the ripple ΔΩ = ``dw`` at mean speeds ``w`` (rad/s): :func:`rwadist.diagnose.ripple.ripple_sideband_powers` with
     β = h·ΔΩ/2πf_r, ε = ΔΩ/Ω0 and τ = ΔΩ·2πf_r/Ω0² on an imbalance (0 else).  All broadcastable."""
     w = np.maximum(np.asarray(w, float), 1e-12)
     tau = np.where(tangential, dw * 2 * np.pi * f_r / w**2, 0.0)
