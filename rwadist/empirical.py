@@ -310,8 +310,10 @@ def _in_band(h, lines: _Lines, f_lo, f_hi):
 #: A candidate line is a pair of fixed-offset sidebands of a stronger line, not a harmonic, when its detections
 #: scatter about f = h·|Ω| by more than this many frequency bins (median) ...
 OFFSET_SCATTER_BINS = 0.3
-#: ... and about f = h₀·|Ω| ± Δ (a constant offset Δ Hz from the stronger line h₀) by less than this fraction of that.
+#: ... and about f = h₀·|Ω| ± Δ (a constant offset Δ Hz from the stronger line h₀) by less than this fraction of that,
 OFFSET_BETTER = 0.5
+#: ... with |Δ| at least this many bins (a sideband detected apart from its carrier).
+OFFSET_MIN_BINS = 2.0
 
 
 def _fixed_offset_sidebands(bins: list, lines: _Lines, df: float, f_lo: float, f_hi: float) -> None:
@@ -349,14 +351,18 @@ def _fixed_offset_sidebands(bins: list, lines: _Lines, df: float, f_lo: float, f
                 dev = f - a.h * w
                 if not multiples:
                     offset = float(np.median(dev))
-                    if float(np.median(np.abs(dev - offset))) < OFFSET_BETTER * ratio:
+                    # a sideband stands apart from its carrier (2 bins: two peaks); a candidate on the carrier's own
+                    # detections (two candidates refined onto one unresolved pair: E wheel 5.37/5.57 at 2048 samples)
+                    # is no sideband
+                    if abs(offset) >= OFFSET_MIN_BINS * df and \
+                            float(np.median(np.abs(dev - offset))) < OFFSET_BETTER * ratio:
                         steps.append(abs(offset))
                         b.kept = False
                         b.reason = (f"sidebands of h {a.h:.4g} at a fixed offset of {offset:+.3g} Hz (not a constant "
                                     "ratio of the speed)")
                         break
                     continue
-                hit = next((d for d in steps if d > 2 * tol and np.all(np.rint(dev / d) != 0)
+                hit = next((d for d in steps if np.all(np.rint(dev / d) != 0)
                             and float(np.median(np.abs(dev - d * np.rint(dev / d)))) < min(tol, OFFSET_BETTER * ratio)),
                            None)
                 if hit is not None:
