@@ -11,6 +11,7 @@ periodic Hann window in closed form (:func:`hann_transform`: the leakage of a li
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import signal
@@ -71,6 +72,47 @@ def windowed_records(records, w: np.ndarray) -> np.ndarray:
     return out
 
 
+@dataclass(frozen=True, eq=False)
+class BlockedRecords:
+    """R windowed records of ``n`` samples and ``channels`` channels in the layout :func:`windowed_dfts` multiplies by its
+    tables of phasors: sample j·block + b of channel k at ``values[r, b, j·K + k]`` ((R, block, J·K), J = ⌈n/block⌉
+    blocks, zero past n), made once (:func:`blocked_records`) for records transformed at several sets of frequencies.
+    ``values`` is read-only (it may be shared)."""
+
+    values: np.ndarray
+    n: int
+    channels: int
+    block: int
+
+    def __len__(self) -> int:
+        return self.values.shape[0]
+
+    @functools.cached_property
+    def single(self) -> np.ndarray:
+        """``values`` in single precision (the samples of :func:`windowed_dfts` with ``single``), read-only."""
+        out = self.values.astype(np.float32)
+        out.flags.writeable = False
+        return out
+
+
+def blocked_records(records, w: np.ndarray, block: int = 128) -> BlockedRecords:
+    """:class:`BlockedRecords` of ``records`` (R lists of K equally long 1-D signals, n samples each) times the window
+    ``w`` (n,): the numbers of :func:`windowed_records` (each sample times its window value), written straight into the
+    blocked layout (one pass over the samples instead of a windowed stack and its transposition per transform)."""
+    n = w.size
+    k = len(records[0]) if records else 0
+    n_blocks = -(-n // block)
+    out = np.zeros((len(records), block, n_blocks * k))
+    view = out.reshape(len(records), block, n_blocks, k)
+    row = np.zeros(n_blocks * block)                      # a record's windowed samples, zero past n
+    for i, chans in enumerate(records):
+        for j, x in enumerate(chans):
+            np.multiply(x, w, out=row[:n])
+            view[i, :, :, j] = row.reshape(n_blocks, block).T
+    out.flags.writeable = False
+    return BlockedRecords(out, n, k, block)
+
+
 def demeaned_windowed(signals, w: np.ndarray) -> np.ndarray:
     """(R, n) array of each of ``signals`` (R 1-D signals, n samples each) less its mean, times the window ``w``
     (n,): (x − x̄)·w, the records of a spectrum or a whole-run phasor."""
@@ -81,7 +123,7 @@ def demeaned_windowed(signals, w: np.ndarray) -> np.ndarray:
     return out
 
 
-def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: int = 128,
+def windowed_dfts(x: "np.ndarray | BlockedRecords", sample_rate: float, f_hz: np.ndarray, block: int = 128,
                   single: bool = False) -> np.ndarray:
     """Σ_n x[r, n, k]·e^{−2πj f[r, l] t_n} (t_n = n/sample_rate) of a stack of R equally long records ``x``
     (R, n, K) at frequencies ``f_hz`` (R, L) Hz, each record at its own frequencies; returns (R, L, K) complex.
@@ -96,9 +138,28 @@ def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: in
     ``single``: the fine sums in single precision (float32 phasors and samples: the product, most of the time, in
     half of it).  Each phasor then carries ~1e-7 of the record's strongest line (measured: 9e-8 of a Hann-windowed
     carrier's |X| at 8192 samples): for a scan that compares line powers with the noise, not for a fit's amplitude
-    read to the last digit."""
-    x = np.asarray(x, dtype=float)
-    n_rec, n, k = x.shape
+    read to the last digit.
+
+    ``x`` may be :class:`BlockedRecords` (:func:`blocked_records`, its ``block``): the same sums, its layout read as it is
+    (no transposition, and in single precision no conversion, per call)."""
+    if isinstance(x, BlockedRecords):
+        n_rec, n, k, block = len(x), x.n, x.channels, x.block
+        source = x.single if single else x.values
+
+        def blocks(s: int, r: int) -> np.ndarray:                 # (r, B, J·K)
+            return source[s:s + r]
+    else:
+        records = np.asarray(x, dtype=float)
+        n_rec, n, k = records.shape
+
+        def blocks(s: int, r: int) -> np.ndarray:
+            xs = records[s:s + r]
+            if n != n_blocks * block:
+                pad = np.zeros((xs.shape[0], n_blocks * block, k))
+                pad[:, :n] = xs
+                xs = pad
+            xt = xs.reshape(-1, n_blocks, block, k).transpose(0, 2, 1, 3).reshape(-1, block, n_blocks * k)
+            return xt.astype(np.float32) if single else xt
     f_hz = np.asarray(f_hz, dtype=float).reshape(n_rec, -1)
     n_f = f_hz.shape[1]
     n_blocks = -(-n // block)
@@ -107,20 +168,15 @@ def windowed_dfts(x: np.ndarray, sample_rate: float, f_hz: np.ndarray, block: in
         return out
     step = max(1, CHUNK_ELEMENTS // (n_f * max(block, n_blocks * k)))
     for s in range(0, n_rec, step):
-        xs = x[s:s + step]
-        r = xs.shape[0]
-        if n != n_blocks * block:
-            pad = np.zeros((r, n_blocks * block, k))
-            pad[:, :n] = xs
-            xs = pad
-        xt = xs.reshape(r, n_blocks, block, k).transpose(0, 2, 1, 3).reshape(r, block, n_blocks * k)   # (r, B, J·K)
+        xt = blocks(s, step)                                                                           # (r, B, J·K)
+        r = xt.shape[0]
         f = f_hz[s:s + step].ravel()
         fine = unit_phasors(f, 1.0 / sample_rate, block, running=True).reshape(r, n_f, block)          # (r, L, B)
         coarse = unit_phasors(f, block / sample_rate, n_blocks, running=True).reshape(r, n_f, 1, n_blocks)
         if single:
             table = np.empty((r, 2 * n_f, block), dtype=np.float32)
             table[:, :n_f], table[:, n_f:] = fine.real, fine.imag
-            parts = (table @ xt.astype(np.float32)).astype(float)
+            parts = (table @ xt).astype(float)
         else:
             parts = np.concatenate([fine.real, fine.imag], axis=1) @ xt                                # (r, 2L, J·K)
         inner = (parts[:, :n_f] + 1j * parts[:, n_f:]).reshape(r, n_f, n_blocks, k)                 # (r, L, J, K)

@@ -42,7 +42,7 @@ import numpy as np
 
 from . import extended as ext
 from .data import DataError, Run, SteadyTest
-from .dft import run_window, windowed_dfts, windowed_records
+from .dft import blocked_records, run_window, windowed_dfts
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .extended_fit_close import with_close_lines
 from .extended_fit_lsq import MODE_PARAMS, LogAmplitudeProblem, Solution, loose_modes
@@ -162,7 +162,7 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             n, fs = batch[0].n_samples, batch[0].sample_rate
             w = run_window("hann", n)[0]             # = signal.windows.hann(n, sym=False)
             f = h[None, :] * np.abs([run.speed for run in batch])[:, None] / (2 * np.pi)
-            x = windowed_records([[run.signals[cx], run.signals[cy]] for run in batch], w)
+            x = blocked_records([[run.signals[cx], run.signals[cy]] for run in batch], w)
             XY = windowed_dfts(x, fs, f)
             # every run's powers at once, added run after run in the batch's order (a cumulative sum along the runs:
             # the adds of a loop over them; a line out of a run's band adds 0 there)

@@ -135,7 +135,7 @@ class Context(Metric):
         and channel set transformed together (:func:`rwadist.dft.windowed_dfts`, whose sums at a frequency do not
         depend on the others asked with it; chunks of :data:`PHASOR_CHUNK_SAMPLES` samples; the windowed signals are
         not kept: a long test's would double its memory)."""
-        from ..dft import run_window, windowed_dfts, windowed_records
+        from ..dft import blocked_records, run_window, windowed_dfts
 
         f_hz = np.asarray(f_hz, dtype=float).reshape(runs.size, -1)
         cols = [np.ascontiguousarray(f_hz[:, j:j + 1]) for j in range(f_hz.shape[1])]
@@ -155,7 +155,7 @@ class Context(Metric):
                 step = max(1, PHASOR_CHUNK_SAMPLES // (n * max(len(have), 1)))
                 for s in range(0, len(rows_all), step):
                     rows = np.asarray(rows_all[s:s + step])
-                    x = windowed_records([[self.test.runs[runs[i]].signals[CHANNELS[j]] for j in have] for i in rows], w)
+                    x = blocked_records([[self.test.runs[runs[i]].signals[CHANNELS[j]] for j in have] for i in rows], w)
                     out[rows[:, None], :, np.asarray(have)[None, :]] = \
                         (2.0 * windowed_dfts(x, fs, f_new[rows]) / wsum).transpose(0, 2, 1)
             for i, k in enumerate(todo):

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..dft import BlockedRecords
 from ..diagnose.constants import LINE_HALF
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
@@ -36,6 +37,8 @@ RUN_WINDOW = "hann"
 RUN_MIN_BINS = 2.0
 #: Samples (runs × record length × channels) transformed together by :func:`_run_line_power`: a few tens of MB.
 RUN_CHUNK_SAMPLES = 1 << 20
+#: Bytes of windowed records :func:`_run_records` keeps on a context (those asked for again), at most
+RUN_RECORDS_KEPT_BYTES = 1 << 26
 
 
 def _scan_key(direction: str, h0: float, runs) -> tuple:
@@ -126,6 +129,28 @@ def side_pair_medians(z: np.ndarray, ok: np.ndarray, cols: np.ndarray) -> np.nda
     return out
 
 
+def _run_records(ctx: Context, runs: np.ndarray, chans) -> "BlockedRecords":
+    """The windowed records (:data:`RUN_WINDOW`) of channels ``chans`` of ``runs`` (one record length) in the layout of
+    :func:`rwadist.dft.windowed_dfts` (:func:`rwadist.dft.blocked_records`), kept on the context from the second request
+    for the same records on, up to :data:`RUN_RECORDS_KEPT_BYTES` in all: the sidebands' scans and fits and the search's
+    later steps ask for the same runs' records at other frequencies (the same numbers as made anew)."""
+    from ..dft import blocked_records, run_window
+
+    key = ("run_records", np.asarray(runs).tobytes(), tuple(chans))
+    kept = ctx._memo.get(key)
+    if kept is not None and kept is not True:
+        return kept
+    made = blocked_records([[ctx.test.runs[r].signals[c] for c in chans] for r in runs],
+                           run_window(RUN_WINDOW, ctx.test.runs[runs[0]].n_samples)[0])
+    size = made.values.nbytes * 3 // 2                  # with its single-precision copy
+    used = ctx._memo.get("run_records_bytes", 0)
+    if kept is True and used + size <= RUN_RECORDS_KEPT_BYTES:
+        ctx._memo[key], ctx._memo["run_records_bytes"] = made, used + size
+    elif kept is None:
+        ctx._memo[key] = True                           # asked once: kept if asked again
+    return made
+
+
 def _run_line_power(ctx: Context, state: State, direction: str, runs, f_hz, h0: float, need=None) -> tuple:
     """(|X|² (len(runs), L, n_chans), noise mean of |X|² same shape): the whole-run line powers of the direction's
     channels at ``f_hz`` (len(runs), L) Hz (:func:`_line_powers`) and the mean |X|² white noise of the state's floor S
@@ -148,7 +173,7 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
     ``chans`` with one table of phasors), each at its needed frequencies (moved to the front of its row; the rest of
     the row padded with its carrier), in chunks of :data:`RUN_CHUNK_SAMPLES` samples; W in closed form
     (:func:`rwadist.dft.hann_transform`)."""
-    from ..dft import hann_transform, run_window, windowed_dfts, windowed_records
+    from ..dft import hann_transform, run_window, windowed_dfts
 
     if need is None:
         need = np.ones(f_hz.shape, dtype=bool)
@@ -167,7 +192,7 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
             valid = np.take_along_axis(nd, pick, axis=1)
             f_c = h0 * ctx.omega[runs[rows]] / (2 * np.pi)
             f_i = np.where(valid, np.take_along_axis(f_hz[rows], pick, axis=1), f_c[:, None])
-            x = windowed_records([[ctx.test.runs[runs[i]].signals[c] for c in chans] for i in rows], w)
+            x = _run_records(ctx, np.asarray(runs)[rows], chans)
             both = 2.0 * windowed_dfts(x, fs, np.column_stack([f_i, f_c]), single=single) / wsum
             leak = hann_transform(n, fs, f_i - f_c[:, None]) / wsum                  # W(f − f_c)/W(0)
             r, j = np.nonzero(valid)
