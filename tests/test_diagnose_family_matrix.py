@@ -103,3 +103,14 @@ def test_new_wheel_clean_and_a_fixture_above_its_axial_mode_hold(tmp_path):
 def test_a_fixture_under_the_modes_of_a_heavy_wheel_is_named_beside_them(tmp_path):
     fix = _cell(2, "fixture 0.75x axial", tmp_path)
     assert "crashed" not in fix and fix["found"] == [True] and not fix["added"] and fix["modes_ok"], fix
+
+
+@pytest.mark.slow
+def test_a_load_cell_offset_beside_close_modes_is_named_and_the_rocking_located(tmp_path):
+    """Family wheel 6 (12 kg, translation 150 Hz, rocking 110 Hz) with a load-cell offset r_z = -60 mm: the offset's
+    first estimate, made beside the rocking it pulls to 138 Hz, is 3 % short and leaves the rocking 2 % off and
+    declared; estimated again beside the modes the corrected torques give, every mode is within 2 % (none declared),
+    the offset is named and nothing else is added (main a588f38: rocking declared, offset missed, 177x clean)."""
+    cell = _cell(6, "cross_coupling", tmp_path)
+    assert "crashed" not in cell and cell["found"] == [True] and not cell["added"], cell
+    assert cell["modes_ok"] and "unc" not in cell["modes"], cell
