@@ -20,11 +20,14 @@ def peaking_gain(f, f_mode, zeta=0.02, gain=5.0):
     return (1 - r**2 + 2j * gain * zeta * r) / (1 - r**2 + 2j * zeta * r)
 
 
-def make_test(harmonics, speeds_rpm, n=4096, noise=1e-3, seed=0, mode=None, extra=None):
+def make_test(harmonics, speeds_rpm, n=4096, noise=1e-3, seed=0, mode=None, extra=None, ripple=None):
     """Steady runs of the radial force channels. harmonics: [(h, C_SI)].
 
     mode: (f_mode_hz, zeta, gain) amplifies lines near f_mode.
     extra: (f_hz, amplitude) a fixed-frequency sinusoid in every run (test-stand resonance).
+    ripple: (f_r Hz, ΔΩ rad/s) the speed Ω(t) = Ω0 + ΔΩ sin(2π f_r t + φ): every line's phase h·ψ(t),
+        ψ = Ω0 t − (ΔΩ/2πf_r) cos(2π f_r t + φ) (amplitude C·Ω0²: phase modulation alone), so each line carries
+        sidebands at ± k·f_r Hz of amplitude J_k(β)·C·Ω0², β = h·ΔΩ/(2π f_r).
     """
     rng = np.random.default_rng(seed)
     t = np.arange(n) / FS
@@ -33,11 +36,15 @@ def make_test(harmonics, speeds_rpm, n=4096, noise=1e-3, seed=0, mode=None, extr
         w = float(rpm_to_rad_s(rpm))
         fx = noise * rng.standard_normal(n)
         fy = noise * rng.standard_normal(n)
+        psi = abs(w) * t
+        if ripple is not None:
+            f_r, delta_omega = ripple
+            psi = psi - delta_omega / (2 * np.pi * f_r) * np.cos(2 * np.pi * f_r * t + rng.uniform(0, 2 * np.pi))
         for h, C in harmonics:
             a = C * w**2 * np.ones(1, complex)
             if mode is not None:
                 a = a * peaking_gain(h * abs(w) / (2 * np.pi), *mode)
-            phi = h * abs(w) * t + rng.uniform(0, 2 * np.pi)
+            phi = h * psi + rng.uniform(0, 2 * np.pi)
             fx += np.abs(a) * np.cos(phi + np.angle(a))
             fy += np.sign(w) * np.abs(a) * np.sin(phi + np.angle(a))
         if extra is not None:
@@ -187,26 +194,6 @@ def test_modal_exclusion_grows_a_contiguous_range():
     assert not np.any(ex[0.8 * bump < 0.01])
 
 
-def rippled_test(harmonics, speeds_rpm, f_r, delta_omega, n=4096, noise=1e-3, seed=0):
-    """Steady runs whose speed ripples, Ω(t) = Ω0 + ΔΩ sin(2π f_r t + φ): every line's phase h·ψ(t),
-    ψ = Ω0 t − (ΔΩ/2πf_r) cos(2π f_r t + φ) (amplitude C·Ω0²: phase modulation alone), so each line carries
-    sidebands at ± k·f_r Hz of amplitude J_k(β)·C·Ω0², β = h·ΔΩ/(2π f_r)."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(n) / FS
-    runs = []
-    for rpm in speeds_rpm:
-        w = float(rpm_to_rad_s(rpm))
-        fx = noise * rng.standard_normal(n)
-        fy = noise * rng.standard_normal(n)
-        psi = w * t - delta_omega / (2 * np.pi * f_r) * np.cos(2 * np.pi * f_r * t + rng.uniform(0, 2 * np.pi))
-        for h, C in harmonics:
-            phi = h * psi + rng.uniform(0, 2 * np.pi)
-            fx += C * w**2 * np.cos(phi)
-            fy += C * w**2 * np.sin(phi)
-        runs.append(Run(w, FS, {"Fx": fx, "Fy": fy}, name=f"r{rpm:g}.csv"))
-    return SteadyTest(runs).sorted()
-
-
 def test_sidebands_at_a_fixed_offset_are_no_harmonics():
     """A 4-Hz speed ripple (ΔΩ 5 rad/s: β = 0.2·h) puts sidebands at ± 4 and 8 Hz beside every line; near the top
     speed their h ± 4/f_rot gather and passed the presence test (11 extra lines).  Only the true harmonics are kept,
@@ -214,7 +201,7 @@ def test_sidebands_at_a_fixed_offset_are_no_harmonics():
     from scipy.special import jv
 
     f_r, dw = 4.0, 5.0
-    fit = fit_empirical(compute_spectra(rippled_test(TRUTH, SPEEDS, f_r, dw)))
+    fit = fit_empirical(compute_spectra(make_test(TRUTH, SPEEDS, ripple=(f_r, dw))))
     got = sorted((x.h, x.C) for x in fit.lines if x.direction == "radial_force")
     assert [round(h, 2) for h, _ in got] == [h for h, _ in TRUTH]
     for (h, C), (_, C_fit) in zip(TRUTH, got):
