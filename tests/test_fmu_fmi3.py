@@ -46,7 +46,8 @@ class Fmi3:
         self.md = read_model_description(path)
         self.vars = {v.name: v for v in self.md.modelVariables}
         self.messages = []
-        self.fmu = FMU3Slave(guid=self.md.guid, unzipDirectory=extract(path),
+        self.unzipdir = extract(path)
+        self.fmu = FMU3Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
                              modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
         self.fmu.instantiate(loggingOn=True, logMessage=self._log)
         self.outputs = [v.valueReference for v in self.md.modelVariables if v.causality == "output"]
@@ -92,6 +93,7 @@ class Fmi3:
         except Exception:       # noqa: BLE001 -- not stepping: nothing to terminate
             pass
         self.fmu.freeInstance()
+        shutil.rmtree(self.unzipdir, ignore_errors=True)      # fmpy's extract() leaves it in the temp folder
 
 
 def test_fmi3_validates_with_its_binary_folders(fmus):

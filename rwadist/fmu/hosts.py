@@ -10,6 +10,7 @@ outputs after initialisation.
 from __future__ import annotations
 
 import math
+import shutil
 
 import numpy as np
 
@@ -59,6 +60,9 @@ class FmpyInstance:
         from fmpy import extract
         from fmpy.fmi2 import FMU2Slave
         self.md, self.vars = _describe(path)
+        # an FMU this instance unpacked itself is removed again on close (fmpy's extract() leaves it in the
+        # temporary folder: one ~0.6 MB folder per instance otherwise accumulates over a test session)
+        self._own_unzipdir = unzipdir is None
         self.unzipdir = unzipdir or extract(path)
         self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
                              modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
@@ -99,6 +103,8 @@ class FmpyInstance:
             pass
         finally:
             self.fmu.freeInstance()
+            if self._own_unzipdir:
+                shutil.rmtree(self.unzipdir, ignore_errors=True)
 
 
 def run_fmpy(path, t, inputs, params=None, name="wheel"):
