@@ -16,10 +16,13 @@ no Python program controls: the process dies of the signal, exit -2, or Python p
 init_import_site" with its traceback, counted apart as ``pre-tb``); their output sets are classed as any other.  Must be 0 MIXED, 0 BAD, 0 tracebacks, every SIGINT exit 130 with one line.
 
     python benchmarks/kill_outputs.py [--kills 20] [--seed 0] [--only fit --only psd ...]
+    python benchmarks/kill_outputs.py --early 100 --only fit --only "convert h5"   # Ctrl-C in the first 0.5 s only
+    python benchmarks/kill_outputs.py --window 10 [--module]    # the traceback window after exec (strace)
 
 The command run is the installed ``rwadist`` (the console script a user types).  Baseline before issue 17: a kill at
 the first write left a 0-byte output (2 of 2); before issue 36: the psd set was not swapped as a set (p.csv new beside
-p_cross.csv old after a kill), and 10 of 39 early Ctrl-C printed a KeyboardInterrupt traceback.
+p_cross.csv old after a kill), and 10 of 39 early Ctrl-C printed a KeyboardInterrupt traceback.  ``--early`` and
+``--window``: what is left is the interpreter's start (docs/cli.md, "Ctrl-C while Python starts").
 """
 from __future__ import annotations
 
@@ -195,6 +198,15 @@ def _clean(members: list) -> None:
         shutil.rmtree(p) if p.is_dir() else p.unlink()
 
 
+def _save(members: list, saved: Path) -> None:
+    saved.mkdir()
+    for i, m in enumerate(members):
+        if m.is_dir():
+            shutil.copytree(m, saved / str(i))
+        elif m.exists():
+            shutil.copy2(m, saved / str(i))
+
+
 def _restore(members: list, saved: Path) -> None:
     for i, m in enumerate(members):
         if m.is_dir():
@@ -213,12 +225,7 @@ def run_matrix(name, old_argv, argv, members, kills, rng, tmp: Path) -> dict:
     t0 = time.perf_counter()
     subprocess.run(_rwadist() + old_argv, cwd=tmp, check=True, capture_output=True)
     saved = tmp / f"saved_{name.replace(' ', '_')}"
-    saved.mkdir()
-    for i, m in enumerate(members):
-        if m.is_dir():
-            shutil.copytree(m, saved / str(i))
-        elif m.exists():
-            shutil.copy2(m, saved / str(i))
+    _save(members, saved)
     old = {m: _snapshot(m) for m in members}
     t1 = time.perf_counter()     # the reference run of the killed command: its duration and its first temporary
     proc = subprocess.run(_rwadist() + argv, cwd=tmp, capture_output=True, text=True)
@@ -275,12 +282,96 @@ def run_matrix(name, old_argv, argv, members, kills, rng, tmp: Path) -> dict:
     return counts
 
 
+def early_matrix(table: dict, chosen: list, n: int, rng, tmp: Path, window: float = 0.5) -> int:
+    """``--early N``: N Ctrl-C per command at uniform instants in the first ``window`` s after exec (the console
+    script's start: the interpreter, site, the wrapper, rwadist's entry point, then the imports).  Counts every
+    traceback (``tb``; ``tb<h``: those that landed before rwadist's handler), the exit codes, Ctrl-C ending in one
+    line and exit 130, temporaries left, and the output set's state.  -2 is a process killed by the signal before
+    Python's own handler exists (the interpreter's first milliseconds): silent, as any program's."""
+    from collections import Counter
+    print(f"{'command':<14} {'n':>4} {'<h':>4} {'tb':>3} {'tb<h':>4} {'1line130':>8} {'temps':>5} {'not old':>7}  exit codes")
+    failures = 0
+    for name in chosen:
+        old_argv, argv, members = table[name]
+        subprocess.run(_rwadist() + old_argv, cwd=tmp, check=True, capture_output=True)
+        saved = tmp / f"early_{name.replace(' ', '_')}"
+        _save(members, saved)
+        old = {m: _snapshot(m) for m in members}
+        codes: Counter = Counter()
+        c = Counter()
+        examples: dict = {}         # exit code -> the end of one stderr (exit codes other than 130)
+        for _ in range(n):
+            proc = subprocess.Popen(_rwadist() + argv, cwd=tmp, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                    text=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+            time.sleep(rng.uniform(0.0, window))
+            before_handler = not _rwadist_started(proc.pid)
+            proc.send_signal(signal.SIGINT)
+            _, err = proc.communicate(timeout=600)
+            codes[proc.returncode] += 1
+            if proc.returncode != 130:      # 0: the Ctrl-C swallowed (raised in a callback: "Exception ignored")
+                examples.setdefault(proc.returncode, err[:200] + " ... " + err[-200:] if len(err) > 400 else err)
+            printed = "Traceback" in err or "internal error" in err or "Fatal Python error" in err
+            lines = [ln for ln in err.replace("\r", "\n").splitlines() if ln.strip() and "%|" not in ln
+                     and "elapsed" not in ln and not ln.startswith(("WARNING", "note", "rwadist: warning"))]
+            c["before_handler"] += before_handler
+            c["tb"] += printed
+            c["tb_before_handler"] += printed and before_handler
+            c["one_line_130"] += proc.returncode == 130 and len(lines) == 1 and "interrupted" in lines[0]
+            c["temps"] += bool(_temporaries(members))
+            c["not_old"] += classify(members, old) != "old"
+            _clean(members)
+            _restore(members, saved)
+        fail = c["tb"] + c["temps"] + sum(k for code, k in codes.items() if code not in (130, -signal.SIGINT))
+        failures += fail
+        print(f"{name:<14} {n:>4} {c['before_handler']:>4} {c['tb']:>3} {c['tb_before_handler']:>4} "
+              f"{c['one_line_130']:>8} {c['temps']:>5} {c['not_old']:>7}  {dict(sorted(codes.items()))}", flush=True)
+        for code, tail in sorted(examples.items()):
+            print(f"    exit {code}, stderr ends: {tail!r}")
+    print(f"failures (tracebacks + temporaries left + exit codes other than 130 and -2): {failures}; baseline "
+          "(91cc6dc, the entry point importing signal and types; --early 100 --only fit --only 'convert h5' --seed 1, "
+          "twice, pip 26.3's console script, load 15-23): 93 tracebacks of 400 (38 in site, exit 1), 4 Ctrl-C lost "
+          "(exit 0); after: 44 (37 in site), 0 lost")
+    return 1 if failures else 0
+
+
+def handler_window(runs: int, command: list) -> int:
+    """``--window N``: when, after exec, Python installs its SIGINT handler (before it a Ctrl-C kills the process
+    silently) and when rwadist's entry point replaces it (after it, one line and 130): between the two a Ctrl-C is
+    Python's traceback.  Read from ``strace -e rt_sigaction`` (seccomp-filtered: the other system calls are not
+    slowed); ms from exec, min / median / max over N runs of ``COMMAND --version``."""
+    import re
+    import statistics
+    if shutil.which("strace") is None:
+        raise SystemExit("--window needs strace")
+    stamps: dict = {"python handler": [], "rwadist handler": [], "window": []}
+    for _ in range(runs):
+        err = subprocess.run(["strace", "--seccomp-bpf", "-ttt", "-e", "trace=execve,rt_sigaction"] + command + ["--version"],
+                             capture_output=True, text=True).stderr
+        t_exec = next(float(m.group(1)) for m in re.finditer(r"^(\d+\.\d+) execve\(", err, re.M))
+        sets = [float(m.group(1)) for m in re.finditer(r"^(\d+\.\d+) rt_sigaction\(SIGINT, \{sa_handler=0x", err, re.M)]
+        stamps["python handler"].append(1e3 * (sets[0] - t_exec))
+        stamps["rwadist handler"].append(1e3 * (sets[1] - t_exec))
+        stamps["window"].append(1e3 * (sets[1] - sets[0]))
+    for what, v in stamps.items():
+        print(f"{what:<16} ms after exec: min {min(v):6.1f}  median {statistics.median(v):6.1f}  max {max(v):6.1f}"
+              if what != "window" else f"{what:<16} ms (traceback): min {min(v):6.1f}  median "
+              f"{statistics.median(v):6.1f}  max {max(v):6.1f}")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--kills", type=int, default=20, help="kills per signal and command (default 20)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--only", action="append", help="a command of the matrix (repeatable)")
+    ap.add_argument("--early", type=int, metavar="N",
+                    help="instead of the matrix: N Ctrl-C per command at uniform instants 0-0.5 s after exec")
+    ap.add_argument("--window", type=int, metavar="N",
+                    help="instead of the matrix: the traceback window after exec, from N runs under strace")
+    ap.add_argument("--module", action="store_true", help="--window of `python -m rwadist` (default: the console script)")
     a = ap.parse_args(argv)
+    if a.window:
+        return handler_window(a.window, [sys.executable, "-m", "rwadist"] if a.module else _rwadist())
     rng = random.Random(a.seed)
     bad = 0
     with tempfile.TemporaryDirectory(prefix="rwadist_kill_") as tmp:
@@ -288,6 +379,8 @@ def main(argv=None) -> int:
         _prepare(tmp)
         table = cases(tmp)
         chosen = a.only or list(table)
+        if a.early:
+            return early_matrix(table, chosen, a.early, rng, tmp)
         print(f"{'command':<14} {'signal':<8} {'kills':>5} {'<0.5s':>5} {'pre':>3} {'pre-tb':>6} {'old':>4} {'new':>4} "
               f"{'partial':>7} {'MIXED':>5} {'BAD':>4} {'tb':>3} {'!130':>4} {'!1line':>6} {'temps':>5}  run s")
         for name in chosen:
