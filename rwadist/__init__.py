@@ -25,7 +25,6 @@ Under it, one module per step: ``data`` (interchange format) -> ``sweep`` (quasi
 ``teststand``/``presets`` (synthetic tests).  SI units inside; rpm only at the edges.
 """
 import sys as _sys
-import types as _types
 
 # not ``from typing import TYPE_CHECKING``: importing typing takes ~7 ms, a window in which a Ctrl-C would still
 # be Python's traceback (mypy reads any name TYPE_CHECKING as True)
@@ -40,6 +39,8 @@ _LAZY = {**dict.fromkeys(("WheelModel", "build_fmu", "campbell", "diagnose", "fi
                           "RwadistWarning"), "errors")}
 
 if TYPE_CHECKING:
+    from types import ModuleType as _ModuleType
+
     from .api import (
         WheelModel,
         build_fmu,
@@ -56,6 +57,8 @@ if TYPE_CHECKING:
         write_nastran,
     )
     from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistError, RwadistWarning
+else:           # the same class, without importing ``types`` (another window before the entry point's handler)
+    _ModuleType = type(_sys)
 del TYPE_CHECKING
 
 
@@ -83,11 +86,11 @@ __version__ = "0.1.0"
 _SHADOWED_SUBMODULES = frozenset({"diagnose", "campbell"})
 
 
-class _Package(_types.ModuleType):
+class _Package(_ModuleType):
     """The ``rwadist`` package object: binding a submodule over an API function of its name is skipped."""
 
     def __setattr__(self, name, value):
-        if name in _SHADOWED_SUBMODULES and isinstance(value, _types.ModuleType):
+        if name in _SHADOWED_SUBMODULES and isinstance(value, _ModuleType):
             return
         super().__setattr__(name, value)
 
