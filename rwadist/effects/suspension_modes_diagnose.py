@@ -21,7 +21,7 @@ from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.state import State
 from ..model import Harmonic, WheelModel
-from ..stand_resonance import fit_extended_beside_stand, stand_starts
+from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, stand_starts
 
 
 def _fit_spectra(ctx: Context, test, runs: list):
@@ -109,7 +109,9 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
     """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``): the modes fitted jointly with a fixture resonance
     (:func:`rwadist.stand_resonance.fit_extended_beside_stand`, from ``stand_start`` or the stands the fit -- else the
     whole data, :func:`_whole_data_fit` -- proposes) when that is confirmed over the fit without one, else the modes
-    alone (stand None).  Only with six channels: a stand is told from a mode by lifting the forces AND the torques."""
+    alone (stand None).  Only with six channels: a stand is told from a mode by lifting the forces AND the torques.
+    ``near`` (the modes of an earlier fit beside ``stand_start``, None: without a stand) guides only the fits beside
+    that same stand (``near_stand`` of :func:`rwadist.stand_resonance.fit_extended_beside_stand`)."""
     from ..extended_fit import fit_extended
 
     if len(ctx.channels) <= 3:
@@ -117,9 +119,10 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
     # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows
     starts = [stand_start] if stand_start is not None else \
         (_stand_starts_once(ctx, fit) or _stand_starts_once(ctx, _whole_data_fit(ctx)))
-    efit = fit_extended_beside_stand(test, fit, starts=starts, near=near)
+    efit = fit_extended_beside_stand(test, fit, starts=starts, near=near, near_stand=stand_start)
     if efit.stand is None and stand_start is None:
-        held = _beside_whole_data_stand(ctx, test, fit, efit, near)
+        # ``near`` came from a fit without a stand (stand_start None): no guide to the modes beside one
+        held = _beside_whole_data_stand(ctx, test, fit, efit)
         if held is not None:
             efit = held
     return efit, efit.stand
@@ -135,7 +138,7 @@ def _stand_starts_once(ctx: Context, fit) -> list:
     return list(ctx._memo[key][1])
 
 
-def _beside_whole_data_stand(ctx: Context, test, fit, plain, near=None):
+def _beside_whole_data_stand(ctx: Context, test, fit, plain):
     """The extended fit of ``test`` (empirical fit ``fit``) with the fixture resonance fitted jointly with the modes on
     EVERY run (:func:`_whole_data_stand`) divided out at its parameters, held fixed, or None when every run shows no
     stand or the fit runs do not confirm it over ``plain`` (the fit runs' own fit, no stand kept:
@@ -152,7 +155,7 @@ def _beside_whole_data_stand(ctx: Context, test, fit, plain, near=None):
     whole = _whole_data_stand(ctx)
     if whole is None:
         return None
-    held = fit_extended(test, fit, stand=whole, near=near)
+    held = fit_extended(test, fit, stand=whole)
     if not stand_confirmed(held, plain):
         return None
     f_r, zeta, gain, above = whole
@@ -488,10 +491,6 @@ def _held_out_fold(ctx: Context, state: State) -> "SuspensionModes | None":
         e = SuspensionModes.fit(ctx, state, ctx.held_runs)
         ctx._memo[key] = (state, None if e is None else replace(e, judge_runs=tuple(int(r) for r in ctx.fit_runs)))
     return ctx._memo[key][1]
-
-
-#: Relative distance in frequency under which a test-stand resonance the search named is the modes' own stand
-SAME_STAND = 0.02
 
 
 def declare_beside_fixtures(ctx: Context, state: State) -> State:
