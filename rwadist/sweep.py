@@ -75,8 +75,14 @@ FUSE_HALF_WIDTH = 4
 #: Automatic slice length: powers of two from AUTO_SLICE_MAX down to AUTO_SLICE_MIN samples ...
 AUTO_SLICE_MAX = 8192
 AUTO_SLICE_MIN = 1024
-#: ... the longest over which the speed changes by at most this share of itself (median over the slices).
+#: ... the longest over which the speed changes by at most this share of itself (median over the slices) ...
 AUTO_SLICE_CHANGE = 0.05
+#: ... and over whose Welch segments (a slice read in SEGMENTS_READ of them, ``rwadist.api.DIAGNOSE_SEGMENTS``) the
+#: highest line of the speed scale sweeps by at most CHIRP_BINS of the segment's bins, in every slice: a line is
+#: read in a window of ±LINE_HALF = 3 bins (:mod:`rwadist.diagnose.constants`) around its mean frequency, a Hann
+#: main lobe is ±2 bins wide, so a chirp of c bins (±c/2) stays within the window for c <= 2(3 − 2) = 2.
+SEGMENTS_READ = 4
+CHIRP_BINS = 2.0
 #: Default drop level: fraction of the largest |speed| found.
 MIN_SPEED_FRACTION = 0.05
 RADIAL = ("Fx", "Fy", "Tx", "Ty")
@@ -472,6 +478,20 @@ def _tach_infos(sweep: Sweep, starts, slice_samples: int) -> list:
             for i, st in enumerate(starts)]
 
 
+def _slice_chirp(infos: list, fs: float, h_max: float) -> float:
+    """Largest over the slices with a speed of the sweep, in bins, of the line h_max across one of the
+    :data:`SEGMENTS_READ` Welch segments of a slice: h_max·|dΩ/dt|·L²/(2π), L = T/SEGMENTS_READ seconds (the line
+    moves h_max·|dΩ/dt|·L/(2π) Hz over the segment, its bin is 1/L Hz); dΩ/dt from the slices' speeds against
+    their centre times (rad/s²).  0 with fewer than 3 slices with a speed."""
+    t = np.array([0.5 * (i.start + i.stop) / fs for i in infos])
+    w = np.array([i.speed for i in infos])
+    ok = np.isfinite(w) & (w != 0)
+    if ok.sum() < 3 or not np.isfinite(h_max):
+        return 0.0
+    seg = (infos[0].stop - infos[0].start) / fs / SEGMENTS_READ
+    return float(np.max(h_max * np.abs(np.gradient(w[ok], t[ok])) * seg**2 / (2 * np.pi)))
+
+
 def _slice_change(infos: list, fs: float) -> float:
     """Median over the slices with a speed of |dΩ/dt|·T/|Ω|: the share by which the speed changes across one
     slice of T seconds (dΩ/dt from the slices' speeds against their centre times)."""
@@ -495,18 +515,26 @@ def _speed_infos(sweep, slice_samples, hop, source, channels) -> tuple:
 
 def _auto_slices(sweep, source, channels) -> tuple:
     """The longest power-of-two slice (AUTO_SLICE_MAX down to AUTO_SLICE_MIN samples, and at most an eighth of
-    the record) over which the speed changes by at most AUTO_SLICE_CHANGE of itself (median over the slices):
-    (slice_samples, starts, hop, infos, SpeedScale, rule text)."""
+    the record) over which the speed changes by at most AUTO_SLICE_CHANGE of itself (median over the slices) and,
+    with the speed from the data, over whose Welch segments the highest line of the speed scale sweeps by at most
+    CHIRP_BINS bins in every slice (:func:`_slice_chirp`: a median over the slices does not see the fast part of a
+    motor's exponential run-up, which spends most of its time near the top speed; family wheel 2, 300 -> 3000 rpm
+    in 300 s, e^(−t/75 s): 0.8 % change at 8192 samples, but h 9.14 swept 5.6 bins per segment in the first slices,
+    and the rocking mode came out 12 % low): (slice_samples, starts, hop, infos, SpeedScale, rule text)."""
     n_total = _n_samples(sweep)
+    fs = float(sweep.sample_rate)
     n = int(min(AUTO_SLICE_MAX, max(2 ** int(np.floor(np.log2(max(n_total // 8, 1)))), AUTO_SLICE_MIN)))
     tried = []
     while True:
         starts, hop, infos, spd = _speed_infos(sweep, n, None, source, channels)
-        change = _slice_change(infos, float(sweep.sample_rate))
-        tried.append(f"{n} samples: {100 * change:.1f} %")
-        if change <= AUTO_SLICE_CHANGE or n // 2 < AUTO_SLICE_MIN:
+        change = _slice_change(infos, fs)
+        h_max = max(spd.ratios) if spd is not None and spd.ratios else float("nan")
+        chirp = _slice_chirp(infos, fs, h_max)
+        tried.append(f"{n} samples: {100 * change:.1f} %" + (f", chirp {chirp:.2f} bins" if np.isfinite(h_max) else ""))
+        if (change <= AUTO_SLICE_CHANGE and chirp <= CHIRP_BINS) or n // 2 < AUTO_SLICE_MIN:
             rule = (f"auto: the longest slice (<= {AUTO_SLICE_MAX} samples) over which the speed changes by <= "
-                    f"{100 * AUTO_SLICE_CHANGE:g} % (median over the slices); " + "; ".join(tried))
+                    f"{100 * AUTO_SLICE_CHANGE:g} % (median over the slices) and the highest line sweeps <= "
+                    f"{CHIRP_BINS:g} bins of a 1/{SEGMENTS_READ}-slice segment (every slice); " + "; ".join(tried))
             return n, starts, hop, infos, spd, rule
         n //= 2
 
@@ -519,7 +547,9 @@ def slice_sweep(sweep: Sweep, slice_samples: int | None = None, hop: int | None 
         non-overlapping, as the thesis).  slice_samples None (default): the longest power of two up to
         8192 samples (the thesis's) over which the speed changes by at most 5 % of itself (median over the
         slices): a fast sweep's lines are smeared over a long slice and their peaks pulled (a 30-s run-up
-        300 -> 3000 rpm at 3840 Hz in 8192-sample slices put h = 3 at 3.04, with the tach too).
+        300 -> 3000 rpm at 3840 Hz in 8192-sample slices put h = 3 at 3.04, with the tach too); with the speed
+        from the data, also short enough that the highest line sweeps at most CHIRP_BINS bins of a
+        quarter-slice Welch segment in every slice (:func:`_auto_slices`).
     speed_source : "auto" (tach if the sweep has one, else data), "tach" (mean of the tach over
         the slice; DataError naming ``speed_rpm`` without one) or "data" (:func:`estimate_speeds`).
     min_speed_rpm : slices with |speed| below this (rpm) are dropped; default 5 % of the largest
