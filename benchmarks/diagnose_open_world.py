@@ -31,6 +31,7 @@ Run (each cell 10-120 s on a free core; nice it)::
     nice -n 10 python benchmarks/diagnose_open_world.py                   # 8 wheels x (clean + 5 effects)
     python benchmarks/diagnose_open_world.py --wheels 0,4 --kinds clean,mains_pickup
     python benchmarks/diagnose_open_world.py --json rows.json --keep /tmp/cells
+    python benchmarks/diagnose_open_world.py --seed 2 --wheels 1,3           # other phases and noise
 """
 from __future__ import annotations
 
@@ -216,12 +217,14 @@ def run_diagnose(data_dir: Path, report_dir: Path) -> tuple:
     return json.loads(summary.read_text()), proc.stdout
 
 
-def cell(i: int, wheel, kind: str, work: Path) -> dict:
+def cell(i: int, wheel, kind: str, work: Path, seed: int = 1) -> dict:
     n_speeds, n_samples, noise = CONDITIONS[i]
     wheel = replace(wheel, n_speeds=n_speeds, n_samples=n_samples)
     speeds = np.linspace(wheel.min_rpm, wheel.max_rpm, n_speeds)
     effect = None if kind == "clean" else make_effect(kind, wheel)
-    data = fw.steady(wheel, speeds_rpm=speeds, noise=noise, seed=i, effects=[effect] if effect else [])
+    # seed 1 is the wheel's own index (the cells as first measured); another seed draws other phases and noise
+    data = fw.steady(wheel, speeds_rpm=speeds, noise=noise, seed=i + 1000 * (seed - 1),
+                     effects=[effect] if effect else [])
     d = fw.write_steady(data, work / f"w{i}_{kind}" / "data", wheel.name)
     t0 = time.perf_counter()
     summary, console = run_diagnose(d, work / f"w{i}_{kind}" / "report")
@@ -250,6 +253,7 @@ def main(argv=None) -> int:
     ap.add_argument("--kinds", default=",".join(KINDS))
     ap.add_argument("--json", default=None, help="write the rows here")
     ap.add_argument("--keep", default=None, help="keep the cells' data and reports in this folder")
+    ap.add_argument("--seed", type=int, default=1, help="1: the cells as first measured; others: other draws")
     args = ap.parse_args(argv)
     family = fw.family()
     work = Path(args.keep) if args.keep else Path(tempfile.mkdtemp(prefix="rwadist_open_world_"))
@@ -258,7 +262,7 @@ def main(argv=None) -> int:
         for i in (int(x) for x in args.wheels.split(",")):
             clean_err = None
             for kind in args.kinds.split(","):
-                r = cell(i, family[i], kind, work)
+                r = cell(i, family[i], kind, work, args.seed)
                 if kind == "clean":
                     clean_err = r.get("error")
                 elif clean_err and r.get("error") and kind == "mains_pickup":

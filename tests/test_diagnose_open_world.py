@@ -101,6 +101,31 @@ def test_one_line_copy_is_a_copy_only_when_the_target_follows_the_sources_depart
     assert _pair(**_one_line(lambda om: 0.3 / whirl(om), whirl)) is None
 
 
+def test_one_line_in_a_fixed_phase_through_two_modes_is_no_copy():
+    """One continuous record (a sweep's slices) keeps every line's phases: Fz's 1x line through an axial mode at
+    90 Hz (1/(1 − (f/90)²): 3.2 dB over C·Ω² at 50 Hz) and Fx's, of the same rotor in a fixed phase to it, following
+    only part of that departure through its own mode further up (the ratio ∝ law^−0.6, 1.9 dB over the speeds: within
+    the cluster's ±15 %) is the wheel's own pair of loads, not a copy; the same line with the ratio constant is."""
+    from rwadist.diagnose.channel_copy import _pair
+
+    axial = lambda om: 1.0 / (1.0 - (om / (2 * np.pi * 90.0)) ** 2)     # noqa: E731
+    assert _pair(**_one_line(lambda om: 0.3 * axial(om) ** -0.6 + 0.0j, axial)) is None
+    got = _pair(**_one_line(lambda om: 0.3 + 0.0j, axial))
+    assert got is not None and got.kappa == pytest.approx(0.3, rel=1e-6)
+    # ... nor when the source's strongest line (5 x stronger, h 2) stands in the target at another ratio: a copy scales
+    # every line alike (a ball-pass line of one rotor read in two directions above both their modes)
+    one, other = _one_line(lambda om: 0.3 + 0.0j, axial), _one_line(lambda om: 0.05j + 0.0, axial, seed=1)
+    both = {k: np.concatenate([one[k], other[k] * (5.0 if k in ("X_s", "X_t") else 1.0)])
+            for k in ("X_s", "X_t", "noise_t", "runs", "omega")}
+    n = one["X_s"].size
+    both["X_t"][n:] = 0.1 * np.abs(both["X_s"][n:]) * np.exp(2j * np.pi * np.random.default_rng(2).uniform(size=n))
+    both.update(h=np.concatenate([one["h"], 2.0 * other["h"]]), cs="Tx", ct="Tz")
+    assert _pair(**both) is None
+    both["X_s"][n:] /= 25.0                                                # now the copied line is the strongest
+    both["X_t"][n:] /= 25.0
+    assert _pair(**both) is not None
+
+
 def test_hump_where_it_is():
     _, truth, d = diagnosed("broadband_hump")
     (u,) = d.unexplained
@@ -390,3 +415,75 @@ def test_an_effect_a_later_one_needs_is_not_taken_back_alone():
     assert _without((), [a, b, c], a) == ("b", "c")
     assert _without((), [a, b, c], c) == ("a", "b")
     assert _without((), [a, b, c], b) is None
+
+
+def test_a_moving_resonance_between_sparse_runs_is_described():
+    """16 runs 1000-10000 rpm, radial-force lines h 1 and 3.55 through a resonance softening with speed (f_r = 330 ×
+    (1 − 0.4 Ω/Ω_max) Hz, ζ 0.03, peak gain 5; family wheel 7's open-world cell): the line h 3.55 moves ~56 Hz from
+    run to run past a resonance 20 Hz wide, so it is lifted 13 dB in one run only, the others 2-3 dB (h 1 near the
+    top speed): described, falling through its true frequencies."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose.describe_structure import LineRatios, moving_resonance
+
+    spin = np.linspace(1000.0, 10000.0, 16) / 60.0
+    hs = (1.0, 3.55)
+    s, h = np.meshgrid(spin, hs)
+    line = np.repeat(np.arange(len(hs)), spin.size)
+    f = (h * s).ravel()
+    q = _softening_db(f, s.ravel(), f0=330.0, spin_max=spin.max()) + np.random.default_rng(5).normal(0, 0.05, f.size)
+    assert np.sum(q >= 3.0) == 1                                             # the case: one run lifted by much
+    r = LineRatios("radial_force", q, f, np.tile(np.arange(spin.size), len(hs)), s.ravel(), line, h.ravel(),
+                   np.full(f.size, 1e4))
+    (u,) = moving_resonance(SimpleNamespace(channels=("Fx", "Fy")), SimpleNamespace(effects=[]), [r],
+                            lambda *a: (0.0, 0.0))
+    p = u.parameters
+    assert p["slope_Hz_per_Hz_of_spin"] < 0 and u.channels == ("Fx", "Fy")
+    assert p["f_at_lowest_speed_Hz"] == pytest.approx(330.0 * (1 - 0.4 * 0.1), rel=0.05)
+    assert p["f_at_highest_speed_Hz"] == pytest.approx(330.0 * 0.6, rel=0.05)
+
+
+def test_runs_whose_change_is_not_read_are_left_out_of_the_second_search():
+    """20 runs, every third one from the second 3.5 dB up, the four slowest with no line over the noise (the 442-rpm
+    run of family wheel 2 among them, switched and unread: left in, it put I_zz/I_rr at 2.5 and an amplitude law was
+    added): the run change lists them as not read, :func:`run_steps` gives them NaN, and :func:`describe.start`
+    leaves them out of the context the search reads (kept in the one the residual is described on) while the read
+    runs are divided by their offsets."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose import describe
+    from rwadist.diagnose.describe_structure import LineRatios, run_change
+    from rwadist.diagnose.engine import Context
+    from rwadist.spectra import compute_spectra
+
+    R, L = 20, 5
+    spin = np.linspace(5.0, 50.0, R)
+    run, line = np.tile(np.arange(R), L), np.repeat(np.arange(L), R)
+    q = 0.03 * spin[run] - 0.5 * line + 0.01 * np.sin(3.0 * run + line) + 3.5 * (run % 3 == 1)
+    read = run >= 4
+    names = [f"run_{i}" for i in range(R)]
+    ctx = SimpleNamespace(runs=np.arange(R), omega=2 * np.pi * spin, channels=("Fx", "Fy"), test=None,
+                          sp=SimpleNamespace(run_names=names))
+    ratios = [LineRatios("radial_force", q[read], spin[run[read]] * (line[read] + 1), run[read], spin[run[read]],
+                         line[read], line[read] + 1.0, np.ones(read.sum()))]
+    (u,) = run_change(ctx, ratios, lambda runs: (0.5, 1.0))
+    assert u.parameters["runs"] == [f"run_{i}" for i in range(4, R) if i % 3 == 1]
+    assert u.parameters["runs_not_read"] == names[:4]
+
+    test, _ = owc.generate("clean", np.linspace(300.0, 3000.0, R), n_samples=1024, seed=1)
+    test = owc.with_runs(test, [_renamed(r, n) for r, n in zip(test.runs, names)])
+    whole = Context(compute_spectra(test, nperseg=256), None, test)
+    diag = SimpleNamespace(ctx=whole, unexplained=[u], hypotheses=[], state_after=SimpleNamespace(effects=[]),
+                           model_given=False)
+    steps = describe.run_steps(diag)
+    assert [r for r, dB in steps.items() if np.isnan(dB)] == [0, 1, 2, 3]
+    opened = describe.start(whole, steps)
+    assert opened.ctx.runs.size == R - 4 and opened.whole is not None and opened.whole.runs.size == R
+    scaled = opened.whole.test.runs[7].signals["Fx"] / test.runs[7].signals["Fx"]
+    assert np.allclose(scaled, 10 ** (-steps[7] / 20))
+
+
+def _renamed(run, name):
+    from dataclasses import replace
+
+    return replace(run, name=name)

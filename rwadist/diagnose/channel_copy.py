@@ -58,6 +58,12 @@ CLEAR_COPY_DB = 20.0
 MIN_SINGLE_RUNS = 8
 MIN_SINGLE_FRACTION = 0.8
 SINGLE_LAW_DB = 3.0
+#: ... and the target follows that departure: the slope of ln|κ| (the run's ratio) on ln(|X_s|/Ω²) over those runs
+#: at most this (a copy's ratio is one constant, slope 0; a load of the target's own direction in a fixed phase to the
+#: source, through its own modes, follows part of it: family wheel 6's 300-s run-up, Fz's 1× line 2.9 dB over its
+#: law through the axial mode at 85 Hz, Fx's 0.8 dB through the translation at 150 Hz, slope −0.7; one continuous
+#: record keeps every line's phases, so the two read at one ratio within the cluster's tolerance in every slice)
+SINGLE_RATIO_SLOPE = 0.25
 
 
 @dataclass(frozen=True)
@@ -149,25 +155,38 @@ def find_channel_copies(ctx, test=None) -> list:
     return out
 
 
-def _one_line_copy(X_s, omega, runs, h, near, strong) -> list:
+def _one_line_copy(X_s, X_t, omega, runs, h, near, strong) -> list:
     """[h] of the one line whose κ holds in at least :data:`MIN_SINGLE_RUNS` runs where the copy stands clear
     (``strong``), :data:`MIN_SINGLE_FRACTION` of them, while the source's line there departs from C·Ω² by at least
-    :data:`SINGLE_LAW_DB` (its |X|/Ω² over those runs, max over min), else [].
+    :data:`SINGLE_LAW_DB` (its |X|/Ω² over those runs, max over min) and the target follows it (the ratio's slope on
+    the source's law at most :data:`SINGLE_RATIO_SLOPE`), the line the source's strongest where the copy would stand
+    clear, else [].
 
     One line at one complex ratio in every run can be the wheel's own geometry (an axial runout turning with the
     imbalance: the two loads in a fixed phase, both ∝ Ω² below their modes); but a target following the source's own
     departure from its law -- the source's modes shaping it, which the target's direction does not share -- at one
     gain and phase is a copy of that channel (family wheel 2: Tz = 0.3·Tx; Tx's imbalance line, attenuated from 0.96
     to 0.45 of C·Ω² by its rocking whirl, the one torque line that stands clear)."""
+    # a copy scales every line of the source alike: the line it is read on must be the source's strongest where the
+    # copy would stand clear (family wheel 2's 300-s run-up: Fz at 0.63 × Fy on the ball-pass line h 4.57, both
+    # above their modes, while Fy's imbalance line, 14 dB stronger, stood in Fz at another ratio: two loads of one
+    # rotor, not a copy)
+    levels = {float(v): float(np.median(np.abs(X_s[(h == v) & strong]))) for v in np.unique(h[strong])}
+    strongest = max(levels, key=lambda v: levels[v]) if levels else None
     best: list = []
     for hv in np.unique(h[near]):
+        if strongest is None or float(hv) != strongest:
+            continue
         sel = (h == hv) & strong
         n_runs = np.unique(runs[sel]).size
         hit = sel & near
         if n_runs < MIN_SINGLE_RUNS or np.unique(runs[hit]).size < max(MIN_SINGLE_FRACTION * n_runs, MIN_SINGLE_RUNS):
             continue
         law = np.abs(X_s[hit]) / np.maximum(np.abs(omega[hit]), 1e-12) ** 2
-        if 20 * np.log10(law.max() / law.min()) >= SINGLE_LAW_DB and (not best or hit.sum() > best[1]):
+        if 20 * np.log10(law.max() / law.min()) < SINGLE_LAW_DB:
+            continue
+        slope = np.polyfit(np.log(law), np.log(np.abs(X_t[hit] / X_s[hit])), 1)[0]
+        if abs(slope) <= SINGLE_RATIO_SLOPE and (not best or hit.sum() > best[1]):
             best = [float(hv), int(hit.sum())]
     return best[:1]
 
@@ -206,7 +225,7 @@ def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str, omega) -> ChannelCopy | 
         if n_runs >= MIN_RUNS and np.unique(runs[sel & near]).size >= MIN_RUN_FRACTION * n_runs:
             lines.append(float(hv))
     if len(lines) < MIN_COPIED_LINES:
-        lines = _one_line_copy(X_s, omega, runs, h, near, strong)
+        lines = _one_line_copy(X_s, X_t, omega, runs, h, near, strong)
         if not lines:
             return None
     keep = near & np.isin(h, lines)
