@@ -34,6 +34,8 @@ from ..units import CHANNEL_DIRECTION, RAD_S_TO_RPM
 LEVER_ARM_PAIRS = {("Fy", "Tx"), ("Fz", "Tx"), ("Fx", "Ty"), ("Fz", "Ty"), ("Fx", "Tz"), ("Fy", "Tz")}
 #: The other channel of a radial pair.
 PARTNER = {"Fx": "Fy", "Fy": "Fx", "Tx": "Ty", "Ty": "Tx"}
+#: A radial force in a radial torque this close to ±90° (deg) is the partner force's r × F (:func:`_lever_arm_through_partner`).
+LEVER_PHASE_DEG = 20.0
 #: A source line's power over the noise in its record bin, at least (dB).
 MIN_LINE_DB = 25.0
 #: Lines per run and channel taken as sources (the strongest).
@@ -136,7 +138,7 @@ def find_channel_copies(ctx, test=None) -> list:
                 continue
             got = _pair(X[mine, s], X[mine, t], noise[mine, t], run_of[mine], h[mine], cs, ct,
                         ctx.omega[run_of[mine]])
-            if got is not None:
+            if got is not None and not _lever_arm_through_partner(got):
                 found.append(got)
     # a radial pair carrying the other radial pair's content alike (Tx = κ·Fx and Ty = κ·Fy) is the rotor's own
     # pattern (a force and a moment of one rotating source, in phase; the virtual stand's wheel without modes), not a
@@ -153,6 +155,17 @@ def find_channel_copies(ctx, test=None) -> list:
         if cands:
             out.append(replace(cands[0], alternatives=tuple(x.source for x in cands[1:])))
     return out
+
+
+def _lever_arm_through_partner(copy: ChannelCopy) -> bool:
+    """A radial force read in a radial torque at ±90° (within :data:`LEVER_PHASE_DEG`): on a rotating line the
+    partner force is that force turned by 90° (F_y = ∓j·F_x), so a load-cell offset's r × F (T_y = r_z·F_x, a
+    :data:`LEVER_ARM_PAIRS` pair) reads as T_y = ∓j·r_z·F_y -- the ``cross_coupling`` / ``lever_arm_noise`` classes'
+    to name, not an instrument's copy (a cross-sensitive channel reads another in phase)."""
+    partner = PARTNER.get(copy.source)
+    if partner is None or (partner, copy.target) not in LEVER_ARM_PAIRS:
+        return False
+    return abs(abs(np.degrees(np.angle(copy.kappa))) - 90.0) <= LEVER_PHASE_DEG
 
 
 def _one_line_copy(X_s, X_t, omega, runs, h, near, strong) -> list:
