@@ -185,23 +185,20 @@ def _one_line_copy(X_s, X_t, omega, runs, h, near, strong) -> list:
     # above their modes, while Fy's imbalance line, 14 dB stronger, stood in Fz at another ratio: two loads of one
     # rotor, not a copy)
     levels = {float(v): float(np.median(np.abs(X_s[(h == v) & strong]))) for v in np.unique(h[strong])}
-    strongest = max(levels, key=lambda v: levels[v]) if levels else None
-    best: list = []
-    for hv in np.unique(h[near]):
-        if strongest is None or float(hv) != strongest:
-            continue
-        sel = (h == hv) & strong
-        n_runs = np.unique(runs[sel]).size
-        hit = sel & near
-        if n_runs < MIN_SINGLE_RUNS or np.unique(runs[hit]).size < max(MIN_SINGLE_FRACTION * n_runs, MIN_SINGLE_RUNS):
-            continue
-        law = np.abs(X_s[hit]) / np.maximum(np.abs(omega[hit]), 1e-12) ** 2
-        if 20 * np.log10(law.max() / law.min()) < SINGLE_LAW_DB:
-            continue
-        slope = np.polyfit(np.log(law), np.log(np.abs(X_t[hit] / X_s[hit])), 1)[0]
-        if abs(slope) <= SINGLE_RATIO_SLOPE and (not best or hit.sum() > best[1]):
-            best = [float(hv), int(hit.sum())]
-    return best[:1]
+    if not levels:
+        return []
+    strongest = max(levels, key=lambda v: levels[v])
+    sel = (h == strongest) & strong
+    hit = sel & near
+    n_runs = np.unique(runs[sel]).size
+    if not hit.any() or n_runs < MIN_SINGLE_RUNS or \
+            np.unique(runs[hit]).size < max(MIN_SINGLE_FRACTION * n_runs, MIN_SINGLE_RUNS):
+        return []
+    law = np.abs(X_s[hit]) / np.maximum(np.abs(omega[hit]), 1e-12) ** 2
+    if 20 * np.log10(law.max() / law.min()) < SINGLE_LAW_DB:
+        return []
+    slope = np.polyfit(np.log(law), np.log(np.abs(X_t[hit] / X_s[hit])), 1)[0]
+    return [float(strongest)] if abs(slope) <= SINGLE_RATIO_SLOPE else []
 
 
 def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str, omega) -> ChannelCopy | None:
