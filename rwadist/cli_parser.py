@@ -15,6 +15,11 @@ from .errors import DataError, ParameterError
 from .units import rpm_to_rad_s
 from .validate import LIMITS, MAX_RPM, MAX_SPEEDS, check_number
 
+#: one help text for fit and diagnose: the slice rule of rwadist.sweep (docs/cli.md says the same)
+_SLICE_SAMPLES_HELP = ("sweep slice length, samples (default: the longest power of two up to 8192 over which the "
+                       "speed changes by at most 5 %% (median over the slices) and, with the speed from the data, "
+                       "the highest line sweeps at most 2 bins of a quarter-slice Welch segment in every slice)")
+
 
 def _version() -> str:
     try:
@@ -149,7 +154,7 @@ def _add_fit_options(p):
     p.add_argument("--epsilon", type=limited("epsilon"), default=0.02, help="binning tolerance on h (default 0.02)")
     p.add_argument("--no-mode-exclusion", action="store_true", help="keep modally amplified speeds in the fit")
     p.add_argument("--slice-samples", type=limited("slice_samples"), default=None,
-                   help="sweep slice length, samples (default: the longest power of two up to 8192 over which the speed changes by at most 5 %%)")
+                   help=_SLICE_SAMPLES_HELP)
     p.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
                    help="speed of sweep slices: tach column, estimated from data, or auto")
     p.add_argument("--extended", action="store_true",
@@ -334,7 +339,7 @@ def _add_diagnose(sub, cli) -> None:
                          "rotation sense); auto (default): extended when the model (--model/--preset) has an "
                          "analytical section and the data's meta.json does not say modes: false")
     dg.add_argument("--slice-samples", type=limited("slice_samples"), default=None,
-                    help="sweep slice length, samples (default: the longest power of two up to 8192 over which the speed changes by at most 5 %%)")
+                    help=_SLICE_SAMPLES_HELP)
     dg.add_argument("--speed-source", choices=("auto", "tach", "data"), default="auto",
                     help="speed of sweep slices: tach column, estimated from data, or auto")
     dg.add_argument("--bearing", action="append", default=None, metavar="KEY=VALUE,...",

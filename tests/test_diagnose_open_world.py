@@ -195,6 +195,26 @@ def test_bearing_ratios_name_the_lines_within_the_resolution():
     assert all(abs(x["h"] - round(x["h"])) > 2 * res for x in plain)
 
 
+def test_a_line_with_co_and_counter_rotating_parts_is_named_once():
+    """A line that holds a co- and a counter-rotating part is two harmonics at one h in the model file; report.md's
+    causes list it once (session 6 listed it twice)."""
+    import copy
+    import dataclasses
+
+    from rwadist.bearings import Bearing
+    from rwadist.diagnose.describe import line_causes
+
+    _, _, d = diagnosed("clean")
+    d2 = copy.deepcopy(d)
+    lines = d2.model.empirical["radial_force"]
+    i = next(k for k, x in enumerate(lines) if abs(x.h - 4.42) < 0.01)
+    co = dataclasses.replace(lines[i], sense="co", C=0.7 * lines[i].C)
+    lines[i:i + 1] = [co, dataclasses.replace(co, sense="counter", C=0.3 * lines[i].C)]
+    got = [(x["direction"], round(x["h"], 2)) for x in line_causes(d2, [Bearing(10, 0.116, 1.0)])]
+    assert got.count(("radial_force", 4.42)) == 1, got
+    assert len(got) == len(set(got)), got
+
+
 def test_bearings_from_the_flag_and_the_model_file(tmp_path, capsys):
     from rwadist import model as model_io
     from rwadist.cli import main

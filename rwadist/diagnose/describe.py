@@ -220,7 +220,7 @@ def channel_copy_shares(res: Residual, copies) -> dict:
 def line_causes(diag, bearings=(), extra_h=()) -> list:
     """Candidate physical causes (:func:`rwadist.bearings.line_causes`) of the improved model's lines whose ratio h is
     not a whole number (within twice the resolution, :func:`ratio_resolution`): [{"direction", "h", "source",
-    "causes"}] for those with at least one; ``source`` is "effect" for a line a ``missing_harmonic`` added, "base"
+    "causes"}] for those with at least one, each (direction, h) once; ``source`` is "effect" for a line a ``missing_harmonic`` added, "base"
     for a line of a base fitted from the data, "model" for one of the given model.  ``extra_h``: ratios of lines
     described but not in the model (the relations among lines read them too)."""
     from ..bearings import line_causes as causes_of
@@ -234,9 +234,12 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
     lines = [(d, float(x.h)) for d in DIRECTIONS for x in diag.model.harmonics(d)]
     every = sorted({h for _, h in lines} | {float(h) for h in extra_h})
     out = []
+    seen = set()
     for d, h in lines:
-        if abs(h - round(h)) <= 2 * res:
+        # a line with a co- and a counter-rotating part is two harmonics at one h: one line, named once
+        if abs(h - round(h)) <= 2 * res or (d, h) in seen:
             continue
+        seen.add((d, h))
         got = causes_of(h, res, bearings, [o for o in every if abs(o - h) > res])
         if got:
             src = "effect" if (d, round(h, 3)) in added else ("base" if fitted else "model")
