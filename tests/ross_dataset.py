@@ -7,7 +7,8 @@ they sit on one rotor), plus white noise as a fraction of the top-speed fundamen
 static imbalance's Fx; torques: the dynamic imbalance's Tx).  Feed it to anything that takes a
 SteadyTest, or write it for the command line::
 
-    python tests/ross_dataset.py OUT_DIR         # then: rwadist diagnose OUT_DIR -o report
+    python tests/ross_dataset.py OUT_DIR [--doc DOC.json --sample-rate HZ --samples N]
+    rwadist diagnose OUT_DIR -o report
 """
 from __future__ import annotations
 
@@ -60,15 +61,22 @@ def ross_test(noise=0.01, seed=0, sample_rate=3840.0, n_samples=4096, path=DATA)
 
 
 def main(argv=None):
+    import argparse
+
     from rwadist import data as data_io
 
-    argv = sys.argv[1:] if argv is None else argv
-    if len(argv) != 1:
-        print("usage: python tests/ross_dataset.py OUT_DIR", file=sys.stderr)
-        return 2
-    test = ross_test()
-    data_io.write_steady(test, Path(argv[0]))
-    print(f"wrote {len(test.runs)} runs of the ROSS dataset to {argv[0]}")
+    ap = argparse.ArgumentParser(description="write the ROSS dataset as load-cell records")
+    ap.add_argument("out", type=Path)
+    ap.add_argument("--doc", type=Path, default=DATA, help="a ROSS document (default: tests/data/ross_loadcell.json)")
+    ap.add_argument("--sample-rate", type=float, default=3840.0, help="Hz")
+    ap.add_argument("--samples", type=int, default=4096, help="samples per run")
+    ap.add_argument("--noise", type=float, default=0.01, help="white noise, a fraction of the top-speed fundamental")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    test = ross_test(noise=args.noise, seed=args.seed, sample_rate=args.sample_rate, n_samples=args.samples,
+                     path=args.doc)
+    data_io.write_steady(test, args.out)
+    print(f"wrote {len(test.runs)} runs of {args.doc.name} to {args.out}")
     return 0
 
 

@@ -1,0 +1,171 @@
+"""Third-party load-cell data of a wheel the project was never tuned on, computed with ROSS (issue 33).
+
+The issue's "new wheel": a 4.2 kg rotor with I_zz/I_rr = 1.56, hard-mounted suspension modes near
+140 Hz (radial translation), 95 Hz (rocking) and 310 Hz (axial), bearing-like non-integer lines
+(a counter-rotating cage line at h 0.4, ball passes at 3.08 and 4.92 and the outer race's second
+multiple 6.16), 600-6000 rpm.  ROSS (ross-rotordynamics) computes every steady-state response, as in
+``benchmarks/ross_loadcell.py`` (same load cell: the bearings' reactions on the ground and their moment
+about the rotor centre), so neither the gyroscopic whirl nor the modes' amplification comes from
+rwadist's own equations.  With ``--fixture HZ`` the two bearings sit on two point masses of
+``--fixture-mass`` kg each, each on a spring to the ground (the load cell) with damping ratio 0.03:
+a test stand between the wheel and the load cell, in ROSS's coupled equations (the wheel's modes
+then move too; the document stores ROSS's modes with and without the stand).
+
+ROSS is not a project dependency.  Run where it imports (ROSS 2.3 needs ``plotly<6``; run from a
+folder without a ``librefprop.so``)::
+
+    python3 -m venv /tmp/rossvenv && /tmp/rossvenv/bin/pip install ross-rotordynamics "plotly<6"
+    /tmp/rossvenv/bin/python benchmarks/ross_new_wheel.py OUT.json [--fixture 230 --fixture-mass 40]
+
+then write load-cell records and diagnose them with the command a user types::
+
+    python tests/ross_dataset.py DATA --doc OUT.json --sample-rate 5000 --samples 8192
+    rwadist diagnose DATA -o REPORT
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import ross as rs
+
+M = 4.2                                           # rotor mass, kg
+I_RATIO = 1.56                                    # I_zz / I_rr
+R = 0.12                                          # m: I_zz = ½·M·R²
+I_P = 0.5 * M * R**2
+I_D = I_P / I_RATIO
+F_TRANS, F_ROCK, F_AXIAL, ZETA = 140.0, 95.0, 310.0, 0.02
+K = M * (2 * np.pi * F_TRANS) ** 2                # both bearings together, N/m
+D_K = np.sqrt(I_D * (2 * np.pi * F_ROCK) ** 2 / K)  # bearing half span: K·D_K² = rocking stiffness
+C = 2 * ZETA * np.sqrt(K * M)
+K_Z = M * (2 * np.pi * F_AXIAL) ** 2
+C_Z = 2 * ZETA * np.sqrt(K_Z * M)
+U_S, U_D, U_PHASE = 0.5e-5, 2.0e-6, 1.1            # kg·m, kg·m², rad
+# (direction, h, C in SI per (rad/s)², +1 with the spin / -1 against)
+HARMONICS = [("radial_force", 0.4, 0.5e-6, -1), ("radial_force", 3.08, 1.2e-6, +1),
+             ("radial_torque", 3.08, 0.6e-7, +1), ("radial_force", 4.92, 0.9e-6, +1),
+             ("radial_torque", 4.92, 0.4e-7, +1), ("radial_force", 6.16, 0.3e-6, +1),
+             ("axial_force", 1.0, 1.0e-6, +1), ("axial_force", 3.08, 0.5e-6, +1)]
+SPEEDS_RPM = np.linspace(600.0, 6000.0, 40)
+CAMPBELL_RPM = [1.0, 3000.0, 6000.0]
+NDOF = 6                                          # ROSS 2.x: x, y, z, alpha, beta, theta per shaft node
+ZETA_FIXTURE = 0.03
+
+
+def build_rotor(fixture_hz=None, fixture_mass=40.0):
+    mat = rs.Material(name="rigid_massless", rho=1e-6, E=2e12, G_s=8e11)
+    shaft = [rs.ShaftElement(L=D_K, idl=0.0, odl=0.1, material=mat, shear_effects=False,
+                             rotary_inertia=False, gyroscopic=False) for _ in range(2)]
+    disk = rs.DiskElement(n=1, m=M, Id=I_D, Ip=I_P)
+    if fixture_hz is None:
+        bearings = [rs.BearingElement(n=0, kxx=K / 2, cxx=C / 2, kzz=K_Z, czz=C_Z),
+                    rs.BearingElement(n=2, kxx=K / 2, cxx=C / 2)]
+        return rs.Rotor(shaft, [disk], bearings), None
+    k_f = fixture_mass * (2 * np.pi * fixture_hz) ** 2
+    c_f = 2 * ZETA_FIXTURE * np.sqrt(k_f * fixture_mass)
+    bearings = [rs.BearingElement(n=0, kxx=K / 2, cxx=C / 2, kzz=K_Z, czz=C_Z, n_link=3),
+                rs.BearingElement(n=2, kxx=K / 2, cxx=C / 2, n_link=4),
+                rs.BearingElement(n=3, kxx=k_f, cxx=c_f, kzz=k_f, czz=c_f),
+                rs.BearingElement(n=4, kxx=k_f, cxx=c_f, kzz=k_f, czz=c_f)]
+    masses = [rs.PointMass(n=3, m=fixture_mass), rs.PointMass(n=4, m=fixture_mass)]
+    return rs.Rotor(shaft, [disk], bearings, point_mass_elements=masses), (k_f, c_f)
+
+
+def load_cell(rotor, q, nu, fixture):
+    """(Fx, Fy, Fz, Tx, Ty, Tz) phasors of the reactions on the ground for the response phasors q."""
+    z = np.asarray(rotor.nodes_pos, float)
+    zc = z[1]
+    out = np.zeros(6, complex)
+    for shaft_node, support in ((0, 3), (2, 4)):
+        if fixture is None:       # the bearing itself stands on the load cell
+            kx, ky = K / 2 + 1j * nu * C / 2, K / 2 + 1j * nu * C / 2
+            kz = (K_Z + 1j * nu * C_Z) if shaft_node == 0 else 0.0
+            ix, iy, iz = (shaft_node * NDOF + k for k in range(3))
+        else:                     # the stand's spring stands on it
+            kx = ky = kz = fixture[0] + 1j * nu * fixture[1]
+            idx = rotor.point_mass_elements[support - 3].dof_global_index
+            ix, iy, iz = idx[f"x_{support}"], idx[f"y_{support}"], idx[f"z_{support}"]
+        fx, fy = kx * q[ix], ky * q[iy]
+        out[0] += fx
+        out[1] += fy
+        out[2] += kz * q[iz]
+        out[3] += -(z[shaft_node] - zc) * fy
+        out[4] += (z[shaft_node] - zc) * fx
+    return out
+
+
+def rotating(dof_x, dof_y, amp, sense, ndof):
+    """Force vector of a load amp·(cos, sin)(±νt) on DOFs (dof_x, dof_y): phasors (1, ∓i)·amp."""
+    f = np.zeros(ndof, complex)
+    f[dof_x] += amp
+    f[dof_y] += -1j * sense * amp
+    return f
+
+
+def lateral_modes(rotor, rpm):
+    modal = rotor.run_modal(speed=rpm * 2 * np.pi / 60, num_modes=24)
+    wn = np.asarray(modal.wn, float) / (2 * np.pi)
+    whirl = list(modal.whirl_direction())
+    return sorted((float(f), w) for f, w in zip(wn, whirl) if f < 2e3)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", type=Path)
+    ap.add_argument("--fixture", type=float, default=None, help="test-stand resonance, Hz (default: none)")
+    ap.add_argument("--fixture-mass", type=float, default=40.0, help="each stand mass, kg")
+    args = ap.parse_args(argv)
+    rotor, fixture = build_rotor(args.fixture, args.fixture_mass)
+    rigid, _ = build_rotor(None)
+    ndof = rotor.ndof
+    lines = [{"direction": "radial_force", "h": 1.0, "sense": "co", "imbalance": True},
+             {"direction": "radial_torque", "h": 1.0, "sense": "co", "imbalance": True}]
+    lines += [{"direction": d, "h": h, "sense": "co" if s > 0 else "counter", "imbalance": False, "C": c}
+              for d, h, c, s in HARMONICS]
+    phasors = np.zeros((len(lines), SPEEDS_RPM.size, 6), complex)
+    for k, rpm in enumerate(SPEEDS_RPM):
+        om = rpm * 2 * np.pi / 60
+        H = rotor.transfer_matrix(speed=om, frequency=om)
+        f_s = rotating(1 * NDOF, 1 * NDOF + 1, U_S * om**2, +1, ndof)
+        couple = U_D / (2 * D_K) * om**2 * np.exp(1j * U_PHASE)
+        f_d = rotating(2 * NDOF, 2 * NDOF + 1, couple, +1, ndof) - rotating(0, 1, couple, +1, ndof)
+        phasors[0, k] = load_cell(rotor, H @ f_s, om, fixture)
+        phasors[1, k] = load_cell(rotor, H @ f_d, om, fixture)
+        for j, (d, h, c, s) in enumerate(HARMONICS, start=2):
+            nu = h * om
+            amp = c * om**2
+            H = rotor.transfer_matrix(speed=om, frequency=nu)
+            if d == "radial_force":
+                f = rotating(NDOF, NDOF + 1, amp, s, ndof)
+            elif d == "radial_torque":
+                f = rotating(NDOF + 3, NDOF + 4, amp, s, ndof)
+            else:
+                f = np.zeros(ndof, complex)
+                f[NDOF + 2] = amp
+            phasors[j, k] = load_cell(rotor, H @ f, nu, fixture)
+    campbell, rigid_campbell = [], []
+    for rpm in CAMPBELL_RPM:
+        for rot, rows in ((rotor, campbell), (rigid, rigid_campbell)):
+            lat = lateral_modes(rot, rpm)
+            rows.append({"speed_rpm": rpm, "modes_hz": [f for f, _ in lat], "whirl": [w for _, w in lat]})
+        print(f"{rpm:6.0f} rpm: " + ", ".join(f"{f:.2f} {w[0]}" for f, w in lateral_modes(rotor, rpm)))
+    doc = {"source": f"ROSS {rs.__version__}, benchmarks/ross_new_wheel.py",
+           "channels": ["Fx", "Fy", "Fz", "Tx", "Ty", "Tz"],
+           "speeds_rpm": SPEEDS_RPM.tolist(),
+           "lines": [dict(ln, phasors_re=phasors[j].real.tolist(), phasors_im=phasors[j].imag.tolist())
+                     for j, ln in enumerate(lines)],
+           "campbell": campbell, "campbell_hard_mounted": rigid_campbell,
+           "truth": {"translation_hz": F_TRANS, "rocking_hz": F_ROCK, "axial_hz": F_AXIAL, "zeta": ZETA,
+                     "I_zz_over_I_rr": I_RATIO, "U_s_kg_m": U_S, "U_d_kg_m2": U_D, "fixture_hz": args.fixture, "fixture_mass_kg": args.fixture_mass,
+                     "fixture_zeta": ZETA_FIXTURE if args.fixture else None},
+           "rotor": {"mass_kg": M, "radius_m": R, "I_p": I_P, "I_d": I_D, "k_N_m": K, "c_N_s_m": C,
+                     "bearing_half_span_m": D_K, "k_z_N_m": K_Z, "c_z_N_s_m": C_Z}}
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(doc, indent=None, separators=(",", ":")))
+    print("wrote", args.out, f"{args.out.stat().st_size / 1e3:.0f} kB")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,64 @@
+"""A wheel the project was never tuned on, computed by a third party, diagnosed by the command a user types (issue 33).
+
+ROSS (benchmarks/ross_new_wheel.py, stored in tests/data/ross_new_wheel.json) computes the steady-state load-cell
+response of the issue's "new wheel": 4.2 kg, I_zz/I_rr 1.56, hard-mounted modes near 140 / 95 / 310 Hz, bearing-like
+lines at h 0.4 (counter-rotating), 3.08, 4.92, 6.16, 600-6000 rpm; written as 5 kHz records by tests/ross_dataset.py.
+The truth is ROSS's: its own modal analysis at rest (run_modal) and the forcing it was given, not rwadist's equations.
+"""
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import ross_dataset as rd  # noqa: E402
+
+from rwadist import data as data_io  # noqa: E402
+from rwadist.cli import main  # noqa: E402
+
+DOC = Path(__file__).resolve().parent / "data" / "ross_new_wheel.json"
+
+
+@pytest.mark.slow
+def test_new_wheel_from_ross_default_command_gives_its_modes_lines_and_nothing_else(tmp_path, capsys):
+    doc = rd.load_doc(DOC)
+    data, out = tmp_path / "data", tmp_path / "report"
+    data_io.write_steady(rd.ross_test(sample_rate=5000.0, n_samples=8192, path=DOC), data)
+    assert main(["diagnose", str(data), "-o", str(out)]) == 0
+    capsys.readouterr()
+    model = json.loads((out / "model.json").read_text())
+    summary = json.loads((out / "summary.json").read_text())
+    assert [e["kind"] for e in model["effects"]] == ["suspension_modes"]
+    assert summary["unexplained"] == []
+
+    # ROSS's modes at rest: rocking (two whirls at ~95 Hz), translation (140 Hz), axial (310 Hz)
+    rest = np.array(next(c for c in doc["campbell"] if c["speed_rpm"] < 10)["modes_hz"])
+    rocking, translation, axial = rest[0], rest[2], rest[4]
+    an = model["analytical"]
+    ratio = an["I_zz_kg_m2"] / an["I_rr_kg_m2"]
+    got_t = np.sqrt(an["k_r_N_per_m"] / an["mass_kg"]) / (2 * np.pi)
+    got_r = np.sqrt(an["k_rock_Nm_per_rad"] / an["I_rr_kg_m2"]) / (2 * np.pi)
+    got_z = np.sqrt(an["k_z_N_per_m"] / an["mass_kg"]) / (2 * np.pi)
+    assert got_t == pytest.approx(translation, rel=0.005)
+    assert got_r == pytest.approx(rocking, rel=0.005)
+    assert got_z == pytest.approx(axial, rel=0.01)
+    assert ratio == pytest.approx(doc["truth"]["I_zz_over_I_rr"], rel=0.01)
+    # per unit mass (no --mass given): the imbalances are read as kg·m and kg·m²
+    assert an["U_s_kg_m"] == pytest.approx(doc["truth"]["U_s_kg_m"], rel=0.01)
+    assert an["U_d_kg_m2"] == pytest.approx(doc["truth"]["U_d_kg_m2"], rel=0.01)
+
+    # every forced line in the base, once, at its ratio and coefficient
+    for ln in doc["lines"]:
+        if ln["imbalance"]:
+            continue
+        got = [x for x in model["empirical"][ln["direction"]] if abs(x["h"] - ln["h"]) < 0.01]
+        assert len(got) == 1, (ln["direction"], ln["h"], got)
+        assert got[0]["h"] == pytest.approx(ln["h"], rel=0.002)
+        assert got[0]["C"] == pytest.approx(ln["C"], rel=0.05), (ln["direction"], ln["h"])
+    forced = {(ln["direction"], ln["h"]) for ln in doc["lines"]}
+    for d, lines in model["empirical"].items():
+        for x in lines:
+            assert (d, round(x["h"], 2)) in forced, (d, x["h"])      # no line ROSS was not given
