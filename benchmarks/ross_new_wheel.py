@@ -116,14 +116,19 @@ def main(argv=None):
     ap.add_argument("out", type=Path)
     ap.add_argument("--fixture", type=float, default=None, help="test-stand resonance, Hz (default: none)")
     ap.add_argument("--fixture-mass", type=float, default=40.0, help="each stand mass, kg")
+    ap.add_argument("--counter-fundamental", type=float, default=0.0,
+                    help="a counter-rotating force at h 1 on the rotor, a fraction of the static imbalance (default 0)")
     args = ap.parse_args(argv)
     rotor, fixture = build_rotor(args.fixture, args.fixture_mass)
+    harmonics = list(HARMONICS)
+    if args.counter_fundamental:
+        harmonics.append(("radial_force", 1.0, args.counter_fundamental * U_S, -1))
     rigid, _ = build_rotor(None)
     ndof = rotor.ndof
     lines = [{"direction": "radial_force", "h": 1.0, "sense": "co", "imbalance": True},
              {"direction": "radial_torque", "h": 1.0, "sense": "co", "imbalance": True}]
     lines += [{"direction": d, "h": h, "sense": "co" if s > 0 else "counter", "imbalance": False, "C": c}
-              for d, h, c, s in HARMONICS]
+              for d, h, c, s in harmonics]
     phasors = np.zeros((len(lines), SPEEDS_RPM.size, 6), complex)
     for k, rpm in enumerate(SPEEDS_RPM):
         om = rpm * 2 * np.pi / 60
@@ -133,7 +138,7 @@ def main(argv=None):
         f_d = rotating(2 * NDOF, 2 * NDOF + 1, couple, +1, ndof) - rotating(0, 1, couple, +1, ndof)
         phasors[0, k] = load_cell(rotor, H @ f_s, om, fixture)
         phasors[1, k] = load_cell(rotor, H @ f_d, om, fixture)
-        for j, (d, h, c, s) in enumerate(HARMONICS, start=2):
+        for j, (d, h, c, s) in enumerate(harmonics, start=2):
             nu = h * om
             amp = c * om**2
             H = rotor.transfer_matrix(speed=om, frequency=nu)
@@ -159,7 +164,8 @@ def main(argv=None):
            "campbell": campbell, "campbell_hard_mounted": rigid_campbell,
            "truth": {"translation_hz": F_TRANS, "rocking_hz": F_ROCK, "axial_hz": F_AXIAL, "zeta": ZETA,
                      "I_zz_over_I_rr": I_RATIO, "U_s_kg_m": U_S, "U_d_kg_m2": U_D, "fixture_hz": args.fixture, "fixture_mass_kg": args.fixture_mass,
-                     "fixture_zeta": ZETA_FIXTURE if args.fixture else None},
+                     "fixture_zeta": ZETA_FIXTURE if args.fixture else None,
+                     "counter_fundamental": args.counter_fundamental},
            "rotor": {"mass_kg": M, "radius_m": R, "I_p": I_P, "I_d": I_D, "k_N_m": K, "c_N_s_m": C,
                      "bearing_half_span_m": D_K, "k_z_N_m": K_Z, "c_z_N_s_m": C_Z}}
     args.out.parent.mkdir(parents=True, exist_ok=True)

@@ -19,20 +19,30 @@ import ross_dataset as rd  # noqa: E402
 from rwadist import data as data_io  # noqa: E402
 from rwadist.cli import main  # noqa: E402
 
-DOC = Path(__file__).resolve().parent / "data" / "ross_new_wheel.json"
+DATA = Path(__file__).resolve().parent / "data"
 
 
 @pytest.mark.slow
-def test_new_wheel_from_ross_default_command_gives_its_modes_lines_and_nothing_else(tmp_path, capsys):
-    doc = rd.load_doc(DOC)
+@pytest.mark.parametrize("doc_name, classes", [("ross_new_wheel.json", ["suspension_modes"]),
+                                               ("ross_new_wheel_counter30.json", ["suspension_modes", "counter_rotation"])])
+def test_new_wheel_from_ross_default_command_gives_its_modes_lines_and_nothing_else(tmp_path, capsys, doc_name, classes):
+    """Clean, and with a counter-rotating force on the fundamental (0.3 of the static imbalance's: ROSS carries it
+    through the backward whirls): the modes, the lines, the counter-rotating part, nothing else."""
+    path = DATA / doc_name
+    doc = rd.load_doc(path)
     data, out = tmp_path / "data", tmp_path / "report"
-    data_io.write_steady(rd.ross_test(sample_rate=5000.0, n_samples=8192, path=DOC), data)
+    data_io.write_steady(rd.ross_test(sample_rate=5000.0, n_samples=8192, path=path), data)
     assert main(["diagnose", str(data), "-o", str(out)]) == 0
     capsys.readouterr()
     model = json.loads((out / "model.json").read_text())
     summary = json.loads((out / "summary.json").read_text())
-    assert [e["kind"] for e in model["effects"]] == ["suspension_modes"]
+    assert [e["kind"] for e in model["effects"]] == classes
     assert summary["unexplained"] == []
+    q_true = doc["truth"]["counter_fundamental"] ** 2 / (1 + doc["truth"]["counter_fundamental"] ** 2)
+    for e in model["effects"]:
+        if e["kind"] == "counter_rotation":         # q: the counter part's share of the line's power
+            assert (e["direction"], e["h"]) == ("radial_force", pytest.approx(1.0, abs=1e-3))
+            assert e["counter_fraction"] == pytest.approx(q_true, rel=0.03)
 
     # ROSS's modes at rest: rocking (two whirls at ~95 Hz), translation (140 Hz), axial (310 Hz)
     rest = np.array(next(c for c in doc["campbell"] if c["speed_rpm"] < 10)["modes_hz"])
@@ -50,11 +60,13 @@ def test_new_wheel_from_ross_default_command_gives_its_modes_lines_and_nothing_e
     assert an["U_s_kg_m"] == pytest.approx(doc["truth"]["U_s_kg_m"], rel=0.01)
     assert an["U_d_kg_m2"] == pytest.approx(doc["truth"]["U_d_kg_m2"], rel=0.01)
 
-    # every forced line in the base, once, at its ratio and coefficient
+    # every forced line in the base, once (a radial one with its rotation sense), at its ratio and coefficient
     for ln in doc["lines"]:
         if ln["imbalance"]:
             continue
-        got = [x for x in model["empirical"][ln["direction"]] if abs(x["h"] - ln["h"]) < 0.01]
+        radial = ln["direction"] != "axial_force"
+        got = [x for x in model["empirical"][ln["direction"]]
+               if abs(x["h"] - ln["h"]) < 0.01 and (not radial or x["sense"] == ln["sense"])]
         assert len(got) == 1, (ln["direction"], ln["h"], got)
         assert got[0]["h"] == pytest.approx(ln["h"], rel=0.002)
         assert got[0]["C"] == pytest.approx(ln["C"], rel=0.05), (ln["direction"], ln["h"])
