@@ -40,23 +40,22 @@ def _measure(ctx, state, direction, h, runs, skip=None):
 
 def measure_run_powers(ctx, state, direction, h, runs, skip=None):
     """Amplitude of the line (direction, h) per part, one per run, the powers of the direction's channels pooled:
-    (amplitude, omega, ratio), amplitude N or N·m that each of the line's parts (its co- and counter-rotating
+    (amplitude, omega, leak), amplitude N or N·m that each of the line's parts (its co- and counter-rotating
     harmonics in the state's model, one co-rotating part when it has none) would carry before any resonance and the
     wheel's modes -- the amplitude an amplitude law gives each of them (:class:`rwadist.effects.actions.LineLaw`) --,
-    omega rad/s, ratio the line's power over the model floor's in its windows (both summed over the channels).
+    omega rad/s, leak the power the state predicts in the line's windows for its other lines over the line's own
+    measured power (both summed over the channels): what the measurement rests on the neighbours' prediction.
 
     A radial line with co- and counter-rotating parts of free phases is |c₊ + c₋| in x and |c₊ − c₋| in y: one
     channel alone swings between 0 and twice the line's mean power from run to run, but the two channels' powers add
     to 2(|c₊|² + |c₋|²) whatever the phases (family wheel 4: its h 4.62 bearing line, half counter-rotating, read
     per channel at 0.03-1.4x its true amplitude, and its Ω³ law was missed).  So each run's amplitude is
     sqrt(Σ_c a_c² / Σ_c Σ_parts g_c,part²), g the resonance and modal gain of a unit load of the part's sense; a
-    channel whose line is below its noise (NaN) beside one that is measured counts as 0.  The ratio is the
-    inverse-variance weight of log amplitude: a measured power p = |L|²/2 + n has, to first order, the variance of
-    its line-noise cross term ∝ p·n, so var(log a) ∝ n/p."""
+    channel whose line is below its noise (NaN) beside one that is measured counts as 0."""
     senses = [getattr(x, "sense", None) or "co" for x in state.model.harmonics(direction) if abs(x.h - h) < 1e-3]
     p_sum = np.zeros(runs.size)
     g_sum = np.zeros(runs.size)
-    n_sum = np.zeros(runs.size)
+    q_sum = np.zeros(runs.size)
     seen = np.zeros(runs.size, bool)
     for c in DIRECTION_CHANNELS[direction]:
         if c not in ctx.channels:
@@ -68,19 +67,23 @@ def measure_run_powers(ctx, state, direction, h, runs, skip=None):
         seen |= ok
         p_sum += np.where(ok, a, 0.0) ** 2
         g_sum += g**2 * np.sum(np.square(modal), axis=0)
-        n_sum += window_noise(ctx, state, c, h, runs)
+        q_sum += _neighbour_power(ctx, state, c, h, runs)
     with np.errstate(divide="ignore", invalid="ignore"):
         amp = np.sqrt(p_sum / g_sum)
+        leak = q_sum / (0.5 * p_sum)
     keep = seen & np.isfinite(amp) & (amp > 0)
-    return amp[keep], ctx.omega[runs][keep], (0.5 * p_sum / np.maximum(n_sum, 1e-300))[keep]
+    return amp[keep], ctx.omega[runs][keep], leak[keep]
 
 
-def window_noise(ctx, state, c, h, runs):
-    """Power (unit²) of the model floor of channel ``c`` in the ±LINE_HALF-bin window of the line h of each run (the
-    window :meth:`Context.measure_line` measures)."""
+def _neighbour_power(ctx, state, c, h, runs):
+    """Power (unit²) the state predicts for its lines other than h (not its floor) in channel ``c``'s ±LINE_HALF-bin
+    window of the line h of each run (the window :meth:`Context.measure_line` measures it in)."""
     k0 = np.rint(h * ctx.omega[runs] / (2 * np.pi) / ctx.df).astype(int)
     k = np.clip(k0[:, None] + np.arange(-LINE_HALF, LINE_HALF + 1), 0, ctx.f.size - 1)
-    return ctx.floor_psd(state, c, runs)[np.arange(runs.size)[:, None], k].sum(1) * ctx.df
+    rows = np.arange(runs.size)[:, None]
+    others = (ctx.predict(state, c, runs)[rows, k] - ctx._predict(state, c, runs, None, h, bins=k)
+              - ctx.floor_psd(state, c, runs)[rows, k])
+    return np.maximum(others, 0.0).sum(1) * ctx.df
 
 
 def _ridge_score(ctx, state, chans, runs, h_grid):

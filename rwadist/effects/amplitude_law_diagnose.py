@@ -66,16 +66,18 @@ class AmplitudeLaw:
 
     @staticmethod
     def fit(ctx: Context, state: State, direction: str, h: float, runs) -> "AmplitudeLaw | None":
-        d, w, snr = measure_run_powers(ctx, state, direction, h, runs, skip=h)
+        d, w, leak = measure_run_powers(ctx, state, direction, h, runs, skip=h)
         if d.size < 5 or np.ptp(np.log(w)) < 0.3:
             return None
         w_ref = ctx.omega_ref()
         X = np.column_stack([np.ones(w.size), np.log(w / w_ref)])
-        # weighted by each run's inverse variance (var(log a) ∝ floor/line power, :func:`measure_run_powers`): a line
-        # that grows as Ω³ is 60 dB weaker at a tenth of the top speed, where its window also holds the leakage of
-        # its neighbours' misfit (family wheel 1: h 3.33 beside the 3x line, 25-70 % high below 2200 rpm); equal
-        # weights gave those runs the say, p 2.85 for 3.0 and the error after 47x the clean level
-        sw = np.sqrt(snr / snr.max())
+        # every run's log amplitude as accurate as the base's model of a line (one relative error for all), less so
+        # where its window rests on the prediction of neighbouring lines: var ∝ 1 + leak², leak their predicted power
+        # over the line's (family wheel 1: h 3.33 a bin from the 3x line at 1000-2200 rpm, read 25-70 % high there;
+        # weighed alike, those runs gave p 2.85 for 3.0 and the error after 47x the clean level).  Not weighted by the
+        # line's power over the noise: the top speeds then set the law alone, and a line rising into a resonance the
+        # search had not named yet (a fixture 20 Hz above the top speed's line) passed for an Ω^3.5 law
+        sw = 1.0 / np.sqrt(1.0 + leak**2)
         coef, *_ = np.linalg.lstsq(X * sw[:, None], np.log(d) * sw, rcond=None)
         r = (np.log(d) - X @ coef) * sw
         s2 = float(r @ r) / max(d.size - 2, 1)
