@@ -40,11 +40,12 @@ def _measure(ctx, state, direction, h, runs, skip=None):
 
 def measure_run_powers(ctx, state, direction, h, runs, skip=None):
     """Amplitude of the line (direction, h) per part, one per run, the powers of the direction's channels pooled:
-    (amplitude, omega, leak), amplitude N or N·m that each of the line's parts (its co- and counter-rotating
+    (amplitude, omega, leak, snr), amplitude N or N·m that each of the line's parts (its co- and counter-rotating
     harmonics in the state's model, one co-rotating part when it has none) would carry before any resonance and the
     wheel's modes -- the amplitude an amplitude law gives each of them (:class:`rwadist.effects.actions.LineLaw`) --,
     omega rad/s, leak the power the state predicts in the line's windows for its other lines over the line's own
-    measured power (both summed over the channels): what the measurement rests on the neighbours' prediction.
+    measured power (both summed over the channels): what the measurement rests on the neighbours' prediction, snr
+    the line's measured power over the model floor's in its windows (summed over the channels).
 
     A radial line with co- and counter-rotating parts of free phases is |c₊ + c₋| in x and |c₊ − c₋| in y: one
     channel alone swings between 0 and twice the line's mean power from run to run, but the two channels' powers add
@@ -56,6 +57,7 @@ def measure_run_powers(ctx, state, direction, h, runs, skip=None):
     p_sum = np.zeros(runs.size)
     g_sum = np.zeros(runs.size)
     q_sum = np.zeros(runs.size)
+    n_sum = np.zeros(runs.size)
     seen = np.zeros(runs.size, bool)
     for c in DIRECTION_CHANNELS[direction]:
         if c not in ctx.channels:
@@ -68,18 +70,30 @@ def measure_run_powers(ctx, state, direction, h, runs, skip=None):
         p_sum += np.where(ok, a, 0.0) ** 2
         g_sum += g**2 * np.sum(np.square(modal), axis=0)
         q_sum += _neighbour_power(ctx, state, c, h, runs)
+        n_sum += _window_floor(ctx, state, c, h, runs)
     with np.errstate(divide="ignore", invalid="ignore"):
         amp = np.sqrt(p_sum / g_sum)
         leak = q_sum / (0.5 * p_sum)
+        snr = 0.5 * p_sum / n_sum
     keep = seen & np.isfinite(amp) & (amp > 0)
-    return amp[keep], ctx.omega[runs][keep], leak[keep]
+    return amp[keep], ctx.omega[runs][keep], leak[keep], snr[keep]
+
+
+def _window_k(ctx, h, runs):
+    """Bins (len(runs), 2·LINE_HALF + 1) of the line h's window in each run (:meth:`Context.measure_line`'s)."""
+    k0 = np.rint(h * ctx.omega[runs] / (2 * np.pi) / ctx.df).astype(int)
+    return np.clip(k0[:, None] + np.arange(-LINE_HALF, LINE_HALF + 1), 0, ctx.f.size - 1)
+
+
+def _window_floor(ctx, state, c, h, runs):
+    """Power (unit²) of the model floor of channel ``c`` in the line h's window of each run."""
+    return ctx.floor_psd(state, c, runs)[np.arange(runs.size)[:, None], _window_k(ctx, h, runs)].sum(1) * ctx.df
 
 
 def _neighbour_power(ctx, state, c, h, runs):
     """Power (unit²) the state predicts for its lines other than h (not its floor) in channel ``c``'s ±LINE_HALF-bin
     window of the line h of each run (the window :meth:`Context.measure_line` measures it in)."""
-    k0 = np.rint(h * ctx.omega[runs] / (2 * np.pi) / ctx.df).astype(int)
-    k = np.clip(k0[:, None] + np.arange(-LINE_HALF, LINE_HALF + 1), 0, ctx.f.size - 1)
+    k = _window_k(ctx, h, runs)
     rows = np.arange(runs.size)[:, None]
     others = (ctx.predict(state, c, runs)[rows, k] - ctx._predict(state, c, runs, None, h, bins=k)
               - ctx.floor_psd(state, c, runs)[rows, k])

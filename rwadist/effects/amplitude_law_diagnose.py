@@ -20,6 +20,31 @@ EXPONENT_Z = 4.0
 MIN_EXPONENT_SHIFT = 0.05
 
 
+def _law_lsq(X, y, leak, var_noise, rounds: int = 4):
+    """(coefficients, covariance) of y ≈ X·c, y a run's log line amplitude, each of variance σ²·(1 + leak²) + its
+    noise's ``var_noise``: what the base's model of a line misses (one relative error σ for every run, estimated from
+    the residual beyond the noise by moments, ``rounds`` times), more where the run's window rests on the prediction
+    of neighbouring lines (``leak``: their predicted power over the line's), plus the line-noise cross term of the
+    measured power, var(log a) = n/(p·ν) (floor n, line p, ν the spectra's degrees of freedom).
+
+    Neither part alone: the noise's weights alone let the top speeds set the law (a line rising into a resonance the
+    search had not named yet, a fixture 20 Hz above the top speed's line, passed for an Ω^3.5 law); a run's own noise
+    ignored, the runs where an Ω³ line is 50-60 dB under its top level had the same say as the strong ones (p 2.91 for
+    3.0 beside a 3x line); the neighbours ignored, family wheel 1's h 3.33, a bin from its 3x line at 1000-2200 rpm
+    and read 25-70 % high there, gave p 2.85 and the error after 47x the clean level."""
+    sys2 = None
+    for _ in range(rounds):
+        var = (1.0 if sys2 is None else sys2) * (1.0 + leak**2) + (0.0 if sys2 is None else var_noise)
+        sw = 1.0 / np.sqrt(var)
+        Xw = X * sw[:, None]
+        coef, *_ = np.linalg.lstsq(Xw, y * sw, rcond=None)
+        r = y - X @ coef
+        sys2 = max(float(np.mean((r**2 - var_noise) / (1.0 + leak**2))), 1e-12)
+    rw = r * sw
+    s2 = float(rw @ rw) / max(y.size - X.shape[1], 1)
+    return coef, s2 * np.linalg.inv(Xw.T @ Xw)
+
+
 @register(order=20)
 @dataclass
 class AmplitudeLaw:
@@ -66,22 +91,12 @@ class AmplitudeLaw:
 
     @staticmethod
     def fit(ctx: Context, state: State, direction: str, h: float, runs) -> "AmplitudeLaw | None":
-        d, w, leak = measure_run_powers(ctx, state, direction, h, runs, skip=h)
+        d, w, leak, snr = measure_run_powers(ctx, state, direction, h, runs, skip=h)
         if d.size < 5 or np.ptp(np.log(w)) < 0.3:
             return None
         w_ref = ctx.omega_ref()
         X = np.column_stack([np.ones(w.size), np.log(w / w_ref)])
-        # every run's log amplitude as accurate as the base's model of a line (one relative error for all), less so
-        # where its window rests on the prediction of neighbouring lines: var ∝ 1 + leak², leak their predicted power
-        # over the line's (family wheel 1: h 3.33 a bin from the 3x line at 1000-2200 rpm, read 25-70 % high there;
-        # weighed alike, those runs gave p 2.85 for 3.0 and the error after 47x the clean level).  Not weighted by the
-        # line's power over the noise: the top speeds then set the law alone, and a line rising into a resonance the
-        # search had not named yet (a fixture 20 Hz above the top speed's line) passed for an Ω^3.5 law
-        sw = 1.0 / np.sqrt(1.0 + leak**2)
-        coef, *_ = np.linalg.lstsq(X * sw[:, None], np.log(d) * sw, rcond=None)
-        r = (np.log(d) - X @ coef) * sw
-        s2 = float(r @ r) / max(d.size - 2, 1)
-        cov = s2 * np.linalg.inv((X * sw[:, None]).T @ (X * sw[:, None]))
+        coef, cov = _law_lsq(X, np.log(d), leak, 1.0 / (snr * ctx.dof))
         if coef[1] < 0:
             # a law of exponent < 0 grows without bound as the speed falls to 0 (a psd over a law through zero speed,
             # an FMU spinning up): the model file takes exponents >= 0 only (rwadist.schema), on either base
