@@ -23,7 +23,8 @@ MIN_EXPONENT_SHIFT = 0.05
 def _law_lsq(X, y, leak, var_noise, rounds: int = 4):
     """(coefficients, covariance) of y ≈ X·c, y a run's log line amplitude, each of variance σ²·(1 + leak²) + its
     noise's ``var_noise``: what the base's model of a line misses (one relative error σ for every run, estimated from
-    the residual beyond the noise by moments, ``rounds`` times), more where the run's window rests on the prediction
+    the median residual beyond the noise, ``rounds`` times: a run far off, the weakest
+    beside a stronger neighbour, does not set it), more where the run's window rests on the prediction
     of neighbouring lines (``leak``: their predicted power over the line's), plus the line-noise cross term of the
     measured power, var(log a) = n/(p·ν) (floor n, line p, ν the spectra's degrees of freedom).
 
@@ -39,7 +40,7 @@ def _law_lsq(X, y, leak, var_noise, rounds: int = 4):
         Xw = X * sw[:, None]
         coef, *_ = np.linalg.lstsq(Xw, y * sw, rcond=None)
         r = y - X @ coef
-        sys2 = max(float(np.mean((r**2 - var_noise) / (1.0 + leak**2))), 1e-12)
+        sys2 = max(float(np.median((r**2 - var_noise) / (1.0 + leak**2))), 1e-12)
     rw = r * sw
     s2 = float(rw @ rw) / max(y.size - X.shape[1], 1)
     return coef, s2 * np.linalg.inv(Xw.T @ Xw)
