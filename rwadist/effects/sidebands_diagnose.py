@@ -24,6 +24,11 @@ from ..units import DIRECTION_CHANNELS
 RECORD_SCAN_RUNS = 12
 #: Scan step of the whole-run route, record bins (fs/n).
 RECORD_STEP_BINS = 0.25
+#: Half-width of :meth:`Sidebands.fit_record`'s refinement grid, scan steps: the scan's score is a median over the
+#: runs whose two sides are clear of other lines, a set that changes along the offsets (a side reaching a line), so
+#: its maximum can sit a step from the pair's (family wheel 4, f_mod 5.625 Hz at 0.9375-Hz record bins: scanned at
+#: 5.859 as one of seven runs left, the pair's Σ|X|² at 5.625, on the edge of a one-step grid: no sidebands)
+REFINE_STEPS = 2
 #: A carrier's whole-run scan score (median |X|²/noise over runs, channels and both sides) a pair must clear:
 #: that of :meth:`rwadist.effects.speed_sidebands_diagnose.SpeedSidebands.candidates` (the lines 20 × over the
 #: noise on half the points).
@@ -174,14 +179,15 @@ class Sidebands:
     @staticmethod
     def fit_record(ctx: Context, state: State, direction: str, h: float, runs, f_mod: float) -> "Sidebands | None":
         """The fit on the whole-run DFT (time series given) of sidebands closer to their carrier than the Welch bins
-        resolve: f_mod the maximum of Σ|X|² over both sides and every valid run on a grid ±RECORD_STEP_BINS record
-        bins around ``f_mod`` (step 1/50 bin); the sides' amplitudes sqrt(|X|² − noise) of the points 10 × over
+        resolve: f_mod the maximum of Σ|X|² over both sides and every valid run on a grid ±REFINE_STEPS scan steps
+        (RECORD_STEP_BINS record bins each) around ``f_mod`` (step 1/50 bin); the sides' amplitudes sqrt(|X|² − noise) of the points 10 × over
         the noise, on their prediction per unit depth q = a·g/2 (a the carrier's model amplitude in the channel, g
         the fixed resonances' gain at the side): m by least squares, Σ A·q / Σ q²."""
         from .speed_sidebands_diagnose import _record_df
 
         df_rec = float(np.max(_record_df(ctx, runs)))
-        grid = f_mod + np.arange(-RECORD_STEP_BINS, RECORD_STEP_BINS + 1e-9, 0.02) * df_rec
+        half = REFINE_STEPS * RECORD_STEP_BINS
+        grid = f_mod + np.arange(-half, half + 1e-9, 0.02) * df_rec
         f, P, _, ok = Sidebands._record_power(ctx, state, direction, h, runs, grid)
         both = ok[:, :grid.size] & ok[:, grid.size:]
         tot = np.sum(np.where(both[:, :, None], P[:, :grid.size] + P[:, grid.size:], 0.0), axis=(0, 2))
