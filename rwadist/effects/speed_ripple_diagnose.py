@@ -84,14 +84,25 @@ class SpeedRipple:
         if any(getattr(e, "kind", "") == "suspension_modes" for e in state.effects):
             from dataclasses import replace
 
-            s.model.empirical = {d: [replace(x, C=x.C / self.carrier_factor(x.h)) for x in v]
+            from .. import extended as ext
+
+            s.model.empirical = {d: [replace(x, C=x.C / self.carrier_factor(
+                x.h, ext.is_imbalance(d, x.h, getattr(x, "sense", None)))) for x in v]
                                  for d, v in s.model.empirical.items()}
+            if s.ext is not None:
+                # the extended base's imbalance lines are U_s and U_d (extended.lines_from_model), not the empirical
+                # fundamentals: measured under the ripple too (family wheel 7, 5-Hz ripple, β 0.13: without this the
+                # 1x carrier was predicted J_0(β)² = 0.991 of its power short, and 1x sidebands at the ripple's own
+                # frequency were named to make it up)
+                imb = self.carrier_factor(1.0, True)
+                s.ext = replace(s.ext, U_s=s.ext.U_s / imb, U_d=s.ext.U_d / imb)
+                s.model.analytical = dict(s.model.analytical or {}, **ext.params_to_dict(s.ext))
         return s
 
-    def carrier_factor(self, h: float) -> float:
-        """|c_0| of a line h (C·Ω²) under this ripple at Ω_ref (:func:`sideband_fractions`): the carrier's share of the
-        line's amplitude."""
-        _, _, c0 = sideband_fractions(h, self.delta_omega, self.omega_ref, self.f_ripple, 2.0, False)
+    def carrier_factor(self, h: float, imbalance: bool = False) -> float:
+        """|c_0| of a line h (C·Ω²; ``imbalance``: with its tangential term) under this ripple at Ω_ref
+        (:func:`sideband_fractions`): the carrier's share of the line's amplitude."""
+        _, _, c0 = sideband_fractions(h, self.delta_omega, self.omega_ref, self.f_ripple, 2.0, imbalance)
         return float(np.sqrt(max(float(c0), 1e-12)))
 
     def contribute(self, parts) -> None:
