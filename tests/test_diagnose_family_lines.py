@@ -6,11 +6,14 @@ An amplitude law (Ω³ instead of Ω², equal at the mid speed) on a bearing lin
 runs below a third of the top speed, where the law's line is 40-60 dB under its top-speed level and its window holds
 its neighbour's leakage, had the say in an unweighted log fit (family wheel 1: p 2.85 for 3.0, error after 47x the
 clean level).  A law on a line half co-, half counter-rotating: one channel's line swings with the two parts'
-phases from run to run (family wheel 4, missed, 145x)."""
+phases from run to run (family wheel 4, missed, 145x).  Sidebands and a speed ripple closer to their carriers than
+the Welch grid (the whole-record route): the pair's offset refined from a scan step off it, and the imbalances' size
+under a ripple."""
 import sys
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -86,3 +89,55 @@ def test_amplitude_law_on_a_bearing_line_named_with_its_exponent(case, tmp_path)
     assert e["direction"] == "radial_force" and e["h"] == pytest.approx(law.params["h"], abs=0.01)
     # the injected law's exponent (the generator's truth), not a fit's own noise: within 0.05 of 3
     assert e["exponent"] == pytest.approx(law.params["exponent"], abs=0.05)
+
+
+def _empirical_context(wheel, effects, noise, seed, tmp_path):
+    """(Context with the time series, the state of the data-fitted empirical base) of the wheel's data."""
+    from rwadist.data import read_steady
+    from rwadist.diagnose.engine import Context, initial_state
+    from rwadist.empirical import fit_empirical
+    from rwadist.spectra import compute_spectra
+
+    test = read_steady(fw.write_steady(fw.steady(wheel, noise=noise, seed=seed, effects=effects), tmp_path / "data",
+                                       wheel.name))
+    ctx = Context(compute_spectra(test, nperseg=api.diagnose_nperseg(test)), None, test)
+    return ctx, initial_state(ctx, fit_empirical(ctx.sp).model)
+
+
+@pytest.mark.parametrize("side", (-1.0, 1.0))
+def test_sidebands_closer_than_the_welch_grid_refined_from_a_scan_step_off(side, tmp_path):
+    """A fixed-offset pair 6 record bins off the imbalance (below 2.5 Welch bins: the whole-record route), its fit
+    started one scan step (RECORD_STEP_BINS) off the pair, as the scan's median over a changing set of runs left it on
+    family wheel 4 (5.859 Hz for 5.625): the pair's offset and depth (the generator's), not the edge of a one-step
+    grid (which gave no fit there, and sidebands at 6.07 Hz beside an invented line a search step later)."""
+    from rwadist.effects.sidebands_diagnose import RECORD_STEP_BINS, Sidebands
+
+    # 6 kg, I_zz/I_rr 1.7, modes far above the band (the lines as loaded), 300-3000 rpm at 3 kHz, 4096 samples
+    wheel = _wheel(43, (6.0, 1.7, 0.14, (40000.0, 30000.0, 35000.0), 3000.0, 3000.0, 10, 0.2, 0.0, True), 12, 4096)
+    df_rec = wheel.sample_rate / wheel.n_samples
+    f_mod = 6 * df_rec
+    ctx, state = _empirical_context(wheel, [fe.Sidebands(h=1.0, f_mod_hz=f_mod, depth=0.4)], 0.003, 3, tmp_path)
+    assert f_mod < 2.5 * ctx.df                                   # the whole-record route
+    e = Sidebands.fit_record(ctx, state, "radial_force", 1.0, ctx.runs, f_mod + side * RECORD_STEP_BINS * df_rec)
+    assert e is not None
+    assert e.f_mod == pytest.approx(f_mod, abs=0.05 * df_rec)
+    # (the depth on the carrier's amplitude as the empirical base fitted it: 0.378 for 0.4 here)
+    assert e.depth == pytest.approx(0.4, rel=0.1)
+
+
+@pytest.mark.slow
+def test_speed_ripple_leaves_the_imbalances_at_their_free_size(tmp_path):
+    """A 5.9-Hz speed ripple (β = ΔΩ/2πf_r = 0.2 on the 1x) on the default path: the wheel's modes and the ripple
+    named, nothing else, and the imbalances U_s, U_d of the extended base at the generator's (the ripple's carrier
+    |c_0| taken off them as off every other line: they were J_0(0.2) = 0.990 of it, and on family wheel 7 the 1x
+    carrier's missing power was named as 1x sidebands at the ripple's own frequency)."""
+    # 5 kg, I_zz/I_rr 1.5, modes 260/80/150 Hz, 600-6000 rpm at 4 kHz, 4096 samples, 12 speeds
+    wheel = _wheel(44, (5.0, 1.5, 0.12, (260.0, 80.0, 150.0), 6000.0, 4000.0, 9, 0.22, 0.0, True), 12, 4096)
+    f_r = 6 * wheel.sample_rate / wheel.n_samples
+    ripple = fe.SpeedRipple(f_ripple_hz=f_r, delta_omega=0.2 * 2 * np.pi * f_r)
+    data = fw.steady(wheel, noise=0.005, seed=5, effects=[ripple])
+    d = api.diagnose(fw.write_steady(data, tmp_path / "data", wheel.name))
+    assert sorted(e.kind for e in d.state_after.effects) == ["speed_ripple", "suspension_modes"]
+    for direction, name in (("radial_force", "U_s"), ("radial_torque", "U_d")):
+        truth = next(ln.C for ln in wheel.lines if ln.direction == direction and ln.name == "imbalance")
+        assert getattr(d.state_after.ext, name) == pytest.approx(truth, rel=0.003)
