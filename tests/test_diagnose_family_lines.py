@@ -141,3 +141,24 @@ def test_speed_ripple_leaves_the_imbalances_at_their_free_size(tmp_path):
     for direction, name in (("radial_force", "U_s"), ("radial_torque", "U_d")):
         truth = next(ln.C for ln in wheel.lines if ln.direction == direction and ln.name == "imbalance")
         assert getattr(d.state_after.ext, name) == pytest.approx(truth, rel=0.003)
+
+
+def test_speed_sidebands_take_no_evidence_from_the_fixed_offset_pair_the_state_has(tmp_path):
+    """5-Hz sidebands of the 1x in the state (fitted on the whole record): a speed-proportional pair that meets them
+    at the top speed (δ = f_mod/f_top per rev) holds nothing the state lacks there, and its held-out evidence on the
+    whole record is not significant (family wheel 7: such a pair, 0.032 per rev, took the fixed pair's power as its
+    own, t 158, and was named beside it)."""
+    from rwadist.effects.sidebands_diagnose import Sidebands
+    from rwadist.effects.speed_sidebands_diagnose import SpeedSidebands
+
+    wheel = _wheel(43, (6.0, 1.7, 0.14, (40000.0, 30000.0, 35000.0), 3000.0, 3000.0, 10, 0.2, 0.0, True), 12, 4096)
+    f_mod = 6 * wheel.sample_rate / wheel.n_samples
+    ctx, state = _empirical_context(wheel, [fe.Sidebands(h=1.0, f_mod_hz=f_mod, depth=0.4)], 0.003, 3, tmp_path)
+    pair = Sidebands.fit_record(ctx, state, "radial_force", 1.0, ctx.runs, f_mod)
+    assert pair is not None and pair.f_mod == pytest.approx(f_mod, rel=0.01)
+    state = pair.apply(state)
+    c1 = next(x.C for x in state.model.harmonics("radial_force") if abs(x.h - 1.0) < 0.01)
+    delta = f_mod / (wheel.max_rpm * fw.RPM / (2 * np.pi))
+    fake = SpeedSidebands("radial_force", 1.0, 1.0 - delta, 1.0 + delta, 0.2 * c1, 0.2 * c1, c1)
+    ev = fake.heldout_evidence(ctx, state, ctx.runs)
+    assert ev is None or ev[0] < 4.0 * ev[1]
