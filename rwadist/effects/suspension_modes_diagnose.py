@@ -22,6 +22,7 @@ from ..diagnose.engine import Context
 from ..diagnose.state import State
 from ..model import Harmonic, WheelModel
 from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, stand_starts
+from .cross_coupling_diagnose import OFFSET_Z, CrossCoupling
 
 
 def _fit_spectra(ctx: Context, test, runs: list):
@@ -72,8 +73,8 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     None.
 
     A fixture resonance on every channel is fitted with the modes, never into them (:func:`_locate`); the stand
-    itself is left to the search (a ``fixed_resonance`` of role test_stand proposed from this fit's stand).  When
-    modes stay unconstrained, a load-cell offset is tried (:func:`_beside_offset`)."""
+    itself is left to the search (a ``fixed_resonance`` of role test_stand proposed from this fit's stand).  A load-cell
+    offset the located modes leave in the torques is taken out before the modes are located (:func:`_beside_offset`)."""
     from ..data import SteadyTest
     from ..empirical import fit_empirical
     from ..extended_fit import amplification_peaks
@@ -89,12 +90,11 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
         return None
     try:
         efit, stand = _locate(ctx, test, fit, stand_start, near)
-        if efit.unconstrained and len(ctx.channels) == 6:
+        if len(ctx.channels) == 6:
             # a load-cell offset (T_measured = T + r × F) puts the forces' lines, amplified by the translation mode,
-            # into the torques (where they also pass for a fixture resonance lifting every direction at that mode):
-            # the modes are located on the torques corrected for it when that locates more of them (the offset
-            # itself is left to the search: a ``cross_coupling`` on the modes' base); with every mode located
-            # (a stand divided out or not) none can be located more, so the correction is not tried
+            # into the torques (where they also pass for a fixture resonance lifting every direction at that mode, or
+            # for the rocking mode): the modes are located on the torques corrected for it when the data show one
+            # (the offset itself is left to the search: a ``cross_coupling`` on the modes' base)
             got = _beside_offset(ctx, state, efit, fit, runs, test, stand_start, near)
             if got is not None:
                 test, fit, efit, stand, _ = got
@@ -196,49 +196,87 @@ def _beside_offset(ctx: Context, state: State, efit, fit, runs, test, stand_star
     load-cell offset r (m: the ``cross_coupling`` fit of ``runs`` on ``state`` with the modes of ``efit``, the
     extended fit of ``test`` whose empirical fit is ``fit``: its torque lines, the wheel's own, weigh the equations
     at their frequencies down; T − r × F), or None when the offset is not significant
-    (:meth:`CrossCoupling.significant`: no component of r stands 4 standard errors from 0) or the corrected data do
-    not locate more modes than ``efit`` leaves unconstrained.
+    (:meth:`CrossCoupling.significant`: no component of r stands 4 standard errors from 0) or the corrected data's
+    modes are not better than those of ``efit``.
+
+    Better: more modes located; or as many, and the corrected data's modes with the offset read as measured
+    (T − r × F, as the search reads a ``cross_coupling``) explain ``runs`` better than ``efit``'s modes on the data as
+    they are, by more than :data:`OFFSET_Z` noise standard errors of the drop in misplaced power (the search's own
+    rule, :func:`rwadist.diagnose.search._evidence`).  A located mode may be a wrong one: the offset moves the
+    forces' lines, amplified by the translation mode, into the torques, where the rocking fit takes them (family
+    wheel 3, r_z = −60 mm, translation 230 Hz, rocking 70 Hz: every mode located, the rocking at 221 Hz on the
+    uncorrected torques).
 
     The offset's estimate weighs each line by the torque the modes predict there, so modes pulled by the offset
-    bias it: when the corrected data locate no more modes, r is estimated again beside the modes they gave, up to
-    :data:`OFFSET_ROUNDS` times (family wheel 6, r_z = −60 mm, rocking 110 Hz beside the 150 Hz translation: r_z
-    −58.0 mm beside the rocking the offset pulled to 138 Hz left the rocking 2 % off and 3.5 dB misfit; the second
-    round, beside 112 Hz, locates it).  A note of the fit says the offset was removed."""
+    bias it: r is estimated again beside the modes the corrected data gave, up to :data:`OFFSET_ROUNDS` times, until
+    a round is better, then while each round is better than the last (family wheel 6, r_z = −60 mm, rocking 110 Hz
+    beside the 150 Hz translation: r_z −58.0 mm beside the rocking the offset pulled to 138 Hz left the rocking 2 %
+    off and 3.5 dB misfit; the second round, beside 112 Hz, locates it; family wheel 3: r_z −54.4 mm beside the
+    221 Hz rocking, the rocking found at 69.7 Hz, ζ 0.0248 for 0.0205).  A note of the fit says the offset was
+    removed."""
+    n_located = 3 - len(efit.unconstrained)
+    runs = np.asarray(runs, dtype=int)
+    modes_fit, modes_efit = fit, efit
+    best, best_state = None, None
+    for _ in range(OFFSET_ROUNDS):
+        with_modes = SuspensionModes.from_fit(modes_efit, modes_fit, runs.size).apply(state)
+        if best_state is None:
+            best_state = with_modes                 # efit's modes on the data as they are
+        cc = CrossCoupling.fit(ctx, with_modes, runs)
+        if cc is None or not cc.significant():
+            break
+        test_c, fit_c, efit_c, stand_c = _located_corrected(ctx, test, np.asarray(cc.r, dtype=float), stand_start,
+                                                            near)
+        k = 3 - len(efit_c.unconstrained)
+        if k == 0:
+            break
+        corrected = cc.apply(SuspensionModes.from_fit(efit_c, fit_c, runs.size).apply(state))
+        if k > n_located or (k == n_located and _better(ctx, best_state, corrected, runs)):
+            best, best_state, n_located = (test_c, fit_c, efit_c, stand_c, tuple(float(v) for v in cc.r)), corrected, k
+        elif best is not None:
+            break                           # the offset estimated again beside the kept modes is no better
+        modes_fit, modes_efit = fit_c, efit_c
+    return None if best is None else _noted(best)
+
+
+def _located_corrected(ctx: Context, test, r: np.ndarray, stand_start, near) -> tuple:
+    """(test, fit, efit, stand) of :func:`_locate` on ``test`` with the torques corrected for the load-cell offset
+    ``r`` (m): T − r × F in every run."""
     from dataclasses import replace
 
     from ..data import SteadyTest
     from ..diagnose.constants import TORQUE_CHANNELS
     from ..empirical import fit_empirical
     from ..spectra import compute_spectra
-    from .cross_coupling_diagnose import CrossCoupling
 
-    n_unconstrained = len(efit.unconstrained)
-    modes_fit, modes_efit = fit, efit
-    for _ in range(OFFSET_ROUNDS):
-        with_modes = SuspensionModes.from_fit(modes_efit, modes_fit, len(runs)).apply(state)
-        cc = CrossCoupling.fit(ctx, with_modes, np.asarray(runs))
-        if cc is None or not cc.significant():
-            return None
-        r = np.asarray(cc.r, dtype=float)
-        corrected = []
-        for run in test.runs:
-            F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
-            T = np.cross(r[None, :], F)
-            corrected.append(replace(run, signals={**run.signals, **{k: run.signals[k] - T[:, j]
-                                                                     for j, k in enumerate(TORQUE_CHANNELS)
-                                                                     if k in run.signals}}))
-        test_c = SteadyTest(corrected, dict(test.meta))
-        fit_c = fit_empirical(compute_spectra(test_c, window=ctx.sp.window, f_lim=ctx.sp.f_lim))
-        efit_c, stand_c = _locate(ctx, test_c, fit_c, stand_start, near)
-        if len(efit_c.unconstrained) < n_unconstrained:
-            efit_c.notes.append("load-cell offset: r = (%s) mm removed from the torques (T − r × F) before the modes "
-                                "were located; not part of the wheel's model (diagnose names it as cross_coupling)"
-                                % ", ".join(f"{1000 * v:.1f}" for v in r))
-            return test_c, fit_c, efit_c, stand_c, tuple(float(v) for v in r)
-        if len(efit_c.unconstrained) == 3:
-            return None
-        modes_fit, modes_efit = fit_c, efit_c
-    return None
+    corrected = []
+    for run in test.runs:
+        F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
+        T = np.cross(r[None, :], F)
+        corrected.append(replace(run, signals={**run.signals, **{k: run.signals[k] - T[:, j]
+                                                                 for j, k in enumerate(TORQUE_CHANNELS)
+                                                                 if k in run.signals}}))
+    test_c = SteadyTest(corrected, dict(test.meta))
+    fit_c = fit_empirical(compute_spectra(test_c, window=ctx.sp.window, f_lim=ctx.sp.f_lim))
+    efit_c, stand_c = _locate(ctx, test_c, fit_c, stand_start, near)
+    return test_c, fit_c, efit_c, stand_c
+
+
+def _better(ctx: Context, state: State, other: State, runs: np.ndarray) -> bool:
+    """Whether ``other`` explains ``runs`` better than ``state``: its drop in misplaced power over every channel more
+    than :data:`OFFSET_Z` of its noise standard errors (:func:`rwadist.diagnose.search._evidence`)."""
+    from ..diagnose.search import _evidence
+
+    gain, _, t, _ = _evidence(ctx, state, other, runs, [c for c in ctx.channels], None)
+    return bool(gain > 0 and t > OFFSET_Z)
+
+
+def _noted(got: tuple) -> tuple:
+    """``got`` of :func:`_beside_offset`, its extended fit noting the offset removed."""
+    got[2].notes.append("load-cell offset: r = (%s) mm removed from the torques (T − r × F) before the modes were "
+                        "located; not part of the wheel's model (diagnose names it as cross_coupling)"
+                        % ", ".join(f"{1000 * v:.1f}" for v in got[4]))
+    return got
 
 
 def _whole_data_fit(ctx: Context):
