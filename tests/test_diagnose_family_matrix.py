@@ -114,3 +114,17 @@ def test_a_load_cell_offset_beside_close_modes_is_named_and_the_rocking_located(
     cell = _cell(6, "cross_coupling", tmp_path)
     assert "crashed" not in cell and cell["found"] == [True] and not cell["added"], cell
     assert cell["modes_ok"] and "unc" not in cell["modes"], cell
+
+
+@pytest.mark.slow
+def test_a_rocking_located_on_the_offsets_lines_is_located_again_on_the_corrected_torques(tmp_path):
+    """Family wheel 3 (7 kg, translation 230 Hz, rocking 70 Hz) with a load-cell offset r_z = -60 mm and force sensors
+    noisier than the torque ones (``lever_arm_noise``): on the uncorrected torques the fit runs locate every mode, the
+    rocking at 221 Hz (the forces' lines through the translation mode, moved into the torques by r × F), so no mode
+    is left unconstrained to ask for the offset; the offset the data show beside those modes, taken out, gives modes
+    that explain the runs better (rocking 70.4 Hz, then 70.0 Hz on every run).  The offset and the noise it moves
+    are named, nothing else is added, every mode within 2 % and none declared (main 6eb954a: lever_arm_noise missed,
+    an amplitude law on the radial torque's 1x added)."""
+    cell = _cell(3, "lever_arm_noise", tmp_path)
+    assert "crashed" not in cell and cell["found"] == [True] and not cell["added"], cell
+    assert cell["modes_ok"] and "unc" not in cell["modes"], cell
