@@ -23,13 +23,14 @@ MAX_ZETA = 0.2
 
 
 def _line_gain_points(ctx, state, chans, runs):
-    """(f Hz, y, weight) of every model line of ``chans`` on ``runs`` measured above the noise and at least
+    """(f Hz, y, weight, direction) of every model line of ``chans`` on ``runs`` measured above the noise and at least
     2·LINE_HALF bins from the channel's other lines:
     y = ln(measured power / predicted power) = 2 ln(a_measured/a_predicted), the log power gain a
     further resonance would have to supply at the line's frequency f = h|Ω|/2π.  weight = s²/(s² + s_k²)
     with s the line's power over the noise power in its window and s_k = :data:`SNR_KNEE`: the scatter of
-    a log power falls as 1/s for weak lines and is bounded by model error for strong ones."""
-    fs, ys, ws = [], [], []
+    a log power falls as 1/s for weak lines and is bounded by model error for strong ones.  direction: the load
+    direction of each point's channel (str)."""
+    fs, ys, ws, ds = [], [], [], []
     offs = np.arange(-LINE_HALF, LINE_HALF + 1)
     for c in chans:
         noise = ctx.floor_psd(state, c, runs)
@@ -48,9 +49,22 @@ def _line_gain_points(ctx, state, chans, runs):
             fs.append(f[ok])
             ys.append(2.0 * np.log(a[ok] / a_pred[ok]))
             ws.append(snr[ok] ** 2 / (snr[ok] ** 2 + SNR_KNEE**2))
+            ds.append(np.full(int(ok.sum()), CHANNEL_DIRECTION[c]))
     if not fs:
-        return np.empty(0), np.empty(0), np.empty(0)
-    return np.concatenate(fs), np.concatenate(ys), np.concatenate(ws)
+        return np.empty(0), np.empty(0), np.empty(0), np.empty(0, str)
+    return np.concatenate(fs), np.concatenate(ys), np.concatenate(ws), np.concatenate(ds)
+
+
+def _lifted_directions(e: "FixedResonance", f: np.ndarray, dirs: np.ndarray) -> int:
+    """Number of load directions among the points ``f`` (Hz; their directions ``dirs``) where the resonance ``e``
+    changes a line's power by a factor e^:data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN` (1.5) or more, either way:
+    the stand detection's own threshold (a fixture resonance lifts every direction's lines near it)."""
+    from ..stand_resonance import STAND_MIN_LOG_GAIN
+
+    if f.size == 0:
+        return 0
+    lg = np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2)
+    return int(np.unique(dirs[np.abs(lg) >= STAND_MIN_LOG_GAIN]).size)
 
 
 #: Evaluation limit of each least-squares fit: scipy's default for 'trf' with 3 parameters (100·n), written out
@@ -161,6 +175,11 @@ class FixedResonance:
     extended_stand: tuple | None = None
     #: H far above f_r (1: the gain returns to 1 on both sides; 0: a transmissibility, :mod:`rwadist.resonance`)
     gain_above: float = 1.0
+    #: load directions with a measured line whose power the resonance changes by a factor
+    #: e^:data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN` (1.5) or more, either way (:func:`_lifted_directions`),
+    #: for a test-stand resonance fitted on diagnose's own lines; -1 when not counted (a wheel mode, a stand of the modes'
+    #: extended fit, which has its own rule: :func:`rwadist.stand_resonance.lifts_every_direction`)
+    lifted_directions: int = -1
 
     def apply(self, state: State) -> State:
         return state.plus(self)
@@ -191,8 +210,12 @@ class FixedResonance:
 
         # a fit ending at its damping floor (1e-3) measured no width: one line's misfit at one speed lifted (family
         # wheel 6 with a fixture at 165 Hz: an axial 'wheel mode' at 89.7 Hz, ζ 0.001, beside its 85 Hz axial mode)
+        # a test stand changes the lines of every direction at its frequency (a resonance of one direction's lines is
+        # that direction's: family wheel 7 clean, seed 3: a 'stand' at 52.9 Hz, ζ 0.0026, gain 0.05, a notch on the
+        # misfit of one direction's line at one speed, was added)
         return bool(abs(np.log(self.peak_gain)) >= np.log(MIN_PEAK_GAIN) and STAND_MIN_ZETA <= self.zeta <= MAX_ZETA
-                    and (self.role != "wheel_mode" or self.peak_gain >= MIN_PEAK_GAIN))
+                    and (self.role != "wheel_mode" or self.peak_gain >= MIN_PEAK_GAIN)
+                    and (self.role != "test_stand" or self.lifted_directions < 0 or self.lifted_directions >= 2))
 
     def params(self) -> dict:
         dirs = sorted({CHANNEL_DIRECTION[c] for c in self.channels})
@@ -257,9 +280,11 @@ class FixedResonance:
     @staticmethod
     def _fit(ctx: Context, state: State, channels, chans, runs, f0, role, n_iter) -> "FixedResonance | None":
         """:meth:`fit` computed (``chans``: the channels of ``channels`` the data have)."""
+        from dataclasses import replace
+
         from scipy.optimize import least_squares
 
-        f, y, wt = _line_gain_points(ctx, state, chans, runs)
+        f, y, wt, dirs = _line_gain_points(ctx, state, chans, runs)
         lo, hi = ctx.k_lo * ctx.df, ctx.k_hi * ctx.df
         pk = FixedResonance.peak(f, y, lo, hi, ctx.df)
         if pk is None or f.size < 6:
@@ -274,7 +299,7 @@ class FixedResonance:
                 # re-measure with the tentative resonance in the state, so that neighbouring lines are
                 # subtracted amplified; the total log gain is the residual one plus the tentative ln|H|²
                 st = e.apply(state)
-                f, y, wt = _line_gain_points(ctx, st, chans, runs)
+                f, y, wt, dirs = _line_gain_points(ctx, st, chans, runs)
                 y = y + np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain)) ** 2)
                 starts = [np.log([e.f_r, e.zeta, e.peak_gain])]
             if f.size < 6:
@@ -305,10 +330,11 @@ class FixedResonance:
         if role == "test_stand" and e is not None:
             # a fixture's gain need not return to 1 above it: the general form, its gain above free, on the lines
             # re-measured with the resonance in place
-            f, y, wt = _line_gain_points(ctx, e.apply(state), chans, runs)
+            f, y, wt, dirs = _line_gain_points(ctx, e.apply(state), chans, runs)
             y = y + np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain)) ** 2)
             if f.size >= 6:
                 e = _general_refit(e, f, y, np.sqrt(wt), lo, hi)
+            e = replace(e, lifted_directions=_lifted_directions(e, f, dirs))
         return e
 
     @staticmethod
