@@ -100,6 +100,8 @@ class ExtendedFit:
     per_unit : True when mass/radius were not given (M = 1 kg, I_rr = 1 kg·m²).
     stand : the fixture resonance (f_r Hz, ζ, peak gain[, gain above]) divided out of every line, or None: the start
         given, or the stand fitted with the modes (``fit_stand``).
+    stand_direction : None, or the load direction ``stand`` acts on alone: then a mode of the wheel's structure, not a
+        fixture (:func:`fit_extended`'s ``stand_direction``).
     line_residuals : (f Hz, r, direction) of every measurement the least squares used: f = h|Ω|/2π the line's
         frequency and r = ln(measured / model amplitude) (radial lines: of sqrt(x² + y²)), the stand divided out (and
         a line whose exponent the fit freed, :func:`rwadist.off_law_lines.off_law_line`, taken with its own growth);
@@ -122,6 +124,7 @@ class ExtendedFit:
     per_unit: bool = False
     stand: tuple | None = None
     line_residuals: tuple = (np.empty(0), np.empty(0), np.empty(0, dtype=str))
+    stand_direction: str | None = None
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -302,12 +305,12 @@ def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=Non
     return scans
 
 
-def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: list):
+def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: list, stand_direction: str | None = None):
     """(test, empirical fit, measured lines, x/y senses) the extended fit works on: the lever-arm torque ``height`` × F
     removed from the test and its fit (:func:`rwadist.geometry.remove_lever_arm`); every line the data show, with
     every measurement (the empirical fit without modal exclusion: with it, lines that are amplified or attenuated at
     most speeds are dropped; close lines measured together on the records); the fixture resonances ``stands`` divided
-    out of their amplitudes."""
+    out of their amplitudes (the first only out of the lines of ``stand_direction`` when given)."""
     if height:
         sp0 = fit.spectra
         test = remove_lever_arm(test, height)
@@ -318,7 +321,8 @@ def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: 
     if stands:
         def fixture_gain(x):
             f = x.h * np.abs(x.speed) / (2 * np.pi)
-            return np.prod([np.abs(resonance(f, *s)) for s in stands], axis=0)
+            acting = [s for i, s in enumerate(stands) if i > 0 or stand_direction in (None, x.direction)]
+            return np.prod([np.abs(resonance(f, *s)) for s in acting], axis=0) if acting else np.ones_like(f)
 
         meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / fixture_gain(x)) for x in meas.lines])
     return test, fit, meas, senses_xy
@@ -427,16 +431,23 @@ def _rows_of_lines(owner: np.ndarray, la: np.ndarray, lr: np.ndarray) -> tuple[d
 
 
 def _log_data(meas_lines: list, la: np.ndarray, sa: np.ndarray, aa: np.ndarray, lr: np.ndarray, sr: np.ndarray,
-              pr: np.ndarray, joint_stand: tuple | None) -> tuple[np.ndarray, FittedResonance | None]:
+              pr: np.ndarray, joint_stand: tuple | None,
+              stand_direction: str | None = None) -> tuple[np.ndarray, FittedResonance | None]:
     """(log amplitude per least-squares row, the stand fitted with the modes or None): the axial rows (line ``la``,
     speed ``sa`` rad/s, amplitude ``aa`` per channel), then the radial ones (``lr``, ``sr``, x²+y² power ``pr`` per
     run); with ``joint_stand`` (its start, divided out of the lines) multiplied back: the least squares divides out
-    its own."""
+    its own.  ``stand_direction``: the stand is a mode of the wheel's structure acting on that direction's rows only,
+    returning to 1 above it (:class:`rwadist.resonance.FittedResonance` ``rows``, ``gain_above`` 1)."""
     log_data = np.concatenate([np.log(np.maximum(aa, 1e-300)), 0.5 * np.log(np.maximum(pr, 1e-300))])
     if joint_stand is None:
         return log_data, None
     h_meas = np.array([x.h for x in meas_lines]) if meas_lines else np.zeros(0)
-    joint = FittedResonance(joint_stand, np.concatenate([h_meas[la] * np.abs(sa), h_meas[lr] * np.abs(sr)]) / (2 * np.pi))
+    f_rows = np.concatenate([h_meas[la] * np.abs(sa), h_meas[lr] * np.abs(sr)]) / (2 * np.pi)
+    if stand_direction is None:
+        joint = FittedResonance(joint_stand, f_rows)
+    else:
+        d_rows = np.concatenate([np.full(la.size, "axial_force"), [meas_lines[j].direction for j in lr]])
+        joint = FittedResonance(joint_stand, f_rows, rows=d_rows == stand_direction, gain_above=1.0)
     return log_data + 0.5 * joint.start_log_gain, joint
 
 
@@ -512,7 +523,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
                  progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
                  more_stands: tuple = (), near: dict | None = None, fit_stand: bool = False,
-                 declare: bool = True) -> ExtendedFit:
+                 declare: bool = True, stand_direction: str | None = None) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
     mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None:
@@ -537,6 +548,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     the modes' standard errors are those with the stand free (what the stand could take of their lines is counted).
     declare: False keeps every located mode in the least squares, however loose (the joint fit's passes, whose next
     scans start from the stand it fits: a mode dropped there leaves its lines to the stand alone).
+    stand_direction: ``stand`` is a mode of the wheel's structure on that load direction only (``rwadist diagnose``'s
+    ``fixed_resonance`` of role wheel_mode), divided out of that direction's lines alone, H → 1 far above it (β = 1).
 
     Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
     measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
@@ -548,7 +561,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     """
     physical = mass is not None and radius is not None
     notes: list[str] = []
-    test, fit, meas, senses_xy = _measured_lines(test, fit, height, ([] if stand is None else [stand]) + list(more_stands))
+    test, fit, meas, senses_xy = _measured_lines(test, fit, height, ([] if stand is None else [stand]) + list(more_stands),
+                                                 stand_direction if stand is not None else None)
     peaks = amplification_peaks(fit)
     la, sa, ca, aa = _axial_measurements(meas)
     radial = _radial_power(meas.lines)
@@ -560,7 +574,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     lines, owner = _forcing_lines(meas.lines, senses_xy)
     lr, sr, pr, dr = radial
     line_of, ax_line, rad_parts = _rows_of_lines(owner, la, lr)
-    log_data, joint = _log_data(meas.lines, la, sa, aa, lr, sr, pr, stand if fit_stand else None)
+    log_data, joint = _log_data(meas.lines, la, sa, aa, lr, sr, pr, stand if fit_stand else None, stand_direction)
     row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
     problem = LogAmplitudeProblem(base, lines, LinePower(lines, sa, ax_line, ca, sr, rad_parts), log_data, joint,
                                   row_line, centred_log_w, meas.lines, progress)
@@ -588,7 +602,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
                        unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
-                       line_residuals=line_residuals)
+                       line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction)
 
 
 def _mode_hz_of(params: ext.ExtendedParams, mode: str) -> float:
@@ -697,10 +711,12 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
     if unresolved:
         analytical["fit"]["unresolved_lines"] = unresolved
     if efit.stand is not None:
-        # the fixture's resonance is not the wheel's: kept out of its model, recorded for the user
+        # the fixture's resonance is not the wheel's: kept out of its model, recorded for the user (a mode of the wheel's
+        # structure on one direction is the wheel's: ``rwadist diagnose`` names it as a fixed_resonance of its model)
         f_r, zeta, gain, *above = efit.stand
-        analytical["fit"]["test_stand"] = {"f_Hz": f_r, "zeta": zeta, "peak_gain": gain,
-                                           "gain_above": above[0] if above else 1.0}
+        key = "test_stand" if efit.stand_direction is None else "structure_mode"
+        analytical["fit"][key] = {"f_Hz": f_r, "zeta": zeta, "peak_gain": gain, "gain_above": above[0] if above else 1.0,
+                                  **({} if efit.stand_direction is None else {"direction": efit.stand_direction})}
     if efit.per_unit:
         analytical["fit"]["per_unit"] = ("mass and radius not given: mass_kg = 1 and I_rr = 1 are units, the "
                                          "stiffnesses and damping are per unit mass / transverse inertia")

@@ -218,27 +218,45 @@ class FittedResonance:
     (:mod:`rwadist.resonance`), the same on every channel; each least-squares row (a line at f Hz) divides it out:
     r = ln(measured) − ln|H(f)| − ln(model), so the modes' standard errors are those with the stand free.
     ``start``: (f_r Hz, ζ, peak gain[, gain above]); ``f_rows``: each row's line frequency, Hz.  Bounds: f_r within
-    ±10 % of the start, ζ in [0.001, 0.3], γ in [0, 200], β in [−1, 3]."""
+    ±10 % of the start, ζ in [0.001, 0.3], γ in [0, 200], β in [−1, 3].
 
-    NAMES = ("stand_ln_f", "stand_ln_zeta", "stand_gamma", "stand_gain_above")
+    ``rows`` (bool per row, or None: every row): the rows the resonance acts on (a resonance of one load direction's
+    channels: a mode of the wheel's structure; 1 elsewhere).  ``gain_above`` (None: fitted): β held at this value, θ
+    then (ln f_r, ln ζ, γ) -- a mode of the structure multiplies what passes it and returns to 1 above it (β = 1)."""
 
-    def __init__(self, start, f_rows):
+    NAMES: tuple[str, ...] = ("stand_ln_f", "stand_ln_zeta", "stand_gamma", "stand_gain_above")
+
+    def __init__(self, start, f_rows, rows=None, gain_above: float | None = None):
         f_r, zeta, gain, *above = (float(v) for v in start)
-        beta = above[0] if above else 1.0
+        beta = gain_above if gain_above is not None else (above[0] if above else 1.0)
+        self.fixed_above = gain_above
         self.f_rows = np.asarray(f_rows, dtype=float)
+        self.rows = None if rows is None else np.asarray(rows, dtype=bool)
+        n = 4 if gain_above is None else 3
+        self.NAMES = FittedResonance.NAMES[:n]
         self.x0 = np.array([np.log(f_r), np.log(np.clip(zeta, 0.0011, 0.29)),
-                            min(numerator_damping(zeta, gain, beta), 199.0), np.clip(beta, -0.99, 2.99)])
-        self.lower = np.array([np.log(0.9 * f_r), np.log(1e-3), 0.0, -1.0])
-        self.upper = np.array([np.log(1.1 * f_r), np.log(0.3), 200.0, 3.0])
-        self.start_log_gain = np.log(np.abs(resonance(self.f_rows, f_r, zeta, gain, beta)) ** 2)
+                            min(numerator_damping(zeta, gain, beta), 199.0), np.clip(beta, -0.99, 2.99)])[:n]
+        self.lower = np.array([np.log(0.9 * f_r), np.log(1e-3), 0.0, -1.0])[:n]
+        self.upper = np.array([np.log(1.1 * f_r), np.log(0.3), 200.0, 3.0])[:n]
+        self.start_log_gain = self._masked(np.log(np.abs(resonance(self.f_rows, f_r, zeta, gain, beta)) ** 2))
+
+    def _masked(self, v):
+        """``v`` (rows, ...) with the rows the resonance does not act on zeroed."""
+        return v if self.rows is None else np.where(self.rows.reshape((-1,) + (1,) * (np.ndim(v) - 1)), v, 0.0)
+
+    def _theta4(self, theta) -> np.ndarray:
+        theta = np.asarray(theta, dtype=float)
+        return theta if self.fixed_above is None else np.append(theta, self.fixed_above)
 
     def log_gain(self, theta):
-        """(ln|H|² at every row (rows,), its derivatives (rows, 4) in θ)."""
-        return general_log_power_gain(self.f_rows, float(np.exp(theta[0])), float(np.exp(theta[1])),
-                                      float(theta[2]), float(theta[3]))
+        """(ln|H|² at every row (rows,), its derivatives (rows, len(θ)) in θ)."""
+        t = self._theta4(theta)
+        lg, d = general_log_power_gain(self.f_rows, float(np.exp(t[0])), float(np.exp(t[1])), float(t[2]),
+                                       float(t[3]))
+        return self._masked(lg), self._masked(d[:, :len(self.NAMES)])
 
-    @staticmethod
-    def stand(theta) -> tuple:
+    def stand(self, theta) -> tuple:
         """(f_r Hz, ζ, peak gain, gain above) of θ."""
-        zeta = float(np.exp(theta[1]))
-        return (float(np.exp(theta[0])), zeta, peak_of(zeta, float(theta[2]), float(theta[3])), float(theta[3]))
+        t = self._theta4(theta)
+        zeta = float(np.exp(t[1]))
+        return (float(np.exp(t[0])), zeta, peak_of(zeta, float(t[2]), float(t[3])), float(t[3]))

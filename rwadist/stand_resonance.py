@@ -366,3 +366,83 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
                        f"{above:.3g} of the load far above it) lifts the lines of every channel: a fixture resonance, "
                        "fitted with the modes and not part of the wheel's model (analytical.fit.test_stand)")
     return joint
+
+
+# --------------------------------------------------------------------------- a mode of the wheel's structure
+#: The load direction each of the extended fit's modes shows (its ``unconstrained`` names)
+MODE_DIRECTION = {"radial_translation": "radial_force", "rocking": "radial_torque", "axial": "axial_force"}
+#: Parameters of a structure mode fitted with the modes (f_r, ζ, γ; H → 1 far above it), for the information criterion
+STRUCTURE_PARAMETERS = 3
+#: Lifts of one direction's residuals tried as a structure mode's start, at most (the strongest first)
+STRUCTURE_STARTS = 2
+
+
+def structure_mode_starts(efit, direction: str) -> list:
+    """Starts (f_r Hz, ζ, peak gain) of a resonance of ``direction``'s lines alone, from the extended fit ``efit``'s log
+    residuals there (:attr:`ExtendedFit.line_residuals`): the frequencies where their local lift over their
+    neighbourhood (:func:`_local_lift` of the log power residuals) is greatest and at least
+    :data:`STAND_MIN_LOG_GAIN`, :data:`STRUCTURE_STARTS` at most, 10 % apart; ζ 0.03 and the lift's gain.
+
+    A wheel's suspension mode is one resonance per direction; a second one on the same lines (a mode of the housing
+    or of the rotor's own structure) is what the extended model lacks, and its lines stand above the model there."""
+    f, r, d = (np.asarray(v) for v in efit.line_residuals)
+    ok = (d == direction) & np.isfinite(r) & (f > 0)
+    f, y = f[ok], 2.0 * r[ok]
+    if f.size < 8 or f.max() <= f.min() * (1 + 2 * STAND_WINDOW):
+        return []
+    grid = np.exp(np.arange(np.log(f.min()), np.log(f.max()), 0.005))
+    lift = _local_lift(f, y, grid, 2)
+    out: list[tuple] = []
+    for i in np.argsort(-np.where(np.isfinite(lift), lift, -np.inf)):
+        if not lift[i] >= STAND_MIN_LOG_GAIN or len(out) == STRUCTURE_STARTS:
+            break
+        if all(abs(grid[i] / s[0] - 1) > 0.1 for s in out):
+            out.append((float(grid[i]), 0.03, float(np.clip(np.exp(lift[i] / 2), 1.25, 50.0))))
+    return out
+
+
+def structure_confirmed(joint, plain) -> bool:
+    """True when the joint fit's structure mode (``joint``, its ``stand`` on one direction) beside the modes is a
+    resonance (:func:`is_fixture_resonance`: a measured width and a lift), explains the lines beyond its parameters'
+    worth (the Bayesian information criterion on the log residuals, :data:`STRUCTURE_PARAMETERS`) and pins more of the
+    wheel's modes than the fit without it (``plain``): what the model lacked is found, the mode it pulled is located."""
+    if joint.stand is None or not is_fixture_resonance(joint.stand[1], joint.stand[2]):
+        return False
+    n = int(np.sum(np.isfinite(joint.line_residuals[1])))
+    c1, c0 = joint_cost(joint), joint_cost(plain)
+    return bool(n > STRUCTURE_PARAMETERS and c1 > 0 and n * np.log(c0 / c1) > STRUCTURE_PARAMETERS * np.log(n)
+                and len(joint.unconstrained) < len(plain.unconstrained))
+
+
+def fit_extended_beside_structure_mode(test, fit, plain, start: tuple | None = None, **kwargs):
+    """The extended fit of ``test`` (empirical fit ``fit``) with a mode of the wheel's structure on one direction fitted
+    jointly with the suspension modes (:func:`rwadist.extended_fit.fit_extended`'s ``stand_direction``), or None.
+
+    Tried when ``plain`` (the fit without it, and without a stand) leaves a mode unconstrained: from each lift of that
+    mode's direction's residuals (:func:`structure_mode_starts`), or from ``start`` ((direction, f_r Hz, ζ, peak gain):
+    an earlier fit's); the fit of least cost kept when :func:`structure_confirmed`.  A fixed-frequency resonance on
+    the radial forces alone beside the radial translation (family wheels: a housing mode between two modes) is not
+    a second translation: the translation is the spring the rotor's force passes through (its transmissibility falls
+    above it), the structure mode multiplies what passes it and returns to 1 above it (β = 1), and the wheel's modes
+    are fitted beside it instead of being pulled onto it or declared."""
+    if start is not None:
+        tries = [(start[0], tuple(start[1:]))]
+    else:
+        dirs = sorted({MODE_DIRECTION[m] for m in plain.unconstrained if m in MODE_DIRECTION})
+        tries = [(d, s) for d in dirs for s in structure_mode_starts(plain, d)]
+    fits = []
+    for d, s in tries:
+        try:
+            fits.append(_joint_from(test, fit, tuple(s) + (1.0,), {**kwargs, "stand_direction": d}))
+        except ValueError:
+            continue
+    fits = [j for j in fits if structure_confirmed(j, plain)]
+    if not fits:
+        return None
+    joint = min(fits, key=joint_cost)
+    f_r, zeta, gain, _ = joint.stand
+    joint.notes.append(f"structure mode: a resonance at {f_r:.4g} Hz (ζ {zeta:.3g}, peak gain {gain:.3g}) on the "
+                       f"{joint.stand_direction} lines alone, fitted with the suspension modes: a mode of the wheel's "
+                       "structure the extended model lacks (analytical.fit.structure_mode; `rwadist diagnose` names it "
+                       "a fixed_resonance of role wheel_mode)")
+    return joint

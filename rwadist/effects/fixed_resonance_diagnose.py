@@ -233,6 +233,16 @@ class FixedResonance:
                               extended_stand=tuple(float(v) for v in stand))
 
     @staticmethod
+    def of_structure(held, channels, structure) -> "FixedResonance":
+        """The mode of the wheel's structure ``held`` (direction, f_r Hz, ζ, peak gain: what the held-out runs judge)
+        of the suspension modes' extended fit, on ``channels``' channels of its direction, refitted as ``structure``
+        (the same fitted on every run); H → 1 far above it."""
+        direction, f_r, zeta, gain = held[0], *(float(v) for v in held[1:4])
+        chans = tuple(c for c in DIRECTION_CHANNELS[direction] if c in channels)
+        return FixedResonance(f_r, zeta, gain, chans, "wheel_mode", extended_stand=tuple(float(v) for v in structure[1:4])
+                              + (1.0,))
+
+    @staticmethod
     def peak(f: np.ndarray, y: np.ndarray, lo: float, hi: float, df: float):
         """Frequency (Hz) and mean log power gain of the strongest excess of ``y`` vs ``f``: the mean of y
         within ±max(2 df, 2 %) of every grid frequency, scored by |mean|·sqrt(count) (4 points at least)."""
@@ -363,6 +373,13 @@ class FixedResonance:
             if modes:
                 m = modes[-1]
                 out.append(FixedResonance.of_stand(m.stand_fit_runs or m.stand, ctx.channels, m.stand))
+            # the mode of the wheel's structure the suspension modes were fitted beside (on one direction): the same,
+            # as a wheel-mode resonance (:func:`rwadist.stand_resonance.fit_extended_beside_structure_mode`)
+            structured = [x for x in state.effects if getattr(x, "kind", "") == "suspension_modes"
+                          and getattr(x, "structure", None) is not None]
+            if structured:
+                m = structured[-1]
+                out.append(FixedResonance.of_structure(m.structure_fit_runs or m.structure, ctx.channels, m.structure))
             # the same from the given model: the stand its reference fit divided out (``analytical.fit.test_stand``,
             # another run on the same fixture): 2048 samples, diagnose's own fit gave 180.4 Hz, ζ 0.040, gain 3.9 for
             # the 180 Hz, ζ 0.03, gain 5 stand the reference located at 180.0 Hz, ζ 0.030, gain 5.02

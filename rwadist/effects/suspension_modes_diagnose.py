@@ -21,7 +21,7 @@ from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.state import State
 from ..model import Harmonic, WheelModel
-from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, stand_starts
+from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode, stand_starts
 from .cross_coupling_diagnose import OFFSET_Z, CrossCoupling
 
 
@@ -64,13 +64,15 @@ def _fit_spectra(ctx: Context, test, runs: list):
     return sp, detections_of_runs({c: det[c] for c in chans if c in det}, rows)
 
 
-def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None, near: dict | None = None):
+def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None, near: dict | None = None,
+              structure_start: tuple | None = None):
     """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
     amplification (or the extended fit fails, or locates no mode); ``stand`` is the fixture resonance (f_r Hz, ζ, peak
     gain, gain above) fitted with the modes, or None.  ``stand_start``: the stand to start from (a refit on every run
     starts from the one fitted on half of them), else those :func:`rwadist.stand_resonance.stand_starts` proposes.
     ``near``: the modes that fit located, searched first (``near`` of :func:`rwadist.extended_fit.fit_extended`), or
-    None.
+    None.  ``structure_start``: the mode of the wheel's structure to start from (direction, f_r Hz, ζ, peak gain: the fit
+    on half the runs had it), or None (:func:`_locate`).
 
     A fixture resonance on every channel is fitted with the modes, never into them (:func:`_locate`); the stand
     itself is left to the search (a ``fixed_resonance`` of role test_stand proposed from this fit's stand).  A load-cell
@@ -89,7 +91,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
         return None
     try:
-        efit, stand = _locate(ctx, test, fit, stand_start, near)
+        efit, stand = _locate(ctx, test, fit, stand_start, near, structure_start)
         if len(ctx.channels) == 6:
             # a load-cell offset (T_measured = T + r × F) puts the forces' lines, amplified by the translation mode,
             # into the torques (where they also pass for a fixture resonance lifting every direction at that mode, or
@@ -105,13 +107,16 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     return test, fit, efit, stand
 
 
-def _locate(ctx: Context, test, fit, stand_start, near=None):
+def _locate(ctx: Context, test, fit, stand_start, near=None, structure_start=None):
     """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``): the modes fitted jointly with a fixture resonance
     (:func:`rwadist.stand_resonance.fit_extended_beside_stand`, from ``stand_start`` or the stands the fit -- else the
     whole data, :func:`_whole_data_fit` -- proposes) when that is confirmed over the fit without one, else the modes
     alone (stand None).  Only with six channels: a stand is told from a mode by lifting the forces AND the torques.
     ``near`` (the modes of an earlier fit beside ``stand_start``, None: without a stand) guides only the fits beside
-    that same stand (``near_stand`` of :func:`rwadist.stand_resonance.fit_extended_beside_stand`)."""
+    that same stand (``near_stand`` of :func:`rwadist.stand_resonance.fit_extended_beside_stand`).  When no stand is
+    kept and a mode stays unconstrained, a mode of the wheel's structure on one direction is tried beside the modes
+    (:func:`rwadist.stand_resonance.fit_extended_beside_structure_mode`, from ``structure_start`` when given): the fit
+    returned is then that joint fit (its ``stand`` on one direction, ``stand_direction``) and the stand None."""
     from ..extended_fit import fit_extended
 
     if len(ctx.channels) <= 3:
@@ -125,6 +130,10 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
         held = _beside_whole_data_stand(ctx, test, fit, efit)
         if held is not None:
             efit = held
+    if efit.stand is None and efit.unconstrained:
+        structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
+        if structure is not None:
+            return structure, None
     return efit, efit.stand
 
 
@@ -404,6 +413,12 @@ class SuspensionModes:
     first = True
     #: the runs this fit is judged on when it was fitted on the held-out runs (:meth:`other_fold`), else None
     judge_runs: tuple | None = field(default=None, repr=False)
+    #: a mode of the wheel's structure on one direction fitted with the modes and divided out of that direction's lines
+    #: for the fit (direction, f_r Hz, ζ, peak gain), or None: named by the search as a ``fixed_resonance`` of role
+    #: wheel_mode (:meth:`stand_effect`), not part of this effect's parameters
+    structure: tuple | None = None
+    #: the structure mode of the fit on the fit runs this effect was refitted from, or None (as ``stand_fit_runs``)
+    structure_fit_runs: tuple | None = field(default=None, repr=False)
 
     @property
     def channels(self) -> tuple:
@@ -418,8 +433,10 @@ class SuspensionModes:
               "axial": float(np.sqrt(p.k_z / p.mass) / (2 * np.pi))}
         zeta = {"radial_translation": float(p.zeta_r), "rocking": float(p.zeta_rock), "axial": float(p.zeta_z)}
         base, pairs = wheel_base(to_model(efit, fit))
+        structure = None if efit.stand_direction is None or efit.stand is None else \
+            (efit.stand_direction,) + tuple(float(v) for v in efit.stand[:3])
         return SuspensionModes(base, f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained), n_runs, stand,
-                               sideband_pairs=pairs)
+                               sideband_pairs=pairs, structure=structure)
 
     def apply(self, state: State) -> State:
         import copy
@@ -440,8 +457,9 @@ class SuspensionModes:
         searched first near it (:meth:`near`); itself when that fit fails."""
         from dataclasses import replace
 
-        return replace(SuspensionModes.fit(ctx, state, ctx.runs, self.stand, self.near()) or self,
-                       stand_fit_runs=self.stand if self.judge_runs is None else None, judge_runs=None)
+        return replace(SuspensionModes.fit(ctx, state, ctx.runs, self.stand, self.near(), self.structure) or self,
+                       stand_fit_runs=self.stand if self.judge_runs is None else None, judge_runs=None,
+                       structure_fit_runs=self.structure if self.judge_runs is None else None)
 
     def other_fold(self, ctx: Context, state: State) -> "SuspensionModes | None":
         """The modes fitted on the held-out runs, judged on the fit runs (``judge_runs``): the search's other fold
@@ -465,9 +483,12 @@ class SuspensionModes:
     def stand_effect(self, channels):
         """The fixture resonance fitted jointly with these modes (``stand``) as the test-stand effect on ``channels``
         (a :class:`~rwadist.effects.fixed_resonance_diagnose.FixedResonance`) the search names after them, or None:
-        what the modes are judged beside when they do not pass alone (:func:`rwadist.diagnose.search._judge_beside_stand`)."""
+        what the modes are judged beside when they do not pass alone (:func:`rwadist.diagnose.search._judge_beside_stand`);
+        without a stand, the mode of the wheel's structure fitted with them (``structure``) as a wheel-mode resonance."""
         from .fixed_resonance_diagnose import FixedResonance
 
+        if self.stand is None and self.structure is not None:
+            return FixedResonance.of_structure(self.structure_fit_runs or self.structure, channels, self.structure)
         return None if self.stand is None else FixedResonance.of_stand(self.stand, channels, self.stand)
 
     def whirl_Hz(self, omega_rad_s: float) -> dict:
@@ -491,10 +512,10 @@ class SuspensionModes:
 
     @staticmethod
     def fit(ctx: Context, state: State, runs, stand_start: tuple | None = None,
-            near: dict | None = None) -> "SuspensionModes | None":
+            near: dict | None = None, structure_start: tuple | None = None) -> "SuspensionModes | None":
         """The modes fitted on ``runs`` (per unit mass and inertia), or None when those runs show no modal
-        amplification or no mode can be located; ``stand_start``, ``near``: see :func:`_fit_runs`."""
-        got = _fit_runs(ctx, runs, state, stand_start, near)
+        amplification or no mode can be located; ``stand_start``, ``near``, ``structure_start``: see :func:`_fit_runs`."""
+        got = _fit_runs(ctx, runs, state, stand_start, near, structure_start)
         return None if got is None else SuspensionModes.from_fit(got[2], got[1], len(runs), got[3])
 
     @staticmethod
