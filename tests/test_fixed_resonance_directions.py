@@ -26,22 +26,30 @@ def _gain_sq(f, f_r, zeta, g):
     return np.abs((1 - r**2 + 2j * g * zeta * r) / (1 - r**2 + 2j * zeta * r)) ** 2
 
 
-def test_directions_counted_where_the_resonance_changes_a_line_by_half_its_power():
+def test_directions_counted_where_the_resonance_explains_the_lines_it_changes_by_half_their_power():
     stand = FixedResonance(195.0, 0.03, 5.0, CHANNELS, "test_stand")
     f = np.array([150.0, 194.0, 197.0, 260.0, 201.0, 120.0])
     dirs = np.array(["radial_force", "radial_force", "radial_torque", "radial_torque", "axial_force", "axial_force"])
-    # power gains 1.30, 24.32, 22.51, 1.25, 12.88, 1.08: each direction has one line lifted 1.5x or more, one not
-    assert [round(float(v), 2) for v in _gain_sq(f, 195.0, 0.03, 5.0)] == [1.3, 24.32, 22.51, 1.25, 12.88, 1.08]
-    assert _lifted_directions(stand, f[[0, 3, 5]], dirs[[0, 3, 5]]) == 0
-    assert _lifted_directions(stand, f, dirs) == 3
+    w = np.ones(f.size)
+    # power gains 1.30, 24.32, 22.51, 1.25, 12.88, 1.08: each direction has one line changed 1.5x or more, one not
+    lifted = np.log(_gain_sq(f, 195.0, 0.03, 5.0))
+    assert [round(float(v), 2) for v in np.exp(lifted)] == [1.3, 24.32, 22.51, 1.25, 12.88, 1.08]
+    # a fixture: every direction's lines lifted as it says (within 20 % of the log gain)
+    assert _lifted_directions(stand, f, 0.8 * lifted, w, dirs) == 3
+    # lines outside its band do not count
+    assert _lifted_directions(stand, f[[0, 3, 5]], lifted[[0, 3, 5]], w[:3], dirs[[0, 3, 5]]) == 0
+    # a resonance of the radial forces alone (a housing mode) pooled over every channel: the torque and axial lines
+    # it passes are not lifted -- it makes them worse, and is no stand
+    housing = np.where(dirs == "radial_force", lifted, 0.0)
+    assert _lifted_directions(stand, f, housing, w, dirs) == 0
     # a notch (gain 0.05, ζ 0.0026) changes only what lies within ~0.5 % of it: the axial line at 53.0 Hz
     notch = FixedResonance(52.9, 0.0026, 0.05, CHANNELS, "test_stand")
     f2 = np.array([53.0, 53.4, 55.0, 50.0])
     dirs2 = np.array(["axial_force", "radial_force", "radial_torque", "radial_force"])
     ratio = _gain_sq(f2, 52.9, 0.0026, 0.05)
     assert np.flatnonzero(np.abs(np.log(ratio)) >= np.log(1.5)).tolist() == [0]
-    assert _lifted_directions(notch, f2, dirs2) == 1
-    assert _lifted_directions(notch, np.empty(0), np.empty(0, str)) == 0
+    assert _lifted_directions(notch, f2, np.log(ratio), np.ones(4), dirs2) == 1
+    assert _lifted_directions(notch, np.empty(0), np.empty(0), np.empty(0), np.empty(0, str)) == 0
 
 
 def test_a_stand_of_one_direction_is_not_significant():

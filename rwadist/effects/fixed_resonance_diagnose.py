@@ -55,16 +55,27 @@ def _line_gain_points(ctx, state, chans, runs):
     return np.concatenate(fs), np.concatenate(ys), np.concatenate(ws), np.concatenate(ds)
 
 
-def _lifted_directions(e: "FixedResonance", f: np.ndarray, dirs: np.ndarray) -> int:
-    """Number of load directions among the points ``f`` (Hz; their directions ``dirs``) where the resonance ``e``
-    changes a line's power by a factor e^:data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN` (1.5) or more, either way:
-    the stand detection's own threshold (a fixture resonance lifts every direction's lines near it)."""
+def _lifted_directions(e: "FixedResonance", f: np.ndarray, y: np.ndarray, w: np.ndarray, dirs: np.ndarray) -> int:
+    """Number of load directions whose measured lines the resonance ``e`` explains, or 0 when it makes one worse.
+
+    ``f`` (Hz), ``y`` (the log power gain each measured line needs over the model without ``e``: ln(measured /
+    predicted power)), ``w`` (its weight, :func:`_line_gain_points`) and ``dirs`` (its load direction) of every point;
+    those where ``e`` changes the power by a factor e^:data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN` (1.5) or more,
+    either way (the stand detection's own threshold), weigh each direction: it is explained when
+    Σw(y − ln|H|²)² < Σwy² over its points, made worse when the reverse.  A fixture resonance lifts every direction's lines near it; a resonance of one direction (a housing
+    mode on the radial forces) pooled over every channel lifts the torques' and axial lines it passes too, which
+    the data do not show."""
     from ..stand_resonance import STAND_MIN_LOG_GAIN
 
     if f.size == 0:
         return 0
     lg = np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2)
-    return int(np.unique(dirs[np.abs(lg) >= STAND_MIN_LOG_GAIN]).size)
+    acts = np.abs(lg) >= STAND_MIN_LOG_GAIN
+    better = []
+    for d in np.unique(dirs[acts]):
+        m = acts & (dirs == d)
+        better.append(bool(np.sum(w[m] * (y[m] - lg[m]) ** 2) < np.sum(w[m] * y[m] ** 2)))
+    return 0 if not all(better) else len(better)
 
 
 #: Evaluation limit of each least-squares fit: scipy's default for 'trf' with 3 parameters (100·n), written out
@@ -175,9 +186,9 @@ class FixedResonance:
     extended_stand: tuple | None = None
     #: H far above f_r (1: the gain returns to 1 on both sides; 0: a transmissibility, :mod:`rwadist.resonance`)
     gain_above: float = 1.0
-    #: load directions with a measured line whose power the resonance changes by a factor
-    #: e^:data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN` (1.5) or more, either way (:func:`_lifted_directions`),
-    #: for a test-stand resonance fitted on diagnose's own lines; -1 when not counted (a wheel mode, a stand of the modes'
+    #: load directions whose measured lines the resonance explains where it changes their power by 1.5x or more, 0
+    #: when it makes one worse (:func:`_lifted_directions`), for a test-stand resonance fitted on diagnose's own
+    #: lines; -1 when not counted (a wheel mode, a stand of the modes'
     #: extended fit, which has its own rule: :func:`rwadist.stand_resonance.lifts_every_direction`)
     lifted_directions: int = -1
 
@@ -344,7 +355,7 @@ class FixedResonance:
             y = y + np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain)) ** 2)
             if f.size >= 6:
                 e = _general_refit(e, f, y, np.sqrt(wt), lo, hi)
-            e = replace(e, lifted_directions=_lifted_directions(e, f, dirs))
+            e = replace(e, lifted_directions=_lifted_directions(e, f, y, wt, dirs))
         return e
 
     @staticmethod
