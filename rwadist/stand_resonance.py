@@ -293,8 +293,8 @@ def lifts_every_direction(joint, plain) -> bool:
     over the measurements where its power gain reaches :data:`STAND_MIN_LOG_GAIN` (a factor 1.5, the detection's own
     threshold), a direction is better (worse) when its squared log residuals fall below (rise above) those of the fit
     without a stand by more than its number of such measurements times the joint fit's mean squared residual (its own
-    scatter); two directions or more must be better, and any worse ones must lose less than 1/:data:`STAND_OUTWEIGH`
-    of what the better ones gain.
+    scatter); two directions or more must be lifted and none worse, or, when some are worse, two or more must be
+    better and the worse ones lose less than 1/:data:`STAND_OUTWEIGH` of what the better ones gain.
 
     A fixture resonance lifts every line near it on every channel; a resonance of one direction beside a wheel mode
     of another passed the overall criterion on what it explained there alone (family wheel 2, a resonance moving from
@@ -326,6 +326,8 @@ def lifts_every_direction(joint, plain) -> bool:
     gained = -sum(c for d, c in change.items() if c < -allowance[d])
     lost = sum(c for d, c in change.items() if c > allowance[d])
     better = sum(c < -allowance[d] for d, c in change.items())
+    if lost == 0:
+        return len(change) >= 2         # none worse: two lifted directions suffice
     return better >= 2 and lost * STAND_OUTWEIGH < gained
 
 
