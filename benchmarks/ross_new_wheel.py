@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 import ross as rs
+from ross_loadcell import NDOF, rotating  # the same ROSS conventions (DOF order, rotating-load phasors)
 
 M = 4.2                                           # rotor mass, kg
 I_RATIO = 1.56                                    # I_zz / I_rr
@@ -50,7 +51,6 @@ HARMONICS = [("radial_force", 0.4, 0.5e-6, -1), ("radial_force", 3.08, 1.2e-6, +
              ("axial_force", 1.0, 1.0e-6, +1), ("axial_force", 3.08, 0.5e-6, +1)]
 SPEEDS_RPM = np.linspace(600.0, 6000.0, 40)
 CAMPBELL_RPM = [1.0, 3000.0, 6000.0]
-NDOF = 6                                          # ROSS 2.x: x, y, z, alpha, beta, theta per shaft node
 ZETA_FIXTURE = 0.03
 
 
@@ -94,14 +94,6 @@ def load_cell(rotor, q, nu, fixture):
         out[3] += -(z[shaft_node] - zc) * fy
         out[4] += (z[shaft_node] - zc) * fx
     return out
-
-
-def rotating(dof_x, dof_y, amp, sense, ndof):
-    """Force vector of a load amp·(cos, sin)(±νt) on DOFs (dof_x, dof_y): phasors (1, ∓i)·amp."""
-    f = np.zeros(ndof, complex)
-    f[dof_x] += amp
-    f[dof_y] += -1j * sense * amp
-    return f
 
 
 def lateral_modes(rotor, rpm):

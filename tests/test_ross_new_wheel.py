@@ -22,20 +22,25 @@ from rwadist.cli import main  # noqa: E402
 DATA = Path(__file__).resolve().parent / "data"
 
 
+def _diagnosed(doc_name, tmp_path, capsys):
+    """(ROSS document, model.json, summary.json) of ``rwadist diagnose DATA -o REPORT`` on the document's records
+    (5 kHz, 8192 samples per run)."""
+    path = DATA / doc_name
+    data, out = tmp_path / "data", tmp_path / "report"
+    data_io.write_steady(rd.ross_test(sample_rate=5000.0, n_samples=8192, path=path), data)
+    assert main(["diagnose", str(data), "-o", str(out)]) == 0
+    capsys.readouterr()
+    return (rd.load_doc(path), json.loads((out / "model.json").read_text()),
+            json.loads((out / "summary.json").read_text()))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("doc_name, classes", [("ross_new_wheel.json", ["suspension_modes"]),
                                                ("ross_new_wheel_counter30.json", ["suspension_modes", "counter_rotation"])])
 def test_new_wheel_from_ross_default_command_gives_its_modes_lines_and_nothing_else(tmp_path, capsys, doc_name, classes):
     """Clean, and with a counter-rotating force on the fundamental (0.3 of the static imbalance's: ROSS carries it
     through the backward whirls): the modes, the lines, the counter-rotating part, nothing else."""
-    path = DATA / doc_name
-    doc = rd.load_doc(path)
-    data, out = tmp_path / "data", tmp_path / "report"
-    data_io.write_steady(rd.ross_test(sample_rate=5000.0, n_samples=8192, path=path), data)
-    assert main(["diagnose", str(data), "-o", str(out)]) == 0
-    capsys.readouterr()
-    model = json.loads((out / "model.json").read_text())
-    summary = json.loads((out / "summary.json").read_text())
+    doc, model, summary = _diagnosed(doc_name, tmp_path, capsys)
     assert [e["kind"] for e in model["effects"]] == classes
     assert summary["unexplained"] == []
     q_true = doc["truth"]["counter_fundamental"] ** 2 / (1 + doc["truth"]["counter_fundamental"] ** 2)
@@ -83,13 +88,7 @@ def test_new_wheel_on_a_ross_test_stand_keeps_its_modes_and_names_one_stand(tmp_
     at rest are given in the document), one test stand near 230 Hz, nothing else.  The axial mode and the stand's
     axial couple into two resonances (210 / 339 Hz) that no hard-mounted mode is: the axial mode may be left
     unconstrained, never put elsewhere silently."""
-    path = DATA / "ross_new_wheel_fixture230.json"
-    doc = rd.load_doc(path)
-    data, out = tmp_path / "data", tmp_path / "report"
-    data_io.write_steady(rd.ross_test(sample_rate=5000.0, n_samples=8192, path=path), data)
-    assert main(["diagnose", str(data), "-o", str(out)]) == 0
-    capsys.readouterr()
-    model = json.loads((out / "model.json").read_text())
+    doc, model, _ = _diagnosed("ross_new_wheel_fixture230.json", tmp_path, capsys)
     kinds = [e["kind"] for e in model["effects"]]
     assert sorted(kinds) == ["fixed_resonance", "suspension_modes"], kinds
     stand = next(e for e in model["effects"] if e["kind"] == "fixed_resonance")
