@@ -19,7 +19,7 @@ init_import_site" with its traceback, counted apart as ``pre-tb``); their output
     python benchmarks/kill_outputs.py --early 100 --only fit --only "convert h5"   # Ctrl-C in the first 0.5 s only
     python benchmarks/kill_outputs.py --window 10 [--module]    # the traceback window after exec (strace)
 
-The command run is the installed ``rwadist`` (the console script a user types).  Baseline before issue 17: a kill at
+The command run is the installed ``rwadist`` (the launcher a user types, scripts/rwadist).  Baseline before issue 17: a kill at
 the first write left a 0-byte output (2 of 2); before issue 36: the psd set was not swapped as a set (p.csv new beside
 p_cross.csv old after a kill), and 10 of 39 early Ctrl-C printed a KeyboardInterrupt traceback.  ``--early`` and
 ``--window``: what is left is the interpreter's start (docs/cli.md, "Ctrl-C while Python starts").
@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import os
 import random
 import shutil
 import signal
@@ -179,8 +180,11 @@ def _rwadist_started(pid: int) -> bool:
     first lines (/proc/PID/status SigCgt); before that the Python interpreter itself is starting."""
     try:
         status = Path(f"/proc/{pid}/status").read_text()
+        exe = os.readlink(f"/proc/{pid}/exe")
     except OSError:
         return True
+    if "python" not in Path(exe).name:     # the launcher's shell (which traps SIGTERM too) or env
+        return False
     caught = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("SigCgt:")), 16)
     return bool(caught >> (signal.SIGTERM - 1) & 1)
 
@@ -282,14 +286,35 @@ def run_matrix(name, old_argv, argv, members, kills, rng, tmp: Path) -> dict:
     return counts
 
 
-def early_matrix(table: dict, chosen: list, n: int, rng, tmp: Path, window: float = 0.5) -> int:
-    """``--early N``: N Ctrl-C per command at uniform instants in the first ``window`` s after exec (the console
-    script's start: the interpreter, site, the wrapper, rwadist's entry point, then the imports).  Counts every
-    traceback (``tb``; ``tb<h``: those that landed before rwadist's handler), the exit codes, Ctrl-C ending in one
-    line and exit 130, temporaries left, and the output set's state.  -2 is a process killed by the signal before
-    Python's own handler exists (the interpreter's first milliseconds): silent, as any program's."""
+def _in_interpreter_start(pid: int) -> bool | None:
+    """True while Python's own SIGINT handler is in place and rwadist's is not yet (the instant a Ctrl-C printed
+    Python's traceback); False before it; None once it has passed or the process is gone."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+        exe = os.readlink(f"/proc/{pid}/exe")
+    except OSError:
+        return None
+    if "python" not in Path(exe).name:
+        return False
+    caught = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("SigCgt:")), 16)
+    if caught >> (signal.SIGTERM - 1) & 1:
+        return None
+    return bool(caught >> (signal.SIGINT - 1) & 1)
+
+
+def early_matrix(table: dict, chosen: list, n: int, rng, tmp: Path, window: float = 0.5, aim: bool = False) -> int:
+    """``--early N``: N Ctrl-C per command at uniform instants in the first ``window`` s after exec (the launcher,
+    the interpreter's start: site, pip's console script; rwadist's entry point, then the imports); ``--aim``: each
+    at the instant Python's own SIGINT handler is seen in place and rwadist's not yet (``aimed``: how many were; the
+    others are sent as soon as that instant is seen to have passed).  Counts every traceback (``tb``; ``tb<h``:
+    those that landed before rwadist's handler), the exit codes, Ctrl-C ending in one line and exit 130, temporaries
+    left, the output set's state, and ``done``: commands that had ended before the Ctrl-C was sent (not
+    interrupts; their exit 0 is no failure).  -2 is a process killed by the signal before any handler exists (the
+    launcher's shell or env, or the interpreter's first milliseconds without the launcher): silent, as any
+    program's, and a shell reports it as 130."""
     from collections import Counter
-    print(f"{'command':<14} {'n':>4} {'<h':>4} {'tb':>3} {'tb<h':>4} {'1line130':>8} {'temps':>5} {'not old':>7}  exit codes")
+    print(f"{'command':<14} {'n':>4} {'<h':>4} {'tb':>3} {'tb<h':>4} {'1line130':>8} {'temps':>5} {'not old':>7} "
+          f"{'done':>4} {'aimed':>5}  exit codes")
     failures = 0
     for name in chosen:
         old_argv, argv, members = table[name]
@@ -303,8 +328,19 @@ def early_matrix(table: dict, chosen: list, n: int, rng, tmp: Path, window: floa
         for _ in range(n):
             proc = subprocess.Popen(_rwadist() + argv, cwd=tmp, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                     text=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-            time.sleep(rng.uniform(0.0, window))
+            if aim:
+                while (state := _in_interpreter_start(proc.pid)) is False:
+                    pass
+                c["aimed"] += bool(state)
+            else:
+                time.sleep(rng.uniform(0.0, window))
             before_handler = not _rwadist_started(proc.pid)
+            if proc.poll() is not None:         # ended before the Ctrl-C: not an interrupt
+                proc.communicate(timeout=600)
+                c["done"] += 1
+                _clean(members)
+                _restore(members, saved)
+                continue
             proc.send_signal(signal.SIGINT)
             _, err = proc.communicate(timeout=600)
             codes[proc.returncode] += 1
@@ -324,38 +360,51 @@ def early_matrix(table: dict, chosen: list, n: int, rng, tmp: Path, window: floa
         fail = c["tb"] + c["temps"] + sum(k for code, k in codes.items() if code not in (130, -signal.SIGINT))
         failures += fail
         print(f"{name:<14} {n:>4} {c['before_handler']:>4} {c['tb']:>3} {c['tb_before_handler']:>4} "
-              f"{c['one_line_130']:>8} {c['temps']:>5} {c['not_old']:>7}  {dict(sorted(codes.items()))}", flush=True)
+              f"{c['one_line_130']:>8} {c['temps']:>5} {c['not_old']:>7} {c['done']:>4} {c['aimed']:>5}  "
+              f"{dict(sorted(codes.items()))}", flush=True)
         for code, tail in sorted(examples.items()):
             print(f"    exit {code}, stderr ends: {tail!r}")
     print(f"failures (tracebacks + temporaries left + exit codes other than 130 and -2): {failures}; baseline "
           "(91cc6dc, the entry point importing signal and types; --early 100 --only fit --only 'convert h5' --seed 1, "
           "twice, pip 26.3's console script, load 15-23): 93 tracebacks of 400 (38 in site, exit 1), 4 Ctrl-C lost "
-          "(exit 0); after: 44 (37 in site), 0 lost")
+          "(exit 0); e2f6fb7 (no launcher): 44 (37 in site), 0 lost; --aim on e2f6fb7: every aimed Ctrl-C a "
+          "traceback (docs/cli.md, 'Ctrl-C while Python starts')")
     return 1 if failures else 0
 
 
 def handler_window(runs: int, command: list) -> int:
-    """``--window N``: when, after exec, Python installs its SIGINT handler (before it a Ctrl-C kills the process
-    silently) and when rwadist's entry point replaces it (after it, one line and 130): between the two a Ctrl-C is
-    Python's traceback.  Read from ``strace -e rt_sigaction`` (seccomp-filtered: the other system calls are not
-    slowed); ms from exec, min / median / max over N runs of ``COMMAND --version``."""
+    """``--window N``: when, after the interpreter's exec, Python installs its SIGINT handler (before it a Ctrl-C
+    kills the process silently) and when rwadist's entry point replaces it (after it, one line and 130): between
+    the two a Ctrl-C is Python's traceback -- unless the launcher (scripts/rwadist) started the interpreter with
+    SIGINT blocked, and the window is then 0 (the Ctrl-C waits for rwadist's handler).  Read from ``strace -e
+    execve,rt_sigaction,rt_sigprocmask`` (the launcher's shell and env are the same process: exec keeps the pid);
+    ms from the first exec, min / median / max over N runs of ``COMMAND --version``."""
     import re
     import statistics
     if shutil.which("strace") is None:
         raise SystemExit("--window needs strace")
-    stamps: dict = {"python handler": [], "rwadist handler": [], "window": []}
+    stamps: dict = {"interpreter exec": [], "python handler": [], "rwadist handler": [], "window": []}
+    blocked_runs = 0
     for _ in range(runs):
-        err = subprocess.run(["strace", "--seccomp-bpf", "-ttt", "-e", "trace=execve,rt_sigaction"] + command + ["--version"],
-                             capture_output=True, text=True).stderr
-        t_exec = next(float(m.group(1)) for m in re.finditer(r"^(\d+\.\d+) execve\(", err, re.M))
-        sets = [float(m.group(1)) for m in re.finditer(r"^(\d+\.\d+) rt_sigaction\(SIGINT, \{sa_handler=0x", err, re.M)]
-        stamps["python handler"].append(1e3 * (sets[0] - t_exec))
-        stamps["rwadist handler"].append(1e3 * (sets[1] - t_exec))
-        stamps["window"].append(1e3 * (sets[1] - sets[0]))
+        err = subprocess.run(["strace", "-ttt", "-e", "trace=execve,rt_sigaction,rt_sigprocmask"] + command +
+                             ["--version"], capture_output=True, text=True).stderr
+        execs = [m for m in re.finditer(r"^(\d+\.\d+) execve\(.*\) = 0$", err, re.M)]
+        t0, last = float(execs[0].group(1)), execs[-1]
+        # SIGINT blocked between the exec before the interpreter's (env's) and the interpreter's own
+        before = err[execs[-2].end():last.start()] if len(execs) > 1 else ""
+        blocked = re.search(r"rt_sigprocmask\(SIG_(BLOCK|SETMASK), \[[^]]*\bINT\b", before) is not None
+        blocked_runs += blocked
+        after = err[last.start():]
+        sets = [float(m.group(1)) for m in re.finditer(r"^(\d+\.\d+) rt_sigaction\(SIGINT, \{sa_handler=0x", after, re.M)]
+        stamps["interpreter exec"].append(1e3 * (float(last.group(1)) - t0))
+        stamps["python handler"].append(1e3 * (sets[0] - t0))
+        stamps["rwadist handler"].append(1e3 * (sets[1] - t0))
+        stamps["window"].append(0.0 if blocked else 1e3 * (sets[1] - sets[0]))
     for what, v in stamps.items():
         print(f"{what:<16} ms after exec: min {min(v):6.1f}  median {statistics.median(v):6.1f}  max {max(v):6.1f}"
               if what != "window" else f"{what:<16} ms (traceback): min {min(v):6.1f}  median "
               f"{statistics.median(v):6.1f}  max {max(v):6.1f}")
+    print(f"SIGINT blocked from before the interpreter's exec to rwadist's handler in {blocked_runs} of {runs} runs")
     return 0
 
 
@@ -366,9 +415,11 @@ def main(argv=None) -> int:
     ap.add_argument("--only", action="append", help="a command of the matrix (repeatable)")
     ap.add_argument("--early", type=int, metavar="N",
                     help="instead of the matrix: N Ctrl-C per command at uniform instants 0-0.5 s after exec")
+    ap.add_argument("--aim", action="store_true",
+                    help="--early: each Ctrl-C at the interpreter's start (its handler in place, rwadist's not yet)")
     ap.add_argument("--window", type=int, metavar="N",
                     help="instead of the matrix: the traceback window after exec, from N runs under strace")
-    ap.add_argument("--module", action="store_true", help="--window of `python -m rwadist` (default: the console script)")
+    ap.add_argument("--module", action="store_true", help="--window of `python -m rwadist` (default: the rwadist command)")
     a = ap.parse_args(argv)
     if a.window:
         return handler_window(a.window, [sys.executable, "-m", "rwadist"] if a.module else _rwadist())
@@ -380,7 +431,7 @@ def main(argv=None) -> int:
         table = cases(tmp)
         chosen = a.only or list(table)
         if a.early:
-            return early_matrix(table, chosen, a.early, rng, tmp)
+            return early_matrix(table, chosen, a.early, rng, tmp, aim=a.aim)
         print(f"{'command':<14} {'signal':<8} {'kills':>5} {'<0.5s':>5} {'pre':>3} {'pre-tb':>6} {'old':>4} {'new':>4} "
               f"{'partial':>7} {'MIXED':>5} {'BAD':>4} {'tb':>3} {'!130':>4} {'!1line':>6} {'temps':>5}  run s")
         for name in chosen:

@@ -27,7 +27,7 @@ PSD = ["psd", "--preset", "ithaco-e", "--speed-rpm", "600:2400", "--empirical", 
 
 
 def _rwadist() -> str:
-    """The installed command (the console script), as a user types it."""
+    """The installed command (the launcher scripts/rwadist), as a user types it."""
     exe = Path(sys.executable).parent / "rwadist"
     return str(exe) if exe.exists() else shutil.which("rwadist")
 
@@ -276,8 +276,11 @@ def _rwadist_started(pid: int) -> bool:
     program can take over)."""
     try:
         status = Path(f"/proc/{pid}/status").read_text()
+        exe = os.readlink(f"/proc/{pid}/exe")
     except OSError:
         return True
+    if "python" not in Path(exe).name:     # the launcher's shell (which traps SIGTERM too) or env
+        return False
     caught = int(next(ln.split()[1] for ln in status.splitlines() if ln.startswith("SigCgt:")), 16)
     return bool(caught >> (signal.SIGTERM - 1) & 1)
 
