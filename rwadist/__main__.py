@@ -28,9 +28,16 @@ except ImportError:             # an interpreter without it (not CPython)
     import signal as _sig
 
 
-def _interrupted(signum, frame):        # no command has started: nothing written
-    os.write(2, b"rwadist: interrupted; nothing written\n" if signum == _sig.SIGINT else
-             b"rwadist: terminated; nothing written\n")
+def _interrupted(signum, frame):
+    """Before the command's own handler (nothing written yet) and after it, while Python exits: then the command's
+    outputs are complete, and :func:`rwadist.outputs.interrupt_message` names them."""
+    outputs = sys.modules.get("rwadist.outputs")
+    try:
+        line = outputs.interrupt_message("", signum).encode(errors="replace") if outputs else b""
+    except Exception:       # noqa: BLE001 - a handler that must end the process whatever happens
+        line = b""
+    os.write(2, (line or (b"rwadist: interrupted" if signum == _sig.SIGINT else b"rwadist: terminated") +
+                 b"; nothing written") + b"\n")
     os._exit(130 if signum == _sig.SIGINT else 143)
 
 

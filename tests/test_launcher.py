@@ -130,3 +130,20 @@ def test_no_worker_inherits_a_blocked_ctrl_c():
         assert run.returncode == 0, run.stderr
         out[take] = int(run.stdout.split()[0])
     assert not out[True] & INT_BIT and out[False] & INT_BIT, out
+
+
+def test_ctrl_c_as_python_exits_names_the_outputs_it_completed(tmp_path):
+    """After the command (its outputs complete, its own handler gone) Python runs its exit (atexit, then module
+    teardown): a Ctrl-C there said "nothing written" of a command that had written its outputs."""
+    out = tmp_path / "m.json"
+    code = ("import atexit, os, signal, sys; import rwadist.__main__ as entry, rwadist.cli as cli, rwadist.outputs as o\n"
+            "def command(argv=None):\n"
+            "    with o.exit_on_interrupt('fit'):\n"
+            f"        o._WRITTEN.append({str(out)!r})\n"
+            "    return 0\n"
+            "cli.main = command\n"
+            "atexit.register(os.kill, os.getpid(), signal.SIGINT)\n"
+            "sys.exit(entry.main())\n")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 130 and run.stderr.count("\n") == 1, (run.returncode, run.stderr)
+    assert "interrupted" in run.stderr and str(out) in run.stderr and "nothing written" not in run.stderr, run.stderr
