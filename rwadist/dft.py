@@ -176,10 +176,13 @@ def windowed_dfts(x: "np.ndarray | BlockedRecords", sample_rate: float, f_hz: np
         if single:
             table = np.empty((r, 2 * n_f, block), dtype=np.float32)
             table[:, :n_f], table[:, n_f:] = fine.real, fine.imag
-            parts = (table @ xt).astype(float)
         else:
-            parts = np.concatenate([fine.real, fine.imag], axis=1) @ xt                                # (r, 2L, J·K)
-        inner = (parts[:, :n_f] + 1j * parts[:, n_f:]).reshape(r, n_f, n_blocks, k)                 # (r, L, J, K)
+            table = np.concatenate([fine.real, fine.imag], axis=1)
+        parts = table @ xt                                                                             # (r, 2L, J·K)
+        # the complex fine sums written part by part (the numbers of parts[:, :L] + 1j·parts[:, L:], no temporaries)
+        sums = np.empty((r, n_f, n_blocks * k), dtype=complex)
+        sums.real, sums.imag = parts[:, :n_f], parts[:, n_f:]
+        inner = sums.reshape(r, n_f, n_blocks, k)                                                      # (r, L, J, K)
         out[s:s + step] = (coarse @ inner)[:, :, 0, :]
     return out
 

@@ -106,14 +106,30 @@ def _smooth_trend(x: np.ndarray, y: np.ndarray, half: int = 3, keep: np.ndarray 
         if kept.size >= 3 and np.ptp(xs[kept]) > 0:
             slope, icpt = theilslopes(ys[kept], xs[kept])[:2]
             line = icpt + slope * xs
-        rest = ys - line
-        for i in range(ys.size):
-            p = int(np.searchsorted(kept, i))
-            own = p < kept.size and kept[p] == i
-            out[i] = line[i] + np.median(rest[kept[max(0, p - half):p + half + (1 if own else 0)]])
+        out = line + _window_medians(ys - line, kept, half)
     back = np.empty_like(out)
     back[order] = out
     return back
+
+
+def _window_medians(rest: np.ndarray, kept: np.ndarray, half: int) -> np.ndarray:
+    """Per point i of ``rest`` (n,), the median of ``rest`` over the ``half`` points of ``kept`` (increasing indices, at
+    least one) on either side of i, and i itself when kept: the numbers of :func:`numpy.median` of each window (the
+    middle value, or the mean of the two middle ones; NaN when the window holds one), all windows at once."""
+    n = rest.size
+    p = np.searchsorted(kept, np.arange(n))
+    own = (p < kept.size) & (kept[np.minimum(p, kept.size - 1)] == np.arange(n))
+    lo = np.maximum(p - half, 0)
+    count = np.minimum(p + half + own, kept.size) - lo
+    idx = lo[:, None] + np.arange(2 * half + 1)[None, :]
+    inside = np.arange(2 * half + 1)[None, :] < count[:, None]
+    vals = np.where(inside, rest[kept[np.minimum(idx, kept.size - 1)]], np.inf)
+    nan = np.any(np.isnan(vals), axis=1)
+    srt = np.sort(np.where(np.isnan(vals), np.inf, vals), axis=1)
+    rows = np.arange(n)
+    upper = srt[rows, count // 2]
+    med = np.where(count % 2 == 1, upper, (srt[rows, np.maximum(count // 2 - 1, 0)] + upper) / 2.0)
+    return np.where(nan, np.nan, med)
 
 
 def _run_deviations(ctx, ratios: list, apart: np.ndarray | None = None) -> np.ndarray:
