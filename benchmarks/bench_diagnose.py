@@ -17,7 +17,8 @@ Run: ``.venv/bin/python benchmarks/bench_diagnose.py [--quick [--sets benchmark 
    speeds over 300-3000 rpm; both by default).  ``rwadist fit`` (:func:`rwadist.api.fit`) and ``rwadist diagnose DATA`` without a
    model (:func:`rwadist.api.diagnose`: the wheel's suspension modes fitted first) in a fresh process that runs
    them as the command line does (its module first, everything inside :func:`rwadist.cli.one_blas_thread`, so a
-   thread pool loaded during the calls counts), ``--repeats`` interleaved (fit, diagnose) pairs, min and median of
+   thread pool loaded during the calls counts), one first (fit, diagnose) pair (the modules each call imports load
+   there: its CPU printed, not counted), then ``--repeats`` interleaved (fit, diagnose) pairs, min and median of
    wall-clock and CPU time with the load average, the thread pools printed; each set timed as the machine is, then
    beside ``--busy K`` spinning processes (default 2), and every ratio summarised at the end.
 
@@ -38,7 +39,14 @@ d2e0f8e x10.4-10.5 and x11.5-11.7 (min; diagnose 2.2 s / fit 0.21 s, 1.3 s / 0.1
 screened in single precision and their best f0 searched again in double precision (the same best points) and the
 suspension-mode refit reusing the whole data's empirical fit: diagnoses of both sets and of family wheels 0, 2, 4, 7
 (clean, fixtures) bit-identical.  What is left is spread over the families (``--quick`` under a profiler): the first
-modes fit ~25 %, the other families' two search steps ~40 %, the refit ~10 %.
+modes fit ~25 %, the other families' two search steps ~40 %, the refit ~10 %.  Session 8 (2026-11-29, 45f9c67, the
+first pair now timed apart; load 6-8 on 2 cores from other jobs, so no idle figure): cpu x10.6 / x10.1 (min / median,
+benchmark; 2.86 s / 0.27 s), x11.7 / x11.7 (sixty; 1.54 s / 0.13 s); beside 2 busy processes x11.4 / x9.3 and x13.9 /
+x12.4.  In-call timers (one process, sixty): the suspension-modes fit and refit ~40 % (the mode scans ~17 %, most of it
+the rocking mode's single-precision screens of 339x9x15 and 101x11x21 grids, ~17 elementwise passes per point and row;
+the log-amplitude least squares 4 %; the load-cell offset check of every fit, a cross_coupling fit, 3 %), the other
+families' candidates and fits ~45 %, none over 8 %, of which the whole-run line powers (speed_sidebands._line_powers,
+single-precision DFTs) 11 %.
 """
 from __future__ import annotations
 
@@ -345,8 +353,10 @@ def timing_data(which: str):
 
 #: the timing child: a fresh interpreter that runs the calls as ``rwadist fit`` / ``rwadist diagnose`` do -- the command
 #: line's module imported first, the data read and every call made inside rwadist.cli.one_blas_thread, so that a library
-#: loaded during the calls (scipy.linalg's OpenBLAS) loads there; interleaved (fit, diagnose) pairs; JSON out: wall and CPU
-#: seconds of each call, the thread pools at the end (threadpoolctl).  Not this file: its imports load scipy first.
+#: loaded during the calls (scipy.linalg's OpenBLAS) loads there; one first (fit, diagnose) pair, which loads the modules
+#: each call imports (1.0-1.6 s CPU for the first fit), timed apart ("first"), then ``repeats`` interleaved pairs; JSON
+#: out: wall and CPU seconds of each call, the thread pools at the end (threadpoolctl).  Not this file: its imports load
+#: scipy first.
 TIMING_CHILD = """
 import json, sys, time
 from pathlib import Path
@@ -356,12 +366,16 @@ with cli.one_blas_thread():
     from threadpoolctl import threadpool_info
     from rwadist import api
     t = api.read(path)
-    out = {"fit": [], "diagnose": []}
-    for _ in range(repeats):
+    out = {"fit": [], "diagnose": [], "first": {}}
+    for i in range(repeats + 1):
         for name, fn in (("fit", lambda: api.fit(t)), ("diagnose", lambda: api.diagnose(t))):
             t0, c0 = time.perf_counter(), time.process_time()
             fn()
-            out[name].append((time.perf_counter() - t0, time.process_time() - c0))
+            took = (time.perf_counter() - t0, time.process_time() - c0)
+            if i == 0:
+                out["first"][name] = took
+            else:
+                out[name].append(took)
     out["pools"] = [(i["internal_api"], Path(i["filepath"]).name, i["num_threads"]) for i in threadpool_info()]
 print(json.dumps(out))
 """
@@ -407,14 +421,15 @@ def timing(sets=("benchmark", "sixty"), repeats: int = 5, busy: int = 2):
                 print(f"\n{which}: {len(t.runs)} speeds ({speeds.min():.0f}-{speeds.max():.0f} rpm) x "
                       f"{len(t.runs[0].signals)} channels, {t.runs[0].n_samples} samples at "
                       f"{t.runs[0].sample_rate:g} Hz, modes on, one effect; {repeats} interleaved (fit, diagnose) "
-                      f"pairs in one process, {n_busy} busy processes beside; load average {res['load'][0]:.2f} -> "
+                      f"pairs in one process after a first one, {n_busy} busy processes beside; load average {res['load'][0]:.2f} -> "
                       f"{res['load'][1]:.2f}")
                 stat = {}
                 for name in ("fit", "diagnose"):
                     wall, cpu = np.array(res[name]).T
                     stat[name] = (wall.min(), float(np.median(wall)), cpu.min(), float(np.median(cpu)))
                     print(f"  {name:8s} wall min {wall.min():6.2f} s  median {np.median(wall):6.2f} s   "
-                          f"cpu min {cpu.min():6.2f} s  median {np.median(cpu):6.2f} s   (first call cpu {cpu[0]:.2f} s)")
+                          f"cpu min {cpu.min():6.2f} s  median {np.median(cpu):6.2f} s   (first call, not counted: cpu "
+                          f"{res['first'][name][1]:.2f} s)")
                 f, d = stat["fit"], stat["diagnose"]
                 ratios = [d[i] / f[i] for i in range(4)]
                 print(f"  diagnose / fit: wall x{ratios[0]:.1f} (min) x{ratios[1]:.1f} (median), cpu x{ratios[2]:.1f} "
