@@ -77,9 +77,9 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     A fixture resonance on every channel is fitted with the modes, never into them (:func:`_locate`); the stand
     itself is left to the search (a ``fixed_resonance`` of role test_stand proposed from this fit's stand).  A load-cell
     offset the located modes leave in the torques is taken out before the modes are located (:func:`_beside_offset`);
-    then, when a mode stays unconstrained and no stand is kept, a mode of the wheel's structure on one direction is
-    tried beside the modes (:func:`rwadist.stand_resonance.fit_extended_beside_structure_mode`): the fit is then that
-    joint fit (its ``stand`` on one direction, ``stand_direction``) and the stand None.  The offset first: the torques
+    then, when no stand is kept, a mode of the wheel's structure on one direction is tried beside the modes (on a
+    direction whose mode stays unconstrained, or on the forces when every mode is located:
+    :func:`rwadist.stand_resonance.fit_extended_beside_structure_mode`): the fit is then that joint fit (its ``stand`` on one direction, ``stand_direction``) and the stand None.  The offset first: the torques
     read r × F of the forces' lines amplified by their translation, which a resonance of the torques alone at that
     frequency also explains (family wheel 4, r_z = −60 mm: a 'structure mode' at 228.5 Hz on the torques, its 227.7 Hz
     translation, pinned the rocking 4.9 % off and the offset's correction was never tried)."""
@@ -106,7 +106,8 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             got = _beside_offset(ctx, state, efit, fit, runs, test, stand_start, near)
             if got is not None:
                 test, fit, efit, stand, _ = got
-        if stand is None and efit.unconstrained and len(ctx.channels) > 3:
+        if stand is None and len(ctx.channels) > 3:
+            # on an unconstrained mode's direction, or on the forces when every mode is located
             structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
             if structure is not None:
                 efit = structure
