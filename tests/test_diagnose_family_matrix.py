@@ -128,3 +128,15 @@ def test_a_rocking_located_on_the_offsets_lines_is_located_again_on_the_correcte
     cell = _cell(3, "lever_arm_noise", tmp_path)
     assert "crashed" not in cell and cell["found"] == [True] and not cell["added"], cell
     assert cell["modes_ok"] and "unc" not in cell["modes"], cell
+
+
+@pytest.mark.slow
+def test_the_offset_the_modes_are_fitted_beside_is_the_one_the_search_names(tmp_path):
+    """Family wheel 2 (15 kg, modes 90/50/62 Hz, 300-3000 rpm) with a load-cell offset r_z = -60 mm: the refit on every
+    run estimates the offset beside the modes twice, -63.19 then -61.93 mm (the search's cross_coupling: -61.92 ±
+    1.27); the second round is no better by 4 standard errors but no worse, and it is the one the torque lines are now
+    fitted beside.  The error within 1.5x the clean cell's (main 45f9c67, the first round kept: 2.0x; now 1.1x)."""
+    clean = _cell(2, "clean", tmp_path)
+    cell = _cell(2, "cross_coupling", tmp_path)
+    assert "crashed" not in cell and cell["found"] == [True] and not cell["added"] and cell["modes_ok"], cell
+    assert cell["error"][1] <= 1.5 * clean["error"][1], (cell["error"], clean["error"])
