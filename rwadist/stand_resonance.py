@@ -444,6 +444,24 @@ def structure_confirmed(joint, plain) -> bool:
                 and pins)
 
 
+def structure_mode_refused(test, fit, direction: str, stand: tuple) -> tuple:
+    """(evidence, f_r Hz) of ``test`` (empirical fit ``fit``) against a mode of the wheel's structure on ``direction``
+    at ``stand`` (f_r Hz, ζ, peak gain): the structure mode fitted again from it, jointly with the suspension modes,
+    and its Bayesian information criterion over the fit with ``stand`` held, n·ln(SSR_held / SSR_free) −
+    :data:`STRUCTURE_PARAMETERS`·ln n (> 0: these data want a resonance of their own), and the frequency they want.
+    Raises ValueError when an extended fit fails."""
+    from .extended_fit import fit_extended
+
+    start = tuple(stand[:3]) + (1.0,)
+    held = fit_extended(test, fit, stand=start, stand_direction=direction)
+    free = _joint_from(test, fit, start, {"stand_direction": direction})
+    n = int(np.sum(np.isfinite(free.line_residuals[1])))
+    c0, c1 = joint_cost(held), joint_cost(free)
+    if free.stand is None or n <= STRUCTURE_PARAMETERS or c1 <= 0 or c0 <= 0:
+        return -np.inf, float(stand[0])
+    return float(n * np.log(c0 / c1) - STRUCTURE_PARAMETERS * np.log(n)), float(free.stand[0])
+
+
 def fit_extended_beside_structure_mode(test, fit, plain, start: tuple | None = None, **kwargs):
     """The extended fit of ``test`` (empirical fit ``fit``) with a mode of the wheel's structure on one direction fitted
     jointly with the suspension modes (:func:`rwadist.extended_fit.fit_extended`'s ``stand_direction``), or None.

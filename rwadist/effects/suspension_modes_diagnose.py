@@ -109,6 +109,8 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
         if stand is None and len(ctx.channels) > 3:
             # on an unconstrained mode's direction, or on the forces when every mode is located
             structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
+            if structure is not None and not _fixed_across_speeds(ctx, runs, structure):
+                structure = None        # a resonance moving with speed: the open world describes it
             if structure is not None:
                 efit = structure
     except ValueError:
@@ -116,6 +118,52 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     if len(efit.unconstrained) == 3:
         return None                     # no mode located: nothing to name
     return test, fit, efit, stand
+
+
+#: A structure mode is a fixed-frequency resonance: when the slower and the faster half of the runs each want a
+#: resonance of their own (:func:`rwadist.stand_resonance.structure_mode_refused`), their two frequencies must lie
+#: within its own relative half-width ζ, and within this at least, for it to stay one fixed resonance
+STRUCTURE_SPEED_SPLIT_TOL = 0.03
+#: ... each half holding this many runs at least (fewer: the split tells nothing, the mode is kept)
+STRUCTURE_SPLIT_MIN_RUNS = 5
+
+
+def _fixed_across_speeds(ctx: Context, runs, joint) -> bool:
+    """Whether the structure mode of ``joint`` (its ``stand`` on ``stand_direction``) stays at one frequency across
+    the speeds.  On the slower and on the faster half of ``runs``, the structure mode is fitted again from it (jointly
+    with the suspension modes) and set against the fit holding it
+    (:func:`rwadist.stand_resonance.structure_mode_refused`: the Bayesian information criterion of its three
+    parameters); it moves with the speed when BOTH halves want a resonance of their own and their two frequencies are
+    more than the resonance's relative half-width ζ (or :data:`STRUCTURE_SPEED_SPLIT_TOL`) apart.  A mode whose
+    frequency falls or rises with speed (a rotor mode softening, a drive resonance following the speed) also lifts
+    the lines of one direction, and one fixed resonance fitted to it sits between its ends (family wheel 0, a radial
+    resonance softening 248 -> 149 Hz over the speeds: a 'wheel mode' at 198 Hz; the halves want 202 and 188 Hz, each
+    beyond its criterion by 75 and 194): it is no wheel mode, and the open world describes it (``moving_resonance``).
+    A fixed one fitted on half its speeds may run off (family wheel 5: 538 Hz on the slower half for a 490-Hz mode)
+    but that half does not want it (criterion -29).  Halves too short, or fits that fail, tell nothing: kept."""
+    from ..data import SteadyTest
+    from ..empirical import fit_empirical
+    from ..stand_resonance import structure_mode_refused
+
+    runs = np.asarray([int(r) for r in runs])
+    half = runs.size // 2
+    if half < STRUCTURE_SPLIT_MIN_RUNS:
+        return True
+    spin = np.abs(np.asarray(ctx.test.speeds, dtype=float)[runs])
+    order = np.argsort(spin, kind="stable")
+    f_r, zeta, gain = joint.stand[:3]
+    got = []
+    for part in (np.sort(runs[order[:half]]), np.sort(runs[order[-half:]])):
+        test = SteadyTest([ctx.test.runs[r] for r in part], dict(ctx.test.meta))
+        try:
+            sp, detections = _fit_spectra(ctx, test, part)
+            got.append(structure_mode_refused(test, fit_empirical(sp, detections=detections), joint.stand_direction,
+                                              (f_r, zeta, gain)))
+        except ValueError:
+            return True
+    moved = abs(float(np.log(got[1][1] / got[0][1])))
+    moving = got[0][0] > 0 and got[1][0] > 0 and moved > max(zeta, STRUCTURE_SPEED_SPLIT_TOL)
+    return not moving
 
 
 def _locate(ctx: Context, test, fit, stand_start, near=None):
