@@ -156,7 +156,7 @@ def _fixed_across_speeds(ctx: Context, runs, joint) -> bool:
     for part in (np.sort(runs[order[:half]]), np.sort(runs[order[-half:]])):
         test = SteadyTest([ctx.test.runs[r] for r in part], dict(ctx.test.meta))
         try:
-            sp, detections = _fit_spectra(ctx, test, part)
+            sp, detections = _fit_spectra(ctx, test, [int(r) for r in part])
             got.append(structure_mode_refused(test, fit_empirical(sp, detections=detections), joint.stand_direction,
                                               (f_r, zeta, gain)))
         except ValueError:
