@@ -144,6 +144,9 @@ def test_ctrl_c_as_python_exits_names_the_outputs_it_completed(tmp_path):
             "cli.main = command\n"
             "atexit.register(os.kill, os.getpid(), signal.SIGINT)\n"
             "sys.exit(entry.main())\n")
-    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    # Ctrl-C as at a terminal: a job started in the background (`cmd &` in a script, as a CI runner may start the
+    # suite) inherits SIGINT ignored, and rwadist keeps an ignored SIGINT ignored
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     assert run.returncode == 130 and run.stderr.count("\n") == 1, (run.returncode, run.stderr)
     assert "interrupted" in run.stderr and str(out) in run.stderr and "nothing written" not in run.stderr, run.stderr
