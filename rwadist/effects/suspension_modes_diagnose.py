@@ -64,6 +64,18 @@ def _fit_spectra(ctx: Context, test, runs: list):
     return sp, detections_of_runs({c: det[c] for c in chans if c in det}, rows)
 
 
+def _test_and_fit(ctx: Context, runs) -> tuple:
+    """(SteadyTest, EmpiricalFit) of the context's runs ``runs`` (positions), the fit at the modes' own resolution
+    (:func:`_fit_spectra`)."""
+    from ..data import SteadyTest
+    from ..empirical import fit_empirical
+
+    runs = [int(r) for r in runs]
+    test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
+    sp, detections = _fit_spectra(ctx, test, runs)
+    return test, fit_empirical(sp, detections=detections)
+
+
 def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None, near: dict | None = None,
               structure_start: tuple | None = None):
     """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
@@ -141,8 +153,6 @@ def _fixed_across_speeds(ctx: Context, runs, joint) -> bool:
     beyond its criterion by 75 and 194): it is no wheel mode, and the open world describes it (``moving_resonance``).
     A fixed one fitted on half its speeds may run off (family wheel 5: 538 Hz on the slower half for a 490-Hz mode)
     but that half does not want it (criterion -29).  Halves too short, or fits that fail, tell nothing: kept."""
-    from ..data import SteadyTest
-    from ..empirical import fit_empirical
     from ..stand_resonance import structure_mode_refused
 
     runs = np.asarray([int(r) for r in runs])
@@ -154,11 +164,9 @@ def _fixed_across_speeds(ctx: Context, runs, joint) -> bool:
     f_r, zeta, gain = joint.stand[:3]
     got = []
     for part in (np.sort(runs[order[:half]]), np.sort(runs[order[-half:]])):
-        test = SteadyTest([ctx.test.runs[r] for r in part], dict(ctx.test.meta))
         try:
-            sp, detections = _fit_spectra(ctx, test, [int(r) for r in part])
-            got.append(structure_mode_refused(test, fit_empirical(sp, detections=detections), joint.stand_direction,
-                                              (f_r, zeta, gain)))
+            test, fit = _test_and_fit(ctx, part)
+            got.append(structure_mode_refused(test, fit, joint.stand_direction, (f_r, zeta, gain)))
         except ValueError:
             return True
     moved = abs(float(np.log(got[1][1] / got[0][1])))
@@ -360,15 +368,9 @@ def _whole_data_fit(ctx: Context):
     detected from the lines near it, so half of a short speed grid (10 of 20 speeds) can hide both while every
     run shows them.  A detection only: the modes (and the stand) are still fitted on the fit runs and judged on
     the held-out ones."""
-    from ..data import SteadyTest
-    from ..empirical import fit_empirical
-
     key = ("suspension_modes.whole_data_fit",)
     if key not in ctx._memo:
-        runs = [int(r) for r in ctx.runs]
-        test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
-        sp, detections = _fit_spectra(ctx, test, runs)
-        ctx._memo[key] = fit_empirical(sp, detections=detections)
+        ctx._memo[key] = _test_and_fit(ctx, ctx.runs)[1]
     return ctx._memo[key]
 
 
@@ -633,8 +635,6 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
     import copy
     from dataclasses import replace
 
-    from ..data import SteadyTest
-    from ..empirical import fit_empirical
     from ..extended_fit import MODE_KEY, fit_extended
     from ..stand_resonance import STAND_SETTLED_MODE, _mode_hz
 
@@ -647,10 +647,7 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
               and (own is None or abs(e.f_r / own[0] - 1) > SAME_STAND)]
     if not others:
         return state
-    runs = [int(r) for r in ctx.runs]
-    test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
-    sp, detections = _fit_spectra(ctx, test, runs)
-    fit = fit_empirical(sp, detections=detections)
+    test, fit = _test_and_fit(ctx, ctx.runs)
     try:
         one = fit_extended(test, fit, stand=own)
         every = fit_extended(test, fit, stand=own, more_stands=tuple(others))
