@@ -29,6 +29,10 @@ RECORD_STEP_BINS = 0.25
 #: its maximum can sit a step from the pair's (family wheel 4, f_mod 5.625 Hz at 0.9375-Hz record bins: scanned at
 #: 5.859 as one of seven runs left, the pair's Σ|X|² at 5.625, on the edge of a one-step grid: no sidebands)
 REFINE_STEPS = 2
+#: Farthest offset of the whole-run scans, Welch bins: ``sidebands`` scans to 2.5 (``_record_offsets``), ``speed_ripple``
+#: the same grid to 4 (its RECORD_WELCH_BINS); a carrier's line powers on the same runs are computed once, to the
+#: farther (:meth:`Sidebands._scan_powers`), and each scan reads its part
+RECORD_SCAN_WELCH_BINS = 4.0
 #: A carrier's whole-run scan score (median |X|²/noise over runs, channels and both sides) a pair must clear:
 #: that of :meth:`rwadist.effects.speed_sidebands_diagnose.SpeedSidebands.candidates` (the lines 20 × over the
 #: noise on half the points).
@@ -170,11 +174,34 @@ class Sidebands:
         key = ("sidebands_record_power", direction, float(h), np.asarray(runs).tobytes(), f.tobytes(), single)
         chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
         if key not in ctx._memo:
-            P = _line_powers(ctx, chans, runs, f, h, single=single)
+            P = Sidebands._scan_powers(ctx, chans, direction, h, runs, offsets) if single else None
+            if P is None:
+                P = _line_powers(ctx, chans, runs, f, h, single=single)
             P.flags.writeable = False                   # shared by every later reader
             ctx._memo[key] = P
         return f, ctx._memo[key], _run_noise(ctx, state, chans, runs, f), \
             Sidebands._record_valid(ctx, state, direction, h, runs, f)
+
+    @staticmethod
+    def _scan_powers(ctx: Context, chans, direction: str, h: float, runs, offsets) -> "np.ndarray | None":
+        """The single-precision line powers (:func:`_line_powers`) of the lower then upper sides f_c ∓ ``offsets`` when
+        ``offsets`` begin the whole-run scans' grid (:meth:`_record_offsets` continued to :data:`RECORD_SCAN_WELCH_BINS`):
+        read from that grid's powers, computed once per carrier and runs (the same numbers: each phasor is its own
+        frequency's, whatever others are transformed with it); None for other offsets."""
+        from .speed_sidebands_diagnose import RUN_MIN_BINS, _line_powers, _record_df
+
+        df_rec = float(np.max(_record_df(ctx, ctx.runs)))
+        grid = np.arange(RUN_MIN_BINS * df_rec, RECORD_SCAN_WELCH_BINS * ctx.df, RECORD_STEP_BINS * df_rec)
+        n = offsets.size
+        if not 0 < n <= grid.size or not np.array_equal(grid[:n], offsets):
+            return None
+        key = ("sidebands_scan_powers", direction, float(h), np.asarray(runs).tobytes(), grid.tobytes())
+        if key not in ctx._memo:
+            fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
+            ctx._memo[key] = _line_powers(ctx, chans, runs, np.concatenate([fc - grid, fc + grid], axis=1), h,
+                                          single=True)
+        P = ctx._memo[key]
+        return np.concatenate([P[:, :n], P[:, grid.size:grid.size + n]], axis=1)
 
     @staticmethod
     def fit_record(ctx: Context, state: State, direction: str, h: float, runs, f_mod: float) -> "Sidebands | None":

@@ -1,0 +1,47 @@
+"""The whole-run scans of ``sidebands`` (offsets to 2.5 Welch bins) and ``speed_ripple`` (the same grid to 4) read one set
+of line powers per carrier and runs (:meth:`rwadist.effects.sidebands_diagnose.Sidebands._scan_powers`): each scan's
+powers must be those computed for its own offsets alone (the uncached route, :func:`_line_powers` at exactly those
+frequencies), to the bit, and the shared set must be transformed once.
+
+Data: the E-wheel data of tests/test_diagnose.py with the whole records (the context's ``test``)."""
+from __future__ import annotations
+
+import numpy as np
+from test_diagnose import TRUTH, e_data, spectra
+
+from rwadist.diagnose.engine import Context, initial_state
+from rwadist.effects import sidebands_diagnose as sd
+from rwadist.effects import speed_sidebands_diagnose as ssd
+from rwadist.effects.speed_ripple_diagnose import RECORD_WELCH_BINS
+from rwadist.units import DIRECTION_CHANNELS
+
+
+def test_both_record_scans_read_their_own_offsets_powers_computed_once(monkeypatch):
+    test = e_data(3)
+    ctx = Context(spectra(test), test=test)
+    state = initial_state(ctx, TRUTH)
+    runs = ctx.fit_runs[np.argsort(ctx.omega[ctx.fit_runs])[::-1][:sd.RECORD_SCAN_RUNS]]
+    df_rec = float(np.max(ssd._record_df(ctx, ctx.runs)))
+    own = sd.Sidebands._record_offsets(ctx)
+    ripple = np.arange(ssd.RUN_MIN_BINS * df_rec, RECORD_WELCH_BINS * ctx.df, sd.RECORD_STEP_BINS * df_rec)
+    assert sd.RECORD_SCAN_WELCH_BINS == RECORD_WELCH_BINS    # the shared grid is the ripple's
+    assert 3 <= own.size < ripple.size          # the sidebands' grid is the first part of the ripple's
+    calls = []
+    transform = ssd._line_powers
+    monkeypatch.setattr(ssd, "_line_powers", lambda *a, **k: calls.append(a[3].shape) or transform(*a, **k))
+    direction, h = "radial_force", 2.0
+    chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+    fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
+    for offsets in (own, ripple, own[:5]):
+        f, P, _, _ = sd.Sidebands._record_power(ctx, state, direction, h, runs, offsets, single=True)
+        alone = transform(ctx, chans, runs, np.concatenate([fc - offsets, fc + offsets], axis=1), h, single=True)
+        np.testing.assert_array_equal(f, np.concatenate([fc - offsets, fc + offsets], axis=1))
+        np.testing.assert_array_equal(P, alone)
+        assert not P.flags.writeable
+    assert calls == [(runs.size, 2 * ripple.size)]      # one transform, of the farther grid
+    # offsets that do not begin the grid (a fit's refinement around one offset) are transformed as asked
+    grid = own[4] + np.arange(-2, 3) * 0.02 * df_rec
+    _, P, _, _ = sd.Sidebands._record_power(ctx, state, direction, h, runs, grid, single=True)
+    np.testing.assert_array_equal(P, transform(ctx, chans, runs, np.concatenate([fc - grid, fc + grid], axis=1), h,
+                                               single=True))
+    assert len(calls) == 2
