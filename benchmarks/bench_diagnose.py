@@ -46,7 +46,16 @@ x12.4.  In-call timers (one process, sixty): the suspension-modes fit and refit 
 the rocking mode's single-precision screens of 339x9x15 and 101x11x21 grids, ~17 elementwise passes per point and row;
 the log-amplitude least squares 4 %; the load-cell offset check of every fit, a cross_coupling fit, 3 %), the other
 families' candidates and fits ~45 %, none over 8 %, of which the whole-run line powers (speed_sidebands._line_powers,
-single-precision DFTs) 11 %.
+single-precision DFTs) 11 %.  Session 9 (2026-11-29, 167d71a and 05ca104 alternated old/new/new/old, --quick
+--repeats 3 --busy 2, load 3.5-7 from other jobs), cpu min / median: benchmark x11.3/x9.1, x10.0/x9.4 (167d71a) against
+x10.4/x9.9, x9.7/x9.4 (05ca104), 2 busy x11.0/x8.8, x10.1/x9.4 against x10.3/x10.0, x9.9/x8.7; sixty x11.3/x11.2,
+x12.2/x11.7 against x12.0/x11.2, x12.6/x11.6, 2 busy x12.6/x11.3, x12.0/x11.9 against x12.0/x11.4, x11.8/x11.8: the
+line powers the sidebands and speed_ripple scans now share (~20 ms, 1.5 % of the sixty set's diagnose CPU) are below
+this noise; target not met.  py-spy samples of the sixty set at 05ca104 (6 diagnoses): the suspension-modes fit and
+refit 43 %, of which the mode scans 19 % (single-precision screens at ~10 ns per grid point and row: ~20 elementwise
+passes, 3 logarithms and 13 products with the line indicator, kept below ~1e6 multiply-adds, where OpenBLAS's small
+kernel runs them 2.4x faster; stacking them into fewer, larger products measured slower), the whole-run DFTs 9 % (their
+products at ~120 GFlop/s single precision, the rest their tables of phasors).
 """
 from __future__ import annotations
 
