@@ -11,12 +11,15 @@ load average):
     (:func:`rwadist.coupling.floor_responses` on its default grid), with the work each does against the plain
     sweep's: line points (speed x line group; a ripple's sideband orders m = -K..K multiply the groups by 2K + 1,
     each at its own frequency, i.e. one coupled interface solve per point) and floor points (speed x grid frequency).
+``--no-peer``: leave python-control out (60-70 s CPU a round; the effects' baseline is the plain sweep).
 ``--dask``: the plain sweep on a 2-worker local dask cluster (processes, 1 thread each) as well.
 ``--orders``: the ripple's points an oracle pruning would keep at 1e-9 of every RMS (:func:`needed_points`, untimed): the
-least work any exact per-point evaluation of the ripple's sidebands needs.
+least work any exact per-point evaluation of the ripple's sidebands needs; and what a pruning by the blocked loads (known
+before the solve) would move the RMS by (:func:`load_trimmed`).  The CPU per line point, plain and with the ripple, is
+printed beside: the ripple's cost is its points' count at the plain sweep's cost per point.
 BLAS is pinned to one thread so serial and parallel compare like for like.
 
-Run: python benchmarks/bench_coupling.py [--speeds N] [--repeats R] [--dask] [--orders]
+Run: python benchmarks/bench_coupling.py [--speeds N] [--repeats R] [--no-peer] [--dask] [--orders]
 """
 import os
 
@@ -71,6 +74,27 @@ def line_points(wheels, speeds):
     return speeds.size * groups * (2 * k + 1), k
 
 
+def load_trimmed(lr, tols=(1e-14, 1e-12, 1e-10, 1e-8, 1e-6)):
+    """What an a-priori pruning of the ripple's points costs in accuracy (issue 37): a point (speed, line group) left
+    out when its blocked load (the only size known before the coupled solve) is below ``tol`` x the largest blocked
+    load of its speed.  Leaving a point out is exactly its phasors set to 0, so from the full responses ``lr``
+    (:class:`rwadist.coupling.LineResponses` of wheels that share their lines): [(tol, points kept as a share of all,
+    largest relative change of any practice's, output's and speed's lines' RMS)]."""
+    mag = np.sqrt(np.sum(np.abs(lr.hard_mounted[0]) ** 2, axis=-1))          # (S, J): the wheels share the lines
+    rel = mag / np.maximum(mag.max(axis=1, keepdims=True), 1e-300)
+    rows = []
+    for tol in tols:
+        keep = (rel >= tol)[..., None]
+        worst = 0.0
+        for ys in lr.y.values():
+            ms = sum(np.sum(np.abs(y) ** 2, axis=1) for y in ys)
+            ms_kept = sum(np.sum(np.abs(np.where(keep, y, 0)) ** 2, axis=1) for y in ys)
+            live = ms > 0
+            worst = max(worst, float(np.max(np.abs(np.sqrt(ms_kept[live] / ms[live]) - 1), initial=0.0)))
+        rows.append((tol, float(keep.mean()), worst))
+    return rows
+
+
 def needed_points(plant, wheels, speeds, tol=1e-9):
     """Points an oracle pruning would keep (issue 37): per practice, speed and output, the (speed, line group) points
     of the smallest power that can be left out together while the lines' RMS moves by <= ``tol`` relative (their
@@ -88,7 +112,7 @@ def needed_points(plant, wheels, speeds, tol=1e-9):
         np.put_along_axis(kept, order, ~dropped, axis=1)
         keep |= kept.any(axis=2)
     m = lr.ripple_order[0]
-    return int(keep.sum()), {int(k): float(keep[:, m == k].mean()) for k in np.unique(m)}
+    return int(keep.sum()), {int(k): float(keep[:, m == k].mean()) for k in np.unique(m)}, lr
 
 
 def _timed(fn):
@@ -97,7 +121,7 @@ def _timed(fn):
     return (time.perf_counter() - t0, time.process_time() - c0), out
 
 
-def main(n_speeds=1000, repeats=3, dask=False, orders=False):
+def main(n_speeds=1000, repeats=3, dask=False, orders=False, peer=True):
     plant, wheels, eff, speeds = setup(n_speeds)
     lines = wheels[0].lines
     hu = np.unique([ln.h for ln in lines])
@@ -107,10 +131,13 @@ def main(n_speeds=1000, repeats=3, dask=False, orders=False):
           f"load average {os.getloadavg()[0]:.2f} at start")
     ripple_only = without_floors(eff)
     t: dict = {"python-control": [], "plain": [], "effects": [], "ripple alone": [], "floors alone": []}
+    if not peer:
+        del t["python-control"]
     plain = with_eff = floors = None
     for _ in range(repeats):
-        dt, H = _timed(lambda: plant.sys.frequency_response(2 * np.pi * f_pts))
-        t["python-control"].append(dt)
+        if peer:
+            dt, H = _timed(lambda: plant.sys.frequency_response(2 * np.pi * f_pts))
+            t["python-control"].append(dt)
         dt, plain = _timed(lambda: cp.jitter_vs_speed(plant, wheels, speeds))
         t["plain"].append(dt)
         dt, with_eff = _timed(lambda: cp.jitter_vs_speed(plant, eff, speeds))
@@ -131,24 +158,32 @@ def main(n_speeds=1000, repeats=3, dask=False, orders=False):
     work = {"effects": "   target <= 3x",
             "ripple alone": f"   line points {pts_eff / pts_plain:.1f}x ({pts_eff} vs {pts_plain}: orders +-{k_rip})",
             "floors alone": f"   floor points {speeds.size * floors.f_hz.size} ({floors.f_hz.size} frequencies)"}
+    print(f"CPU per line point (min): plain {st['plain'][2] / pts_plain * 1e6:.1f} us ({pts_plain} points), ripple "
+          f"alone {st['ripple alone'][2] / pts_eff * 1e6:.1f} us ({pts_eff} points)")
     for label, a, b in (("plain sweep / python-control FRF", "plain", "python-control"),
                         ("with effects / plain sweep", "effects", "plain"),
                         ("  ripple alone / plain sweep", "ripple alone", "plain"),
                         ("  floors alone / plain sweep", "floors alone", "plain")):
+        if b not in st:
+            continue
         r = [st[a][i] / st[b][i] for i in range(4)]
         print(f"{label:34s} wall {r[0]:6.2f}x (min) {r[1]:6.2f}x (median)   CPU {r[2]:6.2f}x (min) {r[3]:6.2f}x "
               f"(median){work.get(a, '')}")
     print(f"load average at end {load:.2f}")
-    G, P = plant.frf(f_pts)
-    Hc = np.asarray(H.fresp)                       # (n_out, n_in, F)
-    err = np.max(np.abs(np.moveaxis(Hc[plant.n_interface:], -1, 0) - P)) / np.max(np.abs(P))
-    print(f"check: our modal FRF agrees with python-control's to {err:.1e} of the peak; median coupled RMS with effects "
-          f"{np.median(with_eff.rms['coupled'] / plain.rms['coupled']):.4f}x the plain one")
+    if peer:
+        G, P = plant.frf(f_pts)
+        Hc = np.asarray(H.fresp)                       # (n_out, n_in, F)
+        err = np.max(np.abs(np.moveaxis(Hc[plant.n_interface:], -1, 0) - P)) / np.max(np.abs(P))
+        print(f"check: our modal FRF agrees with python-control's to {err:.1e} of the peak")
+    print(f"median coupled RMS with effects {np.median(with_eff.rms['coupled'] / plain.rms['coupled']):.4f}x the plain one")
     if orders:
-        kept, share = needed_points(plant, ripple_only, speeds)
+        kept, share, lr = needed_points(plant, ripple_only, speeds)
         print(f"ripple points an oracle pruning keeps at 1e-9 of every lines' RMS: {kept} = {kept / pts_plain:.2f}x the "
               f"plain sweep's ({pts_eff / pts_plain:.1f}x evaluated); share kept per order: "
               + ", ".join(f"{k:+d}: {v:.3f}" for k, v in share.items()))
+        for tol, share_kept, worst in load_trimmed(lr):
+            print(f"  a-priori pruning, blocked load < {tol:.0e} x its speed's largest left out: "
+                  f"{share_kept * pts_eff / pts_plain:5.2f}x the plain sweep's points, lines' RMS moved by up to {worst:.1e}")
     if dask:
         from distributed import Client, LocalCluster
         with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as lc, \
@@ -167,7 +202,8 @@ if __name__ == "__main__":
     ap.add_argument("--speeds", type=int, default=1000)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--dask", action="store_true")
+    ap.add_argument("--no-peer", action="store_true", help="leave python-control's FRF out of the rounds")
     ap.add_argument("--orders", action="store_true", help="also the points an oracle pruning of the ripple's orders "
                     "would keep (untimed)")
     a = ap.parse_args()
-    main(a.speeds, a.repeats, a.dask, a.orders)
+    main(a.speeds, a.repeats, a.dask, a.orders, peer=not a.no_peer)
