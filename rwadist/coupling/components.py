@@ -420,15 +420,22 @@ class Plant:
             hdisp = 1.0 / (wn**2 - om**2 + 2j * zeta * wn * om)       # (..., n_modes)
             # Σ_m φ_m φ_mᵀ h_m(f) for every frequency at once: the modal responses (complex) times the modes'
             # outer products (real), two real matrix products over all frequencies (BLAS), not a complex
-            # n×n_modes×n product per frequency
+            # n×n_modes×n product per frequency; G is symmetric, so only its upper triangle's n(n+1)/2 entries
+            # are summed and each is copied to its mirror (G exactly symmetric), written straight into G's real and
+            # imaginary parts
             m = wn.size
-            KG = np.einsum("im,jm->mij", Phi, Phi).reshape(m, n * n)
+            iu, ju = np.triu_indices(n)
+            KG = np.ascontiguousarray(np.einsum("im,jm->mij", Phi, Phi)[:, iu, ju])
+            mirror = np.zeros((n, n), dtype=np.intp)
+            mirror[iu, ju] = mirror[ju, iu] = np.arange(iu.size)
             KP = np.einsum("im,jm->mij", Phip, Phi).reshape(m, -1)
             ha = (-(om**2) * hdisp).reshape(-1, m)
             hd = hdisp.reshape(-1, m)
-            G = (ha.real @ KG + 1j * (ha.imag @ KG)).reshape(f.shape + (n, n))
+            G = np.empty((ha.shape[0], n * n), dtype=complex)
+            np.take(ha.real @ KG, mirror.ravel(), axis=1, out=G.real)
+            np.take(ha.imag @ KG, mirror.ravel(), axis=1, out=G.imag)
             P = (hd.real @ KP + 1j * (hd.imag @ KP)).reshape(f.shape + (Phip.shape[0], n))
-            return G, P
+            return G.reshape(f.shape + (n, n)), P
         sys = self.state_space()
         A, B, C, D = (np.asarray(x) for x in (sys.A, sys.B, sys.C, sys.D))
         s = 2j * np.pi * f

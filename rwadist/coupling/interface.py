@@ -1,13 +1,13 @@
 """The coupled interface equation's pieces shared by the line and floor responses (:mod:`rwadist.coupling.performance`,
-:mod:`rwadist.coupling.gyro_split`): a hard-mounted wheel's dynamic mass, the congruences of constant selectors, and
-I − Σ_i Mt_iᵀ Zc_i Mt_i G."""
+:mod:`rwadist.coupling.gyro_split`): a wheel's dynamic mass (flexible and hard-mounted), the congruences of constant
+selectors, and I − Σ_i Mt_iᵀ Zc_i Mt_i G."""
 from __future__ import annotations
 
 import numpy as np
 
 from rwadist import extended as ext
 
-from .components import wheel_rigid_mass_matrix
+from .components import wheel_matrices, wheel_rigid_mass_matrix
 
 
 def rigid_wheel_frf(p: ext.ExtendedParams, omega, f, housing_mass: float = 0.0, housing_inertia=(0.0, 0.0, 0.0)):
@@ -28,6 +28,38 @@ def rigid_wheel_frf(p: ext.ExtendedParams, omega, f, housing_mass: float = 0.0, 
     B = np.eye(6)
     B[3, 1], B[4, 0] = -p.height, p.height
     return Zc, B
+
+
+#: Eigenvector-matrix condition number above which the wheel FRF falls back to direct solves.
+_EIG_COND = 1e8
+
+
+def _wheel_frf(spec, omega, f):
+    """(Zc, B) of a flexible wheel at speeds omega (S,) and frequencies f (S, J): (S, J, 6, 6) each.
+
+    Modal form per speed, H(s) = C V (s − Λ)⁻¹ V⁻¹ B + D (one 12×12 eigen-decomposition per speed, then a
+    product per frequency; cond(V) ≈ 1.5e3 for the wheel's state scaling, so ~1e-12 relative); direct
+    solves of (sI − A) X = B at speeds where V is ill-conditioned (> 1e8).  A hard-mounted wheel:
+    :func:`rigid_wheel_frf`."""
+    if spec.hard_mounted:
+        Zc, B = rigid_wheel_frf(spec.params, omega, f, spec.housing_mass, spec.housing_inertia)
+        return Zc, np.broadcast_to(B, Zc.shape)
+    A, B, C, D = wheel_matrices(spec.params, omega, spec.housing_mass, spec.housing_inertia)
+    s = 2j * np.pi * np.asarray(f, dtype=float)
+    lam, V = np.linalg.eig(A)                                           # (S, 12), (S, 12, 12)
+    ok = np.linalg.cond(V) < _EIG_COND
+    H = np.empty(s.shape + (6, 12), dtype=complex)
+    if ok.any():
+        CV = (C @ V[ok])[:, None]                                       # (s, 1, 6, 12)
+        VB = np.linalg.solve(V[ok], np.broadcast_to(B, (int(ok.sum()),) + B.shape))[:, None]
+        r = 1.0 / (s[ok][..., None] - lam[ok][:, None, :])              # (s, J, 12)
+        H[ok] = (CV * r[..., None, :]) @ VB + D
+    if not ok.all():
+        bad = ~ok
+        M = s[bad][..., None, None] * np.eye(12) - A[bad][:, None]
+        X = np.linalg.solve(M, np.broadcast_to(B, M.shape[:-2] + B.shape))
+        H[bad] = C @ X + D
+    return H[..., :6], H[..., 6:]
 
 
 def _congruence(T, Z) -> np.ndarray:
@@ -52,16 +84,22 @@ def _interface_matrix(G, parts) -> np.ndarray:
     point instead of n×n ones."""
     n = G.shape[-1]
     L = None
+    written = np.zeros(n, dtype=bool)                                # rows holding a term (the rest are still 0)
     for Mt, Z in parts:
         reached = np.nonzero(np.any(Mt != 0, axis=0))[0]
         T = Mt[:, reached]
-        cols: np.ndarray | slice = reached
-        if reached.size and np.all(np.diff(reached) == 1):
-            cols = slice(int(reached[0]), int(reached[-1]) + 1)      # a node's DOFs: a view (fancy indexing copies)
-        term = _congruence(T, Z) @ G[..., cols, :]
+        ZT = _congruence(T, Z)
         if L is None:
-            L = np.zeros(np.broadcast_shapes(term.shape[:-2], G.shape[:-2]) + (n, n), dtype=complex)
-        L[..., cols, :] -= term
+            L = np.zeros(np.broadcast_shapes(ZT.shape[:-2], G.shape[:-2]) + (n, n), dtype=complex)
+        if reached.size and np.all(np.diff(reached) == 1) and not written[reached].any() \
+                and L.shape[:-2] == np.broadcast_shapes(ZT.shape[:-2], G.shape[:-2]):
+            # a node's DOFs no wheel reached before: the product written in place (its rows are 0 so far)
+            cols = slice(int(reached[0]), int(reached[-1]) + 1)
+            np.matmul(ZT, G[..., cols, :], out=L[..., cols, :])
+            np.negative(L[..., cols, :], out=L[..., cols, :])
+        else:
+            L[..., reached, :] -= ZT @ G[..., reached, :]
+        written[reached] = True
     if L is None:
         L = np.zeros(G.shape, dtype=complex)
     L.reshape(L.shape[:-2] + (n * n,))[..., :: n + 1] += 1.0      # the diagonal, in place

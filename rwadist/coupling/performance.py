@@ -51,10 +51,10 @@ from rwadist.units import CHANNELS, RAD_S_TO_RPM
 
 from . import geometry, rigid_practice
 from .assemble import PRACTICES
-from .components import Plant, wheel_matrices, wheel_rigid_mass_matrix
+from .components import Plant, wheel_rigid_mass_matrix
 from .errors import CouplingError, SingularInterfaceError
 from .gyro_split import FloorSolver, wheel_split
-from .interface import _apply_left, _interface_matrix, rigid_wheel_frf  # noqa: F401  (rigid_wheel_frf: public here)
+from .interface import _apply_left, _interface_matrix, _wheel_frf, rigid_wheel_frf  # noqa: F401  (rigid_wheel_frf: public here)
 
 # ----------------------------------------------------------------------------- broadband floors
 
@@ -303,38 +303,6 @@ def _grouped_lines(spec: WheelSpec, omega, k_max: int = 0):
     return (ku[:, 0], ku[:, 1] + ku[:, 2] * fr, ku[:, 2].astype(int), f_all.reshape(S, L * M)[:, first], F)
 
 
-#: Eigenvector-matrix condition number above which the wheel FRF falls back to direct solves.
-_EIG_COND = 1e8
-
-
-def _wheel_frf(spec, omega, f):
-    """(Zc, B) of a flexible wheel at speeds omega (S,) and frequencies f (S, J): (S, J, 6, 6) each.
-
-    Modal form per speed, H(s) = C V (s − Λ)⁻¹ V⁻¹ B + D (one 12×12 eigen-decomposition per speed, then a
-    product per frequency; cond(V) ≈ 1.5e3 for the wheel's state scaling, so ~1e-12 relative); direct
-    solves of (sI − A) X = B at speeds where V is ill-conditioned (> 1e8).  A hard-mounted wheel:
-    :func:`rigid_wheel_frf`."""
-    if spec.hard_mounted:
-        Zc, B = rigid_wheel_frf(spec.params, omega, f, spec.housing_mass, spec.housing_inertia)
-        return Zc, np.broadcast_to(B, Zc.shape)
-    A, B, C, D = wheel_matrices(spec.params, omega, spec.housing_mass, spec.housing_inertia)
-    s = 2j * np.pi * np.asarray(f, dtype=float)
-    lam, V = np.linalg.eig(A)                                           # (S, 12), (S, 12, 12)
-    ok = np.linalg.cond(V) < _EIG_COND
-    H = np.empty(s.shape + (6, 12), dtype=complex)
-    if ok.any():
-        CV = (C @ V[ok])[:, None]                                       # (s, 1, 6, 12)
-        VB = np.linalg.solve(V[ok], np.broadcast_to(B, (int(ok.sum()),) + B.shape))[:, None]
-        r = 1.0 / (s[ok][..., None] - lam[ok][:, None, :])              # (s, J, 12)
-        H[ok] = (CV * r[..., None, :]) @ VB + D
-    if not ok.all():
-        bad = ~ok
-        M = s[bad][..., None, None] * np.eye(12) - A[bad][:, None]
-        X = np.linalg.solve(M, np.broadcast_to(B, M.shape[:-2] + B.shape))
-        H[bad] = C @ X + D
-    return H[..., :6], H[..., 6:]
-
-
 def _wheel_key(w):
     return (w.params, float(w.housing_mass), tuple(float(x) for x in w.housing_inertia), float(w.speed_scale),
             bool(w.hard_mounted))
@@ -380,11 +348,13 @@ def _setup(plant: Plant, wheels, practices, omega):
     return om, Mts, Zm
 
 
-def _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache, rigid_form=None) -> list:
-    """[(coupled loads (S, J, 6), {practice: outputs (S, J, n_perf)})] of wheels ``ks``, whose lines all sit at
-    the frequencies ``fe`` (S, J) Hz at speeds ``o``: the plant, the wheels' dynamic masses and the interface
+def _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache, rigid_form=None, loads: bool = True) -> list:
+    """[(coupled loads (S, J, 6) or None, {practice: outputs (S, J, n_perf)})] of wheels ``ks``, whose lines all sit
+    at the frequencies ``fe`` (S, J) Hz at speeds ``o``: the plant, the wheels' dynamic masses and the interface
     matrix once, each practice's solve with every wheel's right-hand side at once; practice 'ii' from
-    ``rigid_form`` (:class:`rwadist.coupling.rigid_practice.RigidPractice`) when given."""
+    ``rigid_form`` (:class:`rwadist.coupling.rigid_practice.RigidPractice`) when given.  Without ``loads`` (only the
+    outputs wanted) and with fewer outputs than right-hand sides, the adjoint: y = (P·Lc⁻¹)·X with P·Lc⁻¹ from one
+    solve with Lcᵀ and the n_perf columns of Pᵀ (the same numbers to rounding, fewer triangular solves)."""
     G, P = plant.frf(fe)
     parts, Bs = [], {}
     for i, wi in enumerate(wheels):
@@ -395,27 +365,34 @@ def _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache, rigid_fo
     rhs = np.concatenate([Mts[k].T @ lines[k][1][..., None] for k in ks], axis=-1)          # (S, J, n_if, |ks|)
     Lc = _interface_matrix(G, parts)                                                        # coupled interface
     n = len(ks)
-    if "iii" in practices:               # one factorisation of Lc for both practices
-        rhs3 = np.concatenate([Mts[k].T @ (Bs[k][1] @ lines[k][1][..., None]) for k in ks], axis=-1)
-        both = np.linalg.solve(Lc, np.concatenate([rhs, rhs3], axis=-1))
-        u = {"coupled": both[..., :n], "iii": both[..., n:]}
-    else:
-        u = {"coupled": np.linalg.solve(Lc, rhs)}
+    X = {"coupled": rhs}
+    if "iii" in practices:
+        X["iii"] = np.concatenate([Mts[k].T @ (Bs[k][1] @ lines[k][1][..., None]) for k in ks], axis=-1)
+    Y = {}
+    if not loads and P.shape[-2] < n * len(X):        # outputs only: P·Lc⁻¹ once, then each practice's loads
+        PL = np.swapaxes(np.linalg.solve(np.swapaxes(Lc, -1, -2), np.swapaxes(P, -1, -2)), -1, -2)
+        Y = {p: PL @ x for p, x in X.items()}
+        u = {}
+    else:                                # one factorisation of Lc for both practices
+        both = np.linalg.solve(Lc, np.concatenate(list(X.values()), axis=-1))
+        u = {p: both[..., i * n:(i + 1) * n] for i, p in enumerate(X)}
     u["i"] = rhs
     if "ii" in practices and rigid_form is None:    # I − Zm·G, wheel by wheel on its node's rows (Zm = −Σ Mtᵀ M6 Mt)
         rigid = [(Mt, -wheel_rigid_mass_matrix(w.params, w.housing_mass, w.housing_inertia))
                  for Mt, w in zip(Mts, wheels)]
         u["ii"] = np.linalg.solve(_interface_matrix(G, rigid), rhs)
     # every wheel's outputs and interface accelerations in one product per practice (columns = wheels)
-    Y = {p: P @ u[p] for p in practices if p in u}                                         # (S, J, n_perf, |ks|)
+    Y.update({p: P @ u[p] for p in practices if p in u and p not in Y})                      # (S, J, n_perf, |ks|)
     if "ii" in practices and rigid_form is not None:
         Y["ii"] = rigid_form.outputs(fe, [Mts[k] for k in ks], [lines[k][1] for k in ks])
-    acc = G @ u["coupled"]                                                                  # (S, J, n_if, |ks|)
+    acc = G @ u["coupled"] if loads else None                                               # (S, J, n_if, |ks|)
     out = []
     for j, k in enumerate(ks):
         live = (lines[k][0] > 0)[..., None]
-        a_k = _apply_left(Mts[k], acc[..., j])[..., None]                                  # its mount's (S, J, 6, 1)
-        load = np.where(live, lines[k][1] + (Bs[k][0] @ a_k)[..., 0], 0)
+        load = None
+        if acc is not None:
+            a_k = _apply_left(Mts[k], acc[..., j])[..., None]                              # its mount's (S, J, 6, 1)
+            load = np.where(live, lines[k][1] + (Bs[k][0] @ a_k)[..., 0], 0)
         out.append((load, {p: np.where(live, Y[p][..., j], 0) for p in practices}))
     return out
 
@@ -438,9 +415,17 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
     Cost: one coupled interface solve (n_if × n_if) per (speed, line group) point, each at its own frequency (the
     plant, the wheels' dynamic masses and the interface matrix change with it); a ripple's 2K + 1 orders multiply
     the points, and its sidebands at f + m·f_r meet no other point's frequency, so the time grows with them
-    (bench_coupling: K = 6, 13.0× the plain sweep's points).  Practice 'ii' (speed-free) of a modal plant is the
-    mass-loaded structure's closed form (:mod:`rwadist.coupling.rigid_practice`: one eigen-decomposition, then a
-    product over its modes per point) instead of a second interface solve."""
+    (bench_coupling: K = 6, 13.0× the plain sweep's points; at a ripple frequency that is no multiple of the speed
+    grid's step they share no frequency: 7 of its 143 000 points coincide).  Per point: the plant's modal sum
+    (:meth:`Plant.frf`, over G's upper triangle), the interface matrix and one LU.  Practice 'ii' (speed-free) of a
+    modal plant is the mass-loaded structure's closed form (:mod:`rwadist.coupling.rigid_practice`: one
+    eigen-decomposition, then a product over its modes per point) instead of a second interface solve."""
+    return _line_sweep(plant, wheels, omega, practices, chunk, floor_f_hz, loads=True)
+
+
+def _line_sweep(plant: Plant, wheels, omega, practices, chunk: int, floor_f_hz, loads: bool) -> LineResponses:
+    """:func:`line_responses`; without ``loads`` the coupled loads are not computed (:attr:`LineResponses.loads`
+    empty) and the outputs come from the adjoint solve where it is cheaper (:func:`_line_group`)."""
     wheels = list(wheels)
     om, Mts, Zm = _setup(plant, wheels, practices, omega)
     # practice 'ii' does not depend on the speed: for a modal plant, one closed form for every point
@@ -488,16 +473,18 @@ def line_responses(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int 
                 groups.append((fe, [k]))
         for fe, ks in groups:
             for k, (ld, y) in zip(ks, _line_group(plant, wheels, Mts, practices, o, fe, ks, lines, cache,
-                                                  rigid_form)):
-                load_parts[k].append(ld)
+                                                  rigid_form, loads)):
+                if ld is not None:
+                    load_parts[k].append(ld)
                 for p in practices:
                     y_parts[p][k].append(y[p])
-    fs, hms, loads = ([np.concatenate(x) for x in lst] for lst in (f_parts, hm_parts, load_parts))
+    fs, hms = ([np.concatenate(x) for x in lst] for lst in (f_parts, hm_parts))
+    coupled_loads = [np.concatenate(x) for x in load_parts] if loads else []
     ys = {p: [np.concatenate(x) for x in v] for p, v in y_parts.items()}
     floor = None
     if any(w.floors for w in wheels):
         floor = floor_responses(plant, wheels, om, practices, f_hz=floor_f_hz)
-    return LineResponses(om, plant.perf_names, hs, fs, ys, loads, hms, offs, orders, floor)
+    return LineResponses(om, plant.perf_names, hs, fs, ys, coupled_loads, hms, offs, orders, floor)
 
 
 # ----------------------------------------------------------------------------- floors through the plant
@@ -744,11 +731,14 @@ def jitter_vs_speed(plant: Plant, wheels, omega, practices=PRACTICES, chunk: int
     """RMS of the named performance outputs vs wheel speed for each practice (see module doc): the lines'
     mean square plus, when wheels have broadband floors, the floors' mean square (incoherent, added in
     quadrature: :meth:`LineResponses.total_rms`; ``floor_f_hz`` as in :func:`floor_responses`).  Without
-    floors the lines alone, as before."""
+    floors the lines alone, as before.  Only the outputs are computed (not the coupled loads of
+    :func:`line_responses`): the coupled and 'iii' outputs of wheels sharing their line frequencies come from P·Lc⁻¹
+    (one solve with Lcᵀ and Pᵀ's n_perf columns) instead of Lc⁻¹ times every wheel's loads (tests: equal to
+    python-control's state-space assembly at every line and sideband)."""
     practices = tuple(practices)
     if "coupled" not in practices:
         practices = ("coupled",) + practices
-    lr = line_responses(plant, wheels, omega, practices, chunk, floor_f_hz)
+    lr = _line_sweep(plant, wheels, omega, practices, chunk, floor_f_hz, loads=False)     # the outputs only
     rms = {p: lr.total_rms(p) for p in practices}
     rc = rms["coupled"]
     with np.errstate(invalid="ignore", divide="ignore"):
