@@ -14,12 +14,24 @@ load average):
 ``--no-peer``: leave python-control out (60-70 s CPU a round; the effects' baseline is the plain sweep).
 ``--dask``: the plain sweep on a 2-worker local dask cluster (processes, 1 thread each) as well.
 ``--orders``: the ripple's points an oracle pruning would keep at 1e-9 of every RMS (:func:`needed_points`, untimed): the
-least work any exact per-point evaluation of the ripple's sidebands needs; and what a pruning by the blocked loads (known
-before the solve) would move the RMS by (:func:`load_trimmed`).  The CPU per line point, plain and with the ripple, is
+least work any exact per-point evaluation of the ripple's sidebands needs; the points at distinct frequencies (the solves
+an exact evaluation needs when coincident lines and sidebands share one, :func:`distinct_points`); and what a pruning by
+the blocked loads (known before the solve) would move the RMS by (:func:`load_trimmed`).  The CPU per line point, plain and with the ripple, is
 printed beside: the ripple's cost is its points' count at the plain sweep's cost per point.
 BLAS is pinned to one thread so serial and parallel compare like for like.
 
 Run: python benchmarks/bench_coupling.py [--speeds N] [--repeats R] [--no-peer] [--dask] [--orders]
+
+Measured (1000 speeds, CPU min / median of 3 rounds; session 9, main and the branch alternated, load 3.4-4.3):
+  167d71a --no-peer: plain 0.77 / 0.78 s, effects 11.25 / 11.61 s (14.55x / 14.96x); again 0.73 / 0.75 s, 10.29 / 10.61 s
+    (14.10x / 14.23x); ripple alone 9.20 / 8.48 s min, floors alone 1.69 / 1.58 s min.
+  3fc8baa (outputs-only adjoint solve, G's upper triangle, interface matrix in place) --no-peer: plain 0.64 / 0.69 s,
+    effects 8.94 / 9.19 s (14.07x / 13.40x); again 0.67 / 0.70 s, 9.31 / 9.65 s (13.80x / 13.80x); ripple alone 7.15 /
+    7.13 s min, floors alone 1.56 / 1.62 s min.  With the peer (load 3.2-4.8): python-control 63.7 / 71.0 s, plain
+    0.69 / 0.77 s, effects 9.76 / 10.26 s (14.17x / 13.28x).
+  --orders: an oracle pruning at 1e-9 keeps 5.09x the plain points; of the ripple's 143000 points 142993 sit at
+    distinct frequencies (a ripple at 8 Hz meets the speed grid's lines only by chance), so no exact evaluation shares
+    its solves: the 3x target needs a tolerance or a cheaper point for plain and ripple alike.
 """
 import os
 
@@ -115,6 +127,15 @@ def needed_points(plant, wheels, speeds, tol=1e-9):
     return int(keep.sum()), {int(k): float(keep[:, m == k].mean()) for k in np.unique(m)}, lr
 
 
+def distinct_points(lr, rtol=1e-12):
+    """(speed, frequency) points of :class:`rwadist.coupling.LineResponses` ``lr`` that differ by more than ``rtol``
+    relative, over every wheel's line groups: the coupled solves an exact evaluation needs when lines and sidebands
+    that meet at one frequency and speed share their solve (issue 37's idea (1); the blocked loads of incoherent
+    sources at one frequency add in power, H·S·Hᴴ with S summed)."""
+    f = np.sort(np.concatenate(lr.f_hz, axis=1), axis=1)                   # (S, all wheels' groups)
+    return int(f.shape[0] + np.count_nonzero(np.diff(f, axis=1) > rtol * f[:, 1:]))
+
+
 def _timed(fn):
     t0, c0 = time.perf_counter(), time.process_time()
     out = fn()
@@ -181,6 +202,10 @@ def main(n_speeds=1000, repeats=3, dask=False, orders=False, peer=True):
         print(f"ripple points an oracle pruning keeps at 1e-9 of every lines' RMS: {kept} = {kept / pts_plain:.2f}x the "
               f"plain sweep's ({pts_eff / pts_plain:.1f}x evaluated); share kept per order: "
               + ", ".join(f"{k:+d}: {v:.3f}" for k, v in share.items()))
+        n_distinct = distinct_points(lr)
+        print(f"ripple points at distinct frequencies (1e-12) per speed, all wheels: {n_distinct} = "
+              f"{n_distinct / pts_plain:.2f}x the plain sweep's points (the wheels share theirs; "
+              f"{pts_eff - n_distinct} of {pts_eff} meet another point's frequency)")
         for tol, share_kept, worst in load_trimmed(lr):
             print(f"  a-priori pruning, blocked load < {tol:.0e} x its speed's largest left out: "
                   f"{share_kept * pts_eff / pts_plain:5.2f}x the plain sweep's points, lines' RMS moved by up to {worst:.1e}")
