@@ -444,24 +444,23 @@ def _line_sweep(plant: Plant, wheels, omega, practices, chunk: int, floor_f_hz, 
     groups_max = max(len({(ln.h, ln.f_offset) for ln in w.lines}) * (2 * k + 1) for w, k in zip(wheels, kmax))
     chunk = max(1, min(int(chunk), LINE_POINTS // max(groups_max, 1)))
     nw = len(wheels)
-    hs, offs, orders = [None] * nw, [None] * nw, [None] * nw
-    # per wheel, the chunks' arrays: line frequencies, loads on the hard mount, interface loads, outputs
-    f_parts: list[list[np.ndarray]] = [[] for _ in range(nw)]
-    hm_parts: list[list[np.ndarray]] = [[] for _ in range(nw)]
+    # each wheel type's grouped lines at every speed at once (a ripple's chunks have few speeds, and its per-line
+    # FFTs per chunk were Python-bound); (h, offset, order, f (S, J), blocked loads (S, J, 6)) per line key
+    grouped: dict = {}
+    for k, wk in enumerate(wheels):
+        if line_key[k] not in grouped:
+            grouped[line_key[k]] = _grouped_lines(wk, om * wk.speed_scale, kmax[k])
+    hs, offs, orders, fs, hms = ([grouped[key][i] for key in line_key] for i in range(5))
+    # per wheel, the chunks' arrays: interface loads, outputs
     load_parts: list[list[np.ndarray]] = [[] for _ in range(nw)]
     y_parts: dict[str, list[list[np.ndarray]]] = {p: [[] for _ in range(nw)] for p in practices}
     for i0 in range(0, om.size, chunk):
         o = om[i0:i0 + chunk]
         cache = _FrfCache()
         lines = []
-        grouped: dict = {}
-        for k, wk in enumerate(wheels):
-            if line_key[k] not in grouped:
-                grouped[line_key[k]] = _grouped_lines(wk, o * wk.speed_scale, kmax[k])
-            hs[k], offs[k], orders[k], f, Fk = grouped[line_key[k]]
+        for k in range(nw):
+            f, Fk = fs[k][i0:i0 + chunk], hms[k][i0:i0 + chunk]
             lines.append((f, Fk, np.where(f > 0, f, 1.0)))
-            f_parts[k].append(f)
-            hm_parts[k].append(Fk)
         # wheels whose lines sit at the same frequencies (equal wheels) share the plant, the interface matrix and
         # its factorisation: one solve with all their right-hand sides
         groups: list = []
@@ -478,7 +477,8 @@ def _line_sweep(plant: Plant, wheels, omega, practices, chunk: int, floor_f_hz, 
                     load_parts[k].append(ld)
                 for p in practices:
                     y_parts[p][k].append(y[p])
-    fs, hms = ([np.concatenate(x) for x in lst] for lst in (f_parts, hm_parts))
+    fs, hms = ([x if line_key.index(key) == k else x.copy() for k, (x, key) in enumerate(zip(lst, line_key))]
+               for lst in (fs, hms))                                  # each wheel its own arrays
     coupled_loads = [np.concatenate(x) for x in load_parts] if loads else []
     ys = {p: [np.concatenate(x) for x in v] for p, v in y_parts.items()}
     floor = None
