@@ -565,7 +565,7 @@ def closed_form_csd(groups, f: np.ndarray, transform_of, progress: bool = False)
         batches[-1].append((g, cols))
     bar = None
     if progress and len(groups) >= 4:
-        from tqdm.auto import tqdm
+        from .progress import tqdm
 
         bar = tqdm(total=len(groups), desc="broadband PSD", unit="wheel", leave=False)
     for b, batch in enumerate(batches):

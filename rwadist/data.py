@@ -41,7 +41,6 @@ import os
 from pathlib import Path
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from .formats import registry
 from .formats.channels import SPEED_COLUMN, to_run, to_sweep
@@ -62,6 +61,7 @@ from .formats.records import (
 )
 from .formats.timebase import sample_step
 from .outputs import WRITER, WRITER_KEY
+from .progress import tqdm
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm, rpm_to_rad_s  # noqa: F401 (re-exported)
 
 __all__ = ["DataError", "Run", "SteadyTest", "Sweep", "RawRecord", "read_json", "read_run", "read_steady",

@@ -39,10 +39,10 @@ from functools import cached_property
 
 import numpy as np
 from scipy import signal, stats
-from tqdm.auto import tqdm
 
 from .data import DataError
 from .model import DIRECTIONS, Harmonic, WheelModel
+from .progress import tqdm
 from .spectra import Spectra, detection_threshold, welch_dof
 from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 

@@ -7,7 +7,13 @@ import sys
 import threading
 from contextlib import contextmanager
 
-from tqdm.auto import tqdm
+if "ipykernel" in sys.modules or "IPython.utils._process_emscripten" in sys.modules:
+    # a notebook's widget bars (tqdm.auto's own test)
+    from tqdm.auto import tqdm
+else:
+    # a terminal: tqdm.std, the class tqdm.auto picks there, without its asyncio mix-in (importing asyncio, ssl
+    # and the rest cost every command ~20 ms of CPU for ``async for``, which the kit never uses)
+    from tqdm.std import tqdm
 
 
 def steps(total: int, desc: str, enabled: bool = True, unit: str = "step"):
