@@ -32,7 +32,7 @@ from .outputs import (
     refuse_special_base,
 )
 from .outputs import write_file as _write
-from .plot_util import psd_title, save_png
+from .plot_util import import_matplotlib_for_command, psd_title, save_png
 from .progress import working
 from .units import RAD_S_TO_RPM
 from .validate import check_grid_size, check_speeds_rpm, check_within_test
@@ -521,6 +521,7 @@ def _write_psd(res, out: Path, args, title: str) -> tuple:
             psd_files.write_hdf5(res, outs.file(cross_path["h5"]), "csd")
         psd_files.write_envelope_csv(res.meta["envelope"], outs.file(sibling["_envelope.csv"]))
         with working("drawing the PSD plot"):
+            import_matplotlib_for_command()
             save_png(psd_files.plot_psd(res, title), outs.file(sibling[".png"]), dpi=110)
     print(wrote)
     if args.cross in cross_path:
