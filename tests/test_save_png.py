@@ -63,3 +63,35 @@ def test_a_figure_changed_after_save_png_is_drawn_as_changed(tmp_path):
                    for ax in fig.axes for axis in (ax.xaxis, ax.yaxis))
     assert np.array_equal(pixels(tmp_path / "kit_changed.png"), pixels(tmp_path / "mpl_changed.png"))
     assert not np.array_equal(pixels(tmp_path / "kit_changed.png"), pixels(tmp_path / "kit_first.png"))
+
+
+def test_matplotlib_imported_for_a_command_draws_the_same_pixels_and_sets_the_same_properties(tmp_path):
+    """``import_matplotlib_for_command`` (a fresh process: this one has matplotlib imported) skips only the generated
+    signatures and docstrings of the artists' ``set``: every property still set by ``set``, the class hook restored
+    (a class defined later gets its docstring), the same pixels as this process's fully imported matplotlib."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    child = f"""
+import sys
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+from rwadist.plot_util import import_matplotlib_for_command, save_png
+import_matplotlib_for_command()
+from matplotlib.artist import Artist
+from matplotlib.lines import Line2D
+line = Line2D([], [])
+line.set(lw=3.5, color="r", label="x")
+assert (line.get_linewidth(), line.get_color(), line.get_label()) == (3.5, "r", "x")
+assert "Supported properties" not in (Line2D.set.__doc__ or "")
+class Later(Artist):
+    pass
+assert "Supported properties" in Later.set.__doc__
+from test_save_png import DPI, busy_figure
+save_png(busy_figure(), sys.argv[1], DPI)
+"""
+    subprocess.run([sys.executable, "-c", child, str(tmp_path / "command.png")], check=True)
+    save_png(busy_figure(), tmp_path / "library.png", DPI)
+    assert np.array_equal(pixels(tmp_path / "command.png"), pixels(tmp_path / "library.png"))
+    from matplotlib.lines import Line2D
+    assert "Supported properties" in Line2D.set.__doc__    # this process's matplotlib left as it was
