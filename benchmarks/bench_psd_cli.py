@@ -11,6 +11,14 @@ Run: python benchmarks/bench_psd_cli.py [--repeats R] [--n-freq N]
 On a shared, loaded machine the wall-clock figure is mostly the other jobs' (at load 11 on 2 cores: 3.8 s wall for
 1.5 s of CPU); ``chrt -f 10 python benchmarks/bench_psd_cli.py`` (root: real-time priority, inherited by the children,
 a few seconds) gives the idle machine's figure -- wall = CPU within 2 %.
+
+History (``--repeats 3``, CPU min / median; trees compared with one venv, ``PYTHONPATH=<tree>``, alternated):
+- session 3 (306a856), ``chrt -f 10`` at load 11: 1.38-1.41 s CPU, 1.36-1.41 s wall.
+- session 9 (2026-11-29 21:14-21:16 UTC), ``chrt -f 10`` at load 3.8-4.3: 306a856 1.90 / 1.95 s, main 1fe9ae9
+  1.87 / 1.92 and 1.90 / 1.99 s, psd9 (tqdm.std in a terminal, matplotlib imported without Artist.set's generated
+  docstrings, the cross-spectra gathered in one take) 1.70 / 1.71 and 1.76 / 1.82 s; the peer 0.57-0.69 s.  The
+  ~0.5 s since session 3 is the machine's, not the code's: session 3's commit measures what main does.  Without
+  chrt at load 3.7-3.9: main 2.17-2.21 / 2.37-2.39 s CPU, 4.4-4.5 s wall; psd9 2.05-2.14 / 2.09-2.31 s, 4.0-4.2 s.
 """
 from __future__ import annotations
 
