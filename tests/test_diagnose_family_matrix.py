@@ -106,6 +106,20 @@ def test_a_fixture_under_the_modes_of_a_heavy_wheel_is_named_beside_them(tmp_pat
 
 
 @pytest.mark.slow
+def test_a_fixture_above_the_translation_mode_is_named_beside_a_beating_band(tmp_path):
+    """Family wheel 4 (translation 227.7 Hz) with a fixture at 1.5x it (341.55 Hz): the modes are fitted with the stand
+    beside them, but the stand's held-out evidence was hidden by one band of the top speed where a bearing line
+    (h 4.62) beats near the translation mode: 0.296 of the radial forces' 0.300 noise variance, its own gain 0, and
+    the stand (77 % of the held-out misplaced power) was at t 0.64 and not named (main 167d71a: the error 4.9x the
+    clean cell's).  That band is judged apart (rwadist.diagnose.search.held_out_t): the stand is named within 5 %,
+    nothing else is added, the modes within 2 %, the error within 1.5x the clean cell's."""
+    clean = _cell(4, "clean", tmp_path)
+    fix = _cell(4, "fixture 1.5x radial_translation", tmp_path)
+    assert "crashed" not in fix and fix["found"] == [True] and not fix["added"] and fix["modes_ok"], fix
+    assert fix["error"][1] <= 1.5 * clean["error"][1], (fix["error"], clean["error"])
+
+
+@pytest.mark.slow
 def test_a_load_cell_offset_beside_close_modes_is_named_and_the_rocking_located(tmp_path):
     """Family wheel 6 (12 kg, translation 150 Hz, rocking 110 Hz) with a load-cell offset r_z = -60 mm: the offset's
     first estimate, made beside the rocking it pulls to 138 Hz, is 3 % short and leaves the rocking 2 % off and

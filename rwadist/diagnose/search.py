@@ -184,10 +184,9 @@ def _evidence(ctx, state, applied, runs, chans, memo, own_beats=False) -> tuple:
     # no pair that beats, only its powers: read at the old amplitudes, the beat of a co/counter pair an Ω³ law makes
     # 3x stronger at the top speed was left unforgiven (family wheel 4, h 4.62 half counter-rotating: held-out gain
     # 15 % of the misplaced power at t 0.7; at its own amplitudes 99.6 %, t 4.4)
-    e1, _, p1 = ctx.run_errors(applied, runs, chans, detail=True, beat_state=applied if own_beats else state)
+    _, _, p1 = ctx.run_errors(applied, runs, chans, detail=True, beat_state=applied if own_beats else state)
     e0_all, all_tot, _ = _state_errors(ctx, state, runs, None, memo)
-    gain, var = _gain_and_variance(ctx, state, runs, chans, e1, p1, memo)
-    t = gain / np.sqrt(var) if var > 0 else (np.inf if gain > 0 else 0.0)
+    gain, t = _t_value(ctx, state, runs, chans, p1, memo)
     return gain, gain / max(float(e0_all.sum()), 1e-300), t, max(float(all_tot.sum()), 1e-300)
 
 
@@ -244,18 +243,65 @@ def _other_folds(ctx, state, judged) -> list:
     return out
 
 
-def _gain_and_variance(ctx, state, runs, chans, e1, p1, memo) -> tuple:
-    """(held-out gain, its noise variance) over ``chans`` of the state whose run errors on them are ``e1`` and band
-    residuals ``p1`` (:meth:`Context.run_errors` with detail), against ``state`` (see :func:`_judge`)."""
-    e0, _, p0 = _state_errors(ctx, state, runs, chans, memo)
-    var = 0.0
+def _band_terms(ctx, state, runs, chans, p1, memo) -> tuple:
+    """(gain, variance, reach), each (len(runs), n_bands), of every band of every held-out run summed over ``chans``:
+    the drop of the band's misplaced power max(|D − M| − NOISE_Z·σ, 0) from ``state`` (band residuals and σ: its
+    :meth:`Context.run_errors` with detail) to the state whose band residuals and σ are ``p1``; its noise variance
+    min(|Δ|, σ)²·P_b (see :func:`_judge`); and min(|Δ|, σ)², what that variance would be if the term moved in every
+    draw of the noise (variance / reach: the chance P_b that it moves at all).  A band of one run is summed over the
+    channels: they see the same lines beating in it, so their terms are not independent of one another, the bands
+    are."""
+    _, _, p0 = _state_errors(ctx, state, runs, chans, memo)
+    gain, var, reach = (np.zeros((runs.size, ctx.n_bands)) for _ in range(3))
     for c in chans:
-        dm, sig = np.abs(p1[c][0] - p0[c][0]), p0[c][1]       # |Δ(D − M)|
+        (r0, sig), (r1, sig1) = p0[c], p1[c]
+        ok = np.isfinite(r0[:, 0]) & np.isfinite(r1[:, 0])          # the runs with data (as run_errors counts them)
+        dm = np.abs(r1 - r0)                                           # |Δ(D − M)|
         r = dm / np.maximum(sig, 1e-300)
         # a band's term changes only when the noise reaches past the forgiven NOISE_Z·σ less |ΔM|
         p_change = np.minimum(2.0 * stats.norm.sf(np.maximum(NOISE_Z - r, 0.0)), 1.0)
-        var += float(np.sum(np.minimum(dm, sig) ** 2 * p_change))
-    return float((e0 - e1).sum()), var
+        g = np.maximum(np.abs(r0) - NOISE_Z * sig, 0.0) - np.maximum(np.abs(r1) - NOISE_Z * sig1, 0.0)
+        step = np.minimum(dm, sig) ** 2
+        gain[ok] += g[ok]
+        var[ok] += (step * p_change)[ok]
+        reach[ok] += step[ok]
+    return gain, var, reach
+
+
+def _t_value(ctx, state, runs, chans, p1, memo) -> tuple:
+    """(held-out gain over ``chans``, its t-value :func:`held_out_t`) of the state whose band residuals are ``p1``
+    against ``state`` (:func:`_judge`)."""
+    gain, var, reach = _band_terms(ctx, state, runs, chans, p1, memo)
+    return float(gain.sum()), held_out_t(gain, var, reach)
+
+
+def held_out_t(gain: np.ndarray, var: np.ndarray, reach: np.ndarray) -> float:
+    """The held-out t-value of a gain summed over independent bands, Σ gain / √(Σ var), with a band that holds more of
+    the variance than all the others together and most likely does not move (var < reach / 2) judged apart: then the
+    same ratio over the other bands, that band's gain counted only when it is a loss.
+
+    ``gain``, ``var``, ``reach``: each band's drop in misplaced power, its noise variance min(|Δ|, σ)²·P_b and
+    min(|Δ|, σ)² (:func:`_band_terms`; any shape, the same).  The ratio is read as a normal deviate, which needs no
+    band to dominate the sum (Lindeberg's condition) unless that band's own term is near normal.  A band whose change
+    |Δ| is a fraction of its noise σ moves at all only with the probability P_b that the noise reaches past the
+    forgiven NOISE_Z·σ: its term is 0 in most draws and a jump of about ±|Δ| in the others, and a sum it dominates
+    has that distribution, not a normal one (tests/test_diagnose_heldout_t.py: with such a band holding 0.7-0.99 of
+    the variance, the ratio passes 3 under no effect 10-16x as often as a normal deviate; the other bands' ratio not
+    more often).  Its large variance also hides the other bands' evidence: family wheel 4, a fixture resonance at
+    1.5x the 227.7 Hz translation mode: one band of the top speed where the bearing line h 4.62 beats near that mode
+    (σ 7.6, the stand's change 1.6, P_b 0.07) held 0.296 of the radial forces' 0.300, its own gain 0; the stand
+    gained 77 % of the held-out misplaced power at t 0.64 and was not named.  The other bands are a valid test by
+    themselves: leaving out an independent term leaves their null distribution as it was, and which band is left out
+    is read from the variances alone (the state's σ and the change the effect, fitted on other runs, makes), not
+    from the held-out data; a loss in it still counts, which can only lower the value."""
+    g, v = float(np.sum(gain)), float(np.sum(var))
+    if v > 0:
+        i = int(np.argmax(var))
+        v_i = float(var.flat[i])
+        if v_i > v - v_i and 2.0 * v_i < float(reach.flat[i]):
+            g_i = float(gain.flat[i])
+            g, v = g - g_i + min(g_i, 0.0), v - v_i
+    return g / np.sqrt(v) if v > 0 else (np.inf if g > 0 else 0.0)
 
 
 #: A test-stand resonance may not make a load direction worse by more than this many standard errors
@@ -264,7 +310,7 @@ STAND_DIRECTION_WORSE = 1.0
 
 def _by_direction_t(ctx, state, runs, chans, applied, memo) -> float:
     """The held-out evidence of a resonance on every channel (role test_stand) read per load direction: the second
-    largest of the directions' t-values (gain over its standard error, :func:`_gain_and_variance`), or -inf when a
+    largest of the directions' t-values (:func:`held_out_t`), or -inf when a
     direction's is below −:data:`STAND_DIRECTION_WORSE`.
 
     A fixture resonance's signature is a lift in every load direction; its evidence summed over the channels is
@@ -278,11 +324,12 @@ def _by_direction_t(ctx, state, runs, chans, applied, memo) -> float:
     ts = []
     for d in sorted({CHANNEL_DIRECTION[c] for c in chans}):
         dch = [c for c in chans if CHANNEL_DIRECTION[c] == d]
-        e1, _, p1 = ctx.run_errors(applied, runs, dch, detail=True, beat_state=state)
-        gain, var = _gain_and_variance(ctx, state, runs, dch, e1, p1, memo)
+        _, _, p1 = ctx.run_errors(applied, runs, dch, detail=True, beat_state=state)
+        g_b, v_b, reach = _band_terms(ctx, state, runs, dch, p1, memo)
+        gain, var = float(g_b.sum()), float(v_b.sum())
         if var <= 0 and gain == 0:
             continue                    # a direction the resonance does not touch (Tz: no line)
-        ts.append(gain / np.sqrt(var) if var > 0 else (np.inf if gain > 0 else -np.inf))
+        ts.append(held_out_t(g_b, v_b, reach) if var > 0 else (np.inf if gain > 0 else -np.inf))
     if len(ts) < 2 or min(ts) < -STAND_DIRECTION_WORSE:
         return -np.inf
     return float(sorted(ts)[-2])
