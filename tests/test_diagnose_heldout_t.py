@@ -96,3 +96,24 @@ def test_under_no_effect_it_passes_no_more_often_than_a_normal_deviate(share):
     assert np.mean(plain > 3.0) > 5.0 * q3, np.mean(plain > 3.0)
     assert np.mean(t > 3.0) <= q3 + 3.0 * np.sqrt(q3 / draws), np.mean(t > 3.0)
     assert np.mean(t > 2.0) <= stats.norm.sf(2.0), np.mean(t > 2.0)
+
+
+@pytest.mark.parametrize("first_change", [0.2, 0.6, 1.2])
+def test_a_second_such_band_left_holding_the_rest_is_judged_apart_too(first_change):
+    """As above, with two such bands: the largest (σ 300x the others', moved by ``first_change`` of it, P_b 0.04-0.42)
+    set aside, the next (σ 200x, moved by 0.2 of it, P_b 0.07) holds the rest of the variance; judged apart only once,
+    the value passed 3 under no effect at 9-14x Q(3) (review of 942a0e9, 20000 draws)."""
+    rng = np.random.default_rng(1)
+    n_bands, draws = 80, 20000
+    sigma = rng.uniform(0.5, 2.0, n_bands)
+    delta = sigma * rng.uniform(0.2, 2.0, n_bands) * rng.choice([-1.0, 1.0], n_bands)
+    top = sigma[2:].max()
+    sigma[0], sigma[1] = 300.0 * top, 200.0 * top
+    delta[0], delta[1] = first_change * sigma[0], 0.2 * sigma[1]
+    var, reach = _variance_and_reach(delta, sigma)
+    assert var[0] > var[1:].sum() and var[1] > var[2:].sum() and 2.0 * var[1] < reach[1]
+    gains = _gains(rng.normal(0.0, 1.0, (draws, n_bands)) * sigma + delta / 2, delta, sigma)
+    t = np.array([held_out_t(g, var, reach) for g in gains])
+    q3 = stats.norm.sf(3.0)
+    assert np.mean(t > 3.0) <= q3 + 3.0 * np.sqrt(q3 / draws), np.mean(t > 3.0)
+    assert np.mean(t > 2.0) <= stats.norm.sf(2.0), np.mean(t > 2.0)
