@@ -55,6 +55,7 @@ from .components import Plant, wheel_rigid_mass_matrix
 from .errors import CouplingError, SingularInterfaceError
 from .gyro_split import FloorSolver, wheel_split
 from .interface import _apply_left, _interface_matrix, _wheel_frf, rigid_wheel_frf  # noqa: F401  (rigid_wheel_frf: public here)
+from .line_groups import grouped_lines_blocked
 
 # ----------------------------------------------------------------------------- broadband floors
 
@@ -280,29 +281,6 @@ class LineResponses:
         return np.sqrt(ms)
 
 
-def _grouped_lines(spec: WheelSpec, omega, k_max: int = 0):
-    """Hard-mounted line phasors summed over lines with equal h and frequency offset (and, with a speed
-    ripple, the ripple order m, the complex ripple coefficient applied per line first):
-    (h (J,), f_offset (J,) Hz incl. m·f_r, m (J,), f (S, J) Hz, F (S, J, 6))."""
-    S = np.size(omega)
-    if spec.ripple is None:
-        m = np.zeros(1, dtype=int)
-        f_all, amp = ext.steady_lines(spec.params, spec.lines, omega, rigid=spec.hard_mounted)
-        f_all, amp = f_all[:, :, None], amp[:, :, None, :]
-    else:
-        m, f_all, amp = ripple_mod.ripple_lines(spec.params, spec.lines, omega, spec.ripple, k_max, rigid=spec.hard_mounted)
-    L, M = len(spec.lines), m.size
-    keys = np.array([(ln.h, ln.f_offset, mm) for ln in spec.lines for mm in m], dtype=float)
-    ku, first, inv = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    inv = np.ravel(inv)
-    ind = np.zeros((ku.shape[0], keys.shape[0]))
-    ind[inv, np.arange(keys.shape[0])] = 1.0
-    A2 = np.moveaxis(amp.reshape(S, L * M, 6), 1, 0).reshape(L * M, S * 6)
-    F = np.moveaxis((ind @ A2.real + 1j * (ind @ A2.imag)).reshape(-1, S, 6), 0, 1)
-    fr = 0.0 if spec.ripple is None else spec.ripple.f_hz
-    return (ku[:, 0], ku[:, 1] + ku[:, 2] * fr, ku[:, 2].astype(int), f_all.reshape(S, L * M)[:, first], F)
-
-
 def _wheel_key(w):
     return (w.params, float(w.housing_mass), tuple(float(x) for x in w.housing_inertia), float(w.speed_scale),
             bool(w.hard_mounted))
@@ -449,7 +427,7 @@ def _line_sweep(plant: Plant, wheels, omega, practices, chunk: int, floor_f_hz, 
     grouped: dict = {}
     for k, wk in enumerate(wheels):
         if line_key[k] not in grouped:
-            grouped[line_key[k]] = _grouped_lines(wk, om * wk.speed_scale, kmax[k])
+            grouped[line_key[k]] = grouped_lines_blocked(wk, om * wk.speed_scale, kmax[k])
     hs, offs, orders, fs, hms = ([grouped[key][i] for key in line_key] for i in range(5))
     # per wheel, the chunks' arrays: interface loads, outputs
     load_parts: list[list[np.ndarray]] = [[] for _ in range(nw)]
