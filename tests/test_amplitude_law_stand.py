@@ -1,0 +1,51 @@
+"""An amplitude law is told from Ω² where no named test stand reaches its line (issue 33, ROSS's stand at 120 Hz).
+
+:func:`rwadist.effects.amplitude_law_diagnose._stand_reach` marks the speeds at which a named fixture changes a line's
+power by 1.5x or more; the law must also be significant on the others (:meth:`AmplitudeLaw.significant`).  Checked
+against the closed form of a transmissibility (gain above 0: the force through a fixture spring).
+"""
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from rwadist.effects.amplitude_law_diagnose import AmplitudeLaw, _stand_reach
+from rwadist.stand_resonance import STAND_MIN_LOG_GAIN
+
+
+def _stand(f_r, zeta, role="test_stand"):
+    # peak gain 1/(2ζ) with gain above 0: H = 1/(1 - r² + 2jζr), no numerator damping (rwadist.resonance)
+    return SimpleNamespace(kind="fixed_resonance", role=role, f_r=f_r, zeta=zeta, peak_gain=1 / (2 * zeta),
+                           gain_above=0.0)
+
+
+def test_stand_reach_is_where_a_transmissibility_changes_the_line_power_by_1_5():
+    f_r, zeta, h = 112.0, 0.03, 1.0
+    f = np.linspace(5.0, 400.0, 4000)
+    w = 2 * np.pi * f / h
+    got = _stand_reach(SimpleNamespace(effects=[_stand(f_r, zeta)]), h, w)
+    # closed form: |H|² = 1/((1 - r²)² + (2ζr)²) reaches 1.5 (lift) or falls to 1/1.5 (above the stand)
+    r = f / f_r
+    d = (1 - r**2) ** 2 + (2 * zeta * r) ** 2
+    g = np.exp(STAND_MIN_LOG_GAIN)
+    want = (d <= 1 / g) | (d >= g)
+    clear = np.abs(np.log(d)) - STAND_MIN_LOG_GAIN
+    sure = np.abs(clear) > 1e-6
+    assert np.array_equal(got[sure], want[sure])
+    # lifted from r = sqrt(1 - 1/sqrt(1.5)) ≈ 0.43 (48 Hz) to sqrt(1 + 1/sqrt(1.5)) ≈ 1.35 (151 Hz), lowered from
+    # sqrt(1 + sqrt(1.5)) ≈ 1.49 (167 Hz) on
+    free = f[~got & (r > 1)]
+    assert f[np.argmax(got)] == pytest.approx(f_r * np.sqrt(1 - 1 / np.sqrt(1.5)), rel=0.01)
+    assert free.min() == pytest.approx(f_r * np.sqrt(1 + 1 / np.sqrt(1.5)), rel=0.01)
+    assert free.max() == pytest.approx(f_r * np.sqrt(1 + np.sqrt(1.5)), rel=0.01)
+    # a wheel-mode resonance is the wheel's, not a fixture's: it reaches nothing here
+    assert not _stand_reach(SimpleNamespace(effects=[_stand(f_r, zeta, "wheel_mode")]), h, w).any()
+
+
+@pytest.mark.parametrize("beyond, told", [(None, True), ((2.04, 0.01), False), ((float("nan"),) * 2, False),
+                                          ((2.5, 0.02), True)])
+def test_law_beside_a_stand_must_be_told_from_omega_squared_where_the_stand_does_not_reach(beyond, told):
+    """An exponent of 2.11 ± 0.003 over every run (ROSS's imbalance force through the 120 Hz stand) is a law only when
+    the runs out of the stand's reach tell it from 2 too (or when no stand reaches the line: None)."""
+    law = AmplitudeLaw("radial_force", 1.0, 2.11, 1.0, 300.0, 0.003, beyond)
+    assert law.significant() is told
