@@ -9,25 +9,27 @@ from rwadist.effects.broadband_floor_diagnose import _floor_law
 
 
 def _plain_floor_law(wt, y, x0):
-    """Three IRLS passes, one exponent at a time (the least squares y = n + g·x per band, the smallest SSE kept)."""
+    """One exponent at a time: three IRLS passes of its own (the least squares y = n + g·x per band, weighted by
+    bins/E² of its previous pass), the exponent of the smallest Whittle deviance Σ wt·(y/E + ln E) kept."""
     level = np.maximum(np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300), 1e-300)
-    expected = np.broadcast_to(level, y.shape)
-    for _ in range(3):
-        wts = wt / np.maximum(expected / float(np.max(level)), 1e-12) ** 2
-        best = None
-        for p in FLOOR_EXPONENTS:
-            x = x0[:, None] ** p
+    use = np.sum(wt * y, 0) > 0
+    best = None
+    for p in FLOOR_EXPONENTS:
+        x = x0[:, None] ** p
+        expected = np.broadcast_to(level, y.shape)
+        for _ in range(3):
+            wts = wt / np.maximum(expected / float(np.max(level)), 1e-12) ** 2
             s0, s1, s2 = wts.sum(0), (wts * x).sum(0), (wts * x * x).sum(0)
             t0, t1 = (wts * y).sum(0), (wts * x * y).sum(0)
             det = s0 * s2 - s1 * s1
             with np.errstate(divide="ignore", invalid="ignore"):
                 g = np.maximum(np.where(det > 0, (s0 * t1 - s1 * t0) / det, 0.0), 0.0)
             n = np.where(s0 > 0, np.maximum((t0 - g * s1) / np.maximum(s0, 1e-300), 0.0), 0.0)
-            sse = float(np.sum(wts * (y - n - g * x) ** 2))
-            if best is None or sse < best[0]:
-                best = (sse, p, n, g)
-        _, p, n, g = best
-        expected = np.maximum(n[None, :] + g[None, :] * x0[:, None] ** p, 1e-300)
+            expected = np.maximum(n[None, :] + g[None, :] * x, 1e-300)
+        e = np.maximum(expected[:, use], 1e-3 * level[use])
+        dev = float(np.sum(wt[:, use] * (y[:, use] / e + np.log(e / level[use]))))
+        if best is None or dev < best[0]:
+            best = (dev, p, n, g)
     return best[1:]
 
 
@@ -48,3 +50,22 @@ def test_floor_law_is_the_loop_over_exponents(n_runs, n_bands, p_true, seed):
         assert abs(got[0] - p_true) <= 1.0      # the law found is the one made (the comparison is not of two zeros)
     np.testing.assert_array_equal(got[1], ref[1])
     np.testing.assert_array_equal(got[2], ref[2])
+
+
+def test_floor_law_finds_the_exponent_made_beside_leaked_bands():
+    """A floor ∝ Ω³ (12 speeds 0.18-1.75 Ω_ref, 20 bands falling off in frequency) read through band means of 1-8
+    Welch bins (chi² scatter of 13.4 degrees of freedom a bin) with six band-runs lifted 3-10x (a line's leakage
+    the off-line mask missed): the exponent found is within 0.5 of 3 on each of 40 draws.  With the weights of the
+    previous pass's best exponent shared by every exponent (cdd25f1), a steep law was its own fixed point: p 8 on
+    5 draws, 7 of 40 more than 0.5 off (family wheel 4's Fz: p 8 for a floor ∝ Ω³)."""
+    x0 = np.linspace(0.18, 1.75, 12)
+    for seed in range(40):
+        rng = np.random.default_rng(seed)
+        growth = rng.uniform(0.0, 200.0, 20) * np.exp(-np.arange(20) / 3)
+        wt = rng.integers(1, 9, (x0.size, 20)).astype(float)
+        y = (1.0 + growth * x0[:, None] ** 3) * rng.gamma(6.7 * wt, 1 / (6.7 * wt))
+        leak = rng.integers(0, y.size, 6)
+        y.flat[leak] *= rng.uniform(3, 10, 6)
+        p, n, g = _floor_law(wt, y, x0)
+        assert abs(p - 3.0) <= 0.5, (seed, p)
+        assert np.all(n >= 0) and np.all(g >= 0)
