@@ -171,3 +171,39 @@ def test_a_resonance_moving_with_speed_is_described_and_no_wheel_mode_is_named(t
     row = dow.cell(0, dow.fw.family()[0], "softening_mode", tmp_path)
     assert "failed" not in row, row
     assert row["added"] == [] and row["right"], row
+
+
+@pytest.mark.slow
+def test_a_floor_of_the_rotor_forces_split_over_three_channels_is_found_at_its_level(tmp_path):
+    """Family wheel 4 (4096 samples at 3840 Hz, 300-3000 rpm) with random rotor forces of PSD ∝ Ω³/(1 + (f/32.9 Hz)⁴)
+    (tests/family_effects.py, 28.5 dB over the noise at the top speed) on the radial and axial forces: each force
+    channel held 2-5 % of the held-out misplaced power, below the search's min_gain, and no single-channel floor was
+    fitted; the floor on Fz alone took p 8 (cdd25f1: missed, described as two broadband humps).  One law of the force
+    channels (rwadist.effects.broadband_floor_diagnose.FloorGroup) is named on Fx, Fy and Fz, nothing else added, the
+    error within 1.5x the clean cell's; its exponent within 0.25 of 3 and its level at Ω_ref within 30 % of the injected
+    PSD through the suspension, S(f, Ω_ref)·|T(f)|², at the band centres whose band ends below the mode that lifts it
+    (Fx, Fy: 28-178 Hz, below the translation at 227.7 Hz, measured 3-18 % off; Fz: 28 Hz, below the axial at 70 Hz,
+    3 % off)."""
+    import json
+
+    import family_wheel as fw
+
+    _assert_named_alone_near_clean(4, "broadband_floor", tmp_path)
+    w = dfm.wheels()[4]
+    floor = next(c for c in dfm.cells(4, w) if c[0] == "broadband_floor")[2][0]
+    model = json.loads((tmp_path / "w4_broadband_floor" / "report" / "model.json").read_text())
+    floors = {e["channel"][0]: e for e in model["effects"] if e["kind"] == "broadband_floor"}
+    assert set(floors) == {"Fx", "Fy", "Fz"} and all(len(e["channel"]) == 1 for e in floors.values())
+    for c, e in floors.items():
+        assert abs(e["exponent"] - floor.params["exponent"]) <= 0.25, (c, e["exponent"])
+        f = np.asarray(e["f_Hz"])
+        w_ref = e["omega_ref_rad_s"]
+        direction, row = ("axial_force", 0) if c == "Fz" else ("radial_force", "xy".index(c[1].lower()))
+        T = fw.transfer(w, direction, 2 * np.pi * f, w_ref)[:, row, :]
+        truth = floor._psd(w, w_ref, f, w.max_rpm * fw.RPM) * np.sum(np.abs(T) ** 2, -1)
+        # the knots (band centres) whose band, 8 bins of 3.75 Hz, ends below the mode (its peak in a band makes the
+        # band mean, which the knot holds, no value at the centre)
+        mode = w.f_axial if c == "Fz" else w.f_trans
+        sel = (f > 20.0) & (f + 15.0 < 0.9 * mode)
+        assert sel.sum() >= (1 if c == "Fz" else 5)
+        np.testing.assert_allclose(np.asarray(e["psd_ref"])[sel], truth[sel], rtol=0.3, err_msg=c)

@@ -3,7 +3,7 @@ held-out speeds, the best passing one refitted on every run and added (docs/diag
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy import stats
@@ -546,6 +546,12 @@ def _search(spectra: Spectra, model: WheelModel | None, k_sigma: float, min_gain
         best.passed = True
         state = applied                         # refit.apply(state), made by _no_worse
         best.effect = state.effects[-1]
+        parts = getattr(refit, "parts", None)
+        if parts:
+            # an effect of several parts (a floor law of several channels, each channel's floor its own entry of the
+            # model file): one passed hypothesis per part, each with the judgement of the whole
+            k = next(i for i, h in enumerate(hyps) if h is best)
+            hyps[k:k] = [replace(best, effect=e) for e in state.effects[-len(parts):-1]]
     else:
         it = max_iterations
     ctx.step = None
