@@ -45,3 +45,35 @@ def test_both_record_scans_read_their_own_offsets_powers_computed_once(monkeypat
     np.testing.assert_array_equal(P, transform(ctx, chans, runs, np.concatenate([fc - grid, fc + grid], axis=1), h,
                                                single=True))
     assert len(calls) == 2
+
+
+def test_record_candidates_transform_every_carrier_at_once_to_the_bit(monkeypatch):
+    """The scan of :meth:`Sidebands.record_candidates` over a direction's carriers: their line powers computed together
+    (:func:`ssd._carrier_line_powers`, one transform) are each carrier's own (:func:`_line_powers` alone) to the bit,
+    and the candidates are those of the carriers computed one at a time (the prefetch switched off)."""
+    test = e_data(3)
+    direction = "radial_force"
+    hs = [x.h for x in TRUTH.harmonics(direction)]
+    assert len(hs) >= 3
+    chans = [c for c in DIRECTION_CHANNELS[direction] if c in test.channels]
+    together = []
+    batched = ssd._carrier_line_powers
+    monkeypatch.setattr(ssd, "_carrier_line_powers", lambda *a, **k: together.append(len(a[4])) or batched(*a, **k))
+    got = {}
+    for prefetch in (True, False):
+        ctx = Context(spectra(test), test=test)
+        state = initial_state(ctx, TRUTH)
+        if not prefetch:
+            monkeypatch.setattr(sd.Sidebands, "_prefetch_scan_powers", staticmethod(lambda *a, **k: None))
+        got[prefetch] = (sd.Sidebands.record_candidates(ctx, state, ctx.fit_runs, direction, hs),
+                         {k: v for k, v in ctx._memo.items() if k[0] == "sidebands_scan_powers"})
+    assert together == [len(hs)]                    # every carrier in one transform, with the prefetch only
+    (cand, kept), (cand_alone, kept_alone) = got[True], got[False]
+    assert cand == cand_alone and kept.keys() == kept_alone.keys() and len(kept) == len(hs)
+    for key, P in kept.items():
+        _, _, h, runs, grid = key
+        runs, grid = np.frombuffer(runs, dtype=np.intp), np.frombuffer(grid)
+        fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
+        alone = ssd._line_powers(ctx, chans, runs, np.concatenate([fc - grid, fc + grid], axis=1), h, single=True)
+        np.testing.assert_array_equal(P, alone)
+        np.testing.assert_array_equal(P, kept_alone[key])

@@ -195,13 +195,46 @@ class Sidebands:
         n = offsets.size
         if not 0 < n <= grid.size or not np.array_equal(grid[:n], offsets):
             return None
-        key = ("sidebands_scan_powers", direction, float(h), np.asarray(runs).tobytes(), grid.tobytes())
+        key = Sidebands._scan_key(direction, h, runs, grid)
         if key not in ctx._memo:
             fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
             ctx._memo[key] = _line_powers(ctx, chans, runs, np.concatenate([fc - grid, fc + grid], axis=1), h,
                                           single=True)
         P = ctx._memo[key]
         return np.concatenate([P[:, :n], P[:, grid.size:grid.size + n]], axis=1)
+
+    @staticmethod
+    def _prefetch_scan_powers(ctx: Context, direction: str, hs, runs, offsets) -> None:
+        """The scan powers (:meth:`_scan_powers`) of every carrier of ``hs`` that :meth:`record_candidates` is about to
+        read from them (the whole-run scans' grid begins with ``offsets``, and neither its scan nor its powers are
+        kept yet), computed together (:func:`~rwadist.effects.speed_sidebands_diagnose._carrier_line_powers`: the
+        numbers of one carrier at a time) and kept as :meth:`_scan_powers` keeps them."""
+        from .speed_sidebands_diagnose import RUN_MIN_BINS, _carrier_line_powers, _record_df
+
+        df_rec = float(np.max(_record_df(ctx, ctx.runs)))
+        grid = np.arange(RUN_MIN_BINS * df_rec, RECORD_SCAN_WELCH_BINS * ctx.df, RECORD_STEP_BINS * df_rec)
+        n = offsets.size
+        if not 0 < n <= grid.size or not np.array_equal(grid[:n], offsets):
+            return
+        todo = []
+        for h in hs:
+            fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
+            f = np.concatenate([fc - offsets[None, :], fc + offsets[None, :]], axis=1)
+            if ("sidebands_record_power", direction, float(h), np.asarray(runs).tobytes(), f.tobytes(), True) \
+                    in ctx._memo or Sidebands._scan_key(direction, h, runs, grid) in ctx._memo:
+                continue
+            todo.append((h, np.concatenate([fc - grid, fc + grid], axis=1)))
+        if len(todo) < 2:
+            return                      # one carrier: :meth:`_scan_powers` computes it as ever
+        chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        P = _carrier_line_powers(ctx, chans, runs, [f for _, f in todo], [h for h, _ in todo], single=True)
+        for (h, _), p in zip(todo, P):
+            ctx._memo[Sidebands._scan_key(direction, h, runs, grid)] = p
+
+    @staticmethod
+    def _scan_key(direction: str, h: float, runs, grid: np.ndarray) -> tuple:
+        """Key of a carrier's scan powers (:meth:`_scan_powers`) on the context."""
+        return ("sidebands_scan_powers", direction, float(h), np.asarray(runs).tobytes(), grid.tobytes())
 
     @staticmethod
     def fit_record(ctx: Context, state: State, direction: str, h: float, runs, f_mod: float) -> "Sidebands | None":
@@ -292,9 +325,11 @@ class Sidebands:
         # the noise and the valid points read the state (its floor, its lines): keyed by what it predicts there
         state_key = ctx.content_key(state, [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels], sel)
         out = []
-        for h in hs:
-            key = ("sidebands_record_scan", direction, round(h, 6), sel.tobytes(), state_key) + \
-                ((offsets.tobytes(),) if given else ())
+        keys = [("sidebands_record_scan", direction, round(h, 6), sel.tobytes(), state_key) +
+                ((offsets.tobytes(),) if given else ()) for h in hs]
+        Sidebands._prefetch_scan_powers(ctx, direction, [h for h, key in zip(hs, keys) if key not in ctx._memo],
+                                        sel, offsets)
+        for h, key in zip(hs, keys):
             if key not in ctx._memo:
                 ctx._memo[key] = Sidebands._record_power(ctx, state, direction, h, sel, offsets, single=True)
             f, P, N, ok = ctx._memo[key]

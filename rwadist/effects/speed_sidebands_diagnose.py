@@ -208,6 +208,38 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
     return np.abs(X) ** 2
 
 
+def _carrier_line_powers(ctx: Context, chans, runs, f_list, hs, single: bool = False) -> list:
+    """``[_line_powers(ctx, chans, runs, f, h, single=single) for f, h in zip(f_list, hs)]`` (each f (len(runs), L_k)
+    Hz, every point needed) with one transform per chunk of runs for all the carriers ``hs``: their frequencies and the
+    carriers themselves in one table (:func:`rwadist.dft.windowed_dfts`: each phasor is its own frequency's, whatever
+    others are transformed with it), each carrier's leakage taken off its own points as :func:`_line_powers` does --
+    the same numbers, one set of tables and products instead of one per carrier (the ``sidebands`` scans ask for
+    every carrier of a direction on the same runs)."""
+    from ..dft import hann_transform, run_window, windowed_dfts
+
+    runs = np.asarray(runs)
+    widths = [int(f.shape[1]) for f in f_list]
+    edges = np.concatenate([[0], np.cumsum(widths)]).astype(int)
+    out = [np.full((runs.size, w_k, len(chans)), np.nan + 0j) for w_k in widths]
+    groups: dict[tuple[int, float], list[int]] = {}            # rows by (record length, sample rate)
+    for i in range(runs.size if edges[-1] else 0):
+        run = ctx.test.runs[runs[i]]
+        groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
+    for (n, fs), rows_all in groups.items():
+        w, wsum, _ = run_window(RUN_WINDOW, n)
+        step = max(1, RUN_CHUNK_SAMPLES // (n * max(len(chans), 1)))
+        for s in range(0, len(rows_all), step):
+            rows = np.asarray(rows_all[s:s + step])
+            f_c = [h * ctx.omega[runs[rows]] / (2 * np.pi) for h in hs]
+            f_i = [np.asarray(f, dtype=float)[rows] for f in f_list]
+            x = _run_records(ctx, runs[rows], chans)
+            both = 2.0 * windowed_dfts(x, fs, np.column_stack(f_i + f_c), single=single) / wsum
+            for k in range(len(hs)):
+                leak = hann_transform(n, fs, f_i[k] - f_c[k][:, None]) / wsum               # W(f − f_c)/W(0)
+                out[k][rows] = both[:, edges[k]:edges[k + 1]] - leak[:, :, None] * both[:, edges[-1] + k][:, None, :]
+    return [np.abs(X) ** 2 for X in out]
+
+
 def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
     """Mean |X|² (len(runs), L, len(chans)) that white noise of the state's floor S puts into the whole-run phasor
     at ``f_hz``: 2·S·fs·Σw²/(Σw)² (:data:`RUN_WINDOW`)."""
