@@ -14,17 +14,22 @@ from rwadist.stand_resonance import STAND_MIN_LOG_GAIN
 
 
 def _stand(f_r, zeta, role="test_stand"):
-    # peak gain 1/(2ζ) with gain above 0: H = 1/(1 - r² + 2jζr), no numerator damping (rwadist.resonance)
+    # peak gain 1/(2ζ) with gain above 0: H = 1/(1 - r² + 2jζr), the bare single mode (no numerator damping,
+    # rwadist.resonance; a transmissibility would be (1 + 2jζr)/(1 - r² + 2jζr))
     return SimpleNamespace(kind="fixed_resonance", role=role, f_r=f_r, zeta=zeta, peak_gain=1 / (2 * zeta),
                            gain_above=0.0)
 
 
-def test_stand_reach_is_where_a_transmissibility_changes_the_line_power_by_1_5():
-    f_r, zeta, h = 112.0, 0.03, 1.0
+@pytest.mark.parametrize("h", [1.0, 3.08])
+def test_stand_reach_is_where_a_single_mode_changes_the_line_power_by_1_5(h):
+    """The line h at speed w (rad/s) sits at f = h·w/2π (Hz): with h 3.08, a reach read at w/2π (h left out) or at
+    w/(2π·h) is off by 3.08x or 9.5x in frequency and fails the closed form."""
+    f_r, zeta = 112.0, 0.03
     f = np.linspace(5.0, 400.0, 4000)
     w = 2 * np.pi * f / h
     got = _stand_reach(SimpleNamespace(effects=[_stand(f_r, zeta)]), h, w)
-    # closed form: |H|² = 1/((1 - r²)² + (2ζr)²) reaches 1.5 (lift) or falls to 1/1.5 (above the stand)
+    # closed form of the bare single mode (gain above 0, peak 1/(2ζ): no numerator term):
+    # |H|² = 1/((1 - r²)² + (2ζr)²) reaches 1.5 (lift) or falls to 1/1.5 (above the stand)
     r = f / f_r
     d = (1 - r**2) ** 2 + (2 * zeta * r) ** 2
     g = np.exp(STAND_MIN_LOG_GAIN)
@@ -42,10 +47,13 @@ def test_stand_reach_is_where_a_transmissibility_changes_the_line_power_by_1_5()
     assert not _stand_reach(SimpleNamespace(effects=[_stand(f_r, zeta, "wheel_mode")]), h, w).any()
 
 
-@pytest.mark.parametrize("beyond, told", [(None, True), ((2.04, 0.01), False), ((float("nan"),) * 2, False),
-                                          ((2.5, 0.02), True)])
+@pytest.mark.parametrize("beyond, told", [(None, True), ((2.04, 0.01), False), ((float("nan"),) * 2, True),
+                                          ((2.5, 0.02), True), ((2.5, float("nan")), False)])
 def test_law_beside_a_stand_must_be_told_from_omega_squared_where_the_stand_does_not_reach(beyond, told):
     """An exponent of 2.11 ± 0.003 over every run (ROSS's imbalance force through the 120 Hz stand) is a law only when
-    the runs out of the stand's reach tell it from 2 too (or when no stand reaches the line: None)."""
+    the runs out of the stand's reach tell it from 2 too, or when no stand reaches the line (None) or the stand leaves
+    too few runs to fit it on ((nan, nan): judged over every run alone); an exponent of no finite standard error
+    tells nothing."""
     law = AmplitudeLaw("radial_force", 1.0, 2.11, 1.0, 300.0, 0.003, beyond)
     assert law.significant() is told
+    assert AmplitudeLaw("radial_force", 1.0, 3.0, 1.0, 300.0, float("nan"), None).significant() is False
