@@ -77,3 +77,37 @@ def test_record_candidates_transform_every_carrier_at_once_to_the_bit(monkeypatc
         alone = ssd._line_powers(ctx, chans, runs, np.concatenate([fc - grid, fc + grid], axis=1), h, single=True)
         np.testing.assert_array_equal(P, alone)
         np.testing.assert_array_equal(P, kept_alone[key])
+
+
+def test_carriers_transformed_in_bounded_batches_to_the_bit(monkeypatch):
+    """:func:`ssd._carrier_line_powers` takes the carriers in batches of at most :data:`ssd.CARRIER_BATCH_ELEMENTS`
+    frequency x (block, channel) elements a record (one transform of every carrier held ~24 bytes per element: 195 MB at
+    65536 samples x 3 channels for 18 carriers of 224 points, linear in the carriers): each carrier's powers are the
+    same to the bit with one carrier a batch, two, or all at once, and each batch stays within the bound (or is one
+    carrier)."""
+    test = e_data(3)
+    direction = "radial_force"
+    hs = [x.h for x in TRUTH.harmonics(direction)]
+    ctx = Context(spectra(test), test=test)
+    chans = [c for c in DIRECTION_CHANNELS[direction] if c in test.channels]
+    runs = np.asarray(ctx.fit_runs)[:4]
+    grid = np.arange(1.0, 30.0, 0.5)
+    f_list = []
+    for h in hs:
+        fc = h * ctx.omega[runs][:, None] / (2 * np.pi)
+        f_list.append(np.concatenate([fc - grid, fc + grid], axis=1))
+    n = test.runs[int(runs[0])].n_samples
+    per_f = max(128, -(-n // 128) * len(chans))
+    got = {}
+    for bound in (1, 3 * (f_list[0].shape[1] + 1) * per_f - 1, 1 << 40):
+        monkeypatch.setattr(ssd, "CARRIER_BATCH_ELEMENTS", bound)
+        batches = ssd._carrier_batches([f.shape[1] for f in f_list], n, len(chans))
+        assert sorted(k for b in batches for k in b) == list(range(len(hs)))
+        assert all(len(b) == 1 or sum(f_list[k].shape[1] + 1 for k in b) * per_f <= bound for b in batches)
+        got[bound] = (len(batches), ssd._carrier_line_powers(ctx, chans, runs, f_list, hs, single=True))
+    assert [v[0] for v in got.values()] == [len(hs), -(-len(hs) // 2), 1]
+    for _, P in got.values():
+        for k, h in enumerate(hs):
+            np.testing.assert_array_equal(P[k], got[1 << 40][1][k])
+    alone = ssd._line_powers(ctx, chans, runs, f_list[0], hs[0], single=True)
+    np.testing.assert_array_equal(got[1][1][0], alone)

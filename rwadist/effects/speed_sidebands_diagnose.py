@@ -208,21 +208,45 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
     return np.abs(X) ** 2
 
 
+#: Most frequency x (sample block, channel) elements of one record that :func:`_carrier_line_powers` transforms at once
+#: (:func:`rwadist.dft.windowed_dfts` holds ~24 bytes each for one record: its phasor table, float32 products and complex
+#: sums, whatever its own chunking): the carriers are taken in batches under it, at least one carrier a batch.
+CARRIER_BATCH_ELEMENTS = 1 << 22
+
+
+def _carrier_batches(widths, n: int, n_chans: int) -> list:
+    """Consecutive carriers [[k, ...], ...] of frequency counts ``widths`` (each carrier's points and its own phasor)
+    whose elements (frequencies x (blocks of 128 samples of a record of ``n``) x ``n_chans``) stay within
+    :data:`CARRIER_BATCH_ELEMENTS`: the transient of one transform bounded whatever the number of carriers."""
+    per_f = max(128, -(-n // 128) * max(n_chans, 1))
+    out: list[list[int]] = []
+    size = 0
+    for k, w_k in enumerate(widths):
+        need = (int(w_k) + 1) * per_f
+        if out and size + need <= CARRIER_BATCH_ELEMENTS:
+            out[-1].append(k)
+            size += need
+        else:
+            out.append([k])
+            size = need
+    return out
+
+
 def _carrier_line_powers(ctx: Context, chans, runs, f_list, hs, single: bool = False) -> list:
     """``[_line_powers(ctx, chans, runs, f, h, single=single) for f, h in zip(f_list, hs)]`` (each f (len(runs), L_k)
     Hz, every point needed) with one transform per chunk of runs for all the carriers ``hs``: their frequencies and the
     carriers themselves in one table (:func:`rwadist.dft.windowed_dfts`: each phasor is its own frequency's, whatever
     others are transformed with it), each carrier's leakage taken off its own points as :func:`_line_powers` does --
     the same numbers, one set of tables and products instead of one per carrier (the ``sidebands`` scans ask for
-    every carrier of a direction on the same runs)."""
+    every carrier of a direction on the same runs).  The carriers in batches of :func:`_carrier_batches` (a
+    transform's transient grows with its frequencies: at most :data:`CARRIER_BATCH_ELEMENTS` a record)."""
     from ..dft import hann_transform, run_window, windowed_dfts
 
     runs = np.asarray(runs)
     widths = [int(f.shape[1]) for f in f_list]
-    edges = np.concatenate([[0], np.cumsum(widths)]).astype(int)
     out = [np.full((runs.size, w_k, len(chans)), np.nan + 0j) for w_k in widths]
     groups: dict[tuple[int, float], list[int]] = {}            # rows by (record length, sample rate)
-    for i in range(runs.size if edges[-1] else 0):
+    for i in range(runs.size if sum(widths) else 0):
         run = ctx.test.runs[runs[i]]
         groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
     for (n, fs), rows_all in groups.items():
@@ -233,10 +257,13 @@ def _carrier_line_powers(ctx: Context, chans, runs, f_list, hs, single: bool = F
             f_c = [h * ctx.omega[runs[rows]] / (2 * np.pi) for h in hs]
             f_i = [np.asarray(f, dtype=float)[rows] for f in f_list]
             x = _run_records(ctx, runs[rows], chans)
-            both = 2.0 * windowed_dfts(x, fs, np.column_stack(f_i + f_c), single=single) / wsum
-            for k in range(len(hs)):
-                leak = hann_transform(n, fs, f_i[k] - f_c[k][:, None]) / wsum               # W(f − f_c)/W(0)
-                out[k][rows] = both[:, edges[k]:edges[k + 1]] - leak[:, :, None] * both[:, edges[-1] + k][:, None, :]
+            for ks in _carrier_batches(widths, n, len(chans)):
+                e = np.concatenate([[0], np.cumsum([widths[k] for k in ks])]).astype(int)
+                both = 2.0 * windowed_dfts(x, fs, np.column_stack([f_i[k] for k in ks] + [f_c[k] for k in ks]),
+                                           single=single) / wsum
+                for j, k in enumerate(ks):
+                    leak = hann_transform(n, fs, f_i[k] - f_c[k][:, None]) / wsum           # W(f − f_c)/W(0)
+                    out[k][rows] = both[:, e[j]:e[j + 1]] - leak[:, :, None] * both[:, e[-1] + j][:, None, :]
     return [np.abs(X) ** 2 for X in out]
 
 
