@@ -18,7 +18,7 @@ def _plain_floor_law(wt, y, x0):
         x = x0[:, None] ** p
         expected = np.broadcast_to(level, y.shape)
         for _ in range(3):
-            wts = wt / np.maximum(expected / float(np.max(level)), 1e-12) ** 2
+            wts = wt / np.maximum(expected / level, 1e-3) ** 2
             s0, s1, s2 = wts.sum(0), (wts * x).sum(0), (wts * x * x).sum(0)
             t0, t1 = (wts * y).sum(0), (wts * x * y).sum(0)
             det = s0 * s2 - s1 * s1
@@ -69,3 +69,21 @@ def test_floor_law_finds_the_exponent_made_beside_leaked_bands():
         p, n, g = _floor_law(wt, y, x0)
         assert abs(p - 3.0) <= 0.5, (seed, p)
         assert np.all(n >= 0) and np.all(g >= 0)
+
+
+@pytest.mark.parametrize("p_true, off_max", [(6.0, 2), (8.0, 4)])
+def test_floor_law_finds_a_steep_exponent(p_true, off_max):
+    """A floor ∝ Ω⁶ or Ω⁸ (12 speeds 0.18-1.75 Ω_ref, 20 bands, chi² band means of 1-8 bins): the exponent found is
+    within 0.5 of the one made on all but ``off_max`` of 40 draws (the likeliest law, measured: 1/40 and 4/40 off).
+    With the IRLS weights unheld (relative to the largest level, floored at 1e-12 of it) a steep law's passes did not
+    reach its likeliest fit and the deviance compared unfinished fits: 8/40 and 18/40 off (p 8 read as 3 on a draw
+    whose exact Gamma likelihood peaks at 8)."""
+    x0 = np.linspace(0.18, 1.75, 12)
+    off = 0
+    for seed in range(40):
+        rng = np.random.default_rng(seed)
+        growth = rng.uniform(0.0, 200.0, 20) * np.exp(-np.arange(20) / 3)
+        wt = rng.integers(1, 9, (x0.size, 20)).astype(float)
+        y = (1.0 + growth * x0[:, None] ** p_true) * rng.gamma(6.7 * wt, 1 / (6.7 * wt))
+        off += abs(_floor_law(wt, y, x0)[0] - p_true) > 0.5
+    assert off <= off_max, off
