@@ -181,31 +181,40 @@ def _line_powers(ctx: Context, chans, runs, f_hz, h0: float, need=None, single: 
     ``chans`` with one table of phasors), each at its needed frequencies (moved to the front of its row; the rest of
     the row padded with its carrier), in chunks of :data:`RUN_CHUNK_SAMPLES` samples; W in closed form
     (:func:`rwadist.dft.hann_transform`)."""
-    from ..dft import hann_transform, run_window, windowed_dfts
+    from ..dft import hann_transform, windowed_dfts
 
     if need is None:
         need = np.ones(f_hz.shape, dtype=bool)
     X = np.full((runs.size, f_hz.shape[1], len(chans)), np.nan + 0j)
-    groups: dict[tuple[int, float], list[np.intp]] = {}       # rows by (record length, sample rate)
-    for i in np.flatnonzero(need.any(axis=1)):
-        run = ctx.test.runs[runs[i]]
-        groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
-    for (n, fs), rows_all in groups.items():
-        w, wsum, _ = run_window(RUN_WINDOW, n)
-        step = max(1, RUN_CHUNK_SAMPLES // (n * max(len(chans), 1)))
-        for s in range(0, len(rows_all), step):
-            rows = np.asarray(rows_all[s:s + step])
-            nd = need[rows]
-            pick = np.argsort(~nd, axis=1, kind="stable")[:, :int(nd.sum(1).max())]
-            valid = np.take_along_axis(nd, pick, axis=1)
-            f_c = h0 * ctx.omega[runs[rows]] / (2 * np.pi)
-            f_i = np.where(valid, np.take_along_axis(f_hz[rows], pick, axis=1), f_c[:, None])
-            x = _run_records(ctx, np.asarray(runs)[rows], chans)
-            both = 2.0 * windowed_dfts(x, fs, np.column_stack([f_i, f_c]), single=single) / wsum
-            leak = hann_transform(n, fs, f_i - f_c[:, None]) / wsum                  # W(f − f_c)/W(0)
-            r, j = np.nonzero(valid)
-            X[rows[r], pick[r, j]] = both[r, j] - leak[r, j, None] * both[r, -1]
+    for n, fs, wsum, rows in _run_chunks(ctx, runs, np.flatnonzero(need.any(axis=1)), len(chans)):
+        nd = need[rows]
+        pick = np.argsort(~nd, axis=1, kind="stable")[:, :int(nd.sum(1).max())]
+        valid = np.take_along_axis(nd, pick, axis=1)
+        f_c = h0 * ctx.omega[runs[rows]] / (2 * np.pi)
+        f_i = np.where(valid, np.take_along_axis(f_hz[rows], pick, axis=1), f_c[:, None])
+        x = _run_records(ctx, np.asarray(runs)[rows], chans)
+        both = 2.0 * windowed_dfts(x, fs, np.column_stack([f_i, f_c]), single=single) / wsum
+        leak = hann_transform(n, fs, f_i - f_c[:, None]) / wsum                      # W(f − f_c)/W(0)
+        r, j = np.nonzero(valid)
+        X[rows[r], pick[r, j]] = both[r, j] - leak[r, j, None] * both[r, -1]
     return np.abs(X) ** 2
+
+
+def _run_chunks(ctx: Context, runs, rows_wanted, n_chans: int):
+    """Yield ``(n, fs, wsum, rows)``: the rows ``rows_wanted`` of ``runs`` grouped by (record length n, sample rate fs
+    Hz), in chunks of at most :data:`RUN_CHUNK_SAMPLES` samples x ``n_chans`` channels, with the sum of the
+    :data:`RUN_WINDOW` window's weights ``wsum`` of a record of n samples (rows: int array into ``runs``)."""
+    from ..dft import run_window
+
+    groups: dict[tuple[int, float], list[int]] = {}            # rows by (record length, sample rate)
+    for i in rows_wanted:
+        run = ctx.test.runs[runs[i]]
+        groups.setdefault((run.n_samples, run.sample_rate), []).append(int(i))
+    for (n, fs), rows_all in groups.items():
+        _, wsum, _ = run_window(RUN_WINDOW, n)
+        step = max(1, RUN_CHUNK_SAMPLES // (n * max(n_chans, 1)))
+        for s in range(0, len(rows_all), step):
+            yield n, fs, wsum, np.asarray(rows_all[s:s + step])
 
 
 #: Most frequency x (sample block, channel) elements of one record that :func:`_carrier_line_powers` transforms at once
@@ -240,30 +249,22 @@ def _carrier_line_powers(ctx: Context, chans, runs, f_list, hs, single: bool = F
     the same numbers, one set of tables and products instead of one per carrier (the ``sidebands`` scans ask for
     every carrier of a direction on the same runs).  The carriers in batches of :func:`_carrier_batches` (a
     transform's transient grows with its frequencies: at most :data:`CARRIER_BATCH_ELEMENTS` a record)."""
-    from ..dft import hann_transform, run_window, windowed_dfts
+    from ..dft import hann_transform, windowed_dfts
 
     runs = np.asarray(runs)
     widths = [int(f.shape[1]) for f in f_list]
     out = [np.full((runs.size, w_k, len(chans)), np.nan + 0j) for w_k in widths]
-    groups: dict[tuple[int, float], list[int]] = {}            # rows by (record length, sample rate)
-    for i in range(runs.size if sum(widths) else 0):
-        run = ctx.test.runs[runs[i]]
-        groups.setdefault((run.n_samples, run.sample_rate), []).append(i)
-    for (n, fs), rows_all in groups.items():
-        w, wsum, _ = run_window(RUN_WINDOW, n)
-        step = max(1, RUN_CHUNK_SAMPLES // (n * max(len(chans), 1)))
-        for s in range(0, len(rows_all), step):
-            rows = np.asarray(rows_all[s:s + step])
-            f_c = [h * ctx.omega[runs[rows]] / (2 * np.pi) for h in hs]
-            f_i = [np.asarray(f, dtype=float)[rows] for f in f_list]
-            x = _run_records(ctx, runs[rows], chans)
-            for ks in _carrier_batches(widths, n, len(chans)):
-                e = np.concatenate([[0], np.cumsum([widths[k] for k in ks])]).astype(int)
-                both = 2.0 * windowed_dfts(x, fs, np.column_stack([f_i[k] for k in ks] + [f_c[k] for k in ks]),
-                                           single=single) / wsum
-                for j, k in enumerate(ks):
-                    leak = hann_transform(n, fs, f_i[k] - f_c[k][:, None]) / wsum           # W(f − f_c)/W(0)
-                    out[k][rows] = both[:, e[j]:e[j + 1]] - leak[:, :, None] * both[:, e[-1] + j][:, None, :]
+    for n, fs, wsum, rows in _run_chunks(ctx, runs, range(runs.size if sum(widths) else 0), len(chans)):
+        f_c = [h * ctx.omega[runs[rows]] / (2 * np.pi) for h in hs]
+        f_i = [np.asarray(f, dtype=float)[rows] for f in f_list]
+        x = _run_records(ctx, runs[rows], chans)
+        for ks in _carrier_batches(widths, n, len(chans)):
+            e = np.concatenate([[0], np.cumsum([widths[k] for k in ks])]).astype(int)
+            both = 2.0 * windowed_dfts(x, fs, np.column_stack([f_i[k] for k in ks] + [f_c[k] for k in ks]),
+                                       single=single) / wsum
+            for j, k in enumerate(ks):
+                leak = hann_transform(n, fs, f_i[k] - f_c[k][:, None]) / wsum               # W(f − f_c)/W(0)
+                out[k][rows] = both[:, e[j]:e[j + 1]] - leak[:, :, None] * both[:, e[-1] + j][:, None, :]
     return [np.abs(X) ** 2 for X in out]
 
 
