@@ -13,11 +13,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from .resonance import general_log_power_gain, peak_of, resonance
+
 #: Smallest local lift (mean over a direction's lines of the ln power gain near one frequency over the same line's
 #: gains on both sides, :func:`_local_lift`) a fixture resonance must show in EVERY load direction with lines there to
 #: be proposed: a power gain of 1.5.  A wheel mode amplifies one direction's lines (translation the radial forces,
 #: rocking the radial torques, axial the axial force); only a resonance of the stand lifts them all at one frequency.
 STAND_MIN_LOG_GAIN = float(np.log(1.5))
+
+
+def log_power_gain(e, f_hz) -> np.ndarray:
+    """ln|H(f)|² of the fixed resonance ``e`` (its f_r Hz, zeta, peak_gain, gain_above: :func:`rwadist.resonance.resonance`)
+    at ``f_hz`` (Hz, any shape), |H|² held at 1e-300 or more: where its magnitude reaches :data:`STAND_MIN_LOG_GAIN` the
+    resonance changes a line's power by a factor 1.5 or more, up or down (the stand detection's own threshold)."""
+    return np.log(np.maximum(np.abs(resonance(f_hz, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2, 1e-300))
+
+
 #: Largest damping ratio of a proposed fixture resonance: a fixture resonance is sharp; a "resonance" as wide as
 #: the fit allows (ζ → 0.5) is a broad tilt of the line gains (a wheel mode's skirt, model error), not a stand.
 STAND_MAX_ZETA = 0.2
@@ -167,8 +178,6 @@ def _fit_on_lines(by_line: dict, f_s: float):
     (β = 1) and from a transmissibility (β = 0, γ = 1), ζ ∈ {0.01, 0.03, 0.1}; the best kept."""
     from scipy.optimize import least_squares
 
-    from .resonance import general_log_power_gain, peak_of
-
     fs: list[np.ndarray] = []
     ys: list[np.ndarray] = []
     lines: list[np.ndarray] = []
@@ -309,8 +318,6 @@ def lifts_every_direction(joint, plain) -> bool:
     stand's 230 Hz become 210 and 339 Hz; the stand fitted with the modes lowered the radial forces' residuals from 41.6
     to 0.58 and the torques' from 20.2 to 0.36, raised the axial force's from 1.5 to 7.3, and put the radial modes
     within 0.4 % of ROSS's; refused, the modes were lost and two amplitude laws invented in their place)."""
-    from .resonance import resonance
-
     f1, r1, d1 = (np.asarray(v) for v in joint.line_residuals)
     _, r0, d0 = (np.asarray(v) for v in plain.line_residuals)
     if r1.shape != r0.shape or not np.array_equal(d1, d0):

@@ -10,8 +10,7 @@ from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.measure import in_unresolved_span, measure_run_powers
 from ..diagnose.state import State
-from ..resonance import resonance
-from ..stand_resonance import STAND_MIN_LOG_GAIN
+from ..stand_resonance import STAND_MIN_LOG_GAIN, log_power_gain
 from ..units import DIRECTION_CHANNELS
 
 #: Standard errors an exponent must lie away from 2 (the model's C·Ω²) to be proposed as a law.
@@ -56,8 +55,7 @@ def _stand_reach(state: State, h: float, w: np.ndarray) -> np.ndarray:
     reach = np.zeros(w.size, bool)
     for e in state.effects:
         if getattr(e, "kind", "") == "fixed_resonance" and getattr(e, "role", "") == "test_stand":
-            g2 = np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2
-            reach |= np.abs(np.log(np.maximum(g2, 1e-300))) >= STAND_MIN_LOG_GAIN
+            reach |= np.abs(log_power_gain(e, f)) >= STAND_MIN_LOG_GAIN
     return reach
 
 

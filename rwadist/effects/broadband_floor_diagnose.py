@@ -1,7 +1,8 @@
 """``broadband_floor``: a noise-like floor of one channel growing with speed."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import weakref
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import stats
@@ -15,6 +16,12 @@ from ..units import CHANNEL_UNIT
 #: Standard errors of held-out evidence the floor's growth needs (:meth:`BroadbandFloor.significant`): the
 #: search's default k_sigma (:func:`rwadist.diagnose.search.diagnose`).
 GROWTH_T = 4.0
+
+
+def _band_levels(y: np.ndarray, wt: np.ndarray) -> np.ndarray:
+    """Each band's mean level over the runs (bands,), unit²/Hz: the off-line band means ``y`` weighted by their bins
+    ``wt`` ((runs, bands) each)."""
+    return np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300)
 
 
 def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
@@ -32,7 +39,7 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
     runs and on every run; each exponent by its own weights, p 3 and 3.25; the error of the floor of p 8 on the
     held-out runs 8 % of the misplaced power worse than none).  The weighted SSEs of different weights are not
     comparable; the likelihood is."""
-    level = np.maximum(np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300), 1e-300)
+    level = np.maximum(_band_levels(y, wt), 1e-300)
     # x = (Ω/Ω_ref)^p of every exponent at once (P, runs, 1), each power as ``x0[:, None] ** p`` computes it
     xs = np.stack([x0[:, None] ** p for p in FLOOR_EXPONENTS])
     expected = np.broadcast_to(level, (len(FLOOR_EXPONENTS),) + y.shape)
@@ -339,7 +346,7 @@ def _floor_of_law(ctx: Context, state: State, c: str, y, wt, x0, p, n, g) -> Bro
     # exponent grid) times its error -- e.g. a band near a mode whose high-speed runs are skirt dominated.
     # Elsewhere the band's noise is its plain weighted mean and its growth is interpolated from its neighbours
     grows = ((wt > 0) & (x0 >= 0.5 * x0.max())[:, None]).any(0)
-    flat = np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300)
+    flat = _band_levels(y, wt)
     n = np.where(grows, n, np.maximum(flat, 0.0))
     g = np.where(grows, g, 0.0)
     # a band with no usable bin in any run (every bin taken by lines) constrains nothing, and a band whose
@@ -374,6 +381,11 @@ def _floor_of_law(ctx: Context, state: State, c: str, y, wt, x0, p, n, g) -> Bro
 PART_GROWTH_T = 2.0
 
 
+def _summed(evidence) -> tuple:
+    """(drop, se) of independent parts' (drop, se) pairs: the drops summed, the standard errors in quadrature."""
+    return float(sum(d for d, _ in evidence)), float(np.sqrt(sum(s * s for _, s in evidence)))
+
+
 def _t_value(drop: float, se: float) -> float:
     """drop / se, the held-out growth in standard errors (inf for a drop with no noise, 0 for none)."""
     return drop / se if se > 0 else (np.inf if drop > 0 else 0.0)
@@ -406,6 +418,8 @@ class FloorGroup:
     kind: str = "broadband_floor"
     #: t-value of the parts' growth on the held-out runs, set by :meth:`refit` (None: not tested)
     growth_t: float | None = None
+    #: (the state, the runs, each part's evidence) of :meth:`_part_evidence`'s last call
+    _evidence: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     @property
     def channels(self):
@@ -417,11 +431,20 @@ class FloorGroup:
             state = e.apply(state)
         return state
 
+    def _part_evidence(self, ctx: Context, state: State, runs) -> list:
+        """Each part's (drop, se) of :meth:`BroadbandFloor.growth_evidence` on ``runs``: computed once for a state and
+        runs (the search judges a group on the held-out runs, then :meth:`refit` reads the same parts' evidence)."""
+        got = self._evidence
+        if got is not None and got[0]() is state and np.array_equal(got[1], runs):
+            return got[2]
+        ev = [e.growth_evidence(ctx, state, runs) for e in self.parts]
+        self._evidence = (weakref.ref(state), np.array(runs), ev)
+        return ev
+
     def heldout_evidence(self, ctx: Context, state: State, runs):
         """(drop, se) of the parts' growth on ``runs`` (:meth:`BroadbandFloor.growth_evidence`), in the error metric's
         units: the drops summed, the standard errors in quadrature (the channels' noises are independent)."""
-        ev = [e.growth_evidence(ctx, state, runs) for e in self.parts]
-        return float(sum(d for d, _ in ev)), float(np.sqrt(sum(s * s for _, s in ev)))
+        return _summed(self._part_evidence(ctx, state, runs))
 
     def refit(self, ctx: Context, state: State) -> "FloorGroup":
         """Refitted on every run, on the channels whose own part (fitted on the fit runs) grows on the held-out runs
@@ -433,13 +456,13 @@ class FloorGroup:
         parts in it, their g >= 0 fitted to their noise (E wheel, a floor on Fz only, 2048 samples: the group of Fx,
         Fy, Fz at held-out t 5.75, of which Fz's part 5.74, Fx's 0.01, Fy's 0.4) -- a floor named on channels that have
         none."""
-        ev = [e.growth_evidence(ctx, state, ctx.held_runs) for e in self.parts]
+        ev = self._part_evidence(ctx, state, ctx.held_runs)
         keep = [i for i, (d, s) in enumerate(ev) if _t_value(d, s) > PART_GROWTH_T]
         if len(keep) < 2:
             return FloorGroup(self.parts, growth_t=0.0)
         kept = tuple(self.parts[i] for i in keep)
         out = FloorGroup.fit(ctx, state, [e.channel for e in kept], ctx.runs) or FloorGroup(kept)
-        out.growth_t = _t_value(float(sum(ev[i][0] for i in keep)), float(np.sqrt(sum(ev[i][1] ** 2 for i in keep))))
+        out.growth_t = _t_value(*_summed([ev[i] for i in keep]))
         return out
 
     def significant(self) -> bool:
@@ -466,10 +489,7 @@ class FloorGroup:
         if len(chans) < 2:
             return None
         x0 = ctx.omega[runs] / ctx.omega_ref()
-        scale = {}
-        for c in chans:
-            y, wt = got[c]
-            scale[c] = max(float(np.max(np.sum(wt * y, 0) / np.maximum(wt.sum(0), 1e-300))), 1e-300)
+        scale = {c: max(float(np.max(_band_levels(*got[c]))), 1e-300) for c in chans}
         p, n, g = _floor_law(np.concatenate([got[c][1] for c in chans], 1),
                              np.concatenate([got[c][0] / scale[c] for c in chans], 1), x0)
         nb = ctx.n_bands

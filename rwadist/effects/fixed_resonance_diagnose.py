@@ -65,11 +65,11 @@ def _lifted_directions(e: "FixedResonance", f: np.ndarray, y: np.ndarray, w: np.
     Σw(y − ln|H|²)² < Σwy² over its points, made worse when the reverse.  A fixture resonance lifts every direction's lines near it; a resonance of one direction (a housing
     mode on the radial forces) pooled over every channel lifts the torques' and axial lines it passes too, which
     the data do not show."""
-    from ..stand_resonance import STAND_MIN_LOG_GAIN
+    from ..stand_resonance import STAND_MIN_LOG_GAIN, log_power_gain
 
     if f.size == 0:
         return 0
-    lg = np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2)
+    lg = log_power_gain(e, f)
     acts = np.abs(lg) >= STAND_MIN_LOG_GAIN
     better = []
     for d in np.unique(dirs[acts]):
