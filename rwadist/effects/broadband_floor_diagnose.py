@@ -50,7 +50,10 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
         # of it as in the deviance below: the likelihood the passes maximise is then the one that judges the exponents.
         # Unheld, a steep law's fit with its noise at 0 weighed its slowest runs up to 1e24 times its fastest and the
         # passes did not reach its likeliest law: a floor ∝ Ω⁸ read as p 3 (12 speeds 0.18-1.75 Ω_ref))
-        wts = wt / np.maximum(expected / level, 1e-3) ** 2
+        # (a band of no positive mean level, held at 1e-300, can expect ~1e-150 or more after a pass: its ratio
+        # squared overflows to inf and the band weighs 0 -- it holds no floor, and the deviance leaves it out too)
+        with np.errstate(over="ignore"):
+            wts = wt / np.maximum(expected / level, 1e-3) ** 2
         # weighted 2-parameter least squares per band and exponent: y = n + g·x (sums over the runs, axis 1)
         wx = wts * xs
         s0, s1, s2 = wts.sum(1), wx.sum(1), (wx * xs).sum(1)
