@@ -17,8 +17,9 @@ the no-slip conditions solved as a linear system and against a bearing's publish
 Without geometry, the ranges the ratios can take (:data:`RATIO_RANGES`) from d/D in [0.05, 0.30] (ball bearings)
 and α in [0°, 40°]: γ in [0.038, 0.30], the cage 0.35-0.48 of the speed (inner race turning) or 0.52-0.65 (outer race
 turning).  :func:`line_causes` names the candidates for a line's ratio: a given bearing's ratios (and their 2nd and
-3rd multiples) within the resolution, else the ranges, and relations among the lines (a ball pass n × the cage, an
-outer/inner ball-pass pair summing to n).
+3rd multiples) within the resolution, else the ranges, the relations among the lines (a ball pass n × the cage, an
+outer/inner ball-pass pair summing to n, a line's 2nd or 3rd multiple) and, without geometry, the ball counts whose
+ball passes can take the ratio.
 
 Where the user gives the geometry (docs/diagnose.md, "Physical causes for lines"): the model file's ``wheel``
 section (``"bearings": [{"balls": 9, "ball_diameter_m": ..., "pitch_diameter_m": ..., "contact_angle_deg": 15,
@@ -156,7 +157,8 @@ def line_causes(h: float, resolution: float, bearings=(), others=()) -> list:
     none within it): the ranges of :data:`RATIO_RANGES` that hold h.  ``others``: the ratios of the other lines
     (the model's and the data's): h = n × a cage-range line (a ball pass over the still race), h = n × (1 − a
     cage-range line) (over the turning race), or h + another non-integer line = n (an outer/inner ball-pass pair,
-    whose cage ratio is then the smaller over n), n in :data:`BALL_COUNTS`."""
+    whose cage ratio is then the smaller over n), n in :data:`BALL_COUNTS`, or the 2nd or 3rd multiple of another
+    non-integer line; last, the ball counts whose ball passes can take h (:func:`_ball_pass_ranges`)."""
     out = []
     for b in bearings:
         for key, r in b.ratios().items():
@@ -166,12 +168,57 @@ def line_causes(h: float, resolution: float, bearings=(), others=()) -> list:
                     out.append(f"{mult}{RATIO_NAMES[key]} of {b.label()} ({k * r:.4g}, {b.balls} balls)")
     if out:
         return out
+    where = ("for any ball bearing (none of the given bearings' ratios within the resolution)" if bearings
+             else "without the bearing's geometry")
     for lo, hi, what in RATIO_RANGES.values():
         if lo - resolution <= h <= hi + resolution:
-            out.append(f"{what}: h in {lo:.2f}-{hi:.2f} without the bearing's geometry")
-    n_lo, n_hi = BALL_COUNTS
+            out.append(f"{what}: h in {lo:.2f}-{hi:.2f} {where}")
     if abs(h - round(h)) <= 2 * resolution:
         return out                              # a harmonic of the speed: no ball-pass relation to name
+    out += _relations(h, resolution, others)
+    if not bearings:                            # the given geometry names a ball pass or rules it out
+        out += _ball_pass_ranges(h, resolution, where)
+    return out
+
+
+def _ball_counts(h: float, resolution: float, race: str) -> list:
+    """The ball counts n in :data:`BALL_COUNTS` for which a ball pass over the ``race`` ('outer': (n/2)(1 − γ), 'inner':
+    (n/2)(1 + γ)) can be ``h`` (to ``resolution``) with γ in :data:`GAMMA_RANGE` and the balls on their pitch circle
+    (n·d < π·D, so γ < π/n)."""
+    sign = -1.0 if race == "outer" else 1.0
+    out = []
+    for n in range(BALL_COUNTS[0], BALL_COUNTS[1] + 1):
+        g_hi = min(GAMMA_RANGE[1], math.pi / n)
+        lo, hi = sorted((0.5 * n * (1 + sign * GAMMA_RANGE[0]), 0.5 * n * (1 + sign * g_hi)))
+        if lo - resolution <= h <= hi + resolution:
+            out.append(n)
+    return out
+
+
+def _counts_text(ns: list) -> str:
+    """'8-10' for a run of whole numbers, '6, 8' otherwise."""
+    return f"{ns[0]}-{ns[-1]}" if len(ns) > 1 and ns[-1] - ns[0] == len(ns) - 1 else ", ".join(map(str, ns))
+
+
+def _ball_pass_ranges(h: float, resolution: float, where: str) -> list:
+    """The sentence naming the ball passes a non-integer line at ``h`` can be without the geometry: over the outer race
+    (BPFO = (n/2)(1 − γ)) or the inner (BPFI = (n/2)(1 + γ)) of a bearing of the ball counts :func:`_ball_counts`
+    finds (the geometry, ``--bearing``, tells which); [] for none."""
+    parts = []
+    for race, key in (("outer", "BPFO"), ("inner", "BPFI")):
+        ns = _ball_counts(h, resolution, race)
+        if ns:
+            parts.append(f"over the {race} race ({key} = (n/2)(1 {'−' if race == 'outer' else '+'} γ)) of a bearing "
+                         f"of {_counts_text(ns)} balls")
+    return [f"a ball pass {where}: " + ", or ".join(parts)] if parts else []
+
+
+def _relations(h: float, resolution: float, others) -> list:
+    """Sentences relating a non-integer line at ``h`` to the other lines' ratios ``others``: a ball pass n × a
+    cage-range line (over the still race) or n × (1 − it) (over the turning race), an outer/inner ball-pass pair
+    summing to n, and the 2nd or 3rd multiple of another non-integer line (a bearing line's harmonics)."""
+    n_lo, n_hi = BALL_COUNTS
+    out = []
     cage = [RATIO_RANGES[k][:2] for k in ("FTF", "FTF_outer")]
     for o in others:
         if abs(o - h) <= resolution:
@@ -188,4 +235,8 @@ def line_causes(h: float, resolution: float, bearings=(), others=()) -> list:
                 and RATIO_RANGES["FTF"][0] <= min(h, o) / n <= RATIO_RANGES["FTF"][1]:
             out.append(f"an outer/inner ball-pass pair of a {n}-ball bearing with the line h = {o:.4g} "
                        f"(BPFO + BPFI = n; cage {min(h, o) / n:.4g})")
+        k = round(h / o) if o > 0 else 0
+        if k in (2, 3) and abs(o - round(o)) > 2 * resolution and abs(h - k * o) <= k * resolution:
+            out.append(f"the {'2nd' if k == 2 else '3rd'} multiple of the line h = {o:.4g} (a harmonic of that line's "
+                       f"cause: a bearing line's impacts are not sinusoidal)")
     return out

@@ -445,9 +445,12 @@ def cmd_diagnose(args) -> int:
             print(f"  - {h.effect.kind} taken back: the search fitted it to the {h.forced_by} described below")
     for u in diag.unexplained:
         print(f"  ? {u.text()}")
+    same: dict = {}                 # one console line for the directions whose line at one h has the same causes
     for lc in diag.line_causes:
-        more = f" (+{len(lc['causes']) - 1} more in report.md)" if len(lc["causes"]) > 1 else ""
-        print(f"  ~ {lc['direction']} h = {lc['h']:.4g}: could be {lc['causes'][0]}{more}")
+        same.setdefault((f"{lc['h']:.4g}", tuple(lc["causes"])), []).append(lc["direction"])
+    for (h_text, causes), directions in same.items():
+        more = f" (+{len(causes) - 1} more in report.md)" if len(causes) > 1 else ""
+        print(f"  ~ {', '.join(directions)} h = {h_text}: could be {causes[0]}{more}")
     print(f"unexplained fraction of the data's power (speed x frequency): {diag.error_before:.4g} -> "
           f"{diag.error_after:.4g} (definition: report.md)")
     print(f"band-by-band misfit, every band alike (narrow lines count as on the waterfall): "

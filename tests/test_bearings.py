@@ -78,6 +78,45 @@ def test_line_causes_name_a_ratio_within_the_resolution_only():
     assert line_causes(3.0, 0.005, others=[0.41]) == []               # a harmonic of the speed: no relation
 
 
+def test_ball_pass_counts_without_geometry_hold_every_real_bearings_ratio():
+    """Round trip against the closed forms: for bearings drawn over the ranges (d/D 0.05-0.30, α 0-40°, the balls on
+    their pitch circle, n 5-40), the ball counts named for a line at a bearing's BPFO (BPFI) include its own n."""
+    rng = np.random.default_rng(7)
+    checked = 0
+    for _ in range(400):
+        n = int(rng.integers(5, 41))
+        dD = rng.uniform(0.05, min(0.30, 0.999 * math.pi / n))
+        b = Bearing(n, dD, 1.0, float(rng.uniform(0.0, 40.0)))
+        for key, race in (("BPFO", "outer"), ("BPFI", "inner")):
+            h = b.ratios()[key]
+            if abs(h - round(h)) <= 0.01:
+                continue                                           # a whole number: a harmonic of the speed
+            text = [x for x in line_causes(h, 0.005) if x.startswith("a ball pass")]
+            assert len(text) == 1, (n, dD, key, h)
+            part = text[0].split(f"over the {race} race")[1].split(", or")[0]
+            counts = part.split(" of ")[-1].removesuffix(" balls")
+            if "-" in counts:
+                lo, hi = map(int, counts.split("-"))
+                assert lo <= n <= hi, (n, key, h, text)
+            else:
+                assert n in [int(x) for x in counts.split(", ")], (n, key, h, text)
+            checked += 1
+    assert checked > 600
+    # the ball-pass ranges are offered without geometry only: a given bearing names a ratio or rules it out
+    assert not any("ball pass" in x for x in line_causes(3.60, 0.005, [Bearing(9, 0.00794, 0.03904)]))
+    # below the smallest ball pass (5 balls, γ 0.30: 1.75) none is offered
+    assert not any("ball pass" in x for x in line_causes(1.6, 0.005))
+
+
+def test_a_line_twice_another_non_integer_line_is_named_its_harmonic():
+    causes = line_causes(7.2, 0.005, others=[0.41, 1.0, 3.6])
+    assert any("2nd multiple of the line h = 3.6" in x for x in causes)
+    assert any("2nd multiple of the line h = 1.25" in x for x in line_causes(2.5, 0.005, others=[1.0, 1.25]))
+    # the speed's own harmonics are no other line's multiples; nor is a line 1 % off twice another
+    assert not any("multiple" in x for x in line_causes(2.5, 0.005, others=[1.0]))
+    assert not any("multiple" in x for x in line_causes(7.27, 0.005, others=[3.6]))
+
+
 def test_parser_reads_the_flag_and_the_model_file_and_names_what_is_wrong():
     b = parse_bearing("balls=9, ball_diameter_m=0.00794,pitch_diameter_m=0.03904,contact_angle_deg=15,name=front")
     assert b == Bearing(9, 0.00794, 0.03904, 15.0, "front")
