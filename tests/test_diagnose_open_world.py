@@ -286,6 +286,12 @@ def test_run_change_flags_the_switched_runs_and_not_a_resonance_crossing():
     (u,) = run_change(ctx, ratios(q + 3.5 * stepped), shares)
     assert sorted(u.parameters["runs"]) == sorted(f"run_{i}" for i in range(R) if i % 3 == 1)
     assert u.level_dB == pytest.approx(3.5, abs=0.1)
+    # one factor on a few runs, the others on their trend: a step, its causes (a re-mounting, a range) first
+    assert u.parameters["pattern"] == "step" and "re-mounted" in u.causes[0]
+    # the runs recorded in shuffled speed order, the gain drifting 0.15 dB a run: a spread, the drift named first
+    order = np.random.default_rng(3).permutation(R)
+    (v,) = run_change(ctx, ratios(q + 0.15 * order[run]), shares)
+    assert v.parameters["pattern"] == "spread" and "drifting" in v.causes[0]
 
 
 def test_run_change_offsets_with_the_top_run_switched():

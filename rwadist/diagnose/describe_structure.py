@@ -208,7 +208,9 @@ def run_change(ctx, ratios: list, shares) -> list:
     line's dB ratio less its own smooth trend with speed, the median over the run's lines (:func:`_run_deviations`);
     described when :data:`RUN_MIN_RUNS` runs (a fifth of them at least) stand beyond :data:`RUN_SCATTER_DB` and
     beyond 3 × the runs' robust scatter (a few runs switched: the others stay on the trend), or the robust scatter
-    itself exceeds :data:`RUN_SCATTER_DB` (a drift in the order of recording, the speeds shuffled)."""
+    itself exceeds :data:`RUN_SCATTER_DB` (a drift in the order of recording, the speeds shuffled).  ``pattern``
+    "step" (the first case, every changed run off by one factor: a re-mounting or a range switched named first) or
+    "spread" (a drift named first)."""
     if not ratios:
         return []
     got = _changed_runs(ctx, ratios)
@@ -223,16 +225,23 @@ def run_change(ctx, ratios: list, shares) -> list:
     names = names_of(idx)
     share, _ = shares(ctx.runs[idx])
     timed = _time_order_note(ctx)
+    # a step: a few runs set apart from others that stay on their trend (the scatter small), all by one factor;
+    # a spread: the runs' offsets scattered beyond RUN_SCATTER_DB (a drift in the order of recording)
+    moved = dev[off]
+    step = scatter < RUN_SCATTER_DB and bool(np.all(np.sign(moved) == np.sign(np.median(moved)))) and \
+        float(np.max(np.abs(moved - np.median(moved)))) <= 0.5 * abs(float(np.median(moved)))
+    drift = "the load cell's or its amplifier's gain drifting over the test (temperature, a bridge supply)"
+    steps = ("the wheel or the fixture re-mounted or re-torqued between runs",
+             "an amplifier range or filter switched between runs")
     return [Unexplained(
         signature="run_change", channels=tuple(ctx.channels), speed_rpm=(float(rpm.min()), float(rpm.max())),
         f_Hz=(float(np.min(np.concatenate([r.f for r in ratios]))), float(np.max(np.concatenate([r.f for r in ratios])))),
         level_dB=float(np.median(np.abs(dev[off]))), share=share, n_runs=int(idx.size),
         parameters={"scatter_dB": float(scatter), "largest_dB": float(np.max(np.abs(dev))),
                     "runs": names, "run_speeds_rpm": [float(x) for x in rpm],
-                    "run_offsets_dB": [float(x) for x in dev[off]], "runs_not_read": names_of(unread), **timed},
-        causes=("the load cell's or its amplifier's gain drifting over the test (temperature, a bridge supply)",
-                "the wheel or the fixture re-mounted or re-torqued between runs",
-                "an amplifier range or filter switched between runs"),
+                    "run_offsets_dB": [float(x) for x in dev[off]], "runs_not_read": names_of(unread),
+                    "pattern": "step" if step else "spread", **timed},
+        causes=steps + (drift,) if step else (drift,) + steps,
         would_tell="the runs in the order they were recorded (a drift grows with time; a re-mounting is a step) and a "
                    "repeated run at one speed at the start and the end of the test")]
 
