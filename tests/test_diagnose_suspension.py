@@ -35,6 +35,8 @@ def _modes_only(d, truth, tol=0.02):
     # the improved model is on the extended base and carries the fitted analytical section
     assert d.state_after.base == "extended" and d.model.analytical
     assert d.model.provenance["diagnose"]["base"] == "extended"
+    # summary.json says the base moved (it said "empirical" alone: an independent trial read the final model as one)
+    assert (d.summary()["base"], d.summary()["base_after"]) == ("empirical", "extended")
     assert d.error_after < 0.1 * d.error_before
     return e
 

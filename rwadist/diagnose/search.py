@@ -87,7 +87,7 @@ class Diagnosis:
         chosen = [h for h in self.hypotheses if h.passed and not h.base_line]
         return {
             "metric": METRIC,
-            "base": self.state_before.base,
+            "base": self.state_before.base, "base_after": self.state_after.base,
             "metric_definition": "sum over channels, runs and %d-bin bands of |data - model| power / sum of "
                                  "data power (each channel divided by the mean power of its unit group)" % BAND_BINS,
             "error_before": self.error_before, "error_after": self.error_after,
