@@ -59,6 +59,15 @@ def test_law_beside_a_stand_must_be_told_from_omega_squared_where_the_stand_does
     assert AmplitudeLaw("radial_force", 1.0, 3.0, 1.0, 300.0, float("nan"), None).significant() is False
 
 
+@pytest.mark.parametrize("exponent, beyond, told", [(2.6, (1.7, 0.05), False), (2.6, (2.4, 0.05), True),
+                                                    (1.5, (2.6, 0.05), False), (1.5, (1.8, 0.02), True)])
+def test_law_beside_a_stand_must_be_told_from_omega_squared_on_the_same_side(exponent, beyond, told):
+    """The law's direction is its claim: an exponent over every run told from 2 on one side (2.6, or 1.5) whose
+    runs out of the stand's reach tell it from 2 on the other (1.7 ± 0.05: 6 standard errors under 2) is no law
+    those runs confirm; on the same side it is (2.4 ± 0.05, 1.8 ± 0.02)."""
+    assert AmplitudeLaw("radial_force", 1.0, exponent, 1.0, 300.0, 0.01, beyond).significant() is told
+
+
 class _TransmissibilityStand:
     """The force through a fixture spring, H = (1 + 2jζr)/(1 − r² + 2jζr) on every channel (gain above → 0): the
     stand reaches nearly every line above it, so few runs are left out of its reach."""

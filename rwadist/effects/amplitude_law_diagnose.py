@@ -116,13 +116,19 @@ class AmplitudeLaw:
         there would never be named (family wheel 6, its Ω³ BPFO line beside such a stand at 112 Hz: Ω^3.011 ± 0.004
         on the fit runs, too few of its 10 runs out of the stand's reach: not proposed; such a stand at 0.5-1.5x each
         family wheel's modes, ζ 0.03: 111 of 120 placements leave the BPFO line too few fit runs).  An exponent whose
-        standard error is not finite tells nothing."""
+        standard error is not finite tells nothing.
+
+        Beyond the stand the exponent must be told from 2 on the same side as over every run: the law's direction
+        (faster or slower than Ω²) is its claim.  An exponent of 2.6 over every run that reads 1.7 ± 0.05 beyond the
+        stand is two contradicting readings of the line, no law the runs the stand does not reach confirm."""
         def told(p, se):
             return bool(np.isfinite(p) and np.isfinite(se)) and not abs(p - 2.0) <= max(EXPONENT_Z * se,
                                                                                             MIN_EXPONENT_SHIFT)
 
-        if self.beyond_stand is not None and np.isfinite(self.beyond_stand[0]) and not told(*self.beyond_stand):
-            return False
+        if self.beyond_stand is not None and np.isfinite(self.beyond_stand[0]):
+            p, se = self.beyond_stand
+            if not told(p, se) or (p > 2.0) != (self.exponent > 2.0):
+                return False
         return told(self.exponent, self.exponent_stderr)
 
     def to_schema(self) -> dict:
