@@ -93,11 +93,13 @@ def search_standing(diag) -> tuple:
     base): what a search run again with a run change taken out must improve on (:func:`run_steps`), compared as a
     tuple.  A mode the fit declares ``unconstrained`` is not located: left in the records, a changed run's lines are
     missed by the modes' linear model by more than its misfit bound (family wheel 0, every third run 3.5 dB up: the
-    translation and rocking declared, the rocking's kept value 1760 Hz, truth 95 Hz)."""
+    translation and rocking declared, the rocking's kept value 1760 Hz, truth 95 Hz).  The parts of one effect of
+    several parts (a floor law of several channels, one hypothesis: ``Hypothesis.group``) count as one effect."""
     added = [h for h in diag.hypotheses if h.passed and not h.base_line and h.effect.kind != "suspension_modes"]
     modes = [e for e in diag.state_after.effects if getattr(e, "kind", "") == "suspension_modes"]
     located = sum(3 - len(getattr(e, "unconstrained", ())) for e in modes)
-    return (located, -len(added))
+    whole = {id(h) if getattr(h, "group", None) is None else id(h.group) for h in added}
+    return (located, -len(whole))
 
 
 #: The runs whose change was not read are left out of the second search only when they are at most this fraction of

@@ -1,0 +1,54 @@
+"""A floor law of several channels (:class:`rwadist.effects.broadband_floor_diagnose.FloorGroup`) is ONE hypothesis, its
+parts each their own entry of the model file and their own row of the hypotheses (``Hypothesis.group``): one effect
+for the search's standing (:func:`rwadist.diagnose.describe.search_standing`), its gain counted once in hypotheses.csv
+(:func:`rwadist.diagnose.report.hypotheses_csv`), and taken back whole when one part was fitted to content no class
+explains (:func:`rwadist.diagnose.describe.finish`).  Checked on hypotheses built as the search builds them (one
+passed hypothesis, copied per part, ``rwadist.diagnose.search._search``)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from types import SimpleNamespace
+
+from rwadist.diagnose import describe
+from rwadist.diagnose.search import Hypothesis
+
+
+@dataclass(eq=False)
+class _Part:
+    """An effect of one channel: applied, it is appended to the state (a tuple of effects)."""
+
+    kind: str
+    channel: str
+
+    @property
+    def channels(self):
+        return (self.channel,)
+
+    def params(self) -> dict:
+        return {"channel": self.channel, "exponent": 3.0}
+
+    def apply(self, state):
+        return state + (self,)
+
+
+def _group_hypotheses(gain=0.12, fraction=0.3, t=9.0):
+    """Hypotheses as the search leaves them: a single-channel amplitude law (iteration 1), then a floor group of Fx,
+    Fy, Fz taken at iteration 2 (one passed hypothesis, copied for each part but the last), and a failed rival."""
+    law = Hypothesis(_Part("amplitude_law", "Fx"), 0.05, 0.2, 6.0, True, 1)
+    parts = tuple(_Part("broadband_floor", c) for c in ("Fx", "Fy", "Fz"))
+    group = SimpleNamespace(parts=parts, channels=("Fx", "Fy", "Fz"), kind="broadband_floor")
+    best = Hypothesis(parts[-1], gain, fraction, t, True, 2, group=group)
+    rival = Hypothesis(_Part("fixed_resonance", "Tx"), 0.01, 0.02, 1.0, False, 2)
+    return [law, *[replace(best, effect=e) for e in parts[:-1]], best, rival], parts
+
+
+def test_a_floor_group_counts_as_one_effect_in_the_search_standing():
+    """Two effects added (an amplitude law, one floor law of three channels): standing (modes located, -2), not -4."""
+    hyps, parts = _group_hypotheses()
+    modes = SimpleNamespace(kind="suspension_modes", unconstrained=("rocking",))
+    diag = SimpleNamespace(hypotheses=hyps, state_after=SimpleNamespace(effects=[modes, *parts]))
+    assert describe.search_standing(diag) == (2, -2)
+    # a search that added one floor group ranks with one that added one amplitude law, above one with two laws
+    one = SimpleNamespace(hypotheses=hyps[1:4], state_after=diag.state_after)
+    two = SimpleNamespace(hypotheses=[hyps[0], replace(hyps[0])], state_after=diag.state_after)
+    assert describe.search_standing(one) == (2, -1) > describe.search_standing(two)
