@@ -6,10 +6,15 @@ explains (:func:`rwadist.diagnose.describe.finish`).  Checked on hypotheses buil
 passed hypothesis, copied per part, ``rwadist.diagnose.search._search``)."""
 from __future__ import annotations
 
+import csv
+import io
 from dataclasses import dataclass, replace
 from types import SimpleNamespace
 
+import pytest
+
 from rwadist.diagnose import describe
+from rwadist.diagnose.report import hypotheses_csv
 from rwadist.diagnose.search import Hypothesis
 
 
@@ -52,3 +57,18 @@ def test_a_floor_group_counts_as_one_effect_in_the_search_standing():
     one = SimpleNamespace(hypotheses=hyps[1:4], state_after=diag.state_after)
     two = SimpleNamespace(hypotheses=[hyps[0], replace(hyps[0])], state_after=diag.state_after)
     assert describe.search_standing(one) == (2, -1) > describe.search_standing(two)
+
+
+def test_hypotheses_csv_writes_a_group_gain_once_so_the_column_sums():
+    hyps, _ = _group_hypotheses(gain=0.12, fraction=0.3)
+    rows = list(csv.DictReader(io.StringIO(hypotheses_csv(hyps))))
+    assert [r["channels"] for r in rows] == ["Fx", "Fx", "Fy", "Fz", "Tx"]
+    passed = [r for r in rows if r["passed"] == "True"]
+    # what the passed hypotheses gained: the law's 0.05 and the group's 0.12, each once
+    assert sum(float(r["heldout_gain"] or 0) for r in passed) == pytest.approx(0.05 + 0.12)
+    assert sum(float(r["heldout_gain_fraction"] or 0) for r in passed) == pytest.approx(0.2 + 0.3)
+    floors = [r for r in rows if r["kind"] == "broadband_floor"]
+    assert [r["heldout_gain"] for r in floors] == ["0.12", "", ""]
+    assert all("part_of=Fx Fy Fz" in r["parameters"] for r in floors)
+    assert all(r["t"] == "9" for r in floors)          # each part with the judgement of the whole
+    assert "part_of" not in rows[0]["parameters"] and rows[0]["heldout_gain"] == "0.05"
