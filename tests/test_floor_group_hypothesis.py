@@ -11,6 +11,7 @@ import io
 from dataclasses import dataclass, replace
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 from rwadist.diagnose import describe
@@ -72,3 +73,26 @@ def test_hypotheses_csv_writes_a_group_gain_once_so_the_column_sums():
     assert all("part_of=Fx Fy Fz" in r["parameters"] for r in floors)
     assert all(r["t"] == "9" for r in floors)          # each part with the judgement of the whole
     assert "part_of" not in rows[0]["parameters"] and rows[0]["heldout_gain"] == "0.05"
+
+
+def test_a_group_is_taken_back_whole_when_one_part_was_fitted_to_unexplained_content(monkeypatch):
+    """:func:`describe.forced_effects` finds the gain of Fz's part alone in the cells of a described hump: the group
+    of Fx, Fy, Fz (one exponent fitted over every part, passed on their summed evidence) is taken back whole; the
+    amplitude law, fitted to nothing described, stays; the model is rebuilt from the state without the group."""
+    hyps, parts = _group_hypotheses()
+    law = hyps[0].effect
+    diag = SimpleNamespace(hypotheses=hyps, state_before=(), state_after=(law, *parts))
+    diag.state_after = SimpleNamespace(effects=diag.state_after)
+    raw = SimpleNamespace(contrast_error=lambda state: 0.0)
+    opened = SimpleNamespace(ctx=raw, raw=raw)
+    hump = SimpleNamespace(signature="broadband_hump", h=None)
+    monkeypatch.setattr(describe, "_described", lambda *a, **k: ([hump], None))
+    monkeypatch.setattr(describe, "forced_effects", lambda *a, **k: [(parts[2], "broadband_hump")])
+    monkeypatch.setattr(describe, "line_causes", lambda *a, **k: [])
+    rebuilt = []
+    describe.finish(diag, opened, rebuild=lambda state, hs: rebuilt.append(state) or "model")
+    assert rebuilt == [(law,)] and diag.model == "model"
+    by_channel = {h.effect.channel: h for h in hyps if h.effect.kind == "broadband_floor"}
+    assert all(not h.passed and h.forced_by == "broadband_hump" for h in by_channel.values())
+    assert hyps[0].passed and hyps[0].forced_by is None
+    assert not np.any([h.passed for h in hyps[1:]])

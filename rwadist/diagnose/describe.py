@@ -431,6 +431,28 @@ def forced_effects(diag, opened: Opened, search_before: State, search_after: Sta
     return out
 
 
+def _with_groups(hypotheses, gone: dict) -> dict:
+    """``gone`` (id of an effect taken back -> the signature it was fitted to) with every other part of an effect of
+    several parts one of whose parts it holds (``Hypothesis.group``: a floor law of several channels), under that
+    part's signature.
+
+    A group stands or falls together: its parts share one exponent, fitted over every part's bands at once, and it
+    passed as one hypothesis on their summed held-out evidence.  A part fitted to content no class explains put that
+    content into the shared exponent and into the evidence the others passed on; without a new fit and judgement of
+    the other channels alone (the search's, not the description's), they stand on nothing of their own."""
+    sig: dict = {}
+    for h in hypotheses:
+        g = getattr(h, "group", None)
+        if g is not None and id(h.effect) in gone:
+            sig.setdefault(id(g), gone[id(h.effect)])
+    out = dict(gone)
+    for h in hypotheses:
+        g = getattr(h, "group", None)
+        if g is not None and id(g) in sig:
+            out.setdefault(id(h.effect), sig[id(g)])
+    return out
+
+
 def finish(diag, opened: Opened, bearings=(), rebuild=None):
     """``diag`` (a :class:`~rwadist.diagnose.search.Diagnosis` of the search on ``opened.ctx``) measured on the data
     as given and described: its context, states and errors those of the data as given (where the fixed lines and
@@ -449,7 +471,7 @@ def finish(diag, opened: Opened, bearings=(), rebuild=None):
     found, res = _described(diag, opened, search_after, bearings)
     forced = forced_effects(diag, opened, search_before, search_after, found, res) if found and rebuild else []
     if forced:
-        gone = {id(e): sig for e, sig in forced}
+        gone = _with_groups(diag.hypotheses, {id(e): sig for e, sig in forced})
         state = search_before
         for e in search_after.effects:
             if id(e) not in gone:
