@@ -115,3 +115,21 @@ def test_a_true_law_beside_a_transmissibility_stand_is_named_with_the_stand(tmp_
     assert abs(fitted["h"] - law.params["h"]) < 0.02 and abs(fitted["exponent"] - 3.0) < 0.1
     named = next(e for e in effects if e["kind"] == "fixed_resonance")
     assert named["role"] == "test_stand" and abs(named["f_Hz"] / f_stand - 1) < 0.01
+
+
+def test_the_law_checked_beyond_the_stand_is_in_its_words_and_model_file_entry():
+    """The law's check beyond a named stand (issue 33) is said where the law is: report.md's and the console's line
+    (:meth:`rwadist.effects.amplitude_law.AmplitudeLaw.describe`) and the model file's entry, which reads back."""
+    from rwadist.effects_text import describe_effect
+    from rwadist.schema import parse_effects
+
+    checked = AmplitudeLaw("radial_force", 1.0, 2.6, 1.0, 300.0, 0.01, (2.55, 0.03, 12)).to_schema()
+    few = AmplitudeLaw("radial_force", 1.0, 3.0, 1.0, 300.0, 0.004, (float("nan"), float("nan"), 3)).to_schema()
+    alone = AmplitudeLaw("radial_force", 1.0, 2.6, 1.0, 300.0, 0.01, None).to_schema()
+    assert "beyond the test stand (12 runs out of its reach) |Ω|^2.55 ±0.03" in describe_effect(checked)
+    assert "leaves 3 runs out of its reach, too few to check the law there" in describe_effect(few)
+    assert "stand" not in describe_effect(alone) and "runs_beyond_stand" not in alone
+    for entry in (checked, alone):
+        back = parse_effects([entry], "<test>")[0]
+        assert back.runs_beyond_stand == entry.get("runs_beyond_stand")
+        assert back.exponent_beyond_stand == entry.get("exponent_beyond_stand")

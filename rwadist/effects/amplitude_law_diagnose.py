@@ -70,10 +70,11 @@ class AmplitudeLaw:
     amplitude_ref: float
     omega_ref: float
     exponent_stderr: float = float("nan")
-    #: (exponent, its standard error) fitted on the runs where no test-stand resonance the state names changes the
-    #: line's power by 1.5x or more (:func:`_stand_reach`); (nan, nan) when the stand leaves too few such runs to fit
-    #: the exponent on (then not checked there); None when no named stand reaches the line at any run
-    #: (:meth:`significant`)
+    #: (exponent, its standard error, the number of runs) fitted on the runs where no test-stand resonance the state
+    #: names changes the line's power by 1.5x or more (:func:`_stand_reach`); (nan, nan, n) when the stand leaves too
+    #: few such runs to fit the exponent on (then not checked there); None when no named stand reaches the line at any
+    #: run (:meth:`significant`; written as ``exponent_beyond_stand``, ``exponent_beyond_stand_stderr`` and
+    #: ``runs_beyond_stand``, :meth:`params`)
     beyond_stand: tuple | None = None
     kind: str = "amplitude_law"
     #: it adds no line, only changes the amplitude of one the state has: judged with that line's beats at its own
@@ -126,7 +127,7 @@ class AmplitudeLaw:
                                                                                             MIN_EXPONENT_SHIFT)
 
         if self.beyond_stand is not None and np.isfinite(self.beyond_stand[0]):
-            p, se = self.beyond_stand
+            p, se = self.beyond_stand[:2]
             if not told(p, se) or (p > 2.0) != (self.exponent > 2.0):
                 return False
         return told(self.exponent, self.exponent_stderr)
@@ -135,9 +136,15 @@ class AmplitudeLaw:
         return schema_entry(self)
 
     def params(self) -> dict:
-        return {"direction": self.direction, "h": round(self.h, 4), "exponent": self.exponent,
-                "exponent_stderr": self.exponent_stderr, "amplitude_ref": self.amplitude_ref,
-                "omega_ref_rad_s": self.omega_ref}
+        out = {"direction": self.direction, "h": round(self.h, 4), "exponent": self.exponent,
+               "exponent_stderr": self.exponent_stderr, "amplitude_ref": self.amplitude_ref,
+               "omega_ref_rad_s": self.omega_ref}
+        if self.beyond_stand is not None:
+            # the law checked beyond a named test stand (:meth:`significant`): on how many runs, with what exponent
+            p, se, *n = self.beyond_stand
+            out.update(runs_beyond_stand=int(n[0]) if n else None, exponent_beyond_stand=float(p),
+                       exponent_beyond_stand_stderr=float(se))
+        return out
 
     @staticmethod
     def fit(ctx: Context, state: State, direction: str, h: float, runs) -> "AmplitudeLaw | None":
@@ -156,10 +163,10 @@ class AmplitudeLaw:
         beyond = None
         if reach.any():
             out = ~reach
-            beyond = (float("nan"), float("nan"))
+            beyond = (float("nan"), float("nan"), int(out.sum()))
             if out.sum() >= 5 and np.ptp(np.log(w[out])) >= 0.3:
                 c2, v2 = _law_lsq(X[out], np.log(d[out]), leak[out], var_noise[out])
-                beyond = (float(c2[1]), float(np.sqrt(v2[1, 1])))
+                beyond = (float(c2[1]), float(np.sqrt(v2[1, 1])), int(out.sum()))
         return AmplitudeLaw(direction, float(h), float(coef[1]), float(np.exp(coef[0])), w_ref,
                             float(np.sqrt(cov[1, 1])), beyond)
 
