@@ -67,10 +67,10 @@ class BroadbandFloor(Element):
         psd = np.asarray(e["psd_ref"], dtype=float)
         chans = " ".join(e["channel"]) if isinstance(e["channel"], (list, tuple)) else str(e["channel"])
         p = num(e["exponent"], ".3g")
-        bound = {"at_least": f" (p >= {p}: the fit's largest exponent, a lower bound)",
-                 "at_most": f" (p <= {p}: the fit's smallest exponent, an upper bound)"}.get(str(e.get("exponent_bound")), "")
-        return (f"{chans}, PSD ∝ |Ω|^{p}{bound}, "
-                f"{f.min():.0f}–{f.max():.0f} Hz, "
+        bounds = {"at_least": f" (p >= {p}: the fit's largest exponent, a lower bound)",
+                  "at_most": f" (p <= {p}: the fit's smallest exponent, an upper bound)"}
+        bound = bounds.get(str(e.get("exponent_bound")), "")
+        return (f"{chans}, PSD ∝ |Ω|^{p}{bound}, {f.min():.0f}–{f.max():.0f} Hz, "
                 f"peak {psd.max():.3g} {cls._psd_unit(e)} at {rpm(e['omega_ref_rad_s'])}")
 
     @staticmethod
