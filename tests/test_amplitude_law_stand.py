@@ -59,6 +59,15 @@ def test_law_beside_a_stand_must_be_told_from_omega_squared_where_the_stand_does
     assert AmplitudeLaw("radial_force", 1.0, 3.0, 1.0, 300.0, float("nan"), None).significant() is False
 
 
+@pytest.mark.parametrize("exponent, beyond, told", [(2.6, (1.7, 0.05), False), (2.6, (2.4, 0.05), True),
+                                                    (1.5, (2.6, 0.05), False), (1.5, (1.8, 0.02), True)])
+def test_law_beside_a_stand_must_be_told_from_omega_squared_on_the_same_side(exponent, beyond, told):
+    """The law's direction is its claim: an exponent over every run told from 2 on one side (2.6, or 1.5) whose
+    runs out of the stand's reach tell it from 2 on the other (1.7 ± 0.05: 6 standard errors under 2) is no law
+    those runs confirm; on the same side it is (2.4 ± 0.05, 1.8 ± 0.02)."""
+    assert AmplitudeLaw("radial_force", 1.0, exponent, 1.0, 300.0, 0.01, beyond).significant() is told
+
+
 class _TransmissibilityStand:
     """The force through a fixture spring, H = (1 + 2jζr)/(1 − r² + 2jζr) on every channel (gain above → 0): the
     stand reaches nearly every line above it, so few runs are left out of its reach."""
@@ -106,3 +115,69 @@ def test_a_true_law_beside_a_transmissibility_stand_is_named_with_the_stand(tmp_
     assert abs(fitted["h"] - law.params["h"]) < 0.02 and abs(fitted["exponent"] - 3.0) < 0.1
     named = next(e for e in effects if e["kind"] == "fixed_resonance")
     assert named["role"] == "test_stand" and abs(named["f_Hz"] / f_stand - 1) < 0.01
+
+
+def _law_beside_stand(peak_gain_named=4.0):
+    """E wheel (virtual stand, --physics simple, modes off; 40 speeds 600-2400 rpm, 4096 samples at 1920 Hz, as
+    tests/test_diagnose.py): its radial h 4.42 line replaced by an Ω^2.5 law (44-177 Hz) and a test-stand resonance at
+    100 Hz (ζ 0.05, peak gain 4, H -> 1 far above) on every channel, which changes the line's power by 1.5x or more
+    from 77 to 131 Hz; the state is the truth model with that stand named (peak gain ``peak_gain_named``)."""
+    from rwadist.diagnose.engine import Context, initial_state
+    from rwadist.effects.fixed_resonance_diagnose import FixedResonance
+    from rwadist.inject import parse, simulate_with_injections
+    from rwadist.presets import preset
+    from rwadist.spectra import compute_spectra
+
+    wheel = preset("ithaco-e")
+    specs = [parse("amplitude_law:direction=radial_force,h=4.42,exponent=2.5"),
+             parse("fixed_resonance:f_hz=100,zeta=0.05,gain=4,role=test_stand")]
+    test = simulate_with_injections(wheel, specs, np.linspace(600.0, 2400.0, 40), physics="simple", seed=5,
+                                    sample_rate=1920.0, n_samples=4096, noise=0.01, modes=False)
+    ctx = Context(compute_spectra(test, nperseg=1024), test=test)
+    stand = FixedResonance(100.0, 0.05, peak_gain_named, ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), "test_stand")
+    return ctx, stand.apply(initial_state(ctx, wheel.to_model()))
+
+
+def test_fit_beyond_a_named_stand_reads_the_injected_exponent_on_the_runs_out_of_its_reach():
+    """:meth:`AmplitudeLaw.fit`'s beyond-stand path against the generator's truth: the runs out of the named stand's
+    reach are those whose line (4.42·Ω/2π) the injected resonance changes by less than 1.5x in power (closed form,
+    :func:`rwadist.resonance.resonance`: below 77 Hz and above 131 Hz, both sides), and the exponent fitted on them
+    alone is the injected 2.5 (within 0.05, the accuracy asked of a fitted law, or 4 standard errors), whether the
+    named stand's peak gain is the truth's or 25 % off (its misfit then enters only the runs it reaches)."""
+    from rwadist.diagnose.measure import measure_run_powers
+    from rwadist.resonance import resonance
+
+    h, p_true = 4.42, 2.5
+    ctx, state = _law_beside_stand()
+    law = AmplitudeLaw.fit(ctx, state, "radial_force", h, ctx.runs)
+    assert law is not None and law.beyond_stand is not None
+    p, se, n = law.beyond_stand
+    _, w, _, _ = measure_run_powers(ctx, state, "radial_force", h, ctx.runs, skip=h)     # the runs the fit reads
+    f = h * w / (2 * np.pi)
+    out = np.abs(np.log(np.abs(resonance(f, 100.0, 0.05, 4.0)) ** 2)) < STAND_MIN_LOG_GAIN
+    assert n == out.sum() and (f[out] < 100).sum() >= 5 and (f[out] > 100).sum() >= 5, (n, f[out])
+    assert abs(p - p_true) < max(0.05, 4 * se) and 0 < se < 0.05, (p, se)
+    off = AmplitudeLaw.fit(ctx, _law_beside_stand(peak_gain_named=5.0)[1], "radial_force", h, ctx.runs)
+    assert abs(off.beyond_stand[0] - p_true) < max(0.05, 4 * off.beyond_stand[1]), off.beyond_stand
+    # the check is written out: the summary's and the model file's entry, and its line of words
+    params = law.params()
+    assert params["runs_beyond_stand"] == n and params["exponent_beyond_stand"] == p
+    assert params["exponent_beyond_stand_stderr"] == se
+
+
+def test_the_law_checked_beyond_the_stand_is_in_its_words_and_model_file_entry():
+    """The law's check beyond a named stand (issue 33) is said where the law is: report.md's and the console's line
+    (:meth:`rwadist.effects.amplitude_law.AmplitudeLaw.describe`) and the model file's entry, which reads back."""
+    from rwadist.effects_text import describe_effect
+    from rwadist.schema import parse_effects
+
+    checked = AmplitudeLaw("radial_force", 1.0, 2.6, 1.0, 300.0, 0.01, (2.55, 0.03, 12)).to_schema()
+    few = AmplitudeLaw("radial_force", 1.0, 3.0, 1.0, 300.0, 0.004, (float("nan"), float("nan"), 3)).to_schema()
+    alone = AmplitudeLaw("radial_force", 1.0, 2.6, 1.0, 300.0, 0.01, None).to_schema()
+    assert "beyond the test stand (12 runs out of its reach) |Ω|^2.55 ±0.03" in describe_effect(checked)
+    assert "leaves 3 runs out of its reach, too few or too close in speed to check the law there" in describe_effect(few)
+    assert "stand" not in describe_effect(alone) and "runs_beyond_stand" not in alone
+    for entry in (checked, alone):
+        back = parse_effects([entry], "<test>")[0]
+        assert back.runs_beyond_stand == entry.get("runs_beyond_stand")
+        assert back.exponent_beyond_stand == entry.get("exponent_beyond_stand")

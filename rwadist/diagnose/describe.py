@@ -93,11 +93,13 @@ def search_standing(diag) -> tuple:
     base): what a search run again with a run change taken out must improve on (:func:`run_steps`), compared as a
     tuple.  A mode the fit declares ``unconstrained`` is not located: left in the records, a changed run's lines are
     missed by the modes' linear model by more than its misfit bound (family wheel 0, every third run 3.5 dB up: the
-    translation and rocking declared, the rocking's kept value 1760 Hz, truth 95 Hz)."""
+    translation and rocking declared, the rocking's kept value 1760 Hz, truth 95 Hz).  The parts of one effect of
+    several parts (a floor law of several channels, one hypothesis: ``Hypothesis.group``) count as one effect."""
     added = [h for h in diag.hypotheses if h.passed and not h.base_line and h.effect.kind != "suspension_modes"]
     modes = [e for e in diag.state_after.effects if getattr(e, "kind", "") == "suspension_modes"]
     located = sum(3 - len(getattr(e, "unconstrained", ())) for e in modes)
-    return (located, -len(added))
+    whole = {id(h) if getattr(h, "group", None) is None else id(h.group) for h in added}
+    return (located, -len(whole))
 
 
 #: The runs whose change was not read are left out of the second search only when they are at most this fraction of
@@ -431,6 +433,28 @@ def forced_effects(diag, opened: Opened, search_before: State, search_after: Sta
     return out
 
 
+def _with_groups(hypotheses, gone: dict) -> dict:
+    """``gone`` (id of an effect taken back -> the signature it was fitted to) with every other part of an effect of
+    several parts one of whose parts it holds (``Hypothesis.group``: a floor law of several channels), under that
+    part's signature.
+
+    A group stands or falls together: its parts share one exponent, fitted over every part's bands at once, and it
+    passed as one hypothesis on their summed held-out evidence.  A part fitted to content no class explains put that
+    content into the shared exponent and into the evidence the others passed on; without a new fit and judgement of
+    the other channels alone (the search's, not the description's), they stand on nothing of their own."""
+    sig: dict = {}
+    for h in hypotheses:
+        g = getattr(h, "group", None)
+        if g is not None and id(h.effect) in gone:
+            sig.setdefault(id(g), gone[id(h.effect)])
+    out = dict(gone)
+    for h in hypotheses:
+        g = getattr(h, "group", None)
+        if g is not None and id(g) in sig:
+            out.setdefault(id(h.effect), sig[id(g)])
+    return out
+
+
 def finish(diag, opened: Opened, bearings=(), rebuild=None):
     """``diag`` (a :class:`~rwadist.diagnose.search.Diagnosis` of the search on ``opened.ctx``) measured on the data
     as given and described: its context, states and errors those of the data as given (where the fixed lines and
@@ -449,7 +473,7 @@ def finish(diag, opened: Opened, bearings=(), rebuild=None):
     found, res = _described(diag, opened, search_after, bearings)
     forced = forced_effects(diag, opened, search_before, search_after, found, res) if found and rebuild else []
     if forced:
-        gone = {id(e): sig for e, sig in forced}
+        gone = _with_groups(diag.hypotheses, {id(e): sig for e, sig in forced})
         state = search_before
         for e in search_after.effects:
             if id(e) not in gone:

@@ -225,6 +225,29 @@ def line_causes_section(diag: Diagnosis) -> list:
     return out
 
 
+def hypotheses_csv(hypotheses) -> str:
+    """hypotheses.csv's text: one row per hypothesis (iteration, kind, channels, parameters, held-out gain and
+    fraction, t, passed).  The parts of an effect of several parts (``Hypothesis.group``: a floor law of several
+    channels, each channel its own entry of the model file) are one hypothesis: its held-out gain and gain fraction
+    are written on its first part's row only (the others' left empty, their parameters marked ``part_of=`` the
+    group's channels), so the columns sum to what the hypotheses gained."""
+    lines = ["iteration,kind,channels,parameters,heldout_gain,heldout_gain_fraction,t,passed"]
+    seen: set = set()
+    for h in hypotheses:
+        e = h.effect
+        par = ";".join(f"{k}={_fmt(v, '.6g')}" for k, v in e.params().items()
+                       if not (isinstance(v, list) and len(v) > 4))
+        g = getattr(h, "group", None)
+        gain = f"{h.gain:.6g},{h.gain_fraction:.6g}"
+        if g is not None:
+            par += f";part_of={' '.join(g.channels)}"
+            gain = "," if id(g) in seen else gain
+            seen.add(id(g))
+        par = par.replace(",", " ")                             # one CSV field
+        lines.append(f"{h.iteration},{e.kind},{' '.join(e.channels)},{par},{gain},{h.t:.4g},{h.passed}")
+    return "\n".join(lines) + "\n"
+
+
 def write_report(diag: Diagnosis, out_dir) -> list:
     """summary.json, model.json (the improved model), rms_vs_speed.csv/.png, residual_waterfall.png,
     hypotheses.csv and report.md into ``out_dir``; returns the paths."""
@@ -254,14 +277,7 @@ def write_report(diag: Diagnosis, out_dir) -> list:
     save_png(_waterfall_figure(diag), p, dpi=100)
     files.append(p)
     p = out / "hypotheses.csv"
-    lines = ["iteration,kind,channels,parameters,heldout_gain,heldout_gain_fraction,t,passed"]
-    for h in diag.hypotheses:
-        e = h.effect
-        par = ";".join(f"{k}={_fmt(v, '.6g')}" for k, v in e.params().items()
-                       if not (isinstance(v, list) and len(v) > 4)).replace(",", " ")     # one CSV field
-        lines.append(f"{h.iteration},{e.kind},{' '.join(e.channels)},{par},{h.gain:.6g},{h.gain_fraction:.6g},"
-                     f"{h.t:.4g},{h.passed}")
-    p.write_text("\n".join(lines) + "\n")
+    p.write_text(hypotheses_csv(diag.hypotheses))
     files.append(p)
     md = ["# rwadist diagnose", "",
           f"Metric: `{METRIC}` — {summary['metric_definition']}; a band's misplaced power is counted beyond "

@@ -39,6 +39,10 @@ class Hypothesis:
     #: the test-stand resonance fitted jointly with the effect that it was judged beside (:func:`_judge_beside_stand`:
     #: the wheel's suspension modes with their fixture divided out on both sides of the comparison), or None
     beside: Effect | None = None
+    #: the effect of several parts this hypothesis's effect is one part of (a floor law of several channels,
+    #: :class:`rwadist.effects.broadband_floor_diagnose.FloorGroup`: one hypothesis, each part its own entry of the
+    #: model file and its own hypothesis with the judgement of the whole), or None
+    group: Effect | None = None
 
 
 @dataclass
@@ -551,6 +555,7 @@ def _search(spectra: Spectra, model: WheelModel | None, k_sigma: float, min_gain
             # an effect of several parts (a floor law of several channels, each channel's floor its own entry of the
             # model file): one passed hypothesis per part, each with the judgement of the whole
             k = next(i for i, h in enumerate(hyps) if h is best)
+            best.group = refit
             hyps[k:k] = [replace(best, effect=e) for e in state.effects[-len(parts):-1]]
     else:
         it = max_iterations

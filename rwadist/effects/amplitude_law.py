@@ -9,6 +9,7 @@ import numpy as np
 
 from ..schema import (
     AMPLITUDE,
+    COUNT,
     DIRECTIONS,
     EXPONENT,
     HARMONIC_NUMBER,
@@ -36,6 +37,13 @@ class AmplitudeLaw(Element):
     exponent_stderr: float | None = field(default=None, metadata=check(statistic(ge=0.0, le=MAX_EXPONENT)))
     amplitude_ref: float = field(metadata=check(AMPLITUDE))
     omega_ref_rad_s: float = field(metadata=check(SPEED))
+    #: beside a test stand (``rwadist diagnose``): the number of runs no named test-stand resonance reaches (its gain
+    #: on the line within 1.5x of 1 in power), and the exponent (± its standard error) fitted on them alone, the law
+    #: checked where no fitted stand gain rests on it; the exponent null where too few runs are left to fit it (the
+    #: law then judged over every run alone).  Absent where no named stand reaches the line.
+    runs_beyond_stand: int | None = field(default=None, metadata=check(COUNT))
+    exponent_beyond_stand: float | None = field(default=None, metadata=check(statistic(ge=None)))
+    exponent_beyond_stand_stderr: float | None = field(default=None, metadata=check(statistic(ge=0.0)))
 
     @property
     def law(self) -> tuple:
@@ -54,7 +62,21 @@ class AmplitudeLaw(Element):
         d = e["direction"]
         return (f"{words(d)}, h {num(e['h'])}, amplitude ∝ |Ω|^{num(e['exponent'], '.3g')}"
                 f"{plus_minus(e, 'exponent_stderr')}, {num(e['amplitude_ref'], '.3g')} {cls.AMPLITUDE_UNIT[d]} at "
-                f"{rpm(e['omega_ref_rad_s'])}")
+                f"{rpm(e['omega_ref_rad_s'])}{cls._beyond_stand(e)}")
+
+    @staticmethod
+    def _beyond_stand(e: Mapping) -> str:
+        """The law's check beyond a test stand (``runs_beyond_stand``, ``exponent_beyond_stand``) in words, or
+        nothing where no stand reaches the line."""
+        n = e.get("runs_beyond_stand")
+        if n is None:
+            return ""
+        p = e.get("exponent_beyond_stand")
+        if p is None or not np.isfinite(float(p)):
+            return (f"; beside a test stand that leaves {int(n)} runs out of its reach, too few or too close in speed "
+                    "to check the law there (judged over every run)")
+        return (f"; beyond the test stand ({int(n)} runs out of its reach) |Ω|^{num(p, '.3g')}"
+                f"{plus_minus(e, 'exponent_beyond_stand_stderr')}")
 
     # ------------------------------------------------------------------ injection
     #: ``amplitude_law:direction=radial_force,h=2,exponent=3,fraction=1``: the line (d, h) of the wheel replaced by

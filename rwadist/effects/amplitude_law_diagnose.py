@@ -50,7 +50,15 @@ def _law_lsq(X, y, leak, var_noise, rounds: int = 4):
 def _stand_reach(state: State, h: float, w: np.ndarray) -> np.ndarray:
     """True for each speed ``w`` (rad/s) at which a test-stand resonance the state names (a ``fixed_resonance`` of role
     test_stand) changes the power of the line h by a factor 1.5 or more (|ln|H|²| >=
-    :data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN`, the stand's own detection threshold), up or down."""
+    :data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN`, the stand's own detection threshold), up or down.
+
+    The level, not its slope: far above a stand whose gain stays off 1 (``gain_above``) the gain is a constant factor,
+    which alone cannot change an exponent, but the measurement divides it out as fitted
+    (:func:`rwadist.diagnose.measure.measure_run_powers`), and the runs beyond the stand hold runs below it as well,
+    where the gain is exactly 1: a misfit of the fitted factor is a step between the two groups, read as a slope (were
+    the 14 runs at 131-177 Hz of tests/test_amplitude_law_stand.py's law on such a factor, beside its 10 runs at 44-77
+    Hz, a factor 20 % off would move the exponent by 0.18, over three times the 0.05 asked of a law).  ROSS's stand
+    held its gain above at 0.28 where the translation's is 0: such a level misfit is what the check guards against."""
     f = h * np.abs(w) / (2 * np.pi)
     reach = np.zeros(w.size, bool)
     for e in state.effects:
@@ -70,10 +78,11 @@ class AmplitudeLaw:
     amplitude_ref: float
     omega_ref: float
     exponent_stderr: float = float("nan")
-    #: (exponent, its standard error) fitted on the runs where no test-stand resonance the state names changes the
-    #: line's power by 1.5x or more (:func:`_stand_reach`); (nan, nan) when the stand leaves too few such runs to fit
-    #: the exponent on (then not checked there); None when no named stand reaches the line at any run
-    #: (:meth:`significant`)
+    #: (exponent, its standard error, the number of runs) fitted on the runs where no test-stand resonance the state
+    #: names changes the line's power by 1.5x or more (:func:`_stand_reach`); (nan, nan, n) when the stand leaves too
+    #: few such runs to fit the exponent on (then not checked there); None when no named stand reaches the line at any
+    #: run (:meth:`significant`; written as ``exponent_beyond_stand``, ``exponent_beyond_stand_stderr`` and
+    #: ``runs_beyond_stand``, :meth:`params`)
     beyond_stand: tuple | None = None
     kind: str = "amplitude_law"
     #: it adds no line, only changes the amplitude of one the state has: judged with that line's beats at its own
@@ -116,22 +125,34 @@ class AmplitudeLaw:
         there would never be named (family wheel 6, its Ω³ BPFO line beside such a stand at 112 Hz: Ω^3.011 ± 0.004
         on the fit runs, too few of its 10 runs out of the stand's reach: not proposed; such a stand at 0.5-1.5x each
         family wheel's modes, ζ 0.03: 111 of 120 placements leave the BPFO line too few fit runs).  An exponent whose
-        standard error is not finite tells nothing."""
+        standard error is not finite tells nothing.
+
+        Beyond the stand the exponent must be told from 2 on the same side as over every run: the law's direction
+        (faster or slower than Ω²) is its claim.  An exponent of 2.6 over every run that reads 1.7 ± 0.05 beyond the
+        stand is two contradicting readings of the line, no law the runs the stand does not reach confirm."""
         def told(p, se):
             return bool(np.isfinite(p) and np.isfinite(se)) and not abs(p - 2.0) <= max(EXPONENT_Z * se,
                                                                                             MIN_EXPONENT_SHIFT)
 
-        if self.beyond_stand is not None and np.isfinite(self.beyond_stand[0]) and not told(*self.beyond_stand):
-            return False
+        if self.beyond_stand is not None and np.isfinite(self.beyond_stand[0]):
+            p, se = self.beyond_stand[:2]
+            if not told(p, se) or (p > 2.0) != (self.exponent > 2.0):
+                return False
         return told(self.exponent, self.exponent_stderr)
 
     def to_schema(self) -> dict:
         return schema_entry(self)
 
     def params(self) -> dict:
-        return {"direction": self.direction, "h": round(self.h, 4), "exponent": self.exponent,
-                "exponent_stderr": self.exponent_stderr, "amplitude_ref": self.amplitude_ref,
-                "omega_ref_rad_s": self.omega_ref}
+        out = {"direction": self.direction, "h": round(self.h, 4), "exponent": self.exponent,
+               "exponent_stderr": self.exponent_stderr, "amplitude_ref": self.amplitude_ref,
+               "omega_ref_rad_s": self.omega_ref}
+        if self.beyond_stand is not None:
+            # the law checked beyond a named test stand (:meth:`significant`): on how many runs, with what exponent
+            p, se, *n = self.beyond_stand
+            out.update(runs_beyond_stand=int(n[0]) if n else None, exponent_beyond_stand=float(p),
+                       exponent_beyond_stand_stderr=float(se))
+        return out
 
     @staticmethod
     def fit(ctx: Context, state: State, direction: str, h: float, runs) -> "AmplitudeLaw | None":
@@ -150,10 +171,10 @@ class AmplitudeLaw:
         beyond = None
         if reach.any():
             out = ~reach
-            beyond = (float("nan"), float("nan"))
+            beyond = (float("nan"), float("nan"), int(out.sum()))
             if out.sum() >= 5 and np.ptp(np.log(w[out])) >= 0.3:
                 c2, v2 = _law_lsq(X[out], np.log(d[out]), leak[out], var_noise[out])
-                beyond = (float(c2[1]), float(np.sqrt(v2[1, 1])))
+                beyond = (float(c2[1]), float(np.sqrt(v2[1, 1])), int(out.sum()))
         return AmplitudeLaw(direction, float(h), float(coef[1]), float(np.exp(coef[0])), w_ref,
                             float(np.sqrt(cov[1, 1])), beyond)
 

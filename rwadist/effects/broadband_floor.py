@@ -7,7 +7,20 @@ from typing import ClassVar
 
 import numpy as np
 
-from ..schema import CHANNELS, EXPONENT, MAX_FREQ_HZ, MAX_KNOTS, MAX_PSD, SPEED, check, names, numbers, register
+from ..schema import (
+    CHANNELS,
+    EXPONENT,
+    MAX_FREQ_HZ,
+    MAX_KNOTS,
+    MAX_PSD,
+    SPEED,
+    check,
+    choice,
+    names,
+    numbers,
+    optional,
+    register,
+)
 from ..units import CHANNEL_UNIT
 from .actions import NoiseFloor
 from .element import Element, FmuSwitch, num, rpm
@@ -29,6 +42,10 @@ class BroadbandFloor(Element):
     f_Hz: np.ndarray = field(metadata=check(numbers(min_len=2, ge=0.0, increasing=True, le=MAX_FREQ_HZ,
                                                     max_len=MAX_KNOTS)))
     psd_ref: np.ndarray = field(metadata=check(numbers(ge=0.0, le=MAX_PSD, max_len=MAX_KNOTS)))
+    #: "at_least" (or "at_most") where the fitted exponent is the largest (smallest) of the grid ``rwadist diagnose``
+    #: chooses it from: the likeliest law may lie beyond it, so the data bound the exponent from that side only; absent
+    #: (None) for an exponent inside the grid.  The floor uses ``exponent`` as it is either way.
+    exponent_bound: str | None = field(default=None, metadata=check(optional(choice(("at_least", "at_most")))))
 
     def _validate(self, source, path, error):
         if self.psd_ref.size != self.f_Hz.size:
@@ -49,7 +66,11 @@ class BroadbandFloor(Element):
         f = np.asarray(e["f_Hz"], dtype=float)
         psd = np.asarray(e["psd_ref"], dtype=float)
         chans = " ".join(e["channel"]) if isinstance(e["channel"], (list, tuple)) else str(e["channel"])
-        return (f"{chans}, PSD ∝ |Ω|^{num(e['exponent'], '.3g')}, {f.min():.0f}–{f.max():.0f} Hz, "
+        p = num(e["exponent"], ".3g")
+        bounds = {"at_least": f" (p >= {p}: the fit's largest exponent, a lower bound)",
+                  "at_most": f" (p <= {p}: the fit's smallest exponent, an upper bound)"}
+        bound = bounds.get(str(e.get("exponent_bound")), "")
+        return (f"{chans}, PSD ∝ |Ω|^{p}{bound}, {f.min():.0f}–{f.max():.0f} Hz, "
                 f"peak {psd.max():.3g} {cls._psd_unit(e)} at {rpm(e['omega_ref_rad_s'])}")
 
     @staticmethod

@@ -290,7 +290,8 @@ class BroadbandFloor:
     def params(self) -> dict:
         kf = self.f_hz[::BAND_BINS] if self.knots_f is None else self.knots_f
         kp = self.psd_ref[::BAND_BINS] if self.knots_psd is None else self.knots_psd
-        return {"channel": self.channel, "exponent": self.exponent, "omega_ref_rad_s": self.omega_ref,
+        return {"channel": self.channel, "exponent": self.exponent, **_exponent_bound(self.exponent),
+                "omega_ref_rad_s": self.omega_ref,
                 "psd_law": "psd_ref(f) * (|omega|/omega_ref)^exponent, linear between knots, 0 outside",
                 "unit": f"{CHANNEL_UNIT[self.channel]}^2/Hz",
                 "f_Hz": [float(x) for x in kf],
@@ -324,6 +325,17 @@ class BroadbandFloor:
                 groups += ctx.reuse("broadband_floor", state, chans, runs,
                                     lambda chans=chans: FloorGroup.fit_list(ctx, state, chans, runs), part="group")
         return singles + groups
+
+
+def _exponent_bound(p: float) -> dict:
+    """``{"exponent_bound": "at_least"}`` for an exponent at the top of :data:`FLOOR_EXPONENTS` (``"at_most"`` at its
+    bottom), else ``{}``: :func:`_floor_law` chooses the likeliest exponent of that grid, and one at its edge says only
+    that the likeliest law lies there or beyond (a floor read p 8 may grow as Ω^10), a bound, not a value."""
+    if p >= FLOOR_EXPONENTS[-1]:
+        return {"exponent_bound": "at_least"}
+    if p <= FLOOR_EXPONENTS[0]:
+        return {"exponent_bound": "at_most"}
+    return {}
 
 
 def _floor_bands(ctx: Context, state: State, c: str, runs) -> tuple | None:
@@ -474,7 +486,8 @@ class FloorGroup:
 
     def params(self) -> dict:
         e = self.parts[0]
-        return {"channel": list(self.channels), "exponent": e.exponent, "omega_ref_rad_s": e.omega_ref,
+        return {"channel": list(self.channels), "exponent": e.exponent, **_exponent_bound(e.exponent),
+                "omega_ref_rad_s": e.omega_ref,
                 "psd_law": "psd_ref_c(f) * (|omega|/omega_ref)^exponent per channel c (one entry each)",
                 "unit": f"{CHANNEL_UNIT[e.channel]}^2/Hz"}
 

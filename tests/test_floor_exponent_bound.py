@@ -1,0 +1,38 @@
+"""A broadband floor's exponent at the edge of the grid it is chosen from
+(:data:`rwadist.diagnose.constants.FLOOR_EXPONENTS`, 0.5-8) is a bound, not a value: the likeliest law lies there or
+beyond.  Checked on band means of known laws (a floor ∝ Ω^10 is read p 8: ``at_least``; ∝ Ω^5, inside the grid: 5, no
+bound; a flat-ish ∝ Ω^0.2: p 0.5, ``at_most``), written in the floor's entry (the model file's, which reads back) and
+in its line of words."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rwadist.diagnose.constants import FLOOR_EXPONENTS
+from rwadist.effects.broadband_floor_diagnose import BroadbandFloor, _floor_law
+from rwadist.effects_text import describe_effect
+from rwadist.schema import parse_effects
+
+
+@pytest.mark.parametrize("p_true, p_read, bound", [(10.0, 8.0, "at_least"), (5.0, 5.0, None),
+                                                   (0.2, 0.5, "at_most")])
+def test_an_exponent_at_the_grid_edge_is_written_as_a_bound(p_true, p_read, bound):
+    assert FLOOR_EXPONENTS[0] == 0.5 and FLOOR_EXPONENTS[-1] == 8.0
+    x0 = np.linspace(0.2, 1.6, 16)                       # Ω/Ω_ref of 16 runs
+    n, g = np.array([1.0, 2.0, 0.5]), np.array([3.0, 1.0, 4.0])
+    y = n[None, :] + g[None, :] * x0[:, None] ** p_true  # band means of the law, no scatter
+    p, _, _ = _floor_law(np.full(y.shape, 8.0), y, x0)
+    assert p == p_read
+    f = np.linspace(10.0, 200.0, 40)
+    floor = BroadbandFloor("Fz", float(p), 300.0, f, np.full(f.size, 1e-4), np.full(f.size, 1e-6))
+    entry = {"kind": "broadband_floor", **floor.params(), "channel": ["Fz"]}
+    assert entry.get("exponent_bound") == bound
+    words = describe_effect(entry)
+    if bound == "at_least":
+        assert "p >= 8: the fit's largest exponent, a lower bound" in words
+    elif bound == "at_most":
+        assert "p <= 0.5: the fit's smallest exponent, an upper bound" in words
+    else:
+        assert ">=" not in words and "<=" not in words
+    back = parse_effects([entry], "<test>")[0]
+    assert back.exponent_bound == bound and back.exponent == p
