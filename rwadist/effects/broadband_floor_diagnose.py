@@ -42,7 +42,10 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
     level = np.maximum(_band_levels(y, wt), 1e-300)
     # x = (Ω/Ω_ref)^p of every exponent at once (P, runs, 1), each power as ``x0[:, None] ** p`` computes it
     xs = np.stack([x0[:, None] ** p for p in FLOOR_EXPONENTS])
-    expected = np.broadcast_to(level, (len(FLOOR_EXPONENTS),) + y.shape)
+    # the (P, runs, bands) arrays of the passes in four buffers written in place (each operation the same as a new
+    # array's, in the same order: the same numbers, without a fresh multi-megabyte array per operation)
+    expected, wts, wx, tmp = (np.empty((len(FLOOR_EXPONENTS),) + y.shape) for _ in range(4))
+    expected[...] = level
     for _ in range(3):
         # weights: bins used / expected value² (a band mean of chi² bins has variance ∝ mean²/bins), each exponent's
         # re-estimated from its own previous pass (iteratively reweighted least squares)
@@ -53,22 +56,35 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
         # (a band of no positive mean level, held at 1e-300, can expect ~1e-150 or more after a pass: its ratio
         # squared overflows to inf and the band weighs 0 -- it holds no floor, and the deviance leaves it out too)
         with np.errstate(over="ignore"):
-            wts = wt / np.maximum(expected / level, 1e-3) ** 2
+            np.square(np.maximum(np.divide(expected, level, out=tmp), 1e-3, out=tmp), out=tmp)
+        np.divide(wt, tmp, out=wts)
         # weighted 2-parameter least squares per band and exponent: y = n + g·x (sums over the runs, axis 1)
-        wx = wts * xs
-        s0, s1, s2 = wts.sum(1), wx.sum(1), (wx * xs).sum(1)
-        t0, t1 = (wts * y).sum(1), (wx * y).sum(1)
+        np.multiply(wts, xs, out=wx)
+        s0, s1 = wts.sum(1), wx.sum(1)
+        s2 = np.multiply(wx, xs, out=tmp).sum(1)
+        t0 = np.multiply(wts, y, out=tmp).sum(1)
+        t1 = np.multiply(wx, y, out=tmp).sum(1)
         det = s0 * s2 - s1 * s1
         with np.errstate(divide="ignore", invalid="ignore"):
             g = np.maximum(np.where(det > 0, (s0 * t1 - s1 * t0) / det, 0.0), 0.0)
         n = np.where(s0 > 0, np.maximum((t0 - g * s1) / np.maximum(s0, 1e-300), 0.0), 0.0)
-        expected = np.maximum(n[:, None, :] + g[:, None, :] * xs, 1e-300)
+        # expected = max(n + g·x, 1e-300)
+        np.maximum(np.add(n[:, None, :], np.multiply(g[:, None, :], xs, out=expected), out=expected), 1e-300,
+                   out=expected)
     # the Whittle deviance of each exponent's law, over the bands whose mean level is positive (a band at or below the
     # model's line skirts holds no estimate of the floor), its expected value held at 1e-3 of the band's level or more
-    # (a law of zero noise where the data are not zero is that unlikely, not infinitely so)
+    # (a law of zero noise where the data are not zero is that unlikely, not infinitely so):
+    # Σ wt·(y/E + ln(E/level)), in place in the buffers when every band is used
     use = np.sum(wt * y, 0) > 0
-    e_use = np.maximum(expected[:, :, use], 1e-3 * level[use])
-    dev = np.sum(wt[:, use] * (y[:, use] / e_use + np.log(e_use / level[use])), axis=(1, 2))
+    lu = level[use]
+    if use.all():
+        e_use, w_use, y_use, term = np.maximum(expected, 1e-3 * lu, out=expected), wt, y, tmp
+    else:
+        e_use, w_use, y_use = np.maximum(expected[:, :, use], 1e-3 * lu), wt[:, use], y[:, use]
+        term = np.empty(e_use.shape)
+    np.divide(y_use, e_use, out=term)
+    np.add(term, np.log(np.divide(e_use, lu, out=e_use), out=e_use), out=term)
+    dev = np.multiply(w_use, term, out=term).sum(axis=(1, 2))
     i = int(np.argmin(dev))                 # the first smallest
     return FLOOR_EXPONENTS[i], n[i], g[i]
 
