@@ -130,9 +130,7 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
     the error metric.  No bin where the time series are unknown or lack the channel.  A whole-run bin has 2
     degrees of freedom (a Welch bin ctx.dof).  Each run's numbers are kept on the context (the data's and the
     lines', the same at every search step)."""
-    from ..dft import run_window
-    from ..diagnose.measure import hann_transform_ratio, record_dfts, state_line_freqs
-    from .missing_harmonic_diagnose import RECORD_MIN_BINS, RECORD_SEP_BINS
+    from ..diagnose.measure import record_dfts, state_line_freqs
 
     y = np.zeros((runs.size, ctx.n_bands))
     cnt_all = np.zeros((runs.size, ctx.n_bands))
@@ -146,53 +144,92 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
             if need[i].any() and keys[i] not in ctx._memo and c in ctx.test.runs[int(r)].signals]
     A = (record_dfts(ctx, [int(runs[i]) for i in todo], c, lines[todo]) if lines.shape[1] and todo
          else np.zeros((len(todo), 0), complex))
-    lo_edge = float(ctx.f[ctx.k_lo] - 0.5 * ctx.df)
-    band_w = BAND_BINS * ctx.df
-    thr = -np.log(RECORD_PEAK_FA)                # |X|² of complex Gaussian noise is exponential: P(> t·mean) = e^{-t}
     spectra = _record_spectra(ctx, c, [int(runs[i]) for i in todo])
+    groups: dict = {}                   # the runs to do by (record length, sample rate): one bin grid each
     for a, i in enumerate(todo):
         run = ctx.test.runs[int(runs[i])]
-        n, fs = run.n_samples, run.sample_rate
-        df_rec = fs / n
-        w, wsum, w2sum = run_window(ctx.sp.window, n)
-        X = spectra[a]
-        f = np.arange(X.size) * df_rec
-        band = np.floor((f - lo_edge) / band_w).astype(int)
-        sel = (f >= RECORD_MIN_BINS * df_rec) & (band >= 0) & (band < ctx.n_bands)
-        sel[sel] = need[i][band[sel]]
-        fk, Xk, band = f[sel], X[sel], band[sel]
-        keep = np.ones(fk.size, bool)
-        fl = lines[i]
-        if fl.size:
-            Xk = Xk - (hann_transform_ratio(n, (fk[:, None] - fl[None, :]) / df_rec) * A[a][None, :]
-                       + hann_transform_ratio(n, (fk[:, None] + fl[None, :]) / df_rec) * np.conj(A[a])[None, :]).sum(1)
-            keep = np.all(np.abs(fk[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
-        P = np.abs(Xk) ** 2 * wsum**2 / (2.0 * fs * w2sum)
-        # a residual peak: above thr times the band's level (median of its bins clear of lines / ln 2); a peak's
-        # neighbours are neighbours on the record grid (the bins kept are contiguous within a band)
-        level = np.zeros(ctx.n_bands)
-        bk, pk = band[keep], P[keep]
-        if bk.size:
-            # each band's median (np.median's: the middle value, or the mean of the middle two) from one sort by band
-            # and value
-            srt = pk[np.lexsort((pk, bk))]
-            b_u, first, cnt_b = np.unique(bk, return_index=True, return_counts=True)
-            hi = first + cnt_b // 2
-            lo = np.where(cnt_b % 2 == 1, hi, hi - 1)
-            level[b_u] = (srt[lo] + srt[hi]) / 2.0 / np.log(2.0)
-        peak = P > thr * level[band]
-        wide = peak.copy()
-        for s_ in range(1, RECORD_PEAK_BINS + 1):
-            wide[s_:] |= peak[:-s_]
-            wide[:-s_] |= peak[s_:]
-        use = keep & ~wide
-        cnt = np.bincount(band[use], minlength=ctx.n_bands).astype(float)
-        tot = np.bincount(band[use], P[use], minlength=ctx.n_bands)
-        ctx._memo[keys[i]] = (np.where(cnt > 0, tot / np.maximum(cnt, 1.0), 0.0), cnt, df_rec)
+        groups.setdefault((run.n_samples, run.sample_rate), []).append(a)
+    for (n, fs), idx in groups.items():
+        rows = [todo[a] for a in idx]
+        got = _record_bands(ctx, n, fs, np.stack([spectra[a] for a in idx]), need[rows], lines[rows], A[idx])
+        for k, i in enumerate(rows):
+            ctx._memo[keys[i]] = (got[0][k], got[1][k], fs / n)
     for i in range(runs.size):
         if keys[i] in ctx._memo:
             y[i], cnt_all[i], df_all[i] = ctx._memo[keys[i]]
     return y, cnt_all, df_all
+
+
+#: Largest (record bins x lines) of the leakage of the lines :func:`_record_bands` evaluates at once (complex; the runs
+#: of one bin grid taken in chunks under it)
+RECORD_CHUNK_ELEMENTS = 1_000_000
+
+
+def _record_bands(ctx: Context, n: int, fs: float, X: np.ndarray, need: np.ndarray, lines: np.ndarray,
+                  A: np.ndarray) -> tuple:
+    """(mean PSD unit²/Hz, bins used), each (runs, n_bands), of :func:`record_offline_bands` for runs of one record
+    length ``n`` and sample rate ``fs``: ``X`` (runs, n//2 + 1) their whole-run spectra, ``need`` (runs, n_bands) the
+    bands wanted, ``lines`` (runs, L) Hz and ``A`` (runs, L) the lines' whole-run phasors.
+
+    Every run's bins at once (the bins kept of all the runs in one array, run by run, each run's in increasing
+    frequency; the runs in chunks of at most :data:`RECORD_CHUNK_ELEMENTS` bins x lines): each bin's numbers are those
+    of the run alone -- the same elementwise operations, each bin's leakage summed over its own lines, each band's
+    median and sums over its own bins in the same order (tests/test_fast_paths_floor.py)."""
+    from ..dft import run_window
+    from ..diagnose.measure import hann_transform_ratio
+    from .missing_harmonic_diagnose import RECORD_MIN_BINS, RECORD_SEP_BINS
+
+    nb = ctx.n_bands
+    df_rec = fs / n
+    _, wsum, w2sum = run_window(ctx.sp.window, n)
+    lo_edge = float(ctx.f[ctx.k_lo] - 0.5 * ctx.df)
+    band_w = BAND_BINS * ctx.df
+    thr = -np.log(RECORD_PEAK_FA)                # |X|² of complex Gaussian noise is exponential: P(> t·mean) = e^{-t}
+    f = np.arange(X.shape[1]) * df_rec
+    band = np.floor((f - lo_edge) / band_w).astype(int)
+    inside = (f >= RECORD_MIN_BINS * df_rec) & (band >= 0) & (band < nb)
+    sel = inside[None, :] & need[:, np.where(inside, band, 0)]          # (runs, bins) each run's bins in its bands
+    mean, used = np.zeros((X.shape[0], nb)), np.zeros((X.shape[0], nb))
+    per_run = sel.sum(1) * max(lines.shape[1], 1)
+    start = 0
+    while start < X.shape[0]:
+        stop = start + max(1, int(np.searchsorted(np.cumsum(per_run[start:]), RECORD_CHUNK_ELEMENTS, side="right")))
+        ri, ki = np.nonzero(sel[start:stop])
+        ri_abs = ri + start
+        fk, Xk, bk = f[ki], X[ri_abs, ki], band[ki]
+        keep = np.ones(fk.size, bool)
+        if lines.shape[1]:
+            fl, Ak = lines[ri_abs], A[ri_abs]
+            Xk = Xk - (hann_transform_ratio(n, (fk[:, None] - fl) / df_rec) * Ak
+                       + hann_transform_ratio(n, (fk[:, None] + fl) / df_rec) * np.conj(Ak)).sum(1)
+            keep = np.all(np.abs(fk[:, None] - fl) >= RECORD_SEP_BINS * df_rec, axis=1)
+        P = np.abs(Xk) ** 2 * wsum**2 / (2.0 * fs * w2sum)
+        # a residual peak: above thr times the band's level (median of its bins clear of lines / ln 2); a peak's
+        # neighbours are neighbours on the run's record grid (the bins kept are contiguous within a band)
+        key = ri * nb + bk                       # (run, band) of each bin, nondecreasing
+        level = np.zeros((stop - start) * nb)
+        kk, pk = key[keep], P[keep]
+        if kk.size:
+            # each band's median (np.median's: the middle value, or the mean of the middle two) from one sort by run,
+            # band and value
+            srt = pk[np.lexsort((pk, kk))]
+            k_u, first, cnt_b = np.unique(kk, return_index=True, return_counts=True)
+            hi = first + cnt_b // 2
+            lo = np.where(cnt_b % 2 == 1, hi, hi - 1)
+            level[k_u] = (srt[lo] + srt[hi]) / 2.0 / np.log(2.0)
+        peak = P > thr * level[key]
+        wide = peak.copy()
+        for s_ in range(1, RECORD_PEAK_BINS + 1):
+            same = ri[s_:] == ri[:-s_]
+            wide[s_:] |= peak[:-s_] & same
+            wide[:-s_] |= peak[s_:] & same
+        use = keep & ~wide
+        cnt = np.bincount(key[use], minlength=level.size).astype(float)
+        tot = np.bincount(key[use], P[use], minlength=level.size)
+        mean[start:stop] = np.where(cnt > 0, tot / np.maximum(cnt, 1.0), 0.0).reshape(-1, nb)
+        used[start:stop] = cnt.reshape(-1, nb)
+        start = stop
+    return mean, used
 
 
 @register(order=30)
