@@ -30,8 +30,8 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
     :data:`FLOOR_EXPONENTS`, n and g its weighted 2-parameter least squares per band in three passes of iteratively
     reweighted least squares, each pass weighted by that exponent's own previous expected values; p the exponent whose
     law is the likeliest, the smallest Whittle deviance Σ wt·(y/E + ln E) (a band mean of chi² bins of expected value
-    E), over the bands of positive mean level.  Every exponent is solved at once (arrays (P, runs, bands)): the same
-    numbers as one exponent at a time (tests/test_fast_paths_floor.py).
+    E), over the bands of positive mean level.  The exponents are solved a chunk at once (arrays (P, runs, bands),
+    :func:`_floor_laws`): the same numbers as one exponent at a time (tests/test_fast_paths_floor.py).
 
     Why each exponent its own weights and the likelihood: with the weights of the previous pass's best exponent shared
     by all, that exponent was a fixed point -- weights 1/E² of a steep law forgive the top speeds' scatter, so the
@@ -42,9 +42,32 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
     level = np.maximum(_band_levels(y, wt), 1e-300)
     # x = (Ω/Ω_ref)^p of every exponent at once (P, runs, 1), each power as ``x0[:, None] ** p`` computes it
     xs = np.stack([x0[:, None] ** p for p in FLOOR_EXPONENTS])
-    # the (P, runs, bands) arrays of the passes in four buffers written in place (each operation the same as a new
-    # array's, in the same order: the same numbers, without a fresh multi-megabyte array per operation)
-    expected, wts, wx, tmp = (np.empty((len(FLOOR_EXPONENTS),) + y.shape) for _ in range(4))
+    use = np.sum(wt * y, 0) > 0
+    n, g, dev = (np.empty((len(FLOOR_EXPONENTS), y.shape[1])), np.empty((len(FLOOR_EXPONENTS), y.shape[1])),
+                 np.empty(len(FLOOR_EXPONENTS)))
+    # the exponents in chunks of about FLOOR_CHUNK_ELEMENTS (runs x bands) elements, each chunk's arrays in four buffers
+    # written in place (each exponent's numbers its own: the same operations in the same order as all at once, kept in
+    # cache)
+    step = max(1, FLOOR_CHUNK_ELEMENTS // max(y.size, 1))
+    bufs = [np.empty((min(step, len(FLOOR_EXPONENTS)),) + y.shape) for _ in range(4)]
+    for s in range(0, len(FLOOR_EXPONENTS), step):
+        k = min(step, len(FLOOR_EXPONENTS) - s)
+        n[s:s + k], g[s:s + k], dev[s:s + k] = _floor_laws(wt, y, xs[s:s + k], level, use, [b[:k] for b in bufs])
+    i = int(np.argmin(dev))                 # the first smallest
+    return FLOOR_EXPONENTS[i], n[i], g[i]
+
+
+#: Elements (runs x bands x exponents) of each of :func:`_floor_law`'s four working arrays: its exponents taken in
+#: chunks of this size (four arrays of 256 kB stay in a core's cache; all 31 exponents at once of 60 runs x 381 bands,
+#: 5.7 MB each, ran from memory at about twice the time)
+FLOOR_CHUNK_ELEMENTS = 32768
+
+
+def _floor_laws(wt, y, xs, level, use, bufs) -> tuple:
+    """(n (P, bands), g (P, bands), deviance (P,)) of :func:`_floor_law` for the exponents whose powers are ``xs``
+    (P, runs, 1) (``level`` (bands,) the bands' mean levels, ``use`` the bands of positive level; ``bufs`` four arrays
+    (P, runs, bands) to work in)."""
+    expected, wts, wx, tmp = bufs
     expected[...] = level
     for _ in range(3):
         # weights: bins used / expected value² (a band mean of chi² bins has variance ∝ mean²/bins), each exponent's
@@ -75,7 +98,6 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
     # model's line skirts holds no estimate of the floor), its expected value held at 1e-3 of the band's level or more
     # (a law of zero noise where the data are not zero is that unlikely, not infinitely so):
     # Σ wt·(y/E + ln(E/level)), in place in the buffers when every band is used
-    use = np.sum(wt * y, 0) > 0
     lu = level[use]
     if use.all():
         e_use, w_use, y_use, term = np.maximum(expected, 1e-3 * lu, out=expected), wt, y, tmp
@@ -84,9 +106,7 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
         term = np.empty(e_use.shape)
     np.divide(y_use, e_use, out=term)
     np.add(term, np.log(np.divide(e_use, lu, out=e_use), out=e_use), out=term)
-    dev = np.multiply(w_use, term, out=term).sum(axis=(1, 2))
-    i = int(np.argmin(dev))                 # the first smallest
-    return FLOOR_EXPONENTS[i], n[i], g[i]
+    return n, g, np.multiply(w_use, term, out=term).sum(axis=(1, 2))
 
 
 #: False-alarm probability of a residual peak on the whole-run spectrum (a line the state lacks): its bin and
