@@ -56,6 +56,24 @@ refit 43 %, of which the mode scans 19 % (single-precision screens at ~10 ns per
 passes, 3 logarithms and 13 products with the line indicator, kept below ~1e6 multiply-adds, where OpenBLAS's small
 kernel runs them 2.4x faster; stacking them into fewer, larger products measured slower), the whole-run DFTs 9 % (their
 products at ~120 GFlop/s single precision, the rest their tables of phasors).
+Session 10 (035bb04..e91bc1c: the floor law chosen by its Whittle deviance, each exponent its own IRLS weights, and one
+law of a unit group's channels, FloorGroup) closed at cpu x13.6/x11.3 (min/median, benchmark), x13.5/x14.0 beside 2
+busy, x16.3/x14.2 and x14.9/x14.3 (sixty); its floors had raised diagnose CPU ~19 % on the benchmark set (_floor_law
+~15 ms a call against 3.4, 26 record_offline_bands calls against 5).  Session 11 (speed11, same numbers: rwadist
+diagnose's summary.json, model.json, hypotheses.csv and rms_vs_speed.csv identical to eec576d on both sets and 12
+family cells, wheels 1 and 4: clean, broadband_floor, lever_arm_noise, three fixtures each): the floor law's arrays
+written in place, its exponents in cache-sized chunks (its 16 calls of the two sets, captured: 266-313 -> 125-129
+ms), the whole-run floor bands of every run of one bin grid at once (0.30 -> 0.16 s a benchmark diagnose), the
+off-line bands kept on the state.  At
+load 5.4-7.8 on 2 cores (other agents' jobs; no quiet moment), main eec576d and speed11 alternated (3 rounds x 3
+pairs each, one fresh child per tree and round): benchmark diagnose cpu min/median 2.54/2.73 s ->
+2.34/2.49 s (0.92x), sixty 1.46/1.62 -> 1.36/1.61 s (0.93x/0.99x); the floor family's candidates and judging (in-call
+timers) 0.53 -> 0.39 s (benchmark) and 0.33 -> 0.19 s (sixty), against 0.15 and 0.11 s at cdd25f1.  --quick
+--repeats 3 --busy 2 at load 6-8: cpu x15.0/x10.3 (benchmark), x14.0/x9.3 (2 busy), x12.8/x13.0 and x14.1/x14.1
+(sixty); target not met.  Where the rest is (benchmark set, in-call timers): the suspension-modes fit and refit
+~40 % (the rocking mode's single-precision screens 0.28 s: 41 M grid point x rows at ~7 ns; their chunk of 512 f0 is
+the fastest of 64-1024 and the only one that gives the same single-precision numbers), the third search step, which
+only ranks hypotheses.csv's top 5, ~15 %.
 """
 from __future__ import annotations
 

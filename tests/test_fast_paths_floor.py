@@ -109,3 +109,43 @@ def test_floor_law_of_a_band_with_no_positive_level_warns_nothing_and_weighs_it_
     assert got[0] == ref[0] and abs(got[0] - 3.0) <= 0.5
     np.testing.assert_array_equal(got[1], ref[1])
     np.testing.assert_array_equal(got[2], ref[2])
+
+
+def _record_case(n_runs, n_lines, seed):
+    """A context's few fields :func:`_record_bands` reads (2048-sample Welch bins of a 3840-Hz record, 40 bands of 8
+    bins from bin 4), and ``n_runs`` whole-run spectra of 8192 samples: complex Gaussian noise with lines of
+    ``n_lines`` random frequencies, each run's last wanted bin a 100x peak (its neighbours must not be dropped in the
+    next run), random bands wanted."""
+    from types import SimpleNamespace
+
+    n, fs = 8192, 3840.0
+    df = fs / 2048
+    ctx = SimpleNamespace(n_bands=40, k_lo=4, df=df, f=np.arange(1025) * df, sp=SimpleNamespace(window="hann"))
+    rng = np.random.default_rng(seed)
+    X = (rng.normal(size=(n_runs, n // 2 + 1)) + 1j * rng.normal(size=(n_runs, n // 2 + 1))) * 1e-3
+    need = rng.random((n_runs, ctx.n_bands)) < 0.3
+    need[:, 5] = True
+    lines = np.sort(rng.uniform(20.0, 700.0, (n_runs, n_lines)), axis=1)
+    A = rng.normal(size=(n_runs, n_lines)) + 1j * rng.normal(size=(n_runs, n_lines))
+    f = np.arange(n // 2 + 1) * fs / n
+    band = np.floor((f - (ctx.f[ctx.k_lo] - 0.5 * df)) / (8 * df)).astype(int)
+    for r in range(n_runs):
+        last = np.flatnonzero((band >= 0) & (band < ctx.n_bands) & need[r][np.clip(band, 0, ctx.n_bands - 1)])[-1]
+        X[r, last] *= 100.0
+    return ctx, n, fs, X, need, lines, A
+
+
+@pytest.mark.parametrize("n_lines, chunk", [(6, 1_000_000), (6, 2_000), (0, 1_000_000), (3, 1)])
+def test_record_bands_all_runs_at_once_are_each_run_alone(monkeypatch, n_lines, chunk):
+    """:func:`_record_bands` of 12 runs at once (in chunks of ``chunk`` bins x lines) gives each run, to the bit, the
+    numbers of that run alone: a peak at the end of one run's bins does not drop the first bins of the next."""
+    import rwadist.effects.broadband_floor_diagnose as bf
+
+    ctx, n, fs, X, need, lines, A = _record_case(12, n_lines, 7)
+    alone = [bf._record_bands(ctx, n, fs, X[r:r + 1], need[r:r + 1], lines[r:r + 1], A[r:r + 1]) for r in range(12)]
+    monkeypatch.setattr(bf, "RECORD_CHUNK_ELEMENTS", chunk)
+    mean, used = bf._record_bands(ctx, n, fs, X, need, lines, A)
+    assert used.sum() > 0 and np.all(used[~need] == 0)
+    for r in range(12):
+        np.testing.assert_array_equal(mean[r], alone[r][0][0])
+        np.testing.assert_array_equal(used[r], alone[r][1][0])

@@ -651,9 +651,12 @@ class Context(Metric):
     def offline_bands(self, state: State, c: str, runs: np.ndarray):
         """Mean PSD of the data less the model's lines (their kernel skirts) per band, over the bins away
         from every line (model lines ±LINE_HALF bins and residual peaks above a 1e-4 false-alarm
-        threshold ±2 bins): (value unit²/Hz, bins used) per run and band."""
+        threshold ±2 bins): (value unit²/Hz, bins used) per run and band; kept on the state, read-only."""
         from scipy import stats
 
+        key = ("offline_bands", c, runs.tobytes())
+        if key in state._cache:
+            return state._cache[key]
         P = self.predict(state, c, runs)
         D = self.data(state, c)[runs] - (P - self.floor_psd(state, c, runs))     # data less the model's lines
         mask = np.zeros(D.shape, bool)
@@ -694,8 +697,11 @@ class Context(Metric):
         keep = ~mask[:, lo:lo + n].reshape(runs.size, self.n_bands, BAND_BINS)
         vals = D[:, lo:lo + n].reshape(runs.size, self.n_bands, BAND_BINS)
         cnt = keep.sum(-1)
-        mean = np.where(cnt > 0, bin_sums(vals * keep) / np.maximum(cnt, 1), 0.0)
-        return mean, cnt.astype(float)
+        out = (np.where(cnt > 0, bin_sums(vals * keep) / np.maximum(cnt, 1), 0.0), cnt.astype(float))
+        for a in out:
+            a.flags.writeable = False
+        state._cache[key] = out
+        return out
 
 
     def measure_line(self, state: State, c: str, h: float, runs: np.ndarray, skip=None):

@@ -30,8 +30,8 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
     :data:`FLOOR_EXPONENTS`, n and g its weighted 2-parameter least squares per band in three passes of iteratively
     reweighted least squares, each pass weighted by that exponent's own previous expected values; p the exponent whose
     law is the likeliest, the smallest Whittle deviance Σ wt·(y/E + ln E) (a band mean of chi² bins of expected value
-    E), over the bands of positive mean level.  Every exponent is solved at once (arrays (P, runs, bands)): the same
-    numbers as one exponent at a time (tests/test_fast_paths_floor.py).
+    E), over the bands of positive mean level.  The exponents are solved a chunk at once (arrays (P, runs, bands),
+    :func:`_floor_laws`): the same numbers as one exponent at a time (tests/test_fast_paths_floor.py).
 
     Why each exponent its own weights and the likelihood: with the weights of the previous pass's best exponent shared
     by all, that exponent was a fixed point -- weights 1/E² of a steep law forgive the top speeds' scatter, so the
@@ -42,7 +42,33 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
     level = np.maximum(_band_levels(y, wt), 1e-300)
     # x = (Ω/Ω_ref)^p of every exponent at once (P, runs, 1), each power as ``x0[:, None] ** p`` computes it
     xs = np.stack([x0[:, None] ** p for p in FLOOR_EXPONENTS])
-    expected = np.broadcast_to(level, (len(FLOOR_EXPONENTS),) + y.shape)
+    use = np.sum(wt * y, 0) > 0
+    n, g, dev = (np.empty((len(FLOOR_EXPONENTS), y.shape[1])), np.empty((len(FLOOR_EXPONENTS), y.shape[1])),
+                 np.empty(len(FLOOR_EXPONENTS)))
+    # the exponents in chunks of about FLOOR_CHUNK_ELEMENTS (runs x bands) elements, each chunk's arrays in four buffers
+    # written in place (each exponent's numbers its own: the same operations in the same order as all at once, kept in
+    # cache)
+    step = max(1, FLOOR_CHUNK_ELEMENTS // max(y.size, 1))
+    bufs = [np.empty((min(step, len(FLOOR_EXPONENTS)),) + y.shape) for _ in range(4)]
+    for s in range(0, len(FLOOR_EXPONENTS), step):
+        k = min(step, len(FLOOR_EXPONENTS) - s)
+        n[s:s + k], g[s:s + k], dev[s:s + k] = _floor_laws(wt, y, xs[s:s + k], level, use, [b[:k] for b in bufs])
+    i = int(np.argmin(dev))                 # the first smallest
+    return FLOOR_EXPONENTS[i], n[i], g[i]
+
+
+#: Elements (runs x bands x exponents) of each of :func:`_floor_law`'s four working arrays: its exponents taken in
+#: chunks of this size (four arrays of 256 kB stay in a core's cache; all 31 exponents at once of 60 runs x 381 bands,
+#: 5.7 MB each, ran from memory at about twice the time)
+FLOOR_CHUNK_ELEMENTS = 32768
+
+
+def _floor_laws(wt, y, xs, level, use, bufs) -> tuple:
+    """(n (P, bands), g (P, bands), deviance (P,)) of :func:`_floor_law` for the exponents whose powers are ``xs``
+    (P, runs, 1) (``level`` (bands,) the bands' mean levels, ``use`` the bands of positive level; ``bufs`` four arrays
+    (P, runs, bands) to work in)."""
+    expected, wts, wx, tmp = bufs
+    expected[...] = level
     for _ in range(3):
         # weights: bins used / expected value² (a band mean of chi² bins has variance ∝ mean²/bins), each exponent's
         # re-estimated from its own previous pass (iteratively reweighted least squares)
@@ -53,24 +79,34 @@ def _floor_law(wt: np.ndarray, y: np.ndarray, x0: np.ndarray) -> tuple:
         # (a band of no positive mean level, held at 1e-300, can expect ~1e-150 or more after a pass: its ratio
         # squared overflows to inf and the band weighs 0 -- it holds no floor, and the deviance leaves it out too)
         with np.errstate(over="ignore"):
-            wts = wt / np.maximum(expected / level, 1e-3) ** 2
+            np.square(np.maximum(np.divide(expected, level, out=tmp), 1e-3, out=tmp), out=tmp)
+        np.divide(wt, tmp, out=wts)
         # weighted 2-parameter least squares per band and exponent: y = n + g·x (sums over the runs, axis 1)
-        wx = wts * xs
-        s0, s1, s2 = wts.sum(1), wx.sum(1), (wx * xs).sum(1)
-        t0, t1 = (wts * y).sum(1), (wx * y).sum(1)
+        np.multiply(wts, xs, out=wx)
+        s0, s1 = wts.sum(1), wx.sum(1)
+        s2 = np.multiply(wx, xs, out=tmp).sum(1)
+        t0 = np.multiply(wts, y, out=tmp).sum(1)
+        t1 = np.multiply(wx, y, out=tmp).sum(1)
         det = s0 * s2 - s1 * s1
         with np.errstate(divide="ignore", invalid="ignore"):
             g = np.maximum(np.where(det > 0, (s0 * t1 - s1 * t0) / det, 0.0), 0.0)
         n = np.where(s0 > 0, np.maximum((t0 - g * s1) / np.maximum(s0, 1e-300), 0.0), 0.0)
-        expected = np.maximum(n[:, None, :] + g[:, None, :] * xs, 1e-300)
+        # expected = max(n + g·x, 1e-300)
+        np.maximum(np.add(n[:, None, :], np.multiply(g[:, None, :], xs, out=expected), out=expected), 1e-300,
+                   out=expected)
     # the Whittle deviance of each exponent's law, over the bands whose mean level is positive (a band at or below the
     # model's line skirts holds no estimate of the floor), its expected value held at 1e-3 of the band's level or more
-    # (a law of zero noise where the data are not zero is that unlikely, not infinitely so)
-    use = np.sum(wt * y, 0) > 0
-    e_use = np.maximum(expected[:, :, use], 1e-3 * level[use])
-    dev = np.sum(wt[:, use] * (y[:, use] / e_use + np.log(e_use / level[use])), axis=(1, 2))
-    i = int(np.argmin(dev))                 # the first smallest
-    return FLOOR_EXPONENTS[i], n[i], g[i]
+    # (a law of zero noise where the data are not zero is that unlikely, not infinitely so):
+    # Σ wt·(y/E + ln(E/level)), in place in the buffers when every band is used
+    lu = level[use]
+    if use.all():
+        e_use, w_use, y_use, term = np.maximum(expected, 1e-3 * lu, out=expected), wt, y, tmp
+    else:
+        e_use, w_use, y_use = np.maximum(expected[:, :, use], 1e-3 * lu), wt[:, use], y[:, use]
+        term = np.empty(e_use.shape)
+    np.divide(y_use, e_use, out=term)
+    np.add(term, np.log(np.divide(e_use, lu, out=e_use), out=e_use), out=term)
+    return n, g, np.multiply(w_use, term, out=term).sum(axis=(1, 2))
 
 
 #: False-alarm probability of a residual peak on the whole-run spectrum (a line the state lacks): its bin and
@@ -114,9 +150,7 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
     the error metric.  No bin where the time series are unknown or lack the channel.  A whole-run bin has 2
     degrees of freedom (a Welch bin ctx.dof).  Each run's numbers are kept on the context (the data's and the
     lines', the same at every search step)."""
-    from ..dft import run_window
-    from ..diagnose.measure import hann_transform_ratio, record_dfts, state_line_freqs
-    from .missing_harmonic_diagnose import RECORD_MIN_BINS, RECORD_SEP_BINS
+    from ..diagnose.measure import record_dfts, state_line_freqs
 
     y = np.zeros((runs.size, ctx.n_bands))
     cnt_all = np.zeros((runs.size, ctx.n_bands))
@@ -130,53 +164,92 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
             if need[i].any() and keys[i] not in ctx._memo and c in ctx.test.runs[int(r)].signals]
     A = (record_dfts(ctx, [int(runs[i]) for i in todo], c, lines[todo]) if lines.shape[1] and todo
          else np.zeros((len(todo), 0), complex))
-    lo_edge = float(ctx.f[ctx.k_lo] - 0.5 * ctx.df)
-    band_w = BAND_BINS * ctx.df
-    thr = -np.log(RECORD_PEAK_FA)                # |X|² of complex Gaussian noise is exponential: P(> t·mean) = e^{-t}
     spectra = _record_spectra(ctx, c, [int(runs[i]) for i in todo])
+    groups: dict = {}                   # the runs to do by (record length, sample rate): one bin grid each
     for a, i in enumerate(todo):
         run = ctx.test.runs[int(runs[i])]
-        n, fs = run.n_samples, run.sample_rate
-        df_rec = fs / n
-        w, wsum, w2sum = run_window(ctx.sp.window, n)
-        X = spectra[a]
-        f = np.arange(X.size) * df_rec
-        band = np.floor((f - lo_edge) / band_w).astype(int)
-        sel = (f >= RECORD_MIN_BINS * df_rec) & (band >= 0) & (band < ctx.n_bands)
-        sel[sel] = need[i][band[sel]]
-        fk, Xk, band = f[sel], X[sel], band[sel]
-        keep = np.ones(fk.size, bool)
-        fl = lines[i]
-        if fl.size:
-            Xk = Xk - (hann_transform_ratio(n, (fk[:, None] - fl[None, :]) / df_rec) * A[a][None, :]
-                       + hann_transform_ratio(n, (fk[:, None] + fl[None, :]) / df_rec) * np.conj(A[a])[None, :]).sum(1)
-            keep = np.all(np.abs(fk[:, None] - fl[None, :]) >= RECORD_SEP_BINS * df_rec, axis=1)
-        P = np.abs(Xk) ** 2 * wsum**2 / (2.0 * fs * w2sum)
-        # a residual peak: above thr times the band's level (median of its bins clear of lines / ln 2); a peak's
-        # neighbours are neighbours on the record grid (the bins kept are contiguous within a band)
-        level = np.zeros(ctx.n_bands)
-        bk, pk = band[keep], P[keep]
-        if bk.size:
-            # each band's median (np.median's: the middle value, or the mean of the middle two) from one sort by band
-            # and value
-            srt = pk[np.lexsort((pk, bk))]
-            b_u, first, cnt_b = np.unique(bk, return_index=True, return_counts=True)
-            hi = first + cnt_b // 2
-            lo = np.where(cnt_b % 2 == 1, hi, hi - 1)
-            level[b_u] = (srt[lo] + srt[hi]) / 2.0 / np.log(2.0)
-        peak = P > thr * level[band]
-        wide = peak.copy()
-        for s_ in range(1, RECORD_PEAK_BINS + 1):
-            wide[s_:] |= peak[:-s_]
-            wide[:-s_] |= peak[s_:]
-        use = keep & ~wide
-        cnt = np.bincount(band[use], minlength=ctx.n_bands).astype(float)
-        tot = np.bincount(band[use], P[use], minlength=ctx.n_bands)
-        ctx._memo[keys[i]] = (np.where(cnt > 0, tot / np.maximum(cnt, 1.0), 0.0), cnt, df_rec)
+        groups.setdefault((run.n_samples, run.sample_rate), []).append(a)
+    for (n, fs), idx in groups.items():
+        rows = [todo[a] for a in idx]
+        got = _record_bands(ctx, n, fs, np.stack([spectra[a] for a in idx]), need[rows], lines[rows], A[idx])
+        for k, i in enumerate(rows):
+            ctx._memo[keys[i]] = (got[0][k], got[1][k], fs / n)
     for i in range(runs.size):
         if keys[i] in ctx._memo:
             y[i], cnt_all[i], df_all[i] = ctx._memo[keys[i]]
     return y, cnt_all, df_all
+
+
+#: Largest (record bins x lines) of the leakage of the lines :func:`_record_bands` evaluates at once (complex; the runs
+#: of one bin grid taken in chunks under it)
+RECORD_CHUNK_ELEMENTS = 1_000_000
+
+
+def _record_bands(ctx: Context, n: int, fs: float, X: np.ndarray, need: np.ndarray, lines: np.ndarray,
+                  A: np.ndarray) -> tuple:
+    """(mean PSD unit²/Hz, bins used), each (runs, n_bands), of :func:`record_offline_bands` for runs of one record
+    length ``n`` and sample rate ``fs``: ``X`` (runs, n//2 + 1) their whole-run spectra, ``need`` (runs, n_bands) the
+    bands wanted, ``lines`` (runs, L) Hz and ``A`` (runs, L) the lines' whole-run phasors.
+
+    Every run's bins at once (the bins kept of all the runs in one array, run by run, each run's in increasing
+    frequency; the runs in chunks of at most :data:`RECORD_CHUNK_ELEMENTS` bins x lines): each bin's numbers are those
+    of the run alone -- the same elementwise operations, each bin's leakage summed over its own lines, each band's
+    median and sums over its own bins in the same order (tests/test_fast_paths_floor.py)."""
+    from ..dft import run_window
+    from ..diagnose.measure import hann_transform_ratio
+    from .missing_harmonic_diagnose import RECORD_MIN_BINS, RECORD_SEP_BINS
+
+    nb = ctx.n_bands
+    df_rec = fs / n
+    _, wsum, w2sum = run_window(ctx.sp.window, n)
+    lo_edge = float(ctx.f[ctx.k_lo] - 0.5 * ctx.df)
+    band_w = BAND_BINS * ctx.df
+    thr = -np.log(RECORD_PEAK_FA)                # |X|² of complex Gaussian noise is exponential: P(> t·mean) = e^{-t}
+    f = np.arange(X.shape[1]) * df_rec
+    band = np.floor((f - lo_edge) / band_w).astype(int)
+    inside = (f >= RECORD_MIN_BINS * df_rec) & (band >= 0) & (band < nb)
+    sel = inside[None, :] & need[:, np.where(inside, band, 0)]          # (runs, bins) each run's bins in its bands
+    mean, used = np.zeros((X.shape[0], nb)), np.zeros((X.shape[0], nb))
+    per_run = sel.sum(1) * max(lines.shape[1], 1)
+    start = 0
+    while start < X.shape[0]:
+        stop = start + max(1, int(np.searchsorted(np.cumsum(per_run[start:]), RECORD_CHUNK_ELEMENTS, side="right")))
+        ri, ki = np.nonzero(sel[start:stop])
+        ri_abs = ri + start
+        fk, Xk, bk = f[ki], X[ri_abs, ki], band[ki]
+        keep = np.ones(fk.size, bool)
+        if lines.shape[1]:
+            fl, Ak = lines[ri_abs], A[ri_abs]
+            Xk = Xk - (hann_transform_ratio(n, (fk[:, None] - fl) / df_rec) * Ak
+                       + hann_transform_ratio(n, (fk[:, None] + fl) / df_rec) * np.conj(Ak)).sum(1)
+            keep = np.all(np.abs(fk[:, None] - fl) >= RECORD_SEP_BINS * df_rec, axis=1)
+        P = np.abs(Xk) ** 2 * wsum**2 / (2.0 * fs * w2sum)
+        # a residual peak: above thr times the band's level (median of its bins clear of lines / ln 2); a peak's
+        # neighbours are neighbours on the run's record grid (the bins kept are contiguous within a band)
+        key = ri * nb + bk                       # (run, band) of each bin, nondecreasing
+        level = np.zeros((stop - start) * nb)
+        kk, pk = key[keep], P[keep]
+        if kk.size:
+            # each band's median (np.median's: the middle value, or the mean of the middle two) from one sort by run,
+            # band and value
+            srt = pk[np.lexsort((pk, kk))]
+            k_u, first, cnt_b = np.unique(kk, return_index=True, return_counts=True)
+            hi = first + cnt_b // 2
+            lo = np.where(cnt_b % 2 == 1, hi, hi - 1)
+            level[k_u] = (srt[lo] + srt[hi]) / 2.0 / np.log(2.0)
+        peak = P > thr * level[key]
+        wide = peak.copy()
+        for s_ in range(1, RECORD_PEAK_BINS + 1):
+            same = ri[s_:] == ri[:-s_]
+            wide[s_:] |= peak[:-s_] & same
+            wide[:-s_] |= peak[s_:] & same
+        use = keep & ~wide
+        cnt = np.bincount(key[use], minlength=level.size).astype(float)
+        tot = np.bincount(key[use], P[use], minlength=level.size)
+        mean[start:stop] = np.where(cnt > 0, tot / np.maximum(cnt, 1.0), 0.0).reshape(-1, nb)
+        used[start:stop] = cnt.reshape(-1, nb)
+        start = stop
+    return mean, used
 
 
 @register(order=30)
