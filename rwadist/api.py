@@ -483,6 +483,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     ParameterError
         A value out of range; a model and a preset; base "extended" without the wheel's modes.
     """
+    from . import speed_whirl
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
@@ -495,9 +496,16 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         bearings = tuple(b if isinstance(b, Bearing) else parse_bearing(b, "diagnose", f"bearings[{i}]")
                          for i, b in enumerate(bearings))
     test = _as_test(data)
-    spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))
-    diagnosis = _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base,
-                          bearings=bearings)
+
+    def run(test, base_check):
+        spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))
+        return _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base, bearings=bearings,
+                         base_check=base_check)
+
+    # a speed from the data is tested by the wheel's gyroscopic whirl (and the data diagnosed again on the scale it
+    # supports); how the speed was obtained goes to the summary and the report
+    test, diagnosis = speed_whirl.settle(test, run)
+    diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None))
     reading = reading_provenance(getattr(test, "meta", None))
     if reading:
         diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(

@@ -16,11 +16,17 @@ therefore found in two steps that assume no line set:
    F_y lags F_x by 90°, |X + iY|² against |X − iY|²).  The imbalance is at exactly 1× the rotor speed, static
    in the radial force and dynamic in the radial torque, both turning with the rotor: the candidates are the
    lines with one sense in the radial-force pair and the same sense in the radial-torque pair (one pair when
-   only one is recorded).  Among them the 1× line is the one whose integer multiples 1..INTEGER_ORDERS (the
-   integer harmonics: misalignment, looseness) carry the most line strength -- the imbalance itself counted,
-   so a wheel with no 2× or 3× line still has its strongest such line; a bearing line's multiples are
-   non-integer in the rotor's units.  Its sense is the sign of the speed.  The other lines keep their ratios,
-   h_i = O_i/O_1.
+   only one is recorded).  Among them the 1× line is the one with the most integer multiples 1..INTEGER_ORDERS
+   among the lines found (the integer harmonics: misalignment, looseness; the imbalance itself counted); a
+   bearing line's multiples are non-integer in the rotor's units.  The count of lines, never their strength:
+   every clear line's strength saturates at L_CAP, and a summed strength flipped with the sweep's duration
+   (trial 11: a 300-s run-up took a ball-pass line at 3.6 with its 2× at 7.2 for the imbalance with its 2×,
+   summed strengths 11.93 against 11.89; every speed 3.6× too high).  Candidates with equally many multiples
+   tie: a ball-pass line with its harmonics lies above the rotor's fundamental, so the lowest is taken and the
+   others are kept (``tied``) for a second, physical test the data can give (the gyroscopic whirl of the
+   wheel's rocking mode reads I_zz/I_rr in proportion to the speed scale, :mod:`rwadist.speed_whirl`); a
+   cage line with a harmonic (below 1×) is what that test catches.  Its sense is the sign of the speed.  The
+   other lines keep their ratios, h_i = O_i/O_1.
 
 The caller (:func:`rwadist.sweep.estimate_speeds`) then refines each slice's speed on every line found, each
 at its own h_i, and reports how well they agree (:class:`SpeedScale`).
@@ -244,10 +250,27 @@ def pair_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray)
 
 
 def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tuple:
-    """(index of the 1× line, its sense ±1, evidence dict, reason text) among lines at relative orders
-    ``orders`` (linear) with template ``strength``; ``senses`` from :func:`pair_senses` ("F", "T" -> (co share,
-    snr)).  Candidates: one sense in every recorded radial pair, the same in all (module docstring);
-    with no such line, every line (said in the reason)."""
+    """The 1× line among the template's lines (module docstring, step 2).
+
+    Parameters
+    ----------
+    orders : ndarray (n,)
+        The lines' orders, linear, in the template's units (any common scale).
+    strength : ndarray (n,)
+        The lines' template strength (mean log content); a line of strength 0 (outside a given rpm range) is neither
+        a candidate nor a multiple.
+    senses : dict
+        :func:`pair_senses`'s output: "F", "T" -> (co share (n,), snr).
+
+    Returns
+    -------
+    tuple
+        (index of the 1× line, its sense ±1, evidence dict, reason text).  Candidates: one sense in every recorded
+        radial pair, the same in all; with no such line, every line (said in the reason).  The evidence holds the
+        line's order and multiples, its co shares, ``tied``: the other candidates with as many integer multiples
+        ({"h": ratio in units of the chosen line, "multiples_found"}; empty when the choice is unique), and
+        ``candidates``: every other candidate, the tied first, then by fewer multiples.
+    """
     share = {key: v[0] for key, v in senses.items()}
     n = orders.size
     sense = np.zeros(n)
@@ -264,19 +287,29 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
         cand = np.ones(n, dtype=bool)
         sense = np.ones(n)
         how = "no line with one rotation sense in the radial pairs: every line a candidate"
-    score = np.zeros(n)
-    multiples = []
+    seen = strength > 0
+    if (cand & seen).any():
+        cand &= seen
+    multiples = {}
     for c in np.flatnonzero(cand):
         ratio = orders / orders[c]
         k = np.rint(ratio)
-        hit = (k >= 1) & (k <= INTEGER_ORDERS) & (np.abs(ratio - k) <= INTEGER_TOL * np.maximum(k, 1))
-        score[c] = np.sum(strength[hit])
-        multiples.append((int(c), sorted(int(x) for x in k[hit])))
-    best = int(np.flatnonzero(cand)[np.argmax(score[cand])])
-    mult = dict(multiples)[best]
-    evidence = {"order": float(orders[best]), "multiples_found": mult,
+        hit = seen & (k >= 1) & (k <= INTEGER_ORDERS) & (np.abs(ratio - k) <= INTEGER_TOL * np.maximum(k, 1))
+        multiples[int(c)] = sorted({int(x) for x in k[hit]} | {1})
+    most = max(len(m) for m in multiples.values())
+    tied = sorted((c for c, m in multiples.items() if len(m) == most), key=lambda c: orders[c])
+    best = tied[0]
+    mult = multiples[best]
+    others = [{"h": float(orders[c] / orders[best]), "multiples_found": multiples[c]} for c in tied[1:]]
+    rest = sorted((c for c in multiples if c not in tied), key=lambda c: (-len(multiples[c]), orders[c]))
+    evidence = {"order": float(orders[best]), "multiples_found": mult, "tied": others,
+                "candidates": others + [{"h": float(orders[c] / orders[best]), "multiples_found": multiples[c]}
+                                        for c in rest],
                 **{f"co_share_{'force' if k == 'F' else 'torque'}": float(v[best]) for k, v in share.items()}}
     reason = f"the 1x line: {how}, with the most integer multiples (found {mult})"
+    if others:
+        reason += ("; as many for the line" + ("s" if len(others) > 1 else "") + " at h "
+                   + ", ".join(f"{o['h']:.4g}" for o in others) + ": the lowest taken")
     return best, float(sense[best]), evidence, reason
 
 

@@ -24,8 +24,11 @@ found from physics alone, assuming no line set:
    give ln|Ω| up to one constant.  The template's peaks are the wheel's lines;
    the 1× line is the imbalance -- one rotation sense in the radial force and
    the same in the radial torque (the static and dynamic imbalances turn with
-   the rotor), with the most line strength on its integer multiples (itself
-   included); every other line keeps its ratio h_i to it.
+   the rotor), with the most integer multiples among the lines (itself
+   included; a count, never a summed strength, which saturates and flipped
+   with the sweep's duration), the lowest of a tie, the others kept for the
+   gyroscopic whirl's test (:mod:`rwadist.speed_whirl`); every other line
+   keeps its ratio h_i to it.
 3. **Refinement.**  The lines near h_i·f0 are found and their frequencies
    refined with :func:`rwadist.spectra.find_lines` on P (log-parabolic
    interpolation on the zero-padded spectrum; P has no frequency-dependent

@@ -4,8 +4,8 @@ The issue's case: a wheel the project never saw (tests/family_wheel.py's wheel 0
 310/95/140 Hz; its bearing lines cage 0.385, BPFO 3.08, BPFI 4.92, 2xBSF 4.118 and no 2x or 3x radial line),
 600 <-> 6000 rpm in 60 s.  A harmonic comb (1, 2, 3, 4 x f0) read its ball-pass line 3.08 as 3x: every line came out
 2.6 % low (h 0.974, 2.9997, 4.79) and some lines twice.  The speed now comes from the line pattern moving
-rigidly in ln f and from the imbalance (one rotation sense in the radial force and torque, the most line
-strength on its integer multiples) being 1x.  Truth: the generator's speed profile (its own time integration
+rigidly in ln f and from the imbalance (one rotation sense in the radial force and torque, the most
+integer multiples among its lines) being 1x.  Truth: the generator's speed profile (its own time integration
 of the rotor's state equations), not anything rwadist computes.
 """
 import functools
@@ -110,7 +110,7 @@ def test_the_imbalance_is_the_line_with_one_sense_in_force_and_torque_and_intege
     torque = np.array([nan, 1.0, nan, 1.0, 0.2])
     senses = {"F": (force, None), "T": (torque, None)}
     best, sense, ev, why = sc.imbalance_line(orders, strength, senses)
-    assert best == 1 and sense == 1.0 and ev["multiples_found"] == [1, 2]     # 2 + 1.5 > 3.08's own 3
+    assert best == 1 and sense == 1.0 and ev["multiples_found"] == [1, 2]     # two multiples against 3.08's one
     # spinning about -z: every sense flipped, the same line, sense -1
     best, sense, _, _ = sc.imbalance_line(orders, strength, {"F": (1 - force, None), "T": (1 - torque, None)})
     assert best == 1 and sense == -1.0

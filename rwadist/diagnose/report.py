@@ -291,7 +291,12 @@ def write_report(diag: Diagnosis, out_dir) -> list:
           f"- narrow-line error (`{CONTRAST_METRIC}`: {summary['narrow_line_metric_definition']}) before / after: "
           f"{diag.contrast_error_before:.4g} / {diag.contrast_error_after:.4g}",
           f"- RMS-vs-speed relative error before / after: {diag.rms_error_before:.4g} / {diag.rms_error_after:.4g}",
-          f"- iterations: {diag.iterations}", "", "## Effects added", ""]
+          f"- iterations: {diag.iterations}", ""]
+    if diag.speed:
+        from ..speed_whirl import speed_lines
+
+        md += ["## Speed", ""] + [f"- {line}" for line in speed_lines(diag.speed)] + [""]
+    md += ["## Effects added", ""]
     from ..effects_text import describe_effect
 
     chosen = [h for h in diag.hypotheses if h.passed]

@@ -68,6 +68,8 @@ class Diagnosis:
     line_causes: list = field(default_factory=list)
     #: the wheel's bearings those causes were named from (:class:`rwadist.bearings.Bearing`)
     bearings: tuple = ()
+    #: how the runs' speeds were obtained (:func:`rwadist.speed_whirl.speed_record`; {} when not told)
+    speed: dict = field(default_factory=dict)
 
     @property
     def effects(self) -> list:
@@ -111,6 +113,7 @@ class Diagnosis:
             "unexplained": [u.to_json() for u in self.unexplained],
             "line_causes": list(self.line_causes),
             "bearings": [dict(vars(b)) for b in self.bearings],
+            "speed": dict(self.speed),
             "hypotheses": [effect_entry(h) for h in self.hypotheses],
         }
 
@@ -443,8 +446,18 @@ def fits_modes_from_data(model: WheelModel | None, base: str = "empirical", test
     return base == "auto" and resolve_base(model, base, test) == "empirical" and not _modes_off(test)
 
 
+class BaseRejected(Exception):
+    """The wheel's own suspension modes the search fitted from the data failed the caller's ``base_check``: the
+    search stopped there (``entry``: the ``suspension_modes`` record, :func:`effect_entry`)."""
+
+    def __init__(self, entry: dict):
+        super().__init__("the suspension modes fitted from the data failed the caller's check")
+        self.entry = entry
+
+
 def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float = 4.0, min_gain: float = 0.05,
-             max_iterations: int = 8, channels=None, test=None, base: str = "empirical", bearings=None) -> Diagnosis:
+             max_iterations: int = 8, channels=None, test=None, base: str = "empirical", bearings=None,
+             base_check=None) -> Diagnosis:
     """Greedy effect search on ``spectra`` starting from ``model`` (default: the empirical fit).
 
     k_sigma, min_gain : acceptance rule (docs/diagnose.md).  test : the SteadyTest ``spectra`` were
@@ -455,7 +468,10 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     otherwise empirical, and the search may move to the wheel's suspension modes fitted from the data); see
     :func:`resolve_base` and :func:`fits_modes_from_data`.  bearings : the wheel's bearings
     (:class:`rwadist.bearings.Bearing`), candidate causes of the lines (docs/diagnose.md, "Physical causes for
-    lines"); None: those of the model's ``wheel`` section, if any.
+    lines"); None: those of the model's ``wheel`` section, if any.  base_check : None, or a callable taking the
+    ``suspension_modes`` record (:func:`effect_entry`) the search fitted from the data, as soon as it is taken;
+    False stops the search with :class:`BaseRejected` (a speed scale from the data the wheel's whirl contradicts,
+    :mod:`rwadist.speed_whirl`: nothing after it is worth fitting on those speeds).
     Returns a :class:`Diagnosis` whose ``model`` carries the added harmonics in ``empirical`` and every
     effect in ``effects``.
     """
@@ -464,7 +480,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         from ..bearings import bearings_of
 
         bearings = bearings_of(getattr(model, "wheel", None) if given else None)
-    args = (spectra, model, k_sigma, min_gain, max_iterations, channels, test, base, bearings)
+    args = (spectra, model, k_sigma, min_gain, max_iterations, channels, test, base, bearings, base_check)
     diag = _search(*args)
     # a run-to-run change (a re-mounting, a range switch) left in the records is forced into classes and spoils the
     # wheel's modes: when one is described and the search added more than its base (or could not fit the modes), the
@@ -489,7 +505,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
 
 
 def _search(spectra: Spectra, model: WheelModel | None, k_sigma: float, min_gain: float, max_iterations: int,
-            channels, test, base: str, bearings, steps: dict | None = None) -> Diagnosis:
+            channels, test, base: str, bearings, base_check=None, steps: dict | None = None) -> Diagnosis:
     """:func:`diagnose` of its arguments, ``bearings`` resolved; ``steps`` (run index -> dB, or None): the common
     factor of those runs taken out of the records the search reads (:func:`rwadist.diagnose.describe.start`)."""
     given = model is not None
@@ -550,6 +566,8 @@ def _search(spectra: Spectra, model: WheelModel | None, k_sigma: float, min_gain
         best.passed = True
         state = applied                         # refit.apply(state), made by _no_worse
         best.effect = state.effects[-1]
+        if base_check is not None and best.effect.kind == "suspension_modes" and not base_check(effect_entry(best)):
+            raise BaseRejected(effect_entry(best))
         parts = getattr(refit, "parts", None)
         if parts:
             # an effect of several parts (a floor law of several channels, each channel's floor its own entry of the

@@ -1,0 +1,249 @@
+"""The gyroscopic whirl as a test of a speed taken from the data (issue 33, item 5).
+
+A sweep without a speed column gets its speed scale from its lines (:mod:`rwadist.speed_scale`): the 1× line is
+the line with one rotation sense in the radial pairs and the most integer multiples.  Two such lines can tie (a
+ball-pass line with its 2× against the imbalance with its 2×; a cage line with its 2× below them), and the data's
+lines alone cannot tell which is the rotor's: every ratio is self-consistent at any scale.  The wheel's rocking
+mode can.  Its whirl obeys I_rr·ω² − I_zz·Ω·ω − k_θ = 0: the gyroscopic term scales with the speed, so speeds k
+times the wheel's read an inertia ratio I_zz/I_rr k times too small (a line of the data at whirl rate ω = h·Ω is
+the same whatever the scale; the term I_zz·Ω·ω only keeps its value with I_zz/k).  And a rotor's ratio is bounded:
+
+* I_zz/I_rr <= 2 for any rigid body symmetric about its spin axis (I_zz = ∫(x² + y²) dm <= I_xx + I_yy = 2·I_rr,
+  equality for a thin disc), about its centre of mass; about any other point I_rr is larger and the ratio smaller;
+* a reaction wheel is a flywheel, its mass on a rim: I_zz/I_rr > 1 (1.2-2 for the wheels of the thesis and the
+  family; 1.8 for trial 11's).
+
+So when diagnose fitted the wheel's suspension modes (``suspension_modes``) on speeds from the data, a ratio
+outside [1, 2] widened by :data:`MARGIN` for the fit's error means the wrong line was taken as 1×: the candidate
+(of the speed scale's) that brings the ratio into the band is tried, the data diagnosed again with its speeds
+(every run's speed × its ratio h, every line's h ÷ h), and kept when the whirl then reads a ratio in the band.
+When the modes are not fitted, or no candidate brings the ratio into the band, the diagnosis says so and asks for
+a speed (tach) column; never silently.  What was done goes to the test's ``meta["slicing"]["speed_scale"]
+["whirl"]``, read by the report (:func:`speed_record`).
+
+Units: dimensionless ratios; speeds rad/s in the runs, rpm in ``meta``.
+"""
+from __future__ import annotations
+
+import copy
+from dataclasses import replace
+
+import numpy as np
+
+from .effects.suspension_modes import RIGID_INERTIA_RATIO
+
+#: a flywheel's polar inertia exceeds its transverse one: the lower end of the physical band of I_zz/I_rr
+FLYWHEEL_INERTIA_RATIO = 1.0
+#: relative widening of the band [FLYWHEEL_INERTIA_RATIO, RIGID_INERTIA_RATIO] for the fit's error (a candidate
+#: scale moves the ratio by the ratio of two lines, 1.5 or more apart for lines with the same count of multiples)
+MARGIN = 1.25
+#: most candidate scales diagnosed again
+MAX_TRIES = 2
+#: relative distance within which a ratio given to :func:`rescaled` is the candidate's line (the speed scale's lines
+#: are at least its INTEGER_TOL apart)
+SAME_LINE = 1e-3
+TACH_ADVICE = "record the wheel's speed (a tach or speed_rpm column) to be sure of it"
+
+
+def band() -> tuple:
+    """(lowest, highest) I_zz/I_rr a wheel's whirl may read before its speed scale is called wrong."""
+    return FLYWHEEL_INERTIA_RATIO / MARGIN, RIGID_INERTIA_RATIO * MARGIN
+
+
+def plausible(ratio: float | None) -> bool:
+    """True when the inertia ratio ``ratio`` (I_zz/I_rr, dimensionless) lies in :func:`band`."""
+    lo, hi = band()
+    return ratio is not None and lo <= ratio <= hi
+
+
+def _modes(diagnosis) -> dict | None:
+    """The ``suspension_modes`` entry a diagnosis fitted (its summary's effect record), or None."""
+    return next((e for e in diagnosis.summary()["effects"] if e.get("kind") == "suspension_modes"), None)
+
+
+def whirl_ratio(diagnosis) -> float | None:
+    """I_zz/I_rr of the ``suspension_modes`` a diagnosis fitted from the data, or None when it fitted none or the
+    data did not locate the rocking mode (its ratio is then no reading of the whirl)."""
+    e = _modes(diagnosis)
+    return None if e is None or "rocking" in (e.get("unconstrained") or ()) else float(e["inertia_ratio"])
+
+
+def fitted_ratio(diagnosis) -> float | None:
+    """I_zz/I_rr of the ``suspension_modes`` a diagnosis fitted, the rocking mode located or not, or None."""
+    e = _modes(diagnosis)
+    return None if e is None else float(e["inertia_ratio"])
+
+
+def data_scale(test) -> dict | None:
+    """The speed scale of a test sliced from a sweep with the speed from the data (``meta["slicing"]
+    ["speed_scale"]``, :meth:`rwadist.speed_scale.SpeedScale.to_meta`), or None."""
+    slicing = (getattr(test, "meta", None) or {}).get("slicing") or {}
+    scale = slicing.get("speed_scale")
+    return scale if slicing.get("speed_source") == "data" and isinstance(scale, dict) and scale.get("ratios") else None
+
+
+def rescaled(test, h: float):
+    """``test`` with the line at ratio ``h`` (of the current 1×) as the 1× line: every run's speed × h, the speed
+    scale's ratios ÷ h and the slices' speed spreads × h (a copy; ``test`` is left alone)."""
+    meta = copy.deepcopy(test.meta)
+    if abs(h - 1.0) <= SAME_LINE:
+        return type(test)(list(test.runs), meta)
+    sl = meta["slicing"]
+    sc = sl["speed_scale"]
+    sc["ratios"] = sorted(round(r / h, 6) for r in sc["ratios"])
+    one = sc.setdefault("one_x", {})
+    others = [{"h": c["h"] / h, "multiples_found": c.get("multiples_found", [])}
+              for c in one.get("candidates", []) if abs(c["h"] / h - 1.0) > SAME_LINE]
+    others.append({"h": 1.0 / h, "multiples_found": one.get("multiples_found", [])})
+    moved: dict = next((c for c in one.get("candidates", []) if abs(c["h"] / h - 1.0) <= SAME_LINE), {})
+    one["candidates"] = others
+    one["tied"] = [c for c in others if len(c["multiples_found"]) == len(moved.get("multiples_found", []))]
+    one["multiples_found"] = moved.get("multiples_found", [])
+    if "order" in one and one["order"] is not None:
+        one["order"] = one["order"] * h
+    if "min_speed_rpm" in sl:
+        sl["min_speed_rpm"] = sl["min_speed_rpm"] * h
+    if "speed_spread_rpm" in sl:
+        sl["speed_spread_rpm"] = [v * h for v in sl["speed_spread_rpm"]]
+    return type(test)([replace(r, speed=r.speed * h) for r in test.runs], meta)
+
+
+def _ratio_of(entry: dict) -> tuple:
+    """(I_zz/I_rr, rocking located) of a ``suspension_modes`` record."""
+    return float(entry["inertia_ratio"]), "rocking" not in (entry.get("unconstrained") or ())
+
+
+def check(entry: dict) -> bool:
+    """``base_check`` of :func:`rwadist.diagnose.diagnose`: False when the suspension modes fitted on a speed scale
+    from the data read I_zz/I_rr outside :func:`band` (the wrong line taken as 1×: stop there)."""
+    return plausible(_ratio_of(entry)[0])
+
+
+def settle(test, run) -> tuple:
+    """(test, diagnosis) of a test after the whirl's test of a speed scale from the data (module docstring).
+
+    Parameters
+    ----------
+    test : rwadist.data.SteadyTest
+        The test; its ``meta["slicing"]["speed_scale"]`` (that of the test kept) gets the record ``whirl``.
+    run : callable
+        ``run(test, base_check) -> Diagnosis``: the diagnosis of a test (:func:`rwadist.diagnose.diagnose` with
+        that ``base_check``; it raises :class:`rwadist.diagnose.search.BaseRejected` when the check fails).
+
+    Returns
+    -------
+    tuple
+        (test, diagnosis): the given test's, or those of the candidate scale the whirl supports.  A test whose speeds
+        are not from the data is diagnosed as it is.
+    """
+    from .diagnose.search import BaseRejected
+
+    scale = data_scale(test)
+    if scale is None:
+        return test, run(test, None)
+    lo, hi = band()
+    rec: dict = {"band": [lo, hi]}
+    try:
+        diagnosis = run(test, check)
+    except BaseRejected as exc:
+        rho = _ratio_of(exc.entry)[0]
+    else:
+        return test, _judged(test, scale, diagnosis, rec)
+    # the wrong line taken as 1x: the candidates whose scale puts the ratio in the band, those with the most integer
+    # multiples first (the lines' own evidence), then the nearest to the band's middle (a fitted ratio may sit at its
+    # bound: trial 11's cage line with its 2x taken as 1x read 3.0 for 4.4, which put the 0.82 line (one multiple)
+    # nearer than the imbalance (two))
+    one = scale.get("one_x") or {}
+    mid = (lo * hi) ** 0.5
+    cands = [(c["h"], len(c.get("multiples_found") or ())) for c in one.get("candidates", [])
+             if plausible(rho / c["h"])]
+    tried = []
+    for h in [h for h, _ in sorted(cands, key=lambda c: (-c[1], abs(np.log(rho / c[0] / mid))))][:MAX_TRIES]:
+        t2 = rescaled(test, h)
+        try:
+            d2 = run(t2, check)
+        except BaseRejected as exc:
+            tried.append(f"h {h:.4g}: I_zz/I_rr {_ratio_of(exc.entry)[0]:.3g}")
+            continue
+        rho2 = whirl_ratio(d2)
+        tried.append(f"h {h:.4g}: I_zz/I_rr {rho2:.3g}" if rho2 is not None else f"h {h:.4g}: rocking not located")
+        if plausible(rho2):
+            sc2 = t2.meta["slicing"]["speed_scale"]
+            sc2["method"] = (f"{scale.get('method', 'speed from the data')}; then the 1x line moved to the line at h "
+                             f"{h:.4g} of it by the gyroscopic whirl")
+            sc2["whirl"] = dict(rec, status="moved", inertia_ratio=rho2, rocking_located=True,
+                                rejected={"inertia_ratio": rho, "h": 1.0 / h},
+                                text=(f"with the first line taken as 1x the gyroscopic whirl read I_zz/I_rr {rho:.3g}, "
+                                      f"outside {lo:.2g}-{hi:.2g} (no rigid rotor exceeds 2; a flywheel is above 1); "
+                                      f"with the line at h {h:.4g} of it as 1x it reads {rho2:.3g}: that line is "
+                                      "the 1x line, every speed and ratio rescaled by it"))
+            return t2, d2
+    diagnosis = run(test, None)
+    scale["whirl"] = dict(rec, status="disagrees", inertia_ratio=rho, rocking_located=whirl_ratio(diagnosis) is not None,
+                          text=(f"the gyroscopic whirl reads I_zz/I_rr {rho:.3g}, outside {lo:.2g}-{hi:.2g} (no rigid "
+                                "rotor exceeds 2; a flywheel is above 1)"
+                                + (f"; candidate scales tried: {'; '.join(tried)}" if tried else
+                                   "; no other 1x candidate brings it into the band")),
+                          warning="the speed scale from the data is suspect: " + TACH_ADVICE)
+    return test, diagnosis
+
+
+def _judged(test, scale: dict, diagnosis, rec: dict):
+    """``diagnosis``, its whirl's verdict on the speed scale (which passed :func:`check`) written to ``scale``."""
+    one = scale.get("one_x") or {}
+    tied = [c["h"] for c in one.get("tied", [])]
+    lo, hi = band()
+    rho, rho_any = whirl_ratio(diagnosis), fitted_ratio(diagnosis)
+    rec.update(inertia_ratio=rho_any, rocking_located=rho is not None)
+    if plausible(rho):
+        rec["status"] = "agrees"
+        rec["text"] = (f"the gyroscopic whirl reads I_zz/I_rr {rho:.3g}, within {lo:.2g}-{hi:.2g} (a flywheel's "
+                       f"1-2, widened by the fit's error): the 1x line stands")
+    else:
+        rec["status"] = "untested"
+        rec["text"] = ("the wheel's rocking mode was not " + ("fitted" if rho_any is None else "located")
+                       + ", so its gyroscopic whirl could not test the speed scale")
+        if tied:
+            rec["warning"] = ("the data cannot tell the 1x line: the line" + ("s" if len(tied) > 1 else "")
+                              + " at h " + ", ".join(f"{h:.4g}" for h in tied) + " of the one taken "
+                              + ("have" if len(tied) > 1 else "has") + " as many integer multiples, and every "
+                              "ratio holds at either scale (speeds and ratios off by that factor); " + TACH_ADVICE)
+    scale["whirl"] = rec
+    return diagnosis
+
+
+def speed_record(meta) -> dict:
+    """How the runs' speeds were obtained, for summary.json and report.md: ``source`` "measured" (a steady test's
+    speeds as given), "tach" (a sweep's tach column) or "data" (with the speed scale of
+    :meth:`rwadist.speed_scale.SpeedScale.to_meta`: method, ratios, the 1× line's evidence, agreement, the whirl's
+    test, a warning when the speed is suspect)."""
+    slicing = (meta or {}).get("slicing")
+    if not isinstance(slicing, dict):
+        return {"source": "measured", "method": "the runs' speeds as given (runs.csv speed_rpm)"}
+    if slicing.get("speed_source") != "data":
+        return {"source": "tach", "method": "each slice's mean of the sweep's speed (tach) column"}
+    sc = slicing.get("speed_scale") or {}
+    whirl = sc.get("whirl") or {}
+    out = {"source": "data", "method": sc.get("method", "speed from the data"), "ratios": sc.get("ratios", []),
+           "one_x": sc.get("one_x", {}), "agreement_rel_rms": sc.get("agreement_rel_rms"), "whirl": whirl}
+    if whirl.get("warning"):
+        out["warning"] = whirl["warning"]
+    return out
+
+
+def speed_lines(record: dict) -> list:
+    """Lines of text (report.md, the console) of :func:`speed_record`'s ``record``."""
+    if not record:
+        return []
+    if record.get("source") != "data":
+        return [f"speed: {record.get('method')}"]
+    agree = record.get("agreement_rel_rms")
+    out = [str(record.get("method"))
+           + (f"; ratios {', '.join(f'{h:.4g}' for h in record.get('ratios', []))}" if record.get("ratios") else "")
+           + (f"; the lines agree with the speed to {100 * agree:.3f} % RMS" if agree is not None else "")]
+    whirl = record.get("whirl") or {}
+    if whirl.get("text"):
+        out.append(f"speed check: {whirl['text']}")
+    if record.get("warning"):
+        out.append(f"warning: {record['warning']}")
+    return out

@@ -1,0 +1,167 @@
+"""Which line of a sweep without a speed column is 1x (issue 33, item 5; trial 11's fault).
+
+Trial 11 (an independent generator, its sweep physics copied into tests/trial_wheel.py): a wheel with lines at h
+0.41, 1, 2, 3.6 and 7.2, the 1x and the ball-pass line 3.6 both co-rotating in the radial force and torque, each
+with its 2x.  The speed scale took the line whose integer multiples carried the most *summed template strength*;
+every clear line's strength saturates, so the choice flipped with the sweep's duration: 300-s run-ups took 3.6 as
+1x (speeds 3.6x too high, I_zz/I_rr 0.48).  Now the count of multiples decides, the lowest of a tie is taken, and
+when diagnose fits the wheel's suspension modes the gyroscopic whirl must read a physical I_zz/I_rr
+(:mod:`rwadist.speed_whirl`), else the candidate scale it supports is diagnosed.  Truth: the generator's speed.
+"""
+import functools
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import trial_wheel as tw  # noqa: E402
+
+from rwadist import speed_scale as sc  # noqa: E402
+from rwadist import speed_whirl as sw  # noqa: E402
+from rwadist.data import Sweep  # noqa: E402
+from rwadist.sweep import slice_sweep  # noqa: E402
+
+TRUE_H = (0.41, 1.0, 2.0, 3.6, 7.2)
+
+
+@functools.lru_cache(maxsize=None)
+def _sliced(duration: float, modes: bool = True, rpm=(300.0, 4500.0)):
+    """(sliced test, slice infos, true speed rad/s per sample) of trial 11's wheel swept in ``duration`` s."""
+    t, ch, omega = tw.sweep(rpm[0], rpm[1], duration, tw.LINES, modes=modes)
+    sweep = Sweep(time=t, signals={c: ch[j] for j, c in enumerate(tw.CHANNELS)}, sample_rate=tw.FS, tach=None)
+    test, infos = slice_sweep(sweep, speed_source="data")
+    return test, infos, omega
+
+
+def test_saturated_strengths_do_not_choose_the_one_x_line():
+    """The template strengths trial 11's 300-s run-up measured (every line near the cap L_CAP = 6): the summed
+    strength of 3.6's multiples (5.976 + 5.951) beat the imbalance's (6.0 + 5.891) and 3.6 was taken.  Both have
+    two integer multiples: the lowest is 1x, and the other is kept as tied."""
+    orders = np.array([1.0, 2.439, 4.878, 8.7805, 17.5608])
+    strength = np.array([5.659, 6.0, 5.891, 5.976, 5.951])
+    nan = np.nan
+    senses = {"F": (np.ones(5), None), "T": (np.array([nan, 1.0, nan, 1.0, 0.0]), None)}
+    best, sense, ev, why = sc.imbalance_line(orders, strength, senses)
+    assert best == 1 and sense == 1.0 and ev["multiples_found"] == [1, 2]
+    assert [round(c["h"], 3) for c in ev["tied"]] == [3.6] and "the lowest taken" in why
+
+
+@pytest.mark.parametrize("rpm", [(300.0, 4500.0), (4500.0, 300.0)])
+def test_ball_pass_line_with_its_harmonic_is_not_taken_for_the_imbalance(rpm):
+    """Trial 11's wheel swept 300 <-> 4500 rpm in 30 s, no speed column: every slice's speed within 0.2 % of the
+    generator's where the speed changes by less than 5 % over the slice (median of all within 0.05 %), every line of the speed scale above h 0.3 within 0.1 % of a true ratio and
+    each true line found (before: every speed 3.6x too high, ratios 0.1139, 0.2778, 0.5556, 1, 2)."""
+    test, infos, omega = _sliced(30.0, rpm=rpm)
+    est = np.array([i.speed for i in infos])
+    truth = np.array([omega[i.start:i.stop].mean() for i in infos])
+    change = np.array([np.ptp(omega[i.start:i.stop]) for i in infos]) / truth
+    err = np.abs(est / truth - 1)
+    # the slowest slices of a 30-s sweep change speed by 10 % or more over their length and are smeared
+    assert np.max(err[change < 0.05]) < 0.002 and np.median(err) < 0.0005
+    scale = test.meta["slicing"]["speed_scale"]
+    ratios = [h for h in scale["ratios"] if h > 0.3]
+    for h in ratios:
+        assert min(abs(h / t - 1) for t in TRUE_H) < 0.001, h
+    for t in TRUE_H:
+        assert min(abs(h / t - 1) for h in ratios) < 0.001, t
+    assert [round(c["h"], 2) for c in scale["one_x"]["tied"]] == [3.6]
+
+
+def test_rescaled_moves_every_speed_and_ratio_by_the_candidates_ratio():
+    """Taking the line at h 3.6 as 1x multiplies every run's speed by 3.6 and divides every ratio by it (the
+    speed scale's own ratios: the sweep is sliced once); the original 1x is then the candidate at h 1/3.6 with its
+    multiples, and taking it back restores the speeds."""
+    test, _, _ = _sliced(30.0)
+    wrong = sw.rescaled(test, 3.6)
+    assert wrong.speeds == pytest.approx(3.6 * test.speeds, rel=1e-12)
+    assert sorted(wrong.meta["slicing"]["speed_scale"]["ratios"]) == pytest.approx(
+        sorted(h / 3.6 for h in test.meta["slicing"]["speed_scale"]["ratios"]), abs=1e-6)       # rounded to 1e-6
+    one = wrong.meta["slicing"]["speed_scale"]["one_x"]
+    back = [c for c in one["candidates"] if abs(c["h"] * 3.6 - 1) < 1e-3]
+    assert back and back[0]["multiples_found"] == [1, 2] and one["multiples_found"] == [1, 2]
+    assert sw.rescaled(wrong, back[0]["h"]).speeds == pytest.approx(test.speeds, rel=1e-5)
+    assert 1.0 in test.meta["slicing"]["speed_scale"]["ratios"]      # the original left alone
+
+
+def test_settle_follows_the_whirl_and_says_when_it_cannot():
+    """:func:`rwadist.speed_whirl.settle` with a stand-in diagnosis whose whirl reads I_zz/I_rr = 1.8 x (true
+    speed / speed given), as I_rr·ω² − I_zz·Ω·ω − k_θ = 0 does: taking 3.6 as 1x it reads 0.5, is rejected, and
+    the candidate that brings the ratio into [0.8, 2.5] is diagnosed and kept; a wheel whose modes are not fitted
+    keeps the tie's lowest with a warning naming the tied line and asking for a speed column."""
+    from rwadist.diagnose.search import BaseRejected
+
+    test, _, _ = _sliced(30.0)
+    true_speeds = test.speeds
+
+    class Fake:
+        def __init__(self, ratio):
+            self.entry = {"kind": "suspension_modes", "inertia_ratio": ratio, "unconstrained": []}
+
+        def summary(self):
+            return {"effects": [self.entry]}
+
+    def run(t, check):
+        e = Fake(round(1.8 * float(np.median(true_speeds / t.speeds)), 2))
+        if check is not None and not check(e.entry):
+            raise BaseRejected(e.entry)
+        return e
+
+    kept, diag = sw.settle(sw.rescaled(test, 3.6), run)
+    whirl = kept.meta["slicing"]["speed_scale"]["whirl"]
+    assert whirl["status"] == "moved" and whirl["rejected"]["inertia_ratio"] == 0.5
+    assert kept.speeds == pytest.approx(true_speeds, rel=1e-5) and diag.entry["inertia_ratio"] == 1.8
+    kept, _ = sw.settle(test, run)
+    assert kept.meta["slicing"]["speed_scale"]["whirl"]["status"] == "agrees"
+
+    class NoModes:
+        def summary(self):
+            return {"effects": []}
+
+    kept, _ = sw.settle(sw.rescaled(test, 1.0), lambda t, check: NoModes())
+    rec = sw.speed_record(kept.meta)
+    assert rec["source"] == "data" and rec["whirl"]["status"] == "untested"
+    assert "3.6" in rec["warning"] and "tach" in rec["warning"]
+    assert sw.speed_record({})["source"] == "measured"
+
+
+def test_report_says_how_the_speed_was_obtained(tmp_path):
+    """Hard-mounted (no modes: nothing the whirl can read) 30-s run-up of trial 11's wheel: diagnose's summary.json
+    and report.md say the speed came from the data, which line is 1x, the ratios, the agreement and that the data
+    cannot tell 1 from 3.6 (a tach asked for); the model's imbalance at h 1."""
+    from rwadist import api
+    from rwadist.diagnose import write_report
+
+    test, _, _ = _sliced(30.0, modes=False)
+    diag = api.diagnose(test)
+    speed = diag.summary()["speed"]
+    assert speed["source"] == "data" and speed["one_x"]["multiples_found"] == [1, 2]
+    assert 0 < speed["agreement_rel_rms"] < 0.02 and speed["whirl"]["status"] == "untested"
+    assert "3.6" in speed["warning"]
+    write_report(diag, tmp_path)
+    md = (tmp_path / "report.md").read_text()
+    assert "## Speed" in md and "the 1x line" in md and "agree with the speed" in md and "tach" in md
+    assert any(abs(x.h - 1.0) < 0.002 for x in diag.model.harmonics("radial_force"))
+
+
+@pytest.mark.slow
+def test_whirl_brings_back_the_imbalance_from_a_wrong_scale():
+    """Trial 11's wheel (modes 140/70/260 Hz, I_zz/I_rr 1.8) swept in 30 s with its speeds given 3.6x too high (the
+    ball-pass line as 1x, as before): the whirl of the fitted modes reads about 0.5, the 1x line is moved back to the
+    imbalance, and the diagnosis is the clean one: I_zz/I_rr within 3 % of 1.8, every mode within 2 %, the speeds
+    those of the data's scale again (the generator's: median within 0.05 %)."""
+    from rwadist import api
+
+    test, infos, omega = _sliced(30.0)
+    diag = api.diagnose(sw.rescaled(test, 3.6))
+    speed = diag.summary()["speed"]
+    assert speed["whirl"]["status"] == "moved" and speed["whirl"]["rejected"]["inertia_ratio"] < 0.8
+    modes = next(e for e in diag.summary()["effects"] if e["kind"] == "suspension_modes")
+    assert modes["inertia_ratio"] == pytest.approx(tw.RATIO, rel=0.03)
+    for key, f in (("radial_translation_Hz", tw.F_R), ("rocking_Hz", tw.F_T), ("axial_Hz", tw.F_Z)):
+        assert modes[key] == pytest.approx(f, rel=0.02), key
+    truth = np.array([omega[i.start:i.stop].mean() for i in infos])          # the runs' order
+    assert diag.ctx.test.speeds == pytest.approx(test.speeds, rel=1e-5)
+    assert np.median(np.abs(diag.ctx.test.speeds / truth - 1)) < 0.0005
