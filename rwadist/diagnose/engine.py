@@ -703,7 +703,6 @@ class Context(Metric):
         state._cache[key] = out
         return out
 
-
     def measure_line(self, state: State, c: str, h: float, runs: np.ndarray, skip=None):
         """Amplitude (unit) of a line h in the data of ``runs`` less everything else the state
         predicts (other lines, floors); NaN where the line is out of band or not above noise."""
@@ -723,9 +722,7 @@ class Context(Metric):
         # 3 standard deviations of the window's noise power: std of a bin mean·sqrt(2/ν), summed
         # over the window's bins with a factor 2 for the Hann correlation of neighbouring bins
         sig = 3.0 * 2.0 * noise * np.sqrt(2.0 / self.dof) / np.sqrt(2 * LINE_HALF + 1)
-        amp = np.where(inband & (p > sig), np.sqrt(2 * np.maximum(p, 0)), np.nan)
-        return amp
-
+        return np.where(inband & (p > sig), np.sqrt(2 * np.maximum(p, 0)), np.nan)
 
     def measure_lines(self, state: State, c: str, runs: np.ndarray) -> np.ndarray:
         """:meth:`measure_line` of every line h of :meth:`channel_lines` against all the others (``skip=h``), one row
@@ -770,7 +767,6 @@ class Context(Metric):
         noise = self.floor_psd(state, c, runs)[rows, k].sum(-1) * self.df
         sig = 3.0 * 2.0 * noise * np.sqrt(2.0 / self.dof) / np.sqrt(2 * LINE_HALF + 1)
         return np.where(inband & (p > sig), np.sqrt(2 * np.maximum(p, 0)), np.nan)
-
 
 
 def initial_state(ctx: Context, model: WheelModel, ext_params=None) -> State:
