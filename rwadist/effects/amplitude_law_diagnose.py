@@ -119,7 +119,7 @@ class AmplitudeLaw:
         and an amplitude law was named (Ω^2.103 on every run), where ROSS's imbalance force is exactly U_s·Ω²; on the
         runs the stand does not reach (below ~55 Hz) the same line reads Ω^2.04 ± 0.01, not told from 2.
 
-        Where the stand leaves too few runs to fit the exponent on (``beyond_stand`` (nan, nan)), only the exponent
+        Where the stand leaves too few runs to fit the exponent on (``beyond_stand``'s exponent and standard error NaN), only the exponent
         over every run is judged: a stand whose gain stays off 1 far above it (a transmissibility, gain above ~0:
         the force through a fixture spring) reaches a line at every speed above ~1.5 f_r, and a law of the source
         there would never be named (family wheel 6, its Ω³ BPFO line beside such a stand at 112 Hz: Ω^3.011 ± 0.004
