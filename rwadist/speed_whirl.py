@@ -64,14 +64,8 @@ def _modes(diagnosis) -> dict | None:
 def whirl_ratio(diagnosis) -> float | None:
     """I_zz/I_rr of the ``suspension_modes`` a diagnosis fitted from the data, or None when it fitted none or the
     data did not locate the rocking mode (its ratio is then no reading of the whirl)."""
-    e = _modes(diagnosis)
-    return None if e is None or "rocking" in (e.get("unconstrained") or ()) else float(e["inertia_ratio"])
-
-
-def fitted_ratio(diagnosis) -> float | None:
-    """I_zz/I_rr of the ``suspension_modes`` a diagnosis fitted, the rocking mode located or not, or None."""
-    e = _modes(diagnosis)
-    return None if e is None else float(e["inertia_ratio"])
+    ratio, located = _ratio_of(_modes(diagnosis))
+    return ratio if located else None
 
 
 def data_scale(test) -> dict | None:
@@ -108,8 +102,10 @@ def rescaled(test, h: float):
     return type(test)([replace(r, speed=r.speed * h) for r in test.runs], meta)
 
 
-def _ratio_of(entry: dict) -> tuple:
-    """(I_zz/I_rr, rocking located) of a ``suspension_modes`` record."""
+def _ratio_of(entry: dict | None) -> tuple:
+    """(I_zz/I_rr, rocking located) of a ``suspension_modes`` record; (None, False) for no record."""
+    if entry is None:
+        return None, False
     return float(entry["inertia_ratio"]), "rocking" not in (entry.get("unconstrained") or ())
 
 
@@ -193,8 +189,9 @@ def _judged(test, scale: dict, diagnosis, rec: dict):
     one = scale.get("one_x") or {}
     tied = [c["h"] for c in one.get("tied", [])]
     lo, hi = band()
-    rho, rho_any = whirl_ratio(diagnosis), fitted_ratio(diagnosis)
-    rec.update(inertia_ratio=rho_any, rocking_located=rho is not None)
+    rho_any, located = _ratio_of(_modes(diagnosis))
+    rho = rho_any if located else None
+    rec.update(inertia_ratio=rho_any, rocking_located=located)
     if plausible(rho):
         rec["status"] = "agrees"
         rec["text"] = (f"the gyroscopic whirl reads I_zz/I_rr {rho:.3g}, within {lo:.2g}-{hi:.2g} (a flywheel's "
