@@ -288,10 +288,15 @@ def test_run_change_flags_the_switched_runs_and_not_a_resonance_crossing():
     assert u.level_dB == pytest.approx(3.5, abs=0.1)
     # one factor on a few runs, the others on their trend: a step, its causes (a re-mounting, a range) first
     assert u.parameters["pattern"] == "step" and "re-mounted" in u.causes[0]
+    # the words carry the step's sign: every changed run up reads "+", down "−", both ways "±"
+    assert u.strength().startswith("the changed runs +3.") and "±" not in u.text()
+    (d,) = run_change(ctx, ratios(q - 3.5 * stepped), shares)
+    assert d.strength().startswith("the changed runs −3.") and d.level_dB == pytest.approx(3.5, abs=0.1)
     # re-mountings going opposite ways (runs 1, 7, 13, 19 +3.5 dB; 4, 10, 16 -3.5 dB), the others on trend: a step
     (s,) = run_change(ctx, ratios(q + 3.5 * (run % 6 == 1) - 3.5 * (run % 6 == 4)), shares)
     assert len(s.parameters["runs"]) == 7
     assert s.parameters["pattern"] == "step" and "re-mounted" in s.causes[0]
+    assert s.strength().startswith("the changed runs ±3.")
     # the runs recorded in shuffled speed order, the gain drifting 0.15 dB a run: a spread, the drift named first
     order = np.random.default_rng(3).permutation(R)
     (v,) = run_change(ctx, ratios(q + 0.15 * order[run]), shares)

@@ -46,7 +46,7 @@ SIGNATURES = {
 #: How ``level_dB`` reads for the signatures whose level is not the data over the model in their cells.
 LEVEL_WORDS = {
     "broadband_hump": "{:+.1f} dB over the floor's smooth course",
-    "run_change": "the changed runs ±{:.2f} dB off the others",
+    "run_change": "the changed runs {} dB off the others",
 }
 
 
@@ -137,7 +137,20 @@ class Unexplained:
 
     def strength(self) -> str:
         """``level_dB`` in words: over the model, or (:data:`LEVEL_WORDS`) what it is for the signature."""
+        if self.signature == "run_change":
+            return LEVEL_WORDS["run_change"].format(self._run_change_level())
         return LEVEL_WORDS.get(self.signature, "{:+.1f} dB over the model").format(self.level_dB)
+
+    def _run_change_level(self) -> str:
+        """A run_change's level with its sign: "+3.52" when every changed run is up, "−3.52" when every one is down,
+        "±3.52" when they go both ways (``parameters["run_offsets_dB"]``; "±" when not recorded)."""
+        offsets = [x for x in (self.parameters.get("run_offsets_dB") or []) if x is not None and math.isfinite(x)]
+        sign = "±"
+        if offsets and all(x > 0 for x in offsets):
+            sign = "+"
+        elif offsets and all(x < 0 for x in offsets):
+            sign = "−"
+        return f"{sign}{abs(self.level_dB):.2f}"
 
     def text(self) -> str:
         """The console's one line: signature, where, strength, share, the first cause and what would tell."""
