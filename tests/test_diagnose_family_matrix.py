@@ -9,6 +9,7 @@ within 2 %, nothing else added, the error within 5x the clean cell's.  Family wh
 2790 rpm): the modes within 2 % and the stand named, nothing else added (no mode was named before the modes were
 judged beside the stand fitted with them).
 """
+import csv
 import sys
 from pathlib import Path
 
@@ -194,6 +195,13 @@ def test_a_floor_of_the_rotor_forces_split_over_three_channels_is_found_at_its_l
     model = json.loads((tmp_path / "w4_broadband_floor" / "report" / "model.json").read_text())
     floors = {e["channel"][0]: e for e in model["effects"] if e["kind"] == "broadband_floor"}
     assert set(floors) == {"Fx", "Fy", "Fz"} and all(len(e["channel"]) == 1 for e in floors.values())
+    # the search passed the three parts as one hypothesis (Hypothesis.group, wired in search._search): its held-out
+    # gain written once in hypotheses.csv, each part's row marked part_of the group's channels
+    with open(tmp_path / "w4_broadband_floor" / "report" / "hypotheses.csv") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["kind"] == "broadband_floor" and r["passed"] == "True"]
+    assert sorted(r["channels"] for r in rows) == ["Fx", "Fy", "Fz"]
+    assert all("part_of=Fx Fy Fz" in r["parameters"] for r in rows)
+    assert sum(r["heldout_gain"] != "" for r in rows) == 1
     for c, e in floors.items():
         assert abs(e["exponent"] - floor.params["exponent"]) <= 0.25, (c, e["exponent"])
         f = np.asarray(e["f_Hz"])
