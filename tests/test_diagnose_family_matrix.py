@@ -202,6 +202,9 @@ def test_a_floor_of_the_rotor_forces_split_over_three_channels_is_found_at_its_l
     assert sorted(r["channels"] for r in rows) == ["Fx", "Fy", "Fz"]
     assert all("part_of=Fx Fy Fz" in r["parameters"] for r in rows)
     assert sum(r["heldout_gain"] != "" for r in rows) == 1
+    summary = json.loads((tmp_path / "w4_broadband_floor" / "report" / "summary.json").read_text())
+    parts = [e for e in summary["effects"] if e["kind"] == "broadband_floor"]
+    assert len(parts) == 3 and all(e["evidence"]["part_of"] == ["Fx", "Fy", "Fz"] for e in parts)
     for c, e in floors.items():
         assert abs(e["exponent"] - floor.params["exponent"]) <= 0.25, (c, e["exponent"])
         f = np.asarray(e["f_Hz"])

@@ -124,6 +124,10 @@ def effect_entry(hyp: Hypothesis) -> dict:
     d = {**e.to_schema(),
          "evidence": {"heldout_gain": hyp.gain, "heldout_gain_fraction": hyp.gain_fraction,
                       "t": hyp.t, "passed": hyp.passed, "iteration": hyp.iteration}}
+    group = getattr(hyp, "group", None)
+    if group is not None:
+        # one hypothesis of several parts: the gain and t above are the whole group's, not this part's alone
+        d["evidence"]["part_of"] = list(group.channels)
     if hyp.forced_by:
         d["evidence"]["taken_back"] = f"fitted to content described as {hyp.forced_by}"
     if hyp.beside is not None:
