@@ -37,6 +37,53 @@ def rms_vs_speed(diag: Diagnosis) -> dict:
     return cols
 
 
+#: The radial channel pairs whose RMS :func:`pair_rms_error` combines.
+RADIAL_PAIRS = (("Fx", "Fy"), ("Tx", "Ty"))
+
+
+def pair_rms_error(cols: dict, tag: str = "after") -> float:
+    """The RMS-vs-speed relative error of the model ``tag`` ("before" or "after") with each radial pair's RMS
+    combined, sqrt(x² + y²), the other channels as they are: the mean over runs and (combined) channels of
+    abs(model − data)/data (``cols``: :func:`rms_vs_speed`'s columns; NaN when no channel is there).
+
+    A line with a co and a counter-rotating part traces an ellipse whose orientation is its parts' phase in the
+    run, which the model cannot know (it changes run to run); the model gives x and y the ellipse's mean square, so
+    each radial channel alone misses the data by the orientation, while the pair's summed power,
+    abs(a₊)² + abs(a₋)², holds whatever the phase."""
+    def col(kind, c):
+        return next((v for k, v in cols.items() if k.startswith(f"{kind}_{c}_rms_")), None)
+
+    rows: list = []
+    paired: set = set()
+    for pair in RADIAL_PAIRS:
+        d = [col("data", c) for c in pair]
+        m = [col(f"model_{tag}", c) for c in pair]
+        if all(x is not None for x in d + m):
+            rows.append((np.hypot(*d), np.hypot(*m)))
+            paired.update(pair)
+    for k, v in cols.items():
+        c = k.split("_")[1] if k.startswith("data_") else None
+        if c is not None and c not in paired and col(f"model_{tag}", c) is not None:
+            rows.append((v, col(f"model_{tag}", c)))
+    if not rows:
+        return float("nan")
+    err = np.concatenate([np.abs(np.asarray(m, float) - np.asarray(d, float)) / np.asarray(d, float) for d, m in rows])
+    return float(np.nanmean(err))
+
+
+def counter_rotating_lines(model) -> list:
+    """The (direction, h) of the radial lines of ``model`` (a WheelModel) that hold both a co and a
+    counter-rotating part: a ``counter_rotation`` effect, or a co and a counter harmonic at one h."""
+    out = [(e.get("direction", "radial_force"), float(e.get("h", 1.0))) for e in model.effects
+           if e.get("kind") == "counter_rotation" and 0.0 < float(e.get("counter_fraction", 0.0)) < 1.0]
+    for direction in ("radial_force", "radial_torque"):
+        hs = model.harmonics(direction)
+        co = {round(x.h, 3) for x in hs if (getattr(x, "sense", None) or "co") == "co" and x.C > 0}
+        ct = {round(x.h, 3) for x in hs if getattr(x, "sense", None) == "counter" and x.C > 0}
+        out += [(direction, h) for h in sorted(co & ct) if (direction, h) not in out]
+    return out
+
+
 def _fmt(v, spec: str) -> str:
     """A parameter for the report: floats with ``spec``, short lists space-separated (no commas: CSV)."""
     if isinstance(v, (list, tuple)):
@@ -286,6 +333,14 @@ def write_report(diag: Diagnosis, out_dir) -> list:
           f"{diag.contrast_error_before:.4g} / {diag.contrast_error_after:.4g}",
           f"- RMS-vs-speed relative error before / after: {diag.rms_error_before:.4g} / {diag.rms_error_after:.4g}",
           f"- iterations: {diag.iterations}", ""]
+    elliptic = counter_rotating_lines(diag.model)
+    if elliptic:
+        which = ", ".join(f"{d.replace('_', ' ')} h = {h:.4g}" for d, h in elliptic)
+        md[-1:-1] = [f"- RMS-vs-speed relative error after, each radial pair combined (√(x² + y²)): "
+                     f"{pair_rms_error(cols):.4g}.  The model holds lines with co and counter-rotating parts "
+                     f"({which}): each traces an ellipse whose orientation is its parts' phase in the run, which "
+                     "changes run to run; the model gives x and y the ellipse's mean square, so Fx and Fy (Tx and Ty) "
+                     "each miss the data by the orientation, while the pair's summed power holds."]
     if diag.speed:
         from ..speed_whirl import speed_lines
 
