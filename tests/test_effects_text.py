@@ -85,3 +85,13 @@ def test_diagnose_lines_carry_the_held_out_gain():
     e = dict(EFFECTS[3], evidence={"heldout_gain_fraction": 0.118})
     (line,) = diagnose_lines([e])
     assert line.startswith("  + fixed resonance: test stand, 180.00 Hz") and line.endswith("(held-out gain 11.8 %)")
+
+
+def test_counter_rotation_says_its_fraction_is_of_power_and_gives_the_amplitude_ratio():
+    """q = abs(a₋)²/(abs(a₊)² + abs(a₋)²): a counter part of a quarter of the co part's amplitude is q = 1/17 (trial12
+    read "q 0.0588" for its 25 % counter-rotating line and had to look the definition up)."""
+    text = describe_effect({"kind": "counter_rotation", "direction": "radial_force", "h": 1.0,
+                            "counter_fraction": 0.25**2 / (1 + 0.25**2)})
+    assert "q 0.0588 (power; counter/co amplitude 0.25)" in text
+    assert "amplitude" not in describe_effect({"kind": "counter_rotation", "direction": "radial_force", "h": 1.0,
+                                               "counter_fraction": 1.0})

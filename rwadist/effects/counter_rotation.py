@@ -28,8 +28,11 @@ class CounterRotation(Element):
 
     @classmethod
     def describe(cls, e: Mapping) -> str:
+        q = float(e["counter_fraction"])
+        # q is a share of the line's power; an engineer's "25 % counter" is often the amplitudes' ratio
+        ratio = f" (power; counter/co amplitude {math.sqrt(q / (1.0 - q)):.3g})" if 0.0 <= q < 1.0 else " (power)"
         return (f"{words(e['direction'])}, h {num(e['h'])}, counter-rotating fraction q "
-                f"{num(e['counter_fraction'], '.3g')}{plus_minus(e, 'counter_fraction_stderr')}")
+                f"{num(e['counter_fraction'], '.3g')}{plus_minus(e, 'counter_fraction_stderr')}{ratio}")
 
     # ------------------------------------------------------------------ injection
     #: ``counter_rotation:direction=radial_force,h=1,fraction=0.3``: that share of the line's power turned against
