@@ -166,6 +166,8 @@ def test_summary_report_and_console_carry_the_descriptions(tmp_path, capsys):
     assert main(["diagnose", str(data), "-o", str(out)]) == 0
     printed = capsys.readouterr().out
     assert printed.count("  ? fixed_line: ") == 3 and "band-by-band misfit" in printed
+    # the described lines are in no model: the console says the figures count them (trial12 read 77x as a bad model)
+    assert "described above with ? is in no model: it counts in both figures" in printed
     summary = json.loads((out / "summary.json").read_text())
     assert [u["signature"] for u in summary["unexplained"]] == ["fixed_line"] * 3
     assert summary["narrow_line_metric"] == "waterfall_band_contrast" and summary["narrow_line_error_after"] > 0
