@@ -31,6 +31,7 @@ from .validate import (
     check_f_lim,
     check_parameter,
     check_speeds_rpm,
+    check_test_speeds,
     refuse_non_finite_model,
     speed_scale_warning,
     warn_unconstrained,
@@ -441,7 +442,8 @@ def _diagnose_model(model, preset: str | None, base: str):
 
 
 def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto", nperseg: int | None = None,
-             f_lim: float | None = None, k_sigma: float = 4.0, min_gain: float = 0.05, bearings=None):
+             f_lim: float | None = None, k_sigma: float = 4.0, min_gain: float = 0.05, bearings=None,
+             source=None):
     """Find what a model leaves out of test data, name the effects, add those that pass a held-out test.
 
     Parameters
@@ -471,6 +473,9 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         The wheel's bearings (:class:`rwadist.bearings.Bearing`, or their descriptions as the model file's
         ``wheel.bearings`` objects or ``--bearing`` texts): their cage, ball-pass and ball-spin ratios are named as
         candidate causes of lines; None: those of the model's ``wheel`` section, if any.
+    source : str, pathlib.Path or None
+        What the data's errors and warnings name when ``data`` is a test read from a file (its path); default
+        ``data`` itself when a path, else "the test".
 
     Returns
     -------
@@ -482,6 +487,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     ------
     ParameterError
         A value out of range; a model and a preset; base "extended" without the wheel's modes.
+    DataError
+        Runs at fewer than 2 distinct speeds (:func:`rwadist.validate.check_test_speeds`).
     """
     from . import speed_whirl
     from .diagnose import diagnose as _diagnose
@@ -496,6 +503,10 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         bearings = tuple(b if isinstance(b, Bearing) else parse_bearing(b, "diagnose", f"bearings[{i}]")
                          for i, b in enumerate(bearings))
     test = _as_test(data)
+    # too few speeds to fit and judge on: refused (one), or warned of (fewer than the data's own fit needs)
+    check_test_speeds(test, source or (data if isinstance(data, (str, Path)) else "the test"),
+                      model_given=model is not None or preset is not None)
+    check_f_lim(test, f_lim)            # before the search starts, not after it
 
     def run(test, base_check):
         spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))

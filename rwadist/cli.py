@@ -406,7 +406,8 @@ def cmd_diagnose(args) -> int:
     try:
         with working("rwadist diagnose: searching the residual for effects"):
             diag = api.diagnose(test, args.model, preset=args.preset, base=args.base, nperseg=args.nperseg,
-                                f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain, bearings=bearings)
+                                f_lim=args.f_lim, k_sigma=args.k_sigma, min_gain=args.min_gain, bearings=bearings,
+                                source=args.data)
     except ParameterError as exc:
         if exc.parameter != "base":
             raise
@@ -698,7 +699,9 @@ def _library_warnings():
                 f"WARNING: {flag_of(parameter) + ' ' if parameter else ''}{text}")
         if text not in seen:
             seen.add(text)
-            print(text, file=sys.stderr)
+            from tqdm import tqdm
+
+            tqdm.write(text, file=sys.stderr)       # on its own line, below a running progress line
 
     with warnings.catch_warnings():
         warnings.simplefilter("always", RwadistWarning)

@@ -150,6 +150,42 @@ def check_f_lim(test, f_lim, parameter: str = "f_lim") -> None:
                              "a limit below it (or leave it out)")
 
 
+#: Distinct speeds the empirical fit needs to keep a line (:class:`rwadist.empirical.FitSettings` ``min_points``):
+#: diagnose on fewer, from the data's own fit, warns that its starting model holds few lines.
+FIT_MIN_SPEEDS = 5
+
+
+def check_test_speeds(test, source, model_given: bool = False) -> None:
+    """Refuse, or warn about, a test too narrow in speed to diagnose (``source``: the data's path, named).
+
+    A :class:`DataError` when the runs of ``test`` hold fewer than 2 distinct speeds (sorted speeds closer than 0.1 % of
+    the top one to the next count as one): the search fits on every other speed and judges on the rest.  A sweep whose slices
+    all share one speed is said to be one steady run recorded as one file.  A :class:`RwadistWarning` when, without
+    a model given, they hold fewer than :data:`FIT_MIN_SPEEDS`: the empirical fit leaves out every line measured at
+    fewer speeds."""
+    speeds = np.abs(np.array([r.speed for r in test.runs], dtype=float))
+    top = float(speeds.max()) if speeds.size else 0.0
+    srt = np.sort(speeds)
+    distinct = srt[np.r_[True, np.diff(srt) > 1e-3 * top]] if top > 0 else srt[:1]
+    rpm = ", ".join(f"{x * RAD_S_TO_RPM:.0f}" for x in distinct)
+    if distinct.size >= 2:
+        if distinct.size < FIT_MIN_SPEEDS and not model_given:
+            warnings.warn(RwadistWarning(
+                f"{source}: runs at {distinct.size} distinct speeds ({rpm} rpm): the data's empirical fit keeps a "
+                f"line measured at {FIT_MIN_SPEEDS} speeds at least, so the starting model holds few lines or none; "
+                "give the test's runs over its speed range (or a model file)"), stacklevel=3)
+        return
+    msg = (f"runs at {distinct.size} distinct speed ({rpm} rpm): diagnose needs runs at 2 speeds at least (it fits on "
+           f"every other speed and judges on the rest; the data's own fit needs {FIT_MIN_SPEEDS}); give the test's "
+           "runs over its speed range")
+    if (getattr(test, "meta", None) or {}).get("slicing") is not None and speeds.size:
+        change = 100.0 * float(speeds.max() - speeds.min()) / max(top, 1e-300)
+        msg += (f". This file was read as a sweep, but its speed changes by {change:.2g} % over the record: one "
+                "steady run recorded as one file; put it with the test's other runs in a steady-test folder "
+                "(runs.csv and one file per run, docs/formats.md)")
+    raise DataError(source, "speed_rpm", msg)
+
+
 def warn_unconstrained(model, source, use) -> None:
     """A :class:`RwadistWarning` that ``model`` has modes the extended fit could not identify, if it has (``use``:
     what rests on them, e.g. "the PSD")."""
