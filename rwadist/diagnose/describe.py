@@ -255,6 +255,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
     the records the search read had the changed runs' factor taken out, :func:`run_steps`)."""
     from .describe_lines import speed_lines
+    from .describe_partial import partial_lines
     from .describe_structure import broadband_hump, line_ratios, moving_resonance, run_change
 
     res = searched if res is None else res
@@ -304,6 +305,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += moving_resonance(ctx, state, ratios, of_track)
     out += run_change(ctx, line_ratios(res.ctx, res.state) if changes else ratios, of_runs)
     out += speed_lines(ctx, state, of_line, bearings, others)
+    out += partial_lines(ctx, line_ratios(ctx, state, absent=True), of_line)
     return out
 
 
@@ -346,7 +348,7 @@ def cells_of(u, res: Residual) -> dict:
         if src not in res.D or dst not in res.e:
             return {}
         return {dst: float(p.get("gain", 0.0)) ** 2 * res.D[src] >= 0.1 * res.D[dst]}
-    if u.signature == "speed_line" and u.h is not None:
+    if u.signature in ("speed_line", "partial_line") and u.h is not None:
         b = res.band_of(u.h * spin[rows])
         lo, hi = np.maximum(b - 1, 0), np.minimum(b + 1, ctx.n_bands - 1)
     elif u.signature == "moving_resonance" and "slope_Hz_per_Hz_of_spin" in p:
