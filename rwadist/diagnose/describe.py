@@ -331,7 +331,8 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
 
 def cells_of(u, res: Residual) -> dict:
     """The waterfall cells (channel -> bool mask (runs, bands)) a record covers, in its channels and the runs within
-    its speed range: a ``speed_line`` the band of f = h·Ω/2π in each run (and its neighbours), a
+    its speed range: a ``speed_line`` the band of f = h·Ω/2π in each run (and its neighbours), a ``partial_line``
+    that band alone, a
     ``moving_resonance`` the bands of its track ±3ζ, a ``channel_copy`` the target's bands where the copy is at
     least a tenth of the target's power, the others the bands of their frequency range; a ``run_change`` none (it is
     a change of whole runs: a class gaining in those runs is not fitted to it)."""
@@ -350,7 +351,9 @@ def cells_of(u, res: Residual) -> dict:
         return {dst: float(p.get("gain", 0.0)) ** 2 * res.D[src] >= 0.1 * res.D[dst]}
     if u.signature in ("speed_line", "partial_line") and u.h is not None:
         b = res.band_of(u.h * spin[rows])
-        lo, hi = np.maximum(b - 1, 0), np.minimum(b + 1, ctx.n_bands - 1)
+        # a partial line is a line of the model: its own band only (with the bands either side, a true law on a
+        # neighbour 0.6·Ω/2π away was taken back with it)
+        lo, hi = (b, b) if u.signature == "partial_line" else (np.maximum(b - 1, 0), np.minimum(b + 1, ctx.n_bands - 1))
     elif u.signature == "moving_resonance" and "slope_Hz_per_Hz_of_spin" in p:
         f_lo, f_hi = p["f_at_lowest_speed_Hz"], p["f_at_highest_speed_Hz"]
         s_lo, s_hi = u.speed_rpm[0] / 60.0, u.speed_rpm[1] / 60.0

@@ -73,7 +73,8 @@ def partial_lines(ctx, ratios: list, of_line) -> list:
         # interleaved: a run holding the line lies between two that lack it, or the other way round
         interleaved = bool(np.any((p_rpm > a_rpm[0]) & (p_rpm < a_rpm[-1])) or
                            np.any((a_rpm > p_rpm[0]) & (a_rpm < p_rpm[-1])))
-        # how far under the model the absent runs are, no further than their noise allows (w: the line's SNR)
+        # how far under the model the absent runs are, no further than their noise allows (w: the line's SNR, capped
+        # at 1e4 by line_ratios: 40 dB)
         depth = float(np.median(np.maximum(q[absent], -10 * np.log10(w[absent]))))
 
         def run_names(sel):
