@@ -305,7 +305,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += moving_resonance(ctx, state, ratios, of_track)
     out += run_change(ctx, line_ratios(res.ctx, res.state) if changes else ratios, of_runs)
     out += speed_lines(ctx, state, of_line, bearings, others)
-    out += partial_lines(ctx, line_ratios(ctx, state, absent=True), of_line)
+    out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
     return out
 
 
