@@ -19,6 +19,8 @@ broadband_hump      band-limited noise at 95-125 Hz on the torque channels, 10 Ã
                     same at every speed
 run_change          every third run (in speed order) recorded 3.5 dB stronger in every channel (an amplifier
                     range switched between runs)
+partial_line        a co-rotating radial-force line at h = 2.7, C 0.08 (thesis units, as the E wheel's 2Ã—
+                    line), in every third run only (from the first, in speed order): a source that comes and goes
 =================== =================================================================================
 """
 from __future__ import annotations
@@ -37,11 +39,14 @@ import independent_wheel as iw  # noqa: E402
 KINDS = ("fixed_lines", "channel_copy", "moving_resonance", "broadband_hump", "run_change")
 #: the signature a description of each kind must have (docs/diagnose.md, "Unexplained residual")
 SIGNATURE = {"fixed_lines": "fixed_line", "weak_fixed_lines": "fixed_line", "channel_copy": "channel_copy", "moving_resonance": "moving_resonance",
-             "broadband_hump": "broadband_hump", "run_change": "run_change"}
+             "broadband_hump": "broadband_hump", "run_change": "run_change", "partial_line": "partial_line"}
 FIXED_HZ = (60.0, 137.0, 180.0)
 COPY = ("Tx", "Tz", 0.3)
 HUMP_HZ = (95.0, 125.0)
 RUN_STEP_DB = 3.5
+#: the partial line: (h, C in thesis units), present in the runs i % PARTIAL_EVERY == 0
+PARTIAL_LINE = (2.7, 0.08)
+PARTIAL_EVERY = 3
 
 
 def _noise_std(lines) -> dict:
@@ -83,6 +88,12 @@ def generate(kind: str, speeds_rpm, n_samples: int = 4096, sample_rate: float = 
         if kind == "channel_copy":
             src, dst, k = COPY
             sig[dst] = sig[dst] + k * sig[src]
+        if kind == "partial_line" and i % PARTIAL_EVERY == 0:
+            h, c = PARTIAL_LINE
+            phase = h * r.speed * np.arange(sig["Fx"].size) / sample_rate + rng.uniform(0, 2 * np.pi)
+            amp = c * iw.C_UNIT * r.speed**2
+            sig["Fx"] = sig["Fx"] + amp * np.cos(phase)
+            sig["Fy"] = sig["Fy"] + amp * np.sin(phase)
         if kind == "run_change" and i % 3 == 1:
             sig = {ch: x * 10 ** (RUN_STEP_DB / 20) for ch, x in sig.items()}
         for ch in sig:
@@ -98,7 +109,8 @@ def generate(kind: str, speeds_rpm, n_samples: int = 4096, sample_rate: float = 
                 sig[ch] = sig[ch] + np.sqrt(10.0) * std[ch] * signal.sosfilt(sos, rng.standard_normal(n_samples))
         runs.append(Run(speed=r.speed, sample_rate=sample_rate, signals=sig, t0=0.0, name=r.name))
     truth = {"kind": kind, "signature": SIGNATURE.get(kind), "fixed_hz": FIXED_HZ, "copy": COPY,
-             "hump_hz": HUMP_HZ, "run_step_db": RUN_STEP_DB}
+             "hump_hz": HUMP_HZ, "run_step_db": RUN_STEP_DB, "partial_line": PARTIAL_LINE,
+             "partial_runs": [r.name for i, r in enumerate(raw.runs) if i % PARTIAL_EVERY == 0]}
     return SteadyTest(runs=runs, meta={"generator": "tests/open_world_cases.py"}), truth
 
 

@@ -524,3 +524,57 @@ def _renamed(run, name):
     from dataclasses import replace
 
     return replace(run, name=name)
+
+
+def test_a_line_in_every_third_run_only_is_described_as_partial_and_not_forced_into_a_class():
+    """A radial-force line at h 2.7 present in every third run only (tests/open_world_cases.py ``partial_line``): the
+    base fitted from the data holds it at the strength of the runs that have it, so the others show it far over the
+    data.  It is described (``partial_line``: the runs without it among the generator's, those with it among the
+    generator's, interleaved), and no class is added for it.  On e91bc1c it was in the base, described nowhere (an
+    independent trial wheel, h 2.7 in 10 of 30 runs, found it so)."""
+    test, truth, d = diagnosed("partial_line")
+    assert _classes(d) == ["suspension_modes"], [u.text() for u in d.unexplained]
+    (u,) = [u for u in d.unexplained if u.signature == "partial_line"]
+    assert u.h == pytest.approx(truth["partial_line"][0], abs=0.01)
+    assert u.parameters["direction"] == "radial_force" and u.parameters["interleaved"] is True
+    with_line = set(truth["partial_runs"])
+    assert set(u.parameters["runs_present"]) <= with_line
+    assert not set(u.parameters["runs_absent"]) & with_line
+    assert len(u.parameters["runs_absent"]) >= 5 and u.level_dB <= -10.0
+    assert "partial_line" in u.text() and "absent" in u.text()
+
+
+def test_a_true_law_on_a_neighbour_of_a_partial_line_is_not_taken_back_with_it(monkeypatch):
+    """The independent E wheel with its radial-force 3× line on an Ω^3.5 law (each run's 3× line of the generator
+    scaled by (Ω/Ω_mid)^1.5) and a partial line at h 2.4 in every third run (tests/open_world_cases.py ``partial_line``):
+    the law on 3× is a class the search finds (Ω^3.50), the partial line is described.  The partial line's cells are
+    its own band: with the bands either side (3 × 30 Hz wide), the true law on 3×, 0.6·Ω/2π away, was taken back with
+    the law the search fitted to the partial line (error after 0.0035 -> 0.053, nothing describing the 3× law)."""
+    from dataclasses import replace
+
+    iw, p_true = owc.iw, 3.5
+    generate = iw.generate
+
+    def with_law(speeds_rpm, sample_rate=3840.0, n_samples=8192, noise=0.01, seed=0, lines=iw.E_LINES,
+                 co_fraction=None):
+        law = [ln for ln in lines if ln[0] == "radial_force" and ln[1] == 3.0]
+        test, tr = generate(speeds_rpm, sample_rate, n_samples, noise, seed, [ln for ln in lines if ln not in law],
+                            co_fraction)
+        ones = [(d, 1.0, 0.0, 1.0) for d in ("radial_force", "radial_torque")]         # (no power: the 3× alone)
+        only, _ = generate(speeds_rpm, sample_rate, n_samples, 0.0, seed + 1, law + ones, co_fraction)
+        om = np.array([r.speed for r in test.runs])
+        mid = np.sqrt(om.min() * om.max())
+        runs = [replace(a, signals={c: a.signals[c] + (a.speed / mid) ** (p_true - 2) * b.signals[c] for c in a.signals})
+                for a, b in zip(test.runs, only.runs)]
+        return replace(test, runs=runs), tr
+
+    monkeypatch.setattr(iw, "generate", with_law)
+    monkeypatch.setattr(owc, "PARTIAL_LINE", (2.4, 0.08))
+    test, truth = owc.generate("partial_line", SPEEDS, seed=4)
+    d = api.diagnose(test)
+    laws = [e for e in d.model.effects if e["kind"] == "amplitude_law"]
+    assert [round(e["h"], 2) for e in laws] == [3.0], [u.text() for u in d.unexplained]
+    assert laws[0]["exponent"] == pytest.approx(p_true, abs=0.05)
+    (u,) = [u for u in d.unexplained if u.signature == "partial_line"]
+    assert u.h == pytest.approx(2.4, abs=0.01)
+    assert not set(u.parameters["runs_absent"]) & set(truth["partial_runs"])

@@ -255,6 +255,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
     the records the search read had the changed runs' factor taken out, :func:`run_steps`)."""
     from .describe_lines import speed_lines
+    from .describe_partial import partial_lines
     from .describe_structure import broadband_hump, line_ratios, moving_resonance, run_change
 
     res = searched if res is None else res
@@ -304,6 +305,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += moving_resonance(ctx, state, ratios, of_track)
     out += run_change(ctx, line_ratios(res.ctx, res.state) if changes else ratios, of_runs)
     out += speed_lines(ctx, state, of_line, bearings, others)
+    out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
     return out
 
 
@@ -329,7 +331,8 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
 
 def cells_of(u, res: Residual) -> dict:
     """The waterfall cells (channel -> bool mask (runs, bands)) a record covers, in its channels and the runs within
-    its speed range: a ``speed_line`` the band of f = h·Ω/2π in each run (and its neighbours), a
+    its speed range: a ``speed_line`` the band of f = h·Ω/2π in each run (and its neighbours), a ``partial_line``
+    that band alone, a
     ``moving_resonance`` the bands of its track ±3ζ, a ``channel_copy`` the target's bands where the copy is at
     least a tenth of the target's power, the others the bands of their frequency range; a ``run_change`` none (it is
     a change of whole runs: a class gaining in those runs is not fitted to it)."""
@@ -346,9 +349,11 @@ def cells_of(u, res: Residual) -> dict:
         if src not in res.D or dst not in res.e:
             return {}
         return {dst: float(p.get("gain", 0.0)) ** 2 * res.D[src] >= 0.1 * res.D[dst]}
-    if u.signature == "speed_line" and u.h is not None:
+    if u.signature in ("speed_line", "partial_line") and u.h is not None:
         b = res.band_of(u.h * spin[rows])
-        lo, hi = np.maximum(b - 1, 0), np.minimum(b + 1, ctx.n_bands - 1)
+        # a partial line is a line of the model: its own band only (with the bands either side, a true law on a
+        # neighbour 0.6·Ω/2π away was taken back with it)
+        lo, hi = (b, b) if u.signature == "partial_line" else (np.maximum(b - 1, 0), np.minimum(b + 1, ctx.n_bands - 1))
     elif u.signature == "moving_resonance" and "slope_Hz_per_Hz_of_spin" in p:
         f_lo, f_hi = p["f_at_lowest_speed_Hz"], p["f_at_highest_speed_Hz"]
         s_lo, s_hi = u.speed_rpm[0] / 60.0, u.speed_rpm[1] / 60.0

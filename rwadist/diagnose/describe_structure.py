@@ -37,8 +37,9 @@ class LineRatios:
     w: np.ndarray
 
 
-def line_ratios(ctx, state) -> list:
-    """The :class:`LineRatios` of every direction with lines (the context's runs)."""
+def line_ratios(ctx, state, absent: bool = False) -> list:
+    """The :class:`LineRatios` of every direction with lines (the context's runs).  ``absent``: the runs where the
+    measured line power is 0 kept too (``q`` then held at −100 dB: a line the run lacks)."""
     runs = ctx.runs
     out = []
     for d, direction_chans in DIRECTION_CHANNELS.items():
@@ -69,12 +70,18 @@ def line_ratios(ctx, state) -> list:
                 continue
             snr = pred / np.maximum(noise, 1e-300)
             good = np.isfinite(meas) & (meas > 0) & (snr >= 10 ** (LINE_SNR_DB / 10))
+            if absent:
+                # a line measured 0 inside the band the lines are read in (outside it, 0 means not read)
+                k = np.rint(hs[:, None] * ctx.omega[runs][None, :] / (2 * np.pi) / ctx.df).astype(int)
+                inband = (k - LINE_HALF >= ctx.k_lo) & (k + LINE_HALF <= ctx.k_hi)
+                good = np.isfinite(meas) & (meas >= 0) & inband & (snr >= 10 ** (LINE_SNR_DB / 10))
             if good.sum() < 3:
                 continue
             L, R = good.shape
             li, ri = np.nonzero(good)
             f = hs[li] * ctx.omega[runs][ri] / (2 * np.pi)
-            out.append(LineRatios(d, 10 * np.log10(meas[good] / pred[good]), f, ri, ctx.omega[runs][ri] / (2 * np.pi),
+            q = 10 * np.log10(np.maximum(meas[good], 1e-10 * pred[good]) / pred[good])
+            out.append(LineRatios(d, q, f, ri, ctx.omega[runs][ri] / (2 * np.pi),
                                   li, hs[li], np.minimum(snr[good], 1e4)))
     return out
 

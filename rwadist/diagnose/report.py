@@ -177,6 +177,12 @@ def _mark_unexplained(ax, c: str, diag: Diagnosis, rpm: np.ndarray) -> None:
             s = np.array([s0, s1])
             ax.plot(u.h * s / 60.0, s, ls=":", **style)
             ax.text(u.h * s1 / 60.0, s1, f" {n}", va="top", **tag)
+        elif u.signature == "partial_line" and u.h is not None:
+            # a short mark on the line's ray at each run it is absent from
+            s = np.asarray(u.parameters.get("absent_rpm", []), float)
+            ax.plot(u.h * s / 60.0, s, ls="none", marker="|", ms=6, mew=1.2, color=MARK_COLOUR, zorder=5)
+            if s.size:
+                ax.text(u.h * s[-1] / 60.0, s[-1], f" {n}", va="top", **tag)
         elif u.signature == "moving_resonance":
             fa = u.parameters.get("f_at_lowest_speed_Hz", u.f_Hz[0])
             fb = u.parameters.get("f_at_highest_speed_Hz", u.f_Hz[1])

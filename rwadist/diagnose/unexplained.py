@@ -41,12 +41,14 @@ SIGNATURES = {
     "moving_resonance": "a resonance whose frequency changes with speed in a way the gyroscopic whirl does not explain",
     "broadband_hump": "a broadband hump above the noise floor",
     "run_change": "a run-to-run change",
+    "partial_line": "a model line present in some runs and absent from others",
 }
 
 #: How ``level_dB`` reads for the signatures whose level is not the data over the model in their cells.
 LEVEL_WORDS = {
     "broadband_hump": "{:+.1f} dB over the floor's smooth course",
     "run_change": "the changed runs {} dB off the others",
+    "partial_line": "{:+.1f} dB against the model in the runs it is absent from",
 }
 
 
