@@ -453,17 +453,21 @@ def _resonance_db(f: np.ndarray, f_r: np.ndarray, zeta: float, gain: float, abov
     return 20 * np.log10(np.maximum(np.abs(resonance_response(f / f_r, zeta, gain, beta)), 1e-12))
 
 
-def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray, shapes=None) -> tuple:
+def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray, shapes=None, per_slope: bool = False):
     """(sse, f0, slope, zeta, gain, gain above) of the best track f_r = f0 + slope·(spin − spin_mid) over the grids
     (``shapes``: the (ζ, gain, gain above) tried, default every one of :data:`ZETAS`, :data:`GAINS` and
     :data:`GAINS_ABOVE`), each line's own offset (its C's misfit) taken out: the least squares of q on the
-    resonance's dB gain per line."""
+    resonance's dB gain per line; with ``per_slope``, the list of the best of each slope."""
     mid = 0.5 * (r.spin.min() + r.spin.max())
     lines = np.unique(r.line)
     onehot = (r.line[None, :] == lines[:, None]).astype(float)                       # (L, N)
     count = onehot.sum(1)
-    best = (np.inf, np.nan, np.nan, np.nan, np.nan, np.nan)
+    none = (np.inf, np.nan, np.nan, np.nan, np.nan, np.nan)
+    best, each = none, []
     for b in slopes:
+        if per_slope:
+            each.append(best)
+            best = none
         fr = f0s[:, None] + b * (r.spin[None, :] - mid)                               # (F, N)
         valid = np.all(fr > 0, axis=1)
         if not valid.any():
@@ -478,7 +482,7 @@ def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray, shapes=None) 
             i = int(np.argmin(sse))
             if sse[i] < best[0]:
                 best = (float(sse[i]), float(f0s[i]), float(b), z, g, above)
-    return best
+    return (each + [best])[1:] if per_slope else best
 
 
 def _offsets_only(r: LineRatios) -> float:
@@ -498,9 +502,15 @@ def _track_db(r: LineRatios, f0: float, slope: float, zeta: float, gain: float, 
 
 #: The fine step's factors on the coarse best's ζ and peak gain (its shape kept): between the coarse grid's values
 #: (a factor 1.7-2 apart) the place of a rotor mode's antiresonance (:func:`gain_above`) moves by several ζ, and the
-#: lines just above the track read it (the wheel family's axial resonance falling 2 Hz per Hz of spin: ζ 0.02, gain 6
-#: on the coarse grids, 0.016 and 9.6 fine, the misfit 3.7 times smaller and the slope −2.0 → −2.05 at the truth's −2)
+#: lines just above the track read it (an independent trial's rotor mode at 1000 − 2·f_spin Hz on Fz, ζ 0.015, peak
+#: gain 10: ζ 0.02, gain 6 on the coarse grids, 0.016 and 9.6 fine, the misfit 3.7 times smaller, slope −2.05)
 FINE_FACTORS = (0.6, 0.8, 1.0, 1.25, 1.6)
+#: ... from the best coarse fits of this many slopes (each its own, the best f0 and shape of that slope): the coarse
+#: f0 grid (3 % steps) and shapes misplace a narrow peak and a rotor mode's antiresonance, which ranks the coarse
+#: slopes unevenly (with one line crossing the track, a rotor mode at 900 − f_spin Hz on family wheel 5's lines:
+#: +2.0 first, misfit 9.2; −1 refined from its own coarse best leaves 0.25.  The open world's softening resonance
+#: on wheel 2: −0.2, −0.4, +0.2, −0.6 first; refined from −0.6 it leaves 1.8 at −0.58, from −0.2 3.9 at −0.25)
+FINE_STARTS = 5
 
 
 def _best_track(r: LineRatios, coarse: np.ndarray, slopes: np.ndarray, q: np.ndarray | None = None) -> tuple:
@@ -511,13 +521,14 @@ def _best_track(r: LineRatios, coarse: np.ndarray, slopes: np.ndarray, q: np.nda
 
     rr = r if q is None else replace(r, q=q)
     fixed = slopes.size == 1 and slopes[0] == 0.0
-    best = _track_fit(rr, coarse, slopes if fixed else slopes[::2])
-    if not np.isfinite(best[0]):
-        return best
-    f0s = np.exp(np.arange(np.log(best[1]) - 0.04, np.log(best[1]) + 0.0401, 0.005))
-    near = slopes if fixed else np.round(np.arange(best[2] - 0.2, best[2] + 0.2001, 0.05), 3)
-    shapes = [(best[3] * a, max(best[4] * b, 1.1), best[5]) for a in FINE_FACTORS for b in FINE_FACTORS]
-    return min(best, _track_fit(rr, f0s, near, shapes), key=lambda t: t[0])
+    starts = sorted(_track_fit(rr, coarse, slopes if fixed else slopes[::2], per_slope=True), key=lambda t: t[0])
+    best = starts[0]
+    for start in [t for t in starts if np.isfinite(t[0])][:FINE_STARTS]:
+        f0s = np.exp(np.arange(np.log(start[1]) - 0.04, np.log(start[1]) + 0.0401, 0.005))
+        near = slopes if fixed else np.round(np.arange(start[2] - 0.2, start[2] + 0.2001, 0.05), 3)
+        shapes = [(start[3] * a, max(start[4] * b, 1.1), start[5]) for a in FINE_FACTORS for b in FINE_FACTORS]
+        best = min(best, _track_fit(rr, f0s, near, shapes), key=lambda t: t[0])
+    return best
 
 
 #: Rounds of the fit of a track beside a fixed resonance, each fitted in turn on what the other leaves.
