@@ -130,3 +130,26 @@ def test_a_travelling_wave_on_a_family_wheel_is_described_on_the_default_path():
     assert u.parameters["slope_Hz_per_Hz_of_spin"] == pytest.approx(-2.0, abs=0.2)
     assert "2 nodal diameters" in u.causes[0] and "backward" in u.causes[0]
     assert float(u.causes[0].split("≈ ")[1].split(" Hz")[0]) == pytest.approx(600.0, rel=0.03)
+
+
+@pytest.mark.parametrize("f_mode, reached", [(420.0, True), (60.0, False)])
+def test_a_fitted_mode_the_track_reaches_is_said_to_be_suspect(f_mode, reached):
+    """Family wheel 7's axial lines through the rotor mode at 700 − 2·f_spin Hz (367 Hz at the top speed), beside a
+    fitted axial mode at 420 Hz (the track passes it) or at 60 Hz (a line there changed by 0.05 dB at most): the
+    record says the first is reached, with the change of a line at the mode's frequency within 2 dB of H written
+    here at the speed it names, and that the mode is suspect; of the second it says nothing."""
+    from rwadist.diagnose.describe_structure import moving_resonance
+
+    r = _ratios(fw.family()[7], 16, 700.0, -2.0)
+    modes = SimpleNamespace(kind="suspension_modes", f0_Hz={"axial": f_mode, "radial_translation": 400.0,
+                                                             "rocking": 130.0}, unconstrained=(), inertia_ratio=2.1)
+    (u,) = moving_resonance(SimpleNamespace(channels=("Fx", "Fy", "Fz")), SimpleNamespace(effects=[modes]), [r],
+                            lambda *a: (0.0, 0.0))
+    got = u.parameters.get("crosses_fitted_mode")
+    if not reached:
+        assert got is None and "suspect" not in u.would_tell
+        return
+    assert got["mode"] == "axial" and got["f_Hz"] == f_mode and got["located"]
+    truth = 20 * np.log10(abs(rotor_mode(f_mode, 700.0 - 2.0 * got["speed_rpm"] / 60.0, 0.015, 0.3)))
+    assert abs(truth) >= 1.0 and got["lift_dB"] == pytest.approx(truth, abs=2.0)
+    assert "fitted axial mode (420 Hz)" in u.would_tell and "suspect" in u.would_tell
