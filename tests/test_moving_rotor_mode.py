@@ -85,6 +85,8 @@ def test_a_rotor_mode_moving_n_hz_per_hz_of_spin_is_described(index, n_runs, f_r
     assert f"{n} nodal diameter" in u.causes[0] and wave in u.causes[0]
     f_said = float(u.causes[0].split("≈ ")[1].split(" Hz")[0])
     assert f_said == pytest.approx(f_rot, rel=0.03)
+    assert p["largest_line_lift_dB"] == pytest.approx(float(r.q.max()))
+    assert f"the lines it lifts up to {r.q.max():+.1f} dB" in u.text()
 
 
 @pytest.mark.parametrize("index", [7, 1])
