@@ -316,7 +316,8 @@ def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: 
         test = remove_lever_arm(test, height)
         spectra = compute_spectra(test, nperseg=sp0.nperseg, f_lim=sp0.f_lim, window=sp0.window)
         fit = fit_empirical(spectra, fit.fit_settings)
-    meas = with_close_lines(test, fit.without_mode_exclusion)
+    meas = _unsmeared_once(test, with_close_lines(test, fit.without_mode_exclusion),
+                           len(fit.without_mode_exclusion.lines))
     senses_xy = _line_senses_once(test, meas)
     if stands:
         def fixture_gain(x):
@@ -326,6 +327,19 @@ def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: 
 
         meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / fixture_gain(x)) for x in meas.lines])
     return test, fit, meas, senses_xy
+
+
+def _unsmeared_once(test: SteadyTest, meas: EmpiricalFit, n_window: int) -> EmpiricalFit:
+    """``meas`` with its first ``n_window`` lines' amplitudes corrected for their chirp across the fit's segment on a
+    test cut from a sweep (:func:`rwadist.chirp.unsmeared_lines`), else ``meas`` itself; kept on ``meas`` per test."""
+    from .chirp import unsmeared_lines
+
+    kept = meas.__dict__.get("_unsmeared")
+    if kept is None or kept[0] is not test:
+        lines = unsmeared_lines(test, meas, n_window)
+        kept = (test, meas if lines is None else replace(meas, lines=lines))
+        meas.__dict__["_unsmeared"] = kept
+    return kept[1]
 
 
 def _inertias(mass: float | None, radius: float | None, rocking_scan, notes: list) -> tuple[float, float, float]:
