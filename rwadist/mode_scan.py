@@ -20,7 +20,7 @@ worse by a log-likelihood ratio of at least ``min_log_lr`` (n/2·ln(SSR/SSR_best
 2.0 is about the 95 % level of one parameter, Δχ² = 3.84) -- the data then exclude a frequency
 error larger than the tolerance.  The profile uses f0 steps of 1 % (2 % when a is scanned), ζ steps
 of a factor 1.6 (2.0) and a-steps of 0.2; the best point is refined to 0.1 % (the least squares that
-follows refines it) and a to 0.02, then to 0.002 (:func:`_refine_ratio`: the least squares holds a).  Otherwise the data do not
+follows refines it).  Otherwise the data do not
 constrain the mode (no line comes near it, only a skirt is seen, or the whirl it shows trades off
 against I_zz/I_rr) and the result says so; nothing is invented.
 
@@ -333,25 +333,6 @@ NEAR_SPAN = 1.25
 NEAR_A_SPAN = 0.4
 
 
-#: Steps of the last refinement of a scanned I_zz/I_rr (:func:`_refine_ratio`): a, and f0 and ζ (factors) with it
-A_FINE_STEP = 0.002
-F_FINE_STEP = 0.0005
-Z_FINE_STEP = 0.05
-
-
-def _refine_ratio(line, h, omega, power, f0: float, zeta: float, a: float, two_parts: bool) -> tuple:
-    """(f0 Hz, ζ, a) of the least SSR on a grid of I_zz/I_rr every :data:`A_FINE_STEP` within ±0.02 of ``a`` (the
-    refinement's step before), f0 and ζ with it (±0.4 % and ±15 %, a and f0 trade off through the whirls): the
-    least squares after the scan holds I_zz/I_rr where the scan put it, and a 0.02 step doubled the error of a
-    ratio between two points (trial 11, truth 1.37: read 1.38).  The input point is on this grid: never worse."""
-    f2 = f0 * np.exp(np.arange(-8, 9) * F_FINE_STEP)
-    z2 = zeta * np.exp(np.arange(-3, 4) * Z_FINE_STEP)
-    a2 = np.unique(np.clip(np.round(a + np.arange(-10, 11) * A_FINE_STEP, 10), 0.02, A_MAX))
-    ssr = _screened_search(line, h, omega, power, f2, z2, a2, two_parts)
-    i, j, k = np.unravel_index(np.nanargmin(ssr), ssr.shape)
-    return float(f2[i]), float(z2[j]), float(a2[k])
-
-
 def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = None, tolerance: float = 0.02,
               min_log_lr: float = 2.0, near_hz: float | None = None, near_a: float | None = None) -> ModeScan:
     """Profile scan of one mode (see the module docstring).
@@ -407,8 +388,6 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     fi, fj, fk = np.unravel_index(np.nanargmin(fine), fine.shape)
     best = float(fine[fi, fj, fk])
     f_best, z_best, a_best = float(f_fine[fi]), float(z_fine[fj]), float(a_fine[fk])
-    if a_fine.size > 1:
-        f_best, z_best, a_best = _refine_ratio(line, h, omega, power, f_best, z_best, a_best, two_parts)
     profile = np.full(f0_grid.size, np.nan)
     scanned = ~np.all(np.isnan(ssr), axis=(1, 2))     # every f0 but those a windowed search left out
     profile[scanned] = np.nanmin(ssr[scanned], axis=(1, 2))
