@@ -15,6 +15,7 @@ from ..model import WheelModel
 from ..resonance import resonance
 from ..spectra import Spectra, welch_dof
 from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
+from . import smear
 from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, NOISE_Z, TORQUE_CHANNELS
 from .metric import Metric, hann_tables, read_table
 from .reduce import bin_sums, column_nanmedian
@@ -220,11 +221,13 @@ class Context(Metric):
         frac = x - i0
         return self.kernel[i0] * (1.0 - frac) + self.kernel[i0 + 1] * frac
 
-    def psd_at(self, f_hz: np.ndarray, power: np.ndarray, bins: np.ndarray | None = None) -> np.ndarray:
+    def psd_at(self, f_hz: np.ndarray, power: np.ndarray, bins: np.ndarray | None = None, kernel=None) -> np.ndarray:
         """PSD (n_runs, n_f) of lines at frequencies ``f_hz`` (n_runs,) or (n_runs, n) Hz with mean squares
         ``power`` (same shape, unit²) through the line kernel; a line at negative frequency (a lower
         sideband below 0 Hz) folds to |f|.  ``bins``: (n_runs, n_b) bin indices (in range): the PSD at those
-        bins only, (n_runs, n_b) -- the same kernel values, without the whole grid."""
+        bins only, (n_runs, n_b) -- the same kernel values, without the whole grid.  ``kernel``: another kernel than
+        :meth:`kernel_at` (offsets in bins -> 1/Hz, within ±KERNEL_HALF), e.g. a chirp's."""
+        kernel_at = self.kernel_at if kernel is None else kernel
         f_hz = np.asarray(f_hz, dtype=float)
         power = np.broadcast_to(np.asarray(power, dtype=float), f_hz.shape)
         if f_hz.ndim == 1:
@@ -234,14 +237,14 @@ class Context(Metric):
             pos = np.abs(f_hz) / self.df                                           # (n_runs, n_l)
             dlt = bins[:, None, :] - pos[:, :, None]                               # (n_runs, n_l, n_b)
             near = np.abs(bins[:, None, :] - np.rint(pos).astype(int)[:, :, None]) <= KERNEL_HALF
-            return np.sum(np.where(near, power[:, :, None] * self.kernel_at(dlt), 0.0), axis=1)
+            return np.sum(np.where(near, power[:, :, None] * kernel_at(dlt), 0.0), axis=1)
         out = np.zeros((n_runs, self.f.size))
         pos = (np.abs(f_hz) / self.df).ravel()                           # fractional bin
         k0 = np.rint(pos).astype(int)
         offs = np.arange(-KERNEL_HALF, KERNEL_HALF + 1)
         k = k0[:, None] + offs
         dlt = k - pos[:, None]                                         # bin minus line, bins
-        val = power.ravel()[:, None] * self.kernel_at(dlt)
+        val = power.ravel()[:, None] * kernel_at(dlt)
         ok = (k >= 0) & (k < self.f.size)
         rows = np.broadcast_to(np.repeat(np.arange(n_runs), n_l)[:, None], k.shape)
         # a flat bincount adds in the same order as np.add.at, several times faster
@@ -484,8 +487,8 @@ class Context(Metric):
                 if state.resonances:
                     a = a * self.gain(state, c, f)
                 if state.smear is not None:
-                    du, wt = self.smear_offsets(state, h, runs)
-                    out += self.psd_at(f[:, None] + du, (a**2 / 2.0)[:, None] * wt, bins)
+                    du, wt, kern = self.smear_offsets(state, h, runs)
+                    out += self.psd_at(f[:, None] + du, (a**2 / 2.0)[:, None] * wt, bins, kernel=kern)
                 elif rip is None or state.speed_modulation is None:       # a ripple's powers come with one
                     plain_f.append(f)
                     plain_p.append(a**2 / 2.0)
@@ -599,51 +602,16 @@ class Context(Metric):
         n = np.asarray(self.sp.n_segments, dtype=float)[runs]
         return (n + 1.0) * self.sp.nperseg / 2.0 / self.sp.sample_rate
 
-    def smear_offsets(self, state: State, h: float, runs: np.ndarray, n_max: int = 48):
-        """(offsets Hz, weights) (len(runs), 3M) of a line h smeared by the state's spin acceleration:
-        during a run of length T at mean speed Ω the line sweeps f ± h|α|T/(4π); M points spaced at most
-        half a bin cover that range, each weighted by the instantaneous power (Ω(τ)/Ω)⁴ (a C·Ω² line) and
-        by how much its part of the record weighs in the Welch estimate (:meth:`_welch_weights`), each
-        point split in three across a segment's own sweep (see the comment in the code)."""
+    def smear_offsets(self, state: State, h: float, runs: np.ndarray) -> tuple:
+        """(offsets Hz, weights) (len(runs), K) of a line h on each run's K Welch segments under the state's spin
+        acceleration, and its kernel on one segment (a function of offsets in bins, 1/Hz): a chirp across every segment
+        (:mod:`rwadist.diagnose.smear`)."""
         if state.smear is None:
             raise ValueError("smear_offsets: the state has no spin acceleration (smear)")
-        alpha = float(state.smear)
-        T = self.run_durations(runs)
-        width = h * alpha * T / (2 * np.pi)                                  # Hz swept during the run
-        m = int(np.clip(np.ceil(2.0 * np.max(width) / self.df) + 1, 1, n_max))
-        u = (np.arange(m) + 0.5) / m - 0.5                                     # −½ … ½
-        du = width[:, None] * u[None, :]
-        w = np.maximum(np.abs(self.omega[runs]), 1e-12)
-        amp = (1.0 + alpha * T[:, None] * u[None, :] / w[:, None]) ** 4
-        n_samp = np.rint(T * self.sp.sample_rate).astype(int)
-        prof = np.array([self._welch_weights(int(n), m) for n in n_samp])
-        # within one Welch segment the line still sweeps h|α|L/(2π f_s) Hz and a chirp's windowed spectrum
-        # is broader than the average of instantaneous kernels: each point is spread over ±⅓ of that
-        # width as well.  Partly double counted (the record-level spread already holds the segments'
-        # chirp), so a fitted |α| comes out some 5-8 % low on fast sweeps -- without it the residual
-        # skirts of high harmonics invite a spurious broadband floor.
-        seg = h * alpha * self.sp.nperseg / self.sp.sample_rate / (2 * np.pi)
-        v = np.array([-1.0, 0.0, 1.0]) / 3.0
-        du = (du[:, :, None] + seg * v[None, None, :]).reshape(du.shape[0], -1)
-        wt = np.repeat(amp * prof, v.size, axis=1) / v.size
-        return du, wt
-
-    def _welch_weights(self, n: int, m: int) -> np.ndarray:
-        """How much each of m equal parts of an n-sample record weighs in its Welch PSD (sum 1): Σ over
-        the segments (50 % overlap) of the squared window falling in the part."""
-        key = ("welch_w", n, m)
-        if key not in self._memo:
-            from scipy import signal
-
-            L = self.sp.nperseg
-            w2 = signal.get_window(self.sp.window, L) ** 2
-            acc = np.zeros(n)
-            for s0 in range(0, n - L + 1, L // 2):
-                acc[s0:s0 + L] += w2
-            edges = np.rint(np.linspace(0, n, m + 1)).astype(int)
-            part = np.add.reduceat(acc, edges[:-1]) if n >= m else np.full(m, acc.sum() / m)
-            self._memo[key] = part / part.sum()
-        return self._memo[key]
+        fs, L = self.sp.sample_rate, self.sp.nperseg
+        n = np.rint(self.run_durations(runs) * fs)
+        du, wt = smear.segment_offsets(state.smear, h, self.omega[runs], n, np.asarray(self.sp.n_segments)[runs], L, fs)
+        return du, wt, smear.chirp_kernel(L, fs, self.sp.window, smear.segment_chirp(state.smear, h, L, fs))
 
     def band_centres(self) -> np.ndarray:
         return self.f[self.k_lo + BAND_BINS * np.arange(self.n_bands) + BAND_BINS // 2] - 0.5 * self.df

@@ -366,6 +366,12 @@ class Sidebands:
                              lambda d=d, hs=hs: Sidebands._record_candidates_fitted(ctx, state, runs, d, hs,
                                                                                     max_per_direction),
                              part="record")
+        if state.smear is not None:
+            # under a spin smear a line sweeps h|α|T/2π Hz over a run: a "pair" within that sweep (and the main lobe
+            # beyond it) is the line's own spread -- a Welch pair's offset refined toward its carrier (family wheel 7's
+            # 60-s run-up: ±0.31 Hz, depth 0.55, on the radial torque's h 3.42 smeared over ±2.8 Hz)
+            T = float(np.max(ctx.run_durations(np.asarray(runs))))
+            out = [e for e in out if e.f_mod >= 2.5 * ctx.df + e.h * state.smear * T / (4 * np.pi)]
         return out
 
     @staticmethod
@@ -389,8 +395,13 @@ class Sidebands:
     @staticmethod
     def _record_candidates_fitted(ctx: Context, state: State, runs, d: str, hs, max_per_direction: int) -> list:
         """Sidebands of direction ``d`` closer to the carrier than 2.5 Welch bins (a short record, a high sample rate:
-        f_mod 7 Hz at 7.5-Hz Welch bins), resolved by the whole record only: :meth:`record_candidates`, fitted."""
-        out = []
+        f_mod 7 Hz at 7.5-Hz Welch bins), resolved by the whole record only: :meth:`record_candidates`, fitted.  None on
+        a state with a spin smear: a line sweeping h|α|T/2π Hz over the record spreads over many record bins, and a
+        "pair" that close is its own spread (their held-out evidence is not read there
+        either, :meth:`heldout_evidence`; family wheel 7's 60-s run-up: a pair at ±0.31 Hz, depth 0.55, on the radial torque's h 3.42)."""
+        out: list = []
+        if state.smear is not None:
+            return out
         near = Sidebands.record_candidates(ctx, state, runs, d, hs)
         for _, h, f_m in sorted(near, reverse=True)[:max_per_direction]:
             e = Sidebands.fit_record(ctx, state, d, h, runs, f_m)

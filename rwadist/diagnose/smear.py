@@ -1,0 +1,91 @@
+"""A line of a run cut from a sweep, as its Welch PSD shows it: a chirp in every segment (the ``spin_acceleration``
+effect's prediction, :meth:`rwadist.diagnose.engine.Context.predict`).
+
+While the wheel accelerates at |α| = |dΩ/dt| the line of harmonic h moves at h|α|/2π Hz/s.  A Welch PSD is the mean
+over its segments (L samples, 50 % overlap: segment k starts at k·L/2) of each segment's windowed periodogram, and
+on one segment the line is a linear chirp about the frequency it has at the segment's centre, sweeping
+c = h|α|(L/f_s)²/2π bins of the segment's grid.  So the line's PSD is, exactly for a linear ramp,
+
+    S(f) = Σ_k (1/K)·P_k·K_c(f − f_k),   f_k = f + h|α|τ_k/2π,   P_k = (a²/2)·(1 + |α|τ_k/|Ω|)⁴,
+
+τ_k the segment's centre less the run's (s), K the run's segments, a the line's amplitude at the run's mean speed Ω
+(a C·Ω² line's power goes as Ω⁴; higher in frequency is faster both ways, so a run-down reads as a run-up), and K_c
+the chirp's kernel: |Σ_n w_n·e^{iπc(n/L − ½)²}·e^{−2πiδn/L}|²/(f_s·Σw²) at δ bins from the centre (its power is the
+window kernel's, Parseval; for c = 0 it is the window kernel).  K_c is tabulated for each c asked by a zero-padded
+FFT (every 1/:data:`OVERSAMPLE` bin) and read by a cubic.
+
+The earlier prediction spread each line over points every half bin across the whole run (weighted by the Welch
+weight of their part of the record) and split each point across ±⅓ of a segment's own sweep through the window's
+steady kernel: the segments' chirp counted twice, a fitted |α| 5-8 % low on fast sweeps (trial 11's 120-s run-up,
+3.48 rad/s² for 3.665 with its tach column).
+
+Units: Hz, s, rad/s, rad/s²; offsets in bins of the Welch segment.
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from .constants import KERNEL_HALF
+
+#: points per bin of the kernel table in δ (read by the 4-point Lagrange cubic)
+OVERSAMPLE = 64
+
+
+@functools.lru_cache(maxsize=512)
+def _kernel_row(nperseg: int, window: str, c: float) -> np.ndarray:
+    """|W_c|²/Σw² (the chirp kernel without its 1/f_s) at δ = −(KERNEL_HALF + 2) … KERNEL_HALF + 2 bins every
+    1/OVERSAMPLE bin, for a line sweeping ``c`` bins across the segment: bin m of the zero-padded FFT of
+    w(n)·e^{iπc(n/L − ½)²}.  Read-only (shared)."""
+    from scipy import signal
+
+    L = int(nperseg)
+    w = signal.get_window(window, L)
+    x = np.arange(L) / L - 0.5
+    steps = np.arange(-(KERNEL_HALF + 2) * OVERSAMPLE, (KERNEL_HALF + 2) * OVERSAMPLE + 1)
+    W = np.fft.fft(w * np.exp(1j * np.pi * c * x**2), L * OVERSAMPLE)[steps % (L * OVERSAMPLE)]
+    row = np.abs(W) ** 2 / np.sum(w**2)
+    row.flags.writeable = False
+    return row
+
+
+def chirp_kernel(nperseg: int, fs: float, window: str, c: float):
+    """The kernel K_c (1/Hz) of a line sweeping ``c`` bins across a segment of ``nperseg`` samples at ``fs`` Hz under
+    ``window``, as a function of the offsets δ (bins, any shape; read within ±(KERNEL_HALF + 1)): the kernel of that
+    c (:func:`_kernel_row`, kept per c: a state's spin acceleration and line set ask for the same few) read by the
+    4-point Lagrange cubic through its table (within 1e-8 of the peak, as the steady kernel's reading)."""
+    row = _kernel_row(int(nperseg), str(window), round(abs(float(c)), 12))
+    n = row.size
+
+    def at(dlt: np.ndarray) -> np.ndarray:
+        y = np.clip((np.asarray(dlt, dtype=float) + KERNEL_HALF + 2) * OVERSAMPLE, 1.0, n - 3.0)
+        i = y.astype(int)
+        u = y - i
+        p0, p1, p2, p3 = row[i - 1], row[i], row[i + 1], row[i + 2]
+        val = (-u * (u - 1) * (u - 2) / 6 * p0 + (u + 1) * (u - 1) * (u - 2) / 2 * p1
+               - (u + 1) * u * (u - 2) / 2 * p2 + (u + 1) * u * (u - 1) / 6 * p3)
+        return np.maximum(val, 0.0) / fs
+
+    return at
+
+
+def segment_offsets(alpha: float, h: float, omega: np.ndarray, n_samples: np.ndarray, n_segments: np.ndarray,
+                    nperseg: int, fs: float) -> tuple:
+    """(offsets Hz, weights) (len(runs), max K) of the line h on each run's Welch segments (module docstring): the
+    centre frequency of segment k less the run's mean h|Ω|/2π, and (1/K)·(1 + |α|τ_k/|Ω|)⁴ (0 past a run's own K).
+    ``omega`` rad/s, ``n_samples`` and ``n_segments`` per run; ``alpha`` rad/s²."""
+    alpha = abs(float(alpha))
+    n_seg = np.maximum(np.asarray(n_segments, dtype=int), 1)
+    k = np.arange(int(n_seg.max()))
+    step = nperseg - int(round(0.5 * nperseg))
+    tau = (k[None, :] * step + nperseg / 2.0 - np.asarray(n_samples, dtype=float)[:, None] / 2.0) / fs     # s
+    w = np.maximum(np.abs(np.asarray(omega, dtype=float)), 1e-12)
+    used = k[None, :] < n_seg[:, None]
+    wt = np.where(used, np.maximum(1.0 + alpha * tau / w[:, None], 0.0) ** 4 / n_seg[:, None], 0.0)
+    return np.where(used, h * alpha * tau / (2 * np.pi), 0.0), wt
+
+
+def segment_chirp(alpha: float, h: float, nperseg: int, fs: float) -> float:
+    """Bins the line h sweeps across one segment at |dΩ/dt| = ``alpha``: h|α|(L/f_s)²/2π."""
+    return abs(float(alpha)) * h * (nperseg / fs) ** 2 / (2 * np.pi)
