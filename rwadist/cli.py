@@ -462,7 +462,7 @@ def cmd_diagnose(args) -> int:
           f"{diag.error_after:.4g} (definition: report.md)")
     print(f"band-by-band misfit, every band alike (narrow lines count as on the waterfall): "
           f"{diag.contrast_error_before:.4g} -> {diag.contrast_error_after:.4g}")
-    if diag.unexplained:
+    if any(u.signature not in ("partial_line", "run_change") for u in diag.unexplained):
         print("  (the content described above with ? is in no model: it counts in both figures)")
     print(f"report: {args.output} ({len(files)} files; improved model: {Path(args.output) / 'model.json'})")
     return 0

@@ -158,15 +158,19 @@ FIT_MIN_SPEEDS = 5
 def check_test_speeds(test, source, model_given: bool = False) -> None:
     """Refuse, or warn about, a test too narrow in speed to diagnose (``source``: the data's path, named).
 
-    A :class:`DataError` when the runs of ``test`` hold fewer than 2 distinct speeds (sorted speeds closer than 0.1 % of
-    the top one to the next count as one): the search fits on every other speed and judges on the rest.  A sweep whose slices
-    all share one speed is said to be one steady run recorded as one file.  A :class:`RwadistWarning` when, without
-    a model given, they hold fewer than :data:`FIT_MIN_SPEEDS`: the empirical fit leaves out every line measured at
-    fewer speeds."""
+    A :class:`DataError` when the runs of ``test`` hold fewer than 2 distinct speeds (a speed within 0.1 % of the top
+    one of a speed already counted is the same; speeds not finite are left out): the search fits on every other speed
+    and judges on the rest.  A sweep whose slices all share one speed is said to be one steady run recorded as one
+    file.  A :class:`RwadistWarning` when, without a model given, they hold fewer than :data:`FIT_MIN_SPEEDS`: the
+    empirical fit leaves out every line measured at fewer speeds."""
     speeds = np.abs(np.array([r.speed for r in test.runs], dtype=float))
+    speeds = speeds[np.isfinite(speeds)]
     top = float(speeds.max()) if speeds.size else 0.0
-    srt = np.sort(speeds)
-    distinct = srt[np.r_[True, np.diff(srt) > 1e-3 * top]] if top > 0 else srt[:1]
+    kept: list = []
+    for x in np.sort(speeds):       # each new speed counted against the last one kept (a slow sweep's slices count)
+        if not kept or x - kept[-1] > 1e-3 * top:
+            kept.append(float(x))
+    distinct = np.array(kept)
     rpm = ", ".join(f"{x * RAD_S_TO_RPM:.0f}" for x in distinct)
     if distinct.size >= 2:
         if distinct.size < FIT_MIN_SPEEDS and not model_given:

@@ -76,3 +76,18 @@ def test_speeds_within_a_thousandth_or_of_opposite_sign_count_as_one(speeds):
     test = SimpleNamespace(runs=[SimpleNamespace(speed=2 * np.pi * s / 60.0) for s in speeds], meta={})
     with pytest.raises(DataError, match="runs at 1 distinct speed"):
         check_test_speeds(test, "x")
+
+
+def test_a_slow_sweeps_many_slices_count_and_a_speed_not_finite_does_not():
+    """600 slices from 2000 to 3000 rpm (1.67 rpm apart, under 0.1 % of the top speed each) are 334 speeds, not one
+    (each speed is counted against the last one counted, not its neighbour; review12); a run whose speed is NaN is
+    left out, not read as the test having one speed."""
+    from types import SimpleNamespace
+
+    from rwadist.validate import check_test_speeds
+
+    slow = SimpleNamespace(runs=[SimpleNamespace(speed=2 * np.pi * s / 60.0) for s in np.linspace(2000, 3000, 600)],
+                           meta={"slicing": {}})
+    check_test_speeds(slow, "sweep.csv", model_given=True)
+    odd = SimpleNamespace(runs=[SimpleNamespace(speed=s) for s in (np.nan, 100.0, 200.0, 300.0, 400.0, 500.0)], meta={})
+    check_test_speeds(odd, "x")

@@ -134,10 +134,12 @@ def test_a_travelling_wave_on_a_family_wheel_is_described_on_the_default_path():
     assert float(u.causes[0].split("≈ ")[1].split(" Hz")[0]) == pytest.approx(600.0, rel=0.03)
 
 
-@pytest.mark.parametrize("f_mode, reached", [(420.0, True), (60.0, False)])
+@pytest.mark.parametrize("f_mode, reached", [(420.0, True), (60.0, False), (1200.0, False)])
 def test_a_fitted_mode_the_track_reaches_is_said_to_be_suspect(f_mode, reached):
     """Family wheel 7's axial lines through the rotor mode at 700 − 2·f_spin Hz (367 Hz at the top speed), beside a
-    fitted axial mode at 420 Hz (the track passes it) or at 60 Hz (a line there changed by 0.05 dB at most): the
+    fitted axial mode at 420 Hz (the track passes it), at 60 Hz (a line there changed by 0.05 dB at most) or at
+    1200 Hz (more than 1.5x above the track everywhere: a line there sits on the shape's far-above asymptote, 1 − μ,
+    −3 dB at μ 0.3, which is no reach of that mode; review12: it was called suspect): the
     record says the first is reached, with the change of a line at the mode's frequency within 2 dB of H written
     here at the speed it names, and that the mode is suspect; of the second it says nothing."""
     from rwadist.diagnose.describe_structure import moving_resonance
@@ -155,3 +157,27 @@ def test_a_fitted_mode_the_track_reaches_is_said_to_be_suspect(f_mode, reached):
     truth = 20 * np.log10(abs(rotor_mode(f_mode, 700.0 - 2.0 * got["speed_rpm"] / 60.0, 0.015, 0.3)))
     assert abs(truth) >= 1.0 and got["lift_dB"] == pytest.approx(truth, abs=2.0)
     assert "fitted axial mode (420 Hz)" in u.would_tell and "suspect" in u.would_tell
+
+
+def test_no_mass_share_shape_holds_more_than_the_rotors_mass():
+    """The mass-share shape's μ = 2ζ·sqrt(g² − 1) < 1 (a mode's modal mass is a share of the rotor's): the grids'
+    ζ 0.08 with gain 10 (μ 1.59, a gain far above of −0.59) is not tried, so no fit reports one (review12)."""
+    from rwadist.diagnose import describe_structure as ds
+
+    r = _ratios(fw.family()[7], 16, 700.0, -2.0)
+    best = ds._track_fit(r, np.linspace(600.0, 800.0, 21), np.array([-2.0]), per_slope=False)
+    every = [(z, g, a) for z in ds.ZETAS for g in ds.GAINS for a in ds.GAINS_ABOVE]
+    assert any(a is ds.MASS_SHARE and ds.gain_above(z, g, a) <= 0 for z, g, a in every)     # the grid holds such
+    assert best[5] is not ds.MASS_SHARE or ds.gain_above(best[3], best[4], best[5]) > 0.0
+    bad = [(0.08, 10.0, ds.MASS_SHARE)]
+    assert np.isinf(ds._track_fit(r, np.linspace(600.0, 800.0, 21), np.array([-2.0]), shapes=bad)[0])
+
+
+def test_a_rising_track_below_n_times_the_spin_is_the_backward_wave_past_its_critical_speed():
+    """Slope +2 at 120 Hz with the spin at 100 Hz: f_rotor + 2·f_spin would put the rotor's mode at −80 Hz; the track
+    is |f_rotor − 2·f_spin| past the backward wave's critical speed, f_rotor = 80 Hz (review12)."""
+    from rwadist.diagnose.describe_structure import _moving_causes
+
+    first = _moving_causes(2.0, "stiffening", 120.0, 100.0)[0]
+    assert "≈ 80 Hz in the rotor's frame" in first and "past its critical speed" in first and "-80" not in first
+    assert "≈ 320 Hz" in _moving_causes(2.0, "stiffening", 520.0, 100.0)[0]       # a forward wave: 520 − 200

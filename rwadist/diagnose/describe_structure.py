@@ -481,6 +481,8 @@ def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray, shapes=None, 
             continue
         fr = np.where(fr > 0, fr, 1.0)
         for z, g, above in shapes or ((z, g, a) for z in ZETAS for g in GAINS for a in GAINS_ABOVE):
+            if above is MASS_SHARE and gain_above(z, g, above) <= 0.0:
+                continue                # a mode of more than the rotor's whole mass (μ >= 1): no physical shape
             G = _resonance_db(r.f[None, :], fr, z, g, above)                      # (F, N)
             res = r.q[None, :] - G
             off = (res @ onehot.T) / count                                        # (F, L) per-line offsets
@@ -657,6 +659,9 @@ def _moving_causes(slope: float, sign: str, f_mid: float, spin_mid: float) -> tu
     if 1 <= n <= NODAL_MAX and abs(abs(slope) - n) <= NODAL_TOL:
         wave, op = ("backward", "−") if slope < 0 else ("forward", "+")
         f_rot = f_mid - np.sign(slope) * n * spin_mid
+        if f_rot < 0:
+            # a rising track below n·f_spin: the backward wave past its critical speed, |f_rotor − n·f_spin|
+            wave, op, f_rot = "backward (past its critical speed, n·f_spin = f_rotor)", "−", -f_rot
         nodal = (f"a mode of the rotor with {n} nodal diameter{'s' if n > 1 else ''} (a disc, web or rim mode) at "
                  f"≈ {f_rot:.4g} Hz in the rotor's frame, seen in the stationary frame as its {wave} travelling wave "
                  f"at f_rotor {op} {n}·f_spin (a rotating-frame mode seen from the housing; an axisymmetric rotor's modes "
@@ -685,6 +690,8 @@ DIRECTION_MODE = {"radial_force": "radial_translation", "axial_force": "axial"}
 #: The track reaches a fitted mode of its direction where its fitted resonance changes a line at the mode's frequency
 #: by this much (dB) at one of the speeds at least
 REACH_DB = 1.0
+#: ... counted only where the mode's frequency is within this factor of the track's
+REACH_RATIO = 1.5
 
 
 def _crossed_mode(direction: str, modes, track, s_lo: float, s_hi: float, shape: tuple) -> dict | None:
@@ -703,7 +710,11 @@ def _crossed_mode(direction: str, modes, track, s_lo: float, s_hi: float, shape:
     if not np.isfinite(f_m) or f_m <= 0:
         return None
     spin = np.linspace(s_lo, s_hi, 201)
-    lift = _resonance_db(np.full(spin.shape, f_m), np.maximum(track(spin), 1e-6), *shape)
+    f_track = np.maximum(track(spin), 1e-6)
+    lift = _resonance_db(np.full(spin.shape, f_m), f_track, *shape)
+    # only where the mode lies near the track (within REACH_RATIO of it): far above it a shape falling to its
+    # asymptote (1/r² of a transmissibility, 1 − μ of a mass share) changes every line, which is no reach of the mode
+    lift = np.where(np.abs(np.log(f_m / f_track)) < np.log(REACH_RATIO), lift, 0.0)
     i = int(np.argmax(np.abs(lift)))
     if not abs(lift[i]) >= REACH_DB:
         return None
