@@ -150,19 +150,17 @@ def check_f_lim(test, f_lim, parameter: str = "f_lim") -> None:
                              "a limit below it (or leave it out)")
 
 
-#: Distinct speeds the empirical fit needs to keep a line (:class:`rwadist.empirical.FitSettings` ``min_points``):
-#: diagnose on fewer, from the data's own fit, warns that its starting model holds few lines.
-FIT_MIN_SPEEDS = 5
-
-
 def check_test_speeds(test, source, model_given: bool = False) -> None:
     """Refuse, or warn about, a test too narrow in speed to diagnose (``source``: the data's path, named).
 
     A :class:`DataError` when the runs of ``test`` hold fewer than 2 distinct speeds (a speed within 0.1 % of the top
     one of a speed already counted is the same; speeds not finite are left out): the search fits on every other speed
     and judges on the rest.  A sweep whose slices all share one speed is said to be one steady run recorded as one
-    file.  A :class:`RwadistWarning` when, without a model given, they hold fewer than :data:`FIT_MIN_SPEEDS`: the
-    empirical fit leaves out every line measured at fewer speeds."""
+    file.  A :class:`RwadistWarning` when, without a model given, they hold fewer than the empirical fit's
+    ``min_points`` (:class:`rwadist.empirical.FitSettings`): that fit leaves out every line measured at fewer speeds."""
+    from .empirical import FitSettings  # diagnose's own import; the one place the count is decided
+
+    need = FitSettings.min_points
     speeds = np.abs(np.array([r.speed for r in test.runs], dtype=float))
     speeds = speeds[np.isfinite(speeds)]
     top = float(speeds.max()) if speeds.size else 0.0
@@ -173,14 +171,14 @@ def check_test_speeds(test, source, model_given: bool = False) -> None:
     distinct = np.array(kept)
     rpm = ", ".join(f"{x * RAD_S_TO_RPM:.0f}" for x in distinct)
     if distinct.size >= 2:
-        if distinct.size < FIT_MIN_SPEEDS and not model_given:
+        if distinct.size < need and not model_given:
             warnings.warn(RwadistWarning(
                 f"{source}: runs at {distinct.size} distinct speeds ({rpm} rpm): the data's empirical fit keeps a "
-                f"line measured at {FIT_MIN_SPEEDS} speeds at least, so the starting model holds few lines or none; "
+                f"line measured at {need} speeds at least, so the starting model holds few lines or none; "
                 "give the test's runs over its speed range (or a model file)"), stacklevel=3)
         return
     msg = (f"runs at {distinct.size} distinct speed ({rpm} rpm): diagnose needs runs at 2 speeds at least (it fits on "
-           f"every other speed and judges on the rest; the data's own fit needs {FIT_MIN_SPEEDS}); give the test's "
+           f"every other speed and judges on the rest; the data's own fit needs {need}); give the test's "
            "runs over its speed range")
     if (getattr(test, "meta", None) or {}).get("slicing") is not None and speeds.size:
         change = 100.0 * float(speeds.max() - speeds.min()) / max(top, 1e-300)
