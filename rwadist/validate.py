@@ -177,7 +177,9 @@ def check_test_speeds(test, source, model_given: bool = False) -> None:
                 f"line measured at {need} speeds at least, so the starting model holds few lines or none; "
                 "give the test's runs over its speed range (or a model file)"), stacklevel=3)
         return
-    msg = (f"runs at {distinct.size} distinct speed ({rpm} rpm): diagnose needs runs at 2 speeds at least (it fits on "
+    held = (f"runs at 1 distinct speed ({rpm} rpm)" if distinct.size else
+            "no run with a finite speed (every speed is NaN or infinite)")
+    msg = (f"{held}: diagnose needs runs at 2 speeds at least (it fits on "
            f"every other speed and judges on the rest; the data's own fit needs {need}); give the test's "
            "runs over its speed range")
     if (getattr(test, "meta", None) or {}).get("slicing") is not None and speeds.size:

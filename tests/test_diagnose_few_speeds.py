@@ -91,3 +91,16 @@ def test_a_slow_sweeps_many_slices_count_and_a_speed_not_finite_does_not():
     check_test_speeds(slow, "sweep.csv", model_given=True)
     odd = SimpleNamespace(runs=[SimpleNamespace(speed=s) for s in (np.nan, 100.0, 200.0, 300.0, 400.0, 500.0)], meta={})
     check_test_speeds(odd, "x")
+
+
+def test_runs_without_a_finite_speed_are_named_as_such():
+    """Every speed NaN or infinite: no "0 distinct speed ()" (review12), the reason in words."""
+    from types import SimpleNamespace
+
+    from rwadist.errors import DataError
+    from rwadist.validate import check_test_speeds
+
+    test = SimpleNamespace(runs=[SimpleNamespace(speed=s) for s in (np.nan, np.inf)], meta={})
+    with pytest.raises(DataError, match=r"no run with a finite speed \(every speed is NaN or infinite\): diagnose "
+                                        r"needs runs at 2 speeds"):
+        check_test_speeds(test, "x")
