@@ -45,7 +45,7 @@ from .data import DataError, Run, SteadyTest
 from .dft import blocked_records, run_window, windowed_dfts
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .extended_fit_close import with_close_lines
-from .extended_fit_lsq import MODE_PARAMS, LogAmplitudeProblem, Solution, loose_modes
+from .extended_fit_lsq import MODE_PARAMS, LogAmplitudeProblem, Solution, loose_modes, power_sum_stderr, split_note
 from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower
 from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
@@ -598,9 +598,12 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     problem = LogAmplitudeProblem(base, lines, LinePower(lines, sa, ax_line, ca, sr, rad_parts), log_data, joint,
                                   row_line, centred_log_w, meas.lines, progress)
     off_law: list[int] = []     # lines given an exponent of their own before a mode is declared (appended in place)
-    res, names, rel_se, unpack, _ = _fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare,
-                                               tolerance, off_law, log_w, lambda m, why: starts.declare(base, m, why))
+    solution = _fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare,
+                          tolerance, off_law, log_w, lambda m, why: starts.declare(base, m, why))
+    res, names, rel_se, unpack = solution.res, solution.names, solution.rel_se, solution.unpack
     params, fitted_lines = unpack(res.x)
+    sums = power_sum_stderr(solution, {(x.direction, float(x.h)): tuple(line_of[j])
+                                       for j, x in enumerate(meas.lines) if x.direction in RADIAL})
     n_x = res.x.size - (len(joint.NAMES) if joint is not None else 0)
     notes += [off_law_note(meas.lines[j], res.x[n_x + i - len(off_law)], rel_se[n_x + i - len(off_law)])
               for i, j in enumerate(off_law)]
@@ -608,6 +611,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         stand = joint.stand(res.x[n_x:])
     params = replace(params, height=float(height))
     senses, kept_lines = _fitted_senses(meas.lines, fitted_lines, line_of)
+    # a line the model file keeps both parts of, whose split the power does not see: its parts' errors say little
+    notes += [split_note(d, h, *se) for (d, h), se in sums.items() if se[3] >= 1.0 and senses[(d, h)][0] == "co+counter"]
     resid_db, line_residuals = _residuals_near_modes(params, lines, ax_line, rad_parts, sa, sr, dr, res.fun, notes)
     for m in (m for m in MODE_PARAMS if declare and starts.identified[m] and resid_db.get(m, 0.0) > MISFIT_DB):
         starts.identified[m] = False
@@ -617,7 +622,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     return ExtendedFit(params=params, lines=kept_lines,
                        zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
                              "axial_translation": params.zeta_z},
-                       rel_stderr={n: float(v) for n, v in zip(names, rel_se)}, identified=starts.identified,
+                       rel_stderr={n: float(v) for n, v in zip(names, rel_se)}
+                       | {f"C[{d},{h:g},co+counter]": se[0] for (d, h), se in sums.items()}, identified=starts.identified,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
                        unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),

@@ -24,6 +24,16 @@ MODE_PARAMS = {"radial_translation": ("k_r", "c_r", "mass"), "rocking": ("k_rock
                "axial_translation": ("k_z", "c_z", "mass")}
 
 
+def _row_variance(res: optimize.OptimizeResult, row_group: np.ndarray) -> np.ndarray:
+    """Per row of the least squares, its direction's mean squared residual (``row_group``: per row its direction),
+    the degrees of freedom shared out in proportion to the rows (:func:`_covariance`)."""
+    r2 = res.fun**2
+    scale = res.fun.size / max(res.fun.size - res.x.size, 1)
+    groups, inverse = np.unique(row_group, return_inverse=True)
+    mean = np.bincount(inverse, weights=r2, minlength=groups.size) / np.maximum(np.bincount(inverse), 1)
+    return scale * mean[inverse]
+
+
 def _covariance(res: optimize.OptimizeResult, row_group: np.ndarray) -> np.ndarray:
     """Covariance of the least squares' parameters ``res.x`` with each load direction's own residual variance
     (``row_group``: per row its direction): (JᵀJ)⁺ Jᵀ S J (JᵀJ)⁺, S = diag of each row's direction's mean squared
@@ -31,11 +41,7 @@ def _covariance(res: optimize.OptimizeResult, row_group: np.ndarray) -> np.ndarr
     own direction's lines: another direction's misfit (a resonance moving with speed on the radial forces, which no
     mode of the model has, 1.3 dB near the translation) is no scatter of the rocking lines, and pooled it widened the
     rocking's standard error past the 2 % of a found mode.  One direction: s²·(JᵀJ)⁺, as before."""
-    r2 = res.fun**2
-    scale = res.fun.size / max(res.fun.size - res.x.size, 1)
-    groups, inverse = np.unique(row_group, return_inverse=True)
-    mean = np.bincount(inverse, weights=r2, minlength=groups.size) / np.maximum(np.bincount(inverse), 1)
-    s2_row = scale * mean[inverse]
+    s2_row = _row_variance(res, row_group)
     inv = np.linalg.pinv(res.jac.T @ res.jac)
     return inv @ (res.jac.T @ (s2_row[:, None] * res.jac)) @ inv
 
@@ -49,6 +55,8 @@ class Solution(NamedTuple):
     rel_se : relative standard error of each entry of θ (the standard error of its logarithm), shape like ``res.x``.
     unpack : θ -> (:class:`~rwadist.extended.ExtendedParams`, fitted lines).
     at_bound : per free mode, the limit its best fit sits at ("stiffness", "damping") or "".
+    cov : covariance of θ (:func:`_covariance`), shape (θ, θ); NaN where it could not be computed.
+    s2_row : per row its direction's residual variance (:func:`_row_variance`), shape like ``res.fun``.
     """
 
     res: optimize.OptimizeResult
@@ -56,6 +64,8 @@ class Solution(NamedTuple):
     rel_se: np.ndarray
     unpack: Callable[[np.ndarray], tuple[ext.ExtendedParams, list[ext.Line]]]
     at_bound: dict[str, str]
+    cov: np.ndarray
+    s2_row: np.ndarray
 
 
 @dataclass
@@ -116,16 +126,18 @@ class LogAmplitudeProblem:
                                      bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=400,
                                      verbose=2 if self.progress else 0)
         try:
-            rel_se = np.sqrt(np.clip(np.diag(_covariance(res, self.row_directions())), 0, None))
+            cov = _covariance(res, self.row_directions())
         except np.linalg.LinAlgError:
-            rel_se = np.full(res.x.size, np.nan)
+            cov = np.full((res.x.size, res.x.size), np.nan)
+        rel_se = np.sqrt(np.clip(np.diag(cov), 0, None))
         # a limit is what the fit allowed, not what the data say: stiffness at ±10 %, damping at its floor ζ = 5e-5 (a
         # stand beside a load-cell offset was taken for the translation so, -19 %)
         at_bound = {m: ("stiffness" if min(res.x[2 * i] - lo[2 * i], hi[2 * i] - res.x[2 * i]) < 0.01 else
                         "damping" if res.x[2 * i + 1] - lo[2 * i + 1] < 0.01 else "")
                     for i, m in enumerate(free_modes)}
         modes = list(free_modes)        # as solved (the caller's list loses the modes it declares next)
-        return Solution(res, names, rel_se, lambda theta: self.unpack(modes, theta), at_bound)
+        return Solution(res, names, rel_se, lambda theta: self.unpack(modes, theta), at_bound, cov,
+                        _row_variance(res, self.row_directions()))
 
     def row_directions(self) -> np.ndarray:
         """Per least-squares row, the index of its measured line's load direction (radial force, radial torque,
@@ -221,3 +233,43 @@ def loose_modes(solution: Solution, free_modes: list[str], base: dict, tolerance
                 at_bound[m], f"located at {f_fit:.4g} Hz but only to ±{100 * 1.5 * se_f:.1f} % (1.5 standard "
                              f"errors), not {100 * tolerance:g} %")))
     return loose
+
+
+def power_sum_stderr(solution: Solution, pairs: dict) -> dict:
+    """Per radial line fitted with a co- and a counter-rotating part (``pairs``: (direction, h) -> the parts' indices
+    among the least squares' forcing lines, co first): {(direction, h): (the relative standard error of the parts'
+    summed amplitude sqrt(C_co² + C_counter²), that of each part, the standard error of ln(C_co/C_counter) with
+    the other parameters held)}.
+
+    The rows are each line's x-plus-y power, abs(C_co·H_co)² + abs(C_counter·H_counter)²: where both senses pass
+    the same gain (a radial force through the translation mode, any line far from the whirl modes) the rows fix
+    the sum and not the split, whose column of the Jacobian then vanishes (trial11: parts' errors of 612 and 1477,
+    or, with the pseudo-inverse, small ones that mean nothing).  With g = (C_co², C_counter²)/P the sum's
+    d ln sqrt(P) = g·(d ln C_co, d ln C_counter): var = g·Σ·g.  The split moves along v = (g_counter, −g_co),
+    which keeps P and changes ln(C_co/C_counter) one for one: var = vᵀJᵀSJv/(vᵀJᵀJv)² (S the rows' variances,
+    the least squares unweighted); infinite when the rows do not see it."""
+    first = next(i for i, n in enumerate(solution.names) if n.startswith("C["))     # θ: the modes, then the lines
+    out = {}
+    for key, (k_co, k_ct) in pairs.items():
+        ij = [first + k_co, first + k_ct]
+        c2 = np.exp(2.0 * solution.res.x[ij])
+        g = c2 / np.sum(c2)
+        var = float(g @ solution.cov[np.ix_(ij, ij)] @ g)
+        jv = solution.res.jac[:, ij] @ np.array([g[1], -g[0]])
+        seen = float(jv @ jv)
+        split = math.sqrt(float(jv**2 @ solution.s2_row)) / seen if seen > 0.0 else math.inf
+        out[key] = (math.sqrt(max(var, 0.0)) if np.isfinite(var) else math.nan,
+                    float(solution.rel_se[ij[0]]), float(solution.rel_se[ij[1]]), split)
+    return out
+
+
+def split_note(direction: str, h: float, rel_sum: float, rel_co: float, rel_counter: float, split: float) -> str:
+    """The model file's note on a radial line whose co/counter split the line power leaves open
+    (:func:`power_sum_stderr`'s ``split`` over 1: the amplitude ratio not known within a factor e)."""
+    return (f"{direction} h={h:.4g}: the line power does not separate its co- and counter-rotating parts (both senses "
+            f"pass the same gain here; standard error of ln(C_co/C_counter) "
+            f"{'unbounded' if split > 1e3 else f'{split:.3g}'}, so the parts' own relative "
+            f"standard errors, {100 * rel_co:.3g} % and {100 * rel_counter:.3g} %, say little): the split is the x/y "
+            f"phase's (analytical.fit.senses; rwadist diagnose's counter_rotation measures it), and the summed "
+            f"amplitude sqrt(C_co² + C_counter²) is known to {100 * rel_sum:.2g} % "
+            f"(rel_stderr C[{direction},{h:g},co+counter])")

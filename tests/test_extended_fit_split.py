@@ -1,0 +1,82 @@
+"""A radial line's co/counter split that the line power cannot tell (trial11's standard errors of 612 and 1477):
+the extended fit says so, and gives the standard error of the parts' summed amplitude, which the data do fix.
+
+Data made here with numpy from :func:`rwadist.extended.steady_lines` (the E wheel, Table 4.2, its centre of mass on
+the load cell's plane): a force line at h = 2 with equal co and counter parts passes only the radial translation,
+which is no whirl (both senses, the same gain): the power cannot split it.  A torque line at h = 2.5 with equal
+parts passes the rocking mode, whose whirl branches split with speed: its split is measured.  The sum's standard
+error is checked against a second method: the scatter of the summed amplitude over the same wheel tested with other
+noise and line phases (8 seeds)."""
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from rwadist import extended as ext
+from rwadist.data import Run, SteadyTest
+from rwadist.empirical import fit_empirical
+from rwadist.extended_fit import fit_extended
+from rwadist.spectra import compute_spectra
+from rwadist.units import rpm_to_rad_s
+
+E = replace(ext.from_table_4_2(), height=0.0)
+LINES = [("radial_force", 2.0, 6e-7, "co"), ("radial_force", 2.0, 6e-7, "counter"),
+         ("radial_torque", 2.5, 3e-7, "co"), ("radial_torque", 2.5, 3e-7, "counter"),
+         ("axial_force", 1.5, 2e-6, "co")]
+
+
+def _data(params, speeds_rpm, fs=1920.0, n=4096, noise=0.01, seed=3):
+    rng = np.random.default_rng(seed)
+    lines = ext.imbalance_lines(params) + [ext.Line(d, h, c, s) for d, h, c, s in LINES]
+    w = rpm_to_rad_s(np.asarray(speeds_rpm, float))
+    f, A = ext.steady_lines(params, lines, w)
+    t = np.arange(n) / fs
+    std_f, std_t = noise * params.U_s * w.max() ** 2, noise * params.U_d * w.max() ** 2
+    runs = []
+    for i in range(w.size):
+        ph = rng.uniform(0, 2 * np.pi, len(lines))
+        ph[1] = ph[0]
+        sig = np.real(np.einsum("lc,ln->cn", A[i], np.exp(1j * (2 * np.pi * f[i][:, None] * t + ph[:, None]))))
+        chans = {c: sig[k] + (std_f if k < 3 else std_t) * rng.standard_normal(n)
+                 for k, c in enumerate(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"))}
+        runs.append(Run(float(w[i]), fs, chans, name=f"r{i:03d}.csv"))
+    return SteadyTest(runs)
+
+
+@pytest.fixture(scope="module")
+def fitted():
+    test = _data(E, np.linspace(600, 2400, 40))
+    fit = fit_empirical(compute_spectra(test))
+    return fit, fit_extended(test, fit, E.mass, 0.1965)
+
+
+def _key(ef, direction, h, part):
+    return next(k for k in ef.rel_stderr if k.startswith(f"C[{direction},") and k.endswith(f",{part}]")
+                and abs(float(k.split(",")[1]) - h) < 1e-3)
+
+
+def test_a_split_the_power_cannot_see_is_said_with_the_sums_standard_error(fitted):
+    _, ef = fitted
+    assert ef.senses[next(k for k in ef.senses if k[0] == "radial_force" and abs(k[1] - 2.0) < 1e-3)][0] == "co+counter"
+    rel_sum = ef.rel_stderr[_key(ef, "radial_force", 2.0, "co+counter")]
+    assert 0.0 < rel_sum < 0.05
+    note = next(n for n in ef.notes if n.startswith("radial_force h=2:"))
+    assert "does not separate its co- and counter-rotating parts" in note and f"known to {100 * rel_sum:.2g} %" in note
+    # second method: the summed amplitude's scatter over 8 tests of the same wheel (the least squares' standard error
+    # also holds its misfit, here the translation mode left at its starting value: 0.0020 against a scatter of 0.0007)
+    sums = []
+    for seed in range(10, 18):
+        test = _data(E, np.linspace(600, 2400, 40), seed=seed)
+        other = fit_extended(test, fit_empirical(compute_spectra(test)), E.mass, 0.1965)
+        sums.append(np.hypot(*[ln.C for ln in other.lines if ln.direction == "radial_force" and abs(ln.h - 2.0) < 1e-3]))
+    scatter = np.std(sums, ddof=1) / np.mean(sums)
+    assert 0.5 * scatter < rel_sum < 5.0 * scatter
+    # the summed amplitude is right: sqrt(2) x each part
+    parts = [ln.C for ln in ef.lines if ln.direction == "radial_force" and abs(ln.h - 2.0) < 1e-3]
+    assert np.hypot(*parts) == pytest.approx(np.sqrt(2) * 6e-7, rel=0.05)
+
+
+def test_a_split_the_rocking_whirl_measures_gets_no_note(fitted):
+    _, ef = fitted
+    assert not [n for n in ef.notes if n.startswith("radial_torque h=2.5")]
+    assert max(ef.rel_stderr[_key(ef, "radial_torque", 2.5, p)] for p in ("co", "counter")) < 0.2
