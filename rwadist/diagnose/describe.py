@@ -254,6 +254,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     :mod:`.describe_lines`), each with its share of the misplaced power and its level measured on ``res`` (default
     ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
     the records the search read had the changed runs' factor taken out, :func:`run_steps`)."""
+    from .describe_fixed import fixed_lines_in_part
     from .describe_lines import speed_lines
     from .describe_partial import partial_lines
     from .describe_structure import broadband_hump, line_ratios, moving_resonance, run_change
@@ -298,6 +299,16 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
                 cells[c] = m
         return res.measure(cells)
 
+    def of_fixed(chans, f_hz, runs):
+        b = int(res.band_of(f_hz))
+        cells = {}
+        for c in chans:
+            if c in res.e:
+                m = res.mask(c)
+                m[np.isin(ctx.runs, runs), b] = True
+                cells[c] = m
+        return res.measure(cells)
+
     ratios = line_ratios(ctx, state)
     others = [x.h for d in ("radial_force", "radial_torque", "axial_force", "axial_torque")
               for x in state.model.harmonics(d)]
@@ -306,6 +317,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += run_change(ctx, line_ratios(res.ctx, res.state) if changes else ratios, of_runs)
     out += speed_lines(ctx, state, of_line, bearings, others)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
+    out += fixed_lines_in_part(ctx, state, of_fixed)
     return out
 
 

@@ -34,7 +34,7 @@ def _parameters_key(parameters: Mapping) -> tuple:
 
 #: Signature -> what it is, in words (the JSON form's ``description``).
 SIGNATURES = {
-    "fixed_line": "a line at one fixed frequency in every run",
+    "fixed_line": "a line at one fixed frequency in every run, or in the runs above (below) some speed",
     "speed_line": "a line at a constant ratio of the speed that no model line has",
     "line_property": "what the data's lines have in common that the model's lines do not",
     "channel_copy": "a channel that carries a copy of another channel's content",
