@@ -255,6 +255,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
     the records the search read had the changed runs' factor taken out, :func:`run_steps`)."""
     from .describe_fixed import fixed_lines_in_part
+    from .describe_gain import channel_gain
     from .describe_lines import speed_lines
     from .describe_partial import partial_lines
     from .describe_structure import broadband_hump, line_ratios, moving_resonance, run_change
@@ -309,6 +310,16 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
                 cells[c] = m
         return res.measure(cells)
 
+    def of_lines(chans, hs, runs):
+        cells = {}
+        for c in chans:
+            if c in res.e:
+                m = res.mask(c)
+                for r in runs:
+                    m[pos[int(r)], res.band_of(np.asarray(hs) * ctx.omega[int(r)] / (2 * np.pi))] = True
+                cells[c] = m
+        return res.measure(cells)
+
     ratios = line_ratios(ctx, state)
     others = [x.h for d in ("radial_force", "radial_torque", "axial_force", "axial_torque")
               for x in state.model.harmonics(d)]
@@ -318,6 +329,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += speed_lines(ctx, state, of_line, bearings, others)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
     out += fixed_lines_in_part(ctx, state, of_fixed)
+    out += channel_gain(ctx, state, of_lines)
     return out
 
 

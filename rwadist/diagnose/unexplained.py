@@ -49,6 +49,7 @@ LEVEL_WORDS = {
     "broadband_hump": "{:+.1f} dB over the floor's smooth course",
     "run_change": "the changed runs {} dB off the others",
     "partial_line": "{:+.1f} dB against the model in the runs it is absent from",
+    "line_property": "{:+.2f} dB (power) in the second channel's lines against the first's",
 }
 
 

@@ -1,0 +1,97 @@
+"""Detector of the open world (issue 33, item 3) on the final model's residual: one channel of a radial pair reading
+every line stronger than its partner (a ``line_property``: a gain or calibration error of a load-cell channel).
+
+A radial line is a load rotating with or against the spin (or both: an ellipse), and the wheel and its suspension
+are axisymmetric, so x and y carry its power alike: exactly for a line of one sense, on average over the runs for an
+ellipse (its orientation is the parts' phase in the run).  The model gives x and y the same power.  A channel whose
+gain is off (a calibration, an amplifier's range, a bridge's excitation) reads every line of the pair by one factor
+against its partner: the lines' measured-over-predicted ratios differ between the two channels by one constant in
+every run and for every line, which no effect class describes (trial13: Ty reading 1.10 x, nothing said, error 5.7x
+the clean level).  Read on the model's lines standing :data:`LINE_SNR_DB` over the noise in both channels: the
+median over (line, run) of 10·log10(P_y/P̂_y) − 10·log10(P_x/P̂_x), described when it is :data:`MIN_DB` or more,
+:data:`MIN_Z` standard errors from 0 (the median's, from the scatter's MAD), and held by :data:`MIN_LINES` lines or
+more, each with its own median of the same sign within a factor 2 of it (an ellipse of fixed orientation, e.g. a
+support stiffer in x, tilts one line; a gain tilts them all).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import RAD_S_TO_RPM
+from .constants import LINE_HALF
+from .unexplained import Unexplained
+
+#: The radial pairs (x, y) read.
+PAIRS = (("Fx", "Fy"), ("Tx", "Ty"))
+#: A line's predicted power over the noise in its window, in both channels, at least (dB).
+LINE_SNR_DB = 20.0
+#: The median difference at least (dB of power: 0.4 dB is a 4.7 % amplitude gain) ...
+MIN_DB = 0.4
+#: ... and this many standard errors of the median.
+MIN_Z = 5.0
+#: Lines (h) that must each show it, with MIN_RUNS runs or more each.
+MIN_LINES = 2
+MIN_RUNS = 4
+
+
+def _powers(ctx, state, c: str, runs: np.ndarray):
+    """(h (L,), measured power (L, R), predicted power (L, R), noise power in the line's window (L, R)) of the model's
+    lines on channel ``c``; None without lines."""
+    cl = ctx.channel_lines(state, c, runs)
+    if not cl:
+        return None
+    h = np.array([x[0] for x in cl])
+    f = h[:, None] * ctx.omega[runs][None, :] / (2 * np.pi)
+    a = np.array([x[2] for x in cl]) * ctx.gain(state, c, f)
+    m = ctx.measure_lines(state, c, runs)
+    k = np.clip(np.rint(f / ctx.df).astype(int), 0, ctx.f.size - 1)
+    noise = ctx.floor_psd(state, c, runs)[np.arange(runs.size)[None, :], k] * ctx.df * (2 * LINE_HALF + 1)
+    ok = np.isfinite(ctx.sp.psd[c][runs, 0])[None, :]
+    return h, np.where(ok, np.nan_to_num(m) ** 2 / 2, np.nan), np.where(ok, a**2 / 2, np.nan), noise
+
+
+def channel_gain(ctx, state, shares) -> list:
+    """``line_property`` records of a radial pair whose two channels read the model's lines by different factors
+    (``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB) of the lines' cells)."""
+    runs = ctx.runs
+    out: list[Unexplained] = []
+    for cx, cy in PAIRS:
+        if cx not in ctx.channels or cy not in ctx.channels:
+            continue
+        px, py = _powers(ctx, state, cx, runs), _powers(ctx, state, cy, runs)
+        if px is None or py is None or px[0].size != py[0].size or np.any(np.abs(px[0] - py[0]) > 1e-9):
+            continue
+        h = px[0]
+        snr = np.minimum(px[2] / np.maximum(px[3], 1e-300), py[2] / np.maximum(py[3], 1e-300))
+        good = (snr >= 10 ** (LINE_SNR_DB / 10)) & (px[1] > 0) & (py[1] > 0) & np.isfinite(px[1] + py[1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d = 10 * np.log10(py[1] / py[2]) - 10 * np.log10(px[1] / px[2])
+        lines = [i for i in range(h.size) if good[i].sum() >= MIN_RUNS]
+        if len(lines) < MIN_LINES:
+            continue
+        cells = np.concatenate([d[i][good[i]] for i in lines])
+        med = float(np.median(cells))
+        se = 1.2533 * 1.4826 * float(np.median(np.abs(cells - med))) / np.sqrt(cells.size)
+        per_line = np.array([np.median(d[i][good[i]]) for i in lines])
+        agree = (np.sign(per_line) == np.sign(med)) & (np.abs(per_line) >= 0.5 * abs(med)) & \
+            (np.abs(per_line) <= 2.0 * abs(med))
+        if abs(med) < MIN_DB or abs(med) < MIN_Z * se or agree.sum() < MIN_LINES:
+            continue
+        used = np.flatnonzero(good[lines].any(axis=0))
+        share, _ = shares((cx, cy), h[lines], runs[used])
+        rpm = ctx.omega[runs[used]] * RAD_S_TO_RPM
+        f = np.concatenate([h[i] * ctx.omega[runs[good[i]]] / (2 * np.pi) for i in lines])
+        ratio = 10 ** (med / 20)
+        hi_c, lo_c = (cy, cx) if med > 0 else (cx, cy)
+        out.append(Unexplained(
+            signature="line_property", channels=(cx, cy), speed_rpm=(float(rpm.min()), float(rpm.max())),
+            f_Hz=(float(f.min()), float(f.max())), level_dB=med, share=share, n_runs=int(used.size),
+            parameters={"property": "channel_gain", "channel": cy, "reference": cx,
+                        "amplitude_ratio": float(ratio), "power_ratio_dB": med, "stderr_dB": se,
+                        "lines_h": [float(x) for x in h[lines][agree]], "cells": int(cells.size)},
+            causes=(f"a gain or calibration error of {hi_c} or {lo_c}: {hi_c} reads {max(ratio, 1 / ratio):.3g} x "
+                    f"{lo_c} on every line (a rotating load gives x and y the same power)",
+                    "a support or fixture stiffer in one direction (then the ratio changes with the frequency)"),
+            would_tell=f"a calibration of {cx} and {cy} with one known load (a mass hung, a shaker's force), or the "
+                       "load cell turned 90 degrees on the stand (a channel's gain goes with the channel)"))
+    return out
