@@ -586,6 +586,29 @@ def _moving_fit(r: LineRatios) -> tuple | None:
     return got
 
 
+def resolved_lines(ctx, state, r: LineRatios) -> LineRatios:
+    """``r`` without the points of a line in a run where it is not resolved from the direction's other lines: where
+    they predict more power in its window than it does (:func:`.describe_partial.others_in_window` over
+    :data:`.describe_partial.OTHERS_IN_WINDOW_MAX`, the lines the effects added included).  There its measured power
+    (:meth:`Context.measure_lines`: the data less the model's other lines) is its neighbours' misfit and beat as
+    much as its own: a speed sideband 0.06·Ω/2π from its carrier read the carrier's misfit, lifted by 4-6 dB in the
+    top three runs (family wheel 7's speed_sidebands, 1.2-1.9 bins from the carrier; the E-like wheel's at the
+    default path), and a track through them was described as a moving resonance of 0 % share, and on the E-like
+    wheel the true speed_sidebands effect was taken back as fitted to it."""
+    from dataclasses import replace
+
+    from .describe_partial import OTHERS_IN_WINDOW_MAX, others_in_window
+
+    keep = np.ones(r.q.size, bool)
+    for ln in np.unique(r.line):
+        m = np.flatnonzero(r.line == ln)
+        others = others_in_window(ctx, state, r.direction, float(r.h[m[0]]), ctx.runs[r.run[m]])
+        keep[m] = others <= OTHERS_IN_WINDOW_MAX
+    if keep.all():
+        return r
+    return replace(r, **{k: getattr(r, k)[keep] for k in ("q", "f", "run", "spin", "line", "h", "w")})
+
+
 def moving_resonance(ctx, state, ratios: list, shares) -> list:
     """A resonance lifting the lines of one direction whose frequency moves with the speed.
 
