@@ -102,3 +102,40 @@ def test_speed_sidebands_on_a_family_wheel_are_no_moving_resonance():
     assert [e.kind for e in d.state_after.effects] == ["suspension_modes", "speed_sidebands"]
     assert not [h for h in d.hypotheses if getattr(h, "forced_by", None)]
     assert not [u for u in d.unexplained if u.signature == "moving_resonance"], [u.text() for u in d.unexplained]
+
+
+@pytest.mark.parametrize("still_described", [False, True])
+def test_an_effect_is_taken_back_for_a_moving_resonance_only_where_one_stands_without_it(monkeypatch, still_described):
+    """:func:`rwadist.diagnose.describe.finish` with the description and the take-back test stubbed: a moving
+    resonance that takes an effect back but is not described once the effect is out was read on the effect's own
+    lines (the E-like wheel's speed sidebands, read against their carrier): the effect is kept, its hypothesis
+    passed, the model not made again and the records those of the state with it.  Where one is still described
+    without it, it is taken back (``forced_by`` "moving_resonance") as before."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose import describe as ds
+
+    effect = SimpleNamespace(kind="speed_sidebands", apply=lambda s: SimpleNamespace(effects=list(s.effects) + [effect]))
+    before = SimpleNamespace(effects=[])
+    after = SimpleNamespace(effects=[effect])
+    track = SimpleNamespace(signature="moving_resonance", h=None)
+
+    def described(diag, opened, state, bearings=()):
+        diag.state_after = state
+        return ([track] if still_described or effect in state.effects else []), "res"
+
+    monkeypatch.setattr(ds, "_described", described)
+    monkeypatch.setattr(ds, "forced_effects", lambda *a: [(effect, "moving_resonance")])
+    monkeypatch.setattr(ds, "line_causes", lambda *a: [])
+    hyp = SimpleNamespace(effect=effect, passed=True, forced_by=None)
+    diag = SimpleNamespace(state_before=before, state_after=after, hypotheses=[hyp])
+    raw = SimpleNamespace(contrast_error=lambda s: 0.0)
+    rebuilt = []
+    ds.finish(diag, SimpleNamespace(ctx=raw, raw=raw), rebuild=lambda s, h: rebuilt.append(s) or "model")
+    assert diag.unexplained == (track,)
+    if still_described:
+        assert hyp.passed is False and hyp.forced_by == "moving_resonance" and len(rebuilt) == 1
+        assert effect not in diag.state_after.effects
+    else:
+        assert hyp.passed is True and hyp.forced_by is None and not rebuilt
+        assert diag.state_after is after
