@@ -430,34 +430,59 @@ MOVING_MIN_MISFIT_DB = 0.45
 SLOPES = np.round(np.arange(-3.0, 3.0001, 0.1), 2)
 ZETAS = (0.01, 0.02, 0.04, 0.08)
 GAINS = (2.0, 3.5, 6.0, 10.0)
-#: ... and the gain far above it: 1 (a resonance of the stand or the rotor, H -> 1 on both sides) or 0 (a wheel mode
-#: seen through its suspension, the transmissibility falling above it), for the moving and the fixed alike
-GAINS_ABOVE = (1.0, 0.0)
+#: ... and the gain far above it: 1 (a resonance of the stand or the rotor, H -> 1 on both sides), 0 (a wheel mode
+#: seen through its suspension, the transmissibility falling above it) or :data:`MASS_SHARE` (a mode carrying a share
+#: of the rotor's mass), for the moving and the fixed alike
+MASS_SHARE = None
+GAINS_ABOVE: tuple = (1.0, 0.0, MASS_SHARE)
 
 
-def _resonance_db(f: np.ndarray, f_r: np.ndarray, zeta: float, gain: float, above: float = 1.0) -> np.ndarray:
-    """20·log10 |H| of the resonance (:func:`rwadist.resonance.resonance_response`, gain ``above`` far above it) at
-    ``f`` over ``f_r``."""
+def gain_above(zeta: float, gain: float, above: float | None) -> float:
+    """β, the gain far above the resonance, of a shape of :data:`GAINS_ABOVE`: ``above`` itself, or for
+    :data:`MASS_SHARE` 1 − μ with μ = 2ζ·sqrt(g² − 1).
+
+    A mode of the rotor holding a share μ of its mass (modal mass over the rotor's, ζ its damping ratio) adds
+    μ·r²/(1 − r² + 2jζr) to the force the rigid rotor puts through its bearings at a line of frequency ratio r = f/f_r:
+    H = (1 − (1 − μ)·r² + 2jζr)/(1 − r² + 2jζr), 1 below, 1 − μ far above, an antiresonance at r = 1/sqrt(1 − μ)
+    between, peak |H(1)| = sqrt(1 + (μ/2ζ)²) = g (the general gain of :mod:`rwadist.resonance` with γ = 1).  The
+    antiresonance takes lines just above the mode down by 10-20 dB, which neither other shape has."""
+    if above is not None:
+        return float(above)
+    return 1.0 - 2.0 * zeta * float(np.sqrt(max(gain * gain - 1.0, 0.0)))
+
+
+def _resonance_db(f: np.ndarray, f_r: np.ndarray, zeta: float, gain: float, above: float | None = 1.0) -> np.ndarray:
+    """20·log10 |H| of the resonance (:func:`rwadist.resonance.resonance_response`, gain ``above`` far above it, or
+    the shape of a mode holding a share of the rotor's mass: :func:`gain_above`) at ``f`` over ``f_r``."""
     from ..resonance import resonance_response
 
-    return 20 * np.log10(np.maximum(np.abs(resonance_response(f / f_r, zeta, gain, above)), 1e-12))
+    beta = gain_above(zeta, gain, above)
+    return 20 * np.log10(np.maximum(np.abs(resonance_response(f / f_r, zeta, gain, beta)), 1e-12))
 
 
-def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray) -> tuple:
-    """(sse, f0, slope, zeta, gain, gain above) of the best track f_r = f0 + slope·(spin − spin_mid) over the grids,
-    each line's own offset (its C's misfit) taken out: the least squares of q on the resonance's dB gain per line."""
+def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray, shapes=None, per_slope: bool = False):
+    """(sse, f0, slope, zeta, gain, gain above) of the best track f_r = f0 + slope·(spin − spin_mid) over the grids
+    (``shapes``: the (ζ, gain, gain above) tried, default every one of :data:`ZETAS`, :data:`GAINS` and
+    :data:`GAINS_ABOVE`), each line's own offset (its C's misfit) taken out: the least squares of q on the
+    resonance's dB gain per line; with ``per_slope``, the list of the best of each slope."""
     mid = 0.5 * (r.spin.min() + r.spin.max())
     lines = np.unique(r.line)
     onehot = (r.line[None, :] == lines[:, None]).astype(float)                       # (L, N)
     count = onehot.sum(1)
-    best = (np.inf, np.nan, np.nan, np.nan, np.nan, np.nan)
+    none = (np.inf, np.nan, np.nan, np.nan, np.nan, np.nan)
+    best, each = none, []
     for b in slopes:
+        if per_slope:
+            each.append(best)
+            best = none
         fr = f0s[:, None] + b * (r.spin[None, :] - mid)                               # (F, N)
         valid = np.all(fr > 0, axis=1)
         if not valid.any():
             continue
         fr = np.where(fr > 0, fr, 1.0)
-        for z, g, above in ((z, g, a) for z in ZETAS for g in GAINS for a in GAINS_ABOVE):
+        for z, g, above in shapes or ((z, g, a) for z in ZETAS for g in GAINS for a in GAINS_ABOVE):
+            if above is MASS_SHARE and gain_above(z, g, above) <= 0.0:
+                continue                # a mode of more than the rotor's whole mass (μ >= 1): no physical shape
             G = _resonance_db(r.f[None, :], fr, z, g, above)                      # (F, N)
             res = r.q[None, :] - G
             off = (res @ onehot.T) / count                                        # (F, L) per-line offsets
@@ -466,7 +491,7 @@ def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray) -> tuple:
             i = int(np.argmin(sse))
             if sse[i] < best[0]:
                 best = (float(sse[i]), float(f0s[i]), float(b), z, g, above)
-    return best
+    return (each + [best])[1:] if per_slope else best
 
 
 def _offsets_only(r: LineRatios) -> float:
@@ -478,24 +503,41 @@ def _offsets_only(r: LineRatios) -> float:
     return sse
 
 
-def _track_db(r: LineRatios, f0: float, slope: float, zeta: float, gain: float, above: float) -> np.ndarray:
+def _track_db(r: LineRatios, f0: float, slope: float, zeta: float, gain: float, above: float | None) -> np.ndarray:
     """The dB gain at every point of ``r`` of the resonance on the track f_r = f0 + slope·(spin − spin_mid)."""
     mid = 0.5 * (r.spin.min() + r.spin.max())
     return _resonance_db(r.f, np.maximum(f0 + slope * (r.spin - mid), 1e-6), zeta, gain, above)
 
 
+#: The fine step's factors on the coarse best's ζ and peak gain (its shape kept): between the coarse grid's values
+#: (a factor 1.7-2 apart) the place of a rotor mode's antiresonance (:func:`gain_above`) moves by several ζ, and the
+#: lines just above the track read it (an independent trial's rotor mode at 1000 − 2·f_spin Hz on Fz, ζ 0.015, peak
+#: gain 10: ζ 0.02, gain 6 on the coarse grids, 0.016 and 9.6 fine, the misfit 3.7 times smaller, slope −2.05)
+FINE_FACTORS = (0.6, 0.8, 1.0, 1.25, 1.6)
+#: ... from the best coarse fits of this many slopes (each its own, the best f0 and shape of that slope): the coarse
+#: f0 grid (3 % steps) and shapes misplace a narrow peak and a rotor mode's antiresonance, which ranks the coarse
+#: slopes unevenly (with one line crossing the track, a rotor mode at 900 − f_spin Hz on family wheel 5's lines:
+#: +2.0 first, misfit 9.2; −1 refined from its own coarse best leaves 0.25.  The open world's softening resonance
+#: on wheel 2: −0.2, −0.4, +0.2, −0.6 first; refined from −0.6 it leaves 1.8 at −0.58, from −0.2 3.9 at −0.25)
+FINE_STARTS = 5
+
+
 def _best_track(r: LineRatios, coarse: np.ndarray, slopes: np.ndarray, q: np.ndarray | None = None) -> tuple:
     """:func:`_track_fit` over the ``coarse`` f0 grid and ``slopes`` (every other one), then finely around the best
-    (f0 to 0.5 %, the slope to 0.05 Hz/Hz; a fixed resonance, ``slopes`` = [0], stays fixed); ``q``: the dB ratios
-    fitted instead of ``r.q`` (what another resonance leaves)."""
+    (f0 to 0.5 %, the slope to 0.05 Hz/Hz, ζ and the peak gain by :data:`FINE_FACTORS`; a fixed resonance,
+    ``slopes`` = [0], stays fixed); ``q``: the dB ratios fitted instead of ``r.q`` (what another resonance leaves)."""
     from dataclasses import replace
 
     rr = r if q is None else replace(r, q=q)
     fixed = slopes.size == 1 and slopes[0] == 0.0
-    best = _track_fit(rr, coarse, slopes if fixed else slopes[::2])
-    f0s = np.exp(np.arange(np.log(best[1]) - 0.04, np.log(best[1]) + 0.0401, 0.005))
-    near = slopes if fixed else np.round(np.arange(best[2] - 0.2, best[2] + 0.2001, 0.05), 3)
-    return min(best, _track_fit(rr, f0s, near))
+    starts = sorted(_track_fit(rr, coarse, slopes if fixed else slopes[::2], per_slope=True), key=lambda t: t[0])
+    best = starts[0]
+    for start in [t for t in starts if np.isfinite(t[0])][:FINE_STARTS]:
+        f0s = np.exp(np.arange(np.log(start[1]) - 0.04, np.log(start[1]) + 0.0401, 0.005))
+        near = slopes if fixed else np.round(np.arange(start[2] - 0.2, start[2] + 0.2001, 0.05), 3)
+        shapes = [(start[3] * a, max(start[4] * b, 1.1), start[5]) for a in FINE_FACTORS for b in FINE_FACTORS]
+        best = min(best, _track_fit(rr, f0s, near, shapes), key=lambda t: t[0])
+    return best
 
 
 #: Rounds of the fit of a track beside a fixed resonance, each fitted in turn on what the other leaves.
@@ -544,6 +586,29 @@ def _moving_fit(r: LineRatios) -> tuple | None:
     return got
 
 
+def resolved_lines(ctx, state, r: LineRatios) -> LineRatios:
+    """``r`` without the points of a line in a run where it is not resolved from the direction's other lines: where
+    they predict more power in its window than it does (:func:`.describe_partial.others_in_window` over
+    :data:`.describe_partial.OTHERS_IN_WINDOW_MAX`, the lines the effects added included).  There its measured power
+    (:meth:`Context.measure_lines`: the data less the model's other lines) is its neighbours' misfit and beat as
+    much as its own: a speed sideband 0.06·Ω/2π from its carrier read the carrier's misfit, lifted by 4-6 dB in the
+    top three runs (family wheel 7's speed_sidebands, 1.2-1.9 bins from the carrier; the E-like wheel's at the
+    default path), and a track through them was described as a moving resonance of 0 % share, and on the E-like
+    wheel the true speed_sidebands effect was taken back as fitted to it."""
+    from dataclasses import replace
+
+    from .describe_partial import OTHERS_IN_WINDOW_MAX, others_in_window
+
+    keep = np.ones(r.q.size, bool)
+    for ln in np.unique(r.line):
+        m = np.flatnonzero(r.line == ln)
+        others = others_in_window(ctx, state, r.direction, float(r.h[m[0]]), ctx.runs[r.run[m]])
+        keep[m] = others <= OTHERS_IN_WINDOW_MAX
+    if keep.all():
+        return r
+    return replace(r, **{k: getattr(r, k)[keep] for k in ("q", "f", "run", "spin", "line", "h", "w")})
+
+
 def moving_resonance(ctx, state, ratios: list, shares) -> list:
     """A resonance lifting the lines of one direction whose frequency moves with the speed.
 
@@ -567,7 +632,7 @@ def moving_resonance(ctx, state, ratios: list, shares) -> list:
         got = _moving_fit(r)
         if got is None:
             continue
-        (sse_m, f0, b, zeta, gain, _), misfit_ratio, f_stat, companion = got
+        (sse_m, f0, b, zeta, gain, above), misfit_ratio, f_stat, companion = got
         mid = 0.5 * (r.spin.min() + r.spin.max())
         f_low, f_high = f0 + b * (r.spin.min() - mid), f0 + b * (r.spin.max() - mid)
         chans = tuple(c for c in DIRECTION_CHANNELS[r.direction] if c in ctx.channels)
@@ -577,22 +642,117 @@ def moving_resonance(ctx, state, ratios: list, shares) -> list:
         share, level = shares(chans, lambda spin: f0 + b * (spin - mid), zeta)
         rpm = np.array([r.spin.min(), r.spin.max()]) * 60.0
         sign = "stiffening" if b > 0 else "softening"
-        beside = {} if companion is None else {"beside_fixed_resonance_Hz": float(companion[1]),
-                                               "beside_fixed_resonance_peak_gain": float(companion[4])}
+        beside: dict = {} if companion is None else {"beside_fixed_resonance_Hz": float(companion[1]),
+                                                     "beside_fixed_resonance_peak_gain": float(companion[4])}
+        track = lambda spin: f0 + b * (spin - mid)                                              # noqa: E731
+        crossed = _crossed_mode(r.direction, modes, track, r.spin.min(), r.spin.max(), (zeta, gain, above))
+        if crossed:
+            beside["crosses_fitted_mode"] = crossed
         out.append(Unexplained(
             signature="moving_resonance", channels=chans, speed_rpm=(float(rpm[0]), float(rpm[1])),
             f_Hz=(float(min(f_low, f_high)), float(max(f_low, f_high))), level_dB=level, share=share,
             n_runs=int(np.unique(r.run).size),
             parameters={"direction": r.direction, "f_at_lowest_speed_Hz": float(f_low),
                         "f_at_highest_speed_Hz": float(f_high), "slope_Hz_per_Hz_of_spin": float(b),
-                        "zeta": float(zeta), "peak_gain": float(gain), "fixed_resonance_misfit_ratio":
+                        "largest_line_lift_dB": float(np.max(r.q)),
+                        "zeta": float(zeta), "peak_gain": float(gain), **_shape_words(zeta, gain, above),
+                        "fixed_resonance_misfit_ratio":
                         float(misfit_ratio), "f_statistic": float(f_stat), "whirl": whirl, **beside},
-            causes=(f"a mode of the rotor {sign} with speed (centrifugal {sign} of the disc or rim: an umbrella or "
-                    "diaphragm mode, or the bearings' preload changing with speed)",
-                    "a resonance of the motor's drive or speed loop whose frequency follows the speed"),
-            would_tell="a slow run-up recorded with its speed tracks the resonance continuously; a tap test of the "
-                       "rotor at rest gives its frequency at zero speed"))
+            causes=_moving_causes(b, sign, track(0.5 * (r.spin.min() + r.spin.max())), mid),
+            would_tell=_crossing_words(crossed) + "a slow run-up recorded with its speed tracks the resonance "
+                       "continuously; a tap test of the rotor at rest gives its frequency at zero speed"))
     return out
+
+
+#: A slope within this of a whole number n (Hz per Hz of spin) reads first as a mode of n nodal diameters of the
+#: rotor seen from the stationary frame (its travelling waves at f_rotor ± n·f_spin), up to n = NODAL_MAX
+NODAL_TOL = 0.25
+NODAL_MAX = 4
+
+
+def _moving_causes(slope: float, sign: str, f_mid: float, spin_mid: float) -> tuple:
+    """The causes of a moving resonance of ``slope`` (Hz per Hz of spin) at ``f_mid`` Hz at the speeds' middle
+    ``spin_mid`` Hz: a rotor mode of n nodal diameters seen from the stationary frame first when the slope is within
+    :data:`NODAL_TOL` of ±n (its frequency in the rotor's frame, f_mid − n_signed·spin_mid, stays put), a mode
+    stiffening or softening with speed and a drive resonance after."""
+    centrifugal = (f"a mode of the rotor {sign} with speed (centrifugal {sign} of the disc or rim: an umbrella or "
+                   "diaphragm mode, or the bearings' preload changing with speed)")
+    drive = "a resonance of the motor's drive or speed loop whose frequency follows the speed"
+    n = int(round(abs(slope)))
+    if 1 <= n <= NODAL_MAX and abs(abs(slope) - n) <= NODAL_TOL:
+        wave, op = ("backward", "−") if slope < 0 else ("forward", "+")
+        f_rot = f_mid - np.sign(slope) * n * spin_mid
+        if f_rot < 0:
+            # a rising track below n·f_spin: the backward wave past its critical speed, |f_rotor − n·f_spin|
+            wave, op, f_rot = "backward (past its critical speed, n·f_spin = f_rotor)", "−", -f_rot
+        nodal = (f"a mode of the rotor with {n} nodal diameter{'s' if n > 1 else ''} (a disc, web or rim mode) at "
+                 f"≈ {f_rot:.4g} Hz in the rotor's frame, seen in the stationary frame as its {wave} travelling wave "
+                 f"at f_rotor {op} {n}·f_spin (a rotating-frame mode seen from the housing; an axisymmetric rotor's modes "
+                 f"of {n} nodal diameters reach the bearings through its asymmetries)")
+        return (nodal, centrifugal, drive)
+    return (centrifugal, drive)
+
+
+def _shape_words(zeta: float, gain: float, above) -> dict:
+    """The fitted shape of a moving resonance (a :data:`GAINS_ABOVE` entry) as parameters: ``gain_far_above`` and
+    ``shape``; for a mode holding a share of the rotor's mass (:func:`gain_above`) also ``mass_share`` μ and
+    ``antiresonance_ratio`` 1/sqrt(1 − μ) (f over f_r)."""
+    beta = gain_above(zeta, gain, above)
+    if above is MASS_SHARE:
+        out = {"shape": "a mode holding a share of the rotor's mass (1 below, 1 − μ above)", "gain_far_above": beta,
+               "mass_share": 1.0 - beta}
+        if 0.0 < beta < 1.0:
+            out["antiresonance_ratio"] = float(1.0 / np.sqrt(beta))
+        return out
+    words = "1 on both sides" if beta == 1.0 else "the transmissibility falling above it"
+    return {"shape": words, "gain_far_above": beta}
+
+
+#: The directions' suspension modes a moving track can reach (the rocking mode whirls: :func:`_whirl_note`)
+DIRECTION_MODE = {"radial_force": "radial_translation", "axial_force": "axial"}
+#: The track reaches a fitted mode of its direction where its fitted resonance changes a line at the mode's frequency
+#: by this much (dB) at one of the speeds at least
+REACH_DB = 1.0
+#: ... counted only where the mode's frequency is within this factor of the track's
+REACH_RATIO = 1.5
+
+
+def _crossed_mode(direction: str, modes, track, s_lo: float, s_hi: float, shape: tuple) -> dict | None:
+    """{"mode", "f_Hz", "speed_rpm", "lift_dB", "located"} of the fitted suspension mode of ``direction`` (``modes``:
+    the ``suspension_modes`` effect, or None) that the moving resonance (``shape``: ζ, peak gain, gain above) on the
+    track f(spin) = ``track(spin)`` reaches over the speeds ``s_lo``-``s_hi`` Hz: where a line at the mode's frequency
+    is changed by at least :data:`REACH_DB` by it; the speed and change (dB) where the change is largest.  None when it
+    reaches none.  The modes are fitted with the lines the track lifts near them: a mode it reaches is read with it
+    (trial12: a rotor mode at 900 − 2·f_spin Hz passing the 560-Hz axial mode at the top speed, the axial mode fitted
+    1.9 % low with ζ 0.008 for 0.025; at 1000 − 2·f_spin Hz, 18 % above it at the top speed and lifting a line there
+    by 4-5 dB, ζ 0.015)."""
+    name = DIRECTION_MODE.get(direction)
+    if modes is None or name is None:
+        return None
+    f_m = float(modes.f0_Hz.get(name, np.nan))
+    if not np.isfinite(f_m) or f_m <= 0:
+        return None
+    spin = np.linspace(s_lo, s_hi, 201)
+    f_track = np.maximum(track(spin), 1e-6)
+    lift = _resonance_db(np.full(spin.shape, f_m), f_track, *shape)
+    # only where the mode lies near the track (within REACH_RATIO of it): far above it a shape falling to its
+    # asymptote (1/r² of a transmissibility, 1 − μ of a mass share) changes every line, which is no reach of the mode
+    lift = np.where(np.abs(np.log(f_m / f_track)) < np.log(REACH_RATIO), lift, 0.0)
+    i = int(np.argmax(np.abs(lift)))
+    if not abs(lift[i]) >= REACH_DB:
+        return None
+    return {"mode": name, "f_Hz": f_m, "speed_rpm": float(60.0 * spin[i]), "lift_dB": float(lift[i]),
+            "located": name not in modes.unconstrained}
+
+
+def _crossing_words(crossed: dict | None) -> str:
+    """The words of :func:`_crossed_mode`'s crossing (empty without one), ahead of what would tell."""
+    if not crossed:
+        return ""
+    where = "" if crossed["located"] else ", which the data do not locate"
+    return (f"it reaches the fitted {crossed['mode'].replace('_', ' ')} mode ({crossed['f_Hz']:.4g} Hz{where}), a "
+            f"line there {crossed['lift_dB']:+.1f} dB by it near {crossed['speed_rpm']:.0f} rpm: that mode's "
+            "frequency and damping are fitted with what it lifts and are suspect; ")
 
 
 def _whirl_note(direction: str, slope: float, modes, s_lo: float, s_hi: float, f_lo: float, f_hi: float) -> tuple:
