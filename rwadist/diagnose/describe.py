@@ -362,8 +362,9 @@ def cells_of(u, res: Residual) -> dict:
     that band alone, a
     ``moving_resonance`` the bands of its track ±3ζ, a ``channel_copy`` the target's bands where the copy is at
     least a tenth of the target's power, the others the bands of their frequency range; a ``run_change`` none (it is
-    a change of whole runs: a class gaining in those runs is not fitted to it)."""
-    if u.signature == "run_change":
+    a change of whole runs: a class gaining in those runs is not fitted to it), nor a ``line_property`` (a property of
+    every line of a channel, a gain: a class acting on that channel's lines is not fitted to it)."""
+    if u.signature in ("run_change", "line_property"):
         return {}
     ctx = res.ctx
     rpm = ctx.omega[ctx.runs] * 60.0 / (2 * np.pi)
