@@ -19,6 +19,45 @@ from . import extended as ext
 from .extended_fit_power import LinePower
 from .resonance import FittedResonance
 
+#: The scatter of a row's log amplitude assumed besides the noise (:meth:`LogAmplitudeProblem.row_weights`): about the
+#: unweighted fit's own RMS log residual on the family's data (0.034-0.040 on family wheel 1's load-cell offset cell).
+LOG_SCATTER = 0.03
+#: A load cell's force sensors are noisier than its torque sensors (or the reverse) when the imbalance line (h = 1)
+#: measured by the one family carries more than this many times the relative noise error it carries in the other's
+#: (:func:`noisy_sensor_directions`; the family's clean cells: 0.9-1.1x, its load-cell offset cells with force
+#: sensors 28 dB noisier: 6-16x)
+SENSOR_NOISE_EXCESS = 3.0
+#: the load directions each sensor family of a six-axis load cell measures
+SENSOR_FAMILIES = {"force": ("radial_force", "axial_force"), "torque": ("radial_torque", "axial_torque")}
+
+
+def noisy_sensor_directions(meas_lines) -> tuple:
+    """The load directions whose sensors are far noisier than the load cell's others: those of the force sensors when
+    the imbalance line (h = 1) of the radial forces is measured with more than :data:`SENSOR_NOISE_EXCESS` times the
+    median relative noise error (:attr:`rwadist.empirical.LineFit.noise`, σ_d/d over its speeds) of the radial
+    torques' h = 1 line, those of the torque sensors in the reverse case, else none (also without both lines).
+
+    A six-axis load cell has two sensor families, its force and its moment channels, each with its own noise.  The
+    imbalance line is in both (the static and the dynamic imbalance) at the same speeds, so the ratio of its two
+    relative errors is the ratio of the families' noise, each against the imbalance it measures: alike (within a few
+    times) on a stand whose noise is alike across its channels, far apart when one family's sensors (their
+    amplifiers, a load-cell offset's lever-arm cabling) are noisier.  Only then do the measurements of the noisier
+    family weigh less in the mode fit (:meth:`LogAmplitudeProblem.row_weights`); a fit of data whose noise is alike
+    across the load cell is left as it is."""
+    level = {}
+    for family, (radial, _) in SENSOR_FAMILIES.items():
+        h1 = [x for x in meas_lines if x.direction == radial and abs(x.h - 1.0) < 1e-3 and x.noise is not None]
+        noise = np.asarray(h1[0].noise, dtype=float) if h1 else np.zeros(0)
+        noise = noise[np.isfinite(noise) & (noise > 0)]
+        if noise.size:
+            level[family] = float(np.median(noise))
+    if len(level) < 2:
+        return ()
+    if level["force"] > SENSOR_NOISE_EXCESS * level["torque"]:
+        return SENSOR_FAMILIES["force"]
+    if level["torque"] > SENSOR_NOISE_EXCESS * level["force"]:
+        return SENSOR_FAMILIES["torque"]
+    return ()
 #: mode -> (its stiffness, its damping, the inertia they act on): fields of :class:`rwadist.extended.ExtendedParams`
 MODE_PARAMS = {"radial_translation": ("k_r", "c_r", "mass"), "rocking": ("k_rock", "c_rock", "I_rr"),
                "axial_translation": ("k_z", "c_z", "mass")}
@@ -71,6 +110,10 @@ class LogAmplitudeProblem:
     row_line, centred_log_w : per row its measured line and centred ln|Ω| (:func:`rwadist.off_law_lines.line_regressors`).
     meas_lines : the measured lines (LineFit list), named by the exponents freed.
     progress : scipy's iteration printout.
+    row_noise : per row, the standard deviation of its log amplitude the noise makes (dimensionless), or None.
+    scatter : the scatter of a row's log amplitude assumed besides the noise (dimensionless; :meth:`row_weights`).
+    noisy : the load directions whose sensors are far noisier than the others' (:func:`noisy_sensor_directions`):
+        only their rows are weighted by their noise.
     """
 
     base: dict
@@ -82,6 +125,29 @@ class LogAmplitudeProblem:
     centred_log_w: np.ndarray
     meas_lines: list
     progress: bool = False
+    row_noise: np.ndarray | None = None
+    scatter: float = 0.0
+    noisy: tuple = ()
+
+    def row_weights(self) -> np.ndarray | None:
+        """Per row, the weight of its log residual, or None (every row alike, the plain least squares): None unless
+        some load directions' sensors are far noisier than the others' (``noisy``); then a row of such a direction
+        weighs 1/sqrt(1 + (σ_row/s)²), σ_row the standard deviation of its log amplitude the noise makes
+        (``row_noise``), s the scatter of a row assumed besides the noise (``scatter``, :data:`LOG_SCATTER`), and
+        every other row 1.
+
+        A row's log amplitude scatters by sqrt(σ_row² + s²) about the model: weighed alike, a line measured at
+        10-30 % of a noisy sensor's floor pulls a mode as much as one measured 60 dB clear of it.  Force sensors
+        28 dB noisier than the torque sensors (family wheel 1, a load-cell offset) moved its 520 Hz translation to
+        519.815 Hz (clean 520.011) and left 12.5x the clean error; on wheel 5 the force lines' misfit hid the
+        corrected torques' noise.  Rows of a quiet family keep weight 1, and data whose noise is alike across the
+        load cell are fitted as before, bit for bit."""
+        if self.row_noise is None or not self.scatter > 0 or not self.noisy:
+            return None
+        dirs = sorted({x.direction for x in self.meas_lines})
+        on = np.isin(np.asarray(dirs, dtype=object)[self.row_directions()], list(self.noisy))
+        sigma = np.where(on, np.asarray(self.row_noise, dtype=float), 0.0)
+        return 1.0 / np.sqrt(1.0 + (sigma / self.scatter) ** 2)
 
     def solve(self, free_modes: list[str], off_law: Sequence[int] = ()) -> Solution:
         """Log-amplitude least squares with the stiffness and damping of ``free_modes`` free, and an exponent of
@@ -119,6 +185,9 @@ class LogAmplitudeProblem:
             rel_se = np.sqrt(np.clip(np.diag(_covariance(res, self.row_directions())), 0, None))
         except np.linalg.LinAlgError:
             rel_se = np.full(res.x.size, np.nan)
+        if residuals.weights is not None:
+            # the log residuals themselves for what reads them after the fit (a mode's misfit in dB, the off-law lines)
+            res.fun = res.fun / residuals.weights
         # a limit is what the fit allowed, not what the data say: stiffness at ±10 %, damping at its floor ζ = 5e-5 (a
         # stand beside a load-cell offset was taken for the translation so, -19 %)
         at_bound = {m: ("stiffness" if min(res.x[2 * i] - lo[2 * i], hi[2 * i] - res.x[2 * i]) < 0.01 else
@@ -159,6 +228,7 @@ class _Residuals:
 
     def __init__(self, problem: LogAmplitudeProblem, free_modes: list[str], off_rows: list[np.ndarray]):
         self.problem, self.free_modes, self.off_rows = problem, free_modes, off_rows
+        self.weights = problem.row_weights()
         self.key: bytes | None = None
         self.r = np.empty(0)
         self.J = np.empty((0, 0))
@@ -203,6 +273,8 @@ class _Residuals:
             J[:, 2 * i] = dk + 0.5 * dc if clamped[m] else dk
             J[:, 2 * i + 1] = 0.0 if clamped[m] else dc
         J[:, n_mode:n_mode + n_c] = d_C
+        if self.weights is not None:
+            r, J = r * self.weights, J * self.weights[:, None]
         self.key, self.r, self.J = key, r, J
 
 
