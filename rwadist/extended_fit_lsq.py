@@ -22,42 +22,65 @@ from .resonance import FittedResonance
 #: The scatter of a row's log amplitude assumed besides the noise (:meth:`LogAmplitudeProblem.row_weights`): about the
 #: unweighted fit's own RMS log residual on the family's data (0.034-0.040 on family wheel 1's load-cell offset cell).
 LOG_SCATTER = 0.03
-#: A load cell's force sensors are noisier than its torque sensors (or the reverse) when the imbalance line (h = 1)
-#: measured by the one family carries more than this many times the relative noise error it carries in the other's
-#: (:func:`noisy_sensor_directions`; the family's clean cells: 0.9-1.1x, its load-cell offset cells with force
-#: sensors 28 dB noisier: 6-16x)
+#: A load cell's force sensors are noisier than its torque sensors (or the reverse) when the one family's noise floor
+#: against its imbalance line is more than this many times the other's at every speed (:func:`noisy_sensor_directions`)
+#: (the family matrix's clean, cross_coupling, sidebands and broadband_floor cells of wheels 1, 5, 6: at most 2.1x
+#: at the slowest speed; its lever_arm_noise cells, force sensors 28 dB noisier: 5.1-19x at every speed)
 SENSOR_NOISE_EXCESS = 3.0
+#: the percentile of the line measurements' noise floors that reads a sensor family's floor (:func:`_family_noise`)
+FLOOR_PERCENTILE = 10.0
 #: the load directions each sensor family of a six-axis load cell measures
 SENSOR_FAMILIES = {"force": ("radial_force", "axial_force"), "torque": ("radial_torque", "axial_torque")}
 
 
+def _family_noise(meas_lines, radial: str) -> dict:
+    """Per speed (rad/s), the noise floor of the sensors measuring ``radial`` against the imbalance they measure: of
+    every measurement of every line of that direction at that speed (each channel), the noise amplitude under the line
+    (σ_d·d, :attr:`rwadist.empirical.LineFit.noise` times the amplitude) divided by the imbalance line's (h = 1)
+    amplitude in the same channel, its :data:`FLOOR_PERCENTILE` th percentile; empty without an h = 1 line.  The low
+    percentile reads the floor under the cleanest lines: a neighbouring line's skirt (a sideband) only lifts it."""
+    lines = [x for x in meas_lines if x.direction == radial and x.noise is not None]
+    h1 = [x for x in lines if abs(x.h - 1.0) < 1e-3]
+    if not h1:
+        return {}
+    ref = {(c, float(w)): float(d) for c, w, d in zip(h1[0].channel, h1[0].speed, h1[0].amplitude) if d > 0}
+    per: dict = {}
+    for x in lines:
+        for c, w, d, n in zip(x.channel, x.speed, x.amplitude, np.asarray(x.noise, dtype=float)):
+            if (c, float(w)) in ref and np.isfinite(n) and n > 0:
+                per.setdefault(float(w), []).append(float(n) * float(d) / ref[(c, float(w))])
+    return {w: float(np.percentile(v, FLOOR_PERCENTILE)) for w, v in per.items()}
+
+
 def noisy_sensor_directions(meas_lines) -> tuple:
     """The load directions whose sensors are far noisier than the load cell's others: those of the force sensors when
-    the imbalance line (h = 1) of the radial forces is measured with more than :data:`SENSOR_NOISE_EXCESS` times the
-    median relative noise error (:attr:`rwadist.empirical.LineFit.noise`, σ_d/d over its speeds) of the radial
-    torques' h = 1 line, those of the torque sensors in the reverse case, else none (also without both lines).
+    the radial forces' noise floor against their imbalance line (:func:`_family_noise`) is more than
+    :data:`SENSOR_NOISE_EXCESS` times the radial torques' at every speed both are measured at, those of the torque
+    sensors in the reverse case, else none (also without an imbalance line in both).
 
     A six-axis load cell has two sensor families, its force and its moment channels, each with its own noise.  The
-    imbalance line is in both (the static and the dynamic imbalance) at the same speeds, so the ratio of its two
-    relative errors is the ratio of the families' noise, each against the imbalance it measures: alike (within a few
-    times) on a stand whose noise is alike across its channels, far apart when one family's sensors (their
-    amplifiers, a load-cell offset's lever-arm cabling) are noisier.  Only then do the measurements of the noisier
-    family weigh less in the mode fit (:meth:`LogAmplitudeProblem.row_weights`); a fit of data whose noise is alike
-    across the load cell is left as it is."""
-    level = {}
-    for family, (radial, _) in SENSOR_FAMILIES.items():
-        h1 = [x for x in meas_lines if x.direction == radial and abs(x.h - 1.0) < 1e-3 and x.noise is not None]
-        noise = np.asarray(h1[0].noise, dtype=float) if h1 else np.zeros(0)
-        noise = noise[np.isfinite(noise) & (noise > 0)]
-        if noise.size:
-            level[family] = float(np.median(noise))
-    if len(level) < 2:
+    imbalance line is in both (the static and the dynamic imbalance) at the same speeds, so the ratio of the two
+    families' noise floors, each against the imbalance it measures, is dimensionless: alike (within a few times) on a
+    stand whose noise is alike across its channels, far apart when one family's sensors (their amplifiers, a
+    load-cell offset's lever-arm cabling) are noisier.  A sensor's noise does not depend on the speed, so a noisier
+    sensor family is noisier at every speed, the slowest included; the rotor's own random loads (a broadband floor on
+    the forces, growing as Ω³) and the lines' skirts grow with the speed and lift the ratio at the top speeds only
+    (family wheel 1, a broadband floor: 7x at the median speed, 0.14x at the slowest; its force sensors 28 dB
+    noisier: 19-23x at every speed).  Only when a family is so much noisier do its measurements weigh less in the
+    mode fit (:meth:`LogAmplitudeProblem.row_weights`); a fit of data whose noise is alike across the load cell is
+    left as it is."""
+    force = _family_noise(meas_lines, SENSOR_FAMILIES["force"][0])
+    torque = _family_noise(meas_lines, SENSOR_FAMILIES["torque"][0])
+    ratio = np.array([force[w] / torque[w] for w in force if w in torque and torque[w] > 0])
+    if not ratio.size:
         return ()
-    if level["force"] > SENSOR_NOISE_EXCESS * level["torque"]:
+    if ratio.min() > SENSOR_NOISE_EXCESS:
         return SENSOR_FAMILIES["force"]
-    if level["torque"] > SENSOR_NOISE_EXCESS * level["force"]:
+    if ratio.max() < 1.0 / SENSOR_NOISE_EXCESS:
         return SENSOR_FAMILIES["torque"]
     return ()
+
+
 #: mode -> (its stiffness, its damping, the inertia they act on): fields of :class:`rwadist.extended.ExtendedParams`
 MODE_PARAMS = {"radial_translation": ("k_r", "c_r", "mass"), "rocking": ("k_rock", "c_rock", "I_rr"),
                "axial_translation": ("k_z", "c_z", "mass")}
