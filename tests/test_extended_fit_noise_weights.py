@@ -17,6 +17,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
 
 from rwadist.data import Run, SteadyTest  # noqa: E402
@@ -64,6 +65,17 @@ def test_the_noisier_sensor_family_is_told_from_the_imbalance_line(wheel, noisy,
     """Alike noise: no family singled out (the fit stays the plain least squares); 28 dB more on one family: it."""
     fit = fit_empirical(compute_spectra(_test(wheel, 1, noisy)))
     assert noisy_sensor_directions(fit.lines) == expected
+
+
+def test_a_load_floor_on_the_forces_is_no_noisier_sensor(wheel):
+    """The rotor's random loads (the matrix's broadband_floor cell: a floor on the forces growing as Ω³, 15x the
+    torques' relative noise under the imbalance line over the speeds) lift the forces' floor at the top speeds, not
+    at the slowest: no family is singled out, the fit stays the plain least squares."""
+    data = fw.steady(wheel, noise=NOISE, seed=101, effects=[fe.default_effect("broadband_floor", wheel)])
+    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
+                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
+    fit = fit_empirical(compute_spectra(SteadyTest(runs=runs, meta={})))
+    assert noisy_sensor_directions(fit.lines) == ()
 
 
 def test_noisy_force_lines_do_not_pull_the_modes(wheel):
