@@ -25,7 +25,8 @@ harmonic takes part and the fit is a least-squares problem:
    matched where a linear model can match them; the residual near each mode
    says where it cannot.  Every row weighs alike, unless one sensor family of
    the load cell (its forces or its torques) is far noisier than the other
-   (:func:`rwadist.extended_fit_lsq.noisy_sensor_directions`): then a row of that
+   (:func:`rwadist.extended_fit_lsq.noisy_sensor_directions`, decided once on the data as
+   recorded: :func:`rwadist.extended_fit_lsq.recorded_noisy_sensors`): then a row of that
    family weighs 1/sqrt(1 + (σ_noise/s)²), σ_noise its log amplitude's error from
    the noise under the line, s the scatter assumed besides it
    (:meth:`rwadist.extended_fit_lsq.LogAmplitudeProblem.row_weights`).
@@ -57,7 +58,7 @@ from .extended_fit_lsq import (
     LogAmplitudeProblem,
     Solution,
     loose_modes,
-    noisy_sensor_directions,
+    recorded_noisy_sensors,
 )
 from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower
 from .geometry import remove_lever_arm
@@ -619,7 +620,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
     problem = LogAmplitudeProblem(base, lines, LinePower(lines, sa, ax_line, ca, sr, rad_parts), log_data, joint,
                                   row_line, centred_log_w, meas.lines, progress, np.concatenate([na, nr]), LOG_SCATTER,
-                                  noisy_sensor_directions(meas.lines))
+                                  recorded_noisy_sensors(test, meas.lines))
     off_law: list[int] = []     # lines given an exponent of their own before a mode is declared (appended in place)
     res, names, rel_se, unpack, _ = _fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare,
                                                tolerance, off_law, log_w, lambda m, why: starts.declare(base, m, why))

@@ -81,6 +81,27 @@ def noisy_sensor_directions(meas_lines) -> tuple:
     return ()
 
 
+#: The key of a test's ``meta`` that holds the load directions of its far noisier sensor family, decided once on the
+#: data as recorded (:func:`recorded_noisy_sensors`); diagnose sets it before any effect is fitted
+NOISY_SENSORS_META = "noisy_sensor_directions"
+
+
+def recorded_noisy_sensors(test, meas_lines) -> tuple:
+    """The load directions of the far noisier sensor family of ``test``: those its ``meta`` holds under
+    :data:`NOISY_SENSORS_META` (decided once on the data as recorded), else :func:`noisy_sensor_directions` of
+    ``meas_lines``, the lines measured on ``test`` itself.
+
+    Which sensors are noisier is a property of the load cell, not of what has been fitted: the test a fit works on may
+    be the recorded data with an effect's correction applied (a load-cell offset's T − r × F moves the force
+    sensors' noise into the corrected torques, so both families read noisy there) or a half of the runs, and the
+    decision read again on those is not the recording's (family wheel 5, load-cell offset with force sensors 28 dB
+    noisier: forces 4.7-5.1x the torques on the recorded data, the force family not singled out on the corrected
+    data).  :func:`rwadist.effects.suspension_modes_diagnose._recorded_meta` decides it once on every recorded run and
+    carries it to every fit of the modes."""
+    held = getattr(test, "meta", {}).get(NOISY_SENSORS_META)
+    return noisy_sensor_directions(meas_lines) if held is None else tuple(held)
+
+
 #: mode -> (its stiffness, its damping, the inertia they act on): fields of :class:`rwadist.extended.ExtendedParams`
 MODE_PARAMS = {"radial_translation": ("k_r", "c_r", "mass"), "rocking": ("k_rock", "c_rock", "I_rr"),
                "axial_translation": ("k_z", "c_z", "mass")}
