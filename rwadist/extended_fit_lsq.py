@@ -94,10 +94,11 @@ def recorded_noisy_sensors(test, meas_lines) -> tuple:
     Which sensors are noisier is a property of the load cell, not of what has been fitted: the test a fit works on may
     be the recorded data with an effect's correction applied (a load-cell offset's T − r × F moves the force
     sensors' noise into the corrected torques, so both families read noisy there) or a half of the runs, and the
-    decision read again on those is not the recording's (family wheel 5, load-cell offset with force sensors 28 dB
-    noisier: forces 4.7-5.1x the torques on the recorded data, the force family not singled out on the corrected
-    data).  :func:`rwadist.effects.suspension_modes_diagnose._recorded_meta` decides it once on every recorded run and
-    carries it to every fit of the modes."""
+    decision read again on those is not the recording's (the family matrix's lever_arm_noise cell of wheel 5, r_z =
+    −60 mm: the forces' floor 5.2-8.0x the torques' at every speed as recorded, 2.9-5.1x on the corrected torques,
+    where the force family was not singled out and the axial mode came out 5.4e-4 off, 0.4e-4 with the recording's
+    decision).  :func:`rwadist.effects.suspension_modes_diagnose._recorded_meta` decides it once on every recorded run
+    and carries it to every fit of the modes."""
     held = getattr(test, "meta", {}).get(NOISY_SENSORS_META)
     return noisy_sensor_directions(meas_lines) if held is None else tuple(held)
 
