@@ -89,6 +89,8 @@ class LineFit:
     per measurement.  C, C_stderr, C_all in SI per (rad/s)²; C_all is Eq. 3.10
     over every measurement before modal exclusion (the thesis's C-bar).
     excluded_rpm: [[lo, hi], ...] speed ranges excluded as modal amplification.
+    noise: per measurement, the relative amplitude error the channel's noise floor under the line's bins
+    makes (dimensionless, σ_d/d; :func:`measure_direction`), or None when not measured so.
     """
 
     direction: str
@@ -103,6 +105,7 @@ class LineFit:
     excluded_rpm: list
     presence: float
     n_possible: int
+    noise: np.ndarray | None = None
 
     @property
     def n_points(self) -> int:
@@ -611,7 +614,7 @@ def direction_lines(direction: str, meas: _DirectionMeasurements, s: FitSettings
         rpm = w * RAD_S_TO_RPM
         order = np.argsort(rpm, kind="stable")
         out.append(LineFit(direction, float(b.h), C, se, C_all, w, ch, dk, used,
-                           _ranges(rpm[order], excluded[order]), b.presence, b.n_possible))
+                           _ranges(rpm[order], excluded[order]), b.presence, b.n_possible, sg))
     return out, bins
 
 

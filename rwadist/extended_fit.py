@@ -23,7 +23,14 @@ harmonic takes part and the fit is a least-squares problem:
    coefficient of each line (U_s and U_d are the h = 1 radial force and torque
    lines) are adjusted together, so height *and* width of each resonance are
    matched where a linear model can match them; the residual near each mode
-   says where it cannot.  Standard errors come from the Jacobian.
+   says where it cannot.  Every row weighs alike, unless one sensor family of
+   the load cell (its forces or its torques) is far noisier than the other
+   (:func:`rwadist.extended_fit_lsq.noisy_sensor_directions`, decided once on the data as
+   recorded: :func:`rwadist.extended_fit_lsq.recorded_noisy_sensors`): then a row of that
+   family weighs 1/sqrt(1 + (σ_noise/s)²), σ_noise its log amplitude's error from
+   the noise under the line, s the scatter assumed besides it
+   (:meth:`rwadist.extended_fit_lsq.LogAmplitudeProblem.row_weights`).
+   Standard errors come from the Jacobian.
 
 A mode the data do not constrain keeps its starting value and is said to be so: a note, and
 ``unconstrained`` (``analytical.unconstrained`` in the model file), never silently.  Mass and
@@ -45,7 +52,16 @@ from .data import DataError, Run, SteadyTest
 from .dft import blocked_records, run_window, windowed_dfts
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .extended_fit_close import with_close_lines
-from .extended_fit_lsq import MODE_PARAMS, LogAmplitudeProblem, Solution, loose_modes, power_sum_stderr, split_note
+from .extended_fit_lsq import (
+    LOG_SCATTER,
+    MODE_PARAMS,
+    LogAmplitudeProblem,
+    Solution,
+    loose_modes,
+    power_sum_stderr,
+    recorded_noisy_sensors,
+    split_note,
+)
 from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower
 from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
@@ -250,23 +266,27 @@ def mode_frequencies(peaks: list, senses: dict, inertia_ratio: float) -> dict:
 
 def _axial_measurements(fit: EmpiricalFit):
     """Flat arrays of every measured amplitude of the axial lines: line index (position in ``fit.lines``), speed,
-    channel index, amplitude."""
-    li, sp, ch, amp = [], [], [], []
+    channel index, amplitude, and the standard deviation of its logarithm the noise makes (its relative amplitude
+    error, :attr:`rwadist.empirical.LineFit.noise`; 0 where not measured)."""
+    li, sp, ch, amp, nz = [], [], [], [], []
     for j, x in enumerate(fit.lines):
         li.append(np.full(x.speed.size, j))
         sp.append(x.speed)
         ch.append(np.array([CHANNEL_INDEX[c] for c in x.channel]))
         amp.append(x.amplitude)
-    la, sa, ca, aa = np.concatenate(li), np.concatenate(sp), np.concatenate(ch), np.concatenate(amp)
+        nz.append(np.zeros(x.speed.size) if x.noise is None else np.asarray(x.noise, dtype=float))
+    la, sa, ca, aa, na = (np.concatenate(a) for a in (li, sp, ch, amp, nz))
     keep = np.array([fit.lines[j].direction not in RADIAL for j in la], bool)
-    return la[keep], sa[keep], ca[keep], aa[keep]
+    return la[keep], sa[keep], ca[keep], aa[keep], na[keep]
 
 
 def _radial_power(meas_lines):
     """Per radial line and run, the measured x and y amplitudes combined: d_x² + d_y² (only runs
     where both are measured; a channel measured twice at one speed counts by its first measurement).  Returns (line
-    index, speed, power, direction) arrays, each line's speeds in increasing order."""
-    li, sp, pw, dr = [], [], [], []
+    index, speed, power, direction, log noise) arrays, each line's speeds in increasing order; log noise: the standard
+    deviation of ½ ln(d_x² + d_y²) the noise makes, sqrt(d_x⁴ s_x² + d_y⁴ s_y²)/(d_x² + d_y²) of the relative amplitude
+    errors s (:attr:`rwadist.empirical.LineFit.noise`; 0 where not measured)."""
+    li, sp, pw, dr, nz = [], [], [], [], []
     for j, x in enumerate(meas_lines):
         if x.direction not in RADIAL:
             continue
@@ -278,13 +298,18 @@ def _radial_power(meas_lines):
         wy, iy = np.unique(x.speed[on_y], return_index=True)
         both, kx, ky = np.intersect1d(wx, wy, assume_unique=True, return_indices=True)
         dx, dy = x.amplitude[on_x][ix[kx]], x.amplitude[on_y][iy[ky]]
+        noise = np.zeros(x.speed.size) if x.noise is None else np.asarray(x.noise, dtype=float)
+        sx, sy = noise[on_x][ix[kx]], noise[on_y][iy[ky]]
+        p = dx**2 + dy**2
         li.append(np.full(both.size, j))
         sp.append(both)
-        pw.append(dx**2 + dy**2)
+        pw.append(p)
         dr.append(np.full(both.size, x.direction))
+        nz.append(np.sqrt((dx**2 * sx) ** 2 + (dy**2 * sy) ** 2) / np.maximum(p, 1e-300))
     if not li:
-        return np.array([], int), np.array([]), np.array([]), np.array([])
-    return np.concatenate(li).astype(int), np.concatenate(sp), np.concatenate(pw), np.concatenate(dr)
+        return np.array([], int), np.array([]), np.array([]), np.array([]), np.array([])
+    return (np.concatenate(li).astype(int), np.concatenate(sp), np.concatenate(pw), np.concatenate(dr),
+            np.concatenate(nz))
 
 
 def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=None):
@@ -294,7 +319,7 @@ def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=Non
     the mode held it off when one force line alone reached it (trial 11's 300-s run-up without the 7.2 lines: h 3.6 of
     Tz to 268 Hz beside h 3.6 of Fz through the 260-Hz mode; the scan put it at 293 Hz, ζ 0.06, the least squares at
     its ±5 % limit, and the Fz line's rise went to an invented amplitude law)."""
-    lr, sr, pr, dr = radial
+    lr, sr, pr, dr, _ = radial
     h_of = np.array([x.h for x in meas_lines]) if meas_lines else np.zeros(0)
     scans = {}
     for mode, direction in MODE_DIRECTION.items():
@@ -583,7 +608,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     test, fit, meas, senses_xy = _measured_lines(test, fit, height, ([] if stand is None else [stand]) + list(more_stands),
                                                  stand_direction if stand is not None else None)
     peaks = amplification_peaks(fit)
-    la, sa, ca, aa = _axial_measurements(meas)
+    la, sa, ca, aa, na = _axial_measurements(meas)
     radial = _radial_power(meas.lines)
     scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near)
     mass_kg, I_rr, I_zz = _inertias(mass, radius, scans["rocking"], notes)
@@ -591,12 +616,13 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                                                      default=100.0), zeta0, notes)
     base = starts.params(mass_kg, I_rr, I_zz)
     lines, owner = _forcing_lines(meas.lines, senses_xy)
-    lr, sr, pr, dr = radial
+    lr, sr, pr, dr, nr = radial
     line_of, ax_line, rad_parts = _rows_of_lines(owner, la, lr)
     log_data, joint = _log_data(meas.lines, la, sa, aa, lr, sr, pr, stand if fit_stand else None, stand_direction)
     row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
     problem = LogAmplitudeProblem(base, lines, LinePower(lines, sa, ax_line, ca, sr, rad_parts), log_data, joint,
-                                  row_line, centred_log_w, meas.lines, progress)
+                                  row_line, centred_log_w, meas.lines, progress, np.concatenate([na, nr]), LOG_SCATTER,
+                                  recorded_noisy_sensors(test, meas.lines))
     off_law: list[int] = []     # lines given an exponent of their own before a mode is declared (appended in place)
     solution = _fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare,
                           tolerance, off_law, log_w, lambda m, why: starts.declare(base, m, why))

@@ -19,6 +19,90 @@ from . import extended as ext
 from .extended_fit_power import LinePower
 from .resonance import FittedResonance
 
+#: The scatter of a row's log amplitude assumed besides the noise (:meth:`LogAmplitudeProblem.row_weights`): about the
+#: unweighted fit's own RMS log residual on the family's data (0.034-0.040 on family wheel 1's load-cell offset cell).
+LOG_SCATTER = 0.03
+#: A load cell's force sensors are noisier than its torque sensors (or the reverse) when the one family's noise floor
+#: against its imbalance line is more than this many times the other's at every speed (:func:`noisy_sensor_directions`)
+#: (the family matrix's clean, cross_coupling, sidebands and broadband_floor cells of wheels 1, 5, 6: at most 2.1x
+#: at the slowest speed; its lever_arm_noise cells, force sensors 28 dB noisier: 5.1-19x at every speed)
+SENSOR_NOISE_EXCESS = 3.0
+#: the percentile of the line measurements' noise floors that reads a sensor family's floor (:func:`_family_noise`)
+FLOOR_PERCENTILE = 10.0
+#: the load directions each sensor family of a six-axis load cell measures
+SENSOR_FAMILIES = {"force": ("radial_force", "axial_force"), "torque": ("radial_torque", "axial_torque")}
+
+
+def _family_noise(meas_lines, radial: str) -> dict:
+    """Per speed (rad/s), the noise floor of the sensors measuring ``radial`` against the imbalance they measure: of
+    every measurement of every line of that direction at that speed (each channel), the noise amplitude under the line
+    (σ_d·d, :attr:`rwadist.empirical.LineFit.noise` times the amplitude) divided by the imbalance line's (h = 1)
+    amplitude in the same channel, its :data:`FLOOR_PERCENTILE` th percentile; empty without an h = 1 line.  The low
+    percentile reads the floor under the cleanest lines: a neighbouring line's skirt (a sideband) only lifts it."""
+    lines = [x for x in meas_lines if x.direction == radial and x.noise is not None]
+    h1 = [x for x in lines if abs(x.h - 1.0) < 1e-3]
+    if not h1:
+        return {}
+    ref = {(c, float(w)): float(d) for c, w, d in zip(h1[0].channel, h1[0].speed, h1[0].amplitude) if d > 0}
+    per: dict = {}
+    for x in lines:
+        for c, w, d, n in zip(x.channel, x.speed, x.amplitude, np.asarray(x.noise, dtype=float)):
+            if (c, float(w)) in ref and np.isfinite(n) and n > 0:
+                per.setdefault(float(w), []).append(float(n) * float(d) / ref[(c, float(w))])
+    return {w: float(np.percentile(v, FLOOR_PERCENTILE)) for w, v in per.items()}
+
+
+def noisy_sensor_directions(meas_lines) -> tuple:
+    """The load directions whose sensors are far noisier than the load cell's others: those of the force sensors when
+    the radial forces' noise floor against their imbalance line (:func:`_family_noise`) is more than
+    :data:`SENSOR_NOISE_EXCESS` times the radial torques' at every speed both are measured at, those of the torque
+    sensors in the reverse case, else none (also without an imbalance line in both).
+
+    A six-axis load cell has two sensor families, its force and its moment channels, each with its own noise.  The
+    imbalance line is in both (the static and the dynamic imbalance) at the same speeds, so the ratio of the two
+    families' noise floors, each against the imbalance it measures, is dimensionless: alike (within a few times) on a
+    stand whose noise is alike across its channels, far apart when one family's sensors (their amplifiers, a
+    load-cell offset's lever-arm cabling) are noisier.  A sensor's noise does not depend on the speed, so a noisier
+    sensor family is noisier at every speed, the slowest included; the rotor's own random loads (a broadband floor on
+    the forces, growing as Ω³) and the lines' skirts grow with the speed and lift the ratio at the top speeds only
+    (family wheel 1, a broadband floor: 7x at the median speed, 0.14x at the slowest; its force sensors 28 dB
+    noisier: 19-23x at every speed).  Only when a family is so much noisier do its measurements weigh less in the
+    mode fit (:meth:`LogAmplitudeProblem.row_weights`); a fit of data whose noise is alike across the load cell is
+    left as it is."""
+    force = _family_noise(meas_lines, SENSOR_FAMILIES["force"][0])
+    torque = _family_noise(meas_lines, SENSOR_FAMILIES["torque"][0])
+    ratio = np.array([force[w] / torque[w] for w in force if w in torque and torque[w] > 0])
+    if not ratio.size:
+        return ()
+    if ratio.min() > SENSOR_NOISE_EXCESS:
+        return SENSOR_FAMILIES["force"]
+    if ratio.max() < 1.0 / SENSOR_NOISE_EXCESS:
+        return SENSOR_FAMILIES["torque"]
+    return ()
+
+
+#: The key of a test's ``meta`` that holds the load directions of its far noisier sensor family, decided once on the
+#: data as recorded (:func:`recorded_noisy_sensors`); diagnose sets it before any effect is fitted
+NOISY_SENSORS_META = "noisy_sensor_directions"
+
+
+def recorded_noisy_sensors(test, meas_lines) -> tuple:
+    """The load directions of the far noisier sensor family of ``test``: those its ``meta`` holds under
+    :data:`NOISY_SENSORS_META` (decided once on the data as recorded), else :func:`noisy_sensor_directions` of
+    ``meas_lines``, the lines measured on ``test`` itself.
+
+    Which sensors are noisier is a property of the load cell, not of what has been fitted: the test a fit works on may
+    be the recorded data with an effect's correction applied (a load-cell offset's T − r × F moves the force
+    sensors' noise into the corrected torques, so both families read noisy there) or a half of the runs, and the
+    decision read again on those is not the recording's (the family matrix's lever_arm_noise cell of wheel 5, r_z =
+    −60 mm: the forces' floor 5.2-8.0x the torques' at every speed as recorded, 2.9-5.1x on the corrected torques,
+    where the force family was not singled out and the axial mode came out 5.4e-4 off, 0.4e-4 with the recording's
+    decision).  :func:`rwadist.effects.suspension_modes_diagnose._recorded_meta` decides it once on every recorded run
+    and carries it to every fit of the modes."""
+    held = getattr(test, "meta", {}).get(NOISY_SENSORS_META)
+    return noisy_sensor_directions(meas_lines) if held is None else tuple(held)
+
+
 #: mode -> (its stiffness, its damping, the inertia they act on): fields of :class:`rwadist.extended.ExtendedParams`
 MODE_PARAMS = {"radial_translation": ("k_r", "c_r", "mass"), "rocking": ("k_rock", "c_rock", "I_rr"),
                "axial_translation": ("k_z", "c_z", "mass")}
@@ -81,6 +165,10 @@ class LogAmplitudeProblem:
     row_line, centred_log_w : per row its measured line and centred ln|Ω| (:func:`rwadist.off_law_lines.line_regressors`).
     meas_lines : the measured lines (LineFit list), named by the exponents freed.
     progress : scipy's iteration printout.
+    row_noise : per row, the standard deviation of its log amplitude the noise makes (dimensionless), or None.
+    scatter : the scatter of a row's log amplitude assumed besides the noise (dimensionless; :meth:`row_weights`).
+    noisy : the load directions whose sensors are far noisier than the others' (:func:`noisy_sensor_directions`):
+        only their rows are weighted by their noise.
     """
 
     base: dict
@@ -92,6 +180,29 @@ class LogAmplitudeProblem:
     centred_log_w: np.ndarray
     meas_lines: list
     progress: bool = False
+    row_noise: np.ndarray | None = None
+    scatter: float = 0.0
+    noisy: tuple = ()
+
+    def row_weights(self) -> np.ndarray | None:
+        """Per row, the weight of its log residual, or None (every row alike, the plain least squares): None unless
+        some load directions' sensors are far noisier than the others' (``noisy``); then a row of such a direction
+        weighs 1/sqrt(1 + (σ_row/s)²), σ_row the standard deviation of its log amplitude the noise makes
+        (``row_noise``), s the scatter of a row assumed besides the noise (``scatter``, :data:`LOG_SCATTER`), and
+        every other row 1.
+
+        A row's log amplitude scatters by sqrt(σ_row² + s²) about the model: weighed alike, a line measured at
+        10-30 % of a noisy sensor's floor pulls a mode as much as one measured 60 dB clear of it.  Force sensors
+        28 dB noisier than the torque sensors (family wheel 1, a load-cell offset) moved its 520 Hz translation to
+        519.815 Hz (clean 520.011) and left 12.5x the clean error; on wheel 5 the force lines' misfit hid the
+        corrected torques' noise.  Rows of a quiet family keep weight 1, and data whose noise is alike across the
+        load cell are fitted as before, bit for bit."""
+        if self.row_noise is None or not self.scatter > 0 or not self.noisy:
+            return None
+        dirs = sorted({x.direction for x in self.meas_lines})
+        on = np.isin(np.asarray(dirs, dtype=object)[self.row_directions()], list(self.noisy))
+        sigma = np.where(on, np.asarray(self.row_noise, dtype=float), 0.0)
+        return 1.0 / np.sqrt(1.0 + (sigma / self.scatter) ** 2)
 
     def solve(self, free_modes: list[str], off_law: Sequence[int] = ()) -> Solution:
         """Log-amplitude least squares with the stiffness and damping of ``free_modes`` free, and an exponent of
@@ -130,14 +241,17 @@ class LogAmplitudeProblem:
         except np.linalg.LinAlgError:
             cov = np.full((res.x.size, res.x.size), np.nan)
         rel_se = np.sqrt(np.clip(np.diag(cov), 0, None))
+        s2_row = _row_variance(res, self.row_directions())      # of the rows as fitted (weighted), as res.jac is
+        if residuals.weights is not None:
+            # the log residuals themselves for what reads them after the fit (a mode's misfit in dB, the off-law lines)
+            res.fun = res.fun / residuals.weights
         # a limit is what the fit allowed, not what the data say: stiffness at ±10 %, damping at its floor ζ = 5e-5 (a
         # stand beside a load-cell offset was taken for the translation so, -19 %)
         at_bound = {m: ("stiffness" if min(res.x[2 * i] - lo[2 * i], hi[2 * i] - res.x[2 * i]) < 0.01 else
                         "damping" if res.x[2 * i + 1] - lo[2 * i + 1] < 0.01 else "")
                     for i, m in enumerate(free_modes)}
         modes = list(free_modes)        # as solved (the caller's list loses the modes it declares next)
-        return Solution(res, names, rel_se, lambda theta: self.unpack(modes, theta), at_bound, cov,
-                        _row_variance(res, self.row_directions()))
+        return Solution(res, names, rel_se, lambda theta: self.unpack(modes, theta), at_bound, cov, s2_row)
 
     def row_directions(self) -> np.ndarray:
         """Per least-squares row, the index of its measured line's load direction (radial force, radial torque,
@@ -171,6 +285,7 @@ class _Residuals:
 
     def __init__(self, problem: LogAmplitudeProblem, free_modes: list[str], off_rows: list[np.ndarray]):
         self.problem, self.free_modes, self.off_rows = problem, free_modes, off_rows
+        self.weights = problem.row_weights()
         self.key: bytes | None = None
         self.r = np.empty(0)
         self.J = np.empty((0, 0))
@@ -215,6 +330,8 @@ class _Residuals:
             J[:, 2 * i] = dk + 0.5 * dc if clamped[m] else dk
             J[:, 2 * i + 1] = 0.0 if clamped[m] else dc
         J[:, n_mode:n_mode + n_c] = d_C
+        if self.weights is not None:
+            r, J = r * self.weights, J * self.weights[:, None]
         self.key, self.r, self.J = key, r, J
 
 

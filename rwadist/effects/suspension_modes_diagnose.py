@@ -76,6 +76,22 @@ def _test_and_fit(ctx: Context, runs) -> tuple:
     return test, fit_empirical(sp, detections=detections)
 
 
+def _recorded_meta(ctx: Context) -> dict:
+    """The meta of the context's test with the far noisier sensor family of the load cell
+    (:func:`rwadist.extended_fit_lsq.noisy_sensor_directions`) decided once, on every run as recorded (the whole
+    data's lines at every speed, :func:`_whole_data_fit`), under
+    :data:`rwadist.extended_fit_lsq.NOISY_SENSORS_META`: every fit of the modes (on half of the runs, on every run, on
+    the torques corrected for a load-cell offset) weighs the same family's measurements by their noise, or none.  On
+    the corrected torques T − r × F the force sensors' noise reads in both families, and a decision taken again
+    there is not the load cell's (:func:`rwadist.extended_fit_lsq.recorded_noisy_sensors`)."""
+    from ..extended_fit_lsq import NOISY_SENSORS_META, noisy_sensor_directions
+
+    key = ("suspension_modes.noisy_sensors",)
+    if key not in ctx._memo:
+        ctx._memo[key] = noisy_sensor_directions(_whole_data_fit(ctx).without_mode_exclusion.lines)
+    return dict(ctx.test.meta, **{NOISY_SENSORS_META: ctx._memo[key]})
+
+
 def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None, near: dict | None = None,
               structure_start: tuple | None = None):
     """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
@@ -100,7 +116,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     from ..extended_fit import amplification_peaks
 
     runs = [int(r) for r in runs]
-    test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
+    test = SteadyTest([ctx.test.runs[r] for r in runs], _recorded_meta(ctx))
     if runs == [int(r) for r in ctx.runs]:
         fit = _whole_data_fit(ctx)      # the refit on every run: the same empirical fit, computed once
     else:
@@ -247,7 +263,7 @@ def _whole_data_stand(ctx: Context):
         whole_fit = _whole_data_fit(ctx)
         starts = _stand_starts_once(ctx, whole_fit)
         if starts:
-            test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], dict(ctx.test.meta))
+            test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], _recorded_meta(ctx))
             try:
                 stand = fit_extended_beside_stand(test, whole_fit, starts=starts).stand
             except ValueError:
@@ -635,6 +651,7 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
     import copy
     from dataclasses import replace
 
+    from ..data import SteadyTest
     from ..extended_fit import MODE_KEY, fit_extended
     from ..stand_resonance import STAND_SETTLED_MODE, _mode_hz
 
@@ -648,6 +665,7 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
     if not others:
         return state
     test, fit = _test_and_fit(ctx, ctx.runs)
+    test = SteadyTest(test.runs, _recorded_meta(ctx))
     try:
         one = fit_extended(test, fit, stand=own)
         every = fit_extended(test, fit, stand=own, more_stands=tuple(others))
