@@ -13,7 +13,9 @@ ends at the highest, in at most :data:`OUTSIDE_FRACTION` of the at least :data:`
 in every run is the other detector's); narrow (the median data-over-model ratio over the block's runs
 :data:`PEAKINESS` times that :data:`SIDE_BINS` bins either side: a hump of noise is nearly as high there); at a
 frequency where a line at a constant ratio of the speed would move by :data:`MIN_MOVE_BINS` Welch bins over the
-block's speeds (otherwise the two cannot be told apart); and :data:`MIN_LEVEL_DB` over the model in its cells.
+block's speeds (otherwise the two cannot be told apart); away from the model's suspension modes and fixed resonances
+(:func:`_at_a_mode`: there it is the mode rung by broadband content); and :data:`MIN_LEVEL_DB` over the model in its
+cells.
 """
 from __future__ import annotations
 
@@ -35,8 +37,33 @@ MIN_MOVE_BINS = 4.0
 #: Narrow: the line's bin over the bins this far either side (median data over model over the block's runs).
 SIDE_BINS = 4
 PEAKINESS = 4.0
-#: Data over model in the line's cells, at least (dB).
-MIN_LEVEL_DB = 1.0
+#: Data over model in the line's cells, at least (dB): the level the whole-range detector asks of the median run
+#: (:data:`rwadist.diagnose.fixed_lines.MIN_LEVEL`, over the floor).  Family wheel 0's counter_rotation cell held a
+#: 95.3 Hz column lit in Fx over the lower speeds at +6.1 dB, which no source made; trial13's tone stood +35 dB.
+MIN_LEVEL_DB = 10.0
+#: A line within this many ζ·f (and two Welch bins) of a suspension mode of the model, or of one of its fixed
+#: resonances, in most of its runs is the mode rung by broadband content, not a source of its own (family wheel 0:
+#: the rocking mode at rest, 95 Hz, in Fx over the lower speeds, where its whirl branches have not yet split).
+MODE_HALF_WIDTHS = 3.0
+
+
+def _at_a_mode(ctx, state, f_hz: float, runs: np.ndarray, chans) -> bool:
+    """True when ``f_hz`` lies within :data:`MODE_HALF_WIDTHS` ζ·f (+ 2 bins) of one of the state's suspension modes
+    (its whirl frequency at each run's speed) in at least half of ``runs``, or of a fixed resonance on ``chans``."""
+    from ..extended import damped_modes
+
+    tol = 2.0 * ctx.df
+    for f_r, zeta, _, on, *_ in state.resonances:        # (f_r, ζ, g, channels[, gain above])
+        if set(on) & set(chans) and abs(f_hz - f_r) <= MODE_HALF_WIDTHS * zeta * f_r + tol:
+            return True
+    if state.ext is None:
+        return False
+    for s in damped_modes(state.ext, ctx.omega[runs]).values():
+        f_m = np.abs(s.imag) / (2 * np.pi)
+        zeta = -s.real / np.maximum(np.abs(s), 1e-300)
+        if np.mean(np.abs(f_hz - f_m) <= MODE_HALF_WIDTHS * zeta * f_m + tol) >= 0.5:
+            return True
+    return False
 
 
 def _blocks(lit: np.ndarray) -> tuple:
@@ -105,6 +132,8 @@ def fixed_lines_in_part(ctx, state, shares) -> list:
         a, b, c3 = np.log(np.maximum(d[kp - 1:kp + 2], 1e-300))
         den = a - 2 * b + c3
         f_hz = (k0 - 3 + kp + (0.5 * (a - c3) / den if den < 0 else 0.0)) * ctx.df
+        if _at_a_mode(ctx, state, f_hz, block, chans):
+            continue
         share, level = shares(chans, f_hz, block)
         if not level >= MIN_LEVEL_DB:
             continue
