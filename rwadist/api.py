@@ -490,7 +490,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     DataError
         Runs at fewer than 2 distinct speeds (:func:`rwadist.validate.check_test_speeds`).
     """
-    from . import speed_whirl
+    from . import speed_check, speed_whirl
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
@@ -507,6 +507,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     check_test_speeds(test, source or (data if isinstance(data, (str, Path)) else "the test"),
                       model_given=model is not None or preset is not None)
     check_f_lim(test, f_lim)            # before the search starts, not after it
+    # a steady test's speed column checked against its imbalance's 1x lines, scaled when they all sit at one ratio
+    test, checked = speed_check.checked(test)
 
     def run(test, base_check):
         spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))
@@ -516,7 +518,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     # a speed from the data is tested by the wheel's gyroscopic whirl (and the data diagnosed again on the scale it
     # supports); how the speed was obtained goes to the summary and the report
     test, diagnosis = speed_whirl.settle(test, run)
-    diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None))
+    diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None), checked)
     reading = reading_provenance(getattr(test, "meta", None))
     if reading:
         diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(

@@ -426,11 +426,13 @@ def cmd_diagnose(args) -> int:
         base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
           f"{base} base")
-    if diag.speed.get("source") == "data":
+    if diag.speed.get("source") in ("data", "scaled"):
         from .speed_whirl import speed_lines
 
-        # how the speed was obtained was said when the sweep was read; the whirl's test (and any warning) follows
-        for line in speed_lines(diag.speed)[1:]:
+        # how the speed was obtained was said when the sweep was read; the whirl's test (and any warning) follows;
+        # a steady test's speed column scaled by its 1x lines is said here in full
+        lines = speed_lines(diag.speed)
+        for line in lines if diag.speed["source"] == "scaled" else lines[1:]:
             print(f"  {line}")
     from .effects_text import diagnose_lines
 

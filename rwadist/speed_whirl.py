@@ -209,14 +209,24 @@ def _judged(test, scale: dict, diagnosis, rec: dict):
     return diagnosis
 
 
-def speed_record(meta) -> dict:
+def speed_record(meta, check: dict | None = None) -> dict:
     """How the runs' speeds were obtained, for summary.json and report.md: ``source`` "measured" (a steady test's
-    speeds as given), "tach" (a sweep's tach column) or "data" (with the speed scale of
-    :meth:`rwadist.speed_scale.SpeedScale.to_meta`: method, ratios, the 1× line's evidence, agreement, the whirl's
-    test, a warning when the speed is suspect)."""
+    speeds as given), "scaled" (a steady test's speed column multiplied by the scale its imbalance's 1× lines
+    give, ``check``: :func:`rwadist.speed_check.check_record`; with ``scale`` and a ``warning``), "tach" (a
+    sweep's tach column) or "data" (with the speed scale of :meth:`rwadist.speed_scale.SpeedScale.to_meta`:
+    method, ratios, the 1× line's evidence, agreement, the whirl's test, a warning when the speed is suspect).
+    A steady test's record holds ``check`` when the 1× lines were measured."""
     slicing = (meta or {}).get("slicing")
     if not isinstance(slicing, dict):
-        return {"source": "measured", "method": "the runs' speeds as given (runs.csv speed_rpm)"}
+        out: dict = {"source": "measured", "method": "the runs' speeds as given (runs.csv speed_rpm)"}
+        if check and check.get("scaled"):
+            out = {"source": "scaled", "method": check["text"], "scale": check["scale"],
+                   "agreement_rel_rms": check["agreement_rel"],
+                   "warning": (f"the speed column reads {1 / check['scale']:.6g} x the rotor speed its imbalance "
+                               "lines give: check the tach constant or the speed_rpm column")}
+        if check:
+            out["check"] = check
+        return out
     if slicing.get("speed_source") != "data":
         return {"source": "tach", "method": "each slice's mean of the sweep's speed (tach) column"}
     sc = slicing.get("speed_scale") or {}
@@ -232,8 +242,11 @@ def speed_lines(record: dict) -> list:
     """Lines of text (report.md, the console) of :func:`speed_record`'s ``record``."""
     if not record:
         return []
+    if record.get("source") == "scaled":
+        return [f"speed: {record.get('method')}", f"warning: {record['warning']}"]
     if record.get("source") != "data":
-        return [f"speed: {record.get('method')}"]
+        check = record.get("check") or {}
+        return [f"speed: {record.get('method')}"] + ([f"speed check: {check['text']}"] if check.get("text") else [])
     agree = record.get("agreement_rel_rms")
     out = [str(record.get("method"))
            + (f"; ratios {', '.join(f'{h:.4g}' for h in record.get('ratios', []))}" if record.get("ratios") else "")

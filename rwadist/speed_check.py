@@ -1,0 +1,191 @@
+"""A steady test's speed column checked against the wheel's own 1× lines (issue 33, item 5).
+
+The imbalance is at exactly 1× the rotor speed, static in the radial force and dynamic in the radial torque, both
+turning with the rotor (:mod:`rwadist.speed_scale`, whose rotation-sense rule this module reuses).  A speed column
+read k times off (a tach constant, a gear ratio, a DAQ scale: trial 13's speeds 1 % high) puts every line of the
+data at 1/k of its ratio and the imbalance at h = 1/k, which no model of the wheel holds (the search pins the
+imbalance at 1× and the fit contradicts itself: trial 13, 43-54x the clean error, nothing said).  So before the
+search each run's 1× lines are measured where the given speed puts them:
+
+* the radial force pair (Fx, Fy) and the radial torque pair (Tx, Ty): the strongest peak of |X|² + |Y|² within
+  :data:`SEARCH` of the given 1× frequency (Hann window, zero-padded :data:`PAD` times, refined by a parabola
+  through the log of the three padded bins around it), counted where it stands :data:`speed_scale.PAIR_SNR` over
+  the local noise (±4..8 native bins) and turns one way (its co-rotating share beyond
+  :data:`speed_scale.POLARIZED`; :func:`rwadist.speed_scale.pair_senses`, the sweep path's rule), the same way
+  relative to the given speed's sign in the runs kept (the majority);
+* the axial force Fz, when it holds a line there (a plane line: no sense).
+
+Each line's ratio to the given speed over the runs, r = f_line / f_given, gives its scale k_line (the median) and its
+spread (1.4826 · MAD).  The column is called off, and every run's speed multiplied by the common k, only when
+
+1. the radial force's 1× line is measured in at least :data:`MIN_RUNS` runs and in half of the spinning runs (a
+   wheel whose radial 1× line is weak is never rescaled by other lines);
+2. every 1× line measured in :data:`MIN_RUNS` runs or more sits at one k (within :data:`AGREE` or
+   :data:`SIGMAS` standard errors; otherwise one of them is something else, e.g. a fixed line, and nothing moves);
+3. the common k is off 1 beyond :data:`SCALE_FLOOR` and :data:`SIGMAS` standard errors (the resolution), and
+   :data:`CONSISTENT` of the runs' radial-force ratios lie nearer k than 1.
+
+On true speeds (every 1× line at 1 within its resolution) the test is left exactly as read.  What was measured
+is :func:`check_record`'s record, which :func:`rwadist.speed_whirl.speed_record` turns into how the speed was
+obtained.
+
+Units: Hz for frequencies, rad/s for the runs' speeds, dimensionless ratios.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import replace
+
+import numpy as np
+from scipy import fft as sfft
+
+from .speed_scale import PAIR_SNR, POLARIZED, pair_senses
+
+#: zero-padding factor of a run's spectrum (the peak's sub-bin sampling)
+PAD = 4
+#: relative half-width of the window searched around the given 1× frequency (a speed column off by up to 3 %)
+SEARCH = 0.03
+#: a 1× line is judged on this many runs at least
+MIN_RUNS = 3
+#: relative scale below which a speed column is left as given (0.05 %: a DAQ's reading of a speed)
+SCALE_FLOOR = 5.0e-4
+#: standard errors by which a scale must exceed 1, and within which two lines' scales agree
+SIGMAS = 6.0
+#: relative difference within which two lines' scales always agree (a line's sub-bin accuracy at the lowest speeds)
+AGREE = 3.0e-4
+#: share of the runs' radial-force ratios that must lie nearer the common scale than 1
+CONSISTENT = 0.8
+#: the run's given 1× frequency must be this many native bins above 0 Hz to be measured
+MIN_BINS = 12
+#: the three 1× lines: key -> (channels, text)
+LINES = {"radial_force": (("Fx", "Fy"), "radial force"), "radial_torque": (("Tx", "Ty"), "radial torque"),
+         "axial_force": (("Fz",), "axial force")}
+
+
+def run_line(run, channels: tuple, f0: float) -> tuple:
+    """(frequency Hz, SNR, co-rotating share) of the strongest peak within :data:`SEARCH` of ``f0`` in a run's
+    ``channels`` (an x/y pair or one channel); nan frequency when the run lacks a channel or the window.
+
+    The peak is the largest |X|² + |Y|² (|X|² for one channel) of the Hann-windowed spectra zero-padded
+    :data:`PAD` times, refined by a parabola through the log of the three padded bins around it.  A pair's SNR and
+    co share are :func:`rwadist.speed_scale.pair_senses`' (the sweep path's one rule of a rotating line): the
+    share |X + iY|²/(|X + iY|² + |X − iY|²) where the line stands PAIR_SNR over the median at ±4..8 native bins;
+    one channel's SNR is its |X|² over that median, its share nan."""
+    none = (np.nan, 0.0, np.nan)
+    if not all(c in run.signals for c in channels):
+        return none
+    fs = float(run.sample_rate)
+    n = run.n_samples
+    df = fs / n
+    if not (np.isfinite(f0) and f0 >= MIN_BINS * df and f0 * (1 + SEARCH) + 8 * df < fs / 2):
+        return none
+    win = np.hanning(n)
+    spec = {c: sfft.rfft((np.asarray(run.signals[c], dtype=float) - np.mean(run.signals[c])) * win, n=PAD * n)
+            for c in channels}
+    f = np.fft.rfftfreq(PAD * n, 1.0 / fs)
+    power = sum(np.abs(s) ** 2 for s in spec.values())
+    lo = int(np.ceil((f0 * (1 - SEARCH) - 2 * df) / f[1]))
+    hi = int(np.floor((f0 * (1 + SEARCH) + 2 * df) / f[1]))
+    k = lo + int(np.argmax(power[lo:hi + 1]))
+    a, b, c = np.log(np.maximum(power[k - 1:k + 2], 1e-300))
+    den = a - 2 * b + c
+    f_peak = (k + (float(np.clip(0.5 * (a - c) / den, -0.5, 0.5)) if den < 0 else 0.0)) * f[1]
+    if len(channels) == 2:
+        share, snr = next(iter(pair_senses({ch: v[None, :] for ch, v in spec.items()}, f, PAD,
+                                           np.array([[f_peak]])).values()))
+        return f_peak, float(snr[0, 0]), float(share[0])
+    noise = float(np.median(power[k + PAD * np.array([-8, -6, -4, 4, 6, 8])]))
+    return f_peak, float(power[k] / max(noise, 1e-300)), np.nan
+
+
+def line_ratios(test) -> dict:
+    """Per 1× line of :data:`LINES` recorded: (ratio f_line/f_given (n_runs,), nan where the line was not
+    measured; the runs' indices kept).  A pair's line counts where it stands PAIR_SNR over its noise and turns
+    one way, the same way relative to the run's speed as the majority of such runs."""
+    out = {}
+    f_given = np.abs(np.array([r.speed for r in test.runs], dtype=float)) / (2 * np.pi)
+    sign = np.sign([r.speed for r in test.runs])
+    for key, (channels, _) in LINES.items():
+        if not any(all(c in r.signals for c in channels) for r in test.runs):
+            continue
+        meas = np.array([run_line(r, channels, f0) for r, f0 in zip(test.runs, f_given)])
+        f_line, snr, share = meas[:, 0], meas[:, 1], meas[:, 2]
+        ok = np.isfinite(f_line) & (snr >= PAIR_SNR)
+        if len(channels) == 2:
+            pol = np.where(share >= POLARIZED, 1.0, np.where(share <= 1 - POLARIZED, -1.0, 0.0)) * sign
+            ok &= pol != 0
+            if ok.any():
+                major = 1.0 if np.sum(pol[ok] > 0) >= np.sum(pol[ok] < 0) else -1.0
+                ok &= pol == major
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = np.where(ok, f_line / f_given, np.nan)
+        out[key] = ratio
+    return out
+
+
+def _scale(ratio: np.ndarray) -> tuple:
+    """(k, spread, standard error, runs) of one line's ratios: median, 1.4826·MAD, spread/√runs (nan when none)."""
+    r = ratio[np.isfinite(ratio)]
+    if r.size == 0:
+        return np.nan, np.nan, np.nan, 0
+    k = float(np.median(r))
+    spread = float(1.4826 * np.median(np.abs(r - k)))
+    return k, spread, spread / np.sqrt(r.size), int(r.size)
+
+
+def check_record(test) -> dict:
+    """What the 1× lines say of a steady test's speed column (module docstring): a JSON-ready dict with
+    ``lines`` (per line measured: k, spread, runs), ``scale`` (the common k, or None when none is judged),
+    ``scaled`` (True when the column is to be multiplied by ``scale``), ``agreement_rel`` (the RMS over the
+    lines' runs of r/k − 1 about the k applied, 1 when not scaled) and ``text`` (one sentence); {} for a
+    test whose speeds are a sweep's slices (``meta["slicing"]``) or with no spinning run."""
+    if (getattr(test, "meta", None) or {}).get("slicing") is not None:
+        return {}
+    spinning = int(np.sum(np.abs([r.speed for r in test.runs]) > 0))
+    if spinning == 0:
+        return {}
+    ratios = line_ratios(test)
+    stats = {key: _scale(r) for key, r in ratios.items()}
+    judged = {key: s for key, s in stats.items() if s[3] >= MIN_RUNS}
+    lines = {key: {"k": round(s[0], 7), "spread_rel": round(s[1], 7), "runs": s[3]} for key, s in judged.items()}
+    rec: dict = {"lines": lines, "scale": None, "scaled": False, "runs": spinning}
+    force = judged.get("radial_force")
+    if force is None or force[3] < 0.5 * spinning:
+        rec["text"] = ("the imbalance's radial-force 1x line was not measured in half of the spinning runs: the "
+                       "speed column is not checked")
+        return rec
+    pooled = np.concatenate([r[np.isfinite(r)] for key, r in ratios.items() if key in judged])
+    k, _, se, _ = _scale(pooled)
+    se = max(se, max(s[2] for s in judged.values()))
+    rec["scale"] = round(k, 7)
+    apart = [key for key, s in judged.items()
+             if abs(s[0] - force[0]) > max(AGREE, SIGMAS * float(np.hypot(s[2], force[2])))]
+    rf = ratios["radial_force"][np.isfinite(ratios["radial_force"])]
+    nearer = float(np.mean(np.abs(rf - k) < np.abs(rf - 1.0)))
+    off = abs(k - 1.0) > max(SCALE_FLOOR, SIGMAS * se)
+    rec["scaled"] = bool(off and not apart and nearer >= CONSISTENT)
+    about = k if rec["scaled"] else 1.0
+    rec["agreement_rel"] = round(float(np.sqrt(np.mean((pooled / about - 1.0) ** 2))), 7)
+    names = ", ".join(LINES[key][1] for key in judged)
+    each = "; ".join(f"{LINES[key][1]} {s[0]:.6g} in {s[3]} runs" for key, s in judged.items())
+    if rec["scaled"]:
+        rec["text"] = (f"speed column scaled by {k:.6g}: the 1x lines ({names}) sit at {k:.6g} of the "
+                       f"given speed in {force[3]} of {spinning} spinning runs ({each}), spread "
+                       f"{100 * rec['agreement_rel']:.3g} % RMS about it; every run's speed multiplied by {k:.6g}")
+    elif apart:
+        rec["text"] = (f"the 1x lines disagree ({each}): the speed column is left as given")
+    else:
+        rec["text"] = (f"the 1x lines ({names}) agree with the given speed: {each}, "
+                       f"{100 * rec['agreement_rel']:.3g} % RMS")
+    return rec
+
+
+def checked(test) -> tuple:
+    """(test, record): ``test`` with every run's speed multiplied by the scale its 1× lines give when
+    :func:`check_record` calls the column off (a copy; its meta is left alone), else ``test`` itself, untouched."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        rec = check_record(test)
+    if not rec.get("scaled"):
+        return test, rec
+    return type(test)([replace(r, speed=r.speed * rec["scale"]) for r in test.runs], dict(test.meta or {})), rec
