@@ -324,13 +324,13 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
                 cells[c] = m
         return res.measure(cells)
 
-    def of_line(chans, h, runs):
+    def of_line(chans, h, runs):          # h: one ratio, or several (every line of a channel's gain)
         cells = {}
         for c in chans:
             if c in res.e:
                 m = res.mask(c)
                 for r in runs:
-                    m[pos[int(r)], res.band_of(h * ctx.omega[int(r)] / (2 * np.pi))] = True
+                    m[pos[int(r)], res.band_of(np.asarray(h) * ctx.omega[int(r)] / (2 * np.pi))] = True
                 cells[c] = m
         return res.measure(cells)
 
@@ -341,16 +341,6 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
             if c in res.e:
                 m = res.mask(c)
                 m[np.isin(ctx.runs, runs), b] = True
-                cells[c] = m
-        return res.measure(cells)
-
-    def of_lines(chans, hs, runs):
-        cells = {}
-        for c in chans:
-            if c in res.e:
-                m = res.mask(c)
-                for r in runs:
-                    m[pos[int(r)], res.band_of(np.asarray(hs) * ctx.omega[int(r)] / (2 * np.pi))] = True
                 cells[c] = m
         return res.measure(cells)
 
@@ -366,7 +356,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += speed_lines(ctx, state, of_line, bearings, others)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
     out += fixed_lines_in_part(ctx, state, of_fixed)
-    out += channel_gain(ctx, state, of_lines)
+    out += channel_gain(ctx, state, of_line)
     return out
 
 
