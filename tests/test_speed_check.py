@@ -147,3 +147,17 @@ def test_an_unchecked_column_says_why(monkeypatch, rpm, weak, drop, words):
     out, rec = chk.checked(test)
     assert out is test and not rec["scaled"]
     assert words in rec["text"] and rec["text"].endswith("the speed column is not checked")
+
+
+def test_a_sample_rate_read_high_is_named_beside_the_speed_column():
+    """Second cause of the same signature (review13): the speeds right, the sample rate read 1 % high puts every line,
+    the 1x lines too, at 1.01 x its frequency, which the check cannot tell from a speed column 1 % low.  The column is
+    scaled by 1.01 (the lines then sit at their ratios) and the warning names the sample rate with that factor."""
+    from dataclasses import replace
+
+    test = wheel_test(1.0)
+    test = SteadyTest([replace(r, sample_rate=r.sample_rate * 1.01) for r in test.runs], {})
+    out, rec = chk.checked(test)
+    assert rec["scaled"] and rec["scale"] == pytest.approx(1.01, abs=2e-5)
+    warning = sw.speed_record(out.meta, rec)["warning"]
+    assert "speed_rpm" in warning and "sample rate read 1.01 x the true one" in warning
