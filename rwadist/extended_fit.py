@@ -605,6 +605,10 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     """
     physical = mass is not None and radius is not None
     notes: list[str] = []
+    # the load cell's noisier sensor family read on the data as recorded, before the lever arm comes out (T − h × F
+    # puts the force sensors' noise in the torques too: wheel 1's forces 28 dB noisier, 5-9x the torques' floor as
+    # recorded, 2.6-3.5x with h = 0.1 m taken out, where no family was singled out)
+    noisy = recorded_noisy_sensors(test, fit.without_mode_exclusion.lines) if height else None
     test, fit, meas, senses_xy = _measured_lines(test, fit, height, ([] if stand is None else [stand]) + list(more_stands),
                                                  stand_direction if stand is not None else None)
     peaks = amplification_peaks(fit)
@@ -622,7 +626,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
     problem = LogAmplitudeProblem(base, lines, LinePower(lines, sa, ax_line, ca, sr, rad_parts), log_data, joint,
                                   row_line, centred_log_w, meas.lines, progress, np.concatenate([na, nr]), LOG_SCATTER,
-                                  recorded_noisy_sensors(test, meas.lines))
+                                  recorded_noisy_sensors(test, meas.lines) if noisy is None else noisy)
     off_law: list[int] = []     # lines given an exponent of their own before a mode is declared (appended in place)
     solution = _fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare,
                           tolerance, off_law, log_w, lambda m, why: starts.declare(base, m, why))

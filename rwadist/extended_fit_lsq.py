@@ -363,8 +363,10 @@ def power_sum_stderr(solution: Solution, pairs: dict) -> dict:
     the sum and not the split, whose column of the Jacobian then vanishes (trial11: parts' errors of 612 and 1477,
     or, with the pseudo-inverse, small ones that mean nothing).  With g = (C_co², C_counter²)/P the sum's
     d ln sqrt(P) = g·(d ln C_co, d ln C_counter): var = g·Σ·g.  The split moves along v = (g_counter, −g_co),
-    which keeps P and changes ln(C_co/C_counter) one for one: var = vᵀJᵀSJv/(vᵀJᵀJv)² (S the rows' variances,
-    the least squares unweighted); infinite when the rows do not see it."""
+    which keeps P and changes ln(C_co/C_counter) one for one: var = vᵀJᵀSJv/(vᵀJᵀJv)² (J and S the rows' Jacobian
+    and variances as fitted: weighted when a far noisier sensor family is, :meth:`LogAmplitudeProblem.row_weights`);
+    infinite when the rows do not see it.  Held the other parameters, this is the least the split's error can be: a
+    note said on it is never said in vain, though a split measured only through a free mode's gain may go unsaid."""
     first = next(i for i, n in enumerate(solution.names) if n.startswith("C["))     # θ: the modes, then the lines
     out = {}
     for key, (k_co, k_ct) in pairs.items():

@@ -133,6 +133,20 @@ def _scale(ratio: np.ndarray) -> tuple:
     return k, spread, spread / np.sqrt(r.size), int(r.size)
 
 
+def _unchecked(ratios: dict, spinning: int) -> str:
+    """Why the radial force's 1× line cannot judge the speed column, in words: the data hold no Fx/Fy pair, there
+    are fewer than :data:`MIN_RUNS` spinning runs, or the line was measured in too few of them."""
+    if "radial_force" not in ratios:
+        return "the data hold no radial force pair (Fx, Fy) to measure the imbalance's 1x line in"
+    seen = int(np.sum(np.isfinite(ratios["radial_force"])))
+    if spinning < MIN_RUNS:
+        return (f"{spinning} spinning run{'s' if spinning != 1 else ''}: the imbalance's radial-force 1x line is judged "
+                f"on {MIN_RUNS} runs at least")
+    return (f"the imbalance's radial-force 1x line was measured in {seen} of {spinning} spinning runs (at least "
+            f"{max(MIN_RUNS, int(np.ceil(0.5 * spinning)))} needed: it stands {PAIR_SNR:g}x over the noise and turns "
+            "one way there)")
+
+
 def check_record(test) -> dict:
     """What the 1× lines say of a steady test's speed column (module docstring): a JSON-ready dict with
     ``lines`` (per line measured: k, spread, runs), ``scale`` (the common k, or None when none is judged),
@@ -151,8 +165,7 @@ def check_record(test) -> dict:
     rec: dict = {"lines": lines, "scale": None, "scaled": False, "runs": spinning}
     force = judged.get("radial_force")
     if force is None or force[3] < 0.5 * spinning:
-        rec["text"] = ("the imbalance's radial-force 1x line was not measured in half of the spinning runs: the "
-                       "speed column is not checked")
+        rec["text"] = _unchecked(ratios, spinning) + ": the speed column is not checked"
         return rec
     pooled = np.concatenate([r[np.isfinite(r)] for key, r in ratios.items() if key in judged])
     k, _, se, _ = _scale(pooled)

@@ -223,7 +223,10 @@ def speed_record(meta, check: dict | None = None) -> dict:
             out = {"source": "scaled", "method": check["text"], "scale": check["scale"],
                    "agreement_rel_rms": check["agreement_rel"],
                    "warning": (f"the speed column reads {1 / check['scale']:.6g} x the rotor speed its imbalance "
-                               "lines give: check the tach constant or the speed_rpm column")}
+                               "lines give: check the tach constant or the speed_rpm column, and the sample "
+                               f"rate (a sample rate read {check['scale']:.6g} x the true one puts every frequency, "
+                               "the 1x lines' too, at that factor: then the speeds as given were right and every "
+                               "frequency in Hz is off)")}
         if check:
             out["check"] = check
         return out

@@ -10,6 +10,8 @@ The data here are this file's own wheel (not the E wheel, not rwadist's generato
 h·Ω_true of a hard-mounted rotor (C·Ω², co-rotating radial vectors Fx = A cos, Fy = A sin), with white noise.  Truth:
 the generator's speeds, so the scale to find is 1/(the column's factor) in closed form.
 """
+import sys
+
 import numpy as np
 import pytest
 
@@ -125,3 +127,37 @@ def test_diagnose_on_a_scaled_column_is_the_true_speeds_diagnosis():
     assert s_off["speed"]["scale"] == pytest.approx(1 / 1.01, abs=2e-5) and "warning" in s_off["speed"]
     assert s_off["error_after"] == pytest.approx(s_true["error_after"], rel=0.05)
     assert any(abs(x.h - 1.0) < 1e-3 for x in off.model.harmonics("radial_force"))
+
+
+@pytest.mark.parametrize("rpm, weak, drop, words", [
+    (np.array([2000.0, 4000.0]), 1.0, (), "2 spinning runs: the imbalance's radial-force 1x line is judged on 3 runs"),
+    (RPM, 1e-4, (), "measured in 0 of 14 spinning runs (at least 7 needed"),
+    (RPM, 1.0, ("Fx", "Fy"), "no radial force pair (Fx, Fy)")])
+def test_an_unchecked_column_says_why(monkeypatch, rpm, weak, drop, words):
+    """The reason the speed column is not checked is the data's, in words (review13: two spinning runs, each with its
+    1x line measured, read "not measured in half of the spinning runs"): too few spinning runs, a 1x line too weak
+    (the radial force's imbalance 1e4 x smaller: under the noise in every run), or no Fx/Fy at all.  Nothing is scaled,
+    though the speeds read 1 % high."""
+    monkeypatch.setattr(sys.modules[__name__], "RPM", rpm)
+    lines = tuple((d, h, c * (weak if d == "radial_force" and h == 1.0 else 1.0), s) for d, h, c, s in LINES)
+    test = wheel_test(1.01, lines=lines)
+    for run in test.runs:
+        for c in drop:
+            del run.signals[c]
+    out, rec = chk.checked(test)
+    assert out is test and not rec["scaled"]
+    assert words in rec["text"] and rec["text"].endswith("the speed column is not checked")
+
+
+def test_a_sample_rate_read_high_is_named_beside_the_speed_column():
+    """Second cause of the same signature (review13): the speeds right, the sample rate read 1 % high puts every line,
+    the 1x lines too, at 1.01 x its frequency, which the check cannot tell from a speed column 1 % low.  The column is
+    scaled by 1.01 (the lines then sit at their ratios) and the warning names the sample rate with that factor."""
+    from dataclasses import replace
+
+    test = wheel_test(1.0)
+    test = SteadyTest([replace(r, sample_rate=r.sample_rate * 1.01) for r in test.runs], {})
+    out, rec = chk.checked(test)
+    assert rec["scaled"] and rec["scale"] == pytest.approx(1.01, abs=2e-5)
+    warning = sw.speed_record(out.meta, rec)["warning"]
+    assert "speed_rpm" in warning and "sample rate read 1.01 x the true one" in warning

@@ -50,6 +50,12 @@ def _powers(ctx, state, c: str, runs: np.ndarray):
     return h, np.where(ok, np.nan_to_num(m) ** 2 / 2, np.nan), np.where(ok, a**2 / 2, np.nan), noise
 
 
+def _lines_words(agreeing: np.ndarray, read: np.ndarray) -> str:
+    """The lines that carry the ratio, in words, when some lines read do not (``agreeing`` among ``read``: h)."""
+    return (f"the lines h {', '.join(f'{x:.3g}' for x in agreeing)} ({agreeing.size} of the {read.size} read; the "
+            "others differ: a gain acts on all)")
+
+
 def channel_gain(ctx, state, shares) -> list:
     """``line_property`` records of a radial pair whose two channels read the model's lines by different factors
     (``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB) of the lines' cells)."""
@@ -90,8 +96,11 @@ def channel_gain(ctx, state, shares) -> list:
                         "amplitude_ratio": float(ratio), "power_ratio_dB": med, "stderr_dB": se,
                         "lines_h": [float(x) for x in h[lines][agree]], "cells": int(cells.size)},
             causes=(f"a gain or calibration error of {hi_c} or {lo_c}: {hi_c} reads {max(ratio, 1 / ratio):.3g} x "
-                    f"{lo_c} on every line (a rotating load gives x and y the same power)",
-                    "a support or fixture stiffer in one direction (then the ratio changes with the frequency)"),
+                    f"{lo_c} on {'every line read' if agree.all() else _lines_words(h[lines][agree], h[lines])} (a "
+                    "rotating load gives x and y the same power)",
+                    "a support or fixture stiffer in one direction: the suspension mode splits into an x and a y mode, "
+                    "and the ratio changes across them but stays nearly constant on the lines well above both "
+                    "(about (f_x/f_y)² in amplitude), as a gain's does"),
             would_tell=f"a calibration of {cx} and {cy} with one known load (a mass hung, a shaker's force), or the "
                        "load cell turned 90 degrees on the stand (a channel's gain goes with the channel)"))
     return out
