@@ -21,9 +21,9 @@ HARMONICS = [("radial_force", 2.0, 7.6e-7, "counter"), ("radial_force", 3.0, 5.0
              ("axial_force", 1.0, 2.8e-6, "co"), ("axial_force", 1.98, 2.6e-6, "co")]
 
 
-def make_data(params, speeds_rpm, fs=1920.0, n=4096, noise=0.01, seed=0):
+def make_data(params, speeds_rpm, fs=1920.0, n=4096, noise=0.01, seed=0, harmonics=HARMONICS):
     rng = np.random.default_rng(seed)
-    lines = ext.imbalance_lines(params) + [ext.Line(d, h, c, s) for d, h, c, s in HARMONICS]
+    lines = ext.imbalance_lines(params) + [ext.Line(d, h, c, s) for d, h, c, s in harmonics]
     w = rpm_to_rad_s(np.asarray(speeds_rpm, float))
     f, A = ext.steady_lines(params, lines, w)
     t = np.arange(n) / fs

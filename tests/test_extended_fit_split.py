@@ -7,17 +7,21 @@ which is no whirl (both senses, the same gain): the power cannot split it.  A to
 parts passes the rocking mode, whose whirl branches split with speed: its split is measured.  The sum's standard
 error is checked against a second method: the scatter of the summed amplitude over the same wheel tested with other
 noise and line phases (8 seeds)."""
+import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from rwadist import extended as ext
-from rwadist.data import Run, SteadyTest
 from rwadist.empirical import fit_empirical
 from rwadist.extended_fit import fit_extended
 from rwadist.spectra import compute_spectra
-from rwadist.units import rpm_to_rad_s
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from test_extended_fit import make_data  # noqa: E402  (the same numpy data, other lines)
 
 E = replace(ext.from_table_4_2(), height=0.0)
 LINES = [("radial_force", 2.0, 6e-7, "co"), ("radial_force", 2.0, 6e-7, "counter"),
@@ -25,22 +29,8 @@ LINES = [("radial_force", 2.0, 6e-7, "co"), ("radial_force", 2.0, 6e-7, "counter
          ("axial_force", 1.5, 2e-6, "co")]
 
 
-def _data(params, speeds_rpm, fs=1920.0, n=4096, noise=0.01, seed=3):
-    rng = np.random.default_rng(seed)
-    lines = ext.imbalance_lines(params) + [ext.Line(d, h, c, s) for d, h, c, s in LINES]
-    w = rpm_to_rad_s(np.asarray(speeds_rpm, float))
-    f, A = ext.steady_lines(params, lines, w)
-    t = np.arange(n) / fs
-    std_f, std_t = noise * params.U_s * w.max() ** 2, noise * params.U_d * w.max() ** 2
-    runs = []
-    for i in range(w.size):
-        ph = rng.uniform(0, 2 * np.pi, len(lines))
-        ph[1] = ph[0]
-        sig = np.real(np.einsum("lc,ln->cn", A[i], np.exp(1j * (2 * np.pi * f[i][:, None] * t + ph[:, None]))))
-        chans = {c: sig[k] + (std_f if k < 3 else std_t) * rng.standard_normal(n)
-                 for k, c in enumerate(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"))}
-        runs.append(Run(float(w[i]), fs, chans, name=f"r{i:03d}.csv"))
-    return SteadyTest(runs)
+def _data(params, speeds_rpm, seed=3):
+    return make_data(params, speeds_rpm, seed=seed, harmonics=LINES)
 
 
 @pytest.fixture(scope="module")
