@@ -289,7 +289,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
     the records the search read had the changed runs' factor taken out, :func:`run_steps`)."""
     from .describe_fixed import fixed_lines_in_part
-    from .describe_gain import channel_gain
+    from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
     from .describe_partial import partial_lines
     from .describe_structure import broadband_hump, line_ratios, moving_resonance, resolved_lines, run_change
@@ -356,7 +356,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += speed_lines(ctx, state, of_line, bearings, others)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
     out += fixed_lines_in_part(ctx, state, of_fixed)
-    out += channel_gain(ctx, state, of_line)
+    # the recorded channels (a gain acts on them, before any load-cell correction), against the noise as given
+    out += channel_gain(ctx, as_recorded(searched.state), of_line)
     return out
 
 

@@ -12,6 +12,13 @@ median over (line, run) of 10·log10(P_y/P̂_y) − 10·log10(P_x/P̂_x), descri
 :data:`MIN_Z` standard errors from 0 (the median's, from the scatter's MAD), and held by :data:`MIN_LINES` lines or
 more, each with its own median of the same sign within a factor 2 of it (an ellipse of fixed orientation, e.g. a
 support stiffer in x, tilts one line; a gain tilts them all).
+
+The pairs are read as recorded, not corrected for a load-cell offset (:func:`as_recorded`): a gain acts on the
+channel as the load cell gives it, T + r × F, and the correction T − r × F with an r fitted to both channels (the
+``cross_coupling`` fit takes one r_z from Tx = −r_z·Fy and Ty = r_z·Fx) cancels the gain's share of the force
+lines' r × F in one channel and not in the other: trial13's Ty × 1.10 with r = 25 mm fitted r = 26.2 mm, read
+through the correction its lines disagreed and nothing was described.  A rotating r × F is a load rotating with
+its force, so the recorded x and y still carry each line's power alike.
 """
 from __future__ import annotations
 
@@ -32,6 +39,21 @@ MIN_Z = 5.0
 #: Lines (h) that must each show it, with MIN_RUNS runs or more each.
 MIN_LINES = 2
 MIN_RUNS = 4
+
+
+#: Effect kinds that read the torques corrected for a load-cell offset (left out by :func:`as_recorded`).
+CORRECTION_KINDS = ("cross_coupling", "lever_arm_noise")
+
+
+def as_recorded(state):
+    """``state`` reading the torques as recorded: a copy without the effects of :data:`CORRECTION_KINDS` (the same
+    lines, noise and other effects; the model's torque lines are the wheel's, r × F is not predicted: the two
+    channels of a pair miss it alike)."""
+    if not any(getattr(e, "kind", None) in CORRECTION_KINDS for e in state.effects):
+        return state
+    out = state.copy()
+    out.effects = [e for e in state.effects if getattr(e, "kind", None) not in CORRECTION_KINDS]
+    return out
 
 
 def _powers(ctx, state, c: str, runs: np.ndarray):

@@ -37,7 +37,8 @@ class Hypothesis:
     #: :func:`rwadist.diagnose.describe.forced_effects`), or None
     forced_by: str | None = None
     #: the test-stand resonance fitted jointly with the effect that it was judged beside (:func:`_judge_beside_stand`:
-    #: the wheel's suspension modes with their fixture divided out on both sides of the comparison), or None
+    #: the wheel's suspension modes with their fixture divided out on both sides of the comparison), or the load-cell
+    #: offset (a ``cross_coupling``) the modes were judged with (:func:`_judge_with_offset`), or None
     beside: Effect | None = None
     #: the effect of several parts this hypothesis's effect is one part of (a floor law of several channels,
     #: :class:`rwadist.effects.broadband_floor_diagnose.FloorGroup`: one hypothesis, each part its own entry of the
@@ -130,7 +131,9 @@ def effect_entry(hyp: Hypothesis) -> dict:
         d["evidence"]["part_of"] = list(group.channels)
     if hyp.forced_by:
         d["evidence"]["taken_back"] = f"fitted to content described as {hyp.forced_by}"
-    if hyp.beside is not None:
+    if getattr(hyp.beside, "kind", None) == "cross_coupling":
+        d["evidence"]["judged_with_load_cell_offset_m"] = [float(x) for x in getattr(hyp.beside, "r")]
+    elif hyp.beside is not None:
         d["evidence"]["judged_beside_test_stand_Hz"] = float(getattr(hyp.beside, "f_r", np.nan))
     return d
 
@@ -179,11 +182,19 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
     if getattr(effect, "role", "") == "test_stand":
         t = max(t, _by_direction_t(ctx, state, runs, chans, applied, memo))
     hyp = Hypothesis(effect, gain / total, frac, float(t), bool(t > k_sigma and frac >= min_gain), iteration)
-    stand = getattr(effect, "stand_effect", lambda channels: None)(ctx.channels)
-    if hyp.passed or stand is None:
+    if hyp.passed:
         return hyp
-    beside = _judge_beside_stand(ctx, state, effect, stand, runs, chans, k_sigma, min_gain, iteration)
-    return beside if beside.passed else hyp
+    stand = getattr(effect, "stand_effect", lambda channels: None)(ctx.channels)
+    if stand is not None:
+        beside = _judge_beside_stand(ctx, state, effect, stand, runs, chans, k_sigma, min_gain, iteration)
+        if beside.passed:
+            return beside
+    offset = getattr(effect, "offset_effect", lambda: None)()
+    if offset is not None:
+        with_offset = _judge_with_offset(ctx, state, effect, offset, runs, chans, k_sigma, min_gain, iteration)
+        if with_offset.passed:
+            return with_offset
+    return hyp
 
 
 def _evidence(ctx, state, applied, runs, chans, memo, own_beats=False) -> tuple:
@@ -214,6 +225,22 @@ def _judge_beside_stand(ctx, state, effect, stand, runs, chans, k_sigma, min_gai
     gain, frac, t, total = _evidence(ctx, base, effect.apply(state).plus(stand), runs, chans, None)
     return Hypothesis(effect, gain / total, frac, float(t), bool(t > k_sigma and frac >= min_gain), iteration,
                       beside=stand)
+
+
+def _judge_with_offset(ctx, state, effect, offset, runs, chans, k_sigma, min_gain, iteration) -> Hypothesis:
+    """Held-out evidence of ``effect`` (the wheel's suspension modes) read with the load-cell offset ``offset`` (a
+    ``cross_coupling``) it was located beside: ``effect`` and ``offset`` added to ``state`` against ``state`` as it is.
+
+    The modes predict the torques at the bearing centre; a load cell whose reference sits below it reads T + r × F,
+    whose r × F carries the forces' lines, amplified by the translation mode, into the torques, where the empirical
+    base fits each line freely: judged alone, the modes lose the torques (tests/standmodes_wheel's new wheel,
+    r_z = 30 mm: modes within 0.1 % rejected in every iteration; a 'wheel mode' and an amplitude law named instead).
+    The pair is judged against the state without either, as one hypothesis of the test (a wheel with these modes on
+    a load cell with this offset); the modes are taken, and the offset is left to the search, which names it
+    (``cross_coupling``, judged on its own) after them.  Same rule as :func:`_judge`."""
+    gain, frac, t, total = _evidence(ctx, state, effect.apply(state).plus(offset), runs, chans, None)
+    return Hypothesis(effect, gain / total, frac, float(t), bool(t > k_sigma and frac >= min_gain), iteration,
+                      beside=offset)
 
 
 def _judge_families(ctx, state, families, k_sigma, min_gain, iteration, memo, other_folds=False) -> list:
@@ -407,6 +434,10 @@ def _no_worse(ctx, state, refit, beside=None) -> tuple[bool, State]:
     refit that runs off raises it by factors.  ``beside``: the test stand the hypothesis was judged beside
     (:func:`_judge_beside_stand`): the refit's own stand (else that one) is then in both states compared."""
     new = refit.apply(state)
+    if getattr(beside, "kind", None) == "cross_coupling":
+        # judged with the offset it was located beside (:func:`_judge_with_offset`): the refit with its own offset
+        offset = getattr(refit, "offset_effect", lambda: None)() or beside
+        return ctx.error(new.plus(offset)) <= _state_error(ctx, state) * (1.0 + NO_WORSE_TOLERANCE), new
     if beside is not None:
         stand = getattr(refit, "stand_effect", lambda channels: None)(ctx.channels) or beside
         return ctx.error(new.plus(stand)) <= ctx.error(stand.apply(state)) * (1.0 + NO_WORSE_TOLERANCE), new

@@ -94,9 +94,10 @@ def _recorded_meta(ctx: Context) -> dict:
 
 def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None, near: dict | None = None,
               structure_start: tuple | None = None):
-    """(SteadyTest, EmpiricalFit, ExtendedFit, stand) of ``runs``, or None when the runs show no modal
+    """(SteadyTest, EmpiricalFit, ExtendedFit, stand, offset) of ``runs``, or None when the runs show no modal
     amplification (or the extended fit fails, or locates no mode); ``stand`` is the fixture resonance (f_r Hz, ζ, peak
-    gain, gain above) fitted with the modes, or None.  ``stand_start``: the stand to start from (a refit on every run
+    gain, gain above) fitted with the modes, or None; ``offset`` the load-cell offset (a ``cross_coupling``) the
+    torques were corrected for before the modes were located (:func:`_beside_offset`), or None.  ``stand_start``: the stand to start from (a refit on every run
     starts from the one fitted on half of them), else those :func:`rwadist.stand_resonance.stand_starts` proposes.
     ``near``: the modes that fit located, searched first (``near`` of :func:`rwadist.extended_fit.fit_extended`), or
     None.  ``structure_start``: the mode of the wheel's structure to start from (direction, f_r Hz, ζ, peak gain: the fit
@@ -124,6 +125,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
         fit = fit_empirical(sp, detections=detections)
     if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
         return None
+    offset = None
     try:
         efit, stand = _locate(ctx, test, fit, stand_start, near)
         if len(ctx.channels) == 6:
@@ -133,7 +135,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             # (the offset itself is left to the search: a ``cross_coupling`` on the modes' base)
             got = _beside_offset(ctx, state, efit, fit, runs, test, stand_start, near)
             if got is not None:
-                test, fit, efit, stand, _ = got
+                test, fit, efit, stand, offset = got
         if stand is None and len(ctx.channels) > 3:
             # on an unconstrained mode's direction, or on the forces when every mode is located
             structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
@@ -145,7 +147,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
         return None
     if len(efit.unconstrained) == 3:
         return None                     # no mode located: nothing to name
-    return test, fit, efit, stand
+    return test, fit, efit, stand, offset
 
 
 #: A structure mode is a fixed-frequency resonance: when the slower and the faster half of the runs each want a
@@ -277,8 +279,8 @@ OFFSET_ROUNDS = 3
 
 
 def _beside_offset(ctx: Context, state: State, efit, fit, runs, test, stand_start, near=None):
-    """(test, fit, efit, stand, r) of the modes located (:func:`_locate`) on the torques of ``test`` corrected for a
-    load-cell offset r (m: the ``cross_coupling`` fit of ``runs`` on ``state`` with the modes of ``efit``, the
+    """(test, fit, efit, stand, offset) of the modes located (:func:`_locate`) on the torques of ``test`` corrected for
+    a load-cell offset r (``offset``, a :class:`CrossCoupling`; r in m: the ``cross_coupling`` fit of ``runs`` on ``state`` with the modes of ``efit``, the
     extended fit of ``test`` whose empirical fit is ``fit``: its torque lines, the wheel's own, weigh the equations
     at their frequencies down; T − r × F), or None when the offset is not significant
     (:meth:`CrossCoupling.significant`: no component of r stands 4 standard errors from 0) or the corrected data's
@@ -321,7 +323,7 @@ def _beside_offset(ctx: Context, state: State, efit, fit, runs, test, stand_star
         if k == 0:
             break
         corrected = cc.apply(SuspensionModes.from_fit(efit_c, fit_c, runs.size).apply(state))
-        got = (test_c, fit_c, efit_c, stand_c, tuple(float(v) for v in cc.r))
+        got = (test_c, fit_c, efit_c, stand_c, cc)
         if k > n_located or (k == n_located and _better(ctx, best_state, corrected, runs)):
             best, best_state, n_located = got, corrected, k
         elif best is not None and k == n_located and not _better(ctx, corrected, best_state, runs):
@@ -373,7 +375,7 @@ def _noted(got: tuple) -> tuple:
     """``got`` of :func:`_beside_offset`, its extended fit noting the offset removed."""
     got[2].notes.append("load-cell offset: r = (%s) mm removed from the torques (T − r × F) before the modes were "
                         "located; not part of the wheel's model (diagnose names it as cross_coupling)"
-                        % ", ".join(f"{1000 * v:.1f}" for v in got[4]))
+                        % ", ".join(f"{1000 * v:.1f}" for v in got[4].r))
     return got
 
 
@@ -502,6 +504,10 @@ class SuspensionModes:
     structure: tuple | None = None
     #: the structure mode of the fit on the fit runs this effect was refitted from, or None (as ``stand_fit_runs``)
     structure_fit_runs: tuple | None = field(default=None, repr=False)
+    #: the load-cell offset (a :class:`CrossCoupling`) the torques were corrected for before the modes were located,
+    #: or None: what the modes are judged with when they do not pass alone (:meth:`offset_effect`); named by the search
+    #: as a ``cross_coupling`` of its own, not part of this effect's parameters
+    offset: CrossCoupling | None = field(default=None, repr=False, compare=False)
 
     @property
     def channels(self) -> tuple:
@@ -574,6 +580,15 @@ class SuspensionModes:
             return FixedResonance.of_structure(self.structure_fit_runs or self.structure, channels, self.structure)
         return None if self.stand is None else FixedResonance.of_stand(self.stand, channels, self.stand)
 
+    def offset_effect(self) -> CrossCoupling | None:
+        """The load-cell offset the modes were located beside (``offset``), or None: what the modes are judged with
+        when they do not pass alone (:func:`rwadist.diagnose.search._judge_with_offset`).  The modes alone predict the
+        torques at the bearing centre, while the data read T + r × F: r × F carries the forces' lines through the
+        translation mode into the torques, where the empirical base fits every line freely (tests/standmodes_wheel's
+        new wheel, r_z = 30 mm: the modes located beside the offset within 0.1 %, r_z 30.0 mm, rejected in every
+        iteration, and a 'wheel mode' at 305 Hz and an amplitude law named instead)."""
+        return self.offset
+
     def whirl_Hz(self, omega_rad_s: float) -> dict:
         """Whirl frequencies (Hz) at wheel speed ``omega_rad_s``: translation, rocking forward/backward, axial."""
         half = 0.5 * self.inertia_ratio * abs(omega_rad_s) / (2 * np.pi)
@@ -598,8 +613,11 @@ class SuspensionModes:
             near: dict | None = None, structure_start: tuple | None = None) -> "SuspensionModes | None":
         """The modes fitted on ``runs`` (per unit mass and inertia), or None when those runs show no modal
         amplification or no mode can be located; ``stand_start``, ``near``, ``structure_start``: see :func:`_fit_runs`."""
+        from dataclasses import replace
+
         got = _fit_runs(ctx, runs, state, stand_start, near, structure_start)
-        return None if got is None else SuspensionModes.from_fit(got[2], got[1], len(runs), got[3])
+        return None if got is None else replace(SuspensionModes.from_fit(got[2], got[1], len(runs), got[3]),
+                                                offset=got[4])
 
     @staticmethod
     def finish(ctx: Context, state: State) -> State:
