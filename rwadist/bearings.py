@@ -216,7 +216,12 @@ def _ball_pass_ranges(h: float, resolution: float, where: str) -> list:
 def _relations(h: float, resolution: float, others) -> list:
     """Sentences relating a non-integer line at ``h`` to the other lines' ratios ``others``: a ball pass n × a
     cage-range line (over the still race) or n × (1 − it) (over the turning race), an outer/inner ball-pass pair
-    summing to n, and the 2nd or 3rd multiple of another non-integer line (a bearing line's harmonics)."""
+    summing to n, and the 2nd or 3rd multiple of another non-integer line (a bearing line's harmonics).
+
+    Ordered by how well each holds: those within half a resolution first (a multiple of another line before a pair
+    before a ball pass: the fewer causes, the likelier), then the rest by their distance in resolutions (each
+    relation's own tolerance: n × a line's resolution for n × it).  trial14's 11-ball bearing: 9.242 was first
+    "16 × 0.5799 = 9.278", 14 whole-record bins off, before the exact 2nd multiple of 4.621."""
     n_lo, n_hi = BALL_COUNTS
     out = []
     cage = [RATIO_RANGES[k][:2] for k in ("FTF", "FTF_outer")]
@@ -227,16 +232,20 @@ def _relations(h: float, resolution: float, others) -> list:
             for name, base in (("over the still race", o), ("over the turning race", 1.0 - o)):
                 n = round(h / base)
                 if n_lo <= n <= n_hi and abs(h - n * base) <= resolution * (1 + n):
-                    out.append(f"ball pass {name} of a {n}-ball bearing whose cage is the line h = {o:.4g} "
-                               f"({n} × {base:.4g} = {n * base:.4g})")
+                    out.append((abs(h - n * base) / (resolution * (1 + n)), 2,
+                                f"ball pass {name} of a {n}-ball bearing whose cage is the line h = {o:.4g} "
+                                f"({n} × {base:.4g} = {n * base:.4g})"))
         s = h + o
         n = round(s)
         if n_lo <= n <= n_hi and abs(s - n) <= 2 * resolution and abs(o - round(o)) > 2 * resolution \
                 and RATIO_RANGES["FTF"][0] <= min(h, o) / n <= RATIO_RANGES["FTF"][1]:
-            out.append(f"an outer/inner ball-pass pair of a {n}-ball bearing with the line h = {o:.4g} "
-                       f"(BPFO + BPFI = n; cage {min(h, o) / n:.4g})")
+            out.append((abs(s - n) / (2 * resolution), 1,
+                        f"an outer/inner ball-pass pair of a {n}-ball bearing with the line h = {o:.4g} "
+                        f"(BPFO + BPFI = n; cage {min(h, o) / n:.4g})"))
         k = round(h / o) if o > 0 else 0
         if k in (2, 3) and abs(o - round(o)) > 2 * resolution and abs(h - k * o) <= k * resolution:
-            out.append(f"the {'2nd' if k == 2 else '3rd'} multiple of the line h = {o:.4g} (a harmonic of that line's "
-                       f"cause: a bearing line's impacts are not sinusoidal)")
-    return out
+            out.append((abs(h - k * o) / (k * resolution), 0,
+                        f"the {'2nd' if k == 2 else '3rd'} multiple of the line h = {o:.4g} (a harmonic of that line's "
+                        f"cause: a bearing line's impacts are not sinusoidal)"))
+    out.sort(key=lambda x: (x[0] > 0.5, x[1] if x[0] <= 0.5 else 0, x[0]))
+    return [x[2] for x in out]

@@ -117,6 +117,23 @@ def test_a_line_twice_another_non_integer_line_is_named_its_harmonic():
     assert not any("multiple" in x for x in line_causes(7.27, 0.005, others=[3.6]))
 
 
+def test_relations_that_hold_exactly_come_before_those_within_the_tolerance_only():
+    """trial14's 11-ball bearing (d 7.144 mm, pitch 42 mm, 20°, inner race turning), its ratios from the closed form
+    FTF = ½(1 − (d/D)·cos α), BPFO = n·FTF, BPFI = n − BPFO, BSF: the line 2·BPFO is first the 2nd multiple of BPFO
+    (exact), not '16 × (1 − FTF) = 9.278' (0.4 % off, inside 17 resolutions only); BPFI is first the pair with BPFO
+    (BPFO + BPFI = 11, exact); no sentence is lost by the ordering."""
+    gamma = 7.144 / 42.0 * math.cos(math.radians(20.0))
+    ftf = 0.5 * (1 - gamma)
+    bpfo, bpfi = 11 * ftf, 11 * (1 - ftf)
+    bsf = 0.5 * 42.0 / 7.144 * (1 - gamma**2)
+    others = [ftf, 1.0, bsf, bpfo, 2 * bsf, bpfi]
+    res = 0.0025
+    first = line_causes(2 * bpfo, res, others=others + [2 * bpfo])
+    assert first[0].startswith(f"the 2nd multiple of the line h = {bpfo:.4g}")
+    assert any("16-ball" in x for x in first)
+    assert line_causes(bpfi, res, others=others)[0].startswith("an outer/inner ball-pass pair of a 11-ball bearing")
+
+
 def test_parser_reads_the_flag_and_the_model_file_and_names_what_is_wrong():
     b = parse_bearing("balls=9, ball_diameter_m=0.00794,pitch_diameter_m=0.03904,contact_angle_deg=15,name=front")
     assert b == Bearing(9, 0.00794, 0.03904, 15.0, "front")
