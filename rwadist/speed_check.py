@@ -63,7 +63,7 @@ LINES = {"radial_force": (("Fx", "Fy"), "radial force"), "radial_torque": (("Tx"
          "axial_force": (("Fz",), "axial force")}
 
 
-def run_line(run, channels: tuple, f0: float) -> tuple:
+def run_line(run, channels: tuple, f0: float, spectra: dict | None = None) -> tuple:
     """(frequency Hz, SNR, co-rotating share) of the strongest peak within :data:`SEARCH` of ``f0`` in a run's
     ``channels`` (an x/y pair or one channel); nan frequency when the run lacks a channel or the window.
 
@@ -71,18 +71,15 @@ def run_line(run, channels: tuple, f0: float) -> tuple:
     :data:`PAD` times, refined by a parabola through the log of the three padded bins around it.  A pair's SNR and
     co share are :func:`rwadist.speed_scale.slice_senses`' (the sweep path's one rule of a rotating line): the
     share |X + iY|²/(|X + iY|² + |X − iY|²) where the line stands PAIR_SNR over the median at ±4..8 native bins;
-    one channel's SNR is its |X|² over that median, its share nan."""
+    one channel's SNR is its |X|² over that median, its share nan.  ``spectra``: the run's spectra
+    (:func:`run_spectra`) holding ``channels``, or None (made here)."""
     none = (np.nan, 0.0, np.nan)
-    if not all(c in run.signals for c in channels):
+    if not all(c in run.signals for c in channels) or not _measurable(run, f0):
         return none
     fs = float(run.sample_rate)
-    n = run.n_samples
-    df = fs / n
-    if not (np.isfinite(f0) and f0 >= MIN_BINS * df and f0 * (1 + SEARCH) + 8 * df < fs / 2):
-        return none
-    win, f = _window_and_bins(n, fs)
-    spec = {c: sfft.rfft((np.asarray(run.signals[c], dtype=float) - np.mean(run.signals[c])) * win, n=PAD * n)
-            for c in channels}
+    df = fs / run.n_samples
+    f = _window_and_bins(run.n_samples, fs)[1]
+    spec = {c: (spectra or run_spectra(run, channels))[c] for c in channels}
 
     def power(bins):
         """|X|² + |Y|² (|X|² for one channel) at the padded ``bins`` (a slice or indices): only these are read."""
@@ -112,6 +109,29 @@ def _window_and_bins(n: int, fs: float) -> tuple:
     return win, f
 
 
+def _measurable(run, f0: float) -> bool:
+    """Whether the run's given 1× frequency ``f0`` Hz is measured: :data:`MIN_BINS` native bins above 0 Hz, the window
+    searched and the noise bins beside it below Nyquist."""
+    fs = float(run.sample_rate)
+    df = fs / run.n_samples
+    return bool(np.isfinite(f0) and f0 >= MIN_BINS * df and f0 * (1 + SEARCH) + 8 * df < fs / 2)
+
+
+def run_spectra(run, channels, buffers: dict | None = None) -> dict:
+    """channel -> the Hann-windowed spectrum of the run's ``channels`` (each less its mean) zero-padded :data:`PAD`
+    times, on :func:`_window_and_bins`' bins: one transform of the channels stacked (the numbers of one
+    ``rfft(x, n=PAD·n)`` each, written into one zero-padded array instead of a padded copy per channel).
+    ``buffers``: a dict (shape -> zero-padded array) kept over the runs of a test, whose arrays are reused (their
+    padding stays zero: only the first n samples of a row are written), or None."""
+    n = run.n_samples
+    win = _window_and_bins(n, float(run.sample_rate))[0]
+    shape = (len(channels), PAD * n)
+    padded = np.zeros(shape) if buffers is None else buffers.setdefault(shape, np.zeros(shape))
+    for row, c in zip(padded, channels):
+        np.multiply(np.asarray(run.signals[c], dtype=float) - np.mean(run.signals[c]), win, out=row[:n])
+    return dict(zip(channels, sfft.rfft(padded, axis=-1)))
+
+
 def line_ratios(test) -> dict:
     """Per 1× line of :data:`LINES` recorded: (ratio f_line/f_given (n_runs,), nan where the line was not
     measured; the runs' indices kept).  A pair's line counts where it stands PAIR_SNR over its noise and turns
@@ -119,10 +139,18 @@ def line_ratios(test) -> dict:
     out = {}
     f_given = np.abs(np.array([r.speed for r in test.runs], dtype=float)) / (2 * np.pi)
     sign = np.sign([r.speed for r in test.runs])
-    for key, (channels, _) in LINES.items():
-        if not any(all(c in r.signals for c in channels) for r in test.runs):
-            continue
-        meas = np.array([run_line(r, channels, f0) for r, f0 in zip(test.runs, f_given)])
+    keys = [key for key, (channels, _) in LINES.items() if any(all(c in r.signals for c in channels) for r in test.runs)]
+    read: dict = {key: [] for key in keys}
+    buffers: dict = {}
+    for r, f0 in zip(test.runs, f_given):
+        # every 1× line of a run is read on the same spectra, made once
+        chans = [c for key in keys for c in LINES[key][0] if all(x in r.signals for x in LINES[key][0])]
+        spectra = run_spectra(r, chans, buffers) if chans and _measurable(r, f0) else {}
+        for key in keys:
+            read[key].append(run_line(r, LINES[key][0], f0, spectra))
+    for key in keys:
+        channels = LINES[key][0]
+        meas = np.array(read[key])
         f_line, snr, share = meas[:, 0], meas[:, 1], meas[:, 2]
         ok = np.isfinite(f_line) & (snr >= PAIR_SNR)
         if len(channels) == 2:
