@@ -11,7 +11,7 @@ search each run's 1× lines are measured where the given speed puts them:
   :data:`SEARCH` of the given 1× frequency (Hann window, zero-padded :data:`PAD` times, refined by a parabola
   through the log of the three padded bins around it), counted where it stands :data:`speed_scale.PAIR_SNR` over
   the local noise (±4..8 native bins) and turns one way (its co-rotating share beyond
-  :data:`speed_scale.POLARIZED`; :func:`rwadist.speed_scale.pair_senses`, the sweep path's rule), the same way
+  :data:`speed_scale.POLARIZED`; :func:`rwadist.speed_scale.slice_senses`, the sweep path's rule), the same way
   relative to the given speed's sign in the runs kept (the majority);
 * the axial force Fz, when it holds a line there (a plane line: no sense).
 
@@ -35,11 +35,12 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import replace
+from functools import lru_cache
 
 import numpy as np
 from scipy import fft as sfft
 
-from .speed_scale import PAIR_SNR, POLARIZED, pair_senses
+from .speed_scale import PAIR_SNR, POLARIZED, slice_senses
 
 #: zero-padding factor of a run's spectrum (the peak's sub-bin sampling)
 PAD = 4
@@ -62,40 +63,73 @@ LINES = {"radial_force": (("Fx", "Fy"), "radial force"), "radial_torque": (("Tx"
          "axial_force": (("Fz",), "axial force")}
 
 
-def run_line(run, channels: tuple, f0: float) -> tuple:
+def run_line(run, channels: tuple, f0: float, spectra: dict | None = None) -> tuple:
     """(frequency Hz, SNR, co-rotating share) of the strongest peak within :data:`SEARCH` of ``f0`` in a run's
     ``channels`` (an x/y pair or one channel); nan frequency when the run lacks a channel or the window.
 
     The peak is the largest |X|² + |Y|² (|X|² for one channel) of the Hann-windowed spectra zero-padded
     :data:`PAD` times, refined by a parabola through the log of the three padded bins around it.  A pair's SNR and
-    co share are :func:`rwadist.speed_scale.pair_senses`' (the sweep path's one rule of a rotating line): the
+    co share are :func:`rwadist.speed_scale.slice_senses`' (the sweep path's one rule of a rotating line): the
     share |X + iY|²/(|X + iY|² + |X − iY|²) where the line stands PAIR_SNR over the median at ±4..8 native bins;
-    one channel's SNR is its |X|² over that median, its share nan."""
+    one channel's SNR is its |X|² over that median, its share nan.  ``spectra``: the run's spectra
+    (:func:`run_spectra`) holding ``channels``, or None (made here)."""
     none = (np.nan, 0.0, np.nan)
-    if not all(c in run.signals for c in channels):
+    if not all(c in run.signals for c in channels) or not _measurable(run, f0):
         return none
     fs = float(run.sample_rate)
-    n = run.n_samples
-    df = fs / n
-    if not (np.isfinite(f0) and f0 >= MIN_BINS * df and f0 * (1 + SEARCH) + 8 * df < fs / 2):
-        return none
-    win = np.hanning(n)
-    spec = {c: sfft.rfft((np.asarray(run.signals[c], dtype=float) - np.mean(run.signals[c])) * win, n=PAD * n)
-            for c in channels}
-    f = np.fft.rfftfreq(PAD * n, 1.0 / fs)
-    power = sum(np.abs(s) ** 2 for s in spec.values())
+    df = fs / run.n_samples
+    f = _window_and_bins(run.n_samples, fs)[1]
+    spec = {c: (spectra or run_spectra(run, channels))[c] for c in channels}
+
+    def power(bins):
+        """|X|² + |Y|² (|X|² for one channel) at the padded ``bins`` (a slice or indices): only these are read."""
+        return sum(np.abs(s[bins]) ** 2 for s in spec.values())
+
     lo = int(np.ceil((f0 * (1 - SEARCH) - 2 * df) / f[1]))
     hi = int(np.floor((f0 * (1 + SEARCH) + 2 * df) / f[1]))
-    k = lo + int(np.argmax(power[lo:hi + 1]))
-    a, b, c = np.log(np.maximum(power[k - 1:k + 2], 1e-300))
+    k = lo + int(np.argmax(power(slice(lo, hi + 1))))
+    a, b, c = np.log(np.maximum(power(slice(k - 1, k + 2)), 1e-300))
     den = a - 2 * b + c
     f_peak = (k + (float(np.clip(0.5 * (a - c) / den, -0.5, 0.5)) if den < 0 else 0.0)) * f[1]
     if len(channels) == 2:
-        share, snr = next(iter(pair_senses({ch: v[None, :] for ch, v in spec.items()}, f, PAD,
-                                           np.array([[f_peak]])).values()))
-        return f_peak, float(snr[0, 0]), float(share[0])
-    noise = float(np.median(power[k + PAD * np.array([-8, -6, -4, 4, 6, 8])]))
-    return f_peak, float(power[k] / max(noise, 1e-300)), np.nan
+        share, snr = next(iter(slice_senses({ch: v[None, :] for ch, v in spec.items()}, f, PAD,
+                                            np.array([[f_peak]])).values()))
+        return f_peak, float(snr[0, 0]), float(share[0, 0])
+    noise = float(np.median(power(k + PAD * np.array([-8, -6, -4, 4, 6, 8]))))
+    return f_peak, float(power(slice(k, k + 1))[0] / max(noise, 1e-300)), np.nan
+
+
+@lru_cache(maxsize=4)
+def _window_and_bins(n: int, fs: float) -> tuple:
+    """(Hann window (n,), frequencies Hz of the :data:`PAD`-times zero-padded spectrum's bins) of an n-sample run at
+    ``fs`` Hz: the same for every run of a test, made once (read-only)."""
+    win, f = np.hanning(n), np.fft.rfftfreq(PAD * n, 1.0 / fs)
+    win.flags.writeable = False
+    f.flags.writeable = False
+    return win, f
+
+
+def _measurable(run, f0: float) -> bool:
+    """Whether the run's given 1× frequency ``f0`` Hz is measured: :data:`MIN_BINS` native bins above 0 Hz, the window
+    searched and the noise bins beside it below Nyquist."""
+    fs = float(run.sample_rate)
+    df = fs / run.n_samples
+    return bool(np.isfinite(f0) and f0 >= MIN_BINS * df and f0 * (1 + SEARCH) + 8 * df < fs / 2)
+
+
+def run_spectra(run, channels, buffers: dict | None = None) -> dict:
+    """channel -> the Hann-windowed spectrum of the run's ``channels`` (each less its mean) zero-padded :data:`PAD`
+    times, on :func:`_window_and_bins`' bins: one transform of the channels stacked (the numbers of one
+    ``rfft(x, n=PAD·n)`` each, written into one zero-padded array instead of a padded copy per channel).
+    ``buffers``: a dict (shape -> zero-padded array) kept over the runs of a test, whose arrays are reused (their
+    padding stays zero: only the first n samples of a row are written), or None."""
+    n = run.n_samples
+    win = _window_and_bins(n, float(run.sample_rate))[0]
+    shape = (len(channels), PAD * n)
+    padded = np.zeros(shape) if buffers is None else buffers.setdefault(shape, np.zeros(shape))
+    for row, c in zip(padded, channels):
+        np.multiply(np.asarray(run.signals[c], dtype=float) - np.mean(run.signals[c]), win, out=row[:n])
+    return dict(zip(channels, sfft.rfft(padded, axis=-1)))
 
 
 def line_ratios(test) -> dict:
@@ -105,10 +139,18 @@ def line_ratios(test) -> dict:
     out = {}
     f_given = np.abs(np.array([r.speed for r in test.runs], dtype=float)) / (2 * np.pi)
     sign = np.sign([r.speed for r in test.runs])
-    for key, (channels, _) in LINES.items():
-        if not any(all(c in r.signals for c in channels) for r in test.runs):
-            continue
-        meas = np.array([run_line(r, channels, f0) for r, f0 in zip(test.runs, f_given)])
+    keys = [key for key, (channels, _) in LINES.items() if any(all(c in r.signals for c in channels) for r in test.runs)]
+    read: dict = {key: [] for key in keys}
+    buffers: dict = {}
+    for r, f0 in zip(test.runs, f_given):
+        # every 1× line of a run is read on the same spectra, made once
+        chans = [c for key in keys for c in LINES[key][0] if all(x in r.signals for x in LINES[key][0])]
+        spectra = run_spectra(r, chans, buffers) if chans and _measurable(r, f0) else {}
+        for key in keys:
+            read[key].append(run_line(r, LINES[key][0], f0, spectra))
+    for key in keys:
+        channels = LINES[key][0]
+        meas = np.array(read[key])
         f_line, snr, share = meas[:, 0], meas[:, 1], meas[:, 2]
         ok = np.isfinite(f_line) & (snr >= PAIR_SNR)
         if len(channels) == 2:

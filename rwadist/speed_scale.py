@@ -223,7 +223,23 @@ def pair_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray)
     Hann-windowed spectra (n_slices, n_f) zero-padded ``pad`` times on ``f_pad``; ``f_lines`` (n_slices,
     n_lines) Hz (nan: not in that slice), read at the nearest padded bin (an eighth of a bin off at most,
     which scales X and Y alike).  Co-rotating with +z: F_x = a cos, F_y = a sin, so Y = −iX: co |X + iY|²,
-    counter |X − iY|².  The local noise is the median |X|² + |Y|² at ±4..8 native bins off the line."""
+    counter |X − iY|².  The local noise is the median |X|² + |Y|² at ±4..8 native bins off the line (each slice's
+    reading: :func:`slice_senses`)."""
+    out = {}
+    for key, (share, snr) in slice_senses(spectra, f_pad, pad, f_lines).items():
+        with np.errstate(invalid="ignore"):
+            med = np.full(share.shape[1], np.nan)
+            seen = np.isfinite(share).any(axis=0)
+            med[seen] = np.nanmedian(share[:, seen], axis=0)
+        out[key] = (med, snr)
+    return out
+
+
+def slice_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray) -> dict:
+    """Per radial pair present ("F", "T"): (co share (n_slices, n_lines), snr (n_slices, n_lines)) of each slice
+    apart, the share nan where the line does not stand PAIR_SNR over the local noise: what :func:`pair_senses` takes
+    the median of over the slices (same arguments); a steady test's run is one slice
+    (:func:`rwadist.speed_check.run_line`)."""
     dfp = f_pad[1] - f_pad[0]
     n_f = f_pad.size
     ok = np.isfinite(f_lines)
@@ -240,12 +256,7 @@ def pair_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray)
         off = sum(np.abs(spectra[c][rows[..., None], ko]) ** 2 for c in pair)
         snr = np.where(ok, line / np.maximum(np.median(off, axis=-1), 1e-300), 0.0)
         co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
-        share = np.where(snr >= PAIR_SNR, co / np.maximum(co + ct, 1e-300), np.nan)
-        with np.errstate(invalid="ignore"):
-            med = np.full(share.shape[1], np.nan)
-            seen = np.isfinite(share).any(axis=0)
-            med[seen] = np.nanmedian(share[:, seen], axis=0)
-        out[pair[0][0]] = (med, snr)
+        out[pair[0][0]] = (np.where(snr >= PAIR_SNR, co / np.maximum(co + ct, 1e-300), np.nan), snr)
     return out
 
 
