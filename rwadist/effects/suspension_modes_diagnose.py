@@ -343,17 +343,16 @@ def _located_corrected(ctx: Context, test, r: np.ndarray, stand_start, near) -> 
     from dataclasses import replace
 
     from ..data import SteadyTest
+    from ..data_quality import offset_corrected_torques
     from ..diagnose.constants import TORQUE_CHANNELS
     from ..empirical import fit_empirical
     from ..spectra import compute_spectra
 
     corrected = []
     for run in test.runs:
-        F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
-        T = np.cross(r[None, :], F)
-        corrected.append(replace(run, signals={**run.signals, **{k: run.signals[k] - T[:, j]
-                                                                 for j, k in enumerate(TORQUE_CHANNELS)
-                                                                 if k in run.signals}}))
+        # a torque whose correction needs a force the run lacks is left out of the run (never corrected with zeros)
+        corrected.append(replace(run, signals={**{k: v for k, v in run.signals.items() if k not in TORQUE_CHANNELS},
+                                               **offset_corrected_torques(run, r)}))
     test_c = SteadyTest(corrected, dict(test.meta))
     fit_c = fit_empirical(compute_spectra(test_c, window=ctx.sp.window, f_lim=ctx.sp.f_lim))
     efit_c, stand_c = _locate(ctx, test_c, fit_c, stand_start, near)
