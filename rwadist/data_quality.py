@@ -155,28 +155,24 @@ def find_frozen(test: SteadyTest) -> list:
 
 
 def screen(test: SteadyTest) -> tuple:
-    """The test with every channel that froze in a run left out of that run, and the records.
+    """The test with every channel that froze in a run marked invalid in that run (``Run.invalid``: its spectra
+    are left out of the run, as for a channel the run lacks), and the records.
 
     Returns
     -------
     (SteadyTest, list)
-        The screened test (the same object when nothing froze; runs left with no channel are dropped) and the
-        :class:`FrozenStretch` records.  ``meta["data_quality"]`` of the screened test holds the records' JSON.
+        The screened test (the same object when nothing froze) and the :class:`FrozenStretch` records;
+        ``meta["data_quality"]`` of the screened test holds the records' JSON.
     """
     found = find_frozen(test)
     if not found:
         return test, []
-    drop: dict = {}
+    bad: dict = {}
     for s in found:
-        drop.setdefault(s.run, set()).add(s.channel)
-    runs = []
-    for i, run in enumerate(test.runs):
-        if i in drop:
-            run = replace(run, signals={c: v for c, v in run.signals.items() if c not in drop[i]})
-        if run.signals:
-            runs.append(run)
-    meta = dict(test.meta, data_quality=[s.to_json() for s in found])
-    return SteadyTest(runs, meta), found
+        bad.setdefault(s.run, set()).add(s.channel)
+    runs = [replace(run, invalid=run.invalid | frozenset(bad[i])) if i in bad else run
+            for i, run in enumerate(test.runs)]
+    return SteadyTest(runs, dict(test.meta, data_quality=[s.to_json() for s in found])), found
 
 
 def quality_lines(records) -> list:
@@ -201,17 +197,16 @@ def quality_lines(records) -> list:
 _LEVER_TERMS = {"Tx": ((1, "Fz"), (2, "Fy")), "Ty": ((2, "Fx"), (0, "Fz")), "Tz": ((0, "Fy"), (1, "Fx"))}
 
 
-def offset_corrected_torques(run, r) -> dict:
-    """The torques of ``run`` referred through the load-cell offset ``r`` (m): T − r × F (N·m), channel -> samples.
+def offset_corrected(run, r, torques_only: bool = False):
+    """``run`` with its torques referred through the load-cell offset ``r`` (m): T − r × F (N·m, the numbers of
+    ``T - np.cross(r, F)``); ``torques_only`` keeps the corrected torques alone.
 
-    A torque the run lacks is absent; so is one whose correction needs a force the run lacks (left out by
-    :func:`screen`, or never recorded) through a non-zero component of ``r``: no torque is corrected with a force
-    that was not measured.  With every force present the numbers are ``T - np.cross(r, F)`` exactly.
+    A torque whose correction takes a force through a non-zero component of ``r`` from a force that froze in the run
+    (``Run.invalid``) is marked invalid too: no torque is corrected with samples that are no measurement.
     """
     r = np.asarray(r, dtype=float)
-    absent = [c for c in ("Fx", "Fy", "Fz") if c not in run.signals]
-    n = run.n_samples
-    F = np.column_stack([run.signals[c] if c in run.signals else np.zeros(n) for c in ("Fx", "Fy", "Fz")])
+    F = np.column_stack([run.signals[c] for c in ("Fx", "Fy", "Fz")])
     T = np.cross(r[None, :], F)
-    return {k: run.signals[k] - T[:, j] for j, k in enumerate(("Tx", "Ty", "Tz"))
-            if k in run.signals and not any(c in absent and r[i] != 0.0 for i, c in _LEVER_TERMS[k])}
+    torques = {k: run.signals[k] - T[:, j] for j, k in enumerate(("Tx", "Ty", "Tz")) if k in run.signals}
+    invalid = run.invalid | {k for k in torques if any(c in run.invalid and r[i] != 0.0 for i, c in _LEVER_TERMS[k])}
+    return replace(run, signals=torques if torques_only else {**run.signals, **torques}, invalid=frozenset(invalid))

@@ -10,7 +10,7 @@ import pytest
 
 from rwadist import api
 from rwadist.data import SteadyTest, read_steady, write_steady
-from rwadist.data_quality import find_frozen, offset_corrected_torques, quality_lines, screen
+from rwadist.data_quality import find_frozen, offset_corrected, quality_lines, screen
 from rwadist.empirical import fit_empirical
 from rwadist.errors import RwadistWarning
 from rwadist.spectra import compute_spectra
@@ -54,8 +54,12 @@ def test_frozen_stretches_found_where_they_are_after_a_csv_round_trip(tmp_path):
     assert len(lines) == len(FROZEN) + 1 and "left out" in lines[0] and "4 channel(s)" in lines[-1]
     screened, again = screen(test)
     assert again == found
+    sp = compute_spectra(screened)
     for i, c, _, _, _ in FROZEN:
-        assert c not in screened.runs[i].signals and len(screened.runs[i].signals) == 5
+        assert screened.runs[i].invalid == {c}
+        # left out of that run's spectra, as a channel the run lacks; the other channels and runs untouched
+        assert not sp.available(c)[i] and sum(sp.available(k)[i] for k in sp.channels) == 5
+    assert sum(int(np.sum(~sp.available(k))) for k in sp.channels) == len(FROZEN)
     assert screened.meta["data_quality"] == [s.to_json() for s in found]
 
 
@@ -109,17 +113,15 @@ def test_axial_amplitudes_after_screening_within_the_clean_scatter():
     assert err_before > 2 * err_after, (err_before, err_after)
 
 
-def test_offset_correction_never_uses_an_absent_force():
+def test_offset_correction_marks_torques_corrected_with_a_frozen_force():
     run = _test(1).runs[4]
     r = np.array([0.0, 0.002, 0.04])
-    full = offset_corrected_torques(run, r)
     F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
     T = np.cross(r[None, :], F)
+    full = offset_corrected(run, r)
     for j, k in enumerate(("Tx", "Ty", "Tz")):
-        np.testing.assert_array_equal(full[k], run.signals[k] - T[:, j])
-    no_fz = replace(run, signals={k: v for k, v in run.signals.items() if k != "Fz"})
-    part = offset_corrected_torques(no_fz, r)
-    # Tx = ... - (r_y Fz - r_z Fy) needs Fz (r_y != 0); Ty needs it only through r_x = 0; Tz never
-    assert set(part) == {"Ty", "Tz"}
-    np.testing.assert_array_equal(part["Ty"], full["Ty"])
-    np.testing.assert_array_equal(part["Tz"], full["Tz"])
+        np.testing.assert_array_equal(full.signals[k], run.signals[k] - T[:, j])
+    assert full.invalid == frozenset()
+    # Tx = ... - (r_y Fz - r_z Fy) takes Fz (r_y != 0); Ty takes it only through r_x = 0; Tz never
+    assert offset_corrected(replace(run, invalid=frozenset({"Fz"})), r).invalid == {"Fz", "Tx"}
+    assert offset_corrected(replace(run, invalid=frozenset({"Fx"})), r).invalid == {"Fx", "Ty", "Tz"}

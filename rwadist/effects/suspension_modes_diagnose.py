@@ -340,19 +340,15 @@ def _beside_offset(ctx: Context, state: State, efit, fit, runs, test, stand_star
 def _located_corrected(ctx: Context, test, r: np.ndarray, stand_start, near) -> tuple:
     """(test, fit, efit, stand) of :func:`_locate` on ``test`` with the torques corrected for the load-cell offset
     ``r`` (m): T − r × F in every run."""
-    from dataclasses import replace
 
     from ..data import SteadyTest
-    from ..data_quality import offset_corrected_torques
-    from ..diagnose.constants import TORQUE_CHANNELS
+    from ..data_quality import offset_corrected
     from ..empirical import fit_empirical
     from ..spectra import compute_spectra
 
     corrected = []
     for run in test.runs:
-        # a torque whose correction needs a force the run lacks is left out of the run (never corrected with zeros)
-        corrected.append(replace(run, signals={**{k: v for k, v in run.signals.items() if k not in TORQUE_CHANNELS},
-                                               **offset_corrected_torques(run, r)}))
+        corrected.append(offset_corrected(run, r))
     test_c = SteadyTest(corrected, dict(test.meta))
     fit_c = fit_empirical(compute_spectra(test_c, window=ctx.sp.window, f_lim=ctx.sp.f_lim))
     efit_c, stand_c = _locate(ctx, test_c, fit_c, stand_start, near)

@@ -30,6 +30,8 @@ class Run:
     signals : channel name -> samples (N or N·m); absent channels are absent keys.
     t0 : time of the first sample, s.
     name : file name of the run in the interchange format.
+    invalid : channels whose samples hold a stretch that is no measurement (a dropout found by
+        :func:`rwadist.data_quality.screen`): their spectra are left out of this run (as for an absent channel).
     """
 
     speed: float
@@ -37,6 +39,7 @@ class Run:
     signals: dict
     t0: float = 0.0
     name: str = ""
+    invalid: frozenset = frozenset()
 
     @property
     def n_samples(self) -> int:
