@@ -193,22 +193,3 @@ def quality_lines(records) -> list:
                  "longer than noise at the printed resolution allows); check the cabling, amplifier and DAQ, "
                  "and repeat those runs if that channel matters")
     return lines
-
-
-#: T = r × F term by term: torque -> ((component of r, force), ...) that enter it
-_LEVER_TERMS = {"Tx": ((1, "Fz"), (2, "Fy")), "Ty": ((2, "Fx"), (0, "Fz")), "Tz": ((0, "Fy"), (1, "Fx"))}
-
-
-def offset_corrected(run, r, torques_only: bool = False):
-    """``run`` with its torques referred through the load-cell offset ``r`` (m): T − r × F (N·m, the numbers of
-    ``T - np.cross(r, F)``); ``torques_only`` keeps the corrected torques alone.
-
-    A torque whose correction takes a force through a non-zero component of ``r`` from a force that froze in the run
-    (``Run.invalid``) is marked invalid too: no torque is corrected with samples that are no measurement.
-    """
-    r = np.asarray(r, dtype=float)
-    F = np.column_stack([run.signals[c] for c in ("Fx", "Fy", "Fz")])
-    T = np.cross(r[None, :], F)
-    torques = {k: run.signals[k] - T[:, j] for j, k in enumerate(("Tx", "Ty", "Tz")) if k in run.signals}
-    invalid = run.invalid | {k for k in torques if any(c in run.invalid and r[i] != 0.0 for i, c in _LEVER_TERMS[k])}
-    return replace(run, signals=torques if torques_only else {**run.signals, **torques}, invalid=frozenset(invalid))

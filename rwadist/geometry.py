@@ -99,11 +99,8 @@ def remove_lever_arm(test, height: float):
     runs = []
     for r in test.runs:
         sig = dict(r.signals)
-        invalid = set(getattr(r, "invalid", ()))
         if all(c in sig for c in ("Fx", "Fy", "Tx", "Ty")):
             sig["Tx"] = sig["Tx"] + height * sig["Fy"]
             sig["Ty"] = sig["Ty"] - height * sig["Fx"]
-            # a torque corrected with a force that froze in the run (rwadist.data_quality) is no measurement either
-            invalid |= {t for t, f in (("Tx", "Fy"), ("Ty", "Fx")) if f in invalid and height != 0.0}
-        runs.append(replace(r, signals=sig, invalid=frozenset(invalid)) if invalid else replace(r, signals=sig))
+        runs.append(replace(r, signals=sig))
     return type(test)(runs, dict(test.meta))

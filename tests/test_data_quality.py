@@ -10,7 +10,7 @@ import pytest
 
 from rwadist import api
 from rwadist.data import SteadyTest, read_steady, write_steady
-from rwadist.data_quality import find_frozen, offset_corrected, quality_lines, screen
+from rwadist.data_quality import find_frozen, quality_lines, screen
 from rwadist.empirical import fit_empirical
 from rwadist.errors import RwadistWarning
 from rwadist.spectra import compute_spectra
@@ -111,17 +111,3 @@ def test_axial_amplitudes_after_screening_within_the_clean_scatter():
     err_before = max(abs(b[h] / c[h] - 1) for h in hs)
     assert err_after <= max(scatter, 0.01), (err_after, scatter)
     assert err_before > 2 * err_after, (err_before, err_after)
-
-
-def test_offset_correction_marks_torques_corrected_with_a_frozen_force():
-    run = _test(1).runs[4]
-    r = np.array([0.0, 0.002, 0.04])
-    F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
-    T = np.cross(r[None, :], F)
-    full = offset_corrected(run, r)
-    for j, k in enumerate(("Tx", "Ty", "Tz")):
-        np.testing.assert_array_equal(full.signals[k], run.signals[k] - T[:, j])
-    assert full.invalid == frozenset()
-    # Tx = ... - (r_y Fz - r_z Fy) takes Fz (r_y != 0); Ty takes it only through r_x = 0; Tz never
-    assert offset_corrected(replace(run, invalid=frozenset({"Fz"})), r).invalid == {"Fz", "Tx"}
-    assert offset_corrected(replace(run, invalid=frozenset({"Fx"})), r).invalid == {"Fx", "Ty", "Tz"}

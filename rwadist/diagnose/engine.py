@@ -106,15 +106,19 @@ class Context(Metric):
             want[np.asarray(runs, dtype=int)] = True
         todo = np.flatnonzero(want & ~done)
         if todo.size:
+            from dataclasses import replace
 
             from ..data import SteadyTest
-            from ..data_quality import offset_corrected
             from ..spectra import compute_spectra
 
             r = np.asarray(key)
             sub = []
             for i in todo:          # the corrected torques only (a copy of every signal is not needed)
-                sub.append(offset_corrected(self.test.runs[i], r, torques_only=True))
+                run = self.test.runs[i]
+                F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
+                T = np.cross(r[None, :], F)
+                sub.append(replace(run, signals={k: run.signals[k] - T[:, j] for j, k in enumerate(TORQUE_CHANNELS)
+                                                 if k in run.signals}))
             sp = compute_spectra(SteadyTest(sub, dict(self.test.meta)), nperseg=self.sp.nperseg,
                                  window=self.sp.window, f_lim=self.sp.f_lim, channels=chans)
             if not np.array_equal(sp.n_segments, np.asarray(self.sp.n_segments)[todo]):

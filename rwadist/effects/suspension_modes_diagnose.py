@@ -340,15 +340,20 @@ def _beside_offset(ctx: Context, state: State, efit, fit, runs, test, stand_star
 def _located_corrected(ctx: Context, test, r: np.ndarray, stand_start, near) -> tuple:
     """(test, fit, efit, stand) of :func:`_locate` on ``test`` with the torques corrected for the load-cell offset
     ``r`` (m): T − r × F in every run."""
+    from dataclasses import replace
 
     from ..data import SteadyTest
-    from ..data_quality import offset_corrected
+    from ..diagnose.constants import TORQUE_CHANNELS
     from ..empirical import fit_empirical
     from ..spectra import compute_spectra
 
     corrected = []
     for run in test.runs:
-        corrected.append(offset_corrected(run, r))
+        F = np.column_stack([run.signals[k] for k in ("Fx", "Fy", "Fz")])
+        T = np.cross(r[None, :], F)
+        corrected.append(replace(run, signals={**run.signals, **{k: run.signals[k] - T[:, j]
+                                                                 for j, k in enumerate(TORQUE_CHANNELS)
+                                                                 if k in run.signals}}))
     test_c = SteadyTest(corrected, dict(test.meta))
     fit_c = fit_empirical(compute_spectra(test_c, window=ctx.sp.window, f_lim=ctx.sp.f_lim))
     efit_c, stand_c = _locate(ctx, test_c, fit_c, stand_start, near)
