@@ -72,7 +72,7 @@ def run_line(run, channels: tuple, f0: float) -> tuple:
     share |X + iY|²/(|X + iY|² + |X − iY|²) where the line stands PAIR_SNR over the median at ±4..8 native bins;
     one channel's SNR is its |X|² over that median, its share nan."""
     none = (np.nan, 0.0, np.nan)
-    if not all(c in run.signals for c in channels):
+    if not all(run.usable(c) for c in channels):
         return none
     fs = float(run.sample_rate)
     n = run.n_samples
@@ -106,7 +106,7 @@ def line_ratios(test) -> dict:
     f_given = np.abs(np.array([r.speed for r in test.runs], dtype=float)) / (2 * np.pi)
     sign = np.sign([r.speed for r in test.runs])
     for key, (channels, _) in LINES.items():
-        if not any(all(c in r.signals for c in channels) for r in test.runs):
+        if not any(all(r.usable(c) for c in channels) for r in test.runs):
             continue
         meas = np.array([run_line(r, channels, f0) for r, f0 in zip(test.runs, f_given)])
         f_line, snr, share = meas[:, 0], meas[:, 1], meas[:, 2]

@@ -49,6 +49,10 @@ class Run:
     def channels(self) -> tuple:
         return tuple(ch for ch in CHANNELS if ch in self.signals)
 
+    def usable(self, channel: str) -> bool:
+        """The run holds ``channel`` and it did not freeze (not in ``invalid``)."""
+        return channel in self.signals and channel not in self.invalid
+
 
 @dataclass
 class SteadyTest:
