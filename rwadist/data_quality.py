@@ -90,8 +90,7 @@ class FrozenStretch:
                 "channel": self.channel, "kind": self.kind,
                 "value": None if not np.isfinite(self.value) else float(self.value),
                 "start_s": self.start_s, "end_s": self.end_s, "n_samples": self.stop - self.start,
-                "fraction_of_run": (self.stop - self.start) / self.n_run,
-                "action": "channel left out of this run's spectra"}
+                "fraction_of_run": (self.stop - self.start) / self.n_run, "action": "channel left out of this run"}
 
 
 def _stretches(mask: np.ndarray) -> np.ndarray:
@@ -186,8 +185,7 @@ def quality_lines(records) -> list:
         what = {"held": f"held at {r['value']:.6g}", "zero": "held at exactly 0", "nan": "not a number"}[r["kind"]]
         lines.append(f"{r['channel']} of run {r['run_name'] or r['run']} ({r['speed_rpm']:.1f} rpm) froze: {what} "
                      f"from {r['start_s']:.4f} s to {r['end_s']:.4f} s ({r['n_samples']} samples, "
-                     f"{100.0 * r['fraction_of_run']:.0f} % of the run); that channel of that run is left out of the "
-                     "spectra")
+                     f"{100.0 * r['fraction_of_run']:.0f} % of the run); that channel of that run is left out")
     pairs = {(r["run"], r["channel"]) for r in records}
     lines.append(f"{len(pairs)} channel(s) of runs left out (a DAQ or amplifier dropout: one value held for far "
                  "longer than noise at the printed resolution allows); check the cabling, amplifier and DAQ, "
