@@ -320,6 +320,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
         The strongest radial line sits where speeds given k times the wheel's would put the imbalance; no
         harmonic passed the presence threshold (the model is empty).
     """
+    from . import data_quality
     from .empirical import FitSettings, fit_empirical
     from .spectra import compute_spectra
 
@@ -328,11 +329,18 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     test = _as_test(data)
     if name is None:
         name = Path(data).name if isinstance(data, (str, Path)) else "fitted wheel"
+    # a channel that froze in a run (a DAQ or amplifier dropout) is left out of that run: no invalid sample is used
+    test, frozen = data_quality.screen(test)
+    if frozen:
+        warnings.warn(RwadistWarning("; ".join(data_quality.quality_lines([s.to_json() for s in frozen]))),
+                      stacklevel=2)
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
     result = fit_empirical(spectra, settings, name=name, progress=progress)
     refuse_non_finite_model(result.model, "fit")
     result.model.provenance.update(reading_provenance(getattr(test, "meta", None)))
+    if frozen:
+        result.model.provenance["data_quality"] = [s.to_json() for s in frozen]
     result.model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))
     if text := speed_scale_warning(result, test.meta):
         warnings.warn(RwadistWarning(text.removeprefix("WARNING: ")), stacklevel=2)
@@ -490,7 +498,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     DataError
         Runs at fewer than 2 distinct speeds (:func:`rwadist.validate.check_test_speeds`).
     """
-    from . import speed_check, speed_whirl
+    from . import data_quality, speed_check, speed_whirl
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
@@ -503,6 +511,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         bearings = tuple(b if isinstance(b, Bearing) else parse_bearing(b, "diagnose", f"bearings[{i}]")
                          for i, b in enumerate(bearings))
     test = _as_test(data)
+    # a channel that froze in a run (a DAQ or amplifier dropout) is left out of that run: no invalid sample is used
+    test, frozen = data_quality.screen(test)
     # too few speeds to fit and judge on: refused (one), or warned of (fewer than the data's own fit needs)
     check_test_speeds(test, source or (data if isinstance(data, (str, Path)) else "the test"),
                       model_given=model is not None or preset is not None)
@@ -519,6 +529,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     # supports); how the speed was obtained goes to the summary and the report
     test, diagnosis = speed_whirl.settle(test, run)
     diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None), checked)
+    diagnosis.data_quality = [s.to_json() for s in frozen]
     reading = reading_provenance(getattr(test, "meta", None))
     if reading:
         diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(

@@ -426,6 +426,11 @@ def cmd_diagnose(args) -> int:
         base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
           f"{base} base")
+    if diag.data_quality:
+        from .data_quality import quality_lines
+
+        for line in quality_lines(diag.data_quality):
+            print(f"  ! {line}")
     if diag.speed.get("source") in ("data", "scaled"):
         from .speed_whirl import speed_lines
 

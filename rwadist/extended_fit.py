@@ -167,7 +167,7 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
         h = np.array([x.h for x in lines])
         p_co = np.zeros(h.size)
         p_ct = np.zeros(h.size)
-        use = [run for run in test.runs if cx in run.signals and cy in run.signals and run.speed != 0]
+        use = [run for run in test.runs if run.usable(cx) and run.usable(cy) and run.speed != 0]
         # consecutive runs of one record length are transformed together (rwadist.dft.windowed_dfts), and their
         # powers added in the runs' order
         batches: list[list[Run]] = []

@@ -122,7 +122,7 @@ class _Span:
             w = abs(float(run.speed))
             n, fs = run.n_samples, run.sample_rate
             bin_hz = fs / n
-            chs = [c for c in chans if c in run.signals]
+            chs = [c for c in chans if run.usable(c)]
             if w <= 0 or not chs or lo * w / (2 * np.pi) < 4 * bin_hz or hi * w / (2 * np.pi) > self.band_limit:
                 continue
             grid = np.arange(lo * w / (2 * np.pi) - 2 * bin_hz, hi * w / (2 * np.pi) + 2 * bin_hz, 0.25 * bin_hz)

@@ -112,7 +112,8 @@ def compute_spectra(test: SteadyTest, nperseg: int | None = None, overlap: float
     for n in np.unique(lengths):
         idx = np.nonzero(lengths == n)[0]
         for ch in channels:
-            have = [i for i in idx if ch in test.runs[i].signals]
+            # a channel that froze in a run (Run.invalid, rwadist.data_quality) is left out of it, as an absent one
+            have = [i for i in idx if ch in test.runs[i].signals and ch not in test.runs[i].invalid]
             if not have:
                 continue
             block = np.stack([test.runs[i].signals[ch] for i in have])

@@ -74,7 +74,7 @@ def run_line(run, channels: tuple, f0: float, spectra: dict | None = None) -> tu
     one channel's SNR is its |X|² over that median, its share nan.  ``spectra``: the run's spectra
     (:func:`run_spectra`) holding ``channels``, or None (made here)."""
     none = (np.nan, 0.0, np.nan)
-    if not all(c in run.signals for c in channels) or not _measurable(run, f0):
+    if not all(run.usable(c) for c in channels) or not _measurable(run, f0):
         return none
     fs = float(run.sample_rate)
     df = fs / run.n_samples
@@ -139,12 +139,12 @@ def line_ratios(test) -> dict:
     out = {}
     f_given = np.abs(np.array([r.speed for r in test.runs], dtype=float)) / (2 * np.pi)
     sign = np.sign([r.speed for r in test.runs])
-    keys = [key for key, (channels, _) in LINES.items() if any(all(c in r.signals for c in channels) for r in test.runs)]
+    keys = [key for key, (channels, _) in LINES.items() if any(all(r.usable(c) for c in channels) for r in test.runs)]
     read: dict = {key: [] for key in keys}
     buffers: dict = {}
     for r, f0 in zip(test.runs, f_given):
         # every 1× line of a run is read on the same spectra, made once
-        chans = [c for key in keys for c in LINES[key][0] if all(x in r.signals for x in LINES[key][0])]
+        chans = [c for key in keys for c in LINES[key][0] if all(r.usable(x) for x in LINES[key][0])]
         spectra = run_spectra(r, chans, buffers) if chans and _measurable(r, f0) else {}
         for key in keys:
             read[key].append(run_line(r, LINES[key][0], f0, spectra))

@@ -271,7 +271,7 @@ def remove_channel_copies(test, copies):
     for run in test.runs:
         sig = dict(run.signals)
         for cp in copies:
-            if cp.source in run.signals and cp.target in run.signals:
+            if run.usable(cp.source) and run.usable(cp.target):
                 xs = np.asarray(run.signals[cp.source], dtype=float)
                 analytic = hilbert(xs - xs.mean()) + xs.mean()
                 sig[cp.target] = sig[cp.target] - np.real(cp.kappa * analytic)

@@ -149,7 +149,7 @@ class Context(Metric):
             groups: dict[tuple, list[int]] = {}
             for i, r in enumerate(runs):
                 run = self.test.runs[r]
-                have = tuple(j for j, c in enumerate(CHANNELS) if c in run.signals)
+                have = tuple(j for j, c in enumerate(CHANNELS) if run.usable(c))
                 groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
             for (n, fs, have), rows_all in groups.items():
                 w, wsum, _ = run_window(self.sp.window, n)

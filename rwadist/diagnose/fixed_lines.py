@@ -230,7 +230,7 @@ def _refine(ctx, k0: int, chans) -> float | None:
 
     runs = ctx.runs
     rows = runs[np.linspace(0, runs.size - 1, min(REFINE_RUNS, runs.size)).round().astype(int)]
-    rows = [r for r in rows if all(c in ctx.test.runs[r].signals for c in chans)]
+    rows = [r for r in rows if all(ctx.test.runs[r].usable(c) for c in chans)]
     if not rows or len({ctx.test.runs[r].n_samples for r in rows}) != 1:
         return None
     n = ctx.test.runs[rows[0]].n_samples
@@ -263,7 +263,7 @@ def run_amplitudes(ctx, f_hz: float, chans) -> np.ndarray:
     out = np.full((len(test.runs), len(chans)), np.nan + 0j)
     pad = int(round(1.0 / TONE_GRID_STEP))
     for i, run in enumerate(test.runs):
-        have = [j for j, c in enumerate(chans) if c in run.signals]
+        have = [j for j, c in enumerate(chans) if run.usable(c)]
         if not have:
             continue
         n = run.n_samples
@@ -329,7 +329,7 @@ def remove_fixed_lines(ctx, lines) -> SteadyTest:
         for i, run in enumerate(test.runs):
             e = np.exp(2j * np.pi * ln.f_Hz * np.arange(run.n_samples) / run.sample_rate)
             for j, c in enumerate(ln.channels):
-                if c in run.signals and np.isfinite(A[i, j]):
+                if run.usable(c) and np.isfinite(A[i, j]):
                     new_signals[i][c] = new_signals[i][c] - np.real(A[i, j] * e)
     return SteadyTest([replace(r, signals=s) for r, s in zip(test.runs, new_signals)], dict(test.meta))
 

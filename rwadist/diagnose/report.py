@@ -347,6 +347,10 @@ def write_report(diag: Diagnosis, out_dir) -> list:
                      f"({which}): each traces an ellipse whose orientation is its parts' phase in the run, which "
                      "changes run to run; the model gives x and y the ellipse's mean square, so Fx and Fy (Tx and Ty) "
                      "each miss the data by the orientation, while the pair's summed power holds."]
+    if diag.data_quality:
+        from ..data_quality import quality_lines
+
+        md += ["## Data quality", ""] + [f"- {line}" for line in quality_lines(diag.data_quality)] + [""]
     if diag.speed:
         from ..speed_whirl import speed_lines
 

@@ -71,6 +71,8 @@ class Diagnosis:
     bearings: tuple = ()
     #: how the runs' speeds were obtained (:func:`rwadist.speed_whirl.speed_record`; {} when not told)
     speed: dict = field(default_factory=dict)
+    #: channels of runs left out because they froze (:meth:`rwadist.data_quality.FrozenStretch.to_json` records)
+    data_quality: list = field(default_factory=list)
 
     @property
     def effects(self) -> list:
@@ -115,6 +117,7 @@ class Diagnosis:
             "line_causes": list(self.line_causes),
             "bearings": [dict(vars(b)) for b in self.bearings],
             "speed": dict(self.speed),
+            "data_quality": list(self.data_quality),
             "hypotheses": [effect_entry(h) for h in self.hypotheses],
         }
 

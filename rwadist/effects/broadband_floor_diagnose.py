@@ -161,7 +161,7 @@ def record_offline_bands(ctx: Context, state: State, c: str, runs: np.ndarray, n
     lines = state_line_freqs(ctx, state, c, runs)
     keys = [("broadband_floor_record", int(r), j, lines[i].tobytes(), need[i].tobytes()) for i, r in enumerate(runs)]
     todo = [i for i, r in enumerate(runs)
-            if need[i].any() and keys[i] not in ctx._memo and c in ctx.test.runs[int(r)].signals]
+            if need[i].any() and keys[i] not in ctx._memo and ctx.test.runs[int(r)].usable(c)]
     A = (record_dfts(ctx, [int(runs[i]) for i in todo], c, lines[todo]) if lines.shape[1] and todo
          else np.zeros((len(todo), 0), complex))
     spectra = _record_spectra(ctx, c, [int(runs[i]) for i in todo])

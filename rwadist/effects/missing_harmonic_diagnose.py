@@ -100,7 +100,7 @@ def _record_grid(ctx: Context, r: int) -> tuple:
         pad = int(round(1.0 / RECORD_GRID_BINS))
         n_keep = int(np.ceil((welch_low_limit(ctx) / df_rec + 20.0) / RECORD_GRID_BINS)) + 1
         X = np.full((n_keep, len(ctx.channels)), np.nan + 0j)
-        have = [j for j, c in enumerate(ctx.channels) if c in run.signals]
+        have = [j for j, c in enumerate(ctx.channels) if run.usable(c)]
         if have:
             xs = demeaned_windowed([run.signals[ctx.channels[j]] for j in have], w)
             # every channel in one call (scipy.fft: the numbers of numpy.fft's, channel by channel, in half the time)

@@ -30,6 +30,8 @@ class Run:
     signals : channel name -> samples (N or N·m); absent channels are absent keys.
     t0 : time of the first sample, s.
     name : file name of the run in the interchange format.
+    invalid : channels whose samples hold a stretch that is no measurement (a dropout found by
+        :func:`rwadist.data_quality.screen`): their spectra are left out of this run (as for an absent channel).
     """
 
     speed: float
@@ -37,6 +39,7 @@ class Run:
     signals: dict
     t0: float = 0.0
     name: str = ""
+    invalid: frozenset = frozenset()
 
     @property
     def n_samples(self) -> int:
@@ -45,6 +48,10 @@ class Run:
     @property
     def channels(self) -> tuple:
         return tuple(ch for ch in CHANNELS if ch in self.signals)
+
+    def usable(self, channel: str) -> bool:
+        """The run holds ``channel`` and it did not freeze (not in ``invalid``)."""
+        return channel in self.signals and channel not in self.invalid
 
 
 @dataclass

@@ -1,0 +1,113 @@
+"""A channel that froze in part of a run (a DAQ or amplifier dropout) is found where it is, left out of that run,
+and said; clean and coarsely printed data never raise it (rwadist.data_quality)."""
+from __future__ import annotations
+
+import warnings
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from rwadist import api
+from rwadist.data import SteadyTest, read_steady, write_steady
+from rwadist.data_quality import find_frozen, quality_lines, screen
+from rwadist.empirical import fit_empirical
+from rwadist.errors import RwadistWarning
+from rwadist.spectra import compute_spectra
+
+SPEEDS = np.linspace(600.0, 2400.0, 16)
+#: (run, channel, first frozen sample, one after the last, kind): Fz held in three runs, Tx at zero in one
+FROZEN = ((3, "Fz", 2000, 4500, "held"), (8, "Fz", 100, 3100, "held"), (13, "Fz", 5000, 8192, "held"),
+          (5, "Tx", 3000, 6000, "zero"))
+
+
+def _test(seed: int) -> SteadyTest:
+    return api.simulate_test("ithaco-e", SPEEDS, n_samples=8192, seed=seed)
+
+
+def _freeze(test: SteadyTest) -> SteadyTest:
+    """Sample and hold (the last good sample's value) or zeros over the stretches of :data:`FROZEN`."""
+    runs = list(test.runs)
+    for i, c, a, b, kind in FROZEN:
+        x = runs[i].signals[c].copy()
+        x[a:b] = x[a - 1] if kind == "held" else 0.0
+        runs[i] = replace(runs[i], signals={**runs[i].signals, c: x})
+    return SteadyTest(runs, dict(test.meta))
+
+
+def _round(x: np.ndarray, digits: int) -> np.ndarray:
+    """``x`` printed with ``%.{digits}g`` and read back."""
+    return np.array([float(f"{v:.{digits}g}") for v in x])
+
+
+def test_frozen_stretches_found_where_they_are_after_a_csv_round_trip(tmp_path):
+    test = read_steady(write_steady(_freeze(_test(1)), tmp_path / "d"))
+    found = find_frozen(test)
+    assert [(s.run, s.channel, s.kind) for s in found] == [(i, c, k) for i, c, _, _, k in sorted(FROZEN)]
+    fs = test.runs[0].sample_rate
+    for s, (i, c, a, b, kind) in zip(found, sorted(FROZEN)):
+        # a held value is the last good sample's, which joins the stretch: the start within one sample
+        assert a - 1 <= s.start <= a and s.stop == b
+        assert s.start_s == pytest.approx(test.runs[i].t0 + s.start / fs)
+        assert s.end_s == pytest.approx(test.runs[i].t0 + (b - 1) / fs)
+    lines = quality_lines([s.to_json() for s in found])
+    assert len(lines) == len(FROZEN) + 1 and "left out" in lines[0] and "4 channel(s)" in lines[-1]
+    screened, again = screen(test)
+    assert again == found
+    sp = compute_spectra(screened)
+    for i, c, _, _, _ in FROZEN:
+        assert screened.runs[i].invalid == {c}
+        # left out of that run's spectra, as a channel the run lacks; the other channels and runs untouched
+        assert not sp.available(c)[i] and sum(sp.available(k)[i] for k in sp.channels) == 5
+    assert sum(int(np.sum(~sp.available(k))) for k in sp.channels) == len(FROZEN)
+    assert screened.meta["data_quality"] == [s.to_json() for s in found]
+
+
+def test_nan_samples_are_found():
+    test = _test(1)
+    x = test.runs[2].signals["Ty"].copy()
+    x[10:13] = np.nan
+    runs = list(test.runs)
+    runs[2] = replace(runs[2], signals={**runs[2].signals, "Ty": x})
+    found = find_frozen(SteadyTest(runs))
+    assert [(s.run, s.channel, s.kind, s.start, s.stop) for s in found] == [(2, "Ty", "nan", 10, 13)]
+
+
+def test_no_false_alarm_on_clean_or_coarsely_printed_data():
+    """Clean runs (the wheel still, in the 0-rpm run, and at speed), as simulated and printed with 4 significant
+    digits (%.4g, as trial13's lab-like files) and 3: coarse printing repeats samples often."""
+    test = api.simulate_test("ithaco-e", np.r_[0.0, SPEEDS], n_samples=8192, seed=3)
+    assert find_frozen(test) == []
+    for digits in (4, 3):
+        rounded = SteadyTest([replace(r, signals={c: _round(v, digits) for c, v in r.signals.items()})
+                              for r in test.runs])
+        repeats = sum(int(np.sum(np.diff(v) == 0)) for r in rounded.runs for v in r.signals.values())
+        assert repeats > 500           # rounding does repeat samples, by chance
+        assert find_frozen(rounded) == [], digits
+    assert screen(test)[0] is test
+
+
+def test_axial_amplitudes_after_screening_within_the_clean_scatter():
+    """The axial force lines' C from the frozen data, screened, agree with the clean data's as well as two noise
+    seeds of clean data agree with each other; the same data not screened read them low."""
+    clean = api.fit(_test(1)).model
+    other = api.fit(_test(2)).model
+    frozen = _freeze(_test(1))
+    with pytest.warns(RwadistWarning, match="left out"):
+        after = api.fit(frozen).model
+    assert len(after.provenance["data_quality"]) == len(FROZEN)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RwadistWarning)
+        before = fit_empirical(compute_spectra(frozen)).model
+
+    def axial(model):
+        return {round(x.h, 1): x.C for x in model.harmonics("axial_force")}
+
+    c, o, a, b = axial(clean), axial(other), axial(after), axial(before)
+    hs = [h for h in c if h in o and h in a and h in b]
+    assert len(hs) >= 3
+    scatter = max(abs(o[h] / c[h] - 1) for h in hs)
+    err_after = max(abs(a[h] / c[h] - 1) for h in hs)
+    err_before = max(abs(b[h] / c[h] - 1) for h in hs)
+    assert err_after <= max(scatter, 0.01), (err_after, scatter)
+    assert err_before > 2 * err_after, (err_before, err_after)
