@@ -15,6 +15,9 @@ no model, is run on it (a subprocess) and its ``summary.json`` read.  Per wheel:
   cell's (<= 5x), anything else added;
 * a fixture (test-stand) resonance on every channel at 0.5-1.5x each suspension mode (ζ 0.03, peak gain 5): the
   modes within 2 % or declared unconstrained, and the stand named (``fixed_resonance`` role test_stand within 5 %);
+* ``fixture_offset``: the same fixture on a table whose load-cell reference sits 20-40 mm off the bearing centre
+  (a ``cross_coupling`` lever arm, :data:`LEVER_ARMS_M`), one cell per wheel: the modes as for ``fixture``, the stand
+  named and the offset named (``cross_coupling`` r_z within 10 mm), nothing else added, error <= 5x the clean cell's;
 * two classes at once (:data:`PAIRS`): both found;
 * each unknown kind: described (``summary.json`` ``unexplained``, docs/diagnose.md "Unexplained residual")
   with the right signature (:attr:`family_effects.Effect.describe`), and 0 classes added for it.
@@ -54,6 +57,10 @@ import family_wheel as fw  # noqa: E402
 CONDITIONS = {0: (24, 8192, 0.01), 1: (16, 8192, 0.003), 2: (20, 4096, 0.03), 3: (20, 8192, 0.01),
               4: (24, 4096, 0.01), 5: (16, 16384, 0.01), 6: (20, 4096, 0.003), 7: (16, 8192, 0.03)}
 FIXTURE_FACTORS = (0.5, 0.75, 1.0, 1.25, 1.5)
+#: ``fixture_offset`` cells: a fixture as in ``fixture`` (same mode and factor) on a table whose load-cell reference
+#: sits off the bearing centre by r_z (a lever arm: every real table has one), this many per wheel, r_z in turn
+FIXTURE_OFFSET_CELLS = 1
+LEVER_ARMS_M = (-0.025, 0.035, -0.04, 0.02)
 MODES = ("radial_translation", "rocking", "axial")
 #: two classes at once, one pair per wheel in turn (two per wheel)
 PAIRS = (("amplitude_law", "cross_coupling"), ("counter_rotation", "broadband_floor"),
@@ -86,6 +93,13 @@ def cells(i: int, wheel) -> list:
         factor = FIXTURE_FACTORS[(i + 2 * j) % len(FIXTURE_FACTORS)]
         f = factor * wheel.modes_hz()[mode]
         out.append((f"fixture {factor:g}x {mode}", "fixture", [fe.Fixture(f_hz=f, zeta=0.03, gain=5.0)]))
+    for j in range(FIXTURE_OFFSET_CELLS):
+        mode = MODES[(i + j) % len(MODES)]
+        factor = FIXTURE_FACTORS[(i + 2 * ((i + j) % len(MODES))) % len(FIXTURE_FACTORS)]
+        f = factor * wheel.modes_hz()[mode]
+        rz = LEVER_ARMS_M[(i + j) % len(LEVER_ARMS_M)]
+        out.append((f"fixture {factor:g}x {mode} r {1e3 * rz:+.0f} mm", "fixture_offset",
+                    [fe.Fixture(f_hz=f, zeta=0.03, gain=5.0), fe.CrossCoupling(r=(0.0, 0.0, rz))]))
     for j in range(2):
         a, b = PAIRS[(2 * i + j) % len(PAIRS)]
         out.append((f"{a}+{b}", "pair", [fe.default_effect(a, wheel), fe.default_effect(b, wheel)]))
@@ -309,6 +323,17 @@ def summarize(rows: list) -> None:
               f"{sum(bool(r['found'][0]) for r in fx if 'crashed' not in r)}/{len(fx)}; nothing else added "
               f"{sum(not r['added'] for r in fx)}/{len(fx)}; error <= {ERROR_FACTOR:g}x clean "
               f"{sum(r.get('error_ratio') is not None and r['error_ratio'] <= ERROR_FACTOR for r in fx)}/{len(fx)}")
+    fo = [r for r in rows if r["label"] == "fixture_offset"]
+    if fo:
+        ok = [r for r in fo if r["modes_ok"] and all(r["found"]) and not r["added"]
+              and r.get("error_ratio") is not None and r["error_ratio"] <= ERROR_FACTOR]
+        print(f"fixtures with a load-cell offset: modes within {100 * MODE_TOL:g} % or declared "
+              f"{sum(r['modes_ok'] for r in fo)}/{len(fo)} (wrong: {[(r['wheel'], r['cell']) for r in fo if not r['modes_ok']]}); "
+              f"stand named {sum(bool(r['found'][0]) for r in fo)}/{len(fo)}; offset named "
+              f"{sum(bool(r['found'][1]) for r in fo if len(r['found']) > 1)}/{len(fo)}; nothing else added "
+              f"{sum(not r['added'] for r in fo)}/{len(fo)}; error <= {ERROR_FACTOR:g}x clean "
+              f"{sum(r.get('error_ratio') is not None and r['error_ratio'] <= ERROR_FACTOR for r in fo)}/{len(fo)}; "
+              f"PASS {len(ok)}/{len(fo)}")
     pr = [r for r in done if r["label"] == "pair"]
     if pr:
         both = [r for r in pr if all(r["found"])]

@@ -317,6 +317,8 @@ def _beside_offset(ctx: Context, state: State, efit, fit, runs, test, stand_star
         cc = CrossCoupling.fit(ctx, with_modes, runs)
         if cc is None or not cc.significant():
             break
+        # the offset taken out weighed by the wheel's own torque, not by the torque as measured (which holds r × F)
+        cc = cc.own_weighted(ctx, with_modes, runs)
         test_c, fit_c, efit_c, stand_c = _located_corrected(ctx, test, np.asarray(cc.r, dtype=float), stand_start,
                                                             near)
         k = 3 - len(efit_c.unconstrained)
