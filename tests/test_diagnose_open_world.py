@@ -126,6 +126,33 @@ def test_one_line_in_a_fixed_phase_through_two_modes_is_no_copy():
     assert _pair(**both) is not None
 
 
+def test_lines_of_one_family_along_a_fixed_direction_are_no_copy():
+    """Two ball-pass multiples (h 9.8, 13.1) read in Fz at 0.7 x Fx in every run, as a real force along a fixed x-z
+    direction puts them (an outer-race impact train on the housing), are a copy only if Fz also holds 0.7 x Fx's
+    strongest line: a crosstalk scales every component of its source.  Fx's imbalance line (30 x stronger) standing in
+    Fz at 0.05 of it (Fz's own 1x line): no copy; the same data with Fz holding 0.7 x that line too (plus its own
+    line, 0.05 of Fx's, at a phase of its own): a copy, κ 0.7."""
+    from rwadist.diagnose.channel_copy import _pair
+
+    rng = np.random.default_rng(4)
+    n = 16
+    omega = 2 * np.pi * np.linspace(15.0, 130.0, n)
+
+    def phases():
+        return np.exp(2j * np.pi * rng.uniform(size=n))
+
+    fam = [omega**2 * 1e-3 * phases() for _ in range(2)]                  # the family's two lines in Fx
+    one = omega**2 * 3e-2 * phases()                                       # Fx's imbalance line, 30 x stronger
+    own = 0.05 * np.abs(one) * phases()                                    # Fz's own 1x line
+    X_s = np.concatenate(fam + [one])
+    h = np.concatenate([np.full(n, 9.8), np.full(n, 13.1), np.ones(n)])
+    args = dict(X_s=X_s, noise_t=np.full(3 * n, np.min(np.abs(0.7 * X_s)) ** 2 / 1e3), runs=np.tile(np.arange(n), 3),
+                h=h, cs="Fx", ct="Fz", omega=np.tile(omega, 3))
+    assert _pair(X_t=np.concatenate([0.7 * f for f in fam] + [own]), **args) is None
+    got = _pair(X_t=np.concatenate([0.7 * f for f in fam] + [0.7 * one + own]), **args)
+    assert got is not None and abs(got.kappa - 0.7) < 0.02
+
+
 def test_hump_where_it_is():
     _, truth, d = diagnosed("broadband_hump")
     (u,) = d.unexplained

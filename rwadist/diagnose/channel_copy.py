@@ -66,6 +66,10 @@ SINGLE_LAW_DB = 3.0
 #: law through the axial mode at 85 Hz, Fx's 0.8 dB through the translation at 150 Hz, slope −0.7; one continuous
 #: record keeps every line's phases, so the two read at one ratio within the cluster's tolerance in every slice)
 SINGLE_RATIO_SLOPE = 0.25
+#: A copy of several lines holds the source's strongest line too: the target carries there at least this fraction of
+#: the copy's amplitude in most runs (:func:`_holds_strongest`; 0.5: the target's own line would have to cancel half of
+#: the copy, in phase opposition, in most runs)
+STRONGEST_HELD = 0.5
 
 
 @dataclass(frozen=True)
@@ -201,6 +205,25 @@ def _one_line_copy(X_s, X_t, omega, runs, h, near, strong) -> list:
     return [float(strongest)] if abs(slope) <= SINGLE_RATIO_SLOPE else []
 
 
+def _holds_strongest(X_s, X_t, kappa: complex, runs, h, strong) -> bool:
+    """Whether the target holds, at the source's strongest line where a copy would stand clear (``strong``), at least
+    :data:`STRONGEST_HELD` of the copy κ·X_s there (the median over those runs of |X_t|/|κ·X_s|).
+
+    A copy scales every component of the source alike: the target's own line at that ratio adds to it with a phase of
+    its own, and cancels it in one run, not in most.  Lines of one ratio family standing in two channels at one
+    complex ratio are also a real force along a fixed direction (an outer-race impact train on a housing, Fz = 0.7·Fx
+    on the ball-pass multiples: trial13's impacts cell), which leaves the source's other lines where they are: there
+    Fx's imbalance line stood in Fz at 0.07 of 0.7·Fx (the median over 24 runs), and taking 0.7·Fx out of
+    Fz put the radial lines, amplified by the radial translation, into the axial direction (axial 1x C x12)."""
+    levels = {float(v): float(np.median(np.abs(X_s[(h == v) & strong]))) for v in np.unique(h[strong])}
+    if not levels:
+        return True
+    sel = (h == max(levels, key=lambda v: levels[v])) & strong
+    if np.unique(runs[sel]).size < MIN_RUNS:
+        return True                     # too few runs to tell
+    return bool(np.median(np.abs(X_t[sel]) / np.maximum(np.abs(kappa * X_s[sel]), 1e-300)) >= STRONGEST_HELD)
+
+
 def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str, omega) -> ChannelCopy | None:
     """The copy of channel ``cs`` in ``ct`` from the source's points: their transforms ``X_s``, ``X_t``, the target's
     noise there, their runs, line ratios ``h`` and speeds ``omega`` (rad/s); or None."""
@@ -238,6 +261,8 @@ def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str, omega) -> ChannelCopy | 
         lines = _one_line_copy(X_s, X_t, omega, runs, h, near, strong)
         if not lines:
             return None
+    elif not _holds_strongest(X_s, X_t, kappa, runs, h, strong):
+        return None
     keep = near & np.isin(h, lines)
     # κ again from the copy's cleanest lines: a line the target also carries itself (a ratio the two directions share)
     # scatters about κ from run to run, one it only copies does not; within the wide cluster such lines pulled κ
