@@ -16,6 +16,8 @@ sensor noise white, added after the torques took r × F.  The state is the one t
 from __future__ import annotations
 
 import functools
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,12 +25,15 @@ import pytest
 from rwadist.diagnose.engine import Context, initial_state
 from rwadist.effects.cross_coupling_diagnose import CrossCoupling
 from rwadist.empirical import fit_empirical
-from rwadist.formats.records import Run, SteadyTest
+from rwadist.formats.records import SteadyTest
 from rwadist.spectra import compute_spectra
 
-FS, T_RUN, NPERSEG = 2000.0, 8.0, 1024
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from test_describe_offset_floor import lever_arm_test  # noqa: E402  (the same numpy generator, other lines)
+
+NPERSEG = 1024                      # FS 2 kHz, 8-s runs and the sensors' noise: lever_arm_test's
 SPEEDS_RPM = np.linspace(1000.0, 7000.0, 24)
-NOISE = {"Fx": 4e-3, "Fy": 4e-3, "Fz": 4e-3, "Tx": 1.5e-4, "Ty": 1.5e-4, "Tz": 1e-4}
 #: (direction, h, C) of the wheel's lines: kg·m (forces), kg·m² (torques)
 LINES = [("radial_force", 1.0, 2e-6), ("radial_force", 2.0, 1e-7), ("radial_force", 3.4, 5e-8),
          ("radial_force", 0.4, 4e-8), ("axial_force", 1.0, 2e-7), ("axial_force", 2.0, 8e-8),
@@ -38,30 +43,8 @@ R_Z = 0.030
 
 
 def _test(r_z: float, seed: int) -> SteadyTest:
-    r = np.array([0.0, 0.0, r_z])
-    rng = np.random.default_rng(seed)
-    n = int(FS * T_RUN)
-    t = np.arange(n) / FS
-    runs = []
-    for i, rpm in enumerate(SPEEDS_RPM):
-        om = rpm * np.pi / 30.0
-        sig = {c: np.zeros(n) for c in NOISE}
-        for d, h, C in LINES:
-            a = C * om**2
-            ph = h * om * t + rng.uniform(0, 2 * np.pi)
-            if d.startswith("radial"):
-                sig["Fx" if d == "radial_force" else "Tx"] += a * np.cos(ph)
-                sig["Fy" if d == "radial_force" else "Ty"] += a * np.sin(ph)
-            else:
-                sig["Fz" if d == "axial_force" else "Tz"] += a * np.cos(ph)
-        F = np.column_stack([sig[c] for c in ("Fx", "Fy", "Fz")])
-        rxF = np.cross(r[None, :], F)
-        for j, c in enumerate(("Tx", "Ty", "Tz")):
-            sig[c] = sig[c] + rxF[:, j]
-        for c, sd in NOISE.items():             # the sensors' noise after the geometry (a real stand)
-            sig[c] = sig[c] + sd * rng.standard_normal(n)
-        runs.append(Run(speed=om, sample_rate=FS, signals=sig, name=f"run_{i:02d}.csv"))
-    return SteadyTest(runs, {"sample_rate_hz": FS})
+    """This file's wheel with the load-cell reference at (0, 0, ``r_z``) (test_describe_offset_floor's generator)."""
+    return lever_arm_test(LINES, (0.0, 0.0, r_z), SPEEDS_RPM, seed)
 
 
 @functools.lru_cache(maxsize=None)

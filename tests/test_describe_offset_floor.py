@@ -38,15 +38,19 @@ LINES = [("radial_force", 1.0, 2e-6), ("radial_force", 2.0, 1e-7), ("radial_forc
 EXTRA = (0.37, 4e-9)
 
 
-def _test(extra: bool, seed: int = 13) -> SteadyTest:
+def lever_arm_test(lines, r, speeds_rpm, seed: int) -> SteadyTest:
+    """Runs (FS, T_RUN) of the wheel ``lines`` ((direction, h, C): a direction ending in "counter" turns against the
+    spin) at ``speeds_rpm``, each line of its own random phase in every run, the torques read at a load-cell reference
+    ``r`` (m, 3-vector: T + r × F) and the sensors' noise :data:`NOISE` added after the geometry (a real stand); also
+    tests/test_cross_coupling_own_weight.py's data."""
+    r = np.asarray(r, dtype=float)
     rng = np.random.default_rng(seed)
     n = int(FS * T_RUN)
     t = np.arange(n) / FS
     runs = []
-    for i, rpm in enumerate(SPEEDS_RPM):
+    for i, rpm in enumerate(speeds_rpm):
         om = rpm * np.pi / 30.0
         sig = {c: np.zeros(n) for c in NOISE}
-        lines = LINES + ([("radial_torque_counter", *EXTRA)] if extra else [])
         for d, h, C in lines:
             a = C * om**2
             ph = h * om * t + rng.uniform(0, 2 * np.pi)
@@ -58,13 +62,17 @@ def _test(extra: bool, seed: int = 13) -> SteadyTest:
             else:
                 sig["Fz" if d == "axial_force" else "Tz"] += a * np.cos(ph)
         F = np.column_stack([sig[c] for c in ("Fx", "Fy", "Fz")])
-        rxF = np.cross(R[None, :], F)
+        rxF = np.cross(r[None, :], F)
         for j, c in enumerate(("Tx", "Ty", "Tz")):
             sig[c] = sig[c] + rxF[:, j]
         for c, sd in NOISE.items():             # the sensors' noise after the geometry (a real stand)
             sig[c] = sig[c] + sd * rng.standard_normal(n)
         runs.append(Run(speed=om, sample_rate=FS, signals=sig, name=f"run_{i:02d}.csv"))
     return SteadyTest(runs, {"sample_rate_hz": FS})
+
+
+def _test(extra: bool, seed: int = 13) -> SteadyTest:
+    return lever_arm_test(LINES + ([("radial_torque_counter", *EXTRA)] if extra else []), R, SPEEDS_RPM, seed)
 
 
 @functools.lru_cache(maxsize=None)
