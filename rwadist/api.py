@@ -329,7 +329,8 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     test = _as_test(data)
     if name is None:
         name = Path(data).name if isinstance(data, (str, Path)) else "fitted wheel"
-    # a channel that froze in a run (a DAQ or amplifier dropout) is left out of that run: no invalid sample is used
+    # a channel that froze in a run (a DAQ or amplifier dropout) is marked invalid in that run (Run.invalid): its
+    # spectra are left out (docs/diagnose.md, "Data quality": what still reads its samples)
     test, frozen = data_quality.screen(test)
     if frozen:
         warnings.warn(RwadistWarning("; ".join(data_quality.quality_lines([s.to_json() for s in frozen]))),
@@ -511,7 +512,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         bearings = tuple(b if isinstance(b, Bearing) else parse_bearing(b, "diagnose", f"bearings[{i}]")
                          for i, b in enumerate(bearings))
     test = _as_test(data)
-    # a channel that froze in a run (a DAQ or amplifier dropout) is left out of that run: no invalid sample is used
+    # a channel that froze in a run (a DAQ or amplifier dropout) is marked invalid in that run (Run.invalid): its
+    # spectra are left out (docs/diagnose.md, "Data quality": what still reads its samples)
     test, frozen = data_quality.screen(test)
     # too few speeds to fit and judge on: refused (one), or warned of (fewer than the data's own fit needs)
     check_test_speeds(test, source or (data if isinstance(data, (str, Path)) else "the test"),

@@ -218,9 +218,10 @@ def _relations(h: float, resolution: float, others) -> list:
     cage-range line (over the still race) or n × (1 − it) (over the turning race), an outer/inner ball-pass pair
     summing to n, and the 2nd or 3rd multiple of another non-integer line (a bearing line's harmonics).
 
-    Ordered by how well each holds: those within half a resolution first (a multiple of another line before a pair
-    before a ball pass: the fewer causes, the likelier), then the rest by their distance in resolutions (each
-    relation's own tolerance: n × a line's resolution for n × it).  trial14's 11-ball bearing: 9.242 was first
+    Ordered by how well each holds: those within half of their own tolerance first (a multiple of another line before
+    a pair before a ball pass: the fewer causes, the likelier), then the rest by their distance in units of their own
+    tolerance (k × the resolution for the k-th multiple, 2 × it for a pair, (1 + n) × it for n × a cage-range
+    line).  trial14's 11-ball bearing: 9.242 was first
     "16 × 0.5799 = 9.278", 14 whole-record bins off, before the exact 2nd multiple of 4.621."""
     n_lo, n_hi = BALL_COUNTS
     out = []

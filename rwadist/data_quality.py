@@ -4,9 +4,10 @@ A load-cell channel that drops out for part of a run holds one value -- the last
 zero -- for many consecutive samples, or (in an in-memory test) holds NaN.  Its spectra then lose the lines'
 power over that stretch and gain the steps' broadband floor: every line amplitude of the channel reads low and
 the run looks like a change of the wheel.  :func:`find_frozen` finds such stretches, per run and channel;
-:func:`screen` leaves the channel of each run that holds one out of the test (a channel the run lacks, the
-readers' documented handling of an absent channel, which every spectrum and fit already honours), so that no
-invalid sample is used, and returns the records that say so.
+:func:`screen` marks the channel of each run that holds one invalid in that run (``Run.invalid``: its spectra get
+the NaN row of a channel the run lacks, and the whole-record steps that ask ``Run.usable`` read it as absent) and
+returns the records that say so.  The samples stay in the run: a torque referred through a load-cell offset
+(T − r × F) still reads a frozen force, and so do the record scans docs/diagnose.md ("Data quality") lists.
 
 When is a stretch of equal samples "frozen"?  Clean samples repeat a value only by chance: the noise moving by
 less than the printed resolution.  The chance that a repeat goes on one more sample is estimated from the channel's

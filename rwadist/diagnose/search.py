@@ -435,7 +435,9 @@ def _no_worse(ctx, state, refit, beside=None) -> tuple[bool, State]:
     more than ``NO_WORSE_TOLERANCE``: a line the Welch metric cannot measure (below its band, found on the whole
     record) moves the error by its window's leakage only (+1e-6 relative for a subharmonic at 2048 samples), while a
     refit that runs off raises it by factors.  ``beside``: the test stand the hypothesis was judged beside
-    (:func:`_judge_beside_stand`): the refit's own stand (else that one) is then in both states compared."""
+    (:func:`_judge_beside_stand`): the refit's own stand (else that one) is then in both states compared; or the
+    load-cell offset the modes were judged with (:func:`_judge_with_offset`): the refit with its own offset (else that
+    one) is compared with ``state`` as it is, and the state returned holds the refit without the offset."""
     new = refit.apply(state)
     if getattr(beside, "kind", None) == "cross_coupling":
         # judged with the offset it was located beside (:func:`_judge_with_offset`): the refit with its own offset
