@@ -515,6 +515,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     # a channel that froze in a run (a DAQ or amplifier dropout) is marked invalid in that run (Run.invalid): its
     # spectra are left out (docs/diagnose.md, "Data quality": what still reads its samples)
     test, frozen = data_quality.screen(test)
+    if frozen:
+        warnings.warn(RwadistWarning(data_quality.summary_line([s.to_json() for s in frozen])), stacklevel=2)
     # too few speeds to fit and judge on: refused (one), or warned of (fewer than the data's own fit needs)
     check_test_speeds(test, source or (data if isinstance(data, (str, Path)) else "the test"),
                       model_given=model is not None or preset is not None)

@@ -15,6 +15,8 @@ own repeats (every run of equal consecutive samples but the one tested, with one
 prior), ``p``; a stretch of ``L`` equal samples is frozen when the expected number of stretches that long in the
 run, ``n_repeats · p^(L - 2)``, is below :data:`FALSE_ALARM` and ``L`` is at least :data:`MIN_SAMPLES`.  Coarse
 printing (``%.4g``) raises ``p`` and with it the length needed; no threshold is tied to a wheel or a sample rate.
+The chance model takes repeats as alike along the run, which a channel that moves less than one printed step does
+not satisfy; such a stretch enters and leaves its value by one step and is not called frozen (:func:`_at_resolution`).
 """
 from __future__ import annotations
 
@@ -100,6 +102,25 @@ def _stretches(mask: np.ndarray) -> np.ndarray:
     return np.column_stack([np.flatnonzero(d == 1), np.flatnonzero(d == -1)])
 
 
+def _at_resolution(x: np.ndarray, a: int, b: int, width: int) -> bool:
+    """Whether the stretch of equal samples ``x[a:b]`` enters and leaves by one step of the printed resolution.
+
+    The chance model of the module docstring takes repeats as alike along the run.  A channel that moves less than
+    one printed step (a quiet axial channel on its preload, ADC counts) breaks that: it sits on one level while
+    its slow drift and noise stay between two steps, and leaves it for the next level.  A channel that froze hides
+    a signal that went on moving: at the stretch's end (and, for zeros, its start too) the samples jump by what the
+    signal moved meanwhile, many steps.  Here the step is the smallest change of the samples within ``width`` of the
+    stretch; a stretch whose every change at its ends (inside the record) is within 1.5 steps is the channel at its
+    resolution, not a dropout.  A whole record of one value has no end to read and stays frozen.
+    """
+    lo, hi = max(0, a - width), min(x.size, b + width)
+    d = np.abs(np.diff(x[lo:hi]))
+    d = d[np.isfinite(d) & (d > 0.0)]
+    ends = [abs(x[i] - x[j]) for i, j in ((a, a - 1), (b, b - 1)) if 0 <= j and i < x.size and np.isfinite(x[i])
+            and np.isfinite(x[j])]
+    return bool(ends and d.size and max(ends) <= 1.5 * d.min())
+
+
 def frozen_spans(x) -> list:
     """Frozen stretches of one record: [(start, stop, kind, value)] (samples, stop exclusive), by start.
 
@@ -135,8 +156,10 @@ def frozen_spans(x) -> list:
             p = (np.sum(rest - 2) + 1.0) / (np.sum(rest - 1) + 2.0)
             if (rest.size + 1) * p ** (L - 2) >= FALSE_ALARM:
                 break
-            flagged[k] = True
             a, b = int(runs[k, 0]), int(runs[k, 1]) + 1
+            if _at_resolution(x, a, b, L):
+                continue
+            flagged[k] = True
             out.append((a, b, "zero" if x[a] == 0.0 else "held", float(x[a])))
     return sorted(out)
 
@@ -192,3 +215,14 @@ def quality_lines(records) -> list:
                  "longer than noise at the printed resolution allows); check the cabling, amplifier and DAQ, "
                  "and repeat those runs if that channel matters")
     return lines
+
+
+def summary_line(records) -> str:
+    """One line for a warning: which channels froze in how many runs (records: JSON dicts of
+    :meth:`FrozenStretch.to_json`), and that each stretch is listed in ``data_quality``."""
+    runs: dict = {}
+    for r in records:
+        runs.setdefault(r["channel"], set()).add(r["run"])
+    which = ", ".join(f"{c} in {len(runs[c])} run(s)" for c in CHANNELS if c in runs)
+    return (f"a channel froze (a DAQ or amplifier dropout): {which}; each is left out of those runs, every stretch "
+            "listed in data_quality")

@@ -79,7 +79,8 @@ def run_line(run, channels: tuple, f0: float, spectra: dict | None = None) -> tu
     fs = float(run.sample_rate)
     df = fs / run.n_samples
     f = _window_and_bins(run.n_samples, fs)[1]
-    spec = {c: (spectra or run_spectra(run, channels))[c] for c in channels}
+    spectra = spectra or run_spectra(run, channels)          # once for all channels (one stacked FFT)
+    spec = {c: spectra[c] for c in channels}
 
     def power(bins):
         """|X|² + |Y|² (|X|² for one channel) at the padded ``bins`` (a slice or indices): only these are read."""

@@ -10,7 +10,7 @@ import pytest
 
 from rwadist import api
 from rwadist.data import SteadyTest, read_steady, write_steady
-from rwadist.data_quality import find_frozen, quality_lines, screen
+from rwadist.data_quality import MIN_SAMPLES, find_frozen, frozen_spans, quality_lines, screen
 from rwadist.empirical import fit_empirical
 from rwadist.errors import RwadistWarning
 from rwadist.spectra import compute_spectra
@@ -111,3 +111,41 @@ def test_axial_amplitudes_after_screening_within_the_clean_scatter():
     err_before = max(abs(b[h] / c[h] - 1) for h in hs)
     assert err_after <= max(scatter, 0.01), (err_after, scatter)
     assert err_before > 2 * err_after, (err_before, err_after)
+
+
+@pytest.mark.parametrize("seed", [4, 5, 6])
+def test_a_channel_at_its_printed_resolution_is_no_dropout_and_a_hold_in_it_is(seed):
+    """Channels that move less than one printed step: ADC counts (0.45 LSB offset, a 0.1 LSB 1 Hz line, 0.03 LSB
+    noise) and a 1.2345 N channel with a 0.1 mN 1 Hz line and 0.03 mN noise printed %.4g (1 mN steps).  They sit on
+    one level for a long while and leave it by one step; the module's chance model takes repeats as alike along the
+    run and called 8-22 such stretches per 8 s record frozen (review14).  The same channel with a 0.2 N (200 LSB) 10
+    Hz line, held for 1 s (sample and hold), is still found: the hold ends with a jump of what the line moved."""
+    fs, rng = 2000.0, np.random.default_rng(seed)
+    t = np.arange(int(8 * fs)) / fs
+    slow = np.sin(2 * np.pi * t + rng.uniform(0, 6))
+    counts = np.round(0.45 + 0.1 * slow + 0.03 * rng.standard_normal(t.size))
+    printed = _round(1.2345 + 1e-4 * slow + 3e-5 * rng.standard_normal(t.size), 4)
+    for x in (counts, printed):
+        held = np.diff(np.flatnonzero(np.diff(x) != 0))
+        assert held.max() > 20 * MIN_SAMPLES and frozen_spans(x) == []   # levels held long, by the signal's nature
+    for x, step in ((counts, 1.0), (printed, 1e-3)):
+        moving = x + np.round(200 * np.sin(2 * np.pi * 10.3 * t + seed)) * step
+        moving[6000:8000] = moving[5999]
+        assert [(a, b, kind) for a, b, kind, _ in frozen_spans(moving)] == [(5999, 8000, "held")]
+
+
+def test_diagnose_warns_and_the_command_says_which_runs_were_left_out(tmp_path, capsys):
+    """``api.diagnose`` warns as ``api.fit`` does (review14: a library user was told nothing); ``rwadist diagnose``
+    prints that warning once on stderr and lists every stretch in its console, summary.json and report.md."""
+    import json
+
+    from rwadist.cli import main
+
+    data = write_steady(_freeze(_test(1)), tmp_path / "d")
+    assert main(["diagnose", str(data), "-o", str(tmp_path / "r")]) == 0
+    out, err = capsys.readouterr()
+    assert err.count("WARNING: a channel froze (a DAQ or amplifier dropout): Fz in 3 run(s), Tx in 1 run(s)") == 1
+    assert sum(line.startswith("  ! ") for line in out.splitlines()) == len(FROZEN) + 1
+    summary = json.loads((tmp_path / "r" / "summary.json").read_text())
+    assert [(r["run"], r["channel"]) for r in summary["data_quality"]] == [(i, c) for i, c, *_ in sorted(FROZEN)]
+    assert "Data quality" in (tmp_path / "r" / "report.md").read_text()

@@ -67,3 +67,34 @@ def test_a_torque_gain_under_a_load_cell_offset_is_read_on_the_recorded_channels
     (u,) = channel_gain(ctx, as_recorded(offset.apply(start)), lambda chans, hs, runs: (0.0, 0.0))
     assert set(u.channels) == {"Tx", "Ty"}
     assert u.parameters["amplitude_ratio"] == pytest.approx(1.10, rel=0.005)
+
+
+@pytest.mark.parametrize("r_mm", [(10.0, -5.0, 30.0), (30.0, -15.0, 30.0)])
+def test_a_lateral_load_cell_offset_without_a_gain_describes_none(r_mm):
+    """review14: read as recorded, a lateral offset puts r_y·Fz in Tx and −r_x·Fz in Ty, unequal, so it tilts the pair
+    on the axial lines' orders; two such orders (axial force lines of 0.4 µkg·m at h 3 and 4, the radial torque lines
+    there of 5 nkg·m², as weak as the lateral r × F: 2-12 nkg·m) must not read as a gain: a gain tilts every line.  The offset as the ``cross_coupling`` fit gives it
+    (within 0.1 mm), the data with no gain: nothing described, on the recorded channels (as diagnose reads them) and
+    on the corrected ones."""
+    from test_describe_offset_floor import LINES, NPERSEG, SPEEDS_RPM, lever_arm_test
+
+    from rwadist.diagnose.describe_gain import as_recorded, channel_gain
+    from rwadist.diagnose.engine import Context, initial_state
+    from rwadist.effects.cross_coupling_diagnose import CrossCoupling
+    from rwadist.model import Harmonic, WheelModel
+    from rwadist.spectra import compute_spectra
+
+    lines = LINES + [("axial_force", 3.0, 4e-7), ("radial_torque", 3.0, 5e-9),
+                     ("axial_force", 4.0, 4e-7), ("radial_torque", 4.0, 5e-9)]
+    r = np.array(r_mm) * 1e-3
+    test = lever_arm_test(lines, r, SPEEDS_RPM, 13)
+    ctx = Context(compute_spectra(test, nperseg=NPERSEG), test=test)
+    model = WheelModel(name="lateral offset, no gain")
+    for d, h, C in lines:
+        model.empirical[d].append(Harmonic(h=h, C=C))
+    start = initial_state(ctx, model)
+    offset = CrossCoupling.fit(ctx, start, ctx.runs)
+    np.testing.assert_allclose(offset.r, r, atol=1e-4)
+    state = offset.apply(start)
+    for read in (as_recorded(state), state):
+        assert channel_gain(ctx, read, lambda chans, hs, runs: (0.0, 0.0)) == []

@@ -122,8 +122,12 @@ def find_channel_copies(ctx, test=None) -> list:
     chans = tuple(c for c in ctx.channels if all(c in test.runs[r].signals for r in ctx.runs))
     if len(chans) < 2:
         return []
+    # a run with a channel that froze (Run.invalid) would make or break a copy's ratio: left out of the detection
+    usable = np.array([r for r in ctx.runs if all(test.runs[r].usable(c) for c in chans)], dtype=int)
+    if usable.size < MIN_RUNS:
+        return []
     # an instrument's copy is in every run: up to MAX_RUNS of them, spread over the speeds, tell
-    order = ctx.runs[np.argsort(ctx.omega[ctx.runs], kind="stable")]
+    order = usable[np.argsort(ctx.omega[usable], kind="stable")]
     runs = order[np.unique(np.linspace(0, order.size - 1, min(MAX_RUNS, order.size)).round().astype(int))]
     parts = [_run_points(test.runs[r], chans, ctx.sp.window) for r in runs]
     run_of = np.concatenate([np.full(p[0].size, r) for p, r in zip(parts, runs)])
