@@ -431,13 +431,13 @@ def cmd_diagnose(args) -> int:
 
         for line in quality_lines(diag.data_quality):
             print(f"  ! {line}")
-    if diag.speed.get("source") in ("data", "scaled"):
+    if diag.speed.get("source") in ("data", "scaled") or diag.speed.get("runs_off"):
         from .speed_whirl import speed_lines
 
         # how the speed was obtained was said when the sweep was read; the whirl's test (and any warning) follows;
-        # a steady test's speed column scaled by its 1x lines is said here in full
+        # a steady test's speed column scaled, or a run of it corrected, by its 1x lines is said here in full
         lines = speed_lines(diag.speed)
-        for line in lines if diag.speed["source"] == "scaled" else lines[1:]:
+        for line in lines if diag.speed["source"] != "data" else lines[1:]:
             print(f"  {line}")
     from .effects_text import diagnose_lines
 

@@ -222,8 +222,19 @@ def check_record(test) -> dict:
     rec["scaled"] = bool(off and not apart and nearer >= CONSISTENT)
     about = k if rec["scaled"] else 1.0
     rec["agreement_rel"] = round(float(np.sqrt(np.mean((pooled / about - 1.0) ** 2))), 7)
+    rec["runs_off"] = _runs_off(test, ratios, list(judged), about, float(1.4826 * np.median(np.abs(pooled / about - 1))))
+    if rec["runs_off"]:
+        # the agreement of the runs that keep the column's speed
+        off = {x["run"] for x in rec["runs_off"]}
+        kept = np.concatenate([np.delete(ratios[key], list(off)) for key in judged])
+        kept = kept[np.isfinite(kept)]
+        rec["agreement_rel"] = round(float(np.sqrt(np.mean((kept / about - 1.0) ** 2))), 7)
     names = ", ".join(LINES[key][1] for key in judged)
     each = "; ".join(f"{LINES[key][1]} {s[0]:.6g} in {s[3]} runs" for key, s in judged.items())
+    if rec["runs_off"]:
+        rec["text_runs"] = "; ".join(
+            f"run {x['run_name']}: the speed column reads {x['given_rpm']:.6g} rpm, its 1x lines ({x['lines']}) sit at "
+            f"{x['ratio']:.6g} of it: its speed taken as {x['speed_rpm']:.6g} rpm" for x in rec["runs_off"])
     if rec["scaled"]:
         rec["text"] = (f"speed column scaled by {k:.6g}: the 1x lines ({names}) sit at {k:.6g} of the "
                        f"given speed in {force[3]} of {spinning} spinning runs ({each}), spread "
@@ -236,12 +247,36 @@ def check_record(test) -> dict:
     return rec
 
 
+def _runs_off(test, ratios: dict, judged: list, about: float, spread: float) -> list:
+    """The runs whose own speed reads off: two 1× lines or more measured in the run (of ``judged``) agree with
+    each other (within :data:`AGREE` or :data:`SIGMAS` times ``spread``, the runs' scatter of r/k) at a ratio to
+    the speed applied (``about`` × given: ``ratio`` is to the given speed) off 1 beyond :data:`SCALE_FLOOR` and :data:`SIGMAS` × ``spread`` (a tach
+    glitch, a run's speed typed wrong: trial15's one run 1 % high, silent).  One line alone could be a fixed line
+    passing near 1×; two of the rotor's 1× lines at one ratio are the rotor's speed.  JSON-ready dicts."""
+    out = []
+    tol = max(SCALE_FLOOR, SIGMAS * spread)
+    for i, run in enumerate(test.runs):
+        r = np.array([ratios[key][i] for key in judged if np.isfinite(ratios[key][i])]) / about
+        if r.size < 2 or abs(float(np.median(r)) - 1.0) <= tol or np.ptp(r) > max(AGREE, SIGMAS * spread):
+            continue
+        k = float(np.median(r))
+        given = float(abs(run.speed)) * 30 / np.pi
+        out.append({"run": i, "run_name": run.name or str(i), "given_rpm": round(given, 6),
+                    "ratio": round(k * about, 7), "speed_rpm": round(given * about * k, 6),
+                    "lines": ", ".join(LINES[key][1] for key in judged if np.isfinite(ratios[key][i]))})
+    return out
+
+
 def checked(test) -> tuple:
     """(test, record): ``test`` with every run's speed multiplied by the scale its 1× lines give when
-    :func:`check_record` calls the column off (a copy; its meta is left alone), else ``test`` itself, untouched."""
+    :func:`check_record` calls the column off, and each run whose own 1× lines put it off (``runs_off``) at the
+    speed they give (a copy; its meta is left alone), else ``test`` itself, untouched."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         rec = check_record(test)
-    if not rec.get("scaled"):
+    scale = rec["scale"] if rec.get("scaled") else 1.0
+    each = {x["run"]: x["ratio"] for x in rec.get("runs_off", [])}
+    if scale == 1.0 and not each:
         return test, rec
-    return type(test)([replace(r, speed=r.speed * rec["scale"]) for r in test.runs], dict(test.meta or {})), rec
+    return type(test)([replace(r, speed=r.speed * each.get(i, scale)) for i, r in enumerate(test.runs)],
+                      dict(test.meta or {})), rec

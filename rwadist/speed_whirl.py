@@ -215,7 +215,8 @@ def speed_record(meta, check: dict | None = None) -> dict:
     give, ``check``: :func:`rwadist.speed_check.check_record`; with ``scale`` and a ``warning``), "tach" (a
     sweep's tach column) or "data" (with the speed scale of :meth:`rwadist.speed_scale.SpeedScale.to_meta`:
     method, ratios, the 1× line's evidence, agreement, the whirl's test, a warning when the speed is suspect).
-    A steady test's record holds ``check`` when the 1× lines were measured."""
+    A steady test's record holds ``check`` when the 1× lines were measured, and ``runs_off`` with a ``warning``
+    when single runs' speeds were taken from their own 1× lines (:func:`rwadist.speed_check.checked`)."""
     slicing = (meta or {}).get("slicing")
     if not isinstance(slicing, dict):
         out: dict = {"source": "measured", "method": "the runs' speeds as given (runs.csv speed_rpm)"}
@@ -229,6 +230,10 @@ def speed_record(meta, check: dict | None = None) -> dict:
                                "frequency in Hz is off)")}
         if check:
             out["check"] = check
+        if check and check.get("runs_off"):
+            out["runs_off"] = check["runs_off"]
+            out["warning"] = " ".join(filter(None, (out.get("warning"), (
+                f"{check['text_runs']} (a tach glitch or a speed typed wrong in that run: check its speed_rpm)"))))
         return out
     if slicing.get("speed_source") != "data":
         return {"source": "tach", "method": "each slice's mean of the sweep's speed (tach) column"}
@@ -249,7 +254,8 @@ def speed_lines(record: dict) -> list:
         return [f"speed: {record.get('method')}", f"warning: {record['warning']}"]
     if record.get("source") != "data":
         check = record.get("check") or {}
-        return [f"speed: {record.get('method')}"] + ([f"speed check: {check['text']}"] if check.get("text") else [])
+        return [f"speed: {record.get('method')}"] + ([f"speed check: {check['text']}"] if check.get("text") else []) \
+            + ([f"warning: {record['warning']}"] if record.get("warning") else [])
     agree = record.get("agreement_rel_rms")
     out = [str(record.get("method"))
            + (f"; ratios {', '.join(f'{h:.4g}' for h in record.get('ratios', []))}" if record.get("ratios") else "")

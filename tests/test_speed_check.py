@@ -11,6 +11,7 @@ h·Ω_true of a hard-mounted rotor (C·Ω², co-rotating radial vectors Fx = A c
 the generator's speeds, so the scale to find is 1/(the column's factor) in closed form.
 """
 import sys
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -186,3 +187,25 @@ def test_run_spectra_are_each_channels_padded_transform():
             if all(c in run.signals for c in lchans):
                 assert chk.run_line(run, lchans, f0, spec) == chk.run_line(run, lchans, f0)
     assert len(buffers) == 2
+
+
+@pytest.mark.parametrize("factor, run", [(1.01, 5), (0.97, 11), (1.003, 2)])
+def test_one_run_off_is_taken_at_its_own_lines_speed(factor, run):
+    """trial15: one run's speed column 1 % high (a tach glitch) was silent.  One run's column ``factor`` x the rotor's
+    speed, the others true: that run's three 1x lines sit at 1/factor (within 2e-5), its speed comes back to the
+    generator's, the others stay as given, the column is not scaled, and the record warns naming the run; with
+    true speeds no run is singled out."""
+    test = wheel_test(1.0)
+    runs = list(test.runs)
+    runs[run + 1] = replace(runs[run + 1], speed=runs[run + 1].speed * factor)
+    bad = SteadyTest(runs, {})
+    out, rec = chk.checked(bad)
+    assert not rec["scaled"] and [x["run"] for x in rec["runs_off"]] == [run + 1]
+    assert rec["runs_off"][0]["ratio"] == pytest.approx(1 / factor, abs=2e-5)
+    truth = np.r_[0.0, RPM * 2 * np.pi / 60]
+    np.testing.assert_allclose(out.speeds, truth, rtol=2e-5, atol=0)
+    assert rec["agreement_rel"] < 1e-4                                  # the runs kept agree as before
+    speed = sw.speed_record(out.meta, rec)
+    assert speed["source"] == "measured" and f"run run_{run:02d}.csv" in speed["warning"]
+    assert sw.speed_lines(speed)[-1].startswith("warning: run run_")
+    assert chk.check_record(test)["runs_off"] == []
