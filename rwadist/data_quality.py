@@ -29,8 +29,11 @@ from .units import CHANNELS, rad_s_to_rpm
 
 #: expected number of chance stretches as long as a flagged one, per run and channel
 FALSE_ALARM = 1e-9
-#: fewest equal samples ever called frozen
+#: fewest equal samples ever called frozen (or clipped)
 MIN_SAMPLES = 16
+#: a clipped extreme holds this many times the samples of any of the CLIP_LEVELS values next inside it
+CLIP_RATIO = 10.0
+CLIP_LEVELS = 4
 
 
 @dataclass(frozen=True)
@@ -54,11 +57,14 @@ class FrozenStretch:
     t0 : float
         Time of the run's first sample, s.
     kind : str
-        ``"held"`` (one value held), ``"zero"`` (exact zeros held) or ``"nan"`` (samples that are not numbers).
+        ``"held"`` (one value held), ``"zero"`` (exact zeros held), ``"nan"`` (samples that are not numbers) or
+        ``"clipped"`` (samples at the channel's limit, spread over ``start``..``stop``: see ``n_at``).
     value : float
         The value held (NaN for ``"nan"``), in the channel's unit (N, N·m).
     n_run : int
         Samples in the run.
+    n_at : int or None
+        For ``"clipped"``: how many samples sit at the limit (None: every sample of start..stop).
     """
 
     run: int
@@ -72,6 +78,7 @@ class FrozenStretch:
     kind: str
     value: float
     n_run: int
+    n_at: int | None = None
 
     @property
     def start_s(self) -> float:
@@ -89,11 +96,12 @@ class FrozenStretch:
         return (self.stop - self.start) / self.sample_rate
 
     def to_json(self) -> dict:
-        return {"type": "frozen_channel", "run": self.run, "run_name": self.run_name, "speed_rpm": self.speed_rpm,
-                "channel": self.channel, "kind": self.kind,
+        n = self.stop - self.start if self.n_at is None else self.n_at
+        return {"type": "clipped_channel" if self.kind == "clipped" else "frozen_channel", "run": self.run,
+                "run_name": self.run_name, "speed_rpm": self.speed_rpm, "channel": self.channel, "kind": self.kind,
                 "value": None if not np.isfinite(self.value) else float(self.value),
-                "start_s": self.start_s, "end_s": self.end_s, "n_samples": self.stop - self.start,
-                "fraction_of_run": (self.stop - self.start) / self.n_run, "action": "channel left out of this run"}
+                "start_s": self.start_s, "end_s": self.end_s, "n_samples": n,
+                "fraction_of_run": n / self.n_run, "action": "channel left out of this run"}
 
 
 def _stretches(mask: np.ndarray) -> np.ndarray:
@@ -164,6 +172,30 @@ def frozen_spans(x) -> list:
     return sorted(out)
 
 
+def clipped_levels(x) -> list:
+    """The limits a record is clipped at: [(first sample, one after the last, value, samples at it)].
+
+    A channel driven past its amplifier's or ADC's range holds the range's end wherever the signal exceeds it: many
+    samples at exactly one extreme value.  Unclipped, the samples pile up near a sinusoid's extremes too (its
+    arcsine density), but smoothly: printed to a step q, the top level holds at most about 2.4 times the level
+    below it (sqrt(q) against sqrt(2q) − sqrt(q)), and a record printed finely holds its maximum once.  An extreme
+    held by :data:`MIN_SAMPLES` samples or more and :data:`CLIP_RATIO` times the most any of the
+    :data:`CLIP_LEVELS` values next inside it holds is a limit (trial15: Fx at ±3 N, 237-9128 samples against 1).
+    """
+    x = np.asarray(x, dtype=float)
+    x = x[np.isfinite(x)] if not np.all(np.isfinite(x)) else x
+    if x.size < 2 * MIN_SAMPLES:
+        return []
+    levels, counts = np.unique(x, return_counts=True)
+    out = []
+    for end, inside in ((-1, slice(-1 - CLIP_LEVELS, -1)), (0, slice(1, 1 + CLIP_LEVELS))):
+        n, near = int(counts[end]), counts[inside]
+        if levels.size > 1 and n >= MIN_SAMPLES and n >= CLIP_RATIO * max(int(near.max()), 1):
+            at = np.flatnonzero(x == levels[end])
+            out.append((int(at[0]), int(at[-1]) + 1, float(levels[end]), n))
+    return out
+
+
 def find_frozen(test: SteadyTest) -> list:
     """Every frozen stretch of every run and channel of ``test``, as :class:`FrozenStretch` records (run order, then
     channel order, then time)."""
@@ -175,6 +207,9 @@ def find_frozen(test: SteadyTest) -> list:
             for a, b, kind, value in frozen_spans(run.signals[c]):
                 found.append(FrozenStretch(i, run.name, float(rad_s_to_rpm(run.speed)), c, a, b,
                                            float(run.sample_rate), float(run.t0), kind, value, run.n_samples))
+            for a, b, value, n in clipped_levels(run.signals[c]):
+                found.append(FrozenStretch(i, run.name, float(rad_s_to_rpm(run.speed)), c, a, b,
+                                           float(run.sample_rate), float(run.t0), "clipped", value, run.n_samples, n))
     return found
 
 
@@ -206,14 +241,24 @@ def quality_lines(records) -> list:
         return []
     lines = []
     for r in records:
+        run = f"{r['channel']} of run {r['run_name'] or r['run']} ({r['speed_rpm']:.1f} rpm)"
+        share = f"{r['n_samples']} samples, {100.0 * r['fraction_of_run']:.0f} % of the run"
+        if r["kind"] == "clipped":
+            lines.append(f"{run} clipped: {share} at its limit {r['value']:.6g} between {r['start_s']:.4f} s and "
+                         f"{r['end_s']:.4f} s; that channel of that run is left out")
+            continue
         what = {"held": f"held at {r['value']:.6g}", "zero": "held at exactly 0", "nan": "not a number"}[r["kind"]]
-        lines.append(f"{r['channel']} of run {r['run_name'] or r['run']} ({r['speed_rpm']:.1f} rpm) froze: {what} "
-                     f"from {r['start_s']:.4f} s to {r['end_s']:.4f} s ({r['n_samples']} samples, "
-                     f"{100.0 * r['fraction_of_run']:.0f} % of the run); that channel of that run is left out")
+        lines.append(f"{run} froze: {what} from {r['start_s']:.4f} s to {r['end_s']:.4f} s ({share}); that channel "
+                     "of that run is left out")
     pairs = {(r["run"], r["channel"]) for r in records}
-    lines.append(f"{len(pairs)} channel(s) of runs left out (a DAQ or amplifier dropout: one value held for far "
-                 "longer than noise at the printed resolution allows); check the cabling, amplifier and DAQ, "
-                 "and repeat those runs if that channel matters")
+    causes = [c for c, kinds in (("a DAQ or amplifier dropout: one value held for far longer than noise at the "
+                                  "printed resolution allows", {"held", "zero", "nan"}),
+                                 ("a channel past its amplifier's or ADC's range: clipped at one value",
+                                  {"clipped"})) if any(r["kind"] in kinds for r in records)]
+    todo = ("check the cabling, amplifier and DAQ" if "clipped" not in {r["kind"] for r in records} else
+            "check the cabling, amplifier and DAQ, and set the range above the largest load of the fastest run")
+    lines.append(f"{len(pairs)} channel(s) of runs left out ({'; '.join(causes)}); {todo}, and repeat those runs "
+                 "if that channel matters")
     return lines
 
 
@@ -224,5 +269,6 @@ def summary_line(records) -> str:
     for r in records:
         runs.setdefault(r["channel"], set()).add(r["run"])
     which = ", ".join(f"{c} in {len(runs[c])} run(s)" for c in CHANNELS if c in runs)
-    return (f"a channel froze (a DAQ or amplifier dropout): {which}; each is left out of those runs, every stretch "
-            "listed in data_quality")
+    what = ("froze (a DAQ or amplifier dropout)" if all(r["kind"] != "clipped" for r in records) else
+            "clipped (past its range)" if all(r["kind"] == "clipped" for r in records) else "froze or clipped")
+    return f"a channel {what}: {which}; each is left out of those runs, every stretch listed in data_quality"

@@ -10,7 +10,7 @@ import pytest
 
 from rwadist import api
 from rwadist.data import SteadyTest, read_steady, write_steady
-from rwadist.data_quality import MIN_SAMPLES, find_frozen, frozen_spans, quality_lines, screen
+from rwadist.data_quality import MIN_SAMPLES, clipped_levels, find_frozen, frozen_spans, quality_lines, screen
 from rwadist.empirical import fit_empirical
 from rwadist.errors import RwadistWarning
 from rwadist.spectra import compute_spectra
@@ -149,3 +149,30 @@ def test_diagnose_warns_and_the_command_says_which_runs_were_left_out(tmp_path, 
     summary = json.loads((tmp_path / "r" / "summary.json").read_text())
     assert [(r["run"], r["channel"]) for r in summary["data_quality"]] == [(i, c) for i, c, *_ in sorted(FROZEN)]
     assert "Data quality" in (tmp_path / "r" / "report.md").read_text()
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_channel_past_its_range_is_found_clipped_and_a_sinusoids_peaks_are_not(seed):
+    """trial15: Fx saturating at ±3 N in the fastest runs gave no data-quality record and 45-47 phantom fixed lines.
+    Three lines and noise clipped at 70 % of their peak: both limits found, each with exactly the samples numpy
+    counts past the limit.  The same record unclipped, and a single sinusoid printed %.4g and %.3g (whose top
+    level holds up to ~2.4x the level below it, the arcsine density's pile-up): nothing."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(20000) / 5000.0
+    x = sum(a * np.sin(2 * np.pi * f * t + rng.uniform(0, 6)) for a, f in ((2.0, 61.3), (0.5, 122.6), (0.3, 226.0)))
+    x = x + 0.02 * rng.standard_normal(t.size)
+    limit = 0.7 * min(x.max(), -x.min())
+    clipped = np.clip(x, -limit, limit)
+    found = clipped_levels(clipped)
+    assert sorted((v, n) for _, _, v, n in found) == [(-limit, int(np.sum(x <= -limit))), (limit, int(np.sum(x >= limit)))]
+    assert clipped_levels(x) == []
+    sine = 3.0 * np.sin(2 * np.pi * 61.3 * t + seed)
+    for digits in (4, 3):
+        assert clipped_levels(_round(sine, digits)) == [], digits
+    test = _test(seed)
+    runs = list(test.runs)
+    fx = runs[-1].signals["Fx"]
+    runs[-1] = replace(runs[-1], signals={**runs[-1].signals, "Fx": np.clip(fx, -0.5 * fx.max(), 0.5 * fx.max())})
+    screened, records = screen(SteadyTest(runs, {}))
+    assert {(s.run, s.channel, s.kind) for s in records} == {(len(runs) - 1, "Fx", "clipped")}
+    assert screened.runs[-1].invalid == {"Fx"} and "clipped" in quality_lines([s.to_json() for s in records])[0]
