@@ -186,6 +186,9 @@ def clipped_levels(x) -> list:
     x = x[np.isfinite(x)] if not np.all(np.isfinite(x)) else x
     if x.size < 2 * MIN_SAMPLES:
         return []
+    # most records hold their extremes a few times: nothing to sort
+    if np.count_nonzero(x == x.max()) < MIN_SAMPLES and np.count_nonzero(x == x.min()) < MIN_SAMPLES:
+        return []
     levels, counts = np.unique(x, return_counts=True)
     out = []
     for end, inside in ((-1, slice(-1 - CLIP_LEVELS, -1)), (0, slice(1, 1 + CLIP_LEVELS))):
