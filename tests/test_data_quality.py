@@ -10,7 +10,7 @@ import pytest
 
 from rwadist import api
 from rwadist.data import SteadyTest, read_steady, write_steady
-from rwadist.data_quality import find_frozen, quality_lines, screen
+from rwadist.data_quality import FALSE_ALARM, MIN_SAMPLES, find_frozen, frozen_spans, quality_lines, screen
 from rwadist.empirical import fit_empirical
 from rwadist.errors import RwadistWarning
 from rwadist.spectra import compute_spectra
@@ -111,3 +111,65 @@ def test_axial_amplitudes_after_screening_within_the_clean_scatter():
     err_before = max(abs(b[h] / c[h] - 1) for h in hs)
     assert err_after <= max(scatter, 0.01), (err_after, scatter)
     assert err_before > 2 * err_after, (err_before, err_after)
+
+
+def _spans_by_the_rule(x) -> list:
+    """The module docstring's rule written out sample by sample (a second implementation, loops only): every maximal
+    stretch of non-finite samples; the stretches of equal finite samples tested longest first, each against the
+    repeat chance ``p`` of all the others not yet flagged (one repeat and one change added), flagged while
+    (stretches − flagged) · p^(L − 2) < FALSE_ALARM and L >= MIN_SAMPLES."""
+    out, equal = [], []
+    i = 0
+    while i < len(x):
+        j = i + 1
+        if not np.isfinite(x[i]):
+            while j < len(x) and not np.isfinite(x[j]):
+                j += 1
+            out.append((i, j, "nan"))
+        else:
+            while j < len(x) and np.isfinite(x[j]) and x[j] == x[i]:
+                j += 1
+            if j - i >= 2:
+                equal.append((i, j))
+        i = j
+    order = sorted(range(len(equal)), key=lambda k: -(equal[k][1] - equal[k][0]))
+    flagged: set = set()
+    for k in order:
+        L = equal[k][1] - equal[k][0]
+        rest = [b - a for m, (a, b) in enumerate(equal) if m != k and m not in flagged]
+        p = (sum(n - 2 for n in rest) + 1.0) / (sum(n - 1 for n in rest) + 2.0)
+        if L < MIN_SAMPLES or (len(rest) + 1) * p ** (L - 2) >= FALSE_ALARM:
+            break
+        flagged.add(k)
+        a, b = equal[k]
+        out.append((a, b, "zero" if x[a] == 0.0 else "held"))
+    return sorted(out)
+
+
+def test_frozen_spans_as_the_rule_says_sample_by_sample():
+    """:func:`frozen_spans` (its first pass over the samples included) against the rule written out sample by sample,
+    on short records: white noise, noise printed with 1-2 decimals (chance repeats), held values and zeros of 1-60
+    samples, NaN and infinities, a record of equal neighbours scattered (MIN_SAMPLES - 1 of them and more, in no
+    stretch long enough) and the first pass's edge (exactly MIN_SAMPLES - 1 equal neighbours in one stretch)."""
+    rng = np.random.default_rng(37)
+    flagged = 0
+    for trial in range(3000):
+        n = int(rng.integers(0, 200))
+        x = rng.normal(size=n)
+        kind = trial % 6
+        if kind == 1:
+            x = np.round(x, int(rng.integers(1, 3)))
+        elif kind in (2, 3) and n > 2:
+            a = int(rng.integers(0, n - 1))
+            x[a:a + int(rng.integers(1, 61))] = x[a] if kind == 2 else 0.0
+        elif kind == 4 and n:
+            x[rng.integers(0, n, size=int(rng.integers(1, 4)))] = rng.choice([np.nan, np.inf, -np.inf])
+        elif kind == 5 and n > 2 * MIN_SAMPLES + 2:
+            pairs = rng.choice(np.arange(0, n - 1, 2), size=MIN_SAMPLES - 1 + trial % 3, replace=False)
+            x[pairs + 1] = x[pairs]
+            if trial % 4 == 1:
+                x[:MIN_SAMPLES] = 0.25          # the edge: MIN_SAMPLES - 1 equal neighbours in one stretch
+        got = [(a, b, kind) for a, b, kind, _ in frozen_spans(x)]
+        assert got == _spans_by_the_rule(x), trial
+        flagged += bool(got)
+    assert flagged > 500               # the rule does flag (held stretches, zeros, non-finite samples)
