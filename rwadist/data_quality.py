@@ -144,6 +144,13 @@ def frozen_spans(x) -> list:
         explain (module docstring): ``kind`` "zero" when the value held is 0, else "held".
     """
     x = np.asarray(x, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = np.sum(x)
+    if x.size >= 2 and np.isfinite(total) and np.count_nonzero(x[1:] == x[:-1]) < MIN_SAMPLES - 1:
+        # the first pass (most records): every sample finite (a finite sum: a NaN or an infinity makes it not) and
+        # fewer than MIN_SAMPLES - 1 equal neighbours in all, so no stretch of MIN_SAMPLES equal samples -- nothing
+        # the full test below could flag, in three passes over the samples instead of a dozen
+        return []
     finite = np.isfinite(x)
     out = [(int(a), int(b), "nan", float("nan")) for a, b in _stretches(~finite)]
     if x.size < 2:

@@ -10,7 +10,15 @@ import pytest
 
 from rwadist import api
 from rwadist.data import SteadyTest, read_steady, write_steady
-from rwadist.data_quality import MIN_SAMPLES, clipped_levels, find_frozen, frozen_spans, quality_lines, screen
+from rwadist.data_quality import (
+    FALSE_ALARM,
+    MIN_SAMPLES,
+    clipped_levels,
+    find_frozen,
+    frozen_spans,
+    quality_lines,
+    screen,
+)
 from rwadist.empirical import fit_empirical
 from rwadist.errors import RwadistWarning
 from rwadist.spectra import compute_spectra
@@ -176,3 +184,73 @@ def test_a_channel_past_its_range_is_found_clipped_and_a_sinusoids_peaks_are_not
     screened, records = screen(SteadyTest(runs, {}))
     assert {(s.run, s.channel, s.kind) for s in records} == {(len(runs) - 1, "Fx", "clipped")}
     assert screened.runs[-1].invalid == {"Fx"} and "clipped" in quality_lines([s.to_json() for s in records])[0]
+
+
+def _spans_by_the_rule(x) -> list:
+    """The module docstring's rule written out sample by sample (a second implementation, loops only): every maximal
+    stretch of non-finite samples; the stretches of equal finite samples tested longest first, each against the
+    repeat chance ``p`` of all the others not yet flagged (one repeat and one change added), flagged while
+    (stretches − flagged) · p^(L − 2) < FALSE_ALARM and L >= MIN_SAMPLES, unless it enters and leaves its value by
+    one printed step."""
+    out, equal = [], []
+    i = 0
+    while i < len(x):
+        j = i + 1
+        if not np.isfinite(x[i]):
+            while j < len(x) and not np.isfinite(x[j]):
+                j += 1
+            out.append((i, j, "nan"))
+        else:
+            while j < len(x) and np.isfinite(x[j]) and x[j] == x[i]:
+                j += 1
+            if j - i >= 2:
+                equal.append((i, j))
+        i = j
+    order = sorted(range(len(equal)), key=lambda k: -(equal[k][1] - equal[k][0]))
+    flagged: set = set()
+    for k in order:
+        L = equal[k][1] - equal[k][0]
+        rest = [b - a for m, (a, b) in enumerate(equal) if m != k and m not in flagged]
+        p = (sum(n - 2 for n in rest) + 1.0) / (sum(n - 1 for n in rest) + 2.0)
+        if L < MIN_SAMPLES or (len(rest) + 1) * p ** (L - 2) >= FALSE_ALARM:
+            break
+        a, b = equal[k]
+        # the channel at its printed resolution: every change at the stretch's ends (inside the record) within 1.5
+        # of the smallest change of the samples within L of it -- not flagged, and still a chance repeat
+        steps = [abs(x[i + 1] - x[i]) for i in range(max(0, a - L), min(len(x), b + L) - 1)
+                 if np.isfinite(x[i]) and np.isfinite(x[i + 1]) and x[i + 1] != x[i]]
+        ends = [abs(x[i] - x[i - 1]) for i in (a, b) if 1 <= i < len(x) and np.isfinite(x[i]) and np.isfinite(x[i - 1])]
+        if ends and steps and max(ends) <= 1.5 * min(steps):
+            continue
+        flagged.add(k)
+        out.append((a, b, "zero" if x[a] == 0.0 else "held"))
+    return sorted(out)
+
+
+def test_frozen_spans_as_the_rule_says_sample_by_sample():
+    """:func:`frozen_spans` (its first pass over the samples included) against the rule written out sample by sample,
+    on short records: white noise, noise printed with 1-2 decimals (chance repeats), held values and zeros of 1-60
+    samples, NaN and infinities, a record of equal neighbours scattered (MIN_SAMPLES - 1 of them and more, in no
+    stretch long enough) and the first pass's edge (exactly MIN_SAMPLES - 1 equal neighbours in one stretch)."""
+    rng = np.random.default_rng(37)
+    flagged = 0
+    for trial in range(3000):
+        n = int(rng.integers(0, 200))
+        x = rng.normal(size=n)
+        kind = trial % 6
+        if kind == 1:
+            x = np.round(x, int(rng.integers(1, 3)))
+        elif kind in (2, 3) and n > 2:
+            a = int(rng.integers(0, n - 1))
+            x[a:a + int(rng.integers(1, 61))] = x[a] if kind == 2 else 0.0
+        elif kind == 4 and n:
+            x[rng.integers(0, n, size=int(rng.integers(1, 4)))] = rng.choice([np.nan, np.inf, -np.inf])
+        elif kind == 5 and n > 2 * MIN_SAMPLES + 2:
+            pairs = rng.choice(np.arange(0, n - 1, 2), size=MIN_SAMPLES - 1 + trial % 3, replace=False)
+            x[pairs + 1] = x[pairs]
+            if trial % 4 == 1:
+                x[:MIN_SAMPLES] = 0.25          # the edge: MIN_SAMPLES - 1 equal neighbours in one stretch
+        got = [(a, b, kind) for a, b, kind, _ in frozen_spans(x)]
+        assert got == _spans_by_the_rule(x), trial
+        flagged += bool(got)
+    assert flagged > 500               # the rule does flag (held stretches, zeros, non-finite samples)
