@@ -232,7 +232,8 @@ def _judge_beside_stand(ctx, state, effect, stand, runs, chans, k_sigma, min_gai
 
 def _judge_with_offset(ctx, state, effect, offset, runs, chans, k_sigma, min_gain, iteration) -> Hypothesis:
     """Held-out evidence of ``effect`` (the wheel's suspension modes) read with the load-cell offset ``offset`` (a
-    ``cross_coupling``) it was located beside: ``effect`` and ``offset`` added to ``state`` against ``state`` as it is.
+    ``cross_coupling``) it was located beside: ``effect`` and ``offset`` added to ``state`` against the better of
+    ``state`` as it is and ``state`` with ``offset`` alone.
 
     The modes predict the torques at the bearing centre; a load cell whose reference sits below it reads T + r × F,
     whose r × F carries the forces' lines, amplified by the translation mode, into the torques, where the empirical
