@@ -63,6 +63,9 @@ class Context(Metric):
         #: the search may move the 'auto' base to the wheel's suspension modes fitted from the data (set by
         #: :func:`rwadist.diagnose.search.diagnose`, read by the ``suspension_modes`` family)
         self.base_switch = False
+        #: the wheel's modes may be judged with the load-cell offset they were located beside (set by
+        #: :func:`rwadist.diagnose.search._search_once`, read by :func:`rwadist.diagnose.search._judge`)
+        self.offset_pair = True
         self._corrected: dict = {}
         self.f = spectra.f
         self.df = spectra.df

@@ -192,7 +192,7 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
         beside = _judge_beside_stand(ctx, state, effect, stand, runs, chans, k_sigma, min_gain, iteration)
         if beside.passed:
             return beside
-    offset = getattr(effect, "offset_effect", lambda: None)()
+    offset = getattr(effect, "offset_effect", lambda: None)() if ctx.offset_pair else None
     if offset is not None:
         with_offset = _judge_with_offset(ctx, state, effect, offset, runs, chans, k_sigma, min_gain, iteration)
         if with_offset.passed:
@@ -232,7 +232,8 @@ def _judge_beside_stand(ctx, state, effect, stand, runs, chans, k_sigma, min_gai
 
 def _judge_with_offset(ctx, state, effect, offset, runs, chans, k_sigma, min_gain, iteration) -> Hypothesis:
     """Held-out evidence of ``effect`` (the wheel's suspension modes) read with the load-cell offset ``offset`` (a
-    ``cross_coupling``) it was located beside: ``effect`` and ``offset`` added to ``state`` against ``state`` as it is.
+    ``cross_coupling``) it was located beside: ``effect`` and ``offset`` added to ``state`` against the better of
+    ``state`` as it is and ``state`` with ``offset`` alone.
 
     The modes predict the torques at the bearing centre; a load cell whose reference sits below it reads T + r × F,
     whose r × F carries the forces' lines, amplified by the translation mode, into the torques, where the empirical
@@ -240,8 +241,19 @@ def _judge_with_offset(ctx, state, effect, offset, runs, chans, k_sigma, min_gai
     r_z = 30 mm: modes within 0.1 % rejected in every iteration; a 'wheel mode' and an amplitude law named instead).
     The pair is judged against the state without either, as one hypothesis of the test (a wheel with these modes on
     a load cell with this offset); the modes are taken, and the offset is left to the search, which names it
-    (``cross_coupling``, judged on its own) after them.  Same rule as :func:`_judge`."""
-    gain, frac, t, total = _evidence(ctx, state, effect.apply(state).plus(offset), runs, chans, None)
+    (``cross_coupling``, judged on its own) after them.  Same rule as :func:`_judge`.
+
+    The pair is judged against the better of the state as it is and the state with the offset alone (the one whose
+    held-out misplaced power is lower): r × F is a gain of the offset's own, and an offset that explains the runs
+    alone would otherwise carry any modes located beside it (review14: a hard-mounted wheel's fixture fitted as
+    modes beside a lever arm).  The modes must add their own gain beside the offset, as a wheel's modes beside a
+    fixture must beside the fixture (:func:`_judge_beside_stand`).  A search that names modes so judged and then no
+    offset is searched again without this path (:func:`_search`)."""
+    pair = effect.apply(state).plus(offset)
+    base = offset.apply(state)
+    if _evidence(ctx, state, base, runs, chans, None)[0] > 0:
+        state = base            # the offset alone explains the held-out runs better: the modes' share beside it
+    gain, frac, t, total = _evidence(ctx, state, pair, runs, chans, None)
     return Hypothesis(effect, gain / total, frac, float(t), bool(t > k_sigma and frac >= min_gain), iteration,
                       beside=offset)
 
@@ -437,12 +449,14 @@ def _no_worse(ctx, state, refit, beside=None) -> tuple[bool, State]:
     refit that runs off raises it by factors.  ``beside``: the test stand the hypothesis was judged beside
     (:func:`_judge_beside_stand`): the refit's own stand (else that one) is then in both states compared; or the
     load-cell offset the modes were judged with (:func:`_judge_with_offset`): the refit with its own offset (else that
-    one) is compared with ``state`` as it is, and the state returned holds the refit without the offset."""
+    one) is compared with the better of ``state`` as it is and ``state`` with that offset alone, and the state
+    returned holds the refit without the offset."""
     new = refit.apply(state)
     if getattr(beside, "kind", None) == "cross_coupling":
         # judged with the offset it was located beside (:func:`_judge_with_offset`): the refit with its own offset
         offset = getattr(refit, "offset_effect", lambda: None)() or beside
-        return ctx.error(new.plus(offset)) <= _state_error(ctx, state) * (1.0 + NO_WORSE_TOLERANCE), new
+        before = min(_state_error(ctx, state), ctx.error(offset.apply(state)))
+        return ctx.error(new.plus(offset)) <= before * (1.0 + NO_WORSE_TOLERANCE), new
     if beside is not None:
         stand = getattr(refit, "stand_effect", lambda channels: None)(ctx.channels) or beside
         return ctx.error(new.plus(stand)) <= ctx.error(stand.apply(state)) * (1.0 + NO_WORSE_TOLERANCE), new
@@ -544,16 +558,39 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     return best
 
 
-def _search(spectra: Spectra, model: WheelModel | None, k_sigma: float, min_gain: float, max_iterations: int,
-            channels, test, base: str, bearings, base_check=None, steps: dict | None = None) -> Diagnosis:
+def _search(*args, **kwargs) -> Diagnosis:
+    """:func:`diagnose` of its arguments (those of :func:`_search_once`), searched again without judging the wheel's
+    modes with a load-cell offset (:func:`_judge_with_offset`) when the modes were taken so and no offset was named
+    after them (:func:`_modes_without_their_offset`): their evidence was that of the pair, and the state kept the modes
+    alone."""
+    diag = _search_once(*args, **kwargs)
+    if _modes_without_their_offset(diag):
+        diag = _search_once(*args, **kwargs, offset_pair=False)
+    return diag
+
+
+def _modes_without_their_offset(diag: Diagnosis) -> bool:
+    """True when ``diag`` took an effect judged with a load-cell offset (:func:`_judge_with_offset`) and named no
+    ``cross_coupling``."""
+    taken = [h for h in diag.hypotheses if h.passed]
+    return (any(getattr(h.beside, "kind", None) == "cross_coupling" for h in taken)
+            and not any(getattr(h.effect, "kind", None) == "cross_coupling" for h in taken))
+
+
+def _search_once(spectra: Spectra, model: WheelModel | None, k_sigma: float, min_gain: float, max_iterations: int,
+                 channels, test, base: str, bearings, base_check=None, steps: dict | None = None,
+                 offset_pair: bool = True) -> Diagnosis:
     """:func:`diagnose` of its arguments, ``bearings`` resolved; ``steps`` (run index -> dB, or None): the common
-    factor of those runs taken out of the records the search reads (:func:`rwadist.diagnose.describe.start`)."""
+    factor of those runs taken out of the records the search reads (:func:`rwadist.diagnose.describe.start`);
+    ``offset_pair``: the wheel's modes that do not pass alone may be judged with the load-cell offset they were
+    located beside (:func:`_judge_with_offset`)."""
     given = model is not None
     # the open world (docs/diagnose.md, "Unexplained residual"): lines at one fixed frequency in every run and a
     # channel's copy of another's content taken out of the records everything after reads, the empirical fit of a
     # model not given included (no class explains them; left in, a class is forced onto them), described after
     opened = describe.start(Context(spectra, channels, test), steps)
     ctx = opened.ctx
+    ctx.offset_pair = offset_pair
     if model is None:
         model = fit_empirical(ctx.sp).model
     request = base
