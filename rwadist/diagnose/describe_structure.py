@@ -307,10 +307,12 @@ def _humps(excess_db: np.ndarray, k_lo: int, k_hi: int) -> list:
     return out
 
 
-def clean_floor(ctx, state, c: str) -> np.ndarray:
+def clean_floor(ctx, state, c: str, less_law: bool = False) -> np.ndarray:
     """The data's own noise floor of channel ``c`` per bin (n_f,): the median over the runs of the data's PSD at the
     bins where the model's lines stand below :data:`CLEAN_LINE_FRACTION` of its floor in that run (the noise alone,
-    clear of every line's leakage and of a misfit of it), NaN where fewer than a quarter of the runs (and 3) are."""
+    clear of every line's leakage and of a misfit of it), NaN where fewer than a quarter of the runs (and 3) are.
+    ``less_law``: each run's PSD less the state's floor law of the channel (``broadband_floor``) at that run's speed
+    first, so that what remains is the floor the law does not hold, whichever runs a bin is clean in."""
     from .reduce import column_nanmedian
 
     runs = ctx.runs
@@ -318,6 +320,8 @@ def clean_floor(ctx, state, c: str) -> np.ndarray:
     runs = runs[ok]
     D = ctx.data(state, c, runs)[runs]
     N = ctx.floor_psd(state, c, runs)
+    if less_law and c in state.floors:
+        D = D - (N - np.asarray(state.noise[c], dtype=float)[None, :])
     clean = (ctx.predict(state, c, runs) - N) < CLEAN_LINE_FRACTION * N
     count = clean.sum(0)
     med = column_nanmedian(np.where(clean, D, np.nan))
@@ -337,10 +341,10 @@ def broadband_hump(ctx, state, shares) -> list:
     half = max(int(HUMP_BASELINE_FRACTION * (k_hi - k_lo) / 2), 3 * HUMP_MIN_BINS)
     floors = {}
     for c in ctx.channels:
-        fl = clean_floor(ctx, state, c)
-        if c in state.floors:                   # a floor the broadband_floor class holds is explained
-            ref, w_ref, p = state.floors[c]
-            fl = fl - ref * (np.median(ctx.omega[ctx.runs]) / w_ref) ** p
+        # a floor the broadband_floor class holds is explained: taken out of each run at that run's speed before the
+        # median over the runs a bin is clean in (those are the fast runs at low frequencies, where the slow runs'
+        # lines stand: the law at the median speed taken out of their median left a hump of the law's growth)
+        fl = clean_floor(ctx, state, c, less_law=True)
         valid = np.isfinite(fl) & (fl > 0)
         if valid[k_lo:k_hi + 1].sum() < 4 * HUMP_MIN_BINS:
             continue
