@@ -37,6 +37,10 @@ Measured (1000 speeds, CPU min / median of 3 rounds; session 9, main and the bra
   --orders: an oracle pruning at 1e-9 keeps 5.09x the plain points; of the ripple's 143000 points 142993 sit at
     distinct frequencies (a ripple at 8 Hz meets the speed grid's lines only by chance), so no exact evaluation shares
     its solves: the 3x target needs a tolerance or a cheaper point for plain and ripple alike.
+  Session 15 (--no-peer, main 8853a00 and couple15 alternated, load 4.6-8.4; CPU min / median of 3 rounds): effects /
+    plain 15.5x / 15.3x and 13.8x / 14.6x on main, 15.3x / 14.1x and 13.2x / 14.1x on the branch (its floor grid and
+    ripple order ~0.1 s cheaper, within the noise); the plant's modal sums alone at the ripple's 143 000 points
+    (G, P, nothing else) 3.38x / 3.16x and 3.28x / 3.36x the whole plain sweep: above the target before any solve.
 """
 import os
 
