@@ -514,7 +514,7 @@ def _modal_poles(plant: Plant) -> np.ndarray:
     matrix is block-diagonal in the modes: the eigenvalues its decomposition gives, to rounding, without the O(n³)
     decomposition); the rigid and the critically or over-damped modes have real poles, which
     :func:`_pole_damping` leaves out."""
-    wn, zeta = (np.asarray(x, dtype=float) for x in plant.modal[:2])
+    wn, zeta = (np.asarray(x, dtype=float) for x in (plant.modal or ())[:2])
     osc = (wn > 0) & (zeta < 1)
     w, z = wn[osc], zeta[osc]
     lam = w * (-z + 1j * np.sqrt(1 - z * z))
