@@ -11,6 +11,8 @@ load average):
     (:func:`rwadist.coupling.floor_responses` on its default grid), with the work each does against the plain
     sweep's: line points (speed x line group; a ripple's sideband orders m = -K..K multiply the groups by 2K + 1,
     each at its own frequency, i.e. one coupled interface solve per point) and floor points (speed x grid frequency).
+  * the plant's modal sums G, P alone at the ripple's points (:func:`modal_sums`): the part of the ripple's work no
+    exact evaluation through the interface equation avoids (every point is at its own frequency).
 ``--no-peer``: leave python-control out (60-70 s CPU a round; the effects' baseline is the plain sweep).
 ``--dask``: the plain sweep on a 2-worker local dask cluster (processes, 1 thread each) as well.
 ``--orders``: the ripple's points an oracle pruning would keep at 1e-9 of every RMS (:func:`needed_points`, untimed): the
@@ -35,6 +37,10 @@ Measured (1000 speeds, CPU min / median of 3 rounds; session 9, main and the bra
   --orders: an oracle pruning at 1e-9 keeps 5.09x the plain points; of the ripple's 143000 points 142993 sit at
     distinct frequencies (a ripple at 8 Hz meets the speed grid's lines only by chance), so no exact evaluation shares
     its solves: the 3x target needs a tolerance or a cheaper point for plain and ripple alike.
+  Session 15 (--no-peer, main 8853a00 and couple15 alternated, load 4.6-8.4; CPU min / median of 3 rounds): effects /
+    plain 15.5x / 15.3x and 13.8x / 14.6x on main, 15.3x / 14.1x and 13.2x / 14.1x on the branch (its floor grid and
+    ripple order ~0.1 s cheaper, within the noise); the plant's modal sums alone at the ripple's 143 000 points
+    (G, P, nothing else) 3.38x / 3.16x and 3.28x / 3.36x the whole plain sweep: above the target before any solve.
 """
 import os
 
@@ -139,6 +145,23 @@ def distinct_points(lr, rtol=1e-12):
     return int(f.shape[0] + np.count_nonzero(np.diff(f, axis=1) > rtol * f[:, 1:]))
 
 
+def modal_sums(plant, wheels, speeds):
+    """A function that evaluates only the plant's modal sums G, P (:meth:`rwadist.coupling.Plant.frf`) at the points
+    the line sweep of ``wheels`` visits (their grouped lines' frequencies, speed blocks as the sweep's chunks): the
+    least per-point work of any evaluation through the interface equation (one G, P per distinct frequency)."""
+    from rwadist.coupling.line_groups import grouped_lines_blocked
+    from rwadist.coupling.performance import LINE_POINTS
+    w = wheels[0]
+    k = line_points(wheels, speeds)[1]
+    f = grouped_lines_blocked(w, speeds * w.speed_scale, k)[3]                 # (S, J) Hz, the wheels share them
+    step = max(1, LINE_POINTS // f.shape[1])
+
+    def run():
+        for i0 in range(0, f.shape[0], step):
+            plant.frf(f[i0:i0 + step])
+    return run
+
+
 def _timed(fn):
     t0, c0 = time.perf_counter(), time.process_time()
     out = fn()
@@ -154,7 +177,9 @@ def main(n_speeds=1000, repeats=3, dask=False, orders=False, peer=True):
           f"{len(lines)} lines ({hu.size} distinct h); {n_speeds} speeds -> {f_pts.size} frequency points per wheel; "
           f"load average {os.getloadavg()[0]:.2f} at start")
     ripple_only = without_floors(eff)
-    t: dict = {"python-control": [], "plain": [], "effects": [], "ripple alone": [], "floors alone": []}
+    t: dict = {"python-control": [], "plain": [], "effects": [], "ripple alone": [], "floors alone": [],
+               "ripple G, P only": []}
+    sums = modal_sums(plant, ripple_only, speeds)
     if not peer:
         del t["python-control"]
     plain = with_eff = floors = None
@@ -170,24 +195,29 @@ def main(n_speeds=1000, repeats=3, dask=False, orders=False, peer=True):
         t["ripple alone"].append(dt)
         dt, floors = _timed(lambda: cp.floor_responses(plant, eff, speeds))
         t["floors alone"].append(dt)
+        dt, _ = _timed(sums)
+        t["ripple G, P only"].append(dt)
     load = os.getloadavg()[0]
     st = {}
     for k, v in t.items():
         w, c = np.array(v).T
         st[k] = (w.min(), float(np.median(w)), c.min(), float(np.median(c)))
-        print(f"  {k:15s} wall min {w.min():7.2f} s  median {np.median(w):7.2f} s   CPU min {c.min():7.2f} s  "
+        print(f"  {k:16s} wall min {w.min():7.2f} s  median {np.median(w):7.2f} s   CPU min {c.min():7.2f} s  "
               f"median {np.median(c):7.2f} s")
     pts_plain, _ = line_points(wheels, speeds)
     pts_eff, k_rip = line_points(eff, speeds)
     work = {"effects": "   target <= 3x",
             "ripple alone": f"   line points {pts_eff / pts_plain:.1f}x ({pts_eff} vs {pts_plain}: orders +-{k_rip})",
-            "floors alone": f"   floor points {speeds.size * floors.f_hz.size} ({floors.f_hz.size} frequencies)"}
+            "floors alone": f"   floor points {speeds.size * floors.f_hz.size} ({floors.f_hz.size} frequencies)",
+            "ripple G, P only": "   the plant's modal sums alone at the ripple's points: an exact per-point "
+                                "evaluation's least work"}
     print(f"CPU per line point (min): plain {st['plain'][2] / pts_plain * 1e6:.1f} us ({pts_plain} points), ripple "
           f"alone {st['ripple alone'][2] / pts_eff * 1e6:.1f} us ({pts_eff} points)")
     for label, a, b in (("plain sweep / python-control FRF", "plain", "python-control"),
                         ("with effects / plain sweep", "effects", "plain"),
                         ("  ripple alone / plain sweep", "ripple alone", "plain"),
-                        ("  floors alone / plain sweep", "floors alone", "plain")):
+                        ("  floors alone / plain sweep", "floors alone", "plain"),
+                        ("  ripple G, P only / plain sweep", "ripple G, P only", "plain")):
         if b not in st:
             continue
         r = [st[a][i] / st[b][i] for i in range(4)]

@@ -114,8 +114,9 @@ def ripple_order(lines, omega, ripple: Ripple, tol: float = 1e-6) -> int:
     if not lines or w.size == 0:
         return 0
     dW = ripple.delta(w)
-    hs = np.array([ln.h for ln in lines])
-    ps = np.array([_line_exponent(ln) for ln in lines])
+    # the coefficients depend on a line only through its h and exponent: each distinct pair once
+    hp = np.unique(np.array([(ln.h, _line_exponent(ln)) for ln in lines], dtype=float), axis=0)
+    hs, ps = hp[:, 0], hp[:, 1]
     k_max = ripple_k_max(float(hs.max() * dW.max() / (2 * np.pi * ripple.f_hz)), float(ps.max()))
     eps = dW / np.where(w == 0.0, 1.0, w)
     eps = np.where(w == 0.0, np.where(dW > 0, 1e6, 0.0), eps)

@@ -461,7 +461,7 @@ def _line_sweep(plant: Plant, wheels, omega, practices, chunk: int, floor_f_hz, 
     ys = {p: [np.concatenate(x) for x in v] for p, v in y_parts.items()}
     floor = None
     if any(w.floors for w in wheels):
-        floor = floor_responses(plant, wheels, om, practices, f_hz=floor_f_hz)
+        floor = floor_responses(plant, wheels, om, practices, f_hz=floor_f_hz, rigid_form=rigid_form)
     return LineResponses(om, plant.perf_names, hs, fs, ys, coupled_loads, hms, offs, orders, floor)
 
 
@@ -509,17 +509,32 @@ def _floor_band(wheels):
 GRID_SPEEDS = 16
 
 
-def _pole_damping(plant: Plant, wheels, omega):
-    """(f Hz, ζ) of the oscillatory poles that shape the floor responses: the plant's ('i'), the plant with
-    the wheels as rigid masses ('ii'), the coupled system at up to GRID_SPEEDS of the speeds (evenly
-    picked; 'coupled', 'iii') and every wheel's blocked rotor modes at all the speeds ('iii')."""
+def _modal_poles(plant: Plant) -> np.ndarray:
+    """The poles (rad/s) of a modal plant's under-damped modes in closed form, λ = ω(−ζ ± j√(1 − ζ²)) (its state
+    matrix is block-diagonal in the modes: the eigenvalues its decomposition gives, to rounding, without the O(n³)
+    decomposition); the rigid and the critically or over-damped modes have real poles, which
+    :func:`_pole_damping` leaves out."""
+    wn, zeta = (np.asarray(x, dtype=float) for x in (plant.modal or ())[:2])
+    osc = (wn > 0) & (zeta < 1)
+    w, z = wn[osc], zeta[osc]
+    lam = w * (-z + 1j * np.sqrt(1 - z * z))
+    return np.concatenate([lam, lam.conj()])
+
+
+def _pole_damping(plant: Plant, wheels, omega, rigid_form=None):
+    """(f Hz, ζ) of the oscillatory poles that shape the floor responses: the plant's ('i'; a modal plant's in
+    closed form, :func:`_modal_poles`), the plant with the wheels as rigid masses ('ii'; the poles of ``rigid_form``,
+    practice 'ii''s closed form :class:`rwadist.coupling.rigid_practice.RigidPractice` of these wheels, when the
+    caller has it: the mass-loaded structure's flexible modes, its rigid modes having no oscillatory pole), the
+    coupled system at up to GRID_SPEEDS of the speeds (evenly picked; 'coupled', 'iii') and every wheel's blocked
+    rotor modes at all the speeds ('iii')."""
     from .assemble import Attachment, assemble
     from .components import rigid_mass, wheel
 
-    lams = [np.linalg.eigvals(np.asarray(plant.state_space().A))]
+    lams = [_modal_poles(plant) if plant.modal is not None else np.linalg.eigvals(np.asarray(plant.state_space().A))]
     rig = [Attachment(rigid_mass(wheel_rigid_mass_matrix(w.params, w.housing_mass, w.housing_inertia)), w.mount)
            for w in wheels]
-    lams.append(np.linalg.eigvals(np.asarray(assemble(plant, rig).sys.A)))
+    lams.append(rigid_form.lam if rigid_form is not None else np.linalg.eigvals(np.asarray(assemble(plant, rig).sys.A)))
     om = np.unique(np.atleast_1d(omega))
     pick = om[np.unique(np.linspace(0, om.size - 1, min(om.size, GRID_SPEEDS)).round().astype(int))]
     for o in pick:
@@ -540,7 +555,7 @@ MIN_FLOOR_ZETA = 1e-4
 
 
 def floor_grid(plant: Plant, wheels, omega, points_per_halfwidth: float = 2.0, per_decade: int = 100,
-               max_points: int = 200_000) -> np.ndarray:
+               max_points: int = 200_000, rigid_form=None) -> np.ndarray:
     """Default frequency grid (Hz) for :func:`floor_responses`.
 
     Band: from the lowest to the highest frequency where any wheel's floor is non-zero (a band starting at
@@ -557,13 +572,14 @@ def floor_grid(plant: Plant, wheels, omega, points_per_halfwidth: float = 2.0, p
     coupled 8-mode plant with two wheels (vs a grid 4× finer) at the default 2 points per half-width (tests).
     Every floor knot inside the band is a grid point (the floors are piecewise linear between knots).
     CouplingError when a pole near the band has ζ < 1e-4 (infinite or unresolvable mean square) or the
-    grid would exceed ``max_points``."""
+    grid would exceed ``max_points``.  ``rigid_form``: practice 'ii''s closed form for these wheels when the caller
+    has it (:func:`rwadist.coupling.rigid_practice.rigid_practice`), whose poles are then not recomputed."""
     wheels = list(wheels)
     band = _floor_band(wheels)
     if band is None:
         raise CouplingError("no wheel has a non-zero broadband floor")
     lo, hi = band
-    f, zeta = _pole_damping(plant, wheels, omega)
+    f, zeta = _pole_damping(plant, wheels, omega, rigid_form)
     near = (f >= lo / 2) & (f <= 2 * hi)
     zmin = float(np.min(zeta[near])) if near.any() else 1.0
     if zmin < MIN_FLOOR_ZETA:
@@ -602,7 +618,7 @@ def _speed_free_psd(A, gains, shapes, col) -> np.ndarray:
 
 
 def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
-                    chunk_points: int = 20000) -> FloorResponses:
+                    chunk_points: int = 20000, rigid_form=None) -> FloorResponses:
     """The wheels' broadband floors through the plant for each practice at sweep speeds ``omega`` (rad/s).
 
     A floor is a blocked load PSD S_c(f, Ω) on channel c of wheel k (:class:`Floor`, Ω = sweep speed ×
@@ -613,7 +629,8 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
     'iii' Mt_kᵀ B_k e_c in the coupled solve; y = P u.  Several floors on one channel add.
 
     f_hz : frequency grid, Hz (increasing, > 0; default :func:`floor_grid`, which resolves the lightly
-    damped plant and wheel modes).  chunk_points : speeds × frequencies evaluated at once (memory).
+    damped plant and wheel modes).  chunk_points : speeds × frequencies evaluated at once (memory).  rigid_form :
+    practice 'ii''s closed form for these wheels, when the caller has it (passed to :func:`floor_grid`).
     Returns :class:`FloorResponses` (mean square = trapezoid over f_hz)."""
     wheels = list(wheels)
     practices = tuple(practices)
@@ -623,7 +640,7 @@ def floor_responses(plant: Plant, wheels, omega, practices=PRACTICES, f_hz=None,
     if not cols:
         raise CouplingError("no wheel has a broadband floor")
     if f_hz is None:
-        f = floor_grid(plant, wheels, om)
+        f = floor_grid(plant, wheels, om, rigid_form=rigid_form)
     else:
         f = np.asarray(f_hz, dtype=float).ravel()
         if f.size < 2 or not np.all(np.isfinite(f)) or f[0] <= 0 or np.any(np.diff(f) <= 0):
