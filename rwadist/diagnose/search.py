@@ -565,7 +565,7 @@ def _search(*args, **kwargs) -> Diagnosis:
     alone."""
     diag = _search_once(*args, **kwargs)
     if _modes_without_their_offset(diag):
-        diag = _search_once(*args, **kwargs, offset_pair=False)
+        diag = _search_once(*args, **{**kwargs, "offset_pair": False})
     return diag
 
 
