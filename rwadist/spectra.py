@@ -285,47 +285,6 @@ def welch_dof(n_segments: int, overlap: float = 0.5) -> float:
     return 2.0 * k / (1.0 + 2.0 * rho**2 * (k - 1) / k)
 
 
-def bin_correlations(window: str, nperseg: int, lags: int) -> np.ndarray:
-    """ρ_l (l = 0 … lags-1, complex): the correlation of one segment's DFT at bins k and k + l for white noise,
-    Σ w_n² e^{−2πj l n/N}/Σ w_n² (periodic Hann: 1, −2/3, 1/6, 0, ...).  For complex Gaussian X, Y,
-    cov(|X|², |Y|²) = |cov(X, Y)|²: the periodogram's bins correlate by |ρ_l|² (Hann: 4/9, 1/36).  Away from 0 Hz
-    and the Nyquist frequency (the pseudo-covariance term is negligible there)."""
-    w2 = signal.get_window(window, nperseg) ** 2
-    n = np.arange(nperseg)
-    return (np.exp(-2j * np.pi * np.arange(lags)[:, None] * n[None, :] / nperseg) @ w2) / w2.sum()
-
-
-def band_mean_median_ratio(keep: np.ndarray, dof, rho: np.ndarray) -> np.ndarray:
-    """median/mean of the mean of a band's kept Welch bins of white noise (…), 1.0 where no bin is kept.
-
-    keep : (..., B) bool, the band's bins used (B ≤ 12).  dof : the Welch estimate's dof per bin (:func:`welch_dof`),
-    broadcastable to ``keep.shape[:-1]``.  rho : the DFT bins' correlations ρ_l (:func:`bin_correlations`, B lags).
-    The kept bins' sum is a quadratic form of Gaussians: with M the kept bins' correlation matrix (ρ_|i−j|) and
-    K = ν/2 independent segments' worth of averaging, the mean of n kept bins has the relative cumulants
-    κ₂ = 2·tr(M²)/(ν n²), κ₃ = 8·tr(M³)/(ν² n³) (one bin: those of chi²(ν)/ν).  Pearson's three-moment
-    approximation a + b·chi²(d) with d = 8κ₂³/κ₃² (the same skewness) gives median/mean
-    = 1 + κ₃/(4κ₂)·(median(chi²(d)) − d); for one bin, median(chi²(ν))/ν.  A two-moment (Satterthwaite) chi²
-    puts the median ~15 % of its shortfall too high: the correlated bins' sum is more skewed
-    (tests/test_noise_estimate_median.py checks both against scipy's Welch estimate of white noise)."""
-    keep = np.asarray(keep, dtype=bool)
-    b = keep.shape[-1]
-    pats = (np.arange(1 << b)[:, None] >> np.arange(b)[None, :]) & 1
-    R = rho[np.abs(np.subtract.outer(np.arange(b), np.arange(b)))]
-    M = pats[:, :, None] * R[None] * pats[:, None, :]                      # (2^B, B, B) kept bins' correlations
-    M2 = M @ M
-    n_p = pats.sum(1).astype(float)
-    tr2 = np.real(np.trace(M2, axis1=1, axis2=2))
-    tr3 = np.real(np.trace(M2 @ M, axis1=1, axis2=2))
-    idx = np.sum(keep * (1 << np.arange(b)), axis=-1)
-    n, t2, t3 = n_p[idx], tr2[idx], tr3[idx]
-    nu = np.broadcast_to(np.asarray(dof, dtype=float), idx.shape)
-    some = n > 0
-    k2 = np.where(some, 2.0 * t2 / (nu * np.maximum(n, 1) ** 2), 1.0)
-    k3 = np.where(some, 8.0 * t3 / (nu**2 * np.maximum(n, 1) ** 3), 1.0)
-    d = 8.0 * k2**3 / k3**2
-    return np.where(some, 1.0 + k3 / (4.0 * k2) * (stats.chi2.median(d) - d), 1.0)
-
-
 def find_lines(psd_row: np.ndarray, f: np.ndarray, floor_row: np.ndarray, threshold: float,
                f_max: float | None = None, f_min: float = 0.0):
     """Significant narrow peaks of one PSD: (frequency Hz refined, peak index).

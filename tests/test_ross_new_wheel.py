@@ -131,18 +131,12 @@ def test_new_wheel_on_a_ross_stand_between_its_modes_gives_the_coupled_modes_and
             assert np.sum(np.abs(modes / f - 1) < 5e-4) == 2, (row["speed_rpm"], f, modes)
 
     doc, model, _ = _diagnosed("ross_new_wheel_fixture120.json", tmp_path, capsys)
-    kinds = [e["kind"] for e in model["effects"]]
-    assert sorted(set(kinds)) == ["fixed_resonance", "suspension_modes"], kinds
+    kinds = sorted(e["kind"] for e in model["effects"])
+    assert kinds == ["fixed_resonance", "suspension_modes"], kinds
     stand = next(e for e in model["effects"] if e["kind"] == "fixed_resonance")
     assert stand["role"] == "test_stand"
     assert stand["f_Hz"] == pytest.approx(stand_t, rel=0.01)
-    rest = np.asarray(next(c for c in doc["campbell"] if c["speed_rpm"] < 10)["modes_hz"])
-    # any further resonance is a mode of the structure, ROSS's own at rest (run_modal): with the instrument noise read
-    # right (the median over the runs, not a mean lifted near 110-140 Hz by the runs whose lines cross the stand) the
-    # search also names the stand's rocking pair, 129.0 Hz at rest in ROSS (126-137 Hz with speed), on the radial
-    # force (129.01 Hz, ζ 0.13: one fixed resonance for a pair moving with speed)
-    for e in [e for e in model["effects"] if e["kind"] == "fixed_resonance"][1:]:
-        assert np.min(np.abs(rest / e["f_Hz"] - 1)) < 0.005, (e["f_Hz"], rest)
     modes = next(e for e in model["effects"] if e["kind"] == "suspension_modes")
+    rest = np.asarray(next(c for c in doc["campbell"] if c["speed_rpm"] < 10)["modes_hz"])
     assert modes["radial_translation_Hz"] == pytest.approx(wheel_t, rel=0.005)
     assert modes["rocking_Hz"] == pytest.approx(rest[0], rel=0.005)       # the wheel's rocking pair, lowest at rest

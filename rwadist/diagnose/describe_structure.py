@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..units import CHANNEL_DIRECTION, DIRECTION_CHANNELS, RAD_S_TO_RPM
+from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .constants import LINE_HALF
 from .unexplained import Unexplained
 
@@ -307,13 +307,10 @@ def _humps(excess_db: np.ndarray, k_lo: int, k_hi: int) -> list:
     return out
 
 
-def clean_floor(ctx, state, c: str, less_law: bool = False) -> np.ndarray:
+def clean_floor(ctx, state, c: str) -> np.ndarray:
     """The data's own noise floor of channel ``c`` per bin (n_f,): the median over the runs of the data's PSD at the
     bins where the model's lines stand below :data:`CLEAN_LINE_FRACTION` of its floor in that run (the noise alone,
-    clear of every line's leakage and of a misfit of it), NaN where fewer than a quarter of the runs (and 3) are.
-    ``less_law``: less the median over the same clean runs of the state's floor law of the channel
-    (``broadband_floor``; the law at their median speed), so that what remains is the floor the law does not hold,
-    whichever runs a bin is clean in."""
+    clear of every line's leakage and of a misfit of it), NaN where fewer than a quarter of the runs (and 3) are."""
     from .reduce import column_nanmedian
 
     runs = ctx.runs
@@ -324,10 +321,6 @@ def clean_floor(ctx, state, c: str, less_law: bool = False) -> np.ndarray:
     clean = (ctx.predict(state, c, runs) - N) < CLEAN_LINE_FRACTION * N
     count = clean.sum(0)
     med = column_nanmedian(np.where(clean, D, np.nan))
-    if less_law and c in state.floors:
-        # the law's median over the same clean runs (it grows with speed: the law at their median speed)
-        law = N - np.asarray(state.noise[c], dtype=float)[None, :]
-        med = med - column_nanmedian(np.where(clean, law, np.nan))
     return np.where(count >= max(3, runs.size // 4), med, np.nan)
 
 
@@ -344,10 +337,10 @@ def broadband_hump(ctx, state, shares) -> list:
     half = max(int(HUMP_BASELINE_FRACTION * (k_hi - k_lo) / 2), 3 * HUMP_MIN_BINS)
     floors = {}
     for c in ctx.channels:
-        # a floor the broadband_floor class holds is explained: the law's median over the runs a bin is clean in taken
-        # out of theirs (those are the fast runs at low frequencies, where the slow runs' lines stand, and the slow
-        # ones high up: the law at the median speed of every run left a hump of the law's growth at low frequencies)
-        fl = clean_floor(ctx, state, c, less_law=True)
+        fl = clean_floor(ctx, state, c)
+        if c in state.floors:                   # a floor the broadband_floor class holds is explained
+            ref, w_ref, p = state.floors[c]
+            fl = fl - ref * (np.median(ctx.omega[ctx.runs]) / w_ref) ** p
         valid = np.isfinite(fl) & (fl > 0)
         if valid[k_lo:k_hi + 1].sum() < 4 * HUMP_MIN_BINS:
             continue
@@ -365,7 +358,7 @@ def broadband_hump(ctx, state, shares) -> list:
         k0, k1 = min(x[1] for x in items), max(x[2] for x in items)
         peak = max(items, key=lambda x: x[4])
         f0, f1, fp = ctx.f[k0], ctx.f[k1], ctx.f[peak[3]]
-        if _at_a_fitted_resonance(ctx, state, fp, chans) or _at_a_wheel_mode(ctx, state, fp, chans):
+        if _at_a_fitted_resonance(ctx, state, fp, chans):
             continue
         share, level = shares(chans, f0, f1)
         rpm = ctx.omega[ctx.runs] * RAD_S_TO_RPM
@@ -398,28 +391,6 @@ def _at_a_fitted_resonance(ctx, state, f_peak: float, chans) -> bool:
 
     for f_r, zeta, _, on, *_ in state.resonances:        # (f_r, ζ, g, channels[, gain above])
         if set(on) & set(chans) and abs(f_peak - f_r) <= RESONANCE_HALF_WIDTHS * zeta * f_r + BAND_BINS * ctx.df:
-            return True
-    return False
-
-
-def _at_a_wheel_mode(ctx, state, f_peak: float, chans) -> bool:
-    """True when one of ``chans`` holds a floor law (``broadband_floor``: a noise-like load of the rotor) and the wheel's
-    fitted mode of its direction that stays at one frequency (radial translation, axial: :data:`DIRECTION_MODE`) peaks
-    within :data:`RESONANCE_HALF_WIDTHS` ζ·f (and a band) of ``f_peak``: the rotor's floor reaches the load cell
-    through that mode as its lines do, and the law (one level per band) does not shape it (family wheel 0: a floor
-    Ω^3 on Fx Fy Fz, humps at 288-325 Hz in Fy and 120-154 Hz in Fz, its 310 Hz translation and 140 Hz axial mode)."""
-    from .constants import BAND_BINS
-
-    modes = next((e for e in state.effects if getattr(e, "kind", "") == "suspension_modes"), None)
-    if modes is None:
-        return False
-    for c in chans:
-        name = DIRECTION_MODE.get(CHANNEL_DIRECTION.get(c, ""))
-        if c not in state.floors or name is None:
-            continue
-        f_m, zeta = float(modes.f0_Hz.get(name, np.nan)), float(modes.zeta.get(name, np.nan))
-        if np.isfinite(f_m) and np.isfinite(zeta) and \
-                abs(f_peak - f_m) <= RESONANCE_HALF_WIDTHS * zeta * f_m + BAND_BINS * ctx.df:
             return True
     return False
 

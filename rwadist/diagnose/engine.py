@@ -13,7 +13,7 @@ import numpy as np
 from ..empirical import block_floor
 from ..model import WheelModel
 from ..resonance import resonance
-from ..spectra import Spectra, band_mean_median_ratio, bin_correlations, welch_dof
+from ..spectra import Spectra, welch_dof
 from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
 from . import smear
 from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, NOISE_Z, TORQUE_CHANNELS
@@ -669,26 +669,10 @@ class Context(Metric):
         vals = D[:, lo:lo + n].reshape(runs.size, self.n_bands, BAND_BINS)
         cnt = keep.sum(-1)
         out = (np.where(cnt > 0, bin_sums(vals * keep) / np.maximum(cnt, 1), 0.0), cnt.astype(float))
-        # each band mean's median over its mean for white noise, from the bins it kept (their Welch dof, the
-        # window's bin correlations): what noise_estimate divides the band means by before their median over runs
-        if "bin_rho" not in self._memo:
-            self._memo["bin_rho"] = bin_correlations(self.sp.window, self.sp.nperseg, BAND_BINS)
-        run_dof = np.array([welch_dof(int(m)) for m in self.sp.n_segments[runs]])
-        ratio = band_mean_median_ratio(keep, run_dof[:, None], self._memo["bin_rho"])
-        for a in out + (ratio,):
+        for a in out:
             a.flags.writeable = False
         state._cache[key] = out
-        state._cache[("offline_band_median_ratio",) + key[1:]] = ratio
         return out
-
-    def offline_band_median_ratio(self, state: State, c: str, runs: np.ndarray) -> np.ndarray:
-        """median/mean (n_runs, n_bands) of each of :meth:`offline_bands`' band means were the data white noise
-        (1.0 where a band kept no bin): :func:`rwadist.spectra.band_mean_median_ratio` of its kept bins."""
-        key = ("offline_band_median_ratio", c, runs.tobytes())
-        if key not in state._cache:
-            state._cache.pop(("offline_bands", c, runs.tobytes()), None)
-            self.offline_bands(state, c, runs)
-        return state._cache[key]
 
     def measure_line(self, state: State, c: str, h: float, runs: np.ndarray, skip=None):
         """Amplitude (unit) of a line h in the data of ``runs`` less everything else the state
@@ -757,10 +741,10 @@ class Context(Metric):
 
 
 def initial_state(ctx: Context, model: WheelModel, ext_params=None) -> State:
-    """The model with a speed-independent instrument noise per channel (:func:`noise_estimate`): the median over runs
-    of the off-line band means (:meth:`Context.offline_bands`), each scaled from its median to its mean, interpolated
-    between the centres of the bands with a positive level (the median block floor of the data outside them).
-    ``ext_params``: the :class:`rwadist.extended.ExtendedParams` of the extended base, or None (empirical base)."""
+    """The model with a speed-independent instrument noise per channel: the off-line band means
+    (:meth:`Context.offline_bands`) averaged over every run, interpolated between the centres of the
+    bands with a positive mean (the median block floor of the data outside them).  ``ext_params``:
+    the :class:`rwadist.extended.ExtendedParams` of the extended base, or None (empirical base)."""
     rough = {c: column_nanmedian(ctx.floor[c][ctx.runs]) for c in ctx.channels}
     state = State(copy.deepcopy(model), rough, ext=ext_params)
     return State(state.model, noise_estimate(ctx, state), ext=ext_params)
@@ -769,32 +753,19 @@ def initial_state(ctx: Context, model: WheelModel, ext_params=None) -> State:
 def noise_estimate(ctx: Context, state: State) -> dict:
     """Instrument noise per channel (unit²/Hz on the grid) as :func:`initial_state` estimates it, the
     model's lines (as ``state`` predicts them, smear included) masked out; ``state.noise`` is the
-    fallback outside the bands.
-
-    Per band, the median over the runs of the off-line band means, each first divided by its median/mean ratio for
-    white noise (:meth:`Context.offline_band_median_ratio`, from the bins it kept): each divided one has median σ²
-    (the PSD), and so has the median over independent runs whatever their bins and dof.  The majority of
-    the runs sets the noise: a mean over the runs let a few runs' misfit (the Hann skirts of a line a fixture lifts in
-    the top runs, a channel that drops out in some runs, a line the model over-predicts) move every run's floor by
-    5-28 dB (trial14 finding 5, trial13 finding 8)."""
+    fallback outside the bands."""
     noise = {}
     fc = ctx.band_centres()
     for c in ctx.channels:
         ok = ctx.runs[np.isfinite(ctx.sp.psd[c][ctx.runs, 0])]
         y, cnt = ctx.offline_bands(state, c, ok)
-        ratio = ctx.offline_band_median_ratio(state, c, ok)
-        seen = cnt > 0
-        level = np.full(cnt.shape[1], np.nan)
-        have = seen.any(0)
-        if have.any():
-            z = np.where(seen, y / ratio, np.nan)
-            level[have] = np.nanmedian(z[:, have], axis=0)
-        # a band whose level is not positive (the model's line skirts exceed the data there: coherent lines
+        mean = np.sum(y * cnt, 0) / np.maximum(cnt.sum(0), 1)
+        # a band whose mean is not positive (the model's line skirts exceed the data there: coherent lines
         # closer than the kernel beat in the Welch estimate) says nothing about the noise: interpolated over
-        good = have & (level > 0)
+        good = (cnt.sum(0) > 0) & (mean > 0)
         n = np.array(state.noise[c], dtype=float)
         band = (ctx.f >= fc[0]) & (ctx.f <= fc[-1])
         if good.sum() >= 2:
-            n[band] = np.interp(ctx.f[band], fc[good], level[good])
+            n[band] = np.interp(ctx.f[band], fc[good], mean[good])
         noise[c] = n
     return noise

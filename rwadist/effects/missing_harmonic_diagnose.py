@@ -47,9 +47,6 @@ WELCH_LOBE_BINS = 2.0
 #: the 1.98 line beside it), while a missing line of its own is as strong as its neighbours (h 2.73 at 1.7 × the 2.96
 #: line, 1.5 Welch bins from it at 2048 samples, measured to 0.6 %).
 LOBE_MIN_RATIO = 0.2
-#: Ridges read (strongest first) to find a direction's Welch-route candidates among: the ridges that are the model's own
-#: lines (their misfit) are passed over, up to this many in all.
-RIDGE_POOL = 12
 #: Grid of the record spectrum, record bins: the Hann-windowed record zero-padded 4× (a line between grid points
 #: loses at most 0.1 dB).
 RECORD_GRID_BINS = 0.25
@@ -449,34 +446,19 @@ class MissingHarmonic:
         ratios = sweep_ratios(ctx.test.meta if ctx.test is not None else None)
 
         def welch(d, chans) -> list:
-            # the strongest max_per_direction ridges that are not the model's own lines: a ridge at a model line
-            # (within 0.03) or fitted inside its lobe as its misfit takes no place.  The ridge score counts every
-            # residual above 20x the noise alike, so a strong line's misfit ridges score as a missing line's do
-            # wherever the noise is estimated right (short records: three misfit ridges of the 4.42 line beside the
-            # modes took the three places, and the merged 5.37/5.57 pair's ridge was never fitted)
             found: list[MissingHarmonic] = []
-            used = 0
-            for h in ridge_peaks(ctx, state, chans, runs, RIDGE_POOL):
-                if used >= max_per_direction:
-                    break
+            for h in ridge_peaks(ctx, state, chans, runs, max_per_direction):
                 if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
                     continue
-                own = True
                 # on a sweep whose speed came from the data, the wheel's lines of the speed scale's ratios within the
                 # ridge's lobe (a blend of two close lines, a smeared line's ridge beside itself), else the ridge's h
                 for h in ratios_near(refine_h(ctx, state, chans, runs, h), ratios, lobe):
-                    if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
-                        continue
-                    if any(abs(h - x.h) < 0.005 for x in found):
-                        own = False
+                    if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)) or \
+                            any(abs(h - x.h) < 0.005 for x in found):
                         continue
                     e = MissingHarmonic.fit(ctx, state, d, h, runs)
-                    if e is not None and e.C > 0 and misfit(e):
-                        continue
-                    own = False
-                    if e is not None and e.C > 0:
+                    if e is not None and e.C > 0 and not misfit(e):
                         found.append(e)
-                used += not own
             return found
 
         # each direction's lines from its own channels alone (Context.reuse): the Welch route's first, then the record
