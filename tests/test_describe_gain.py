@@ -38,6 +38,24 @@ def test_a_channel_gain_is_described_with_its_ratio(channel, partner, gain):
     assert [e["kind"] for e in d.summary()["effects"]] == ["suspension_modes"]
 
 
+def _lines_and_fitted_offset(test, lines):
+    """(context, the state holding the wheel's true ``lines``, the load-cell offset the ``cross_coupling`` fit gives
+    on it) of ``test`` (test_describe_offset_floor's numpy wheel)."""
+    from test_describe_offset_floor import NPERSEG
+
+    from rwadist.diagnose.engine import Context, initial_state
+    from rwadist.effects.cross_coupling_diagnose import CrossCoupling
+    from rwadist.model import Harmonic, WheelModel
+    from rwadist.spectra import compute_spectra
+
+    ctx = Context(compute_spectra(test, nperseg=NPERSEG), test=test)
+    model = WheelModel(name="the wheel's lines")
+    for d, h, C in lines:
+        model.empirical[d].append(Harmonic(h=h, C=C))
+    start = initial_state(ctx, model)
+    return ctx, start, CrossCoupling.fit(ctx, start, ctx.runs)
+
+
 @pytest.mark.parametrize("seed", [13, 14, 15])
 def test_a_torque_gain_under_a_load_cell_offset_is_read_on_the_recorded_channels(seed):
     """Ty × 1.10 on a load cell whose reference sits 30 mm below the bearing centre (test_describe_offset_floor's numpy
@@ -46,23 +64,14 @@ def test_a_torque_gain_under_a_load_cell_offset_is_read_on_the_recorded_channels
     and the torques corrected by it keep a share of r × F that differs between the two channels (trial13: 26.2 mm for
     25, and no gain described).  Read as recorded (:func:`as_recorded`), where r × F of a rotating force rotates with
     it, every line's power ratio is the gain squared: the ratio within 0.5 %."""
-    from test_describe_offset_floor import LINES, NPERSEG, SPEEDS_RPM, R, lever_arm_test
+    from test_describe_offset_floor import LINES, SPEEDS_RPM, R, lever_arm_test
 
     from rwadist.diagnose.describe_gain import as_recorded, channel_gain
-    from rwadist.diagnose.engine import Context, initial_state
-    from rwadist.effects.cross_coupling_diagnose import CrossCoupling
-    from rwadist.model import Harmonic, WheelModel
-    from rwadist.spectra import compute_spectra
 
     test = lever_arm_test(LINES, R, SPEEDS_RPM, seed)
     for run in test.runs:
         run.signals["Ty"] = 1.10 * run.signals["Ty"]
-    ctx = Context(compute_spectra(test, nperseg=NPERSEG), test=test)
-    model = WheelModel(name="gain under an offset")
-    for d, h, C in LINES:
-        model.empirical[d].append(Harmonic(h=h, C=C))
-    start = initial_state(ctx, model)
-    offset = CrossCoupling.fit(ctx, start, ctx.runs)
+    ctx, start, offset = _lines_and_fitted_offset(test, LINES)
     assert R[2] * 1.01 < offset.r[2] < R[2] * 1.10            # the fitted offset takes part of the gain
     (u,) = channel_gain(ctx, as_recorded(offset.apply(start)), lambda chans, hs, runs: (0.0, 0.0))
     assert set(u.channels) == {"Tx", "Ty"}
@@ -76,24 +85,14 @@ def test_a_lateral_load_cell_offset_without_a_gain_describes_none(r_mm):
     there of 5 nkg·m², as weak as the lateral r × F: 2-12 nkg·m) must not read as a gain: a gain tilts every line.  The offset as the ``cross_coupling`` fit gives it
     (within 0.1 mm), the data with no gain: nothing described, on the recorded channels (as diagnose reads them) and
     on the corrected ones."""
-    from test_describe_offset_floor import LINES, NPERSEG, SPEEDS_RPM, lever_arm_test
+    from test_describe_offset_floor import LINES, SPEEDS_RPM, lever_arm_test
 
     from rwadist.diagnose.describe_gain import as_recorded, channel_gain
-    from rwadist.diagnose.engine import Context, initial_state
-    from rwadist.effects.cross_coupling_diagnose import CrossCoupling
-    from rwadist.model import Harmonic, WheelModel
-    from rwadist.spectra import compute_spectra
 
     lines = LINES + [("axial_force", 3.0, 4e-7), ("radial_torque", 3.0, 5e-9),
                      ("axial_force", 4.0, 4e-7), ("radial_torque", 4.0, 5e-9)]
     r = np.array(r_mm) * 1e-3
-    test = lever_arm_test(lines, r, SPEEDS_RPM, 13)
-    ctx = Context(compute_spectra(test, nperseg=NPERSEG), test=test)
-    model = WheelModel(name="lateral offset, no gain")
-    for d, h, C in lines:
-        model.empirical[d].append(Harmonic(h=h, C=C))
-    start = initial_state(ctx, model)
-    offset = CrossCoupling.fit(ctx, start, ctx.runs)
+    ctx, start, offset = _lines_and_fitted_offset(lever_arm_test(lines, r, SPEEDS_RPM, 13), lines)
     np.testing.assert_allclose(offset.r, r, atol=1e-4)
     state = offset.apply(start)
     for read in (as_recorded(state), state):
