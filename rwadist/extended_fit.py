@@ -539,6 +539,7 @@ def _residuals_near_modes(params: ext.ExtendedParams, lines: list, ax_line: np.n
     f_ax = np.array([lines[k].h for k in ax_line]) * np.abs(sa) / (2 * np.pi)
     f_rd = np.array([lines[k].h for k in rad_parts[:, 0]]) * np.abs(sr) / (2 * np.pi) if sr.size else np.empty(0)
     r_ax, r_rad = r[:sa.size], r[sa.size:]
+    on_fz = np.array([lines[k].direction == "axial_force" for k in ax_line], bool)
     resid_db = {}
     for m, keys, use_rad, dirs in (("radial_translation", ("radial_translation",), True, ("radial_force",)),
                                    ("rocking", ("rocking_forward", "rocking_backward"), True, ("radial_torque",)),
@@ -550,9 +551,9 @@ def _residuals_near_modes(params: ext.ExtendedParams, lines: list, ax_line: np.n
                 near |= np.abs(f_rd / fm[key] - 1) < 0.1
             near &= np.isin(dr, dirs)
             rr = r_rad[near]
-        else:
+        else:       # the axial force's rows: the axial torque has no mode (its lines pass through, hard-mounted)
             fm = ext.whirl_frequencies(params, sa)
-            rr = r_ax[np.abs(f_ax / fm[keys[0]] - 1) < 0.1]
+            rr = r_ax[(np.abs(f_ax / fm[keys[0]] - 1) < 0.1) & on_fz]
         if rr.size:
             resid_db[m] = float(20 / np.log(10) * np.sqrt(np.mean(rr**2)))
             if resid_db[m] > MISFIT_DB:
