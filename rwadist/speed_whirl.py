@@ -216,7 +216,9 @@ def speed_record(meta, check: dict | None = None) -> dict:
     sweep's tach column) or "data" (with the speed scale of :meth:`rwadist.speed_scale.SpeedScale.to_meta`:
     method, ratios, the 1× line's evidence, agreement, the whirl's test, a warning when the speed is suspect).
     A steady test's record holds ``check`` when the 1× lines were measured, and ``runs_off`` with a ``warning``
-    when single runs' speeds were taken from their own 1× lines (:func:`rwadist.speed_check.checked`)."""
+    when single runs' speeds were taken from their own 1× lines (:func:`rwadist.speed_check.checked`; the method says
+    which), ``runs_doubtful`` with a ``warning`` when a run's 1× lines read off beside a line at its given speed (its
+    speed kept)."""
     slicing = (meta or {}).get("slicing")
     if not isinstance(slicing, dict):
         out: dict = {"source": "measured", "method": "the runs' speeds as given (runs.csv speed_rpm)"}
@@ -232,8 +234,15 @@ def speed_record(meta, check: dict | None = None) -> dict:
             out["check"] = check
         if check and check.get("runs_off"):
             out["runs_off"] = check["runs_off"]
+            moved = ", ".join(x["run_name"] for x in check["runs_off"])
+            out["method"] = (f"{out['method']}, except {'run' if len(check['runs_off']) == 1 else 'runs'} {moved}: "
+                             "taken at the speed of its own 1x lines")
             out["warning"] = " ".join(filter(None, (out.get("warning"), (
                 f"{check['text_runs']} (a tach glitch or a speed typed wrong in that run: check its speed_rpm)"))))
+        if check and check.get("runs_doubtful"):
+            out["runs_doubtful"] = check["runs_doubtful"]
+            out["warning"] = " ".join(filter(None, (out.get("warning"), (
+                f"{check['text_doubtful']} (check that run's speed_rpm, and what else turns on the test plate)"))))
         return out
     if slicing.get("speed_source") != "data":
         return {"source": "tach", "method": "each slice's mean of the sweep's speed (tach) column"}

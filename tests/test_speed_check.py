@@ -209,3 +209,50 @@ def test_one_run_off_is_taken_at_its_own_lines_speed(factor, run):
     assert speed["source"] == "measured" and f"run run_{run:02d}.csv" in speed["warning"]
     assert sw.speed_lines(speed)[-1].startswith("warning: run run_")
     assert chk.check_record(test)["runs_off"] == []
+
+
+def _with_foreign_source(test: SteadyTest, rpm: float, seed: int) -> SteadyTest:
+    """``test`` with a co-rotating source of fixed speed ``rpm`` on every run (a neighbouring wheel on the plate: 0.2 N
+    radial, 8 mN·m radial torque, 0.05 N axial, each with its own phase per run)."""
+    rng = np.random.default_rng(seed)
+    w = rpm * 2 * np.pi / 60
+    runs = []
+    for run in test.runs:
+        t = np.arange(run.n_samples) / run.sample_rate
+        sig = {c: np.array(v, dtype=float) for c, v in run.signals.items()}
+        for (x, y), a in ((("Fx", "Fy"), 0.2), (("Tx", "Ty"), 8e-3)):
+            phase = w * t + rng.uniform(0, 2 * np.pi)
+            sig[x] += a * np.cos(phase)
+            sig[y] += a * np.sin(phase)
+        sig["Fz"] += 0.05 * np.cos(w * t + rng.uniform(0, 2 * np.pi))
+        runs.append(replace(run, signals=sig))
+    return SteadyTest(runs, {})
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_a_foreign_source_near_one_x_moves_no_run(seed):
+    """review15 S4: a source turning at 2370 rpm, stronger than the wheel's own 1x lines, read beside the run given
+    as 2307.7 rpm (+2.70 %, all three lines agreeing) moved that run, though the wheel's 1x stands at the given speed
+    in the same window.  Now no run is moved; that run is listed as doubtful and the record warns naming it.  A run
+    whose column is wrong holds nothing at its given 1x, and is still moved (test_one_run_off_...)."""
+    test = _with_foreign_source(wheel_test(1.0, seed=seed), 2370.0, seed)
+    out, rec = chk.checked(test)
+    assert rec["runs_off"] == [] and not rec["scaled"]
+    assert [x["run_name"] for x in rec["runs_doubtful"]] == ["run_03.csv"]
+    assert rec["runs_doubtful"][0]["ratio"] == pytest.approx(2370.0 / RPM[3], abs=1e-3)
+    np.testing.assert_array_equal(out.speeds, test.speeds)
+    speed = sw.speed_record(out.meta, rec)
+    assert "run run_03.csv" in speed["warning"] and "kept as given" in speed["warning"]
+    assert speed["method"] == "the runs' speeds as given (runs.csv speed_rpm)"
+
+
+def test_a_moved_run_is_named_in_the_method():
+    """review15 N4: with a run taken at its own 1x lines' speed the record's method said the speeds were as given."""
+    test = wheel_test(1.0)
+    runs = list(test.runs)
+    runs[6] = replace(runs[6], speed=runs[6].speed * 1.01)
+    out, rec = chk.checked(SteadyTest(runs, {}))
+    speed = sw.speed_record(out.meta, rec)
+    assert speed["method"] == ("the runs' speeds as given (runs.csv speed_rpm), except run run_05.csv: taken at the "
+                               "speed of its own 1x lines")
+    assert rec["runs_doubtful"] == []
