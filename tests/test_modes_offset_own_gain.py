@@ -71,3 +71,35 @@ def test_a_hard_mounted_wheel_on_a_fixture_with_a_30_mm_lever_arm_names_no_modes
     kinds = [e["kind"] for e in api.diagnose(test).summary()["effects"]]
     assert "suspension_modes" not in kinds
     assert "fixed_resonance" in kinds
+
+
+def _diag(*kinds_beside):
+    """A stand-in Diagnosis: hypotheses taken, each (effect kind, kind of the effect it was judged beside or None)."""
+    from types import SimpleNamespace as NS
+
+    return NS(hypotheses=[NS(passed=True, effect=NS(kind=k), beside=None if b is None else NS(kind=b))
+                          for k, b in kinds_beside])
+
+
+@pytest.mark.parametrize("first, calls", [
+    # the modes taken on the pair's evidence, no offset named after them: searched again without the pair path
+    ([("suspension_modes", "cross_coupling")], [True, False]),
+    # the offset named too: the pair's evidence stands
+    ([("suspension_modes", "cross_coupling"), ("cross_coupling", None)], [True]),
+    # modes taken alone: nothing to re-check
+    ([("suspension_modes", None), ("amplitude_law", None)], [True]),
+])
+def test_modes_taken_on_an_offsets_evidence_without_it_are_searched_again(monkeypatch, first, calls):
+    """review15 S5: the re-run path (search._search) had no test.  A search that kept modes judged with a load-cell
+    offset it did not name is searched again with offset_pair False, and that search's result is the answer (the
+    first's modes stood on evidence its own model does not hold); any other search runs once."""
+    seen, second = [], _diag(("suspension_modes", None))
+
+    def fake(*args, offset_pair=True, **kwargs):
+        seen.append(offset_pair)
+        return _diag(*first) if offset_pair else second
+
+    monkeypatch.setattr(search, "_search_once", fake)
+    out = search._search("args")
+    assert seen == calls
+    assert (out is second) == (calls == [True, False])

@@ -562,7 +562,10 @@ def _search(*args, **kwargs) -> Diagnosis:
     """:func:`diagnose` of its arguments (those of :func:`_search_once`), searched again without judging the wheel's
     modes with a load-cell offset (:func:`_judge_with_offset`) when the modes were taken so and no offset was named
     after them (:func:`_modes_without_their_offset`): their evidence was that of the pair, and the state kept the modes
-    alone."""
+    alone.  The second search's result is the answer, not compared with the first by
+    :func:`rwadist.diagnose.describe.search_standing` (which ranks a search that located the modes first): the first
+    is no candidate, its model holding modes whose test it passed only with an offset that model lacks
+    (tests/test_modes_offset_own_gain.py)."""
     diag = _search_once(*args, **kwargs)
     if _modes_without_their_offset(diag):
         diag = _search_once(*args, **{**kwargs, "offset_pair": False})
