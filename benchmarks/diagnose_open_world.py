@@ -19,6 +19,9 @@ torque_hump          broadband_hump    band-limited noise on Tx, Ty, Tz (second-
                                        1.6 x the rocking mode, 10 dB over the noise at its centre, every speed
 remount_step         run_change        every third run (speed order) with all its lines 3.5 dB stronger (the
                                        wheel re-mounted between runs)
+inverter_sidebands   sideband_line     a carrier at 0.17 x the sample rate on every channel, 8 x the channel's
+                                       noise std, with sidebands at +- p x the spin frequency of 0.35 x it (an
+                                       inverter modulated by a motor of p pole pairs: p = 1, 2, 3, 4 by wheel)
 ==================== ================= =========================================================================
 
 A cell passes when a record of the right signature is where the injection is (:func:`right`) and no class beyond
@@ -161,7 +164,28 @@ class RemountStep:
         return {"kind": "remount_step", "step_db": self.step_db, "every": self.every}
 
 
-KINDS = ("clean", "mains_pickup", "torque_crosstalk", "softening_mode", "torque_hump", "remount_step")
+class InverterSidebands:
+    """A carrier at ``f_c`` Hz on every channel, ``level`` x the channel's noise std, one phase per run, and its
+    sidebands at f_c ± p·Ω/2π of ``side`` x it, each its own phase."""
+
+    signature = "sideband_line"
+
+    def __init__(self, f_c, p, level=8.0, side=0.35):
+        self.f_c, self.p, self.level, self.side = f_c, p, level, side
+
+    def cell_signal(self, t, omega, run, rng, wheel, std):
+        out = np.zeros((6, t.size))
+        for f, a in ((self.f_c, 1.0), (self.f_c - self.p * omega / (2 * np.pi), self.side),
+                     (self.f_c + self.p * omega / (2 * np.pi), self.side)):
+            out += a * self.level * std[:, None] * np.cos(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+        return out
+
+    def truth(self):
+        return {"kind": "inverter_sidebands", "carrier_hz": self.f_c, "pole_pairs": self.p, "side": self.side}
+
+
+KINDS = ("clean", "mains_pickup", "torque_crosstalk", "softening_mode", "torque_hump", "remount_step",
+         "inverter_sidebands")
 
 
 def make_effect(kind: str, wheel):
@@ -175,6 +199,9 @@ def make_effect(kind: str, wheel):
         return TorqueHump(1.6 * wheel.f_rock)
     if kind == "remount_step":
         return RemountStep()
+    if kind == "inverter_sidebands":
+        # p = 1, 2, 3, 4 by the family's index (wheels "family-N")
+        return InverterSidebands(0.17 * wheel.sample_rate, float(1 + int(wheel.name.rsplit("-", 1)[-1]) % 4))
     raise ValueError(kind)
 
 
@@ -195,6 +222,9 @@ def right(kind: str, effect, wheel, speeds_rpm, recs: list) -> bool:
     if kind == "torque_hump":
         return any(set(r["channels"]) <= {"Tx", "Ty", "Tz"}
                    and abs(r["parameters"]["peak_Hz"] / effect.f_hz - 1) < 0.15 for r in mine)
+    if kind == "inverter_sidebands":
+        return any(abs(r["parameters"].get("carrier_Hz", 0) - effect.f_c) < 1.0 and r["parameters"].get("sides") == [-1, 1]
+                   and abs(r["parameters"].get("h", 0) / effect.p - 1) < 2e-3 for r in mine)
     if kind == "remount_step":
         stepped = {round(float(s), 3) for i, s in enumerate(speeds_rpm) if effect.stepped(i)}
         for r in mine:

@@ -283,11 +283,14 @@ def floor_as_read(ctx: Context, state: State) -> State:
     return out
 
 
-def describe_residual(searched: Residual, bearings=(), res: Residual | None = None, changes: bool = False) -> list:
+def describe_residual(searched: Residual, bearings=(), res: Residual | None = None, changes: bool = False,
+                      carriers=()) -> list:
     """The records of the final model's residual on ``searched`` (the detectors of :mod:`.describe_structure` and
     :mod:`.describe_lines`), each with its share of the misplaced power and its level measured on ``res`` (default
     ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
-    the records the search read had the changed runs' factor taken out, :func:`run_steps`)."""
+    the records the search read had the changed runs' factor taken out, :func:`run_steps`).  ``carriers``: the fixed
+    lines found before the search (:mod:`.describe_carrier` reads their sidebands)."""
+    from .describe_carrier import sideband_lines
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
@@ -334,6 +337,15 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
                 cells[c] = m
         return res.measure(cells)
 
+    def of_track_f(chans, f_hz, runs):        # one frequency per run of ``runs``
+        cells = {}
+        for c in chans:
+            if c in res.e:
+                m = res.mask(c)
+                m[[pos[int(r)] for r in runs], res.band_of(f_hz)] = True
+                cells[c] = m
+        return res.measure(cells)
+
     def of_fixed(chans, f_hz, runs):
         b = int(res.band_of(f_hz))
         cells = {}
@@ -356,6 +368,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += speed_lines(ctx, state, of_line, bearings, others)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
     out += fixed_lines_in_part(ctx, state, of_fixed)
+    out += sideband_lines(ctx, state, carriers, of_track_f)
     # the recorded channels (a gain acts on them, before any load-cell correction), against the noise as given
     out += channel_gain(ctx, as_recorded(searched.state), of_line)
     return out
@@ -377,7 +390,7 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
     found = describe_fixed_lines(opened.raw, opened.fixed, fixed_line_shares(res, opened.fixed))
     found += describe_channel_copies(opened.raw, opened.copies, channel_copy_shares(res, opened.copies))
     # the final model's residual on the data the search read (the fixed lines and copies out), shares on the data
-    found += describe_residual(searched or res, bearings, res, changes=bool(opened.steps))
+    found += describe_residual(searched or res, bearings, res, changes=bool(opened.steps), carriers=opened.fixed)
     return found, res
 
 
@@ -407,6 +420,13 @@ def cells_of(u, res: Residual) -> dict:
         # a partial line is a line of the model: its own band only (with the bands either side, a true law on a
         # neighbour 0.6·Ω/2π away was taken back with it)
         lo, hi = (b, b) if u.signature == "partial_line" else (np.maximum(b - 1, 0), np.minimum(b + 1, ctx.n_bands - 1))
+    elif u.signature == "sideband_line" and "carrier_Hz" in p:
+        # each side's band in every run of the range (a side below 0 Hz or past the band clips to an edge band: kept,
+        # as a speed line's)
+        sides = np.asarray(p.get("sides", [1]), float)
+        rows = np.repeat(rows, sides.size)
+        f = p["carrier_Hz"] + np.tile(sides, rows.size // max(sides.size, 1)) * p["h"] * spin[rows]
+        lo = hi = res.band_of(f)
     elif u.signature == "moving_resonance" and "slope_Hz_per_Hz_of_spin" in p:
         f_lo, f_hi = p["f_at_lowest_speed_Hz"], p["f_at_highest_speed_Hz"]
         s_lo, s_hi = u.speed_rpm[0] / 60.0, u.speed_rpm[1] / 60.0

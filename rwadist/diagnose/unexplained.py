@@ -42,6 +42,7 @@ SIGNATURES = {
     "broadband_hump": "a broadband hump above the noise floor",
     "run_change": "a run-to-run change",
     "partial_line": "a model line present in some runs and absent from others",
+    "sideband_line": "lines at a fixed line's frequency plus or minus a constant ratio of the speed",
 }
 
 #: How ``level_dB`` reads for the signatures whose level is not the data over the model in their cells.
@@ -91,7 +92,8 @@ class Unexplained:
     share : its share of what is left, 0..1: the misplaced power of its cells (the error metric's numerator
         over them) over the misplaced power of every cell after the search.
     n_runs : runs in which it stands above the noise.
-    h : the ratio to the speed of a ``speed_line`` (and of a ``line_property`` of a line), else None.
+    h : the ratio to the speed of a ``speed_line`` (and of a ``line_property`` of a line, and a ``sideband_line``'s
+        offset from its carrier), else None.
     parameters : the signature's own numbers (docs/diagnose.md lists them per signature); read-only.
     causes : what it could physically be, where a known cause fits (each a short sentence); may be empty.
     would_tell : which data would tell the causes apart (or confirm the one named).

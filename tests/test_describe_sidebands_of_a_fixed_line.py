@@ -1,0 +1,74 @@
+"""A fixed line modulated by the rotation is described with its sidebands (issue 33 item 3; trial15 finding 8).
+
+A new user's inverter line at 400 Hz with sidebands at 400 ± the spin frequency (0.35 of it) got the carrier
+described and its sidebands passed over in silence: they are neither at one fixed frequency nor at a constant ratio
+of the speed.  Now each fixed line's residual is searched along f = f_c ± h·|Ω|/2π (``sideband_line``,
+rwadist.diagnose.describe_carrier).
+
+Data: family wheels (tests/family_wheel.py, numpy only) with a carrier at 0.17 of the sample rate on every channel
+and its two sidebands at ± p times the spin frequency (p the motor's pole pairs, a different one per wheel), each
+with its own phase per run, written by numpy into the records; diagnosed with no model (the default path).  Truth:
+the injection's f_c and p, and the same wheel's diagnosis with the carrier alone (no sideband record, the same
+classes).
+"""
+import functools
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import family_wheel as fw  # noqa: E402
+
+from rwadist import api  # noqa: E402
+from rwadist.data import Run, SteadyTest  # noqa: E402
+
+
+class _Inverter:
+    """A carrier at ``f_c`` Hz, ``level`` x each channel's noise std, and sidebands at f_c ± p·Ω/2π of ``side`` x it."""
+
+    def __init__(self, f_c: float, p: float, level: float = 8.0, side: float = 0.35):
+        self.f_c, self.p, self.level, self.side = f_c, p, level, side
+
+    def cell_signal(self, t, omega, run, rng, wheel, std):
+        out = np.zeros((6, t.size))
+        for f, a in ((self.f_c, 1.0), (self.f_c - self.p * omega / (2 * np.pi), self.side),
+                     (self.f_c + self.p * omega / (2 * np.pi), self.side)):
+            if a > 0:
+                out += a * self.level * std[:, None] * np.cos(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+        return out
+
+
+@functools.lru_cache(maxsize=None)
+def _diagnosed(index: int, p: float, side: float):
+    wheel = replace(fw.family()[index], n_speeds=16, n_samples=8192)
+    effect = _Inverter(0.17 * wheel.sample_rate, p, side=side)
+    data = fw.steady(wheel, noise=0.01, seed=index + 40, effects=[effect])
+    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
+                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
+    return effect, api.diagnose(SteadyTest(runs=runs, meta={}))
+
+
+@pytest.mark.parametrize("index, p", [(0, 1.0), (3, 4.0), (5, 2.0)])
+def test_sidebands_of_a_fixed_line_are_described_at_their_ratio(index, p):
+    effect, d = _diagnosed(index, p, 0.35)
+    (carrier,) = [u for u in d.unexplained if u.signature == "fixed_line"]
+    assert carrier.f_Hz[0] == pytest.approx(effect.f_c, abs=0.2)
+    (sb,) = [u for u in d.unexplained if u.signature == "sideband_line"]
+    assert sb.parameters["carrier_Hz"] == pytest.approx(effect.f_c, abs=0.2)
+    assert sb.parameters["sides"] == [-1, 1]
+    assert sb.h == pytest.approx(p, rel=2e-3)
+    assert set(sb.channels) == set(fw.CHANNELS)
+    assert "modulated by the rotation" in sb.causes[0]
+    # nothing forced into a class: the classes of the same wheel with the carrier alone
+    _, alone = _diagnosed(index, p, 0.0)
+    assert [e["kind"] for e in d.model.effects] == [e["kind"] for e in alone.model.effects]
+
+
+def test_a_carrier_alone_has_no_sidebands_described():
+    _, d = _diagnosed(0, 1.0, 0.0)
+    assert [u.signature for u in d.unexplained].count("fixed_line") == 1
+    assert not [u for u in d.unexplained if u.signature == "sideband_line"]
