@@ -52,7 +52,7 @@ def _diagnosed(index: int, p: float, side: float):
     return effect, api.diagnose(SteadyTest(runs=runs, meta={}))
 
 
-@pytest.mark.parametrize("index, p", [(0, 1.0), (3, 4.0), (5, 2.0)])
+@pytest.mark.parametrize("index, p", [(0, 1.0), (3, 4.0), (5, 2.0), (4, 1.0)])
 def test_sidebands_of_a_fixed_line_are_described_at_their_ratio(index, p):
     effect, d = _diagnosed(index, p, 0.35)
     (carrier,) = [u for u in d.unexplained if u.signature == "fixed_line"]

@@ -290,7 +290,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
     the records the search read had the changed runs' factor taken out, :func:`run_steps`).  ``carriers``: the fixed
     lines found before the search (:mod:`.describe_carrier` reads their sidebands)."""
-    from .describe_carrier import sideband_lines
+    from .describe_carrier import on_a_sideband, sideband_lines
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
@@ -367,8 +367,9 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += run_change(ctx, line_ratios(res.ctx, res.state) if changes else ratios, of_runs)
     out += speed_lines(ctx, state, of_line, bearings, others)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
-    out += fixed_lines_in_part(ctx, state, of_fixed)
-    out += sideband_lines(ctx, state, carriers, of_track_f)
+    sidebands = sideband_lines(ctx, state, carriers, of_track_f)
+    out += [u for u in fixed_lines_in_part(ctx, state, of_fixed) if not on_a_sideband(ctx, u, sidebands)]
+    out += sidebands
     # the recorded channels (a gain acts on them, before any load-cell correction), against the noise as given
     out += channel_gain(ctx, as_recorded(searched.state), of_line)
     return out

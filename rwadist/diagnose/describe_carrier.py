@@ -149,3 +149,29 @@ def _record(ctx, ln, chans, sides, track_shares) -> Unexplained | None:
                 "in the motor's field)",),
         would_tell="runs with the drive's switching frequency changed move the carrier and these lines together; "
                    "runs coasting with the drive off show neither; the motor's pole-pair count names h")
+
+
+#: Welch bins either side of a sideband's track that its lit bins reach: a Hann window's main lobe (2) and the lit
+#: bin's neighbour (1)
+TRACK_REACH_BINS = 3
+
+
+def on_a_sideband(ctx, u, sidebands) -> bool:
+    """Whether the ``fixed_line`` record ``u`` (a line at one frequency over part of the speeds,
+    :func:`.describe_fixed.fixed_lines_in_part`) lies within :data:`TRACK_REACH_BINS` Welch bins of a track of one of
+    ``sidebands`` (``sideband_line`` records) in half of the runs of its speed range or more: those bins were lit by
+    the sideband sweeping past slowly (family wheel 4, 300-3000 rpm: an inverter's f_c + f_spin, 24 dB over the model,
+    read as four 'fixed lines' over part of the speeds at 611-687 Hz)."""
+    rpm = ctx.omega[ctx.runs] * RAD_S_TO_RPM
+    inside = (rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6)
+    if not inside.any():
+        return False
+    spin = rpm[inside] / 60.0
+    for sb in sidebands:
+        p = sb.parameters
+        for side in p.get("sides", []):
+            f = p["carrier_Hz"] + side * p["h"] * spin
+            if np.mean(np.abs(f - u.f_Hz[0]) <= TRACK_REACH_BINS * ctx.df) >= 0.5:
+                return True
+    return False
+
