@@ -39,6 +39,8 @@ class Opened:
     #: when ``ctx`` lacks runs (steps of NaN): the context of the records the search reads with every run, on which
     #: the final model's residual is described (its runs are the data's); else None
     whole: Context | None = None
+    #: the fixed lines' sidebands taken out with them (:class:`~rwadist.diagnose.describe_carrier.Sideband`)
+    sidebands: list = field(default_factory=list)
 
 
 def start(ctx: Context, steps: dict | None = None) -> Opened:
@@ -49,9 +51,11 @@ def start(ctx: Context, steps: dict | None = None) -> Opened:
     dB, from a first search's :func:`run_steps`): those runs' records also divided by their common factor, and the
     runs of a NaN step (their change not read) left out of the search's context (``Opened.whole`` keeps them)."""
     from .channel_copy import find_channel_copies, remove_channel_copies
+    from .describe_carrier import find_sidebands
 
     fixed = find_fixed_lines(ctx)
-    test = remove_fixed_lines(ctx, fixed) if fixed else ctx.test
+    sidebands = find_sidebands(ctx, fixed) if fixed else []
+    test = remove_fixed_lines(ctx, fixed + sidebands) if fixed else ctx.test
     copies = find_channel_copies(ctx, test)
     if copies:
         test = remove_channel_copies(test, copies)
@@ -69,11 +73,11 @@ def start(ctx: Context, steps: dict | None = None) -> Opened:
     whole = context(test)
     unread = {r for r, dB in steps.items() if not np.isfinite(dB)}
     if not unread or test is None:
-        return Opened(whole, ctx, fixed, copies, steps)
+        return Opened(whole, ctx, fixed, copies, steps, sidebands=sidebands)
     from ..data import SteadyTest
 
     kept = SteadyTest([run for i, run in enumerate(test.runs) if i not in unread], dict(test.meta))
-    return Opened(context(kept), ctx, fixed, copies, steps, whole)
+    return Opened(context(kept), ctx, fixed, copies, steps, whole, sidebands=sidebands)
 
 
 def scale_runs(test, steps: dict):
@@ -284,13 +288,14 @@ def floor_as_read(ctx: Context, state: State) -> State:
 
 
 def describe_residual(searched: Residual, bearings=(), res: Residual | None = None, changes: bool = False,
-                      carriers=()) -> list:
+                      carriers=(), known_sidebands=()) -> list:
     """The records of the final model's residual on ``searched`` (the detectors of :mod:`.describe_structure` and
     :mod:`.describe_lines`), each with its share of the misplaced power and its level measured on ``res`` (default
     ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
     the records the search read had the changed runs' factor taken out, :func:`run_steps`).  ``carriers``: the fixed
-    lines found before the search (:mod:`.describe_carrier` reads their sidebands)."""
-    from .describe_carrier import on_a_sideband, sideband_lines
+    lines found before the search (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands
+    taken out with them."""
+    from .describe_carrier import on_a_sideband, sideband_lines, sideband_tracks
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
@@ -367,8 +372,9 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += run_change(ctx, line_ratios(res.ctx, res.state) if changes else ratios, of_runs)
     out += speed_lines(ctx, state, of_line, bearings, others)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
-    sidebands = sideband_lines(ctx, state, carriers, of_track_f)
-    out += [u for u in fixed_lines_in_part(ctx, state, of_fixed) if not on_a_sideband(ctx, u, sidebands)]
+    sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)
+    tracks = sideband_tracks(sidebands, known_sidebands)
+    out += [u for u in fixed_lines_in_part(ctx, state, of_fixed) if not on_a_sideband(ctx, u, tracks)]
     out += sidebands
     # the recorded channels (a gain acts on them, before any load-cell correction), against the noise as given
     out += channel_gain(ctx, as_recorded(searched.state), of_line)
@@ -387,11 +393,14 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
     diag.contrast_error_after = opened.raw.contrast_error(after)
     res = Residual.of(opened.raw, after)
     from .channel_copy import describe_channel_copies
+    from .describe_carrier import describe_sidebands
 
     found = describe_fixed_lines(opened.raw, opened.fixed, fixed_line_shares(res, opened.fixed))
+    found += describe_sidebands(res, opened.sidebands)
     found += describe_channel_copies(opened.raw, opened.copies, channel_copy_shares(res, opened.copies))
     # the final model's residual on the data the search read (the fixed lines and copies out), shares on the data
-    found += describe_residual(searched or res, bearings, res, changes=bool(opened.steps), carriers=opened.fixed)
+    found += describe_residual(searched or res, bearings, res, changes=bool(opened.steps), carriers=opened.fixed,
+                               known_sidebands=opened.sidebands)
     return found, res
 
 

@@ -249,12 +249,12 @@ def _refine(ctx, k0: int, chans) -> float | None:
     return float((k[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0)) * step)
 
 
-def run_amplitudes(ctx, f_hz: float, chans) -> np.ndarray:
-    """Complex amplitude (n_runs, len(chans)) of a tone at ``f_hz`` in every run (all of the test's, NaN where a
-    channel is missing) and channel: from the run's whole-record transform (Hann, the mean taken off, zero-padded to
-    1/:data:`TONE_GRID_STEP` points per record bin: one FFT per run) at the points within ±:data:`TONE_GRID_BINS`
-    record bins of it (:func:`_tone_amplitudes`: beside a wheel line passing it in that run, the two fitted
-    together)."""
+def run_amplitudes(ctx, f_hz, chans) -> np.ndarray:
+    """Complex amplitude (n_runs, len(chans)) of a tone at ``f_hz`` (Hz: one frequency, or one per run of the test,
+    NaN for a run not read) in every run (all of the test's, NaN where a channel is missing) and channel: from the
+    run's whole-record transform (Hann, the mean taken off, zero-padded to 1/:data:`TONE_GRID_STEP` points per record
+    bin: one FFT per run) at the points within ±:data:`TONE_GRID_BINS` record bins of it (:func:`_tone_amplitudes`:
+    beside a wheel line passing it in that run, the two fitted together)."""
     from scipy import fft as sp_fft
 
     from ..dft import demeaned_windowed, run_window
@@ -262,9 +262,11 @@ def run_amplitudes(ctx, f_hz: float, chans) -> np.ndarray:
     test = ctx.test
     out = np.full((len(test.runs), len(chans)), np.nan + 0j)
     pad = int(round(1.0 / TONE_GRID_STEP))
+    f_runs = np.broadcast_to(np.asarray(f_hz, dtype=float), (len(test.runs),))
     for i, run in enumerate(test.runs):
         have = [j for j, c in enumerate(chans) if run.usable(c)]
-        if not have:
+        f_hz = float(f_runs[i])
+        if not have or not np.isfinite(f_hz):
             continue
         n = run.n_samples
         rec_bin = run.sample_rate / n
@@ -316,8 +318,9 @@ def remove_fixed_lines(ctx, lines) -> SteadyTest:
     """A copy of the context's test with every line of ``lines`` subtracted from each run's records: x − Re(A·e^{2πj f
     t}), A the line's amplitude in that run and channel (:attr:`FixedLine.amplitudes`), in every channel that carries
     it, except in a run whose amplitude is more than :data:`SAME_AMPLITUDE` times from the median over the runs (a
-    wheel line at the same frequency there, not told apart).  The runs' signals are new arrays (the input is not
-    changed)."""
+    wheel line at the same frequency there, not told apart).  A line's ``f_runs`` (a fixed line's sideband,
+    :class:`rwadist.diagnose.describe_carrier.Sideband`), when it has one, gives its frequency in each run instead of
+    ``f_Hz``.  The runs' signals are new arrays (the input is not changed)."""
     from ..data import SteadyTest
 
     test = ctx.test
@@ -326,8 +329,11 @@ def remove_fixed_lines(ctx, lines) -> SteadyTest:
         A = ln.amplitudes
         med = np.nanmedian(np.abs(A), axis=0)
         A = np.where((np.abs(A) > SAME_AMPLITUDE * med) | (np.abs(A) < med / SAME_AMPLITUDE), np.nan, A)
+        f_runs = np.broadcast_to(np.asarray(getattr(ln, "f_runs", ln.f_Hz), dtype=float), (len(test.runs),))
         for i, run in enumerate(test.runs):
-            e = np.exp(2j * np.pi * ln.f_Hz * np.arange(run.n_samples) / run.sample_rate)
+            if not np.isfinite(f_runs[i]):
+                continue
+            e = np.exp(2j * np.pi * f_runs[i] * np.arange(run.n_samples) / run.sample_rate)
             for j, c in enumerate(ln.channels):
                 if run.usable(c) and np.isfinite(A[i, j]):
                     new_signals[i][c] = new_signals[i][c] - np.real(A[i, j] * e)
