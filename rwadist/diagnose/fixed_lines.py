@@ -342,12 +342,15 @@ def remove_fixed_lines(ctx, lines) -> SteadyTest:
 
 def mains_family(freqs) -> tuple | None:
     """(mains Hz, orders) when every frequency of ``freqs`` is a whole multiple of one mains frequency of
-    :data:`MAINS_HZ` within 0.5 % (at least one of them the fundamental or an order up to 9), else None."""
+    :data:`MAINS_HZ` within 0.5 % (at least one of them the fundamental or an order up to 9), else None; of several,
+    the one of the lowest orders (a 400 Hz line is the 400 Hz supply's fundamental before it is the 50 Hz mains'
+    eighth order: trial15's inverter)."""
+    found = []
     for m in MAINS_HZ:
         orders = [f / m for f in freqs]
         if all(o >= 0.9 and abs(o - round(o)) <= 0.005 * o for o in orders) and min(orders) < 9.5:
-            return m, tuple(int(round(o)) for o in orders)
-    return None
+            found.append((m, tuple(int(round(o)) for o in orders)))
+    return min(found, key=lambda x: max(x[1])) if found else None
 
 
 def describe_fixed_lines(ctx, lines, shares: dict) -> list:
@@ -366,7 +369,8 @@ def describe_fixed_lines(ctx, lines, shares: dict) -> list:
         if mains is not None:
             m, orders = mains
             k = int(round(ln.f_Hz / m))
-            causes = (f"electrical pickup: order {k} of the {m:g} Hz mains" + (
+            supply = "mains" if m < 100 else "supply (an aircraft or ground power supply, a converter's switching)"
+            causes = (f"electrical pickup: order {k} of the {m:g} Hz {supply}" + (
                 f" (the fixed lines found are orders {', '.join(map(str, orders))} of it)" if family and len(
                     orders) > 1 else ""),)
             tell = "a run with the wheel still and its electronics on shows pickup at the same frequency; so do " \
