@@ -102,11 +102,10 @@ def _pairs(tracks, dh: float) -> list:
 def find_sidebands(ctx, fixed) -> list:
     """The :class:`Sideband` of the fixed lines ``fixed`` (:class:`~rwadist.diagnose.fixed_lines.FixedLine`) in the
     context's data as given, before any model: bins lit over each run's block floor (those of
-    :func:`rwadist.diagnose.fixed_lines.find_fixed_lines`) along the carrier's tracks (:func:`_tracks`), each side
-    kept when its median over its lit runs stands :data:`~rwadist.diagnose.fixed_lines.MIN_LEVEL` over the floor and
-    its amplitude is steady from run to run as a fixed line's (a source of its own, not wheel lines met on the way),
-    with its amplitude in every run."""
-    from .fixed_lines import MIN_LEVEL, STEADY_FRACTION, STEADY_RATIO, run_amplitudes
+    :func:`rwadist.diagnose.fixed_lines.find_fixed_lines`) along the carrier's tracks (:func:`_tracks`), kept when
+    both sides of one ratio are found and each stands out and is steady (:func:`_measured_side`: a source of its own,
+    not wheel lines met on the way), with its amplitude in every run.  A single side is left to the residual's
+    reading after the search (:func:`sideband_lines`)."""
     from .fixed_lines import _lit as floor_lit
 
     runs = ctx.runs
@@ -119,30 +118,50 @@ def find_sidebands(ctx, fixed) -> list:
         if ok.any():
             m[ok] = floor_lit(ctx.sp.psd[c][runs[ok]], ctx.floor[c][runs[ok]], ctx.dof)
         lit[c] = m
+    dh = H_STEP_BINS * ctx.df / float(ctx.omega[runs].max() / (2 * np.pi))
     out = []
     for ln in fixed:
         chans = [c for c in ln.channels if c in lit]
-        for side, h, on_runs, frac in _tracks(ctx, ln.f_Hz, chans, lit) if chans else []:
-            f_runs = np.full(len(ctx.test.runs), np.nan)
-            f = ln.f_Hz + side * h * ctx.omega[runs] / (2 * np.pi)
-            k = np.rint(f / ctx.df).astype(int)
-            ok = (k >= ctx.k_lo) & (k <= ctx.k_hi) & (np.abs(f - ln.f_Hz) > CARRIER_BINS * ctx.df)
-            f_runs[runs[ok]] = f[ok]
-            pos = np.array([int(np.flatnonzero(runs == r)[0]) for r in on_runs], int)
-            ratio = np.stack([ctx.sp.psd[c][on_runs, k[pos]] / np.maximum(ctx.floor[c][on_runs, k[pos]], 1e-300)
-                              for c in chans])
-            level = float(np.max(np.nanmedian(10 * np.log10(np.maximum(ratio, 1e-30)), axis=1)))
-            if not level >= 10 * np.log10(MIN_LEVEL):
-                continue
-            A = run_amplitudes(ctx, f_runs, chans)
-            mag = np.abs(A[runs[ok]])
-            med = np.nanmedian(mag, axis=0)
-            within = np.nanmean((mag <= STEADY_RATIO * med) & (mag >= med / STEADY_RATIO), axis=0)
-            if not np.any(within >= STEADY_FRACTION):
-                continue
-            out.append(Sideband(float(ln.f_Hz), float(side), float(h), tuple(chans),
-                                tuple(int(r) for r in on_runs), level, float(frac), f_runs, A))
+        for pair in _pairs(_tracks(ctx, ln.f_Hz, chans, lit), dh) if chans else []:
+            # a modulation makes both sides; one side alone over the floor, before any model, may be the wheel's
+            # own lines lighting the track (a 50-250 Hz pickup among a wheel's dense low lines: 14 such "sidebands")
+            got = [_measured_side(ctx, ln.f_Hz, chans, side, h, on_runs, frac) for side, h, on_runs, frac in pair]
+            if len(got) == 2 and all(x is not None for x in got):
+                out += got
     return out
+
+
+def _measured_side(ctx, f_c: float, chans, side: float, h: float, on_runs, frac: float) -> Sideband | None:
+    """The :class:`Sideband` f_c + side·h·|Ω|/2π lit in ``on_runs``, or None when its median over those runs stands
+    less than :data:`~rwadist.diagnose.fixed_lines.MIN_LEVEL` over the block floor or its amplitude is not steady
+    from run to run as a fixed line's (:data:`~rwadist.diagnose.fixed_lines.STEADY_FRACTION` of the runs it is read
+    in within :data:`~rwadist.diagnose.fixed_lines.STEADY_RATIO` of the median, in some channel)."""
+    from .fixed_lines import MIN_LEVEL, STEADY_FRACTION, STEADY_RATIO, run_amplitudes
+
+    runs = ctx.runs
+    f_runs = np.full(len(ctx.test.runs), np.nan)
+    f = f_c + side * h * ctx.omega[runs] / (2 * np.pi)
+    k = np.rint(f / ctx.df).astype(int)
+    ok = (k >= ctx.k_lo) & (k <= ctx.k_hi) & (np.abs(f - f_c) > CARRIER_BINS * ctx.df)
+    f_runs[runs[ok]] = f[ok]
+    pos = np.array([int(np.flatnonzero(runs == r)[0]) for r in on_runs], int)
+    ratio = np.stack([ctx.sp.psd[c][on_runs, k[pos]] / np.maximum(ctx.floor[c][on_runs, k[pos]], 1e-300)
+                      for c in chans])
+    level = float(np.max(np.nanmedian(10 * np.log10(np.maximum(ratio, 1e-30)), axis=1)))
+    if not level >= 10 * np.log10(MIN_LEVEL):
+        return None
+    A = run_amplitudes(ctx, f_runs, chans)
+    mag = np.abs(A[runs[ok]])
+    read = np.isfinite(mag)
+    if not read.any():
+        return None             # no run's tone fitted (a wheel line in every window): no source of its own
+    med = np.array([np.median(mag[read[:, j], j]) if read[:, j].any() else np.nan for j in range(len(chans))])
+    # over every run it is taken out in (a run whose tone was not fitted counts as not steady), as a fixed line's
+    within = np.mean((mag <= STEADY_RATIO * med) & (mag >= med / STEADY_RATIO), axis=0)
+    if not np.any(within >= STEADY_FRACTION):
+        return None
+    return Sideband(float(f_c), float(side), float(h), tuple(chans), tuple(int(r) for r in on_runs), level,
+                    float(frac), f_runs, A)
 
 
 def describe_sidebands(res, sidebands) -> list:

@@ -327,7 +327,9 @@ def remove_fixed_lines(ctx, lines) -> SteadyTest:
     new_signals = [dict(r.signals) for r in test.runs]
     for ln in lines:
         A = ln.amplitudes
-        med = np.nanmedian(np.abs(A), axis=0)
+        mag = np.abs(A)
+        # a channel with no run read (a sideband's tone not fitted in any run of it) is not corrected
+        med = np.array([np.median(m[np.isfinite(m)]) if np.isfinite(m).any() else np.nan for m in mag.T])
         A = np.where((np.abs(A) > SAME_AMPLITUDE * med) | (np.abs(A) < med / SAME_AMPLITUDE), np.nan, A)
         f_runs = np.broadcast_to(np.asarray(getattr(ln, "f_runs", ln.f_Hz), dtype=float), (len(test.runs),))
         for i, run in enumerate(test.runs):
