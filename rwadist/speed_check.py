@@ -278,7 +278,10 @@ def _runs_off(test, ratios: dict, judged: list, about: float, spread: float) -> 
         entry = {"run": i, "run_name": run.name or str(i), "given_rpm": round(given, 6),
                  "ratio": round(k * about, 7), "speed_rpm": round(given * about * k, 6),
                  "lines": ", ".join(LINES[key][1] for key in read)}
-        at_given = any(_line_at_given(run, LINES[key][0], f_given, f_given * ratios[key][i] / about) for key in read)
+        near = [test.runs[j] for j in np.argsort(np.abs(np.abs([x.speed for x in test.runs]) - abs(run.speed)))
+                if j != i and test.runs[j].speed != 0][:FIXED_CHECK_RUNS]
+        at_given = any(_line_at_given(run, LINES[key][0], f_given, f_given * ratios[key][i] / about, near)
+                       for key in read)
         (doubtful if at_given else out).append(entry)
     return out, doubtful
 
@@ -288,28 +291,52 @@ def _runs_off(test, ratios: dict, judged: list, about: float, spread: float) -> 
 GIVEN_LINE_SHARE = 0.01
 
 
-def _line_at_given(run, channels: tuple, f_given: float, f_read: float) -> bool:
+#: runs of the nearest speeds read at the frequency of a line found at a run's given 1× (:func:`_line_at_given`)
+FIXED_CHECK_RUNS = 4
+
+
+def _stands_at(run, channels: tuple, f_hz: float) -> tuple | None:
+    """(frequency Hz, power, noise, the padded power spectrum) of the local maximum of ``channels``' zero-padded power (:func:`run_line`'s) within
+    one native bin of ``f_hz`` in ``run``, or None when the bins there hold no local maximum (or the run lacks a
+    channel); the noise is the median at ±4..8 native bins."""
+    if not all(run.usable(c) for c in channels):
+        return None
+    f = _window_and_bins(run.n_samples, float(run.sample_rate))[1]
+    power = sum(np.abs(s) ** 2 for s in run_spectra(run, channels).values())
+    k0 = int(round(f_hz / f[1]))
+    lo, hi = max(k0 - PAD, 1), min(k0 + PAD, power.size - 2)
+    if hi < lo:
+        return None
+    k = lo + int(np.argmax(power[lo:hi + 1]))
+    if not (power[k] > power[k - 1] and power[k] > power[k + 1]):
+        return None
+    noise = float(np.median(power[np.clip(k + PAD * np.array([-8, -6, -4, 4, 6, 8]), 0, power.size - 1)]))
+    return float(f[k]), float(power[k]), noise, power
+
+
+def _line_at_given(run, channels: tuple, f_given: float, f_read: float, others=()) -> bool:
     """Whether ``channels`` of ``run`` hold a line at the given 1× frequency ``f_given`` (Hz) besides the peak read at
     ``f_read``: a local maximum of the zero-padded power (:func:`run_line`'s) within one native bin of ``f_given``, two
     native bins or more from ``f_read``, :data:`speed_scale.PAIR_SNR` over the noise there and within
-    :data:`GIVEN_LINE_SHARE` of the peak read's power."""
+    :data:`GIVEN_LINE_SHARE` of the peak read's power, and not a fixed line: it does not stand at the same frequency
+    in most of ``others`` (runs of other speeds, their own 1× two native bins or more from it; a 50 Hz pickup at a
+    run typed 3000 rpm is no rotor turning at the given speed)."""
     fs = float(run.sample_rate)
     df = fs / run.n_samples
     if abs(f_read - f_given) < 2 * df:
         return False
-    f = _window_and_bins(run.n_samples, fs)[1]
-    spec = run_spectra(run, channels)
-    power = sum(np.abs(s) ** 2 for s in spec.values())
-    k0 = int(round(f_given / f[1]))
-    lo, hi = max(k0 - PAD, 1), min(k0 + PAD, power.size - 2)
-    if hi < lo:
+    got = _stands_at(run, channels, f_given)
+    if got is None or abs(got[0] - f_read) < 2 * df:
         return False
-    k = lo + int(np.argmax(power[lo:hi + 1]))
-    if not (power[k] > power[k - 1] and power[k] > power[k + 1]) or abs(f[k] - f_read) < 2 * df:
+    f_k, p_k, noise, power = got
+    peak = float(power[int(round(f_read / _window_and_bins(run.n_samples, fs)[1][1]))])
+    if not (p_k >= PAIR_SNR * noise and p_k >= GIVEN_LINE_SHARE * peak):
         return False
-    noise = float(np.median(power[np.clip(k + PAD * np.array([-8, -6, -4, 4, 6, 8]), 0, power.size - 1)]))
-    peak = float(power[int(round(f_read / f[1]))])
-    return bool(power[k] >= PAIR_SNR * noise and power[k] >= GIVEN_LINE_SHARE * peak)
+    # the same frequency in runs of other speeds (their 1x away from it): a line there too is fixed, not the rotor's
+    seen = [_stands_at(o, channels, f_k) for o in others
+            if abs(abs(o.speed) / (2 * np.pi) - f_k) >= 2 * float(o.sample_rate) / o.n_samples]
+    fixed = [x is not None and abs(x[0] - f_k) <= df and x[1] >= PAIR_SNR * x[2] for x in seen]
+    return not (len(fixed) >= 2 and np.mean(fixed) >= 0.5)
 
 
 def checked(test) -> tuple:

@@ -256,3 +256,33 @@ def test_a_moved_run_is_named_in_the_method():
     assert speed["method"] == ("the runs' speeds as given (runs.csv speed_rpm), except run run_05.csv: taken at the "
                                "speed of its own 1x lines")
     assert rec["runs_doubtful"] == []
+
+
+def _with_pickup(test: SteadyTest, f_hz: float, share: float, seed: int) -> SteadyTest:
+    """``test`` with a fixed line at ``f_hz`` (mains pickup) on the five channels of the 1x lines, ``share`` x the
+    wheel's radial 1x amplitudes at 3046 rpm, each channel and run its own phase."""
+    rng = np.random.default_rng(seed)
+    om = 3046.0 * 2 * np.pi / 60
+    amp = {"F": share * 2e-6 * om ** 2, "T": share * 8e-8 * om ** 2}
+    runs = []
+    for run in test.runs:
+        t = np.arange(run.n_samples) / run.sample_rate
+        sig = {c: np.array(v, dtype=float) for c, v in run.signals.items()}
+        for c in ("Fx", "Fy", "Fz", "Tx", "Ty"):
+            sig[c] = sig[c] + amp[c[0]] * np.cos(2 * np.pi * f_hz * t + rng.uniform(0, 2 * np.pi))
+        runs.append(replace(run, signals=sig))
+    return SteadyTest(runs, {})
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_a_run_typed_wrong_onto_a_mains_line_is_still_moved(seed):
+    """review16: a run at 3046 rpm typed 3000 rpm, with a 50 Hz pickup in every run (0.1 x the wheel's 1x amplitude):
+    the pickup stood at the given 1x and kept the run at the wrong speed ('doubtful').  A line at the given speed that
+    stands at the same frequency in runs of other speeds is a fixed line, not the rotor: the run is moved to its
+    generator speed (within 2e-5)."""
+    test = wheel_test(1.0, seed=seed)
+    runs = list(test.runs)
+    runs[6] = replace(runs[6], speed=3000.0 * 2 * np.pi / 60)          # RPM[5] = 3046.15 rpm
+    out, rec = chk.checked(_with_pickup(SteadyTest(runs, {}), 50.0, 0.1, seed))
+    assert [x["run_name"] for x in rec["runs_off"]] == ["run_05.csv"] and rec["runs_doubtful"] == []
+    assert out.speeds[6] == pytest.approx(RPM[5] * 2 * np.pi / 60, rel=2e-5)
