@@ -60,7 +60,12 @@ def test_sidebands_of_a_fixed_line_are_described_at_their_ratio(index, p):
     (sb,) = [u for u in d.unexplained if u.signature == "sideband_line"]
     assert sb.parameters["carrier_Hz"] == pytest.approx(effect.f_c, abs=0.2)
     assert sb.parameters["sides"] == [-1, 1]
-    assert sb.h == pytest.approx(p, rel=2e-3)
+    # h read to a small part of a record bin at the top speed (2e-3 x 4 x 100 Hz was 1.6 record bins: a subtraction that
+    # far off leaves the line in); seen within 3e-5 on these four
+    assert sb.h == pytest.approx(p, rel=2e-4)
+    # both sides stand out of the data before any model: taken out of the records the search reads (without it, a
+    # sweep through the wheel's lines was fitted as an amplitude law: open-world wheel 7)
+    assert sb.parameters["removed_before_the_search"] is True
     assert set(sb.channels) == set(fw.CHANNELS)
     assert "modulated by the rotation" in sb.causes[0]
     # nothing forced into a class: the wheel's modes alone, as on its clean data
