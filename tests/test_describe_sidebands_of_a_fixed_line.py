@@ -80,12 +80,13 @@ def test_a_carrier_alone_has_no_sidebands_described():
 
 
 def test_a_400_hz_line_is_named_the_400_hz_supply_not_the_50_hz_mains_eighth_order():
-    """trial15: its inverter at 400 Hz was named "order 8 of the 50 Hz mains"; a family is named by the supply of the
-    lowest orders that holds every line, and a 50 Hz family stays the mains'."""
+    """trial15: its inverter at 400 Hz was named "order 8 of the 50 Hz mains"; the 400 Hz supply names a family it holds
+    at lower orders than the mains do, and the mains keep their order otherwise (50 Hz before 60 Hz)."""
     from rwadist.diagnose.fixed_lines import mains_family
 
     assert mains_family([400.0]) == (400.0, (1,))
     assert mains_family([400.0, 800.0]) == (400.0, (1, 2))
     assert mains_family([50.0, 100.0, 150.0, 250.0]) == (50.0, (1, 2, 3, 5))
     assert mains_family([60.0, 180.0, 300.0]) == (60.0, (1, 3, 5))
+    assert mains_family([300.0]) == (50.0, (6,))            # 50 Hz before 60 Hz, as before (review16 S4)
     assert mains_family([137.0]) is None

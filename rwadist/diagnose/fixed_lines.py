@@ -344,15 +344,21 @@ def remove_fixed_lines(ctx, lines) -> SteadyTest:
 
 def mains_family(freqs) -> tuple | None:
     """(mains Hz, orders) when every frequency of ``freqs`` is a whole multiple of one mains frequency of
-    :data:`MAINS_HZ` within 0.5 % (at least one of them the fundamental or an order up to 9), else None; of several,
-    the one of the lowest orders (a 400 Hz line is the 400 Hz supply's fundamental before it is the 50 Hz mains'
+    :data:`MAINS_HZ` within 0.5 % (at least one of them the fundamental or an order up to 9), else None: the mains
+    first (50 Hz before 60 Hz: 300 Hz stays the 50 Hz mains' sixth order, a six-pulse rectifier's ripple), unless the
+    400 Hz supply holds them at lower orders (a 400 Hz line is that supply's fundamental before it is the 50 Hz mains'
     eighth order: trial15's inverter)."""
     found = []
     for m in MAINS_HZ:
         orders = [f / m for f in freqs]
         if all(o >= 0.9 and abs(o - round(o)) <= 0.005 * o for o in orders) and min(orders) < 9.5:
             found.append((m, tuple(int(round(o)) for o in orders)))
-    return min(found, key=lambda x: max(x[1])) if found else None
+    mains = [x for x in found if x[0] < 100.0]
+    supply = [x for x in found if x[0] >= 100.0]
+    pick = mains[0] if mains else None
+    if supply and (pick is None or max(supply[0][1]) < max(pick[1])):
+        pick = supply[0]
+    return pick
 
 
 def describe_fixed_lines(ctx, lines, shares: dict) -> list:
