@@ -43,10 +43,10 @@ class _Inverter:
 
 
 @functools.lru_cache(maxsize=None)
-def _diagnosed(index: int, p: float, side: float):
+def _diagnosed(index: int, p: float, side: float, f_c: float | None = None, seed: int | None = None):
     wheel = replace(fw.family()[index], n_speeds=16, n_samples=8192)
-    effect = _Inverter(0.17 * wheel.sample_rate, p, side=side)
-    data = fw.steady(wheel, noise=0.01, seed=index + 40, effects=[effect])
+    effect = _Inverter(0.17 * wheel.sample_rate if f_c is None else f_c, p, side=side)
+    data = fw.steady(wheel, noise=0.01, seed=index + 40 if seed is None else seed, effects=[effect])
     runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
                 signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
     return effect, api.diagnose(SteadyTest(runs=runs, meta={}))
@@ -69,6 +69,20 @@ def test_sidebands_of_a_fixed_line_are_described_at_their_ratio(index, p):
     assert set(sb.channels) == set(fw.CHANNELS)
     assert "modulated by the rotation" in sb.causes[0]
     # nothing forced into a class: the wheel's modes alone, as on its clean data
+    assert [e["kind"] for e in d.model.effects] == ["suspension_modes"]
+
+
+def test_a_lower_sideband_past_0_hz_folds_and_is_taken_out():
+    """review16 S3: a 50 Hz carrier's −1·f_spin side on family wheel 3 (600-6000 rpm) passes 0 Hz at 3000 rpm and is
+    then at f_spin − 50 Hz (a real signal's line at −f is at f); read as out of band, it stayed in the records the
+    search reads (31-34 dB over the floor in 9 runs) and made a phantom moving resonance at 18.8-35.6 Hz.  Folded, the
+    pair is taken out and described over the whole range, nothing else."""
+    effect, d = _diagnosed(3, 1.0, 0.35, f_c=50.0, seed=43)
+    assert sorted(u.signature for u in d.unexplained) == ["fixed_line", "sideband_line"]
+    (sb,) = [u for u in d.unexplained if u.signature == "sideband_line"]
+    assert sb.h == pytest.approx(1.0, rel=2e-4) and sb.parameters["removed_before_the_search"] is True
+    top = 6000.0 / 60.0
+    assert sb.f_Hz[1] == pytest.approx(50.0 + top, rel=1e-3)
     assert [e["kind"] for e in d.model.effects] == ["suspension_modes"]
 
 

@@ -435,7 +435,7 @@ def cells_of(u, res: Residual) -> dict:
         # as a speed line's)
         sides = np.asarray(p.get("sides", [1]), float)
         rows = np.repeat(rows, sides.size)
-        f = p["carrier_Hz"] + np.tile(sides, rows.size // max(sides.size, 1)) * p["h"] * spin[rows]
+        f = np.abs(p["carrier_Hz"] + np.tile(sides, rows.size // max(sides.size, 1)) * p["h"] * spin[rows])
         lo = hi = res.band_of(f)
     elif u.signature == "moving_resonance" and "slope_Hz_per_Hz_of_spin" in p:
         f_lo, f_hi = p["f_at_lowest_speed_Hz"], p["f_at_highest_speed_Hz"]

@@ -9,7 +9,9 @@ one fixed frequency nor at a constant ratio of the speed, so neither the fixed l
 along f = f_c ± h·|Ω|/2π in the fixed line's channels, for each fixed line f_c found: an h lit in at least
 :data:`~.describe_lines.RIDGE_FRACTION` of the runs where that track lies in the band and more than
 :data:`CARRIER_BINS` Welch bins from the carrier, :data:`~.describe_lines.RIDGE_RUNS` runs at least, its ratio read on
-the whole records (:func:`_stretch_h`), the two sides of one h one record.
+the whole records (:func:`_stretch_h`), the two sides of one h one record.  A lower side whose f_c − h·|Ω|/2π falls below 0 Hz is at its absolute value (a
+real signal's line at −f is at f): the track folds at 0 Hz (review16, a 50 Hz carrier's −1·f_spin side above
+3000 rpm, left in the records, made a phantom moving resonance).
 
 As the fixed lines themselves, sidebands that stand out of the data before any model are found before the search
 (:func:`find_sidebands`, on the Welch PSDs over each run's block floor) and taken out of the records it reads
@@ -66,7 +68,7 @@ def _tracks(ctx, f_c: float, chans, lit: dict, known=()) -> list:
     rows = np.arange(runs.size)[None, :]
     cands = []
     for side in (-1.0, 1.0):
-        f = f_c + side * np.outer(h_grid, spin)                                               # (H, R)
+        f = np.abs(f_c + side * np.outer(h_grid, spin))                                       # (H, R)
         k = np.rint(f / ctx.df).astype(int)
         inb = (k >= ctx.k_lo) & (k <= ctx.k_hi) & (np.abs(f - f_c) > CARRIER_BINS * ctx.df)
         hit = np.zeros(k.shape, bool)
@@ -140,7 +142,7 @@ def _measured_side(ctx, f_c: float, chans, side: float, h: float, on_runs, frac:
 
     runs = ctx.runs
     f_runs = np.full(len(ctx.test.runs), np.nan)
-    f = f_c + side * h * ctx.omega[runs] / (2 * np.pi)
+    f = np.abs(f_c + side * h * ctx.omega[runs] / (2 * np.pi))
     k = np.rint(f / ctx.df).astype(int)
     ok = (k >= ctx.k_lo) & (k <= ctx.k_hi) & (np.abs(f - f_c) > CARRIER_BINS * ctx.df)
     f_runs[runs[ok]] = f[ok]
@@ -235,7 +237,7 @@ def _stretch_h(ctx, chans, runs, h_a: float, h_b: float, f_c: float, side: float
     cols = [CHANNELS.index(c) for c in chans]
 
     def power(grid):
-        X = ctx.phasors(runs, f_c + side * np.outer(w, grid))[:, :, cols]
+        X = ctx.phasors(runs, np.abs(f_c + side * np.outer(w, grid)))[:, :, cols]
         return np.nanmedian(np.nansum(np.abs(X) ** 2, axis=2), axis=0)
 
     step = max(ratio_resolution(ctx), 1e-9)
@@ -255,8 +257,8 @@ def _shadow(ctx, f_c: float, side: float, h: float, runs, accepted) -> bool:
     """Whether the track f_c + side·h·|Ω|/2π lies within 1.5 Welch bins (a lit bin and its neighbour) of a track
     already taken in half of ``runs`` or more: its ridge is that line's, lit where the two tracks are not resolved (a
     line's ridge at the low speeds, where a Welch bin spans a wide range of h)."""
-    f = f_c + side * h * ctx.omega[runs] / (2 * np.pi)
-    return any(np.mean(np.abs(f - (f_c + s * g * ctx.omega[runs] / (2 * np.pi))) <= 1.5 * ctx.df) >= 0.5
+    f = np.abs(f_c + side * h * ctx.omega[runs] / (2 * np.pi))
+    return any(np.mean(np.abs(f - np.abs(f_c + s * g * ctx.omega[runs] / (2 * np.pi))) <= 1.5 * ctx.df) >= 0.5
                for s, g, _, _ in accepted)
 
 
@@ -268,7 +270,7 @@ def _record(ctx, f_c: float, chans, sides, track_shares, removed: bool = False,
     pos = {int(r): i for i, r in enumerate(ctx.runs)}
     share, levels, f_all, rpm_all, n_runs = 0.0, [], [], [], set()
     for side, h, lit_runs, _ in sides:
-        f = f_c + side * h * ctx.omega[lit_runs] / (2 * np.pi)
+        f = np.abs(f_c + side * h * ctx.omega[lit_runs] / (2 * np.pi))
         s, level = track_shares(chans, f, lit_runs)
         share += s
         levels.append(level)
@@ -318,6 +320,6 @@ def on_a_sideband(ctx, u, tracks) -> bool:
     if not inside.any():
         return False
     spin = rpm[inside] / 60.0
-    return any(np.mean(np.abs(f_c + side * h * spin - u.f_Hz[0]) <= TRACK_REACH_BINS * ctx.df) >= 0.5
+    return any(np.mean(np.abs(np.abs(f_c + side * h * spin) - u.f_Hz[0]) <= TRACK_REACH_BINS * ctx.df) >= 0.5
                for f_c, side, h in tracks)
 

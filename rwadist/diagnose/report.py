@@ -178,9 +178,9 @@ def _mark_unexplained(ax, c: str, diag: Diagnosis, rpm: np.ndarray) -> None:
             ax.plot(u.h * s / 60.0, s, ls=":", **style)
             ax.text(u.h * s1 / 60.0, s1, f" {n}", va="top", **tag)
         elif u.signature == "sideband_line" and "carrier_Hz" in u.parameters:
-            s = np.array([s0, s1])
+            s = np.linspace(s0, s1, 64)        # a lower side folds at 0 Hz (its |f|): a polyline, not a segment
             for side in u.parameters.get("sides", [1]):
-                ax.plot(u.parameters["carrier_Hz"] + side * u.parameters["h"] * s / 60.0, s, ls=":", **style)
+                ax.plot(np.abs(u.parameters["carrier_Hz"] + side * u.parameters["h"] * s / 60.0), s, ls=":", **style)
             ax.text(u.parameters["carrier_Hz"], s1, f" {n}", va="top", **tag)
         elif u.signature == "partial_line" and u.h is not None:
             # a short mark on the line's ray at each run it is absent from
