@@ -17,9 +17,8 @@ target on the source over those points), a copy when the points near κ hold at 
 least :data:`MIN_RUN_FRACTION` of the runs where the copy would stand :data:`CLEAR_COPY_DB` over the target's
 noise, and κ times the source stands over the target's
 noise.  Pairs of channels of one direction (Fx-Fy, Tx-Ty: a rotating line fixes their phase) are not tried, nor a
-torque carrying a force of a load-cell offset's r × F (the ``cross_coupling`` class; :data:`LEVER_ARM_PAIRS`) when
-the offset's other term holds too (:data:`LEVER_ARM_MIRROR`: Ty = r_z·Fx comes with Tx = −r_z·Fy; one term alone
-is a calibration matrix missing that one force-to-moment term, a copy); and a radial pair reading the other radial pair alike (Tx = κ·Fx with Ty = κ·Fy: a rotating source's force and
+torque carrying a force of a load-cell offset's r × F (the ``cross_coupling`` class; :data:`LEVER_ARM_PAIRS`);
+and a radial pair reading the other radial pair alike (Tx = κ·Fx with Ty = κ·Fy: a rotating source's force and
 moment in phase) is the rotor's own pattern, not a copy.
 """
 from __future__ import annotations
@@ -33,14 +32,6 @@ from ..units import CHANNEL_DIRECTION, RAD_S_TO_RPM
 #: (force, torque) pairs of a load-cell offset's r × F (Tx = r_y·Fz − r_z·Fy, ...): the ``cross_coupling`` class
 #: explains a torque carrying such a force, so those pairs are left to it
 LEVER_ARM_PAIRS = {("Fy", "Tx"), ("Fz", "Tx"), ("Fx", "Ty"), ("Fz", "Ty"), ("Fx", "Tz"), ("Fy", "Tz")}
-#: The other term of the same component of r in r × F, whose ratio is the pair's negated (Ty = r_z·Fx, Tx = −r_z·Fy;
-#: Tx = r_y·Fz, Tz = −r_y·Fx; Ty = −r_x·Fz, Tz = r_x·Fy)
-LEVER_ARM_MIRROR = {("Fx", "Ty"): ("Fy", "Tx"), ("Fy", "Tx"): ("Fx", "Ty"), ("Fz", "Tx"): ("Fx", "Tz"),
-                    ("Fx", "Tz"): ("Fz", "Tx"), ("Fz", "Ty"): ("Fy", "Tz"), ("Fy", "Tz"): ("Fz", "Ty")}
-#: A lever-arm pair's copy is an offset's when the mirror pair's points on the copy's lines stand at the negated
-#: ratio (within :data:`CLUSTER_TOLERANCE`) in at least this fraction of those where it would stand clear (half of
-#: :data:`MIN_RUN_FRACTION`, which the copy's own lines must reach)
-MIRROR_FRACTION = 0.3
 #: The other channel of a radial pair.
 PARTNER = {"Fx": "Fy", "Fy": "Fx", "Tx": "Ty", "Ty": "Tx"}
 #: A radial force in a radial torque this close to ±90° (deg) is the partner force's r × F (:func:`_lever_arm_through_partner`).
@@ -151,19 +142,12 @@ def find_channel_copies(ctx, test=None) -> list:
         if mine.sum() < MIN_RUNS:
             continue
         for t, ct in enumerate(chans):
-            if t == s or CHANNEL_DIRECTION[ct] == CHANNEL_DIRECTION[cs]:
+            if t == s or CHANNEL_DIRECTION[ct] == CHANNEL_DIRECTION[cs] or (cs, ct) in LEVER_ARM_PAIRS:
                 continue
-            if (cs, ct) in LEVER_ARM_PAIRS and not all(c in chans for c in LEVER_ARM_MIRROR[(cs, ct)]):
-                continue                # the offset's other term cannot be read: left to cross_coupling
             got = _pair(X[mine, s], X[mine, t], noise[mine, t], run_of[mine], h[mine], cs, ct,
                         ctx.omega[run_of[mine]])
-            if got is None or _lever_arm_through_partner(got):
-                continue
-            if (cs, ct) in LEVER_ARM_PAIRS:
-                ms, mt = (chans.index(c) for c in LEVER_ARM_MIRROR[(cs, ct)])
-                if _mirror_holds(X[src == ms, ms], X[src == ms, mt], noise[src == ms, mt], h[src == ms], got):
-                    continue            # both terms of r × F: a load-cell offset (cross_coupling)
-            found.append(got)
+            if got is not None and not _lever_arm_through_partner(got):
+                found.append(got)
     # a radial pair carrying the other radial pair's content alike (Tx = κ·Fx and Ty = κ·Fy) is the rotor's own
     # pattern (a force and a moment of one rotating source, in phase; the virtual stand's wheel without modes), not a
     # copy: a cross-sensitive channel reads one other channel, not its pair's partner too
@@ -179,22 +163,6 @@ def find_channel_copies(ctx, test=None) -> list:
         if cands:
             out.append(replace(cands[0], alternatives=tuple(x.source for x in cands[1:])))
     return out
-
-
-def _mirror_holds(X_s, X_t, noise_t, h, copy: ChannelCopy) -> bool:
-    """Whether the mirror pair of a lever-arm copy (:data:`LEVER_ARM_MIRROR`; its source's points ``X_s``, its target's
-    transforms ``X_t`` and noise there, line ratios ``h``) stands at −κ on the copy's lines: in at least
-    :data:`MIRROR_FRACTION` of the points where −κ·X_s would stand :data:`CLEAR_COPY_DB` over the target's noise, its
-    ratio within :data:`CLUSTER_TOLERANCE` of −κ.  A load-cell offset r × F puts both terms of r's component in the
-    torques (Ty = r_z·Fx and Tx = −r_z·Fy), a calibration matrix missing one force-to-moment term only one (trial15's
-    crosstalkT: Ty += 5 mm·Fx, Tx untouched: taken for an offset, the modes were lost, a 475 Hz 'wheel mode' and
-    amplitude laws named).  Too few clear points to tell: True (left to ``cross_coupling``, as before)."""
-    kappa = -copy.kappa
-    pts = np.isin(h, copy.lines_h) & (np.abs(kappa * X_s) ** 2 >= 10 ** (CLEAR_COPY_DB / 10) * noise_t)
-    if pts.sum() < MIN_RUNS:
-        return True
-    near = np.abs(X_t[pts] / X_s[pts] - kappa) <= CLUSTER_TOLERANCE * abs(kappa)
-    return bool(near.mean() >= MIRROR_FRACTION)
 
 
 def _lever_arm_through_partner(copy: ChannelCopy) -> bool:
