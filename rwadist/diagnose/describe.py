@@ -295,7 +295,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     the records the search read had the changed runs' factor taken out, :func:`run_steps`).  ``carriers``: the fixed
     lines found before the search (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands
     taken out with them."""
-    from .describe_carrier import on_a_sideband, sideband_lines, sideband_tracks
+    from .describe_carrier import measure_track, on_a_sideband, sideband_lines, sideband_tracks
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
@@ -343,13 +343,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
         return res.measure(cells)
 
     def of_track_f(chans, f_hz, runs):        # one frequency per run of ``runs``
-        cells = {}
-        for c in chans:
-            if c in res.e:
-                m = res.mask(c)
-                m[[pos[int(r)] for r in runs], res.band_of(f_hz)] = True
-                cells[c] = m
-        return res.measure(cells)
+        return measure_track(res, chans, f_hz, runs)
 
     def of_fixed(chans, f_hz, runs):
         b = int(res.band_of(f_hz))

@@ -166,6 +166,19 @@ def _measured_side(ctx, f_c: float, chans, side: float, h: float, on_runs, frac:
                     float(frac), f_runs, A)
 
 
+def measure_track(res, chans, f_hz, runs) -> tuple:
+    """(share, level dB) of ``res`` (a :class:`~rwadist.diagnose.describe.Residual`) over the cells of a track: in each
+    run of ``runs`` (indices of the test) the band of its frequency ``f_hz`` (Hz, one per run), in ``chans``."""
+    pos = {int(r): i for i, r in enumerate(res.ctx.runs)}
+    cells = {}
+    for c in chans:
+        if c in res.e:
+            m = res.mask(c)
+            m[[pos[int(r)] for r in runs], res.band_of(f_hz)] = True
+            cells[c] = m
+    return res.measure(cells)
+
+
 def describe_sidebands(res, sidebands) -> list:
     """``sideband_line`` records of the sidebands found before the search (:func:`find_sidebands`), the two sides of
     one ratio one record, each with its share and level on ``res`` (the final model's residual on the data as given:
@@ -176,13 +189,7 @@ def describe_sidebands(res, sidebands) -> list:
         return []
 
     def track_shares(chans, f, runs):
-        cells = {}
-        for c in chans:
-            if c in res.e:
-                m = res.mask(c)
-                m[[pos[int(r)] for r in runs], res.band_of(f)] = True
-                cells[c] = m
-        return res.measure(cells)
+        return measure_track(res, chans, f, runs)
 
     dh = H_STEP_BINS * ctx.df / float(ctx.omega[ctx.runs].max() / (2 * np.pi))
     out = []
