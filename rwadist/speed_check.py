@@ -58,6 +58,8 @@ AGREE = 3.0e-4
 CONSISTENT = 0.8
 #: the run's given 1× frequency must be this many native bins above 0 Hz to be measured
 MIN_BINS = 12
+#: padded bins, from a peak, of the local noise a line is read against (the median at ±4..8 native bins)
+NOISE_BINS = PAD * np.array([-8, -6, -4, 4, 6, 8])
 #: the three 1× lines: key -> (channels, text)
 LINES = {"radial_force": (("Fx", "Fy"), "radial force"), "radial_torque": (("Tx", "Ty"), "radial torque"),
          "axial_force": (("Fz",), "axial force")}
@@ -96,7 +98,7 @@ def run_line(run, channels: tuple, f0: float, spectra: dict | None = None) -> tu
         share, snr = next(iter(slice_senses({ch: v[None, :] for ch, v in spec.items()}, f, PAD,
                                             np.array([[f_peak]])).values()))
         return f_peak, float(snr[0, 0]), float(share[0, 0])
-    noise = float(np.median(power(k + PAD * np.array([-8, -6, -4, 4, 6, 8]))))
+    noise = float(np.median(power(k + NOISE_BINS)))
     return f_peak, float(power(slice(k, k + 1))[0] / max(noise, 1e-300)), np.nan
 
 
@@ -310,7 +312,7 @@ def _stands_at(run, channels: tuple, f_hz: float) -> tuple | None:
     k = lo + int(np.argmax(power[lo:hi + 1]))
     if not (power[k] > power[k - 1] and power[k] > power[k + 1]):
         return None
-    noise = float(np.median(power[np.clip(k + PAD * np.array([-8, -6, -4, 4, 6, 8]), 0, power.size - 1)]))
+    noise = float(np.median(power[np.clip(k + NOISE_BINS, 0, power.size - 1)]))
     return float(f[k]), float(power[k]), noise, power
 
 

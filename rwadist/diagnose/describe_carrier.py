@@ -27,7 +27,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..units import RAD_S_TO_RPM
-from .describe_lines import H_STEP_BINS, MIN_LEVEL_DB, RIDGE_FRACTION, RIDGE_RUNS, _lit, ratio_resolution
+from .describe_lines import (
+    H_STEP_BINS,
+    MIN_LEVEL_DB,
+    RIDGE_FRACTION,
+    RIDGE_RUNS,
+    _lit,
+    log_parabola_offset,
+    ratio_resolution,
+)
 from .unexplained import Unexplained
 
 #: Welch bins from the carrier within which a run's sideband bin is not read (the carrier's own leakage)
@@ -255,9 +263,7 @@ def _stretch_h(ctx, chans, runs, h_a: float, h_b: float, f_c: float, side: float
     j = int(np.argmax(p))
     if not 0 < j < fine.size - 1:
         return None                 # no peak: the stretch is the skirt of something else
-    lo, mid, hi = np.log(np.maximum(p[j - 1:j + 2], 1e-300))
-    den = lo - 2 * mid + hi
-    return float(fine[j] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * 0.25 * step)
+    return float(fine[j] + log_parabola_offset(p[j - 1:j + 2]) * 0.25 * step)
 
 
 def _shadow(ctx, f_c: float, side: float, h: float, runs, accepted) -> bool:

@@ -151,9 +151,15 @@ def _record_h(ctx, chans, runs, h: float) -> float:
     j = int(np.argmax(tot))
     if not 0 < j < grid.size - 1:
         return h
-    lo, mid, hi = np.log(np.maximum(tot[j - 1:j + 2], 1e-300))
+    return float(grid[j] + log_parabola_offset(tot[j - 1:j + 2]) * step)
+
+
+def log_parabola_offset(three) -> float:
+    """The peak's offset (in grid steps, −0.5..0.5 for a peak at the middle point) of a parabola through the
+    logarithms of three equally spaced powers ``three`` around their largest; 0 when they do not curve down."""
+    lo, mid, hi = np.log(np.maximum(three, 1e-300))
     den = lo - 2 * mid + hi
-    return float(grid[j] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * step)
+    return 0.5 * (lo - hi) / den if den < 0 else 0.0
 
 
 def _sense(ctx, direction: str, h: float, runs) -> float | None:
