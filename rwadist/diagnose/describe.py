@@ -224,13 +224,15 @@ def channel_copy_shares(res: Residual, copies) -> dict:
 
 
 def line_causes(diag, bearings=(), extra_h=()) -> list:
-    """Candidate physical causes (:func:`rwadist.bearings.line_causes`) of the improved model's lines whose ratio h is
-    not a whole number (within twice the resolution, :func:`ratio_resolution`): [{"direction", "h", "source",
-    "causes"}] for those with at least one, each (direction, h) once; ``source`` is "effect" for a line a ``missing_harmonic`` added, "base"
+    """Candidate physical causes of the improved model's lines: bearing ratios (:func:`rwadist.bearings.line_causes`)
+    for a line whose ratio h is not a whole number (within twice the resolution, :func:`ratio_resolution`), a motor's
+    torque ripple (:func:`rwadist.motor.motor_causes`) for an axial-torque line at a whole h ≥ 2: [{"direction", "h",
+    "source", "causes"}] for those with at least one, each (direction, h) once; ``source`` is "effect" for a line a ``missing_harmonic`` added, "base"
     for a line of a base fitted from the data, "model" for one of the given model.  ``extra_h``: ratios of lines
     described but not in the model (the relations among lines read them too)."""
     from ..bearings import line_causes as causes_of
     from ..model import DIRECTIONS
+    from ..motor import motor_causes
     from .describe_lines import ratio_resolution
 
     res = ratio_resolution(diag.ctx)
@@ -243,10 +245,13 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
     seen = set()
     for d, h in lines:
         # a line with a co- and a counter-rotating part is two harmonics at one h: one line, named once
-        if abs(h - round(h)) <= 2 * res or (d, h) in seen:
+        if (d, h) in seen:
             continue
         seen.add((d, h))
-        got = causes_of(h, res, bearings, [o for o in every if abs(o - h) > res])
+        if abs(h - round(h)) <= 2 * res:
+            got = motor_causes(h, res, d)           # a whole multiple: no bearing ratio, a motor's ripple on Tz
+        else:
+            got = causes_of(h, res, bearings, [o for o in every if abs(o - h) > res])
         if got:
             src = "effect" if (d, round(h, 3)) in added else ("base" if fitted else "model")
             out.append({"direction": d, "h": h, "source": src, "causes": got})

@@ -62,8 +62,10 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
     """``speed_line`` records of the residual ridges at a constant h no model line of the direction has, pooled over
     the direction's channels; each with its ratio refined on the residual peaks, its rotation sense on a radial
     direction (from the x/y phase of the whole-run transforms, with the time series), its amplitude's power law in
-    the speed and its candidate bearing causes (:func:`rwadist.bearings.line_causes`)."""
+    the speed and its candidate bearing causes (:func:`rwadist.bearings.line_causes`), or a motor's on the axial torque
+    (:func:`rwadist.motor.motor_causes`)."""
     from ..bearings import line_causes
+    from ..motor import motor_causes
     from .measure import refine_h
 
     runs = ctx.runs
@@ -106,7 +108,8 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
             if not level >= MIN_LEVEL_DB:
                 continue
             sense = _sense(ctx, d, h, lit_runs)
-            causes = tuple(line_causes(h, ratio_resolution(ctx), bearings, others))
+            causes = tuple(line_causes(h, ratio_resolution(ctx), bearings, others)
+                           + motor_causes(h, ratio_resolution(ctx), d))
             f = h * ctx.omega[lit_runs] / (2 * np.pi)
             out.append(Unexplained(
                 signature="speed_line", channels=tuple(chans), speed_rpm=(float(rpm.min()), float(rpm.max())),

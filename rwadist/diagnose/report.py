@@ -259,8 +259,9 @@ def unexplained_section(diag: Diagnosis) -> list:
 
 
 def line_causes_section(diag: Diagnosis) -> list:
-    """report.md's lines on the candidate physical causes of the model's non-integer lines (bearing ratios: named
-    from the bearings' geometry within the resolution, else the ranges they can take)."""
+    """report.md's lines on the candidate physical causes of the model's lines (bearing ratios for the non-integer
+    ones: named from the bearings' geometry within the resolution, else the ranges they can take; a motor's torque
+    ripple for the axial torque's whole multiples of the speed)."""
     if diag.bearings:
         head = "Bearings given: " + "; ".join(
             f"{b.label()}: {b.balls} balls, d {1000 * b.ball_diameter_m:.4g} mm, D {1000 * b.pitch_diameter_m:.4g} mm, "
@@ -270,7 +271,8 @@ def line_causes_section(diag: Diagnosis) -> list:
         head = ("No bearing geometry given (`--bearing` or the model file's `wheel.bearings`): the ranges bearing "
                 "ratios can take, and the relations among the lines, are named.")
     if not diag.line_causes:
-        return [head, "", "No line of the model at a non-integer ratio has a candidate cause."]
+        return [head, "", "No line of the model has a candidate cause (a bearing's ratio for a line at a non-integer "
+                      "ratio, a motor's torque ripple for an axial-torque line at a whole one)."]
     out = [head, ""]
     for lc in diag.line_causes:
         out.append(f"- {lc['direction']} h = {lc['h']:.5g} ({lc['source']}): " + "; ".join(lc["causes"]))
