@@ -538,6 +538,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     test, diagnosis = speed_whirl.settle(test, run)
     diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None), checked)
     diagnosis.data_quality = [s.to_json() for s in frozen] + ([polarity] if polarity is not None else [])
+    if polarity is not None:        # the model was fitted to the data with that channel's sign put right
+        diagnosis.model.provenance = dict(diagnosis.model.provenance, data_quality=[polarity])
     reading = reading_provenance(getattr(test, "meta", None))
     if reading:
         diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(

@@ -91,6 +91,7 @@ def test_diagnose_of_a_reversed_channel(index, seed, flip):
     assert not [e for e in d.model.effects if e["kind"] == "counter_rotation" and e["direction"] == direction]
     recs = [r for r in d.data_quality if r.get("type") == "reversed_polarity"]
     assert len(recs) == 1 and recs[0]["direction"] == direction
+    assert d.model.provenance["data_quality"] == recs
     truth = {(ln.direction, round(ln.h, 3)): ln.co for ln in wheel.lines if ln.direction == direction}
     seen = 0
     for hm in d.model.empirical[direction]:
