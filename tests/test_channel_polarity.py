@@ -84,9 +84,11 @@ def test_diagnose_of_a_reversed_channel(index, seed, flip):
     1x), a reversed_polarity record in data_quality, every line of the pair the generator makes wholly co- or
     counter-rotating fitted with that sense and each suspension mode within 2 % of the generator's."""
     from rwadist import api
+    from rwadist.errors import RwadistWarning
 
     wheel = fw.family()[index]
-    d = api.diagnose(_test(wheel, seed, flip))
+    with pytest.warns(RwadistWarning, match="wired with the wrong polarity"):
+        d = api.diagnose(_test(wheel, seed, flip))
     direction = "radial_force" if flip[0] == "F" else "radial_torque"
     assert not [e for e in d.model.effects if e["kind"] == "counter_rotation" and e["direction"] == direction]
     recs = [r for r in d.data_quality if r.get("type") == "reversed_polarity"]
