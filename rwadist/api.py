@@ -499,7 +499,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     DataError
         Runs at fewer than 2 distinct speeds (:func:`rwadist.validate.check_test_speeds`).
     """
-    from . import data_quality, speed_check, speed_whirl
+    from . import channel_polarity, data_quality, speed_check, speed_whirl
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
@@ -523,6 +523,10 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     check_f_lim(test, f_lim)            # before the search starts, not after it
     # a steady test's speed column checked against its imbalance's 1x lines, scaled when they all sit at one ratio
     test, checked = speed_check.checked(test)
+    # a radial pair whose 1x line reads mirrored against the other pair's: one channel's sign flipped back
+    test, polarity = channel_polarity.checked(test)
+    if polarity is not None:
+        warnings.warn(RwadistWarning(channel_polarity.polarity_lines(polarity)[0]), stacklevel=2)
 
     def run(test, base_check):
         spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))
@@ -533,7 +537,9 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     # supports); how the speed was obtained goes to the summary and the report
     test, diagnosis = speed_whirl.settle(test, run)
     diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None), checked)
-    diagnosis.data_quality = [s.to_json() for s in frozen]
+    diagnosis.data_quality = [s.to_json() for s in frozen] + ([polarity] if polarity is not None else [])
+    if polarity is not None:        # the model was fitted to the data with that channel's sign put right
+        diagnosis.model.provenance = dict(diagnosis.model.provenance, data_quality=[polarity])
     reading = reading_provenance(getattr(test, "meta", None))
     if reading:
         diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(

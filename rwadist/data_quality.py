@@ -260,10 +260,14 @@ def screen(test: SteadyTest) -> tuple:
 
 def quality_lines(records) -> list:
     """Console / report lines of the records (JSON dicts of :meth:`FrozenStretch.to_json`): one per stretch and a
-    closing line that says what was done and what to do next."""
+    closing line that says what was done and what to do next; a ``reversed_polarity`` record
+    (:mod:`rwadist.channel_polarity`) first, in its own lines."""
+    from .channel_polarity import polarity_lines
+
+    lines = [x for r in records if r.get("type") == "reversed_polarity" for x in polarity_lines(r)]
+    records = [r for r in records if r.get("type") != "reversed_polarity"]
     if not records:
-        return []
-    lines = []
+        return lines
     for r in records:
         run = f"{r['channel']} of run {r['run_name'] or r['run']} ({r['speed_rpm']:.1f} rpm)"
         share = f"{r['n_samples']} samples, {100.0 * r['fraction_of_run']:.0f} % of the run"
