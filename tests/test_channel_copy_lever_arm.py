@@ -10,7 +10,10 @@ search and with it the equations that tell r's lateral part (trial16's wheel, r 
 
 Here family wheels (tests/family_wheel.py, generated without rwadist's physics) on a load cell with
 r = (20, 15, 150) mm: no copy is found (on 906dfd9 a T_z copy of T_x in each of wheels 0, 1 and 4); the same wheels
-with an instrument's crosstalk T_z += 0.3·T_x and no offset: the copy is still found, at κ 0.3.
+with an instrument's crosstalk T_z += 0.3·T_x and no offset: the copy is still found, at κ 0.3.  The user's
+command on wheel 0 (modes 310 / 95 / 140 Hz): r within 0.1 mm and every mode located, nothing else named or
+described (906dfd9: r (0.06, 0.18, 149.98) mm, the rocking not located, an amplitude law named, the copy and a
+moving resonance described, error 28x).
 """
 import sys
 from pathlib import Path
@@ -23,6 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
 
+from rwadist.api import diagnose  # noqa: E402
 from rwadist.data import Run, SteadyTest  # noqa: E402
 from rwadist.diagnose.channel_copy import find_channel_copies  # noqa: E402
 from rwadist.diagnose.engine import Context  # noqa: E402
@@ -54,3 +58,16 @@ def test_an_instruments_torque_crosstalk_is_still_a_copy(index):
     assert got == [("Tx", "Tz")]
     assert abs(copies[0].kappa) == pytest.approx(0.3, rel=0.01)
     assert abs(np.angle(copies[0].kappa)) < 0.01
+
+
+def test_the_offset_is_found_whole_by_the_users_command(tmp_path):
+    wheel = fw.family()[0]
+    data = fw.steady(wheel, noise=0.01, seed=0, effects=[fe.CrossCoupling(OFFSET_M)])
+    d = diagnose(fw.write_steady(data, tmp_path / "data", wheel.name))
+    kinds = [e["kind"] for e in d.summary()["effects"]]
+    assert kinds == ["suspension_modes", "cross_coupling"]
+    modes, cc = d.summary()["effects"]
+    assert not modes["unconstrained"]
+    assert modes["rocking_Hz"] == pytest.approx(wheel.f_rock, rel=0.02)
+    assert cc["r_m"] == pytest.approx(list(OFFSET_M), abs=1e-4)
+    assert [u.signature for u in d.unexplained] == []
