@@ -17,7 +17,8 @@ target on the source over those points), a copy when the points near κ hold at 
 least :data:`MIN_RUN_FRACTION` of the runs where the copy would stand :data:`CLEAR_COPY_DB` over the target's
 noise, and κ times the source stands over the target's
 noise.  Pairs of channels of one direction (Fx-Fy, Tx-Ty: a rotating line fixes their phase) are not tried, nor a
-torque carrying a force of a load-cell offset's r × F (the ``cross_coupling`` class; :data:`LEVER_ARM_PAIRS`);
+torque carrying a force of a load-cell offset's r × F (the ``cross_coupling`` class; :data:`LEVER_ARM_PAIRS`); a copy
+whose target torque that offset's r × F of the forces explains as well is the offset's (:func:`_lever_arm_of_forces`);
 and a radial pair reading the other radial pair alike (Tx = κ·Fx with Ty = κ·Fy: a rotating source's force and
 moment in phase) is the rotor's own pattern, not a copy.
 """
@@ -32,6 +33,14 @@ from ..units import CHANNEL_DIRECTION, RAD_S_TO_RPM
 #: (force, torque) pairs of a load-cell offset's r × F (Tx = r_y·Fz − r_z·Fy, ...): the ``cross_coupling`` class
 #: explains a torque carrying such a force, so those pairs are left to it
 LEVER_ARM_PAIRS = {("Fy", "Tx"), ("Fz", "Tx"), ("Fx", "Ty"), ("Fz", "Ty"), ("Fx", "Tz"), ("Fy", "Tz")}
+#: Each torque's row of a load-cell offset's r × F: (force, sign) of its two terms, the real components of r the
+#: unknowns (T_x = r_y·F_z − r_z·F_y, T_y = r_z·F_x − r_x·F_z, T_z = r_x·F_y − r_y·F_x)
+TORQUE_ROW = {"Tx": (("Fz", 1.0), ("Fy", -1.0)), "Ty": (("Fx", 1.0), ("Fz", -1.0)),
+              "Tz": (("Fy", 1.0), ("Fx", -1.0))}
+#: A copy whose target that row explains within this factor of the copy's own median misfit is the offset's
+#: (:func:`_lever_arm_of_forces`): two explanations right to the noise differ by the noise's draw (tens of per cent
+#: on the medians of a copy's points); a wrong one leaves the structure it misses, of the order of the line itself
+LEVER_MISFIT_RATIO = 2.0
 #: The other channel of a radial pair.
 PARTNER = {"Fx": "Fy", "Fy": "Fx", "Tx": "Ty", "Ty": "Tx"}
 #: A radial force in a radial torque this close to ±90° (deg) is the partner force's r × F (:func:`_lever_arm_through_partner`).
@@ -146,7 +155,8 @@ def find_channel_copies(ctx, test=None) -> list:
                 continue
             got = _pair(X[mine, s], X[mine, t], noise[mine, t], run_of[mine], h[mine], cs, ct,
                         ctx.omega[run_of[mine]])
-            if got is not None and not _lever_arm_through_partner(got):
+            if got is not None and not _lever_arm_through_partner(got) and \
+                    not _lever_arm_of_forces(got, X[mine], chans, run_of[mine], h[mine]):
                 found.append(got)
     # a radial pair carrying the other radial pair's content alike (Tx = κ·Fx and Ty = κ·Fy) is the rotor's own
     # pattern (a force and a moment of one rotating source, in phase; the virtual stand's wheel without modes), not a
@@ -174,6 +184,50 @@ def _lever_arm_through_partner(copy: ChannelCopy) -> bool:
     if partner is None or (partner, copy.target) not in LEVER_ARM_PAIRS:
         return False
     return abs(abs(np.degrees(np.angle(copy.kappa))) - 90.0) <= LEVER_PHASE_DEG
+
+
+def _lever_arm_of_forces(copy: ChannelCopy, X: np.ndarray, chans: tuple, runs, h) -> bool:
+    """Whether the copy's target, a torque, reads a load-cell offset's r × F of the forces (its row of r × F with real
+    r, :data:`TORQUE_ROW`: T_x = r_y·F_z − r_z·F_y, T_y = r_z·F_x − r_x·F_z, T_z = r_x·F_y − r_y·F_x, fitted by least
+    squares) within :data:`LEVER_MISFIT_RATIO` of how closely it reads κ × the source, at the copy's points: the
+    source's lines ``copy.lines_h`` in ``copy.runs`` whose ratio lies within :data:`CLUSTER_TOLERANCE` of κ (``X``
+    (P, K) the transforms of ``chans`` at the source's points, their ``runs`` and line ratios ``h``); the median
+    relative misfit |X_t − fit|/|X_t| of the two explanations compared.
+
+    An offset puts r × F into every torque: where one term dominates a torque (T_y ≈ r_z·F_x with r_z large), another
+    torque's r × F (T_z = r_x·F_y − r_y·F_x, the same rotating force lines) is that torque times one complex constant
+    on every co-rotating line (F_y = ∓j·F_x), a copy to the cluster of ratios; taken out before the search it took
+    the very equations that tell the offset's lateral part (trial16's wheel, r = (4, −3, 30) mm: T_z read as
+    0.167 × T_y, r then fitted (0.04, −0.03, 30.02) mm, and r_x·F_z in T_y, the axial mode's 400 Hz, named a
+    'wheel mode' on the radial torque).  The forces' pairs of a torque are left to the ``cross_coupling`` class
+    (:data:`LEVER_ARM_PAIRS`); a copy the target's lever-arm forces explain as well is theirs too.  A cross-sensitive
+    torque (T_z = κ·T_x of the wheel's own moment) is not: the wheel's own torque lines and its forces' have
+    amplitudes and phases of their own from line to line and, through the modes, from speed to speed, which no one r
+    maps onto each other.  Measured (median relative misfits, lever arm / copy, over the torque pairs tried):
+    trial16's offset, offset@2 and offD (r_z 30 mm and a lateral part), 0.006-0.019 / 0.009-0.018, both at the noise
+    (ratio 0.34-1.26); the open world's torque crosstalk (T_z += 0.3·T_x, family wheels 0-7), 0.18-1.0 / 0.003-0.019
+    (ratio 17-330)."""
+    if copy.target not in TORQUE_ROW:
+        return False
+    rows = TORQUE_ROW[copy.target]
+    if not all(f in chans for f, _ in rows):
+        return False
+    s, t = chans.index(copy.source), chans.index(copy.target)
+    sel = np.isin(h, copy.lines_h) & np.isin(runs, copy.runs)
+    Xs, Xt = X[sel, s], X[sel, t]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sel2 = np.isfinite(Xt / Xs) & (np.abs(Xt / Xs - copy.kappa) <= CLUSTER_TOLERANCE * abs(copy.kappa))
+    idx = np.flatnonzero(sel)[sel2]
+    if idx.size < MIN_RUNS:
+        return False
+    Xt = X[idx, t]
+    scale = np.maximum(np.abs(Xt), 1e-300)
+    A = np.column_stack([sign * X[idx, chans.index(f)] / scale for f, sign in rows])     # (P, 2) complex
+    b = Xt / scale
+    coef, *_ = np.linalg.lstsq(np.vstack([A.real, A.imag]), np.concatenate([b.real, b.imag]), rcond=None)
+    lever = float(np.median(np.abs(b - A @ coef)))
+    own = float(np.median(np.abs(Xt - copy.kappa * X[idx, s]) / scale))
+    return lever <= LEVER_MISFIT_RATIO * own
 
 
 def _one_line_copy(X_s, X_t, omega, runs, h, near, strong) -> list:
