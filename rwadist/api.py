@@ -499,7 +499,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     DataError
         Runs at fewer than 2 distinct speeds (:func:`rwadist.validate.check_test_speeds`).
     """
-    from . import channel_polarity, data_quality, speed_check, speed_whirl
+    from . import channel_polarity, data_quality, speed_check, speed_runs, speed_whirl
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
@@ -523,10 +523,13 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     check_f_lim(test, f_lim)            # before the search starts, not after it
     # a steady test's speed column checked against its imbalance's 1x lines, scaled when they all sit at one ratio
     test, checked = speed_check.checked(test)
-    # a radial pair whose 1x line reads mirrored against the other pair's: one channel's sign flipped back
+    # a radial pair whose 1x line reads mirrored against the other pair's: one channel's sign flipped back (before
+    # the runs' own speeds: those read the 1x lines' senses)
     test, polarity = channel_polarity.checked(test)
     if polarity is not None:
         warnings.warn(RwadistWarning(channel_polarity.polarity_lines(polarity)[0]), stacklevel=2)
+    # each run's own mean speed from its 1x lines, taken where it is off the column beyond its own uncertainty
+    test, checked = speed_runs.own_speeds(test, checked)
 
     def run(test, base_check):
         spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))

@@ -431,7 +431,8 @@ def cmd_diagnose(args) -> int:
 
         for line in quality_lines(diag.data_quality):
             print(f"  ! {line}")
-    if diag.speed.get("source") in ("data", "scaled") or diag.speed.get("runs_off") or diag.speed.get("runs_doubtful"):
+    if diag.speed.get("source") in ("data", "scaled") or any(diag.speed.get(k) for k in ("runs_off", "runs_doubtful",
+                                                                                           "runs_speed")):
         from .speed_whirl import speed_lines
 
         # how the speed was obtained was said when the sweep was read; the whirl's test (and any warning) follows;

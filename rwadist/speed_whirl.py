@@ -217,7 +217,8 @@ def speed_record(meta, check: dict | None = None) -> dict:
     method, ratios, the 1× line's evidence, agreement, the whirl's test, a warning when the speed is suspect).
     A steady test's record holds ``check`` when the 1× lines were measured, and ``runs_off`` with a ``warning``
     when single runs' speeds were taken from their own 1× lines (:func:`rwadist.speed_check.checked`; the method says
-    which), ``runs_doubtful`` with a ``warning`` when a run's 1× lines read off beside a line at its given speed (its
+    which), ``runs_speed`` with a ``warning`` when runs' mean speeds were taken from their own 1× lines beyond their
+    uncertainty or their lines are wider than a steady tone (:func:`rwadist.speed_runs.own_speeds`), ``runs_doubtful`` with a ``warning`` when a run's 1× lines read off beside a line at its given speed (its
     speed kept)."""
     slicing = (meta or {}).get("slicing")
     if not isinstance(slicing, dict):
@@ -239,6 +240,16 @@ def speed_record(meta, check: dict | None = None) -> dict:
                              "taken at the speed of its own 1x lines")
             out["warning"] = " ".join(filter(None, (out.get("warning"), (
                 f"{check['text_runs']} (a tach glitch or a speed typed wrong in that run: check its speed_rpm)"))))
+        own = (check or {}).get("runs_speed") or {}
+        if own.get("runs_moved") or own.get("wander"):
+            out["runs_speed"] = own
+        if own.get("runs_moved"):
+            out["method"] = f"{out['method']}; {own['text']}"
+            out["warning"] = " ".join(filter(None, (out.get("warning"), (
+                f"the speed column is off each run's rotor speed by {100 * own['rms_rel']:.3g} % RMS (its 1x lines "
+                "read to a few ppm): check how speed_rpm was recorded (a set-point, or one tach reading per run)"))))
+        if own.get("wander"):
+            out["warning"] = " ".join(filter(None, (out.get("warning"), own["wander"]["text"])))
         if check and check.get("runs_doubtful"):
             out["runs_doubtful"] = check["runs_doubtful"]
             out["warning"] = " ".join(filter(None, (out.get("warning"), (

@@ -1,0 +1,200 @@
+"""Each run's own speed from its own 1× lines (issue 33, item 5: a speed column slightly off in each run).
+
+A steady run's speed column can be off by a little in every run (a tach read once per run, a speed controller's
+set-point printed instead of the speed reached): trial 16's runs each at a constant speed 0.25 % rms off their column
+put a line at h 6.16 of 5000 rpm 1.3 Hz (5 bins of a 4 s record) beside the model's, 30-58x the clean error, with
+nothing said.  :mod:`rwadist.speed_check` moves a whole test (a common scale) or a run whose 1× lines sit off by more
+than the runs' scatter; a scatter of every run about its column is below that test by construction.  Here each run is
+judged against its *own* uncertainty instead:
+
+* the imbalance is at exactly 1× the rotor speed, on every wheel: the radial force pair, the radial torque pair and
+  the axial force are read where :func:`rwadist.speed_check.line_ratios` counts them (they stand
+  :data:`rwadist.speed_scale.PAIR_SNR` over the local noise, a pair turning one way, the way of the majority);
+* each line's frequency is refined to well below a bin by maximising the exact Hann-windowed transform of the run
+  (:func:`zoom_peak`: a three-point log parabola at :data:`ZOOM` of a native bin, twice, about the padded peak), with
+  its standard deviation from the Cramér-Rao bound of a tone in white noise at the line's SNR
+  (:func:`line_sigma`: ``df·√2 / (2π·√SNR)``, inflated by :data:`HANN_LOSS` for the window), and a floor
+  :data:`REL_FLOOR` (what the neighbouring lines' leakage leaves);
+* the run's relative speed error is the lines' inverse-variance mean of ``f_line/f_applied − 1``; its standard error
+  is inflated by the lines' own disagreement (√(χ²/dof) when above 1).
+
+A run's speed is taken from its lines only when at least two lines are read in it, they agree (χ²/dof within
+:data:`AGREE_CHI2`: one line pulled by a fixed line passing near 1× is not the rotor), and the mean is off its column
+by more than :data:`SIGMAS` standard errors.  On true speeds every run's error is within its uncertainty and nothing
+moves: the test is returned untouched (the identical object).  The speed within a run is taken as constant: the
+refined frequency is the run's mean speed (a wander within the run, e.g. trial 16's 0.3 % Ornstein-Uhlenbeck, widens
+the lines and is not corrected here).
+
+Units: Hz for frequencies, rad/s for the runs' speeds, dimensionless relative errors.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import replace
+
+import numpy as np
+
+from .speed_check import LINES, _window_and_bins, line_ratios, run_line, run_spectra
+
+#: spacing, in native bins, of the three exact transforms about a peak whose log parabola refines it
+ZOOM = 0.05
+#: variance inflation of a Hann-windowed frequency estimate over the rectangular window's Cramér-Rao bound
+HANN_LOSS = 1.5
+#: relative floor of one line's frequency uncertainty (leakage of the run's other lines, the window's bias)
+REL_FLOOR = 1.0e-5
+#: standard errors by which a run's mean speed must be off its column to be taken from its lines
+SIGMAS = 6.0
+#: χ²/dof of a run's lines about their mean above which they are called in disagreement (one is something else)
+AGREE_CHI2 = 9.0
+#: the runs' lines needed to judge a run's speed
+MIN_LINES = 2
+#: runs (and half of those judged) whose lines are all wider than a tone for the speed to be called wandering
+MIN_WIDE = 3
+
+
+def _transform(run, channels: tuple, freqs: np.ndarray) -> np.ndarray:
+    """Σ over ``channels`` of |X(f)|² of the run's Hann-windowed samples (less their mean) at ``freqs`` Hz: the exact
+    transform (no bins)."""
+    n = run.n_samples
+    win = _window_and_bins(n, float(run.sample_rate))[0]
+    t = np.arange(n) / float(run.sample_rate)
+    kernel = np.exp(-2j * np.pi * np.outer(freqs, t)) * win
+    total = np.zeros(len(freqs))
+    for c in channels:
+        x = np.asarray(run.signals[c], dtype=float)
+        total += np.abs(kernel @ (x - x.mean())) ** 2
+    return total
+
+
+def zoom_peak(run, channels: tuple, f_peak: float) -> tuple:
+    """(frequency Hz, curvature 1/Hz²) of the maximum of ``channels``' exact windowed power near ``f_peak`` (a padded
+    spectrum's peak, :func:`rwadist.speed_check.run_line`): a log parabola through the transform at ``f ± ZOOM``
+    native bins, twice (each step kept within one spacing); the curvature is the last parabola's d²(ln P)/df² (nan
+    when the three points do not bend down)."""
+    step = ZOOM * float(run.sample_rate) / run.n_samples
+    f, curv = float(f_peak), np.nan
+    for _ in range(2):
+        a, b, c = np.log(np.maximum(_transform(run, channels, np.array([f - step, f, f + step])), 1e-300))
+        den = a - 2 * b + c
+        if not den < 0:
+            curv = np.nan
+            break
+        curv = float(den / step ** 2)
+        f += step * float(np.clip(0.5 * (a - c) / den, -1.0, 1.0))
+    return f, curv
+
+
+def tone_curvature(run) -> float:
+    """d²(ln P)/df² (1/Hz²) at the peak of one steady tone's Hann-windowed power: −8π² times the variance of the
+    time under the window's weights (the second-order expansion of |Σ w_n e^(−i2πu t_n)|² about u = 0)."""
+    n = run.n_samples
+    win = _window_and_bins(n, float(run.sample_rate))[0]
+    t = np.arange(n) / float(run.sample_rate)
+    mean = float(np.sum(win * t) / np.sum(win))
+    return float(-8 * np.pi ** 2 * np.sum(win * (t - mean) ** 2) / np.sum(win))
+
+
+def width_rel(curv: float, tone: float, f_line: float) -> float:
+    """A line's relative width beyond a steady tone's: √(1/|curv| − 1/|tone|)/f_line (a Gaussian line's variance
+    added to the window's), 0 when the line is no wider than a tone, nan when ``curv`` is."""
+    if not np.isfinite(curv):
+        return np.nan
+    return float(np.sqrt(max(0.0, -1.0 / curv + 1.0 / tone)) / f_line)
+
+
+def line_sigma(run, snr: float, f_line: float) -> float:
+    """Standard deviation (Hz) of a line's refined frequency: the Cramér-Rao bound of one tone in white noise,
+    ``df·√2/(2π·√SNR)`` with SNR the line's power over the mean noise power of a bin (the local median / ln 2),
+    inflated by :data:`HANN_LOSS`, with the floor :data:`REL_FLOOR` · ``f_line``."""
+    df = float(run.sample_rate) / run.n_samples
+    crb = df * np.sqrt(2.0 * HANN_LOSS) / (2 * np.pi * np.sqrt(max(snr * np.log(2.0), 1e-12)))
+    return float(max(crb, REL_FLOOR * f_line))
+
+
+def run_errors(test) -> list:
+    """Per run: None (not judged) or a dict ``rel`` (the lines' mean of f_line/f_applied − 1), ``se`` (its standard
+    error, with the lines' width added in quadrature where every line of the run is wider than a tone beyond
+    :data:`SIGMAS` of its own frequency's standard deviation), ``chi2`` (per degree of freedom), ``lines`` (the keys
+    of :data:`rwadist.speed_check.LINES` read), ``width`` (that relative width, :func:`width_rel`'s median, else 0)."""
+    ratios = line_ratios(test)
+    out: list = []
+    for i, run in enumerate(test.runs):
+        f0 = abs(float(run.speed)) / (2 * np.pi)
+        keys = [k for k, r in ratios.items() if np.isfinite(r[i])]
+        if len(keys) < MIN_LINES:
+            out.append(None)
+            continue
+        chans = [c for k in keys for c in LINES[k][0]]
+        spectra = run_spectra(run, chans)
+        rel, sig, wid = [], [], []
+        tone = tone_curvature(run)
+        for k in keys:
+            f_peak, snr, _ = run_line(run, LINES[k][0], f0, spectra)
+            f, curv = zoom_peak(run, LINES[k][0], f_peak)
+            rel.append(f / f0 - 1.0)
+            sig.append(line_sigma(run, snr, f) / f0)
+            wid.append(width_rel(curv, tone, f))
+        rel_a, w = np.array(rel), 1.0 / np.array(sig) ** 2
+        mean = float(np.sum(w * rel_a) / np.sum(w))
+        chi2 = float(np.sum(w * (rel_a - mean) ** 2) / (len(rel) - 1))
+        se = float(np.sqrt(1.0 / np.sum(w)) * np.sqrt(max(1.0, chi2)))
+        # every line of the run wider than a steady tone beyond its own uncertainty: the speed moved within the run,
+        # and the peak is its mean only to within the width
+        widened = bool(np.all(np.array(wid) > SIGMAS * np.array(sig)))
+        width = float(np.median(wid)) if widened else 0.0
+        out.append({"rel": mean, "se": float(np.hypot(se, width)), "chi2": chi2, "lines": keys, "width": width})
+    return out
+
+
+def own_speeds(test, check: dict) -> tuple:
+    """(test, check): ``test`` with each run whose own 1× lines put its mean speed off the speed applied (module
+    docstring) at the speed they give, and ``check`` (:func:`rwadist.speed_check.check_record`'s record) with
+    ``runs_speed``: method, the runs judged, their RMS relative error, the runs moved (name, given and taken rpm,
+    relative correction and its standard error, lines) and one sentence ``text``; ``test`` itself, untouched, when no
+    run moves.  Runs :func:`rwadist.speed_check.checked` already moved (``runs_off``) or doubted are left alone."""
+    if not check or not check.get("lines"):
+        return test, check
+    skip = {x["run"] for x in check.get("runs_off", []) + check.get("runs_doubtful", [])}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        errors = run_errors(test)
+    judged = {i: e for i, e in enumerate(errors) if e is not None and i not in skip}
+    if not judged:
+        return test, check
+    wide = [e["width"] for e in judged.values() if e["width"] > 0]
+    wander = len(wide) >= max(MIN_WIDE, 0.5 * len(judged))
+    # a speed that wanders within the runs: a line's peak is not the run's mean speed (trial 16's 0.3 % wander read
+    # 0.1 % RMS off the runs' means), and nothing is moved
+    moved = {} if wander else {i: e for i, e in judged.items()
+                               if e["chi2"] <= AGREE_CHI2 and abs(e["rel"]) > SIGMAS * e["se"]}
+    rms = float(np.sqrt(np.mean([e["rel"] ** 2 for e in judged.values()])))
+    rec = {"method": ("each run's mean speed from its own 1x lines (exact windowed transform's peak, weighted by "
+                      "their SNR); taken where two lines or more agree and sit off the column beyond "
+                      f"{SIGMAS:g} standard errors"),
+           "runs_judged": len(judged), "rms_rel": round(rms, 7),
+           "runs_moved": [{"run": i, "run_name": test.runs[i].name or str(i),
+                           "given_rpm": round(abs(float(test.runs[i].speed)) * 30 / np.pi, 6),
+                           "speed_rpm": round(abs(float(test.runs[i].speed)) * 30 / np.pi * (1 + e["rel"]), 6),
+                           "rel": round(e["rel"], 7), "se_rel": round(e["se"], 7),
+                           "lines": ", ".join(LINES[k][1] for k in e["lines"])} for i, e in moved.items()]}
+    if moved:
+        big = max(moved.values(), key=lambda e: abs(e["rel"]))
+        rec["text"] = (f"{len(moved)} of {len(judged)} runs taken at the speed of their own 1x lines: each run's speed "
+                       f"is off its column by {100 * rms:.3g} % RMS (largest {100 * big['rel']:+.3g} %, "
+                       f"to +/-{100 * float(np.median([e['se'] for e in moved.values()])):.2g} % each)")
+    else:
+        rec["text"] = (f"each run's 1x lines agree with its speed within their uncertainty "
+                       f"({len(judged)} runs, {100 * rms:.3g} % RMS)")
+    if wander:
+        rec["wander"] = {"runs": len(wide), "width_rel_median": round(float(np.median(wide)), 7), "text": (
+            f"the speed wanders within the runs: in {len(wide)} of {len(judged)} runs every 1x line is wider than a "
+            f"steady tone's (by {100 * float(np.median(wide)):.2g} % of its frequency, median; from the peak's "
+            "curvature, which reads a slow wander low), the lines of a run alike: the rotor's speed moved during each "
+            "record (a speed loop hunting, a drifting set-point); the model takes each run at one speed, and lines "
+            "at high h are smeared in the data; the runs' speeds are kept as given (a wandering line's peak is "
+            "not the run's mean speed)")}
+    check = dict(check, runs_speed=rec)
+    if not moved:
+        return test, check
+    runs = [replace(r, speed=r.speed * (1 + moved[i]["rel"])) if i in moved else r for i, r in enumerate(test.runs)]
+    return type(test)(runs, dict(test.meta or {})), check
