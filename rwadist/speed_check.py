@@ -135,13 +135,10 @@ def run_spectra(run, channels, buffers: dict | None = None) -> dict:
     return dict(zip(channels, sfft.rfft(padded, axis=-1)))
 
 
-def line_ratios(test) -> dict:
-    """Per 1× line of :data:`LINES` recorded: (ratio f_line/f_given (n_runs,), nan where the line was not
-    measured; the runs' indices kept).  A pair's line counts where it stands PAIR_SNR over its noise and turns
-    one way, the same way relative to the run's speed as the majority of such runs."""
-    out = {}
+def line_reads(test) -> dict:
+    """Per 1× line of :data:`LINES` recorded: (n_runs, 3) of :func:`run_line`'s (frequency Hz, SNR, co-rotating
+    share) in each run at its given speed, nan where the run is not measured."""
     f_given = np.abs(np.array([r.speed for r in test.runs], dtype=float)) / (2 * np.pi)
-    sign = np.sign([r.speed for r in test.runs])
     keys = [key for key, (channels, _) in LINES.items() if any(all(r.usable(c) for c in channels) for r in test.runs)]
     read: dict = {key: [] for key in keys}
     buffers: dict = {}
@@ -151,9 +148,20 @@ def line_ratios(test) -> dict:
         spectra = run_spectra(r, chans, buffers) if chans and _measurable(r, f0) else {}
         for key in keys:
             read[key].append(run_line(r, LINES[key][0], f0, spectra))
-    for key in keys:
+    return {key: np.array(read[key], dtype=float).reshape(len(test.runs), 3) for key in keys}
+
+
+def line_ratios(test, reads: dict | None = None) -> dict:
+    """Per 1× line of :data:`LINES` recorded: (ratio f_line/f_given (n_runs,), nan where the line was not
+    measured; the runs' indices kept).  A pair's line counts where it stands PAIR_SNR over its noise and turns
+    one way, the same way relative to the run's speed as the majority of such runs.  ``reads``: the test's
+    :func:`line_reads`, when the caller has them."""
+    out = {}
+    f_given = np.abs(np.array([r.speed for r in test.runs], dtype=float)) / (2 * np.pi)
+    sign = np.sign([r.speed for r in test.runs])
+    reads = line_reads(test) if reads is None else reads
+    for key, meas in reads.items():
         channels = LINES[key][0]
-        meas = np.array(read[key])
         f_line, snr, share = meas[:, 0], meas[:, 1], meas[:, 2]
         ok = np.isfinite(f_line) & (snr >= PAIR_SNR)
         if len(channels) == 2:

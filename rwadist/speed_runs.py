@@ -34,7 +34,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .speed_check import LINES, _window_and_bins, line_ratios, run_line, run_spectra
+from .speed_check import LINES, _window_and_bins, line_ratios, line_reads
 
 #: spacing, in native bins, of the three exact transforms about a peak whose log parabola refines it
 ZOOM = 0.05
@@ -116,7 +116,8 @@ def run_errors(test) -> list:
     error, with the lines' width added in quadrature where every line of the run is wider than a tone beyond
     :data:`SIGMAS` of its own frequency's standard deviation), ``chi2`` (per degree of freedom), ``lines`` (the keys
     of :data:`rwadist.speed_check.LINES` read), ``width`` (that relative width, :func:`width_rel`'s median, else 0)."""
-    ratios = line_ratios(test)
+    reads = line_reads(test)            # each line's peak and SNR, read once for the ratios and the refinement
+    ratios = line_ratios(test, reads)
     out: list = []
     for i, run in enumerate(test.runs):
         f0 = abs(float(run.speed)) / (2 * np.pi)
@@ -124,12 +125,10 @@ def run_errors(test) -> list:
         if len(keys) < MIN_LINES:
             out.append(None)
             continue
-        chans = [c for k in keys for c in LINES[k][0]]
-        spectra = run_spectra(run, chans)
         rel, sig, wid = [], [], []
         tone = tone_curvature(run)
         for k in keys:
-            f_peak, snr, _ = run_line(run, LINES[k][0], f0, spectra)
+            f_peak, snr = float(reads[k][i, 0]), float(reads[k][i, 1])
             f, curv = zoom_peak(run, LINES[k][0], f_peak)
             rel.append(f / f0 - 1.0)
             sig.append(line_sigma(run, snr, f) / f0)
