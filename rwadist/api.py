@@ -521,15 +521,15 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     check_test_speeds(test, source or (data if isinstance(data, (str, Path)) else "the test"),
                       model_given=model is not None or preset is not None)
     check_f_lim(test, f_lim)            # before the search starts, not after it
-    # a steady test's speed column checked against its imbalance's 1x lines, scaled when they all sit at one ratio
-    test, checked = speed_check.checked(test)
+    # a steady test's speed column checked against its 1x lines (read once for the next two steps too: `reads`)
+    test, checked = speed_check.checked(test, reads := speed_check.LineReads())
     # a radial pair whose 1x line reads mirrored against the other pair's: one channel's sign flipped back (before
     # the runs' own speeds: those read the 1x lines' senses)
-    test, polarity = channel_polarity.checked(test)
+    test, polarity = channel_polarity.checked(test, reads)
     if polarity is not None:
         warnings.warn(RwadistWarning(channel_polarity.polarity_lines(polarity)[0]), stacklevel=2)
     # each run's own mean speed from its 1x lines, taken where it is off the column beyond its own uncertainty
-    test, checked = speed_runs.own_speeds(test, checked)
+    test, checked = speed_runs.own_speeds(test, checked, reads)
 
     def run(test, base_check):
         spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))

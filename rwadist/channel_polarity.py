@@ -41,11 +41,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from .speed_check import MIN_RUNS, run_line, run_spectra
+from .speed_check import LINES, MIN_RUNS, LineReads
 from .speed_scale import PAIR_SNR
 
 #: the radial pairs: direction -> (x channel, y channel)
-PAIRS = {"radial_force": ("Fx", "Fy"), "radial_torque": ("Tx", "Ty")}
+PAIRS = {d: LINES[d][0] for d in ("radial_force", "radial_torque")}
 #: median co-rotating share of a 1× line read as co-rotating (its mirror 1 − POLARIZED_1X: counter-rotating)
 POLARIZED_1X = 0.8
 #: a bin of a pair's complex spectrum counts as line power this many times over the run's median bin power
@@ -54,17 +54,14 @@ LINE_SNR = 100.0
 LOW_BINS = 4
 
 
-def _one_x_shares(test, pair: tuple) -> np.ndarray:
-    """Per run the co-rotating share of the pair's 1× line relative to the run's spin (nan where not measured)."""
-    out = np.full(len(test.runs), np.nan)
-    for i, run in enumerate(test.runs):
-        if run.speed == 0 or not all(run.usable(c) for c in pair):
-            continue
-        f0 = abs(float(run.speed)) / (2 * np.pi)
-        _, snr, share = run_line(run, pair, f0, run_spectra(run, pair))
-        if np.isfinite(share) and snr >= PAIR_SNR:
-            out[i] = share if run.speed > 0 else 1.0 - share
-    return out
+def _one_x_shares(test, direction: str, reads: dict) -> np.ndarray:
+    """Per run the co-rotating share of the ``direction``'s 1× line relative to the run's spin (nan where not
+    measured), from ``reads`` (:func:`rwadist.speed_check.line_reads` of ``test``: the line and its share at the
+    run's given speed, nan where the run lacks the pair or the speed puts the line out of reach)."""
+    _, snr, share = reads[direction].T
+    speed = np.array([r.speed for r in test.runs], dtype=float)
+    ok = (speed != 0) & np.isfinite(share) & (snr >= PAIR_SNR)
+    return np.where(ok, np.where(speed > 0, share, 1.0 - share), np.nan)
 
 
 def line_power_counter_share(test, pair: tuple) -> float:
@@ -91,14 +88,16 @@ def _reading(shares: np.ndarray, spinning: int) -> float:
     return float(np.median(ok)) if ok.size >= max(MIN_RUNS, int(np.ceil(0.5 * spinning))) else float("nan")
 
 
-def check_record(test) -> dict | None:
+def check_record(test, reads: LineReads | None = None) -> dict | None:
     """The ``reversed_polarity`` record of a steady test (module docstring) when one radial pair reads reversed
-    against the other, else None."""
+    against the other, else None.  ``reads``: a :class:`rwadist.speed_check.LineReads` shared with the steps before
+    and after this one, or None."""
     pairs = {d: p for d, p in PAIRS.items() if any(all(r.usable(c) for c in p) for r in test.runs)}
     if len(pairs) < 2:
         return None
     spinning = sum(1 for r in test.runs if r.speed != 0)
-    shares = {d: _one_x_shares(test, p) for d, p in pairs.items()}
+    read = (reads or LineReads())(test)
+    shares = {d: _one_x_shares(test, d, read) for d in pairs}
     med = {d: _reading(s, spinning) for d, s in shares.items()}
     rev = [d for d in pairs if med[d] <= 1 - POLARIZED_1X]
     if len(rev) != 1:
@@ -117,10 +116,10 @@ def check_record(test) -> dict | None:
             "action": f"{y} multiplied by -1 in every run before the fit"}
 
 
-def checked(test) -> tuple:
+def checked(test, reads: LineReads | None = None) -> tuple:
     """(test, record): ``test`` with the reversed pair's y channel multiplied by −1 in every run (a copy; its meta
-    records it) when :func:`check_record` finds one, else (``test``, None)."""
-    rec = check_record(test)
+    records it) when :func:`check_record` finds one, else (``test``, None).  ``reads``: as :func:`check_record`'s."""
+    rec = check_record(test, reads)
     if rec is None:
         return test, None
     y = rec["channel"]

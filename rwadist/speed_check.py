@@ -151,6 +151,22 @@ def line_reads(test) -> dict:
     return {key: np.array(read[key], dtype=float).reshape(len(test.runs), 3) for key in keys}
 
 
+class LineReads:
+    """:func:`line_reads` of the last test it was called with, kept: the steps before the search (the column's check,
+    the radial pairs' polarity, the runs' own speeds, :func:`rwadist.api.diagnose`) read the 1× lines of one test
+    once.  The same test is the same object: a step that changes a speed or a channel returns a new one, which is
+    read anew."""
+
+    def __init__(self) -> None:
+        self._test: object = None
+        self._reads: dict = {}
+
+    def __call__(self, test) -> dict:
+        if test is not self._test:
+            self._reads, self._test = line_reads(test), test
+        return self._reads
+
+
 def line_ratios(test, reads: dict | None = None) -> dict:
     """Per 1× line of :data:`LINES` recorded: (ratio f_line/f_given (n_runs,), nan where the line was not
     measured; the runs' indices kept).  A pair's line counts where it stands PAIR_SNR over its noise and turns
@@ -200,18 +216,19 @@ def _unchecked(ratios: dict, spinning: int) -> str:
             "one way there)")
 
 
-def check_record(test) -> dict:
+def check_record(test, reads: LineReads | None = None) -> dict:
     """What the 1× lines say of a steady test's speed column (module docstring): a JSON-ready dict with
     ``lines`` (per line measured: k, spread, runs), ``scale`` (the common k, or None when none is judged),
     ``scaled`` (True when the column is to be multiplied by ``scale``), ``agreement_rel`` (the RMS over the
     lines' runs of r/k − 1 about the k applied, 1 when not scaled) and ``text`` (one sentence); {} for a
-    test whose speeds are a sweep's slices (``meta["slicing"]``) or with no spinning run."""
+    test whose speeds are a sweep's slices (``meta["slicing"]``) or with no spinning run.  ``reads``: a
+    :class:`LineReads` shared with the steps after this one, or None."""
     if (getattr(test, "meta", None) or {}).get("slicing") is not None:
         return {}
     spinning = int(np.sum(np.abs([r.speed for r in test.runs]) > 0))
     if spinning == 0:
         return {}
-    ratios = line_ratios(test)
+    ratios = line_ratios(test, (reads or LineReads())(test))
     stats = {key: _scale(r) for key, r in ratios.items()}
     judged = {key: s for key, s in stats.items() if s[3] >= MIN_RUNS}
     lines = {key: {"k": round(s[0], 7), "spread_rel": round(s[1], 7), "runs": s[3]} for key, s in judged.items()}
@@ -349,13 +366,14 @@ def _line_at_given(run, channels: tuple, f_given: float, f_read: float, others=(
     return not (len(fixed) >= 2 and np.mean(fixed) >= 0.5)
 
 
-def checked(test) -> tuple:
+def checked(test, reads: LineReads | None = None) -> tuple:
     """(test, record): ``test`` with every run's speed multiplied by the scale its 1× lines give when
     :func:`check_record` calls the column off, and each run whose own 1× lines put it off (``runs_off``) at the
-    speed they give (a copy; its meta is left alone), else ``test`` itself, untouched."""
+    speed they give (a copy; its meta is left alone), else ``test`` itself, untouched.  ``reads``: a
+    :class:`LineReads` shared with the steps after this one, or None."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        rec = check_record(test)
+        rec = check_record(test, reads)
     scale = rec["scale"] if rec.get("scaled") else 1.0
     each = {x["run"]: x["ratio"] for x in rec.get("runs_off", [])}
     if scale == 1.0 and not each:

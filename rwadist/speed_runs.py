@@ -34,7 +34,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .speed_check import LINES, _window_and_bins, line_ratios, line_reads
+from .speed_check import LINES, LineReads, _window_and_bins, line_ratios
 
 #: spacing, in native bins, of the three exact transforms about a peak whose log parabola refines it
 ZOOM = 0.05
@@ -130,13 +130,14 @@ def line_sigma(run, snr: float, f_line: float) -> float:
     return float(max(crb, REL_FLOOR * f_line))
 
 
-def run_errors(test) -> list:
+def run_errors(test, reads: LineReads | None = None) -> list:
     """Per run: None (not judged) or a dict ``rel`` (the lines' mean of f_line/f_applied − 1), ``se`` (its standard
     error, with the lines' width added in quadrature where every line of the run is wider than a tone beyond
     :data:`SIGMAS` of its own frequency's standard deviation), ``chi2`` (per degree of freedom), ``lines`` (the keys
-    of :data:`rwadist.speed_check.LINES` read), ``width`` (that relative width, :func:`width_rel`'s median, else 0)."""
-    reads = line_reads(test)            # each line's peak and SNR, read once for the ratios and the refinement
-    ratios = line_ratios(test, reads)
+    of :data:`rwadist.speed_check.LINES` read), ``width`` (that relative width, :func:`width_rel`'s median, else 0).
+    ``reads``: a :class:`rwadist.speed_check.LineReads` shared with the steps before this one, or None."""
+    read = (reads or LineReads())(test)     # each line's peak and SNR, read once for the ratios and the refinement
+    ratios = line_ratios(test, read)
     out: list = []
     for i, run in enumerate(test.runs):
         f0 = abs(float(run.speed)) / (2 * np.pi)
@@ -149,7 +150,7 @@ def run_errors(test) -> list:
         chans = [c for k in keys for c in LINES[k][0]]
         blocks = dict(zip(chans, _blocks(run, tuple(chans))))       # every line's channels windowed once per run
         for k in keys:
-            f_peak, snr = float(reads[k][i, 0]), float(reads[k][i, 1])
+            f_peak, snr = float(read[k][i, 0]), float(read[k][i, 1])
             f, curv = zoom_peak(run, LINES[k][0], f_peak, np.stack([blocks[c] for c in LINES[k][0]]))
             rel.append(f / f0 - 1.0)
             sig.append(line_sigma(run, snr, f) / f0)
@@ -166,18 +167,19 @@ def run_errors(test) -> list:
     return out
 
 
-def own_speeds(test, check: dict) -> tuple:
+def own_speeds(test, check: dict, reads: LineReads | None = None) -> tuple:
     """(test, check): ``test`` with each run whose own 1× lines put its mean speed off the speed applied (module
     docstring) at the speed they give, and ``check`` (:func:`rwadist.speed_check.check_record`'s record) with
     ``runs_speed``: method, the runs judged, their RMS relative error, the runs moved (name, given and taken rpm,
     relative correction and its standard error, lines) and one sentence ``text``; ``test`` itself, untouched, when no
-    run moves.  Runs :func:`rwadist.speed_check.checked` already moved (``runs_off``) or doubted are left alone."""
+    run moves.  Runs :func:`rwadist.speed_check.checked` already moved (``runs_off``) or doubted are left alone.
+    ``reads``: a :class:`rwadist.speed_check.LineReads` shared with the steps before this one, or None."""
     if not check or not check.get("lines"):
         return test, check
     skip = {x["run"] for x in check.get("runs_off", []) + check.get("runs_doubtful", [])}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        errors = run_errors(test)
+        errors = run_errors(test, reads)
     judged = {i: e for i, e in enumerate(errors) if e is not None and i not in skip}
     if not judged:
         return test, check

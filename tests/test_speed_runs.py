@@ -125,3 +125,34 @@ def test_factored_transform_is_the_direct_sum(n):
     got = speed_runs._transform(run, ("Fx", "Fy"), freqs)
     np.testing.assert_allclose(got, direct, rtol=1e-10, atol=1e-10 * direct.max())
 
+
+def test_shared_line_reads_give_the_unshared_records():
+    """The column's check, the polarity check and the runs' own speeds with one speed_check.LineReads shared (as
+    api.diagnose runs them) give the records and speeds of each step reading the lines itself, also where a step
+    changes the test under the next (Fy wired reversed and flipped back, then every run's speed moved; the column
+    1 % high and scaled): a new test object is read anew."""
+    from rwadist import channel_polarity
+
+    base, _, _ = family_test(0, 16, 8192, 0.003, SCATTER)
+    flipped = SteadyTest([replace(r, signals=dict(r.signals, Fy=-np.asarray(r.signals["Fy"]))) for r in base.runs], {})
+    scaled = SteadyTest([replace(r, speed=1.01 * r.speed) for r in family_test(1, 16, 8192, 0.003, 0.0)[0].runs], {})
+    for test in (flipped, scaled):
+        outs = []
+        for reads in (None, speed_check.LineReads()):
+            t1, ck = speed_check.checked(test, reads)
+            t2, pol = channel_polarity.checked(t1, reads)
+            t3, ck = speed_runs.own_speeds(t2, ck, reads)
+            outs.append((ck, pol, [r.speed for r in t3.runs], t1 is test, t2 is t1))
+        assert outs[0] == outs[1]
+        assert outs[0][2] != [r.speed for r in test.runs]         # a step moved the speeds
+    assert outs[0][3] is False                                   # the scaled column: a new test after the check
+    # the flipped pair: the polarity step flipped Fy back (a new test), and the memo read that test anew: its radial
+    # force shares are the mirror (1 − s) of the flipped data's, at the same frequencies
+    reads = speed_check.LineReads()
+    before = reads(flipped)
+    assert reads(flipped) is before
+    back, pol = channel_polarity.checked(flipped, reads)
+    assert pol is not None and pol["channel"] == "Fy" and back is not flipped
+    after = reads(back)["radial_force"]
+    np.testing.assert_allclose(after[:, 0], before["radial_force"][:, 0], rtol=1e-12)
+    np.testing.assert_allclose(after[:, 2], 1.0 - before["radial_force"][:, 2], atol=1e-9)
