@@ -34,6 +34,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .dft import demeaned_windowed, windowed_dft
 from .speed_check import LINES, LineReads, _window_and_bins, line_ratios
 
 #: spacing, in native bins, of the three exact transforms about a peak whose log parabola refines it
@@ -50,50 +51,39 @@ AGREE_CHI2 = 9.0
 MIN_LINES = 2
 #: runs (and half of those judged) whose lines are all wider than a tone for the speed to be called wandering
 MIN_WIDE = 3
-#: samples per block of the exact transform's factored kernel (:func:`_power`)
-BLOCK = 64
 
 
-def _blocks(run, channels: tuple) -> np.ndarray:
-    """(channels, A, :data:`BLOCK`) of the run's Hann-windowed samples (each channel less its mean), zero-padded to
-    A·BLOCK samples: sample k = BLOCK·a + b at [a, b] (:func:`_power`'s factored kernel)."""
-    n = run.n_samples
-    win = _window_and_bins(n, float(run.sample_rate))[0]
-    y = np.zeros((len(channels), -(-n // BLOCK) * BLOCK))
-    for row, c in zip(y, channels):
-        x = np.asarray(run.signals[c], dtype=float)
-        np.multiply(x - x.mean(), win, out=row[:n])
-    return y.reshape(len(channels), -1, BLOCK)
+def _windowed(run, channels: tuple) -> np.ndarray:
+    """(n, channels) of the run's Hann-windowed samples, each channel less its mean (:func:`_power`'s records)."""
+    win = _window_and_bins(run.n_samples, float(run.sample_rate))[0]
+    return demeaned_windowed([run.signals[c] for c in channels], win).T
 
 
-def _power(blocks: np.ndarray, fs: float, freqs: np.ndarray) -> np.ndarray:
-    """Σ over the channels of ``blocks`` (:func:`_blocks`) of |Σ_k y_k e^(−i2πf k/fs)|² at ``freqs`` Hz: the exact
-    transform, its kernel factored as e^(−i2πf·BLOCK·a/fs) · e^(−i2πf·b/fs) for k = BLOCK·a + b (A + BLOCK complex
-    exponentials per frequency instead of one per sample)."""
-    _, n_a, n_b = blocks.shape
-    inner = np.exp(-2j * np.pi * np.outer(np.arange(n_b) / fs, freqs))                    # (BLOCK, F)
-    outer = np.exp(-2j * np.pi * np.outer(np.arange(n_a) * (n_b / fs), freqs))            # (A, F)
-    x = np.einsum("caf,af->cf", (blocks @ inner.real) + 1j * (blocks @ inner.imag), outer)
-    return np.sum(x.real ** 2 + x.imag ** 2, axis=0)
+def _power(y: np.ndarray, fs: float, freqs: np.ndarray) -> np.ndarray:
+    """Σ over the columns of ``y`` (:func:`_windowed`) of |Σ_k y_k e^(−i2πf k/fs)|² at ``freqs`` Hz: the exact
+    transform (:func:`rwadist.dft.windowed_dft`: its kernel a product of two short tables of phasors, not one
+    complex exponential per sample)."""
+    x = windowed_dft(y, fs, freqs)                                                      # (F, channels)
+    return np.sum(x.real ** 2 + x.imag ** 2, axis=1)
 
 
 def _transform(run, channels: tuple, freqs: np.ndarray) -> np.ndarray:
     """Σ over ``channels`` of |X(f)|² of the run's Hann-windowed samples (less their mean) at ``freqs`` Hz: the exact
     transform (no bins)."""
-    return _power(_blocks(run, channels), float(run.sample_rate), np.asarray(freqs, dtype=float))
+    return _power(_windowed(run, channels), float(run.sample_rate), np.asarray(freqs, dtype=float))
 
 
-def zoom_peak(run, channels: tuple, f_peak: float, blocks: np.ndarray | None = None) -> tuple:
+def zoom_peak(run, channels: tuple, f_peak: float, y: np.ndarray | None = None) -> tuple:
     """(frequency Hz, curvature 1/Hz²) of the maximum of ``channels``' exact windowed power near ``f_peak`` (a padded
     spectrum's peak, :func:`rwadist.speed_check.run_line`): a log parabola through the transform at ``f ± ZOOM``
     native bins, twice (each step kept within one spacing); the curvature is the last parabola's d²(ln P)/df² (nan
-    when the three points do not bend down).  ``blocks``: :func:`_blocks` of ``channels``, or None (made here)."""
+    when the three points do not bend down).  ``y``: :func:`_windowed` of ``channels``, or None (made here)."""
     fs = float(run.sample_rate)
     step = ZOOM * fs / run.n_samples
-    blocks = _blocks(run, channels) if blocks is None else blocks
+    y = _windowed(run, channels) if y is None else y
     f, curv = float(f_peak), np.nan
     for _ in range(2):
-        a, b, c = np.log(np.maximum(_power(blocks, fs, np.array([f - step, f, f + step])), 1e-300))
+        a, b, c = np.log(np.maximum(_power(y, fs, np.array([f - step, f, f + step])), 1e-300))
         den = a - 2 * b + c
         if not den < 0:
             curv = np.nan
@@ -148,10 +138,10 @@ def run_errors(test, reads: LineReads | None = None) -> list:
         rel, sig, wid = [], [], []
         tone = tone_curvature(run)
         chans = [c for k in keys for c in LINES[k][0]]
-        blocks = dict(zip(chans, _blocks(run, tuple(chans))))       # every line's channels windowed once per run
+        y = dict(zip(chans, _windowed(run, tuple(chans)).T))       # every line's channels windowed once per run
         for k in keys:
             f_peak, snr = float(read[k][i, 0]), float(read[k][i, 1])
-            f, curv = zoom_peak(run, LINES[k][0], f_peak, np.stack([blocks[c] for c in LINES[k][0]]))
+            f, curv = zoom_peak(run, LINES[k][0], f_peak, np.stack([y[c] for c in LINES[k][0]], axis=1))
             rel.append(f / f0 - 1.0)
             sig.append(line_sigma(run, snr, f) / f0)
             wid.append(width_rel(curv, tone, f))

@@ -108,10 +108,10 @@ def test_diagnose_on_a_scattered_column_is_the_true_speeds_diagnosis():
 
 @pytest.mark.parametrize("n", [4000, 8192, 1000])
 def test_factored_transform_is_the_direct_sum(n):
-    """The exact windowed transform with its kernel factored in blocks (speed_runs._power) is the direct sum
-    Σ_k w_k (x_k − x̄) e^(−i2πf k/fs) over every sample, one complex exponential per sample (numpy, in full), within
-    1e-10 of its power, for record lengths that are and are not a multiple of the block, at frequencies on and
-    between bins, a pair of channels summed."""
+    """The exact windowed transform of the refinement (speed_runs._transform: rwadist.dft.windowed_dft, its kernel a
+    product of two short tables of phasors) is the direct sum Σ_k w_k (x_k − x̄) e^(−i2πf k/fs) over every sample,
+    one complex exponential per sample (numpy, in full), within 1e-10 of its power, for record lengths that are and
+    are not a multiple of the table's block, at frequencies on and between bins, a pair of channels summed."""
     fs = 1000.0
     rng = np.random.default_rng(n)
     t = np.arange(n) / fs
