@@ -73,7 +73,16 @@ timers) 0.53 -> 0.39 s (benchmark) and 0.33 -> 0.19 s (sixty), against 0.15 and 
 (sixty); target not met.  Where the rest is (benchmark set, in-call timers): the suspension-modes fit and refit
 ~40 % (the rocking mode's single-precision screens 0.28 s: 41 M grid point x rows at ~7 ns; their chunk of 512 f0 is
 the fastest of 64-1024 and the only one that gives the same single-precision numbers), the third search step, which
-only ranks hypotheses.csv's top 5, ~15 %.
+only ranks hypotheses.csv's top 5, ~15 %.  Session 17 added two steps before the search (each run's own speed,
+rwadist.speed_runs; the radial pairs' polarity, rwadist.channel_polarity) and the ratio rose to x11.9/x11.5
+(benchmark) and x18.4/x17.9 (sixty) idle at 49928af.  2026-11-30, session 18 (speed18): the runs' refinement on
+rwadist.dft.windowed_dft (factored phasor tables) instead of a 3 x 8192 np.exp kernel per transform (702 of them:
+0.41 s), and the 1x lines read once for the speed check, the polarity and the runs' speeds (speed_check.LineReads):
+those steps 0.81 -> 0.25 s CPU (benchmark), 0.39 -> 0.11 s (sixty), the same records.  --quick --repeats 3 --busy 0,
+49928af and speed18 interleaved (old, new, new, old) at load 3.1-3.4 on 2 cores (two other agents' jobs): diagnose
+cpu min 2.85/2.98 s -> 2.46/2.36 s (benchmark), 1.62/1.60 -> 1.38/1.30 s (sixty); cpu x12.2/x12.3, x16.8/x13.0 ->
+x10.9/x11.0, x11.5/x10.0 (benchmark, min/median), x18.4/x17.8, x18.8/x18.6 -> x15.4/x15.5, x15.5/x15.2 (sixty);
+target not met on the sixty set.
 """
 from __future__ import annotations
 
