@@ -523,8 +523,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     check_f_lim(test, f_lim)            # before the search starts, not after it
     # a steady test's speed column checked against its imbalance's 1x lines, scaled when they all sit at one ratio
     test, checked = speed_check.checked(test)
-    # a radial pair whose 1x line reads mirrored against the other pair's: one channel's sign flipped back (before
-    # the runs' own speeds: those read the 1x lines' senses)
+    # a radial pair whose 1x line reads mirrored against the other pair's: one channel's sign flipped back; both
+    # pairs mirrored: every speed negated (before the runs' own speeds: those read the 1x lines' senses)
     test, polarity = channel_polarity.checked(test)
     if polarity is not None:
         warnings.warn(RwadistWarning(channel_polarity.polarity_lines(polarity)[0]), stacklevel=2)
