@@ -499,7 +499,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     DataError
         Runs at fewer than 2 distinct speeds (:func:`rwadist.validate.check_test_speeds`).
     """
-    from . import channel_polarity, data_quality, speed_check, speed_runs, speed_whirl
+    from . import channel_polarity, data_quality, order_tracking, speed_check, speed_runs, speed_whirl
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
@@ -530,6 +530,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         warnings.warn(RwadistWarning(channel_polarity.polarity_lines(polarity)[0]), stacklevel=2)
     # each run's own mean speed from its 1x lines, taken where it is off the column beyond its own uncertainty
     test, checked = speed_runs.own_speeds(test, checked)
+    # a speed that wanders within the runs: each run resampled at equal steps of the rotor's angle (order tracking)
+    test, checked = order_tracking.tracked(test, checked)
 
     def run(test, base_check):
         spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))

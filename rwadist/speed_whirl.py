@@ -250,7 +250,10 @@ def speed_record(meta, check: dict | None = None) -> dict:
                 f"the speed column is off each run's rotor speed by {100 * own['rms_rel']:.3g} % RMS (its 1x lines "
                 "read to a few ppm): check how speed_rpm was recorded (a set-point, or one tach reading per run)"))))
         if own.get("wander"):
-            out["warning"] = " ".join(filter(None, (out.get("warning"), own["wander"]["text"])))
+            wander = own["wander"]
+            out["warning"] = " ".join(filter(None, (out.get("warning"), f"{wander['text']}; {wander['action']}")))
+        if own.get("runs_tracked"):
+            out["method"] = f"{out['method']}; {own['wander']['action']}"
         if check and check.get("runs_doubtful"):
             out["runs_doubtful"] = check["runs_doubtful"]
             out["warning"] = " ".join(filter(None, (out.get("warning"), (
