@@ -16,7 +16,7 @@ runs or more).  Here it is undone the way a rotating-machinery lab does, by comp
 * a run is resampled only where the angle's swing about a steady turn is :data:`SWING_OVER_NOISE` times what the
   sensor noise alone gives the reading (a slow run's weak 1× line gains nothing from it);
 * every channel of the run is resampled at equal steps of θ (a cubic spline of the record, first upsampled
-  :data:`UPSAMPLE` x by a polyphase filter, so the spline's error stays below ~1e-4 up to the Nyquist frequency)
+  :data:`UPSAMPLE` x band-limited (the FFT of the record and its mirror image), flat to the Nyquist frequency)
   onto the run's own time base, at the run's mean speed (θ's rise over the record).  Every line at h·θ is then a
   steady tone at h times that mean, as the model takes it;
 * what is not tied to the rotor (a fixed resonance, the noise floor, a mains line) is time-warped by the wander,
@@ -42,7 +42,7 @@ ORDER = 4
 CUT_RATIO = 0.25
 #: ... and at most this (Hz): a wander of a speed loop or a set-point is slower than this
 CUT_MAX_HZ = 5.0
-#: upsampling before the spline (a polyphase filter): the spline's error at the old Nyquist frequency ~1e-4
+#: upsampling before the spline (band-limited): the spline then reads a signal sampled 4x over its band
 UPSAMPLE = 4
 #: wander's RMS (relative to the mean speed) within a run below which the run is left as recorded
 MIN_WANDER_REL = 1.0e-5
@@ -95,8 +95,8 @@ def rotor_angle(run, channels: tuple, f_line: float, turn: float = 1.0) -> tuple
 
 def resampled(run, theta: np.ndarray):
     """(run, mean speed rad/s, wander RMS relative): ``run`` with every channel at equal steps of ``theta`` on its own
-    time base (module docstring) and its speed the mean over the record (the least-squares slope of θ over the
-    record less its first and last :data:`EDGE`; the sign kept)."""
+    time base (module docstring) and its speed the mean over the record (θ's rise end to end; the sign kept).  The
+    wander's RMS is read over the record less its first and last :data:`EDGE`."""
     from scipy import signal
     from scipy.interpolate import CubicSpline
 
@@ -104,7 +104,11 @@ def resampled(run, theta: np.ndarray):
     n = run.n_samples
     t = np.arange(n) / fs
     mid = slice(int(EDGE * n), n - int(EDGE * n))
-    mean, start = np.polyfit(t[mid], theta[mid], 1)
+    # the mean over the whole record (what every Welch segment averages), from the angle's rise end to end: its
+    # ends carry the low-pass's edge (~0.05 rad, 1e-5 of a record's turn), a least-squares slope over part of the
+    # record the wander's own departure from that mean (~1e-4)
+    mean = float(theta[-1] - theta[0]) / float(t[-1] - t[0])
+    start = float(theta[0])
     # the times at which the rotor reaches equal steps of angle (θ rises: an inverse by interpolation, continued
     # beyond the record's ends at the mean speed)
     t_ext = np.concatenate([[t[0] - 1.0], t, [t[-1] + 1.0]])
@@ -114,7 +118,10 @@ def resampled(run, theta: np.ndarray):
     t_up = np.arange(n * UPSAMPLE) / (fs * UPSAMPLE)
     signals = {}
     for c, v in run.signals.items():
-        up = signal.resample_poly(np.asarray(v, dtype=float), UPSAMPLE, 1)
+        x = np.asarray(v, dtype=float)
+        # band-limited upsampling of the record and its mirror image (one period without a jump at the ends): flat
+        # to the Nyquist frequency, where a polyphase filter's transition band takes 1-3 dB of the top 10 %
+        up = signal.resample(np.concatenate([x, x[::-1]]), 2 * n * UPSAMPLE)[: n * UPSAMPLE]
         signals[c] = CubicSpline(t_up, up)(t_new)
     wander = float(np.std(np.gradient(theta, t)[mid]) / mean)
     return replace(run, signals=signals, speed=float(np.sign(run.speed)) * mean), float(mean), wander

@@ -67,7 +67,7 @@ def test_the_rotor_angle_is_read_from_the_1x_line(index, seed):
 @pytest.mark.parametrize("index, seed", [(2, 4), (6, 5)])
 def test_diagnose_tracks_a_wandering_speed(index, seed):
     """rwadist.diagnose with no model on 0.3 % RMS wander: the runs resampled (the speed record's method says so),
-    the error within 8x the same wheel's steady data (same seed), each suspension mode within 2 % of the generator's
+    the error within 3x the same wheel's steady data (same seed), each suspension mode within 2 % of the generator's
     and no effect class added that the steady data do not get."""
     from rwadist import api
 
@@ -80,9 +80,9 @@ def test_diagnose_tracks_a_wandering_speed(index, seed):
                                                effects=[fe.SpeedWander(0.003, 1.0)])))
     assert "order tracking" in d.speed["method"]
     assert d.speed["runs_speed"]["runs_tracked"]
-    # main (no tracking): wheel 2 37x the steady error, wheel 6 311x; tracked 2.1x
-    # and 6.1x, where the generator's θ itself gives 5.8x on wheel 6 (what is left is not the angle's reading)
-    assert d.error_after < 8.0 * steady.error_after, (d.error_after, steady.error_after)
+    # main (no tracking): wheel 2 37x the steady error, wheel 6 311x; tracked 1.6x and 2.0x (resampled at the
+    # generator's own θ, wheel 6 gives 1.8x)
+    assert d.error_after < 3.0 * steady.error_after, (d.error_after, steady.error_after)
     assert {e["kind"] for e in d.model.effects} <= {e["kind"] for e in steady.model.effects}
     sm = next(e for e in d.model.effects if e["kind"] == "suspension_modes")
     for m, f in wheel.modes_hz().items():
