@@ -35,7 +35,8 @@ def test_the_rotor_angle_is_read_from_the_1x_line(index, seed):
     """Per run whose 1x line stands far enough over the noise (the noise's share of the angle, as
     rwadist.order_tracking estimates it, 0.005 rad or less): the angle from the strongest radial pair's 1x line
     against the generator's θ (0.3 % RMS wander) within 0.02 rad RMS over the record less 5 % at each end, and the
-    mean speed (the resampled run's speed) within 2e-5 of θ's own least-squares slope."""
+    mean speed (the resampled run's speed) within 2e-4 of θ's rise over the record (the ends' ~0.1 rad over a few
+    hundred turns: 1/15 of the wander)."""
     from rwadist import order_tracking as ot
     from rwadist import speed_check as sc
 
@@ -57,9 +58,9 @@ def test_the_rotor_angle_is_read_from_the_1x_line(index, seed):
         t = np.arange(n) / run.sample_rate
         err = theta - wander.angles[i][:n]
         assert np.std(err[mid]) < 0.02, (i, np.std(err[mid]))
-        true_mean = np.polyfit(t[mid], wander.angles[i][:n][mid], 1)[0]
+        true_mean = (wander.angles[i][n - 1] - wander.angles[i][0]) / t[-1]
         _, mean, rms = ot.resampled(run, theta)
-        assert mean == pytest.approx(true_mean, rel=2e-5)
+        assert mean == pytest.approx(true_mean, rel=2e-4)
         assert 0.0005 < rms < 0.01                   # the wander seen within the run (0.3 % of a 1 s process)
     assert seen >= 3
 
