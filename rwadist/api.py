@@ -450,6 +450,25 @@ def _diagnose_model(model, preset: str | None, base: str):
     return model
 
 
+def _one_x_checks(test) -> tuple:
+    """(test, speed check record, polarity record or None) of :func:`diagnose`'s steps before the search, each read
+    from the imbalance's 1x lines (the lines of one test read once: :class:`rwadist.speed_check.LineReads`)."""
+    from . import channel_polarity, order_tracking, speed_check, speed_runs
+
+    # a steady test's speed column checked against its 1x lines, scaled when they all sit at one ratio
+    test, checked = speed_check.checked(test, reads := speed_check.LineReads())
+    # a radial pair whose 1x line reads mirrored against the other pair's: one channel's sign flipped back; both
+    # pairs mirrored: every speed negated (before the runs' own speeds: those read the 1x lines' senses)
+    test, polarity = channel_polarity.checked(test, reads)
+    if polarity is not None:
+        warnings.warn(RwadistWarning(channel_polarity.polarity_lines(polarity)[0]), stacklevel=3)
+    # each run's own mean speed from its 1x lines, taken where it is off the column beyond its own uncertainty
+    test, checked = speed_runs.own_speeds(test, checked, reads)
+    # a speed that wanders within the runs: each run resampled at equal steps of the rotor's angle (order tracking)
+    test, checked = order_tracking.tracked(test, checked, reads)
+    return test, checked, polarity
+
+
 def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto", nperseg: int | None = None,
              f_lim: float | None = None, k_sigma: float = 4.0, min_gain: float = 0.05, bearings=None,
              source=None):
@@ -499,7 +518,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     DataError
         Runs at fewer than 2 distinct speeds (:func:`rwadist.validate.check_test_speeds`).
     """
-    from . import channel_polarity, data_quality, speed_check, speed_runs, speed_whirl
+    from . import data_quality, speed_whirl
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
@@ -521,15 +540,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     check_test_speeds(test, source or (data if isinstance(data, (str, Path)) else "the test"),
                       model_given=model is not None or preset is not None)
     check_f_lim(test, f_lim)            # before the search starts, not after it
-    # a steady test's speed column checked against its 1x lines (read once for the next two steps too: `reads`)
-    test, checked = speed_check.checked(test, reads := speed_check.LineReads())
-    # a radial pair whose 1x line reads mirrored against the other pair's: one channel's sign flipped back (before
-    # the runs' own speeds: those read the 1x lines' senses)
-    test, polarity = channel_polarity.checked(test, reads)
-    if polarity is not None:
-        warnings.warn(RwadistWarning(channel_polarity.polarity_lines(polarity)[0]), stacklevel=2)
-    # each run's own mean speed from its 1x lines, taken where it is off the column beyond its own uncertainty
-    test, checked = speed_runs.own_speeds(test, checked, reads)
+    test, checked, polarity = _one_x_checks(test)
 
     def run(test, base_check):
         spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))

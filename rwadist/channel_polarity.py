@@ -12,7 +12,14 @@ anisotropic support can add a counter-rotating part to the response, but the for
 one support keep one sense between them; a radial pair whose 1× line reads counter-rotating run after run while the
 other pair's 1× line (the same rotor, the same speeds) reads co-rotating is the signature of a sign error on one of
 that pair's channels, never of an imbalance (a genuine counter-rotating share q of the 1× reads 1 − q co, e.g.
-0.75 at q = 0.25).  A speed column of the wrong sign reverses both pairs alike and is not this.
+0.75 at q = 0.25).
+
+A speed column of the wrong sign reverses both pairs alike: both 1× lines read counter-rotating.  That is the
+rotor turning about −z of the load cell's frame while the column says +z (a tachometer gives an unsigned speed; a
+wheel mounted with its spin axis along the cell's −z; the cell's z axis pointing the other way).  The same
+physics reads it: no imbalance turns against its rotor in both pairs.  Every run's speed is then negated (the
+wheel's spin in the cell's frame, the frame every other channel is read in) rather than fitted as given, where the
+imbalance would be named a counter-rotating q ≈ 1 and every radial line's sense reversed.
 
 So before the search, per run, the 1× line of each radial pair is measured where the speed puts it
 (:func:`rwadist.speed_check.run_line`: the strongest peak within 3 % of the 1× frequency, its co-rotating share
@@ -31,7 +38,8 @@ antisymmetric in Fx, Fy, cannot be fitted to a reversed channel).  PSDs do not c
 each pair's line power that is counter-rotating is also measured (every bin of the complex spectrum of x + iy that
 stands :data:`LINE_SNR` over the run's median; positive frequencies co-rotating for Ω > 0), before the flip.
 
-What was found goes to ``data_quality`` (a ``reversed_polarity`` record), the console and report.md.
+What was found goes to ``data_quality`` (a ``reversed_polarity`` or ``reversed_spin`` record), the console and
+report.md.
 
 Units: Hz, rad/s, dimensionless shares.
 """
@@ -90,8 +98,8 @@ def _reading(shares: np.ndarray, spinning: int) -> float:
 
 def check_record(test, reads: LineReads | None = None) -> dict | None:
     """The ``reversed_polarity`` record of a steady test (module docstring) when one radial pair reads reversed
-    against the other, else None.  ``reads``: a :class:`rwadist.speed_check.LineReads` shared with the steps before
-    and after this one, or None."""
+    against the other, the ``reversed_spin`` record when both read reversed, else None.  ``reads``: a
+    :class:`rwadist.speed_check.LineReads` shared with the steps before and after this one, or None."""
     pairs = {d: p for d, p in PAIRS.items() if any(all(r.usable(c) for c in p) for r in test.runs)}
     if len(pairs) < 2:
         return None
@@ -100,6 +108,13 @@ def check_record(test, reads: LineReads | None = None) -> dict | None:
     shares = {d: _one_x_shares(test, d, read) for d in pairs}
     med = {d: _reading(s, spinning) for d, s in shares.items()}
     rev = [d for d in pairs if med[d] <= 1 - POLARIZED_1X]
+    if len(rev) == 2:
+        counter = {o: line_power_counter_share(test, p) for o, p in pairs.items()}
+        return {"type": "reversed_spin", "directions": list(pairs),
+                "one_x_co_shares": {d: round(med[d], 4) for d in pairs},
+                "one_x_runs": {d: int(np.isfinite(shares[d]).sum()) for d in pairs},
+                "line_power_counter_shares": {d: round(counter[d], 4) for d in pairs},
+                "action": "every run's speed multiplied by -1 before the fit"}
     if len(rev) != 1:
         return None
     d = rev[0]
@@ -117,11 +132,15 @@ def check_record(test, reads: LineReads | None = None) -> dict | None:
 
 
 def checked(test, reads: LineReads | None = None) -> tuple:
-    """(test, record): ``test`` with the reversed pair's y channel multiplied by −1 in every run (a copy; its meta
-    records it) when :func:`check_record` finds one, else (``test``, None).  ``reads``: as :func:`check_record`'s."""
+    """(test, record): ``test`` with the reversed pair's y channel multiplied by −1 in every run, or with every run's
+    speed negated for a ``reversed_spin`` record (a copy; its meta records it) when :func:`check_record` finds one,
+    else (``test``, None).  ``reads``: as :func:`check_record`'s."""
     rec = check_record(test, reads)
     if rec is None:
         return test, None
+    if rec["type"] == "reversed_spin":
+        runs = [replace(r, speed=-r.speed) for r in test.runs]
+        return type(test)(runs, dict(test.meta or {}, spin_reversed=True)), rec
     y = rec["channel"]
     runs = [replace(r, signals={c: (-np.asarray(v) if c == y else v) for c, v in r.signals.items()})
             for r in test.runs]
@@ -129,7 +148,18 @@ def checked(test, reads: LineReads | None = None) -> tuple:
 
 
 def polarity_lines(rec: dict) -> list:
-    """Console / report lines of a ``reversed_polarity`` record: what the data show, what was done, what to do."""
+    """Console / report lines of a ``reversed_polarity`` or ``reversed_spin`` record: what the data show, what was
+    done, what to do."""
+    if rec["type"] == "reversed_spin":
+        shares = rec["one_x_co_shares"]
+        read = " and ".join(f"the {d.replace('_', ' ')}'s {shares[d]:.3g} ({rec['one_x_runs'][d]} runs)"
+                            for d in rec["directions"])
+        return ["the rotor turns against the sign of the speed column: the 1x line (the imbalance, fixed to the "
+                f"rotor: it turns with it) reads counter-rotating in both radial pairs, median co-rotating share {read}; "
+                "no imbalance turns against its rotor in both",
+                "every run's speed was multiplied by -1 before the fit (the wheel spins about -z of the load cell's "
+                "frame); check the speed column's sign (a tachometer gives an unsigned speed) and the wheel's and the "
+                "cell's z axes, and give the speed signed in the cell's frame"]
     x, y = rec["channels"]
     d, o = rec["direction"].replace("_", " "), rec["other_direction"].replace("_", " ")
     return [f"{x}/{y} wired with the wrong polarity (one of them): the {d}'s 1x line (the imbalance, fixed to the "

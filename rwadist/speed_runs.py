@@ -203,8 +203,8 @@ def own_speeds(test, check: dict, reads: LineReads | None = None) -> tuple:
             f"steady tone's (by {100 * float(np.median(wide)):.2g} % of its frequency, median; from the peak's "
             "curvature, which reads a slow wander low), the lines of a run alike: the rotor's speed moved during each "
             "record (a speed loop hunting, a drifting set-point); the model takes each run at one speed, and lines "
-            "at high h are smeared in the data; the runs' speeds are kept as given (a wandering line's peak is "
-            "not the run's mean speed)")}
+            "at high h are smeared in the data"),
+            "action": "the runs' speeds are kept as given (a wandering line's peak is not the run's mean speed)"}
     check = dict(check, runs_speed=rec)
     if not moved:
         return test, check

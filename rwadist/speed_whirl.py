@@ -219,7 +219,8 @@ def speed_record(meta, check: dict | None = None) -> dict:
     when single runs' speeds were taken from their own 1× lines (:func:`rwadist.speed_check.checked`; the method says
     which), ``runs_speed`` with a ``warning`` when runs' mean speeds were taken from their own 1× lines beyond their
     uncertainty or their lines are wider than a steady tone (:func:`rwadist.speed_runs.own_speeds`), ``runs_doubtful`` with a ``warning`` when a run's 1× lines read off beside a line at its given speed (its
-    speed kept)."""
+    speed kept).  The method says so when every speed was negated (``meta["spin_reversed"]``,
+    :mod:`rwadist.channel_polarity`)."""
     slicing = (meta or {}).get("slicing")
     if not isinstance(slicing, dict):
         out: dict = {"source": "measured", "method": "the runs' speeds as given (runs.csv speed_rpm)"}
@@ -249,11 +250,16 @@ def speed_record(meta, check: dict | None = None) -> dict:
                 f"the speed column is off each run's rotor speed by {100 * own['rms_rel']:.3g} % RMS (its 1x lines "
                 "read to a few ppm): check how speed_rpm was recorded (a set-point, or one tach reading per run)"))))
         if own.get("wander"):
-            out["warning"] = " ".join(filter(None, (out.get("warning"), own["wander"]["text"])))
+            wander = own["wander"]
+            out["warning"] = " ".join(filter(None, (out.get("warning"), f"{wander['text']}; {wander['action']}")))
+        if own.get("runs_tracked"):
+            out["method"] = f"{out['method']}; {own['wander']['action']}"
         if check and check.get("runs_doubtful"):
             out["runs_doubtful"] = check["runs_doubtful"]
             out["warning"] = " ".join(filter(None, (out.get("warning"), (
                 f"{check['text_doubtful']} (check that run's speed_rpm, and what else turns on the test plate)"))))
+        if (meta or {}).get("spin_reversed"):    # rwadist.channel_polarity: both pairs' 1x against the column
+            out["method"] = f"{out['method']}, each multiplied by -1 (the rotor turns against the column's sign)"
         return out
     if slicing.get("speed_source") != "data":
         return {"source": "tach", "method": "each slice's mean of the sweep's speed (tach) column"}

@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import family_wheel as fw
 import numpy as np
+from scipy import signal
 
 #: a line part stands above the noise at this power ratio in its own bin (10 dB)
 SIGNATURE_RATIO = 10.0
@@ -394,6 +395,33 @@ class SpeedRipple(Effect):
 
     def signature(self, wheel, data):
         return parts_signature(data, _tagged(data, self.kind))
+
+
+class SpeedWander(Effect):
+    """The rotor's speed wandering within each run: Ω(t) = Ω₀·(1 + σ·g(t)), g an Ornstein-Uhlenbeck process of unit
+    RMS and correlation time ``corr_s`` (exact discretisation) less its mean over the run, θ(t) its trapezoidal
+    integral.  The lines' amplitudes (the cell's response) are taken at Ω₀, the mean: quasi-static only to first
+    order in σ (the steady generator's loads at the run's mean speed, turning at the wandering angle).  ``angles`` keeps each
+    run's θ (rad) for the tests.  Not an effect class: diagnose should track it (rwadist.order_tracking)."""
+
+    kind = "speed_wander"
+    expects = "order_tracking"
+
+    def __init__(self, rms_rel=0.003, corr_s=1.0):
+        super().__init__(rms_rel=rms_rel, corr_s=corr_s)
+        self.angles: dict = {}
+
+    def rotor_angle(self, t, omega, run, rng):
+        dt = float(t[1] - t[0])
+        a = np.exp(-dt / self.params["corr_s"])
+        e = rng.standard_normal(t.size) * np.sqrt(1 - a * a)
+        e[0] = rng.standard_normal()
+        g = signal.lfilter([1.0], [1.0, -a], e)         # g[k] = a·g[k−1] + e[k]: unit variance throughout
+        g -= g.mean()                   # the run's mean speed is Ω₀: the lines' amplitudes are the steady ones there
+        om = omega * (1 + self.params["rms_rel"] * g)
+        theta = np.concatenate([[0.0], np.cumsum(0.5 * (om[1:] + om[:-1]) * dt)])
+        self.angles[run] = theta
+        return theta
 
 
 class CounterRotation(Effect):

@@ -371,7 +371,10 @@ def steady(wheel: Wheel, speeds_rpm=None, sample_rate=None, n_samples=None, nois
     * ``mixing() -> (6, 6)``: a linear map of the cell's channels (a load-cell offset, crosstalk);
     * ``load_floor(wheel, omega, f_hz, rng) -> {direction: (n_f, k) complex}``: random loads on the rotor;
     * ``cell_components(omega, run, rng, wheel) -> Components, A (k, 6)``: lines added at the cell (pickup);
-    * ``cell_signal(t, omega, run, rng, wheel, std) -> (6, n)``: added at the cell (a hump, sensor noise).
+    * ``cell_signal(t, omega, run, rng, wheel, std) -> (6, n)``: added at the cell (a hump, sensor noise);
+    * ``rotor_angle(t, omega, run, rng) -> (n,)``: the rotor's angle θ(t) rad when the speed moves within the run
+      (a wander): every line of the rotor then turns at (w/Ω)·θ(t), its amplitude the steady one at ``omega``
+      (not with ``cell_components``).
     """
     speeds_rpm = np.linspace(wheel.min_rpm, wheel.max_rpm, wheel.n_speeds) if speeds_rpm is None else speeds_rpm
     fs = float(sample_rate or wheel.sample_rate)
@@ -407,7 +410,11 @@ def steady(wheel: Wheel, speeds_rpm=None, sample_rate=None, n_samples=None, nois
         keep = comp.w / (2 * np.pi) < ANTI_ALIAS * fs
         comp, A = comp.select(keep), A[keep]
         f = comp.w / (2 * np.pi)
-        signals[i] = synthesize(f, A, t)
+        angle = [e.rotor_angle(t, om, i, rng) for e in effects if hasattr(e, "rotor_angle")]
+        if angle:                       # a wandering speed: each line at its order of the rotor's angle
+            signals[i] = np.real(A.T @ np.exp(1j * np.outer(comp.w / om, angle[0])))
+        else:
+            signals[i] = synthesize(f, A, t)
         spec = _floor_spectrum(wheel, effects, om, f_bins, rng, fs, n)
         if spec is not None:
             spec = (spec * _gains(effects, f_bins, om)) @ mix.T

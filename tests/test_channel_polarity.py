@@ -106,3 +106,56 @@ def test_diagnose_of_a_reversed_channel(index, seed, flip):
     for m, f in wheel.modes_hz().items():
         if m not in (sm.get("unconstrained") or []):
             assert sm[f"{m}_Hz"] == pytest.approx(f, rel=0.02)
+
+
+def _column_negated(test):
+    """``test`` as a tachometer's unsigned speed reads a wheel spinning Ω < 0: every run's speed column multiplied
+    by -1, the signals as recorded."""
+    from dataclasses import replace
+
+    return SteadyTest(runs=[replace(r, speed=-r.speed) for r in test.runs], meta={})
+
+
+@pytest.mark.parametrize("index, seed", [(1, 7), (4, 8), (7, 9)])
+def test_a_speed_column_of_the_wrong_sign_is_found_and_negated(index, seed):
+    """A wheel spinning Ω < 0 given with a positive speed column: both radial pairs' 1x read counter-rotating (the
+    generator's imbalance turns with the rotor in both); the record says reversed_spin and the test it returns is
+    the generated one exactly (speeds and signals).  One channel reversed on top of it is still a polarity error."""
+    from rwadist import channel_polarity as cp
+
+    wheel = fw.family()[index]
+    true = _test(wheel, seed, sign=-1.0)
+    assert cp.check_record(true) is None
+    fixed, rec = cp.checked(_column_negated(true))
+    assert rec is not None and rec["type"] == "reversed_spin"
+    assert set(rec["directions"]) == set(cp.PAIRS)
+    assert all(s < 0.05 for s in rec["one_x_co_shares"].values())
+    for r0, r1 in zip(true.runs, fixed.runs):
+        assert r1.speed == r0.speed < 0
+        for c in fw.CHANNELS:
+            np.testing.assert_array_equal(r1.signals[c], r0.signals[c])
+    one = cp.check_record(_column_negated(_test(wheel, seed, "Fy", sign=-1.0)))
+    assert one is not None and one["type"] == "reversed_polarity" and one["direction"] == "radial_torque"
+
+
+@pytest.mark.parametrize("index, seed", [(2, 10), (6, 11)])
+def test_diagnose_of_a_speed_column_of_the_wrong_sign(index, seed):
+    """rwadist.diagnose with no model on the wrong-sign column: the same effects, model lines and error as on the
+    signed column (main named a counter_rotation of q 1 on the radial-force 1x), a reversed_spin record in
+    data_quality and the model's provenance, and the speed record saying the speeds were negated."""
+    from rwadist import api
+    from rwadist.errors import RwadistWarning
+
+    wheel = fw.family()[index]
+    true = _test(wheel, seed, sign=-1.0)
+    right = api.diagnose(true)
+    with pytest.warns(RwadistWarning, match="turns against the sign of the speed column"):
+        d = api.diagnose(_column_negated(true))
+    assert not [e for e in d.model.effects if e["kind"] == "counter_rotation"]
+    assert [e["kind"] for e in d.model.effects] == [e["kind"] for e in right.model.effects]
+    assert d.error_after == pytest.approx(right.error_after, rel=1e-9)
+    for direction, lines in right.model.empirical.items():
+        assert [(hm.h, hm.sense) for hm in d.model.empirical[direction]] == [(hm.h, hm.sense) for hm in lines]
+    recs = [r for r in d.data_quality if r.get("type") == "reversed_spin"]
+    assert len(recs) == 1 and d.model.provenance["data_quality"] == recs
+    assert "multiplied by -1" in d.speed["method"]
