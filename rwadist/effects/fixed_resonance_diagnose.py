@@ -171,7 +171,7 @@ class FixedResonance:
     channels by H(f/f_r) (:func:`resonance`; ζ damping ratio, g = |H| at f_r, ``gain_above`` H far above f_r).
     ``role``: "test_stand" when it acts on every channel alike (a fixture resonance, to be excluded from the wheel's
     model; its gain above f_r is fitted: the force through a fixture spring falls there), "wheel_mode" when on one
-    direction's channels only (an unmodelled wheel mode, to be added; H → 1 above)."""
+    direction's channels only (an unmodelled wheel mode, to be added; H → 1 − μ above a mode of the load's path)."""
 
     f_r: float
     zeta: float
