@@ -139,11 +139,11 @@ class WheelLines:
         """(n_speeds, n_sel) factor turning C·Ω² into the diagnosed amplitude law (1 without one),
         times the diagnosed wheel-mode resonances of the source's direction."""
         fac = np.ones((w.size, idx.size), dtype=complex)
-        for dirs, f_r, zeta, g in self.resonances:
+        for dirs, f_r, zeta, g, *above in self.resonances:
             for j, i in enumerate(idx):
                 d = self.spec[int(i)][0] if self.kind == "empirical" else self.groups[int(i)][0].direction
                 if d in dirs:
-                    H = resonance(self.freqs(w, [i])[:, 0], f_r, zeta, g)
+                    H = resonance(self.freqs(w, [i])[:, 0], f_r, zeta, g, *above)
                     fac[:, j] *= np.where(w < 0, np.conj(H), H)   # a real filter at negative frequency
         for j, i in enumerate(idx):
             if int(i) in self.laws:

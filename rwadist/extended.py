@@ -246,7 +246,7 @@ class Line:
         frequency |hΩ/2π + f_offset| Hz.  A diagnosed ``sidebands`` effect (depth m, f_mod) is two
         such copies of its carrier, f_offset = ±f_mod with C (and A_ref) times m/2:
         a(1 + m·cos 2πf_mod t) = a + (m/2)a·e^{+i2πf_mod t} + (m/2)a·e^{−i2πf_mod t} per component.
-    resonances : ((f_r Hz, ζ, peak_gain), ...) of diagnosed ``fixed_resonance`` effects of role
+    resonances : ((f_r Hz, ζ, peak_gain[, gain_above]), ...) of diagnosed ``fixed_resonance`` effects of role
         ``wheel_mode``: each component's load is multiplied by H(ν/2π) (:func:`resonance_gain`,
         the formula of :func:`rwadist.resonance.resonance` with a signed frequency, i.e. a real
         filter acting on x and y alike) at the component's instantaneous whirl rate ν.
@@ -285,9 +285,9 @@ class Line:
             raise ValueError(f"Line.f_offset must be finite, got {self.f_offset!r}")
         object.__setattr__(self, "resonances", tuple(tuple(float(v) for v in r) for r in self.resonances))
         for r in self.resonances:
-            if len(r) != 3 or not all(math.isfinite(v) and v > 0 for v in r):
-                raise ValueError(f"Line.resonances entries (f_r Hz, zeta, peak_gain) must be finite and > 0, "
-                                 f"got {r!r}")
+            if len(r) not in (3, 4) or not all(math.isfinite(v) and v > 0 for v in r[:3]) or not math.isfinite(r[-1]):
+                raise ValueError(f"Line.resonances entries (f_r Hz, zeta, peak_gain[, gain_above]) must be finite, the "
+                                 f"first three > 0, got {r!r}")
 
     def amplitude(self, omega):
         """Load amplitude at wheel speeds ``omega`` (rad/s): C·Ω², or A_ref·(|Ω|/Ω_ref)^p with a law."""

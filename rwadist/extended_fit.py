@@ -67,7 +67,7 @@ from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
 from .off_law_lines import free_off_law_lines, lawful_lines, line_regressors, off_law_note
-from .resonance import FittedResonance, resonance
+from .resonance import PATH_MODE_MAX_ABOVE, FittedResonance, resonance
 from .spectra import compute_spectra, welch_dof
 from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 
@@ -481,7 +481,7 @@ def _log_data(meas_lines: list, la: np.ndarray, sa: np.ndarray, aa: np.ndarray, 
     speed ``sa`` rad/s, amplitude ``aa`` per channel), then the radial ones (``lr``, ``sr``, x²+y² power ``pr`` per
     run); with ``joint_stand`` (its start, divided out of the lines) multiplied back: the least squares divides out
     its own.  ``stand_direction``: the stand is a mode of the wheel's structure acting on that direction's rows only,
-    returning to 1 above it (:class:`rwadist.resonance.FittedResonance` ``rows``, ``gain_above`` 1)."""
+    keeping β <= 1 of the load above it (:class:`rwadist.resonance.FittedResonance` ``rows``, ``max_above``)."""
     log_data = np.concatenate([np.log(np.maximum(aa, 1e-300)), 0.5 * np.log(np.maximum(pr, 1e-300))])
     if joint_stand is None:
         return log_data, None
@@ -491,7 +491,7 @@ def _log_data(meas_lines: list, la: np.ndarray, sa: np.ndarray, aa: np.ndarray, 
         joint = FittedResonance(joint_stand, f_rows)
     else:
         d_rows = np.concatenate([np.full(la.size, "axial_force"), [meas_lines[j].direction for j in lr]])
-        joint = FittedResonance(joint_stand, f_rows, rows=d_rows == stand_direction, gain_above=1.0)
+        joint = FittedResonance(joint_stand, f_rows, rows=d_rows == stand_direction, max_above=PATH_MODE_MAX_ABOVE)
     return log_data + 0.5 * joint.start_log_gain, joint
 
 

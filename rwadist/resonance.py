@@ -210,6 +210,17 @@ def general_log_power_gain(f_hz, f_r: float, zeta: float, gamma: float, gain_abo
     return np.log(N) - np.log(D), out
 
 
+#: The greatest gain far above a mode of the path between the wheel's load and the load cell (a housing, a mode of
+#: the wheel's structure on one direction).  The cell reads the load F less the momentum of the structure's moving
+#: mass (Newton on the structure): a mode q of modal mass m_q and stiffness k_q, driven by φ_P·F (φ_P its shape at the
+#: load's point) and of participation L = ∫ρφ dV, gives R = F − L·q̈ = F·(1 + μr²/(1 − r² + 2jζr)),
+#: μ = φ_P·L/m_q, r = f/f_r: the general gain with β = 1 − μ, γ = 1 (the damper also reacts on the cell).  For a
+#: mode that moves the load's point with its mass (φ_P·L >= 0, a fundamental mode), μ >= 0 and β <= 1: the lines
+#: above it keep 1 − μ of the load, with an antiresonance at f_r/sqrt(β) above the resonance (β = 0: the whole load
+#: drives it, the transmissibility of a suspension).
+PATH_MODE_MAX_ABOVE = 1.0
+
+
 class FittedResonance:
     """A fixture resonance's parameters in a least squares of log line amplitudes (the extended fit's, fitted with the
     wheel's modes: :func:`rwadist.extended_fit.fit_extended` with ``fit_stand``).
@@ -222,11 +233,12 @@ class FittedResonance:
 
     ``rows`` (bool per row, or None: every row): the rows the resonance acts on (a resonance of one load direction's
     channels: a mode of the wheel's structure; 1 elsewhere).  ``gain_above`` (None: fitted): β held at this value, θ
-    then (ln f_r, ln ζ, γ) -- a mode of the structure multiplies what passes it and returns to 1 above it (β = 1)."""
+    then (ln f_r, ln ζ, γ).  ``max_above``: the upper bound of a fitted β (:data:`PATH_MODE_MAX_ABOVE` for a mode of
+    the path the load passes: β = 1 − μ, μ >= 0)."""
 
     NAMES: tuple[str, ...] = ("stand_ln_f", "stand_ln_zeta", "stand_gamma", "stand_gain_above")
 
-    def __init__(self, start, f_rows, rows=None, gain_above: float | None = None):
+    def __init__(self, start, f_rows, rows=None, gain_above: float | None = None, max_above: float = 3.0):
         f_r, zeta, gain, *above = (float(v) for v in start)
         beta = gain_above if gain_above is not None else (above[0] if above else 1.0)
         self.fixed_above = gain_above
@@ -235,9 +247,10 @@ class FittedResonance:
         n = 4 if gain_above is None else 3
         self.NAMES = FittedResonance.NAMES[:n]
         self.x0 = np.array([np.log(f_r), np.log(np.clip(zeta, 0.0011, 0.29)),
-                            min(numerator_damping(zeta, gain, beta), 199.0), np.clip(beta, -0.99, 2.99)])[:n]
+                            min(numerator_damping(zeta, gain, beta), 199.0),
+                            np.clip(beta, -0.99, max_above - 0.01)])[:n]
         self.lower = np.array([np.log(0.9 * f_r), np.log(1e-3), 0.0, -1.0])[:n]
-        self.upper = np.array([np.log(1.1 * f_r), np.log(0.3), 200.0, 3.0])[:n]
+        self.upper = np.array([np.log(1.1 * f_r), np.log(0.3), 200.0, max_above])[:n]
         self.start_log_gain = self._masked(np.log(np.abs(resonance(self.f_rows, f_r, zeta, gain, beta)) ** 2))
 
     def _masked(self, v):

@@ -398,8 +398,9 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
 # --------------------------------------------------------------------------- a mode of the wheel's structure
 #: The load direction each of the extended fit's modes shows (its ``unconstrained`` names)
 MODE_DIRECTION = {"radial_translation": "radial_force", "rocking": "radial_torque", "axial": "axial_force"}
-#: Parameters of a structure mode fitted with the modes (f_r, ζ, γ; H → 1 far above it), for the information criterion
-STRUCTURE_PARAMETERS = 3
+#: Parameters of a structure mode fitted with the modes (f_r, ζ, γ and β, the gain far above it:
+#: :data:`rwadist.resonance.PATH_MODE_MAX_ABOVE`), for the information criterion
+STRUCTURE_PARAMETERS = 4
 #: Lifts of one direction's residuals tried as a structure mode's start, at most (the strongest first)
 STRUCTURE_STARTS = 2
 #: The directions a structure mode is looked for on when the fit without it locates every mode: the forces.  The
@@ -453,13 +454,13 @@ def structure_confirmed(joint, plain) -> bool:
 
 def structure_mode_refused(test, fit, direction: str, stand: tuple) -> tuple:
     """(evidence, f_r Hz) of ``test`` (empirical fit ``fit``) against a mode of the wheel's structure on ``direction``
-    at ``stand`` (f_r Hz, ζ, peak gain): the structure mode fitted again from it, jointly with the suspension modes,
+    at ``stand`` (f_r Hz, ζ, peak gain[, gain above]): the structure mode fitted again from it, jointly with the suspension modes,
     and its Bayesian information criterion over the fit with ``stand`` held, n·ln(SSR_held / SSR_free) −
     :data:`STRUCTURE_PARAMETERS`·ln n (> 0: these data want a resonance of their own), and the frequency they want.
     Raises ValueError when an extended fit fails."""
     from .extended_fit import fit_extended
 
-    start = tuple(stand[:3]) + (1.0,)
+    start = tuple(stand[:4]) + (() if len(stand) >= 4 else (1.0,))
     held = fit_extended(test, fit, stand=start, stand_direction=direction)
     free = _joint_from(test, fit, start, {"stand_direction": direction})
     n = int(np.sum(np.isfinite(free.line_residuals[1])))
@@ -478,8 +479,10 @@ def fit_extended_beside_structure_mode(test, fit, plain, start: tuple | None = N
     an earlier fit's); the fit of least cost kept when :func:`structure_confirmed`.  A fixed-frequency resonance on
     the radial forces alone beside the radial translation (family wheels: a housing mode between two modes) is not
     a second translation: the translation is the spring the rotor's force passes through (its transmissibility falls
-    above it), the structure mode multiplies what passes it and returns to 1 above it (β = 1), and the wheel's modes
-    are fitted beside it instead of being pulled onto it or declared."""
+    above it), the structure mode passes β = 1 − μ of it above its frequency (μ >= 0 its participation:
+    :data:`rwadist.resonance.PATH_MODE_MAX_ABOVE`), and the wheel's modes are fitted beside it instead of being pulled
+    onto it or declared.  Of the fits the lines do not tell apart, the one of least participation is kept
+    (:func:`least_participation`)."""
     if start is not None:
         tries = [(start[0], tuple(start[1:]))]
     else:
@@ -489,16 +492,39 @@ def fit_extended_beside_structure_mode(test, fit, plain, start: tuple | None = N
     fits = []
     for d, s in tries:
         try:
-            fits.append(_joint_from(test, fit, tuple(s) + (1.0,), {**kwargs, "stand_direction": d}))
+            fits.append(_joint_from(test, fit, tuple(s) + (() if len(s) == 4 else (1.0,)),
+                                    {**kwargs, "stand_direction": d}))
         except ValueError:
             continue
     fits = [j for j in fits if structure_confirmed(j, plain)]
     if not fits:
         return None
-    joint = min(fits, key=joint_cost)
-    f_r, zeta, gain, _ = joint.stand
-    joint.notes.append(f"structure mode: a resonance at {f_r:.4g} Hz (ζ {zeta:.3g}, peak gain {gain:.3g}) on the "
-                       f"{joint.stand_direction} lines alone, fitted with the suspension modes: a mode of the wheel's "
+    joint = least_participation(fits)
+    f_r, zeta, gain, above = joint.stand
+    joint.notes.append(f"structure mode: a resonance at {f_r:.4g} Hz (ζ {zeta:.3g}, peak gain {gain:.3g}, {above:.3g} "
+                       f"of the load far above it) on the {joint.stand_direction} lines alone, fitted with the "
+                       "suspension modes: a mode of the wheel's "
                        "structure the extended model lacks (analytical.fit.structure_mode; `rwadist diagnose` names it "
                        "a fixed_resonance of role wheel_mode)")
     return joint
+
+
+def least_participation(fits: list):
+    """Of the joint fits ``fits`` (each with a structure mode on one direction, its ``stand`` (f_r Hz, ζ, peak gain,
+    β)), the one of least cost, or of the fits whose cost is within one parameter's worth of it (n·ln of their cost
+    ratio below ln n, the information criterion's price of one parameter: the lines do not tell them apart) the one
+    whose structure mode has the least participation μ = 1 − β (:data:`rwadist.resonance.PATH_MODE_MAX_ABOVE`).
+
+    The radial force lines pass the translation's transmissibility T(f) (the whole load drives it: μ = 1, no zero)
+    and the structure mode H(f) (a zero at f_s/sqrt(β)): their product's magnitude has two resonances and one
+    antiresonance f_a, which each assignment of the two resonances reproduces up to the numerators' damping terms
+    (a few 0.1 % of power) -- the structure mode at the lower resonance f_1 with β = (f_1/f_a)², or at the upper f_2
+    with β = (f_2/f_a)² (trial16's housing: 340 Hz, β 0.70, the translation 260 Hz; or 260 Hz, β 0.41, the
+    'translation' 340 Hz; costs 0.05 % apart).  A structure mode is what the wheel's model lacks beside its
+    suspension; the least of it that explains the lines is the one nearest its antiresonance, the lightest mode of
+    the path (the suspension is the one the whole load passes)."""
+    best = min(fits, key=joint_cost)
+    n = int(np.sum(np.isfinite(best.line_residuals[1])))
+    c0 = joint_cost(best)
+    tied = [j for j in fits if n * np.log(joint_cost(j) / c0) < np.log(max(n, 2))]
+    return min(tied, key=lambda j: (abs(1.0 - j.stand[3]), joint_cost(j)))

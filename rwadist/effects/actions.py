@@ -37,19 +37,22 @@ class LineLaw:
 @dataclass(frozen=True)
 class LineFilter:
     """The lines of ``directions`` pass through a resonance at ``f_hz`` (damping ratio ``zeta``, gain ``peak_gain``
-    there): H(ν) = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r), r = ν/(2π f_r), at each line's whirl rate ν."""
+    there, ``gain_above`` far above it): H(ν) = (1 − r² + 2j·g·ζ·r)/(1 − r² + 2j·ζ·r) when ``gain_above`` is 1,
+    r = ν/(2π f_r), at each line's whirl rate ν (the general form: :func:`rwadist.resonance.resonance`)."""
 
     directions: tuple
     f_hz: float
     zeta: float
     peak_gain: float
+    gain_above: float = 1.0
 
     STAGE = 0
 
     @property
     def resonance(self) -> tuple:
-        """(f_r Hz, ζ, peak gain)."""
-        return (self.f_hz, self.zeta, self.peak_gain)
+        """(f_r Hz, ζ, peak gain), and the gain above when it is not 1."""
+        out = (self.f_hz, self.zeta, self.peak_gain)
+        return out if self.gain_above == 1.0 else out + (self.gain_above,)
 
 
 @dataclass(frozen=True)

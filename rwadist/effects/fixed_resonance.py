@@ -14,8 +14,9 @@ from .element import Element, directions, num
 @dataclass(frozen=True, eq=False, kw_only=True)
 class FixedResonance(Element):
     """A resonance at f_Hz (damping ratio zeta, gain peak_gain at f_Hz, gain_above far above it:
-    :func:`rwadist.resonance.resonance`) of role ``wheel_mode`` (the wheel's loads of ``directions`` pass through it)
-    or ``test_stand`` (a fixture: measurement only)."""
+    :func:`rwadist.resonance.resonance`) of role ``wheel_mode`` (the wheel's loads of ``directions`` pass through it:
+    a mode of the path between the wheel's load and its interface keeps gain_above = 1 − μ of it, μ the mode's
+    participation, :data:`rwadist.resonance.PATH_MODE_MAX_ABOVE`) or ``test_stand`` (a fixture: measurement only)."""
 
     KIND: ClassVar[str] = "fixed_resonance"
     ORDER: ClassVar[int] = 40
@@ -28,9 +29,6 @@ class FixedResonance(Element):
     gain_above: float = field(default=1.0, metadata=check(optional(number(ge=-1.0, le=3.0), 1.0)))
 
     def _validate(self, source, path, error):
-        if self.gain_above != 1.0 and self.role != "test_stand":
-            raise error(source, f"{path}.gain_above", f"is {self.gain_above!r}: a gain other than 1 above the resonance "
-                        "is a fixture's (role test_stand); a wheel_mode resonance returns to 1 (leave it out)")
         least = self.smallest_peak(self.zeta, self.gain_above)
         if self.peak_gain < least * (1 - 1e-9):
             raise error(source, f"{path}.peak_gain", f"is {self.peak_gain!r}: a resonance of zeta {self.zeta!r} whose "
@@ -63,8 +61,8 @@ class FixedResonance(Element):
     # ------------------------------------------------------------------ injection
     #: ``fixed_resonance:f_hz=150,zeta=0.03,gain=5,channels=Fx+Fy+Fz+Tx+Ty+Tz,role=test_stand,gain_above=1``: a
     #: fixed-frequency resonance H(f/f_r) on the lines of those channels (the stand's fixture resonance, or a wheel mode:
-    #: role wheel_mode, --physics simple only), |H| = gain at f_hz and H -> gain_above far above it (test_stand only:
-    #: 0 is the force through a fixture spring, whose gain is then at least 1/(2 zeta); rwadist.resonance)
+    #: role wheel_mode, --physics simple only), |H| = gain at f_hz and H -> gain_above far above it (0 is the force
+    #: through a fixture spring, whose gain is then at least 1/(2 zeta); 1 - mu a wheel mode of participation mu)
     INJECT: ClassVar[Mapping] = {"f_hz": 150.0, "zeta": 0.03, "gain": 5.0, "channels": "Fx+Fy+Fz+Tx+Ty+Tz",
                                  "role": "test_stand", "gain_above": 1.0}
     INJECT_TEXT: ClassVar[tuple] = ("channels", "role")
@@ -75,8 +73,6 @@ class FixedResonance(Element):
     def inject_check(cls, spec, bad):
         if spec["role"] not in cls.ROLES:
             raise bad("role", f"{spec['role']!r}; expected one of {', '.join(cls.ROLES)}")
-        if spec["gain_above"] != 1.0 and spec["role"] != "test_stand":
-            raise bad("gain_above", "a gain other than 1 above the resonance is a fixture's: role=test_stand")
         least = cls.smallest_peak(spec["zeta"], spec["gain_above"])
         if spec["gain"] < least * (1 - 1e-9):
             raise bad("gain", f"{spec['gain']!r}: with zeta={spec['zeta']!r} and gain_above={spec['gain_above']!r} the "

@@ -171,7 +171,7 @@ class FixedResonance:
     channels by H(f/f_r) (:func:`resonance`; ζ damping ratio, g = |H| at f_r, ``gain_above`` H far above f_r).
     ``role``: "test_stand" when it acts on every channel alike (a fixture resonance, to be excluded from the wheel's
     model; its gain above f_r is fitted: the force through a fixture spring falls there), "wheel_mode" when on one
-    direction's channels only (an unmodelled wheel mode, to be added; H → 1 above)."""
+    direction's channels only (an unmodelled wheel mode, to be added; H → 1 − μ above a mode of the load's path)."""
 
     f_r: float
     zeta: float
@@ -245,13 +245,14 @@ class FixedResonance:
 
     @staticmethod
     def of_structure(held, channels, structure) -> "FixedResonance":
-        """The mode of the wheel's structure ``held`` (direction, f_r Hz, ζ, peak gain: what the held-out runs judge)
-        of the suspension modes' extended fit, on ``channels``' channels of its direction, refitted as ``structure``
-        (the same fitted on every run); H → 1 far above it."""
-        direction, f_r, zeta, gain = held[0], *(float(v) for v in held[1:4])
+        """The mode of the wheel's structure ``held`` (direction, f_r Hz, ζ, peak gain[, gain above]: what the held-out
+        runs judge) of the suspension modes' extended fit, on ``channels``' channels of its direction, refitted as
+        ``structure`` (the same fitted on every run); H → β far above it (1 when not given)."""
+        direction, f_r, zeta, gain, *above = held[0], *(float(v) for v in held[1:5])
         chans = tuple(c for c in DIRECTION_CHANNELS[direction] if c in channels)
-        return FixedResonance(f_r, zeta, gain, chans, "wheel_mode", extended_stand=tuple(float(v) for v in structure[1:4])
-                              + (1.0,))
+        refit = tuple(float(v) for v in structure[1:5])
+        return FixedResonance(f_r, zeta, gain, chans, "wheel_mode", gain_above=above[0] if above else 1.0,
+                              extended_stand=refit + (() if len(refit) == 4 else (1.0,)))
 
     @staticmethod
     def peak(f: np.ndarray, y: np.ndarray, lo: float, hi: float, df: float):

@@ -164,7 +164,7 @@ def _fixed_across_speeds(ctx: Context, runs, joint) -> bool:
     """Whether the structure mode of ``joint`` (its ``stand`` on ``stand_direction``) stays at one frequency across
     the speeds.  On the slower and on the faster half of ``runs``, the structure mode is fitted again from it (jointly
     with the suspension modes) and set against the fit holding it
-    (:func:`rwadist.stand_resonance.structure_mode_refused`: the Bayesian information criterion of its three
+    (:func:`rwadist.stand_resonance.structure_mode_refused`: the Bayesian information criterion of its four
     parameters); it moves with the speed when BOTH halves want a resonance of their own and their two frequencies are
     more than the resonance's relative half-width ζ (or :data:`STRUCTURE_SPEED_SPLIT_TOL`) apart.  A mode whose
     frequency falls or rises with speed (a rotor mode softening, a drive resonance following the speed) also lifts
@@ -181,16 +181,15 @@ def _fixed_across_speeds(ctx: Context, runs, joint) -> bool:
         return True
     spin = np.abs(np.asarray(ctx.test.speeds, dtype=float)[runs])
     order = np.argsort(spin, kind="stable")
-    f_r, zeta, gain = joint.stand[:3]
     got = []
     for part in (np.sort(runs[order[:half]]), np.sort(runs[order[-half:]])):
         try:
             test, fit = _test_and_fit(ctx, part)
-            got.append(structure_mode_refused(test, fit, joint.stand_direction, (f_r, zeta, gain)))
+            got.append(structure_mode_refused(test, fit, joint.stand_direction, tuple(joint.stand[:4])))
         except ValueError:
             return True
     moved = abs(float(np.log(got[1][1] / got[0][1])))
-    moving = got[0][0] > 0 and got[1][0] > 0 and moved > max(zeta, STRUCTURE_SPEED_SPLIT_TOL)
+    moving = got[0][0] > 0 and got[1][0] > 0 and moved > max(joint.stand[1], STRUCTURE_SPEED_SPLIT_TOL)
     return not moving
 
 
@@ -540,7 +539,7 @@ class SuspensionModes:
         zeta = {"radial_translation": float(p.zeta_r), "rocking": float(p.zeta_rock), "axial": float(p.zeta_z)}
         base, pairs = wheel_base(to_model(efit, fit))
         structure = None if efit.stand_direction is None or efit.stand is None else \
-            (efit.stand_direction,) + tuple(float(v) for v in efit.stand[:3])
+            (efit.stand_direction,) + tuple(float(v) for v in efit.stand[:4])
         return SuspensionModes(base, f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained), n_runs, stand,
                                sideband_pairs=pairs, structure=structure)
 

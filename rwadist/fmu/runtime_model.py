@@ -164,6 +164,10 @@ def effects_from_doc(doc, source="<model>"):
     for e, a in pairs:
         switch = getattr(getattr(e, "FMU_SWITCH", None), "name", None)
         if isinstance(a, _actions.LineFilter):
+            if a.gain_above != 1.0:
+                raise ModelError(f"{source}: a wheel_mode fixed_resonance keeping gain_above {a.gain_above!r} of the load "
+                                 "far above it: the FMU's wheel-mode filter returns to 1 above the resonance (not "
+                                 "supported in an FMU yet)")
             resonances.append((a.directions, *a.resonance))
         elif isinstance(a, _actions.LineModulation):
             sidebands.append((a.direction, a.h, a.f_mod_hz, a.depth))
