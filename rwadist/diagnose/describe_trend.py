@@ -15,6 +15,8 @@ own (a law fitted to the line took its trend): each line's least-squares slope o
 
 - changes the lines' power by :data:`MIN_CHANGE_DB` or more across the speed range,
 - stands :data:`MIN_Z` standard errors from 0 (the median's, from the lines' scatter, its MAD),
+- leaves the runs no common offset from it scattering by more than :data:`MAX_RUN_SCATTER` of its change (runs
+  changed in steps, a ``run_change``, are not a trend),
 - is held by :data:`MIN_LINES` lines or more, a share :data:`MIN_AGREE` of those read (a slope of the same sign
   within a factor 2 of the median), in :data:`MIN_DIRECTIONS` directions or more (one line's own amplitude law, or a
   resonance misfit near one mode, moves one line or the lines of one band: the ``amplitude_law`` class, not this),
@@ -50,6 +52,14 @@ MIN_LINES = 4
 MIN_AGREE = 0.6
 #: ... in this many directions (radial force, radial torque, axial force, axial torque) or more.
 MIN_DIRECTIONS = 2
+#: The runs' common offset from the trend (the median over the lines read in a run of what the common slope leaves of
+#: each line, its offset out) scatters (1.4826 × MAD over the runs) by at most this fraction of the trend's change:
+#: a gain that changes smoothly with speed leaves the runs only the lines' noise in common (0.004-0.015 dB on
+#: trial16 tempgain and family wheels 0, 4, 5, 6 with 1 − 0.08·Ω/Ω_max, for changes of 0.55-0.65 dB), runs changed in
+#: steps by a common factor (a re-mounting: the ``run_change`` signature) leave their steps, of which a slope is only
+#: the projection on the speed (the open world's every third run 3.5 dB up on family wheel 3: 0.47 dB over the range,
+#: the runs scattering 0.32 dB).
+MAX_RUN_SCATTER = 0.25
 #: A gain of the line's frequency (a filter) rather than of the speed when one slope against the frequency leaves less
 #: than this fraction of the residual one slope against the speed leaves.  Between it and 1 the two are not told apart
 #: (lines of a narrow span of h, or lines whose misfit near a suspension mode outweighs the difference: family wheel 4
@@ -136,6 +146,16 @@ def gain_trend(ctx, state, shares) -> list:
     if (abs(change) < MIN_CHANGE_DB or abs(med) < MIN_Z * se or agree.sum() < max(MIN_LINES, MIN_AGREE * len(lines))
             or len(directions) < MIN_DIRECTIONS):
         return []
+    # a smooth trend, not runs changed in steps: what the common slope leaves of each line, per run, its median
+    left: dict = {}
+    for x in lines:
+        r = x[5] - x[5].mean() - med * (x[3] - x[3].mean()) / 1000.0
+        for k, v in zip(x[2], r):
+            left.setdefault(int(k), []).append(v)
+    per_run = np.array([np.median(v) for v in left.values()])
+    run_scatter = 1.4826 * float(np.median(np.abs(per_run - np.median(per_run))))
+    if run_scatter > MAX_RUN_SCATTER * abs(change):
+        return []
     # the speed against the line's frequency: one common slope each, every line its own offset
     d_all = [x[5] for x in lines]
     s_speed, rss_speed = _pooled([x[3] / 1000.0 for x in lines], d_all)
@@ -160,7 +180,7 @@ def gain_trend(ctx, state, shares) -> list:
                     "change_dB": change, "gain_change_percent": pct, "amplitude_ratio": float(ratio),
                     "lines_agreeing": int(agree.sum()), "lines_read": len(lines), "directions": directions,
                     "lines_h": sorted({x[1] for x in held}), "read_h": read_h,
-                    "lines_with_a_law": [[x[0], x[1]] for x in read if x[6]],
+                    "lines_with_a_law": [[x[0], x[1]] for x in read if x[6]], "run_scatter_dB": run_scatter,
                     "pooled_slope_dB_per_krpm": s_speed, "rss_speed_dB2": rss_speed,
                     "frequency_slope_dB_per_kHz": s_freq, "rss_frequency_dB2": rss_freq,
                     "depends_on": "speed" if apart else "speed or frequency, not told apart"},
