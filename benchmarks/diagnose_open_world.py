@@ -2,7 +2,7 @@
 injected into wheels rwadist's tests were not tuned on, diagnosed on the command a user types.
 
 Data: the wheels of tests/family_wheel.py (eight wheels, 2-15 kg, I_zz/I_rr 1.2-2.2, modes 50-600 Hz, bearing-like
-lines, 3000-10000 rpm, 2-10 kHz; numpy only, nothing of rwadist), each with one of the five effects below written
+lines, 3000-10000 rpm, 2-10 kHz; numpy only, nothing of rwadist), each with one of the effects below written
 into its runs through the generator's own hooks (written here with numpy: none of them is a diagnose class, and
 each differs from the family's own unknown kinds of tests/family_effects.py), saved in the interchange format and
 diagnosed by ``rwadist diagnose DATA -o R`` (no model: the default path; a subprocess) and its summary.json read.
@@ -22,6 +22,9 @@ remount_step         run_change        every third run (speed order) with all it
 inverter_sidebands   sideband_line     a carrier at 0.17 x the sample rate on every channel, 8 x the channel's
                                        noise std, with sidebands at +- p x the spin frequency of 0.35 x it (an
                                        inverter modulated by a motor of p pole pairs: p = 1, 2, 3, 4 by wheel)
+speed_gain           line_property     every channel's gain 1 - 0.08 Omega/Omega_max before the sensor noise (a
+                                       load cell warming with speed: trial16 tempgain); right when a gain_trend
+                                       record reads the gain's change over the speed range within 25 %
 ==================== ================= =========================================================================
 
 A cell passes when a record of the right signature is where the injection is (:func:`right`) and no class beyond
@@ -184,8 +187,27 @@ class InverterSidebands:
         return {"kind": "inverter_sidebands", "carrier_hz": self.f_c, "pole_pairs": self.p, "side": self.side}
 
 
+class SpeedGain:
+    """Every channel's gain 1 − ``k``·Ω/Ω_max at every frequency (the sensor noise added after it)."""
+
+    signature = "line_property"
+
+    def __init__(self, omega_max, k=0.08):
+        self.omega_max, self.k = omega_max, k
+
+    def gain(self, f_hz, omega):
+        return np.full((np.size(f_hz), 6), 1.0 - self.k * abs(omega) / self.omega_max, dtype=complex)
+
+    def change_db(self, omega_min):
+        """The lines' change of power from ``omega_min`` to Ω_max, dB."""
+        return 20 * np.log10((1 - self.k) / (1 - self.k * abs(omega_min) / self.omega_max))
+
+    def truth(self):
+        return {"kind": "speed_gain", "k": self.k, "omega_max_rad_s": self.omega_max}
+
+
 KINDS = ("clean", "mains_pickup", "torque_crosstalk", "softening_mode", "torque_hump", "remount_step",
-         "inverter_sidebands")
+         "inverter_sidebands", "speed_gain")
 
 
 def make_effect(kind: str, wheel):
@@ -202,6 +224,8 @@ def make_effect(kind: str, wheel):
     if kind == "inverter_sidebands":
         # p = 1, 2, 3, 4 by the family's index (wheels "family-N")
         return InverterSidebands(0.17 * wheel.sample_rate, float(1 + int(wheel.name.rsplit("-", 1)[-1]) % 4))
+    if kind == "speed_gain":
+        return SpeedGain(wheel.max_rpm * fw.RPM)
     raise ValueError(kind)
 
 
@@ -225,6 +249,10 @@ def right(kind: str, effect, wheel, speeds_rpm, recs: list) -> bool:
     if kind == "inverter_sidebands":
         return any(abs(r["parameters"].get("carrier_Hz", 0) - effect.f_c) < 1.0 and r["parameters"].get("sides") == [-1, 1]
                    and abs(r["parameters"].get("h", 0) / effect.p - 1) < 2e-3 for r in mine)
+    if kind == "speed_gain":
+        truth = effect.change_db(min(speeds_rpm) * fw.RPM)
+        return any(r["parameters"].get("property") == "gain_trend"
+                   and abs(r["parameters"]["change_dB"] / truth - 1) < 0.25 for r in mine)
     if kind == "remount_step":
         stepped = {round(float(s), 3) for i, s in enumerate(speeds_rpm) if effect.stepped(i)}
         for r in mine:

@@ -306,6 +306,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_lines import speed_lines
     from .describe_partial import partial_lines
     from .describe_structure import broadband_hump, line_ratios, moving_resonance, resolved_lines, run_change
+    from .describe_trend import gain_trend
 
     res = searched if res is None else res
     ctx, state = searched.ctx, floor_as_read(searched.ctx, searched.state)
@@ -377,6 +378,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += sidebands
     # the recorded channels (a gain acts on them, before any load-cell correction), against the noise as given
     out += channel_gain(ctx, as_recorded(searched.state), of_line)
+    # a gain common to the channels that changes with speed, on the recorded channels too
+    out += gain_trend(ctx, as_recorded(searched.state), of_line)
     return out
 
 
@@ -414,7 +417,11 @@ def cells_of(u, res: Residual) -> dict:
     ``moving_resonance`` the bands of its track ±3ζ, a ``channel_copy`` the target's bands where the copy is at
     least a tenth of the target's power, the others the bands of their frequency range; a ``run_change`` none (it is
     a change of whole runs: a class gaining in those runs is not fitted to it), nor a ``line_property`` (a property of
-    every line of a channel, a gain: a class acting on that channel's lines is not fitted to it)."""
+    every line of a channel, a gain: a class acting on that channel's lines is not fitted to it), but for a gain
+    that changes with speed (``gain_trend``) the bands of its lines in its channels: an amplitude law on one of them
+    is that trend read on one line (trial16 tempgain at seed 2: Ω^1.93 on one of 25 lines that share it)."""
+    if u.signature == "line_property" and u.parameters.get("property") == "gain_trend":
+        return _trend_cells(u, res)
     if u.signature in ("run_change", "line_property"):
         return {}
     ctx = res.ctx
@@ -454,6 +461,24 @@ def cells_of(u, res: Residual) -> dict:
             m = res.mask(c)
             for r, a, z in zip(rows, lo, hi):
                 m[r, a:z + 1] = True
+            out[c] = m
+    return out
+
+
+def _trend_cells(u, res: Residual) -> dict:
+    """The cells of a ``gain_trend`` record: the band of each line it read (``read_h``: those that hold the trend and
+    those that do not, an amplitude law fitted to one line having taken its share) in each run of its speed range, in
+    its channels."""
+    ctx = res.ctx
+    rpm = np.abs(ctx.omega[ctx.runs]) * 60.0 / (2 * np.pi)
+    rows = np.flatnonzero((rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6))
+    hs = np.asarray(u.parameters.get("read_h", u.parameters.get("lines_h", ())), float)
+    out = {}
+    for c in u.channels:
+        if c in res.e and hs.size:
+            m = res.mask(c)
+            for r in rows:
+                m[r, res.band_of(hs * rpm[r] / 60.0)] = True
             out[c] = m
     return out
 

@@ -51,6 +51,7 @@ LEVEL_WORDS = {
     "run_change": "the changed runs {} dB off the others",
     "partial_line": "{:+.1f} dB against the model in the runs it is absent from",
     "line_property": "{:+.2f} dB (power) in the second channel's lines against the first's",
+    "line_property:gain_trend": "{:+.2f} dB (power) on every line from the lowest speed to the highest",
 }
 
 
@@ -88,7 +89,10 @@ class Unexplained:
     f_Hz : (lowest, highest) frequency where it is, Hz (a fixed line: its frequency twice).
     level_dB : how far it stands out, dB: the median over its cells of 10·log10(data / model); for a
         ``broadband_hump`` (which the model takes as noise) its peak over the floor's smooth course, for a
-        ``run_change`` the median offset of the changed runs from the lines' smooth trends with speed (:data:`LEVEL_WORDS`).
+        ``run_change`` the median offset of the changed runs from the lines' smooth trends with speed, for a
+        ``line_property`` of a channel's gain the median power ratio of the pair's channels and of a ``gain_trend`` the
+        lines' change of power from the lowest speed to the highest (:data:`LEVEL_WORDS`, keyed by signature, or by
+        "signature:property").
     share : its share of what is left, 0..1: the misplaced power of its cells (the error metric's numerator
         over them) over the misplaced power of every cell after the search.
     n_runs : runs in which it stands above the noise.
@@ -147,7 +151,8 @@ class Unexplained:
         stand out (trial12: −0.1 dB for a line 17.9 dB over the model)."""
         if self.signature == "run_change":
             return LEVEL_WORDS["run_change"].format(self._run_change_level())
-        out = LEVEL_WORDS.get(self.signature, "{:+.1f} dB over the model").format(self.level_dB)
+        key = f"{self.signature}:{self.parameters.get('property')}"
+        out = LEVEL_WORDS.get(key, LEVEL_WORDS.get(self.signature, "{:+.1f} dB over the model")).format(self.level_dB)
         lift = _number(self.parameters.get("largest_line_lift_dB")) if self.signature == "moving_resonance" else None
         if lift is not None:
             out += f" in its track's bands, the lines it lifts up to {lift:+.1f} dB"
