@@ -54,6 +54,11 @@ EDGE = 0.05
 ONE_WAY = 0.9
 
 
+def _middle(n: int) -> slice:
+    """The samples of a record of ``n`` less its first and last :data:`EDGE` (the low-pass's own edges)."""
+    return slice(int(EDGE * n), n - int(EDGE * n))
+
+
 def cut_hz(f_line: float) -> float:
     """The low-pass's cut (Hz) for a 1× line at ``f_line`` Hz."""
     return min(CUT_RATIO * abs(float(f_line)), CUT_MAX_HZ)
@@ -103,7 +108,7 @@ def resampled(run, theta: np.ndarray):
     fs = float(run.sample_rate)
     n = run.n_samples
     t = np.arange(n) / fs
-    mid = slice(int(EDGE * n), n - int(EDGE * n))
+    mid = _middle(n)
     # the mean over the whole record (what every Welch segment averages), from the angle's rise end to end: its
     # ends carry the low-pass's edge (~0.05 rad, 1e-5 of a record's turn), a least-squares slope over part of the
     # record the wander's own departure from that mean (~1e-4)
@@ -154,7 +159,7 @@ def tracked(test, check: dict, reads=None) -> tuple:
         new, mean, wander = resampled(run, theta)
         # the wander's swing of the angle about a steady turn against what the noise alone gives the reading
         t = np.arange(run.n_samples) / float(run.sample_rate)
-        mid = slice(int(EDGE * t.size), t.size - int(EDGE * t.size))
+        mid = _middle(t.size)
         swing = float(np.std(theta[mid] - np.polyval(np.polyfit(t[mid], theta[mid], 1), t[mid])))
         if wander < MIN_WANDER_REL or swing < SWING_OVER_NOISE * noise:
             continue
