@@ -82,6 +82,18 @@ those steps 0.81 -> 0.25 s CPU (benchmark), 0.39 -> 0.11 s (sixty), the same rec
 49928af and speed18 interleaved (old, new, new, old) at load 3.1-3.4 on 2 cores (two other agents' jobs): diagnose
 cpu min 2.85/2.98 s -> 2.46/2.36 s (benchmark), 1.62/1.60 -> 1.38/1.30 s (sixty); cpu x12.2/x12.3, x16.8/x13.0 ->
 x10.9/x11.0, x11.5/x10.0 (benchmark, min/median), x18.4/x17.8, x18.8/x18.6 -> x15.4/x15.5, x15.5/x15.2 (sixty);
+target not met on the sixty set.  2026-12-01, session 19 (speed19; in-call timers at 1fae24a, one process, the sixty set,
+diagnose 1.39 s: the suspension-modes fit on the fit runs 0.31 s and its refit on every run 0.18 s, of which the mode
+scans 0.22 s, the rocking mode's single-precision screens 0.19 s; the other families' two steps 0.51 s, none over
+0.07 s; the 1x-line steps before the search 0.11 s; the description 0.11 s): the runs' own speeds refined for all
+runs of a line at once (one windowed_dfts per line and parabola step instead of 354 one-record transforms: 0.050 ->
+0.025 s, the same numbers bit for bit), the rocking screens in base-2 logarithms (~5 % of the screens).  --quick
+--repeats 3 --busy 2, 1fae24a and speed19 alternated (main, new, new, main) at load 7.4-9.3 on 2 cores (other
+agents' jobs): cpu min/median benchmark x11.9/x10.5, x12.9/x10.4 (main) against x12.1/x10.1, x10.7/x9.4; 2 busy
+x11.2/x10.4, x11.1/x11.3 against x10.3/x9.2, x9.9/x9.2; sixty x16.0/x15.6, x14.9/x15.2 against x15.1/x15.1,
+x14.6/x14.8; 2 busy x16.1/x16.3, x15.2/x15.2 against x14.9/x15.8, x15.7/x15.8; a third round (new, main) at load
+5.6-6.9: benchmark x9.4/x9.0 against x11.3/x11.5, 2 busy x9.6/x10.0 against x9.9/x9.2, sixty x14.7/x15.1 against
+x15.6/x15.5, 2 busy x15.1/x15.8 against x15.8/x14.8: a few per cent idle, none beside 2 busy, at this load's noise;
 target not met on the sixty set.
 """
 from __future__ import annotations

@@ -192,6 +192,9 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
     both_senses = two_parts and not same
     trend = _Trend(om, starts, counts, _imbalance_lines(np.asarray(h, float)[order][starts], two_parts))
     seg = _Segments(starts, counts, dtype)
+    # the screen's logarithms in base 2 (single precision: 40 % faster than the natural logarithm), its SSR times
+    # (ln 2)² at the end: every SSR is a sum of squared differences of logs, so the same number to rounding
+    log = np.log if dtype == np.float64 else np.log2
     n_z, n_a, n_rows = zeta_grid.size, a_grid.size, om.size
     out = np.empty((f0_grid.size, n_z, n_a))
     bufs = None                     # the two-senses search's arrays, one set for every chunk (the first is the largest)
@@ -202,21 +205,27 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
         d2 = ((2 * zeta_grid[None, :] * w0[:, None])[:, :, None] * nu[None, None, :]) ** 2   # (F, Z, rows)
         num = ((w02**2)[:, None, None] + d2) * scale                                  # |T|² numerator × scale
         rest = w02[:, None] - nu2[None, :]                                            # (F, rows)
-        lnum = np.log(num)
+        lnum = log(num)
         if same:
-            lw = (lnum - np.log(rest[:, None, :] ** 2 + d2))[:, :, None, :]           # (F, Z, 1, rows)
+            lw = (lnum - log(rest[:, None, :] ** 2 + d2))[:, :, None, :]              # (F, Z, 1, rows)
             out[s:s + step] = np.sum(_line_log_ssr(lw, seg, trend), axis=-1)
             continue
         lnum = lnum[:, :, None, :]
         if not both_senses:
             den_u = ((rest[:, None, :] + gyro[None]) ** 2)[:, None] + d2[:, :, None, :]    # (F, Z, A, rows)
-            out[s:s + step] = np.sum(_line_log_ssr(lnum - np.log(den_u), seg, trend), axis=-1)
+            out[s:s + step] = np.sum(_line_log_ssr(lnum - log(den_u), seg, trend), axis=-1)
             continue
         if bufs is None:
             bufs = np.empty((4, w0.size, n_z, n_a, n_rows), num.dtype)
         out[s:s + step] = np.sum(_two_senses_ssr(num[:, :, None, :], lnum, rest[:, None, :], gyro[None],
                                                  d2[:, :, None, :], seg, trend, bufs), axis=-1)
+    if log is not np.log:
+        out *= LN2_SQUARED
     return out
+
+
+#: (ln 2)²: the single-precision screen's SSR of base-2 logarithms times this is its SSR of natural logarithms
+LN2_SQUARED = math.log(2.0) ** 2
 
 
 def _two_senses_ssr(num, lnum, rest, gyro, d2, seg, trend, bufs):
@@ -235,9 +244,9 @@ def _two_senses_ssr(num, lnum, rest, gyro, d2, seg, trend, bufs):
         ssr = np.minimum(ssr, _line_log_ssr(np.subtract(lnum, np.log(v, out=lw), out=lw), seg, trend, tmp))
     np.divide(num, u, out=u)
     np.divide(num, v, out=v)
-    if not double:                  # the screen: the logs of the ratios (no subtraction broadcast over a)
-        ssr = _line_log_ssr(np.log(u, out=lw), seg, trend, tmp)
-        ssr = np.minimum(ssr, _line_log_ssr(np.log(v, out=lw), seg, trend, tmp))
+    if not double:                  # the screen: the base-2 logs of the ratios (no subtraction broadcast over a)
+        ssr = _line_log_ssr(np.log2(u, out=lw), seg, trend, tmp)
+        ssr = np.minimum(ssr, _line_log_ssr(np.log2(v, out=lw), seg, trend, tmp))
     su, sv = seg.sum(u), seg.sum(v)
     suu, svv, suv = (seg.sum(np.multiply(a, b, out=tmp)) for a, b in ((u, u), (v, v), (u, v)))
     det = suu * svv - suv**2
@@ -249,7 +258,8 @@ def _two_senses_ssr(num, lnum, rest, gyro, d2, seg, trend, bufs):
         reps = seg.counts.astype(int)
         np.multiply(np.repeat(np.where(ok, x, 1.0), reps, axis=-1), u, out=lw)
         np.add(lw, np.multiply(np.repeat(np.where(ok, y, 0.0), reps, axis=-1), v, out=tmp), out=lw)   # the mix
-        ssr = np.where(ok, np.minimum(ssr, _line_log_ssr(np.log(lw, out=lw), seg, scratch=tmp)), ssr)
+        ssr = np.where(ok, np.minimum(ssr, _line_log_ssr((np.log if double else np.log2)(lw, out=lw), seg,
+                                                          scratch=tmp)), ssr)
     return ssr
 
 

@@ -129,7 +129,11 @@ def run_spectra(run, channels, buffers: dict | None = None) -> dict:
     n = run.n_samples
     win = _window_and_bins(n, float(run.sample_rate))[0]
     shape = (len(channels), PAD * n)
-    padded = np.zeros(shape) if buffers is None else buffers.setdefault(shape, np.zeros(shape))
+    padded = None if buffers is None else buffers.get(shape)
+    if padded is None:                  # made once per shape (not a new zero-filled array per run to discard)
+        padded = np.zeros(shape)
+        if buffers is not None:
+            buffers[shape] = padded
     for row, c in zip(padded, channels):
         np.multiply(np.asarray(run.signals[c], dtype=float) - np.mean(run.signals[c]), win, out=row[:n])
     return dict(zip(channels, sfft.rfft(padded, axis=-1)))

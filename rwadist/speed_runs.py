@@ -31,10 +31,11 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import replace
+from functools import lru_cache
 
 import numpy as np
 
-from .dft import demeaned_windowed, windowed_dft
+from .dft import BlockedRecords, blocked_records, demeaned_windowed, windowed_dft, windowed_dfts
 from .speed_check import LINES, LineReads, _window_and_bins, line_ratios
 
 #: spacing, in native bins, of the three exact transforms about a peak whose log parabola refines it
@@ -93,14 +94,47 @@ def zoom_peak(run, channels: tuple, f_peak: float, y: np.ndarray | None = None) 
     return f, curv
 
 
+def zoom_peaks(ys: "BlockedRecords | np.ndarray", fs: float, f_peaks: np.ndarray, step: float) -> tuple:
+    """(frequencies Hz, curvatures 1/Hz²) of :func:`zoom_peak` of R records at once: ``ys``, each record's
+    :func:`_windowed` channels (one sample rate ``fs`` Hz and length), (R, n, K) or in the layout of
+    :func:`rwadist.dft.blocked_records`,
+    ``f_peaks`` (R,) their padded peaks, ``step`` the spacing Hz (:data:`ZOOM` native bins).  Each of the two parabola
+    steps is one :func:`rwadist.dft.windowed_dfts` of the records still refined (each record at its own three
+    frequencies, its own products and sums: the numbers of one record at a time) instead of one transform per record
+    and step."""
+    f = np.asarray(f_peaks, dtype=float).copy()
+    curv = np.full(f.size, np.nan)
+    live = np.arange(f.size)
+    for _ in range(2):
+        if not live.size:
+            break
+        freqs = f[live, None] + np.array([-step, 0.0, step])[None, :]
+        part = ys if live.size == len(ys) else BlockedRecords(ys.values[live], ys.n, ys.channels, ys.block) \
+            if isinstance(ys, BlockedRecords) else ys[live]
+        x = windowed_dfts(part, fs, freqs)                                                  # (r, 3, K)
+        a, b, c = np.log(np.maximum(np.sum(x.real ** 2 + x.imag ** 2, axis=2), 1e-300)).T
+        den = a - 2 * b + c
+        bent = den < 0
+        curv[live[~bent]] = np.nan
+        live, a, c, den = live[bent], a[bent], c[bent], den[bent]
+        curv[live] = den / step ** 2
+        f[live] += step * np.clip(0.5 * (a - c) / den, -1.0, 1.0)
+    return f, curv
+
+
+@lru_cache(maxsize=8)
+def _tone_curvature(n: int, fs: float) -> float:
+    """:func:`tone_curvature` of a run of ``n`` samples at ``fs`` Hz (the same for every run of a test: made once)."""
+    win = _window_and_bins(n, fs)[0]
+    t = np.arange(n) / fs
+    mean = float(np.sum(win * t) / np.sum(win))
+    return float(-8 * np.pi ** 2 * np.sum(win * (t - mean) ** 2) / np.sum(win))
+
+
 def tone_curvature(run) -> float:
     """d²(ln P)/df² (1/Hz²) at the peak of one steady tone's Hann-windowed power: −8π² times the variance of the
     time under the window's weights (the second-order expansion of |Σ w_n e^(−i2πu t_n)|² about u = 0)."""
-    n = run.n_samples
-    win = _window_and_bins(n, float(run.sample_rate))[0]
-    t = np.arange(n) / float(run.sample_rate)
-    mean = float(np.sum(win * t) / np.sum(win))
-    return float(-8 * np.pi ** 2 * np.sum(win * (t - mean) ** 2) / np.sum(win))
+    return _tone_curvature(int(run.n_samples), float(run.sample_rate))
 
 
 def width_rel(curv: float, tone: float, f_line: float) -> float:
@@ -128,20 +162,21 @@ def run_errors(test, reads: LineReads | None = None) -> list:
     ``reads``: a :class:`rwadist.speed_check.LineReads` shared with the steps before this one, or None."""
     read = (reads or LineReads())(test)     # each line's peak and SNR, read once for the ratios and the refinement
     ratios = line_ratios(test, read)
+    judged = {i: [k for k, r in ratios.items() if np.isfinite(r[i])] for i in range(len(test.runs))}
+    judged = {i: keys for i, keys in judged.items() if len(keys) >= MIN_LINES}
+    zoomed = _zoomed(test, judged, read)
     out: list = []
     for i, run in enumerate(test.runs):
         f0 = abs(float(run.speed)) / (2 * np.pi)
-        keys = [k for k, r in ratios.items() if np.isfinite(r[i])]
-        if len(keys) < MIN_LINES:
+        keys = judged.get(i)
+        if keys is None:
             out.append(None)
             continue
         rel, sig, wid = [], [], []
         tone = tone_curvature(run)
-        chans = [c for k in keys for c in LINES[k][0]]
-        y = dict(zip(chans, _windowed(run, tuple(chans)).T))       # every line's channels windowed once per run
         for k in keys:
-            f_peak, snr = float(read[k][i, 0]), float(read[k][i, 1])
-            f, curv = zoom_peak(run, LINES[k][0], f_peak, np.stack([y[c] for c in LINES[k][0]], axis=1))
+            snr = float(read[k][i, 1])
+            f, curv = zoomed[i, k]
             rel.append(f / f0 - 1.0)
             sig.append(line_sigma(run, snr, f) / f0)
             wid.append(width_rel(curv, tone, f))
@@ -154,6 +189,37 @@ def run_errors(test, reads: LineReads | None = None) -> list:
         widened = bool(np.all(np.array(wid) > SIGMAS * np.array(sig)))
         width = float(np.median(wid)) if widened else 0.0
         out.append({"rel": mean, "se": float(np.hypot(se, width)), "chi2": chi2, "lines": keys, "width": width})
+    return out
+
+
+def _demeaned(x) -> np.ndarray:
+    """``x`` less its mean (float): what :func:`rwadist.dft.demeaned_windowed` multiplies by the window."""
+    x = np.asarray(x, dtype=float)
+    return x - x.mean()
+
+
+def _zoomed(test, judged: dict, read: dict) -> dict:
+    """(run, line key) -> :func:`zoom_peak` (frequency Hz, curvature 1/Hz²) of every line of ``judged`` (run -> the keys
+    of its lines read, :data:`rwadist.speed_check.LINES`) from its padded peak in ``read``: the runs of one line, sample
+    rate and length refined together (:func:`zoom_peaks`)."""
+    groups: dict = {}
+    for i, keys in judged.items():
+        run = test.runs[i]
+        for k in keys:
+            groups.setdefault((k, run.n_samples, float(run.sample_rate)), []).append(i)
+    out: dict = {}
+    for (k, n, fs), rows in groups.items():
+        # each channel less its mean, times the window (the numbers of :func:`_windowed`); a pair's in the transform's
+        # layout (blocked_records), one channel's as the (R, n, 1) records whose blocks the transform reads in place
+        # (the numbers of one run at a time: its product of a strided view rounds apart from a contiguous one)
+        win = _window_and_bins(n, fs)[0]
+        ys: BlockedRecords | np.ndarray
+        if len(LINES[k][0]) == 1:
+            ys = demeaned_windowed([test.runs[i].signals[LINES[k][0][0]] for i in rows], win)[:, :, None]
+        else:
+            ys = blocked_records([[_demeaned(test.runs[i].signals[c]) for c in LINES[k][0]] for i in rows], win)
+        f, curv = zoom_peaks(ys, fs, np.array([float(read[k][i, 0]) for i in rows]), ZOOM * fs / n)
+        out.update({(i, k): (float(f[j]), float(curv[j])) for j, i in enumerate(rows)})
     return out
 
 
