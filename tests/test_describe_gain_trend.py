@@ -35,16 +35,6 @@ from rwadist.data import Run, SteadyTest  # noqa: E402
 K = 0.08
 
 
-class _SpeedGain:
-    """Every channel's gain 1 − k·Ω/Ω_max (a load cell warming with speed), at every frequency."""
-
-    def __init__(self, k: float, omega_max: float):
-        self.k, self.omega_max = k, omega_max
-
-    def gain(self, f_hz, omega):
-        return np.full((len(f_hz), 6), 1.0 - self.k * abs(omega) / self.omega_max, dtype=complex)
-
-
 class _LowPass:
     """Every channel through a 4-pole Butterworth low-pass at ``fc`` Hz (an anti-alias filter: the gain depends on the
     frequency, not on the speed; trial16 ``aaf``: 600 Hz at 4 kHz, 0.15 of the sample rate)."""
@@ -67,7 +57,7 @@ def _test(data) -> SteadyTest:
 def _diagnosed(index: int, kind: str):
     wheel = dfm.wheels()[index]
     om_max = wheel.max_rpm * fw.RPM
-    effects = {"clean": [], "trend": [_SpeedGain(K, om_max)], "amplitude_law": [fe.default_effect("amplitude_law", wheel)],
+    effects = {"clean": [], "trend": [dow.SpeedGain(om_max, k=K)], "amplitude_law": [fe.default_effect("amplitude_law", wheel)],
                "filter": [_LowPass(0.15 * wheel.sample_rate)], "remount": [dow.RemountStep()]}[kind]
     seed = index if kind == "remount" else 1 + 100 * index          # remount: the open world's own cell
     data = fw.steady(wheel, noise=dfm.CONDITIONS[index][2], seed=seed, effects=effects)
@@ -79,7 +69,7 @@ def _trends(d) -> list:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("index", [0, 1, 3, 4, 5, 6])
+@pytest.mark.parametrize("index", [0, 1, 2, 3, 4, 5, 6])
 def test_a_gain_falling_with_speed_on_every_channel_is_described_with_its_change(index):
     wheel, d = _diagnosed(index, "trend")
     (u,) = _trends(d)
@@ -89,8 +79,11 @@ def test_a_gain_falling_with_speed_on_every_channel_is_described_with_its_change
     assert u.level_dB == u.parameters["change_dB"]
     assert u.parameters["gain_change_percent"] == pytest.approx(100 * (10 ** (truth_dB / 20) - 1), abs=1.5)
     assert u.speed_rpm == pytest.approx((wheel.min_rpm, wheel.max_rpm), rel=1e-6)
-    # forces and torques alike, and the speed explains the lines better than their frequency
-    assert {"radial_force", "radial_torque"} <= set(u.parameters["directions"])
+    # forces and torques alike, and the speed explains the lines better than their frequency; wheel 2 (noise 0.03)
+    # reads its torques' 1x through a rocking-mode fit that bent to the gain (+0.15 dB per 1000 rpm against the
+    # gain's -0.24) and its other torque line unresolved: the forces, radial and axial, hold it there
+    want = {"radial_force", "axial_force"} if index == 2 else {"radial_force", "radial_torque"}
+    assert want <= set(u.parameters["directions"])
     assert u.parameters["rss_speed_dB2"] < u.parameters["rss_frequency_dB2"]
     assert "temperature" in u.causes[0] and "run-down" in u.would_tell
     # nothing forced into a class for it: no amplitude law on one of its lines
@@ -98,13 +91,13 @@ def test_a_gain_falling_with_speed_on_every_channel_is_described_with_its_change
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("index", [0, 1, 3, 4, 5, 6])
+@pytest.mark.parametrize("index", [0, 1, 2, 3, 4, 5, 6, 7])
 def test_clean_data_hold_no_gain_trend(index):
     assert _trends(_diagnosed(index, "clean")[1]) == []
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("index", [0, 3, 4])
+@pytest.mark.parametrize("index", [0, 2, 3, 4, 5])
 def test_one_lines_amplitude_law_is_no_common_trend(index):
     _, d = _diagnosed(index, "amplitude_law")
     assert _trends(d) == []
@@ -112,7 +105,7 @@ def test_one_lines_amplitude_law_is_no_common_trend(index):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("index", [0, 3, 5])
+@pytest.mark.parametrize("index", [0, 2, 3, 5])
 def test_a_filter_on_the_frequency_is_no_gain_trend_with_speed(index):
     assert _trends(_diagnosed(index, "filter")[1]) == []
 
@@ -156,3 +149,64 @@ def test_the_detector_reads_a_common_slope_and_not_a_frequency_one(monkeypatch):
         assert bool(got) == described
         if described:
             assert got[0].parameters["slope_dB_per_krpm"] == pytest.approx(-0.15, abs=0.01)
+
+
+@pytest.mark.slow
+def test_the_open_worlds_noisy_wheel_with_the_speed_gain_gets_a_trend_and_no_amplitude_law(tmp_path):
+    """The open world's own cell of family wheel 2 (20 speeds 300-3000 rpm, 4096 samples, noise 0.03: few lines
+    stand 20 dB over the noise), through the files a user gives the command: the search fitted the 1x lines of the
+    radial and axial forces Ω^1.94 and Ω^1.93, the trend a law each, and nothing was described (main 1fae24a: two
+    lines read without a law, four needed).  Now the trend is described to 25 % of the gain's change, the two laws
+    (the trend read on two lines) taken back; the same wheel clean, with one line's own law, or through a low-pass
+    filter, holds none (the controls above)."""
+    i = 2
+    wheel = dfm.wheels()[i]
+    gain = dow.SpeedGain(wheel.max_rpm * fw.RPM)
+    speeds = np.linspace(wheel.min_rpm, wheel.max_rpm, wheel.n_speeds)
+    data = fw.steady(wheel, speeds_rpm=speeds, noise=dfm.CONDITIONS[i][2], seed=i, effects=[gain])
+    d = api.diagnose(api.read(fw.write_steady(data, tmp_path / "data", wheel.name)))
+    (u,) = _trends(d)
+    truth_dB = 20 * np.log10((1 - K) / (1 - K * wheel.min_rpm / wheel.max_rpm))
+    assert truth_dB == pytest.approx(gain.change_db(wheel.min_rpm * fw.RPM), rel=1e-9)
+    assert u.parameters["change_dB"] == pytest.approx(truth_dB, rel=0.25)
+    assert {"radial_force", "axial_force"} <= set(u.parameters["directions"])
+    assert [e["kind"] for e in d.summary()["effects"]] == ["suspension_modes"]
+    # the laws the search fitted to the trend were taken back as fitted to it
+    assert {h.effect.kind for h in d.hypotheses if getattr(h, "forced_by", None)} == {"amplitude_law"}
+
+
+def test_a_law_fitted_to_the_trend_is_read_against_omega_squared(monkeypatch):
+    """A line the model gives a law a·(Ω/Ω_ref)^p (fitted to the trend: its measured-over-predicted ratio flat) reads,
+    the law put back, the same ratios against C·Ω² as the line without a law, to within each line's constant (closed
+    form: 20·(p − 2)·log10(Ω/Ω_ref)), and their slope is the gain's; a line at 12 dB over the noise whose ratios
+    scatter 0.02 dB resolves the change tested, the same line scattering 1 dB does not (its slope does not decide)."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose import describe_trend as dt
+
+    rpm = np.linspace(300.0, 3000.0, 20)
+    om = rpm * 2 * np.pi / 60.0
+    g2 = (1 - K * om / om[-1]) ** 2                                 # the trend, in power
+    p, w_ref = 1.93, om[10]
+    rng = np.random.default_rng(0)
+    meas = om**4 * g2 * 10 ** (0.02 * rng.standard_normal(rpm.size) / 10)   # the line, 0.02 dB of scatter
+    law_pred = w_ref**4 * (om / w_ref) ** (2 * p)                    # the law fitted to it (a = Ω_ref²)
+    free_pred = om**4
+    noise = free_pred / 10 ** 1.2                                     # 12 dB under the line
+    noisy = meas * 10 ** (rng.standard_normal(rpm.size) / 10)         # 1 dB of scatter
+    rows = {"radial_force": ([1.0, 2.0, 3.0], [(w_ref**2, w_ref, p), None, None],
+                             np.array([meas, meas, noisy]), np.array([law_pred, free_pred, free_pred]),
+                             np.array([noise, noise, noise]))}
+    monkeypatch.setattr(dt, "_direction_powers", lambda ctx, state, d, runs: (
+        None if d not in rows else (np.array(rows[d][0]), rows[d][1], rows[d][2], rows[d][3], rows[d][4])))
+    ctx = SimpleNamespace(omega=om)
+    got = dt._lines(ctx, None, np.arange(rpm.size))
+    assert [(x[1], x[6]) for x in got] == [(1.0, True), (2.0, False), (3.0, False)]
+    law_db, free_db = got[0][5], got[1][5]
+    assert np.ptp(law_db - free_db) < 1e-9                            # the same ratios but a constant
+    truth = dt._slope(rpm / 1000.0, 10 * np.log10(g2))
+    assert dt._slope(rpm / 1000.0, law_db) == pytest.approx(truth, abs=0.01)
+    # the slope's standard error over the range: the 0.02 dB line resolves the change tested, the 1 dB one not
+    span = np.ptp(rpm) / 1000.0
+    assert dt._line_slope_se(rpm / 1000.0, free_db) * span < dt.MAX_LINE_SE_DB < dt._line_slope_se(
+        rpm / 1000.0, got[2][5]) * span
