@@ -19,6 +19,7 @@ import numpy as np
 # the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
+from ..diagnose.modes_trend import beside_trend
 from ..diagnose.state import State
 from ..model import Harmonic, WheelModel
 from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode, stand_starts
@@ -138,6 +139,13 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             got = _beside_offset(ctx, state, efit, fit, runs, test, stand_start, near, offset_start)
             if got is not None:
                 test, fit, efit, stand, offset = got
+        if efit.unconstrained and offset is None:
+            # a gain common to every line that changes with speed bends the trend the modes are read from: taken out
+            # when the located modes' lines show one and the modes are then located better
+            # (:mod:`rwadist.diagnose.modes_trend`)
+            trend = beside_trend(ctx, test, fit, efit, stand_start, near, _locate)
+            if trend is not None:
+                test, fit, efit, stand = trend
         if stand is None and len(ctx.channels) > 3:
             # on an unconstrained mode's direction, or on the forces when every mode is located
             structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
