@@ -78,20 +78,12 @@ def zoom_peak(run, channels: tuple, f_peak: float, y: np.ndarray | None = None) 
     """(frequency Hz, curvature 1/Hz²) of the maximum of ``channels``' exact windowed power near ``f_peak`` (a padded
     spectrum's peak, :func:`rwadist.speed_check.run_line`): a log parabola through the transform at ``f ± ZOOM``
     native bins, twice (each step kept within one spacing); the curvature is the last parabola's d²(ln P)/df² (nan
-    when the three points do not bend down).  ``y``: :func:`_windowed` of ``channels``, or None (made here)."""
+    when the three points do not bend down); one record of :func:`zoom_peaks`.  ``y``: :func:`_windowed` of ``channels``,
+    or None (made here)."""
     fs = float(run.sample_rate)
-    step = ZOOM * fs / run.n_samples
     y = _windowed(run, channels) if y is None else y
-    f, curv = float(f_peak), np.nan
-    for _ in range(2):
-        a, b, c = np.log(np.maximum(_power(y, fs, np.array([f - step, f, f + step])), 1e-300))
-        den = a - 2 * b + c
-        if not den < 0:
-            curv = np.nan
-            break
-        curv = float(den / step ** 2)
-        f += step * float(np.clip(0.5 * (a - c) / den, -1.0, 1.0))
-    return f, curv
+    f, curv = zoom_peaks(np.asarray(y, dtype=float)[None], fs, np.array([float(f_peak)]), ZOOM * fs / run.n_samples)
+    return float(f[0]), float(curv[0])
 
 
 def zoom_peaks(ys: "BlockedRecords | np.ndarray", fs: float, f_peaks: np.ndarray, step: float) -> tuple:
