@@ -89,10 +89,11 @@ def test_ctrl_c_while_the_launcher_or_python_starts_is_one_line_and_130(tmp_path
     """Aimed at the interpreter's start, where pip's console script alone printed the traceback every time, and at
     the launcher's shell after its trap.  Every try: no traceback, one line and 130 -- or, from the shell, killed by
     the signal without a word when it landed in ``env`` before env blocked it (a shell reports 130).  Two tries
-    must land at the instant aimed at (a process that passed it unseen is tried again)."""
+    must land at the instant aimed at (a process that passed it unseen is tried again: up to 30 starts, as on a loaded
+    machine the poll of /proc misses the interpreter's instant in most starts; CI hit it once in 10)."""
     when = _in_the_shell if where == "shell" else _in_the_interpreter
     hits = 0
-    for _ in range(10):
+    for _ in range(30):
         code, err, seen = _ctrl_c(tmp_path, when)
         assert "Traceback" not in err and "Fatal Python error" not in err, err
         silent = where == "shell" and code == -signal.SIGINT and err == ""
@@ -103,7 +104,7 @@ def test_ctrl_c_while_the_launcher_or_python_starts_is_one_line_and_130(tmp_path
                 assert seen[1] & INT_BIT, seen
         if hits == 2:
             break
-    assert hits == 2, f"the {where}'s instant was hit {hits} times in 10 starts"
+    assert hits == 2, f"the {where}'s instant was hit {hits} times in 30 starts"
     assert not (tmp_path / "c.csv").exists()
 
 
