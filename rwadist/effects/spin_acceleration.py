@@ -12,13 +12,19 @@ from .element import Element, num
 @register
 @dataclass(frozen=True, eq=False, kw_only=True)
 class SpinAcceleration(Element):
-    """The runs were recorded while the wheel accelerated at alpha_rad_s2 (rad/s²).  Measurement only."""
+    """The runs were recorded while the wheel accelerated at alpha_rad_s2 (rad/s², from the runs' speeds against their
+    start times); alpha_residual_rad_s2 is the acceleration that best explains the residual alone, the check.
+    Measurement only."""
 
     KIND: ClassVar[str] = "spin_acceleration"
     ORDER: ClassVar[int] = 90
     alpha_rad_s2: float = field(metadata=check(number(ge=-MAX_ALPHA_RAD_S2, le=MAX_ALPHA_RAD_S2)))
     alpha_track_rad_s2: float | None = field(default=None, metadata=check(statistic(ge=-MAX_ALPHA_RAD_S2, le=MAX_ALPHA_RAD_S2)))
+    alpha_residual_rad_s2: float | None = field(default=None,
+                                                metadata=check(statistic(ge=-MAX_ALPHA_RAD_S2, le=MAX_ALPHA_RAD_S2)))
 
     @classmethod
     def describe(cls, e: Mapping) -> str:
-        return f"α {num(e['alpha_rad_s2'], '.3g')} rad/s²"
+        residual = e.get("alpha_residual_rad_s2")
+        check = "" if residual is None else f" (the speeds' track; the residual alone {num(residual, '.3g')})"
+        return f"α {num(e['alpha_rad_s2'], '.3g')} rad/s²{check}"
