@@ -164,6 +164,84 @@ def _general_refit(e: "FixedResonance", f, y, sw, lo: float, hi: float) -> "Fixe
                    gain_above=float(best.x[3]))
 
 
+#: A proposed fixed resonance is read on the slower and the faster half of the runs (:func:`speed_split`) when each half
+#: holds this many runs at least (fewer: the split tells nothing and the resonance is kept), the number the suspension
+#: modes' structure-mode split asks (:data:`rwadist.effects.suspension_modes_diagnose.STRUCTURE_SPLIT_MIN_RUNS`)
+SPLIT_MIN_RUNS = 5
+#: ... and it moves with the speed when the two halves' centres lie more than its relative half-power half-width ζ
+#: apart, and this at least: the same floor as that split's (``STRUCTURE_SPEED_SPLIT_TOL``)
+SPLIT_MIN_MOVE = 0.03
+
+
+def speed_split(ctx: Context, state: State, e: "FixedResonance") -> dict | None:
+    """The resonance ``e`` (proposed on ``state``, which does not hold it) fitted with one centre for the slower and
+    one for the faster half of the runs (ζ, the numerator's damping γ and, fixed, its gain far above shared), against
+    one centre for both; None when a half holds fewer than :data:`SPLIT_MIN_RUNS` runs or the lines give too few
+    points.
+
+    Both fits are robust (soft-L1) least squares of ln|H|² (:func:`rwadist.resonance.general_log_power_gain`) on the
+    log power gains of ``e``'s channels' lines (:func:`_line_gain_points`, measured on each half's runs), from ``e``
+    itself.  A resonance fixed in frequency lifts the lines near one frequency at every speed, the slower runs' high
+    orders and the faster runs' low ones alike, and the two centres agree; a resonance whose centre moves with the
+    speed (a disc mode stiffening, a drive resonance following the speed) lifts the slower runs' lines near one
+    frequency and the faster runs' near another, and one fixed resonance fitted to it sits between them.
+
+    Returns
+    -------
+    dict or None
+        ``f_slow_Hz``, ``f_fast_Hz`` (the centres, Hz), ``f_common_Hz``, ``zeta`` (the split fit's), ``n`` (points),
+        ``evidence`` (n·ln(cost_common/cost_split) − ln n: the Bayesian information criterion of the split's one more
+        parameter, > 0 where the data want two centres) and ``moved`` (|ln(f_fast/f_slow)|)."""
+    from scipy.optimize import least_squares
+
+    from ..resonance import general_log_power_gain, numerator_damping
+
+    runs = np.asarray(ctx.runs)
+    half = runs.size // 2
+    if half < SPLIT_MIN_RUNS:
+        return None
+    order = np.argsort(np.abs(ctx.omega[runs]), kind="stable")
+    chans = [c for c in e.channels if c in ctx.channels]
+    parts = [_line_gain_points(ctx, state, chans, np.sort(runs[o]))[:3] for o in (order[:half], order[-half:])]
+    f, y, w = (np.concatenate([p[k] for p in parts]) for k in range(3))
+    fast = np.repeat([False, True], [parts[0][0].size, parts[1][0].size])
+    if min(p[0].size for p in parts) < 3 or f.size < 8:
+        return None
+    sw, beta = np.sqrt(w), float(e.gain_above)
+
+    def res_jac(x, split):
+        # x: (ln f_r[, ln f_r fast], ln ζ, γ); r = f/f_r of each point's own centre (general_log_power_gain of f/f_r at
+        # f_r = 1: its derivative in ln f_r depends on r alone)
+        centre = np.where(fast, np.exp(x[1]), np.exp(x[0])) if split else np.exp(x[0])
+        lg, d = general_log_power_gain(f / centre, 1.0, float(np.exp(x[-2])), float(x[-1]), beta)
+        cols = [d[:, 0] * ~fast, d[:, 0] * fast] if split else [d[:, 0]]
+        return sw * (y - lg), -sw[:, None] * np.column_stack(cols + [d[:, 1], d[:, 2]])
+
+    lo, hi = ctx.k_lo * ctx.df, ctx.k_hi * ctx.df
+    lb, ub = np.array([np.log(lo), np.log(1e-3), 0.0]), np.array([np.log(hi), np.log(0.5), 200.0])
+    x0 = np.clip([np.log(e.f_r), np.log(e.zeta), numerator_damping(e.zeta, e.peak_gain, beta)], lb + 1e-9, ub - 1e-9)
+    kw = {"loss": "soft_l1", "f_scale": 0.5, "max_nfev": MAX_NFEV}
+    one = least_squares(lambda x: res_jac(x, False)[0], x0, jac=lambda x: res_jac(x, False)[1], bounds=(lb, ub), **kw)
+    two = least_squares(lambda x: res_jac(x, True)[0], np.r_[one.x[0], one.x], jac=lambda x: res_jac(x, True)[1],
+                        bounds=(np.r_[lb[0], lb], np.r_[ub[0], ub]), **kw)
+    n = int(f.size)
+    evidence = n * np.log(max(one.cost, 1e-300) / max(two.cost, 1e-300)) - np.log(n)
+    f_slow, f_fast = float(np.exp(two.x[0])), float(np.exp(two.x[1]))
+    return {"f_slow_Hz": f_slow, "f_fast_Hz": f_fast, "f_common_Hz": float(np.exp(one.x[0])),
+            "zeta": float(np.exp(two.x[2])), "n": n, "evidence": float(evidence),
+            "moved": float(abs(np.log(f_fast / f_slow)))}
+
+
+def moves_with_speed(ctx: Context, state: State, e: "FixedResonance") -> bool:
+    """Whether the proposed fixed resonance ``e`` moves with the speed (:func:`speed_split`): the data want a centre of
+    their own for each half of the runs (evidence > 0) and the two lie more than the resonance's relative half-power
+    half-width ζ (and :data:`SPLIT_MIN_MOVE`) apart, beyond what a resonance of that width resolves.  Such a resonance
+    is no fixed resonance: the open world describes it (``moving_resonance``, :mod:`rwadist.diagnose.describe_structure`)."""
+    split = speed_split(ctx, state, e)
+    return bool(split is not None and split["evidence"] > 0
+                and split["moved"] > max(split["zeta"], SPLIT_MIN_MOVE))
+
+
 @register(order=40)
 @dataclass
 class FixedResonance:
@@ -412,8 +490,12 @@ class FixedResonance:
         # speeds; the E-like wheel beside a 180 Hz stand: gain 0.89 at 96 Hz on the radial torques); nor a tilt across
         # the band that the fit can only bend by running ζ up to its bound (:meth:`significant`)
         out = [e for e in out if e.significant()]
-        return [e for e in out if not any(abs(e.f_r - r[0]) < 0.02 * r[0] and set(e.channels) & set(r[3])
-                                          for r in state.resonances)]
+        out = [e for e in out if not any(abs(e.f_r - r[0]) < 0.02 * r[0] and set(e.channels) & set(r[3])
+                                         for r in state.resonances)]
+        # nor a resonance whose centre moves with the speed, read on every run (:func:`moves_with_speed`): a fixed one
+        # fitted to it was added as a wheel mode (family wheel 4, an axial disc mode stiffening 149 -> 167 Hz over
+        # 300-3000 rpm: a 'wheel mode' at 158.5 Hz; the slower half of the runs wants 151.7 Hz, the faster 159.3 Hz)
+        return [e for e in out if not moves_with_speed(ctx, state, e)]
 
 
 def stands_beside_offset(ctx: Context, state: State) -> State:
