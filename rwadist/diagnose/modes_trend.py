@@ -19,7 +19,8 @@ C's take the mean gain) reads it from the lines the located modes fit.  When it 
 ``gain_trend``), the records are divided by that power law (centred on the speeds' geometric mean) and the modes
 located again; the result is kept only when it locates more modes (the search then judges them on the held-out runs,
 as it judges any fit).  The gain itself is left to the open world, which describes it (``line_property``,
-``gain_trend``).
+``gain_trend``).  tests/test_modes_trend_units.py checks both steps against a generator with a known power law
+(δ −0.05 and +0.08 read within 0.003; the corrected records hold C·Ω² within 1 %).
 """
 from __future__ import annotations
 

@@ -514,6 +514,8 @@ def stands_beside_offset(ctx: Context, state: State) -> State:
     gain 5.10, 1.0006, as the same fixture without an offset gives (195.59 Hz, 0.0297, 5.11, 1.0007), the error after
     0.0044, 1.9x).  The stand proposed from the modes' own fit (``extended_stand``) was fitted with them beside the
     offset: left as it is.  The stand's held-out evidence is the search's judgement of it as named.
+    tests/test_stands_beside_offset.py: a 150 Hz stand (ζ 0.03, gain 5) named before a 30 mm offset, 150.7 Hz,
+    ζ 0.036, gain 4.3; refitted, 150.01 Hz, ζ 0.0301, gain within 3 % of 5.
     """
     at = next((i for i, e in enumerate(state.effects) if getattr(e, "kind", "") == "cross_coupling"), None)
     if at is None:
