@@ -64,8 +64,8 @@ def _test(r_z: float, seed: int = 3) -> SteadyTest:
     return SteadyTest(runs, {"sample_rate_hz": FS})
 
 
-def _named_in_order(r_z: float):
-    """(context, state: the generator's lines, the stand fitted on them, the offset fitted beside the stand)."""
+def _stand_on(r_z: float):
+    """(context, state: the generator's lines with the stand fitted on them, the stand) of the data at ``r_z``."""
     test = _test(r_z)
     ctx = Context(compute_spectra(test, nperseg=NPERSEG), test=test)
     model = WheelModel(name="hard")
@@ -73,7 +73,12 @@ def _named_in_order(r_z: float):
         model.empirical[d].append(Harmonic(h=h, C=C))
     state = initial_state(ctx, model)
     stand = FixedResonance.fit(ctx, state, tuple(ctx.channels), ctx.runs, 1.03 * F_FIX, "test_stand")
-    state = stand.apply(state)
+    return ctx, stand.apply(state), stand
+
+
+def _named_in_order(r_z: float):
+    """(context, state: the generator's lines, the stand fitted on them, the offset fitted beside the stand)."""
+    ctx, state, stand = _stand_on(r_z)
     offset = CrossCoupling.fit(ctx, state, ctx.runs)
     return ctx, offset.apply(state), stand, offset
 
@@ -95,13 +100,6 @@ def test_a_stand_named_before_the_offset_is_refitted_to_the_generators():
 
 def test_without_an_offset_the_state_is_left_as_it_is():
     """No ``cross_coupling`` in the state (the stand alone, on data without an offset): nothing to refit beside."""
-    test = _test(0.0)
-    ctx = Context(compute_spectra(test, nperseg=NPERSEG), test=test)
-    model = WheelModel(name="hard")
-    for d, h, C in LINES:
-        model.empirical[d].append(Harmonic(h=h, C=C))
-    state = initial_state(ctx, model)
-    stand = FixedResonance.fit(ctx, state, tuple(ctx.channels), ctx.runs, 1.03 * F_FIX, "test_stand")
+    ctx, state, stand = _stand_on(0.0)
     assert stand.f_r == pytest.approx(F_FIX, rel=5e-4) and stand.zeta == pytest.approx(ZETA_FIX, rel=0.03)
-    state = stand.apply(state)
     assert stands_beside_offset(ctx, state) is state
