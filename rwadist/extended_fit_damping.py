@@ -58,15 +58,13 @@ def damping_interval(problem: LogAmplitudeProblem, solution: Solution, free_mode
     grid = np.unique(np.concatenate([np.geomspace(ZETA_FLOOR, ZETA_CEILING, n),
                                      [min(max(math.exp(theta[2 * i + 1]) / root, ZETA_FLOOR), ZETA_CEILING)]]))
     s2 = np.maximum(np.asarray(solution.s2_row, dtype=float), 1e-300)
-    residuals = solution.residuals
-    assert residuals is not None, "a least-squares Solution carries the residual function it minimised"
     cost = np.empty(grid.size)
     for k, z in enumerate(grid):
         t = theta.copy()
         t[2 * i + 1] = math.log(z * root)
-        r = residuals(t)
+        r = solution.residuals(t)
         cost[k] = float(np.sum(r**2 / s2))
-    residuals(theta)                    # the residual function's cache back at the fit
+    solution.residuals(theta)           # the residual function's cache back at the fit
     ok = grid[cost <= cost.min() + PROFILE_RISE]
     return float(ok.min()), float(ok.max())
 
