@@ -288,6 +288,12 @@ def _holds_strongest(X_s, X_t, kappa: complex, runs, h, strong) -> bool:
     return bool(np.median(np.abs(X_t[sel]) / np.maximum(np.abs(kappa * X_s[sel]), 1e-300)) >= STRONGEST_HELD)
 
 
+def _copy_ratio(X_s: np.ndarray, X_t: np.ndarray, sel: np.ndarray) -> complex:
+    """κ of the least squares of the target's bins ``X_t`` on the source's ``X_s`` (complex, same shape) over the
+    points ``sel`` (bool): Σ X_t·conj(X_s) / Σ |X_s|², each point weighted by the source line's power."""
+    return complex(np.sum(X_t[sel] * np.conj(X_s[sel])) / np.sum(np.abs(X_s[sel]) ** 2))
+
+
 def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str, omega) -> ChannelCopy | None:
     """The copy of channel ``cs`` in ``ct`` from the source's points: their transforms ``X_s``, ``X_t``, the target's
     noise there, their runs, line ratios ``h`` and speeds ``omega`` (rad/s); or None."""
@@ -311,7 +317,7 @@ def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str, omega) -> ChannelCopy | 
     # κ to the precision the strongest lines give (a copy 80 dB over the noise needs it to 1e-4 to be taken out): the
     # least squares of X_t on X_s over the copy's points, weighted by the lines' power (the ratio's own mean is pulled
     # by the weak lines, whose source carries noise the copy does not)
-    kappa = complex(np.sum(X_t[near] * np.conj(X_s[near])) / np.sum(np.abs(X_s[near]) ** 2))
+    kappa = _copy_ratio(X_s, X_t, near)
     # where the copy would stand clear of the target's noise (CLEAR_COPY_DB) its ratio is the copy's to the cluster's
     # tolerance (the strongest line, the one-line copy read there); a line counts in the runs where it would stand
     # MIN_COPY_DB over it, its ratio within the tolerance or within the scatter that noise gives it (NOISE_Z): a
@@ -348,11 +354,11 @@ def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str, omega) -> ChannelCopy | 
         best = min(spread.values())
         clean = [hv for hv, sp in spread.items() if sp <= max(2.0 * best, 1e-3)]
         sel = keep & strong & np.isin(h, clean)
-        kappa = complex(np.sum(X_t[sel] * np.conj(X_s[sel])) / np.sum(np.abs(X_s[sel]) ** 2))
+        kappa = _copy_ratio(X_s, X_t, sel)
     else:
         # no line with 3 runs clear of the noise (every copied point 10-20 dB over it): the least squares over all
         # the copy's points, the strict cluster's few alone left κ 5-10 % off
-        kappa = complex(np.sum(X_t[keep] * np.conj(X_s[keep])) / np.sum(np.abs(X_s[keep]) ** 2))
+        kappa = _copy_ratio(X_s, X_t, keep)
     level = 10 * np.log10(np.median(np.abs(kappa * X_s[keep]) ** 2 / np.maximum(noise_t[keep], 1e-300)))
     if level < MIN_COPY_DB:
         return None
