@@ -95,3 +95,14 @@ def test_counter_rotation_says_its_fraction_is_of_power_and_gives_the_amplitude_
     assert "q 0.0588 (power; counter/co amplitude 0.25)" in text
     assert "amplitude" not in describe_effect({"kind": "counter_rotation", "direction": "radial_force", "h": 1.0,
                                                "counter_fraction": 1.0})
+
+
+def test_a_mode_the_data_do_not_locate_is_said_not_located_not_given_a_frequency():
+    """trial20 (outside generator): "rocking at rest 1810 Hz" was printed for a rocking mode at 80 Hz that the fit
+    had lost and declared unconstrained; the number is where the fit ended, no finding."""
+    modes = dict(next(e for e in EFFECTS if e["kind"] == "suspension_modes"), rocking_Hz=1810.0,
+                 unconstrained=["rocking"])
+    line = describe_effect(modes)
+    assert "rocking at rest not located (the fit ended at 1810 Hz)" in line
+    assert "rocking at rest 1810" not in line and "ζ 0.02)" not in line    # its damping is no finding either
+    assert "radial translation 227.7 Hz (ζ 0.01)" in line and "axial 70 Hz (ζ 0.015)" in line

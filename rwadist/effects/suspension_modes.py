@@ -18,7 +18,7 @@ from ..schema import (
     optional,
     register,
 )
-from .element import Element, directions, num
+from .element import Element, num
 
 #: I_zz/I_rr of a thin disc, the most a rigid rotor has about its centre of mass (I_zz <= I_xx + I_yy)
 RIGID_INERTIA_RATIO = 2.0
@@ -47,13 +47,17 @@ class SuspensionModes(Element):
     @classmethod
     def describe(cls, e: Mapping) -> str:
         free = e.get("unconstrained") or ()
-        note = f"; not located by the data: {directions(free)}" if free else ""
+        note = ""
         a = e.get("inertia_ratio")
         if isinstance(a, (int, float)) and a > RIGID_INERTIA_RATIO:
             note = (f" (above {RIGID_INERTIA_RATIO:g}, which no rigid rotor rocking about its centre of mass exceeds: "
                     "an effective ratio of the whirls, from a flexible rotor or rocking coupled with other motion)"
                     + note)
-        return (f"radial translation {num(e['radial_translation_Hz'], '.4g')} Hz "
-                f"(ζ {num(e['zeta_radial_translation'], '.2g')}), rocking at rest {num(e['rocking_Hz'], '.4g')} Hz "
-                f"(ζ {num(e['zeta_rocking'], '.2g')}), axial {num(e['axial_Hz'], '.4g')} Hz "
-                f"(ζ {num(e['zeta_axial'], '.2g')}), I_zz/I_rr {num(e['inertia_ratio'], '.3g')}{note}")
+        def mode(name: str, label: str) -> str:
+            # a mode the data do not locate has no frequency to print: the fit's end point is no finding
+            if name in free:
+                return f"{label} not located (the fit ended at {num(e[name + '_Hz'], '.4g')} Hz)"
+            return f"{label} {num(e[name + '_Hz'], '.4g')} Hz (ζ {num(e['zeta_' + name], '.2g')})"
+
+        return (f"{mode('radial_translation', 'radial translation')}, {mode('rocking', 'rocking at rest')}, "
+                f"{mode('axial', 'axial')}, I_zz/I_rr {num(e['inertia_ratio'], '.3g')}{note}")
