@@ -249,4 +249,6 @@ def _relations(h: float, resolution: float, others) -> list:
                         f"the {'2nd' if k == 2 else '3rd'} multiple of the line h = {o:.4g} (a harmonic of that line's "
                         f"cause: a bearing line's impacts are not sinusoidal)"))
     out.sort(key=lambda x: (x[0] > 0.5, x[1] if x[0] <= 0.5 else 0, x[0]))
-    return [x[2] for x in out]
+    # one line read in several directions (h 3.3 in the radial force, torque and axial force, each a few 1e-4 apart)
+    # is one relation: each sentence once, in the order of its closeness
+    return list(dict.fromkeys(x[2] for x in out))

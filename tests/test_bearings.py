@@ -117,6 +117,14 @@ def test_a_line_twice_another_non_integer_line_is_named_its_harmonic():
     assert not any("multiple" in x for x in line_causes(7.27, 0.005, others=[3.6]))
 
 
+def test_one_line_read_in_several_directions_is_one_relation():
+    """trial21: the line h 3.3 read in the radial force, radial torque and axial force (3.3, 3.3001, 3.2999) made
+    report.md say 'the 2nd multiple of the line h = 3.3' three times for the line h 6.6."""
+    causes = line_causes(6.6, 0.005, others=[0.42, 1.0, 3.3, 3.3001, 3.2999, 4.7])
+    multiples = [x for x in causes if x.startswith("the 2nd multiple of the line h = 3.3 ")]
+    assert len(multiples) == 1 and len(causes) == len(set(causes))
+
+
 def test_relations_that_hold_exactly_come_before_those_within_the_tolerance_only():
     """trial14's 11-ball bearing (d 7.144 mm, pitch 42 mm, 20°, inner race turning), its ratios from the closed form
     FTF = ½(1 − (d/D)·cos α), BPFO = n·FTF, BPFI = n − BPFO, BSF: the line 2·BPFO is first the 2nd multiple of BPFO
