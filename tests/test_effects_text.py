@@ -106,3 +106,5 @@ def test_a_mode_the_data_do_not_locate_is_said_not_located_not_given_a_frequency
     assert "rocking at rest not located (the fit ended at 1810 Hz)" in line
     assert "rocking at rest 1810" not in line and "ζ 0.02)" not in line    # its damping is no finding either
     assert "radial translation 227.7 Hz (ζ 0.01)" in line and "axial 70 Hz (ζ 0.015)" in line
+    # the inertia ratio is the split of the rocking's whirls (trial21 printed "I_zz/I_rr 1.21" for a lost rocking)
+    assert "I_zz/I_rr not located" in line and "1.9" not in line

@@ -51,13 +51,15 @@ class SuspensionModes(Element):
         a = e.get("inertia_ratio")
         if isinstance(a, (int, float)) and a > RIGID_INERTIA_RATIO:
             note = (f" (above {RIGID_INERTIA_RATIO:g}, which no rigid rotor rocking about its centre of mass exceeds: "
-                    "an effective ratio of the whirls, from a flexible rotor or rocking coupled with other motion)"
-                    + note)
+                    "an effective ratio of the whirls, from a flexible rotor or rocking coupled with other motion)")
         def mode(name: str, label: str) -> str:
             # a mode the data do not locate has no frequency to print: the fit's end point is no finding
             if name in free:
                 return f"{label} not located (the fit ended at {num(e[name + '_Hz'], '.4g')} Hz)"
             return f"{label} {num(e[name + '_Hz'], '.4g')} Hz (ζ {num(e['zeta_' + name], '.2g')})"
 
+        # I_zz/I_rr is read from the split of the rocking mode's whirls: no rocking, no ratio
+        ratio = ("I_zz/I_rr not located (read from the rocking's whirls)" if "rocking" in free
+                 else f"I_zz/I_rr {num(e['inertia_ratio'], '.3g')}{note}")
         return (f"{mode('radial_translation', 'radial translation')}, {mode('rocking', 'rocking at rest')}, "
-                f"{mode('axial', 'axial')}, I_zz/I_rr {num(e['inertia_ratio'], '.3g')}{note}")
+                f"{mode('axial', 'axial')}, {ratio}")
