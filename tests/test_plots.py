@@ -295,3 +295,23 @@ def test_log_axis_labels_are_plain_text_naming_their_tick(lo, hi):
             if text:
                 assert value(text) == pytest.approx(loc, rel=1e-9), (text, loc)
     assert hi / lo > 100 or any("×" in t for t in labelled)      # a narrow range labels its minor ticks: 2×10⁻⁴
+
+
+def test_a_waterfall_mark_is_labelled_inside_its_panel_on_the_mark():
+    """trial21: the label of a speed line's ray h 6.6 (to 990 Hz at 9000 rpm) on a panel zoomed to 595 Hz was drawn
+    at the ray's end, outside the panel, and the constrained layout opened wide gaps between the panels for it."""
+    from matplotlib.figure import Figure
+
+    from rwadist.diagnose.report import _tag
+
+    ax = Figure().subplots()
+    ax.set_xlim(0.0, 595.0)
+    ax.set_ylim(300.0, 9000.0)
+    s = np.array([678.0, 9000.0])
+    _tag(ax, 6.6 * s / 60.0, s, " 1")
+    (label,) = ax.texts
+    x, y = label.get_position()
+    assert 0.0 <= x <= 595.0 and 300.0 <= y <= 9000.0 and label.get_clip_on()
+    assert x == pytest.approx(6.6 * y / 60.0, rel=1e-9) and x == pytest.approx(0.94 * 595.0, rel=0.01)   # on the ray, by the edge
+    _tag(ax, [700.0], [9000.0], " 2")                  # a fixed line beyond the zoom: no label
+    assert len(ax.texts) == 1

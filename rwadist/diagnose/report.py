@@ -158,6 +158,22 @@ def _waterfall_figure(diag: Diagnosis):
 MARK_COLOUR = "#1b7837"
 
 
+def _tag(ax, xs, ys, text: str, **kwargs) -> None:
+    """The label ``text`` at the last point of the polyline (``xs``, ``ys``; data units) inside the panel, none when no
+    point of it is: a label at a mark's end beyond the zoomed frequency axis (a speed line's ray to 990 Hz on a panel
+    ending at 595 Hz) was drawn outside the panel, and the constrained layout widened the gaps between panels for it."""
+    xs, ys = np.asarray(xs, float), np.asarray(ys, float)
+    if xs.size > 1:
+        t = np.linspace(0.0, xs.size - 1.0, 256 * (xs.size - 1) + 1)
+        xs, ys = np.interp(t, np.arange(xs.size), xs), np.interp(t, np.arange(ys.size), ys)
+    (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
+    x1 -= 0.06 * (x1 - x0)                             # room for the label's own width left of the right edge
+    inside = np.flatnonzero((xs >= x0) & (xs <= x1) & (ys >= y0) & (ys <= y1))
+    if inside.size:
+        k = inside[-1]
+        ax.text(xs[k], ys[k], text, clip_on=True, **kwargs)
+
+
 def _mark_unexplained(ax, c: str, diag: Diagnosis, rpm: np.ndarray) -> None:
     """Marks on one "after" panel (channel ``c``) of the records of ``diag.unexplained`` that hold the channel, each
     labelled with its number in report.md: a fixed line a dashed vertical, a speed line its ray f = h·rpm/60, a
@@ -172,30 +188,30 @@ def _mark_unexplained(ax, c: str, diag: Diagnosis, rpm: np.ndarray) -> None:
         s0, s1 = u.speed_rpm
         if u.signature == "fixed_line":
             ax.axvline(u.f_Hz[0], ls="--", **style)
-            ax.text(u.f_Hz[0], hi, f" {n}", va="top", **tag)
+            _tag(ax, [u.f_Hz[0]], [hi], f" {n}", va="top", **tag)
         elif u.signature == "speed_line" and u.h is not None:
             s = np.array([s0, s1])
             ax.plot(u.h * s / 60.0, s, ls=":", **style)
-            ax.text(u.h * s1 / 60.0, s1, f" {n}", va="top", **tag)
+            _tag(ax, u.h * s / 60.0, s, f" {n}", va="top", **tag)
         elif u.signature == "sideband_line" and "carrier_Hz" in u.parameters:
             s = np.linspace(s0, s1, 64)        # a lower side folds at 0 Hz (its |f|): a polyline, not a segment
             for side in u.parameters.get("sides", [1]):
                 ax.plot(np.abs(u.parameters["carrier_Hz"] + side * u.parameters["h"] * s / 60.0), s, ls=":", **style)
-            ax.text(u.parameters["carrier_Hz"], s1, f" {n}", va="top", **tag)
+            _tag(ax, [u.parameters["carrier_Hz"]], [s1], f" {n}", va="top", **tag)
         elif u.signature == "partial_line" and u.h is not None:
             # a short mark on the line's ray at each run it is absent from
             s = np.asarray(u.parameters.get("absent_rpm", []), float)
             ax.plot(u.h * s / 60.0, s, ls="none", marker="|", ms=6, mew=1.2, color=MARK_COLOUR, zorder=5)
             if s.size:
-                ax.text(u.h * s[-1] / 60.0, s[-1], f" {n}", va="top", **tag)
+                _tag(ax, u.h * s / 60.0, s, f" {n}", va="top", **tag)
         elif u.signature == "moving_resonance":
             fa = u.parameters.get("f_at_lowest_speed_Hz", u.f_Hz[0])
             fb = u.parameters.get("f_at_highest_speed_Hz", u.f_Hz[1])
             ax.plot([fa, fb], [s0, s1], ls="-.", **style)
-            ax.text(fb, s1, f" {n}", va="top", **tag)
+            _tag(ax, [fa, fb], [s0, s1], f" {n}", va="top", **tag)
         elif u.signature == "broadband_hump":
             ax.axvspan(u.f_Hz[0], u.f_Hz[1], color=MARK_COLOUR, alpha=0.15, lw=0, zorder=4)
-            ax.text(0.5 * (u.f_Hz[0] + u.f_Hz[1]), hi, f"{n}", ha="center", va="top", **tag)
+            _tag(ax, [0.5 * (u.f_Hz[0] + u.f_Hz[1])], [hi], f"{n}", ha="center", va="top", **tag)
         else:
             words = {"channel_copy": f"{n}: copy of {u.parameters.get('source', '?')}",
                      "run_change": f"{n}: runs differ"}.get(u.signature, f"{n}: {u.signature}")
