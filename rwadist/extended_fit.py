@@ -52,6 +52,7 @@ from .data import DataError, Run, SteadyTest
 from .dft import blocked_records, run_window, windowed_dfts
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .extended_fit_close import with_close_lines
+from .extended_fit_damping import DAMPING_NAME, damping_note, hold_unmeasured_damping
 from .extended_fit_lsq import (
     LOG_SCATTER,
     MODE_PARAMS,
@@ -122,6 +123,8 @@ class ExtendedFit:
         frequency and r = ln(measured / model amplitude) (radial lines: of sqrt(x² + y²)), the stand divided out (and
         a line whose exponent the fit freed, :func:`rwadist.off_law_lines.off_law_line`, taken with its own growth);
         direction its load direction ("axial_force", "radial_force", "radial_torque").
+    zeta_bounds : per located mode whose damping the data do not measure, (lo, hi) the damping ratios they allow; its
+        ζ is held (:mod:`rwadist.extended_fit_damping`), written as zeta_<mode> to ``analytical.unconstrained``.
     """
 
     params: ext.ExtendedParams
@@ -141,6 +144,7 @@ class ExtendedFit:
     stand: tuple | None = None
     line_residuals: tuple = (np.empty(0), np.empty(0), np.empty(0, dtype=str))
     stand_direction: str | None = None
+    zeta_bounds: dict = field(default_factory=dict)
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -496,15 +500,20 @@ def _log_data(meas_lines: list, la: np.ndarray, sa: np.ndarray, aa: np.ndarray, 
 
 
 def _fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tolerance: float, off_law: list,
-               log_w: np.ndarray, declared: Callable[[str, str], None]) -> Solution:
+               log_w: np.ndarray, declared: Callable[[str, str], None], zeta0: float, zeta_bounds: dict) -> Solution:
     """The least squares with ``free_modes``, lines of another law freed (``off_law``, appended in place; ``log_w``
-    ln|Ω| per row: :func:`rwadist.off_law_lines.free_off_law_lines`); with ``declare``, each mode it does not pin is
-    given to ``declared(mode, why)`` (which resets it in ``problem.base``), dropped from ``free_modes`` and the fit
-    repeated."""
+    ln|Ω| per row: :func:`rwadist.off_law_lines.free_off_law_lines`); with ``declare``, a damping the data do not
+    measure is held (at ``zeta0`` moved into what the data allow, its interval put in ``zeta_bounds``:
+    :func:`rwadist.extended_fit_damping.hold_unmeasured_damping`) and the fit repeated, before each mode it does not
+    pin is given to ``declared(mode, why)`` (which resets it in ``problem.base``), dropped from ``free_modes`` and the
+    fit repeated: a mode whose damping runs to the floor while its frequency is pinned is located, its damping
+    declared."""
     while True:
         solution, loose = free_off_law_lines(
             lambda lns: problem.solve(free_modes, lns), lambda sol: loose_modes(sol, free_modes, problem.base, tolerance),
             off_law, problem.row_line, log_w, lawful_lines(problem.meas_lines))
+        if declare and hold_unmeasured_damping(problem, solution, free_modes, zeta0, zeta_bounds):
+            continue
         if not loose or not declare:
             return solution
         for m, why in loose:
@@ -629,8 +638,9 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                                   row_line, centred_log_w, meas.lines, progress, np.concatenate([na, nr]), LOG_SCATTER,
                                   recorded_noisy_sensors(test, meas.lines) if noisy is None else noisy)
     off_law: list[int] = []     # lines given an exponent of their own before a mode is declared (appended in place)
+    zeta_bounds: dict = {}      # mode -> (lo, hi): a damping the data do not measure, held (filled in place)
     solution = _fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare,
-                          tolerance, off_law, log_w, lambda m, why: starts.declare(base, m, why))
+                          tolerance, off_law, log_w, lambda m, why: starts.declare(base, m, why), zeta0, zeta_bounds)
     res, names, rel_se, unpack = solution.res, solution.names, solution.rel_se, solution.unpack
     params, fitted_lines = unpack(res.x)
     sums = power_sum_stderr(solution, {(x.direction, float(x.h)): tuple(line_of[j])
@@ -650,6 +660,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         notes.append(f"{m}: NOT CONSTRAINED: located at {_mode_hz_of(params, m):.4g} Hz, but the model misses the data "
                      f"near it by {resid_db[m]:.1f} dB RMS (more than {MISFIT_DB:g} dB: something the model lacks "
                      "acts there, and pulls the mode); its fitted value is kept, listed in analytical.unconstrained")
+    zeta_bounds = {m: b for m, b in zeta_bounds.items() if starts.identified[m]}     # of a located mode only
+    notes += [damping_note(m, problem.held_zeta[m], *b) for m, b in zeta_bounds.items()]
     return ExtendedFit(params=params, lines=kept_lines,
                        zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
                              "axial_translation": params.zeta_z},
@@ -658,7 +670,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
                        unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
-                       line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction)
+                       line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
+                       zeta_bounds=zeta_bounds)
 
 
 def _mode_hz_of(params: ext.ExtendedParams, mode: str) -> float:
@@ -762,7 +775,9 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
                          "rel_stderr": efit.rel_stderr, "residual_db_near_mode": efit.residual_db,
                          "senses": {f"{d} h={h:.4g}": {"sense": s_, "co_fraction": fr}
                                     for (d, h), (s_, fr) in efit.senses.items()}, "notes": efit.notes}
-    analytical["unconstrained"] = list(efit.unconstrained)
+    analytical["unconstrained"] = list(efit.unconstrained) + [DAMPING_NAME[m] for m in efit.zeta_bounds]
+    if efit.zeta_bounds:
+        analytical["fit"]["zeta_bounds"] = {m: list(b) for m, b in efit.zeta_bounds.items()}
     unresolved = unresolved_spans(fit)
     if unresolved:
         analytical["fit"]["unresolved_lines"] = unresolved

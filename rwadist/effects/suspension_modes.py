@@ -9,16 +9,36 @@ from ..schema import (
     COUNT,
     FREQUENCY,
     MAX_INERTIA_RATIO,
+    MAX_ZETA,
+    UNCONSTRAINED_DAMPING,
     UNCONSTRAINED_MODES,
     ZETA,
     boolean,
     check,
     names,
     number,
+    numbers,
     optional,
     register,
 )
-from .element import Element, directions, num
+from .element import Element, directions, num, words
+
+def _zeta_bounds():
+    """Check of ``zeta_bounds``: {mode of :data:`UNCONSTRAINED_MODES`: [lo, hi] damping ratios, lo <= hi} ->
+    {mode: (lo, hi)}."""
+    pair = numbers(length=2, ge=0, le=MAX_ZETA, increasing=False)
+
+    def run(v, where, err):
+        if not isinstance(v, Mapping) or any(m not in UNCONSTRAINED_MODES for m in v):
+            raise err(where[0], where[1], f"{v!r} must map modes ({', '.join(UNCONSTRAINED_MODES)}) to [lo, hi] "
+                      "damping ratios")
+        out = {m: tuple(float(x) for x in pair(b, (where[0], f"{where[1]}.{m}"), err)) for m, b in v.items()}
+        if any(lo > hi for lo, hi in out.values()):
+            raise err(where[0], where[1], f"each [lo, hi] needs lo <= hi, got {v!r}")
+        return out
+    run.json = {"type": "object", "additionalProperties": pair.json}  # type: ignore[attr-defined]
+    return run
+
 
 #: I_zz/I_rr of a thin disc, the most a rigid rotor has about its centre of mass (I_zz <= I_xx + I_yy)
 RIGID_INERTIA_RATIO = 2.0
@@ -40,14 +60,22 @@ class SuspensionModes(Element):
     zeta_rocking: float = field(metadata=check(ZETA))
     zeta_axial: float = field(metadata=check(ZETA))
     inertia_ratio: float = field(metadata=check(number(gt=0, le=MAX_INERTIA_RATIO)))
-    unconstrained: tuple = field(default=(), metadata=check(optional(names(UNCONSTRAINED_MODES), ())))
+    unconstrained: tuple = field(default=(), metadata=check(optional(names(UNCONSTRAINED_MODES + UNCONSTRAINED_DAMPING),
+                                                                      ())))
+    #: per mode whose damping is listed in ``unconstrained`` (zeta_<mode>), [lo, hi] the damping ratios the data allow
+    #: (its zeta_<mode> is a value held inside them, not a fit)
+    zeta_bounds: Mapping | None = field(default=None, metadata=check(optional(_zeta_bounds(), None)))
     per_unit: bool = field(default=True, metadata=check(optional(boolean(), True)))
     n_runs: int | None = field(default=None, metadata=check(COUNT))
 
     @classmethod
     def describe(cls, e: Mapping) -> str:
-        free = e.get("unconstrained") or ()
+        free = [m for m in e.get("unconstrained") or () if m in UNCONSTRAINED_MODES]
         note = f"; not located by the data: {directions(free)}" if free else ""
+        bounds = e.get("zeta_bounds") or {}
+        if bounds:
+            note += "; damping not constrained by the data (held, not fitted): " + ", ".join(
+                f"{words(m)} ζ in {num(b[0], '.2g')}-{num(b[1], '.2g')}" for m, b in bounds.items())
         a = e.get("inertia_ratio")
         if isinstance(a, (int, float)) and a > RIGID_INERTIA_RATIO:
             note = (f" (above {RIGID_INERTIA_RATIO:g}, which no rigid rotor rocking about its centre of mass exceeds: "
