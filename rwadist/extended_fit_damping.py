@@ -19,10 +19,12 @@ the extended fit, ``unconstrained`` of ``rwadist diagnose``'s ``suspension_modes
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
-from .extended_fit_lsq import MODE_PARAMS, LogAmplitudeProblem, Solution
+from .extended_fit_lsq import MODE_PARAMS, LogAmplitudeProblem, Solution, loose_modes
+from .off_law_lines import free_off_law_lines, lawful_lines
 
 #: the least squares' floor on a damping ratio (:meth:`LogAmplitudeProblem.solve`'s bounds)
 ZETA_FLOOR = 5e-5
@@ -68,16 +70,17 @@ def damping_interval(problem: LogAmplitudeProblem, solution: Solution, free_mode
 
 
 def hold_unmeasured_damping(problem: LogAmplitudeProblem, solution: Solution, free_modes: list, zeta0: float,
-                            bounds: dict) -> list:
+                            bounds: dict, intervals: dict) -> list:
     """The free modes of ``solution`` (not held yet) whose damping the data do not measure (:func:`damping_interval`
     spans more than :data:`MAX_SPAN`): each is held in ``problem.held_zeta`` at ``zeta0`` moved into its interval
     (its damping coefficient in ``problem.base`` set to match, the start of the next least squares) and its interval
-    recorded in ``bounds`` (mode -> (lo, hi)); returned, so that the caller fits again."""
+    recorded in ``bounds`` (mode -> (lo, hi)); returned, so that the caller fits again.  ``intervals`` gets the
+    interval of every damping profiled (mode -> (lo, hi)): that of a measured damping, at this solution."""
     held = []
     for m in free_modes:
         if m in problem.held_zeta or solution.residuals is None:
             continue
-        lo, hi = damping_interval(problem, solution, free_modes, m)
+        lo, hi = intervals[m] = damping_interval(problem, solution, free_modes, m)
         if hi / lo <= MAX_SPAN:
             continue
         zeta = min(max(zeta0, lo, 2 * ZETA_FLOOR), hi)
@@ -95,3 +98,27 @@ def damping_note(mode: str, zeta: float, lo: float, hi: float) -> str:
             "errors (no measured speed sits on a crossing of a line with this mode's peak; only its skirts are "
             f"seen); held at ζ = {zeta:.3g}, the frequency fitted with it; listed in analytical.unconstrained "
             f"as {DAMPING_NAME[mode]}")
+
+
+def fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tolerance: float, off_law: list,
+              log_w: np.ndarray, declared: Callable[[str, str], None], zeta0: float, zeta_bounds: dict,
+              intervals: dict) -> Solution:
+    """The least squares with ``free_modes``, lines of another law freed (``off_law``, appended in place; ``log_w``
+    ln|Ω| per row: :func:`rwadist.off_law_lines.free_off_law_lines`); with ``declare``, a damping the data do not
+    measure is held (at ``zeta0`` moved into what the data allow, its interval put in ``zeta_bounds``, every profiled
+    damping's in ``intervals``:
+    :func:`rwadist.extended_fit_damping.hold_unmeasured_damping`) and the fit repeated, before each mode it does not
+    pin is given to ``declared(mode, why)`` (which resets it in ``problem.base``), dropped from ``free_modes`` and the
+    fit repeated: a mode whose damping runs to the floor while its frequency is pinned is located, its damping
+    declared."""
+    while True:
+        solution, loose = free_off_law_lines(
+            lambda lns: problem.solve(free_modes, lns), lambda sol: loose_modes(sol, free_modes, problem.base, tolerance),
+            off_law, problem.row_line, log_w, lawful_lines(problem.meas_lines))
+        if declare and hold_unmeasured_damping(problem, solution, free_modes, zeta0, zeta_bounds, intervals):
+            continue
+        if not loose or not declare:
+            return solution
+        for m, why in loose:
+            declared(m, why)
+            free_modes.remove(m)

@@ -23,6 +23,7 @@ from ..schema import (
 )
 from .element import Element, directions, num, words
 
+
 def _zeta_bounds():
     """Check of ``zeta_bounds``: {mode of :data:`UNCONSTRAINED_MODES`: [lo, hi] damping ratios, lo <= hi} ->
     {mode: (lo, hi)}."""
@@ -65,6 +66,9 @@ class SuspensionModes(Element):
     #: per mode whose damping is listed in ``unconstrained`` (zeta_<mode>), [lo, hi] the damping ratios the data allow
     #: (its zeta_<mode> is a value held inside them, not a fit)
     zeta_bounds: Mapping | None = field(default=None, metadata=check(optional(_zeta_bounds(), None)))
+    #: per located mode whose damping the fit profiled, [lo, hi] the damping ratios the data allow (1.5 standard
+    #: errors, the other parameters held: the narrowest they could give)
+    zeta_interval: Mapping | None = field(default=None, metadata=check(optional(_zeta_bounds(), None)))
     per_unit: bool = field(default=True, metadata=check(optional(boolean(), True)))
     n_runs: int | None = field(default=None, metadata=check(COUNT))
 
