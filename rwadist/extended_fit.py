@@ -51,7 +51,7 @@ from .data import DataError, Run, SteadyTest
 from .dft import blocked_records, run_window, windowed_dfts
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .extended_fit_close import with_close_lines
-from .extended_fit_damping import DAMPING_NAME, damping_note, fit_modes
+from .extended_fit_damping import DAMPING_NAME, damping_record, fit_modes, located_damping
 from .extended_fit_lsq import (
     LOG_SCATTER,
     MODE_PARAMS,
@@ -639,9 +639,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         notes.append(f"{m}: NOT CONSTRAINED: located at {_mode_hz_of(params, m):.4g} Hz, but the model misses the data "
                      f"near it by {resid_db[m]:.1f} dB RMS (more than {MISFIT_DB:g} dB: something the model lacks "
                      "acts there, and pulls the mode); its fitted value is kept, listed in analytical.unconstrained")
-    zeta_bounds = {m: b for m, b in zeta_bounds.items() if starts.identified[m]}     # of a located mode only
-    intervals = {m: zeta_bounds.get(m, b) for m, b in intervals.items() if starts.identified[m]}
-    notes += [damping_note(m, problem.held_zeta[m], *b) for m, b in zeta_bounds.items()]
+    zeta_bounds, intervals = located_damping(zeta_bounds, intervals, starts.identified, problem.held_zeta, notes)
     return ExtendedFit(params=params, lines=kept_lines,
                        zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
                              "axial_translation": params.zeta_z},
@@ -756,10 +754,7 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
                          "senses": {f"{d} h={h:.4g}": {"sense": s_, "co_fraction": fr}
                                     for (d, h), (s_, fr) in efit.senses.items()}, "notes": efit.notes}
     analytical["unconstrained"] = list(efit.unconstrained) + [DAMPING_NAME[m] for m in efit.zeta_bounds]
-    if efit.zeta_bounds:
-        analytical["fit"]["zeta_bounds"] = {m: list(b) for m, b in efit.zeta_bounds.items()}
-    if efit.zeta_interval:
-        analytical["fit"]["zeta_interval"] = {m: list(b) for m, b in efit.zeta_interval.items()}
+    analytical["fit"] |= damping_record(efit.zeta_bounds, efit.zeta_interval)
     unresolved = unresolved_spans(fit)
     if unresolved:
         analytical["fit"]["unresolved_lines"] = unresolved

@@ -57,14 +57,17 @@ def damping_interval(problem: LogAmplitudeProblem, solution: Solution, free_mode
     n = int(round(PER_DECADE * math.log10(ZETA_CEILING / ZETA_FLOOR))) + 1
     grid = np.unique(np.concatenate([np.geomspace(ZETA_FLOOR, ZETA_CEILING, n),
                                      [min(max(math.exp(theta[2 * i + 1]) / root, ZETA_FLOOR), ZETA_CEILING)]]))
+    residuals = solution.residuals
+    if residuals is None:
+        raise ValueError("damping_interval needs the solution's residual function (LogAmplitudeProblem.solve's)")
     s2 = np.maximum(np.asarray(solution.s2_row, dtype=float), 1e-300)
     cost = np.empty(grid.size)
     for k, z in enumerate(grid):
         t = theta.copy()
         t[2 * i + 1] = math.log(z * root)
-        r = solution.residuals(t)
+        r = residuals(t)
         cost[k] = float(np.sum(r**2 / s2))
-    solution.residuals(theta)           # the residual function's cache back at the fit
+    residuals(theta)                    # the residual function's cache back at the fit
     ok = grid[cost <= cost.min() + PROFILE_RISE]
     return float(ok.min()), float(ok.max())
 
@@ -98,6 +101,23 @@ def damping_note(mode: str, zeta: float, lo: float, hi: float) -> str:
             "errors (no measured speed sits on a crossing of a line with this mode's peak; only its skirts are "
             f"seen); held at ζ = {zeta:.3g}, the frequency fitted with it; listed in analytical.unconstrained "
             f"as {DAMPING_NAME[mode]}")
+
+
+def located_damping(zeta_bounds: dict, intervals: dict, identified: dict, held_zeta: dict, notes: list) -> tuple:
+    """(bounds, intervals) of the modes the fit located (``identified``, mode -> bool, after its last declarations):
+    the held dampings' (lo, hi) of ``zeta_bounds`` and every profiled damping's of ``intervals`` (a held one's: its
+    bounds); the note of each held damping (at its ``held_zeta``, :func:`damping_note`) appended to ``notes``.  A
+    mode declared after its damping was held keeps its starting values: its damping is no held value of a fit."""
+    bounds = {m: b for m, b in zeta_bounds.items() if identified[m]}
+    notes += [damping_note(m, held_zeta[m], *b) for m, b in bounds.items()]
+    return bounds, {m: bounds.get(m, b) for m, b in intervals.items() if identified[m]}
+
+
+def damping_record(zeta_bounds: dict, zeta_interval: dict) -> dict:
+    """The model file's ``analytical.fit`` entries of the dampings (``zeta_bounds``, ``zeta_interval``: mode ->
+    [lo, hi]), each only when it holds a mode."""
+    return ({"zeta_bounds": {m: list(b) for m, b in zeta_bounds.items()}} if zeta_bounds else {}) | \
+        ({"zeta_interval": {m: list(b) for m, b in zeta_interval.items()}} if zeta_interval else {})
 
 
 def fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tolerance: float, off_law: list,
