@@ -46,7 +46,8 @@ DAMPING_NAME = {"radial_translation": "zeta_radial_translation", "rocking": "zet
 def damping_interval(problem: LogAmplitudeProblem, solution: Solution, free_modes: list, mode: str) -> tuple:
     """(lo, hi) damping ratios of ``mode`` (a free mode of ``solution``, the least squares of ``problem``) whose cost
     stays within :data:`PROFILE_RISE` of the least on a log grid from :data:`ZETA_FLOOR` to :data:`ZETA_CEILING`
-    (and the fitted ζ itself), the other parameters held at their best fit.
+    (and the fitted ζ itself), the other parameters held at their best fit; each end where the cost crosses that
+    level between the last grid point inside and the next (linear in ln ζ), or the grid's end.
 
     Held, the others cannot trade against the damping, so the interval is the narrowest the data could give: a
     damping declared on it is never declared in vain."""
@@ -68,8 +69,17 @@ def damping_interval(problem: LogAmplitudeProblem, solution: Solution, free_mode
         r = residuals(t)
         cost[k] = float(np.sum(r**2 / s2))
     residuals(theta)                    # the residual function's cache back at the fit
-    ok = grid[cost <= cost.min() + PROFILE_RISE]
-    return float(ok.min()), float(ok.max())
+    level = cost.min() + PROFILE_RISE
+    inside = np.flatnonzero(cost <= level)
+
+    def edge(k: int, out: int) -> float:
+        # where the cost crosses the level between the grid point inside (k) and its neighbour outside (linear in ln ζ):
+        # a grid step is a factor 1.33, and the last point inside alone understates the interval by up to that
+        if not 0 <= out < grid.size:
+            return float(grid[k])
+        t = (level - cost[k]) / (cost[out] - cost[k])
+        return float(math.exp(math.log(grid[k]) + t * (math.log(grid[out]) - math.log(grid[k]))))
+    return edge(int(inside.min()), int(inside.min()) - 1), edge(int(inside.max()), int(inside.max()) + 1)
 
 
 def hold_unmeasured_damping(problem: LogAmplitudeProblem, solution: Solution, free_modes: list, zeta0: float,
