@@ -42,7 +42,6 @@ rotor centre).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -52,12 +51,11 @@ from .data import DataError, Run, SteadyTest
 from .dft import blocked_records, run_window, windowed_dfts
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .extended_fit_close import with_close_lines
+from .extended_fit_damping import DAMPING_NAME, damping_record, fit_modes, located_damping
 from .extended_fit_lsq import (
     LOG_SCATTER,
     MODE_PARAMS,
     LogAmplitudeProblem,
-    Solution,
-    loose_modes,
     power_sum_stderr,
     recorded_noisy_sensors,
     split_note,
@@ -66,7 +64,7 @@ from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower
 from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
-from .off_law_lines import free_off_law_lines, lawful_lines, line_regressors, off_law_note
+from .off_law_lines import line_regressors, off_law_note
 from .resonance import PATH_MODE_MAX_ABOVE, FittedResonance, resonance
 from .spectra import compute_spectra, welch_dof
 from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
@@ -122,6 +120,10 @@ class ExtendedFit:
         frequency and r = ln(measured / model amplitude) (radial lines: of sqrt(x² + y²)), the stand divided out (and
         a line whose exponent the fit freed, :func:`rwadist.off_law_lines.off_law_line`, taken with its own growth);
         direction its load direction ("axial_force", "radial_force", "radial_torque").
+    zeta_bounds : per located mode whose damping the data do not measure, (lo, hi) the damping ratios they allow; its
+        ζ is held (:mod:`rwadist.extended_fit_damping`), written as zeta_<mode> to ``analytical.unconstrained``.
+    zeta_interval : per located mode whose damping was profiled, (lo, hi) the damping ratios the data allow (a held
+        one's: its ``zeta_bounds``); in ``analytical.fit.zeta_interval``.
     """
 
     params: ext.ExtendedParams
@@ -141,6 +143,8 @@ class ExtendedFit:
     stand: tuple | None = None
     line_residuals: tuple = (np.empty(0), np.empty(0), np.empty(0, dtype=str))
     stand_direction: str | None = None
+    zeta_bounds: dict = field(default_factory=dict)
+    zeta_interval: dict = field(default_factory=dict)
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -495,23 +499,6 @@ def _log_data(meas_lines: list, la: np.ndarray, sa: np.ndarray, aa: np.ndarray, 
     return log_data + 0.5 * joint.start_log_gain, joint
 
 
-def _fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tolerance: float, off_law: list,
-               log_w: np.ndarray, declared: Callable[[str, str], None]) -> Solution:
-    """The least squares with ``free_modes``, lines of another law freed (``off_law``, appended in place; ``log_w``
-    ln|Ω| per row: :func:`rwadist.off_law_lines.free_off_law_lines`); with ``declare``, each mode it does not pin is
-    given to ``declared(mode, why)`` (which resets it in ``problem.base``), dropped from ``free_modes`` and the fit
-    repeated."""
-    while True:
-        solution, loose = free_off_law_lines(
-            lambda lns: problem.solve(free_modes, lns), lambda sol: loose_modes(sol, free_modes, problem.base, tolerance),
-            off_law, problem.row_line, log_w, lawful_lines(problem.meas_lines))
-        if not loose or not declare:
-            return solution
-        for m, why in loose:
-            declared(m, why)
-            free_modes.remove(m)
-
-
 def _fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple[dict, list]:
     """(senses, kept lines): the rotation sense of each radial line from its fitted forcing, (direction, h) ->
     (sense, co-rotating fraction of its power); negligible parts (< 1 % of the line's power) dropped."""
@@ -629,8 +616,10 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                                   row_line, centred_log_w, meas.lines, progress, np.concatenate([na, nr]), LOG_SCATTER,
                                   recorded_noisy_sensors(test, meas.lines) if noisy is None else noisy)
     off_law: list[int] = []     # lines given an exponent of their own before a mode is declared (appended in place)
-    solution = _fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare,
-                          tolerance, off_law, log_w, lambda m, why: starts.declare(base, m, why))
+    zeta_bounds: dict = {}      # mode -> (lo, hi): a damping the data do not measure, held (filled in place)
+    intervals: dict = {}        # mode -> (lo, hi): every damping's interval at the last fit that profiled it
+    solution = fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare, tolerance, off_law,
+                          log_w, lambda m, why: starts.declare(base, m, why), zeta0, zeta_bounds, intervals)
     res, names, rel_se, unpack = solution.res, solution.names, solution.rel_se, solution.unpack
     params, fitted_lines = unpack(res.x)
     sums = power_sum_stderr(solution, {(x.direction, float(x.h)): tuple(line_of[j])
@@ -650,6 +639,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         notes.append(f"{m}: NOT CONSTRAINED: located at {_mode_hz_of(params, m):.4g} Hz, but the model misses the data "
                      f"near it by {resid_db[m]:.1f} dB RMS (more than {MISFIT_DB:g} dB: something the model lacks "
                      "acts there, and pulls the mode); its fitted value is kept, listed in analytical.unconstrained")
+    zeta_bounds, intervals = located_damping(zeta_bounds, intervals, starts.identified, problem.held_zeta, notes)
     return ExtendedFit(params=params, lines=kept_lines,
                        zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
                              "axial_translation": params.zeta_z},
@@ -658,7 +648,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
                        unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
-                       line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction)
+                       line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
+                       zeta_bounds=zeta_bounds, zeta_interval=intervals)
 
 
 def _mode_hz_of(params: ext.ExtendedParams, mode: str) -> float:
@@ -762,7 +753,8 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
                          "rel_stderr": efit.rel_stderr, "residual_db_near_mode": efit.residual_db,
                          "senses": {f"{d} h={h:.4g}": {"sense": s_, "co_fraction": fr}
                                     for (d, h), (s_, fr) in efit.senses.items()}, "notes": efit.notes}
-    analytical["unconstrained"] = list(efit.unconstrained)
+    analytical["unconstrained"] = list(efit.unconstrained) + [DAMPING_NAME[m] for m in efit.zeta_bounds]
+    analytical["fit"] |= damping_record(efit.zeta_bounds, efit.zeta_interval)
     unresolved = unresolved_spans(fit)
     if unresolved:
         analytical["fit"]["unresolved_lines"] = unresolved
@@ -785,16 +777,22 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
 def unconstrained_warning(model, source: str, use: str) -> str | None:
     """The warning a command prints when it uses ``model`` whose ``analytical.unconstrained`` lists modes
     (the extended fit could not identify them: their values are starting values, or values the fit could not tell
-    apart from a test-stand resonance, as its notes say); None otherwise.
+    apart from a test-stand resonance, as its notes say) or held dampings (zeta_<mode>: located modes whose damping is
+    held inside the bounds the data allow, :mod:`rwadist.extended_fit_damping`); None otherwise.
 
     source : where the model came from (file name), for the message.  use : what the command does with it.
     """
     analytical = getattr(model, "analytical", None) or {}
-    modes = analytical.get("unconstrained") or []
-    if not modes:
+    listed = analytical.get("unconstrained") or []
+    if not listed:
         return None
-    return (f"warning: {source}: analytical.unconstrained = {list(modes)}: the extended fit could not identify "
-            f"{'this mode' if len(modes) == 1 else 'these modes'} from the test data; {use} uses "
-            f"{'its' if len(modes) == 1 else 'their'} starting values or values not told apart from a test stand (see "
-            "the model's analytical.fit.notes; measure a speed range whose lines cross "
-            "the mode, or give the mode from another source)")
+    modes = [m for m in listed if m not in DAMPING_NAME.values()]
+    held = [m[len("zeta_"):] for m in listed if m not in modes]
+    text = [f"the extended fit could not identify {'this mode' if len(modes) == 1 else 'these modes'} from the test "
+            f"data; {use} uses {'its' if len(modes) == 1 else 'their'} starting values or values not told apart from "
+            "a test stand (see the model's analytical.fit.notes; measure a speed range whose lines cross the mode, or "
+            "give the mode from another source)"] if modes else []
+    # a held damping: the mode is located, its ζ a value inside what the data allow (no speed on a crossing's peak)
+    text += [f"the damping of {', '.join(held)} is held inside the bounds the data allow (analytical.fit.zeta_bounds), "
+             f"not measured: no speed sits on a line's crossing of that mode, and {use} uses the held value"] if held else []
+    return f"warning: {source}: analytical.unconstrained = {list(listed)}: " + "; ".join(text)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -141,6 +141,8 @@ class Solution(NamedTuple):
     at_bound : per free mode, the limit its best fit sits at ("stiffness", "damping") or "".
     cov : covariance of θ (:func:`_covariance`), shape (θ, θ); NaN where it could not be computed.
     s2_row : per row its direction's residual variance (:func:`_row_variance`), shape like ``res.fun``.
+    residuals : θ -> the rows' residuals as fitted (weighted), the function the least squares minimised (a damping's
+        profile, :func:`rwadist.extended_fit_damping.damping_interval`).
     """
 
     res: optimize.OptimizeResult
@@ -150,6 +152,7 @@ class Solution(NamedTuple):
     at_bound: dict[str, str]
     cov: np.ndarray
     s2_row: np.ndarray
+    residuals: Callable[[np.ndarray], np.ndarray] | None = None
 
 
 @dataclass
@@ -169,6 +172,9 @@ class LogAmplitudeProblem:
     scatter : the scatter of a row's log amplitude assumed besides the noise (dimensionless; :meth:`row_weights`).
     noisy : the load directions whose sensors are far noisier than the others' (:func:`noisy_sensor_directions`):
         only their rows are weighted by their noise.
+    held_zeta : mode -> the damping ratio it is held at (its damping the data do not constrain,
+        :mod:`rwadist.extended_fit_damping`): its damping coefficient follows its stiffness, c = 2ζ·sqrt(k·inertia),
+        and its ln c entry of θ is inert.
     """
 
     base: dict
@@ -183,6 +189,7 @@ class LogAmplitudeProblem:
     row_noise: np.ndarray | None = None
     scatter: float = 0.0
     noisy: tuple = ()
+    held_zeta: dict = field(default_factory=dict)
 
     def row_weights(self) -> np.ndarray | None:
         """Per row, the weight of its log residual, or None (every row alike, the plain least squares): None unless
@@ -251,7 +258,11 @@ class LogAmplitudeProblem:
                         "damping" if res.x[2 * i + 1] - lo[2 * i + 1] < 0.01 else "")
                     for i, m in enumerate(free_modes)}
         modes = list(free_modes)        # as solved (the caller's list loses the modes it declares next)
-        return Solution(res, names, rel_se, lambda theta: self.unpack(modes, theta), at_bound, cov, s2_row)
+        if self.held_zeta:
+            # a held damping is no limit the fit ran into
+            at_bound = {m: ("" if m in self.held_zeta and why == "damping" else why) for m, why in at_bound.items()}
+        return Solution(res, names, rel_se, lambda theta: self.unpack(modes, theta), at_bound, cov, s2_row,
+                        residuals.residuals)
 
     def row_directions(self) -> np.ndarray:
         """Per least-squares row, the index of its measured line's load direction (radial force, radial torque,
@@ -267,8 +278,9 @@ class LogAmplitudeProblem:
         for m in free_modes:
             kn, cn, inertia = MODE_PARAMS[m]
             vals[kn] = math.exp(theta[k])
-            # damping stays below critical (the model refuses overdamped modes)
-            vals[cn] = min(math.exp(theta[k + 1]), 1.9 * math.sqrt(vals[kn] * vals[inertia]))
+            # damping stays below critical (the model refuses overdamped modes); a held damping ratio follows k
+            vals[cn] = (2 * self.held_zeta[m] * math.sqrt(vals[kn] * vals[inertia]) if m in self.held_zeta else
+                        min(math.exp(theta[k + 1]), 1.9 * math.sqrt(vals[kn] * vals[inertia])))
             k += 2
         n_mode, n_c = 2 * len(free_modes), len(self.lines)
         C = np.exp(theta[n_mode:n_mode + n_c])
@@ -310,6 +322,11 @@ class _Residuals:
             kn, cn, inertia = MODE_PARAMS[m]
             vals[kn] = math.exp(theta[2 * i])
             crit = 1.9 * math.sqrt(vals[kn] * vals[inertia])
+            if m in p.held_zeta:
+                # held: c = 2ζ·sqrt(k·inertia) follows k as a clamped damping does (d ln c / d ln k = 1/2)
+                clamped[m] = True
+                vals[cn] = 2 * p.held_zeta[m] * math.sqrt(vals[kn] * vals[inertia])
+                continue
             clamped[m] = math.exp(theta[2 * i + 1]) > crit
             vals[cn] = min(math.exp(theta[2 * i + 1]), crit)
         if p.joint is None:

@@ -48,6 +48,9 @@ SENSES = ("co", "counter", "planar")
 ANALYTICAL_KIND = "rigid_rotor_5dof"
 #: Suspension modes an extended fit may leave unidentified (``analytical.unconstrained``).
 UNCONSTRAINED_MODES = ("radial_translation", "rocking", "axial")
+#: ... and the damping ratios of located modes the data do not measure (held, with the bounds the data allow in
+#: ``analytical.fit.zeta_bounds``): either may be listed in ``analytical.unconstrained``
+UNCONSTRAINED_DAMPING = ("zeta_radial_translation", "zeta_rocking", "zeta_axial")
 #: Model-file keys of the extended-model parameters (parameter name -> key with its unit): the one
 #: table the kit (:class:`rwadist.extended.ExtendedParams`) and the FMU runtime read.
 PARAM_KEYS = {
@@ -537,9 +540,10 @@ class Analytical(_ReadsAsJson):
         unc = doc.get("unconstrained", _ABSENT)
         unconstrained = None
         if unc is not _ABSENT:
-            if not isinstance(unc, list) or any(not isinstance(m, str) or m not in UNCONSTRAINED_MODES for m in unc):
+            allowed = UNCONSTRAINED_MODES + UNCONSTRAINED_DAMPING
+            if not isinstance(unc, list) or any(not isinstance(m, str) or m not in allowed for m in unc):
                 raise error(source, "analytical.unconstrained", f"{unc!r} must be a list of "
-                            f"{', '.join(UNCONSTRAINED_MODES)}")
+                            f"{', '.join(allowed)}")
             unconstrained = tuple(unc)
         known = set(PARAM_KEYS.values()) | {"kind", "modes_assumed", "unconstrained"}
         out = cls(kind=kind, params=params, modes_assumed=assumed, unconstrained=unconstrained,

@@ -49,7 +49,7 @@ def json_schema() -> dict:
                     else {"type": "number"}) for name, key in schema.PARAM_KEYS.items()}
     analytical = {"type": "object", "properties": {
         "kind": {"const": schema.ANALYTICAL_KIND}, **params, "modes_assumed": {"type": "boolean"},
-        "unconstrained": {"type": "array", "items": {"enum": list(schema.UNCONSTRAINED_MODES)}}}}
+        "unconstrained": {"type": "array", "items": {"enum": list(schema.UNCONSTRAINED_MODES + schema.UNCONSTRAINED_DAMPING)}}}}
     kinds = sorted(schema.EFFECT_KINDS)
     effect = {"type": "object", "required": ["kind"], "properties": {"kind": {"type": "string"}},
               "allOf": [{"if": {"properties": {"kind": {"const": k}}, "required": ["kind"]},

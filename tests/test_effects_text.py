@@ -108,3 +108,13 @@ def test_a_mode_the_data_do_not_locate_is_said_not_located_not_given_a_frequency
     assert "radial translation 227.7 Hz (ζ 0.01)" in line and "axial 70 Hz (ζ 0.015)" in line
     # the inertia ratio is the split of the rocking's whirls (trial21 printed "I_zz/I_rr 1.21" for a lost rocking)
     assert "I_zz/I_rr not located" in line and "1.9" not in line
+
+
+def test_a_held_damping_is_said_held_with_the_range_the_data_allow():
+    """A located mode whose damping the data do not measure (zeta_<mode> in unconstrained, zeta_bounds): its frequency
+    is a finding, its held ζ is not; the range is."""
+    modes = dict(next(e for e in EFFECTS if e["kind"] == "suspension_modes"), unconstrained=["zeta_rocking"],
+                 zeta_bounds={"rocking": [5e-5, 0.0167]})
+    line = describe_effect(modes)
+    assert "rocking at rest 54.9 Hz (ζ not constrained by the data: held, 5e-05-0.017 allowed)" in line
+    assert "I_zz/I_rr 1.9" in line and "not located" not in line

@@ -49,6 +49,20 @@ def _diagnosed(seed: int):
     return wheel, api.diagnose(SteadyTest(runs=runs, meta={}))
 
 
+def _located_with_damping_held_honestly(modes, wheel):
+    """Every mode located (none of the mode names in ``unconstrained``); a damping the data do not measure may be
+    declared there as zeta_<mode> (:mod:`rwadist.extended_fit_damping`: the rocking's, whose forward whirl the 1x line
+    never crosses at I_zz/I_rr 2.1: seed 701 clean, bounds 5e-5-0.016), and then its bounds hold the generator's ζ."""
+    listed = modes.get("unconstrained") or []
+    assert not [m for m in listed if m in dfm.MODES], listed
+    truth = {"radial_translation": wheel.zeta_trans, "rocking": wheel.zeta_rock, "axial": wheel.zeta_axial}
+    for name in listed:
+        m = name[len("zeta_"):]
+        lo, hi = modes["zeta_bounds"][m]
+        assert lo <= truth[m] <= hi, (m, lo, hi, truth[m])
+        assert lo <= modes[name] <= hi
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", SEEDS)
 def test_the_modes_are_located_beside_a_gain_that_changes_with_speed(seed):
@@ -57,8 +71,8 @@ def test_the_modes_are_located_beside_a_gain_that_changes_with_speed(seed):
     (modes,) = [e for e in s["effects"] if e["kind"] == "suspension_modes"]
     truth = wheel.modes_hz()
     # every mode located (the rocking mode is the one the gain had left unconstrained), within 2 % (the issue's bound;
-    # seed 703 puts the rocking at 128.6 Hz, 1.05 % low)
-    assert not modes.get("unconstrained")
+    # seed 703 puts the rocking at 128.6 Hz, 1.05 % low); a damping the data do not measure declared with true bounds
+    _located_with_damping_held_honestly(modes, wheel)
     for m in dfm.MODES:
         assert modes[f"{m}_Hz"] == pytest.approx(truth[m], rel=dfm.MODE_TOL), m
     # nothing forced into a class for the gain: no amplitude law, nothing beside the wheel's modes
@@ -79,7 +93,7 @@ def test_the_same_draws_clean_are_diagnosed_as_before():
                 signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
     s = api.diagnose(SteadyTest(runs=runs, meta={})).summary()
     (modes,) = [e for e in s["effects"] if e["kind"] == "suspension_modes"]
-    assert not modes.get("unconstrained")
+    _located_with_damping_held_honestly(modes, wheel)
     for m, f in wheel.modes_hz().items():
         assert modes[f"{m}_Hz"] == pytest.approx(f, rel=0.01), m
     assert [e["kind"] for e in s["effects"]] == ["suspension_modes"]

@@ -25,6 +25,20 @@ def test_warning_text_names_modes_and_file():
     assert "x.json" in text and "'rocking'" in text and "'axial'" in text and "starting values" in text
 
 
+def test_held_damping_warns_as_a_held_value_not_a_lost_mode(tmp_path):
+    """A located mode whose damping the data do not measure (zeta_rocking, rwadist.extended_fit_damping): the warning
+    says the damping is held inside the data's bounds, not that the mode was not identified; the file round-trips."""
+    m = preset("ithaco-e").to_model()
+    m.analytical["unconstrained"] = ["zeta_rocking"]
+    text = unconstrained_warning(m, "x.json", "the PSD")
+    assert "damping of rocking is held" in text and "could not identify" not in text
+    m.analytical["unconstrained"] = ["axial", "zeta_rocking"]
+    text = unconstrained_warning(m, "x.json", "the PSD")
+    assert "could not identify this mode" in text and "damping of rocking is held" in text
+    back = model_io.load(model_io.save(m, tmp_path / "m.json"))
+    assert list(back.analytical["unconstrained"]) == ["axial", "zeta_rocking"]
+
+
 def test_psd_warns(model_file, tmp_path, capsys):
     assert main(["psd", str(model_file), "--speed-rpm", "500:1500", "--n-freq", "200", "--n-speeds", "20",
                  "-o", str(tmp_path / "p.csv")]) == 0

@@ -532,6 +532,13 @@ class SuspensionModes:
     #: or None: what the modes are judged with when they do not pass alone (:meth:`offset_effect`); named by the search
     #: as a ``cross_coupling`` of its own, not part of this effect's parameters
     offset: CrossCoupling | None = field(default=None, repr=False, compare=False)
+    #: per located mode ("radial_translation", "rocking", "axial") whose damping the data do not measure, the damping
+    #: ratios (lo, hi) they allow: its ζ is held, not fitted (:mod:`rwadist.extended_fit_damping`), listed in the
+    #: effect's ``unconstrained`` as zeta_<mode>
+    zeta_bounds: dict = field(default_factory=dict)
+    #: per located mode whose damping was profiled, the damping ratios (lo, hi) the data allow (a measured damping's
+    #: interval; a held one's is its ``zeta_bounds``)
+    zeta_interval: dict = field(default_factory=dict)
 
     @property
     def channels(self) -> tuple:
@@ -548,8 +555,12 @@ class SuspensionModes:
         base, pairs = wheel_base(to_model(efit, fit))
         structure = None if efit.stand_direction is None or efit.stand is None else \
             (efit.stand_direction,) + tuple(float(v) for v in efit.stand[:4])
+        def named(d):
+            return {("axial" if m == "axial_translation" else m): tuple(float(v) for v in b) for m, b in d.items()}
+
         return SuspensionModes(base, f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained), n_runs, stand,
-                               sideband_pairs=pairs, structure=structure)
+                               sideband_pairs=pairs, structure=structure, zeta_bounds=named(efit.zeta_bounds),
+                               zeta_interval=named(efit.zeta_interval))
 
     def apply(self, state: State) -> State:
         import copy
@@ -625,7 +636,10 @@ class SuspensionModes:
         return {"radial_translation_Hz": self.f0_Hz["radial_translation"], "rocking_Hz": self.f0_Hz["rocking"],
                 "axial_Hz": self.f0_Hz["axial"], "zeta_radial_translation": self.zeta["radial_translation"],
                 "zeta_rocking": self.zeta["rocking"], "zeta_axial": self.zeta["axial"],
-                "inertia_ratio": self.inertia_ratio, "unconstrained": list(self.unconstrained) or None,
+                "inertia_ratio": self.inertia_ratio,
+                "unconstrained": list(self.unconstrained) + [f"zeta_{m}" for m in self.zeta_bounds] or None,
+                "zeta_bounds": {m: list(b) for m, b in self.zeta_bounds.items()} or None,
+                "zeta_interval": {m: list(b) for m, b in self.zeta_interval.items()} or None,
                 "per_unit": True, "n_runs": self.n_runs,
                 "whirl": "rocking forward/backward f = sqrt((a·f_spin/2)^2 + rocking_Hz^2) ± a·f_spin/2, "
                          "a = inertia_ratio; the model's analytical section holds the fitted parameters"}
