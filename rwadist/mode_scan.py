@@ -21,7 +21,7 @@ worse by a log-likelihood ratio of at least ``min_log_lr`` (n/2·ln(SSR/SSR_best
 error larger than the tolerance.  The profile uses f0 steps of 1 % (2 % when a is scanned), ζ steps
 of a factor 1.6 (2.0) and a-steps of 0.2; the best point is refined to 0.1 % (the least squares that
 follows refines it; that grid is searched within ±2 % and ±0.1 of a first, and whole only when
-its best point lies on that part's edge: :func:`_fine_search`).  Otherwise the data do not
+its best point lies on that part's edge, or with fewer than 64 measurements: :func:`_fine_search`).  Otherwise the data do not
 constrain the mode (no line comes near it, only a skirt is seen, or the whirl it shows trades off
 against I_zz/I_rr) and the result says so; nothing is invented.
 
@@ -334,6 +334,11 @@ def _windowed_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_part
 #: first: the coarse step either side of the coarse best point (2 % when I_zz/I_rr is scanned) and half the a-range
 FINE_F_SPAN = 0.02
 FINE_A_SPAN = 0.1
+#: ... with this many measurements at least; fewer (the 19-20 radial-torque rows of a 16-24 speed family cell) leave
+#: near-equal minima apart in the refinement grid, and the part's interior best missed the whole grid's (family wheel
+#: 2 of 1x-translation fixture: 49.66 Hz, a = 2.21 for 50.36 Hz, a = 2.163; wheel 7 of 1.5x-rocking fixture), while
+#: such a grid is cheap: searched whole
+FINE_PART_MIN_ROWS = 64
 
 
 def _fine_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts, f_centre: float, a_centre: float):
@@ -341,10 +346,11 @@ def _fine_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts, f_cen
     within ±:data:`FINE_F_SPAN` (relative) of the coarse best f0 ``f_centre`` and ±:data:`FINE_A_SPAN` of its
     I_zz/I_rr ``a_centre`` (every ζ), the others NaN: kept when the best point lies inside that part, the whole grid
     searched when it lies on an edge the grid goes beyond (the rule of :func:`_windowed_search`: the whole grid's best
-    point whenever that lies in the part)."""
+    point whenever that lies in the part); the whole grid at once with fewer than :data:`FINE_PART_MIN_ROWS` rows."""
     fi = np.flatnonzero(np.abs(np.log(f_fine / f_centre)) <= FINE_F_SPAN + 1e-9)
     ai = np.flatnonzero(np.abs(a_fine - a_centre) <= FINE_A_SPAN + 1e-9) if a_fine.size > 1 else np.arange(a_fine.size)
-    if fi.size < 3 or ai.size == 0 or (fi.size == f_fine.size and ai.size == a_fine.size):
+    if np.size(line) < FINE_PART_MIN_ROWS or fi.size < 3 or ai.size == 0 or \
+            (fi.size == f_fine.size and ai.size == a_fine.size):
         return _screened_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
     sub = _screened_search(line, h, omega, power, f_fine[fi], z_fine, a_fine[ai], two_parts)
     if np.all(np.isnan(sub)):

@@ -16,10 +16,10 @@ from rwadist.spectra import compute_spectra
 from rwadist.teststand import simulate_steady
 
 
-def _scan_case(seed=3):
+def _scan_case(seed=3, n_speeds=9):
     """A few lines measured at a few speeds through a rocking-like mode, with scatter."""
     rng = np.random.default_rng(seed)
-    n_lines, n_speeds = 4, 9
+    n_lines = 4
     line = np.repeat(np.arange(n_lines), n_speeds)
     h = np.array([1.0, 2.0, 2.7, 4.4])[line]
     omega = np.tile(np.linspace(40.0, 250.0, n_speeds), n_lines)
@@ -104,15 +104,16 @@ def test_scan_near_an_earlier_fit_is_the_whole_grid_scan():
 
 def test_scan_refinement_part_first_is_the_whole_refinement_grid():
     # every scan refines its coarse best point on a finer grid (f0 ±5 % or ±3 %, ζ, I_zz/I_rr ±0.2), searched first
-    # within ±2 % and ±0.1 of that point (mode_scan._fine_search): the same best point as the whole refinement grid's,
-    # bit for bit, and the whole grid searched when the part's best lies on its edge (a centre put 4 % off)
+    # within ±2 % and ±0.1 of that point with 64 rows or more (mode_scan._fine_search): the same best point as the whole
+    # refinement grid's, bit for bit, and the whole grid searched when the part's best lies on its edge (a centre put
+    # 4 % off) or the rows are fewer
     import rwadist.mode_scan as ms
 
     def whole_grid(line, h, omega, power, f, z, a, two, f_centre, a_centre):
         return ms._screened_search(line, h, omega, power, f, z, a, two)
 
     for seed in (3, 5, 7, 11):
-        line, h, omega, power = _scan_case(seed=seed)
+        line, h, omega, power = _scan_case(seed=seed, n_speeds=20)    # 80 rows: the part first
         for mode, two in (("rocking", True), ("radial_translation", True), ("axial_translation", False)):
             args = (mode, line, h, omega, power if two else np.sqrt(power))
             for min_log_lr in (-np.inf, 2.0):
@@ -131,6 +132,9 @@ def test_scan_refinement_part_first_is_the_whole_refinement_grid():
                                    (f[best[0]], a[best[2]])):
             part = ms._fine_search(line, h, omega, power, f, z, a, True, f_centre, a_centre)
             assert np.unravel_index(np.nanargmin(part), part.shape) == best and part[best] == full[best], seed
+        assert np.isnan(ms._fine_search(line, h, omega, power, f, z, a, True, f[best[0]], a[best[2]])).any()
+        few = _scan_case(seed=seed)                                     # 36 rows: the whole grid
+        assert not np.isnan(ms._fine_search(*few, f, z, a, True, f[best[0]], a[best[2]])).any()
 
 
 def test_hann_transform_is_the_window_sum():
