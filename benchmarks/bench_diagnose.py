@@ -94,7 +94,16 @@ x11.2/x10.4, x11.1/x11.3 against x10.3/x9.2, x9.9/x9.2; sixty x16.0/x15.6, x14.9
 x14.6/x14.8; 2 busy x16.1/x16.3, x15.2/x15.2 against x14.9/x15.8, x15.7/x15.8; a third round (new, main) at load
 5.6-6.9: benchmark x9.4/x9.0 against x11.3/x11.5, 2 busy x9.6/x10.0 against x9.9/x9.2, sixty x14.7/x15.1 against
 x15.6/x15.5, 2 busy x15.1/x15.8 against x15.8/x14.8: a few per cent idle, none beside 2 busy, at this load's noise;
-target not met on the sixty set.
+target not met on the sixty set.  2026-12-01, session 21 (speed21): the mode scans' refinement grids searched within
+±2 % of f0 and ±0.1 of I_zz/I_rr of the coarse best point first (mode_scan._fine_search, scans of 64 rows or more):
+the scans' grid searches 0.28 -> 0.18 s of a sixty-set diagnose (in-call timers), the same scans, summaries and
+family-matrix rows bit for bit.  --quick --repeats 3 at load 8.5-9.9 on 2 cores (other agents' jobs), 71216fb
+(--busy 0) then speed21 (--busy 2): diagnose cpu min/median benchmark 2.49/2.60 s -> 2.39/2.51 s, sixty 1.44/1.47 s
+-> 1.38/1.40 s; cpu x11.4/x9.9 -> x8.4/x8.7 (benchmark; the fit's 0.22 -> 0.28 s is this load's noise), x13.9/x13.2
+-> x12.8/x12.4 (sixty), 2 busy x9.6/x9.0 and x12.4/x12.7: target not met on the sixty set.  Already in place and
+measured again: the suspension-mode least squares has its analytic Jacobian (0.06 s of the sixty set's diagnose),
+no grid search or record transform repeats its arguments within a diagnose (so nothing to cache), and every BLAS
+pool holds one thread, scipy's loaded after start-up included (threadpoolctl; their idle threads ~0 CPU).
 """
 from __future__ import annotations
 

@@ -5,6 +5,7 @@ empirical fit reusing the first one's detections against a fresh one, the suspen
 from every run's against those of its runs alone, and the mode scan searched first near an earlier fit's mode against
 the scan of its whole grid."""
 import numpy as np
+import pytest
 from scipy import optimize, signal
 
 from rwadist.dft import hann_transform, windowed_dfts
@@ -15,10 +16,10 @@ from rwadist.spectra import compute_spectra
 from rwadist.teststand import simulate_steady
 
 
-def _scan_case(seed=3):
+def _scan_case(seed=3, n_speeds=9):
     """A few lines measured at a few speeds through a rocking-like mode, with scatter."""
     rng = np.random.default_rng(seed)
-    n_lines, n_speeds = 4, 9
+    n_lines = 4
     line = np.repeat(np.arange(n_lines), n_speeds)
     h = np.array([1.0, 2.0, 2.7, 4.4])[line]
     omega = np.tile(np.linspace(40.0, 250.0, n_speeds), n_lines)
@@ -99,6 +100,41 @@ def test_scan_near_an_earlier_fit_is_the_whole_grid_scan():
             assert (got.found, got.f0_hz, got.zeta, got.inertia_ratio, got.reason) == \
                 (whole.found, whole.f0_hz, whole.zeta, whole.inertia_ratio, whole.reason), (mode, near_hz, near_a)
     assert 50.0 < scan_mode("rocking", line, h, omega, power, min_log_lr=-np.inf).f0_hz < 60.0    # the case's 55 Hz
+
+
+def test_scan_refinement_part_first_is_the_whole_refinement_grid():
+    # every scan refines its coarse best point on a finer grid (f0 ±5 % or ±3 %, ζ, I_zz/I_rr ±0.2), searched first
+    # within ±2 % and ±0.1 of that point with 64 rows or more (mode_scan._fine_search): the same best point as the whole
+    # refinement grid's, bit for bit, and the whole grid searched when the part's best lies on its edge (a centre put
+    # 4 % off) or the rows are fewer
+    import rwadist.mode_scan as ms
+
+    def whole_grid(line, h, omega, power, f, z, a, two, f_centre, a_centre):
+        return ms._screened_search(line, h, omega, power, f, z, a, two)
+
+    for seed in (3, 5, 7, 11):
+        line, h, omega, power = _scan_case(seed=seed, n_speeds=20)    # 80 rows: the part first
+        for mode, two in (("rocking", True), ("radial_translation", True), ("axial_translation", False)):
+            args = (mode, line, h, omega, power if two else np.sqrt(power))
+            for min_log_lr in (-np.inf, 2.0):
+                got = scan_mode(*args, min_log_lr=min_log_lr)
+                with pytest.MonkeyPatch.context() as mp:
+                    mp.setattr(ms, "_fine_search", whole_grid)
+                    whole = scan_mode(*args, min_log_lr=min_log_lr)
+                assert (got.found, got.f0_hz, got.zeta, got.inertia_ratio, got.reason) == \
+                    (whole.found, whole.f0_hz, whole.zeta, whole.inertia_ratio, whole.reason), (seed, mode)
+        # the part's edge: the refinement grid about 55 Hz searched first about 4 % and 0.15 away from its best
+        f = 55.0 * np.exp(np.arange(-0.05, 0.0501, 0.001))
+        z, a = 0.04 * np.exp(np.linspace(-0.75, 0.75, 11)), np.round(np.arange(1.4, 1.801, 0.02), 10)
+        full = ms._screened_search(line, h, omega, power, f, z, a, True)
+        best = np.unravel_index(np.nanargmin(full), full.shape)
+        for f_centre, a_centre in ((f[best[0]] * 1.04, a[best[2]] + 0.15), (f[best[0]] / 1.04, a[best[2]] - 0.15),
+                                   (f[best[0]], a[best[2]])):
+            part = ms._fine_search(line, h, omega, power, f, z, a, True, f_centre, a_centre)
+            assert np.unravel_index(np.nanargmin(part), part.shape) == best and part[best] == full[best], seed
+        assert np.isnan(ms._fine_search(line, h, omega, power, f, z, a, True, f[best[0]], a[best[2]])).any()
+        few = _scan_case(seed=seed)                                     # 36 rows: the whole grid
+        assert not np.isnan(ms._fine_search(*few, f, z, a, True, f[best[0]], a[best[2]])).any()
 
 
 def test_hann_transform_is_the_window_sum():
