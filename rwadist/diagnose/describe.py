@@ -407,6 +407,9 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
     # the final model's residual on the data the search read (the fixed lines and copies out), shares on the data
     found += describe_residual(searched or res, bearings, res, changes=bool(opened.steps), carriers=opened.fixed,
                                known_sidebands=opened.sidebands)
+    from .describe_law import describe_laws
+
+    found += describe_laws(res, getattr(diag, "laws_below_gain", ()))
     return found, res
 
 

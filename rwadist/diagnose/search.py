@@ -14,6 +14,7 @@ from ..model import WheelModel
 from ..spectra import Spectra
 from . import describe
 from .constants import BAND_BINS, CONTRAST_METRIC, CONTRAST_NOISE_Z, METRIC, NOISE_Z
+from .describe_law import laws_below_gain
 from .effects import family_classes
 from .effects.base import Effect
 from .engine import Context, initial_state
@@ -73,6 +74,9 @@ class Diagnosis:
     speed: dict = field(default_factory=dict)
     #: channels of runs left out because they froze (:meth:`rwadist.data_quality.FrozenStretch.to_json` records)
     data_quality: list = field(default_factory=list)
+    #: [(hypothesis, law refitted on every run)] of the amplitude laws the last step measured beyond ``k_sigma`` but
+    #: below ``min_gain`` (:func:`rwadist.diagnose.describe_law.laws_below_gain`), described in ``unexplained``
+    laws_below_gain: list = field(default_factory=list)
 
     @property
     def effects(self) -> list:
@@ -610,8 +614,9 @@ def _search_once(spectra: Spectra, model: WheelModel | None, k_sigma: float, min
     # its error on every run first (the diagnosis reports it): the held-out and fit runs' terms are then its rows
     _state_error(ctx, state0)
     state = state0
-    hyps = []
-    it = 0
+    hyps: list = []
+    judged: list = []                           # the last step's hypotheses (read after the loop, with its best)
+    it, best = 0, None
     # a family marked ``first`` (the wheel's own modes) is taken before any other passing effect: it is proposed
     # and judged alone, and the other families only when it is not taken (the same choice as judging all together,
     # without fitting every other family to a state about to change)
@@ -619,7 +624,7 @@ def _search_once(spectra: Spectra, model: WheelModel | None, k_sigma: float, min
     rest = [cls for cls in family_classes() if not getattr(cls, "first", False)]
     for it in range(1, max_iterations + 1):
         memo: dict = {}
-        judged: list = []
+        judged = []
         # what a family's fit could at most gain on the held-out runs (Context.can_pass): the step's own errors
         ctx.step = (state, lambda chans, state=state, memo=memo: _state_errors(ctx, state, ctx.held_runs, chans, memo),
                     min_gain)
@@ -672,6 +677,10 @@ def _search_once(spectra: Spectra, model: WheelModel | None, k_sigma: float, min
     out = improved_model(model, state, hyps)
     diag = Diagnosis(out, state0, state, _state_error(ctx, state0), _state_error(ctx, state), ctx.rms_error(state0),
                      ctx.rms_error(state), hyps, it, ctx, model_given=given)
+    if best is None:
+        # the last step took nothing: a law it measured to t > k_sigma but below min_gain is described, not dropped
+        # (a law on a weak line gains little of a power-weighted misplaced power: docs/diagnose.md)
+        diag.laws_below_gain = laws_below_gain(ctx, state, judged, k_sigma, min_gain)
     # measured on the data as given, what the residual holds that no class explains described (and an effect the
     # search fitted to that content taken back: the model made again without it)
     return describe.finish(diag, opened, bearings, rebuild=lambda st, hs: improved_model(model, st, hs))

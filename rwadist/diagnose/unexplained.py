@@ -52,6 +52,7 @@ LEVEL_WORDS = {
     "partial_line": "{:+.1f} dB against the model in the runs it is absent from",
     "line_property": "{:+.2f} dB (power) in the second channel's lines against the first's",
     "line_property:gain_trend": "{:+.2f} dB (power) on every line from the lowest speed to the highest",
+    "line_property:amplitude_law": "{:+.1f} dB (power) against C·Ω² from the lowest speed to the highest",
 }
 
 
