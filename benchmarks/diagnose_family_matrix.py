@@ -15,6 +15,9 @@ no model, is run on it (a subprocess) and its ``summary.json`` read.  Per wheel:
   cell's (<= 5x), anything else added;
 * a fixture (test-stand) resonance on every channel at 0.5-1.5x each suspension mode (ζ 0.03, peak gain 5): the
   modes within 2 % or declared unconstrained, and the stand named (``fixed_resonance`` role test_stand within 5 %);
+* ``fixture_pair``: two fixture resonances on every channel at once, on either side of the wheel's radial
+  translation mode (0.75-0.85x and 1.25-1.35x it, drawn with the wheel's seed; ζ 0.03, peak gain 5 each), one cell
+  per wheel: the modes as for ``fixture`` and both stands named (trial20's 128 + 208 Hz case on the family);
 * ``fixture_offset``: the same fixture on a table whose load-cell reference sits 20-40 mm off the bearing centre
   (a ``cross_coupling`` lever arm, :data:`LEVER_ARMS_M`), one cell per wheel: the modes as for ``fixture``, the stand
   named and the offset named (``cross_coupling`` r_z within 10 mm), nothing else added, error <= 5x the clean cell's;
@@ -93,6 +96,10 @@ def cells(i: int, wheel) -> list:
         factor = FIXTURE_FACTORS[(i + 2 * j) % len(FIXTURE_FACTORS)]
         f = factor * wheel.modes_hz()[mode]
         out.append((f"fixture {factor:g}x {mode}", "fixture", [fe.Fixture(f_hz=f, zeta=0.03, gain=5.0)]))
+    lo, hi = fixture_pair_factors(i)
+    f_tr = wheel.modes_hz()["radial_translation"]
+    out.append((f"fixture pair {lo:.2f}x+{hi:.2f}x radial_translation", "fixture_pair",
+                [fe.Fixture(f_hz=lo * f_tr, zeta=0.03, gain=5.0), fe.Fixture(f_hz=hi * f_tr, zeta=0.03, gain=5.0)]))
     for j in range(FIXTURE_OFFSET_CELLS):
         mode = MODES[(i + j) % len(MODES)]
         factor = FIXTURE_FACTORS[(i + 2 * ((i + j) % len(MODES))) % len(FIXTURE_FACTORS)]
@@ -105,6 +112,17 @@ def cells(i: int, wheel) -> list:
         out.append((f"{a}+{b}", "pair", [fe.default_effect(a, wheel), fe.default_effect(b, wheel)]))
     out += [(k, k, [fe.default_effect(k, wheel)]) for k in fe.UNKNOWN]
     return out
+
+
+#: ``fixture_pair`` cells: the two fixtures' factors of the radial translation are drawn from these ranges
+FIXTURE_PAIR_RANGES = ((0.75, 0.85), (1.25, 1.35))
+
+
+def fixture_pair_factors(i: int) -> tuple:
+    """The two factors of wheel ``i``'s radial translation its ``fixture_pair`` cell puts fixtures at, drawn with the
+    wheel's seed (the cell's own, :func:`main`'s seed + 100·i is the data's)."""
+    rng = np.random.default_rng(1000 + i)
+    return tuple(float(rng.uniform(*r)) for r in FIXTURE_PAIR_RANGES)
 
 
 def run_diagnose(data_dir: Path, report_dir: Path) -> tuple:
@@ -323,6 +341,14 @@ def summarize(rows: list) -> None:
               f"{sum(bool(r['found'][0]) for r in fx if 'crashed' not in r)}/{len(fx)}; nothing else added "
               f"{sum(not r['added'] for r in fx)}/{len(fx)}; error <= {ERROR_FACTOR:g}x clean "
               f"{sum(r.get('error_ratio') is not None and r['error_ratio'] <= ERROR_FACTOR for r in fx)}/{len(fx)}")
+    fp = [r for r in rows if r["label"] == "fixture_pair" and "crashed" not in r]
+    if fp:
+        ok = [r for r in fp if r["modes_ok"] and all(r["found"]) and not r["added"]
+              and r.get("error_ratio") is not None and r["error_ratio"] <= ERROR_FACTOR]
+        print(f"fixture pairs: modes within {100 * MODE_TOL:g} % or declared {sum(r['modes_ok'] for r in fp)}/{len(fp)}; "
+              f"both stands named {sum(all(r['found']) for r in fp)}/{len(fp)}; nothing else added "
+              f"{sum(not r['added'] for r in fp)}/{len(fp)}; PASS {len(ok)}/{len(fp)} "
+              f"(failed: {[r['wheel'] for r in fp if r not in ok]})")
     fo = [r for r in rows if r["label"] == "fixture_offset"]
     if fo:
         ok = [r for r in fo if r["modes_ok"] and all(r["found"]) and not r["added"]

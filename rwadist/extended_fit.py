@@ -145,6 +145,7 @@ class ExtendedFit:
     stand_direction: str | None = None
     zeta_bounds: dict = field(default_factory=dict)
     zeta_interval: dict = field(default_factory=dict)
+    more_stands: tuple = ()         # further fixture resonances divided out of every line, held (``more_stands``)
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -569,12 +570,10 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     frequency error the data must exclude for a mode to count as found (:func:`scan_mode`).
     stand: (f_r Hz, ζ, peak gain[, gain above]) of a fixture resonance acting on every channel (``rwadist diagnose``'s
     ``fixed_resonance`` of role test_stand; :func:`rwadist.resonance.resonance`), or None: every measured line
-    amplitude is divided by its |H|
-    (:func:`rwadist.resonance.resonance`) before the modes are located and fitted, so that the fixture's
-    amplification is not taken for the wheel's.  more_stands: further fixture resonances (each (f_r Hz, ζ,
-    peak gain), on every channel) divided out the same way (``rwadist diagnose`` checks the modes beside every
-    test-stand resonance it named); not recorded in ``ExtendedFit.stand``.  near: mode -> ``near_hz``/``near_a`` of
-    :func:`rwadist.mode_scan.scan_mode` (where an earlier fit of the same wheel located it), or None.
+    amplitude is divided by its |H| before the modes are located and fitted, so that the fixture's amplification is
+    not taken for the wheel's.  more_stands: further fixture resonances (each (f_r Hz, ζ, peak gain[, gain above]), on
+    every channel) divided out the same way and held (``ExtendedFit.more_stands``).  near: mode -> ``near_hz``/
+    ``near_a`` of :func:`rwadist.mode_scan.scan_mode` (where an earlier fit of the same wheel located it), or None.
     fit_stand: the modes are located with ``stand`` divided out, and its parameters (f_r, ζ, the numerator's damping
     and the gain above, :class:`rwadist.resonance.FittedResonance`) are fitted in the modes' least squares, from it:
     the modes' standard errors are those with the stand free (what the stand could take of their lines is counted).
@@ -649,7 +648,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                        unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
                        line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
-                       zeta_bounds=zeta_bounds, zeta_interval=intervals)
+                       zeta_bounds=zeta_bounds, zeta_interval=intervals,
+                       more_stands=tuple(tuple(float(v) for v in k) for k in more_stands))
 
 
 def _mode_hz_of(params: ext.ExtendedParams, mode: str) -> float:

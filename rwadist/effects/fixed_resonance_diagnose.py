@@ -468,7 +468,7 @@ class FixedResonance:
                      and getattr(x, "stand", None) is not None]
             if modes:
                 m = modes[-1]
-                out.append(FixedResonance.of_stand(m.stand_fit_runs or m.stand, ctx.channels, m.stand))
+                out += m.stand_effects(ctx.channels)         # its stand and any further ones fitted with it
             # the mode of the wheel's structure the suspension modes were fitted beside (on one direction): the same,
             # as a wheel-mode resonance (:func:`rwadist.stand_resonance.fit_extended_beside_structure_mode`)
             structured = [x for x in state.effects if getattr(x, "kind", "") == "suspension_modes"

@@ -20,6 +20,7 @@ import numpy as np
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.modes_trend import beside_trend
+from ..diagnose.stands import StandGroup
 from ..diagnose.state import State
 from ..model import Harmonic, WheelModel
 from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode, stand_starts
@@ -216,8 +217,10 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
     starts = [stand_start] if stand_start is not None else \
         (_stand_starts_once(ctx, fit) or _stand_starts_once(ctx, _whole_data_fit(ctx)))
     efit = fit_extended_beside_stand(test, fit, starts=starts, near=near, near_stand=stand_start)
-    if efit.stand is None and stand_start is None:
-        # ``near`` came from a fit without a stand (stand_start None): no guide to the modes beside one
+    own = ((efit.stand,) if efit.stand is not None else ()) + tuple(efit.more_stands)
+    if stand_start is None and (not own or stand_starts(_whole_data_fit(ctx), known=own)):
+        # every run may show a stand (or another one) these runs do not resolve; ``near`` came from a fit without a
+        # stand (stand_start None): no guide to the modes beside one
         held = _beside_whole_data_stand(ctx, test, fit, efit)
         if held is not None:
             efit = held
@@ -235,51 +238,57 @@ def _stand_starts_once(ctx: Context, fit) -> list:
 
 
 def _beside_whole_data_stand(ctx: Context, test, fit, plain):
-    """The extended fit of ``test`` (empirical fit ``fit``) with the fixture resonance fitted jointly with the modes on
-    EVERY run (:func:`_whole_data_stand`) divided out at its parameters, held fixed, or None when every run shows no
-    stand or the fit runs do not confirm it over ``plain`` (the fit runs' own fit, no stand kept:
-    :func:`rwadist.stand_resonance.stand_confirmed`).
+    """The extended fit of ``test`` (empirical fit ``fit``) with the fixture resonances fitted jointly with the modes
+    on EVERY run (:func:`_whole_data_stands`) divided out at their parameters, held fixed, or None when every run
+    shows no stand or the fit runs do not confirm them over ``plain`` (the fit runs' own fit, beside no stand or
+    fewer: :func:`rwadist.stand_resonance.stand_confirmed` of a stand every run shows and ``plain`` has not).
 
     Half of a short speed grid may put no line within the stand's width: the lines near it then tell neither its
     width nor its frequency from a mode's on the same spot (family wheel 0, a fixture at its radial translation's
     310 Hz, 8 of 16 speeds: no line between 290 and 330 Hz; the joint fit ran to ζ 0.001, no fixture resonance,
     and the fit without a stand located no mode).  Every run shows it; held at what they show, the fit runs locate
-    the modes (the search then judges them on the held-out runs, as any effect)."""
+    the modes (the search then judges them on the held-out runs, as any effect).  Two fixtures (trial20, 128 and
+    208 Hz, seed 22): 10 of 20 speeds fitted the 128 Hz stand at 124.0 Hz, ζ 0.019 and ran the 208 Hz one to the
+    damping's floor (ζ 0.001, gain 55: no measured width), no mode located; every run fits both within 0.1 %."""
     from ..extended_fit import fit_extended
-    from ..stand_resonance import stand_confirmed
+    from ..stand_resonance import same_stand, stand_confirmed
 
-    whole = _whole_data_stand(ctx)
-    if whole is None:
+    whole = _whole_data_stands(ctx)
+    own = ((plain.stand,) if plain.stand is not None else ()) + tuple(plain.more_stands)
+    if len(whole) <= len(own):
         return None
-    held = fit_extended(test, fit, stand=whole)
-    if not stand_confirmed(held, plain):
+    held = fit_extended(test, fit, stand=whole[0], more_stands=whole[1:])
+    new = next((w for w in whole if not any(same_stand(w, k) for k in own)), None)
+    if new is None or not stand_confirmed(held, plain, new):
         return None
-    f_r, zeta, gain, above = whole
-    held.notes.append(f"test stand: a resonance at {f_r:.4g} Hz (ζ {zeta:.3g}, peak gain {gain:.3g}, {above:.3g} of the "
-                      "load far above it) lifts the lines of every channel: a fixture resonance, fitted with the modes "
-                      "on every run (these runs alone do not resolve it) and divided out here; not part of the "
-                      "wheel's model (analytical.fit.test_stand)")
+    for f_r, zeta, gain, above in whole:
+        held.notes.append(f"test stand: a resonance at {f_r:.4g} Hz (ζ {zeta:.3g}, peak gain {gain:.3g}, {above:.3g} of "
+                          "the load far above it) lifts the lines of every channel: a fixture resonance, fitted with the "
+                          "modes on every run (these runs alone do not resolve it) and divided out here; not part of "
+                          "the wheel's model (analytical.fit.test_stand)")
     return held
 
 
-def _whole_data_stand(ctx: Context):
-    """The fixture resonance (f_r Hz, ζ, peak gain, gain above) fitted jointly with the modes on every run
+def _whole_data_stands(ctx: Context) -> tuple:
+    """The fixture resonances ((f_r Hz, ζ, peak gain, gain above) each) fitted jointly with the modes on every run
     (:func:`rwadist.stand_resonance.fit_extended_beside_stand` of the whole data's empirical fit,
-    :func:`_whole_data_fit`) when that fit confirms one, else None; computed once per diagnosis."""
+    :func:`_whole_data_fit`: its ``stand`` and ``more_stands``) when that fit confirms any, else (); computed once per
+    diagnosis."""
     from ..data import SteadyTest
 
     key = ("suspension_modes.whole_data_stand",)
     if key not in ctx._memo:
-        ctx._memo[key] = None
+        ctx._memo[key] = ()
         whole_fit = _whole_data_fit(ctx)
         starts = _stand_starts_once(ctx, whole_fit)
         if starts:
             test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], _recorded_meta(ctx))
             try:
-                stand = fit_extended_beside_stand(test, whole_fit, starts=starts).stand
+                efit = fit_extended_beside_stand(test, whole_fit, starts=starts)
             except ValueError:
-                stand = None
-            ctx._memo[key] = None if stand is None else tuple(float(v) for v in stand)
+                efit = None
+            if efit is not None and efit.stand is not None:
+                ctx._memo[key] = tuple(tuple(float(v) for v in k) for k in (efit.stand,) + tuple(efit.more_stands))
     return ctx._memo[key]
 
 
@@ -528,6 +537,11 @@ class SuspensionModes:
     structure: tuple | None = None
     #: the structure mode of the fit on the fit runs this effect was refitted from, or None (as ``stand_fit_runs``)
     structure_fit_runs: tuple | None = field(default=None, repr=False)
+    #: further fixture resonances fitted with the modes beside ``stand`` (each (f_r Hz, ζ, peak gain, gain above):
+    #: :func:`rwadist.stand_resonance.beside_more_stands`), named by the search as ``fixed_resonance`` effects too
+    more_stands: tuple = ()
+    #: the further stands of the fit on the fit runs this effect was refitted from (as ``stand_fit_runs``)
+    more_stands_fit_runs: tuple = field(default=(), repr=False)
     #: the load-cell offset (a :class:`CrossCoupling`) the torques were corrected for before the modes were located,
     #: or None: what the modes are judged with when they do not pass alone (:meth:`offset_effect`); named by the search
     #: as a ``cross_coupling`` of its own, not part of this effect's parameters
@@ -558,9 +572,10 @@ class SuspensionModes:
         def named(d):
             return {("axial" if m == "axial_translation" else m): tuple(float(v) for v in b) for m, b in d.items()}
 
+        more = () if stand is None else tuple(tuple(float(v) for v in k) for k in efit.more_stands)
         return SuspensionModes(base, f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained), n_runs, stand,
                                sideband_pairs=pairs, structure=structure, zeta_bounds=named(efit.zeta_bounds),
-                               zeta_interval=named(efit.zeta_interval))
+                               zeta_interval=named(efit.zeta_interval), more_stands=more)
 
     def apply(self, state: State) -> State:
         import copy
@@ -584,6 +599,7 @@ class SuspensionModes:
         return replace(SuspensionModes.fit(ctx, state, ctx.runs, self.stand, self.near(), self.structure,
                                            self.offset) or self,
                        stand_fit_runs=self.stand if self.judge_runs is None else None, judge_runs=None,
+                       more_stands_fit_runs=self.more_stands if self.judge_runs is None else (),
                        structure_fit_runs=self.structure if self.judge_runs is None else None)
 
     def other_fold(self, ctx: Context, state: State) -> "SuspensionModes | None":
@@ -614,7 +630,25 @@ class SuspensionModes:
 
         if self.stand is None and self.structure is not None:
             return FixedResonance.of_structure(self.structure_fit_runs or self.structure, channels, self.structure)
-        return None if self.stand is None else FixedResonance.of_stand(self.stand, channels, self.stand)
+        if self.stand is None:
+            return None
+        one = FixedResonance.of_stand(self.stand, channels, self.stand)
+        return one if not self.more_stands else StandGroup((one,) + tuple(
+            FixedResonance.of_stand(k, channels, k) for k in self.more_stands))
+
+    def stand_effects(self, channels) -> list:
+        """Each fixture resonance fitted with these modes (``stand``, then ``more_stands``) as a test-stand
+        ``fixed_resonance`` on ``channels``, as judged on the held-out runs (the fit runs' stand of that frequency when
+        this is a refit, :func:`rwadist.stand_resonance.same_stand`), refitted as this fit has it."""
+        from ..stand_resonance import same_stand
+        from .fixed_resonance_diagnose import FixedResonance
+
+        if self.stand is None:
+            return []
+        held = list(self.more_stands_fit_runs) + ([self.stand_fit_runs] if self.stand_fit_runs else [])
+        return [FixedResonance.of_stand(self.stand_fit_runs or self.stand, channels, self.stand)] + [
+            FixedResonance.of_stand(next((h for h in held if same_stand(h, k)), k), channels, k)
+            for k in self.more_stands]
 
     def offset_effect(self) -> CrossCoupling | None:
         """The load-cell offset the modes were located beside (``offset``), or None: what the modes are judged with
@@ -718,16 +752,17 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
     if modes is None or ctx.test is None or len(ctx.channels) < 6:
         return state
     own = modes.stand
+    mine = ((own,) if own is not None else ()) + tuple(modes.more_stands)
     others = [(e.f_r, e.zeta, e.peak_gain, e.gain_above) for e in state.effects
               if e.kind == "fixed_resonance" and e.role == "test_stand" and len(e.channels) == 6
-              and (own is None or abs(e.f_r / own[0] - 1) > SAME_STAND)]
+              and all(abs(e.f_r / k[0] - 1) > SAME_STAND for k in mine)]
     if not others:
         return state
     test, fit = _test_and_fit(ctx, ctx.runs)
     test = SteadyTest(test.runs, _recorded_meta(ctx))
     try:
-        one = fit_extended(test, fit, stand=own)
-        every = fit_extended(test, fit, stand=own, more_stands=tuple(others))
+        one = fit_extended(test, fit, stand=own, more_stands=tuple(modes.more_stands))
+        every = fit_extended(test, fit, stand=own, more_stands=tuple(modes.more_stands) + tuple(others))
     except ValueError:
         return state
     f_one, f_every = _mode_hz(one.params), _mode_hz(every.params)
