@@ -448,10 +448,10 @@ def _with_new_stand(test, fit, known: tuple, start: tuple, kwargs) -> tuple:
     rocking's forward whirl reaching 190 Hz at the top speed: rocking unconstrained, cost 11.0; the 128 Hz stand free
     beside it held: every mode within 0.4 %, cost 1.5): the fit of least cost is kept, not the last."""
     stands = [tuple(start) + (() if len(start) == 4 else (1.0,))] + [tuple(k) for k in known]
-    fits = []
+    fits: list = []
     for i in 2 * list(range(len(stands))):
         held = tuple(k for j, k in enumerate(stands) if j != i)
-        extra = {"more_stands": held}
+        extra: dict = {"more_stands": held}
         if fits:
             best = min(fits, key=lambda g: joint_cost(g[0]))[0]
             extra["near"] = _near_of(best)
