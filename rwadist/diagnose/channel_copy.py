@@ -198,7 +198,7 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
     skip = (LEVER_ARM_PAIRS - radial) | {(x.source, x.target) for x in found} | \
         {(a, x.target) for x in found for a in chans}
     got = find_broadband_copies(test, runs, chans, CLUSTER_TOLERANCE, skip)
-    got = [g for g in got if not offset_mirror(got, g)]
+    got = [g for g in got if not offset_mirror(got, g, PARTNER)]
     gain = {}
     for g in got:
         s, t = chans.index(g[0]), chans.index(g[1])

@@ -113,12 +113,11 @@ def _pair(per_run, s: int, t: int, tolerance: float):
     return kappa, tuple(int(r) for r in agree), float(np.median([x[1] for _, x in strong]))
 
 
-def offset_mirror(found: list, copy) -> bool:
+def offset_mirror(found: list, copy, partner: dict) -> bool:
     """Whether ``copy`` (source, target, κ, ...) of a radial force in a radial torque is a load-cell offset's r × F:
-    the partner pair reads −κ too (T_x = −r_z·F_y with T_y = r_z·F_x), among ``found`` (the pairs' tuples)."""
-    from .channel_copy import PARTNER
-
+    the partner pair reads −κ too (T_x = −r_z·F_y with T_y = r_z·F_x), among ``found`` (the pairs' tuples);
+    ``partner``: each radial channel's other channel of its pair."""
     cs, ct, kappa = copy[0], copy[1], copy[2]
     if cs not in ("Fx", "Fy") or ct not in ("Tx", "Ty"):
         return False
-    return any(x[0] == PARTNER[cs] and x[1] == PARTNER[ct] and abs(x[2] + kappa) <= 0.3 * abs(kappa) for x in found)
+    return any(x[0] == partner[cs] and x[1] == partner[ct] and abs(x[2] + kappa) <= 0.3 * abs(kappa) for x in found)
