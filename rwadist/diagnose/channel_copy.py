@@ -99,6 +99,9 @@ class ChannelCopy:
     runs: tuple
     level_dB: float
     alternatives: tuple = ()
+    #: read on the noise floor (:mod:`~rwadist.diagnose.channel_copy_broadband`): the null-scatter z of its
+    #: cross-spectrum (median over the runs), else 0 (read on the lines)
+    floor_z: float = 0.0
 
 
 def _run_points(run, chans, window: str):
@@ -164,6 +167,7 @@ def find_channel_copies(ctx, test=None) -> list:
             if got is not None and not _lever_arm_through_partner(got) and \
                     not _lever_arm_of_forces(got, X[mine], chans, run_of[mine], h[mine]):
                 found.append(got)
+    found += _floor_copies(test, runs, chans, found, X, noise, src, run_of, h)
     # a radial pair carrying the other radial pair's content alike (Tx = κ·Fx and Ty = κ·Fy) is the rotor's own
     # pattern (a force and a moment of one rotating source, in phase; the virtual stand's wheel without modes), not a
     # copy: a cross-sensitive channel reads one other channel, not its pair's partner too
@@ -174,10 +178,47 @@ def find_channel_copies(ctx, test=None) -> list:
     # is the same copy read backwards)
     out = []
     for ct in dict.fromkeys(x.target for x in found):
-        cands = sorted((x for x in found if x.target == ct and abs(x.kappa) < 1.0),
+        cands = sorted((x for x in found if x.target == ct and (abs(x.kappa) < 1.0 or x.floor_z > 0)),
                        key=lambda x: (-len(x.lines_h), -len(x.runs)))
         if cands:
             out.append(replace(cands[0], alternatives=tuple(x.source for x in cands[1:])))
+    return out
+
+
+def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
+    """The :class:`ChannelCopy` read on the noise floor (:func:`~rwadist.diagnose.channel_copy_broadband.
+    find_broadband_copies`) of the targets the lines gave none: a radial force in a radial torque tried too (a
+    load-cell offset's r × F, the partner pair reading −κ alike, left to ``cross_coupling``), the other
+    :data:`LEVER_ARM_PAIRS` not; of a pair read both ways the way whose removal takes the more of the target's power
+    at the source's lines (the copied lines leave the target; read backwards, the source's own lines stay).  ``X``,
+    ``noise``, ``src``, ``run_of``, ``h``: the lines' points of :func:`find_channel_copies`."""
+    from .channel_copy_broadband import find_broadband_copies, offset_mirror
+
+    radial = {("Fy", "Tx"), ("Fx", "Ty")}
+    skip = (LEVER_ARM_PAIRS - radial) | {(x.source, x.target) for x in found} | \
+        {(a, x.target) for x in found for a in chans}
+    got = find_broadband_copies(test, runs, chans, CLUSTER_TOLERANCE, skip)
+    got = [g for g in got if not offset_mirror(got, g, PARTNER)]
+    gain = {}
+    for g in got:
+        s, t = chans.index(g[0]), chans.index(g[1])
+        mine = src == s
+        Xs, Xt = X[mine, s], X[mine, t]
+        total = float(np.sum(np.abs(Xt) ** 2))
+        gain[g[:2]] = 1.0 - float(np.sum(np.abs(Xt - g[2] * Xs) ** 2)) / total if total > 0 else 0.0
+    out = []
+    for g in got:
+        back = (g[1], g[0])
+        if back in gain and gain[back] > gain[g[:2]]:
+            continue
+        s, t = chans.index(g[0]), chans.index(g[1])
+        mine = (src == s) & np.isin(run_of, g[3])
+        over = np.abs(g[2] * X[mine, s]) ** 2 / np.maximum(noise[mine, t], 1e-300)
+        heard = over >= 10 ** (MIN_COPY_DB / 10)
+        lines = [float(v) for v in np.unique(h[mine][heard]) if np.unique(run_of[mine][heard & (h[mine] == v)]).size
+                 >= MIN_RUNS]
+        level = float(10 * np.log10(np.median(over))) if over.size else float("nan")
+        out.append(ChannelCopy(g[0], g[1], g[2], tuple(lines), g[3], level, floor_z=g[4]))
     return out
 
 
@@ -394,6 +435,8 @@ def describe_channel_copies(ctx, copies, shares: dict) -> list:
     for i, cp in enumerate(copies):
         speeds = ctx.omega[list(cp.runs)] * RAD_S_TO_RPM
         f = np.array([h * ctx.omega[r] / (2 * np.pi) for h in cp.lines_h for r in cp.runs])
+        if f.size == 0:                 # read on the noise floor alone: every frequency of the spectra
+            f = np.asarray(ctx.sp.f, dtype=float)[[1, -1]]
         share, level = shares.get(i, (float("nan"), cp.level_dB))
         gain, phase = abs(cp.kappa), float(np.degrees(np.angle(cp.kappa)))
         alt = f" ({' or '.join((cp.source,) + cp.alternatives)}: their lines share a phase)" if cp.alternatives else ""
@@ -402,7 +445,8 @@ def describe_channel_copies(ctx, copies, shares: dict) -> list:
             f_Hz=(float(f.min()), float(f.max())), level_dB=level, share=share, n_runs=len(cp.runs),
             parameters={"source": cp.source, "target": cp.target, "gain": gain, "phase_deg": phase,
                         "lines_h": list(cp.lines_h), "copy_over_noise_dB": cp.level_dB,
-                        "other_sources": list(cp.alternatives), "removed_before_the_search": True},
+                        "other_sources": list(cp.alternatives), "removed_before_the_search": True,
+                        "read_on": "noise floor" if cp.floor_z > 0 else "lines", "floor_z": cp.floor_z},
             causes=(f"crosstalk: {cp.target} reads {gain:.3g} × {cp.source}{alt} (the load cell's {cp.target} bridge or "
                     f"its amplifier picking up {cp.source}, a calibration matrix missing that off-diagonal term, "
                     "or a wiring fault)",),

@@ -1,0 +1,123 @@
+"""A channel's copy of another read on the records' noise floor, where the target's own lines are not: the copy
+:func:`~rwadist.diagnose.channel_copy.find_channel_copies` misses on the lines when the target carries lines of its
+own at the source's ratios (trial21: Tx += 0.03 × Fy on an 11-kg wheel; Tx's own radial-torque lines at h 0.42, 1,
+3.3 as strong as 0.03 × Fy's, the ratios Tx/Fy scattering 0.01-0.5 from line to line, no cluster at κ).
+
+A copy carries the source's every component, its noise too: between the lines, in bins where neither channel has a
+line, the target's transform is κ × the source's plus the target's own noise, independent of the source's.  The
+cross-spectrum of the pair over those bins, summed over Welch segments, stands out of its null scatter
+(|Σ S_ts| / sqrt(Σ S_ss·S_tt / M), M segments) by a z of hundreds for a copy at 3 % (trial21: 172 in every run,
+the other pairs 0.5-3), with one ratio κ = Σ S_ts / Σ S_ss in every run and every part of the band.  A physical
+pair's broadband coherence (a structure's response to the wheel's random loads) has a transfer that changes with
+the frequency through the modes: one κ across the band (:data:`BAND_PARTS` parts, each within
+:data:`~rwadist.diagnose.channel_copy.CLUSTER_TOLERANCE` plus its noise's scatter) and across the runs is asked
+for.  A load-cell offset's r × F reads the same way on a force-torque pair (T_x = −r_z·F_y) but puts the mirror
+term into the partner torque too (T_y = r_z·F_x): a copy whose partner pair carries −κ alike is left to the
+``cross_coupling`` class.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import CHANNEL_DIRECTION
+
+#: A run's noise-bin cross-spectrum over its null scatter, at least (an independent pair: |z| ~ 1, Rayleigh).
+MIN_Z = 8.0
+#: Fraction of the runs that must hold the copy (z and κ).
+MIN_RUN_FRACTION = 0.6
+#: Parts of the noise bins (contiguous in frequency) whose κ must agree: a copy is flat in frequency.
+BAND_PARTS = 4
+#: A bin is a noise bin of a channel where its Welch power is under this factor of the channel's median.
+NOISE_FACTOR = 3.0
+#: Welch segment length (samples, at most; the record's eighth when shorter).
+NPERSEG = 2048
+
+
+def _segments(run, chans):
+    """(f (F,), Z (M, F, K)): the Hann-windowed FFTs of the run's half-overlapping segments of every channel."""
+    x = np.stack([np.asarray(run.signals[c], dtype=float) for c in chans])            # (K, n)
+    n = x.shape[1]
+    L = int(min(NPERSEG, 2 ** int(np.log2(max(n // 8, 16)))))
+    starts = np.arange(0, n - L + 1, L // 2)
+    w = np.hanning(L + 1)[:-1]
+    seg = np.stack([x[:, s:s + L] for s in starts])                                   # (M, K, L)
+    seg = (seg - seg.mean(axis=-1, keepdims=True)) * w
+    Z = np.fft.rfft(seg, axis=-1).transpose(0, 2, 1)                                  # (M, F, K)
+    return np.arange(Z.shape[1]) * run.sample_rate / L, Z
+
+
+def _run_stats(Z, s: int, t: int):
+    """(κ, z, parts κ, parts σ) of the pair (s, t) on one run's segments: over the bins where both are noise."""
+    Pss = np.mean(np.abs(Z[:, :, s]) ** 2, axis=0)
+    Ptt = np.mean(np.abs(Z[:, :, t]) ** 2, axis=0)
+    Pst = np.mean(np.conj(Z[:, :, s]) * Z[:, :, t], axis=0)
+    noise = (Pss < NOISE_FACTOR * np.median(Pss[4:])) & (Ptt < NOISE_FACTOR * np.median(Ptt[4:]))
+    noise[:4] = False
+    idx = np.flatnonzero(noise)
+    if idx.size < 4 * BAND_PARTS or np.sum(Pss[idx]) <= 0:
+        return None
+    M = Z.shape[0]
+    null = np.sum(Pss[idx] * Ptt[idx]) / M
+    if null <= 0:
+        return None
+    kappa = complex(np.sum(Pst[idx]) / np.sum(Pss[idx]))
+    z = float(abs(np.sum(Pst[idx])) / np.sqrt(null))
+    parts = np.array_split(idx, BAND_PARTS)
+    return kappa, z, [(np.sum(Pst[b]), np.sum(Pss[b]), np.sum(Pss[b] * Ptt[b]) / M) for b in parts]
+
+
+def find_broadband_copies(test, runs, chans, tolerance: float, skip=()) -> list:
+    """[(source, target, κ, runs, z median)] of the channel pairs of ``chans`` (not one direction's, not in
+    ``skip``) whose noise floors share one κ in :data:`MIN_RUN_FRACTION` of ``runs`` (indices of ``test.runs``) and
+    across the band (``tolerance``: the relative agreement asked for, besides the noise's own scatter)."""
+    per_run = []
+    for r in runs:
+        _, Z = _segments(test.runs[r], chans)
+        per_run.append((r, Z))
+    out = []
+    K = len(chans)
+    for s in range(K):
+        for t in range(K):
+            cs, ct = chans[s], chans[t]
+            if s == t or CHANNEL_DIRECTION[cs] == CHANNEL_DIRECTION[ct] or (cs, ct) in skip:
+                continue
+            got = _pair(per_run, s, t, tolerance)
+            if got is not None:
+                out.append((cs, ct) + got)
+    return out
+
+
+def _pair(per_run, s: int, t: int, tolerance: float):
+    """(κ, runs, z median) of the copy of channel s in t over ``per_run`` [(run, Z)], or None."""
+    stats = [(r, _run_stats(Z, s, t)) for r, Z in per_run]
+    stats = [(r, x) for r, x in stats if x is not None]
+    if not stats:
+        return None
+    strong = [(r, x) for r, x in stats if x[1] >= MIN_Z]
+    if len(strong) < MIN_RUN_FRACTION * len(per_run):
+        return None
+    num = sum(sum(p[0] for p in x[2]) for _, x in strong)
+    den = sum(sum(p[1] for p in x[2]) for _, x in strong)
+    kappa = complex(num / den)
+    # one ratio in every run (within the tolerance and the run's own scatter, |κ|/z)
+    agree = [r for r, x in strong if abs(x[0] - kappa) <= tolerance * abs(kappa) + 3.0 * abs(x[0]) / x[1]]
+    if len(agree) < MIN_RUN_FRACTION * len(per_run):
+        return None
+    # and in every part of the band: a copy is flat in frequency (a structure's transfer is not)
+    for j in range(BAND_PARTS):
+        st = sum(x[2][j][0] for _, x in strong)
+        ss = sum(x[2][j][1] for _, x in strong)
+        var = sum(x[2][j][2] for _, x in strong)
+        if ss <= 0 or abs(st / ss - kappa) > tolerance * abs(kappa) + 3.0 * np.sqrt(var) / ss:
+            return None
+    return kappa, tuple(int(r) for r in agree), float(np.median([x[1] for _, x in strong]))
+
+
+def offset_mirror(found: list, copy, partner: dict) -> bool:
+    """Whether ``copy`` (source, target, κ, ...) of a radial force in a radial torque is a load-cell offset's r × F:
+    the partner pair reads −κ too (T_x = −r_z·F_y with T_y = r_z·F_x), among ``found`` (the pairs' tuples);
+    ``partner``: each radial channel's other channel of its pair."""
+    cs, ct, kappa = copy[0], copy[1], copy[2]
+    if cs not in ("Fx", "Fy") or ct not in ("Tx", "Ty"):
+        return False
+    return any(x[0] == partner[cs] and x[1] == partner[ct] and abs(x[2] + kappa) <= 0.3 * abs(kappa) for x in found)
