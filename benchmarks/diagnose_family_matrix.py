@@ -306,6 +306,13 @@ def _described(r: dict) -> bool:
                for rec in r.get("unexplained_records", []))
 
 
+def _all_right(r: dict) -> bool:
+    """A cell with several things to find (a fixture pair, a fixture with an offset): modes within MODE_TOL or
+    declared, every one found, nothing else added, the error within ERROR_FACTOR of clean."""
+    return bool(r["modes_ok"] and all(r["found"]) and not r["added"] and r.get("error_ratio") is not None
+                and r["error_ratio"] <= ERROR_FACTOR)
+
+
 def _passes(r: dict, j: int = 0) -> bool:
     ok_err = r.get("error_ratio") is not None and r["error_ratio"] <= ERROR_FACTOR
     return bool(r["found"][j] and ok_err and not r["added"])
@@ -343,16 +350,14 @@ def summarize(rows: list) -> None:
               f"{sum(r.get('error_ratio') is not None and r['error_ratio'] <= ERROR_FACTOR for r in fx)}/{len(fx)}")
     fp = [r for r in rows if r["label"] == "fixture_pair" and "crashed" not in r]
     if fp:
-        ok = [r for r in fp if r["modes_ok"] and all(r["found"]) and not r["added"]
-              and r.get("error_ratio") is not None and r["error_ratio"] <= ERROR_FACTOR]
+        ok = [r for r in fp if _all_right(r)]
         print(f"fixture pairs: modes within {100 * MODE_TOL:g} % or declared {sum(r['modes_ok'] for r in fp)}/{len(fp)}; "
               f"both stands named {sum(all(r['found']) for r in fp)}/{len(fp)}; nothing else added "
               f"{sum(not r['added'] for r in fp)}/{len(fp)}; PASS {len(ok)}/{len(fp)} "
               f"(failed: {[r['wheel'] for r in fp if r not in ok]})")
     fo = [r for r in rows if r["label"] == "fixture_offset"]
     if fo:
-        ok = [r for r in fo if r["modes_ok"] and all(r["found"]) and not r["added"]
-              and r.get("error_ratio") is not None and r["error_ratio"] <= ERROR_FACTOR]
+        ok = [r for r in fo if _all_right(r)]
         print(f"fixtures with a load-cell offset: modes within {100 * MODE_TOL:g} % or declared "
               f"{sum(r['modes_ok'] for r in fo)}/{len(fo)} (wrong: {[(r['wheel'], r['cell']) for r in fo if not r['modes_ok']]}); "
               f"stand named {sum(bool(r['found'][0]) for r in fo)}/{len(fo)}; offset named "

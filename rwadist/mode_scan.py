@@ -317,16 +317,24 @@ def _windowed_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_part
         ai = np.arange(a_grid.size)
     if fi.size == f0_grid.size and ai.size == a_grid.size:
         return search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
-    sub = search(line, h, omega, power, f0_grid[fi], zeta_grid, a_grid[ai], two_parts)
+    return _part_first(search, (line, h, omega, power), f0_grid, zeta_grid, a_grid, two_parts, fi, ai)
+
+
+def _part_first(search, data: tuple, f_grid, z_grid, a_grid, two_parts, fi, ai) -> np.ndarray:
+    """``search(*data, f, ζ, a, two_parts)`` first on the part of the grid at f0 indices ``fi`` and I_zz/I_rr indices
+    ``ai`` (every ζ), the other points NaN: kept when the part's best point lies inside it (a point of the same grid,
+    so the whole grid's best whenever that lies in the part); the whole grid searched when the part's best lies on an
+    edge the whole grid goes beyond, or the part holds no finite cost."""
+    sub = search(*data, f_grid[fi], z_grid, a_grid[ai], two_parts)
     if np.all(np.isnan(sub)):
-        return search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+        return search(*data, f_grid, z_grid, a_grid, two_parts)
     i, _, k = np.unravel_index(np.nanargmin(sub), sub.shape)
-    on_edge = ((i == 0 and fi[0] > 0) or (i == fi.size - 1 and fi[-1] < f0_grid.size - 1)
+    on_edge = ((i == 0 and fi[0] > 0) or (i == fi.size - 1 and fi[-1] < f_grid.size - 1)
                or (k == 0 and ai[0] > 0) or (k == ai.size - 1 and ai[-1] < a_grid.size - 1))
     if on_edge:
-        return search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
-    out = np.full((f0_grid.size, zeta_grid.size, a_grid.size), np.nan)
-    out[np.ix_(fi, np.arange(zeta_grid.size), ai)] = sub
+        return search(*data, f_grid, z_grid, a_grid, two_parts)
+    out = np.full((f_grid.size, z_grid.size, a_grid.size), np.nan)
+    out[np.ix_(fi, np.arange(z_grid.size), ai)] = sub
     return out
 
 
@@ -352,17 +360,7 @@ def _fine_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts, f_cen
     if np.size(line) < FINE_PART_MIN_ROWS or fi.size < 3 or ai.size == 0 or \
             (fi.size == f_fine.size and ai.size == a_fine.size):
         return _screened_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
-    sub = _screened_search(line, h, omega, power, f_fine[fi], z_fine, a_fine[ai], two_parts)
-    if np.all(np.isnan(sub)):
-        return _screened_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
-    i, _, k = np.unravel_index(np.nanargmin(sub), sub.shape)
-    on_edge = ((i == 0 and fi[0] > 0) or (i == fi.size - 1 and fi[-1] < f_fine.size - 1)
-               or (k == 0 and ai[0] > 0) or (k == ai.size - 1 and ai[-1] < a_fine.size - 1))
-    if on_edge:
-        return _screened_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
-    out = np.full((f_fine.size, z_fine.size, a_fine.size), np.nan)
-    out[np.ix_(fi, np.arange(z_fine.size), ai)] = sub
-    return out
+    return _part_first(_screened_search, (line, h, omega, power), f_fine, z_fine, a_fine, two_parts, fi, ai)
 
 
 #: Largest I_zz/I_rr the rocking scan tries.  A rigid rotor about its centre of mass has I_zz <= 2 I_rr, but the
