@@ -7,6 +7,7 @@ from importlib.metadata import version
 
 import pytest
 
+from rwadist import progress
 from rwadist.cli import main
 from rwadist.progress import working
 
@@ -18,7 +19,9 @@ def test_version(capsys):
     assert capsys.readouterr().out.strip() == f"rwadist {version('rwadist')}"
 
 
-def test_working_line_ticks_while_the_stage_runs(capsys):
+def test_working_line_ticks_while_the_stage_runs(capsys, monkeypatch):
+    # stderr captured is no terminal: the progress is written as lines, here one per 0.2 s at most
+    monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.2)
     with working("searching", interval_s=0.2):
         time.sleep(1.3)
     err = capsys.readouterr().err
