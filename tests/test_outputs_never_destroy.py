@@ -345,7 +345,7 @@ def test_a_background_jobs_ignored_ctrl_c_stays_ignored(tmp_path):
 def test_ctrl_c_during_the_demo_is_never_swallowed(tmp_path):
     """During `demo` a Ctrl-C was sometimes swallowed (`Exception ignored in: WeakValueDictionary`) and the demo ran
     on to exit 0."""
-    for delay in (1.0, 2.0, 3.5):
+    for delay in (1.0, 2.0, 3.0):      # the demo runs 4.4-4.9 s here: a Ctrl-C after its end is no test
         code, err, lines = _interrupt(["demo", "--out", "d", "--n-speeds", "12"], delay, tmp_path)
         assert code == 130 and "Exception ignored" not in err and "Traceback" not in err, err
         assert len(lines) == 1 and "interrupted" in lines[0], err
