@@ -60,6 +60,9 @@ CONSISTENT = 0.8
 MIN_BINS = 12
 #: padded bins, from a peak, of the local noise a line is read against (the median at ±4..8 native bins)
 NOISE_BINS = PAD * np.array([-8, -6, -4, 4, 6, 8])
+#: a line beside the radial force's counts only when its reads cluster: their spread (1.4826·MAD of r) below this share
+#: of the spread of reads taken at random in the window (1.4826·SEARCH/2: noise's highest peak, wherever it falls)
+CLUSTERED = 0.25
 #: the three 1× lines: key -> (channels, text)
 LINES = {"radial_force": (("Fx", "Fy"), "radial force"), "radial_torque": (("Tx", "Ty"), "radial torque"),
          "axial_force": (("Fz",), "axial force")}
@@ -234,7 +237,9 @@ def check_record(test, reads: LineReads | None = None) -> dict:
         return {}
     ratios = line_ratios(test, (reads or LineReads())(test))
     stats = {key: _scale(r) for key, r in ratios.items()}
-    judged = {key: s for key, s in stats.items() if s[3] >= MIN_RUNS}
+    # a wheel without an axial 1x still has noise peaks 10x over the median in some runs, at random in the window
+    judged = {key: s for key, s in stats.items() if s[3] >= MIN_RUNS
+              and (key == "radial_force" or s[1] < CLUSTERED * 1.4826 * SEARCH / 2)}
     lines = {key: {"k": round(s[0], 7), "spread_rel": round(s[1], 7), "runs": s[3]} for key, s in judged.items()}
     rec: dict = {"lines": lines, "scale": None, "scaled": False, "runs": spinning}
     force = judged.get("radial_force")
