@@ -40,3 +40,19 @@ def test_non_finite_numbers_are_null_in_json():
     doc = _record(level_dB=float("nan"), h=float("inf"), parameters={"x": float("nan")}).to_json()
     assert doc["level_dB"] is None and doc["h"] is None and doc["parameters"]["x"] is None
     json.dumps(doc, allow_nan=False)
+
+
+def test_report_md_gives_each_record_the_strength_the_console_gives():
+    """report.md had printed every level as "dB over the model", a hump's peak over the floor's course and a law's
+    change of power over the speeds included (trial 21: "+1.5 dB over the model" for a line the model lacks); it now
+    words each as the console does (:meth:`Unexplained.strength`)."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose.report import unexplained_section
+
+    hump = _record(signature="broadband_hump", f_Hz=(120.0, 180.0), level_dB=6.3, parameters={})
+    line = _record(signature="speed_line", h=6.6, level_dB=1.5, parameters={})
+    lines = unexplained_section(SimpleNamespace(unexplained=(hump, line)))
+    assert "+6.3 dB over the floor's smooth course" in lines[2] and "over the model" not in lines[2]
+    assert "the data +1.5 dB over the model in its bins (median)" in next(ln for ln in lines if "speed_line" in ln)
+    assert hump.strength() in hump.text() and line.strength() in line.text()

@@ -262,7 +262,7 @@ def unexplained_section(diag: Diagnosis) -> list:
     out = ["Structure the residual holds above the noise that no effect class explains (described, not added to "
            "the model; marked on the residual waterfall):", ""]
     for i, u in enumerate(diag.unexplained, 1):
-        out.append(f"{i}. **{u.signature}** ({u.description}): {u.where()}; {u.level_dB:+.1f} dB over the model, "
+        out.append(f"{i}. **{u.signature}** ({u.description}): {u.where()}; {u.strength()}, "
                    f"{100.0 * u.share:.0f} % of the misplaced power left, {u.n_runs} runs.")
         par = ", ".join(f"{k} = {_fmt(v, '.5g')}" for k, v in u.parameters.items())
         if par:

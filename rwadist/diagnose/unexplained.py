@@ -46,6 +46,9 @@ SIGNATURES = {
 }
 
 #: How ``level_dB`` reads for the signatures whose level is not the data over the model in their cells.
+#: a level in words where :data:`LEVEL_WORDS` has none: the data's median over the model in its cells (a line the model
+#: lacks reads a small level where it stands little over the noise in them: trial 21's "+1.5 dB over the model")
+DEFAULT_LEVEL_WORDS = "the data {:+.1f} dB over the model in its bins (median)"
 LEVEL_WORDS = {
     "broadband_hump": "{:+.1f} dB over the floor's smooth course",
     "run_change": "the changed runs {} dB off the others",
@@ -153,7 +156,7 @@ class Unexplained:
         if self.signature == "run_change":
             return LEVEL_WORDS["run_change"].format(self._run_change_level())
         key = f"{self.signature}:{self.parameters.get('property')}"
-        out = LEVEL_WORDS.get(key, LEVEL_WORDS.get(self.signature, "{:+.1f} dB over the model")).format(self.level_dB)
+        out = LEVEL_WORDS.get(key, LEVEL_WORDS.get(self.signature, DEFAULT_LEVEL_WORDS)).format(self.level_dB)
         lift = _number(self.parameters.get("largest_line_lift_dB")) if self.signature == "moving_resonance" else None
         if lift is not None:
             out += f" in its track's bands, the lines it lifts up to {lift:+.1f} dB"
