@@ -104,6 +104,9 @@ family-matrix rows bit for bit.  --quick --repeats 3 at load 8.5-9.9 on 2 cores 
 measured again: the suspension-mode least squares has its analytic Jacobian (0.06 s of the sixty set's diagnose),
 no grid search or record transform repeats its arguments within a diagnose (so nothing to cache), and every BLAS
 pool holds one thread, scipy's loaded after start-up included (threadpoolctl; their idle threads ~0 CPU).
+2026-12-01, session 22: speed21's part-first refinement removed -- not the same numbers on every data set: family
+wheel 7's 60 s run-up (benchmarks/sweep_speed_family.py) kept a local minimum of the part, rocking +2.04 % (its
+rows: tests/data/scan_rocking_runup_wheel7.json); the refinement grid is searched whole again.
 """
 from __future__ import annotations
 

@@ -20,8 +20,7 @@ worse by a log-likelihood ratio of at least ``min_log_lr`` (n/2·ln(SSR/SSR_best
 2.0 is about the 95 % level of one parameter, Δχ² = 3.84) -- the data then exclude a frequency
 error larger than the tolerance.  The profile uses f0 steps of 1 % (2 % when a is scanned), ζ steps
 of a factor 1.6 (2.0) and a-steps of 0.2; the best point is refined to 0.1 % (the least squares that
-follows refines it; that grid is searched within ±2 % and ±0.1 of a first, and whole only when
-its best point lies on that part's edge, or with fewer than 64 measurements: :func:`_fine_search`).  Otherwise the data do not
+follows refines it).  Otherwise the data do not
 constrain the mode (no line comes near it, only a skirt is seen, or the whirl it shows trades off
 against I_zz/I_rr) and the result says so; nothing is invented.
 
@@ -338,31 +337,6 @@ def _part_first(search, data: tuple, f_grid, z_grid, a_grid, two_parts, fi, ai) 
     return out
 
 
-#: Half-width (relative f0) and I_zz/I_rr half-width of the part of the refinement grid :func:`_fine_search` searches
-#: first: the coarse step either side of the coarse best point (2 % when I_zz/I_rr is scanned) and half the a-range
-FINE_F_SPAN = 0.02
-FINE_A_SPAN = 0.1
-#: ... with this many measurements at least; fewer (the 19-20 radial-torque rows of a 16-24 speed family cell) leave
-#: near-equal minima apart in the refinement grid, and the part's interior best missed the whole grid's (family wheel
-#: 2 of 1x-translation fixture: 49.66 Hz, a = 2.21 for 50.36 Hz, a = 2.163; wheel 7 of 1.5x-rocking fixture), while
-#: such a grid is cheap: searched whole
-FINE_PART_MIN_ROWS = 64
-
-
-def _fine_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts, f_centre: float, a_centre: float):
-    """:func:`_screened_search` of the refinement grid (``f_fine`` x ``z_fine`` x ``a_fine``), first on its points
-    within ±:data:`FINE_F_SPAN` (relative) of the coarse best f0 ``f_centre`` and ±:data:`FINE_A_SPAN` of its
-    I_zz/I_rr ``a_centre`` (every ζ), the others NaN: kept when the best point lies inside that part, the whole grid
-    searched when it lies on an edge the grid goes beyond (the rule of :func:`_windowed_search`: the whole grid's best
-    point whenever that lies in the part); the whole grid at once with fewer than :data:`FINE_PART_MIN_ROWS` rows."""
-    fi = np.flatnonzero(np.abs(np.log(f_fine / f_centre)) <= FINE_F_SPAN + 1e-9)
-    ai = np.flatnonzero(np.abs(a_fine - a_centre) <= FINE_A_SPAN + 1e-9) if a_fine.size > 1 else np.arange(a_fine.size)
-    if np.size(line) < FINE_PART_MIN_ROWS or fi.size < 3 or ai.size == 0 or \
-            (fi.size == f_fine.size and ai.size == a_fine.size):
-        return _screened_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
-    return _part_first(_screened_search, (line, h, omega, power), f_fine, z_fine, a_fine, two_parts, fi, ai)
-
-
 #: Largest I_zz/I_rr the rocking scan tries.  A rigid rotor about its centre of mass has I_zz <= 2 I_rr, but the
 #: ratio the whirls show is an effective one (a flexible rotor or rim, rocking coupled with other motion, a test
 #: generator outside that bound): measured wheels and the family's (I_zz/I_rr up to 2.2) go beyond 2, and a scan
@@ -427,8 +401,11 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     f_fine = f0_grid[i] * np.exp(np.arange(-2 * f_step - 0.01, 2 * f_step + 0.0101, 0.001))
     z_fine = zeta_grid[j] * np.exp(np.linspace(-0.5, 0.5, 11) * (1 if a_grid.size == 1 else 1.5))
     a_fine = a_grid if a_grid.size == 1 else np.unique(np.clip(a_grid[k] + np.linspace(-0.2, 0.2, 21), 0.02, A_MAX))
-    # the refinement grid screened in single precision too: its best point is the double-precision grid's
-    fine = _fine_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts, f0_grid[i], a_grid[k])
+    # the refinement grid screened in single precision too: its best point is the double-precision grid's.  Searched
+    # whole: its part within ±2 % and ±0.1 of the coarse best point, searched first (session 21), kept an interior
+    # local minimum 7x the whole grid's least SSR on family wheel 7's 60 s run-up (rocking 132.7 Hz, a 2.05 for
+    # 130.1 Hz, a 2.10; truth 130 Hz, 2.10: tests/test_fast_paths.py)
+    fine = _screened_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
     fi, fj, fk = np.unravel_index(np.nanargmin(fine), fine.shape)
     best = float(fine[fi, fj, fk])
     f_best, z_best, a_best = float(f_fine[fi]), float(z_fine[fj]), float(a_fine[fk])

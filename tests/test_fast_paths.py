@@ -4,6 +4,9 @@ window's closed-form transform against its plain sum, the batched whole-run DFT 
 empirical fit reusing the first one's detections against a fresh one, the suspension-mode fit's spectra taken
 from every run's against those of its runs alone, and the mode scan searched first near an earlier fit's mode against
 the scan of its whole grid."""
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy import optimize, signal
@@ -102,39 +105,17 @@ def test_scan_near_an_earlier_fit_is_the_whole_grid_scan():
     assert 50.0 < scan_mode("rocking", line, h, omega, power, min_log_lr=-np.inf).f0_hz < 60.0    # the case's 55 Hz
 
 
-def test_scan_refinement_part_first_is_the_whole_refinement_grid():
-    # every scan refines its coarse best point on a finer grid (f0 ±5 % or ±3 %, ζ, I_zz/I_rr ±0.2), searched first
-    # within ±2 % and ±0.1 of that point with 64 rows or more (mode_scan._fine_search): the same best point as the whole
-    # refinement grid's, bit for bit, and the whole grid searched when the part's best lies on its edge (a centre put
-    # 4 % off) or the rows are fewer
-    import rwadist.mode_scan as ms
-
-    def whole_grid(line, h, omega, power, f, z, a, two, f_centre, a_centre):
-        return ms._screened_search(line, h, omega, power, f, z, a, two)
-
-    for seed in (3, 5, 7, 11):
-        line, h, omega, power = _scan_case(seed=seed, n_speeds=20)    # 80 rows: the part first
-        for mode, two in (("rocking", True), ("radial_translation", True), ("axial_translation", False)):
-            args = (mode, line, h, omega, power if two else np.sqrt(power))
-            for min_log_lr in (-np.inf, 2.0):
-                got = scan_mode(*args, min_log_lr=min_log_lr)
-                with pytest.MonkeyPatch.context() as mp:
-                    mp.setattr(ms, "_fine_search", whole_grid)
-                    whole = scan_mode(*args, min_log_lr=min_log_lr)
-                assert (got.found, got.f0_hz, got.zeta, got.inertia_ratio, got.reason) == \
-                    (whole.found, whole.f0_hz, whole.zeta, whole.inertia_ratio, whole.reason), (seed, mode)
-        # the part's edge: the refinement grid about 55 Hz searched first about 4 % and 0.15 away from its best
-        f = 55.0 * np.exp(np.arange(-0.05, 0.0501, 0.001))
-        z, a = 0.04 * np.exp(np.linspace(-0.75, 0.75, 11)), np.round(np.arange(1.4, 1.801, 0.02), 10)
-        full = ms._screened_search(line, h, omega, power, f, z, a, True)
-        best = np.unravel_index(np.nanargmin(full), full.shape)
-        for f_centre, a_centre in ((f[best[0]] * 1.04, a[best[2]] + 0.15), (f[best[0]] / 1.04, a[best[2]] - 0.15),
-                                   (f[best[0]], a[best[2]])):
-            part = ms._fine_search(line, h, omega, power, f, z, a, True, f_centre, a_centre)
-            assert np.unravel_index(np.nanargmin(part), part.shape) == best and part[best] == full[best], seed
-        assert np.isnan(ms._fine_search(line, h, omega, power, f, z, a, True, f[best[0]], a[best[2]])).any()
-        few = _scan_case(seed=seed)                                     # 36 rows: the whole grid
-        assert not np.isnan(ms._fine_search(*few, f, z, a, True, f[best[0]], a[best[2]])).any()
+def test_scan_refinement_searches_its_whole_grid():
+    """The refinement grid about the coarse best point was searched within ±2 % and ±0.1 of it first (session 21),
+    its interior best kept: on family wheel 7's 60 s run-up the part held a local minimum at 132.7 Hz, a 2.05 with 7x
+    the least SSR of the whole grid's 130.1 Hz, a 2.10 (the generator's 130 Hz, 2.100), and the diagnosis moved the
+    rocking +2.04 %.  The rows recorded there (tests/data/scan_rocking_runup_wheel7.json) give the generator's mode."""
+    doc = json.loads((Path(__file__).parent / "data" / "scan_rocking_runup_wheel7.json").read_text())
+    rows = [np.asarray(doc[k]) for k in ("line", "h", "omega", "power")]
+    for min_log_lr in (-np.inf, 2.0):
+        got = scan_mode("rocking", *rows, min_log_lr=min_log_lr)
+        assert got.found and got.f0_hz == pytest.approx(doc["truth"]["rocking_Hz"], rel=0.002)
+        assert got.inertia_ratio == pytest.approx(doc["truth"]["inertia_ratio"], abs=0.01)
 
 
 def test_hann_transform_is_the_window_sum():
