@@ -256,7 +256,9 @@ class FixedResonance:
     peak_gain: float
     channels: tuple
     role: str
-    n_points: int = 0
+    #: line measurements its own fit used; None for one taken from an extended fit (of_stand, of_structure), whose
+    #: lines that fit counts (trial21 read a stand's 0 as "fitted on nothing")
+    n_points: int | None = None
     kind: str = "fixed_resonance"
     #: (f_r Hz, ζ, peak gain) of the stand an extended fit located at its own resolution (the wheel's
     #: ``suspension_modes`` on every run, or the given model's reference fit), for a resonance proposed from it
