@@ -104,6 +104,21 @@ family-matrix rows bit for bit.  --quick --repeats 3 at load 8.5-9.9 on 2 cores 
 measured again: the suspension-mode least squares has its analytic Jacobian (0.06 s of the sixty set's diagnose),
 no grid search or record transform repeats its arguments within a diagnose (so nothing to cache), and every BLAS
 pool holds one thread, scipy's loaded after start-up included (threadpoolctl; their idle threads ~0 CPU).
+2026-12-01, session 22 (speed22): the channel copies read on the noise floor (channel_copy_broadband, part of
+describe.start before the search) made each channel's segment power and noise bins once per run instead of once per
+pair (22 pairs x 24 runs), a run's band parts only where its z reaches MIN_Z, sums by np.add.reduce: that step
+0.16 -> 0.07 s (30 sixty-set runs), the same statistics bit for bit (tests/test_diagnose_speed.py), the diagnose
+summaries of both sets and the family matrix's 28 rows of wheels 0-3 (clean, fixtures, amplitude_law, sidebands,
+counter_rotation) identical.  --quick --repeats 3 --busy 2, land 0c473d5 and speed22 alternated (land, new, new, land)
+at load 6-8.5 on 2 cores (other agents' jobs): sixty diagnose cpu min 1.46/1.42 s -> 1.35/1.37 s (idle), 1.53/1.51 ->
+1.42/1.47 s (2 busy); cpu min/median x14.1/x14.2, x14.0/x14.0 -> x13.2/x13.0, x13.3/x13.4 (idle), x14.0/x13.4,
+x13.7/x13.8 -> x13.2/x13.1, x13.4/x13.2 (2 busy); benchmark x11.5/x9.1, x10.4/x9.1 -> x11.0/x8.7, x8.9/x8.6 (idle),
+x10.4/x10.3, x10.6/x9.4 -> x8.7/x8.8, x8.7/x8.1 (2 busy): target not met on the sixty set.  Where the sixty set's
+1.39 s go (in-call CPU timers, one process): the suspension modes' candidates on the fit runs 0.32 s (its whole-data
+empirical fit at the fit's resolution 0.10 s, the mode scans 0.16 s with the refit's) and refit on every run 0.14 s;
+the other 11 families' candidates over 2 search steps 0.46 s, none over 0.075 s a step; the held-out judge 0.09 s;
+the 1x checks 0.08 s; describe.start 0.08 s (of which the channel copies 0.07 s); compute_spectra 0.07 s;
+describe.finish 0.06 s; the state errors 0.08 s; the starting empirical fit 0.04 s.
 2026-12-01, session 22: speed21's part-first refinement removed -- not the same numbers on every data set: family
 wheel 7's 60 s run-up (benchmarks/sweep_speed_family.py) kept a local minimum of the part, rocking +2.04 % (its
 rows: tests/data/scan_rocking_runup_wheel7.json); the refinement grid is searched whole again.

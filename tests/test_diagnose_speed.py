@@ -131,3 +131,55 @@ def test_flat_no_resonance_stop_keeps_the_decision(monkeypatch):
                     (full.f_r, full.zeta, full.peak_gain), rel=1e-6)
         if stand:
             assert fr._is_resonance_gain(fits[1][-1].peak_gain) and fits[1][-1].f_r == pytest.approx(150.0, rel=0.01)
+
+
+def _pair_stats_written_out(Z, s, t):
+    """The noise-bin statistics of channel pair (s, t) of one run's segments Z (M, F, K), straight from their definition
+    (:mod:`rwadist.diagnose.channel_copy_broadband`): each channel's mean segment power, the bins where both are under
+    NOISE_FACTOR x their median above bin 4, the cross-spectrum's sum over the power's (κ), its z over the null scatter,
+    and per part of the bins (np.array_split) the sums of the cross-spectrum, the source's power and their null
+    variance."""
+    from rwadist.diagnose.channel_copy_broadband import BAND_PARTS, NOISE_FACTOR
+
+    Pss = np.mean(np.abs(Z[:, :, s]) ** 2, axis=0)
+    Ptt = np.mean(np.abs(Z[:, :, t]) ** 2, axis=0)
+    Pst = np.mean(np.conj(Z[:, :, s]) * Z[:, :, t], axis=0)
+    noise = (Pss < NOISE_FACTOR * np.median(Pss[4:])) & (Ptt < NOISE_FACTOR * np.median(Ptt[4:]))
+    noise[:4] = False
+    idx = np.flatnonzero(noise)
+    M = Z.shape[0]
+    null = np.sum(Pss[idx] * Ptt[idx]) / M
+    kappa = complex(np.sum(Pst[idx]) / np.sum(Pss[idx]))
+    z = float(abs(np.sum(Pst[idx])) / np.sqrt(null))
+    parts = [(np.sum(Pst[b]), np.sum(Pss[b]), np.sum(Pss[b] * Ptt[b]) / M) for b in np.array_split(idx, BAND_PARTS)]
+    return kappa, z, parts
+
+
+def test_floor_copy_pair_statistics_are_their_definition_bit_for_bit():
+    """The channel-copy floor statistics made per channel once and summed by np.add.reduce (its speed-up) are the
+    numbers of their definition written out, to the last bit, for a pair holding a copy (z in the tens: its band parts
+    too) and for independent pairs (z ~ 1: κ and z; their parts are not read below MIN_Z)."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose.channel_copy_broadband import MIN_Z, _channel_stats, _run_stats, _segments
+
+    rng = np.random.default_rng(7)
+    n, fs = 8192, 3840.0
+    t = np.arange(n) / fs
+    x = {c: rng.normal(0.0, 1.0, n) + 3.0 * np.sin(2 * np.pi * f * t) for c, f in zip("abcd", (37.0, 81.0, 50.0, 123.0))}
+    x["d"] = x["d"] + 0.3 * x["a"]                       # d carries a copy of a, noise and line alike
+    _, Z = _segments(SimpleNamespace(signals=x, sample_rate=fs), tuple(x))
+    stats = _channel_stats(Z)
+    strong = 0
+    for s in range(4):
+        for u in range(4):
+            if s == u:
+                continue
+            want, got = _pair_stats_written_out(Z, s, u), _run_stats(Z, stats, s, u)
+            assert got[:2] == want[:2]
+            if want[1] >= MIN_Z:
+                strong += 1
+                assert got[2] == want[2]
+            else:
+                assert got[2] is None
+    assert strong == 2                                  # a -> d and d -> a

@@ -46,24 +46,46 @@ def _segments(run, chans):
     return np.arange(Z.shape[1]) * run.sample_rate / L, Z
 
 
-def _run_stats(Z, s: int, t: int):
-    """(κ, z, parts κ, parts σ) of the pair (s, t) on one run's segments: over the bins where both are noise."""
-    Pss = np.mean(np.abs(Z[:, :, s]) ** 2, axis=0)
-    Ptt = np.mean(np.abs(Z[:, :, t]) ** 2, axis=0)
-    Pst = np.mean(np.conj(Z[:, :, s]) * Z[:, :, t], axis=0)
-    noise = (Pss < NOISE_FACTOR * np.median(Pss[4:])) & (Ptt < NOISE_FACTOR * np.median(Ptt[4:]))
+def _channel_stats(Z) -> tuple:
+    """(P, quiet) of one run's segments ``Z`` (M, F, K): each channel's mean segment power P[k] (F,) and its noise
+    bins quiet[k] (F,) bool, power under :data:`NOISE_FACTOR` x its median above bin 4.  Made once per run and
+    channel, not once per pair: each channel is in up to 2(K-1) pairs (the same expressions, so the same bits)."""
+    P = [np.mean(np.abs(Z[:, :, k]) ** 2, axis=0) for k in range(Z.shape[2])]
+    quiet = [p < NOISE_FACTOR * np.median(p[4:]) for p in P]
+    return P, quiet
+
+
+def _run_stats(Z, stats: tuple, s: int, t: int):
+    """(κ, z, parts κ, parts σ) of the pair (s, t) on one run's segments: over the bins where both are noise;
+    ``stats``: the run's :func:`_channel_stats`.  The parts (read only of a run where z reaches :data:`MIN_Z`) are
+    None below it.  Sums by ``np.add.reduce`` (what ``np.sum`` calls, without its Python layers: ~20 sums per pair
+    and run)."""
+    P, quiet = stats
+    noise = quiet[s] & quiet[t]
     noise[:4] = False
     idx = np.flatnonzero(noise)
-    if idx.size < 4 * BAND_PARTS or np.sum(Pss[idx]) <= 0:
+    Pss = P[s][idx]
+    total = np.add.reduce(Pss)
+    if idx.size < 4 * BAND_PARTS or total <= 0:
         return None
     M = Z.shape[0]
-    null = np.sum(Pss[idx] * Ptt[idx]) / M
+    both = Pss * P[t][idx]
+    null = np.add.reduce(both) / M
     if null <= 0:
         return None
-    kappa = complex(np.sum(Pst[idx]) / np.sum(Pss[idx]))
-    z = float(abs(np.sum(Pst[idx])) / np.sqrt(null))
-    parts = np.array_split(idx, BAND_PARTS)
-    return kappa, z, [(np.sum(Pst[b]), np.sum(Pss[b]), np.sum(Pss[b] * Ptt[b]) / M) for b in parts]
+    # the cross-spectrum of every bin, from the channels' strided columns: a product of contiguous copies of the
+    # noise bins alone takes numpy's vector loop, whose complex products differ in the last bit
+    Pst = np.mean(np.conj(Z[:, :, s]) * Z[:, :, t], axis=0)[idx]
+    cross = np.add.reduce(Pst)
+    kappa = complex(cross / total)
+    z = float(abs(cross) / np.sqrt(null))
+    if z < MIN_Z:
+        return kappa, z, None
+    # BAND_PARTS contiguous parts of the noise bins, sized as np.array_split's
+    n, k = divmod(idx.size, BAND_PARTS)
+    ends = np.cumsum([0] + [n + 1] * k + [n] * (BAND_PARTS - k))
+    return kappa, z, [(np.add.reduce(Pst[i:j]), np.add.reduce(Pss[i:j]), np.add.reduce(both[i:j]) / M)
+                      for i, j in zip(ends[:-1], ends[1:])]
 
 
 def find_broadband_copies(test, runs, chans, tolerance: float, skip=()) -> list:
@@ -73,7 +95,7 @@ def find_broadband_copies(test, runs, chans, tolerance: float, skip=()) -> list:
     per_run = []
     for r in runs:
         _, Z = _segments(test.runs[r], chans)
-        per_run.append((r, Z))
+        per_run.append((r, Z, _channel_stats(Z)))
     out = []
     K = len(chans)
     for s in range(K):
@@ -88,8 +110,8 @@ def find_broadband_copies(test, runs, chans, tolerance: float, skip=()) -> list:
 
 
 def _pair(per_run, s: int, t: int, tolerance: float):
-    """(κ, runs, z median) of the copy of channel s in t over ``per_run`` [(run, Z)], or None."""
-    stats = [(r, _run_stats(Z, s, t)) for r, Z in per_run]
+    """(κ, runs, z median) of the copy of channel s in t over ``per_run`` [(run, Z, its channel stats)], or None."""
+    stats = [(r, _run_stats(Z, cs, s, t)) for r, Z, cs in per_run]
     stats = [(r, x) for r, x in stats if x is not None]
     if not stats:
         return None
