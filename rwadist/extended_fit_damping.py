@@ -144,7 +144,7 @@ def fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tol
     while True:
         solution, loose = free_off_law_lines(
             lambda lns: problem.solve(free_modes, lns), lambda sol: loose_modes(sol, free_modes, problem.base, tolerance),
-            off_law, problem.row_line, log_w, lawful_lines(problem.meas_lines))
+            off_law, problem.row_line, log_w, lawful_lines(problem.meas_lines), [x.h for x in problem.meas_lines])
         if declare and hold_unmeasured_damping(problem, solution, free_modes, zeta0, zeta_bounds, intervals):
             continue
         if not loose or not declare:

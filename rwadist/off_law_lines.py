@@ -16,7 +16,13 @@ from .extended import IMBALANCE_H_TOL
 
 #: Lines of a law other than C·Ω² whose exponent the least squares may free before a mode is declared not
 #: constrained (:func:`off_law_line`): one such line (an amplitude law, a foreign load) is what drags a mode to the
-#: ±5 % limit while every other line places it.
+#: ±5 % limit while every other line places it.  Beyond it, only the other directions' lines of a harmonic already
+#: freed: a law of a line's source (a bearing defect's impacts) is the law of that harmonic in every direction it
+#: loads -- radial force, radial torque, axial force, each a measured line of the fit -- and one of them left C·Ω²
+#: drags the mode it crosses (trial21's Ω^2.6 on h 3.3: radial force and Fz freed, the radial torque's crossing of
+#: the forward whirl at 1064 rpm pulled the rocking damping to 0.0545, truth 0.02).  A third harmonic is not freed:
+#: family wheel 0's axial resonance stiffening with speed lifts its h 3.08 lines, and a third freed harmonic (4.92)
+#: left the axial mode to be declared instead of fitted beside that resonance.
 MAX_OFF_LAW_LINES = 2
 #: A line is off its C·Ω² law when the trend of its log residual in ln|Ω| (its exponent shift) lies at least this
 #: many standard errors from 0 ...
@@ -61,12 +67,14 @@ def line_regressors(ax_line: np.ndarray, rad_line: np.ndarray, ax_omega: np.ndar
 
 
 def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, log_w: np.ndarray,
-                       lawful: tuple = ()):
+                       lawful: tuple = (), line_h=None):
     """(fit, loose) of the least squares ``fit_with(off_law)`` (a tuple whose first item is the scipy result) with
     ``loose_of(fit)`` its modes not pinned; while fewer than :data:`MAX_OFF_LAW_LINES` lines are freed, the line
     :func:`off_law_line` picks (never one of ``lawful``: the imbalances, whose U·Ω² is their physics,
     :func:`lawful_lines`) is freed when that pins more modes, or as many and explains the lines better by more than
-    its one parameter (:func:`_explains_more`; ``off_law`` is appended in place).
+    its one parameter (:func:`_explains_more`; ``off_law`` is appended in place).  Once :data:`MAX_OFF_LAW_LINES`
+    lines are freed, only the other directions' lines of a harmonic already freed may follow (``line_h``: each
+    measured line's h; None: none may).
 
     Is one line of another law (an amplitude law on one harmonic, Ω³ where the model says Ω²) dragging the modes off
     while the other lines place them?  Before a located mode is declared not constrained, and also when every mode is
@@ -76,8 +84,14 @@ def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, 
     (:func:`off_law_note`), for ``rwadist diagnose`` to name its law."""
     fit = fit_with(off_law)
     loose = loose_of(fit)
-    while len(off_law) < MAX_OFF_LAW_LINES:
-        j = off_law_line(fit[0].fun, row_line, log_w, list(off_law) + list(lawful))
+    harmonic = (lambda j: round(float(line_h[j]), 3)) if line_h is not None else (lambda j: j)
+    n_lines = int(row_line.max()) + 1 if row_line.size else 0
+    while True:
+        skip = list(off_law) + list(lawful)
+        if len(off_law) >= MAX_OFF_LAW_LINES:
+            freed = {harmonic(k) for k in off_law}
+            skip += [k for k in range(n_lines) if harmonic(k) not in freed]
+        j = off_law_line(fit[0].fun, row_line, log_w, skip)
         if j is None:
             break
         trial = fit_with(off_law + [j])

@@ -9,6 +9,7 @@ import numpy as np
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.measure import in_unresolved_span, measure_run_powers
+from ..diagnose.mode_reach import crossing_groups
 from ..diagnose.state import State
 from ..stand_resonance import STAND_MIN_LOG_GAIN, log_power_gain
 from ..units import DIRECTION_CHANNELS
@@ -67,6 +68,24 @@ def _stand_reach(state: State, h: float, w: np.ndarray) -> np.ndarray:
     return reach
 
 
+def _mode_sides(state: State, direction: str, h: float, w, X, y, leak, var_noise) -> tuple:
+    """((exponent, its standard error, the number of runs), ...) fitted on each stretch of runs between the line's
+    crossings of the state's suspension modes, out of their reach (:func:`rwadist.diagnose.mode_reach.crossing_groups`),
+    that holds 5 runs or more over a speed ratio of e^0.3 or more (the least :meth:`AmplitudeLaw.fit` fits a law on);
+    () on the empirical base or when the line crosses no mode."""
+    senses = [getattr(x, "sense", None) or "co" for x in state.model.harmonics(direction) if abs(x.h - h) < 1e-3]
+    group = crossing_groups(state, direction, h, senses or ["co"], w)
+    if group.max(initial=0) == 0 and not (group < 0).any():
+        return ()
+    out = []
+    for g in np.unique(group[group >= 0]):
+        m = group == g
+        if m.sum() >= 5 and np.ptp(np.log(w[m])) >= 0.3:
+            c, v = _law_lsq(X[m], y[m], leak[m], var_noise[m])
+            out.append((float(c[1]), float(np.sqrt(v[1, 1])), int(m.sum())))
+    return tuple(out)
+
+
 @register(order=20)
 @dataclass
 class AmplitudeLaw:
@@ -84,6 +103,10 @@ class AmplitudeLaw:
     #: run (:meth:`significant`; written as ``exponent_beyond_stand``, ``exponent_beyond_stand_stderr`` and
     #: ``runs_beyond_stand``, :meth:`params`)
     beyond_stand: tuple | None = None
+    #: ((exponent, its standard error, the number of runs), ...) fitted on each stretch of runs between the line's
+    #: crossings of the wheel's suspension modes (a whirl branch included), out of the modes' reach
+    #: (:func:`_mode_sides`); () when it crosses none or on the empirical base (:meth:`significant`)
+    mode_sides: tuple = ()
     kind: str = "amplitude_law"
     #: it adds no line, only changes the amplitude of one the state has: judged with that line's beats at its own
     #: amplitudes (:func:`rwadist.diagnose.search._evidence`)
@@ -138,7 +161,20 @@ class AmplitudeLaw:
             p, se = self.beyond_stand[:2]
             if not told(p, se) or (p > 2.0) != (self.exponent > 2.0):
                 return False
+        if not all(self._side_agrees(p, se, told) for p, se, _ in self.mode_sides):
+            return False
         return told(self.exponent, self.exponent_stderr)
+
+    def _side_agrees(self, p: float, se: float, told) -> bool:
+        """Whether the exponent ``p`` ± ``se`` fitted between two of the line's mode crossings (:attr:`mode_sides`)
+        does not contradict the law: told from 2 on the law's side, or not told from the law's own exponent (a
+        stretch of weak runs measures little).  A stretch whose exponent is 2 to its standard errors and told from
+        the law's is a line that follows Ω² there: the law over every run was a step at a crossing (a misfit of the
+        fitted mode's frequency or damping, divided out of the line's measurement) read as a slope
+        (:mod:`rwadist.diagnose.mode_reach`)."""
+        if told(p, se):
+            return (p > 2.0) == (self.exponent > 2.0)
+        return not abs(p - self.exponent) > EXPONENT_Z * se
 
     def to_schema(self) -> dict:
         return schema_entry(self)
@@ -175,8 +211,9 @@ class AmplitudeLaw:
             if out.sum() >= 5 and np.ptp(np.log(w[out])) >= 0.3:
                 c2, v2 = _law_lsq(X[out], np.log(d[out]), leak[out], var_noise[out])
                 beyond = (float(c2[1]), float(np.sqrt(v2[1, 1])), int(out.sum()))
+        sides = _mode_sides(state, direction, h, w, X, np.log(d), leak, var_noise)
         return AmplitudeLaw(direction, float(h), float(coef[1]), float(np.exp(coef[0])), w_ref,
-                            float(np.sqrt(cov[1, 1])), beyond)
+                            float(np.sqrt(cov[1, 1])), beyond, sides)
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
