@@ -414,6 +414,8 @@ MORE_STAND_STARTS = 1
 
 
 def beside_more_stands(test, fit, joint, kwargs):
+    from .stand_every import fit_every_stand
+
     """The joint fit ``joint`` (the modes beside one confirmed stand or more: its ``stand`` and ``more_stands``) with
     each further fixture resonance the lines show beside them fitted too, up to :data:`MAX_STANDS` in all.
 
@@ -437,7 +439,8 @@ def beside_more_stands(test, fit, joint, kwargs):
         if not stand_confirmed(got[0], joint, got[1]):
             break
         joint = got[0]
-    return joint
+    # each found while the others were held: all of them fitted again at once with the modes
+    return fit_every_stand(test, fit, joint, kwargs)
 
 
 def _with_new_stand(test, fit, known: tuple, start: tuple, kwargs) -> tuple:
