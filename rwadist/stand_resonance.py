@@ -429,7 +429,8 @@ def beside_more_stands(test, fit, joint, kwargs):
     held (each was fitted while the new one was still in the lines), twice round: of these fits the least cost is
     kept when the new stand is confirmed over the fit without it (:func:`stand_confirmed`: a fixture resonance, worth
     its parameters, lifting every direction).  Trial20 seed 22, every run: the rounds' costs 1.33, 0.53, 0.30, 0.23,
-    the stands 127.86 Hz (ζ 0.0298, gain 4.97) and 208.22 Hz (ζ 0.0263, gain 5.11), the modes within 0.1 %."""
+    the stands 127.86 Hz (ζ 0.0298, gain 4.97) and 208.22 Hz (ζ 0.0263, gain 5.11), the modes within 0.1 %.  Then
+    every stand is fitted again at once with the modes (:func:`rwadist.stand_every.fit_every_stand`)."""
     for _ in range(MAX_STANDS - 1 - len(joint.more_stands)):
         known = (joint.stand,) + tuple(joint.more_stands)
         starts = stand_starts(fit, known=known)[:MORE_STAND_STARTS]
