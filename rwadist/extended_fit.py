@@ -67,7 +67,6 @@ from .model import Harmonic
 from .off_law_lines import line_regressors, off_law_note
 from .resonance import resonance
 from .spectra import compute_spectra, welch_dof
-from .stand_every import FittedStands
 from .stand_every import log_data as _log_data
 from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 
@@ -562,8 +561,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     scans start from the stand it fits: a mode dropped there leaves its lines to the stand alone).
     stand_direction: ``stand`` is a mode of the wheel's structure on that load direction only (``rwadist diagnose``'s
     ``fixed_resonance`` of role wheel_mode), divided out of that direction's lines alone, H → 1 far above it (β = 1).
-    fit_more_stands: with ``fit_stand``, ``more_stands`` are fitted in the same least squares too, not held
-    (:class:`rwadist.stand_every.FittedStands`; ``ExtendedFit.more_stands`` then holds their fitted values).
+    fit_more_stands: with ``fit_stand``, ``more_stands`` fitted in its least squares too (:mod:`rwadist.stand_every`).
 
     Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
     measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
@@ -611,8 +609,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     notes += [off_law_note(meas.lines[j], res.x[n_x + i - len(off_law)], rel_se[n_x + i - len(off_law)])
               for i, j in enumerate(off_law)]
     if joint is not None:
-        stand = joint.stand(res.x[n_x:])
-        more_stands = joint.more(res.x[n_x:]) if isinstance(joint, FittedStands) else more_stands
+        stand, more_stands = joint.stand(res.x[n_x:]), joint.more(res.x[n_x:], more_stands)
     params = replace(params, height=float(height))
     senses, kept_lines = _fitted_senses(meas.lines, fitted_lines, line_of)
     # a line the model file keeps both parts of, whose split the power does not see: its parts' errors say little

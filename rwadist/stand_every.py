@@ -6,7 +6,7 @@ either side of the radial translation pull on its lines from both sides; held in
 error and the mode's meet, and the mode with them (family wheel 1, 0.81x and 1.25x its 520 Hz translation, ζ 0.03, peak
 gain 5 each: the stands 420.9 Hz (ζ 0.031, 1.024 of the load above it) and 651.3 Hz (ζ 0.026, gain 4.78), the
 translation 520.8 Hz, ζ 0.0190 against 0.0184: the error after 15.7x the clean cell's; the modes fitted beside the
-true stands held: 520.01 Hz, ζ 0.01844, 0.8x).  :func:`fit_every_stand` fits them all free in one least squares
+true stands held: 520.01 Hz, ζ 0.01844, 0.8x).  :func:`rwadist.stand_resonance.fit_every_stand` fits them all free in one least squares
 (:class:`FittedStands`), the modes located again beside each pass's stands until they settle.
 """
 from __future__ import annotations
@@ -50,8 +50,8 @@ class FittedStands:
         """(f_r Hz, ζ, peak gain, gain above) of the first resonance."""
         return self.parts[0].stand(self._split(theta)[0])
 
-    def more(self, theta) -> tuple:
-        """The others' (f_r Hz, ζ, peak gain, gain above), in order."""
+    def more(self, theta, held=()) -> tuple:
+        """The others' (f_r Hz, ζ, peak gain, gain above), in order (``held``: what they were held at, unused)."""
         return tuple(p.stand(t) for p, t in zip(self.parts[1:], self._split(theta)[1:]))
 
 
@@ -80,29 +80,3 @@ def log_data(meas_lines: list, la: np.ndarray, sa: np.ndarray, aa: np.ndarray, l
         joint = FittedResonance(joint_stand, f_rows, rows=d_rows == stand_direction, max_above=PATH_MODE_MAX_ABOVE)
     return out + 0.5 * joint.start_log_gain, joint
 
-
-def fit_every_stand(test, fit, joint, kwargs: dict):
-    """The extended fit of ``test`` (empirical fit ``fit``) with every stand of ``joint`` (its ``stand`` and
-    ``more_stands``, found one at a time: :func:`rwadist.stand_resonance.beside_more_stands`) fitted free at once with
-    the modes (:class:`FittedStands`), the modes located again beside each pass's stands until they settle
-    (:data:`rwadist.stand_resonance.JOINT_PASSES` at most; the scans searching first where ``joint`` located them),
-    or ``joint`` itself when it has one stand or its cost (:func:`rwadist.stand_resonance.joint_cost`) is not above this
-    fit's.  ``kwargs`` passed on to :func:`rwadist.extended_fit.fit_extended`."""
-    from .extended_fit import fit_extended
-    from .stand_resonance import JOINT_PASSES, JOINT_SETTLED_LOG_F, _near_of, joint_cost
-
-    if joint.stand is None or not joint.more_stands:
-        return joint
-    stands = (tuple(joint.stand),) + tuple(tuple(k) for k in joint.more_stands)
-    extra = {**kwargs, "near": _near_of(joint), "fit_stand": True, "fit_more_stands": True}
-    for _ in range(JOINT_PASSES):
-        # every located mode kept in the passes' least squares (as :func:`rwadist.stand_resonance._joint_from`)
-        efit = fit_extended(test, fit, stand=stands[0], more_stands=stands[1:], declare=False, **extra)
-        new = (efit.stand,) + tuple(efit.more_stands)
-        settled = all(abs(np.log(a[0] / b[0])) < JOINT_SETTLED_LOG_F and
-                      abs(np.log(a[1] / b[1])) < 10 * JOINT_SETTLED_LOG_F for a, b in zip(new, stands))
-        stands = new
-        if settled:
-            break
-    every = fit_extended(test, fit, stand=stands[0], more_stands=stands[1:], **extra)
-    return every if joint_cost(every) < joint_cost(joint) else joint
