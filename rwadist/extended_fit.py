@@ -65,8 +65,9 @@ from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
 from .off_law_lines import line_regressors, off_law_note
-from .resonance import PATH_MODE_MAX_ABOVE, FittedResonance, resonance
+from .resonance import resonance
 from .spectra import compute_spectra, welch_dof
+from .stand_every import log_data as _log_data
 from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 
 #: RMS log-amplitude misfit (dB) of the measurements near a mode beyond which the linear model misses the data there
@@ -479,27 +480,6 @@ def _rows_of_lines(owner: np.ndarray, la: np.ndarray, lr: np.ndarray) -> tuple[d
     return line_of, ax_line, rad_parts
 
 
-def _log_data(meas_lines: list, la: np.ndarray, sa: np.ndarray, aa: np.ndarray, lr: np.ndarray, sr: np.ndarray,
-              pr: np.ndarray, joint_stand: tuple | None,
-              stand_direction: str | None = None) -> tuple[np.ndarray, FittedResonance | None]:
-    """(log amplitude per least-squares row, the stand fitted with the modes or None): the axial rows (line ``la``,
-    speed ``sa`` rad/s, amplitude ``aa`` per channel), then the radial ones (``lr``, ``sr``, x²+y² power ``pr`` per
-    run); with ``joint_stand`` (its start, divided out of the lines) multiplied back: the least squares divides out
-    its own.  ``stand_direction``: the stand is a mode of the wheel's structure acting on that direction's rows only,
-    keeping β <= 1 of the load above it (:class:`rwadist.resonance.FittedResonance` ``rows``, ``max_above``)."""
-    log_data = np.concatenate([np.log(np.maximum(aa, 1e-300)), 0.5 * np.log(np.maximum(pr, 1e-300))])
-    if joint_stand is None:
-        return log_data, None
-    h_meas = np.array([x.h for x in meas_lines]) if meas_lines else np.zeros(0)
-    f_rows = np.concatenate([h_meas[la] * np.abs(sa), h_meas[lr] * np.abs(sr)]) / (2 * np.pi)
-    if stand_direction is None:
-        joint = FittedResonance(joint_stand, f_rows)
-    else:
-        d_rows = np.concatenate([np.full(la.size, "axial_force"), [meas_lines[j].direction for j in lr]])
-        joint = FittedResonance(joint_stand, f_rows, rows=d_rows == stand_direction, max_above=PATH_MODE_MAX_ABOVE)
-    return log_data + 0.5 * joint.start_log_gain, joint
-
-
 def _fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple[dict, list]:
     """(senses, kept lines): the rotation sense of each radial line from its fitted forcing, (direction, h) ->
     (sense, co-rotating fraction of its power); negligible parts (< 1 % of the line's power) dropped."""
@@ -556,7 +536,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
                  progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
                  more_stands: tuple = (), near: dict | None = None, fit_stand: bool = False,
-                 declare: bool = True, stand_direction: str | None = None) -> ExtendedFit:
+                 declare: bool = True, stand_direction: str | None = None, fit_more_stands: bool = False) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
     mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None:
@@ -581,6 +561,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     scans start from the stand it fits: a mode dropped there leaves its lines to the stand alone).
     stand_direction: ``stand`` is a mode of the wheel's structure on that load direction only (``rwadist diagnose``'s
     ``fixed_resonance`` of role wheel_mode), divided out of that direction's lines alone, H → 1 far above it (β = 1).
+    fit_more_stands: with ``fit_stand``, ``more_stands`` fitted in its least squares too (:mod:`rwadist.stand_every`).
 
     Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
     measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
@@ -609,7 +590,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     lines, owner = _forcing_lines(meas.lines, senses_xy)
     lr, sr, pr, dr, nr = radial
     line_of, ax_line, rad_parts = _rows_of_lines(owner, la, lr)
-    log_data, joint = _log_data(meas.lines, la, sa, aa, lr, sr, pr, stand if fit_stand else None, stand_direction)
+    log_data, joint = _log_data(meas.lines, la, sa, aa, lr, sr, pr, stand if fit_stand else None, stand_direction,
+                                tuple(more_stands) if fit_stand and fit_more_stands else ())
     row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
     problem = LogAmplitudeProblem(base, lines, LinePower(lines, sa, ax_line, ca, sr, rad_parts), log_data, joint,
                                   row_line, centred_log_w, meas.lines, progress, np.concatenate([na, nr]), LOG_SCATTER,
@@ -627,7 +609,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     notes += [off_law_note(meas.lines[j], res.x[n_x + i - len(off_law)], rel_se[n_x + i - len(off_law)])
               for i, j in enumerate(off_law)]
     if joint is not None:
-        stand = joint.stand(res.x[n_x:])
+        stand, more_stands = joint.stand(res.x[n_x:]), joint.more(res.x[n_x:], more_stands)
     params = replace(params, height=float(height))
     senses, kept_lines = _fitted_senses(meas.lines, fitted_lines, line_of)
     # a line the model file keeps both parts of, whose split the power does not see: its parts' errors say little

@@ -18,6 +18,7 @@ from scipy import optimize
 from . import extended as ext
 from .extended_fit_power import LinePower
 from .resonance import FittedResonance
+from .stand_every import FittedStands
 
 #: The scatter of a row's log amplitude assumed besides the noise (:meth:`LogAmplitudeProblem.row_weights`): about the
 #: unweighted fit's own RMS log residual on the family's data (0.034-0.040 on family wheel 1's load-cell offset cell).
@@ -164,7 +165,7 @@ class LogAmplitudeProblem:
     lines : the forcing lines at their starting coefficients (a radial line: a co- and a counter-rotating part).
     power : the model's line power at every measured row (:class:`rwadist.extended_fit_power.LinePower`).
     log_data : the rows' measured log amplitudes, shape (rows,) (with ``joint``: the start stand multiplied back).
-    joint : the fixture resonance fitted with the modes, or None.
+    joint : the fixture resonance (or resonances, :class:`rwadist.stand_every.FittedStands`) fitted with the modes, or None.
     row_line, centred_log_w : per row its measured line and centred ln|Ω| (:func:`rwadist.off_law_lines.line_regressors`).
     meas_lines : the measured lines (LineFit list), named by the exponents freed.
     progress : scipy's iteration printout.
@@ -181,7 +182,7 @@ class LogAmplitudeProblem:
     lines: list
     power: LinePower
     log_data: np.ndarray
-    joint: FittedResonance | None
+    joint: FittedResonance | FittedStands | None
     row_line: np.ndarray
     centred_log_w: np.ndarray
     meas_lines: list

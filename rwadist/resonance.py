@@ -273,3 +273,7 @@ class FittedResonance:
         t = self._theta4(theta)
         zeta = float(np.exp(t[1]))
         return (float(np.exp(t[0])), zeta, peak_of(zeta, float(t[2]), float(t[3])), float(t[3]))
+
+    def more(self, theta, held=()) -> tuple:
+        """The further stands of the fit: ``held`` (one resonance fitted, the others held)."""
+        return tuple(held)

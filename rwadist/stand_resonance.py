@@ -427,7 +427,8 @@ def beside_more_stands(test, fit, joint, kwargs):
     held (each was fitted while the new one was still in the lines), twice round: of these fits the least cost is
     kept when the new stand is confirmed over the fit without it (:func:`stand_confirmed`: a fixture resonance, worth
     its parameters, lifting every direction).  Trial20 seed 22, every run: the rounds' costs 1.33, 0.53, 0.30, 0.23,
-    the stands 127.86 Hz (ζ 0.0298, gain 4.97) and 208.22 Hz (ζ 0.0263, gain 5.11), the modes within 0.1 %."""
+    the stands 127.86 Hz (ζ 0.0298, gain 4.97) and 208.22 Hz (ζ 0.0263, gain 5.11), the modes within 0.1 %.  Then
+    every stand is fitted again at once with the modes (:func:`fit_every_stand`)."""
     for _ in range(MAX_STANDS - 1 - len(joint.more_stands)):
         known = (joint.stand,) + tuple(joint.more_stands)
         starts = stand_starts(fit, known=known)[:MORE_STAND_STARTS]
@@ -437,7 +438,34 @@ def beside_more_stands(test, fit, joint, kwargs):
         if not stand_confirmed(got[0], joint, got[1]):
             break
         joint = got[0]
-    return joint
+    # each found while the others were held: all of them fitted again at once with the modes
+    return fit_every_stand(test, fit, joint, kwargs)
+
+
+def fit_every_stand(test, fit, joint, kwargs: dict):
+    """The extended fit of ``test`` (empirical fit ``fit``) with every stand of ``joint`` (its ``stand`` and
+    ``more_stands``, found one at a time: :func:`beside_more_stands`) fitted free at once with
+    the modes (:class:`rwadist.stand_every.FittedStands`), the modes located again beside each pass's stands until they settle
+    (:data:`JOINT_PASSES` at most; the scans searching first where ``joint`` located them),
+    or ``joint`` itself when it has one stand or its cost (:func:`joint_cost`) is not above this
+    fit's.  ``kwargs`` passed on to :func:`rwadist.extended_fit.fit_extended`."""
+    from .extended_fit import fit_extended
+
+    if joint.stand is None or not joint.more_stands:
+        return joint
+    stands = (tuple(joint.stand),) + tuple(tuple(k) for k in joint.more_stands)
+    extra = {**kwargs, "near": _near_of(joint), "fit_stand": True, "fit_more_stands": True}
+    for _ in range(JOINT_PASSES):
+        # every located mode kept in the passes' least squares (as :func:`rwadist.stand_resonance._joint_from`)
+        efit = fit_extended(test, fit, stand=stands[0], more_stands=stands[1:], declare=False, **extra)
+        new = (efit.stand,) + tuple(efit.more_stands)
+        settled = all(abs(np.log(a[0] / b[0])) < JOINT_SETTLED_LOG_F and
+                      abs(np.log(a[1] / b[1])) < 10 * JOINT_SETTLED_LOG_F for a, b in zip(new, stands))
+        stands = new
+        if settled:
+            break
+    every = fit_extended(test, fit, stand=stands[0], more_stands=stands[1:], **extra)
+    return every if joint_cost(every) < joint_cost(joint) else joint
 
 
 def _with_new_stand(test, fit, known: tuple, start: tuple, kwargs) -> tuple:
