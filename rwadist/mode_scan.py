@@ -401,10 +401,7 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     f_fine = f0_grid[i] * np.exp(np.arange(-2 * f_step - 0.01, 2 * f_step + 0.0101, 0.001))
     z_fine = zeta_grid[j] * np.exp(np.linspace(-0.5, 0.5, 11) * (1 if a_grid.size == 1 else 1.5))
     a_fine = a_grid if a_grid.size == 1 else np.unique(np.clip(a_grid[k] + np.linspace(-0.2, 0.2, 21), 0.02, A_MAX))
-    # the refinement grid screened in single precision too: its best point is the double-precision grid's.  Searched
-    # whole: its part within ±2 % and ±0.1 of the coarse best point, searched first (session 21), kept an interior
-    # local minimum 7x the whole grid's least SSR on family wheel 7's 60 s run-up (rocking 132.7 Hz, a 2.05 for
-    # 130.1 Hz, a 2.10; truth 130 Hz, 2.10: tests/test_fast_paths.py)
+    # screened in single precision, its best the double-precision grid's; whole (a part first: a false local minimum)
     fine = _screened_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
     fi, fj, fk = np.unravel_index(np.nanargmin(fine), fine.shape)
     best = float(fine[fi, fj, fk])
