@@ -19,8 +19,8 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
-from rwadist.data import Run, SteadyTest  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402
 from rwadist.extended_fit import MISFIT_DB, fit_extended  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
@@ -46,9 +46,7 @@ def _efit(wheel, channel: int, seed: int):
     # a line 30 % of the imbalance's load: clear of the noise (1 % of the top-speed imbalance) from the lowest speed
     group = "radial_torque" if channel == 5 else "radial_force"
     _scattered_line(wheel, data, channel, 0.3 * wheel.imbalance(group))
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    test = SteadyTest(runs=runs, meta={})
+    test = steady_test(data)
     return fit_extended(test, fit_empirical(compute_spectra(test)))
 
 

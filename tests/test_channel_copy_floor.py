@@ -22,9 +22,9 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist.api import diagnose  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 from rwadist.diagnose.channel_copy import find_channel_copies  # noqa: E402
 from rwadist.diagnose.engine import Context  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
@@ -46,9 +46,7 @@ def _data(index: int, offset: bool = False):
 
 
 def _copies(data) -> list:
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    test = SteadyTest(runs=runs, meta={})
+    test = steady_test(data)
     return find_channel_copies(Context(compute_spectra(test, nperseg=1024), test=test))
 
 

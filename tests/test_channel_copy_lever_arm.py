@@ -25,9 +25,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist.api import diagnose  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 from rwadist.diagnose.channel_copy import find_channel_copies  # noqa: E402
 from rwadist.diagnose.engine import Context  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
@@ -39,9 +39,7 @@ OFFSET_M = (0.020, 0.015, 0.150)
 def _copies(index: int, effect) -> list:
     wheel = fw.family()[index]
     data = fw.steady(wheel, noise=0.01, seed=index, effects=[effect])
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    test = SteadyTest(runs=runs, meta={})
+    test = steady_test(data)
     return find_channel_copies(Context(compute_spectra(test, nperseg=1024), test=test))
 
 

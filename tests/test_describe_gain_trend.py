@@ -27,9 +27,9 @@ import diagnose_family_matrix as dfm  # noqa: E402
 import diagnose_open_world as dow  # noqa: E402
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist import api  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 
 #: The gain's fall at the top speed (trial16: 0.08).
 K = 0.08
@@ -47,12 +47,6 @@ class _LowPass:
         return np.repeat(g[:, None], 6, axis=1).astype(complex)
 
 
-def _test(data) -> SteadyTest:
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    return SteadyTest(runs=runs, meta={})
-
-
 @functools.lru_cache(maxsize=None)
 def _diagnosed(index: int, kind: str):
     wheel = dfm.wheels()[index]
@@ -61,7 +55,7 @@ def _diagnosed(index: int, kind: str):
                "filter": [_LowPass(0.15 * wheel.sample_rate)], "remount": [dow.RemountStep()]}[kind]
     seed = index if kind == "remount" else 1 + 100 * index          # remount: the open world's own cell
     data = fw.steady(wheel, noise=dfm.CONDITIONS[index][2], seed=seed, effects=effects)
-    return wheel, api.diagnose(_test(data))
+    return wheel, api.diagnose(steady_test(data))
 
 
 def _trends(d) -> list:

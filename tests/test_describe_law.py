@@ -25,17 +25,11 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 import diagnose_family_matrix as dfm  # noqa: E402
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist import api  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 
 WHEEL = 3
-
-
-def _test(data) -> SteadyTest:
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    return SteadyTest(runs=runs, meta={})
 
 
 @functools.lru_cache(maxsize=None)
@@ -44,7 +38,7 @@ def _diagnosed(exponent: float):
     line = next(x for x in wheel.lines if x.direction == "axial_force" and x.name == "3x")
     law = fe.AmplitudeLaw(direction="axial_force", h=line.h, exponent=exponent)
     data = fw.steady(wheel, noise=dfm.CONDITIONS[WHEEL][2], seed=1 + 100 * WHEEL, effects=[law])
-    return line, api.diagnose(_test(data))
+    return line, api.diagnose(steady_test(data))
 
 
 def _laws(d, h):

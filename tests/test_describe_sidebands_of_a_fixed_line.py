@@ -22,9 +22,9 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist import api  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 
 
 class _Inverter:
@@ -47,9 +47,7 @@ def _diagnosed(index: int, p: float, side: float, f_c: float | None = None, seed
     wheel = replace(fw.family()[index], n_speeds=16, n_samples=8192)
     effect = _Inverter(0.17 * wheel.sample_rate if f_c is None else f_c, p, side=side)
     data = fw.steady(wheel, noise=0.01, seed=index + 40 if seed is None else seed, effects=[effect])
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    return effect, api.diagnose(SteadyTest(runs=runs, meta={}))
+    return effect, api.diagnose(steady_test(data))
 
 
 @pytest.mark.parametrize("index, p", [(0, 1.0), (3, 4.0), (5, 2.0), (4, 1.0)])

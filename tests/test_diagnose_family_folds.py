@@ -21,9 +21,9 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist import api  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 
 
 @pytest.mark.slow
@@ -32,9 +32,7 @@ def test_clean_wheel_whose_fit_half_misses_a_mode_gets_its_modes_and_nothing_els
     wheel = fw.family(seed=2)[index]
     data = fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, 16), n_samples=4096, noise=0.01,
                      seed=7)
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    d = api.diagnose(SteadyTest(runs=runs, meta={}))
+    d = api.diagnose(steady_test(data))
     assert [e["kind"] for e in d.model.effects] == ["suspension_modes"], [e["kind"] for e in d.model.effects]
     modes = d.model.effects[0]
     for name, truth in wheel.modes_hz().items():

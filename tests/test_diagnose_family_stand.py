@@ -37,9 +37,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist import api  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 
 
 def _diagnosis(index, mode, factor, n_speeds=16, n_samples=4096, seed=1):
@@ -47,9 +47,7 @@ def _diagnosis(index, mode, factor, n_speeds=16, n_samples=4096, seed=1):
     f_fix = factor * wheel.modes_hz()[mode]
     data = fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, n_speeds), n_samples=n_samples,
                      noise=0.01, seed=seed, effects=(fe.Fixture(f_hz=f_fix),))
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    return wheel, f_fix, api.diagnose(SteadyTest(runs=runs, meta={}))
+    return wheel, f_fix, api.diagnose(steady_test(data))
 
 
 @pytest.mark.slow

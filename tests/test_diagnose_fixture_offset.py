@@ -24,9 +24,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist import api  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 
 F_FIX, ZETA_FIX, GAIN_FIX = 195.0, 0.03, 5.0
 R_Z = 0.02                      # m
@@ -41,9 +41,7 @@ def case():
     data = fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, 16), n_samples=8192, noise=0.03,
                      seed=701, effects=(fe.Fixture(f_hz=F_FIX, zeta=ZETA_FIX, gain=GAIN_FIX),
                                         fe.CrossCoupling(r=(0.0, 0.0, R_Z))))
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    return wheel, data, api.diagnose(SteadyTest(runs=runs, meta={}))
+    return wheel, data, api.diagnose(steady_test(data))
 
 
 def _misplaced(d, data) -> dict:

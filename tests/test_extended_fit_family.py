@@ -21,8 +21,9 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
-from rwadist.data import Run, SteadyTest  # noqa: E402
+from rwadist.data import SteadyTest  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402
 from rwadist.extended_fit import fit_extended  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
@@ -32,9 +33,7 @@ from rwadist.stand_resonance import _mode_hz  # noqa: E402
 def _test_of(wheel, n_speeds=16, n_samples=4096, seed=1, noise=0.01) -> SteadyTest:
     data = fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, n_speeds), n_samples=n_samples,
                      noise=noise, seed=seed)
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    return SteadyTest(runs=runs, meta={})
+    return steady_test(data)
 
 
 @pytest.mark.parametrize("index", range(8))

@@ -19,6 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist.data import Run, SteadyTest  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402
@@ -72,9 +73,7 @@ def test_a_load_floor_on_the_forces_is_no_noisier_sensor(wheel):
     torques' relative noise under the imbalance line over the speeds) lift the forces' floor at the top speeds, not
     at the slowest: no family is singled out, the fit stays the plain least squares."""
     data = fw.steady(wheel, noise=NOISE, seed=101, effects=[fe.default_effect("broadband_floor", wheel)])
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    fit = fit_empirical(compute_spectra(SteadyTest(runs=runs, meta={})))
+    fit = fit_empirical(compute_spectra(steady_test(data)))
     assert noisy_sensor_directions(fit.lines) == ()
 
 
@@ -116,9 +115,7 @@ def test_the_recordings_noisier_family_is_carried_to_the_corrected_torques():
     wheel = replace(fw.family()[5], n_speeds=16, n_samples=16384)
     offset = fe.default_effect("lever_arm_noise", wheel)
     data = fw.steady(wheel, noise=0.01, seed=501, effects=[offset])
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    recorded = SteadyTest(runs=runs, meta={})
+    recorded = steady_test(data)
     forces = ("radial_force", "axial_force")
     assert noisy_sensor_directions(fit_empirical(compute_spectra(recorded)).without_mode_exclusion.lines) == forces
     corrected = _offset_removed(recorded, offset.params["r"])

@@ -32,19 +32,13 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 import diagnose_family_matrix as dfm  # noqa: E402
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist import api  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 from rwadist.diagnose.mode_reach import crossing_groups  # noqa: E402
 from rwadist.effects.amplitude_law_diagnose import AmplitudeLaw  # noqa: E402
 
 WHEEL = 0
-
-
-def _test(data) -> SteadyTest:
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    return SteadyTest(runs=runs, meta={})
 
 
 @functools.lru_cache(maxsize=None)
@@ -52,7 +46,7 @@ def _diagnosed(kind: str):
     wheel = dfm.wheels()[WHEEL]
     effect = fe.default_effect(kind, wheel)
     data = fw.steady(wheel, noise=dfm.CONDITIONS[WHEEL][2], seed=1 + 100 * WHEEL, effects=[effect])
-    return wheel, effect, api.diagnose(_test(data))
+    return wheel, effect, api.diagnose(steady_test(data))
 
 
 def _modes_state(d):
@@ -97,7 +91,7 @@ def _law_in_every_direction(exponent: float = 2.6):
     laws = [fe.AmplitudeLaw(direction=d, h=bpfo.h, exponent=exponent)
             for d in ("radial_force", "radial_torque", "axial_force")]
     data = fw.steady(wheel, noise=dfm.CONDITIONS[WHEEL][2], seed=1 + 100 * WHEEL, effects=laws)
-    return wheel, bpfo, api.diagnose(_test(data))
+    return wheel, bpfo, api.diagnose(steady_test(data))
 
 
 @pytest.mark.slow

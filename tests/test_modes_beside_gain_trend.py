@@ -28,9 +28,9 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 import diagnose_family_matrix as dfm  # noqa: E402
 import diagnose_open_world as dow  # noqa: E402
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist import api  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 
 #: the gain's fall at the top speed
 K = 0.08
@@ -44,9 +44,7 @@ def _diagnosed(seed: int):
     wheel = dfm.wheels()[WHEEL]
     data = fw.steady(wheel, noise=dfm.CONDITIONS[WHEEL][2], seed=seed,
                      effects=[dow.SpeedGain(wheel.max_rpm * fw.RPM, k=K)])
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    return wheel, api.diagnose(SteadyTest(runs=runs, meta={}))
+    return wheel, api.diagnose(steady_test(data))
 
 
 def _located_with_damping_held_honestly(modes, wheel):
@@ -89,9 +87,7 @@ def test_the_same_draws_clean_are_diagnosed_as_before():
     left unconstrained, and none is)."""
     wheel = dfm.wheels()[WHEEL]
     data = fw.steady(wheel, noise=dfm.CONDITIONS[WHEEL][2], seed=SEEDS[0], effects=[])
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    s = api.diagnose(SteadyTest(runs=runs, meta={})).summary()
+    s = api.diagnose(steady_test(data)).summary()
     (modes,) = [e for e in s["effects"] if e["kind"] == "suspension_modes"]
     _located_with_damping_held_honestly(modes, wheel)
     for m, f in wheel.modes_hz().items():

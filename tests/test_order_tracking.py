@@ -20,14 +20,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
-
-from rwadist.data import Run, SteadyTest  # noqa: E402
-
-
-def _test(wheel, data):
-    return SteadyTest(runs=[Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)})
-                            for i, om in enumerate(data.speeds)], meta={})
+from family_test import steady_test  # noqa: E402
 
 
 @pytest.mark.parametrize("index, seed", [(2, 1), (4, 2), (6, 3)])
@@ -43,7 +36,7 @@ def test_the_rotor_angle_is_read_from_the_1x_line(index, seed):
     wheel = fw.family()[index]
     wander = fe.SpeedWander(0.003, 1.0)
     speeds = np.linspace(wheel.min_rpm, wheel.max_rpm, 6)
-    test = _test(wheel, fw.steady(wheel, speeds_rpm=speeds, n_samples=16384, seed=seed, effects=[wander]))
+    test = steady_test(fw.steady(wheel, speeds_rpm=speeds, n_samples=16384, seed=seed, effects=[wander]))
     reads = sc.line_reads(test)
     seen = 0
     for i, run in enumerate(test.runs):
@@ -76,8 +69,8 @@ def test_diagnose_tracks_a_wandering_speed(index, seed):
     speeds = np.linspace(wheel.min_rpm, wheel.max_rpm, 16)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        steady = api.diagnose(_test(wheel, fw.steady(wheel, speeds_rpm=speeds, n_samples=16384, seed=seed)))
-        d = api.diagnose(_test(wheel, fw.steady(wheel, speeds_rpm=speeds, n_samples=16384, seed=seed,
+        steady = api.diagnose(steady_test(fw.steady(wheel, speeds_rpm=speeds, n_samples=16384, seed=seed)))
+        d = api.diagnose(steady_test(fw.steady(wheel, speeds_rpm=speeds, n_samples=16384, seed=seed,
                                                effects=[fe.SpeedWander(0.003, 1.0)])))
     assert "order tracking" in d.speed["method"]
     assert d.speed["runs_speed"]["runs_tracked"]
@@ -98,7 +91,7 @@ def test_steady_data_are_left_as_recorded():
     from rwadist import speed_runs as sr
 
     wheel = fw.family()[1]
-    test = _test(wheel, fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, 8), seed=6))
+    test = steady_test(fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, 8), seed=6))
     _, check = sc.checked(test)
     test2, check = sr.own_speeds(test, check)
     out, rec = ot.tracked(test2, check)

@@ -17,8 +17,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
-from rwadist.data import Run, SteadyTest  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402
 from rwadist.resonance import resonance  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
@@ -65,9 +65,7 @@ def test_two_fixtures_are_fitted_at_their_truth_beside_the_modes():
     f_tr = wheel.modes_hz()["radial_translation"]
     fixtures = [fe.Fixture(f_hz=k * f_tr, zeta=0.03, gain=5.0) for k in (0.81, 1.25)]
     data = fw.steady(wheel, noise=0.003, seed=101, effects=fixtures)
-    test = SteadyTest(runs=[Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)})
-                            for i, om in enumerate(data.speeds)], meta={})
+    test = steady_test(data)
     efit = fit_extended_beside_stand(test, fit_empirical(compute_spectra(test)))
     stands = sorted(((efit.stand,) if efit.stand is not None else ()) + tuple(efit.more_stands))
     assert len(stands) == 2

@@ -21,9 +21,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import family_effects as fe  # noqa: E402
 import family_wheel as fw  # noqa: E402
 import standmodes_wheel as sw  # noqa: E402
+from family_test import steady_test  # noqa: E402
 
 from rwadist import api  # noqa: E402
-from rwadist.data import Run, SteadyTest  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
 from rwadist.stand_resonance import _mode_hz, fit_extended_beside_stand, stand_starts  # noqa: E402
@@ -85,9 +85,7 @@ def test_two_fixtures_are_named_beside_the_modes_and_nothing_else():
     f_fix = [k * f_tr for k in FACTORS]
     data = fw.steady(wheel, speeds_rpm=np.linspace(wheel.min_rpm, wheel.max_rpm, 16), n_samples=4096, noise=0.01,
                      seed=1, effects=tuple(fe.Fixture(f_hz=f) for f in f_fix))
-    runs = [Run(speed=float(om), sample_rate=data.sample_rate, t0=0.0, name=f"run_{i:04d}.csv",
-                signals={c: data.signals[i, j] for j, c in enumerate(fw.CHANNELS)}) for i, om in enumerate(data.speeds)]
-    d = api.diagnose(SteadyTest(runs=runs, meta={})).summary()
+    d = api.diagnose(steady_test(data)).summary()
     (modes,) = [e for e in d["effects"] if e["kind"] == "suspension_modes"]
     assert not modes.get("unconstrained")
     for m, truth in wheel.modes_hz().items():
