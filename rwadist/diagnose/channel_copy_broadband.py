@@ -81,11 +81,9 @@ def _run_stats(Z, stats: tuple, s: int, t: int):
     z = float(abs(cross) / np.sqrt(null))
     if z < MIN_Z:
         return kappa, z, None
-    # BAND_PARTS contiguous parts of the noise bins, sized as np.array_split's
-    n, k = divmod(idx.size, BAND_PARTS)
-    ends = np.cumsum([0] + [n + 1] * k + [n] * (BAND_PARTS - k))
-    return kappa, z, [(np.add.reduce(Pst[i:j]), np.add.reduce(Pss[i:j]), np.add.reduce(both[i:j]) / M)
-                      for i, j in zip(ends[:-1], ends[1:])]
+    # BAND_PARTS contiguous parts of the noise bins
+    parts = zip(*(np.array_split(x, BAND_PARTS) for x in (Pst, Pss, both)))
+    return kappa, z, [(np.add.reduce(a), np.add.reduce(b), np.add.reduce(c) / M) for a, b, c in parts]
 
 
 def find_broadband_copies(test, runs, chans, tolerance: float, skip=()) -> list:
