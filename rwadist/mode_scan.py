@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .extended import IMBALANCE_H_TOL
+from .off_law_lines import OFF_LAW_Z
 from .schema import MAX_INERTIA_RATIO
 
 #: modes scanned and the measured direction that shows each
@@ -81,9 +82,6 @@ def transmissibility_sq(nu, omega, f0_hz, zeta, a):
     return (w02**2 + d2) / ((w02 - nu**2 + a * om * nu) ** 2 + d2)
 
 
-#: A line of the scan may take an exponent of its own (its log residual detrended in ln|Ω|) at the cost of a trend this
-#: many standard errors from 0 (a likelihood ratio of OFF_LAW_Z², as :mod:`rwadist.off_law_lines` frees one in the fit)
-OFF_LAW_Z = 4.0
 
 
 class _Segments:

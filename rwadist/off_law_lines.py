@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .extended import IMBALANCE_H_TOL
+from .extended import IMBALANCE_H_TOL, LAW_H_TOL
 
 #: Lines of a law other than C·Ω² whose exponent the least squares may free before a mode is declared not
 #: constrained (:func:`off_law_line`): one such line (an amplitude law, a foreign load) is what drags a mode to the
@@ -84,13 +84,11 @@ def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, 
     (:func:`off_law_note`), for ``rwadist diagnose`` to name its law."""
     fit = fit_with(off_law)
     loose = loose_of(fit)
-    harmonic = (lambda j: round(float(line_h[j]), 3)) if line_h is not None else (lambda j: j)
     n_lines = int(row_line.max()) + 1 if row_line.size else 0
     while True:
         skip = list(off_law) + list(lawful)
         if len(off_law) >= MAX_OFF_LAW_LINES:
-            freed = {harmonic(k) for k in off_law}
-            skip += [k for k in range(n_lines) if harmonic(k) not in freed]
+            skip += [k for k in range(n_lines) if not same_harmonic(k, off_law, line_h)]
         j = off_law_line(fit[0].fun, row_line, log_w, skip)
         if j is None:
             break
@@ -102,6 +100,16 @@ def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, 
         off_law.append(j)
         fit, loose = trial, trial_loose
     return fit, loose
+
+
+def same_harmonic(k: int, freed: list, line_h=None) -> bool:
+    """True when measured line ``k`` is one of the ``freed`` lines' harmonics: its h (``line_h``, one per measured
+    line) within :data:`rwadist.extended.LAW_H_TOL` of a freed line's, the tolerance within which the model takes two
+    directions' lines for one harmonic (each direction's h is measured on its own, so 3.2994 and 3.3003 are one line;
+    rounding both to 3 decimals had called them two).  Without ``line_h`` only the freed lines themselves."""
+    if line_h is None:
+        return k in freed
+    return any(abs(float(line_h[k]) - float(line_h[j])) < LAW_H_TOL for j in freed)
 
 
 def lawful_lines(meas_lines: list) -> tuple:
