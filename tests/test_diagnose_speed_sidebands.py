@@ -110,3 +110,35 @@ def test_a_side_inside_its_carriers_smear_over_a_sweeps_slice_is_not_resolvable(
     # a slice whose speed moves 60 rpm (1 Hz of spin): the carrier spans 3 Hz, the side must be 5.5 Hz away
     swept = ctx({"slicing": {"speed_spread_rpm": [60.0, 60.0, 60.0]}})
     assert list(resolvable_runs(swept, state, "radial_force", 3.0, 3.1, idx)) == [2]
+
+
+def test_the_pair_carries_its_carriers_rotation_sense():
+    """A carrier of co- and counter-rotating parts (C_co e^{iΩt} + C_ct e^{-iΩt}, amplitude-modulated by
+    1 + m·cos δΩt): its spectrum (an FFT of the closed form, one rotating vector x + iy) has the pair at ±(1 ± δ)Ω in
+    the proportion of the parts; the model's harmonics ``SpeedSidebands.apply`` writes hold the same split."""
+    from rwadist.diagnose.state import State
+    from rwadist.effects.speed_sidebands_diagnose import SpeedSidebands
+    from rwadist.model import Harmonic, WheelModel
+
+    n, m, delta, c_co, c_ct = 4096, 0.4, 0.0625, 0.8, 0.6
+    t = np.arange(n) / n
+    omega = 2 * np.pi * 64                     # 64 cycles per record: every line on a bin
+    z = (1 + m * np.cos(delta * omega * t)) * (c_co * np.exp(1j * omega * t) + c_ct * np.exp(-1j * omega * t))
+    spectrum = np.abs(np.fft.fft(z)) / n       # amplitude per rotating line, bin k = k cycles per record
+    lower_co, lower_ct = spectrum[60], spectrum[-60]    # (1 − δ)·64 = 60 cycles: co at +60, counter at −60
+    c_lower = np.hypot(lower_co, lower_ct)     # what a power (x² + y²) measurement of the pair reads
+    assert c_lower == pytest.approx(m / 2, rel=1e-9)
+
+    model = WheelModel(name="split carrier")
+    model.empirical["radial_force"] = [Harmonic(1.0, c_co, sense="co"), Harmonic(1.0, c_ct, sense="counter")]
+    effect = SpeedSidebands("radial_force", 1.0, 1 - delta, 1 + delta, c_lower, c_lower, 1.0)
+    added = [x for x in effect.apply(State(model, {})).model.harmonics("radial_force") if abs(x.h - 1.0) > 1e-3]
+    lower = {x.sense: x.C for x in added if x.h < 1}
+    assert lower["co"] == pytest.approx(lower_co, rel=1e-9) and lower["counter"] == pytest.approx(lower_ct, rel=1e-9)
+    assert sorted(x.sense for x in added) == ["co", "co", "counter", "counter"]
+
+    only_counter = WheelModel(name="counter carrier")
+    only_counter.empirical["radial_force"] = [Harmonic(4.7, 1.0, sense="counter")]
+    effect = SpeedSidebands("radial_force", 4.7, 4.6, 4.8, 0.2, 0.2, 1.0)
+    added = [x for x in effect.apply(State(only_counter, {})).model.harmonics("radial_force") if x.h != 4.7]
+    assert [(x.h, x.C, x.sense) for x in added] == [(4.6, 0.2, "counter"), (4.8, 0.2, "counter")]

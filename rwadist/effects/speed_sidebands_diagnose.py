@@ -320,11 +320,25 @@ class SpeedSidebands:
 
     def apply(self, state: State) -> State:
         s = state.copy()
-        new = [Harmonic(h=round(self.h_lower, 4), C=self.C_lower, n_points=self.n_points),
-               Harmonic(h=round(self.h_upper, 4), C=self.C_upper, n_points=self.n_points)]
+        # a rotating load modulated in size, (1 + m·cos δΩt)·C·e^{±iΩt}, is the carrier and two lines (m/2)·C at
+        # (1 ± δ)Ω of the carrier's own rotation sense: each part of the carrier (co, counter) gets its share of the
+        # pair (written with no sense, every consumer read them co-rotating)
+        new = [Harmonic(h=round(h, 4), C=C * share, n_points=self.n_points, sense=sense)
+               for sense, share in self.carrier_parts(state)
+               for h, C in ((self.h_lower, self.C_lower), (self.h_upper, self.C_upper))]
         s.model.empirical[self.direction] = sorted(s.model.harmonics(self.direction) + new, key=lambda x: x.h)
         s.effects.append(self)
         return s
+
+    def carrier_parts(self, state: State) -> list:
+        """[(sense, share)] of the model's carrier line h0 in ``state``: each rotation-sense part of it ('co',
+        'counter', 'planar') and its share C_part/√(ΣC²) of the carrier's amplitude (the shares' squares sum to 1: the
+        pair keeps its measured power); [(None, 1.0)] for an axial line or a carrier the model does not hold."""
+        parts = [x for x in state.model.harmonics(self.direction) if abs(x.h - self.h0) <= 1e-3 and x.C > 0]
+        norm = float(np.sqrt(sum(x.C**2 for x in parts)))
+        if self.direction == "axial_force" or norm <= 0:
+            return [(None, 1.0)]
+        return [(x.sense, x.C / norm) for x in parts]
 
     def refit(self, ctx: Context, state: State) -> "SpeedSidebands":
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""
