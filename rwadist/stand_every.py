@@ -64,14 +64,17 @@ def log_data(meas_lines: list, la: np.ndarray, sa: np.ndarray, aa: np.ndarray, l
     its own (a :class:`rwadist.resonance.FittedResonance`).  ``stand_direction``: the stand is a mode of the wheel's
     structure acting on that direction's rows only, keeping β <= 1 of the load above it (``rows``, ``max_above``).
     ``more_stands``: further fixture resonances on every row (divided out of the lines too) fitted with it, every one
-    multiplied back (a :class:`FittedStands`)."""
+    multiplied back (a :class:`FittedStands`); not beside a ``stand_direction`` (a structure mode is fitted alone:
+    ValueError, rather than the further stands left held unsaid)."""
+    if more_stands and stand_direction is not None:
+        raise ValueError(f"further stands fitted beside a structure mode on {stand_direction}: fit one or the other")
     out = np.concatenate([np.log(np.maximum(aa, 1e-300)), 0.5 * np.log(np.maximum(pr, 1e-300))])
     if joint_stand is None:
         return out, None
     h_meas = np.array([x.h for x in meas_lines]) if meas_lines else np.zeros(0)
     f_rows = np.concatenate([h_meas[la] * np.abs(sa), h_meas[lr] * np.abs(sr)]) / (2 * np.pi)
     joint: FittedResonance | FittedStands
-    if more_stands and stand_direction is None:
+    if more_stands:
         joint = FittedStands((joint_stand,) + tuple(more_stands), f_rows)
     elif stand_direction is None:
         joint = FittedResonance(joint_stand, f_rows)

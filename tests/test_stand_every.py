@@ -22,7 +22,7 @@ from family_test import steady_test  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402
 from rwadist.resonance import resonance  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
-from rwadist.stand_every import FittedStands  # noqa: E402
+from rwadist.stand_every import FittedStands, log_data  # noqa: E402
 from rwadist.stand_resonance import _mode_hz, fit_extended_beside_stand  # noqa: E402
 
 STANDS = ((120.0, 0.03, 5.0, 1.0), (210.0, 0.05, 3.0, 0.8))
@@ -76,3 +76,11 @@ def test_two_fixtures_are_fitted_at_their_truth_beside_the_modes():
     assert not efit.unconstrained
     assert _mode_hz(efit.params)["radial_translation"] == pytest.approx(f_tr, rel=0.0005)
     assert efit.zeta["radial_translation"] == pytest.approx(wheel.zeta_trans, rel=0.01)
+
+
+def test_further_stands_beside_a_structure_mode_are_refused_not_left_held():
+    """log_data fits further stands (FittedStands) or one structure mode on one direction, never both at once."""
+    z = np.zeros(0)
+    with pytest.raises(ValueError, match="structure mode on radial_force"):
+        log_data([], z.astype(int), z, z, z.astype(int), z, z, (100.0, 0.03, 5.0, 1.0), "radial_force",
+                 ((200.0, 0.03, 5.0, 1.0),))
