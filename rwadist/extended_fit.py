@@ -743,10 +743,11 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
     if efit.stand is not None:
         # the fixture's resonance is not the wheel's: kept out of its model, recorded for the user (a mode of the wheel's
         # structure on one direction is the wheel's: ``rwadist diagnose`` names it as a fixed_resonance of its model)
-        f_r, zeta, gain, *above = efit.stand
         key = "test_stand" if efit.stand_direction is None else "structure_mode"
-        analytical["fit"][key] = {"f_Hz": f_r, "zeta": zeta, "peak_gain": gain, "gain_above": above[0] if above else 1.0,
-                                  **({} if efit.stand_direction is None else {"direction": efit.stand_direction})}
+        analytical["fit"][key] = dict(stand_record(efit.stand),
+                                      **({} if efit.stand_direction is None else {"direction": efit.stand_direction}))
+        if efit.more_stands:    # the further fixture resonances fitted with it (two fixtures on one stand)
+            analytical["fit"]["more_test_stands"] = [stand_record(k) for k in efit.more_stands]
     if efit.per_unit:
         analytical["fit"]["per_unit"] = ("mass and radius not given: mass_kg = 1 and I_rr = 1 are units, the "
                                          "stiffnesses and damping are per unit mass / transverse inertia")
@@ -754,6 +755,12 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
     model.provenance = dict(model.provenance, extended_fit="rwadist fit --extended: harmonics are the fitted "
                             "forcing lines of the extended model")
     return model
+
+
+def stand_record(stand: tuple) -> dict:
+    """A fitted stand (f_r Hz, ζ, peak gain[, gain above]) as the model file records it."""
+    f_r, zeta, gain, *above = stand
+    return {"f_Hz": f_r, "zeta": zeta, "peak_gain": gain, "gain_above": above[0] if above else 1.0}
 
 
 def unconstrained_warning(model, source: str, use: str) -> str | None:

@@ -400,10 +400,11 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
     if not stand_confirmed(joint, plain):
         return plain
     joint = beside_more_stands(test, fit, joint, kwargs)
-    for f_r, zeta, gain, above in (joint.stand,) + joint.more_stands:
+    for i, (f_r, zeta, gain, above) in enumerate((joint.stand,) + joint.more_stands):
+        where = "analytical.fit.test_stand" if i == 0 else f"analytical.fit.more_test_stands[{i - 1}]"
         joint.notes.append(f"test stand: a resonance at {f_r:.4g} Hz (ζ {zeta:.3g}, peak gain {gain:.3g}, "
                            f"{above:.3g} of the load far above it) lifts the lines of every channel: a fixture "
-                           "resonance, fitted with the modes and not part of the wheel's model (analytical.fit.test_stand)")
+                           f"resonance, fitted with the modes and not part of the wheel's model ({where})")
     return joint
 
 

@@ -20,6 +20,9 @@ import family_wheel as fw  # noqa: E402
 from family_test import steady_test  # noqa: E402
 
 from rwadist.empirical import fit_empirical  # noqa: E402
+from rwadist.extended_fit import to_model  # noqa: E402
+from rwadist.model import from_json as model_from_json  # noqa: E402
+from rwadist.model import to_json as model_to_json  # noqa: E402
 from rwadist.resonance import resonance  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
 from rwadist.stand_every import FittedStands, log_data  # noqa: E402
@@ -66,9 +69,14 @@ def test_two_fixtures_are_fitted_at_their_truth_beside_the_modes():
     fixtures = [fe.Fixture(f_hz=k * f_tr, zeta=0.03, gain=5.0) for k in (0.81, 1.25)]
     data = fw.steady(wheel, noise=0.003, seed=101, effects=fixtures)
     test = steady_test(data)
-    efit = fit_extended_beside_stand(test, fit_empirical(compute_spectra(test)))
+    fit = fit_empirical(compute_spectra(test))
+    efit = fit_extended_beside_stand(test, fit)
     stands = sorted(((efit.stand,) if efit.stand is not None else ()) + tuple(efit.more_stands))
     assert len(stands) == 2
+    # the model file records both (the one the modes were first fitted beside, and the further one)
+    record = model_from_json(model_to_json(to_model(efit, fit))).analytical["fit"]
+    written = sorted([record["test_stand"]] + record["more_test_stands"], key=lambda k: k["f_Hz"])
+    assert [k["f_Hz"] for k in written] == pytest.approx([s[0] for s in stands], rel=1e-12)
     for (f_r, zeta, gain, _above), fx in zip(stands, fixtures):
         assert f_r == pytest.approx(fx.params["f_hz"], rel=0.001)
         assert zeta == pytest.approx(0.03, rel=0.02)

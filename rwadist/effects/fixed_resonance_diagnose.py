@@ -481,9 +481,10 @@ class FixedResonance:
             # the same from the given model: the stand its reference fit divided out (``analytical.fit.test_stand``,
             # another run on the same fixture): 2048 samples, diagnose's own fit gave 180.4 Hz, ζ 0.040, gain 3.9 for
             # the 180 Hz, ζ 0.03, gain 5 stand the reference located at 180.0 Hz, ζ 0.030, gain 5.02
-            ref = ((getattr(state.model, "analytical", None) or {}).get("fit") or {}).get("test_stand")
-            if ref and not modes:
-                given = tuple(float(ref[k]) for k in ("f_Hz", "zeta", "peak_gain")) + (float(ref.get("gain_above", 1.0)),)
+            ref = (getattr(state.model, "analytical", None) or {}).get("fit") or {}
+            stands = ([ref["test_stand"]] if ref.get("test_stand") else []) + list(ref.get("more_test_stands") or [])
+            for k in stands if not modes else []:        # every stand of that fit (two fixtures: both)
+                given = tuple(float(k[v]) for v in ("f_Hz", "zeta", "peak_gain")) + (float(k.get("gain_above", 1.0)),)
                 out.append(FixedResonance.of_stand(given, ctx.channels, given))
         # a "resonance" that changes no line by more than MIN_PEAK_GAIN is a patch on model error, not a mode; nor is a
         # wheel mode that lowers the lines at its frequency: a mode of the wheel's structure amplifies what passes it
