@@ -84,6 +84,11 @@ def rescaled(test, h: float):
         return type(test)(list(test.runs), meta)
     sl = meta["slicing"]
     sc = sl["speed_scale"]
+    # the speed's sign is the 1x line's rotation sense (about +z): a cage line turns against the rotor, so moving
+    # the 1x from it to the imbalance turns every speed round too (trial23: kept, the imbalance read counter-rotating)
+    sense = _line_sense(sc, h)
+    flip = 1.0 if sense is None or sense == sc.get("sense", 1) else -1.0
+    sc["sense"] = sc.get("sense", 1) if sense is None else sense
     sc["ratios"] = sorted(round(r / h, 6) for r in sc["ratios"])
     one = sc.setdefault("one_x", {})
     others = [{"h": c["h"] / h, "multiples_found": c.get("multiples_found", [])}
@@ -99,7 +104,21 @@ def rescaled(test, h: float):
         sl["min_speed_rpm"] = sl["min_speed_rpm"] * h
     if "speed_spread_rpm" in sl:
         sl["speed_spread_rpm"] = [v * h for v in sl["speed_spread_rpm"]]
-    return type(test)([replace(r, speed=r.speed * h) for r in test.runs], meta)
+    return type(test)([replace(r, speed=r.speed * h * flip) for r in test.runs], meta)
+
+
+def _line_sense(scale: dict, h: float) -> int | None:
+    """+1 or −1: the rotation sense about +z of the speed scale's line at ratio ``h`` (its co-rotating share in the
+    radial pairs, ``co_share``, above or below one half), or None when the pairs do not tell."""
+    ratios = np.asarray(scale.get("ratios") or [], dtype=float)
+    shares = scale.get("co_share") or []
+    if ratios.size == 0 or len(shares) != ratios.size:
+        return None
+    i = int(np.argmin(np.abs(ratios - h)))
+    if abs(ratios[i] / h - 1.0) > SAME_LINE:
+        return None
+    values = [v for v in shares[i] if v is not None and np.isfinite(v)]
+    return None if not values else (1 if float(np.mean(values)) >= 0.5 else -1)
 
 
 def _ratio_of(entry: dict | None) -> tuple:

@@ -86,6 +86,27 @@ def test_rescaled_moves_every_speed_and_ratio_by_the_candidates_ratio():
     assert 1.0 in test.meta["slicing"]["speed_scale"]["ratios"]      # the original left alone
 
 
+def test_rescaled_turns_the_speed_with_the_new_one_x_lines_sense():
+    """A cage line counter-rotating in both radial pairs (as a cage does when the inner race turns with the wheel):
+    the speed's sign is the 1x line's sense about +z, so taking the cage as 1x gives speeds −0.41 × the rotor's
+    (the rotor turns the cage's way), and moving the 1x back to the imbalance turns them round again: the generator's
+    speeds, positive.  Before, the sign was kept, and trial23's run-up (its cage taken as 1x first, then moved to the
+    imbalance by the whirl) read the imbalance counter-rotating, a counter_rotation of q = 1 added."""
+    cage = tuple(x for x in tw.LINES if x[1] != 0.41) + (
+        ("radial_force", 0.41, -1, 0.06 * tw.U_S), ("radial_torque", 0.41, -1, 0.06 * tw.U_D))
+    t, ch, omega = tw.sweep(300.0, 4500.0, 30.0, cage, modes=False)
+    sweep = Sweep(time=t, signals={c: ch[j] for j, c in enumerate(tw.CHANNELS)}, sample_rate=tw.FS, tach=None)
+    test, infos = slice_sweep(sweep, speed_source="data")
+    truth = np.array([omega[i.start:i.stop].mean() for i in infos])
+    assert test.speeds == pytest.approx(truth, rel=2e-3)
+    h_cage = next(c["h"] for c in test.meta["slicing"]["speed_scale"]["one_x"]["candidates"] if abs(c["h"] - 0.41) < 1e-3)
+    on_cage = sw.rescaled(test, h_cage)
+    assert on_cage.speeds == pytest.approx(-h_cage * truth, rel=2e-3)
+    assert on_cage.meta["slicing"]["speed_scale"]["sense"] == -1
+    back = next(c["h"] for c in on_cage.meta["slicing"]["speed_scale"]["one_x"]["candidates"] if abs(c["h"] * h_cage - 1) < 1e-3)
+    assert sw.rescaled(on_cage, back).speeds == pytest.approx(truth, rel=2e-3)
+
+
 def test_settle_follows_the_whirl_and_says_when_it_cannot():
     """:func:`rwadist.speed_whirl.settle` with a stand-in diagnosis whose whirl reads I_zz/I_rr = 1.8 x (true
     speed / speed given), as I_rr·ω² − I_zz·Ω·ω − k_θ = 0 does: taking 3.6 as 1x it reads 0.5, is rejected, and
