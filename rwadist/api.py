@@ -317,10 +317,11 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     Warns
     -----
     RwadistWarning
-        The strongest radial line sits where speeds given k times the wheel's would put the imbalance; no
+        The strongest radial line sits where speeds given k times the wheel's would put the imbalance; a sweep's
+        speed from the data whose 1x line tied with another (the scale unsure: ``rwadist diagnose`` tests it); no
         harmonic passed the presence threshold (the model is empty).
     """
-    from . import data_quality
+    from . import data_quality, speed_whirl
     from .empirical import FitSettings, fit_empirical
     from .spectra import compute_spectra
 
@@ -345,6 +346,8 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     result.model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))
     if text := speed_scale_warning(result, test.meta):
         warnings.warn(RwadistWarning(text.removeprefix("WARNING: ")), stacklevel=2)
+    if text := speed_whirl.fit_tie_warning(test):      # a sweep's speed from the data, its 1x line a tie
+        warnings.warn(RwadistWarning(text), stacklevel=2)
     if not any(result.model.empirical.values()):
         warnings.warn(RwadistWarning(f"no harmonic passed the presence threshold ({presence:g} of the runs): the model "
                                      "is empty; give more runs over the speed range, or lower `presence`"),

@@ -220,12 +220,26 @@ def _judged(test, scale: dict, diagnosis, rec: dict):
         rec["text"] = ("the wheel's rocking mode was not " + ("fitted" if rho_any is None else "located")
                        + ", so its gyroscopic whirl could not test the speed scale")
         if tied:
-            rec["warning"] = ("the data cannot tell the 1x line: the line" + ("s" if len(tied) > 1 else "")
-                              + " at h " + ", ".join(f"{h:.4g}" for h in tied) + " of the one taken "
-                              + ("have" if len(tied) > 1 else "has") + " as many integer multiples, and every "
-                              "ratio holds at either scale (speeds and ratios off by that factor); " + TACH_ADVICE)
+            rec["warning"] = tie_warning(tied)
     scale["whirl"] = rec
     return diagnosis
+
+
+def tie_warning(tied: list, advice: str = TACH_ADVICE) -> str:
+    """The warning of a speed scale whose 1× line tied with the lines at ratios ``tied`` (of the one taken)."""
+    return ("the data cannot tell the 1x line: the line" + ("s" if len(tied) > 1 else "") + " at h "
+            + ", ".join(f"{h:.4g}" for h in tied) + " of the one taken " + ("have" if len(tied) > 1 else "has")
+            + " as many integer multiples, and every ratio holds at either scale (speeds and ratios off by that "
+            "factor); " + advice)
+
+
+def fit_tie_warning(test) -> str | None:
+    """The warning :func:`rwadist.api.fit` gives for a sweep whose speed from the data tied (:func:`tie_warning`; the
+    fit has no modes whose whirl could test it, diagnose has), or None."""
+    scale = data_scale(test)
+    tied = [c["h"] for c in ((scale or {}).get("one_x") or {}).get("tied", [])]
+    return tie_warning(tied, "`rwadist diagnose` tests the scale with the wheel's gyroscopic whirl; or "
+                       + TACH_ADVICE) if tied else None
 
 
 def speed_record(meta, check: dict | None = None) -> dict:

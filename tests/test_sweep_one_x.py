@@ -10,6 +10,7 @@ when diagnose fits the wheel's suspension modes the gyroscopic whirl must read a
 """
 import functools
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -165,6 +166,24 @@ def test_report_says_how_the_speed_was_obtained(tmp_path):
     md = (tmp_path / "report.md").read_text()
     assert "## Speed" in md and "the 1x line" in md and "agree with the speed" in md and "tach" in md
     assert any(abs(x.h - 1.0) < 0.002 for x in diag.model.harmonics("radial_force"))
+
+
+def test_fit_warns_of_a_tied_speed_scale():
+    """``rwadist fit`` fits no modes, so nothing tests a tie of the speed scale: trial 11's hard-mounted 30-s run-up
+    (the ball pass 3.6 with its 2x ties the imbalance with its 2x) is fitted with a warning naming the tied line, diagnose
+    and a tach; with a tach column nothing is said."""
+    from rwadist import api
+    from rwadist.errors import RwadistWarning
+
+    test, _, _ = _sliced(30.0, modes=False)
+    with pytest.warns(RwadistWarning, match=r"cannot tell the 1x line: the line at h 3\.6 .*rwadist diagnose.*tach"):
+        api.fit(test)
+    t, ch, omega = tw.sweep(300.0, 4500.0, 30.0, tw.LINES, modes=False)
+    sweep = Sweep(time=t, signals={c: ch[j] for j, c in enumerate(tw.CHANNELS)}, sample_rate=tw.FS, tach=omega)
+    measured, _ = slice_sweep(sweep, speed_source="tach")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RwadistWarning)
+        api.fit(measured)
 
 
 @pytest.mark.slow
