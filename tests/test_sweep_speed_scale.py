@@ -73,9 +73,13 @@ def test_fitted_lines_on_the_sliced_sweep_are_the_wheels_once_each():
     none twice."""
     from rwadist import api
 
+    from rwadist.errors import RwadistWarning
+
     wheel = fw.family()[0]
     _, test, _ = _run("up", "linear")
-    model = api.fit(test, exclude_modes=False).model
+    # the imbalance and the ball pass 3.08 with its 2x tie: the fit, which tests no whirl, says so
+    with pytest.warns(RwadistWarning, match=r"cannot tell the 1x line: the line at h 3\.08"):
+        model = api.fit(test, exclude_modes=False).model
     for d in fw.DIRECTIONS:
         truth = np.array([ln.h for ln in wheel.lines if ln.direction == d])
         hs = sorted(x.h for x in model.harmonics(d))
