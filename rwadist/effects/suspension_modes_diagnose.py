@@ -23,7 +23,8 @@ from ..diagnose.modes_trend import beside_trend
 from ..diagnose.stands import StandGroup
 from ..diagnose.state import State
 from ..model import Harmonic, WheelModel
-from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode, stand_starts
+from ..stand_resonance import (SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode,
+                               modes_beside_moving, stand_starts)
 from .cross_coupling_diagnose import OFFSET_Z, CrossCoupling
 
 
@@ -151,7 +152,8 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             # on an unconstrained mode's direction, or on the forces when every mode is located
             structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
             if structure is not None and not _fixed_across_speeds(ctx, runs, structure):
-                structure = None        # a resonance moving with speed: the open world describes it
+                # a resonance moving with speed: the open world describes it, the modes it hid are located beside it
+                structure = modes_beside_moving(efit, structure)
             if structure is not None:
                 efit = structure
     except ValueError:
