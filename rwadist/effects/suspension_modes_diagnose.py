@@ -23,8 +23,7 @@ from ..diagnose.modes_trend import beside_trend
 from ..diagnose.stands import StandGroup
 from ..diagnose.state import State
 from ..model import Harmonic, WheelModel
-from ..stand_resonance import (SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode,
-                               modes_beside_moving, stand_starts)
+from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode, stand_starts
 from .cross_coupling_diagnose import OFFSET_Z, CrossCoupling
 
 
@@ -120,6 +119,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     from ..data import SteadyTest
     from ..empirical import fit_empirical
     from ..extended_fit import amplification_peaks
+    from ..stand_resonance import modes_beside_moving
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], _recorded_meta(ctx))
