@@ -635,3 +635,27 @@ def least_participation(fits: list):
     c0 = joint_cost(best)
     tied = [j for j in fits if n * np.log(joint_cost(j) / c0) < np.log(max(n, 2))]
     return min(tied, key=lambda j: (abs(1.0 - j.stand[3]), joint_cost(j)))
+
+
+def modes_beside_moving(plain, joint):
+    """The suspension modes ``joint`` located beside a resonance on one direction that moves with speed (its
+    ``stand``, refused as a structure mode: no fixed resonance), without that resonance, or None when they pin no
+    mode ``plain`` (the fit without it) left unconstrained, or leave unconstrained one ``plain`` located.
+
+    The lines such a resonance lifts are no wheel mode's: fitted without it, the mode of that direction is pulled and
+    widened by them, or declared unconstrained (family wheel 6, an axial resonance stiffening 117.5 -> 139 Hz over
+    the speeds beside its 85-Hz axial mode: the axial mode 86.4 Hz, ζ 0.019 for 0.0126, unconstrained, and the lines
+    it misfits held the residual the moving track's cells should).  A fixed resonance fitted over its track (there
+    131 Hz, ζ 0.068: its envelope) takes those lines out of the modes' fit as it is
+    refused (axial 85.02 Hz, ζ 0.014); the modes are that fit's and the resonance stays out of the wheel's model: it
+    moves, and the open world describes it (``moving_resonance``, :mod:`rwadist.diagnose.describe_structure`)."""
+    from dataclasses import replace
+
+    if not set(joint.unconstrained) < set(plain.unconstrained):
+        return None
+    f_r, zeta, gain, *_ = joint.stand
+    notes = [n for n in joint.notes if not n.startswith("structure mode:")]
+    notes.append(f"modes located beside a resonance moving with speed on the {joint.stand_direction} lines (fitted as "
+                 f"fixed over its track: {f_r:.4g} Hz, ζ {zeta:.3g}, peak gain {gain:.3g}), which is not the wheel's "
+                 "model: `rwadist diagnose` describes it (moving_resonance)")
+    return replace(joint, stand=None, stand_direction=None, notes=notes)

@@ -119,6 +119,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     from ..data import SteadyTest
     from ..empirical import fit_empirical
     from ..extended_fit import amplification_peaks
+    from ..stand_resonance import modes_beside_moving
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], _recorded_meta(ctx))
@@ -151,7 +152,8 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             # on an unconstrained mode's direction, or on the forces when every mode is located
             structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
             if structure is not None and not _fixed_across_speeds(ctx, runs, structure):
-                structure = None        # a resonance moving with speed: the open world describes it
+                # a resonance moving with speed: the open world describes it, the modes it hid are located beside it
+                structure = modes_beside_moving(efit, structure)
             if structure is not None:
                 efit = structure
     except ValueError:
