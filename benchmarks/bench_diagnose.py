@@ -122,6 +122,22 @@ describe.finish 0.06 s; the state errors 0.08 s; the starting empirical fit 0.04
 2026-12-01, session 22: speed21's part-first refinement removed -- not the same numbers on every data set: family
 wheel 7's 60 s run-up (benchmarks/sweep_speed_family.py) kept a local minimum of the part, rocking +2.04 % (its
 rows: tests/data/scan_rocking_runup_wheel7.json); the refinement grid is searched whole again.
+2026-12-01, session 23 (speed23): the extended fit's damping profiles (extended_fit_damping.damping_interval, ~25
+points a mode) read the residuals alone (extended_fit_lsq._Residuals.value: the same numbers, no Jacobian), and
+LinePower sums its d_C cells by one bincount (np.add.at's numbers) with its subsystem masks made once: in-call CPU of a
+sixty-set diagnose damping_interval 34 -> 11 ms, fit_modes 89 -> 64 ms (~1.7 % of its 1.43 s); summary.json, model.json,
+hypotheses.csv, rms_vs_speed.csv of both sets identical.  --quick --repeats 3 --busy 0 alternated (land, new, new,
+land) at load 4.7-5.5: cpu min/median benchmark x9.9/x9.6, x12.3/x11.8 (land) against x10.8/x9.8, x13.0/x9.2; sixty
+x14.4/x13.7, x14.6/x14.4 against x14.2/x14.1, x14.0/x14.0; a second round at load 4.1-5.4: benchmark x10.7/x10.3,
+x10.7/x10.0 against x11.1/x10.4, x9.3/x9.0, sixty x14.2/x14.3, x14.3/x14.4 against x14.3/x13.8, x13.7/x13.5 (sixty
+diagnose cpu min 1.44-1.49 s -> 1.40-1.48 s): within this noise; target not met.  Where a sixty diagnose's
+1.41 s go (in-call CPU timers): the suspension modes 0.52 s (the mode scans 0.24 s, of which the single-precision
+screens 0.21 s at ~8 ns a grid point and row -- ~19 elementwise passes and 13 products with the line indicator of 6
+lines, numpy's floor without fusing them; the whole data's empirical fit at the fit's resolution 0.094 s, which is
+the plain fit's own work again; the least squares 0.064 s; the offset check 0.041 s), the other families 0.46 s, none
+over 0.08 s.  No record transform, grid search or least squares repeats its arguments (checked by hashing every
+call's inputs); the FFTs of different steps use different windows (np.hanning, the periodic Hann, Welch's scaled
+one) or paddings, so none can be shared with the same numbers.
 """
 from __future__ import annotations
 

@@ -68,7 +68,6 @@ def damping_interval(problem: LogAmplitudeProblem, solution: Solution, free_mode
         t[2 * i + 1] = math.log(z * root)
         r = residuals(t)
         cost[k] = float(np.sum(r**2 / s2))
-    residuals(theta)                    # the residual function's cache back at the fit
     level = cost.min() + PROFILE_RISE
     inside = np.flatnonzero(cost <= level)
 

@@ -142,8 +142,8 @@ class Solution(NamedTuple):
     at_bound : per free mode, the limit its best fit sits at ("stiffness", "damping") or "".
     cov : covariance of θ (:func:`_covariance`), shape (θ, θ); NaN where it could not be computed.
     s2_row : per row its direction's residual variance (:func:`_row_variance`), shape like ``res.fun``.
-    residuals : θ -> the rows' residuals as fitted (weighted), the function the least squares minimised (a damping's
-        profile, :func:`rwadist.extended_fit_damping.damping_interval`).
+    residuals : θ -> the rows' residuals as fitted (weighted), the function the least squares minimised, without its
+        Jacobian (:meth:`_Residuals.value`: a damping's profile, :func:`rwadist.extended_fit_damping.damping_interval`).
     """
 
     res: optimize.OptimizeResult
@@ -263,7 +263,7 @@ class LogAmplitudeProblem:
             # a held damping is no limit the fit ran into
             at_bound = {m: ("" if m in self.held_zeta and why == "damping" else why) for m, why in at_bound.items()}
         return Solution(res, names, rel_se, lambda theta: self.unpack(modes, theta), at_bound, cov, s2_row,
-                        residuals.residuals)
+                        residuals.value)
 
     def row_directions(self) -> np.ndarray:
         """Per least-squares row, the index of its measured line's load direction (radial force, radial torque,
@@ -311,15 +311,26 @@ class _Residuals:
         self._at(theta)
         return self.J
 
-    def _at(self, theta: np.ndarray) -> None:
-        key = theta.tobytes()
-        if self.key == key:
-            return
-        p, free_modes = self.problem, self.free_modes
-        n_mode, n_c, n_off = 2 * len(free_modes), len(p.lines), len(self.off_rows)
+    def value(self, theta: np.ndarray) -> np.ndarray:
+        """:meth:`residuals` at θ without the Jacobian (the same numbers: the same operations in the same order), the
+        cache left as it is: what a damping's profile (:func:`rwadist.extended_fit_damping.damping_interval`) reads at
+        each of its ~25 points."""
+        p = self.problem
+        n_mode, n_c, n_off = 2 * len(self.free_modes), len(p.lines), len(self.off_rows)
+        vals, _ = self._vals(theta)
+        log_data = p.log_data if p.joint is None else \
+            p.log_data - 0.5 * p.joint.log_gain(theta[n_mode + n_c + n_off:])[0]
+        r = p.power.log_residuals(vals, theta[n_mode:n_mode + n_c], log_data, derivatives=False)[0]
+        for i, L in enumerate(self.off_rows):
+            r = r - theta[n_mode + n_c + i] * L
+        return r * self.weights if self.weights is not None else r
+
+    def _vals(self, theta: np.ndarray) -> tuple:
+        """(the :class:`~rwadist.extended.ExtendedParams` fields at θ, per free mode whether its damping is clamped)."""
+        p = self.problem
         vals = dict(p.base)
         clamped = {}
-        for i, m in enumerate(free_modes):
+        for i, m in enumerate(self.free_modes):
             kn, cn, inertia = MODE_PARAMS[m]
             vals[kn] = math.exp(theta[2 * i])
             crit = 1.9 * math.sqrt(vals[kn] * vals[inertia])
@@ -330,6 +341,15 @@ class _Residuals:
                 continue
             clamped[m] = math.exp(theta[2 * i + 1]) > crit
             vals[cn] = min(math.exp(theta[2 * i + 1]), crit)
+        return vals, clamped
+
+    def _at(self, theta: np.ndarray) -> None:
+        key = theta.tobytes()
+        if self.key == key:
+            return
+        p, free_modes = self.problem, self.free_modes
+        n_mode, n_c, n_off = 2 * len(free_modes), len(p.lines), len(self.off_rows)
+        vals, clamped = self._vals(theta)
         if p.joint is None:
             r, d_mode, d_C = p.power.log_residuals(vals, theta[n_mode:n_mode + n_c], p.log_data)
             J = np.zeros((r.size, theta.size))

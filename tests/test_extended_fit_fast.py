@@ -93,3 +93,41 @@ def test_scan_transmissibility_is_the_complex_ratio():
     d = 2 * z[:, None] * w0 * nu[None, :]
     ref = np.abs(w0**2 + 1j * d) ** 2 / np.abs(w0**2 - nu**2 + a[:, None] * np.abs(om) * nu + 1j * d) ** 2
     np.testing.assert_allclose(transmissibility_sq(nu, om, f0, z, a), ref, rtol=1e-12)
+
+
+def test_line_power_cells_sum_as_add_at_does():
+    # d_C sums each (row, line) cell's terms by one bincount over lp.cell: the numbers of np.add.at over (row, line)
+    # in the same order, bit for bit (a radial row holds two terms; a co/counter pair of one line shares a cell)
+    _, _, _, _, lp = _case()
+    w = np.random.default_rng(3).normal(size=lp.row.size)
+    ref = np.zeros((lp.n_rows, lp.n_lines))
+    np.add.at(ref, (lp.row, lp.line), w)
+    got = np.bincount(lp.cell, w, minlength=lp.n_rows * lp.n_lines).reshape(lp.n_rows, lp.n_lines)
+    assert np.array_equal(got, ref)
+    # every live row's shares sum to one: its d_C row to -1
+    _, _, d_c = lp.log_residuals(VALS, np.log([ln.C for ln in LINES]), np.zeros(lp.n_rows))
+    np.testing.assert_allclose(d_c.sum(axis=1)[d_c.any(axis=1)], -1.0, rtol=1e-12)
+
+
+def test_residuals_alone_are_those_of_the_jacobians_evaluation():
+    # a damping's profile reads _Residuals.value: the residuals of the least squares' own evaluation bit for bit, with
+    # a freed exponent, row weights, a clamped and a held damping, and the cache of the Jacobian left as it was
+    from rwadist.extended_fit_lsq import LogAmplitudeProblem, _Residuals
+
+    om, _, _, _, lp = _case()
+    rng = np.random.default_rng(4)
+    base = dict(VALS, height=0.0, U_s=0.0, U_d=0.0)
+    row_line = rng.integers(0, 3, lp.n_rows)
+    problem = LogAmplitudeProblem(base, LINES, lp, rng.normal(size=lp.n_rows), None, row_line,
+                                  rng.normal(size=lp.n_rows), [], held_zeta={"axial_translation": 0.02})
+    modes = ["radial_translation", "rocking", "axial_translation"]
+    res = _Residuals(problem, modes, [np.where(row_line == 1, problem.centred_log_w, 0.0)])
+    theta0 = np.concatenate([np.log([VALS[k] for k in ("k_r", "c_r", "k_rock", "c_rock", "k_z", "c_z")]),
+                             np.log([ln.C for ln in LINES]), [0.3]])
+    for weights in (None, rng.uniform(0.2, 1.0, lp.n_rows)):
+        res.weights = weights
+        for shift in (0.0, 0.4, 9.0):                  # 9: the rocking damping beyond critical, clamped
+            theta = theta0 + shift * (np.arange(theta0.size) == 3) + 0.01 * rng.normal(size=theta0.size)
+            alone = res.value(theta)
+            assert res.key != theta.tobytes()          # the cache untouched
+            assert np.array_equal(alone, res.residuals(theta))
