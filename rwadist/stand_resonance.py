@@ -469,8 +469,8 @@ def fit_every_stand(test, fit, joint, kwargs: dict):
     ``more_stands``, found one at a time: :func:`beside_more_stands`) fitted free at once with
     the modes (:class:`rwadist.stand_every.FittedStands`), the modes located again beside each pass's stands until they settle
     (:data:`JOINT_PASSES` at most; the scans searching first where ``joint`` located them),
-    or ``joint`` itself when it has one stand or its cost (:func:`joint_cost`) is not above this
-    fit's.  ``kwargs`` passed on to :func:`rwadist.extended_fit.fit_extended`."""
+    or ``joint`` itself when it has one stand or its noise-weighted cost (:func:`noise_weighted_cost`) is not above
+    this fit's.  ``kwargs`` passed on to :func:`rwadist.extended_fit.fit_extended`."""
     from .extended_fit import fit_extended
 
     if joint.stand is None or not joint.more_stands:
