@@ -633,9 +633,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                        unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
                        line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
-                       zeta_bounds=zeta_bounds, zeta_interval=intervals,
-                       more_stands=tuple(tuple(float(v) for v in k) for k in more_stands),
-                       line_noise=np.asarray(problem.row_noise, dtype=float))
+                       zeta_bounds=zeta_bounds, zeta_interval=intervals, line_noise=np.concatenate([na, nr]),
+                       more_stands=tuple(tuple(float(v) for v in k) for k in more_stands))
 
 
 def _mode_hz_of(params: ext.ExtendedParams, mode: str) -> float:
