@@ -121,6 +121,8 @@ class ExtendedFit:
         frequency and r = ln(measured / model amplitude) (radial lines: of sqrt(x² + y²)), the stand divided out (and
         a line whose exponent the fit freed, :func:`rwadist.off_law_lines.off_law_line`, taken with its own growth);
         direction its load direction ("axial_force", "radial_force", "radial_torque").
+    line_noise : per row of ``line_residuals``, the standard deviation of its log amplitude the noise under the line
+        makes (dimensionless; 0 where not measured; :attr:`rwadist.empirical.LineFit.noise`).
     zeta_bounds : per located mode whose damping the data do not measure, (lo, hi) the damping ratios they allow; its
         ζ is held (:mod:`rwadist.extended_fit_damping`), written as zeta_<mode> to ``analytical.unconstrained``.
     zeta_interval : per located mode whose damping was profiled, (lo, hi) the damping ratios the data allow (a held
@@ -147,6 +149,7 @@ class ExtendedFit:
     zeta_bounds: dict = field(default_factory=dict)
     zeta_interval: dict = field(default_factory=dict)
     more_stands: tuple = ()         # further fixture resonances divided out of every line, held (``more_stands``)
+    line_noise: np.ndarray = field(default_factory=lambda: np.empty(0))     # per row of line_residuals, σ_noise
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -630,7 +633,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                        unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
                        line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
-                       zeta_bounds=zeta_bounds, zeta_interval=intervals,
+                       zeta_bounds=zeta_bounds, zeta_interval=intervals, line_noise=np.concatenate([na, nr]),
                        more_stands=tuple(tuple(float(v) for v in k) for k in more_stands))
 
 
