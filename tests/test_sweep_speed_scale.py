@@ -72,7 +72,6 @@ def test_fitted_lines_on_the_sliced_sweep_are_the_wheels_once_each():
     """The empirical fit of the sliced run-up (600 -> 6000 rpm in 60 s): every line within 0.2 % of a true ratio,
     none twice."""
     from rwadist import api
-
     from rwadist.errors import RwadistWarning
 
     wheel = fw.family()[0]
