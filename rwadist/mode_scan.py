@@ -82,8 +82,6 @@ def transmissibility_sq(nu, omega, f0_hz, zeta, a):
     return (w02**2 + d2) / ((w02 - nu**2 + a * om * nu) ** 2 + d2)
 
 
-
-
 class _Segments:
     """Per-line sums over the last axis (the rows sorted by line: ``starts``, ``counts`` rows each).  In double precision
     segment sums (:func:`numpy.add.reduceat`: each point's sums the same numbers whichever grid holds it); in single

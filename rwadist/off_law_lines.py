@@ -88,7 +88,8 @@ def free_off_law_lines(fit_with, loose_of, off_law: list, row_line: np.ndarray, 
     while True:
         skip = list(off_law) + list(lawful)
         if len(off_law) >= MAX_OFF_LAW_LINES:
-            skip += [k for k in range(n_lines) if not same_harmonic(k, off_law, line_h)]
+            # the harmonics are those of the lines freed up to the cap (a match never chains from a follower)
+            skip += [k for k in range(n_lines) if not same_harmonic(k, off_law[:MAX_OFF_LAW_LINES], line_h)]
         j = off_law_line(fit[0].fun, row_line, log_w, skip)
         if j is None:
             break

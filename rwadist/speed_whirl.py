@@ -84,9 +84,10 @@ def rescaled(test, h: float):
         return type(test)(list(test.runs), meta)
     sl = meta["slicing"]
     sc = sl["speed_scale"]
-    # the speed's sign is the 1x line's rotation sense (about +z): a cage line turns against the rotor, so moving
-    # the 1x from it to the imbalance turns every speed round too (trial23: kept, the imbalance read counter-rotating)
-    sense = _line_sense(sc, h)
+    # the speed's sign is the 1x line's rotation sense about +z: moving the 1x to a line turning the other way turns
+    # every speed round too (trial23's counter-rotating line at 0.39 taken first: the sign kept, the imbalance read
+    # counter-rotating)
+    sense, shares = _line_sense(sc, h)
     flip = 1.0 if sense is None or sense == sc.get("sense", 1) else -1.0
     sc["sense"] = sc.get("sense", 1) if sense is None else sense
     sc["ratios"] = sorted(round(r / h, 6) for r in sc["ratios"])
@@ -98,6 +99,9 @@ def rescaled(test, h: float):
     one["candidates"] = others
     one["tied"] = [c for c in others if len(c["multiples_found"]) == len(moved.get("multiples_found", []))]
     one["multiples_found"] = moved.get("multiples_found", [])
+    for k, pair in enumerate(("force", "torque")):      # the new 1x line's co shares (:func:`_line_sense`)
+        if shares is not None and f"co_share_{pair}" in one and k < len(shares):
+            one[f"co_share_{pair}"] = shares[k]
     if "order" in one and one["order"] is not None:
         one["order"] = one["order"] * h
     if "min_speed_rpm" in sl:
@@ -107,18 +111,26 @@ def rescaled(test, h: float):
     return type(test)([replace(r, speed=r.speed * h * flip) for r in test.runs], meta)
 
 
-def _line_sense(scale: dict, h: float) -> int | None:
-    """+1 or −1: the rotation sense about +z of the speed scale's line at ratio ``h`` (its co-rotating share in the
-    radial pairs, ``co_share``, above or below one half), or None when the pairs do not tell."""
+def _line_sense(scale: dict, h: float) -> tuple:
+    """(+1 or −1, the line's co shares) of the speed scale's line at ratio ``h``: its rotation sense about +z, as
+    :func:`rwadist.speed_scale.imbalance_line` reads a 1× candidate's (every pair's co share at least
+    :data:`rwadist.speed_scale.POLARIZED` one way, the same way in every pair), or (None, shares) when the pairs do not
+    tell (a line turning no one way, or the pairs disagreeing: no speed is turned round on that)."""
+    from .speed_scale import POLARIZED
+
     ratios = np.asarray(scale.get("ratios") or [], dtype=float)
     shares = scale.get("co_share") or []
     if ratios.size == 0 or len(shares) != ratios.size:
-        return None
+        return None, None
     i = int(np.argmin(np.abs(ratios - h)))
     if abs(ratios[i] / h - 1.0) > SAME_LINE:
-        return None
-    values = [v for v in shares[i] if v is not None and np.isfinite(v)]
-    return None if not values else (1 if float(np.mean(values)) >= 0.5 else -1)
+        return None, None
+    values = [float(v) for v in shares[i] if v is not None and np.isfinite(v)]
+    if values and all(v >= POLARIZED for v in values):
+        return 1, shares[i]
+    if values and all(v <= 1 - POLARIZED for v in values):
+        return -1, shares[i]
+    return None, shares[i]
 
 
 def _ratio_of(entry: dict | None) -> tuple:

@@ -275,7 +275,8 @@ def noise_weighted_cost(efit) -> float:
     gain 4.76), and 0.138 of the difference was one row: the axial 2xBPFO line at 197.2 Hz, its log amplitude's
     noise σ 0.37 (the rows' median 0.028), residual +0.379 against +0.074.  Weighed by their scatter the rows cost
     37.6 against 56.9, and the stands fitted at once left the error after 2.96x the clean cell's instead of 8.3x.
-    Rows whose noise was not measured (σ 0) weigh 1/s² each."""
+    Rows whose noise was not measured (σ 0) weigh 1/s² each; rows whose residual or noise is not a number (a line
+    not measured at that speed) are left out, as the plain cost leaves them."""
     r = np.asarray(efit.line_residuals[1], dtype=float)
     sigma = np.asarray(getattr(efit, "line_noise", np.empty(0)), dtype=float)
     if sigma.shape != r.shape:

@@ -142,3 +142,23 @@ def test_the_pair_carries_its_carriers_rotation_sense():
     effect = SpeedSidebands("radial_force", 4.7, 4.6, 4.8, 0.2, 0.2, 1.0)
     added = [x for x in effect.apply(State(only_counter, {})).model.harmonics("radial_force") if x.h != 4.7]
     assert [(x.h, x.C, x.sense) for x in added] == [(4.6, 0.2, "counter"), (4.8, 0.2, "counter")]
+
+
+def test_a_carriers_parts_give_one_pair_from_the_base():
+    """The base the suspension modes fitted lists a pair per rotation-sense part of a split carrier (co 0.8, counter
+    0.6 of the carrier; each part's pair 0.2 × it): one pair is proposed, whose sides hold both parts' power
+    (C = hypot of the parts' C: 0.2 × 1.0)."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose.state import State
+    from rwadist.effects.speed_sidebands_diagnose import SpeedSidebands
+    from rwadist.model import Harmonic, WheelModel
+
+    model = WheelModel(name="split carrier")
+    model.empirical["radial_force"] = [Harmonic(1.0, 0.8, sense="co"), Harmonic(1.0, 0.6, sense="counter")]
+    modes = SimpleNamespace(kind="suspension_modes", sideband_pairs=(
+        ("radial_force", 1.0, 0.94, 1.06, 0.16, 0.16, 20), ("radial_force", 1.0, 0.94, 1.06, 0.12, 0.12, 18)))
+    pairs = SpeedSidebands._from_base(State(model, {}, [modes]), [])
+    assert len(pairs) == 1
+    assert (pairs[0].C_lower, pairs[0].C_upper) == pytest.approx((0.2, 0.2), rel=1e-12)
+    assert pairs[0].n_points == 20

@@ -55,3 +55,13 @@ def test_same_harmonic_is_the_models_tolerance():
     h = [3.3, 3.3 + 0.99 * LAW_H_TOL, 3.3 + 1.01 * LAW_H_TOL]
     assert same_harmonic(1, [0], h) and not same_harmonic(2, [0], h)
     assert same_harmonic(0, [0]) and not same_harmonic(1, [0])
+
+
+def test_a_follower_past_the_cap_does_not_chain_the_match():
+    """h 3.2994 freed up to the cap; 3.3003 follows (within 0.001 of it); 3.3012 is 0.0018 from 3.2994 and must not
+    follow through 3.3003."""
+    line_h = [2.0, 3.2994, 3.3003, 3.3012]
+    fit_with, row_line, log_w = _problem([0.9, 0.6, 0.3, 0.2])
+    off_law: list = []
+    free_off_law_lines(fit_with, lambda fit: [], off_law, row_line, log_w, (), line_h)
+    assert sorted(off_law) == [0, 1, 2]

@@ -88,10 +88,9 @@ def test_rescaled_moves_every_speed_and_ratio_by_the_candidates_ratio():
 
 
 def test_rescaled_turns_the_speed_with_the_new_one_x_lines_sense():
-    """A cage line counter-rotating in both radial pairs (as a cage does when the inner race turns with the wheel):
-    the speed's sign is the 1x line's sense about +z, so taking the cage as 1x gives speeds −0.41 × the rotor's
-    (the rotor turns the cage's way), and moving the 1x back to the imbalance turns them round again: the generator's
-    speeds, positive.  Before, the sign was kept, and trial23's run-up (its cage taken as 1x first, then moved to the
+    """A line at h 0.41 counter-rotating in both radial pairs (trial23's generator has its cage line so): the speed's
+    sign is the 1x line's sense about +z, so taking that line as 1x gives speeds −0.41 × the rotor's, and moving
+    the 1x back to the imbalance turns them round again: the generator's speeds, positive.  Before, the sign was kept, and trial23's run-up (its cage taken as 1x first, then moved to the
     imbalance by the whirl) read the imbalance counter-rotating, a counter_rotation of q = 1 added."""
     cage = tuple(x for x in tw.LINES if x[1] != 0.41) + (
         ("radial_force", 0.41, -1, 0.06 * tw.U_S), ("radial_torque", 0.41, -1, 0.06 * tw.U_D))
@@ -104,6 +103,7 @@ def test_rescaled_turns_the_speed_with_the_new_one_x_lines_sense():
     on_cage = sw.rescaled(test, h_cage)
     assert on_cage.speeds == pytest.approx(-h_cage * truth, rel=2e-3)
     assert on_cage.meta["slicing"]["speed_scale"]["sense"] == -1
+    assert on_cage.meta["slicing"]["speed_scale"]["one_x"]["co_share_force"] < 0.4      # the new 1x line's evidence
     back = next(c["h"] for c in on_cage.meta["slicing"]["speed_scale"]["one_x"]["candidates"] if abs(c["h"] * h_cage - 1) < 1e-3)
     assert sw.rescaled(on_cage, back).speeds == pytest.approx(truth, rel=2e-3)
 
@@ -205,3 +205,12 @@ def test_whirl_brings_back_the_imbalance_from_a_wrong_scale():
     truth = np.array([omega[i.start:i.stop].mean() for i in infos])          # the runs' order
     assert diag.ctx.test.speeds == pytest.approx(test.speeds, rel=1e-5)
     assert np.median(np.abs(diag.ctx.test.speeds / truth - 1)) < 0.0005
+
+
+def test_a_line_turning_no_one_way_turns_no_speed_round():
+    """The sense of the line a speed scale moves its 1x to is read as the 1x candidates are (every pair's co share
+    >= POLARIZED one way): a line with shares 0.52 / 0.47, or pairs that disagree (0.9 / 0.2), tells no sense."""
+    scale = {"ratios": [0.41, 1.0, 2.0], "co_share": [[0.52, 0.47], [0.9, 0.2], [0.1, None]]}
+    assert sw._line_sense(scale, 0.41)[0] is None
+    assert sw._line_sense(scale, 1.0)[0] is None
+    assert sw._line_sense(scale, 2.0)[0] == -1

@@ -12,6 +12,7 @@ from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.measure import _measure, refine_h
 from ..diagnose.state import State
+from ..extended import LAW_H_TOL
 from ..model import Harmonic
 from ..units import DIRECTION_CHANNELS
 
@@ -295,8 +296,8 @@ def _eq310_C(d: np.ndarray, w: np.ndarray):
 @register(order=15)
 @dataclass
 class SpeedSidebands:
-    """Two co-rotating lines at h_lower·|Ω| and h_upper·|Ω| (h_lower < h₀ < h_upper) beside the carrier line h₀ of
-    a direction: an amplitude modulation of the carrier at δ·|Ω| (a cage or a bearing defect's once-per-δ-rev
+    """Two lines of the carrier's rotation sense at h_lower·|Ω| and h_upper·|Ω| (h_lower < h₀ < h_upper) beside the
+    carrier line h₀ of a direction: an amplitude modulation of the carrier at δ·|Ω| (a cage or a bearing defect's once-per-δ-rev
     beat, a tone ring) puts them at (h₀ ± δ)|Ω| with amplitudes (m/2)·C₀Ω² each.  They move with the speed, so
     they are harmonics (``missing_harmonic`` would take each, if it could see them): the model file gets two
     harmonics C_lower, C_upper (every consumer reads them) and this record.  Close to a strong line they are
@@ -334,7 +335,7 @@ class SpeedSidebands:
         """[(sense, share)] of the model's carrier line h0 in ``state``: each rotation-sense part of it ('co',
         'counter', 'planar') and its share C_part/√(ΣC²) of the carrier's amplitude (the shares' squares sum to 1: the
         pair keeps its measured power); [(None, 1.0)] for an axial line or a carrier the model does not hold."""
-        parts = [x for x in state.model.harmonics(self.direction) if abs(x.h - self.h0) <= 1e-3 and x.C > 0]
+        parts = [x for x in state.model.harmonics(self.direction) if abs(x.h - self.h0) < LAW_H_TOL and x.C > 0]
         norm = float(np.sqrt(sum(x.C**2 for x in parts)))
         if self.direction == "axial_force" or norm <= 0:
             return [(None, 1.0)]
@@ -379,10 +380,11 @@ class SpeedSidebands:
         m1 = np.zeros((len(chans),) + f.shape)
         for j, c in enumerate(chans):
             for k, h in enumerate(np.round(sides, 4)):
-                a = next((x[2] for x in ctx.channel_lines(applied, c, runs) if abs(x[0] - h) < 1e-6), None)
-                if a is None:
+                # the side's every rotation-sense part (a carrier split co/counter gives its pair two, apply())
+                a2 = [x[2] ** 2 for x in ctx.channel_lines(applied, c, runs) if abs(x[0] - h) < 1e-6]
+                if not a2:
                     return None
-                m1[j, :, k] = (a * ctx.gain(applied, c, f[:, k])) ** 2
+                m1[j, :, k] = sum(a2) * ctx.gain(applied, c, f[:, k]) ** 2
         P = np.moveaxis(P, 2, 0).reshape(len(chans), -1)
         N = np.moveaxis(N, 2, 0).reshape(len(chans), -1)
         use = np.broadcast_to(ok.reshape(1, -1), P.shape)
@@ -396,8 +398,8 @@ class SpeedSidebands:
                 "ratio_lower": self.C_lower / c0 if c0 > 0 else float("nan"),
                 "ratio_upper": self.C_upper / c0 if c0 > 0 else float("nan"),
                 "depth": (self.C_lower + self.C_upper) / c0 if c0 > 0 else float("nan"), "n_points": self.n_points,
-                "law": "co-rotating lines C_lower*omega^2 at h_lower*|omega| and C_upper*omega^2 at h_upper*|omega| "
-                       "(harmonics of the model); ratio = C/C of the carrier h, depth = ratio_lower + ratio_upper"}
+                "law": "lines of the carrier's rotation sense, C_lower*omega^2 at h_lower*|omega| and C_upper*omega^2 "
+                       "at h_upper*|omega| (harmonics of the model); ratio = C/C of the carrier h, depth = ratio_lower + ratio_upper"}
 
     @staticmethod
     def _carrier_C(state: State, direction: str, h0: float) -> float:
@@ -607,8 +609,14 @@ class SpeedSidebands:
         modes = [e for e in state.effects if getattr(e, "kind", "") == "suspension_modes"]
         done = {(e.direction, round(e.h0, 3)) for e in state.effects if isinstance(e, SpeedSidebands)} | \
             {(e.direction, round(e.h0, 3)) for e in found}
-        out = []
+        # one pair per carrier: the base lists a pair per rotation-sense part (a carrier split co/counter), whose
+        # powers add (apply() splits the pair again as its carrier)
+        pairs: dict = {}
         for d, h0, hl, hu, cl, cu, n in (getattr(modes[-1], "sideband_pairs", ()) if modes else ()):
-            if (d, round(h0, 3)) not in done and state.model.harmonics(d):
-                out.append(SpeedSidebands(d, h0, hl, hu, cl, cu, SpeedSidebands._carrier_C(state, d, h0), n))
-        return out
+            key = (d, round(h0, 3))
+            if key in pairs:
+                _, _, _, _, cl0, cu0, n0 = pairs[key]
+                cl, cu, n = float(np.hypot(cl0, cl)), float(np.hypot(cu0, cu)), max(n0, n)
+            pairs[key] = (d, h0, hl, hu, cl, cu, n)
+        return [SpeedSidebands(d, h0, hl, hu, cl, cu, SpeedSidebands._carrier_C(state, d, h0), n)
+                for key, (d, h0, hl, hu, cl, cu, n) in pairs.items() if key not in done and state.model.harmonics(d)]
