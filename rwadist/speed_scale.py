@@ -260,6 +260,21 @@ def slice_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray
     return out
 
 
+def polarized_senses(shares: list, n: int) -> np.ndarray:
+    """Per line, its rotation sense about +z, +1 or −1, where every pair's co share (``shares``: one array (n,) per
+    radial pair) is finite and at least :data:`POLARIZED` the same way; 0 elsewhere (a line turning no one way, absent
+    from a pair, or the pairs disagreeing), and 0 for every line with no pair."""
+    sense = np.zeros(n)
+    ok = np.full(n, bool(shares))
+    for s in shares:
+        s = np.asarray(s, dtype=float)
+        pol = np.where(s >= POLARIZED, 1.0, np.where(s <= 1 - POLARIZED, -1.0, 0.0))
+        pol = np.where(np.isfinite(s), pol, 0.0)
+        ok &= pol != 0
+        sense = np.where(sense == 0, pol, np.where(sense == pol, sense, 0.0))
+    return np.where(ok, sense, 0.0)
+
+
 def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tuple:
     """The 1× line among the template's lines (module docstring, step 2).
 
@@ -284,14 +299,8 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
     """
     share = {key: v[0] for key, v in senses.items()}
     n = orders.size
-    sense = np.zeros(n)
-    cand = np.ones(n, dtype=bool)
-    for s in share.values():
-        pol = np.where(s >= POLARIZED, 1.0, np.where(s <= 1 - POLARIZED, -1.0, 0.0))
-        pol = np.where(np.isfinite(s), pol, 0.0)
-        cand &= pol != 0
-        sense = np.where(sense == 0, pol, np.where(sense == pol, sense, 0.0))
-    cand &= sense != 0
+    sense = polarized_senses(list(share.values()), n)
+    cand = sense != 0
     how = ("one sense in " + " and ".join({"F": "radial force", "T": "radial torque"}[k] for k in share)
            if share else "no radial x/y pair recorded: every line a candidate")
     if not cand.any():

@@ -113,10 +113,10 @@ def rescaled(test, h: float):
 
 def _line_sense(scale: dict, h: float) -> tuple:
     """(+1 or −1, the line's co shares) of the speed scale's line at ratio ``h``: its rotation sense about +z, as
-    :func:`rwadist.speed_scale.imbalance_line` reads a 1× candidate's (every pair's co share at least
-    :data:`rwadist.speed_scale.POLARIZED` one way, the same way in every pair), or (None, shares) when the pairs do not
-    tell (a line turning no one way, or the pairs disagreeing: no speed is turned round on that)."""
-    from .speed_scale import POLARIZED
+    :func:`rwadist.speed_scale.imbalance_line` reads a 1× candidate's (:func:`rwadist.speed_scale.polarized_senses`),
+    or (None, shares) when the pairs do not tell (a line turning no one way, or the pairs disagreeing: no speed is
+    turned round on that)."""
+    from .speed_scale import polarized_senses
 
     ratios = np.asarray(scale.get("ratios") or [], dtype=float)
     shares = scale.get("co_share") or []
@@ -125,12 +125,10 @@ def _line_sense(scale: dict, h: float) -> tuple:
     i = int(np.argmin(np.abs(ratios - h)))
     if abs(ratios[i] / h - 1.0) > SAME_LINE:
         return None, None
-    values = [float(v) for v in shares[i] if v is not None and np.isfinite(v)]
-    if values and all(v >= POLARIZED for v in values):
-        return 1, shares[i]
-    if values and all(v <= 1 - POLARIZED for v in values):
-        return -1, shares[i]
-    return None, shares[i]
+    # the pairs the line was read in (a pair not recorded holds None)
+    values = [np.array([float(v)]) for v in shares[i] if v is not None and np.isfinite(v)]
+    sense = int(polarized_senses(values, 1)[0])
+    return (sense or None), shares[i]
 
 
 def _ratio_of(entry: dict | None) -> tuple:
