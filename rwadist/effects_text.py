@@ -44,8 +44,13 @@ def diagnose_lines(effects) -> list:
     gain each brought."""
     out = []
     for e in effects:
-        gain = (e.get("evidence") or {}).get("heldout_gain_fraction")
-        tail = f" (held-out gain {100 * float(gain):.1f} %)" if gain is not None else ""
+        ev = e.get("evidence") or {}
+        gain, narrow = ev.get("heldout_gain_fraction"), ev.get("heldout_narrow_gain_fraction")
+        tail = f" (held-out gain {100 * float(gain):.1f} %" if gain is not None else ""
+        if tail and narrow is not None:
+            # taken on the narrow-line misfit (rwadist.diagnose.search._narrow_judge): the share a reviewer sees
+            tail += f" of the misplaced power, {100 * float(narrow):.1f} % of the narrow-line misfit"
+        tail += ")" if tail else ""
         out.append(f"  + {describe_effect(e)}{tail}")
     return out
 

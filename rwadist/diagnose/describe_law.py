@@ -1,5 +1,7 @@
 """``line_property`` (property ``amplitude_law``): a model line whose amplitude departs from C·Ω² as a law Ω^p the
-search measured to many standard errors on the held-out runs but did not add, its held-out gain below ``min_gain``.
+search measured to many standard errors on the held-out runs but did not add, its held-out gain below ``min_gain``
+of the misplaced power and of the narrow-line misfit (:func:`rwadist.diagnose.search._narrow_judge` names a law
+above it on the narrow lines: trial21's below, now named).
 
 The acceptance rule's ``min_gain`` is a share of the held-out misplaced power of every channel (docs/diagnose.md,
 "Acceptance rule"), a power-weighted sum: a law on a weak line (a bearing line 20-40 dB under the imbalance) gains
@@ -7,7 +9,8 @@ little of it however well it is measured, and the more so when another misfit ho
 Ω^2.6 on a bearing line h 3.3 (radial force and Fz): the law took the line's residual in its bands from up to 128 and
 273 noise standard deviations to within 1-3 (t 187), but those bands held 0.2 % (Fx, Fy) and 4 % (Fz) of their
 channels' misplaced power, and the torques' misfit at the rocking whirl crossings held 85 % of all of it: a held-out
-gain of 0.03-0.06 % of the misplaced power, and the law appeared nowhere.  Such a law is no noise and no model
+gain of 0.03-0.06 % of the misplaced power, and the law appeared nowhere.  Such a law, below ``min_gain`` of the
+narrow-line misfit as well, is no noise and no model
 imperfection (its exponent is told from 2 by :meth:`AmplitudeLaw.significant` on every run): it is described here,
 with its exponent, its standard error and its held-out evidence.
 """

@@ -388,8 +388,11 @@ def write_report(diag: Diagnosis, out_dir) -> list:
         par = ", ".join(f"{k} = {_fmt(v, '.5g')}"
                         for k, v in h.effect.params().items() if not (isinstance(v, list) and len(v) > 4))
         words = describe_effect({"kind": h.effect.kind, **h.effect.params()})
+        narrow = ("" if h.narrow_gain_fraction is None
+                  else f", {h.narrow_gain_fraction:.1%} of the narrow-line misfit (taken on it: its power share is "
+                       "below min_gain)")
         md.append(f"- **{words}**: held-out gain {h.gain_fraction:.1%} of the unexplained "
-                  f"power, {h.t:.1f} noise standard errors (parameters: {par})")
+                  f"power{narrow}, {h.t:.1f} noise standard errors (parameters: {par})")
     if diag.model_given and diag.state_after.base != diag.state_before.base:
         missing = diag.lines_missing_from_given_model()
         md += ["", "## The given model's harmonics", "",

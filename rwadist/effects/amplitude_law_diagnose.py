@@ -111,6 +111,9 @@ class AmplitudeLaw:
     #: it adds no line, only changes the amplitude of one the state has: judged with that line's beats at its own
     #: amplitudes (:func:`rwadist.diagnose.search._evidence`)
     own_beats: ClassVar[bool] = True
+    #: it re-weights a line the state has: beside the share of the misplaced power, judged on the share of the
+    #: narrow-line misfit it takes (:func:`rwadist.diagnose.search._narrow_judge`)
+    judged_on_narrow_lines: ClassVar[bool] = True
 
     @property
     def channels(self):
