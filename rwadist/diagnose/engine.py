@@ -330,19 +330,18 @@ class Context(Metric):
             lines = tuple(state.ext_lines())
             content = ("ext_lines", state.ext, lines, runs.tobytes())
             if content not in self._memo:
-                self._memo[content] = self._ext_lines(state, runs, lines)
+                self._memo[content] = self._ext_lines(state, self.omega[runs], lines)
             state._cache[key] = self._memo[content]
         return state._cache[key]
 
-    def _ext_lines(self, state: State, runs: np.ndarray, lines) -> tuple:
-        """(:meth:`channel_lines`, :meth:`line_mixing`) of every channel on the extended base, computed (``lines``:
-        ``state.ext_lines()``)."""
+    def _ext_lines(self, state: State, w: np.ndarray, lines) -> tuple:
+        """(:meth:`channel_lines`, :meth:`line_mixing`) of every channel on the extended base at the speeds ``w``
+        (rad/s, 1-D), computed (``lines``: ``state.ext_lines()``)."""
         from .. import extended as ext
 
         if state.ext is None:
             raise ValueError("extended lines asked of a state on the empirical base (ext is None)")
         out: dict[str, list[tuple]]         # channel -> (h, law, amplitude, modal gain) per line
-        w = self.omega[runs]
         out = {c: [] for c in self.channels}
         mixing: dict[str, list[np.ndarray]] = {c: [] for c in self.channels}
         if not lines:
@@ -491,6 +490,8 @@ class Context(Metric):
                     a = a * self.gain(state, c, f)
                 if state.smear is not None:
                     du, wt, kern = self.smear_offsets(state, h, runs)
+                    if state.ext is not None:
+                        wt = wt * self.smear_transfer(state, c, h, runs)
                     out += self.psd_at(f[:, None] + du, (a**2 / 2.0)[:, None] * wt, bins, kernel=kern)
                 elif rip is None or state.speed_modulation is None:       # a ripple's powers come with one
                     plain_f.append(f)
@@ -615,6 +616,31 @@ class Context(Metric):
         n = np.rint(self.run_durations(runs) * fs)
         du, wt = smear.segment_offsets(state.smear, h, self.omega[runs], n, np.asarray(self.sp.n_segments)[runs], L, fs)
         return du, wt, smear.chirp_kernel(L, fs, self.sp.window, smear.segment_chirp(state.smear, h, L, fs))
+
+    def smear_transfer(self, state: State, c: str, h: float, runs: np.ndarray) -> np.ndarray:
+        """(len(runs), K) on the extended base: the line h's power in channel ``c`` on each Welch segment under the
+        state's spin acceleration over its power at the run's mean speed, less a C·Ω² line's (Ω(τ_k)/Ω)⁴
+        (:mod:`rwadist.diagnose.smear`): the modes' transfer (and a law) at the segment's own speed, where a line
+        crosses a mode within a run (docs/diagnose.md, ``spin_acceleration``); 1 where it has no power.  Cached."""
+        key = ("smear_transfer", c, round(float(h), 9), runs.tobytes())
+        if key not in state._cache:
+            fs, L = self.sp.sample_rate, self.sp.nperseg
+            n = np.rint(self.run_durations(runs) * fs)
+            ratio = smear.speed_ratios(state.smear, self.omega[runs], n, np.asarray(self.sp.n_segments)[runs], L, fs)
+            w_seg = self.omega[runs][:, None] * ratio
+            seg, _ = self._ext_lines(state, w_seg.ravel(), tuple(state.ext_lines()))
+            mean = self.channel_lines(state, c, runs)
+            out = np.ones(w_seg.shape)
+            for (hs, _, a_seg, _), (hm, _, a0, _) in zip(seg.get(c, []), mean):
+                if abs(hs - h) < 1e-9 and abs(hm - h) < 1e-9:
+                    a_seg = a_seg.reshape(w_seg.shape)
+                    ok = (a0[:, None] > 0) & (ratio > 0)
+                    out = np.where(ok, (a_seg / np.where(ok, a0[:, None], 1.0)) ** 2 / np.where(ok, ratio, 1.0) ** 4,
+                                   1.0)
+                    break
+            out.flags.writeable = False
+            state._cache[key] = out
+        return state._cache[key]
 
     def band_centres(self) -> np.ndarray:
         return self.f[self.k_lo + BAND_BINS * np.arange(self.n_bands) + BAND_BINS // 2] - 0.5 * self.df

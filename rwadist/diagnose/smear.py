@@ -76,14 +76,29 @@ def segment_offsets(alpha: float, h: float, omega: np.ndarray, n_samples: np.nda
     centre frequency of segment k less the run's mean h|Ω|/2π, and (1/K)·(1 + |α|τ_k/|Ω|)⁴ (0 past a run's own K).
     ``omega`` rad/s, ``n_samples`` and ``n_segments`` per run; ``alpha`` rad/s²."""
     alpha = abs(float(alpha))
+    tau, used, n_seg = _segment_times(n_samples, n_segments, nperseg, fs)
+    ratio = speed_ratios(alpha, omega, n_samples, n_segments, nperseg, fs)
+    wt = np.where(used, ratio**4 / n_seg[:, None], 0.0)
+    return np.where(used, h * alpha * tau / (2 * np.pi), 0.0), wt
+
+
+def _segment_times(n_samples: np.ndarray, n_segments: np.ndarray, nperseg: int, fs: float) -> tuple:
+    """(τ_k s, used, K) of each run's Welch segments: the centre of segment k less the run's, (len(runs), max K);
+    True for a segment the run has; each run's own K."""
     n_seg = np.maximum(np.asarray(n_segments, dtype=int), 1)
     k = np.arange(int(n_seg.max()))
     step = nperseg - int(round(0.5 * nperseg))
-    tau = (k[None, :] * step + nperseg / 2.0 - np.asarray(n_samples, dtype=float)[:, None] / 2.0) / fs     # s
+    tau = (k[None, :] * step + nperseg / 2.0 - np.asarray(n_samples, dtype=float)[:, None] / 2.0) / fs
+    return tau, k[None, :] < n_seg[:, None], n_seg
+
+
+def speed_ratios(alpha: float, omega: np.ndarray, n_samples: np.ndarray, n_segments: np.ndarray, nperseg: int,
+                 fs: float) -> np.ndarray:
+    """|Ω(τ_k)|/|Ω| = max(1 + |α|τ_k/|Ω|, 0) (len(runs), max K) on each run's Welch segments (higher in frequency is
+    faster both ways: a run-down reads as a run-up); 1 past a run's own K."""
+    tau, used, _ = _segment_times(n_samples, n_segments, nperseg, fs)
     w = np.maximum(np.abs(np.asarray(omega, dtype=float)), 1e-12)
-    used = k[None, :] < n_seg[:, None]
-    wt = np.where(used, np.maximum(1.0 + alpha * tau / w[:, None], 0.0) ** 4 / n_seg[:, None], 0.0)
-    return np.where(used, h * alpha * tau / (2 * np.pi), 0.0), wt
+    return np.where(used, np.maximum(1.0 + abs(float(alpha)) * tau / w[:, None], 0.0), 1.0)
 
 
 def segment_chirp(alpha: float, h: float, nperseg: int, fs: float) -> float:
