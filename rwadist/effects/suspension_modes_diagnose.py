@@ -23,8 +23,7 @@ from ..diagnose.modes_trend import beside_trend
 from ..diagnose.stands import StandGroup
 from ..diagnose.state import State
 from ..model import Harmonic, WheelModel
-from ..stand_resonance import (SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode,
-                               stand_of_structure, stand_starts)
+from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode, stand_starts
 from .cross_coupling_diagnose import OFFSET_Z, CrossCoupling
 
 
@@ -156,8 +155,9 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
                 # a resonance moving with speed: the open world describes it, the modes it hid are located beside it
                 structure = modes_beside_moving(efit, structure)
             elif structure is not None and len(ctx.channels) == 6:
-                # found on one direction, it may lift every one: then it is the stand's (too few lines crossed it
-                # for the empirical fit to propose it, :func:`rwadist.stand_resonance.stand_of_structure`)
+                from ..stand_resonance import stand_of_structure
+
+                # found on one direction, it may lift every one: the stand's (too few lines crossed it to propose it)
                 efit, stand = stand_of_structure(test, fit, efit, structure)
                 structure = None if stand is not None else structure
             if structure is not None:
