@@ -652,14 +652,25 @@ def stand_of_structure(test, fit, plain, structure) -> tuple:
     1000-10000 rpm, a fixture at 225 Hz, ζ 0.03, gain 5, between its 150-Hz rocking and 480-Hz translation) put one
     point of each line within ±6 % of it, the pooled fit had no measured width, no stand was proposed, and the modes'
     fit found it on the radial forces alone (225.1 Hz, ζ 0.029, gain 5.09: named a wheel mode, the stand's peak
-    carried into the flight model, the axial force and the torques left 21-23 % off at 4000 rpm)."""
+    carried into the flight model, the axial force and the torques left 21-23 % off at 4000 rpm).  Fitted on every
+    channel, the few lines near it may leave its width unresolved (ζ at the fit's floor, no fixture resonance by
+    :func:`is_fixture_resonance`) where the one direction's resolved it: the stand is then held at that direction's
+    resonance on every channel and judged so."""
+    from .extended_fit import fit_extended
+
+    start = tuple(structure.stand[:4])
     try:
-        joint = _joint_from(test, fit, tuple(structure.stand[:4]), {})
+        joint = _joint_from(test, fit, start, {})
+        if joint.stand is None or not stand_confirmed(joint, plain):
+            # every channel's few lines near it may not resolve its width (ζ run to the fit's floor, the peak to
+            # 100 and more) where one direction's did: held at that direction's resonance on every channel
+            joint = fit_extended(test, fit, stand=start)
     except ValueError:
         return plain, None
-    if joint.stand is None or not stand_confirmed(joint, plain) or joint_cost(joint) > joint_cost(structure):
+    if not stand_confirmed(joint, plain, start if joint.stand is None else None) or \
+            joint_cost(joint) > joint_cost(structure):
         return plain, None
-    f_r, zeta, gain, above = joint.stand
+    f_r, zeta, gain, above = start if joint.stand is None else joint.stand
     joint.notes.append(f"test stand: a resonance at {f_r:.4g} Hz (ζ {zeta:.3g}, peak gain {gain:.3g}, {above:.3g} of "
                        "the load far above it) lifts the lines of every channel: a fixture resonance, found on one "
                        "direction's lines and fitted with the modes on every channel; not part of the wheel's model "
