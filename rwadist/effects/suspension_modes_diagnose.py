@@ -13,6 +13,7 @@ the held-out runs like any effect and carries on from it.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import reduce
 
 import numpy as np
 
@@ -35,8 +36,7 @@ def _fit_spectra(ctx: Context, test, runs: list):
 
     A run's Welch PSD, block floor and lines are its own: those of every run of the context are computed once (kept
     on the context) and the rows of ``runs`` taken, so the fit on the fit runs and the refit on every run share
-    them; computed on ``test`` alone when the context's runs cannot be (a run shorter than the segment outside
-    ``runs``)."""
+    them; computed on ``test`` alone when the context's runs cannot be (a run outside ``runs`` too short)."""
     from dataclasses import replace
 
     from ..data import DataError
@@ -67,8 +67,7 @@ def _fit_spectra(ctx: Context, test, runs: list):
 
 
 def _test_and_fit(ctx: Context, runs) -> tuple:
-    """(SteadyTest, EmpiricalFit) of the context's runs ``runs`` (positions), the fit at the modes' own resolution
-    (:func:`_fit_spectra`)."""
+    """(SteadyTest, EmpiricalFit) of the context's runs ``runs`` (positions), at the modes' resolution (:func:`_fit_spectra`)."""
     from ..data import SteadyTest
     from ..empirical import fit_empirical
 
@@ -348,7 +347,7 @@ def _beside_offset(ctx: Context, state: State, efit, fit, runs, test, stand_star
     modes_fit, modes_efit = fit, efit
     best, best_state, previous = None, None, None
     for _ in range(OFFSET_ROUNDS):
-        with_modes = SuspensionModes.from_fit(modes_efit, modes_fit, runs.size).apply(state)
+        with_modes = _modes_state(ctx, state, modes_efit, modes_fit, runs.size)
         if best_state is None:
             best_state = with_modes                 # efit's modes on the data as they are
         cc = CrossCoupling.fit(ctx, with_modes, runs)
@@ -363,7 +362,7 @@ def _beside_offset(ctx: Context, state: State, efit, fit, runs, test, stand_star
         k = 3 - len(efit_c.unconstrained)
         if k == 0:
             break
-        corrected = cc.apply(SuspensionModes.from_fit(efit_c, fit_c, runs.size).apply(state))
+        corrected = cc.apply(_modes_state(ctx, state, efit_c, fit_c, runs.size))
         got = (test_c, fit_c, efit_c, stand_c, cc)
         if k > n_located or (k == n_located and _better(ctx, best_state, corrected, runs)):
             best, best_state, n_located = got, corrected, k
@@ -378,6 +377,14 @@ def _beside_offset(ctx: Context, state: State, efit, fit, runs, test, stand_star
         previous = cc
         modes_fit, modes_efit = fit_c, efit_c
     return None if best is None else _noted(best)
+
+
+def _modes_state(ctx: Context, state: State, efit, fit, n_runs: int) -> State:
+    """``state`` on the modes of ``efit`` (empirical fit ``fit``, ``n_runs`` runs) with the stands they were located
+    beside, as the search names them: :func:`_beside_offset`'s offset read beside the modes alone took a stand's lift
+    of the torques, torque that state lacks, for r × F (docs/diagnose.md, trial21's fixture, no offset)."""
+    modes = SuspensionModes.from_fit(efit, fit, n_runs, efit.stand if efit.stand_direction is None else None)
+    return reduce(lambda s, e: e.apply(s), modes.stand_effects(ctx.channels), modes.apply(state))
 
 
 def _located_corrected(ctx: Context, test, r: np.ndarray, stand_start, near) -> tuple:
