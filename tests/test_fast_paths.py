@@ -266,8 +266,9 @@ def test_scan_screened_is_the_double_precision_scan(monkeypatch):
 def test_screened_scan_grid_has_the_double_precision_best_point():
     # a locate-only scan screens its grid in single precision and searches the f0 near the screen's best again in double
     # precision (mode_scan._screened_search): the best point and its SSR are the double-precision grid's, bit for bit,
-    # and so is every f0 kept; the others are within the screen's error of it
-    from rwadist.mode_scan import _screened_search
+    # and so is every f0 kept; the others are within the screen's error of it, or (a point the screen ruled out,
+    # mode_scan._pruned_screen) below it and beyond the kept margin
+    from rwadist.mode_scan import SCREEN_MARGIN, _screened_search
 
     for seed in (3, 5, 7, 11):
         line, h, omega, power = _scan_case(seed=seed)
@@ -281,4 +282,43 @@ def test_screened_scan_grid_has_the_double_precision_best_point():
             best = np.unravel_index(np.argmin(whole), whole.shape)
             assert np.unravel_index(np.argmin(got), got.shape) == best and got[best] == whole[best], (seed, a.size)
             same = np.all(got == whole, axis=(1, 2))
-            assert same[best[0]] and np.allclose(got, whole, rtol=1e-3, atol=1e-3), (seed, a.size)
+            close = np.isclose(got, whole, rtol=1e-3, atol=1e-3)
+            ruled_out = (got <= whole * (1 + 1e-3) + 1e-3) & (got > whole[best] + SCREEN_MARGIN * (1 + whole[best]))
+            assert same[best[0]] and np.all(close | ruled_out), (seed, a.size)
+
+
+def test_pruned_screen_is_the_single_precision_grid_where_it_can_matter(monkeypatch):
+    # the screen sums the lines' terms one at a time and stops at a point once the sum passes the least SSR of a few
+    # points evaluated whole plus the margin (mode_scan._pruned_screen): every point within the margin of the least
+    # holds the single-precision grid's SSR (to its rounding), every other one a lower bound of it beyond the margin,
+    # so the screen keeps the same f0 and has the same least; and most of a sharp mode's grid is ruled out after a
+    # line or two (else the pruning did nothing: at most half the points reach the second)
+    import rwadist.mode_scan as ms
+
+    monkeypatch.setattr(ms, "PRUNE_MIN_ELEMENTS", 0)            # the small case pruned too
+    calls = []
+    points_ssr = ms._points_ssr
+    monkeypatch.setattr(ms, "_points_ssr", lambda rows, k, w0, *rest: calls.append(w0.size) or
+                        points_ssr(rows, k, w0, *rest))
+    for seed in (3, 5, 7, 11):
+        line, h, omega, power = _scan_case(seed=seed)
+        f0 = np.exp(np.arange(np.log(10.0), np.log(1000.0), 0.02))
+        for zeta, a, two in ((np.geomspace(0.002, 0.6, 9), np.arange(0.2, 3.01, 0.2), True),
+                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), True),
+                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), False)):
+            p = power if two else np.sqrt(power)
+            calls.clear()
+            ref = ms._grid_search(line, h, omega, p, f0, zeta, a, two, dtype=np.float32)
+            got = ms._pruned_screen(line, h, omega, p, f0, zeta, a, two)
+            least = ref.min()
+            margin = ms.SCREEN_MARGIN * (1 + least)
+            assert abs(got.min() - least) <= 1e-5 * (1 + least), (seed, a.size)
+            near = ref <= least + 1.5 * margin
+            assert np.allclose(got[near], ref[near], rtol=1e-5, atol=1e-6), (seed, a.size)
+            assert np.all(got[~near] <= ref[~near] * (1 + 1e-5) + 1e-6), (seed, a.size)       # lower bounds
+            assert np.all(got[~near] > least + margin), (seed, a.size)
+            kept = np.flatnonzero(ref.min(axis=(1, 2)) <= least + margin)
+            assert np.array_equal(np.flatnonzero(got.min(axis=(1, 2)) <= got.min() + ms.SCREEN_MARGIN * (1 + got.min())),
+                                  kept), (seed, a.size)
+            # after the first line (on the whole grid) the other three are summed at a few of the points only
+            assert len(calls) > 0 and max(calls) < 0.5 * got.size, (seed, a.size, calls)
