@@ -322,3 +322,38 @@ def test_pruned_screen_is_the_single_precision_grid_where_it_can_matter(monkeypa
                                   kept), (seed, a.size)
             # after the first line (on the whole grid) the other three are summed at a few of the points only
             assert len(calls) > 0 and max(calls) < 0.5 * got.size, (seed, a.size, calls)
+
+
+def test_presence_curve_counts_the_pairs_of_a_coverage_matrix():
+    # empirical.presence_curve counts, per h of the grid, the pairs with a line within ±tol (N_bin) and the pairs whose
+    # band f_lo <= h·speed <= f_hi holds h (N_poss) from merged intervals and one difference array: the same integers
+    # as the per-pair coverage written out (every line's interval marked in its pair's row, the band tested point by
+    # point), with lines on grid points, overlapping lines of one pair, band edges on grid products and empty pairs
+    from types import SimpleNamespace
+
+    from rwadist.empirical import presence_curve
+
+    rng = np.random.default_rng(1)
+    for trial in range(60):
+        n_pairs = int(rng.integers(1, 40))
+        speed = rng.uniform(1.0, 60.0, n_pairs)
+        if trial % 3 == 0:
+            speed = np.round(speed, 1)
+        n_lines = int(rng.integers(0, 200))
+        pair = np.sort(rng.integers(0, n_pairs, n_lines))
+        star = rng.uniform(0.0, 12.0, n_lines)
+        if trial % 4 == 0:
+            star = np.round(star * 20) / 20
+        eps = 0.005 if trial % 2 else 0.05
+        tol = np.full(n_pairs, eps) if trial % 5 else np.maximum(eps, rng.uniform(0.0, 0.1, n_pairs))
+        h_grid = np.arange(0.1, 12 + eps / 4, eps / 4)
+        f_lo, f_hi = (rng.uniform(0, 20), rng.uniform(100, 400)) if trial % 6 else \
+            (float(h_grid[37] * speed[0]), float(h_grid[300] * speed[-1]))
+        lines = SimpleNamespace(pair_speed_hz=speed, pair_tol=tol, line_pair=pair, line_star=star)
+        covered = np.zeros((n_pairs, h_grid.size), bool)
+        for p, x in zip(pair, star):
+            covered[p] |= (h_grid >= x - tol[p]) & (h_grid <= x + tol[p])
+        band = (h_grid[None, :] * speed[:, None] >= f_lo) & (h_grid[None, :] * speed[:, None] <= f_hi)
+        n_bin, n_poss = presence_curve(h_grid, lines, f_lo, f_hi)
+        assert np.array_equal(n_bin, (covered & band).sum(axis=0)), trial
+        assert np.array_equal(n_poss, band.sum(axis=0)), trial
