@@ -265,6 +265,9 @@ POINT_CHUNK_ELEMENTS = 1 << 17
 #: :func:`_pruned_screen` evaluates every line first on every this-many-th point of each axis of its grid (through the
 #: grid's centre): a 1/9-1/27 share of the points, for a first bound on the least SSR
 SAMPLE_STRIDE = 3
+#: when more than this share of a grid's points is left after its first line, :func:`_pruned_screen` screens the whole
+#: grid instead (a point's line summed point by point costs ~2.5x its share of the product grid's passes)
+PRUNE_FALLBACK_SHARE = 0.25
 #: grids of fewer points × rows than this are screened whole (:func:`_grid_search`): the pruning's own steps cost more
 #: than they save there
 PRUNE_MIN_ELEMENTS = 1 << 20
@@ -376,6 +379,10 @@ def _pruned_screen(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
         best = np.argsort(partial, kind="stable")[:PROMISING_POINTS]
         bound = min(bound, _screen_bound(float(np.min(partial[best] + sum(terms(k, best) for k in order[1:])))))
     alive = np.flatnonzero(partial <= bound)
+    if alive.size > PRUNE_FALLBACK_SHARE * n_points:
+        # a flat profile (no sharp mode: most points stay near the least): the point-by-point sums of the other lines
+        # would cost more than the product grid's, so the whole grid is screened as it is
+        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, dtype=np.float32)
     for k in order[1:]:
         partial[alive] += terms(k, alive)
         alive = alive[partial[alive] <= bound]

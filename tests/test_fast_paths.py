@@ -357,3 +357,26 @@ def test_presence_curve_counts_the_pairs_of_a_coverage_matrix():
         n_bin, n_poss = presence_curve(h_grid, lines, f_lo, f_hi)
         assert np.array_equal(n_bin, (covered & band).sum(axis=0)), trial
         assert np.array_equal(n_poss, band.sum(axis=0)), trial
+
+
+def test_pruned_screen_of_a_flat_profile_is_the_whole_grid_screen(monkeypatch):
+    # lines of the C·Ω² law through no mode leave most of a scan's grid near its least SSR: the first line rules out
+    # few points, and the screen is then the product grid's own single-precision SSR (mode_scan.PRUNE_FALLBACK_SHARE),
+    # bit for bit, with no point summed one by one
+    import rwadist.mode_scan as ms
+
+    monkeypatch.setattr(ms, "PRUNE_MIN_ELEMENTS", 0)
+    calls = []
+    points_ssr = ms._points_ssr
+    monkeypatch.setattr(ms, "_points_ssr", lambda rows, k, w0, *rest: calls.append(w0.size) or
+                        points_ssr(rows, k, w0, *rest))
+    rng = np.random.default_rng(4)
+    line = np.repeat(np.arange(4), 12)
+    h = np.array([1.0, 2.0, 2.7, 4.4])[line]
+    omega = np.tile(np.linspace(40.0, 250.0, 12), 4)
+    power = omega**4 * rng.uniform(0.5, 1.0, 4)[line] * rng.lognormal(0.0, 0.01, line.size)
+    f0, zeta, a = np.exp(np.arange(np.log(2000.0), np.log(8000.0), 0.02)), np.geomspace(0.002, 0.6, 9), np.array([0.0])
+    ref = ms._grid_search(line, h, omega, power, f0, zeta, a, True, dtype=np.float32)
+    got = ms._pruned_screen(line, h, omega, power, f0, zeta, a, True)
+    assert np.array_equal(got, ref)
+    assert len(calls) <= ms.PROMISING_POINTS and max(calls) <= ms.PROMISING_POINTS       # the bound's points only
