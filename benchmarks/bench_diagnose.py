@@ -138,6 +138,15 @@ the plain fit's own work again; the least squares 0.064 s; the offset check 0.04
 over 0.08 s.  No record transform, grid search or least squares repeats its arguments (checked by hashing every
 call's inputs); the FFTs of different steps use different windows (np.hanning, the periodic Hann, Welch's scaled
 one) or paddings, so none can be shared with the same numbers.
+2026-12-01, session 24 (speed24): the mode scans' single-precision screens prune (mode_scan._pruned_screen: every
+line's term >= 0, a point left once its partial sum passes the least SSR of a few whole points plus the margin; the
+14 screens of a sixty diagnose 220 -> 81 ms CPU, the same kept f0 and best points) and the empirical fit's presence
+curve counts merged intervals (empirical.presence_curve, the same integers; 12 calls ~50 -> 5 ms, the plain fit's too).
+--quick --repeats 3 --busy 0, land then speed24, each from its own tree, at load 7.7-8.0 on 2 cores (other agents'
+jobs): diagnose cpu min benchmark 2.45 -> 2.10 s, sixty 1.45 -> 1.28 s (wall min 2.86 -> 2.49 s); fit 0.21 -> 0.16 s
+and 0.10 -> 0.09 s; cpu x11.7/x10.9 -> x13.1/x12.9 (benchmark), x14.3/x14.3 -> x14.9/x14.7 (sixty): the ratio
+rose, the fit gaining more from the presence curve than diagnose; target not met.  Family matrix wheels 0-1 (46
+cells) and the open world (64 cells) identical to session 23's rows in every field.
 """
 from __future__ import annotations
 

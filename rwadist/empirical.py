@@ -286,23 +286,55 @@ def collect_lines(spectra: Spectra, chans, fit_runs, detected: dict, epsilon: fl
 
 
 def presence_curve(h_grid: np.ndarray, lines: _Lines, f_lo: float, f_hi: float):
-    """N_bin and N_poss (thesis Eq. 3.5, Table 3.2) on a grid of h.
+    """N_bin and N_poss (thesis Eq. 3.5, Table 3.2) on a grid of h (increasing).
 
     N_bin(h): pairs with a line within ±tol of h; N_poss(h): pairs in which
-    f_lo <= h·speed <= f_hi.  Each line covers a grid interval; a difference
-    array turns intervals into per-pair coverage without loops.
+    f_lo <= h·speed <= f_hi.  Each line covers a grid interval and each pair's band is one run of the grid (h·speed
+    grows with h): a pair's lines merged into disjoint intervals and cut to its band, every interval's ends go into one
+    difference array of the grid, whose running sum counts the pairs (integers: the counts of a per-pair coverage
+    matrix, without its n_pairs × n_grid passes).
     """
-    n_pairs, n_grid = lines.pair_run.size, h_grid.size
-    in_band = (h_grid[None, :] * lines.pair_speed_hz[:, None] >= f_lo) & \
-              (h_grid[None, :] * lines.pair_speed_hz[:, None] <= f_hi)
-    diff = np.zeros((n_pairs, n_grid + 1), np.int32)
-    tol = lines.pair_tol[lines.line_pair]
-    lo = np.searchsorted(h_grid, lines.line_star - tol, "left")
-    hi = np.searchsorted(h_grid, lines.line_star + tol, "right")
-    np.add.at(diff, (lines.line_pair, lo), 1)
-    np.add.at(diff, (lines.line_pair, hi), -1)
-    covered = np.cumsum(diff[:, :-1], axis=1) > 0
-    return (covered & in_band).sum(axis=0), in_band.sum(axis=0)
+    n_grid = h_grid.size
+    speed = lines.pair_speed_hz
+    # each pair's band [b_lo, b_hi): the grid points passing the elementwise test f_lo <= h·speed <= f_hi
+    b_lo = _first_where(h_grid, speed, lambda x: x >= f_lo)
+    b_hi = _first_where(h_grid, speed, lambda x: x > f_hi)
+    b_hi = np.maximum(b_hi, b_lo)
+    n_poss = np.cumsum(np.bincount(b_lo, minlength=n_grid + 1) - np.bincount(b_hi, minlength=n_grid + 1))[:n_grid]
+    pair = lines.line_pair
+    tol = lines.pair_tol[pair]
+    lo = np.maximum(np.searchsorted(h_grid, lines.line_star - tol, "left"), b_lo[pair])
+    hi = np.minimum(np.searchsorted(h_grid, lines.line_star + tol, "right"), b_hi[pair])
+    keep = lo < hi
+    pair, lo, hi = pair[keep], lo[keep], hi[keep]
+    if pair.size == 0:
+        return np.zeros(n_grid, dtype=n_poss.dtype), n_poss
+    # the pairs' intervals on one axis, each pair n_grid + 1 apart: merged where one starts within the reach so far
+    span = n_grid + 1
+    start, end = pair * span + lo, pair * span + hi
+    order = np.lexsort((start, pair))
+    start, end = start[order], end[order]
+    reach = np.maximum.accumulate(end)
+    first = np.r_[True, start[1:] > reach[:-1]]
+    last = np.r_[first[1:], True]
+    n_bin = np.cumsum(np.bincount(start[first] % span, minlength=span) - np.bincount(reach[last] % span, minlength=span))
+    return n_bin[:n_grid], n_poss
+
+
+def _first_where(h_grid: np.ndarray, speed: np.ndarray, test) -> np.ndarray:
+    """Per speed, the first index g of the increasing ``h_grid`` with ``test(h_grid[g]·speed)`` true (h_grid.size if
+    none), for a test that holds from some product on (a threshold: h·speed rounded never decreases with h): by
+    bisection on the products themselves, so the index of the elementwise test."""
+    n = h_grid.size
+    lo = np.zeros(speed.size, dtype=np.intp)
+    hi = np.full(speed.size, n, dtype=np.intp)
+    while np.any(lo < hi):
+        mid = (lo + hi) // 2
+        ok = test(h_grid[np.minimum(mid, n - 1)] * speed)
+        active = lo < hi
+        hi = np.where(active & ok, mid, hi)
+        lo = np.where(active & ~ok, mid + 1, lo)
+    return lo
 
 
 def _in_band(h, lines: _Lines, f_lo, f_hi):

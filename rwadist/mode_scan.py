@@ -259,6 +259,143 @@ def _two_senses_ssr(num, lnum, rest, gyro, d2, seg, trend, bufs):
     return ssr
 
 
+#: points of the single-precision screen evaluated at once by :func:`_points_ssr` (about 2**17 point × row elements per
+#: array: its few arrays stay in the core's cache)
+POINT_CHUNK_ELEMENTS = 1 << 17
+#: :func:`_pruned_screen` evaluates every line first on every this-many-th point of each axis of its grid (through the
+#: grid's centre): a 1/9-1/27 share of the points, for a first bound on the least SSR
+SAMPLE_STRIDE = 3
+#: when more than this share of a grid's points is left after its first line, :func:`_pruned_screen` screens the whole
+#: grid instead (a point's line summed point by point costs ~2.5x its share of the product grid's passes)
+PRUNE_FALLBACK_SHARE = 0.25
+#: grids of fewer points × rows than this are screened whole (:func:`_grid_search`): the pruning's own steps cost more
+#: than they save there
+PRUNE_MIN_ELEMENTS = 1 << 20
+#: after the first line, the points of least partial SSR evaluated on every line too (a tighter bound)
+PROMISING_POINTS = 64
+
+
+class _Rows:
+    """The rows of :func:`_grid_search` in single precision, sorted by line, each line's scale divided by its geometric
+    mean (the screen's own numbers), and per line its rows' slice with its :class:`_Segments` and :class:`_Trend`."""
+
+    def __init__(self, line, h, omega, power, two_parts):
+        order = np.argsort(line, kind="stable")
+        line_s = np.asarray(line)[order]
+        starts = np.flatnonzero(np.r_[True, line_s[1:] != line_s[:-1]])
+        counts = np.diff(np.r_[starts, line_s.size]).astype(float)
+        om = np.abs(np.asarray(omega, float))[order]
+        nu = np.asarray(h, float)[order] * om
+        scale = om**4 / np.asarray(power, float)[order]
+        scale = scale / np.exp(np.repeat(np.add.reduceat(np.log(scale), starts) / counts, counts.astype(int)))
+        lawful = _imbalance_lines(np.asarray(h, float)[order][starts], two_parts)
+        self.om64, self.nu64 = om, nu
+        self.om, self.nu, self.scale = (np.asarray(x, np.float32) for x in (om, nu, scale))
+        self.lines = []
+        for i, (s, c) in enumerate(zip(starts, counts.astype(int))):
+            one_start, one_count = np.array([0]), np.array([float(c)])
+            self.lines.append((slice(s, s + c), _Segments(one_start, one_count, np.float32),
+                               _Trend(self.om[s:s + c], one_start, one_count, lawful[i:i + 1])))
+
+
+def _points_ssr(rows: _Rows, k: int, w0, zeta, a, same: bool, both_senses: bool) -> np.ndarray:
+    """The single-precision SSR of line ``k`` of ``rows`` (:class:`_Rows`) at the grid points (ω0 rad/s, ζ, a) given
+    one by one (``w0``, ``zeta``, ``a``, (P,) float32): :func:`_grid_search`'s terms of that line (the same formulas on
+    a list of points instead of a product grid), in natural-log units."""
+    part, seg, trend = rows.lines[k]
+    om, nu, scale = rows.om[part], rows.nu[part], rows.scale[part]
+    nu2 = nu * nu
+    out = np.empty(w0.size)
+    step = max(1, POINT_CHUNK_ELEMENTS // max(om.size, 1))
+    bufs = None
+    for s in range(0, w0.size, step):
+        w = w0[s:s + step]
+        w02 = w * w
+        d2 = ((2 * zeta[s:s + step] * w)[:, None] * nu[None, :]) ** 2                # (P, rows)
+        num = ((w02 * w02)[:, None] + d2) * scale
+        rest = w02[:, None] - nu2[None, :]
+        if same:
+            ssr = _line_log_ssr(np.log2(num) - np.log2(rest * rest + d2), seg, trend)
+        else:
+            gyro = (a[s:s + step, None] * om[None, :]) * nu[None, :]
+            if not both_senses:
+                ssr = _line_log_ssr(np.log2(num) - np.log2((rest + gyro) ** 2 + d2), seg, trend)
+            else:
+                if bufs is None:
+                    bufs = np.empty((4, w.size, 1, 1, om.size), np.float32)
+                ssr = _two_senses_ssr(num[:, None, None, :], None, rest[:, None, :], gyro[:, None, :],
+                                      d2[:, None, None, :], seg, trend, bufs)
+        out[s:s + step] = np.reshape(ssr, (w.size,))
+    return out * LN2_SQUARED
+
+
+def _pruned_screen(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts) -> np.ndarray:
+    """The single-precision screen of :func:`_screened_search`: :func:`_grid_search`'s SSR (single precision) at every
+    point of the grid that can come within :data:`SCREEN_MARGIN` of the least; at the others a lower bound of it above
+    that, the sum of some of its lines' terms.
+
+    Every line's term is ≥ 0, so the sum over some lines bounds a point's SSR from below.  Every line is evaluated on a
+    sub-grid (every :data:`SAMPLE_STRIDE`-th point of each axis, through the grid's centre, where a refinement grid
+    holds the coarse best point) and at the :data:`PROMISING_POINTS` points of least first-line term: U, their least
+    SSR, bounds the grid's least from above.  The lines are then summed one at a time (first the one that rules out
+    most of the sub-grid, on the whole grid; the others at the points left), each only at the points whose sum so far
+    is within U + SCREEN_MARGIN·(1 + U) (:func:`_screen_bound`): a point beyond it can be neither the least nor within
+    the margin of it, which is all :func:`_screened_search` reads of the screen (the f0 it searches again in double
+    precision, and its least).  On the mode scans of a 60-speed diagnose the first line leaves 0-10 % of the points (a
+    sharp mode rules out most of the grid)."""
+    f0_grid, zeta_grid, a_grid = (np.asarray(x, float) for x in (f0_grid, zeta_grid, a_grid))
+    shape = (f0_grid.size, zeta_grid.size, a_grid.size)
+    line, h, omega, power = (np.asarray(x) for x in (line, h, omega, power))
+    n_points = int(np.prod(shape))
+    if n_points * line.size < PRUNE_MIN_ELEMENTS:
+        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, dtype=np.float32)
+    rows = _Rows(line, h, omega, power, two_parts)
+    n_lines = len(rows.lines)
+    order_rows = np.argsort(line, kind="stable")
+
+    def on_grid(k, f, z, a):
+        # line k's terms on a product grid: _grid_search's single-precision numbers of that line's rows alone
+        r = order_rows[rows.lines[k][0]]
+        return _grid_search(line[r], h[r], omega[r], power[r], f, z, a, two_parts, dtype=np.float32)[..., None]
+
+    sub = [np.arange((n // 2) % SAMPLE_STRIDE, n, SAMPLE_STRIDE) if n > SAMPLE_STRIDE else np.arange(n) for n in shape]
+    at_sub = np.concatenate([on_grid(k, f0_grid[sub[0]], zeta_grid[sub[1]], a_grid[sub[2]])
+                             for k in range(n_lines)], axis=-1).reshape(-1, n_lines)      # (sub-grid points, lines)
+    bound = _screen_bound(float(np.min(at_sub.sum(axis=1))))
+    order = np.argsort(-np.mean(at_sub > bound, axis=0), kind="stable")
+    partial = on_grid(order[0], f0_grid, zeta_grid, a_grid).ravel().astype(float)
+    # as _grid_search decides them, on the whole grid: no gyroscopic term anywhere, or a line's two senses
+    same = not np.any(a_grid[:, None] * rows.om64[None, :] * rows.nu64[None, :])
+    both_senses = two_parts and not same
+    fi, zi, ai = np.unravel_index(np.arange(n_points), shape)
+    w0 = (2 * np.pi * np.asarray(f0_grid, np.float32))[fi]
+    zeta, a = np.asarray(zeta_grid, np.float32)[zi], np.asarray(a_grid, np.float32)[ai]
+
+    def terms(k, idx):
+        return _points_ssr(rows, k, w0[idx], zeta[idx], a[idx], same, both_senses)
+
+    if n_lines > 1:
+        # the points the first line favours, on every line: a tighter bound than the sub-grid's
+        best = np.argsort(partial, kind="stable")[:PROMISING_POINTS]
+        bound = min(bound, _screen_bound(float(np.min(partial[best] + sum(terms(k, best) for k in order[1:])))))
+    alive = np.flatnonzero(partial <= bound)
+    if alive.size > PRUNE_FALLBACK_SHARE * n_points:
+        # a flat profile (no sharp mode: most points stay near the least): the point-by-point sums of the other lines
+        # would cost more than the product grid's, so the whole grid is screened as it is
+        return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, dtype=np.float32)
+    for k in order[1:]:
+        partial[alive] += terms(k, alive)
+        alive = alive[partial[alive] <= bound]
+    return partial.reshape(shape)
+
+
+def _screen_bound(upper: float) -> float:
+    """The largest SSR a point of the screen can have and still be kept (:func:`_screened_search`) when the least SSR
+    is at most ``upper``: upper + :data:`SCREEN_MARGIN`·(1 + upper), with 1 % of that margin more for the rounding of
+    single-precision sums taken in another order."""
+    return upper + 1.01 * SCREEN_MARGIN * (1.0 + abs(upper))
+
+
 def _window(grid: np.ndarray, centre: float | None, lo: float, hi: float) -> np.ndarray:
     """Indices of the points of ``grid`` (increasing) within [lo, hi]·``centre`` (all of them when ``centre`` is
     None or no point falls there)."""
@@ -283,7 +420,9 @@ def _screened_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_part
     the grid it is computed in) whenever the two precisions differ by less than half the margin near it; the whole
     grid is searched in double precision when the screen is not finite or its kept points do not come within half
     the margin of its least."""
-    approx = _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, dtype=np.float32)
+    approx = _pruned_screen(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
+    if approx.size and not np.all(np.isfinite(approx)):
+        approx = _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, dtype=np.float32)
     if approx.size == 0 or not np.all(np.isfinite(approx)):
         return _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
     least = float(approx.min())

@@ -266,8 +266,9 @@ def test_scan_screened_is_the_double_precision_scan(monkeypatch):
 def test_screened_scan_grid_has_the_double_precision_best_point():
     # a locate-only scan screens its grid in single precision and searches the f0 near the screen's best again in double
     # precision (mode_scan._screened_search): the best point and its SSR are the double-precision grid's, bit for bit,
-    # and so is every f0 kept; the others are within the screen's error of it
-    from rwadist.mode_scan import _screened_search
+    # and so is every f0 kept; the others are within the screen's error of it, or (a point the screen ruled out,
+    # mode_scan._pruned_screen) below it and beyond the kept margin
+    from rwadist.mode_scan import SCREEN_MARGIN, _screened_search
 
     for seed in (3, 5, 7, 11):
         line, h, omega, power = _scan_case(seed=seed)
@@ -281,4 +282,101 @@ def test_screened_scan_grid_has_the_double_precision_best_point():
             best = np.unravel_index(np.argmin(whole), whole.shape)
             assert np.unravel_index(np.argmin(got), got.shape) == best and got[best] == whole[best], (seed, a.size)
             same = np.all(got == whole, axis=(1, 2))
-            assert same[best[0]] and np.allclose(got, whole, rtol=1e-3, atol=1e-3), (seed, a.size)
+            close = np.isclose(got, whole, rtol=1e-3, atol=1e-3)
+            ruled_out = (got <= whole * (1 + 1e-3) + 1e-3) & (got > whole[best] + SCREEN_MARGIN * (1 + whole[best]))
+            assert same[best[0]] and np.all(close | ruled_out), (seed, a.size)
+
+
+def test_pruned_screen_is_the_single_precision_grid_where_it_can_matter(monkeypatch):
+    # the screen sums the lines' terms one at a time and stops at a point once the sum passes the least SSR of a few
+    # points evaluated whole plus the margin (mode_scan._pruned_screen): every point within the margin of the least
+    # holds the single-precision grid's SSR (to its rounding), every other one a lower bound of it beyond the margin,
+    # so the screen keeps the same f0 and has the same least; and most of a sharp mode's grid is ruled out after a
+    # line or two (else the pruning did nothing: at most half the points reach the second)
+    import rwadist.mode_scan as ms
+
+    monkeypatch.setattr(ms, "PRUNE_MIN_ELEMENTS", 0)            # the small case pruned too
+    calls = []
+    points_ssr = ms._points_ssr
+    monkeypatch.setattr(ms, "_points_ssr", lambda rows, k, w0, *rest: calls.append(w0.size) or
+                        points_ssr(rows, k, w0, *rest))
+    for seed in (3, 5, 7, 11):
+        line, h, omega, power = _scan_case(seed=seed)
+        f0 = np.exp(np.arange(np.log(10.0), np.log(1000.0), 0.02))
+        for zeta, a, two in ((np.geomspace(0.002, 0.6, 9), np.arange(0.2, 3.01, 0.2), True),
+                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), True),
+                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), False)):
+            p = power if two else np.sqrt(power)
+            calls.clear()
+            ref = ms._grid_search(line, h, omega, p, f0, zeta, a, two, dtype=np.float32)
+            got = ms._pruned_screen(line, h, omega, p, f0, zeta, a, two)
+            least = ref.min()
+            margin = ms.SCREEN_MARGIN * (1 + least)
+            assert abs(got.min() - least) <= 1e-5 * (1 + least), (seed, a.size)
+            near = ref <= least + 1.5 * margin
+            assert np.allclose(got[near], ref[near], rtol=1e-5, atol=1e-6), (seed, a.size)
+            assert np.all(got[~near] <= ref[~near] * (1 + 1e-5) + 1e-6), (seed, a.size)       # lower bounds
+            assert np.all(got[~near] > least + margin), (seed, a.size)
+            kept = np.flatnonzero(ref.min(axis=(1, 2)) <= least + margin)
+            assert np.array_equal(np.flatnonzero(got.min(axis=(1, 2)) <= got.min() + ms.SCREEN_MARGIN * (1 + got.min())),
+                                  kept), (seed, a.size)
+            # after the first line (on the whole grid) the other three are summed at a few of the points only
+            assert len(calls) > 0 and max(calls) < 0.5 * got.size, (seed, a.size, calls)
+
+
+def test_presence_curve_counts_the_pairs_of_a_coverage_matrix():
+    # empirical.presence_curve counts, per h of the grid, the pairs with a line within ±tol (N_bin) and the pairs whose
+    # band f_lo <= h·speed <= f_hi holds h (N_poss) from merged intervals and one difference array: the same integers
+    # as the per-pair coverage written out (every line's interval marked in its pair's row, the band tested point by
+    # point), with lines on grid points, overlapping lines of one pair, band edges on grid products and empty pairs
+    from types import SimpleNamespace
+
+    from rwadist.empirical import presence_curve
+
+    rng = np.random.default_rng(1)
+    for trial in range(60):
+        n_pairs = int(rng.integers(1, 40))
+        speed = rng.uniform(1.0, 60.0, n_pairs)
+        if trial % 3 == 0:
+            speed = np.round(speed, 1)
+        n_lines = int(rng.integers(0, 200))
+        pair = np.sort(rng.integers(0, n_pairs, n_lines))
+        star = rng.uniform(0.0, 12.0, n_lines)
+        if trial % 4 == 0:
+            star = np.round(star * 20) / 20
+        eps = 0.005 if trial % 2 else 0.05
+        tol = np.full(n_pairs, eps) if trial % 5 else np.maximum(eps, rng.uniform(0.0, 0.1, n_pairs))
+        h_grid = np.arange(0.1, 12 + eps / 4, eps / 4)
+        f_lo, f_hi = (rng.uniform(0, 20), rng.uniform(100, 400)) if trial % 6 else \
+            (float(h_grid[37] * speed[0]), float(h_grid[300] * speed[-1]))
+        lines = SimpleNamespace(pair_speed_hz=speed, pair_tol=tol, line_pair=pair, line_star=star)
+        covered = np.zeros((n_pairs, h_grid.size), bool)
+        for p, x in zip(pair, star):
+            covered[p] |= (h_grid >= x - tol[p]) & (h_grid <= x + tol[p])
+        band = (h_grid[None, :] * speed[:, None] >= f_lo) & (h_grid[None, :] * speed[:, None] <= f_hi)
+        n_bin, n_poss = presence_curve(h_grid, lines, f_lo, f_hi)
+        assert np.array_equal(n_bin, (covered & band).sum(axis=0)), trial
+        assert np.array_equal(n_poss, band.sum(axis=0)), trial
+
+
+def test_pruned_screen_of_a_flat_profile_is_the_whole_grid_screen(monkeypatch):
+    # lines of the C·Ω² law through no mode leave most of a scan's grid near its least SSR: the first line rules out
+    # few points, and the screen is then the product grid's own single-precision SSR (mode_scan.PRUNE_FALLBACK_SHARE),
+    # bit for bit, with no point summed one by one
+    import rwadist.mode_scan as ms
+
+    monkeypatch.setattr(ms, "PRUNE_MIN_ELEMENTS", 0)
+    calls = []
+    points_ssr = ms._points_ssr
+    monkeypatch.setattr(ms, "_points_ssr", lambda rows, k, w0, *rest: calls.append(w0.size) or
+                        points_ssr(rows, k, w0, *rest))
+    rng = np.random.default_rng(4)
+    line = np.repeat(np.arange(4), 12)
+    h = np.array([1.0, 2.0, 2.7, 4.4])[line]
+    omega = np.tile(np.linspace(40.0, 250.0, 12), 4)
+    power = omega**4 * rng.uniform(0.5, 1.0, 4)[line] * rng.lognormal(0.0, 0.01, line.size)
+    f0, zeta, a = np.exp(np.arange(np.log(2000.0), np.log(8000.0), 0.02)), np.geomspace(0.002, 0.6, 9), np.array([0.0])
+    ref = ms._grid_search(line, h, omega, power, f0, zeta, a, True, dtype=np.float32)
+    got = ms._pruned_screen(line, h, omega, power, f0, zeta, a, True)
+    assert np.array_equal(got, ref)
+    assert len(calls) <= ms.PROMISING_POINTS and max(calls) <= ms.PROMISING_POINTS       # the bound's points only
