@@ -601,6 +601,47 @@ def structure_mode_refused(test, fit, direction: str, stand: tuple) -> tuple:
     return float(n * np.log(c0 / c1) - STRUCTURE_PARAMETERS * np.log(n)), float(free.stand[0])
 
 
+#: A structure mode is a fixed-frequency resonance: when the slower and the faster half of the runs each want a
+#: resonance of their own (:func:`structure_mode_refused`), their two frequencies must lie
+#: within its own relative half-width ζ, and within this at least, for it to stay one fixed resonance
+STRUCTURE_SPEED_SPLIT_TOL = 0.03
+#: ... each half holding this many runs at least (fewer: the split tells nothing, the mode is kept)
+STRUCTURE_SPLIT_MIN_RUNS = 5
+
+
+def fixed_across_speeds(test_and_fit, speeds, runs, joint) -> bool:
+    """Whether the structure mode of ``joint`` (its ``stand`` on ``stand_direction``) stays at one frequency across
+    the speeds.  On the slower and on the faster half of ``runs``, the structure mode is fitted again from it (jointly
+    with the suspension modes) and set against the fit holding it
+    (:func:`structure_mode_refused`: the Bayesian information criterion of its four
+    parameters); it moves with the speed when BOTH halves want a resonance of their own and their two frequencies are
+    more than the resonance's relative half-width ζ (or :data:`STRUCTURE_SPEED_SPLIT_TOL`) apart.  A mode whose
+    frequency falls or rises with speed (a rotor mode softening, a drive resonance following the speed) also lifts
+    the lines of one direction, and one fixed resonance fitted to it sits between its ends (family wheel 0, a radial
+    resonance softening 248 -> 149 Hz over the speeds: a 'wheel mode' at 198 Hz; the halves want 202 and 188 Hz, each
+    beyond its criterion by 75 and 194): it is no wheel mode, and the open world describes it (``moving_resonance``).
+    A fixed one fitted on half its speeds may run off (family wheel 5: 538 Hz on the slower half for a 490-Hz mode)
+    but that half does not want it (criterion -29).  Halves too short, or fits that fail, tell nothing: kept.
+    ``test_and_fit(runs)``: (SteadyTest, EmpiricalFit) of those runs (positions); ``speeds``: every run's, rad/s
+    (``rwadist diagnose``'s suspension modes)."""
+    runs = np.asarray([int(r) for r in runs])
+    half = runs.size // 2
+    if half < STRUCTURE_SPLIT_MIN_RUNS:
+        return True
+    spin = np.abs(np.asarray(speeds, dtype=float)[runs])
+    order = np.argsort(spin, kind="stable")
+    got = []
+    for part in (np.sort(runs[order[:half]]), np.sort(runs[order[-half:]])):
+        try:
+            test, fit = test_and_fit(part)
+            got.append(structure_mode_refused(test, fit, joint.stand_direction, tuple(joint.stand[:4])))
+        except ValueError:
+            return True
+    moved = abs(float(np.log(got[1][1] / got[0][1])))
+    moving = got[0][0] > 0 and got[1][0] > 0 and moved > max(joint.stand[1], STRUCTURE_SPEED_SPLIT_TOL)
+    return not moving
+
+
 def fit_extended_beside_structure_mode(test, fit, plain, start: tuple | None = None, **kwargs):
     """The extended fit of ``test`` (empirical fit ``fit``) with a mode of the wheel's structure on one direction fitted
     jointly with the suspension modes (:func:`rwadist.extended_fit.fit_extended`'s ``stand_direction``), or None.

@@ -626,7 +626,7 @@ class Context(Metric):
         if key not in state._cache:
             fs, L = self.sp.sample_rate, self.sp.nperseg
             n = np.rint(self.run_durations(runs) * fs)
-            ratio = smear.speed_ratios(state.smear, self.omega[runs], n, np.asarray(self.sp.n_segments)[runs], L, fs)
+            ratio = smear.speed_ratios(state.smear or 0.0, self.omega[runs], n, np.asarray(self.sp.n_segments)[runs], L, fs)
             w_seg = self.omega[runs][:, None] * ratio
             seg, _ = self._ext_lines(state, w_seg.ravel(), tuple(state.ext_lines()))
             mean = self.channel_lines(state, c, runs)

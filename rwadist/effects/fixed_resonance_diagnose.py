@@ -166,7 +166,7 @@ def _general_refit(e: "FixedResonance", f, y, sw, lo: float, hi: float) -> "Fixe
 
 #: A proposed fixed resonance is read on the slower and the faster half of the runs (:func:`speed_split`) when each half
 #: holds this many runs at least (fewer: the split tells nothing and the resonance is kept), the number the suspension
-#: modes' structure-mode split asks (:data:`rwadist.effects.suspension_modes_diagnose.STRUCTURE_SPLIT_MIN_RUNS`)
+#: modes' structure-mode split asks (:data:`rwadist.stand_resonance.STRUCTURE_SPLIT_MIN_RUNS`)
 SPLIT_MIN_RUNS = 5
 #: ... and it moves with the speed when the two halves' centres lie more than its relative half-power half-width ζ
 #: apart, and this at least: the same floor as that split's (``STRUCTURE_SPEED_SPLIT_TOL``)

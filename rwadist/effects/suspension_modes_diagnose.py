@@ -96,29 +96,31 @@ def _recorded_meta(ctx: Context) -> dict:
 def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None, near: dict | None = None,
               structure_start: tuple | None = None, offset_start: CrossCoupling | None = None):
     """(SteadyTest, EmpiricalFit, ExtendedFit, stand, offset) of ``runs``, or None when the runs show no modal
-    amplification (or the extended fit fails, or locates no mode); ``stand`` is the fixture resonance (f_r Hz, ζ, peak
-    gain, gain above) fitted with the modes, or None; ``offset`` the load-cell offset (a ``cross_coupling``) the
-    torques were corrected for before the modes were located (:func:`_beside_offset`), or None.  ``stand_start``: the stand to start from (a refit on every run
-    starts from the one fitted on half of them), else those :func:`rwadist.stand_resonance.stand_starts` proposes.
-    ``near``: the modes that fit located, searched first (``near`` of :func:`rwadist.extended_fit.fit_extended`), or
-    None.  ``structure_start``: the mode of the wheel's structure to start from (direction, f_r Hz, ζ, peak gain: the fit
-    on half the runs had it), or None.  ``offset_start``: the load-cell offset the fit on half the runs located its
-    modes beside (its ``offset``), or None: :func:`_beside_offset` starts from it when the offset estimated beside the
-    modes located on the data as they are is not significant.
+    amplification (or the extended fit fails, or locates no mode); ``stand`` is the fixture resonance (f_r Hz, ζ,
+    peak gain, gain above) fitted with the modes, or None; ``offset`` the load-cell offset (a ``cross_coupling``)
+    the torques were corrected for before the modes were located (:func:`_beside_offset`), or None.
+    ``stand_start``: the stand to start from (a refit on every run starts from the one fitted on half of them), else
+    those :func:`rwadist.stand_resonance.stand_starts` proposes. ``near``: the modes that fit located, searched
+    first (``near`` of :func:`rwadist.extended_fit.fit_extended`), or None.  ``structure_start``: the mode of the
+    wheel's structure to start from (direction, f_r Hz, ζ, peak gain: the fit on half the runs had it), or None.
+    ``offset_start``: the load-cell offset the fit on half the runs located its modes beside (its ``offset``), or
+    None: :func:`_beside_offset` starts from it when the offset estimated beside the modes located on the data as
+    they are is not significant.
 
     A fixture resonance on every channel is fitted with the modes, never into them (:func:`_locate`); the stand
-    itself is left to the search (a ``fixed_resonance`` of role test_stand proposed from this fit's stand).  A load-cell
-    offset the located modes leave in the torques is taken out before the modes are located (:func:`_beside_offset`);
-    then, when no stand is kept, a mode of the wheel's structure on one direction is tried beside the modes (on a
-    direction whose mode stays unconstrained, or on the forces when every mode is located:
-    :func:`rwadist.stand_resonance.fit_extended_beside_structure_mode`): the fit is then that joint fit (its ``stand`` on one direction, ``stand_direction``) and the stand None.  The offset first: the torques
-    read r × F of the forces' lines amplified by their translation, which a resonance of the torques alone at that
-    frequency also explains (family wheel 4, r_z = −60 mm: a 'structure mode' at 228.5 Hz on the torques, its 227.7 Hz
+    itself is left to the search (a ``fixed_resonance`` of role test_stand proposed from this fit's stand).  A
+    load-cell offset the located modes leave in the torques is taken out before the modes are located
+    (:func:`_beside_offset`); then, when no stand is kept, a mode of the wheel's structure on one direction is tried
+    beside the modes (on a direction whose mode stays unconstrained, or on the forces when every mode is located:
+    :func:`rwadist.stand_resonance.fit_extended_beside_structure_mode`): the fit is then that joint fit (its
+    ``stand`` on one direction, ``stand_direction``) and the stand None.  The offset first: the torques read r × F
+    of the forces' lines amplified by their translation, which a resonance of the torques alone at that frequency
+    also explains (family wheel 4, r_z = −60 mm: a 'structure mode' at 228.5 Hz on the torques, its 227.7 Hz
     translation, pinned the rocking 4.9 % off and the offset's correction was never tried)."""
     from ..data import SteadyTest
     from ..empirical import fit_empirical
     from ..extended_fit import amplification_peaks
-    from ..stand_resonance import modes_beside_moving
+    from ..stand_resonance import fixed_across_speeds, modes_beside_moving, stand_of_structure
 
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], _recorded_meta(ctx))
@@ -150,12 +152,11 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
         if stand is None and len(ctx.channels) > 3:
             # on an unconstrained mode's direction, or on the forces when every mode is located
             structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
-            if structure is not None and not _fixed_across_speeds(ctx, runs, structure):
+            if structure is not None and not fixed_across_speeds(lambda part: _test_and_fit(ctx, part),
+                                                                 ctx.test.speeds, runs, structure):
                 # a resonance moving with speed: the open world describes it, the modes it hid are located beside it
                 structure = modes_beside_moving(efit, structure)
             elif structure is not None and len(ctx.channels) == 6:
-                from ..stand_resonance import stand_of_structure
-
                 # found on one direction, it may lift every one: the stand's (too few lines crossed it to propose it)
                 efit, stand = stand_of_structure(test, fit, efit, structure)
                 structure = None if stand is not None else structure
@@ -166,47 +167,6 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     if len(efit.unconstrained) == 3:
         return None                     # no mode located: nothing to name
     return test, fit, efit, stand, offset
-
-
-#: A structure mode is a fixed-frequency resonance: when the slower and the faster half of the runs each want a
-#: resonance of their own (:func:`rwadist.stand_resonance.structure_mode_refused`), their two frequencies must lie
-#: within its own relative half-width ζ, and within this at least, for it to stay one fixed resonance
-STRUCTURE_SPEED_SPLIT_TOL = 0.03
-#: ... each half holding this many runs at least (fewer: the split tells nothing, the mode is kept)
-STRUCTURE_SPLIT_MIN_RUNS = 5
-
-
-def _fixed_across_speeds(ctx: Context, runs, joint) -> bool:
-    """Whether the structure mode of ``joint`` (its ``stand`` on ``stand_direction``) stays at one frequency across
-    the speeds.  On the slower and on the faster half of ``runs``, the structure mode is fitted again from it (jointly
-    with the suspension modes) and set against the fit holding it
-    (:func:`rwadist.stand_resonance.structure_mode_refused`: the Bayesian information criterion of its four
-    parameters); it moves with the speed when BOTH halves want a resonance of their own and their two frequencies are
-    more than the resonance's relative half-width ζ (or :data:`STRUCTURE_SPEED_SPLIT_TOL`) apart.  A mode whose
-    frequency falls or rises with speed (a rotor mode softening, a drive resonance following the speed) also lifts
-    the lines of one direction, and one fixed resonance fitted to it sits between its ends (family wheel 0, a radial
-    resonance softening 248 -> 149 Hz over the speeds: a 'wheel mode' at 198 Hz; the halves want 202 and 188 Hz, each
-    beyond its criterion by 75 and 194): it is no wheel mode, and the open world describes it (``moving_resonance``).
-    A fixed one fitted on half its speeds may run off (family wheel 5: 538 Hz on the slower half for a 490-Hz mode)
-    but that half does not want it (criterion -29).  Halves too short, or fits that fail, tell nothing: kept."""
-    from ..stand_resonance import structure_mode_refused
-
-    runs = np.asarray([int(r) for r in runs])
-    half = runs.size // 2
-    if half < STRUCTURE_SPLIT_MIN_RUNS:
-        return True
-    spin = np.abs(np.asarray(ctx.test.speeds, dtype=float)[runs])
-    order = np.argsort(spin, kind="stable")
-    got = []
-    for part in (np.sort(runs[order[:half]]), np.sort(runs[order[-half:]])):
-        try:
-            test, fit = _test_and_fit(ctx, part)
-            got.append(structure_mode_refused(test, fit, joint.stand_direction, tuple(joint.stand[:4])))
-        except ValueError:
-            return True
-    moved = abs(float(np.log(got[1][1] / got[0][1])))
-    moving = got[0][0] > 0 and got[1][0] > 0 and moved > max(joint.stand[1], STRUCTURE_SPEED_SPLIT_TOL)
-    return not moving
 
 
 def _locate(ctx: Context, test, fit, stand_start, near=None):
