@@ -629,9 +629,8 @@ def _search_once(spectra: Spectra, model: WheelModel | None, k_sigma: float, min
     ``offset_pair``: the wheel's modes that do not pass alone may be judged with the load-cell offset they were
     located beside (:func:`_judge_with_offset`)."""
     given = model is not None
-    # the open world (docs/diagnose.md, "Unexplained residual"): lines at one fixed frequency in every run and a
-    # channel's copy of another's content taken out of the records everything after reads, the empirical fit of a
-    # model not given included (no class explains them; left in, a class is forced onto them), described after
+    # the open world (docs/diagnose.md, "Unexplained residual"): fixed-frequency lines and a channel's copy of another
+    # taken out of the records all after reads, a model's empirical fit included (no class explains them), described
     opened = describe.start(Context(spectra, channels, test), steps)
     ctx = opened.ctx
     ctx.offset_pair = offset_pair
@@ -654,9 +653,8 @@ def _search_once(spectra: Spectra, model: WheelModel | None, k_sigma: float, min
     hyps: list = []
     judged: list = []                           # the last step's hypotheses (read after the loop, with its best)
     it, best = 0, None
-    # a family marked ``first`` (the wheel's own modes) is taken before any other passing effect: it is proposed
-    # and judged alone, and the other families only when it is not taken (the same choice as judging all together,
-    # without fitting every other family to a state about to change)
+    # a family marked ``first`` (the wheel's own modes) is proposed and judged alone, before any other, and the others
+    # only when it is not taken (the choice of judging all together, without fitting them to a state about to change)
     first = [cls for cls in family_classes() if getattr(cls, "first", False)]
     rest = [cls for cls in family_classes() if not getattr(cls, "first", False)]
     for it in range(1, max_iterations + 1):
