@@ -18,7 +18,8 @@ least :data:`MIN_RUN_FRACTION` of the runs where the copy would stand :data:`MIN
 noise (its ratio there within :data:`CLUSTER_TOLERANCE` of κ, or within the scatter that noise gives it,
 :data:`NOISE_Z`, the tolerance's own at :data:`CLEAR_COPY_DB`: a noisy test's copied lines stand 10-20 dB over the
 target's noise), and κ times the source stands over the target's noise.  Pairs of channels of one direction (Fx-Fy, Tx-Ty: a rotating line fixes their phase) are not tried, nor a
-torque carrying a force of a load-cell offset's r × F (the ``cross_coupling`` class; :data:`LEVER_ARM_PAIRS`); a copy
+torque carrying a force of a load-cell offset's r × F on the lines (the ``cross_coupling`` class;
+:data:`LEVER_ARM_PAIRS`: on the floor they are, against their mirror pair, :func:`_floor_copies`); a copy
 whose target torque that offset's r × F of the forces explains as well is the offset's (:func:`_lever_arm_of_forces`);
 and a radial pair reading the other radial pair alike (Tx = κ·Fx with Ty = κ·Fy: a rotating source's force and
 moment in phase) is the rotor's own pattern, not a copy.
@@ -32,7 +33,8 @@ import numpy as np
 from ..units import CHANNEL_DIRECTION, RAD_S_TO_RPM
 
 #: (force, torque) pairs of a load-cell offset's r × F (Tx = r_y·Fz − r_z·Fy, ...): the ``cross_coupling`` class
-#: explains a torque carrying such a force, so those pairs are left to it
+#: explains a torque carrying such a force on the lines, so those pairs are left to it there (the noise floor tells
+#: an instrument's copy from an offset: :func:`_floor_copies`)
 LEVER_ARM_PAIRS = {("Fy", "Tx"), ("Fz", "Tx"), ("Fx", "Ty"), ("Fz", "Ty"), ("Fx", "Tz"), ("Fy", "Tz")}
 #: Each lever-arm pair's mirror: the other term of the same component of r in r × F, at the negated ratio
 #: (T_y = r_z·F_x with T_x = −r_z·F_y; T_x = r_y·F_z with T_z = −r_y·F_x; T_z = r_x·F_y with T_y = −r_x·F_z)

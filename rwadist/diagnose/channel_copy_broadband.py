@@ -11,9 +11,10 @@ the other pairs 0.5-3), with one ratio κ = Σ S_ts / Σ S_ss in every run and e
 pair's broadband coherence (a structure's response to the wheel's random loads) has a transfer that changes with
 the frequency through the modes: one κ across the band (:data:`BAND_PARTS` parts, each within
 :data:`~rwadist.diagnose.channel_copy.CLUSTER_TOLERANCE` plus its noise's scatter) and across the runs is asked
-for.  A load-cell offset's r × F reads the same way on a force-torque pair (T_x = −r_z·F_y) but puts the mirror
-term into the partner torque too (T_y = r_z·F_x): a copy whose partner pair carries −κ alike is left to the
-``cross_coupling`` class.
+for.  A load-cell offset's r × F of noisy forces (a lever-arm correction) reads the same way on a force-torque pair
+(T_x = −r_z·F_y) but puts the mirror term of r's component into another torque too (T_y = r_z·F_x; T_x = r_y·F_z
+with T_z = −r_y·F_x; T_y = −r_x·F_z with T_z = r_x·F_y): a copy whose mirror pair carries −κ alike, or cannot be
+read, is left to the ``cross_coupling`` class (:func:`offset_mirror`).
 """
 from __future__ import annotations
 
