@@ -18,7 +18,8 @@ least :data:`MIN_RUN_FRACTION` of the runs where the copy would stand :data:`MIN
 noise (its ratio there within :data:`CLUSTER_TOLERANCE` of κ, or within the scatter that noise gives it,
 :data:`NOISE_Z`, the tolerance's own at :data:`CLEAR_COPY_DB`: a noisy test's copied lines stand 10-20 dB over the
 target's noise), and κ times the source stands over the target's noise.  Pairs of channels of one direction (Fx-Fy, Tx-Ty: a rotating line fixes their phase) are not tried, nor a
-torque carrying a force of a load-cell offset's r × F (the ``cross_coupling`` class; :data:`LEVER_ARM_PAIRS`); a copy
+torque carrying a force of a load-cell offset's r × F on the lines (the ``cross_coupling`` class;
+:data:`LEVER_ARM_PAIRS`: on the floor they are, against their mirror pair, :func:`_floor_copies`); a copy
 whose target torque that offset's r × F of the forces explains as well is the offset's (:func:`_lever_arm_of_forces`);
 and a radial pair reading the other radial pair alike (Tx = κ·Fx with Ty = κ·Fy: a rotating source's force and
 moment in phase) is the rotor's own pattern, not a copy.
@@ -32,8 +33,13 @@ import numpy as np
 from ..units import CHANNEL_DIRECTION, RAD_S_TO_RPM
 
 #: (force, torque) pairs of a load-cell offset's r × F (Tx = r_y·Fz − r_z·Fy, ...): the ``cross_coupling`` class
-#: explains a torque carrying such a force, so those pairs are left to it
+#: explains a torque carrying such a force on the lines, so those pairs are left to it there (the noise floor tells
+#: an instrument's copy from an offset: :func:`_floor_copies`)
 LEVER_ARM_PAIRS = {("Fy", "Tx"), ("Fz", "Tx"), ("Fx", "Ty"), ("Fz", "Ty"), ("Fx", "Tz"), ("Fy", "Tz")}
+#: Each lever-arm pair's mirror: the other term of the same component of r in r × F, at the negated ratio
+#: (T_y = r_z·F_x with T_x = −r_z·F_y; T_x = r_y·F_z with T_z = −r_y·F_x; T_z = r_x·F_y with T_y = −r_x·F_z)
+LEVER_ARM_MIRROR = {("Fx", "Ty"): ("Fy", "Tx"), ("Fy", "Tx"): ("Fx", "Ty"), ("Fz", "Tx"): ("Fx", "Tz"),
+                    ("Fx", "Tz"): ("Fz", "Tx"), ("Fz", "Ty"): ("Fy", "Tz"), ("Fy", "Tz"): ("Fz", "Ty")}
 #: Each torque's row of a load-cell offset's r × F: (force, sign) of its two terms, the real components of r the
 #: unknowns (T_x = r_y·F_z − r_z·F_y, T_y = r_z·F_x − r_x·F_z, T_z = r_x·F_y − r_y·F_x)
 TORQUE_ROW = {"Tx": (("Fz", 1.0), ("Fy", -1.0)), "Ty": (("Fx", 1.0), ("Fz", -1.0)),
@@ -187,18 +193,21 @@ def find_channel_copies(ctx, test=None) -> list:
 
 def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
     """The :class:`ChannelCopy` read on the noise floor (:func:`~rwadist.diagnose.channel_copy_broadband.
-    find_broadband_copies`) of the targets the lines gave none: a radial force in a radial torque tried too (a
-    load-cell offset's r × F, the partner pair reading −κ alike, left to ``cross_coupling``), the other
-    :data:`LEVER_ARM_PAIRS` not; of a pair read both ways the way whose removal takes the more of the target's power
-    at the source's lines (the copied lines leave the target; read backwards, the source's own lines stay).  ``X``,
-    ``noise``, ``src``, ``run_of``, ``h``: the lines' points of :func:`find_channel_copies`."""
-    from .channel_copy_broadband import find_broadband_copies, offset_mirror
+    find_broadband_copies`) of the targets the lines gave none: every pair of two directions, a force in a torque
+    (:data:`LEVER_ARM_PAIRS`) too unless its mirror pair (:data:`LEVER_ARM_MIRROR`, the same component of a load-cell
+    offset's r) reads −κ or cannot be read (:func:`~rwadist.diagnose.channel_copy_broadband.offset_mirror`: an
+    offset's r × F, left to ``cross_coupling``); of a pair read both ways the way whose removal takes the more of the
+    target's power at the source's lines (the copied lines leave the target; read backwards, the source's own lines
+    stay).  ``X``, ``noise``, ``src``, ``run_of``, ``h``: the lines' points of :func:`find_channel_copies`.
 
-    radial = {("Fy", "Tx"), ("Fx", "Ty")}
-    skip = (LEVER_ARM_PAIRS - radial) | {(x.source, x.target) for x in found} | \
-        {(a, x.target) for x in found for a in chans}
-    got = find_broadband_copies(test, runs, chans, CLUSTER_TOLERANCE, skip)
-    got = [g for g in got if not offset_mirror(got, g, PARTNER)]
+    On the lines a copy of a force in a torque at a real κ is an offset's r × F to the last digit (trial24's
+    T_z += 0.02·F_x: r_y = −20 mm explains T_z as well, :func:`_lever_arm_of_forces`); the floor tells them apart: an
+    offset moves loads, a copy carries the source's sensor noise too, and a lever-arm correction's (T − r × F of the
+    measured forces) moves both of r's terms."""
+    from .channel_copy_broadband import find_broadband_copies
+
+    skip = {(x.source, x.target) for x in found} | {(a, x.target) for x in found for a in chans}
+    got = find_broadband_copies(test, runs, chans, CLUSTER_TOLERANCE, skip, mirror=LEVER_ARM_MIRROR)
     gain = {}
     for g in got:
         s, t = chans.index(g[0]), chans.index(g[1])

@@ -11,9 +11,10 @@ the other pairs 0.5-3), with one ratio κ = Σ S_ts / Σ S_ss in every run and e
 pair's broadband coherence (a structure's response to the wheel's random loads) has a transfer that changes with
 the frequency through the modes: one κ across the band (:data:`BAND_PARTS` parts, each within
 :data:`~rwadist.diagnose.channel_copy.CLUSTER_TOLERANCE` plus its noise's scatter) and across the runs is asked
-for.  A load-cell offset's r × F reads the same way on a force-torque pair (T_x = −r_z·F_y) but puts the mirror
-term into the partner torque too (T_y = r_z·F_x): a copy whose partner pair carries −κ alike is left to the
-``cross_coupling`` class.
+for.  A load-cell offset's r × F of noisy forces (a lever-arm correction) reads the same way on a force-torque pair
+(T_x = −r_z·F_y) but puts the mirror term of r's component into another torque too (T_y = r_z·F_x; T_x = r_y·F_z
+with T_z = −r_y·F_x; T_y = −r_x·F_z with T_z = r_x·F_y): a copy whose mirror pair carries −κ alike, or cannot be
+read, is left to the ``cross_coupling`` class (:func:`offset_mirror`).
 """
 from __future__ import annotations
 
@@ -31,6 +32,9 @@ BAND_PARTS = 4
 NOISE_FACTOR = 3.0
 #: Welch segment length (samples, at most; the record's eighth when shorter).
 NPERSEG = 2048
+#: A load-cell offset's mirror pair reads −κ within this fraction of |κ| (besides its noise's scatter):
+#: :func:`offset_mirror`
+MIRROR_TOLERANCE = 0.3
 
 
 def _segments(run, chans):
@@ -86,24 +90,33 @@ def _run_stats(Z, stats: tuple, s: int, t: int):
     return kappa, z, [(np.add.reduce(a), np.add.reduce(b), np.add.reduce(c) / M) for a, b, c in parts]
 
 
-def find_broadband_copies(test, runs, chans, tolerance: float, skip=()) -> list:
+def find_broadband_copies(test, runs, chans, tolerance: float, skip=(), mirror=None) -> list:
     """[(source, target, κ, runs, z median)] of the channel pairs of ``chans`` (not one direction's, not in
     ``skip``) whose noise floors share one κ in :data:`MIN_RUN_FRACTION` of ``runs`` (indices of ``test.runs``) and
-    across the band (``tolerance``: the relative agreement asked for, besides the noise's own scatter)."""
+    across the band (``tolerance``: the relative agreement asked for, besides the noise's own scatter).  ``mirror``:
+    (source, target) -> the pair a load-cell offset's r × F would fill with −κ alongside (the same component of r,
+    :func:`offset_mirror`); a pair's copy is dropped when its mirror reads −κ or cannot be read."""
     per_run = []
     for r in runs:
         _, Z = _segments(test.runs[r], chans)
         per_run.append((r, Z, _channel_stats(Z)))
     out = []
     K = len(chans)
+    mirror = mirror or {}
     for s in range(K):
         for t in range(K):
             cs, ct = chans[s], chans[t]
             if s == t or CHANNEL_DIRECTION[cs] == CHANNEL_DIRECTION[ct] or (cs, ct) in skip:
                 continue
             got = _pair(per_run, s, t, tolerance)
-            if got is not None:
-                out.append((cs, ct) + got)
+            if got is None:
+                continue
+            if (cs, ct) in mirror:
+                ms, mt = mirror[(cs, ct)]
+                if ms not in chans or mt not in chans or \
+                        offset_mirror(per_run, chans.index(ms), chans.index(mt), got[0]):
+                    continue
+            out.append((cs, ct) + got)
     return out
 
 
@@ -133,11 +146,34 @@ def _pair(per_run, s: int, t: int, tolerance: float):
     return kappa, tuple(int(r) for r in agree), float(np.median([x[1] for _, x in strong]))
 
 
-def offset_mirror(found: list, copy, partner: dict) -> bool:
-    """Whether ``copy`` (source, target, κ, ...) of a radial force in a radial torque is a load-cell offset's r × F:
-    the partner pair reads −κ too (T_x = −r_z·F_y with T_y = r_z·F_x), among ``found`` (the pairs' tuples);
-    ``partner``: each radial channel's other channel of its pair."""
-    cs, ct, kappa = copy[0], copy[1], copy[2]
-    if cs not in ("Fx", "Fy") or ct not in ("Tx", "Ty"):
-        return False
-    return any(x[0] == partner[cs] and x[1] == partner[ct] and abs(x[2] + kappa) <= 0.3 * abs(kappa) for x in found)
+def mirror_reading(per_run, ms: int, mt: int, kappa: complex) -> tuple:
+    """(κ_m, z_m, z_expected) of the mirror pair (channel ``ms`` in ``mt``) over every run of ``per_run``, pooled
+    on the bins where both are noise: its ratio Σ S_ts / Σ S_ss, its null-scatter z, and the z that −``kappa`` × the
+    source would give there (|κ|·Σ S_ss / sqrt(Σ S_ss·S_tt / M): whether the mirror can be read at all)."""
+    cross, total, null = 0j, 0.0, 0.0
+    for _, Z, (P, quiet) in per_run:
+        noise = quiet[ms] & quiet[mt]
+        noise[:4] = False
+        idx = np.flatnonzero(noise)
+        cross += complex(np.add.reduce(np.mean(np.conj(Z[:, :, ms]) * Z[:, :, mt], axis=0)[idx]))
+        total += float(np.add.reduce(P[ms][idx]))
+        null += float(np.add.reduce(P[ms][idx] * P[mt][idx])) / Z.shape[0]
+    if total <= 0 or null <= 0:
+        return 0j, 0.0, 0.0
+    return cross / total, abs(cross) / np.sqrt(null), abs(kappa) * total / np.sqrt(null)
+
+
+def offset_mirror(per_run, ms: int, mt: int, kappa: complex) -> bool:
+    """Whether a copy κ of a force in a torque is a load-cell offset's r × F (a ``cross_coupling`` / a lever-arm
+    correction's ``lever_arm_noise``): r's component puts its other term into another torque at −κ (T_x = −r_z·F_y
+    with T_y = r_z·F_x; T_z = −r_y·F_x with T_x = r_y·F_z; T_z = r_x·F_y with T_y = −r_x·F_z), so the mirror pair
+    (channel ``ms`` in ``mt``, pooled over ``per_run``, :func:`mirror_reading`) reads −κ within
+    :data:`MIRROR_TOLERANCE` plus its noise's scatter; or it cannot be read (−κ × its source would not reach
+    :data:`MIN_Z` over the mirror target's noise): then the two are not told apart and the pair is left to the
+    offset's classes.  A cross-sensitive channel or a calibration matrix missing one force-to-moment term reads one
+    force, the mirror pair stays at z ~ 1 (trial24, T_z += 0.02·F_x: the mirror F_z -> T_x would stand at z ~ 170,
+    it reads z ~ 1)."""
+    k_m, _, z_exp = mirror_reading(per_run, ms, mt, kappa)
+    if z_exp < MIN_Z:
+        return True
+    return bool(abs(k_m + kappa) <= MIRROR_TOLERANCE * abs(kappa) + 3.0 * abs(kappa) / z_exp)
