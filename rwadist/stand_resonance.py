@@ -708,10 +708,9 @@ def stand_of_structure(test, fit, plain, structure) -> tuple:
             joint = fit_extended(test, fit, stand=start)
     except ValueError:
         return plain, None
-    if not stand_confirmed(joint, plain, start if joint.stand is None else None) or \
-            joint_cost(joint) > joint_cost(structure):
+    if joint.stand is None or not stand_confirmed(joint, plain) or joint_cost(joint) > joint_cost(structure):
         return plain, None
-    f_r, zeta, gain, above = start if joint.stand is None else joint.stand
+    f_r, zeta, gain, above = joint.stand
     joint.notes.append(f"test stand: a resonance at {f_r:.4g} Hz (ζ {zeta:.3g}, peak gain {gain:.3g}, {above:.3g} of "
                        "the load far above it) lifts the lines of every channel: a fixture resonance, found on one "
                        "direction's lines and fitted with the modes on every channel; not part of the wheel's model "

@@ -95,7 +95,9 @@ def find_broadband_copies(test, runs, chans, tolerance: float, skip=(), mirror=N
     ``skip``) whose noise floors share one κ in :data:`MIN_RUN_FRACTION` of ``runs`` (indices of ``test.runs``) and
     across the band (``tolerance``: the relative agreement asked for, besides the noise's own scatter).  ``mirror``:
     (source, target) -> the pair a load-cell offset's r × F would fill with −κ alongside (the same component of r,
-    :func:`offset_mirror`); a pair's copy is dropped when its mirror reads −κ or cannot be read."""
+    :func:`offset_mirror`); a pair's copy is dropped when its mirror reads −κ or cannot be read, and so is the pair
+    read backwards (a torque in a force), judged with the force's own κ in the torque (an offset r_y read T_x -> F_z
+    at 1/κ survived its forward pair's drop and was taken out of the records as a copy: review of 6f9006e)."""
     per_run = []
     for r in runs:
         _, Z = _segments(test.runs[r], chans)
@@ -111,10 +113,13 @@ def find_broadband_copies(test, runs, chans, tolerance: float, skip=(), mirror=N
             got = _pair(per_run, s, t, tolerance)
             if got is None:
                 continue
-            if (cs, ct) in mirror:
-                ms, mt = mirror[(cs, ct)]
+            pair = (cs, ct) if (cs, ct) in mirror else (ct, cs) if (ct, cs) in mirror else None
+            if pair is not None:
+                # a torque read in a force (T -> F) is that pair read backwards: judged by the force's own reading
+                ms, mt = mirror[pair]
+                kappa = got[0] if pair == (cs, ct) else mirror_reading(per_run, t, s, 0j)[0]
                 if ms not in chans or mt not in chans or \
-                        offset_mirror(per_run, chans.index(ms), chans.index(mt), got[0]):
+                        offset_mirror(per_run, chans.index(ms), chans.index(mt), kappa):
                     continue
             out.append((cs, ct) + got)
     return out

@@ -628,16 +628,16 @@ class Context(Metric):
             n = np.rint(self.run_durations(runs) * fs)
             ratio = smear.speed_ratios(state.smear or 0.0, self.omega[runs], n, np.asarray(self.sp.n_segments)[runs], L, fs)
             w_seg = self.omega[runs][:, None] * ratio
-            seg, _ = self._ext_lines(state, w_seg.ravel(), tuple(state.ext_lines()))
-            mean = self.channel_lines(state, c, runs)
+            seg_key = ("smear_lines", runs.tobytes())        # every line at every segment's speed, once per runs
+            if seg_key not in state._cache:
+                state._cache[seg_key] = self._ext_lines(state, w_seg.ravel(), tuple(state.ext_lines()))[0]
+            a_seg = next((a for hs, _, a, _ in state._cache[seg_key].get(c, []) if abs(hs - h) < 1e-9), None)
+            a0 = next((a for hm, _, a, _ in self.channel_lines(state, c, runs) if abs(hm - h) < 1e-9), None)
             out = np.ones(w_seg.shape)
-            for (hs, _, a_seg, _), (hm, _, a0, _) in zip(seg.get(c, []), mean):
-                if abs(hs - h) < 1e-9 and abs(hm - h) < 1e-9:
-                    a_seg = a_seg.reshape(w_seg.shape)
-                    ok = (a0[:, None] > 0) & (ratio > 0)
-                    out = np.where(ok, (a_seg / np.where(ok, a0[:, None], 1.0)) ** 2 / np.where(ok, ratio, 1.0) ** 4,
-                                   1.0)
-                    break
+            if a_seg is not None and a0 is not None:
+                a_seg = a_seg.reshape(w_seg.shape)
+                ok = (a0[:, None] > 0) & (ratio > 0)
+                out = np.where(ok, (a_seg / np.where(ok, a0[:, None], 1.0)) ** 2 / np.where(ok, ratio, 1.0) ** 4, 1.0)
             out.flags.writeable = False
             state._cache[key] = out
         return state._cache[key]

@@ -226,9 +226,11 @@ def _narrow_judge(ctx, state, judged, min_gain) -> tuple:
     the same laws took 14-29 % of the narrow-line misfit, the reviewer's view of the waterfall
     (``waterfall_band_contrast``: every band weighs alike).  An effect that adds content (a line, a floor, a resonance)
     is not judged so: its power share is its measure, and every band alike would let a floor's many bands pass."""
-    if any(not m.startswith("zeta") for e in state.effects if getattr(e, "kind", "") == "suspension_modes"
-           for m in e.unconstrained):
-        # a wheel mode not located leaves its lines' misfit to whatever re-weights them: no law on the narrow lines
+    modes = [e for e in state.effects if getattr(e, "kind", "") == "suspension_modes"]
+    if (getattr(ctx, "base_switch", False) and not modes) or \
+            any(not m.startswith("zeta") for e in modes for m in e.unconstrained):
+        # a wheel mode not located (or none, where the data were to give them) leaves its lines' misfit to whatever
+        # re-weights them: no law on the narrow lines
         # (trial24, rocking not located beside an Ω^2.4 torque line crossing its backward whirl: Ω^1.66 on h 0.41)
         return None, None, None
     narrow = [h for h in judged if h.narrow_gain_fraction is not None and h.narrow_gain_fraction >= min_gain]
