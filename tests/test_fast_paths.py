@@ -263,6 +263,18 @@ def test_scan_screened_is_the_double_precision_scan(monkeypatch):
                         == (whole.found, whole.f0_hz, whole.zeta, whole.inertia_ratio, whole.reason)), (seed, mode)
 
 
+def _screen_cases():
+    """(seed, line, h, omega, power, f0, zeta, a, two) of the screen tests: four seeds of :func:`_scan_case`, each with
+    a three-parameter grid and two grids without a, in power (``two``) and in amplitude."""
+    for seed in (3, 5, 7, 11):
+        line, h, omega, power = _scan_case(seed=seed)
+        f0 = np.exp(np.arange(np.log(10.0), np.log(1000.0), 0.02))
+        for zeta, a, two in ((np.geomspace(0.002, 0.6, 9), np.arange(0.2, 3.01, 0.2), True),
+                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), True),
+                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), False)):
+            yield seed, line, h, omega, power if two else np.sqrt(power), f0, zeta, a, two
+
+
 def test_screened_scan_grid_has_the_double_precision_best_point():
     # a locate-only scan screens its grid in single precision and searches the f0 near the screen's best again in double
     # precision (mode_scan._screened_search): the best point and its SSR are the double-precision grid's, bit for bit,
@@ -270,21 +282,15 @@ def test_screened_scan_grid_has_the_double_precision_best_point():
     # mode_scan._pruned_screen) below it and beyond the kept margin
     from rwadist.mode_scan import SCREEN_MARGIN, _screened_search
 
-    for seed in (3, 5, 7, 11):
-        line, h, omega, power = _scan_case(seed=seed)
-        f0 = np.exp(np.arange(np.log(10.0), np.log(1000.0), 0.02))
-        for zeta, a, two in ((np.geomspace(0.002, 0.6, 9), np.arange(0.2, 3.01, 0.2), True),
-                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), True),
-                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), False)):
-            p = power if two else np.sqrt(power)
-            whole = _grid_search(line, h, omega, p, f0, zeta, a, two)
-            got = _screened_search(line, h, omega, p, f0, zeta, a, two)
-            best = np.unravel_index(np.argmin(whole), whole.shape)
-            assert np.unravel_index(np.argmin(got), got.shape) == best and got[best] == whole[best], (seed, a.size)
-            same = np.all(got == whole, axis=(1, 2))
-            close = np.isclose(got, whole, rtol=1e-3, atol=1e-3)
-            ruled_out = (got <= whole * (1 + 1e-3) + 1e-3) & (got > whole[best] + SCREEN_MARGIN * (1 + whole[best]))
-            assert same[best[0]] and np.all(close | ruled_out), (seed, a.size)
+    for seed, line, h, omega, p, f0, zeta, a, two in _screen_cases():
+        whole = _grid_search(line, h, omega, p, f0, zeta, a, two)
+        got = _screened_search(line, h, omega, p, f0, zeta, a, two)
+        best = np.unravel_index(np.argmin(whole), whole.shape)
+        assert np.unravel_index(np.argmin(got), got.shape) == best and got[best] == whole[best], (seed, a.size)
+        same = np.all(got == whole, axis=(1, 2))
+        close = np.isclose(got, whole, rtol=1e-3, atol=1e-3)
+        ruled_out = (got <= whole * (1 + 1e-3) + 1e-3) & (got > whole[best] + SCREEN_MARGIN * (1 + whole[best]))
+        assert same[best[0]] and np.all(close | ruled_out), (seed, a.size)
 
 
 def test_pruned_screen_is_the_single_precision_grid_where_it_can_matter(monkeypatch):
@@ -300,28 +306,22 @@ def test_pruned_screen_is_the_single_precision_grid_where_it_can_matter(monkeypa
     points_ssr = ms._points_ssr
     monkeypatch.setattr(ms, "_points_ssr", lambda rows, k, w0, *rest: calls.append(w0.size) or
                         points_ssr(rows, k, w0, *rest))
-    for seed in (3, 5, 7, 11):
-        line, h, omega, power = _scan_case(seed=seed)
-        f0 = np.exp(np.arange(np.log(10.0), np.log(1000.0), 0.02))
-        for zeta, a, two in ((np.geomspace(0.002, 0.6, 9), np.arange(0.2, 3.01, 0.2), True),
-                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), True),
-                             (np.geomspace(0.002, 0.6, 13), np.array([0.0]), False)):
-            p = power if two else np.sqrt(power)
-            calls.clear()
-            ref = ms._grid_search(line, h, omega, p, f0, zeta, a, two, dtype=np.float32)
-            got = ms._pruned_screen(line, h, omega, p, f0, zeta, a, two)
-            least = ref.min()
-            margin = ms.SCREEN_MARGIN * (1 + least)
-            assert abs(got.min() - least) <= 1e-5 * (1 + least), (seed, a.size)
-            near = ref <= least + 1.5 * margin
-            assert np.allclose(got[near], ref[near], rtol=1e-5, atol=1e-6), (seed, a.size)
-            assert np.all(got[~near] <= ref[~near] * (1 + 1e-5) + 1e-6), (seed, a.size)       # lower bounds
-            assert np.all(got[~near] > least + margin), (seed, a.size)
-            kept = np.flatnonzero(ref.min(axis=(1, 2)) <= least + margin)
-            assert np.array_equal(np.flatnonzero(got.min(axis=(1, 2)) <= got.min() + ms.SCREEN_MARGIN * (1 + got.min())),
-                                  kept), (seed, a.size)
-            # after the first line (on the whole grid) the other three are summed at a few of the points only
-            assert len(calls) > 0 and max(calls) < 0.5 * got.size, (seed, a.size, calls)
+    for seed, line, h, omega, p, f0, zeta, a, two in _screen_cases():
+        calls.clear()
+        ref = ms._grid_search(line, h, omega, p, f0, zeta, a, two, dtype=np.float32)
+        got = ms._pruned_screen(line, h, omega, p, f0, zeta, a, two)
+        least = ref.min()
+        margin = ms.SCREEN_MARGIN * (1 + least)
+        assert abs(got.min() - least) <= 1e-5 * (1 + least), (seed, a.size)
+        near = ref <= least + 1.5 * margin
+        assert np.allclose(got[near], ref[near], rtol=1e-5, atol=1e-6), (seed, a.size)
+        assert np.all(got[~near] <= ref[~near] * (1 + 1e-5) + 1e-6), (seed, a.size)       # lower bounds
+        assert np.all(got[~near] > least + margin), (seed, a.size)
+        kept = np.flatnonzero(ref.min(axis=(1, 2)) <= least + margin)
+        assert np.array_equal(np.flatnonzero(got.min(axis=(1, 2)) <= got.min() + ms.SCREEN_MARGIN * (1 + got.min())),
+                              kept), (seed, a.size)
+        # after the first line (on the whole grid) the other three are summed at a few of the points only
+        assert len(calls) > 0 and max(calls) < 0.5 * got.size, (seed, a.size, calls)
 
 
 def test_presence_curve_counts_the_pairs_of_a_coverage_matrix():
