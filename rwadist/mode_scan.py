@@ -548,7 +548,7 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
         # neighbourhood of the best point once more, a to 0.001 (f0 and ζ move with it along the whirl's valley)
         f_2 = f_best * np.exp(np.arange(-0.003, 0.00301, 0.0005))
         z_2 = z_best * np.exp(np.linspace(-0.1, 0.1, 5))
-        a_2 = np.unique(np.clip(a_best + np.arange(-0.02, 0.02001, 0.001), 0.02, A_MAX))
+        a_2 = np.unique(np.clip(np.round(a_best + np.arange(-0.02, 0.02001, 0.001), 9), 0.02, A_MAX))
         fine_2 = _screened_search(line, h, omega, power, f_2, z_2, a_2, two_parts)
         gi, gj, gk = np.unravel_index(np.nanargmin(fine_2), fine_2.shape)
         if float(fine_2[gi, gj, gk]) < best:

@@ -24,6 +24,13 @@ def test_json_form_round_trips_through_a_file_and_keeps_every_field():
     assert "50 Hz in Fx Tz, 600-6000 rpm" in u.text() and "41 % of what is left" in u.text()
 
 
+@pytest.mark.parametrize("share, words", [(0.41, "41 %"), (0.0171, "2 %"), (0.0017, "0.2 %"), (0.0003, "< 0.1 %"),
+                                          (0.0, "0 %")])
+def test_a_small_share_is_printed_as_what_it_is_not_as_nothing(share, words):
+    """trial24: a described hump of 0.17 % of what is left read "0 % of what is left"."""
+    assert f", {words} of what is left" in _record(share=share).text()
+
+
 def test_record_is_read_only_and_rejects_unknown_signatures_and_bad_documents():
     u = _record()
     with pytest.raises(AttributeError):

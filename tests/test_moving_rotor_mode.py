@@ -181,3 +181,19 @@ def test_a_rising_track_below_n_times_the_spin_is_the_backward_wave_past_its_cri
     first = _moving_causes(2.0, "stiffening", 120.0, 100.0)[0]
     assert "≈ 80 Hz in the rotor's frame" in first and "past its critical speed" in first and "-80" not in first
     assert "≈ 320 Hz" in _moving_causes(2.0, "stiffening", 520.0, 100.0)[0]       # a forward wave: 520 − 200
+
+
+@pytest.mark.parametrize("slope, f_mid, n, rest, words", [
+    (1.2, 450.0, 1, "+0.20", "stiffening"),     # forward wave f = f_r(s) + s, f_r rising 0.2 Hz per Hz (trial24)
+    (-0.9, 300.0, 1, "+0.10", "stiffening"),    # backward wave f = f_r(s) − s, f_r rising 0.1 Hz per Hz
+    (2.1, 120.0, 2, "-0.10", "softening"),      # past its critical speed, f = 2·s − f_r(s), f_r falling 0.1
+])
+def test_a_slope_off_a_whole_number_leaves_the_rest_to_the_rotor_frame_mode(slope, f_mid, n, rest, words):
+    """A travelling wave's track has slope ±n plus the rotor-frame frequency's own slope d f_r / d f_spin (the signs
+    from f = f_r ± n·f_spin, and n·f_spin − f_r past the critical speed): the description says what is left."""
+    from rwadist.diagnose.describe_structure import _moving_causes
+
+    first = _moving_causes(slope, "stiffening", f_mid, 100.0)[0]
+    assert f"{n} nodal diameter" in first
+    assert f"leaves {rest} to the mode's own frequency in the rotor's frame: {words} with speed" in first
+    assert "leaves" not in _moving_causes(1.02, "stiffening", 450.0, 100.0)[0]     # a whole number within 0.05

@@ -689,6 +689,15 @@ def _moving_causes(slope: float, sign: str, f_mid: float, spin_mid: float) -> tu
                  f"≈ {f_rot:.4g} Hz in the rotor's frame, seen in the stationary frame as its {wave} travelling wave "
                  f"at f_rotor {op} {n}·f_spin (a rotating-frame mode seen from the housing; an axisymmetric rotor's modes "
                  f"of {n} nodal diameters reach the bearings through its asymmetries)")
+        # the rotor-frame frequency's own slope: the track's slope less the wave's n·f_spin (sign flipped for a
+        # backward wave past its critical speed, where the housing sees n·f_spin − f_rotor)
+        rest = slope - np.sign(slope) * n
+        if "past" in wave:
+            rest = -rest
+        if abs(rest) >= 0.05:
+            # the track's slope is not a whole number: say what the rest would be (trial24: 1.2 read as n = 1 alone)
+            nodal += (f"; the measured slope {slope:+.2f} Hz per Hz of spin leaves {rest:+.2f} to the mode's own "
+                      f"frequency in the rotor's frame: {'stiffening' if rest > 0 else 'softening'} with speed")
         return (nodal, centrifugal, drive)
     return (centrifugal, drive)
 

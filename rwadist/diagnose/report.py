@@ -263,7 +263,7 @@ def unexplained_section(diag: Diagnosis) -> list:
            "the model; marked on the residual waterfall):", ""]
     for i, u in enumerate(diag.unexplained, 1):
         out.append(f"{i}. **{u.signature}** ({u.description}): {u.where()}; {u.strength()}, "
-                   f"{100.0 * u.share:.0f} % of the misplaced power left, {u.n_runs} runs.")
+                   f"{u.share_text()} of the misplaced power left, {u.n_runs} runs.")
         par = ", ".join(f"{k} = {_fmt(v, '.5g')}" for k, v in u.parameters.items())
         if par:
             out.append(f"   Parameters: {par}.")

@@ -83,6 +83,18 @@ def _plain(v):
         return str(v)
 
 
+
+def _percent(share: float) -> str:
+    """A share 0..1 as a percentage a reader can tell from nothing: whole percent from 1 %, one decimal below it and
+    "< 0.1 %" for a share that is there but smaller (trial24: a hump of 0.17 % was printed as "0 % of what is left")."""
+    pct = 100.0 * share
+    if pct >= 0.95:
+        return f"{pct:.0f} %"
+    if pct >= 0.095:
+        return f"{pct:.1f} %"
+    return "< 0.1 %" if pct > 0.0 else "0 %"
+
+
 @dataclass(frozen=True)
 class Unexplained:
     """One description of structured residual no effect class explains.
@@ -173,9 +185,13 @@ class Unexplained:
             sign = "−"
         return f"{sign}{abs(self.level_dB):.2f}"
 
+    def share_text(self) -> str:
+        """Its share of what is left as a percentage ("41 %", "0.2 %", "< 0.1 %")."""
+        return _percent(self.share)
+
     def text(self) -> str:
         """The console's one line: signature, where, strength, share, the first cause and what would tell."""
-        out = f"{self.signature}: {self.where()}, {self.strength()}, {100.0 * self.share:.0f} % of what is left"
+        out = f"{self.signature}: {self.where()}, {self.strength()}, {self.share_text()} of what is left"
         if self.causes:
             out += f"; could be {self.causes[0]}"
         if self.would_tell:
