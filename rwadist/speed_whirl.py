@@ -201,7 +201,8 @@ def settle(test, run) -> tuple:
                                 text=(f"with the first line taken as 1x the gyroscopic whirl read I_zz/I_rr {rho:.3g}, "
                                       f"outside {lo:.2g}-{hi:.2g} (no rigid rotor exceeds 2; a flywheel is above 1); "
                                       f"with the line at h {h:.4g} of it as 1x it reads {rho2:.3g}: that line is "
-                                      "the 1x line, every speed and ratio rescaled by it"))
+                                      "the 1x line, every speed and ratio rescaled by it (ratios now "
+                                      + ", ".join(f"{r:.4g}" for r in sc2.get("ratios", [])) + ")"))
             return t2, d2
     diagnosis = run(test, None)
     scale["whirl"] = dict(rec, status="disagrees", inertia_ratio=rho, rocking_located=whirl_ratio(diagnosis) is not None,

@@ -134,6 +134,9 @@ def test_settle_follows_the_whirl_and_says_when_it_cannot():
     kept, diag = sw.settle(sw.rescaled(test, 3.6), run)
     whirl = kept.meta["slicing"]["speed_scale"]["whirl"]
     assert whirl["status"] == "moved" and whirl["rejected"]["inertia_ratio"] == 0.5
+    # the words carry the ratios of the scale kept (the slicing's first console line gave the rejected scale's)
+    now = [float(x) for x in whirl["text"].split("(ratios now ")[1].rstrip(")").split(", ")]
+    assert now == pytest.approx(kept.meta["slicing"]["speed_scale"]["ratios"], rel=1e-3) and 1.0 in now
     assert kept.speeds == pytest.approx(true_speeds, rel=1e-5) and diag.entry["inertia_ratio"] == 1.8
     kept, _ = sw.settle(test, run)
     assert kept.meta["slicing"]["speed_scale"]["whirl"]["status"] == "agrees"
