@@ -426,6 +426,10 @@ def cmd_diagnose(args) -> int:
         base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
     print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
           f"{base} base")
+    summary = diag.summary()
+    status = summary["suspension_modes_status"]
+    if status and status["status"] != "no_amplification":
+        print(f"  ! suspension modes: {status['text']}")
     if diag.data_quality:
         from .data_quality import quality_lines
 
@@ -442,7 +446,6 @@ def cmd_diagnose(args) -> int:
             print(f"  {line}")
     from .effects_text import diagnose_lines
 
-    summary = diag.summary()
     print("\n".join(diagnose_lines(summary["effects"])) or "  no effect added (none passed the held-out test)")
     for e in summary["base_lines"]:
         print(f"  = {e['direction']} h = {e['h']:g}, C = {e['C']:.3g}: a line of the data the modes' fit did not "

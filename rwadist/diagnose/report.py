@@ -357,6 +357,8 @@ def write_report(diag: Diagnosis, out_dir) -> list:
              else "C·Ω², hard mounted)")
           + (f" -> {diag.state_after.base} (through the wheel's suspension modes fitted from the data)"
              if diag.state_after.base != diag.state_before.base else ""),
+          *([f"- suspension modes: {summary['suspension_modes_status']['text']}"]
+            if summary.get("suspension_modes_status") else []),
           f"- error before: {diag.error_before:.4g}", f"- error after: {diag.error_after:.4g}",
           f"- narrow-line error (`{CONTRAST_METRIC}`: {summary['narrow_line_metric_definition']}) before / after: "
           f"{diag.contrast_error_before:.4g} / {diag.contrast_error_after:.4g}",

@@ -19,6 +19,7 @@ from .effects import family_classes
 from .effects.base import Effect
 from .engine import Context, initial_state
 from .measure import in_unresolved_span
+from .modes_status import modes_status
 from .state import State
 
 
@@ -125,6 +126,7 @@ class Diagnosis:
             "bearings": [dict(vars(b)) for b in self.bearings],
             "speed": dict(self.speed),
             "data_quality": list(self.data_quality),
+            "suspension_modes_status": modes_status(self),
             "hypotheses": [effect_entry(h) for h in self.hypotheses],
         }
 

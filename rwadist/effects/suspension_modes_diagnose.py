@@ -20,6 +20,7 @@ import numpy as np
 # the fixture-resonance detection lives beside the extended fit (``rwadist fit --extended`` uses it too)
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
+from ..diagnose.modes_status import WHOLE_DATA_FIT
 from ..diagnose.modes_trend import beside_trend
 from ..diagnose.stands import StandGroup
 from ..diagnose.state import State
@@ -394,7 +395,7 @@ def _whole_data_fit(ctx: Context):
     detected from the lines near it, so half of a short speed grid (10 of 20 speeds) can hide both while every
     run shows them.  A detection only: the modes (and the stand) are still fitted on the fit runs and judged on
     the held-out ones."""
-    key = ("suspension_modes.whole_data_fit",)
+    key = WHOLE_DATA_FIT
     if key not in ctx._memo:
         ctx._memo[key] = _test_and_fit(ctx, ctx.runs)[1]
     return ctx._memo[key]
