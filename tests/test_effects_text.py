@@ -85,6 +85,10 @@ def test_diagnose_lines_carry_the_held_out_gain():
     e = dict(EFFECTS[3], evidence={"heldout_gain_fraction": 0.118})
     (line,) = diagnose_lines([e])
     assert line.startswith("  + fixed resonance: test stand, 180.00 Hz") and line.endswith("(held-out gain 11.8 %)")
+    # above 100 %: an effect's own held-out evidence (trial25's counter rotation read 124 %) is said to be so
+    (line,) = diagnose_lines([dict(e, evidence={"heldout_gain_fraction": 1.24})])
+    assert line.endswith("(held-out gain 124.0 % of the misplaced power the PSDs show: the effect's own held-out "
+                         "evidence reads more than they see)")
 
 
 def test_counter_rotation_says_its_fraction_is_of_power_and_gives_the_amplitude_ratio():

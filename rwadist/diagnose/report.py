@@ -381,7 +381,7 @@ def write_report(diag: Diagnosis, out_dir) -> list:
 
         md += ["## Speed", ""] + [f"- {line}" for line in speed_lines(diag.speed)] + [""]
     md += ["## Effects added", ""]
-    from ..effects_text import describe_effect
+    from ..effects_text import beyond_power, describe_effect
 
     chosen = [h for h in diag.hypotheses if h.passed]
     if not chosen:
@@ -394,7 +394,7 @@ def write_report(diag: Diagnosis, out_dir) -> list:
                   else f", {h.narrow_gain_fraction:.1%} of the narrow-line misfit (taken on it: its power share is "
                        "below min_gain)")
         md.append(f"- **{words}**: held-out gain {h.gain_fraction:.1%} of the unexplained "
-                  f"power{narrow}, {h.t:.1f} noise standard errors (parameters: {par})")
+                  f"power{beyond_power(h.gain_fraction)}{narrow}, {h.t:.1f} noise standard errors (parameters: {par})")
     if diag.model_given and diag.state_after.base != diag.state_before.base:
         missing = diag.lines_missing_from_given_model()
         md += ["", "## The given model's harmonics", "",
