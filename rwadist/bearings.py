@@ -46,6 +46,9 @@ RATIO_RANGES = {
     "FTF_outer": (0.5 * (1 + GAMMA_RANGE[0]), 0.5 * (1 + GAMMA_RANGE[1]),
                   "the cage of a ball bearing whose outer race turns with the wheel (FTF = ½(1 + (d/D)·cos α))"),
 }
+#: Subharmonic orders k whose line at exactly 1/k of the speed is named as a rub or looseness (Muszynska's rotor rub:
+#: 1/2 and 1/3 of the speed, the commonest)
+SUBHARMONICS = (2, 3)
 #: Keys of a bearing's description (model file ``wheel.bearings[i]`` and ``--bearing``).
 KEYS = ("balls", "ball_diameter_m", "pitch_diameter_m", "contact_angle_deg", "name", "rotating_race")
 RATIO_NAMES = {"FTF": "cage (FTF)", "BPFO": "ball pass, outer race (BPFO)", "BPFI": "ball pass, inner race (BPFI)",
@@ -175,6 +178,12 @@ def line_causes(h: float, resolution: float, bearings=(), others=()) -> list:
             out.append(f"{what}: h in {lo:.2f}-{hi:.2f} {where}")
     if abs(h - round(h)) <= 2 * resolution:
         return out                              # a harmonic of the speed: no ball-pass relation to name
+    for k in SUBHARMONICS:
+        if abs(h - 1.0 / k) <= resolution:
+            # a line at exactly 1/k of the speed comes from a support that is not linear, not from kinematics
+            out.append(f"a subharmonic, 1/{k} of the speed: a rub (the rotor touching a still part every {k} turns, "
+                       "its friction driving a backward, counter-rotating whirl) or looseness in a mount or a "
+                       "bearing's fit (a support stiffer one way than the other halves the frequency)")
     out += _relations(h, resolution, others)
     if not bearings:                            # the given geometry names a ball pass or rules it out
         out += _ball_pass_ranges(h, resolution, where)

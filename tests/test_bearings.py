@@ -161,3 +161,12 @@ def test_parser_reads_the_flag_and_the_model_file_and_names_what_is_wrong():
             parse_bearing(bad)
     with pytest.raises(BearingError, match=r"model.json: wheel.bearings\[0\].balls: missing"):
         bearings_of({"bearings": [{"ball_diameter_m": 0.005, "pitch_diameter_m": 0.04}]}, "model.json")
+
+
+def test_a_line_at_half_or_a_third_of_the_speed_is_named_a_subharmonic():
+    """trial25's rub (a counter-rotating line at h 0.5 above an onset speed) had no cause named: no bearing ratio is
+    1/2 or 1/3 without slip (the cage ranges 0.35-0.48 and 0.52-0.65 leave both out), a rub or looseness is."""
+    assert not any(lo - 0.002 <= 0.5 <= hi + 0.002 or lo <= 1 / 3 <= hi for lo, hi, _ in RATIO_RANGES.values())
+    for h, k in ((0.5004, 2), (0.3331, 3)):
+        assert any(x.startswith(f"a subharmonic, 1/{k} of the speed: a rub") for x in line_causes(h, 0.002))
+    assert not any("subharmonic" in x for x in line_causes(0.4100, 0.002) + line_causes(0.5100, 0.002))
