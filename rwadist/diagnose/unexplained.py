@@ -56,6 +56,7 @@ LEVEL_WORDS = {
     "line_property": "{:+.2f} dB (power) in the second channel's lines against the first's",
     "line_property:gain_trend": "{:+.2f} dB (power) on every line from the lowest speed to the highest",
     "line_property:amplitude_law": "{:+.1f} dB (power) against C·Ω² from the lowest speed to the highest",
+    "line_property:split_mode": "{:+.2f} dB (power) in Fy's lines against Fx's where they differ most",
 }
 
 
