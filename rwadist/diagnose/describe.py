@@ -130,8 +130,11 @@ def run_steps(diag) -> dict:
         return {}
     index = {name: i for i, name in enumerate(ctx.sp.run_names)}
     p = recs[0].parameters
-    steps = {index[n]: float(dB) for n, dB in zip(p.get("runs", ()), p.get("run_offsets_dB", ()))
-             if n in index and np.isfinite(dB)}
+    # a drift spread over every run is taken out of every run, each by its factor against the model's lines
+    # (:mod:`.run_gains`): the few runs beyond the scatter alone leave the rest of it bending the lines' course
+    named, offsets = ((p["run_gain_runs"], p["run_gains_dB"]) if p.get("pattern") == "spread" and p.get("run_gains_dB")
+                      else (p.get("runs", ()), p.get("run_offsets_dB", ())))
+    steps = {index[n]: float(dB) for n, dB in zip(named, offsets) if n in index and np.isfinite(dB)}
     # a run whose change could not be read (too few lines over the noise: the lowest speeds) may be a changed one: its
     # factor unknown, it is left out of the second search (NaN), when the change was read on most runs (family wheel
     # 2, 300-3000 rpm, every third run 3.5 dB up: the 442-rpm run, switched and unread, pulled the rocking whirl to
@@ -369,7 +372,10 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     # described where its cells hold content (:func:`holds_content`)
     out += [u for u in moving_resonance(ctx, state, [resolved_lines(ctx, state, r) for r in ratios], of_track)
             if holds_content(u, res)]
-    out += run_change(ctx, line_ratios(res.ctx, res.state) if changes else ratios, of_runs)
+    from .run_gains import annotate
+
+    read = line_ratios(res.ctx, res.state) if changes else ratios
+    out += annotate(ctx, state, run_change(ctx, read, of_runs), read, taken_out=changes)
     out += speed_lines(ctx, state, of_line, bearings, others)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
     sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)

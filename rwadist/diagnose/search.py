@@ -582,6 +582,8 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     # a run-to-run change (a re-mounting, a range switch) left in the records is forced into classes and spoils the
     # wheel's modes: when one is described and the search added more than its base (or could not fit the modes), the
     # search is run again on the records with the changed runs' common factor taken out (docs/diagnose.md)
+    from .run_gains import is_spread
+
     steps = describe.run_steps(diag)
     read = {r: dB for r, dB in steps.items() if np.isfinite(dB)}
     if not read:
@@ -591,6 +593,8 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     # amplitude law was added; family wheel 7 --seed 2, the unread 1000-rpm run unchanged: left out, the rocking
     # mode alone was located)
     tries = [_search(*args, steps=read)] + ([_search(*args, steps=steps)] if len(read) < len(steps) else [])
+    if is_spread(diag):           # a drift changes every run: an unread run's factor is unknown, not 0 dB
+        tries.reverse()
     # kept when it did better by the search's own standard (the wheel's modes located where they were not, else fewer
     # effects beyond the base): a drift spread over every run is no step a factor per run takes out (family wheel 7,
     # shuffled drift: the modes were not located either way and the second search added an amplitude law)
