@@ -13,12 +13,12 @@ reads 1.3 x Fy" over 1600-10000 rpm).
 The change point (:func:`change_point`): the runs in speed order, the split with the smallest sum of absolute
 deviations of each side from its median (two runs on a side at least: :data:`MIN_SIDE`), against the Theil-Sen line
 through every run (a ratio that changes smoothly with speed, e.g. one channel's gain warming, is a ``trend``, not a
-step).  It is significant when the step is :data:`.describe_gain.MIN_DB` or more and :data:`STEP_Z` standard
-errors of the two sides' medians (from the runs' robust scatter about their side's median, never taken below
-:data:`SCATTER_FLOOR_DB`); a gain acts on every line, so :data:`.describe_gain.MIN_LINES` lines must each step the
-same way, within a factor 2 of it.  The channel that moved is the one whose own lines step against the model (the
-model's lines are smooth in speed, its C the same in x and y): its per-run median of 10·log10(P/P̂), each line's
-own median out, steps by about the whole ratio's step and the partner's by little.
+step).  It is significant when the step is ``min_db`` (:data:`.describe_gain.MIN_DB`) or more and :data:`STEP_Z`
+standard errors of the two sides' medians (from the runs' robust scatter about their side's median, never taken
+below :data:`SCATTER_FLOOR_DB`); a gain acts on every line, so ``min_lines`` (:data:`.describe_gain.MIN_LINES`) lines
+must each step the same way, within a factor 2 of it.  The channel that moved is the one whose own lines step against
+the model (the model's lines are smooth in speed, its C the same in x and y): its per-run median of 10·log10(P/P̂),
+each line's own median out, steps by about the whole ratio's step and the partner's by little.
 """
 from __future__ import annotations
 
@@ -103,22 +103,22 @@ def _own_step(q: np.ndarray, good: np.ndarray, cp: dict) -> float:
     return float(np.median(hi) - np.median(lo)) if lo.size and hi.size else 0.0
 
 
-def gain_step(ctx, pair: tuple, h: np.ndarray, q: tuple, good: np.ndarray, shares) -> Unexplained | None:
+def gain_step(ctx, pair: tuple, h: np.ndarray, q: tuple, good: np.ndarray, shares, min_db: float,
+              min_lines: int) -> Unexplained | None:
     """A ``line_property`` record (property ``channel_gain``, pattern ``step`` or ``trend``) of the radial ``pair``
     (cx, cy) whose lines' ratio changes between runs, or None.  ``h`` (L,) the lines, ``q`` = (q_x, q_y) each (L, R)
     10·log10(P/P̂) of the pair's channels on the context's runs, ``good`` (L, R) the cells read (both channels over the
-    noise), ``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB)."""
-    from .describe_gain import MIN_DB, MIN_LINES
-
+    noise), ``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB); ``min_db`` the step (dB of power)
+    and ``min_lines`` the lines holding it at least (those of a constant gain, :mod:`.describe_gain`)."""
     cx, cy = pair
     d = q[1] - q[0]
     d = np.where(good, d, np.nan)
     spin = ctx.omega[ctx.runs] / (2 * np.pi)
     cp = change_point(spin, per_run(np.nan_to_num(d), good))
-    if cp is None or not (abs(cp["step_dB"]) >= MIN_DB and cp["z"] >= STEP_Z):
+    if cp is None or not (abs(cp["step_dB"]) >= min_db and cp["z"] >= STEP_Z):
         return None
     stepping = _lines_stepping(np.nan_to_num(d), good, cp)
-    if stepping.sum() < MIN_LINES:
+    if stepping.sum() < min_lines:
         return None
     own = {c: _own_step(q[j], good, cp) for j, c in enumerate(pair)}
     # the channel that moved steps against the model; its partner by little (the model's lines are smooth in speed)

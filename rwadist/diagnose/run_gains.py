@@ -128,7 +128,8 @@ def annotate(ctx, state, records: list, ratios: list, taken_out: bool = False) -
             p["run_gains_dB"] = [float(x) for x in g[changed]]
             rpm = ctx.omega[ctx.runs[changed]] * RAD_S_TO_RPM
             spread = 1.4826 * float(np.median(np.abs(g[changed] - np.median(g[changed]))))
-            extra = {"speed_rpm": (float(rpm.min()), float(rpm.max())), "n_runs": int(changed.sum()), "level_dB": spread}
+            extra = {"speed_rpm": (float(rpm.min()), float(rpm.max())), "n_runs": int(changed.sum()),
+                     "level_dB": spread}
             factors = np.nan_to_num(g)
         else:
             changed = np.isin(names, p.get("runs", ()))
