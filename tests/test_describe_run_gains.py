@@ -61,6 +61,9 @@ def test_a_channel_gain_switched_between_runs_is_described_where_it_steps(wheel_
     assert p["amplitude_ratio_below"] == pytest.approx(1.0, abs=0.02)
     assert p["amplitude_ratio_above"] == pytest.approx(above, rel=0.02)
     assert set(recs[0].channels) == {channel, partner}
+    # the pair's direction's mode is read on both sides of the step: named (radial forces: the translation; radial
+    # torques: the rocking)
+    assert ("radial_translation" if channel.startswith("F") else "rocking") in p["modes_on_changed_runs"]
     assert recs[0].causes[0].startswith(f"{channel}'s gain changed by x ")
     said = float(recs[0].causes[0].split(" by x ")[1].split()[0])
     assert said == pytest.approx(gain, rel=0.02)

@@ -100,7 +100,7 @@ def channel_gain(ctx, state, shares) -> list:
         if len(lines) < MIN_LINES:
             continue
         # a ratio that changes between runs (a gain switched) is described where it changes, not as one constant
-        stepped = gain_step(ctx, (cx, cy), h, (np.where(good, qx, 0.0), np.where(good, qy, 0.0)), good, shares,
+        stepped = gain_step(ctx, state, (cx, cy), h, (np.where(good, qx, 0.0), np.where(good, qy, 0.0)), good, shares,
                             MIN_DB, MIN_LINES)
         if stepped is not None:
             out.append(stepped)

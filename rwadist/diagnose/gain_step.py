@@ -22,6 +22,8 @@ each line's own median out, steps by about the whole ratio's step and the partne
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..units import RAD_S_TO_RPM
@@ -103,10 +105,10 @@ def _own_step(q: np.ndarray, good: np.ndarray, cp: dict) -> float:
     return float(np.median(hi) - np.median(lo)) if lo.size and hi.size else 0.0
 
 
-def gain_step(ctx, pair: tuple, h: np.ndarray, q: tuple, good: np.ndarray, shares, min_db: float,
+def gain_step(ctx, state, pair: tuple, h: np.ndarray, q: tuple, good: np.ndarray, shares, min_db: float,
               min_lines: int) -> Unexplained | None:
     """A ``line_property`` record (property ``channel_gain``, pattern ``step`` or ``trend``) of the radial ``pair``
-    (cx, cy) whose lines' ratio changes between runs, or None.  ``h`` (L,) the lines, ``q`` = (q_x, q_y) each (L, R)
+    (cx, cy) of ``state``'s lines whose ratio changes between runs, or None.  ``h`` (L,) the lines, ``q`` = (q_x, q_y) each (L, R)
     10·log10(P/P̂) of the pair's channels on the context's runs, ``good`` (L, R) the cells read (both channels over the
     noise), ``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB); ``min_db`` the step (dB of power)
     and ``min_lines`` the lines holding it at least (those of a constant gain, :mod:`.describe_gain`)."""
@@ -125,7 +127,20 @@ def gain_step(ctx, pair: tuple, h: np.ndarray, q: tuple, good: np.ndarray, share
     big = max(pair, key=lambda c: abs(own[c]))
     other = cy if big == cx else cx
     moved = (big,) if abs(own[big]) >= OWN_FACTOR * abs(own[other]) else pair
-    return _record(ctx, pair, h, stepping, cp, own, moved, shares)
+    u = _record(ctx, pair, h, stepping, cp, own, moved, shares)
+    # the modes the pair's direction reads on runs of either side: the two sides' gains disagree, and the fit
+    # takes the lines of both (which side is right the data cannot say)
+    from .run_gains import modes_in_changed_runs
+
+    both = np.isin(np.arange(ctx.runs.size), np.concatenate([cp["below"], cp["above"]]))
+    direction = "radial_force" if cx.startswith("F") else "radial_torque"
+    modes = modes_in_changed_runs(ctx, state, both, np.full(both.size, abs(cp["step_dB"])), (direction,))
+    if not modes:
+        return replace(u, parameters={**u.parameters, "modes_on_changed_runs": []})
+    note = (f"; the {', '.join(m.replace('_', ' ') for m in modes)} mode{'s rest' if len(modes) > 1 else ' rests'} "
+            f"on {cx} and {cy} across the step, fitted through the two gains: suspect")
+    return replace(u, parameters={**u.parameters, "modes_on_changed_runs": modes},
+                   causes=(u.causes[0] + note,) + tuple(u.causes[1:]))
 
 
 def _record(ctx, pair, h, stepping, cp, own, moved, shares) -> Unexplained:

@@ -58,13 +58,15 @@ def run_gains(ctx, ratios: list) -> np.ndarray:
     return out
 
 
-def _line_powers(state, par, w: np.ndarray) -> list:
-    """Per direction with model lines: ln of each line's power (R, lines) pooled over the direction's channels, both
-    senses of each radial line at unit load, through the modes of ``par``."""
+def _line_powers(state, par, w: np.ndarray, directions=None) -> list:
+    """Per direction with model lines (of ``directions``, default every one): ln of each line's power (R, lines)
+    pooled over the direction's channels, both senses of each radial line at unit load, through the modes of ``par``."""
     from .. import extended as ext
 
     out = []
     for direction, chans in DIRECTION_CHANNELS.items():
+        if directions is not None and direction not in directions:
+            continue
         idx = [CHANNELS.index(c) for c in chans]
         hs = [x.h for x in state.model.harmonics(direction)]
         if hs:
@@ -74,24 +76,24 @@ def _line_powers(state, par, w: np.ndarray) -> list:
     return out
 
 
-def mode_runs(ctx, state, factors_db: np.ndarray) -> dict:
+def mode_runs(ctx, state, factors_db: np.ndarray, directions=None) -> dict:
     """Mode name -> bool (R,) over the context's runs: the runs that set the mode's estimate, where doubling its
     damping changes some model line's power by a factor 1.5 or more (the damping's reach,
     :func:`rwadist.diagnose.mode_reach.damping_log_gain`), or moving its frequency by :data:`MODE_SHIFT` changes
     some line's power by the run's own factor (``factors_db`` (R,), dB of power: that run's change can be taken for
-    such a shift) or more; {} without the modes."""
+    such a shift) or more, on the lines of ``directions`` (default every direction); {} without the modes."""
     from ..stand_resonance import STAND_MIN_LOG_GAIN
 
     p = getattr(state, "ext", None)
     if p is None:
         return {}
     w = ctx.omega[ctx.runs]
-    base = _line_powers(state, p, w)
+    base = _line_powers(state, p, w, directions)
     factor = np.abs(np.nan_to_num(np.asarray(factors_db, float))) * np.log(10.0) / 10.0       # ln of power
     out = {}
     for mode, (k, c) in MODE_PARAMS.items():
-        damped = _line_powers(state, replace(p, **{c: 2.0 * getattr(p, c)}), w)
-        moved = _line_powers(state, replace(p, **{k: (1.0 + MODE_SHIFT) ** 2 * getattr(p, k)}), w)
+        damped = _line_powers(state, replace(p, **{c: 2.0 * getattr(p, c)}), w, directions)
+        moved = _line_powers(state, replace(p, **{k: (1.0 + MODE_SHIFT) ** 2 * getattr(p, k)}), w, directions)
         hit = np.zeros(w.size, bool)
         for b, d, m in zip(base, damped, moved):
             hit |= np.any(np.abs(d - b) >= STAND_MIN_LOG_GAIN, axis=1)
@@ -100,10 +102,11 @@ def mode_runs(ctx, state, factors_db: np.ndarray) -> dict:
     return out
 
 
-def modes_in_changed_runs(ctx, state, changed: np.ndarray, factors_db: np.ndarray) -> list:
+def modes_in_changed_runs(ctx, state, changed: np.ndarray, factors_db: np.ndarray, directions=None) -> list:
     """The modes of ``state`` (names) whose estimate rests on runs among ``changed`` (bool (R,) over the context's
-    runs, ``factors_db`` their factors, :func:`mode_runs`)."""
-    return [m for m, hit in mode_runs(ctx, state, np.where(changed, factors_db, 0.0)).items() if np.any(hit & changed)]
+    runs, ``factors_db`` their factors, :func:`mode_runs` on the lines of ``directions``)."""
+    hits = mode_runs(ctx, state, np.where(changed, factors_db, 0.0), directions)
+    return [m for m, hit in hits.items() if np.any(hit & changed)]
 
 
 def annotate(ctx, state, records: list, ratios: list, taken_out: bool = False) -> list:
