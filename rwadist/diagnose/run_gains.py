@@ -143,7 +143,7 @@ def annotate(ctx, state, records: list, ratios: list, taken_out: bool = False) -
         p["factors_taken_out"] = bool(taken_out)
         causes = tuple(u.causes)
         if modes and causes:
-            how = ("located on the records with the runs' factors taken out" if taken_out else
+            how = ("fitted on the records with the runs' factors taken out" if taken_out else
                    "fitted through the runs' factors: suspect")
             causes = (causes[0] + f"; the {', '.join(m.replace('_', ' ') for m in modes)} mode"
                       f"{'s rest' if len(modes) > 1 else ' rests'} on the changed runs, {how}",) + causes[1:]
