@@ -111,14 +111,15 @@ def search_standing(diag) -> tuple:
 RUN_UNREAD_FRACTION = 0.5
 
 
-def run_steps(diag) -> dict:
+def run_steps(diag, every_run: bool = True) -> dict:
     """Run index -> dB: the runs a ``run_change`` record of ``diag`` holds apart from the others (a few runs changed
     by a common factor: a re-mounting, a range switch) and their offsets, when the search may have been led by them:
     it added an effect beyond its base, or, on the default path (no model given), did not locate each of the wheel's
     ``suspension_modes`` (left in the records, a changed run's lines were fitted as a test-stand resonance of gain
     7.5 or an amplitude law Ω^1.4, and the modes were not located, on two wheels of the family with every third run
     3.5 dB up).  A run whose change could not be read (``runs_not_read``) gets NaN: left out of the second search.
-    Empty otherwise, or without the time series."""
+    A change spread over every run (a drift) gives every run read its factor (``run_gains_dB``) with ``every_run``,
+    the runs held apart otherwise.  Empty otherwise, or without the time series."""
     ctx = diag.ctx
     if ctx.test is None:
         return {}
@@ -130,8 +131,12 @@ def run_steps(diag) -> dict:
         return {}
     index = {name: i for i, name in enumerate(ctx.sp.run_names)}
     p = recs[0].parameters
-    steps = {index[n]: float(dB) for n, dB in zip(p.get("runs", ()), p.get("run_offsets_dB", ()))
-             if n in index and np.isfinite(dB)}
+    # a drift spread over every run is taken out of every run, each by its factor against the model's lines
+    # (:mod:`.run_gains`): the few runs beyond the scatter alone leave the rest of it bending the lines' course
+    every = every_run and p.get("pattern") == "spread" and p.get("run_gains_dB")
+    named, offsets = ((p["run_gain_runs"], p["run_gains_dB"]) if every
+                      else (p.get("runs", ()), p.get("run_offsets_dB", ())))
+    steps = {index[n]: float(dB) for n, dB in zip(named, offsets) if n in index and np.isfinite(dB)}
     # a run whose change could not be read (too few lines over the noise: the lowest speeds) may be a changed one: its
     # factor unknown, it is left out of the second search (NaN), when the change was read on most runs (family wheel
     # 2, 300-3000 rpm, every third run 3.5 dB up: the 442-rpm run, switched and unread, pulled the rocking whirl to
@@ -370,7 +375,10 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     # described where its cells hold content (:func:`holds_content`)
     out += [u for u in moving_resonance(ctx, state, [resolved_lines(ctx, state, r) for r in ratios], of_track)
             if holds_content(u, res)]
-    out += run_change(ctx, line_ratios(res.ctx, res.state) if changes else ratios, of_runs)
+    from .run_gains import annotate
+
+    read = line_ratios(res.ctx, res.state) if changes else ratios
+    out += annotate(ctx, state, run_change(ctx, read, of_runs), read, taken_out=changes)
     out += speed_lines(ctx, state, of_line, bearings, others)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
     sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)

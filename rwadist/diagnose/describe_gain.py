@@ -26,6 +26,7 @@ import numpy as np
 
 from ..units import RAD_S_TO_RPM
 from .constants import LINE_HALF
+from .gain_step import gain_step
 from .unexplained import Unexplained
 
 #: The radial pairs (x, y) read.
@@ -93,9 +94,16 @@ def channel_gain(ctx, state, shares) -> list:
         snr = np.minimum(px[2] / np.maximum(px[3], 1e-300), py[2] / np.maximum(py[3], 1e-300))
         good = (snr >= 10 ** (LINE_SNR_DB / 10)) & (px[1] > 0) & (py[1] > 0) & np.isfinite(px[1] + py[1])
         with np.errstate(divide="ignore", invalid="ignore"):
-            d = 10 * np.log10(py[1] / py[2]) - 10 * np.log10(px[1] / px[2])
+            qx, qy = 10 * np.log10(px[1] / px[2]), 10 * np.log10(py[1] / py[2])
+            d = qy - qx
         lines = [i for i in range(h.size) if good[i].sum() >= MIN_RUNS]
         if len(lines) < MIN_LINES:
+            continue
+        # a ratio that changes between runs (a gain switched) is described where it changes, not as one constant
+        stepped = gain_step(ctx, state, (cx, cy), h, (np.where(good, qx, 0.0), np.where(good, qy, 0.0)), good, shares,
+                            MIN_DB, MIN_LINES)
+        if stepped is not None:
+            out.append(stepped)
             continue
         cells = np.concatenate([d[i][good[i]] for i in lines])
         med = float(np.median(cells))

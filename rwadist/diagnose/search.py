@@ -584,18 +584,18 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     # a run-to-run change (a re-mounting, a range switch) left in the records is forced into classes and spoils the
     # wheel's modes: when one is described and the search added more than its base (or could not fit the modes), the
     # search is run again on the records with the changed runs' common factor taken out (docs/diagnose.md)
-    steps = describe.run_steps(diag)
-    read = {r: dB for r, dB in steps.items() if np.isfinite(dB)}
-    if not read:
+    from .run_gains import step_sets
+
+    sets = step_sets(diag, describe.run_steps)
+    if not sets:
         return diag
     # the runs whose change was not read (NaN) may be changed ones: searched with them left in (as unchanged) and left
     # out, each kept by the search's own standard below (family wheel 2, the switched 442-rpm run unread: left in, an
     # amplitude law was added; family wheel 7 --seed 2, the unread 1000-rpm run unchanged: left out, the rocking
     # mode alone was located)
-    tries = [_search(*args, steps=read)] + ([_search(*args, steps=steps)] if len(read) < len(steps) else [])
+    tries = [_search(*args, steps=s) for s in sets]
     # kept when it did better by the search's own standard (the wheel's modes located where they were not, else fewer
-    # effects beyond the base): a drift spread over every run is no step a factor per run takes out (family wheel 7,
-    # shuffled drift: the modes were not located either way and the second search added an amplitude law)
+    # effects beyond the base; a drift spread over every run is taken out of every run first, :mod:`.run_gains`)
     best = diag
     for again in tries:
         if describe.search_standing(again) > describe.search_standing(best):

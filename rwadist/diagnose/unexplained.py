@@ -52,8 +52,14 @@ DEFAULT_LEVEL_WORDS = "the data {:+.1f} dB over the model in its bins (median)"
 LEVEL_WORDS = {
     "broadband_hump": "{:+.1f} dB over the floor's smooth course",
     "run_change": "the changed runs {} dB off the others",
+    "run_change:spread": "every run off the model by its own factor, {:.2f} dB scatter ({:+.2f} to {:+.2f} dB over {} "
+                         "runs)",
     "partial_line": "{:+.1f} dB against the model in the runs it is absent from",
     "line_property": "{:+.2f} dB (power) in the second channel's lines against the first's",
+    "line_property:channel_gain:step": "{:+.2f} dB (power) step between runs in the second channel's lines against "
+                                       "the first's",
+    "line_property:channel_gain:trend": "{:+.2f} dB (power) change with speed in the second channel's lines against "
+                                        "the first's",
     "line_property:gain_trend": "{:+.2f} dB (power) on every line from the lowest speed to the highest",
     "line_property:amplitude_law": "{:+.1f} dB (power) against C·Ω² from the lowest speed to the highest",
     "line_property:split_mode": "{:+.2f} dB (power) in Fy's lines against Fx's where they differ most",
@@ -166,10 +172,14 @@ class Unexplained:
         ``moving_resonance`` also the most its track lifts a line (``largest_line_lift_dB``): its cells (the track's
         bands ±3ζ in every run) are mostly noise, whose median reads near 0 dB however far the lines it crosses
         stand out (trial12: −0.1 dB for a line 17.9 dB over the model)."""
+        gains = self.parameters.get("run_gains_dB") if self.signature == "run_change" else None
+        if gains:
+            return LEVEL_WORDS["run_change:spread"].format(abs(self.level_dB), min(gains), max(gains), len(gains))
         if self.signature == "run_change":
             return LEVEL_WORDS["run_change"].format(self._run_change_level())
         key = f"{self.signature}:{self.parameters.get('property')}"
-        out = LEVEL_WORDS.get(key, LEVEL_WORDS.get(self.signature, DEFAULT_LEVEL_WORDS)).format(self.level_dB)
+        words = LEVEL_WORDS.get(f"{key}:{self.parameters.get('pattern')}", LEVEL_WORDS.get(key))
+        out = (words or LEVEL_WORDS.get(self.signature, DEFAULT_LEVEL_WORDS)).format(self.level_dB)
         lift = _number(self.parameters.get("largest_line_lift_dB")) if self.signature == "moving_resonance" else None
         if lift is not None:
             out += f" in its track's bands, the lines it lifts up to {lift:+.1f} dB"
