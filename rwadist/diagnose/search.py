@@ -510,7 +510,9 @@ def _take(ctx, state, h, k_sigma, min_gain) -> tuple:
     runs = ctx.held_runs if other is None else np.asarray(other)
     chans = [c for c in h.effect.channels if c in ctx.channels]
     pair = _judge_with_offset(ctx, state, h.effect, offset, runs, chans, k_sigma, min_gain, h.iteration)
-    ok, applied = _no_worse(ctx, state, refit, offset) if pair.passed else (False, None)
+    if not pair.passed:
+        return None, refit, None
+    ok, applied = _no_worse(ctx, state, refit, offset)
     return (pair, refit, applied) if ok else (None, refit, None)
 
 
