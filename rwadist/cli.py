@@ -461,6 +461,8 @@ def cmd_diagnose(args) -> int:
     for h in diag.hypotheses:
         if getattr(h, "forced_by", None):
             print(f"  - {h.effect.kind} taken back: the search fitted it to the {h.forced_by} described below")
+        elif getattr(h, "taken_back", None):
+            print(f"  - {h.effect.kind} (iteration {h.iteration}) taken back: {h.taken_back}")
     for u in diag.unexplained:
         print(f"  ? {u.text()}")
     same: dict = {}                 # one console line for the directions whose line at one h has the same causes

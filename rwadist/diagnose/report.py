@@ -318,6 +318,25 @@ def hypotheses_csv(hypotheses) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _taken_back(diag) -> list:
+    """report.md's lines of the effects taken back: fitted to content no class explains, or an amplitude law taken
+    before the wheel's modes or a load-cell offset and judged again on that base (:mod:`.law_recheck`)."""
+    from ..effects_text import describe_effect
+
+    md: list = []
+    back = [h for h in diag.hypotheses if getattr(h, "forced_by", None)]
+    if back:
+        md += ["", "Taken back (the search fitted them to content described below as no class explains it):", ""]
+        md += [f"- {describe_effect({'kind': h.effect.kind, **h.effect.params()})} (to the {h.forced_by})" for h in back]
+    again = [h for h in diag.hypotheses if getattr(h, "taken_back", None)]
+    if again:
+        md += ["", "Taken back (an amplitude law taken before the wheel's modes or a load-cell offset, judged again on "
+               "that base):", ""]
+        md += [f"- {describe_effect({'kind': h.effect.kind, **h.effect.params()})} (iteration {h.iteration}): "
+               f"{h.taken_back}" for h in again]
+    return md
+
+
 def write_report(diag: Diagnosis, out_dir) -> list:
     """summary.json, model.json (the improved model), rms_vs_speed.csv/.png, residual_waterfall.png,
     hypotheses.csv and report.md into ``out_dir``; returns the paths."""
@@ -404,10 +423,7 @@ def write_report(diag: Diagnosis, out_dir) -> list:
                   else " It lacks none of the data's lines."), ""]
         md += [f"- {d} h = {h:.4g}" + (f" ({sense}-rotating part)" if sense in ("co", "counter") else "")
                + f", C = {C:.4g}" for d, h, C, sense in missing]
-    back = [h for h in diag.hypotheses if getattr(h, "forced_by", None)]
-    if back:
-        md += ["", "Taken back (the search fitted them to content described below as no class explains it):", ""]
-        md += [f"- {describe_effect({'kind': h.effect.kind, **h.effect.params()})} (to the {h.forced_by})" for h in back]
+    md += _taken_back(diag)
     md += ["", "## Unexplained residual", ""] + unexplained_section(diag)
     md += ["", "## Physical causes for lines", ""] + line_causes_section(diag)
     md += ["", "## Hypotheses (best five per iteration)", "", "see `hypotheses.csv`", "",
