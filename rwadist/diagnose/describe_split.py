@@ -125,5 +125,5 @@ def split_mode(ctx, state, shares) -> list:
         causes=(f"a radial translation split in two: along {stiff[-1]} at {hi:.4g} Hz, along {soft[-1]} at {lo:.4g} Hz "
                 f"(stiffness {100 * ((hi / lo) ** 2 - 1):.1f} % higher along {stiff[-1]}): a suspension, bearing "
                 "preload or mount stiffer along one axis; the model's one axisymmetric mode cannot follow it",),
-        would_tell=f"the wheel turned 90 degrees on the stand (a split of the wheel's own turns with it, one of the "
-                   f"stand's stays), or a tap test along x and along y at rest")]
+        would_tell="the wheel turned 90 degrees on the stand (a split of the wheel's own turns with it, one of the "
+                   "stand's stays), or a tap test along x and along y at rest")]
