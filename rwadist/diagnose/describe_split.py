@@ -60,12 +60,12 @@ def fit_split(f: np.ndarray, d: np.ndarray) -> dict:
         L = _transmissibility_db(f, grid, zeta)                 # (n, m)
         # misfit of every (f_y = grid[i], f_x = grid[j]): Σ_cells |d − (L_i − L_j)|, in blocks of f_y
         cost = np.abs(d[None, None, :] - (L[:, None, :] - L[None, :, :])).sum(axis=2)
-        i, j = np.unravel_index(np.argmin(cost), cost.shape)
-        if cost[i, j] < best[0]:
-            best = (float(cost[i, j]), int(i), int(j), zeta)
-    l1, i, j, zeta = best
-    course = _transmissibility_db(f, grid[[i]], zeta)[0] - _transmissibility_db(f, grid[[j]], zeta)[0]
-    return {"f_x_Hz": float(grid[j]), "f_y_Hz": float(grid[i]), "zeta": float(zeta), "misfit_dB": l1,
+        iy, ix = np.unravel_index(np.argmin(cost), cost.shape)
+        if cost[iy, ix] < best[0]:
+            best = (float(cost[iy, ix]), int(iy), int(ix), zeta)
+    l1, i_y, i_x, zeta = best
+    course = _transmissibility_db(f, grid[[i_y]], zeta)[0] - _transmissibility_db(f, grid[[i_x]], zeta)[0]
+    return {"f_x_Hz": float(grid[i_x]), "f_y_Hz": float(grid[i_y]), "zeta": float(zeta), "misfit_dB": l1,
             "constant_misfit_dB": float(np.abs(d - np.median(d)).sum()), "course_dB": course}
 
 
