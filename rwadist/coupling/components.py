@@ -65,6 +65,22 @@ STABILITY_TOL = 1e-9
 
 # ----------------------------------------------------------------------------- helpers
 
+def reciprocal(re, im) -> np.ndarray:
+    """1/(re + j·im) for real arrays ``re``, ``im`` (broadcast together), as (re − j·im)/(re² + im²) in real
+    arithmetic written into the result's real and imaginary parts: the same values to ~1 ulp as numpy's complex
+    division (Smith's algorithm, ~2x the time), which the coupled sweeps make at every point and mode (the plant's
+    modal responses, practice 'ii''s closed form).  For the moduli they meet (1e-150 .. 1e150) the sum of squares
+    neither overflows nor underflows."""
+    re, im = np.broadcast_arrays(np.asarray(re, dtype=float), np.asarray(im, dtype=float))
+    den = im * im
+    den += re * re
+    out = np.empty(re.shape, dtype=complex)
+    np.divide(re, den, out=out.real)
+    np.divide(im, den, out=out.imag)
+    np.negative(out.imag, out=out.imag)
+    return out
+
+
 def ss_frf(A, B, C, D, s):
     """Frequency response C (sI − A)⁻¹ B + D at complex points ``s``, batched.
 
@@ -417,12 +433,13 @@ class Plant:
         if self.modal is not None:
             wn, zeta, Phi, Phip = self.modal
             om = 2 * np.pi * f[..., None]
-            hdisp = 1.0 / (wn**2 - om**2 + 2j * zeta * wn * om)       # (..., n_modes)
+            hdisp = reciprocal(wn**2 - om**2, 2 * zeta * wn * om)     # (..., n_modes)
             # Σ_m φ_m φ_mᵀ h_m(f) for every frequency at once: the modal responses (complex) times the modes'
-            # outer products (real), two real matrix products over all frequencies (BLAS), not a complex
-            # n×n_modes×n product per frequency; G is symmetric, so only its upper triangle's n(n+1)/2 entries
-            # are summed and each is copied to its mirror (G exactly symmetric), written straight into G's real and
-            # imaginary parts
+            # outer products (real), one real matrix product over all frequencies' real and imaginary parts
+            # stacked (BLAS), not a complex n×n_modes×n product per frequency; G is symmetric, so only its upper
+            # triangle's n(n+1)/2 entries are summed and each is copied to its mirror (G exactly symmetric) by one
+            # gather of contiguous complex entries (gathering into G's strided real and imaginary parts apart cost
+            # 1.5-2x as much: ~10 % of bench_coupling's sweeps)
             m = wn.size
             iu, ju = np.triu_indices(n)
             KG = np.ascontiguousarray(np.einsum("im,jm->mij", Phi, Phi)[:, iu, ju])
@@ -431,9 +448,11 @@ class Plant:
             KP = np.einsum("im,jm->mij", Phip, Phi).reshape(m, -1)
             ha = (-(om**2) * hdisp).reshape(-1, m)
             hd = hdisp.reshape(-1, m)
-            G = np.empty((ha.shape[0], n * n), dtype=complex)
-            np.take(ha.real @ KG, mirror.ravel(), axis=1, out=G.real)
-            np.take(ha.imag @ KG, mirror.ravel(), axis=1, out=G.imag)
+            k = ha.shape[0]
+            R = np.concatenate([ha.real, ha.imag]) @ KG                  # (2k, n(n+1)/2): real parts, then imaginary
+            Gu = np.empty((k, iu.size), dtype=complex)
+            Gu.real, Gu.imag = R[:k], R[k:]
+            G = np.take(Gu, mirror.ravel(), axis=1)
             P = (hd.real @ KP + 1j * (hd.imag @ KP)).reshape(f.shape + (Phip.shape[0], n))
             return G.reshape(f.shape + (n, n)), P
         sys = self.state_space()
