@@ -84,19 +84,25 @@ def _interface_matrix(G, parts) -> np.ndarray:
     point instead of n×n ones."""
     n = G.shape[-1]
     L = None
+    reach = [np.nonzero(np.any(Mt != 0, axis=0))[0] for Mt, _ in parts]
+    # when the wheels' nodes are distinct blocks covering every interface DOF, every row is written in place below
+    # and L needs no zeroing (a pass over n × n per point)
+    tiling = np.sort(np.concatenate(reach)) if reach else np.zeros(0, dtype=int)
+    shapes = [np.broadcast_shapes(Z.shape[:-2], G.shape[:-2]) for _, Z in parts]
+    covers = tiling.size == n and np.array_equal(tiling, np.arange(n)) and len(set(shapes)) == 1 \
+        and all(r.size and np.all(np.diff(r) == 1) for r in reach)
     written = np.zeros(n, dtype=bool)                                # rows holding a term (the rest are still 0)
-    for Mt, Z in parts:
-        reached = np.nonzero(np.any(Mt != 0, axis=0))[0]
+    for (Mt, Z), reached in zip(parts, reach):
         T = Mt[:, reached]
         ZT = _congruence(T, Z)
+        shape = np.broadcast_shapes(ZT.shape[:-2], G.shape[:-2])
         if L is None:
-            L = np.zeros(np.broadcast_shapes(ZT.shape[:-2], G.shape[:-2]) + (n, n), dtype=complex)
-        if reached.size and np.all(np.diff(reached) == 1) and not written[reached].any() \
-                and L.shape[:-2] == np.broadcast_shapes(ZT.shape[:-2], G.shape[:-2]):
-            # a node's DOFs no wheel reached before: the product written in place (its rows are 0 so far)
+            L = (np.empty if covers else np.zeros)(shape + (n, n), dtype=complex)
+        if reached.size and np.all(np.diff(reached) == 1) and not written[reached].any() and L.shape[:-2] == shape:
+            # a node's DOFs no wheel reached before: −ZT·G written in place (no term in its rows yet; negating the
+            # 6 × 6 factor is exact and cheaper than negating the 6 × n product)
             cols = slice(int(reached[0]), int(reached[-1]) + 1)
-            np.matmul(ZT, G[..., cols, :], out=L[..., cols, :])
-            np.negative(L[..., cols, :], out=L[..., cols, :])
+            np.matmul(-ZT, G[..., cols, :], out=L[..., cols, :])
         else:
             L[..., reached, :] -= ZT @ G[..., reached, :]
         written[reached] = True
