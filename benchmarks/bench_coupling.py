@@ -41,18 +41,22 @@ Measured (1000 speeds, CPU min / median of 3 rounds; session 9, main and the bra
     plain 15.5x / 15.3x and 13.8x / 14.6x on main, 15.3x / 14.1x and 13.2x / 14.1x on the branch (its floor grid and
     ripple order ~0.1 s cheaper, within the noise); the plant's modal sums alone at the ripple's 143 000 points
     (G, P, nothing else) 3.38x / 3.16x and 3.28x / 3.36x the whole plain sweep: above the target before any solve.
-  Session 26 (--no-peer, main 86ff871 = base26 and couple26 a6f3d05 alternated in one window, load 4.5-7.0; CPU min
-    / median of 3 rounds): main plain 0.52 / 0.53 s, effects 7.34 / 7.58 s (14.16x / 14.36x), ripple alone 5.79 s, floors
-    alone 1.36 s; branch 0.51 / 0.52 s, 6.99 / 7.45 s (13.84x / 14.38x), 5.46 s, 1.34 s; again main 0.52 / 0.53 s, 7.16 /
-    7.31 s (13.73x / 13.84x), branch 0.48 / 0.48 s, 6.73 / 7.01 s (14.15x / 14.50x), 5.12 s, 1.30 s.  The branch's
-    per-point work (G's mirror by one gather, complex reciprocals in real arithmetic, the interface matrix without
-    zeroing) takes 5-8 % off plain and effects alike: the ratio does not move.  Same numbers: 2.6e-12 at most
-    (coupling_same_numbers.py --compare).  The floor, measured: the modal sums alone at the ripple's points 2.9x the
-    plain sweep; the floors 2.4-2.7x (about half of it the default grid's poles: 16 eigen-decompositions of the
-    448-state coupled system); an oracle pruning of the ripple's points keeps 5.09x the plain points at 1e-9 of every
-    RMS, 3.01x at 1e-6, 1.38x at 1e-4; a pruning by the blocked loads (load_trimmed) keeps 10.2x and moves an RMS
-    by 6.1e-5 at 1e-8 of its speed's largest load (the coupled response lifts sidebands near its modes by ~1e3): no
-    exact evaluation, and no a-priori tolerance a jitter engineer would accept (1e-6), reaches 3x.
+  Session 26 (--no-peer, main 86ff871 = base26 and couple26 alternated in one window; CPU min / median of 3 rounds):
+    a6f3d05, load 4.5-7.0: main plain 0.52 / 0.53 s, effects 7.34 / 7.58 s (14.16x / 14.36x); branch 0.51 / 0.52 s,
+    6.99 / 7.45 s (13.84x / 14.38x); again main 0.52 / 0.53 s, 7.16 / 7.31 s (13.73x / 13.84x), branch 0.48 / 0.48 s,
+    6.73 / 7.01 s (14.15x / 14.50x).  5d3f9a8, load 2.5-5.1: main plain 0.51 / 0.52 s, effects 7.32 / 7.55 s
+    (14.45x / 14.62x), ripple alone 5.57 s, floors alone 1.30 s, G, P only 3.13x; branch 0.47 / 0.48 s, 6.80 / 6.97 s
+    (14.32x / 14.52x), 5.24 s, 1.32 s, 3.06x; again main 0.52 / 0.55 s, 7.18 / 7.98 s (13.94x / 14.53x), branch
+    0.49 / 0.50 s, 7.04 / 7.27 s (14.39x / 14.67x), 5.62 s, 1.33 s, 2.91x.  The branch's per-point work (G's mirror by
+    one gather, complex reciprocals in real arithmetic, the interface matrix without zeroing) takes 3-8 % off plain
+    and effects alike: the ratio does not move.  Same numbers: 2.6e-12 at most (coupling_same_numbers.py --compare).
+    The floor, measured: the modal sums alone at the ripple's points 2.9-3.1x the plain sweep; the floors 2.4-2.8x
+    (about half of it the default grid's poles: 16 eigen-decompositions of the 448-state coupled system, ~40 ms
+    each, so a per-speed pole-residue form of the coupled system, 1000 of them, would cost ~80x the plain sweep); an
+    oracle pruning of the ripple's points keeps 5.09x the plain points at 1e-9 of every RMS, 3.01x at 1e-6, 1.38x at
+    1e-4; a pruning by the blocked loads (load_trimmed) keeps 10.2x and moves an RMS by 6.1e-5 at 1e-8 of its speed's
+    largest load (the coupled response lifts sidebands near its modes by ~1e3): no exact evaluation, and no a-priori
+    tolerance a jitter engineer would accept (1e-6), reaches 3x.
 """
 import os
 
