@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..dft import run_window, windowed_dft
+from ..dft import blocked_records, run_window, windowed_dfts
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .unexplained import Unexplained
 
@@ -42,43 +42,51 @@ MIN_PHASE_DEG = 5.0
 #: ... on this many lines (and cells) or more
 MIN_LINES = 2
 MIN_CELLS = 6
+#: Samples (runs × record length) of the records transformed together
+CHUNK_SAMPLES = 1 << 20
 #: The skews searched, ± this (s): 10 ms, a hundred samples at 10 kHz
 TAU_MAX_S = 0.01
 
 
 def _cells(ctx, state, direction: str) -> tuple | None:
     """(f Hz, d rad, line index, run position, h) of the direction's model lines read in one sense: per cell the x/y
-    phase's departure from its quarter turn, or None without records of both channels."""
+    phase's departure from its quarter turn, or None without records of both channels.  Consecutive runs of one
+    record length are transformed together (:func:`rwadist.dft.windowed_dfts`)."""
     test = ctx.test
     cx, cy = DIRECTION_CHANNELS[direction]
     h = np.unique([x.h for x in state.model.harmonics(direction) if x.h > 0])
     if test is None or h.size < MIN_LINES or not {cx, cy} <= set(ctx.channels):
         return None
-    f_all, d_all, li_all, ri_all = [], [], [], []
+    batches: list[list] = []
     for pos, r in enumerate(ctx.runs):
         run = test.runs[int(r)]
         if run.speed == 0 or not (run.usable(cx) and run.usable(cy)):
             continue
-        n, fs = run.n_samples, run.sample_rate
-        f = h * abs(run.speed) / (2 * np.pi)
-        keep = np.flatnonzero((f > 4 * fs / n) & (f < 0.45 * fs))
-        if keep.size == 0:
-            continue
-        fq = np.concatenate([f[keep]] + [f[keep] + b * fs / n for b in NOISE_BINS])
-        w = run_window("hann", n)[0]
-        XY = windowed_dft(np.stack([run.signals[cx] * w, run.signals[cy] * w], axis=1), fs, fq)
-        X, Y = XY[:keep.size, 0], XY[:keep.size, 1]
-        beside = (np.abs(XY[keep.size:]) ** 2).sum(axis=1).reshape(len(NOISE_BINS), keep.size).mean(axis=0)
+        if (batches and (batches[-1][0][1].n_samples, batches[-1][0][1].sample_rate) == (run.n_samples, run.sample_rate)
+                and len(batches[-1]) * run.n_samples < CHUNK_SAMPLES):
+            batches[-1].append((pos, run))
+        else:
+            batches.append([(pos, run)])
+    f_all, d_all, li_all, ri_all = [], [], [], []
+    for batch in batches:
+        n, fs = batch[0][1].n_samples, batch[0][1].sample_rate
+        f = h[None, :] * np.abs([run.speed for _, run in batch])[:, None] / (2 * np.pi)         # (runs, lines)
+        x = blocked_records([[run.signals[cx], run.signals[cy]] for _, run in batch], run_window("hann", n)[0])
+        XY = windowed_dfts(x, fs, np.concatenate([f] + [f + b * fs / n for b in NOISE_BINS], axis=1))
+        X, Y = XY[:, :h.size, 0], XY[:, :h.size, 1]
+        beside = (np.abs(XY[:, h.size:]) ** 2).sum(axis=2).reshape(len(batch), len(NOISE_BINS), h.size).mean(axis=1)
         power = np.abs(X) ** 2 + np.abs(Y) ** 2
         with np.errstate(divide="ignore", invalid="ignore"):
             axis_db = 20 * np.log10(np.abs(Y) / np.abs(X))
-            good = (power >= MIN_SNR * beside) & (np.abs(axis_db) <= MAX_AXIS_DB)
+            good = ((power >= MIN_SNR * beside) & (np.abs(axis_db) <= MAX_AXIS_DB) & (f > 4 * fs / n)
+                    & (f < 0.45 * fs))
         co = np.abs(X + 1j * Y) >= np.abs(X - 1j * Y)
         d = _wrap(np.angle(Y / np.where(X != 0, X, 1.0) * np.where(co, 1j, -1j)))
-        f_all.append(f[keep][good])
-        d_all.append(d[good])
-        li_all.append(keep[good])
-        ri_all.append(np.full(int(good.sum()), pos))
+        rows, cols = np.nonzero(good)
+        f_all.append(f[rows, cols])
+        d_all.append(d[rows, cols])
+        li_all.append(cols)
+        ri_all.append(np.array([batch[i][0] for i in rows], dtype=int))
     if not f_all:
         return None
     return (np.concatenate(f_all), np.concatenate(d_all), np.concatenate(li_all).astype(int),
@@ -96,10 +104,14 @@ def fit_skew(f: np.ndarray, d: np.ndarray, tau_max: float = TAU_MAX_S) -> dict:
     course the cells follow best (the length of Σ e^{2j(d + 2πfτ)}: the doubled angle reads a half turn as none), then
     least squares on the residuals, the cells beyond 3 robust scatters left out once.  Returns ``tau_s``, ``stderr_s``,
     ``explained`` (1 − Σ residual² / Σ d² on the kept cells, both modulo π) and ``kept`` (bool mask)."""
-    step = 0.02 / (4 * np.pi * float(f.max()))
-    grid = np.arange(-tau_max, tau_max + step, step)
-    coherence = np.abs(np.exp(2j * (d[None, :] + 2 * np.pi * f[None, :] * grid[:, None])).sum(axis=1))
-    tau = float(grid[int(np.argmax(coherence))])
+    def best(grid):
+        return float(grid[int(np.argmax(np.abs(np.exp(2j * (d[None, :] + 2 * np.pi * f[None, :] * grid[:, None]))
+                                               .sum(axis=1))))])
+
+    # a coarse grid (the doubled phase moves ≤ 0.2 rad a step at the highest cell), then a fine one about its best
+    step = 0.1 / (4 * np.pi * float(f.max()))
+    tau = best(np.arange(-tau_max, tau_max + step, step))
+    tau = best(tau + np.linspace(-step, step, 21))
     kept = np.ones(f.size, bool)
     for _ in range(3):
         x = -2 * np.pi * f[kept]
