@@ -88,7 +88,7 @@ def _empirical(lines, i: int, sign: float) -> list:
     else:
         vec[base] = 1.0
         vec[base + 1] = (-1j if mode == "co" else 1j) * sign
-    res = [(f_r, zeta) for dirs, f_r, zeta, _ in lines.resonances if d in dirs]
+    res = [(f_r, zeta) for dirs, f_r, zeta, *_ in lines.resonances if d in dirs]
     idx = np.array([i])
 
     def scalar(u):
@@ -140,9 +140,9 @@ def _extended(lines, i: int, sign: float, u_at: float) -> list:
 
             off = float(lines.offsets.get(i, 0.0))
             peaks = _mode_peaks(p, ln.direction, ln.h, sigma)
-            peaks += [pk for f, z, _ in ln.resonances for pk in _resonance_peaks(f, z, ln.h, 0.0)]
+            peaks += [pk for f, z, *_ in ln.resonances for pk in _resonance_peaks(f, z, ln.h, 0.0)]
             if i not in lines.laws:
-                peaks += [pk for dirs, f_r, zeta, _ in lines.resonances if ln.direction in dirs
+                peaks += [pk for dirs, f_r, zeta, *_ in lines.resonances if ln.direction in dirs
                           for pk in _resonance_peaks(f_r, zeta, ln.h, off)]
             out.append(Component(("ext", n, ln.direction, sigma, pos, sign), vec, scalar, None, tuple(peaks)))
     return out

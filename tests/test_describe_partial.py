@@ -33,8 +33,9 @@ PARTIAL_H, PARTIAL_C, EVERY = 2.7, 0.5, 3
 
 
 @functools.lru_cache(maxsize=None)
-def _truth_state():
-    """(context, the generator's truth as a state) of the records with the sidebands and the partial line."""
+def _truth_state(onset_rpm: float | None = None):
+    """(context, the generator's truth as a state) of the records with the sidebands and the partial line (in every
+    third run; with ``onset_rpm``, in the runs above that speed instead)."""
     test = simulate_steady(preset("ithaco-e"), SPEEDS, sample_rate=FS, n_samples=N, modes=False, noise=0.01, seed=5)
     c1 = TRUTH.empirical["radial_force"][0].C
     lines = [(1 - DELTA, DEPTH / 2 * c1, 1), (1 + DELTA, DEPTH / 2 * c1, 1), (PARTIAL_H, PARTIAL_C * c1, EVERY)]
@@ -43,7 +44,7 @@ def _truth_state():
         t = np.arange(run.n_samples) / run.sample_rate
         w = abs(run.speed)
         for h, C, every in lines:
-            if i % every == 0:
+            if (i % every == 0) if (onset_rpm is None or h != PARTIAL_H) else w * 60 / (2 * np.pi) > onset_rpm:
                 phase = h * w * t + rng.uniform(0, 2 * np.pi)
                 run.signals["Fx"] = run.signals["Fx"] + C * w**2 * np.cos(phase)
                 run.signals["Fy"] = run.signals["Fy"] + C * w**2 * np.sin(phase)
@@ -103,3 +104,16 @@ def test_others_in_window_is_the_neighbours_share_of_the_lines_window():
     far = 0.3 * spin > (LINE_HALF + 2.5) * ctx.df
     assert far.sum() >= 15
     assert np.all(others_in_window(ctx, state, "radial_force", PARTIAL_H, runs)[far] < 10 ** -2.5)
+
+
+def test_a_line_that_starts_at_one_speed_says_between_which_speeds_it_starts():
+    """The 2.7 line present only above 3060 rpm (a rub that a speed brings on; trial25's rub read "1625-4000 rpm"
+    alone, joining the runs without it and with it): described as starting between the fastest run without it and the
+    slowest with it, the two bracketing the generator's onset, no run interleaved."""
+    onset = 3060.0                      # between two runs of the 120 rpm grid
+    ctx, state = _truth_state(onset)
+    found = describe_residual(Residual.of(ctx, state))
+    (u,) = [u for u in found if u.signature == "partial_line"]
+    p = u.parameters
+    assert p["interleaved"] is False and max(p["absent_rpm"]) < onset < min(p["present_rpm"])
+    assert f"starts between {max(p['absent_rpm']):.0f} and {min(p['present_rpm']):.0f} rpm" in u.text(), u.text()

@@ -88,3 +88,34 @@ def test_sidebands_sit_at_the_carrier_plus_minus_f_mod():
     for fc in (f2 + 7.0, f2 - 7.0):
         assert window(plain, fc) < 1e-12 * carrier
         assert window(res, fc) == pytest.approx(0.2**2 * carrier, rel=1e-6)
+
+
+def test_a_wheel_mode_keeping_part_of_the_load_above_enters_the_extended_psd():
+    """A wheel_mode ``fixed_resonance`` with ``gain_above`` < 1 (what diagnose writes for a mode holding a share of
+    the load above it) on an extended model: the PSD's mean square (Parseval) is the quadrature over the speed law of
+    the axial line C·Ω² through the axial mode's transmissibility |(k + icν)/(k − Mν² + icν)|² and the model file's
+    gain law H = (1 − a·r² + 2j·c·ζ·r)/(1 − r² + 2jζr), c = √((2ζP)² − (1 − a)²)/(2ζ), written out here.  `rwadist psd`
+    stopped with an internal error on such a model (trial26's rattle: a 4-tuple unpacked from a 5-tuple)."""
+    from rwadist import extended as ext
+    from rwadist.broadband import extended_lines_from_model
+
+    C, h, f_r, zeta, peak, above = 2e-6, 2.0, 90.0, 0.05, 4.0, 0.6
+    m = WheelModel(name="one", empirical={"radial_force": [], "radial_torque": [], "axial_torque": [],
+                                          "axial_force": [Harmonic(h=h, C=C)]},
+                   analytical=ext.params_to_dict(ext.from_table_4_2()))
+    m.effects = [{"kind": "fixed_resonance", "f_Hz": f_r, "zeta": zeta, "peak_gain": peak, "gain_above": above,
+                  "role": "wheel_mode", "directions": ["axial_force"]}]
+    res = broadband_psd(extended_lines_from_model(m), LAW, f_max=150.0, n_freq=30001, n_speeds=4000)
+    p = ext.from_table_4_2()
+    c = np.sqrt((2 * zeta * peak) ** 2 - (1 - above) ** 2) / (2 * zeta)
+
+    def line_ms(w, resonance=True):
+        nu = h * abs(w)
+        r = nu / (2 * np.pi * f_r)
+        gain = (1 - above * r**2 + 2j * c * zeta * r) / (1 - r**2 + 2j * zeta * r)
+        trans = (p.k_z + 1j * p.c_z * nu) / (p.k_z - p.mass * nu**2 + 1j * p.c_z * nu)
+        return abs(C * w**2 * trans * (gain if resonance else 1.0)) ** 2 / 2
+
+    ms = np.sum(res.psd[:, 2]) * (res.f[1] - res.f[0])
+    assert ms == pytest.approx(_mean(line_ms), rel=5e-3)
+    assert abs(_mean(line_ms) / _mean(lambda w: line_ms(w, resonance=False)) - 1) > 0.1      # the resonance matters

@@ -372,3 +372,14 @@ def test_fmu_ripple_equals_the_coupling_kits_sidebands():
         err = np.abs(fit - pred)[:, :5].max(0) / np.abs(pred)[:, :5].max(0)    # (Tz: no line of this model)
         assert np.all(err[:3] < 1e-4), (rpm, err)
         print(f"\n{rpm} rpm: {fu.size} line frequencies, FMU vs ripple_lines per channel {np.array2string(err, precision=1)}")
+
+
+def test_a_wheel_mode_keeping_load_above_is_refused_saying_what_to_do():
+    """A wheel_mode resonance with gain_above < 1 (diagnose writes it for a mode holding a share of the load; the FMU's
+    filter returns to 1 above): the build is refused naming the resonance and the way on (trial26's rattle model,
+    where `rwadist psd` runs); the same resonance returning to 1 above is taken."""
+    mode = {"kind": "fixed_resonance", "f_Hz": 404.0, "zeta": 0.1, "peak_gain": 5.8, "role": "wheel_mode",
+            "directions": ["axial_force"]}
+    with pytest.raises(rt.ModelError, match=r"404 Hz keeps gain_above 0.6.*remove that effect from a copy"):
+        build_fmu(doc_with([dict(mode, gain_above=0.6)]), "/nonexistent/x.fmu")
+    assert rt.effects_from_doc(doc_with([mode]))["resonances"] == [(("axial_force",), 404.0, 0.1, 5.8)]

@@ -310,6 +310,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
     from .describe_partial import partial_lines
+    from .describe_skew import channel_skew
     from .describe_split import split_mode
     from .describe_structure import broadband_hump, line_ratios, moving_resonance, resolved_lines, run_change
     from .describe_trend import gain_trend
@@ -389,6 +390,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += channel_gain(ctx, as_recorded(searched.state), of_line)
     # the radial forces through two translation modes, x and y (a support stiffer along one axis)
     out += split_mode(ctx, state, of_line)
+    # one channel of a radial pair recorded later than the other (its lines' x/y phase off a quarter turn ∝ f)
+    out += channel_skew(ctx, state, of_line)
     # a gain common to the channels that changes with speed, on the recorded channels too
     out += gain_trend(ctx, as_recorded(searched.state), of_line)
     return out

@@ -139,30 +139,37 @@ def _window_medians(rest: np.ndarray, kept: np.ndarray, half: int) -> np.ndarray
     return np.where(nan, np.nan, med)
 
 
+def per_run_median(ratios: list, n_runs: int, min_points: int, min_lines: int, detrend) -> np.ndarray:
+    """Per run (n_runs,): the median over its lines of each line's dB ratio less ``detrend(r, m)`` (that line's
+    reference, (m.sum(),), for :class:`LineRatios` ``r`` and the line's mask ``m``), lines read in ``min_points``
+    runs at least; NaN for a run with fewer than ``min_lines`` such lines."""
+    devs, runs = [], []
+    for r in ratios:
+        for ln in np.unique(r.line):
+            m = r.line == ln
+            if m.sum() >= min_points:
+                devs.append(r.q[m] - detrend(r, m))
+                runs.append(r.run[m])
+    per = np.full(n_runs, np.nan)
+    if not devs:
+        return per
+    dev, run = np.concatenate(devs), np.concatenate(runs)
+    for i in np.flatnonzero(np.bincount(run, minlength=n_runs) >= min_lines):
+        per[i] = np.median(dev[run == i])
+    return per
+
+
 def _run_deviations(ctx, ratios: list, apart: np.ndarray | None = None) -> np.ndarray:
     """Per run of the context (R,): the median over its lines of each line's dB ratio less that line's own smooth
     trend with speed (:func:`_smooth_trend` over the line's runs; with ``apart``, a bool (R,), over its runs not set
     apart), NaN for a run with fewer than :data:`RUN_MIN_LINES` such lines.  Each line detrended on its own: a
     resonance crossing lifts one line in a run (a bump on that line's trend), a change of the run lifts all of them
     alike."""
-    devs, runs = [], []
-    for r in ratios:
-        for ln in np.unique(r.line):
-            m = r.line == ln
-            if m.sum() < 2 * RUN_MIN_RUNS + 1:
-                continue
-            keep = None if apart is None else ~apart[r.run[m]]
-            devs.append(r.q[m] - _smooth_trend(r.spin[m], r.q[m], keep=keep))
-            runs.append(r.run[m])
-    R = ctx.runs.size
-    per = np.full(R, np.nan)
-    if not devs:
-        return per
-    dev, run = np.concatenate(devs), np.concatenate(runs)
-    n_lines = np.bincount(run, minlength=R)
-    for i in np.flatnonzero(n_lines >= RUN_MIN_LINES):
-        per[i] = np.median(dev[run == i])
-    return per
+
+    def trend(r, m):
+        return _smooth_trend(r.spin[m], r.q[m], keep=None if apart is None else ~apart[r.run[m]])
+
+    return per_run_median(ratios, ctx.runs.size, 2 * RUN_MIN_RUNS + 1, RUN_MIN_LINES, trend)
 
 
 #: Rounds of :func:`_changed_runs`: the runs set apart, the lines' trends made again without them

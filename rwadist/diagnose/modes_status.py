@@ -13,6 +13,8 @@ import numpy as np
 
 #: the memo key of the modes' empirical fit of every run (:func:`rwadist.effects.suspension_modes_diagnose._whole_data_fit`)
 WHOLE_DATA_FIT = ("suspension_modes.whole_data_fit",)
+#: the memo key of the amplification peaks read from that fit (:func:`rwadist.extended_fit.amplification_peaks`)
+AMPLIFICATION_PEAKS = ("modes_status.amplification_peaks",)
 #: the amplification peaks' directions, in the order they are said
 _DIRECTIONS = ("radial_force", "radial_torque", "axial_force")
 
@@ -37,12 +39,16 @@ def modes_status(diag) -> dict | None:
     from ..empirical import fit_empirical
     from ..extended_fit import amplification_peaks
 
-    # the modes' own fit of every run when their search made it, else the empirical fit of the diagnosis's spectra
-    fit = ctx._memo.get(WHOLE_DATA_FIT)
-    try:
-        peaks = amplification_peaks(fit if fit is not None else fit_empirical(ctx.sp))
-    except ValueError:
-        peaks = []
+    # the modes' own fit of every run when their search made it, else the empirical fit of the diagnosis's spectra;
+    # kept on the context, as every summary of the diagnosis asks again
+    peaks = ctx._memo.get(AMPLIFICATION_PEAKS)
+    if peaks is None:
+        fit = ctx._memo.get(WHOLE_DATA_FIT)
+        try:
+            peaks = amplification_peaks(fit if fit is not None else fit_empirical(ctx.sp))
+        except ValueError:
+            peaks = []
+        ctx._memo[AMPLIFICATION_PEAKS] = peaks
     # a rise a named resonance explains (a test stand on a modes-off test) is no sign of the wheel's modes
     named = [e.f_r for e in diag.state_after.effects if e.kind == "fixed_resonance"]
     peaks = [p for p in peaks if not p["at_range_edge"] and all(abs(p["f_hz"] / f - 1.0) > 0.1 for f in named)]

@@ -25,6 +25,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..units import CHANNELS, DIRECTION_CHANNELS
+from .describe_structure import per_run_median
 
 #: A run's factor needs this many lines read in it.
 MIN_LINES = 2
@@ -37,21 +38,7 @@ MODE_SHIFT = 0.02
 def run_gains(ctx, ratios: list) -> np.ndarray:
     """Per run of the context (R,): its common factor (dB of power) against the model's lines, the runs' median 0,
     NaN where fewer than :data:`MIN_LINES` lines are read; ``ratios`` the :class:`.describe_structure.LineRatios`."""
-    devs, runs = [], []
-    for r in ratios:
-        for ln in np.unique(r.line):
-            m = r.line == ln
-            if m.sum() >= 3:
-                devs.append(r.q[m] - np.median(r.q[m]))
-                runs.append(r.run[m])
-    R = ctx.runs.size
-    out = np.full(R, np.nan)
-    if not devs:
-        return out
-    dev, run = np.concatenate(devs), np.concatenate(runs)
-    for i in range(R):
-        if np.sum(run == i) >= MIN_LINES:
-            out[i] = float(np.median(dev[run == i]))
+    out = per_run_median(ratios, ctx.runs.size, 3, MIN_LINES, lambda r, m: np.median(r.q[m]))
     ok = np.isfinite(out)
     if ok.any():
         out[ok] -= np.median(out[ok])

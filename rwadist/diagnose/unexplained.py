@@ -63,6 +63,8 @@ LEVEL_WORDS = {
     "line_property:gain_trend": "{:+.2f} dB (power) on every line from the lowest speed to the highest",
     "line_property:amplitude_law": "{:+.1f} dB (power) against C·Ω² from the lowest speed to the highest",
     "line_property:split_mode": "{:+.2f} dB (power) in Fy's lines against Fx's where they differ most",
+    "line_property:channel_skew": "{:+.1f} dB: the other rotation sense's share of a line's power at the highest "
+                                  "line read",
 }
 
 
@@ -183,7 +185,24 @@ class Unexplained:
         lift = _number(self.parameters.get("largest_line_lift_dB")) if self.signature == "moving_resonance" else None
         if lift is not None:
             out += f" in its track's bands, the lines it lifts up to {lift:+.1f} dB"
+        if self.signature == "partial_line":
+            out += self._partial_span()
         return out
+
+    def _partial_span(self) -> str:
+        """A partial line's runs in words: where it is absent and present, and, when the two part at one speed, the
+        speeds it starts (stops) between (trial25's rub, present above 2800 rpm, read "1625-4000 rpm" alone)."""
+        absent = [x for x in (self.parameters.get("absent_rpm") or []) if _number(x) is not None]
+        present = [x for x in (self.parameters.get("present_rpm") or []) if _number(x) is not None]
+        if not absent or not present:
+            return ""
+        out = (f" ({len(absent)} runs at {min(absent):.0f}-{max(absent):.0f} rpm; present in {len(present)} at "
+               f"{min(present):.0f}-{max(present):.0f} rpm")
+        if self.parameters.get("interleaved", True):
+            return out + ", the two interleaved)"
+        if max(absent) < min(present):
+            return out + f": it starts between {max(absent):.0f} and {min(present):.0f} rpm)"
+        return out + f": it stops between {max(present):.0f} and {min(absent):.0f} rpm)"
 
     def _run_change_level(self) -> str:
         """A run_change's level with its sign: "+3.52" when every changed run is up, "−3.52" when every one is down,

@@ -165,9 +165,10 @@ def effects_from_doc(doc, source="<model>"):
         switch = getattr(getattr(e, "FMU_SWITCH", None), "name", None)
         if isinstance(a, _actions.LineFilter):
             if a.gain_above != 1.0:
-                raise ModelError(f"{source}: a wheel_mode fixed_resonance keeping gain_above {a.gain_above!r} of the load "
-                                 "far above it: the FMU's wheel-mode filter returns to 1 above the resonance (not "
-                                 "supported in an FMU yet)")
+                raise ModelError(f"{source}: the wheel_mode fixed_resonance at {a.resonance[0]:.6g} Hz keeps gain_above "
+                                 f"{a.gain_above!r} of the load far above it: the FMU's wheel-mode filter returns to 1 "
+                                 "above the resonance (not supported in an FMU yet); to build the FMU without it, "
+                                 "remove that effect from a copy of the model file ('rwadist psd' models it)")
             resonances.append((a.directions, *a.resonance))
         elif isinstance(a, _actions.LineModulation):
             sidebands.append((a.direction, a.h, a.f_mod_hz, a.depth))
