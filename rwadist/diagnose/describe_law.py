@@ -27,7 +27,7 @@ def laws_below_gain(ctx, state, judged, k_sigma: float, min_gain: float) -> list
     its ``min_gain``, and whose law refitted on every run against ``state`` is still told from Ω²
     (:meth:`AmplitudeLaw.significant`); a line with a law in ``state`` is left out, and a line judged twice is taken
     once."""
-    out = []
+    out: list[tuple] = []
     for h in judged:
         e = h.effect
         if getattr(e, "kind", "") != "amplitude_law" or not (h.t > k_sigma and h.gain_fraction < min_gain):
