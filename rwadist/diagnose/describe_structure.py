@@ -14,6 +14,7 @@ import numpy as np
 
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .constants import LINE_HALF
+from .sweep_crossing import crossings
 from .unexplained import Unexplained
 
 #: A line's predicted power over the noise in its window, at least, for its ratio to be read (dB).
@@ -75,14 +76,15 @@ def line_ratios(ctx, state, absent: bool = False) -> list:
                 k = np.rint(hs[:, None] * ctx.omega[runs][None, :] / (2 * np.pi) / ctx.df).astype(int)
                 inband = (k - LINE_HALF >= ctx.k_lo) & (k + LINE_HALF <= ctx.k_hi)
                 good = np.isfinite(meas) & (meas >= 0) & inband & (snr >= 10 ** (LINE_SNR_DB / 10))
-            if good.sum() < 3:
-                continue
-            L, R = good.shape
             li, ri = np.nonzero(good)
+            keep = ~crossings(ctx, state, hs[li], ri)      # a sweep's line passing a mode: not its steady response
+            li, ri = li[keep], ri[keep]
+            if li.size < 3:
+                continue
             f = hs[li] * ctx.omega[runs][ri] / (2 * np.pi)
-            q = 10 * np.log10(np.maximum(meas[good], 1e-10 * pred[good]) / pred[good])
+            q = 10 * np.log10(np.maximum(meas[li, ri], 1e-10 * pred[li, ri]) / pred[li, ri])
             out.append(LineRatios(d, q, f, ri, ctx.omega[runs][ri] / (2 * np.pi),
-                                  li, hs[li], np.minimum(snr[good], 1e4)))
+                                  li, hs[li], np.minimum(snr[li, ri], 1e4)))
     return out
 
 
