@@ -289,7 +289,8 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
         Upper limit of good data, Hz (a test-stand resonance above it; at most the Nyquist frequency);
         default the test's record.
     nperseg : int or None
-        FFT length, samples (16 to 2**24); default the largest power of 2 in a run.
+        FFT length, samples (62 to 2**24: the noise floor takes medians of blocks of 32 frequency bins); default
+        the largest power of 2 in a run.
     presence : float
         Bin presence threshold P0, a fraction in (0, 1].
     epsilon : float
@@ -430,9 +431,10 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
 
 
 def diagnose_nperseg(test: SteadyTest) -> int:
-    """Default FFT length of :func:`diagnose`, samples: the largest power of 2 at most 1/4 of the median run."""
+    """Default FFT length of :func:`diagnose`, samples: the largest power of 2 at most 1/4 of the median run, at
+    least 64 (the smallest power of 2 the ``nperseg`` limit allows, :data:`rwadist.validate.LIMITS`)."""
     n = int(np.median([r.n_samples for r in test.runs]))
-    return int(2 ** np.floor(np.log2(max(n // DIAGNOSE_SEGMENTS, 16))))
+    return int(2 ** np.floor(np.log2(max(n // DIAGNOSE_SEGMENTS, 64))))
 
 
 def _diagnose_model(model, preset: str | None, base: str):
