@@ -210,8 +210,12 @@ def read_data(path, progress: bool = False):
     if path.suffix.lower() in (".h5", ".hdf5"):
         from .hdf5 import read_hdf5  # h5py only when a file needs it: every command imports this module
 
-        return read_hdf5(path)
-    return read_sweep(path)
+        obj = read_hdf5(path)
+    else:
+        obj = read_sweep(path)
+    if isinstance(obj, Sweep) and not obj.name:
+        obj.name = str(path)            # a sweep's messages name its file (they said <sweep>)
+    return obj
 
 
 # --------------------------------------------------------------------------- writing
