@@ -568,8 +568,9 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     return diagnosis
 
 
-def extended_source(model=None, *, preset: str | None = None) -> tuple:
-    """(ExtendedParams, lines, description) of a model (file) with an analytical section, or of a preset."""
+def extended_source(model=None, *, preset: str | None = None, needed_for: str | None = None) -> tuple:
+    """(ExtendedParams, lines, description) of a model (file) with an analytical section, or of a preset;
+    ``needed_for``: what asks for them, said when the model has none (:func:`rwadist.extended.params_from_dict`)."""
     from . import extended
 
     if preset and model is not None:
@@ -585,7 +586,7 @@ def extended_source(model=None, *, preset: str | None = None) -> tuple:
         raise ParameterError("model", "missing: give a model (a WheelModel or a model-file path) or a preset")
     source = _model_name(model)
     m = _as_model(model)
-    params = extended.params_from_model(m, source)
+    params = extended.params_from_model(m, source, needed_for)
     return params, extended.lines_from_model(m, params), source
 
 
@@ -619,7 +620,7 @@ def campbell(model=None, speeds_rpm=None, *, preset: str | None = None) -> tuple
     """
     from .campbell import campbell_crossings, campbell_table
 
-    params, lines, source = extended_source(model, preset=preset)
+    params, lines, source = extended_source(model, preset=preset, needed_for="the Campbell diagram")
     if model is not None:
         warn_unconstrained(_as_model(model), source, "the Campbell diagram")
     speeds = np.arange(0.0, 3000.0 + 50.0, 100.0) if speeds_rpm is None else check_speeds_rpm(speeds_rpm,
