@@ -289,7 +289,8 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
         Upper limit of good data, Hz (a test-stand resonance above it; at most the Nyquist frequency);
         default the test's record.
     nperseg : int or None
-        FFT length, samples (16 to 2**24); default the largest power of 2 in a run.
+        FFT length, samples (62 to 2**24: the noise floor takes medians of blocks of 32 frequency bins); default
+        the largest power of 2 in a run.
     presence : float
         Bin presence threshold P0, a fraction in (0, 1].
     epsilon : float
@@ -430,9 +431,10 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
 
 
 def diagnose_nperseg(test: SteadyTest) -> int:
-    """Default FFT length of :func:`diagnose`, samples: the largest power of 2 at most 1/4 of the median run."""
+    """Default FFT length of :func:`diagnose`, samples: the largest power of 2 at most 1/4 of the median run, at
+    least 64 (the smallest power of 2 the ``nperseg`` limit allows, :data:`rwadist.validate.LIMITS`)."""
     n = int(np.median([r.n_samples for r in test.runs]))
-    return int(2 ** np.floor(np.log2(max(n // DIAGNOSE_SEGMENTS, 16))))
+    return int(2 ** np.floor(np.log2(max(n // DIAGNOSE_SEGMENTS, 64))))
 
 
 def _diagnose_model(model, preset: str | None, base: str):
@@ -566,8 +568,9 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     return diagnosis
 
 
-def extended_source(model=None, *, preset: str | None = None) -> tuple:
-    """(ExtendedParams, lines, description) of a model (file) with an analytical section, or of a preset."""
+def extended_source(model=None, *, preset: str | None = None, needed_for: str | None = None) -> tuple:
+    """(ExtendedParams, lines, description) of a model (file) with an analytical section, or of a preset;
+    ``needed_for``: what asks for them, said when the model has none (:func:`rwadist.extended.params_from_dict`)."""
     from . import extended
 
     if preset and model is not None:
@@ -583,7 +586,7 @@ def extended_source(model=None, *, preset: str | None = None) -> tuple:
         raise ParameterError("model", "missing: give a model (a WheelModel or a model-file path) or a preset")
     source = _model_name(model)
     m = _as_model(model)
-    params = extended.params_from_model(m, source)
+    params = extended.params_from_model(m, source, needed_for)
     return params, extended.lines_from_model(m, params), source
 
 
@@ -617,7 +620,7 @@ def campbell(model=None, speeds_rpm=None, *, preset: str | None = None) -> tuple
     """
     from .campbell import campbell_crossings, campbell_table
 
-    params, lines, source = extended_source(model, preset=preset)
+    params, lines, source = extended_source(model, preset=preset, needed_for="the Campbell diagram")
     if model is not None:
         warn_unconstrained(_as_model(model), source, "the Campbell diagram")
     speeds = np.arange(0.0, 3000.0 + 50.0, 100.0) if speeds_rpm is None else check_speeds_rpm(speeds_rpm,

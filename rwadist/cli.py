@@ -38,9 +38,11 @@ from .units import RAD_S_TO_RPM
 from .validate import check_grid_size, check_speeds_rpm, check_within_test
 
 
-def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm") -> np.ndarray:
+def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm",
+                 n_flag: str | None = "--n-speeds") -> np.ndarray:
     """rpm list from 'A,B,C', 'START:STOP:STEP' (stop inclusive) or 'START:STOP' with ``n`` points;
-    every speed finite within +-MAX_RPM, at most MAX_SPEEDS of them (:class:`DataError` naming ``flag``)."""
+    every speed finite within +-MAX_RPM, at most MAX_SPEEDS of them (:class:`DataError` naming ``flag``).
+    ``n_flag``: the command's flag giving ``n``, None when it has none (``fit --cumulative-rpm``: no START:STOP)."""
     try:
         if ":" in text:
             parts = [float(p) for p in text.split(":")]
@@ -48,7 +50,8 @@ def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm") ->
                 raise ValueError("every part must be a finite number of rpm")
             if len(parts) == 2:
                 if not n:
-                    raise ValueError("START:STOP needs --n-speeds")
+                    raise ValueError(f"START:STOP needs {n_flag}" if n_flag else
+                                     "START:STOP gives no number of speeds: give START:STOP:STEP or A,B,C")
                 return check_speeds_rpm(np.linspace(parts[0], parts[1], int(n)), flag)
             if len(parts) != 3:
                 raise ValueError("expected START:STOP:STEP or START:STOP")
@@ -66,7 +69,8 @@ def parse_speeds(text: str, n: int | None = None, flag: str = "--speeds-rpm") ->
             raise
         why = str(exc)
         if why.startswith("could not convert"):
-            why = "not a number; give speeds in rpm as A,B,C or START:STOP:STEP, or START:STOP with --n-speeds"
+            why = "not a number; give speeds in rpm as A,B,C or START:STOP:STEP" + (
+                f", or START:STOP with {n_flag}" if n_flag else "")
         raise DataError(flag, "value", f"{text!r}: {why}") from None
 
 
@@ -144,6 +148,10 @@ def cmd_fit(args) -> int:
         if not args.report:
             refuse_special_base(args.output, "-o", f"its report folder {report_dir.name}",
                                 "give --report DIR or --no-report")
+        elif report_dir.resolve() == Path(args.output).resolve():   # the fit ran, then the two writes collided
+            raise DataError("--report", "value", f"{args.report}: the same path as -o (the model file); the report "
+                            f"is a folder of its own: give another, e.g. --report "
+                            f"{Path(args.output).with_suffix('').parent / (Path(args.output).stem + '_report')}")
         check_output_dir(report_dir, "--report")
     check_fit_flags(args)
     if args.extended:
@@ -153,14 +161,14 @@ def cmd_fit(args) -> int:
     t0 = time.perf_counter()
     test = load_steady(args.data, args)
     if args.cumulative_rpm and report_dir is not None:
-        check_within_test(parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm"), test, "cumulative_rpm")
+        check_within_test(parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm", n_flag=None), test, "cumulative_rpm")
     fit = run_fit(test, args, name=Path(args.data).name)
     fit.model.provenance["data"] = str(args.data)
     model = fit.model
     efit = None
     if args.extended:
         efit, model = run_extended_fit(test, fit, args)
-    cum = parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm") if args.cumulative_rpm else None
+    cum = parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm", n_flag=None) if args.cumulative_rpm else None
     files = []
     with output_set() as outs:      # the model and its report replace the old ones together, once both are complete
         if report_dir is not None:
@@ -367,7 +375,7 @@ def cmd_campbell(args) -> int:
     refuse_special_base(out, "-o", f"its plot {out.with_suffix('.png').name}")
     speeds = parse_speeds(args.speeds_rpm, args.n_speeds)
     table, rows = api.campbell(args.model, speeds, preset=args.preset)
-    params, lines, source = api.extended_source(args.model, preset=args.preset)
+    params, lines, source = api.extended_source(args.model, preset=args.preset, needed_for="the Campbell diagram")
     png_path, csv_path = out.with_suffix(".png"), out
     with output_set() as outs:      # the table and its plot replace the old pair together
         save_png(plot_campbell(params, speeds, lines), outs.file(png_path), dpi=120)

@@ -50,23 +50,23 @@ class CheckedNumber:
     rwadist_checked = True
 
     def __init__(self, lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
-                 unit: str = ""):
+                 unit: str = "", why: str = ""):
         self.lo, self.hi, self.lo_open, self.hi_open = lo, hi, lo_open, hi_open
-        self.integer, self.unit = integer, unit
+        self.integer, self.unit, self.why = integer, unit, why
         self.__name__ = "integer" if integer else "number"      # argparse names the type by it
 
     def __call__(self, text):
         try:
             return check_number(text, "value", self.lo, self.hi, lo_open=self.lo_open, hi_open=self.hi_open,
-                                integer=self.integer, unit=self.unit)
+                                integer=self.integer, unit=self.unit, why=self.why)
         except ParameterError as exc:       # refused by check_parsed, which knows the flag (exit 2 from main)
             return Refused(text, exc.problem)
 
 
 def number(lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False, integer: bool = False,
-           unit: str = "") -> CheckedNumber:
-    """An argparse ``type`` checking a finite number (or an integer) in a range."""
-    return CheckedNumber(lo, hi, lo_open=lo_open, hi_open=hi_open, integer=integer, unit=unit)
+           unit: str = "", why: str = "") -> CheckedNumber:
+    """An argparse ``type`` checking a finite number (or an integer) in a range (``why``: the bound's reason)."""
+    return CheckedNumber(lo, hi, lo_open=lo_open, hi_open=hi_open, integer=integer, unit=unit, why=why)
 
 
 def check_parsed(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:

@@ -60,7 +60,7 @@ from .formats.records import (
     read_text,
 )
 from .formats.timebase import sample_step
-from .outputs import WRITER, WRITER_KEY
+from .outputs import MANIFEST, WRITER, WRITER_KEY
 from .progress import tqdm
 from .units import CHANNEL_COLUMN, CHANNELS, COLUMN_CHANNEL, rad_s_to_rpm, rpm_to_rad_s  # noqa: F401 (re-exported)
 
@@ -173,7 +173,8 @@ def read_steady(directory, progress: bool = False) -> SteadyTest:
                             "one test holds one sample rate: resample the runs to one rate (or split them into "
                             "one test per rate)")
     files_read = {f.rsplit(":", 1)[0] if ".tdms:" in f.lower() else f for f in files_seen}
-    listed = files_read | {RUNS_FILE, META_FILE}
+    # rwadist's own record of the files it wrote in the folder (outputs.MANIFEST) is no run left out
+    listed = files_read | {RUNS_FILE, META_FILE, MANIFEST}
     unlisted = sorted(p.name for p in directory.iterdir() if p.is_file() and p.name not in listed)
     if unlisted:
         # kept in meta so nothing goes unnoticed; the CLI prints it
@@ -209,8 +210,12 @@ def read_data(path, progress: bool = False):
     if path.suffix.lower() in (".h5", ".hdf5"):
         from .hdf5 import read_hdf5  # h5py only when a file needs it: every command imports this module
 
-        return read_hdf5(path)
-    return read_sweep(path)
+        obj = read_hdf5(path)
+    else:
+        obj = read_sweep(path)
+    if isinstance(obj, Sweep) and not obj.name:
+        obj.name = str(path)            # a sweep's messages name its file (they said <sweep>)
+    return obj
 
 
 # --------------------------------------------------------------------------- writing

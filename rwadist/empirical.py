@@ -206,8 +206,10 @@ def block_floor(psd: np.ndarray, block: int = 32, dof: float = 2.0) -> np.ndarra
     """Mean noise level of PSDs (n_runs, n_f): medians of blocks of ``block`` bins,
     interpolated between block centres, scaled from the median to the mean of
     chi²(dof)/dof.  Block medians cost O(n) and ignore lines narrower than half a block.
+    A spectrum shorter than one block (9 bins at nperseg 16) is one block of all its bins.
     """
     n_runs, n_f = psd.shape
+    block = max(min(block, n_f), 1)
     n_blocks = max(n_f // block, 1)
     # np.median's values (the mean of the middle one or two of each sorted block, NaN where a block holds NaN),
     # from one sort: several times faster than np.median's partition for these short blocks

@@ -205,12 +205,19 @@ def params_to_dict(p: ExtendedParams) -> dict:
     return d
 
 
-def params_from_dict(d, source="<model>") -> ExtendedParams:
+def params_from_dict(d, source="<model>", needed_for: str | None = None) -> ExtendedParams:
     """Inverse of :func:`params_to_dict` (a dict or a :class:`rwadist.schema.Analytical`), read by the
     schema: a :class:`rwadist.model.ModelFileError` (a DataError) naming ``analytical.<key>`` on a
-    missing or invalid field, ``analytical`` when the values are unphysical."""
+    missing or invalid field, ``analytical`` when the values are unphysical.  ``needed_for``: what asked for the
+    parameters (``"the Campbell diagram"``), said with what gives them when they are missing (the general advice
+    names the psd's choices, which such a caller does not have)."""
     from .model import ModelFileError
 
+    if d is None and needed_for:
+        raise ModelFileError(source, "analytical", f"missing: the model file has no analytical parameters "
+                             f"(suspension modes), which {needed_for} is made of; add them with the extended fit "
+                             "(rwadist fit DATA --extended, or rwadist.fit_extended; the rotor's mass and radius are "
+                             "optional) or give a wheel `preset` instead of the model")
     if d is None:
         raise ModelFileError(source, "analytical", "missing: the model file has no analytical parameters (suspension "
                              "modes); add them with the extended fit (with the rotor's `mass` and `radius`) or use a "
@@ -222,9 +229,10 @@ def params_from_dict(d, source="<model>") -> ExtendedParams:
         raise ModelFileError(source, "analytical", str(exc)) from exc
 
 
-def params_from_model(model, source="<model>") -> ExtendedParams:
-    """Parameters from a :class:`rwadist.model.WheelModel`'s ``analytical`` section."""
-    return params_from_dict(model.analytical, source)
+def params_from_model(model, source="<model>", needed_for: str | None = None) -> ExtendedParams:
+    """Parameters from a :class:`rwadist.model.WheelModel`'s ``analytical`` section (``needed_for``: as
+    :func:`params_from_dict`'s)."""
+    return params_from_dict(model.analytical, source, needed_for)
 
 
 # ---------------------------------------------------------------- harmonics

@@ -269,7 +269,9 @@ def from_time_profile(t, omega, n_bins: int = 2000, source="time profile") -> Hi
     dt = np.diff(t)
     if np.any(dt <= 0):
         i = int(np.argmax(dt <= 0))
-        raise DataError(source, "time_s", f"must increase: row {i + 1} ({t[i + 1]!r}) <= row {i} ({t[i]!r})")
+        # plain numbers (not np.float64(5.0)), rows counted from 1 as the CSV reader counts its data rows
+        raise DataError(source, "time_s", f"must increase: data row {i + 2} ({float(t[i + 1]):g} s) <= data row "
+                        f"{i + 1} ({float(t[i]):g} s)")
     lo, hi = float(w.min()), float(w.max())
     if not hi > lo:
         raise DataError(source, "speed_rpm", f"constant speed {lo * RAD_S_TO_RPM:g} rpm: empty speed range "

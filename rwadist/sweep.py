@@ -121,6 +121,8 @@ class SliceInfo:
 # --------------------------------------------------------------------------- slicing
 
 def _sweep_name(sweep: Sweep) -> str:
+    if sweep.name:
+        return sweep.name
     return str(sweep.meta.get("file", sweep.meta.get("source", "<sweep>"))) if sweep.meta else "<sweep>"
 
 
@@ -470,7 +472,8 @@ def speed_note(slicing: dict) -> str:
 def _tach_infos(sweep: Sweep, starts, slice_samples: int) -> list:
     if sweep.tach is None:
         raise DataError(_sweep_name(sweep), TACH_COLUMN,
-                        "speed_source='tach' but the sweep has no tach column; use 'data' or 'auto'")
+                        "`speed_source` tach, but the sweep has no tach column: give `speed_source` data (the speed "
+                        "estimated from the lines) or auto")
     tach = np.asarray(sweep.tach, dtype=float)
     if len(tach) != _n_samples(sweep):
         raise DataError(_sweep_name(sweep), TACH_COLUMN,
@@ -572,7 +575,8 @@ def slice_sweep(sweep: Sweep, slice_samples: int | None = None, hop: int | None 
     source = ("tach" if sweep.tach is not None else "data") if speed_source == "auto" else speed_source
     if source == "tach" and sweep.tach is None:
         raise DataError(_sweep_name(sweep), TACH_COLUMN,
-                        "speed_source='tach' but the sweep has no tach column; use 'data' or 'auto'")
+                        "`speed_source` tach, but the sweep has no tach column: give `speed_source` data (the speed "
+                        "estimated from the lines) or auto")
     if slice_samples is None:
         slice_samples, starts, hop, infos, spd, rule = _auto_slices(sweep, source, channels)
     else:

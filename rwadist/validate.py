@@ -26,7 +26,8 @@ MAX_SPEEDS = 100_000
 MAX_SAMPLES = 50_000_000
 
 #: The allowed range of every numeric parameter of the API, by name: the keyword arguments of
-#: :func:`check_number` (``lo``/``hi`` bounds, ``lo_open``/``hi_open`` bound excluded, ``integer``, ``unit``).
+#: :func:`check_number` (``lo``/``hi`` bounds, ``lo_open``/``hi_open`` bound excluded, ``integer``, ``unit``,
+#: ``why``: the reason for a bound, said when a value is out of range).
 class Limit(TypedDict, total=False):
     """The keyword arguments of :func:`check_number` that give a parameter's range."""
 
@@ -36,11 +37,16 @@ class Limit(TypedDict, total=False):
     hi_open: bool
     integer: bool
     unit: str
+    why: str
 
 
 LIMITS: dict[str, Limit] = {
     "f_lim": dict(lo=0, hi=1e6, lo_open=True, unit="Hz"),
-    "nperseg": dict(lo=16, hi=2**24, integer=True),
+    # the fit's noise floor takes medians of blocks of 32 frequency bins (rwadist.empirical.block_floor) and
+    # nperseg samples give nperseg // 2 + 1 bins: 16 gave 9 (a fit crashed, then found no line; diagnose crashed)
+    "nperseg": dict(lo=62, hi=2**24, integer=True,
+                    why="the noise floor is the median of blocks of 32 frequency bins, and nperseg samples give "
+                        "nperseg/2 + 1 bins: 62 is the smallest usable"),
     "presence": dict(lo=0, hi=1, lo_open=True),
     "epsilon": dict(lo=0, hi=0.5, lo_open=True),
     "slice_samples": dict(lo=64, hi=2**24, integer=True),
@@ -75,9 +81,10 @@ def _range_text(lo, hi, lo_open: bool, hi_open: bool) -> str:
 
 
 def check_number(value, parameter: str, lo=None, hi=None, *, lo_open: bool = False, hi_open: bool = False,
-                 integer: bool = False, unit: str = ""):
+                 integer: bool = False, unit: str = "", why: str = ""):
     """``value`` as a float (or int) checked finite and in range; :class:`ParameterError` naming ``parameter``
-    otherwise.  ``lo_open``/``hi_open``: the bound itself is excluded."""
+    otherwise.  ``lo_open``/``hi_open``: the bound itself is excluded; ``why``: the bound's reason, said when
+    ``value`` is out of range."""
     text = value if isinstance(value, str) else repr(value)
     kind = "an integer" if integer else "a finite number"
     allowed = _range_text(lo, hi, lo_open, hi_open) + (f" {unit}" if unit else "")
@@ -95,7 +102,7 @@ def check_number(value, parameter: str, lo=None, hi=None, *, lo_open: bool = Fal
         x = int(x)
     if (lo is not None and (x < lo or (lo_open and x == lo))) or (
             hi is not None and (x > hi or (hi_open and x == hi))):
-        raise ParameterError(parameter, f"{text}: out of range; allowed {allowed}")
+        raise ParameterError(parameter, f"{text}: out of range; allowed {allowed}" + (f" ({why})" if why else ""))
     return x
 
 

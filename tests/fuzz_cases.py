@@ -72,7 +72,7 @@ _FLAGS = [
     (["fit", "{tmp}/no_such_data", "-o", "{tmp}/m.json"], "--epsilon", lambda x: x <= 0 or x >= 1),
     (["fit", "{tmp}/no_such_data", "-o", "{tmp}/m.json", "--extended"], "--radius", lambda x: x <= 0),
     (["fit", "{tmp}/no_such_data", "-o", "{tmp}/m.json", "--extended"], "--mass", lambda x: x <= 0),
-    (["fit", "{tmp}/no_such_data", "-o", "{tmp}/m.json"], "--nperseg", lambda x: x < 2 or x != int(x)),
+    (["fit", "{tmp}/no_such_data", "-o", "{tmp}/m.json"], "--nperseg", lambda x: x < 62 or x != int(x)),
     (["diagnose", "{tmp}/no_such_data", "-o", "{tmp}/diag"], "--k-sigma", lambda x: x <= 0),
     (["diagnose", "{tmp}/no_such_data", "-o", "{tmp}/diag"], "--min-gain", lambda x: x <= 0 or x >= 1),
     (["fmu", "check", "{tmp}/no_such.fmu"], "--step-size", lambda x: x <= 0),

@@ -222,7 +222,7 @@ def api_cases(n: int, seed: int, tmp: Path) -> list:
         "simulate_test.noise": (lambda v: rwadist.simulate_test("ithaco-e", [600.0], n_samples=256, noise=v),
                                 lambda x: x < 0 or x > 10),
         "fit.f_lim": (lambda v: rwadist.fit(test, f_lim=v), lambda x: x <= 0 or x > 1920),
-        "fit.nperseg": (lambda v: rwadist.fit(test, nperseg=v), lambda x: x < 16 or x != int(x) or x > 1024),
+        "fit.nperseg": (lambda v: rwadist.fit(test, nperseg=v), lambda x: x < 62 or x != int(x) or x > 1024),
         "fit.presence": (lambda v: rwadist.fit(test, presence=v), lambda x: x <= 0 or x > 1),
         "fit.epsilon": (lambda v: rwadist.fit(test, epsilon=v), lambda x: x <= 0 or x > 0.5),
         "psd.speed_rpm": (lambda v: rwadist.psd(model, (600.0, v), empirical=True, n_freq=201, n_speeds=40),

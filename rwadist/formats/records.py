@@ -83,6 +83,7 @@ class Sweep:
 
     time : s; signals : channel -> samples (SI); sample_rate : Hz;
     tach : measured wheel speed per sample, rad/s, or None when not recorded.
+    name : the file it was read from ("" when made in memory), for messages.
     """
 
     time: np.ndarray
@@ -90,6 +91,7 @@ class Sweep:
     sample_rate: float
     tach: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
+    name: str = ""
 
     @property
     def channels(self) -> tuple:
