@@ -132,10 +132,98 @@ def _writable(directory: Path) -> bool:
         return False
 
 
+_OWN_SIGNATURES = {".json": b'"schema": "rwadist.model"'}    # a model file: recognisable as rwadist's own
+
+
+def _recorded(final: Path) -> dict | None:
+    """The record (:data:`MANIFEST` of its folder, key ``outputs``) of the file ``final`` rwadist wrote as an output
+    of its own: ``{"size", "mtime_ns"}`` of the file as written; None when not recorded.  A member of a folder rwadist
+    wrote whole (a dataset's ``runs.csv``, listed under ``files``) is not one: another command's output never
+    replaces it."""
+    try:
+        doc = json.loads((final.parent / MANIFEST).read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(doc, dict):
+        return None
+    outs = doc.get("outputs")
+    return outs[final.name] if isinstance(outs, dict) and isinstance(outs.get(final.name), dict) else None
+
+
+def written_by_rwadist(path) -> bool:
+    """True when the existing file ``path`` is one rwadist wrote and nobody changed since: recorded in its folder's
+    :data:`MANIFEST` with the size and modification time it had when written, or a model file
+    (``"schema": "rwadist.model"`` near its start: written by any rwadist)."""
+    final = Path(path)
+    rec = _recorded(final)
+    if rec is not None:
+        try:
+            st = os.stat(final)
+        except OSError:
+            return False
+        if rec.get("size") == st.st_size and rec.get("mtime_ns") == st.st_mtime_ns:
+            return True
+    sig = _OWN_SIGNATURES.get(final.suffix.lower())
+    if sig is not None:
+        try:
+            with open(final, "rb") as f:
+                return sig in f.read(4096)
+        except OSError:
+            return False
+    return False
+
+
+def refuse_foreign_file(path, flag: str = "-o", shown=None) -> None:
+    """Refuse (:class:`DataError` naming ``flag``) to replace the existing regular file ``path`` unless rwadist
+    wrote it (:func:`written_by_rwadist`): a lab's CSV, a dataset's run, someone's notes are never replaced."""
+    final = Path(path)
+    st = _stat(final, flag)
+    if st is None or not stat.S_ISREG(st.st_mode) or written_by_rwadist(final):
+        return
+    raise DataError(flag, "value", f"{str(shown if shown is not None else path)!r} exists and rwadist did not write "
+                    "it; it would be replaced: choose another output path, or move or delete that file yourself")
+
+
+def _record_written(finals: list) -> None:
+    """Add the regular files ``finals`` (just written) to their folders' :data:`MANIFEST` with their size and
+    modification time, so that a later run may replace them (and only while nobody changed them).  Best effort: a
+    record that cannot be written only means that the next run refuses to replace the file."""
+    by_folder: dict = {}
+    for final in finals:
+        by_folder.setdefault(final.parent, []).append(final)
+    for folder, members in by_folder.items():
+        record = folder / MANIFEST
+        try:
+            doc = json.loads(record.read_text())
+        except (OSError, ValueError):
+            doc = None
+        if not isinstance(doc, dict):
+            doc = {}
+        outs = doc.get("outputs") if isinstance(doc.get("outputs"), dict) else {}
+        for final in members:
+            try:
+                st = os.stat(final)
+            except OSError:
+                continue
+            outs[final.name] = {"size": st.st_size, "mtime_ns": st.st_mtime_ns}
+        for name in [n for n in outs if not (folder / n).is_file()]:       # files gone since: forgotten
+            del outs[name]
+        doc.setdefault("written_by", f"{WRITER} {_version()}")
+        doc["outputs"] = outs
+        doc.setdefault("note", "the files rwadist wrote in this folder; it replaces only those (while unchanged)")
+        tmp = folder / f".{MANIFEST}.part-{_token()}"
+        try:
+            tmp.write_text(json.dumps(doc, indent=1) + "\n")
+            os.replace(tmp, record)
+        except OSError:
+            _remove(tmp)
+
+
 def check_output_file(path, flag: str = "-o") -> Path:
     """``path`` as an output file, refused (:class:`DataError` naming ``flag``) when it is empty, a folder, a
-    block device or socket, a loop of links, or in a folder that cannot be created or written.  A character device
-    or a FIFO is accepted (written into, never replaced)."""
+    block device or socket, a loop of links, in a folder that cannot be created or written, or an existing file
+    rwadist did not write (:func:`refuse_foreign_file`).  A character device or a FIFO is accepted (written into,
+    never replaced)."""
     if path is None or str(path).strip() == "":
         raise DataError(flag, "value", "empty: give the path of the file to write")
     path = Path(path)
@@ -147,6 +235,8 @@ def check_output_file(path, flag: str = "-o") -> Path:
     if st is not None and not stat.S_ISREG(st.st_mode):
         _check_special(target, flag)
         return path
+    if st is not None:
+        refuse_foreign_file(target, flag, path)
     existing = target.parent
     while not existing.exists() and existing != existing.parent:
         existing = existing.parent
@@ -436,6 +526,7 @@ class OutputSet:
             tmp = Path(tempfile.gettempdir()) / f".rwadist.part-{_token()}{final.suffix}"
             kind = "device"
         else:
+            refuse_foreign_file(final, flag, path)
             final.parent.mkdir(parents=True, exist_ok=True)
             remove_stale_temporaries(final)
             tmp = _part_name(final)
@@ -459,7 +550,8 @@ class OutputSet:
         """An output of an earlier run this run does not write (a companion file): removed with the commit, so that
         no member of an earlier set stays beside the new one."""
         final = Path(path)
-        if final.exists() and final.is_file() and all(final != m[0] for m in self.members):
+        if final.exists() and final.is_file() and all(final != m[0] for m in self.members) and \
+                written_by_rwadist(final):      # a file rwadist did not write is not an earlier member: kept
             self.stale.append(final)
 
     def discard(self) -> None:
@@ -490,6 +582,7 @@ class OutputSet:
                     _remove(tmp)
                 _LIVE.pop(tmp, None)
             _WRITTEN.extend(m[0] for m in self.members)
+        _record_written([final for final, _, kind in self.members if kind == "file"])
 
 
 def _write_manifest(folder: Path) -> None:
@@ -591,11 +684,11 @@ def atomic_dir(path):
         yield s.folder(path)
 
 
-def write_file(path, writer):
+def write_file(path, writer, flag: str = "-o"):
     """Run ``writer(tmp)`` on a temporary sibling of ``path`` and rename it onto ``path`` when complete
-    (:func:`atomic_file`); returns ``path`` (a :class:`pathlib.Path`)."""
+    (:func:`atomic_file`; a refusal names ``flag``); returns ``path`` (a :class:`pathlib.Path`)."""
     path = Path(path)
-    with atomic_file(path) as tmp:
+    with atomic_file(path, flag) as tmp:
         writer(tmp)
     return path
 
