@@ -38,6 +38,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .formats.records import DataError
+from .output_record import MANIFEST, _version, record_written, refuse_foreign_file, written_by_rwadist
 
 #: names a reader takes from a steady-test directory besides its run files
 _DATASET_INDEX_FILES = ("runs.csv", "meta.json")
@@ -48,9 +49,6 @@ WRITER_KEY, WRITER = "written_by", "rwadist"
 _SIMULATE_OUTPUTS = ("sweep.csv", "sweep.meta.json")
 #: extensions of files a dataset reader may read (runs, sweeps, HDF5)
 _DATA_SUFFIXES = (".csv", ".h5", ".hdf5", ".uff", ".unv", ".tdms", ".mat", ".json")
-#: The record of what rwadist wrote in an output folder (a report): a hidden JSON file listing the folder's files.
-#: A folder whose files it does not all list is not replaced (:func:`check_output_dir`).
-MANIFEST = ".rwadist-files.json"
 #: files an operating system's file browser leaves in any folder it shows: not the user's work
 _BROWSER_LITTER = frozenset({".DS_Store", "Thumbs.db", "desktop.ini"})
 
@@ -58,16 +56,6 @@ _BROWSER_LITTER = frozenset({".DS_Store", "Thumbs.db", "desktop.ini"})
 _LIVE: dict = {}
 #: outputs this process completed, in order (named by the Ctrl-C message)
 _WRITTEN: list = []
-
-
-def _version() -> str:
-    """The installed rwadist's version (importlib.metadata: the package itself is not imported, no cycle)."""
-    try:
-        from importlib.metadata import version
-
-        return version("rwadist")
-    except Exception:   # a bare source tree, not installed
-        return "unknown (not installed)"
 
 
 # --------------------------------------------------------------------------- what an output path is
@@ -130,93 +118,6 @@ def _writable(directory: Path) -> bool:
             return True
     except OSError:
         return False
-
-
-_OWN_SIGNATURES = {".json": b'"schema": "rwadist.model"'}    # a model file: recognisable as rwadist's own
-
-
-def _recorded(final: Path) -> dict | None:
-    """The record (:data:`MANIFEST` of its folder, key ``outputs``) of the file ``final`` rwadist wrote as an output
-    of its own: ``{"size", "mtime_ns"}`` of the file as written; None when not recorded.  A member of a folder rwadist
-    wrote whole (a dataset's ``runs.csv``, listed under ``files``) is not one: another command's output never
-    replaces it."""
-    try:
-        doc = json.loads((final.parent / MANIFEST).read_text())
-    except (OSError, ValueError):
-        return None
-    if not isinstance(doc, dict):
-        return None
-    outs = doc.get("outputs")
-    return outs[final.name] if isinstance(outs, dict) and isinstance(outs.get(final.name), dict) else None
-
-
-def written_by_rwadist(path) -> bool:
-    """True when the existing file ``path`` is one rwadist wrote and nobody changed since: recorded in its folder's
-    :data:`MANIFEST` with the size and modification time it had when written, or a model file
-    (``"schema": "rwadist.model"`` near its start: written by any rwadist)."""
-    final = Path(path)
-    rec = _recorded(final)
-    if rec is not None:
-        try:
-            st = os.stat(final)
-        except OSError:
-            return False
-        if rec.get("size") == st.st_size and rec.get("mtime_ns") == st.st_mtime_ns:
-            return True
-    sig = _OWN_SIGNATURES.get(final.suffix.lower())
-    if sig is not None:
-        try:
-            with open(final, "rb") as f:
-                return sig in f.read(4096)
-        except OSError:
-            return False
-    return False
-
-
-def refuse_foreign_file(path, flag: str = "-o", shown=None) -> None:
-    """Refuse (:class:`DataError` naming ``flag``) to replace the existing regular file ``path`` unless rwadist
-    wrote it (:func:`written_by_rwadist`): a lab's CSV, a dataset's run, someone's notes are never replaced."""
-    final = Path(path)
-    st = _stat(final, flag)
-    if st is None or not stat.S_ISREG(st.st_mode) or written_by_rwadist(final):
-        return
-    raise DataError(flag, "value", f"{str(shown if shown is not None else path)!r} exists and rwadist did not write "
-                    "it; it would be replaced: choose another output path, or move or delete that file yourself")
-
-
-def _record_written(finals: list) -> None:
-    """Add the regular files ``finals`` (just written) to their folders' :data:`MANIFEST` with their size and
-    modification time, so that a later run may replace them (and only while nobody changed them).  Best effort: a
-    record that cannot be written only means that the next run refuses to replace the file."""
-    by_folder: dict = {}
-    for final in finals:
-        by_folder.setdefault(final.parent, []).append(final)
-    for folder, members in by_folder.items():
-        record = folder / MANIFEST
-        try:
-            doc = json.loads(record.read_text())
-        except (OSError, ValueError):
-            doc = None
-        if not isinstance(doc, dict):
-            doc = {}
-        outs = doc.get("outputs") if isinstance(doc.get("outputs"), dict) else {}
-        for final in members:
-            try:
-                st = os.stat(final)
-            except OSError:
-                continue
-            outs[final.name] = {"size": st.st_size, "mtime_ns": st.st_mtime_ns}
-        for name in [n for n in outs if not (folder / n).is_file()]:       # files gone since: forgotten
-            del outs[name]
-        doc.setdefault("written_by", f"{WRITER} {_version()}")
-        doc["outputs"] = outs
-        doc.setdefault("note", "the files rwadist wrote in this folder; it replaces only those (while unchanged)")
-        tmp = folder / f".{MANIFEST}.part-{_token()}"
-        try:
-            tmp.write_text(json.dumps(doc, indent=1) + "\n")
-            os.replace(tmp, record)
-        except OSError:
-            _remove(tmp)
 
 
 def check_output_file(path, flag: str = "-o") -> Path:
@@ -582,7 +483,7 @@ class OutputSet:
                     _remove(tmp)
                 _LIVE.pop(tmp, None)
             _WRITTEN.extend(m[0] for m in self.members)
-        _record_written([final for final, _, kind in self.members if kind == "file"])
+            record_written([final for final, _, kind in self.members if kind == "file"])   # before a held Ctrl-C
 
 
 def _write_manifest(folder: Path) -> None:
