@@ -43,11 +43,12 @@ __all__ = ["read", "simulate_test", "simulate_sweep", "fit", "fit_extended", "di
 def save_model(model: WheelModel, path) -> Path:
     """Write ``model`` as a model file (JSON) at ``path``, atomically (a kill leaves the old file or the new one).
     Refused (:class:`DataError` naming ``path``, nothing written): a folder, a path in a folder that cannot be
-    written, an existing file rwadist did not write (a measurement, someone's notes: never replaced; a model file or
-    an output rwadist wrote is); a model :func:`load_model` would refuse (:class:`ModelFileError`)."""
-    from .outputs import check_output_file, write_file
+    written, a path ending in a data format's extension (``.csv``, ``.h5``: a model file is JSON), an existing file
+    rwadist did not write (a measurement, someone's notes: never replaced; a model file or an output rwadist wrote
+    is); a model :func:`load_model` would refuse (:class:`ModelFileError`)."""
+    from .outputs import check_model_file, write_file
 
-    check_output_file(path, "path")
+    check_model_file(path, "path")
     doc = model_io.to_json(model)
     model_io.from_json(doc, str(path))        # refused naming the user's path, before anything is written
     text = json.dumps(doc, indent=2, allow_nan=False) + "\n"

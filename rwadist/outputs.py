@@ -148,6 +148,17 @@ def check_output_file(path, flag: str = "-o") -> Path:
     return path
 
 
+def check_model_file(path, flag: str = "-o") -> Path:
+    """``path`` as a model file to write (:func:`check_output_file`); a path ending in the extension of a data format
+    rwadist reads (``.csv``, ``.h5``, ...) is refused: a model file is a JSON document (docs/formats.md, section 4),
+    and such a path is most likely a slip onto a measurement."""
+    suffix = Path(str(path)).suffix.lower() if path is not None else ""
+    if suffix != ".json" and suffix in _DATA_SUFFIXES:
+        raise DataError(flag, "value", f"{str(path)!r}: a model file is a JSON document, not a {suffix} file: "
+                        "give a path ending in .json")
+    return check_output_file(path, flag)
+
+
 def refuse_special_base(path, flag: str, companions: str, remedy: str = "give a file path in a folder") -> None:
     """Refuse an output ``path`` that is a device or FIFO when the command also writes files named after it
     (``companions``: what, e.g. "its report folder null_report"): those would land beside the device."""

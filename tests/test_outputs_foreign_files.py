@@ -68,14 +68,16 @@ def test_convert_onto_a_foreign_file_is_refused_untouched(sweep, tmp_path, capsy
     assert not lab.with_suffix(".meta.json").exists()
 
 
-def test_fit_onto_another_datasets_run_file_is_refused_untouched(dataset, tmp_path, capsys):
+def test_fit_onto_another_datasets_files_is_refused_untouched(dataset, tmp_path, capsys):
+    """`fit DS -o other/run_0002.csv` wrote a model over a run of another dataset; its meta.json alike."""
     other = tmp_path / "other"
     shutil.copytree(dataset, other)
-    target = other / "run_0002.csv"
-    before = target.read_bytes()
-    code, err = run(capsys, "fit", dataset, "-o", target, "--no-report")
-    _refused(code, err, target)
-    assert target.read_bytes() == before
+    before = {p.name: p.read_bytes() for p in other.iterdir()}
+    code, err = run(capsys, "fit", dataset, "-o", other / "run_0002.csv", "--no-report")
+    assert code == 2 and str(other / "run_0002.csv") in err and "JSON document" in err
+    code, err = run(capsys, "fit", dataset, "-o", other / "meta.json", "--no-report")
+    _refused(code, err, other / "meta.json")
+    assert {p.name: p.read_bytes() for p in other.iterdir()} == before
 
 
 def test_psd_onto_a_datasets_runs_csv_is_refused_untouched(dataset, tmp_path, capsys):
@@ -130,3 +132,16 @@ def test_save_model_onto_a_folder_or_a_foreign_file_is_a_data_error(tmp_path):
     out = tmp_path / "w.json"
     assert rwadist.save_model(model, out) == out and rwadist.save_model(model, out) == out
     assert rwadist.load_model(out).name == model.name
+
+
+@pytest.mark.parametrize("name", ["new_run.csv", "model.h5"])
+def test_a_model_path_with_a_data_formats_extension_is_refused(dataset, tmp_path, capsys, name):
+    """A model file is a JSON document (docs/formats.md section 4): `fit -o x.csv` is a slip onto a measurement."""
+    code, err = run(capsys, "fit", dataset, "-o", tmp_path / name, "--no-report")
+    assert code == 2 and "a model file is a JSON document" in err and name in err
+    assert list(tmp_path.iterdir()) == []
+    from rwadist.presets import preset
+
+    with pytest.raises(rwadist.DataError, match="JSON document"):
+        rwadist.save_model(preset("ithaco-e").to_model(), tmp_path / name)
+    assert list(tmp_path.iterdir()) == []
