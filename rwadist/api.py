@@ -12,6 +12,7 @@ named ``*_rpm``), as the CLI.  The heavy modules (scipy, matplotlib) are importe
 from __future__ import annotations
 
 import functools
+import json
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -25,7 +26,6 @@ from .errors import DataError, MissingDependencyError, ModelError, ParameterErro
 from .formats.records import reading_provenance
 from .model import WheelModel
 from .model import load as load_model
-from .model import save as save_model
 from .validate import (
     MAX_SAMPLES,
     check_f_lim,
@@ -39,6 +39,21 @@ from .validate import (
 
 __all__ = ["read", "simulate_test", "simulate_sweep", "fit", "fit_extended", "diagnose", "psd", "write_nastran",
            "campbell", "build_fmu", "WheelModel", "load_model", "save_model"]
+
+def save_model(model: WheelModel, path) -> Path:
+    """Write ``model`` as a model file (JSON) at ``path``, atomically (a kill leaves the old file or the new one).
+    Refused (:class:`DataError` naming ``path``, nothing written): a folder, a path in a folder that cannot be
+    written, a path ending in a data format's extension (``.csv``, ``.h5``: a model file is JSON), an existing file
+    rwadist did not write (a measurement, someone's notes: never replaced; a model file or an output rwadist wrote
+    is); a model :func:`load_model` would refuse (:class:`ModelFileError`)."""
+    from .outputs import check_model_file, write_file
+
+    check_model_file(path, "path")
+    doc = model_io.to_json(model)
+    model_io.from_json(doc, str(path))        # refused naming the user's path, before anything is written
+    text = json.dumps(doc, indent=2, allow_nan=False) + "\n"
+    return write_file(path, lambda tmp: Path(tmp).write_text(text), "path")
+
 
 #: Default FFT length rule of :func:`diagnose`: a power of 2 at most a quarter of the median run length, so
 #: every PSD averages several Welch segments (the residual needs noise statistics).

@@ -23,6 +23,7 @@ from .errors import ParameterError, RwadistError
 from .outputs import (
     atomic_dataset_dir,
     check_dataset_dir,
+    check_model_file,
     check_output_dir,
     check_output_file,
     exit_on_interrupt,
@@ -137,7 +138,7 @@ def run_fit(test, args, name: str, progress: bool = True):
 def cmd_fit(args) -> int:
     from .report import write_report
 
-    check_output_file(args.output)
+    check_model_file(args.output)
     if args.no_report and args.report:
         raise DataError("--no-report", "--report", f"{args.report}: give one of the two (--no-report writes the model file "
                         "only)")

@@ -327,7 +327,7 @@ def stamp(data: Any = None) -> dict:
     8601) and the data it came from (a path, or a description of a test built in memory)."""
     import datetime
 
-    from .outputs import _version
+    from .output_record import _version
     if isinstance(data, (str, Path)):
         source = str(data)
     elif data is not None and hasattr(data, "runs"):

@@ -38,6 +38,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .formats.records import DataError
+from .output_record import MANIFEST, _version, record_written, refuse_foreign_file, written_by_rwadist
 
 #: names a reader takes from a steady-test directory besides its run files
 _DATASET_INDEX_FILES = ("runs.csv", "meta.json")
@@ -48,9 +49,6 @@ WRITER_KEY, WRITER = "written_by", "rwadist"
 _SIMULATE_OUTPUTS = ("sweep.csv", "sweep.meta.json")
 #: extensions of files a dataset reader may read (runs, sweeps, HDF5)
 _DATA_SUFFIXES = (".csv", ".h5", ".hdf5", ".uff", ".unv", ".tdms", ".mat", ".json")
-#: The record of what rwadist wrote in an output folder (a report): a hidden JSON file listing the folder's files.
-#: A folder whose files it does not all list is not replaced (:func:`check_output_dir`).
-MANIFEST = ".rwadist-files.json"
 #: files an operating system's file browser leaves in any folder it shows: not the user's work
 _BROWSER_LITTER = frozenset({".DS_Store", "Thumbs.db", "desktop.ini"})
 
@@ -58,16 +56,6 @@ _BROWSER_LITTER = frozenset({".DS_Store", "Thumbs.db", "desktop.ini"})
 _LIVE: dict = {}
 #: outputs this process completed, in order (named by the Ctrl-C message)
 _WRITTEN: list = []
-
-
-def _version() -> str:
-    """The installed rwadist's version (importlib.metadata: the package itself is not imported, no cycle)."""
-    try:
-        from importlib.metadata import version
-
-        return version("rwadist")
-    except Exception:   # a bare source tree, not installed
-        return "unknown (not installed)"
 
 
 # --------------------------------------------------------------------------- what an output path is
@@ -134,8 +122,9 @@ def _writable(directory: Path) -> bool:
 
 def check_output_file(path, flag: str = "-o") -> Path:
     """``path`` as an output file, refused (:class:`DataError` naming ``flag``) when it is empty, a folder, a
-    block device or socket, a loop of links, or in a folder that cannot be created or written.  A character device
-    or a FIFO is accepted (written into, never replaced)."""
+    block device or socket, a loop of links, in a folder that cannot be created or written, or an existing file
+    rwadist did not write (:func:`refuse_foreign_file`).  A character device or a FIFO is accepted (written into,
+    never replaced)."""
     if path is None or str(path).strip() == "":
         raise DataError(flag, "value", "empty: give the path of the file to write")
     path = Path(path)
@@ -147,6 +136,8 @@ def check_output_file(path, flag: str = "-o") -> Path:
     if st is not None and not stat.S_ISREG(st.st_mode):
         _check_special(target, flag)
         return path
+    if st is not None:
+        refuse_foreign_file(target, flag, path)
     existing = target.parent
     while not existing.exists() and existing != existing.parent:
         existing = existing.parent
@@ -155,6 +146,17 @@ def check_output_file(path, flag: str = "-o") -> Path:
     if not _writable(existing):
         raise DataError(flag, "value", f"{str(path)!r}: the directory {str(existing)!r} is not writable")
     return path
+
+
+def check_model_file(path, flag: str = "-o") -> Path:
+    """``path`` as a model file to write (:func:`check_output_file`); a path ending in the extension of a data format
+    rwadist reads (``.csv``, ``.h5``, ...) is refused: a model file is a JSON document (docs/formats.md, section 4),
+    and such a path is most likely a slip onto a measurement."""
+    suffix = Path(str(path)).suffix.lower() if path is not None else ""
+    if suffix != ".json" and suffix in _DATA_SUFFIXES:
+        raise DataError(flag, "value", f"{str(path)!r}: a model file is a JSON document, not a {suffix} file: "
+                        "give a path ending in .json")
+    return check_output_file(path, flag)
 
 
 def refuse_special_base(path, flag: str, companions: str, remedy: str = "give a file path in a folder") -> None:
@@ -436,6 +438,7 @@ class OutputSet:
             tmp = Path(tempfile.gettempdir()) / f".rwadist.part-{_token()}{final.suffix}"
             kind = "device"
         else:
+            refuse_foreign_file(final, flag, path)
             final.parent.mkdir(parents=True, exist_ok=True)
             remove_stale_temporaries(final)
             tmp = _part_name(final)
@@ -459,7 +462,8 @@ class OutputSet:
         """An output of an earlier run this run does not write (a companion file): removed with the commit, so that
         no member of an earlier set stays beside the new one."""
         final = Path(path)
-        if final.exists() and final.is_file() and all(final != m[0] for m in self.members):
+        if final.exists() and final.is_file() and all(final != m[0] for m in self.members) and \
+                written_by_rwadist(final):      # a file rwadist did not write is not an earlier member: kept
             self.stale.append(final)
 
     def discard(self) -> None:
@@ -490,6 +494,7 @@ class OutputSet:
                     _remove(tmp)
                 _LIVE.pop(tmp, None)
             _WRITTEN.extend(m[0] for m in self.members)
+            record_written([final for final, _, kind in self.members if kind == "file"])   # before a held Ctrl-C
 
 
 def _write_manifest(folder: Path) -> None:
@@ -591,11 +596,11 @@ def atomic_dir(path):
         yield s.folder(path)
 
 
-def write_file(path, writer):
+def write_file(path, writer, flag: str = "-o"):
     """Run ``writer(tmp)`` on a temporary sibling of ``path`` and rename it onto ``path`` when complete
-    (:func:`atomic_file`); returns ``path`` (a :class:`pathlib.Path`)."""
+    (:func:`atomic_file`; a refusal names ``flag``); returns ``path`` (a :class:`pathlib.Path`)."""
     path = Path(path)
-    with atomic_file(path) as tmp:
+    with atomic_file(path, flag) as tmp:
         writer(tmp)
     return path
 

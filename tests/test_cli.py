@@ -67,13 +67,14 @@ def test_fit_no_report_writes_the_model_only(tmp_path, capsys):
     with ``--report`` refused."""
     from rwadist import api
     from rwadist import model as model_io
+    from rwadist.outputs import MANIFEST
 
     data = tmp_path / "e"
     run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "8",
         "--samples", "2048", "--sample-rate", "1920", "--no-modes")
     code, out, _ = run(capsys, "fit", data, "-o", tmp_path / "a.json", "--no-report")
     assert code == 0 and "--no-report" in out and not (tmp_path / "a_report").exists()
-    assert {p.name for p in tmp_path.iterdir()} == {"e", "a.json"}
+    assert {p.name for p in tmp_path.iterdir()} == {"e", "a.json", MANIFEST}   # the model and the record of it
     got = json.loads((tmp_path / "a.json").read_text())
     want = json.loads(json.dumps(model_io.to_json(api.fit(api.read(data)).model)))
     assert got["empirical"] == want["empirical"] and got["empirical"]

@@ -21,19 +21,26 @@ def run(capsys, *argv):
     return code, out.out, out.err
 
 
+def own(path, text: str) -> None:
+    """Write ``path`` as rwadist writes an output (recorded in its folder's MANIFEST): a later output may replace it,
+    where it would refuse a file rwadist did not write (tests/test_outputs_foreign_files.py)."""
+    with atomic_file(path) as tmp:
+        tmp.write_text(text)
+
+
 def test_atomic_file_replaces_only_when_complete(tmp_path):
     target = tmp_path / "model.json"
-    target.write_text("old")
+    own(target, "old")
     with pytest.raises(RuntimeError):
         with atomic_file(target) as tmp:
             tmp.write_text("half")
             raise RuntimeError("writer failed")
-    assert target.read_text() == "old" and os.listdir(tmp_path) == ["model.json"]
+    assert target.read_text() == "old" and sorted(os.listdir(tmp_path)) == [MANIFEST, "model.json"]
     with atomic_file(target) as tmp:
         assert tmp.parent == tmp_path and tmp.suffix == ".json" and tmp != target
         tmp.write_text("new")
         assert target.read_text() == "old"       # not visible until complete
-    assert target.read_text() == "new" and os.listdir(tmp_path) == ["model.json"]
+    assert target.read_text() == "new" and sorted(os.listdir(tmp_path)) == [MANIFEST, "model.json"]
 
 
 def test_atomic_dir_swaps_the_whole_folder(tmp_path):
@@ -120,21 +127,21 @@ _SLOW_WRITER = textwrap.dedent("""
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT])
 def test_kill_during_the_write_keeps_the_old_file(tmp_path, sig):
     target = tmp_path / "out.json"
-    target.write_text("old complete\n")
+    own(target, "old complete\n")
     proc = subprocess.Popen([sys.executable, "-c", _SLOW_WRITER, str(target)], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     assert proc.stdout.readline().strip() == "writing"   # killed at its first write
     proc.send_signal(sig)
     proc.wait(timeout=20)
     assert target.read_text() == "old complete\n"
-    left = [p for p in os.listdir(tmp_path) if p != "out.json"]
+    left = [p for p in os.listdir(tmp_path) if p not in ("out.json", MANIFEST)]
     # SIGINT runs the clean-up; SIGKILL can leave only the hidden temporary, never a truncated output
     assert left == [] if sig == signal.SIGINT else all(p.startswith(".out.part-") for p in left)
 
 
 def test_ctrl_c_is_one_line_exit_130(tmp_path):
     out = tmp_path / "psd.csv"
-    out.write_text("old")
+    own(out, "old")
     # four wheels of the extended model on 200001 frequencies: a CSD long enough to be interrupted while its
     # progress bar runs (one empirical wheel took 1 s before issue 37's closed form, 0.1 s after)
     wheels = tmp_path / "wheels.json"
@@ -160,7 +167,7 @@ def test_ctrl_c_is_one_line_exit_130(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert "Traceback" not in err and "interrupted" in err.strip().splitlines()[-1]
-    assert out.read_text() == "old" and sorted(os.listdir(tmp_path)) == ["psd.csv", "wheels.json"]
+    assert out.read_text() == "old" and sorted(os.listdir(tmp_path)) == [MANIFEST, "psd.csv", "wheels.json"]
 
 
 def test_a_failed_set_removes_the_companions_its_writers_made_beside_a_temporary(tmp_path):

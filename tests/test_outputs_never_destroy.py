@@ -115,7 +115,8 @@ def test_a_fifo_is_written_into(dataset, tmp_path):
 
 def test_a_symbolic_link_is_followed_and_a_loop_refused(dataset, tmp_path, capsys):
     real = tmp_path / "real.json"
-    real.write_text("old")
+    with outputs.atomic_file(real) as tmp:      # rwadist's own output: replaced (a file it did not write is not)
+        tmp.write_text("old")
     link = tmp_path / "link.json"
     link.symlink_to(real)
     assert main(["fit", str(dataset), "-o", str(link), "--no-report"]) == 0
@@ -175,7 +176,7 @@ def test_psd_outputs_are_replaced_as_a_set(tmp_path, monkeypatch, capsys):
     assert main(PSD + ["--n-freq", "301", "-o", str(stem) + ".csv", "--cross", "csv"]) == 2
     monkeypatch.setattr(os, "rename", real)
     assert {s: p.read_bytes() for s, p in _psd_set(stem).items()} == old
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in _psd_set(stem).values())
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([outputs.MANIFEST] + [p.name for p in _psd_set(stem).values()])
     assert main(PSD + ["--n-freq", "301", "-o", str(stem) + ".csv", "--cross", "none"]) == 0
     assert not _psd_set(stem)["_cross.csv"].exists()
     assert all(_psd_set(stem)[s].read_bytes() != old[s] for s in (".csv", "_envelope.csv"))
@@ -184,8 +185,9 @@ def test_psd_outputs_are_replaced_as_a_set(tmp_path, monkeypatch, capsys):
 def test_ctrl_c_during_the_swap_waits_for_it(tmp_path):
     """Ctrl-C arriving between the renames of a set runs after the last one: both members new, then the interrupt."""
     a, b = tmp_path / "a.txt", tmp_path / "b.txt"
-    a.write_text("old a")
-    b.write_text("old b")
+    with outputs.output_set() as s:     # rwadist's own outputs: replaced (a file it did not write is not)
+        s.file(a).write_text("old a")
+        s.file(b).write_text("old b")
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     real = os.rename
     try:
@@ -202,7 +204,7 @@ def test_ctrl_c_during_the_swap_waits_for_it(tmp_path):
         os.rename = real
         signal.signal(signal.SIGINT, previous)
     assert (a.read_text(), b.read_text()) == ("new a", "new b")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [outputs.MANIFEST, "a.txt", "b.txt"]
 
 
 _CTRL_C_AFTER_MKDIR = """
