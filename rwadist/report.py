@@ -490,16 +490,20 @@ def plot_coefficients(lines, direction: str, fig=None):
     for ax in axes[:n]:
         for hd, lb in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(lb, hd)
-    fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncol=min(len(handles), 6),
-               fontsize="small")
-    f_lines = [ln.h * np.abs(ln.speed) / (2 * np.pi) for ln in sel if ln.speed.size]
-    band = f", lines at {min(f.min() for f in f_lines):.3g}–{max(f.max() for f in f_lines):.3g} Hz" if f_lines else ""
-    fig.suptitle(f"{_direction_label(direction)}: amplitude coefficient curve fits (line amplitudes at every speed "
-                 f"of the data{band})")
     import textwrap
 
-    fig.text(0.5, 0.995, "\n".join(textwrap.wrap(UNCERTAINTY_NOTE, 150)), ha="center", va="top", fontsize=6.5,
-             color="0.3")
+    # title and note wrapped to the figure's width (characters of ~0.55 em) and placed by the constrained layout: the
+    # suptitle above the panels, the note as the title of the legend under them.  A note written at a fixed height
+    # overprinted the title and the top row's panel titles, and the title ran off both edges of a 3-panel row
+    width_pt = fig.get_figwidth() * 72.0
+    note = "\n".join(textwrap.wrap(UNCERTAINTY_NOTE, max(int(width_pt / (8.0 * 0.55)), 60)))
+    fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncol=min(len(handles), 6),
+               fontsize="small", title=note, title_fontsize=8)
+    f_lines = [ln.h * np.abs(ln.speed) / (2 * np.pi) for ln in sel if ln.speed.size]
+    band = f", lines at {min(f.min() for f in f_lines):.3g}–{max(f.max() for f in f_lines):.3g} Hz" if f_lines else ""
+    title = (f"{_direction_label(direction)}: amplitude coefficient curve fits (line amplitudes at every speed of the "
+             f"data{band})")
+    fig.suptitle("\n".join(textwrap.wrap(title, max(int(width_pt / (12.0 * 0.55)), 40))), fontsize=12)
     return fig, axes[:n]
 
 

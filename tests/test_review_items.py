@@ -92,7 +92,7 @@ def test_every_uncertainty_says_what_it_covers(extended_fit):
     titles = [ax.get_title() for ax in axes]
     assert all("(2σ noise)" in t for t in titles if "±" in t)
     assert sum("(model form)" in t for t in titles) >= 1
-    assert any(UNCERTAINTY_NOTE[:40] in t.get_text().replace("\n", " ") for t in fig.texts)
+    assert UNCERTAINTY_NOTE[:40] in fig.legends[0].get_title().get_text().replace("\n", " ")
     md = (out / "summary.md").read_text()
     assert "±2σ noise" in md and "held-out (model form)" in md and "Neither covers" in md
     rows = list(csv.DictReader((out / "harmonics.csv").open()))
