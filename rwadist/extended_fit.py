@@ -587,6 +587,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     radial = _radial_power(meas.lines)
     scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near)
     mass_kg, I_rr, I_zz = _inertias(mass, radius, scans["rocking"], notes)
+    ratio_from_scan = not physical and scans["rocking"].found
     starts = _ModeStarts(scans, start, physical, max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines),
                                                      default=100.0), zeta0, notes)
     base = starts.params(mass_kg, I_rr, I_zz)
@@ -624,6 +625,11 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                      f"near it by {resid_db[m]:.1f} dB RMS (more than {MISFIT_DB:g} dB: something the model lacks "
                      "acts there, and pulls the mode); its fitted value is kept, listed in analytical.unconstrained")
     zeta_bounds, intervals = located_damping(zeta_bounds, intervals, starts.identified, problem.held_zeta, notes)
+    if ratio_from_scan and not starts.identified["rocking"]:
+        # the scan's ratio rests on a rocking mode the fit did not confirm: not "fitted from the whirls" (a new
+        # user's hard-mounted wheel with no modes in band: I_zz/I_rr 3.000, the scan's bound, said so)
+        notes[:] = [n.replace("fitted from the whirls", "from the rocking scan, but the rocking mode is NOT "
+                              "CONSTRAINED: the whirls do not fix it") for n in notes]
     return ExtendedFit(params=params, lines=kept_lines,
                        zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
                              "axial_translation": params.zeta_z},
