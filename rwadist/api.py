@@ -365,10 +365,20 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     if text := speed_whirl.fit_tie_warning(test):      # a sweep's speed from the data, its 1x line a tie
         warnings.warn(RwadistWarning(text), stacklevel=2)
     if not any(result.model.empirical.values()):
-        warnings.warn(RwadistWarning(f"no harmonic passed the presence threshold ({presence:g} of the runs): the model "
-                                     "is empty; give more runs over the speed range, or lower `presence`"),
-                      stacklevel=2)
+        warnings.warn(RwadistWarning(_empty_model_advice(test, settings, presence)), stacklevel=2)
     return result
+
+
+def _empty_model_advice(test: SteadyTest, settings, presence: float) -> str:
+    """The words of an empty empirical fit: the cause the test shows (too few spinning runs for a harmonic's
+    ``min_points`` measurements), else where to look (the presence threshold, the band, the speed column's unit)."""
+    spinning = sum(1 for r in test.runs if np.isfinite(r.speed) and r.speed != 0)
+    if spinning < settings.min_points:
+        return (f"the model is empty: a harmonic needs {settings.min_points} measurements and the test has "
+                f"{spinning} spinning run(s); give at least {settings.min_points} runs over the speed range")
+    return (f"no harmonic passed the presence threshold ({presence:g} of the runs): the model is empty; check that "
+            "the lines lie in the band read (`f_lim`) and that the speeds are in rpm, give more runs over the speed "
+            "range, or lower `presence`")
 
 
 def extended_options(mass: float | None = None, radius: float | None = None, height: float = 0.0,
