@@ -216,8 +216,8 @@ def params_from_dict(d, source="<model>", needed_for: str | None = None) -> Exte
     if d is None and needed_for:
         raise ModelFileError(source, "analytical", f"missing: the model file has no analytical parameters "
                              f"(suspension modes), which {needed_for} is made of; add them with the extended fit "
-                             "(rwadist fit DATA --extended, or rwadist.fit_extended; the rotor's mass and radius are "
-                             "optional) or give a wheel `preset` instead of the model")
+                             "(rwadist.fit_extended, or the fit command's `extended` option; the rotor's mass and "
+                             "radius are optional) or give a wheel `preset` instead of the model")
     if d is None:
         raise ModelFileError(source, "analytical", "missing: the model file has no analytical parameters (suspension "
                              "modes); add them with the extended fit (with the rotor's `mass` and `radius`) or use a "
