@@ -395,6 +395,16 @@ def _inertias(mass: float | None, radius: float | None, rocking_scan, notes: lis
     return 1.0, 1.0, float(a_fit)
 
 
+def _ratio_words(notes: list, identified: dict) -> list:
+    """``notes`` with I_zz/I_rr "fitted from the whirls" (:func:`_inertias`) said as the rocking scan's when the fit then
+    declared the rocking mode not constrained: the ratio rests on a mode the fit did not confirm (a new user's
+    hard-mounted wheel, no mode in band: "I_zz/I_rr = 3.000 fitted from the whirls", the scan's bound)."""
+    if identified.get("rocking", True):
+        return notes
+    return [n.replace("fitted from the whirls", "from the rocking scan, but the rocking mode is NOT CONSTRAINED: the "
+                      "whirls do not fix it") for n in notes]
+
+
 @dataclass
 class _ModeStarts:
     """The modes' starting point.  Per mode the frequency its scan found (``f_modes``, Hz at rest; None: not found)
@@ -587,7 +597,6 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     radial = _radial_power(meas.lines)
     scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near)
     mass_kg, I_rr, I_zz = _inertias(mass, radius, scans["rocking"], notes)
-    ratio_from_scan = not physical and scans["rocking"].found
     starts = _ModeStarts(scans, start, physical, max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines),
                                                      default=100.0), zeta0, notes)
     base = starts.params(mass_kg, I_rr, I_zz)
@@ -625,17 +634,12 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                      f"near it by {resid_db[m]:.1f} dB RMS (more than {MISFIT_DB:g} dB: something the model lacks "
                      "acts there, and pulls the mode); its fitted value is kept, listed in analytical.unconstrained")
     zeta_bounds, intervals = located_damping(zeta_bounds, intervals, starts.identified, problem.held_zeta, notes)
-    if ratio_from_scan and not starts.identified["rocking"]:
-        # the scan's ratio rests on a rocking mode the fit did not confirm: not "fitted from the whirls" (a new
-        # user's hard-mounted wheel with no modes in band: I_zz/I_rr 3.000, the scan's bound, said so)
-        notes[:] = [n.replace("fitted from the whirls", "from the rocking scan, but the rocking mode is NOT "
-                              "CONSTRAINED: the whirls do not fix it") for n in notes]
     return ExtendedFit(params=params, lines=kept_lines,
                        zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
                              "axial_translation": params.zeta_z},
                        rel_stderr={n: float(v) for n, v in zip(names, rel_se)}
                        | {f"C[{d},{h:g},co+counter]": se[0] for (d, h), se in sums.items()}, identified=starts.identified,
-                       peaks=peaks, senses=senses, residual_db=resid_db, notes=notes, measured=meas.lines,
+                       peaks=peaks, senses=senses, residual_db=resid_db, notes=_ratio_words(notes, starts.identified), measured=meas.lines,
                        unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
                        line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
