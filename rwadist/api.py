@@ -26,6 +26,7 @@ from .errors import DataError, MissingDependencyError, ModelError, ParameterErro
 from .formats.records import reading_provenance
 from .model import WheelModel
 from .model import load as load_model
+from .threads import in_one_blas_thread
 from .validate import (
     MAX_SAMPLES,
     check_f_lim,
@@ -164,6 +165,7 @@ def _stand_wheel(preset: str, physics: str, assumed_modes: bool) -> tuple:
     return wheel, note
 
 
+@in_one_blas_thread
 def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: float | None = None,
                   n_samples: int = 8192, noise: float = 0.01, modes: bool = True, test_stand: bool = True,
                   seed: int = 0, physics: str = "simple", inject=(), assumed_modes: bool = False) -> SteadyTest:
@@ -236,6 +238,7 @@ def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: flo
     return test
 
 
+@in_one_blas_thread
 def simulate_sweep(preset: str = "ithaco-e", start_rpm: float = 0.0, end_rpm: float = 2400.0, *,
                    duration: float = 390.0, sample_rate: float | None = None, noise: float = 0.01,
                    modes: bool = True, test_stand: bool = True, seed: int = 0, profile: str = "linear",
@@ -292,6 +295,7 @@ def _f_lim(test: SteadyTest, f_lim):
     return test.meta.get("f_lim_hz") if f_lim is None else f_lim
 
 
+@in_one_blas_thread
 def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presence: float = 0.25,
         epsilon: float = 0.02, exclude_modes: bool = True, name: str | None = None, progress: bool = False):
     """Fit the empirical model (harmonics C·Ω², thesis ch. 3) to steady test data.
@@ -404,6 +408,7 @@ def extended_options(mass: float | None = None, radius: float | None = None, hei
     return mass, radius, start
 
 
+@in_one_blas_thread
 def fit_extended(data, empirical=None, *, mass: float | None = None, radius: float | None = None,
                  height: float = 0.0, preset: str | None = None, progress: bool = False):
     """Fit the extended model (suspension modes, damping, imbalances) on top of the empirical fit.
@@ -499,6 +504,7 @@ def _one_x_checks(test) -> tuple:
     return test, checked, polarity
 
 
+@in_one_blas_thread
 def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto", nperseg: int | None = None,
              f_lim: float | None = None, k_sigma: float = 4.0, min_gain: float = 0.05, bearings=None,
              source=None):
@@ -615,6 +621,7 @@ def extended_source(model=None, *, preset: str | None = None, needed_for: str | 
     return params, extended.lines_from_model(m, params), source
 
 
+@in_one_blas_thread
 def campbell(model=None, speeds_rpm=None, *, preset: str | None = None) -> tuple:
     """Campbell diagram of the extended model: mode frequencies against speed, and the crossings.
 

@@ -12,6 +12,7 @@ import math
 from pathlib import Path
 
 from .errors import ParameterError
+from .threads import in_one_blas_thread
 from .validate import (
     check_parameter,
     check_speed_range,
@@ -67,6 +68,7 @@ def _wheel_set(wheels, default, law, empirical: bool, assumed_modes: bool, fmax,
     return res, [(w.lines, w.mounting) for w in ws], support
 
 
+@in_one_blas_thread
 def psd(model=None, speed_rpm=(0.0, 3000.0), *, preset: str | None = None, wheels=None, dist: str = "uniform",
         std_rpm: float | None = None, empirical: bool = False, assumed_modes: bool = False,
         fmax: float | None = None, n_freq: int = 20001, n_speeds: int = 2000, envelope: bool = False,

@@ -35,6 +35,7 @@ from .outputs import (
 from .outputs import write_file as _write
 from .plot_util import import_matplotlib_for_command, psd_title, save_png
 from .progress import working
+from .threads import one_blas_thread
 from .units import RAD_S_TO_RPM
 from .validate import check_grid_size, check_speeds_rpm, check_within_test
 
@@ -658,44 +659,6 @@ def _write_crash_log(command: str) -> Path | None:
         return Path(name)
     except OSError:
         return None
-
-
-#: thread-count variables of the BLAS/OpenMP libraries numpy and scipy load (a user who sets one has chosen)
-BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-#: what a library loaded later reads at its start: these set to 1 for the command's life (BLIS, Apple Accelerate and
-#: numexpr read their own)
-ONE_THREAD_ENVIRONMENT = BLAS_THREAD_VARIABLES + ("BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
-
-
-@contextmanager
-def one_blas_thread():
-    """One thread in every BLAS and OpenMP pool for a command's whole life, unless the environment sets a count: the
-    kit's least squares are small, and pool threads only slow them (``fit --extended`` of the demo's data beside two
-    jobs on 2 cores: 108 s CPU, 4.6 s).  The pools loaded already are limited (threadpoolctl), and those loaded
-    during the command -- scipy.linalg's own OpenBLAS loads at its first use, after the command started, with a
-    thread per core (issue 37) -- read the thread-count variables, set to 1 until the command ends."""
-    if any(os.environ.get(v) for v in BLAS_THREAD_VARIABLES):
-        yield
-        return
-    from threadpoolctl import ThreadpoolController, threadpool_limits
-
-    loaded = {lib.filepath for lib in ThreadpoolController().lib_controllers}
-    saved = {v: os.environ.get(v) for v in ONE_THREAD_ENVIRONMENT}
-    os.environ.update({v: "1" for v in ONE_THREAD_ENVIRONMENT})
-    try:
-        with threadpool_limits(limits=1):
-            yield
-    finally:
-        for v, value in saved.items():
-            if value is None:
-                os.environ.pop(v, None)
-            else:
-                os.environ[v] = value
-        # a pool loaded during the command (one thread) gets the count it would have started with (one per core)
-        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-        for lib in ThreadpoolController().lib_controllers:
-            if lib.filepath not in loaded and lib.num_threads == 1:
-                lib.set_num_threads(cores)
 
 
 @contextmanager

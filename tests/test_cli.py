@@ -190,12 +190,12 @@ def test_commands_run_with_one_blas_thread_unless_the_environment_says(monkeypat
 
     from threadpoolctl import threadpool_info
 
-    from rwadist import cli
+    from rwadist import cli, threads
 
     def blas_threads():
         return [i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"]
 
-    for name in cli.BLAS_THREAD_VARIABLES:
+    for name in threads.BLAS_THREAD_VARIABLES:
         monkeypatch.delenv(name, raising=False)
     with cli.one_blas_thread():
         inside = blas_threads()
@@ -226,21 +226,21 @@ def test_a_pool_loaded_during_a_command_runs_one_thread_too():
     import subprocess
     import sys
 
-    from rwadist import cli
+    from rwadist import threads
 
     code = """
 import json
 from threadpoolctl import threadpool_info
-from rwadist import cli
+from rwadist import threads
 def pools():
     return sorted((i["filepath"], i["num_threads"]) for i in threadpool_info())
-with cli.one_blas_thread():
+with threads.one_blas_thread():
     import scipy.linalg
     scipy.linalg.lu_factor([[2.0, 1.0], [1.0, 3.0]])
     inside = pools()
 print(json.dumps({"inside": inside, "after": pools()}))
 """
-    env = {k: v for k, v in os.environ.items() if k not in cli.ONE_THREAD_ENVIRONMENT}
+    env = {k: v for k, v in os.environ.items() if k not in threads.ONE_THREAD_ENVIRONMENT}
     out = json.loads(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
                                     check=True).stdout)
     assert len(out["inside"]) >= 2                                  # numpy's OpenBLAS and scipy's
