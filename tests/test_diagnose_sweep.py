@@ -114,6 +114,8 @@ def test_spin_acceleration_on_the_default_command_is_the_ramp(tmp_path, case):
     effects = json.loads((tmp_path / "r" / "summary.json").read_text())["effects"]
     spin = [e for e in effects if e["kind"] == "spin_acceleration"]
     assert len(spin) == 1, [e["kind"] for e in effects]
-    ramp = abs(end - start) * RPM / duration
+    ramp = (end - start) * RPM / duration          # dΩ/dt: negative on the run-down (printed unsigned before)
     assert spin[0]["alpha_rad_s2"] == pytest.approx(ramp, rel=0.01)
     assert spin[0]["alpha_residual_rad_s2"] == pytest.approx(ramp, rel=0.25)
+    console = (tmp_path / "r" / "report.md").read_text()
+    assert ("(a run-down)" in console) == (ramp < 0)

@@ -12,9 +12,9 @@ from .element import Element, num
 @register
 @dataclass(frozen=True, eq=False, kw_only=True)
 class SpinAcceleration(Element):
-    """The runs were recorded while the wheel accelerated at alpha_rad_s2 (rad/s², from the runs' speeds against their
-    start times); alpha_residual_rad_s2 is the acceleration that best explains the residual alone, the check.
-    Measurement only."""
+    """The runs were recorded while the wheel accelerated at alpha_rad_s2 (rad/s², dΩ/dt from the runs' speeds against
+    their start times: negative on a run-down); alpha_residual_rad_s2 is the acceleration that best explains the
+    residual alone, the check.  Measurement only."""
 
     KIND: ClassVar[str] = "spin_acceleration"
     ORDER: ClassVar[int] = 90
@@ -27,4 +27,5 @@ class SpinAcceleration(Element):
     def describe(cls, e: Mapping) -> str:
         residual = e.get("alpha_residual_rad_s2")
         check = "" if residual is None else f" (the speeds' track; the residual alone {num(residual, '.3g')})"
-        return f"α {num(e['alpha_rad_s2'], '.3g')} rad/s²{check}"
+        way = " (a run-down)" if e["alpha_rad_s2"] < 0 else ""
+        return f"α {num(e['alpha_rad_s2'], '.3g')} rad/s²{way}{check}"

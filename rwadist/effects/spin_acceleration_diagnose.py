@@ -16,10 +16,11 @@ from ..units import CHANNELS
 class SpinAcceleration:
     """Lines smeared by the wheel's acceleration during each run of a sweep (a measurement artefact of
     slicing a spin-up or run-down into quasi-steady runs): the line of harmonic h sweeps h|α|T/2π Hz
-    during a run of length T.  ``alpha`` (rad/s², |dΩ/dt|) is the smear predicted: the speed track ``alpha_track``
-    (the runs' speeds against their start times, NaN for steady runs), a direct measurement; ``alpha_residual`` is
-    the acceleration that best explains the residual alone (:meth:`fit`), the check that the smear is what the
-    residual holds."""
+    during a run of length T.  ``alpha`` (rad/s², dΩ/dt: negative on a run-down) is the acceleration whose smear is
+    predicted: the speed track ``alpha_track`` (the runs' speeds against their start times, NaN for steady runs), a
+    direct measurement; ``alpha_residual`` is the acceleration that best explains the residual alone (:meth:`fit`;
+    its size, given the track's sign), the check that the smear is what the residual holds.  The smear depends on
+    |α| only (a line higher in frequency is faster both ways, :mod:`rwadist.diagnose.smear`)."""
 
     alpha: float
     alpha_track: float = float("nan")
@@ -38,7 +39,7 @@ class SpinAcceleration:
         return s
 
     def contribute(self, parts) -> None:
-        parts.smear = self.alpha
+        parts.smear = abs(self.alpha)
 
     def refit(self, ctx: Context, state: State) -> "SpinAcceleration":
         """Refitted on every run (``ctx.runs``); itself when that fit fails."""
@@ -53,8 +54,8 @@ class SpinAcceleration:
 
     @staticmethod
     def track(ctx: Context, runs) -> float:
-        """Median |dΩ/dt| (rad/s²) from the runs' speeds against their start times (runs of one sweep,
-        ``Run.t0`` distinct), or NaN."""
+        """Median dΩ/dt (rad/s², negative on a run-down) from the runs' speeds against their start times (runs of
+        one sweep, ``Run.t0`` distinct), or NaN."""
         if ctx.test is None or len(runs) < 3:
             return float("nan")
         t0 = np.array([ctx.test.runs[r].t0 for r in runs], dtype=float)
@@ -63,7 +64,7 @@ class SpinAcceleration:
         dt = np.diff(t0[order])
         if not np.all(np.isfinite(t0)) or np.any(dt <= 0):
             return float("nan")
-        return float(np.median(np.abs(np.diff(w[order]) / dt)))
+        return float(np.median(np.diff(w[order]) / dt))
 
     @staticmethod
     def fit(ctx: Context, state: State, runs) -> "SpinAcceleration | None":
@@ -80,9 +81,10 @@ class SpinAcceleration:
 
         if state.smear is not None or len(runs) < 3:
             return None
-        track = SpinAcceleration.track(ctx, np.asarray(runs))
-        if not np.isfinite(track):      # not slices of one sweep (steady runs, or no time series given)
+        signed = SpinAcceleration.track(ctx, np.asarray(runs))
+        if not np.isfinite(signed):     # not slices of one sweep (steady runs, or no time series given)
             return None
+        track, sign = abs(signed), (-1.0 if signed < 0 else 1.0)
         T = float(np.median(ctx.run_durations(runs)))
         h_max = max((h for c in ctx.channels for h, *_ in ctx.channel_lines(state, c, runs)), default=0.0)
         if h_max <= 0 or T <= 0 or track <= 0:
@@ -100,7 +102,7 @@ class SpinAcceleration:
         res = optimize.minimize_scalar(cost, bounds=(0.0, a_max), method="bounded",
                                        options={"xatol": 1e-3 * a_max})
         trial = state.plus(SpinAcceleration(track))
-        return SpinAcceleration(track, track, noise_estimate(ctx, trial), float(res.x))
+        return SpinAcceleration(signed, signed, noise_estimate(ctx, trial), sign * float(res.x))
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
