@@ -55,3 +55,22 @@ def test_block_floor_of_a_spectrum_shorter_than_a_block():
     assert floor.shape == psd.shape
     assert np.allclose(floor, floor[:, :1])
     assert np.all(np.isfinite(floor))
+
+
+@pytest.mark.parametrize("samples, advice", [
+    (50, "record at least 62 samples a run (the fewest a spectrum can use) or drop the run"),
+    (100, "pass --nperseg between 62 and 100, or drop the run"),
+])
+def test_a_run_shorter_than_the_segment_gets_advice_it_can_follow(tmp_path, capsys, samples, advice):
+    """A run shorter than the FFT segment was told to "pass a smaller nperseg" even when it held fewer samples than the
+    smallest nperseg allowed (62), which that advice then refused (new-user trial 27)."""
+    data = tmp_path / "w"
+    assert main(["simulate-test", str(data), "--preset", "ithaco-e", "--speeds-rpm", "600:3000", "--n-speeds", "4",
+                 "--samples", "1024", "--seed", "1"]) == 0
+    run = sorted(data.glob("run_*.csv"))[1]
+    lines = run.read_text().splitlines(keepends=True)
+    run.write_text("".join(lines[:1 + samples]))
+    code = main(["fit", str(data), "-o", str(tmp_path / "m.json"), "--no-report", "--nperseg", "128"])
+    err = capsys.readouterr().err
+    assert code == 2 and run.name in err and f"{samples} samples" in err, err
+    assert advice in err, err
