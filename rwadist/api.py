@@ -380,6 +380,13 @@ def _empty_model_advice(test: SteadyTest, settings, presence: float) -> str:
     if spinning < settings.min_points:
         return (f"the model is empty: a harmonic needs {settings.min_points} measurements and the test has "
                 f"{spinning} spinning run(s); give at least {settings.min_points} runs over the speed range")
+    from .speed_check import misread_unit
+
+    unit = misread_unit(test)
+    if unit is not None:
+        return (f"the model is empty: the speeds look like {unit['unit']}, not rpm: the imbalance's radial-force line "
+                f"sits at the column's value read in {unit['unit']} in {unit['runs']} of {unit['spinning']} spinning "
+                f"runs; give the speeds in rpm (multiply them by {unit['factor']:.6g})")
     return (f"no harmonic passed the presence threshold ({presence:g} of the runs): the model is empty; check that "
             "the lines lie in the band read (`f_lim`) and that the speeds are in rpm, give more runs over the speed "
             "range, or lower `presence`")

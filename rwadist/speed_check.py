@@ -389,3 +389,37 @@ def checked(test, reads: LineReads | None = None) -> tuple:
         return test, rec
     return type(test)([replace(r, speed=r.speed * each.get(i, scale)) for i, r in enumerate(test.runs)],
                       dict(test.meta or {})), rec
+
+
+#: units a speed column labelled rpm is mistaken for, and what multiplies their values into rpm
+MISREAD_UNITS = (("rev/s (Hz)", 60.0), ("rad/s", 60.0 / (2 * np.pi)))
+#: a misread unit is named when the imbalance's line sits this close to the unit's speed (relative: the thesis's B
+#: wheel's first radial line is at h 0.99; the units' factors are 6.3 times apart)
+UNIT_MATCH = 0.02
+
+
+def misread_unit(test) -> dict | None:
+    """The unit a speed column given as rpm was written in, when the imbalance's radial-force 1× line says so: the
+    Fx/Fy pair's strongest line stands :data:`PAIR_SNR` over its noise within :data:`UNIT_MATCH` of the column's value
+    read in that unit (×60 for rev/s, ×60/2π for rad/s, :data:`MISREAD_UNITS`) in at least :data:`MIN_RUNS` and half
+    of the spinning runs, and in fewer runs at the column's value read in rpm.  A dict (``unit``, ``factor`` to rpm,
+    ``runs`` found, ``spinning``), or None (the column reads as rpm, or nothing tells).  Read only when a fit comes
+    out empty: a column in rev/s puts the wheel's lines at 60 times their harmonic numbers, beyond the fit's band."""
+    spinning = [r for r in test.runs if np.isfinite(r.speed) and r.speed != 0]
+    if len(spinning) < MIN_RUNS or not all(r.usable(c) for r in spinning for c in ("Fx", "Fy")):
+        return None
+
+    def found(factor: float) -> int:
+        hits = 0
+        for run in spinning:
+            f0 = factor * abs(run.speed) / (2 * np.pi)
+            f_line, snr, _ = run_line(run, ("Fx", "Fy"), f0)
+            hits += bool(np.isfinite(f_line) and snr >= PAIR_SNR and abs(f_line / f0 - 1.0) < UNIT_MATCH)
+        return hits
+
+    as_rpm = found(1.0)
+    for unit, factor in MISREAD_UNITS:
+        hits = found(factor)
+        if hits >= max(MIN_RUNS, 0.5 * len(spinning)) and hits > as_rpm:
+            return {"unit": unit, "factor": factor, "runs": hits, "spinning": len(spinning)}
+    return None

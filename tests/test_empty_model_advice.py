@@ -20,3 +20,27 @@ def test_a_band_below_every_line_is_told_to_check_the_band_and_the_speeds():
     with pytest.warns(rwadist.RwadistWarning, match=r"lines lie in the band read \(`f_lim`\).*speeds are in rpm"):
         fit = rwadist.fit(test, f_lim=3.0)
     assert not any(fit.model.empirical.values())
+
+
+@pytest.mark.parametrize("wheel, factor", [
+    ("ithaco-e", 60.0),                 # runs.csv speed_rpm written in rev/s: every line at 60 x its h
+    ("ithaco-b", 60.0),
+])
+def test_speeds_given_in_rev_per_second_are_named_with_the_factor(wheel, factor):
+    """A new user's speed column in Hz (rev/s) gave "the model is empty ... check that the speeds are in rpm" beside
+    other causes; the imbalance's radial-force line says which: it sits at the column's value read in rev/s."""
+    from dataclasses import replace
+
+    test = rwadist.simulate_test(wheel, speeds_rpm=np.linspace(600, 2400, 8), n_samples=4096, seed=1)
+    in_hz = type(test)([replace(r, speed=r.speed / factor) for r in test.runs], test.meta)
+    with pytest.warns(rwadist.RwadistWarning, match=r"the speeds look like rev/s \(Hz\), not rpm") as rec:
+        fit = rwadist.fit(in_hz)
+    assert not any(fit.model.empirical.values())
+    text = next(str(w.message) for w in rec if "rev/s" in str(w.message))
+    assert "multiply them by 60" in text
+    runs = int(text.split(" of 8 spinning")[0].rsplit(" ", 1)[1])
+    assert runs >= 4, text
+    # the same data in rpm: not named (a fit that is empty for another reason keeps the general words)
+    with pytest.warns(rwadist.RwadistWarning, match=r"lines lie in the band read") as rec:
+        rwadist.fit(test, f_lim=3.0)
+    assert not any("rev/s" in str(w.message) for w in rec)
