@@ -9,6 +9,7 @@ import zipfile
 
 import numpy as np
 import pytest
+from cli_run import run
 
 import rwadist
 from rwadist import catalogue, psd_files
@@ -19,11 +20,6 @@ HR16 = "honeywell-hr16-75"
 SPEEDS = "600:2400"
 N_SPEEDS = 8
 
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 @pytest.fixture(scope="module")

@@ -5,16 +5,11 @@ import json
 
 import numpy as np
 import pytest
+from cli_run import run
 
-from rwadist.cli import main, parse_speeds
+from rwadist.cli import parse_speeds
 from rwadist.data import DataError, read_steady, read_sweep
 from rwadist.presets import preset
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def test_parse_speeds():

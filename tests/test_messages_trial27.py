@@ -10,15 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from cli_run import run
 
 import rwadist
 from rwadist.cli import main
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 @pytest.fixture(scope="module")

@@ -9,16 +9,10 @@ import textwrap
 import time
 
 import pytest
+from cli_run import run
 
-from rwadist.cli import main
 from rwadist.data import DataError
 from rwadist.outputs import MANIFEST, atomic_dir, atomic_file, refuse_input_overwrite
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def own(path, text: str) -> None:

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_run import run
 
 import rwadist
 from rwadist.cli import main
@@ -18,11 +19,6 @@ SIM = ["simulate-test", "--preset", "ithaco-e", "--samples", "1024", "--speeds-r
        "--no-modes"]
 PSD = ["psd", "--empirical", "--speed-rpm", "600:2400", "--n-freq", "201", "--n-speeds", "20"]
 
-
-def run(capsys, *argv) -> tuple:
-    code = main([str(a) for a in argv])
-    out = capsys.readouterr()
-    return code, out.err
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +58,7 @@ def test_convert_onto_a_foreign_file_is_refused_untouched(sweep, tmp_path, capsy
     lab = tmp_path / ("lab" + suffix)
     shutil.copy(sweep if suffix == ".csv" else h5, lab)
     before = lab.read_bytes()
-    code, err = run(capsys, "convert", h5 if suffix == ".csv" else sweep, "-o", lab)
+    code, _, err = run(capsys, "convert", h5 if suffix == ".csv" else sweep, "-o", lab)
     _refused(code, err, lab)
     assert lab.read_bytes() == before
     assert not lab.with_suffix(".meta.json").exists()
@@ -73,9 +69,9 @@ def test_fit_onto_another_datasets_files_is_refused_untouched(dataset, tmp_path,
     other = tmp_path / "other"
     shutil.copytree(dataset, other)
     before = {p.name: p.read_bytes() for p in other.iterdir()}
-    code, err = run(capsys, "fit", dataset, "-o", other / "run_0002.csv", "--no-report")
+    code, _, err = run(capsys, "fit", dataset, "-o", other / "run_0002.csv", "--no-report")
     assert code == 2 and str(other / "run_0002.csv") in err and "JSON document" in err
-    code, err = run(capsys, "fit", dataset, "-o", other / "meta.json", "--no-report")
+    code, _, err = run(capsys, "fit", dataset, "-o", other / "meta.json", "--no-report")
     _refused(code, err, other / "meta.json")
     assert {p.name: p.read_bytes() for p in other.iterdir()} == before
 
@@ -86,7 +82,7 @@ def test_psd_onto_a_datasets_runs_csv_is_refused_untouched(dataset, tmp_path, ca
     model = tmp_path / "m.json"
     assert run(capsys, "fit", dataset, "-o", model, "--no-report")[0] == 0
     before = {p.name: p.read_bytes() for p in other.iterdir()}
-    code, err = run(capsys, *PSD, model, "-o", other / "runs.csv")
+    code, _, err = run(capsys, *PSD, model, "-o", other / "runs.csv")
     _refused(code, err, other / "runs.csv")
     assert {p.name: p.read_bytes() for p in other.iterdir()} == before
 
@@ -94,7 +90,7 @@ def test_psd_onto_a_datasets_runs_csv_is_refused_untouched(dataset, tmp_path, ca
 def test_a_psd_companion_rwadist_did_not_write_is_refused(tmp_path, capsys):
     """The plot beside the table (`p.png`) is an output too: a user's own p.png is not replaced."""
     (tmp_path / "p.png").write_bytes(b"my figure")
-    code, err = run(capsys, *PSD, "--preset", "ithaco-e", "-o", tmp_path / "p.csv")
+    code, _, err = run(capsys, *PSD, "--preset", "ithaco-e", "-o", tmp_path / "p.csv")
     _refused(code, err, tmp_path / "p.png")
     assert (tmp_path / "p.png").read_bytes() == b"my figure" and not (tmp_path / "p.csv").exists()
 
@@ -111,7 +107,7 @@ def test_rerunning_a_command_replaces_what_it_wrote(dataset, tmp_path, capsys):
     # a file rwadist wrote and someone changed since is no longer its own
     with open(tmp_path / "p.csv", "a") as f:
         f.write("# my note\n")
-    code, err = run(capsys, *psd)
+    code, _, err = run(capsys, *psd)
     _refused(code, err, tmp_path / "p.csv")
     assert (tmp_path / "p.csv").read_text().endswith("# my note\n")
 
@@ -137,7 +133,7 @@ def test_save_model_onto_a_folder_or_a_foreign_file_is_a_data_error(tmp_path):
 @pytest.mark.parametrize("name", ["new_run.csv", "model.h5"])
 def test_a_model_path_with_a_data_formats_extension_is_refused(dataset, tmp_path, capsys, name):
     """A model file is a JSON document (docs/formats.md section 4): `fit -o x.csv` is a slip onto a measurement."""
-    code, err = run(capsys, "fit", dataset, "-o", tmp_path / name, "--no-report")
+    code, _, err = run(capsys, "fit", dataset, "-o", tmp_path / name, "--no-report")
     assert code == 2 and "a model file is a JSON document" in err and name in err
     assert list(tmp_path.iterdir()) == []
     from rwadist.presets import preset
