@@ -341,7 +341,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
         speed from the data whose 1x line tied with another (the scale unsure: ``rwadist diagnose`` tests it); no
         harmonic passed the presence threshold (the model is empty).
     """
-    from . import data_quality, speed_whirl
+    from . import channel_distortion, data_quality, speed_whirl
     from .empirical import FitSettings, fit_empirical
     from .spectra import compute_spectra
 
@@ -356,13 +356,16 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     if frozen:
         warnings.warn(RwadistWarning("; ".join(data_quality.quality_lines([s.to_json() for s in frozen]))),
                       stacklevel=2)
+    test, distorted = channel_distortion.corrected(test)     # a radial channel's distortion undone (as diagnose)
+    for rec in distorted:
+        warnings.warn(RwadistWarning(channel_distortion.summary_line(rec)), stacklevel=2)
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
     result = fit_empirical(spectra, settings, name=name, progress=progress)
     refuse_non_finite_model(result.model, "fit")
     result.model.provenance.update(reading_provenance(getattr(test, "meta", None)))
-    if frozen:
-        result.model.provenance["data_quality"] = [s.to_json() for s in frozen]
+    if frozen or distorted:
+        result.model.provenance["data_quality"] = [s.to_json() for s in frozen] + distorted
     result.model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))
     if text := speed_scale_warning(result, test.meta):
         warnings.warn(RwadistWarning(text.removeprefix("WARNING: ")), stacklevel=2)
@@ -561,7 +564,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     DataError
         Runs at fewer than 2 distinct speeds (:func:`rwadist.validate.check_test_speeds`).
     """
-    from . import data_quality, speed_whirl
+    from . import channel_distortion, data_quality, speed_whirl
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
@@ -579,6 +582,11 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     test, frozen = data_quality.screen(test)
     if frozen:
         warnings.warn(RwadistWarning(data_quality.summary_line([s.to_json() for s in frozen])), stacklevel=2)
+    # a radial channel whose signal chain distorts (lines of its own at sums and differences of its lines, which its
+    # partner lacks) is put right before the search (docs/diagnose.md, "Data quality")
+    test, distorted = channel_distortion.corrected(test)
+    for rec in distorted:
+        warnings.warn(RwadistWarning(channel_distortion.summary_line(rec)), stacklevel=2)
     # too few speeds to fit and judge on: refused (one), or warned of (fewer than the data's own fit needs)
     check_test_speeds(test, source or (data if isinstance(data, (str, Path)) else "the test"),
                       model_given=model is not None or preset is not None)
@@ -594,9 +602,11 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     # supports); how the speed was obtained goes to the summary and the report
     test, diagnosis = speed_whirl.settle(test, run)
     diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None), checked)
-    diagnosis.data_quality = [s.to_json() for s in frozen] + ([polarity] if polarity is not None else [])
-    if polarity is not None:        # the model was fitted to the data with that channel's sign put right
-        diagnosis.model.provenance = dict(diagnosis.model.provenance, data_quality=[polarity])
+    diagnosis.data_quality = ([s.to_json() for s in frozen] + distorted
+                              + ([polarity] if polarity is not None else []))
+    if polarity is not None or distorted:     # the model was fitted to the data with those channels put right
+        diagnosis.model.provenance = dict(diagnosis.model.provenance,
+                                          data_quality=distorted + ([polarity] if polarity is not None else []))
     reading = reading_provenance(getattr(test, "meta", None))
     if reading:
         diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(

@@ -262,11 +262,13 @@ def quality_lines(records) -> list:
     """Console / report lines of the records (JSON dicts of :meth:`FrozenStretch.to_json`): one per stretch and a
     closing line that says what was done and what to do next; a ``reversed_polarity`` or ``reversed_spin``
     record (:mod:`rwadist.channel_polarity`) first, in its own lines."""
+    from .channel_distortion import distortion_lines
     from .channel_polarity import polarity_lines
 
     sign_errors = ("reversed_polarity", "reversed_spin")
     lines = [x for r in records if r.get("type") in sign_errors for x in polarity_lines(r)]
-    records = [r for r in records if r.get("type") not in sign_errors]
+    lines += [x for r in records if r.get("type") == "distorted" for x in distortion_lines(r)]
+    records = [r for r in records if r.get("type") not in sign_errors + ("distorted",)]
     if not records:
         return lines
     for r in records:

@@ -103,7 +103,10 @@ def compute_spectra(test: SteadyTest, nperseg: int | None = None, overlap: float
                         f"{r.n_samples} samples, shorter than one FFT segment ({nperseg}); {advice}")
     if f_lim is not None and not (0 < f_lim <= fs / 2):
         raise DataError("<spectra>", "f_lim", f"{f_lim!r} Hz is outside (0, Nyquist={fs / 2:g}]")
-    channels = tuple(channels) if channels is not None else test.channels
+    # a channel left out of every run (Run.invalid in each: a dropout, a distorted signal chain) is as one the test
+    # lacks: its rows would be NaN in every run, which no step reads
+    channels = (tuple(channels) if channels is not None else
+                tuple(ch for ch in test.channels if any(r.usable(ch) for r in test.runs)))
     noverlap = int(round(overlap * nperseg))
     win = signal.get_window(window, nperseg)
     # density -> "spectrum" (power of a sinusoid) scaling, as scipy defines both.

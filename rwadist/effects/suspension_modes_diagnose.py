@@ -56,7 +56,7 @@ def _fit_spectra(ctx: Context, test, runs: list):
         return compute_spectra(test, nperseg=nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim), None
     full, det = ctx._memo[key]
     rows = np.asarray(runs, dtype=int)
-    chans = test.channels
+    chans = [c for c in test.channels if c in full.psd]      # a channel left out of every run is not read
     # consecutive runs (every run with a speed): views, not copies
     sel = slice(rows[0], rows[-1] + 1) if rows.size and np.all(np.diff(rows) == 1) else rows
     sp = replace(full, speed=full.speed[sel], psd={c: full.psd[c][sel] for c in chans},
