@@ -113,3 +113,23 @@ def test_fit_puts_the_channel_right_too(wheels):
     with pytest.warns(rwadist.RwadistWarning, match="Fy's signal chain is not linear"):
         fit = rwadist.fit(test)
     assert [r["channel"] for r in fit.model.provenance["data_quality"]] == ["Fy"]
+
+
+def test_a_channel_left_out_of_every_run_is_as_one_the_test_lacks():
+    """A channel invalid in every run (it froze throughout, ``Run.invalid``) kept NaN rows in the spectra, which the
+    search read: "Mean of empty slice" on 8 runs, an internal error (SVD did not converge) on 12 runs of 4096 samples.
+    It is now left out of the spectra, as a channel the test lacks."""
+    import warnings
+
+    from rwadist.spectra import compute_spectra
+
+    test = rwadist.simulate_test("ithaco-e", speeds_rpm=np.linspace(600, 2400, 8), n_samples=2048, seed=1)
+    runs = [dataclasses.replace(r, signals=dict(r.signals, Fx=np.zeros_like(r.signals["Fx"]))) for r in test.runs]
+    test = type(test)(runs, test.meta)
+    assert "Fx" not in compute_spectra(type(test)([dataclasses.replace(r, invalid=frozenset({"Fx"})) for r in runs],
+                                                  test.meta)).psd
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        diagnosis = rwadist.diagnose(test)
+    assert not [w for w in caught if issubclass(w.category, RuntimeWarning)], [str(w.message) for w in caught]
+    assert [r["channel"] for r in diagnosis.data_quality] == ["Fx"] * len(runs)
