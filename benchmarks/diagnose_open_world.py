@@ -25,6 +25,10 @@ inverter_sidebands   sideband_line     a carrier at 0.17 x the sample rate on ev
 speed_gain           line_property     every channel's gain 1 - 0.08 Omega/Omega_max before the sensor noise (a
                                        load cell warming with speed: trial16 tempgain); right when a gain_trend
                                        record reads the gain's change over the speed range within 25 %
+amplifier_distortion distorted         one radial channel through y = x + a2 x^2/s + a3 x^3/s^2 (s its RMS), by
+                                       wheel Fx 2 %/2 %, Ty 3 % odd, Fy 2 % even, Tx 0.5 %/0.5 %; right when
+                                       data_quality holds a ``distorted`` record of that channel, its orders
+                                       within 15 % (rwadist.channel_distortion: put right before the search)
 ==================== ================= =========================================================================
 
 A cell passes when a record of the right signature is where the injection is (:func:`right`) and no class beyond
@@ -206,8 +210,29 @@ class SpeedGain:
         return {"kind": "speed_gain", "k": self.k, "omega_max_rad_s": self.omega_max}
 
 
+class AmplifierDistortion:
+    """One radial channel through a signal chain that is not linear, y = x + a2·x²/σ + a3·x³/σ² (σ the run's RMS of
+    the channel, noise included: the amplifier sees the sensor's output); the channel and the orders by wheel."""
+
+    signature = "distorted"         # a data_quality record (rwadist.channel_distortion), not a description
+    CASES = (("Fx", 0.02, 0.02), ("Ty", 0.0, 0.03), ("Fy", 0.02, 0.0), ("Tx", 0.005, 0.005))
+
+    def __init__(self, index: int):
+        self.channel, self.a2, self.a3 = self.CASES[index % len(self.CASES)]
+
+    def apply(self, data):
+        signals = data.signals.copy()
+        x = signals[:, CH[self.channel], :]
+        s = x.std(axis=1, keepdims=True)
+        signals[:, CH[self.channel], :] = x + self.a2 * x**2 / s + self.a3 * x**3 / s**2
+        return replace(data, signals=signals)
+
+    def truth(self):
+        return {"kind": "amplifier_distortion", "channel": self.channel, "a2": self.a2, "a3": self.a3}
+
+
 KINDS = ("clean", "mains_pickup", "torque_crosstalk", "softening_mode", "torque_hump", "remount_step",
-         "inverter_sidebands", "speed_gain")
+         "inverter_sidebands", "speed_gain", "amplifier_distortion")
 
 
 def make_effect(kind: str, wheel):
@@ -226,6 +251,8 @@ def make_effect(kind: str, wheel):
         return InverterSidebands(0.17 * wheel.sample_rate, float(1 + int(wheel.name.rsplit("-", 1)[-1]) % 4))
     if kind == "speed_gain":
         return SpeedGain(wheel.max_rpm * fw.RPM)
+    if kind == "amplifier_distortion":
+        return AmplifierDistortion(int(wheel.name.rsplit("-", 1)[-1]))
     raise ValueError(kind)
 
 
@@ -253,6 +280,10 @@ def right(kind: str, effect, wheel, speeds_rpm, recs: list) -> bool:
         truth = effect.change_db(min(speeds_rpm) * fw.RPM)
         return any(r["parameters"].get("property") == "gain_trend"
                    and abs(r["parameters"]["change_dB"] / truth - 1) < 0.25 for r in mine)
+    if kind == "amplifier_distortion":       # the channel named, its law read within 15 % (an order absent: ~0)
+        return any(r["channel"] == effect.channel and all(
+            abs(r[key] - a) <= 0.15 * max(a, 0.1 * max(effect.a2, effect.a3)) for key, a in
+            (("second_order", effect.a2), ("third_order", effect.a3))) for r in recs)
     if kind == "remount_step":
         stepped = {round(float(s), 3) for i, s in enumerate(speeds_rpm) if effect.stepped(i)}
         for r in mine:
@@ -281,8 +312,11 @@ def cell(i: int, wheel, kind: str, work: Path, seed: int = 1) -> dict:
     speeds = np.linspace(wheel.min_rpm, wheel.max_rpm, n_speeds)
     effect = None if kind == "clean" else make_effect(kind, wheel)
     # seed 1 is the wheel's own index (the cells as first measured); another seed draws other phases and noise
+    hooked = effect is not None and not hasattr(effect, "apply")
     data = fw.steady(wheel, speeds_rpm=speeds, noise=noise, seed=i + 1000 * (seed - 1),
-                     effects=[effect] if effect else [])
+                     effects=[effect] if hooked else [])
+    if effect is not None and not hooked:
+        data = effect.apply(data)
     d = fw.write_steady(data, work / f"w{i}_{kind}" / "data", wheel.name)
     t0 = time.perf_counter()
     summary, console = run_diagnose(d, work / f"w{i}_{kind}" / "report")
@@ -299,7 +333,9 @@ def cell(i: int, wheel, kind: str, work: Path, seed: int = 1) -> dict:
     if effect is None:
         row["ok"] = not recs and not added
     else:
-        row["right"] = right(kind, effect, wheel, speeds, recs)
+        found = ([r for r in summary.get("data_quality", []) if r.get("type") == effect.signature]
+                 if effect.signature == "distorted" else recs)
+        row["right"] = right(kind, effect, wheel, speeds, found)
         row["ok"] = row["right"] and not added
         row["truth"] = effect.truth()
     return row
