@@ -305,7 +305,11 @@ def _runs_off(test, ratios: dict, judged: list, about: float, spread: float) -> 
     tol = max(SCALE_FLOOR, SIGMAS * spread)
     for i, run in enumerate(test.runs):
         r = np.array([ratios[key][i] for key in judged if np.isfinite(ratios[key][i])]) / about
-        if r.size < 2 or abs(float(np.median(r)) - 1.0) <= tol or np.ptp(r) > max(AGREE, SIGMAS * spread):
+        # a run's own 1x lines are read no closer than RUN_BIN_FLOOR of its bin (neighbouring lines' leakage, noise)
+        resolution = RUN_BIN_FLOOR * float(run.sample_rate) / run.n_samples / max(about * abs(run.speed) / (2 * np.pi),
+                                                                                  1e-300)
+        if (r.size < 2 or abs(float(np.median(r)) - 1.0) <= max(tol, resolution)
+                or np.ptp(r) > max(AGREE, SIGMAS * spread, 2 * resolution)):
             continue
         k = float(np.median(r))
         given = float(abs(run.speed)) * 30 / np.pi
@@ -320,6 +324,12 @@ def _runs_off(test, ratios: dict, judged: list, about: float, spread: float) -> 
                        for key in read)
         (doubtful if at_given else out).append(entry)
     return out, doubtful
+
+
+#: a run's own 1× lines are read off its given speed only beyond this share of its native bin (over the 1×
+#: frequency): clean family wheel 2's lowest run (300 rpm, 5 Hz, bins of 0.244 Hz) read its three 1× lines together at
+#: +0.0032-0.0040 Hz (0.013-0.016 bins), and was called a tach glitch at 1.00079
+RUN_BIN_FLOOR = 0.03
 
 
 #: a line at a run's given 1× frequency, beside the one read, counts within this power ratio of it (a Hann window's
