@@ -258,6 +258,10 @@ def make_effect(kind: str, wheel):
 
 def right(kind: str, effect, wheel, speeds_rpm, recs: list) -> bool:
     """Whether a record of the effect's signature is where the injection is."""
+    if kind == "amplifier_distortion":       # the channel named, its law read within 15 % (an order absent: ~0)
+        return any(r["channel"] == effect.channel and all(
+            abs(r[key] - a) <= 0.15 * max(a, 0.1 * max(effect.a2, effect.a3)) for key, a in
+            (("second_order", effect.a2), ("third_order", effect.a3))) for r in recs)
     mine = [r for r in recs if r["signature"] == effect.signature]
     if kind == "mains_pickup":
         band = [f for f in effect.freqs_hz if f < fw.ANTI_ALIAS * wheel.sample_rate]
@@ -280,10 +284,6 @@ def right(kind: str, effect, wheel, speeds_rpm, recs: list) -> bool:
         truth = effect.change_db(min(speeds_rpm) * fw.RPM)
         return any(r["parameters"].get("property") == "gain_trend"
                    and abs(r["parameters"]["change_dB"] / truth - 1) < 0.25 for r in mine)
-    if kind == "amplifier_distortion":       # the channel named, its law read within 15 % (an order absent: ~0)
-        return any(r["channel"] == effect.channel and all(
-            abs(r[key] - a) <= 0.15 * max(a, 0.1 * max(effect.a2, effect.a3)) for key, a in
-            (("second_order", effect.a2), ("third_order", effect.a3))) for r in recs)
     if kind == "remount_step":
         stepped = {round(float(s), 3) for i, s in enumerate(speeds_rpm) if effect.stepped(i)}
         for r in mine:
