@@ -358,7 +358,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
                       stacklevel=2)
     test, distorted = channel_distortion.corrected(test)     # a radial channel's distortion undone (as diagnose)
     for rec in distorted:
-        warnings.warn(RwadistWarning(channel_distortion.summary_line(rec)), stacklevel=2)
+        warnings.warn(RwadistWarning(channel_distortion.summary_line(rec, "the fit")), stacklevel=2)
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
     result = fit_empirical(spectra, settings, name=name, progress=progress)
@@ -586,7 +586,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     # partner lacks) is put right before the search (docs/diagnose.md, "Data quality")
     test, distorted = channel_distortion.corrected(test)
     for rec in distorted:
-        warnings.warn(RwadistWarning(channel_distortion.summary_line(rec)), stacklevel=2)
+        warnings.warn(RwadistWarning(channel_distortion.summary_line(rec, "the diagnosis")), stacklevel=2)
     # too few speeds to fit and judge on: refused (one), or warned of (fewer than the data's own fit needs)
     check_test_speeds(test, source or (data if isinstance(data, (str, Path)) else "the test"),
                       model_given=model is not None or preset is not None)

@@ -272,8 +272,8 @@ def distortion_lines(rec: dict) -> list:
             "(the lines move with the amplifier)"]
 
 
-def summary_line(rec: dict) -> str:
-    """One line for a warning: the channel distorted, and what was done."""
+def summary_line(rec: dict, step: str) -> str:
+    """One line for a warning: the channel distorted, and what was done before ``step`` ("the fit", "the diagnosis")."""
     return (f"{rec['channel']}'s signal chain is not linear: {rec['lines_at_products']} lines {rec['channel']} holds "
             f"and {rec['partner']} does not sit at sums and differences of its own lines; {rec['channel']} was corrected "
-            f"in {rec['runs_corrected']} run(s) before the diagnosis (data_quality)")
+            f"in {rec['runs_corrected']} run(s) before {step} (data_quality)")
