@@ -16,7 +16,6 @@ from scipy import ndimage, signal, stats
 
 from .data import DataError, SteadyTest
 from .units import CHANNELS
-from .validate import LIMITS
 
 
 @dataclass
@@ -95,6 +94,8 @@ def compute_spectra(test: SteadyTest, nperseg: int | None = None, overlap: float
     short = np.nonzero(lengths < nperseg)[0]
     if short.size:
         r = test.runs[short[0]]
+        from .validate import LIMITS        # here: validate reads the empirical fit's modules, which read this one
+
         smallest = int(LIMITS["nperseg"]["lo"])
         advice = (f"record at least {smallest} samples a run (the fewest a spectrum can use) or drop the run"
                   if r.n_samples < smallest else
