@@ -31,6 +31,7 @@ from .validate import (
     MAX_SAMPLES,
     check_f_lim,
     check_parameter,
+    check_run_lengths,
     check_speeds_rpm,
     check_test_speeds,
     refuse_non_finite_model,
@@ -343,7 +344,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     """
     from . import channel_distortion, data_quality, speed_whirl
     from .empirical import FitSettings, fit_empirical
-    from .spectra import compute_spectra
+    from .spectra import _default_nperseg, compute_spectra
 
     for parameter, value in (("f_lim", f_lim), ("nperseg", nperseg), ("presence", presence), ("epsilon", epsilon)):
         check_parameter(parameter, value)
@@ -359,6 +360,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     test, distorted = channel_distortion.corrected(test)     # a radial channel's distortion undone (as diagnose)
     for rec in distorted:
         warnings.warn(RwadistWarning(channel_distortion.summary_line(rec, "the fit")), stacklevel=2)
+    check_run_lengths(test, nperseg or _default_nperseg(int(np.median([r.n_samples for r in test.runs]))))
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
     result = fit_empirical(spectra, settings, name=name, progress=progress)
@@ -592,6 +594,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
                       model_given=model is not None or preset is not None)
     check_f_lim(test, f_lim)            # before the search starts, not after it
     test, checked, polarity = _one_x_checks(test)
+    check_run_lengths(test, nperseg or diagnose_nperseg(test))
 
     def run(test, base_check):
         spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))

@@ -94,14 +94,9 @@ def compute_spectra(test: SteadyTest, nperseg: int | None = None, overlap: float
     short = np.nonzero(lengths < nperseg)[0]
     if short.size:
         r = test.runs[short[0]]
-        from .validate import LIMITS        # here: validate reads the empirical fit's modules, which read this one
-
-        smallest = int(LIMITS["nperseg"]["lo"])
-        advice = (f"record at least {smallest} samples a run (the fewest a spectrum can use) or drop the run"
-                  if r.n_samples < smallest else
-                  f"pass `nperseg` between {smallest} and {r.n_samples}, or drop the run")
         raise DataError(r.name or f"run {short[0]}", "samples",
-                        f"{r.n_samples} samples, shorter than one FFT segment ({nperseg}); {advice}")
+                        f"{r.n_samples} samples, shorter than one FFT segment ({nperseg}); drop the run or record longer "
+                        "runs")
     if f_lim is not None and not (0 < f_lim <= fs / 2):
         raise DataError("<spectra>", "f_lim", f"{f_lim!r} Hz is outside (0, Nyquist={fs / 2:g}]")
     # a channel left out of every run (Run.invalid in each: a dropout, a distorted signal chain) is as one the test

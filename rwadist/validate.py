@@ -308,3 +308,18 @@ def speed_scale_warning(fit, meta: dict | None = None) -> str | None:
     return (f"WARNING: the strongest radial-force line is at h = {top.h:.4g} of the speeds given, not at h = 1 (a "
             f"wheel's imbalance, nearly always its strongest radial line), and no line at h = 1 comes near it: "
             f"{hint}.  If this wheel's imbalance is not its strongest line, ignore this")
+
+
+def check_run_lengths(test, nperseg: int) -> None:
+    """DataError naming the first run of ``test`` shorter than one FFT segment of ``nperseg`` samples, with advice it
+    can follow: a run with fewer samples than the smallest ``nperseg`` allowed (:data:`LIMITS`) is told to record
+    longer runs, not to pass a smaller ``nperseg`` (which that range would refuse)."""
+    for i, run in enumerate(test.runs):
+        if run.n_samples >= nperseg:
+            continue
+        smallest = int(LIMITS["nperseg"]["lo"])
+        advice = (f"record at least {smallest} samples a run (the fewest a spectrum can use) or drop the run"
+                  if run.n_samples < smallest else
+                  f"pass `nperseg` between {smallest} and {run.n_samples}, or drop the run")
+        raise DataError(run.name or f"run {i}", "samples",
+                        f"{run.n_samples} samples, shorter than one FFT segment ({nperseg}); {advice}")
