@@ -260,7 +260,7 @@ def right(kind: str, effect, wheel, speeds_rpm, recs: list) -> bool:
     """Whether a record of the effect's signature is where the injection is."""
     if kind == "amplifier_distortion":       # the channel named, its law read within 15 % (an order absent: ~0)
         return any(r["channel"] == effect.channel and all(
-            abs(r[key] - a) <= 0.15 * max(a, 0.1 * max(effect.a2, effect.a3)) for key, a in
+            r[key] is not None and abs(r[key] - a) <= 0.15 * max(a, 0.1 * max(effect.a2, effect.a3)) for key, a in
             (("second_order", effect.a2), ("third_order", effect.a3))) for r in recs)
     mine = [r for r in recs if r["signature"] == effect.signature]
     if kind == "mains_pickup":

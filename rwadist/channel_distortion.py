@@ -65,6 +65,8 @@ MIN_MATCHED = 6
 MIN_RUNS = 3
 MIN_FRACTION = 0.6
 FALSE_ALARM = 1e-9
+#: the largest law undone (b₂σ, b₃σ²), and the largest change of the channel's RMS its inverse may make
+MAX_ORDER = 0.2
 #: matched lines a run needs for its own coefficients
 MIN_RUN_LINES = 3
 #: a model of one order is kept when its residual at the product lines is within this share of both orders'
@@ -173,14 +175,20 @@ def _coefficients(y: np.ndarray, bins: np.ndarray) -> tuple:
 
 def _undo(runs: list, matched: list, alone: np.ndarray, channel: str, partner: str) -> tuple:
     """Put ``channel`` right in place in ``runs`` (a list of runs): each run whose matched lines number
-    :data:`MIN_RUN_LINES` with its own (b₂, b₃), the others with the median of those, relative to the run's RMS (b·σ)
+    :data:`MIN_RUN_LINES` (2 when no run has as many) with its own (b₂, b₃), the others with the median of those, relative to the run's RMS (b·σ)
     or absolute, whichever leaves fewer alone lines; a run keeps its samples unless both its alone lines and its matched
     ones fall.  Returns (indices of the runs put right, {index: (b₂σ, b₃σ²)})."""
     coef: dict = {}
 
     def attempt(i: int, b2: float, b3: float) -> bool:
         y = np.asarray(runs[i].signals[channel], dtype=float)
-        trial = replace(runs[i], signals=dict(runs[i].signals, **{channel: inverse(y, b2, b3)}))
+        sigma_y = float(np.std(y))
+        if not (abs(b2) * sigma_y <= MAX_ORDER and abs(b3) * sigma_y**2 <= MAX_ORDER):
+            return False                # no slight distortion: the inverse's iteration need not converge
+        x = inverse(y, b2, b3)
+        if not (np.all(np.isfinite(x)) and abs(float(np.std(x)) / sigma_y - 1.0) <= MAX_ORDER):
+            return False
+        trial = replace(runs[i], signals=dict(runs[i].signals, **{channel: x}))
         m_after, alone_after, _ = _run_matches(trial, channel, partner)
         if alone_after >= alone[i] or m_after.size >= matched[i].size:
             return False
@@ -190,6 +198,8 @@ def _undo(runs: list, matched: list, alone: np.ndarray, channel: str, partner: s
         return True
 
     own = [i for i, m in enumerate(matched) if m is not None and m.size >= MIN_RUN_LINES]
+    if not own:                     # a weak distortion: runs of two lines each fit their own law
+        own = [i for i, m in enumerate(matched) if m is not None and m.size >= 2]
     fitted = {i: _coefficients(np.asarray(runs[i].signals[channel], dtype=float), matched[i]) for i in own}
     for i in own:
         attempt(i, *fitted[i])
