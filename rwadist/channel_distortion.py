@@ -44,6 +44,7 @@ Units: the coefficients are reported relative to each run's channel RMS σ (b₂
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import replace
 
 import numpy as np
@@ -76,17 +77,31 @@ INVERSE_STEPS = 6
 REFINE = 3
 
 
+@functools.lru_cache(maxsize=8)
+def _window(n: int) -> np.ndarray:
+    """The Hann window of n samples, made once per length (read-only)."""
+    w = np.hanning(n)
+    w.flags.writeable = False
+    return w
+
+
 def _spectrum(x: np.ndarray) -> np.ndarray:
-    return np.fft.rfft((x - x.mean()) * np.hanning(x.size))
+    """The Hann-windowed spectrum of the rows of ``x`` (each less its mean)."""
+    return np.fft.rfft((x - x.mean(axis=-1, keepdims=True)) * _window(x.shape[-1]), axis=-1)
 
 
-def _lines(power: np.ndarray, noise: np.ndarray) -> np.ndarray:
-    """Bins of the local maxima (over ±2 bins) standing LINE_SNR over ``noise``."""
+def _run_power(run, channels: tuple) -> dict:
+    """channel -> (power spectrum, its lines, the spectrum over its noise at most ±2 bins off) of a run's ``channels``,
+    made in one transform: what every pair direction reads.  The lines: the local maxima (over ±2 bins) standing
+    :data:`LINE_SNR` over the local noise (:func:`_local_noise`)."""
     from scipy import ndimage
 
-    peak = (power == ndimage.maximum_filter1d(power, 5)) & (power > LINE_SNR * noise)
-    peak[:PRODUCT_HALF + 1] = False
-    return np.nonzero(peak)[0]
+    P = np.abs(_spectrum(np.stack([np.asarray(run.signals[c], dtype=float) for c in channels]))) ** 2
+    noise = _local_noise(P)
+    level = ndimage.maximum_filter1d(P / noise, 2 * PRODUCT_HALF + 1, axis=1)
+    peak = (P == ndimage.maximum_filter1d(P, 2 * PRODUCT_HALF + 1, axis=1)) & (P > LINE_SNR * noise)
+    peak[:, :PRODUCT_HALF + 1] = False
+    return {c: (P[j], np.nonzero(peak[j])[0], level[j]) for j, c in enumerate(channels)}
 
 
 def _local_noise(P: np.ndarray) -> np.ndarray:
@@ -116,20 +131,17 @@ def _products(top: np.ndarray, n: int) -> np.ndarray:
     return cover
 
 
-def _run_matches(run, channel: str, partner: str) -> tuple:
-    """(matched alone bins, alone lines, chance) of one run's ``channel`` against ``partner``."""
-    from scipy import ndimage
-
-    P = np.abs(np.stack([_spectrum(np.asarray(run.signals[c], dtype=float)) for c in (channel, partner)])) ** 2
-    noise = _local_noise(P)
-    lines = _lines(P[0], noise[0])
-    partner_level = ndimage.maximum_filter1d(P[1] / noise[1], 2 * PRODUCT_HALF + 1)
-    quiet = partner_level[lines] < PARTNER_QUIET
+def _run_matches(run, channel: str, partner: str, power: dict | None = None) -> tuple:
+    """(matched alone bins, alone lines, chance) of one run's ``channel`` against ``partner``; ``power``: the run's
+    :func:`_run_power` holding both, or None (made here)."""
+    power = power or _run_power(run, (channel, partner))
+    P, lines, _ = power[channel]
+    quiet = power[partner][2][lines] < PARTNER_QUIET
     alone, shared = lines[quiet], lines[~quiet]
     if alone.size == 0 or shared.size == 0:
         return alone[:0], int(alone.size), 0.0
-    top = shared[np.argsort(P[0][shared])[::-1][:TOP_LINES]]
-    cover = _products(top, P.shape[1])
+    top = shared[np.argsort(P[shared])[::-1][:TOP_LINES]]
+    cover = _products(top, P.size)
     return alone[cover[alone]], int(alone.size), float(cover.mean())
 
 
@@ -216,17 +228,28 @@ def _undo(runs: list, matched: list, alone: np.ndarray, channel: str, partner: s
     return sorted(coef), coef
 
 
-def _channel_matches(test, channel: str, partner: str) -> tuple:
-    """Per run (matched bins or None where the run lacks the pair), alone lines and chance, of ``channel``."""
+def _channel_matches(test, channel: str, partner: str, powers: list | None = None) -> tuple:
+    """Per run (matched bins or None where the run lacks the pair), alone lines and chance, of ``channel``;
+    ``powers``: each run's :func:`_run_power` (or None), or None (made here)."""
     matched: list = []
     alone, chance = np.zeros(len(test.runs)), np.zeros(len(test.runs))
     for i, run in enumerate(test.runs):
         if not (run.usable(channel) and run.usable(partner)) or not np.isfinite(run.speed) or run.speed == 0:
             matched.append(None)
             continue
-        m, alone[i], chance[i] = _run_matches(run, channel, partner)
+        power = powers[i] if powers is not None and powers[i] is not None else None
+        m, alone[i], chance[i] = _run_matches(run, channel, partner, power)
         matched.append(m)
     return matched, alone, chance
+
+
+def _test_powers(test) -> list:
+    """Each run's :func:`_run_power` of the radial channels it holds usable (None for a run with none)."""
+    out = []
+    for run in test.runs:
+        chans = tuple(c for pair in PAIRS for c in pair if run.usable(c))
+        out.append(_run_power(run, chans) if chans else None)
+    return out
 
 
 def _verdict(matched: list, alone: np.ndarray, chance: np.ndarray) -> dict | None:
@@ -250,9 +273,10 @@ def corrected(test) -> tuple:
     products show (a copy; the same object when none is), and one ``distorted`` record (JSON-ready) per channel."""
     runs = list(test.runs)
     records = []
+    powers = _test_powers(test)
     for pair in PAIRS:
         for channel, partner in (pair, pair[::-1]):
-            matched, alone, chance = _channel_matches(test, channel, partner)
+            matched, alone, chance = _channel_matches(test, channel, partner, powers)
             before = _verdict(matched, alone, chance)
             if before is None or not before["distorted"]:
                 continue
