@@ -602,7 +602,7 @@ def steady_lines(p: ExtendedParams, lines, omega, rigid: bool = False, omega_dot
                 resp = transmissibility(p, ln.direction, nu, wj) * coef * load0
             else:           # ν̇ = σ·h·dΩ/dt (ν is linear in Ω)
                 nu_dot = ln.nu(sigma, wj + w_dot) - nu
-                resp = chirp_transmissibility(p, ln.direction, nu, nu_dot, wj) * coef * load0
+                resp = chirp_transmissibility(_subsystem(p, ln.direction), nu, nu_dot, wj) * coef * load0
             if ln.resonances:
                 resp = resp * ln.gain(nu)
             _add_to_channels(amp[:, j], ln.direction, p.height, resp, nu)

@@ -51,15 +51,13 @@ def poles(m: float, c: float, k: float, g_omega) -> tuple:
     return p1, p2, (k + c * p1) / (m * diff), -(k + c * p2) / (m * diff)
 
 
-def chirp_transmissibility(p, direction: str, nu, nu_dot, omega) -> np.ndarray:
+def chirp_transmissibility(sub, nu, nu_dot, omega) -> np.ndarray:
     """Interface load per internal load, relative to the load's own phasor, for a complex-coordinate load whose whirl
     rate is ``nu`` (rad/s, signed) at the instant and moves at ``nu_dot`` (rad/s²), at wheel speed ``omega`` (rad/s):
-    Σ_j r_j·G_j (module docstring); :func:`rwadist.extended.transmissibility` where ``nu_dot`` is 0.  ``p`` the
-    :class:`~rwadist.extended.ExtendedParams`."""
-    from .extended import _subsystem
-
+    Σ_j r_j·G_j (module docstring); :func:`rwadist.extended.transmissibility` where ``nu_dot`` is 0.  ``sub`` the
+    subsystem the load's direction loads, (inertia, damping, stiffness, gyro) in SI units, or None (no suspension:
+    ones)."""
     shape = np.broadcast(nu, nu_dot, omega).shape
-    sub = _subsystem(p, direction)
     if sub is None:
         return np.ones(shape, dtype=complex)
     m, c, k, gyro = sub
