@@ -109,6 +109,20 @@ def segment_chirp(alpha: float, h: float, nperseg: int, fs: float) -> float:
     return abs(float(alpha)) * h * (nperseg / fs) ** 2 / (2 * np.pi)
 
 
+def speed_track(ctx, runs) -> float:
+    """Median |dΩ/dt| (rad/s²) of the runs' speeds against their start times (runs of one sweep, ``Run.t0``
+    distinct), or NaN (no time series, fewer than 3 runs, start times not known or repeated)."""
+    if ctx.test is None or len(runs) < 3:
+        return float("nan")
+    t0 = np.array([ctx.test.runs[r].t0 for r in runs], dtype=float)
+    w = np.asarray(ctx.omega, dtype=float)[runs]
+    order = np.argsort(t0)
+    dt = np.diff(t0[order])
+    if not np.all(np.isfinite(t0)) or np.any(dt <= 0):
+        return float("nan")
+    return float(np.median(np.abs(np.diff(w[order]) / dt)))
+
+
 def sweep_sign(ctx) -> float:
     """+1 when the context's runs rise in |Ω| with their start times (a run-up), −1 when they fall (a run-down); +1
     when their start times are not known (no time series, or runs not cut from one record)."""
