@@ -50,8 +50,13 @@ def _beside_fast_crossings(ctx, state, law) -> bool:
     from .smear import speed_track
     from .sweep_crossing import crossings
 
+    rate = getattr(state, "smear", None)
+    if rate is None and ctx is not None:
+        rate = speed_track(ctx, ctx.runs)
+    if rate is None or not np.isfinite(rate):
+        return True                     # steady runs (or none read): no crossing
     pos = np.arange(ctx.runs.size)
-    fast = crossings(ctx, state, np.full(pos.size, law.h), pos, speed_track(ctx, ctx.runs))
+    fast = crossings(ctx, state, np.full(pos.size, law.h), pos, rate)
     if not fast.any():
         return True
     calm = AmplitudeLaw.fit(ctx, state, law.direction, law.h, ctx.runs[~fast])
