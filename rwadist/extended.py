@@ -568,7 +568,7 @@ def transmissibility(p: ExtendedParams, direction: str, nu, omega):
     return (k + 1j * c * nu) / (k - m * nu**2 + gyro * omega * nu + 1j * c * nu)
 
 
-def steady_lines(p: ExtendedParams, lines, omega, rigid: bool = False) -> tuple:
+def steady_lines(p: ExtendedParams, lines, omega, rigid: bool = False, omega_dot=None) -> tuple:
     """Steady-state lines at constant wheel speeds ``omega`` (rad/s, signed), closed form.
 
     Returns (f_hz (n_speeds, n_lines), amplitude (n_speeds, n_lines, 6) complex): each channel
@@ -577,9 +577,15 @@ def steady_lines(p: ExtendedParams, lines, omega, rigid: bool = False) -> tuple:
     line's wheel-mode resonances multiply each component by H at its whirl rate.  ``rigid``: the
     suspension is rigid (a hard-mounted wheel, e.g. a datasheet wheel whose modes are only assumed): no
     transmissibility, each line's free load (C·Ω², U_s·Ω², U_d·Ω²) reaches the interface as it is, the
-    radial force with its lever arm ``height``.
+    radial force with its lever arm ``height``.  ``omega_dot`` (rad/s², signed dΩ/dt, broadcast with ``omega``): the
+    lines at the instants of a run-up or run-down where the speed is ``omega``, each component through the suspension
+    as a linear chirp (:func:`rwadist.extended_chirp.chirp_transmissibility`: the lag, the lower peak and the ringing
+    of a mode crossed fast), relative to the line's own phasor at the instant.
     """
     w = _omega_array(np.atleast_1d(omega))[:, None]
+    if omega_dot is not None:
+        from .extended_chirp import chirp_transmissibility
+        w_dot = np.broadcast_to(np.asarray(omega_dot, dtype=float), w[:, 0].shape)
     lines = list(lines)
     n_l = len(lines)
     amp = np.zeros((w.shape[0], n_l, 6), dtype=complex)
@@ -590,7 +596,13 @@ def steady_lines(p: ExtendedParams, lines, omega, rigid: bool = False) -> tuple:
         load0 = ln.amplitude(wj)
         for sigma, coef in ln.components():
             nu = ln.nu(sigma, wj)
-            resp = coef * load0 if rigid else transmissibility(p, ln.direction, nu, wj) * coef * load0
+            if rigid:
+                resp = coef * load0
+            elif omega_dot is None:
+                resp = transmissibility(p, ln.direction, nu, wj) * coef * load0
+            else:           # ν̇ = σ·h·dΩ/dt (ν is linear in Ω)
+                nu_dot = ln.nu(sigma, wj + w_dot) - nu
+                resp = chirp_transmissibility(_subsystem(p, ln.direction), nu, nu_dot, wj) * coef * load0
             if ln.resonances:
                 resp = resp * ln.gain(nu)
             _add_to_channels(amp[:, j], ln.direction, p.height, resp, nu)

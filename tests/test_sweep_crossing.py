@@ -94,3 +94,36 @@ def test_a_clean_run_up_has_no_moving_resonance(tmp_path):
     truth = wheel.modes_hz()
     for m in ("radial_translation", "rocking", "axial"):
         assert abs(modes[f"{m}_Hz"] / truth[m] - 1) < 0.02, m
+
+
+def test_a_steady_test_has_no_crossing_and_a_sweep_track_gives_one():
+    """No spin smear and no speed track: nothing is a crossing; the runs' speed track (rad/s²) stands for a smear the
+    search did not name (a slow line's smear inside a run is below a bin: family wheel 6's 30-s run-down)."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose.sweep_crossing import crossings
+
+    modes = SimpleNamespace(kind="suspension_modes", inertia_ratio=2.0, f0_Hz={"radial_translation": 150.0,
+                            "rocking": 110.0, "axial": 85.0}, zeta={"radial_translation": 0.011, "rocking": 0.019,
+                                                                   "axial": 0.013})
+    state = SimpleNamespace(smear=None, effects=[modes])
+    ctx = SimpleNamespace(runs=np.arange(3), omega=np.array([10.0, 67.0, 300.0]),
+                          run_durations=lambda runs: np.full(len(runs), 0.7), df=2.44)
+    h, pos = np.full(3, 7.97), np.arange(3)
+    assert not crossings(ctx, state, h, pos).any()
+    assert not crossings(ctx, state, h, pos, float("nan")).any()
+    # 7.97 × 67/2π = 85 Hz on the axial mode, 11.95 Hz/s: η = 1.5; 380 Hz and 12.7 Hz are far from every mode
+    assert crossings(ctx, state, h, pos, 9.42).tolist() == [False, True, False]
+
+
+def test_a_clean_run_down_has_no_amplitude_law_read_through_its_fast_crossing(tmp_path):
+    """Family wheel 6, 3000 -> 300 rpm in 30 s at 2.5 kHz (linear), no speed column: its axial h 7.97 line (C·Ω²)
+    crosses the 85-Hz axial mode at 638 rpm at η 1.5 and rings on below it; over every run it read Ω^1.33 ± 0.13
+    (a ``line_property`` amplitude_law described on clean data), over the runs out of the fast crossings' reach
+    Ω^1.98 ± 0.07, not told from 2: nothing is described."""
+    wheel = fw.family()[6]
+    data = fw.sweep(wheel, 3000.0, 300.0, 30.0, noise=0.01, seed=3 + 6, profile="linear")
+    csv = fw.write_sweep(data, tmp_path / "sweep.csv", tach=False)
+    d = api.diagnose(api.read(csv))
+    assert [u.signature for u in d.unexplained] == []
+    assert sorted(e["kind"] for e in d.model.effects) == ["suspension_modes"]

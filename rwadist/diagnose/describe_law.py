@@ -36,9 +36,31 @@ def laws_below_gain(ctx, state, judged, k_sigma: float, min_gain: float) -> list
         if (e.direction, round(e.h, 4)) in state.laws or any((x.direction, x.h) == (e.direction, e.h) for _, x in out):
             continue
         refit = e.refit(ctx, state)
-        if refit is not e and refit.significant():
+        if refit is not e and refit.significant() and _beside_fast_crossings(ctx, state, refit):
             out.append((h, refit))
     return out
+
+
+def _beside_fast_crossings(ctx, state, law) -> bool:
+    """True when ``law`` is still told from Ω² refitted on the runs where its line does not pass a resonance faster
+    than the resonance settles (:func:`rwadist.diagnose.sweep_crossing.crossings`, at the state's spin smear or the
+    runs' speed track): there the line's level is not its steady response (the lag, the lower peak, the ringing after
+    the line has passed), and a law fitted through it reads that as the source's.  True on steady runs."""
+    from ..effects.amplitude_law_diagnose import AmplitudeLaw
+    from .smear import speed_track
+    from .sweep_crossing import crossings
+
+    rate = getattr(state, "smear", None)
+    if rate is None and ctx is not None:
+        rate = speed_track(ctx, ctx.runs)
+    if rate is None or not np.isfinite(rate):
+        return True                     # steady runs (or none read): no crossing
+    pos = np.arange(ctx.runs.size)
+    fast = crossings(ctx, state, np.full(pos.size, law.h), pos, rate)
+    if not fast.any():
+        return True
+    calm = AmplitudeLaw.fit(ctx, state, law.direction, law.h, ctx.runs[~fast])
+    return calm is not None and calm.significant()
 
 
 def describe_laws(res, laws) -> list:

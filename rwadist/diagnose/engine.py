@@ -334,9 +334,10 @@ class Context(Metric):
             state._cache[key] = self._memo[content]
         return state._cache[key]
 
-    def _ext_lines(self, state: State, w: np.ndarray, lines) -> tuple:
+    def _ext_lines(self, state: State, w: np.ndarray, lines, omega_dot=None) -> tuple:
         """(:meth:`channel_lines`, :meth:`line_mixing`) of every channel on the extended base at the speeds ``w``
-        (rad/s, 1-D), computed (``lines``: ``state.ext_lines()``)."""
+        (rad/s, 1-D), computed (``lines``: ``state.ext_lines()``); at instants of a sweep whose dΩ/dt is ``omega_dot``
+        (rad/s², as ``w``) when given (:func:`rwadist.extended.steady_lines`)."""
         from .. import extended as ext
 
         if state.ext is None:
@@ -346,7 +347,7 @@ class Context(Metric):
         mixing: dict[str, list[np.ndarray]] = {c: [] for c in self.channels}
         if not lines:
             return out, mixing
-        _, A = ext.steady_lines(state.ext, lines, w)                  # (S, L, 6)
+        _, A = ext.steady_lines(state.ext, lines, w, omega_dot=omega_dot)    # (S, L, 6)
         P = np.abs(A) ** 2                                             # 2 × mean square
         hs = np.array([ln.h for ln in lines])
         free = np.array([ln.amplitude(w) for ln in lines]).T           # (S, L) load amplitudes
@@ -619,25 +620,12 @@ class Context(Metric):
 
     def smear_transfer(self, state: State, c: str, h: float, runs: np.ndarray) -> np.ndarray:
         """(len(runs), K) on the extended base: the line h's power in channel ``c`` on each Welch segment under the
-        state's spin acceleration over its power at the run's mean speed, less a C·Ω² line's (Ω(τ_k)/Ω)⁴
-        (:mod:`rwadist.diagnose.smear`): the modes' transfer (and a law) at the segment's own speed, where a line
-        crosses a mode within a run (docs/diagnose.md, ``spin_acceleration``); 1 where it has no power.  Cached."""
+        state's spin acceleration over its power at the run's mean speed, less a C·Ω² line's (Ω(τ_k)/Ω)⁴: the
+        modes' response to the line sweeping through them over the segment (:func:`rwadist.diagnose.smear.
+        segment_transfer`; docs/diagnose.md, ``spin_acceleration``); 1 where it has no power.  Cached."""
         key = ("smear_transfer", c, round(float(h), 9), runs.tobytes())
         if key not in state._cache:
-            fs, L = self.sp.sample_rate, self.sp.nperseg
-            n = np.rint(self.run_durations(runs) * fs)
-            ratio = smear.speed_ratios(state.smear or 0.0, self.omega[runs], n, np.asarray(self.sp.n_segments)[runs], L, fs)
-            w_seg = self.omega[runs][:, None] * ratio
-            seg_key = ("smear_lines", runs.tobytes())        # every line at every segment's speed, once per runs
-            if seg_key not in state._cache:
-                state._cache[seg_key] = self._ext_lines(state, w_seg.ravel(), tuple(state.ext_lines()))[0]
-            a_seg = next((a for hs, _, a, _ in state._cache[seg_key].get(c, []) if abs(hs - h) < 1e-9), None)
-            a0 = next((a for hm, _, a, _ in self.channel_lines(state, c, runs) if abs(hm - h) < 1e-9), None)
-            out = np.ones(w_seg.shape)
-            if a_seg is not None and a0 is not None:
-                a_seg = a_seg.reshape(w_seg.shape)
-                ok = (a0[:, None] > 0) & (ratio > 0)
-                out = np.where(ok, (a_seg / np.where(ok, a0[:, None], 1.0)) ** 2 / np.where(ok, ratio, 1.0) ** 4, 1.0)
+            out = smear.segment_transfer(self, state, c, h, runs)
             out.flags.writeable = False
             state._cache[key] = out
         return state._cache[key]

@@ -31,6 +31,9 @@ from .constants import KERNEL_HALF
 
 #: points per bin of the kernel table in δ (read by the 4-point Lagrange cubic)
 OVERSAMPLE = 64
+#: instants per Welch segment at which a line's response through the suspension modes is read
+#: (:func:`segment_transfer`)
+INSTANTS = 32
 
 
 @functools.lru_cache(maxsize=512)
@@ -104,3 +107,83 @@ def speed_ratios(alpha: float, omega: np.ndarray, n_samples: np.ndarray, n_segme
 def segment_chirp(alpha: float, h: float, nperseg: int, fs: float) -> float:
     """Bins the line h sweeps across one segment at |dΩ/dt| = ``alpha``: h|α|(L/f_s)²/2π."""
     return abs(float(alpha)) * h * (nperseg / fs) ** 2 / (2 * np.pi)
+
+
+def speed_track(ctx, runs, signed: bool = False) -> float:
+    """Median |dΩ/dt| (rad/s²; ``signed``: dΩ/dt, negative on a run-down) of the runs' speeds against their start
+    times (runs of one sweep, ``Run.t0`` distinct), or NaN (no time series, fewer than 3 runs, start times not known or
+    repeated)."""
+    if ctx.test is None or len(runs) < 3:
+        return float("nan")
+    t0 = np.array([ctx.test.runs[r].t0 for r in runs], dtype=float)
+    w = np.asarray(ctx.omega, dtype=float)[runs]
+    order = np.argsort(t0)
+    dt = np.diff(t0[order])
+    if not np.all(np.isfinite(t0)) or np.any(dt <= 0):
+        return float("nan")
+    rates = np.diff(w[order]) / dt
+    return float(np.median(rates if signed else np.abs(rates)))
+
+
+def sweep_sign(ctx) -> float:
+    """+1 when the context's runs rise in |Ω| with their start times (a run-up), −1 when they fall (a run-down); +1
+    when their start times are not known (no time series, or runs not cut from one record)."""
+    test = ctx.test
+    if test is None or len(ctx.runs) < 2:
+        return 1.0
+    t0 = np.array([getattr(test.runs[r], "t0", None) or np.nan for r in ctx.runs], dtype=float)
+    w = np.abs(np.asarray(ctx.omega, dtype=float)[ctx.runs])
+    if not np.all(np.isfinite(t0)) or np.ptp(t0) <= 0:
+        return 1.0
+    return 1.0 if np.sum((t0 - t0.mean()) * (w - w.mean())) >= 0 else -1.0
+
+
+def instant_ratios(alpha: float, omega: np.ndarray, n_samples: np.ndarray, n_segments: np.ndarray, nperseg: int,
+                   fs: float, window: str) -> tuple:
+    """(|Ω(t)|/|Ω| (len(runs), max K, :data:`INSTANTS`), weights (INSTANTS,)) at :data:`INSTANTS` instants spread
+    evenly over each Welch segment, and the squares of the segment's window there, summing to 1 (a segment's
+    periodogram holds the window²-weighted mean square of its record, Parseval); the instants of a segment a run does
+    not have carry the segment's centre's ratio (1)."""
+    from scipy import signal
+
+    tau, used, _ = _segment_times(n_samples, n_segments, nperseg, fs)
+    idx = ((np.arange(INSTANTS) + 0.5) * nperseg / INSTANTS).astype(int)
+    s = (idx - nperseg / 2.0) / fs                                   # s from the segment's centre
+    win = signal.get_window(window, nperseg)[idx] ** 2
+    w = np.maximum(np.abs(np.asarray(omega, dtype=float)), 1e-12)
+    r = np.maximum(1.0 + abs(float(alpha)) * (tau[:, :, None] + s) / w[:, None, None], 0.0)
+    return np.where(used[:, :, None], r, 1.0), win / win.sum()
+
+
+def segment_transfer(ctx, state, c: str, h: float, runs: np.ndarray) -> np.ndarray:
+    """(len(runs), K): the line h's power in channel ``c`` on each of the runs' Welch segments under the state's spin
+    acceleration (the extended base's lines at :data:`INSTANTS` instants of the segment, each through the suspension
+    as a linear chirp of the sweep's sign, :func:`rwadist.extended.steady_lines` ``omega_dot``: a mode crossed faster
+    than it settles lags, peaks lower and rings on; their window²-weighted mean square) over its power at the run's
+    mean speed, less a C·Ω² line's (Ω(τ_k)/Ω)⁴; 1 where it has no power.  ``ctx`` a
+    :class:`~rwadist.diagnose.engine.Context`."""
+    fs, L = ctx.sp.sample_rate, ctx.sp.nperseg
+    n = np.rint(ctx.run_durations(runs) * fs)
+    n_seg = np.asarray(ctx.sp.n_segments)[runs]
+    alpha = abs(float(state.smear or 0.0))
+    w_run = np.asarray(ctx.omega, dtype=float)[runs]
+    ratio = speed_ratios(alpha, w_run, n, n_seg, L, fs)
+    seg_key = ("smear_lines", runs.tobytes())            # every line at every segment's instants, once per runs
+    if seg_key not in state._cache:
+        lines = tuple(state.ext_lines())
+        sign = sweep_sign(ctx)
+        content = ("smear_lines", state.ext, lines, runs.tobytes(), alpha, sign, L, fs)
+        if content not in ctx._memo:
+            r, win = instant_ratios(alpha, w_run, n, n_seg, L, fs, ctx.sp.window)
+            w_inst = w_run[:, None, None] * r
+            w_dot = np.broadcast_to(sign * alpha * np.sign(w_run)[:, None, None], w_inst.shape)
+            by_channel = ctx._ext_lines(state, w_inst.ravel(), lines, omega_dot=w_dot.ravel())[0]
+            ctx._memo[content] = {ch: [(hs, (a.reshape(w_inst.shape) ** 2) @ win) for hs, _, a, _ in rows]
+                                  for ch, rows in by_channel.items()}
+        state._cache[seg_key] = ctx._memo[content]
+    p_seg = next((p for hs, p in state._cache[seg_key].get(c, []) if abs(hs - h) < 1e-9), None)
+    a0 = next((a for hm, _, a, _ in ctx.channel_lines(state, c, runs) if abs(hm - h) < 1e-9), None)
+    if p_seg is None or a0 is None:
+        return np.ones(ratio.shape)
+    ok = (a0[:, None] > 0) & (ratio > 0)
+    return np.where(ok, p_seg / np.where(ok, a0[:, None], 1.0) ** 2 / np.where(ok, ratio, 1.0) ** 4, 1.0)

@@ -66,18 +66,20 @@ def near_crossing(f, f_dot, half_span, f_m, zeta: float, read: float = 0.0) -> n
     return fast & (gap <= HALF_WIDTHS * bw + TIME_CONSTANTS * f_dot / (2 * np.pi * bw) + read)
 
 
-def crossings(ctx, state, h: np.ndarray, run: np.ndarray) -> np.ndarray:
+def crossings(ctx, state, h: np.ndarray, run: np.ndarray, alpha: float | None = None) -> np.ndarray:
     """Boolean mask (P,) of the points (line ratio ``h``, position ``run`` in the context's runs) whose line passes a
-    fitted resonance too fast for its steady-state response within the run's record (:func:`near_crossing`); all
-    False on a steady test (``state.smear`` None)."""
+    fitted resonance too fast for its steady-state response within the run's record (:func:`near_crossing`), the
+    wheel accelerating at the state's spin smear or else ``alpha`` (rad/s², |dΩ/dt|); all False on a steady test
+    (neither given)."""
     h = np.abs(np.asarray(h, dtype=float))
     run = np.asarray(run, dtype=int)
     mask = np.zeros(h.shape, bool)
-    if state.smear is None or h.size == 0:
+    rate = state.smear if state.smear is not None else alpha
+    if rate is None or not np.isfinite(rate) or rate == 0 or h.size == 0:
         return mask
     runs = ctx.runs[run]
     spin = np.abs(ctx.omega[runs]) / (2 * np.pi)
-    f_dot = h * abs(float(state.smear)) / (2 * np.pi)                # Hz/s
+    f_dot = h * abs(float(rate)) / (2 * np.pi)                       # Hz/s
     half_span = 0.5 * f_dot * ctx.run_durations(runs)
     for f_m, zeta in _resonances(state, spin):
         mask |= near_crossing(h * spin, f_dot, half_span, f_m, zeta, (LINE_HALF + 1) * ctx.df)

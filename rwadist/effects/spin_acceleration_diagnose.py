@@ -7,6 +7,7 @@ import numpy as np
 
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context, noise_estimate
+from ..diagnose.smear import speed_track
 from ..diagnose.state import State
 from ..units import CHANNELS
 
@@ -55,16 +56,8 @@ class SpinAcceleration:
     @staticmethod
     def track(ctx: Context, runs) -> float:
         """Median dΩ/dt (rad/s², negative on a run-down) from the runs' speeds against their start times (runs of
-        one sweep, ``Run.t0`` distinct), or NaN."""
-        if ctx.test is None or len(runs) < 3:
-            return float("nan")
-        t0 = np.array([ctx.test.runs[r].t0 for r in runs], dtype=float)
-        w = ctx.omega[runs]
-        order = np.argsort(t0)
-        dt = np.diff(t0[order])
-        if not np.all(np.isfinite(t0)) or np.any(dt <= 0):
-            return float("nan")
-        return float(np.median(np.diff(w[order]) / dt))
+        one sweep, ``Run.t0`` distinct), or NaN (:func:`rwadist.diagnose.smear.speed_track`)."""
+        return speed_track(ctx, np.asarray(runs), signed=True)
 
     @staticmethod
     def fit(ctx: Context, state: State, runs) -> "SpinAcceleration | None":
