@@ -37,6 +37,7 @@ import numpy as np
 from . import geometry
 from .data import DataError, read_json
 from .geometry import skew  # noqa: F401  (re-exported: its home is rwadist.geometry)
+from .model import WheelModel
 
 #: Tolerance on ‖RᵀR − I‖ (max abs) and on det R − 1: the one of :data:`rwadist.geometry.DCM_TOL`.
 ORTHO_TOL = geometry.DCM_TOL
@@ -226,7 +227,13 @@ def _wheel_lines(path, where: str, w: dict, base: Path, cache: dict, default_lin
     assumed-modes rule of :func:`rwadist.wheel_source.wheel_source` (one source read once per set)."""
     from .wheel_source import wheel_source
 
-    if "model" in w:
+    if "model" in w and isinstance(w["model"], WheelModel):     # from Python: the model object itself
+        model = w["model"]
+        key, ref, preset = ("object", str(id(model))), f"model {model.name}", None
+    elif "model" in w:
+        if not isinstance(w["model"], (str, Path)):
+            raise DataError(path, f"{where}.model", f"a {type(w['model']).__name__}: expected a model-file path "
+                            "(or, from Python, a WheelModel)")
         mp = Path(w["model"])
         mp = mp if mp.is_absolute() else base / mp
         if not mp.exists():

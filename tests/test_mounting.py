@@ -157,3 +157,22 @@ def test_wheels_file_top_level_keys_are_checked(tmp_path):
                              "speed": {"dist": "uniform", "min_rpm": 0, "max_rpm": 100}}))
     with pytest.raises(DataError, match=r"document\.speed.*unknown key"):
         mt.load_wheels(p)
+
+
+LAW = bb.Uniform(500 * W, 3000 * W)
+
+
+def test_a_wheel_object_from_python_takes_the_model_itself(tmp_path):
+    """From Python a wheel object's ``model`` may be the WheelModel: the same lines as its file (a round trip), read
+    once for the set; anything else but a path is refused naming the field."""
+    save(E_MODEL, tmp_path / "e.json")
+    by_file = mt.load_wheels([{"model": str(tmp_path / "e.json"), "mounting": {"preset": "pyramid-4", "index": i}}
+                              for i in range(2)], default_law=LAW, empirical=True)
+    by_object = mt.load_wheels([{"model": E_MODEL, "mounting": {"preset": "pyramid-4", "index": i}}
+                                for i in range(2)], default_law=LAW, empirical=True)
+    for a, b in zip(by_file, by_object):
+        np.testing.assert_array_equal(a.lines.h, b.lines.h)
+        assert a.lines.spec == b.lines.spec and a.lines.kind == b.lines.kind == "empirical"
+    assert by_object[0].lines is by_object[1].lines
+    with pytest.raises(DataError, match=r"wheels\[0\]\.model.*a int: expected a model-file path"):
+        mt.load_wheels([{"model": 3, "mounting": {"preset": "pyramid-4", "index": 0}}])
