@@ -50,8 +50,8 @@ from dataclasses import replace
 
 import numpy as np
 
-#: the radial pairs whose channels are compared
-PAIRS = (("Fx", "Fy"), ("Tx", "Ty"))
+from .units import RADIAL_PAIRS  # the pairs whose channels are compared
+
 #: a line stands this many times over the local noise of its channel's power spectrum
 LINE_SNR = 30.0
 #: bins of a block whose median is the local noise
@@ -248,7 +248,7 @@ def _test_powers(test) -> list:
     """Each run's :func:`_run_power` of the radial channels it holds usable (None for a run with none)."""
     out = []
     for run in test.runs:
-        chans = tuple(c for pair in PAIRS for c in pair if run.usable(c))
+        chans = tuple(c for pair in RADIAL_PAIRS for c in pair if run.usable(c))
         out.append(_run_power(run, chans) if chans else None)
     return out
 
@@ -275,7 +275,7 @@ def corrected(test) -> tuple:
     runs = list(test.runs)
     records = []
     powers = _test_powers(test)
-    for pair in PAIRS:
+    for pair in RADIAL_PAIRS:
         for channel, partner in (pair, pair[::-1]):
             matched, alone, chance = _channel_matches(test, channel, partner, powers)
             before = _verdict(matched, alone, chance)

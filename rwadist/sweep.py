@@ -62,7 +62,7 @@ from scipy import signal
 from . import speed_scale as scale
 from .data import TACH_COLUMN, DataError, Run, SteadyTest, Sweep
 from .spectra import find_lines, noise_floor
-from .units import rad_s_to_rpm, rpm_to_rad_s
+from .units import RADIAL_PAIRS, rad_s_to_rpm, rpm_to_rad_s
 
 #: Zero-padding factor of the slice periodograms (sub-bin sampling of the comb and the peaks).
 PAD = 4
@@ -89,7 +89,6 @@ CHIRP_BINS = 2.0
 #: Default drop level: fraction of the largest |speed| found.
 MIN_SPEED_FRACTION = 0.05
 RADIAL = ("Fx", "Fy", "Tx", "Ty")
-ROTATING_PAIRS = (("Fx", "Fy"), ("Tx", "Ty"))
 
 
 @dataclass
@@ -318,7 +317,7 @@ def _fuse_track(f0: np.ndarray, sigma: np.ndarray, half_width: int = FUSE_HALF_W
 
 def _rotation_sign(sweep: Sweep, starts, slice_samples: int, f1: np.ndarray) -> np.ndarray:
     """+1 / -1 per slice from the phase of Y against X at the 1× line (f1 Hz); +1 if no x/y pair."""
-    pair = next(((x, y) for x, y in ROTATING_PAIRS if x in sweep.signals and y in sweep.signals), None)
+    pair = next(((x, y) for x, y in RADIAL_PAIRS if x in sweep.signals and y in sweep.signals), None)
     sign = np.ones(len(starts))
     ok = np.isfinite(f1) & (f1 > 0)
     if pair is None or not ok.any():

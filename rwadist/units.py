@@ -9,6 +9,8 @@ import numpy as np
 
 #: Channel order everywhere: forces (N) then torques (N·m), wheel frame.
 CHANNELS = ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")
+#: The radial pairs: the two channels of a radial force or torque, x then y (a rotating vector reads on both).
+RADIAL_PAIRS = (("Fx", "Fy"), ("Tx", "Ty"))
 CHANNEL_UNIT = {"Fx": "N", "Fy": "N", "Fz": "N", "Tx": "Nm", "Ty": "Nm", "Tz": "Nm"}
 #: Column name of each channel in the interchange CSV files.
 CHANNEL_COLUMN = {ch: f"{ch}_{CHANNEL_UNIT[ch]}" for ch in CHANNELS}

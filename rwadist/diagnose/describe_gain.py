@@ -24,13 +24,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..units import RAD_S_TO_RPM
+from ..units import RAD_S_TO_RPM, RADIAL_PAIRS
 from .constants import LINE_HALF
 from .gain_step import gain_step
 from .unexplained import Unexplained
 
 #: The radial pairs (x, y) read.
-PAIRS = (("Fx", "Fy"), ("Tx", "Ty"))
 #: A line's predicted power over the noise in its window, in both channels, at least (dB).
 LINE_SNR_DB = 20.0
 #: The median difference at least (dB of power: 0.4 dB is a 4.7 % amplitude gain) ...
@@ -84,7 +83,7 @@ def channel_gain(ctx, state, shares) -> list:
     (``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB) of the lines' cells)."""
     runs = ctx.runs
     out: list[Unexplained] = []
-    for cx, cy in PAIRS:
+    for cx, cy in RADIAL_PAIRS:
         if cx not in ctx.channels or cy not in ctx.channels:
             continue
         px, py = _powers(ctx, state, cx, runs), _powers(ctx, state, cy, runs)

@@ -6,7 +6,7 @@ import copy
 import numpy as np
 
 from ..formats.records import json_text
-from ..units import CHANNEL_UNIT, RAD_S_TO_RPM
+from ..units import CHANNEL_UNIT, RAD_S_TO_RPM, RADIAL_PAIRS
 from .constants import BAND_BINS, CONTRAST_METRIC, METRIC, NOISE_Z
 from .search import Diagnosis
 
@@ -38,7 +38,6 @@ def rms_vs_speed(diag: Diagnosis) -> dict:
 
 
 #: The radial channel pairs whose RMS :func:`pair_rms_error` combines.
-RADIAL_PAIRS = (("Fx", "Fy"), ("Tx", "Ty"))
 
 
 def pair_rms_error(cols: dict, tag: str = "after") -> float:
