@@ -133,8 +133,12 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
         return None
     offset = None
+    # what follows depends on the runs and the starts alone, except the offset (read beside ``state``): kept on the
+    # context, the search's next step asks the same runs again with its new state and pays only for the offset
+    key = ("suspension_modes.located", tuple(runs), stand_start, repr(sorted(near.items())) if near else None,
+           structure_start)
     try:
-        efit, stand = _locate(ctx, test, fit, stand_start, near)
+        efit, stand = _memo(ctx, key, lambda: _locate(ctx, test, fit, stand_start, near))
         if len(ctx.channels) == 6:
             # a load-cell offset (T_measured = T + r × F) puts the forces' lines, amplified by the translation mode,
             # into the torques (where they also pass for a fixture resonance lifting every direction at that mode, or
@@ -147,27 +151,46 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             # a gain common to every line that changes with speed bends the trend the modes are read from: taken out
             # when the located modes' lines show one and the modes are then located better
             # (:mod:`rwadist.diagnose.modes_trend`)
-            trend = beside_trend(ctx, test, fit, efit, stand_start, near, _locate)
+            trend = _memo(ctx, key + ("trend",), lambda: beside_trend(ctx, test, fit, efit, stand_start, near, _locate))
             if trend is not None:
                 test, fit, efit, stand = trend
         if stand is None and len(ctx.channels) > 3:
             # on an unconstrained mode's direction, or on the forces when every mode is located
-            structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
-            if structure is not None and not fixed_across_speeds(lambda part: _test_and_fit(ctx, part),
-                                                                 ctx.test.speeds, runs, structure):
-                # a resonance moving with speed: the open world describes it, the modes it hid are located beside it
-                structure = modes_beside_moving(efit, structure)
-            elif structure is not None and len(ctx.channels) == 6:
-                # found on one direction, it may lift every one: the stand's (too few lines crossed it to propose it)
-                efit, stand = stand_of_structure(test, fit, efit, structure)
-                structure = None if stand is not None else structure
-            if structure is not None:
-                efit = structure
+            def beside_structure(efit=efit):
+                structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
+                if structure is not None and not fixed_across_speeds(lambda part: _test_and_fit(ctx, part),
+                                                                     ctx.test.speeds, runs, structure):
+                    # a resonance moving with speed: the open world describes it, the modes it hid are located
+                    # beside it
+                    return modes_beside_moving(efit, structure), None
+                if structure is not None and len(ctx.channels) == 6:
+                    # found on one direction, it may lift every one: the stand's (too few lines crossed it to
+                    # propose it)
+                    efit_s, stand_s = stand_of_structure(test, fit, efit, structure)
+                    return (efit_s, stand_s) if stand_s is not None else (structure, None)
+                return (efit if structure is None else structure), None
+
+            efit, stand = beside_structure() if offset is not None else _memo(ctx, key + ("structure",),
+                                                                              beside_structure)
     except ValueError:
         return None
     if len(efit.unconstrained) == 3:
         return None                     # no mode located: nothing to name
     return test, fit, efit, stand, offset
+
+
+def _memo(ctx: Context, key: tuple, compute):
+    """``compute()`` kept on the context under ``key`` (its ValueError too): asked again, the same object (never
+    changed by its readers: a fit's notes are added to the new fits made from it)."""
+    if key not in ctx._memo:
+        try:
+            ctx._memo[key] = (compute(), None)
+        except ValueError as exc:
+            ctx._memo[key] = (None, exc)
+    value, exc = ctx._memo[key]
+    if exc is not None:
+        raise exc
+    return value
 
 
 def _locate(ctx: Context, test, fit, stand_start, near=None):
