@@ -228,8 +228,8 @@ def _wheel_lines(path, where: str, w: dict, base: Path, cache: dict, default_lin
     from .wheel_source import wheel_source
 
     if "model" in w and isinstance(w["model"], WheelModel):     # from Python: the model object itself
-        model = w["model"]
-        key, ref, preset = ("object", str(id(model))), f"model {model.name}", None
+        model: WheelModel | Path | None = w["model"]
+        key, ref, preset = ("object", str(id(model))), f"model {w['model'].name}", None
     elif "model" in w:
         if not isinstance(w["model"], (str, Path)):
             raise DataError(path, f"{where}.model", f"a {type(w['model']).__name__}: expected a model-file path "

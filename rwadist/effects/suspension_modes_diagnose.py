@@ -187,9 +187,9 @@ def _memo(ctx: Context, key: tuple, compute):
             ctx._memo[key] = (compute(), None)
         except ValueError as exc:
             ctx._memo[key] = (None, exc)
-    value, exc = ctx._memo[key]
-    if exc is not None:
-        raise exc
+    value, error = ctx._memo[key]
+    if error is not None:
+        raise error
     return value
 
 
