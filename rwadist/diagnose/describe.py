@@ -92,6 +92,10 @@ def scale_runs(test, steps: dict):
     return SteadyTest(runs, dict(test.meta))
 
 
+#: :func:`search_standing` of a search that located every suspension mode and added nothing: none stands higher
+BEST_STANDING = (3, 0)
+
+
 def search_standing(diag) -> tuple:
     """(the number of the wheel's suspension modes the model locates, minus the number of effects added beyond the
     base): what a search run again with a run change taken out must improve on (:func:`run_steps`), compared as a
