@@ -25,12 +25,14 @@ from .data import SteadyTest, Sweep
 from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistWarning
 from .formats.records import reading_provenance
 from .model import WheelModel
-from .model import load as load_model
+from .model import load as _load
 from .threads import in_one_blas_thread
 from .validate import (
     MAX_SAMPLES,
     check_f_lim,
+    check_object,
     check_parameter,
+    check_path,
     check_run_lengths,
     check_speeds_rpm,
     check_test_speeds,
@@ -42,6 +44,14 @@ from .validate import (
 __all__ = ["read", "simulate_test", "simulate_sweep", "fit", "fit_extended", "diagnose", "psd", "write_nastran",
            "campbell", "build_fmu", "WheelModel", "load_model", "save_model"]
 
+def load_model(path) -> WheelModel:
+    """The model file (JSON) at ``path``, parsed and validated once; a :class:`rwadist.model.ModelKeyWarning` per
+    key or effect kind of the file this version does not read.  :class:`ParameterError` for a ``path`` that is not
+    a path; :class:`DataError` / :class:`ModelError` naming the file and field."""
+    check_path("path", path, "a model file (JSON)")
+    return _load(path)
+
+
 def save_model(model: WheelModel, path) -> Path:
     """Write ``model`` as a model file (JSON) at ``path``, atomically (a kill leaves the old file or the new one).
     Refused (:class:`DataError` naming ``path``, nothing written): a folder, a path in a folder that cannot be
@@ -50,6 +60,8 @@ def save_model(model: WheelModel, path) -> Path:
     is); a model :func:`load_model` would refuse (:class:`ModelFileError`)."""
     from .outputs import check_model_file, write_file
 
+    check_object("model", model, WheelModel, "rwadist.fit's .model, or load_model")
+    check_path("path", path, "the model file (JSON) to write")
     check_model_file(path, "path")
     doc = model_io.to_json(model)
     model_io.from_json(doc, str(path))        # refused naming the user's path, before anything is written
@@ -124,6 +136,7 @@ def read(path, *, slice_samples: int | None = None, speed_source: str = "auto", 
     """
     from . import data as data_io
 
+    check_path("path", path, "test data (a run folder, a sweep CSV or a .h5 file)")
     check_parameter("slice_samples", slice_samples)
     _choice("speed_source", speed_source, SPEED_SOURCES)
     obj = data_io.read_data(path, progress=progress)
@@ -142,7 +155,13 @@ def read(path, *, slice_samples: int | None = None, speed_source: str = "auto", 
 
 
 def _as_test(data, **read_options) -> SteadyTest:
-    return data if isinstance(data, SteadyTest) else read(data, **read_options)
+    if isinstance(data, SteadyTest):
+        return data
+    if isinstance(data, WheelModel):
+        raise ParameterError("data", "a WheelModel: the test data go first (a SteadyTest from read or simulate_test, "
+                             "or a data path); a model is passed as model")
+    check_path("data", data, "test data (a run folder, a sweep CSV or a .h5 file), or a SteadyTest")
+    return read(data, **read_options)
 
 
 def _stand_wheel(preset: str, physics: str, assumed_modes: bool) -> tuple:

@@ -202,11 +202,15 @@ def write_nastran(result, path, *, fields: str = "small", cross: bool = True) ->
         {table id: (channel j, channel k, "auto" | "re" | "im")} of the TABRND1 tables written; subcase of
         channel Fx, Fy, Fz, Tx, Ty, Tz = 1 … 6; units Hz and N²/Hz, N·N·m/Hz, (N·m)²/Hz.
     """
+    from .broadband import BroadbandPSD
     from .nastran import write_deck
     from .outputs import write_file
+    from .validate import check_object, check_path
 
+    check_object("result", result, BroadbandPSD, "what rwadist.psd returns")
+    check_path("path", path, "the bulk-data file to write")
     if fields not in ("small", "free"):
         raise ParameterError("fields", f"{fields!r}: must be 'small' or 'free'")
     tables: dict = {}
-    write_file(path, lambda tmp: tables.update(write_deck(result, tmp, fmt=fields, cross=cross)))
+    write_file(path, lambda tmp: tables.update(write_deck(result, tmp, fmt=fields, cross=cross)), "path")
     return tables

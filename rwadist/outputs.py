@@ -433,6 +433,8 @@ class OutputSet:
     def file(self, path, flag: str = "-o") -> Path:
         """A temporary path to write for the output file ``path`` (its suffix kept)."""
         final = _target(Path(path), flag)
+        if final.is_dir():
+            raise DataError(flag, "value", f"{path}: is a folder: give the path of a file to write")
         if is_special(final):
             _check_special(final, flag)
             tmp = Path(tempfile.gettempdir()) / f".rwadist.part-{_token()}{final.suffix}"

@@ -111,6 +111,21 @@ def check_number(value, parameter: str, lo=None, hi=None, *, lo_open: bool = Fal
 NONE_IS_DEFAULT = frozenset({"f_lim", "nperseg", "mass", "radius", "std_rpm", "fmax", "sample_rate", "slice_samples"})
 
 
+def check_path(name: str, value, what: str) -> None:
+    """:class:`ParameterError` naming ``name`` unless ``value`` is a path (str or os.PathLike); ``what``: what the
+    path must lead to (the message's advice, e.g. 'a model file (JSON)')."""
+    import os
+
+    if not isinstance(value, (str, os.PathLike)):
+        raise ParameterError(name, f"a {type(value).__name__}: expected the path of {what}")
+
+
+def check_object(name: str, value, cls: type, what: str) -> None:
+    """:class:`ParameterError` naming ``name`` unless ``value`` is a ``cls``; ``what``: where one comes from."""
+    if not isinstance(value, cls):
+        raise ParameterError(name, f"a {type(value).__name__}: expected a {cls.__name__} ({what})")
+
+
 def check_parameter(name: str, value):
     """``value`` of the API parameter ``name`` checked against :data:`LIMITS` (None passes as None for the
     parameters of :data:`NONE_IS_DEFAULT`); :class:`ParameterError` naming ``name`` otherwise."""

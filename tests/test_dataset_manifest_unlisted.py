@@ -12,8 +12,8 @@ from rwadist.outputs import MANIFEST
 
 def _dataset(tmp_path):
     path = tmp_path / "w"
-    assert main(["simulate-test", str(path), "--preset", "ithaco-e", "--speeds-rpm", "600:3000", "--n-speeds", "3",
-                 "--samples", "512"]) == 0
+    assert main(["simulate-test", str(path), "--preset", "ithaco-e", "--speeds-rpm", "600:3000", "--n-speeds", "6",
+                 "--samples", "1024"]) == 0
     assert (path / MANIFEST).is_file()
     return path
 

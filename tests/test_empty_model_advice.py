@@ -44,3 +44,25 @@ def test_speeds_given_in_rev_per_second_are_named_with_the_factor(wheel, factor)
     with pytest.warns(rwadist.RwadistWarning, match=r"lines lie in the band read") as rec:
         rwadist.fit(test, f_lim=3.0)
     assert not any("rev/s" in str(w.message) for w in rec)
+
+
+def test_the_command_exits_1_on_an_empty_model_and_keeps_it_for_inspection(tmp_path, capsys):
+    """``rwadist fit`` of a two-run test: the empty model is written (to look at) but the command fails (exit 1,
+    a check failed), so a script does not go on to a PSD or an FMU of zeros."""
+    from cli_run import run
+
+    data = tmp_path / "two"
+    code, _, _ = run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "900,1800",
+                     "--samples", "2048")
+    assert code == 0
+    code, out, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--no-report")
+    assert code == 1
+    assert "needs 5 measurements" in err
+    assert "ERROR: the model is empty" in err and "written for inspection" in err
+    assert not any(rwadist.load_model(tmp_path / "m.json").empirical.values())
+    # a test with lines still exits 0
+    data8 = tmp_path / "eight"
+    run(capsys, "simulate-test", "--preset", "ithaco-e", data8, "--speeds-rpm", "600:2400", "--n-speeds", "8",
+        "--samples", "2048")
+    code, _, _ = run(capsys, "fit", data8, "-o", tmp_path / "m8.json", "--no-report")
+    assert code == 0

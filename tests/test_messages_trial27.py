@@ -19,8 +19,8 @@ from rwadist.cli import main
 @pytest.fixture(scope="module")
 def steady(tmp_path_factory):
     path = tmp_path_factory.mktemp("m27") / "w"
-    assert main(["simulate-test", str(path), "--preset", "ithaco-e", "--speeds-rpm", "600:3000", "--n-speeds", "4",
-                 "--samples", "1024"]) == 0
+    assert main(["simulate-test", str(path), "--preset", "ithaco-e", "--speeds-rpm", "600:3000", "--n-speeds", "8",
+                 "--samples", "2048"]) == 0
     return path
 
 

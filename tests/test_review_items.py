@@ -208,8 +208,8 @@ def test_model_files_carry_version_date_and_data(tmp_path):
     when = datetime.datetime.fromisoformat(prov["created_utc"])
     assert abs((datetime.datetime.now(datetime.timezone.utc) - when).total_seconds()) < 3600
     ds = tmp_path / "ds"
-    assert main(["simulate-test", str(ds), "--preset", "ithaco-e", "--speeds-rpm", "600,1200,1800",
-                 "--samples", "1024"]) == 0
+    assert main(["simulate-test", str(ds), "--preset", "ithaco-e", "--speeds-rpm", "600:2400", "--n-speeds", "8",
+                 "--samples", "2048"]) == 0
     assert main(["fit", str(ds), "-o", str(tmp_path / "m.json"), "--no-report"]) == 0
     doc = json.loads((tmp_path / "m.json").read_text())
     assert doc["provenance"]["data"] == str(ds) and doc["provenance"]["rwadist"] == rwadist.__version__

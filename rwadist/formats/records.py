@@ -98,6 +98,11 @@ class Sweep:
         return tuple(ch for ch in CHANNELS if ch in self.signals)
 
 
+#: the first bytes of binary files a user may give where text goes, and what each is
+BINARY_SIGNATURES = {b"\x89HDF\r\n\x1a\n": "an HDF5 file", b"MATLAB 5.0 MAT-file": "a MATLAB .mat file",
+                     b"TDSm": "a TDMS file", b"PK\x03\x04": "a zip archive (an FMU, a spreadsheet)"}
+
+
 def read_text(path) -> str:
     """The UTF-8 text of ``path`` (a leading BOM dropped); DataError naming the file and the byte when it is
     not UTF-8 (a UTF-16 export or a damaged file) or cannot be read."""
@@ -109,6 +114,10 @@ def read_text(path) -> str:
     if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
         raise DataError(path, "encoding", "the file is UTF-16 text; save it as UTF-8 (e.g. 'CSV UTF-8' in a "
                         "spreadsheet, or `iconv -f UTF-16 -t UTF-8`)")
+    kind = next((k for sig, k in BINARY_SIGNATURES.items() if raw.startswith(sig)), None)
+    if kind is not None:
+        raise DataError(path, "file", f"{kind}, not text: this file is read where a text file is expected (a model "
+                        "file is JSON; test data go to read, fit or diagnose)")
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
