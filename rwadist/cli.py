@@ -199,6 +199,10 @@ def cmd_fit(args) -> int:
               "fit the wheel's modes with --extended, or keep them with --no-mode-exclusion", file=sys.stderr)
     print(f"model:  {args.output}")
     print(f"report: {report_dir} ({len(files)} files)" if report_dir is not None else "report: none (--no-report)")
+    earlier = Path(args.output).with_suffix("").parent / (Path(args.output).stem + "_report")
+    if report_dir is None and earlier.is_dir():
+        print(f"note: {earlier} is the report of an earlier fit and does not describe this model (rerun without "
+              "--no-report to replace it, or remove it)", file=sys.stderr)
     if n == 0:
         # a script that goes on to psd, fmu or diagnose with this model would compute zeros: exit 1, as a failed check
         print(f"ERROR: the model is empty: no harmonic was found in {args.data} (the warning above says where to "

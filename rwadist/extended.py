@@ -220,8 +220,9 @@ def params_from_dict(d, source="<model>", needed_for: str | None = None) -> Exte
                              "radius are optional) or give a wheel `preset` instead of the model")
     if d is None:
         raise ModelFileError(source, "analytical", "missing: the model file has no analytical parameters (suspension "
-                             "modes); add them with the extended fit (with the rotor's `mass` and `radius`) or use a "
-                             "wheel `preset`; the empirical PSD (`empirical`) needs only the harmonics")
+                             "modes); add them with the extended fit (rwadist.fit_extended, or the fit command's "
+                             "`extended` option; the rotor's mass and radius are optional) or use a wheel `preset`; "
+                             "the empirical PSD (`empirical`) needs only the harmonics")
     vals = schema.Analytical.from_json(d, source, ModelFileError).require(source, ModelFileError)
     try:
         return ExtendedParams(**vals)

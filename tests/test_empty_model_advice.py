@@ -66,3 +66,19 @@ def test_the_command_exits_1_on_an_empty_model_and_keeps_it_for_inspection(tmp_p
         "--samples", "2048")
     code, _, _ = run(capsys, "fit", data8, "-o", tmp_path / "m8.json", "--no-report")
     assert code == 0
+
+
+def test_a_model_written_without_its_report_names_the_earlier_report_beside_it(tmp_path, capsys):
+    """``fit -o m.json --no-report`` over a model whose report folder is beside it (new-user trial 29: the old report
+    listed 11 harmonics beside a new empty model, nothing said): the note names the folder as an earlier fit's."""
+    from cli_run import run
+
+    data = tmp_path / "eight"
+    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "8",
+        "--samples", "2048")
+    assert run(capsys, "fit", data, "-o", tmp_path / "m.json")[0] == 0
+    assert (tmp_path / "m_report").is_dir()
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--no-report")
+    assert code == 0 and "m_report is the report of an earlier fit" in err
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "n.json", "--no-report")
+    assert code == 0 and "earlier fit" not in err
