@@ -27,6 +27,7 @@ from .formats.records import reading_provenance
 from .model import WheelModel
 from .model import load as _load
 from .threads import in_one_blas_thread
+from .units import RAD_S_TO_RPM
 from .validate import (
     MAX_SAMPLES,
     check_f_lim,
@@ -72,6 +73,8 @@ def save_model(model: WheelModel, path) -> Path:
 #: Default FFT length rule of :func:`diagnose`: a power of 2 at most a quarter of the median run length, so
 #: every PSD averages several Welch segments (the residual needs noise statistics).
 DIAGNOSE_SEGMENTS = 4
+#: A sweep whose slices' speeds span less than this fraction is named as one steady run read as a sweep.
+STEADY_FILE_SPREAD = 0.02
 #: What :func:`read` may take each sweep slice's speed from.
 SPEED_SOURCES = ("auto", "tach", "data")
 #: Physics of the virtual test stand (:func:`simulate_test`, :func:`simulate_sweep`).
@@ -146,6 +149,12 @@ def read(path, *, slice_samples: int | None = None, speed_source: str = "auto", 
         test, _ = slice_sweep(obj, slice_samples=slice_samples, speed_source=speed_source)
         if log is not None:
             log(speed_note(test.meta["slicing"]))
+            rpm = np.abs(np.asarray(test.speeds, dtype=float)) * RAD_S_TO_RPM
+            if rpm.size >= 2 and rpm.min() > 0 and rpm.max() / rpm.min() - 1.0 < STEADY_FILE_SPREAD:
+                # one steady run's file read as a sweep (new-user trial 29): fitted, but not what was meant
+                log(f"note: the speed hardly changes over {path} ({rpm.min():.6g}-{rpm.max():.6g} rpm): one steady "
+                    "run? Its slices are fitted as runs at one speed; a steady test is a folder of runs with their "
+                    "speeds in runs.csv (docs/formats.md)")
         return test
     names = obj.meta.get("unlisted_files")
     if names and log is not None:
