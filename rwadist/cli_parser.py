@@ -167,10 +167,21 @@ def _add_fit_options(p):
     p.add_argument("--preset", default=None, help="take mass and radius (and unseen modes) from a wheel preset")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, its refusal of a flag whose value starts with '-' (a negative speed range: argparse
+    takes ``-3000:-600`` for a flag) saying how to give it."""
+
+    def error(self, message: str):
+        if message.endswith("expected one argument"):
+            flag = message.split("argument ", 1)[-1].split(":", 1)[0].split("/")[-1]
+            message += f" (a value that starts with '-' goes after '=': {flag}=-VALUE)"
+        super().error(message)
+
+
 def build_parser(cli) -> argparse.ArgumentParser:
     """The argument parser; ``cli`` is the :mod:`rwadist.cli` module, whose ``cmd_*`` functions run the
     commands (passed in, not imported: the parser stays a leaf of the import graph)."""
-    p = argparse.ArgumentParser(prog="rwadist", description="Reaction wheel disturbance models from test data.")
+    p = _Parser(prog="rwadist", description="Reaction wheel disturbance models from test data.")
     p.add_argument("--version", action="version", version=f"rwadist {_version()}")
     sub = p.add_subparsers(dest="command", required=True)
     # the commands in the order ``rwadist --help`` lists them

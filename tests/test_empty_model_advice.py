@@ -67,36 +67,3 @@ def test_the_command_exits_1_on_an_empty_model_and_keeps_it_for_inspection(tmp_p
     code, _, _ = run(capsys, "fit", data8, "-o", tmp_path / "m8.json", "--no-report")
     assert code == 0
 
-
-def test_a_model_written_without_its_report_names_the_earlier_report_beside_it(tmp_path, capsys):
-    """``fit -o m.json --no-report`` over a model whose report folder is beside it (new-user trial 29: the old report
-    listed 11 harmonics beside a new empty model, nothing said): the note names the folder as an earlier fit's."""
-    from cli_run import run
-
-    data = tmp_path / "eight"
-    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "8",
-        "--samples", "2048")
-    assert run(capsys, "fit", data, "-o", tmp_path / "m.json")[0] == 0
-    assert (tmp_path / "m_report").is_dir()
-    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--no-report")
-    assert code == 0 and "m_report is the report of an earlier fit" in err
-    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "n.json", "--no-report")
-    assert code == 0 and "earlier fit" not in err
-
-
-def test_one_steady_run_file_read_as_a_sweep_is_named(tmp_path, capsys):
-    """A steady run's CSV given alone (no runs.csv) is read as a sweep with its speed from the data; the slices all
-    sit at one speed, which the command now says (new-user trial 29: "sliced sweep into 8 quasi-steady runs", nothing
-    else).  A real sweep gets no such note."""
-    from cli_run import run
-
-    data = tmp_path / "eight"
-    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "8",
-        "--samples", "65536")
-    run_file = sorted(data.glob("run_*.csv"))[3]
-    code, out, err = run(capsys, "fit", run_file, "-o", tmp_path / "m.json", "--no-report")
-    assert "the speed hardly changes over" in out + err and "one steady run?" in out + err
-    sweep = tmp_path / "sweep"
-    run(capsys, "simulate-test", "--preset", "ithaco-e", sweep, "--sweep", "--duration", "60")
-    code, out, err = run(capsys, "fit", next(sweep.glob("*.csv")), "-o", tmp_path / "s.json", "--no-report")
-    assert code == 0 and "hardly changes" not in out + err
