@@ -41,3 +41,23 @@ def test_a_negative_value_after_a_flag_is_told_to_go_after_equals(capsys):
     assert info.value.code == 2
     err = capsys.readouterr().err
     assert "argument --speed-rpm: expected one argument" in err and "--speed-rpm=-VALUE" in err
+
+
+def test_a_channel_in_pound_force_is_named_by_its_unit_factor():
+    """Fy recorded in lbf and declared N: Fy × 4.44822 of its true value in N (new-user trial 29).  The
+    diagnosis names the gain (it did) and now the unit factor it is; a plain gain error (× 1.10) names no unit."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    import rwadist
+    from rwadist.diagnose.describe_gain import _unit_words
+
+    test = rwadist.simulate_test("ithaco-e", speeds_rpm=np.linspace(600, 2400, 24), n_samples=4096, seed=1,
+                                 physics="extended")
+    test = type(test)([replace(r, signals={**r.signals, "Fy": r.signals["Fy"] * 4.44822}) for r in test.runs],
+                      test.meta)
+    (gain,) = [u for u in rwadist.diagnose(test).unexplained if u.parameters.get("property") == "channel_gain"]
+    assert gain.parameters["amplitude_ratio"] == pytest.approx(4.44822, rel=0.01)
+    assert "near the number of N in one lbf" in gain.causes[0]
+    assert _unit_words(1.10, "Fx", "Fx", "Fy") == "" and "in·lbf in one N·m" in _unit_words(8.9, "Tx", "Tx", "Ty")
