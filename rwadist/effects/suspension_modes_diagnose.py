@@ -161,8 +161,9 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
                 if structure is not None and not fixed_across_speeds(lambda part: _test_and_fit(ctx, part),
                                                                      ctx.test.speeds, runs, structure):
                     # a resonance moving with speed: the open world describes it, the modes it hid are located
-                    # beside it
-                    return modes_beside_moving(efit, structure), None
+                    # beside it (none: the modes as they were)
+                    moved = modes_beside_moving(efit, structure)
+                    return (efit if moved is None else moved), None
                 if structure is not None and len(ctx.channels) == 6:
                     # found on one direction, it may lift every one: the stand's (too few lines crossed it to
                     # propose it)
