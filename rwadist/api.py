@@ -31,6 +31,7 @@ from .units import RAD_S_TO_RPM
 from .validate import (
     MAX_SAMPLES,
     check_f_lim,
+    check_flags,
     check_object,
     check_parameter,
     check_path,
@@ -140,6 +141,7 @@ def read(path, *, slice_samples: int | None = None, speed_source: str = "auto", 
     from . import data as data_io
 
     check_path("path", path, "test data (a run folder, a sweep CSV or a .h5 file)")
+    check_flags(progress=progress)
     check_parameter("slice_samples", slice_samples)
     _choice("speed_source", speed_source, SPEED_SOURCES)
     obj = data_io.read_data(path, progress=progress)
@@ -239,6 +241,7 @@ def simulate_test(preset: str = "ithaco-e", speeds_rpm=None, *, sample_rate: flo
     """
     from .teststand import simulate_steady
 
+    check_flags(modes=modes, test_stand=test_stand, assumed_modes=assumed_modes)
     for name, value in (("sample_rate", sample_rate), ("n_samples", n_samples), ("noise", noise), ("seed", seed)):
         check_parameter(name, value)
     wheel, assumed_note = _stand_wheel(preset, physics, assumed_modes)
@@ -298,6 +301,7 @@ def simulate_sweep(preset: str = "ithaco-e", start_rpm: float = 0.0, end_rpm: fl
     """
     from .teststand import simulate_sweep as stand_sweep
 
+    check_flags(modes=modes, test_stand=test_stand, tach=tach, assumed_modes=assumed_modes)
     for name, value in (("sample_rate", sample_rate), ("noise", noise), ("seed", seed)):
         check_parameter(name, value)
     _choice("profile", profile, ("linear", "exp"))
@@ -374,6 +378,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     from .empirical import FitSettings, fit_empirical
     from .spectra import _default_nperseg, compute_spectra
 
+    check_flags(exclude_modes=exclude_modes, progress=progress)
     for parameter, value in (("f_lim", f_lim), ("nperseg", nperseg), ("presence", presence), ("epsilon", epsilon)):
         check_parameter(parameter, value)
     test = _as_test(data)
@@ -486,6 +491,7 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     from .extended_fit import to_model
     from .stand_resonance import fit_extended_beside_stand
 
+    check_flags(progress=progress)
     mass, radius, start = extended_options(mass, radius, height, preset)
     test = _as_test(data)
     if empirical is None:
@@ -757,6 +763,7 @@ def build_fmu(model=None, path="wheel.fmu", *, preset: str | None = None, native
     from .presets import preset as get_preset
     from .progress import working
 
+    check_flags(native=native, assumed_modes=assumed_modes, progress=progress)
     if Path(path).suffix != ".fmu":
         raise ParameterError("path", f"{str(path)!r} must end in .fmu")
     if preset and model is not None:

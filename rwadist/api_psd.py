@@ -129,7 +129,9 @@ def psd(model=None, speed_rpm=(0.0, 3000.0), *, preset: str | None = None, wheel
         Speeds beyond the wheel's rated maximum; modes the extended fit could not identify.
     """
     from .broadband import line_envelope
+    from .validate import check_flags
 
+    check_flags(empirical=empirical, assumed_modes=assumed_modes, envelope=envelope, progress=progress)
     law, (lo_rpm, hi_rpm) = _speed_law(speed_rpm, dist, std_rpm, fmax, n_freq, n_speeds)
     source = None               # the one wheel, or the set's default wheel
     if wheels is None or model is not None or preset:
@@ -205,8 +207,9 @@ def write_nastran(result, path, *, fields: str = "small", cross: bool = True) ->
     from .broadband import BroadbandPSD
     from .nastran import write_deck
     from .outputs import write_file
-    from .validate import check_object, check_path
+    from .validate import check_flags, check_object, check_path
 
+    check_flags(cross=cross)
     check_object("result", result, BroadbandPSD, "what rwadist.psd returns")
     check_path("path", path, "the bulk-data file to write")
     if fields not in ("small", "free"):

@@ -120,6 +120,14 @@ def check_path(name: str, value, what: str) -> None:
         raise ParameterError(name, f"a {type(value).__name__}: expected the path of {what}")
 
 
+def check_flags(**flags) -> None:
+    """:class:`ParameterError` naming the first of ``flags`` (name=value) that is not a bool (``"no"`` is a truthy
+    string: read as True, it would do the opposite of what was meant)."""
+    for name, value in flags.items():
+        if not isinstance(value, (bool, np.bool_)):
+            raise ParameterError(name, f"{value!r}: must be True or False")
+
+
 def check_object(name: str, value, cls: type, what: str) -> None:
     """:class:`ParameterError` naming ``name`` unless ``value`` is a ``cls``; ``what``: where one comes from."""
     if not isinstance(value, cls):

@@ -52,3 +52,15 @@ def test_an_hdf5_file_given_as_a_model_is_named_hdf5(tmp_path):
         rwadist.load_model(path)
     with pytest.raises(rwadist.DataError, match=r"an HDF5 file, not text"):
         rwadist.psd(str(path), speed_rpm=(600, 2400), empirical=True)
+
+
+@pytest.mark.parametrize("call, parameter", [
+    (lambda t: rwadist.fit(t, exclude_modes="no"), "exclude_modes"),
+    (lambda t: rwadist.simulate_test("ithaco-e", [600.0, 1200.0], modes="off"), "modes"),
+    (lambda t: rwadist.psd(MODEL, empirical=1), "empirical"),
+    (lambda t: rwadist.read("x", progress="yes"), "progress"),
+])
+def test_a_switch_given_as_anything_but_true_or_false_is_refused(test_data, call, parameter):
+    """``exclude_modes="no"`` was read as True (a non-empty string), the opposite of what was meant (trial 29)."""
+    with pytest.raises(rwadist.ParameterError, match=rf"^{parameter}: .*must be True or False"):
+        call(test_data)
