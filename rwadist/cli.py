@@ -280,6 +280,9 @@ def cmd_demo(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise DataError("--out", "value", f"{str(out)!r} is a file, not a folder: give a folder for the demo's outputs")
+    if (out / "runs.csv").is_file():        # a lab's runs: the demo's data and model would sit beside them
+        raise DataError("--out", "folder", f"{str(out)!r} holds a steady-test dataset (runs.csv); the demo writes "
+                        "its own data.h5, model.json and report/ there: give a new folder")
     check_output_dir(out / "report", "--out")       # its report folder is replaced whole
     wheel = preset("ithaco-e")
     speeds = np.linspace(300.0, 2400.0, args.n_speeds)

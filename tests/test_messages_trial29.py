@@ -61,3 +61,15 @@ def test_a_channel_in_pound_force_is_named_by_its_unit_factor():
     assert gain.parameters["amplitude_ratio"] == pytest.approx(4.44822, rel=0.01)
     assert "near the number of N in one lbf" in gain.causes[0]
     assert _unit_words(1.10, "Fx", "Fx", "Fy") == "" and "in·lbf in one N·m" in _unit_words(8.9, "Tx", "Tx", "Ty")
+
+
+def test_the_demo_is_not_written_into_a_dataset_folder(tmp_path, capsys):
+    """``rwadist demo --out LAB`` put data.h5, model.json and report/ beside a lab's runs (trial 29): refused, exit 2,
+    nothing written."""
+    data = tmp_path / "lab"
+    run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "3",
+        "--samples", "512")
+    before = sorted(p.name for p in data.iterdir())
+    code, _, err = run(capsys, "demo", "--out", data)
+    assert code == 2 and "holds a steady-test dataset (runs.csv)" in err
+    assert sorted(p.name for p in data.iterdir()) == before
