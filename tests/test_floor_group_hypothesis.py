@@ -96,3 +96,12 @@ def test_a_group_is_taken_back_whole_when_one_part_was_fitted_to_unexplained_con
     assert all(not h.passed and h.forced_by == "broadband_hump" for h in by_channel.values())
     assert hyps[0].passed and hyps[0].forced_by is None
     assert not np.any([h.passed for h in hyps[1:]])
+
+
+def test_a_semicolon_inside_a_value_does_not_split_its_pair():
+    """hypotheses.csv separates key=value pairs by ';' (docs/formats.md); a speed ripple's law text held one, which
+    split its pair in two (docs29 review)."""
+    law = Hypothesis(_Part("amplitude_law", "Fx"), 0.05, 0.2, 6.0, True, 1)
+    law.effect.params = lambda: {"law": "a; b", "h": 2.0}
+    (row,) = list(csv.DictReader(io.StringIO(hypotheses_csv([law]))))
+    assert row["parameters"].split(";") == ["law=a  b", "h=2"]

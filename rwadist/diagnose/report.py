@@ -304,7 +304,8 @@ def hypotheses_csv(hypotheses) -> str:
     seen: set = set()
     for h in hypotheses:
         e = h.effect
-        par = ";".join(f"{k}={_fmt(v, '.6g')}" for k, v in e.params().items()
+        # ';' separates the pairs: one inside a value (a law's text) would split it
+        par = ";".join(f"{k}={_fmt(v, '.6g').replace(';', ' ')}" for k, v in e.params().items()
                        if not (isinstance(v, list) and len(v) > 4))
         g = getattr(h, "group", None)
         gain = f"{h.gain:.6g},{h.gain_fraction:.6g}"
