@@ -147,6 +147,13 @@ jobs): diagnose cpu min benchmark 2.45 -> 2.10 s, sixty 1.45 -> 1.28 s (wall min
 and 0.10 -> 0.09 s; cpu x11.7/x10.9 -> x13.1/x12.9 (benchmark), x14.3/x14.3 -> x14.9/x14.7 (sixty): the ratio
 rose, the fit gaining more from the presence curve than diagnose; target not met.  Family matrix wheels 0-1 (46
 cells) and the open world (64 cells) identical to session 23's rows in every field.
+2026-12-02, session 29 (speed29, from 8189642): the extended base's lines of a subset of the runs are the rows of every
+run's when those are known (metric.rows_of_lines: each run's are its own; Context._ext_lines 23 -> 5 calls, 44 -> 12 ms
+a sixty diagnose); diagnose summaries of both sets and family wheels 0, 4, 7 byte-identical.  Alternated fresh
+children (2 x 3 pairs, load 2.8-3.3): sixty diagnose cpu min/median 1.62/1.68 -> 1.56/1.64 s.  --quick --repeats 3 at
+load 3.2-4.6: cpu x8.1/x8.3 (benchmark), x8.4/x7.8 (2 busy), x11.0/x11.3 and x11.5/x11.2 (sixty; 1.62 s / 0.15 s);
+target not met on the sixty set.  Tried, no gain: blocked_records written a record at a time (faster for 6 channels,
+slower for 2; memory-bound), the phasors' records kept for runs asked again (~5 ms, below the noise).
 """
 from __future__ import annotations
 

@@ -17,7 +17,7 @@ from ..spectra import Spectra, welch_dof
 from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
 from . import smear
 from .constants import BAND_BINS, F_MIN_BINS, KERNEL_HALF, LINE_HALF, NOISE_Z, TORQUE_CHANNELS
-from .metric import Metric, hann_tables, read_table
+from .metric import Metric, hann_tables, read_table, rows_of_lines
 from .reduce import bin_sums, column_nanmedian
 from .ripple import RIPPLE_IMBALANCE_DIRECTIONS, RIPPLE_OWN_GAIN_ORDERS, ripple_sideband_powers
 from .state import State
@@ -329,6 +329,9 @@ class Context(Metric):
         if key not in state._cache:
             lines = tuple(state.ext_lines())
             content = ("ext_lines", state.ext, lines, runs.tobytes())
+            every = ("ext_lines", state.ext, lines, self.runs.tobytes())
+            if content not in self._memo and every in self._memo and (pos := self.run_rows(runs)) is not None:
+                self._memo[content] = rows_of_lines(self._memo[every], pos)     # each run's lines are its own
             if content not in self._memo:
                 self._memo[content] = self._ext_lines(state, self.omega[runs], lines)
             state._cache[key] = self._memo[content]

@@ -102,11 +102,17 @@ class Metric:
         nothing is kept for every run or ``runs`` is not a proper subset of the runs (sorted, as ``self.runs``).
         For terms each run has on its own: a subset's are the rows of every run's."""
         whole = state._cache.get((name, c, self.runs.tobytes()))
-        if whole is None or runs.size >= self.runs.size:
+        pos = None if whole is None else self.run_rows(runs)
+        return None if pos is None else (whole, pos)
+
+    def run_rows(self, runs: np.ndarray) -> np.ndarray | None:
+        """The positions of ``runs`` in ``self.runs``, or None when ``runs`` is not a proper subset of them (sorted,
+        as ``self.runs``)."""
+        if runs.size >= self.runs.size:
             return None
         pos = np.searchsorted(self.runs, runs)
         if np.all(pos < self.runs.size) and np.array_equal(self.runs[np.minimum(pos, self.runs.size - 1)], runs):
-            return whole, pos
+            return pos
         return None
 
     def band_sums(self, x: np.ndarray) -> np.ndarray:
@@ -360,3 +366,19 @@ class Metric:
             M = self.band_sums(self.predict(state, c, self.runs)).sum(1)
             vals.append(np.abs(np.sqrt(M) - np.sqrt(D)) / np.sqrt(D))
         return float(np.nanmean(np.concatenate(vals)))
+
+
+def rows_of_lines(whole: tuple, pos: np.ndarray) -> tuple:
+    """(lines, mixing) by channel of the extended base's lines (:meth:`rwadist.diagnose.engine.Context.channel_lines`,
+    :meth:`~rwadist.diagnose.engine.Context.line_mixing`) at the rows ``pos`` of every run's ``whole``: each entry's
+    rows (each run's numbers are its own), an entry kept where it has power in one of those runs, as they are made."""
+    lines: dict = {c: [] for c in whole[0]}
+    mixing: dict = {c: [] for c in whole[1]}
+    for c, entries in whole[0].items():
+        for (h, law, a, gain), mix in zip(entries, whole[1][c]):
+            if np.any(a[pos] > 0):
+                a, gain, mix = a[pos], gain[pos], mix[pos]
+                a.flags.writeable = gain.flags.writeable = mix.flags.writeable = False
+                lines[c].append((h, law, a, gain))
+                mixing[c].append(mix)
+    return lines, mixing
