@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
+
 from .errors import ParameterError
 from .threads import in_one_blas_thread
 from .validate import (
@@ -50,7 +52,7 @@ def _one_wheel(source, law, fmax, n_freq: int, n_speeds: int, progress: bool):
 def _wheel_set(wheels, default, law, empirical: bool, assumed_modes: bool, fmax, n_freq: int, n_speeds: int,
                progress: bool):
     """The spacecraft-frame CSD of a set of wheels (:func:`rwadist.mounting.load_wheels`; ``meta`` names those whose
-    assumed modes were run hard-mounted or used), its line sources and its speed support (rad/s)."""
+    assumed modes were run hard-mounted or used), its line sources and each wheel's speed support (rad/s)."""
     from .mounting import load_wheels, spacecraft_csd
     from .speed_laws import law_text
 
@@ -62,10 +64,30 @@ def _wheel_set(wheels, default, law, empirical: bool, assumed_modes: bool, fmax,
     res.meta["hard_mounted_wheels"] = [w.name for w in ws if w.meta.get("modes_assumed") == "hard-mounted"]
     res.meta["on_assumed_modes"] = [f"{w.name} ({w.model_ref})" for w in ws
                                     if w.meta.get("modes_assumed") == "assumed modes used"]
-    support = (min(w.law.support[0] for w in ws if w.law), max(w.law.support[1] for w in ws if w.law))
     res.meta["speed_laws"] = [(w.name, law_text(w.law) if w.law is not None else
                                f"tied to {ws[w.tie.to].name} ×{w.tie.ratio:g}") for w in ws]
-    return res, [(w.lines, w.mounting) for w in ws], support
+    return res, [(w.lines, w.mounting) for w in ws], [_own_support(ws, i) for i in range(len(ws))]
+
+
+def _own_support(ws: list, i: int) -> tuple:
+    """(lo, hi) rad/s wheel ``i`` of the set ``ws`` runs over: its speed law's support, or for a tied wheel that
+    of the wheel its ties lead to, times the ties' ratios (±1; the chain ends: mounting refuses cycles)."""
+    ratio = 1.0
+    while ws[i].law is None:
+        ratio *= ws[i].tie.ratio
+        i = ws[i].tie.to
+    lo, hi = (ratio * v for v in ws[i].law.support)
+    return (min(lo, hi), max(lo, hi))
+
+
+def _set_envelope(sources: list, supports: list, f: np.ndarray):
+    """The worst-case line envelope of a set of wheels, each over its own speeds (``supports``, rad/s): the largest
+    of the wheels' own envelopes at each frequency, the table of each with its wheel's index."""
+    from .broadband import Envelope, line_envelope
+
+    own = [line_envelope([src], sup, f) for src, sup in zip(sources, supports)]
+    table = [dict(row, wheel=i) for i, e in enumerate(own) for row in e.table]
+    return Envelope(f=own[0].f, amplitude=np.max([e.amplitude for e in own], axis=0), table=table)
 
 
 @in_one_blas_thread
@@ -156,7 +178,10 @@ def psd(model=None, speed_rpm=(0.0, 3000.0), *, preset: str | None = None, wheel
     res.meta.update(meta, model="empirical" if hard else "extended", speed_rpm=(lo_rpm, hi_rpm),
                     fmax_hz=float(res.f[-1]))
     if envelope:
-        res.meta["envelope"] = line_envelope(sources, support, res.f)
+        # a wheel of a set only over its own speeds: over the set's whole range, a wheel run slower than the others
+        # was enveloped at speeds it never reaches
+        res.meta["envelope"] = (line_envelope(sources, support, res.f) if wheels is None
+                                else _set_envelope(sources, support, res.f))
     return res
 
 

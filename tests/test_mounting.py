@@ -176,3 +176,31 @@ def test_a_wheel_object_from_python_takes_the_model_itself(tmp_path):
     assert by_object[0].lines is by_object[1].lines
     with pytest.raises(DataError, match=r"wheels\[0\]\.model.*a int: expected a model-file path"):
         mt.load_wheels([{"model": 3, "mounting": {"preset": "pyramid-4", "index": 0}}])
+
+
+def test_each_wheel_of_a_set_is_enveloped_over_its_own_speeds():
+    """The worst-case line envelope of a set: wheel A (identity, 0-3000 rpm) and wheel B (spin axis along x, its
+    radial force on Fy and Fz, 1000-2000 rpm), one radial-force line h = 1 of C each.  Closed form: Fz holds B's line
+    alone, C·Ω² (peak) for f in [1000, 2000]/60 Hz and nothing above (the set's range was B's before: Fz enveloped up
+    to 50 Hz); Fx holds A's, C·Ω² up to 50 Hz."""
+    import rwadist
+
+    C = 2e-6
+    m = WheelModel(name="one", empirical={"radial_force": [Harmonic(h=1.0, C=C)], "radial_torque": [],
+                                          "axial_force": [], "axial_torque": []})
+    along_x = [[0, 0, 1], [1, 0, 0], [0, 1, 0]]          # wheel x, y, z -> spacecraft y, z, x
+    wheels = [{"name": "A", "model": m, "dcm": np.eye(3).tolist()},
+              {"name": "B", "model": m, "dcm": along_x, "speed": {"dist": "uniform", "min_rpm": 1000, "max_rpm": 2000}}]
+    res = rwadist.psd(wheels=wheels, speed_rpm=(0, 3000), empirical=True, envelope=True, fmax=60.0, n_freq=601)
+    env = res.meta["envelope"]
+    f, a = env.f, env.amplitude
+    want = C * (2 * np.pi * f) ** 2
+    inside = (f > 1000 / 60 + 0.2) & (f < 2000 / 60 - 0.2)
+    above = f > 2000 / 60 + 0.2
+    np.testing.assert_allclose(a[inside, 2], want[inside], rtol=1e-3)
+    assert np.all(a[above, 2] == 0.0)
+    below_top = (f > 1.0) & (f < 50.0 - 0.2)
+    np.testing.assert_allclose(a[below_top, 0], want[below_top], rtol=1e-3)
+    assert {row["wheel"] for row in env.table} == {0, 1}
+    top_b = max(row["speed_rpm"] for row in env.table if row["wheel"] == 1)
+    assert top_b == pytest.approx(2000.0, rel=1e-6)
