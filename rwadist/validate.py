@@ -235,9 +235,12 @@ def check_speeds_rpm(speeds, parameter: str) -> np.ndarray:
     if isinstance(speeds, (str, bytes)) or any(isinstance(x, (str, bytes, bool, np.bool_)) for x in items):
         raise ParameterError(parameter, f"{speeds!r}: not a list of numbers (rpm)")
     try:
-        s = np.asarray(speeds, dtype=float).ravel()
+        s = np.asarray(speeds, dtype=float)
     except (TypeError, ValueError):
         raise ParameterError(parameter, f"{speeds!r}: not a list of numbers (rpm)") from None
+    if s.ndim > 1:              # a table flattened would run speeds nobody listed in that order
+        raise ParameterError(parameter, f"an array of shape {s.shape}: give one list of speeds (rpm)")
+    s = s.ravel()
     if s.size == 0:
         raise ParameterError(parameter, "no speeds: give at least one speed in rpm")
     if s.size > MAX_SPEEDS:

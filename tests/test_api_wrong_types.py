@@ -64,3 +64,9 @@ def test_a_switch_given_as_anything_but_true_or_false_is_refused(test_data, call
     """``exclude_modes="no"`` was read as True (a non-empty string), the opposite of what was meant (trial 29)."""
     with pytest.raises(rwadist.ParameterError, match=rf"^{parameter}: .*must be True or False"):
         call(test_data)
+
+
+def test_a_table_of_speeds_is_refused_not_flattened():
+    """``simulate_test(speeds_rpm=[[1000, 2000], [1500, 1800]])`` ran the four speeds in the table's order (trial 29)."""
+    with pytest.raises(rwadist.ParameterError, match=r"^speeds_rpm: an array of shape \(2, 2\): give one list"):
+        rwadist.simulate_test("ithaco-e", speeds_rpm=np.array([[1000, 2000], [1500, 1800]]))
