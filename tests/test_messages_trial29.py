@@ -10,8 +10,7 @@ def test_a_model_written_without_its_report_names_the_earlier_report_beside_it(t
     data = tmp_path / "eight"
     run(capsys, "simulate-test", "--preset", "ithaco-e", data, "--speeds-rpm", "600:2400", "--n-speeds", "8",
         "--samples", "2048")
-    assert run(capsys, "fit", data, "-o", tmp_path / "m.json")[0] == 0
-    assert (tmp_path / "m_report").is_dir()
+    (tmp_path / "m_report").mkdir()            # where `fit -o m.json` put its report (tests/test_cli.py)
     code, _, err = run(capsys, "fit", data, "-o", tmp_path / "m.json", "--no-report")
     assert code == 0 and "m_report is the report of an earlier fit" in err
     code, _, err = run(capsys, "fit", data, "-o", tmp_path / "n.json", "--no-report")
