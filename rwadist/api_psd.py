@@ -16,7 +16,10 @@ import numpy as np
 from .errors import ParameterError
 from .threads import in_one_blas_thread
 from .validate import (
+    check_flags,
+    check_object,
     check_parameter,
+    check_path,
     check_speed_range,
     refuse_non_finite_psd,
     warn_beyond_rated_speed,
@@ -151,7 +154,6 @@ def psd(model=None, speed_rpm=(0.0, 3000.0), *, preset: str | None = None, wheel
         Speeds beyond the wheel's rated maximum; modes the extended fit could not identify.
     """
     from .broadband import line_envelope
-    from .validate import check_flags
 
     check_flags(empirical=empirical, assumed_modes=assumed_modes, envelope=envelope, progress=progress)
     law, (lo_rpm, hi_rpm) = _speed_law(speed_rpm, dist, std_rpm, fmax, n_freq, n_speeds)
@@ -232,7 +234,6 @@ def write_nastran(result, path, *, fields: str = "small", cross: bool = True) ->
     from .broadband import BroadbandPSD
     from .nastran import write_deck
     from .outputs import write_file
-    from .validate import check_flags, check_object, check_path
 
     check_flags(cross=cross)
     check_object("result", result, BroadbandPSD, "what rwadist.psd returns")

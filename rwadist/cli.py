@@ -144,16 +144,16 @@ def cmd_fit(args) -> int:
         raise DataError("--no-report", "--report", f"{args.report}: give one of the two (--no-report writes the model file "
                         "only)")
     report_dir: Path | None = None
+    beside = Path(args.output).with_suffix("").parent / (Path(args.output).stem + "_report")   # the default report
     if not args.no_report:
-        report_dir = Path(args.report) if args.report else Path(args.output).with_suffix("").parent / (
-            Path(args.output).stem + "_report")
+        report_dir = Path(args.report) if args.report else beside
         if not args.report:
             refuse_special_base(args.output, "-o", f"its report folder {report_dir.name}",
                                 "give --report DIR or --no-report")
         elif report_dir.resolve() == Path(args.output).resolve():   # the fit ran, then the two writes collided
             raise DataError("--report", "value", f"{args.report}: the same path as -o (the model file); the report "
                             f"is a folder of its own: give another, e.g. --report "
-                            f"{Path(args.output).with_suffix('').parent / (Path(args.output).stem + '_report')}")
+                            f"{beside}")
         check_output_dir(report_dir, "--report")
     check_fit_flags(args)
     if args.extended:
@@ -199,9 +199,8 @@ def cmd_fit(args) -> int:
               "fit the wheel's modes with --extended, or keep them with --no-mode-exclusion", file=sys.stderr)
     print(f"model:  {args.output}")
     print(f"report: {report_dir} ({len(files)} files)" if report_dir is not None else "report: none (--no-report)")
-    earlier = Path(args.output).with_suffix("").parent / (Path(args.output).stem + "_report")
-    if report_dir is None and earlier.is_dir():
-        print(f"note: {earlier} is the report of an earlier fit and does not describe this model (rerun without "
+    if report_dir is None and beside.is_dir():
+        print(f"note: {beside} is the report of an earlier fit and does not describe this model (rerun without "
               "--no-report to replace it, or remove it)", file=sys.stderr)
     if n == 0:
         # a script that goes on to psd, fmu or diagnose with this model would compute zeros: exit 1, as a failed check

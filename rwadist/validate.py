@@ -10,6 +10,7 @@ rpm and Hz at this edge.
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from typing import TypedDict
 
@@ -114,8 +115,6 @@ NONE_IS_DEFAULT = frozenset({"f_lim", "nperseg", "mass", "radius", "std_rpm", "f
 def check_path(name: str, value, what: str) -> None:
     """:class:`ParameterError` naming ``name`` unless ``value`` is a path (str or os.PathLike); ``what``: what the
     path must lead to (the message's advice, e.g. 'a model file (JSON)')."""
-    import os
-
     if not isinstance(value, (str, os.PathLike)):
         raise ParameterError(name, f"a {type(value).__name__}: expected the path of {what}")
 
