@@ -371,10 +371,11 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     -----
     RwadistWarning
         The strongest radial line sits where speeds given k times the wheel's would put the imbalance; a sweep's
-        speed from the data whose 1x line tied with another (the scale unsure: ``rwadist diagnose`` tests it); no
-        harmonic passed the presence threshold (the model is empty).
+        speed from the data whose 1x line tied with another (the scale unsure: ``rwadist diagnose`` tests it); a
+        radial channel reads its partner's lines by a unit factor (:func:`rwadist.fit_warnings.unit_mixup_warning`:
+        one of them in lbf, kgf, in·lbf, ...); no harmonic passed the presence threshold (the model is empty).
     """
-    from . import channel_distortion, data_quality, speed_whirl
+    from . import channel_distortion, data_quality, fit_warnings, speed_whirl
     from .empirical import FitSettings, fit_empirical
     from .spectra import _default_nperseg, compute_spectra
 
@@ -406,28 +407,11 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
         warnings.warn(RwadistWarning(text.removeprefix("WARNING: ")), stacklevel=2)
     if text := speed_whirl.fit_tie_warning(test):      # a sweep's speed from the data, its 1x line a tie
         warnings.warn(RwadistWarning(text), stacklevel=2)
+    if text := fit_warnings.unit_mixup_warning(spectra, result.model):     # a channel in another unit
+        warnings.warn(RwadistWarning(text), stacklevel=2)
     if not any(result.model.empirical.values()):
-        warnings.warn(RwadistWarning(_empty_model_advice(test, settings, presence)), stacklevel=2)
+        warnings.warn(RwadistWarning(fit_warnings.empty_model_advice(test, settings, presence)), stacklevel=2)
     return result
-
-
-def _empty_model_advice(test: SteadyTest, settings, presence: float) -> str:
-    """The words of an empty empirical fit: the cause the test shows (too few spinning runs for a harmonic's
-    ``min_points`` measurements), else where to look (the presence threshold, the band, the speed column's unit)."""
-    spinning = sum(1 for r in test.runs if np.isfinite(r.speed) and r.speed != 0)
-    if spinning < settings.min_points:
-        return (f"the model is empty: a harmonic needs {settings.min_points} measurements and the test has "
-                f"{spinning} spinning run(s); give at least {settings.min_points} runs over the speed range")
-    from .speed_check import misread_unit
-
-    unit = misread_unit(test)
-    if unit is not None:
-        return (f"the model is empty: the speeds look like {unit['unit']}, not rpm: the imbalance's radial-force line "
-                f"sits at the column's value read in {unit['unit']} in {unit['runs']} of {unit['spinning']} spinning "
-                f"runs; give the speeds in rpm (multiply them by {unit['factor']:.6g})")
-    return (f"no harmonic passed the presence threshold ({presence:g} of the runs): the model is empty; check that "
-            "the lines lie in the band read (`f_lim`) and that the speeds are in rpm, give more runs over the speed "
-            "range, or lower `presence`")
 
 
 def extended_options(mass: float | None = None, radius: float | None = None, height: float = 0.0,

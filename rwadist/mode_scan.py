@@ -486,6 +486,16 @@ NEAR_SPAN = 1.25
 NEAR_A_SPAN = 0.4
 
 
+def _at_the_end(f_best: float, f0_grid: np.ndarray) -> str:
+    """Why a mode whose best fit ``f_best`` (Hz) lies at an end of the scanned ``f0_grid`` (Hz) is not located; the
+    refinement around the grid's last points may step past them, which is said so (trial 29: "909.7 Hz of
+    1.25-882.8 Hz" quoted a value outside the range it named)."""
+    end = "bottom" if f_best <= f0_grid[2] * 1.001 else "top"
+    where = "at" if f0_grid[0] <= f_best <= f0_grid[-1] else "past"
+    return (f"the best fit puts it {where} the {end} of the scanned range {f0_grid[0]:.4g}-{f0_grid[-1]:.4g} Hz, "
+            f"at {f_best:.4g} Hz: no line comes near it")
+
+
 def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = None, tolerance: float = 0.02,
               min_log_lr: float = 2.0, near_hz: float | None = None, near_a: float | None = None) -> ModeScan:
     """Profile scan of one mode (see the module docstring).
@@ -578,8 +588,7 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     interval = (float(f0_grid[inside.min()]), float(f0_grid[inside.max()])) if inside.size else (f_best, f_best)
     reason = ""
     if f_best <= f0_grid[2] * 1.001 or f_best >= f0_grid[-3] * 0.999:
-        reason = (f"the best fit puts it at the end of the scanned range ({f_best:.4g} Hz of "
-                  f"{f0_grid[0]:.4g}-{f0_grid[-1]:.4g} Hz): no line comes near it")
+        reason = _at_the_end(f_best, f0_grid)
     elif log_lr_off < min_log_lr:
         far = f0_grid[io]
         reason = (f"the data fit a mode at {far:.4g} Hz almost as well as at {f_best:.4g} Hz "

@@ -55,3 +55,21 @@ def rad_s_to_rpm(omega):
 def rad_s_to_hz(omega):
     """Wheel speed in rad/s -> revolutions per second (Hz)."""
     return np.asarray(omega, dtype=float) / (2.0 * np.pi)
+
+
+#: Unit factors a channel recorded in the wrong unit reads by (amplitude ratio, the unit, the unit the other reads),
+#: forces then torques; a ratio within :data:`UNIT_TOLERANCE` of one is named as such.
+UNIT_FACTORS = {"F": ((4.44822, "lbf", "N"), (9.80665, "kgf", "N"), (3.59694, "N", "ozf")),
+                "T": ((1.35582, "ft·lbf", "N·m"), (8.85075, "N·m", "in·lbf"), (1000.0, "N·m", "N·mm"),
+                      (12.0, "ft·lbf", "in·lbf"))}
+UNIT_TOLERANCE = 0.02
+
+
+def unit_words(ratio: float, channel: str) -> str:
+    """'' or, when the amplitude ratio ``ratio`` (> 1) of a radial pair's channels is a unit factor of the pair of
+    ``channel`` ('Fx', 'Ty', ...: :data:`UNIT_FACTORS` of its first letter), the words naming the mix-up."""
+    for factor, big, small in UNIT_FACTORS[channel[0]]:
+        if abs(ratio / factor - 1.0) <= UNIT_TOLERANCE:
+            return (f"; {ratio:.4g} is near the number of {small} in one {big} ({factor:g}): one of the two "
+                    "recorded or declared in the other unit (the channel map's unit in meta.json, docs/formats.md)?")
+    return ""

@@ -50,7 +50,7 @@ def test_a_channel_in_pound_force_is_named_by_its_unit_factor():
     import numpy as np
 
     import rwadist
-    from rwadist.diagnose.describe_gain import _unit_words
+    from rwadist.units import unit_words
 
     test = rwadist.simulate_test("ithaco-e", speeds_rpm=np.linspace(600, 2400, 24), n_samples=4096, seed=1,
                                  physics="extended")
@@ -59,7 +59,7 @@ def test_a_channel_in_pound_force_is_named_by_its_unit_factor():
     (gain,) = [u for u in rwadist.diagnose(test).unexplained if u.parameters.get("property") == "channel_gain"]
     assert gain.parameters["amplitude_ratio"] == pytest.approx(4.44822, rel=0.01)
     assert "near the number of N in one lbf" in gain.causes[0]
-    assert _unit_words(1.10, "Fx", "Fx", "Fy") == "" and "in·lbf in one N·m" in _unit_words(8.9, "Tx", "Tx", "Ty")
+    assert unit_words(1.10, "Fx") == "" and "in·lbf in one N·m" in unit_words(8.9, "Tx")
 
 
 def test_the_demo_is_not_written_into_a_dataset_folder(tmp_path, capsys):

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..units import RAD_S_TO_RPM, RADIAL_PAIRS
+from ..units import RAD_S_TO_RPM, RADIAL_PAIRS, unit_words
 from .constants import LINE_HALF
 from .gain_step import gain_step
 from .unexplained import Unexplained
@@ -40,22 +40,6 @@ MIN_LINES = 2
 MIN_RUNS = 4
 
 
-#: Unit factors a channel recorded in the wrong unit reads by (amplitude ratio, the unit, the unit the other reads),
-#: forces then torques; a ratio within :data:`UNIT_TOLERANCE` of one is named as such.
-UNIT_FACTORS = {"F": ((4.44822, "lbf", "N"), (9.80665, "kgf", "N"), (3.59694, "N", "ozf")),
-                "T": ((1.35582, "ft·lbf", "N·m"), (8.85075, "N·m", "in·lbf"), (1000.0, "N·m", "N·mm"),
-                      (12.0, "ft·lbf", "in·lbf"))}
-UNIT_TOLERANCE = 0.02
-
-
-def _unit_words(ratio: float, cx: str, hi_c: str, lo_c: str) -> str:
-    """'' or, when the amplitude ratio ``ratio`` (> 1, ``hi_c`` over ``lo_c``) is a unit factor of the pair of
-    ``cx`` (:data:`UNIT_FACTORS`), the words naming the mix-up."""
-    for factor, big, small in UNIT_FACTORS[cx[0]]:
-        if abs(ratio / factor - 1.0) <= UNIT_TOLERANCE:
-            return (f"; {ratio:.4g} is near the number of {small} in one {big} ({factor:g}): one of the two "
-                    "recorded or declared in the other unit (the channel map's unit in meta.json, docs/formats.md)?")
-    return ""
 
 
 #: Effect kinds that read the torques corrected for a load-cell offset (left out by :func:`as_recorded`).
@@ -143,7 +127,7 @@ def channel_gain(ctx, state, shares) -> list:
                         "lines_h": [float(x) for x in h[lines][agree]], "cells": int(cells.size)},
             causes=(f"a gain or calibration error of {hi_c} or {lo_c}: {hi_c} reads {max(ratio, 1 / ratio):.3g} x "
                     f"{lo_c} on {'every line read' if agree.all() else _lines_words(h[lines][agree], h[lines])} (a "
-                    f"rotating load gives x and y the same power){_unit_words(max(ratio, 1 / ratio), cx, hi_c, lo_c)}",
+                    f"rotating load gives x and y the same power){unit_words(max(ratio, 1 / ratio), cx)}",
                     "a support or fixture stiffer in one direction: the suspension mode splits into an x and a y mode, "
                     "and the ratio changes across them but stays nearly constant on the lines well above both "
                     "(about (f_x/f_y)² in amplitude), as a gain's does"),
