@@ -17,7 +17,8 @@ target on the source over those points), a copy when the points near κ hold at 
 least :data:`MIN_RUN_FRACTION` of the runs where the copy would stand :data:`MIN_COPY_DB` over the target's
 noise (its ratio there within :data:`CLUSTER_TOLERANCE` of κ, or within the scatter that noise gives it,
 :data:`NOISE_Z`, the tolerance's own at :data:`CLEAR_COPY_DB`: a noisy test's copied lines stand 10-20 dB over the
-target's noise), and κ times the source stands over the target's noise.  Pairs of channels of one direction (Fx-Fy, Tx-Ty: a rotating line fixes their phase) are not tried, nor a
+target's noise), and κ times the source stands over the target's noise.  Pairs of channels of one direction (Fx-Fy, Tx-Ty: a rotating line fixes their phase) are not tried on the lines
+(on the floor they are, :func:`_floor_copies`), nor a
 torque carrying a force of a load-cell offset's r × F on the lines (the ``cross_coupling`` class;
 :data:`LEVER_ARM_PAIRS`: on the floor they are, against their mirror pair, :func:`_floor_copies`); a copy
 whose target torque that offset's r × F of the forces explains as well is the offset's (:func:`_lever_arm_of_forces`);
@@ -204,7 +205,7 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
     T_z += 0.02·F_x: r_y = −20 mm explains T_z as well, :func:`_lever_arm_of_forces`); the floor tells them apart: an
     offset moves loads, a copy carries the source's sensor noise too, and a lever-arm correction's (T − r × F of the
     measured forces) moves both of r's terms."""
-    from .channel_copy_broadband import find_broadband_copies
+    from .channel_copy_broadband import RADIAL_PAIR_WAYS, find_broadband_copies
 
     skip = {(x.source, x.target) for x in found} | {(a, x.target) for x in found for a in chans}
     got = find_broadband_copies(test, runs, chans, CLUSTER_TOLERANCE, skip, mirror=LEVER_ARM_MIRROR)
@@ -213,6 +214,12 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
         s, t = chans.index(g[0]), chans.index(g[1])
         mine = src == s
         Xs, Xt = X[mine, s], X[mine, t]
+        if g[:2] in RADIAL_PAIR_WAYS:
+            # a radial pair's two ways are one Gaussian pair of floors read backwards, and take alike of the lines; the
+            # lines tell: the copy removed the right way leaves them as a rotating load has them, x and y of one
+            # amplitude (trial 30, Fy += 0.2·Fx: median |ln| of the ratio 0 that way, 0.04 the other)
+            gain[g[:2]] = -_out_of_round(Xs, Xt - g[2] * Xs)
+            continue
         total = float(np.sum(np.abs(Xt) ** 2))
         gain[g[:2]] = 1.0 - float(np.sum(np.abs(Xt - g[2] * Xs) ** 2)) / total if total > 0 else 0.0
     out = []
@@ -229,6 +236,13 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
         level = float(10 * np.log10(np.median(over))) if over.size else float("nan")
         out.append(ChannelCopy(g[0], g[1], g[2], tuple(lines), g[3], level, floor_z=g[4]))
     return out
+
+
+def _out_of_round(a: np.ndarray, b: np.ndarray) -> float:
+    """Median over the line points of |ln(|b|/|a|)|: 0 for the two channels of a radial pair carrying a rotating load
+    (x and y of one amplitude); ``a``, ``b``: their transforms at the points (P,)."""
+    ok = (np.abs(a) > 0) & (np.abs(b) > 0)
+    return float(np.median(np.abs(np.log(np.abs(b[ok]) / np.abs(a[ok]))))) if ok.any() else float("inf")
 
 
 def _lever_arm_through_partner(copy: ChannelCopy) -> bool:

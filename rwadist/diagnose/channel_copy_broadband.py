@@ -20,7 +20,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..units import CHANNEL_DIRECTION
+from ..units import CHANNEL_DIRECTION, RADIAL_PAIRS
+
+#: The two channels of a radial pair (Fx-Fy, Tx-Ty), either way round: read on the real part of their noise floors'
+#: cross-spectrum.  A crosstalk inside the pair (Fy += 0.2·Fx: one bridge of the cell reading the other, a calibration
+#: matrix without its off-diagonal term) is a real gain; the pair's own coherence is the rotating lines' skirts, in
+#: quadrature (±90°: clean data read z 2-5 at −82°, which biased the band's lowest part of trial 30's Fy += 0.2·Fx
+#: past the tolerance), and a whirl's broadband response is in quadrature too
+RADIAL_PAIR_WAYS = {p for a, b in RADIAL_PAIRS for p in ((a, b), (b, a))}
 
 #: A run's noise-bin cross-spectrum over its null scatter, at least (an independent pair: |z| ~ 1, Rayleigh).
 MIN_Z = 8.0
@@ -59,11 +66,12 @@ def _channel_stats(Z) -> tuple:
     return P, quiet
 
 
-def _run_stats(Z, stats: tuple, s: int, t: int):
+def _run_stats(Z, stats: tuple, s: int, t: int, real: bool = False):
     """(κ, z, parts κ, parts σ) of the pair (s, t) on one run's segments: over the bins where both are noise;
     ``stats``: the run's :func:`_channel_stats`.  The parts (read only of a run where z reaches :data:`MIN_Z`) are
     None below it.  Sums by ``np.add.reduce`` (what ``np.sum`` calls, without its Python layers: ~20 sums per pair
-    and run)."""
+    and run).  ``real``: the cross-spectrum's real part alone (a radial pair, :func:`find_broadband_copies`), its
+    null scatter half the complex one's."""
     P, quiet = stats
     noise = quiet[s] & quiet[t]
     noise[:4] = False
@@ -80,6 +88,8 @@ def _run_stats(Z, stats: tuple, s: int, t: int):
     # the cross-spectrum of every bin, from the channels' strided columns: a product of contiguous copies of the
     # noise bins alone takes numpy's vector loop, whose complex products differ in the last bit
     Pst = np.mean(np.conj(Z[:, :, s]) * Z[:, :, t], axis=0)[idx]
+    if real:
+        Pst, null = Pst.real, null / 2
     cross = np.add.reduce(Pst)
     kappa = complex(cross / total)
     z = float(abs(cross) / np.sqrt(null))
@@ -87,12 +97,14 @@ def _run_stats(Z, stats: tuple, s: int, t: int):
         return kappa, z, None
     # BAND_PARTS contiguous parts of the noise bins
     parts = zip(*(np.array_split(x, BAND_PARTS) for x in (Pst, Pss, both)))
-    return kappa, z, [(np.add.reduce(a), np.add.reduce(b), np.add.reduce(c) / M) for a, b, c in parts]
+    return kappa, z, [(np.add.reduce(a), np.add.reduce(b), np.add.reduce(c) / M / (2 if real else 1))
+                      for a, b, c in parts]
 
 
 def find_broadband_copies(test, runs, chans, tolerance: float, skip=(), mirror=None) -> list:
-    """[(source, target, κ, runs, z median)] of the channel pairs of ``chans`` (not one direction's, not in
-    ``skip``) whose noise floors share one κ in :data:`MIN_RUN_FRACTION` of ``runs`` (indices of ``test.runs``) and
+    """[(source, target, κ, runs, z median)] of the channel pairs of ``chans`` (not one direction's but a radial
+    pair's two channels, not in ``skip``) whose noise floors share one κ in :data:`MIN_RUN_FRACTION` of ``runs``
+    (indices of ``test.runs``) and
     across the band (``tolerance``: the relative agreement asked for, besides the noise's own scatter).  ``mirror``:
     (source, target) -> the pair a load-cell offset's r × F would fill with −κ alongside (the same component of r,
     :func:`offset_mirror`); a pair's copy is dropped when its mirror reads −κ or cannot be read, and so is the pair
@@ -108,9 +120,10 @@ def find_broadband_copies(test, runs, chans, tolerance: float, skip=(), mirror=N
     for s in range(K):
         for t in range(K):
             cs, ct = chans[s], chans[t]
-            if s == t or CHANNEL_DIRECTION[cs] == CHANNEL_DIRECTION[ct] or (cs, ct) in skip:
+            radial = (cs, ct) in RADIAL_PAIR_WAYS
+            if s == t or (CHANNEL_DIRECTION[cs] == CHANNEL_DIRECTION[ct] and not radial) or (cs, ct) in skip:
                 continue
-            got = _pair(per_run, s, t, tolerance)
+            got = _pair(per_run, s, t, tolerance, real=radial)
             if got is None:
                 continue
             pair = (cs, ct) if (cs, ct) in mirror else (ct, cs) if (ct, cs) in mirror else None
@@ -125,9 +138,10 @@ def find_broadband_copies(test, runs, chans, tolerance: float, skip=(), mirror=N
     return out
 
 
-def _pair(per_run, s: int, t: int, tolerance: float):
-    """(κ, runs, z median) of the copy of channel s in t over ``per_run`` [(run, Z, its channel stats)], or None."""
-    stats = [(r, _run_stats(Z, cs, s, t)) for r, Z, cs in per_run]
+def _pair(per_run, s: int, t: int, tolerance: float, real: bool = False):
+    """(κ, runs, z median) of the copy of channel s in t over ``per_run`` [(run, Z, its channel stats)], or None;
+    ``real``: read on the cross-spectrum's real part (:func:`_run_stats`)."""
+    stats = [(r, _run_stats(Z, cs, s, t, real)) for r, Z, cs in per_run]
     stats = [(r, x) for r, x in stats if x is not None]
     if not stats:
         return None

@@ -179,6 +179,12 @@ class Unexplained:
             return LEVEL_WORDS["run_change:spread"].format(abs(self.level_dB), min(gains), max(gains), len(gains))
         if self.signature == "run_change":
             return LEVEL_WORDS["run_change"].format(self._run_change_level())
+        if self.signature == "channel_copy" and _number(self.level_dB) is None:
+            # a copy under a tenth of the target's own content in every band (a radial pair's crosstalk: Fy += 0.2·Fx
+            # is 4 % of Fy's own lines, trial 30) has no cells of its own: its level over the target's noise instead
+            p, over = self.parameters, _number(self.parameters.get("copy_over_noise_dB"))
+            return f"under a tenth of {p.get('target')}'s own content in every band" + (
+                "" if over is None else f", the copy {over:+.1f} dB over its noise on {p.get('source')}'s lines (median)")
         key = f"{self.signature}:{self.parameters.get('property')}"
         words = LEVEL_WORDS.get(f"{key}:{self.parameters.get('pattern')}", LEVEL_WORDS.get(key))
         out = (words or LEVEL_WORDS.get(self.signature, DEFAULT_LEVEL_WORDS)).format(self.level_dB)
