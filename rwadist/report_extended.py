@@ -16,12 +16,12 @@ from .report import (
     _band_top,
     _direction_label,
     _direction_unit,
-    _fmt,
     _new_figure,
     _save,
     _summary_md,
     harmonic_rows,
 )
+from .text_table import cell
 from .units import DIRECTION_C_UNIT, DIRECTION_CHANNELS, RAD_S_TO_RPM
 
 
@@ -172,8 +172,8 @@ def write_extended_report(efit, fit, out_dir, model=None, report_files=None) -> 
         w.writerow(["direction", "speed_rpm", "data_rms", "empirical_rms", "extended_rms", "modes_act"])
         for d, c in comparison.items():
             for k in np.argsort(c["speed_rpm"]):
-                w.writerow([d, _fmt(c["speed_rpm"][k]), _fmt(c["data"][k]), _fmt(c["empirical"][k]),
-                            _fmt(c["extended"][k]), int(c["in_modes"][k])])
+                w.writerow([d, cell(c["speed_rpm"][k]), cell(c["data"][k]), cell(c["empirical"][k]),
+                            cell(c["extended"][k]), int(c["in_modes"][k])])
     files.append(path)
     path = out / "extended_params.csv"
     with open(path, "w", newline="") as fh:
@@ -183,12 +183,12 @@ def write_extended_report(efit, fit, out_dir, model=None, report_files=None) -> 
             if key == "kind":
                 continue
             name = key.split("_")[0] + ("_" + key.split("_")[1] if key.startswith(("k_", "c_", "U_", "I_")) else "")
-            w.writerow([key, _fmt(value), _fmt(efit.rel_stderr.get(name, float("nan")))])
+            w.writerow([key, cell(value), cell(efit.rel_stderr.get(name, float("nan")))])
         for mode, z in efit.zeta.items():
-            w.writerow([f"zeta_{mode}", _fmt(z), ""])
+            w.writerow([f"zeta_{mode}", cell(z), ""])
         for d, c in comparison.items():
-            w.writerow([f"rms_error_in_modes_empirical_{d}", _fmt(c["error_empirical"]), ""])
-            w.writerow([f"rms_error_in_modes_extended_{d}", _fmt(c["error_extended"]), ""])
+            w.writerow([f"rms_error_in_modes_empirical_{d}", cell(c["error_empirical"]), ""])
+            w.writerow([f"rms_error_in_modes_extended_{d}", cell(c["error_extended"]), ""])
     files.append(path)
     if report_files is not None:
         top = _band_top(fit.spectra, None)
