@@ -150,3 +150,8 @@ def test_the_diagnose_reports_tables_are_documented(small_fit, tmp_path):
         "hypotheses.csv": undocumented("`hypotheses.csv`", header(tmp_path / "hypotheses.csv")),
     }
     assert not any(missing.values()), f"columns not defined in docs/formats.md section 6: {missing}"
+    # as every table: booleans true/false, a missing value an empty cell (docs review: True/False, nan)
+    with open(tmp_path / "hypotheses.csv", newline="") as fh:
+        assert {r["passed"] for r in csv.DictReader(fh)} <= {"true", "false"}
+    for name in ("hypotheses.csv", "rms_vs_speed.csv"):
+        assert "nan" not in (tmp_path / name).read_text().lower(), name
