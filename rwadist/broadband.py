@@ -467,7 +467,10 @@ def expected_mean_square(lines: WheelLines, law, f_max: float | None = None, n_s
 class Envelope:
     """Worst-case line spectrum: ``amplitude[k, c]`` is the largest peak amplitude (N or N·m) of any
     line that can sit at f[k] for some speed in the range; ``table`` lists per source and channel the
-    largest amplitude over the range and the speed (rpm) and frequency (Hz) where it occurs."""
+    largest amplitude over the range and the speed (rpm) and frequency (Hz) where it occurs: dicts of ``wheel`` (index),
+    ``line`` (index in its wheel's lines), ``source`` (its label), ``h``, ``channel``, ``max_amplitude`` (N or N·m),
+    ``speed_rpm`` (signed) and ``f_Hz``, a channel the line does not reach left out
+    (:func:`rwadist.psd_files.write_envelope_harmonics_csv` writes it)."""
 
     f: np.ndarray
     amplitude: np.ndarray
@@ -524,8 +527,8 @@ def line_envelope(wheels, speed_range, f: np.ndarray, n_speeds: int = 4000) -> E
         for i in range(len(lines)):
             for c, ch in enumerate(CHANNELS):
                 if best[i, c] > 0:
-                    table.append({"wheel": wi, "source": lines.labels[i], "h": float(lines.h[i]), "channel": ch,
-                                  "max_amplitude": float(best[i, c]),
+                    table.append({"wheel": wi, "line": i, "source": lines.labels[i], "h": float(lines.h[i]),
+                                  "channel": ch, "max_amplitude": float(best[i, c]),
                                   "speed_rpm": float(best_w[i, c] * RAD_S_TO_RPM),
                                   "f_Hz": float(lines.freqs([best_w[i, c]], [i])[0, 0])})
     return Envelope(f=f, amplitude=env, table=table)

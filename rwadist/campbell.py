@@ -8,13 +8,13 @@ Plots use a bare matplotlib ``Figure`` with the Agg canvas (no pyplot state).
 """
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 
 from . import extended as ext
 from .errors import ParameterError
+from .text_table import write_rows
 from .units import RPM_TO_RAD_S
 
 #: Column of each mode in a Campbell table (Hz): mode and whirl in the name.
@@ -42,16 +42,12 @@ def campbell_table(params: ext.ExtendedParams, speeds_rpm) -> dict:
 
 
 def write_campbell_csv(table: dict, path) -> Path:
-    """Write a :func:`campbell_table` as CSV (speed_rpm first, then the mode columns); returns the path."""
+    """Write a :func:`campbell_table` as CSV (speed_rpm first, then the mode columns, Hz; every digit, a NaN empty as in
+    every table: :func:`rwadist.text_table.cell`); returns the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     cols = ["speed_rpm"] + [c for c in table if c != "speed_rpm"]
-    data = np.column_stack([np.asarray(table[c], dtype=float) for c in cols])
-    with path.open("w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(cols)
-        w.writerows([[repr(float(v)) for v in row] for row in data])
-    return path
+    return write_rows(path, cols, zip(*(np.asarray(table[c], dtype=float) for c in cols)))
 
 
 def speed_range_rad_s(speeds_rpm) -> tuple:

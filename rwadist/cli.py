@@ -529,24 +529,28 @@ def _psd_kind(res, args) -> str:
     return kind + (" on ASSUMED modes" if res.meta["on_assumed_modes"] else "")
 
 
+#: the files ``rwadist psd -o X.csv`` writes beside X.csv, named X + each of these
+PSD_COMPANIONS = ("_cross.csv", "_cross.h5", "_envelope.csv", "_envelope_harmonics.csv", ".png", "_ASSUMED_MODES.txt")
+
+
 def _write_psd(res, out: Path, args, title: str) -> tuple:
     """The PSD's files, swapped in as ONE set (a kill never leaves a new table beside old cross-spectra): the table
-    (CSV or NASTRAN), the cross-spectra, the line envelope, the plot and, on assumed modes, the note; an older
-    companion this run does not write is removed with the set.  Returns (envelope, png)."""
+    (CSV or NASTRAN), the cross-spectra, the line envelope and its worst amplitude per line, the plot and, on assumed
+    modes, the note; an older companion this run does not write is removed with the set.  Returns (envelope, its
+    table per line, png)."""
     from . import psd_files
     from .nastran import left_out_text
 
     stem = out.with_suffix("")
-    sibling = {s: stem.parent / (stem.name + s) for s in ("_cross.csv", "_cross.h5", "_envelope.csv", ".png",
-                                                           "_ASSUMED_MODES.txt")}
+    sibling = {s: stem.parent / (stem.name + s) for s in PSD_COMPANIONS}
     cross_path = {"csv": sibling["_cross.csv"], "h5": sibling["_cross.h5"]}
     with output_set() as outs:
         note = sibling["_ASSUMED_MODES.txt"]
         if res.meta["on_assumed_modes"]:
             from .catalogue import write_assumed_note
 
-            write_assumed_note(note, res.meta["on_assumed_modes"], [out, sibling["_cross.csv"],
-                               sibling["_envelope.csv"], sibling[".png"]], with_flags, write_to=outs.file(note))
+            write_assumed_note(note, res.meta["on_assumed_modes"], [out, sibling["_cross.csv"], sibling["_envelope.csv"],
+                               sibling["_envelope_harmonics.csv"], sibling[".png"]], with_flags, write_to=outs.file(note))
         else:
             outs.remove(note)
         if args.format == "nastran":
@@ -566,13 +570,15 @@ def _write_psd(res, out: Path, args, title: str) -> tuple:
         elif args.cross == "h5":
             psd_files.write_hdf5(res, outs.file(cross_path["h5"]), "csd")
         psd_files.write_envelope_csv(res.meta["envelope"], outs.file(sibling["_envelope.csv"]))
+        psd_files.write_envelope_harmonics_csv(res.meta["envelope"], outs.file(sibling["_envelope_harmonics.csv"]),
+                                               psd_files.wheel_names(res))
         with working("drawing the PSD plot"):
             import_matplotlib_for_command()
             save_png(psd_files.plot_psd(res, title), outs.file(sibling[".png"]), dpi=110)
     print(wrote)
     if args.cross in cross_path:
         print(f"cross-spectra: {cross_path[args.cross]}" + (" (group /csd)" if args.cross == "h5" else ""))
-    return sibling["_envelope.csv"], sibling[".png"]
+    return sibling["_envelope.csv"], sibling["_envelope_harmonics.csv"], sibling[".png"]
 
 
 def cmd_psd(args) -> int:
@@ -585,10 +591,9 @@ def cmd_psd(args) -> int:
     check_psd_flags(args)
     lo_rpm, hi_rpm = _speed_range_flag(args.speed_rpm)
     out = check_output_file(args.output)
-    refuse_special_base(out, "-o", "its companions (_envelope.csv, .png)")
+    refuse_special_base(out, "-o", "its companions (_envelope.csv, _envelope_harmonics.csv, .png)")
     stem = out.with_suffix("")
-    written = [out] + [stem.parent / (stem.name + s) for s in ("_cross.csv", "_cross.h5", "_envelope.csv", ".png",
-                                                               "_ASSUMED_MODES.txt")]
+    written = [out] + [stem.parent / (stem.name + s) for s in PSD_COMPANIONS]
     refuse_input_overwrite([("-o", p, "file") for p in written],
                            [args.model, args.wheels, args.dist if Path(args.dist).suffix else None])
     t0 = time.perf_counter()
@@ -596,13 +601,13 @@ def cmd_psd(args) -> int:
                   std_rpm=args.std_rpm, empirical=args.empirical, assumed_modes=args.assumed_modes, fmax=args.fmax,
                   n_freq=args.n_freq, n_speeds=args.n_speeds, envelope=True, progress=True)
     kind = _psd_kind(res, args)
-    p_env, png = _write_psd(res, out, args, psd_title(kind, res))
+    p_env, p_lines, png = _write_psd(res, out, args, psd_title(kind, res))
     rms = res.rms()
     print(f"{kind}, {res.frame} frame, {res.f.size} frequencies to {res.meta['fmax_hz']:g} Hz, "
           f"{time.perf_counter() - t0:.1f} s")
     print("RMS: " + ", ".join(f"{c} {v:.4g} {'N' if c[0] == 'F' else 'N·m'}"
                               for c, v in zip(("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"), rms)))
-    print(f"worst-case line envelope: {p_env}; plots: {png}")
+    print(f"worst-case line envelope: {p_env}; its worst amplitude per line: {p_lines}; plots: {png}")
     return 0
 
 

@@ -656,9 +656,9 @@ def _mode_hz_of(params: ext.ExtendedParams, mode: str) -> float:
 # --------------------------------------------------------------------------- 4. comparison
 
 def rms_comparison(efit: ExtendedFit, fit: EmpiricalFit) -> dict:
-    """RMS vs speed of data, empirical model and extended model, per direction, and the
-    error of each model where modes are excited (speeds inside any excluded range of that
-    direction).
+    """RMS vs speed of data, empirical model and extended model, per direction (``runs``: its spinning runs with the
+    direction's first channel, indices of the spectra; ``speed_rpm``: their |speed|), and the error of each model
+    where modes are excited (speeds inside any excluded range of that direction).
 
     Data RMS is over (0, band limit] with the noise floor's mean square removed, so what
     is compared is the harmonic content.  Error = RMS over those speeds of
@@ -692,7 +692,7 @@ def rms_comparison(efit: ExtendedFit, fit: EmpiricalFit) -> dict:
             m = in_modes & (data > 0)
             return float(np.sqrt(np.mean(((model[m] - data[m]) / data[m]) ** 2))) if m.any() else float("nan")
         out[d] = {"speed_rpm": rpm[ok], "data": data, "empirical": emp, "extended": exm, "in_modes": in_modes,
-                  "error_empirical": err(emp), "error_extended": err(exm)}
+                  "error_empirical": err(emp), "error_extended": err(exm), "runs": np.flatnonzero(ok)}
     return out
 
 

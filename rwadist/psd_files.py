@@ -1,4 +1,5 @@
-"""Files and plots of the broadband PSD: CSV (auto and cross spectra, envelopes), HDF5, a figure.
+"""Files and plots of the broadband PSD: CSV (auto and cross spectra, envelopes, the envelope's worst line amplitudes),
+HDF5, a figure.
 Part of :mod:`rwadist.broadband`, which re-exports these names."""
 from __future__ import annotations
 
@@ -9,8 +10,8 @@ from pathlib import Path
 import numpy as np
 
 from .broadband import _CROSS_UNIT, PAIRS, BroadbandPSD, Envelope
-from .text_table import write_csv
-from .units import CHANNELS, PSD_COLUMN
+from .text_table import write_csv, write_rows
+from .units import CHANNEL_UNIT, CHANNELS, PSD_COLUMN
 
 
 def write_psd_csv(res: BroadbandPSD, path) -> Path:
@@ -146,5 +147,57 @@ def plot_psd(res: BroadbandPSD, title: str = ""):
 
 
 def write_envelope_csv(env: Envelope, path) -> Path:
-    cols = ["f_Hz"] + [f"{c}_{'N' if c.startswith('F') else 'Nm'}" for c in CHANNELS]
+    """The worst-case line envelope: columns f_Hz, then per channel its peak amplitude ``<ch>_N`` or ``<ch>_Nm``
+    (N or N·m) of the strongest line at that frequency (docs/formats.md); 8 significant digits."""
+    cols = ["f_Hz"] + [f"{c}_{CHANNEL_UNIT[c]}" for c in CHANNELS]
     return write_csv(path, ",".join(cols), np.column_stack([env.f, env.amplitude]), 8)
+
+
+def envelope_harmonics_columns() -> list:
+    """Columns of the envelope's table per line: ``wheel``, ``source``, ``h``, then per channel <ch> (unit <unit>:
+    N or Nm) ``<ch>_max_<unit>``, ``<ch>_speed_rpm``, ``<ch>_f_Hz``."""
+    cols = ["wheel", "source", "h"]
+    for c in CHANNELS:
+        cols += [f"{c}_max_{CHANNEL_UNIT[c]}", f"{c}_speed_rpm", f"{c}_f_Hz"]
+    return cols
+
+
+def wheel_names(res: BroadbandPSD) -> list:
+    """The name of each wheel of :func:`rwadist.psd`'s result ``res``, in the order of the envelope's ``wheel`` index:
+    a set's names (``meta["speed_laws"]``), or the one wheel's (``meta["wheel"]``)."""
+    one = res.meta.get("wheel") or (res.meta.get("source") or {}).get("name") or ""
+    return [str(name) if name is not None else str(one) for name, _ in res.meta.get("speed_laws", [(None, "")])]
+
+
+def write_envelope_harmonics_csv(env: Envelope, path, names=None) -> Path:
+    """The envelope's table (:attr:`rwadist.broadband.Envelope.table`) as CSV, one row per line of each wheel, in the
+    order of the wheels and of their lines: the wheel (``names[i]``, default its index), the line's label and harmonic
+    number h, then per channel the line's largest peak amplitude over the wheel's speeds (N or N·m, in the envelope's
+    frame), the signed speed (rpm) and the line's frequency (Hz) where it occurs; a channel the line does not reach
+    has amplitude 0 and its speed and frequency empty.  8 significant digits (:func:`rwadist.text_table.cell`).
+
+    Parameters
+    ----------
+    env : rwadist.broadband.Envelope
+        The envelope, with its table.
+    path : str or pathlib.Path
+        The CSV file to write.
+    names : list of str or None
+        The wheels' names by index (:func:`wheel_names`); None: the indices.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    rows: dict = {}
+    for r in env.table:
+        key = (r["wheel"], r["line"])
+        row = rows.setdefault(key, {"wheel": names[r["wheel"]] if names is not None else r["wheel"],
+                                    "source": r["source"], "h": r["h"]}
+                              | {f"{c}_max_{CHANNEL_UNIT[c]}": 0.0 for c in CHANNELS})
+        c = r["channel"]
+        row |= {f"{c}_max_{CHANNEL_UNIT[c]}": r["max_amplitude"], f"{c}_speed_rpm": r["speed_rpm"],
+                f"{c}_f_Hz": r["f_Hz"]}
+    cols = envelope_harmonics_columns()
+    return write_rows(path, cols, ([row.get(c) for c in cols] for row in rows.values()), digits=8)

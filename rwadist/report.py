@@ -13,8 +13,6 @@ Hz; amplitudes and RMS in N or N·m.  The ``fit`` argument is an
 """
 from __future__ import annotations
 
-import csv
-import json
 import warnings
 from pathlib import Path
 
@@ -26,6 +24,7 @@ from matplotlib.figure import Figure
 from . import compare
 from .plot_util import PNG_COMPRESS_LEVEL, log_axis, save_png  # noqa: F401 (PNG_COMPRESS_LEVEL: its old home)
 from .spectra import cumulative_rms
+from .text_table import write_rows
 from .units import (
     CHANNEL_DIRECTION,
     CHANNEL_UNIT,
@@ -516,8 +515,8 @@ def _same_h(a: float, b: float) -> bool:
 
 def harmonic_rows(fit) -> list:
     """One dict per harmonic: direction, h, C_SI, C_stderr_SI, C_all_SI, n_points, presence,
-    excluded_rpm (list), in_model.  From the fit's lines; harmonics of the model without a line
-    are added from the model (C_all unknown: NaN)."""
+    excluded_rpm (list of [lo, hi] rpm: summary.md's column, excluded_ranges.csv's rows), in_model, heldout_rel.
+    From the fit's lines; harmonics of the model without a line are added from the model (C_all unknown: NaN)."""
     model_h = {d: [float(hm.h) for hm in fit.model.harmonics(d)] for d in DIRECTION_CHANNELS}
     rows = []
     matched: dict[str, set[int]] = {d: set() for d in DIRECTION_CHANNELS}    # indices into model_h[d] with a line
@@ -544,29 +543,9 @@ def harmonic_rows(fit) -> list:
     return rows
 
 
-def _fmt(v) -> str:
-    if isinstance(v, (bool, np.bool_)):
-        return "true" if v else "false"
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    if isinstance(v, (float, np.floating)):
-        return "" if not np.isfinite(v) else repr(float(v))
-    if isinstance(v, list):
-        return json.dumps(v)
-    return str(v)
-
-
-def _write_csv(path: Path, columns: list, rows) -> Path:
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(columns)
-        for r in rows:
-            w.writerow([_fmt(r[c]) for c in columns])
-    return path
-
-
-HARMONICS_COLUMNS = ["direction", "h", "C_SI", "C_stderr_SI", "C_all_SI", "n_points", "presence",
-                     "excluded_rpm", "in_model", "heldout_rel"]
+#: harmonics.csv's columns: a line's excluded speed ranges are the rows of excluded_ranges.csv with its direction and h
+HARMONICS_COLUMNS = ["direction", "h", "C_SI", "C_stderr_SI", "C_all_SI", "n_points", "presence", "in_model",
+                     "heldout_rel"]
 BINS_COLUMNS = ["direction", "h", "n_bin", "n_possible", "presence", "kept", "reason"]
 EXCLUDED_COLUMNS = ["direction", "h", "lo_rpm", "hi_rpm"]
 
@@ -668,16 +647,16 @@ def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None =
         bar.update()
 
     rows = harmonic_rows(fit)
-    files.append(_write_csv(out / "harmonics.csv", HARMONICS_COLUMNS, rows))
+    files.append(write_rows(out / "harmonics.csv", HARMONICS_COLUMNS, rows))
     table = compare.rms_table(fit, top)
     cols = list(table)
-    files.append(_write_csv(out / "rms_vs_speed.csv", cols,
+    files.append(write_rows(out / "rms_vs_speed.csv", cols,
                             ({c: float(table[c][i]) for c in cols} for i in range(len(table["speed_rpm"])))))
-    files.append(_write_csv(out / "bins.csv", BINS_COLUMNS,
+    files.append(write_rows(out / "bins.csv", BINS_COLUMNS,
                             ({c: getattr(b, c, "") for c in BINS_COLUMNS} for b in fit.bins)))
     exc = [{"direction": r["direction"], "h": r["h"], "lo_rpm": float(lo), "hi_rpm": float(hi)}
            for r in rows for lo, hi in r["excluded_rpm"]]
-    files.append(_write_csv(out / "excluded_ranges.csv", EXCLUDED_COLUMNS, exc))
+    files.append(write_rows(out / "excluded_ranges.csv", EXCLUDED_COLUMNS, exc))
     summary = out / "summary.md"
     summary.write_text(_summary_md(fit, rows, table, top, files))
     files.append(summary)

@@ -3,7 +3,6 @@ vs speed, line amplitudes through the fitted modes, the parameters, and summary.
 (:func:`write_extended_report`).  Built on :mod:`rwadist.report`'s helpers."""
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
@@ -16,13 +15,14 @@ from .report import (
     _band_top,
     _direction_label,
     _direction_unit,
-    _fmt,
     _new_figure,
     _save,
     _summary_md,
     harmonic_rows,
 )
-from .units import DIRECTION_C_UNIT, DIRECTION_CHANNELS, RAD_S_TO_RPM
+from .schema import PARAM_KEYS
+from .text_table import write_rows
+from .units import CHANNEL_UNIT, DIRECTION_C_UNIT, DIRECTION_CHANNELS, RAD_S_TO_RPM
 
 
 def _extended_md(efit, comparison, model) -> list:
@@ -147,13 +147,88 @@ def plot_extended_lines(efit, direction: str, fig=None):
     return fig
 
 
+def rms_columns(comparison: dict) -> list:
+    """extended_rms_vs_speed.csv's columns: ``speed_rpm``, then per direction of ``comparison`` (radial force, radial
+    torque, axial force, as :func:`rwadist.extended_fit.rms_comparison` holds them) with its first channel <ch> and
+    its unit <unit> (N, Nm): ``data_floor_removed_<ch>_rms_<unit>``, ``empirical_<ch>_rms_<unit>``,
+    ``extended_<ch>_rms_<unit>`` and ``modes_act_<direction>``."""
+    cols = ["speed_rpm"]
+    for d in comparison:
+        c = DIRECTION_CHANNELS[d][0]
+        u = CHANNEL_UNIT[c]
+        cols += [f"data_floor_removed_{c}_rms_{u}", f"empirical_{c}_rms_{u}", f"extended_{c}_rms_{u}", f"modes_act_{d}"]
+    return cols
+
+
+def write_rms_csv(comparison: dict, spectra, path) -> Path:
+    """extended_rms_vs_speed.csv: one row per spinning run of ``spectra`` with a direction's first channel, in the
+    test's order, its speed signed (rpm); per direction (:func:`rms_columns`) the data's RMS with the noise floor's
+    mean square removed, the empirical and the extended model's RMS (N or N·m, over (0, band limit]) and whether the
+    speed lies inside an excluded (modal) range of the direction; cells of a run without the channel left empty.
+    ``comparison``: :func:`rwadist.extended_fit.rms_comparison`'s.  Returns the path."""
+    runs = sorted({int(r) for c in comparison.values() for r in c["runs"]})
+    rows = {r: {"speed_rpm": float(spectra.speed[r]) * RAD_S_TO_RPM} for r in runs}
+    for d, c in comparison.items():
+        ch = DIRECTION_CHANNELS[d][0]
+        u = CHANNEL_UNIT[ch]
+        for k, r in enumerate(c["runs"]):
+            rows[int(r)] |= {f"data_floor_removed_{ch}_rms_{u}": float(c["data"][k]),
+                             f"empirical_{ch}_rms_{u}": float(c["empirical"][k]),
+                             f"extended_{ch}_rms_{u}": float(c["extended"][k]), f"modes_act_{d}": bool(c["in_modes"][k])}
+    cols = rms_columns(comparison)
+    return write_rows(path, cols, ([row.get(col) for col in cols] for row in rows.values()))
+
+
+#: a relative standard error below this is no estimate: the least squares did not move the parameter
+NOT_MOVED = 1e-9
+
+
+def param_rel_stderr(efit, name: str) -> float:
+    """The relative standard error (σ/value) of the extended model's parameter ``name`` (a key of the fit's
+    parameters: "k_r", "c_rock", "U_s", ...) from the extended fit ``efit``'s final least squares, NaN where it has
+    none: a stiffness or damping of a mode the least squares did not leave free (held at its starting value), a
+    damping it held (its mode in ``efit.zeta_bounds``) or pinned at its ceiling (the least squares does not move it:
+    its error would read 0, below :data:`NOT_MOVED`), the mass, the inertias and the lever arm (given, or per unit, or the rocking scan's ratio: not fitted there).  The
+    imbalances U_s and U_d are the coefficients of the h = 1 co-rotating radial force and torque lines: their lines'
+    errors."""
+    if name in ("U_s", "U_d"):
+        d = "radial_force" if name == "U_s" else "radial_torque"
+        line = next((ln for ln in efit.lines if ln.imbalance and ln.direction == d), None)
+        return float("nan") if line is None else float(
+            efit.rel_stderr.get(f"C[{line.direction},{line.h:g},{line.sense}]", float("nan")))
+    held = {"c_r": "radial_translation", "c_rock": "rocking", "c_z": "axial_translation"}.get(name)
+    rel = float(efit.rel_stderr.get(name, float("nan")))
+    # a parameter the least squares does not move (a held damping, or one pinned at its ceiling: its column of the
+    # Jacobian zero) comes out with an error of 0, or of rounding's 1e-18
+    return float("nan") if held in efit.zeta_bounds or rel < NOT_MOVED else rel
+
+
+def param_rows(efit, comparison: dict) -> list:
+    """extended_params.csv's rows [parameter, value, rel_stderr]: the model file's ``analytical`` parameters (units in
+    their names) with :func:`param_rel_stderr`, the modes' damping ratios and the models' errors where modes act
+    (fractions; no standard error: NaN)."""
+    from .extended import params_to_dict
+
+    nan = float("nan")
+    rows = []
+    for key, value in params_to_dict(efit.params).items():
+        if key == "kind":
+            continue
+        name = next(n for n, k in PARAM_KEYS.items() if k == key)
+        rows.append([key, value, param_rel_stderr(efit, name)])
+    rows += [[f"zeta_{mode}", z, nan] for mode, z in efit.zeta.items()]
+    for d, c in comparison.items():
+        rows += [[f"rms_error_in_modes_empirical_{d}", c["error_empirical"], nan],
+                 [f"rms_error_in_modes_extended_{d}", c["error_extended"], nan]]
+    return rows
+
+
 def write_extended_report(efit, fit, out_dir, model=None, report_files=None) -> list:
     """Extended-model part of the report: ``extended_rms_<direction>.png``,
     ``extended_lines_<direction>.png``, ``extended_rms_vs_speed.csv`` and ``extended_params.csv``.
     With ``report_files`` (what :func:`write_report` wrote in ``out_dir``), summary.md is written again as the
     extended fit's report: the extended model (``model``, the model file's) first -- its modes, its errors, every
     file -- then the empirical fit it started from."""
-    from .extended import params_to_dict
     from .extended_fit import rms_comparison
 
     out = Path(out_dir)
@@ -166,30 +241,9 @@ def write_extended_report(efit, fit, out_dir, model=None, report_files=None) -> 
         fig = plot_extended_lines(efit, d)
         if fig is not None:
             files.append(_save(fig, out / f"extended_lines_{d}.png"))
-    path = out / "extended_rms_vs_speed.csv"
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["direction", "speed_rpm", "data_rms", "empirical_rms", "extended_rms", "modes_act"])
-        for d, c in comparison.items():
-            for k in np.argsort(c["speed_rpm"]):
-                w.writerow([d, _fmt(c["speed_rpm"][k]), _fmt(c["data"][k]), _fmt(c["empirical"][k]),
-                            _fmt(c["extended"][k]), int(c["in_modes"][k])])
-    files.append(path)
-    path = out / "extended_params.csv"
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["parameter", "value", "rel_stderr"])
-        for key, value in params_to_dict(efit.params).items():
-            if key == "kind":
-                continue
-            name = key.split("_")[0] + ("_" + key.split("_")[1] if key.startswith(("k_", "c_", "U_", "I_")) else "")
-            w.writerow([key, _fmt(value), _fmt(efit.rel_stderr.get(name, float("nan")))])
-        for mode, z in efit.zeta.items():
-            w.writerow([f"zeta_{mode}", _fmt(z), ""])
-        for d, c in comparison.items():
-            w.writerow([f"rms_error_in_modes_empirical_{d}", _fmt(c["error_empirical"]), ""])
-            w.writerow([f"rms_error_in_modes_extended_{d}", _fmt(c["error_extended"]), ""])
-    files.append(path)
+    files.append(write_rms_csv(comparison, fit.spectra, out / "extended_rms_vs_speed.csv"))
+    files.append(write_rows(out / "extended_params.csv", ["parameter", "value", "rel_stderr"],
+                            param_rows(efit, comparison)))
     if report_files is not None:
         top = _band_top(fit.spectra, None)
         every = [f for f in report_files if Path(f).name != "summary.md"] + files

@@ -1,4 +1,5 @@
-"""Numeric tables written as CSV text fast: printf's ``%.{d}e`` for whole arrays at once.
+"""Tables written as CSV text: numeric arrays fast, printf's ``%.{d}e`` for whole arrays at once (:func:`write_csv`);
+the report and result tables row by row, each cell as every table writes it (:func:`cell`, :func:`write_rows`).
 
 ``np.savetxt`` formats number after number in Python (~0.3 µs each: 2.5 s for the 76 MB of a spacecraft CSD's
 tables).  Here the digits come from numpy arithmetic on the whole array, the same characters printf writes:
@@ -199,3 +200,48 @@ def write_csv(path, header: str, columns: np.ndarray, digits: int, chunk: int = 
             fh.write(format_rows(columns[s:s + rows], digits))
     return path
 
+
+
+def cell(value, digits: int | None = None) -> str:
+    """One cell of a report or result table (docs/formats.md section 6), the same in every table.
+
+    Parameters
+    ----------
+    value : bool, int, float, str or None
+        The value, in the unit its column names.
+    digits : int or None
+        Significant digits of a float (``%.{digits}g``); None: every digit (``repr``, read back bit for bit).
+
+    Returns
+    -------
+    str
+        ``true``/``false`` for a boolean, an integer as it is, a float as above, the empty string for NaN, ±inf or
+        None (a value that could not be computed), anything else as ``str``.
+    """
+    if value is None:
+        return ""
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        if not np.isfinite(value):
+            return ""
+        return repr(float(value)) if digits is None else format(float(value), f".{digits}g")
+    return str(value)
+
+
+def write_rows(path, columns: list, rows, digits: int | None = None) -> Path:
+    """A table of ``rows`` (dicts, or sequences in the order of ``columns``) as CSV through the csv module (a
+    comma or quote inside a text cell is quoted, never a new column): ``columns`` as the header, each value as
+    :func:`cell` writes it; ``digits`` as there.  Returns the path."""
+    import csv
+
+    path = Path(path)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(columns)
+        for r in rows:
+            values = [r[c] for c in columns] if isinstance(r, dict) else r
+            w.writerow([cell(v, digits) for v in values])
+    return path

@@ -236,7 +236,7 @@ def test_cli_psd_outputs_and_errors(tmp_path, capsys):
                  "-o", str(out)]) == 0
     header = out.read_text().splitlines()[0]
     assert header == "f_Hz,Fx_N2_per_Hz,Fy_N2_per_Hz,Fz_N2_per_Hz,Tx_Nm2_per_Hz,Ty_Nm2_per_Hz,Tz_Nm2_per_Hz"
-    for suffix in ("_cross.csv", "_envelope.csv", ".png"):
+    for suffix in ("_cross.csv", "_envelope.csv", "_envelope_harmonics.csv", ".png"):
         assert (tmp_path / ("psd" + suffix)).exists()
     cross = (tmp_path / "psd_cross.csv").read_text().splitlines()[0].split(",")
     assert len(cross) == 1 + 2 * 15 and "Fx_Tx_re_N2m_per_Hz" in cross

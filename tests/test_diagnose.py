@@ -10,6 +10,7 @@ within 5 %; load-cell offset r within 1 mm per component.  Error metric: ``water
 """
 from __future__ import annotations
 
+import csv
 import json
 from dataclasses import replace
 
@@ -329,6 +330,8 @@ def test_cross_coupling_report(tmp_path):
     assert [e["kind"] for e in summary["effects"]] == ["cross_coupling"]
     assert summary["effects"][0]["r_m"][2] == pytest.approx(0.05, abs=1e-3)
     assert model_io.load(tmp_path / "model.json").effects[0]["r_m"] == summary["effects"][0]["r_m"]
-    rows = (tmp_path / "hypotheses.csv").read_text().strip().splitlines()
-    assert len({len(x.split(",")) for x in rows}) == 1
+    with open(tmp_path / "hypotheses.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert len({len(x) for x in rows}) == 1 and len(rows) > 1
+    assert {r[-1] for r in rows[1:]} <= {"true", "false"}
     assert summary["error_before"] > 3 * summary["error_after"]

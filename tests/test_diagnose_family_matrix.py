@@ -233,7 +233,7 @@ def test_a_floor_of_the_rotor_forces_split_over_three_channels_is_found_at_its_l
     # the search passed the three parts as one hypothesis (Hypothesis.group, wired in search._search): its held-out
     # gain written once in hypotheses.csv, each part's row marked part_of the group's channels
     with open(tmp_path / "w4_broadband_floor" / "report" / "hypotheses.csv") as fh:
-        rows = [r for r in csv.DictReader(fh) if r["kind"] == "broadband_floor" and r["passed"] == "True"]
+        rows = [r for r in csv.DictReader(fh) if r["kind"] == "broadband_floor" and r["passed"] == "true"]
     assert sorted(r["channels"] for r in rows) == ["Fx", "Fy", "Fz"]
     assert all("part_of=Fx Fy Fz" in r["parameters"] for r in rows)
     assert sum(r["heldout_gain"] != "" for r in rows) == 1

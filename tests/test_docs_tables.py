@@ -102,7 +102,8 @@ def test_the_psd_and_campbell_tables_are_documented(capsys, tmp_path):
                        "-o", tmp_path / "campbell.csv")
     assert code == 0, err
     written = sorted(p.name for p in tmp_path.glob("*.csv"))
-    assert written == ["campbell.csv", "psd.csv", "psd_cross.csv", "psd_envelope.csv"], written
+    assert written == ["campbell.csv", "psd.csv", "psd_cross.csv", "psd_envelope.csv", "psd_envelope_harmonics.csv"], \
+        written
     missing = {name: undocumented(f"`{name}`", header(tmp_path / name)) for name in written}
     assert not any(missing.values()), f"columns not defined in docs/formats.md section 6: {missing}"
 
@@ -110,8 +111,7 @@ def test_the_psd_and_campbell_tables_are_documented(capsys, tmp_path):
 def test_a_column_left_undocumented_is_caught():
     """The check reads the table's own subsection: a column defined only in another table's fails."""
     doc = (ROOT / "docs" / "formats.md").read_text()
-    cols = ["direction", "h", "C_SI", "C_stderr_SI", "C_all_SI", "n_points", "presence", "excluded_rpm", "in_model",
-            "heldout_rel"]
+    cols = ["direction", "h", "C_SI", "C_stderr_SI", "C_all_SI", "n_points", "presence", "in_model", "heldout_rel"]
     assert undocumented("`harmonics.csv`", cols, doc) == []
     cut = re.sub(r"^\| `heldout_rel` \|.*\n", "", doc, flags=re.M)
     assert cut != doc
@@ -151,3 +151,8 @@ def test_the_diagnose_reports_tables_are_documented(small_fit, tmp_path):
         "hypotheses.csv": undocumented("`hypotheses.csv`", header(tmp_path / "hypotheses.csv")),
     }
     assert not any(missing.values()), f"columns not defined in docs/formats.md section 6: {missing}"
+    # as every table: booleans true/false, a missing value an empty cell (docs review: True/False, nan)
+    with open(tmp_path / "hypotheses.csv", newline="") as fh:
+        assert {r["passed"] for r in csv.DictReader(fh)} <= {"true", "false"}
+    for name in ("hypotheses.csv", "rms_vs_speed.csv"):
+        assert "nan" not in (tmp_path / name).read_text().lower(), name

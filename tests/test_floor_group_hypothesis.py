@@ -64,7 +64,7 @@ def test_hypotheses_csv_writes_a_group_gain_once_so_the_column_sums():
     hyps, _ = _group_hypotheses(gain=0.12, fraction=0.3)
     rows = list(csv.DictReader(io.StringIO(hypotheses_csv(hyps))))
     assert [r["channels"] for r in rows] == ["Fx", "Fx", "Fy", "Fz", "Tx"]
-    passed = [r for r in rows if r["passed"] == "True"]
+    passed = [r for r in rows if r["passed"] == "true"]
     # what the passed hypotheses gained: the law's 0.05 and the group's 0.12, each once
     assert sum(float(r["heldout_gain"] or 0) for r in passed) == pytest.approx(0.05 + 0.12)
     assert sum(float(r["heldout_gain_fraction"] or 0) for r in passed) == pytest.approx(0.2 + 0.3)

@@ -155,7 +155,8 @@ def test_a_block_device_is_refused(tmp_path):
 # --------------------------------------------------------------------------- sets
 
 def _psd_set(stem: Path) -> dict:
-    return {s: (stem.parent / (stem.name + s)) for s in (".csv", "_cross.csv", "_envelope.csv", ".png")}
+    return {s: (stem.parent / (stem.name + s)) for s in (".csv", "_cross.csv", "_envelope.csv",
+                                                          "_envelope_harmonics.csv", ".png")}
 
 
 def test_psd_outputs_are_replaced_as_a_set(tmp_path, monkeypatch, capsys):
@@ -168,7 +169,7 @@ def test_psd_outputs_are_replaced_as_a_set(tmp_path, monkeypatch, capsys):
 
     def failing(a, b):
         calls.append((a, b))
-        if len(calls) == 6:     # 4 old members moved aside, then the 2nd new one moved in
+        if len(calls) == 7:     # 5 old members moved aside, then the 2nd new one moved in
             raise OSError(5, "Input/output error", str(b))
         return real(a, b)
 

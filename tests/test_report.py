@@ -6,7 +6,6 @@ number compared has an independent closed form (Eq. 3.19, Parseval).
 from __future__ import annotations
 
 import csv
-import json
 
 import numpy as np
 import pytest
@@ -255,8 +254,8 @@ def test_write_report_files_and_tables(data, tmp_path):
             assert img[..., :3].std() > 0.05  # not blank
 
     cols, rows = _read_csv(tmp_path / "harmonics.csv")
-    assert cols[:8] == ["direction", "h", "C_SI", "C_stderr_SI", "C_all_SI", "n_points", "presence",
-                        "excluded_rpm"]
+    assert cols == ["direction", "h", "C_SI", "C_stderr_SI", "C_all_SI", "n_points", "presence", "in_model",
+                    "heldout_rel"]
     assert len(rows) == len(fit.lines)
     for ln in fit.lines:
         (r,) = [r for r in rows if r["direction"] == ln.direction and float(r["h"]) == ln.h]
@@ -264,13 +263,19 @@ def test_write_report_files_and_tables(data, tmp_path):
         assert float(r["C_stderr_SI"]) == pytest.approx(ln.C_stderr, rel=1e-12)
         assert float(r["C_all_SI"]) == pytest.approx(ln.C_all, rel=1e-12)
         assert int(r["n_points"]) == int(ln.used.sum())
-        assert json.loads(r["excluded_rpm"]) == ln.excluded_rpm
         assert r["in_model"] == "true"
 
+    # a line's excluded ranges: the rows of excluded_ranges.csv with its direction and h, the same text
+    harmonics = rows
     cols, rows = _read_csv(tmp_path / "excluded_ranges.csv")
     assert cols == ["direction", "h", "lo_rpm", "hi_rpm"]
     assert [(r["direction"], float(r["h"]), float(r["lo_rpm"]), float(r["hi_rpm"])) for r in rows] == \
         [("radial_force", MODAL[0], MODAL[1], MODAL[2])]
+    for ln in fit.lines:
+        (r,) = [r for r in harmonics if r["direction"] == ln.direction and float(r["h"]) == ln.h]
+        ranges = [[float(x["lo_rpm"]), float(x["hi_rpm"])] for x in rows
+                  if (x["direction"], x["h"]) == (r["direction"], r["h"])]
+        assert ranges == ln.excluded_rpm
 
     cols, rows = _read_csv(tmp_path / "bins.csv")
     assert cols[:6] == ["direction", "h", "n_bin", "n_possible", "presence", "kept"]

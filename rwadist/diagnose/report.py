@@ -6,6 +6,7 @@ import copy
 import numpy as np
 
 from ..formats.records import json_text
+from ..text_table import cell, write_rows
 from ..units import CHANNEL_UNIT, RAD_S_TO_RPM, RADIAL_PAIRS
 from .constants import BAND_BINS, CONTRAST_METRIC, METRIC, NOISE_Z
 from .search import Diagnosis
@@ -94,10 +95,12 @@ def _fmt(v, spec: str) -> str:
     return format(v, spec) if isinstance(v, float) else str(v)
 
 
-def _write_csv(path, cols: dict):
+def write_rms_csv(path, cols: dict):
+    """rms_vs_speed.csv: :func:`rms_vs_speed`'s columns (speed in rpm, RMS in N and N·m as named), one row per
+    run, 8 significant digits, a value that could not be computed (NaN) as an empty cell as in every table
+    (:func:`rwadist.text_table.cell`)."""
     names = list(cols)
-    arr = np.column_stack([np.asarray(cols[k], dtype=float) for k in names])
-    np.savetxt(path, arr, delimiter=",", header=",".join(names), comments="", fmt="%.8g")
+    return write_rows(path, names, zip(*(np.asarray(cols[k], dtype=float) for k in names)), digits=8)
 
 
 _UNIT_LABEL = {"N": "N", "Nm": "N·m"}
@@ -294,13 +297,19 @@ def line_causes_section(diag: Diagnosis) -> list:
     return out
 
 
-def hypotheses_csv(hypotheses) -> str:
-    """hypotheses.csv's text: one row per hypothesis (iteration, kind, channels, parameters, held-out gain and
-    fraction, t, passed).  The parts of an effect of several parts (``Hypothesis.group``: a floor law of several
-    channels, each channel its own entry of the model file) are one hypothesis: its held-out gain and gain fraction
-    are written on its first part's row only (the others' left empty, their parameters marked ``part_of=`` the
-    group's channels), so the columns sum to what the hypotheses gained."""
-    lines = ["iteration,kind,channels,parameters,heldout_gain,heldout_gain_fraction,t,passed"]
+#: hypotheses.csv's columns
+HYPOTHESES_COLUMNS = ["iteration", "kind", "channels", "parameters", "heldout_gain", "heldout_gain_fraction", "t",
+                      "passed"]
+
+
+def hypotheses_rows(hypotheses) -> list:
+    """hypotheses.csv's rows, each a list of its cells in the order of :data:`HYPOTHESES_COLUMNS` (iteration, kind,
+    channels, parameters, held-out gain and fraction, t, passed as ``true``/``false``).  The parts of an effect of
+    several parts (``Hypothesis.group``: a floor law of several channels, each channel its own entry of the model
+    file) are one hypothesis: its held-out gain and gain fraction are written on its first part's row only (the
+    others' left empty, their parameters marked ``part_of=`` the group's channels), so the columns sum to what the
+    hypotheses gained."""
+    rows = []
     seen: set = set()
     for h in hypotheses:
         e = h.effect
@@ -308,14 +317,26 @@ def hypotheses_csv(hypotheses) -> str:
         par = ";".join(f"{k}={_fmt(v, '.6g').replace(';', ' ')}" for k, v in e.params().items()
                        if not (isinstance(v, list) and len(v) > 4))
         g = getattr(h, "group", None)
-        gain = f"{h.gain:.6g},{h.gain_fraction:.6g}"
+        gain = [cell(h.gain, 6), cell(h.gain_fraction, 6)]
         if g is not None:
             par += f";part_of={' '.join(g.channels)}"
-            gain = "," if id(g) in seen else gain
+            gain = ["", ""] if id(g) in seen else gain
             seen.add(id(g))
-        par = par.replace(",", " ")                             # one CSV field
-        lines.append(f"{h.iteration},{e.kind},{' '.join(e.channels)},{par},{gain},{h.t:.4g},{h.passed}")
-    return "\n".join(lines) + "\n"
+        rows.append([cell(h.iteration), e.kind, " ".join(e.channels), par, *gain, cell(h.t, 4), cell(bool(h.passed))])
+    return rows
+
+
+def hypotheses_csv(hypotheses) -> str:
+    """hypotheses.csv's text (:func:`hypotheses_rows` through the csv module: a comma inside a parameter's text is
+    quoted, never a new column)."""
+    import csv
+    import io
+
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(HYPOTHESES_COLUMNS)
+    w.writerows(hypotheses_rows(hypotheses))
+    return buf.getvalue()
 
 
 def _taken_back(diag) -> list:
@@ -356,18 +377,14 @@ def write_report(diag: Diagnosis, out_dir) -> list:
     model.effects = _clean(model.effects)
     files.append(save(model, out / "model.json"))
     cols = rms_vs_speed(diag)
-    p = out / "rms_vs_speed.csv"
-    _write_csv(p, cols)
-    files.append(p)
+    files.append(write_rms_csv(out / "rms_vs_speed.csv", cols))
     p = out / "rms_vs_speed.png"
     save_png(_rms_figure(diag, cols), p, dpi=100)
     files.append(p)
     p = out / "residual_waterfall.png"
     save_png(_waterfall_figure(diag), p, dpi=100)
     files.append(p)
-    p = out / "hypotheses.csv"
-    p.write_text(hypotheses_csv(diag.hypotheses))
-    files.append(p)
+    files.append(write_rows(out / "hypotheses.csv", HYPOTHESES_COLUMNS, hypotheses_rows(diag.hypotheses)))
     md = ["# rwadist diagnose", "",
           f"Metric: `{METRIC}` — {summary['metric_definition']}; a band's misplaced power is counted beyond "
           f"{NOISE_Z:g} noise standard deviations.", "",
