@@ -138,17 +138,20 @@ def annotate(ctx, state, records: list, ratios: list, taken_out: bool = False) -
     return out
 
 
-def step_sets(diag, run_steps) -> list:
+def step_sets(diag, run_steps, located: int = 3) -> list:
     """The run factors (run index -> dB, NaN: left out) the search is tried again with (``run_steps``:
     :func:`rwadist.diagnose.describe.run_steps`, passed in: describe reads this module), in order: the runs read, then with those whose change was not read
-    left out.  Under a change spread over every run (:func:`is_spread`) first every run's factor (:func:`run_gains`),
-    the unread runs left out first (a drift changes them too), then the runs held apart as for a step: the factors
+    left out.  Under a change spread over every run (:func:`is_spread`) also every run's factor (:func:`run_gains`),
+    the unread runs left out first (a drift changes them too), and the runs held apart as for a step: the factors
     against the model are only as good as its course in speed, and a first search that located no mode has none
     (the open world's family wheel 3, every third run 3.5 dB up: no mode in the first search, its runs read as a
-    spread, factors of −3.7 to +4.3 dB against it; the runs held apart, all three modes located)."""
+    spread, factors of −3.7 to +4.3 dB against it; the runs held apart, all three modes located).  So every run's
+    factors come first when the first search located a mode (``located``: how many), else last: the search's tries
+    end at the best standing there is, which the runs held apart reach on that wheel (its diagnosis 67 → 39 s, the
+    same answer)."""
     spread = is_spread(diag)
     out: list = []
-    for every in ((True, False) if spread else (False,)):
+    for every in (((True, False) if located else (False, True)) if spread else (False,)):
         steps = run_steps(diag, every_run=every)
         read = {r: dB for r, dB in steps.items() if np.isfinite(dB)}
         if not read:

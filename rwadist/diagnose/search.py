@@ -623,7 +623,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
     # search is run again on the records with the changed runs' common factor taken out (docs/diagnose.md)
     from .run_gains import step_sets
 
-    sets = step_sets(diag, describe.run_steps)
+    sets = step_sets(diag, describe.run_steps, describe.search_standing(diag)[0])
     if not sets:
         return diag
     # the runs whose change was not read (NaN) may be changed ones: searched with them left in (as unchanged) and left
