@@ -122,3 +122,13 @@ def test_a_held_damping_is_said_held_with_the_range_the_data_allow():
     line = describe_effect(modes)
     assert "rocking at rest 54.9 Hz (ζ not constrained by the data: held, 5e-05-0.017 allowed)" in line
     assert "I_zz/I_rr 1.9" in line and "not located" not in line
+
+
+def test_a_fixed_resonance_whose_gain_at_its_frequency_is_under_one_is_said_to_be_a_notch():
+    """trial 30b: a 'test stand' of peak gain 0.271 (fitted to bearing lines whose ratios slip with speed) read as a
+    resonance; |H(f_r)| < 1 attenuates the lines there, and the line says so.  A gain over 1 reads as before."""
+    e = dict(EFFECTS[3], evidence={"heldout_gain_fraction": 0.069})
+    (line,) = diagnose_lines([dict(e, peak_gain=0.271)])
+    assert "peak gain 0.271 (under 1: a notch, the lines attenuated there)" in line
+    (line,) = diagnose_lines([dict(e, peak_gain=1.5)])
+    assert "notch" not in line and "peak gain 1.5," in line

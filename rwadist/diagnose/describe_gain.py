@@ -38,6 +38,10 @@ MIN_Z = 5.0
 #: Lines (h) that must each show it, with MIN_RUNS runs or more each.
 MIN_LINES = 2
 MIN_RUNS = 4
+#: The runs' robust scatter of the pair's ratio (per run the median over its lines, dB of power) at which a constant
+#: ratio is said to change from run to run: clean family wheels scatter 0.01-0.05 dB (:mod:`.gain_step`); trial 30b's
+#: Fy gain 1.0-1.3 in recording order, shuffled against the speeds, 0.6-0.9 dB (read as a constant 1.14× before)
+RUN_SCATTER_DB = 0.3
 
 
 
@@ -119,18 +123,62 @@ def channel_gain(ctx, state, shares) -> list:
         f = np.concatenate([h[i] * ctx.omega[runs[good[i]]] / (2 * np.pi) for i in lines])
         ratio = 10 ** (med / 20)
         hi_c, lo_c = (cy, cx) if med > 0 else (cx, cy)
+        carry = np.zeros_like(good)                 # the lines that carry the ratio (a gain acts on all alike)
+        carry[np.asarray(lines)[agree]] = good[np.asarray(lines)[agree]]
+        scatter, spread = _run_scatter(np.where(good, d, 0.0), carry)
         out.append(Unexplained(
             signature="line_property", channels=(cx, cy), speed_rpm=(float(rpm.min()), float(rpm.max())),
             f_Hz=(float(f.min()), float(f.max())), level_dB=med, share=share, n_runs=int(used.size),
             parameters={"property": "channel_gain", "channel": cy, "reference": cx,
                         "amplitude_ratio": float(ratio), "power_ratio_dB": med, "stderr_dB": se,
-                        "lines_h": [float(x) for x in h[lines][agree]], "cells": int(cells.size)},
-            causes=(f"a gain or calibration error of {hi_c} or {lo_c}: {hi_c} reads {max(ratio, 1 / ratio):.3g} x "
+                        "lines_h": [float(x) for x in h[lines][agree]], "cells": int(cells.size),
+                        "run_scatter_dB": scatter, "run_range_dB": spread},
+            causes=_varying(hi_c, lo_c, scatter, spread) + (
+                    f"a gain or calibration error of {hi_c} or {lo_c}: {hi_c} reads {max(ratio, 1 / ratio):.3g} x "
                     f"{lo_c} on {'every line read' if agree.all() else _lines_words(h[lines][agree], h[lines])} (a "
                     f"rotating load gives x and y the same power){unit_words(max(ratio, 1 / ratio), cx)}",
                     "a support or fixture stiffer in one direction: the suspension mode splits into an x and a y mode, "
                     "and the ratio changes across them but stays nearly constant on the lines well above both "
                     "(about (f_x/f_y)² in amplitude), as a gain's does"),
-            would_tell=f"a calibration of {cx} and {cy} with one known load (a mass hung, a shaker's force), or the "
-                       "load cell turned 90 degrees on the stand (a channel's gain goes with the channel)"))
+            would_tell=("the runs in the order they were recorded (a drift grows with time); " if _varies(scatter) else "")
+            + f"a calibration of {cx} and {cy} with one known load (a mass hung, a shaker's force), or the "
+              "load cell turned 90 degrees on the stand (a channel's gain goes with the channel)"))
     return out
+
+
+def _run_scatter(d: np.ndarray, good: np.ndarray) -> tuple:
+    """(robust scatter dB, [lowest, highest] dB) over the runs of the pair's ratio per run (:func:`.gain_step.per_run`
+    of ``d`` (lines, runs) where ``good``: the lines that carry the ratio, within a factor 2 of it; a line of its own
+    x/y asymmetry, a co- and counter-rotating part, reads off in every run, and a run holding few lines took its
+    median from it: family wheel 1, +2.95 dB for a run's +2.28)."""
+    from .gain_step import per_run
+
+    # two passes: the lines that scatter about the runs' first medians far more than the others (a line through a
+    # split mode, or of a sense mix that changes with speed: ±10 dB from run to run on family wheel 4) are left out
+    first = per_run(d, good)
+    off = np.where(good & np.isfinite(first)[None, :], np.abs(d - np.nan_to_num(first)[None, :]), np.nan)
+    read = np.isfinite(off).any(axis=1)
+    line_mad = np.full(d.shape[0], np.nan)
+    line_mad[read] = np.nanmedian(off[read], axis=1)
+    keep = np.isfinite(line_mad) & (line_mad <= max(3.0 * float(np.nanmedian(line_mad)), 0.1)) \
+        if np.isfinite(line_mad).any() else np.zeros(d.shape[0], bool)
+    y = per_run(d, good & keep[:, None])
+    y = y[np.isfinite(y)]
+    if y.size == 0:
+        return 0.0, [float("nan"), float("nan")]
+    return 1.4826 * float(np.median(np.abs(y - np.median(y)))), [float(y.min()), float(y.max())]
+
+
+def _varies(scatter: float) -> bool:
+    return scatter >= RUN_SCATTER_DB
+
+
+def _varying(hi_c: str, lo_c: str, scatter: float, spread: list) -> tuple:
+    """() or the first cause of a ratio that scatters from run to run by :data:`RUN_SCATTER_DB` or more (with no
+    step or trend in speed: :mod:`.gain_step` read none)."""
+    if not _varies(scatter):
+        return ()
+    return (f"a gain of {hi_c} or {lo_c} that changes from run to run: the ratio scatters {scatter:.2g} dB between "
+            f"runs ({spread[0]:+.2f} to {spread[1]:+.2f} dB of power; a fixed gain's ratio scatters 0.01-0.05 dB), "
+            "with no step or trend in speed: a drift with time (an amplifier or bridge warming, a connector working "
+            "loose), so the runs' order of recording decides",)

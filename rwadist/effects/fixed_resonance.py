@@ -55,8 +55,10 @@ class FixedResonance(Element):
         role = "test stand" if e["role"] == "test_stand" else "wheel mode"
         above = e.get("gain_above", 1.0)
         below = "" if above == 1.0 else f", {num(above, '.2g')} of the load far above"
+        # a gain under 1 at f_r attenuates the lines there: said so, not left to read as a resonance (trial 30b)
+        notch = " (under 1: a notch, the lines attenuated there)" if float(e["peak_gain"]) < 1.0 else ""
         return (f"{role}, {num(e['f_Hz'], '.2f')} Hz, ζ {num(e['zeta'], '.3g')}, peak gain "
-                f"{num(e['peak_gain'], '.3g')}{below}, on {directions(e['directions'])}")
+                f"{num(e['peak_gain'], '.3g')}{notch}{below}, on {directions(e['directions'])}")
 
     # ------------------------------------------------------------------ injection
     #: ``fixed_resonance:f_hz=150,zeta=0.03,gain=5,channels=Fx+Fy+Fz+Tx+Ty+Tz,role=test_stand,gain_above=1``: a
