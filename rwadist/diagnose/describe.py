@@ -310,6 +310,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     lines found before the search (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands
     taken out with them."""
     from .describe_carrier import measure_track, on_a_sideband, sideband_lines, sideband_tracks
+    from .describe_drift import ratio_drift
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
@@ -375,11 +376,9 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     ratios = line_ratios(ctx, state)
     others = [x.h for d in ("radial_force", "radial_torque", "axial_force", "axial_torque")
               for x in state.model.harmonics(d)]
-    # a narrow hump peaking on a fixed line taken out before the search is that line's leftover main lobe (trial 30:
-    # the 50 and 150 Hz mains in Fz read as 4-bin "humps" on one seed of three)
+    # a narrow hump on a fixed line taken out before the search is its leftover lobe (trial 30: mains in Fz)
     out = [u for u in broadband_hump(ctx, state, of_band) if not on_a_fixed_line(u, carriers, float(ctx.sp.df))]
-    # a moving resonance is read on the lines resolved from their neighbours only (:func:`resolved_lines`) and
-    # described where its cells hold content (:func:`holds_content`)
+    # a moving resonance: read on lines resolved from their neighbours, described where its cells hold content
     out += [u for u in moving_resonance(ctx, state, [resolved_lines(ctx, state, r) for r in ratios], of_track)
             if holds_content(u, res)]
     from .run_gains import annotate
@@ -400,6 +399,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += channel_skew(ctx, state, of_line)
     # a gain common to the channels that changes with speed, on the recorded channels too
     out += gain_trend(ctx, as_recorded(searched.state), of_line)
+    out += ratio_drift(ctx, state, of_line)       # a line whose ratio drifts with the speed (a cage slipping)
     return out
 
 

@@ -1,0 +1,123 @@
+"""Detector of the open world (issue 33, item 3) on the final model's residual: a line whose ratio to the speed drifts
+with the speed (a ``line_property`` of property ``ratio_drift``).
+
+A rolling bearing's cage turns at a fixed fraction of the shaft only while its balls roll without slip; under a
+light preload or at high speed they slide, the cage lags, and the cage ratio and the ball-pass over the outer race
+(n × the cage's) fall while the inner race's (n − BPFO) rises, by a few per cent over the speed range.  The model's
+lines are at constant ratios h: a drifting line is binned into one h or split into two, and the modes' fit bends to
+it (trial 30b, wheel A with the cage slipping 5 % at 3000 rpm, three seeds: a mode declared unconstrained each time,
+an invented test stand of peak gain 0.27 on one, nothing described on another).
+
+Read on the Welch PSDs the search used: in each run, the peak of the line's channels summed within a window around
+h·|Ω|/2π (at most :data:`WINDOW` of h, and under half the way to the model's nearest other line), :data:`MIN_SNR_DB`
+over the median of the PSD around it, refined by a parabola through the log powers of the top three bins; its ratio
+h_run against the runs' speeds by a Theil-Sen line.  A drift over the speeds of at least :data:`MIN_DRIFT` of h,
+the Theil-Sen slope's confidence interval clear of 0 and at least :data:`MIN_BINS` Welch bins at the top speed, in :data:`MIN_RUNS`
+runs or more, is described with the ratios read at the lowest and the highest speed.  A line at a whole multiple of the
+speed (a ratio within :data:`WHOLE` of one) is locked to the rotor and not read.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import RAD_S_TO_RPM
+from .describe_lines import log_parabola_offset
+from .unexplained import Unexplained
+
+#: Directions read and their channels (summed).
+DIRECTIONS = {"radial_force": ("Fx", "Fy"), "radial_torque": ("Tx", "Ty"), "axial_force": ("Fz",)}
+#: Half-width of the window searched around h, as a fraction of h (a cage slips by a few per cent).
+WINDOW = 0.08
+#: The window stays under this fraction of the distance to the model's nearest other line.
+NEIGHBOUR_FRACTION = 0.45
+#: Peak over the median PSD around the window (dB), at least.
+MIN_SNR_DB = 15.0
+#: Bins either side of the window whose PSD median is the floor.
+FLOOR_BINS = 20
+#: Runs read, at least.
+MIN_RUNS = 8
+#: Drift of the ratio over the speeds read (fraction of h), at least: clean lines read 0.00 % (trial 30b's wheels).
+MIN_DRIFT = 0.01
+#: The drift in frequency at the top speed, at least this many Welch bins (what the PSD can tell).
+MIN_BINS = 2.0
+#: Lines of the model closer than this fraction of h are this line (read in another direction, or split by its drift).
+SAME_LINE = 0.02
+#: A ratio within this of a whole number is locked to the rotor.
+WHOLE = 0.05
+
+
+def _run_ratios(ctx, chans, h0: float, half: float) -> np.ndarray:
+    """(rpm, h_run) of the runs where the line's peak stands :data:`MIN_SNR_DB` over its floor, shape (n, 2)."""
+    df = float(ctx.sp.df)
+    P = np.sum([np.asarray(ctx.sp.psd[c], dtype=float) for c in chans], axis=0)
+    top = float(ctx.f[-1]) if ctx.sp.f_lim is None else min(float(ctx.sp.f_lim), float(ctx.f[-1]))
+    rows = []
+    for r in ctx.runs:
+        spin = abs(float(ctx.omega[r])) / (2 * np.pi)
+        k0, k1 = int(np.ceil((h0 - half) * spin / df)), int(np.floor((h0 + half) * spin / df))
+        if k1 - k0 < 4 or k0 < 2 or (h0 + half) * spin >= top or not np.all(np.isfinite(P[r, k0:k1 + 1])):
+            continue
+        seg = P[r, k0:k1 + 1]
+        j = int(np.argmax(seg))
+        floor = float(np.median(P[r, max(1, k0 - FLOOR_BINS):k1 + FLOOR_BINS + 1]))
+        if not 0 < j < seg.size - 1 or floor <= 0 or seg[j] < floor * 10 ** (MIN_SNR_DB / 10):
+            continue
+        k = k0 + j + log_parabola_offset(seg[j - 1:j + 2])
+        rows.append((spin * 60.0, k * df / spin))
+    return np.asarray(rows, dtype=float).reshape(-1, 2)
+
+
+def ratio_drift(ctx, state, shares) -> list:
+    """``line_property`` records (``ratio_drift``) of the model's lines (``state.model``) whose ratio to the speed
+    drifts with it (module docstring); ``shares(chans, h, runs)`` -> (share, level dB) of a line's cells."""
+    from scipy.stats import theilslopes
+
+    model = state.model
+    every = sorted({float(x.h) for d in DIRECTIONS for x in model.harmonics(d)})
+    out: list[Unexplained] = []
+    for d, chans in DIRECTIONS.items():
+        chans = tuple(c for c in chans if c in ctx.channels and c in ctx.sp.psd)
+        if not chans:
+            continue
+        said: list[float] = []
+        for h0 in sorted({float(x.h) for x in model.harmonics(d)}):
+            # a line split in two by its drift is one line: read once
+            if h0 < 0.2 or abs(h0 - round(h0)) < WHOLE or any(abs(h0 - x) <= SAME_LINE * h0 for x in said):
+                continue
+            # another line of the model is one more than SAME_LINE of h away (closer: this line read in another
+            # direction, or split in two by the drift itself: 4.733 and 4.758 in trial 30b's axial force)
+            gap = min((abs(h - h0) for h in every if abs(h - h0) > SAME_LINE * h0), default=np.inf)
+            half = min(WINDOW * h0, NEIGHBOUR_FRACTION * gap)
+            rows = _run_ratios(ctx, chans, h0, half)
+            if rows.shape[0] < MIN_RUNS:
+                continue
+            rpm, h = rows[:, 0], rows[:, 1]
+            slope, icpt, lo, hi = theilslopes(h, rpm)
+            # the ratios read at the lowest and the highest speed (a slip grows as Ω², no straight line); the
+            # Theil-Sen slope's interval says whether they drift at all
+            h_lo, h_hi = float(h[np.argmin(rpm)]), float(h[np.argmax(rpm)])
+            drift = (h_hi - h_lo) / h0
+            if abs(drift) < MIN_DRIFT or lo * hi <= 0 or \
+                    abs(h_hi - h_lo) * rpm.max() / 60.0 < MIN_BINS * float(ctx.sp.df):
+                continue
+            said.append(h0)
+            read = np.asarray([r for r in ctx.runs if abs(float(ctx.omega[r])) * RAD_S_TO_RPM in set(rpm)])
+            share, level = shares(chans, h0, read)
+            way = "falls" if drift < 0 else "rises"
+            out.append(Unexplained(
+                signature="line_property", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
+                f_Hz=(float(h_lo * rpm.min() / 60.0), float(h_hi * rpm.max() / 60.0)), level_dB=level, share=share,
+                n_runs=int(rpm.size), h=h0,
+                parameters={"property": "ratio_drift", "direction": d, "h": h0, "h_at_lowest_speed": float(h_lo),
+                            "h_at_highest_speed": float(h_hi), "drift_percent": float(100 * drift),
+                            "drift_interval_percent": [float(100 * lo * np.ptp(rpm) / h0),
+                                                       float(100 * hi * np.ptp(rpm) / h0)]},
+                causes=(f"a rolling bearing's cage slipping more as the speed grows: the line's ratio {way} from "
+                        f"{h_lo:.4g} to {h_hi:.4g} ({100 * drift:+.1f} %) over {rpm.min():.0f}-{rpm.max():.0f} rpm; "
+                        "the cage's ratio and the outer race's ball pass fall together, the inner race's rises "
+                        "(n − BPFO), so lines of one bearing drift by one slip",
+                        "a line of a source not locked to the rotor (a pump, a fan, another machine) whose frequency "
+                        "grows with the wheel's speed but not in proportion"),
+                would_tell="the bearing's preload or lubrication changed (slip shrinks with preload); the cage's own "
+                           "line, at h ≈ 0.4, drifting by the same fraction as the ball-pass lines names the bearing"))
+    return out
