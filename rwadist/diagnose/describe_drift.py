@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..units import RAD_S_TO_RPM
 from .describe_lines import log_parabola_offset
 from .unexplained import Unexplained
 
@@ -47,7 +46,8 @@ WHOLE = 0.05
 
 
 def _run_ratios(ctx, chans, h0: float, half: float) -> np.ndarray:
-    """(rpm, h_run) of the runs where the line's peak stands :data:`MIN_SNR_DB` over its floor, shape (n, 2)."""
+    """(run index, rpm, h_run) of the runs where the line's peak stands :data:`MIN_SNR_DB` over its floor, shape
+    (n, 3)."""
     df = float(ctx.sp.df)
     P = np.sum([np.asarray(ctx.sp.psd[c], dtype=float) for c in chans], axis=0)
     top = float(ctx.f[-1]) if ctx.sp.f_lim is None else min(float(ctx.sp.f_lim), float(ctx.f[-1]))
@@ -63,8 +63,8 @@ def _run_ratios(ctx, chans, h0: float, half: float) -> np.ndarray:
         if not 0 < j < seg.size - 1 or floor <= 0 or seg[j] < floor * 10 ** (MIN_SNR_DB / 10):
             continue
         k = k0 + j + log_parabola_offset(seg[j - 1:j + 2])
-        rows.append((spin * 60.0, k * df / spin))
-    return np.asarray(rows, dtype=float).reshape(-1, 2)
+        rows.append((float(r), spin * 60.0, k * df / spin))
+    return np.asarray(rows, dtype=float).reshape(-1, 3)
 
 
 def ratio_drift(ctx, state, shares) -> list:
@@ -96,7 +96,7 @@ def ratio_drift(ctx, state, shares) -> list:
             rows = _run_ratios(ctx, chans, h0, half)
             if rows.shape[0] < MIN_RUNS:
                 continue
-            rpm, h = rows[:, 0], rows[:, 1]
+            rpm, h = rows[:, 1], rows[:, 2]
             slope, icpt, lo, hi = theilslopes(h, rpm)
             # the ratios read at the lowest and the highest speed (a slip grows as Ω², no straight line); the
             # Theil-Sen slope's interval says whether they drift at all
@@ -106,7 +106,7 @@ def ratio_drift(ctx, state, shares) -> list:
                     abs(h_hi - h_lo) * rpm.max() / 60.0 < MIN_BINS * float(ctx.sp.df):
                 continue
             said.append(h0)
-            read = np.asarray([r for r in ctx.runs if abs(float(ctx.omega[r])) * RAD_S_TO_RPM in set(rpm)])
+            read = rows[:, 0].astype(int)
             share, level = shares(chans, h0, read)
             way = "falls" if drift < 0 else "rises"
             out.append(Unexplained(
