@@ -310,7 +310,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     lines found before the search (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands
     taken out with them."""
     from .describe_carrier import measure_track, on_a_sideband, sideband_lines, sideband_tracks
-    from .describe_drift import ratio_drift
+    from .describe_drift import beside_drifts, ratio_drift
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
@@ -399,8 +399,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += channel_skew(ctx, state, of_line)
     # a gain common to the channels that changes with speed, on the recorded channels too
     out += gain_trend(ctx, as_recorded(searched.state), of_line)
-    out += ratio_drift(ctx, state, of_line)       # a line whose ratio drifts with the speed (a cage slipping)
-    return out
+    # a line whose ratio drifts with the speed (a cage slipping), and what its fixed-ratio model line made of it
+    return beside_drifts(out, ratio_drift(ctx, state, of_line))
 
 
 #: A hump at most this many bins wide whose peak lies within its own width of a fixed line on one of its channels is
@@ -457,9 +457,12 @@ def cells_of(u, res: Residual) -> dict:
     a change of whole runs: a class gaining in those runs is not fitted to it), nor a ``line_property`` (a property of
     every line of a channel, a gain: a class acting on that channel's lines is not fitted to it), but for a gain
     that changes with speed (``gain_trend``) the bands of its lines in its channels: an amplitude law on one of them
-    is that trend read on one line (trial16 tempgain at seed 2: Ω^1.93 on one of 25 lines that share it)."""
+    is that trend read on one line (trial16 tempgain at seed 2: Ω^1.93 on one of 25 lines that share it), and for a
+    line whose ratio drifts (``ratio_drift``) the bands between the model's line and the data's (:func:`_drift_cells`)."""
     if u.signature == "line_property" and u.parameters.get("property") == "gain_trend":
         return _trend_cells(u, res)
+    if u.signature == "line_property" and u.parameters.get("property") == "ratio_drift":
+        return _drift_cells(u, res)
     if u.signature in ("run_change", "line_property"):
         return {}
     ctx = res.ctx
@@ -493,6 +496,33 @@ def cells_of(u, res: Residual) -> dict:
     else:
         lo = np.full(rows.size, int(res.band_of(u.f_Hz[0])))
         hi = np.full(rows.size, int(res.band_of(u.f_Hz[1])))
+    out = {}
+    for c in u.channels:
+        if c in res.e:
+            m = res.mask(c)
+            for r, a, z in zip(rows, lo, hi):
+                m[r, a:z + 1] = True
+            out[c] = m
+    return out
+
+
+def _drift_cells(u, res: Residual) -> dict:
+    """The cells of a ``ratio_drift`` record: in each run of its speed range, the bands from the model's line
+    (h·Ω/2π) to the data's (its ratio read there, interpolated between the readings) and one either side, in its
+    channels.  The model's fixed ratio misses the drifting line by a few bands at the top speed: an effect whose gain
+    lies there (trial 30b wheel A, the cage slipping 5 %: a test stand of peak gain 0.27, a notch under the model's
+    ball-pass lines where the data's had moved away) was fitted to the drift."""
+    ctx = res.ctx
+    p = u.parameters
+    if not p.get("readings_rpm"):
+        return {}
+    rpm = np.abs(ctx.omega[ctx.runs]) * 60.0 / (2 * np.pi)
+    rows = np.flatnonzero((rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6))
+    spin = rpm[rows] / 60.0
+    h_run = np.interp(rpm[rows], np.asarray(p["readings_rpm"], float), np.asarray(p["readings_h"], float))
+    f_model, f_data = float(p["h"]) * spin, h_run * spin
+    lo = np.maximum(res.band_of(np.minimum(f_model, f_data)) - 1, 0)
+    hi = np.minimum(res.band_of(np.maximum(f_model, f_data)) + 1, ctx.n_bands - 1)
     out = {}
     for c in u.channels:
         if c in res.e:

@@ -67,9 +67,10 @@ def _run_ratios(ctx, chans, h0: float, half: float) -> np.ndarray:
     return np.asarray(rows, dtype=float).reshape(-1, 3)
 
 
-def ratio_drift(ctx, state, shares) -> list:
-    """``line_property`` records (``ratio_drift``) of the model's lines (``state.model``) whose ratio to the speed
-    drifts with it (module docstring); ``shares(chans, h, runs)`` -> (share, level dB) of a line's cells."""
+def _drifts(ctx, model) -> list:
+    """(direction, channels, h, rows, slope interval (lo, hi), h at the lowest speed, h at the highest) of every line of
+    ``model`` whose ratio to the speed drifts on ``ctx``'s Welch PSDs (module docstring); ``rows`` of
+    :func:`_run_ratios`.  Kept on the context by the model's lines: the search asks it at every step."""
     from scipy.stats import theilslopes
 
     test = getattr(ctx, "test", None)
@@ -77,15 +78,19 @@ def ratio_drift(ctx, state, shares) -> list:
         # a sweep's slices: the speed moves within each, and the power-weighted peak (the load grows as Ω²) sits above
         # the slice's mean speed by an amount that changes with speed (family wheel 0, a 30-s run-up: a phantom drift)
         return []
-    model = state.model
-    every = sorted({float(x.h) for d in DIRECTIONS for x in model.harmonics(d)})
-    out: list[Unexplained] = []
+    lines = {d: sorted({float(x.h) for x in model.harmonics(d)}) for d in DIRECTIONS}
+    key = ("ratio_drift", tuple((d, tuple(v)) for d, v in lines.items()))
+    memo = getattr(ctx, "_memo", None)
+    if memo is not None and key in memo:
+        return memo[key]
+    every = sorted({h for v in lines.values() for h in v})
+    out = []
     for d, chans in DIRECTIONS.items():
         chans = tuple(c for c in chans if c in ctx.channels and c in ctx.sp.psd)
         if not chans:
             continue
         said: list[float] = []
-        for h0 in sorted({float(x.h) for x in model.harmonics(d)}):
+        for h0 in lines[d]:
             # a line split in two by its drift is one line: read once
             if h0 < 0.2 or abs(h0 - round(h0)) < WHOLE or any(abs(h0 - x) <= SAME_LINE * h0 for x in said):
                 continue
@@ -101,28 +106,64 @@ def ratio_drift(ctx, state, shares) -> list:
             # the ratios read at the lowest and the highest speed (a slip grows as Ω², no straight line); the
             # Theil-Sen slope's interval says whether they drift at all
             h_lo, h_hi = float(h[np.argmin(rpm)]), float(h[np.argmax(rpm)])
-            drift = (h_hi - h_lo) / h0
-            if abs(drift) < MIN_DRIFT or lo * hi <= 0 or \
+            if abs(h_hi - h_lo) / h0 < MIN_DRIFT or lo * hi <= 0 or \
                     abs(h_hi - h_lo) * rpm.max() / 60.0 < MIN_BINS * float(ctx.sp.df):
                 continue
             said.append(h0)
-            read = rows[:, 0].astype(int)
-            share, level = shares(chans, h0, read)
-            way = "falls" if drift < 0 else "rises"
-            out.append(Unexplained(
-                signature="line_property", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
-                f_Hz=(float(h_lo * rpm.min() / 60.0), float(h_hi * rpm.max() / 60.0)), level_dB=level, share=share,
-                n_runs=int(rpm.size), h=h0,
-                parameters={"property": "ratio_drift", "direction": d, "h": h0, "h_at_lowest_speed": float(h_lo),
-                            "h_at_highest_speed": float(h_hi), "drift_percent": float(100 * drift),
-                            "drift_interval_percent": [float(100 * lo * np.ptp(rpm) / h0),
-                                                       float(100 * hi * np.ptp(rpm) / h0)]},
-                causes=(f"a rolling bearing's cage slipping more as the speed grows: the line's ratio {way} from "
-                        f"{h_lo:.4g} to {h_hi:.4g} ({100 * drift:+.1f} %) over {rpm.min():.0f}-{rpm.max():.0f} rpm; "
-                        "the cage's ratio and the outer race's ball pass fall together, the inner race's rises "
-                        "(n − BPFO), so lines of one bearing drift by one slip",
-                        "a line of a source not locked to the rotor (a pump, a fan, another machine) whose frequency "
-                        "grows with the wheel's speed but not in proportion"),
-                would_tell="the bearing's preload or lubrication changed (slip shrinks with preload); the cage's own "
-                           "line, at h ≈ 0.4, drifting by the same fraction as the ball-pass lines names the bearing"))
+            out.append((d, chans, h0, rows, (float(lo), float(hi)), h_lo, h_hi))
+    if memo is not None:
+        memo[key] = out
     return out
+
+
+def drifting(ctx, model) -> set:
+    """(direction, h) of the lines of ``model`` whose ratio drifts with the speed (:func:`_drifts`), with every
+    line of the model within :data:`SAME_LINE` of one (the same line split in two by its drift)."""
+    out = set()
+    for d, _, h0, *_ in _drifts(ctx, model):
+        out |= {(d, float(x.h)) for x in model.harmonics(d) if abs(float(x.h) - h0) <= SAME_LINE * h0}
+    return out
+
+
+def ratio_drift(ctx, state, shares) -> list:
+    """``line_property`` records (``ratio_drift``) of the model's lines (``state.model``) whose ratio to the speed
+    drifts with it (module docstring); ``shares(chans, h, runs)`` -> (share, level dB) of a line's cells."""
+    out: list[Unexplained] = []
+    for d, chans, h0, rows, (lo, hi), h_lo, h_hi in _drifts(ctx, state.model):
+        rpm, h = rows[:, 1], rows[:, 2]
+        drift = (h_hi - h_lo) / h0
+        read = rows[:, 0].astype(int)
+        order = np.argsort(rpm)
+        share, level = shares(chans, h0, read)
+        way = "falls" if drift < 0 else "rises"
+        out.append(Unexplained(
+            signature="line_property", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
+            f_Hz=(float(h_lo * rpm.min() / 60.0), float(h_hi * rpm.max() / 60.0)), level_dB=level, share=share,
+            n_runs=int(rpm.size), h=h0,
+            parameters={"property": "ratio_drift", "direction": d, "h": h0, "h_at_lowest_speed": float(h_lo),
+                        "h_at_highest_speed": float(h_hi), "drift_percent": float(100 * drift),
+                        "readings_rpm": [float(x) for x in rpm[order]],
+                        "readings_h": [float(x) for x in h[order]],
+                        "drift_interval_percent": [float(100 * lo * np.ptp(rpm) / h0),
+                                                   float(100 * hi * np.ptp(rpm) / h0)]},
+            causes=(f"a rolling bearing's cage slipping more as the speed grows: the line's ratio {way} from "
+                    f"{h_lo:.4g} to {h_hi:.4g} ({100 * drift:+.1f} %) over {rpm.min():.0f}-{rpm.max():.0f} rpm; "
+                    "the cage's ratio and the outer race's ball pass fall together, the inner race's rises "
+                    "(n − BPFO), so lines of one bearing drift by one slip",
+                    "a line of a source not locked to the rotor (a pump, a fan, another machine) whose frequency "
+                    "grows with the wheel's speed but not in proportion"),
+            would_tell="the bearing's preload or lubrication changed (slip shrinks with preload); the cage's own "
+                       "line, at h ≈ 0.4, drifting by the same fraction as the ball-pass lines names the bearing"))
+    return out
+
+
+def beside_drifts(records: list, drifts: list) -> list:
+    """``records`` without the ``partial_line`` records of a line of ``drifts`` (a ``ratio_drift`` record's h within
+    :data:`SAME_LINE` of it, on one of its channels), then ``drifts``: the data's line moves off the model's fixed
+    ratio as the speed grows, and read there it is 'absent' from the top speeds (trial 30b wheel A, h 3.255 on the
+    radial torques: 'stops between 2435 and 2589 rpm' beside its drift of -4.9 %)."""
+    def drifting(u) -> bool:
+        return u.signature == "partial_line" and u.h is not None and any(
+            abs(u.h - x.h) <= SAME_LINE * x.h and set(u.channels) & set(x.channels) for x in drifts)
+
+    return [u for u in records if not drifting(u)] + list(drifts)
