@@ -14,6 +14,7 @@ sideband record.
 import functools
 import sys
 from dataclasses import replace
+from types import SimpleNamespace
 from pathlib import Path
 
 import numpy as np
@@ -102,3 +103,38 @@ def test_a_400_hz_line_is_named_the_400_hz_supply_not_the_50_hz_mains_eighth_ord
     assert mains_family([60.0, 180.0, 300.0]) == (60.0, (1, 3, 5))
     assert mains_family([300.0]) == (50.0, (6,))            # 50 Hz before 60 Hz, as before (review16 S4)
     assert mains_family([137.0]) is None
+
+
+class _LowerSide(_Inverter):
+    """The carrier and its lower sideband alone (f_c − p·Ω/2π): a side without its pair, left to the residual's reading
+    after the search."""
+
+    def cell_signal(self, t, omega, run, rng, wheel, std):
+        out = np.zeros((6, t.size))
+        for f, a in ((self.f_c, 1.0), (self.f_c - self.p * omega / (2 * np.pi), self.side)):
+            out += a * self.level * std[:, None] * np.cos(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+        return out
+
+
+def test_a_side_alone_is_described_where_it_stands_out_and_not_where_its_bins_are_noise(monkeypatch):
+    """A lower side alone (a family wheel, p = 2) is described at its ratio, read on the residual; a track lit only in
+    the neighbours of its bins, in one channel or another, whose own bins sit at the noise floor is not (trial 30b
+    wheel C: a pickup at 120 Hz and 'a side at −0.281x the speed' at −0.3 dB over the floor, in the best channel)."""
+    from rwadist.diagnose import describe_carrier as dc
+
+    wheel = replace(fw.family()[5], n_speeds=16, n_samples=8192)
+    effect = _LowerSide(0.17 * wheel.sample_rate, 2.0, side=0.5)
+    d = api.diagnose(steady_test(fw.steady(wheel, noise=0.01, seed=45, effects=[effect])))
+    (sb,) = [u for u in d.unexplained if u.signature == "sideband_line"]
+    assert sb.parameters["sides"] == [-1] and sb.parameters["removed_before_the_search"] is False
+    assert sb.h == pytest.approx(2.0, rel=2e-4)
+    assert [e["kind"] for e in d.model.effects] == ["suspension_modes"]
+    # the same data, a track of the same carrier at a ratio where nothing is (its bins at the floor) offered as lit
+    ctx = d.ctx
+    runs = ctx.runs
+    assert dc._level_over_floor(ctx, effect.f_c, list(fw.CHANNELS), -1.0, 2.0, runs) > 20.0
+    assert dc._level_over_floor(ctx, effect.f_c, list(fw.CHANNELS), -1.0, 0.281, runs) < dc.SIDE_ALONE_DB
+    monkeypatch.setattr(dc, "_tracks", lambda ctx, f_c, chans, lit, known=(): [(-1.0, 0.281, runs, 1.0)])
+    carrier = next(u for u in d.unexplained if u.signature == "fixed_line")
+    line = SimpleNamespace(f_Hz=carrier.f_Hz[0], channels=carrier.channels)
+    assert dc.sideband_lines(ctx, d.state_after, [line], lambda chans, f, r: (0.1, 10.0)) == []
