@@ -14,8 +14,8 @@ sideband record.
 import functools
 import sys
 from dataclasses import replace
-from types import SimpleNamespace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest

@@ -14,7 +14,9 @@ over the median of the PSD around it, refined by a parabola through the log powe
 h_run against the runs' speeds by a Theil-Sen line.  A drift over the speeds of at least :data:`MIN_DRIFT` of h,
 the Theil-Sen slope's confidence interval clear of 0 and at least :data:`MIN_BINS` Welch bins at the top speed, in :data:`MIN_RUNS`
 runs or more, is described with the ratios read at the lowest and the highest speed.  A line at a whole multiple of the
-speed (a ratio within :data:`WHOLE` of one) is locked to the rotor and not read.
+speed (a ratio within :data:`WHOLE` of one) is locked to the rotor and not read.  A line whose drift of
+:data:`MIN_DRIFT` would stay under :data:`MIN_BINS` Welch bins at the top speed (a cage's, h ≈ 0.4) is read on the
+whole records instead (:func:`_record_ratios`), its drift then counted in their bins.
 """
 from __future__ import annotations
 
@@ -43,6 +45,8 @@ MIN_BINS = 2.0
 SAME_LINE = 0.02
 #: A ratio within this of a whole number is locked to the rotor.
 WHOLE = 0.05
+#: Points of the h grid a line is read on in the whole records, at most.
+MAX_GRID = 400
 
 
 def _run_ratios(ctx, chans, h0: float, half: float) -> np.ndarray:
@@ -67,6 +71,38 @@ def _run_ratios(ctx, chans, h0: float, half: float) -> np.ndarray:
     return np.asarray(rows, dtype=float).reshape(-1, 3)
 
 
+def _record_ratios(ctx, chans, h0: float, half: float) -> tuple:
+    """(rows, df) as :func:`_run_ratios`' rows, read on the whole records (:meth:`Context.phasors`) where the Welch bins
+    cannot tell a drift of :data:`MIN_DRIFT` (a cage's line at h ≈ 0.4: 1 % of 20 Hz is a fifth of a 1 Hz Welch bin),
+    ``df`` the records' resolution (Hz): in each run the power Σ|X|² of ``chans`` on a grid of h over the window (half a
+    record bin apart at the top speed), its peak :data:`MIN_SNR_DB` over the grid's median (at the low speeds the
+    window lies within the line's own lobe, and its median is no floor: those runs are not read), refined by a
+    parabola through the log powers of the top three points."""
+    from ..units import CHANNELS
+
+    runs = np.asarray(ctx.runs)
+    df = float(np.median([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs]))
+    spin = np.abs(ctx.omega[runs]) / (2 * np.pi)
+    n = int(min(np.ceil(2 * half * spin.max() / (0.5 * df)) + 1, MAX_GRID))
+    grid = h0 + np.linspace(-half, half, n)
+    top = float(ctx.f[-1]) if ctx.sp.f_lim is None else min(float(ctx.sp.f_lim), float(ctx.f[-1]))
+    ok = (h0 + half) * spin < top
+    if n < 5 or not ok.any():
+        return np.empty((0, 3)), df
+    runs, spin = runs[ok], spin[ok]
+    X = ctx.phasors(runs, np.outer(spin, grid))[:, :, [CHANNELS.index(c) for c in chans]]
+    P = np.sum(np.abs(X) ** 2, axis=2)                                          # (runs, grid)
+    j = np.argmax(P, axis=1)
+    floor = np.median(P, axis=1)
+    rows = []
+    for i, r in enumerate(runs):
+        if not 0 < j[i] < n - 1 or not np.all(np.isfinite(P[i])) or P[i, j[i]] < floor[i] * 10 ** (MIN_SNR_DB / 10):
+            continue
+        h = grid[j[i]] + log_parabola_offset(P[i, j[i] - 1:j[i] + 2]) * (grid[1] - grid[0])
+        rows.append((float(r), spin[i] * 60.0, float(h)))
+    return np.asarray(rows, dtype=float).reshape(-1, 3), df
+
+
 def _drifts(ctx, model) -> list:
     """(direction, channels, h, rows, slope interval (lo, hi), h at the lowest speed, h at the highest) of every line of
     ``model`` whose ratio to the speed drifts on ``ctx``'s Welch PSDs (module docstring); ``rows`` of
@@ -84,6 +120,7 @@ def _drifts(ctx, model) -> list:
     if memo is not None and key in memo:
         return memo[key]
     every = sorted({h for v in lines.values() for h in v})
+    spin_top = float(np.max(np.abs(ctx.omega[ctx.runs]))) / (2 * np.pi)
     out = []
     for d, chans in DIRECTIONS.items():
         chans = tuple(c for c in chans if c in ctx.channels and c in ctx.sp.psd)
@@ -98,7 +135,11 @@ def _drifts(ctx, model) -> list:
             # direction, or split in two by the drift itself: 4.733 and 4.758 in trial 30b's axial force)
             gap = min((abs(h - h0) for h in every if abs(h - h0) > SAME_LINE * h0), default=np.inf)
             half = min(WINDOW * h0, NEIGHBOUR_FRACTION * gap)
-            rows = _run_ratios(ctx, chans, h0, half)
+            df = float(ctx.sp.df)
+            if MIN_DRIFT * h0 * spin_top < MIN_BINS * df and ctx.test is not None:
+                rows, df = _record_ratios(ctx, chans, h0, half)
+            else:
+                rows = _run_ratios(ctx, chans, h0, half)
             if rows.shape[0] < MIN_RUNS:
                 continue
             rpm, h = rows[:, 1], rows[:, 2]
@@ -107,7 +148,7 @@ def _drifts(ctx, model) -> list:
             # Theil-Sen slope's interval says whether they drift at all
             h_lo, h_hi = float(h[np.argmin(rpm)]), float(h[np.argmax(rpm)])
             if abs(h_hi - h_lo) / h0 < MIN_DRIFT or lo * hi <= 0 or \
-                    abs(h_hi - h_lo) * rpm.max() / 60.0 < MIN_BINS * float(ctx.sp.df):
+                    abs(h_hi - h_lo) * rpm.max() / 60.0 < MIN_BINS * df:
                 continue
             said.append(h0)
             out.append((d, chans, h0, rows, (float(lo), float(hi)), h_lo, h_hi))
