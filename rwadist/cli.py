@@ -119,7 +119,7 @@ def cmd_simulate(args) -> int:
     fs = test.runs[0].sample_rate
     with atomic_dataset_dir(out, "OUT_DIR") as tmp, working(f"writing {len(test.runs)} runs"):
         data_io.write_steady(test, tmp)
-    print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g}-{speeds.max():g} rpm, {fs:g} Hz, "
+    print(f"wrote {len(test.runs)} runs to {out} ({speeds.min():g} to {speeds.max():g} rpm, {fs:g} Hz, "
           f"{args.samples} samples each)")
     return 0
 

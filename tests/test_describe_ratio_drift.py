@@ -13,7 +13,7 @@ import pytest
 from rwadist.data import Run, SteadyTest
 from rwadist.diagnose import describe_drift
 from rwadist.diagnose.describe import Residual, cells_of
-from rwadist.diagnose.describe_drift import MIN_DRIFT, SAME_LINE, beside_drifts, ratio_drift
+from rwadist.diagnose.describe_drift import MIN_DRIFT, SAME_LINE, beside_drifts, drifting_speed_lines, ratio_drift
 from rwadist.diagnose.engine import Context, initial_state
 from rwadist.diagnose.unexplained import Unexplained
 from rwadist.effects.fixed_resonance_diagnose import _line_gain_points
@@ -134,3 +134,30 @@ def test_a_cage_line_under_the_welch_resolution_is_read_on_the_whole_records():
         for key, r in (("h_at_lowest_speed", rpm.min()), ("h_at_highest_speed", rpm.max())):
             assert u.parameters[key] == pytest.approx(CAGE * (1 - 0.05 * (r / RPM[-1]) ** 2), rel=0.003)
         assert u.parameters["drift_percent"] < -1.0
+
+
+def test_a_speed_line_of_no_model_that_drifts_is_described_as_the_drift():
+    """A drifting line no model holds is caught as a ridge at one h (trial 31 wheel D: twice the ball pass slipping 4 %
+    read as 'speed lines' at h 6.795 and 6.747, named 15-16 and 16-ball bearings): read again, it is the drift, once;
+    a speed line at a constant ratio stays.  Here the radial-force ball-pass lines, in no model of this data."""
+    ctx, model = _context(0.05)
+    state = SimpleNamespace(model=model)
+
+    def speed_line(h, chans=("Fx", "Fy"), d="radial_force"):
+        return Unexplained(signature="speed_line", channels=chans, speed_rpm=(600.0, 3000.0), f_Hz=(30.0, 160.0),
+                           level_dB=15.0, share=0.01, n_runs=16, h=h, parameters={"direction": d, "h": h})
+
+    outer = BALLS * CAGE
+    a, b, steady = speed_line(outer * 0.985), speed_line(outer * 0.975), speed_line(1.5)
+    kept, found = drifting_speed_lines(ctx, state, [a, b, steady])
+    assert kept == [steady]
+    (got,) = found
+    d, chans, h0, rows, _, h_lo, h_hi = got
+    assert d == "radial_force" and chans == ("Fx", "Fy")
+    rpm = rows[:, 1]
+    for h, r in ((h_lo, rpm.min()), (h_hi, rpm.max())):
+        assert h == pytest.approx(outer * (1 - 0.05 * (r / RPM[-1]) ** 2), rel=0.005)
+    # the model's own drifting lines first (the axial force's), then this one
+    rec = ratio_drift(ctx, state, lambda chans, h, runs: (0.0, 0.0), found)[-1]
+    assert rec.signature == "line_property" and rec.parameters["property"] == "ratio_drift"
+    assert rec.h == pytest.approx(a.h) and rec.parameters["drift_percent"] < -1.0

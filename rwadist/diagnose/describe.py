@@ -310,7 +310,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     lines found before the search (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands
     taken out with them."""
     from .describe_carrier import measure_track, on_a_sideband, sideband_lines, sideband_tracks
-    from .describe_drift import beside_drifts, ratio_drift
+    from .describe_drift import with_drifts
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
@@ -400,7 +400,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     # a gain common to the channels that changes with speed, on the recorded channels too
     out += gain_trend(ctx, as_recorded(searched.state), of_line)
     # a line whose ratio drifts with the speed (a cage slipping), and what its fixed-ratio model line made of it
-    return beside_drifts(out, ratio_drift(ctx, state, of_line))
+    return with_drifts(ctx, state, out, of_line)
 
 
 #: A hump at most this many bins wide whose peak lies within its own width of a fixed line on one of its channels is

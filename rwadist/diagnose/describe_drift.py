@@ -103,16 +103,45 @@ def _record_ratios(ctx, chans, h0: float, half: float) -> tuple:
     return np.asarray(rows, dtype=float).reshape(-1, 3), df
 
 
+def _read(ctx, chans, h0: float, every, spin_top: float):
+    """(rows, slope interval (lo, hi), h at the lowest speed, h at the highest) of the line near ``h0`` in ``chans``
+    when its ratio to the speed drifts (module docstring), else None; ``every``: the model's lines (ratios), whose
+    nearest other one bounds the window."""
+    from scipy.stats import theilslopes
+
+    # another line of the model is one more than SAME_LINE of h away (closer: this line read in another direction,
+    # or split in two by the drift itself: 4.733 and 4.758 in trial 30b's axial force)
+    gap = min((abs(h - h0) for h in every if abs(h - h0) > SAME_LINE * h0), default=np.inf)
+    half = min(WINDOW * h0, NEIGHBOUR_FRACTION * gap)
+    df = float(ctx.sp.df)
+    if MIN_DRIFT * h0 * spin_top < MIN_BINS * df and ctx.test is not None:
+        rows, df = _record_ratios(ctx, chans, h0, half)
+    else:
+        rows = _run_ratios(ctx, chans, h0, half)
+    if rows.shape[0] < MIN_RUNS:
+        return None
+    rpm, h = rows[:, 1], rows[:, 2]
+    slope, icpt, lo, hi = theilslopes(h, rpm)
+    # the ratios read at the lowest and the highest speed (a slip grows as Ω², no straight line); the Theil-Sen
+    # slope's interval says whether they drift at all
+    h_lo, h_hi = float(h[np.argmin(rpm)]), float(h[np.argmax(rpm)])
+    if abs(h_hi - h_lo) / h0 < MIN_DRIFT or lo * hi <= 0 or abs(h_hi - h_lo) * rpm.max() / 60.0 < MIN_BINS * df:
+        return None
+    return rows, (float(lo), float(hi)), h_lo, h_hi
+
+
+def _sliced(ctx) -> bool:
+    """A sweep's slices: the speed moves within each, and the power-weighted peak (the load grows as Ω²) sits above
+    the slice's mean speed by an amount that changes with speed (family wheel 0, a 30-s run-up: a phantom drift)."""
+    test = getattr(ctx, "test", None)
+    return test is not None and "slicing" in (getattr(test, "meta", None) or {})
+
+
 def _drifts(ctx, model) -> list:
     """(direction, channels, h, rows, slope interval (lo, hi), h at the lowest speed, h at the highest) of every line of
     ``model`` whose ratio to the speed drifts on ``ctx``'s Welch PSDs (module docstring); ``rows`` of
     :func:`_run_ratios`.  Kept on the context by the model's lines: the search asks it at every step."""
-    from scipy.stats import theilslopes
-
-    test = getattr(ctx, "test", None)
-    if test is not None and "slicing" in (getattr(test, "meta", None) or {}):
-        # a sweep's slices: the speed moves within each, and the power-weighted peak (the load grows as Ω²) sits above
-        # the slice's mean speed by an amount that changes with speed (family wheel 0, a 30-s run-up: a phantom drift)
+    if _sliced(ctx):
         return []
     lines = {d: sorted({float(x.h) for x in model.harmonics(d)}) for d in DIRECTIONS}
     key = ("ratio_drift", tuple((d, tuple(v)) for d, v in lines.items()))
@@ -131,30 +160,43 @@ def _drifts(ctx, model) -> list:
             # a line split in two by its drift is one line: read once
             if h0 < 0.2 or abs(h0 - round(h0)) < WHOLE or any(abs(h0 - x) <= SAME_LINE * h0 for x in said):
                 continue
-            # another line of the model is one more than SAME_LINE of h away (closer: this line read in another
-            # direction, or split in two by the drift itself: 4.733 and 4.758 in trial 30b's axial force)
-            gap = min((abs(h - h0) for h in every if abs(h - h0) > SAME_LINE * h0), default=np.inf)
-            half = min(WINDOW * h0, NEIGHBOUR_FRACTION * gap)
-            df = float(ctx.sp.df)
-            if MIN_DRIFT * h0 * spin_top < MIN_BINS * df and ctx.test is not None:
-                rows, df = _record_ratios(ctx, chans, h0, half)
-            else:
-                rows = _run_ratios(ctx, chans, h0, half)
-            if rows.shape[0] < MIN_RUNS:
-                continue
-            rpm, h = rows[:, 1], rows[:, 2]
-            slope, icpt, lo, hi = theilslopes(h, rpm)
-            # the ratios read at the lowest and the highest speed (a slip grows as Ω², no straight line); the
-            # Theil-Sen slope's interval says whether they drift at all
-            h_lo, h_hi = float(h[np.argmin(rpm)]), float(h[np.argmax(rpm)])
-            if abs(h_hi - h_lo) / h0 < MIN_DRIFT or lo * hi <= 0 or \
-                    abs(h_hi - h_lo) * rpm.max() / 60.0 < MIN_BINS * df:
-                continue
-            said.append(h0)
-            out.append((d, chans, h0, rows, (float(lo), float(hi)), h_lo, h_hi))
+            got = _read(ctx, chans, h0, every, spin_top)
+            if got is not None:
+                said.append(h0)
+                out.append((d, chans, h0) + got)
     if memo is not None:
         memo[key] = out
     return out
+
+
+def drifting_speed_lines(ctx, state, records: list) -> tuple:
+    """(``records`` without the ``speed_line`` records whose ratio drifts with the speed, the (direction, channels, h,
+    rows, interval, h_lo, h_hi) readings of those, as :func:`_drifts`'): a line of no model whose ratio drifts is
+    caught as a ridge at one h over part of the speeds, or two (trial 31 wheel D, twice the outer race's ball pass
+    slipping 4 %: 'speed lines' at h 6.795 over 400-3304 rpm and 6.747 over 400-3646 rpm, named 15-16 and 16-ball
+    bearings, never tied to the drift).  Lines of one direction within :data:`SAME_LINE` of a drifting one are it."""
+    if _sliced(ctx):
+        return records, []
+    every = sorted({float(x.h) for d in DIRECTIONS for x in state.model.harmonics(d)})
+    spin_top = float(np.max(np.abs(ctx.omega[ctx.runs]))) / (2 * np.pi)
+    kept: list = []
+    found: list = []
+    for u in records:
+        d = (u.parameters or {}).get("direction") if u.signature == "speed_line" else None
+        if d not in DIRECTIONS or u.h is None or abs(u.h - round(u.h)) < WHOLE:
+            kept.append(u)
+            continue
+        if any(x[0] == d and abs(u.h - x[2]) <= SAME_LINE * x[2] for x in found):
+            continue                        # the drifting line read already, caught as another ridge
+        chans = tuple(c for c in DIRECTIONS[d] if c in ctx.channels and c in ctx.sp.psd)
+        got = _read(ctx, chans, float(u.h), every, spin_top) if chans else None
+        if got is None:
+            kept.append(u)
+        else:
+            found.append((d, chans, float(u.h)) + got)
+    kept = [u for u in kept if not (u.signature == "speed_line" and any(
+        x[0] == (u.parameters or {}).get("direction") and abs(u.h - x[2]) <= SAME_LINE * x[2] for x in found))]
+    return kept, found
 
 
 def drifting(ctx, model) -> set:
@@ -166,11 +208,12 @@ def drifting(ctx, model) -> set:
     return out
 
 
-def ratio_drift(ctx, state, shares) -> list:
+def ratio_drift(ctx, state, shares, more=()) -> list:
     """``line_property`` records (``ratio_drift``) of the model's lines (``state.model``) whose ratio to the speed
-    drifts with it (module docstring); ``shares(chans, h, runs)`` -> (share, level dB) of a line's cells."""
+    drifts with it (module docstring), and of the readings ``more`` (:func:`drifting_speed_lines`: lines of no
+    model); ``shares(chans, h, runs)`` -> (share, level dB) of a line's cells."""
     out: list[Unexplained] = []
-    for d, chans, h0, rows, (lo, hi), h_lo, h_hi in _drifts(ctx, state.model):
+    for d, chans, h0, rows, (lo, hi), h_lo, h_hi in list(_drifts(ctx, state.model)) + list(more):
         rpm, h = rows[:, 1], rows[:, 2]
         drift = (h_hi - h_lo) / h0
         read = rows[:, 0].astype(int)
@@ -208,3 +251,11 @@ def beside_drifts(records: list, drifts: list) -> list:
             abs(u.h - x.h) <= SAME_LINE * x.h and set(u.channels) & set(x.channels) for x in drifts)
 
     return [u for u in records if not drifting(u)] + list(drifts)
+
+
+def with_drifts(ctx, state, records: list, shares) -> list:
+    """``records`` (the residual's descriptions) with the lines whose ratio drifts with the speed described as such:
+    those of the model (:func:`ratio_drift`) and the ``speed_line`` records that drift (:func:`drifting_speed_lines`,
+    replaced), without a drifting line's fixed-ratio reading as a ``partial_line`` (:func:`beside_drifts`)."""
+    kept, more = drifting_speed_lines(ctx, state, records)
+    return beside_drifts(kept, ratio_drift(ctx, state, shares, more))
