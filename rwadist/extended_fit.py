@@ -47,7 +47,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from . import extended as ext
-from .data import DataError, Run, SteadyTest
+from .data import Run, SteadyTest
 from .dft import blocked_records, run_window, windowed_dfts
 from .empirical import EmpiricalFit, FitSettings, block_floor, fit_empirical
 from .extended_fit_close import with_close_lines
@@ -60,7 +60,7 @@ from .extended_fit_lsq import (
     recorded_noisy_sensors,
     split_note,
 )
-from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower
+from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower, fitted_senses, forcing_lines, rows_of_lines
 from .geometry import remove_lever_arm
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
@@ -451,63 +451,23 @@ class _ModeStarts:
             base[cn] = 2 * zeta * math.sqrt(base[kn] * base[inertia])
         return base
 
-    def declare(self, base: dict, mode: str, why: str) -> None:
-        """``mode`` not pinned by the least squares: NOT CONSTRAINED (``why``), back to its start in ``base``."""
+    def declare(self, base: dict, mode: str, why: str, kept: tuple | None = None) -> None:
+        """``mode`` not pinned by the least squares: NOT CONSTRAINED (``why``), back to its start in ``base``, or held
+        at the stiffness and damping ``kept`` where it was located (above every line of its direction:
+        :func:`rwadist.extended_fit_damping.above_every_line`); else its damping ratio ``zeta0``."""
         self.scans[mode].reason = why
         self.scans[mode].found = False
         self.identified[mode] = False
         self.f_modes[mode] = None
         kn, cn, inertia = MODE_PARAMS[mode]
-        base[kn] = self.stiffness(mode, base[inertia], kn)
-        base[cn] = 2 * self.zeta0 * math.sqrt(base[kn] * base[inertia])
-
-
-def _forcing_lines(meas_lines: list, senses_xy: dict) -> tuple[list[ext.Line], np.ndarray]:
-    """(forcing lines at their start, per forcing line its measured line): an axial line one coefficient, a radial
-    line a co- and a counter-rotating part started from the x/y-phase split (floored so both can grow)."""
-    lines, owner = [], []
-    for j, x in enumerate(meas_lines):
-        if x.direction in RADIAL:
-            fr = senses_xy.get((x.direction, float(x.h)), ("co", 1.0))[1]
-            c_co, c_ct = x.C * max(math.sqrt(fr), 0.03), x.C * max(math.sqrt(1 - fr), 0.03)
-            imb = abs(x.h - 1.0) <= ext.IMBALANCE_H_TOL
-            lines.append(ext.Line(x.direction, 1.0 if imb else float(x.h), float(c_co), "co", imbalance=imb))
-            lines.append(ext.Line(x.direction, float(x.h), float(c_ct), "counter"))
-            owner += [j, j]
+        if kept is None:
+            base[kn] = self.stiffness(mode, base[inertia], kn)
+            base[cn] = 2 * self.zeta0 * math.sqrt(base[kn] * base[inertia])
         else:
-            lines.append(ext.Line(x.direction, float(x.h), float(x.C), "co"))
-            owner.append(j)
-    if not lines:
-        raise DataError("empirical fit", "harmonics", "none: nothing to fit the extended model to (lower `presence`)")
-    return lines, np.array(owner)
-
-
-def _rows_of_lines(owner: np.ndarray, la: np.ndarray, lr: np.ndarray) -> tuple[dict, np.ndarray, np.ndarray]:
-    """(measured line -> its forcing lines, per axial row its forcing line, per radial row its two parts) of the
-    forcing lines' measured lines ``owner`` and the rows' measured lines ``la`` (axial), ``lr`` (radial)."""
-    line_of: dict[int, list[int]] = {}
-    for k, j in enumerate(owner):
-        line_of.setdefault(int(j), []).append(k)
-    ax_line = np.array([line_of[int(j)][0] for j in la], dtype=int)
-    rad_parts = np.array([line_of[int(j)] for j in lr], dtype=int).reshape(-1, 2) if lr.size else np.zeros((0, 2), int)
-    return line_of, ax_line, rad_parts
-
-
-def _fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple[dict, list]:
-    """(senses, kept lines): the rotation sense of each radial line from its fitted forcing, (direction, h) ->
-    (sense, co-rotating fraction of its power); negligible parts (< 1 % of the line's power) dropped."""
-    senses, kept_lines = {}, []
-    for j, x in enumerate(meas_lines):
-        parts = [fitted_lines[k] for k in line_of[j]]
-        if x.direction not in RADIAL:
-            kept_lines += parts
-            continue
-        p_co, p_ct = parts[0].C ** 2, parts[1].C ** 2
-        fr = p_co / (p_co + p_ct)
-        sense = "co" if fr >= 0.99 else ("counter" if fr <= 0.01 else "co+counter")
-        senses[(x.direction, float(x.h))] = (sense, float(fr))
-        kept_lines += [ln for ln, pw in zip(parts, (p_co, p_ct)) if pw >= 0.01 * (p_co + p_ct) or ln.imbalance]
-    return senses, kept_lines
+            base[kn], base[cn] = kept
+            self.notes.append(f"{mode}: NOT CONSTRAINED by the data ({why}); above every line of its direction (the "
+                              "lines show the rise below it, not the mode): its fitted value is kept, listed in "
+                              "analytical.unconstrained")
 
 
 def _residuals_near_modes(params: ext.ExtendedParams, lines: list, ax_line: np.ndarray, rad_parts: np.ndarray,
@@ -600,9 +560,9 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     starts = _ModeStarts(scans, start, physical, max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines),
                                                      default=100.0), zeta0, notes)
     base = starts.params(mass_kg, I_rr, I_zz)
-    lines, owner = _forcing_lines(meas.lines, senses_xy)
+    lines, owner = forcing_lines(meas.lines, senses_xy)
     lr, sr, pr, dr, nr = radial
-    line_of, ax_line, rad_parts = _rows_of_lines(owner, la, lr)
+    line_of, ax_line, rad_parts = rows_of_lines(owner, la, lr)
     log_data, joint = _log_data(meas.lines, la, sa, aa, lr, sr, pr, stand if fit_stand else None, stand_direction,
                                 tuple(more_stands) if fit_stand and fit_more_stands else ())
     row_line, log_w, centred_log_w = line_regressors(la, lr, sa, sr)     # per row: its line, ln|Ω|, centred
@@ -613,7 +573,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     zeta_bounds: dict = {}      # mode -> (lo, hi): a damping the data do not measure, held (filled in place)
     intervals: dict = {}        # mode -> (lo, hi): every damping's interval at the last fit that profiled it
     solution = fit_modes(problem, [m for m in MODE_PARAMS if starts.identified[m]], declare, tolerance, off_law,
-                          log_w, lambda m, why: starts.declare(base, m, why), zeta0, zeta_bounds, intervals)
+                          log_w, lambda m, why, kept: starts.declare(base, m, why, kept), zeta0, zeta_bounds, intervals)
     res, names, rel_se, unpack = solution.res, solution.names, solution.rel_se, solution.unpack
     params, fitted_lines = unpack(res.x)
     sums = power_sum_stderr(solution, {(x.direction, float(x.h)): tuple(line_of[j])
@@ -624,7 +584,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     if joint is not None:
         stand, more_stands = joint.stand(res.x[n_x:]), joint.more(res.x[n_x:], more_stands)
     params = replace(params, height=float(height))
-    senses, kept_lines = _fitted_senses(meas.lines, fitted_lines, line_of)
+    senses, kept_lines = fitted_senses(meas.lines, fitted_lines, line_of)
     # a line the model file keeps both parts of, whose split the power does not see: its parts' errors say little
     notes += [split_note(d, h, *se) for (d, h), se in sums.items() if se[3] >= 1.0 and senses[(d, h)][0] == "co+counter"]
     resid_db, line_residuals = _residuals_near_modes(params, lines, ax_line, rad_parts, sa, sr, dr, res.fun, notes)

@@ -1,8 +1,13 @@
-"""The extended fit's measured-line powers and their derivatives (:func:`rwadist.extended_fit.fit_extended`)."""
+"""The extended fit's forcing lines, measured-line powers and their derivatives
+(:func:`rwadist.extended_fit.fit_extended`)."""
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
+from . import extended as ext
+from .errors import DataError
 from .units import CHANNELS
 
 CHANNEL_INDEX = {c: i for i, c in enumerate(CHANNELS)}
@@ -96,3 +101,51 @@ class LinePower:
         # Σ over the terms of each (row, line) cell in their order, from 0: the numbers of np.add.at, in one pass
         d_C = np.bincount(self.cell, -share, minlength=self.n_rows * self.n_lines).reshape(self.n_rows, self.n_lines)
         return r, d_mode, d_C
+
+
+def forcing_lines(meas_lines: list, senses_xy: dict) -> tuple[list[ext.Line], np.ndarray]:
+    """(forcing lines at their start, per forcing line its measured line): an axial line one coefficient, a radial
+    line a co- and a counter-rotating part started from the x/y-phase split (floored so both can grow)."""
+    lines, owner = [], []
+    for j, x in enumerate(meas_lines):
+        if x.direction in RADIAL:
+            fr = senses_xy.get((x.direction, float(x.h)), ("co", 1.0))[1]
+            c_co, c_ct = x.C * max(math.sqrt(fr), 0.03), x.C * max(math.sqrt(1 - fr), 0.03)
+            imb = abs(x.h - 1.0) <= ext.IMBALANCE_H_TOL
+            lines.append(ext.Line(x.direction, 1.0 if imb else float(x.h), float(c_co), "co", imbalance=imb))
+            lines.append(ext.Line(x.direction, float(x.h), float(c_ct), "counter"))
+            owner += [j, j]
+        else:
+            lines.append(ext.Line(x.direction, float(x.h), float(x.C), "co"))
+            owner.append(j)
+    if not lines:
+        raise DataError("empirical fit", "harmonics", "none: nothing to fit the extended model to (lower `presence`)")
+    return lines, np.array(owner)
+
+
+def rows_of_lines(owner: np.ndarray, la: np.ndarray, lr: np.ndarray) -> tuple[dict, np.ndarray, np.ndarray]:
+    """(measured line -> its forcing lines, per axial row its forcing line, per radial row its two parts) of the
+    forcing lines' measured lines ``owner`` and the rows' measured lines ``la`` (axial), ``lr`` (radial)."""
+    line_of: dict[int, list[int]] = {}
+    for k, j in enumerate(owner):
+        line_of.setdefault(int(j), []).append(k)
+    ax_line = np.array([line_of[int(j)][0] for j in la], dtype=int)
+    rad_parts = np.array([line_of[int(j)] for j in lr], dtype=int).reshape(-1, 2) if lr.size else np.zeros((0, 2), int)
+    return line_of, ax_line, rad_parts
+
+
+def fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple[dict, list]:
+    """(senses, kept lines): the rotation sense of each radial line from its fitted forcing, (direction, h) ->
+    (sense, co-rotating fraction of its power); negligible parts (< 1 % of the line's power) dropped."""
+    senses, kept_lines = {}, []
+    for j, x in enumerate(meas_lines):
+        parts = [fitted_lines[k] for k in line_of[j]]
+        if x.direction not in RADIAL:
+            kept_lines += parts
+            continue
+        p_co, p_ct = parts[0].C ** 2, parts[1].C ** 2
+        fr = p_co / (p_co + p_ct)
+        sense = "co" if fr >= 0.99 else ("counter" if fr <= 0.01 else "co+counter")
+        senses[(x.direction, float(x.h))] = (sense, float(fr))
+        kept_lines += [ln for ln, pw in zip(parts, (p_co, p_ct)) if pw >= 0.01 * (p_co + p_ct) or ln.imbalance]
+    return senses, kept_lines

@@ -496,8 +496,30 @@ def _at_the_end(f_best: float, f0_grid: np.ndarray) -> str:
             f"at {f_best:.4g} Hz: no line comes near it")
 
 
+def _competitor(line, h, omega, power, grids, ssr, io, f_step, f_best, tolerance, two_parts, at_grid) -> float:
+    """The SSR of the best competitor farther than ``tolerance`` from ``f_best``, at f0 grid index ``io`` (``grids``:
+    the scan's f0, ζ and a grids; ``ssr`` its grid of SSRs; ``at_grid`` the profile's SSR there), given the same
+    refinement as the best point (a coarse ζ grid would make it look worse than it is and the mode look pinned when
+    it is not)."""
+    f0_grid, zeta_grid, a_grid = grids
+    jo, ko = np.unravel_index(np.nanargmin(ssr[io]), ssr[io].shape)
+    f_o = f0_grid[io] * np.exp(np.arange(-f_step, f_step + 0.0001, 0.002))
+    f_o = f_o[np.abs(np.log(f_o / f_best)) > math.log1p(tolerance)]
+    z_o = zeta_grid[jo] * np.exp(np.linspace(-0.5, 0.5, 11) * (1 if a_grid.size == 1 else 1.5))
+    a_o = a_grid if a_grid.size == 1 else np.unique(np.clip(a_grid[ko] + np.linspace(-0.2, 0.2, 21), 0.02, A_MAX))
+    return min(float(np.nanmin(_grid_search(line, h, omega, power, f_o, z_o, a_o, two_parts))), at_grid)
+
+
+#: The largest damping ratio a mode above every line is scanned with (:func:`scan_mode`'s ``zeta_max``): below a mode
+#: the lines show only its rise, along which f0 and ζ trade (a ROSS wheel's axial mode at 334.5 Hz, ζ 0.024, its lines
+#: to 154 Hz: 237.5 Hz at a large ζ, then declared and its rise described as two lines' laws), and a suspension mode's
+#: damping is well under it
+QUASI_STATIC_ZETA = 0.15
+
+
 def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = None, tolerance: float = 0.02,
-              min_log_lr: float = 2.0, near_hz: float | None = None, near_a: float | None = None) -> ModeScan:
+              min_log_lr: float = 2.0, near_hz: float | None = None, near_a: float | None = None,
+              zeta_max: float = 0.6) -> ModeScan:
     """Profile scan of one mode (see the module docstring).
 
     line : (n,) int, index of the line each measurement belongs to.  h : (n,) harmonic number.
@@ -511,6 +533,7 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     is searched within ×/÷ :data:`NEAR_SPAN` (and ±:data:`NEAR_A_SPAN`) of it first and over its whole range only
     when the best point lies on that window's edge; the result is the whole grid's whenever its best point lies
     inside the window.  ``interval_hz`` and ``log_lr_off`` are then those of the profile inside the window.
+    zeta_max : the largest damping ratio scanned (:data:`QUASI_STATIC_ZETA` for a mode above every line).
     """
     line, h, omega, power = (np.asarray(x) for x in (line, h, omega, power))
     ok = (power > 0) & np.isfinite(power) & (np.abs(omega) > 0)
@@ -536,7 +559,7 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     # a third axis (a unknown) costs 10x: coarser f0 and ζ steps there, the refinement recovers them
     f_step = 0.01 if a_grid.size == 1 else 0.02
     f0_grid = np.exp(np.arange(math.log(f_lo), math.log(f_hi), f_step))
-    zeta_grid = np.exp(np.linspace(math.log(0.002), math.log(0.6), 13 if a_grid.size == 1 else 9))
+    zeta_grid = np.exp(np.linspace(math.log(0.002), math.log(zeta_max), 13 if a_grid.size == 1 else 9))
     # a locate-only scan reads its grid's best point alone: screened in single precision first
     ssr = _windowed_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, near_hz,
                            near_a if rocking and inertia_ratio is None else None,
@@ -564,6 +587,9 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
         if float(fine_2[gi, gj, gk]) < best:
             best = float(fine_2[gi, gj, gk])
             f_best, z_best, a_best = float(f_2[gi]), float(z_2[gj]), float(a_2[gk])
+    if z_best > QUASI_STATIC_ZETA and zeta_max > QUASI_STATIC_ZETA and f_best > float(f_line.max()):
+        return scan_mode(mode, line, h, omega, power, inertia_ratio, tolerance, min_log_lr, near_hz, near_a,
+                         zeta_max=QUASI_STATIC_ZETA)
     profile = np.full(f0_grid.size, np.nan)
     scanned = ~np.all(np.isnan(ssr), axis=(1, 2))     # every f0 but those a windowed search left out
     profile[scanned] = np.nanmin(ssr[scanned], axis=(1, 2))
@@ -574,15 +600,9 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     if min_log_lr == -math.inf:
         log_lr_off = math.nan           # a locate-only scan: no competitor is weighed
     elif off.any():
-        # the competitor farther than the tolerance gets the same refinement as the best point (a coarse
-        # ζ grid would make it look worse than it is and the mode look pinned when it is not)
         io = np.nonzero(off)[0][np.argmin(log_lr[off])]
-        jo, ko = np.unravel_index(np.nanargmin(ssr[io]), ssr[io].shape)
-        f_o = f0_grid[io] * np.exp(np.arange(-f_step, f_step + 0.0001, 0.002))
-        f_o = f_o[np.abs(np.log(f_o / f_best)) > math.log1p(tolerance)]
-        z_o = zeta_grid[jo] * np.exp(np.linspace(-0.5, 0.5, 11) * (1 if a_grid.size == 1 else 1.5))
-        a_o = a_grid if a_grid.size == 1 else np.unique(np.clip(a_grid[ko] + np.linspace(-0.2, 0.2, 21), 0.02, A_MAX))
-        ssr_o = min(float(np.nanmin(_grid_search(line, h, omega, power, f_o, z_o, a_o, two_parts))), float(profile[io]))
+        ssr_o = _competitor(line, h, omega, power, (f0_grid, zeta_grid, a_grid), ssr, io, f_step, f_best, tolerance,
+                            two_parts, float(profile[io]))
         log_lr_off = float(0.5 * n * np.log(max(ssr_o, 1e-300) / max(best, 1e-300)))
     inside = np.nonzero(log_lr < max(min_log_lr, 2.0))[0]
     interval = (float(f0_grid[inside.min()]), float(f0_grid[inside.max()])) if inside.size else (f_best, f_best)

@@ -35,10 +35,12 @@ def test_every_mode_found_within_2_percent_or_declared(cell):
     assert all(row[m]["found"] for m in matrix.MODES), matrix.format_row(row)
 
 
-def test_modes_no_line_reaches_are_declared_unconstrained(tmp_path, monkeypatch):
-    """300-1000 rpm: the highest line reaches 93 Hz; radial translation (228 Hz) is out of reach and the
-    axial mode (70 Hz, crossed only by the weak h = 4.33 line near the top) may be too.  What is not found
-    is listed in ``unconstrained`` and in the model file; the rocking whirls are crossed and found."""
+def test_modes_no_line_reaches_are_located_by_their_rise_or_declared(tmp_path, monkeypatch):
+    """300-1000 rpm: the highest line reaches 93 Hz; no line reaches the radial translation (228 Hz), and the axial
+    mode (70 Hz) is crossed only by the weak h = 4.33 line near the top.  Below the translation the force lines show
+    its rise alone, along which f0 and ζ trade: its damping held, the rise places it (229.6 Hz, +0.8 %; before, with
+    ζ free, not pinned and declared).  Every mode is within 2 % or listed in ``unconstrained`` and in the model
+    file; the rocking whirls are crossed and found."""
     from rwadist import empirical, extended_fit
     from rwadist import model as model_io
     from rwadist.extended_fit import to_model
@@ -59,13 +61,19 @@ def test_modes_no_line_reaches_are_declared_unconstrained(tmp_path, monkeypatch)
     row = matrix.run_cell(cell)
     print(matrix.format_row(row))
     assert row["ok"], row["problems"]
-    assert not row["radial_translation"]["found"] and row["radial_translation"]["declared_unconstrained"]
     assert row["rocking"]["found"] and abs(row["rocking"]["error"]) < 0.02
-    # the model file carries the list
     fit, ef = made["fit"], made["ef"]
+    translation = row["radial_translation"]
+    if translation["found"]:        # by its rise: within 2 %, its damping held (not a measured one)
+        assert abs(translation["error"]) < 0.02
+        assert "radial_translation" in ef.zeta_bounds
+    else:
+        assert translation["declared_unconstrained"]
+    # the model file carries the list
     m = model_io.load(model_io.save(to_model(ef, fit), tmp_path / "m.json"))
-    assert "radial_translation" in m.analytical["unconstrained"]
-    assert set(m.analytical["unconstrained"]) == set(ef.unconstrained)
+    listed = set(m.analytical.get("unconstrained") or [])
+    assert {x for x in listed if not x.startswith("zeta_")} == set(ef.unconstrained)
+    assert translation["found"] <= ("zeta_radial_translation" in listed)     # a held damping is listed too
 
 
 def test_per_unit_fit_without_mass_and_radius():

@@ -150,3 +150,21 @@ def test_new_wheel_on_a_ross_stand_between_its_modes_gives_the_coupled_modes_and
     rest = np.asarray(next(c for c in doc["campbell"] if c["speed_rpm"] < 10)["modes_hz"])
     assert modes["radial_translation_Hz"] == pytest.approx(wheel_t, rel=0.005)
     assert modes["rocking_Hz"] == pytest.approx(rest[0], rel=0.005)       # the wheel's rocking pair, lowest at rest
+
+
+@pytest.mark.slow
+def test_modes_above_every_line_stay_where_their_rise_puts_them(tmp_path, capsys):
+    """A ROSS wheel whose axial (334.5 Hz) and rocking (405.6 Hz) modes lie above every line of their direction
+    (12.45 kg, I_zz/I_rr 1.22, 300-3000 rpm: the axial lines reach 154 Hz, the torques' 246 Hz): the data show only
+    the rise of the lines below each mode, along which f0 and ζ trade.  The translation within 0.5 %; the axial mode,
+    not pinned to 2 % by a rise, is declared, but kept within 10 % of ROSS's with its damping held (before: located at
+    243.9 Hz with ζ 0.58, reset to a start of 924 Hz, and the rise of the Fz line h 3.08 described as its source
+    growing as Ω^2.2, 'a bearing defect's impacts'); nothing is described on the axial force."""
+    doc, model, summary = _diagnosed("ross_wheel_high_modes.json", tmp_path, capsys)
+    assert [e["kind"] for e in model["effects"]] == ["suspension_modes"]
+    modes = model["effects"][0]
+    truth = doc["truth"]
+    assert modes["radial_translation_Hz"] == pytest.approx(truth["translation_hz"], rel=0.005)
+    assert "axial" in modes["unconstrained"]
+    assert modes["axial_Hz"] == pytest.approx(truth["axial_hz"], rel=0.10)
+    assert not [u for u in summary["unexplained"] if "Fz" in u.get("channels", [])], summary["unexplained"]

@@ -63,6 +63,26 @@ def _beside_fast_crossings(ctx, state, law) -> bool:
     return calm is not None and calm.significant()
 
 
+#: the suspension mode each load direction's lines pass through (its name in ``suspension_modes``' parameters)
+_MODE_OF = {"radial_force": "radial_translation", "radial_torque": "rocking", "axial_force": "axial"}
+
+
+def _unlocated_mode(state, law) -> tuple:
+    """The cause a rising line (``law``, exponent over 2) has when the mode of its direction is in the model's
+    ``suspension_modes`` but not located (``unconstrained``): the rise of the lines below a mode above them, which the
+    lines' own rise could not pin (a ROSS wheel's 405.6 Hz rocking mode, I_zz/I_rr 1.22, its torque lines to 246 Hz:
+    h 3.08 and 4.92 rose 1.4 and 3.2 dB faster than Ω², read as their sources' laws).  Empty otherwise."""
+    mode = _MODE_OF.get(law.direction, "")
+    modes = [e for e in state.effects if getattr(e, "kind", "") == "suspension_modes"]
+    if law.exponent <= 2.0 or not modes or mode not in modes[-1].unconstrained:
+        return ()
+    name = mode.replace("_", " ")
+    ratio = " and its I_zz/I_rr from the wheel's inertias" if mode == "rocking" else ""
+    return (f"the rise of the line below the {name} mode, which the data do not locate (the fit ended at "
+            f"{modes[-1].f0_Hz[mode]:.4g} Hz): a suspension mode above the line lifts it as 1/(1 − (f/f0)²); the "
+            f"mode's frequency from a tap test{ratio} would place it",)
+
+
 def describe_laws(res, laws) -> list:
     """The ``line_property`` records (property ``amplitude_law``) of ``laws`` (:func:`laws_below_gain`), each with
     its share of the misplaced power left measured on ``res`` (the final model's
@@ -99,7 +119,8 @@ def describe_laws(res, laws) -> list:
                         "exponent": float(law.exponent), "exponent_stderr": float(law.exponent_stderr),
                         "amplitude_ref": float(law.amplitude_ref), "omega_ref_rad_s": float(law.omega_ref),
                         "heldout_t": float(hyp.t), "heldout_gain_fraction": float(hyp.gain_fraction)},
-            causes=(f"the line's source grows as Ω^{law.exponent:.3f} ± {law.exponent_stderr:.2g} "
+            causes=_unlocated_mode(res.state, law) + (
+                    f"the line's source grows as Ω^{law.exponent:.3f} ± {law.exponent_stderr:.2g} "
                     f"({z:.0f} standard errors from the model's Ω²), not as an imbalance: a bearing defect's impacts, "
                     f"a drive ripple that follows the motor current; an amplitude_law measured at t {hyp.t:.0f} on "
                     f"the held-out runs, its held-out gain {100.0 * hyp.gain_fraction:.2g} % of the misplaced power "
