@@ -150,11 +150,13 @@ def fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tol
             continue
         if not loose or not declare:
             return solution
-        kept = {m: above_every_line(problem, solution, free_modes, m) for m, _ in loose}    # before any is dropped
+        # each loose mode's fitted stiffness when it lies above every line (at a bound of its window or not), read
+        # before any is dropped; kept only when it is not at a bound
+        rising = {m: above_every_line(problem, solution, free_modes, m) for m, _ in loose}
+        kept = {m: None if solution.at_bound[m] else k for m, k in rising.items()}
         # below a mode ζ and f0 trade along one valley (a ROSS wheel's axial mode above its lines: 243.9 Hz, ζ 0.58,
         # 334.5 Hz, 0.024 in truth): a loose mode above every line has its damping held, its frequency fitted with it
-        below = [m for m, _ in loose if m not in problem.held_zeta
-                 and above_every_line(problem, solution, free_modes, m, True) is not None]
+        below = [m for m, _ in loose if m not in problem.held_zeta and rising[m] is not None]
         for m in below:
             zeta_bounds[m] = (2 * ZETA_FLOOR, QUASI_STATIC_ZETA)
             problem.held_zeta[m] = zeta0
@@ -163,10 +165,10 @@ def fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tol
         # from f0 (the ROSS wheel's 405.6 Hz, 1.22: scanned 573 Hz, 3.0; walked to 576 Hz, the 1x torque's
         # gyroscopic stiffening 1.5 % at the top speed for ROSS's 0.3 %)
         walk = [m for m, _ in loose if m != "rocking" and m in problem.held_zeta and solution.at_bound[m] == "stiffness"
-                and walks.get(m, 0) < MAX_WALKS and above_every_line(problem, solution, free_modes, m, True)]
+                and walks.get(m, 0) < MAX_WALKS and rising[m]]
         for m in below + walk:
             walks[m] = walks.get(m, 0) + (m in walk)
-            k = above_every_line(problem, solution, free_modes, m, True)
+            k = rising[m]
             kn, cn, inertia = MODE_PARAMS[m]
             problem.base[kn] = k
             problem.base[cn] = 2 * problem.held_zeta[m] * math.sqrt(k * problem.base[inertia])
@@ -189,19 +191,15 @@ def _top_line_hz(problem: LogAmplitudeProblem, mode: str) -> float:
 MAX_WALKS = 6
 
 
-def above_every_line(problem: LogAmplitudeProblem, solution: Solution, free_modes: list, mode: str,
-                     at_bound: bool = False) -> float | None:
-    """The stiffness (SI) the least squares ``solution`` located the loose ``mode`` at when that frequency lies above
-    every measured line of its direction (the data show only the rise below it, C·Ω²/(1 − r²)) and the mode was
-    located there, imprecisely -- not at a bound of its stiffness or damping, unless ``at_bound`` -- else None.
+def above_every_line(problem: LogAmplitudeProblem, solution: Solution, free_modes: list, mode: str) -> float | None:
+    """The stiffness (SI) the least squares ``solution`` put the loose ``mode`` at when that frequency lies above
+    every measured line of its direction (the data show only the rise below it, C·Ω²/(1 − r²)), else None.
 
     Such a mode is declared, but kept where the rise puts it: reset to a starting value far above the band, its rise
     was left to the lines, each then given an exponent of its own and described as a source growing faster than Ω²
     (a ROSS wheel whose 334.5 Hz axial and 405.6 Hz rocking modes lie above its lines, 300-3000 rpm: axial located at
     243.9 Hz ±14.9 %, reset to 924 Hz, and three lines described as 'grows as Ω^2.1-2.2: a bearing defect')."""
     i = free_modes.index(mode)
-    if solution.at_bound[mode] and not at_bound:
-        return None
     top = _top_line_hz(problem, mode)
     k = math.exp(float(solution.res.x[2 * i]))
     f_hz = math.sqrt(k / problem.base[MODE_PARAMS[mode][2]]) / (2 * np.pi)

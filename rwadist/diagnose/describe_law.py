@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..extended_fit import UNCONSTRAINED_NAME
+from ..mode_scan import MODE_DIRECTION
 from .unexplained import Unexplained
 
 
@@ -64,7 +66,7 @@ def _beside_fast_crossings(ctx, state, law) -> bool:
 
 
 #: the suspension mode each load direction's lines pass through (its name in ``suspension_modes``' parameters)
-_MODE_OF = {"radial_force": "radial_translation", "radial_torque": "rocking", "axial_force": "axial"}
+_MODE_OF = {direction: UNCONSTRAINED_NAME[mode] for mode, direction in MODE_DIRECTION.items()}
 
 
 def _unlocated_mode(state, law) -> tuple:
