@@ -142,24 +142,33 @@ def fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tol
     damping ``kept`` of :func:`above_every_line`), dropped from ``free_modes`` and the fit repeated: a mode whose damping runs to the floor while its frequency is pinned is located, its damping
     declared."""
     walks: dict = {}
+    risen: list = []            # the modes whose damping was held because only the lines' rise below them shows them
     while True:
         solution, loose = free_off_law_lines(
             lambda lns: problem.solve(free_modes, lns), lambda sol: loose_modes(sol, free_modes, problem.base, tolerance),
             off_law, problem.row_line, log_w, lawful_lines(problem.meas_lines), [x.h for x in problem.meas_lines])
         if declare and hold_unmeasured_damping(problem, solution, free_modes, zeta0, zeta_bounds, intervals):
             continue
+        # a mode placed by the rise below it alone, its damping held, is never taken as located: with ζ held its
+        # frequency's error no longer counts the trade, and a compromise looked pinned (a ROSS wheel's 334.5 Hz axial
+        # mode on a coupled stand: 178.9 Hz "located")
+        loose += [(m, f"located at {_f_hz(problem, solution, free_modes, m):.4g} Hz only by the rise of the lines "
+                      "below it, its damping held: no line crosses it") for m in risen
+                  if declare and m in free_modes and m not in dict(loose)]
         if not loose or not declare:
             return solution
         # each loose mode's fitted stiffness when it lies above every line (at a bound of its window or not), read
-        # before any is dropped; kept only when it is not at a bound
+        # before any is dropped; kept when it is not at a bound, or at one when it could walk (not the rocking mode)
         rising = {m: above_every_line(problem, solution, free_modes, m) for m, _ in loose}
-        kept = {m: None if solution.at_bound[m] else k for m, k in rising.items()}
+        kept = {m: None if solution.at_bound[m] and not (m in risen and m != "rocking") else k
+                for m, k in rising.items()}
         # below a mode ζ and f0 trade along one valley (a ROSS wheel's axial mode above its lines: 243.9 Hz, ζ 0.58,
         # 334.5 Hz, 0.024 in truth): a loose mode above every line has its damping held, its frequency fitted with it
         below = [m for m, _ in loose if m not in problem.held_zeta and rising[m] is not None]
         for m in below:
             zeta_bounds[m] = (2 * ZETA_FLOOR, QUASI_STATIC_ZETA)
             problem.held_zeta[m] = zeta0
+            risen.append(m)
         # such a mode, held, that runs into the ±5 % window around its start: the window moved there, fitted again.
         # Not the rocking mode: its I_zz/I_rr is held at the scan's, and below the whirls the lines do not tell it
         # from f0 (the ROSS wheel's 405.6 Hz, 1.22: scanned 573 Hz, 3.0; walked to 576 Hz, the 1x torque's
@@ -179,6 +188,12 @@ def fit_modes(problem: LogAmplitudeProblem, free_modes: list, declare: bool, tol
             inertia = problem.base[MODE_PARAMS[m][2]]
             declared(m, why, None if k is None else (k, 2 * problem.held_zeta.get(m, zeta0) * math.sqrt(k * inertia)))
             free_modes.remove(m)
+
+
+def _f_hz(problem: LogAmplitudeProblem, solution: Solution, free_modes: list, mode: str) -> float:
+    """The frequency (Hz) at rest of the free ``mode`` in ``solution``."""
+    k = math.exp(float(solution.res.x[2 * free_modes.index(mode)]))
+    return math.sqrt(k / problem.base[MODE_PARAMS[mode][2]]) / (2 * np.pi)
 
 
 def _top_line_hz(problem: LogAmplitudeProblem, mode: str) -> float:
@@ -201,6 +216,4 @@ def above_every_line(problem: LogAmplitudeProblem, solution: Solution, free_mode
     243.9 Hz ±14.9 %, reset to 924 Hz, and three lines described as 'grows as Ω^2.1-2.2: a bearing defect')."""
     i = free_modes.index(mode)
     top = _top_line_hz(problem, mode)
-    k = math.exp(float(solution.res.x[2 * i]))
-    f_hz = math.sqrt(k / problem.base[MODE_PARAMS[mode][2]]) / (2 * np.pi)
-    return k if top and f_hz > top else None
+    return math.exp(float(solution.res.x[2 * i])) if top and _f_hz(problem, solution, free_modes, mode) > top else None
