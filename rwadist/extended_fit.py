@@ -160,12 +160,14 @@ class ExtendedFit:
 # --------------------------------------------------------------------------- 1. senses
 
 def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) -> dict:
-    """Rotation sense of each radial line from the x/y phase, (direction, h) -> (sense, co_fraction).
+    """Rotation sense of each radial line from the x/y phase, (direction, h) -> (sense, co_fraction, every_run).
 
     For each run the complex Hann-windowed DFT of the x and y channels at +h|Ω|
     gives the co-rotating power |X + iY|² and the counter-rotating |X − iY|²
     (swapped for Ω < 0); summed over runs, co_fraction = P_co / (P_co + P_counter).
     Above ``threshold``: "co"; below 1 − threshold: "counter"; between: "planar".
+    every_run: "co" ("counter") when the response turns that way by more than :data:`ONE_SENSE` of its power in every
+    run the fit measures the line in (:data:`ONE_SENSE_RUNS` at least), else "" (:func:`one_sense_rows`).
     """
     out = {}
     by_dir = {d: [x for x in fit.lines if x.direction == d] for d in RADIAL}
@@ -176,6 +178,9 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
         h = np.array([x.h for x in lines])
         p_co = np.zeros(h.size)
         p_ct = np.zeros(h.size)
+        # per line the least and the greatest co-rotating share of one run's response, over the runs it is measured in
+        q_lo, q_hi, n_runs = np.ones(h.size), np.zeros(h.size), np.zeros(h.size, int)
+        measured = [np.unique(np.abs(x.speed)) for x in lines]
         use = [run for run in test.runs if run.usable(cx) and run.usable(cy) and run.speed != 0]
         # consecutive runs of one record length are transformed together (rwadist.dft.windowed_dfts), and their
         # powers added in the runs' order
@@ -201,11 +206,44 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             ok = f < 0.45 * fs
             p_co = np.cumsum(np.vstack([p_co, np.where(ok, co, 0.0)]), axis=0)[-1]
             p_ct = np.cumsum(np.vstack([p_ct, np.where(ok, ct, 0.0)]), axis=0)[-1]
+            speeds = np.abs([run.speed for run in batch])
+            seen = ok & np.array([np.isclose(speeds[:, None], m[None, :], rtol=1e-9, atol=0).any(axis=1)
+                                  for m in measured]).T
+            q = co / np.maximum(co + ct, 1e-300)
+            q_lo = np.minimum(q_lo, np.where(seen, q, 1.0).min(axis=0))
+            q_hi = np.maximum(q_hi, np.where(seen, q, 0.0).max(axis=0))
+            n_runs += seen.sum(axis=0)
         frac = p_co / np.maximum(p_co + p_ct, 1e-300)
-        for hk, fr in zip(h, frac):
+        for hk, fr, lo, hi, n_k in zip(h, frac, q_lo, q_hi, n_runs):
             sense = "co" if fr >= threshold else ("counter" if fr <= 1 - threshold else "planar")
-            out[(d, float(hk))] = (sense, float(fr))
+            every = "" if n_k < ONE_SENSE_RUNS else "co" if lo > ONE_SENSE else "counter" if hi < 1 - ONE_SENSE else ""
+            out[(d, float(hk))] = (sense, float(fr), every)
     return out
+
+
+#: A radial line whose response turns one way by more than this share of its power in every run it is measured in
+#: (:func:`line_senses`' every_run) is forced that way alone in the modes' scans (:func:`one_sense_rows`): a load
+#: turning the other way, or both ways, shows its other sense where the other whirl amplifies it
+ONE_SENSE = 0.5
+#: Runs a line must be measured in for its every-run sense to count
+ONE_SENSE_RUNS = 5
+
+
+def one_sense_rows(meas_lines: list, row_line: np.ndarray, senses_xy: dict) -> np.ndarray:
+    """Per radial row (its measured line ``row_line``), +1 when its line's response is co-rotating in every run
+    (:func:`line_senses`' every_run), −1 counter-rotating, 0 otherwise: the rocking scan's forcing of that line
+    (:func:`rwadist.mode_scan.scan_mode`'s ``sense``).
+
+    The x²+y² power of a line does not tell a co-rotating load through the forward whirl from a counter-rotating one
+    through the backward whirl of another rotor, and the two can fit the power alike at every speed (trial 33, a 6.3 kg
+    wheel, rocking 63 Hz at I_zz/I_rr 1.38: the h 3.27 torque line co-rotating, 93-100 % of its power in every run,
+    fitted as counter-rotating through a rocking at 105 Hz and 2.03, its amplitudes within 1-2 %, on 2 of 9 clean
+    seeds).  A response turning one way in every run is a load turning that way: a load of both senses reads its
+    counter part where the backward whirl amplifies it and its co part where neither whirl does."""
+    every = {k: v[2] for k, v in senses_xy.items()}
+    per_line = np.array([{"co": 1, "counter": -1}.get(every.get((x.direction, float(x.h)), ""), 0)
+                         for x in meas_lines], int)
+    return per_line[np.asarray(row_line, int)] if per_line.size else np.zeros(len(row_line), int)
 
 
 def _line_senses_once(test: SteadyTest, fit: EmpiricalFit) -> dict:
@@ -321,13 +359,14 @@ def _radial_power(meas_lines):
             np.concatenate(nz))
 
 
-def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=None):
+def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=None, senses_xy=None):
     """Profile scan (:mod:`rwadist.mode_scan`) of each mode on the measured lines (``radial``: their
     :func:`_radial_power`; ``near``: :func:`fit_extended`).  The axial mode on the axial-force lines alone: the
     spin-axis torque's lines pass through no mode (:mod:`rwadist.extended`), and scanned with them a flat Tz line up to
     the mode held it off when one force line alone reached it (trial 11's 300-s run-up without the 7.2 lines: h 3.6 of
     Tz to 268 Hz beside h 3.6 of Fz through the 260-Hz mode; the scan put it at 293 Hz, ζ 0.06, the least squares at
-    its ±5 % limit, and the Fz line's rise went to an invented amplitude law)."""
+    its ±5 % limit, and the Fz line's rise went to an invented amplitude law).  ``senses_xy``: :func:`line_senses`
+    of the measured lines, whose every-run senses restrict the rocking scan's forcing (:func:`one_sense_rows`)."""
     lr, sr, pr, dr, _ = radial
     h_of = np.array([x.h for x in meas_lines]) if meas_lines else np.zeros(0)
     scans = {}
@@ -338,9 +377,10 @@ def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=Non
         else:
             m = dr == direction
             line, omega, power = lr[m], sr[m], pr[m]
+        sense = one_sense_rows(meas_lines, line, senses_xy) if mode == "rocking" and senses_xy else None
         scans[mode] = scan_mode(mode, line, h_of[line] if line.size else np.zeros(0), omega, power,
                                 inertia_ratio=inertia_ratio if mode == "rocking" else None, tolerance=tolerance,
-                                min_log_lr=-math.inf, **(near or {}).get(mode, {}))
+                                min_log_lr=-math.inf, sense=sense, **(near or {}).get(mode, {}))
     return scans
 
 
@@ -555,7 +595,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     peaks = amplification_peaks(fit)
     la, sa, ca, aa, na = _axial_measurements(meas)
     radial = _radial_power(meas.lines)
-    scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near)
+    scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near, senses_xy)
     mass_kg, I_rr, I_zz = _inertias(mass, radius, scans["rocking"], notes)
     starts = _ModeStarts(scans, start, physical, max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines),
                                                      default=100.0), zeta0, notes)

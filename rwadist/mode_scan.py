@@ -87,8 +87,10 @@ class _Segments:
     segment sums (:func:`numpy.add.reduceat`: each point's sums the same numbers whichever grid holds it); in single
     precision (the screen of :func:`_screened_search`) one matrix product with the rows' line indicator."""
 
-    def __init__(self, starts, counts, dtype):
+    def __init__(self, starts, counts, dtype, only=None):
         self.starts, self.counts = starts, counts
+        # per line +1 (co-rotating forcing only), -1 (counter-rotating only), 0 (both), or None: every line both
+        self.only = None if only is None or not np.any(only) else np.asarray(only, int)
         self.indicator = None
         if dtype != np.float64:
             n_rows = int(counts.sum())
@@ -127,6 +129,32 @@ def _imbalance_lines(h_line, radial: bool) -> np.ndarray:
     return radial & (np.abs(np.asarray(h_line, float) - 1.0) <= IMBALANCE_H_TOL)
 
 
+def _two(two_parts) -> bool:
+    """Whether ``two_parts`` (:func:`_grid_search`) gives a radial line a co- and a counter-rotating part."""
+    return True if isinstance(two_parts, np.ndarray) else bool(two_parts)
+
+
+def _rows_of(two_parts, rows):
+    """``two_parts`` (:func:`_grid_search`) of the rows ``rows`` alone (a per-row restriction sliced, a flag as it is)."""
+    return two_parts[rows] if isinstance(two_parts, np.ndarray) else two_parts
+
+
+def _parts(mode: str, sense, ok) -> bool | np.ndarray:
+    """:func:`_grid_search`'s ``two_parts`` of ``mode``'s scan: False (the axial mode: one forcing), else the per-row
+    restriction ``sense`` of the rows ``ok`` (:func:`scan_mode`) when it restricts any, else True."""
+    if mode == "axial_translation":
+        return False
+    return True if sense is None or not np.any(np.asarray(sense)[ok]) else np.asarray(sense, int)[ok]
+
+
+def _line_only(two_parts, order, starts):
+    """Per line (the rows sorted by ``order``, each line's first at ``starts``) the sense its forcing is restricted
+    to (+1 co-rotating, -1 counter-rotating, 0 both), or None when ``two_parts`` restricts none."""
+    if not isinstance(two_parts, np.ndarray) or not np.any(two_parts):
+        return None
+    return np.asarray(two_parts, int)[order][starts]
+
+
 def _line_log_ssr(lw, seg, trend=None, scratch=None):
     """Per line (along the last axis, its rows summed by ``seg``, :class:`_Segments`) Σ(lw − mean lw)²: the log least
     squares of the line's rows with its scale free (closed form: the scale is the mean).  With ``trend``
@@ -160,9 +188,10 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
 
     line (rows,) int line index; h, omega (rows,); power (rows,) measured x²+y² (radial) or amp² (axial).
     two_parts : a radial line's forcing has a co- and a counter-rotating part (not restricted by the sense measured at
-    the load cell: the whirls amplify one sense more than the other, so a line forced 80 % co-rotating reads 95 %
-    co-rotating near the forward whirl, and scanned as co-rotating only it put the family's new wheel's rocking mode at
-    87 Hz, truth 95).
+    the load cell summed over the runs: the whirls amplify one sense more than the other, so a line forced 80 %
+    co-rotating reads 95 % co-rotating near the forward whirl, and scanned as co-rotating only it put the family's new
+    wheel's rocking mode at 87 Hz, truth 95); or, per row, +1 / -1 where the line's forcing turns one way only
+    (co- / counter-rotating: its response turns that way in every run, ``scan_mode``'s ``sense``), 0 both.
 
     The grid is a product: d² = (2ζω0ν)² depends on (f0, ζ, row) only, ω0² − ν² ± aΩν on (f0, a, row) only, so
     those are computed on their own sub-grids and broadcast; the sums over each line's rows are segment sums of
@@ -185,9 +214,9 @@ def _grid_search(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts, c
             f0_grid, zeta_grid, om, nu, nu2, scale, gyro))
     # no gyroscopic term (translation modes, or a = 0): both senses see the same |T|² and the two parts are one
     same = not np.any(gyro)
-    both_senses = two_parts and not same
-    trend = _Trend(om, starts, counts, _imbalance_lines(np.asarray(h, float)[order][starts], two_parts))
-    seg = _Segments(starts, counts, dtype)
+    both_senses = _two(two_parts) and not same
+    trend = _Trend(om, starts, counts, _imbalance_lines(np.asarray(h, float)[order][starts], _two(two_parts)))
+    seg = _Segments(starts, counts, dtype, _line_only(two_parts, order, starts))
     # the screen's logarithms in base 2 (single precision: 40 % faster than the natural logarithm), its SSR times
     # (ln 2)² at the end: every SSR is a sum of squared differences of logs, so the same number to rounding
     log = np.log if dtype == np.float64 else np.log2
@@ -236,13 +265,14 @@ def _two_senses_ssr(num, lnum, rest, gyro, d2, seg, trend, bufs):
     np.add(((rest - gyro) ** 2)[:, None], d2, out=v)            # den_v
     double = seg.indicator is None
     if double:                      # double precision: the logs of numerator and denominator, as ever
-        ssr = _line_log_ssr(np.subtract(lnum, np.log(u, out=lw), out=lw), seg, trend, tmp)
-        ssr = np.minimum(ssr, _line_log_ssr(np.subtract(lnum, np.log(v, out=lw), out=lw), seg, trend, tmp))
+        ssr_u = _line_log_ssr(np.subtract(lnum, np.log(u, out=lw), out=lw), seg, trend, tmp)
+        ssr_v = _line_log_ssr(np.subtract(lnum, np.log(v, out=lw), out=lw), seg, trend, tmp)
     np.divide(num, u, out=u)
     np.divide(num, v, out=v)
     if not double:                  # the screen: the base-2 logs of the ratios (no subtraction broadcast over a)
-        ssr = _line_log_ssr(np.log2(u, out=lw), seg, trend, tmp)
-        ssr = np.minimum(ssr, _line_log_ssr(np.log2(v, out=lw), seg, trend, tmp))
+        ssr_u = _line_log_ssr(np.log2(u, out=lw), seg, trend, tmp)
+        ssr_v = _line_log_ssr(np.log2(v, out=lw), seg, trend, tmp)
+    ssr = np.minimum(ssr_u, ssr_v)
     su, sv = seg.sum(u), seg.sum(v)
     suu, svv, suv = (seg.sum(np.multiply(a, b, out=tmp)) for a, b in ((u, u), (v, v), (u, v)))
     det = suu * svv - suv**2
@@ -256,6 +286,8 @@ def _two_senses_ssr(num, lnum, rest, gyro, d2, seg, trend, bufs):
         np.add(lw, np.multiply(np.repeat(np.where(ok, y, 0.0), reps, axis=-1), v, out=tmp), out=lw)   # the mix
         ssr = np.where(ok, np.minimum(ssr, _line_log_ssr((np.log if double else np.log2)(lw, out=lw), seg,
                                                           scratch=tmp)), ssr)
+    if seg.only is not None:        # a line forced one way only: that sense's fit alone
+        ssr = np.where(seg.only == 1, ssr_u, np.where(seg.only == -1, ssr_v, ssr))
     return ssr
 
 
@@ -288,13 +320,15 @@ class _Rows:
         nu = np.asarray(h, float)[order] * om
         scale = om**4 / np.asarray(power, float)[order]
         scale = scale / np.exp(np.repeat(np.add.reduceat(np.log(scale), starts) / counts, counts.astype(int)))
-        lawful = _imbalance_lines(np.asarray(h, float)[order][starts], two_parts)
+        lawful = _imbalance_lines(np.asarray(h, float)[order][starts], _two(two_parts))
+        only = _line_only(two_parts, order, starts)
         self.om64, self.nu64 = om, nu
         self.om, self.nu, self.scale = (np.asarray(x, np.float32) for x in (om, nu, scale))
         self.lines = []
         for i, (s, c) in enumerate(zip(starts, counts.astype(int))):
             one_start, one_count = np.array([0]), np.array([float(c)])
-            self.lines.append((slice(s, s + c), _Segments(one_start, one_count, np.float32),
+            self.lines.append((slice(s, s + c), _Segments(one_start, one_count, np.float32,
+                                                          None if only is None else only[i:i + 1]),
                                _Trend(self.om[s:s + c], one_start, one_count, lawful[i:i + 1])))
 
 
@@ -356,7 +390,8 @@ def _pruned_screen(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
     def on_grid(k, f, z, a):
         # line k's terms on a product grid: _grid_search's single-precision numbers of that line's rows alone
         r = order_rows[rows.lines[k][0]]
-        return _grid_search(line[r], h[r], omega[r], power[r], f, z, a, two_parts, dtype=np.float32)[..., None]
+        return _grid_search(line[r], h[r], omega[r], power[r], f, z, a, _rows_of(two_parts, r),
+                            dtype=np.float32)[..., None]
 
     sub = [np.arange((n // 2) % SAMPLE_STRIDE, n, SAMPLE_STRIDE) if n > SAMPLE_STRIDE else np.arange(n) for n in shape]
     at_sub = np.concatenate([on_grid(k, f0_grid[sub[0]], zeta_grid[sub[1]], a_grid[sub[2]])
@@ -366,7 +401,7 @@ def _pruned_screen(line, h, omega, power, f0_grid, zeta_grid, a_grid, two_parts)
     partial = on_grid(order[0], f0_grid, zeta_grid, a_grid).ravel().astype(float)
     # as _grid_search decides them, on the whole grid: no gyroscopic term anywhere, or a line's two senses
     same = not np.any(a_grid[:, None] * rows.om64[None, :] * rows.nu64[None, :])
-    both_senses = two_parts and not same
+    both_senses = _two(two_parts) and not same
     fi, zi, ai = np.unravel_index(np.arange(n_points), shape)
     w0 = (2 * np.pi * np.asarray(f0_grid, np.float32))[fi]
     zeta, a = np.asarray(zeta_grid, np.float32)[zi], np.asarray(a_grid, np.float32)[ai]
@@ -519,7 +554,7 @@ QUASI_STATIC_ZETA = 0.15
 
 def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = None, tolerance: float = 0.02,
               min_log_lr: float = 2.0, near_hz: float | None = None, near_a: float | None = None,
-              zeta_max: float = 0.6) -> ModeScan:
+              zeta_max: float = 0.6, sense=None) -> ModeScan:
     """Profile scan of one mode (see the module docstring).
 
     line : (n,) int, index of the line each measurement belongs to.  h : (n,) harmonic number.
@@ -534,6 +569,8 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     when the best point lies on that window's edge; the result is the whole grid's whenever its best point lies
     inside the window.  ``interval_hz`` and ``log_lr_off`` are then those of the profile inside the window.
     zeta_max : the largest damping ratio scanned (:data:`QUASI_STATIC_ZETA` for a mode above every line).
+    sense : (n,) +1 / -1 where the measurement's radial line is forced co- / counter-rotating only (its response turns
+    that way in every run: :func:`rwadist.extended_fit.one_sense_rows`), 0 where both parts are free; None: all free.
     """
     line, h, omega, power = (np.asarray(x) for x in (line, h, omega, power))
     ok = (power > 0) & np.isfinite(power) & (np.abs(omega) > 0)
@@ -545,7 +582,7 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     _, line = np.unique(line, return_inverse=True)
     f_line = h * np.abs(omega) / (2 * np.pi)
     rocking = mode == "rocking"
-    two_parts = mode != "axial_translation"
+    two_parts = _parts(mode, sense, ok)
     f_lo, f_hi = 0.25 * f_line.min(), 4.0 * f_line.max()
     if rocking:
         # the backward whirl of a mode at f0 falls to ~f0²/(a·f_spin): f0 may sit above every line
@@ -589,7 +626,7 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
             f_best, z_best, a_best = float(f_2[gi]), float(z_2[gj]), float(a_2[gk])
     if z_best > QUASI_STATIC_ZETA and zeta_max > QUASI_STATIC_ZETA and f_best > float(f_line.max()):
         return scan_mode(mode, line, h, omega, power, inertia_ratio, tolerance, min_log_lr, near_hz, near_a,
-                         zeta_max=QUASI_STATIC_ZETA)
+                         zeta_max=QUASI_STATIC_ZETA, sense=two_parts if isinstance(two_parts, np.ndarray) else None)
     profile = np.full(f0_grid.size, np.nan)
     scanned = ~np.all(np.isnan(ssr), axis=(1, 2))     # every f0 but those a windowed search left out
     profile[scanned] = np.nanmin(ssr[scanned], axis=(1, 2))
