@@ -161,3 +161,31 @@ def test_a_speed_line_of_no_model_that_drifts_is_described_as_the_drift():
     rec = ratio_drift(ctx, state, lambda chans, h, runs: (0.0, 0.0), found)[-1]
     assert rec.signature == "line_property" and rec.parameters["property"] == "ratio_drift"
     assert rec.h == pytest.approx(a.h) and rec.parameters["drift_percent"] < -1.0
+
+
+def _readings(h: np.ndarray, rpm: np.ndarray) -> np.ndarray:
+    return np.column_stack([np.arange(rpm.size, dtype=float), rpm, h])
+
+
+#: trial 33's readings (rpm, h_run) of its h 3.27 radial-force line, band-limited noise at 260-340 Hz on the forces:
+#: read on the hump's noise in its window at the two top speeds (Welch bins of 0.25 Hz)
+TRIAL33_READINGS = [
+    (1785.7143, 3.2704934), (1914.2857, 3.2694048), (2042.8571, 3.2693842), (2171.4286, 3.2698887),
+    (2300.0, 3.2698384), (2428.5714, 3.2699318), (2557.1429, 3.2700014), (2685.7143, 3.2699856),
+    (2814.2857, 3.2700421), (2942.8571, 3.269899), (3071.4286, 3.2699875), (3200.0, 3.2699457),
+    (3328.5714, 3.2700705), (3457.1429, 3.2700161), (3585.7143, 3.2699048), (3714.2857, 3.2702343),
+    (3842.8571, 3.269905), (3971.4286, 3.2699867), (4100.0, 3.2700231), (4228.5714, 3.2699284),
+    (4357.1429, 3.2700941), (4614.2857, 3.5171339), (4742.8571, 3.4088531)]
+
+
+def test_a_line_at_one_ratio_read_in_a_hump_at_its_top_speeds_is_no_drift():
+    """Trial 33 (an independent generator): the weak h 3.27 line read at 3.2700 ± 0.0003 in 21 runs and on a hump's
+    noise at the two top speeds was described as a cage slipping, "the line's ratio rises from 3.27 to 3.409 (+4.2 %)".
+    The Theil-Sen line through the readings does not drift by half MIN_DRIFT: no drift.  A slip growing as Ω² to 5 %
+    over the same speeds, read with the same scatter: its drift, from the readings at the ends."""
+    rpm, h = (np.array(v) for v in zip(*TRIAL33_READINGS))
+    assert describe_drift.drift_of(_readings(h, rpm), 3.2699, 0.25) is None
+    rng = np.random.default_rng(33)
+    slip = 3.28 * (1 - 0.05 * (rpm / rpm[-1]) ** 2) + 0.0003 * rng.standard_normal(rpm.size)
+    got = describe_drift.drift_of(_readings(slip, rpm), 3.28, 0.25)
+    assert got is not None and got[1:] == (pytest.approx(slip[0]), pytest.approx(slip[-1]))

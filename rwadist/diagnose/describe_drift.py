@@ -107,8 +107,6 @@ def _read(ctx, chans, h0: float, every, spin_top: float):
     """(rows, slope interval (lo, hi), h at the lowest speed, h at the highest) of the line near ``h0`` in ``chans``
     when its ratio to the speed drifts (module docstring), else None; ``every``: the model's lines (ratios), whose
     nearest other one bounds the window."""
-    from scipy.stats import theilslopes
-
     # another line of the model is one more than SAME_LINE of h away (closer: this line read in another direction,
     # or split in two by the drift itself: 4.733 and 4.758 in trial 30b's axial force)
     gap = min((abs(h - h0) for h in every if abs(h - h0) > SAME_LINE * h0), default=np.inf)
@@ -118,16 +116,31 @@ def _read(ctx, chans, h0: float, every, spin_top: float):
         rows, df = _record_ratios(ctx, chans, h0, half)
     else:
         rows = _run_ratios(ctx, chans, h0, half)
+    got = drift_of(rows, h0, df)
+    return None if got is None else (rows,) + got
+
+
+def drift_of(rows: np.ndarray, h0: float, df: float):
+    """(slope interval (lo, hi), h at the lowest speed, h at the highest) of the readings ``rows`` ((run, rpm, h_run),
+    shape (n, 3)) of the line near ``h0`` when its ratio drifts by :data:`MIN_DRIFT` of h0 and :data:`MIN_BINS` bins of
+    ``df`` (Hz) at the top speed, else None.
+
+    The ratios read at the lowest and the highest speed say how far it drifts (a slip grows as Ω², no straight line);
+    the Theil-Sen line through every reading says whether it drifts at all: its slope's interval clear of 0, and its
+    own drift over the speeds at least half :data:`MIN_DRIFT`, the chord of a slip growing as Ω² that a line through it
+    follows.  A line at one ratio whose last two or three readings fall on something else (trial 33: h 3.27 read in a
+    broadband hump at 260-340 Hz at the top speeds, 3.33-3.41, the other 21 readings 3.2700 ± 0.0003) is no drift."""
+    from scipy.stats import theilslopes
+
     if rows.shape[0] < MIN_RUNS:
         return None
     rpm, h = rows[:, 1], rows[:, 2]
     slope, icpt, lo, hi = theilslopes(h, rpm)
-    # the ratios read at the lowest and the highest speed (a slip grows as Ω², no straight line); the Theil-Sen
-    # slope's interval says whether they drift at all
     h_lo, h_hi = float(h[np.argmin(rpm)]), float(h[np.argmax(rpm)])
-    if abs(h_hi - h_lo) / h0 < MIN_DRIFT or lo * hi <= 0 or abs(h_hi - h_lo) * rpm.max() / 60.0 < MIN_BINS * df:
+    if abs(h_hi - h_lo) / h0 < MIN_DRIFT or lo * hi <= 0 or abs(h_hi - h_lo) * rpm.max() / 60.0 < MIN_BINS * df \
+            or abs(slope) * float(np.ptp(rpm)) / h0 < 0.5 * MIN_DRIFT:
         return None
-    return rows, (float(lo), float(hi)), h_lo, h_hi
+    return (float(lo), float(hi)), h_lo, h_hi
 
 
 def _sliced(ctx) -> bool:
