@@ -201,7 +201,11 @@ def _measure(ctx, k0: int, chans) -> FixedLine | None:
         return None
     A = run_amplitudes(ctx, f0, chans)                                                   # (all runs, chans)
     mag = np.abs(A[runs])
-    med = np.nanmedian(mag, axis=0)
+    # a channel no run reads the tone in (every fit past its misfit limit: trial 33's fixture at 100 Hz) has no median,
+    # and numpy's all-NaN warning would reach the console
+    read = np.isfinite(mag).any(axis=0)
+    med = np.full(mag.shape[1], np.nan)
+    med[read] = np.nanmedian(mag[:, read], axis=0)
     within = np.nanmean((mag <= STEADY_RATIO * med) & (mag >= med / STEADY_RATIO), axis=0)
     if not np.any(within >= STEADY_FRACTION):
         return None
