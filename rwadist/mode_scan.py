@@ -149,10 +149,9 @@ def _parts(mode: str, sense, ok) -> bool | np.ndarray:
 
 def _line_only(two_parts, order, starts):
     """Per line (the rows sorted by ``order``, each line's first at ``starts``) the sense its forcing is restricted
-    to (+1 co-rotating, -1 counter-rotating, 0 both), or None when ``two_parts`` restricts none."""
-    if not isinstance(two_parts, np.ndarray) or not np.any(two_parts):
-        return None
-    return np.asarray(two_parts, int)[order][starts]
+    to (+1 co-rotating, -1 counter-rotating, 0 both), or None when ``two_parts`` is a flag (:class:`_Segments` takes
+    a restriction of none as None)."""
+    return np.asarray(two_parts, int)[order][starts] if isinstance(two_parts, np.ndarray) else None
 
 
 def _line_log_ssr(lw, seg, trend=None, scratch=None):
