@@ -14,6 +14,7 @@ import numpy as np
 
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .constants import LINE_HALF
+from .describe_whirl import rocking_whirl, whirl_note
 from .sweep_crossing import crossings
 from .unexplained import Unexplained
 
@@ -645,14 +646,17 @@ def moving_resonance(ctx, state, ratios: list, shares) -> list:
         mid = 0.5 * (r.spin.min() + r.spin.max())
         f_low, f_high = f0 + b * (r.spin.min() - mid), f0 + b * (r.spin.max() - mid)
         chans = tuple(c for c in DIRECTION_CHANNELS[r.direction] if c in ctx.channels)
-        whirl, explained = _whirl_note(r.direction, b, modes, r.spin.min(), r.spin.max(), f_low, f_high)
+        beside: dict = {} if companion is None else {"beside_fixed_resonance_Hz": float(companion[1]),
+                                                     "beside_fixed_resonance_peak_gain": float(companion[4])}
+        whirl, explained = whirl_note(r.direction, b, modes, r.spin.min(), r.spin.max(), f_low, f_high)
         if explained:
             continue
+        rocking = rocking_whirl(r, modes, (f0, b, zeta, gain, gain_above(zeta, gain, above)), sse_m)
+        if rocking is not None:
+            whirl, beside["rocking_whirl"] = rocking[1], rocking[0]
         share, level = shares(chans, lambda spin: f0 + b * (spin - mid), zeta)
         rpm = np.array([r.spin.min(), r.spin.max()]) * 60.0
         sign = "stiffening" if b > 0 else "softening"
-        beside: dict = {} if companion is None else {"beside_fixed_resonance_Hz": float(companion[1]),
-                                                     "beside_fixed_resonance_peak_gain": float(companion[4])}
         track = lambda spin: f0 + b * (spin - mid)                                              # noqa: E731
         crossed = _crossed_mode(r.direction, modes, track, r.spin.min(), r.spin.max(), (zeta, gain, above))
         if crossed:
@@ -667,7 +671,7 @@ def moving_resonance(ctx, state, ratios: list, shares) -> list:
                         "zeta": float(zeta), "peak_gain": float(gain), **_shape_words(zeta, gain, above),
                         "fixed_resonance_misfit_ratio":
                         float(misfit_ratio), "f_statistic": float(f_stat), "whirl": whirl, **beside},
-            causes=_moving_causes(b, sign, track(0.5 * (r.spin.min() + r.spin.max())), mid),
+            causes=(() if rocking is None else (rocking[2],)) + _moving_causes(b, sign, track(mid), mid),
             would_tell=_crossing_words(crossed) + "a slow run-up recorded with its speed tracks the resonance "
                        "continuously; a tap test of the rotor at rest gives its frequency at zero speed"))
     return out
@@ -726,7 +730,7 @@ def _shape_words(zeta: float, gain: float, above) -> dict:
     return {"shape": words, "gain_far_above": beta}
 
 
-#: The directions' suspension modes a moving track can reach (the rocking mode whirls: :func:`_whirl_note`)
+#: The directions' suspension modes a moving track can reach (the rocking mode whirls: :func:`.describe_whirl.whirl_note`)
 DIRECTION_MODE = {"radial_force": "radial_translation", "axial_force": "axial"}
 #: The track reaches a fitted mode of its direction where its fitted resonance changes a line at the mode's frequency
 #: by this much (dB) at one of the speeds at least
@@ -771,23 +775,3 @@ def _crossing_words(crossed: dict | None) -> str:
     return (f"it reaches the fitted {crossed['mode'].replace('_', ' ')} mode ({crossed['f_Hz']:.4g} Hz{where}), a "
             f"line there {crossed['lift_dB']:+.1f} dB by it near {crossed['speed_rpm']:.0f} rpm: that mode's "
             "frequency and damping are fitted with what it lifts and are suspect; ")
-
-
-def _whirl_note(direction: str, slope: float, modes, s_lo: float, s_hi: float, f_lo: float, f_hi: float) -> tuple:
-    """(words on what the gyroscopic whirl would do, True when the track is the fitted rocking whirl within 5 %)."""
-    if direction != "radial_torque":
-        return (f"no gyroscopic whirl moves a {direction.replace('_', ' ')} mode (the whirl splits the rocking mode "
-                "only)"), False
-    if modes is not None:
-        # the fitted whirl first: its I_zz/I_rr may exceed 2 (an effective ratio, rwadist.schema.MAX_INERTIA_RATIO)
-        a, f0 = modes.inertia_ratio, modes.f0_Hz["rocking"]
-        branch = lambda s, sgn: np.sqrt((0.5 * a * s) ** 2 + f0**2) + sgn * 0.5 * a * s   # noqa: E731
-        for sgn, name in ((1, "forward"), (-1, "backward")):
-            if abs(branch(s_lo, sgn) / f_lo - 1) < 0.05 and abs(branch(s_hi, sgn) / f_hi - 1) < 0.05:
-                return f"the fitted rocking {name} whirl", True
-    if abs(slope) > 2.0:
-        return "faster than any rigid rotor's whirl (at most I_zz/I_rr ≤ 2 Hz per Hz of spin)", False
-    if modes is None:
-        return "a rocking whirl with I_zz/I_rr ≈ %.2g could move so; no suspension modes were fitted" % abs(slope), False
-    return (f"the fitted rocking whirl (I_zz/I_rr = {a:.3g}) runs {branch(s_lo, 1):.4g} -> {branch(s_hi, 1):.4g} Hz "
-            f"forward and {branch(s_lo, -1):.4g} -> {branch(s_hi, -1):.4g} Hz backward"), False

@@ -38,7 +38,7 @@ SIGNATURES = {
     "speed_line": "a line at a constant ratio of the speed that no model line has",
     "line_property": "what the data's lines have in common that the model's lines do not",
     "channel_copy": "a channel that carries a copy of another channel's content",
-    "moving_resonance": "a resonance whose frequency changes with speed in a way the gyroscopic whirl does not explain",
+    "moving_resonance": "a resonance whose frequency changes with speed in a way the fitted modes' gyroscopic whirl does not explain",
     "broadband_hump": "a broadband hump above the noise floor",
     "run_change": "a run-to-run change",
     "partial_line": "a model line present in some runs and absent from others",
