@@ -1,7 +1,7 @@
 """Whole-run discrete Fourier transforms at arbitrary frequencies (not on the FFT grid).
 
 The extended fit reads each radial line's rotation sense from the x/y phase of the whole record
-(:func:`rwadist.extended_fit.line_senses`), and ``rwadist diagnose`` measures lines, sidebands and phasors
+(:func:`rwadist.line_senses.line_senses`), and ``rwadist diagnose`` measures lines, sidebands and phasors
 on the whole record of every run (:meth:`rwadist.diagnose.engine.Context.phasors`,
 :func:`rwadist.effects.speed_sidebands_diagnose._run_line_power`).  Those sums are computed here: one run
 (:func:`windowed_dft`) or a stack of equally long runs at once (:func:`windowed_dfts`: one batched matrix

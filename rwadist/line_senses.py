@@ -16,6 +16,26 @@ SENSE_CHUNK_SAMPLES = 1 << 20
 #: Whole-record bins either side of a line where :func:`line_senses` reads the noise under it (past a Hann window's
 #: main lobe of ±2 bins)
 NOISE_BINS = (5.0, 7.0)
+#: ... left out where a line of the direction lies within this many bins of them, or they lie under it
+NOISE_CLEAR_BINS = 3.0
+#: The noise is taken out of a line's summed powers when they stand this many of its scatters over it
+NOISE_CLEAR = 3.0
+
+
+def _beside(co_all: np.ndarray, ct_all: np.ndarray, f: np.ndarray, off: np.ndarray, df: float) -> tuple:
+    """(co, counter) noise power per run and line (R, L): the mean of each sense's powers ``co_all``, ``ct_all`` (R,
+    (1 + K)·L: the lines' own, then K offsets ``off[1:]`` Hz from every line) over the offsets no line of ``f`` (R, L)
+    Hz lies within :data:`NOISE_CLEAR_BINS` bins of ``df`` Hz (nor 0 Hz); 0 where fewer than two are left."""
+    r, n_lines = f.shape
+    fo = f[:, None, :] + off[None, 1:, None]                                        # (R, K, L)
+    near = np.abs(fo[..., None] - f[:, None, None, :]).min(axis=-1) < NOISE_CLEAR_BINS * df
+    good = ~(near | (fo < NOISE_CLEAR_BINS * df))
+    count = good.sum(axis=1)
+    out = []
+    for p in (co_all, ct_all):
+        side = p[:, n_lines:].reshape(r, off.size - 1, n_lines)
+        out.append(np.where(count >= 2, np.where(good, side, 0.0).sum(axis=1) / np.maximum(count, 1), 0.0))
+    return out[0], out[1]
 
 
 def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) -> dict:
@@ -23,9 +43,9 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
 
     For each run the complex Hann-windowed DFT of the x and y channels at +h|Ω|
     gives the co-rotating power |X + iY|² and the counter-rotating |X − iY|²
-    (swapped for Ω < 0); summed over runs, each less the noise under the line (the median of both senses' powers
-    :data:`NOISE_BINS` bins either side: white noise in x and y adds the same power to both), co_fraction = P_co /
-    (P_co + P_counter) (0.5 when the noise takes all of both).
+    (swapped for Ω < 0); summed over runs, each less its noise under the line (:func:`_beside`: that sense's mean
+    power :data:`NOISE_BINS` bins either side) where the line stands :data:`NOISE_CLEAR` of the noise's scatter over
+    it, co_fraction = P_co / (P_co + P_counter) (0.5 when the noise takes all of both).
     Above ``threshold``: "co"; below 1 − threshold: "counter"; between: "planar".
     every_run: "co" ("counter") when the response turns that way by more than :data:`ONE_SENSE` of its power in every
     run the fit measures the line in (:data:`ONE_SENSE_RUNS` at least), else "" (:func:`one_sense_rows`).
@@ -37,8 +57,7 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
         if not lines:
             continue
         h = np.array([x.h for x in lines])
-        p_co = np.zeros(h.size)
-        p_ct = np.zeros(h.size)
+        p_co, p_ct, n_co, n_ct, n_var = (np.zeros(h.size) for _ in range(5))
         # per line the least and the greatest co-rotating share of one run's response, over the runs it is measured in
         q_lo, q_hi, n_runs = np.ones(h.size), np.zeros(h.size), np.zeros(h.size, int)
         measured = [np.unique(np.abs(x.speed)) for x in lines]
@@ -64,16 +83,18 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             # the adds of a loop over them; a line out of a run's band adds 0 there)
             X, Y = XY[..., 0], XY[..., 1]
             co_all, ct_all = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
-            co, ct = co_all[:, :h.size], ct_all[:, :h.size]
-            # white noise in x and y puts the same power into both senses: its median beside the line, taken out
-            # of the sums (a weak co-rotating line read 1.6 % counter-rotating on the noise alone: trial 34's h 10.74
-            # radial force, 13 % counter-rotating amplitude in the fitted model)
-            noise = np.median(0.5 * (co_all + ct_all)[:, h.size:].reshape(len(batch), off.size - 1, h.size), axis=1)
             back = np.array([run.speed < 0 for run in batch])[:, None]
-            co, ct = np.where(back, ct, co), np.where(back, co, ct)
+            co_all, ct_all = np.where(back, ct_all, co_all), np.where(back, co_all, ct_all)
+            co, ct = co_all[:, :h.size], ct_all[:, :h.size]
+            # the noise in each sense beside the line (a whirl's broadband response turns one way more than the
+            # other): the mean over the offsets no line of the direction is near, nor the spectrum's start
+            nz_co, nz_ct = _beside(co_all, ct_all, f, off, fs / n)
             ok = f < 0.45 * fs
-            p_co = np.cumsum(np.vstack([p_co, np.where(ok, co - noise, 0.0)]), axis=0)[-1]
-            p_ct = np.cumsum(np.vstack([p_ct, np.where(ok, ct - noise, 0.0)]), axis=0)[-1]
+            p_co = np.cumsum(np.vstack([p_co, np.where(ok, co, 0.0)]), axis=0)[-1]
+            p_ct = np.cumsum(np.vstack([p_ct, np.where(ok, ct, 0.0)]), axis=0)[-1]
+            n_co = np.cumsum(np.vstack([n_co, np.where(ok, nz_co, 0.0)]), axis=0)[-1]
+            n_ct = np.cumsum(np.vstack([n_ct, np.where(ok, nz_ct, 0.0)]), axis=0)[-1]
+            n_var += np.sum(np.where(ok, nz_co**2 + nz_ct**2, 0.0), axis=0)
             speeds = np.abs([run.speed for run in batch])
             seen = ok & np.array([np.isclose(speeds[:, None], m[None, :], rtol=1e-9, atol=0).any(axis=1)
                                   for m in measured]).T
@@ -81,7 +102,13 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             q_lo = np.minimum(q_lo, np.where(seen, q, 1.0).min(axis=0))
             q_hi = np.maximum(q_hi, np.where(seen, q, 0.0).max(axis=0))
             n_runs += seen.sum(axis=0)
-        p_co, p_ct = np.maximum(p_co, 0.0), np.maximum(p_ct, 0.0)
+        # the noise taken out where the line stands clear of its scatter (an exponential power's spread is its mean):
+        # below it, the difference is noise and its sense a coin's; the powers as read then (white noise in x and y
+        # adds the same to both senses: a weak co-rotating line read 1.6 % counter-rotating on the noise alone,
+        # trial 34's h 10.74 radial force, kept as a 13 % counter-rotating part in the fitted model)
+        clear = p_co + p_ct - n_co - n_ct >= NOISE_CLEAR * np.sqrt(n_var)
+        p_co = np.where(clear, np.maximum(p_co - n_co, 0.0), p_co)
+        p_ct = np.where(clear, np.maximum(p_ct - n_ct, 0.0), p_ct)
         frac = np.where(p_co + p_ct > 0, p_co / np.maximum(p_co + p_ct, 1e-300), 0.5)
         for hk, fr, lo, hi, n_k in zip(h, frac, q_lo, q_hi, n_runs):
             sense = "co" if fr >= threshold else ("counter" if fr <= 1 - threshold else "planar")

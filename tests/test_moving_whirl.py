@@ -77,6 +77,23 @@ def test_a_straight_track_no_whirl_can_follow_is_left_as_it_was():
     assert not u.causes[0].startswith("the wheel's rocking mode")
 
 
+@pytest.mark.parametrize("f0, slope", [(120.0, 0.3), (150.0, -0.6)])
+def test_a_straight_track_a_whirl_also_meets_lists_the_whirl_after_the_other_causes(f0, slope):
+    """Over a span a branch bends little on, a straight track is met by some whirl as well (review34: 120 Hz +
+    0.5·f_spin read as a forward whirl of I_zz/I_rr 0.89, a -0.6 slope as a backward one): no wheel's forward whirl
+    (I_zz/I_rr 1-3) and no better fit, so a mode stiffening or softening with speed stays the first cause."""
+    rpm = np.linspace(300, 2700, 20)
+    r = _ratios("radial_torque", (1, 1.5, 2, 2.5, 3, 4, 5, 6), rpm, lambda s: f0 + slope * (s - 25.0), zeta=0.02)
+    (u,) = _described(r)
+    assert u.parameters["slope_Hz_per_Hz_of_spin"] == pytest.approx(slope, abs=0.1)
+    got = u.parameters.get("rocking_whirl")
+    if got is not None:          # listed as a candidate, after the others
+        assert got["misfit_ratio_to_straight_track"] > 0.5
+        assert not u.causes[0].startswith("the wheel's rocking mode")
+        assert u.causes[-1].startswith("the wheel's rocking mode")
+    assert "stiffening" in u.causes[0] or "softening" in u.causes[0]
+
+
 def test_no_whirl_on_the_axial_force_nor_beside_a_located_rocking_mode():
     from rwadist.diagnose.describe_whirl import rocking_whirl
 

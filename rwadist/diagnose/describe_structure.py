@@ -671,7 +671,8 @@ def moving_resonance(ctx, state, ratios: list, shares) -> list:
                         "zeta": float(zeta), "peak_gain": float(gain), **_shape_words(zeta, gain, above),
                         "fixed_resonance_misfit_ratio":
                         float(misfit_ratio), "f_statistic": float(f_stat), "whirl": whirl, **beside},
-            causes=(() if rocking is None else (rocking[2],)) + _moving_causes(b, sign, track(mid), mid),
+            causes=(() if rocking is None or not rocking[3] else (rocking[2],)) + _moving_causes(b, sign, track(mid), mid)
+            + (() if rocking is None or rocking[3] else (rocking[2],)),
             would_tell=_crossing_words(crossed) + "a slow run-up recorded with its speed tracks the resonance "
                        "continuously; a tap test of the rotor at rest gives its frequency at zero speed"))
     return out

@@ -29,8 +29,16 @@ REST_FACTORS = np.exp(np.arange(-0.2, 0.2001, 0.005))
 FINE_RATIOS = np.arange(-0.06, 0.0601, 0.01)
 FINE_REST = np.exp(np.arange(-0.01, 0.01001, 0.0025))
 FINE_SHAPE = (0.6, 0.8, 1.0, 1.25, 1.6)
-#: A whirl fits "as well" when it leaves at most this times the straight track's misfit (both have two parameters)
+#: A whirl fits "as well" when it leaves at most this times the straight track's misfit (both have two parameters),
+#: "better" at most WHIRL_BETTER times it.  Over a short span a branch is nearly straight, and any slope between
+#: ~0.05 and 1.5 Hz per Hz of spin (−1.5 backward) is met by some whirl as well as by a straight track (a straight
+#: 120 Hz + 0.5·f_spin track: a forward whirl of I_zz/I_rr 0.89 at 0.88 of its misfit; the E wheel's true whirl over
+#: 600-2400 rpm: 0.99-1.01 of it): the whirl is the first cause only when it fits better, or as well on the forward
+#: branch with a wheel's ratio (WHEEL_RATIOS: a disc; a co-rotating imbalance drives the forward whirl), else it is
+#: listed after the others
 WHIRL_AS_WELL = 1.1
+WHIRL_BETTER = 0.5
+WHEEL_RATIOS = (1.0, MAX_INERTIA_RATIO)
 
 
 def branch_hz(spin, f_rest, a, sign: float):
@@ -69,6 +77,15 @@ def _misfits(r, fr: np.ndarray, zeta: float, gain: float, beta: float) -> np.nda
     return np.sum(e * e, axis=1)
 
 
+def _straight(r, f0: float, slope: float, shapes) -> float:
+    """The least misfit of a straight track f0·FINE_REST + (slope ± FINE_RATIOS)·(spin − spin_mid) over ``shapes``:
+    the straight track at the whirl's own resolution, so that neither wins by a finer grid."""
+    mid = 0.5 * (r.spin.min() + r.spin.max())
+    f0s, slopes = np.repeat(f0 * FINE_REST, FINE_RATIOS.size), np.tile(slope + FINE_RATIOS, FINE_REST.size)
+    fr = np.maximum(f0s[:, None] + slopes[:, None] * (r.spin[None, :] - mid), 1e-6)
+    return min(float(np.min(_misfits(r, fr, zeta, gain, beta))) for zeta, gain, beta in shapes)
+
+
 def _fit(r, sign: float, ratios: np.ndarray, rests: np.ndarray, shapes) -> tuple:
     """(misfit, I_zz/I_rr, f_rest Hz, ζ, peak gain) of the best whirl over the grids (``ratios`` × ``rests`` pairs)."""
     fr = branch_hz(r.spin[None, :], rests[:, None], ratios[:, None], sign)
@@ -82,12 +99,13 @@ def _fit(r, sign: float, ratios: np.ndarray, rests: np.ndarray, shapes) -> tuple
 
 
 def rocking_whirl(r, modes, track: tuple, sse: float) -> tuple | None:
-    """(parameters, whirl words, cause) of the rocking whirl that fits the points of ``r`` (a
+    """(parameters, whirl words, cause, first) of the rocking whirl that fits the points of ``r`` (a
     :class:`~rwadist.diagnose.describe_structure.LineRatios` of a radial direction) as well as the straight track
     ``track`` (f0 Hz at the middle speed, slope Hz per Hz of spin, ζ, peak gain, gain far above) of misfit ``sse``
     does (:data:`WHIRL_AS_WELL`), on the branch of the slope's sign; None when one does not, on the axial direction,
     or when the fitted ``modes`` (the ``suspension_modes`` effect) located the rocking mode (:func:`whirl_note` then
-    compares the track with that mode's whirl)."""
+    compares the track with that mode's whirl).  ``first``: whether the whirl leads the causes (:data:`WHIRL_BETTER`,
+    :data:`WHEEL_RATIOS`)."""
     f0, slope, zeta, gain, beta = track
     if r.direction not in ("radial_force", "radial_torque") or slope == 0.0 or \
             (modes is not None and "rocking" not in modes.unconstrained):
@@ -108,18 +126,20 @@ def rocking_whirl(r, modes, track: tuple, sse: float) -> tuple | None:
     ratios, rests = np.repeat(a, FINE_REST.size), np.tile(coarse[2] * FINE_REST, a.size)
     shapes = [(zeta * x, max(gain * y, 1.1), beta) for x in FINE_SHAPE for y in FINE_SHAPE]
     best = min(coarse, _fit(r, sign, ratios, rests, shapes), key=lambda t: t[0])
+    sse = min(sse, _straight(r, f0, slope, shapes))
     if not best[0] <= WHIRL_AS_WELL * sse:
         return None
     misfit, a, f_rest = best[:3]
     name = "forward" if sign > 0 else "backward"
     where = "" if r.direction == "radial_torque" else (" (seen on the radial forces: the rocking coupled with the "
                                                        "translation, or the loads measured away from the rotor's centre)")
-    params = {"branch": name, "f_at_rest_Hz": f_rest, "inertia_ratio": a, "misfit_ratio_to_straight_track":
-              misfit / max(sse, 1e-300)}
-    words = (f"the lines fit a rocking {name} whirl (≈ {f_rest:.4g} Hz at rest, I_zz/I_rr ≈ {a:.3g}) as well as a "
-             f"straight track; no rocking mode was located")
+    ratio = misfit / max(sse, 1e-300)
+    params = {"branch": name, "f_at_rest_Hz": f_rest, "inertia_ratio": a, "misfit_ratio_to_straight_track": ratio}
+    words = (f"the lines fit a rocking {name} whirl (≈ {f_rest:.4g} Hz at rest, I_zz/I_rr ≈ {a:.3g}) "
+             f"{'better than' if ratio <= WHIRL_BETTER else 'as well as'} a straight track; no rocking mode was located")
+    first = ratio <= WHIRL_BETTER or (sign > 0 and WHEEL_RATIOS[0] <= a <= WHEEL_RATIOS[1])
     cause = (f"the wheel's rocking mode whirling with speed, its {name} branch (≈ {f_rest:.4g} Hz at rest, I_zz/I_rr "
              f"≈ {a:.3g}){where}, amplifying lines the suspension-mode fit could not give to it (lines of either "
              "rotation sense lifted by either branch, as Masterson's modal model has it, or a rocking coupled with "
              "other motion)")
-    return params, words, cause
+    return params, words, cause, first

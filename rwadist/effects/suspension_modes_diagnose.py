@@ -573,8 +573,13 @@ class SuspensionModes:
             return {("axial" if m == "axial_translation" else m): tuple(float(v) for v in b) for m, b in d.items()}
 
         more = () if stand is None else tuple(tuple(float(v) for v in k) for k in efit.more_stands)
+        bounds = named(efit.zeta_bounds)
+        # a held damping is held inside its bounds (rwadist.extended_fit_damping.hold_unmeasured_damping), at a bound
+        # when the start lies beyond it: read back from its damping coefficient it may pass that bound by a rounding
+        # (family wheel 7, seed 701: 0.01418914241710545 for 0.014189142417105447)
+        zeta = {m: min(max(z, bounds[m][0]), bounds[m][1]) if m in bounds else z for m, z in zeta.items()}
         return SuspensionModes(base, f0, zeta, float(p.inertia_ratio), tuple(efit.unconstrained), n_runs, stand,
-                               sideband_pairs=pairs, structure=structure, zeta_bounds=named(efit.zeta_bounds),
+                               sideband_pairs=pairs, structure=structure, zeta_bounds=bounds,
                                zeta_interval=named(efit.zeta_interval), more_stands=more)
 
     def apply(self, state: State) -> State:
