@@ -13,29 +13,6 @@ from .units import DIRECTION_CHANNELS
 
 #: samples (runs × record length) of the x/y records :func:`line_senses` transforms together
 SENSE_CHUNK_SAMPLES = 1 << 20
-#: Whole-record bins either side of a line where :func:`line_senses` reads the noise under it (past a Hann window's
-#: main lobe of ±2 bins)
-NOISE_BINS = (5.0, 7.0)
-#: ... left out where a line of the direction lies within this many bins of them, or they lie under it
-NOISE_CLEAR_BINS = 3.0
-#: The noise is taken out of a line's summed powers when they stand this many of its scatters over it
-NOISE_CLEAR = 3.0
-
-
-def _beside(co_all: np.ndarray, ct_all: np.ndarray, f: np.ndarray, off: np.ndarray, df: float) -> tuple:
-    """(co, counter) noise power per run and line (R, L): the mean of each sense's powers ``co_all``, ``ct_all`` (R,
-    (1 + K)·L: the lines' own, then K offsets ``off[1:]`` Hz from every line) over the offsets no line of ``f`` (R, L)
-    Hz lies within :data:`NOISE_CLEAR_BINS` bins of ``df`` Hz (nor 0 Hz); 0 where fewer than two are left."""
-    r, n_lines = f.shape
-    fo = f[:, None, :] + off[None, 1:, None]                                        # (R, K, L)
-    near = np.abs(fo[..., None] - f[:, None, None, :]).min(axis=-1) < NOISE_CLEAR_BINS * df
-    good = ~(near | (fo < NOISE_CLEAR_BINS * df))
-    count = good.sum(axis=1)
-    out = []
-    for p in (co_all, ct_all):
-        side = p[:, n_lines:].reshape(r, off.size - 1, n_lines)
-        out.append(np.where(count >= 2, np.where(good, side, 0.0).sum(axis=1) / np.maximum(count, 1), 0.0))
-    return out[0], out[1]
 
 
 def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) -> dict:
@@ -43,9 +20,7 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
 
     For each run the complex Hann-windowed DFT of the x and y channels at +h|Ω|
     gives the co-rotating power |X + iY|² and the counter-rotating |X − iY|²
-    (swapped for Ω < 0); summed over runs, each less its noise under the line (:func:`_beside`: that sense's mean
-    power :data:`NOISE_BINS` bins either side) where the line stands :data:`NOISE_CLEAR` of the noise's scatter over
-    it, co_fraction = P_co / (P_co + P_counter) (0.5 when the noise takes all of both).
+    (swapped for Ω < 0); summed over runs, co_fraction = P_co / (P_co + P_counter).
     Above ``threshold``: "co"; below 1 − threshold: "counter"; between: "planar".
     every_run: "co" ("counter") when the response turns that way by more than :data:`ONE_SENSE` of its power in every
     run the fit measures the line in (:data:`ONE_SENSE_RUNS` at least), else "" (:func:`one_sense_rows`).
@@ -57,7 +32,8 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
         if not lines:
             continue
         h = np.array([x.h for x in lines])
-        p_co, p_ct, n_co, n_ct, n_var = (np.zeros(h.size) for _ in range(5))
+        p_co = np.zeros(h.size)
+        p_ct = np.zeros(h.size)
         # per line the least and the greatest co-rotating share of one run's response, over the runs it is measured in
         q_lo, q_hi, n_runs = np.ones(h.size), np.zeros(h.size), np.zeros(h.size, int)
         measured = [np.unique(np.abs(x.speed)) for x in lines]
@@ -76,25 +52,16 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             w = run_window("hann", n)[0]             # = signal.windows.hann(n, sym=False)
             f = h[None, :] * np.abs([run.speed for run in batch])[:, None] / (2 * np.pi)
             x = blocked_records([[run.signals[cx], run.signals[cy]] for run in batch], w)
-            # the line and, for the noise under it, the same transforms NOISE_BINS whole-record bins either side
-            off = np.concatenate([[0.0], -np.asarray(NOISE_BINS), NOISE_BINS]) * fs / n
-            XY = windowed_dfts(x, fs, np.concatenate([f + o for o in off], axis=1))
+            XY = windowed_dfts(x, fs, f)
             # every run's powers at once, added run after run in the batch's order (a cumulative sum along the runs:
             # the adds of a loop over them; a line out of a run's band adds 0 there)
             X, Y = XY[..., 0], XY[..., 1]
-            co_all, ct_all = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
+            co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
             back = np.array([run.speed < 0 for run in batch])[:, None]
-            co_all, ct_all = np.where(back, ct_all, co_all), np.where(back, co_all, ct_all)
-            co, ct = co_all[:, :h.size], ct_all[:, :h.size]
-            # the noise in each sense beside the line (a whirl's broadband response turns one way more than the
-            # other): the mean over the offsets no line of the direction is near, nor the spectrum's start
-            nz_co, nz_ct = _beside(co_all, ct_all, f, off, fs / n)
+            co, ct = np.where(back, ct, co), np.where(back, co, ct)
             ok = f < 0.45 * fs
             p_co = np.cumsum(np.vstack([p_co, np.where(ok, co, 0.0)]), axis=0)[-1]
             p_ct = np.cumsum(np.vstack([p_ct, np.where(ok, ct, 0.0)]), axis=0)[-1]
-            n_co = np.cumsum(np.vstack([n_co, np.where(ok, nz_co, 0.0)]), axis=0)[-1]
-            n_ct = np.cumsum(np.vstack([n_ct, np.where(ok, nz_ct, 0.0)]), axis=0)[-1]
-            n_var += np.sum(np.where(ok, nz_co**2 + nz_ct**2, 0.0), axis=0)
             speeds = np.abs([run.speed for run in batch])
             seen = ok & np.array([np.isclose(speeds[:, None], m[None, :], rtol=1e-9, atol=0).any(axis=1)
                                   for m in measured]).T
@@ -102,14 +69,7 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) ->
             q_lo = np.minimum(q_lo, np.where(seen, q, 1.0).min(axis=0))
             q_hi = np.maximum(q_hi, np.where(seen, q, 0.0).max(axis=0))
             n_runs += seen.sum(axis=0)
-        # the noise taken out where the line stands clear of its scatter (an exponential power's spread is its mean):
-        # below it, the difference is noise and its sense a coin's; the powers as read then (white noise in x and y
-        # adds the same to both senses: a weak co-rotating line read 1.6 % counter-rotating on the noise alone,
-        # trial 34's h 10.74 radial force, kept as a 13 % counter-rotating part in the fitted model)
-        clear = p_co + p_ct - n_co - n_ct >= NOISE_CLEAR * np.sqrt(n_var)
-        p_co = np.where(clear, np.maximum(p_co - n_co, 0.0), p_co)
-        p_ct = np.where(clear, np.maximum(p_ct - n_ct, 0.0), p_ct)
-        frac = np.where(p_co + p_ct > 0, p_co / np.maximum(p_co + p_ct, 1e-300), 0.5)
+        frac = p_co / np.maximum(p_co + p_ct, 1e-300)
         for hk, fr, lo, hi, n_k in zip(h, frac, q_lo, q_hi, n_runs):
             sense = "co" if fr >= threshold else ("counter" if fr <= 1 - threshold else "planar")
             every = "" if n_k < ONE_SENSE_RUNS else "co" if lo > ONE_SENSE else "counter" if hi < 1 - ONE_SENSE else ""
