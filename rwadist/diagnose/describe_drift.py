@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .describe_lines import log_parabola_offset
+from .describe_lines import log_parabola_offset, sliced
 from .unexplained import Unexplained
 
 #: Directions read and their channels (summed).
@@ -143,18 +143,11 @@ def drift_of(rows: np.ndarray, h0: float, df: float):
     return (float(lo), float(hi)), h_lo, h_hi
 
 
-def _sliced(ctx) -> bool:
-    """A sweep's slices: the speed moves within each, and the power-weighted peak (the load grows as Ω²) sits above
-    the slice's mean speed by an amount that changes with speed (family wheel 0, a 30-s run-up: a phantom drift)."""
-    test = getattr(ctx, "test", None)
-    return test is not None and "slicing" in (getattr(test, "meta", None) or {})
-
-
 def _drifts(ctx, model) -> list:
     """(direction, channels, h, rows, slope interval (lo, hi), h at the lowest speed, h at the highest) of every line of
     ``model`` whose ratio to the speed drifts on ``ctx``'s Welch PSDs (module docstring); ``rows`` of
     :func:`_run_ratios`.  Kept on the context by the model's lines: the search asks it at every step."""
-    if _sliced(ctx):
+    if sliced(ctx):  # family wheel 0, a 30-s run-up: a phantom drift
         return []
     lines = {d: sorted({float(x.h) for x in model.harmonics(d)}) for d in DIRECTIONS}
     key = ("ratio_drift", tuple((d, tuple(v)) for d, v in lines.items()))
@@ -188,7 +181,7 @@ def drifting_speed_lines(ctx, state, records: list) -> tuple:
     caught as a ridge at one h over part of the speeds, or two (trial 31 wheel D, twice the outer race's ball pass
     slipping 4 %: 'speed lines' at h 6.795 over 400-3304 rpm and 6.747 over 400-3646 rpm, named 15-16 and 16-ball
     bearings, never tied to the drift).  Lines of one direction within :data:`SAME_LINE` of a drifting one are it."""
-    if _sliced(ctx):
+    if sliced(ctx):
         return records, []
     every = sorted({float(x.h) for d in DIRECTIONS for x in state.model.harmonics(d)})
     spin_top = float(np.max(np.abs(ctx.omega[ctx.runs]))) / (2 * np.pi)

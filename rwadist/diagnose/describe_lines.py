@@ -48,6 +48,14 @@ def ratio_resolution(ctx) -> float:
 RING_BINS = (3, 7)
 
 
+def sliced(ctx) -> bool:
+    """A sweep's slices: the speed moves within each, so a line is smeared over several bins (5 % of its frequency
+    over the slice) and the power-weighted peak (the load grows as Ω²) sits above the slice's mean speed by an amount
+    that changes with speed.  The narrow test here and the ratio drift (:mod:`.describe_drift`) are for steady runs."""
+    test = getattr(ctx, "test", None)
+    return test is not None and "slicing" in (getattr(test, "meta", None) or {})
+
+
 def _narrow(ratio: np.ndarray, thr: float) -> np.ndarray:
     """Bins (runs, n_f) where ``ratio`` (data over model) exceeds ``thr`` times its median over the ring of
     :data:`RING_BINS` bins either side in the same run."""
@@ -95,10 +103,8 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
     om = ctx.omega[runs]
     if runs.size < RIDGE_RUNS:
         return []
-    # a sweep's slice smears a line over several bins (5 % of its frequency over the slice): the narrow test is for
-    # steady runs (review34: a 500-Hz line of 2048-sample slices at 4.8 kHz smeared over the ring and lit nowhere)
-    test = getattr(ctx, "test", None)
-    sliced = test is not None and "slicing" in (getattr(test, "meta", None) or {})
+    # review34: a 500-Hz line of 2048-sample slices at 4.8 kHz smeared over the ring and lit nowhere
+    narrow = not sliced(ctx)
     dh = H_STEP_BINS * ctx.df * 2 * np.pi / om.max()
     h_grid = np.arange(0.1, min(ctx.k_hi * ctx.df * 2 * np.pi / om.min(), 40.0), dh)
     k = np.rint(np.outer(h_grid, om) / (2 * np.pi) / ctx.df).astype(int)                      # (H, R)
@@ -111,7 +117,7 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
             continue
         hit = np.zeros(k.shape, bool)
         for c in chans:
-            hit |= _lit(ctx, state, c, narrow=not sliced)[rows, np.clip(k, 0, ctx.f.size - 1)]
+            hit |= _lit(ctx, state, c, narrow=narrow)[rows, np.clip(k, 0, ctx.f.size - 1)]
         n_in = inb.sum(1)
         frac = np.where(n_in >= RIDGE_RUNS, (hit & inb).sum(1) / np.maximum(n_in, 1), 0.0)
         model_h = np.array([x.h for x in state.model.harmonics(d)])
