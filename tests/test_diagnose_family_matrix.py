@@ -108,6 +108,16 @@ def test_new_wheel_clean_and_a_fixture_above_its_axial_mode_hold(tmp_path):
 
 
 @pytest.mark.slow
+def test_a_planar_lines_share_of_one_channel_is_no_wheel_mode(tmp_path):
+    """Family wheel 3 clean, seed 300 (600-6000 rpm, 4 kHz): its planar 2xBPFO line (h 8.03, co 0.5) read on Fy
+    alone at 5147 rpm (Fx did not measure it there) was fitted as a wheel mode at 688.8 Hz, peak gain 1.42, and added;
+    the pair's power sum holds no such lift (tests/test_line_gain_pair.py)."""
+    w = dfm.wheels()[3]
+    clean = dfm.run_cell(3, w, "clean", "clean", [], 300, tmp_path, None)
+    assert "crashed" not in clean and not clean["added"] and clean["modes_ok"], clean
+
+
+@pytest.mark.slow
 def test_a_fixture_under_the_modes_of_a_heavy_wheel_is_named_beside_them(tmp_path):
     fix = _cell(2, "fixture 0.75x axial", tmp_path)
     assert "crashed" not in fix and fix["found"] == [True] and not fix["added"] and fix["modes_ok"], fix

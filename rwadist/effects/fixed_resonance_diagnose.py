@@ -10,7 +10,7 @@ from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.state import State
 from ..resonance import log_power_gain_jacobian, resonance
-from ..units import CHANNEL_DIRECTION, DIRECTION_CHANNELS
+from ..units import CHANNEL_DIRECTION, DIRECTION_CHANNELS, RADIAL_PAIRS
 
 #: Smallest peak gain (or 1/gain, an anti-resonance of a test stand) proposed: |H| within 10 % of 1 everywhere is the size of the
 #: fit's own model error near a mode (a per-unit extended base leaves ~1-3 % there), not a resonance.
@@ -31,19 +31,28 @@ def _line_gain_points(ctx, state, chans, runs):
     a log power falls as 1/s for weak lines and is bounded by model error for strong ones.  direction: the load
     direction of each point's channel (str).
 
+    A radial line read on both channels of its pair (Fx/Fy, Tx/Ty) is read on their power sum, the same point for
+    each: a line with co- and counter-rotating parts is an ellipse whose orientation is set by the parts' phases, which
+    change from run to run, so one channel's share of it does too (a planar line: 0 to 2x the power of each), and
+    only the sum is the line's (the parts' cross term cancels between x and y).  Family wheel 3 clean, seed 300: a
+    planar line at h 8.03, measured on Fy alone at 5147 rpm (688.9 Hz; Fx did not measure it there), was fitted as a
+    wheel mode at 688.8 Hz of peak gain 1.42 and added.  A run where one channel of the pair does not measure the
+    line gives no point.
+
     A line whose ratio to the speed drifts (:func:`rwadist.diagnose.describe_drift.drifting`: a bearing's cage
     slipping) is left out: read at its fixed ratio it falls away from the model as the data's line moves off, a loss
     a notch there fits (trial 30b wheel A, the cage slipping 5 %: a 'test stand' at 139.6 Hz of peak gain 0.27)."""
     from ..diagnose.describe_drift import drifting
 
     moving = drifting(ctx, state.model)
-    fs, ys, ws, ds = [], [], [], []
     offs = np.arange(-LINE_HALF, LINE_HALF + 1)
+    read: dict = {}                     # channel -> {h: (f, measured power, predicted power, noise power, usable)}
     for c in chans:
         noise = ctx.floor_psd(state, c, runs)
         cl = ctx.channel_lines(state, c, runs)
         hs = np.array([x[0] for x in cl])
         measured = ctx.measure_lines(state, c, runs)          # each line against all the others, all at once
+        read[c] = {}
         for (h, law, amp, _), a in zip(cl, measured):
             if any(d == CHANNEL_DIRECTION[c] and abs(x - float(h)) <= 1e-9 * x for d, x in moving):
                 continue
@@ -54,10 +63,22 @@ def _line_gain_points(ctx, state, chans, runs):
             alone = np.all(sep >= 2 * LINE_HALF, axis=0) if sep.size else np.ones(runs.size, bool)
             ok = np.isfinite(a) & (a_pred > 0) & alone
             k = np.clip(np.rint(f / ctx.df).astype(int)[:, None] + offs, 0, ctx.f.size - 1)
-            snr = np.where(ok, a, 0.0) ** 2 / 2 / (np.take_along_axis(noise, k, axis=1).sum(1) * ctx.df)
+            n_pow = np.take_along_axis(noise, k, axis=1).sum(1) * ctx.df
+            read[c][float(h)] = (f, np.where(ok, a, 0.0) ** 2 / 2, a_pred ** 2 / 2, n_pow, ok)
+    fs, ys, ws, ds = [], [], [], []
+    for c in chans:
+        partner = next((b if a == c else a for a, b in RADIAL_PAIRS if c in (a, b) and b != a), None)
+        other = read.get(partner, {})
+        for h, (f, p, p_pred, n_pow, ok) in read[c].items():
+            if h in other:
+                # the pair's power sum, on both channels' points (module docstring of this function)
+                _, p2, p2_pred, n2, ok2 = other[h]
+                ok = ok & ok2
+                p, p_pred, n_pow = p + p2, p_pred + p2_pred, n_pow + n2
+            snr = p[ok] / n_pow[ok]
             fs.append(f[ok])
-            ys.append(2.0 * np.log(a[ok] / a_pred[ok]))
-            ws.append(snr[ok] ** 2 / (snr[ok] ** 2 + SNR_KNEE**2))
+            ys.append(np.log(p[ok] / p_pred[ok]))
+            ws.append(snr ** 2 / (snr ** 2 + SNR_KNEE**2))
             ds.append(np.full(int(ok.sum()), CHANNEL_DIRECTION[c]))
     if not fs:
         return np.empty(0), np.empty(0), np.empty(0), np.empty(0, str)
