@@ -31,10 +31,11 @@ def _line_gain_points(ctx, state, chans, runs):
     a log power falls as 1/s for weak lines and is bounded by model error for strong ones.  direction: the load
     direction of each point's channel (str).
 
-    A radial line read on both channels of its pair (Fx/Fy, Tx/Ty) is read on their power sum, the same point for
-    each: a line with co- and counter-rotating parts is an ellipse whose orientation is set by the parts' phases, which
-    change from run to run, so one channel's share of it does too (a planar line: 0 to 2x the power of each), and
-    only the sum is the line's (the parts' cross term cancels between x and y).  Family wheel 3 clean, seed 300: a
+    A radial line read on both channels of its pair (Fx/Fy, Tx/Ty) is read on their power sum, one point for the
+    pair (one measurement of the line: counted once where points are counted, :func:`speed_split`): a line with co-
+    and counter-rotating parts is an ellipse whose orientation is set by the parts' phases, which change from run to
+    run, so one channel's share of it does too (a planar line: 0 to 2x the power of each), and only the sum is the
+    line's (the parts' cross term cancels between x and y).  Family wheel 3 clean, seed 300: a
     planar line at h 8.03, measured on Fy alone at 5147 rpm (688.9 Hz; Fx did not measure it there), was fitted as a
     wheel mode at 688.8 Hz of peak gain 1.42 and added.  A run where one channel of the pair does not measure the
     line gives no point.
@@ -67,11 +68,14 @@ def _line_gain_points(ctx, state, chans, runs):
             read[c][float(h)] = (f, np.where(ok, a, 0.0) ** 2 / 2, a_pred ** 2 / 2, n_pow, ok)
     fs, ys, ws, ds = [], [], [], []
     for c in chans:
-        partner = next((b if a == c else a for a, b in RADIAL_PAIRS if c in (a, b) and b != a), None)
-        other = read.get(partner, {})
+        pair = next((x for x in RADIAL_PAIRS if c in x), (c, c))
+        partner = pair[1] if c == pair[0] else pair[0]
+        other = read.get(partner, {}) if partner != c else {}
         for h, (f, p, p_pred, n_pow, ok) in read[c].items():
             if h in other:
-                # the pair's power sum, on both channels' points (module docstring of this function)
+                if c != pair[0]:
+                    continue            # the pair's point is its first channel's
+                # the pair's power sum (this function's docstring)
                 _, p2, p2_pred, n2, ok2 = other[h]
                 ok = ok & ok2
                 p, p_pred, n_pow = p + p2, p_pred + p2_pred, n_pow + n2
