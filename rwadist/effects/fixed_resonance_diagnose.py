@@ -31,14 +31,17 @@ def _line_gain_points(ctx, state, chans, runs):
     a log power falls as 1/s for weak lines and is bounded by model error for strong ones.  direction: the load
     direction of each point's channel (str).
 
-    A radial line read on both channels of its pair (Fx/Fy, Tx/Ty) is read on their power sum, one point for the
-    pair (one measurement of the line: counted once where points are counted, :func:`speed_split`): a line with co-
-    and counter-rotating parts is an ellipse whose orientation is set by the parts' phases, which change from run to
-    run, so one channel's share of it does too (a planar line: 0 to 2x the power of each), and only the sum is the
-    line's (the parts' cross term cancels between x and y).  Family wheel 3 clean, seed 300: a
-    planar line at h 8.03, measured on Fy alone at 5147 rpm (688.9 Hz; Fx did not measure it there), was fitted as a
-    wheel mode at 688.8 Hz of peak gain 1.42 and added.  A run where one channel of the pair does not measure the
-    line gives no point.
+    On one radial direction's lines (``chans`` one pair, Fx/Fy or Tx/Ty: a wheel mode's fit) a line is read on the
+    pair's power sum, one point for the pair (one measurement of the line: counted once where points are counted,
+    :func:`speed_split`): a line with co- and counter-rotating parts is an ellipse whose orientation is set by the
+    parts' phases, which change from run to run, so one channel's share of it does too (a planar line: 0 to 2x the
+    power of each), and only the sum is the line's (the parts' cross term cancels between x and y).  Family wheel 3
+    clean, seed 300: a planar line at h 8.03, measured on Fy alone at 5147 rpm (688.9 Hz; Fx did not measure it
+    there), was fitted as a wheel mode at 688.8 Hz of peak gain 1.42 and added.  A run where one channel of the pair
+    does not measure the line gives no point.  A stand's fit on every channel reads each channel as it is: read on
+    the pairs' sums there, family wheel 7's fixture at 195 Hz on a table with a 20-mm load-cell offset was fitted
+    with 1.6 % of the load far above it (1.0 % per channel), and the offset, judged beside that stand, lost its
+    held-out gain (t +6.6 -> -4.5) and went unnamed.
 
     A line whose ratio to the speed drifts (:func:`rwadist.diagnose.describe_drift.drifting`: a bearing's cage
     slipping) is left out: read at its fixed ratio it falls away from the model as the data's line moves off, a loss
@@ -67,10 +70,11 @@ def _line_gain_points(ctx, state, chans, runs):
             n_pow = np.take_along_axis(noise, k, axis=1).sum(1) * ctx.df
             read[c][float(h)] = (f, np.where(ok, a, 0.0) ** 2 / 2, a_pred ** 2 / 2, n_pow, ok)
     fs, ys, ws, ds = [], [], [], []
+    one_pair = any(set(chans) == set(x) for x in RADIAL_PAIRS)
     for c in chans:
         pair = next((x for x in RADIAL_PAIRS if c in x), (c, c))
         partner = pair[1] if c == pair[0] else pair[0]
-        other = read.get(partner, {}) if partner != c else {}
+        other = read.get(partner, {}) if partner != c and one_pair else {}
         for h, (f, p, p_pred, n_pow, ok) in read[c].items():
             if h in other:
                 if c != pair[0]:
