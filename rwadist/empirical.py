@@ -18,8 +18,9 @@ thesis toolbox did with a manual decision at every step:
    harmonics; each h is refined by least squares of f = h·|Ω| over its lines.
 3. **Amplitudes** (``find_coeff.m``): the line amplitude in each run where
    the line is in band, detected (Eq. 3.11) and resolved from the other
-   harmonics, measured as the power under the line (exact between bins, by
-   Parseval) less the local noise floor; C by Eq. 3.10.
+   harmonics (or with weaker lines only in its bins, their part taken out:
+   :mod:`rwadist.line_overlap`), measured as the power under the line (exact
+   between bins, by Parseval) less the local noise floor; C by Eq. 3.10.
 4. **Modal amplification** (``remove_mode.m``, automatic): speeds where the
    amplitude departs from C·Ω² by more than noise and scatter allow, grown
    into contiguous speed ranges, are excluded and C is refitted; the ranges
@@ -41,6 +42,7 @@ import numpy as np
 from scipy import signal, stats
 
 from .data import DataError
+from .line_overlap import measured_beside
 from .model import DIRECTIONS, Harmonic, WheelModel
 from .progress import tqdm
 from .spectra import Spectra, detection_threshold, welch_dof
@@ -575,7 +577,7 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
     chans = [c for c in DIRECTION_CHANNELS[direction] if c in spectra.psd]
     if not chans:
         return _DirectionMeasurements([])
-    f, df = spectra.f, spectra.df
+    df = spectra.df
     f_lo, f_hi = s.f_min_bins * df, spectra.band_limit
     lines = collect_lines(spectra, chans, fit_runs, detected, s.epsilon)
     bins = identify_harmonics(lines, f_lo, f_hi, s, direction, df)
@@ -586,11 +588,12 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
     fpk = lines.match(h)                                    # (n_h, n_pairs)
     predicted = h[:, None] * lines.pair_speed_hz[None, :]
     valid = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)
-    # resolved: no other harmonic's line within the summed bins of this one
-    sep = np.abs(predicted[None, :, :] - np.where(np.isfinite(fpk), fpk, predicted)[:, None, :])
-    sep[np.arange(h.size), np.arange(h.size), :] = np.inf
-    valid &= sep.min(axis=1) >= (2 * s.line_half_width + 1) * df
+    # resolved: no other harmonic's line within the summed bins of this one ...
+    at = np.where(np.isfinite(fpk), fpk, predicted)
+    clear = np.abs(predicted[None, :, :] - at[:, None, :]) >= (2 * s.line_half_width + 1) * df   # (a, b, pair)
+    clear[np.arange(h.size), np.arange(h.size), :] = True
     # ... nor any other detected line (a harmonic too weak or too rare to be kept) under its window
+    n_near = np.zeros(fpk.shape, int)
     if lines.line_pair.size:
         keys = lines.line_pair + lines.line_star / lines.scale
         half = (s.line_half_width + 0.5) * df / lines.pair_speed_hz[None, :]
@@ -598,9 +601,27 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
         pair = np.arange(lines.pair_run.size)[None, :]
         n_near = (np.searchsorted(keys, pair + (star + half) / lines.scale, "right")
                   - np.searchsorted(keys, pair + (star - half) / lines.scale, "left"))
-        valid &= n_near <= 1
-    hi_, pi_ = np.nonzero(valid)
-    # line power in every valid (harmonic, pair), one gather per channel
+    resolved = valid & clear.all(axis=1) & (n_near <= 1)
+    hi_, pi_ = np.nonzero(resolved)
+    d, sig = _line_powers(spectra, chans, lines, fpk, hi_, pi_, floors, s)
+    # a line with only weak lines in its bins (a carrier's speed sidebands at low speed) is measured there too
+    power = np.full(fpk.shape, np.nan)
+    power[hi_, pi_] = np.where(d > 0, d ** 2 / 2, np.nan)
+    hb, pb, part, beat = measured_beside(valid, resolved, clear, n_near, fpk, predicted, power, df, s.line_half_width,
+                                   spectra.window, spectra.nperseg)
+    if hb.size:
+        db, sb = _line_powers(spectra, chans, lines, fpk, hb, pb, floors, s)
+        order = np.lexsort((np.concatenate([pi_, pb]), np.concatenate([hi_, hb])))
+        hi_, pi_ = np.concatenate([hi_, hb])[order], np.concatenate([pi_, pb])[order]
+        d = np.concatenate([d, db / np.sqrt(1 + part)])[order]
+        sig = np.concatenate([sig, np.hypot(sb * np.sqrt(1 + part), beat / 2)])[order]
+    return _DirectionMeasurements(bins, _LineMeasurements(lines, hi_, pi_, d, sig))
+
+
+def _line_powers(spectra: Spectra, chans, lines: _Lines, fpk: np.ndarray, hi_: np.ndarray, pi_: np.ndarray,
+                 floors: dict, s: FitSettings) -> tuple:
+    """Amplitude (SI) and relative noise of the lines of the cells (``hi_``, ``pi_``) (m,) each: the power in the
+    2L+1 bins about the detected peak less the channel's noise floor there, one gather per channel."""
     d = np.zeros(hi_.size)
     sig = np.zeros(hi_.size)
     offsets = np.arange(-s.line_half_width, s.line_half_width + 1)
@@ -609,13 +630,14 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
         if not m.any():
             continue
         runs = lines.pair_run[pi_[m]]
-        bins_ = np.clip(np.rint(fpk[hi_[m], pi_[m]] / df).astype(int)[:, None] + offsets, 0, f.size - 1)
-        p = spectra.psd[c][runs[:, None], bins_].sum(axis=1) * df
-        noise = floors[c][runs[:, None], bins_].sum(axis=1) * df
+        bins_ = np.clip(np.rint(fpk[hi_[m], pi_[m]] / spectra.df).astype(int)[:, None] + offsets, 0,
+                        spectra.f.size - 1)
+        p = spectra.psd[c][runs[:, None], bins_].sum(axis=1) * spectra.df
+        noise = floors[c][runs[:, None], bins_].sum(axis=1) * spectra.df
         power = np.maximum(p - noise, 0.0)
         d[m] = np.sqrt(2 * power)
         sig[m] = np.sqrt(noise / np.maximum(2 * power, 1e-300))
-    return _DirectionMeasurements(bins, _LineMeasurements(lines, hi_, pi_, d, sig))
+    return d, sig
 
 
 def direction_lines(direction: str, meas: _DirectionMeasurements, s: FitSettings):
