@@ -190,6 +190,11 @@ def _is_resonance(sol) -> bool:
     return _is_resonance_gain(float(np.exp(sol.x[2])))
 
 
+def _soft_l1_cost(r: np.ndarray) -> float:
+    """The cost least_squares minimises for residuals ``r`` with loss soft_l1 and f_scale 0.5."""
+    return float(np.sum(2.0 * (np.sqrt(1.0 + (r / 0.5) ** 2) - 1.0))) * 0.125
+
+
 def _general_refit(e: "FixedResonance", f, y, sw, lo: float, hi: float) -> "FixedResonance":
     """``e`` refitted in the general form of :mod:`rwadist.resonance` (f_r, ζ, the numerator's damping γ and the gain
     above β free) on the log power gains ``y`` at ``f`` (weights ``sw``): robust (soft-L1) least squares from ``e``
@@ -206,7 +211,7 @@ def _general_refit(e: "FixedResonance", f, y, sw, lo: float, hi: float) -> "Fixe
         return sw * (y - lg), -sw[:, None] * d
 
     base = res_jac(np.array([np.log(e.f_r), np.log(e.zeta), e.peak_gain, 1.0]))[0]
-    base_cost = float(np.sum(2.0 * (np.sqrt(1.0 + (base / 0.5) ** 2) - 1.0))) * 0.125   # soft-L1 as least_squares
+    base_cost = _soft_l1_cost(base)
     sols = []
     for gamma, beta in ((min(e.peak_gain, 199.0), 1.0), (1.0, 0.0)):
         x0 = np.clip([np.log(e.f_r), np.log(e.zeta), gamma, beta], lb + 1e-9, ub - 1e-9)
@@ -570,11 +575,6 @@ class FixedResonance:
 #: wheel translates and rocks at frequencies a few per cent apart (ROSS's wheel D on a 105-Hz stand: 103.1 and
 #: 108.6 Hz), and one resonance on every channel holds them as a compromise
 STAND_DIRECTION_SPREAD = 0.1
-
-
-def _soft_l1_cost(r: np.ndarray) -> float:
-    """The cost least_squares minimises for residuals ``r`` with loss soft_l1 and f_scale 0.5."""
-    return float(np.sum(2.0 * (np.sqrt(1.0 + (r / 0.5) ** 2) - 1.0))) * 0.125
 
 
 def stand_explains(f: np.ndarray, y: np.ndarray, sw: np.ndarray, e: "FixedResonance", stands) -> bool:
