@@ -15,6 +15,7 @@ import numpy as np
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .constants import LINE_HALF
 from .describe_whirl import rocking_whirl, whirl_note
+from .line_offsets import line_indicator, offset_free_sse
 from .sweep_crossing import crossings
 from .unexplained import Unexplained
 
@@ -476,9 +477,7 @@ def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray, shapes=None, 
     :data:`GAINS_ABOVE`), each line's own offset (its C's misfit) taken out: the least squares of q on the
     resonance's dB gain per line; with ``per_slope``, the list of the best of each slope."""
     mid = 0.5 * (r.spin.min() + r.spin.max())
-    lines = np.unique(r.line)
-    onehot = (r.line[None, :] == lines[:, None]).astype(float)                       # (L, N)
-    count = onehot.sum(1)
+    onehot, count = line_indicator(r.line)                                          # (L, N), (L,)
     none = (np.inf, np.nan, np.nan, np.nan, np.nan, np.nan)
     best, each = none, []
     for b in slopes:
@@ -494,10 +493,7 @@ def _track_fit(r: LineRatios, f0s: np.ndarray, slopes: np.ndarray, shapes=None, 
             if above is MASS_SHARE and gain_above(z, g, above) <= 0.0:
                 continue                # a mode of more than the rotor's whole mass (μ >= 1): no physical shape
             G = _resonance_db(r.f[None, :], fr, z, g, above)                      # (F, N)
-            res = r.q[None, :] - G
-            off = (res @ onehot.T) / count                                        # (F, L) per-line offsets
-            e = res - off @ onehot
-            sse = np.where(valid, np.sum(e * e, axis=1), np.inf)
+            sse = np.where(valid, offset_free_sse(r.q[None, :] - G, onehot, count), np.inf)
             i = int(np.argmin(sse))
             if sse[i] < best[0]:
                 best = (float(sse[i]), float(f0s[i]), float(b), z, g, above)

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..resonance import resonance_response
 from ..schema import MAX_INERTIA_RATIO
+from .line_offsets import line_indicator, offset_free_sse
 
 #: I_zz/I_rr tried for a rocking whirl through a moving track (0.02 steps, up to the effective ratio a model may hold)
 WHIRL_RATIOS = np.round(np.arange(0.1, MAX_INERTIA_RATIO + 1e-9, 0.02), 2)
@@ -69,12 +70,8 @@ def whirl_note(direction: str, slope: float, modes, s_lo: float, s_hi: float, f_
 def _misfits(r, fr: np.ndarray, zeta: float, gain: float, beta: float) -> np.ndarray:
     """Misfit (K,) of each track ``fr`` (K, N) Hz through the points of ``r`` (a LineRatios), each line's own offset
     taken out (as the straight track's fit does)."""
-    lines = np.unique(r.line)
-    onehot = (r.line[None, :] == lines[:, None]).astype(float)                          # (L, N)
     g = 20 * np.log10(np.maximum(np.abs(resonance_response(r.f[None, :] / fr, zeta, gain, beta)), 1e-12))
-    res = r.q[None, :] - g
-    e = res - ((res @ onehot.T) / onehot.sum(1)) @ onehot
-    return np.sum(e * e, axis=1)
+    return offset_free_sse(r.q[None, :] - g, *line_indicator(r.line))
 
 
 def _straight(r, f0: float, slope: float, shapes) -> float:
