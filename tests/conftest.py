@@ -146,6 +146,30 @@ def once_per_run(tmp_path_factory, name: str, build) -> Path:
     return folder
 
 
+@pytest.fixture(scope="session")
+def family_clean_cell(tmp_path_factory):
+    """``family_clean_cell(i)`` -> (row, cell folder) of family wheel ``i``'s clean cell of the robustness matrix
+    (benchmarks/diagnose_family_matrix.py ``run_cell``: its data at seed 1 + 100·i written as a lab's CSV and
+    ``rwadist diagnose DATA -o REPORT`` run on them; the folder holds ``data``, ``truth.json`` and ``report``), run once
+    per test run across the ``-n`` workers: several files compare a cell with the same wheel's clean one.  ``row`` is
+    the cell's evaluation as ``run_cell`` returns it (read back from JSON: lists for its tuples)."""
+    import json
+    import sys
+
+    def get(i: int):
+        def build(folder: Path) -> None:
+            sys.path.insert(0, str(TESTS_DIR.parent / "benchmarks"))
+            import diagnose_family_matrix as dfm
+
+            row = dfm.run_cell(i, dfm.wheels()[i], "clean", "clean", [], 1 + 100 * i, folder, None)
+            (folder / "row.json").write_text(json.dumps(row))
+
+        folder = once_per_run(tmp_path_factory, f"family_clean_cell_{i}", build)
+        return json.loads((folder / "row.json").read_text()), folder / f"w{i}_clean"
+
+    return get
+
+
 #: the example notebook, executed by test_notebook.py and test_coupling.py
 EXAMPLE_NOTEBOOK = Path(__file__).resolve().parents[1] / "examples" / "coupling_study.ipynb"
 
