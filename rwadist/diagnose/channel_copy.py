@@ -465,7 +465,10 @@ def describe_channel_copies(ctx, copies, shares: dict) -> list:
             f = np.asarray(ctx.sp.f, dtype=float)[[1, -1]]
         share, level = shares.get(i, (float("nan"), cp.level_dB))
         gain, phase = abs(cp.kappa), float(np.degrees(np.angle(cp.kappa)))
-        alt = f" ({' or '.join((cp.source,) + cp.alternatives)}: their lines share a phase)" if cp.alternatives else ""
+        # the other sources' lines fit a copy as well, each at its own phase (Fy's a quarter turn from Fx's on a
+        # co-rotating line): a crosstalk term is mostly in phase, which the phase of the one named tells
+        alt = (f" (or {' or '.join(cp.alternatives)}: the lines fit a copy of either, each at its own phase; "
+               f"{cp.source}'s is {phase:+.1f}°)" if cp.alternatives else "")
         out.append(Unexplained(
             signature="channel_copy", channels=(cp.target,), speed_rpm=(float(speeds.min()), float(speeds.max())),
             f_Hz=(float(f.min()), float(f.max())), level_dB=level, share=share, n_runs=len(cp.runs),

@@ -303,14 +303,14 @@ def floor_as_read(ctx: Context, state: State) -> State:
 
 def describe_residual(searched: Residual, bearings=(), res: Residual | None = None, changes: bool = False,
                       carriers=(), known_sidebands=()) -> list:
-    """The records of the final model's residual on ``searched`` (the detectors of :mod:`.describe_structure` and
-    :mod:`.describe_lines`), each with its share of the misplaced power and its level measured on ``res`` (default
-    ``searched``: the same runs and bands).  ``changes``: the run-to-run change read on ``res`` (the data as given:
-    the records the search read had the changed runs' factor taken out, :func:`run_steps`).  ``carriers``: the fixed
-    lines found before the search (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands
-    taken out with them."""
+    """The records of the final model's residual on ``searched`` (the detectors of the describe_* modules), each with
+    its share of the misplaced power and its level measured on ``res`` (default ``searched``: the same runs and bands).
+    ``changes``: the run-to-run change read on ``res`` (the data as given: the records the search read had the changed
+    runs' factor taken out, :func:`run_steps`).  ``carriers``: the fixed lines found before the search
+    (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands taken out with them."""
     from .describe_carrier import measure_track, on_a_sideband, sideband_lines, sideband_tracks
     from .describe_drift import with_drifts
+    from .describe_filter import frequency_response
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded, channel_gain
     from .describe_lines import speed_lines
@@ -397,8 +397,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += split_mode(ctx, state, of_line)
     # one channel of a radial pair recorded later than the other (its lines' x/y phase off a quarter turn ∝ f)
     out += channel_skew(ctx, state, of_line)
-    # a gain common to the channels that changes with speed, on the recorded channels too
-    out += gain_trend(ctx, as_recorded(searched.state), of_line)
+    # a gain common to the channels that changes with speed, on the recorded channels too; one of the line's frequency
+    out += gain_trend(ctx, recorded := as_recorded(searched.state), of_line) + frequency_response(ctx, recorded, of_line)
     # a line whose ratio drifts with the speed (a cage slipping), and what its fixed-ratio model line made of it
     return with_drifts(ctx, state, out, of_line)
 
@@ -459,7 +459,7 @@ def cells_of(u, res: Residual) -> dict:
     that changes with speed (``gain_trend``) the bands of its lines in its channels: an amplitude law on one of them
     is that trend read on one line (trial16 tempgain at seed 2: Ω^1.93 on one of 25 lines that share it), and for a
     line whose ratio drifts (``ratio_drift``) the bands between the model's line and the data's (:func:`_drift_cells`)."""
-    if u.signature == "line_property" and u.parameters.get("property") == "gain_trend":
+    if u.signature == "line_property" and u.parameters.get("property") in ("gain_trend", "frequency_response"):
         return _trend_cells(u, res)
     if u.signature == "line_property" and u.parameters.get("property") == "ratio_drift":
         return _drift_cells(u, res)
