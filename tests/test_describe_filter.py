@@ -59,13 +59,17 @@ def test_a_high_pass_is_described_as_one(monkeypatch):
     assert u.parameters["shape"] == "high-pass" and u.parameters["corner_Hz"] == pytest.approx(40.0, rel=0.05)
 
 
-@pytest.mark.parametrize("case", ["noise", "speed_gain", "one_line_law", "one_direction", "one_h"])
+@pytest.mark.parametrize("case", ["noise", "speed_gain", "one_line_law", "one_direction", "one_h", "radial_only",
+                                  "common_law"])
 def test_what_is_no_gain_of_the_frequency_is_not_described(monkeypatch, case):
     """Scatter alone; one gain falling 1 dB per 1000 rpm on every line (a gain trend with speed: the other detector's);
     one line's own amplitude law (Ω^3 on h 9.8 of the radial force: the amplitude_law class's); a filter that reaches
     one direction's lines alone (a chain filter acts on every channel: one direction's lines bending with frequency may
     be a suspension mode's misfit above it); a 'filter' on the lines of one h alone, in two directions (on one h a
-    gain of the frequency is a gain of the speed: a bearing line's own law acts on each of its directions)."""
+    gain of the frequency is a gain of the speed: a bearing line's own law acts on each of its directions); the radial
+    directions bent alike with the axial lines flat at the same frequencies (the force's transfer is in the torque
+    through the height: one mode's misfit bends both); every line departing from Ω² by one law Ω^3 (review: described
+    as a 1-pole low-pass at the corner grid's end before)."""
     def db_of(d, h, rpm, f):
         if case == "speed_gain":
             return -1.0 * rpm / 1000.0
@@ -73,6 +77,10 @@ def test_what_is_no_gain_of_the_frequency_is_not_described(monkeypatch, case):
             return 20.0 * np.log10(rpm / rpm[0]) if (d, h) == ("radial_force", 9.8) else 0.0 * rpm
         if case == "one_direction":
             return _butterworth_db(f, 300.0, 4)
+        if case == "radial_only":       # the radial force and torque bent alike, the axial lines flat beside them
+            return _butterworth_db(f, 600.0, 4) if d.startswith("radial") else 0.0 * rpm
+        if case == "common_law":        # every line Ω^3: below any corner a low-pass is a power of f, one law
+            return 20.0 * np.log10(rpm / rpm[0])
         if case == "one_h":
             return _butterworth_db(f, 500.0, 4) if h == 9.8 else 0.0 * rpm
         return 0.0 * rpm

@@ -19,12 +19,13 @@ corners and orders (:data:`ORDERS`); the best is described when
 
 - it explains the lines' ratios far better than their offsets alone: the residual falls below :data:`MAX_RSS_SHARE`
   of theirs and by more than its two parameters' worth (the Bayesian information criterion),
-- and far better than one common slope against the speed (a gain trend: :data:`MAX_RSS_SHARE` of its residual),
+- and far better than one common slope against the speed or its logarithm (a gain trend, a common Ω^p law:
+  :data:`MAX_RSS_SHARE` of the lesser residual), its corner inside the grid (at an end the magnitude is a power of f),
 - it changes the lines by :data:`MIN_CHANGE_DB` or more over the frequencies read,
 - and the lines it moves (:data:`LINE_CHANGE_DB` or more over their own runs) are :data:`MIN_LINES` or more, of two
   harmonic numbers or more (on lines of one h a gain of the frequency is one of the speed: a bearing line's own
-  amplitude law on every direction), in :data:`MIN_DIRECTIONS` load directions or more, and each of those fits
-  better with it than without.
+  amplitude law on every direction), in :data:`MIN_DIRECTIONS` load directions or more, each of those fitting better
+  with it than without, and fewer than half as many lines it would move that fit worse with it (they contradict it).
 """
 from __future__ import annotations
 
@@ -68,7 +69,7 @@ def frequency_response(ctx, state, shares) -> list:
     (:func:`rwadist.diagnose.describe_gain.as_recorded`), ``shares(chans, hs, runs)`` -> (share of the misplaced power,
     level dB) of the lines' cells."""
     runs = ctx.runs
-    read = [x for x in _lines(ctx, state, runs) if np.all(x[4] > 0)]
+    read = [x for x in _lines(ctx, state, runs) if np.all(x[4] > 0) and np.all(np.isfinite(x[5]))]
     if len(read) < MIN_LINES:
         return []
     f = np.concatenate([x[4] for x in read])
@@ -76,9 +77,11 @@ def frequency_response(ctx, state, shares) -> list:
     line = np.repeat(np.arange(len(read)), [x[4].size for x in read])
     onehot, count = line_indicator(line)
     rss0 = float(offset_free_sse(db[None, :], onehot, count)[0])
-    _, rss_speed = _pooled([x[3] / 1000.0 for x in read], [x[5] for x in read])
     if not rss0 > 0:
         return []
+    # one common slope against the speed, and one against its logarithm (a common Ω^p law)
+    rss_speed = min(_pooled([x[3] / 1000.0 for x in read], [x[5] for x in read])[1],
+                    _pooled([np.log(x[3]) for x in read], [x[5] for x in read])[1])
     corners = np.geomspace(0.2 * f.min(), 5.0 * f.max(), N_CORNERS)
     best = (np.inf, 0.0, 0, True)
     for low in (True, False):
@@ -88,6 +91,8 @@ def frequency_response(ctx, state, shares) -> list:
             if sse[i] < best[0]:
                 best = (float(sse[i]), float(corners[i]), order, low)
     rss_f, corner, order, low = best
+    if not corners[0] < corner < corners[-1]:
+        return []       # at the grid's end the magnitude is a power of f: one common Ω^p law, not a corner (review)
     # the corner to a fraction of a per cent: a finer grid over the coarse one's step on either side of the best
     step = float(corners[1] / corners[0])
     fine = corner * np.geomspace(1.0 / step, step, N_FINE)
@@ -103,14 +108,19 @@ def frequency_response(ctx, state, shares) -> list:
     change = float(g.max() - g.min())
     if change < MIN_CHANGE_DB:
         return []
-    # the lines it moves, each fitted better with it than by its own offset alone
-    moved = []
+    # the lines it moves, each fitted better with it than by its own offset alone; those it would move that fit worse
+    # with it contradict it (a chain filter bends every channel's lines at a frequency: review, the radial force and
+    # torque bent alike by one mode's misfit while the axial lines at the same frequencies stay flat)
+    moved, against = [], 0
     for k, x in enumerate(read):
         gk, dk = g[line == k], x[5]
-        if np.ptp(gk) >= LINE_CHANGE_DB and np.sum((dk - gk - np.mean(dk - gk)) ** 2) < np.sum((dk - dk.mean()) ** 2):
-            moved.append(x)
+        if np.ptp(gk) >= LINE_CHANGE_DB:
+            if np.sum((dk - gk - np.mean(dk - gk)) ** 2) < np.sum((dk - dk.mean()) ** 2):
+                moved.append(x)
+            else:
+                against += 1
     directions = sorted({x[0] for x in moved})
-    if len(moved) < MIN_LINES or len(directions) < MIN_DIRECTIONS or len({x[1] for x in moved}) < 2:
+    if 2 * against >= len(moved) or len(moved) < MIN_LINES or len(directions) < MIN_DIRECTIONS or len({x[1] for x in moved}) < 2:
         return []       # lines of one h alone: a gain of their frequency is one of the speed (their source's law)
     chans = tuple(c for c in ctx.channels if any(c in DIRECTION_CHANNELS[d] for d in directions))
     read_h = sorted({x[1] for x in moved})
