@@ -149,3 +149,9 @@ def test_beside_trend_none_below_the_change_tested_or_when_no_more_modes_are_loc
         return _efit(test, ["rocking"]), None
     assert beside_trend(_ctx(), test, SimpleNamespace(spectra=SimpleNamespace(nperseg=1024)), efit, None, None,
                         never) is None
+    # no mode located: the lines' residuals hold the resonances themselves, no gain of the chain is read from them
+    # (the stand-in would locate the modes on the corrected records: it is never asked)
+    none = _efit(test, ["radial_translation", "rocking", "axial"])
+    assert beside_trend(_ctx(), test, SimpleNamespace(spectra=SimpleNamespace(nperseg=1024)), none, None, None,
+                        _locate(calls)) is None
+    assert not calls

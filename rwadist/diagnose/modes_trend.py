@@ -75,14 +75,18 @@ def beside_trend(ctx, test, fit, efit, stand_start, near, locate):
     (:func:`common_trend` of ``efit``, the modes located on ``test`` as it is, whose empirical fit is ``fit``):
     each run's records by (|Ω|/Ω_g)^δ, Ω_g the runs' geometric mean speed.  None when the trend changes the lines'
     power by less than :data:`rwadist.diagnose.describe_trend.MIN_CHANGE_DB` over the speed range, a run has no
-    speed, or the corrected records locate no more modes than ``efit``."""
+    speed, or the corrected records locate no more modes than ``efit``; None too when ``efit`` locates no mode: the
+    trend is read on the lines the located modes fit, and with none located each line's residual holds the
+    resonances themselves (a hard-mounted wheel on a fixture: every mode above the band, the stand's skirt read as
+    a 'gain' and the modes located again three times over for nothing, 41 of its diagnosis's 63 s)."""
     from ..empirical import fit_empirical
+    from ..extended_fit import UNCONSTRAINED_NAME
     from ..spectra import compute_spectra
     from .describe import scale_runs
     from .describe_trend import MIN_CHANGE_DB
 
     speed = np.abs(np.asarray(test.speeds, dtype=float))
-    if not np.all(speed > 0):
+    if not np.all(speed > 0) or set(UNCONSTRAINED_NAME.values()) <= set(efit.unconstrained):
         return None
     lw = np.log(speed)
     total, last = 0.0, efit
