@@ -7,6 +7,7 @@ low and the rocking mode's damping 0.018 for 0.025, and nothing said why.  Here 
 (closed form: the Butterworth magnitude itself) and on the robustness matrix's family wheels through the same filter
 (tests/test_describe_gain_trend.py's filter cells)."""
 import importlib
+import re
 from types import SimpleNamespace
 
 import numpy as np
@@ -35,7 +36,7 @@ def _described(monkeypatch, db_of, seed=0, lines=LINES):
         f = h * RPM / 60.0
         db = db_of(d, h, RPM, f) + rng.uniform(-3, 3) + 0.05 * rng.standard_normal(RPM.size)
         read.append((d, h, np.arange(RPM.size), RPM, f, db, False))
-    monkeypatch.setattr(describe_filter, "_lines", lambda ctx, state, runs: read)
+    monkeypatch.setattr(describe_filter, "read_lines", lambda ctx, state, runs: read)
     ctx = SimpleNamespace(runs=np.arange(RPM.size), omega=RPM * 2 * np.pi / 60.0,
                           channels=("Fx", "Fy", "Fz", "Tx", "Ty", "Tz"))
     return describe_filter.frequency_response(ctx, None, lambda chans, hs, runs: (0.1, 0.0))
@@ -52,6 +53,9 @@ def test_a_low_pass_on_every_channel_is_described_with_its_corner_and_order(monk
     assert p["edge_Hz"] == pytest.approx(edge) and p["loss_dB_at_edge"] == pytest.approx(
         -_butterworth_db(edge, corner, order), abs=0.3)
     assert set(p["directions"]) >= {"radial_force", "axial_force"} and {"Fx", "Fz"} <= set(u.channels)
+    # the causes name where the fitted magnitude takes 1 dB (half the corner for one pole only: review39)
+    f_1db = float(re.search(r"above ([0-9.]+) Hz \(where it takes 1 dB\)", u.causes[0]).group(1))
+    assert -_butterworth_db(f_1db, p["corner_Hz"], order) == pytest.approx(1.0, abs=0.02)
 
 
 def test_a_high_pass_is_described_as_one(monkeypatch):

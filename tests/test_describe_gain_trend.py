@@ -210,7 +210,7 @@ def test_a_law_fitted_to_the_trend_is_read_against_omega_squared(monkeypatch):
     monkeypatch.setattr(dt, "_direction_powers", lambda ctx, state, d, runs: (
         None if d not in rows else (np.array(rows[d][0]), rows[d][1], rows[d][2], rows[d][3], rows[d][4])))
     ctx = SimpleNamespace(omega=om)
-    got = dt._lines(ctx, None, np.arange(rpm.size))
+    got = dt.read_lines(ctx, None, np.arange(rpm.size))
     assert [(x[1], x[6]) for x in got] == [(1.0, True), (2.0, False), (3.0, False)]
     law_db, free_db = got[0][5], got[1][5]
     assert np.ptp(law_db - free_db) < 1e-9                            # the same ratios but a constant

@@ -33,7 +33,7 @@ def _ctx():
 
 
 def _draw(rng, sds, ns):
-    """[(direction, h, runs, rpm, f Hz, dB, has a law)] as :func:`describe_trend._lines` gives them: each line on
+    """[(direction, h, runs, rpm, f Hz, dB, has a law)] as :func:`describe_trend.read_lines` gives them: each line on
     ``n`` runs spread over the whole range."""
     out = []
     for (d, h), sd, n in zip(LINES, sds, ns):
@@ -47,16 +47,16 @@ def _draw(rng, sds, ns):
 def _records(gen, n: int, seed: int = 0) -> np.ndarray:
     rng = np.random.default_rng(seed)
     ctx, out = _ctx(), []
-    orig = dt._lines
+    orig = dt.read_lines
     try:
         for _ in range(n):
             lines = _draw(rng, *gen)
-            dt._lines = lambda ctx, state, runs, lines=lines: lines
+            dt.read_lines = lambda ctx, state, runs, lines=lines: lines
             (u,) = dt.gain_trend(ctx, None, lambda chans, hs, runs: (0.5, 1.0))
             p = u.parameters
             out.append((p["slope_dB_per_krpm"], p["slope_stderr_dB_per_krpm"], p["change_dB"]))
     finally:
-        dt._lines = orig
+        dt.read_lines = orig
     return np.array(out)
 
 

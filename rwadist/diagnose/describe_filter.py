@@ -11,7 +11,7 @@ trial, session 39: the C of the 9.8 lines 25-27 % low, the rocking mode's ζ 0.0
 the search named an amplitude law on one line or nothing.  :mod:`rwadist.diagnose.describe_trend` reads the same
 lines' ratios and leaves a gain of the frequency to this detector (its ``FILTER_RSS_RATIO``).
 
-The lines read are :func:`rwadist.diagnose.describe_trend._lines`' (every direction, pairs' powers summed, the lines
+The lines read are :func:`rwadist.diagnose.describe_trend.read_lines`' (every direction, pairs' powers summed, the lines
 standing 10 dB over the noise in 6 runs or more over 40 % of the speed range, a line's own law put back).  Their
 ratios 10·log10(P/P̂) are fitted with each line's own offset and one common gain of the frequency G(f), a
 Butterworth-like magnitude (low-pass −10·log10(1 + (f/f_c)^2n), high-pass −10·log10(1 + (f_c/f)^2n)) over a grid of
@@ -32,8 +32,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..units import DIRECTION_CHANNELS
-from .describe_trend import _lines, _pooled
-from .line_offsets import line_indicator, offset_free_sse
+from .describe_trend import pooled_slope, read_lines
+from .line_offsets import line_indicator, offset_free_sse, per_line_sse
 from .unexplained import Unexplained
 
 #: Filter orders tried (poles of a Butterworth-like magnitude)
@@ -69,7 +69,7 @@ def frequency_response(ctx, state, shares) -> list:
     (:func:`rwadist.diagnose.describe_gain.as_recorded`), ``shares(chans, hs, runs)`` -> (share of the misplaced power,
     level dB) of the lines' cells."""
     runs = ctx.runs
-    read = [x for x in _lines(ctx, state, runs) if np.all(x[4] > 0) and np.all(np.isfinite(x[5]))]
+    read = [x for x in read_lines(ctx, state, runs) if np.all(x[4] > 0) and np.all(np.isfinite(x[5]))]
     if len(read) < MIN_LINES:
         return []
     f = np.concatenate([x[4] for x in read])
@@ -80,8 +80,8 @@ def frequency_response(ctx, state, shares) -> list:
     if not rss0 > 0:
         return []
     # one common slope against the speed, and one against its logarithm (a common Ω^p law)
-    rss_speed = min(_pooled([x[3] / 1000.0 for x in read], [x[5] for x in read])[1],
-                    _pooled([np.log(x[3]) for x in read], [x[5] for x in read])[1])
+    rss_speed = min(pooled_slope([x[3] / 1000.0 for x in read], [x[5] for x in read])[1],
+                    pooled_slope([np.log(x[3]) for x in read], [x[5] for x in read])[1])
     corners = np.geomspace(0.2 * f.min(), 5.0 * f.max(), N_CORNERS)
     best = (np.inf, 0.0, 0, True)
     for low in (True, False):
@@ -111,16 +111,14 @@ def frequency_response(ctx, state, shares) -> list:
     # the lines it moves, each fitted better with it than by its own offset alone; those it would move that fit worse
     # with it contradict it (a chain filter bends every channel's lines at a frequency: review, the radial force and
     # torque bent alike by one mode's misfit while the axial lines at the same frequencies stay flat)
-    moved, against = [], 0
-    for k, x in enumerate(read):
-        gk, dk = g[line == k], x[5]
-        if np.ptp(gk) >= LINE_CHANGE_DB:
-            if np.sum((dk - gk - np.mean(dk - gk)) ** 2) < np.sum((dk - dk.mean()) ** 2):
-                moved.append(x)
-            else:
-                against += 1
+    starts = np.r_[0, np.cumsum(count[:-1])].astype(int)          # the lines' points lie one line after the other
+    reach = np.maximum.reduceat(g, starts) - np.minimum.reduceat(g, starts) >= LINE_CHANGE_DB
+    better = per_line_sse(db - g, onehot, count) < per_line_sse(db, onehot, count)
+    moved = [x for x, r, b in zip(read, reach, better) if r and b]
+    against = int(np.sum(reach & ~better))
     directions = sorted({x[0] for x in moved})
-    if 2 * against >= len(moved) or len(moved) < MIN_LINES or len(directions) < MIN_DIRECTIONS or len({x[1] for x in moved}) < 2:
+    if 2 * against >= len(moved) or len(moved) < MIN_LINES or len(directions) < MIN_DIRECTIONS \
+            or len({x[1] for x in moved}) < 2:
         return []       # lines of one h alone: a gain of their frequency is one of the speed (their source's law)
     chans = tuple(c for c in ctx.channels if any(c in DIRECTION_CHANNELS[d] for d in directions))
     read_h = sorted({x[1] for x in moved})
@@ -132,6 +130,9 @@ def frequency_response(ctx, state, shares) -> list:
     where = "above" if low else "below"
     edge = float(f_moved.max() if low else f_moved.min())
     loss = -float(_gain_db(np.array([edge]), np.array([corner]), order, low)[0, 0])
+    # 10·log10(1 + x^(2n)) = 1 dB at x = (10^0.1 − 1)^(1/2n): f_c/2 for one pole, 0.85·f_c for four
+    x_1db = (10.0 ** 0.1 - 1.0) ** (1.0 / (2 * order))
+    f_1db = corner * x_1db if low else corner / x_1db
     return [Unexplained(
         signature="line_property", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
         f_Hz=(float(f_moved.min()), float(f_moved.max())), level_dB=-loss, share=share, n_runs=int(used.size),
@@ -145,8 +146,8 @@ def frequency_response(ctx, state, shares) -> list:
                 f"frequency in every direction ({', '.join(directions)}) whatever the speed: "
                 + ("the data acquisition's anti-alias filter, or the load-cell amplifier's bandwidth" if low else
                    "a charge amplifier's or an AC-coupled input's high-pass")
-                + f"; the model's lines {where} about {corner / 2 if low else 2 * corner:.4g} Hz are read "
-                  "low (their C's take the mean loss) and the suspension modes' damping near them bends to it",),
+                + f"; the model's lines {where} {f_1db:.4g} Hz (where it takes 1 dB) are read low (their C's take "
+                  "the mean loss) and the suspension modes' damping near them bends to it",),
         would_tell="the data acquisition's filter settings (type, corner, order) and the amplifier's bandwidth; the "
                    "same test recorded with the filter off or at a higher sample rate; a calibration of the chain with "
                    "a shaker at known frequencies")]

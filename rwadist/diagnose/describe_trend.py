@@ -92,7 +92,7 @@ def _slope(x: np.ndarray, y: np.ndarray) -> float:
     return float(np.dot(xc, y - y.mean()) / np.dot(xc, xc))
 
 
-def _pooled(xs: list, ys: list) -> tuple:
+def pooled_slope(xs: list, ys: list) -> tuple:
     """(common slope, residual sum of squares) of y = a_l + s·x over the lines (each its own offset a_l)."""
     xc = [x - x.mean() for x in xs]
     yc = [y - y.mean() for y in ys]
@@ -155,7 +155,7 @@ def _line_slope_se(x: np.ndarray, y: np.ndarray) -> float:
     return float(np.sqrt(np.dot(r, r) / max(x.size - 2, 1) / sxx)) if sxx > 0 else np.inf
 
 
-def _lines(ctx, state, runs: np.ndarray) -> list:
+def read_lines(ctx, state, runs: np.ndarray) -> list:
     """[(direction, h, runs (n,), rpm (n,), f_Hz (n,), dB (n,), has a law)] of the model's lines read
     (:data:`LINE_SNR_DB`, :data:`MIN_RUNS`, :data:`MIN_SPAN`), per direction
     (:func:`_direction_powers`): each line's runs (indices into the context's), speeds, frequencies,
@@ -190,7 +190,7 @@ def gain_trend(ctx, state, shares) -> list:
     with one slope against the speed (a gain common to the channels that changes with speed), else []; ``state`` read
     as recorded (:func:`rwadist.diagnose.describe_gain.as_recorded`), ``shares(chans, hs, runs)`` -> (share of the
     misplaced power, level dB) of the lines' cells.  A line with an amplitude law of its own is read with the law put
-    back (:func:`_lines`: the search gave the 1x lines of three directions Ω^1.93 on family wheel 4 with the gain
+    back (:func:`read_lines`: the search gave the 1x lines of three directions Ω^1.93 on family wheel 4 with the gain
     below, their ratios against the law flat); the record's cells hold the lines read whose slopes the trend does
     not contradict, laws included (:func:`rwadist.diagnose.describe.cells_of`: a law fitted to the trend is taken
     back)."""
@@ -200,7 +200,7 @@ def gain_trend(ctx, state, shares) -> list:
     rpm_all = np.abs(ctx.omega[runs]) * RAD_S_TO_RPM
     if not np.ptp(rpm_all) > 0:
         return []          # every run at one speed: no slope against the speed to read
-    read = _lines(ctx, state, runs)
+    read = read_lines(ctx, state, runs)
     # each line's slope and its standard error; the slopes of the lines that resolve the change tested decide
     slopes_read = np.array([_slope(x[3] / 1000.0, x[5]) for x in read])
     se_read = np.array([_line_slope_se(x[3] / 1000.0, x[5]) for x in read])
@@ -232,8 +232,8 @@ def gain_trend(ctx, state, shares) -> list:
         return []
     # the speed against the line's frequency: one common slope each, every line its own offset
     d_all = [x[5] for x in lines]
-    s_speed, rss_speed = _pooled([x[3] / 1000.0 for x in lines], d_all)
-    s_freq, rss_freq = _pooled([x[4] / 1000.0 for x in lines], d_all)
+    s_speed, rss_speed = pooled_slope([x[3] / 1000.0 for x in lines], d_all)
+    s_freq, rss_freq = pooled_slope([x[4] / 1000.0 for x in lines], d_all)
     if rss_freq < FILTER_RSS_RATIO * rss_speed:
         return []          # a gain that depends on the line's frequency (a filter): not a gain trend with speed
     apart = rss_speed <= rss_freq

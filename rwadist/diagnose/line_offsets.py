@@ -18,3 +18,10 @@ def offset_free_sse(res: np.ndarray, onehot: np.ndarray, count: np.ndarray) -> n
     (``onehot``, ``count``: :func:`line_indicator`), shape (K,)."""
     e = res - ((res @ onehot.T) / count) @ onehot
     return np.sum(e * e, axis=1)
+
+
+def per_line_sse(res: np.ndarray, onehot: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """Per line, Σ of the squared residuals ``res`` (N,) dB about the line's own mean (``onehot``, ``count``:
+    :func:`line_indicator`), shape (L,)."""
+    e = res - ((onehot @ res) / count) @ onehot
+    return onehot @ (e * e)
