@@ -306,6 +306,26 @@ def _joint_from(test, fit, start, kwargs):
     return fit_extended(test, fit, stand=stand, fit_stand=True, **kwargs)
 
 
+def _joint_once(memo: dict | None, test, fit, start, kwargs):
+    """:func:`_joint_from` of ``test``, ``fit``, ``start``, ``kwargs``, made once per ``memo`` (None: every time): a
+    fresh copy of the kept fit each time (its readers add notes and declare modes on it)."""
+    if memo is None:
+        return _joint_from(test, fit, start, kwargs)
+    key = (tuple(float(v) for v in start), repr(sorted(kwargs.items())))
+    if key not in memo:
+        memo[key] = _joint_from(test, fit, start, kwargs)
+    return fresh_copy(memo[key])
+
+
+def fresh_copy(efit):
+    """A copy of the :class:`~rwadist.extended_fit.ExtendedFit` ``efit`` whose lists and dicts are its own (the
+    arrays and line fits, never changed by a reader, shared)."""
+    from dataclasses import fields, replace
+
+    return replace(efit, **{f.name: type(v)(v) for f in fields(efit)
+                            if isinstance(v := getattr(efit, f.name), (list, dict))})
+
+
 #: A stand fitted with the modes is kept when it lowers the fit's cost beyond the Bayesian information criterion of
 #: its parameters: n·ln(SSR_without / SSR_with) > STAND_PARAMETERS·ln n
 STAND_PARAMETERS = 4
@@ -386,7 +406,8 @@ def same_stand(a: tuple | None, b: tuple | None) -> bool:
 
 
 def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, starts: list | None = None,
-                              near: dict | None = None, near_stand: tuple | None = None, **kwargs):
+                              near: dict | None = None, near_stand: tuple | None = None, joints: dict | None = None,
+                              **kwargs):
     """:func:`rwadist.extended_fit.fit_extended` of ``test`` (empirical fit ``fit``; ``kwargs`` passed on) with a
     fixture resonance fitted jointly with the wheel's modes, never into them.
 
@@ -406,7 +427,11 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
     lines put the modes, and a scan started near the modes of the other hypothesis can settle inside that window on a
     point of its own (family wheel 7, a stand at 195 Hz on its 130 Hz rocking mode: the fit runs saw no stand and put
     the rocking at 265 Hz, I_zz/I_rr 2.8; every run's joint fit scanned from there stayed at 247 Hz, 2.8, and the
-    rocking was declared; scanned over its whole range, 129.7 Hz, 2.10)."""
+    rocking was declared; scanned over its whole range, 129.7 Hz, 2.10).
+
+    ``joints``: a dict kept by the caller for this ``test`` and ``fit`` (the same data and empirical fit), holding the
+    joint fit from each start already made with the same arguments: asked again (the stands of every run, then the
+    refit of the modes on every run, from the same starts), the same fit is not made twice."""
     from .extended_fit import fit_extended
 
     def near_beside(stand):
@@ -426,7 +451,7 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
     # 10.06, below the 70.07 Hz ζ 0.042 gain 4.05 of the first (10.45), and no stand was kept; which of the two that
     # start reaches turns on the smallest change of the rows (the 300-rpm radial imbalance row scaled by 0.9-1.1:
     # 70.1 Hz at 0.9, 0.95, 1.05, 1.1; 83-87 Hz, ζ 0.3 at 0.8, 1.0, 1.25)
-    joints = [_joint_from(test, fit, s, {**kwargs, **near_beside(s)}) for s in full]
+    joints = [_joint_once(joints, test, fit, s, {**kwargs, **near_beside(s)}) for s in full]
     confirmed = [j for j in joints if stand_confirmed(j, plain)]
     if not confirmed:
         return plain

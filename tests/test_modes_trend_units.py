@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from rwadist.data import Run, SteadyTest
-from rwadist.diagnose.modes_trend import beside_trend, common_trend
+from rwadist.diagnose.modes_trend import SETTLED_DB, beside_trend, common_trend
 from rwadist.empirical import LineFit
 from rwadist.extended_fit import _axial_measurements, _radial_power
 
@@ -145,10 +145,16 @@ def test_beside_trend_none_below_the_change_tested_or_when_no_more_modes_are_loc
     test = _test(DELTA)
     efit = _efit(test, ["rocking"])
 
+    asked: list = []
+
     def never(ctx, test, fit, stand_start, near):
+        asked.append(test)
         return _efit(test, ["rocking"]), None
     assert beside_trend(_ctx(), test, SimpleNamespace(spectra=SimpleNamespace(nperseg=1024)), efit, None, None,
                         never) is None
+    # the records corrected once hold the generator's C·Ω²: the trend read again on them adds less than SETTLED_DB,
+    # and no second location is asked of records that would not change
+    assert len(asked) == 1 and abs(common_trend(_efit(asked[0], ["rocking"]))[1]) < SETTLED_DB
     # no mode located: the lines' residuals hold the resonances themselves, no gain of the chain is read from them
     # (the stand-in would locate the modes on the corrected records: it is never asked)
     none = _efit(test, ["radial_translation", "rocking", "axial"])

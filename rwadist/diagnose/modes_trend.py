@@ -38,6 +38,10 @@ MIN_LINE_ROWS = 4
 #: the trend bent reads it off: family wheel 7, seed 706, the held-out runs read -0.56 dB, then -0.10 dB more beside
 #: the corrected modes, and located the rocking mode at -0.66 dB, the gain's -0.65)
 TREND_ROUNDS = 3
+#: a round whose trend read again adds less than this (dB of power over the speed range; a tenth of the open world's
+#: smallest ``gain_trend``) corrects records the last round already located the modes on: no round follows (family
+#: wheel 7 with a stand and a load-cell offset: -0.62 dB, then -0.047, then -0.0036 dB and a third location for it)
+SETTLED_DB = 0.03
 
 
 def common_trend(efit) -> tuple[float, float]:
@@ -75,7 +79,8 @@ def beside_trend(ctx, test, fit, efit, stand_start, near, locate):
     (:func:`common_trend` of ``efit``, the modes located on ``test`` as it is, whose empirical fit is ``fit``):
     each run's records by (|Ω|/Ω_g)^δ, Ω_g the runs' geometric mean speed.  None when the trend changes the lines'
     power by less than :data:`rwadist.diagnose.describe_trend.MIN_CHANGE_DB` over the speed range, a run has no
-    speed, or the corrected records locate no more modes than ``efit``; None too when ``efit`` locates no mode: the
+    speed, or the corrected records locate no more modes than ``efit`` (rounds stop once the trend read again adds
+    less than :data:`SETTLED_DB`); None too when ``efit`` locates no mode: the
     trend is read on the lines the located modes fit, and with none located each line's residual holds the
     resonances themselves (a hard-mounted wheel on a fixture: every mode above the band, the stand's skirt read as
     a 'gain' and the modes located again three times over for nothing, 41 of its diagnosis's 63 s)."""
@@ -94,6 +99,8 @@ def beside_trend(ctx, test, fit, efit, stand_start, near, locate):
         delta, change = common_trend(last)
         if last is efit and not abs(change) >= MIN_CHANGE_DB:
             return None
+        if last is not efit and not abs(change) >= SETTLED_DB:
+            return None         # read again beside the modes it gave, the trend no longer moves: they stay as located
         total += delta
         db = 20.0 / np.log(10.0) * total * (lw - lw.mean())
         test_t = scale_runs(test, {i: float(v) for i, v in enumerate(db)})

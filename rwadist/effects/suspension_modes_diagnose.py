@@ -208,7 +208,8 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
     # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows
     starts = [stand_start] if stand_start is not None else \
         (_stand_starts_once(ctx, fit) or _stand_starts_once(ctx, _whole_data_fit(ctx)))
-    efit = fit_extended_beside_stand(test, fit, starts=starts, near=near, near_stand=stand_start)
+    efit = fit_extended_beside_stand(test, fit, starts=starts, near=near, near_stand=stand_start,
+                                     joints=_joints_memo(ctx, test, fit))
     own = ((efit.stand,) if efit.stand is not None else ()) + tuple(efit.more_stands)
     if stand_start is None and (not own or stand_starts(_whole_data_fit(ctx), known=own)):
         # every run may show a stand (or another one) these runs do not resolve; ``near`` came from a fit without a
@@ -217,6 +218,20 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
         if held is not None:
             efit = held
     return efit, efit.stand
+
+
+def _joints_memo(ctx: Context, test, fit) -> dict:
+    """The joint fits of the modes and a stand made on ``test`` (empirical fit ``fit``), by start
+    (:func:`rwadist.stand_resonance.fit_extended_beside_stand`'s ``joints``), kept for the diagnosis: the stands of
+    every run (:func:`_whole_data_stands`) and the refit of the modes on every run start from the same stands of the
+    same data and fit.  Kept with the fit and the runs they were made of, so a fit of other data is never served."""
+    key = ("suspension_modes.joints", id(fit))
+    runs = tuple(id(r) for r in test.runs)
+    meta = repr(sorted(test.meta.items()))
+    kept = ctx._memo.get(key)
+    if kept is None or kept[0] is not fit or kept[1] != runs or kept[2] != meta:
+        kept = ctx._memo[key] = (fit, runs, meta, test.runs, {})
+    return kept[4]
 
 
 def _stand_starts_once(ctx: Context, fit) -> list:
@@ -276,7 +291,8 @@ def _whole_data_stands(ctx: Context) -> tuple:
         if starts:
             test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], _recorded_meta(ctx))
             try:
-                efit = fit_extended_beside_stand(test, whole_fit, starts=starts)
+                efit = fit_extended_beside_stand(test, whole_fit, starts=starts,
+                                                 joints=_joints_memo(ctx, test, whole_fit))
             except ValueError:
                 efit = None
             if efit is not None and efit.stand is not None:
