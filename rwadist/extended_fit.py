@@ -154,6 +154,18 @@ class ExtendedFit:
         tol = ext.IMBALANCE_H_TOL if abs(h - 1.0) <= ext.IMBALANCE_H_TOL else 1e-6
         return [ln for ln in self.lines if ln.direction == direction and abs(ln.h - h) <= tol]
 
+    def fresh_copy(self) -> "ExtendedFit":
+        """A copy whose lists and dicts are its own (notes, declared modes, ...: what a reader adds to); the arrays
+        and line fits, which no reader changes, shared."""
+        import copy
+        from dataclasses import fields
+
+        out = copy.copy(self)
+        for f in fields(self):
+            if isinstance(v := getattr(self, f.name), (list, dict)):
+                setattr(out, f.name, type(v)(v))
+        return out
+
 
 # --------------------------------------------------------------------------- 1. senses
 

@@ -207,13 +207,20 @@ def _fit_on_lines(by_line: dict, f_s: float):
     lf = np.log(f / f_s)
     rows = np.arange(f.size)
 
+    last: dict = {}
+
     def res_jac(x):
-        lg, d = general_log_power_gain(f, float(np.exp(x[0])), float(np.exp(x[1])), float(x[2]), float(x[3]))
-        J = np.zeros((f.size, x.size))
-        J[:, :4] = -d
-        J[rows, 4 + line] = -1.0
-        J[rows, 4 + n_line + which] = -lf
-        return y - x[4 + line] - x[4 + n_line + which] * lf - lg, J
+        # scipy asks the residuals, then the Jacobian at the same point: both made once (a copy of each handed out:
+        # the robust loss scales what it is given in place)
+        key = x.tobytes()
+        if last.get("x") != key:
+            lg, d = general_log_power_gain(f, float(np.exp(x[0])), float(np.exp(x[1])), float(x[2]), float(x[3]))
+            J = np.zeros((f.size, x.size))
+            J[:, :4] = -d
+            J[rows, 4 + line] = -1.0
+            J[rows, 4 + n_line + which] = -lf
+            last.update(x=key, r=y - x[4 + line] - x[4 + n_line + which] * lf - lg, J=J)
+        return last["r"].copy(), last["J"].copy()
 
     n_free = n_line + n_dir
     lb = np.concatenate([[np.log(0.9 * f_s), np.log(1e-3), 0.0, -1.0], np.full(n_free, -np.inf)])
@@ -314,16 +321,7 @@ def _joint_once(memo: dict | None, test, fit, start, kwargs):
     key = (tuple(float(v) for v in start), repr(sorted(kwargs.items())))
     if key not in memo:
         memo[key] = _joint_from(test, fit, start, kwargs)
-    return fresh_copy(memo[key])
-
-
-def fresh_copy(efit):
-    """A copy of the :class:`~rwadist.extended_fit.ExtendedFit` ``efit`` whose lists and dicts are its own (the
-    arrays and line fits, never changed by a reader, shared)."""
-    from dataclasses import fields, replace
-
-    return replace(efit, **{f.name: type(v)(v) for f in fields(efit)
-                            if isinstance(v := getattr(efit, f.name), (list, dict))})
+    return memo[key].fresh_copy()
 
 
 #: A stand fitted with the modes is kept when it lowers the fit's cost beyond the Bayesian information criterion of
@@ -451,8 +449,8 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
     # 10.06, below the 70.07 Hz ζ 0.042 gain 4.05 of the first (10.45), and no stand was kept; which of the two that
     # start reaches turns on the smallest change of the rows (the 300-rpm radial imbalance row scaled by 0.9-1.1:
     # 70.1 Hz at 0.9, 0.95, 1.05, 1.1; 83-87 Hz, ζ 0.3 at 0.8, 1.0, 1.25)
-    joints = [_joint_once(joints, test, fit, s, {**kwargs, **near_beside(s)}) for s in full]
-    confirmed = [j for j in joints if stand_confirmed(j, plain)]
+    fitted = [_joint_once(joints, test, fit, s, {**kwargs, **near_beside(s)}) for s in full]
+    confirmed = [j for j in fitted if stand_confirmed(j, plain)]
     if not confirmed:
         return plain
     joint = min(confirmed, key=joint_cost)

@@ -154,7 +154,7 @@ def test_the_detector_reads_a_common_slope_and_not_a_frequency_one(monkeypatch):
 
     ctx = SimpleNamespace(runs=np.arange(rpm.size), omega=rpm * 2 * np.pi / 60.0, channels=("Fx", "Tx"))
     for of_f, described in ((False, True), (True, False)):
-        monkeypatch.setattr(dt, "_lines", lambda ctx, state, runs, of_f=of_f: lines(of_f))
+        monkeypatch.setattr(dt, "read_lines", lambda ctx, state, runs, of_f=of_f: lines(of_f))
         got = dt.gain_trend(ctx, None, lambda chans, hs, runs: (0.5, 0.0))
         assert bool(got) == described
         if described:

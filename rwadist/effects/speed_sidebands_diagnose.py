@@ -602,7 +602,7 @@ class SpeedSidebands:
     @staticmethod
     def _from_base(state: State, found: list) -> list:
         """The pairs the wheel's ``suspension_modes`` left out of the base it fitted from the data (:func:`rwadist.
-        diagnose.effects.suspension_modes.wheel_base`: close lines measured together on the records, where this
+        diagnose.modes_base.wheel_base`: close lines measured together on the records, where this
         family's own search needs RUN_MIN_BINS record bins from the carrier: 0.94/1.06 x the speed is 1.97 bins at
         2400 rpm on 4096 samples at 5 kHz), as measured there, those the search did not find itself; judged on the
         held-out runs like any."""
