@@ -113,7 +113,8 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     itself is left to the search (a ``fixed_resonance`` of role test_stand proposed from this fit's stand).  A
     load-cell offset the located modes leave in the torques is taken out before the modes are located
     (:func:`_beside_offset`); then, when no stand is kept, a mode of the wheel's structure on one direction is tried
-    beside the modes (on a direction whose mode stays unconstrained, or on the forces when every mode is located:
+    beside the modes (on a direction whose mode stays unconstrained while another is located, or on the forces when
+    every mode is located:
     :func:`rwadist.stand_resonance.fit_extended_beside_structure_mode`): the fit is then that joint fit (its
     ``stand`` on one direction, ``stand_direction``) and the stand None.  The offset first: the torques read r × F
     of the forces' lines amplified by their translation, which a resonance of the torques alone at that frequency
@@ -155,8 +156,11 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             trend = _memo(ctx, key + ("trend",), lambda: beside_trend(ctx, test, fit, efit, stand_start, near, _locate))
             if trend is not None:
                 test, fit, efit, stand = trend
-        if stand is None and len(ctx.channels) > 3:
-            # on an unconstrained mode's direction, or on the forces when every mode is located
+        if stand is None and len(ctx.channels) > 3 and len(efit.unconstrained) < 3:
+            # on an unconstrained mode's direction, or on the forces when every mode is located.  Not when no mode is
+            # located: a resonance of one direction's structure hides that direction's mode, and the others' would
+            # be located beside it (the ithaco-e data of Masterson's modal model, every mode unlocated: 14 of its 48 s
+            # tried it on each direction for nothing)
             def beside_structure(efit=efit):
                 structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
                 if structure is not None and not fixed_across_speeds(lambda part: _test_and_fit(ctx, part),
