@@ -154,6 +154,11 @@ class ExtendedFit:
         tol = ext.IMBALANCE_H_TOL if abs(h - 1.0) <= ext.IMBALANCE_H_TOL else 1e-6
         return [ln for ln in self.lines if ln.direction == direction and abs(ln.h - h) <= tol]
 
+    @property
+    def locates_no_mode(self) -> bool:
+        """True when every suspension mode is declared unconstrained: the data locate none of them."""
+        return set(UNCONSTRAINED_NAME.values()) <= set(self.unconstrained)
+
     def fresh_copy(self) -> "ExtendedFit":
         """A copy whose lists and dicts are its own (notes, declared modes, ...: what a reader adds to); the arrays
         and line fits, which no reader changes, shared."""

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .extended_fit_lsq import LOG_SCATTER
+from .extended_fit_lsq import joint_cost, noise_weighted_cost
 from .resonance import general_log_power_gain, peak_of, resonance
 
 #: Smallest local lift (mean over a direction's lines of the ln power gain near one frequency over the same line's
@@ -268,54 +268,36 @@ JOINT_PASSES = 4
 JOINT_SETTLED_LOG_F = 2e-4
 
 
-def joint_cost(efit) -> float:
-    """Sum of squared log residuals of an extended fit (:attr:`ExtendedFit.line_residuals`): its least squares'
-    cost, every fit of one empirical fit measured on the same rows."""
-    r = np.asarray(efit.line_residuals[1], dtype=float)
-    return float(np.sum(r[np.isfinite(r)] ** 2))
-
-
-def noise_weighted_cost(efit) -> float:
-    """Σ r²/(s² + σ²) over the rows of an extended fit (:attr:`rwadist.extended_fit.ExtendedFit.line_residuals` r,
-    ``line_noise`` σ): each log residual over the scatter its row has about a right model, the noise under the line
-    (σ, the standard deviation of its log amplitude) and the scatter assumed besides it (s,
-    :data:`rwadist.extended_fit_lsq.LOG_SCATTER`, 0.03) -- twice the negative log likelihood of the rows, up to a
-    constant.  The plain cost (:func:`rwadist.stand_resonance.joint_cost`) weighs every row alike, so one line
-    measured at the noise floor can outweigh all the rest: on family wheel 2's fixture pair (stands 70.93 and
-    115.71 Hz, ζ 0.03, gain 5) the stands fitted at once (70.998 Hz ζ 0.0305 gain 4.97; 115.66 Hz ζ 0.0302 gain
-    4.96) cost 0.299 against 0.175 for those fitted one at a time (70.31 Hz ζ 0.0224 gain 6.03; 115.96 Hz ζ 0.0295
-    gain 4.76), and 0.138 of the difference was one row: the axial 2xBPFO line at 197.2 Hz, its log amplitude's
-    noise σ 0.37 (the rows' median 0.028), residual +0.379 against +0.074.  Weighed by their scatter the rows cost
-    37.6 against 56.9, and the stands fitted at once left the error after 2.96x the clean cell's instead of 8.3x.
-    Rows whose noise was not measured (σ 0) weigh 1/s² each; rows whose residual or noise is not a number (a line
-    not measured at that speed) are left out, as the plain cost leaves them."""
-    r = np.asarray(efit.line_residuals[1], dtype=float)
-    sigma = np.asarray(getattr(efit, "line_noise", np.empty(0)), dtype=float)
-    if sigma.shape != r.shape:
-        sigma = np.zeros_like(r)
-    ok = np.isfinite(r) & np.isfinite(sigma)
-    return float(np.sum(r[ok] ** 2 / (LOG_SCATTER**2 + sigma[ok] ** 2)))
-
-
-def _joint_from(test, fit, start, kwargs):
+def _joint_from(test, fit, start, kwargs, settled_at: list | None = None):
     """The extended fit with the stand fitted jointly with the modes, from the stand ``start``: the modes located
     again with each pass's stand divided out until the stand settles (:data:`JOINT_PASSES` at most); ``kwargs``
-    passed on to :func:`rwadist.extended_fit.fit_extended` in every pass."""
+    passed on to :func:`rwadist.extended_fit.fit_extended` in every pass.  ``settled_at``: [(stand, fit)] of the joint
+    fits of the same data, fit and ``kwargs`` that settled (appended to): a pass that reaches one of those stands ends
+    with that fit, as the passes from there would (the Masterson-model E data: three starts at 222-226 Hz settled at
+    one 245.73 Hz)."""
     from .extended_fit import fit_extended
 
-    stand = tuple(start)
+    stand, settled = tuple(start), False
     for _ in range(JOINT_PASSES):
         # every mode the scans locate stays in the passes' least squares (a mode declared loose there leaves the stand
         # alone to explain its lines, and the stand runs off: ζ to its bound, gain 450); declared in the last fit only
         efit = fit_extended(test, fit, stand=stand, fit_stand=True, declare=False, **kwargs)
-        new = efit.stand
-        assert new is not None, "fit_extended with fit_stand=True returns the stand it fitted"
-        settled = abs(np.log(new[0] / stand[0])) < JOINT_SETTLED_LOG_F and \
-            abs(np.log(new[1] / stand[1])) < 10 * JOINT_SETTLED_LOG_F
-        stand = new
+        assert efit.stand is not None, "fit_extended with fit_stand=True returns the stand it fitted"
+        settled, stand = _one_stand(efit.stand, stand), efit.stand
+        reached = next((f for s, f in settled_at or () if _one_stand(stand, s)), None)
+        if reached is not None:
+            return reached
         if settled:
             break
-    return fit_extended(test, fit, stand=stand, fit_stand=True, **kwargs)
+    out = fit_extended(test, fit, stand=stand, fit_stand=True, **kwargs)
+    if settled and settled_at is not None:
+        settled_at.append((stand, out))
+    return out
+
+
+def _one_stand(a: tuple, b: tuple) -> bool:
+    """True when two passes' stands differ by less than the passes settle to (:data:`JOINT_SETTLED_LOG_F`)."""
+    return bool(abs(np.log(a[0] / b[0])) < JOINT_SETTLED_LOG_F and abs(np.log(a[1] / b[1])) < 10 * JOINT_SETTLED_LOG_F)
 
 
 def _joint_once(memo: dict | None, test, fit, start, kwargs):
@@ -325,7 +307,7 @@ def _joint_once(memo: dict | None, test, fit, start, kwargs):
         return _joint_from(test, fit, start, kwargs)
     key = (tuple(float(v) for v in start), repr(sorted(kwargs.items())))
     if key not in memo:
-        memo[key] = _joint_from(test, fit, start, kwargs)
+        memo[key] = _joint_from(test, fit, start, kwargs, memo.setdefault(("settled", key[1]), []))
     return memo[key].fresh_copy()
 
 

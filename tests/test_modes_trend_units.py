@@ -75,7 +75,8 @@ def _efit(test: SteadyTest, unconstrained: list):
     model_r = np.array([measured[j].C for j in lr]) * sr**2 * np.sqrt(2.0)        # x and y each C·Ω²
     r = np.concatenate([np.log(aa / model_a), np.log(np.sqrt(pr) / model_r)])
     return SimpleNamespace(measured=measured, line_residuals=(np.zeros(r.size), r, np.zeros(r.size, str)),
-                           unconstrained=list(unconstrained), notes=[])
+                           unconstrained=list(unconstrained), notes=[],
+                           locates_no_mode={"radial_translation", "rocking", "axial"} <= set(unconstrained))
 
 
 @pytest.mark.parametrize("delta", [-0.05, 0.08])

@@ -160,3 +160,32 @@ def test_a_fixture_the_lines_cross_too_sparsely_to_resolve_is_still_fitted_with_
     got = _mode_hz(efit.params)
     for m, truth in wheel.modes_hz().items():
         assert got[m] == pytest.approx(truth, rel=0.02), m
+
+
+def test_a_start_whose_passes_reach_a_settled_stand_ends_with_that_fit(monkeypatch):
+    """Two starts 1.5 % apart on the new wheel's 230 Hz fixture (transmissibility): the passes from the second reach
+    the stand the first settled at, and end there with the first's fit (the passes from there would be the same)
+    instead of passing on and fitting again.  Second method: the same start with no earlier fit to meet, all its
+    passes made: the same stand, modes and cost to the passes' own settling tolerance, with more fits made."""
+    import rwadist.extended_fit as ef
+    import rwadist.stand_resonance as sr
+
+    test, fit = _fit(sw.NEW_WHEEL, (600.0, 6000.0), [(230.0, ZETA, 1.0, "transmissibility")])
+    made: list = []
+    fit_extended = ef.fit_extended
+    monkeypatch.setattr(ef, "fit_extended", lambda *a, **k: made.append(k.get("declare", True)) or fit_extended(*a, **k))
+    first, second = (230.0, 0.02, 10.0, 0.5), (233.5, 0.02, 10.0, 0.5)
+    memo: dict = {}
+    kept = sr._joint_once(memo, test, fit, first, {})
+    assert memo[("settled", repr([]))], "the first start settles within the passes"
+    n_first = len(made)
+    met = sr._joint_once(memo, test, fit, second, {})
+    n_met = len(made) - n_first
+    alone = sr._joint_from(test, fit, second, {})
+    n_alone = len(made) - n_first - n_met
+    assert n_met < n_alone and made[n_first:n_first + n_met].count(True) == 0      # no final fit of its own
+    assert met.stand == kept.stand and met.params == kept.params and met is not memo[(first, repr([]))]
+    assert np.allclose(alone.stand[:2], met.stand[:2], rtol=2e-3)
+    for m, f_hz in _mode_hz(alone.params).items():
+        assert _mode_hz(met.params)[m] == pytest.approx(f_hz, rel=2e-3), m
+    assert sr.joint_cost(met) == pytest.approx(sr.joint_cost(alone), rel=0.02)

@@ -85,13 +85,12 @@ def beside_trend(ctx, test, fit, efit, stand_start, near, locate):
     resonances themselves (a hard-mounted wheel on a fixture: every mode above the band, the stand's skirt read as
     a 'gain' and the modes located again three times over for nothing, 41 of its diagnosis's 63 s)."""
     from ..empirical import fit_empirical
-    from ..extended_fit import UNCONSTRAINED_NAME
     from ..spectra import compute_spectra
     from .describe import scale_runs
     from .describe_trend import MIN_CHANGE_DB
 
     speed = np.abs(np.asarray(test.speeds, dtype=float))
-    if not np.all(speed > 0) or set(UNCONSTRAINED_NAME.values()) <= set(efit.unconstrained):
+    if not np.all(speed > 0) or efit.locates_no_mode:
         return None
     lw = np.log(speed)
     total, last = 0.0, efit

@@ -156,7 +156,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             trend = _memo(ctx, key + ("trend",), lambda: beside_trend(ctx, test, fit, efit, stand_start, near, _locate))
             if trend is not None:
                 test, fit, efit, stand = trend
-        if stand is None and len(ctx.channels) > 3 and len(efit.unconstrained) < 3:
+        if stand is None and len(ctx.channels) > 3 and not efit.locates_no_mode:
             # on an unconstrained mode's direction, or on the forces when every mode is located.  Not when no mode is
             # located: a resonance of one direction's structure hides that direction's mode, and the others' would
             # be located beside it (the ithaco-e data of Masterson's modal model, every mode unlocated: 14 of its 48 s
@@ -180,7 +180,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
                                                                               beside_structure)
     except ValueError:
         return None
-    if len(efit.unconstrained) == 3:
+    if efit.locates_no_mode:
         return None                     # no mode located: nothing to name
     return test, fit, efit, stand, offset
 
