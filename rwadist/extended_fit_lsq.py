@@ -443,9 +443,9 @@ def noise_weighted_cost(efit) -> float:
     """Σ r²/(s² + σ²) over the rows of an extended fit (:attr:`rwadist.extended_fit.ExtendedFit.line_residuals` r,
     ``line_noise`` σ): each log residual over the scatter its row has about a right model, the noise under the line
     (σ, the standard deviation of its log amplitude) and the scatter assumed besides it (s,
-    :data:`rwadist.extended_fit_lsq.LOG_SCATTER`, 0.03) -- twice the negative log likelihood of the rows, up to a
-    constant.  The plain cost (:func:`joint_cost`) weighs every row alike, so one line
-    measured at the noise floor can outweigh all the rest: on family wheel 2's fixture pair (stands 70.93 and
+    :data:`LOG_SCATTER`, 0.03) -- twice the negative log likelihood of the rows, up to a
+    constant.  The plain cost (:func:`joint_cost`) weighs every row alike, so one line measured at the noise floor
+    can outweigh all the rest: on family wheel 2's fixture pair (stands 70.93 and
     115.71 Hz, ζ 0.03, gain 5) the stands fitted at once (70.998 Hz ζ 0.0305 gain 4.97; 115.66 Hz ζ 0.0302 gain
     4.96) cost 0.299 against 0.175 for those fitted one at a time (70.31 Hz ζ 0.0224 gain 6.03; 115.96 Hz ζ 0.0295
     gain 4.76), and 0.138 of the difference was one row: the axial 2xBPFO line at 197.2 Hz, its log amplitude's

@@ -273,8 +273,8 @@ def _joint_from(test, fit, start, kwargs, settled_at: list | None = None):
     again with each pass's stand divided out until the stand settles (:data:`JOINT_PASSES` at most); ``kwargs``
     passed on to :func:`rwadist.extended_fit.fit_extended` in every pass.  ``settled_at``: [(stand, fit)] of the joint
     fits of the same data, fit and ``kwargs`` that settled (appended to): a pass that reaches one of those stands ends
-    with that fit, as the passes from there would (the Masterson-model E data: three starts at 222-226 Hz settled at
-    one 245.73 Hz)."""
+    with that fit, as the passes from there would (family wheel 0 with a 20/15/150 mm load-cell offset: four starts
+    at 309.8-310.2 Hz, ζ 0.019-0.021, gain 21-82, all at 319.14 Hz, ζ 0.049 after their passes)."""
     from .extended_fit import fit_extended
 
     stand, settled = tuple(start), False
