@@ -59,7 +59,16 @@ from .extended_fit_lsq import (
     recorded_noisy_sensors,
     split_note,
 )
-from .extended_fit_power import CHANNEL_INDEX, RADIAL, LinePower, fitted_senses, forcing_lines, rows_of_lines
+from .extended_fit_power import (
+    CHANNEL_INDEX,
+    RADIAL,
+    SPLIT_UNSEEN,
+    LinePower,
+    fitted_senses,
+    forcing_lines,
+    rows_of_lines,
+    split_from_phase,
+)
 from .geometry import remove_lever_arm
 from .line_senses import ONE_SENSE, ONE_SENSE_RUNS, _line_senses_once, line_senses, one_sense_rows  # noqa: F401
 from .mode_scan import MODE_DIRECTION, scan_mode
@@ -534,6 +543,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     params, fitted_lines = unpack(res.x)
     sums = power_sum_stderr(solution, {(x.direction, float(x.h)): tuple(line_of[j])
                                        for j, x in enumerate(meas.lines) if x.direction in RADIAL})
+    params, fitted_lines, split_se = split_from_phase(params, meas.lines, fitted_lines, line_of, sums, senses_xy)
     n_x = res.x.size - (len(joint.NAMES) if joint is not None else 0)
     notes += [off_law_note(meas.lines[j], res.x[n_x + i - len(off_law)], rel_se[n_x + i - len(off_law)])
               for i, j in enumerate(off_law)]
@@ -541,8 +551,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         stand, more_stands = joint.stand(res.x[n_x:]), joint.more(res.x[n_x:], more_stands)
     params = replace(params, height=float(height))
     senses, kept_lines = fitted_senses(meas.lines, fitted_lines, line_of)
-    # a line the model file keeps both parts of, whose split the power does not see: its parts' errors say little
-    notes += [split_note(d, h, *se) for (d, h), se in sums.items() if se[3] >= 1.0 and senses[(d, h)][0] == "co+counter"]
+    notes += [split_note(d, h, *se) for (d, h), se in sums.items() if se[3] >= SPLIT_UNSEEN and senses[(d, h)][0] == "co+counter"]
     resid_db, line_residuals = _residuals_near_modes(params, lines, ax_line, rad_parts, sa, sr, dr, res.fun, notes)
     for m in (m for m in MODE_PARAMS if declare and starts.identified[m] and resid_db.get(m, 0.0) > MISFIT_DB):
         starts.identified[m] = False
@@ -553,7 +562,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     return ExtendedFit(params=params, lines=kept_lines,
                        zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
                              "axial_translation": params.zeta_z},
-                       rel_stderr={n: float(v) for n, v in zip(names, rel_se)}
+                       rel_stderr={n: float(v) for n, v in zip(names, rel_se)} | split_se
                        | {f"C[{d},{h:g},co+counter]": se[0] for (d, h), se in sums.items()}, identified=starts.identified,
                        peaks=peaks, senses=senses, residual_db=resid_db, notes=_ratio_words(notes, starts.identified), measured=meas.lines,
                        unconstrained=[UNCONSTRAINED_NAME[m] for m in MODE_PARAMS if not starts.identified[m]], scans=scans,

@@ -422,13 +422,14 @@ def power_sum_stderr(solution: Solution, pairs: dict) -> dict:
 
 def split_note(direction: str, h: float, rel_sum: float, rel_co: float, rel_counter: float, split: float) -> str:
     """The model file's note on a radial line whose co/counter split the line power leaves open
-    (:func:`power_sum_stderr`'s ``split`` over 1: the amplitude ratio not known within a factor e)."""
+    (:func:`power_sum_stderr`'s ``split`` over 1: the amplitude ratio not known within a factor e; ``rel_co`` and
+    ``rel_counter``, the parts' own errors from the power, are not said: the split is the x/y phase's,
+    :func:`rwadist.extended_fit_power.split_from_phase`)."""
     return (f"{direction} h={h:.4g}: the line power does not separate its co- and counter-rotating parts (both senses "
             f"pass the same gain here; standard error of ln(C_co/C_counter) "
-            f"{'unbounded' if split > 1e3 else f'{split:.3g}'}, so the parts' own relative "
-            f"standard errors, {100 * rel_co:.3g} % and {100 * rel_counter:.3g} %, say little): the split is the x/y "
-            f"phase's (analytical.fit.senses; rwadist diagnose's counter_rotation measures it), and the summed "
-            f"amplitude sqrt(C_co² + C_counter²) is known to {100 * rel_sum:.2g} % "
+            f"{'unbounded' if split > 1e3 else f'{split:.3g}'}): the split is the x/y phase's (analytical.fit.senses; "
+            f"rwadist diagnose's counter_rotation measures it), and each part's standard error is that of the summed "
+            f"amplitude sqrt(C_co² + C_counter²), known to {100 * rel_sum:.2g} % "
             f"(rel_stderr C[{direction},{h:g},co+counter])")
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -132,6 +133,41 @@ def rows_of_lines(owner: np.ndarray, la: np.ndarray, lr: np.ndarray) -> tuple[di
     ax_line = np.array([line_of[int(j)][0] for j in la], dtype=int)
     rad_parts = np.array([line_of[int(j)] for j in lr], dtype=int).reshape(-1, 2) if lr.size else np.zeros((0, 2), int)
     return line_of, ax_line, rad_parts
+
+
+#: a radial line whose co/counter split the line power does not see within a factor e (the standard error of
+#: ln(C_co/C_counter), :func:`rwadist.extended_fit_lsq.power_sum_stderr`, at least this) has it from the x/y phase
+SPLIT_UNSEEN = 1.0
+
+
+def split_from_phase(params, meas_lines: list, fitted_lines: list, line_of: dict, sums: dict, senses_xy: dict) -> tuple:
+    """(params, lines, standard errors): ``fitted_lines`` (and the imbalances U_s, U_d of ``params``) with the co- and
+    counter-rotating parts of each radial line whose split the line power does not see (``sums``:
+    :func:`rwadist.extended_fit_lsq.power_sum_stderr` by (direction, h) of its measured line; its split's standard
+    error at least :data:`SPLIT_UNSEEN`) shared as its x/y phase shares them (``senses_xy``' co_fraction,
+    :func:`rwadist.line_senses.line_senses`), their summed power kept; each such part's relative standard error
+    ({"C[direction,h,sense]": value}) that of the summed amplitude, the split being the phase's.
+
+    Where both senses pass the same gain (a radial force through the translation mode, any line far from the whirl
+    modes) the least squares fix the parts' summed power and leave the split where rounding takes it: family wheel 1's
+    planar h 5.67 force line (co fraction 0.5, x/y phase 0.4999) ended at 0.500 or 0.470 as numpy's AVX2 or AVX-512
+    logarithms rounded, and the second made a ``counter_rotation`` of the x/y phase's 0.4999; the E wheel's
+    co-rotating torque imbalance, 8 speeds whose rocking no whirl pins, ended counter-rotating, its part's error
+    1100 %.  There the response turns as the load does, and its x/y phase measures the split."""
+    out, stderr = list(fitted_lines), {}
+    for j, x in enumerate(meas_lines):
+        key = (x.direction, float(x.h))
+        if x.direction not in RADIAL or key not in sums or sums[key][3] < SPLIT_UNSEEN or key not in senses_xy:
+            continue
+        k_co, k_ct = line_of[j]
+        total = out[k_co].C ** 2 + out[k_ct].C ** 2
+        co = min(max(float(senses_xy[key][1]), 0.0), 1.0)
+        out[k_co] = replace(out[k_co], C=math.sqrt(co * total))
+        out[k_ct] = replace(out[k_ct], C=math.sqrt((1.0 - co) * total))
+        stderr |= {f"C[{ln.direction},{ln.h:g},{ln.sense}]": float(sums[key][0]) for ln in (out[k_co], out[k_ct])}
+    imbalance = {ln.direction: ln.C for ln in out if ln.imbalance}
+    params = replace(params, U_s=imbalance.get("radial_force", params.U_s), U_d=imbalance.get("radial_torque", params.U_d))
+    return params, out, stderr
 
 
 def fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple[dict, list]:
