@@ -15,29 +15,29 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_wheel as fw  # noqa: E402
 
-
-def _dispatched_on() -> list:
-    """The SIMD targets numpy dispatches to on this machine (empty: it runs its baseline loops only)."""
-    umath = np._core._multiarray_umath
-    return [f for f in umath.__cpu_dispatch__ if umath.__cpu_features__.get(f)]
+TARGETS_ON = ("import numpy as np; u = np._core._multiarray_umath; "
+              "print(' '.join(f for f in u.__cpu_dispatch__ if u.__cpu_features__.get(f)))")
 
 
-def _diagnose(data: Path, out: Path, disable: str | None) -> dict:
-    env = dict(os.environ)
-    env.pop("NPY_DISABLE_CPU_FEATURES", None)
-    if disable:
-        env["NPY_DISABLE_CPU_FEATURES"] = disable
-        check = subprocess.run([sys.executable, "-c", "import numpy as np; u = np._core._multiarray_umath; "
-                                "print([f for f in u.__cpu_dispatch__ if u.__cpu_features__.get(f)])"],
-                               env=env, capture_output=True, text=True, check=True)
-        assert check.stdout.strip() == "[]"          # the child really runs numpy's baseline loops
+def _env(disable: str | None) -> dict:
+    """This process's environment with numpy's ``NPY_DISABLE_CPU_FEATURES`` set to ``disable`` (None: unset)."""
+    env = {k: v for k, v in os.environ.items() if k != "NPY_DISABLE_CPU_FEATURES"}
+    return env if disable is None else env | {"NPY_DISABLE_CPU_FEATURES": disable}
+
+
+def _targets_on(env: dict) -> str:
+    """The SIMD targets numpy dispatches to in a fresh process with ``env`` (empty: its baseline loops only)."""
+    return subprocess.run([sys.executable, "-c", TARGETS_ON], env=env, capture_output=True, text=True,
+                          check=True).stdout.strip()
+
+
+def _diagnose(data: Path, out: Path, env: dict) -> dict:
     subprocess.run([sys.executable, "-m", "rwadist", "diagnose", str(data), "-o", str(out)], env=env,
                    capture_output=True, text=True, check=True)
     return json.loads((out / "summary.json").read_text())
@@ -45,15 +45,16 @@ def _diagnose(data: Path, out: Path, disable: str | None) -> dict:
 
 @pytest.mark.slow
 def test_a_channel_copy_is_diagnosed_alike_with_numpys_simd_kernels_on_and_off(tmp_path):
-    on = _dispatched_on()
+    on = _targets_on(_env(None))
     if not on:
         pytest.skip("numpy dispatches no SIMD extension on this machine: there is nothing to turn off")
+    assert _targets_on(_env(on)) == ""                  # the second child really runs numpy's baseline loops
     wheel = fw.family()[1]
     data = fw.steady(wheel, noise=0.01, seed=1)
     data.signals[:, fw.CHANNELS.index("Fy")] += 0.2 * data.signals[:, fw.CHANNELS.index("Fx")].copy()
     path = fw.write_steady(data, tmp_path / "data", wheel.name)
-    native = _diagnose(path, tmp_path / "native", None)
-    baseline = _diagnose(path, tmp_path / "baseline", " ".join(on))
+    native = _diagnose(path, tmp_path / "native", _env(None))
+    baseline = _diagnose(path, tmp_path / "baseline", _env(on))
     assert [e["kind"] for e in native["effects"]] == [e["kind"] for e in baseline["effects"]] == ["suspension_modes"]
     assert [u["signature"] for u in native["unexplained"]] == [u["signature"] for u in baseline["unexplained"]]
     modes = [next(e for e in s["effects"] if e["kind"] == "suspension_modes") for s in (native, baseline)]
