@@ -154,7 +154,7 @@ def split_from_phase(params, meas_lines: list, fitted_lines: list, line_of: dict
     logarithms rounded, and the second made a ``counter_rotation`` of the x/y phase's 0.4999; the E wheel's
     co-rotating torque imbalance, 8 speeds whose rocking no whirl pins, ended counter-rotating, its part's error
     1100 %.  There the response turns as the load does, and its x/y phase measures the split."""
-    out, stderr = list(fitted_lines), {}
+    out, stderr = list(fitted_lines), dict[str, float]()
     for j, x in enumerate(meas_lines):
         key = (x.direction, float(x.h))
         if x.direction not in RADIAL or key not in sums or sums[key][3] < SPLIT_UNSEEN or key not in senses_xy:
