@@ -34,6 +34,17 @@ reproduce the cell) and keeps each cell's ROSS document and report (the records 
 
 ROSS is not a project dependency (see benchmarks/ross_new_wheel.py for its venv); it runs from /tmp, not the repo.
 One cell takes ~15 s of ROSS and ~1-2 min of diagnose on a shared two-core machine.
+
+Record (default 8 wheels, seed 33).  At 6894472: clean 8/8; stand cells 14/24 with every mode within 2 % or declared,
+the stand named 13/24, effects invented in 10/24.  At c6eb5a0 (2026-12-04, ROSS 2.3.0, plotly<6; 668 s wall on two
+cores, diagnose median 12 s, max 96 s): clean 8/8 (nothing added, every mode within 2 % or declared); stand cells 17/24
+(modes: 39 within 2 %, 19 unconstrained, 14 off, of 72); a test_stand within 2 % of the fixture or of ROSS's nearest
+coupled mode 14/24; effects invented in 6/24 stand cells (amplitude_law 6, fixed_resonance wheel_mode 5); every
+criterion in 21/32 cells.  Failing: the stand at 1x the translation (w0: the axial 8 % off, the stand named 3.5 % off;
+w3: the translation 10.5 % off, no stand), every stand cell of w1 (I_zz/I_rr 1.22, rocking 405.6 Hz above its 334.5 Hz
+axial: the rocking declared, two amplitude laws invented, no stand), w4 at 0.5x/1.5x rocking (no mode located:
+suspension_modes not named), w5 at 0.5x axial (the translation 8 % off, no stand), w7 at every rocking stand (its
+rocking at 462.6 Hz, I_zz/I_rr 1.24: wheel_mode resonances invented).
 """
 from __future__ import annotations
 
