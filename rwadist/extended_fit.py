@@ -551,7 +551,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
         stand, more_stands = joint.stand(res.x[n_x:]), joint.more(res.x[n_x:], more_stands)
     params = replace(params, height=float(height))
     senses, kept_lines = fitted_senses(meas.lines, fitted_lines, line_of)
-    notes += [split_note(d, h, *se) for (d, h), se in sums.items() if se[3] >= SPLIT_UNSEEN and senses[(d, h)][0] == "co+counter"]
+    notes += [split_note(d, h, se[0], se[3]) for (d, h), se in sums.items() if se[3] >= SPLIT_UNSEEN and senses[(d, h)][0] == "co+counter"]
     resid_db, line_residuals = _residuals_near_modes(params, lines, ax_line, rad_parts, sa, sr, dr, res.fun, notes)
     for m in (m for m in MODE_PARAMS if declare and starts.identified[m] and resid_db.get(m, 0.0) > MISFIT_DB):
         starts.identified[m] = False

@@ -16,7 +16,7 @@ import numpy as np
 from scipy import optimize
 
 from . import extended as ext
-from .extended_fit_power import LinePower
+from .extended_fit_power import LinePower, imbalances
 from .resonance import FittedResonance
 from .stand_every import FittedStands
 
@@ -286,9 +286,7 @@ class LogAmplitudeProblem:
         n_mode, n_c = 2 * len(free_modes), len(self.lines)
         C = np.exp(theta[n_mode:n_mode + n_c])
         lns = [replace(ln, C=float(c)) for ln, c in zip(self.lines, C)]
-        vals["U_s"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_force"), 0.0)
-        vals["U_d"] = next((ln.C for ln in lns if ln.imbalance and ln.direction == "radial_torque"), 0.0)
-        return ext.ExtendedParams(**vals), lns
+        return ext.ExtendedParams(**(vals | imbalances(lns))), lns
 
 
 class _Residuals:
@@ -420,11 +418,11 @@ def power_sum_stderr(solution: Solution, pairs: dict) -> dict:
     return out
 
 
-def split_note(direction: str, h: float, rel_sum: float, rel_co: float, rel_counter: float, split: float) -> str:
+def split_note(direction: str, h: float, rel_sum: float, split: float) -> str:
     """The model file's note on a radial line whose co/counter split the line power leaves open
-    (:func:`power_sum_stderr`'s ``split`` over 1: the amplitude ratio not known within a factor e; ``rel_co`` and
-    ``rel_counter``, the parts' own errors from the power, are not said: the split is the x/y phase's,
-    :func:`rwadist.extended_fit_power.split_from_phase`)."""
+    (:func:`power_sum_stderr`'s ``split`` over 1: the amplitude ratio not known within a factor e; ``rel_sum`` its
+    summed amplitude's relative standard error): the split is the x/y phase's,
+    :func:`rwadist.extended_fit_power.split_from_phase`."""
     return (f"{direction} h={h:.4g}: the line power does not separate its co- and counter-rotating parts (both senses "
             f"pass the same gain here; standard error of ln(C_co/C_counter) "
             f"{'unbounded' if split > 1e3 else f'{split:.3g}'}): the split is the x/y phase's (analytical.fit.senses; "

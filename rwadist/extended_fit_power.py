@@ -140,6 +140,13 @@ def rows_of_lines(owner: np.ndarray, la: np.ndarray, lr: np.ndarray) -> tuple[di
 SPLIT_UNSEEN = 1.0
 
 
+def imbalances(lines: list) -> dict:
+    """{"U_s": C, "U_d": C} of the imbalance lines among ``lines`` (radial force, radial torque; 0.0 without one): the
+    :class:`~rwadist.extended.ExtendedParams` values their C stands for."""
+    return {u: next((ln.C for ln in lines if ln.imbalance and ln.direction == d), 0.0)
+            for u, d in (("U_s", "radial_force"), ("U_d", "radial_torque"))}
+
+
 def split_from_phase(params, meas_lines: list, fitted_lines: list, line_of: dict, sums: dict, senses_xy: dict) -> tuple:
     """(params, lines, standard errors): ``fitted_lines`` (and the imbalances U_s, U_d of ``params``) with the co- and
     counter-rotating parts of each radial line whose split the line power does not see (``sums``:
@@ -151,7 +158,7 @@ def split_from_phase(params, meas_lines: list, fitted_lines: list, line_of: dict
     Where both senses pass the same gain (a radial force through the translation mode, any line far from the whirl
     modes) the least squares fix the parts' summed power and leave the split where rounding takes it: family wheel 1's
     planar h 5.67 force line (co fraction 0.5, x/y phase 0.4999) ended at 0.500 or 0.470 as numpy's AVX2 or AVX-512
-    logarithms rounded, and the second made a ``counter_rotation`` of the x/y phase's 0.4999; the E wheel's
+    kernels rounded, and the second made a ``counter_rotation`` of the x/y phase's 0.4999; the E wheel's
     co-rotating torque imbalance, 8 speeds whose rocking no whirl pins, ended counter-rotating, its part's error
     1100 %.  There the response turns as the load does, and its x/y phase measures the split."""
     out, stderr = list(fitted_lines), dict[str, float]()
@@ -165,9 +172,7 @@ def split_from_phase(params, meas_lines: list, fitted_lines: list, line_of: dict
         out[k_co] = replace(out[k_co], C=math.sqrt(co * total))
         out[k_ct] = replace(out[k_ct], C=math.sqrt((1.0 - co) * total))
         stderr |= {f"C[{ln.direction},{ln.h:g},{ln.sense}]": float(sums[key][0]) for ln in (out[k_co], out[k_ct])}
-    imbalance = {ln.direction: ln.C for ln in out if ln.imbalance}
-    params = replace(params, U_s=imbalance.get("radial_force", params.U_s), U_d=imbalance.get("radial_torque", params.U_d))
-    return params, out, stderr
+    return replace(params, **imbalances(out)), out, stderr
 
 
 def fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple[dict, list]:

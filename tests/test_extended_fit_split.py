@@ -83,7 +83,7 @@ def test_a_split_the_rocking_whirl_measures_gets_no_note(fitted):
 
 def test_a_split_the_power_cannot_see_is_the_xy_phases(fitted):
     """Where the power does not see the split, the least squares leave it where rounding takes it (family wheel 1's
-    planar h 5.67 force line ended at co fraction 0.500 or 0.470 as numpy's AVX2 or AVX-512 logarithms rounded, and
+    planar h 5.67 force line ended at co fraction 0.500 or 0.470 as numpy's AVX2 or AVX-512 kernels rounded, and
     the second made a counter_rotation of the x/y phase's 0.4999): the model holds the x/y phase's split, the parts'
     summed power as fitted.  The torque line's split, which the rocking whirl measures, stays the power's."""
     from rwadist.line_senses import line_senses
