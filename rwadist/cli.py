@@ -191,7 +191,7 @@ def cmd_fit(args) -> int:
     if efit is not None:
         print(f"extended model: {sum(len(v) for v in model.empirical.values())} forcing lines through the fitted "
               "modes (every line the data show, modally amplified or not)")
-    modal = [f"{b.direction} h={b.h:.4g}" for b in fit.bins if not b.kept and "outside modal ranges" in b.reason]
+    modal = [f"{b.direction} h={b.h:.4g}" for b in fit.modally_left_out]
     if modal and efit is None:
         print(f"WARNING: {len(modal)} harmonic(s) the data show were left out of the model because their lines are "
               f"modally amplified at nearly every speed ({', '.join(modal[:6])}{' and more' if modal[6:] else ''}"

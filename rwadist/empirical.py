@@ -149,6 +149,13 @@ class EmpiricalFit:
         for the model file)."""
         return FitSettings(**{k: v for k, v in self.settings.items() if k in FitSettings.__dataclass_fields__})
 
+    @property
+    def modally_left_out(self) -> list:
+        """The :class:`BinStat` of every harmonic the data show that the modal exclusion left out of the model: its
+        lines amplified by a resonance at nearly every speed (too few measurements outside the modal ranges to fit
+        C·Ω²)."""
+        return [b for b in self.bins if not b.kept and "outside modal ranges" in b.reason]
+
     @cached_property
     def without_mode_exclusion(self) -> "EmpiricalFit":
         """The fit of the same spectra, settings and detections with ``exclude_modes=False``: every line the data

@@ -385,7 +385,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
 
     read = line_ratios(res.ctx, res.state) if changes else ratios
     out += annotate(ctx, state, run_change(ctx, read, of_runs), read, taken_out=changes)
-    out += speed_lines(ctx, state, of_line, bearings, others)
+    out += speed_lines(ctx, state, of_line, bearings, others, ctx.left_out)
     out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
     sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)
     tracks = sideband_tracks(sidebands, known_sidebands)

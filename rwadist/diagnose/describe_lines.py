@@ -89,12 +89,19 @@ def _lit(ctx, state, c: str, narrow: bool = False) -> np.ndarray:
     return out
 
 
-def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
+#: what would tell on a harmonic the model lacks for its modal amplification
+LEFT_OUT_TELLS = ("the wheel's suspension modes measured (a tap test of the wheel on its mount, or a model of them "
+                  "given: the line is then carried through them), or the fit kept at every speed (rwadist fit "
+                  "--no-mode-exclusion: C·Ω² through the resonance)")
+
+
+def speed_lines(ctx, state, shares, bearings=(), others=(), left_out=()) -> list:
     """``speed_line`` records of the residual ridges at a constant h no model line of the direction has, pooled over
     the direction's channels; each with its ratio refined on the residual peaks, its rotation sense on a radial
     direction (from the x/y phase of the whole-run transforms, with the time series), its amplitude's power law in
     the speed and its candidate bearing causes (:func:`rwadist.bearings.line_causes`), or a motor's on the axial torque
-    (:func:`rwadist.motor.motor_causes`)."""
+    (:func:`rwadist.motor.motor_causes`); first of all, when it is one of ``left_out`` ((direction, h) of the harmonics
+    the starting fit left out for their modal amplification, :attr:`Context.left_out`), that harmonic."""
     from ..bearings import line_causes
     from ..motor import motor_causes
     from .measure import refine_h
@@ -141,8 +148,11 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
             if not level >= MIN_LEVEL_DB:
                 continue
             sense = _sense(ctx, d, h, lit_runs)
-            causes = tuple(line_causes(h, ratio_resolution(ctx), bearings, others)
-                           + motor_causes(h, ratio_resolution(ctx), d))
+            causes = tuple(f"the wheel's harmonic h = {hl:.4g} of the {d.replace('_', ' ')}, left out of the model: "
+                           "its lines are modally amplified at nearly every speed, which C·Ω² does not describe and "
+                           "no suspension mode of the model explains" for dl, hl in left_out
+                           if dl == d and abs(hl - h) <= 4 * dh) \
+                + tuple(line_causes(h, ratio_resolution(ctx), bearings, others) + motor_causes(h, ratio_resolution(ctx), d))
             f = h * ctx.omega[lit_runs] / (2 * np.pi)
             out.append(Unexplained(
                 signature="speed_line", channels=tuple(chans), speed_rpm=(float(rpm.min()), float(rpm.max())),
@@ -151,9 +161,9 @@ def speed_lines(ctx, state, shares, bearings=(), others=()) -> list:
                                         "lit_fraction": float(frac[i])},
                 causes=causes + ("a line of the wheel the classes could not fit (its strength erratic from run to "
                                  "run, or present over part of the speeds only)",),
-                would_tell="runs repeated at a few speeds (a steady line repeats; an intermittent one, e.g. a "
-                           "cage's instability or a rub, does not) and the bearings' geometry (--bearing) to name "
-                           "the ratio"))
+                would_tell=LEFT_OUT_TELLS if causes[:1] and "left out of the model" in causes[0] else
+                "runs repeated at a few speeds (a steady line repeats; an intermittent one, e.g. a "
+                "cage's instability or a rub, does not) and the bearings' geometry (--bearing) to name the ratio"))
     return out
 
 

@@ -66,6 +66,10 @@ class Context(Metric):
         #: the wheel's modes may be judged with the load-cell offset they were located beside (set by
         #: :func:`rwadist.diagnose.search._search_once`, read by :func:`rwadist.diagnose.search._judge`)
         self.offset_pair = True
+        #: (direction, h) of the harmonics the data show that the starting empirical fit left out of the model, its
+        #: lines modally amplified at nearly every speed (:attr:`rwadist.empirical.EmpiricalFit.modally_left_out`; set
+        #: by :func:`rwadist.diagnose.search._search_once` when no model is given)
+        self.left_out: tuple = ()
         self._corrected: dict = {}
         self.f = spectra.f
         self.df = spectra.df

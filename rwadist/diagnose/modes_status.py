@@ -17,6 +17,8 @@ WHOLE_DATA_FIT = ("suspension_modes.whole_data_fit",)
 AMPLIFICATION_PEAKS = ("modes_status.amplification_peaks",)
 #: the amplification peaks' directions, in the order they are said
 _DIRECTIONS = ("radial_force", "radial_torque", "axial_force")
+#: a line of the model within this fraction of a left-out harmonic's h is that harmonic, put back
+LEFT_OUT_MATCH = 0.005
 
 
 def modes_status(diag) -> dict | None:
@@ -28,7 +30,8 @@ def modes_status(diag) -> dict | None:
     dict or None
         ``status``: "no_amplification" (the lines show none: the empirical base is the right one),
         "not_located" (amplified lines, no mode located on them: no hypothesis) or "rejected" (a hypothesis
-        made and not taken); ``peaks_Hz``: {direction: {"median_Hz", "lowest_Hz", "highest_Hz", "lines"}} the
+        made and not taken); ``left_out``: [{"direction", "h"}] the harmonics the data show that the model lacks,
+        their lines modally amplified at nearly every speed (:attr:`Context.left_out`); ``peaks_Hz``: {direction: {"median_Hz", "lowest_Hz", "highest_Hz", "lines"}} the
         amplification peaks (a line's frequency at the speed of its largest rise over C·Ω², away from the speed
         range's ends); ``tried``: [{"iteration", "heldout_gain_fraction",
         "t", "modes_Hz"}] the hypotheses not taken; ``text``: one sentence.
@@ -58,21 +61,24 @@ def modes_status(diag) -> dict | None:
         if f:
             where[d] = {"median_Hz": float(np.median(f)), "lowest_Hz": float(min(f)), "highest_Hz": float(max(f)),
                         "lines": len(f)}
+    # a harmonic the starting fit left out for its modal amplification and nothing put back: the model lacks it
+    left = [{"direction": d, "h": h} for d, h in getattr(ctx, "left_out", ())
+            if not any(abs(x.h - h) <= LEFT_OUT_MATCH * h for x in diag.state_after.model.harmonics(d))]
     tried = [{"iteration": h.iteration, "heldout_gain_fraction": h.gain_fraction, "t": h.t,
               "modes_Hz": {m: float(h.effect.f0_Hz[m]) for m in ("radial_translation", "rocking", "axial")
                            if m not in h.effect.unconstrained}}
              for h in diag.hypotheses if h.effect.kind == "suspension_modes" and not h.passed]
     if tried:
         status = "rejected"
-    elif where:
+    elif where or left:
         status = "not_located"
     else:
-        return {"status": "no_amplification", "peaks_Hz": {}, "tried": [],
+        return {"status": "no_amplification", "peaks_Hz": {}, "tried": [], "left_out": [],
                 "text": "the lines show no modal amplification: every line is fitted as C·Ω² hard mounted "
                         "(no suspension modes in the model)"}
     rise = "; ".join(f"{d.replace('_', ' ')} near {w['median_Hz']:.4g} Hz ({w['lines']} line peak"
                      f"{'s' if w['lines'] > 1 else ''}{_span(w)})" for d, w in where.items()) \
-        or "at the ends of the speed range"
+        or ("in the lines left out of the model" if left else "at the ends of the speed range")
     text = f"NOT FITTED, although the lines rise as through a resonance: {rise}"
     if tried:
         words = []
@@ -84,10 +90,17 @@ def modes_status(diag) -> dict | None:
     else:
         text += "; no mode of the model (a radial translation, a rocking mode whirling by I_zz/I_rr, an axial " \
                 "mode) could be located on them"
-    text += (": every line is fitted as C·Ω² hard mounted, so the model holds no modes; a suspension the model does "
-             "not describe (translation and rocking coupled, an x/y split) or a stand resonance moving with speed "
-             "could do this; a tap test of the wheel on its mount, or the lines read at more speeds, would tell")
-    return {"status": status, "peaks_Hz": where, "tried": tried, "text": text}
+    if left:
+        names = ", ".join(f"{x['direction'].replace('_', ' ')} h {x['h']:.4g}" for x in left)
+        text += (f": every line is fitted as C·Ω² hard mounted where it is not modally amplified, so the model holds no "
+                 f"modes, and {len(left)} harmonic{'s' if len(left) > 1 else ''} amplified at nearly every speed "
+                 f"{'are' if len(left) > 1 else 'is'} left out of it ({names}: C·Ω² does not describe "
+                 f"{'them' if len(left) > 1 else 'it'}; the model lacks {'them' if len(left) > 1 else 'it'})")
+    else:
+        text += ": every line is fitted as C·Ω² hard mounted, so the model holds no modes"
+    text += ("; a suspension the model does not describe (translation and rocking coupled, an x/y split) or a stand "
+             "resonance moving with speed could do this; a tap test of the wheel on its mount, or the lines read at more speeds, would tell")
+    return {"status": status, "peaks_Hz": where, "tried": tried, "left_out": left, "text": text}
 
 
 def _span(w: dict) -> str:

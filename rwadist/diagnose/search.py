@@ -679,7 +679,9 @@ def _search_once(spectra: Spectra, model: WheelModel | None, k_sigma: float, min
     ctx = opened.ctx
     ctx.offset_pair = offset_pair
     if model is None:
-        model = fit_empirical(ctx.sp).model
+        fit0 = fit_empirical(ctx.sp)
+        model = fit0.model
+        ctx.left_out = tuple((b.direction, float(b.h)) for b in fit0.modally_left_out)
     request = base
     base = resolve_base(model, base, test)
     ext_params = None
