@@ -152,8 +152,7 @@ class EmpiricalFit:
     @property
     def modally_left_out(self) -> list:
         """The :class:`BinStat` of every harmonic the data show that the modal exclusion left out of the model: its
-        lines amplified by a resonance at nearly every speed (too few measurements outside the modal ranges to fit
-        C·Ω²)."""
+        lines amplified at nearly every speed (too few measurements outside the modal ranges to fit C·Ω²)."""
         return [b for b in self.bins if not b.kept and "outside modal ranges" in b.reason]
 
     @cached_property

@@ -81,7 +81,8 @@ def test_a_group_is_taken_back_whole_when_one_part_was_fitted_to_unexplained_con
     amplitude law, fitted to nothing described, stays; the model is rebuilt from the state without the group."""
     hyps, parts = _group_hypotheses()
     law = hyps[0].effect
-    diag = SimpleNamespace(hypotheses=hyps, state_before=(), state_after=(law, *parts))
+    diag = SimpleNamespace(hypotheses=hyps, state_before=(), state_after=(law, *parts), error_before=1.0,
+                           error_after=0.1)
     diag.state_after = SimpleNamespace(effects=diag.state_after)
     raw = SimpleNamespace(contrast_error=lambda state: 0.0)
     opened = SimpleNamespace(ctx=raw, raw=raw)

@@ -128,7 +128,7 @@ def test_an_effect_is_taken_back_for_a_moving_resonance_only_where_one_stands_wi
     monkeypatch.setattr(ds, "forced_effects", lambda *a: [(effect, "moving_resonance")])
     monkeypatch.setattr(ds, "line_causes", lambda *a: [])
     hyp = SimpleNamespace(effect=effect, passed=True, forced_by=None)
-    diag = SimpleNamespace(state_before=before, state_after=after, hypotheses=[hyp])
+    diag = SimpleNamespace(state_before=before, state_after=after, hypotheses=[hyp], error_before=1.0, error_after=0.1)
     raw = SimpleNamespace(contrast_error=lambda s: 0.0)
     rebuilt = []
     ds.finish(diag, SimpleNamespace(ctx=raw, raw=raw), rebuild=lambda s, h: rebuilt.append(s) or "model")
@@ -139,3 +139,34 @@ def test_an_effect_is_taken_back_for_a_moving_resonance_only_where_one_stands_wi
     else:
         assert hyp.passed is True and hyp.forced_by is None and not rebuilt
         assert diag.state_after is after
+
+
+def test_a_take_back_that_leaves_the_model_worse_than_the_start_does_not_stand(monkeypatch):
+    """:func:`rwadist.diagnose.describe.finish`, stubbed as above: the moving resonance is still described without the
+    effect, but the state without it describes the data worse than the search's starting state (its error 1.4 against
+    1.0: the effects after it were fitted beside it): the effect is kept, its hypothesis passed, the model not made
+    again, the records and the error those of the state with it (tests/test_diagnose_never_worse.py: ROSS's family
+    wheel 5 on a stand, end to end)."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose import describe as ds
+
+    effect = SimpleNamespace(kind="fixed_resonance", apply=lambda s: SimpleNamespace(effects=list(s.effects) + [effect]))
+    before, after = SimpleNamespace(effects=[]), SimpleNamespace(effects=[effect])
+    track = SimpleNamespace(signature="moving_resonance", h=None)
+
+    def described(diag, opened, state, bearings=()):
+        diag.state_after = state
+        diag.error_after = 0.2 if effect in state.effects else 1.4
+        return [track], "res"
+
+    monkeypatch.setattr(ds, "_described", described)
+    monkeypatch.setattr(ds, "forced_effects", lambda *a: [(effect, "moving_resonance")])
+    monkeypatch.setattr(ds, "line_causes", lambda *a: [])
+    hyp = SimpleNamespace(effect=effect, passed=True, forced_by=None)
+    diag = SimpleNamespace(state_before=before, state_after=after, hypotheses=[hyp], error_before=1.0, error_after=0.2)
+    raw = SimpleNamespace(contrast_error=lambda s: 0.0)
+    rebuilt = []
+    ds.finish(diag, SimpleNamespace(ctx=raw, raw=raw), rebuild=lambda s, h: rebuilt.append(s) or "model")
+    assert hyp.passed is True and hyp.forced_by is None and not rebuilt
+    assert diag.state_after is after and diag.error_after == 0.2 and diag.unexplained == (track,)
