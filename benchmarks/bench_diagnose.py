@@ -154,6 +154,11 @@ children (2 x 3 pairs, load 2.8-3.3): sixty diagnose cpu min/median 1.62/1.68 ->
 load 3.2-4.6: cpu x8.1/x8.3 (benchmark), x8.4/x7.8 (2 busy), x11.0/x11.3 and x11.5/x11.2 (sixty; 1.62 s / 0.15 s);
 target not met on the sixty set.  Tried, no gain: blocked_records written a record at a time (faster for 6 channels,
 slower for 2; memory-bound), the phasors' records kept for runs asked again (~5 ms, below the noise).
+2026-12-04, session 43 (main 2feb826, idle AVX-512 machine, --quick --repeats 3 --busy 2): cpu min/median x10.8/x10.6
+(benchmark; 2.80 s / 0.26 s), x9.6/x8.5 (2 busy), x11.9/x13.0 (sixty; 1.35 s / 0.11 s), x12.2/x12.2 (2 busy); target
+not met on three rows.  cProfile of a sixty diagnose: spread over the families (the wheel's modes 0.44 s of 1.85 s
+profiled, the fixed-resonance candidates 0.27 s, the open world's descriptions 0.33 s, none else over 0.2 s);
+blocked_records 26 calls, 50-65 ms CPU of 1.36-1.41 s (timed apart): a cache of the blocked records would save < 4 %.
 """
 from __future__ import annotations
 
