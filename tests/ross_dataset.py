@@ -60,6 +60,25 @@ def ross_test(noise=0.01, seed=0, sample_rate=3840.0, n_samples=4096, path=DATA)
     return SteadyTest(runs=runs, meta=meta)
 
 
+def diagnosed(path: Path, tmp_path: Path, sample_rate: float, n_samples: int = 8192) -> tuple:
+    """(ROSS document, model.json, summary.json, console) of ``rwadist diagnose DATA -o REPORT`` -- the command a user
+    types, no model -- on the records of the ROSS document at ``path`` (``sample_rate`` Hz, ``n_samples`` per run),
+    written under ``tmp_path``."""
+    import contextlib
+    import io
+
+    from rwadist import data as data_io
+    from rwadist.cli import main as rwadist_main
+
+    data, out = tmp_path / "data", tmp_path / "report"
+    data_io.write_steady(ross_test(sample_rate=sample_rate, n_samples=n_samples, path=path), data)
+    console = io.StringIO()
+    with contextlib.redirect_stdout(console):
+        assert rwadist_main(["diagnose", str(data), "-o", str(out)]) == 0
+    return (load_doc(path), json.loads((out / "model.json").read_text()),
+            json.loads((out / "summary.json").read_text()), console.getvalue())
+
+
 def main(argv=None):
     import argparse
 

@@ -12,7 +12,6 @@ every line fitted as C·Ω², the residual's h = 1 ridge was called a line 'the 
 harmonic the data show is either in the model or listed as left out, with the reason, on the console, in summary.json
 and on the residual's record of its ridge.
 """
-import json
 import sys
 from pathlib import Path
 
@@ -22,21 +21,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import ross_dataset as rd  # noqa: E402
 
-from rwadist import data as data_io  # noqa: E402
-from rwadist.cli import main  # noqa: E402
-
 DOC = Path(__file__).resolve().parent / "data" / "ross_family4_stand_rocking_half.json"
 
 
 @pytest.mark.slow
-def test_an_imbalance_the_model_lacks_is_said_on_the_console_in_the_summary_and_on_its_ridge(tmp_path, capsys):
-    data, out = tmp_path / "data", tmp_path / "report"
-    doc = rd.load_doc(DOC)
-    data_io.write_steady(rd.ross_test(sample_rate=6600.0, n_samples=8192, path=DOC), data)
-    assert main(["diagnose", str(data), "-o", str(out)]) == 0
-    console = capsys.readouterr().out
-    model = json.loads((out / "model.json").read_text())
-    summary = json.loads((out / "summary.json").read_text())
+def test_an_imbalance_the_model_lacks_is_said_on_the_console_in_the_summary_and_on_its_ridge(tmp_path):
+    doc, model, summary, console = rd.diagnosed(DOC, tmp_path, 6600.0)
     status = summary["suspension_modes_status"] or {}
     left = {(x["direction"], round(x["h"], 3)) for x in status.get("left_out", [])}
     # ROSS's imbalance lines, U_s and U_d given to it: h = 1 on the radial force and the radial torque

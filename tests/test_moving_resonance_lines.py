@@ -104,61 +104,22 @@ def test_speed_sidebands_on_a_family_wheel_are_no_moving_resonance():
     assert not [u for u in d.unexplained if u.signature == "moving_resonance"], [u.text() for u in d.unexplained]
 
 
-@pytest.mark.parametrize("still_described", [False, True])
-def test_an_effect_is_taken_back_for_a_moving_resonance_only_where_one_stands_without_it(monkeypatch, still_described):
-    """:func:`rwadist.diagnose.describe.finish` with the description and the take-back test stubbed: a moving
-    resonance that takes an effect back but is not described once the effect is out was read on the effect's own
-    lines (the E-like wheel's speed sidebands, read against their carrier): the effect is kept, its hypothesis
-    passed, the model not made again and the records those of the state with it.  Where one is still described
-    without it, it is taken back (``forced_by`` "moving_resonance") as before."""
+def _finished(monkeypatch, kind: str, read):
+    """:func:`rwadist.diagnose.describe.finish` with its description and take-back test stubbed: the search's final
+    state holds one effect of ``kind``, forced by a moving resonance; ``read(diag, with_effect)`` stands for the
+    description of a state (it may set ``diag.error_after``) and returns whether the track is described.  Returns
+    (diag, the effect's hypothesis, the final state, the track, the states the model was made again from)."""
     from types import SimpleNamespace
 
     from rwadist.diagnose import describe as ds
 
-    effect = SimpleNamespace(kind="speed_sidebands", apply=lambda s: SimpleNamespace(effects=list(s.effects) + [effect]))
-    before = SimpleNamespace(effects=[])
-    after = SimpleNamespace(effects=[effect])
-    track = SimpleNamespace(signature="moving_resonance", h=None)
-
-    def described(diag, opened, state, bearings=()):
-        diag.state_after = state
-        return ([track] if still_described or effect in state.effects else []), "res"
-
-    monkeypatch.setattr(ds, "_described", described)
-    monkeypatch.setattr(ds, "forced_effects", lambda *a: [(effect, "moving_resonance")])
-    monkeypatch.setattr(ds, "line_causes", lambda *a: [])
-    hyp = SimpleNamespace(effect=effect, passed=True, forced_by=None)
-    diag = SimpleNamespace(state_before=before, state_after=after, hypotheses=[hyp], error_before=1.0, error_after=0.1)
-    raw = SimpleNamespace(contrast_error=lambda s: 0.0)
-    rebuilt = []
-    ds.finish(diag, SimpleNamespace(ctx=raw, raw=raw), rebuild=lambda s, h: rebuilt.append(s) or "model")
-    assert diag.unexplained == (track,)
-    if still_described:
-        assert hyp.passed is False and hyp.forced_by == "moving_resonance" and len(rebuilt) == 1
-        assert effect not in diag.state_after.effects
-    else:
-        assert hyp.passed is True and hyp.forced_by is None and not rebuilt
-        assert diag.state_after is after
-
-
-def test_a_take_back_that_leaves_the_model_worse_than_the_start_does_not_stand(monkeypatch):
-    """:func:`rwadist.diagnose.describe.finish`, stubbed as above: the moving resonance is still described without the
-    effect, but the state without it describes the data worse than the search's starting state (its error 1.4 against
-    1.0: the effects after it were fitted beside it): the effect is kept, its hypothesis passed, the model not made
-    again, the records and the error those of the state with it (tests/test_diagnose_never_worse.py: ROSS's family
-    wheel 5 on a stand, end to end)."""
-    from types import SimpleNamespace
-
-    from rwadist.diagnose import describe as ds
-
-    effect = SimpleNamespace(kind="fixed_resonance", apply=lambda s: SimpleNamespace(effects=list(s.effects) + [effect]))
+    effect = SimpleNamespace(kind=kind, apply=lambda s: SimpleNamespace(effects=list(s.effects) + [effect]))
     before, after = SimpleNamespace(effects=[]), SimpleNamespace(effects=[effect])
     track = SimpleNamespace(signature="moving_resonance", h=None)
 
     def described(diag, opened, state, bearings=()):
         diag.state_after = state
-        diag.error_after = 0.2 if effect in state.effects else 1.4
-        return [track], "res"
+        return ([track] if read(diag, effect in state.effects) else []), "res"
 
     monkeypatch.setattr(ds, "_described", described)
     monkeypatch.setattr(ds, "forced_effects", lambda *a: [(effect, "moving_resonance")])
@@ -166,7 +127,37 @@ def test_a_take_back_that_leaves_the_model_worse_than_the_start_does_not_stand(m
     hyp = SimpleNamespace(effect=effect, passed=True, forced_by=None)
     diag = SimpleNamespace(state_before=before, state_after=after, hypotheses=[hyp], error_before=1.0, error_after=0.2)
     raw = SimpleNamespace(contrast_error=lambda s: 0.0)
-    rebuilt = []
+    rebuilt: list = []
     ds.finish(diag, SimpleNamespace(ctx=raw, raw=raw), rebuild=lambda s, h: rebuilt.append(s) or "model")
+    return diag, hyp, after, track, rebuilt
+
+
+@pytest.mark.parametrize("still_described", [False, True])
+def test_an_effect_is_taken_back_for_a_moving_resonance_only_where_one_stands_without_it(monkeypatch, still_described):
+    """A moving resonance that takes an effect back but is not described once the effect is out was read on the
+    effect's own lines (the E-like wheel's speed sidebands, read against their carrier): the effect is kept, its
+    hypothesis passed, the model not made again and the records those of the state with it.  Where one is still
+    described without it, it is taken back (``forced_by`` "moving_resonance") as before."""
+    diag, hyp, after, track, rebuilt = _finished(monkeypatch, "speed_sidebands",
+                                                 lambda diag, with_effect: still_described or with_effect)
+    assert diag.unexplained == (track,)
+    if still_described:
+        assert hyp.passed is False and hyp.forced_by == "moving_resonance" and len(rebuilt) == 1
+        assert hyp.effect not in diag.state_after.effects
+    else:
+        assert hyp.passed is True and hyp.forced_by is None and not rebuilt
+        assert diag.state_after is after
+
+
+def test_a_take_back_that_leaves_the_model_worse_than_the_start_does_not_stand(monkeypatch):
+    """The moving resonance is still described without the effect, but the state without it describes the data worse
+    than the search's starting state (its error 1.4 against 1.0: the effects after it were fitted beside it): the
+    effect is kept, its hypothesis passed, the model not made again, the records and the error those of the state with
+    it (tests/test_diagnose_never_worse.py: ROSS's family wheel 5 on a stand, end to end)."""
+    def read(diag, with_effect):
+        diag.error_after = 0.2 if with_effect else 1.4
+        return True
+
+    diag, hyp, after, track, rebuilt = _finished(monkeypatch, "fixed_resonance", read)
     assert hyp.passed is True and hyp.forced_by is None and not rebuilt
     assert diag.state_after is after and diag.error_after == 0.2 and diag.unexplained == (track,)

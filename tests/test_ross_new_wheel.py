@@ -5,7 +5,6 @@ response of the issue's "new wheel": 4.2 kg, I_zz/I_rr 1.56, hard-mounted modes 
 lines at h 0.4 (counter-rotating), 3.08, 4.92, 6.16, 600-6000 rpm; written as 5 kHz records by tests/ross_dataset.py.
 The truth is ROSS's: its own modal analysis at rest (run_modal) and the forcing it was given, not rwadist's equations.
 """
-import json
 import sys
 from pathlib import Path
 
@@ -16,22 +15,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import ross_dataset as rd  # noqa: E402
 
-from rwadist import data as data_io  # noqa: E402
-from rwadist.cli import main  # noqa: E402
-
 DATA = Path(__file__).resolve().parent / "data"
 
 
 def _diagnosed(doc_name, tmp_path, capsys):
     """(ROSS document, model.json, summary.json) of ``rwadist diagnose DATA -o REPORT`` on the document's records
     (5 kHz, 8192 samples per run)."""
-    path = DATA / doc_name
-    data, out = tmp_path / "data", tmp_path / "report"
-    data_io.write_steady(rd.ross_test(sample_rate=5000.0, n_samples=8192, path=path), data)
-    assert main(["diagnose", str(data), "-o", str(out)]) == 0
-    capsys.readouterr()
-    return (rd.load_doc(path), json.loads((out / "model.json").read_text()),
-            json.loads((out / "summary.json").read_text()))
+    doc, model, summary, _ = rd.diagnosed(DATA / doc_name, tmp_path, 5000.0)
+    return doc, model, summary
 
 
 @pytest.mark.slow

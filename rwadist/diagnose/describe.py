@@ -686,7 +686,6 @@ def finish(diag, opened: Opened, bearings=(), rebuild=None):
         # after it were fitted beside it (ROSS family wheel 5 on a stand at half its axial mode: the wheel's modes
         # refitted beside a test stand the moving resonance's take-back removed, the error 0.53 -> 0.70)
         if diag.error_after > diag.error_before:
-            forced = []
             found, res = _described(diag, opened, search_after, bearings)
             break
         if not lost:

@@ -167,11 +167,11 @@ def speed_lines(ctx, state, shares, bearings=(), others=(), left_out=()) -> list
             if not level >= MIN_LEVEL_DB:
                 continue
             sense = _sense(ctx, d, h, lit_runs)
-            causes = tuple(f"the wheel's harmonic h = {hl:.4g} of the {d.replace('_', ' ')}, left out of the model: "
-                           "its lines are modally amplified at nearly every speed, which C·Ω² does not describe and "
-                           "no suspension mode of the model explains" for dl, hl in left_out
-                           if dl == d and abs(hl - h) <= 4 * dh) \
-                + tuple(line_causes(h, ratio_resolution(ctx), bearings, others) + motor_causes(h, ratio_resolution(ctx), d))
+            left = [f"the wheel's harmonic h = {hl:.4g} of the {d.replace('_', ' ')}, left out of the model: its "
+                    "lines are modally amplified at nearly every speed, which C·Ω² does not describe and no "
+                    "suspension mode of the model explains" for dl, hl in left_out if dl == d and abs(hl - h) <= 4 * dh]
+            causes = tuple(left + line_causes(h, ratio_resolution(ctx), bearings, others)
+                           + motor_causes(h, ratio_resolution(ctx), d))
             f = h * ctx.omega[lit_runs] / (2 * np.pi)
             out.append(Unexplained(
                 signature="speed_line", channels=tuple(chans), speed_rpm=(float(rpm.min()), float(rpm.max())),
@@ -180,8 +180,7 @@ def speed_lines(ctx, state, shares, bearings=(), others=(), left_out=()) -> list
                                         "lit_fraction": float(frac[i])},
                 causes=causes + ("a line of the wheel the classes could not fit (its strength erratic from run to "
                                  "run, or present over part of the speeds only)",),
-                would_tell=LEFT_OUT_TELLS if causes[:1] and "left out of the model" in causes[0] else
-                "runs repeated at a few speeds (a steady line repeats; an intermittent one, e.g. a "
+                would_tell=LEFT_OUT_TELLS if left else "runs repeated at a few speeds (a steady line repeats; an intermittent one, e.g. a "
                 "cage's instability or a rub, does not) and the bearings' geometry (--bearing) to name the ratio"))
     return out
 

@@ -31,8 +31,8 @@ def modes_status(diag) -> dict | None:
         ``status``: "no_amplification" (the lines show none: the empirical base is the right one),
         "not_located" (amplified lines, no mode located on them: no hypothesis) or "rejected" (a hypothesis
         made and not taken); ``left_out``: [{"direction", "h"}] the harmonics the data show that the model lacks,
-        their lines modally amplified at nearly every speed (:attr:`Context.left_out`); ``peaks_Hz``: {direction: {"median_Hz", "lowest_Hz", "highest_Hz", "lines"}} the
-        amplification peaks (a line's frequency at the speed of its largest rise over C·Ω², away from the speed
+        their lines modally amplified at nearly every speed (:attr:`Context.left_out`); ``peaks_Hz``: {direction:
+        {"median_Hz", "lowest_Hz", "highest_Hz", "lines"}} the amplification peaks (a line's frequency at the speed of its largest rise over C·Ω², away from the speed
         range's ends); ``tried``: [{"iteration", "heldout_gain_fraction",
         "t", "modes_Hz"}] the hypotheses not taken; ``text``: one sentence.
     """
@@ -99,7 +99,8 @@ def modes_status(diag) -> dict | None:
     else:
         text += ": every line is fitted as C·Ω² hard mounted, so the model holds no modes"
     text += ("; a suspension the model does not describe (translation and rocking coupled, an x/y split) or a stand "
-             "resonance moving with speed could do this; a tap test of the wheel on its mount, or the lines read at more speeds, would tell")
+             "resonance moving with speed could do this; a tap test of the wheel on its mount, or the lines read at "
+             "more speeds, would tell")
     return {"status": status, "peaks_Hz": where, "tried": tried, "left_out": left, "text": text}
 
 
