@@ -445,8 +445,9 @@ def cmd_diagnose(args) -> int:
     base = diag.state_before.base
     if diag.state_after.base != base:
         base += f" -> {diag.state_after.base} (the wheel's suspension modes fitted from the data)"
-    print(f"diagnosed {len(test.runs)} runs in {time.perf_counter() - t0:.1f} s, {diag.iterations} iteration(s), "
-          f"{base} base")
+    lo, hi = diag.band_Hz
+    print(f"diagnosed {len(test.runs)} runs over {lo:.3g}-{hi:.4g} Hz in {time.perf_counter() - t0:.1f} s, "
+          f"{diag.iterations} iteration(s), {base} base")
     summary = diag.summary()
     status = summary["suspension_modes_status"]
     if status and status["status"] != "no_amplification":

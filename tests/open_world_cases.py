@@ -21,6 +21,13 @@ run_change          every third run (in speed order) recorded 3.5 dB stronger in
                     range switched between runs)
 partial_line        a co-rotating radial-force line at h = 2.7, C 0.08 (thesis units, as the E wheel's 2×
                     line), in every third run only (from the first, in speed order): a source that comes and goes
+wide_hump           noise through a first-order band-pass of 450-1000 Hz on every channel, 12 × the noise's
+                    PSD at its centre: a hump a third of the band wide
+rattle              a part rattling: impacts at random times (20 per second) ringing at 700 Hz (ζ 0.05) on
+                    the radial forces and torques, in every run ("rattle_some_runs": in every third run only,
+                    from the second in speed order)
+affine_line         a line at 150 Hz + 1.5·f_spin on Fz and Tz (a source at a fixed frequency mixed with a line
+                    of the rotor), 5 × the noise std in amplitude
 =================== =================================================================================
 """
 from __future__ import annotations
@@ -39,7 +46,12 @@ import independent_wheel as iw  # noqa: E402
 KINDS = ("fixed_lines", "channel_copy", "moving_resonance", "broadband_hump", "run_change")
 #: the signature a description of each kind must have (docs/diagnose.md, "Unexplained residual")
 SIGNATURE = {"fixed_lines": "fixed_line", "weak_fixed_lines": "fixed_line", "channel_copy": "channel_copy", "moving_resonance": "moving_resonance",
-             "broadband_hump": "broadband_hump", "run_change": "run_change", "partial_line": "partial_line"}
+             "broadband_hump": "broadband_hump", "run_change": "run_change", "partial_line": "partial_line",
+             "wide_hump": "broadband_hump", "rattle": "broadband_hump", "rattle_some_runs": "broadband_hump",
+             "affine_line": "affine_line"}
+WIDE_HUMP_HZ = (450.0, 1000.0)
+RATTLE = (700.0, 0.05, 20.0)          # ringing frequency (Hz), damping ratio, impacts per second
+AFFINE = (150.0, 1.5)                 # offset (Hz), slope (Hz per Hz of spin)
 FIXED_HZ = (60.0, 137.0, 180.0)
 COPY = ("Tx", "Tz", 0.3)
 HUMP_HZ = (95.0, 125.0)
@@ -107,10 +119,27 @@ def generate(kind: str, speeds_rpm, n_samples: int = 4096, sample_rate: float = 
             sos = signal.butter(4, HUMP_HZ, btype="bandpass", fs=sample_rate, output="sos")
             for ch in ("Tx", "Ty", "Tz"):
                 sig[ch] = sig[ch] + np.sqrt(10.0) * std[ch] * signal.sosfilt(sos, rng.standard_normal(n_samples))
+        if kind == "wide_hump":
+            sos = signal.butter(1, WIDE_HUMP_HZ, btype="bandpass", fs=sample_rate, output="sos")
+            for ch in sig:
+                sig[ch] = sig[ch] + np.sqrt(12.0) * std[ch] * signal.sosfilt(sos, rng.standard_normal(n_samples))
+        if kind == "rattle" or (kind == "rattle_some_runs" and i % 3 == 1):
+            f_r, zeta, rate = RATTLE
+            w = 2 * np.pi * f_r / sample_rate
+            ring = ([1.0], [1.0, -2 * np.exp(-zeta * w) * np.cos(w), np.exp(-2 * zeta * w)])   # a decaying sine
+            hits = rng.random((4, n_samples)) < rate / sample_rate
+            for j, ch in enumerate(("Fx", "Fy", "Tx", "Ty")):
+                sig[ch] = sig[ch] + 8.0 * std[ch] * signal.lfilter(*ring, hits[j] * rng.standard_normal(n_samples))
+        if kind == "affine_line":
+            f0, b = AFFINE
+            f_line = f0 + b * abs(r.speed) / (2 * np.pi)
+            for ch in ("Fz", "Tz"):
+                sig[ch] = sig[ch] + 5.0 * std[ch] * np.cos(2 * np.pi * f_line * t + rng.uniform(0, 2 * np.pi))
         runs.append(Run(speed=r.speed, sample_rate=sample_rate, signals=sig, t0=0.0, name=r.name))
     truth = {"kind": kind, "signature": SIGNATURE.get(kind), "fixed_hz": FIXED_HZ, "copy": COPY,
              "hump_hz": HUMP_HZ, "run_step_db": RUN_STEP_DB, "partial_line": PARTIAL_LINE,
-             "partial_runs": [r.name for i, r in enumerate(raw.runs) if i % PARTIAL_EVERY == 0]}
+             "partial_runs": [r.name for i, r in enumerate(raw.runs) if i % PARTIAL_EVERY == 0],
+             "rattle_rpm": [abs(r.speed) * 30 / np.pi for i, r in enumerate(raw.runs) if i % 3 == 1]}
     return SteadyTest(runs=runs, meta={"generator": "tests/open_world_cases.py"}), truth
 
 

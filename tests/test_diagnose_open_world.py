@@ -40,7 +40,8 @@ def test_clean_data_get_no_description_and_only_the_modes():
     assert d.summary()["unexplained"] == []
 
 
-@pytest.mark.parametrize("kind", ["fixed_lines", "channel_copy", "broadband_hump"])
+@pytest.mark.parametrize("kind", ["fixed_lines", "channel_copy", "broadband_hump", "wide_hump", "rattle",
+                                  "rattle_some_runs", "affine_line"])
 def test_each_unknown_kind_is_described_by_its_signature_and_no_class_is_added(kind):
     _, truth, d = diagnosed(kind)
     assert _classes(d) == ["suspension_modes"], kind
@@ -162,6 +163,56 @@ def test_hump_where_it_is():
     assert 5.0 <= u.level_dB <= 13.0
 
 
+@pytest.mark.parametrize("kind", ["wide_hump", "rattle"])
+def test_a_hump_wider_than_the_running_median_or_a_rattle_is_where_it_is(kind):
+    _, truth, d = diagnosed(kind)
+    (u,) = d.unexplained
+    # the band-pass's corners lie within the hump; the rattle's ringing frequency at its peak (within 5 %)
+    lo, hi = owc.WIDE_HUMP_HZ if kind == "wide_hump" else (0.95 * owc.RATTLE[0], 1.05 * owc.RATTLE[0])
+    want = {"Fx", "Fy", "Fz", "Tx", "Ty", "Tz"} if kind == "wide_hump" else {"Fx", "Fy", "Tx", "Ty"}
+    assert set(u.channels) == want
+    assert lo <= u.parameters["peak_Hz"] <= hi
+    assert u.f_Hz[0] < lo and u.f_Hz[1] > hi if kind == "wide_hump" else u.f_Hz[0] < owc.RATTLE[0] < u.f_Hz[1]
+    # band-passed to the hump, noise has kurtosis 3; impacts ringing a resonance far more, and the rattle is named
+    impacts = u.causes[0].startswith("impacts ringing a resonance")
+    assert impacts == (kind == "rattle") and (u.parameters["kurtosis"] > 4.5) == impacts, u.parameters["kurtosis"]
+
+
+def test_a_rattle_in_some_runs_is_described_in_those_runs_as_impacts():
+    _, truth, d = diagnosed("rattle_some_runs")
+    (u,) = d.unexplained
+    assert u.parameters["in_every_run"] is False and set(u.channels) == {"Fx", "Fy", "Tx", "Ty"}
+    assert u.parameters["run_speeds_rpm"] == pytest.approx(sorted(truth["rattle_rpm"]), rel=1e-6)
+    assert u.f_Hz[0] < owc.RATTLE[0] < u.f_Hz[1] and abs(u.parameters["peak_Hz"] - owc.RATTLE[0]) < 35
+    assert u.causes[0].startswith("impacts ringing a resonance at")
+
+
+def test_a_line_off_both_axes_is_one_affine_line_at_its_offset_and_slope():
+    _, truth, d = diagnosed("affine_line")
+    (u,) = d.unexplained
+    f0, b = owc.AFFINE
+    assert set(u.channels) == {"Fz", "Tz"} and u.n_runs >= 18
+    assert u.parameters["offset_Hz"] == pytest.approx(f0, abs=0.5)
+    assert u.parameters["slope"] == pytest.approx(b, abs=0.01)
+    assert u.causes[0].startswith(f"a source at {u.parameters['offset_Hz']:.4g} Hz")
+
+
+def test_the_floors_lower_course_lets_a_monotone_floor_through_and_measures_a_hump_on_a_slope():
+    from rwadist.diagnose.describe_hump import _lower_course
+
+    f = np.linspace(1.0, 1000.0, 2001)
+    one_over_f = -10 * np.log10(f)
+    assert np.max(_lower_course(one_over_f, 0, f.size - 1)) == pytest.approx(0.0, abs=1e-9)
+    roll_off = np.where(f < 800, 0.0, -40 * np.log10(f / 800))
+    assert np.max(_lower_course(roll_off, 0, f.size - 1)) == pytest.approx(0.0, abs=1e-9)
+    bump = 15.0 * np.exp(-0.5 * ((f - 500) / 120) ** 2)             # wider than an eighth of the band
+    excess = _lower_course(one_over_f + bump, 0, f.size - 1)
+    k = int(np.argmax(excess))
+    # measured against the higher of the floors either side: the falling floor's left shoulder (about -22.5 dB, at
+    # the bump's foot) against -27 + 15 dB at its centre
+    assert f[k] == pytest.approx(500, abs=60) and 9.0 <= excess[k] <= 15.0
+
+
 def test_narrow_line_metric_sees_the_fixed_lines_the_power_metric_hardly_does():
     """Three pickup lines 26 dB over the noise in their bins, in every channel and run: stripes a reviewer sees at
     once; the power-weighted metric moves little for what they are (the issue: 1.0 -> 1.1 × the clean level; here
@@ -197,6 +248,12 @@ def test_summary_report_and_console_carry_the_descriptions(tmp_path, capsys):
     assert "described above with ? is in no model: it counts in both figures" in printed
     summary = json.loads((out / "summary.json").read_text())
     assert [u["signature"] for u in summary["unexplained"]] == ["fixed_line"] * 3
+    # the band the metrics count, said once in each (the new-user trial of session 43 never read it): within the
+    # records' band, and holding the lines (the fixed ones at 60-180 Hz)
+    lo, hi = summary["band_Hz"]
+    assert 0.0 <= lo < min(owc.FIXED_HZ) and max(owc.FIXED_HZ) < hi <= test.runs[0].sample_rate / 2
+    assert f"diagnosed {len(test.runs)} runs over {lo:.3g}-{hi:.4g} Hz in " in printed
+    assert f"- band analysed: {lo:.3g}-{hi:.4g} Hz" in (out / "report.md").read_text()
     assert summary["narrow_line_metric"] == "waterfall_band_contrast" and summary["narrow_line_error_after"] > 0
     md = (out / "report.md").read_text()
     assert "## Unexplained residual" in md and md.count("**fixed_line**") == 3

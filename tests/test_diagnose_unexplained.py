@@ -63,3 +63,22 @@ def test_report_md_gives_each_record_the_strength_the_console_gives():
     assert "+6.3 dB over the floor's smooth course" in lines[2] and "over the model" not in lines[2]
     assert "the data +1.5 dB over the model in its bins (median)" in next(ln for ln in lines if "speed_line" in ln)
     assert hump.strength() in hump.text() and line.strength() in line.text()
+
+
+def test_a_copy_with_no_band_of_its_own_reads_no_share_not_zero_percent():
+    """The new-user trial (session 43): Fy += 0.2·Fx, under a tenth of Fy's content in every band, read "0 % of
+    what is left" beside "the copy +40 dB over its noise"."""
+    u = _record(signature="channel_copy", channels=("Fy",), level_dB=None, share=0.0,
+                parameters={"source": "Fx", "target": "Fy", "gain": 0.2, "copy_over_noise_dB": 40.1})
+    assert "no band of what is left its own" in u.text() and "0 % of what is left" not in u.text()
+    assert "under a tenth of Fy's own content in every band" in u.text()
+
+
+def test_a_spring_fitted_a_hair_below_zero_far_above_reads_zero():
+    from rwadist.effects.fixed_resonance import FixedResonance
+
+    e = {"role": "test_stand", "f_Hz": 180.0, "zeta": 0.03, "peak_gain": 5.0, "directions": ["radial_force"]}
+    assert "-1.1e-06" not in FixedResonance.describe(dict(e, gain_above=-1.1e-06))
+    assert ", 0 of the load far above" in FixedResonance.describe(dict(e, gain_above=-1.1e-06))
+    assert ", 0.7 of the load far above" in FixedResonance.describe(dict(e, gain_above=0.7))
+    assert "of the load far above" not in FixedResonance.describe(dict(e, gain_above=1.0))

@@ -308,16 +308,18 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     ``changes``: the run-to-run change read on ``res`` (the data as given: the records the search read had the changed
     runs' factor taken out, :func:`run_steps`).  ``carriers``: the fixed lines found before the search
     (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands taken out with them."""
+    from .describe_affine import affine_lines, without_pieces
     from .describe_carrier import measure_track, on_a_sideband, sideband_lines, sideband_tracks
     from .describe_drift import with_drifts
     from .describe_filter import frequency_response
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded, channel_gain
+    from .describe_hump import broadband_hump, humps_in_some_runs
     from .describe_lines import speed_lines
     from .describe_partial import partial_lines
     from .describe_skew import channel_skew
     from .describe_split import split_mode
-    from .describe_structure import broadband_hump, line_ratios, moving_resonance, resolved_lines, run_change
+    from .describe_structure import line_ratios, moving_resonance, resolved_lines, run_change
     from .describe_trend import gain_trend
 
     res = searched if res is None else res
@@ -335,6 +337,17 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
             if c in res.e:
                 m = res.mask(c)
                 m[:, b0:b1 + 1] = True
+                cells[c] = m
+        return res.measure(cells)
+
+    def of_band_runs(chans, f0, f1, runs):
+        b0, b1 = int(res.band_of(f0)), int(res.band_of(f1))
+        rows = np.isin(ctx.runs, runs)
+        cells = {}
+        for c in chans:
+            if c in res.e:
+                m = res.mask(c)
+                m[rows, b0:b1 + 1] = True
                 cells[c] = m
         return res.measure(cells)
 
@@ -378,6 +391,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
               for x in state.model.harmonics(d)]
     # a narrow hump on a fixed line taken out before the search is its leftover lobe (trial 30: mains in Fz)
     out = [u for u in broadband_hump(ctx, state, of_band) if not on_a_fixed_line(u, carriers, float(ctx.sp.df))]
+    out += humps_in_some_runs(ctx, state, of_band_runs, out)
     # a moving resonance: read on lines resolved from their neighbours, described where its cells hold content
     out += [u for u in moving_resonance(ctx, state, [resolved_lines(ctx, state, r) for r in ratios], of_track)
             if holds_content(u, res)]
@@ -400,7 +414,10 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     # a gain common to the channels that changes with speed, on the recorded channels too; one of the line's frequency
     out += gain_trend(ctx, recorded := as_recorded(searched.state), of_line) + frequency_response(ctx, recorded, of_line)
     # a line whose ratio drifts with the speed (a cage slipping), and what its fixed-ratio model line made of it
-    return with_drifts(ctx, state, out, of_line)
+    out = with_drifts(ctx, state, out, of_line)
+    # a line on a straight track f0 + b·f_spin off both axes: the pieces the detectors above made of it are its own
+    affine = affine_lines(ctx, state, of_track_f, carriers)
+    return without_pieces(out, affine, float(ctx.df)) + affine
 
 
 #: A hump at most this many bins wide whose peak lies within its own width of a fixed line on one of its channels is
@@ -488,6 +505,9 @@ def cells_of(u, res: Residual) -> dict:
         rows = np.repeat(rows, sides.size)
         f = np.abs(p["carrier_Hz"] + np.tile(sides, rows.size // max(sides.size, 1)) * p["h"] * spin[rows])
         lo = hi = res.band_of(f)
+    elif u.signature == "affine_line" and "offset_Hz" in p:
+        b = res.band_of(p["offset_Hz"] + p["slope"] * spin[rows])
+        lo, hi = np.maximum(b - 1, 0), np.minimum(b + 1, ctx.n_bands - 1)
     elif u.signature == "moving_resonance" and "slope_Hz_per_Hz_of_spin" in p:
         f_lo, f_hi = p["f_at_lowest_speed_Hz"], p["f_at_highest_speed_Hz"]
         s_lo, s_hi = u.speed_rpm[0] / 60.0, u.speed_rpm[1] / 60.0

@@ -200,6 +200,11 @@ def _mark_unexplained(ax, c: str, diag: Diagnosis, rpm: np.ndarray) -> None:
             for side in u.parameters.get("sides", [1]):
                 ax.plot(np.abs(u.parameters["carrier_Hz"] + side * u.parameters["h"] * s / 60.0), s, ls=":", **style)
             _tag(ax, [u.parameters["carrier_Hz"]], [s1], f" {n}", va="top", **tag)
+        elif u.signature == "affine_line" and "offset_Hz" in u.parameters:
+            s = np.array([s0, s1])
+            f = u.parameters["offset_Hz"] + u.parameters["slope"] * s / 60.0
+            ax.plot(f, s, ls=":", **style)
+            _tag(ax, f, s, f" {n}", va="top", **tag)
         elif u.signature == "partial_line" and u.h is not None:
             # a short mark on the line's ray at each run it is absent from
             s = np.asarray(u.parameters.get("absent_rpm", []), float)
@@ -248,9 +253,8 @@ def _rms_figure(diag: Diagnosis, cols: dict):
         ax.set_xlabel("Wheel speed (rpm)")
         if j == 0:
             ax.legend(fontsize=8)
-    lo = float(ctx.f[ctx.k_lo]) - 0.5 * ctx.df
-    hi = float(ctx.f[ctx.k_lo + ctx.n_bands * BAND_BINS - 1]) + 0.5 * ctx.df
-    fig.suptitle(f"RMS vs wheel speed over {max(lo, 0.0):.3g}–{hi:.0f} Hz (the metric's band): data and the model "
+    lo, hi = diag.band_Hz
+    fig.suptitle(f"RMS vs wheel speed over {lo:.3g}–{hi:.0f} Hz (the metric's band): data and the model "
                  "before and after diagnose")
     fig.tight_layout()
     return fig
@@ -388,6 +392,8 @@ def write_report(diag: Diagnosis, out_dir) -> list:
     md = ["# rwadist diagnose", "",
           f"Metric: `{METRIC}` — {summary['metric_definition']}; a band's misplaced power is counted beyond "
           f"{NOISE_Z:g} noise standard deviations.", "",
+          f"- band analysed: {summary['band_Hz'][0]:.3g}-{summary['band_Hz'][1]:.4g} Hz (the metrics' bands; "
+          "`--f-lim` narrows it)",
           f"- base: {diag.state_before.base} (lines "
           + ("through the suspension modes of the model's analytical section)" if diag.state_before.ext is not None
              else "C·Ω², hard mounted)")

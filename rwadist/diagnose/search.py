@@ -103,6 +103,13 @@ class Diagnosis:
         return [(d, float(x.h), float(x.C), getattr(x, "sense", None)) for d in DIRECTIONS
                 for x in self.model.harmonics(d) if not any(abs(x.h - y.h) < 0.03 for y in given.harmonics(d))]
 
+    @property
+    def band_Hz(self) -> tuple:
+        """(lowest, highest) frequency of the bands the metrics count, Hz (the band analysed)."""
+        ctx = self.ctx
+        return (max(float(ctx.f[ctx.k_lo]) - 0.5 * ctx.df, 0.0),
+                float(ctx.f[min(ctx.k_lo + ctx.n_bands * BAND_BINS - 1, ctx.f.size - 1)]) + 0.5 * ctx.df)
+
     def summary(self) -> dict:
         chosen = [h for h in self.hypotheses if h.passed and not h.base_line]
         return {
@@ -110,6 +117,7 @@ class Diagnosis:
             "base": self.state_before.base, "base_after": self.state_after.base,
             "metric_definition": "sum over channels, runs and %d-bin bands of |data - model| power / sum of "
                                  "data power (each channel divided by the mean power of its unit group)" % BAND_BINS,
+            "band_Hz": list(self.band_Hz),
             "error_before": self.error_before, "error_after": self.error_after,
             "narrow_line_metric": CONTRAST_METRIC,
             "narrow_line_metric_definition": "mean over every channel, run and %d-bin band of max(|data - model| - "

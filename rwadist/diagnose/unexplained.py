@@ -43,6 +43,8 @@ SIGNATURES = {
     "run_change": "a run-to-run change",
     "partial_line": "a model line present in some runs and absent from others",
     "sideband_line": "lines at a fixed line's frequency plus or minus a constant ratio of the speed",
+    "affine_line": "a line whose frequency moves with the speed as f0 + b × the speed, neither fixed nor at a "
+                   "constant ratio of it",
 }
 
 #: How ``level_dB`` reads for the signatures whose level is not the data over the model in their cells.
@@ -229,7 +231,11 @@ class Unexplained:
 
     def text(self) -> str:
         """The console's one line: signature, where, strength, share, the first cause and what would tell."""
-        out = f"{self.signature}: {self.where()}, {self.strength()}, {self.share_text()} of what is left"
+        if self.signature == "channel_copy" and _number(self.level_dB) is None:
+            share = "no band of what is left its own"           # its cells are none (:meth:`strength`), not 0 %
+        else:
+            share = f"{self.share_text()} of what is left"
+        out = f"{self.signature}: {self.where()}, {self.strength()}, {share}"
         if self.causes:
             out += f"; could be {self.causes[0]}"
         if self.would_tell:

@@ -1,0 +1,226 @@
+"""Detector of the open world (issue 33, item 3) on the final model's residual: a line whose frequency moves with the
+speed along a straight line that passes neither through 0 Hz nor stays at one frequency, f = f0 + b·|Ω|/2π (an
+``affine_line``).
+
+A source at a fixed frequency mixed with a line of the rotor (a product of the two: an amplitude modulation, a
+nonlinearity, a drive's switching frequency modulated by the commutation) puts a line at f0 ± b·f_spin while the
+carrier itself may stay under the noise; a ratio that falls with speed as b + f0/f_spin reads the same over a speed
+range.  Neither the fixed lines, nor the speed lines, nor a fixed line's sidebands (a carrier found in the data) hold
+it: each takes a piece (the new-user generator's line at 40 Hz + 0.5·f_spin on Fz and Tz, 1000-10000 rpm: a speed
+line h 0.80 over the upper half, two fixed lines at 72.8 and 104.8 Hz over parts of the speeds and a ratio drift
+named a cage slipping).  Found as a straight ridge of lit bins (:func:`.describe_lines._lit`, narrow: a line, not a
+hump) in the plane of speed and frequency, pooled over the channels: for each slope b on a grid whose step moves the
+track :data:`SLOPE_STEP_BINS` Welch bins over the speed range, each run's lit bins shifted by b·f_spin and counted per
+offset; a track lit in :data:`~.describe_lines.RIDGE_FRACTION` of the runs where it lies in the band (and
+:data:`MIN_RUNS` of them), that moves :data:`MIN_MOVE_BINS` Welch bins over its speeds (else a fixed line) and
+departs :data:`MIN_OFFSET_BINS` Welch bins from the best line at a constant ratio through it (else a speed line), at
+an offset that is no fixed line of the data (else that line's sideband), standing :data:`MIN_LEVEL_DB` over the
+model in its cells.  Its offset and slope are then read on the peaks of its lit runs (a parabola through the top
+three bins' log powers, a least-squares line), which lie on it within :data:`MAX_MISFIT_BINS`.  The pieces the other
+detectors made of it are its own (:func:`without_pieces`).  Steady runs only: a sweep's slice smears a line over
+bins by the speed's change within it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .describe_lines import RIDGE_FRACTION, _lit, log_parabola_offset, sliced
+from .unexplained import Unexplained
+
+#: The slope grid's step moves a track this many Welch bins over the runs' speed range.
+SLOPE_STEP_BINS = 0.5
+#: Largest |slope| searched (Hz per Hz of spin).
+MAX_SLOPE = 4.0
+#: Runs the track is lit in, at least.
+MIN_RUNS = 8
+#: The track moves this many Welch bins over its lit runs' speeds, at least (else a fixed line's).
+MIN_MOVE_BINS = 4.0
+#: The track departs this many Welch bins, at its worst run, from the best constant-ratio line through it (else a
+#: speed line's).
+MIN_OFFSET_BINS = 4.0
+#: Two tracks closer than this many Welch bins over the whole speed range are one.
+SAME_TRACK_BINS = 3.0
+#: A channel carries the line when lit in this fraction of its lit runs.
+CHANNEL_FRACTION = 0.5
+#: An offset within this many Welch bins of a fixed line of the data is that line's sideband.
+CARRIER_BINS = 2.0
+#: The peaks read in its lit runs lie on the straight line within this RMS (Welch bins): a line's peak is read to a
+#: tenth of a bin (the new-user generator's 40 Hz + 0.5·f_spin: 0.01 bin); a chance alignment of lit noise is not
+#: a line (the same data's other seed: 1.4 bins, 4.7 dB over the model).
+MAX_MISFIT_BINS = 0.5
+#: The data over the model in its cells, at least (dB).
+MIN_LEVEL_DB = 6.0
+
+
+def _segments(lit: np.ndarray) -> np.ndarray:
+    """Labels (runs, n_f) of the runs of consecutive lit bins of ``lit`` within each run (0 where unlit), each its own
+    label: a strong line lights several bins, through which several slopes pass."""
+    from scipy.ndimage import label
+
+    return label(lit, structure=np.array([[0, 0, 0], [1, 1, 1], [0, 0, 0]]))[0]
+
+
+def _tracks(lit: np.ndarray, spin: np.ndarray, df: float, k_lo: int, k_hi: int) -> tuple:
+    """(tracks, segment labels (:func:`_segments`)): the tracks (slope b, offset bin j, runs lit (bool per run), fraction lit, lit segment label per run (0 where
+    unlit)) of the pooled lit map ``lit`` (runs, n_f), the best first; a track whose lit segments are mostly a better
+    one's is that one (a strong line's segments several bins wide let several slopes through)."""
+    R, K = lit.shape
+    span = float(spin.max() - spin.min())
+    seg = _segments(lit)
+    if span <= 0:
+        return [], seg
+    step = SLOPE_STEP_BINS * df / span
+    slopes = np.arange(-MAX_SLOPE, MAX_SLOPE + step / 2, step)
+    slopes = slopes[np.abs(slopes) * span >= MIN_MOVE_BINS * df]
+    r_lit, k_lit = np.nonzero(lit)                                      # the lit cells alone: the map is sparse
+    r_lit, k_lit = r_lit[(k_lit >= k_lo) & (k_lit <= k_hi)], k_lit[(k_lit >= k_lo) & (k_lit <= k_hi)]
+    pad = int(np.ceil(MAX_SLOPE * spin.max() / df)) + 1                 # offsets j from -pad (a line below b·f_spin)
+    size = K + 2 * pad
+    cands = []
+    for b in slopes:
+        shift = np.rint(b * spin / df).astype(int)                     # (R,) bins the track moves in each run
+        # runs lit on the track of offset j (j = k - shift, one cell per run), and runs where it lies in the band
+        n_hit = np.bincount(k_lit - shift[r_lit] + pad, minlength=size)
+        n_in = np.cumsum(np.bincount(k_lo - shift + pad, minlength=size + 1)
+                         - np.bincount(k_hi - shift + 1 + pad, minlength=size + 1))[:size]
+        frac = np.where(n_in >= MIN_RUNS, n_hit / np.maximum(n_in, 1), 0.0)
+        for jj in np.flatnonzero((frac >= RIDGE_FRACTION) & (n_hit >= MIN_RUNS)) - pad:
+            k = jj + shift
+            inb = (k >= k_lo) & (k <= k_hi)
+            hit = lit[np.arange(R), np.clip(k, 0, K - 1)] & inb
+            labels = np.where(hit, seg[np.arange(R), np.clip(k, 0, K - 1)], 0)
+            cands.append((float(frac[jj + pad]) * n_hit[jj + pad], float(b), int(jj), hit, float(frac[jj + pad]),
+                          labels))
+    cands.sort(key=lambda x: -x[0])
+    out: list = []
+    claimed: set = set()
+    for cand in cands:
+        mine = cand[5][cand[5] > 0]
+        if mine.size < MIN_RUNS or sum(x in claimed for x in mine.tolist()) >= 0.5 * mine.size:
+            continue
+        claimed.update(mine.tolist())
+        out.append(cand[1:])
+    return out, seg
+
+
+def _read_track(ctx, state, chans, runs: np.ndarray, windows: list) -> tuple | None:
+    """(offset f0 Hz, slope b, RMS misfit Hz) of the line in ``windows`` ((first, last) bin of its lit segment in
+    each run of ``runs``): each run's peak of the data over the model summed over ``chans`` there, refined by a
+    parabola through the log powers of the top three bins, a least-squares line through them against f_spin."""
+    df = ctx.df
+    pos = {int(r): i for i, r in enumerate(ctx.runs)}
+    rows = np.array([pos[int(r)] for r in runs])
+    ratio = sum(ctx.data(state, c, ctx.runs)[ctx.runs][rows] / np.maximum(ctx.predict(state, c, ctx.runs)[rows],
+                                                                            1e-300) for c in chans)
+    f_pk = np.full(runs.size, np.nan)
+    for i, (a, z) in enumerate(windows):
+        a, z = max(a, 1), min(z, ratio.shape[1] - 2)
+        if z < a or not np.all(np.isfinite(ratio[i, a - 1:z + 2])):
+            continue
+        k = a + int(np.argmax(ratio[i, a:z + 1]))
+        f_pk[i] = (k + log_parabola_offset(ratio[i, k - 1:k + 2])) * df
+    ok = np.isfinite(f_pk)
+    if ok.sum() < MIN_RUNS:
+        return None
+    spin = np.abs(ctx.omega[runs[ok]]) / (2 * np.pi)
+    b, f0 = np.polyfit(spin, f_pk[ok], 1)
+    rms = float(np.sqrt(np.mean((f_pk[ok] - (f0 + b * spin)) ** 2)))
+    return float(f0), float(b), rms
+
+
+def _offset_from_ratio(f0: float, b: float, spin: np.ndarray) -> float:
+    """Largest distance (Hz) over ``spin`` (Hz) of the track f0 + b·f_spin from the best line h·f_spin through it."""
+    f = f0 + b * spin
+    h = float(np.dot(f, spin) / np.dot(spin, spin))
+    return float(np.max(np.abs(f - h * spin)))
+
+
+def affine_lines(ctx, state, shares, carriers=()) -> list:
+    """``affine_line`` records of the residual's straight ridges f = f0 + b·f_spin (module docstring); ``shares``
+    gives (share, level) of a track's cells (channels, frequency per run, runs), ``carriers`` the fixed lines found
+    before the search (:class:`~rwadist.diagnose.fixed_lines.FixedLine`)."""
+    runs = ctx.runs
+    if runs.size < MIN_RUNS or sliced(ctx):
+        return []
+    df = float(ctx.df)
+    spin = np.abs(ctx.omega[runs]) / (2 * np.pi)
+    lits = {c: _lit(ctx, state, c, narrow=True) for c in ctx.channels}
+    pooled = np.any(np.stack(list(lits.values())), axis=0)
+    out: list[Unexplained] = []
+    tracks, seg = _tracks(pooled, spin, df, ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1))
+    bins = np.arange(ctx.f.size)
+    for b, jj, runs_lit, frac, labels in tracks:
+        s = spin[runs_lit]
+        if np.ptp(b * s) < MIN_MOVE_BINS * df or _offset_from_ratio(jj * df, b, s) < MIN_OFFSET_BINS * df:
+            continue
+        k_run = np.clip(np.rint((jj * df + b * s) / df).astype(int), 0, ctx.f.size - 1)
+        chans = tuple(c for c in ctx.channels if lits[c][runs_lit][np.arange(s.size), k_run].mean() >= CHANNEL_FRACTION)
+        if not chans:
+            continue
+        rows = np.flatnonzero(runs_lit)
+        windows = [(int(bins[seg[i] == labels[i]].min()), int(bins[seg[i] == labels[i]].max())) for i in rows]
+        got = _read_track(ctx, state, chans, runs[runs_lit], windows)
+        if got is None:
+            continue
+        f0, b, rms = got
+        if rms > MAX_MISFIT_BINS * df or np.ptp(b * s) < MIN_MOVE_BINS * df or \
+                _offset_from_ratio(f0, b, s) < MIN_OFFSET_BINS * df or any(abs(f0 - ln.f_Hz) <= CARRIER_BINS * df for ln in carriers) or \
+                any(np.max(np.abs(f0 + b * s - track_of(u, s))) <= SAME_TRACK_BINS * df for u in out):
+            continue
+        f_run = f0 + b * s
+        share, level = shares(chans, f_run, runs[runs_lit])
+        if not level >= MIN_LEVEL_DB:
+            continue
+        rpm = s * 60.0
+        out.append(Unexplained(
+            signature="affine_line", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
+            f_Hz=(float(f_run.min()), float(f_run.max())), level_dB=level, share=share, n_runs=int(s.size),
+            parameters={"offset_Hz": f0, "slope": b, "misfit_rms_Hz": rms, "lit_fraction": frac,
+                        "h_at_lowest_speed": float(f_run[np.argmin(s)] / s.min()),
+                        "h_at_highest_speed": float(f_run[np.argmax(s)] / s.max())},
+            causes=_causes(f0, b),
+            would_tell="a record with the wheel still shows a source of its own at the offset frequency; runs at more "
+                       "speeds, and below and above these, show whether the offset stays fixed (a mixing of two "
+                       "sources) or the ratio keeps drifting (a slip)"))
+    return out
+
+
+def _causes(f0: float, b: float) -> tuple:
+    """What a line at f0 + b·f_spin could be."""
+    sign = "+" if b >= 0 else "−"
+    out = [f"a source at {abs(f0):.4g} Hz (a machine of the stand, the electronics, a structural resonance rung "
+           f"steadily) mixed with a line of the rotor at {abs(b):.3g} × the speed: f = {f0:.4g} Hz {sign} "
+           f"{abs(b):.3g}·f_spin, a product of the two (an amplitude modulation, a nonlinear joint or sensor) whose "
+           "carrier stays under the noise"]
+    if abs(b - round(b)) <= 0.02 and round(b) >= 1:
+        out.append(f"a motor drive's switching frequency ({abs(f0):.4g} Hz) modulated by the commutation at "
+                   f"{round(b)} × the speed ({round(b)} pole pairs, or a multiple)")
+    out.append("a line whose ratio to the speed drifts as b + f0/f_spin over these speeds (a slip that grows with "
+               "the speed), which a fixed offset describes here")
+    return tuple(out)
+
+
+def without_pieces(records: list, affine: list, df: float) -> list:
+    """``records`` without the pieces the other detectors made of an ``affine_line`` of ``affine``: a ``fixed_line``,
+    ``speed_line``, ``partial_line`` or ratio-drift ``line_property`` on a channel of the track whose frequency meets
+    the track (within 2 Welch bins of ``df`` Hz) over its own speed range."""
+    def meets(u, a) -> bool:
+        if not set(u.channels) & set(a.channels):
+            return False
+        if not (u.signature in ("fixed_line", "speed_line", "partial_line") or
+                (u.signature == "line_property" and u.parameters.get("property") == "ratio_drift")):
+            return False
+        lo, hi = max(u.speed_rpm[0], a.speed_rpm[0]), min(u.speed_rpm[1], a.speed_rpm[1])
+        if lo > hi:
+            return False
+        s = np.linspace(lo, hi, 64) / 60.0
+        track = a.parameters["offset_Hz"] + a.parameters["slope"] * s
+        piece = np.full(s.size, u.f_Hz[0]) if u.signature == "fixed_line" or u.h is None else u.h * s
+        gap = track - piece
+        return bool(np.min(np.abs(gap)) <= 2 * df or np.min(gap) < 0 < np.max(gap))
+    return [u for u in records if not any(meets(u, a) for a in affine)]
+
+
+def track_of(u, spin: np.ndarray) -> np.ndarray:
+    """The frequency (Hz) of the ``affine_line`` record ``u`` at the spin frequencies ``spin`` (Hz)."""
+    return u.parameters["offset_Hz"] + u.parameters["slope"] * np.asarray(spin, dtype=float)

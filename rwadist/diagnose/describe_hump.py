@@ -1,0 +1,338 @@
+"""Detector of the open world (issue 33, item 3) on the final model's residual: a broadband hump above the noise
+floor (a ``broadband_hump``), in every run or in some runs only, and whether it is made of impacts.
+
+The model takes the data's noise floor as instrument noise at every speed, read per bin from the data themselves; a
+hump in it (a fixture or sensor resonance excited by the surroundings, a pump of the stand, a part rattling) is then
+in the model and nowhere on the residual waterfall.  Found on the data's own floor clear of the model's lines
+(:func:`clean_floor`): against its smooth course, against its lower course for a hump wider than the running median
+sees (:func:`broadband_hump`), and run by run against that floor for a hump in some runs only
+(:func:`humps_in_some_runs`); in the records, band-passed to the hump, its kurtosis tells impacts from noise
+(:func:`impulsiveness`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..units import RAD_S_TO_RPM
+from .unexplained import Unexplained
+
+#: A hump stands this far over the floor's smooth course (dB) at its peak, over at least HUMP_MIN_BINS bins
+#: (wider than a line's main lobe) and at most a quarter of the band.
+HUMP_PEAK_DB = 4.0
+HUMP_EDGE_DB = 2.0
+HUMP_MIN_BINS = 4
+#: The floor's smooth course: a running median over this fraction of the band's bins.
+HUMP_BASELINE_FRACTION = 0.125
+#: A hump wider than the running median sees (a band wider than an eighth of the band, or a rattle's ringing whose
+#: skirts cover the band: the new-user generator's 450 +- 50 Hz and 350 Hz ringing at 2 kHz, 22 and 13 dB over the
+#: floor, read 0 dB by the running median) is measured against the floor's lower course: at each bin, the higher of
+#: the lowest floor on its left and on its right (a floor that only falls or only rises, a 1/f floor or a filter's
+#: roll-off, stands 0 dB over it), after a running median over this fraction of the band that takes out the noise,
+#: and must stand HUMP_WIDE_PEAK_DB over it at its peak.
+HUMP_WIDE_SMOOTH_FRACTION = 1.0 / 64.0
+HUMP_WIDE_PEAK_DB = 6.0
+#: A bin is clear of the model's lines in a run where their predicted PSD is below this fraction of the floor.
+CLEAN_LINE_FRACTION = 0.01
+
+
+def _running_median(x: np.ndarray, half: int) -> np.ndarray:
+    """Running median of ``x`` (1-D) over ±``half`` points (shrinking at the ends)."""
+    from scipy.ndimage import median_filter
+
+    return median_filter(x, size=2 * half + 1, mode="nearest")
+
+
+def _lower_course(lf: np.ndarray, k_lo: int, k_hi: int) -> np.ndarray:
+    """The floor's lower course (dB per bin, ``lf`` smoothed by a running median over
+    :data:`HUMP_WIDE_SMOOTH_FRACTION` of the band): at each bin of [k_lo, k_hi] the higher of the lowest value on its
+    left and the lowest on its right, so only what rises and falls again stands over it."""
+    half = max(int(HUMP_WIDE_SMOOTH_FRACTION * (k_hi - k_lo) / 2), HUMP_MIN_BINS)
+    smooth = _running_median(lf, half)
+    band = smooth[k_lo:k_hi + 1]
+    course = np.full(lf.size, np.inf)
+    course[k_lo:k_hi + 1] = np.maximum(np.minimum.accumulate(band), np.minimum.accumulate(band[::-1])[::-1])
+    return smooth - course
+
+
+def _humps(excess_db: np.ndarray, k_lo: int, k_hi: int, max_width: int | None = None,
+           peak_db: float = HUMP_PEAK_DB) -> list:
+    """(k0, k1, peak bin) of every run of bins in [k_lo, k_hi] standing HUMP_EDGE_DB over the course and
+    ``peak_db`` at its peak, HUMP_MIN_BINS to ``max_width`` (a quarter of the band) wide."""
+    max_width = (k_hi - k_lo) // 4 if max_width is None else max_width
+    above = excess_db >= HUMP_EDGE_DB
+    above[:k_lo] = False
+    above[k_hi + 1:] = False
+    out = []
+    k = k_lo
+    while k <= k_hi:
+        if not above[k]:
+            k += 1
+            continue
+        k1 = k
+        while k1 + 1 <= k_hi and above[k1 + 1]:
+            k1 += 1
+        width = k1 - k + 1
+        if HUMP_MIN_BINS <= width <= max_width:
+            pk = k + int(np.argmax(excess_db[k:k1 + 1]))
+            if excess_db[pk] >= peak_db:
+                out.append((k, k1, pk))
+        k = k1 + 1
+    return out
+
+
+def clean_floor(ctx, state, c: str) -> np.ndarray:
+    """The data's own noise floor of channel ``c`` per bin (n_f,): the median over the runs of the data's PSD at the
+    bins where the model's lines stand below :data:`CLEAN_LINE_FRACTION` of its floor in that run (the noise alone,
+    clear of every line's leakage and of a misfit of it), NaN where fewer than a quarter of the runs (and 3) are."""
+    from .reduce import column_nanmedian
+
+    runs = ctx.runs
+    ok = np.isfinite(ctx.sp.psd[c][runs, 0])
+    runs = runs[ok]
+    D = ctx.data(state, c, runs)[runs]
+    N = ctx.floor_psd(state, c, runs)
+    clean = (ctx.predict(state, c, runs) - N) < CLEAN_LINE_FRACTION * N
+    count = clean.sum(0)
+    med = column_nanmedian(np.where(clean, D, np.nan))
+    return np.where(count >= max(3, runs.size // 4), med, np.nan)
+
+
+def broadband_hump(ctx, state, shares) -> list:
+    """A broadband hump: the data's own noise floor (:func:`clean_floor`, 3-bin means of its dB) standing over its
+    smooth course (a running median over an eighth of the band) by :data:`HUMP_PEAK_DB` at its peak, over a
+    frequency range wider than a line and narrower than a quarter of the band, or over its lower course
+    (:func:`_lower_course`) by :data:`HUMP_WIDE_PEAK_DB`, however wide, in one channel or several (one
+    record, the channels listed).  The model takes such a hump as instrument noise (at every speed) or, growing with
+    speed as a power law, as the ``broadband_floor`` class (whose floor is not counted here: it is the data's
+    floor less the class's).  What it could be: a fixture or sensor resonance excited by the surroundings, a pump
+    or fan of the stand, the electronics' own noise shape."""
+    k_lo, k_hi = ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1)
+    found: dict[int, list[tuple[str, int, int, int, float]]] = {}     # peak bin -> (channel, k0, k1, peak, excess dB)
+    half = max(int(HUMP_BASELINE_FRACTION * (k_hi - k_lo) / 2), 3 * HUMP_MIN_BINS)
+    floors = {}
+    for c in ctx.channels:
+        fl = clean_floor(ctx, state, c)
+        if c in state.floors:                   # a floor the broadband_floor class holds is explained
+            ref, w_ref, p = state.floors[c]
+            fl = fl - ref * (np.median(ctx.omega[ctx.runs]) / w_ref) ** p
+        valid = np.isfinite(fl) & (fl > 0)
+        if valid[k_lo:k_hi + 1].sum() < 4 * HUMP_MIN_BINS:
+            continue
+        k = np.arange(fl.size)
+        lf = np.interp(k, k[valid], 10 * np.log10(fl[valid]))
+        lf = np.convolve(lf, np.ones(3) / 3.0, mode="same")
+        excess = np.where(valid, lf - _running_median(lf, half), -np.inf)
+        wide = np.where(valid, _lower_course(lf, k_lo, k_hi), -np.inf)
+        floors[c] = (fl, lf)
+        narrow = _humps(excess, k_lo, k_hi)
+        broad = [(k0, k1, pk) for k0, k1, pk in _humps(wide, k_lo, k_hi, k_hi - k_lo, HUMP_WIDE_PEAK_DB)
+                 if not any(a <= pk <= b for a, b, _ in narrow)]
+        for (k0, k1, pk), ex in [(h, excess) for h in narrow] + [(h, wide) for h in broad]:
+            key = next((x for x in found if abs(x - pk) <= max(3, (k1 - k0) // 2)), pk)
+            found.setdefault(key, []).append((c, k0, k1, pk, float(ex[pk])))
+    out = []
+    for items in found.values():
+        chans = tuple(x[0] for x in items)
+        k0, k1 = min(x[1] for x in items), max(x[2] for x in items)
+        peak = max(items, key=lambda x: x[4])
+        f0, f1, fp = ctx.f[k0], ctx.f[k1], ctx.f[peak[3]]
+        if _at_a_fitted_resonance(ctx, state, fp, chans):
+            continue
+        share, level = shares(chans, f0, f1)
+        rpm = ctx.omega[ctx.runs] * RAD_S_TO_RPM
+        width = float(_half_power_width(ctx, floors[peak[0]][1], peak[3]))
+        kurt = impulsiveness(ctx, state, chans, ctx.runs, fp, width)
+        out.append(Unexplained(
+            signature="broadband_hump", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
+            f_Hz=(float(f0), float(f1)), level_dB=peak[4], share=share, n_runs=int(ctx.runs.size),
+            parameters={"peak_Hz": float(fp), "peak_over_floor_dB": peak[4], "over_the_model_dB": level,
+                        "half_power_width_Hz": width, "in_every_run": True, "kurtosis": kurt},
+            causes=_hump_causes(kurt, fp, "at every speed"),
+            would_tell=_HUMP_TELLS))
+    return out
+
+
+_HUMP_TELLS = ("a record with the wheel still (stand running, then stopped) shows a hump of the stand or its "
+               "surroundings; one in the electronics stays with the cell unloaded; a tap test of the fixture finds a "
+               "resonance there; a loose part rattles on a shaker or by hand")
+#: The records band-passed to a hump (its half-power width about its peak, the model's lines' bins left out) have
+#: kurtosis 3 when it is noise; above this, impacts ringing a resonance: a rattle (the open-world cases' 20 impacts a
+#: second ringing at 700 Hz, ζ 0.05: kurtosis 8-9).  A kurtosis is read on at most IMPULSE_RUNS runs.
+IMPULSIVE_KURTOSIS = 4.5
+IMPULSE_RUNS = 12
+
+
+def impulsiveness(ctx, state, chans, runs, f_peak: float, width: float) -> float | None:
+    """The median over ``chans`` and up to :data:`IMPULSE_RUNS` of ``runs`` of the kurtosis E[y⁴]/E[y²]² of the
+    records band-passed to ``f_peak`` ± ``width`` (Hz) by their whole-record FFT (a 10 % Tukey taper first, the
+    moments over the middle 80 %: the record's ends wrapped onto each other are a step), the bins where a model line
+    stands over the floor (the Welch bin's prediction over twice its floor) left out: 3 for Gaussian noise, more for
+    impacts; None without the records."""
+    from scipy.signal.windows import tukey
+
+    def taper(n):
+        return tukey(n, 0.1)
+
+    test = getattr(ctx, "test", None)
+    if test is None or width <= 0:
+        return None
+    runs = np.asarray(runs)[np.linspace(0, len(runs) - 1, min(len(runs), IMPULSE_RUNS)).astype(int)]
+    pos = {int(r): i for i, r in enumerate(ctx.runs)}
+    out = []
+    for c in chans:
+        M, N = ctx.predict(state, c, ctx.runs), ctx.floor_psd(state, c, ctx.runs)
+        for r in runs:
+            run = test.runs[int(r)]
+            if c not in run.signals:
+                continue
+            x = np.asarray(run.signals[c], dtype=float)
+            x = (x - x.mean()) * taper(x.size)
+            f = np.fft.rfftfreq(x.size, 1.0 / run.sample_rate)
+            k = np.clip(np.rint(f / ctx.df).astype(int), 0, ctx.f.size - 1)
+            lines = M[pos[int(r)], k] > 2.0 * N[pos[int(r)], k]
+            keep = (np.abs(f - f_peak) <= width) & ~lines
+            if keep.sum() < 8:
+                continue
+            y = np.fft.irfft(np.where(keep, np.fft.rfft(x), 0.0), n=x.size)
+            y = y[x.size // 10: x.size - x.size // 10]      # clear of the taper and the filter's wrap-around
+            m2 = float(np.mean(y * y))
+            if m2 > 0:
+                out.append(float(np.mean(y ** 4)) / m2 ** 2)
+    return float(np.median(out)) if out else None
+
+
+def _hump_causes(kurt: float | None, f_peak: float, when: str) -> tuple:
+    """What a hump could be: impacts ringing a resonance first when its kurtosis says so."""
+    noise = (f"a resonance of the fixture or the load cell excited by the surroundings (the floor, pumps, air) {when}",
+             "a pump, fan or compressor of the stand (broadband, at one frequency whatever the wheel does)",
+             "the shape of the sensor or amplifier noise (a filter's peaking)")
+    if kurt is not None and kurt >= IMPULSIVE_KURTOSIS:
+        return (f"impacts ringing a resonance at {f_peak:.4g} Hz (kurtosis {kurt:.1f} in its band, 3 for noise): a "
+                "loose part, fastener or cable rattling, or a bearing's defect struck by its balls",) + noise[:1]
+    return noise
+
+
+#: A hump in some runs only: a run's floor over the floor of the runs (the median, :func:`clean_floor`), each run's
+#: dB first averaged over RUN_HUMP_SMOOTH_FRACTION of the band (a Welch bin's dB scatters by 1-2 dB), by this much (dB)
+#: at its peak in at least RUN_HUMP_RUNS runs whose peaks lie within RUN_HUMP_PEAKS_FRACTION of the band of each
+#: other, and in at most RUN_HUMP_MAX_FRACTION of the runs (in more, the floor of the runs holds it:
+#: :func:`broadband_hump`); it spans the bins around that peak where those runs' mean excess stands RUN_HUMP_EDGE_DB.
+#: A rattle in every third run (the new-user generator's 700 Hz impacts at 4 kHz) lifts its runs' floor 10-20 dB at
+#: its ringing and by 2-6 dB over most of the band (its skirts).
+RUN_HUMP_PEAK_DB = 6.0
+RUN_HUMP_EDGE_DB = 2.0
+RUN_HUMP_SMOOTH_FRACTION = 1.0 / 64.0
+RUN_HUMP_RUNS = 2
+RUN_HUMP_MAX_FRACTION = 0.6
+RUN_HUMP_PEAKS_FRACTION = 1.0 / 16.0
+
+
+def _run_excess(ctx, state, c: str, width: int) -> np.ndarray:
+    """Each run's clean floor over the runs' (:func:`clean_floor`), dB (runs, n_f), averaged over ``width`` bins;
+    NaN where a model line stands in that run or no floor is known."""
+    from scipy.ndimage import uniform_filter1d
+
+    runs = ctx.runs
+    D = ctx.data(state, c, runs)[runs]
+    N = ctx.floor_psd(state, c, runs)
+    clean = (ctx.predict(state, c, runs) - N) < CLEAN_LINE_FRACTION * N
+    ref = clean_floor(ctx, state, c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = np.where(clean & (D > 0) & (ref[None, :] > 0), 10 * np.log10(D / ref[None, :]), np.nan)
+    ok = np.isfinite(x)
+    total = uniform_filter1d(np.where(ok, x, 0.0), width, axis=1, mode="nearest")
+    count = uniform_filter1d(ok.astype(float), width, axis=1, mode="nearest")
+    return np.where(count >= 0.5, total / np.maximum(count, 1e-12), np.nan)
+
+
+def _mean_of_finite(x: np.ndarray) -> np.ndarray:
+    """Column means of the finite entries of ``x`` (rows, n), NaN where a column has none."""
+    ok = np.isfinite(x)
+    n = ok.sum(0)
+    return np.where(n > 0, np.where(ok, x, 0.0).sum(0) / np.maximum(n, 1), np.nan)
+
+
+def humps_in_some_runs(ctx, state, shares, every=()) -> list:
+    """``broadband_hump`` records of a hump in some runs only (:data:`RUN_HUMP_PEAK_DB`): the runs whose floor
+    stands over the runs' floor at one frequency in one channel or several, one record with the channels where their
+    mean excess does, none where a hump of ``every`` (the humps in every run) peaks.  ``shares(chans, f0, f1,
+    runs)``: (share, level) of the cells of the band in those runs (indices of the test)."""
+    k_lo, k_hi = ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1)
+    R = ctx.runs.size
+    if R < 2 * RUN_HUMP_RUNS or k_hi - k_lo < 16:
+        return []
+    width = max(3, int(RUN_HUMP_SMOOTH_FRACTION * (k_hi - k_lo)))
+    ex = {c: _run_excess(ctx, state, c, width) for c in ctx.channels}
+    band = np.zeros(ctx.f.size, bool)
+    band[k_lo:k_hi + 1] = True
+    pooled = np.max(np.stack([np.where(np.isfinite(e) & band, e, -np.inf) for e in ex.values()]), axis=0)
+    peak_bin, peak_db = np.argmax(pooled, axis=1), np.max(pooled, axis=1)
+    hot = np.flatnonzero(peak_db >= RUN_HUMP_PEAK_DB)
+    near = max(RUN_HUMP_PEAKS_FRACTION * (k_hi - k_lo), width)
+    out: list[Unexplained] = []
+    while hot.size >= RUN_HUMP_RUNS:
+        centre = np.median(peak_bin[hot])
+        rows = hot[np.abs(peak_bin[hot] - centre) <= near]
+        hot = np.setdiff1d(hot, rows)
+        if not RUN_HUMP_RUNS <= rows.size <= RUN_HUMP_MAX_FRACTION * R:
+            continue
+        mean = {c: _mean_of_finite(e[rows]) for c, e in ex.items()}
+        pk = int(np.rint(np.median(peak_bin[rows])))
+        if not k_lo + width <= pk <= k_hi - width:          # a floor rising to the band's edge is no hump
+            continue
+        chans = tuple(c for c in ctx.channels if np.nanmax(mean[c][max(pk - width, 0):pk + width + 1],
+                                                           initial=-np.inf) >= RUN_HUMP_PEAK_DB)
+        if not chans:
+            continue
+        m = np.max(np.stack([np.where(np.isfinite(mean[c]), mean[c], -np.inf) for c in chans]), axis=0)
+        k0 = k1 = pk
+        while k0 - 1 >= k_lo and m[k0 - 1] >= RUN_HUMP_EDGE_DB:
+            k0 -= 1
+        while k1 + 1 <= k_hi and m[k1 + 1] >= RUN_HUMP_EDGE_DB:
+            k1 += 1
+        f0, f1 = float(ctx.f[k0]), float(ctx.f[k1])
+        fp = float(ctx.f[k0 + int(np.argmax(m[k0:k1 + 1]))])
+        if any(u.f_Hz[0] <= fp <= u.f_Hz[1] for u in every) or _at_a_fitted_resonance(ctx, state, fp, chans):
+            continue
+        runs = ctx.runs[rows]
+        share, level = shares(chans, f0, f1, runs)
+        rpm = np.sort(ctx.omega[runs] * RAD_S_TO_RPM)
+        half = float(ctx.f[k0 + int(np.argmax(m[k0:k1 + 1]))] - ctx.f[k0])
+        kurt = impulsiveness(ctx, state, chans, runs, fp, max(min(half, float(ctx.f[k1]) - fp), 4 * ctx.df))
+        top = float(np.max(m[k0:k1 + 1]))
+        out.append(Unexplained(
+            signature="broadband_hump", channels=chans, speed_rpm=(float(rpm[0]), float(rpm[-1])),
+            f_Hz=(f0, f1), level_dB=top, share=share, n_runs=int(rows.size),
+            parameters={"peak_Hz": fp, "peak_over_floor_dB": top, "over_the_model_dB": level,
+                        "half_power_width_Hz": None, "in_every_run": False, "run_speeds_rpm": rpm.tolist(),
+                        "kurtosis": kurt},
+            causes=_hump_causes(kurt, fp, f"in {rows.size} of the {R} runs only"),
+            would_tell=_HUMP_TELLS + "; the runs' order in time shows whether it comes and goes"))
+    return out
+
+
+#: A hump peaking within this many half-power half-widths (ζ·f_r) of a fitted fixed resonance (plus a band's width)
+#: is that resonance: a fixture's resonance lifts the noise passing through the stand as it lifts the lines.
+RESONANCE_HALF_WIDTHS = 3.0
+
+
+def _at_a_fitted_resonance(ctx, state, f_peak: float, chans) -> bool:
+    """True when a fixed resonance of ``state`` (the ``fixed_resonance`` class: a test stand's or a wheel mode's) on
+    one of ``chans`` peaks within :data:`RESONANCE_HALF_WIDTHS` ζ·f_r (and a band) of ``f_peak``: the hump is the
+    noise through that resonance, which the class names."""
+    from .constants import BAND_BINS
+
+    for f_r, zeta, _, on, *_ in state.resonances:        # (f_r, ζ, g, channels[, gain above])
+        if set(on) & set(chans) and abs(f_peak - f_r) <= RESONANCE_HALF_WIDTHS * zeta * f_r + BAND_BINS * ctx.df:
+            return True
+    return False
+
+
+def _half_power_width(ctx, log_floor: np.ndarray, pk: int) -> float:
+    """Width (Hz) over which a floor (dB per bin) stays within 3 dB of its value at bin ``pk``."""
+    k0 = k1 = pk
+    while k0 > 0 and log_floor[k0 - 1] >= log_floor[pk] - 3.0:
+        k0 -= 1
+    while k1 + 1 < log_floor.size and log_floor[k1 + 1] >= log_floor[pk] - 3.0:
+        k1 += 1
+    return (k1 - k0 + 1) * ctx.df
