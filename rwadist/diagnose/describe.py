@@ -14,6 +14,7 @@ Two steps around the search (:func:`rwadist.diagnose.search.diagnose`):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
@@ -308,7 +309,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     ``changes``: the run-to-run change read on ``res`` (the data as given: the records the search read had the changed
     runs' factor taken out, :func:`run_steps`).  ``carriers``: the fixed lines found before the search
     (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands taken out with them."""
-    from .describe_affine import affine_lines, without_pieces
+    from .describe_affine import with_affine_lines
     from .describe_carrier import measure_track, on_a_sideband, sideband_lines, sideband_tracks
     from .describe_drift import with_drifts
     from .describe_filter import frequency_response
@@ -330,17 +331,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     def of_runs(runs):
         return res.measure({c: np.isin(ctx.runs, runs)[:, None] & np.ones(res.e[c].shape, bool) for c in res.e})
 
-    def of_band(chans, f0, f1):
-        b0, b1 = int(res.band_of(f0)), int(res.band_of(f1))
-        cells = {}
-        for c in chans:
-            if c in res.e:
-                m = res.mask(c)
-                m[:, b0:b1 + 1] = True
-                cells[c] = m
-        return res.measure(cells)
-
-    def of_band_runs(chans, f0, f1, runs):
+    def of_band_runs(chans, f0, f1, runs):        # the bands of [f0, f1] in ``runs``
         b0, b1 = int(res.band_of(f0)), int(res.band_of(f1))
         rows = np.isin(ctx.runs, runs)
         cells = {}
@@ -373,18 +364,13 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
                 cells[c] = m
         return res.measure(cells)
 
-    def of_track_f(chans, f_hz, runs):        # one frequency per run of ``runs``
-        return measure_track(res, chans, f_hz, runs)
+    of_track_f = partial(measure_track, res)        # (chans, one frequency per run of ``runs``, runs)
+
+    def of_band(chans, f0, f1):
+        return of_band_runs(chans, f0, f1, ctx.runs)
 
     def of_fixed(chans, f_hz, runs):
-        b = int(res.band_of(f_hz))
-        cells = {}
-        for c in chans:
-            if c in res.e:
-                m = res.mask(c)
-                m[np.isin(ctx.runs, runs), b] = True
-                cells[c] = m
-        return res.measure(cells)
+        return of_band_runs(chans, f_hz, f_hz, runs)
 
     ratios = line_ratios(ctx, state)
     others = [x.h for d in ("radial_force", "radial_torque", "axial_force", "axial_torque")
@@ -414,10 +400,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     # a gain common to the channels that changes with speed, on the recorded channels too; one of the line's frequency
     out += gain_trend(ctx, recorded := as_recorded(searched.state), of_line) + frequency_response(ctx, recorded, of_line)
     # a line whose ratio drifts with the speed (a cage slipping), and what its fixed-ratio model line made of it
-    out = with_drifts(ctx, state, out, of_line)
-    # a line on a straight track f0 + b·f_spin off both axes: the pieces the detectors above made of it are its own
-    affine = affine_lines(ctx, state, of_track_f, carriers)
-    return without_pieces(out, affine, float(ctx.df)) + affine
+    # and a line on a straight track f0 + b·f_spin off both axes, whose pieces the detectors above described
+    return with_affine_lines(ctx, state, with_drifts(ctx, state, out, of_line), of_track_f, carriers)
 
 
 #: A hump at most this many bins wide whose peak lies within its own width of a fixed line on one of its channels is

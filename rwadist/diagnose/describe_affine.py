@@ -224,3 +224,10 @@ def without_pieces(records: list, affine: list, df: float) -> list:
 def track_of(u, spin: np.ndarray) -> np.ndarray:
     """The frequency (Hz) of the ``affine_line`` record ``u`` at the spin frequencies ``spin`` (Hz)."""
     return u.parameters["offset_Hz"] + u.parameters["slope"] * np.asarray(spin, dtype=float)
+
+
+def with_affine_lines(ctx, state, records: list, shares, carriers=()) -> list:
+    """``records`` with the ``affine_line`` records of the residual (:func:`affine_lines`) in place of the pieces
+    the other detectors made of them (:func:`without_pieces`)."""
+    affine = affine_lines(ctx, state, shares, carriers)
+    return without_pieces(records, affine, float(ctx.df)) + affine
