@@ -228,7 +228,8 @@ def evaluate(wheel_index: int, wheel, name: str, label: str, effects: list, summ
             "error": [float(summary["error_before"]), err],
             "error_ratio": (err / clean_error) if clean_error else None,
             "unexplained": [u.get("signature") for u in unexplained],
-            "unexplained_records": [{k: u.get(k) for k in ("signature", "channels", "f_Hz", "h", "speed_rpm")}
+            "unexplained_records": [{k: u.get(k) for k in ("signature", "channels", "f_Hz", "h", "speed_rpm",
+                                                           "parameters")}
                                     for u in unexplained],
             "effects": [_label(e) for e in effs]}
     return row
@@ -279,7 +280,8 @@ def row_text(r: dict) -> str:
 
 #: the signature key of docs/diagnose.md's "Unexplained residual" table each unknown kind should be described by
 DESCRIBED_AS = {"pickup": "fixed_line", "crosstalk": "channel_copy", "moving_resonance": "moving_resonance",
-                "hump": "broadband_hump", "drift": "run_change"}
+                "hump": "broadband_hump", "drift": "run_change", "wide_hump": "broadband_hump",
+                "rattle": "broadband_hump", "affine_line": "affine_line"}
 
 
 def _where_ok(label: str, rec: dict, truth: dict) -> bool:
@@ -294,8 +296,11 @@ def _where_ok(label: str, rec: dict, truth: dict) -> bool:
         return truth["target"] in chans
     if label == "moving_resonance":
         return "Fz" in chans
-    if label == "hump":
+    if label in ("hump", "wide_hump", "rattle"):
         return bool(f) and min(f) <= 1.1 * truth["f_hz"] and max(f) >= 0.9 * truth["f_hz"]
+    if label == "affine_line":
+        return {"Fz", "Tz"} & set(chans) and abs(rec.get("parameters", {}).get("offset_Hz", -1e9) - truth["f0_hz"]) \
+            <= 0.01 * truth["f0_hz"] + 1.0 and abs(rec.get("parameters", {}).get("slope", -1e9) - truth["slope"]) <= 0.02
     return True
 
 

@@ -610,9 +610,85 @@ class Drift(Effect):
         return parts_signature(data, parts)
 
 
+class WideHump(Hump):
+    """A hump wider than an eighth of the band (a running median over an eighth follows it): a low-q band-pass."""
+    kind = "wide_hump"
+    describe = "a broadband hump wider than an eighth of the band"
+
+
+class Rattle(Effect):
+    kind = "rattle"
+    expects = "unexplained"
+    describe = "a hump in some runs only, made of impacts (a part rattling in every third run)"
+
+    def __init__(self, f_hz, zeta=0.05, per_second=20.0, rise_db=15.0, every=3):
+        super().__init__(f_hz=f_hz, zeta=zeta, per_second=per_second, rise_db=rise_db, every=every)
+
+    def _ringing(self, fs):
+        """(b, a) of a decaying sine at f_hz (damping ratio ζ) and the peak of its |H|² (digital, one-sided)."""
+        from scipy import signal
+
+        p = self.params
+        w = 2 * np.pi * p["f_hz"] / fs
+        a = [1.0, -2 * np.exp(-p["zeta"] * w) * np.cos(w), np.exp(-2 * p["zeta"] * w)]
+        _, h = signal.freqz([1.0], a, worN=[w])
+        return ([1.0], a), float(np.abs(h[0]) ** 2)
+
+    def rattles(self, run: int) -> bool:
+        return run % self.params["every"] == 1
+
+    def cell_signal(self, t, omega, run, rng, wheel, std):
+        from scipy import signal
+
+        n, fs = t.size, 1.0 / (t[1] - t[0])
+        out = np.zeros((6, n))
+        if not self.rattles(run):
+            return out
+        p = self.params
+        (b, a), peak = self._ringing(fs)
+        rate = p["per_second"] / fs
+        # impacts of random strength: the PSD at the ringing frequency (10^(rise/10) - 1) × the noise's, 2σ²/fs
+        # one-sided for white noise, is rate·E[x²]·|H|²·2/fs
+        for ch in (0, 1, 3, 4):
+            x = (rng.random(n) < rate) * rng.standard_normal(n)
+            gain = np.sqrt((10 ** (p["rise_db"] / 10) - 1) * std[ch] ** 2 / (rate * peak))
+            out[ch] = gain * signal.lfilter(b, a, x)
+        return out
+
+    def signature(self, wheel, data):
+        ok = self.params["f_hz"] < fw.ANTI_ALIAS * data.sample_rate
+        rise = [self.params["rise_db"] if ok and self.rattles(i) else 0.0 for i in range(len(data.speeds))]
+        return floor_signature(rise)
+
+
+class AffineLine(Effect):
+    kind = "affine_line"
+    expects = "unexplained"
+    describe = "a line at f0 + b × the speed on the axial channels (a source at f0 mixed with a rotor line)"
+
+    def __init__(self, f0_hz, slope=0.5, level=0.03):
+        super().__init__(f0_hz=f0_hz, slope=slope, level=level)
+
+    def f_hz(self, omega):
+        return self.params["f0_hz"] + self.params["slope"] * abs(omega) / (2 * np.pi)
+
+    def cell_components(self, omega, run, rng, wheel):
+        p = self.params
+        top = wheel.max_rpm * fw.RPM
+        scale = np.zeros(6)
+        scale[2] = wheel.imbalance("radial_force") * top**2 * p["level"]
+        scale[5] = wheel.imbalance("radial_torque") * top**2 * p["level"]
+        w = np.array([2 * np.pi * self.f_hz(omega)])
+        A = np.exp(1j * rng.uniform(0, 2 * np.pi)) * scale[None, :]
+        return fw.Components(["cell"], w, np.ones(1), np.ones(1, complex), [self.kind]), A
+
+    def signature(self, wheel, data):
+        return parts_signature(data, _tagged(data, self.kind))
+
+
 KNOWN = ("missing_harmonic", "amplitude_law", "broadband_floor", "fixed_resonance", "cross_coupling", "sidebands",
          "speed_ripple", "counter_rotation", "speed_sidebands", "lever_arm_noise")
-UNKNOWN = ("pickup", "crosstalk", "moving_resonance", "hump", "drift")
+UNKNOWN = ("pickup", "crosstalk", "moving_resonance", "hump", "drift", "wide_hump", "rattle", "affine_line")
 
 
 def default_effect(kind: str, wheel) -> Effect:
@@ -654,4 +730,12 @@ def default_effect(kind: str, wheel) -> Effect:
         return Hump(f_hz=float(np.sqrt(modes[0] * modes[1])))
     if kind == "drift":
         return Drift()
+    top = fw.ANTI_ALIAS * wheel.sample_rate
+    if kind == "wide_hump":
+        # q 1.5: a half-power width of f/q, over a quarter of the band at 0.45 of the anti-aliased band
+        return WideHump(f_hz=0.45 * top, q=1.5, rise_db=10.0)
+    if kind == "rattle":
+        return Rattle(f_hz=0.7 * top)
+    if kind == "affine_line":
+        return AffineLine(f0_hz=0.25 * top, slope=0.5)
     raise ValueError(f"unknown effect kind {kind!r}; known: {KNOWN + UNKNOWN}")

@@ -265,3 +265,15 @@ def test_a_floor_of_the_rotor_forces_split_over_three_channels_is_found_at_its_l
         sel = (f > 20.0) & (f + 15.0 < 0.9 * mode)
         assert sel.sum() >= (1 if c == "Fz" else 5)
         np.testing.assert_allclose(np.asarray(e["psd_ref"])[sel], truth[sel], rtol=0.3, err_msg=c)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("wheel, kind", [(4, "affine_line"), (6, "affine_line"), (0, "rattle"), (1, "wide_hump")])
+def test_an_affine_line_a_rattle_in_some_runs_and_a_wide_hump_are_each_one_description(wheel, kind, tmp_path):
+    """Session 44's open-world kinds on the family (tests/family_effects.py :class:`AffineLine`, :class:`Rattle`,
+    :class:`WideHump`): each described with its signature where it is, alone, and no class added.  Before, wheel 4's
+    and 6's line at f0 + 0.5·f_spin on Fz and Tz came with a 'hump' of 20 Hz (its bins lifting the floor the model
+    reads, kurtosis 1.5: a sinusoid's) beside it; the rattle and the wide hump were not described at all."""
+    row = _cell(wheel, kind, tmp_path)
+    assert "crashed" not in row and not row["added"] and row["modes_ok"], row
+    assert dfm._described(row) and row["unexplained"] == [dfm.DESCRIBED_AS[kind]], row["unexplained_records"]

@@ -16,9 +16,9 @@ offset; a track lit in :data:`~.describe_lines.RIDGE_FRACTION` of the runs where
 departs :data:`MIN_OFFSET_BINS` Welch bins from the best line at a constant ratio through it (else a speed line), at
 an offset that is no fixed line of the data (else that line's sideband), standing :data:`MIN_LEVEL_DB` over the
 model in its cells.  Its offset and slope are then read on the peaks of its lit runs (a parabola through the top
-three bins' log powers, a least-squares line), which lie on it within :data:`MAX_MISFIT_BINS`.  The pieces the other
-detectors made of it are its own (:func:`without_pieces`).  Steady runs only: a sweep's slice smears a line over
-bins by the speed's change within it.
+three bins' log powers, a least-squares line), which lie on it within :data:`MAX_MISFIT_BINS`. The pieces the other
+detectors made of it, and the hump it makes of the floor, are its own (:func:`without_pieces`). Steady runs only: a
+sweep's slice smears a line over bins by the speed's change within it.
 """
 from __future__ import annotations
 
@@ -203,10 +203,14 @@ def _causes(f0: float, b: float) -> tuple:
 def without_pieces(records: list, affine: list, df: float) -> list:
     """``records`` without the pieces the other detectors made of an ``affine_line`` of ``affine``: a ``fixed_line``,
     ``speed_line``, ``partial_line`` or ratio-drift ``line_property`` on a channel of the track whose frequency meets
-    the track (within 2 Welch bins of ``df`` Hz) over its own speed range."""
+    the track (within 2 Welch bins of ``df`` Hz) over its own speed range, and a ``broadband_hump`` within the track's
+    frequencies (the family's wheel 4 with a line at 432 Hz + 0.5·f_spin on Fz and Tz: a hump of 435-454 Hz there,
+    its kurtosis 1.5, a sinusoid's)."""
     def meets(u, a) -> bool:
         if not set(u.channels) & set(a.channels):
             return False
+        if u.signature == "broadband_hump":       # the line's bins, clear of the model's lines, lift the floor there
+            return bool(a.f_Hz[0] - 2 * df <= u.f_Hz[0] and u.f_Hz[1] <= a.f_Hz[1] + 2 * df)
         if not (u.signature in ("fixed_line", "speed_line", "partial_line") or
                 (u.signature == "line_property" and u.parameters.get("property") == "ratio_drift")):
             return False
