@@ -663,3 +663,89 @@ def test_a_true_law_on_a_neighbour_of_a_partial_line_is_not_taken_back_with_it(m
     (u,) = [u for u in d.unexplained if u.signature == "partial_line"]
     assert u.h == pytest.approx(2.4, abs=0.01)
     assert not set(u.parameters["runs_absent"]) & set(truth["partial_runs"])
+
+
+# ---- session 44's review: the cases that broke the first version of the hump and affine-line detectors
+def _noise_std(test):
+    """The generator's white-noise std per channel (tests/open_world_cases.py: 0.01 of the top-speed fundamental)."""
+    import independent_wheel as iw
+
+    w_top = max(abs(r.speed) for r in test.runs)
+    fund = {g: c * iw.C_UNIT * w_top**2 for g, c in zip("FT", owc._noise_std(iw.E_LINES).values())}
+    return {ch: 0.01 * fund[ch[0]] for ch in ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")}
+
+
+def _with(kind="clean", noise=0.01, change=None):
+    test, truth = owc.generate(kind, SPEEDS, seed=4, noise=noise)
+    rng = np.random.default_rng(7)
+    std = _noise_std(test)
+    for i, r in enumerate(test.runs):
+        t = np.arange(r.signals["Fz"].size) / r.sample_rate
+        change(i, r, t, std, rng)
+    return test, api.diagnose(test)
+
+
+def test_hot_runs_in_two_groups_far_apart_are_two_groups_and_the_loop_ends():
+    from rwadist.diagnose.describe_hump import _run_groups
+
+    peaks = np.array([100, 103, 900, 905, 500])
+    groups = _run_groups(peaks, np.array([0, 1, 2, 3]), near=20.0)          # the median (501.5) lies in the gap
+    assert sorted(sorted(g.tolist()) for g in groups) == [[0, 1], [2, 3]]
+    assert [g.tolist() for g in _run_groups(peaks, np.array([4]), near=20.0)] == [[4]]
+
+
+def test_a_floor_through_a_high_pass_and_an_anti_alias_filter_is_no_hump():
+    from scipy import signal
+
+    sos = None
+
+    def floor(i, r, t, std, rng):
+        nonlocal sos
+        if sos is None:
+            sos = np.vstack([signal.butter(8, 1500.0, "lowpass", fs=r.sample_rate, output="sos"),
+                             signal.butter(2, 20.0, "highpass", fs=r.sample_rate, output="sos")])
+        for ch in r.signals:
+            r.signals[ch] = r.signals[ch] + std[ch] * signal.sosfilt(sos, rng.standard_normal(t.size + 4096))[4096:]
+
+    _, d = _with(noise=1e-9, change=floor)
+    assert _classes(d) == ["suspension_modes"] and d.unexplained == (), [u.text() for u in d.unexplained]
+
+
+def test_a_tone_in_the_fastest_runs_is_no_hump():
+    def tone(i, r, t, std, rng):
+        if abs(r.speed) * 30 / np.pi >= 2300:
+            r.signals["Fz"] = r.signals["Fz"] + 5.0 * std["Fz"] * np.cos(2 * np.pi * 215.0 * t + rng.uniform(0, 6.3))
+
+    _, d = _with(change=tone)
+    assert not [u for u in d.unexplained if u.signature == "broadband_hump"], [u.text() for u in d.unexplained]
+
+
+def test_an_affine_line_and_a_fixed_line_it_crosses_are_both_described():
+    def both(i, r, t, std, rng):
+        f_line = 150.0 + 1.5 * abs(r.speed) / (2 * np.pi)
+        for ch in ("Fz", "Tz"):
+            r.signals[ch] = r.signals[ch] + 5.0 * std[ch] * np.cos(2 * np.pi * f_line * t + rng.uniform(0, 6.3))
+        r.signals["Fz"] = r.signals["Fz"] + 5.0 * std["Fz"] * np.cos(2 * np.pi * 190.0 * t + rng.uniform(0, 6.3))
+
+    _, d = _with(change=both)
+    sig = sorted(u.signature for u in d.unexplained)
+    assert sig == ["affine_line", "fixed_line"], [u.text() for u in d.unexplained]
+    fixed = next(u for u in d.unexplained if u.signature == "fixed_line")
+    assert fixed.f_Hz[0] == pytest.approx(190.0, abs=0.5)
+
+
+def test_a_line_below_a_multiple_of_the_speed_is_read_with_its_negative_offset():
+    """f = 3·f_spin − 40 Hz on Fz and Tz (a drive's lower side): a shallower track through more runs, refused as a
+    speed line, had claimed its stretches first and two speed lines were described instead."""
+    def lower(i, r, t, std, rng):
+        f_line = abs(3.0 * abs(r.speed) / (2 * np.pi) - 40.0)
+        for ch in ("Fz", "Tz"):
+            r.signals[ch] = r.signals[ch] + 5.0 * std[ch] * np.cos(2 * np.pi * f_line * t + rng.uniform(0, 6.3))
+
+    _, d = _with(change=lower)
+    affine = [u for u in d.unexplained if u.signature == "affine_line"]
+    assert len(affine) == 1, [u.text() for u in d.unexplained]
+    assert affine[0].parameters["offset_Hz"] == pytest.approx(-40.0, abs=1.5)
+    assert affine[0].parameters["slope"] == pytest.approx(3.0, abs=0.03)
+    # below a multiple of the speed, the ratio rises with it (b + f0/f_spin, f0 < 0): no "falls"
+    assert any("rises as" in c for c in affine[0].causes) and not any("falls as" in c for c in affine[0].causes)

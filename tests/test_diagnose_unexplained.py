@@ -70,7 +70,7 @@ def test_a_copy_with_no_band_of_its_own_reads_no_share_not_zero_percent():
     what is left" beside "the copy +40 dB over its noise"."""
     u = _record(signature="channel_copy", channels=("Fy",), level_dB=None, share=0.0,
                 parameters={"source": "Fx", "target": "Fy", "gain": 0.2, "copy_over_noise_dB": 40.1})
-    assert "no band of what is left its own" in u.text() and "0 % of what is left" not in u.text()
+    assert "no band of its own in what is left" in u.text() and "0 % of what is left" not in u.text()
     assert "under a tenth of Fy's own content in every band" in u.text()
 
 
@@ -82,3 +82,4 @@ def test_a_spring_fitted_a_hair_below_zero_far_above_reads_zero():
     assert ", 0 of the load far above" in FixedResonance.describe(dict(e, gain_above=-1.1e-06))
     assert ", 0.7 of the load far above" in FixedResonance.describe(dict(e, gain_above=0.7))
     assert "of the load far above" not in FixedResonance.describe(dict(e, gain_above=1.0))
+    assert "of the load far above" not in FixedResonance.describe(dict(e, gain_above=0.9999996))

@@ -470,8 +470,11 @@ def cells_of(u, res: Residual) -> dict:
     rpm = ctx.omega[ctx.runs] * 60.0 / (2 * np.pi)
     runs = (rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6)
     spin = rpm / 60.0
-    rows = np.flatnonzero(runs)
     p = u.parameters
+    if u.signature == "broadband_hump" and p.get("run_speeds_rpm"):      # a hump in some runs: those runs only
+        runs &= np.any(np.abs(rpm[:, None] - np.asarray(p["run_speeds_rpm"], float)[None, :]) <= 1e-6 * np.abs(rpm).max(),
+                       axis=1)
+    rows = np.flatnonzero(runs)
     if u.signature == "channel_copy":
         src, dst = p.get("source"), p.get("target")
         if src not in res.D or dst not in res.e:

@@ -50,6 +50,20 @@ CARRIER_BINS = 2.0
 MAX_MISFIT_BINS = 0.5
 #: The data over the model in its cells, at least (dB).
 MIN_LEVEL_DB = 6.0
+#: A run's peak is read within this many Welch bins of the counted track (and its lit stretch); one this far off the
+#: straight line through the others is another line's (a review's 60 Hz + 1.3·f_spin on Fx and Fy: two runs where
+#: it passed under a model line read 9 and 5 Hz off, RMS 0.68 bin, and no line was described).
+WINDOW_BINS = 2
+OUTLIER_BINS = 1.5
+KEPT_FRACTION = 0.75
+#: A record of another detector is a piece of the track when it lies within this many Welch bins of it over this
+#: fraction of its speeds at least (a line that crosses the track is its own).
+PIECE_BINS = 3.0
+PIECE_FRACTION = 0.6
+#: ... or within twice that reach, reading the track's level within this (dB)
+SAME_LEVEL_DB = 1.0
+#: Candidate tracks read, at most (a strong line lets dozens of slopes through its lit stretches).
+MAX_CANDIDATES = 400
 
 
 def _segments(lit: np.ndarray) -> np.ndarray:
@@ -61,9 +75,11 @@ def _segments(lit: np.ndarray) -> np.ndarray:
 
 
 def _tracks(lit: np.ndarray, spin: np.ndarray, df: float, k_lo: int, k_hi: int) -> tuple:
-    """(tracks, segment labels (:func:`_segments`)): the tracks (slope b, offset bin j, runs lit (bool per run), fraction lit, lit segment label per run (0 where
-    unlit)) of the pooled lit map ``lit`` (runs, n_f), the best first; a track whose lit segments are mostly a better
-    one's is that one (a strong line's segments several bins wide let several slopes through)."""
+    """(tracks, segment labels (:func:`_segments`)): the candidate tracks (slope b, offset bin j, runs lit (bool per
+    run), fraction lit, lit segment label per run (0 where unlit)) of the pooled lit map ``lit`` (runs, n_f) that move
+    :data:`MIN_MOVE_BINS` and depart :data:`MIN_OFFSET_BINS` from every constant ratio over their lit runs, the most
+    lit first (at most :data:`MAX_CANDIDATES`).  A strong line's lit stretches are several bins wide and let several
+    slopes through: :func:`affine_lines` reads them in turn, and one that reads a line claims its stretches."""
     R, K = lit.shape
     span = float(spin.max() - spin.min())
     seg = _segments(lit)
@@ -88,30 +104,23 @@ def _tracks(lit: np.ndarray, spin: np.ndarray, df: float, k_lo: int, k_hi: int) 
             k = jj + shift
             inb = (k >= k_lo) & (k <= k_hi)
             hit = lit[np.arange(R), np.clip(k, 0, K - 1)] & inb
+            s_hit = spin[hit]
+            if np.ptp(b * s_hit) < MIN_MOVE_BINS * df or _offset_from_ratio(jj * df, b, s_hit) < MIN_OFFSET_BINS * df:
+                continue
             labels = np.where(hit, seg[np.arange(R), np.clip(k, 0, K - 1)], 0)
-            cands.append((float(frac[jj + pad]) * n_hit[jj + pad], float(b), int(jj), hit, float(frac[jj + pad]),
-                          labels))
-    cands.sort(key=lambda x: -x[0])
-    out: list = []
-    claimed: set = set()
-    for cand in cands:
-        mine = cand[5][cand[5] > 0]
-        if mine.size < MIN_RUNS or sum(x in claimed for x in mine.tolist()) >= 0.5 * mine.size:
-            continue
-        claimed.update(mine.tolist())
-        out.append(cand[1:])
-    return out, seg
+            cands.append(((float(frac[jj + pad]), int(n_hit[jj + pad])), float(b), int(jj), hit,
+                          float(frac[jj + pad]), labels))
+    cands.sort(key=lambda x: (-x[0][0], -x[0][1]))
+    return [c[1:] for c in cands[:MAX_CANDIDATES]], seg
 
 
-def _read_track(ctx, state, chans, runs: np.ndarray, windows: list) -> tuple | None:
-    """(offset f0 Hz, slope b, RMS misfit Hz) of the line in ``windows`` ((first, last) bin of its lit segment in
-    each run of ``runs``): each run's peak of the data over the model summed over ``chans`` there, refined by a
-    parabola through the log powers of the top three bins, a least-squares line through them against f_spin."""
+def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list) -> tuple | None:
+    """(offset f0 Hz, slope b, RMS misfit Hz) of the line in ``windows`` ((first, last) bin in each run of ``runs``):
+    each run's peak of ``ratio`` (the data over the model summed over the line's channels, a row per run) there, refined by a parabola through the log
+    powers of the top three bins, a least-squares line through them against f_spin, twice without the peaks off it by
+    :data:`OUTLIER_BINS` (another line's, where the track passes under a model line), at least :data:`KEPT_FRACTION`
+    of the runs kept."""
     df = ctx.df
-    pos = {int(r): i for i, r in enumerate(ctx.runs)}
-    rows = np.array([pos[int(r)] for r in runs])
-    ratio = sum(ctx.data(state, c, ctx.runs)[ctx.runs][rows] / np.maximum(ctx.predict(state, c, ctx.runs)[rows],
-                                                                            1e-300) for c in chans)
     f_pk = np.full(runs.size, np.nan)
     for i, (a, z) in enumerate(windows):
         a, z = max(a, 1), min(z, ratio.shape[1] - 2)
@@ -119,12 +128,17 @@ def _read_track(ctx, state, chans, runs: np.ndarray, windows: list) -> tuple | N
             continue
         k = a + int(np.argmax(ratio[i, a:z + 1]))
         f_pk[i] = (k + log_parabola_offset(ratio[i, k - 1:k + 2])) * df
+    spin = np.abs(ctx.omega[runs]) / (2 * np.pi)
     ok = np.isfinite(f_pk)
-    if ok.sum() < MIN_RUNS:
+    for _ in range(2):              # a run whose peak is another line's (under a model line, the track is not lit)
+        if ok.sum() < MIN_RUNS:
+            return None
+        b, f0 = np.polyfit(spin[ok], f_pk[ok], 1)
+        ok &= np.abs(f_pk - (f0 + b * spin)) <= OUTLIER_BINS * df
+    if ok.sum() < max(MIN_RUNS, KEPT_FRACTION * runs.size):
         return None
-    spin = np.abs(ctx.omega[runs[ok]]) / (2 * np.pi)
-    b, f0 = np.polyfit(spin, f_pk[ok], 1)
-    rms = float(np.sqrt(np.mean((f_pk[ok] - (f0 + b * spin)) ** 2)))
+    b, f0 = np.polyfit(spin[ok], f_pk[ok], 1)
+    rms = float(np.sqrt(np.mean((f_pk[ok] - (f0 + b * spin[ok])) ** 2)))
     return float(f0), float(b), rms
 
 
@@ -149,22 +163,32 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
     out: list[Unexplained] = []
     tracks, seg = _tracks(pooled, spin, df, ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1))
     bins = np.arange(ctx.f.size)
+    claimed: set = set()            # the lit stretches of the lines read so far
+    ratios: dict = {}               # the data over the model summed over a channel set, per set
     for b, jj, runs_lit, frac, labels in tracks:
+        mine = labels[labels > 0].tolist()
+        if sum(x in claimed for x in mine) >= 0.5 * len(mine):
+            continue                # mostly a line already read (or refused): the same line at another slope
         s = spin[runs_lit]
-        if np.ptp(b * s) < MIN_MOVE_BINS * df or _offset_from_ratio(jj * df, b, s) < MIN_OFFSET_BINS * df:
-            continue
         k_run = np.clip(np.rint((jj * df + b * s) / df).astype(int), 0, ctx.f.size - 1)
         chans = tuple(c for c in ctx.channels if lits[c][runs_lit][np.arange(s.size), k_run].mean() >= CHANNEL_FRACTION)
         if not chans:
             continue
         rows = np.flatnonzero(runs_lit)
-        windows = [(int(bins[seg[i] == labels[i]].min()), int(bins[seg[i] == labels[i]].max())) for i in rows]
-        got = _read_track(ctx, state, chans, runs[runs_lit], windows)
+        windows = [(max(int(bins[seg[i] == labels[i]].min()), int(k) - WINDOW_BINS),
+                    min(int(bins[seg[i] == labels[i]].max()), int(k) + WINDOW_BINS)) for i, k in zip(rows, k_run)]
+        if chans not in ratios:
+            ratios[chans] = sum(ctx.data(state, c, runs)[runs] / np.maximum(ctx.predict(state, c, runs), 1e-300)
+                                for c in chans)
+        got = _read_track(ctx, ratios[chans][rows], runs[runs_lit], windows)
         if got is None:
             continue
+        claimed.update(mine)
         f0, b, rms = got
+        # a fixed line's sideband (its lower side past 0 Hz folds: f0 = -f_c) is the sideband detector's
         if rms > MAX_MISFIT_BINS * df or np.ptp(b * s) < MIN_MOVE_BINS * df or \
-                _offset_from_ratio(f0, b, s) < MIN_OFFSET_BINS * df or any(abs(f0 - ln.f_Hz) <= CARRIER_BINS * df for ln in carriers) or \
+                _offset_from_ratio(f0, b, s) < MIN_OFFSET_BINS * df or \
+                any(abs(abs(f0) - ln.f_Hz) <= CARRIER_BINS * df for ln in carriers) or \
                 any(np.max(np.abs(f0 + b * s - track_of(u, s))) <= SAME_TRACK_BINS * df for u in out):
             continue
         f_run = f0 + b * s
@@ -186,42 +210,57 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
 
 
 def _causes(f0: float, b: float) -> tuple:
-    """What a line at f0 + b·f_spin could be."""
+    """What a line at f0 + b·f_spin could be, worded for the signs of f0 and b."""
     sign = "+" if b >= 0 else "−"
     out = [f"a source at {abs(f0):.4g} Hz (a machine of the stand, the electronics, a structural resonance rung "
            f"steadily) mixed with a line of the rotor at {abs(b):.3g} × the speed: f = {f0:.4g} Hz {sign} "
            f"{abs(b):.3g}·f_spin, a product of the two (an amplitude modulation, a nonlinear joint or sensor) whose "
            "carrier stays under the noise"]
-    if abs(b - round(b)) <= 0.02 and round(b) >= 1:
-        out.append(f"a motor drive's switching frequency ({abs(f0):.4g} Hz) modulated by the commutation at "
-                   f"{round(b)} × the speed ({round(b)} pole pairs, or a multiple)")
-    out.append("a line whose ratio to the speed drifts as b + f0/f_spin over these speeds (a slip that grows with "
-               "the speed), which a fixed offset describes here")
+    n = round(abs(b))
+    if abs(abs(b) - n) <= 0.02 and n >= 1:
+        out.append(f"a motor drive's switching frequency ({abs(f0):.4g} Hz) modulated by the commutation at {n} × "
+                   f"the speed, its {'upper side' if b > 0 and f0 > 0 else 'lower side (past 0 Hz when f0 < 0)'} "
+                   f"(the pole pairs times a harmonic of the electrical frequency make {n})")
+    if b > 0:
+        trend = "falls" if f0 > 0 else "rises"
+        out.append(f"a line whose ratio to the speed {trend} as {b:.3g} + ({f0:.4g} Hz)/f_spin over these speeds (a "
+                   f"ratio drifting with the speed: a bearing's slip), which a fixed offset describes here")
     return tuple(out)
 
 
 def without_pieces(records: list, affine: list, df: float) -> list:
     """``records`` without the pieces the other detectors made of an ``affine_line`` of ``affine``: a ``fixed_line``,
-    ``speed_line``, ``partial_line`` or ratio-drift ``line_property`` on a channel of the track whose frequency meets
-    the track (within 2 Welch bins of ``df`` Hz) over its own speed range, and a ``broadband_hump`` within the track's
-    frequencies (the family's wheel 4 with a line at 432 Hz + 0.5·f_spin on Fz and Tz: a hump of 435-454 Hz there,
-    its kurtosis 1.5, a sinusoid's)."""
+    ``speed_line``, ``partial_line``, ``sideband_line`` or ratio-drift ``line_property`` on a channel of the track that
+    lies within :data:`PIECE_BINS` Welch bins of ``df`` Hz of it over :data:`PIECE_FRACTION` of its own speeds (one
+    that crosses the track is a line of its own), and a ``broadband_hump`` within the track's frequencies (the
+    family's wheel 4 with a line at 432 Hz + 0.5·f_spin on Fz and Tz: a hump of 435-454 Hz there, its kurtosis 1.5,
+    a sinusoid's)."""
+    def piece_f(u, s):
+        p = u.parameters
+        if u.signature == "fixed_line" or (u.h is None and u.signature != "sideband_line"):
+            return np.full(s.size, u.f_Hz[0])
+        if u.signature == "sideband_line" and "carrier_Hz" in p:
+            return np.abs(p["carrier_Hz"] + np.asarray(p.get("sides", [1]), float)[:, None] * p["h"] * s[None, :])
+        if u.signature == "line_property" and p.get("readings_rpm"):
+            return np.interp(s, np.asarray(p["readings_rpm"], float) / 60.0, np.asarray(p["readings_h"], float)) * s
+        return u.h * s
+
     def meets(u, a) -> bool:
         if not set(u.channels) & set(a.channels):
             return False
         if u.signature == "broadband_hump":       # the line's bins, clear of the model's lines, lift the floor there
             return bool(a.f_Hz[0] - 2 * df <= u.f_Hz[0] and u.f_Hz[1] <= a.f_Hz[1] + 2 * df)
-        if not (u.signature in ("fixed_line", "speed_line", "partial_line") or
+        if not (u.signature in ("fixed_line", "speed_line", "partial_line", "sideband_line") or
                 (u.signature == "line_property" and u.parameters.get("property") == "ratio_drift")):
             return False
-        lo, hi = max(u.speed_rpm[0], a.speed_rpm[0]), min(u.speed_rpm[1], a.speed_rpm[1])
-        if lo > hi:
-            return False
-        s = np.linspace(lo, hi, 64) / 60.0
-        track = a.parameters["offset_Hz"] + a.parameters["slope"] * s
-        piece = np.full(s.size, u.f_Hz[0]) if u.signature == "fixed_line" or u.h is None else u.h * s
-        gap = track - piece
-        return bool(np.min(np.abs(gap)) <= 2 * df or np.min(gap) < 0 < np.max(gap))
+        s = np.linspace(u.speed_rpm[0], u.speed_rpm[1], 64) / 60.0
+        gap = np.min(np.abs(np.atleast_2d(piece_f(u, s)) - track_of(a, s)[None, :]), axis=0)
+        # a strong line lights a stretch several bins wide: a piece that reads the track's own level (the same bins'
+        # content) is its within twice the reach (w3_own_s2: a fixed line at 101.2 Hz over 5385-10000 rpm, 38.0 dB
+        # against the track's 38.0, within 3 bins over 59 % of its speeds)
+        same = u.level_dB is not None and abs(float(u.level_dB) - float(a.level_dB)) <= SAME_LEVEL_DB
+        return bool(np.mean(gap <= PIECE_BINS * df) >= PIECE_FRACTION or
+                    (same and np.mean(gap <= 2 * PIECE_BINS * df) >= PIECE_FRACTION))
     return [u for u in records if not any(meets(u, a) for a in affine)]
 
 

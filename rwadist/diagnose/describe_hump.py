@@ -31,6 +31,25 @@ HUMP_BASELINE_FRACTION = 0.125
 #: and must stand HUMP_WIDE_PEAK_DB over it at its peak.
 HUMP_WIDE_SMOOTH_FRACTION = 1.0 / 64.0
 HUMP_WIDE_PEAK_DB = 6.0
+#: ... and peaks: within 3 dB of its peak over at most this fraction of the band (a floor shaped by the chain's
+#: high-pass and anti-alias filters is a plateau: a review's 20 Hz high-pass and 1500 Hz low-pass read as a 9-1982 Hz
+#: hump of +17 dB over its lower course, a floor rising as f^0.3 under the same low-pass as one of +7.4 dB, 3 dB wide
+#: over 44 % of the band; the open-world cases' first-order band-pass of 450-1000 Hz, 29 %).
+HUMP_TOP_FRACTION = 1.0 / 3.0
+#: A hump in some runs peaks that far from the band's edges (a fraction of the band) at least.
+HUMP_EDGE_FRACTION = 1.0 / 32.0
+
+
+def _peaked(excess_db: np.ndarray, pk: int, k_lo: int, k_hi: int) -> bool:
+    """Whether the hump of ``excess_db`` (dB per bin) peaking at ``pk`` stands within 3 dB of its peak over at most
+    :data:`HUMP_TOP_FRACTION` of [k_lo, k_hi] (a plateau does not)."""
+    top = excess_db >= excess_db[pk] - 3.0
+    k0 = k1 = pk
+    while k0 - 1 >= k_lo and top[k0 - 1]:
+        k0 -= 1
+    while k1 + 1 <= k_hi and top[k1 + 1]:
+        k1 += 1
+    return bool(k1 - k0 + 1 <= HUMP_TOP_FRACTION * (k_hi - k_lo))
 #: A bin is clear of the model's lines in a run where their predicted PSD is below this fraction of the floor.
 CLEAN_LINE_FRACTION = 0.01
 
@@ -101,13 +120,13 @@ def broadband_hump(ctx, state, shares) -> list:
     """A broadband hump: the data's own noise floor (:func:`clean_floor`, 3-bin means of its dB) standing over its
     smooth course (a running median over an eighth of the band) by :data:`HUMP_PEAK_DB` at its peak, over a
     frequency range wider than a line and narrower than a quarter of the band, or over its lower course
-    (:func:`_lower_course`) by :data:`HUMP_WIDE_PEAK_DB`, however wide, in one channel or several (one
+    (:func:`_lower_course`) by :data:`HUMP_WIDE_PEAK_DB` and peaked (:func:`_peaked`), in one channel or several (one
     record, the channels listed).  The model takes such a hump as instrument noise (at every speed) or, growing with
     speed as a power law, as the ``broadband_floor`` class (whose floor is not counted here: it is the data's
     floor less the class's).  What it could be: a fixture or sensor resonance excited by the surroundings, a pump
     or fan of the stand, the electronics' own noise shape."""
     k_lo, k_hi = ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1)
-    found: dict[int, list[tuple[str, int, int, int, float]]] = {}     # peak bin -> (channel, k0, k1, peak, excess dB)
+    found: dict[int, list[tuple]] = {}      # peak bin -> (channel, k0, k1, peak, excess dB, against what)
     half = max(int(HUMP_BASELINE_FRACTION * (k_hi - k_lo) / 2), 3 * HUMP_MIN_BINS)
     floors = {}
     for c in ctx.channels:
@@ -125,11 +144,13 @@ def broadband_hump(ctx, state, shares) -> list:
         wide = np.where(valid, _lower_course(lf, k_lo, k_hi), -np.inf)
         floors[c] = (fl, lf)
         narrow = _humps(excess, k_lo, k_hi)
+        # a wide hump peaks: a floor shaped by the chain's high-pass and anti-alias filters is a plateau
         broad = [(k0, k1, pk) for k0, k1, pk in _humps(wide, k_lo, k_hi, k_hi - k_lo, HUMP_WIDE_PEAK_DB)
-                 if not any(a <= pk <= b for a, b, _ in narrow)]
-        for (k0, k1, pk), ex in [(h, excess) for h in narrow] + [(h, wide) for h in broad]:
-            key = next((x for x in found if abs(x - pk) <= max(3, (k1 - k0) // 2)), pk)
-            found.setdefault(key, []).append((c, k0, k1, pk, float(ex[pk])))
+                 if not any(a <= pk <= b for a, b, _ in narrow) and _peaked(wide, pk, k_lo, k_hi)]
+        for (k0, k1, pk), ex, how in [(h, excess, "smooth") for h in narrow] + [(h, wide, "lower") for h in broad]:
+            key = next((x for x, v in found.items() if abs(x - pk) <= max(3, min(k1 - k0, v[0][2] - v[0][1]) // 2)),
+                       pk)
+            found.setdefault(key, []).append((c, k0, k1, pk, float(ex[pk]), how))
     out = []
     for items in found.values():
         chans = tuple(x[0] for x in items)
@@ -138,15 +159,18 @@ def broadband_hump(ctx, state, shares) -> list:
         f0, f1, fp = ctx.f[k0], ctx.f[k1], ctx.f[peak[3]]
         if _at_a_fitted_resonance(ctx, state, fp, chans):
             continue
+        width = float(_half_power_width(ctx, floors[peak[0]][1], peak[3]))
+        kurt = impulsiveness(ctx, state, chans, ctx.runs, fp, 0.5 * width)
+        if kurt is not None and kurt < LINE_KURTOSIS:
+            continue                # a line stands in it (a sinusoid's kurtosis is 1.5): the line detectors' to say
         share, level = shares(chans, f0, f1)
         rpm = ctx.omega[ctx.runs] * RAD_S_TO_RPM
-        width = float(_half_power_width(ctx, floors[peak[0]][1], peak[3]))
-        kurt = impulsiveness(ctx, state, chans, ctx.runs, fp, width)
         out.append(Unexplained(
             signature="broadband_hump", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
             f_Hz=(float(f0), float(f1)), level_dB=peak[4], share=share, n_runs=int(ctx.runs.size),
             parameters={"peak_Hz": float(fp), "peak_over_floor_dB": peak[4], "over_the_model_dB": level,
-                        "half_power_width_Hz": width, "in_every_run": True, "kurtosis": kurt},
+                        "half_power_width_Hz": width, "in_every_run": True, "kurtosis": kurt,
+                        "measured_against": "smooth course" if peak[5] == "smooth" else "lower course"},
             causes=_hump_causes(kurt, fp, "at every speed"),
             would_tell=_HUMP_TELLS))
     return out
@@ -160,14 +184,17 @@ _HUMP_TELLS = ("a record with the wheel still (stand running, then stopped) show
 #: second ringing at 700 Hz, ζ 0.05: kurtosis 8-9).  A kurtosis is read on at most IMPULSE_RUNS runs.
 IMPULSIVE_KURTOSIS = 4.5
 IMPULSE_RUNS = 12
+#: ... and below this a line stands in it (a sinusoid's kurtosis is 1.5; noise's 3): not a hump but a line the model
+#: lacks, which the line detectors describe (a review's 215 Hz tone in the top four runs read as a hump, 1.506).
+LINE_KURTOSIS = 2.0
 
 
 def impulsiveness(ctx, state, chans, runs, f_peak: float, width: float) -> float | None:
     """The median over ``chans`` and up to :data:`IMPULSE_RUNS` of ``runs`` of the kurtosis E[y⁴]/E[y²]² of the
     records band-passed to ``f_peak`` ± ``width`` (Hz) by their whole-record FFT (a 10 % Tukey taper first, the
     moments over the middle 80 %: the record's ends wrapped onto each other are a step), the bins where a model line
-    stands over the floor (the Welch bin's prediction over twice its floor) left out: 3 for Gaussian noise, more for
-    impacts; None without the records."""
+    stands in the Welch bin (its prediction over the floor by :data:`CLEAN_LINE_FRACTION` of it) left out: 3 for
+    Gaussian noise, more for impacts, 1.5 for a sinusoid; None without the records."""
     from scipy.signal.windows import tukey
 
     def taper(n):
@@ -189,7 +216,7 @@ def impulsiveness(ctx, state, chans, runs, f_peak: float, width: float) -> float
             x = (x - x.mean()) * taper(x.size)
             f = np.fft.rfftfreq(x.size, 1.0 / run.sample_rate)
             k = np.clip(np.rint(f / ctx.df).astype(int), 0, ctx.f.size - 1)
-            lines = M[pos[int(r)], k] > 2.0 * N[pos[int(r)], k]
+            lines = M[pos[int(r)], k] - N[pos[int(r)], k] > CLEAN_LINE_FRACTION * N[pos[int(r)], k]
             keep = (np.abs(f - f_peak) <= width) & ~lines
             if keep.sum() < 8:
                 continue
@@ -212,37 +239,48 @@ def _hump_causes(kurt: float | None, f_peak: float, when: str) -> tuple:
     return noise
 
 
-#: A hump in some runs only: a run's floor over the floor of the runs (the median, :func:`clean_floor`), each run's
-#: dB first averaged over RUN_HUMP_SMOOTH_FRACTION of the band (a Welch bin's dB scatters by 1-2 dB), by this much (dB)
-#: at its peak in at least RUN_HUMP_RUNS runs whose peaks lie within RUN_HUMP_PEAKS_FRACTION of the band of each
-#: other, and in at most RUN_HUMP_MAX_FRACTION of the runs (in more, the floor of the runs holds it:
-#: :func:`broadband_hump`); it spans the bins around that peak where those runs' mean excess stands RUN_HUMP_EDGE_DB.
-#: A rattle in every third run (the new-user generator's 700 Hz impacts at 4 kHz) lifts its runs' floor 10-20 dB at
-#: its ringing and by 2-6 dB over most of the band (its skirts).
+#: A hump in some runs only: a run's floor over the floor the model holds for it (its instrument noise, with a
+#: ``broadband_floor`` class's at that speed), each run's dB first the running median over RUN_HUMP_SMOOTH_FRACTION of
+#: the band (at least RUN_HUMP_MIN_SMOOTH bins: a Welch bin's dB scatters by 1-2 dB, a line's lobe spans 4 bins)
+#: with the bins where a line stands out of its neighbours left out, by this much (dB) at its peak in at least
+#: RUN_HUMP_RUNS runs whose peaks lie within RUN_HUMP_PEAKS_FRACTION of the band of the first's (the run whose peak
+#: has most others near it), and in at most RUN_HUMP_MAX_FRACTION of the runs (in more, the floor of the runs holds
+#: it: :func:`broadband_hump`); it spans the bins around that peak where those runs' mean excess stands
+#: RUN_HUMP_EDGE_DB, and it peaks (:func:`_peaked`: a floor growing with speed lifts the whole band of the fast
+#: runs).  A rattle in every third run (the new-user generator's 700 Hz impacts at 4 kHz) lifts its runs'
+#: floor 10-20 dB at its ringing and by 2-6 dB over most of the band (its skirts).
 RUN_HUMP_PEAK_DB = 6.0
 RUN_HUMP_EDGE_DB = 2.0
 RUN_HUMP_SMOOTH_FRACTION = 1.0 / 64.0
+RUN_HUMP_MIN_SMOOTH = 9
 RUN_HUMP_RUNS = 2
 RUN_HUMP_MAX_FRACTION = 0.6
 RUN_HUMP_PEAKS_FRACTION = 1.0 / 16.0
 
 
 def _run_excess(ctx, state, c: str, width: int) -> np.ndarray:
-    """Each run's clean floor over the runs' (:func:`clean_floor`), dB (runs, n_f), averaged over ``width`` bins;
-    NaN where a model line stands in that run or no floor is known."""
-    from scipy.ndimage import uniform_filter1d
+    """Each run's data over the model's floor for it, dB (runs, n_f), a running median over ``width`` bins of the
+    bins clear of the model's lines and of any line standing out of its neighbours (:func:`~.describe_lines._lit`,
+    narrow); NaN where fewer than half of a window's bins are."""
+    from scipy.ndimage import median_filter, uniform_filter1d
+
+    from .describe_lines import _lit
 
     runs = ctx.runs
     D = ctx.data(state, c, runs)[runs]
     N = ctx.floor_psd(state, c, runs)
-    clean = (ctx.predict(state, c, runs) - N) < CLEAN_LINE_FRACTION * N
-    ref = clean_floor(ctx, state, c)
+    clean = ((ctx.predict(state, c, runs) - N) < CLEAN_LINE_FRACTION * N) & ~_lit(ctx, state, c, narrow=True)
     with np.errstate(divide="ignore", invalid="ignore"):
-        x = np.where(clean & (D > 0) & (ref[None, :] > 0), 10 * np.log10(D / ref[None, :]), np.nan)
+        x = np.where(clean & (D > 0) & (N > 0), 10 * np.log10(D / N), np.nan)
     ok = np.isfinite(x)
-    total = uniform_filter1d(np.where(ok, x, 0.0), width, axis=1, mode="nearest")
-    count = uniform_filter1d(ok.astype(float), width, axis=1, mode="nearest")
-    return np.where(count >= 0.5, total / np.maximum(count, 1e-12), np.nan)
+    k = np.arange(x.shape[1])
+    filled = np.zeros_like(x)
+    for i in range(x.shape[0]):                      # a row at a time: the gaps bridged for the median filter
+        if ok[i].sum() >= 2:
+            filled[i] = np.interp(k, k[ok[i]], x[i, ok[i]])
+    med = median_filter(filled, size=(1, width), mode="nearest")
+    share = uniform_filter1d(ok.astype(float), width, axis=1, mode="nearest")
+    return np.where(share >= 0.5, med, np.nan)
 
 
 def _mean_of_finite(x: np.ndarray) -> np.ndarray:
@@ -252,36 +290,46 @@ def _mean_of_finite(x: np.ndarray) -> np.ndarray:
     return np.where(n > 0, np.where(ok, x, 0.0).sum(0) / np.maximum(n, 1), np.nan)
 
 
+def _run_groups(peak_bin: np.ndarray, hot: np.ndarray, near: float) -> list:
+    """The hot runs (``hot``: rows) in groups whose peaks (``peak_bin``) lie within ``near`` bins of the group's
+    first: each time the run with most other hot runs near it, and those runs."""
+    left, out = hot.copy(), []
+    while left.size:
+        close = np.abs(peak_bin[left][:, None] - peak_bin[left][None, :]) <= near
+        first = int(np.argmax(close.sum(1)))
+        out.append(left[close[first]])
+        left = left[~close[first]]
+    return out
+
+
 def humps_in_some_runs(ctx, state, shares, every=()) -> list:
     """``broadband_hump`` records of a hump in some runs only (:data:`RUN_HUMP_PEAK_DB`): the runs whose floor
-    stands over the runs' floor at one frequency in one channel or several, one record with the channels where their
-    mean excess does, none where a hump of ``every`` (the humps in every run) peaks.  ``shares(chans, f0, f1,
-    runs)``: (share, level) of the cells of the band in those runs (indices of the test)."""
+    stands over the model's floor at one frequency in one channel or several, one record with the channels where their
+    mean excess does, none where a hump of ``every`` (the humps in every run) peaks and none where a line stands (its
+    kurtosis under :data:`LINE_KURTOSIS`).  ``shares(chans, f0, f1, runs)``: (share, level) of the cells of the band
+    in those runs (indices of the test)."""
     k_lo, k_hi = ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1)
     R = ctx.runs.size
-    if R < 2 * RUN_HUMP_RUNS or k_hi - k_lo < 16:
+    if R < 2 * RUN_HUMP_RUNS or k_hi - k_lo < 64:
         return []
-    width = max(3, int(RUN_HUMP_SMOOTH_FRACTION * (k_hi - k_lo)))
+    width = max(RUN_HUMP_MIN_SMOOTH, int(RUN_HUMP_SMOOTH_FRACTION * (k_hi - k_lo)))
+    margin = max(width, int(HUMP_EDGE_FRACTION * (k_hi - k_lo)))
     ex = {c: _run_excess(ctx, state, c, width) for c in ctx.channels}
     band = np.zeros(ctx.f.size, bool)
-    band[k_lo:k_hi + 1] = True
+    band[k_lo + margin:k_hi - margin + 1] = True     # a run's peak away from the edges, where the floor may fall away
     pooled = np.max(np.stack([np.where(np.isfinite(e) & band, e, -np.inf) for e in ex.values()]), axis=0)
     peak_bin, peak_db = np.argmax(pooled, axis=1), np.max(pooled, axis=1)
     hot = np.flatnonzero(peak_db >= RUN_HUMP_PEAK_DB)
-    near = max(RUN_HUMP_PEAKS_FRACTION * (k_hi - k_lo), width)
     out: list[Unexplained] = []
-    while hot.size >= RUN_HUMP_RUNS:
-        centre = np.median(peak_bin[hot])
-        rows = hot[np.abs(peak_bin[hot] - centre) <= near]
-        hot = np.setdiff1d(hot, rows)
+    for rows in _run_groups(peak_bin, hot, max(RUN_HUMP_PEAKS_FRACTION * (k_hi - k_lo), width)):
         if not RUN_HUMP_RUNS <= rows.size <= RUN_HUMP_MAX_FRACTION * R:
             continue
-        mean = {c: _mean_of_finite(e[rows]) for c, e in ex.items()}
         pk = int(np.rint(np.median(peak_bin[rows])))
-        if not k_lo + width <= pk <= k_hi - width:          # a floor rising to the band's edge is no hump
-            continue
-        chans = tuple(c for c in ctx.channels if np.nanmax(mean[c][max(pk - width, 0):pk + width + 1],
-                                                           initial=-np.inf) >= RUN_HUMP_PEAK_DB)
+        mean = {c: _mean_of_finite(e[rows]) for c, e in ex.items()}
+        # a channel carries it where its runs' mean stands half the peak's level near it (a line of the model
+        # over part of the hump leaves fewer of its bins to read)
+        chans = tuple(c for c in ctx.channels if np.nanmax(mean[c][max(pk - 2 * width, 0):pk + 2 * width + 1],
+                                                           initial=-np.inf) >= 0.5 * RUN_HUMP_PEAK_DB)
         if not chans:
             continue
         m = np.max(np.stack([np.where(np.isfinite(mean[c]), mean[c], -np.inf) for c in chans]), axis=0)
@@ -290,26 +338,29 @@ def humps_in_some_runs(ctx, state, shares, every=()) -> list:
             k0 -= 1
         while k1 + 1 <= k_hi and m[k1 + 1] >= RUN_HUMP_EDGE_DB:
             k1 += 1
+        top_k = k0 + int(np.argmax(m[k0:k1 + 1]))
+        if not _peaked(m, top_k, k_lo, k_hi):                 # a floor growing with speed lifts the fast runs' band
+            continue
         f0, f1 = float(ctx.f[k0]), float(ctx.f[k1])
-        fp = float(ctx.f[k0 + int(np.argmax(m[k0:k1 + 1]))])
+        fp = float(ctx.f[top_k])
         if any(u.f_Hz[0] <= fp <= u.f_Hz[1] for u in every) or _at_a_fitted_resonance(ctx, state, fp, chans):
             continue
         runs = ctx.runs[rows]
+        kurt = impulsiveness(ctx, state, chans, runs, fp, max(min(fp - f0, f1 - fp), 4 * ctx.df))
+        if kurt is not None and kurt < LINE_KURTOSIS:
+            continue
         share, level = shares(chans, f0, f1, runs)
         rpm = np.sort(ctx.omega[runs] * RAD_S_TO_RPM)
-        half = float(ctx.f[k0 + int(np.argmax(m[k0:k1 + 1]))] - ctx.f[k0])
-        kurt = impulsiveness(ctx, state, chans, runs, fp, max(min(half, float(ctx.f[k1]) - fp), 4 * ctx.df))
-        top = float(np.max(m[k0:k1 + 1]))
+        top = float(m[top_k])
         out.append(Unexplained(
             signature="broadband_hump", channels=chans, speed_rpm=(float(rpm[0]), float(rpm[-1])),
             f_Hz=(f0, f1), level_dB=top, share=share, n_runs=int(rows.size),
             parameters={"peak_Hz": fp, "peak_over_floor_dB": top, "over_the_model_dB": level,
                         "half_power_width_Hz": None, "in_every_run": False, "run_speeds_rpm": rpm.tolist(),
-                        "kurtosis": kurt},
+                        "kurtosis": kurt, "measured_against": "some runs"},
             causes=_hump_causes(kurt, fp, f"in {rows.size} of the {R} runs only"),
             would_tell=_HUMP_TELLS + "; the runs' order in time shows whether it comes and goes"))
     return out
-
 
 #: A hump peaking within this many half-power half-widths (ζ·f_r) of a fitted fixed resonance (plus a band's width)
 #: is that resonance: a fixture's resonance lifts the noise passing through the stand as it lifts the lines.

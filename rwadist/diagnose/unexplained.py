@@ -53,6 +53,8 @@ SIGNATURES = {
 DEFAULT_LEVEL_WORDS = "the data {:+.1f} dB over the model in its bins (median)"
 LEVEL_WORDS = {
     "broadband_hump": "{:+.1f} dB over the floor's smooth course",
+    "broadband_hump:lower course": "{:+.1f} dB over the floor's lower course (the higher of its lowest on either side)",
+    "broadband_hump:some runs": "{:+.1f} dB over the floor the model holds for those runs",
     "run_change": "the changed runs {} dB off the others",
     "run_change:spread": "every run off the model by its own factor, {:.2f} dB scatter ({:+.2f} to {:+.2f} dB over {} "
                          "runs)",
@@ -117,7 +119,8 @@ class Unexplained:
     speed_rpm : (lowest, highest) wheel speed of the runs where it stands above the noise, rpm.
     f_Hz : (lowest, highest) frequency where it is, Hz (a fixed line: its frequency twice).
     level_dB : how far it stands out, dB: the median over its cells of 10·log10(data / model); for a
-        ``broadband_hump`` (which the model takes as noise) its peak over the floor's smooth course, for a
+        ``broadband_hump`` (which the model takes as noise) its peak over the floor's smooth course (its lower
+        course for a wide one, the floor the model holds for those runs for one in some runs), for a
         ``run_change`` the median offset of the changed runs from the lines' smooth trends with speed, for a
         ``line_property`` of a channel's gain the median power ratio of the pair's channels and of a ``gain_trend`` the
         lines' change of power from the lowest speed to the highest (:data:`LEVEL_WORDS`, keyed by signature, or by
@@ -189,7 +192,7 @@ class Unexplained:
             p, over = self.parameters, _number(self.parameters.get("copy_over_noise_dB"))
             return f"under a tenth of {p.get('target')}'s own content in every band" + (
                 "" if over is None else f", the copy {over:+.1f} dB over its noise on {p.get('source')}'s lines (median)")
-        key = f"{self.signature}:{self.parameters.get('property')}"
+        key = f"{self.signature}:{self.parameters.get('property', self.parameters.get('measured_against'))}"
         words = LEVEL_WORDS.get(f"{key}:{self.parameters.get('pattern')}", LEVEL_WORDS.get(key))
         out = (words or LEVEL_WORDS.get(self.signature, DEFAULT_LEVEL_WORDS)).format(self.level_dB)
         lift = _number(self.parameters.get("largest_line_lift_dB")) if self.signature == "moving_resonance" else None
@@ -232,7 +235,7 @@ class Unexplained:
     def text(self) -> str:
         """The console's one line: signature, where, strength, share, the first cause and what would tell."""
         if self.signature == "channel_copy" and _number(self.level_dB) is None:
-            share = "no band of what is left its own"           # its cells are none (:meth:`strength`), not 0 %
+            share = "no band of its own in what is left"           # its cells are none (:meth:`strength`), not 0 %
         else:
             share = f"{self.share_text()} of what is left"
         out = f"{self.signature}: {self.where()}, {self.strength()}, {share}"

@@ -55,7 +55,8 @@ class FixedResonance(Element):
         role = "test stand" if e["role"] == "test_stand" else "wheel mode"
         above = e.get("gain_above", 1.0)
         # a fitted 1e-6 either side of 0 is the spring's 0 (a "-1.1e-06 of the load" read as a finding)
-        above = 0.0 if isinstance(above, (int, float)) and abs(above) < 1e-3 else above
+        if isinstance(above, (int, float)):
+            above = 0.0 if abs(above) < 1e-3 else 1.0 if abs(above - 1.0) < 1e-3 else above
         below = "" if above == 1.0 else f", {num(above, '.2g')} of the load far above"
         # a gain under 1 at f_r attenuates the lines there: said so, not left to read as a resonance (trial 30b)
         notch = " (under 1: a notch, the lines attenuated there)" if float(e["peak_gain"]) < 1.0 else ""
