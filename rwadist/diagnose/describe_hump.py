@@ -239,8 +239,7 @@ def _hump_causes(kurt: float | None, f_peak: float, when: str) -> tuple:
     return noise
 
 
-#: A hump in some runs only: a run's floor over the floor the model holds for it (its instrument noise, with a
-#: ``broadband_floor`` class's at that speed), each run's dB first the running median over RUN_HUMP_SMOOTH_FRACTION of
+#: A hump in some runs only: a run's floor over the runs' (:func:`_run_excess`), each run's dB first the running median over RUN_HUMP_SMOOTH_FRACTION of
 #: the band (at least RUN_HUMP_MIN_SMOOTH bins: a Welch bin's dB scatters by 1-2 dB, a line's lobe spans 4 bins)
 #: with the bins where a line stands out of its neighbours left out, by this much (dB) at its peak in at least
 #: RUN_HUMP_RUNS runs whose peaks lie within RUN_HUMP_PEAKS_FRACTION of the band of the first's (the run whose peak
@@ -259,9 +258,10 @@ RUN_HUMP_PEAKS_FRACTION = 1.0 / 16.0
 
 
 def _run_excess(ctx, state, c: str, width: int) -> np.ndarray:
-    """Each run's data over the model's floor for it, dB (runs, n_f), a running median over ``width`` bins of the
-    bins clear of the model's lines and of any line standing out of its neighbours (:func:`~.describe_lines._lit`,
-    narrow); NaN where fewer than half of a window's bins are."""
+    """Each run's data over the runs' floor (:func:`clean_floor`, scaled as the model's floor changes from run to
+    run), dB (runs, n_f), a running median over ``width`` bins of the bins clear of the model's lines and of any line
+    standing out of its neighbours (:func:`~.describe_lines._lit`, narrow); NaN where fewer than half of a window's
+    bins are."""
     from scipy.ndimage import median_filter, uniform_filter1d
 
     from .describe_lines import _lit
@@ -270,8 +270,12 @@ def _run_excess(ctx, state, c: str, width: int) -> np.ndarray:
     D = ctx.data(state, c, runs)[runs]
     N = ctx.floor_psd(state, c, runs)
     clean = ((ctx.predict(state, c, runs) - N) < CLEAN_LINE_FRACTION * N) & ~_lit(ctx, state, c, narrow=True)
+    # the runs' floor, the median over them (a hump in a third of them does not lift it; the model's noise, a mean,
+    # is lifted by a third of its height: family wheel 0's rattle read +4.8 dB for +15), as the model's floor
+    # changes from run to run (a broadband_floor class's, growing with speed)
     with np.errstate(divide="ignore", invalid="ignore"):
-        x = np.where(clean & (D > 0) & (N > 0), 10 * np.log10(D / N), np.nan)
+        ref = clean_floor(ctx, state, c)[None, :] * N / np.median(N, axis=0)[None, :]
+        x = np.where(clean & (D > 0) & (ref > 0), 10 * np.log10(D / ref), np.nan)
     ok = np.isfinite(x)
     k = np.arange(x.shape[1])
     filled = np.zeros_like(x)
@@ -281,6 +285,19 @@ def _run_excess(ctx, state, c: str, width: int) -> np.ndarray:
     med = median_filter(filled, size=(1, width), mode="nearest")
     share = uniform_filter1d(ok.astype(float), width, axis=1, mode="nearest")
     return np.where(share >= 0.5, med, np.nan)
+
+
+def _over_lower_course(excess: np.ndarray, k_lo: int, k_hi: int) -> np.ndarray:
+    """Each row of ``excess`` (runs, n_f; dB, NaN unknown) over its lower course in [k_lo, k_hi] (the higher of the
+    lowest value on either side, :func:`_lower_course`'s): what rises and falls again, not a run's floor rising into
+    the band's edge (a review's anti-alias roll-off to -100 dB, where a rattle's skirt stood 90 dB over the runs'
+    floor and hid its 15 dB peak at 700 Hz)."""
+    band = np.where(np.isfinite(excess[:, k_lo:k_hi + 1]), excess[:, k_lo:k_hi + 1], np.inf)
+    course = np.maximum(np.minimum.accumulate(band, axis=1), np.minimum.accumulate(band[:, ::-1], axis=1)[:, ::-1])
+    out = np.full(excess.shape, np.nan)
+    with np.errstate(invalid="ignore"):
+        out[:, k_lo:k_hi + 1] = np.where(np.isfinite(band) & np.isfinite(course), band - course, np.nan)
+    return out
 
 
 def _mean_of_finite(x: np.ndarray) -> np.ndarray:
@@ -305,16 +322,19 @@ def _run_groups(peak_bin: np.ndarray, hot: np.ndarray, near: float) -> list:
 def humps_in_some_runs(ctx, state, shares, every=()) -> list:
     """``broadband_hump`` records of a hump in some runs only (:data:`RUN_HUMP_PEAK_DB`): the runs whose floor
     stands over the model's floor at one frequency in one channel or several, one record with the channels where their
-    mean excess does, none where a hump of ``every`` (the humps in every run) peaks and none where a line stands (its
-    kurtosis under :data:`LINE_KURTOSIS`).  ``shares(chans, f0, f1, runs)``: (share, level) of the cells of the band
+    mean excess does, none where a hump of ``every`` (the humps in every run) peaks, at a suspension mode's whirl in
+    those runs or a fixed resonance (:func:`~.describe_fixed._at_a_mode`), or where a line stands (its kurtosis under
+    :data:`LINE_KURTOSIS`).  ``shares(chans, f0, f1, runs)``: (share, level) of the cells of the band
     in those runs (indices of the test)."""
+    from .describe_fixed import _at_a_mode
+
     k_lo, k_hi = ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1)
     R = ctx.runs.size
     if R < 2 * RUN_HUMP_RUNS or k_hi - k_lo < 64:
         return []
     width = max(RUN_HUMP_MIN_SMOOTH, int(RUN_HUMP_SMOOTH_FRACTION * (k_hi - k_lo)))
     margin = max(width, int(HUMP_EDGE_FRACTION * (k_hi - k_lo)))
-    ex = {c: _run_excess(ctx, state, c, width) for c in ctx.channels}
+    ex = {c: _over_lower_course(_run_excess(ctx, state, c, width), k_lo, k_hi) for c in ctx.channels}
     band = np.zeros(ctx.f.size, bool)
     band[k_lo + margin:k_hi - margin + 1] = True     # a run's peak away from the edges, where the floor may fall away
     pooled = np.max(np.stack([np.where(np.isfinite(e) & band, e, -np.inf) for e in ex.values()]), axis=0)
@@ -338,14 +358,21 @@ def humps_in_some_runs(ctx, state, shares, every=()) -> list:
             k0 -= 1
         while k1 + 1 <= k_hi and m[k1 + 1] >= RUN_HUMP_EDGE_DB:
             k1 += 1
-        top_k = k0 + int(np.argmax(m[k0:k1 + 1]))
-        if not _peaked(m, top_k, k_lo, k_hi):                 # a floor growing with speed lifts the fast runs' band
+        a, z = max(k0, k_lo + margin), min(k1, k_hi - margin)
+        top_k = a + int(np.argmax(m[a:z + 1])) if z >= a else pk
+        # a floor growing with speed lifts the fast runs' band (no peak); one rising on into the band's edge is the
+        # runs' floor falling away there (an anti-alias filter's roll-off: 1830-1920 Hz, +8 dB in two runs): the
+        # peak stands 3 dB over the excess 4 smoothing widths either side, inside the band
+        sides = [top_k - 4 * width, top_k + 4 * width]
+        if not _peaked(m, top_k, k_lo, k_hi) or not all(k_lo <= k <= k_hi for k in sides) or \
+                m[top_k] - max(m[sides[0]], m[sides[1]]) < 3.0:
             continue
         f0, f1 = float(ctx.f[k0]), float(ctx.f[k1])
         fp = float(ctx.f[top_k])
-        if any(u.f_Hz[0] <= fp <= u.f_Hz[1] for u in every) or _at_a_fitted_resonance(ctx, state, fp, chans):
-            continue
         runs = ctx.runs[rows]
+        # a suspension mode's whirl rung by broadband loads in those runs is the wheel's own
+        if any(u.f_Hz[0] <= fp <= u.f_Hz[1] for u in every) or _at_a_mode(ctx, state, fp, runs, chans):
+            continue
         kurt = impulsiveness(ctx, state, chans, runs, fp, max(min(fp - f0, f1 - fp), 4 * ctx.df))
         if kurt is not None and kurt < LINE_KURTOSIS:
             continue

@@ -54,7 +54,7 @@ DEFAULT_LEVEL_WORDS = "the data {:+.1f} dB over the model in its bins (median)"
 LEVEL_WORDS = {
     "broadband_hump": "{:+.1f} dB over the floor's smooth course",
     "broadband_hump:lower course": "{:+.1f} dB over the floor's lower course (the higher of its lowest on either side)",
-    "broadband_hump:some runs": "{:+.1f} dB over the floor the model holds for those runs",
+    "broadband_hump:some runs": "{:+.1f} dB over the floor of the runs (their median) in those runs",
     "run_change": "the changed runs {} dB off the others",
     "run_change:spread": "every run off the model by its own factor, {:.2f} dB scatter ({:+.2f} to {:+.2f} dB over {} "
                          "runs)",
@@ -120,7 +120,7 @@ class Unexplained:
     f_Hz : (lowest, highest) frequency where it is, Hz (a fixed line: its frequency twice).
     level_dB : how far it stands out, dB: the median over its cells of 10·log10(data / model); for a
         ``broadband_hump`` (which the model takes as noise) its peak over the floor's smooth course (its lower
-        course for a wide one, the floor the model holds for those runs for one in some runs), for a
+        course for a wide one, the runs' median floor for one in some runs), for a
         ``run_change`` the median offset of the changed runs from the lines' smooth trends with speed, for a
         ``line_property`` of a channel's gain the median power ratio of the pair's channels and of a ``gain_trend`` the
         lines' change of power from the lowest speed to the highest (:data:`LEVEL_WORDS`, keyed by signature, or by
