@@ -25,6 +25,15 @@ in every third run (w4 own, 400-900 Hz, the waterfall plain) not described; impa
 not on w1, w2; a line at 40 Hz + 0.5 f_spin (w3 own) read as a constant-ratio line, two fixed lines 'of the stand' and
 a cage slipping 14 %; a line of random strength run to run (w2 own) described as a partial line covering 3-34 % of the
 error left.
+
+Record (2026-12-04, session 44, rwadist at e381cc0, the same 62 data sets, 3.1-9.2 s each): the four wide humps
+described where they are on every channel (327-572 Hz for 450 ± 50 Hz ...), kurtosis 2.9-3.0, named a fixture or
+sensor resonance; the speed-dependent hump (w1 own, both seeds) described on Fx Fy Fz at 207-465 Hz; impacts in every
+run described on all four wheels (kurtosis 12-14, named impacts ringing at 350/357/1410/718 Hz); impacts in every third
+run (w4 own, both seeds) described in 11 of the 32 runs at 206-1042 Hz, kurtosis 41-46, named impacts ringing at
+692-700 Hz; the line at 40 Hz + 0.5 f_spin (w3 own, both seeds) one affine_line on Fz Tz, f0 39.98 Hz, slope
+0.5001-0.5002, nothing else; clean, fixtures, counter-rotation, pickup and crosstalk as before.  Left: the line of
+random strength (w2 own) is still a partial line.
 """
 import json
 import os

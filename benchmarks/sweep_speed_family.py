@@ -129,7 +129,8 @@ def run(i: int, way: str, duration: float, profile: str, work: Path, seed: int) 
     row["speed_scale"] = (reading.get("slicing") or {}).get("speed_scale")
     row["effects"] = [e["kind"] for e in summary["effects"]]
     row["added"] = [k for k in row["effects"] if k not in OWN_CLASSES]
-    row["unexplained"] = [u.get("text", "").split(":")[0] + f" h {u.get('h', float('nan')):.4g}"
+    row["unexplained"] = [u.get("signature", "") + (f" h {u['h']:.4g}" if u.get("h") is not None else
+                                                     " {:.4g}-{:.4g} Hz".format(*u.get("f_Hz", [0, 0])))
                           for u in summary.get("unexplained") or []]
     return row
 

@@ -327,10 +327,13 @@ def humps_in_some_runs(ctx, state, shares, every=()) -> list:
     :data:`LINE_KURTOSIS`).  ``shares(chans, f0, f1, runs)``: (share, level) of the cells of the band
     in those runs (indices of the test)."""
     from .describe_fixed import _at_a_mode
+    from .describe_lines import sliced
 
     k_lo, k_hi = ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1)
     R = ctx.runs.size
-    if R < 2 * RUN_HUMP_RUNS or k_hi - k_lo < 64:
+    # steady runs only: a sweep's slices smear its lines over bins by the speed's change within each, and the fast
+    # slices' smeared skirts read as humps (family wheel 5's 1000-10000 rpm sweeps: +6-7 dB at 512 Hz in 2-5 slices)
+    if R < 2 * RUN_HUMP_RUNS or k_hi - k_lo < 64 or sliced(ctx):
         return []
     width = max(RUN_HUMP_MIN_SMOOTH, int(RUN_HUMP_SMOOTH_FRACTION * (k_hi - k_lo)))
     margin = max(width, int(HUMP_EDGE_FRACTION * (k_hi - k_lo)))
