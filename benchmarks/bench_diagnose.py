@@ -159,6 +159,12 @@ slower for 2; memory-bound), the phasors' records kept for runs asked again (~5 
 not met on three rows.  cProfile of a sixty diagnose: spread over the families (the wheel's modes 0.44 s of 1.85 s
 profiled, the fixed-resonance candidates 0.27 s, the open world's descriptions 0.33 s, none else over 0.2 s);
 blocked_records 26 calls, 50-65 ms CPU of 1.36-1.41 s (timed apart): a cache of the blocked records would save < 4 %.
+2026-12-04, session 44 (the open world's wide and some-runs humps, affine lines): --quick --repeats 5 at 8529031,
+--busy 2: cpu min/median x11.7/x12.5 (benchmark; 2.46 s / 0.21 s), x11.4/x12.5 (2 busy), x15.3/x14.1 (sixty; 1.48 s /
+0.10 s), x13.1/x13.0 (2 busy); cProfile of a sixty diagnose: the new detectors 0.19 s (humps in some runs 0.13 s,
+its running medians 0.07 s; affine lines 0.06 s), the residual's lit bins computed 24 times (0.13 s).  With the lit
+bins kept on the state (computed once per channel and kind, read-only): --busy 0, x11.2/x11.4 and x10.9 (benchmark;
+2.29 s / 0.21 s), x12.8/x12.3 and x11.6 (sixty; 1.28-1.30 s / 0.11 s) in two rounds; target not met.
 """
 from __future__ import annotations
 

@@ -87,6 +87,10 @@ def _lit(ctx, state, c: str, narrow: bool = False) -> np.ndarray:
     """Bins (runs, n_f) of channel ``c`` where the data stand over the model beyond the χ² level, or a neighbour does,
     away from the model's lines (bins where the lines' predicted PSD exceeds the floor); ``narrow``: only where they
     also stand so over their own neighbourhood (:func:`_narrow`: a line, not a hump)."""
+    key = ("lit", c, narrow, ctx.runs.tobytes())   # kept read-only on the state, as its floor: five detectors read it
+    cache = getattr(state, "_cache", None)
+    if cache is not None and key in cache:
+        return cache[key]
     from scipy import stats
 
     runs = ctx.runs
@@ -101,6 +105,9 @@ def _lit(ctx, state, c: str, narrow: bool = False) -> np.ndarray:
     out[:, 1:] |= lit[:, :-1]
     out[:, :-1] |= lit[:, 1:]
     out[~np.isfinite(D[:, 0])] = False
+    out.flags.writeable = False
+    if cache is not None:
+        cache[key] = out
     return out
 
 
