@@ -479,6 +479,20 @@ class LeverArmNoise(CrossCoupling):
 
 
 # --------------------------------------------------------------------------------------- unknown kinds
+def _top_loads(wheel) -> np.ndarray:
+    """Per channel (6,) the wheel's imbalance load at its top speed: the radial force's on the forces, the radial
+    torque's on the torques (the scale of a line added at the cell)."""
+    top = wheel.max_rpm * fw.RPM
+    return np.array([wheel.imbalance("radial_force")] * 3 + [wheel.imbalance("radial_torque")] * 3) * top**2
+
+
+def _cell_lines(kind: str, w: np.ndarray, A: np.ndarray) -> tuple:
+    """(Components, A) of lines at angular frequencies ``w`` (rad/s) added at the cell, tagged ``kind``, with the
+    complex amplitudes ``A`` (len(w), 6)."""
+    n = len(w)
+    return fw.Components(["cell"] * n, w, np.ones(n), np.ones(n, complex), [kind] * n), A
+
+
 class Pickup(Effect):
     kind = "pickup"
     expects = "unexplained"
@@ -490,13 +504,9 @@ class Pickup(Effect):
     def cell_components(self, omega, run, rng, wheel):
         p = self.params
         w = 2 * np.pi * p["mains_hz"] * np.array(p["orders"], dtype=float)
-        top = wheel.max_rpm * fw.RPM
-        scale = np.array([wheel.imbalance("radial_force")] * 3 + [wheel.imbalance("radial_torque")] * 3) * top**2
         phase = rng.uniform(0, 2 * np.pi, len(w))                       # common mode: one phase on every channel
         amp = p["level"] / np.array(p["orders"], dtype=float)
-        A = (amp * np.exp(1j * phase))[:, None] * scale[None, :]
-        comp = fw.Components(["cell"] * len(w), w, np.ones(len(w)), np.ones(len(w), complex), [self.kind] * len(w))
-        return comp, A
+        return _cell_lines(self.kind, w, (amp * np.exp(1j * phase))[:, None] * _top_loads(wheel)[None, :])
 
     def signature(self, wheel, data):
         return parts_signature(data, _tagged(data, self.kind))
@@ -673,14 +683,10 @@ class AffineLine(Effect):
         return self.params["f0_hz"] + self.params["slope"] * abs(omega) / (2 * np.pi)
 
     def cell_components(self, omega, run, rng, wheel):
-        p = self.params
-        top = wheel.max_rpm * fw.RPM
-        scale = np.zeros(6)
-        scale[2] = wheel.imbalance("radial_force") * top**2 * p["level"]
-        scale[5] = wheel.imbalance("radial_torque") * top**2 * p["level"]
+        axial = np.isin(np.arange(6), [fw.CHANNELS.index("Fz"), fw.CHANNELS.index("Tz")])
+        scale = np.where(axial, _top_loads(wheel) * self.params["level"], 0.0)
         w = np.array([2 * np.pi * self.f_hz(omega)])
-        A = np.exp(1j * rng.uniform(0, 2 * np.pi)) * scale[None, :]
-        return fw.Components(["cell"], w, np.ones(1), np.ones(1, complex), [self.kind]), A
+        return _cell_lines(self.kind, w, np.exp(1j * rng.uniform(0, 2 * np.pi)) * scale[None, :])
 
     def signature(self, wheel, data):
         return parts_signature(data, _tagged(data, self.kind))

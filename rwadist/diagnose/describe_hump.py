@@ -67,10 +67,14 @@ def _lower_course(lf: np.ndarray, k_lo: int, k_hi: int) -> np.ndarray:
     left and the lowest on its right, so only what rises and falls again stands over it."""
     half = max(int(HUMP_WIDE_SMOOTH_FRACTION * (k_hi - k_lo) / 2), HUMP_MIN_BINS)
     smooth = _running_median(lf, half)
-    band = smooth[k_lo:k_hi + 1]
     course = np.full(lf.size, np.inf)
-    course[k_lo:k_hi + 1] = np.maximum(np.minimum.accumulate(band), np.minimum.accumulate(band[::-1])[::-1])
+    course[k_lo:k_hi + 1] = _course(smooth[k_lo:k_hi + 1])
     return smooth - course
+
+
+def _course(x: np.ndarray) -> np.ndarray:
+    """Along the last axis of ``x``, the higher of the lowest value on the left and the lowest on the right."""
+    return np.maximum(np.minimum.accumulate(x, axis=-1), np.flip(np.minimum.accumulate(np.flip(x, -1), axis=-1), -1))
 
 
 def _humps(excess_db: np.ndarray, k_lo: int, k_hi: int, max_width: int | None = None,
@@ -197,9 +201,6 @@ def impulsiveness(ctx, state, chans, runs, f_peak: float, width: float) -> float
     Gaussian noise, more for impacts, 1.5 for a sinusoid; None without the records."""
     from scipy.signal.windows import tukey
 
-    def taper(n):
-        return tukey(n, 0.1)
-
     test = getattr(ctx, "test", None)
     if test is None or width <= 0:
         return None
@@ -213,7 +214,7 @@ def impulsiveness(ctx, state, chans, runs, f_peak: float, width: float) -> float
             if c not in run.signals:
                 continue
             x = np.asarray(run.signals[c], dtype=float)
-            x = (x - x.mean()) * taper(x.size)
+            x = (x - x.mean()) * tukey(x.size, 0.1)
             f = np.fft.rfftfreq(x.size, 1.0 / run.sample_rate)
             k = np.clip(np.rint(f / ctx.df).astype(int), 0, ctx.f.size - 1)
             lines = M[pos[int(r)], k] - N[pos[int(r)], k] > CLEAN_LINE_FRACTION * N[pos[int(r)], k]
@@ -293,7 +294,7 @@ def _over_lower_course(excess: np.ndarray, k_lo: int, k_hi: int) -> np.ndarray:
     the band's edge (a review's anti-alias roll-off to -100 dB, where a rattle's skirt stood 90 dB over the runs'
     floor and hid its 15 dB peak at 700 Hz)."""
     band = np.where(np.isfinite(excess[:, k_lo:k_hi + 1]), excess[:, k_lo:k_hi + 1], np.inf)
-    course = np.maximum(np.minimum.accumulate(band, axis=1), np.minimum.accumulate(band[:, ::-1], axis=1)[:, ::-1])
+    course = _course(band)
     out = np.full(excess.shape, np.nan)
     with np.errstate(invalid="ignore"):
         out[:, k_lo:k_hi + 1] = np.where(np.isfinite(band) & np.isfinite(course), band - course, np.nan)
