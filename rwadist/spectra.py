@@ -223,26 +223,25 @@ def noise_floor(psd: np.ndarray, f: np.ndarray, dof: float = 2.0, width_hz: floa
     return med * (max(dof, 2.0) / stats.chi2.median(max(dof, 2.0)))
 
 
-#: elements of the window stack :func:`running_median` selects from at once (bounds its memory: 32 MB)
-_MEDIAN_BLOCK = 1 << 22
+def running_median(x: np.ndarray, n: int, mode: str = "mirror") -> np.ndarray:
+    """Running median of width ``n`` along the last axis of ``x``; the values of
+    ``scipy.ndimage.median_filter(x, size=(1, .., 1, n), mode=mode)`` (``"mirror"``: edges mirrored about the end
+    sample; ``"nearest"``: the end sample repeated).
 
-
-def running_median(x: np.ndarray, n: int) -> np.ndarray:
-    """Running median of odd width ``n`` along the last axis of ``x``, edges mirrored; the values of
-    ``scipy.ndimage.median_filter(x, size=(1, .., 1, n), mode="mirror")``.
-
-    The median of an odd number of values is one of them, so selecting it from a strided window stack
-    (``np.partition``) gives the same numbers as ndimage, several times faster for the PSD widths used
-    here (mirror = ``np.pad`` "reflect").  An array with NaN or inf next to finite values in a row, rows
-    shorter than the window and non-float input go through ndimage itself (NaN has no place in a
-    partition's order); a row of NaN alone gives NaN in both.
+    ndimage filters a 1-D array with its own running rank filter (O(n_f·log n)), an n-D one by selecting from every
+    window again (O(n_f·n)): the rows are filtered one at a time, the same numbers 2.5-15x faster at the widths used
+    here (a (60, 4097) array at n = 61: 11 ms against 165 ms).  An array with NaN or inf next to finite values in a
+    row goes through ndimage as it is (NaN has no place in a rank's order, and ndimage's 1-D and n-D paths order it
+    differently); a row of NaN alone gives NaN in both.
 
     Parameters
     ----------
     x : numpy.ndarray
         Any shape (..., n_f); filtered along the last axis.
     n : int
-        Window width in samples, odd.
+        Window width in samples.
+    mode : str
+        ndimage's edge mode.
 
     Returns
     -------
@@ -250,19 +249,14 @@ def running_median(x: np.ndarray, n: int) -> np.ndarray:
         The running median, shape of ``x``.
     """
     x = np.asarray(x)
-    half = n // 2
-    rows = x.reshape(-1, x.shape[-1]) if x.ndim else x
-    if n % 2 == 0 or x.ndim == 0 or x.dtype.kind != "f" or x.shape[-1] <= n:
-        return ndimage.median_filter(x, size=(1,) * (x.ndim - 1) + (n,), mode="mirror")
-    if not np.all(np.isfinite(rows).all(axis=1) | np.isnan(rows).all(axis=1)):
-        # NaN/inf among finite values: ndimage's own order (which differs between its 1-D and n-D paths)
-        return ndimage.median_filter(x, size=(1,) * (x.ndim - 1) + (n,), mode="mirror")
+    if x.ndim == 0:
+        return ndimage.median_filter(x, size=n, mode=mode)
+    rows = x.reshape(-1, x.shape[-1])
+    if x.dtype.kind != "f" or not np.all(np.isfinite(rows).all(axis=1) | np.isnan(rows).all(axis=1)):
+        return ndimage.median_filter(x, size=(1,) * (x.ndim - 1) + (n,), mode=mode)
     out = np.empty(rows.shape, dtype=x.dtype)
-    step = max(1, _MEDIAN_BLOCK // (rows.shape[1] * n))
-    for i in range(0, rows.shape[0], step):
-        padded = np.pad(rows[i:i + step], ((0, 0), (half, half)), mode="reflect")
-        windows = np.lib.stride_tricks.sliding_window_view(padded, n, axis=-1)
-        out[i:i + step] = np.partition(windows, half, axis=-1)[..., half]
+    for i, row in enumerate(rows):                   # one 1-D filter a row (module docstring): n_rows calls
+        ndimage.median_filter(row, size=n, mode=mode, output=out[i])
     return out.reshape(x.shape)
 
 

@@ -32,7 +32,7 @@ def test_a_hump_of_noise_lights_no_more_bins_than_the_false_alarm_level_and_a_li
         ratio, hump = _ratio(seed, lines=((700, 30.0), (410, 30.0)))
         in_hump = hump > 2.0
         plain = ratio > thr
-        narrow = plain & _narrow(ratio, thr)
+        narrow = _narrow(ratio, thr, plain)
         assert plain[:, in_hump].mean() > 0.5                 # without the test: the hump lit throughout
         hump_bins = in_hump.copy()
         hump_bins[[409, 410, 411]] = False

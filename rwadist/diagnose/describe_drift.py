@@ -78,8 +78,6 @@ def _record_ratios(ctx, chans, h0: float, half: float) -> tuple:
     record bin apart at the top speed), its peak :data:`MIN_SNR_DB` over the grid's median (at the low speeds the
     window lies within the line's own lobe, and its median is no floor: those runs are not read), refined by a
     parabola through the log powers of the top three points."""
-    from ..units import CHANNELS
-
     runs = np.asarray(ctx.runs)
     df = float(np.median([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs]))
     spin = np.abs(ctx.omega[runs]) / (2 * np.pi)
@@ -90,7 +88,7 @@ def _record_ratios(ctx, chans, h0: float, half: float) -> tuple:
     if n < 5 or not ok.any():
         return np.empty((0, 3)), df
     runs, spin = runs[ok], spin[ok]
-    X = ctx.phasors(runs, np.outer(spin, grid))[:, :, [CHANNELS.index(c) for c in chans]]
+    X = ctx.transforms(runs, np.outer(spin, grid), chans)
     P = np.sum(np.abs(X) ** 2, axis=2)                                          # (runs, grid)
     j = np.argmax(P, axis=1)
     floor = np.median(P, axis=1)

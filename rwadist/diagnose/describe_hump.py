@@ -55,10 +55,10 @@ CLEAN_LINE_FRACTION = 0.01
 
 
 def _running_median(x: np.ndarray, half: int) -> np.ndarray:
-    """Running median of ``x`` (1-D) over ±``half`` points (shrinking at the ends)."""
-    from scipy.ndimage import median_filter
+    """Running median of ``x`` (1-D) over ±``half`` points (the end points repeated)."""
+    from ..spectra import running_median
 
-    return median_filter(x, size=2 * half + 1, mode="nearest")
+    return running_median(x, 2 * half + 1, mode="nearest")
 
 
 def _lower_course(lf: np.ndarray, k_lo: int, k_hi: int) -> np.ndarray:
@@ -263,8 +263,9 @@ def _run_excess(ctx, state, c: str, width: int) -> np.ndarray:
     run), dB (runs, n_f), a running median over ``width`` bins of the bins clear of the model's lines and of any line
     standing out of its neighbours (:func:`~.describe_lines._lit`, narrow); NaN where fewer than half of a window's
     bins are."""
-    from scipy.ndimage import median_filter, uniform_filter1d
+    from scipy.ndimage import uniform_filter1d
 
+    from ..spectra import running_median
     from .describe_lines import _lit
 
     runs = ctx.runs
@@ -283,7 +284,7 @@ def _run_excess(ctx, state, c: str, width: int) -> np.ndarray:
     for i in range(x.shape[0]):                      # a row at a time: the gaps bridged for the median filter
         if ok[i].sum() >= 2:
             filled[i] = np.interp(k, k[ok[i]], x[i, ok[i]])
-    med = median_filter(filled, size=(1, width), mode="nearest")
+    med = running_median(filled, width, mode="nearest")
     share = uniform_filter1d(ok.astype(float), width, axis=1, mode="nearest")
     return np.where(share >= 0.5, med, np.nan)
 

@@ -143,35 +143,43 @@ class Context(Metric):
         and channel set transformed together (:func:`rwadist.dft.windowed_dfts`, whose sums at a frequency do not
         depend on the others asked with it; chunks of :data:`PHASOR_CHUNK_SAMPLES` samples; the windowed signals are
         not kept: a long test's would double its memory)."""
-        from ..dft import blocked_records, run_window, windowed_dfts
-
         f_hz = np.asarray(f_hz, dtype=float).reshape(runs.size, -1)
         cols = [np.ascontiguousarray(f_hz[:, j:j + 1]) for j in range(f_hz.shape[1])]
         keys = [("phasors", runs.tobytes(), col.tobytes()) for col in cols]
         todo = list(dict.fromkeys(k for k in keys if k not in self._memo))        # each missing column once
         if todo:
             first = {k: keys.index(k) for k in todo}
-            f_new = np.column_stack([cols[first[k]] for k in todo])
-            out = np.full((runs.size, f_new.shape[1], len(CHANNELS)), np.nan + 0j)
-            groups: dict[tuple, list[int]] = {}
-            for i, r in enumerate(runs):
-                run = self.test.runs[r]
-                have = tuple(j for j, c in enumerate(CHANNELS) if run.usable(c))
-                groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
-            for (n, fs, have), rows_all in groups.items():
-                w, wsum, _ = run_window(self.sp.window, n)
-                step = max(1, PHASOR_CHUNK_SAMPLES // (n * max(len(have), 1)))
-                for s in range(0, len(rows_all), step):
-                    rows = np.asarray(rows_all[s:s + step])
-                    x = blocked_records([[self.test.runs[runs[i]].signals[CHANNELS[j]] for j in have] for i in rows], w)
-                    out[rows[:, None], :, np.asarray(have)[None, :]] = \
-                        (2.0 * windowed_dfts(x, fs, f_new[rows]) / wsum).transpose(0, 2, 1)
+            out = self.transforms(runs, np.column_stack([cols[first[k]] for k in todo]))
             for i, k in enumerate(todo):
                 col = out[:, i:i + 1].copy()
                 col.flags.writeable = False
                 self._memo[k] = col
         return np.concatenate([self._memo[k] for k in keys], axis=1) if keys else \
             np.full((runs.size, 0, len(CHANNELS)), np.nan + 0j)
+
+    def transforms(self, runs: np.ndarray, f_hz: np.ndarray, channels: tuple = CHANNELS) -> np.ndarray:
+        """The numbers of :meth:`phasors` (len(runs), L, len(channels)) of ``channels`` only, not kept: the runs of
+        one record length and channel set transformed together (:func:`rwadist.dft.windowed_dfts`), in chunks of
+        :data:`PHASOR_CHUNK_SAMPLES` samples.  A scan over a grid of frequencies read once (a line's drift) asks it for
+        the channels it reads: a third of the work of every channel's phasors for a radial pair."""
+        from ..dft import blocked_records, run_window, windowed_dfts
+
+        f_hz = np.asarray(f_hz, dtype=float).reshape(runs.size, -1)
+        out = np.full((runs.size, f_hz.shape[1], len(channels)), np.nan + 0j)
+        groups: dict[tuple, list[int]] = {}
+        for i, r in enumerate(runs):
+            run = self.test.runs[r]
+            have = tuple(j for j, c in enumerate(channels) if run.usable(c))
+            groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
+        for (n, fs, have), rows_all in groups.items():
+            w, wsum, _ = run_window(self.sp.window, n)
+            step = max(1, PHASOR_CHUNK_SAMPLES // (n * max(len(have), 1)))
+            for s in range(0, len(rows_all), step):
+                rows = np.asarray(rows_all[s:s + step])
+                x = blocked_records([[self.test.runs[runs[i]].signals[channels[j]] for j in have] for i in rows], w)
+                out[rows[:, None], :, np.asarray(have)[None, :]] = \
+                    (2.0 * windowed_dfts(x, fs, f_hz[rows]) / wsum).transpose(0, 2, 1)
+        return out
 
     def prefetch_phasors(self, runs: np.ndarray, f_hz: np.ndarray) -> None:
         """:meth:`phasors` of every column of ``f_hz`` (len(runs), L) Hz computed in one pass over the records and kept:
