@@ -56,14 +56,17 @@ def test_the_same_wheel_without_it_describes_nothing():
 
 
 def test_the_block_is_where_the_lit_runs_agree():
-    """Runs sorted by speed: lit from run 15 of 24 (one gap) is the block 15-24; lit in every run, or in 4 only, or in
-    alternate runs, is none (the other detector's, too short, no edge)."""
+    """Runs sorted by speed: lit from run 15 of 24 (one gap) is the block 15-24; lit in every run, or in 3 only, or in
+    alternate runs, is none (the other detector's, too short, no edge); lit in the top 4 is a block."""
     lit = np.zeros((24, 4), bool)
     lit[15:, 0] = True
     lit[18, 0] = False
     lit[:, 1] = True
-    lit[20:, 2] = True
+    lit[21:, 2] = True
     lit[::2, 3] = True
     first, end, inside, outside = _blocks(lit)
     assert (first[0], end[0]) == (15, 24) and inside[0] == pytest.approx(8 / 9) and outside[0] == 0.0
     assert (end - first)[1:].tolist() == [0, 0, 0]
+    lit[20, 2] = True
+    first, end, inside, outside = _blocks(lit)
+    assert (first[2], end[2]) == (20, 24) and inside[2] == 1.0 and outside[2] == 0.0

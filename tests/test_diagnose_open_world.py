@@ -711,13 +711,63 @@ def test_a_floor_through_a_high_pass_and_an_anti_alias_filter_is_no_hump():
     assert _classes(d) == ["suspension_modes"] and d.unexplained == (), [u.text() for u in d.unexplained]
 
 
-def test_a_tone_in_the_fastest_runs_is_no_hump():
+@pytest.mark.parametrize("f_tone", [215.0, 300.0])
+def test_a_tone_in_the_fastest_runs_is_a_fixed_line_there_and_no_hump_or_moving_resonance(f_tone):
+    """A tone in Fz over the top five of twenty runs (from 2432 rpm): one fixed line from there up, at its frequency.
+    At 215 Hz it lifted one model line in the two fastest runs and a moving resonance was fitted through them (its
+    leakage, :func:`~rwadist.diagnose.describe_structure.without_line_leaks`); at 300 Hz it was taken for the radial
+    translation mode (ζ 0.17, 76 Hz away), which does not move Fz; both times five runs were too few for a block."""
     def tone(i, r, t, std, rng):
         if abs(r.speed) * 30 / np.pi >= 2300:
-            r.signals["Fz"] = r.signals["Fz"] + 5.0 * std["Fz"] * np.cos(2 * np.pi * 215.0 * t + rng.uniform(0, 6.3))
+            r.signals["Fz"] = r.signals["Fz"] + 5.0 * std["Fz"] * np.cos(2 * np.pi * f_tone * t + rng.uniform(0, 6.3))
 
-    _, d = _with(change=tone)
-    assert not [u for u in d.unexplained if u.signature == "broadband_hump"], [u.text() for u in d.unexplained]
+    test, d = _with(change=tone)
+    texts = [u.text() for u in d.unexplained]
+    assert [u.signature for u in d.unexplained] == ["fixed_line"] and _classes(d) == ["suspension_modes"], texts
+    u = d.unexplained[0]
+    first = min(abs(r.speed) * 30 / np.pi for r in test.runs if abs(r.speed) * 30 / np.pi >= 2300)
+    assert u.channels == ("Fz",) and u.f_Hz[0] == pytest.approx(f_tone, abs=0.5) and u.n_runs == 5
+    assert u.speed_rpm[0] == pytest.approx(first) and u.parameters["peak_over_model_dB"] > 20.0
+
+
+def test_an_affine_line_among_the_radial_lines_is_described_and_no_moving_resonance():
+    """60 Hz + 1.3·f_spin on Fx and Fy, through the E-like wheel's radial lines: 3.5 dB over the model in its bands
+    (their lines beside it), +34 dB at its own bins; it was passed over and a moving resonance of slope 3.1 was fitted
+    to the lines its leakage lifted."""
+    def affine(i, r, t, std, rng):
+        f_line = 60.0 + 1.3 * abs(r.speed) / (2 * np.pi)
+        for ch in ("Fx", "Fy"):
+            r.signals[ch] = r.signals[ch] + 5.0 * std[ch] * np.cos(2 * np.pi * f_line * t + rng.uniform(0, 6.3))
+
+    _, d = _with(change=affine)
+    assert [u.signature for u in d.unexplained] == ["affine_line"], [u.text() for u in d.unexplained]
+    u = d.unexplained[0]
+    assert set(u.channels) == {"Fx", "Fy"} and _classes(d) == ["suspension_modes"]
+    assert u.parameters["offset_Hz"] == pytest.approx(60.0, abs=1.0)
+    assert u.parameters["slope"] == pytest.approx(1.3, abs=0.02)
+
+
+def test_a_moving_resonance_is_a_narrow_lines_leakage_only_when_that_line_stands_far_above_its_lifts():
+    from rwadist.diagnose.describe_structure import without_line_leaks
+    from rwadist.diagnose.unexplained import Unexplained
+
+    rpm = np.array([1000.0, 1500.0, 2000.0])
+    moving = Unexplained(signature="moving_resonance", channels=("Fx", "Fy"), speed_rpm=(1000.0, 2000.0),
+                         f_Hz=(80.0, 120.0), level_dB=0.0, share=0.1, n_runs=3,
+                         parameters={"largest_line_lift_dB": 6.0, "lifted_rpm": rpm.tolist(),
+                                     "lifted_Hz": (60.0 + 1.3 * rpm / 60.0 + [1.0, -9.0, 30.0]).tolist()})
+
+    def line(peak, chans=("Fx", "Fy")):
+        return Unexplained(signature="affine_line", channels=chans, speed_rpm=(300.0, 3000.0), f_Hz=(66.5, 125.0),
+                           level_dB=3.0, share=0.1, n_runs=20,
+                           parameters={"offset_Hz": 60.0, "slope": 1.3, "peak_over_model_dB": peak})
+
+    # two of three lifted lines within 4 bins (3.75 Hz) of a line 28 dB over the model: its leakage
+    assert without_line_leaks([moving, line(34.0)], 3.75) == [line(34.0)]
+    # a line no higher than the lifts (a resonance's own hump read as a line), on other channels, or farther: kept
+    assert len(without_line_leaks([moving, line(10.0)], 3.75)) == 2
+    assert len(without_line_leaks([moving, line(34.0, ("Fz",))], 3.75)) == 2
+    assert len(without_line_leaks([moving, line(34.0)], 1.0)) == 2
 
 
 def test_an_affine_line_and_a_fixed_line_it_crosses_are_both_described():

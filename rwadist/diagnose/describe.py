@@ -320,7 +320,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_partial import partial_lines
     from .describe_skew import channel_skew
     from .describe_split import split_mode
-    from .describe_structure import line_ratios, moving_resonance, resolved_lines, run_change
+    from .describe_structure import line_ratios, moving_resonance, resolved_lines, run_change, without_line_leaks
     from .describe_trend import gain_trend
 
     res = searched if res is None else res
@@ -401,7 +401,9 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += gain_trend(ctx, recorded := as_recorded(searched.state), of_line) + frequency_response(ctx, recorded, of_line)
     # a line whose ratio drifts with the speed (a cage slipping), and what its fixed-ratio model line made of it
     # and a line on a straight track f0 + b·f_spin off both axes, whose pieces the detectors above described
-    return with_affine_lines(ctx, state, with_drifts(ctx, state, out, of_line), of_track_f, carriers)
+    # a moving resonance made of a narrow line's leakage into the model's lines it passes is that line's
+    return without_line_leaks(with_affine_lines(ctx, state, with_drifts(ctx, state, out, of_line), of_track_f,
+                                                carriers), float(ctx.df))
 
 
 #: A hump at most this many bins wide whose peak lies within its own width of a fixed line on one of its channels is

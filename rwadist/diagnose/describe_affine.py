@@ -15,7 +15,7 @@ offset; a track lit in :data:`~.describe_lines.RIDGE_FRACTION` of the runs where
 :data:`MIN_RUNS` of them), that moves :data:`MIN_MOVE_BINS` Welch bins over its speeds (else a fixed line) and
 departs :data:`MIN_OFFSET_BINS` Welch bins from the best line at a constant ratio through it (else a speed line), at
 an offset that is no fixed line of the data (else that line's sideband), standing :data:`MIN_LEVEL_DB` over the
-model in its cells.  Its offset and slope are then read on the peaks of its lit runs (a parabola through the top
+model in its cells (or :data:`MIN_PEAK_DB` at its own peaks).  Its offset and slope are then read on the peaks of its lit runs (a parabola through the top
 three bins' log powers, a least-squares line), which lie on it within :data:`MAX_MISFIT_BINS`. The pieces the other
 detectors made of it, and the hump it makes of the floor, are its own (:func:`without_pieces`). Steady runs only: a
 sweep's slice smears a line over bins by the speed's change within it.
@@ -48,8 +48,12 @@ CARRIER_BINS = 2.0
 #: tenth of a bin (the new-user generator's 40 Hz + 0.5·f_spin: 0.01 bin); a chance alignment of lit noise is not
 #: a line (the same data's other seed: 1.4 bins, 4.7 dB over the model).
 MAX_MISFIT_BINS = 0.5
-#: The data over the model in its cells, at least (dB).
+#: The data over the model in its cells, at least (dB) ...
 MIN_LEVEL_DB = 6.0
+#: ... or at its own peaks, per channel, in the median run read (dB): the metric's bands of a radial channel hold the
+#: model's lines beside it (a review's 60 Hz + 1.3·f_spin on Fx and Fy among the E-like wheel's lines, 3.7 Hz bins:
+#: 3.5 dB in its bands, so it was not described and a moving resonance was fitted to the lines it lifted).
+MIN_PEAK_DB = 10.0
 #: A run's peak is read within this many Welch bins of the counted track (and its lit stretch); one this far off the
 #: straight line through the others is another line's (a review's 60 Hz + 1.3·f_spin on Fx and Fy: two runs where
 #: it passed under a model line read 9 and 5 Hz off, RMS 0.68 bin, and no line was described).
@@ -118,19 +122,21 @@ def _tracks(lit: np.ndarray, spin: np.ndarray, df: float, k_lo: int, k_hi: int) 
 
 
 def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list) -> tuple | None:
-    """(offset f0 Hz, slope b, RMS misfit Hz) of the line in ``windows`` ((first, last) bin in each run of ``runs``):
+    """(offset f0 Hz, slope b, RMS misfit Hz, peak dB) of the line in ``windows`` ((first, last) bin in each run of ``runs``):
     each run's peak of ``ratio`` (the data over the model summed over the line's channels, a row per run) there, refined by a parabola through the log
     powers of the top three bins, a least-squares line through them against f_spin, twice without the peaks off it by
     :data:`OUTLIER_BINS` (another line's, where the track passes under a model line), at least :data:`KEPT_FRACTION`
-    of the runs kept."""
+    of the runs kept; peak dB: the median over the runs kept of the peak's ``ratio``, dB."""
     df = ctx.df
     f_pk = np.full(runs.size, np.nan)
+    r_pk = np.full(runs.size, np.nan)
     for i, (a, z) in enumerate(windows):
         a, z = max(a, 1), min(z, ratio.shape[1] - 2)
         if z < a or not np.all(np.isfinite(ratio[i, a - 1:z + 2])):
             continue
         k = a + int(np.argmax(ratio[i, a:z + 1]))
         f_pk[i] = (k + log_parabola_offset(ratio[i, k - 1:k + 2])) * df
+        r_pk[i] = ratio[i, k]
     spin = np.abs(ctx.omega[runs]) / (2 * np.pi)
     ok = np.isfinite(f_pk)
     for _ in range(2):              # a run whose peak is another line's (under a model line, the track is not lit)
@@ -142,7 +148,7 @@ def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list) -> tupl
         return None
     b, f0 = np.polyfit(spin[ok], f_pk[ok], 1)
     rms = float(np.sqrt(np.mean((f_pk[ok] - (f0 + b * spin[ok])) ** 2)))
-    return float(f0), float(b), rms
+    return float(f0), float(b), rms, float(10 * np.log10(max(float(np.median(r_pk[ok])), 1e-300)))
 
 
 def _offset_from_ratio(f0: float, b: float, spin: np.ndarray) -> float:
@@ -193,7 +199,7 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
         if got is None:
             continue
         claimed.update(mine)
-        f0, b, rms = got
+        f0, b, rms, peak_db = got
         # a fixed line's sideband (its lower side past 0 Hz folds: f0 = -f_c) is the sideband detector's
         if rms > MAX_MISFIT_BINS * df or np.ptp(b * s) < MIN_MOVE_BINS * df or \
                 _offset_from_ratio(f0, b, s) < MIN_OFFSET_BINS * df or \
@@ -202,13 +208,15 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
             continue
         f_run = f0 + b * s
         share, level = shares(chans, f_run, runs[runs_lit])
-        if not level >= MIN_LEVEL_DB:
+        peak_db -= 10 * np.log10(len(chans))              # the ratio is summed over the channels
+        if not (level >= MIN_LEVEL_DB or peak_db >= MIN_PEAK_DB):
             continue
         rpm = s * 60.0
         out.append(Unexplained(
             signature="affine_line", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
             f_Hz=(float(f_run.min()), float(f_run.max())), level_dB=level, share=share, n_runs=int(s.size),
             parameters={"offset_Hz": f0, "slope": b, "misfit_rms_Hz": rms, "lit_fraction": frac,
+                        "peak_over_model_dB": float(peak_db),
                         "h_at_lowest_speed": float(f_run[np.argmin(s)] / s.min()),
                         "h_at_highest_speed": float(f_run[np.argmax(s)] / s.max())},
             causes=_causes(f0, b),

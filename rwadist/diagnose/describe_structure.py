@@ -523,6 +523,7 @@ def moving_resonance(ctx, state, ratios: list, shares) -> list:
             parameters={"direction": r.direction, "f_at_lowest_speed_Hz": float(f_low),
                         "f_at_highest_speed_Hz": float(f_high), "slope_Hz_per_Hz_of_spin": float(b),
                         "largest_line_lift_dB": float(np.max(r.q)),
+                        **_lifted(r),
                         "zeta": float(zeta), "peak_gain": float(gain), **_shape_words(zeta, gain, above),
                         "fixed_resonance_misfit_ratio":
                         float(misfit_ratio), "f_statistic": float(f_stat), "whirl": whirl, **beside},
@@ -531,6 +532,71 @@ def moving_resonance(ctx, state, ratios: list, shares) -> list:
             would_tell=_crossing_words(crossed) + "a slow run-up recorded with its speed tracks the resonance "
                        "continuously; a tap test of the rotor at rest gives its frequency at zero speed"))
     return out
+
+
+def _lifted(r: LineRatios) -> dict:
+    """The points of ``r`` lifted by :data:`MOVING_GATE_DB` at least: their speeds (rpm), frequencies (Hz) and lifts
+    (dB), by speed."""
+    m = np.flatnonzero(r.q >= MOVING_GATE_DB)
+    m = m[np.argsort(r.spin[m], kind="stable")]
+    return {"lifted_rpm": [float(x) for x in r.spin[m] * 60.0], "lifted_Hz": [float(x) for x in r.f[m]],
+            "lifted_dB": [float(x) for x in r.q[m]]}
+
+
+#: A line lifted within this many Welch bins of a narrow line of no model (a tone's or a straight track's Hann lobe
+#: and leakage; a review's 60 Hz + 1.3·f_spin, +34 dB over the model, lifted lines 0-3.9 bins from it by 2-6.5 dB)
+#: ...
+LEAK_BINS = 4.0
+#: ... which stands this much (dB) over the most it lifts a line, at least: a resonance's own peak over the model is
+#: the gain it lifts the lines at its peak by (a hump of noise through it lifts the floor as much), a foreign line's
+#: leakage lifts them far less than it stands itself.
+LEAK_MARGIN_DB = 6.0
+#: A moving resonance whose lifted lines are at least this fraction a narrow line's leakage is that line's.
+LEAK_FRACTION = 2.0 / 3.0
+
+
+def _line_at(u, rpm: np.ndarray) -> np.ndarray:
+    """The frequency (Hz) of the narrow-line record ``u`` (a ``fixed_line`` or an ``affine_line``) at ``rpm``, NaN
+    outside its speeds."""
+    p = u.parameters or {}
+    inside = (rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6)
+    if u.signature == "affine_line":
+        f = p["offset_Hz"] + p["slope"] * rpm / 60.0
+    else:
+        f = np.full(rpm.shape, float(u.f_Hz[0]))
+    return np.where(inside, f, np.nan)
+
+
+def without_line_leaks(records: list, df: float) -> list:
+    """``records`` without the ``moving_resonance`` records whose lifted lines (``lifted_rpm``/``lifted_Hz``) lie, at
+    least :data:`LEAK_FRACTION` of them, within :data:`LEAK_BINS` Welch bins of ``df`` (Hz) of a described narrow line
+    on one of its channels (a record with ``peak_over_model_dB``, :data:`LEAK_MARGIN_DB` over the largest lift): that
+    line leaking into the model's lines it passes, not a resonance (a review's tone at 215 Hz in Fz over the top
+    speeds lifted one line in two runs; a 60 Hz + 1.3·f_spin line on Fx, Fy lifted six points, and a track of slope 3.1
+    was fitted through them)."""
+    lines = [u for u in records if u.signature in ("fixed_line", "affine_line")
+             and _number_or_none((u.parameters or {}).get("peak_over_model_dB")) is not None]
+    if not lines:
+        return records
+
+    def leaks(m) -> bool:
+        p = m.parameters or {}
+        rpm, f = np.asarray(p.get("lifted_rpm", []), float), np.asarray(p.get("lifted_Hz", []), float)
+        if m.signature != "moving_resonance" or rpm.size == 0 or f.size != rpm.size:
+            return False
+        near = np.zeros(rpm.size, bool)
+        for u in lines:
+            if set(u.channels) & set(m.channels) and \
+                    u.parameters["peak_over_model_dB"] >= p.get("largest_line_lift_dB", np.inf) + LEAK_MARGIN_DB:
+                with np.errstate(invalid="ignore"):
+                    near |= np.abs(f - _line_at(u, rpm)) <= LEAK_BINS * df
+        return bool(near.mean() >= LEAK_FRACTION)
+
+    return [u for u in records if not leaks(u)]
+
+
+def _number_or_none(x):
+    return float(x) if isinstance(x, (int, float)) and np.isfinite(x) else None
 
 
 #: A slope within this of a whole number n (Hz per Hz of spin) reads first as a mode of n nodal diameters of the

@@ -198,6 +198,10 @@ class Unexplained:
         lift = _number(self.parameters.get("largest_line_lift_dB")) if self.signature == "moving_resonance" else None
         if lift is not None:
             out += f" in its track's bands, the lines it lifts up to {lift:+.1f} dB"
+        peak = _number(self.parameters.get("peak_over_model_dB"))
+        if peak is not None:
+            # a narrow line's bands hold the model's lines beside it: its own bins say how far it stands out
+            out += f", {peak:+.1f} dB at its own bins"
         if self.signature == "partial_line":
             out += self._partial_span()
         return out
