@@ -32,6 +32,12 @@ PARTIAL_MIN_FRACTION = 0.2
 #: the E wheel's 3× read absent at +1.3/+1.8 dB where a partial 2.7× beside it was absent; the partial 2.7× itself,
 #: at -1 to -9 dB beside the 3×, read right.
 OTHERS_IN_WINDOW_MAX = 1.0
+#: A line whose runs read neither absent nor present in at least this fraction of its runs, its measured-over-model
+#: ratio scattering by at least SCATTER_DB from run to run (:func:`_scatter`), is a line whose strength is not locked to
+#: the speed rather than one that comes and goes (the new-user generator's h = 2.3 of a lognormal strength, 8 dB from
+#: run to run: -21 to +17 dB, 18 of 35 runs between); described so even where no run reads absent.
+SCATTER_BETWEEN_FRACTION = 1.0 / 3.0
+SCATTER_DB = 4.0
 
 
 def others_in_window(ctx, state, direction: str, h: float, runs: np.ndarray) -> np.ndarray:
@@ -51,10 +57,27 @@ def others_in_window(ctx, state, direction: str, h: float, runs: np.ndarray) -> 
     return np.where(own > 0, np.maximum(lines - own, 0.0) / np.where(own > 0, own, 1.0), np.inf)
 
 
+def _scatter(q: np.ndarray, rpm: np.ndarray, w: np.ndarray) -> tuple:
+    """(spread dB, whether it scatters, the readings dB) of a line's measured-over-model ratios ``q`` (dB) at ``rpm``:
+    read no further under the model than the noise allows (``w``: the line's SNR), the robust spread of each run's
+    reading about its neighbours' median by speed (:func:`rwadist.line_scatter.spread`: a mode's smooth gain, or a run
+    or two where one lifts it, do not count); it scatters at :data:`SCATTER_DB`, with :data:`SCATTER_BETWEEN_FRACTION`
+    of the runs neither absent nor present."""
+    from ..line_scatter import spread
+
+    read = np.maximum(q, -10 * np.log10(w))
+    order = np.argsort(rpm, kind="stable")
+    s = spread(read[order])
+    between = (read > ABSENT_DB) & (np.abs(read) > PRESENT_DB)
+    return s, bool(s >= SCATTER_DB and np.mean(between) >= SCATTER_BETWEEN_FRACTION), read
+
+
 def _candidates(ctx, state, ratios: list) -> list:
     """Per line of each direction whose ratios hold :data:`PARTIAL_MIN_RUNS` present runs: (direction, channels, h,
-    run positions, rpm, frequencies, q dB, SNR, absent mask, present mask).  A run is absent only where the line is
-    resolved from the direction's other lines (:func:`others_in_window` at most :data:`OTHERS_IN_WINDOW_MAX`)."""
+    run positions, rpm, frequencies, q dB, SNR, absent mask, present mask, resolved mask).  A run is absent, and its
+    reading counts for the line's scatter, only where the line is resolved from the direction's other lines
+    (:func:`others_in_window` at most :data:`OTHERS_IN_WINDOW_MAX`: a speed sideband beside its carrier read -39 to +7
+    dB, the carrier's misfit and beat, and was described as a line of scattering strength)."""
     out = []
     for r in ratios:
         chans = [c for c in DIRECTION_CHANNELS[r.direction] if c in ctx.channels]
@@ -62,11 +85,16 @@ def _candidates(ctx, state, ratios: list) -> list:
             m = np.flatnonzero(r.line == ln)
             q, rpm = r.q[m], r.spin[m] * 60.0
             absent, present = q <= ABSENT_DB, np.abs(q) <= PRESENT_DB
-            if absent.any():
-                others = others_in_window(ctx, state, r.direction, float(r.h[m[0]]), ctx.runs[r.run[m]])
-                absent &= others <= OTHERS_IN_WINDOW_MAX
-            if absent.any() and present.sum() >= PARTIAL_MIN_RUNS:
-                out.append((r.direction, chans, float(r.h[m[0]]), r.run[m], rpm, r.f[m], q, r.w[m], absent, present))
+            resolved = np.ones(q.size, bool)
+            if absent.any() or _scatter(q, rpm, r.w[m])[1]:
+                # a run reads the line's own power only where it is resolved from the direction's other lines
+                resolved = others_in_window(ctx, state, r.direction, float(r.h[m[0]]),
+                                            ctx.runs[r.run[m]]) <= OTHERS_IN_WINDOW_MAX
+                absent &= resolved
+            if (absent.any() or _scatter(q[resolved], rpm[resolved], r.w[m][resolved])[1]) and \
+                    present.sum() >= PARTIAL_MIN_RUNS:
+                out.append((r.direction, chans, float(r.h[m[0]]), r.run[m], rpm, r.f[m], q, r.w[m], absent, present,
+                            resolved))
     return out
 
 
@@ -87,32 +115,42 @@ def partial_lines(ctx, state, ratios: list, of_line) -> list:
     reach = (2 * LINE_HALF + 1) * ctx.df
     scored = []
     for cand in _candidates(ctx, state, ratios):
-        direction, chans, h, pos, rpm, f, q, w, absent, present = cand
+        direction, chans, h, pos, rpm, f, q, w, absent, present, _ = cand
         share, _ = of_line(chans, h, ctx.runs[pos[absent | present]])
         scored.append((share, cand))
     taken: list = []                            # (direction, h, absent run positions) of the lines described
-    for share, (direction, chans, h, pos, rpm, f, q, w, absent, present) in sorted(scored, key=lambda x: -x[0]):
+    scattering: list = []                       # (direction, h) of the scattering lines described
+    for share, (direction, chans, h, pos, rpm, f, q, w, absent, present, resolved) in sorted(scored,
+                                                                                          key=lambda x: -x[0]):
         shadow = np.zeros(absent.shape, bool)
         for d, h_other, gone in taken:
             if d == direction:
                 shadow |= np.isin(pos, gone) & (np.abs(h - h_other) * rpm / 60.0 <= reach)
         absent = absent & ~shadow
-        if absent.sum() < max(PARTIAL_MIN_RUNS, PARTIAL_MIN_FRACTION * (absent | present).sum()):
+        scatter, scatters, _ = _scatter(q[resolved], rpm[resolved], w[resolved])
+        read = np.maximum(q, -10 * np.log10(w))
+        few = absent.sum() < max(PARTIAL_MIN_RUNS, PARTIAL_MIN_FRACTION * (absent | present).sum())
+        # a neighbour of a scattering line described, within a line window of it, reads its leakage as its own scatter
+        near_scattering = any(d == direction and abs(h - h_other) * float(np.median(rpm)) / 60.0 <= reach
+                              for d, h_other in scattering)
+        if few and (not scatters or near_scattering):
             continue
+        if scatters:
+            scattering.append((direction, h))
         taken.append((direction, h, pos[absent]))
         runs = ctx.runs[pos]
         a_rpm, p_rpm = np.sort(rpm[absent]), np.sort(rpm[present])
         # interleaved: a run holding the line lies between two that lack it, or the other way round
-        interleaved = bool(np.any((p_rpm > a_rpm[0]) & (p_rpm < a_rpm[-1])) or
-                           np.any((a_rpm > p_rpm[0]) & (a_rpm < p_rpm[-1])))
+        interleaved = bool(a_rpm.size and (np.any((p_rpm > a_rpm[0]) & (p_rpm < a_rpm[-1])) or
+                                           np.any((a_rpm > p_rpm[0]) & (a_rpm < p_rpm[-1]))))
         # how far under the model the absent runs are, no further than their noise allows (w: the line's SNR, capped
         # at 1e4 by line_ratios: 40 dB)
-        depth = float(np.median(np.maximum(q[absent], -10 * np.log10(w[absent]))))
+        depth = float(np.median(read[absent])) if absent.any() else float(np.min(read))
+        both = absent | present
 
         def run_names(sel):
             return [names[int(x)] if int(x) < len(names) else str(int(x)) for x in runs[sel]]
 
-        both = absent | present
         out.append(Unexplained(
             signature="partial_line", channels=tuple(chans),
             speed_rpm=(float(rpm[both].min()), float(rpm[both].max())),
@@ -121,8 +159,13 @@ def partial_lines(ctx, state, ratios: list, of_line) -> list:
             parameters={"direction": direction, "h": h, "runs_absent": run_names(absent),
                         "runs_present": run_names(present), "absent_rpm": [float(x) for x in a_rpm],
                         "present_rpm": [float(x) for x in p_rpm], "interleaved": interleaved,
-                        "present_dB": float(np.median(q[present]))},
-            causes=(("an intermittent source: a cage's unstable whirl, a rub, a loose part that settles and comes "
+                        "present_dB": float(np.median(q[present])),
+                        **({"scatter_dB": scatter, "read_dB": [float(read[resolved].min()), float(read[resolved].max())],
+                            "runs_between": int(np.sum(~both))} if scatters else {})},
+            causes=((f"a source whose strength is not locked to the speed: from run to run it scatters by {scatter:.0f} "
+                     "dB (rms) about the model's law, weakest where it reads absent (a bearing defect's impacts, a "
+                     "lubricant film that forms and breaks, a rub that bears harder or lighter)" if scatters else
+                     "an intermittent source: a cage's unstable whirl, a rub, a loose part that settles and comes "
                      "loose again" if interleaved else
                      "a source that starts or stops at one speed: a rub or a loose part that a speed or its heating "
                      "brings on, a cage whose motion changes regime"),

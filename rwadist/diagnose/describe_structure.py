@@ -474,6 +474,28 @@ def resolved_lines(ctx, state, r: LineRatios) -> LineRatios:
     return replace(r, **{k: getattr(r, k)[keep] for k in ("q", "f", "run", "spin", "line", "h", "w")})
 
 
+def steady_lines(r: LineRatios, df: float) -> LineRatios:
+    """``r`` without the points of a line whose strength scatters from run to run (its ratios' spread about their
+    neighbours' by speed :data:`.describe_partial.SCATTER_DB` or more, :func:`.describe_partial._scatter`), nor those
+    of another line within a line window (2·LINE_HALF + 1 bins of ``df`` Hz) of it in their run: its strong runs are no
+    resonance's lift, and its leakage lifts its neighbours beyond what the model's line at its median strength
+    predicts there (a line at h 2.3 of lognormal strength, 8 dB from run to run: moving resonances 'lifting lines up
+    to +18.5 dB' were fitted through its strongest runs, and through h 2.0's runs where it leaked in)."""
+    from dataclasses import replace
+
+    from .constants import LINE_HALF
+    from .describe_partial import SCATTER_DB, _scatter
+
+    scattering = [float(r.h[r.line == ln][0]) for ln in np.unique(r.line)
+                  if _scatter(r.q[r.line == ln], r.spin[r.line == ln], r.w[r.line == ln])[0] >= SCATTER_DB]
+    keep = np.ones(r.q.size, bool)
+    for h_s in scattering:
+        keep &= np.abs(r.h - h_s) * r.spin > (2 * LINE_HALF + 1) * df
+    if keep.all():
+        return r
+    return replace(r, **{k: getattr(r, k)[keep] for k in ("q", "f", "run", "spin", "line", "h", "w")})
+
+
 def moving_resonance(ctx, state, ratios: list, shares) -> list:
     """A resonance lifting the lines of one direction whose frequency moves with the speed.
 

@@ -41,7 +41,8 @@ SIGNATURES = {
     "moving_resonance": "a resonance whose frequency changes with speed in a way the fitted modes' gyroscopic whirl does not explain",
     "broadband_hump": "a broadband hump above the noise floor",
     "run_change": "a run-to-run change",
-    "partial_line": "a model line present in some runs and absent from others",
+    "partial_line": "a model line present in some runs and absent from others, or whose strength scatters from run to "
+                    "run",
     "sideband_line": "lines at a fixed line's frequency plus or minus a constant ratio of the speed",
     "affine_line": "a line whose frequency moves with the speed as f0 + b × the speed, neither fixed nor at a "
                    "constant ratio of it",
@@ -203,6 +204,15 @@ class Unexplained:
             # a narrow line's bands hold the model's lines beside it: its own bins say how far it stands out
             out += f", {peak:+.1f} dB at its own bins"
         if self.signature == "partial_line":
+            scatter, read = _number(self.parameters.get("scatter_dB")), self.parameters.get("read_dB")
+            scattering = "" if scatter is None or not read or len(read) != 2 else (
+                f"its strength scattering {scatter:.1f} dB (rms) from run to run ({read[0]:+.0f} to {read[1]:+.0f} dB "
+                "against the model)")
+            absent = [x for x in (self.parameters.get("absent_rpm") or []) if _number(x) is not None]
+            if scattering and not absent:
+                return scattering                   # in every run, at a strength of its own in each
+            if scattering:                          # its weakest runs: no start or stop, no run's pattern
+                return out + f" ({len(absent)} runs at {min(absent):.0f}-{max(absent):.0f} rpm), " + scattering
             out += self._partial_span()
         return out
 
