@@ -309,7 +309,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     ``changes``: the run-to-run change read on ``res`` (the data as given: the records the search read had the changed
     runs' factor taken out, :func:`run_steps`).  ``carriers``: the fixed lines found before the search
     (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands taken out with them."""
-    from .describe_affine import with_affine_lines
+    from . import describe_structure as structure
+    from .describe_affine import affine_lines, with_affine_lines
     from .describe_carrier import measure_track, on_a_sideband, sideband_lines, sideband_tracks
     from .describe_drift import with_drifts
     from .describe_filter import frequency_response
@@ -320,8 +321,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_partial import partial_lines
     from .describe_skew import channel_skew
     from .describe_split import split_mode
-    from .describe_structure import line_ratios, moving_resonance, resolved_lines, run_change, without_line_leaks
     from .describe_trend import gain_trend
+    from .run_gains import annotate
 
     res = searched if res is None else res
     ctx, state = searched.ctx, floor_as_read(searched.ctx, searched.state)
@@ -334,34 +335,25 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     def of_band_runs(chans, f0, f1, runs):        # the bands of [f0, f1] in ``runs``
         b0, b1 = int(res.band_of(f0)), int(res.band_of(f1))
         rows = np.isin(ctx.runs, runs)
-        cells = {}
-        for c in chans:
-            if c in res.e:
-                m = res.mask(c)
-                m[rows, b0:b1 + 1] = True
-                cells[c] = m
+        cells = {c: res.mask(c) for c in chans if c in res.e}
+        for m in cells.values():
+            m[rows, b0:b1 + 1] = True
         return res.measure(cells)
 
     def of_track(chans, track, zeta):
         f = track(spin)
         lo, hi = res.band_of(f * (1 - 3 * zeta)), res.band_of(f * (1 + 3 * zeta))
-        cells = {}
-        for c in chans:
-            if c in res.e:
-                m = res.mask(c)
-                for i in range(spin.size):
-                    m[i, lo[i]:hi[i] + 1] = True
-                cells[c] = m
+        cells = {c: res.mask(c) for c in chans if c in res.e}
+        for m in cells.values():
+            for i in range(spin.size):
+                m[i, lo[i]:hi[i] + 1] = True
         return res.measure(cells)
 
     def of_line(chans, h, runs):          # h: one ratio, or several (every line of a channel's gain)
-        cells = {}
-        for c in chans:
-            if c in res.e:
-                m = res.mask(c)
-                for r in runs:
-                    m[pos[int(r)], res.band_of(np.asarray(h) * ctx.omega[int(r)] / (2 * np.pi))] = True
-                cells[c] = m
+        cells = {c: res.mask(c) for c in chans if c in res.e}
+        for m in cells.values():
+            for r in runs:
+                m[pos[int(r)], res.band_of(np.asarray(h) * ctx.omega[int(r)] / (2 * np.pi))] = True
         return res.measure(cells)
 
     of_track_f = partial(measure_track, res)        # (chans, one frequency per run of ``runs``, runs)
@@ -372,25 +364,22 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     def of_fixed(chans, f_hz, runs):
         return of_band_runs(chans, f_hz, f_hz, runs)
 
-    ratios = line_ratios(ctx, state)
+    ratios = structure.line_ratios(ctx, state)
     others = [x.h for d in ("radial_force", "radial_torque", "axial_force", "axial_torque")
               for x in state.model.harmonics(d)]
     # a narrow hump on a fixed line taken out before the search is its leftover lobe (trial 30: mains in Fz)
     out = [u for u in broadband_hump(ctx, state, of_band) if not on_a_fixed_line(u, carriers, float(ctx.sp.df))]
     out += humps_in_some_runs(ctx, state, of_band_runs, out)
-    # a moving resonance: read on lines resolved from their neighbours, described where its cells hold content
-    out += [u for u in moving_resonance(ctx, state, [resolved_lines(ctx, state, r) for r in ratios], of_track)
-            if holds_content(u, res)]
-    from .run_gains import annotate
-
-    read = line_ratios(res.ctx, res.state) if changes else ratios
-    out += annotate(ctx, state, run_change(ctx, read, of_runs), read, taken_out=changes)
+    # a moving resonance: read on steady lines resolved from their neighbours, described where its cells hold content
+    steady = [structure.steady_lines(structure.resolved_lines(ctx, state, r), float(ctx.df)) for r in ratios]
+    out += [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)]
+    read = structure.line_ratios(res.ctx, res.state) if changes else ratios
+    out += annotate(ctx, state, structure.run_change(ctx, read, of_runs), read, taken_out=changes)
     out += speed_lines(ctx, state, of_line, bearings, others, ctx.left_out)
-    out += partial_lines(ctx, state, line_ratios(ctx, state, absent=True), of_line)
+    out += partial_lines(ctx, state, structure.line_ratios(ctx, state, absent=True), of_line)
     sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)
     tracks = sideband_tracks(sidebands, known_sidebands)
-    out += [u for u in fixed_lines_in_part(ctx, state, of_fixed) if not on_a_sideband(ctx, u, tracks)]
-    out += sidebands
+    out += [u for u in fixed_lines_in_part(ctx, state, of_fixed) if not on_a_sideband(ctx, u, tracks)] + sidebands
     # the recorded channels (a gain acts on them, before any load-cell correction), against the noise as given
     out += channel_gain(ctx, as_recorded(searched.state), of_line)
     # the radial forces through two translation modes, x and y (a support stiffer along one axis)
@@ -399,11 +388,12 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += channel_skew(ctx, state, of_line)
     # a gain common to the channels that changes with speed, on the recorded channels too; one of the line's frequency
     out += gain_trend(ctx, recorded := as_recorded(searched.state), of_line) + frequency_response(ctx, recorded, of_line)
-    # a line whose ratio drifts with the speed (a cage slipping), and what its fixed-ratio model line made of it
-    # and a line on a straight track f0 + b·f_spin off both axes, whose pieces the detectors above described
-    # a moving resonance made of a narrow line's leakage into the model's lines it passes is that line's
-    return without_line_leaks(with_affine_lines(ctx, state, with_drifts(ctx, state, out, of_line), of_track_f,
-                                                carriers), float(ctx.df))
+    # a line whose ratio drifts with the speed (a cage slipping), what its fixed-ratio model line made of it; a line on
+    # a straight track f0 + b·f_spin off both axes, whose pieces the detectors above described; a moving resonance
+    # made of a narrow line's leakage into the model's lines it passes is that line's
+    out = with_affine_lines(ctx, state, with_drifts(ctx, state, out, of_line), affine_lines(ctx, state, of_track_f,
+                                                                                             carriers))
+    return structure.without_line_leaks(out, float(ctx.df))
 
 
 #: A hump at most this many bins wide whose peak lies within its own width of a fixed line on one of its channels is
