@@ -165,6 +165,14 @@ blocked_records 26 calls, 50-65 ms CPU of 1.36-1.41 s (timed apart): a cache of 
 its running medians 0.07 s; affine lines 0.06 s), the residual's lit bins computed 24 times (0.13 s).  With the lit
 bins kept on the state (computed once per channel and kind, read-only): --busy 0, x11.2/x11.4 and x10.9 (benchmark;
 2.29 s / 0.21 s), x12.8/x12.3 and x11.6 (sixty; 1.28-1.30 s / 0.11 s) in two rounds; target not met.
+2026-12-05, session 45 (idle machine, load 0.5-0.9; --quick --repeats 3): at a5c98e6 cpu min/median x10.7/x10.7
+(benchmark; 2.08 s / 0.19 s), x12.1/x12.2 (sixty; 1.18 s / 0.10 s), beside 2 busy x10.5/x9.4 and x12.1/x12.4.  Same
+numbers, faster: running medians a row at a time on ndimage's 1-D rank filter (rwadist.spectra.running_median: the
+humps' (60, 4097) medians 165 -> 11 ms), the narrow lines' ring medians read at the lit bins only, the drift scan
+transformed for its own channels, a search state's model copied without a deep copy of its harmonics (16 new-user
+sets' summary.json, model.json, hypotheses.csv identical): x9.3-9.5/x9.7-9.9 (benchmark), x10.6-10.8/x10.6 (sixty)
+in two rounds; the sixty set still over 10x.  Tried, below the noise: the records' blocked layout kept per run, the
+drift scan in single precision.
 """
 from __future__ import annotations
 

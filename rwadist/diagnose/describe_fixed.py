@@ -22,11 +22,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..units import RAD_S_TO_RPM
+from .describe_lines import sliced
 from .unexplained import Unexplained
 
 #: Runs of the block lit at least (a review's tone at 300 Hz over the top five of twenty runs), and of the runs outside it.
 MIN_RUNS = 4
 MIN_ABSENT = 3
+#: ... on a sweep's slices, which smear the lines over bins, the runs of a block at least, its level read in its cells
+#: alone (family wheel 5's 60-s run-down from 10000 rpm: a 'fixed line' at 484 Hz over its top four slices, +0.6 dB in
+#: its bands, +16 dB at its bin)
+SLICED_MIN_RUNS = 6
 #: Fraction of the block's runs where the bin (or a neighbour) is lit, at least; of the runs outside, at most.
 BLOCK_FRACTION = 0.75
 OUTSIDE_FRACTION = 0.25
@@ -80,7 +85,7 @@ def _at_a_mode(ctx, state, f_hz: float, runs: np.ndarray, chans) -> bool:
     return False
 
 
-def _blocks(lit: np.ndarray) -> tuple:
+def _blocks(lit: np.ndarray, min_runs: int = MIN_RUNS) -> tuple:
     """Per bin the best block of ``lit`` (runs sorted by speed × bins): (first run, end run (exclusive), fraction lit
     inside, fraction lit outside), of the blocks that begin at the lowest speed or end at the highest and meet the
     fractions the one with the most runs lit inside or unlit outside; first = end = 0 where none does."""
@@ -89,13 +94,13 @@ def _blocks(lit: np.ndarray) -> tuple:
     total = cs[-1]
     best = (np.zeros(K, int), np.zeros(K, int), np.zeros(K), np.ones(K))
     agree = np.full(K, -1.0)
-    for n in range(MIN_RUNS, R - MIN_ABSENT + 1):
+    for n in range(min_runs, R - MIN_ABSENT + 1):
         for i0 in (0, R - n):
             lit_in = cs[i0 + n] - cs[i0]
             inside, outside = lit_in / n, (total - lit_in) / (R - n)
             # the block whose runs agree best with lit inside, unlit outside: its edge where the line begins
             score = lit_in + (R - n) - (total - lit_in)
-            better = (inside >= BLOCK_FRACTION) & (lit_in >= MIN_RUNS) & (outside <= OUTSIDE_FRACTION) & (score > agree)
+            better = (inside >= BLOCK_FRACTION) & (lit_in >= min_runs) & (outside <= OUTSIDE_FRACTION) & (score > agree)
             agree[better] = score[better]
             best[0][better], best[1][better] = i0, i0 + n
             best[2][better], best[3][better] = inside[better], outside[better]
@@ -116,7 +121,9 @@ def fixed_lines_in_part(ctx, state, shares) -> list:
     lit = np.zeros_like(next(iter(lits.values())))
     for x in lits.values():
         lit |= x
-    first, end, inside, _ = _blocks(lit)
+    # a sweep's slices smear the lines over bins: there a block of SLICED_MIN_RUNS, its level in its cells
+    swept = sliced(ctx)
+    first, end, inside, _ = _blocks(lit, SLICED_MIN_RUNS if swept else MIN_RUNS)
     k = np.arange(lit.shape[1])
     length = end - first
     cand = (length > 0) & (k >= ctx.k_lo + SIDE_BINS) & (k <= ctx.k_hi - SIDE_BINS)
@@ -150,7 +157,7 @@ def fixed_lines_in_part(ctx, state, shares) -> list:
             continue
         share, level = shares(chans, f_hz, block)
         peak_db = 10 * np.log10(max(float(np.mean([ratio[c][SIDE_BINS] for c in chans])), 1e-300))
-        if not (level >= MIN_LEVEL_DB or peak_db >= MIN_PEAK_DB):
+        if not (level >= MIN_LEVEL_DB or (peak_db >= MIN_PEAK_DB and not swept)):
             continue
         rpm = ctx.omega[block] * RAD_S_TO_RPM
         upper = first[k0] > 0
