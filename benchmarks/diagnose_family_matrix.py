@@ -35,6 +35,11 @@ nothing added; the ten classes 100 % of their eligible cells (lever_arm_noise 6/
 fixtures 8/8, fixture and offset 8/8; pairs of classes 15/16 (wheel 2's lever_arm_noise under the noise); the eight
 open-world kinds 8/8 each (wide_hump, rattle in every third run and affine_line new this session), 0 classes added;
 the same cells as session 43's but two broadband_floor cells with one more hump described beside the class.
+Session 45 (ca1d3d8: narrow lines judged at their own bins, a fixed line over 4 lit runs, a mode ringing only the
+channels it moves, a moving resonance made of a narrow line's leakage dropped, lines of scattering strength read at
+their median law by the mode fit, lines lit on the model lines' skirts, a gain of Fz alone; 208 cells, 1191 s of
+diagnoses): every cell's effects and descriptions as session 44's; the modes the same to 0.1 % but wheel 7's rocking
+beside its 1.5x rocking fixture, -0.3 % -> -0.8 %.
 
 Run (long: ~210 cells of 3-120 s each on a free core; nice it)::
 

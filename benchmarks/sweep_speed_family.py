@@ -28,6 +28,9 @@ within 2 % 16/16 (worst 0.62 %, wheel 4's rocking on a 30-s run-up), no class ad
 records in 3 sweeps, each a line of the wheel the model lacks (wheel 3's BPFI 5.985 read 5.979 and 5.984, both ways;
 wheel 7's 2xBPFO 6.848 on its 60-s run-up, read four times at the edges of its 4 % smear, 6.826 / 6.868 in Fx Fy and
 6.728 / 6.918 in Fz).  At 3abf466 (the ridges within a line's smear one line): the same, 4 records in 3 sweeps.
+Session 45: at ca1d3d8 wheel 5's 60-s run-down from 10000 rpm read a fixed line at 484 Hz over its top four slices (a
+block of 4 runs judged at its own bin); at 5fb92bc (a sweep's slices: 6 runs, the level in the cells) the same as
+3abf466, 4 records in 3 sweeps, worst h 0.090 %, modes 16/16.
 At e381cc0 (session 44, humps in some runs) wheel 5's two sweeps each had a hump at 512 Hz in 2-5 fast slices
 (kurtosis 2.7-3.1, a smeared line's skirt); at 545f9e2 (that detector on steady runs only) the same as at 3abf466.
 """
