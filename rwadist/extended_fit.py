@@ -43,7 +43,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any
 
 import numpy as np
 
@@ -71,8 +70,6 @@ from .extended_fit_power import (
     split_from_phase,
 )
 from .geometry import remove_lever_arm
-from .line_scatter import at_median_law, scattering
-from .line_scatter import note as scatter_note
 from .line_senses import ONE_SENSE, ONE_SENSE_RUNS, _line_senses_once, line_senses, one_sense_rows  # noqa: F401
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
@@ -312,14 +309,12 @@ def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=Non
     return scans
 
 
-def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: list, stand_direction: str | None = None,
-                    steady_lines: tuple = ()):
+def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: list, stand_direction: str | None = None):
     """(test, empirical fit, measured lines, x/y senses) the extended fit works on: the lever-arm torque ``height`` × F
     removed from the test and its fit (:func:`rwadist.geometry.remove_lever_arm`); every line the data show, with
     every measurement (the empirical fit without modal exclusion: with it, lines that are amplified or attenuated at
     most speeds are dropped; close lines measured together on the records); the fixture resonances ``stands`` divided
-    out of their amplitudes (the first only out of the lines of ``stand_direction`` when given); the measured lines
-    ``steady_lines`` (indices) read at their median law (:func:`rwadist.line_scatter.at_median_law`)."""
+    out of their amplitudes (the first only out of the lines of ``stand_direction`` when given)."""
     if height:
         sp0 = fit.spectra
         test = remove_lever_arm(test, height)
@@ -335,8 +330,6 @@ def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: 
             return np.prod([np.abs(resonance(f, *s)) for s in acting], axis=0) if acting else np.ones_like(f)
 
         meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / fixture_gain(x)) for x in meas.lines])
-    if steady_lines:    # lines whose strength scatters from run to run: no evidence of a mode, read at their law
-        meas = replace(meas, lines=at_median_law(meas.lines, steady_lines))
     return test, fit, meas, senses_xy
 
 
@@ -481,11 +474,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
                  progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
                  more_stands: tuple = (), near: dict | None = None, fit_stand: bool = False,
-                 declare: bool = True, stand_direction: str | None = None, fit_more_stands: bool = False,
-                 steady_lines: tuple = ()) -> ExtendedFit:
-    """Fit the extended model to a steady test whose empirical fit is ``fit`` (:func:`_fit_extended`); when the fit's
-    residuals show lines whose strength scatters from run to run (:func:`rwadist.line_scatter.scattering`), and
-    ``steady_lines`` is empty, made again with those lines read at their median law, once.
+                 declare: bool = True, stand_direction: str | None = None, fit_more_stands: bool = False) -> ExtendedFit:
+    """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
     mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None:
     the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr and I_zz/I_rr, so the fit is
@@ -510,9 +500,6 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     stand_direction: ``stand`` is a mode of the wheel's structure on that load direction only (``rwadist diagnose``'s
     ``fixed_resonance`` of role wheel_mode), divided out of that direction's lines alone, H → 1 far above it (β = 1).
     fit_more_stands: with ``fit_stand``, ``more_stands`` fitted in its least squares too (:mod:`rwadist.stand_every`).
-    steady_lines: indices of the measured lines read at their median law (:mod:`rwadist.line_scatter`); when it is
-    empty and the fit's residuals show lines whose strength scatters from run to run, the fit is made again with them
-    so (once).
 
     Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
     measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
@@ -522,23 +509,6 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     rotation sense is read from the forcing, not from the response (a mode amplifies one sense
     more than the other, so the response alone would mislabel a planar load).
     """
-    given: dict[str, Any] = dict(mass=mass, radius=radius, height=height, start=start, zeta0=zeta0,
-                                 progress=progress, tolerance=tolerance, stand=stand, more_stands=more_stands,
-                                 near=near, fit_stand=fit_stand, declare=declare, stand_direction=stand_direction,
-                                 fit_more_stands=fit_more_stands)
-    efit, scattered = _fit_extended(test, fit, steady_lines=steady_lines, **given)
-    if scattered and not steady_lines:
-        efit, _ = _fit_extended(test, fit, steady_lines=tuple(scattered), **given)
-    return efit
-
-
-def _fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None, radius: float | None = None,
-                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
-                  progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
-                  more_stands: tuple = (), near: dict | None = None, fit_stand: bool = False,
-                  declare: bool = True, stand_direction: str | None = None, fit_more_stands: bool = False,
-                  steady_lines: tuple = ()) -> tuple:
-    """(the fit, the measured lines whose residuals scatter) of :func:`fit_extended`."""
     physical = mass is not None and radius is not None
     notes: list[str] = []
     # the load cell's noisier sensor family read on the data as recorded, before the lever arm comes out (T − h × F
@@ -546,8 +516,7 @@ def _fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None
     # recorded, 2.6-3.5x with h = 0.1 m taken out, where no family was singled out)
     noisy = recorded_noisy_sensors(test, fit.without_mode_exclusion.lines) if height else None
     test, fit, meas, senses_xy = _measured_lines(test, fit, height, ([] if stand is None else [stand]) + list(more_stands),
-                                                 stand_direction if stand is not None else None, steady_lines)
-    notes += [scatter_note(meas.lines[j].direction, float(meas.lines[j].h)) for j in steady_lines]
+                                                 stand_direction if stand is not None else None)
     peaks = amplification_peaks(fit)
     la, sa, ca, aa, na = _axial_measurements(meas)
     radial = _radial_power(meas.lines)
@@ -590,7 +559,6 @@ def _fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None
                      f"near it by {resid_db[m]:.1f} dB RMS (more than {MISFIT_DB:g} dB: something the model lacks "
                      "acts there, and pulls the mode); its fitted value is kept, listed in analytical.unconstrained")
     zeta_bounds, intervals = located_damping(zeta_bounds, intervals, starts.identified, problem.held_zeta, notes)
-    scattered = [] if steady_lines else scattering(res.fun, row_line, np.concatenate([sa, sr]))
     return ExtendedFit(params=params, lines=kept_lines,
                        zeta={"radial_translation": params.zeta_r, "rocking": params.zeta_rock,
                              "axial_translation": params.zeta_z},
@@ -601,7 +569,7 @@ def _fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
                        line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
                        zeta_bounds=zeta_bounds, zeta_interval=intervals, line_noise=np.concatenate([na, nr]),
-                       more_stands=tuple(tuple(float(v) for v in k) for k in more_stands)), scattered
+                       more_stands=tuple(tuple(float(v) for v in k) for k in more_stands))
 
 
 def _mode_hz_of(params: ext.ExtendedParams, mode: str) -> float:

@@ -476,7 +476,8 @@ def resolved_lines(ctx, state, r: LineRatios) -> LineRatios:
 
 def steady_lines(r: LineRatios, df: float) -> LineRatios:
     """``r`` without the points of a line whose strength scatters from run to run (its ratios' spread about their
-    neighbours' by speed :data:`.describe_partial.SCATTER_DB` or more, :func:`.describe_partial._scatter`), nor those
+    neighbours' by speed :data:`.describe_partial.SCATTER_DB` or more, a third of its runs neither absent nor present:
+    :func:`.describe_partial._scatter`; a line a moving resonance lifts in a few runs is not), nor those
     of another line within a line window (2·LINE_HALF + 1 bins of ``df`` Hz) of it in their run: its strong runs are no
     resonance's lift, and its leakage lifts its neighbours beyond what the model's line at its median strength
     predicts there (a line at h 2.3 of lognormal strength, 8 dB from run to run: moving resonances 'lifting lines up
@@ -484,10 +485,10 @@ def steady_lines(r: LineRatios, df: float) -> LineRatios:
     from dataclasses import replace
 
     from .constants import LINE_HALF
-    from .describe_partial import SCATTER_DB, _scatter
+    from .describe_partial import _scatter
 
     scattering = [float(r.h[r.line == ln][0]) for ln in np.unique(r.line)
-                  if _scatter(r.q[r.line == ln], r.spin[r.line == ln], r.w[r.line == ln])[0] >= SCATTER_DB]
+                  if _scatter(r.q[r.line == ln], r.spin[r.line == ln], r.w[r.line == ln])[1]]
     keep = np.ones(r.q.size, bool)
     for h_s in scattering:
         keep &= np.abs(r.h - h_s) * r.spin > (2 * LINE_HALF + 1) * df

@@ -172,12 +172,14 @@ class Context(Metric):
             have = tuple(j for j, c in enumerate(channels) if run.usable(c))
             groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
         for (n, fs, have), rows_all in groups.items():
+            if not have:
+                continue                # no channel asked for in these runs (frozen there): NaN
             w, wsum, _ = run_window(self.sp.window, n)
             step = max(1, PHASOR_CHUNK_SAMPLES // (n * max(len(have), 1)))
             for s in range(0, len(rows_all), step):
                 rows = np.asarray(rows_all[s:s + step])
                 x = blocked_records([[self.test.runs[runs[i]].signals[channels[j]] for j in have] for i in rows], w)
-                out[rows[:, None], :, np.asarray(have)[None, :]] = \
+                out[rows[:, None], :, np.asarray(have, dtype=int)[None, :]] = \
                     (2.0 * windowed_dfts(x, fs, f_hz[rows]) / wsum).transpose(0, 2, 1)
         return out
 
