@@ -169,11 +169,9 @@ class Context(Metric):
         groups: dict[tuple, list[int]] = {}
         for i, r in enumerate(runs):
             run = self.test.runs[r]
-            have = tuple(j for j, c in enumerate(channels) if run.usable(c))
-            groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
+            if have := tuple(j for j, c in enumerate(channels) if run.usable(c)):    # none (frozen there): NaN
+                groups.setdefault((run.n_samples, run.sample_rate, have), []).append(i)
         for (n, fs, have), rows_all in groups.items():
-            if not have:
-                continue                # no channel asked for in these runs (frozen there): NaN
             w, wsum, _ = run_window(self.sp.window, n)
             step = max(1, PHASOR_CHUNK_SAMPLES // (n * max(len(have), 1)))
             for s in range(0, len(rows_all), step):
