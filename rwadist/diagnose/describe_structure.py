@@ -17,7 +17,7 @@ from .constants import LINE_HALF
 from .describe_whirl import rocking_whirl, whirl_note
 from .line_offsets import line_indicator, offset_free_sse
 from .sweep_crossing import crossings
-from .unexplained import Unexplained
+from .unexplained import Unexplained, _number
 
 #: A line's predicted power over the noise in its window, at least, for its ratio to be read (dB).
 LINE_SNR_DB = 20.0
@@ -484,7 +484,6 @@ def steady_lines(r: LineRatios, df: float) -> LineRatios:
     to +18.5 dB' were fitted through its strongest runs, and through h 2.0's runs where it leaked in)."""
     from dataclasses import replace
 
-    from .constants import LINE_HALF
     from .describe_partial import _scatter
 
     scattering = [float(r.h[r.line == ln][0]) for ln in np.unique(r.line)
@@ -581,10 +580,11 @@ LEAK_FRACTION = 2.0 / 3.0
 def _line_at(u, rpm: np.ndarray) -> np.ndarray:
     """The frequency (Hz) of the narrow-line record ``u`` (a ``fixed_line`` or an ``affine_line``) at ``rpm``, NaN
     outside its speeds."""
-    p = u.parameters or {}
+    from .describe_affine import track_of
+
     inside = (rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6)
     if u.signature == "affine_line":
-        f = p["offset_Hz"] + p["slope"] * rpm / 60.0
+        f = track_of(u, rpm / 60.0)
     else:
         f = np.full(rpm.shape, float(u.f_Hz[0]))
     return np.where(inside, f, np.nan)
@@ -598,7 +598,7 @@ def without_line_leaks(records: list, df: float) -> list:
     speeds lifted one line in two runs; a 60 Hz + 1.3·f_spin line on Fx, Fy lifted six points, and a track of slope 3.1
     was fitted through them)."""
     lines = [u for u in records if u.signature in ("fixed_line", "affine_line")
-             and _number_or_none((u.parameters or {}).get("peak_over_model_dB")) is not None]
+             and _number((u.parameters or {}).get("peak_over_model_dB")) is not None]
     if not lines:
         return records
 
@@ -616,10 +616,6 @@ def without_line_leaks(records: list, df: float) -> list:
         return bool(near.mean() >= LEAK_FRACTION)
 
     return [u for u in records if not leaks(u)]
-
-
-def _number_or_none(x):
-    return float(x) if isinstance(x, (int, float)) and np.isfinite(x) else None
 
 
 #: A slope within this of a whole number n (Hz per Hz of spin) reads first as a mode of n nodal diameters of the
