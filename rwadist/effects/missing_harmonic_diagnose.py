@@ -56,6 +56,9 @@ RECORD_SCORE = 20.0
 #: Fewest points (run, channel) and runs of a record-route ridge or fit.
 RECORD_MIN_POINTS = 6
 RECORD_MIN_RUNS = 3
+#: Smallest separation (record bins) of a close line from every line of the state, in a run :func:`resolved_h` reads:
+#: RECORD_SEP_BINS and one more (the Hann main lobe's edge, and a line's own lobe beside the candidate's grid).
+RESOLVED_SEP_BINS = 3.0
 #: Points used for C stand this many times over the noise (as the whole-run fit of ``speed_sidebands``).
 RECORD_FIT_SNR = 10.0
 
@@ -74,6 +77,68 @@ def record_line_evidence(ctx: Context, chans, P, N, ok, M1) -> tuple:
         drop += float(np.sum((np.abs(p - n) - np.abs(p - n - m1))[v])) / scale
         var += float(np.sum(np.minimum(m1, sig)[v] ** 2)) / scale**2
     return drop, float(np.sqrt(var))
+
+
+def _apart_residuals(ctx: Context, state: State, direction: str, runs, h: float, grid: np.ndarray) -> list:
+    """[(channel, rows (R',), X (R', G) complex)] of the direction's channels: the whole-run phasors at h'·|Ω|/2π for
+    every h' of ``grid`` less the leakage of every line of the state on the channel (each line's own phasor times the
+    window's transform, its negative-frequency image too: nought at each line of the state), in the runs ``rows``
+    where ``h`` lies RESOLVED_SEP_BINS record bins or more from every such line."""
+    w_hz = ctx.omega[runs] / (2 * np.pi)
+    df_rec = np.array([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs])
+    out = []
+    for c in (c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels):
+        lines = state_line_freqs(ctx, state, c, runs)                                   # (R, L)
+        apart = np.all(np.abs(h * w_hz[:, None] - lines) >= RESOLVED_SEP_BINS * df_rec[:, None], axis=1)
+        use = np.array([i for i, r in enumerate(runs) if apart[i] and _has_channel(ctx, int(r), ctx.channels.index(c))],
+                       dtype=int)
+        if not use.size:
+            continue
+        rows = runs[use]
+        f = np.outer(w_hz[use], grid)                                                   # (R', G)
+        X = record_dfts(ctx, rows, c, f)
+        if lines.shape[1]:
+            A = record_dfts(ctx, rows, c, lines[use])[:, None, :]                      # (R', 1, L)
+            fl = lines[use][:, None, :]
+            lengths = np.array([ctx.test.runs[r].n_samples for r in rows])
+            for n in np.unique(lengths):                        # the window's transform, runs of one length at once
+                k = lengths == n
+                d = df_rec[use][k][:, None, None]
+                X[k] -= (hann_transform_ratio(int(n), (f[k][:, :, None] - fl[k]) / d) * A[k]
+                         + hann_transform_ratio(int(n), (f[k][:, :, None] + fl[k]) / d) * np.conj(A[k])).sum(2)
+        out.append((c, rows, X))
+    return out
+
+
+def _steady(ctx: Context, state: State) -> bool:
+    """The whole-run DFT holds the state's lines as steady ones: time series given, no spin smear, no speed ripple."""
+    return ctx.test is not None and state.smear is None and state.speed_modulation is None
+
+
+def resolved_h(ctx: Context, state: State, direction: str, runs, h: float, half: float) -> "float | None":
+    """h of a line within ``half`` (h) of the Welch route's estimate ``h``, measured on the whole-run DFT, where a line
+    closer to a model line than the Welch main lobe (the two one ridge on the Welch grid, its h a blend of both) stands
+    apart: the maximum over a grid of RECORD_GRID_BINS record bins (at the fastest run) of Σ|X − leakage|²
+    (:func:`_apart_residuals`) over the direction's channels and the runs where ``h`` is apart from the state's
+    lines, a log-parabola through the top three.  None where the record's lines are not steady (:func:`_steady`) or
+    with fewer than RECORD_MIN_RUNS such runs."""
+    if not _steady(ctx, state):
+        return None
+    runs = np.asarray(runs)
+    df_rec = max(ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs)
+    step = RECORD_GRID_BINS * df_rec / max(float(np.max(ctx.omega[runs])) / (2 * np.pi), 1e-9)
+    grid = np.arange(h - half, h + half + 0.5 * step, step)
+    grid = grid[grid > 0]
+    parts = _apart_residuals(ctx, state, direction, runs, h, grid)
+    if grid.size < 3 or max((rows.size for _, rows, _ in parts), default=0) < RECORD_MIN_RUNS:
+        return None
+    tot = sum(np.sum(np.abs(X) ** 2, axis=0) for _, _, X in parts)
+    i = int(np.argmax(tot))
+    if not 0 < i < grid.size - 1:
+        return float(grid[i])
+    lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
+    den = lo - 2 * mid + hi
+    return float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * step)
 
 
 def welch_low_limit(ctx: Context) -> float:
@@ -276,6 +341,7 @@ class MissingHarmonic:
     C: float
     n_points: int = 0
     record: bool = False
+    close: bool = False
     kind: str = "missing_harmonic"
 
     @property
@@ -295,6 +361,8 @@ class MissingHarmonic:
         fails."""
         if self.record:
             return MissingHarmonic.fit_record(ctx, state, self.direction, self.h, ctx.runs) or self
+        if self.close:
+            return MissingHarmonic.fit_close(ctx, state, self.direction, self.h, ctx.runs) or self
         return MissingHarmonic.fit(ctx, state, self.direction, self.h, ctx.runs) or self
 
     def to_schema(self) -> dict:
@@ -310,6 +378,45 @@ class MissingHarmonic:
             return None
         C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
         return MissingHarmonic(direction, float(h), C, int(d.size))
+
+    @staticmethod
+    def fit_close(ctx: Context, state: State, direction: str, h: float, runs) -> "MissingHarmonic | None":
+        """A line closer to a model line than the Welch main lobe (:func:`resolved_h`), fitted on the whole-run DFT
+        where the two stand apart: C by thesis Eq. 3.10 on the amplitudes sqrt(|X − leakage|² − noise)
+        (:func:`_apart_residuals`; the noise the white noise of the state's floor at the nearest Welch bin) of the
+        points RECORD_FIT_SNR × over the noise, divided by the fixed resonances' and the modal gain.  None where the
+        record's lines are not steady, with fewer than RECORD_MIN_POINTS such points or RECORD_MIN_RUNS runs, or no
+        positive C."""
+        from ..dft import run_window
+
+        if not _steady(ctx, state):
+            return None
+        d_parts: list[np.ndarray] = []
+        w_parts: list[np.ndarray] = []
+        used: set[int] = set()
+        for c, rows, X in _apart_residuals(ctx, state, direction, np.asarray(runs), h, np.array([h])):
+            w = ctx.omega[rows]
+            k = np.clip(np.rint(h * w / (2 * np.pi) / ctx.df).astype(int), ctx.k_lo, ctx.k_hi)
+            S = ctx.floor_psd(state, c, rows)[np.arange(rows.size), k]
+            N = np.empty(rows.size)
+            for i, r in enumerate(rows):
+                run = ctx.test.runs[r]
+                _, wsum, w2sum = run_window(ctx.sp.window, run.n_samples)
+                N[i] = 2.0 * S[i] * run.sample_rate * w2sum / wsum**2
+            P = np.abs(X[:, 0]) ** 2
+            keep = P > RECORD_FIT_SNR * N
+            unit = MissingHarmonic._line_amplitude(ctx, state, c, direction, h, 1.0, rows)    # per unit C
+            a = np.sqrt(np.maximum(P - N, 0.0)) / np.maximum(unit, 1e-300) * w**2
+            d_parts.append(a[keep])
+            w_parts.append(w[keep])
+            used.update(int(r) for r in rows[keep])
+        if not d_parts:
+            return None
+        d, w = np.concatenate(d_parts), np.concatenate(w_parts)
+        if d.size < RECORD_MIN_POINTS or len(used) < RECORD_MIN_RUNS:
+            return None
+        C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
+        return MissingHarmonic(direction, float(h), C, int(d.size), close=True) if C > 0 else None
 
     # ------------------------------------------------------------------ the record route (below the Welch band)
     @staticmethod
@@ -444,6 +551,11 @@ class MissingHarmonic:
                        for x in state.model.harmonics(e.direction))
 
         ratios = sweep_ratios(ctx.test.meta if ctx.test is not None else None)
+        # RESOLVED_SEP_BINS record bins at the fastest run, in h: a line measured on the whole-run DFT this close to a
+        # model line is that line
+        sep_rec = 0.0 if ctx.test is None else RESOLVED_SEP_BINS * max(
+            ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs) / max(
+            float(np.max(np.abs(ctx.omega[runs]))) / (2 * np.pi), 1e-300)
 
         def welch(d, chans) -> list:
             found: list[MissingHarmonic] = []
@@ -453,10 +565,20 @@ class MissingHarmonic:
                 # on a sweep whose speed came from the data, the wheel's lines of the speed scale's ratios within the
                 # ridge's lobe (a blend of two close lines, a smeared line's ridge beside itself), else the ridge's h
                 for h in ratios_near(refine_h(ctx, state, chans, runs, h), ratios, lobe):
-                    if any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)) or \
-                            any(abs(h - x.h) < 0.005 for x in found):
+                    # within a model line's Welch lobe the ridge's h is a blend of the two lines: measured again on
+                    # the whole-run DFT, where they stand apart (resolved_h), and kept when apart from every line
+                    close = any(abs(h - x.h) < lobe for x in state.model.harmonics(d))
+                    h_rec = resolved_h(ctx, state, d, runs, h, lobe) if close else None
+                    if h_rec is not None:
+                        h = h_rec
+                        if any(abs(h - x.h) < sep_rec for x in state.model.harmonics(d)):
+                            continue
+                    elif any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
                         continue
-                    e = MissingHarmonic.fit(ctx, state, d, h, runs)
+                    if any(abs(h - x.h) < 0.005 for x in found):
+                        continue
+                    e = (h_rec is not None and MissingHarmonic.fit_close(ctx, state, d, h, runs)) or \
+                        MissingHarmonic.fit(ctx, state, d, h, runs)
                     if e is not None and e.C > 0 and not misfit(e):
                         found.append(e)
             return found
