@@ -10,7 +10,7 @@ it there too (:meth:`MissingHarmonic.heldout_evidence`: the error metric's bands
 PSDs cannot see it)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -56,9 +56,6 @@ RECORD_SCORE = 20.0
 #: Fewest points (run, channel) and runs of a record-route ridge or fit.
 RECORD_MIN_POINTS = 6
 RECORD_MIN_RUNS = 3
-#: Smallest separation (record bins) of a close line from every line of the state, in a run :func:`resolved_h` reads:
-#: RECORD_SEP_BINS and one more (the Hann main lobe's edge, and a line's own lobe beside the candidate's grid).
-RESOLVED_SEP_BINS = 3.0
 #: Points used for C stand this many times over the noise (as the whole-run fit of ``speed_sidebands``).
 RECORD_FIT_SNR = 10.0
 
@@ -83,13 +80,13 @@ def _apart_residuals(ctx: Context, state: State, direction: str, runs, h: float,
     """[(channel, rows (R',), X (R', G) complex)] of the direction's channels: the whole-run phasors at h'·|Ω|/2π for
     every h' of ``grid`` less the leakage of every line of the state on the channel (each line's own phasor times the
     window's transform, its negative-frequency image too: nought at each line of the state), in the runs ``rows``
-    where ``h`` lies RESOLVED_SEP_BINS record bins or more from every such line."""
+    where ``h`` lies RECORD_SEP_BINS record bins or more from every such line."""
     w_hz = ctx.omega[runs] / (2 * np.pi)
     df_rec = np.array([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs])
     out = []
     for c in (c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels):
         lines = state_line_freqs(ctx, state, c, runs)                                   # (R, L)
-        apart = np.all(np.abs(h * w_hz[:, None] - lines) >= RESOLVED_SEP_BINS * df_rec[:, None], axis=1)
+        apart = np.all(np.abs(h * w_hz[:, None] - lines) >= RECORD_SEP_BINS * df_rec[:, None], axis=1)
         use = np.array([i for i, r in enumerate(runs) if apart[i] and _has_channel(ctx, int(r), ctx.channels.index(c))],
                        dtype=int)
         if not use.size:
@@ -108,6 +105,44 @@ def _apart_residuals(ctx: Context, state: State, direction: str, runs, h: float,
                          + hann_transform_ratio(int(n), (f[k][:, :, None] + fl[k]) / d) * np.conj(A[k])).sum(2)
         out.append((c, rows, X))
     return out
+
+
+def _remeasured_neighbours(ctx: Context, state: State, direction: str, runs: np.ndarray, h: float) -> tuple:
+    """((h, C before, C), ...) of the model lines of ``direction`` within the Welch main lobe (WELCH_LOBE_BINS at the
+    fastest run) of a close line h: each line's C scaled by the least-squares ratio of its power on the whole-run DFT
+    (|X|² at its own frequency) to the power the state predicts for it (its amplitude through the modes and the fixed
+    resonances: whatever form the line has, scaled as one), over the direction's channels and the runs where it lies
+    RECORD_SEP_BINS record bins or more from every other line of the state and from h; a line with fewer than
+    RECORD_MIN_RUNS such runs is left as it is."""
+    w_hz = ctx.omega[runs] / (2 * np.pi)
+    lobe = WELCH_LOBE_BINS * ctx.df / max(float(w_hz.max()), 1e-300)
+    df_rec = np.array([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs])
+    out = []
+    for x in state.model.harmonics(direction):
+        if abs(x.h - h) >= lobe:
+            continue
+        fx = x.h * w_hz
+        num = den = 0.0
+        used: set[int] = set()
+        for c in (c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels):
+            entry = [a for hh, _, a, _ in ctx.channel_lines(state, c, runs) if abs(hh - x.h) < 1e-9]
+            if not entry:
+                continue
+            lines = state_line_freqs(ctx, state, c, runs)
+            near = np.abs(lines - fx[:, None]) < RECORD_SEP_BINS * df_rec[:, None]
+            apart = (near.sum(1) <= 1) & (np.abs(fx - h * w_hz) >= RECORD_SEP_BINS * df_rec)
+            use = np.array([i for i, r in enumerate(runs) if apart[i] and _has_channel(ctx, int(r),
+                                                                                      ctx.channels.index(c))], dtype=int)
+            if not use.size:
+                continue
+            P = np.abs(record_dfts(ctx, runs[use], c, fx[use][:, None])[:, 0]) ** 2
+            a = entry[0][use] * (ctx.gain(state, c, fx[use]) if state.resonances else 1.0)
+            num += float(np.sum(P * a**2))
+            den += float(np.sum(a**4))
+            used.update(int(r) for r in runs[use])
+        if den > 0 and len(used) >= RECORD_MIN_RUNS:
+            out.append((x.h, x.C, x.C * float(np.sqrt(num / den))))
+    return tuple(out)
 
 
 def _steady(ctx: Context, state: State) -> bool:
@@ -129,16 +164,19 @@ def resolved_h(ctx: Context, state: State, direction: str, runs, h: float, half:
     step = RECORD_GRID_BINS * df_rec / max(float(np.max(ctx.omega[runs])) / (2 * np.pi), 1e-9)
     grid = np.arange(h - half, h + half + 0.5 * step, step)
     grid = grid[grid > 0]
-    parts = _apart_residuals(ctx, state, direction, runs, h, grid)
-    if grid.size < 3 or max((rows.size for _, rows, _ in parts), default=0) < RECORD_MIN_RUNS:
-        return None
-    tot = sum(np.sum(np.abs(X) ** 2, axis=0) for _, _, X in parts)
-    i = int(np.argmax(tot))
-    if not 0 < i < grid.size - 1:
-        return float(grid[i])
-    lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
-    den = lo - 2 * mid + hi
-    return float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * step)
+    # twice: the runs apart from the Welch route's h, then from the h they give (a blend's h can be off by a lobe)
+    for _ in range(2):
+        parts = _apart_residuals(ctx, state, direction, runs, h, grid)
+        if grid.size < 3 or max((rows.size for _, rows, _ in parts), default=0) < RECORD_MIN_RUNS:
+            return None
+        tot = sum(np.sum(np.abs(X) ** 2, axis=0) for _, _, X in parts)
+        i = int(np.argmax(tot))
+        h = float(grid[i])
+        if 0 < i < grid.size - 1:
+            lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
+            den = lo - 2 * mid + hi
+            h += (0.5 * (lo - hi) / den if den < 0 else 0.0) * step
+    return h
 
 
 def welch_low_limit(ctx: Context) -> float:
@@ -342,17 +380,28 @@ class MissingHarmonic:
     n_points: int = 0
     record: bool = False
     close: bool = False
+    #: ((h, C before, C), ...): the model lines within the Welch lobe of a ``close`` line, their C measured again apart
+    #: from it on the whole-run DFT (the base's fit measured the blend of both on the Welch grid)
+    beside: tuple = ()
     kind: str = "missing_harmonic"
 
     @property
     def channels(self):
         return DIRECTION_CHANNELS[self.direction]
 
+    @property
+    def judged_on_narrow_lines(self) -> bool:
+        """A ``close`` line is judged on the narrow lines as well (:func:`rwadist.diagnose.search._narrow_judge`): it
+        moves power between two lines one Welch lobe apart, a share of the power-weighted misfit as small as the
+        weaker line, where a reviewer of the waterfall sees both."""
+        return self.close
+
     def apply(self, state: State) -> State:
         s = state.copy()
+        remeasured = {h: C for h, _, C in self.beside}
+        kept = [replace(x, C=remeasured[x.h]) if x.h in remeasured else x for x in s.model.harmonics(self.direction)]
         s.model.empirical[self.direction] = sorted(
-            s.model.harmonics(self.direction) + [Harmonic(h=round(self.h, 4), C=self.C, n_points=self.n_points)],
-            key=lambda x: x.h)
+            kept + [Harmonic(h=round(self.h, 4), C=self.C, n_points=self.n_points)], key=lambda x: x.h)
         s.effects.append(self)
         return s
 
@@ -416,7 +465,10 @@ class MissingHarmonic:
         if d.size < RECORD_MIN_POINTS or len(used) < RECORD_MIN_RUNS:
             return None
         C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
-        return MissingHarmonic(direction, float(h), C, int(d.size), close=True) if C > 0 else None
+        if C <= 0:
+            return None
+        return MissingHarmonic(direction, float(h), C, int(d.size), close=True,
+                               beside=_remeasured_neighbours(ctx, state, direction, np.asarray(runs), h))
 
     # ------------------------------------------------------------------ the record route (below the Welch band)
     @staticmethod
@@ -551,9 +603,9 @@ class MissingHarmonic:
                        for x in state.model.harmonics(e.direction))
 
         ratios = sweep_ratios(ctx.test.meta if ctx.test is not None else None)
-        # RESOLVED_SEP_BINS record bins at the fastest run, in h: a line measured on the whole-run DFT this close to a
+        # RECORD_SEP_BINS record bins at the fastest run, in h: a line measured on the whole-run DFT this close to a
         # model line is that line
-        sep_rec = 0.0 if ctx.test is None else RESOLVED_SEP_BINS * max(
+        sep_rec = 0.0 if ctx.test is None else RECORD_SEP_BINS * max(
             ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs) / max(
             float(np.max(np.abs(ctx.omega[runs]))) / (2 * np.pi), 1e-300)
 
