@@ -343,6 +343,12 @@ def hypotheses_csv(hypotheses) -> str:
     return buf.getvalue()
 
 
+def _measured_apart(effect) -> list:
+    """The model lines a close line was measured apart from (``apart_entry`` of a ``missing_harmonic``), or []."""
+    entry: dict = getattr(effect, "apart_entry", dict)()
+    return list(entry.get("measured_apart", []))
+
+
 def _taken_back(diag) -> list:
     """report.md's lines of the effects taken back: fitted to content no class explains, or an amplitude law taken
     before the wheel's modes or a load-cell offset and judged again on that base (:mod:`.law_recheck`)."""
@@ -436,7 +442,10 @@ def write_report(diag: Diagnosis, out_dir) -> list:
                   else f", {h.narrow_gain_fraction:.1%} of the narrow-line misfit (taken on it: its power share is "
                        "below min_gain)")
         md.append(f"- **{words}**: held-out gain {h.gain_fraction:.1%} of the unexplained "
-                  f"power{beyond_power(h.gain_fraction)}{narrow}, {h.t:.1f} noise standard errors (parameters: {par})")
+                  f"power{beyond_power(h.gain_fraction)}{narrow}, {h.t:.1f} noise standard errors (parameters: {par})"
+                  + "".join(f"; beside it h = {m['h_before']:.5g}, C = {m['C_before']:.4g} was the two lines' blend on "
+                            f"the Welch grid, measured apart on the whole-run DFT: h = {m['h']:.5g}, C = {m['C']:.4g}"
+                            for m in _measured_apart(h.effect)))
     if diag.model_given and diag.state_after.base != diag.state_before.base:
         missing = diag.lines_missing_from_given_model()
         md += ["", "## The given model's harmonics", "",

@@ -129,7 +129,8 @@ class Diagnosis:
             "rms_relative_error_before": self.rms_error_before, "rms_relative_error_after": self.rms_error_after,
             "iterations": self.iterations,
             "effects": [effect_entry(h) for h in chosen],
-            "base_lines": [effect_entry(h) for h in self.hypotheses if h.passed and h.base_line],
+            "base_lines": [{**effect_entry(h), **getattr(h.effect, "apart_entry", dict)()}
+                           for h in self.hypotheses if h.passed and h.base_line],
             "lines_missing_from_given_model": [{"direction": d, "h": h, "C": C, "sense": sense}
                                                for d, h, C, sense in self.lines_missing_from_given_model()],
             "unexplained": [u.to_json() for u in self.unexplained],

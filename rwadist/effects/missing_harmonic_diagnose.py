@@ -108,9 +108,9 @@ def _apart_residuals(ctx: Context, state: State, direction: str, runs, h: float,
 
 
 def _remeasured_neighbours(ctx: Context, state: State, direction: str, runs: np.ndarray, h: float) -> tuple:
-    """((h, C before, C), ...) of the model lines of ``direction`` within the Welch main lobe (WELCH_LOBE_BINS at the
-    fastest run) of a close line h: each line's C scaled by the least-squares ratio of its power on the whole-run DFT
-    (|X|² at its own frequency) to the power the state predicts for it (its amplitude through the modes and the fixed
+    """((h before, C before, h, C), ...) of the model lines of ``direction`` within the Welch main lobe (WELCH_LOBE_BINS
+    at the fastest run) of a close line h: each line's h the maximum of its power on the whole-run DFT, and its C
+    scaled by the least-squares ratio of that power (|X|² at its own frequency) to the power the state predicts for it (its amplitude through the modes and the fixed
     resonances: whatever form the line has, scaled as one), over the direction's channels and the runs where it lies
     RECORD_SEP_BINS record bins or more from every other line of the state and from h; a line with fewer than
     RECORD_MIN_RUNS such runs is left as it is."""
@@ -122,7 +122,7 @@ def _remeasured_neighbours(ctx: Context, state: State, direction: str, runs: np.
         if abs(x.h - h) >= lobe:
             continue
         fx = x.h * w_hz
-        num = den = 0.0
+        parts = []
         used: set[int] = set()
         for c in (c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels):
             entry = [a for hh, _, a, _ in ctx.channel_lines(state, c, runs) if abs(hh - x.h) < 1e-9]
@@ -135,13 +135,27 @@ def _remeasured_neighbours(ctx: Context, state: State, direction: str, runs: np.
                                                                                       ctx.channels.index(c))], dtype=int)
             if not use.size:
                 continue
-            P = np.abs(record_dfts(ctx, runs[use], c, fx[use][:, None])[:, 0]) ** 2
-            a = entry[0][use] * (ctx.gain(state, c, fx[use]) if state.resonances else 1.0)
-            num += float(np.sum(P * a**2))
-            den += float(np.sum(a**4))
+            parts.append((c, use, entry[0][use]))
             used.update(int(r) for r in runs[use])
-        if den > 0 and len(used) >= RECORD_MIN_RUNS:
-            out.append((x.h, x.C, x.C * float(np.sqrt(num / den))))
+        if len(used) < RECORD_MIN_RUNS:
+            continue
+        # h: the maximum of Σ|X|² on a grid of ±½ record bin at the fastest run (41 points, a log-parabola
+        # through the top three); C: the least-squares ratio of the powers there
+        grid = x.h + np.linspace(-0.5, 0.5, 41) * float(df_rec.max()) / float(w_hz.max())
+        P = [np.abs(record_dfts(ctx, runs[use], c, np.outer(w_hz[use], grid))) ** 2 for c, use, _ in parts]
+        tot = sum(p.sum(0) for p in P)
+        i = int(np.clip(np.argmax(tot), 1, grid.size - 2))
+        lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
+        den = lo - 2 * mid + hi
+        h_x = float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * (grid[1] - grid[0]))
+        num = den = 0.0
+        for c, use, amp in parts:
+            p = np.abs(record_dfts(ctx, runs[use], c, (h_x * w_hz[use])[:, None])[:, 0]) ** 2
+            a = amp * (ctx.gain(state, c, h_x * w_hz[use]) if state.resonances else 1.0)
+            num += float(np.sum(p * a**2))
+            den += float(np.sum(a**4))
+        if den > 0:
+            out.append((x.h, x.C, round(h_x, 4), x.C * float(np.sqrt(num / den))))
     return tuple(out)
 
 
@@ -380,8 +394,8 @@ class MissingHarmonic:
     n_points: int = 0
     record: bool = False
     close: bool = False
-    #: ((h, C before, C), ...): the model lines within the Welch lobe of a ``close`` line, their C measured again apart
-    #: from it on the whole-run DFT (the base's fit measured the blend of both on the Welch grid)
+    #: ((h before, C before, h, C), ...): the model lines within the Welch lobe of a ``close`` line, measured again
+    #: apart from it on the whole-run DFT (the base's fit measured the blend of both on the Welch grid)
     beside: tuple = ()
     kind: str = "missing_harmonic"
 
@@ -398,8 +412,9 @@ class MissingHarmonic:
 
     def apply(self, state: State) -> State:
         s = state.copy()
-        remeasured = {h: C for h, _, C in self.beside}
-        kept = [replace(x, C=remeasured[x.h]) if x.h in remeasured else x for x in s.model.harmonics(self.direction)]
+        remeasured = {h: (h_new, C) for h, _, h_new, C in self.beside}
+        kept = [replace(x, h=remeasured[x.h][0], C=remeasured[x.h][1]) if x.h in remeasured else x
+                for x in s.model.harmonics(self.direction)]
         s.model.empirical[self.direction] = sorted(
             kept + [Harmonic(h=round(self.h, 4), C=self.C, n_points=self.n_points)], key=lambda x: x.h)
         s.effects.append(self)
@@ -416,6 +431,12 @@ class MissingHarmonic:
 
     def to_schema(self) -> dict:
         return schema_entry(self)
+
+    def apart_entry(self) -> dict:
+        """``{"measured_apart": [{h_before, C_before, h, C}, ...]}`` of the model lines a ``close`` line was measured
+        apart from (:attr:`beside`), for the summary; {} when none."""
+        return {"measured_apart": [{"h_before": a, "C_before": b, "h": c, "C": d} for a, b, c, d in self.beside]} \
+            if self.beside else {}
 
     def params(self) -> dict:
         return {"direction": self.direction, "h": round(self.h, 4), "C": self.C}
@@ -434,8 +455,7 @@ class MissingHarmonic:
         where the two stand apart: C by thesis Eq. 3.10 on the amplitudes sqrt(|X − leakage|² − noise)
         (:func:`_apart_residuals`; the noise the white noise of the state's floor at the nearest Welch bin) of the
         points RECORD_FIT_SNR × over the noise, divided by the fixed resonances' and the modal gain.  None where the
-        record's lines are not steady, with fewer than RECORD_MIN_POINTS such points or RECORD_MIN_RUNS runs, or no
-        positive C."""
+        record's lines are not steady, with such points in fewer than RECORD_MIN_RUNS runs, or no positive C."""
         from ..dft import run_window
 
         if not _steady(ctx, state):
@@ -462,7 +482,7 @@ class MissingHarmonic:
         if not d_parts:
             return None
         d, w = np.concatenate(d_parts), np.concatenate(w_parts)
-        if d.size < RECORD_MIN_POINTS or len(used) < RECORD_MIN_RUNS:
+        if len(used) < RECORD_MIN_RUNS:             # (points of RECORD_FIT_SNR: one channel of an axial line is enough)
             return None
         C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
         if C <= 0:
@@ -617,19 +637,22 @@ class MissingHarmonic:
                 # on a sweep whose speed came from the data, the wheel's lines of the speed scale's ratios within the
                 # ridge's lobe (a blend of two close lines, a smeared line's ridge beside itself), else the ridge's h
                 for h in ratios_near(refine_h(ctx, state, chans, runs, h), ratios, lobe):
-                    # within a model line's Welch lobe the ridge's h is a blend of the two lines: measured again on
-                    # the whole-run DFT, where they stand apart (resolved_h), and kept when apart from every line
-                    close = any(abs(h - x.h) < lobe for x in state.model.harmonics(d))
-                    h_rec = resolved_h(ctx, state, d, runs, h, lobe) if close else None
+                    # near a model line the ridge's h is a blend of the two lines (one Welch lobe apart, the blend's
+                    # ridge up to a lobe beside them): measured again on the whole-run DFT, where they stand apart
+                    # (resolved_h), and kept when apart from every line; a line within a lobe of one is fitted there
+                    near = any(abs(h - x.h) < 2.0 * lobe for x in state.model.harmonics(d))
+                    h_rec = resolved_h(ctx, state, d, runs, h, 2.0 * lobe) if near else None
+                    close = False
                     if h_rec is not None:
                         h = h_rec
                         if any(abs(h - x.h) < sep_rec for x in state.model.harmonics(d)):
                             continue
+                        close = any(abs(h - x.h) < lobe for x in state.model.harmonics(d))
                     elif any(abs(h - x.h) < 0.03 for x in state.model.harmonics(d)):
                         continue
                     if any(abs(h - x.h) < 0.005 for x in found):
                         continue
-                    e = (h_rec is not None and MissingHarmonic.fit_close(ctx, state, d, h, runs)) or \
+                    e = (close and MissingHarmonic.fit_close(ctx, state, d, h, runs)) or \
                         MissingHarmonic.fit(ctx, state, d, h, runs)
                     if e is not None and e.C > 0 and not misfit(e):
                         found.append(e)
