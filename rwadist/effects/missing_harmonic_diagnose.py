@@ -56,6 +56,9 @@ RECORD_SCORE = 20.0
 #: Fewest points (run, channel) and runs of a record-route ridge or fit.
 RECORD_MIN_POINTS = 6
 RECORD_MIN_RUNS = 3
+#: Grid of :func:`resolved_h`'s first scan, record bins at the fastest run (a line between its points loses at most
+#: 0.4 dB of the Hann window's main lobe; the second scan is five times finer around its maximum).
+RESOLVED_SCAN_BINS = 0.5
 #: Points used for C stand this many times over the noise (as the whole-run fit of ``speed_sidebands``).
 RECORD_FIT_SNR = 10.0
 
@@ -167,29 +170,30 @@ def _steady(ctx: Context, state: State) -> bool:
 def resolved_h(ctx: Context, state: State, direction: str, runs, h: float, half: float) -> "float | None":
     """h of a line within ``half`` (h) of the Welch route's estimate ``h``, measured on the whole-run DFT, where a line
     closer to a model line than the Welch main lobe (the two one ridge on the Welch grid, its h a blend of both) stands
-    apart: the maximum over a grid of RECORD_GRID_BINS record bins (at the fastest run) of Σ|X − leakage|²
-    (:func:`_apart_residuals`) over the direction's channels and the runs where ``h`` is apart from the state's
-    lines, a log-parabola through the top three.  None where the record's lines are not steady (:func:`_steady`) or
-    with fewer than RECORD_MIN_RUNS such runs."""
+    apart: Σ|X − leakage|² (:func:`_apart_residuals`) over the direction's channels and the runs where ``h`` is apart
+    from the state's lines, its maximum on a grid of RESOLVED_SCAN_BINS record bins (at the fastest run) over ±``half``,
+    then on a grid of a fifth of that over ±1 step of the first, on the runs apart from that maximum (a blend's h can be
+    off by a lobe), and a log-parabola through the top three.  None where the record's lines are not steady
+    (:func:`_steady`) or with fewer than RECORD_MIN_RUNS such runs."""
     if not _steady(ctx, state):
         return None
     runs = np.asarray(runs)
     df_rec = max(ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs)
-    step = RECORD_GRID_BINS * df_rec / max(float(np.max(ctx.omega[runs])) / (2 * np.pi), 1e-9)
-    grid = np.arange(h - half, h + half + 0.5 * step, step)
-    grid = grid[grid > 0]
-    # twice: the runs apart from the Welch route's h, then from the h they give (a blend's h can be off by a lobe)
-    for _ in range(2):
+    step = RESOLVED_SCAN_BINS * df_rec / max(float(np.max(ctx.omega[runs])) / (2 * np.pi), 1e-9)
+    grids = (np.arange(h - half, h + half + 0.5 * step, step), np.linspace(-step, step, 11))
+    for k, grid in enumerate(grids):
+        grid = grid + h if k else grid
+        grid = grid[grid > 0]
         parts = _apart_residuals(ctx, state, direction, runs, h, grid)
         if grid.size < 3 or max((rows.size for _, rows, _ in parts), default=0) < RECORD_MIN_RUNS:
             return None
         tot = sum(np.sum(np.abs(X) ** 2, axis=0) for _, _, X in parts)
         i = int(np.argmax(tot))
         h = float(grid[i])
-        if 0 < i < grid.size - 1:
-            lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
-            den = lo - 2 * mid + hi
-            h += (0.5 * (lo - hi) / den if den < 0 else 0.0) * step
+    if 0 < i < grid.size - 1:
+        lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
+        den = lo - 2 * mid + hi
+        h += (0.5 * (lo - hi) / den if den < 0 else 0.0) * (grid[1] - grid[0])
     return h
 
 
