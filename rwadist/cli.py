@@ -473,7 +473,8 @@ def cmd_diagnose(args) -> int:
         print(f"  = {e['direction']} h = {e['h']:g}, C = {e['C']:.3g}: a line of the data the modes' fit did not "
               "resolve, added to the fitted base (no model to miss it from)")
         for m in e.get("measured_apart", ()):
-            print(f"    beside it h = {m['h_before']:g}, C = {m['C_before']:.3g} was the two lines' blend on the Welch "
+            part = f" ({m['sense']}-rotating part)" if m.get("sense") in ("co", "counter") else ""
+            print(f"    beside it h = {m['h_before']:g}{part}, C = {m['C_before']:.3g} was the two lines' blend on the Welch "
                   f"grid: measured apart on the whole-run DFT, h = {m['h']:g}, C = {m['C']:.3g}")
     missing = summary["lines_missing_from_given_model"]
     if diag.model_given and diag.state_after.base != diag.state_before.base:

@@ -443,7 +443,9 @@ def write_report(diag: Diagnosis, out_dir) -> list:
                        "below min_gain)")
         md.append(f"- **{words}**: held-out gain {h.gain_fraction:.1%} of the unexplained "
                   f"power{beyond_power(h.gain_fraction)}{narrow}, {h.t:.1f} noise standard errors (parameters: {par})"
-                  + "".join(f"; beside it h = {m['h_before']:.5g}, C = {m['C_before']:.4g} was the two lines' blend on "
+                  + "".join(f"; beside it h = {m['h_before']:.5g}"
+                            + (f" ({m['sense']}-rotating part)" if m.get("sense") in ("co", "counter") else "")
+                            + f", C = {m['C_before']:.4g} was the two lines' blend on "
                             f"the Welch grid, measured apart on the whole-run DFT: h = {m['h']:.5g}, C = {m['C']:.4g}"
                             for m in _measured_apart(h.effect)))
     if diag.model_given and diag.state_after.base != diag.state_before.base:

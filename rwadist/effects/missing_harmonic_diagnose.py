@@ -111,55 +111,78 @@ def _apart_residuals(ctx: Context, state: State, direction: str, runs, h: float,
 
 
 def _remeasured_neighbours(ctx: Context, state: State, direction: str, runs: np.ndarray, h: float) -> tuple:
-    """((h before, C before, h, C), ...) of the model lines of ``direction`` within the Welch main lobe (WELCH_LOBE_BINS
-    at the fastest run) of a close line h: each line's h the maximum of its power on the whole-run DFT, and its C
-    scaled by the least-squares ratio of that power (|X|² at its own frequency) to the power the state predicts for it (its amplitude through the modes and the fixed
-    resonances: whatever form the line has, scaled as one), over the direction's channels and the runs where it lies
-    RECORD_SEP_BINS record bins or more from every other line of the state and from h; a line with fewer than
-    RECORD_MIN_RUNS such runs is left as it is."""
+    """((h before, sense, C before, h, C), ...) of the model lines of ``direction`` within the Welch main lobe
+    (WELCH_LOBE_BINS at the fastest run) of a close line h, measured on the whole-run DFT over the direction's channels
+    and the runs where the line lies RECORD_SEP_BINS record bins or more from every other line of the state and from
+    h: its h the maximum of its power there; its C the least-squares ratio of that power (|X|² at its own frequency) to
+    the power the state predicts for it (through the modes and the fixed resonances: whatever form the line has, scaled
+    as one), or, for a radial line the model holds as a co- and a counter-rotating part, each part's own amplitude
+    (:func:`_sense_amplitudes`) over the amplitude the state gives it per unit C (the blend of two co-rotating lines
+    one Welch lobe apart can read as a co/counter pair on the Welch grid: the record splits them again).  A line with
+    fewer than RECORD_MIN_RUNS such runs is left as it is."""
     w_hz = ctx.omega[runs] / (2 * np.pi)
     lobe = WELCH_LOBE_BINS * ctx.df / max(float(w_hz.max()), 1e-300)
     df_rec = np.array([ctx.test.runs[r].sample_rate / ctx.test.runs[r].n_samples for r in runs])
-    out = []
-    for x in state.model.harmonics(direction):
-        if abs(x.h - h) >= lobe:
-            continue
-        fx = x.h * w_hz
+    out: list = []
+    for h_model in sorted({x.h for x in state.model.harmonics(direction) if abs(x.h - h) < lobe}):
+        parts_of = [x for x in state.model.harmonics(direction) if x.h == h_model]
+        fx = h_model * w_hz
         parts = []
-        used: set[int] = set()
         for c in (c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels):
-            entry = [a for hh, _, a, _ in ctx.channel_lines(state, c, runs) if abs(hh - x.h) < 1e-9]
+            entry = [a for hh, _, a, _ in ctx.channel_lines(state, c, runs) if abs(hh - h_model) < 1e-9]
             if not entry:
                 continue
             lines = state_line_freqs(ctx, state, c, runs)
             near = np.abs(lines - fx[:, None]) < RECORD_SEP_BINS * df_rec[:, None]
             apart = (near.sum(1) <= 1) & (np.abs(fx - h * w_hz) >= RECORD_SEP_BINS * df_rec)
-            use = np.array([i for i, r in enumerate(runs) if apart[i] and _has_channel(ctx, int(r),
-                                                                                      ctx.channels.index(c))], dtype=int)
-            if not use.size:
-                continue
-            parts.append((c, use, entry[0][use]))
-            used.update(int(r) for r in runs[use])
-        if len(used) < RECORD_MIN_RUNS:
+            apart &= np.array([_has_channel(ctx, int(r), ctx.channels.index(c)) for r in runs])
+            if apart.any():
+                parts.append((c, apart, entry[0]))
+        if np.count_nonzero(np.any([a for _, a, _ in parts], axis=0) if parts else []) < RECORD_MIN_RUNS:
             continue
         # h: the maximum of Σ|X|² on a grid of ±½ record bin at the fastest run (41 points, a log-parabola
-        # through the top three); C: the least-squares ratio of the powers there
-        grid = x.h + np.linspace(-0.5, 0.5, 41) * float(df_rec.max()) / float(w_hz.max())
-        P = [np.abs(record_dfts(ctx, runs[use], c, np.outer(w_hz[use], grid))) ** 2 for c, use, _ in parts]
-        tot = sum(p.sum(0) for p in P)
+        # through the top three)
+        grid = h_model + np.linspace(-0.5, 0.5, 41) * float(df_rec.max()) / float(w_hz.max())
+        tot = sum((np.abs(record_dfts(ctx, runs[a], c, np.outer(w_hz[a], grid))) ** 2).sum(0) for c, a, _ in parts)
         i = int(np.clip(np.argmax(tot), 1, grid.size - 2))
         lo, mid, hi = np.log(np.maximum(tot[i - 1:i + 2], 1e-300))
         den = lo - 2 * mid + hi
-        h_x = float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * (grid[1] - grid[0]))
+        h_x = round(float(grid[i] + (0.5 * (lo - hi) / den if den < 0 else 0.0) * (grid[1] - grid[0])), 4)
+        senses = {x.sense for x in parts_of}
+        pair = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+        if len(parts_of) == 2 and senses == {"co", "counter"} and len(pair) == 2 and len(parts) == 2:
+            both = parts[0][1] & parts[1][1]
+            if np.count_nonzero(both) < RECORD_MIN_RUNS:
+                continue
+            measured = _sense_amplitudes(ctx, state, direction, runs[both], h_x, pair)
+            out += [(h_model, x.sense, x.C, h_x, measured[x.sense]) for x in parts_of]
+            continue
         num = den = 0.0
-        for c, use, amp in parts:
-            p = np.abs(record_dfts(ctx, runs[use], c, (h_x * w_hz[use])[:, None])[:, 0]) ** 2
-            a = amp * (ctx.gain(state, c, h_x * w_hz[use]) if state.resonances else 1.0)
-            num += float(np.sum(p * a**2))
-            den += float(np.sum(a**4))
+        for c, a, amp in parts:
+            p = np.abs(record_dfts(ctx, runs[a], c, (h_x * w_hz[a])[:, None])[:, 0]) ** 2
+            m = amp[a] * (ctx.gain(state, c, h_x * w_hz[a]) if state.resonances else 1.0)
+            num += float(np.sum(p * m**2))
+            den += float(np.sum(m**4))
         if den > 0:
-            out.append((x.h, x.C, round(h_x, 4), x.C * float(np.sqrt(num / den))))
+            out += [(h_model, x.sense, x.C, h_x, x.C * float(np.sqrt(num / den))) for x in parts_of]
     return tuple(out)
+
+
+def _sense_amplitudes(ctx: Context, state: State, direction: str, rows: np.ndarray, h: float, pair: list) -> dict:
+    """{"co": C, "counter": C} of a radial line h on the runs ``rows``: the whole-run phasors X, Y of its pair of
+    channels split into the co-rotating part (X + jY)/2 (x + jy ∝ e^{+jωt}) and the counter-rotating one (X − jY)/2,
+    each part's C the least-squares fit of its amplitude to the amplitude the state gives that part per unit C (its
+    own modal gain, :meth:`~rwadist.diagnose.engine.Context.unit_gain`, times Ω² and the fixed resonances' gain)."""
+    w = ctx.omega[rows]
+    f = (h * w / (2 * np.pi))[:, None]
+    X, Y = (record_dfts(ctx, rows, c, f)[:, 0] for c in pair)
+    out = {}
+    for sense, part in (("co", np.abs(X + 1j * Y) / 2), ("counter", np.abs(X - 1j * Y) / 2)):
+        unit = ctx.unit_gain(state, pair[0], direction, h, sense, rows) * w**2
+        if state.resonances:
+            unit = unit * ctx.gain(state, pair[0], f[:, 0])
+        out[sense] = float(np.sum(part * unit) / max(float(np.sum(unit**2)), 1e-300))
+    return out
 
 
 def _steady(ctx: Context, state: State) -> bool:
@@ -398,7 +421,7 @@ class MissingHarmonic:
     n_points: int = 0
     record: bool = False
     close: bool = False
-    #: ((h before, C before, h, C), ...): the model lines within the Welch lobe of a ``close`` line, measured again
+    #: ((h before, sense, C before, h, C), ...): the model lines within the Welch lobe of a ``close`` line, measured again
     #: apart from it on the whole-run DFT (the base's fit measured the blend of both on the Welch grid)
     beside: tuple = ()
     kind: str = "missing_harmonic"
@@ -416,9 +439,9 @@ class MissingHarmonic:
 
     def apply(self, state: State) -> State:
         s = state.copy()
-        remeasured = {h: (h_new, C) for h, _, h_new, C in self.beside}
-        kept = [replace(x, h=remeasured[x.h][0], C=remeasured[x.h][1]) if x.h in remeasured else x
-                for x in s.model.harmonics(self.direction)]
+        remeasured = {(h, sense): (h_new, C) for h, sense, _, h_new, C in self.beside}
+        kept = [replace(x, h=remeasured[x.h, x.sense][0], C=remeasured[x.h, x.sense][1])
+                if (x.h, x.sense) in remeasured else x for x in s.model.harmonics(self.direction)]
         s.model.empirical[self.direction] = sorted(
             kept + [Harmonic(h=round(self.h, 4), C=self.C, n_points=self.n_points)], key=lambda x: x.h)
         s.effects.append(self)
@@ -439,8 +462,8 @@ class MissingHarmonic:
     def apart_entry(self) -> dict:
         """``{"measured_apart": [{h_before, C_before, h, C}, ...]}`` of the model lines a ``close`` line was measured
         apart from (:attr:`beside`), for the summary; {} when none."""
-        return {"measured_apart": [{"h_before": a, "C_before": b, "h": c, "C": d} for a, b, c, d in self.beside]} \
-            if self.beside else {}
+        return {"measured_apart": [{"h_before": a, "sense": sense, "C_before": b, "h": c, "C": d}
+                                   for a, sense, b, c, d in self.beside]} if self.beside else {}
 
     def params(self) -> dict:
         return {"direction": self.direction, "h": round(self.h, 4), "C": self.C}
