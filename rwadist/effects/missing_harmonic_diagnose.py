@@ -90,8 +90,7 @@ def _apart_residuals(ctx: Context, state: State, direction: str, runs, h: float,
     for c in (c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels):
         lines = state_line_freqs(ctx, state, c, runs)                                   # (R, L)
         apart = np.all(np.abs(h * w_hz[:, None] - lines) >= RECORD_SEP_BINS * df_rec[:, None], axis=1)
-        use = np.array([i for i, r in enumerate(runs) if apart[i] and _has_channel(ctx, int(r), ctx.channels.index(c))],
-                       dtype=int)
+        use = np.array([i for i, r in enumerate(runs) if apart[i] and ctx.test.runs[r].usable(c)], dtype=int)
         if not use.size:
             continue
         rows = runs[use]
@@ -135,7 +134,7 @@ def _remeasured_neighbours(ctx: Context, state: State, direction: str, runs: np.
             lines = state_line_freqs(ctx, state, c, runs)
             near = np.abs(lines - fx[:, None]) < RECORD_SEP_BINS * df_rec[:, None]
             apart = (near.sum(1) <= 1) & (np.abs(fx - h * w_hz) >= RECORD_SEP_BINS * df_rec)
-            apart &= np.array([_has_channel(ctx, int(r), ctx.channels.index(c)) for r in runs])
+            apart &= np.array([ctx.test.runs[r].usable(c) for r in runs])
             if apart.any():
                 parts.append((c, apart, entry[0]))
         if np.count_nonzero(np.any([a for _, a, _ in parts], axis=0) if parts else []) < RECORD_MIN_RUNS:
