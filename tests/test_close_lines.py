@@ -63,3 +63,14 @@ def test_a_cage_line_beside_an_added_line_on_a_family_wheel():
     assert 0.03 * 4500.0 / 60.0 < 2.0 * df
     d = api.diagnose(test)
     _assert_pair(d, [(cage.h, cage.C), (extra.h, extra.C)])
+
+
+def test_a_line_hidden_in_the_window_of_a_counter_rotating_line():
+    # h 1.96 co-rotating at 23 % of the power of the wheel's counter-rotating h 2 line: no ridge of its own on the Welch
+    # grid (the base measured the blend as h 2 with C 8 % high); the h 2 line's Welch power over its whole-run power
+    # gives it away, and the record splits the two
+    lines = list(iw.E_LINES) + [("radial_force", 1.96, 0.04, 1.0)]
+    test, _ = iw.generate(np.linspace(300.0, 3000.0, 20), lines=lines, seed=0)
+    d = api.diagnose(test)
+    _assert_pair(d, [(1.96, 0.04 * iw.C_UNIT), (2.0, 0.0832 * iw.C_UNIT)])
+    assert [x.sense for x in d.model.harmonics("radial_force") if abs(x.h - 2.0) < 0.01] == ["counter"]

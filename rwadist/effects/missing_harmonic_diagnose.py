@@ -56,6 +56,9 @@ RECORD_SCORE = 20.0
 #: Fewest points (run, channel) and runs of a record-route ridge or fit.
 RECORD_MIN_POINTS = 6
 RECORD_MIN_RUNS = 3
+#: A model line's amplitude on the Welch PSDs over its amplitude on the whole-run DFT, at least (median of the faster
+#: half of the runs), for a line hidden in its window (:func:`hidden_neighbours`): 6 % more power
+HIDDEN_RATIO = 1.03
 #: Grid of :func:`resolved_h`'s first scan, record bins at the fastest run (a line between its points loses at most
 #: 0.4 dB of the Hann window's main lobe; the second scan is five times finer around its maximum).
 RESOLVED_SCAN_BINS = 0.5
@@ -217,6 +220,61 @@ def resolved_h(ctx: Context, state: State, direction: str, runs, h: float, half:
         den = lo - 2 * mid + hi
         h += (0.5 * (lo - hi) / den if den < 0 else 0.0) * (grid[1] - grid[0])
     return h
+
+
+def hidden_neighbours(ctx: Context, state: State, direction: str, chans, runs) -> list:
+    """h of the model lines of ``direction`` whose Welch window holds more power than the line itself on the whole-run
+    DFT: the median over the faster half of ``runs`` and ``chans`` of the ratio of the line's amplitude on the Welch
+    PSDs (:meth:`~rwadist.diagnose.engine.Context.measure_line`, every other line of the state taken off) to its
+    amplitude on the whole-run DFT (|X| at its own frequency) at least HIDDEN_RATIO, and the lower quartile a third of
+    that excess: another line inside the window, too close for a ridge of its own (a blend the base measured as one
+    line: the E-like wheel's counter-rotating h 2 line with a co-rotating h 1.96 at 23 % of its power reads 1.11;
+    every line of clean data 0.99-1.00).  [] where the record's lines are not steady (:func:`_steady`)."""
+    if not _steady(ctx, state):
+        return []
+    runs = np.asarray(runs)
+    w_hz = ctx.omega[runs] / (2 * np.pi)
+    fast = runs[w_hz >= np.median(w_hz)]
+    out = []
+    for h in sorted({x.h for x in state.model.harmonics(direction)}):
+        ratios = []
+        for c in chans:
+            usable = np.array([ctx.test.runs[r].usable(c) for r in fast])
+            if not usable.any():
+                continue
+            rows = fast[usable]
+            welch = ctx.measure_line(state, c, h, rows, skip=h)
+            record = np.abs(record_dfts(ctx, rows, c, (h * ctx.omega[rows] / (2 * np.pi))[:, None])[:, 0])
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ratios.append(welch / record)
+        r = np.concatenate(ratios) if ratios else np.empty(0)
+        r = r[np.isfinite(r)]
+        if r.size >= RECORD_MIN_RUNS and np.median(r) >= HIDDEN_RATIO and \
+                np.percentile(r, 25) >= 1.0 + (HIDDEN_RATIO - 1.0) / 3.0:
+            out.append(h)
+    return out
+
+
+def _hidden_lines(ctx: Context, state: State, direction: str, chans, runs, found: list, sep_rec: float) -> list:
+    """``close`` lines (:meth:`MissingHarmonic.fit_close`) beside the model lines that hide one
+    (:func:`hidden_neighbours`): on each side of such a line, the maximum of the whole-run residual over half the Welch
+    window's width in h at the fastest run (:func:`resolved_h`), kept when RECORD_SEP_BINS record bins from every model
+    line and not one of ``found``."""
+    hidden = hidden_neighbours(ctx, state, direction, chans, runs)
+    if not hidden:
+        return []
+    half = (LINE_HALF + 1) * ctx.df / max(float(np.max(ctx.omega[runs])) / (2 * np.pi), 1e-300)
+    out: list[MissingHarmonic] = []
+    for h_model in hidden:
+        for side in (-1.0, 1.0):
+            h = resolved_h(ctx, state, direction, runs, h_model + 0.5 * side * half, 0.5 * half)
+            if h is None or any(abs(h - x.h) < sep_rec for x in state.model.harmonics(direction)) or \
+                    any(abs(h - e.h) < 0.005 for e in found + out):
+                continue
+            e = MissingHarmonic.fit_close(ctx, state, direction, h, runs)
+            if e is not None:
+                out.append(e)
+    return out
 
 
 def welch_low_limit(ctx: Context) -> float:
@@ -682,7 +740,7 @@ class MissingHarmonic:
                         MissingHarmonic.fit(ctx, state, d, h, runs)
                     if e is not None and e.C > 0 and not misfit(e):
                         found.append(e)
-            return found
+            return found + [e for e in _hidden_lines(ctx, state, d, chans, runs, found, sep_rec) if not misfit(e)]
 
         # each direction's lines from its own channels alone (Context.reuse): the Welch route's first, then the record
         # route's (below the Welch band) of every direction, a line the Welch route found not proposed again
