@@ -403,6 +403,18 @@ def cmd_campbell(args) -> int:
 
 # --------------------------------------------------------------------------- diagnose
 
+def _print_base_lines(base_lines) -> None:
+    """Console lines of the lines a diagnosis completed into a base fitted from the data (its summary's
+    ``base_lines``), each with the model lines measured apart from it."""
+    for e in base_lines:
+        print(f"  = {e['direction']} h = {e['h']:g}, C = {e['C']:.3g}: a line of the data the modes' fit did not "
+              "resolve, added to the fitted base (no model to miss it from)")
+        for m in e.get("measured_apart", ()):
+            part = f" ({m['sense']}-rotating part)" if m.get("sense") in ("co", "counter") else ""
+            print(f"    beside it h = {m['h_before']:g}{part}, C = {m['C_before']:.3g} was the two lines' blend on the Welch "
+                  f"grid: measured apart on the whole-run DFT, h = {m['h']:g}, C = {m['C']:.3g}")
+
+
 def cmd_diagnose(args) -> int:
     """Fit (or take) a model, find what it leaves in the residual, add the effects that pass, report."""
     from .diagnose import write_report
@@ -469,13 +481,7 @@ def cmd_diagnose(args) -> int:
     from .effects_text import diagnose_lines
 
     print("\n".join(diagnose_lines(summary["effects"])) or "  no effect added (none passed the held-out test)")
-    for e in summary["base_lines"]:
-        print(f"  = {e['direction']} h = {e['h']:g}, C = {e['C']:.3g}: a line of the data the modes' fit did not "
-              "resolve, added to the fitted base (no model to miss it from)")
-        for m in e.get("measured_apart", ()):
-            part = f" ({m['sense']}-rotating part)" if m.get("sense") in ("co", "counter") else ""
-            print(f"    beside it h = {m['h_before']:g}{part}, C = {m['C_before']:.3g} was the two lines' blend on the Welch "
-                  f"grid: measured apart on the whole-run DFT, h = {m['h']:g}, C = {m['C']:.3g}")
+    _print_base_lines(summary["base_lines"])
     missing = summary["lines_missing_from_given_model"]
     if diag.model_given and diag.state_after.base != diag.state_before.base:
         print(f"  note: {args.model or args.preset} has no suspension modes the data could be read through (none, or "
