@@ -311,6 +311,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     (:mod:`.describe_carrier` reads their sidebands), ``known_sidebands`` the sidebands taken out with them."""
     from . import describe_structure as structure
     from .describe_affine import affine_lines, with_affine_lines
+    from .describe_blend import blended_lines
     from .describe_carrier import measure_track, on_a_sideband, sideband_lines, sideband_tracks
     from .describe_drift import with_drifts
     from .describe_filter import frequency_response
@@ -386,6 +387,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += split_mode(ctx, state, of_line)
     # one channel of a radial pair recorded later than the other (its lines' x/y phase off a quarter turn ∝ f)
     out += channel_skew(ctx, state, of_line)
+    # a model line that is two or more lines closer than the Welch segments resolve (the whole record reads it alone)
+    out += blended_lines(ctx, state, of_line)
     # a gain common to the channels that changes with speed, on the recorded channels too; one of the line's frequency
     out += gain_trend(ctx, recorded := as_recorded(searched.state), of_line) + frequency_response(ctx, recorded, of_line)
     # a line whose ratio drifts with the speed (a cage slipping), what its fixed-ratio model line made of it; a line on

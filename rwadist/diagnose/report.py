@@ -205,6 +205,10 @@ def _mark_unexplained(ax, c: str, diag: Diagnosis, rpm: np.ndarray) -> None:
             f = u.parameters["offset_Hz"] + u.parameters["slope"] * s / 60.0
             ax.plot(f, s, ls=":", **style)
             _tag(ax, f, s, f" {n}", va="top", **tag)
+        elif u.signature == "line_property" and u.parameters.get("property") == "blended_lines" and u.h is not None:
+            s = np.array([s0, s1])                  # the blended model line's ray over the runs read
+            ax.plot(u.h * s / 60.0, s, ls="-.", **style)
+            _tag(ax, u.h * s / 60.0, s, f" {n}", va="top", **tag)
         elif u.signature == "partial_line" and u.h is not None:
             # a short mark on the line's ray at each run it is absent from
             s = np.asarray(u.parameters.get("absent_rpm", []), float)

@@ -68,6 +68,8 @@ LEVEL_WORDS = {
     "line_property:gain_trend": "{:+.2f} dB (power) on every line from the lowest speed to the highest",
     "line_property:frequency_response": "{:+.1f} dB (power) on the lines at the edge of the band read",
     "line_property:amplitude_law": "{:+.1f} dB (power) against C·Ω² from the lowest speed to the highest",
+    "line_property:blended_lines": "{:+.1f} dB (power) in the line's Welch window over the line itself on the "
+                                      "whole record (median)",
     "line_property:split_mode": "{:+.2f} dB (power) in Fy's lines against Fx's where they differ most",
     "line_property:ratio_drift": "the data {:+.1f} dB over the model in its bins (median)",
     "line_property:channel_skew": "{:+.1f} dB: the other rotation sense's share of a line's power at the highest "

@@ -222,14 +222,41 @@ def resolved_h(ctx: Context, state: State, direction: str, runs, h: float, half:
     return h
 
 
+def window_ratios(ctx: Context, state: State, c: str, h: float, rows: np.ndarray, snr: bool = False) -> tuple:
+    """(ratio, record power over its noise or None), each (len(rows),), of model line h on channel ``c`` in runs
+    ``rows``: its amplitude on the Welch PSDs (:meth:`~rwadist.diagnose.engine.Context.measure_line`, every other line
+    of the state taken off) over its amplitude on the whole-run DFT (|X| at its own frequency), and with ``snr`` |X|²
+    over the record's white noise there (:func:`record_noise`).  A line alone in its Welch window reads 1: more is
+    another line inside it."""
+    welch = ctx.measure_line(state, c, h, rows, skip=h)
+    f = h * ctx.omega[rows] / (2 * np.pi)
+    record = np.abs(record_dfts(ctx, rows, c, f[:, None])[:, 0])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return welch / record, (record**2 / record_noise(ctx, state, c, rows, f) if snr else None)
+
+
+def record_noise(ctx: Context, state: State, c: str, rows: np.ndarray, f_hz: np.ndarray) -> np.ndarray:
+    """E|X|² (len(rows),) of white noise on the whole-run phasor X = 2·Σwx·e^{−2πjft}/Σw of channel ``c`` at ``f_hz``
+    (one frequency per run of ``rows``): 2·S·f_s·Σw²/(Σw)², S the state's floor at the nearest Welch bin."""
+    from ..dft import run_window
+
+    k = np.clip(np.rint(np.asarray(f_hz) / ctx.df).astype(int), ctx.k_lo, ctx.k_hi)
+    S = ctx.floor_psd(state, c, rows)[np.arange(rows.size), k]
+    out = np.empty(rows.size)
+    for i, r in enumerate(rows):
+        run = ctx.test.runs[r]
+        _, wsum, w2sum = run_window(ctx.sp.window, run.n_samples)
+        out[i] = 2.0 * S[i] * run.sample_rate * w2sum / wsum**2
+    return out
+
+
 def hidden_neighbours(ctx: Context, state: State, direction: str, chans, runs) -> list:
     """h of the model lines of ``direction`` whose Welch window holds more power than the line itself on the whole-run
-    DFT: the median over the faster half of ``runs`` and ``chans`` of the ratio of the line's amplitude on the Welch
-    PSDs (:meth:`~rwadist.diagnose.engine.Context.measure_line`, every other line of the state taken off) to its
-    amplitude on the whole-run DFT (|X| at its own frequency) at least HIDDEN_RATIO, and the lower quartile a third of
-    that excess: another line inside the window, too close for a ridge of its own (a blend the base measured as one
-    line: the E-like wheel's counter-rotating h 2 line with a co-rotating h 1.96 at 23 % of its power reads 1.11;
-    every line of clean data 0.99-1.00).  [] where the record's lines are not steady (:func:`_steady`)."""
+    DFT: the median over the faster half of ``runs`` and ``chans`` of :func:`window_ratios` at least HIDDEN_RATIO, and
+    the lower quartile a third of that excess (:func:`hidden_in_window`): another line inside the window, too close
+    for a ridge of its own (a blend the base measured as one line: the E-like wheel's counter-rotating h 2 line with a
+    co-rotating h 1.96 at 23 % of its power reads 1.11; every line of clean data 0.99-1.00).  [] where the record's
+    lines are not steady (:func:`_steady`)."""
     if not _steady(ctx, state):
         return []
     runs = np.asarray(runs)
@@ -240,19 +267,19 @@ def hidden_neighbours(ctx: Context, state: State, direction: str, chans, runs) -
         ratios = []
         for c in chans:
             usable = np.array([ctx.test.runs[r].usable(c) for r in fast])
-            if not usable.any():
-                continue
-            rows = fast[usable]
-            welch = ctx.measure_line(state, c, h, rows, skip=h)
-            record = np.abs(record_dfts(ctx, rows, c, (h * ctx.omega[rows] / (2 * np.pi))[:, None])[:, 0])
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ratios.append(welch / record)
+            if usable.any():
+                ratios.append(window_ratios(ctx, state, c, h, fast[usable])[0])
         r = np.concatenate(ratios) if ratios else np.empty(0)
-        r = r[np.isfinite(r)]
-        if r.size >= RECORD_MIN_RUNS and np.median(r) >= HIDDEN_RATIO and \
-                np.percentile(r, 25) >= 1.0 + (HIDDEN_RATIO - 1.0) / 3.0:
+        if hidden_in_window(r[np.isfinite(r)]):
             out.append(h)
     return out
+
+
+def hidden_in_window(r: np.ndarray) -> bool:
+    """Whether :func:`window_ratios`' ratios ``r`` (finite) show a line hidden in a model line's window: at least
+    RECORD_MIN_RUNS of them, their median HIDDEN_RATIO or more and their lower quartile a third of that excess."""
+    return bool(r.size >= RECORD_MIN_RUNS and np.median(r) >= HIDDEN_RATIO and
+                np.percentile(r, 25) >= 1.0 + (HIDDEN_RATIO - 1.0) / 3.0)
 
 
 def _hidden_lines(ctx: Context, state: State, direction: str, chans, runs, found: list, sep_rec: float) -> list:
@@ -540,8 +567,6 @@ class MissingHarmonic:
         (:func:`_apart_residuals`; the noise the white noise of the state's floor at the nearest Welch bin) of the
         points RECORD_FIT_SNR × over the noise, divided by the fixed resonances' and the modal gain.  None where the
         record's lines are not steady, with such points in fewer than RECORD_MIN_RUNS runs, or no positive C."""
-        from ..dft import run_window
-
         if not _steady(ctx, state):
             return None
         d_parts: list[np.ndarray] = []
@@ -549,13 +574,7 @@ class MissingHarmonic:
         used: set[int] = set()
         for c, rows, X in _apart_residuals(ctx, state, direction, np.asarray(runs), h, np.array([h])):
             w = ctx.omega[rows]
-            k = np.clip(np.rint(h * w / (2 * np.pi) / ctx.df).astype(int), ctx.k_lo, ctx.k_hi)
-            S = ctx.floor_psd(state, c, rows)[np.arange(rows.size), k]
-            N = np.empty(rows.size)
-            for i, r in enumerate(rows):
-                run = ctx.test.runs[r]
-                _, wsum, w2sum = run_window(ctx.sp.window, run.n_samples)
-                N[i] = 2.0 * S[i] * run.sample_rate * w2sum / wsum**2
+            N = record_noise(ctx, state, c, rows, h * w / (2 * np.pi))
             P = np.abs(X[:, 0]) ** 2
             keep = P > RECORD_FIT_SNR * N
             unit = MissingHarmonic._line_amplitude(ctx, state, c, direction, h, 1.0, rows)    # per unit C
