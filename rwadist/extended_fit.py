@@ -130,6 +130,7 @@ class ExtendedFit:
         direction its load direction ("axial_force", "radial_force", "radial_torque").
     line_noise : per row of ``line_residuals``, the standard deviation of its log amplitude the noise under the line
         makes (dimensionless; 0 where not measured; :attr:`rwadist.empirical.LineFit.noise`).
+    line_h : per row of ``line_residuals``, the ratio h of its line to the speed.
     zeta_bounds : per located mode whose damping the data do not measure, (lo, hi) the damping ratios they allow; its
         ζ is held (:mod:`rwadist.extended_fit_damping`), written as zeta_<mode> to ``analytical.unconstrained``.
     zeta_interval : per located mode whose damping was profiled, (lo, hi) the damping ratios the data allow (a held
@@ -157,6 +158,7 @@ class ExtendedFit:
     zeta_interval: dict = field(default_factory=dict)
     more_stands: tuple = ()         # further fixture resonances divided out of every line, held (``more_stands``)
     line_noise: np.ndarray = field(default_factory=lambda: np.empty(0))     # per row of line_residuals, σ_noise
+    line_h: np.ndarray = field(default_factory=lambda: np.empty(0))         # per row of line_residuals, its line's h
 
     def parts_of(self, direction: str, h: float) -> list:
         """The model lines (co- and counter-rotating parts) of the measured harmonic (direction, h)."""
@@ -569,6 +571,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
                        line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
                        zeta_bounds=zeta_bounds, zeta_interval=intervals, line_noise=np.concatenate([na, nr]),
+                       line_h=np.array([lines[k].h for k in ax_line]
+                                       + ([lines[k].h for k in rad_parts[:, 0]] if sr.size else []), float),
                        more_stands=tuple(tuple(float(v) for v in k) for k in more_stands))
 
 

@@ -116,3 +116,19 @@ def test_a_pair_the_record_cannot_split_is_described_on_a_family_wheel():
     d = api.diagnose(steady_test(data))
     _assert_blend_described(d, [(cage.h, cage.C), (extra.h, extra.C)], rel=0.03)
     assert d.unexplained[0].parameters["record_resolution_h"] > 0.008
+
+
+def test_a_pair_inside_one_record_bin_invents_no_resonance():
+    # the cage line and a line 0.003 beside it at 70 % of it: 0.7 record bin apart at 4500 rpm, so their beat changes
+    # the pair's power from run to run on every record.  One line's scatter is no resonance: before, a 'structure
+    # mode' at 12.2 Hz (ζ 0.033, gain 1.6) fitted on that line's runs alone was named a wheel-mode fixed_resonance
+    wheel = fw.family()[3]
+    cage = next(x for x in wheel.lines if x.name == "cage")
+    extra = fw.Line("radial_force", cage.h + 0.003, 0.7 * cage.C, 1.0, "added")
+    wheel = fw.with_lines(wheel, [fw.Line(x.direction, x.h, x.C, 1.0, x.name) if x is cage else x
+                                  for x in wheel.lines] + [extra])
+    data = fw.steady(wheel, speeds_rpm=np.linspace(500.0, 4500.0, 28), n_samples=12000, noise=0.01, seed=5)
+    d = api.diagnose(steady_test(data))
+    assert [e["kind"] for e in d.model.effects] == ["suspension_modes"]
+    got = [x.h for x in d.model.harmonics("radial_force") if abs(x.h - cage.h) < 0.02]
+    assert len(got) == 1 and cage.h - 1e-3 <= got[0] <= extra.h + 1e-3

@@ -222,32 +222,32 @@ def resolved_h(ctx: Context, state: State, direction: str, runs, h: float, half:
     return h
 
 
-def window_ratios(ctx: Context, state: State, c: str, h: float, rows: np.ndarray, snr: bool = False) -> tuple:
-    """(ratio, record power over its noise or None), each (len(rows),), of model line h on channel ``c`` in runs
-    ``rows``: its amplitude on the Welch PSDs (:meth:`~rwadist.diagnose.engine.Context.measure_line`, every other line
-    of the state taken off) over its amplitude on the whole-run DFT (|X| at its own frequency), and with ``snr`` |X|²
-    over the record's white noise there (:func:`record_noise`).  A line alone in its Welch window reads 1: more is
-    another line inside it."""
+def window_ratios(ctx: Context, state: State, c: str, h: float, rows: np.ndarray) -> np.ndarray:
+    """(len(rows),) of model line h on channel ``c`` in runs ``rows``: its amplitude on the Welch PSDs
+    (:meth:`~rwadist.diagnose.engine.Context.measure_line`, every other line of the state taken off) over its amplitude
+    on the whole-run DFT (|X| at its own frequency).  A line alone in its Welch window reads 1: more is another line
+    inside it (:mod:`rwadist.diagnose.describe_blend` reads every line of a channel at once)."""
     welch = ctx.measure_line(state, c, h, rows, skip=h)
-    f = h * ctx.omega[rows] / (2 * np.pi)
-    record = np.abs(record_dfts(ctx, rows, c, f[:, None])[:, 0])
+    record = np.abs(record_dfts(ctx, rows, c, (h * ctx.omega[rows] / (2 * np.pi))[:, None])[:, 0])
     with np.errstate(divide="ignore", invalid="ignore"):
-        return welch / record, (record**2 / record_noise(ctx, state, c, rows, f) if snr else None)
+        return welch / record
 
 
 def record_noise(ctx: Context, state: State, c: str, rows: np.ndarray, f_hz: np.ndarray) -> np.ndarray:
-    """E|X|² (len(rows),) of white noise on the whole-run phasor X = 2·Σwx·e^{−2πjft}/Σw of channel ``c`` at ``f_hz``
-    (one frequency per run of ``rows``): 2·S·f_s·Σw²/(Σw)², S the state's floor at the nearest Welch bin."""
+    """E|X|² (the shape of ``f_hz``) of white noise on the whole-run phasor X = 2·Σwx·e^{−2πjft}/Σw of channel ``c`` at
+    ``f_hz`` ((len(rows),) or (len(rows), L): frequencies per run of ``rows``): 2·S·f_s·Σw²/(Σw)², S the state's floor
+    at the nearest Welch bin."""
     from ..dft import run_window
 
-    k = np.clip(np.rint(np.asarray(f_hz) / ctx.df).astype(int), ctx.k_lo, ctx.k_hi)
-    S = ctx.floor_psd(state, c, rows)[np.arange(rows.size), k]
-    out = np.empty(rows.size)
+    f_hz = np.asarray(f_hz, dtype=float)
+    k = np.clip(np.rint(f_hz / ctx.df).astype(int), ctx.k_lo, ctx.k_hi).reshape(rows.size, -1)
+    S = np.take_along_axis(ctx.floor_psd(state, c, rows), k, axis=1)
+    fs, w2, w1 = (np.empty((rows.size, 1)) for _ in range(3))
     for i, r in enumerate(rows):
         run = ctx.test.runs[r]
-        _, wsum, w2sum = run_window(ctx.sp.window, run.n_samples)
-        out[i] = 2.0 * S[i] * run.sample_rate * w2sum / wsum**2
-    return out
+        _, w1[i], w2[i] = run_window(ctx.sp.window, run.n_samples)
+        fs[i] = run.sample_rate
+    return (2.0 * S * fs * w2 / w1**2).reshape(f_hz.shape)
 
 
 def hidden_neighbours(ctx: Context, state: State, direction: str, chans, runs) -> list:
@@ -268,7 +268,7 @@ def hidden_neighbours(ctx: Context, state: State, direction: str, chans, runs) -
         for c in chans:
             usable = np.array([ctx.test.runs[r].usable(c) for r in fast])
             if usable.any():
-                ratios.append(window_ratios(ctx, state, c, h, fast[usable])[0])
+                ratios.append(window_ratios(ctx, state, c, h, fast[usable]))
         r = np.concatenate(ratios) if ratios else np.empty(0)
         if hidden_in_window(r[np.isfinite(r)]):
             out.append(h)
