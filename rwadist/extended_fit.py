@@ -521,14 +521,13 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                                                  stand_direction if stand is not None else None)
     peaks = amplification_peaks(fit)
     la, sa, ca, aa, na = _axial_measurements(meas)
-    radial = _radial_power(meas.lines)
+    lr, sr, pr, dr, nr = radial = _radial_power(meas.lines)
     scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near, senses_xy)
     mass_kg, I_rr, I_zz = _inertias(mass, radius, scans["rocking"], notes)
     starts = _ModeStarts(scans, start, physical, max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines),
                                                      default=100.0), zeta0, notes)
     base = starts.params(mass_kg, I_rr, I_zz)
     lines, owner = forcing_lines(meas.lines, senses_xy)
-    lr, sr, pr, dr, nr = radial
     line_of, ax_line, rad_parts = rows_of_lines(owner, la, lr)
     log_data, joint = _log_data(meas.lines, la, sa, aa, lr, sr, pr, stand if fit_stand else None, stand_direction,
                                 tuple(more_stands) if fit_stand and fit_more_stands else ())
@@ -571,9 +570,13 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                        per_unit=not physical, stand=None if stand is None else tuple(float(v) for v in stand),
                        line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
                        zeta_bounds=zeta_bounds, zeta_interval=intervals, line_noise=np.concatenate([na, nr]),
-                       line_h=np.array([lines[k].h for k in ax_line]
-                                       + ([lines[k].h for k in rad_parts[:, 0]] if sr.size else []), float),
+                       line_h=_rows_h(lines, ax_line, rad_parts, sr),
                        more_stands=tuple(tuple(float(v) for v in k) for k in more_stands))
+
+
+def _rows_h(lines: list, ax_line: np.ndarray, rad_parts: np.ndarray, sr: np.ndarray) -> np.ndarray:
+    """h of the line of every row of :attr:`ExtendedFit.line_residuals` (the axial rows, then the radial ones)."""
+    return np.array([lines[k].h for k in ax_line] + ([lines[k].h for k in rad_parts[:, 0]] if sr.size else []), float)
 
 
 def _mode_hz_of(params: ext.ExtendedParams, mode: str) -> float:

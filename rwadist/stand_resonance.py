@@ -603,12 +603,10 @@ def structure_confirmed(joint, plain) -> bool:
 
 
 def lifts_two_lines(joint, plain) -> bool:
-    """True when the joint fit's structure mode explains two lines or more (of distinct h) better than ``plain`` where
-    it lifts them by :data:`STAND_MIN_LOG_GAIN` or more (their squared log residuals there lower by more than their
-    rows times the joint fit's mean squared residual), or the rows of the two fits differ.  A resonance lifts every
-    line that crosses it; one line's run-to-run scatter is not told from it (family wheel 3's cage line with a line
-    0.003 beside it at 70 % of it: inside one record bin, their beat changes the pair's power from run to run, and a
-    'structure mode' at 12.2 Hz, ζ 0.033, gain 1.6 on that line's runs alone was named a wheel mode)."""
+    """True when the structure mode of ``joint`` explains two lines or more (distinct h) better than ``plain`` where it
+    lifts them by :data:`STAND_MIN_LOG_GAIN` (squared log residuals lower by over their rows × the joint fit's mean), or
+    the fits' rows differ.  One line's run-to-run scatter is no resonance (family wheel 3's cage line and a line 0.003
+    beside it beat within one record bin: a 'wheel mode' at 12.2 Hz, ζ 0.033, gain 1.6 was named on that line alone)."""
     f1, r1, d1 = (np.asarray(v) for v in joint.line_residuals)
     _, r0, d0 = (np.asarray(v) for v in plain.line_residuals)
     h = np.asarray(getattr(joint, "line_h", np.empty(0)), dtype=float)
@@ -617,9 +615,8 @@ def lifts_two_lines(joint, plain) -> bool:
     ok = np.isfinite(r1) & np.isfinite(r0)
     scatter = float(np.mean(r1[ok] ** 2)) if ok.any() else 0.0
     lifted = ok & (np.log(np.abs(resonance(f1, *joint.stand)) ** 2) >= STAND_MIN_LOG_GAIN)
-    better = [x for x in np.unique(h[lifted])
-              if np.sum(r1[lifted & (h == x)] ** 2 - r0[lifted & (h == x)] ** 2) < -np.sum(lifted & (h == x)) * scatter]
-    return len(better) >= 2
+    return sum(np.sum(r1[m] ** 2 - r0[m] ** 2) < -np.sum(m) * scatter for m in (lifted & (h == x) for x in np.unique(
+        h[lifted]))) >= 2
 
 
 def structure_mode_refused(test, fit, direction: str, stand: tuple) -> tuple:
