@@ -92,17 +92,23 @@ def _spectrum(x: np.ndarray) -> np.ndarray:
 
 
 def _run_power(run, channels: tuple) -> dict:
-    """channel -> (power spectrum, its lines, the spectrum over its noise at most ±2 bins off) of a run's ``channels``,
+    """channel -> (power spectrum, its lines, the spectrum over its noise) of a run's ``channels``,
     made in one transform: what every pair direction reads.  The lines: the local maxima (over ±2 bins) standing
     :data:`LINE_SNR` over the local noise (:func:`_local_noise`)."""
     from scipy import ndimage
 
     P = np.abs(_spectrum(np.stack([np.asarray(run.signals[c], dtype=float) for c in channels]))) ** 2
     noise = _local_noise(P)
-    level = ndimage.maximum_filter1d(P / noise, 2 * PRODUCT_HALF + 1, axis=1)
     peak = (P == ndimage.maximum_filter1d(P, 2 * PRODUCT_HALF + 1, axis=1)) & (P > LINE_SNR * noise)
     peak[:, :PRODUCT_HALF + 1] = False
-    return {c: (P[j], np.nonzero(peak[j])[0], level[j]) for j, c in enumerate(channels)}
+    return {c: (P[j], np.nonzero(peak[j])[0], P[j] / noise[j]) for j, c in enumerate(channels)}
+
+
+def _level_at(over_noise: np.ndarray, bins: np.ndarray) -> np.ndarray:
+    """The largest of ``over_noise`` (a spectrum over its noise) within ±PRODUCT_HALF bins of each of ``bins``: the
+    numbers of a running maximum over the whole spectrum, read at those bins only."""
+    k = np.clip(bins[:, None] + np.arange(-PRODUCT_HALF, PRODUCT_HALF + 1), 0, over_noise.size - 1)
+    return over_noise[k].max(axis=1) if bins.size else over_noise[:0]
 
 
 def _local_noise(P: np.ndarray) -> np.ndarray:
@@ -137,7 +143,7 @@ def _run_matches(run, channel: str, partner: str, power: dict | None = None) -> 
     :func:`_run_power` holding both, or None (made here)."""
     power = power or _run_power(run, (channel, partner))
     P, lines, _ = power[channel]
-    quiet = power[partner][2][lines] < PARTNER_QUIET
+    quiet = _level_at(power[partner][2], lines) < PARTNER_QUIET
     alone, shared = lines[quiet], lines[~quiet]
     if alone.size == 0 or shared.size == 0:
         return alone[:0], int(alone.size), 0.0
