@@ -13,7 +13,7 @@ blend more on the Welch window (2.6-5.5 dB for the pair above).  Where the searc
 resolves the two lines in enough runs: a ``missing_harmonic`` of route ``close``) the model holds both and its lines
 read 1 again; where it could not, the blend is described here, read as the search reads it
 (:func:`rwadist.effects.missing_harmonic_diagnose.hidden_in_window`) on the faster half of the runs where the line
-stands :data:`MIN_SNR_DB` over the record's noise.
+stands :data:`MIN_SNR_DB` over the record's noise, on :data:`MIN_POINTS` readings or more.
 """
 from __future__ import annotations
 
@@ -29,6 +29,9 @@ MIN_SNR_DB = 20.0
 #: The power the model's other lines predict in the line's window, over the line's own there, at most in a run that is
 #: read (:func:`rwadist.diagnose.describe_partial.others_in_window`)
 OTHERS_MAX = 0.1
+#: Readings (channel × run) at least: three (the search's own floor for trying a split) let the few top-speed runs of a
+#: broadband floor's noise or a lever arm's read as a blend (family wheel 7: +1.5 and +0.3 dB on 3 points each)
+MIN_POINTS = 6
 
 
 def blended_lines(ctx, state, of_line) -> list:
@@ -84,7 +87,7 @@ def blended_lines(ctx, state, of_line) -> list:
                 if keep.any():
                     read.add(c)
             r = np.concatenate(ratio) if ratio else np.empty(0)
-            if not hidden_in_window(r):
+            if r.size < MIN_POINTS or not hidden_in_window(r):
                 continue
             rows = np.unique(np.concatenate(used))
             rpm = ctx.omega[rows] * RAD_S_TO_RPM
