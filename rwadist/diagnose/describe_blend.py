@@ -41,8 +41,8 @@ def blended_lines(ctx, state, of_line) -> list:
     from .describe_partial import others_in_window
     from .measure import record_dfts
 
-    if not _steady(ctx, state):
-        return []
+    if not _steady(ctx, state) or (ctx.test.meta or {}).get("slicing") is not None:
+        return []                       # a sweep's slice holds each line as a chirp, on its record as on its Welch PSD
     runs = np.asarray(ctx.runs)
     w_hz = ctx.omega[runs] / (2 * np.pi)
     fast = runs[w_hz >= np.median(w_hz)]
