@@ -40,6 +40,18 @@ def _assert_pair(d, pair):
     assert d.unexplained == ()
 
 
+def _cage_pair(sep: float, ratio: float) -> tuple:
+    """(SteadyTest, cage line, added line) of family wheel 3 with its cage line co-rotating and a co-rotating radial-force
+    line ``sep`` above it at ``ratio`` × its C (28 speeds 500-4500 rpm, 12000 samples, 1 % noise)."""
+    wheel = fw.family()[3]
+    cage = next(x for x in wheel.lines if x.name == "cage")
+    extra = fw.Line("radial_force", cage.h + sep, ratio * cage.C, 1.0, "added")
+    wheel = fw.with_lines(wheel, [fw.Line(x.direction, x.h, x.C, 1.0, x.name) if x is cage else x
+                                  for x in wheel.lines] + [extra])
+    data = fw.steady(wheel, speeds_rpm=np.linspace(500.0, 4500.0, 28), n_samples=12000, noise=0.01, seed=5)
+    return steady_test(data), cage, extra
+
+
 def test_a_pair_one_welch_lobe_apart_on_the_e_like_wheel():
     pair = [(0.40, 0.04), (0.43, 0.10)]                 # thesis units; 0.03 apart: 1.6 Welch bins at 3000 rpm
     lines = list(iw.E_LINES) + [("radial_force", h, C, 1.0) for h, C in pair]
@@ -51,13 +63,7 @@ def test_a_pair_one_welch_lobe_apart_on_the_e_like_wheel():
 
 
 def test_a_cage_line_beside_an_added_line_on_a_family_wheel():
-    wheel = fw.family()[3]
-    cage = next(x for x in wheel.lines if x.name == "cage")
-    extra = fw.Line("radial_force", cage.h + 0.03, 2.5 * cage.C, 1.0, "added")
-    wheel = fw.with_lines(wheel, [fw.Line(x.direction, x.h, x.C, 1.0, x.name) if x is cage else x
-                                  for x in wheel.lines] + [extra])
-    data = fw.steady(wheel, speeds_rpm=np.linspace(500.0, 4500.0, 28), n_samples=12000, noise=0.01, seed=5)
-    test = steady_test(data)
+    test, cage, extra = _cage_pair(0.03, 2.5)
     # the two lines are one Welch lobe apart at the top speed: the premise of the test
     df = test.runs[0].sample_rate / diagnose_nperseg(test)
     assert 0.03 * 4500.0 / 60.0 < 2.0 * df
@@ -107,13 +113,8 @@ def test_a_pair_the_record_cannot_split_is_described_on_the_e_like_wheel():
 
 def test_a_pair_the_record_cannot_split_is_described_on_a_family_wheel():
     # the cage line and a line 0.008 beside it, as strong: under 1 record bin apart at 4500 rpm (3 s records)
-    wheel = fw.family()[3]
-    cage = next(x for x in wheel.lines if x.name == "cage")
-    extra = fw.Line("radial_force", cage.h + 0.008, cage.C, 1.0, "added")
-    wheel = fw.with_lines(wheel, [fw.Line(x.direction, x.h, x.C, 1.0, x.name) if x is cage else x
-                                  for x in wheel.lines] + [extra])
-    data = fw.steady(wheel, speeds_rpm=np.linspace(500.0, 4500.0, 28), n_samples=12000, noise=0.01, seed=5)
-    d = api.diagnose(steady_test(data))
+    test, cage, extra = _cage_pair(0.008, 1.0)
+    d = api.diagnose(test)
     _assert_blend_described(d, [(cage.h, cage.C), (extra.h, extra.C)], rel=0.03)
     assert d.unexplained[0].parameters["record_resolution_h"] > 0.008
 
@@ -122,13 +123,8 @@ def test_a_pair_inside_one_record_bin_invents_no_resonance():
     # the cage line and a line 0.003 beside it at 70 % of it: 0.7 record bin apart at 4500 rpm, so their beat changes
     # the pair's power from run to run on every record.  One line's scatter is no resonance: before, a 'structure
     # mode' at 12.2 Hz (ζ 0.033, gain 1.6) fitted on that line's runs alone was named a wheel-mode fixed_resonance
-    wheel = fw.family()[3]
-    cage = next(x for x in wheel.lines if x.name == "cage")
-    extra = fw.Line("radial_force", cage.h + 0.003, 0.7 * cage.C, 1.0, "added")
-    wheel = fw.with_lines(wheel, [fw.Line(x.direction, x.h, x.C, 1.0, x.name) if x is cage else x
-                                  for x in wheel.lines] + [extra])
-    data = fw.steady(wheel, speeds_rpm=np.linspace(500.0, 4500.0, 28), n_samples=12000, noise=0.01, seed=5)
-    d = api.diagnose(steady_test(data))
+    test, cage, extra = _cage_pair(0.003, 0.7)
+    d = api.diagnose(test)
     assert [e["kind"] for e in d.model.effects] == ["suspension_modes"]
     got = [x.h for x in d.model.harmonics("radial_force") if abs(x.h - cage.h) < 0.02]
     assert len(got) == 1 and cage.h - 1e-3 <= got[0] <= extra.h + 1e-3
