@@ -454,7 +454,7 @@ def _by_direction_t(ctx, state, runs, chans, applied, memo) -> float:
     return float(sorted(ts)[-2])
 
 
-def _base_lines(hyps, model=None) -> None:
+def _base_lines(hyps, model=None, left_out=()) -> None:
     """Mark the passing ``missing_harmonic`` hypotheses added after a ``suspension_modes`` as lines of the wheel's
     base (``Hypothesis.base_line``), not foreign effects.
 
@@ -468,7 +468,18 @@ def _base_lines(hyps, model=None) -> None:
     The same for a given ``model`` whose extended fit recorded lines it detected but could not measure apart
     (``analytical.fit.unresolved_lines``: a close pair on the reference's short record): a missing harmonic found
     inside such a span is the wheel's own content the model already said it could not measure, completed into the
-    model, not a foreign effect."""
+    model, not a foreign effect.
+
+    And a line the empirical base left out as modally amplified at nearly every speed (``left_out``: (direction, h)
+    of each) found again after a test-stand resonance was named: the fixture amplified it, and with the fixture
+    divided out it is the wheel's own line (the W7 trial wheel on a 120-Hz fixture: the three lines h 3.12)."""
+    stand_at = min((h.iteration for h in hyps if h.passed and getattr(h.effect, "role", "") == "test_stand"),
+                   default=None)
+    for h in hyps:
+        e = h.effect
+        if (stand_at is not None and h.passed and h.iteration > stand_at and getattr(e, "kind", "") == "missing_harmonic"
+                and any(d == e.direction and abs(x - e.h) <= 1e-3 * x for d, x in left_out)):
+            h.base_line = True
     for h in hyps:
         e = h.effect
         if (h.passed and getattr(e, "kind", "") == "missing_harmonic"
@@ -760,7 +771,7 @@ def _search_once(spectra: Spectra, model: WheelModel | None, k_sigma: float, min
             for h in hyps:
                 h.effect = revised.get(id(h.effect), h.effect)
             state = done
-    _base_lines(hyps, model)
+    _base_lines(hyps, model, getattr(ctx, "left_out", ()))
     out = improved_model(model, state, hyps)
     diag = Diagnosis(out, state0, state, _state_error(ctx, state0), _state_error(ctx, state), ctx.rms_error(state0),
                      ctx.rms_error(state), hyps, it, ctx, model_given=given)

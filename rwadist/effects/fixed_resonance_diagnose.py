@@ -9,7 +9,7 @@ from ..diagnose.constants import LINE_HALF, SNR_KNEE
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.state import State
-from ..resonance import log_power_gain_jacobian, resonance
+from ..resonance import log_power_gain_jacobian, numerator_damping, resonance
 from ..units import CHANNEL_DIRECTION, DIRECTION_CHANNELS, RADIAL_PAIRS
 
 #: Smallest peak gain (or 1/gain, an anti-resonance of a test stand) proposed: |H| within 10 % of 1 everywhere is the size of the
@@ -22,14 +22,15 @@ MIN_PEAK_GAIN = 1.1
 MAX_ZETA = 0.2
 
 
-def _line_gain_points(ctx, state, chans, runs):
+def _line_gain_points(ctx, state, chans, runs, with_lines: bool = False):
     """(f Hz, y, weight, direction) of every model line of ``chans`` on ``runs`` measured above the noise and at least
     2·LINE_HALF bins from the channel's other lines:
     y = ln(measured power / predicted power) = 2 ln(a_measured/a_predicted), the log power gain a
     further resonance would have to supply at the line's frequency f = h|Ω|/2π.  weight = s²/(s² + s_k²)
     with s the line's power over the noise power in its window and s_k = :data:`SNR_KNEE`: the scatter of
     a log power falls as 1/s for weak lines and is bounded by model error for strong ones.  direction: the load
-    direction of each point's channel (str).
+    direction of each point's channel (str).  ``with_lines``: two more, each point's line id (int) and the lines
+    ((direction, h) of each id, a list).
 
     On one radial direction's lines (``chans`` one pair, Fx/Fy or Tx/Ty: a wheel mode's fit) a line is read on the
     pair's power sum, one point for the pair (one measurement of the line: counted once where points are counted,
@@ -49,6 +50,7 @@ def _line_gain_points(ctx, state, chans, runs):
     from ..diagnose.describe_drift import drifting
 
     moving = drifting(ctx, state.model)
+    line_ids: dict = {}                 # (direction, h) -> its id (``with_lines``)
     offs = np.arange(-LINE_HALF, LINE_HALF + 1)
     read: dict = {}                     # channel -> {h: (f, measured power, predicted power, noise power, usable)}
     for c in chans:
@@ -69,7 +71,7 @@ def _line_gain_points(ctx, state, chans, runs):
             k = np.clip(np.rint(f / ctx.df).astype(int)[:, None] + offs, 0, ctx.f.size - 1)
             n_pow = np.take_along_axis(noise, k, axis=1).sum(1) * ctx.df
             read[c][float(h)] = (f, np.where(ok, a, 0.0) ** 2 / 2, a_pred ** 2 / 2, n_pow, ok)
-    fs, ys, ws, ds = [], [], [], []
+    fs, ys, ws, ds, ids = [], [], [], [], []
     one_pair = any(set(chans) == set(x) for x in RADIAL_PAIRS)
     for c in chans:
         pair = next((x for x in RADIAL_PAIRS if c in x), (c, c))
@@ -88,9 +90,12 @@ def _line_gain_points(ctx, state, chans, runs):
             ys.append(np.log(p[ok] / p_pred[ok]))
             ws.append(snr ** 2 / (snr ** 2 + SNR_KNEE**2))
             ds.append(np.full(int(ok.sum()), CHANNEL_DIRECTION[c]))
+            ids.append(np.full(int(ok.sum()), line_ids.setdefault((CHANNEL_DIRECTION[c], h), len(line_ids))))
     if not fs:
-        return np.empty(0), np.empty(0), np.empty(0), np.empty(0, str)
-    return np.concatenate(fs), np.concatenate(ys), np.concatenate(ws), np.concatenate(ds)
+        out = (np.empty(0), np.empty(0), np.empty(0), np.empty(0, str))
+        return out + (np.empty(0, int), []) if with_lines else out
+    out = (np.concatenate(fs), np.concatenate(ys), np.concatenate(ws), np.concatenate(ds))
+    return out + (np.concatenate(ids), list(line_ids)) if with_lines else out
 
 
 def _lifted_directions(e: "FixedResonance", f: np.ndarray, y: np.ndarray, w: np.ndarray, dirs: np.ndarray) -> int:
@@ -306,6 +311,38 @@ def moves_with_speed(ctx: Context, state: State, e: "FixedResonance") -> bool:
                 and split["moved"] > max(split["zeta"], SPLIT_MIN_MOVE))
 
 
+def _fit_stand_with_levels(ctx: Context, state: State, channels, chans, runs, f0, n_iter) -> "FixedResonance | None":
+    """A test-stand resonance on the empirical base fitted with the levels of the lines it reaches
+    (:func:`rwadist.effects.fixed_resonance_levels.fit_with_levels`); ``n_iter`` passes, each re-measuring the lines
+    with the previous pass's resonance (not its levels) in the state; None when no resonance is reached."""
+    from dataclasses import replace
+
+    from .fixed_resonance_levels import fit_with_levels, starts_of
+
+    lo, hi = ctx.k_lo * ctx.df, ctx.k_hi * ctx.df
+    e, st = None, state
+    for _ in range(n_iter):
+        f, y, wt, dirs, ids, keys = _line_gain_points(ctx, st, chans, runs, with_lines=True)
+        if e is not None:
+            y = y + np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2)
+            starts = [(e.f_r, e.zeta, numerator_damping(e.zeta, e.peak_gain, e.gain_above), e.gain_above)]
+        else:
+            starts = starts_of(f, y, wt, ids, lambda f_, y_: FixedResonance.peak(f_, y_, lo, hi, ctx.df), f0)
+        got = fit_with_levels(f, y, wt, ids, lo, hi, starts) if starts else None
+        if got is None:
+            return None
+        f_r, zeta, gain, above, levels, _ = got
+        e = FixedResonance(f_r, zeta, gain, tuple(channels), "test_stand", int(f.size), gain_above=above,
+                           line_levels=tuple((d, h, float(np.exp(v / 2))) for (d, h), v in zip(keys, levels)
+                                             if v != 0.0))
+        st = replace(e, line_levels=()).apply(state)
+    if e is None or not reached(f, e.f_r, e.zeta, e.peak_gain):
+        return None
+    # the directions it lifts, read on each line's gains about its fitted level
+    y_level = y - levels[ids]
+    return replace(e, lifted_directions=_lifted_directions(e, f, y_level, wt, dirs))
+
+
 @register(order=40)
 @dataclass
 class FixedResonance:
@@ -335,9 +372,25 @@ class FixedResonance:
     #: lines; -1 when not counted (a wheel mode, a stand of the modes'
     #: extended fit, which has its own rule: :func:`rwadist.stand_resonance.lifts_every_direction`)
     lifted_directions: int = -1
+    #: (direction, h, factor) of each empirical-base line whose C was fitted with the resonance
+    #: (:mod:`.fixed_resonance_levels`: a test stand on the empirical base), multiplying that C when applied
+    line_levels: tuple = ()
 
     def apply(self, state: State) -> State:
+        if self.line_levels and state.ext is None:
+            s = self.levelled(state)
+            s.effects.append(self)
+            return s
         return state.plus(self)
+
+    def levelled(self, state: State) -> State:
+        """A new ``state`` with the line levels fitted with the resonance (:attr:`line_levels`) and not the resonance
+        itself."""
+        from .fixed_resonance_levels import levelled_harmonics
+
+        s = state.copy()
+        s.model.empirical = levelled_harmonics(s.model, self.line_levels)
+        return s
 
     def contribute(self, parts) -> None:
         parts.resonances.append((self.f_r, self.zeta, self.peak_gain, tuple(self.channels), self.gain_above))
@@ -456,6 +509,8 @@ class FixedResonance:
 
         from scipy.optimize import least_squares
 
+        if role == "test_stand" and state.ext is None:
+            return _fit_stand_with_levels(ctx, state, channels, chans, runs, f0, n_iter)
         f, y, wt, dirs = _line_gain_points(ctx, state, chans, runs)
         lo, hi = ctx.k_lo * ctx.df, ctx.k_hi * ctx.df
         pk = FixedResonance.peak(f, y, lo, hi, ctx.df)
@@ -568,7 +623,9 @@ class FixedResonance:
         # nor a resonance whose centre moves with the speed, read on every run (:func:`moves_with_speed`): a fixed one
         # fitted to it was added as a wheel mode (family wheel 4, an axial disc mode stiffening 149 -> 167 Hz over
         # 300-3000 rpm: a 'wheel mode' at 158.5 Hz; the slower half of the runs wants 151.7 Hz, the faster 159.3 Hz)
-        return [e for e in out if not moves_with_speed(ctx, state, e)]
+        # (read with the line levels fitted with it: a fixture biases the base's C, and a line read against a biased C
+        # lifts the half of the speeds on the fixture's other side, W7 trial wheel on a 120-Hz fixture)
+        return [e for e in out if not moves_with_speed(ctx, e.levelled(state) if e.line_levels else state, e)]
 
 
 #: A test stand's frequency as one direction's lines may read it (:func:`patches_a_stand`): one structure under the
@@ -647,7 +704,7 @@ def stands_beside_offset(ctx: Context, state: State) -> State:
         new = FixedResonance.fit(ctx, without, stand.channels, ctx.runs, stand.f_r, stand.role)
         if new is None or not new.significant():
             continue
-        trial = state.copy()
+        trial = new.levelled(without) if new.line_levels and without.ext is None else state.copy()
         trial.effects = [new if e is stand else e for e in state.effects]
         if ctx.error(trial) < ctx.error(state):
             state = trial

@@ -664,7 +664,28 @@ class SuspensionModes:
             # half of a short speed grid can miss a sharp mode's peak (its damping runs to the fit's floor and no mode
             # is located) while the other half holds it: the other fold, judged on these runs
             e = _held_out_fold(ctx, state)
-        return [] if e is None else [e]
+        return [] if e is None or one_fixed_resonance(e) else [e]
+
+
+#: The least I_zz/I_rr of a wheel's rotor (a disc is 2, a rim-weighted one up to ~2.2; 0.5 is a cylinder ~1.7x as
+#: long as it is wide): below it the rocking whirl barely moves with the speed (:func:`one_fixed_resonance`)
+MIN_WHEEL_INERTIA_RATIO = 0.5
+#: ... and the located modes lie within this factor of one another
+ONE_RESONANCE_SPREAD = 1.05
+
+
+def one_fixed_resonance(e: SuspensionModes) -> bool:
+    """Whether the suspension modes ``e`` are one fixed resonance on every channel, not a wheel's: two or more modes
+    located within :data:`ONE_RESONANCE_SPREAD` of one frequency and a rotor whose whirl does not move with the speed
+    (I_zz/I_rr below :data:`MIN_WHEEL_INERTIA_RATIO`).  That is a fixture's signature (issue 33: the stand is the one
+    resonance whose frequency does not move with speed and that lifts every line near it on all channels), and the
+    test-stand resonance fitted with the lines' levels takes it (:mod:`rwadist.effects.fixed_resonance_levels`).  A
+    wheel with no suspension modes on a 180-Hz fixture (the W7 trial wheel, ζ 0.03): translation, rocking and axial at
+    179.9, 179.6 and 179.9 Hz with I_zz/I_rr 0.02 were named its suspension modes, and the fixture went into the flight
+    PSD (axial RMS 3.8x the hard-mounted one)."""
+    located = [f for m, f in e.f0_Hz.items() if m not in e.unconstrained]
+    return bool(len(located) >= 2 and max(located) <= ONE_RESONANCE_SPREAD * min(located)
+                and e.inertia_ratio < MIN_WHEEL_INERTIA_RATIO)
 
 
 def _held_out_fold(ctx: Context, state: State) -> "SuspensionModes | None":
