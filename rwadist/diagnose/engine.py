@@ -329,10 +329,10 @@ class Context(Metric):
         """Per entry of :meth:`channel_lines` of channel ``c``: the share of its power squared that the cross terms of
         its parts carry in variance, Σ_{i<j} 2·P_i·P_j / (Σ P)² per run (parts of one h acting on the channel with
         independent phases: a co/counter pair of one radial line, whose cross term 2·√(P₊P₋)·cos Δφ is constant over a
-        run's Welch segments, of zero mean and variance 2·P₊·P₋ over the runs' phases); zeros on the empirical base
-        (one part per line)."""
+        run's Welch segments, of zero mean and variance 2·P₊·P₋ over the runs' phases); on the empirical base
+        :meth:`State.mixing_shares` (0 for a line of one part)."""
         if state.ext is None:
-            return [np.zeros(runs.size) for _ in state.lines(c)]
+            return [np.full(runs.size, share) for share in state.mixing_shares(c)]
         return self._ext_lines_of(state, runs)[1].get(c, [])
 
     def _ext_lines_of(self, state: State, runs: np.ndarray) -> tuple:

@@ -36,6 +36,10 @@ class Prediction:
     modulations: list = field(default_factory=list)
     speed_modulation: tuple | None = None
     smear: float | None = None
+    #: (direction, h rounded to 4 places) -> e: the line's x/y power split on the empirical base, x C·sqrt(1 + e) and y
+    #: C·sqrt(1 − e) (a co + counter pair whose ellipse keeps one orientation in the stator, :mod:`rwadist.effects.
+    #: counter_rotation_diagnose`)
+    xy_splits: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -161,10 +165,41 @@ class State:
         return out
 
     def lines(self, channel: str):
-        """(h, amplitude function of omega) for every harmonic acting on ``channel``."""
+        """(h, C, amplitude law or None) of every line acting on ``channel``: harmonics of one h (a co and a counter
+        part of a radial line, :mod:`rwadist.effects.counter_rotation_diagnose`) merged into one line of their
+        root-sum-square C (independent phases: the expected power; the pair's cross term cancels between x and y)."""
         d = CHANNEL_DIRECTION[channel]
-        out = []
+        out: list = []
         for hm in self.model.harmonics(d):
-            law = self.laws.get((d, round(hm.h, 4)))
-            out.append((hm.h, hm.C, law))
+            if out and out[-1][0] == hm.h:
+                out[-1] = (hm.h, float((out[-1][1] ** 2 + hm.C ** 2) ** 0.5), out[-1][2])
+                continue
+            out.append((hm.h, hm.C, self.laws.get((d, round(hm.h, 4)))))
+        splits = self.prediction.xy_splits
+        if splits and channel in ("Fx", "Fy", "Tx", "Ty"):
+            sign = 1.0 if channel in ("Fx", "Tx") else -1.0
+            out = [(h, C * (1.0 + sign * splits.get((d, round(h, 4)), 0.0)) ** 0.5, law) for h, C, law in out]
+        return out
+
+    def mixing_shares(self, channel: str) -> list:
+        """Per line of :meth:`lines`: the share of its power squared the cross terms of its parts carry in variance,
+        Σ_{i<j} 2·P_i·P_j / (Σ P)² (a co and a counter part of independent phases: their cross term is constant over a
+        run and of zero mean over the runs); 0 for a line of one part, or one whose x/y split is known (the parts' phase
+        held by the stator: the cross term is predicted, :attr:`Prediction.xy_splits`)."""
+        d = CHANNEL_DIRECTION[channel]
+        powers: list = []
+        last = None
+        for hm in self.model.harmonics(d):
+            if powers and last == hm.h:
+                powers[-1].append(hm.C ** 2)
+            else:
+                powers.append([hm.C ** 2])
+            last = hm.h
+        hs = [x[0] for x in self.lines(channel)]
+        splits = self.prediction.xy_splits
+        out = []
+        for h, p in zip(hs, powers):
+            total = sum(p)
+            out.append(0.0 if len(p) < 2 or total <= 0 or (d, round(h, 4)) in splits
+                       else (total ** 2 - sum(x * x for x in p)) / total ** 2)
         return out

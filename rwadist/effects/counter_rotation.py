@@ -25,14 +25,20 @@ class CounterRotation(Element):
     counter_fraction_stderr: float | None = field(default=None, metadata=check(statistic(ge=0.0, le=1.0)))
     counter_fraction_phase: float | None = field(default=None, metadata=check(statistic(ge=-4 * math.pi, le=4 * math.pi)))
     n_points: int | None = field(default=None, metadata=check(COUNT))
+    #: (P_x − P_y)/(P_x + P_y) of the line measured hard mounted when every run agrees on it: the ellipse of a co and a
+    #: counter part held in one orientation by the stator (an anisotropic mount); None when not measured
+    xy_split: float | None = field(default=None, metadata=check(statistic(ge=-1.0, le=1.0)))
 
     @classmethod
     def describe(cls, e: Mapping) -> str:
         q = float(e["counter_fraction"])
         # q is a share of the line's power; an engineer's "25 % counter" is often the amplitudes' ratio
         ratio = f" (power; counter/co amplitude {math.sqrt(q / (1.0 - q)):.3g})" if 0.0 <= q < 1.0 else " (power)"
+        split = e.get("xy_split")
+        held = (f"; x/y power split {float(split):+.3g} in every run: the ellipse held in one orientation by the "
+                f"stator (an anisotropic mount or bearing)") if split else ""
         return (f"{words(e['direction'])}, h {num(e['h'])}, counter-rotating fraction q "
-                f"{num(e['counter_fraction'], '.3g')}{plus_minus(e, 'counter_fraction_stderr')}{ratio}")
+                f"{num(e['counter_fraction'], '.3g')}{plus_minus(e, 'counter_fraction_stderr')}{ratio}{held}")
 
     # ------------------------------------------------------------------ injection
     #: ``counter_rotation:direction=radial_force,h=1,fraction=0.3``: that share of the line's power turned against

@@ -1,4 +1,4 @@
-"""``counter_rotation``: counter-rotating content of a radial harmonic (extended base only)."""
+"""``counter_rotation``: counter-rotating content of a radial harmonic (the extended base; the imbalance order alone on the empirical base)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -16,11 +16,12 @@ from ..units import CHANNELS, DIRECTION_CHANNELS
 def _sense_group(state: State, direction: str, h: float):
     """The state's extended lines of (direction, h) (|Δh| < LAW_H_TOL) when they are all co- or counter-rotating and
     carry no amplitude law: (h of the group, C_co, C_counter, imbalance?) with C the root-sum-square of the lines'
-    C (kg·m or kg·m², per (rad/s)²; an imbalance's C is U_s or U_d of the analytical section); else None."""
+    C (kg·m or kg·m², per (rad/s)²; an imbalance's C is U_s or U_d of the analytical section); else None.  On the
+    empirical base the same of its harmonics of the imbalance's order h = 1 (:func:`_empirical_group`)."""
     from .. import extended as ext
 
     if state.ext is None:
-        return None
+        return _empirical_group(state, direction, h)
     g = [ln for ln in state.ext_lines() if ln.direction == direction and abs(ln.h - h) < ext.LAW_H_TOL]
     if not g or any(ln.sense == "planar" or ln.law is not None for ln in g):
         return None
@@ -31,10 +32,34 @@ def _sense_group(state: State, direction: str, h: float):
     return float(g[0].h), c_co, c_ct, any(ln.imbalance for ln in g)
 
 
+#: The one line whose counter-rotating part is an effect on the empirical base: the imbalance's order h = 1 (within
+#: this).  Every other line of a hard-mounted wheel turns as its source does (a bearing line may hold both senses), and
+#: a part of either sense is the line's own, not an effect; the imbalance turns with the rotor, and a counter-rotating
+#: part of it is what the extended base names too (an anisotropic suspension or mount, a planar load at 1x).
+EMPIRICAL_H = 1.0
+EMPIRICAL_H_TOL = 1e-3
+
+
+def _empirical_group(state: State, direction: str, h: float):
+    """(h, C_co, C_counter, False) of the empirical base's harmonics of (direction, h) at the imbalance's order h = 1
+    (:data:`EMPIRICAL_H`): a sense of None counted as co (the imbalance turns with the rotor); None for another h, a
+    planar harmonic or one under an amplitude law."""
+    if abs(h - EMPIRICAL_H) > EMPIRICAL_H_TOL:
+        return None
+    g = [x for x in state.model.harmonics(direction) if abs(x.h - h) <= EMPIRICAL_H_TOL]
+    if not g or any(x.sense == "planar" for x in g) or (direction, round(g[0].h, 4)) in state.laws:
+        return None
+    c_co = float(np.sqrt(sum(x.C**2 for x in g if x.sense != "counter")))
+    c_ct = float(np.sqrt(sum(x.C**2 for x in g if x.sense == "counter")))
+    if c_co**2 + c_ct**2 <= 0:
+        return None
+    return float(g[0].h), c_co, c_ct, False
+
+
 @register(order=80)
 @dataclass
 class CounterRotation:
-    """Counter-rotating content of a radial harmonic (extended base only).
+    """Counter-rotating content of a radial harmonic (any line of the extended base; the imbalance order h = 1 of the empirical base).
 
     The radial load of harmonic h is F = a₊e^{+iσθ} + a₋e^{−iσθ} (θ = h·φ, φ the rotor angle, complex x + iy
     coordinates): a co-rotating part a₊ and a counter-rotating part a₋ (a planar, anisotropic load is
@@ -56,6 +81,19 @@ class CounterRotation:
     counter_fraction_phase: float = float("nan")
     n_points: int = 0
     kind: str = "counter_rotation"
+    #: e = (P_x − P_y)/(P_x + P_y) of the line on the empirical base when the runs agree on it (:func:`xy_split`): a co
+    #: and a counter part whose ellipse keeps one orientation in the stator (an anisotropic mount or bearing), x read
+    #: C·sqrt(1 + e) and y C·sqrt(1 − e); 0 when it changes from run to run (the parts' phases of their own) or on the
+    #: extended base
+    xy_split: float = 0.0
+    #: the line's total C (co and counter parts' root-sum-square) measured with the split on the empirical base, from the
+    #: x + y power of the phasors, or 0 (the state's kept): the empirical fit of C on an ellipse's x and y amplitudes
+    #: reads their mean, below the root-mean-square (the W7 trial wheel, q 0.083 held at one orientation: 3 % low)
+    c_total: float = 0.0
+
+    def contribute(self, parts) -> None:
+        if self.xy_split:
+            parts.xy_splits[(self.direction, round(self.h, 4))] = self.xy_split
 
     @property
     def channels(self):
@@ -66,7 +104,7 @@ class CounterRotation:
         g = _sense_group(state, self.direction, self.h)
         if g is None:
             raise ValueError(f"counter_rotation: no co/counter line {self.direction} h = {self.h} in the state")
-        c_tot = float(np.hypot(g[1], g[2]))
+        c_tot = self.c_total if self.c_total > 0 else float(np.hypot(g[1], g[2]))
         q = float(np.clip(self.counter_fraction, 0.0, 1.0))
         return c_tot * np.sqrt(1.0 - q), c_tot * np.sqrt(q)
 
@@ -92,6 +130,11 @@ class CounterRotation:
             s.model.analytical = dict(s.model.analytical or {}, **ext.params_to_dict(s.ext))
             scale = c_co / c_co0 if c_co0 > 0 else 0.0
             new += [replace(x, C=x.C * scale) for x in at_h if x.sense != "counter"]
+        elif c_co > 0 and s.ext is None and at_h:
+            # the empirical base's line keeps what its fit measured (its standard error scaled alike)
+            x = at_h[0]
+            new.append(replace(x, h=h_key, C=c_co, sense="co",
+                               C_stderr=None if x.C_stderr is None else x.C_stderr * c_co / max(x.C, 1e-300)))
         elif c_co > 0:
             new.append(Harmonic(h=h_key, C=c_co, sense="co"))
         if c_ct > 0:
@@ -123,6 +166,7 @@ class CounterRotation:
         return {"direction": self.direction, "h": round(self.h, 4), "counter_fraction": self.counter_fraction,
                 "counter_fraction_stderr": self.counter_fraction_stderr,
                 "counter_fraction_phase": self.counter_fraction_phase, "n_points": self.n_points,
+                **({"xy_split": self.xy_split} if self.xy_split else {}),
                 "law": "radial load C*omega^2*(sqrt(1-q) e^{+i h phi} + sqrt(q) e^{-i h phi}), q = counter_fraction "
                        "= |a-|^2/(|a+|^2+|a-|^2); model: a co harmonic C*sqrt(1-q) and a counter one C*sqrt(q)"}
 
@@ -229,7 +273,12 @@ class CounterRotation:
         var_a = np.sum((noise**2 + 2 * np.maximum(co - noise, 0) * noise) / gp**2)
         var_b = np.sum((noise**2 + 2 * np.maximum(ct - noise, 0) * noise) / gn**2)
         se = float(np.sqrt(var_b * (1 - q) ** 2 + var_a * q**2) / tot)
-        return CounterRotation(direction, float(h), q, se, q, int(ok.sum()))
+        split, c_total = 0.0, 0.0
+        if state.ext is None:
+            split = xy_split(ctx, state, direction, h, runs, q)
+            w4 = ctx.omega[runs][ok] ** 4
+            c_total = float(np.sqrt(max(float(np.sum((a + b) * w4) / np.sum(w4 * w4)), 0.0)))
+        return CounterRotation(direction, float(h), q, se, q, int(ok.sum()), xy_split=split, c_total=c_total)
 
     def heldout_evidence(self, ctx: Context, state: State, runs):
         """Held-out evidence of a split the PSDs cannot see (:meth:`fit_phase`): (drop, se), in the units of the
@@ -237,6 +286,8 @@ class CounterRotation:
         Σ_runs |co − n − M₊| + |counter − n − M₋|, M± the model's co and counter mean squares of the line
         (its x + y power through the modal gains, before and after this effect); se as the search's judge
         (Σ min(|ΔM|, σ)², σ² = n² + 2Pn).  None when the effect changes the PSDs (the search's own judge)."""
+        if self.xy_split:
+            return None         # the split changes the x and y PSDs: the search's own judge
         g = _sense_group(state, self.direction, self.h)
         pw = CounterRotation._phase_powers(ctx, state, self.direction, self.h, runs)
         if g is None or pw is None or CounterRotation._sees_senses(ctx, state, self.direction, self.h, runs):
@@ -312,21 +363,21 @@ class CounterRotation:
     def candidates(ctx: Context, state: State, runs) -> list:
         """Every co/counter radial harmonic of the extended base not yet split, whose fitted q departs from the
         state's own (0 for a co line, 1 for a counter line) by more than 0.01 and 2 standard errors."""
-        if state.ext is None:
-            return []
+        if state.ext is None and ctx.test is None:
+            return []           # the empirical base's x/y phase is read on the records
         done = {(e.direction, round(e.h, 3)) for e in state.effects if isinstance(e, CounterRotation)}
         out = []
         if ctx.test is not None:
             # the x/y phasors of every line (:meth:`_phase_powers`) in one pass over the records
             h0s = [g[0] for d in ("radial_force", "radial_torque")
                    if all(c in ctx.channels for c in DIRECTION_CHANNELS[d])
-                   for h in sorted({round(ln.h, 4) for ln in state.ext_lines() if ln.direction == d})
+                   for h in _line_orders(state, d)
                    if (g := _sense_group(state, d, h)) is not None and (d, round(h, 3)) not in done]
             if h0s:
                 ctx.prefetch_phasors(runs, np.outer(ctx.omega[runs], h0s) / (2 * np.pi))
         def split(d) -> list:
             found = []
-            for h in sorted({round(ln.h, 4) for ln in state.ext_lines() if ln.direction == d}):
+            for h in _line_orders(state, d):
                 g = _sense_group(state, d, h)
                 if g is None or (d, round(h, 3)) in done:
                     continue
@@ -342,3 +393,46 @@ class CounterRotation:
                 # a direction's split from its own channels alone (Context.reuse)
                 out += ctx.reuse("counter_rotation", state, chans, runs, lambda d=d: split(d))
         return out
+
+
+def _line_orders(state: State, direction: str) -> list:
+    """The orders h (rounded to 4 places, sorted) of the state's lines of ``direction``: the extended base's lines, or
+    the empirical base's harmonics."""
+    if state.ext is None:
+        return sorted({round(x.h, 4) for x in state.model.harmonics(direction)})
+    return sorted({round(ln.h, 4) for ln in state.ext_lines() if ln.direction == direction})
+
+
+#: The x/y split is kept when its weighted mean over the runs stands this many standard errors from 0 (the runs'
+#: scatter about it): a split whose sign and size change from run to run is the parts' phases of their own
+XY_SPLIT_MIN_T = 5.0
+
+
+def xy_split(ctx: Context, state: State, direction: str, h: float, runs, q: float) -> float:
+    """e = Σ(P_x − P_y)/Σ(P_x + P_y) of the line (direction, h) over ``runs`` from the x/y phasors (each run's line
+    powers less the noise's expected share), when the runs agree on it (:data:`XY_SPLIT_MIN_T`), else 0.
+
+    A radial load z = x + iy = a₊e^{iθ} + a₋e^{−iθ} reads |x|² ∝ |a₊|² + |a₋|² + 2|a₊||a₋|cos ψ and |y|² with −, ψ the
+    phase of a₊a₋: twice the ellipse's orientation in the stator.  An anisotropic mount or bearing holds ψ at every
+    run (x cos θ and y sin θ of different stiffness), so e = 2·sqrt(q(1 − q))·cos ψ the same in every run, bounded by
+    that of q; a counter part of its own phase (a second source) turns ψ from run to run and e averages out."""
+    h0 = _sense_group(state, direction, h)[0]
+    cx, cy = DIRECTION_CHANNELS[direction]
+    w = ctx.omega[runs]
+    f = h0 * np.abs(w) / (2 * np.pi)
+    inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
+    X = ctx.phasors(runs, (h0 * w / (2 * np.pi))[:, None])[:, 0, :]
+    px, py = np.abs(X[:, CHANNELS.index(cx)]) ** 2, np.abs(X[:, CHANNELS.index(cy)]) ** 2
+    ok = inb & np.isfinite(px) & np.isfinite(py) & (px + py > 0)
+    if ok.sum() < 3:
+        return 0.0
+    px, py = px[ok], py[ok]
+    e_run = (px - py) / (px + py)
+    wt = (px + py) / np.sum(px + py)
+    e = float(np.sum(wt * e_run))
+    n_eff = 1.0 / float(np.sum(wt**2))
+    scatter = float(np.sqrt(np.sum(wt * (e_run - e) ** 2)))
+    if abs(e) < XY_SPLIT_MIN_T * max(scatter, 1e-12) / np.sqrt(n_eff):
+        return 0.0
+    bound = 2.0 * np.sqrt(max(q * (1.0 - q), 0.0))
+    return float(np.clip(e, -bound, bound))

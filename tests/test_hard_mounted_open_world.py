@@ -1,0 +1,118 @@
+"""A hard-mounted wheel (no suspension modes in its band) on the default path (no model given): a fixture resonance
+under it, and a counter-rotating part of its imbalance held by an anisotropic mount.
+
+Data: this file's own generator (numpy): a wheel of radial-force lines h 0.41, 1, 2, 3.12 and 4.88, radial-torque lines
+h 1 and 3.12, axial-force lines h 2, 3.12 and 4.88, each C·Ω² at a random phase per run, white sensor noise.  The fixture
+is the transmissibility of a mass on a spring, H = 1/(1 − r² + 2jζr) (r = f/f_r), on every channel: it lifts the lines
+near f_r by 1/(2ζ) and attenuates those above it as 1/r² (the form the W7 trial put under its wheel).  The
+anisotropic mount reads the imbalance as x = k_x·a cos θ, y = k_y·a sin θ: a co part (k_x + k_y)/2 and a counter part
+(k_x − k_y)/2, an ellipse held along the stator's x axis at every run.  Truth in closed form: the counter fraction
+q = (k_x − k_y)²/(2(k_x² + k_y²)) and the x/y power split e = (k_x² − k_y²)/(k_x² + k_y²)."""
+import numpy as np
+import pytest
+
+from rwadist import api
+from rwadist.data import Run, SteadyTest
+from rwadist.resonance import resonance
+
+FS, N, SPEEDS_RPM = 2000.0, 8192, np.linspace(500.0, 4000.0, 24)
+#: (direction, h, C): kg·m forces, kg·m² torques
+LINES = [("radial_force", 1.0, 3e-6), ("radial_force", 2.0, 2.5e-7), ("radial_force", 0.41, 3e-7),
+         ("radial_force", 3.12, 4e-7), ("radial_force", 4.88, 2e-7), ("radial_torque", 1.0, 4e-7),
+         ("radial_torque", 3.12, 5e-8), ("axial_force", 2.0, 1e-7), ("axial_force", 3.12, 2e-7),
+         ("axial_force", 4.88, 1.2e-7)]
+F_FIX, ZETA_FIX = 150.0, 0.03
+
+
+def _test(fixture: bool = False, k_xy=(1.0, 1.0), random_orientation: bool = False, seed: int = 4) -> SteadyTest:
+    rng = np.random.default_rng(seed)
+    t = np.arange(N) / FS
+    top = max(SPEEDS_RPM) * np.pi / 30
+    sd = {"F": 0.01 * 3e-6 * top**2, "T": 0.01 * 4e-7 * top**2}
+    runs = []
+    for i, rpm in enumerate(SPEEDS_RPM):
+        om = rpm * np.pi / 30.0
+        sig = {c: sd[c[0]] * rng.standard_normal(N) for c in ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")}
+        for d, h, C in LINES:
+            f = h * om / (2 * np.pi)
+            H = 1.0 / (1 - (f / F_FIX) ** 2 + 2j * ZETA_FIX * f / F_FIX) if fixture else 1.0
+            theta = h * om * t + rng.uniform(0, 2 * np.pi)
+            a = C * om**2 * np.abs(H)
+            theta = theta + np.angle(H)
+            if d == "axial_force":
+                sig["Fz"] += a * np.cos(theta)
+                continue
+            x, y = ("Fx", "Fy") if d == "radial_force" else ("Tx", "Ty")
+            kx, ky = k_xy if (d, h) == ("radial_force", 1.0) else (1.0, 1.0)
+            if random_orientation and kx != ky:
+                # the counter part of a phase of its own: the ellipse turns from run to run
+                co, ct = 0.5 * (kx + ky), 0.5 * (kx - ky)
+                z = a * (co * np.exp(1j * theta) + ct * np.exp(-1j * (theta + rng.uniform(0, 2 * np.pi))))
+                sig[x] += z.real
+                sig[y] += z.imag
+            else:
+                sig[x] += kx * a * np.cos(theta)
+                sig[y] += ky * a * np.sin(theta)
+        runs.append(Run(speed=om, sample_rate=FS, signals=sig, name=f"run_{i:02d}.csv"))
+    return SteadyTest(runs, {"sample_rate_hz": FS})
+
+
+def _kinds(d) -> list:
+    return [e["kind"] for e in d.model.effects]
+
+
+def test_a_fixture_under_a_hard_mounted_wheel_is_the_test_stand_not_its_modes():
+    """Before: the fixture was named the wheel's suspension modes (translation, rocking and axial at f_r, I_zz/I_rr
+    0.02) and went into the model's PSD, or nothing was named and the lines above it were fitted 3-13x low."""
+    d = api.diagnose(_test(fixture=True))
+    assert "suspension_modes" not in _kinds(d)
+    (stand,) = [e for e in d.model.effects if e["kind"] == "fixed_resonance"]
+    assert stand["role"] == "test_stand"
+    assert stand["f_Hz"] == pytest.approx(F_FIX, rel=2e-3)
+    assert stand["zeta"] == pytest.approx(ZETA_FIX, rel=0.05)
+    assert stand["peak_gain"] == pytest.approx(1 / (2 * ZETA_FIX), rel=0.05)
+    # its gain where the lines read it (up to 4.88 x 4000 rpm, 325 Hz, r 2.2; above, its gain far above is not
+    # measured: 0.06 for the truth's 0)
+    f = np.array([40.0, 75.0, 140.0, 160.0, 225.0, 300.0])
+    assert np.abs(resonance(f, stand["f_Hz"], stand["zeta"], stand["peak_gain"], stand["gain_above"])) == \
+        pytest.approx(np.abs(1 / (1 - (f / F_FIX) ** 2 + 2j * ZETA_FIX * f / F_FIX)), rel=0.02)
+    # the lines' C fitted with the fixture divided out: the generator's
+    for direction, h, C in LINES:
+        got = [x.C for x in d.model.harmonics(direction) if abs(x.h - h) < 1e-3]
+        assert len(got) == 1 and got[0] == pytest.approx(C, rel=0.03), (direction, h, got)
+    assert d.error_after < 0.01 * d.error_before
+
+
+def test_a_clean_hard_mounted_wheel_is_left_alone():
+    d = api.diagnose(_test())
+    assert _kinds(d) == [] and not d.unexplained
+
+
+def test_an_anisotropic_mount_is_a_counter_rotating_imbalance_held_in_one_orientation():
+    """Before: nothing named, nothing described, Fx and Fy predicted alike (the error figure 2.3 x 10^4 the clean one)."""
+    kx, ky = 1.3, 0.7
+    clean = api.diagnose(_test()).error_after
+    d = api.diagnose(_test(k_xy=(kx, ky)))
+    (e,) = [e for e in d.model.effects if e["kind"] == "counter_rotation"]
+    assert e["direction"] == "radial_force" and e["h"] == 1.0
+    q = (kx - ky) ** 2 / (2 * (kx**2 + ky**2))
+    assert e["counter_fraction"] == pytest.approx(q, rel=0.02)
+    assert e["xy_split"] == pytest.approx((kx**2 - ky**2) / (kx**2 + ky**2), rel=0.02)
+    # the model's imbalance: its co and counter parts, whose power sum is the generator's ((k_x² + k_y²)/2 · C²)
+    parts = {x.sense: x.C for x in d.model.harmonics("radial_force") if x.h == 1.0}
+    assert set(parts) == {"co", "counter"}
+    assert np.hypot(parts["co"], parts["counter"]) == pytest.approx(3e-6 * np.sqrt((kx**2 + ky**2) / 2), rel=0.01)
+    assert d.error_after < 3 * clean < 0.01 * d.error_before
+
+
+def test_a_counter_part_of_its_own_phase_is_named_without_a_split():
+    """The ellipse turns from run to run: the counter fraction is named, no x/y split, and the parts' cross term is
+    the allowance of the metric (before: nothing named, the error figure 9.7 x 10^3 the clean one)."""
+    kx, ky = 1.3, 0.7
+    clean = api.diagnose(_test()).error_after
+    d = api.diagnose(_test(k_xy=(kx, ky), random_orientation=True))
+    (e,) = [e for e in d.model.effects if e["kind"] == "counter_rotation"]
+    assert e["counter_fraction"] == pytest.approx(((kx - ky) / (kx + ky)) ** 2 / (1 + ((kx - ky) / (kx + ky)) ** 2),
+                                                  rel=0.05)
+    assert "xy_split" not in e
+    assert d.error_after < 3 * clean
