@@ -24,7 +24,8 @@ LINES = [("radial_force", 1.0, 3e-6), ("radial_force", 2.0, 2.5e-7), ("radial_fo
 F_FIX, ZETA_FIX = 150.0, 0.03
 
 
-def _test(fixture: bool = False, k_xy=(1.0, 1.0), random_orientation: bool = False, seed: int = 4) -> SteadyTest:
+def _test(fixture: bool = False, k_xy=(1.0, 1.0), random_orientation: bool = False, seed: int = 4,
+          extra=()) -> SteadyTest:
     rng = np.random.default_rng(seed)
     t = np.arange(N) / FS
     top = max(SPEEDS_RPM) * np.pi / 30
@@ -33,7 +34,7 @@ def _test(fixture: bool = False, k_xy=(1.0, 1.0), random_orientation: bool = Fal
     for i, rpm in enumerate(SPEEDS_RPM):
         om = rpm * np.pi / 30.0
         sig = {c: sd[c[0]] * rng.standard_normal(N) for c in ("Fx", "Fy", "Fz", "Tx", "Ty", "Tz")}
-        for d, h, C in LINES:
+        for d, h, C in LINES + list(extra):
             f = h * om / (2 * np.pi)
             H = 1.0 / (1 - (f / F_FIX) ** 2 + 2j * ZETA_FIX * f / F_FIX) if fixture else 1.0
             theta = h * om * t + rng.uniform(0, 2 * np.pi)
@@ -116,3 +117,20 @@ def test_a_counter_part_of_its_own_phase_is_named_without_a_split():
                                                   rel=0.05)
     assert "xy_split" not in e
     assert d.error_after < 3 * clean
+
+
+def test_speed_sidebands_the_segments_do_not_resolve_are_named_beside_their_carrier():
+    """Lines at 0.95 and 1.05 x the speed at 20 % of the imbalance (an amplitude modulation of it at 0.05 x the
+    speed): diagnose's Welch segments (2048 samples, 0.98 Hz) hold them within 1-3 bins of the imbalance, its
+    empirical fit left the three out (before: the imbalance came back as a missing harmonic of their summed power, 3 %
+    high, the line 0.95 as one 54 % low, 1.05 was lost, no sidebands named, the error figure 1.6 x 10^3 the clean one).
+    Read on the whole records (0.24 Hz) they are the generator's."""
+    pair = [("radial_force", 0.95, 6e-7), ("radial_force", 1.05, 6e-7)]
+    d = api.diagnose(_test(extra=pair))
+    assert _kinds(d) == ["speed_sidebands"]
+    (e,) = d.model.effects
+    assert (e["h"], e["h_lower"], e["h_upper"]) == (1.0, 0.95, 1.05)
+    assert e["C_lower"] == pytest.approx(6e-7, rel=0.01) and e["C_upper"] == pytest.approx(6e-7, rel=0.01)
+    (carrier,) = [x.C for x in d.model.harmonics("radial_force") if x.h == 1.0]
+    assert carrier == pytest.approx(3e-6, rel=0.005)
+    assert d.error_after < 3 * api.diagnose(_test()).error_after

@@ -21,6 +21,7 @@ from .engine import Context, initial_state
 from .law_recheck import recheck_laws
 from .measure import in_unresolved_span
 from .modes_status import modes_status
+from .start_sidebands import start_model
 from .state import State
 
 
@@ -700,7 +701,7 @@ def _search_once(spectra: Spectra, model: WheelModel | None, k_sigma: float, min
     ctx.offset_pair = offset_pair
     if model is None:
         fit0 = fit_empirical(ctx.sp)
-        model = fit0.model
+        model = start_model(ctx, fit0)         # with the carriers of sideband pairs only the records resolve
         ctx.left_out = tuple((b.direction, float(b.h)) for b in fit0.modally_left_out)
     request = base
     base = resolve_base(model, base, test)

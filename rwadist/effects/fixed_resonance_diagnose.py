@@ -313,11 +313,11 @@ def moves_with_speed(ctx: Context, state: State, e: "FixedResonance") -> bool:
 
 def _fit_stand_with_levels(ctx: Context, state: State, channels, chans, runs, f0, n_iter) -> "FixedResonance | None":
     """A test-stand resonance on the empirical base fitted with the levels of the lines it reaches
-    (:func:`rwadist.effects.fixed_resonance_levels.fit_with_levels`); ``n_iter`` passes, each re-measuring the lines
+    (:func:`rwadist.diagnose.stand_levels.fit_with_levels`); ``n_iter`` passes, each re-measuring the lines
     with the previous pass's resonance (not its levels) in the state; None when no resonance is reached."""
     from dataclasses import replace
 
-    from .fixed_resonance_levels import fit_with_levels, starts_of
+    from ..diagnose.stand_levels import fit_with_levels, starts_of
 
     lo, hi = ctx.k_lo * ctx.df, ctx.k_hi * ctx.df
     e, st = None, state
@@ -373,7 +373,7 @@ class FixedResonance:
     #: extended fit, which has its own rule: :func:`rwadist.stand_resonance.lifts_every_direction`)
     lifted_directions: int = -1
     #: (direction, h, factor) of each empirical-base line whose C was fitted with the resonance
-    #: (:mod:`.fixed_resonance_levels`: a test stand on the empirical base), multiplying that C when applied
+    #: (:mod:`rwadist.diagnose.stand_levels`: a test stand on the empirical base), multiplying that C when applied
     line_levels: tuple = ()
 
     def apply(self, state: State) -> State:
@@ -386,7 +386,7 @@ class FixedResonance:
     def levelled(self, state: State) -> State:
         """A new ``state`` with the line levels fitted with the resonance (:attr:`line_levels`) and not the resonance
         itself."""
-        from .fixed_resonance_levels import levelled_harmonics
+        from ..diagnose.stand_levels import levelled_harmonics
 
         s = state.copy()
         s.model.empirical = levelled_harmonics(s.model, self.line_levels)

@@ -597,22 +597,23 @@ class SpeedSidebands:
                 e = SpeedSidebands.fit(ctx, state, d, x.h, runs, float(dl[j]))
                 if e is not None:
                     out.append(e)
-        return out + SpeedSidebands._from_base(state, out)
+        return out + SpeedSidebands._from_base(state, out, getattr(ctx, "base_sideband_pairs", ()))
 
     @staticmethod
-    def _from_base(state: State, found: list) -> list:
+    def _from_base(state: State, found: list, start_pairs=()) -> list:
         """The pairs the wheel's ``suspension_modes`` left out of the base it fitted from the data (:func:`rwadist.
         diagnose.modes_base.wheel_base`: close lines measured together on the records, where this
         family's own search needs RUN_MIN_BINS record bins from the carrier: 0.94/1.06 x the speed is 1.97 bins at
         2400 rpm on 4096 samples at 5 kHz), as measured there, those the search did not find itself; judged on the
-        held-out runs like any."""
+        held-out runs like any.  Without the modes, the pairs the empirical starting model's Welch resolution left out
+        (``start_pairs``, :func:`rwadist.diagnose.start_sidebands.start_model`: read on the whole records)."""
         modes = [e for e in state.effects if getattr(e, "kind", "") == "suspension_modes"]
         done = {(e.direction, round(e.h0, 3)) for e in state.effects if isinstance(e, SpeedSidebands)} | \
             {(e.direction, round(e.h0, 3)) for e in found}
         # one pair per carrier: the base lists a pair per rotation-sense part (a carrier split co/counter), whose
         # powers add (apply() splits the pair again as its carrier)
         pairs: dict = {}
-        for d, h0, hl, hu, cl, cu, n in (getattr(modes[-1], "sideband_pairs", ()) if modes else ()):
+        for d, h0, hl, hu, cl, cu, n in (getattr(modes[-1], "sideband_pairs", ()) if modes else start_pairs):
             key = (d, round(h0, 3))
             if key in pairs:
                 _, _, _, _, cl0, cu0, n0 = pairs[key]

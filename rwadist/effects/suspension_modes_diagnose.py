@@ -679,7 +679,7 @@ def one_fixed_resonance(e: SuspensionModes) -> bool:
     located within :data:`ONE_RESONANCE_SPREAD` of one frequency and a rotor whose whirl does not move with the speed
     (I_zz/I_rr below :data:`MIN_WHEEL_INERTIA_RATIO`).  That is a fixture's signature (issue 33: the stand is the one
     resonance whose frequency does not move with speed and that lifts every line near it on all channels), and the
-    test-stand resonance fitted with the lines' levels takes it (:mod:`rwadist.effects.fixed_resonance_levels`).  A
+    test-stand resonance fitted with the lines' levels takes it (:mod:`rwadist.diagnose.stand_levels`).  A
     wheel with no suspension modes on a 180-Hz fixture (the W7 trial wheel, ζ 0.03): translation, rocking and axial at
     179.9, 179.6 and 179.9 Hz with I_zz/I_rr 0.02 were named its suspension modes, and the fixture went into the flight
     PSD (axial RMS 3.8x the hard-mounted one)."""

@@ -1,0 +1,61 @@
+"""The empirical starting model of ``rwadist diagnose`` (no model given) and the speed-sideband pairs its Welch
+resolution cannot tell from their carrier.
+
+Diagnose reads the runs as Welch PSDs of quarter-record segments (:func:`rwadist.api.diagnose_nperseg`: its held-out
+evidence needs averaged segments), 4x coarser than a whole record.  Two lines at h₀ ± δ beside a strong line h₀ (an
+amplitude modulation of the line at δ times the speed: ``speed_sidebands``) lie within a few of those bins of their
+carrier at the low speeds, and the empirical fit there leaves the whole cluster out of the starting model, carrier
+included (the W7 trial wheel, 0.95/1.05 x the speed at 20 % of its imbalance, 16384 samples at 6 kHz: no line near
+h = 1; the imbalance came back as a ``missing_harmonic`` of the cluster's power, 3.4 % high, and the sidebands were
+never named).  The whole records resolve them (``rwadist fit`` fits all three within 0.1 %): read there, the carrier
+goes into the starting model at its own C and the pair is handed to the ``speed_sidebands`` family, which proposes it
+as measured, judged on the held-out runs like any effect (as the wheel's suspension-mode base hands the pairs it
+left out, :func:`rwadist.diagnose.modes_base.wheel_base`)."""
+from __future__ import annotations
+
+import copy
+from dataclasses import replace
+
+from ..units import DIRECTION_CHANNELS
+
+#: Two lines are one when their h agree within this (the empirical fit's precision on h, 4 places, and a margin)
+SAME_H = 2e-3
+#: The whole records are read when they resolve this many times finer than diagnose's Welch segments
+FINER = 2.0
+
+
+def start_model(ctx, fit0):
+    """The empirical fit ``fit0``'s model (a copy, when changed) with the carriers of the speed-sideband pairs its
+    resolution left out (their C read on the whole records); the pairs ((direction, h₀, h_lower, h_upper, C_lower,
+    C_upper, measurements) each) set on ``ctx.base_sideband_pairs``.  The model as it is without the records, on a
+    sweep's slices (a line sweeps over a slice) or when the records are no finer than the segments."""
+    from ..empirical import fit_empirical
+    from ..spectra import compute_spectra
+    from .modes_base import _sideband_pairs
+
+    ctx.base_sideband_pairs = ()
+    model = fit0.model
+    test = ctx.test
+    if test is None or not test.runs or ((getattr(test, "meta", None) or {}).get("slicing")):
+        return model
+    n = min(r.n_samples for r in test.runs)
+    fs = min(r.sample_rate for r in test.runs)
+    if fs / n * FINER > ctx.df:
+        return model
+    try:
+        fine = fit_empirical(compute_spectra(test, nperseg=n, channels=list(ctx.channels)))
+    except ValueError:
+        return model                        # the records cannot be read whole (runs of other lengths)
+    out, pairs = None, []
+    for d in DIRECTION_CHANNELS:
+        have = model.harmonics(d)
+        for c, a, b in _sideband_pairs(fine.model.harmonics(d)):
+            if any(abs(x.h - a.h) <= SAME_H or abs(x.h - b.h) <= SAME_H for x in have):
+                continue                    # resolved by the segments: the base's own lines
+            out = out or copy.deepcopy(model)
+            carrier = [x for x in out.harmonics(d) if abs(x.h - c.h) <= SAME_H]
+            kept = [x for x in out.harmonics(d) if abs(x.h - c.h) > SAME_H]
+            out.empirical[d] = sorted(kept + [replace(carrier[0], C=c.C) if carrier else c], key=lambda x: x.h)
+            pairs.append((d, float(c.h), float(a.h), float(b.h), float(a.C), float(b.C), int(min(a.n_points, b.n_points))))
+    ctx.base_sideband_pairs = tuple(pairs)
+    return model if out is None else out
