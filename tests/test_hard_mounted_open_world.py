@@ -1,13 +1,15 @@
 """A hard-mounted wheel (no suspension modes in its band) on the default path (no model given): a fixture resonance
-under it, and a counter-rotating part of its imbalance held by an anisotropic mount.
+under it, a counter-rotating part of its imbalance held by an anisotropic mount, speed sidebands beside its imbalance,
+and the rotation senses of its lines.
 
 Data: this file's own generator (numpy): a wheel of radial-force lines h 0.41, 1, 2, 3.12 and 4.88, radial-torque lines
-h 1 and 3.12, axial-force lines h 2, 3.12 and 4.88, each C·Ω² at a random phase per run, white sensor noise.  The fixture
-is the transmissibility of a mass on a spring, H = 1/(1 − r² + 2jζr) (r = f/f_r), on every channel: it lifts the lines
-near f_r by 1/(2ζ) and attenuates those above it as 1/r² (the form the W7 trial put under its wheel).  The
-anisotropic mount reads the imbalance as x = k_x·a cos θ, y = k_y·a sin θ: a co part (k_x + k_y)/2 and a counter part
-(k_x − k_y)/2, an ellipse held along the stator's x axis at every run.  Truth in closed form: the counter fraction
-q = (k_x − k_y)²/(2(k_x² + k_y²)) and the x/y power split e = (k_x² − k_y²)/(k_x² + k_y²)."""
+h 1 and 3.12, axial-force lines h 2, 3.12 and 4.88, each C·Ω² at a random phase per run, the lines h 3.12 turning
+against the spin, white sensor noise.  The fixture is the transmissibility of a mass on a spring,
+H = 1/(1 − r² + 2jζr) (r = f/f_r), on every channel: it lifts the lines near f_r by 1/(2ζ) and attenuates those above
+it as 1/r² (the form the W7 trial put under its wheel).  The anisotropic mount reads the imbalance as
+x = k_x·a cos θ, y = k_y·a sin θ: a co part (k_x + k_y)/2 and a counter part (k_x − k_y)/2, an ellipse held along the
+stator's x axis at every run.  Truth in closed form: the counter fraction q = (k_x − k_y)²/(2(k_x² + k_y²)) and the x/y
+power split e = (k_x² − k_y²)/(k_x² + k_y²)."""
 import numpy as np
 import pytest
 
@@ -22,10 +24,12 @@ LINES = [("radial_force", 1.0, 3e-6), ("radial_force", 2.0, 2.5e-7), ("radial_fo
          ("radial_torque", 3.12, 5e-8), ("axial_force", 2.0, 1e-7), ("axial_force", 3.12, 2e-7),
          ("axial_force", 4.88, 1.2e-7)]
 F_FIX, ZETA_FIX = 150.0, 0.03
+#: the lines that turn against the spin (y = −a sin θ): an outer-race ball-pass line, as the W7 trial wheel's
+COUNTER = {("radial_force", 3.12), ("radial_torque", 3.12)}
 
 
 def _test(fixture: bool = False, k_xy=(1.0, 1.0), random_orientation: bool = False, seed: int = 4,
-          extra=()) -> SteadyTest:
+          extra=(), pickup_hz: float = 0.0) -> SteadyTest:
     rng = np.random.default_rng(seed)
     t = np.arange(N) / FS
     top = max(SPEEDS_RPM) * np.pi / 30
@@ -53,7 +57,10 @@ def _test(fixture: bool = False, k_xy=(1.0, 1.0), random_orientation: bool = Fal
                 sig[y] += z.imag
             else:
                 sig[x] += kx * a * np.cos(theta)
-                sig[y] += ky * a * np.sin(theta)
+                sig[y] += (-1.0 if (d, h) in COUNTER else 1.0) * ky * a * np.sin(theta)
+        if pickup_hz:
+            for c in sig:           # mains pickup on every channel: 10 mN, 1 mN·m
+                sig[c] += (1e-2 if c[0] == "F" else 1e-3) * np.sin(2 * np.pi * pickup_hz * t + rng.uniform(0, 2 * np.pi))
         runs.append(Run(speed=om, sample_rate=FS, signals=sig, name=f"run_{i:02d}.csv"))
     return SteadyTest(runs, {"sample_rate_hz": FS})
 
@@ -84,9 +91,16 @@ def test_a_fixture_under_a_hard_mounted_wheel_is_the_test_stand_not_its_modes():
     assert d.error_after < 0.01 * d.error_before
 
 
-def test_a_clean_hard_mounted_wheel_is_left_alone():
+def test_a_clean_hard_mounted_wheel_is_left_alone_its_lines_turning_as_generated():
+    """Nothing added or described; each radial line's rotation sense read from the x/y phase (before: written with
+    none, which every consumer reads co-rotating), the imbalance's left to the counter_rotation family."""
     d = api.diagnose(_test())
     assert _kinds(d) == [] and not d.unexplained
+    for direction, h, _ in LINES:
+        if direction == "axial_force":
+            continue
+        (x,) = [x for x in d.model.harmonics(direction) if abs(x.h - h) < 1e-3]
+        assert x.sense == (None if h == 1.0 else "counter" if (direction, h) in COUNTER else "co"), (direction, h)
 
 
 def test_an_anisotropic_mount_is_a_counter_rotating_imbalance_held_in_one_orientation():
@@ -134,3 +148,16 @@ def test_speed_sidebands_the_segments_do_not_resolve_are_named_beside_their_carr
     (carrier,) = [x.C for x in d.model.harmonics("radial_force") if x.h == 1.0]
     assert carrier == pytest.approx(3e-6, rel=0.005)
     assert d.error_after < 3 * api.diagnose(_test()).error_after
+
+
+def test_mains_pickup_is_described_and_no_modal_rise_is_read_into_it():
+    """A 50-Hz line on every channel is taken out of the records the search reads and described; whether the lines
+    rise as through modes is read on those records (before: summary.json's suspension_modes_status was null, and read
+    on the data as given the lines crossing 50 Hz rose there)."""
+    from rwadist.diagnose.modes_status import modes_status
+
+    d = api.diagnose(_test(pickup_hz=50.0))
+    assert _kinds(d) == []
+    (u,) = d.unexplained
+    assert u.signature == "fixed_line" and u.f_Hz[0] == pytest.approx(50.0, abs=0.1)
+    assert modes_status(d)["status"] == "no_amplification"

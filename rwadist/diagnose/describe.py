@@ -425,6 +425,11 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
     # load-cell offset's correction T − r × F carries the forces' noise into them (trial16's 30 mm offset, exact:
     # the torques 1.3 dB over the model's floor in every band, the narrow-line error 78-163× the clean level)
     read = floor_as_read(opened.raw, after)
+    # the context the search read, for the records of what it was set to do (modes_status: whether the wheel's modes
+    # were to be fitted, read on the data the search read; the W7 trial's pickup case wrote suspension_modes_status null)
+    from .modes_status import SEARCH_CONTEXT
+
+    opened.raw._memo[SEARCH_CONTEXT] = opened.ctx
     diag.ctx, diag.state_after = opened.raw, read
     diag.error_after, diag.rms_error_after = opened.raw.error(read), opened.raw.rms_error(read)
     diag.contrast_error_after = opened.raw.contrast_error(read)

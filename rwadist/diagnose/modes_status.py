@@ -15,6 +15,9 @@ import numpy as np
 WHOLE_DATA_FIT = ("suspension_modes.whole_data_fit",)
 #: the memo key of the amplification peaks read from that fit (:func:`rwadist.extended_fit.amplification_peaks`)
 AMPLIFICATION_PEAKS = ("modes_status.amplification_peaks",)
+#: the memo key, on the context of the data as given, of the context the search read (:func:`rwadist.diagnose.describe.
+#: _described`)
+SEARCH_CONTEXT = ("modes_status.search_context",)
 #: the amplification peaks' directions, in the order they are said
 _DIRECTIONS = ("radial_force", "radial_torque", "axial_force")
 #: a line of the model within this fraction of a left-out harmonic's h is that harmonic, put back
@@ -36,7 +39,9 @@ def modes_status(diag) -> dict | None:
         range's ends); ``tried``: [{"iteration", "heldout_gain_fraction",
         "t", "modes_Hz"}] the hypotheses not taken; ``text``: one sentence.
     """
-    ctx = diag.ctx
+    # the context the search read (the data with fixed lines or a channel's copy taken out: :func:`rwadist.diagnose.
+    # describe.start`), not the data as given that the diagnosis's figures read: a pickup line is no mode's rise
+    ctx = diag.ctx._memo.get(SEARCH_CONTEXT) or diag.ctx
     if not getattr(ctx, "base_switch", False) or diag.state_after.base != "empirical" or ctx.test is None:
         return None
     from ..empirical import fit_empirical

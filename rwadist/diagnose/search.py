@@ -21,7 +21,7 @@ from .engine import Context, initial_state
 from .law_recheck import recheck_laws
 from .measure import in_unresolved_span
 from .modes_status import modes_status
-from .start_sidebands import start_model
+from .start_model import start_model
 from .state import State
 
 

@@ -606,7 +606,7 @@ class SpeedSidebands:
         family's own search needs RUN_MIN_BINS record bins from the carrier: 0.94/1.06 x the speed is 1.97 bins at
         2400 rpm on 4096 samples at 5 kHz), as measured there, those the search did not find itself; judged on the
         held-out runs like any.  Without the modes, the pairs the empirical starting model's Welch resolution left out
-        (``start_pairs``, :func:`rwadist.diagnose.start_sidebands.start_model`: read on the whole records)."""
+        (``start_pairs``, :func:`rwadist.diagnose.start_model.start_model`: read on the whole records)."""
         modes = [e for e in state.effects if getattr(e, "kind", "") == "suspension_modes"]
         done = {(e.direction, round(e.h0, 3)) for e in state.effects if isinstance(e, SpeedSidebands)} | \
             {(e.direction, round(e.h0, 3)) for e in found}

@@ -1,5 +1,5 @@
-"""The empirical starting model of ``rwadist diagnose`` (no model given) and the speed-sideband pairs its Welch
-resolution cannot tell from their carrier.
+"""The empirical starting model of ``rwadist diagnose`` (no model given): the speed-sideband pairs its Welch
+resolution cannot tell from their carrier, and the rotation sense of its radial lines.
 
 Diagnose reads the runs as Welch PSDs of quarter-record segments (:func:`rwadist.api.diagnose_nperseg`: its held-out
 evidence needs averaged segments), 4x coarser than a whole record.  Two lines at h₀ ± δ beside a strong line h₀ (an
@@ -10,7 +10,13 @@ h = 1; the imbalance came back as a ``missing_harmonic`` of the cluster's power,
 never named).  The whole records resolve them (``rwadist fit`` fits all three within 0.1 %): read there, the carrier
 goes into the starting model at its own C and the pair is handed to the ``speed_sidebands`` family, which proposes it
 as measured, judged on the held-out runs like any effect (as the wheel's suspension-mode base hands the pairs it
-left out, :func:`rwadist.diagnose.modes_base.wheel_base`)."""
+left out, :func:`rwadist.diagnose.modes_base.wheel_base`).
+
+The empirical fit reads each line's power, not the way it turns: its radial lines were written with no sense, which
+every consumer reads co-rotating (the W7 trial wheel's counter-rotating ball-pass lines h 3.12 and 6.24: the flight
+CSD's Im(Fx·Fy*) of the wrong sign).  The x/y phase of the whole runs tells it (:func:`rwadist.line_senses.line_senses`,
+the extended fit's own reading): co, counter or planar (both alike), on every radial line but the imbalance's order,
+whose counter-rotating part is the ``counter_rotation`` family's to name."""
 from __future__ import annotations
 
 import copy
@@ -34,9 +40,11 @@ def start_model(ctx, fit0):
     from .modes_base import _sideband_pairs
 
     ctx.base_sideband_pairs = ()
-    model = fit0.model
     test = ctx.test
-    if test is None or not test.runs or ((getattr(test, "meta", None) or {}).get("slicing")):
+    if test is None or not test.runs:
+        return fit0.model
+    model = _with_senses(fit0, test)
+    if (getattr(test, "meta", None) or {}).get("slicing"):
         return model
     n = min(r.n_samples for r in test.runs)
     fs = min(r.sample_rate for r in test.runs)
@@ -52,10 +60,38 @@ def start_model(ctx, fit0):
         for c, a, b in _sideband_pairs(fine.model.harmonics(d)):
             if any(abs(x.h - a.h) <= SAME_H or abs(x.h - b.h) <= SAME_H for x in have):
                 continue                    # resolved by the segments: the base's own lines
-            out = out or copy.deepcopy(model)
+            out = out or (model if model is not fit0.model else copy.deepcopy(model))
             carrier = [x for x in out.harmonics(d) if abs(x.h - c.h) <= SAME_H]
             kept = [x for x in out.harmonics(d) if abs(x.h - c.h) > SAME_H]
             out.empirical[d] = sorted(kept + [replace(carrier[0], C=c.C) if carrier else c], key=lambda x: x.h)
             pairs.append((d, float(c.h), float(a.h), float(b.h), float(a.C), float(b.C), int(min(a.n_points, b.n_points))))
     ctx.base_sideband_pairs = tuple(pairs)
+    return model if out is None else out
+
+
+#: The imbalance's order: its sense is left to the ``counter_rotation`` family (within this of h = 1)
+IMBALANCE_H_TOL = 1e-3
+
+
+def _with_senses(fit0, test):
+    """``fit0``'s model with the rotation sense of each radial line the x/y phase of the whole runs reads
+    (:func:`rwadist.line_senses.line_senses`), but the imbalance's order; a copy when one is set, else the model."""
+    from ..line_senses import _line_senses_once
+
+    model = fit0.model
+    try:
+        senses = _line_senses_once(test, fit0)
+    except (ValueError, KeyError):
+        return model                        # a run without both channels of a pair: no sense read
+    out = None
+    for d in ("radial_force", "radial_torque"):
+        new = []
+        for x in model.harmonics(d):
+            got = next((v[0] for (dd, h), v in senses.items() if dd == d and abs(h - x.h) <= SAME_H), None)
+            if got is not None and x.sense is None and abs(x.h - 1.0) > IMBALANCE_H_TOL:
+                x = replace(x, sense=got)
+            new.append(x)
+        if any(a is not b for a, b in zip(new, model.harmonics(d))):
+            out = out or copy.deepcopy(model)
+            out.empirical[d] = new
     return model if out is None else out
