@@ -407,8 +407,9 @@ def _print_base_lines(base_lines) -> None:
     """Console lines of the lines a diagnosis completed into a base fitted from the data (its summary's
     ``base_lines``), each with the model lines measured apart from it."""
     for e in base_lines:
-        print(f"  = {e['direction']} h = {e['h']:g}, C = {e['C']:.3g}: a line of the data the modes' fit did not "
-              "resolve, added to the fitted base (no model to miss it from)")
+        print(f"  = {e['direction']} h = {e['h']:g}, C = {e['C']:.3g}: a line of the data the fitted base did not hold "
+              "(unresolved by the modes' fit, or left out as amplified at nearly every speed before a test stand was "
+              "named), added to it (no model to miss it from)")
         for m in e.get("measured_apart", ()):
             part = f" ({m['sense']}-rotating part)" if m.get("sense") in ("co", "counter") else ""
             print(f"    beside it h = {m['h_before']:g}{part}, C = {m['C_before']:.3g} was the two lines' blend on the Welch "
