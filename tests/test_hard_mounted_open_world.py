@@ -29,7 +29,7 @@ COUNTER = {("radial_force", 3.12), ("radial_torque", 3.12)}
 
 
 def _test(fixture: bool = False, k_xy=(1.0, 1.0), random_orientation: bool = False, seed: int = 4,
-          extra=(), pickup_hz: float = 0.0) -> SteadyTest:
+          extra=(), pickup_hz: float = 0.0, counter=COUNTER) -> SteadyTest:
     rng = np.random.default_rng(seed)
     t = np.arange(N) / FS
     top = max(SPEEDS_RPM) * np.pi / 30
@@ -57,7 +57,7 @@ def _test(fixture: bool = False, k_xy=(1.0, 1.0), random_orientation: bool = Fal
                 sig[y] += z.imag
             else:
                 sig[x] += kx * a * np.cos(theta)
-                sig[y] += (-1.0 if (d, h) in COUNTER else 1.0) * ky * a * np.sin(theta)
+                sig[y] += (-1.0 if (d, h) in counter else 1.0) * ky * a * np.sin(theta)
         if pickup_hz:
             for c in sig:           # mains pickup on every channel: 10 mN, 1 mN·m
                 sig[c] += (1e-2 if c[0] == "F" else 1e-3) * np.sin(2 * np.pi * pickup_hz * t + rng.uniform(0, 2 * np.pi))
@@ -161,3 +161,14 @@ def test_mains_pickup_is_described_and_no_modal_rise_is_read_into_it():
     (u,) = d.unexplained
     assert u.signature == "fixed_line" and u.f_Hz[0] == pytest.approx(50.0, abs=0.1)
     assert modes_status(d)["status"] == "no_amplification"
+
+
+def test_lines_the_search_adds_turn_as_their_phase_says():
+    """A sideband pair turning against the spin beside the co-rotating imbalance: the pair is named, and its harmonics
+    carry the sense the x/y phase reads (before: none, which every consumer reads co-rotating; an independent trial's
+    counter-rotating line completed into the base after a test stand lost its sense alike)."""
+    pair = [("radial_force", 0.95, 6e-7), ("radial_force", 1.05, 6e-7)]
+    d = api.diagnose(_test(extra=pair, counter=COUNTER | {("radial_force", 0.95), ("radial_force", 1.05)}))
+    assert _kinds(d) == ["speed_sidebands"]
+    senses = {x.h: x.sense for x in d.model.harmonics("radial_force")}
+    assert senses[0.95] == senses[1.05] == senses[3.12] == "counter" and senses[2.0] == "co" and senses[1.0] is None

@@ -22,7 +22,9 @@ from __future__ import annotations
 import copy
 from dataclasses import replace
 
-from ..units import DIRECTION_CHANNELS
+import numpy as np
+
+from ..units import CHANNELS, DIRECTION_CHANNELS
 
 #: Two lines are one when their h agree within this (the empirical fit's precision on h, 4 places, and a margin)
 SAME_H = 2e-3
@@ -94,4 +96,52 @@ def _with_senses(fit0, test):
         if any(a is not b for a, b in zip(new, model.harmonics(d))):
             out = out or copy.deepcopy(model)
             out.empirical[d] = new
+    return model if out is None else out
+
+
+#: A line is read co (counter) when that share of its x/y power turns so, else planar (:func:`rwadist.line_senses.
+#: line_senses`' threshold)
+SENSE_SHARE = 0.75
+
+
+def sensed_lines(diag):
+    """``diag``'s model (a copy when changed) with a sense on each radial harmonic of the empirical base that has
+    none, but the imbalance's order: the lines the search added (a line the base left out and completed after a test
+    stand, a speed-sideband pair beside a carrier of no sense) read as the starting model's were, on the x/y phase of
+    the whole runs; the model as it is beside a model given, on the extended base, or without the records.
+
+    An independent trial (session 48: a counter-rotating ball-pass line the base left out under a 140-Hz fixture,
+    completed after it; a counter-rotating sideband pair beside the imbalance) had them written with no sense, which
+    every consumer reads co-rotating."""
+    ctx, model = diag.ctx, diag.model
+    if diag.model_given or diag.state_after.base != "empirical" or ctx.test is None:
+        return model
+    runs = np.asarray(ctx.runs)
+    w = ctx.omega[runs]
+    fs = np.array([ctx.test.runs[r].sample_rate for r in runs], dtype=float)
+    out = None
+    for d in ("radial_force", "radial_torque"):
+        cx, cy = DIRECTION_CHANNELS[d]
+        if not {cx, cy} <= set(ctx.channels):
+            continue
+        todo = [i for i, x in enumerate(model.harmonics(d)) if x.sense is None and abs(x.h - 1.0) > IMBALANCE_H_TOL]
+        if not todo:
+            continue
+        hs = np.array([model.harmonics(d)[i].h for i in todo])
+        f = np.abs(w)[:, None] * hs[None, :] / (2 * np.pi)
+        X = ctx.phasors(runs, f)
+        x, y = X[..., CHANNELS.index(cx)], X[..., CHANNELS.index(cy)]
+        co, ct = np.abs(x + 1j * y) ** 2, np.abs(x - 1j * y) ** 2
+        back = (w < 0)[:, None]
+        co, ct = np.where(back, ct, co), np.where(back, co, ct)
+        ok = np.isfinite(co) & np.isfinite(ct) & (f < 0.45 * fs[:, None]) & (f >= ctx.k_lo * ctx.df)
+        p_co, p_ct = np.where(ok, co, 0.0).sum(axis=0), np.where(ok, ct, 0.0).sum(axis=0)
+        share = p_co / np.maximum(p_co + p_ct, 1e-300)
+        lines = list(model.harmonics(d))
+        for i, q, n in zip(todo, share, ok.sum(axis=0)):
+            if n:
+                lines[i] = replace(lines[i], sense="co" if q >= SENSE_SHARE else "counter" if q <= 1 - SENSE_SHARE
+                                   else "planar")
+        out = out or copy.deepcopy(model)
+        out.empirical[d] = lines
     return model if out is None else out
