@@ -99,7 +99,7 @@ def named(kind: str, effects: list, f_fix) -> bool:
                    and abs(e["f_Hz"] / f_fix - 1) < 0.01 for e in effects)
     if kind == "counter_aniso":
         q = (KX - KY) ** 2 / (2 * (KX**2 + KY**2))
-        return any(e["kind"] == "counter_rotation" and e["h"] == 1.0 and abs(e["counter_fraction"] / q - 1) < 0.1
+        return any(e["kind"] == "counter_rotation" and abs(e["h"] - 1.0) < 1e-3 and abs(e["counter_fraction"] / q - 1) < 0.1
                    for e in effects)
     return any(e["kind"] == "speed_sidebands" and abs(e.get("per_rev", 0) - DELTA) < 2e-3 for e in effects)
 

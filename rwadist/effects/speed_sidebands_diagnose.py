@@ -2,7 +2,7 @@
 proportional to the speed), searched on the speeds where they stand resolved from their carrier."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -14,7 +14,7 @@ from ..diagnose.measure import _measure, refine_h
 from ..diagnose.state import State
 from ..extended import LAW_H_TOL
 from ..model import Harmonic
-from ..units import DIRECTION_CHANNELS
+from ..units import CHANNELS, DIRECTION_CHANNELS
 
 #: Smallest separation (Welch bins) between a sideband and its carrier for a run to count: the Hann main lobe
 #: is ±2 bins, so closer sidebands sit in the carrier's own kernel and are not measured there; half a bin more
@@ -285,6 +285,27 @@ def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
 
 
 
+def _record_carrier_C(ctx: Context, state: State, direction: str, h0: float, sides: tuple, runs) -> float | None:
+    """The carrier's C (Eq. 3.10) from its whole-run DFT amplitude |X| (:meth:`Context.phasors`, the fixed resonances
+    divided out) on the runs where both sides stand :data:`RUN_MIN_BINS` record bins from it, or None (fewer than 3
+    such runs)."""
+    sub = runs
+    for h in sides:
+        sub = np.intersect1d(sub, record_resolvable_runs(ctx, state, direction, h0, h, runs))
+    if sub.size < 3:
+        return None
+    f = h0 * ctx.omega[sub] / (2 * np.pi)
+    X = ctx.phasors(sub, f[:, None])[:, 0, :]
+    d_parts, w_parts = [], []
+    for c in DIRECTION_CHANNELS[direction]:
+        if c in ctx.channels:
+            a = np.abs(X[:, CHANNELS.index(c)]) / ctx.gain(state, c, f)
+            ok = np.isfinite(a)
+            d_parts.append(a[ok])
+            w_parts.append(ctx.omega[sub][ok])
+    return _eq310_C(np.concatenate(d_parts), np.concatenate(w_parts))
+
+
 def _eq310_C(d: np.ndarray, w: np.ndarray):
     """Thesis Eq. 3.10's least-squares C of amplitudes ``d`` (unit) against speeds ``w`` (rad/s), d = C·w²;
     None with fewer than 3 points or a C that is not positive."""
@@ -314,6 +335,9 @@ class SpeedSidebands:
     C_carrier: float
     n_points: int = 0
     kind: str = "speed_sidebands"
+    #: the carrier's C read on the whole records apart from the pair (empirical base, :func:`_record_carrier_C`),
+    #: which the carrier takes when applied; 0: the state's kept
+    carrier_record_C: float = 0.0
 
     @property
     def channels(self):
@@ -321,6 +345,14 @@ class SpeedSidebands:
 
     def apply(self, state: State) -> State:
         s = state.copy()
+        if self.carrier_record_C > 0 and s.ext is None:
+            # the empirical base fitted the carrier on Welch bins that hold the pair at the low speeds: its C took
+            # their power (family wheel 4 hard mounted, 0.95/1.05 at 20 %: +4 %, and the pair on top failed its refit)
+            parts = [x for x in s.model.harmonics(self.direction) if abs(x.h - self.h0) < LAW_H_TOL and x.C > 0]
+            norm = float(np.sqrt(sum(x.C**2 for x in parts)))
+            scale = self.carrier_record_C / norm if norm > 0 else 1.0
+            s.model.empirical[self.direction] = [replace(x, C=x.C * scale) if any(x is p for p in parts) else x
+                                                 for x in s.model.harmonics(self.direction)]
         # a rotating load modulated in size, (1 + m·cos δΩt)·C·e^{±iΩt}, is the carrier and two lines (m/2)·C at
         # (1 ± δ)Ω of the carrier's own rotation sense: each part of the carrier (co, counter) gets its share of the
         # pair (written with no sense, every consumer read them co-rotating)
@@ -482,7 +514,12 @@ class SpeedSidebands:
             if C is None:
                 return None
             out.append((h, C, d.size))
-        return SpeedSidebands._from_sides(state, direction, h0, out)
+        e = SpeedSidebands._from_sides(state, direction, h0, out)
+        if state.ext is None:
+            c0 = _record_carrier_C(ctx, state, direction, h0, (out[0][0], out[1][0]), runs)
+            if c0 is not None:
+                e = replace(e, carrier_record_C=c0, C_carrier=c0)
+        return e
 
     @staticmethod
     def _from_sides(state: State, direction: str, h0: float, out) -> "SpeedSidebands":
