@@ -586,7 +586,6 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     """
     from . import channel_distortion, data_quality, speed_whirl
     from .diagnose import diagnose as _diagnose
-    from .diagnose.start_model import sensed_lines
     from .spectra import compute_spectra
 
     for parameter, value in (("nperseg", nperseg), ("f_lim", f_lim), ("k_sigma", k_sigma), ("min_gain", min_gain)):
@@ -623,8 +622,6 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     # a speed from the data is tested by the wheel's gyroscopic whirl (and the data diagnosed again on the scale it
     # supports); how the speed was obtained goes to the summary and the report
     test, diagnosis = speed_whirl.settle(test, run)
-    # the lines the search added to an empirical base carry the sense their x/y phase reads, as the base's do
-    diagnosis.model = sensed_lines(diagnosis)
     diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None), checked)
     diagnosis.data_quality = ([s.to_json() for s in frozen] + distorted
                               + ([polarity] if polarity is not None else []))

@@ -708,4 +708,8 @@ def finish(diag, opened: Opened, bearings=(), rebuild=None):
     diag.unexplained = tuple(found)
     diag.line_causes = line_causes(diag, bearings, [u.h for u in found if u.h is not None])
     diag.bearings = bearings
+    # the lines the search added to an empirical base carry the sense their x/y phase reads, as the base's do
+    from .start_model import sensed_lines
+
+    diag.model = sensed_lines(diag)
     return diag
