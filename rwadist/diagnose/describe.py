@@ -711,5 +711,6 @@ def finish(diag, opened: Opened, bearings=(), rebuild=None):
     # the lines the search added to an empirical base carry the sense their x/y phase reads, as the base's do
     from .start_model import sensed_lines
 
-    diag.model = sensed_lines(diag)
+    if getattr(diag, "ctx", None) is not None:
+        diag.model = sensed_lines(diag)
     return diag
