@@ -19,7 +19,14 @@ A cell passes when its class is named (``fixed_resonance`` role test_stand withi
 within 5x the clean cell's.  The worst |C/C_truth − 1| of the wheel's lines is printed beside (lines a fixture
 attenuates below the noise may be missing: counted apart).
 
-Record (session 48, 845f134): see the closing table printed by the run.
+Record (session 48, fc58d3c, 40 cells in 258 s beside a test run): clean 8/8 (nothing added or described);
+fixture_peak 7/8 and fixture_trans 6/8 -- the stand named within 1 % in all 16 cells, no other class added; the three
+failing cells fail the error figure only (wheel 4 transmissibility 5.8x its clean cell, wheel 5 28x and 990x of a clean
+level of 2e-5 that holds no mixed-sense lines), lines a transmissibility attenuates under the noise missing (0-3 per
+wheel, described as speed lines where they stand out); counter_aniso 8/8 (q 0.0588 and x/y split 0.470 against the
+closed form's 0.0588 and 0.471); sidebands 8/8.  The worst C of the clean cells is 0.2-14 % (the family's lines
+of both senses; not examined this session: an empirical fit on an ellipse's x and y amplitudes reads their mean,
+3 % low on the imbalance at q 0.08, docs/diagnose.md ``counter_rotation``).
 
 Run (about 40 diagnoses of 3-20 s; nice it)::
 
