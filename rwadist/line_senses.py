@@ -15,7 +15,11 @@ from .units import DIRECTION_CHANNELS
 SENSE_CHUNK_SAMPLES = 1 << 20
 
 
-def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = 0.75) -> dict:
+#: A radial line is read co (counter) when that share of its x/y power turns so, else planar (:func:`line_senses`)
+SENSE_SHARE = 0.75
+
+
+def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = SENSE_SHARE) -> dict:
     """Rotation sense of each radial line from the x/y phase, (direction, h) -> (sense, co_fraction, every_run).
 
     For each run the complex Hann-windowed DFT of the x and y channels at +h|Ω|

@@ -99,9 +99,6 @@ def _with_senses(fit0, test):
     return model if out is None else out
 
 
-#: A line is read co (counter) when that share of its x/y power turns so, else planar (:func:`rwadist.line_senses.
-#: line_senses`' threshold)
-SENSE_SHARE = 0.75
 
 
 def sensed_lines(diag):
@@ -113,6 +110,8 @@ def sensed_lines(diag):
     An independent trial (session 48: a counter-rotating ball-pass line the base left out under a 140-Hz fixture,
     completed after it; a counter-rotating sideband pair beside the imbalance) had them written with no sense, which
     every consumer reads co-rotating."""
+    from ..line_senses import SENSE_SHARE
+
     ctx, model = diag.ctx, diag.model
     if diag.model_given or diag.state_after.base != "empirical" or ctx.test is None:
         return model

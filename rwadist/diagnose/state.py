@@ -164,17 +164,24 @@ class State:
                 out += [(f_m, 0.5 * m), (-f_m, 0.5 * m)]
         return out
 
-    def lines(self, channel: str):
-        """(h, C, amplitude law or None) of every line acting on ``channel``: harmonics of one h (a co and a counter
-        part of a radial line, :mod:`rwadist.effects.counter_rotation_diagnose`) merged into one line of their
-        root-sum-square C (independent phases: the expected power; the pair's cross term cancels between x and y)."""
-        d = CHANNEL_DIRECTION[channel]
+    def _parts(self, direction: str) -> list:
+        """[(h, [C of each harmonic of that h])] of ``direction``'s harmonics, those of one h (a co and a counter
+        part of a radial line, :mod:`rwadist.effects.counter_rotation_diagnose`) together."""
         out: list = []
-        for hm in self.model.harmonics(d):
+        for hm in self.model.harmonics(direction):
             if out and out[-1][0] == hm.h:
-                out[-1] = (hm.h, float((out[-1][1] ** 2 + hm.C ** 2) ** 0.5), out[-1][2])
-                continue
-            out.append((hm.h, hm.C, self.laws.get((d, round(hm.h, 4)))))
+                out[-1][1].append(hm.C)
+            else:
+                out.append((hm.h, [hm.C]))
+        return out
+
+    def lines(self, channel: str):
+        """(h, C, amplitude law or None) of every line acting on ``channel``: harmonics of one h merged into one line
+        of their root-sum-square C (independent phases: the expected power; the pair's cross term cancels between x
+        and y), scaled by its x/y split on a radial pair's channels (:attr:`Prediction.xy_splits`)."""
+        d = CHANNEL_DIRECTION[channel]
+        out = [(h, Cs[0] if len(Cs) == 1 else float(sum(C ** 2 for C in Cs) ** 0.5), self.laws.get((d, round(h, 4))))
+               for h, Cs in self._parts(d)]
         splits = self.prediction.xy_splits
         if splits and channel in ("Fx", "Fy", "Tx", "Ty"):
             sign = 1.0 if channel in ("Fx", "Tx") else -1.0
@@ -187,18 +194,10 @@ class State:
         run and of zero mean over the runs); 0 for a line of one part, or one whose x/y split is known (the parts' phase
         held by the stator: the cross term is predicted, :attr:`Prediction.xy_splits`)."""
         d = CHANNEL_DIRECTION[channel]
-        powers: list = []
-        last = None
-        for hm in self.model.harmonics(d):
-            if powers and last == hm.h:
-                powers[-1].append(hm.C ** 2)
-            else:
-                powers.append([hm.C ** 2])
-            last = hm.h
-        hs = [x[0] for x in self.lines(channel)]
         splits = self.prediction.xy_splits
         out = []
-        for h, p in zip(hs, powers):
+        for h, Cs in self._parts(d):
+            p = [C ** 2 for C in Cs]
             total = sum(p)
             out.append(0.0 if len(p) < 2 or total <= 0 or (d, round(h, 4)) in splits
                        else (total ** 2 - sum(x * x for x in p)) / total ** 2)
