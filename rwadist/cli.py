@@ -257,10 +257,10 @@ def cmd_model_show(args) -> int:
         print(json.dumps(model_io.to_json(m), indent=2))
         return 0
     if args.format == "csv":
-        print("direction,h,C_SI,C_stderr_SI")
+        print("direction,h,C_SI,C_stderr_SI,sense")
         for d, h in rows:
             se = "" if h.C_stderr is None else repr(float(h.C_stderr))
-            print(f"{d},{h.h!r},{h.C!r},{se}")
+            print(f"{d},{h.h!r},{h.C!r},{se},{'' if d.startswith('axial') else (h.sense or 'co')}")
         return 0
     from .effects_text import model_table
 

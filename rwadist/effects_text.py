@@ -70,11 +70,13 @@ def model_table(model) -> list:
 
     rows = [(d, h) for d in DIRECTIONS for h in model.harmonics(d)]
     out = [f"model {model.name!r}  (C in SI per (rad/s)²: kg·m for forces, kg·m² for torques)",
-           f"{'direction':<14} {'h':>7} {'C':>12} {'stderr':>10} {'points':>6}  excluded rpm"]
+           f"{'direction':<14} {'h':>7} {'sense':>7} {'C':>12} {'stderr':>10} {'points':>6}  excluded rpm"]
     for d, h in rows:
         se = "" if h.C_stderr is None else f"{h.C_stderr:.2e}"
         ex = " ".join(f"{lo:.0f}-{hi:.0f}" for lo, hi in h.excluded_rpm)
-        out.append(f"{d:<14} {h.h:7.3f} {h.C:12.4e} {se:>10} {h.n_points:6d}  {ex}")
+        # a radial line without a sense is read co-rotating by every consumer (docs/formats.md)
+        sense = "" if d.startswith("axial") else (h.sense or "co")
+        out.append(f"{d:<14} {h.h:7.3f} {sense:>7} {h.C:12.4e} {se:>10} {h.n_points:6d}  {ex}")
     effects = list(model.effects or [])
     out.append(f"effects ({len(effects)}):" if effects else "effects: none")
     out += [f"  {i + 1}. {describe_effect(e)}" for i, e in enumerate(effects)]

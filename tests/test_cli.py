@@ -35,7 +35,7 @@ def test_simulate_fit_show(tmp_path, capsys):
     assert code == 0 and model.exists() and (tmp_path / "m_report" / "summary.md").exists()
     code, out, _ = run(capsys, "model", "show", model, "--format", "csv")
     rows = list(csv.DictReader(io.StringIO(out)))
-    assert list(rows[0]) == ["direction", "h", "C_SI", "C_stderr_SI"]
+    assert list(rows[0]) == ["direction", "h", "C_SI", "C_stderr_SI", "sense"]
     truth = preset("ithaco-e").to_model()
     for d in ("radial_force", "radial_torque", "axial_force"):
         got = {round(float(r["h"]), 2): float(r["C_SI"]) for r in rows if r["direction"] == d}

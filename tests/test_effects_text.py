@@ -81,6 +81,22 @@ def test_model_show_lists_the_effects(tmp_path, capsys):
     assert "effects: none" in capsys.readouterr().out
 
 
+def test_model_show_gives_each_radial_line_its_sense(tmp_path, capsys):
+    """The table and the CSV say the rotation sense every consumer reads (a radial line without one: co)."""
+    m = WheelModel(name="w", empirical={"radial_force": [Harmonic(h=1.0, C=1e-6), Harmonic(h=2.5, C=2e-7, sense="counter")],
+                                        "radial_torque": [Harmonic(h=3.1, C=1e-8, sense="planar")],
+                                        "axial_force": [Harmonic(h=2.0, C=3e-7)]})
+    path = tmp_path / "m.json"
+    model_io.save(m, path)
+    assert main(["model", "show", str(path)]) == 0
+    rows = {tuple(line.split()[:3]) for line in capsys.readouterr().out.splitlines()[2:6]}
+    assert rows == {("radial_force", "1.000", "co"), ("radial_force", "2.500", "counter"),
+                    ("radial_torque", "3.100", "planar"), ("axial_force", "2.000", "3.0000e-07")}
+    assert main(["model", "show", str(path), "--format", "csv"]) == 0
+    senses = [line.split(",")[-1] for line in capsys.readouterr().out.splitlines()[1:]]
+    assert senses == ["co", "counter", "planar", ""]
+
+
 def test_diagnose_lines_carry_the_held_out_gain():
     e = dict(EFFECTS[3], evidence={"heldout_gain_fraction": 0.118})
     (line,) = diagnose_lines([e])
