@@ -19,19 +19,16 @@ thesis toolbox did with a manual decision at every step:
 3. **Amplitudes** (``find_coeff.m``): the line amplitude in each run where
    the line is in band, detected (Eq. 3.11) and resolved from the other
    harmonics (or with weaker lines only in its bins, their part taken out:
-   :mod:`rwadist.line_overlap`), measured as the power under the line (exact
-   between bins, by Parseval) less the local noise floor; C by Eq. 3.10.
+   :mod:`rwadist.line_overlap`), measured as the power under the line (exact between bins, by Parseval) less the
+   local noise floor; C by Eq. 3.10's weights on the power (:func:`line_C`).
 4. **Modal amplification** (``remove_mode.m``, automatic): speeds where the
    amplitude departs from C·Ω² by more than noise and scatter allow, grown
    into contiguous speed ranges, are excluded and C is refitted; the ranges
    are reported.
-5. **Standard error** of every C: a cluster-robust (sandwich) estimate of the
-   Eq. 3.10 least-squares fit, clustered by run so x and y measurements of
-   one run are not counted as independent.  It is the *statistical* error
-   (noise, speed-to-speed scatter).  It does not cover a bias the model form
-   cannot see: amplification by a mode's skirts below the exclusion threshold,
-   or an amplitude law other than Ω²; compare C with C_all and look at the
-   coefficient plots for those.
+5. **Standard error** of every C: a cluster-robust (sandwich) estimate, clustered by run so x and y measurements
+   of one run are not counted as independent.  It is the *statistical* error (noise, speed-to-speed scatter).  It
+   does not cover a bias the model form cannot see: amplification by a mode's skirts below the exclusion threshold,
+   or an amplitude law other than Ω²; compare C with C_all and look at the coefficient plots for those.
 """
 from __future__ import annotations
 
@@ -88,7 +85,7 @@ class LineFit:
     """One harmonic of one direction, with every measurement behind its C.
 
     speed (rad/s, >0), channel, amplitude (N or N·m), used (bool): one entry
-    per measurement.  C, C_stderr, C_all in SI per (rad/s)²; C_all is Eq. 3.10
+    per measurement.  C, C_stderr, C_all in SI per (rad/s)²; C_all is :func:`line_C`
     over every measurement before modal exclusion (the thesis's C-bar).
     excluded_rpm: [[lo, hi], ...] speed ranges excluded as modal amplification.
     noise: per measurement, the relative amplitude error the channel's noise floor under the line's bins
@@ -464,35 +461,32 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
 
 # --------------------------------------------------------------------------- steps 3-5: coefficients
 
-def _eq310(d, w):
-    """Amplitude coefficient by thesis Eq. 3.10: C = Σ d Ω² / Σ Ω⁴."""
-    return float(np.sum(d * w**2) / np.sum(w**4))
+def line_C(d, w):
+    """C of a line from its amplitudes ``d`` (SI) at speeds ``w`` (rad/s), (m,) each: Eq. 3.10's Ω⁴ weights on the
+    power, C² = Σ d²/Σ Ω⁴.  Exact for a steady line, as Eq. 3.10 (C = Σ dΩ²/Σ Ω⁴); unlike it, it reads the mean power
+    (the model's C²Ω⁴/2 a channel) of a line whose amplitude on a channel changes from run to run (both senses with
+    their own phases: Eq. 3.10 read a planar line 10-14 % low), and d² (power less noise) is unbiased."""
+    return float(np.sqrt(np.sum(np.square(d)) / np.sum(np.asarray(w, float) ** 4)))
 
 
 def _cluster_stderr(d, w, runs, C):
-    """Cluster-robust standard error of the Eq. 3.10 estimate, clustered by run."""
-    e = d - C * w**2
+    """Cluster-robust standard error of :func:`line_C`'s estimate, clustered by run: the sandwich variance of
+    C² = Σ d² / Σ Ω⁴ (its residuals d² − C²Ω⁴ summed per run), carried to C by var(C) = var(C²) / (2C)²."""
+    e = d**2 - C**2 * w**4
     uniq, inv = np.unique(runs, return_inverse=True)
-    g = np.bincount(inv, weights=w**2 * e)
+    g = np.bincount(inv, weights=e)
     n_cl = uniq.size
-    if n_cl < 2:
+    if n_cl < 2 or not C > 0:
         return float("nan")
     var = np.sum(g**2) / np.sum(w**4) ** 2 * n_cl / (n_cl - 1)
-    return float(np.sqrt(var))
+    return float(np.sqrt(var) / (2 * C))
 
 
 def _ranges(speeds_sorted, flags_sorted):
     """Contiguous runs of flagged points -> [[lo, hi], ...] in the speed's unit."""
-    out = []
-    start = None
-    for k, fl in enumerate(flags_sorted):
-        if fl and start is None:
-            start = k
-        if (not fl or k == len(flags_sorted) - 1) and start is not None:
-            stop = k if fl else k - 1
-            out.append([float(speeds_sorted[start]), float(speeds_sorted[stop])])
-            start = None
-    return out
+    edges = np.diff(np.concatenate([[0], np.asarray(flags_sorted, int), [0]]))
+    return [[float(speeds_sorted[a]), float(speeds_sorted[b - 1])] for a, b in zip(np.flatnonzero(edges == 1),
+                                                                                 np.flatnonzero(edges == -1))]
 
 
 def modal_exclusion(d, w, run, sigma_noise, s: FitSettings):
@@ -504,7 +498,7 @@ def modal_exclusion(d, w, run, sigma_noise, s: FitSettings):
 
     Works on the log ratio ℓ = log(d / (C·Ω²)) per run (x and y of a run share
     a verdict), in speed order.  C is the median ratio of the runs not yet
-    flagged: a mode's wide skirts bias Eq. 3.10 (whose Ω⁴ weights favour the
+    flagged: a mode's wide skirts bias C (whose Ω⁴ weights favour the
     top speeds), not the median.  The random scatter is estimated from
     differences of neighbouring runs, so the smooth rise of a resonance is not
     mistaken for noise.  A core of runs departing by more than
@@ -664,14 +658,14 @@ def direction_lines(direction: str, meas: _DirectionMeasurements, s: FitSettings
             b.reason = "no measurement resolved from the other lines"
             continue
         w, dk, run, ch, sg = w_all[m], d[m], lines.pair_run[pi_[m]], lines.pair_chan[pi_[m]], sig[m]
-        C_all = _eq310(dk, w)
+        C_all = line_C(dk, w)
         excluded = modal_exclusion(dk, w, run, sg, s) if s.exclude_modes else np.zeros(w.size, bool)
         used = ~excluded
         if used.sum() < s.min_points:
             b.kept = False
             b.reason = f"only {int(used.sum())} measurements outside modal ranges (< {s.min_points})"
             continue
-        C = _eq310(dk[used], w[used])
+        C = line_C(dk[used], w[used])
         se = _cluster_stderr(dk[used], w[used], run[used], C)
         rpm = w * RAD_S_TO_RPM
         order = np.argsort(rpm, kind="stable")

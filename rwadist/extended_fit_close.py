@@ -79,7 +79,7 @@ def close_lines(test, fit) -> list:
     mirror of a lone one beside the span's strongest line, measured together on each run's whole record (module
     docstring); those with fewer than the fit's ``min_points`` measurements kept are left out.  ``test``: the
     SteadyTest of ``fit``'s spectra (its runs in the same order)."""
-    from .empirical import FitSettings, LineFit, _eq310
+    from .empirical import FitSettings, LineFit, line_C
 
     eps = float(fit.settings.get("epsilon", FitSettings.epsilon))
     half = int(fit.settings.get("line_half_width", FitSettings.line_half_width))
@@ -99,7 +99,7 @@ def close_lines(test, fit) -> list:
             for j in span.lost:
                 w, ch, amp = span.measurements(j)
                 if w.size >= min_points:
-                    C = _eq310(amp, w)
+                    C = line_C(amp, w)
                     out.append(LineFit(d, float(span.h[j]), C, float("nan"), C, w, ch, amp, np.ones(w.size, bool), [],
                                        1.0, int(w.size)))
     return out

@@ -22,6 +22,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from . import compare
+from .empirical import line_C
 from .plot_util import PNG_COMPRESS_LEVEL, log_axis, save_png  # noqa: F401 (PNG_COMPRESS_LEVEL: its old home)
 from .spectra import cumulative_rms
 from .text_table import write_rows
@@ -405,7 +406,7 @@ UNCERTAINTY_NOTE = ("±2σ: the fit's statistical error of C (measurement noise,
 
 
 def model_form_error(line) -> float:
-    """Held-out error of C·Ω² for ``line`` (a :class:`rwadist.empirical.LineFit`), relative: C fitted by Eq. 3.10 on
+    """Held-out error of C·Ω² for ``line`` (a :class:`rwadist.empirical.LineFit`), relative: C fitted as the fit does (:func:`~rwadist.empirical.line_C`) on
     every other speed of the measurements the fit used (sorted by speed), the RMS of (measured − predicted) at the
     others over the RMS predicted, both ways, the larger; NaN with fewer than 4 points.  The noise is in it too:
     compare with 2σ/C (a pure C·Ω² line gives about the noise's scatter)."""
@@ -416,7 +417,7 @@ def model_form_error(line) -> float:
     order = np.argsort(w, kind="stable")
     worst = 0.0
     for fit_idx, test_idx in ((order[::2], order[1::2]), (order[1::2], order[::2])):
-        C = np.sum(d[fit_idx] * w[fit_idx] ** 2) / np.sum(w[fit_idx] ** 4)
+        C = line_C(d[fit_idx], w[fit_idx])
         pred = C * w[test_idx] ** 2
         den = np.sqrt(np.mean(pred ** 2))
         if not den > 0:

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from rwadist.data import Run, SteadyTest
-from rwadist.empirical import FitSettings, _cluster_stderr, _eq310, fit_empirical, modal_exclusion
+from rwadist.empirical import FitSettings, _cluster_stderr, fit_empirical, line_C, modal_exclusion
 from rwadist.spectra import compute_spectra
 from rwadist.units import rpm_to_rad_s
 
@@ -148,21 +148,49 @@ def test_negative_zero_and_duplicate_speeds():
     assert fit.model.provenance["n_runs"] == len(speeds) - 1
 
 
-def test_eq_3_10_and_its_standard_error_closed_form():
+def test_line_C_and_its_standard_error_closed_form():
     """Eq. 3.10 on exact data returns C; the sandwich SE equals the OLS SE when the
     residuals are homoscedastic in the Ω² regressor (checked by Monte Carlo)."""
     rng = np.random.default_rng(5)
     w = np.linspace(50, 300, 40)
-    assert _eq310(2.5e-6 * w**2, w) == pytest.approx(2.5e-6, rel=1e-12)
+    assert line_C(2.5e-6 * w**2, w) == pytest.approx(2.5e-6, rel=1e-12)
     estimates, ses = [], []
     for _ in range(2000):
         d = 2.5e-6 * w**2 + 1e-3 * rng.standard_normal(w.size)
-        c = _eq310(d, w)
+        c = line_C(d, w)
         estimates.append(c)
         ses.append(_cluster_stderr(d, w, np.arange(w.size), c))
     true_sd = 1e-3 / np.sqrt(np.sum(w**4))   # closed form of the OLS slope's sd
     assert np.std(estimates) == pytest.approx(true_sd, rel=0.05)
     assert np.median(ses) == pytest.approx(true_sd, rel=0.1)
+
+
+def test_a_line_whose_channel_amplitude_changes_from_run_to_run_is_read_at_its_power():
+    """A straight load along an angle that changes from run to run (a planar line) and a line of both senses with
+    their own phases: each channel's amplitude scatters from run to run, x² + y² of a run does not (closed form:
+    A² for the straight load, 2(a₊² + a₋²) for the two senses), so the model's C (C²Ω⁴/2 a channel) is A/√2 and
+    sqrt(a₊² + a₋²).  Eq. 3.10's mean amplitude reads them 10 % low (E|cos α| = 2/π against its RMS 1/√2)."""
+    rng = np.random.default_rng(3)
+    t = np.arange(4096) / FS
+    A, a_co, a_ct = 3.0e-6, 1.6e-6, 1.2e-6
+    runs = []
+    for rpm in np.linspace(600, 3000, 25):
+        w = float(rpm_to_rad_s(rpm))
+        fx, fy = 1e-3 * rng.standard_normal((2, t.size))
+        alpha, p1, p2, p3 = rng.uniform(0, 2 * np.pi, 4)
+        straight = A * w**2 * np.cos(w * t + p1)                       # h = 1 along alpha
+        fx, fy = fx + straight * np.cos(alpha), fy + straight * np.sin(alpha)
+        phi = 2.0 * w * t                                               # h = 2: a co and a counter part
+        fx = fx + a_co * w**2 * np.cos(phi + p2) + a_ct * w**2 * np.cos(phi + p3)
+        fy = fy + a_co * w**2 * np.sin(phi + p2) - a_ct * w**2 * np.sin(phi + p3)
+        runs.append(Run(w, FS, {"Fx": fx, "Fy": fy}, name=f"r{rpm:g}.csv"))
+    fit = fit_empirical(compute_spectra(SteadyTest(runs).sorted()))
+    got = _match(fit)
+    assert got[1.0].C == pytest.approx(A / np.sqrt(2), rel=0.01)
+    assert got[2.0].C == pytest.approx(np.hypot(a_co, a_ct), rel=0.01)
+    line = next(ln for ln in fit.lines if abs(ln.h - 1.0) < 0.01)
+    d, w = line.amplitude[line.used], line.speed[line.used]
+    assert np.sum(d * w**2) / np.sum(w**4) < 0.95 * A / np.sqrt(2)       # what Eq. 3.10 read
 
 
 def test_reported_stderr_matches_spread_over_seeds():

@@ -28,6 +28,7 @@ from ..diagnose.measure import (
 )
 from ..diagnose.reduce import column_nanmedian
 from ..diagnose.state import State
+from ..empirical import line_C
 from ..model import Harmonic
 from ..speed_scale import ratios_near, sweep_ratios
 from ..units import DIRECTION_CHANNELS
@@ -557,13 +558,13 @@ class MissingHarmonic:
         d, w = _measure(ctx, state, direction, h, runs)
         if d.size < 3:
             return None
-        C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
+        C = line_C(d, w)
         return MissingHarmonic(direction, float(h), C, int(d.size))
 
     @staticmethod
     def fit_close(ctx: Context, state: State, direction: str, h: float, runs) -> "MissingHarmonic | None":
         """A line closer to a model line than the Welch main lobe (:func:`resolved_h`), fitted on the whole-run DFT
-        where the two stand apart: C by thesis Eq. 3.10 on the amplitudes sqrt(|X − leakage|² − noise)
+        where the two stand apart: C by :func:`~rwadist.empirical.line_C` on the amplitudes sqrt(|X − leakage|² − noise)
         (:func:`_apart_residuals`; the noise the white noise of the state's floor at the nearest Welch bin) of the
         points RECORD_FIT_SNR × over the noise, divided by the fixed resonances' and the modal gain.  None where the
         record's lines are not steady, with such points in fewer than RECORD_MIN_RUNS runs, or no positive C."""
@@ -587,7 +588,7 @@ class MissingHarmonic:
         d, w = np.concatenate(d_parts), np.concatenate(w_parts)
         if len(used) < RECORD_MIN_RUNS:             # (points of RECORD_FIT_SNR: one channel of an axial line is enough)
             return None
-        C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
+        C = line_C(d, w)
         if C <= 0:
             return None
         return MissingHarmonic(direction, float(h), C, int(d.size), close=True,
@@ -617,7 +618,7 @@ class MissingHarmonic:
     def fit_record(ctx: Context, state: State, direction: str, h: float, runs) -> "MissingHarmonic | None":
         """The record route's fit: h the maximum of Σ|X|² over the valid points on a grid ±1 record-grid step (at the
         fastest run) around ``h`` (steps of 1/20 of it, then a parabola through the top three; the points' own
-        frequencies, :func:`record_residual` exact), C by thesis Eq. 3.10 on
+        frequencies, :func:`record_residual` exact), C by :func:`~rwadist.empirical.line_C` on
         the amplitudes sqrt(|X|² − noise) of the points RECORD_FIT_SNR × over the noise, divided by the fixed
         resonances' and the modal gain (the line before the mount).  None with fewer than RECORD_MIN_POINTS such
         points or RECORD_MIN_RUNS runs, or no positive C."""
@@ -648,7 +649,7 @@ class MissingHarmonic:
         d, w = np.concatenate(d_parts), np.concatenate(w_parts)
         if d.size < RECORD_MIN_POINTS or used.sum() < RECORD_MIN_RUNS:
             return None
-        C = float(np.sum(d * w**2) / np.sum(w**4))                      # thesis Eq. 3.10
+        C = line_C(d, w)
         return MissingHarmonic(direction, h, C, int(d.size), record=True) if C > 0 else None
 
     @staticmethod

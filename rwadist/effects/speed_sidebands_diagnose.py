@@ -12,6 +12,7 @@ from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.measure import _measure, refine_h
 from ..diagnose.state import State
+from ..empirical import line_C
 from ..extended import LAW_H_TOL
 from ..model import Harmonic
 from ..units import CHANNELS, DIRECTION_CHANNELS
@@ -286,7 +287,7 @@ def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
 
 
 def _record_carrier_C(ctx: Context, state: State, direction: str, h0: float, sides: tuple, runs) -> float | None:
-    """The carrier's C (Eq. 3.10) from its whole-run DFT amplitude |X| (:meth:`Context.phasors`, the fixed resonances
+    """The carrier's C (:func:`~rwadist.empirical.line_C`) from its whole-run DFT amplitude |X| (:meth:`Context.phasors`, the fixed resonances
     divided out) on the runs where both sides stand :data:`RUN_MIN_BINS` record bins from it, or None (fewer than 3
     such runs)."""
     sub = runs
@@ -307,11 +308,11 @@ def _record_carrier_C(ctx: Context, state: State, direction: str, h0: float, sid
 
 
 def _eq310_C(d: np.ndarray, w: np.ndarray):
-    """Thesis Eq. 3.10's least-squares C of amplitudes ``d`` (unit) against speeds ``w`` (rad/s), d = C·w²;
+    """The C of amplitudes ``d`` (unit) against speeds ``w`` (rad/s), d = C·w² (:func:`rwadist.empirical.line_C`);
     None with fewer than 3 points or a C that is not positive."""
     if d.size < 3:
         return None
-    C = float(np.sum(d * w**2) / np.sum(w**4))
+    C = line_C(d, w)
     return C if C > 0 else None
 
 @register(order=15)
@@ -447,7 +448,7 @@ class SpeedSidebands:
     @staticmethod
     def fit(ctx: Context, state: State, direction: str, h0: float, runs, delta: float) -> "SpeedSidebands | None":
         """Each side's h refined on its residual peaks (:func:`rwadist.diagnose.measure.refine_h`) and its C by
-        thesis Eq. 3.10 on the amplitudes measured (modal gain divided out), both on the runs where that side
+        :func:`~rwadist.empirical.line_C` on the amplitudes measured (modal gain divided out), both on the runs where that side
         is resolved (:func:`resolvable_runs`); None when a side has fewer than 3 measured points or no
         positive C."""
         if ctx.test is not None:
@@ -474,7 +475,7 @@ class SpeedSidebands:
     def _fit_record(ctx: Context, state: State, direction: str, h0: float, runs, delta: float):
         """:meth:`fit` on the whole-run DFT (time series given): each side's h is the maximum of the summed line
         power Σ|X|² over a grid h₀ ± δ ± 0.0125 (step 0.0005, then ± 0.0006 in steps of 0.00002, each refined by a
-        parabola through the top three) on the runs where it is resolved; its C by thesis Eq. 3.10 on the amplitudes sqrt(|X|² − noise) of the points standing
+        parabola through the top three) on the runs where it is resolved; its C by :func:`~rwadist.empirical.line_C` on the amplitudes sqrt(|X|² − noise) of the points standing
         10 × over the noise, divided by the fixed resonances' and the modal gain (the line before the mount)."""
         out = []
         for side in (-1.0, 1.0):
