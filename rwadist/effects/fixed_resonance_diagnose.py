@@ -29,8 +29,8 @@ def _line_gain_points(ctx, state, chans, runs, with_lines: bool = False):
     further resonance would have to supply at the line's frequency f = h|Ω|/2π.  weight = s²/(s² + s_k²)
     with s the line's power over the noise power in its window and s_k = :data:`SNR_KNEE`: the scatter of
     a log power falls as 1/s for weak lines and is bounded by model error for strong ones.  direction: the load
-    direction of each point's channel (str).  ``with_lines``: two more, each point's line id (int) and the lines
-    ((direction, h) of each id, a list).
+    direction of each point's channel (str).  ``with_lines``: three more, each point's line id (int), the lines
+    ((direction, h) of each id, a list) and each point's predicted power (its line's level is read on the powers).
 
     On one radial direction's lines (``chans`` one pair, Fx/Fy or Tx/Ty: a wheel mode's fit) a line is read on the
     pair's power sum, one point for the pair (one measurement of the line: counted once where points are counted,
@@ -71,7 +71,7 @@ def _line_gain_points(ctx, state, chans, runs, with_lines: bool = False):
             k = np.clip(np.rint(f / ctx.df).astype(int)[:, None] + offs, 0, ctx.f.size - 1)
             n_pow = np.take_along_axis(noise, k, axis=1).sum(1) * ctx.df
             read[c][float(h)] = (f, np.where(ok, a, 0.0) ** 2 / 2, a_pred ** 2 / 2, n_pow, ok)
-    fs, ys, ws, ds, ids = [], [], [], [], []
+    fs, ys, ws, ds, ids, preds = [], [], [], [], [], []
     one_pair = any(set(chans) == set(x) for x in RADIAL_PAIRS)
     for c in chans:
         pair = next((x for x in RADIAL_PAIRS if c in x), (c, c))
@@ -88,14 +88,15 @@ def _line_gain_points(ctx, state, chans, runs, with_lines: bool = False):
             snr = p[ok] / n_pow[ok]
             fs.append(f[ok])
             ys.append(np.log(p[ok] / p_pred[ok]))
+            preds.append(p_pred[ok])
             ws.append(snr ** 2 / (snr ** 2 + SNR_KNEE**2))
             ds.append(np.full(int(ok.sum()), CHANNEL_DIRECTION[c]))
             ids.append(np.full(int(ok.sum()), line_ids.setdefault((CHANNEL_DIRECTION[c], h), len(line_ids))))
     if not fs:
         out = (np.empty(0), np.empty(0), np.empty(0), np.empty(0, str))
-        return out + (np.empty(0, int), []) if with_lines else out
+        return out + (np.empty(0, int), [], np.empty(0)) if with_lines else out
     out = (np.concatenate(fs), np.concatenate(ys), np.concatenate(ws), np.concatenate(ds))
-    return out + (np.concatenate(ids), list(line_ids)) if with_lines else out
+    return out + (np.concatenate(ids), list(line_ids), np.concatenate(preds)) if with_lines else out
 
 
 def _lifted_directions(e: "FixedResonance", f: np.ndarray, y: np.ndarray, w: np.ndarray, dirs: np.ndarray) -> int:
@@ -322,13 +323,14 @@ def _fit_stand_with_levels(ctx: Context, state: State, channels, chans, runs, f0
     lo, hi = ctx.k_lo * ctx.df, ctx.k_hi * ctx.df
     e, st = None, state
     for _ in range(n_iter):
-        f, y, wt, dirs, ids, keys = _line_gain_points(ctx, st, chans, runs, with_lines=True)
+        f, y, wt, dirs, ids, keys, pred = _line_gain_points(ctx, st, chans, runs, with_lines=True)
         if e is not None:
-            y = y + np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2)
+            prev = np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2)
+            y, pred = y + prev, pred * np.exp(-prev)        # against the base without the previous pass's stand
             starts = [(e.f_r, e.zeta, numerator_damping(e.zeta, e.peak_gain, e.gain_above), e.gain_above)]
         else:
             starts = starts_of(f, y, wt, ids, lambda f_, y_: FixedResonance.peak(f_, y_, lo, hi, ctx.df), f0)
-        got = fit_with_levels(f, y, wt, ids, lo, hi, starts) if starts else None
+        got = fit_with_levels(f, y, wt, ids, lo, hi, starts, pred) if starts else None
         if got is None:
             return None
         f_r, zeta, gain, above, levels, _ = got
