@@ -241,15 +241,16 @@ def _narrow_judge(ctx, state, judged, min_gain) -> tuple:
     beside a misfit of the modes.  trial21 (11-kg wheel, Ω^2.6 on the bearing line h 3.3): t 83-188 on the held-out
     runs, 0.13-0.47 % of the misplaced power, the torques' misfit at the rocking whirl crossings holding 85 % of it;
     the same laws took 14-29 % of the narrow-line misfit, the reviewer's view of the waterfall
-    (``waterfall_band_contrast``: every band weighs alike).  An effect that adds content (a line, a floor, a resonance)
-    is not judged so: its power share is its measure, and every band alike would let a floor's many bands pass."""
+    (``waterfall_band_contrast``: every band weighs alike).  An effect that adds content (a floor, a resonance, a line
+    but a close one or one the base left out) is not judged so: its power share is its measure, and every band alike
+    would let a floor's many bands pass."""
     modes = [e for e in state.effects if getattr(e, "kind", "") == "suspension_modes"]
     if (getattr(ctx, "base_switch", False) and not modes) or \
             any(not m.startswith("zeta") for e in modes for m in e.unconstrained):
         # a wheel mode not located (or none, where the data were to give them) leaves its lines' misfit to whatever
-        # re-weights them: no law on the narrow lines
-        # (trial24, rocking not located beside an Ω^2.4 torque line crossing its backward whirl: Ω^1.66 on h 0.41)
-        return None, None, None
+        # re-weights them: no law on the narrow lines, only a line the base left out found beside a stand (trial24:
+        # rocking not located beside an Ω^2.4 torque line crossing its backward whirl, Ω^1.66 on h 0.41)
+        judged = [h for h in judged if getattr(h.effect, "left_out", False)]
     narrow = [h for h in judged if h.narrow_gain_fraction is not None and h.narrow_gain_fraction >= min_gain]
     for h in sorted(narrow, key=lambda h: -float(h.narrow_gain_fraction)):
         refit = h.effect.refit(ctx, state)

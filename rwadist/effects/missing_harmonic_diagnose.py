@@ -509,6 +509,8 @@ class MissingHarmonic:
     #: ((h before, sense, C before, h, C), ...): the model lines within the Welch lobe of a ``close`` line, measured again
     #: apart from it on the whole-run DFT (the base's fit measured the blend of both on the Welch grid)
     beside: tuple = ()
+    #: a line the base left out as amplified at nearly every speed (``ctx.left_out``), fitted beside a test stand
+    left_out: bool = False
     kind: str = "missing_harmonic"
 
     @property
@@ -519,8 +521,10 @@ class MissingHarmonic:
     def judged_on_narrow_lines(self) -> bool:
         """A ``close`` line is judged on the narrow lines as well (:func:`rwadist.diagnose.search._narrow_judge`): it
         moves power between two lines one Welch lobe apart, a share of the power-weighted misfit as small as the
-        weaker line, where a reviewer of the waterfall sees both."""
-        return self.close
+        weaker line, where a reviewer of the waterfall sees both.  So is a line the base left out, found again beside a
+        test stand: the wheel's own line, whose share of the power-weighted misfit beside the stand's is small (family
+        wheel 4 hard mounted on a 90-Hz transmissibility: axial h 4.62, +33 dB over the model in its bins, 1 %)."""
+        return self.close or self.left_out
 
     def apply(self, state: State) -> State:
         s = state.copy()
@@ -559,7 +563,9 @@ class MissingHarmonic:
         if d.size < 3:
             return None
         C = line_C(d, w)
-        return MissingHarmonic(direction, float(h), C, int(d.size))
+        left_out = any(x == direction and abs(y - h) <= 1e-3 * y for x, y in getattr(ctx, "left_out", ())) and any(
+            getattr(e, "role", "") == "test_stand" for e in state.effects)
+        return MissingHarmonic(direction, float(h), C, int(d.size), left_out=left_out)
 
     @staticmethod
     def fit_close(ctx: Context, state: State, direction: str, h: float, runs) -> "MissingHarmonic | None":
