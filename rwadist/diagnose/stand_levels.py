@@ -110,11 +110,14 @@ def starts_of(f: np.ndarray, y: np.ndarray, w: np.ndarray, lines: np.ndarray, pe
 def levelled_harmonics(model, line_levels) -> dict:
     """``model``'s empirical harmonics ({direction: [Harmonic]}, new lists) with each (direction, h, factor) of
     ``line_levels`` multiplying that line's C (the level fitted with a test stand, on every speed: its speeds the base
-    left out as modally amplified are no longer listed, ``excluded_rpm`` emptied)."""
+    left out as modally amplified are no longer listed, ``excluded_rpm`` emptied; its ``C_stderr`` scaled alike: the
+    relative error the base measured, not an absolute one of another C)."""
     from dataclasses import replace
 
     out = {d: list(v) for d, v in model.empirical.items()}
     for direction, h, factor in line_levels:
-        out[direction] = [replace(x, C=x.C * factor, excluded_rpm=[]) if abs(x.h - h) <= 1e-9 * h else x
+        out[direction] = [replace(x, C=x.C * factor, excluded_rpm=[],
+                                  C_stderr=None if x.C_stderr is None else x.C_stderr * factor)
+                          if abs(x.h - h) <= 1e-9 * h else x
                           for x in out.get(direction, [])]
     return out
