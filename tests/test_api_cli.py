@@ -115,8 +115,9 @@ def test_model_show_and_compare(steady, tmp_path, capsys):
     assert code == 0 and json.loads(out) == model_io.to_json(rwadist.load_model(file))
     code, out, _ = run(capsys, "model", "show", file, "--format", "csv")
     rows = [line.split(",") for line in out.strip().splitlines()[1:]]
-    want = [(d, h.h, h.C) for d in model_io.DIRECTIONS for h in model.harmonics(d)]
-    assert [(d, float(h), float(c)) for d, h, c, _ in rows] == want
+    want = [(d, h.h, h.C, "" if d.startswith("axial") else (h.sense or "co"))
+            for d in model_io.DIRECTIONS for h in model.harmonics(d)]
+    assert [(d, float(h), float(c), sense) for d, h, c, _, sense in rows] == want
     code, out, _ = run(capsys, "model", "compare", file, "--preset", "ithaco-e")
     res = catalogue.compare(rwadist.load_model(file), catalogue.load("ithaco-e"))
     printed = re.findall(r"^(\w+_\w+) +([\d.]+) +([\d.e+-]+) +([\d.]+) +([\d.e+-]+)", out, flags=re.M)
