@@ -25,8 +25,16 @@ failing cells fail the error figure only (wheel 4 transmissibility 5.8x its clea
 level of 2e-5 that holds no mixed-sense lines), lines a transmissibility attenuates under the noise missing (0-3 per
 wheel, described as speed lines where they stand out); counter_aniso 8/8 (q 0.0588 and x/y split 0.470 against the
 closed form's 0.0588 and 0.471); sidebands 8/8.  The worst C of the clean cells is 0.2-14 % (the family's lines
-of both senses; not examined this session: an empirical fit on an ellipse's x and y amplitudes reads their mean,
-3 % low on the imbalance at q 0.08, docs/diagnose.md ``counter_rotation``).
+of both senses: Eq. 3.10 read their mean amplitude).
+
+Session 49 (3b71d3b, 40 cells in 283 s beside a CI run): C read at the lines' mean power (rwadist.empirical.line_C),
+a stand's line levels on the powers, a line the base left out completed beside the stand.  The same passes (clean 8/8,
+fixture_peak 7/8, fixture_trans 6/8 -- the same three cells fail the error figure only, wheel 4 transmissibility
+5.6x, wheel 5 24x and 910x of a clean level of 2e-5: the stand's ζ fitted 0.0285 for 0.03 on its skirts' points --
+counter_aniso 8/8, sidebands 8/8); the worst C of the clean cells 0.1-0.4 % (wheel 2 3.7 %: a planar line h 9.14),
+of the fixture cells 0.4-5.8 % (wheel 4 transmissibility 22 % before), lines missing 0 but one (wheel 4 fixture_peak; before 0-3 per
+wheel).  counter_aniso's 3.1 % is the mount's: x 1.25 and y 0.75 carry sqrt((1.25² + 0.75²)/2) = 1.031 of the
+line's power.
 
 Run (about 40 diagnoses of 3-20 s; nice it)::
 
