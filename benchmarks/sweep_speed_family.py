@@ -30,7 +30,8 @@ wheel 7's 2xBPFO 6.848 on its 60-s run-up, read four times at the edges of its 4
 6.728 / 6.918 in Fz).  At 3abf466 (the ridges within a line's smear one line): the same, 4 records in 3 sweeps.
 Session 45: at ca1d3d8 wheel 5's 60-s run-down from 10000 rpm read a fixed line at 484 Hz over its top four slices (a
 block of 4 runs judged at its own bin); at 5fb92bc (a sweep's slices: 6 runs, the level in the cells) the same as
-3abf466, 4 records in 3 sweeps, worst h 0.090 %, modes 16/16.
+3abf466, 4 records in 3 sweeps, worst h 0.090 %, modes 16/16.  Session 49 (3b71d3b: C read at the lines' mean power): the same, 16/16, worst h
+0.090 %, no line twice, modes 16/16, 4 records in 3 sweeps.
 At e381cc0 (session 44, humps in some runs) wheel 5's two sweeps each had a hump at 512 Hz in 2-5 fast slices
 (kurtosis 2.7-3.1, a smeared line's skirt); at 545f9e2 (that detector on steady runs only) the same as at 3abf466.
 """
