@@ -172,7 +172,12 @@ humps' (60, 4097) medians 165 -> 11 ms), the narrow lines' ring medians read at 
 transformed for its own channels, a search state's model copied without a deep copy of its harmonics (16 new-user
 sets' summary.json, model.json, hypotheses.csv identical): x9.3-9.5/x9.7-9.9 (benchmark), x10.6-10.8/x10.6 (sixty)
 in two rounds; the sixty set still over 10x.  Tried, below the noise: the records' blocked layout kept per run, the
-drift scan in single precision.
+drift scan in single precision.  Session 49 (e1ed974, --quick --repeats 3 --busy 2, load 0.55-1.41): cpu min/median
+x8.4/x8.3 (benchmark; 1.93 s / 0.23 s), x10.2/x8.7 beside 2 busy, x12.5/x12.5 (sixty; 1.14 s / 0.09 s), x11.9/x12.2
+beside 2 busy: the sixty set lost ground since session 45 (x10.6) to what sessions 46-48 added to the search (the
+sideband pairs and line senses of its starting model, the stand's levels); cProfile of a sixty diagnose: the wheel's
+modes 0.34 s, the fixed-resonance candidates 0.14 s, the whole data's fit at the fit's resolution (noisy sensors,
+mode reach) 0.09 s -- as much as the plain fit it is compared with.
 """
 from __future__ import annotations
 
