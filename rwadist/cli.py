@@ -256,13 +256,14 @@ def cmd_model_show(args) -> int:
     if args.format == "json":
         print(json.dumps(model_io.to_json(m), indent=2))
         return 0
+    from .effects_text import model_table, shown_sense
+
     if args.format == "csv":
         print("direction,h,C_SI,C_stderr_SI,sense")
         for d, h in rows:
             se = "" if h.C_stderr is None else repr(float(h.C_stderr))
-            print(f"{d},{h.h!r},{h.C!r},{se},{'' if d.startswith('axial') else (h.sense or 'co')}")
+            print(f"{d},{h.h!r},{h.C!r},{se},{shown_sense(d, h)}")
         return 0
-    from .effects_text import model_table
 
     print("\n".join(model_table(m)))
     return 0

@@ -64,6 +64,12 @@ def diagnose_lines(effects) -> list:
     return out
 
 
+def shown_sense(direction: str, harmonic) -> str:
+    """The rotation sense a table shows for ``harmonic`` of ``direction``: '' on an axial line, else its ``sense``, 'co'
+    where it has none (every consumer reads such a radial line co-rotating, docs/formats.md)."""
+    return "" if direction.startswith("axial") else (harmonic.sense or "co")
+
+
 def model_table(model) -> list:
     """Lines of `rwadist model show` (table format): the harmonics, then one line per effect."""
     from .model import DIRECTIONS
@@ -74,9 +80,7 @@ def model_table(model) -> list:
     for d, h in rows:
         se = "" if h.C_stderr is None else f"{h.C_stderr:.2e}"
         ex = " ".join(f"{lo:.0f}-{hi:.0f}" for lo, hi in h.excluded_rpm)
-        # a radial line without a sense is read co-rotating by every consumer (docs/formats.md)
-        sense = "" if d.startswith("axial") else (h.sense or "co")
-        out.append(f"{d:<14} {h.h:7.3f} {sense:>7} {h.C:12.4e} {se:>10} {h.n_points:6d}  {ex}")
+        out.append(f"{d:<14} {h.h:7.3f} {shown_sense(d, h):>7} {h.C:12.4e} {se:>10} {h.n_points:6d}  {ex}")
     effects = list(model.effects or [])
     out.append(f"effects ({len(effects)}):" if effects else "effects: none")
     out += [f"  {i + 1}. {describe_effect(e)}" for i, e in enumerate(effects)]

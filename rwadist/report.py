@@ -406,8 +406,8 @@ UNCERTAINTY_NOTE = ("±2σ: the fit's statistical error of C (measurement noise,
 
 
 def model_form_error(line) -> float:
-    """Held-out error of C·Ω² for ``line`` (a :class:`rwadist.empirical.LineFit`), relative: C fitted as the fit does (:func:`~rwadist.empirical.line_C`) on
-    every other speed of the measurements the fit used (sorted by speed), the RMS of (measured − predicted) at the
+    """Held-out error of C·Ω² for ``line`` (a :class:`rwadist.empirical.LineFit`), relative: C fitted as the fit does
+    (:func:`~rwadist.empirical.line_C`) on every other speed of the measurements the fit used (sorted by speed), the RMS of (measured − predicted) at the
     others over the RMS predicted, both ways, the larger; NaN with fewer than 4 points.  The noise is in it too:
     compare with 2σ/C (a pure C·Ω² line gives about the noise's scatter)."""
     used = np.asarray(line.used, dtype=bool)

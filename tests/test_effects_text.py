@@ -83,7 +83,8 @@ def test_model_show_lists_the_effects(tmp_path, capsys):
 
 def test_model_show_gives_each_radial_line_its_sense(tmp_path, capsys):
     """The table and the CSV say the rotation sense every consumer reads (a radial line without one: co)."""
-    m = WheelModel(name="w", empirical={"radial_force": [Harmonic(h=1.0, C=1e-6), Harmonic(h=2.5, C=2e-7, sense="counter")],
+    m = WheelModel(name="w", empirical={"radial_force": [Harmonic(h=1.0, C=1e-6),
+                                                         Harmonic(h=2.5, C=2e-7, sense="counter")],
                                         "radial_torque": [Harmonic(h=3.1, C=1e-8, sense="planar")],
                                         "axial_force": [Harmonic(h=2.0, C=3e-7)]})
     path = tmp_path / "m.json"

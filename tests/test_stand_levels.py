@@ -1,4 +1,5 @@
-"""The line levels fitted with a test stand on the empirical base (rwadist.diagnose.stand_levels), against closed forms."""
+"""The line levels fitted with a test stand on the empirical base (rwadist.diagnose.stand_levels), against closed
+forms."""
 import numpy as np
 import pytest
 
@@ -42,8 +43,8 @@ def test_levels_are_the_lines_mean_power_over_the_resonance(scatter):
 
 
 def test_a_levelled_line_keeps_its_relative_error_and_loses_its_exclusions():
-    m = WheelModel(name="w", empirical={"radial_force": [Harmonic(h=1.0, C=2e-6, C_stderr=1e-8),
-                                                         Harmonic(h=2.0, C=1e-6, C_stderr=4e-9, excluded_rpm=[[900, 1200]])]})
+    m = WheelModel(name="w", empirical={"radial_force": [
+        Harmonic(h=1.0, C=2e-6, C_stderr=1e-8), Harmonic(h=2.0, C=1e-6, C_stderr=4e-9, excluded_rpm=[[900, 1200]])]})
     (a, b) = levelled_harmonics(m, [("radial_force", 2.0, 3.0)])["radial_force"]
     assert (a.C, a.C_stderr) == (2e-6, 1e-8)
     assert (b.C, b.C_stderr) == pytest.approx((3e-6, 1.2e-8)) and b.excluded_rpm == []

@@ -287,8 +287,8 @@ def _run_noise(ctx: Context, state: State, chans, runs, f_hz) -> np.ndarray:
 
 
 def _record_carrier_C(ctx: Context, state: State, direction: str, h0: float, sides: tuple, runs) -> float | None:
-    """The carrier's C (:func:`~rwadist.empirical.line_C`) from its whole-run DFT amplitude |X| (:meth:`Context.phasors`, the fixed resonances
-    divided out) on the runs where both sides stand :data:`RUN_MIN_BINS` record bins from it, or None (fewer than 3
+    """The carrier's C (:func:`~rwadist.empirical.line_C`) from its whole-run DFT amplitude |X|
+    (:meth:`Context.phasors`, the fixed resonances divided out) on the runs where both sides stand :data:`RUN_MIN_BINS` record bins from it, or None (fewer than 3
     such runs)."""
     sub = runs
     for h in sides:
@@ -304,10 +304,10 @@ def _record_carrier_C(ctx: Context, state: State, direction: str, h0: float, sid
             ok = np.isfinite(a)
             d_parts.append(a[ok])
             w_parts.append(ctx.omega[sub][ok])
-    return _eq310_C(np.concatenate(d_parts), np.concatenate(w_parts))
+    return _positive_C(np.concatenate(d_parts), np.concatenate(w_parts))
 
 
-def _eq310_C(d: np.ndarray, w: np.ndarray):
+def _positive_C(d: np.ndarray, w: np.ndarray):
     """The C of amplitudes ``d`` (unit) against speeds ``w`` (rad/s), d = C·w² (:func:`rwadist.empirical.line_C`);
     None with fewer than 3 points or a C that is not positive."""
     if d.size < 3:
@@ -448,8 +448,8 @@ class SpeedSidebands:
     @staticmethod
     def fit(ctx: Context, state: State, direction: str, h0: float, runs, delta: float) -> "SpeedSidebands | None":
         """Each side's h refined on its residual peaks (:func:`rwadist.diagnose.measure.refine_h`) and its C by
-        :func:`~rwadist.empirical.line_C` on the amplitudes measured (modal gain divided out), both on the runs where that side
-        is resolved (:func:`resolvable_runs`); None when a side has fewer than 3 measured points or no
+        :func:`~rwadist.empirical.line_C` on the amplitudes measured (modal gain divided out), both on the runs where
+        that side is resolved (:func:`resolvable_runs`); None when a side has fewer than 3 measured points or no
         positive C."""
         if ctx.test is not None:
             return SpeedSidebands._fit_record(ctx, state, direction, h0, runs, delta)
@@ -465,7 +465,7 @@ class SpeedSidebands:
                 return None
             sub = resolvable_runs(ctx, state, direction, h0, h, runs)
             d, w = _measure(ctx, state, direction, h, sub)
-            C = _eq310_C(d, w)
+            C = _positive_C(d, w)
             if C is None:
                 return None
             out.append((h, C, d.size))
@@ -475,8 +475,8 @@ class SpeedSidebands:
     def _fit_record(ctx: Context, state: State, direction: str, h0: float, runs, delta: float):
         """:meth:`fit` on the whole-run DFT (time series given): each side's h is the maximum of the summed line
         power Σ|X|² over a grid h₀ ± δ ± 0.0125 (step 0.0005, then ± 0.0006 in steps of 0.00002, each refined by a
-        parabola through the top three) on the runs where it is resolved; its C by :func:`~rwadist.empirical.line_C` on the amplitudes sqrt(|X|² − noise) of the points standing
-        10 × over the noise, divided by the fixed resonances' and the modal gain (the line before the mount)."""
+        parabola through the top three) on the runs where it is resolved; its C by :func:`~rwadist.empirical.line_C`
+        on the amplitudes sqrt(|X|² − noise) of the points standing 10 × over the noise, divided by the fixed resonances' and the modal gain (the line before the mount)."""
         out = []
         for side in (-1.0, 1.0):
             h = h0 + side * delta
@@ -511,7 +511,7 @@ class SpeedSidebands:
                 d_parts.append(a[ok])
                 w_parts.append(ctx.omega[sub][ok])
             d, w = np.concatenate(d_parts), np.concatenate(w_parts)
-            C = _eq310_C(d, w)
+            C = _positive_C(d, w)
             if C is None:
                 return None
             out.append((h, C, d.size))
