@@ -168,13 +168,13 @@ def test_second_empirical_fit_reusing_the_detections_is_a_fresh_fit():
 def test_mode_fit_spectra_of_some_runs_are_those_runs_alone():
     from rwadist.data import SteadyTest
     from rwadist.diagnose.engine import Context
-    from rwadist.effects.suspension_modes_diagnose import _fit_spectra
+    from rwadist.diagnose.whole_fit import fit_spectra
 
     test = _small_test()
     ctx = Context(compute_spectra(test, nperseg=512), test=test)
     for runs in (ctx.fit_runs, ctx.runs):
         sub = SteadyTest([test.runs[r] for r in runs], dict(test.meta))
-        got, det = _fit_spectra(ctx, sub, list(runs))
+        got, det = fit_spectra(ctx, sub, list(runs))
         ref = compute_spectra(sub, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
         assert got.nperseg == ref.nperseg and got.channels == ref.channels and got.run_names == ref.run_names
         np.testing.assert_array_equal(got.speed, ref.speed)

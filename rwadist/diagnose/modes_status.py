@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-#: the memo key of the modes' empirical fit of every run (:func:`rwadist.effects.suspension_modes_diagnose._whole_data_fit`)
+#: the memo key of the modes' empirical fit of every run (:func:`rwadist.diagnose.whole_fit.whole_data_fit`)
 WHOLE_DATA_FIT = ("suspension_modes.whole_data_fit",)
 #: the memo key of the amplification peaks read from that fit (:func:`rwadist.extended_fit.amplification_peaks`)
 AMPLIFICATION_PEAKS = ("modes_status.amplification_peaks",)

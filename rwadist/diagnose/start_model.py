@@ -37,9 +37,8 @@ def start_model(ctx, fit0):
     resolution left out (their C read on the whole records); the pairs ((direction, h₀, h_lower, h_upper, C_lower,
     C_upper, measurements) each) set on ``ctx.base_sideband_pairs``.  The model as it is without the records, on a
     sweep's slices (a line sweeps over a slice) or when the records are no finer than the segments."""
-    from ..empirical import fit_empirical
-    from ..spectra import compute_spectra
     from .modes_base import _sideband_pairs
+    from .whole_fit import whole_records_fit
 
     ctx.base_sideband_pairs = ()
     test = ctx.test
@@ -53,7 +52,7 @@ def start_model(ctx, fit0):
     if fs / n * FINER > ctx.df:
         return model
     try:
-        fine = fit_empirical(compute_spectra(test, nperseg=n, channels=list(ctx.channels)))
+        fine = whole_records_fit(ctx, n)
     except ValueError:
         return model                        # the records cannot be read whole (runs of other lengths)
     out, pairs = None, []

@@ -21,68 +21,19 @@ import numpy as np
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.modes_base import wheel_base
-from ..diagnose.modes_status import WHOLE_DATA_FIT
 from ..diagnose.modes_trend import beside_trend
 from ..diagnose.stands import StandGroup
 from ..diagnose.state import State
+from ..diagnose.whole_fit import fit_of_runs, fit_spectra, whole_data_fit
 from ..model import WheelModel
 from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode, stand_starts
 from .cross_coupling_diagnose import OFFSET_Z, CrossCoupling
 
 
-def _fit_spectra(ctx: Context, test, runs: list):
-    """(spectra, detections) of ``test`` (the context's runs ``runs``) at the fit's own resolution, as ``rwadist fit``
-    computes them (:func:`rwadist.spectra.compute_spectra`'s default segment: the longest): close lines (h = 5.37,
-    5.57 of the E wheel) that diagnose's shorter Welch segments cannot separate are resolved here; ``detections``
-    their block floors and detected lines (:func:`rwadist.empirical.line_detections`), or None.
-
-    A run's Welch PSD, block floor and lines are its own: those of every run of the context are computed once (kept
-    on the context) and the rows of ``runs`` taken, so the fit on the fit runs and the refit on every run share
-    them; computed on ``test`` alone when the context's runs cannot be (a run outside ``runs`` too short)."""
-    from dataclasses import replace
-
-    from ..data import DataError
-    from ..empirical import detections_of_runs, line_detections
-    from ..spectra import _default_nperseg, compute_spectra
-
-    nperseg = _default_nperseg(int(np.median([r.n_samples for r in test.runs])))
-    key = ("suspension_modes.spectra", nperseg)
-    if key not in ctx._memo:
-        try:
-            full = compute_spectra(ctx.test, nperseg=nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
-            ctx._memo[key] = (full, line_detections(full))
-        except DataError:
-            ctx._memo[key] = None
-    if ctx._memo[key] is None:
-        return compute_spectra(test, nperseg=nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim), None
-    full, det = ctx._memo[key]
-    rows = np.asarray(runs, dtype=int)
-    chans = [c for c in test.channels if c in full.psd]      # a channel left out of every run is not read
-    # consecutive runs (every run with a speed): views, not copies
-    sel = slice(rows[0], rows[-1] + 1) if rows.size and np.all(np.diff(rows) == 1) else rows
-    sp = replace(full, speed=full.speed[sel], psd={c: full.psd[c][sel] for c in chans},
-                 amplitude={c: full.amplitude[c][sel] for c in chans}, n_segments=full.n_segments[sel],
-                 run_names=[full.run_names[r] for r in rows])
-    if rows.size and np.any(np.diff(rows) <= 0):
-        return sp, None                 # the lines' renumbering needs the runs in order
-    return sp, detections_of_runs({c: det[c] for c in chans if c in det}, rows)
-
-
-def _test_and_fit(ctx: Context, runs) -> tuple:
-    """(SteadyTest, EmpiricalFit) of the context's runs ``runs`` (positions), at the modes' resolution (:func:`_fit_spectra`)."""
-    from ..data import SteadyTest
-    from ..empirical import fit_empirical
-
-    runs = [int(r) for r in runs]
-    test = SteadyTest([ctx.test.runs[r] for r in runs], dict(ctx.test.meta))
-    sp, detections = _fit_spectra(ctx, test, runs)
-    return test, fit_empirical(sp, detections=detections)
-
-
 def _recorded_meta(ctx: Context) -> dict:
     """The meta of the context's test with the far noisier sensor family of the load cell
     (:func:`rwadist.extended_fit_lsq.noisy_sensor_directions`) decided once, on every run as recorded (the whole
-    data's lines at every speed, :func:`_whole_data_fit`), under
+    data's lines at every speed, :func:`whole_data_fit`), under
     :data:`rwadist.extended_fit_lsq.NOISY_SENSORS_META`: every fit of the modes (on half of the runs, on every run, on
     the torques corrected for a load-cell offset) weighs the same family's measurements by their noise, or none.  On
     the corrected torques T − r × F the force sensors' noise reads in both families, and a decision taken again
@@ -91,7 +42,7 @@ def _recorded_meta(ctx: Context) -> dict:
 
     key = ("suspension_modes.noisy_sensors",)
     if key not in ctx._memo:
-        ctx._memo[key] = noisy_sensor_directions(_whole_data_fit(ctx).without_mode_exclusion.lines)
+        ctx._memo[key] = noisy_sensor_directions(whole_data_fit(ctx).without_mode_exclusion.lines)
     return dict(ctx.test.meta, **{NOISY_SENSORS_META: ctx._memo[key]})
 
 
@@ -128,11 +79,11 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     runs = [int(r) for r in runs]
     test = SteadyTest([ctx.test.runs[r] for r in runs], _recorded_meta(ctx))
     if runs == [int(r) for r in ctx.runs]:
-        fit = _whole_data_fit(ctx)      # the refit on every run: the same empirical fit, computed once
+        fit = whole_data_fit(ctx)      # the refit on every run: the same empirical fit, computed once
     else:
-        sp, detections = _fit_spectra(ctx, test, runs)
+        sp, detections = fit_spectra(ctx, test, runs)
         fit = fit_empirical(sp, detections=detections)
-    if not amplification_peaks(fit) and not amplification_peaks(_whole_data_fit(ctx)):
+    if not amplification_peaks(fit) and not amplification_peaks(whole_data_fit(ctx)):
         return None
     offset = None
     # what follows depends on the runs and the starts alone, except the offset (read beside ``state``): kept on the
@@ -163,7 +114,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
             # tried it on each direction for nothing)
             def beside_structure(efit=efit):
                 structure = fit_extended_beside_structure_mode(test, fit, efit, start=structure_start)
-                if structure is not None and not fixed_across_speeds(lambda part: _test_and_fit(ctx, part),
+                if structure is not None and not fixed_across_speeds(lambda part: fit_of_runs(ctx, part),
                                                                      ctx.test.speeds, runs, structure):
                     # a resonance moving with speed: the open world describes it, the modes it hid are located
                     # beside it (none: the modes as they were)
@@ -202,7 +153,7 @@ def _memo(ctx: Context, key: tuple, compute):
 def _locate(ctx: Context, test, fit, stand_start, near=None):
     """(ExtendedFit, stand) of ``test`` (empirical fit ``fit``): the modes fitted jointly with a fixture resonance
     (:func:`rwadist.stand_resonance.fit_extended_beside_stand`, from ``stand_start`` or the stands the fit -- else the
-    whole data, :func:`_whole_data_fit` -- proposes) when that is confirmed over the fit without one, else the modes
+    whole data, :func:`whole_data_fit` -- proposes) when that is confirmed over the fit without one, else the modes
     alone (stand None).  Only with six channels: a stand is told from a mode by lifting the forces AND the torques.
     ``near`` (the modes of an earlier fit beside ``stand_start``, None: without a stand) guides only the fits beside
     that same stand (``near_stand`` of :func:`rwadist.stand_resonance.fit_extended_beside_stand`)."""
@@ -212,11 +163,11 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
         return fit_extended(test, fit, near=near), None
     # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows
     starts = [stand_start] if stand_start is not None else \
-        (_stand_starts_once(ctx, fit) or _stand_starts_once(ctx, _whole_data_fit(ctx)))
+        (_stand_starts_once(ctx, fit) or _stand_starts_once(ctx, whole_data_fit(ctx)))
     efit = fit_extended_beside_stand(test, fit, starts=starts, near=near, near_stand=stand_start,
                                      joints=_joints_memo(ctx, test, fit))
     own = ((efit.stand,) if efit.stand is not None else ()) + tuple(efit.more_stands)
-    if stand_start is None and (not own or stand_starts(_whole_data_fit(ctx), known=own)):
+    if stand_start is None and (not own or stand_starts(whole_data_fit(ctx), known=own)):
         # every run may show a stand (or another one) these runs do not resolve; ``near`` came from a fit without a
         # stand (stand_start None): no guide to the modes beside one
         held = _beside_whole_data_stand(ctx, test, fit, efit)
@@ -284,14 +235,14 @@ def _beside_whole_data_stand(ctx: Context, test, fit, plain):
 def _whole_data_stands(ctx: Context) -> tuple:
     """The fixture resonances ((f_r Hz, ζ, peak gain, gain above) each) fitted jointly with the modes on every run
     (:func:`rwadist.stand_resonance.fit_extended_beside_stand` of the whole data's empirical fit,
-    :func:`_whole_data_fit`: its ``stand`` and ``more_stands``) when that fit confirms any, else (); computed once per
+    :func:`whole_data_fit`: its ``stand`` and ``more_stands``) when that fit confirms any, else (); computed once per
     diagnosis."""
     from ..data import SteadyTest
 
     key = ("suspension_modes.whole_data_stand",)
     if key not in ctx._memo:
         ctx._memo[key] = ()
-        whole_fit = _whole_data_fit(ctx)
+        whole_fit = whole_data_fit(ctx)
         starts = _stand_starts_once(ctx, whole_fit)
         if starts:
             test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], _recorded_meta(ctx))
@@ -431,19 +382,6 @@ def _noted(got: tuple) -> tuple:
                         "located; not part of the wheel's model (diagnose names it as cross_coupling)"
                         % ", ".join(f"{1000 * v:.1f}" for v in got[4].r))
     return got
-
-
-def _whole_data_fit(ctx: Context):
-    """The empirical fit of EVERY run (at the fit's own resolution, as :func:`_fit_runs`), computed once per
-    diagnosis.  What the data as a whole show, asked only when the fit runs alone do not show it: the empirical
-    fit marks a line amplified only over a speed range several of its speeds cover, and a fixture resonance is
-    detected from the lines near it, so half of a short speed grid (10 of 20 speeds) can hide both while every
-    run shows them.  A detection only: the modes (and the stand) are still fitted on the fit runs and judged on
-    the held-out ones."""
-    key = WHOLE_DATA_FIT
-    if key not in ctx._memo:
-        ctx._memo[key] = _test_and_fit(ctx, ctx.runs)[1]
-    return ctx._memo[key]
 
 
 @register(order=100)
@@ -730,7 +668,7 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
               and all(abs(e.f_r / k[0] - 1) > SAME_STAND for k in mine)]
     if not others:
         return state
-    test, fit = _test_and_fit(ctx, ctx.runs)
+    test, fit = fit_of_runs(ctx, ctx.runs)
     test = SteadyTest(test.runs, _recorded_meta(ctx))
     try:
         one = fit_extended(test, fit, stand=own, more_stands=tuple(modes.more_stands))
