@@ -36,6 +36,17 @@ of the fixture cells 0.4-5.8 % (wheel 4 transmissibility 22 % before), lines mis
 wheel).  counter_aniso's 3.1 % is the mount's: x 1.25 and y 0.75 carry sqrt((1.25² + 0.75²)/2) = 1.031 of the
 line's power.
 
+Session 50 (40 cells in 429 s beside a family-matrix run): a test stand fitted again at the end beside the lines
+completed after it (rwadist.effects.fixed_resonance_diagnose.stands_refitted_last), its line points weighted by their
+own scatter (rwadist.diagnose.stand_levels), and a line the base left out proposed beside the stand where the power
+bound would skip its direction: clean 8/8; fixture_peak 8/8 and fixture_trans 7/8, the stand named within 1 % in all
+16 cells, nothing else added; counter_aniso 8/8; sidebands 8/8.  Wheel 4 transmissibility 5.6x -> 4.1x its clean
+cell, wheel 5 peak 24x -> 1.7x (18x with the refit alone: its stand 299.97 Hz, 1e-4 off), wheel 5
+transmissibility 910x -> 6.9x of a clean level of 2e-5: the stand 300.33 Hz, ζ 0.0285 -> 300.001 Hz, ζ 0.0300, what is
+left the split of the 296.9-Hz line's power, lifted 250x at 5304 rpm, between two Welch bands (0.2 %).  The worst C of
+the fixture cells 0.1-4.0 % (wheel 2's planar line as in its clean cell), lines missing 0 but one (wheel 4
+fixture_peak, as before).
+
 Run (about 40 diagnoses of 3-20 s; nice it)::
 
     nice -n 10 python benchmarks/diagnose_hard_mounted.py [--wheels 0,4] [--kinds clean,fixture_trans]

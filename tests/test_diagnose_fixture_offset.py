@@ -10,7 +10,7 @@ them against the modes' corrected torque lines, and took part of r × F for itse
 Kept after the offset was named, it misplaced 2.2 % of the forces' line power and 1.5 % of the torques' against the
 generator's noise-free lines (the clean wheel's diagnosis: 0.6 % and 0.4 %), and the error after was 6.0x the clean
 cell's.  A stand named before the offset is now refitted beside it at the end of the search
-(:func:`rwadist.effects.fixed_resonance_diagnose.stands_beside_offset`): 195.61 Hz, gain above 1.0006, 0.9 % and
+(:func:`rwadist.effects.fixed_resonance_diagnose.stands_refitted_last`): 195.61 Hz, gain above 1.0006, 0.9 % and
 0.4 % misplaced (the same fixture without the offset: 195.59 Hz, 1.0007, 0.9 % and 0.35 %); the error after 1.9x the
 clean cell's.
 """

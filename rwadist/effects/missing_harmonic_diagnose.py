@@ -60,8 +60,7 @@ RECORD_MIN_RUNS = 3
 #: A model line's amplitude on the Welch PSDs over its amplitude on the whole-run DFT, at least (median of the faster
 #: half of the runs), for a line hidden in its window (:func:`hidden_neighbours`): 6 % more power
 HIDDEN_RATIO = 1.03
-#: Grid of :func:`resolved_h`'s first scan, record bins at the fastest run (a line between its points loses at most
-#: 0.4 dB of the Hann window's main lobe; the second scan is five times finer around its maximum).
+#: :func:`resolved_h`'s first scan grid (the second 5x finer), record bins at the fastest run: a line loses <= 0.4 dB
 RESOLVED_SCAN_BINS = 0.5
 #: Points used for C stand this many times over the noise (as the whole-run fit of ``speed_sidebands``).
 RECORD_FIT_SNR = 10.0
@@ -493,6 +492,12 @@ def record_residual(ctx: Context, state: State, c: str, runs, f_hz, exact: bool 
     return P, N, ok
 
 
+def left_out_beside_stand(ctx: Context, state: State, direction: str, h: float | None = None) -> bool:
+    """Whether ``ctx.left_out`` (lines the base left out) holds ``direction``'s line ``h`` (any: None) beside a stand."""
+    return any(x == direction and (h is None or abs(y - h) <= 1e-3 * y) for x, y in getattr(ctx, "left_out", ())) \
+        and any(getattr(e, "role", "") == "test_stand" for e in state.effects)
+
+
 @register(order=10)
 @dataclass
 class MissingHarmonic:
@@ -562,10 +567,8 @@ class MissingHarmonic:
         d, w = _measure(ctx, state, direction, h, runs)
         if d.size < 3:
             return None
-        C = line_C(d, w)
-        left_out = any(x == direction and abs(y - h) <= 1e-3 * y for x, y in getattr(ctx, "left_out", ())) and any(
-            getattr(e, "role", "") == "test_stand" for e in state.effects)
-        return MissingHarmonic(direction, float(h), C, int(d.size), left_out=left_out)
+        return MissingHarmonic(direction, float(h), line_C(d, w), int(d.size),
+                               left_out=left_out_beside_stand(ctx, state, direction, h))
 
     @staticmethod
     def fit_close(ctx: Context, state: State, direction: str, h: float, runs) -> "MissingHarmonic | None":
@@ -776,14 +779,16 @@ class MissingHarmonic:
             return ctx.reuse("missing_harmonic", state, lanes[d], runs, lambda: welch(d, lanes[d]))
 
         # a Welch-route line is judged by the error metric on the direction's channels: proposed only where it could
-        # pass (Context.can_pass); the record route's lines bring their own held-out evidence, and one within 0.03 of a
-        # Welch-route line of its direction is not proposed (that line still found, where skipped, to tell)
+        # pass (Context.can_pass) but one the base left out, beside a stand (judged on the narrow lines too); the record
+        # route's lines bring their own held-out evidence, and one within 0.03 of a Welch-route line of its direction
+        # is not proposed (that line still found, where skipped, to tell)
         skipped = set()
         for d, chans in lanes.items():
             if ctx.can_pass(state, chans):
                 out += welch_lines(d)
             else:
                 skipped.add(d)
+                out += [e for e in welch_lines(d) if e.left_out] if left_out_beside_stand(ctx, state, d) else []
         for d, chans in lanes.items():
             found = ctx.reuse("missing_harmonic", state, chans, runs,
                               lambda d=d: MissingHarmonic.record_candidates(ctx, state, runs, max_per_direction, (d,)),

@@ -1,5 +1,5 @@
 """A test-stand resonance named before a load-cell offset is refitted beside it
-(:func:`rwadist.effects.fixed_resonance_diagnose.stands_beside_offset`), checked against the generator's stand.
+(:func:`rwadist.effects.fixed_resonance_diagnose.stands_refitted_last`), checked against the generator's stand.
 
 Data: a hard-mounted wheel of this file's own (numpy; the lines of tests/test_cross_coupling_own_weight.py, each of its
 own random phase in every run, the sensors' noise of tests/test_describe_offset_floor.py) on a fixture whose transfer is tests/family_effects.py's ``peak_resonance`` (150 Hz,
@@ -23,7 +23,7 @@ from test_describe_offset_floor import NOISE  # noqa: E402
 from rwadist.data import Run, SteadyTest  # noqa: E402
 from rwadist.diagnose.engine import Context, initial_state  # noqa: E402
 from rwadist.effects.cross_coupling_diagnose import CrossCoupling  # noqa: E402
-from rwadist.effects.fixed_resonance_diagnose import FixedResonance, stands_beside_offset  # noqa: E402
+from rwadist.effects.fixed_resonance_diagnose import FixedResonance, stands_refitted_last  # noqa: E402
 from rwadist.model import Harmonic, WheelModel  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
 
@@ -83,12 +83,18 @@ def _named_in_order(r_z: float):
     return ctx, offset.apply(state), stand, offset
 
 
-def test_a_stand_named_before_the_offset_is_refitted_to_the_generators():
+def test_a_stand_named_before_the_offset_is_refitted_to_the_generators(monkeypatch):
+    from rwadist.diagnose import stand_levels
+
+    # the stand fitted with one weight for every line (its fit before the lines' own scatter weighed them,
+    # rwadist.diagnose.stand_levels._scatter_weights): the premise, a stand that took part of r × F for itself
+    monkeypatch.setattr(stand_levels, "_scatter_weights", lambda res, inverse, w, w_sum: w)
     ctx, state, before, offset = _named_in_order(R_Z)
+    monkeypatch.undo()
     assert offset.r[2] == pytest.approx(R_Z, abs=5e-4)
-    # the premise: named before the offset, the stand took part of r × F for itself (150.7 Hz, ζ 0.036, gain 4.3)
+    # named before the offset, the stand took part of r × F for itself (150.7 Hz, ζ 0.036, gain 4.3)
     assert abs(before.f_r / F_FIX - 1) > 0.003 and abs(before.zeta / ZETA_FIX - 1) > 0.1
-    out = stands_beside_offset(ctx, state)
+    out = stands_refitted_last(ctx, state)
     (after,) = [e for e in out.effects if isinstance(e, FixedResonance)]
     assert after is not before and [type(e) for e in out.effects] == [type(e) for e in state.effects]
     # refitted beside the offset: the generator's stand (150.012 Hz, ζ 0.0301, gain 4.99)
@@ -102,4 +108,13 @@ def test_without_an_offset_the_state_is_left_as_it_is():
     """No ``cross_coupling`` in the state (the stand alone, on data without an offset): nothing to refit beside."""
     ctx, state, stand = _stand_on(0.0)
     assert stand.f_r == pytest.approx(F_FIX, rel=5e-4) and stand.zeta == pytest.approx(ZETA_FIX, rel=0.03)
-    assert stands_beside_offset(ctx, state) is state
+    assert stands_refitted_last(ctx, state) is state
+
+
+def test_weighed_by_their_scatter_the_lines_read_the_stand_before_the_offset():
+    """The torques' lines r × F carries scatter about a stand fitted without the offset far more than the forces' do;
+    weighed by their own scatter the stand is the generator's before the offset is named (150.006 Hz, ζ 0.0302)."""
+    _, _, before, _ = _named_in_order(R_Z)
+    assert before.f_r == pytest.approx(F_FIX, rel=3e-4)
+    assert before.zeta == pytest.approx(ZETA_FIX, rel=0.03)
+    assert before.peak_gain == pytest.approx(GAIN_FIX, rel=0.03)
