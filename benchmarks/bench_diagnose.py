@@ -177,7 +177,12 @@ x8.4/x8.3 (benchmark; 1.93 s / 0.23 s), x10.2/x8.7 beside 2 busy, x12.5/x12.5 (s
 beside 2 busy: the sixty set lost ground since session 45 (x10.6) to what sessions 46-48 added to the search (the
 sideband pairs and line senses of its starting model, the stand's levels); cProfile of a sixty diagnose: the wheel's
 modes 0.34 s, the fixed-resonance candidates 0.14 s, the whole data's fit at the fit's resolution (noisy sensors,
-mode reach) 0.09 s -- as much as the plain fit it is compared with.
+mode reach) 0.09 s -- as much as the plain fit it is compared with.  Session 50 (799fbdd: that fit shared with the
+starting model's whole-record read of the sideband pairs, which computed the same spectra, lines and fit again;
+rwadist.diagnose.whole_fit): main 5e64498 and the new tree run one after the other at load 0.1-1.9 on an idle 2-core
+machine, --quick --repeats 3 --busy 2: cpu min/median x9.7/x9.6 -> x9.4/x9.2 (benchmark), x9.8/x9.6 -> x9.3/x9.3
+beside 2 busy, x11.4/x11.4 -> x10.8/x10.9 (sixty), x11.4/x11.3 -> x11.1/x11.1 beside 2 busy; sixty alone again:
+diagnose cpu min 1.41 -> 1.35 s (fit 0.12 s), x11.5 -> x11.3.  The sixty set is still over 10x.
 """
 from __future__ import annotations
 

@@ -51,7 +51,11 @@ translation still 8 % off): the stand named within 2 % of the fixture or ROSS's 
 criterion 21/32.  w4 at 0.5x rocking (a 75-kg stand at 37 Hz; ROSS's coupled rocking at rest 100.6 Hz, 35 % above
 the hard-mounted 74.5 Hz, the stand's own tilt whirling with speed): no mode located, and the 1x lines, amplified at
 nearly every speed, left out of the model -- now said (suspension_modes_status.left_out, the console, the h = 1
-ridges' first cause; tests/test_diagnose_left_out.py).
+ridges' first cause; tests/test_diagnose_left_out.py).  Session 50 (120fcc5: the test stand on the empirical base
+refitted at the end, its lines weighted by their scatter; 1733 s wall, one cell at a time beside other runs): every
+cell's pass the same as main 5e64498's, run beside it (21/32; stand named within 2 % of the fixture or ROSS's coupled
+mode 15/24; effects invented in 6/24 stand cells), the diagnoses identical but w7 at 1x rocking (its stand 464.057 ->
+464.059 Hz, the error after 0.033997 -> 0.033991).
 """
 from __future__ import annotations
 
