@@ -214,12 +214,9 @@ def test_a_pair_the_whole_records_resolve_only_at_the_top_speeds_is_named_with_i
     assert got == pytest.approx({0.95: 0.2, 1.0: 1.0, 1.05: 0.2}, rel=0.005)
 
 
-def test_lines_a_transmissibility_amplifies_at_nearly_every_speed_are_completed_after_it():
-    """Family wheel 4 hard mounted on a fixture H = 1/(1 − r² + 2jζr) at 90 Hz (1.8x its top speed's rotation, ζ 0.03):
-    the axial lines h 3 and 4.62 cross it, amplified at nearly every speed, and the empirical base leaves them out.
-    Found again beside the stand, each is 1 % of the power-weighted misfit the stand's leaves and +33 dB over the model
-    in its bins (before: described as speed lines, 'no suspension mode of the model explains' them).  Every line of
-    the wheel is in the model, its power (co and counter parts summed) within 3 % of the generator's."""
+def _family_on_transmissibility(index: int, f_fix: float):
+    """(family wheel ``index`` hard mounted -- its modes moved to 35-45 kHz --, its diagnosis with no model) on a fixture
+    H = 1/(1 − r² + 2jζr) at ``f_fix`` Hz (ζ 0.03) on every channel (tests/family_wheel.py's ``gain`` hook)."""
     import sys
     from dataclasses import replace
     from pathlib import Path
@@ -230,11 +227,20 @@ def test_lines_a_transmissibility_amplifies_at_nearly_every_speed_are_completed_
 
     class Transmissibility:
         def gain(self, f_hz, omega):
-            r = np.abs(f_hz) / 90.0
+            r = np.abs(f_hz) / f_fix
             return np.repeat((1.0 / (1 - r**2 + 2j * 0.03 * r))[:, None], 6, axis=1)
 
-    wheel = replace(fw.family()[4], f_trans=40000.0, f_rock=35000.0, f_axial=45000.0)
-    d = api.diagnose(steady_test(fw.steady(wheel, noise=0.01, seed=0, effects=[Transmissibility()])))
+    wheel = replace(fw.family()[index], f_trans=40000.0, f_rock=35000.0, f_axial=45000.0)
+    return wheel, api.diagnose(steady_test(fw.steady(wheel, noise=0.01, seed=0, effects=[Transmissibility()])))
+
+
+def test_lines_a_transmissibility_amplifies_at_nearly_every_speed_are_completed_after_it():
+    """Family wheel 4 hard mounted on a fixture H = 1/(1 − r² + 2jζr) at 90 Hz (1.8x its top speed's rotation, ζ 0.03):
+    the axial lines h 3 and 4.62 cross it, amplified at nearly every speed, and the empirical base leaves them out.
+    Found again beside the stand, each is 1 % of the power-weighted misfit the stand's leaves and +33 dB over the model
+    in its bins (before: described as speed lines, 'no suspension mode of the model explains' them).  Every line of
+    the wheel is in the model, its power (co and counter parts summed) within 3 % of the generator's."""
+    wheel, d = _family_on_transmissibility(4, 90.0)
     (stand,) = d.model.effects
     assert stand["role"] == "test_stand" and stand["f_Hz"] == pytest.approx(90.0, rel=0.01)
     assert not [u for u in d.unexplained if u.signature == "speed_line"]
@@ -250,22 +256,8 @@ def test_a_stand_named_before_the_lines_it_amplifies_is_measured_again_on_them()
     without them on its skirts: no line within 4 % of it.  Refitted at the end beside them
     (:func:`rwadist.effects.fixed_resonance_diagnose.stands_refitted_last`) its width and height are the closed form's
     (before: 300.33 Hz, ζ 0.0285, peak gain 17.5, those lines 3-4 % high in amplitude, the error after 0.018)."""
-    import sys
-    from dataclasses import replace
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    import family_wheel as fw
-    from family_test import steady_test
-
-    class Transmissibility:
-        def gain(self, f_hz, omega):
-            r = np.abs(f_hz) / 300.0
-            return np.repeat((1.0 / (1 - r**2 + 2j * 0.03 * r))[:, None], 6, axis=1)
-
-    wheel = replace(fw.family()[5], f_trans=40000.0, f_rock=35000.0, f_axial=45000.0)
+    wheel, d = _family_on_transmissibility(5, 300.0)
     assert wheel.max_rpm == 10000.0
-    d = api.diagnose(steady_test(fw.steady(wheel, noise=0.01, seed=0, effects=[Transmissibility()])))
     (stand,) = [e for e in d.model.effects if e["kind"] == "fixed_resonance"]
     assert stand["role"] == "test_stand"
     assert stand["f_Hz"] == pytest.approx(300.0, rel=3e-4)
