@@ -261,7 +261,10 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
         if abs(h - round(h)) <= 2 * res:
             got = motor_causes(h, res, d)           # a whole multiple: no bearing ratio, a motor's ripple on Tz
         else:
-            got = causes_of(h, res, bearings, [o for o in every if abs(o - h) > res])
+            # the lines of its direction stronger than it: what it may be a sum or difference of
+            level = {float(x.h): abs(float(x.C)) for x in diag.model.harmonics(d)}
+            parents = [o for o, c in level.items() if c > level.get(h, np.inf)]
+            got = causes_of(h, res, bearings, [o for o in every if abs(o - h) > res], parents)
         if got:
             src = "effect" if (d, round(h, 3)) in added else ("base" if fitted else "model")
             out.append({"direction": d, "h": h, "source": src, "causes": got})
@@ -321,7 +324,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_lines import speed_lines
     from .describe_partial import partial_lines
     from .describe_skew import channel_skew
-    from .describe_split import split_mode
+    from .describe_split import pair_asymmetries
     from .describe_trend import gain_trend
     from .run_gains import annotate
 
@@ -383,10 +386,15 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += [u for u in fixed_lines_in_part(ctx, state, of_fixed) if not on_a_sideband(ctx, u, tracks)] + sidebands
     # the recorded channels (a gain acts on them, before any load-cell correction), against the noise as given
     out += channel_gain(ctx, as_recorded(searched.state), of_line)
-    # the radial forces through two translation modes, x and y (a support stiffer along one axis)
-    out += split_mode(ctx, state, of_line)
-    # one channel of a radial pair recorded later than the other (its lines' x/y phase off a quarter turn ∝ f)
-    out += channel_skew(ctx, state, of_line)
+    # the radial forces through two translation modes, x and y (a support stiffer along one axis), or one channel of a
+    # radial pair through a resonance of its own (a sensor's, a fixture's along one axis)
+    asymmetric = pair_asymmetries(ctx, state, of_line)
+    out += asymmetric
+    # one channel of a radial pair recorded later than the other (its lines' x/y phase off a quarter turn ∝ f); not on
+    # a pair with a channel's resonance, whose phase below it grows as 2ζ(g − 1)·f/f_r, a delay's (docs/diagnose.md)
+    resonant = {c for u in asymmetric if u.parameters.get("property") == "channel_resonance"
+                for c in (u.parameters["channel"], u.parameters["partner"])}
+    out += [u for u in channel_skew(ctx, state, of_line) if not set(u.channels) & resonant]
     # a model line that is two or more lines closer than the Welch segments resolve (the whole record reads it alone)
     out += blended_lines(ctx, state, of_line)
     # a gain common to the channels that changes with speed, on the recorded channels too; one of the line's frequency

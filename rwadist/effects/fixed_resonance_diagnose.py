@@ -622,6 +622,7 @@ class FixedResonance:
                or not patches_a_stand(ctx, state, e, runs)]
         out = [e for e in out if not any(abs(e.f_r - r[0]) < 0.02 * r[0] and set(e.channels) & set(r[3])
                                          for r in state.resonances)]
+        out = [e for e in out if e.role != "wheel_mode" or one_channel_of_pair(ctx, state, e, runs) is None]
         # nor a resonance whose centre moves with the speed, read on every run (:func:`moves_with_speed`): a fixed one
         # fitted to it was added as a wheel mode (family wheel 4, an axial disc mode stiffening 149 -> 167 Hz over
         # 300-3000 rpm: a 'wheel mode' at 158.5 Hz; the slower half of the runs wants 151.7 Hz, the faster 159.3 Hz)
@@ -634,6 +635,35 @@ class FixedResonance:
 #: wheel translates and rocks at frequencies a few per cent apart (ROSS's wheel D on a 105-Hz stand: 103.1 and
 #: 108.6 Hz), and one resonance on every channel holds them as a compromise
 STAND_DIRECTION_SPREAD = 0.1
+
+
+#: A wheel-mode resonance on a radial pair lifts one channel alone when its lift of the other, fitted on that channel's
+#: own lines (:func:`one_channel_of_pair`), is under this share of the first's
+ONE_CHANNEL_LIFT_SHARE = 1.0 / 3.0
+
+
+def one_channel_of_pair(ctx: Context, state: State, e: "FixedResonance", runs) -> str | None:
+    """The channel of a radial pair that the wheel-mode resonance ``e`` (fitted on the pair's power sums) lifts alone,
+    or None.  Each channel's line gains (:func:`_line_gain_points` of that channel alone) are fitted with ``e``'s
+    shape scaled, y ≈ β·ln|H(f)|² (weighted least squares); the pair is lifted by one channel when β of the other is
+    under :data:`ONE_CHANNEL_LIFT_SHARE` of the larger.  A mode of the wheel lifts the lines of a radial direction in
+    x and in y alike (every line's ellipse passes through it whole); a resonance of one channel's sensor, amplifier or
+    cabling lifts that channel's alone, and fitted on the pair's sums it read as a 'wheel mode' of half its power gain
+    on both (the new-user trial's Fy sensor at 200 Hz, peak gain 5: a wheel mode of gain 3.6 on Fx and Fy, its
+    prediction 3.6x on the untouched Fx)."""
+    pair = next((p for p in RADIAL_PAIRS if set(p) == set(e.channels)), None)
+    if pair is None or not all(c in ctx.channels for c in pair):
+        return None
+    beta = {}
+    for c in pair:
+        f, y, w, _ = _line_gain_points(ctx, state, [c], runs)
+        shape = np.log(np.abs(resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2)
+        den = float(np.sum(w * shape * shape))
+        if f.size < 6 or den <= 0:
+            return None
+        beta[c] = float(np.sum(w * shape * y)) / den
+    lo, hi = sorted(pair, key=lambda c: beta[c])
+    return hi if beta[hi] > 0 and beta[lo] < ONE_CHANNEL_LIFT_SHARE * beta[hi] else None
 
 
 def stand_explains(f: np.ndarray, y: np.ndarray, sw: np.ndarray, e: "FixedResonance", stands) -> bool:
