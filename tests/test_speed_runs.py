@@ -156,3 +156,33 @@ def test_shared_line_reads_give_the_unshared_records():
     after = reads(back)["radial_force"]
     np.testing.assert_allclose(after[:, 0], before["radial_force"][:, 0], rtol=1e-12)
     np.testing.assert_allclose(after[:, 2], 1.0 - before["radial_force"][:, 2], atol=1e-9)
+
+
+def test_two_rotating_lines_that_agree_move_a_run_whose_axial_read_is_pulled_off_them():
+    """The new-user trial (session 51): runs from the median speed up 1.5 % faster than their column; four of 25 were
+    not moved, their axial 1x read pulled off the radial force's and torque's, which agreed to 7e-6 (the three lines'
+    χ²/dof 130-7900).  Here family wheel 7 (an axial 1x line of its own), the column 1.5 % low from the median speed
+    up and a line 2 % over the rotor's 1x added to Fz, three times its 1x line's amplitude (it takes the axial read):
+    every one of those runs is moved to the generator's speed within 1e-4, read from the radial force and torque, the
+    axial line left out; on main none was."""
+    wheel = replace(fw.family()[7], n_speeds=12, n_samples=8192)
+    data = fw.steady(wheel, noise=0.01, seed=5)
+    t = np.arange(data.signals.shape[2]) / data.sample_rate
+    fast = data.speeds >= np.median(data.speeds)
+    runs = []
+    for i, om in enumerate(data.speeds):
+        sig = {c: data.signals[i, j].copy() for j, c in enumerate(fw.CHANNELS)}
+        f1 = om / (2 * np.pi)
+        ref = 2 * np.abs(np.mean(sig["Fz"] * np.exp(-2j * np.pi * f1 * t)))          # the Fz 1x line's amplitude
+        sig["Fz"] = sig["Fz"] + 3 * ref * np.cos(2 * np.pi * 1.02 * f1 * t)
+        runs.append(Run(speed=float(om / 1.015 if fast[i] else om), sample_rate=data.sample_rate, signals=sig,
+                        name=f"run_{i:02d}.csv"))
+    test = SteadyTest(runs, {})
+    errors = speed_runs.run_errors(test)
+    for i in np.flatnonzero(fast):
+        assert errors[i]["lines"] == ["radial_force", "radial_torque"] and errors[i]["left_out"] == ["axial_force"]
+    out, rec = corrected(test)
+    moved = {x["run"] for x in rec["runs_speed"]["runs_moved"]}
+    assert moved == set(np.flatnonzero(fast))
+    got = np.array([r.speed for r in out.runs])
+    assert np.max(np.abs(got[fast] / data.speeds[fast] - 1)) < 1e-4
