@@ -153,7 +153,7 @@ def bearings_of(wheel: Mapping | None, source: str = "<model>") -> tuple:
     return tuple(parse_bearing(b, source, f"wheel.bearings[{i}]") for i, b in enumerate(items))
 
 
-def line_causes(h: float, resolution: float, bearings=(), others=()) -> list:
+def line_causes(h: float, resolution: float, bearings=(), others=(), parents=()) -> list:
     """Candidate bearing causes (sentences) of a line at ratio ``h`` to the speed, resolved to ``resolution`` (in h).
 
     With ``bearings``: each bearing ratio (and its 2nd and 3rd multiple) within the resolution of h.  Without (or
@@ -161,7 +161,10 @@ def line_causes(h: float, resolution: float, bearings=(), others=()) -> list:
     (the model's and the data's): h = n × a cage-range line (a ball pass over the still race), h = n × (1 − a
     cage-range line) (over the turning race), or h + another non-integer line = n (an outer/inner ball-pass pair,
     whose cage ratio is then the smaller over n), n in :data:`BALL_COUNTS`, or the 2nd or 3rd multiple of another
-    non-integer line; last, the ball counts whose ball passes can take h (:func:`_ball_pass_ranges`)."""
+    non-integer line; last, the ball counts whose ball passes can take h (:func:`_ball_pass_ranges`).  ``parents``: the
+    ratios of the lines of h's direction stronger than it, whose sums and differences it may be (:func:`_combinations`:
+    a combination is weaker than the lines it is made of, and read among every line one pair or another sums to
+    nearly any h)."""
     out = []
     for b in bearings:
         for key, r in b.ratios().items():
@@ -184,7 +187,7 @@ def line_causes(h: float, resolution: float, bearings=(), others=()) -> list:
             out.append(f"a subharmonic, 1/{k} of the speed: a rub (the rotor touching a still part every {k} turns, "
                        "its friction driving a backward, counter-rotating whirl) or looseness in a mount or a "
                        "bearing's fit (a support stiffer one way than the other halves the frequency)")
-    out += _relations(h, resolution, others)
+    out += _relations(h, resolution, others, parents)
     if not bearings:                            # the given geometry names a ball pass or rules it out
         out += _ball_pass_ranges(h, resolution, where)
     return out
@@ -222,7 +225,7 @@ def _ball_pass_ranges(h: float, resolution: float, where: str) -> list:
     return [f"a ball pass {where}: " + ", or ".join(parts)] if parts else []
 
 
-def _relations(h: float, resolution: float, others) -> list:
+def _relations(h: float, resolution: float, others, parents=()) -> list:
     """Sentences relating a non-integer line at ``h`` to the other lines' ratios ``others``: a ball pass n × a
     cage-range line (over the still race) or n × (1 − it) (over the turning race), an outer/inner ball-pass pair
     summing to n, and the 2nd or 3rd multiple of another non-integer line (a bearing line's harmonics).
@@ -257,7 +260,29 @@ def _relations(h: float, resolution: float, others) -> list:
             out.append((abs(h - k * o) / (k * resolution), 0,
                         f"the {'2nd' if k == 2 else '3rd'} multiple of the line h = {o:.4g} (a harmonic of that line's "
                         f"cause: a bearing line's impacts are not sinusoidal)"))
+    out += _combinations(h, resolution, [o for o in parents if abs(o - h) > resolution and o > 0])
     out.sort(key=lambda x: (x[0] > 0.5, x[1] if x[0] <= 0.5 else 0, x[0]))
     # one line read in several directions (h 3.3 in the radial force, torque and axial force, each a few 1e-4 apart)
     # is one relation: each sentence once, in the order of its closeness
     return list(dict.fromkeys(x[2] for x in out))
+
+
+def _combinations(h: float, resolution: float, others) -> list:
+    """(closeness, rank, sentence) of a line at ``h`` that is the sum or the difference of two other lines' ratios
+    (``others``, distinct from h), within 2 × the resolution: one line modulating the other puts lines at their sum and
+    difference -- a bearing defect's line carried round by the cage or the shaft, or a nonlinearity of the structure
+    or the measuring chain (a quadratic term makes every sum and difference of the lines it carries).  The new-user
+    trial's quadratic load cell channel: 3.22 = 3.63 − 0.41 and 4.04 = 3.63 + 0.41 were named ball passes of 8- and
+    10-ball bearings and nothing said they were combinations."""
+    out = []
+    uniq = sorted(set(float(o) for o in others))
+    for i, a in enumerate(uniq):
+        for b in uniq[:i]:                              # b < a
+            for value, word, sign in ((a + b, "sum", "+"), (a - b, "difference", "−")):
+                if abs(h - value) <= 2 * resolution:
+                    out.append((abs(h - value) / (2 * resolution), 1,
+                                f"the {word} of the lines h = {a:.4g} and {b:.4g} ({a:.4g} {sign} {b:.4g} = {value:.4g}): "
+                                "one modulating the other (a bearing defect's line carried round by the cage or the "
+                                "shaft) or a nonlinearity of the structure or the measuring chain, which puts lines at "
+                                "every sum and difference of the lines it carries"))
+    return out

@@ -43,6 +43,9 @@ def _zeta_bounds():
 
 #: I_zz/I_rr of a thin disc, the most a rigid rotor has about its centre of mass (I_zz <= I_xx + I_yy)
 RIGID_INERTIA_RATIO = 2.0
+#: A ratio read from the whirls within this relative distance above RIGID_INERTIA_RATIO is a disc's, read to the
+#: whirl fit's resolution (the new-user trial's 2.0 disc read 2.001, printed "2 (above 2 ...)")
+RIGID_RATIO_RESOLUTION = 0.01
 
 
 @register
@@ -78,7 +81,7 @@ class SuspensionModes(Element):
         bounds = e.get("zeta_bounds") or {}
         note = ""
         a = e.get("inertia_ratio")
-        if isinstance(a, (int, float)) and a > RIGID_INERTIA_RATIO:
+        if isinstance(a, (int, float)) and a > RIGID_INERTIA_RATIO * (1.0 + RIGID_RATIO_RESOLUTION):
             note = (f" (above {RIGID_INERTIA_RATIO:g}, which no rigid rotor rocking about its centre of mass exceeds: "
                     "an effective ratio of the whirls, from a flexible rotor or rocking coupled with other motion)")
 
