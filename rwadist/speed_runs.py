@@ -182,7 +182,7 @@ def run_errors(test, reads: LineReads | None = None) -> list:
         widened = bool(np.all(np.array(wid)[use] > SIGMAS * np.array(sig)[use]))
         width = float(np.median(np.array(wid)[use])) if widened else 0.0
         got = {"rel": mean, "se": float(np.hypot(se, width)), "chi2": chi2, "lines": [keys[j] for j in use],
-               "width": width}
+               "width": width, "per_line": {k: (float(rel[j]), float(sig[j])) for j, k in enumerate(keys)}}
         if len(use) < len(keys):
             got["left_out"] = [k for j, k in enumerate(keys) if j not in use]
         out.append(got)
@@ -250,8 +250,8 @@ def own_speeds(test, check: dict, reads: LineReads | None = None) -> tuple:
     """(test, check): ``test`` with each run whose own 1× lines put its mean speed off the speed applied (module
     docstring) at the speed they give, and ``check`` (:func:`rwadist.speed_check.check_record`'s record) with
     ``runs_speed``: method, the runs judged, their RMS relative error, the runs moved (name, given and taken rpm,
-    relative correction and its standard error, lines) and one sentence ``text``; ``test`` itself, untouched, when no
-    run moves.  Runs :func:`rwadist.speed_check.checked` already moved (``runs_off``) or doubted are left alone.
+    relative correction and its standard error, lines), the runs off the column whose lines disagree (``runs_unsettled``:
+    not moved, said) and one sentence ``text``; ``test`` itself, untouched, when no run moves.  Runs :func:`rwadist.speed_check.checked` already moved (``runs_off``) or doubted are left alone.
     ``reads``: a :class:`rwadist.speed_check.LineReads` shared with the steps before this one, or None."""
     if not check or not check.get("lines"):
         return test, check
@@ -286,6 +286,22 @@ def own_speeds(test, check: dict, reads: LineReads | None = None) -> tuple:
     else:
         rec["text"] = (f"each run's 1x lines agree with its speed within their uncertainty "
                        f"({len(judged)} runs, {100 * rms:.3g} % RMS)")
+    # runs whose radial force's 1x line sits off the column beyond its uncertainty while the run's other lines disagree
+    # with it: not moved, and said (before, the sentence above said every run's lines agreed with its speed)
+    def force_off(e) -> bool:                       # the radial force's own line off the column beyond its σ
+        rel, sig = e["per_line"].get("radial_force", (0.0, np.inf))
+        return abs(rel) > SIGMAS * sig
+
+    unsettled = {} if wander else {i: e for i, e in judged.items() if e["chi2"] > AGREE_CHI2 and force_off(e)}
+    if unsettled:
+        rec["runs_unsettled"] = [{"run": i, "run_name": test.runs[i].name or str(i),
+                                  "rel_by_line": {LINES[k][1]: round(v[0], 7) for k, v in e["per_line"].items()},
+                                  "chi2": round(e["chi2"], 3)} for i, e in unsettled.items()]
+        names = ", ".join(f"{test.runs[i].name or i} (radial force {100 * e['per_line']['radial_force'][0]:+.2g} %)"
+                          for i, e in list(unsettled.items())[:4])
+        lead = rec["text"] if moved else f"{len(moved)} of {len(judged)} runs moved"
+        rec["text"] = (f"{lead}; {len(unsettled)} run(s) off the column by their radial force's 1x line, which the "
+                       f"run's other 1x lines disagree with, not moved: {names}{' ...' if len(unsettled) > 4 else ''}")
     if wander:
         rec["wander"] = {"runs": len(wide), "width_rel_median": round(float(np.median(wide)), 7), "text": (
             f"the speed wanders within the runs: in {len(wide)} of {len(judged)} runs every 1x line is wider than a "

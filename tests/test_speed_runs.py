@@ -186,3 +186,29 @@ def test_two_rotating_lines_that_agree_move_a_run_whose_axial_read_is_pulled_off
     assert moved == set(np.flatnonzero(fast))
     got = np.array([r.speed for r in out.runs])
     assert np.max(np.abs(got[fast] / data.speeds[fast] - 1)) < 1e-4
+
+
+def test_runs_whose_two_lines_disagree_off_the_column_are_said_not_moved():
+    """The same column and pulled axial line, the torques' 1x line left out (Tx, Ty zero): two lines that disagree, no
+    run moved -- and the record says which runs' radial force sits off the column with the other line disagreeing
+    (``runs_unsettled``: the fast half, not the slow, whose radial force is on it), where its sentence said every run's
+    lines agreed with its speed."""
+    wheel = replace(fw.family()[7], n_speeds=12, n_samples=8192)
+    data = fw.steady(wheel, noise=0.01, seed=5)
+    t = np.arange(data.signals.shape[2]) / data.sample_rate
+    fast = data.speeds >= np.median(data.speeds)
+    runs = []
+    for i, om in enumerate(data.speeds):
+        sig = {c: data.signals[i, j].copy() for j, c in enumerate(fw.CHANNELS)}
+        f1 = om / (2 * np.pi)
+        ref = 2 * np.abs(np.mean(sig["Fz"] * np.exp(-2j * np.pi * f1 * t)))
+        sig["Fz"] = sig["Fz"] + 3 * ref * np.cos(2 * np.pi * 1.02 * f1 * t)
+        sig["Tx"], sig["Ty"] = np.zeros_like(t), np.zeros_like(t)
+        runs.append(Run(speed=float(om / 1.015 if fast[i] else om), sample_rate=data.sample_rate, signals=sig,
+                        name=f"run_{i:02d}.csv"))
+    out, rec = corrected(SteadyTest(runs, {}))
+    own = rec["runs_speed"]
+    assert own["runs_moved"] == []
+    assert {x["run"] for x in own["runs_unsettled"]} == set(np.flatnonzero(fast))
+    assert "which the run's other 1x lines disagree with, not moved" in own["text"]
+    assert "agree with its speed" not in own["text"]
