@@ -262,7 +262,7 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
             got = motor_causes(h, res, d)           # a whole multiple: no bearing ratio, a motor's ripple on Tz
         else:
             # the lines of its direction stronger than it: what it may be a sum or difference of
-            level = {float(x.h): abs(float(x.C)) for x in diag.model.harmonics(d)}
+            level = {float(x.h): abs(float(x.C)) for x in diag.model.harmonics(d) if getattr(x, "C", None) is not None}
             parents = [o for o, c in level.items() if c > level.get(h, np.inf)]
             got = causes_of(h, res, bearings, [o for o in every if abs(o - h) > res], parents)
         if got:

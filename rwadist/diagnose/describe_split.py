@@ -125,11 +125,14 @@ def _reaches(fit: dict, li, f=None) -> np.ndarray | None:
     """The cells where ``fit``'s course reaches MIN_PEAK_DB, when it leaves at most MAX_MISFIT_RATIO of a constant's
     misfit and reaches MIN_CELLS cells of MIN_LINES lines; else None.  With ``f`` (the cells' frequencies, Hz; a
     resonance's fit, its ``f_r_Hz``), one line will do when its reached cells lie on both sides of the resonance: one
-    line crossing it over the speeds draws its peak (family wheel 3's h 4.02 on Tx, the only torque line past 200 Hz)."""
+    line crossing it over the speeds draws its peak (family wheel 3's h 4.02 on Tx, the only torque line past 200 Hz),
+    when the course there reaches :data:`ONE_LINE_PEAK_DB` (a line whose x and y drift apart by a few dB over its speeds
+    is no resonance: family wheel 0's run-up, h 3.08 on Tx, 3.5 dB)."""
     reach = np.abs(fit["course_dB"]) >= MIN_PEAK_DB
     if fit["misfit_dB"] > MAX_MISFIT_RATIO * fit["constant_misfit_dB"] or reach.sum() < MIN_CELLS:
         return None
-    crossed = f is not None and np.any(f[reach] < fit["f_r_Hz"]) and np.any(f[reach] > fit["f_r_Hz"])
+    crossed = f is not None and np.any(f[reach] < fit["f_r_Hz"]) and np.any(f[reach] > fit["f_r_Hz"]) \
+        and np.max(np.abs(fit["course_dB"])) >= ONE_LINE_PEAK_DB
     return reach if np.unique(li[reach]).size >= MIN_LINES or crossed else None
 
 
@@ -189,6 +192,10 @@ def split_mode(ctx, state, shares) -> list:
 RESONANCE_GAINS = np.geomspace(1.25, 40.0, 17)
 #: Step (log) of its resonance frequencies over the cells' range, refined off the grid after
 RESONANCE_STEP = 0.03
+#: A channel's resonance is described with ζ at most this (the refinement may run ζ to 0.3 on a tilt)
+MAX_RESONANCE_ZETA = 0.1
+#: ... and, read on one line alone, with its course reaching this at least (dB; a peak gain of 2)
+ONE_LINE_PEAK_DB = 6.0
 
 
 def _resonance_db(f: np.ndarray, f0: np.ndarray, zeta: float, gains: np.ndarray) -> np.ndarray:
@@ -251,8 +258,8 @@ def channel_resonance(ctx, state, shares, pair=("Fx", "Fy")) -> list:
         return []
     fit, li, ri, f, dc = got
     reach = _reaches(fit, li, f)
-    if reach is None:
-        return []
+    if reach is None or fit["zeta"] > MAX_RESONANCE_ZETA:
+        return []                           # a tilt the fit can only bend by running ζ up is no resonance
     runs = ctx.runs
     used = np.unique(ri[reach])
     share, _ = shares((cx, cy), h[np.unique(li[reach])], runs[used])
