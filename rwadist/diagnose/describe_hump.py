@@ -79,6 +79,11 @@ def line_skirts(ctx, state, c: str, runs) -> np.ndarray:
     95 dB over the floor at 9600 rpm, +13 dB 16 bins off its centre, described as a 430-551 Hz hump in 4 runs)."""
     from .constants import KERNEL_HALF
 
+    runs = np.asarray(runs)
+    key = ("line_skirts", c, runs.tobytes())     # kept read-only on the state, as its prediction: three readers
+    cache = getattr(state, "_cache", None)
+    if cache is not None and key in cache:
+        return cache[key]
     M, N = ctx.predict(state, c, runs), ctx.floor_psd(state, c, runs)
     out = np.zeros(M.shape, dtype=bool)
     E = M - N
@@ -87,8 +92,6 @@ def line_skirts(ctx, state, c: str, runs) -> np.ndarray:
     floor = np.median(N, axis=1, keepdims=True)
     strong = E[:, 1:-1] > floor * CLEAN_LINE_FRACTION / _hann_skirt(KERNEL_HALF)
     strong &= (E[:, 1:-1] >= E[:, :-2]) & (E[:, 1:-1] >= E[:, 2:])
-    if not strong.any():
-        return out
     offsets = np.arange(-SKIRT_MAX_BINS, SKIRT_MAX_BINS + 1)
     skirt = _hann_skirt(offsets)
     n_f = M.shape[1]
@@ -97,6 +100,9 @@ def line_skirts(ctx, state, c: str, runs) -> np.ndarray:
         ks = k + offsets
         ok = (ks >= 0) & (ks < n_f)
         out[r, ks[ok]] |= E[r, k] * skirt[ok] > CLEAN_LINE_FRACTION * N[r, ks[ok]]
+    out.flags.writeable = False
+    if cache is not None:
+        cache[key] = out
     return out
 
 
