@@ -158,13 +158,10 @@ def test_shared_line_reads_give_the_unshared_records():
     np.testing.assert_allclose(after[:, 2], 1.0 - before["radial_force"][:, 2], atol=1e-9)
 
 
-def test_two_rotating_lines_that_agree_move_a_run_whose_axial_read_is_pulled_off_them():
-    """The new-user trial (session 51): runs from the median speed up 1.5 % faster than their column; four of 25 were
-    not moved, their axial 1x read pulled off the radial force's and torque's, which agreed to 7e-6 (the three lines'
-    χ²/dof 130-7900).  Here family wheel 7 (an axial 1x line of its own), the column 1.5 % low from the median speed
-    up and a line 2 % over the rotor's 1x added to Fz, three times its 1x line's amplitude (it takes the axial read):
-    every one of those runs is moved to the generator's speed within 1e-4, read from the radial force and torque, the
-    axial line left out; on main none was."""
+def _pulled_axial(torques: bool = True) -> tuple:
+    """(SteadyTest, the generator's speeds rad/s, the fast runs (bool)) of family wheel 7 (an axial 1x line of its own),
+    its column 1.5 % low from the median speed up, a line 2 % over the rotor's 1x added to Fz at three times its 1x
+    line's amplitude (it takes the axial read); ``torques`` False: Tx and Ty zero (no radial-torque line)."""
     wheel = replace(fw.family()[7], n_speeds=12, n_samples=8192)
     data = fw.steady(wheel, noise=0.01, seed=5)
     t = np.arange(data.signals.shape[2]) / data.sample_rate
@@ -175,9 +172,21 @@ def test_two_rotating_lines_that_agree_move_a_run_whose_axial_read_is_pulled_off
         f1 = om / (2 * np.pi)
         ref = 2 * np.abs(np.mean(sig["Fz"] * np.exp(-2j * np.pi * f1 * t)))          # the Fz 1x line's amplitude
         sig["Fz"] = sig["Fz"] + 3 * ref * np.cos(2 * np.pi * 1.02 * f1 * t)
+        if not torques:
+            sig["Tx"], sig["Ty"] = np.zeros_like(t), np.zeros_like(t)
         runs.append(Run(speed=float(om / 1.015 if fast[i] else om), sample_rate=data.sample_rate, signals=sig,
                         name=f"run_{i:02d}.csv"))
-    test = SteadyTest(runs, {})
+    return SteadyTest(runs, {}), data.speeds, fast
+
+
+def test_two_rotating_lines_that_agree_move_a_run_whose_axial_read_is_pulled_off_them():
+    """The new-user trial (session 51): runs from the median speed up 1.5 % faster than their column; four of 25 were
+    not moved, their axial 1x read pulled off the radial force's and torque's, which agreed to 7e-6 (the three lines'
+    χ²/dof 130-7900).  Here family wheel 7 (an axial 1x line of its own), the column 1.5 % low from the median speed
+    up and a line 2 % over the rotor's 1x added to Fz, three times its 1x line's amplitude (it takes the axial read):
+    every one of those runs is moved to the generator's speed within 1e-4, read from the radial force and torque, the
+    axial line left out; on main none was."""
+    test, speeds, fast = _pulled_axial()
     errors = speed_runs.run_errors(test)
     for i in np.flatnonzero(fast):
         assert errors[i]["lines"] == ["radial_force", "radial_torque"] and errors[i]["left_out"] == ["axial_force"]
@@ -185,7 +194,7 @@ def test_two_rotating_lines_that_agree_move_a_run_whose_axial_read_is_pulled_off
     moved = {x["run"] for x in rec["runs_speed"]["runs_moved"]}
     assert moved == set(np.flatnonzero(fast))
     got = np.array([r.speed for r in out.runs])
-    assert np.max(np.abs(got[fast] / data.speeds[fast] - 1)) < 1e-4
+    assert np.max(np.abs(got[fast] / speeds[fast] - 1)) < 1e-4
 
 
 def test_runs_whose_two_lines_disagree_off_the_column_are_said_not_moved():
@@ -193,20 +202,8 @@ def test_runs_whose_two_lines_disagree_off_the_column_are_said_not_moved():
     run moved -- and the record says which runs' radial force sits off the column with the other line disagreeing
     (``runs_unsettled``: the fast half, not the slow, whose radial force is on it), where its sentence said every run's
     lines agreed with its speed."""
-    wheel = replace(fw.family()[7], n_speeds=12, n_samples=8192)
-    data = fw.steady(wheel, noise=0.01, seed=5)
-    t = np.arange(data.signals.shape[2]) / data.sample_rate
-    fast = data.speeds >= np.median(data.speeds)
-    runs = []
-    for i, om in enumerate(data.speeds):
-        sig = {c: data.signals[i, j].copy() for j, c in enumerate(fw.CHANNELS)}
-        f1 = om / (2 * np.pi)
-        ref = 2 * np.abs(np.mean(sig["Fz"] * np.exp(-2j * np.pi * f1 * t)))
-        sig["Fz"] = sig["Fz"] + 3 * ref * np.cos(2 * np.pi * 1.02 * f1 * t)
-        sig["Tx"], sig["Ty"] = np.zeros_like(t), np.zeros_like(t)
-        runs.append(Run(speed=float(om / 1.015 if fast[i] else om), sample_rate=data.sample_rate, signals=sig,
-                        name=f"run_{i:02d}.csv"))
-    out, rec = corrected(SteadyTest(runs, {}))
+    test, _, fast = _pulled_axial(torques=False)
+    out, rec = corrected(test)
     own = rec["runs_speed"]
     assert own["runs_moved"] == []
     assert {x["run"] for x in own["runs_unsettled"]} == set(np.flatnonzero(fast))

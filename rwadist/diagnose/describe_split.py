@@ -121,6 +121,17 @@ def _steady_fit(fit_fn, li, ri, f, dc):
     return fit_fn(f, dc), li, ri, f, dc
 
 
+def _fitted_cells(ctx, state, pair, fit_fn):
+    """(h, fit, line index, run index, f Hz, d dB) of ``fit_fn`` on the cells of the radial ``pair``
+    (:func:`_pair_cells`, then :func:`_steady_fit`), or None when either has nothing."""
+    cells = _pair_cells(ctx, state, *pair)
+    if cells is None:
+        return None
+    h, li, ri, f, dc = cells
+    got = _steady_fit(fit_fn, li, ri, f, dc)
+    return None if got is None else (h,) + got
+
+
 def _reaches(fit: dict, li, f=None) -> np.ndarray | None:
     """The cells where ``fit``'s course reaches MIN_PEAK_DB, when it leaves at most MAX_MISFIT_RATIO of a constant's
     misfit and reaches MIN_CELLS cells of MIN_LINES lines; else None.  With ``f`` (the cells' frequencies, Hz; a
@@ -154,14 +165,10 @@ def split_mode(ctx, state, shares) -> list:
     """``line_property`` records (property ``split_mode``) of the radial forces read through two translation modes
     (``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB) of the lines' cells)."""
     cx, cy = "Fx", "Fy"
-    cells = _pair_cells(ctx, state, cx, cy)
-    if cells is None:
-        return []
-    h, li, ri, f, dc = cells
-    got = _steady_fit(fit_split, li, ri, f, dc)
+    got = _fitted_cells(ctx, state, (cx, cy), fit_split)
     if got is None:
         return []
-    fit, li, ri, f, dc = got
+    h, fit, li, ri, f, dc = got
     split = abs(np.log(fit["f_x_Hz"] / fit["f_y_Hz"]))
     reach = _reaches(fit, li)
     if reach is None or split < MIN_SPLIT:
@@ -249,14 +256,10 @@ def channel_resonance(ctx, state, shares, pair=("Fx", "Fy")) -> list:
     (``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB) of the lines' cells).  The new-user
     trial's sensor resonance on Fy alone (200 Hz, ζ 0.03, peak gain 5) was a 'wheel mode' of gain 3.6 on Fx and Fy."""
     cx, cy = pair
-    cells = _pair_cells(ctx, state, cx, cy)
-    if cells is None:
-        return []
-    h, li, ri, f, dc = cells
-    got = _steady_fit(fit_channel_resonance, li, ri, f, dc)
+    got = _fitted_cells(ctx, state, pair, fit_channel_resonance)
     if got is None:
         return []
-    fit, li, ri, f, dc = got
+    h, fit, li, ri, f, dc = got
     reach = _reaches(fit, li, f)
     if reach is None or fit["zeta"] > MAX_RESONANCE_ZETA:
         return []                           # a tilt the fit can only bend by running ζ up is no resonance
