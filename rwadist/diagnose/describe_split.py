@@ -199,6 +199,9 @@ def split_mode(ctx, state, shares) -> list:
 RESONANCE_GAINS = np.geomspace(1.25, 40.0, 17)
 #: Step (log) of its resonance frequencies over the cells' range, refined off the grid after
 RESONANCE_STEP = 0.03
+#: Evaluations of the refinement at most (a resonance converges in 10-30; cells of no resonance ran it to its default
+#: 300, 0.14 s a fit on family wheel 3's clean torques)
+REFINE_NFEV = 60
 #: A channel's resonance is described with ζ at most this (the refinement may run ζ to 0.3 on a tilt)
 MAX_RESONANCE_ZETA = 0.1
 #: ... and, read on one line alone, with its course reaching this at least (dB; a peak gain of 2)
@@ -239,7 +242,7 @@ def fit_channel_resonance(f: np.ndarray, d: np.ndarray) -> dict:
     # for a 0.03 / 5 resonance), kept where its L1 misfit is lower
     fine = least_squares(lambda x: d - sign * _resonance_db(f, np.exp(x[:1]), float(np.exp(x[1])),
                                                            np.exp(x[2:]))[0],
-                         np.log([f_r, zeta, g]), loss="soft_l1", f_scale=0.5,
+                         np.log([f_r, zeta, g]), loss="soft_l1", f_scale=0.5, max_nfev=REFINE_NFEV,
                          bounds=(np.log([grid[0], 1e-3, 1.0]), np.log([grid[-1], 0.3, 1e3])))
     f_fine, z_fine, g_fine = (float(v) for v in np.exp(fine.x))
     course = sign * _resonance_db(f, np.array([f_fine]), z_fine, np.array([g_fine]))[0]
