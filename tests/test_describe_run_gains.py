@@ -69,6 +69,20 @@ def test_a_channel_gain_switched_between_runs_is_described_where_it_steps(wheel_
     assert said == pytest.approx(gain, rel=0.02)
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("wheel_index, channel, gain, first, seed", [(3, "Fy", 1.25, 9, 10), (0, "Fx", 1.5, 8, 7)])
+def test_a_channel_gain_switched_between_runs_is_no_amplitude_law(wheel_index, channel, gain, first, seed):
+    """One channel read 1.25-1.5x from mid-speed lifts the pooled radial lines of the upper runs: on main (f10986f)
+    wheel 3's 2x radial force passed for an Ω^2.125 law (added) and wheel 0's laws were described; a law of the wheel
+    holds in x and y alike, and the untouched channel reads Ω² (:func:`rwadist.effects.amplitude_law_diagnose.
+    _channel_sides`).  Truth: the generator's lines are all C·Ω²."""
+    test, _ = _switched(wheel_index, channel, gain, first, seed)
+    d = api.diagnose(test)
+    assert [e.kind for e in d.effects] == ["suspension_modes"]
+    said = [u.parameters.get("property") or u.signature for u in d.unexplained]
+    assert "amplitude_law" not in said and "channel_gain" in said, said
+
+
 WHEEL = 7
 SEED = 1 + 100 * WHEEL                                    # the matrix's draw of wheel 7 (benchmarks: seed + 100·i)
 

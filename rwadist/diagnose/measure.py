@@ -38,7 +38,7 @@ def _measure(ctx, state, direction, h, runs, skip=None):
     return np.concatenate(ds) if ds else np.empty(0), np.concatenate(ws) if ws else np.empty(0)
 
 
-def measure_run_powers(ctx, state, direction, h, runs, skip=None):
+def measure_run_powers(ctx, state, direction, h, runs, skip=None, channels=None):
     """Amplitude of the line (direction, h) per part, one per run, the powers of the direction's channels pooled:
     (amplitude, omega, leak, snr), amplitude N or N·m that each of the line's parts (its co- and counter-rotating
     harmonics in the state's model, one co-rotating part when it has none) would carry before any resonance and the
@@ -52,7 +52,8 @@ def measure_run_powers(ctx, state, direction, h, runs, skip=None):
     to 2(|c₊|² + |c₋|²) whatever the phases (family wheel 4: its h 4.62 bearing line, half counter-rotating, read
     per channel at 0.03-1.4x its true amplitude, and its Ω³ law was missed).  So each run's amplitude is
     sqrt(Σ_c a_c² / Σ_c Σ_parts g_c,part²), g the resonance and modal gain of a unit load of the part's sense; a
-    channel whose line is below its noise (NaN) beside one that is measured counts as 0."""
+    channel whose line is below its noise (NaN) beside one that is measured counts as 0.  ``channels``: those of the
+    direction's channels to pool (default: every one the data hold)."""
     senses = [getattr(x, "sense", None) or "co" for x in state.model.harmonics(direction) if abs(x.h - h) < 1e-3]
     p_sum = np.zeros(runs.size)
     g_sum = np.zeros(runs.size)
@@ -60,7 +61,7 @@ def measure_run_powers(ctx, state, direction, h, runs, skip=None):
     n_sum = np.zeros(runs.size)
     seen = np.zeros(runs.size, bool)
     for c in DIRECTION_CHANNELS[direction]:
-        if c not in ctx.channels:
+        if c not in ctx.channels or (channels is not None and c not in channels):
             continue
         a = ctx.measure_line(state, c, h, runs, skip=skip)
         g = ctx.gain(state, c, h * ctx.omega[runs] / (2 * np.pi))

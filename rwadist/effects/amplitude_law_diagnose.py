@@ -87,6 +87,32 @@ def _mode_sides(state: State, direction: str, h: float, w, X, y, leak, var_noise
     return tuple(out)
 
 
+def _channel_sides(ctx: Context, state: State, direction: str, h: float, runs) -> tuple:
+    """((channel, exponent, its standard error, the number of runs), ...) of the line (direction, h) fitted on each
+    channel of a radial pair alone (:func:`rwadist.diagnose.measure.measure_run_powers` of that channel, the law's
+    least squares), where the channel reads it in 5 runs or more over a speed ratio of e^0.3; () on an axial
+    direction or with one channel of the pair.
+
+    A radial line is a load rotating with or against the spin: its x and y follow one law, whatever their phases
+    (a line of both senses swings between the channels from run to run, which widens each channel's error, not its
+    exponent).  A gain of one channel that changes between runs lifts that channel's lines alone: the new-user trial's
+    Fx read 1.5x from 5500 rpm up (an amplifier's range switched) and the pooled radial force's h 3.63 passed for an
+    Ω^2.16 law (Fx alone Ω^2.3, Fy alone Ω^2.0)."""
+    chans = [c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels]
+    if len(chans) < 2:                          # an axial direction, or one channel of the pair recorded
+        return ()
+    out = []
+    w_ref = ctx.omega_ref()
+    for c in chans:
+        d, w, leak, snr = measure_run_powers(ctx, state, direction, h, runs, skip=h, channels=(c,))
+        if d.size < 5 or np.ptp(np.log(w)) < 0.3:
+            continue
+        X = np.column_stack([np.ones(w.size), np.log(w / w_ref)])
+        coef, cov = _law_lsq(X, np.log(d), leak, 1.0 / (snr * ctx.dof))
+        out.append((c, float(coef[1]), float(np.sqrt(cov[1, 1])), int(d.size)))
+    return tuple(out)
+
+
 @register(order=20)
 @dataclass
 class AmplitudeLaw:
@@ -108,6 +134,9 @@ class AmplitudeLaw:
     #: crossings of the wheel's suspension modes (a whirl branch included), out of the modes' reach
     #: (:func:`_mode_sides`); () when it crosses none or on the empirical base (:meth:`significant`)
     mode_sides: tuple = ()
+    #: ((channel, exponent, its standard error, the number of runs), ...) fitted on each channel of a radial pair
+    #: alone (:func:`_channel_sides`); () on an axial direction or with one channel of the pair (:meth:`significant`)
+    channel_sides: tuple = ()
     kind: str = "amplitude_law"
     #: it adds no line, only changes the amplitude of one the state has: judged with that line's beats at its own
     #: amplitudes (:func:`rwadist.diagnose.search._evidence`)
@@ -167,6 +196,10 @@ class AmplitudeLaw:
                 return False
         if not all(self._side_agrees(p, se, told) for p, se, _ in self.mode_sides):
             return False
+        # a law of the line's source holds in x and in y alike: one channel's lines growing alone is that channel's
+        # gain (a range switched between runs), not the wheel's
+        if not all(self._side_agrees(p, se, told) for _, p, se, _ in self.channel_sides):
+            return False
         return told(self.exponent, self.exponent_stderr)
 
     def _side_agrees(self, p: float, se: float, told) -> bool:
@@ -217,7 +250,7 @@ class AmplitudeLaw:
                 beyond = (float(c2[1]), float(np.sqrt(v2[1, 1])), int(out.sum()))
         sides = _mode_sides(state, direction, h, w, X, np.log(d), leak, var_noise)
         return AmplitudeLaw(direction, float(h), float(coef[1]), float(np.exp(coef[0])), w_ref,
-                            float(np.sqrt(cov[1, 1])), beyond, sides)
+                            float(np.sqrt(cov[1, 1])), beyond, sides, _channel_sides(ctx, state, direction, h, runs))
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
