@@ -220,10 +220,10 @@ def _resonance_db(f: np.ndarray, f0: np.ndarray, zeta: float, gains: np.ndarray)
 
 def fit_channel_resonance(f: np.ndarray, d: np.ndarray) -> dict:
     """The course d(f) = s·20·log10|H(f; f_r, ζ, g)| (:func:`_resonance_db`; s = +1: the resonance is y's, −1: x's)
-    best fitting the cells' dB differences ``d`` (y over x) at frequencies ``f`` Hz in L1, over the grids (f_r within
-    ±SPAN of the largest |d|'s frequency, ζ in ZETAS, g in RESONANCE_GAINS); returns f_r (Hz), zeta, peak_gain, sign,
-    the L1 misfits of the course and of the best constant (the median) and the fitted course at the cells.  f_r is
-    searched over the cells' whole range (log steps of :data:`RESONANCE_STEP`), not about the largest |d|: the lines
+    best fitting the cells' dB differences ``d`` (y over x) at frequencies ``f`` Hz in L1, over the grids (f_r over
+    the cells' whole range in log steps of :data:`RESONANCE_STEP`, ζ in ZETAS, g in RESONANCE_GAINS), then refined
+    off the grid; returns f_r (Hz), zeta, peak_gain, sign, the L1 misfits of the course and of the best constant (the
+    median) and the fitted course at the cells.  f_r is not searched about the largest |d| alone: the lines
     a channel's resonance lifts may be few beside stronger misfits elsewhere (family wheel 3's torques: one line, h
     4.02, crosses a 300-Hz resonance on Tx; the largest |d| was at 67 Hz)."""
     lo, hi = float(f.min()), float(f.max())
