@@ -63,6 +63,10 @@ NOISE_BINS = PAD * np.array([-8, -6, -4, 4, 6, 8])
 #: a line beside the radial force's counts only when its reads cluster: their spread (1.4826·MAD of r) below this share
 #: of the spread of reads taken at random in the window (1.4826·SEARCH/2: noise's highest peak, wherever it falls)
 CLUSTERED = 0.25
+#: a tach's pulses a turn, counted as turns: the column reads that many times the rotor's speed
+TACH_PULSES = (2, 3, 4)
+#: the fractions of the given speed the 1× lines are read at beside it (:class:`LineReads`, :func:`_whole_factor`)
+WHOLE_FRACTIONS = tuple(1.0 / n for n in TACH_PULSES)
 #: the three 1× lines: key -> (channels, text)
 LINES = {"radial_force": (("Fx", "Fy"), "radial force"), "radial_torque": (("Tx", "Ty"), "radial torque"),
          "axial_force": (("Fz",), "axial force")}
@@ -142,36 +146,55 @@ def run_spectra(run, channels, buffers: dict | None = None) -> dict:
     return dict(zip(channels, sfft.rfft(padded, axis=-1)))
 
 
-def line_reads(test) -> dict:
+def line_reads(test, factors=(1.0,), other_keys=None) -> dict:
     """Per 1× line of :data:`LINES` recorded: (n_runs, 3) of :func:`run_line`'s (frequency Hz, SNR, co-rotating
-    share) in each run at its given speed, nan where the run is not measured."""
+    share) in each run at its given speed, nan where the run is not measured.  With ``factors`` other than (1.0,):
+    {factor: those reads at the factor times each run's given speed}, every factor read on one transform of each
+    run; ``other_keys``: the lines (of :data:`LINES`) read at the factors other than 1 (None: every one)."""
     f_given = np.abs(np.array([r.speed for r in test.runs], dtype=float)) / (2 * np.pi)
     keys = [key for key, (channels, _) in LINES.items() if any(all(r.usable(c) for c in channels) for r in test.runs)]
-    read: dict = {key: [] for key in keys}
+    read: dict = {(k, key): [] for k in factors for key in keys
+                  if k == 1.0 or other_keys is None or key in other_keys}
     buffers: dict = {}
     for r, f0 in zip(test.runs, f_given):
         # every 1× line of a run is read on the same spectra, made once
         chans = [c for key in keys for c in LINES[key][0] if all(r.usable(x) for x in LINES[key][0])]
-        spectra = run_spectra(r, chans, buffers) if chans and _measurable(r, f0) else {}
-        for key in keys:
-            read[key].append(run_line(r, LINES[key][0], f0, spectra))
-    return {key: np.array(read[key], dtype=float).reshape(len(test.runs), 3) for key in keys}
+        spectra = run_spectra(r, chans, buffers) if chans and any(_measurable(r, k * f0) for k in factors) else {}
+        for k, key in read:
+            read[k, key].append(run_line(r, LINES[key][0], k * f0, spectra))
+    out: dict = {k: {} for k in factors}
+    for (k, key), v in read.items():
+        out[k][key] = np.array(v, dtype=float).reshape(len(test.runs), 3)
+    return out[1.0] if tuple(factors) == (1.0,) else out
 
 
 class LineReads:
     """:func:`line_reads` of the last test it was called with, kept: the steps before the search (the column's check,
     the radial pairs' polarity, the runs' own speeds, :func:`rwadist.api.diagnose`) read the 1× lines of one test
-    once.  The same test is the same object: a step that changes a speed or a channel returns a new one, which is
-    read anew."""
+    once, and the column's check reads the radial force's at :data:`WHOLE_FRACTIONS` of the given speed on the same
+    transforms (:meth:`at`).  The same test is the same object: a step that changes a speed or a channel returns a new one,
+    which is read anew."""
 
     def __init__(self) -> None:
         self._test: object = None
         self._reads: dict = {}
 
     def __call__(self, test) -> dict:
+        return self.at(test, 1.0)
+
+    def at(self, test, factor: float) -> dict:
+        """The reads of ``test`` at ``factor`` (1.0 or one of :data:`WHOLE_FRACTIONS`: the radial force's alone) times
+        its given speeds."""
         if test is not self._test:
-            self._reads, self._test = line_reads(test), test
-        return self._reads
+            self._reads, self._test = line_reads(test, (1.0,) + WHOLE_FRACTIONS, ("radial_force",)), test
+        return self._reads[factor]
+
+    @classmethod
+    def of(cls, test, reads: dict) -> "LineReads":
+        """A LineReads holding ``reads`` (:func:`line_reads` of ``test``, read elsewhere) as ``test``'s."""
+        out = cls()
+        out._test, out._reads = test, {1.0: reads}
+        return out
 
 
 def line_ratios(test, reads: dict | None = None) -> dict:
@@ -223,19 +246,22 @@ def _unchecked(ratios: dict, spinning: int) -> str:
             "one way there)")
 
 
-def check_record(test, reads: LineReads | None = None) -> dict:
+def check_record(test, reads: LineReads | None = None, whole_factors: bool = True) -> dict:
     """What the 1× lines say of a steady test's speed column (module docstring): a JSON-ready dict with
     ``lines`` (per line measured: k, spread, runs), ``scale`` (the common k, or None when none is judged),
     ``scaled`` (True when the column is to be multiplied by ``scale``), ``agreement_rel`` (the RMS over the
     lines' runs of r/k − 1 about the k applied, 1 when not scaled) and ``text`` (one sentence); {} for a
     test whose speeds are a sweep's slices (``meta["slicing"]``) or with no spinning run.  ``reads``: a
-    :class:`LineReads` shared with the steps after this one, or None."""
+    :class:`LineReads` shared with the steps after this one, or None.  ``whole_factors``: when the radial force's 1×
+    line is not read at the given speed, whether the column is tried at :data:`WHOLE_FACTORS` of it
+    (:func:`_whole_factor`)."""
     if (getattr(test, "meta", None) or {}).get("slicing") is not None:
         return {}
     spinning = int(np.sum(np.abs([r.speed for r in test.runs]) > 0))
     if spinning == 0:
         return {}
-    ratios = line_ratios(test, (reads or LineReads())(test))
+    reads = reads or LineReads()
+    ratios = line_ratios(test, reads(test))
     stats = {key: _scale(r) for key, r in ratios.items()}
     # a wheel without an axial 1x still has noise peaks 10x over the median in some runs, at random in the window
     judged = {key: s for key, s in stats.items() if s[3] >= MIN_RUNS
@@ -245,7 +271,8 @@ def check_record(test, reads: LineReads | None = None) -> dict:
     force = judged.get("radial_force")
     if force is None or force[3] < 0.5 * spinning:
         rec["text"] = _unchecked(ratios, spinning) + ": the speed column is not checked"
-        return rec
+        return (_whole_factor(test, spinning, rec, _unchecked(ratios, spinning), reads, "radial_torque" in ratios)
+                if whole_factors else None) or rec
     pooled = np.concatenate([r[np.isfinite(r)] for key, r in ratios.items() if key in judged])
     k, _, se, _ = _scale(pooled)
     se = max(se, max(s[2] for s in judged.values()))
@@ -283,10 +310,68 @@ def check_record(test, reads: LineReads | None = None) -> dict:
                        f"{100 * rec['agreement_rel']:.3g} % RMS about it; every run's speed multiplied by {k:.6g}")
     elif apart:
         rec["text"] = (f"the 1x lines disagree ({each}): the speed column is left as given")
+        rec["lines_apart"] = apart
     else:
         rec["text"] = (f"the 1x lines ({names}) agree with the given speed: {each}, "
                        f"{100 * rec['agreement_rel']:.3g} % RMS")
+    if whole_factors:
+        # the rotor's 2x (or 3x, 4x) lines read where a column 2 (3, 4) times the rotor's speed puts the 1x (or, a few
+        # per cent off it, a bearing line there: family wheel 0's h 3.08 read as a column 2.7 % slow)
+        why = f"lines stand at the given speed's 1x ({each})"
+        return _whole_factor(test, spinning, rec, why, reads, "radial_torque" in ratios, WHOLE_FRACTIONS) or rec
     return rec
+
+
+#: speed columns off the rotor's speed by a whole factor, (true speed / the column's, what does it): the imbalance's 1×
+#: lines then sit at that factor of the column's speed, outside the window read about it
+WHOLE_FACTORS = tuple((1.0 / n, f"a tach giving {n} pulses a turn counted as turns") for n in TACH_PULSES) + (
+    (60.0 / (2.0 * np.pi), "a column in rad/s written as rpm"),)
+#: the 1× lines read at a whole factor must give it within this (relative): a line near it (a cage at 0.49) is no
+#: unit's or tach's exact factor
+WHOLE_FACTOR_TOL = 2.0e-3
+
+
+def _whole_factor(test, spinning: int, given: dict, why: str, reads: LineReads, torques: bool,
+                  factors=None) -> dict | None:
+    """The record of a speed column that reads the rotor's speed times a whole factor (of :data:`WHOLE_FACTORS`), or
+    None.  ``given``: :func:`check_record`'s record at the given speed, ``why`` what it read there, in words;
+    ``reads`` the test's :class:`LineReads`; ``torques`` whether the radial torques are recorded; ``factors`` those
+    tried (true speed / the column's; None: every one).  Read at a factor, the 1× lines must pass :func:`check_record`'s every rule
+    (the radial force's in half the spinning runs, every line read at one scale) at a scale within
+    :data:`WHOLE_FACTOR_TOL` of 1, with the radial torque's among them when the torques are recorded (the imbalance
+    is static and dynamic: its 1x stands in both radial pairs, turning with the rotor); of the factors that pass, the
+    lowest is taken (a column at the rotor's speed holds its 2x lines too, so lines at the given 1x and at half of it
+    make the half the rotor's; family wheel 4 with a 4-pulse tach reads its 1x and 2x at a quarter and a half of the
+    column); the record's scale is the factor times that scale.  The new-user trial (session 52): a tach's 2 pulses a turn counted as turns put the
+    imbalance at h 0.5 of the column, which the search named "a subharmonic: a rub" with U_s 100 times low, I_zz/I_rr
+    0.65 for 1.3, and the error at the clean level; nothing was said."""
+    passed = []
+    for k, what in WHOLE_FACTORS:
+        if factors is not None and k not in factors:
+            continue
+        scaled = type(test)([replace(r, speed=r.speed * k) for r in test.runs], dict(test.meta or {}))
+        if k in WHOLE_FRACTIONS:
+            # the radial force's line read at the fraction with the given speed's (the same transforms) judges first
+            force = check_record(scaled, LineReads.of(scaled, reads.at(test, k)), whole_factors=False)
+            if force.get("scale") is None or abs(force["scale"] - 1.0) > WHOLE_FACTOR_TOL:
+                continue
+        rec = check_record(scaled, LineReads.of(scaled, line_reads(test, (k,))[k]), whole_factors=False)
+        if rec.get("scale") is None or abs(rec["scale"] - 1.0) > WHOLE_FACTOR_TOL or rec.get("lines_apart"):
+            continue
+        if torques and "radial_torque" not in rec["lines"]:
+            continue
+        passed.append((k, what, rec))
+    if not passed:
+        return None
+    k, what, rec = min(passed, key=lambda x: x[0])
+    scale = k * rec["scale"]
+    each = "; ".join(f"{LINES[key][1]} {v['k'] * k:.6g} in {v['runs']} runs" for key, v in rec["lines"].items())
+    return {"lines": given["lines"], "scale": round(scale, 7), "scaled": True, "runs": spinning,
+            "agreement_rel": rec["agreement_rel"], "runs_off": [], "runs_doubtful": [],
+            "whole_factor": {"factor": round(k, 7), "cause": what, "lines_at_factor": rec["lines"]},
+            "text": (f"speed column scaled by {scale:.6g}: {why}, but the imbalance's 1x lines sit at {k:.6g} of the "
+                     f"given speed ({each}; {100 * rec['agreement_rel']:.3g} % RMS about it){' in both radial pairs' if torques else ''}"
+                     f": {what}; every run's speed multiplied by {scale:.6g}")}
 
 
 def _runs_off(test, ratios: dict, judged: list, about: float, spread: float) -> tuple[list, list]:

@@ -98,3 +98,23 @@ def test_the_channel_resonance_fit_returns_the_closed_form_and_is_no_split():
 
     split = L(190.0) - L(200.0)
     assert fit_split(f, split)["misfit_dB"] < fit_channel_resonance(f, split)["misfit_dB"]
+
+
+def test_a_channel_resonance_is_divided_out_before_a_gain_is_read(tmp_path):
+    """The session-51 new-user generator's own wheel W4 (8 kg, I_zz/I_rr 1.85, 500-6000 rpm; benchmarks/
+    newuser_generator_s51.py, written from the physics alone), Tx through a resonance at 380 Hz (ζ 0.03, gain 5):
+    the h 5.37 line passes it from ~4300 rpm, and on f10986f a "Tx's gain changed by x 1.11" step was described
+    beside the resonance.  A gain is one factor at every frequency: the resonance's course divided out of Tx's lines,
+    no gain remains (rwadist.diagnose.describe_gain.channel_gain's ``resonances``)."""
+    import subprocess
+
+    root = Path(__file__).resolve().parents[1]
+    out = tmp_path / "w4_tx"
+    subprocess.run([sys.executable, str(root / "benchmarks" / "newuser_generator_s51.py"), "W4", "tx_res", str(out),
+                    "--seed", "1"], check=True, capture_output=True)
+    diag = api.diagnose(str(out))
+    (u,) = _channel_resonances(diag)
+    assert u.channels == ("Tx",) and u.parameters["f_r_Hz"] == pytest.approx(380.0, rel=0.01)
+    gains = [v for v in diag.unexplained if v.parameters.get("property") == "channel_gain"]
+    assert gains == [], [v.causes[0][:120] for v in gains]
+    assert _wheel_modes(diag) == []

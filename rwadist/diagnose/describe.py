@@ -319,12 +319,11 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_drift import with_drifts
     from .describe_filter import frequency_response
     from .describe_fixed import fixed_lines_in_part
-    from .describe_gain import as_recorded, channel_gain
+    from .describe_gain import as_recorded
     from .describe_hump import broadband_hump, humps_in_some_runs
     from .describe_lines import speed_lines
     from .describe_partial import partial_lines
-    from .describe_skew import channel_skew
-    from .describe_split import pair_asymmetries
+    from .describe_split import radial_pairs
     from .describe_trend import gain_trend
     from .run_gains import annotate
 
@@ -384,17 +383,10 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)
     tracks = sideband_tracks(sidebands, known_sidebands)
     out += [u for u in fixed_lines_in_part(ctx, state, of_fixed) if not on_a_sideband(ctx, u, tracks)] + sidebands
-    # the recorded channels (a gain acts on them, before any load-cell correction), against the noise as given
-    out += channel_gain(ctx, as_recorded(searched.state), of_line)
-    # the radial forces through two translation modes, x and y (a support stiffer along one axis), or one channel of a
-    # radial pair through a resonance of its own (a sensor's, a fixture's along one axis)
-    asymmetric = pair_asymmetries(ctx, state, of_line)
-    out += asymmetric
-    # one channel of a radial pair recorded later than the other (its lines' x/y phase off a quarter turn ∝ f); not on
-    # a pair with a channel's resonance, whose phase below it grows as 2ζ(g − 1)·f/f_r, a delay's (docs/diagnose.md)
-    resonant = {c for u in asymmetric if u.parameters.get("property") == "channel_resonance"
-                for c in (u.parameters["channel"], u.parameters["partner"])}
-    out += [u for u in channel_skew(ctx, state, of_line) if not set(u.channels) & resonant]
+    # a radial pair's channels reading the lines differently: a gain of one (on the recorded channels), two translation
+    # modes (a support stiffer along one axis), a resonance of one channel (a sensor's, a fixture's along one axis),
+    # one channel recorded later than the other (its lines' x/y phase off a quarter turn ∝ f)
+    out += radial_pairs(ctx, as_recorded(searched.state), state, of_line)
     # a model line that is two or more lines closer than the Welch segments resolve (the whole record reads it alone)
     out += blended_lines(ctx, state, of_line)
     # a gain common to the channels that changes with speed, on the recorded channels too; one of the line's frequency

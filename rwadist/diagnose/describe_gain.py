@@ -83,9 +83,16 @@ def _lines_words(agreeing: np.ndarray, read: np.ndarray) -> str:
             "others differ: a gain acts on all)")
 
 
-def channel_gain(ctx, state, shares) -> list:
+def channel_gain(ctx, state, shares, resonances=()) -> list:
     """``line_property`` records of a radial pair whose two channels read the model's lines by different factors
-    (``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB) of the lines' cells)."""
+    (``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB) of the lines' cells).  ``resonances``:
+    the ``channel_resonance`` records of the pairs (:func:`.describe_split.channel_resonance`), whose course is divided
+    out of their channel's lines before a gain is read from them: a gain is one factor at every frequency, and a
+    channel's resonance lifting the lines near it changes the pair's ratio where the speed brings them there (the
+    new-user trial's Tx resonance at 380 Hz, ζ 0.03, peak gain 5, was also a "Tx's gain changed by x 1.11" step from
+    4316 rpm, where the h 5.37 line passes 380 Hz)."""
+    from ..resonance import resonance
+
     runs = ctx.runs
     out: list[Unexplained] = []
     for cx, cy in RADIAL_PAIRS:
@@ -99,6 +106,13 @@ def channel_gain(ctx, state, shares) -> list:
         good = (snr >= 10 ** (LINE_SNR_DB / 10)) & (px[1] > 0) & (py[1] > 0) & np.isfinite(px[1] + py[1])
         with np.errstate(divide="ignore", invalid="ignore"):
             qx, qy = 10 * np.log10(px[1] / px[2]), 10 * np.log10(py[1] / py[2])
+        f_cells = h[:, None] * ctx.omega[runs][None, :] / (2 * np.pi)
+        for u in resonances:
+            p = u.parameters
+            if p["channel"] in (cx, cy):
+                course = 20 * np.log10(np.abs(resonance(f_cells, p["f_r_Hz"], p["zeta"], p["peak_gain"])))
+                qx, qy = (qx - course, qy) if p["channel"] == cx else (qx, qy - course)
+        with np.errstate(invalid="ignore"):
             d = qy - qx
         lines = [i for i in range(h.size) if good[i].sum() >= MIN_RUNS]
         if len(lines) < MIN_LINES:

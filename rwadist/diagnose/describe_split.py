@@ -161,6 +161,24 @@ def pair_asymmetries(ctx, state, shares) -> list:
     return out
 
 
+def radial_pairs(ctx, recorded, state, shares) -> list:
+    """The records of the radial pairs' channels reading the model's lines differently: a gain of one channel
+    (:func:`.describe_gain.channel_gain`, on the ``recorded`` channels: a gain acts on them, before any load-cell
+    correction), two translation modes or one channel's resonance (:func:`pair_asymmetries`, on ``state``), one
+    channel recorded later than the other (:func:`.describe_skew.channel_skew`).  A channel's resonance is divided
+    out of its lines before a gain is read, and no skew is described on its pair: its phase below the resonance grows
+    as 2ζ(g − 1)·f/f_r, a delay's (docs/diagnose.md).  ``shares(chans, hs, runs)`` -> (share of the misplaced power,
+    level dB) of the lines' cells."""
+    from .describe_gain import channel_gain
+    from .describe_skew import channel_skew
+
+    asymmetric = pair_asymmetries(ctx, state, shares)
+    resonant = [u for u in asymmetric if u.parameters.get("property") == "channel_resonance"]
+    chans = {c for u in resonant for c in (u.parameters["channel"], u.parameters["partner"])}
+    return (channel_gain(ctx, recorded, shares, resonant) + asymmetric
+            + [u for u in channel_skew(ctx, state, shares) if not set(u.channels) & chans])
+
+
 def split_mode(ctx, state, shares) -> list:
     """``line_property`` records (property ``split_mode``) of the radial forces read through two translation modes
     (``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB) of the lines' cells)."""

@@ -46,6 +46,9 @@ RIGID_INERTIA_RATIO = 2.0
 #: A ratio read from the whirls within this relative distance above RIGID_INERTIA_RATIO is a disc's, read to the
 #: whirl fit's resolution (the new-user trial's 2.0 disc read 2.001, printed "2 (above 2 ...)")
 RIGID_RATIO_RESOLUTION = 0.01
+#: I_zz/I_rr below this is a rotor longer than it is wide (a thin rod's is 0): no reaction wheel's (a disc's 2, a
+#: ring with its hub and shaft 1.2-2), and the likeliest cause is the speed column read k times the rotor's speed
+WHEEL_INERTIA_RATIO_MIN = 1.0
 
 
 @register
@@ -84,6 +87,10 @@ class SuspensionModes(Element):
         if isinstance(a, (int, float)) and a > RIGID_INERTIA_RATIO * (1.0 + RIGID_RATIO_RESOLUTION):
             note = (f" (above {RIGID_INERTIA_RATIO:g}, which no rigid rotor rocking about its centre of mass exceeds: "
                     "an effective ratio of the whirls, from a flexible rotor or rocking coupled with other motion)")
+        elif isinstance(a, (int, float)) and a < WHEEL_INERTIA_RATIO_MIN:
+            note = (f" (below {WHEEL_INERTIA_RATIO_MIN:g}: a rotor longer than it is wide, not a wheel's disc; the "
+                    "whirls' split grows as I_zz/I_rr times the speed, so a speed column reading k times the rotor's "
+                    "speed reads the ratio k times low: check the tach's pulses per turn and the column's unit)")
 
         def mode(name: str, label: str) -> str:
             # a mode the data do not locate has no frequency to print: the fit's end point is no finding
