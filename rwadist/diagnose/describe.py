@@ -321,6 +321,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded
     from .describe_hump import broadband_hump, humps_in_some_runs
+    from .describe_line_step import line_steps
     from .describe_lines import speed_lines
     from .describe_partial import partial_lines
     from .describe_split import radial_pairs
@@ -378,6 +379,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)]
     read = structure.line_ratios(res.ctx, res.state) if changes else ratios
     out += annotate(ctx, state, structure.run_change(ctx, read, of_runs), read, taken_out=changes)
+    out += line_steps(ctx, state, ratios, of_line)        # one line's level stepping between runs, the others not
     out += speed_lines(ctx, state, of_line, bearings, others, ctx.left_out)
     out += partial_lines(ctx, state, structure.line_ratios(ctx, state, absent=True), of_line)
     sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)
