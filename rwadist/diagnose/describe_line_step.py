@@ -77,6 +77,8 @@ def line_steps(ctx, state, ratios: list, shares) -> list:
     names = [ctx.sp.run_names[int(r)] if r < len(ctx.sp.run_names) else str(int(r)) for r in ctx.runs]
     out = []
     for direction, h, y in series:
+        if np.isfinite(y).sum() < 2 * MIN_SIDE_RUNS or np.nanmax(y) - np.nanmin(y) < MIN_STEP_DB:
+            continue            # no two sides' medians of it lie MIN_STEP_DB apart: the change point is not sought
         cp = change_point(np.abs(spin), y)
         if cp is None or cp["pattern"] != "step" or abs(cp["step_dB"]) < max(MIN_STEP_DB, STEP_OVER_SCATTER *
                                                                                cp["scatter_dB"]) or cp["z"] < STEP_Z:
