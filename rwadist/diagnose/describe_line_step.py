@@ -17,7 +17,8 @@ median or more, and :data:`~.gain_step.STEP_Z` standard errors of the two sides'
 with :data:`MIN_SIDE_RUNS` runs on each side; when the other lines, read across the same split, step by less than
 :data:`OTHERS_SHARE` of it (a change of every line is a gain or a re-mounting, the run-change's); and when the split
 is no crossing of the line with a suspension mode of the model (:func:`.mode_reach.crossing_groups`: a mode's
-frequency or damping a little off leaves the runs below its crossing and those above on two levels too).
+frequency or damping a little off leaves the runs below its crossing and those above on two levels too) or with a
+fixed resonance of the state (a test stand).
 """
 from __future__ import annotations
 
@@ -59,12 +60,23 @@ def _step_across(y: np.ndarray, below: np.ndarray, above: np.ndarray) -> float |
     return float(np.median(hi) - np.median(lo)) if lo.size >= 2 and hi.size >= 2 else None
 
 
+#: A fixed resonance of the state (a test stand, a wheel mode) reaches a line within this many half-power widths
+#: (ζ·f_r each) of its frequency
+RESONANCE_REACH = 3.0
+
+
 def _at_a_crossing(ctx, state, direction: str, h: float, last: int, first: int) -> bool:
-    """Whether the line (direction, h) crosses one of the model's suspension modes (a whirl branch included) between
-    the runs at positions ``last`` and ``first``, or either of them lies in a mode's reach."""
+    """Whether the line (direction, h) crosses one of the model's suspension modes (a whirl branch included) or a
+    fixed resonance of the state (a test stand: the new-user W2's force fixture at 105 Hz, fitted on every channel,
+    left its h 4.12 line on two levels either side of 105 Hz) between the runs at positions ``last`` and ``first``,
+    or either of them lies in such a resonance's reach."""
     senses = [getattr(x, "sense", None) or "co" for x in state.model.harmonics(direction) if abs(x.h - h) < 1e-3]
     group = crossing_groups(state, direction, h, senses or ["co"], ctx.omega[ctx.runs[[last, first]]])
-    return bool(group[0] != group[1] or np.any(group < 0))
+    if group[0] != group[1] or np.any(group < 0):
+        return True
+    lo, hi = sorted(h * np.abs(ctx.omega[ctx.runs[[last, first]]]) / (2 * np.pi))
+    return any(lo - RESONANCE_REACH * e.zeta * e.f_r <= e.f_r <= hi + RESONANCE_REACH * e.zeta * e.f_r
+               for e in state.effects if getattr(e, "kind", "") == "fixed_resonance")
 
 
 def line_steps(ctx, state, ratios: list, shares) -> list:
