@@ -379,7 +379,6 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)]
     read = structure.line_ratios(res.ctx, res.state) if changes else ratios
     out += annotate(ctx, state, structure.run_change(ctx, read, of_runs), read, taken_out=changes)
-    out += line_steps(ctx, state, ratios, of_line)        # one line's level stepping between runs, the others not
     out += speed_lines(ctx, state, of_line, bearings, others, ctx.left_out)
     out += partial_lines(ctx, state, structure.line_ratios(ctx, state, absent=True), of_line)
     sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)
@@ -389,6 +388,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     # modes (a support stiffer along one axis), a resonance of one channel (a sensor's, a fixture's along one axis),
     # one channel recorded later than the other (its lines' x/y phase off a quarter turn ∝ f)
     out += radial_pairs(ctx, as_recorded(searched.state), state, of_line)
+    out += line_steps(ctx, state, ratios, of_line, out)   # one line's level stepping between runs, the others not
     # a model line that is two or more lines closer than the Welch segments resolve (the whole record reads it alone)
     out += blended_lines(ctx, state, of_line)
     # a gain common to the channels that changes with speed, on the recorded channels too; one of the line's frequency

@@ -12,10 +12,11 @@ said.
 
 Per line (its direction's channels pooled, :func:`.describe_structure.line_ratios`), the runs in speed order, the
 change point of :func:`.gain_step.change_point`: described when it is a step (a law, smooth in speed, is a
-``trend``), :data:`MIN_STEP_DB` or more, :data:`STEP_OVER_SCATTER` times the runs' scatter about their side's
-median or more, and :data:`~.gain_step.STEP_Z` standard errors of the two sides' medians,
+``trend``, and each side's own course moves by at most :data:`SIDE_COURSE_SHARE` of it), :data:`MIN_STEP_DB` or
+more, :data:`STEP_OVER_SCATTER` times the runs' scatter about their side's median or more, and :data:`~.gain_step.STEP_Z` standard errors of the two sides' medians,
 with :data:`MIN_SIDE_RUNS` runs on each side; when the other lines, read across the same split, step by less than
-:data:`OTHERS_SHARE` of it (a change of every line is a gain or a re-mounting, the run-change's); and when the split
+:data:`OTHERS_SHARE` of it, those of its own direction too (a change of every line is a gain or a re-mounting, the
+run-change's; of every line of one direction, a gain of its channels); and when the split
 is no crossing of the line with a suspension mode of the model (:func:`.mode_reach.crossing_groups`: a mode's
 frequency or damping a little off leaves the runs below its crossing and those above on two levels too) or with a
 fixed resonance of the state (a test stand).
@@ -24,6 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..resonance import resonance
+from ..stand_resonance import STAND_MIN_LOG_GAIN
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .gain_step import STEP_Z, change_point
 from .mode_reach import crossing_groups
@@ -35,6 +38,10 @@ MIN_STEP_DB = 1.0
 MIN_SIDE_RUNS = 3
 #: The other lines' median step across the same split, at most this share of the line's (else a common change)
 OTHERS_SHARE = 0.5
+#: Over either side's runs, the line's own course (its Theil-Sen slope times the side's span of speeds) moves by at most
+#: this share of the step: two flat levels (a line growing fast at the top speeds, the session-51 generator's quadratic
+#: channel's Ω⁴ line at h 7.26, rose +15 dB over its top four runs and read as a step into them)
+SIDE_COURSE_SHARE = 0.25
 #: The step over the runs' robust scatter about their side's median, at least: two levels, each flat (a line rising
 #: through a resonance the model lacks scatters about any two levels: the new-user trial's W1 with its modes unfitted,
 #: h 5.39 through the 420 Hz translation read +8.4 dB at 3.1 dB scatter; a step of the imbalance 1.6 dB at 0.02)
@@ -60,30 +67,69 @@ def _step_across(y: np.ndarray, below: np.ndarray, above: np.ndarray) -> float |
     return float(np.median(hi) - np.median(lo)) if lo.size >= 2 and hi.size >= 2 else None
 
 
-#: A fixed resonance of the state (a test stand, a wheel mode) reaches a line within this many half-power widths
-#: (ζ·f_r each) of its frequency
-RESONANCE_REACH = 3.0
+def _side_course(spin: np.ndarray, y: np.ndarray) -> float:
+    """|Theil-Sen slope of ``y`` against ``spin``| times the span of ``spin`` (dB): how far one side's runs move along
+    their own course."""
+    from scipy.stats import theilslopes
+
+    ok = np.isfinite(y)
+    if ok.sum() < 2 or np.ptp(spin[ok]) <= 0:
+        return 0.0
+    return float(abs(theilslopes(y[ok], spin[ok])[0]) * np.ptp(spin[ok]))
+
+
+def _lifted(f: np.ndarray, f_r, zeta: float, gain: float, above: float = 1.0) -> bool:
+    """Whether a resonance at ``f_r`` Hz (a number, or one per frequency: a moving one's track) changes the power of a
+    line at ``f`` Hz (the two runs either side of a step) by a factor 1.5 or more in either run, or lies between them:
+    the stand detection's own threshold (:data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN`)."""
+    lift = np.abs(np.log(np.maximum(np.abs(resonance(f, f_r, zeta, gain, above)) ** 2, 1e-300)))
+    off = np.asarray(f - f_r, dtype=float)
+    return bool(np.any(lift >= STAND_MIN_LOG_GAIN) or off[0] * off[-1] <= 0)
 
 
 def _at_a_crossing(ctx, state, direction: str, h: float, last: int, first: int) -> bool:
     """Whether the line (direction, h) crosses one of the model's suspension modes (a whirl branch included) or a
     fixed resonance of the state (a test stand: the new-user W2's force fixture at 105 Hz, fitted on every channel,
     left its h 4.12 line on two levels either side of 105 Hz) between the runs at positions ``last`` and ``first``,
-    or either of them lies in such a resonance's reach."""
+    or either of them lies in such a resonance's reach (its power gain 1.5 or more, up or down)."""
     senses = [getattr(x, "sense", None) or "co" for x in state.model.harmonics(direction) if abs(x.h - h) < 1e-3]
     group = crossing_groups(state, direction, h, senses or ["co"], ctx.omega[ctx.runs[[last, first]]])
     if group[0] != group[1] or np.any(group < 0):
         return True
-    lo, hi = sorted(h * np.abs(ctx.omega[ctx.runs[[last, first]]]) / (2 * np.pi))
-    return any(lo - RESONANCE_REACH * e.zeta * e.f_r <= e.f_r <= hi + RESONANCE_REACH * e.zeta * e.f_r
+    f = h * np.abs(ctx.omega[ctx.runs[[last, first]]]) / (2 * np.pi)
+    return any(_lifted(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)
                for e in state.effects if getattr(e, "kind", "") == "fixed_resonance")
 
 
-def line_steps(ctx, state, ratios: list, shares) -> list:
+def _on_a_track(records, direction: str, f: np.ndarray, spin: np.ndarray) -> bool:
+    """Whether a line of ``direction`` at frequencies ``f`` (Hz) at the spins ``spin`` (Hz, signed as the runs'; two
+    runs) is lifted (:func:`_lifted`) by a ``moving_resonance`` among ``records`` (its frequency linear in the spin
+    from its lowest speed to its highest) or a ``channel_resonance`` of the direction's channels: family wheel 4, an
+    axial mode stiffening with speed, read its h 3 line x 1.38 across the two runs where the line rose into it; the
+    session-51 generator's one-channel resonances."""
+    for u in records:
+        p = u.parameters
+        if p.get("property") == "channel_resonance" and set(u.channels) & set(DIRECTION_CHANNELS[direction]):
+            if _lifted(f, p["f_r_Hz"], p["zeta"], p["peak_gain"]):
+                return True
+        elif u.signature == "moving_resonance" and p.get("direction") == direction:
+            s_lo, s_hi = (x / 60.0 for x in u.speed_rpm)
+            f_lo, f_hi = p["f_at_lowest_speed_Hz"], p["f_at_highest_speed_Hz"]
+            track = f_lo + (f_hi - f_lo) * (spin - s_lo) / (s_hi - s_lo) if s_hi > s_lo else np.full(spin.shape, f_lo)
+            if _lifted(f, track, p["zeta"], p["peak_gain"]):
+                return True
+    return False
+
+
+def line_steps(ctx, state, ratios: list, shares, described=()) -> list:
     """``line_property`` records (property ``line_step``) of the model's lines whose level steps between two runs
-    (module docstring); ``ratios``: :func:`.describe_structure.line_ratios` of ``state``; ``shares(chans, hs, runs)``
-    -> (share of the misplaced power, level dB) of the lines' cells."""
-    series = _series(ctx, ratios)
+    (module docstring); ``ratios``: :func:`.describe_structure.line_ratios` of ``state``, read where each line is
+    resolved from the others (:func:`.describe_structure.resolved_lines`: a speed sideband's measure near its carrier
+    is the carrier's misfit); ``shares(chans, hs, runs)`` -> (share of the misplaced power, level dB) of the lines'
+    cells; ``described``: the records made before (no step across a ``moving_resonance``'s track)."""
+    from .describe_structure import resolved_lines
+
+    series = _series(ctx, [resolved_lines(ctx, state, r) for r in ratios])
     spin = ctx.omega[ctx.runs] / (2 * np.pi)
     rpm = np.abs(ctx.omega[ctx.runs]) * RAD_S_TO_RPM
     names = [ctx.sp.run_names[int(r)] if r < len(ctx.sp.run_names) else str(int(r)) for r in ctx.runs]
@@ -96,14 +142,19 @@ def line_steps(ctx, state, ratios: list, shares) -> list:
                                                                                cp["scatter_dB"]) or cp["z"] < STEP_Z:
             continue
         below, above = cp["below"], cp["above"]
-        if below.size < MIN_SIDE_RUNS or above.size < MIN_SIDE_RUNS:
+        if below.size < MIN_SIDE_RUNS or above.size < MIN_SIDE_RUNS or \
+                any(_side_course(np.abs(spin[side]), y[side]) > SIDE_COURSE_SHARE * abs(cp["step_dB"])
+                    for side in (below, above)):
             continue
-        others = [s for d, x, v in series if (d, x) != (direction, h)
-                  if (s := _step_across(v, below, above)) is not None]
-        if others and abs(float(np.median(others))) >= OTHERS_SHARE * abs(cp["step_dB"]):
+        steps = [(d, s) for d, x, v in series if (d, x) != (direction, h)
+                 if (s := _step_across(v, below, above)) is not None]
+        others = [s for _, s in steps]
+        own = [s for d, s in steps if d == direction]       # a gain of the direction's channels steps them all
+        if any(x and abs(float(np.median(x))) >= OTHERS_SHARE * abs(cp["step_dB"]) for x in (others, own)):
             continue
         last, first = int(below[np.argmax(rpm[below])]), int(above[np.argmin(rpm[above])])
-        if _at_a_crossing(ctx, state, direction, h, last, first):
+        if _at_a_crossing(ctx, state, direction, h, last, first) or \
+                _on_a_track(described, direction, h * np.abs(spin[[last, first]]), spin[[last, first]]):
             continue
         chans = tuple(c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels)
         used = np.concatenate([below, above])
