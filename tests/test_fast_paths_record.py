@@ -7,8 +7,8 @@ import pytest
 
 from rwadist.dft import run_window, windowed_dft
 from rwadist.diagnose import measure
+from rwadist.diagnose import record_residual as mh
 from rwadist.diagnose.engine import Context, initial_state
-from rwadist.effects import missing_harmonic_diagnose as mh
 from rwadist.effects.sidebands_diagnose import Sidebands
 from rwadist.empirical import fit_empirical
 from rwadist.presets import preset

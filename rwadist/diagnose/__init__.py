@@ -14,6 +14,8 @@ in ``docs/diagnose.md``; the package's modules:
 - :mod:`~rwadist.diagnose.engine` the prediction engine (:class:`Context`, :func:`line_kernel`),
   :mod:`~rwadist.diagnose.state` the :class:`State`, :mod:`~rwadist.diagnose.metric` the error metric;
 - :mod:`~rwadist.diagnose.measure` residual measurements shared by effect families;
+- :mod:`~rwadist.diagnose.record_residual` the whole-run DFT residual (lines below the Welch band or apart from
+  their neighbours);
 - :mod:`~rwadist.diagnose.effects` the effect families' protocol and registry (the families themselves:
   ``rwadist/effects/<kind>_diagnose.py``);
 - :mod:`~rwadist.diagnose.search` the greedy search (:func:`diagnose`, :func:`resolve_base`);

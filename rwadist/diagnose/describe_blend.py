@@ -37,9 +37,10 @@ MIN_POINTS = 6
 def blended_lines(ctx, state, of_line) -> list:
     """``line_property`` records (property ``blended_lines``) of the final model's lines that hide another line in
     their Welch window (module docstring); ``of_line(chans, h, runs)`` -> (share, level dB) of a line's cells."""
-    from ..effects.missing_harmonic_diagnose import RECORD_SEP_BINS, _steady, hidden_in_window, record_noise
+    from ..effects.missing_harmonic_diagnose import _steady, hidden_in_window, record_noise
     from .describe_partial import others_in_window
     from .measure import record_dfts
+    from .record_residual import RECORD_SEP_BINS
 
     if not _steady(ctx, state) or (ctx.test.meta or {}).get("slicing") is not None:
         return []                       # a sweep's slice holds each line as a chirp, on its record as on its Welch PSD

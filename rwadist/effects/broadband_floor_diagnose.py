@@ -197,7 +197,7 @@ def _record_bands(ctx: Context, n: int, fs: float, X: np.ndarray, need: np.ndarr
     median and sums over its own bins in the same order (tests/test_fast_paths_floor.py)."""
     from ..dft import run_window
     from ..diagnose.measure import hann_transform_ratio
-    from .missing_harmonic_diagnose import RECORD_MIN_BINS, RECORD_SEP_BINS
+    from ..diagnose.record_residual import RECORD_MIN_BINS, RECORD_SEP_BINS
 
     nb = ctx.n_bands
     df_rec = fs / n
