@@ -270,9 +270,10 @@ def check_record(test, reads: LineReads | None = None, whole_factors: bool = Tru
     rec: dict = {"lines": lines, "scale": None, "scaled": False, "runs": spinning}
     force = judged.get("radial_force")
     if force is None or force[3] < 0.5 * spinning:
-        rec["text"] = _unchecked(ratios, spinning) + ": the speed column is not checked"
-        return (_whole_factor(test, spinning, rec, _unchecked(ratios, spinning), reads, "radial_torque" in ratios)
-                if whole_factors else None) or rec
+        why = _unchecked(ratios, spinning)
+        rec["text"] = why + ": the speed column is not checked"
+        return (_whole_factor(test, spinning, rec, why, reads, "radial_torque" in ratios) if whole_factors else None) \
+            or rec
     pooled = np.concatenate([r[np.isfinite(r)] for key, r in ratios.items() if key in judged])
     k, _, se, _ = _scale(pooled)
     se = max(se, max(s[2] for s in judged.values()))
