@@ -113,3 +113,21 @@ def test_a_drift_over_every_run_is_read_on_every_run_and_the_modes_stay_right():
     for m in dfm.MODES:
         assert sm[f"{m}_Hz"] == pytest.approx(truth_hz[m], rel=0.02), m
     assert "rocking" in p["modes_on_changed_runs"]
+
+
+@pytest.mark.slow
+def test_planar_lines_through_a_mode_are_no_gain_step(tmp_path):
+    """The session-52 new-user generator's own wheel W1 (2.5 kg, I_zz/I_rr 1.8, translation 420 Hz, 600-6000 rpm;
+    benchmarks/newuser_generator_s52.py, written from the physics alone) beside a lab pump, its h 2 and 3.61 bearing
+    lines planar: on 00e3b10 "Fx's gain changed by x 0.286 between run_0027.csv and run_0028.csv" was described, held
+    by those two lines as they near the translation mode while the 1x and the cage line read the pair alike across
+    the split (0.02 and 0.00 dB) and a third line stepped 25 dB.  A gain moves every line: half of the lines read on
+    both sides must step with it (rwadist.diagnose.gain_step.READ_SHARE); none is described, the pump's lines are."""
+    import subprocess
+
+    out = tmp_path / "w1_pump"
+    subprocess.run([sys.executable, str(ROOT / "benchmarks" / "newuser_generator_s52.py"), "--wheel", "W1", "--case",
+                    "pump", "--seed", "1", "--out", str(out)], check=True, capture_output=True)
+    diag = api.diagnose(str(out))
+    assert [u.parameters for u in diag.unexplained if u.parameters.get("property") == "channel_gain"] == []
+    assert sorted(round(u.f_Hz[0], 1) for u in diag.unexplained if u.signature == "fixed_line") == [24.7, 49.3]
