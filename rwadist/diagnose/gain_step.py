@@ -126,8 +126,7 @@ def gain_step(ctx, state, pair: tuple, h: np.ndarray, q: tuple, good: np.ndarray
     # a gain moves every line: most of the lines read on both sides step with it (the session-52 generator's W1, planar
     # bearing lines through its translation mode: 2 of the 5 lines read stepped within a factor 2 of 10.9 dB, two not
     # at all (0.02, 0.00 dB), one 25 dB; "Fx's gain changed by x 0.286" had been described)
-    read = np.array([np.sum(good[i, cp["below"]]) >= MIN_SIDE and np.sum(good[i, cp["above"]]) >= MIN_SIDE
-                     for i in range(d.shape[0])], bool)
+    read = (good[:, cp["below"]].sum(axis=1) >= MIN_SIDE) & (good[:, cp["above"]].sum(axis=1) >= MIN_SIDE)
     if stepping.sum() < min_lines or stepping.sum() < READ_SHARE * read.sum():
         return None
     own = {c: _own_step(q[j], good, cp) for j, c in enumerate(pair)}
