@@ -125,5 +125,13 @@ def test_a_clean_run_down_has_no_amplitude_law_read_through_its_fast_crossing(tm
     data = fw.sweep(wheel, 3000.0, 300.0, 30.0, noise=0.01, seed=3 + 6, profile="linear")
     csv = fw.write_sweep(data, tmp_path / "sweep.csv", tach=False)
     d = api.diagnose(api.read(csv))
-    assert [u.signature for u in d.unexplained] == []
+    # the sweep draws each part of a co + counter line one phase for the record: its ellipse keeps one orientation, which
+    # the model's powers do not hold (rwadist.diagnose.describe_direction): described with the generator's shape
+    directed = [u for u in d.unexplained if u.parameters.get("property") == "fixed_direction"]
+    assert [u.signature for u in d.unexplained if u not in directed] == []
+    for u in directed:
+        direction = "radial_force" if u.channels[0] == "Fx" else "radial_torque"
+        co = {round(ln.h, 2): ln.co for ln in wheel.lines if ln.direction == direction}
+        for h, q in zip(u.parameters["lines_h"], u.parameters["counter_over_co"]):
+            assert co[round(h, 2)] < 1 and abs(q / np.sqrt((1 - co[round(h, 2)]) / co[round(h, 2)]) - 1) < 0.1, (h, q)
     assert sorted(e["kind"] for e in d.model.effects) == ["suspension_modes"]

@@ -26,6 +26,7 @@ import numpy as np
 
 from ..units import RAD_S_TO_RPM, RADIAL_PAIRS, unit_words
 from .constants import LINE_HALF
+from .describe_direction import fixed_direction
 from .gain_step import gain_step
 from .unexplained import Unexplained
 
@@ -38,6 +39,9 @@ MIN_Z = 5.0
 #: Lines (h) that must each show it, with MIN_RUNS runs or more each.
 MIN_LINES = 2
 MIN_RUNS = 4
+#: ... and at least this share of the lines read (a gain moves every line: the session-52 generator's W1 sweep, four
+#: planar lines of their own directions and two rotating ones, read "Fx reads 1.58 x Fy" on two of the six)
+READ_SHARE = 0.5
 #: The runs' robust scatter of the pair's ratio (per run the median over its lines, dB of power) at which a constant
 #: ratio is said to change from run to run: clean family wheels scatter 0.01-0.05 dB (:mod:`.gain_step`); trial 30b's
 #: Fy gain 1.0-1.3 in recording order, shuffled against the speeds, 0.6-0.9 dB (read as a constant 1.14× before)
@@ -129,7 +133,12 @@ def channel_gain(ctx, state, shares, resonances=()) -> list:
         per_line = np.array([np.median(d[i][good[i]]) for i in lines])
         agree = (np.sign(per_line) == np.sign(med)) & (np.abs(per_line) >= 0.5 * abs(med)) & \
             (np.abs(per_line) <= 2.0 * abs(med))
-        if abs(med) < MIN_DB or abs(med) < MIN_Z * se or agree.sum() < MIN_LINES:
+        if abs(med) < MIN_DB or abs(med) < MIN_Z * se or agree.sum() < max(MIN_LINES, READ_SHARE * len(lines)):
+            # no gain: a gain moves every line read alike; lines that keep their own x/y ratios are loads of a fixed
+            # direction (:mod:`.describe_direction`)
+            directed = fixed_direction(ctx, (cx, cy), h, np.where(good, d, 0.0), good, lines, shares)
+            if directed is not None:
+                out.append(directed)
             continue
         used = np.flatnonzero(good[lines].any(axis=0))
         share, _ = shares((cx, cy), h[lines], runs[used])

@@ -70,6 +70,8 @@ LEVEL_WORDS = {
     "line_property:amplitude_law": "{:+.1f} dB (power) against C·Ω² from the lowest speed to the highest",
     "line_property:blended_lines": "{:+.1f} dB (power) in the line's Welch window over the line itself on the "
                                       "whole record (median)",
+    "line_property:fixed_direction": "{:+.1f} dB (power) in the second channel's line against the first's, the "
+                                     "farthest of the lines' own ratios",
     "line_property:split_mode": "{:+.2f} dB (power) in Fy's lines against Fx's where they differ most",
     "line_property:channel_resonance": "{:+.2f} dB (power) in the channel's lines against its partner's at the "
                                        "resonance",
