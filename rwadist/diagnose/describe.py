@@ -323,6 +323,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_hump import broadband_hump, humps_in_some_runs
     from .describe_line_step import line_steps
     from .describe_lines import speed_lines
+    from .describe_mode_drift import drifting_modes, same_track
     from .describe_partial import partial_lines
     from .describe_split import radial_pairs
     from .describe_trend import gain_trend
@@ -376,7 +377,10 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += humps_in_some_runs(ctx, state, of_band_runs, out)
     # a moving resonance: read on steady lines resolved from their neighbours, described where its cells hold content
     steady = [structure.steady_lines(structure.resolved_lines(ctx, state, r), float(ctx.df)) for r in ratios]
-    out += [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)]
+    # the model's own mode moving over the runs first: a resonance lifting lines fits only its rise
+    drifting = [u for u in drifting_modes(ctx, state, steady, of_track) if holds_content(u, res)]
+    out += drifting + [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)
+                       and not any(same_track(u, v) for v in drifting)]
     read = structure.line_ratios(res.ctx, res.state) if changes else ratios
     out += annotate(ctx, state, structure.run_change(ctx, read, of_runs), read, taken_out=changes)
     out += speed_lines(ctx, state, of_line, bearings, others, ctx.left_out)
