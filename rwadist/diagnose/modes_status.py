@@ -42,6 +42,8 @@ def modes_status(diag) -> dict | None:
     # the context the search read (the data with fixed lines or a channel's copy taken out: :func:`rwadist.diagnose.
     # describe.start`), not the data as given that the diagnosis's figures read: a pickup line is no mode's rise
     ctx = diag.ctx._memo.get(SEARCH_CONTEXT) or diag.ctx
+    if getattr(ctx, "base_switch", False) and diag.state_after.base == "extended":
+        return _unread(ctx, diag)
     if not getattr(ctx, "base_switch", False) or diag.state_after.base != "empirical" or ctx.test is None:
         return None
     from ..empirical import fit_empirical
@@ -107,6 +109,30 @@ def modes_status(diag) -> dict | None:
              "resonance moving with speed could do this; a tap test of the wheel on its mount, or the lines read at "
              "more speeds, would tell")
     return {"status": status, "peaks_Hz": where, "tried": tried, "left_out": left, "text": text}
+
+
+#: The load-cell channels each mode is read on
+MODE_CHANNELS = {"radial_translation": ("Fx", "Fy"), "rocking": ("Tx", "Ty"), "axial": ("Fz",)}
+
+
+def _unread(ctx, diag) -> dict | None:
+    """The record of the fitted suspension modes that no recorded channel reads (status "unread"), or None: a test of
+    the forces alone reads no rocking, and the model holds that mode and I_zz/I_rr at the fit's starting values (the
+    new-user trial of session 54, forces only: "rocking at rest not located (the fit ended at 3964 Hz)" was all it
+    said)."""
+    modes = next((e for e in diag.state_after.effects if getattr(e, "kind", "") == "suspension_modes"), None)
+    if modes is None:
+        return None
+    unread = [m for m, chans in MODE_CHANNELS.items() if m in modes.unconstrained and not set(chans) & set(ctx.channels)]
+    if not unread:
+        return None
+    words = "; ".join(f"{m.replace('_', ' ')}: no {' or '.join(MODE_CHANNELS[m])} recorded, which read it"
+                      for m in unread)
+    held = " and I_zz/I_rr (read from its whirls)" if "rocking" in unread else ""
+    return {"status": "unread", "peaks_Hz": {}, "tried": [], "left_out": [], "unread": unread,
+            "text": f"{words}: the model holds {'it' if len(unread) == 1 else 'them'}{held} at the fit's starting "
+                    "values, not fitted; a test recording those channels would locate "
+                    f"{'it' if len(unread) == 1 else 'them'}"}
 
 
 def _span(w: dict) -> str:
