@@ -23,10 +23,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..resonance import resonance_response
 from ..units import DIRECTION_CHANNELS
 from .describe_structure import MOVING_F, MOVING_NULL_RATIO, MOVING_RATIO, LineRatios, _offsets_only
-from .line_offsets import line_indicator, offset_free_sse
+from .line_offsets import line_indicator
 from .unexplained import Unexplained
 
 #: The mode of the suspension each direction's lines pass (the rocking's whirl moves with speed by itself: not here)
@@ -41,37 +40,51 @@ ZETAS = (0.005, 0.01, 0.02, 0.04, 0.08)
 #: and 3 with the translation moving +6 % and +5 % rise 1.9 dB at most; their clean cells read 0.06-0.27 dB)
 MIN_POINTS = 8
 MIN_DB = 1.0
+#: ... within this log distance of the model's mode (±20 %: the grids' ±15 % and the lines' reach beyond it)
+NEAR_MODE = 0.2
 
 
 def _gain_db(f: np.ndarray, f_r: "np.ndarray | float", zeta: float) -> np.ndarray:
-    """10·log10|H|² (dB) of the suspension's transmissibility (1 + 2jζr)/(1 − r² + 2jζr), r = f/f_r (any shapes that
-    broadcast)."""
-    peak = np.sqrt(1 + 4 * zeta**2) / (2 * zeta)
-    return 20 * np.log10(np.abs(resonance_response(f / f_r, zeta, peak, 0.0)))
+    """10·log10|H|² (dB) of the suspension's transmissibility H = (1 + 2jζr)/(1 − r² + 2jζr), r = f/f_r (any shapes
+    that broadcast): 10·log10((1 + (2ζr)²)/((1 − r²)² + (2ζr)²)) in real arithmetic."""
+    r2 = (f / f_r) ** 2
+    x = 4 * zeta**2 * r2
+    return 10 * np.log10((1 + x) / ((1 - r2) ** 2 + x))
+
+
+def _grid_sse(r: LineRatios, q: np.ndarray, f0s: np.ndarray, slopes: np.ndarray, zetas, onehot, count) -> tuple:
+    """(sse, f0, slope, ζ) of the best track f0 + slope·(spin − mid) over the grids (every combination at once), each
+    line's offset out: Σ res² − Σ_lines (Σ res)²/n per curve."""
+    mid = 0.5 * (r.spin.min() + r.spin.max())
+    fr = f0s[None, :, None] + slopes[:, None, None] * (r.spin - mid)[None, None, :]          # (S, F, N)
+    valid = np.all(fr > 0, axis=2)
+    fr = np.where(fr > 0, fr, 1.0)
+    best = (np.inf, np.nan, np.nan, np.nan)
+    for z in zetas:
+        res = (q - _gain_db(r.f, fr, z)).reshape(-1, q.size)
+        sse = (res * res).sum(1) - (((res @ onehot.T) ** 2) / count).sum(1)
+        sse = np.where(valid.ravel(), sse, np.inf)
+        i = int(np.argmin(sse))
+        if sse[i] < best[0]:
+            best = (float(sse[i]), float(f0s[i % f0s.size]), float(slopes[i // f0s.size]), float(z))
+    return best
 
 
 def _drift_fit(r: LineRatios, f_m: float, zeta: float) -> tuple:
     """((sse, f0, slope, ζ) of the best moving mode, (sse, f0, ζ) of the best fixed one) of the ratios ``r`` read as
     the model's mode at ``f_m`` Hz (ζ ``zeta``) replaced by one on the track f0 + slope·(spin − mid), its own ζ from
     :data:`ZETAS` or the model's (a mode the fit did not locate has no damping to trust: family wheel 3's translation
-    moving +5 % was held at ζ 0.0038, its truth 0.016)."""
-    mid = 0.5 * (r.spin.min() + r.spin.max())
+    moving +5 % was held at ζ 0.0038, its truth 0.016).  Coarse (f0 in 1 % steps, the slope in 0.1) then fine about
+    the best (:data:`F0_FACTORS`' 0.5 % steps over ±1 %, :data:`SLOPES`' 0.02 over ±0.1, ζ × 0.7-1.4)."""
     onehot, count = line_indicator(r.line)
     q = r.q + _gain_db(r.f, f_m, zeta)          # the data over the model with the model's mode put back
-    f0s = f_m * F0_FACTORS
-    best, fixed = (np.inf, np.nan, np.nan, np.nan), (np.inf, np.nan, np.nan)
-    for b in SLOPES:
-        fr = f0s[:, None] + b * (r.spin[None, :] - mid)                                  # (F, N)
-        valid = np.all(fr > 0, axis=1)
-        fr = np.where(fr > 0, fr, 1.0)
-        for z in (zeta,) + ZETAS:
-            sse = np.where(valid, offset_free_sse(q - _gain_db(r.f[None, :], fr, z), onehot, count), np.inf)
-            i = int(np.argmin(sse))
-            if sse[i] < best[0]:
-                best = (float(sse[i]), float(f0s[i]), float(b), float(z))
-            if b == 0.0 and sse[i] < fixed[0]:
-                fixed = (float(sse[i]), float(f0s[i]), float(z))
-    return best, fixed
+    zetas = (zeta,) + ZETAS
+    _, f0, b, z = _grid_sse(r, q, f_m * F0_FACTORS[::2], SLOPES[::5], zetas, onehot, count)
+    near_f0 = f_m * F0_FACTORS[np.abs(np.log(f_m * F0_FACTORS / f0)) <= 0.0101]
+    near_b = SLOPES[np.abs(SLOPES - b) <= 0.1001]
+    best = _grid_sse(r, q, near_f0, near_b, (0.7 * z, z, 1.4 * z), onehot, count)
+    sse_f, f0_f, _, z_f = _grid_sse(r, q, f_m * F0_FACTORS, np.zeros(1), zetas, onehot, count)
+    return best, (sse_f, f0_f, z_f)
 
 
 def drifting_modes(ctx, state, ratios: list, shares) -> list:
@@ -84,9 +97,11 @@ def drifting_modes(ctx, state, ratios: list, shares) -> list:
     out = []
     for r in ratios:
         name = MODE_OF.get(r.direction)
-        if name is None or r.q.size < MIN_POINTS or np.unique(r.line).size < 2 or not np.any(np.abs(r.q) >= MIN_DB):
+        if name is None or r.q.size < MIN_POINTS or np.unique(r.line).size < 2:
             continue
         f_m, zeta = float(modes.f0_Hz[name]), float(modes.zeta[name])
+        if not np.any((np.abs(r.q) >= MIN_DB) & (np.abs(np.log(r.f / f_m)) <= NEAR_MODE)):
+            continue                    # a moved mode changes the lines near it: none is off the model there
         (sse_m, f0, b, zeta_m), (sse_f, _, _) = _drift_fit(r, f_m, zeta)
         sse0 = _offsets_only(r)
         dof = max(r.q.size - np.unique(r.line).size - 3, 1)
