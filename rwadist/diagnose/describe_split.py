@@ -175,8 +175,12 @@ def radial_pairs(ctx, recorded, state, shares) -> list:
     asymmetric = pair_asymmetries(ctx, state, shares)
     resonant = [u for u in asymmetric if u.parameters.get("property") == "channel_resonance"]
     chans = {c for u in resonant for c in (u.parameters["channel"], u.parameters["partner"])}
-    return (channel_gain(ctx, recorded, shares, resonant) + asymmetric
-            + [u for u in channel_skew(ctx, state, shares) if not set(u.channels) & chans])
+    # a pair read through two courses gives each line its own x/y ratio, steady over the runs above both modes: no
+    # load of a fixed direction (the session-54 trial's 450/510 Hz split: its h 8.8 line at +2.8 dB beside the split)
+    split = {c for u in asymmetric for c in u.channels}
+    gains = [u for u in channel_gain(ctx, recorded, shares, resonant)
+             if not (u.parameters.get("property") == "fixed_direction" and set(u.channels) & split)]
+    return (gains + asymmetric + [u for u in channel_skew(ctx, state, shares) if not set(u.channels) & chans])
 
 
 def split_mode(ctx, state, shares) -> list:
