@@ -365,6 +365,16 @@ def mains_family(freqs) -> tuple | None:
     return pick
 
 
+def fundamental_of(f_hz: float, freqs) -> float | None:
+    """The lowest of ``freqs`` (Hz) of which ``f_hz`` is a whole multiple of order 2 or more within 0.5 %, or None (the
+    session-54 new-user trial's lab machine at 37 Hz: its 74 and 111 Hz lines were each described alone)."""
+    for f in sorted(freqs):
+        k = f_hz / f if f > 0 else 0.0
+        if round(k) >= 2 and abs(k - round(k)) <= 0.005 * k:
+            return float(f)
+    return None
+
+
 def describe_fixed_lines(ctx, lines, shares: dict) -> list:
     """:class:`~rwadist.diagnose.unexplained.Unexplained` records (signature ``fixed_line``) of ``lines``, one per
     line; ``shares``: line index -> (share of the misplaced power, level over the model dB) measured on the data as
@@ -388,8 +398,11 @@ def describe_fixed_lines(ctx, lines, shares: dict) -> list:
             tell = "a run with the wheel still and its electronics on shows pickup at the same frequency; so do " \
                    "runs with the load cell's cables rerouted or its amplifier grounded differently (pickup changes)"
         else:
-            causes = ("a machine of the stand or near it (a pump, a fan, a compressor) or a clock of the electronics",
-                      "a structural resonance of the stand excited by a steady source")
+            base = fundamental_of(ln.f_Hz, [x.f_Hz for x in lines])
+            own = (f"order {int(round(ln.f_Hz / base))} of the fixed line at {base:.4g} Hz: the same source's harmonic "
+                   "(a machine's or a clock's line is seldom a pure tone)",) if base is not None else ()
+            causes = own + ("a machine of the stand or near it (a pump, a fan, a compressor) or a clock of the "
+                            "electronics", "a structural resonance of the stand excited by a steady source")
             tell = "a run with the wheel still (electronics on, then off) tells the stand's sources from the wheel's " \
                    "electronics; a line the wheel makes moves with its speed"
         out.append(Unexplained(
