@@ -40,10 +40,10 @@ class StandGroup:
 
 
 @dataclass
-class StandSet:
+class StandSet(StandGroup):
     """Two or more fixture resonances the wheel's suspension modes located together (their ``stand`` and
-    ``more_stands``), proposed as one hypothesis whose ``parts`` the search names each as its own ``fixed_resonance``
-    (as a :class:`~rwadist.effects.broadband_floor_diagnose.FloorGroup`'s).
+    ``more_stands``), proposed as one hypothesis whose ``parts`` (its ``members``) the search names each as its own
+    ``fixed_resonance`` (as a :class:`~rwadist.effects.broadband_floor_diagnose.FloorGroup`'s).
 
     Fixtures in series each carry the lines the other lifts or lowers: the new-user trial of session 54 (its own
     generator: a 2.5 kg wheel on fixtures at 350 Hz, ζ 0.03, and 800 Hz, ζ 0.02, base-excitation transmissibilities on
@@ -52,31 +52,19 @@ class StandSet:
     roll-off lowers), and one resonance at 349 Hz with 0.67 of the load far above, a compromise over both, gained
     0.92 and was named; the 800 Hz lift was then read as an 8-pole anti-alias filter at 882 Hz."""
 
-    parts: tuple
-    kind: str = "fixed_resonance"
-    role: str = "test_stand"
-
     @property
-    def f_r(self) -> float:
-        """Frequency (Hz) of the first part."""
-        return float(self.parts[0].f_r)
-
-    @property
-    def channels(self) -> tuple:
-        return tuple(self.parts[0].channels)
+    def parts(self) -> tuple:
+        return self.members
 
     def apply(self, state: State) -> State:
         """Each part added in turn (one effect of the state per fixture)."""
-        for e in self.parts:
+        for e in self.members:
             state = e.apply(state)
         return state
 
     def refit(self, ctx, state: State) -> "StandSet":
         """Each part as the modes' fit on every run has it (:meth:`FixedResonance.refit`)."""
-        return StandSet(tuple(e.refit(ctx, state) for e in self.parts))
+        return StandSet(tuple(e.refit(ctx, state) for e in self.members))
 
     def significant(self) -> bool:
-        return all(e.significant() for e in self.parts)
-
-    def params(self) -> dict:
-        return {"members": [e.params() for e in self.parts]}
+        return all(e.significant() for e in self.members)
