@@ -3,8 +3,8 @@
 A resonance of the stand lifts the lines of EVERY load direction at one frequency; a wheel mode lifts one
 direction (translation the radial forces, rocking the radial torques, axial the axial force).  Taken for a
 mode, a stand resonance near one spoils the modes' fit (the radial translation pulled to the stand and
-declared unconstrained, the other modes' damping widened).  This module detects one from an empirical fit
-(:func:`stand_starts`) and fits the extended model with it, the stand's parameters in the modes' least squares
+declared unconstrained, the other modes' damping widened).  This module takes the starts proposed from an
+empirical fit (:mod:`rwadist.stand_detect`) and fits the extended model with it, the stand's parameters in the modes' least squares
 (:func:`fit_extended_beside_stand`, what ``rwadist fit --extended`` and ``rwadist diagnose``'s ``suspension_modes``
 run).  The stand's gain is the general single-mode form of :mod:`rwadist.resonance`: a fixture resonance need not
 return to 1 above its frequency (the force through a fixture spring falls as 2ζ/r there).
@@ -14,244 +14,19 @@ from __future__ import annotations
 import numpy as np
 
 from .extended_fit_lsq import joint_cost, noise_weighted_cost
-from .resonance import general_log_power_gain, peak_of, resonance
+from .resonance import resonance
+from .stand_detect import (
+    STAND_MIN_LOG_GAIN,
+    STAND_WINDOW,
+    further_stand_starts,
+    is_fixture_resonance,
+    local_lift,
+    stand_starts,
+)
 
-#: Smallest local lift (mean over a direction's lines of the ln power gain near one frequency over the same line's
-#: gains on both sides, :func:`_local_lift`) a fixture resonance must show in EVERY load direction with lines there to
-#: be proposed: a power gain of 1.5.  A wheel mode amplifies one direction's lines (translation the radial forces,
-#: rocking the radial torques, axial the axial force); only a resonance of the stand lifts them all at one frequency.
-STAND_MIN_LOG_GAIN = float(np.log(1.5))
-
-
-def log_power_gain(e, f_hz) -> np.ndarray:
-    """ln|H(f)|² of the fixed resonance ``e`` (its f_r Hz, zeta, peak_gain, gain_above: :func:`rwadist.resonance.resonance`)
-    at ``f_hz`` (Hz, any shape), |H|² held at 1e-300 or more: where its magnitude reaches :data:`STAND_MIN_LOG_GAIN` the
-    resonance changes a line's power by a factor 1.5 or more, up or down (the stand detection's own threshold)."""
-    return np.log(np.maximum(np.abs(resonance(f_hz, e.f_r, e.zeta, e.peak_gain, e.gain_above)) ** 2, 1e-300))
-
-
-#: Largest damping ratio of a proposed fixture resonance: a fixture resonance is sharp; a "resonance" as wide as
-#: the fit allows (ζ → 0.5) is a broad tilt of the line gains (a wheel mode's skirt, model error), not a stand.
-STAND_MAX_ZETA = 0.2
-#: Smallest damping ratio of a fixture resonance: the fits' lower bound is 0.001 (:func:`_fit_on_lines`,
-#: :class:`rwadist.resonance.FittedResonance`, :class:`rwadist.effects.fixed_resonance_diagnose.FixedResonance`); a fit that ends there measured no width -- a
-#: "resonance" narrower than the lines resolve, one line's misfit at one speed lifted by a gain of 20-40.
-STAND_MIN_ZETA = 0.0015
 #: Largest relative move of a located mode between the fit beside the modes' own stand and the fit beside every
 #: fixture resonance the search named (``rwadist diagnose``'s suspension modes): half the 2 % a mode must be found to.
 STAND_SETTLED_MODE = 0.01
-#: Half width of the window (relative to the frequency) in which a line's log gains are averaged (its neighbourhood:
-#: 2-5 times as far on both sides, :func:`_local_lift`).
-STAND_WINDOW = 0.05
-
-
-def _line_log_gains(fit, known: tuple = ()) -> dict:
-    """(direction, h) -> (f Hz, y) of every measured line amplitude of an empirical fit: f = h|Ω|/2π and
-    y = 2 ln(a / (C·Ω²)), the log power gain over the line's hard-mounted law, less ln|H(f)|² of each fixture
-    resonance of ``known`` ((f_r Hz, ζ, peak gain, gain above) each: stands already fitted with the modes)."""
-    out: dict[tuple[str, float], tuple[list[np.ndarray], list[np.ndarray]]] = {}
-    for x in fit.lines:
-        w = np.abs(np.asarray(x.speed, dtype=float))
-        a = np.asarray(x.amplitude, dtype=float)
-        ok = np.isfinite(a) & (a > 0) & (w > 0)
-        if x.C <= 0 or not ok.any():
-            continue
-        f, y = out.setdefault((x.direction, float(x.h)), ([], []))
-        f.append(x.h * w[ok] / (2 * np.pi))
-        y.append(2.0 * np.log(a[ok] / (x.C * w[ok] ** 2)))
-    got = {d: (np.concatenate(f), np.concatenate(y)) for d, (f, y) in out.items()}
-    for k in known:
-        got = {d: (f, y - np.log(np.maximum(np.abs(resonance(f, *k)) ** 2, 1e-300))) for d, (f, y) in got.items()}
-    return got
-
-
-def _local_lift(f, y, grid, min_points):
-    """Mean of y over the points within ±STAND_WINDOW of each grid frequency less the mean of y over its points 2-5 ×
-    STAND_WINDOW below and above it (the mean of the two sides' means; one side where the line's points end on the
-    other: a line whose top speed puts it on the stand's flank); NaN where fewer than ``min_points`` points lie within
-    ±STAND_WINDOW (one where the line's points are that sparse) or none on either side."""
-    rel = f[None, :] / grid[:, None] - 1.0
-    inner = np.abs(rel) <= STAND_WINDOW
-    below = (rel < -2 * STAND_WINDOW) & (rel >= -5 * STAND_WINDOW)
-    above = (rel > 2 * STAND_WINDOW) & (rel <= 5 * STAND_WINDOW)
-    n_in, n_lo, n_hi = inner.sum(1), below.sum(1), above.sum(1)
-    need = min(min_points, max(1, int(np.ceil(f.size / 20))))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        side = np.where((n_lo > 0) & (n_hi > 0), 0.5 * ((below @ y) / n_lo + (above @ y) / n_hi),
-                        np.where(n_lo > 0, (below @ y) / n_lo, (above @ y) / n_hi))
-        lift = (inner @ y) / n_in - side
-    return np.where((n_in >= need) & ((n_lo > 0) | (n_hi > 0)), lift, np.nan)
-
-
-def is_fixture_resonance(zeta: float, peak_gain: float) -> bool:
-    """True when a resonance of damping ratio ``zeta`` and peak gain ``peak_gain`` (|H| at f_r) can be a fixture's:
-    at most :data:`STAND_MAX_ZETA` wide (broader is a tilt of the line gains: a wheel mode's skirt, an amplitude
-    law's growth, model error), at least :data:`STAND_MIN_ZETA` (narrower is no measured width) and lifting the lines
-    by at least 1 + :data:`STAND_MIN_LOG_GAIN`/2.  The one rule of the stand's detection (:func:`stand_starts`)
-    and of the stand fitted with the modes (:func:`stand_confirmed`)."""
-    return bool(STAND_MIN_ZETA <= zeta <= STAND_MAX_ZETA and peak_gain >= 1.0 + STAND_MIN_LOG_GAIN / 2)
-
-
-def _stand_frequency(fit, min_points: int = 2, known: tuple = ()):
-    """(f Hz, the lines' log gains by line) where a fixture resonance lifts every direction in ``fit``, or None;
-    ``known``: stands already fitted, divided out of the gains (:func:`_line_log_gains`) and not proposed again
-    (no f within :data:`STAND_WINDOW` of one).
-
-    The signature of a stand resonance is one frequency at which the lines of every load direction are lifted (a
-    wheel mode lifts one direction only).  Score of a frequency f: the smallest, over the directions with lines
-    there, of the mean over the direction's lines of each line's local lift at f (:func:`_local_lift`: its log
-    power gains within ±:data:`STAND_WINDOW` of f over its own gains on both sides, at least ``min_points`` of them
-    where the line's points are that dense); f where the score is best, when it reaches :data:`STAND_MIN_LOG_GAIN`
-    in two directions or more.
-    """
-    # every line the data show, at every speed (a line lifted by the stand at most of its speeds is dropped from the
-    # fit with modal exclusion: the E wheel's radial-force lines near a 180 Hz stand at 300-2400 rpm)
-    by_line = _line_log_gains(getattr(fit, "without_mode_exclusion", fit), known)
-    if len({d for d, _ in by_line}) < 2:
-        return None
-    f_all = np.concatenate([f for f, _ in by_line.values()])
-    lo, hi = float(np.min(f_all)), float(np.max(f_all))
-    if hi <= lo * (1 + 2 * STAND_WINDOW):
-        return None
-    grid = np.exp(np.arange(np.log(lo), np.log(hi), 0.005))                     # 0.5 % steps
-    # each line's lift at f over its own gains on both sides of f: the offset of its C·Ω² law and a wheel mode's
-    # broad skirt (the new wheel's three modes lift each direction over most of the band) cancel; the mean over a
-    # direction's lines; the smallest over the directions with lines measured there, where two directions or more
-    # have them: a direction with no line measured near f (on a short record the empirical fit resolves fewer lines:
-    # 2048 samples kept no radial-force line within 5 % of a 180 Hz stand) neither lifts nor rules out f
-    dirs = sorted({d for d, _ in by_line})
-    total, count = np.zeros((len(dirs), grid.size)), np.zeros((len(dirs), grid.size))
-    for (d, _h), (f, y) in by_line.items():
-        c = _local_lift(f, y, grid, min_points)
-        ok = np.isfinite(c)
-        total[dirs.index(d)] += np.where(ok, c, 0.0)
-        count[dirs.index(d)] += ok
-    seen = count > 0
-    means = total / np.maximum(count, 1)
-    score = np.where(seen.sum(0) >= 2, np.min(np.where(seen, means, np.inf), axis=0), -np.inf)
-    for k in known:
-        score[np.abs(grid / k[0] - 1.0) <= STAND_WINDOW] = -np.inf
-    i = int(np.argmax(score))
-    if not score[i] >= STAND_MIN_LOG_GAIN:
-        return None
-    return float(grid[i]), by_line
-
-
-def stand_resonance_start(fit, min_points: int = 2):
-    """(f_r Hz, ζ, peak gain, gain above) of a fixture resonance seen in the empirical fit ``fit``, or None: the first
-    of :func:`stand_starts`."""
-    starts = stand_starts(fit, min_points)
-    return starts[0] if starts else None
-
-
-def stand_starts(fit, min_points: int = 2, known: tuple = ()) -> list:
-    """Starts (f_r Hz, ζ, peak gain, gain above) of the fixture resonance seen in the empirical fit ``fit``: none when
-    :func:`_stand_frequency` sees none; else the resonance fitted on every direction's lines (:func:`_fit_on_lines`),
-    then the one of each direction alone that is a fixture resonance within ±5 % of it, weakest first.  A wheel mode
-    beside the stand lifts its own direction's lines by the mode times the stand (the axial mode at 140 Hz beside a
-    stand at 142 Hz: the pooled fit 138.6 Hz, gain 12.6 for a stand of gain 5), so the direction lifted least is the
-    stand's best start where a mode sits on one direction.  ``known``: stands already fitted with the modes, divided
-    out of the line gains first (:func:`_line_log_gains`): the starts of another stand beside them."""
-    found = _stand_frequency(fit, min_points, tuple(known))
-    if found is None:
-        return []
-    f_s, by_line = found
-    pooled = _fit_on_lines(by_line, f_s)
-    out = [] if pooled is None else [pooled]
-    dirs = sorted({d for d, _ in by_line})
-    own = [_fit_on_lines({k: v for k, v in by_line.items() if k[0] == d}, f_s) for d in dirs]
-    ref = f_s if pooled is None else pooled[0]
-    own = sorted((o for o in own if o is not None and abs(o[0] / ref - 1) <= 0.05), key=lambda o: o[2])
-    for o in own:
-        if not any(abs(o[0] / q[0] - 1) < 0.005 and abs(np.log(o[2] / q[2])) < 0.05 for q in out):
-            out.append(o)
-    return out
-
-
-#: Window (factors of f_r) of the line gains a fixture resonance is fitted on: wide enough to see where the gain
-#: ends above the resonance (a transmissibility's |H| crosses 1 at sqrt(2)·f_r)
-GENERAL_WINDOW = (0.5, 2.0)
-#: Damping ratio a start is given when the lines alone do not resolve the stand's width (:func:`_fit_on_lines`): the
-#: smallest of that fit's own starting values; the joint fit with the modes measures it
-UNRESOLVED_START_ZETA = 0.01
-#: Evaluations of one start's least squares at most (:func:`_fit_on_lines`).  The starts converge in 15-300; one that
-#: does not crawls along the width's floor where the lines do not resolve the peak (family wheel 2 clean, its 90 Hz
-#: translation seen as a stand: 1700 evaluations, 1.2 s, each to ζ 0.0023, gain 8.9; stopped at 200: ζ 0.0028, gain 8.3).
-#: What it proposes is a start: the joint fit with the modes measures the stand or rejects it.
-START_MAX_NFEV = 200
-
-
-def _fit_on_lines(by_line: dict, f_s: float):
-    """(f_r Hz, ζ, peak gain, gain above) of the fixture resonance near ``f_s`` fitted to the lines' log power gains
-    ``by_line`` ((direction, h) -> (f Hz, y)) within :data:`GENERAL_WINDOW` of f_s, or None when it is no fixture
-    resonance (:func:`is_fixture_resonance`).
-
-    Robust (soft-L1) least squares of y = a_line + b_direction·ln(f/f_s) + ln|H(f)|², H the general single-mode gain
-    (:mod:`rwadist.resonance`, f_r within ±10 % of f_s): each line's own offset a (its C·Ω² law was fitted on speeds
-    that the fixture lifts or lowers, so its gains are offset by its own amount), each direction's own tilt b (a
-    wheel mode's skirt beside the stand is one direction's), the resonance common to all.  Started from H → 1 above
-    (β = 1) and from a transmissibility (β = 0, γ = 1), ζ ∈ {0.01, 0.03, 0.1}; the best kept."""
-    from scipy.optimize import least_squares
-
-    fs: list[np.ndarray] = []
-    ys: list[np.ndarray] = []
-    lines: list[np.ndarray] = []
-    whichs: list[np.ndarray] = []
-    dirs = sorted({d for d, _ in by_line})
-    for j, ((d, _h), (fd, yd)) in enumerate(by_line.items()):
-        near = (fd >= GENERAL_WINDOW[0] * f_s) & (fd <= GENERAL_WINDOW[1] * f_s)
-        fs.append(fd[near])
-        ys.append(yd[near])
-        lines.append(np.full(int(near.sum()), j))
-        whichs.append(np.full(int(near.sum()), dirs.index(d)))
-    f, y, line, which = (np.concatenate(v) for v in (fs, ys, lines, whichs))
-    if f.size < 8:
-        return None
-    _, line = np.unique(line, return_inverse=True)
-    n_line, n_dir = int(line.max()) + 1, len(dirs)
-    lf = np.log(f / f_s)
-    rows = np.arange(f.size)
-
-    last: dict = {}
-
-    def res_jac(x):
-        # scipy asks the residuals, then the Jacobian at the same point: both made once (a copy of each handed out:
-        # the robust loss scales what it is given in place)
-        key = x.tobytes()
-        if last.get("x") != key:
-            lg, d = general_log_power_gain(f, float(np.exp(x[0])), float(np.exp(x[1])), float(x[2]), float(x[3]))
-            J = np.zeros((f.size, x.size))
-            J[:, :4] = -d
-            J[rows, 4 + line] = -1.0
-            J[rows, 4 + n_line + which] = -lf
-            last.update(x=key, r=y - x[4 + line] - x[4 + n_line + which] * lf - lg, J=J)
-        return last["r"].copy(), last["J"].copy()
-
-    n_free = n_line + n_dir
-    lb = np.concatenate([[np.log(0.9 * f_s), np.log(1e-3), 0.0, -1.0], np.full(n_free, -np.inf)])
-    ub = np.concatenate([[np.log(1.1 * f_s), np.log(0.3), 200.0, 3.0], np.full(n_free, np.inf)])
-    # each line's offset started at its median gain outside ±10 % of f_s (where a sharp resonance lifts little)
-    off = np.array([np.median(y[(line == k) & (np.abs(lf) > 0.1)]) if np.any((line == k) & (np.abs(lf) > 0.1))
-                    else np.median(y[line == k]) for k in range(n_line)])
-    near = np.abs(lf) <= 0.05
-    g0 = float(np.clip(np.exp(np.max(y[near] - off[line[near]]) / 2.0) if near.any() else 3.0, 1.2, 100.0))
-    sols = []
-    for zeta in (0.01, 0.03, 0.1):
-        for gamma, beta in ((g0, 1.0), (1.0, 0.0)):
-            x0 = np.concatenate([[np.log(f_s), np.log(zeta), gamma, beta], off, np.zeros(n_dir)])
-            sols.append(least_squares(lambda x: res_jac(x)[0], x0, jac=lambda x: res_jac(x)[1], loss="soft_l1",
-                                      f_scale=0.5, bounds=(lb, ub), max_nfev=START_MAX_NFEV))
-    best = min(sols, key=lambda sol: sol.cost)      # the first of the lowest cost
-    zeta = float(np.exp(best.x[1]))
-    out = (float(np.exp(best.x[0])), zeta, peak_of(zeta, float(best.x[2]), float(best.x[3])), float(best.x[3]))
-    if zeta < STAND_MIN_ZETA and out[2] > 1.0:
-        # the width runs to the fit's floor: the lines cross the stand too sparsely to resolve it (family wheel 7,
-        # 16 speeds to 10000 rpm, each line one point within ±5 % of a 200 Hz stand on its axial mode: ζ 0.001, gain
-        # 200), and measure only the lift off its peak, ζ·g.  That start, at a width the fit can leave, is proposed:
-        # the joint fit with the modes measures the width (200.2 Hz, ζ 0.031, gain 4.9 there) or rejects the stand
-        # (:func:`stand_confirmed`)
-        out = (out[0], UNRESOLVED_START_ZETA, max(out[2] * zeta / UNRESOLVED_START_ZETA, 1.0), out[3])
-    return out if is_fixture_resonance(out[1], out[2]) else None
 
 
 def _mode_hz(params) -> dict:
@@ -392,7 +167,7 @@ def same_stand(a: tuple | None, b: tuple | None) -> bool:
 
 def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, starts: list | None = None,
                               near: dict | None = None, near_stand: tuple | None = None, joints: dict | None = None,
-                              **kwargs):
+                              further_starts=None, **kwargs):
     """:func:`rwadist.extended_fit.fit_extended` of ``test`` (empirical fit ``fit``; ``kwargs`` passed on) with a
     fixture resonance fitted jointly with the wheel's modes, never into them.
 
@@ -416,7 +191,11 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
 
     ``joints``: a dict kept by the caller for this ``test`` and ``fit`` (the same data and empirical fit), holding the
     joint fit from each start already made with the same arguments: asked again (the stands of every run, then the
-    refit of the modes on every run, from the same starts), the same fit is not made twice."""
+    refit of the modes on every run, from the same starts), the same fit is not made twice.
+
+    ``further_starts``: a callable returning the starts of a stand at another frequency
+    (:func:`rwadist.stand_detect.further_stand_starts`), fitted only when no start of ``starts`` is confirmed; None:
+    those of ``fit`` when the starts are its own (``starts`` and ``stand_start`` None), else none."""
     from .extended_fit import fit_extended
 
     def near_beside(stand):
@@ -425,6 +204,8 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
     if starts is None:
         channels = {c for r in test.runs for c in r.signals}
         starts = [stand_start] if stand_start is not None else (stand_starts(fit) if len(channels) >= 6 else [])
+        if further_starts is None and stand_start is None and len(channels) >= 6:
+            further_starts = lambda: further_stand_starts(fit)  # noqa: E731 (asked only when no start is confirmed)
     plain = fit_extended(test, fit, **kwargs, **near_beside(None))
     if not starts:
         return plain
@@ -438,6 +219,11 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
     # 70.1 Hz at 0.9, 0.95, 1.05, 1.1; 83-87 Hz, ζ 0.3 at 0.8, 1.0, 1.25)
     fitted = [_joint_once(joints, test, fit, s, {**kwargs, **near_beside(s)}) for s in full]
     confirmed = [j for j in fitted if stand_confirmed(j, plain)]
+    if not confirmed and further_starts is not None:
+        # the lines lift at another frequency too: a second fixture, beside which the modes may be located first
+        more = [tuple(s) + (() if len(s) == 4 else (1.0,)) for s in further_starts()]
+        confirmed = [j for j in (_joint_once(joints, test, fit, s, {**kwargs, **near_beside(s)}) for s in more)
+                     if stand_confirmed(j, plain)]
     if not confirmed:
         return plain
     joint = min(confirmed, key=joint_cost)
@@ -564,7 +350,7 @@ LOCATED_STRUCTURE_DIRECTIONS = ("axial_force", "radial_force")
 def structure_mode_starts(efit, direction: str) -> list:
     """Starts (f_r Hz, ζ, peak gain) of a resonance of ``direction``'s lines alone, from the extended fit ``efit``'s log
     residuals there (:attr:`ExtendedFit.line_residuals`): the frequencies where their local lift over their
-    neighbourhood (:func:`_local_lift` of the log power residuals) is greatest and at least
+    neighbourhood (:func:`local_lift` of the log power residuals) is greatest and at least
     :data:`STAND_MIN_LOG_GAIN`, :data:`STRUCTURE_STARTS` at most, 10 % apart; ζ 0.03 and the lift's gain.
 
     A wheel's suspension mode is one resonance per direction; a second one on the same lines (a mode of the housing
@@ -575,7 +361,7 @@ def structure_mode_starts(efit, direction: str) -> list:
     if f.size < 8 or f.max() <= f.min() * (1 + 2 * STAND_WINDOW):
         return []
     grid = np.exp(np.arange(np.log(f.min()), np.log(f.max()), 0.005))
-    lift = _local_lift(f, y, grid, 2)
+    lift = local_lift(f, y, grid, 2)
     out: list[tuple] = []
     for i in np.argsort(-np.where(np.isfinite(lift), lift, -np.inf)):
         if not lift[i] >= STAND_MIN_LOG_GAIN or len(out) == STRUCTURE_STARTS:

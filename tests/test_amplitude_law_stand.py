@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rwadist.effects.amplitude_law_diagnose import AmplitudeLaw, _stand_reach
-from rwadist.stand_resonance import STAND_MIN_LOG_GAIN
+from rwadist.stand_detect import STAND_MIN_LOG_GAIN
 
 
 def _stand(f_r, zeta, role="test_stand"):

@@ -74,7 +74,7 @@ def test_diagnose_without_model_names_the_modes_then_the_law(law_test):
 def test_a_broad_tilt_is_no_fixture_resonance():
     """The rule the stand's detection and diagnose's stand rounds share: the matrix's 180-Hz stand (ζ 0.03, gain 5)
     is one; the broad 'stands' the Ω³ law's growth produced (ζ 0.2-0.5, gain 1.15-1.3) are not."""
-    from rwadist.stand_resonance import is_fixture_resonance
+    from rwadist.stand_detect import is_fixture_resonance
 
     assert is_fixture_resonance(0.03, 5.0)
     # ... nor one at the fits' lower damping bound (0.001: no measured width; the 163-Hz, gain-27 patch of one

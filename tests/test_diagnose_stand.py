@@ -25,7 +25,7 @@ from rwadist.empirical import fit_empirical  # noqa: E402
 from rwadist.inject import parse, simulate_with_injections  # noqa: E402
 from rwadist.presets import preset  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
-from rwadist.stand_resonance import stand_resonance_start  # noqa: E402
+from rwadist.stand_detect import stand_resonance_start  # noqa: E402
 from rwadist.teststand import simulate_steady  # noqa: E402
 
 F_STAND = 180.0

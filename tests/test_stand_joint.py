@@ -30,7 +30,8 @@ from rwadist.resonance import (  # noqa: E402
     smallest_peak,
 )
 from rwadist.spectra import compute_spectra  # noqa: E402
-from rwadist.stand_resonance import _mode_hz, fit_extended_beside_stand, stand_starts  # noqa: E402
+from rwadist.stand_detect import stand_starts  # noqa: E402
+from rwadist.stand_resonance import _mode_hz, fit_extended_beside_stand  # noqa: E402
 
 ZETA = 0.03
 #: |H(f_r)| of a fixture spring's transmissibility of damping ZETA (closed form: sqrt(1 + 4ζ²)/(2ζ))

@@ -26,7 +26,8 @@ from family_test import steady_test  # noqa: E402
 from rwadist import api  # noqa: E402
 from rwadist.empirical import fit_empirical  # noqa: E402
 from rwadist.spectra import compute_spectra  # noqa: E402
-from rwadist.stand_resonance import _mode_hz, fit_extended_beside_stand, stand_starts  # noqa: E402
+from rwadist.stand_detect import stand_starts  # noqa: E402
+from rwadist.stand_resonance import _mode_hz, fit_extended_beside_stand  # noqa: E402
 
 ZETA, PEAK = 0.03, 5.0
 #: the two fixtures' factors of the radial translation (trial20's 0.8x and 1.3x)

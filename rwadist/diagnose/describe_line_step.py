@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..resonance import resonance
-from ..stand_resonance import STAND_MIN_LOG_GAIN
+from ..stand_detect import STAND_MIN_LOG_GAIN
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .gain_step import STEP_Z, change_point
 from .mode_reach import crossing_groups
@@ -93,7 +93,7 @@ def _side_scatter(y: np.ndarray) -> float:
 def _lifted(f: np.ndarray, f_r, zeta: float, gain: float, above: float = 1.0) -> bool:
     """Whether a resonance at ``f_r`` Hz (a number, or one per frequency: a moving one's track) changes the power of a
     line at ``f`` Hz (the two runs either side of a step) by a factor 1.5 or more in either run, or lies between them:
-    the stand detection's own threshold (:data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN`)."""
+    the stand detection's own threshold (:data:`rwadist.stand_detect.STAND_MIN_LOG_GAIN`)."""
     lift = np.abs(np.log(np.maximum(np.abs(resonance(f, f_r, zeta, gain, above)) ** 2, 1e-300)))
     off = np.asarray(f - f_r, dtype=float)
     return bool(np.any(lift >= STAND_MIN_LOG_GAIN) or off[0] * off[-1] <= 0)

@@ -15,7 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..stand_resonance import STAND_MIN_LOG_GAIN
+from ..stand_detect import STAND_MIN_LOG_GAIN
 from ..units import CHANNELS, DIRECTION_CHANNELS
 
 #: Speeds (log spaced over the runs' range) the damping's reach is read on to place the crossings between runs.
@@ -27,7 +27,7 @@ def damping_log_gain(state, direction: str, h: float, senses, omega: np.ndarray)
     channels with every mode's damping doubled to that with the state's modes (``state.ext``), at ``omega`` rad/s.
 
     Near a crossing it is about ln ¼ (the resonant peak goes as 1/ζ²); away from the modes about 0: where its
-    magnitude reaches :data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN` (a factor 1.5) the modes' damping, not the
+    magnitude reaches :data:`rwadist.stand_detect.STAND_MIN_LOG_GAIN` (a factor 1.5) the modes' damping, not the
     line's source, sets the line's level."""
     from .. import extended as ext
 

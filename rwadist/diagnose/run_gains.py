@@ -13,7 +13,7 @@ through the modes the extended fit reads them from (family wheel 7, the true fac
 for 130; left in: 125.8 Hz, −3.3 %, and its damping not constrained).
 
 A mode's frequency and damping are read on the runs where the mode sets a line's level: where doubling that mode's
-damping changes a model line's power by :data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN` (a factor 1.5) or more
+damping changes a model line's power by :data:`rwadist.stand_detect.STAND_MIN_LOG_GAIN` (a factor 1.5) or more
 (:func:`rwadist.diagnose.mode_reach.damping_log_gain`'s test, one mode at a time).  A mode with such runs among the
 changed ones is fitted through their factors: :func:`modes_in_changed_runs` names it, so that the record says so
 (no mode wrong silently).
@@ -69,7 +69,7 @@ def mode_runs(ctx, state, factors_db: np.ndarray, directions=None) -> dict:
     :func:`rwadist.diagnose.mode_reach.damping_log_gain`), or moving its frequency by :data:`MODE_SHIFT` changes
     some line's power by the run's own factor (``factors_db`` (R,), dB of power: that run's change can be taken for
     such a shift) or more, on the lines of ``directions`` (default every direction); {} without the modes."""
-    from ..stand_resonance import STAND_MIN_LOG_GAIN
+    from ..stand_detect import STAND_MIN_LOG_GAIN
 
     p = getattr(state, "ext", None)
     if p is None:

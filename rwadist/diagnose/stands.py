@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .effects.base import schema_entry
 from .state import State
 
 
@@ -30,6 +31,11 @@ class StandGroup:
 
     def params(self) -> dict:
         return {"members": [e.params() for e in self.members]}
+
+    def to_schema(self) -> dict:
+        """The entry of the hypothesis (summary.json's ``hypotheses``, hypotheses.csv): each member's parameters; the
+        members named are written each as its own ``fixed_resonance``."""
+        return schema_entry(self)
 
     def apply(self, state: State) -> State:
         return state.plus(self)

@@ -12,7 +12,7 @@ from ..diagnose.measure import in_unresolved_span, measure_run_powers
 from ..diagnose.mode_reach import crossing_groups
 from ..diagnose.state import State
 from ..extended import is_imbalance
-from ..stand_resonance import STAND_MIN_LOG_GAIN, log_power_gain
+from ..stand_detect import STAND_MIN_LOG_GAIN, log_power_gain
 from ..units import DIRECTION_CHANNELS
 
 #: Standard errors an exponent must lie away from 2 (the model's C·Ω²) to be proposed as a law.
@@ -56,7 +56,7 @@ def _law_lsq(X, y, leak, var_noise, rounds: int = 4):
 def _stand_reach(state: State, h: float, w: np.ndarray) -> np.ndarray:
     """True for each speed ``w`` (rad/s) at which a test-stand resonance the state names (a ``fixed_resonance`` of role
     test_stand) changes the power of the line h by a factor 1.5 or more (|ln|H|²| >=
-    :data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN`, the stand's own detection threshold), up or down.
+    :data:`rwadist.stand_detect.STAND_MIN_LOG_GAIN`, the stand's own detection threshold), up or down.
 
     The level, not its slope: far above a stand whose gain stays off 1 (``gain_above``) the gain is a constant factor,
     which alone cannot change an exponent, but the measurement divides it out as fitted

@@ -105,12 +105,12 @@ def _lifted_directions(e: "FixedResonance", f: np.ndarray, y: np.ndarray, w: np.
 
     ``f`` (Hz), ``y`` (the log power gain each measured line needs over the model without ``e``: ln(measured /
     predicted power)), ``w`` (its weight, :func:`_line_gain_points`) and ``dirs`` (its load direction) of every point;
-    those where ``e`` changes the power by a factor e^:data:`rwadist.stand_resonance.STAND_MIN_LOG_GAIN` (1.5) or more,
+    those where ``e`` changes the power by a factor e^:data:`rwadist.stand_detect.STAND_MIN_LOG_GAIN` (1.5) or more,
     either way (the stand detection's own threshold), weigh each direction: it is explained when
     Σw(y − ln|H|²)² < Σwy² over its points, made worse when the reverse.  A fixture resonance lifts every direction's lines near it; a resonance of one direction (a housing
     mode on the radial forces) pooled over every channel lifts the torques' and axial lines it passes too, which
     the data do not show."""
-    from ..stand_resonance import STAND_MIN_LOG_GAIN, log_power_gain
+    from ..stand_detect import STAND_MIN_LOG_GAIN, log_power_gain
 
     if f.size == 0:
         return 0
@@ -322,7 +322,7 @@ def _straddles(e: "FixedResonance", f: np.ndarray) -> bool:
     power by 1.5x or more.  A half of the runs whose lines reach only one skirt cannot (the new-user trial of session
     54: a fixture at 800 Hz crossed only by the lines of the runs above 5450 rpm, the slower half's skirt put its centre
     11 % from the faster half's, ζ 0.0045, and the fixture was refused as moving with the speed)."""
-    from ..stand_resonance import STAND_MIN_LOG_GAIN, log_power_gain
+    from ..stand_detect import STAND_MIN_LOG_GAIN, log_power_gain
 
     near = f[np.abs(log_power_gain(e, f)) >= STAND_MIN_LOG_GAIN]
     return bool(np.any(near < e.f_r) and np.any(near > e.f_r))
@@ -445,10 +445,10 @@ class FixedResonance:
     def significant(self) -> bool:
         """Still a resonance its family would propose (:meth:`candidates`' rules): |H| at f_r at least
         :data:`MIN_PEAK_GAIN` from 1 (a wheel mode above it: it amplifies) and ζ between the width a fit can measure
-        (:data:`rwadist.stand_resonance.STAND_MIN_ZETA`) and :data:`MAX_ZETA`.  The search
+        (:data:`rwadist.stand_detect.STAND_MIN_ZETA`) and :data:`MAX_ZETA`.  The search
         asks it of the refit on every run: family wheel 6 with a fixture at 188 Hz, a wheel-mode candidate on the axial
         force at 88 Hz refitted to a peak gain of 1.003 was added."""
-        from ..stand_resonance import STAND_MIN_ZETA
+        from ..stand_detect import STAND_MIN_ZETA
 
         # a fit ending at its damping floor (1e-3) measured no width: one line's misfit at one speed lifted (family
         # wheel 6 with a fixture at 165 Hz: an axial 'wheel mode' at 89.7 Hz, ζ 0.001, beside its 85 Hz axial mode)

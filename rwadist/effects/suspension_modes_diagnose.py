@@ -26,7 +26,8 @@ from ..diagnose.stands import StandGroup
 from ..diagnose.state import State
 from ..diagnose.whole_fit import fit_of_runs, fit_spectra, whole_data_fit
 from ..model import WheelModel
-from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode, stand_starts
+from ..stand_detect import further_stand_starts, stand_starts
+from ..stand_resonance import SAME_STAND, fit_extended_beside_stand, fit_extended_beside_structure_mode
 from .cross_coupling_diagnose import OFFSET_Z, CrossCoupling
 
 
@@ -53,7 +54,7 @@ def _fit_runs(ctx: Context, runs, state: State, stand_start: tuple | None = None
     peak gain, gain above) fitted with the modes, or None; ``offset`` the load-cell offset (a ``cross_coupling``)
     the torques were corrected for before the modes were located (:func:`_beside_offset`), or None.
     ``stand_start``: the stand to start from (a refit on every run starts from the one fitted on half of them), else
-    those :func:`rwadist.stand_resonance.stand_starts` proposes. ``near``: the modes that fit located, searched
+    those :func:`rwadist.stand_detect.stand_starts` proposes. ``near``: the modes that fit located, searched
     first (``near`` of :func:`rwadist.extended_fit.fit_extended`), or None.  ``structure_start``: the mode of the
     wheel's structure to start from (direction, f_r Hz, ζ, peak gain: the fit on half the runs had it), or None.
     ``offset_start``: the load-cell offset the fit on half the runs located its modes beside (its ``offset``), or
@@ -162,9 +163,10 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
     if len(ctx.channels) <= 3:
         return fit_extended(test, fit, near=near), None
     # a fixture resonance the fit runs are too few to show (half of a short speed grid) but every run shows
-    starts = [stand_start] if stand_start is not None else \
-        (_stand_starts_once(ctx, fit) or _stand_starts_once(ctx, whole_data_fit(ctx)))
-    efit = fit_extended_beside_stand(test, fit, starts=starts, near=near, near_stand=stand_start,
+    source = None if stand_start is not None else (fit if _stand_starts_once(ctx, fit) else whole_data_fit(ctx))
+    starts = [stand_start] if source is None else _stand_starts_once(ctx, source)
+    further = None if source is None else (lambda: _stand_starts_once(ctx, source, further=True))
+    efit = fit_extended_beside_stand(test, fit, starts=starts, further_starts=further, near=near, near_stand=stand_start,
                                      joints=_joints_memo(ctx, test, fit))
     own = ((efit.stand,) if efit.stand is not None else ()) + tuple(efit.more_stands)
     if stand_start is None and (not own or stand_starts(whole_data_fit(ctx), known=own)):
@@ -190,13 +192,14 @@ def _joints_memo(ctx: Context, test, fit) -> dict:
     return kept[4]
 
 
-def _stand_starts_once(ctx: Context, fit) -> list:
-    """:func:`rwadist.stand_resonance.stand_starts` of the empirical fit ``fit``, computed once per fit and diagnosis
-    (the whole data's fit is asked by the fit on the fit runs, by the whole data's stand and by the refit on every
-    run, which fits the same empirical fit)."""
-    key = ("suspension_modes.stand_starts", id(fit))
+def _stand_starts_once(ctx: Context, fit, further: bool = False) -> list:
+    """:func:`rwadist.stand_detect.stand_starts` of the empirical fit ``fit`` (``further``:
+    :func:`rwadist.stand_detect.further_stand_starts`), computed once per fit and diagnosis (the whole data's fit is
+    asked by the fit on the fit runs, by the whole data's stand and by the refit on every run, which fits the same
+    empirical fit)."""
+    key = ("suspension_modes.stand_starts", id(fit), further)
     if key not in ctx._memo or ctx._memo[key][0] is not fit:
-        ctx._memo[key] = (fit, stand_starts(fit))
+        ctx._memo[key] = (fit, (further_stand_starts if further else stand_starts)(fit))
     return list(ctx._memo[key][1])
 
 
@@ -248,6 +251,7 @@ def _whole_data_stands(ctx: Context) -> tuple:
             test = SteadyTest([ctx.test.runs[int(r)] for r in ctx.runs], _recorded_meta(ctx))
             try:
                 efit = fit_extended_beside_stand(test, whole_fit, starts=starts,
+                                                 further_starts=lambda: _stand_starts_once(ctx, whole_fit, True),
                                                  joints=_joints_memo(ctx, test, whole_fit))
             except ValueError:
                 efit = None
@@ -534,8 +538,12 @@ class SuspensionModes:
 
         if self.stand is None:
             return []
-        held = list(self.more_stands_fit_runs) + ([self.stand_fit_runs] if self.stand_fit_runs else [])
-        return [FixedResonance.of_stand(self.stand_fit_runs or self.stand, channels, self.stand)] + [
+        # matched by frequency: the refit on every run may hold the fit runs' stands in another order (family wheel 1's
+        # fixtures at 422 and 651 Hz: 650 then 422 on the fit runs, 422 then 651 on every run, and the 650 Hz stand
+        # was proposed twice)
+        held = ([self.stand_fit_runs] if self.stand_fit_runs else []) + list(self.more_stands_fit_runs)
+        first = next((h for h in held if same_stand(h, self.stand)), self.stand_fit_runs or self.stand)
+        return [FixedResonance.of_stand(first, channels, self.stand)] + [
             FixedResonance.of_stand(next((h for h in held if same_stand(h, k)), k), channels, k)
             for k in self.more_stands]
 
