@@ -321,7 +321,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded
     from .describe_hump import broadband_hump, humps_in_some_runs
-    from .describe_line_step import line_steps
+    from .describe_line_step import line_steps, without_steps
     from .describe_lines import speed_lines
     from .describe_mode_drift import drifting_modes, same_track
     from .describe_partial import partial_lines
@@ -376,7 +376,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out = [u for u in broadband_hump(ctx, state, of_band) if not on_a_fixed_line(u, carriers, float(ctx.sp.df))]
     out += humps_in_some_runs(ctx, state, of_band_runs, out)
     # a moving resonance: read on steady lines resolved from their neighbours, described where its cells hold content
-    steady = [structure.steady_lines(structure.resolved_lines(ctx, state, r), float(ctx.df)) for r in ratios]
+    steady = [without_steps(structure.steady_lines(structure.resolved_lines(ctx, state, r), float(ctx.df)))
+              for r in ratios]
     # the model's own mode moving over the runs first: a resonance lifting lines fits only its rise
     drifting = [u for u in drifting_modes(ctx, state, steady, of_track) if holds_content(u, res)]
     out += drifting + [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)

@@ -133,6 +133,43 @@ def _on_a_track(records, direction: str, f: np.ndarray, spin: np.ndarray) -> boo
     return False
 
 
+def two_levels(x: np.ndarray, y: np.ndarray) -> dict | None:
+    """The change point of :func:`.gain_step.change_point` of ``y`` (R,, dB, NaN where not read) against ``x`` (R,,
+    the runs' speeds or any increasing function of them) when it is a step between two flat levels, else None: a step
+    (not a Theil-Sen trend against ``x``), :data:`MIN_STEP_DB` or more, :data:`STEP_OVER_SCATTER` times the runs'
+    scatter about their side's median or more (pooled, and each side's own: :func:`_side_scatter`), each side's own
+    course at most :data:`SIDE_COURSE_SHARE` of it (:func:`_side_course`), :data:`~.gain_step.STEP_Z` standard errors
+    of the two sides' medians, and :data:`MIN_SIDE_RUNS` runs on each side."""
+    if np.isfinite(y).sum() < 2 * MIN_SIDE_RUNS or np.nanmax(y) - np.nanmin(y) < MIN_STEP_DB:
+        return None             # no two sides' medians of it lie MIN_STEP_DB apart: the change point is not sought
+    cp = change_point(x, y)
+    if cp is None or cp["pattern"] != "step" or abs(cp["step_dB"]) < max(MIN_STEP_DB, STEP_OVER_SCATTER *
+                                                                           cp["scatter_dB"]) or cp["z"] < STEP_Z:
+        return None
+    if any(side.size < MIN_SIDE_RUNS or _side_course(x[side], y[side]) > SIDE_COURSE_SHARE * abs(cp["step_dB"]) or
+           STEP_OVER_SCATTER * _side_scatter(y[side]) > abs(cp["step_dB"]) for side in (cp["below"], cp["above"])):
+        return None
+    return cp
+
+
+def without_steps(r):
+    """The line ratios ``r`` (:class:`.describe_structure.LineRatios`) without the points of a line whose levels step
+    between two flat levels over the runs in speed order (:func:`two_levels`): its runs above the step are no
+    resonance's lift (a resonance lifts a line where it crosses, and lets it go).  The new-user trial of session 55, a
+    bearing line at h 3.55 doubling from the 20th of 40 runs: once no amplitude law took it, a moving resonance
+    "f_rotor + 3·f_spin of a rotor mode of 3 nodal diameters" was fitted through its upper runs and its step, "100 %
+    of what is left", was never described."""
+    from dataclasses import replace
+
+    keep = np.ones(r.q.size, bool)
+    for ln in np.unique(r.line):
+        m = r.line == ln
+        if two_levels(np.abs(r.spin[m]), r.q[m]) is not None:
+            keep &= ~m
+    return r if keep.all() else replace(r, **{k: getattr(r, k)[keep] for k in ("q", "f", "run", "spin", "line", "h",
+                                                                                "w")})
+
+
 def line_steps(ctx, state, ratios: list, shares, described=()) -> list:
     """``line_property`` records (property ``line_step``) of the model's lines whose level steps between two runs
     (module docstring); ``ratios``: :func:`.describe_structure.line_ratios` of ``state``, read where each line is
@@ -149,17 +186,10 @@ def line_steps(ctx, state, ratios: list, shares, described=()) -> list:
     names = [ctx.sp.run_names[int(r)] if r < len(ctx.sp.run_names) else str(int(r)) for r in ctx.runs]
     out = []
     for direction, h, y in series:
-        if np.isfinite(y).sum() < 2 * MIN_SIDE_RUNS or np.nanmax(y) - np.nanmin(y) < MIN_STEP_DB:
-            continue            # no two sides' medians of it lie MIN_STEP_DB apart: the change point is not sought
-        cp = change_point(np.abs(spin), y)
-        if cp is None or cp["pattern"] != "step" or abs(cp["step_dB"]) < max(MIN_STEP_DB, STEP_OVER_SCATTER *
-                                                                               cp["scatter_dB"]) or cp["z"] < STEP_Z:
+        cp = two_levels(np.abs(spin), y)
+        if cp is None:
             continue
         below, above = cp["below"], cp["above"]
-        if below.size < MIN_SIDE_RUNS or above.size < MIN_SIDE_RUNS or \
-                any(_side_course(np.abs(spin[side]), y[side]) > SIDE_COURSE_SHARE * abs(cp["step_dB"]) or
-                    STEP_OVER_SCATTER * _side_scatter(y[side]) > abs(cp["step_dB"]) for side in (below, above)):
-            continue
         steps = [(d, s) for d, x, v in series if (d, x) != (direction, h)
                  if (s := _step_across(v, below, above)) is not None]
         others = [s for _, s in steps]

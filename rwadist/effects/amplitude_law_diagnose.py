@@ -6,6 +6,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from ..diagnose.describe_line_step import two_levels
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.measure import in_unresolved_span, measure_run_powers
@@ -141,6 +142,10 @@ class AmplitudeLaw:
     #: ((channel, exponent, its standard error, the number of runs), ...) fitted on each channel of a radial pair
     #: alone (:func:`_channel_sides`); () on an axial direction or with one channel of the pair (:meth:`significant`)
     channel_sides: tuple = ()
+    #: The step (dB) between two flat levels that the line's amplitude over Ω² makes across the runs in speed order
+    #: (:func:`rwadist.diagnose.describe_line_step.two_levels`), None when it makes none: a change of the line's
+    #: source between runs, no law (:meth:`significant`)
+    two_levels_dB: float | None = None
     kind: str = "amplitude_law"
     #: it adds no line, only changes the amplitude of one the state has: judged with that line's beats at its own
     #: amplitudes (:func:`rwadist.diagnose.search._evidence`)
@@ -204,6 +209,12 @@ class AmplitudeLaw:
         # gain (a range switched between runs), not the wheel's
         if not all(self._side_agrees(p, se, told) for _, p, se, _ in self.channel_sides):
             return False
+        # two flat levels are a step, not a law: the new-user trial of session 55, a 3 kg wheel's bearing line at h 3.55
+        # doubling from the 20th of 40 runs (in speed order, 5615 rpm), read Ω^2.46 ± 0.06 and named, the line 0.68x
+        # its level at 1000 rpm, 1.49x below the step and 0.76x above it; left to the model, the step is described
+        # (:func:`rwadist.diagnose.describe_line_step.line_steps`)
+        if self.two_levels_dB is not None:
+            return False
         return told(self.exponent, self.exponent_stderr)
 
     def _side_agrees(self, p: float, se: float, told) -> bool:
@@ -260,8 +271,11 @@ class AmplitudeLaw:
                 c2, v2 = _law_lsq(X[out], np.log(d[out]), leak[out], var_noise[out])
                 beyond = (float(c2[1]), float(np.sqrt(v2[1, 1])), int(out.sum()))
         sides = _mode_sides(state, direction, h, w, X, np.log(d), leak, var_noise)
+        # the runs' levels over Ω² (dB) against ln|Ω|: a step is told from every law, a straight line there
+        step = two_levels(np.log(w), 20.0 * np.log10(d / w**2))
         return AmplitudeLaw(direction, float(h), float(coef[1]), float(np.exp(coef[0])), w_ref,
-                            float(np.sqrt(cov[1, 1])), beyond, sides, _channel_sides(ctx, state, direction, h, runs))
+                            float(np.sqrt(cov[1, 1])), beyond, sides, _channel_sides(ctx, state, direction, h, runs),
+                            None if step is None else float(step["step_dB"]))
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:

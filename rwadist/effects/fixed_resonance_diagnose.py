@@ -6,6 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..diagnose.constants import LINE_HALF, SNR_KNEE
+from ..diagnose.describe_line_step import two_levels
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.stands import StandSet
@@ -47,7 +48,10 @@ def _line_gain_points(ctx, state, chans, runs, with_lines: bool = False):
 
     A line whose ratio to the speed drifts (:func:`rwadist.diagnose.describe_drift.drifting`: a bearing's cage
     slipping) is left out: read at its fixed ratio it falls away from the model as the data's line moves off, a loss
-    a notch there fits (trial 30b wheel A, the cage slipping 5 %: a 'test stand' at 139.6 Hz of peak gain 0.27)."""
+    a notch there fits (trial 30b wheel A, the cage slipping 5 %: a 'test stand' at 139.6 Hz of peak gain 0.27); so is
+    a line whose level steps between two flat levels over the runs in speed order
+    (:func:`rwadist.diagnose.describe_line_step.two_levels`: session 55's 3 kg wheel, its imbalance doubled from the
+    20th of 40 runs, got a 'wheel mode' at 129.8 Hz, ζ 0.15, peak gain 1.27 on the radial forces)."""
     from ..diagnose.describe_drift import drifting
 
     moving = drifting(ctx, state.model)
@@ -86,6 +90,9 @@ def _line_gain_points(ctx, state, chans, runs, with_lines: bool = False):
                 _, p2, p2_pred, n2, ok2 = other[h]
                 ok = ok & ok2
                 p, p_pred, n_pow = p + p2, p_pred + p2_pred, n_pow + n2
+            with np.errstate(divide="ignore", invalid="ignore"):
+                if two_levels(np.abs(ctx.omega[runs]), np.where(ok, 10 * np.log10(p / p_pred), np.nan)) is not None:
+                    continue            # its level steps between two flat levels: no resonance's lift (docstring)
             snr = p[ok] / n_pow[ok]
             fs.append(f[ok])
             ys.append(np.log(p[ok] / p_pred[ok]))
