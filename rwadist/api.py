@@ -554,7 +554,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
         extended when the model has an analytical section whose modes are not assumed (a catalogue
         datasheet wheel's are) and the data's record does not say the wheel's modes were off; otherwise
         empirical, and the search may name the wheel's ``suspension_modes`` fitted from the data and carry
-        on from them (:func:`rwadist.diagnose.search.fits_modes_from_data`).
+        on from them (:func:`rwadist.diagnose.bases.fits_modes_from_data`).
     nperseg : int or None
         FFT length, samples; default :func:`diagnose_nperseg`.
     f_lim : float or None

@@ -18,12 +18,13 @@ in ``docs/diagnose.md``; the package's modules:
   their neighbours);
 - :mod:`~rwadist.diagnose.effects` the effect families' protocol and registry (the families themselves:
   ``rwadist/effects/<kind>_diagnose.py``);
-- :mod:`~rwadist.diagnose.search` the greedy search (:func:`diagnose`, :func:`resolve_base`);
+- :mod:`~rwadist.diagnose.search` the greedy search (:func:`diagnose`); :mod:`~rwadist.diagnose.bases` its starting base (:func:`resolve_base`);
 - :mod:`~rwadist.diagnose.report` the report (:func:`write_report`).
 """
 from __future__ import annotations
 
 from ..resonance import resonance
+from .bases import BASES, resolve_base
 from .constants import (
                         BAND_BINS,
                         F_MIN_BINS,
@@ -40,7 +41,7 @@ from .engine import Context, initial_state, line_kernel, noise_estimate
 from .measure import refine_h, ridge_peaks
 from .report import rms_vs_speed, write_report
 from .ripple import ripple_sideband_powers
-from .search import BASES, Diagnosis, Hypothesis, diagnose, effect_entry, resolve_base
+from .search import Diagnosis, Hypothesis, diagnose, effect_entry
 from .state import State
 
 __all__ = [

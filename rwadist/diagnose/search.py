@@ -9,10 +9,10 @@ import numpy as np
 from scipy import stats
 
 from ..empirical import fit_empirical
-from ..errors import ParameterError
 from ..model import WheelModel
 from ..spectra import Spectra
 from . import describe
+from .bases import fits_modes_from_data, resolve_base
 from .constants import BAND_BINS, CONTRAST_METRIC, CONTRAST_NOISE_Z, METRIC, NOISE_Z
 from .describe_law import laws_below_gain
 from .effects import family_classes
@@ -202,8 +202,9 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
         e0_all, all_tot, _ = _state_errors(ctx, state, runs, None, memo)
         t = gain / se if se > 0 else (np.inf if gain > 0 else 0.0)
         frac = gain / max(float(e0_all.sum()), 1e-300)
-        return Hypothesis(effect, gain / max(float(all_tot.sum()), 1e-300), frac, float(t),
-                          bool(t > k_sigma and frac >= min_gain), iteration)
+        hyp = Hypothesis(effect, gain / max(float(all_tot.sum()), 1e-300), frac, float(t),
+                         bool(t > k_sigma and frac >= min_gain), iteration)
+        return _narrow_measured(ctx, state, hyp, effect.apply(state), runs, k_sigma)
     chans = [c for c in effect.channels if c in ctx.channels]
     applied = effect.apply(state)
     gain, frac, t, total = _evidence(ctx, state, applied, runs, chans, memo,
@@ -213,9 +214,7 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
     hyp = Hypothesis(effect, gain / total, frac, float(t), bool(t > k_sigma and frac >= min_gain), iteration)
     if hyp.passed:
         return hyp
-    if getattr(effect, "judged_on_narrow_lines", False) and t > k_sigma:
-        c0 = ctx.contrast_error(state, runs)
-        hyp.narrow_gain_fraction = (c0 - ctx.contrast_error(applied, runs)) / c0 if c0 > 0 else 0.0
+    _narrow_measured(ctx, state, hyp, applied, runs, k_sigma)
     stand = getattr(effect, "stand_effect", lambda channels: None)(ctx.channels)
     if stand is not None:
         beside = _judge_beside_stand(ctx, state, effect, stand, runs, chans, k_sigma, min_gain, iteration)
@@ -226,6 +225,15 @@ def _judge(ctx, state, effect, k_sigma, min_gain, iteration, memo=None):
         with_offset = _judge_with_offset(ctx, state, effect, offset, runs, chans, k_sigma, min_gain, iteration)
         if with_offset.passed:
             return with_offset
+    return hyp
+
+
+def _narrow_measured(ctx, state, hyp: Hypothesis, applied, runs, k_sigma) -> Hypothesis:
+    """``hyp`` with its ``narrow_gain_fraction`` measured (``applied``: its effect applied to ``state``) when it did not
+    pass, its effect is judged on the narrow lines as well and its t is beyond ``k_sigma`` (:func:`_narrow_judge`)."""
+    if not hyp.passed and getattr(hyp.effect, "judged_on_narrow_lines", False) and hyp.t > k_sigma:
+        c0 = ctx.contrast_error(state, runs)
+        hyp.narrow_gain_fraction = (c0 - ctx.contrast_error(applied, runs)) / c0 if c0 > 0 else 0.0
     return hyp
 
 
@@ -565,43 +573,6 @@ def _no_worse(ctx, state, refit, beside=None) -> tuple[bool, State]:
         stand = getattr(refit, "stand_effect", lambda channels: None)(ctx.channels) or beside
         return ctx.error(new.plus(stand)) <= ctx.error(stand.apply(state)) * (1.0 + NO_WORSE_TOLERANCE), new
     return _state_error(ctx, new) <= _state_error(ctx, state) * (1.0 + NO_WORSE_TOLERANCE), new
-
-
-BASES = ("empirical", "extended", "auto")
-
-
-def _modes_off(test) -> bool:
-    """True when the test's record says the wheel's modes were off (a virtual-stand test made with modes=False)."""
-    return test is not None and getattr(test, "meta", {}).get("modes") is False
-
-
-def resolve_base(model: WheelModel | None, base: str = "empirical", test=None) -> str:
-    """'empirical' or 'extended' for a ``base`` request (the one rule of the library and the CLI).
-
-    'auto' is 'extended' when the model has an ``analytical`` section whose suspension modes are not
-    assumed (a catalogue datasheet wheel carries ``analytical.modes_assumed``: its modes are guesses, the
-    data's own are fitted instead, :func:`fits_modes_from_data`), unless the test's record says the wheel's
-    modes were off (``test.meta["modes"] is False``: a virtual-stand test made with modes=False is
-    hard-mounted C·Ω² truth); else 'empirical'.  'extended' without an analytical section is a ValueError.
-    ``test``: the SteadyTest (or None: no record)."""
-    from ..catalogue import modes_assumed
-
-    if base not in BASES:
-        raise ParameterError(f"diagnose: base must be one of {BASES}, got {base!r}")
-    has = model is not None and bool(getattr(model, "analytical", None))
-    if base == "auto":
-        return "extended" if has and not modes_assumed(model) and not _modes_off(test) else "empirical"
-    if base == "extended" and not has:
-        raise ParameterError("base", "'extended' needs a model with an analytical section "
-                             "(rwadist.extended.params_to_dict), e.g. preset('ithaco-e').to_model()")
-    return base
-
-
-def fits_modes_from_data(model: WheelModel | None, base: str = "empirical", test=None) -> bool:
-    """True when the search may name the wheel's own ``suspension_modes``, fitted from the data, and carry on
-    from that extended base: the request is 'auto', it resolves to 'empirical' (:func:`resolve_base`: no
-    analytical model, or one whose modes are assumed) and the test does not record the modes off."""
-    return base == "auto" and resolve_base(model, base, test) == "empirical" and not _modes_off(test)
 
 
 class BaseRejected(Exception):

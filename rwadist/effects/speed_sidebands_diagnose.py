@@ -3,6 +3,7 @@ proportional to the speed), searched on the speeds where they stand resolved fro
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -336,6 +337,11 @@ class SpeedSidebands:
     C_carrier: float
     n_points: int = 0
     kind: str = "speed_sidebands"
+    #: two narrow lines beside a strong carrier: beside the share of the misplaced power, judged on the share of the
+    #: narrow-line misfit they take (:func:`rwadist.diagnose.search._narrow_judge`).  The session-55 new-user trial's
+    #: 7 kg wheel on a 162 Hz fixture: its 3 % sidebands of the imbalance fitted at t ≈ 1600, 2.6-4.8 % of the
+    #: misplaced power the fixture's compromise leaves (under min_gain) and left out, with nothing said
+    judged_on_narrow_lines: ClassVar[bool] = True
     #: the carrier's C read on the whole records apart from the pair (empirical base, :func:`_record_carrier_C`),
     #: which the carrier takes when applied; 0: the state's kept
     carrier_record_C: float = 0.0
