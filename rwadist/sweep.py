@@ -279,6 +279,15 @@ def _predict_from_neighbours(f0, sigma, usable, half_width: int) -> tuple:
     return pred, pvar
 
 
+#: A slice's speed more than this share off the track its neighbours predict (and 4 combined standard errors) is a
+#: line of another ratio taken for 1x there, not the rotor's speed (the rotor cannot jump so between two slices): the
+#: session-55 trial's 4.5 kg wheel swept 500 -> 7500 rpm in 90 s without a speed column read its cage line (h 0.41) as
+#: 1x in two slices at ~500 rpm (1244 and 1299 rpm), and those two slices' jumps set the slice-length rule's chirp
+#: (50 bins at 8192 samples): 2048-sample slices were cut, the band started at 54.7 Hz, counter-rotating torque
+#: lines and an Ω^2.06 law were fitted
+OFF_TRACK_REL = 0.2
+
+
 def _fuse_track(f0: np.ndarray, sigma: np.ndarray, half_width: int = FUSE_HALF_WIDTH) -> tuple:
     """Combine each slice's estimate with the prediction of its neighbours (continuity).
 
@@ -290,10 +299,12 @@ def _fuse_track(f0: np.ndarray, sigma: np.ndarray, half_width: int = FUSE_HALF_W
     model error m of the prediction is estimated from the data (robust method of moments on the
     residuals, relative to f0), and each slice's value becomes the inverse-variance mean of its
     own estimate (σ²) and p (v + m²f0²); an outlier keeps its own value.  Precise slices keep
-    their value; noisy ones (the wheel slow, its lines near the noise) borrow from the track.
+    their value; noisy ones (the wheel slow, its lines near the noise) borrow from the track.  A slice off the
+    track (:func:`_off_track`) gets σ = ∞: a mis-picked line, no speed.
     Returns (f0, σ) fused, Hz.
     """
-    good = np.isfinite(f0) & np.isfinite(sigma) & (sigma > 0)
+    off = _off_track(f0, half_width)
+    good = np.isfinite(f0) & np.isfinite(sigma) & (sigma > 0) & ~off
     pred, pvar = _predict_from_neighbours(f0, sigma, good, half_width)
     have = np.isfinite(pred)
     outlier = np.zeros(len(f0), dtype=bool)
@@ -302,7 +313,7 @@ def _fuse_track(f0: np.ndarray, sigma: np.ndarray, half_width: int = FUSE_HALF_W
         pred, pvar = _predict_from_neighbours(f0, sigma, good & ~outlier, half_width)
         have = np.isfinite(pred)
     if have.sum() < 3:
-        return f0, sigma
+        return f0, np.where(off, np.inf, sigma)
     r = f0[have] - pred[have]
     excess = (r**2 - sigma[have] ** 2 - pvar[have]) / f0[have] ** 2
     m_rel2 = max(float(np.median(excess[~outlier[have]])) if (~outlier[have]).any() else 0.0, 0.0)
@@ -312,7 +323,38 @@ def _fuse_track(f0: np.ndarray, sigma: np.ndarray, half_width: int = FUSE_HALF_W
     out_f, out_s = f0.copy(), sigma.copy()
     out_f[have] = (w_own * f0[have] + w_pred * pred[have]) / (w_own + w_pred)
     out_s[have] = 1.0 / np.sqrt(w_own + w_pred)
+    # far off the track: another line taken for 1x in that slice; its speed is not known (the slice is dropped as
+    # uncertain, :func:`slice_sweep`, and no slice-length rule reads it)
+    out_s[off] = np.inf
     return out_f, out_s
+
+
+def _off_track(f0: np.ndarray, half_width: int) -> np.ndarray:
+    """Bool per slice: its estimate ``f0`` (Hz) lies more than :data:`OFF_TRACK_REL` off the Theil-Sen line through
+    its neighbours' within ``half_width`` slices (twice as far on the one side at an end of the sweep, where the
+    slowest slices are: 4 neighbours at least).  Robust to a neighbour off the track too (the trial's two first
+    slices both read the cage as 1x), which the weighted quadratic of :func:`_predict_from_neighbours`, fitted
+    through them, is not."""
+    from scipy.stats import theilslopes
+
+    found = np.isfinite(f0) & (f0 > 0)
+    off = np.zeros(f0.size, bool)
+    for _ in range(2):
+        # the second pass reads each slice against the neighbours the first found on the track: two slices off it
+        # beside a third leave its Theil-Sen line with a third of its points wrong
+        idx = np.flatnonzero(found & ~off)
+        new = np.zeros(f0.size, bool)
+        for i in np.flatnonzero(found):
+            j = idx[(np.abs(idx - i) <= half_width) & (idx != i)]
+            if j.size and not (j.min() < i < j.max()):
+                j = idx[(np.abs(idx - i) <= 2 * half_width) & (idx != i)]
+            if j.size < 4:
+                continue
+            slope, icpt = theilslopes(f0[j], j)[:2]
+            p = icpt + slope * i
+            new[i] = bool(p > 0 and abs(f0[i] / p - 1.0) > OFF_TRACK_REL)
+        off = new
+    return off
 
 
 def _rotation_sign(sweep: Sweep, starts, slice_samples: int, f1: np.ndarray) -> np.ndarray:
@@ -487,10 +529,11 @@ def _slice_chirp(infos: list, fs: float, h_max: float) -> float:
     """Largest over the slices with a speed of the sweep, in bins, of the line h_max across one of the
     :data:`SEGMENTS_READ` Welch segments of a slice: h_max·|dΩ/dt|·L²/(2π), L = T/SEGMENTS_READ seconds (the line
     moves h_max·|dΩ/dt|·L/(2π) Hz over the segment, its bin is 1/L Hz); dΩ/dt from the slices' speeds against
-    their centre times (rad/s²).  0 with fewer than 3 slices with a speed."""
+    their centre times (rad/s²), the slices with a known speed (a finite standard error: :func:`_fuse_track`).  0 with
+    fewer than 3 such slices."""
     t = np.array([0.5 * (i.start + i.stop) / fs for i in infos])
     w = np.array([i.speed for i in infos])
-    ok = np.isfinite(w) & (w != 0)
+    ok = np.isfinite(w) & (w != 0) & np.isfinite([i.speed_stderr for i in infos])
     if ok.sum() < 3 or not np.isfinite(h_max):
         return 0.0
     seg = (infos[0].stop - infos[0].start) / fs / SEGMENTS_READ
@@ -502,7 +545,7 @@ def _slice_change(infos: list, fs: float) -> float:
     slice of T seconds (dΩ/dt from the slices' speeds against their centre times)."""
     t = np.array([0.5 * (i.start + i.stop) / fs for i in infos])
     w = np.array([i.speed for i in infos])
-    ok = np.isfinite(w) & (w != 0)
+    ok = np.isfinite(w) & (w != 0) & np.isfinite([i.speed_stderr for i in infos])
     if ok.sum() < 3:
         return 0.0
     rate = np.abs(np.gradient(w[ok], t[ok]))

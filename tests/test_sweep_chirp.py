@@ -146,3 +146,33 @@ def test_axial_mode_reached_by_one_force_line_beside_a_flat_spin_axis_torque_lin
     p = efit.params
     assert "axial" not in efit.unconstrained and not any("exponent was left free" in n for n in efit.notes)
     assert np.sqrt(p.k_z / p.mass) / (2 * np.pi) == pytest.approx(tw.F_Z, rel=0.005)
+
+
+def test_a_slice_whose_speed_reads_another_line_is_dropped_not_kept():
+    """A run-up's slices whose speed estimate took another line for 1x (the session-55 new-user trial: a 4.5 kg wheel
+    swept 500 -> 7500 rpm in 90 s without a speed column read its cage line, h 0.41, as 1x in its two first slices:
+    1244 and 1299 rpm for 510 and 530) lie off the track the other slices make: their speed is unknown (standard
+    error inf: :func:`rwadist.sweep.slice_sweep` drops them as uncertain) and the slice-length rule does not read their
+    jumps.  On ce37b70 both kept their own values (an outlier next to another supported it), and their jumps set the
+    chirp rule's largest sweep rate.  Closed form: a linear ramp of the rotor frequency, 1 % scatter."""
+    from rwadist.sweep import SliceInfo, _fuse_track, _slice_change, _slice_chirp
+
+    rng = np.random.default_rng(5)
+    n = 120
+    truth = np.linspace(8.5, 125.0, n)                       # Hz, 510 -> 7500 rpm
+    f0 = truth * (1 + 0.001 * rng.standard_normal(n))
+    sigma = 0.001 * truth
+    wrong = [0, 1, 60]
+    f0[wrong] = truth[wrong] / 0.41                          # the cage taken for 1x there
+    fused, s = _fuse_track(f0, sigma)
+    assert np.flatnonzero(~np.isfinite(s)).tolist() == wrong
+    ok = np.isfinite(s)
+    assert np.max(np.abs(fused[ok] / truth[ok] - 1)) < 0.005
+    fs, L = 8000.0, 2048
+    infos = [SliceInfo(start=k * L, stop=(k + 1) * L, speed=2 * np.pi * fused[k], speed_source="data",
+                       speed_spread=0.0, confidence=1.0, speed_stderr=2 * np.pi * s[k]) for k in range(n)]
+    alpha = 2 * np.pi * (truth[1] - truth[0]) / (L / fs)      # rad/s²
+    seg = L / fs / 4
+    # the chirp of h 6.56 over a quarter-slice segment, h·α·seg²/2π, and the speed's change over a slice
+    assert _slice_chirp(infos, fs, 6.56) == pytest.approx(6.56 * alpha * seg**2 / (2 * np.pi), rel=0.1)
+    assert _slice_change(infos, fs) == pytest.approx(np.median(alpha * L / fs / (2 * np.pi * truth)), rel=0.05)
