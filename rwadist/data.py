@@ -38,6 +38,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -180,7 +181,8 @@ def read_steady(directory, progress: bool = False) -> SteadyTest:
         # kept in meta so nothing goes unnoticed; the CLI prints it
         meta = dict(meta, unlisted_files=unlisted)
     check_f_lim_meta(meta, runs[0].sample_rate, meta_path)
-    return SteadyTest(runs, meta).sorted()
+    # runs.csv's rows are the order the runs were recorded: kept on each run before the sort by speed
+    return SteadyTest([replace(r, recorded=i) for i, r in enumerate(runs)], meta).sorted()
 
 
 def read_sweep(path, sample_rate: float | None = None) -> Sweep:
@@ -226,7 +228,9 @@ def write_run(path, run: Run, fmt: str = "csv") -> Path:
 
 
 def write_steady(test: SteadyTest, directory, fmt: str = "csv") -> Path:
-    """Write a steady-state test: ``runs.csv``, ``meta.json`` and one ``fmt`` file per run. Returns the directory."""
+    """Write a steady-state test: ``runs.csv`` (its rows in the order the runs were recorded where that is known,
+    :attr:`Run.recorded`, else in the test's order), ``meta.json`` and one ``fmt`` file per run. Returns the
+    directory."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     rates = {r.sample_rate for r in test.runs}
@@ -249,10 +253,12 @@ def write_steady(test: SteadyTest, directory, fmt: str = "csv") -> Path:
         taken.add(name)
         names.append(name)
         write_run(directory / name, run, fmt)
+    # the rows in the order the runs were recorded where it is known (Run.recorded: read back so)
+    rows = sorted(zip(names, test.runs), key=lambda x: x[1].recorded if x[1].recorded >= 0 else len(names))
     with open(directory / RUNS_FILE, "w", newline="") as fh:
         writer = csv.writer(fh, lineterminator="\n")
         writer.writerow(["file", "speed_rpm"])
-        for name, run in zip(names, test.runs):
+        for name, run in rows:
             writer.writerow([name, repr(float(rad_s_to_rpm(run.speed)))])
     (directory / META_FILE).write_text(json_text(meta, indent=2) + os.linesep)
     return directory

@@ -113,3 +113,50 @@ def test_a_lines_hump_through_its_parents_resonance_is_no_step(tmp_path):
     subprocess.run([sys.executable, str(root / "benchmarks" / "newuser_generator_s51.py"), "W3", "nonlinear", str(out),
                     "--seed", "2"], check=True, capture_output=True)
     assert [(u.parameters["direction"], u.parameters["h"]) for u in _steps(api.diagnose(str(out)))] == []
+
+
+def _recorded_in_random_order(index: int, factor: float, k: int, seed: int = 1):
+    """(test, each run's place in the recording by name): family wheel ``index``'s runs recorded in a random speed
+    order (``Run.recorded``), its radial-force imbalance x ``factor`` from the ``k``-th recorded run on (k from 0)."""
+    wheel = dfm.wheels()[index]
+    noise = dfm.CONDITIONS[index][2]
+    a = family_test.steady_test(fw.steady(wheel, noise=noise, seed=seed))
+    lines = [replace(ln, C=ln.C * factor) if ln.direction == "radial_force" and ln.name == "imbalance" else ln
+             for ln in wheel.lines]
+    b = family_test.steady_test(fw.steady(fw.with_lines(wheel, lines), noise=noise, seed=seed))
+    order = np.random.default_rng(index).permutation(len(a.runs))     # order[j]: the j-th run recorded
+    position = np.argsort(order)                                      # each run's place in the recording
+    runs = [replace(rb if position[i] >= k else ra, recorded=int(position[i]))
+            for i, (ra, rb) in enumerate(zip(a.runs, b.runs))]
+    return SteadyTest(runs, {}), {r.name: r.recorded for r in runs}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("index", [0, 5])
+def test_a_change_in_time_is_read_in_the_order_the_runs_were_recorded(index, tmp_path):
+    """The session-55 new-user trials (their own generators: a 9.5 kg and a 3 kg wheel): the imbalance 1.5x (a
+    bearing line 2x) from the middle of the runs as recorded, the runs recorded in a random speed order and runs.csv
+    listing them so.  On ce37b70 the runs were read in speed order only: 'changed by x 0.667 between 4720 and 4880
+    rpm', the model's C a blend of the two levels, 68-250x the clean error.  Here family wheels written so
+    (:func:`rwadist.data.write_steady` writes runs.csv's rows in the recorded order, :func:`rwadist.data.read_steady`
+    keeps it on each run) and diagnosed from the folder: one line_step on h 1, read in the recorded order, x 1.5
+    within 2 %, between two runs recorded either side of the change; no class added, and no scatter of the line
+    described beside it."""
+    from rwadist.data import read_steady, write_steady
+
+    test, place = _recorded_in_random_order(index, 1.5, 12)
+    folder = write_steady(test, tmp_path / "shuffled")
+    rows = (folder / "runs.csv").read_text().splitlines()[1:]
+    back = read_steady(folder)
+    assert [r.name for r in sorted(back.runs, key=lambda r: r.recorded)] == [x.split(",")[0] for x in rows]
+    assert [r.recorded for r in sorted(back.runs, key=lambda r: r.recorded)] == list(range(len(rows)))
+    diag = api.diagnose(str(folder))
+    steps = [u.parameters for u in _steps(diag)]
+    assert [(p["direction"], round(p["h"], 3), p["order"]) for p in steps] == [("radial_force", 1.0, "recorded")], steps
+    assert steps[0]["amplitude_ratio"] == pytest.approx(1.5, rel=0.02)
+    # the runs read last before the change and first after it, in the recording (a run whose 1x is not read, the
+    # slowest, is not one of them)
+    before, after = (place[n] for n in steps[0]["step_between_runs"])
+    assert before < 12 <= after
+    assert [e.kind for e in diag.effects] == ["suspension_modes"]
+    assert not [u for u in diag.unexplained if u.signature == "partial_line" and u.parameters.get("h") == 1.0]

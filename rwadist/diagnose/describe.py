@@ -321,7 +321,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_fixed import fixed_lines_in_part
     from .describe_gain import as_recorded
     from .describe_hump import broadband_hump, humps_in_some_runs
-    from .describe_line_step import line_steps, without_steps
+    from .describe_line_step import line_steps, with_line_steps, without_steps
     from .describe_lines import speed_lines
     from .describe_mode_drift import drifting_modes, same_track
     from .describe_partial import partial_lines
@@ -393,7 +393,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     # modes (a support stiffer along one axis), a resonance of one channel (a sensor's, a fixture's along one axis),
     # one channel recorded later than the other (its lines' x/y phase off a quarter turn ∝ f)
     out += radial_pairs(ctx, as_recorded(searched.state), state, of_line)
-    out += line_steps(ctx, state, ratios, of_line, out)   # one line's level stepping between runs, the others not
+    # one line's level stepping between runs, the others not
+    out = with_line_steps(out, line_steps(ctx, state, ratios, of_line, out))
     # a model line that is two or more lines closer than the Welch segments resolve (the whole record reads it alone)
     out += blended_lines(ctx, state, of_line)
     # a gain common to the channels that changes with speed, on the recorded channels too; one of the line's frequency

@@ -170,6 +170,18 @@ def without_steps(r):
                                                                                 "w")})
 
 
+def _recorded_order(ctx, spin: np.ndarray) -> np.ndarray | None:
+    """(R,) the context's runs' positions in the order they were recorded (:attr:`rwadist.formats.records.Run.
+    recorded`), or None when any is unknown or that order is their speed order (``spin``, Hz)."""
+    test = getattr(ctx, "test", None)
+    if test is None:
+        return None
+    rec = np.array([getattr(test.runs[int(r)], "recorded", -1) for r in ctx.runs], dtype=float)
+    if rec.size < 2 or np.any(rec < 0) or np.all(np.diff(rec[np.argsort(np.abs(spin), kind="stable")]) > 0):
+        return None
+    return rec
+
+
 def line_steps(ctx, state, ratios: list, shares, described=()) -> list:
     """``line_property`` records (property ``line_step``) of the model's lines whose level steps between two runs
     (module docstring); ``ratios``: :func:`.describe_structure.line_ratios` of ``state``, read where each line is
@@ -184,11 +196,20 @@ def line_steps(ctx, state, ratios: list, shares, described=()) -> list:
     spin = ctx.omega[ctx.runs] / (2 * np.pi)
     rpm = np.abs(ctx.omega[ctx.runs]) * RAD_S_TO_RPM
     names = [ctx.sp.run_names[int(r)] if r < len(ctx.sp.run_names) else str(int(r)) for r in ctx.runs]
+    recorded = _recorded_order(ctx, spin)
     out = []
     for direction, h, y in series:
-        cp = two_levels(np.abs(spin), y)
+        cp, key = two_levels(np.abs(spin), y), np.abs(spin)
+        if recorded is not None:
+            # the runs as they were recorded, when that is not their speed order: a change in time between two runs
+            # is two flat levels there, and scatter in speed order (the session-55 trials' imbalance 1.5x from the
+            # 18th of 36 runs recorded in random speed order: read "x 0.667 between 4720 and 4880 rpm")
+            in_time = two_levels(recorded, y)
+            if in_time is not None and (cp is None or in_time["z"] > cp["z"]):
+                cp, key = in_time, recorded
         if cp is None:
             continue
+        timed = key is recorded
         below, above = cp["below"], cp["above"]
         steps = [(d, s) for d, x, v in series if (d, x) != (direction, h)
                  if (s := _step_across(v, below, above)) is not None]
@@ -196,9 +217,10 @@ def line_steps(ctx, state, ratios: list, shares, described=()) -> list:
         own = [s for d, s in steps if d == direction]       # a gain of the direction's channels steps them all
         if any(x and abs(float(np.median(x))) >= OTHERS_SHARE * abs(cp["step_dB"]) for x in (others, own)):
             continue
-        last, first = int(below[np.argmax(rpm[below])]), int(above[np.argmin(rpm[above])])
-        if _at_a_crossing(ctx, state, direction, h, last, first) or \
-                _on_a_track(described, direction, h * np.abs(spin[[last, first]]), spin[[last, first]]):
+        last, first = int(below[np.argmax(key[below])]), int(above[np.argmin(key[above])])
+        # a mode's crossing or a resonance's track puts a line on two levels in speed order, not in time
+        if not timed and (_at_a_crossing(ctx, state, direction, h, last, first) or
+                          _on_a_track(described, direction, h * np.abs(spin[[last, first]]), spin[[last, first]])):
             continue
         chans = tuple(c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels)
         used = np.concatenate([below, above])
@@ -208,17 +230,34 @@ def line_steps(ctx, state, ratios: list, shares, described=()) -> list:
                 if abs(h - 1.0) < 1e-3 and direction in ("radial_force", "radial_torque") else
                 "the line's source (a bearing re-lubricated or re-preloaded, a part shifted between those runs)")
         f = h * np.abs(spin[used])
+        order = "in the order they were recorded (runs.csv's rows)" if timed else "in speed order"
+        would = (f"a run at a speed recorded before {names[first]} repeated after it (a change in time holds at "
+                 "every speed)" if timed else
+                 f"the runs in the order they were recorded (a change in time between {names[last]} and "
+                 f"{names[first]}), and a run below {rpm[first]:.0f} rpm repeated at the end of the test")
         out.append(Unexplained(
             signature="line_property", channels=chans, speed_rpm=(float(rpm[used].min()), float(rpm[used].max())),
             f_Hz=(float(f.min()), float(f.max())), level_dB=float(cp["step_dB"]), share=share, n_runs=int(used.size),
             parameters={"property": "line_step", "direction": direction, "h": h, "step_dB": float(cp["step_dB"]),
                         "amplitude_ratio": float(factor), "stderr_z": float(cp["z"]),
+                        "order": "recorded" if timed else "speed",
                         "step_between_runs": [names[last], names[first]],
                         "step_between_rpm": [float(rpm[last]), float(rpm[first])],
                         "others_step_dB": float(np.median(others)) if others else None},
             causes=(f"{direction.replace('_', ' ')} h = {h:.4g} changed by x {factor:.3g} in amplitude between "
-                    f"{names[last]} ({rpm[last]:.0f} rpm) and {names[first]} ({rpm[first]:.0f} rpm), in speed order, "
+                    f"{names[last]} ({rpm[last]:.0f} rpm) and {names[first]} ({rpm[first]:.0f} rpm), {order}, "
                     f"the other lines on their course: {what}; the model's C is a compromise of the two",),
-            would_tell=(f"the runs in the order they were recorded (a change in time between {names[last]} and "
-                        f"{names[first]}), and a run below {rpm[first]:.0f} rpm repeated at the end of the test")))
+            would_tell=would))
     return out
+
+
+def with_line_steps(records: list, steps: list) -> list:
+    """``records`` and the ``steps`` (:func:`line_steps`), without a ``partial_line`` record of a line's strength
+    scattering from run to run where the line steps in the order the runs were recorded: that step, read in speed
+    order (one description: the session-55 trials' bearing line doubling from the 20th of 40 runs recorded in random
+    speed order was also described as 'its strength scattering 4.5 dB (rms) from run to run')."""
+    timed = {(u.parameters["direction"], round(u.parameters["h"], 4)) for u in steps
+             if u.parameters.get("order") == "recorded"}
+    return [u for u in records if not (u.signature == "partial_line" and "scatter_dB" in u.parameters and
+                                       (u.parameters.get("direction"), round(u.parameters.get("h", -1.0), 4)) in timed)
+            ] + list(steps)

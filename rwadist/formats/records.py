@@ -32,6 +32,9 @@ class Run:
     name : file name of the run in the interchange format.
     invalid : channels whose samples hold a stretch that is no measurement (a dropout found by
         :func:`rwadist.data_quality.screen`): their spectra are left out of this run (as for an absent channel).
+    recorded : the run's position in the order the runs were recorded (a steady test's ``runs.csv`` rows, read so
+        before the runs are sorted by speed); -1 when not known.  Read only to tell a change between runs in time
+        (:mod:`rwadist.diagnose.describe_line_step`).
     """
 
     speed: float
@@ -40,6 +43,7 @@ class Run:
     t0: float = 0.0
     name: str = ""
     invalid: frozenset = frozenset()
+    recorded: int = -1
 
     @property
     def n_samples(self) -> int:
