@@ -376,7 +376,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out = [u for u in broadband_hump(ctx, state, of_band) if not on_a_fixed_line(u, carriers, float(ctx.sp.df))]
     out += humps_in_some_runs(ctx, state, of_band_runs, out)
     # a moving resonance: read on steady lines resolved from their neighbours, described where its cells hold content
-    steady = [without_steps(structure.steady_lines(structure.resolved_lines(ctx, state, r), float(ctx.df)))
+    steady = [without_steps(ctx, structure.steady_lines(structure.resolved_lines(ctx, state, r), float(ctx.df)))
               for r in ratios]
     # the model's own mode moving over the runs first: a resonance lifting lines fits only its rise
     drifting = [u for u in drifting_modes(ctx, state, steady, of_track) if holds_content(u, res)]
