@@ -159,7 +159,9 @@ def polarity_lines(rec: dict) -> list:
                 "no imbalance turns against its rotor in both",
                 "every run's speed was multiplied by -1 before the fit (the wheel spins about -z of the load cell's "
                 "frame); check the speed column's sign (a tachometer gives an unsigned speed) and the wheel's and the "
-                "cell's z axes, and give the speed signed in the cell's frame"]
+                "cell's z axes, and give the speed signed in the cell's frame; or the x and y channels exchanged in "
+                "both radial pairs (Fx with Fy and Tx with Ty: two cables, or the channel map's x and y swapped), "
+                "which reads every rotating line the other way round as well"]
     x, y = rec["channels"]
     d, o = rec["direction"].replace("_", " "), rec["other_direction"].replace("_", " ")
     return [f"{x}/{y} wired with the wrong polarity (one of them): the {d}'s 1x line (the imbalance, fixed to the "
@@ -171,5 +173,6 @@ def polarity_lines(rec: dict) -> list:
             "every line of the pair, no imbalance does",
             f"{y} was multiplied by -1 in every run before the fit (the data cannot tell {x} from {y}: flipping {x} "
             "instead turns the pair by 180 degrees, which changes no PSD or sense, only the sign of a fitted "
-            f"load-cell offset's lateral coupling); check the {x}/{y} wiring and the load cell's calibration matrix, "
-            "fix the sign and re-run"]
+            f"load-cell offset's lateral coupling, nor from {x} and {y} exchanged, which turns it by 90 degrees); "
+            f"check the {x}/{y} wiring (a sign, or the two cables swapped) and the load cell's calibration matrix, "
+            "fix it and re-run"]

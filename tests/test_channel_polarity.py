@@ -159,3 +159,24 @@ def test_diagnose_of_a_speed_column_of_the_wrong_sign(index, seed):
     recs = [r for r in d.data_quality if r.get("type") == "reversed_spin"]
     assert len(recs) == 1 and d.model.provenance["data_quality"] == recs
     assert "multiplied by -1" in d.speed["method"]
+
+
+@pytest.mark.parametrize("index, seed, pairs, kind", [(1, 12, (("Fx", "Fy"), ("Tx", "Ty")), "reversed_spin"),
+                                                      (4, 13, (("Fx", "Fy"),), "reversed_polarity")])
+def test_exchanged_x_and_y_channels_are_named_beside_the_sign(index, seed, pairs, kind):
+    """x and y exchanged (Fx + iFy of a co-rotating A·e^{iΩt} becomes Fy + iFx = i·conj(A)·e^{−iΩt}, counter-rotating):
+    both radial pairs exchanged read as the speed column's sign reversed, one pair as that pair's polarity; the
+    console's lines say the exchange could be it (the session-55 trial's swapped cable pair was sent to the speed
+    column's sign and the z axes only).  The test returned is the generated one with every run's speed negated
+    (both pairs) or its y channel negated (one pair), as for a sign error: no PSD or sense tells them apart."""
+    from rwadist import channel_polarity as cp
+
+    wheel = fw.family()[index]
+    true = _test(wheel, seed)
+    swap = {a: b for x, y in pairs for a, b in ((x, y), (y, x))}
+    runs = [Run(speed=r.speed, sample_rate=r.sample_rate, name=r.name,
+                signals={swap.get(c, c): v for c, v in r.signals.items()}) for r in true.runs]
+    rec = cp.check_record(SteadyTest(runs, {}))
+    assert rec is not None and rec["type"] == kind
+    text = " ".join(cp.polarity_lines(rec))
+    assert ("x and y channels exchanged" in text) if kind == "reversed_spin" else ("two cables swapped" in text)
