@@ -165,6 +165,11 @@ def same_stand(a: tuple | None, b: tuple | None) -> bool:
     return bool(abs(a[0] / b[0] - 1.0) <= SAME_STAND)
 
 
+def _four(start) -> tuple:
+    """A stand's start as (f_r Hz, ζ, peak gain, gain above): a three-value start returns to 1 far above."""
+    return tuple(start) + (() if len(start) == 4 else (1.0,))
+
+
 def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, starts: list | None = None,
                               near: dict | None = None, near_stand: tuple | None = None, joints: dict | None = None,
                               further_starts=None, **kwargs):
@@ -209,7 +214,10 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
     plain = fit_extended(test, fit, **kwargs, **near_beside(None))
     if not starts:
         return plain
-    full = [tuple(s) + (() if len(s) == 4 else (1.0,)) for s in starts]
+    def confirmed_from(starts_):
+        return [j for j in (_joint_once(joints, test, fit, _four(s), {**kwargs, **near_beside(_four(s))})
+                            for s in starts_) if stand_confirmed(j, plain)]
+
     # of the joint fits whose stand is confirmed, the least cost (as a structure mode's: those confirmed, then the
     # best): a start whose fit runs off to no fixture resonance (ζ at its 0.3 bound, a broad tilt of the line gains)
     # can cost less than the stand another start found, and must not hide it.  Family wheel 2's fixture pair (seed
@@ -217,13 +225,10 @@ def fit_extended_beside_stand(test, fit, stand_start: tuple | None = None, start
     # 10.06, below the 70.07 Hz ζ 0.042 gain 4.05 of the first (10.45), and no stand was kept; which of the two that
     # start reaches turns on the smallest change of the rows (the 300-rpm radial imbalance row scaled by 0.9-1.1:
     # 70.1 Hz at 0.9, 0.95, 1.05, 1.1; 83-87 Hz, ζ 0.3 at 0.8, 1.0, 1.25)
-    fitted = [_joint_once(joints, test, fit, s, {**kwargs, **near_beside(s)}) for s in full]
-    confirmed = [j for j in fitted if stand_confirmed(j, plain)]
+    confirmed = confirmed_from(starts)
     if not confirmed and further_starts is not None:
         # the lines lift at another frequency too: a second fixture, beside which the modes may be located first
-        more = [tuple(s) + (() if len(s) == 4 else (1.0,)) for s in further_starts()]
-        confirmed = [j for j in (_joint_once(joints, test, fit, s, {**kwargs, **near_beside(s)}) for s in more)
-                     if stand_confirmed(j, plain)]
+        confirmed = confirmed_from(further_starts())
     if not confirmed:
         return plain
     joint = min(confirmed, key=joint_cost)
@@ -486,8 +491,7 @@ def fit_extended_beside_structure_mode(test, fit, plain, start: tuple | None = N
     fits = []
     for d, s in tries:
         try:
-            fits.append(_joint_from(test, fit, tuple(s) + (() if len(s) == 4 else (1.0,)),
-                                    {**kwargs, "stand_direction": d}))
+            fits.append(_joint_from(test, fit, _four(s), {**kwargs, "stand_direction": d}))
         except ValueError:
             continue
     fits = [j for j in fits if structure_confirmed(j, plain)]

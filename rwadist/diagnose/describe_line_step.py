@@ -181,7 +181,7 @@ def _recorded_order(ctx, spin: np.ndarray) -> np.ndarray | None:
     test = getattr(ctx, "test", None)
     if test is None:
         return None
-    rec = np.array([getattr(test.runs[int(r)], "recorded", -1) for r in ctx.runs], dtype=float)
+    rec = np.array([test.runs[int(r)].recorded for r in ctx.runs], dtype=float)
     if rec.size < 2 or np.any(rec < 0) or np.all(np.diff(rec[np.argsort(np.abs(spin), kind="stable")]) > 0):
         return None
     return rec
