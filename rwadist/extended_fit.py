@@ -66,8 +66,8 @@ from .extended_fit_power import (
     LinePower,
     fitted_senses,
     forcing_lines,
+    phase_splits,
     rows_of_lines,
-    split_from_phase,
 )
 from .geometry import remove_lever_arm
 from .line_senses import ONE_SENSE, ONE_SENSE_RUNS, _line_senses_once, line_senses, one_sense_rows  # noqa: F401
@@ -544,7 +544,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     params, fitted_lines = unpack(res.x)
     sums = power_sum_stderr(solution, {(x.direction, float(x.h)): tuple(line_of[j])
                                        for j, x in enumerate(meas.lines) if x.direction in RADIAL})
-    params, fitted_lines, split_se = split_from_phase(params, meas.lines, fitted_lines, line_of, sums, senses_xy)
+    params, fitted_lines, split_se = phase_splits(params, meas.lines, fitted_lines, line_of, sums, senses_xy, problem.power, notes)
     n_x = res.x.size - (len(joint.NAMES) if joint is not None else 0)
     notes += [off_law_note(meas.lines[j], res.x[n_x + i - len(off_law)], rel_se[n_x + i - len(off_law)])
               for i, j in enumerate(off_law)]

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import asdict, replace
 
 import numpy as np
 
@@ -64,11 +64,9 @@ class LinePower:
         self.masks = [self.sub == i for i in range(len(_SUB_MODES))]
         self.cell = self.row * self.n_lines + self.line
 
-    def log_residuals(self, vals: dict, log_C: np.ndarray, log_data: np.ndarray, derivatives: bool = True):
-        """(r, d_mode, d_C) at parameters ``vals`` (:class:`~rwadist.extended.ExtendedParams` fields) and line
-        coefficients exp(``log_C``): r = log_data − ½ ln(model power) (n_rows,); d_mode[mode] = (∂r/∂ln k,
-        ∂r/∂ln c) of each subsystem (n_rows,) each; d_C = ∂r/∂ln C (n_rows, n_lines).  ``derivatives`` False: (r,
-        None, None), r the same numbers (a damping's profile evaluates the residuals alone, ~25 points a mode)."""
+    def _gains(self, vals: dict, derivatives: bool = True) -> tuple:
+        """(|T|², ∂ ln|T|²/∂ ln k, ∂ ln|T|²/∂ ln c) of every term (n_terms,) at parameters ``vals``: the derivatives zero
+        when ``derivatives`` is False."""
         t2 = np.ones(self.nu.size)
         dlk = np.zeros(self.nu.size)
         dlc = np.zeros(self.nu.size)
@@ -87,6 +85,19 @@ class LinePower:
             if derivatives:
                 dlk[m] = 2.0 * k * (k / num - re / den)        # ∂ ln|T|² / ∂ ln k
                 dlc[m] = 2.0 * cnu2 * (1.0 / num - 1.0 / den)  # ∂ ln|T|² / ∂ ln c
+        return t2, dlk, dlc
+
+    def line_powers(self, vals: dict) -> np.ndarray:
+        """(n_lines,) each forcing line's response power per unit C², summed over its rows (Σ |T|²·Ω⁴ and the channels
+        it reaches) at parameters ``vals``."""
+        return np.bincount(self.line, self._gains(vals, False)[0] * self.scale, minlength=self.n_lines)
+
+    def log_residuals(self, vals: dict, log_C: np.ndarray, log_data: np.ndarray, derivatives: bool = True):
+        """(r, d_mode, d_C) at parameters ``vals`` (:class:`~rwadist.extended.ExtendedParams` fields) and line
+        coefficients exp(``log_C``): r = log_data − ½ ln(model power) (n_rows,); d_mode[mode] = (∂r/∂ln k,
+        ∂r/∂ln c) of each subsystem (n_rows,) each; d_C = ∂r/∂ln C (n_rows, n_lines).  ``derivatives`` False: (r,
+        None, None), r the same numbers (a damping's profile evaluates the residuals alone, ~25 points a mode)."""
+        t2, dlk, dlc = self._gains(vals, derivatives)
         p_term = t2 * np.exp(2.0 * log_C[self.line]) * self.scale
         p_row = np.bincount(self.row, p_term, minlength=self.n_rows)
         live = p_row > 1e-300
@@ -173,6 +184,71 @@ def split_from_phase(params, meas_lines: list, fitted_lines: list, line_of: dict
         out[k_ct] = replace(out[k_ct], C=math.sqrt((1.0 - co) * total))
         stderr |= {f"C[{ln.direction},{ln.h:g},{ln.sense}]": float(sums[key][0]) for ln in (out[k_co], out[k_ct])}
     return replace(params, **imbalances(out)), out, stderr
+
+
+#: a radial line's fitted counter-rotating part is contradicted by its x/y phase when the response share the fit
+#: gives it exceeds the measured share by this factor and by :data:`SENSE_MARGIN` of the line's power
+SENSE_FACTOR = 3.0
+SENSE_MARGIN = 0.01
+
+
+def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict, powers: np.ndarray,
+                    senses_xy: dict) -> tuple:
+    """(params, lines, keys): ``fitted_lines`` (and the imbalances of ``params``) with the co- and counter-rotating
+    parts of each radial line whose fitted split its x/y phase contradicts shared as the phase measures them, and the
+    (direction, h) of those lines.
+
+    The x/y phase measures the response's counter-rotating share directly (``senses_xy``' co_fraction,
+    :func:`rwadist.line_senses.line_senses`, summed over the runs).  The parts fitted to the line power predict it:
+    q = C_counter²·P_counter / (C_co²·P_co + C_counter²·P_counter), with P a part's response power per unit C²
+    (``powers``: :meth:`LinePower.line_powers` at the fitted modes).  Where q exceeds the measured share m by
+    :data:`SENSE_FACTOR` and :data:`SENSE_MARGIN`, the data hold no such counter-rotating response, and the split is
+    model error absorbed (a fast sweep's top torque line crossing the forward whirl within one slice: a peak smeared
+    in the slice, fitted as a counter part of 24-38 % of C that the x/y phase put at 0.1 % of the line's power, in 5 of
+    12 sweeps of three wheels).  There C_counter² = m·P/P_counter, C_co² = (1 − m)·P/P_co: the response's summed power P
+    kept, its share as measured; m = 0 when the response turns with the spin in every run (``senses_xy``' every_run
+    "co"): a share that small is the noise's, and, divided by a backward whirl's far smaller gain, would still make a
+    counter part of 13 % of C (a family wheel's co line crossing the forward whirl in a 40 s run-up)."""
+    out, changed = list(fitted_lines), []
+    for j, x in enumerate(meas_lines):
+        key = (x.direction, float(x.h))
+        if x.direction not in RADIAL or key not in senses_xy:
+            continue
+        k_co, k_ct = line_of[j]
+        p_co, p_ct = out[k_co].C ** 2 * powers[k_co], out[k_ct].C ** 2 * powers[k_ct]
+        total = p_co + p_ct
+        if not total > 0.0 or powers[k_co] <= 0.0 or powers[k_ct] <= 0.0:
+            continue
+        m = 1.0 - min(max(float(senses_xy[key][1]), 0.0), 1.0)
+        if p_ct / total <= SENSE_FACTOR * m + SENSE_MARGIN:
+            continue
+        if senses_xy[key][2] == "co":
+            m = 0.0     # the response turns with the spin in every run: what turns against it is the noise's
+        out[k_co] = replace(out[k_co], C=math.sqrt((1.0 - m) * total / powers[k_co]))
+        out[k_ct] = replace(out[k_ct], C=math.sqrt(m * total / powers[k_ct]))
+        changed.append(key)
+    return replace(params, **imbalances(out)), out, changed
+
+
+def resplit_note(direction: str, h: float, co_fraction: float) -> str:
+    """The model file's note on a radial line whose fitted co/counter split its x/y phase contradicted
+    (:func:`split_to_senses`)."""
+    return (f"{direction} h={h:.4g}: the co/counter split fitted to the line power put a counter-rotating response "
+            f"in the data that the x/y phase does not show ({100 * (1 - co_fraction):.2g} % of the line's power "
+            "turns against the spin): the split is the phase's, the line's power kept (a misfit near a whirl mode, "
+            "e.g. a line crossing it within one slice of a fast sweep, is not taken for a counter-rotating load)")
+
+
+def phase_splits(params, meas_lines: list, fitted_lines: list, line_of: dict, sums: dict, senses_xy: dict,
+                 power: "LinePower", notes: list) -> tuple:
+    """(params, lines, standard errors) of :func:`split_from_phase` then :func:`split_to_senses` (the forcing lines'
+    response powers per unit C² from ``power`` at the fitted modes); a note of each line split again appended to
+    ``notes``."""
+    params, lines, stderr = split_from_phase(params, meas_lines, fitted_lines, line_of, sums, senses_xy)
+    powers = power.line_powers(asdict(params))
+    params, lines, resplit = split_to_senses(params, meas_lines, lines, line_of, powers, senses_xy)
+    notes += [resplit_note(d, h, senses_xy[(d, h)][1]) for d, h in resplit]
+    return params, lines, stderr
 
 
 def fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple[dict, list]:
