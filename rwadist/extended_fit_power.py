@@ -187,9 +187,10 @@ def split_from_phase(params, meas_lines: list, fitted_lines: list, line_of: dict
 
 
 #: a radial line's fitted counter-rotating part is contradicted by its x/y phase when the response share the fit
-#: gives it exceeds the measured share by this factor and by :data:`SENSE_MARGIN` of the line's power
-SENSE_FACTOR = 3.0
-SENSE_MARGIN = 0.01
+#: gives it exceeds this many times the measured share (which holds the noise's: an upper bound) ...
+SENSE_FACTOR = 2.0
+#: ... on a line whose response turns with the spin in every run, all but this share of its power at most
+PURE_CO = 0.01
 
 
 def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict, powers: np.ndarray,
@@ -201,14 +202,17 @@ def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict,
     The x/y phase measures the response's counter-rotating share directly (``senses_xy``' co_fraction,
     :func:`rwadist.line_senses.line_senses`, summed over the runs).  The parts fitted to the line power predict it:
     q = C_counter²·P_counter / (C_co²·P_co + C_counter²·P_counter), with P a part's response power per unit C²
-    (``powers``: :meth:`LinePower.line_powers` at the fitted modes).  Where q exceeds the measured share m by
-    :data:`SENSE_FACTOR` and :data:`SENSE_MARGIN`, the data hold no such counter-rotating response, and the split is
+    (``powers``: :meth:`LinePower.line_powers` at the fitted modes).  Where the response turns with the spin in every
+    run (``senses_xy``' every_run "co") and all but m <= :data:`PURE_CO` of its power, and q exceeds
+    :data:`SENSE_FACTOR` times m, the data hold no such counter-rotating response, and the split is
     model error absorbed (a fast sweep's top torque line crossing the forward whirl within one slice: a peak smeared
     in the slice, fitted as a counter part of 24-38 % of C that the x/y phase put at 0.1 % of the line's power, in 5 of
-    12 sweeps of three wheels).  There C_counter² = m·P/P_counter, C_co² = (1 − m)·P/P_co: the response's summed power P
-    kept, its share as measured; m = 0 when the response turns with the spin in every run (``senses_xy``' every_run
-    "co"): a share that small is the noise's, and, divided by a backward whirl's far smaller gain, would still make a
-    counter part of 13 % of C (a family wheel's co line crossing the forward whirl in a 40 s run-up)."""
+    12 sweeps of three wheels; another's 0.36 % against the phase's 0.089 %).  There the line is co-rotating alone, its response's summed power P kept
+    (C_co² = P/P_co): a share m that small is the noise's, and, divided by a backward whirl's far smaller gain, would
+    still make a counter part of 13 % of C (a family wheel's co line crossing the forward whirl in a 40 s run-up).
+    Not on a line that turns both ways: there the measured share is weighted by what lifts the runs (a fixture
+    resonance, divided out of the fitted rows), and a line of 20 % counter-rotating load, its phase's share 0.078 and
+    the fit's 0.245, lost family wheel 6's fixture at 1.25x its rocking mode."""
     out, changed = list(fitted_lines), []
     for j, x in enumerate(meas_lines):
         key = (x.direction, float(x.h))
@@ -220,10 +224,9 @@ def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict,
         if not total > 0.0 or powers[k_co] <= 0.0 or powers[k_ct] <= 0.0:
             continue
         m = 1.0 - min(max(float(senses_xy[key][1]), 0.0), 1.0)
-        if p_ct / total <= SENSE_FACTOR * m + SENSE_MARGIN:
+        if senses_xy[key][2] != "co" or m > PURE_CO or p_ct / total <= SENSE_FACTOR * m:
             continue
-        if senses_xy[key][2] == "co":
-            m = 0.0     # the response turns with the spin in every run: what turns against it is the noise's
+        m = 0.0     # the response turns with the spin in every run, all but m of it: what turns against it is noise
         out[k_co] = replace(out[k_co], C=math.sqrt((1.0 - m) * total / powers[k_co]))
         out[k_ct] = replace(out[k_ct], C=math.sqrt(m * total / powers[k_ct]))
         changed.append(key)
