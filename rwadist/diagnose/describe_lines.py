@@ -21,6 +21,14 @@ RIDGE_RUNS = 5
 MODEL_LINE_BINS = 3.0
 #: Step of the h grid, Welch bins at the top speed.
 H_STEP_BINS = 0.25
+#: A ridge's ratio refined on the residual's peaks and the records (:func:`rwadist.diagnose.measure.refine_h`,
+#: :func:`_record_h`) puts the line in the band in at least this share of the runs where the ridge was lit, or the
+#: ridge holds no line: a sweep's slices read on a floor rising at low frequency (1/f noise on Tz alone) lit h 0.1 at
+#: the band's lower edge at the top speeds, refined to h 0.062 (7.6-8.2 Hz, under the band's 13.7 Hz), and a line no
+#: data hold was described (session 56's sweep trial, three of twelve sweeps; another lit h 0.122, refined to 0.0997:
+#: 7.0-8.3 Hz, under the band's 9.8 Hz).  Not "the refined ratio near the grid's": a Welch bin spans a wide range of h
+#: at the low speeds, and a true line at h 0.37 lit h 0.31-0.43 in every run
+IN_BAND_SHARE = 0.5
 #: False-alarm probability of a lit bin.
 LIT_FALSE_ALARM = 1e-3
 #: A ridge is described when the data stand over the model by this much (dB, the median over its lit cells' bands):
@@ -185,7 +193,10 @@ def speed_lines(ctx, state, shares, bearings=(), others=(), left_out=()) -> list
         near_model = np.any(np.abs(h_grid[:, None] - model_h[None, :]) <= MODEL_LINE_BINS * dh / H_STEP_BINS,
                             axis=1) if model_h.size else np.zeros(h_grid.size, bool)
         cand = (frac >= RIDGE_FRACTION) & ~near_model
+        # a ridge's peak inside the grid (np.roll wraps the grid's ends onto each other): at its lowest h the lit
+        # fraction of a floor rising below the band's edge peaks too (:data:`IN_BAND_SHARE`'s sweeps)
         peaks = np.flatnonzero(cand & (frac >= np.roll(frac, 1)) & (frac >= np.roll(frac, -1)))
+        peaks = peaks[(peaks > 0) & (peaks < h_grid.size - 1)]
         taken: list[float] = []
         for i in peaks[np.argsort(-frac[peaks])]:
             if any(abs(h_grid[i] - t) <= 4 * dh for t in taken):
@@ -194,6 +205,8 @@ def speed_lines(ctx, state, shares, bearings=(), others=(), left_out=()) -> list
             h = refine_h(ctx, state, chans, runs, float(h_grid[i]))
             lit_runs = runs[hit[i] & inb[i]]
             h = _record_h(ctx, chans, lit_runs, h)
+            if not np.mean(h * ctx.omega[lit_runs] / (2 * np.pi) >= ctx.k_lo * ctx.df) >= IN_BAND_SHARE:
+                continue                    # refined under the band in most runs it was lit in: no line there
             # on a sweep's slices one line lights ridges across its smear (the speed moves 4 % over a 60-s run-up's
             # slice: family wheel 7's h 6.848 was described as 6.826 and 6.868, and 6.728 and 6.918): one line
             if any(u.parameters["direction"] == d and u.h is not None and abs(u.h - h) <= max(4 * dh, smear * h)
