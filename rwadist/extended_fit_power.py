@@ -186,6 +186,8 @@ def split_from_phase(params, meas_lines: list, fitted_lines: list, line_of: dict
     return replace(params, **imbalances(out)), out, stderr
 
 
+#: a radial line's part under this share of the line's load power is dropped (:func:`fitted_senses`)
+KEPT_PART = 0.01
 #: a radial line's fitted counter-rotating part is contradicted by its x/y phase when the response share the fit
 #: gives it exceeds this many times the measured share (which holds the noise's: an upper bound) ...
 SENSE_FACTOR = 2.0
@@ -226,6 +228,8 @@ def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict,
         m = 1.0 - min(max(float(senses_xy[key][1]), 0.0), 1.0)
         if senses_xy[key][2] != "co" or m > PURE_CO or p_ct / total <= SENSE_FACTOR * m:
             continue
+        if out[k_ct].C ** 2 < KEPT_PART * (out[k_co].C ** 2 + out[k_ct].C ** 2):
+            continue    # a counter part the model does not keep (:func:`fitted_senses`): nothing to correct
         m = 0.0     # the response turns with the spin in every run, all but m of it: what turns against it is noise
         out[k_co] = replace(out[k_co], C=math.sqrt((1.0 - m) * total / powers[k_co]))
         out[k_ct] = replace(out[k_ct], C=math.sqrt(m * total / powers[k_ct]))
@@ -267,5 +271,5 @@ def fitted_senses(meas_lines: list, fitted_lines: list, line_of: dict) -> tuple[
         fr = p_co / (p_co + p_ct)
         sense = "co" if fr >= 0.99 else ("counter" if fr <= 0.01 else "co+counter")
         senses[(x.direction, float(x.h))] = (sense, float(fr))
-        kept_lines += [ln for ln, pw in zip(parts, (p_co, p_ct)) if pw >= 0.01 * (p_co + p_ct) or ln.imbalance]
+        kept_lines += [ln for ln, pw in zip(parts, (p_co, p_ct)) if pw >= KEPT_PART * (p_co + p_ct) or ln.imbalance]
     return senses, kept_lines
