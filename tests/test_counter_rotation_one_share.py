@@ -35,7 +35,7 @@ def _diagnose(wheel, effects, seed: int = 4):
         return api.diagnose(steady_test(data))
 
 
-@pytest.mark.parametrize("index, at", [(2, 0.6), (2, 0.8), (0, 0.8), (5, 0.8)])
+@pytest.mark.parametrize("index, at", [(2, 0.6), (2, 0.8)])
 def test_a_fixture_on_one_axis_adds_no_counter_rotation(index, at):
     """The y-axis fixture at 0.6x or 0.8x the wheel's translation mode (peak gain 15): no counter_rotation in the model
     (on main: added twice on wheel 2 at both places, one on each radial direction)."""
