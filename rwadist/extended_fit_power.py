@@ -197,9 +197,8 @@ PURE_CO = 0.01
 
 def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict, powers: np.ndarray,
                     senses_xy: dict) -> tuple:
-    """(params, lines, keys): ``fitted_lines`` (and the imbalances of ``params``) with the co- and counter-rotating
-    parts of each radial line whose fitted split its x/y phase contradicts shared as the phase measures them, and the
-    (direction, h) of those lines.
+    """(params, lines, keys): ``fitted_lines`` (and the imbalances of ``params``) with each radial line whose fitted
+    counter-rotating part its x/y phase contradicts made co-rotating alone, and the (direction, h) of those lines.
 
     The x/y phase measures the response's counter-rotating share directly (``senses_xy``' co_fraction,
     :func:`rwadist.line_senses.line_senses`, summed over the runs).  The parts fitted to the line power predict it:
@@ -223,16 +222,16 @@ def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict,
         k_co, k_ct = line_of[j]
         p_co, p_ct = out[k_co].C ** 2 * powers[k_co], out[k_ct].C ** 2 * powers[k_ct]
         total = p_co + p_ct
-        if not total > 0.0 or powers[k_co] <= 0.0 or powers[k_ct] <= 0.0:
+        if not total > 0.0 or powers[k_co] <= 0.0:
             continue
         m = 1.0 - min(max(float(senses_xy[key][1]), 0.0), 1.0)
         if senses_xy[key][2] != "co" or m > PURE_CO or p_ct / total <= SENSE_FACTOR * m:
             continue
         if out[k_ct].C ** 2 < KEPT_PART * (out[k_co].C ** 2 + out[k_ct].C ** 2):
             continue    # a counter part the model does not keep (:func:`fitted_senses`): nothing to correct
-        m = 0.0     # the response turns with the spin in every run, all but m of it: what turns against it is noise
-        out[k_co] = replace(out[k_co], C=math.sqrt((1.0 - m) * total / powers[k_co]))
-        out[k_ct] = replace(out[k_ct], C=math.sqrt(m * total / powers[k_ct]))
+        # the response turns with the spin in every run, all but m of it: what turns against it is noise
+        out[k_co] = replace(out[k_co], C=math.sqrt(total / powers[k_co]))
+        out[k_ct] = replace(out[k_ct], C=0.0)
         changed.append(key)
     return replace(params, **imbalances(out)), out, changed
 
