@@ -473,6 +473,7 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
         mass, radius or height out of range, or one of mass and radius without the other.
     """
     from .extended_fit import to_model
+    from .stand_axes import axis_stand, fit_beside
     from .stand_resonance import fit_extended_beside_stand
 
     check_flags(progress=progress)
@@ -481,9 +482,13 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     if empirical is None:
         empirical = fit(test)
     # a fixture resonance lifting every channel is fitted with the wheel's modes, never into them (a mode the data do
-    # not tell apart from it is declared by the joint fit's standard errors)
-    efit = fit_extended_beside_stand(test, empirical, mass=mass, radius=radius, height=height, start=start,
-                                     progress=progress)
+    # not tell apart from it is declared by the joint fit's standard errors); one that lifts one channel of each radial
+    # pair is measured on their x/y ratios and divided out of its channels (rwadist.stand_axes)
+    options = dict(mass=mass, radius=radius, height=height, start=start, progress=progress)
+    axis = axis_stand(empirical)
+    efit = None if axis is None else fit_beside(test, empirical, axis, **options)
+    if efit is None:
+        efit = fit_extended_beside_stand(test, empirical, **options)
     model = to_model(efit, empirical)
     refuse_non_finite_model(model, "fit")
     model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))

@@ -157,6 +157,7 @@ class ExtendedFit:
     zeta_bounds: dict = field(default_factory=dict)
     zeta_interval: dict = field(default_factory=dict)
     more_stands: tuple = ()         # further fixture resonances divided out of every line, held (``more_stands``)
+    stand_on: tuple | None = None   # the channels ``stand`` acts on when not every one (``stand_on``)
     line_noise: np.ndarray = field(default_factory=lambda: np.empty(0))     # per row of line_residuals, σ_noise
     line_h: np.ndarray = field(default_factory=lambda: np.empty(0))         # per row of line_residuals, its line's h
 
@@ -311,12 +312,16 @@ def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=Non
     return scans
 
 
-def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: list, stand_direction: str | None = None):
+def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: list, stand_direction: str | None = None,
+                    stand_on: tuple | None = None, fit_stand: bool = False):
     """(test, empirical fit, measured lines, x/y senses) the extended fit works on: the lever-arm torque ``height`` × F
     removed from the test and its fit (:func:`rwadist.geometry.remove_lever_arm`); every line the data show, with
     every measurement (the empirical fit without modal exclusion: with it, lines that are amplified or attenuated at
     most speeds are dropped; close lines measured together on the records); the fixture resonances ``stands`` divided
-    out of their amplitudes (the first only out of the lines of ``stand_direction`` when given)."""
+    out of their amplitudes (the first only out of the lines of ``stand_direction``, or of the measurements on the
+    channels ``stand_on``, when given: held, not with ``fit_stand``, ValueError)."""
+    if stand_on is not None and fit_stand:
+        raise ValueError("a stand on some channels is held (measured on the x/y ratios, rwadist.stand_axes), not fitted")
     if height:
         sp0 = fit.spectra
         test = remove_lever_arm(test, height)
@@ -324,12 +329,15 @@ def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: 
         fit = fit_empirical(spectra, fit.fit_settings)
     meas = _unsmeared_once(test, with_close_lines(test, fit.without_mode_exclusion),
                            len(fit.without_mode_exclusion.lines))
-    senses_xy = _line_senses_once(test, meas)
+    senses_xy = _line_senses_once(test, meas, None if stand_on is None else (tuple(stands[0]), tuple(stand_on)))
     if stands:
         def fixture_gain(x):
             f = x.h * np.abs(x.speed) / (2 * np.pi)
             acting = [s for i, s in enumerate(stands) if i > 0 or stand_direction in (None, x.direction)]
-            return np.prod([np.abs(resonance(f, *s)) for s in acting], axis=0) if acting else np.ones_like(f)
+            gains = [np.abs(resonance(f, *s)) for s in acting]
+            if stand_on is not None and acting and acting[0] is stands[0]:
+                gains[0] = np.where(np.isin(x.channel, stand_on), gains[0], 1.0)
+            return np.prod(gains, axis=0) if acting else np.ones_like(f)
 
         meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / fixture_gain(x)) for x in meas.lines])
     return test, fit, meas, senses_xy
@@ -476,49 +484,48 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                  height: float = 0.0, start: ext.ExtendedParams | None = None, zeta0: float = 0.02,
                  progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
                  more_stands: tuple = (), near: dict | None = None, fit_stand: bool = False,
-                 declare: bool = True, stand_direction: str | None = None, fit_more_stands: bool = False) -> ExtendedFit:
+                 declare: bool = True, stand_direction: str | None = None, fit_more_stands: bool = False,
+                 stand_on: tuple | None = None) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
-    mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None:
-    the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr and I_zz/I_rr, so the fit is
-    then per unit mass and per unit transverse inertia (M = 1 kg, I_rr = 1 kg·m², I_zz = the fitted
-    ratio; stated in the notes) and I_zz/I_rr is fitted from the two whirls.  height (m): z of the
-    rotor centre above the point the torques are measured about (the interface), as in
-    :class:`rwadist.extended.ExtendedParams`; the lever-arm torque height × F is removed from the
-    data before the fit and put back in the model.  start: parameters for modes the data do not
-    constrain (default: modes at 3x the top line frequency, ζ = zeta0).  tolerance: relative
-    frequency error the data must exclude for a mode to count as found (:func:`scan_mode`).
+    mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None: the interface
+    loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr and I_zz/I_rr, so the fit is then per unit mass and per unit
+    transverse inertia (M = 1 kg, I_rr = 1 kg·m², I_zz = the fitted ratio; stated in the notes) and I_zz/I_rr is fitted
+    from the two whirls.  height (m): z of the rotor centre above the point the torques are measured about (the
+    interface), as in :class:`rwadist.extended.ExtendedParams`; the lever-arm torque height × F is removed from the data
+    before the fit and put back in the model.  start: parameters for modes the data do not constrain (default: modes at
+    3x the top line frequency, ζ = zeta0).  tolerance: relative frequency error the data must exclude for a mode to
+    count as found (:func:`scan_mode`).
     stand: (f_r Hz, ζ, peak gain[, gain above]) of a fixture resonance acting on every channel (``rwadist diagnose``'s
-    ``fixed_resonance`` of role test_stand; :func:`rwadist.resonance.resonance`), or None: every measured line
-    amplitude is divided by its |H| before the modes are located and fitted, so that the fixture's amplification is
-    not taken for the wheel's.  more_stands: further fixture resonances (each (f_r Hz, ζ, peak gain[, gain above]), on
-    every channel) divided out the same way and held (``ExtendedFit.more_stands``).  near: mode -> ``near_hz``/
-    ``near_a`` of :func:`rwadist.mode_scan.scan_mode` (where an earlier fit of the same wheel located it), or None.
-    fit_stand: the modes are located with ``stand`` divided out, and its parameters (f_r, ζ, the numerator's damping
-    and the gain above, :class:`rwadist.resonance.FittedResonance`) are fitted in the modes' least squares, from it:
-    the modes' standard errors are those with the stand free (what the stand could take of their lines is counted).
-    declare: False keeps every located mode in the least squares, however loose (the joint fit's passes, whose next
-    scans start from the stand it fits: a mode dropped there leaves its lines to the stand alone).
-    stand_direction: ``stand`` is a mode of the wheel's structure on that load direction only (``rwadist diagnose``'s
-    ``fixed_resonance`` of role wheel_mode), divided out of that direction's lines alone, H → 1 far above it (β = 1).
-    fit_more_stands: with ``fit_stand``, ``more_stands`` fitted in its least squares too (:mod:`rwadist.stand_every`).
+    ``fixed_resonance`` of role test_stand; :func:`rwadist.resonance.resonance`), or None: every measured line amplitude
+    is divided by its |H| before the modes are located and fitted, so that the fixture's amplification is not taken for
+    the wheel's.  more_stands: further fixture resonances (each (f_r Hz, ζ, peak gain[, gain above]), on every channel)
+    divided out the same way and held (``ExtendedFit.more_stands``).  near: mode -> ``near_hz``/``near_a`` of
+    :func:`rwadist.mode_scan.scan_mode` (where an earlier fit of the same wheel located it), or None.  fit_stand: the
+    modes are located with ``stand`` divided out, and its parameters (f_r, ζ, the numerator's damping and the gain
+    above, :class:`rwadist.resonance.FittedResonance`) are fitted in the modes' least squares, from it: the modes'
+    standard errors are those with the stand free (what the stand could take of their lines is counted).  declare: False
+    keeps every located mode in the least squares, however loose (the joint fit's passes, whose next scans start from
+    the stand it fits: a mode dropped there leaves its lines to the stand alone).  stand_direction: ``stand`` is a mode
+    of the wheel's structure on that load direction only (``rwadist diagnose``'s ``fixed_resonance`` of role
+    wheel_mode), divided out of that direction's lines alone, H → 1 far above it (β = 1).  fit_more_stands: with
+    ``fit_stand``, ``more_stands`` fitted in its least squares too (:mod:`rwadist.stand_every`).  stand_on: the channels
+    a held ``stand`` acts on when not every one (:mod:`rwadist.stand_axes`); not with ``fit_stand``.
 
-    Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every
-    measured line at every speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data
-    do not pin down keeps its starting value, is named in ``unconstrained`` and in the notes.
-    Each radial line gets two forcing coefficients, one rotating with the spin and one against
-    it, fitted to the x-plus-y line power (which does not depend on their relative phase): the
-    rotation sense is read from the forcing, not from the response (a mode amplifies one sense
-    more than the other, so the response alone would mislabel a planar load).
+    Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every measured line at every
+    speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data do not pin down keeps its starting value,
+    is named in ``unconstrained`` and in the notes.  Each radial line gets two forcing coefficients, one rotating with
+    the spin and one against it, fitted to the x-plus-y line power (which does not depend on their relative phase): the
+    rotation sense is read from the forcing, not from the response (a mode amplifies one sense more than the other, so
+    the response alone would mislabel a planar load).
     """
     physical = mass is not None and radius is not None
     notes: list[str] = []
-    # the load cell's noisier sensor family read on the data as recorded, before the lever arm comes out (T − h × F
-    # puts the force sensors' noise in the torques too: wheel 1's forces 28 dB noisier, 5-9x the torques' floor as
-    # recorded, 2.6-3.5x with h = 0.1 m taken out, where no family was singled out)
+    # the load cell's noisier sensor family read on the data as recorded, before the lever arm comes out (T − h × F puts
+    # the force sensors' noise in the torques: wheel 1's forces 28 dB noisier, 5-9x the torques' floor, 2.6-3.5x less h)
     noisy = recorded_noisy_sensors(test, fit.without_mode_exclusion.lines) if height else None
     test, fit, meas, senses_xy = _measured_lines(test, fit, height, ([] if stand is None else [stand]) + list(more_stands),
-                                                 stand_direction if stand is not None else None)
+                                                 stand_direction if stand is not None else None, stand_on, fit_stand)
     peaks = amplification_peaks(fit)
     la, sa, ca, aa, na = _axial_measurements(meas)
     lr, sr, pr, dr, nr = radial = _radial_power(meas.lines)
@@ -571,7 +578,8 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                        line_residuals=line_residuals, stand_direction=None if stand is None else stand_direction,
                        zeta_bounds=zeta_bounds, zeta_interval=intervals, line_noise=np.concatenate([na, nr]),
                        line_h=_rows_h(lines, ax_line, rad_parts, sr),
-                       more_stands=tuple(tuple(float(v) for v in k) for k in more_stands))
+                       more_stands=tuple(tuple(float(v) for v in k) for k in more_stands),
+                       stand_on=None if stand is None or stand_on is None else tuple(stand_on))
 
 
 def _rows_h(lines: list, ax_line: np.ndarray, rad_parts: np.ndarray, sr: np.ndarray) -> np.ndarray:
@@ -690,7 +698,8 @@ def to_model(efit: ExtendedFit, fit: EmpiricalFit):
         # structure on one direction is the wheel's: ``rwadist diagnose`` names it as a fixed_resonance of its model)
         key = "test_stand" if efit.stand_direction is None else "structure_mode"
         analytical["fit"][key] = dict(stand_record(efit.stand),
-                                      **({} if efit.stand_direction is None else {"direction": efit.stand_direction}))
+                                      **({} if efit.stand_direction is None else {"direction": efit.stand_direction}),
+                                      **({} if efit.stand_on is None else {"channels": list(efit.stand_on)}))
         if efit.more_stands:    # the further fixture resonances fitted with it (two fixtures on one stand)
             analytical["fit"]["more_test_stands"] = [stand_record(k) for k in efit.more_stands]
     if efit.per_unit:

@@ -9,6 +9,7 @@ from .data import Run, SteadyTest
 from .dft import blocked_records, run_window, windowed_dfts
 from .empirical import EmpiricalFit
 from .extended_fit_power import RADIAL
+from .resonance import resonance
 from .units import DIRECTION_CHANNELS
 
 #: samples (runs × record length) of the x/y records :func:`line_senses` transforms together
@@ -19,7 +20,7 @@ SENSE_CHUNK_SAMPLES = 1 << 20
 SENSE_SHARE = 0.75
 
 
-def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = SENSE_SHARE) -> dict:
+def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = SENSE_SHARE, stand: tuple | None = None) -> dict:
     """Rotation sense of each radial line from the x/y phase, (direction, h) -> (sense, co_fraction, every_run).
 
     For each run the complex Hann-windowed DFT of the x and y channels at +h|Ω|
@@ -27,7 +28,9 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = SENSE_SH
     (swapped for Ω < 0); summed over runs, co_fraction = P_co / (P_co + P_counter).
     Above ``threshold``: "co"; below 1 − threshold: "counter"; between: "planar".
     every_run: "co" ("counter") when the response turns that way by more than :data:`ONE_SENSE` of its power in every
-    run the fit measures the line in (:data:`ONE_SENSE_RUNS` at least), else "" (:func:`one_sense_rows`).
+    run the fit measures the line in (:data:`ONE_SENSE_RUNS` at least), else "" (:func:`rwadist.line_senses.one_sense_rows`).
+    ``stand``: ((f_r Hz, ζ, peak gain, gain above), channels) of a fixture resonance on some channels, its complex gain
+    divided out of those channels' DFTs first (a fixture on Fy alone turns every circular line into an ellipse).
     """
     out = {}
     by_dir = {d: [x for x in fit.lines if x.direction == d] for d in RADIAL}
@@ -60,6 +63,9 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = SENSE_SH
             # every run's powers at once, added run after run in the batch's order (a cumulative sum along the runs:
             # the adds of a loop over them; a line out of a run's band adds 0 there)
             X, Y = XY[..., 0], XY[..., 1]
+            if stand is not None:
+                gain = resonance(f, *stand[0])
+                X, Y = (X / gain if cx in stand[1] else X), (Y / gain if cy in stand[1] else Y)
             co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
             back = np.array([run.speed < 0 for run in batch])[:, None]
             co, ct = np.where(back, ct, co), np.where(back, co, ct)
@@ -106,13 +112,14 @@ def one_sense_rows(meas_lines: list, row_line: np.ndarray, senses_xy: dict) -> n
     return per_line[np.asarray(row_line, int)] if per_line.size else np.zeros(len(row_line), int)
 
 
-def _line_senses_once(test: SteadyTest, fit: EmpiricalFit) -> dict:
+def _line_senses_once(test: SteadyTest, fit: EmpiricalFit, stand: tuple | None = None) -> dict:
     """:func:`line_senses` of ``test`` and ``fit``, computed once per (test, fit) and kept on the fit: a fixture
     resonance's joint fit (:func:`rwadist.stand_resonance.fit_extended_beside_stand`) fits the same test and empirical
     fit again and again with another stand divided out,
-    which changes the lines' amplitudes, never their directions, h or the time series the senses are read from."""
-    cached = fit.__dict__.get("_line_senses")
+    which changes the lines' amplitudes, never their directions, h or the time series the senses are read from.
+    ``stand``: as :func:`line_senses`' (a fixture on some channels changes the senses read: kept by it)."""
+    cached = fit.__dict__.setdefault("_line_senses", {}).get(stand)
     if cached is None or cached[0] is not test:
-        cached = (test, line_senses(test, fit))
-        fit.__dict__["_line_senses"] = cached
+        cached = (test, line_senses(test, fit, stand=stand))
+        fit.__dict__["_line_senses"][stand] = cached
     return cached[1]

@@ -30,7 +30,7 @@ def log_power_gain(e, f_hz) -> np.ndarray:
 #: Largest damping ratio of a proposed fixture resonance: a fixture resonance is sharp; a "resonance" as wide as
 #: the fit allows (ζ → 0.5) is a broad tilt of the line gains (a wheel mode's skirt, model error), not a stand.
 STAND_MAX_ZETA = 0.2
-#: Smallest damping ratio of a fixture resonance: the fits' lower bound is 0.001 (:func:`_fit_on_lines`,
+#: Smallest damping ratio of a fixture resonance: the fits' lower bound is 0.001 (:func:`fit_on_lines`,
 #: :class:`rwadist.resonance.FittedResonance`, :class:`rwadist.effects.fixed_resonance_diagnose.FixedResonance`); a fit that ends there measured no width -- a
 #: "resonance" narrower than the lines resolve, one line's misfit at one speed lifted by a gain of 20-40.
 STAND_MIN_ZETA = 0.0015
@@ -39,7 +39,7 @@ STAND_MIN_ZETA = 0.0015
 STAND_WINDOW = 0.05
 
 
-def _line_log_gains(fit, known: tuple = ()) -> dict:
+def line_log_gains(fit, known: tuple = ()) -> dict:
     """(direction, h) -> (f Hz, y) of every measured line amplitude of an empirical fit: f = h|Ω|/2π and
     y = 2 ln(a / (C·Ω²)), the log power gain over the line's hard-mounted law, less ln|H(f)|² of each fixture
     resonance of ``known`` ((f_r Hz, ζ, peak gain, gain above) each: stands already fitted with the modes)."""
@@ -97,7 +97,7 @@ def _stand_frequencies(fit, min_points: int = 2, known: tuple = ()):
     """(the frequencies (Hz, best first), the lines' log gains by line) where a fixture resonance lifts every
     direction in ``fit``, or None when there is none: :data:`STAND_FREQUENCIES` at most, each
     :data:`STAND_FREQUENCY_APART` from the others; ``known``: stands already fitted, divided out of the gains
-    (:func:`_line_log_gains`) and not proposed again (no f within :data:`STAND_WINDOW` of one).
+    (:func:`line_log_gains`) and not proposed again (no f within :data:`STAND_WINDOW` of one).
 
     The signature of a stand resonance is one frequency at which the lines of every load direction are lifted (a
     wheel mode lifts one direction only).  Score of a frequency f: the smallest, over the directions with lines
@@ -108,7 +108,7 @@ def _stand_frequencies(fit, min_points: int = 2, known: tuple = ()):
     """
     # every line the data show, at every speed (a line lifted by the stand at most of its speeds is dropped from the
     # fit with modal exclusion: the E wheel's radial-force lines near a 180 Hz stand at 300-2400 rpm)
-    by_line = _line_log_gains(getattr(fit, "without_mode_exclusion", fit), known)
+    by_line = line_log_gains(getattr(fit, "without_mode_exclusion", fit), known)
     if len({d for d, _ in by_line}) < 2:
         return None
     f_all = np.concatenate([f for f, _ in by_line.values()])
@@ -157,20 +157,20 @@ def stand_resonance_start(fit, min_points: int = 2):
 
 def stand_starts(fit, min_points: int = 2, known: tuple = ()) -> list:
     """Starts (f_r Hz, ζ, peak gain, gain above) of the fixture resonance seen in the empirical fit ``fit``: none when
-    :func:`_stand_frequency` sees none; else the resonance fitted on every direction's lines (:func:`_fit_on_lines`),
+    :func:`_stand_frequency` sees none; else the resonance fitted on every direction's lines (:func:`fit_on_lines`),
     then the one of each direction alone that is a fixture resonance within ±5 % of it, weakest first.  A wheel mode
     beside the stand lifts its own direction's lines by the mode times the stand (the axial mode at 140 Hz beside a
     stand at 142 Hz: the pooled fit 138.6 Hz, gain 12.6 for a stand of gain 5), so the direction lifted least is the
     stand's best start where a mode sits on one direction.  ``known``: stands already fitted with the modes, divided
-    out of the line gains first (:func:`_line_log_gains`): the starts of another stand beside them."""
+    out of the line gains first (:func:`line_log_gains`): the starts of another stand beside them."""
     found = _stand_frequency(fit, min_points, tuple(known))
     if found is None:
         return []
     f_s, by_line = found
-    pooled = _fit_on_lines(by_line, f_s)
+    pooled = fit_on_lines(by_line, f_s)
     out = [] if pooled is None else [pooled]
     dirs = sorted({d for d, _ in by_line})
-    own = [_fit_on_lines({k: v for k, v in by_line.items() if k[0] == d}, f_s) for d in dirs]
+    own = [fit_on_lines({k: v for k, v in by_line.items() if k[0] == d}, f_s) for d in dirs]
     ref = f_s if pooled is None else pooled[0]
     own = sorted((o for o in own if o is not None and abs(o[0] / ref - 1) <= 0.05), key=lambda o: o[2])
     for o in own:
@@ -181,7 +181,7 @@ def stand_starts(fit, min_points: int = 2, known: tuple = ()) -> list:
 
 def further_stand_starts(fit, min_points: int = 2, known: tuple = ()) -> list:
     """Starts (f_r Hz, ζ, peak gain, gain above) of a fixture resonance at the frequencies of :func:`_stand_frequencies`
-    after the best (each the resonance fitted on every direction's lines there, :func:`_fit_on_lines`): tried by the
+    after the best (each the resonance fitted on every direction's lines there, :func:`fit_on_lines`): tried by the
     joint fit with the modes only when no start of :func:`stand_starts` is confirmed.
 
     Two fixtures lift the lines at two frequencies; the one scored best is not always the one the modes can be fitted
@@ -194,24 +194,24 @@ def further_stand_starts(fit, min_points: int = 2, known: tuple = ()) -> list:
     if got is None:
         return []
     frequencies, by_line = got
-    starts = (_fit_on_lines(by_line, f_s) for f_s in frequencies[1:])
+    starts = (fit_on_lines(by_line, f_s) for f_s in frequencies[1:])
     return [s for s in starts if s is not None]
 
 
 #: Window (factors of f_r) of the line gains a fixture resonance is fitted on: wide enough to see where the gain
 #: ends above the resonance (a transmissibility's |H| crosses 1 at sqrt(2)·f_r)
 GENERAL_WINDOW = (0.5, 2.0)
-#: Damping ratio a start is given when the lines alone do not resolve the stand's width (:func:`_fit_on_lines`): the
+#: Damping ratio a start is given when the lines alone do not resolve the stand's width (:func:`fit_on_lines`): the
 #: smallest of that fit's own starting values; the joint fit with the modes measures it
 UNRESOLVED_START_ZETA = 0.01
-#: Evaluations of one start's least squares at most (:func:`_fit_on_lines`).  The starts converge in 15-300; one that
+#: Evaluations of one start's least squares at most (:func:`fit_on_lines`).  The starts converge in 15-300; one that
 #: does not crawls along the width's floor where the lines do not resolve the peak (family wheel 2 clean, its 90 Hz
 #: translation seen as a stand: 1700 evaluations, 1.2 s, each to ζ 0.0023, gain 8.9; stopped at 200: ζ 0.0028, gain 8.3).
 #: What it proposes is a start: the joint fit with the modes measures the stand or rejects it.
 START_MAX_NFEV = 200
 
 
-def _fit_on_lines(by_line: dict, f_s: float):
+def fit_on_lines(by_line: dict, f_s: float):
     """(f_r Hz, ζ, peak gain, gain above) of the fixture resonance near ``f_s`` fitted to the lines' log power gains
     ``by_line`` ((direction, h) -> (f Hz, y)) within :data:`GENERAL_WINDOW` of f_s, or None when it is no fixture
     resonance (:func:`is_fixture_resonance`).

@@ -10,6 +10,7 @@ from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.state import State
 from ..model import Harmonic
+from ..resonance import resonance
 from ..units import CHANNELS, DIRECTION_CHANNELS
 
 
@@ -219,10 +220,11 @@ class CounterRotation:
     @staticmethod
     def _phase_powers(ctx, state, direction, h, runs):
         """Per run of ``runs``: the co- and counter-rotating mean squares of the line (direction, h) from the x/y
-        phasors (co |X + iY|²/4, counter |X − iY|²/4, swapped for Ω < 0; their sum is the x + y line power),
-        the noise's expected share of each (white noise of the model floor S_x, S_y at the line through the
-        whole-run Hann window: (S_x + S_y)/2 · f_s·Σw²/(Σw)²), the modal power gains |G₊|², |G₋|² (times the
-        fixed resonances) of a unit co and counter load, and an in-band mask.  None without time series."""
+        phasors (co |X + iY|²/4, counter |X − iY|²/4, swapped for Ω < 0; their sum is the x + y line power), each
+        channel's fixed resonances divided out of its phasor (:func:`complex_gain`: a fixture on Fy alone turns a
+        circular line into an ellipse), the noise's expected share of each (white noise of the model floor S_x, S_y
+        at the line through the whole-run Hann window: (S_x + S_y)/2 · f_s·Σw²/(Σw)², each divided alike), the modal power
+        gains |G₊|², |G₋|² of a unit co and counter load, and an in-band mask.  None without time series."""
         chans = DIRECTION_CHANNELS[direction]
         if ctx.test is None or not all(c in ctx.channels for c in chans):
             return None
@@ -232,21 +234,21 @@ class CounterRotation:
         f = h0 * ctx.omega[runs] / (2 * np.pi)
         inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
         X = ctx.phasors(runs, f[:, None])[:, 0, :]
-        x, y = X[:, CHANNELS.index(chans[0])], X[:, CHANNELS.index(chans[1])]
+        x, y = (X[:, CHANNELS.index(c)] / complex_gain(state, c, f) for c in chans)
         co, ct = np.abs(x + 1j * y) ** 2 / 4.0, np.abs(x - 1j * y) ** 2 / 4.0
         neg = np.asarray(ctx.sp.speed, float)[runs] < 0
         co, ct = np.where(neg, ct, co), np.where(neg, co, ct)
         k = np.clip(np.rint(f / ctx.df).astype(int), 0, ctx.f.size - 1)[:, None]
-        S = sum(np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1)[:, 0] for c in chans) / 2.0
+        S = sum(np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1)[:, 0] / np.abs(complex_gain(state, c, f)) ** 2
+                for c in chans) / 2.0
         enbw = np.empty(runs.size)
         for i, r in enumerate(runs):
             run = ctx.test.runs[r]
             _, wsum, w2sum = run_window(ctx.sp.window, run.n_samples)
             enbw[i] = run.sample_rate * w2sum / wsum ** 2
         noise = S * enbw
-        Hc2 = ctx.gain(state, chans[0], f) ** 2
-        gp = ctx.unit_gain(state, chans[0], direction, h0, "co", runs) ** 2 * Hc2
-        gn = ctx.unit_gain(state, chans[0], direction, h0, "counter", runs) ** 2 * Hc2
+        gp = ctx.unit_gain(state, chans[0], direction, h0, "co", runs) ** 2
+        gn = ctx.unit_gain(state, chans[0], direction, h0, "counter", runs) ** 2
         ok = inb & np.isfinite(co) & np.isfinite(ct) & (gp > 0) & (gn > 0)
         return co, ct, noise, gp, gn, ok
 
@@ -437,7 +439,7 @@ XY_SPLIT_MIN_T = 5.0
 
 def xy_split(ctx: Context, state: State, direction: str, h: float, runs, q: float) -> float:
     """e = Σ(P_x − P_y)/Σ(P_x + P_y) of the line (direction, h) over ``runs`` from the x/y phasors (each run's line
-    powers less the noise's expected share), when the runs agree on it (:data:`XY_SPLIT_MIN_T`), else 0.
+    powers less the noise's expected share, each channel's fixed resonances divided out), when the runs agree on it (:data:`XY_SPLIT_MIN_T`), else 0.
 
     A radial load z = x + iy = a₊e^{iθ} + a₋e^{−iθ} reads |x|² ∝ |a₊|² + |a₋|² + 2|a₊||a₋|cos ψ and |y|² with −, ψ the
     phase of a₊a₋: twice the ellipse's orientation in the stator.  An anisotropic mount or bearing holds ψ at every
@@ -449,7 +451,7 @@ def xy_split(ctx: Context, state: State, direction: str, h: float, runs, q: floa
     f = h0 * np.abs(w) / (2 * np.pi)
     inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
     X = ctx.phasors(runs, (h0 * w / (2 * np.pi))[:, None])[:, 0, :]
-    px, py = np.abs(X[:, CHANNELS.index(cx)]) ** 2, np.abs(X[:, CHANNELS.index(cy)]) ** 2
+    px, py = (np.abs(X[:, CHANNELS.index(c)] / complex_gain(state, c, f)) ** 2 for c in (cx, cy))
     ok = inb & np.isfinite(px) & np.isfinite(py) & (px + py > 0)
     if ok.sum() < 3:
         return 0.0
@@ -463,3 +465,13 @@ def xy_split(ctx: Context, state: State, direction: str, h: float, runs, q: floa
         return 0.0
     bound = 2.0 * np.sqrt(max(q * (1.0 - q), 0.0))
     return float(np.clip(e, -bound, bound))
+
+
+def complex_gain(state: State, c: str, f_hz) -> np.ndarray:
+    """H of the state's fixed resonances acting on channel ``c`` at ``f_hz`` (Hz), complex: what the channel's phasor
+    is divided by to read the load (a resonance on one channel of a pair changes the pair's phase and ellipse)."""
+    g = np.ones(np.shape(f_hz), dtype=complex)
+    for f_r, zeta, peak, chans, *above in state.resonances:
+        if c in chans:
+            g = g * resonance(f_hz, f_r, zeta, peak, *above)
+    return g

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 from ..schema import COUNT, DIRECTIONS, FREQUENCY, GAIN, MAX_ZETA, check, choice, names, number, optional, register
+from ..units import CHANNELS, DIRECTION_CHANNELS
 from .actions import LineFilter
 from .element import Element, directions, num
 
@@ -16,7 +17,9 @@ class FixedResonance(Element):
     """A resonance at f_Hz (damping ratio zeta, gain peak_gain at f_Hz, gain_above far above it:
     :func:`rwadist.resonance.resonance`) of role ``wheel_mode`` (the wheel's loads of ``directions`` pass through it:
     a mode of the path between the wheel's load and its interface keeps gain_above = 1 − μ of it, μ the mode's
-    participation, :data:`rwadist.resonance.PATH_MODE_MAX_ABOVE`) or ``test_stand`` (a fixture: measurement only)."""
+    participation, :data:`rwadist.resonance.PATH_MODE_MAX_ABOVE`) or ``test_stand`` (a fixture: measurement only).
+    ``channels``: a test stand's channels when it acts on some of its directions' channels only (a fixture that sways
+    along one axis lifts Fy and Tx, not Fx and Ty), else None: every channel of ``directions``."""
 
     KIND: ClassVar[str] = "fixed_resonance"
     ORDER: ClassVar[int] = 40
@@ -27,8 +30,14 @@ class FixedResonance(Element):
     directions: tuple = field(metadata=check(names(DIRECTIONS)))
     n_points: int | None = field(default=None, metadata=check(COUNT))
     gain_above: float = field(default=1.0, metadata=check(optional(number(ge=-1.0, le=3.0), 1.0)))
+    channels: tuple | None = field(default=None, metadata=check(optional(names(CHANNELS))))
 
     def _validate(self, source, path, error):
+        if self.channels is not None:
+            own = {c for d in self.directions for c in DIRECTION_CHANNELS[d]}
+            if self.role != "test_stand" or not set(self.channels) <= own:
+                raise error(source, f"{path}.channels", f"is {list(self.channels)!r}: the channels of a test stand "
+                            f"(role test_stand) on some of its directions' channels ({', '.join(sorted(own))}) only")
         least = self.smallest_peak(self.zeta, self.gain_above)
         if self.peak_gain < least * (1 - 1e-9):
             raise error(source, f"{path}.peak_gain", f"is {self.peak_gain!r}: a resonance of zeta {self.zeta!r} whose "
@@ -60,8 +69,9 @@ class FixedResonance(Element):
         below = "" if above == 1.0 else f", {num(above, '.2g')} of the load far above"
         # a gain under 1 at f_r attenuates the lines there: said so, not left to read as a resonance (trial 30b)
         notch = " (under 1: a notch, the lines attenuated there)" if float(e["peak_gain"]) < 1.0 else ""
+        where = ", ".join(e["channels"]) if e.get("channels") else directions(e["directions"])
         return (f"{role}, {num(e['f_Hz'], '.2f')} Hz, ζ {num(e['zeta'], '.3g')}, peak gain "
-                f"{num(e['peak_gain'], '.3g')}{notch}{below}, on {directions(e['directions'])}")
+                f"{num(e['peak_gain'], '.3g')}{notch}{below}, on {where}")
 
     # ------------------------------------------------------------------ injection
     #: ``fixed_resonance:f_hz=150,zeta=0.03,gain=5,channels=Fx+Fy+Fz+Tx+Ty+Tz,role=test_stand,gain_above=1``: a

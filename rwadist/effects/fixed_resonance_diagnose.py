@@ -468,8 +468,11 @@ class FixedResonance:
 
     def params(self) -> dict:
         dirs = sorted({CHANNEL_DIRECTION[c] for c in self.channels})
+        # a test stand on some of its directions' channels only (a fixture swaying along one axis): said so
+        some = self.role == "test_stand" and set(self.channels) != {c for d in dirs for c in DIRECTION_CHANNELS[d]}
         return {"f_Hz": self.f_r, "zeta": self.zeta, "peak_gain": self.peak_gain, "gain_above": self.gain_above,
                 "role": self.role, "directions": dirs, "n_points": self.n_points,
+                "channels": list(self.channels) if some else None,
                 "gain_law": "H = (1 - gain_above*r^2 + 2j*c*zeta*r)/(1 - r^2 + 2j*zeta*r) with r = f/f_Hz and "
                             "c = sqrt((2*zeta*peak_gain)^2 - (1 - gain_above)^2)/(2*zeta) (|H| = peak_gain at f_Hz)"}
 
