@@ -329,7 +329,8 @@ def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: 
         fit = fit_empirical(spectra, fit.fit_settings)
     meas = _unsmeared_once(test, with_close_lines(test, fit.without_mode_exclusion),
                            len(fit.without_mode_exclusion.lines))
-    senses_xy = _line_senses_once(test, meas, None if stand_on is None else (tuple(stands[0]), tuple(stand_on)))
+    radial_on = None if stand_on is None else tuple(c for c in stand_on if c in ("Fx", "Fy", "Tx", "Ty"))
+    senses_xy = _line_senses_once(test, meas, (tuple(stands[0]), radial_on) if radial_on else None)
     if stands:
         def fixture_gain(x):
             f = x.h * np.abs(x.speed) / (2 * np.pi)

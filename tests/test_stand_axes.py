@@ -96,3 +96,21 @@ def test_fit_extended_divides_the_one_axis_stand_out_of_its_channels():
     assert p.omega_rock / (2 * np.pi) == pytest.approx(wheel.f_rock, rel=0.005)
     stand = model.analytical["fit"]["test_stand"]
     assert stand["channels"] == ["Fy", "Tx"] and stand["f_Hz"] == pytest.approx(0.8 * wheel.f_trans, rel=0.005)
+
+
+def test_a_given_model_s_one_axis_stand_is_proposed_on_its_channels():
+    """``rwadist diagnose DATA --model M`` with M from ``fit --extended`` of another run of the same rig (family wheel 6,
+    the Fy/Tx fixture at 0.8x, seeds 4 and 5): the stand its fit recorded is named on Fy and Tx and the error after is
+    the clean level's order (proposed on every channel instead: nothing named, error after 0.59)."""
+    from rwadist import api
+
+    wheel = fw.family()[6]
+    fixture = [AxisFixture(0.8 * wheel.f_trans, zeta=0.03, gain=15.0)]
+    _, model = api.fit_extended(steady_test(fw.steady(wheel, noise=0.003, seed=4, effects=fixture)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = api.diagnose(steady_test(fw.steady(wheel, noise=0.003, seed=5, effects=fixture)), model)
+    stands = [e for e in d.model.effects if e["kind"] == "fixed_resonance"]
+    assert [e["channels"] for e in stands] == [["Fy", "Tx"]]
+    assert stands[0]["f_Hz"] == pytest.approx(0.8 * wheel.f_trans, rel=0.005)
+    assert d.error_after < 0.01

@@ -297,6 +297,11 @@ class CounterRotation:
         if g is None or pw is None or CounterRotation._sees_senses(ctx, state, self.direction, self.h, runs):
             return None
         co, ct, noise, gp, gn, ok = pw
+        # the phasors' powers are read with the channels' fixed resonances divided out (:meth:`_phase_powers`): put
+        # back in measured units, those of the error metric the drop is weighed against (the pair's mean |H|²)
+        f = g[0] * np.abs(ctx.omega[runs]) / (2 * np.pi)
+        back = sum(np.abs(complex_gain(state, c, f)) ** 2 for c in DIRECTION_CHANNELS[self.direction]) / 2.0
+        co, ct, noise, gp, gn = co * back, ct * back, noise * back, gp * back, gn * back
         c_tot2 = g[1] ** 2 + g[2] ** 2
         q0 = g[2] ** 2 / c_tot2
         free = c_tot2 * ctx.omega[runs] ** 4                       # free x + y mean square of the harmonic

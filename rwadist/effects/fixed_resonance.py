@@ -69,7 +69,8 @@ class FixedResonance(Element):
         below = "" if above == 1.0 else f", {num(above, '.2g')} of the load far above"
         # a gain under 1 at f_r attenuates the lines there: said so, not left to read as a resonance (trial 30b)
         notch = " (under 1: a notch, the lines attenuated there)" if float(e["peak_gain"]) < 1.0 else ""
-        where = ", ".join(e["channels"]) if e.get("channels") else directions(e["directions"])
+        chans = e.get("channels")
+        where = ", ".join([chans] if isinstance(chans, str) else chans) if chans else directions(e["directions"])
         return (f"{role}, {num(e['f_Hz'], '.2f')} Hz, ζ {num(e['zeta'], '.3g')}, peak gain "
                 f"{num(e['peak_gain'], '.3g')}{notch}{below}, on {where}")
 

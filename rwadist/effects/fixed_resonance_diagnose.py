@@ -646,7 +646,9 @@ class FixedResonance:
             stands = ([ref["test_stand"]] if ref.get("test_stand") else []) + list(ref.get("more_test_stands") or [])
             for k in stands if not modes else []:        # every stand of that fit (two fixtures: both)
                 given = tuple(float(k[v]) for v in ("f_Hz", "zeta", "peak_gain")) + (float(k.get("gain_above", 1.0)),)
-                out.append(FixedResonance.of_stand(given, ctx.channels, given))
+                # a stand on some channels only (``channels``: rwadist.stand_axes) proposed on those
+                chans = tuple(c for c in ctx.channels if c in k["channels"]) if k.get("channels") else ctx.channels
+                out.append(FixedResonance.of_stand(given, chans, given))
         # a "resonance" that changes no line by more than MIN_PEAK_GAIN is a patch on model error, not a mode; nor is a
         # wheel mode that lowers the lines at its frequency: a mode of the wheel's structure amplifies what passes it
         # (docs/diagnose.md), and a dip fitted on one direction's lines is a patch on the misfit of the few lines there

@@ -720,8 +720,9 @@ def declare_beside_fixtures(ctx: Context, state: State) -> State:
     test, fit = fit_of_runs(ctx, ctx.runs)
     test = SteadyTest(test.runs, _recorded_meta(ctx))
     try:
-        one = fit_extended(test, fit, stand=own, more_stands=tuple(modes.more_stands))
-        every = fit_extended(test, fit, stand=own, more_stands=tuple(modes.more_stands) + tuple(others))
+        one = fit_extended(test, fit, stand=own, more_stands=tuple(modes.more_stands), stand_on=modes.stand_on)
+        every = fit_extended(test, fit, stand=own, more_stands=tuple(modes.more_stands) + tuple(others),
+                             stand_on=modes.stand_on)
     except ValueError:
         return state
     f_one, f_every = _mode_hz(one.params), _mode_hz(every.params)
