@@ -192,12 +192,12 @@ def _beside_axis_stand(ctx: Context, test, fit, near):
     on the held-out runs failed; every run: 341.6 Hz)."""
     from ..stand_axes import axis_stand, fit_beside
 
-    key = ("suspension_modes.axis_stand", id(fit))
-    if key not in ctx._memo or ctx._memo[key][0] is not fit:
-        ctx._memo[key] = (fit, axis_stand(fit))
-    whole = whole_data_fit(ctx)
-    axis = _axis_stand_whole(ctx) if fit is not whole else None
-    axis = axis or ctx._memo[key][1]
+    axis = _axis_stand_whole(ctx)
+    if axis is None and fit is not whole_data_fit(ctx):
+        key = ("suspension_modes.axis_stand", id(fit))
+        if key not in ctx._memo or ctx._memo[key][0] is not fit:
+            ctx._memo[key] = (fit, axis_stand(fit))
+        axis = ctx._memo[key][1]
     return None if axis is None else fit_beside(test, fit, axis, near=near)
 
 
