@@ -20,7 +20,9 @@ noise (its ratio there within :data:`CLUSTER_TOLERANCE` of κ, or within the sca
 target's noise), and κ times the source stands over the target's noise.  Pairs of channels of one direction (Fx-Fy, Tx-Ty: a rotating line fixes their phase) are not tried on the lines
 (on the floor they are, :func:`_floor_copies`), nor a
 torque carrying a force of a load-cell offset's r × F on the lines (the ``cross_coupling`` class;
-:data:`LEVER_ARM_PAIRS`: on the floor they are, against their mirror pair, :func:`_floor_copies`); a copy
+:data:`LEVER_ARM_PAIRS`: on the floor they are, against their mirror pair, :func:`_floor_copies`), but a radial force
+in a radial torque, whose mirror pair tells an offset from a copy on the lines too (:data:`RADIAL_LEVER`,
+:func:`_mirror_missing`); a copy
 whose target torque that offset's r × F of the forces explains as well is the offset's (:func:`_lever_arm_of_forces`);
 and a radial pair reading the other radial pair alike (Tx = κ·Fx with Ty = κ·Fy: a rotating source's force and
 moment in phase) is the rotor's own pattern, not a copy.
@@ -35,7 +37,7 @@ from ..units import CHANNEL_DIRECTION, RAD_S_TO_RPM
 
 #: (force, torque) pairs of a load-cell offset's r × F (Tx = r_y·Fz − r_z·Fy, ...): the ``cross_coupling`` class
 #: explains a torque carrying such a force on the lines, so those pairs are left to it there (the noise floor tells
-#: an instrument's copy from an offset: :func:`_floor_copies`)
+#: an instrument's copy from an offset: :func:`_floor_copies`), but for :data:`RADIAL_LEVER`'s
 LEVER_ARM_PAIRS = {("Fy", "Tx"), ("Fz", "Tx"), ("Fx", "Ty"), ("Fz", "Ty"), ("Fx", "Tz"), ("Fy", "Tz")}
 #: Each lever-arm pair's mirror: the other term of the same component of r in r × F, at the negated ratio
 #: (T_y = r_z·F_x with T_x = −r_z·F_y; T_x = r_y·F_z with T_z = −r_y·F_x; T_z = r_x·F_y with T_y = −r_x·F_z)
@@ -51,6 +53,16 @@ TORQUE_ROW = {"Tx": (("Fz", 1.0), ("Fy", -1.0)), "Ty": (("Fx", 1.0), ("Fz", -1.0
 LEVER_MISFIT_RATIO = 2.0
 #: The other channel of a radial pair.
 PARTNER = {"Fx": "Fy", "Fy": "Fx", "Tx": "Ty", "Ty": "Tx"}
+#: The lever-arm pairs of a radial force in a radial torque, each with its mirror: an offset r_z reads in both
+#: (T_y = r_z·F_x with T_x = −r_z·F_y), a load cell's or an amplifier's crosstalk in one.  Tried on the lines
+#: (:func:`_mirror_missing`): the classic cross-talk of a six-axis cell, a force into a moment, undeclared, left the
+#: family's wheel 0 (Ty += 0.08·Fx, Fx's noise under Ty's own) with its rocking mode lost, a counter-rotating part
+#: named on the radial torque and no word of a copy
+RADIAL_LEVER = {("Fx", "Ty"): ("Fy", "Tx"), ("Fy", "Tx"): ("Fx", "Ty")}
+#: ... one channel's copy when the mirror's torque departs from −κ × its force, at the copy's lines and runs where
+#: that would stand CLEAR_COPY_DB over the mirror's noise, by more than this share of it (median): an offset's mirror
+#: holds it to the wheel's own torque there (which the copy's points, where κ·F dominates, keep small)
+MIRROR_MISFIT = 0.5
 #: A radial force in a radial torque this close to ±90° (deg) is the partner force's r × F (:func:`_lever_arm_through_partner`).
 LEVER_PHASE_DEG = 20.0
 #: A source line's power over the noise in its record bin, at least (dB).
@@ -167,12 +179,16 @@ def find_channel_copies(ctx, test=None) -> list:
         if mine.sum() < MIN_RUNS:
             continue
         for t, ct in enumerate(chans):
-            if t == s or CHANNEL_DIRECTION[ct] == CHANNEL_DIRECTION[cs] or (cs, ct) in LEVER_ARM_PAIRS:
+            lever = (cs, ct) in LEVER_ARM_PAIRS
+            if t == s or CHANNEL_DIRECTION[ct] == CHANNEL_DIRECTION[cs] or (lever and (cs, ct) not in RADIAL_LEVER):
                 continue
             got = _pair(X[mine, s], X[mine, t], noise[mine, t], run_of[mine], h[mine], cs, ct,
                         ctx.omega[run_of[mine]])
-            if got is not None and not _lever_arm_through_partner(got) and \
-                    not _lever_arm_of_forces(got, X[mine], chans, run_of[mine], h[mine]):
+            if got is None:
+                continue
+            if (_mirror_missing(got, X, src, chans, run_of, h, noise) if lever else
+                    not _lever_arm_through_partner(got) and
+                    not _lever_arm_of_forces(got, X[mine], chans, run_of[mine], h[mine])):
                 found.append(got)
     found += _floor_copies(test, runs, chans, found, X, noise, src, run_of, h)
     # a radial pair carrying the other radial pair's content alike (Tx = κ·Fx and Ty = κ·Fy) is the rotor's own
@@ -239,6 +255,32 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
         level = float(10 * np.log10(np.median(over))) if over.size else float("nan")
         out.append(ChannelCopy(g[0], g[1], g[2], tuple(lines), g[3], level, floor_z=g[4]))
     return out
+
+
+def _mirror_missing(copy: ChannelCopy, X: np.ndarray, src: np.ndarray, chans: tuple, run_of: np.ndarray,
+                    h: np.ndarray, noise: np.ndarray) -> bool:
+    """Whether ``copy`` (a radial force in a radial torque, :data:`RADIAL_LEVER`) lacks its mirror: at the mirror
+    force's points of the copy's lines and runs where −κ × that force would stand :data:`CLEAR_COPY_DB` over the
+    mirror torque's noise (in :data:`MIN_RUNS` runs at least), the median of |X_mirror torque + κ·X_mirror force −
+    r·X_Fz| (r real, least squares: an offset's lateral term) over |κ·X_mirror force| exceeds :data:`MIRROR_MISFIT`.  ``X`` (P, K), ``src``, ``run_of``, ``h``, ``noise`` (P, K): the
+    lines' points of :func:`find_channel_copies`."""
+    ms, mt = RADIAL_LEVER[(copy.source, copy.target)]
+    if ms not in chans or mt not in chans:
+        return False
+    s, t = chans.index(ms), chans.index(mt)
+    sel = (src == s) & np.isin(h, copy.lines_h) & np.isin(run_of, copy.runs)
+    pred = -copy.kappa * X[sel, s]
+    heard = np.abs(pred) ** 2 >= 10 ** (CLEAR_COPY_DB / 10) * noise[sel, t]
+    if np.unique(run_of[sel][heard]).size < MIN_RUNS:
+        return False
+    left = X[sel, t][heard] - pred[heard]
+    if "Fz" in chans:
+        # the mirror torque's other term, an offset's lateral part times the axial force (T_x = r_y·F_z − r_z·F_y,
+        # T_y = r_z·F_x − r_x·F_z): r real, fitted by least squares, taken off too
+        fz = X[sel, chans.index("Fz")][heard]
+        A, b = np.concatenate([fz.real, fz.imag]), np.concatenate([left.real, left.imag])
+        left = left - (float(A @ b / (A @ A)) if A @ A > 0 else 0.0) * fz
+    return float(np.median(np.abs(left) / np.abs(pred[heard]))) > MIRROR_MISFIT
 
 
 def _out_of_round(a: np.ndarray, b: np.ndarray) -> float:
