@@ -25,6 +25,8 @@ The channel is called distorted when over the test at least :data:`MIN_MATCHED` 
 from deciding).  Over the data of every cell of the family matrix and of seven open-world kinds on its eight wheels
 (240 tests: 2-15 kg, modes 50-600 Hz, bearing lines, 2-10 kHz, fixtures, effects) none is called distorted, the
 lowest false-alarm probability 1.3e-3; a 0.5 % distortion of Fx on family wheel 6 makes 45 alone lines, 45 matched.
+Nor when its matched lines are another channel's, copied (:func:`_copy_source`: a linear crosstalk, which the
+diagnosis describes as a ``channel_copy``).
 
 The distortion is then undone, run by run: at the matched lines (±1 bin) the channel's spectrum Y is the products'
 part of y², y³ (Y ≈ b₂·FFT(y²) + b₃·FFT(y³) there, as y ≈ x to first order), a linear least squares for (b₂, b₃) in
@@ -76,6 +78,10 @@ SIMPLER = 0.1
 #: fixed-point steps of the inverse of a fitted law, and refits of the law on what its inverse leaves
 INVERSE_STEPS = 6
 REFINE = 3
+#: a channel's lines at products are another channel's content copied into it (a linear crosstalk, which
+#: :mod:`rwadist.diagnose.channel_copy` describes), not made by its electronics, when one complex factor over the
+#: test times that channel's spectrum holds at least this share of their power
+COPY_EXPLAINED = 0.9
 
 
 @functools.lru_cache(maxsize=8)
@@ -183,13 +189,55 @@ def inverse(y: np.ndarray, b2: float, b3: float) -> np.ndarray:
 def _coefficients(y: np.ndarray, bins: np.ndarray) -> tuple:
     """(b₂, b₃) of y = x + b₂x² + b₃x³, fitted at the product ``bins`` (±1 bin each): to first order the products of
     y are b₂·FFT(y²) + b₃·FFT(y³) there (:func:`_fit_orders`); what the exact inverse of that law leaves at them is
-    fitted again and added, :data:`REFINE` times (a 2 % distortion of both orders reads 25 % low at first order)."""
+    fitted again and added, :data:`REFINE` times (a 2 % distortion of both orders reads 25 % low at first order).
+    (NaN, NaN) when the refits diverge (lines at products that no such law makes: the inverse's iteration grows
+    without bound), which no run is corrected with."""
     k = np.unique(np.clip((bins[:, None] + np.arange(-1, 2)).ravel(), 0, y.size // 2))
-    b, orders = _fit_orders(y, k, None)
-    for _ in range(REFINE):
-        step, _ = _fit_orders(inverse(y, *b), k, orders)
-        b = b + step
+    with np.errstate(over="ignore", invalid="ignore"):
+        try:
+            b, orders = _fit_orders(y, k, None)
+            for _ in range(REFINE):
+                z = inverse(y, *b)
+                if not np.all(np.isfinite(z)):
+                    return np.nan, np.nan
+                step, _ = _fit_orders(z, k, orders)
+                b = b + step
+        except np.linalg.LinAlgError:       # powers of a diverged inverse overflow in the products' spectra
+            return np.nan, np.nan
     return float(b[0]), float(b[1])
+
+
+def _copy_source(test, channel: str, partner: str, matched: list) -> str | None:
+    """The channel (neither ``channel`` nor its ``partner``) whose spectrum times one complex factor a over the test
+    (|a| < 1: the weaker way round) holds :data:`COPY_EXPLAINED` or more of the power of ``channel``'s lines at
+    products (``matched``: per run, their bins, or None), and bin by bin leaves a median of at most 1 −
+    COPY_EXPLAINED of each: those lines are that channel's content copied (a crosstalk holds every line of its source, and
+    a bearing's line set, h 0.41, 0.82, 3.6, 7.2, sits at sums and differences of itself: new-user trial nuL, Ty
+    holding 8 % of Fx, was called distorted, 44 of 44 lines), not products of ``channel``'s own lines; or None."""
+    from .units import CHANNELS
+
+    rows = [(i, m) for i, m in enumerate(matched) if m is not None and m.size]
+    for source in (c for c in CHANNELS if c not in (channel, partner)):
+        if not rows or not all(test.runs[i].usable(source) for i, _ in rows):
+            continue
+        cross, own, power = 0j, 0.0, 0.0
+        spectra = []
+        for i, m in rows:
+            y, z = _spectrum(np.stack([np.asarray(test.runs[i].signals[c], dtype=float) for c in (channel, source)]))
+            spectra.append((y[m], z[m]))
+            cross += np.vdot(z[m], y[m])
+            own += float(np.vdot(z[m], z[m]).real)
+            power += float(np.vdot(y[m], y[m]).real)
+        a = cross / own if own > 0 else 0.0
+        if not 0.0 < abs(a) < 1.0:
+            continue        # the copy is the weaker way round: a distorted source read back from its copy is not one
+        y, z = (np.concatenate(v) for v in zip(*spectra))
+        left = float(np.sum(np.abs(y - a * z) ** 2))
+        # held by the power (the strongest bins) and bin by bin (the median), so one strong bin does not decide it
+        if power > 0 and left <= (1.0 - COPY_EXPLAINED) * power and \
+                float(np.median(np.abs(y - a * z) / np.maximum(np.abs(y), 1e-300))) <= 1.0 - COPY_EXPLAINED:
+            return source
+    return None
 
 
 def _undo(runs: list, matched: list, alone: np.ndarray, channel: str, partner: str) -> tuple:
@@ -285,7 +333,7 @@ def corrected(test) -> tuple:
         for channel, partner in (pair, pair[::-1]):
             matched, alone, chance = _channel_matches(test, channel, partner, powers)
             before = _verdict(matched, alone, chance)
-            if before is None or not before["distorted"]:
+            if before is None or not before["distorted"] or _copy_source(test, channel, partner, matched):
                 continue
             fixed, coef = _undo(runs, matched, alone, channel, partner)
             second = [coef[i][0] for i in fixed]
