@@ -113,15 +113,25 @@ def _running_median(x: np.ndarray, half: int) -> np.ndarray:
     return running_median(x, 2 * half + 1, mode="nearest")
 
 
-def _lower_course(lf: np.ndarray, k_lo: int, k_hi: int) -> np.ndarray:
-    """The floor's lower course (dB per bin, ``lf`` smoothed by a running median over
-    :data:`HUMP_WIDE_SMOOTH_FRACTION` of the band): at each bin of [k_lo, k_hi] the higher of the lowest value on its
-    left and the lowest on its right, so only what rises and falls again stands over it."""
+def _over(top_db: np.ndarray, base_db: np.ndarray, beside=None) -> np.ndarray:
+    """``top_db`` over ``base_db`` (dB per bin); with ``beside`` (a floor the model holds already, per bin, in the
+    same unit as the dB's power), both with it added: a residual floor's hump counted against all the floor there."""
+    if beside is None:
+        return top_db - base_db
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):    # -inf (no floor) stays -inf
+        return 10 * np.log10((10 ** (top_db / 10) + beside) / (10 ** (base_db / 10) + beside))
+
+
+def _lower_course(lf: np.ndarray, k_lo: int, k_hi: int, beside=None) -> np.ndarray:
+    """The floor ``lf`` (dB per bin) over its lower course (``lf`` smoothed by a running median over
+    :data:`HUMP_WIDE_SMOOTH_FRACTION` of the band: at each bin of [k_lo, k_hi] the higher of the lowest value on its
+    left and the lowest on its right, so only what rises and falls again stands over it), dB; ``beside``: as
+    :func:`_over`."""
     half = max(int(HUMP_WIDE_SMOOTH_FRACTION * (k_hi - k_lo) / 2), HUMP_MIN_BINS)
     smooth = _running_median(lf, half)
     course = np.full(lf.size, np.inf)
     course[k_lo:k_hi + 1] = _course(smooth[k_lo:k_hi + 1])
-    return smooth - course
+    return _over(smooth, course, beside)
 
 
 def _course(x: np.ndarray) -> np.ndarray:
@@ -155,10 +165,13 @@ def _humps(excess_db: np.ndarray, k_lo: int, k_hi: int, max_width: int | None = 
     return out
 
 
-def clean_floor(ctx, state, c: str) -> np.ndarray:
+def clean_floor(ctx, state, c: str, less_class_floor: bool = False) -> np.ndarray:
     """The data's own noise floor of channel ``c`` per bin (n_f,): the median over the runs of the data's PSD at the
     bins where the model's lines stand below :data:`CLEAN_LINE_FRACTION` of its floor in that run (the noise alone,
-    clear of every line's leakage and of a misfit of it), NaN where fewer than a quarter of the runs (and 3) are."""
+    clear of every line's leakage and of a misfit of it), NaN where fewer than a quarter of the runs (and 3) are.
+    ``less_class_floor``: each run's PSD less the ``broadband_floor`` class's floor at that run's speed first (the
+    floor the class explains; taken off run by run, as the runs clear of lines differ from bin to bin: the class's
+    floor at one speed taken off the median of other runs leaves humps where those runs are faster or slower)."""
     from .reduce import column_nanmedian
 
     runs = ctx.runs
@@ -167,9 +180,22 @@ def clean_floor(ctx, state, c: str) -> np.ndarray:
     D = ctx.data(state, c, runs)[runs]
     N = ctx.floor_psd(state, c, runs)
     clean = ((ctx.predict(state, c, runs) - N) < CLEAN_LINE_FRACTION * N) & ~line_skirts(ctx, state, c, runs)
+    if less_class_floor:
+        D = D - (N - np.asarray(state.noise[c]))
     count = clean.sum(0)
     med = column_nanmedian(np.where(clean, D, np.nan))
     return np.where(count >= max(3, runs.size // 4), med, np.nan)
+
+
+def _class_floor(ctx, state, c: str):
+    """The ``broadband_floor`` class's floor of channel ``c`` (per bin, the median over the runs of its value at each
+    run's speed), or None when the class holds none there.  What stands over the residual floor's course stands over
+    all the floor only when it stands over this as well: where the class's floor rises 40 dB over the instrument's
+    (nuI c6, a 400 Hz hump growing as Ω² named a floor), a 1 % misfit of its shape is a 20 dB hump of the residual."""
+    if c not in state.floors:
+        return None
+    ref, w_ref, p = state.floors[c]
+    return ref * float(np.median((np.abs(ctx.omega[ctx.runs]) / w_ref) ** p))
 
 
 def broadband_hump(ctx, state, shares) -> list:
@@ -186,19 +212,17 @@ def broadband_hump(ctx, state, shares) -> list:
     half = max(int(HUMP_BASELINE_FRACTION * (k_hi - k_lo) / 2), 3 * HUMP_MIN_BINS)
     floors = {}
     for c in ctx.channels:
-        fl = clean_floor(ctx, state, c)
-        if c in state.floors:                   # a floor the broadband_floor class holds is explained
-            ref, w_ref, p = state.floors[c]
-            fl = fl - ref * (np.median(ctx.omega[ctx.runs]) / w_ref) ** p
+        fl = clean_floor(ctx, state, c, less_class_floor=True)  # a floor the broadband_floor class holds is explained
         valid = np.isfinite(fl) & (fl > 0)
         if valid[k_lo:k_hi + 1].sum() < 4 * HUMP_MIN_BINS:
             continue
         k = np.arange(fl.size)
         lf = np.interp(k, k[valid], 10 * np.log10(fl[valid]))
         lf = np.convolve(lf, np.ones(3) / 3.0, mode="same")
-        excess = np.where(valid, lf - _running_median(lf, half), -np.inf)
-        wide = np.where(valid, _lower_course(lf, k_lo, k_hi), -np.inf)
-        floors[c] = (fl, lf)
+        held = _class_floor(ctx, state, c)
+        excess = np.where(valid, _over(lf, _running_median(lf, half), held), -np.inf)
+        wide = np.where(valid, _lower_course(lf, k_lo, k_hi, held), -np.inf)
+        floors[c] = (fl, lf if held is None else 10 * np.log10(10 ** (lf / 10) + held))
         narrow = _humps(excess, k_lo, k_hi)
         # a wide hump peaks: a floor shaped by the chain's high-pass and anti-alias filters is a plateau
         broad = [(k0, k1, pk) for k0, k1, pk in _humps(wide, k_lo, k_hi, k_hi - k_lo, HUMP_WIDE_PEAK_DB)
@@ -215,7 +239,7 @@ def broadband_hump(ctx, state, shares) -> list:
         f0, f1, fp = ctx.f[k0], ctx.f[k1], ctx.f[peak[3]]
         if _at_a_fitted_resonance(ctx, state, fp, chans):
             continue
-        width = float(_half_power_width(ctx, floors[peak[0]][1], peak[3]))
+        width = float(_half_power_width(ctx, floors[peak[0]][1], peak[3]))     # of all the floor, the class's too
         kurt = impulsiveness(ctx, state, chans, ctx.runs, fp, 0.5 * width)
         if kurt is not None and kurt < LINE_KURTOSIS:
             continue                # a line stands in it (a sinusoid's kurtosis is 1.5): the line detectors' to say
@@ -514,16 +538,31 @@ def humps_in_some_runs(ctx, state, shares, every=()) -> list:
 RESONANCE_HALF_WIDTHS = 3.0
 
 
+#: The largest damping ratio of a suspension mode's window in :func:`_at_a_fitted_resonance` (three half widths)
+MODE_ZETA_MAX = 0.05
+
+
 def _at_a_fitted_resonance(ctx, state, f_peak: float, chans) -> bool:
-    """True when a fixed resonance of ``state`` (the ``fixed_resonance`` class: a test stand's or a wheel mode's) on
-    one of ``chans`` peaks within :data:`RESONANCE_HALF_WIDTHS` ζ·f_r (and a band) of ``f_peak``: the hump is the
-    noise through that resonance, which the class names."""
+    """True when a fixed resonance of ``state`` (the ``fixed_resonance`` class: a test stand's or a wheel mode's), or
+    a suspension mode of its extended base whose frequency does not move with the speed (the axial mode on Fz, the
+    radial translation on the radial forces) where a ``broadband_floor`` class holds the channel, on one of ``chans``
+    peaks within :data:`RESONANCE_HALF_WIDTHS` ζ·f_r (and a band; a mode's ζ at most :data:`MODE_ZETA_MAX`, and a bin)
+    of ``f_peak``: the hump is the noise through that resonance, which a class names (family wheel 6's floor through
+    its 85 Hz axial mode of ζ 0.011, narrower than the floor class's knots, was a hump of what it left)."""
     from .constants import BAND_BINS
 
-    for f_r, zeta, _, on, *_ in state.resonances:        # (f_r, ζ, g, channels[, gain above])
-        if set(on) & set(chans) and abs(f_peak - f_r) <= RESONANCE_HALF_WIDTHS * zeta * f_r + BAND_BINS * ctx.df:
-            return True
-    return False
+    # (f_r, ζ, channels, slack): a class's resonance within a band; a suspension mode within a bin (its frequency
+    # is fitted on the lines: a hump of the floor a band off it is not its)
+    found = [(f_r, zeta, on, BAND_BINS * ctx.df) for f_r, zeta, _, on, *_ in state.resonances]
+    if state.ext is not None:
+        # only where a floor class holds the channel (its knots may cut a narrow mode's peak; without one, the noise
+        # through the mode is no class's, and a hump there is described), a lightly damped mode's own width
+        e = state.ext
+        found += [(f, min(zeta, MODE_ZETA_MAX), tuple(c for c in on if c in state.floors), ctx.df)
+                  for f, zeta, on in ((e.omega_z / (2 * np.pi), e.zeta_z, ("Fz",)),
+                                      (e.omega_r / (2 * np.pi), e.zeta_r, ("Fx", "Fy")))]
+    return any(set(on) & set(chans) and abs(f_peak - f_r) <= RESONANCE_HALF_WIDTHS * zeta * f_r + slack
+               for f_r, zeta, on, slack in found)
 
 
 def _half_power_width(ctx, log_floor: np.ndarray, pk: int) -> float:
