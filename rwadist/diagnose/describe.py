@@ -20,6 +20,7 @@ import numpy as np
 
 from .engine import Context
 from .fixed_lines import describe_fixed_lines, find_fixed_lines, remove_fixed_lines
+from .run_order import read_in_recorded_order as in_order
 from .state import State
 
 
@@ -383,7 +384,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out += drifting + [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)
                        and not any(same_track(u, v) for v in drifting)]
     read = structure.line_ratios(res.ctx, res.state) if changes else ratios
-    out += annotate(ctx, state, structure.run_change(ctx, read, of_runs), read, taken_out=changes)
+    out += annotate(ctx, state, structure.run_change(ctx, read, of_runs, in_order(ctx, read)), read, taken_out=changes)
     out += speed_lines(ctx, state, of_line, bearings, others, ctx.left_out)
     out += partial_lines(ctx, state, structure.line_ratios(ctx, state, absent=True), of_line)
     sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)

@@ -220,18 +220,20 @@ def _changed_runs(ctx, ratios: list) -> tuple | None:
     return np.flatnonzero(off), dev[ok], off[ok], scatter, np.flatnonzero(~ok)
 
 
-def run_change(ctx, ratios: list, shares) -> list:
+def run_change(ctx, ratios: list, shares, order: dict | None = None) -> list:
     """A run-to-run change: every line of a run (all directions together) off the model by a common factor (a load
     cell's gain drifting over the test, a wheel re-mounted between runs, an amplifier's range switched).  Each
     line's dB ratio less its own smooth trend with speed, the median over the run's lines (:func:`_run_deviations`);
     described when :data:`RUN_MIN_RUNS` runs (a fifth of them at least) stand beyond :data:`RUN_SCATTER_DB` and
     beyond 3 × the runs' robust scatter (a few runs switched: the others stay on the trend), or the robust scatter
-    itself exceeds :data:`RUN_SCATTER_DB` (a drift in the order of recording, the speeds shuffled).  ``pattern``
-    "step" (the first case, a few runs off the others' trend: a re-mounting or a range switched named first) or
-    "spread" (a drift named first)."""
+    itself exceeds :data:`RUN_SCATTER_DB` (a drift in the order of recording, the speeds shuffled); first, where the
+    order of recording is known, a step or a drift read in it (``order``: :func:`.run_order.read_in_recorded_order`,
+    made by the caller: a step sets the runs recorded after it apart, a drift every run).  ``pattern`` "step" (a few
+    runs off the others' trend: a re-mounting or a range switched named first) or "spread" (a drift named first)."""
     if not ratios:
         return []
-    got = _changed_runs(ctx, ratios)
+    order = order or {"recorded_order": "unknown", "kind": None}
+    got = order["runs"] if order["kind"] is not None else _changed_runs(ctx, ratios)
     if got is None:
         return []
     idx, dev, off, scatter, unread = got
@@ -242,14 +244,18 @@ def run_change(ctx, ratios: list, shares) -> list:
 
     names = names_of(idx)
     share, _ = shares(ctx.runs[idx])
-    timed = _time_order_note(ctx)
     # a step: a few runs set apart from others that stay on their trend (the scatter small), whatever their factors
     # (two re-mountings may go opposite ways; a drift moves every run); a spread: the runs' offsets scattered beyond
     # RUN_SCATTER_DB (a drift in the order of recording)
-    step = scatter < RUN_SCATTER_DB
-    drift = "the load cell's or its amplifier's gain drifting over the test (temperature, a bridge supply)"
-    steps = ("the wheel or the fixture re-mounted or re-torqued between runs",
-             "an amplifier range or filter switched between runs")
+    step = order["kind"] == "step" if order["kind"] is not None else scatter < RUN_SCATTER_DB
+    words = order.get("words", "")
+    causes = (("the wheel or the fixture re-mounted or re-torqued between runs" + (words if step else ""),
+               "an amplifier range or filter switched between runs"),
+              ("the load cell's or its amplifier's gain drifting over the test (temperature, a bridge supply)" +
+               ("" if step else words),))
+    tell = ("a repeated run at one speed at the start and the end of the test" if order["recorded_order"] == "known"
+            else "the runs in the order they were recorded (a drift grows with time; a re-mounting is a step) and a "
+                 "repeated run at one speed at the start and the end of the test")
     return [Unexplained(
         signature="run_change", channels=tuple(ctx.channels), speed_rpm=(float(rpm.min()), float(rpm.max())),
         f_Hz=(float(np.min(np.concatenate([r.f for r in ratios]))), float(np.max(np.concatenate([r.f for r in ratios])))),
@@ -257,22 +263,9 @@ def run_change(ctx, ratios: list, shares) -> list:
         parameters={"scatter_dB": float(scatter), "largest_dB": float(np.max(np.abs(dev))),
                     "runs": names, "run_speeds_rpm": [float(x) for x in rpm],
                     "run_offsets_dB": [float(x) for x in dev[off]], "runs_not_read": names_of(unread),
-                    "pattern": "step" if step else "spread", **timed},
-        causes=steps + (drift,) if step else (drift,) + steps,
-        would_tell="the runs in the order they were recorded (a drift grows with time; a re-mounting is a step) and a "
-                   "repeated run at one speed at the start and the end of the test")]
-
-
-def _time_order_note(ctx) -> dict:
-    """{"recorded_order": "known"} and the runs' order by start time when the runs carry distinct start times,
-    else {"recorded_order": "unknown"}."""
-    test = ctx.test
-    if test is None:
-        return {"recorded_order": "unknown"}
-    t0 = np.array([getattr(test.runs[r], "t0", 0.0) for r in ctx.runs], dtype=float)
-    if np.unique(t0).size < t0.size:
-        return {"recorded_order": "unknown"}
-    return {"recorded_order": "known"}
+                    "pattern": "step" if step else "spread", "recorded_order": order["recorded_order"],
+                    **order.get("parameters", {})},
+        causes=causes[0] + causes[1] if step else causes[1] + causes[0], would_tell=tell)]
 
 
 # ----------------------------------------------------------------------------------------------- moving resonance

@@ -34,7 +34,7 @@ class Run:
         :func:`rwadist.data_quality.screen`): their spectra are left out of this run (as for an absent channel).
     recorded : the run's position in the order the runs were recorded (a steady test's ``runs.csv`` rows, read so
         before the runs are sorted by speed); -1 when not known.  Read only to tell a change between runs in time
-        (:mod:`rwadist.diagnose.describe_line_step`).
+        (:mod:`rwadist.diagnose.describe_line_step`, :mod:`rwadist.diagnose.run_order`).
     """
 
     speed: float
