@@ -430,7 +430,13 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
     n_bin, _ = presence_curve(h_grid, strict, f_lo, f_hi)
     cand, _ = signal.find_peaks(np.concatenate([[0], n_bin, [0]]), height=s.min_detections,
                                 distance=max(int(s.epsilon / step), 1))
-    h = h_grid[cand - 1]
+    # lines 2ε apart (a carrier, its speed sideband at 0.04: trial nuL) abut at ±ε, the weaker a shoulder, no peak;
+    # at ±ε/2 each is its own, and a line seen twice is one once refined (candidates within ε merged below)
+    half = replace(lines, pair_tol=np.full_like(lines.pair_tol, s.epsilon / 2))
+    n_half, _ = presence_curve(h_grid, half, f_lo, f_hi)
+    more, _ = signal.find_peaks(np.concatenate([[0], n_half, [0]]), height=s.min_detections,
+                                distance=max(int(s.epsilon / 2 / step), 1))
+    h = h_grid[np.union1d(cand, more) - 1]
     for _ in range(2):
         fpk = lines.match(h)
         ok = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)

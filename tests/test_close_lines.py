@@ -58,8 +58,9 @@ def test_a_pair_one_welch_lobe_apart_on_the_e_like_wheel():
     test, _ = iw.generate(np.linspace(300.0, 3000.0, 20), lines=lines, seed=0)
     d = api.diagnose(test)
     _assert_pair(d, [(h, C * iw.C_UNIT) for h, C in pair])
-    base = [e for e in d.summary()["base_lines"] if e["direction"] == "radial_force"]
-    assert [round(e["h"], 3) for e in base] == [0.4]
+    # the base's own fit holds both: its candidates are read at ±ε/2 as well (session 58: two lines 0.03 apart, 1.5ε,
+    # made one plateau at ±ε, and the base held their blend, 0.4 completed after it)
+    assert [e for e in d.summary()["base_lines"] if e["direction"] == "radial_force"] == []
 
 
 def test_a_cage_line_beside_an_added_line_on_a_family_wheel():
