@@ -11,6 +11,7 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -85,3 +86,15 @@ def test_a_distorted_channel_copied_into_another_is_still_the_distorted_one(whee
     _, records = channel_distortion.corrected(test)
     assert [r["channel"] for r in records] == ["Fx"], records
     assert records[0]["second_order"] == pytest.approx(0.02, rel=0.12)
+
+
+def test_a_correction_that_diverges_is_not_applied(wheels):
+    """The copy's lines taken for products anyway (the check before the correction bypassed): the law fitted to them
+    diverges in its inverse; the code before raised LinAlgError there (the trial's exit 3), now no run is changed by
+    a law that diverges and every sample stays finite."""
+    test = family_test.steady_test(fw.steady(doubled(wheels[0]), seed=1, effects=[fe.Crosstalk("Fx", "Ty", 0.08)]))
+    matched, alone, _ = channel_distortion._channel_matches(test, "Ty", "Tx")
+    runs = list(test.runs)
+    fixed, coef = channel_distortion._undo(runs, matched, alone, "Ty", "Tx")
+    assert all(np.all(np.isfinite(r.signals["Ty"])) for r in runs)
+    assert all(np.all(np.isfinite(v)) for v in coef.values()) and sorted(coef) == fixed
