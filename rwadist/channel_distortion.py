@@ -217,25 +217,24 @@ def _copy_source(test, channel: str, partner: str, matched: list) -> str | None:
     from .units import CHANNELS
 
     rows = [(i, m) for i, m in enumerate(matched) if m is not None and m.size]
-    for source in (c for c in CHANNELS if c not in (channel, partner)):
-        if not rows or not all(test.runs[i].usable(source) for i, _ in rows):
-            continue
-        cross, own, power = 0j, 0.0, 0.0
-        spectra = []
-        for i, m in rows:
-            y, z = _spectrum(np.stack([np.asarray(test.runs[i].signals[c], dtype=float) for c in (channel, source)]))
-            spectra.append((y[m], z[m]))
-            cross += np.vdot(z[m], y[m])
-            own += float(np.vdot(z[m], z[m]).real)
-            power += float(np.vdot(y[m], y[m]).real)
-        a = cross / own if own > 0 else 0.0
+    sources = [c for c in CHANNELS if c not in (channel, partner)
+               and rows and all(test.runs[i].usable(c) for i, _ in rows)]
+    if not sources:
+        return None
+    # every run's spectra at its matched bins, once: (the channel, then each source)
+    at = [_spectrum(np.stack([np.asarray(test.runs[i].signals[c], dtype=float) for c in (channel, *sources)]))[:, m]
+          for i, m in rows]
+    y = np.concatenate([a[0] for a in at])
+    for j, source in enumerate(sources, start=1):
+        z = np.concatenate([a[j] for a in at])
+        own = float(np.vdot(z, z).real)
+        a = np.vdot(z, y) / own if own > 0 else 0.0
         if not 0.0 < abs(a) < 1.0:
             continue        # the copy is the weaker way round: a distorted source read back from its copy is not one
-        y, z = (np.concatenate(v) for v in zip(*spectra))
-        left = float(np.sum(np.abs(y - a * z) ** 2))
+        left = np.abs(y - a * z)
         # held by the power (the strongest bins) and bin by bin (the median), so one strong bin does not decide it
-        if power > 0 and left <= (1.0 - COPY_EXPLAINED) * power and \
-                float(np.median(np.abs(y - a * z) / np.maximum(np.abs(y), 1e-300))) <= 1.0 - COPY_EXPLAINED:
+        if float(np.sum(left**2)) <= (1.0 - COPY_EXPLAINED) * float(np.vdot(y, y).real) and \
+                float(np.median(left / np.maximum(np.abs(y), 1e-300))) <= 1.0 - COPY_EXPLAINED:
             return source
     return None
 

@@ -424,19 +424,16 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
     h_hi = min(s.h_range[1], f_hi / lines.pair_speed_hz.min())
     step = s.epsilon / 4
     h_grid = np.arange(s.h_range[0], h_hi + step, step)
-    # candidates from the strict tolerance ε only: the half-bin widening at low speed would
-    # smear two close harmonics into one peak; presence below uses the widened tolerance
-    strict = replace(lines, pair_tol=np.full_like(lines.pair_tol, s.epsilon))
-    n_bin, _ = presence_curve(h_grid, strict, f_lo, f_hi)
-    cand, _ = signal.find_peaks(np.concatenate([[0], n_bin, [0]]), height=s.min_detections,
-                                distance=max(int(s.epsilon / step), 1))
-    # lines 2ε apart (a carrier, its speed sideband at 0.04: trial nuL) abut at ±ε, the weaker a shoulder, no peak;
-    # at ±ε/2 each is its own, and a line seen twice is one once refined (candidates within ε merged below)
-    half = replace(lines, pair_tol=np.full_like(lines.pair_tol, s.epsilon / 2))
-    n_half, _ = presence_curve(h_grid, half, f_lo, f_hi)
-    more, _ = signal.find_peaks(np.concatenate([[0], n_half, [0]]), height=s.min_detections,
-                                distance=max(int(s.epsilon / 2 / step), 1))
-    h = h_grid[np.union1d(cand, more) - 1]
+    # candidates from the strict tolerance ε only: the half-bin widening at low speed would smear two close harmonics
+    # into one peak (presence below uses the widened tolerance); and from ε/2: lines 2ε apart (a carrier, its speed
+    # sideband at 0.04: trial nuL) abut at ±ε, the weaker a shoulder, no peak (a line seen twice is one once refined:
+    # candidates within ε merged below)
+    cand = []
+    for tol in (s.epsilon, s.epsilon / 2):
+        n_bin, _ = presence_curve(h_grid, replace(lines, pair_tol=np.full_like(lines.pair_tol, tol)), f_lo, f_hi)
+        cand.append(signal.find_peaks(np.concatenate([[0], n_bin, [0]]), height=s.min_detections,
+                                      distance=max(int(tol / step), 1))[0])
+    h = h_grid[np.union1d(*cand) - 1]
     for _ in range(2):
         fpk = lines.match(h)
         ok = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)

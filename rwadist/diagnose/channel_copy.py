@@ -53,12 +53,12 @@ TORQUE_ROW = {"Tx": (("Fz", 1.0), ("Fy", -1.0)), "Ty": (("Fx", 1.0), ("Fz", -1.0
 LEVER_MISFIT_RATIO = 2.0
 #: The other channel of a radial pair.
 PARTNER = {"Fx": "Fy", "Fy": "Fx", "Tx": "Ty", "Ty": "Tx"}
-#: The lever-arm pairs of a radial force in a radial torque, each with its mirror: an offset r_z reads in both
+#: The lever-arm pairs of a radial force in a radial torque (mirrors of each other): an offset r_z reads in both
 #: (T_y = r_z·F_x with T_x = −r_z·F_y), a load cell's or an amplifier's crosstalk in one.  Tried on the lines
 #: (:func:`_mirror_missing`): the classic cross-talk of a six-axis cell, a force into a moment, undeclared, left the
 #: family's wheel 0 (Ty += 0.08·Fx, Fx's noise under Ty's own) with its rocking mode lost, a counter-rotating part
 #: named on the radial torque and no word of a copy
-RADIAL_LEVER = {("Fx", "Ty"): ("Fy", "Tx"), ("Fy", "Tx"): ("Fx", "Ty")}
+RADIAL_LEVER = {("Fx", "Ty"), ("Fy", "Tx")}
 #: ... one channel's copy when the mirror's torque departs from −κ × its force, at the copy's lines and runs where
 #: that would stand CLEAR_COPY_DB over the mirror's noise, by more than this share of it (median): an offset's mirror
 #: holds it to the wheel's own torque there (which the copy's points, where κ·F dominates, keep small)
@@ -259,12 +259,13 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
 
 def _mirror_missing(copy: ChannelCopy, X: np.ndarray, src: np.ndarray, chans: tuple, run_of: np.ndarray,
                     h: np.ndarray, noise: np.ndarray) -> bool:
-    """Whether ``copy`` (a radial force in a radial torque, :data:`RADIAL_LEVER`) lacks its mirror: at the mirror
+    """Whether ``copy`` (a radial force in a radial torque, :data:`RADIAL_LEVER`) lacks its mirror
+    (:data:`LEVER_ARM_MIRROR`): at the mirror
     force's points of the copy's lines and runs where −κ × that force would stand :data:`CLEAR_COPY_DB` over the
     mirror torque's noise (in :data:`MIN_RUNS` runs at least), the median of |X_mirror torque + κ·X_mirror force −
     r·X_Fz| (r real, least squares: an offset's lateral term) over |κ·X_mirror force| exceeds :data:`MIRROR_MISFIT`.  ``X`` (P, K), ``src``, ``run_of``, ``h``, ``noise`` (P, K): the
     lines' points of :func:`find_channel_copies`."""
-    ms, mt = RADIAL_LEVER[(copy.source, copy.target)]
+    ms, mt = LEVER_ARM_MIRROR[(copy.source, copy.target)]
     if ms not in chans or mt not in chans:
         return False
     s, t = chans.index(ms), chans.index(mt)
@@ -274,10 +275,11 @@ def _mirror_missing(copy: ChannelCopy, X: np.ndarray, src: np.ndarray, chans: tu
     if np.unique(run_of[sel][heard]).size < MIN_RUNS:
         return False
     left = X[sel, t][heard] - pred[heard]
-    if "Fz" in chans:
-        # the mirror torque's other term, an offset's lateral part times the axial force (T_x = r_y·F_z − r_z·F_y,
-        # T_y = r_z·F_x − r_x·F_z): r real, fitted by least squares, taken off too
-        fz = X[sel, chans.index("Fz")][heard]
+    other = next(f for f, _ in TORQUE_ROW[mt] if f != ms)
+    if other in chans:
+        # the mirror torque's other term of r × F, an offset's lateral part times the axial force (T_x = r_y·F_z −
+        # r_z·F_y): r real, fitted by least squares, taken off too
+        fz = X[sel, chans.index(other)][heard]
         A, b = np.concatenate([fz.real, fz.imag]), np.concatenate([left.real, left.imag])
         left = left - (float(A @ b / (A @ A)) if A @ A > 0 else 0.0) * fz
     return float(np.median(np.abs(left) / np.abs(pred[heard]))) > MIRROR_MISFIT
