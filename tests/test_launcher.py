@@ -40,11 +40,11 @@ def _masks(pid: int):
     return exe, field["SigBlk"], field["SigCgt"]
 
 
-def _ctrl_c(cwd, when) -> tuple:
+def _ctrl_c(cwd, when, env=None) -> tuple:
     """Start the command in its own process group, wait until ``when(exe, blocked, caught)`` is true (or
     ``when`` s), Ctrl-C as a terminal sends it (to the group); (exit code, stderr, the /proc state it was sent in)."""
     proc = subprocess.Popen([_launcher()] + LONG, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True,
+                            text=True, start_new_session=True, env=env,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     seen = None
     if callable(when):
@@ -78,6 +78,17 @@ def _in_the_interpreter(exe, blocked, caught) -> bool:
     return "python" in Path(exe).name and bool(caught & INT_BIT) and not caught & TERM_BIT
 
 
+def _slow_site(tmp_path) -> dict:
+    """An environment whose interpreter stays 0.3 s in ``site`` (a ``sitecustomize`` that sleeps): Python's SIGINT
+    handler is in place there and rwadist's is not, the instant that printed the traceback.  Without it the poll of
+    /proc caught that instant in 1 start of 30 on a loaded CI machine, and the test failed by chance."""
+    slow = tmp_path / "slow_site"
+    slow.mkdir(exist_ok=True)
+    (slow / "sitecustomize.py").write_text("import time\ntime.sleep(0.3)\n")
+    path = os.pathsep.join(p for p in (str(slow), os.environ.get("PYTHONPATH", "")) if p)
+    return {**os.environ, "PYTHONPATH": path}
+
+
 def _in_the_shell(exe, blocked, caught) -> bool:
     """The launcher's shell with its trap set (mostly waiting for ``env --block-signal=INT --version``: can env
     block signals?)."""
@@ -89,12 +100,13 @@ def test_ctrl_c_while_the_launcher_or_python_starts_is_one_line_and_130(tmp_path
     """Aimed at the interpreter's start, where pip's console script alone printed the traceback every time, and at
     the launcher's shell after its trap.  Every try: no traceback, one line and 130 -- or, from the shell, killed by
     the signal without a word when it landed in ``env`` before env blocked it (a shell reports 130).  Two tries
-    must land at the instant aimed at (a process that passed it unseen is tried again: up to 30 starts, as on a loaded
-    machine the poll of /proc misses the interpreter's instant in most starts; CI hit it once in 10)."""
+    must land at the instant aimed at (a process that passed it unseen is tried again, up to 30 starts); the
+    interpreter is held in ``site`` for 0.3 s so that its instant is there to be hit on a loaded machine."""
     when = _in_the_shell if where == "shell" else _in_the_interpreter
+    env = _slow_site(tmp_path) if where == "interpreter" else None
     hits = 0
     for _ in range(30):
-        code, err, seen = _ctrl_c(tmp_path, when)
+        code, err, seen = _ctrl_c(tmp_path, when, env)
         assert "Traceback" not in err and "Fatal Python error" not in err, err
         silent = where == "shell" and code == -signal.SIGINT and err == ""
         assert _one_line_130(code, err) or silent, (code, err)
