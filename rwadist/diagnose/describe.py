@@ -250,13 +250,16 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
     added = {(getattr(h.effect, "direction", None), round(float(getattr(h.effect, "h", np.nan)), 3))
              for h in diag.hypotheses if h.passed and not h.base_line}
     fitted = not diag.model_given or diag.state_after.base != diag.state_before.base
+    # a line an effect names (a sideband pair's) has that effect for its cause: read by the others, given none
+    named = {(d, round(float(h), 3)) for e in diag.model.typed_effects()
+             for d, h in getattr(e, "named_lines", tuple)()}
     lines = [(d, float(x.h)) for d in DIRECTIONS for x in diag.model.harmonics(d)]
     every = sorted({h for _, h in lines} | {float(h) for h in extra_h})
     out = []
     seen = set()
     for d, h in lines:
         # a line with a co- and a counter-rotating part is two harmonics at one h: one line, named once
-        if (d, h) in seen:
+        if (d, h) in seen or (d, round(h, 3)) in named:
             continue
         seen.add((d, h))
         if abs(h - round(h)) <= 2 * res:

@@ -54,6 +54,12 @@ class Element(Effect):
         also give the generic line."""
         return None
 
+    def named_lines(self) -> tuple:
+        """The model's lines this effect names, ((direction, h), ...): lines the search put into the model as its
+        record (a sideband pair's two lines), whose cause is the effect itself, not a bearing ratio or a
+        combination of other lines; none by default."""
+        return ()
+
     # ------------------------------------------------------------------ what it does to the wheel's loads
     #: the FMU parameter that turns this kind's floors and speed modulation off (:class:`FmuSwitch`), or None
     FMU_SWITCH: ClassVar[FmuSwitch | None] = None

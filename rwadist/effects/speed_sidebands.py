@@ -26,6 +26,9 @@ class SpeedSidebands(Element):
     C_upper: float = field(metadata=check(COEFFICIENT))
     n_points: int | None = field(default=None, metadata=check(COUNT))
 
+    def named_lines(self) -> tuple:
+        return ((self.direction, float(self.h_lower)), (self.direction, float(self.h_upper)))
+
     @classmethod
     def describe(cls, e: Mapping) -> str:
         return (f"{words(e['direction'])}, lines at h {num(e['h_lower'])} and {num(e['h_upper'])} beside h "
