@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..dft import blocked_records, run_window, windowed_dfts
+from ..resonance import resonance
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .unexplained import Unexplained
 
@@ -76,6 +77,11 @@ def _cells(ctx, state, direction: str) -> tuple | None:
         X, Y = XY[:, :h.size, 0], XY[:, :h.size, 1]
         beside = (np.abs(XY[:, h.size:]) ** 2).sum(axis=2).reshape(len(batch), len(NOISE_BINS), h.size).mean(axis=1)
         power = np.abs(X) ** 2 + np.abs(Y) ** 2
+        # a fixed resonance of the state on one channel of the pair (a fixture swaying along one axis) lifts that
+        # channel and turns its phase: both taken off the x/y comparison, not read as a skew
+        gx, gy = _stand_gain(state, cx, f), _stand_gain(state, cy, f)
+        if not np.array_equal(gx, gy):
+            X, Y = X / gx, Y / gy
         with np.errstate(divide="ignore", invalid="ignore"):
             axis_db = 20 * np.log10(np.abs(Y) / np.abs(X))
             good = ((power >= MIN_SNR * beside) & (np.abs(axis_db) <= MAX_AXIS_DB) & (f > 4 * fs / n)
@@ -91,6 +97,16 @@ def _cells(ctx, state, direction: str) -> tuple | None:
         return None
     return (np.concatenate(f_all), np.concatenate(d_all), np.concatenate(li_all).astype(int),
             np.concatenate(ri_all).astype(int), h)
+
+
+def _stand_gain(state, channel: str, f: np.ndarray) -> np.ndarray:
+    """The complex gain H(f) (:func:`rwadist.resonance.resonance`) of the state's fixed resonances on ``channel``
+    at the line frequencies ``f`` (Hz, any shape); 1 where none acts on it."""
+    gain = np.ones(f.shape, dtype=complex)
+    for e in state.effects:
+        if getattr(e, "kind", "") == "fixed_resonance" and channel in e.channels:
+            gain *= resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)
+    return gain
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
