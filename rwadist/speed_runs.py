@@ -13,7 +13,7 @@ judged against its *own* uncertainty instead:
 * each line's frequency is refined to well below a bin by maximising the exact Hann-windowed transform of the run
   (:func:`zoom_peak`: a three-point log parabola at :data:`ZOOM` of a native bin, twice, about the padded peak), with
   its standard deviation from the Cramér-Rao bound of a tone in white noise at the line's SNR
-  (:func:`line_sigma`: ``df·√2 / (2π·√SNR)``, inflated by :data:`HANN_LOSS` for the window), and a floor
+  (:func:`line_sigma`: ``df·√2 / (2π·√SNR)``, inflated by :data:`rwadist.speed_check.HANN_LOSS` for the window), and a floor
   :data:`REL_FLOOR` (what the neighbouring lines' leakage leaves);
 * the run's relative speed error is the lines' inverse-variance mean of ``f_line/f_applied − 1``; its standard error
   is inflated by the lines' own disagreement (√(χ²/dof) when above 1).
@@ -37,12 +37,10 @@ from functools import lru_cache
 import numpy as np
 
 from .dft import BlockedRecords, blocked_records, demeaned_windowed, windowed_dft, windowed_dfts
-from .speed_check import LINES, LineReads, _window_and_bins, line_ratios
+from .speed_check import LINES, LineReads, _window_and_bins, line_ratios, tone_sigma
 
 #: spacing, in native bins, of the three exact transforms about a peak whose log parabola refines it
 ZOOM = 0.05
-#: variance inflation of a Hann-windowed frequency estimate over the rectangular window's Cramér-Rao bound
-HANN_LOSS = 1.5
 #: relative floor of one line's frequency uncertainty (leakage of the run's other lines, the window's bias)
 REL_FLOOR = 1.0e-5
 #: standard errors by which a run's mean speed must be off its column to be taken from its lines
@@ -148,13 +146,13 @@ def width_rel(curv: float, tone: float, f_line: float) -> float:
 def line_sigma(run, snr: float, f_line: float, lobe_share: float = 0.0) -> float:
     """Standard deviation (Hz) of a line's refined frequency: the Cramér-Rao bound of one tone in white noise,
     ``df·√2/(2π·√SNR)`` with SNR the line's power over the mean noise power of a bin (the local median / ln 2),
-    inflated by :data:`HANN_LOSS`, with the floor :data:`REL_FLOOR` · ``f_line``; and, in quadrature, the pull of a
+    inflated by :data:`rwadist.speed_check.HANN_LOSS`, with the floor :data:`REL_FLOOR` · ``f_line``; and, in quadrature, the pull of a
     neighbour inside the window's main lobe: :data:`NEIGHBOUR_GAIN` · df · √(``lobe_share`` less the noise's expected
     share, :func:`lobe_shares`): speed sidebands 1 bin from a 1× line moved its peak 0.086 % with its Cramér-Rao
     bound at 0.0056 % (the new-user trial's runs "off the column" at 720 rpm)."""
     df = float(run.sample_rate) / run.n_samples
     snr_mean = max(snr * np.log(2.0), 1e-12)
-    crb = df * np.sqrt(2.0 * HANN_LOSS) / (2 * np.pi * np.sqrt(snr_mean))
+    crb = float(tone_sigma(df, snr))
     excess = max(0.0, lobe_share - NOISE_MARGIN * _lobe_noise(run.n_samples, float(run.sample_rate)) / snr_mean)
     return float(np.hypot(max(crb, REL_FLOOR * f_line), NEIGHBOUR_GAIN * df * np.sqrt(excess)))
 
