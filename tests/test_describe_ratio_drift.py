@@ -71,6 +71,7 @@ def test_a_slipping_cages_ball_pass_lines_are_described_with_their_drift():
         assert inner.parameters["h_at_highest_speed"] == pytest.approx(BALLS - hi, rel=0.005)
         assert outer.parameters["drift_percent"] < 0 < inner.parameters["drift_percent"]
         assert "cage slipping" in outer.causes[0] and "falls" in outer.causes[0] and "rises" in inner.causes[0]
+        assert "inner-race ball pass" in inner.causes[0] and "inner-race" not in outer.causes[0]
     # no line read twice in a direction (a drifting line may be split in two by the fit's binning)
     dirs = [u.parameters["direction"] for u in got.values()]
     assert len(dirs) == len(set(zip(dirs, [round(u.parameters["h"], 1) for u in got.values()])))
@@ -157,10 +158,40 @@ def test_a_speed_line_of_no_model_that_drifts_is_described_as_the_drift():
     rpm = rows[:, 1]
     for h, r in ((h_lo, rpm.min()), (h_hi, rpm.max())):
         assert h == pytest.approx(outer * (1 - 0.05 * (r / RPM[-1]) ** 2), rel=0.005)
-    # the model's own drifting lines first (the axial force's), then this one
-    rec = ratio_drift(ctx, state, lambda chans, h, runs: (0.0, 0.0), found)[-1]
+    # the same track as the model's own drifting axial line (the generator's outer race on Fx/Fy and Fz): one record
+    # of both directions, read from both lines, beside the inner race's
+    recs = ratio_drift(ctx, state, lambda chans, h, runs: (0.0, 0.0), found)
+    (rec,) = [u for u in recs if abs(u.h - outer) < 0.15]
     assert rec.signature == "line_property" and rec.parameters["property"] == "ratio_drift"
-    assert rec.h == pytest.approx(a.h) and rec.parameters["drift_percent"] < -1.0
+    assert rec.channels == ("Fx", "Fy", "Fz") and rec.parameters["directions"] == ["axial_force", "radial_force"]
+    assert pytest.approx(a.h) in rec.parameters["model_h"] and rec.parameters["drift_percent"] < -1.0
+    assert len(recs) == 2
+
+
+def test_one_drifting_line_caught_as_two_ridges_is_one_record():
+    """New-user trial nuM: a line drifting 1.55 -> 1.85 over the speeds, in no model, was caught as two ridges (speed
+    lines at h 1.688 and 1.75, further apart than SAME_LINE), each read again as the drift over overlapping speeds
+    with the same readings in the runs both read, and described four times (twice per direction), its share counted
+    twice.  Here the radial-force outer-race line as two ridges 2.5 % apart, the axial force's (a third reading of the
+    track) taken out of the model: both read the drift, one record is made of them, spanning the readings of both."""
+    from dataclasses import replace
+
+    ctx, model = _context(0.05)
+    axial = [x for x in model.harmonics("axial_force") if abs(x.h - 3.2) > 0.3]
+    state = SimpleNamespace(model=replace(model, empirical={**model.empirical, "axial_force": axial}))
+    outer = BALLS * CAGE
+    ridges = [Unexplained(signature="speed_line", channels=("Fx", "Fy"), speed_rpm=(600.0, 3000.0), f_Hz=(30.0, 160.0),
+                          level_dB=15.0, share=0.01, n_runs=16, h=h, parameters={"direction": "radial_force", "h": h})
+              for h in (outer * 0.99, outer * 0.965)]
+    kept, found = drifting_speed_lines(ctx, state, ridges)
+    assert kept == [] and len(found) == 2                   # each ridge reads the drift
+    recs = [u for u in ratio_drift(ctx, state, lambda chans, h, runs: (0.0, 0.0), found) if abs(u.h - outer) < 0.2]
+    assert len(recs) == 1
+    (rec,) = recs
+    assert rec.channels == ("Fx", "Fy") and rec.parameters["model_h"] == pytest.approx([outer * 0.965, outer * 0.99])
+    lo, hi = (outer * (1 - 0.05 * (r / RPM[-1]) ** 2) for r in (RPM[0], RPM[-1]))
+    assert rec.parameters["h_at_highest_speed"] == pytest.approx(hi, rel=0.005)
+    assert rec.speed_rpm[1] == RPM[-1] and rec.n_runs <= RPM.size
 
 
 def _readings(h: np.ndarray, rpm: np.ndarray) -> np.ndarray:

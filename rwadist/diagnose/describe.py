@@ -539,9 +539,11 @@ def _drift_cells(u, res: Residual) -> dict:
     rows = np.flatnonzero((rpm >= u.speed_rpm[0] - 1e-6) & (rpm <= u.speed_rpm[1] + 1e-6))
     spin = rpm[rows] / 60.0
     h_run = np.interp(rpm[rows], np.asarray(p["readings_rpm"], float), np.asarray(p["readings_h"], float))
-    f_model, f_data = float(p["h"]) * spin, h_run * spin
-    lo = np.maximum(res.band_of(np.minimum(f_model, f_data)) - 1, 0)
-    hi = np.minimum(res.band_of(np.maximum(f_model, f_data)) + 1, ctx.n_bands - 1)
+    # from the model's line (the lowest and highest of those one drifting line was read from) to the data's
+    model_h = [float(x) for x in p.get("model_h") or [p["h"]]]
+    f_lo, f_hi, f_data = min(model_h) * spin, max(model_h) * spin, h_run * spin
+    lo = np.maximum(res.band_of(np.minimum(f_lo, f_data)) - 1, 0)
+    hi = np.minimum(res.band_of(np.maximum(f_hi, f_data)) + 1, ctx.n_bands - 1)
     out = {}
     for c in u.channels:
         if c in res.e:

@@ -212,32 +212,86 @@ def drifting(ctx, model) -> set:
     return out
 
 
+#: Two readings are one line's track when, in the runs both read (at least MIN_COMMON), their frequencies lie within
+#: this many Welch bins of each other in SAME_TRACK_SHARE of those runs or more
+TRACK_BINS = 0.5
+MIN_COMMON = 3
+SAME_TRACK_SHARE = 0.8
+
+
+def _same_track(a: np.ndarray, b: np.ndarray, df: float) -> bool:
+    """Whether readings ``a`` and ``b`` ((run, rpm, h_run) rows) follow one track: :data:`TRACK_BINS` of ``df`` Hz
+    apart in :data:`SAME_TRACK_SHARE` of the runs both read."""
+    common, ia, ib = np.intersect1d(a[:, 0], b[:, 0], return_indices=True)
+    if common.size < MIN_COMMON:
+        return False
+    gap = np.abs(a[ia, 2] - b[ib, 2]) * a[ia, 1] / 60.0
+    return float(np.mean(gap <= TRACK_BINS * df)) >= SAME_TRACK_SHARE
+
+
+def joined_tracks(readings: list, df: float) -> list:
+    """The drift readings (:func:`_drifts`' tuples) grouped by the track they follow (:func:`_same_track`), each group
+    led by its reading of the most runs: one drifting line read from two of the model's lines (split by its drift
+    more than :data:`SAME_LINE` apart: the new-user trial nuM's h 1.55 -> 1.85, in the model at 1.688 and 1.75, was
+    four records, two per direction, over overlapping speeds) or in two directions is one line."""
+    groups: list[list] = []
+    for x in sorted(readings, key=lambda x: -x[3].shape[0]):
+        group = next((g for g in groups if any(_same_track(y[3], x[3], df) for y in g)), None)
+        if group is None:
+            groups.append([x])
+        else:
+            group.append(x)
+    return groups
+
+
+def _cause(way: str, h_lo: float, h_hi: float, drift: float, rpm: np.ndarray) -> str:
+    """The bearing cause of a drifting line, worded for the way its ratio goes."""
+    span = f"from {h_lo:.4g} to {h_hi:.4g} ({100 * drift:+.1f} %) over {rpm.min():.0f}-{rpm.max():.0f} rpm"
+    if way == "falls":
+        return (f"a rolling bearing's cage slipping more as the speed grows: the line's ratio falls {span}, as the "
+                "cage's ratio and the outer race's ball pass (n × the cage's) fall together by one slip")
+    return (f"a rolling bearing's inner-race ball pass (BPFI = n − BPFO) as its cage slips more with the speed: the "
+            f"line's ratio rises {span}, while the cage's own line and the outer race's ball pass would fall by the "
+            "same slip")
+
+
 def ratio_drift(ctx, state, shares, more=()) -> list:
     """``line_property`` records (``ratio_drift``) of the model's lines (``state.model``) whose ratio to the speed
     drifts with it (module docstring), and of the readings ``more`` (:func:`drifting_speed_lines`: lines of no
-    model); ``shares(chans, h, runs)`` -> (share, level dB) of a line's cells."""
+    model), one per track (:func:`joined_tracks`: its directions' channels together, ``model_h`` the model's lines
+    it was read from); ``shares(chans, h, runs)`` -> (share, level dB) of a line's cells."""
+    from ..units import CHANNELS
+
     out: list[Unexplained] = []
-    for d, chans, h0, rows, (lo, hi), h_lo, h_hi in list(_drifts(ctx, state.model)) + list(more):
+    for group in joined_tracks(list(_drifts(ctx, state.model)) + list(more), float(ctx.sp.df)):
+        d, _, h0, rows, (lo, hi), _, _ = group[0]
+        seen = set(rows[:, 0])
+        for x in group[1:]:                     # the runs only the others read
+            extra = x[3][[r not in seen for r in x[3][:, 0]]]
+            rows = np.vstack([rows, extra])
+            seen |= set(extra[:, 0])
+        chans = tuple(c for c in CHANNELS if any(c in x[1] for x in group))
+        directions = list(dict.fromkeys(x[0] for x in group))
         rpm, h = rows[:, 1], rows[:, 2]
+        h_lo, h_hi = float(h[np.argmin(rpm)]), float(h[np.argmax(rpm)])
         drift = (h_hi - h_lo) / h0
         read = rows[:, 0].astype(int)
         order = np.argsort(rpm)
-        share, level = shares(chans, h0, read)
+        share, level = shares(chans, h0, np.unique(read))
         way = "falls" if drift < 0 else "rises"
+        joined = {} if len(group) == 1 else {"directions": directions,
+                                              "model_h": sorted({float(x[2]) for x in group})}
         out.append(Unexplained(
             signature="line_property", channels=chans, speed_rpm=(float(rpm.min()), float(rpm.max())),
             f_Hz=(float(h_lo * rpm.min() / 60.0), float(h_hi * rpm.max() / 60.0)), level_dB=level, share=share,
-            n_runs=int(rpm.size), h=h0,
-            parameters={"property": "ratio_drift", "direction": d, "h": h0, "h_at_lowest_speed": float(h_lo),
-                        "h_at_highest_speed": float(h_hi), "drift_percent": float(100 * drift),
+            n_runs=int(np.unique(read).size), h=h0,
+            parameters={"property": "ratio_drift", "direction": d, "h": h0, "h_at_lowest_speed": h_lo,
+                        "h_at_highest_speed": h_hi, "drift_percent": float(100 * drift),
                         "readings_rpm": [float(x) for x in rpm[order]],
                         "readings_h": [float(x) for x in h[order]],
                         "drift_interval_percent": [float(100 * lo * np.ptp(rpm) / h0),
-                                                   float(100 * hi * np.ptp(rpm) / h0)]},
-            causes=(f"a rolling bearing's cage slipping more as the speed grows: the line's ratio {way} from "
-                    f"{h_lo:.4g} to {h_hi:.4g} ({100 * drift:+.1f} %) over {rpm.min():.0f}-{rpm.max():.0f} rpm; "
-                    "the cage's ratio and the outer race's ball pass fall together, the inner race's rises "
-                    "(n − BPFO), so lines of one bearing drift by one slip",
+                                                   float(100 * hi * np.ptp(rpm) / h0)], **joined},
+            causes=(_cause(way, h_lo, h_hi, drift, rpm),
                     "a line of a source not locked to the rotor (a pump, a fan, another machine) whose frequency "
                     "grows with the wheel's speed but not in proportion"),
             would_tell="the bearing's preload or lubrication changed (slip shrinks with preload); the cage's own "
