@@ -118,9 +118,18 @@ def channel_gain(ctx, state, shares, resonances=()) -> list:
                 qx, qy = (qx - course, qy) if p["channel"] == cx else (qx, qy - course)
         with np.errstate(invalid="ignore"):
             d = qy - qx
-        lines = [i for i in range(h.size) if good[i].sum() >= MIN_RUNS]
+        # a gain is read on the cells of a load of one sense (x and y a quarter turn apart); the others' x/y ratio is
+        # their ellipse's, kept for the loads of a fixed direction
+        sensed = good & in_quadrature(ctx, (cx, cy), h, runs)
+        lines = [i for i in range(h.size) if sensed[i].sum() >= MIN_RUNS]
         if len(lines) < MIN_LINES:
+            lines = [i for i in range(h.size) if good[i].sum() >= MIN_RUNS]
+            directed = fixed_direction(ctx, (cx, cy), h, np.where(good, d, 0.0), good, lines, shares) \
+                if len(lines) >= MIN_LINES else None
+            if directed is not None:
+                out.append(directed)
             continue
+        good_all, good = good, sensed
         # a ratio that changes between runs (a gain switched) is described where it changes, not as one constant
         stepped = gain_step(ctx, state, (cx, cy), h, (np.where(good, qx, 0.0), np.where(good, qy, 0.0)), good, shares,
                             MIN_DB, MIN_LINES)
@@ -136,7 +145,8 @@ def channel_gain(ctx, state, shares, resonances=()) -> list:
         if abs(med) < MIN_DB or abs(med) < MIN_Z * se or agree.sum() < max(MIN_LINES, READ_SHARE * len(lines)):
             # no gain: a gain moves every line read alike; lines that keep their own x/y ratios are loads of a fixed
             # direction (:mod:`.describe_direction`)
-            directed = fixed_direction(ctx, (cx, cy), h, np.where(good, d, 0.0), good, lines, shares)
+            every = [i for i in range(h.size) if good_all[i].sum() >= MIN_RUNS]
+            directed = fixed_direction(ctx, (cx, cy), h, np.where(good_all, d, 0.0), good_all, every, shares)
             if directed is not None:
                 out.append(directed)
             continue
@@ -167,6 +177,28 @@ def channel_gain(ctx, state, shares, resonances=()) -> list:
             + f"a calibration of {cx} and {cy} with one known load (a mass hung, a shaker's force), or the "
               "load cell turned 90 degrees on the stand (a channel's gain goes with the channel)"))
     return out
+
+
+#: A cell is a load of one sense where the pair's x/y phase lies within this of a quarter turn (degrees): a gain
+#: scales one channel and keeps the quarter turn; a co- and a counter-rotating part together (an ellipse tilted off
+#: the axes, a load of a fixed direction) or a channel read late move it (noise at 20 dB: a few degrees)
+QUADRATURE_DEG = 15.0
+
+
+def in_quadrature(ctx, pair: tuple, h: np.ndarray, runs: np.ndarray) -> np.ndarray:
+    """Bool (L, R): whether each line h of the pair's channels, in each run, reads x and y a quarter turn apart
+    (within :data:`QUADRATURE_DEG`) on the records (True where it cannot be read: no records).  A line of both senses
+    reads its ellipse's x/y ratio, which moves as the parts pass the whirl branches of the rocking mode apart (family
+    wheel 4, its h 2 (co 0.8) and 4.62 (co 0.5) lines about the 55 Hz rocking mode, clean: "Fx's gain changed by
+    x 3.23 between 770 and 887 rpm" was described); a gain error of one channel keeps every line's quarter turn."""
+    out = np.ones((h.size, runs.size), bool)
+    if ctx.test is None or not h.size:
+        return out
+    f = h[None, :] * np.abs(ctx.omega[runs])[:, None] / (2 * np.pi)
+    z = ctx.transforms(runs, f, pair)                                   # (R, L, 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        off = np.abs(np.abs(np.angle(z[..., 1] / z[..., 0])) - np.pi / 2)
+    return (~np.isfinite(off) | (off <= np.radians(QUADRATURE_DEG))).T
 
 
 def _run_scatter(d: np.ndarray, good: np.ndarray) -> tuple:
