@@ -589,7 +589,7 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     DataError
         Runs at fewer than 2 distinct speeds (:func:`rwadist.validate.check_test_speeds`).
     """
-    from . import channel_distortion, data_quality, speed_whirl
+    from . import channel_distortion, channel_timing, data_quality, speed_whirl
     from .diagnose import diagnose as _diagnose
     from .spectra import compute_spectra
 
@@ -625,14 +625,22 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
                          base_check=base_check)
 
     # a speed from the data is tested by the wheel's gyroscopic whirl (and the data diagnosed again on the scale it
-    # supports); how the speed was obtained goes to the summary and the report
-    test, diagnosis = speed_whirl.settle(test, run)
+    # supports); a radial channel recorded late (read on the records at the model's lines) moved back and the data
+    # diagnosed again; how the speed was obtained, and what was put right, go to the summary and the report
+    test, diagnosis, late = channel_timing.in_time(speed_whirl.settle(test, run), lambda t: speed_whirl.settle(t, run))
+    for rec in late:
+        warnings.warn(RwadistWarning(channel_timing.summary_line(rec)), stacklevel=2)
     diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None), checked)
-    diagnosis.data_quality = ([s.to_json() for s in frozen] + distorted
-                              + ([polarity] if polarity is not None else []))
-    if polarity is not None or distorted:     # the model was fitted to the data with those channels put right
-        diagnosis.model.provenance = dict(diagnosis.model.provenance,
-                                          data_quality=distorted + ([polarity] if polarity is not None else []))
+    put_right = distorted + late + ([polarity] if polarity is not None else [])
+    diagnosis.data_quality = [s.to_json() for s in frozen] + put_right
+    return _with_provenance(diagnosis, test, put_right, data)
+
+
+def _with_provenance(diagnosis, test, put_right: list, data):
+    """``diagnosis`` with its model's provenance: the data quality records of what was put right before the model was
+    fitted (``put_right``), how the data were read and the data's stamp."""
+    if put_right:     # the model was fitted to the data with those channels put right
+        diagnosis.model.provenance = dict(diagnosis.model.provenance, data_quality=put_right)
     reading = reading_provenance(getattr(test, "meta", None))
     if reading:
         diagnosis.model.provenance = dict(diagnosis.model.provenance, diagnose=dict(

@@ -264,11 +264,13 @@ def quality_lines(records) -> list:
     record (:mod:`rwadist.channel_polarity`) first, in its own lines."""
     from .channel_distortion import distortion_lines
     from .channel_polarity import polarity_lines
+    from .channel_timing import late_lines
 
     sign_errors = ("reversed_polarity", "reversed_spin")
     lines = [x for r in records if r.get("type") in sign_errors for x in polarity_lines(r)]
     lines += [x for r in records if r.get("type") == "distorted" for x in distortion_lines(r)]
-    records = [r for r in records if r.get("type") not in sign_errors + ("distorted",)]
+    lines += [x for r in records if r.get("type") == "late_channel" for x in late_lines(r)]
+    records = [r for r in records if r.get("type") not in sign_errors + ("distorted", "late_channel")]
     if not records:
         return lines
     for r in records:
