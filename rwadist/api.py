@@ -526,7 +526,7 @@ def _one_x_checks(test) -> tuple:
     from . import channel_polarity, order_tracking, speed_check, speed_runs
 
     # a steady test's speed column checked against its 1x lines, scaled when they all sit at one ratio
-    test, checked = speed_check.checked(test, reads := speed_check.LineReads())
+    test, checked = speed_check.checked(test, reads := speed_check.LineReads(), confirm=speed_runs.confirmed_off)
     # a radial pair whose 1x line reads mirrored against the other pair's: one channel's sign flipped back; both
     # pairs mirrored: every speed negated (before the runs' own speeds: those read the 1x lines' senses)
     test, polarity = channel_polarity.checked(test, reads)

@@ -300,10 +300,7 @@ def check_record(test, reads: LineReads | None = None, whole_factors: bool = Tru
         rec["agreement_rel"] = round(float(np.sqrt(np.mean((kept / about - 1.0) ** 2))), 7)
     names = ", ".join(LINES[key][1] for key in judged)
     each = "; ".join(f"{LINES[key][1]} {s[0]:.6g} in {s[3]} runs" for key, s in judged.items())
-    if rec["runs_off"]:
-        rec["text_runs"] = "; ".join(
-            f"run {x['run_name']}: the speed column reads {x['given_rpm']:.6g} rpm, its 1x lines ({x['lines']}) sit at "
-            f"{x['ratio']:.6g} of it: its speed taken as {x['speed_rpm']:.6g} rpm" for x in rec["runs_off"])
+    rec = _with_runs_off(rec, rec["runs_off"])
     if rec["runs_doubtful"]:
         rec["text_doubtful"] = "; ".join(
             f"run {x['run_name']}: its 1x lines ({x['lines']}) read at {x['ratio']:.6g} of the speed column's "
@@ -391,6 +388,17 @@ def tone_sigma(df: float, snr) -> np.ndarray:
     the mean noise power of a bin (``snr``, over the local median, times ln 2); any shape of ``snr``."""
     snr_mean = np.maximum(np.asarray(snr, dtype=float) * np.log(2.0), 1e-12)
     return df * np.sqrt(2.0 * HANN_LOSS) / (2 * np.pi * np.sqrt(snr_mean))
+
+
+def _with_runs_off(rec: dict, runs_off: list) -> dict:
+    """``rec`` with ``runs_off`` (and its sentence ``text_runs``, none when empty)."""
+    out = {k: v for k, v in rec.items() if k != "text_runs"}
+    out["runs_off"] = runs_off
+    if runs_off:
+        out["text_runs"] = "; ".join(
+            f"run {x['run_name']}: the speed column reads {x['given_rpm']:.6g} rpm, its 1x lines ({x['lines']}) sit at "
+            f"{x['ratio']:.6g} of it: its speed taken as {x['speed_rpm']:.6g} rpm" for x in runs_off)
+    return out
 
 
 def _runs_off(test, ratios: dict, judged: list, about: float, spread: float,
@@ -498,14 +506,18 @@ def _line_at_given(run, channels: tuple, f_given: float, f_read: float, others=(
     return not (len(fixed) >= 2 and np.mean(fixed) >= 0.5)
 
 
-def checked(test, reads: LineReads | None = None) -> tuple:
+def checked(test, reads: LineReads | None = None, confirm=None) -> tuple:
     """(test, record): ``test`` with every run's speed multiplied by the scale its 1× lines give when
     :func:`check_record` calls the column off, and each run whose own 1× lines put it off (``runs_off``) at the
     speed they give (a copy; its meta is left alone), else ``test`` itself, untouched.  ``reads``: a
-    :class:`LineReads` shared with the steps after this one, or None."""
+    :class:`LineReads` shared with the steps after this one, or None.  ``confirm(test, runs) -> runs``: the runs
+    off (indices) whose own lines' finer reading confirms it (:func:`rwadist.speed_runs.confirmed_off`), or None."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         rec = check_record(test, reads)
+        if confirm is not None and rec.get("runs_off") and not rec.get("scaled"):
+            kept = set(confirm(test, [x["run"] for x in rec["runs_off"]]))
+            rec = _with_runs_off(rec, [x for x in rec["runs_off"] if x["run"] in kept])
     scale = rec["scale"] if rec.get("scaled") else 1.0
     each = {x["run"]: x["ratio"] for x in rec.get("runs_off", [])}
     if scale == 1.0 and not each:

@@ -230,6 +230,17 @@ def run_errors(test, reads: LineReads | None = None) -> list:
     return out
 
 
+def confirmed_off(test, runs: list) -> list:
+    """Of ``runs`` (indices into ``test.runs``: runs whose 1× lines' padded peaks put them off their column,
+    :func:`rwadist.speed_check.checked`), those whose finer reading here (:func:`run_errors`: the exact transform's
+    peak, its uncertainty with a neighbour in the window's main lobe) puts them off by more than :data:`SIGMAS`
+    standard errors too, or that it cannot judge.  The new-user trial nuN: speed sidebands at ±0.03 of a 500-rpm
+    run's 1× (0.25 Hz, half a bin of its 2-s record), unresolved, pulled both 1× peaks to 0.9948 of the column, and the
+    run was taken at 497.4 rpm, "a tach glitch"."""
+    errors = run_errors(type(test)([test.runs[i] for i in runs], dict(test.meta or {})))
+    return [i for i, e in zip(runs, errors) if e is None or abs(e["rel"]) > SIGMAS * e["se"]]
+
+
 def _mean_chi2(rel: np.ndarray, w: np.ndarray) -> tuple:
     """(inverse-variance mean, χ² per degree of freedom about it) of relative errors ``rel`` with weights ``w``."""
     mean = float(np.sum(w * rel) / np.sum(w))
