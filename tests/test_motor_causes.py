@@ -88,7 +88,7 @@ def test_only_whole_axial_torque_lines_get_a_motor_cause():
 
 def test_the_diagnosis_names_the_motor_for_a_tz_line_and_keeps_bearing_causes_for_the_rest():
     lines = {"axial_torque": [18.0, 1.0], "axial_force": [18.0], "radial_force": [1.0, 3.08, 4.92]}
-    model = SimpleNamespace(harmonics=lambda d: [SimpleNamespace(h=h) for h in lines.get(d, [])])
+    model = SimpleNamespace(harmonics=lambda d: [SimpleNamespace(h=h) for h in lines.get(d, [])], typed_effects=tuple)
     state = SimpleNamespace(base=None)
     ctx = SimpleNamespace(test=None, df=0.25, omega=np.array([2 * np.pi * 5000 / 60]), runs=np.arange(1))
     diag = SimpleNamespace(ctx=ctx, hypotheses=[], model_given=True, state_before=state, state_after=state,
