@@ -627,7 +627,8 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
     # a speed from the data is tested by the wheel's gyroscopic whirl (and the data diagnosed again on the scale it
     # supports); a radial channel recorded late (read on the records at the model's lines) moved back and the data
     # diagnosed again; how the speed was obtained, and what was put right, go to the summary and the report
-    test, diagnosis, late = channel_timing.in_time(speed_whirl.settle(test, run), lambda t: speed_whirl.settle(t, run))
+    # (the speed scale the whirl settled is kept: the test diagnosed again on it, not judged again)
+    test, diagnosis, late = channel_timing.in_time(speed_whirl.settle(test, run), lambda t: (t, run(t, None)))
     for rec in late:
         warnings.warn(RwadistWarning(channel_timing.summary_line(rec)), stacklevel=2)
     diagnosis.speed = speed_whirl.speed_record(getattr(test, "meta", None), checked)

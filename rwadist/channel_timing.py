@@ -64,7 +64,7 @@ def undone(test, records: list):
     for run in test.runs:
         signals = dict(run.signals)
         for rec in records:
-            if rec["channel"] in signals:
+            if rec["channel"] in signals and run.usable(rec["channel"]):     # a channel left out stays as it is
                 signals[rec["channel"]] = moved_earlier(signals[rec["channel"]], rec["tau_s"], float(run.sample_rate))
         runs.append(replace(run, signals=signals))
     return replace(test, runs=runs, meta=dict(test.meta))

@@ -220,3 +220,17 @@ def test_a_line_at_one_ratio_read_in_a_hump_at_its_top_speeds_is_no_drift():
     slip = 3.28 * (1 - 0.05 * (rpm / rpm[-1]) ** 2) + 0.0003 * rng.standard_normal(rpm.size)
     got = describe_drift.drift_of(_readings(slip, rpm), 3.28, 0.25)
     assert got is not None and got[1:] == (pytest.approx(slip[0]), pytest.approx(slip[-1]))
+
+
+def test_a_joined_drift_drops_the_partial_lines_of_every_line_it_was_read_from():
+    """Review of session 59: a record joined from the model lines 1.688 and 1.75 (nuM's case, 3.7 % apart, more than
+    SAME_LINE) kept the fixed-ratio ``partial_line`` of 1.75, its lead being 1.688."""
+    drift = Unexplained(signature="line_property", channels=("Fx", "Fy", "Fz"), speed_rpm=(969.0, 9000.0),
+                        f_Hz=(25.0, 277.0), level_dB=22.0, share=0.08, n_runs=35, h=1.688,
+                        parameters={"property": "ratio_drift", "direction": "radial_force", "h": 1.688,
+                                    "model_h": [1.688, 1.75]})
+    partial = Unexplained(signature="partial_line", channels=("Fz",), speed_rpm=(969.0, 9000.0), f_Hz=(30.0, 260.0),
+                          level_dB=-20.0, share=0.01, n_runs=30, h=1.75)
+    other = Unexplained(signature="partial_line", channels=("Fz",), speed_rpm=(969.0, 9000.0), f_Hz=(30.0, 260.0),
+                        level_dB=-20.0, share=0.01, n_runs=30, h=2.2)
+    assert beside_drifts([partial, other], [drift]) == [other, drift]

@@ -305,8 +305,10 @@ def beside_drifts(records: list, drifts: list) -> list:
     ratio as the speed grows, and read there it is 'absent' from the top speeds (trial 30b wheel A, h 3.255 on the
     radial torques: 'stops between 2435 and 2589 rpm' beside its drift of -4.9 %)."""
     def drifting(u) -> bool:
+        # every model line a joined record was read from (``model_h``), not its lead's alone
         return u.signature == "partial_line" and u.h is not None and any(
-            abs(u.h - x.h) <= SAME_LINE * x.h and set(u.channels) & set(x.channels) for x in drifts)
+            abs(u.h - h) <= SAME_LINE * h and set(u.channels) & set(x.channels)
+            for x in drifts for h in (x.parameters.get("model_h") or [x.h]))
 
     return [u for u in records if not drifting(u)] + list(drifts)
 

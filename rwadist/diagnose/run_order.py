@@ -5,7 +5,8 @@ A steady test's ``runs.csv`` rows are the order its runs were recorded (docs/for
 no order).  A load cell's gain drifting with its temperature, or a wheel re-mounted part way, moves every line of a
 run by one factor, in that order; recorded in shuffled speed order, each run's factor against the model's lines
 (:func:`.run_gains.run_gains`, no trend with speed taken off: a line's neighbours in speed were recorded anywhere) read
-in that order tells them.  New-user trial nuL (session 58, an independent generator, 30 runs): a gain rising 15 % was
+in that order tells them; a step is then placed and sized again with the runs' common trend with speed fitted beside
+it (:func:`speed_trend`).  New-user trial nuL (session 58, an independent generator, 30 runs): a gain rising 15 % was
 described on one seed of three from the runs' scatter about the lines' trends with speed (0.25-0.6 dB) and said
 ``recorded_order: unknown``; a 0.83 dB step at the 16th run recorded read as three levels against those trends (found
 at the 23rd, or called a drift).  In that order: the drift +1.17 to +1.21 dB (truth +1.21), the steps at the 16th,
@@ -97,7 +98,8 @@ def recorded_change(ctx, gains: np.ndarray) -> dict | None:
         trend = speed_trend(np.log(np.abs(ctx.omega[ctx.runs])), gains, later)
         if trend is not None:
             again = change_point(place, gains - trend)
-            if again is not None and again["pattern"] == "step" and again["z"] >= STEP_Z:
+            if again is not None and again["pattern"] == "step" and again["z"] >= STEP_Z and \
+                    abs(again["step_dB"]) >= RUN_SCATTER_DB:
                 cp = again
                 later = np.zeros(gains.size, bool)
                 later[cp["above"]] = True
