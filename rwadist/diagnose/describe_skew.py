@@ -24,7 +24,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..dft import blocked_records, run_window, windowed_dfts
-from ..resonance import resonance
 from ..units import DIRECTION_CHANNELS, RAD_S_TO_RPM
 from .unexplained import Unexplained
 
@@ -86,7 +85,7 @@ def _cells(ctx, state, direction: str) -> tuple | None:
         # new-user trial nuN's 480 Hz Fx/Ty fixture of a spring mount, (1 + 2jζr)/(1 − r² + 2jζr): 4-45 degrees off
         # below and above it, read as "Fx sampled 0.113 ms after Fy"): out of its reach what it turns, right or
         # wrong, stays under half of what a skew must reach to be described
-        gx, gy = _stand_gain(state, cx, f), _stand_gain(state, cy, f)
+        gx, gy = state.channel_gain(cx, f), state.channel_gain(cy, f)
         g = gx / gy
         if not np.array_equal(gx, gy):
             X, Y = X / gx, Y / gy
@@ -107,16 +106,6 @@ def _cells(ctx, state, direction: str) -> tuple | None:
         return None
     return (np.concatenate(f_all), np.concatenate(d_all), np.concatenate(li_all).astype(int),
             np.concatenate(ri_all).astype(int), h)
-
-
-def _stand_gain(state, channel: str, f: np.ndarray) -> np.ndarray:
-    """The complex gain H(f) (:func:`rwadist.resonance.resonance`) of the state's fixed resonances on ``channel``
-    at the line frequencies ``f`` (Hz, any shape); 1 where none acts on it."""
-    gain = np.ones(f.shape, dtype=complex)
-    for e in state.effects:
-        if getattr(e, "kind", "") == "fixed_resonance" and channel in e.channels:
-            gain *= resonance(f, e.f_r, e.zeta, e.peak_gain, e.gain_above)
-    return gain
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:

@@ -12,7 +12,6 @@ import numpy as np
 
 from ..empirical import block_floor
 from ..model import WheelModel
-from ..resonance import resonance
 from ..spectra import Spectra, welch_dof
 from ..units import CHANNEL_DIRECTION, CHANNEL_UNIT, CHANNELS
 from . import smear
@@ -303,11 +302,7 @@ class Context(Metric):
 
     def gain(self, state: State, c: str, f_hz) -> np.ndarray:
         """|H| of the state's fixed resonances acting on channel ``c`` at line frequencies ``f_hz`` (Hz)."""
-        g = np.ones_like(np.asarray(f_hz, dtype=float))
-        for f_r, zeta, peak, chans, *above in state.resonances:
-            if c in chans:
-                g = g * np.abs(resonance(f_hz, f_r, zeta, peak, *above))
-        return g
+        return np.abs(state.channel_gain(c, f_hz))
 
     def channel_lines(self, state: State, c: str, runs: np.ndarray) -> list:
         """[(h, law, a, g)] of every line acting on channel ``c``: harmonic number, amplitude law or None, the

@@ -5,7 +5,10 @@ import copy
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..model import WheelModel
+from ..resonance import resonance
 from ..units import CHANNEL_DIRECTION
 
 if TYPE_CHECKING:
@@ -102,6 +105,16 @@ class State:
     @property
     def resonances(self) -> list:
         return self.prediction.resonances
+
+    def channel_gain(self, channel: str, f_hz) -> np.ndarray:
+        """Complex H of the state's fixed resonances acting on ``channel`` at the line frequencies ``f_hz`` (Hz, any
+        shape; :func:`rwadist.resonance.resonance` of each, multiplied): what the channel's phasor is divided by to
+        read the load before the mount; 1 where none acts on it."""
+        gain = np.ones(np.shape(f_hz), dtype=complex)
+        for f_r, zeta, peak, chans, *above in self.resonances:
+            if channel in chans:
+                gain = gain * resonance(f_hz, f_r, zeta, peak, *above)
+        return gain
 
     @property
     def load_cell_offset(self) -> tuple | None:

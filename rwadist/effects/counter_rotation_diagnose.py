@@ -10,7 +10,6 @@ from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.state import State
 from ..model import Harmonic
-from ..resonance import resonance
 from ..units import CHANNELS, DIRECTION_CHANNELS
 
 
@@ -221,8 +220,8 @@ class CounterRotation:
     def _phase_powers(ctx, state, direction, h, runs):
         """Per run of ``runs``: the co- and counter-rotating mean squares of the line (direction, h) from the x/y
         phasors (co |X + iY|²/4, counter |X − iY|²/4, swapped for Ω < 0; their sum is the x + y line power), each
-        channel's fixed resonances divided out of its phasor (:func:`complex_gain`: a fixture on Fy alone turns a
-        circular line into an ellipse), the noise's expected share of each (white noise of the model floor S_x, S_y
+        channel's fixed resonances divided out of its phasor (``state.channel_gain``: a fixture on Fy alone turns
+        a circular line into an ellipse), the noise's expected share of each (white noise of the model floor S_x, S_y
         at the line through the whole-run Hann window: (S_x + S_y)/2 · f_s·Σw²/(Σw)², each divided alike), the modal power
         gains |G₊|², |G₋|² of a unit co and counter load, and an in-band mask.  None without time series."""
         chans = DIRECTION_CHANNELS[direction]
@@ -234,12 +233,12 @@ class CounterRotation:
         f = h0 * ctx.omega[runs] / (2 * np.pi)
         inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
         X = ctx.phasors(runs, f[:, None])[:, 0, :]
-        x, y = (X[:, CHANNELS.index(c)] / complex_gain(state, c, f) for c in chans)
+        x, y = (X[:, CHANNELS.index(c)] / state.channel_gain(c, f) for c in chans)
         co, ct = np.abs(x + 1j * y) ** 2 / 4.0, np.abs(x - 1j * y) ** 2 / 4.0
         neg = np.asarray(ctx.sp.speed, float)[runs] < 0
         co, ct = np.where(neg, ct, co), np.where(neg, co, ct)
         k = np.clip(np.rint(f / ctx.df).astype(int), 0, ctx.f.size - 1)[:, None]
-        S = sum(np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1)[:, 0] / np.abs(complex_gain(state, c, f)) ** 2
+        S = sum(np.take_along_axis(ctx.floor_psd(state, c, runs), k, axis=1)[:, 0] / np.abs(state.channel_gain(c, f)) ** 2
                 for c in chans) / 2.0
         enbw = np.empty(runs.size)
         for i, r in enumerate(runs):
@@ -300,7 +299,7 @@ class CounterRotation:
         # the phasors' powers are read with the channels' fixed resonances divided out (:meth:`_phase_powers`): put
         # back in measured units, those of the error metric the drop is weighed against (the pair's mean |H|²)
         f = g[0] * np.abs(ctx.omega[runs]) / (2 * np.pi)
-        back = sum(np.abs(complex_gain(state, c, f)) ** 2 for c in DIRECTION_CHANNELS[self.direction]) / 2.0
+        back = sum(np.abs(state.channel_gain(c, f)) ** 2 for c in DIRECTION_CHANNELS[self.direction]) / 2.0
         co, ct, noise, gp, gn = co * back, ct * back, noise * back, gp * back, gn * back
         c_tot2 = g[1] ** 2 + g[2] ** 2
         q0 = g[2] ** 2 / c_tot2
@@ -456,7 +455,7 @@ def xy_split(ctx: Context, state: State, direction: str, h: float, runs, q: floa
     f = h0 * np.abs(w) / (2 * np.pi)
     inb = (f >= ctx.k_lo * ctx.df) & (f <= ctx.k_hi * ctx.df)
     X = ctx.phasors(runs, (h0 * w / (2 * np.pi))[:, None])[:, 0, :]
-    px, py = (np.abs(X[:, CHANNELS.index(c)] / complex_gain(state, c, f)) ** 2 for c in (cx, cy))
+    px, py = (np.abs(X[:, CHANNELS.index(c)] / state.channel_gain(c, f)) ** 2 for c in (cx, cy))
     ok = inb & np.isfinite(px) & np.isfinite(py) & (px + py > 0)
     if ok.sum() < 3:
         return 0.0
@@ -470,13 +469,3 @@ def xy_split(ctx: Context, state: State, direction: str, h: float, runs, q: floa
         return 0.0
     bound = 2.0 * np.sqrt(max(q * (1.0 - q), 0.0))
     return float(np.clip(e, -bound, bound))
-
-
-def complex_gain(state: State, c: str, f_hz) -> np.ndarray:
-    """H of the state's fixed resonances acting on channel ``c`` at ``f_hz`` (Hz), complex: what the channel's phasor
-    is divided by to read the load (a resonance on one channel of a pair changes the pair's phase and ellipse)."""
-    g = np.ones(np.shape(f_hz), dtype=complex)
-    for f_r, zeta, peak, chans, *above in state.resonances:
-        if c in chans:
-            g = g * resonance(f_hz, f_r, zeta, peak, *above)
-    return g
