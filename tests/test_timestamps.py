@@ -184,3 +184,39 @@ def test_a_long_record_of_exact_time_stamps_is_uniform(duration_s, fmt):
     assert abs(step * FS - 1.0) <= (1e-13 if fmt == "%.17g" else 1e-9), step * FS - 1.0
     with pytest.raises(DataError, match=r"x\.csv: time_s: sampling is not uniform: .* at line 1003 .*1 dropped sample"):
         sample_step("x.csv", "time_s", np.delete(t, 1001))
+
+
+@pytest.mark.parametrize("fs", [6000.0, 7000.0, 5120.0, 3000.0])
+@pytest.mark.parametrize("drop_meta_rate", [False, True])
+def test_stamps_printed_coarser_than_a_quarter_step_read_when_one_uniform_grid_fits(tmp_path, fs, drop_meta_rate):
+    """A DAQ printing its stamps to 0.1 ms at 6 kHz (0.6 of a step; session 60's new-user trial: every run refused as
+    "a gap in the sampling"): each stamp still names one sample, so the column is read, at the declared rate, with
+    the samples unchanged; the same samples at full precision are the reference."""
+    run = simulate_steady(preset("ithaco-e"), [1500.0], sample_rate=fs, n_samples=4096, noise=0.01, seed=3)
+    full = read_steady(write_steady(run, tmp_path / "full"))
+    coarse_dir = write_steady(run, tmp_path / "coarse")
+    rewrite_time(coarse_dir, "%.4f", drop_meta_rate)
+    coarse = read_steady(coarse_dir)
+    # without meta.json's rate, the least-squares step of 4096 stamps rounded to q: ~q/n^1.5 (2.7e-6 of a 7 kHz step)
+    assert abs(coarse.runs[0].sample_rate / fs - 1) < (1e-12 if not drop_meta_rate else 1e-5)
+    for ch in full.runs[0].channels:
+        np.testing.assert_array_equal(full.runs[0].signals[ch], coarse.runs[0].signals[ch])
+
+
+@pytest.mark.parametrize("fs", [6000.0, 7000.0, 3000.0])
+@pytest.mark.parametrize("where", [5, 1700, 4090])
+def test_a_lost_or_repeated_sample_in_stamps_printed_coarser_than_a_quarter_step_is_refused(tmp_path, fs, where):
+    """The same 0.1 ms stamps with one sample lost or one written twice, near either end or in the middle: refused,
+    naming the line where the stamps leave the grid and what was lost."""
+    from rwadist.data import read_run
+    t = np.arange(4097) / fs
+    x = np.random.default_rng(1).standard_normal((4097, 2))
+    rows = np.column_stack([t, x])
+    path = tmp_path / "r.csv"
+    for kind, table, line in (("1 dropped sample", np.delete(rows, where, axis=0)[:4096], where + 2),
+                              ("repeated sample", np.insert(rows[:4095], where, rows[where - 1], axis=0), where + 2)):
+        np.savetxt(path, table, delimiter=",", header="time_s,Fx_N,Fy_N", comments="", fmt=["%.4f", "%.17g", "%.17g"])
+        with pytest.raises(DataError) as info:
+            read_run(path, 1.0)
+        msg = str(info.value)
+        assert f"line {line} " in msg and kind in msg, (kind, line, msg)

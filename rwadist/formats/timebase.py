@@ -62,7 +62,7 @@ def printed_resolution(time: np.ndarray, stored_rtol: float = 0.0) -> np.ndarray
     fixed_decimals = int(decimals[nonzero].max())
     significant = int((decimals + exponent + 1)[nonzero].max())
     fixed = 10.0 ** (-fixed_decimals)
-    relative = 10.0 ** (exponent + 1 - significant).astype(float)
+    relative = np.where(nonzero, 10.0 ** (exponent + 1 - significant).astype(float), 0.0)   # 0 prints exactly
     return np.maximum(np.maximum(fixed, relative), (FLOAT_MARGIN + stored_rtol) * mag)
 
 
@@ -84,17 +84,51 @@ def _least_squares_step(time: np.ndarray) -> tuple:
     return step, float(t[0] + r.mean() - slope * 0.5 * (n - 1))
 
 
+#: Rounding up to this fraction of the step is judged over the whole column (:func:`_on_one_grid`); from there on a
+#: stamp cannot name its sample (exact stamps a whole step apart fit a grid shifted half a step as well, a lost
+#: sample included)
+COARSE_MAX_FRACTION = 0.95
+def _on_one_grid(t: np.ndarray, step: float, q: np.ndarray, n: int) -> bool:
+    """True when one uniform grid t0 + k·``step`` (k = 0..n-1) lies within every stamp's rounding (±q/2, s): some t0
+    satisfies |t_k − t0 − k·step| ≤ q_k/2 for all k, the least-squares step's own error allowed (~q/√n)."""
+    i = np.arange(n, dtype=float)
+    u = t - (t[0] + step * i)
+    margin = 2.0 * float(q.max()) / np.sqrt(n) + FLOAT_MARGIN * float(np.max(np.abs(t)))
+    return float(np.max(u - 0.5 * q)) <= float(np.min(u + 0.5 * q)) + margin
+
+
+def _change_point(t: np.ndarray) -> tuple[int, float]:
+    """(i, jump s): the step (sample i to i+1) after which the stamps sit off the grid of those before, and by how
+    much: the least squares of a line plus one jump at each place in turn (a lost sample shifts every later stamp
+    by a step and tilts the column's line, which the fitted line takes up), the place explaining most chosen.
+    Closed form from suffix sums, no loop."""
+    n = len(t)
+    idx = np.arange(n, dtype=float)
+    x = idx - idx.mean()
+    u = t - (t[0] + (t[-1] - t[0]) / (n - 1) * idx)
+    u = u - u.mean()
+    u = u - x * (x @ u) / (x @ x)                            # the residual of the column's line
+    m = np.arange(n - 1, 0, -1, dtype=float)                  # samples from k = 1..n-1 on
+    su = np.cumsum(u[::-1])[::-1][1:]
+    sx = np.cumsum(x[::-1])[::-1][1:]
+    # a jump at k, H = (index >= k), orthogonalised against the line: |H⊥|² = m − m²/n − (Σx over H)²/Σx²
+    den = np.maximum(m - m * m / n - sx * sx / (x @ x), np.finfo(float).tiny)
+    k = int(np.argmax(su * su / den))
+    return k, float(su[k] / den[k])
+
+
 def _what_to_do(ratio: float) -> str:
     """The advice of a non-uniform time column: a run with lost or repeated samples is no steady record."""
     return ("; export the run again without the loss (or leave it out: a steady run's lines need an unbroken "
             "record)" if ratio > 0 else "; export the run again with increasing time stamps (or leave it out)")
 
 
-def _kind_of_step(ratio: float) -> str:
+def _kind_of_step(ratio: float, whole: float = 0.05) -> str:
+    """What a step of ``ratio`` sampling steps is; within ``whole`` of a whole number of steps, lost samples."""
     if ratio < 0.5:
         return "a repeated sample (time stamp written twice)" if ratio > -0.5 else "time going backwards"
     n_missing = round(ratio) - 1
-    if n_missing >= 1 and abs(ratio - round(ratio)) < 0.05:
+    if n_missing >= 1 and abs(ratio - round(ratio)) < whole:
         return f"{n_missing} dropped sample(s)"
     return "a gap in the sampling"
 
@@ -142,18 +176,28 @@ def sample_step(path, field_name: str, time, declared_rate: float | None = None,
     tolerance = np.minimum(0.5 * (q[:-1] + q[1:]) + step_error * 1.01 + FLOAT_MARGIN * np.abs(t[1:]),
                            MAX_RESOLUTION_FRACTION * step)
     excess = np.abs(dt - step) - tolerance
-    if excess.max() > 0:
-        i = int(np.argmax(excess))
-        ratio = dt[i] / step
-        hint = ""
-        if q_max > MAX_RESOLUTION_FRACTION * step:
-            hint = (f"; the time stamps are printed to {q_max:.3g} s, too coarse for this step: write more digits "
-                    "(%.10g or 17 significant digits)")
-        where = _csv_line(i) if position is None else position(i)
-        raise DataError(path, field_name, f"sampling is not uniform: step {dt[i]:.9g} s at {where} is "
-                        f"{ratio:.4g} sampling steps ({_kind_of_step(ratio)}); sampling step {step:.9g} s "
-                        f"from a least-squares line through all {n} time stamps, printed rounding "
-                        f"explains ±{tolerance[i]:.2g} s{hint or _what_to_do(ratio)}")
+    coarse = MAX_RESOLUTION_FRACTION * step < q_max < COARSE_MAX_FRACTION * step
+    if coarse:
+        # stamps rounded coarser than a quarter step but finer than a whole one: one step cannot tell a dropped
+        # sample from rounding, the whole column can (every stamp the rounding of one uniform grid)
+        bad, jump = (None, 0.0) if _on_one_grid(t, step, q, n) else _change_point(t)
+        ratio = 1.0 + jump / step
+    else:
+        bad = int(np.argmax(excess)) if excess.max() > 0 else None
+        ratio = 1.0 if bad is None else dt[bad] / step
+    if bad is not None:
+        where = _csv_line(bad) if position is None else position(bad)
+        if coarse:
+            found = (f"the time stamps from {where} on sit {ratio - 1:.3g} sampling steps off the uniform grid of "
+                     f"those before ({_kind_of_step(ratio, 0.25)}); sampling step {step:.9g} s from a least-squares line "
+                     f"through all {n} time stamps, printed to {q_max:.3g} s (rounding explains ±{0.5 * q_max:.2g} s)")
+        else:
+            found = (f"step {dt[bad]:.9g} s at {where} is {ratio:.4g} sampling steps ({_kind_of_step(ratio)}); "
+                     f"sampling step {step:.9g} s from a least-squares line through all {n} time stamps, printed "
+                     f"rounding explains ±{tolerance[bad]:.2g} s")
+        hint = (f"; the time stamps are printed to {q_max:.3g} s, too coarse for this step: write more digits "
+                "(%.10g or 17 significant digits)") if q_max >= COARSE_MAX_FRACTION * step else _what_to_do(ratio)
+        raise DataError(path, field_name, f"sampling is not uniform: {found}{hint}")
     if declared_rate is not None:
         declared_step = 1.0 / float(declared_rate)
         if abs(declared_step - step) > step_error * 1.01 + FLOAT_MARGIN * step:
