@@ -234,3 +234,30 @@ def test_a_joined_drift_drops_the_partial_lines_of_every_line_it_was_read_from()
     other = Unexplained(signature="partial_line", channels=("Fz",), speed_rpm=(969.0, 9000.0), f_Hz=(30.0, 260.0),
                         level_dB=-20.0, share=0.01, n_runs=30, h=2.2)
     assert beside_drifts([partial, other], [drift]) == [other, drift]
+
+
+def test_a_rising_ratio_is_worded_by_where_the_line_sits():
+    """A rising ratio under h ½ is a cage's, whose ratio slip lowers (session 60's new-user trial: a cage line drifting
+    0.3755 -> 0.39 read as "an inner-race ball pass (BPFI = n − BPFO)", which needs fewer than one ball); over 1.5 an
+    inner race's ball pass; between them neither."""
+    from rwadist.diagnose.describe_drift import _cause
+    rpm = np.array([1945.0, 6000.0])
+    cage = _cause("rises", 0.3755, 0.39, 0.038, rpm)
+    assert "cage" in cage and "contact angle" in cage and "BPFI" not in cage
+    assert "inner-race ball pass" in _cause("rises", 4.70, 4.80, 0.02, rpm)
+    between = _cause("rises", 1.10, 1.13, 0.027, rpm)
+    assert "no bearing slip" in between and "cage whose" not in between
+    assert "cage slipping" in _cause("falls", 0.40, 0.39, -0.025, rpm)
+
+
+def test_a_drift_drops_the_blend_its_fixed_ratio_reading_makes():
+    """Session 60's trial: a cage line drifting 0.3755 -> 0.39, its model line at 0.3849, read in the Welch window as
+    'two or more lines within ±0.0513' on Fx Fy and on Tx Ty beside its drift; a blend of another line stays."""
+    drift = Unexplained(signature="line_property", channels=("Fx", "Fy", "Tx", "Ty"), speed_rpm=(1945.0, 6000.0),
+                        f_Hz=(12.2, 39.0), level_dB=0.0, share=0.03, n_runs=20, h=0.3849,
+                        parameters={"property": "ratio_drift", "direction": "radial_force", "h": 0.3849})
+    blends = [Unexplained(signature="line_property", channels=chans, speed_rpm=(3297.0, 6000.0), f_Hz=(21.2, 38.5),
+                          level_dB=2.0, share=0.009, n_runs=12, h=h,
+                          parameters={"property": "blended_lines", "direction": "radial_force"})
+              for chans, h in ((("Fx", "Fy"), 0.3849), (("Tx", "Ty"), 0.3849), (("Fx", "Fy"), 2.73))]
+    assert beside_drifts(blends, [drift]) == [blends[2], drift]

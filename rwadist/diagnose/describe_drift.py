@@ -27,6 +27,10 @@ from .unexplained import Unexplained
 
 #: Directions read and their channels (summed).
 DIRECTIONS = {"radial_force": ("Fx", "Fy"), "radial_torque": ("Tx", "Ty"), "axial_force": ("Fz",)}
+#: A cage's ratio with its inner race turning, ½(1 − (d/D)·cos α), lies under this
+CAGE_MAX_H = 0.5
+#: An inner-race ball pass, (n/2)(1 + (d/D)·cos α), lies over this with n ≥ 3 balls
+BPFI_MIN_H = 1.5
 #: Half-width of the window searched around h, as a fraction of h (a cage slips by a few per cent).
 WINDOW = 0.08
 #: The window stays under this fraction of the distance to the model's nearest other line.
@@ -245,14 +249,24 @@ def joined_tracks(readings: list, df: float) -> list:
 
 
 def _cause(way: str, h_lo: float, h_hi: float, drift: float, rpm: np.ndarray) -> str:
-    """The bearing cause of a drifting line, worded for the way its ratio goes."""
+    """The bearing cause of a drifting line, worded for the way its ratio goes and where it sits: a slipping cage
+    lowers the cage's ratio FTF = ½(1 − γ) and the outer race's ball pass n·FTF and raises the inner race's
+    BPFI = n − n·FTF, which lies over :data:`BPFI_MIN_H` (n ≥ 3 balls); a cage's ratio (under :data:`CAGE_MAX_H`)
+    rises only as γ = (d/D)·cos α shrinks: the contact angle α growing with the speed."""
     span = f"from {h_lo:.4g} to {h_hi:.4g} ({100 * drift:+.1f} %) over {rpm.min():.0f}-{rpm.max():.0f} rpm"
     if way == "falls":
         return (f"a rolling bearing's cage slipping more as the speed grows: the line's ratio falls {span}, as the "
                 "cage's ratio and the outer race's ball pass (n × the cage's) fall together by one slip")
-    return (f"a rolling bearing's inner-race ball pass (BPFI = n − BPFO) as its cage slips more with the speed: the "
-            f"line's ratio rises {span}, while the cage's own line and the outer race's ball pass would fall by the "
-            "same slip")
+    if max(h_lo, h_hi) < CAGE_MAX_H:
+        return (f"a rolling bearing's cage whose contact angle grows with the speed (the balls' centrifugal load on "
+                f"an angular-contact pair, or a preload changing as the bearing warms): the line's ratio rises {span}; "
+                "a slipping cage would lower it")
+    if min(h_lo, h_hi) >= BPFI_MIN_H:
+        return (f"a rolling bearing's inner-race ball pass (BPFI = n − BPFO) as its cage slips more with the speed: "
+                f"the line's ratio rises {span}, while the cage's own line and the outer race's ball pass would fall "
+                "by the same slip")
+    return (f"a line of the wheel whose ratio rises {span}: under any inner-race ball pass (BPFI ≥ "
+            f"{BPFI_MIN_H:g} with three balls or more) and over a cage's, so no bearing slip")
 
 
 def ratio_drift(ctx, state, shares, more=()) -> list:
@@ -300,13 +314,17 @@ def ratio_drift(ctx, state, shares, more=()) -> list:
 
 
 def beside_drifts(records: list, drifts: list) -> list:
-    """``records`` without the ``partial_line`` records of a line of ``drifts`` (a ``ratio_drift`` record's h within
-    :data:`SAME_LINE` of it, on one of its channels), then ``drifts``: the data's line moves off the model's fixed
-    ratio as the speed grows, and read there it is 'absent' from the top speeds (trial 30b wheel A, h 3.255 on the
-    radial torques: 'stops between 2435 and 2589 rpm' beside its drift of -4.9 %)."""
+    """``records`` without the ``partial_line`` and ``blended_lines`` records of a line of ``drifts`` (a
+    ``ratio_drift`` record's h within :data:`SAME_LINE` of it, on one of its channels), then ``drifts``: the data's
+    line moves off the model's fixed ratio as the speed grows, and read there it is 'absent' from the top speeds
+    (trial 30b wheel A, h 3.255 on the radial torques: 'stops between 2435 and 2589 rpm' beside its drift of -4.9 %)
+    or, spread over the Welch window's bins as the record's finer ones are not, 'two or more lines' (session 60's
+    trial: a cage line drifting 0.3755 -> 0.39, +2 dB in its window on Fx Fy and on Tx Ty)."""
     def drifting(u) -> bool:
         # every model line a joined record was read from (``model_h``), not its lead's alone
-        return u.signature == "partial_line" and u.h is not None and any(
+        read_fixed = u.signature == "partial_line" or (u.signature == "line_property" and
+                                                        u.parameters.get("property") == "blended_lines")
+        return read_fixed and u.h is not None and any(
             abs(u.h - h) <= SAME_LINE * h and set(u.channels) & set(x.channels)
             for x in drifts for h in (x.parameters.get("model_h") or [x.h]))
 
