@@ -21,6 +21,12 @@ from .unexplained import Unexplained, _number
 
 #: A line's predicted power over the noise in its window, at least, for its ratio to be read (dB).
 LINE_SNR_DB = 20.0
+#: ... and for a run to tell whether it holds the line at all (``line_ratios(absent=True)``, read by
+#: :mod:`.describe_partial`): the noise alone then reads 13 dB under the model, 3 dB past ``ABSENT_DB`` (−10 dB), and
+#: a present line within 0.2 dB of it.  At LINE_SNR_DB a weaker direction's share of one line went unread (session 60's
+#: trial: h 5.46 absent under 3000 rpm on the radial force and torque, the torque's 14-17 dB over its window's noise
+#: where present: named on Fx Fy alone)
+ABSENT_SNR_DB = 13.0
 
 
 @dataclass
@@ -77,7 +83,7 @@ def line_ratios(ctx, state, absent: bool = False) -> list:
                 # a line measured 0 inside the band the lines are read in (outside it, 0 means not read)
                 k = np.rint(hs[:, None] * ctx.omega[runs][None, :] / (2 * np.pi) / ctx.df).astype(int)
                 inband = (k - LINE_HALF >= ctx.k_lo) & (k + LINE_HALF <= ctx.k_hi)
-                good = np.isfinite(meas) & (meas >= 0) & inband & (snr >= 10 ** (LINE_SNR_DB / 10))
+                good = np.isfinite(meas) & (meas >= 0) & inband & (snr >= 10 ** (ABSENT_SNR_DB / 10))
             li, ri = np.nonzero(good)
             keep = ~crossings(ctx, state, hs[li], ri)      # a sweep's line passing a mode: not its steady response
             li, ri = li[keep], ri[keep]
