@@ -94,3 +94,24 @@ def test_the_speed_trend_is_fitted_with_the_step_and_not_where_they_are_one():
     np.testing.assert_allclose(got, trend - trend.mean(), atol=1e-12)
     assert abs(np.median(gains[later]) - np.median(gains[~later]) - 0.67) > 0.1     # what the medians alone read
     assert speed_trend(x, gains, u > 0.3) is None
+
+
+@pytest.mark.parametrize("index", [0, 6])
+def test_a_drift_of_the_force_bridges_alone_is_read_on_the_forces(index, tmp_path):
+    """Session 60's trial: the forces' gain falling 1.5 dB over the test, the torques steady, was read "in Fx Fy Fz Tx
+    Ty Tz" at −1.22 dB (the median of every line, the torques' steady ones among them).  Here the three force channels
+    (lines and noise) of each run scaled by 1 + 0.2·(τ − ½), τ its place in the recording order: read on the forces
+    alone, at the drift within 10 %."""
+    wheel = fw.family()[index]
+    data = fw.steady(wheel, seed=1, noise=0.01)
+    place = np.random.default_rng(SEED).permutation(len(data.speeds))
+    gain = 1.0 + 0.2 * (place / (len(place) - 1) - 0.5)
+    forces = [fw.CHANNELS.index(c) for c in ("Fx", "Fy", "Fz")]
+    data.signals[:, forces] *= gain[:, None, None]
+    path = fw.write_steady(data, tmp_path / "data", wheel.name)
+    header, *rows = (path / "runs.csv").read_text().splitlines()
+    (path / "runs.csv").write_text("\n".join([header] + [rows[i] for i in np.argsort(place)]) + "\n")
+    diag = api.diagnose(api.read(path))
+    (u,) = [u for u in diag.unexplained if u.signature == "run_change"]
+    assert u.channels == ("Fx", "Fy", "Fz"), u.channels
+    assert u.parameters["drift_dB"] == pytest.approx(20 * np.log10(1.1 / 0.9), rel=0.1)

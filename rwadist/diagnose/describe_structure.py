@@ -263,7 +263,9 @@ def run_change(ctx, ratios: list, shares, order: dict | None = None) -> list:
             else "the runs in the order they were recorded (a drift grows with time; a re-mounting is a step) and a "
                  "repeated run at one speed at the start and the end of the test")
     return [Unexplained(
-        signature="run_change", channels=tuple(ctx.channels), speed_rpm=(float(rpm.min()), float(rpm.max())),
+        signature="run_change", channels=tuple(c for c in ctx.channels if any(c in DIRECTION_CHANNELS[r.direction]
+                                                                               for r in ratios)),
+        speed_rpm=(float(rpm.min()), float(rpm.max())),
         f_Hz=(float(np.min(np.concatenate([r.f for r in ratios]))), float(np.max(np.concatenate([r.f for r in ratios])))),
         level_dB=float(np.median(np.abs(dev[off]))), share=share, n_runs=int(idx.size),
         parameters={"scatter_dB": float(scatter), "largest_dB": float(np.max(np.abs(dev))),

@@ -45,6 +45,27 @@ def run_gains(ctx, ratios: list) -> np.ndarray:
     return out
 
 
+#: A direction takes part in a run-to-run change when its own runs' factors follow the common ones by this share or
+#: more (the slope of its factors on the common factors, through 0)
+CHANGED_SHARE = 0.5
+
+
+def in_changed_directions(ctx, ratios: list) -> list:
+    """``ratios`` of the directions whose runs change with the common factor (:func:`run_gains` of each direction
+    alone against that of all: a slope of :data:`CHANGED_SHARE` or more), all of them when none or every one does.
+    A gain drifting on the force bridges alone was read over every channel at the median of all the lines (session
+    60's trial: forces −1.5 dB over the test, the torques steady: "in Fx Fy Fz Tx Ty Tz", −1.22 dB)."""
+    common = run_gains(ctx, ratios)
+    keep = []
+    for r in ratios:
+        own = run_gains(ctx, [r])
+        ok = np.isfinite(own) & np.isfinite(common)
+        den = float(np.sum(common[ok] ** 2))
+        if ok.sum() >= 3 and den > 0 and float(np.sum(own[ok] * common[ok])) / den >= CHANGED_SHARE:
+            keep.append(r)
+    return keep if keep else list(ratios)
+
+
 def _line_powers(state, par, w: np.ndarray, directions=None) -> list:
     """Per direction with model lines (of ``directions``, default every one): ln of each line's power (R, lines)
     pooled over the direction's channels, both senses of each radial line at unit load, through the modes of ``par``."""
