@@ -386,8 +386,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     drifting = [u for u in drifting_modes(ctx, state, steady, of_track) if holds_content(u, res)]
     out += drifting + [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)
                        and not any(same_track(u, v) for v in drifting)]
-    # read on the directions that change with the runs (a drift of the force bridges alone: not the torques' lines)
-    read = in_changed_directions(ctx, structure.line_ratios(res.ctx, res.state) if changes else ratios)
+    read = in_changed_directions(ctx, structure.line_ratios(res.ctx, res.state) if changes else ratios)  # where it is
     out += annotate(ctx, state, structure.run_change(ctx, read, of_runs, in_order(ctx, read)), read, taken_out=changes)
     out += speed_lines(ctx, state, of_line, bearings, others, ctx.left_out)
     out += partial_lines(ctx, state, structure.line_ratios(ctx, state, absent=True), of_line)
