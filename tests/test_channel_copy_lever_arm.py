@@ -58,6 +58,7 @@ def test_an_instruments_torque_crosstalk_is_still_a_copy(index):
     assert abs(np.angle(copies[0].kappa)) < 0.01
 
 
+@pytest.mark.slow
 def test_the_offset_is_found_whole_by_the_users_command(tmp_path):
     wheel = fw.family()[0]
     data = fw.steady(wheel, noise=0.01, seed=0, effects=[fe.CrossCoupling(OFFSET_M)])

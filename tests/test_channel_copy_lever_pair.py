@@ -41,6 +41,7 @@ def test_a_force_copied_into_a_moment_is_described_and_the_modes_kept(index, sou
 
 
 @pytest.mark.parametrize("r", [(0.0, 0.0, -0.06), (0.004, -0.003, 0.03)])     # with a lateral part: r_y·Fz in Tx
+@pytest.mark.slow
 def test_an_offset_reads_in_both_mirrors_and_stays_the_offset(r):
     _, diag = _diagnosed(0, fe.CrossCoupling(r=r))
     assert [e["kind"] for e in diag.model.effects] == ["suspension_modes", "cross_coupling"]

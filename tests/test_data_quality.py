@@ -150,6 +150,7 @@ def test_a_channel_at_its_printed_resolution_is_no_dropout_and_a_hold_in_it_is(s
     assert 2990 <= a <= 2999 and 3256 <= b <= 3265 and kind == "held"   # the level may repeat beside it, by chance
 
 
+@pytest.mark.slow
 def test_diagnose_warns_and_the_command_says_which_runs_were_left_out(tmp_path, capsys):
     """``api.diagnose`` warns as ``api.fit`` does (review14: a library user was told nothing); ``rwadist diagnose``
     prints that warning once on stderr and lists every stretch in its console, summary.json and report.md."""

@@ -10,6 +10,8 @@ it as 1/r² (the form the W7 trial put under its wheel).  The anisotropic mount 
 x = k_x·a cos θ, y = k_y·a sin θ: a co part (k_x + k_y)/2 and a counter part (k_x − k_y)/2, an ellipse held along the
 stator's x axis at every run.  Truth in closed form: the counter fraction q = (k_x − k_y)²/(2(k_x² + k_y²)) and the x/y
 power split e = (k_x² − k_y²)/(k_x² + k_y²)."""
+import functools
+
 import numpy as np
 import pytest
 
@@ -70,6 +72,12 @@ def _test(fixture: bool = False, k_xy=(1.0, 1.0), random_orientation: bool = Fal
     return SteadyTest(runs, {"sample_rate_hz": FS})
 
 
+@functools.cache
+def _clean():
+    """The clean wheel's diagnosis, made once per test process (four tests read it; none changes it)."""
+    return api.diagnose(_test())
+
+
 def _kinds(d) -> list:
     return [e["kind"] for e in d.model.effects]
 
@@ -111,7 +119,7 @@ def test_a_line_of_both_senses_the_fixture_reaches_keeps_its_power():
 def test_a_clean_hard_mounted_wheel_is_left_alone_its_lines_turning_as_generated():
     """Nothing added or described; each radial line's rotation sense read from the x/y phase (before: written with
     none, which every consumer reads co-rotating), the imbalance's left to the counter_rotation family."""
-    d = api.diagnose(_test())
+    d = _clean()
     assert _kinds(d) == [] and not d.unexplained
     for direction, h, _ in LINES:
         if direction == "axial_force":
@@ -123,7 +131,7 @@ def test_a_clean_hard_mounted_wheel_is_left_alone_its_lines_turning_as_generated
 def test_an_anisotropic_mount_is_a_counter_rotating_imbalance_held_in_one_orientation():
     """Before: nothing named, nothing described, Fx and Fy predicted alike (the error figure 2.3 x 10^4 the clean one)."""
     kx, ky = 1.3, 0.7
-    clean = api.diagnose(_test()).error_after
+    clean = _clean().error_after
     d = api.diagnose(_test(k_xy=(kx, ky)))
     (e,) = [e for e in d.model.effects if e["kind"] == "counter_rotation"]
     assert e["direction"] == "radial_force" and e["h"] == 1.0
@@ -141,7 +149,7 @@ def test_a_counter_part_of_its_own_phase_is_named_without_a_split():
     """The ellipse turns from run to run: the counter fraction is named, no x/y split, and the parts' cross term is
     the allowance of the metric (before: nothing named, the error figure 9.7 x 10^3 the clean one)."""
     kx, ky = 1.3, 0.7
-    clean = api.diagnose(_test()).error_after
+    clean = _clean().error_after
     d = api.diagnose(_test(k_xy=(kx, ky), random_orientation=True))
     (e,) = [e for e in d.model.effects if e["kind"] == "counter_rotation"]
     assert e["counter_fraction"] == pytest.approx(((kx - ky) / (kx + ky)) ** 2 / (1 + ((kx - ky) / (kx + ky)) ** 2),
@@ -164,7 +172,7 @@ def test_speed_sidebands_the_segments_do_not_resolve_are_named_beside_their_carr
     assert e["C_lower"] == pytest.approx(6e-7, rel=0.01) and e["C_upper"] == pytest.approx(6e-7, rel=0.01)
     (carrier,) = [x.C for x in d.model.harmonics("radial_force") if x.h == 1.0]
     assert carrier == pytest.approx(3e-6, rel=0.005)
-    assert d.error_after < 3 * api.diagnose(_test()).error_after
+    assert d.error_after < 3 * _clean().error_after
 
 
 def test_mains_pickup_is_described_and_no_modal_rise_is_read_into_it():
@@ -234,6 +242,7 @@ def _family_on_transmissibility(index: int, f_fix: float):
     return wheel, api.diagnose(steady_test(fw.steady(wheel, noise=0.01, seed=0, effects=[Transmissibility()])))
 
 
+@pytest.mark.slow
 def test_lines_a_transmissibility_amplifies_at_nearly_every_speed_are_completed_after_it():
     """Family wheel 4 hard mounted on a fixture H = 1/(1 − r² + 2jζr) at 90 Hz (1.8x its top speed's rotation, ζ 0.03):
     the axial lines h 3 and 4.62 cross it, amplified at nearly every speed, and the empirical base leaves them out.
@@ -249,6 +258,7 @@ def test_lines_a_transmissibility_amplifies_at_nearly_every_speed_are_completed_
         assert got and np.sqrt(np.sum(np.square(got))) == pytest.approx(ln.C, rel=0.03), (ln.direction, ln.h, got)
 
 
+@pytest.mark.slow
 def test_a_stand_named_before_the_lines_it_amplifies_is_measured_again_on_them():
     """Family wheel 5 hard mounted on a transmissibility at 300 Hz (1.8x its top speed's rotation, ζ 0.03): the lines
     that pass closest to it (h 3.36 at 5304 rpm, 296.9 Hz; h 2 at 8826 and 9217 rpm, 294.2 and 307.2 Hz) are

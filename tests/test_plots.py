@@ -199,6 +199,7 @@ def test_campbell_labels_name_every_harmonic_and_do_not_overlap():
     _legend_artists_are_drawn(fig)
 
 
+@pytest.mark.slow
 def test_residual_waterfall_zoomed_to_the_lines():
     from rwadist.diagnose.report import _waterfall_figure
 

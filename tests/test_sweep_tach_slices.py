@@ -9,10 +9,13 @@ import sys
 import warnings
 from pathlib import Path
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import family_wheel as fw  # noqa: E402
 
 
+@pytest.mark.slow
 def test_a_run_up_read_with_its_tach_is_diagnosed_as_well_as_without_it(tmp_path):
     """``rwadist.diagnose`` (no model) of the run-up with its tach column: the slices' highest line sweeps at most
     2 bins of a Welch segment (the rule says so), every suspension mode located within 2 %, and the error within
