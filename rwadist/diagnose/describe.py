@@ -244,6 +244,7 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
     from ..bearings import line_causes as causes_of
     from ..model import DIRECTIONS
     from ..motor import motor_causes
+    from ..sideband_causes import sideband_causes, signed_lines
     from .describe_lines import ratio_resolution
 
     res = ratio_resolution(diag.ctx)
@@ -254,6 +255,12 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
     named = {(d, round(float(h), 3)) for e in diag.model.typed_effects()
              for d, h in getattr(e, "named_lines", tuple)()}
     lines = [(d, float(x.h)) for d in DIRECTIONS for x in diag.model.harmonics(d)]
+    signed = {d: signed_lines(d, diag.model.harmonics(d)) for d in DIRECTIONS}
+    # a line's sense, one per (direction, h): "counter" only where that is its one part
+    sense = {}
+    for d in DIRECTIONS:
+        for x in diag.model.harmonics(d):
+            sense[(d, float(x.h))] = getattr(x, "sense", None) if (d, float(x.h)) not in sense else None
     every = sorted({h for _, h in lines} | {float(h) for h in extra_h})
     out = []
     seen = set()
@@ -262,13 +269,15 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
         if (d, h) in seen or (d, round(h, 3)) in named:
             continue
         seen.add((d, h))
+        # one of two sidebands of a stronger line (a modulation of it), whatever else it may be
+        got = sideband_causes(d, h, sense.get((d, h)), signed[d], res)
         if abs(h - round(h)) <= 2 * res:
-            got = motor_causes(h, res, d)           # a whole multiple: no bearing ratio, a motor's ripple on Tz
+            got += motor_causes(h, res, d)          # a whole multiple: no bearing ratio, a motor's ripple on Tz
         else:
             # the lines of its direction stronger than it: what it may be a sum or difference of
             level = {float(x.h): abs(float(x.C)) for x in diag.model.harmonics(d) if getattr(x, "C", None) is not None}
             parents = [o for o, c in level.items() if c > level.get(h, np.inf)]
-            got = causes_of(h, res, bearings, [o for o in every if abs(o - h) > res], parents)
+            got += causes_of(h, res, bearings, [o for o in every if abs(o - h) > res], parents)
         if got:
             src = "effect" if (d, round(h, 3)) in added else ("base" if fitted else "model")
             out.append({"direction": d, "h": h, "source": src, "causes": got})

@@ -1,0 +1,73 @@
+"""A line that is one of two sidebands of a stronger line: the candidate cause "that line modulated m times a
+revolution".
+
+A rotating load of ratio p (its angle p·θ) whose amplitude or phase is modulated m times a revolution,
+a·(1 + ε·cos(mθ))·e^{i(pθ + β·sin(mθ))}, holds, besides its carrier, two lines at the signed ratios p + m and
+p − m: a line of a radial direction turns forward at a positive ratio and backward at a negative one, so the lower
+sideband of the imbalance (p = 1) modulated 6 times a revolution is a counter-rotating line at h 5 beside a
+co-rotating one at h 7 (session 60's new-user trial: a 6/rev phase modulation of index 0.05, both read right and
+named a bearing's ball passes).  For a small phase modulation the two sidebands hold β/2 of the carrier each, for an
+amplitude modulation ε/2 each: the same C (a line's C is its load over Ω², and both ride the carrier's load).  So a
+line is named a sideband where a stronger line of its direction stands at p and a line of the same C
+(:data:`SAME_C`) at the mirror ratio 2p − s.  A series of harmonics (1, 2, 3 of falling C) is not: its neighbours
+differ in C.  A whole m is a motor's ripple or cogging (:mod:`rwadist.motor`), or a gear's mesh."""
+from __future__ import annotations
+
+import math
+
+#: Two lines are a sideband pair when their C differ by at most this factor.
+SAME_C = 1.25
+#: The directions whose lines turn (a counter-rotating line: a negative ratio).
+TURNING = ("radial_force", "radial_torque")
+
+
+def signed_lines(direction: str, harmonics) -> list:
+    """[(signed ratio, C)] of a direction's harmonics (objects with ``h``, ``C``, ``sense``): a radial line's
+    counter-rotating part at −h, a planar one (both senses) at ±h."""
+    out = []
+    for x in harmonics:
+        c = getattr(x, "C", None)
+        if c is None:
+            continue
+        sense = getattr(x, "sense", None) if direction in TURNING else None
+        h = float(x.h)
+        if sense in ("counter", "planar"):
+            out.append((-h, abs(float(c))))
+        if sense != "counter":
+            out.append((h, abs(float(c))))
+    return out
+
+
+def sideband_causes(direction: str, h: float, sense, lines: list, resolution: float) -> list:
+    """Candidate causes (sentences) of the line at ratio ``h`` (its ``sense``: "counter" reads it at −h) among its
+    ``direction``'s ``lines`` (:func:`signed_lines`), ratios resolved to ``resolution``: "one of two sidebands of the
+    line h = p" for each stronger line at p whose mirror 2p − s holds a line of the same C (module docstring; in a
+    direction that does not turn, the mirror at |2p − s|)."""
+    turning = direction in TURNING
+    if not turning:
+        signs = (h,)
+    else:
+        signs = (-h,) if sense == "counter" else (h,) if sense == "co" else (h, -h)   # a line of both parts: either
+    out = []
+    for s in signs:
+        own = [c for r, c in lines if abs(r - s) <= resolution]
+        if not own:
+            continue
+        c0 = max(own)
+        for p, cp in lines:
+            m = abs(s - p)
+            if cp <= c0 or p == 0 or m <= 2 * resolution:
+                continue
+            at = 2 * p - s if turning else abs(2 * p - s)
+            mirror = [c for r, c in lines if abs(r - at) <= resolution]
+            if not any(abs(math.log(c / c0)) <= math.log(SAME_C) for c in mirror if c > 0):
+                continue
+            whole = abs(m - round(m)) <= 2 * resolution
+            out.append(f"one of two sidebands of the line h = {abs(p):.4g} at ±{m:.4g} per rev (with the {_line(at)}, "
+                       f"of the same C): that line modulated {m:.4g} times a revolution, in amplitude or phase"
+                       + (" (a motor's torque ripple or cogging, a gear's mesh)" if whole else ""))
+    return out
+
+
+def _line(signed: float) -> str:
+    return f"counter-rotating line h = {-signed:.4g}" if signed < 0 else f"line h = {signed:.4g}"
