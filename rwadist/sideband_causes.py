@@ -17,6 +17,8 @@ import math
 
 #: Two lines are a sideband pair when their C differ by at most this factor.
 SAME_C = 1.25
+#: The mirror line is looked for within this many ratio resolutions of 2p − s (three measured ratios' errors add up)
+MIRROR_RESOLUTIONS = 3.0
 #: The directions whose lines turn (a counter-rotating line: a negative ratio).
 TURNING = ("radial_force", "radial_torque")
 
@@ -44,6 +46,7 @@ def sideband_causes(direction: str, h: float, sense, lines: list, resolution: fl
     line h = p" for each stronger line at p whose mirror 2p − s holds a line of the same C (module docstring; in a
     direction that does not turn, the mirror at |2p − s|)."""
     turning = direction in TURNING
+    signs: tuple[float, ...]
     if not turning:
         signs = (h,)
     else:
@@ -59,7 +62,7 @@ def sideband_causes(direction: str, h: float, sense, lines: list, resolution: fl
             if cp <= c0 or p == 0 or m <= 2 * resolution:
                 continue
             at = 2 * p - s if turning else abs(2 * p - s)
-            mirror = [c for r, c in lines if abs(r - at) <= resolution]
+            mirror = [c for r, c in lines if abs(r - at) <= MIRROR_RESOLUTIONS * resolution]
             if not any(abs(math.log(c / c0)) <= math.log(SAME_C) for c in mirror if c > 0):
                 continue
             whole = abs(m - round(m)) <= 2 * resolution

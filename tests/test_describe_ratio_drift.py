@@ -237,16 +237,18 @@ def test_a_joined_drift_drops_the_partial_lines_of_every_line_it_was_read_from()
 
 
 def test_a_rising_ratio_is_worded_by_where_the_line_sits():
-    """A rising ratio under h ½ is a cage's, whose ratio slip lowers (session 60's new-user trial: a cage line drifting
-    0.3755 -> 0.39 read as "an inner-race ball pass (BPFI = n − BPFO)", which needs fewer than one ball); over 1.5 an
-    inner race's ball pass; between them neither."""
+    """A rising ratio in a cage's range is that cage's contact angle, which slip cannot raise (session 60's new-user
+    trial: a cage line drifting 0.3755 -> 0.39 read as "an inner-race ball pass (BPFI = n − BPFO)", which needs fewer
+    than one ball), the outer-race-turning cage's range (0.52-0.65) too; over the least ball pass over a turning race
+    (5 balls, γ 0.3: 1.75) a ball pass the cage's slip raises; between them neither."""
     from rwadist.diagnose.describe_drift import _cause
     rpm = np.array([1945.0, 6000.0])
     cage = _cause("rises", 0.3755, 0.39, 0.038, rpm)
-    assert "cage" in cage and "contact angle" in cage and "BPFI" not in cage
-    assert "inner-race ball pass" in _cause("rises", 4.70, 4.80, 0.02, rpm)
+    assert "cage" in cage and "inner race turns" in cage and "contact angle" in cage and "BPFI" not in cage
+    assert "outer race turns" in _cause("rises", 0.55, 0.57, 0.036, rpm)
+    assert "turning race" in _cause("rises", 4.70, 4.80, 0.02, rpm)
     between = _cause("rises", 1.10, 1.13, 0.027, rpm)
-    assert "no bearing slip" in between and "cage whose" not in between
+    assert "no bearing slip" in between and "1.75" in between and "contact angle" not in between
     assert "cage slipping" in _cause("falls", 0.40, 0.39, -0.025, rpm)
 
 

@@ -115,3 +115,52 @@ def test_a_drift_of_the_force_bridges_alone_is_read_on_the_forces(index, tmp_pat
     (u,) = [u for u in diag.unexplained if u.signature == "run_change"]
     assert u.channels == ("Fx", "Fy", "Fz"), u.channels
     assert u.parameters["drift_dB"] == pytest.approx(20 * np.log10(1.1 / 0.9), rel=0.1)
+
+
+def test_a_change_read_on_some_channels_is_taken_out_of_those_alone():
+    """Review of session 60: the drift read on the forces alone was still divided out of every channel when the search
+    ran again (``scale_runs``), putting its inverse into the steady torques.  The factors of a ``run_change`` record
+    (``run_steps``: a ``RunSteps`` carrying the record's channels, kept by ``step_sets``) scale those channels only."""
+    import importlib
+    from types import SimpleNamespace
+
+    from rwadist.data import Run, SteadyTest
+
+    describe = importlib.import_module("rwadist.diagnose.describe")
+    run_gains = importlib.import_module("rwadist.diagnose.run_gains")
+    ones = {c: np.ones(8) for c in fw.CHANNELS}
+    test = SteadyTest([Run(speed=100.0, sample_rate=1000.0, signals=dict(ones)) for _ in range(2)], {})
+    steps = describe.RunSteps({1: 20.0, 0: float("nan")}, ("Fx", "Fy", "Fz"))
+    scaled = describe.scale_runs(test, {1: steps[1]}, steps.channels)
+    assert [float(scaled.runs[1].signals[c][0]) for c in fw.CHANNELS] == [0.1, 0.1, 0.1, 1.0, 1.0, 1.0]
+    assert float(scaled.runs[0].signals["Fx"][0]) == 1.0
+    diag = SimpleNamespace(unexplained=[])
+    got = run_gains.step_sets(diag, lambda d, every_run=True: steps, located=0)
+    assert got and all(getattr(s, "channels", None) == ("Fx", "Fy", "Fz") for s in got)
+
+
+def test_a_direction_of_one_line_is_judged_on_that_line():
+    """Review of session 60: a direction's own factor asked for two lines a run, so a direction of one model line was
+    always left out of a change every direction shares.  Here 20 runs drifting 0 -> −1.5 dB on the radial force's two
+    lines and the radial torque's one, the axial force's two lines steady (0.05 dB noise): those two directions kept."""
+    from types import SimpleNamespace
+
+    from rwadist.diagnose.describe_structure import LineRatios
+    from rwadist.diagnose.run_gains import in_changed_directions
+
+    rng = np.random.default_rng(3)
+    n = 20
+    drift = np.linspace(0.0, -1.5, n)
+
+    def ratios(direction, hs, moves):
+        run = np.tile(np.arange(n), len(hs))
+        line = np.repeat(np.arange(len(hs)), n)
+        q = (drift[run] if moves else 0.0) + 0.05 * rng.standard_normal(run.size)
+        spin = 10.0 + run
+        h = np.asarray(hs, float)[line]
+        return LineRatios(direction, q, h * spin, run, spin, line, h, np.full(run.size, 1e4))
+
+    read = [ratios("radial_force", [1.0, 2.7], True), ratios("radial_torque", [1.0], True),
+            ratios("axial_force", [2.7, 3.9], False)]
+    kept = in_changed_directions(SimpleNamespace(runs=np.arange(n)), read)
+    assert [r.direction for r in kept] == ["radial_force", "radial_torque"]

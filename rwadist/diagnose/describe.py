@@ -61,9 +61,10 @@ def start(ctx: Context, steps: dict | None = None) -> Opened:
     copies = find_channel_copies(ctx, test)
     if copies:
         test = remove_channel_copies(test, copies)
+    on = getattr(steps, "channels", None)
     steps = dict(steps or {})
     if steps and test is not None:
-        test = scale_runs(test, {r: dB for r, dB in steps.items() if np.isfinite(dB)})
+        test = scale_runs(test, {r: dB for r, dB in steps.items() if np.isfinite(dB)}, on)
     if not fixed and not copies and not steps:
         return Opened(ctx, ctx)
     from ..spectra import compute_spectra
@@ -82,14 +83,25 @@ def start(ctx: Context, steps: dict | None = None) -> Opened:
     return Opened(context(kept), ctx, fixed, copies, steps, whole, sidebands=sidebands)
 
 
-def scale_runs(test, steps: dict):
-    """A copy of ``test`` with the records of each run r of ``steps`` multiplied by 10^(−steps[r]/20) (every channel:
-    the run's common factor, a power ratio in dB, taken out); new arrays, the input unchanged."""
+class RunSteps(dict):
+    """Run index -> dB of a run-to-run change (:func:`run_steps`), and ``channels``: those it was read on (None: every
+    channel; a drift of the force bridges alone is no change of the torques)."""
+
+    def __init__(self, steps=(), channels: tuple | None = None):
+        super().__init__(steps)
+        self.channels = channels
+
+
+def scale_runs(test, steps: dict, channels: tuple | None = None):
+    """A copy of ``test`` with the records of each run r of ``steps`` multiplied by 10^(−steps[r]/20) (the run's
+    common factor, a power ratio in dB, taken out) on ``channels`` (None: every channel); new arrays, the input
+    unchanged."""
     from dataclasses import replace
 
     from ..data import SteadyTest
 
-    runs = [replace(run, signals={c: x * 10.0 ** (-steps[i] / 20.0) for c, x in run.signals.items()})
+    runs = [replace(run, signals={c: x * 10.0 ** (-steps[i] / 20.0) if channels is None or c in channels else x
+                                  for c, x in run.signals.items()})
             if i in steps else run for i, run in enumerate(test.runs)]
     return SteadyTest(runs, dict(test.meta))
 
@@ -117,7 +129,7 @@ def search_standing(diag) -> tuple:
 RUN_UNREAD_FRACTION = 0.5
 
 
-def run_steps(diag, every_run: bool = True) -> dict:
+def run_steps(diag, every_run: bool = True) -> RunSteps:
     """Run index -> dB: the runs a ``run_change`` record of ``diag`` holds apart from the others (a few runs changed
     by a common factor: a re-mounting, a range switch) and their offsets, when the search may have been led by them:
     it added an effect beyond its base, or, on the default path (no model given), did not locate each of the wheel's
@@ -128,13 +140,13 @@ def run_steps(diag, every_run: bool = True) -> dict:
     the runs held apart otherwise.  Empty otherwise, or without the time series."""
     ctx = diag.ctx
     if ctx.test is None:
-        return {}
+        return RunSteps()
     recs = [u for u in diag.unexplained if u.signature == "run_change"]
     if not recs:
-        return {}
+        return RunSteps()
     located, minus_added = search_standing(diag)
     if not minus_added and (located == 3 or diag.model_given):
-        return {}
+        return RunSteps()
     index = {name: i for i, name in enumerate(ctx.sp.run_names)}
     p = recs[0].parameters
     # a drift spread over every run is taken out of every run, each by its factor against the model's lines
@@ -150,7 +162,7 @@ def run_steps(diag, every_run: bool = True) -> dict:
     unread = [index[n] for n in p.get("runs_not_read", ()) if n in index]
     if steps and len(unread) <= RUN_UNREAD_FRACTION * ctx.runs.size:
         steps.update({r: float("nan") for r in unread})
-    return steps
+    return RunSteps(steps, tuple(recs[0].channels))
 
 
 @dataclass

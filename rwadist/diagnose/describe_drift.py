@@ -22,15 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..bearings import BALL_COUNTS, GAMMA_RANGE, RATIO_RANGES
 from .describe_lines import log_parabola_offset, sliced
 from .unexplained import Unexplained
 
 #: Directions read and their channels (summed).
 DIRECTIONS = {"radial_force": ("Fx", "Fy"), "radial_torque": ("Tx", "Ty"), "axial_force": ("Fz",)}
-#: A cage's ratio with its inner race turning, ½(1 − (d/D)·cos α), lies under this
-CAGE_MAX_H = 0.5
-#: An inner-race ball pass, (n/2)(1 + (d/D)·cos α), lies over this with n ≥ 3 balls
-BPFI_MIN_H = 1.5
 #: Half-width of the window searched around h, as a fraction of h (a cage slips by a few per cent).
 WINDOW = 0.08
 #: The window stays under this fraction of the distance to the model's nearest other line.
@@ -249,24 +246,34 @@ def joined_tracks(readings: list, df: float) -> list:
 
 
 def _cause(way: str, h_lo: float, h_hi: float, drift: float, rpm: np.ndarray) -> str:
-    """The bearing cause of a drifting line, worded for the way its ratio goes and where it sits: a slipping cage
-    lowers the cage's ratio FTF = ½(1 − γ) and the outer race's ball pass n·FTF and raises the inner race's
-    BPFI = n − n·FTF, which lies over :data:`BPFI_MIN_H` (n ≥ 3 balls); a cage's ratio (under :data:`CAGE_MAX_H`)
-    rises only as γ = (d/D)·cos α shrinks: the contact angle α growing with the speed."""
+    """The bearing cause of a drifting line, worded for the way its ratio goes and where it sits
+    (:data:`rwadist.bearings.RATIO_RANGES`): a slipping cage lowers its own ratio (½(1 ∓ γ), γ = (d/D)·cos α, the
+    inner or the outer race turning) and the ball pass over the still race, n × it, and raises the ball pass over the
+    turning race, n × (1 − it), over :func:`_turning_pass_min` with :data:`rwadist.bearings.BALL_COUNTS` balls; a
+    cage's ratio rises only as γ changes: its contact angle moving with the speed."""
     span = f"from {h_lo:.4g} to {h_hi:.4g} ({100 * drift:+.1f} %) over {rpm.min():.0f}-{rpm.max():.0f} rpm"
     if way == "falls":
         return (f"a rolling bearing's cage slipping more as the speed grows: the line's ratio falls {span}, as the "
-                "cage's ratio and the outer race's ball pass (n × the cage's) fall together by one slip")
-    if max(h_lo, h_hi) < CAGE_MAX_H:
-        return (f"a rolling bearing's cage whose contact angle grows with the speed (the balls' centrifugal load on "
-                f"an angular-contact pair, or a preload changing as the bearing warms): the line's ratio rises {span}; "
-                "a slipping cage would lower it")
-    if min(h_lo, h_hi) >= BPFI_MIN_H:
-        return (f"a rolling bearing's inner-race ball pass (BPFI = n − BPFO) as its cage slips more with the speed: "
-                f"the line's ratio rises {span}, while the cage's own line and the outer race's ball pass would fall "
-                "by the same slip")
-    return (f"a line of the wheel whose ratio rises {span}: under any inner-race ball pass (BPFI ≥ "
-            f"{BPFI_MIN_H:g} with three balls or more) and over a cage's, so no bearing slip")
+                "cage's ratio and the still race's ball pass (n × the cage's) fall together by one slip")
+    lo, hi = min(h_lo, h_hi), max(h_lo, h_hi)
+    for key, (a, b, _) in RATIO_RANGES.items():
+        if a <= lo and hi <= b:
+            race = "inner" if key == "FTF" else "outer"
+            return (f"the cage of a ball bearing whose {race} race turns, its contact angle moving with the speed (the "
+                    f"balls' centrifugal load on an angular-contact pair, or a preload changing as the bearing warms): "
+                    f"the line's ratio rises {span}; a slipping cage would lower it")
+    if lo >= _turning_pass_min():
+        return (f"a rolling bearing's ball pass over its turning race (the inner-race ball pass BPFI = n − BPFO when "
+                f"the inner race turns) as its cage slips more with the speed: the line's ratio rises {span}, while the "
+                "cage's own line and the still race's ball pass would fall by the same slip")
+    return (f"a line of the wheel whose ratio rises {span}: off every cage's range and under any ball pass over a "
+            f"turning race (h ≥ {_turning_pass_min():.2f} with {BALL_COUNTS[0]} balls or more), so no bearing slip")
+
+
+def _turning_pass_min() -> float:
+    """The least ratio of a ball pass over a bearing's turning race: (n/2)(1 − γ) with the fewest balls and the
+    largest γ of :mod:`rwadist.bearings` (the outer race turning; the inner race's, (n/2)(1 + γ), lies higher)."""
+    return 0.5 * BALL_COUNTS[0] * (1.0 - GAMMA_RANGE[1])
 
 
 def ratio_drift(ctx, state, shares, more=()) -> list:

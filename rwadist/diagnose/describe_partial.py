@@ -4,7 +4,7 @@ A line the base fitted from the data over every run holds at the strength of the
 runs where it is absent the model puts it far over the data (a blue stripe of the residual waterfall at h·Ω/2π on
 those runs only).  No class explains a line that comes and goes with the run: it is described.  Read on the
 lines' measured-over-predicted ratios per direction (:func:`.describe_structure.line_ratios` with the absent
-runs kept), in the runs where the model's line stands :data:`~.describe_structure.LINE_SNR_DB` over the noise:
+runs kept), in the runs where the model's line stands :data:`~.describe_structure.ABSENT_SNR_DB` over the noise:
 absent where the data hold :data:`ABSENT_DB` or less of it (in a run where the line is resolved from the
 direction's other lines, :func:`others_in_window`), present within :data:`PRESENT_DB` of it.
 """

@@ -35,10 +35,10 @@ MODE_PARAMS = {"radial_translation": ("k_r", "c_r"), "rocking": ("k_rock", "c_ro
 MODE_SHIFT = 0.02
 
 
-def run_gains(ctx, ratios: list) -> np.ndarray:
+def run_gains(ctx, ratios: list, min_lines: int = MIN_LINES) -> np.ndarray:
     """Per run of the context (R,): its common factor (dB of power) against the model's lines, the runs' median 0,
-    NaN where fewer than :data:`MIN_LINES` lines are read; ``ratios`` the :class:`.describe_structure.LineRatios`."""
-    out = per_run_median(ratios, ctx.runs.size, 3, MIN_LINES, lambda r, m: np.median(r.q[m]))
+    NaN where fewer than ``min_lines`` lines are read; ``ratios`` the :class:`.describe_structure.LineRatios`."""
+    out = per_run_median(ratios, ctx.runs.size, 3, min_lines, lambda r, m: np.median(r.q[m]))
     ok = np.isfinite(out)
     if ok.any():
         out[ok] -= np.median(out[ok])
@@ -58,10 +58,11 @@ def in_changed_directions(ctx, ratios: list) -> list:
     common = run_gains(ctx, ratios)
     keep = []
     for r in ratios:
-        own = run_gains(ctx, [r])
+        own = run_gains(ctx, [r], min_lines=1)          # a direction of one line reads its factor on that line
         ok = np.isfinite(own) & np.isfinite(common)
         den = float(np.sum(common[ok] ** 2))
-        if ok.sum() >= 3 and den > 0 and float(np.sum(own[ok] * common[ok])) / den >= CHANGED_SHARE:
+        # a direction whose factor cannot be read against the common one is kept: no evidence it stayed still
+        if ok.sum() < 3 or den <= 0 or float(np.sum(own[ok] * common[ok])) / den >= CHANGED_SHARE:
             keep.append(r)
     return keep if keep else list(ratios)
 
@@ -174,7 +175,7 @@ def step_sets(diag, run_steps, located: int = 3) -> list:
     out: list = []
     for every in (((True, False) if located else (False, True)) if spread else (False,)):
         steps = run_steps(diag, every_run=every)
-        read = {r: dB for r, dB in steps.items() if np.isfinite(dB)}
+        read = type(steps)({r: dB for r, dB in steps.items() if np.isfinite(dB)}, steps.channels)
         if not read:
             continue
         sets = [read] + ([steps] if len(read) < len(steps) else [])
