@@ -277,3 +277,15 @@ def test_an_affine_line_a_rattle_in_some_runs_and_a_wide_hump_are_each_one_descr
     row = _cell(wheel, kind, tmp_path)
     assert "crashed" not in row and not row["added"] and row["modes_ok"], row
     assert dfm._described(row) and row["unexplained"] == [dfm.DESCRIBED_AS[kind]], row["unexplained_records"]
+
+
+def test_speed_sidebands_beating_in_one_direction_are_no_run_change(tmp_path):
+    """Session 60: read on the radial force's lines alone (the direction a change was located in), family wheel 2's
+    speed sidebands beating with their carrier scattered the runs 0.26 dB and were described as a run_change of Fx Fy
+    (-4.8 to +2.4 dB, every mode "on the changed runs"), which no direction's change had been seen in.  Whether the runs
+    changed is read on every direction; where, on those that follow it.  The matrix's cell: seed 1 + 100·2."""
+    w = dfm.wheels()[2]
+    cell = dfm.run_cell(2, w, "speed_sidebands", "speed_sidebands", [fe.default_effect("speed_sidebands", w)], 201,
+                        tmp_path, None)
+    assert "crashed" not in cell and cell["found"] == [True], cell
+    assert "run_change" not in cell["unexplained"], cell["unexplained_records"]

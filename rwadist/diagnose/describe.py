@@ -352,7 +352,6 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_partial import partial_lines
     from .describe_split import radial_pairs
     from .describe_trend import gain_trend
-    from .run_gains import annotate, in_changed_directions
 
     res = searched if res is None else res
     ctx, state = searched.ctx, floor_as_read(searched.ctx, searched.state)
@@ -407,8 +406,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     drifting = [u for u in drifting_modes(ctx, state, steady, of_track) if holds_content(u, res)]
     out += drifting + [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)
                        and not any(same_track(u, v) for v in drifting)]
-    read = in_changed_directions(ctx, structure.line_ratios(res.ctx, res.state) if changes else ratios)  # where it is
-    out += annotate(ctx, state, structure.run_change(ctx, read, of_runs, in_order(ctx, read)), read, taken_out=changes)
+    read = structure.line_ratios(res.ctx, res.state) if changes else ratios
+    out += _run_change(ctx, state, read, of_runs, in_order, changes)
     out += speed_lines(ctx, state, of_line, bearings, others, ctx.left_out)
     out += partial_lines(ctx, state, structure.line_ratios(ctx, state, absent=True), of_line)
     sidebands = sideband_lines(ctx, state, carriers, of_track_f, known_sidebands)
@@ -430,6 +429,24 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     out = with_affine_lines(ctx, state, with_drifts(ctx, state, out, of_line), affine_lines(ctx, state, of_track_f,
                                                                                              carriers))
     return structure.without_line_leaks(out, float(ctx.df))
+
+
+def _run_change(ctx, state, read: list, of_runs, in_order, taken_out: bool) -> list:
+    """The ``run_change`` records of the lines' ratios ``read`` (:func:`.describe_structure.run_change`, annotated by
+    :func:`.run_gains.annotate`): whether the runs changed is read on every direction's lines, where and by how much
+    on the directions that follow the change (:func:`.run_gains.in_changed_directions`; a drift of the force bridges
+    alone, read over every line at −1.22 dB for −1.5).  Read on one direction's lines from the start, a line's own
+    scatter (family wheel 2's speed sidebands beating in the radial force) was taken for a change of the runs."""
+    from . import describe_structure as structure
+    from .run_gains import annotate, in_changed_directions
+
+    got = structure.run_change(ctx, read, of_runs, in_order(ctx, read))
+    where = in_changed_directions(ctx, read) if got else read
+    if len(where) < len(read):
+        there = structure.run_change(ctx, where, of_runs, in_order(ctx, where))
+        if there:
+            got, read = there, where
+    return annotate(ctx, state, got, read, taken_out=taken_out)
 
 
 #: A hump at most this many bins wide whose peak lies within its own width of a fixed line on one of its channels is
