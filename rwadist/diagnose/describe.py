@@ -268,11 +268,12 @@ def line_causes(diag, bearings=(), extra_h=()) -> list:
              for d, h in getattr(e, "named_lines", tuple)()}
     lines = [(d, float(x.h)) for d in DIRECTIONS for x in diag.model.harmonics(d)]
     signed = {d: signed_lines(d, diag.model.harmonics(d)) for d in DIRECTIONS}
-    # a line's sense, one per (direction, h): "counter" only where that is its one part
-    sense = {}
+    # a line's sense, one per (direction, h): None where it has a co- and a counter-rotating part
+    parts: dict = {}
     for d in DIRECTIONS:
         for x in diag.model.harmonics(d):
-            sense[(d, float(x.h))] = getattr(x, "sense", None) if (d, float(x.h)) not in sense else None
+            parts.setdefault((d, float(x.h)), []).append(getattr(x, "sense", None))
+    sense = {k: v[0] if len(v) == 1 else None for k, v in parts.items()}
     every = sorted({h for _, h in lines} | {float(h) for h in extra_h})
     out = []
     seen = set()

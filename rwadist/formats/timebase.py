@@ -91,12 +91,16 @@ COARSE_MAX_FRACTION = 0.95
 #: Golden-section steps of :func:`_on_one_grid`'s search over the grid's step (the slopes of the lines through both end
 #: stamps' bands: 0.618^80, 1e-17 of that span)
 GRID_SEARCH_STEPS = 80
+
+
 def _on_one_grid(t: np.ndarray, q: np.ndarray) -> bool:
     """True when one uniform grid t0 + k·s (k = 0..n-1) lies within every stamp's rounding: some t0 and s with
     |t_k − t0 − k·s| ≤ q_k/2 for all k.  For a slope s the least gap left, max(t − q/2 − k·s) − min(t + q/2 − k·s),
     is convex in s: its least over the slopes of the lines through both end stamps' bands (golden section) is ≤ 0
     exactly when such a grid exists.  Not the least-squares step: where the step is an odd multiple of half the
-    rounding, ties round one way over long stretches and tilt it (4 kHz printed to 0.1 ms from t0 = 0.1 s)."""
+    rounding, ties round one way over long stretches and tilt it (4 kHz printed to 0.1 ms from t0 = 0.1 s).  A golden
+    section of its own: scipy's bounded Brent search stalls on this piecewise-linear gap (4 kHz and 40 kHz columns
+    with rounding ties refused)."""
     n = t.size
     i = np.arange(n, dtype=float)
     r = t - (t[0] + (t[-1] - t[0]) / (n - 1) * i)         # about the line through the ends: numbers of the rounding
