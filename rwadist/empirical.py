@@ -39,6 +39,7 @@ import numpy as np
 from scipy import signal, stats
 
 from .data import DataError
+from .fit_sidebands import fixed_offset_sidebands, in_band
 from .line_overlap import measured_beside
 from .model import DIRECTIONS, Harmonic, WheelModel
 from .progress import tqdm
@@ -122,6 +123,8 @@ class BinStat:
     presence: float
     kept: bool
     reason: str = ""
+    #: h of the stronger line this candidate is a fixed-offset sideband of (:func:`rwadist.fit_sidebands.fixed_offset_sidebands`), or None
+    sideband_of: float | None = None
 
 
 @dataclass
@@ -344,81 +347,12 @@ def _first_where(h_grid: np.ndarray, speed: np.ndarray, test) -> np.ndarray:
     return lo
 
 
-def _in_band(h, lines: _Lines, f_lo, f_hi):
-    f_line = np.asarray(h)[:, None] * lines.pair_speed_hz[None, :]
-    return (f_line >= f_lo) & (f_line <= f_hi)
-
-
-#: A candidate line is a pair of fixed-offset sidebands of a stronger line, not a harmonic, when its detections
-#: scatter about f = h·|Ω| by more than this many frequency bins (median) ...
-OFFSET_SCATTER_BINS = 0.3
-#: ... and about f = h₀·|Ω| ± Δ (a constant offset Δ Hz from the stronger line h₀) by less than this fraction of that,
-OFFSET_BETTER = 0.5
-#: ... with |Δ| at least this many bins (a sideband detected apart from its carrier).
-OFFSET_MIN_BINS = 2.0
-
-
-def _fixed_offset_sidebands(bins: list, lines: _Lines, df: float, f_lo: float, f_hi: float) -> None:
-    """Mark not kept (in place) the kept candidates of ``bins`` whose detections follow a stronger kept line h₀ at a
-    constant offset in Hz rather than a constant ratio of the speed: the sidebands of a modulation at a fixed
-    frequency (a speed ripple puts them beside every line, an amplitude modulation beside one).  Near the top speed
-    h₀ ± Δ/|Ω| changes slowly, so their detections there gather at one h and pass the presence test (family wheel 0,
-    a 5-Hz ripple at 600-6000 rpm: lines at h 0.94 and 1.06 in 42 % of the spectra, and the wheel's modes fitted on
-    them went wrong); they are no harmonic: ``sidebands`` and ``speed_ripple`` describe them.  Judged on the median
-    absolute scatter of the detections matched to the candidate about each law (a true harmonic is detected within a
-    small fraction of a bin of h·|Ω|; sidebands of a constant offset scatter about it by Δ − (h₀ − h)|Ω|).  Then, the
-    offsets Δ so found known, a candidate whose detections sit at whole multiples k·Δ (k ≠ 0) of a stronger line
-    (higher orders of a deep ripple, matched at one order at some speeds and another at others: family wheel 5,
-    β = 0.75 at h 5.64)."""
-    kept = [b for b in bins if b.kept]
-    if len(kept) < 2:
-        return
-    h = np.array([b.h for b in kept])
-    fpk = lines.match(h)
-    speed = lines.pair_speed_hz
-    ok = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)
-    tol = OFFSET_SCATTER_BINS * df
-    steps: list[float] = []                  # the offsets Δ (Hz) of the sidebands found
-    for multiples in (False, True):
-        for i, b in enumerate(kept):
-            if not b.kept or ok[i].sum() < 5:
-                continue
-            f, w = fpk[i, ok[i]], speed[ok[i]]
-            ratio = float(np.median(np.abs(f - b.h * w)))
-            if ratio <= tol:
-                continue
-            for a in kept:
-                if a is b or not a.kept or a.n_bin <= b.n_bin:
-                    continue
-                dev = f - a.h * w
-                if not multiples:
-                    offset = float(np.median(dev))
-                    # a sideband stands apart from its carrier (2 bins: two peaks); a candidate on the carrier's own
-                    # detections (two candidates refined onto one unresolved pair: E wheel 5.37/5.57 at 2048 samples)
-                    # is no sideband
-                    if abs(offset) >= OFFSET_MIN_BINS * df and \
-                            float(np.median(np.abs(dev - offset))) < OFFSET_BETTER * ratio:
-                        steps.append(abs(offset))
-                        b.kept = False
-                        b.reason = (f"sidebands of h {a.h:.4g} at a fixed offset of {offset:+.3g} Hz (not a constant "
-                                    "ratio of the speed)")
-                        break
-                    continue
-                hit = next((d for d in steps if np.all(np.rint(dev / d) != 0)
-                            and float(np.median(np.abs(dev - d * np.rint(dev / d)))) < min(tol, OFFSET_BETTER * ratio)),
-                           None)
-                if hit is not None:
-                    b.kept = False
-                    b.reason = f"sidebands of h {a.h:.4g} at multiples of a fixed offset of {hit:.3g} Hz"
-                    break
-
-
 def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, direction: str,
                        df: float | None = None):
     """Harmonic numbers of one direction: candidate bins from N_bin(h), each h
     refined by least squares of f = h·|Ω| over its lines (Eq. 3.2), kept when
     P >= P_0 and, given the spectra's resolution ``df`` (Hz), not the sidebands of a stronger line at a fixed offset
-    (:func:`_fixed_offset_sidebands`).  Returns a list of :class:`BinStat` sorted by h."""
+    (:func:`rwadist.fit_sidebands.fixed_offset_sidebands`).  Returns a list of :class:`BinStat` sorted by h."""
     if lines.pair_run.size == 0:
         return []
     h_hi = min(s.h_range[1], f_hi / lines.pair_speed_hz.min())
@@ -436,29 +370,39 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
     h = h_grid[np.union1d(*cand) - 1]
     for _ in range(2):
         fpk = lines.match(h)
-        ok = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)
+        ok = np.isfinite(fpk) & in_band(h, lines, f_lo, f_hi)
         w = np.where(ok, lines.pair_speed_hz[None, :], 0.0)
         num, den = np.sum(np.where(ok, fpk, 0.0) * w, axis=1), np.sum(w**2, axis=1)
         h = np.where(den > 0, num / np.where(den > 0, den, 1), h)
-    ok = np.isfinite(lines.match(h)) & _in_band(h, lines, f_lo, f_hi)
-    n_b, n_p = ok.sum(axis=1), _in_band(h, lines, f_lo, f_hi).sum(axis=1)
+    fpk = lines.match(h)
+    ok = np.isfinite(fpk) & in_band(h, lines, f_lo, f_hi)
+    n_b, n_p = ok.sum(axis=1), in_band(h, lines, f_lo, f_hi).sum(axis=1)
+    # each candidate's detections' scatter about f = h·|Ω| (Hz, median): a harmonic's lie on its law, a candidate
+    # refined between a carrier and its sidebands scatters by their offset
+    scatter = [float(np.median(np.abs(fpk[i, ok[i]] - h[i] * lines.pair_speed_hz[ok[i]]))) if ok[i].any() else np.inf
+               for i in range(h.size)]
     stats_ = []
-    for hk, nb, npss in zip(h, n_b, n_p):
+    for hk, nb, npss, sc in zip(h, n_b, n_p, scatter):
         presence = float(nb / npss) if npss else 0.0
         kept = bool(presence >= s.presence_min and nb >= s.min_detections)
         reason = "" if kept else (f"presence {presence:.0%} < P0 {s.presence_min:.0%}"
                                   if presence < s.presence_min else f"only {int(nb)} detections")
-        stats_.append(BinStat(direction, float(hk), int(nb), int(npss), presence, kept, reason))
-    stats_.sort(key=lambda b: b.h)
+        stats_.append((BinStat(direction, float(hk), int(nb), int(npss), presence, kept, reason), sc))
+    stats_.sort(key=lambda bs: bs[0].h)
     merged: list[BinStat] = []
-    for b in stats_:  # two candidates refined onto one line: keep the better supported
+    merged_scatter = np.inf
+    for b, sc in stats_:
+        # two candidates refined onto one line: keep the better supported, of two as well supported the one on its
+        # law (a 1x line amplitude-modulated at 0.7 Hz, trial nuR: candidates at h 0.985, 1.0 and 1.0145 all in every
+        # run; the first kept on a tie, the carrier merged into its lower sideband's candidate and the 1x line lost)
         if merged and abs(b.h - merged[-1].h) < s.epsilon:
-            if b.n_bin > merged[-1].n_bin:
-                merged[-1] = b
+            if (b.n_bin, -sc) > (merged[-1].n_bin, -merged_scatter):
+                merged[-1], merged_scatter = b, sc
             continue
         merged.append(b)
+        merged_scatter = sc
     if df is not None:
-        _fixed_offset_sidebands(merged, lines, df, f_lo, f_hi)
+        fixed_offset_sidebands(merged, lines, df, f_lo, f_hi)
     return merged
 
 
@@ -590,7 +534,7 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
     h = np.array([b.h for b in kept])
     fpk = lines.match(h)                                    # (n_h, n_pairs)
     predicted = h[:, None] * lines.pair_speed_hz[None, :]
-    valid = np.isfinite(fpk) & _in_band(h, lines, f_lo, f_hi)
+    valid = np.isfinite(fpk) & in_band(h, lines, f_lo, f_hi)
     # resolved: no other harmonic's line within the summed bins of this one ...
     at = np.where(np.isfinite(fpk), fpk, predicted)
     clear = np.abs(predicted[None, :, :] - at[:, None, :]) >= (2 * s.line_half_width + 1) * df   # (a, b, pair)
@@ -604,7 +548,13 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
         pair = np.arange(lines.pair_run.size)[None, :]
         n_near = (np.searchsorted(keys, pair + (star + half) / lines.scale, "right")
                   - np.searchsorted(keys, pair + (star - half) / lines.scale, "left"))
-    resolved = valid & clear.all(axis=1) & (n_near <= 1)
+    # a carrier's own fixed-offset sidebands (an amplitude modulation, a speed ripple) may lie under its window: its
+    # measurement then holds their power with its own, as a harmonic read with weak neighbours does (a 1x line
+    # modulated 0.3 at 0.7 Hz, family wheel 2 at 4096 samples: its two sidebands under the window in every run, the
+    # imbalance left out of the fit and the wheel's modes lost with it)
+    carriers = {b.sideband_of for b in bins if b.sideband_of is not None}
+    own_sides = np.array([2 if any(abs(x - hk) < 1e-9 for x in carriers) else 0 for hk in h])
+    resolved = valid & clear.all(axis=1) & (n_near <= 1 + own_sides[:, None])
     hi_, pi_ = np.nonzero(resolved)
     d, sig = _line_powers(spectra, chans, lines, fpk, hi_, pi_, floors, s)
     # a line with only weak lines in its bins (a carrier's speed sidebands at low speed) is measured there too
