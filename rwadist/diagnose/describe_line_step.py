@@ -47,6 +47,11 @@ SIDE_COURSE_SHARE = 0.25
 #: through a resonance the model lacks scatters about any two levels: the new-user trial's W1 with its modes unfitted,
 #: h 5.39 through the 420 Hz translation read +8.4 dB at 3.1 dB scatter; a step of the imbalance 1.6 dB at 0.02)
 STEP_OVER_SCATTER = 4.0
+#: A line's drift over the test (``line_drift``): its level rank-correlated with the order the runs were recorded in
+#: (Kendall's τ) with a chance below this, two-sided ...
+DRIFT_CHANCE = 1e-4
+#: ... and not with their speed below this (a misfit with speed is read in any order the runs were recorded in)
+DRIFT_SPEED_CHANCE = 1e-3
 
 
 def _series(ctx, ratios: list) -> list:
@@ -152,6 +157,86 @@ def two_levels(x: np.ndarray, y: np.ndarray) -> dict | None:
     return cp
 
 
+def drift(recorded: np.ndarray, spin: np.ndarray, y: np.ndarray) -> dict | None:
+    """A line's drift over the test: its dB ratios ``y`` (R,, NaN where not read) against the runs' positions in the
+    order they were recorded (``recorded``, R,), the runs' speeds ``spin`` (R,) beside, when they follow that order
+    (Kendall's τ, chance below :data:`DRIFT_CHANCE`) and not the speed (:data:`DRIFT_SPEED_CHANCE`), along a Theil-Sen
+    line that moves :data:`MIN_STEP_DB` or more over the test and :data:`STEP_OVER_SCATTER` times the runs' robust
+    scatter about it: a dict (``change_dB`` over the test, ``slope_dB_per_run``, ``scatter_dB``, ``chance``), or None.
+    Fewer than 2·:data:`MIN_SIDE_RUNS` + 2 runs read: None."""
+    from scipy.stats import kendalltau, theilslopes
+
+    ok = np.isfinite(y)
+    if ok.sum() < 2 * MIN_SIDE_RUNS + 2 or np.ptp(y[ok]) < MIN_STEP_DB:
+        return None
+    x, v = recorded[ok], y[ok]
+    chance = float(kendalltau(x, v)[1])
+    if not chance < DRIFT_CHANCE or float(kendalltau(np.abs(spin[ok]), v)[1]) < DRIFT_SPEED_CHANCE:
+        return None
+    slope, icpt = (float(a) for a in theilslopes(v, x)[:2])
+    change = slope * float(np.ptp(x))
+    scatter = 1.4826 * float(np.median(np.abs(v - (icpt + slope * x))))
+    if abs(change) < max(MIN_STEP_DB, STEP_OVER_SCATTER * scatter):
+        return None
+    return {"change_dB": change, "slope_dB_per_run": slope, "scatter_dB": scatter, "chance": chance}
+
+
+def _course(recorded: np.ndarray, y: np.ndarray) -> float | None:
+    """A line's change over the test in the recorded order (dB: its Theil-Sen slope against ``recorded`` times their
+    span), None with fewer than 2·:data:`MIN_SIDE_RUNS` runs read."""
+    from scipy.stats import theilslopes
+
+    ok = np.isfinite(y)
+    if ok.sum() < 2 * MIN_SIDE_RUNS:
+        return None
+    return float(theilslopes(y[ok], recorded[ok])[0]) * float(np.ptp(recorded[ok]))
+
+
+def line_drifts(ctx, series: list, recorded: np.ndarray, stepped: set, shares) -> list:
+    """``line_property`` records (property ``line_drift``) of the model's lines (``series``: [(direction, h, y)] as
+    :func:`line_steps` reads them) whose level drifts over the test in the order the runs were recorded (``recorded``:
+    positions, not the speed order) while the other lines keep their course (their own change over the test, and their
+    own direction's, less than :data:`OTHERS_SHARE` of it: every line alike is a ``run_change``); not a line of
+    ``stepped`` ((direction, h) already described as a step).  New-user trial nuR (a 12-kg wheel, its bearing line h
+    3.31 growing x 1 -> x 3 over 40 runs recorded in shuffled speed order): nothing was said, 11x the clean error."""
+    spin = ctx.omega[ctx.runs] / (2 * np.pi)
+    rpm = np.abs(ctx.omega[ctx.runs]) * RAD_S_TO_RPM
+    names = [ctx.sp.run_names[int(r)] if r < len(ctx.sp.run_names) else str(int(r)) for r in ctx.runs]
+    out = []
+    for direction, h, y in series:
+        if (direction, h) in stepped or (d := drift(recorded, spin, y)) is None:
+            continue
+        courses = [(dd, c) for dd, x, v in series if (dd, x) != (direction, h)
+                   if (c := _course(recorded, v)) is not None]
+        others = [c for _, c in courses]
+        own = [c for dd, c in courses if dd == direction]
+        if any(x and abs(float(np.median(x))) >= OTHERS_SHARE * abs(d["change_dB"]) for x in (others, own)):
+            continue
+        used = np.flatnonzero(np.isfinite(y))
+        first, last = int(used[np.argmin(recorded[used])]), int(used[np.argmax(recorded[used])])
+        chans = tuple(c for c in DIRECTION_CHANNELS[direction] if c in ctx.channels)
+        share, _ = shares(chans, h, ctx.runs[used])
+        factor = 10 ** (d["change_dB"] / 20)
+        f = h * np.abs(spin[used])
+        what = ("the imbalance moving (a part creeping, a balance mass working loose)"
+                if abs(h - 1.0) < 1e-3 and direction in ("radial_force", "radial_torque") else
+                "the line's source wearing in or warming (a bearing's lubricant, its preload relaxing, a defect growing)")
+        out.append(Unexplained(
+            signature="line_property", channels=chans, speed_rpm=(float(rpm[used].min()), float(rpm[used].max())),
+            f_Hz=(float(f.min()), float(f.max())), level_dB=d["change_dB"], share=share, n_runs=int(used.size),
+            parameters={"property": "line_drift", "direction": direction, "h": h, "change_dB": d["change_dB"],
+                        "amplitude_ratio": float(factor), "slope_dB_per_run": d["slope_dB_per_run"],
+                        "scatter_dB": d["scatter_dB"], "chance": d["chance"], "order": "recorded",
+                        "from_run": names[first], "to_run": names[last],
+                        "others_change_dB": float(np.median(others)) if others else None},
+            causes=(f"{direction.replace('_', ' ')} h = {h:.4g} drifted by x {factor:.3g} in amplitude from "
+                    f"{names[first]} to {names[last]} in the order the runs were recorded (runs.csv's rows), the other "
+                    f"lines on their course: {what}; the model's C is their average",),
+            would_tell=("a run at one speed repeated at the start and at the end of the test (a drift in time holds at "
+                        "every speed), and the line's level against the test's time or temperature")))
+    return out
+
+
 def without_steps(ctx, r):
     """The line ratios ``r`` (:class:`.describe_structure.LineRatios`) without the points of a line whose levels step
     between two flat levels over the runs in speed order (:func:`two_levels`): its runs above the step are no
@@ -253,6 +338,9 @@ def line_steps(ctx, state, ratios: list, shares, described=()) -> list:
                     f"{names[last]} ({rpm[last]:.0f} rpm) and {names[first]} ({rpm[first]:.0f} rpm), {order}, "
                     f"the other lines on their course: {what}; the model's C is a compromise of the two",),
             would_tell=would))
+    if recorded is not None:
+        out += line_drifts(ctx, series, recorded, {(u.parameters["direction"], u.parameters["h"]) for u in out},
+                           shares)
     return out
 
 
@@ -271,6 +359,8 @@ def with_line_steps(records: list, steps: list) -> list:
 
     def at_an_edge(u) -> bool:
         rpm = present.get((u.parameters["direction"], round(u.parameters["h"], 4)))
+        if u.parameters["property"] != "line_step":
+            return False
         lo, hi = u.parameters["step_between_rpm"]
         return (rpm is not None and u.parameters.get("order") == "speed"
                 and any(lo - 1e-6 <= x <= hi + 1e-6 for x in (min(rpm), max(rpm))))

@@ -76,6 +76,8 @@ LEVEL_WORDS = {
     "line_property:channel_resonance": "{:+.2f} dB (power) in the channel's lines against its partner's at the "
                                        "resonance",
     "line_property:line_step": "{:+.2f} dB (power) step of the line between two runs, the other lines on their course",
+    "line_property:line_drift": "{:+.2f} dB (power) drift of the line over the test in the order its runs were "
+                                "recorded, the other lines on their course",
     "line_property:ratio_drift": "the data {:+.1f} dB over the model in its bins (median)",
     "line_property:channel_skew": "{:+.1f} dB: the other rotation sense's share of a line's power at the highest "
                                   "line read",
