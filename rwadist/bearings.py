@@ -18,7 +18,7 @@ Without geometry, the ranges the ratios can take (:data:`RATIO_RANGES`) from d/D
 and α in [0°, 40°]: γ in [0.038, 0.30], the cage 0.35-0.48 of the speed (inner race turning) or 0.52-0.65 (outer race
 turning).  :func:`line_causes` names the candidates for a line's ratio: a given bearing's ratios (and their 2nd and
 3rd multiples) within the resolution, else the ranges, the relations among the lines (a ball pass n × the cage, an
-outer/inner ball-pass pair summing to n, a line's 2nd or 3rd multiple) and, without geometry, the ball counts whose
+outer/inner ball-pass pair summing to n, a line's k-th multiple) and, without geometry, the ball counts whose
 ball passes can take the ratio.
 
 Where the user gives the geometry (docs/diagnose.md, "Physical causes for lines"): the model file's ``wheel``
@@ -37,6 +37,9 @@ from .errors import DataError
 
 #: Ranges of γ = (d/D)·cos α without geometry: d/D in [0.05, 0.30], α in [0°, 40°].
 GAMMA_RANGE = (0.05 * math.cos(math.radians(40.0)), 0.30)
+#: The highest multiple k of another non-integer line a line is named as (a bearing defect's impacts hold many: trial
+#: nuR's half-sine pulses at 3.31 put lines at 3.31·k to k = 12, the 2nd and 3rd alone were named)
+MAX_MULTIPLE = 16
 #: Ball counts a bearing's ball-pass relations are searched over.
 BALL_COUNTS = (5, 40)
 #: The ratios' ranges without geometry (name -> (lo, hi, what)).
@@ -160,7 +163,7 @@ def line_causes(h: float, resolution: float, bearings=(), others=(), parents=())
     none within it): the ranges of :data:`RATIO_RANGES` that hold h.  ``others``: the ratios of the other lines
     (the model's and the data's): h = n × a cage-range line (a ball pass over the still race), h = n × (1 − a
     cage-range line) (over the turning race), or h + another non-integer line = n (an outer/inner ball-pass pair,
-    whose cage ratio is then the smaller over n), n in :data:`BALL_COUNTS`, or the 2nd or 3rd multiple of another
+    whose cage ratio is then the smaller over n), n in :data:`BALL_COUNTS`, or the k-th multiple of another
     non-integer line; last, the ball counts whose ball passes can take h (:func:`_ball_pass_ranges`).  ``parents``: the
     ratios of the lines of h's direction stronger than it, whose sums and differences it may be (:func:`_combinations`:
     a combination is weaker than the lines it is made of, and read among every line one pair or another sums to
@@ -228,7 +231,8 @@ def _ball_pass_ranges(h: float, resolution: float, where: str) -> list:
 def _relations(h: float, resolution: float, others, parents=()) -> list:
     """Sentences relating a non-integer line at ``h`` to the other lines' ratios ``others``: a ball pass n × a
     cage-range line (over the still race) or n × (1 − it) (over the turning race), an outer/inner ball-pass pair
-    summing to n, and the 2nd or 3rd multiple of another non-integer line (a bearing line's harmonics).
+    summing to n, and the k-th multiple (2 <= k <= :data:`MAX_MULTIPLE`) of another non-integer line (a bearing line's
+    harmonics).
 
     Ordered by how well each holds: those within half of their own tolerance first (a multiple of another line before
     a pair before a ball pass: the fewer causes, the likelier), then the rest by their distance in units of their own
@@ -237,6 +241,7 @@ def _relations(h: float, resolution: float, others, parents=()) -> list:
     "16 × 0.5799 = 9.278", 14 whole-record bins off, before the exact 2nd multiple of 4.621."""
     n_lo, n_hi = BALL_COUNTS
     out = []
+    multiple_of: dict = {}              # a multiple's sentence -> the line it is a multiple of
     cage = [RATIO_RANGES[k][:2] for k in ("FTF", "FTF_outer")]
     for o in others:
         if abs(o - h) <= resolution:
@@ -256,15 +261,24 @@ def _relations(h: float, resolution: float, others, parents=()) -> list:
                         f"an outer/inner ball-pass pair of a {n}-ball bearing with the line h = {o:.4g} "
                         f"(BPFO + BPFI = n; cage {min(h, o) / n:.4g})"))
         k = round(h / o) if o > 0 else 0
-        if k in (2, 3) and abs(o - round(o)) > 2 * resolution and abs(h - k * o) <= k * resolution:
-            out.append((abs(h - k * o) / (k * resolution), 0,
-                        f"the {'2nd' if k == 2 else '3rd'} multiple of the line h = {o:.4g} (a harmonic of that line's "
-                        f"cause: a bearing line's impacts are not sinusoidal)"))
+        if 2 <= k <= MAX_MULTIPLE and abs(o - round(o)) > 2 * resolution and abs(h - k * o) <= k * resolution:
+            sentence = (f"the {_ordinal(k)} multiple of the line h = {o:.4g} (a harmonic of that line's cause: a "
+                        "bearing line's impacts are not sinusoidal)")
+            multiple_of[sentence] = o
+            out.append((abs(h - k * o) / (k * resolution), 0, sentence))
     out += _combinations(h, resolution, [o for o in parents if abs(o - h) > resolution and o > 0])
-    out.sort(key=lambda x: (x[0] > 0.5, x[1] if x[0] <= 0.5 else 0, x[0]))
+    # of the multiples that hold, the one of the lowest line first: the series' own base (trial nuR's impacts at
+    # 3.31·k: h 13.24 read "the 2nd multiple of 6.62" and h 29.79 "the 3rd of 9.93")
+    out.sort(key=lambda x: (x[0] > 0.5, x[1] if x[0] <= 0.5 else 0, multiple_of.get(x[2], math.inf) if x[0] <= 0.5 else 0,
+                            x[0]))
     # one line read in several directions (h 3.3 in the radial force, torque and axial force, each a few 1e-4 apart)
     # is one relation: each sentence once, in the order of its closeness
     return list(dict.fromkeys(x[2] for x in out))
+
+
+def _ordinal(k: int) -> str:
+    """2nd, 3rd, 4th, ..., 11th, 12th, 13th, 21st, ..."""
+    return f"{k}{'th' if 10 <= k % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(k % 10, 'th')}"
 
 
 def _combinations(h: float, resolution: float, others) -> list:

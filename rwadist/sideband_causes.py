@@ -59,17 +59,35 @@ def sideband_causes(direction: str, h: float, sense, lines: list, resolution: fl
         c0 = max(own)
         for p, cp in lines:
             m = abs(s - p)
-            if cp <= c0 or p == 0 or m <= 2 * resolution:
+            # the line's own part of the other sense is no carrier of it (a planar line: trial nuR's impacts at h 3.31,
+            # "one of two sidebands of the line h = 3.31")
+            if cp <= c0 or p == 0 or m <= 2 * resolution or abs(abs(p) - abs(s)) <= resolution:
                 continue
             at = 2 * p - s if turning else abs(2 * p - s)
             mirror = [c for r, c in lines if abs(r - at) <= MIRROR_RESOLUTIONS * resolution]
-            if not any(abs(math.log(c / c0)) <= math.log(SAME_C) for c in mirror if c > 0):
+            if not any(abs(math.log(c / c0)) <= math.log(SAME_C) for c in mirror if c > 0) or \
+                    _one_series((s, p, at), lines, resolution):
                 continue
             whole = abs(m - round(m)) <= 2 * resolution
             out.append(f"one of two sidebands of the line h = {abs(p):.4g} at ±{m:.4g} per rev (with the {_line(at)}, "
                        f"of the same C): that line modulated {m:.4g} times a revolution, in amplitude or phase"
                        + (" (a motor's torque ripple or cogging, a gear's mesh)" if whole else ""))
     return out
+
+
+def _one_series(ratios, lines: list, resolution: float) -> bool:
+    """Whether every ratio of ``ratios`` (signed) is a whole multiple (1, 2, ...) of one line of ``lines`` whose ratio
+    is not a whole number: the harmonics of one non-sinusoidal source (a bearing defect's impacts, trial nuR: its lines
+    at 3.31·k, each of both senses, read "sidebands of h 3.31 at ±13.24 per rev"), not a modulation.  A whole base
+    (the imbalance's 1) is not asked: a modulation of the imbalance m times a revolution puts its sidebands at whole
+    ratios too (the trial of session 60's 6/rev phase modulation)."""
+    for b in {abs(r) for r, _ in lines}:
+        if b <= 2 * resolution or abs(b - round(b)) <= 2 * resolution:
+            continue
+        k = [round(abs(r) / b) for r in ratios]
+        if all(n >= 1 and abs(abs(r) - n * b) <= MIRROR_RESOLUTIONS * resolution * n for r, n in zip(ratios, k)):
+            return True
+    return False
 
 
 def _line(signed: float) -> str:

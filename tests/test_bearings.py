@@ -170,3 +170,16 @@ def test_a_line_at_half_or_a_third_of_the_speed_is_named_a_subharmonic():
     for h, k in ((0.5004, 2), (0.3331, 3)):
         assert any(x.startswith(f"a subharmonic, 1/{k} of the speed: a rub") for x in line_causes(h, 0.002))
     assert not any("subharmonic" in x for x in line_causes(0.4100, 0.002) + line_causes(0.5100, 0.002))
+
+
+def test_a_high_multiple_is_named_of_the_series_base():
+    """Trial nuR's bearing-defect impacts (half-sine pulses at 3.31 a revolution): lines at 3.31·k to k = 12; h 13.24
+    was "the 2nd multiple of 6.62", h 29.79 "the 3rd of 9.93" and h 16.55 "the difference of 26.48 and 9.93"
+    first.  Now the series' base first, whichever multiple."""
+    series = [3.31 * k for k in range(1, 13)]
+    for k in (4, 5, 9, 12):
+        causes = line_causes(3.31 * k, 0.002, others=[o for o in series if o != 3.31 * k], parents=series[:k - 1])
+        assert causes[0].startswith(f"the {k}th multiple of the line h = 3.31 "), (k, causes[:2])
+    assert line_causes(3.31 * 2, 0.002, others=series[2:] + [3.31])[0].startswith("the 2nd multiple of the line h = 3.31")
+    # beyond MAX_MULTIPLE no multiple is named (a low line divides nearly anything at a high enough order)
+    assert not any("multiple" in x for x in line_causes(0.4137 * 23, 0.002, others=[0.4137]))

@@ -54,3 +54,28 @@ def test_an_axial_line_reads_its_lower_sideband_at_the_absolute_ratio():
     model = _lines([(2.0, 1e-7, None), (8.0, 5e-9, None), (4.0, 5e-9, None)])
     lines = signed_lines("axial_force", model)
     assert "sidebands of the line h = 2 at ±6" in sideband_causes("axial_force", 8.0, None, lines, RES)[0]
+
+
+def _impacts(base=3.31, n=12, c=2e-7):
+    """A bearing defect's impacts along one fixed direction (trial nuR): the lines k·base, each of both senses (a
+    fixed-direction load is a co- and a counter-rotating part of half its amplitude each, read a few per cent apart),
+    their C falling slowly with k (a short pulse's spectrum: 2 % a harmonic)."""
+    return [(k * base, c * (1 - 0.02 * k) * (1.03 if s == "co" else 1.0), s) for k in range(1, n + 1)
+            for s in ("co", "counter")]
+
+
+def test_the_harmonics_of_a_planar_non_integer_line_are_no_sidebands():
+    """Trial nuR: the counter part of h 3.31 was "one of two sidebands of the line h = 3.31", and every multiple from
+    the 4th "one of two sidebands of h 3.31 at ±13.24 per rev": the series of one non-sinusoidal source."""
+    lines = signed_lines("radial_force", _lines(_impacts()))
+    for k in range(1, 13):
+        for sense in ("co", "counter", None):
+            assert sideband_causes("radial_force", k * 3.31, sense, lines, RES) == [], (k, sense)
+
+
+def test_a_modulation_of_a_non_integer_line_beside_its_harmonics_is_still_named():
+    """The rule above asks for one series: the 6/rev sidebands of the bearing line 3.07 (2.93 and 9.07 are no
+    multiples of 3.07) are named beside that line's own 2nd and 3rd harmonics."""
+    model = _lines(_modulated([(1.0, 4e-7), (3.07, 2.4e-8)]) + [(6.14, 6e-9, "co"), (9.21, 3e-9, "co")])
+    lines = signed_lines("radial_force", model)
+    assert "sidebands of the line h = 3.07 at ±6" in sideband_causes("radial_force", 2.93, "counter", lines, RES)[0]
