@@ -261,7 +261,9 @@ def _relations(h: float, resolution: float, others, parents=()) -> list:
                         f"an outer/inner ball-pass pair of a {n}-ball bearing with the line h = {o:.4g} "
                         f"(BPFO + BPFI = n; cage {min(h, o) / n:.4g})"))
         k = round(h / o) if o > 0 else 0
-        if 2 <= k <= MAX_MULTIPLE and abs(o - round(o)) > 2 * resolution and abs(h - k * o) <= k * resolution:
+        # a cage-range line's multiples beyond the 3rd are its ball passes' relation (BPFO = Z·FTF), said above
+        top = 3 if any(lo <= o <= hi for lo, hi in cage) else MAX_MULTIPLE
+        if 2 <= k <= top and abs(o - round(o)) > 2 * resolution and abs(h - k * o) <= k * resolution:
             sentence = (f"the {_ordinal(k)} multiple of the line h = {o:.4g} (a harmonic of that line's cause: a "
                         "bearing line's impacts are not sinusoidal)")
             multiple_of[sentence] = o

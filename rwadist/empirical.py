@@ -552,9 +552,7 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
     # measurement then holds their power with its own, as a harmonic read with weak neighbours does (a 1x line
     # modulated 0.3 at 0.7 Hz, family wheel 2 at 4096 samples: its two sidebands under the window in every run, the
     # imbalance left out of the fit and the wheel's modes lost with it)
-    carriers = {b.sideband_of for b in bins if b.sideband_of is not None}
-    own_sides = np.array([2 if any(abs(x - hk) < 1e-9 for x in carriers) else 0 for hk in h])
-    resolved = valid & clear.all(axis=1) & (n_near <= 1 + own_sides[:, None])
+    resolved = valid & clear.all(axis=1) & (n_near <= 1 + _own_sides_near(bins, h, lines, fpk, s, df))
     hi_, pi_ = np.nonzero(resolved)
     d, sig = _line_powers(spectra, chans, lines, fpk, hi_, pi_, floors, s)
     # a line with only weak lines in its bins (a carrier's speed sidebands at low speed) is measured there too
@@ -569,6 +567,35 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
         d = np.concatenate([d, db / np.sqrt(1 + part)])[order]
         sig = np.concatenate([sig, np.hypot(sb * np.sqrt(1 + part), beat / 2)])[order]
     return _DirectionMeasurements(bins, _LineMeasurements(lines, hi_, pi_, d, sig))
+
+
+def _own_sides_near(bins: list, h: np.ndarray, lines: _Lines, fpk: np.ndarray, s: FitSettings, df: float) -> np.ndarray:
+    """(n_h, n_pairs) int: per kept harmonic ``h`` and pair, how many detections lie within a bin of its own
+    fixed-offset sidebands f ± Δ under its window (±(L + ½) bins about its peak ``fpk``): Δ (Hz) the median offset of
+    each candidate of ``bins`` whose ``sideband_of`` is it from the peak, read where it is detected under the window
+    (an amplitude modulation's sides stand at ±Δ at every speed, found as a candidate near the top speed only)."""
+    out = np.zeros(fpk.shape, int)
+    if lines.line_pair.size == 0:
+        return out
+    keys = lines.line_pair + lines.line_star / lines.scale
+    pair = np.arange(lines.pair_run.size)
+    speed = lines.pair_speed_hz
+    window = (s.line_half_width + 0.5) * df
+    for i, hk in enumerate(h):
+        sides = [b.h for b in bins if b.sideband_of is not None and abs(b.sideband_of - hk) < 1e-9]
+        offsets = set()
+        for off in lines.match(np.array(sides)) - fpk[i][None, :] if sides else ():
+            near = np.abs(off[np.isfinite(off)])
+            near = near[(near > 0.5 * df) & (near <= window)]
+            if near.size:
+                offsets.add(float(np.median(near)))
+        for d in offsets:
+            for at in (fpk[i] - d, fpk[i] + d):
+                star = np.where(np.isfinite(at), at, 0.0) / speed
+                n = (np.searchsorted(keys, pair + (star + df / speed) / lines.scale, "right")
+                     - np.searchsorted(keys, pair + (star - df / speed) / lines.scale, "left"))
+                out[i] += np.where(np.isfinite(at), np.minimum(n, 1), 0)
+    return out
 
 
 def _line_powers(spectra: Spectra, chans, lines: _Lines, fpk: np.ndarray, hi_: np.ndarray, pi_: np.ndarray,

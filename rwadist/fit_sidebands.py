@@ -37,7 +37,7 @@ def fixed_offset_sidebands(bins: list, lines, df: float, f_lo: float, f_hi: floa
     small fraction of a bin of h·|Ω|; sidebands of a constant offset scatter about it by Δ − (h₀ − h)|Ω|).  Then, the
     offsets Δ so found known, a candidate whose detections sit at whole multiples k·Δ (k ≠ 0) of a stronger line
     (higher orders of a deep ripple, matched at one order at some speeds and another at others: family wheel 5,
-    β = 0.75 at h 5.64).  Every candidate so read, a rejected one's too, gets its carrier's h in ``sideband_of``."""
+    β = 0.75 at h 5.64).  Every candidate so read (a rejected one with 5 detections or more too) gets its carrier's h in ``sideband_of``."""
     # every candidate is read (a rejected one's detections can be a carrier's sidebands too: their carrier is then
     # measured with them under its window, :func:`measure_direction`), only a kept one is marked not kept
     cands = [b for b in bins if b.kept or b.n_bin >= 5]

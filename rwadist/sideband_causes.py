@@ -19,6 +19,8 @@ import math
 SAME_C = 1.25
 #: The mirror line is looked for within this many ratio resolutions of 2p − s (three measured ratios' errors add up)
 MIRROR_RESOLUTIONS = 3.0
+#: The highest order of one series (:func:`_one_series`) read as such
+MAX_ORDER = 16
 #: The directions whose lines turn (a counter-rotating line: a negative ratio).
 TURNING = ("radial_force", "radial_torque")
 
@@ -66,7 +68,7 @@ def sideband_causes(direction: str, h: float, sense, lines: list, resolution: fl
             at = 2 * p - s if turning else abs(2 * p - s)
             mirror = [c for r, c in lines if abs(r - at) <= MIRROR_RESOLUTIONS * resolution]
             if not any(abs(math.log(c / c0)) <= math.log(SAME_C) for c in mirror if c > 0) or \
-                    _one_series((s, p, at), lines, resolution):
+                    _one_series((s, p, at), (s, p, at, *(r for r, c in lines if c >= c0)), resolution):
                 continue
             whole = abs(m - round(m)) <= 2 * resolution
             out.append(f"one of two sidebands of the line h = {abs(p):.4g} at ±{m:.4g} per rev (with the {_line(at)}, "
@@ -75,17 +77,20 @@ def sideband_causes(direction: str, h: float, sense, lines: list, resolution: fl
     return out
 
 
-def _one_series(ratios, lines: list, resolution: float) -> bool:
-    """Whether every ratio of ``ratios`` (signed) is a whole multiple (1, 2, ...) of one line of ``lines`` whose ratio
-    is not a whole number: the harmonics of one non-sinusoidal source (a bearing defect's impacts, trial nuR: its lines
-    at 3.31·k, each of both senses, read "sidebands of h 3.31 at ±13.24 per rev"), not a modulation.  A whole base
-    (the imbalance's 1) is not asked: a modulation of the imbalance m times a revolution puts its sidebands at whole
-    ratios too (the trial of session 60's 6/rev phase modulation)."""
-    for b in {abs(r) for r, _ in lines}:
-        if b <= 2 * resolution or abs(b - round(b)) <= 2 * resolution:
+def _one_series(ratios, bases, resolution: float) -> bool:
+    """Whether every ratio of ``ratios`` (signed) is a whole multiple (1 to :data:`MAX_ORDER`) of one of ``bases`` (the
+    three lines' own ratios and those of the lines as strong as the one named) that is no simple fraction (k/q, q <= 4:
+    the imbalance's 1 and its subharmonics divide whole ratios at every order): the harmonics of one non-sinusoidal
+    source (a bearing defect's impacts, trial nuR: its lines at 3.31·k, each of both senses, read "sidebands of h
+    3.31 at ±13.24 per rev"), not a modulation.  A modulation of the imbalance m times a revolution puts its sidebands
+    at whole ratios (the trial of session 60's 6/rev phase modulation): no simple fraction is asked, nor a weak line
+    elsewhere (a rub's h 0.5)."""
+    for b in {abs(r) for r in bases}:
+        if b <= 2 * resolution or any(abs(b * q - round(b * q)) <= 2 * resolution * q for q in range(1, 5)):
             continue
         k = [round(abs(r) / b) for r in ratios]
-        if all(n >= 1 and abs(abs(r) - n * b) <= MIRROR_RESOLUTIONS * resolution * n for r, n in zip(ratios, k)):
+        if all(1 <= n <= MAX_ORDER and abs(abs(r) - n * b) <= MIRROR_RESOLUTIONS * resolution * n
+               for r, n in zip(ratios, k)):
             return True
     return False
 

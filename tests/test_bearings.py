@@ -183,3 +183,11 @@ def test_a_high_multiple_is_named_of_the_series_base():
     assert line_causes(3.31 * 2, 0.002, others=series[2:] + [3.31])[0].startswith("the 2nd multiple of the line h = 3.31")
     # beyond MAX_MULTIPLE no multiple is named (a low line divides nearly anything at a high enough order)
     assert not any("multiple" in x for x in line_causes(0.4137 * 23, 0.002, others=[0.4137]))
+
+
+def test_a_ball_pass_is_named_before_the_cage_lines_high_multiple():
+    """BPFO = Z·FTF: the 8th "multiple" of a cage line at 0.4 is its 8-ball bearing's ball pass, said so first (the
+    review of session 61: "the 8th multiple of the line h = 0.4" had come first)."""
+    assert line_causes(3.2, 0.002, others=[0.4])[0].startswith("ball pass over the still race of a 8-ball bearing")
+    assert not any("multiple of the line h = 0.4" in x for x in line_causes(3.2, 0.002, others=[0.4]))
+    assert any("3rd multiple of the line h = 0.4" in x for x in line_causes(1.2, 0.002, others=[0.4]))

@@ -79,3 +79,13 @@ def test_a_modulation_of_a_non_integer_line_beside_its_harmonics_is_still_named(
     model = _lines(_modulated([(1.0, 4e-7), (3.07, 2.4e-8)]) + [(6.14, 6e-9, "co"), (9.21, 3e-9, "co")])
     lines = signed_lines("radial_force", model)
     assert "sidebands of the line h = 3.07 at ±6" in sideband_causes("radial_force", 2.93, "counter", lines, RES)[0]
+
+
+@pytest.mark.parametrize("extra", [(0.5, 1e-9, "counter"), (0.4137, 1e-9, "co"), (1.5, 1e-9, "co")])
+def test_a_weak_low_line_elsewhere_does_not_make_a_modulation_one_series(extra):
+    """A weak rub at h 0.5, a cage at 0.4137 or a line at 1.5 divides the imbalance's sidebands h 5 and 7 at some order:
+    no series of theirs (the review of session 61: the pair was no longer named beside a line at 0.5)."""
+    lines = signed_lines("radial_force", _lines(_modulated([(1.0, 4e-7), (3.07, 2.4e-8)]) + [extra]))
+    for res in (RES, 0.005):
+        assert "sidebands of the line h = 1 at ±6" in sideband_causes("radial_force", 5.0, "counter", lines, res)[0]
+        assert "sidebands of the line h = 3.07 at ±6" in sideband_causes("radial_force", 2.93, "counter", lines, res)[0]

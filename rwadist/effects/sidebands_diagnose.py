@@ -363,9 +363,10 @@ class Sidebands:
         # sidebands added on top raised the error 0.0059 -> 0.019 and were not taken); a base that measured the
         # carrier apart from the pair (family wheel 1, ±7.3 Hz at 10 kHz) is left as it is
         scale = 1.0
-        full = float(np.sqrt(1.0 - 0.5 * m * m)) if m * m < 1.0 else 1.0
+        full = float(np.sqrt(1.0 - 0.5 * m * m)) if m * m < 1.98 else 1.0          # m < sqrt(2) always: a_c > 0
         if full < 1.0 - CARRIER_SCALE_MIN:
-            r = _carrier_over_model(ctx, state, direction, h, runs)
+            # the carrier read on the runs the depth was read on (both sides valid)
+            r = _carrier_over_model(ctx, state, direction, h, np.asarray(runs)[ok[:, 0] & ok[:, 1]])
             if r is not None and abs(np.log(r / full)) < abs(np.log(r)):
                 scale = full
         m /= scale
