@@ -61,6 +61,8 @@ def test_a_small_drift_is_read_in_the_order_of_recording(index, tmp_path):
 def test_clean_runs_in_a_shuffled_order_hold_no_drift(index, tmp_path):
     diag = api.diagnose(api.read(_in_recorded_order(index, 0.0, tmp_path)))
     assert [u for u in diag.unexplained if u.signature == "run_change"] == []
+    # nor one line's drift in that order (tests/test_line_drift_recorded_order.py)
+    assert [u for u in diag.unexplained if u.parameters.get("property") == "line_drift"] == []
 
 
 @pytest.mark.parametrize("index", [0, 3, 6])
