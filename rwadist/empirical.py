@@ -542,12 +542,7 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
     # ... nor any other detected line (a harmonic too weak or too rare to be kept) under its window
     n_near = np.zeros(fpk.shape, int)
     if lines.line_pair.size:
-        keys = lines.line_pair + lines.line_star / lines.scale
-        half = (s.line_half_width + 0.5) * df / lines.pair_speed_hz[None, :]
-        star = np.where(np.isfinite(fpk), fpk, 0.0) / lines.pair_speed_hz[None, :]
-        pair = np.arange(lines.pair_run.size)[None, :]
-        n_near = (np.searchsorted(keys, pair + (star + half) / lines.scale, "right")
-                  - np.searchsorted(keys, pair + (star - half) / lines.scale, "left"))
+        n_near = _detections_near(lines, fpk, (s.line_half_width + 0.5) * df)
     # a carrier's own fixed-offset sidebands (an amplitude modulation, a speed ripple) may lie under its window: its
     # measurement then holds their power with its own, as a harmonic read with weak neighbours does (a 1x line
     # modulated 0.3 at 0.7 Hz, family wheel 2 at 4096 samples: its two sidebands under the window in every run, the
@@ -577,9 +572,6 @@ def _own_sides_near(bins: list, h: np.ndarray, lines: _Lines, fpk: np.ndarray, s
     out = np.zeros(fpk.shape, int)
     if lines.line_pair.size == 0:
         return out
-    keys = lines.line_pair + lines.line_star / lines.scale
-    pair = np.arange(lines.pair_run.size)
-    speed = lines.pair_speed_hz
     window = (s.line_half_width + 0.5) * df
     for i, hk in enumerate(h):
         sides = [b.h for b in bins if b.sideband_of is not None and abs(b.sideband_of - hk) < 1e-9]
@@ -591,11 +583,19 @@ def _own_sides_near(bins: list, h: np.ndarray, lines: _Lines, fpk: np.ndarray, s
                 offsets.add(float(np.median(near)))
         for d in offsets:
             for at in (fpk[i] - d, fpk[i] + d):
-                star = np.where(np.isfinite(at), at, 0.0) / speed
-                n = (np.searchsorted(keys, pair + (star + df / speed) / lines.scale, "right")
-                     - np.searchsorted(keys, pair + (star - df / speed) / lines.scale, "left"))
-                out[i] += np.where(np.isfinite(at), np.minimum(n, 1), 0)
+                out[i] += np.where(np.isfinite(at), np.minimum(_detections_near(lines, at, df), 1), 0)
     return out
+
+
+def _detections_near(lines: _Lines, f_hz: np.ndarray, half_hz: float) -> np.ndarray:
+    """Per pair, the detected lines of ``lines`` within ``half_hz`` of ``f_hz`` (Hz; (..., n_pairs), NaN read as 0:
+    none there), the same shape: one sorted search over the (pair, normalised frequency) keys."""
+    keys = lines.line_pair + lines.line_star / lines.scale
+    pair = np.arange(lines.pair_run.size)
+    star = np.where(np.isfinite(f_hz), f_hz, 0.0) / lines.pair_speed_hz
+    half = half_hz / lines.pair_speed_hz
+    return (np.searchsorted(keys, pair + (star + half) / lines.scale, "right")
+            - np.searchsorted(keys, pair + (star - half) / lines.scale, "left"))
 
 
 def _line_powers(spectra: Spectra, chans, lines: _Lines, fpk: np.ndarray, hi_: np.ndarray, pi_: np.ndarray,

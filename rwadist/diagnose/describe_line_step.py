@@ -203,11 +203,13 @@ def line_drifts(ctx, series: list, recorded: np.ndarray, stepped: set, shares) -
     rpm = np.abs(ctx.omega[ctx.runs]) * RAD_S_TO_RPM
     names = [ctx.sp.run_names[int(r)] if r < len(ctx.sp.run_names) else str(int(r)) for r in ctx.runs]
     out = []
+    course = None                       # every line's change over the test, read once, when a drift asks for it
     for direction, h, y in series:
         if (direction, h) in stepped or (d := drift(recorded, spin, y)) is None:
             continue
-        courses = [(dd, c) for dd, x, v in series if (dd, x) != (direction, h)
-                   if (c := _course(recorded, v)) is not None]
+        if course is None:
+            course = [(dd, x, _course(recorded, v)) for dd, x, v in series]
+        courses = [(dd, c) for dd, x, c in course if (dd, x) != (direction, h) and c is not None]
         others = [c for _, c in courses]
         own = [c for dd, c in courses if dd == direction]
         if any(x and abs(float(np.median(x))) >= OTHERS_SHARE * abs(d["change_dB"]) for x in (others, own)):
