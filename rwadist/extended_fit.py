@@ -255,13 +255,20 @@ def _axial_measurements(fit: EmpiricalFit):
     return la[keep], sa[keep], ca[keep], aa[keep], na[keep]
 
 
-def _radial_power(meas_lines):
+def _radial_power(meas_lines, read_speeds: dict | None = None):
     """Per radial line and run, the measured x and y amplitudes combined: d_x² + d_y² (only runs
-    where both are measured; a channel measured twice at one speed counts by its first measurement; a line never
-    measured on both at one speed: √2·d² of the one measured, every speed).  Returns (line
-    index, speed, power, direction, log noise) arrays, each line's speeds in increasing order; log noise: the standard
-    deviation of ½ ln(d_x² + d_y²) the noise makes, sqrt(d_x⁴ s_x² + d_y⁴ s_y²)/(d_x² + d_y²) of the relative amplitude
-    errors s (:attr:`rwadist.empirical.LineFit.noise`; 0 where not measured)."""
+    where both are measured; a channel measured twice at one speed counts by its first measurement).  A line never
+    measured on both channels at one speed is read on the one it was measured on, at every speed: √2·d² where the
+    other channel was read (``read_speeds``: channel -> the speeds, rad/s, of the runs that have it; None: every
+    channel at every speed) and did not show the line, whose x² + y² then lies between d² and 2d² (log noise the
+    measurement's and that factor's, uniform); 2d² where it was not read (a load turning in the plane, as most do).
+    Returns (line index, speed, power, direction, log noise) arrays, each line's speeds in increasing order; log
+    noise: the standard deviation of ½ ln(d_x² + d_y²) the noise makes, sqrt(d_x⁴ s_x² + d_y⁴ s_y²)/(d_x² + d_y²) of
+    the relative amplitude errors s (:attr:`rwadist.empirical.LineFit.noise`; 0 where not measured).
+
+    Without those rows such a line's coefficients were free in the least squares and went where rounding took them
+    (family wheel 2's run-up with its tach: the planar 2xBSF line, at each speed on the channel it leant to, at
+    100-150x its level as OpenBLAS's kernels rounded; its modes lost on the held-out runs, on one CI machine)."""
     li, sp, pw, dr, nz = [], [], [], [], []
     for j, x in enumerate(meas_lines):
         if x.direction not in RADIAL:
@@ -280,14 +287,12 @@ def _radial_power(meas_lines):
             p = dx**2 + dy**2
             log_noise = np.sqrt((dx**2 * sx) ** 2 + (dy**2 * sy) ** 2) / np.maximum(p, 1e-300)
         else:
-            # measured on one channel of the pair at every speed (a planar line whose other channel stays under the
-            # noise): d_x² + d_y² lies between d² and 2d² of the channel measured, read as √2·d², within a factor
-            # 2^¼ in amplitude either way.  With no row its coefficient was free in the least squares and went
-            # where rounding took it (family wheel 2's run-up with its tach: the 2xBSF line at 100-150x its level as
-            # OpenBLAS's kernels rounded, its modes lost on the held-out runs and on one CI machine)
             both, first = np.unique(x.speed, return_index=True)
-            p = math.sqrt(2.0) * x.amplitude[first] ** 2
-            log_noise = noise[first]
+            other = np.where(chan[first] == cx, cy, cx)
+            read = np.ones(both.size, bool) if read_speeds is None else \
+                np.array([np.isin(abs(w), read_speeds.get(str(c), ())) for w, c in zip(both, other)], bool)
+            p = np.where(read, math.sqrt(2.0), 2.0) * x.amplitude[first] ** 2
+            log_noise = np.sqrt(noise[first] ** 2 + np.where(read, ONE_CHANNEL_LOG_SPREAD ** 2, 0.0))
         li.append(np.full(both.size, j))
         sp.append(both)
         pw.append(p)
@@ -297,6 +302,18 @@ def _radial_power(meas_lines):
         return np.array([], int), np.array([]), np.array([]), np.array([]), np.array([])
     return (np.concatenate(li).astype(int), np.concatenate(sp), np.concatenate(pw), np.concatenate(dr),
             np.concatenate(nz))
+
+
+#: The standard deviation of ½ ln(x² + y²) about ln(2^¼·d) when x² + y² lies uniformly in ln between d² and 2d²
+#: (:func:`_radial_power`: a line measured on one channel of its pair, the other read and under the noise)
+ONE_CHANNEL_LOG_SPREAD = math.log(2.0) / 4.0 / math.sqrt(3.0)
+
+
+def _read_speeds(spectra) -> dict:
+    """Channel -> the |speeds| (rad/s) of the runs of ``spectra`` that have it
+    (:meth:`rwadist.spectra.Spectra.available`)."""
+    speed = np.abs(np.asarray(spectra.speed, dtype=float))
+    return {c: speed[spectra.available(c)] for c in spectra.channels}
 
 
 def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=None, senses_xy=None):
@@ -541,7 +558,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                                                  stand_direction if stand is not None else None, stand_on, fit_stand)
     peaks = amplification_peaks(fit)
     la, sa, ca, aa, na = _axial_measurements(meas)
-    lr, sr, pr, dr, nr = radial = _radial_power(meas.lines)
+    lr, sr, pr, dr, nr = radial = _radial_power(meas.lines, _read_speeds(meas.spectra))
     scans = _scan_all(meas.lines, radial, la, sa, aa, 2.0 if physical else None, tolerance, near, senses_xy)
     mass_kg, I_rr, I_zz = _inertias(mass, radius, scans["rocking"], notes)
     starts = _ModeStarts(scans, start, physical, max((x.h * x.speed.max() / (2 * np.pi) for x in meas.lines),
