@@ -375,8 +375,11 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
         radial channel reads its partner's lines by a unit factor (:func:`rwadist.fit_warnings.unit_mixup_warning`:
         one of them in lbf, kgf, in·lbf, ...); no harmonic passed the presence threshold (the model is empty).
     """
+    from dataclasses import replace
+
     from . import channel_distortion, data_quality, fit_warnings, speed_whirl
     from .empirical import FitSettings, fit_empirical
+    from .line_senses import with_senses
     from .spectra import _default_nperseg, compute_spectra
 
     check_flags(exclude_modes=exclude_modes, progress=progress)
@@ -398,6 +401,8 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
     result = fit_empirical(spectra, settings, name=name, progress=progress)
+    # each radial line's rotation sense as the x/y phase reads it (without one, every consumer reads it co-rotating)
+    result = replace(result, model=with_senses(result, test))
     refuse_non_finite_model(result.model, "fit")
     result.model.provenance.update(reading_provenance(getattr(test, "meta", None)))
     if frozen or distorted:

@@ -3,6 +3,9 @@ extended fit's start of each line's co- and counter-rotating parts and the rocki
 one way in every run (:func:`one_sense_rows`)."""
 from __future__ import annotations
 
+import copy
+from dataclasses import replace
+
 import numpy as np
 
 from .data import Run, SteadyTest
@@ -123,3 +126,34 @@ def _line_senses_once(test: SteadyTest, fit: EmpiricalFit, stand: tuple | None =
         cached = (test, line_senses(test, fit, stand=stand))
         fit.__dict__["_line_senses"][stand] = cached
     return cached[1]
+
+
+#: The imbalance's order: its sense is left to ``rwadist diagnose``'s ``counter_rotation`` family (within this of h = 1)
+IMBALANCE_H_TOL = 1e-3
+#: A measured line and a model harmonic within this of one another in h are one line (:func:`with_senses`)
+SAME_LINE_H = 2e-3
+
+
+def with_senses(fit: EmpiricalFit, test: SteadyTest):
+    """``fit``'s model with the rotation sense of each radial line the x/y phase of the whole runs reads
+    (:func:`line_senses`: co, counter or planar) on each harmonic that has none, but the imbalance's order; a copy
+    when one is set, else the model itself.  Without a sense every consumer reads a radial line co-rotating
+    (docs/formats.md): a counter-rotating cage line fitted by ``rwadist fit`` was shown and used co-rotating (session
+    61's new-user trial); ``rwadist diagnose`` starts from the model so sensed."""
+    model = fit.model
+    try:
+        senses = _line_senses_once(test, fit)
+    except (ValueError, KeyError):
+        return model                        # a run without both channels of a pair: no sense read
+    out = None
+    for d in RADIAL:
+        new = []
+        for x in model.harmonics(d):
+            got = next((v[0] for (dd, h), v in senses.items() if dd == d and abs(h - x.h) <= SAME_LINE_H), None)
+            if got is not None and x.sense is None and abs(x.h - 1.0) > IMBALANCE_H_TOL:
+                x = replace(x, sense=got)
+            new.append(x)
+        if any(a is not b for a, b in zip(new, model.harmonics(d))):
+            out = out or copy.deepcopy(model)
+            out.empirical[d] = new
+    return model if out is None else out

@@ -37,6 +37,7 @@ def start_model(ctx, fit0):
     resolution left out (their C read on the whole records); the pairs ((direction, h₀, h_lower, h_upper, C_lower,
     C_upper, measurements) each) set on ``ctx.base_sideband_pairs``.  The model as it is without the records, on a
     sweep's slices (a line sweeps over a slice) or when the records are no finer than the segments."""
+    from ..line_senses import with_senses
     from .modes_base import _sideband_pairs
     from .whole_fit import whole_records_fit
 
@@ -44,7 +45,7 @@ def start_model(ctx, fit0):
     test = ctx.test
     if test is None or not test.runs:
         return fit0.model
-    model = _with_senses(fit0, test)
+    model = with_senses(fit0, test)
     if (getattr(test, "meta", None) or {}).get("slicing"):
         return model
     n = min(r.n_samples for r in test.runs)
@@ -70,36 +71,6 @@ def start_model(ctx, fit0):
     return model if out is None else out
 
 
-#: The imbalance's order: its sense is left to the ``counter_rotation`` family (within this of h = 1)
-IMBALANCE_H_TOL = 1e-3
-
-
-def _with_senses(fit0, test):
-    """``fit0``'s model with the rotation sense of each radial line the x/y phase of the whole runs reads
-    (:func:`rwadist.line_senses.line_senses`), but the imbalance's order; a copy when one is set, else the model."""
-    from ..line_senses import _line_senses_once
-
-    model = fit0.model
-    try:
-        senses = _line_senses_once(test, fit0)
-    except (ValueError, KeyError):
-        return model                        # a run without both channels of a pair: no sense read
-    out = None
-    for d in ("radial_force", "radial_torque"):
-        new = []
-        for x in model.harmonics(d):
-            got = next((v[0] for (dd, h), v in senses.items() if dd == d and abs(h - x.h) <= SAME_H), None)
-            if got is not None and x.sense is None and abs(x.h - 1.0) > IMBALANCE_H_TOL:
-                x = replace(x, sense=got)
-            new.append(x)
-        if any(a is not b for a, b in zip(new, model.harmonics(d))):
-            out = out or copy.deepcopy(model)
-            out.empirical[d] = new
-    return model if out is None else out
-
-
-
-
 def sensed_lines(diag):
     """``diag``'s model (a copy when changed) with a sense on each radial harmonic of the empirical base that has
     none, but the imbalance's order: the lines the search added (a line the base left out and completed after a test
@@ -109,7 +80,7 @@ def sensed_lines(diag):
     An independent trial (session 48: a counter-rotating ball-pass line the base left out under a 140-Hz fixture,
     completed after it; a counter-rotating sideband pair beside the imbalance) had them written with no sense, which
     every consumer reads co-rotating."""
-    from ..line_senses import SENSE_SHARE
+    from ..line_senses import IMBALANCE_H_TOL, SENSE_SHARE
 
     ctx, model = diag.ctx, diag.model
     if diag.model_given or diag.state_after.base != "empirical" or ctx.test is None:
