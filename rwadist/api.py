@@ -15,6 +15,7 @@ import functools
 import json
 import warnings
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -375,8 +376,6 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
         radial channel reads its partner's lines by a unit factor (:func:`rwadist.fit_warnings.unit_mixup_warning`:
         one of them in lbf, kgf, in·lbf, ...); no harmonic passed the presence threshold (the model is empty).
     """
-    from dataclasses import replace
-
     from . import channel_distortion, data_quality, fit_warnings, speed_whirl
     from .empirical import FitSettings, fit_empirical
     from .line_senses import with_senses
