@@ -188,50 +188,53 @@ def split_from_phase(params, meas_lines: list, fitted_lines: list, line_of: dict
 
 #: a radial line's part under this share of the line's load power is dropped (:func:`fitted_senses`)
 KEPT_PART = 0.01
-#: a radial line's fitted counter-rotating part is contradicted by its x/y phase when the response share the fit
-#: gives it exceeds this many times the measured share (which holds the noise's: an upper bound) ...
+#: a radial line's fitted part of one sense is contradicted by its x/y phase when the response share the fit gives it
+#: exceeds this many times the measured share (which holds the noise's: an upper bound) ...
 SENSE_FACTOR = 2.0
-#: ... on a line whose response turns with the spin in every run, all but this share of its power at most
-PURE_CO = 0.01
+#: ... on a line whose response turns one way in every run, all but this share of its power at most
+PURE_SENSE = 0.01
 
 
 def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict, powers: np.ndarray,
                     senses_xy: dict) -> tuple:
     """(params, lines, keys): ``fitted_lines`` (and the imbalances of ``params``) with each radial line whose fitted
-    counter-rotating part its x/y phase contradicts made co-rotating alone, and the (direction, h) of those lines.
+    part of one sense its x/y phase contradicts made a line of the other sense alone, and the (direction, h) of those
+    lines.
 
-    The x/y phase measures the response's counter-rotating share directly (``senses_xy``' co_fraction,
+    The x/y phase measures the response's co-rotating share directly (``senses_xy``' co_fraction,
     :func:`rwadist.line_senses.line_senses`, summed over the runs).  The parts fitted to the line power predict it:
-    q = C_counter²·P_counter / (C_co²·P_co + C_counter²·P_counter), with P a part's response power per unit C²
-    (``powers``: :meth:`LinePower.line_powers` at the fitted modes).  Where the response turns with the spin in every
-    run (``senses_xy``' every_run "co") and all but m <= :data:`PURE_CO` of its power, and q exceeds
-    :data:`SENSE_FACTOR` times m, the data hold no such counter-rotating response, and the split is
-    model error absorbed (a fast sweep's top torque line crossing the forward whirl within one slice: a peak smeared
-    in the slice, fitted as a counter part of 24-38 % of C that the x/y phase put at 0.1 % of the line's power, in 5 of
-    12 sweeps of three wheels; another's 0.36 % against the phase's 0.089 %).  There the line is co-rotating alone, its response's summed power P kept
-    (C_co² = P/P_co): a share m that small is the noise's, and, divided by a backward whirl's far smaller gain, would
-    still make a counter part of 13 % of C (a family wheel's co line crossing the forward whirl in a 40 s run-up).
+    the minority sense's share q = C_m²·P_m / (C_co²·P_co + C_counter²·P_counter), with P a part's response power per
+    unit C² (``powers``: :meth:`LinePower.line_powers` at the fitted modes).  Where the response turns one way in every
+    run (``senses_xy``' every_run "co" or "counter") and all but m <= :data:`PURE_SENSE` of its power, and q exceeds
+    :data:`SENSE_FACTOR` times m, the data hold no such response of the other sense, and the split is model error
+    absorbed.  A co-rotating line: a fast sweep's top torque line crossing the forward whirl within one slice, a peak
+    smeared in the slice, fitted as a counter part of 24-38 % of C that the x/y phase put at 0.1 % of the line's power,
+    in 5 of 12 sweeps of three wheels; another's 0.36 % against the phase's 0.089 %.  A counter-rotating one: session
+    62's trial (a 7.5-kg wheel, I_zz/I_rr 1.55, rocking 88 Hz), its cage torque line h 0.41 fitted with a co part of
+    29 % of C, 1.5 % of the response, where the phase put 3e-6: at 4500 rpm the model turned 4e-3 N·m with the spin
+    that the data held at 2e-5.  There the line is of the one sense alone, its response's summed power P kept
+    (C² = P/P_sense): a share m that small is the noise's, and, divided by a far smaller gain of the other whirl,
+    would still make a part of 13 % of C (a family wheel's co line crossing the forward whirl in a 40 s run-up).
     Not on a line that turns both ways: there the measured share is weighted by what lifts the runs (a fixture
     resonance, divided out of the fitted rows), and a line of 20 % counter-rotating load, its phase's share 0.078 and
     the fit's 0.245, lost family wheel 6's fixture at 1.25x its rocking mode."""
     out, changed = list(fitted_lines), []
     for j, x in enumerate(meas_lines):
         key = (x.direction, float(x.h))
-        if x.direction not in RADIAL or key not in senses_xy:
+        if x.direction not in RADIAL or key not in senses_xy or senses_xy[key][2] not in ("co", "counter"):
             continue
         k_co, k_ct = line_of[j]
-        p_co, p_ct = out[k_co].C ** 2 * powers[k_co], out[k_ct].C ** 2 * powers[k_ct]
-        total = p_co + p_ct
-        if not total > 0.0 or powers[k_co] <= 0.0:
+        co_share = min(max(float(senses_xy[key][1]), 0.0), 1.0)
+        k_own, k_other, m = (k_co, k_ct, 1.0 - co_share) if senses_xy[key][2] == "co" else (k_ct, k_co, co_share)
+        p_own, p_other = out[k_own].C ** 2 * powers[k_own], out[k_other].C ** 2 * powers[k_other]
+        total = p_own + p_other
+        if not total > 0.0 or powers[k_own] <= 0.0 or m > PURE_SENSE or p_other / total <= SENSE_FACTOR * m:
             continue
-        m = 1.0 - min(max(float(senses_xy[key][1]), 0.0), 1.0)
-        if senses_xy[key][2] != "co" or m > PURE_CO or p_ct / total <= SENSE_FACTOR * m:
-            continue
-        if out[k_ct].C ** 2 < KEPT_PART * (out[k_co].C ** 2 + out[k_ct].C ** 2):
-            continue    # a counter part the model does not keep (:func:`fitted_senses`): nothing to correct
-        # the response turns with the spin in every run, all but m of it: what turns against it is noise
-        out[k_co] = replace(out[k_co], C=math.sqrt(total / powers[k_co]))
-        out[k_ct] = replace(out[k_ct], C=0.0)
+        if out[k_other].C ** 2 < KEPT_PART * (out[k_own].C ** 2 + out[k_other].C ** 2):
+            continue    # a part the model does not keep (:func:`fitted_senses`): nothing to correct
+        # the response turns one way in every run, all but m of it: what turns the other way is noise
+        out[k_own] = replace(out[k_own], C=math.sqrt(total / powers[k_own]))
+        out[k_other] = replace(out[k_other], C=0.0)
         changed.append(key)
     return replace(params, **imbalances(out)), out, changed
 
@@ -239,10 +242,13 @@ def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict,
 def resplit_note(direction: str, h: float, co_fraction: float) -> str:
     """The model file's note on a radial line whose fitted co/counter split its x/y phase contradicted
     (:func:`split_to_senses`)."""
-    return (f"{direction} h={h:.4g}: the co/counter split fitted to the line power put a counter-rotating response "
-            f"in the data that the x/y phase does not show ({100 * (1 - co_fraction):.2g} % of the line's power "
-            "turns against the spin): the split is the phase's, the line's power kept (a misfit near a whirl mode, "
-            "e.g. a line crossing it within one slice of a fast sweep, is not taken for a counter-rotating load)")
+    own, other = ("co", "counter") if co_fraction >= 0.5 else ("counter", "co")
+    share = 1.0 - co_fraction if own == "co" else co_fraction
+    return (f"{direction} h={h:.4g}: the co/counter split fitted to the line power put a {other}-rotating response "
+            f"in the data that the x/y phase does not show ({100 * share:.2g} % of the line's power "
+            f"turns {'against' if own == 'co' else 'with'} the spin): the split is the phase's, the line's power kept "
+            f"(a misfit near a whirl mode, e.g. a line crossing it within one slice of a fast sweep, is not taken for a "
+            f"{other}-rotating load)")
 
 
 def phase_splits(params, meas_lines: list, fitted_lines: list, line_of: dict, sums: dict, senses_xy: dict,

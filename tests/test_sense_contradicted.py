@@ -18,6 +18,7 @@ from rwadist.extended_fit_power import split_to_senses
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import family_wheel as fw  # noqa: E402
+from cli_run import run  # noqa: E402
 
 
 def _trial_wheel() -> fw.Wheel:
@@ -82,3 +83,60 @@ def test_a_contradicted_split_is_the_phases_with_the_power_kept():
     for senses in ({key: ("co", 0.9, "co")}, {key: ("co", 0.999, "")}):
         _, out, changed = split_to_senses(params, [_Measured()], _parts(1.0, 1.0), {0: [0, 1]}, powers, senses)
         assert changed == [] and [ln.C for ln in out] == [1.0, 1.0]
+
+
+def test_a_contradicted_co_part_of_a_counter_rotating_line_is_dropped_too():
+    """The mirror of the closed form above: parts whose response powers per unit C² are 1 (co) and 4 (counter, through
+    the backward whirl) predict a co share of 1/5; measured counter-rotating in every run, all but 0.001 of it: the
+    line counter-rotating alone, C_counter² = 5/4, no co part; left as fitted where the response turns both ways."""
+    params = replace(ext.from_table_4_2(), U_d=0.0)
+    powers = np.array([1.0, 4.0])
+    key = ("radial_torque", 2.5)
+    _, out, changed = split_to_senses(params, [_Measured()], _parts(1.0, 1.0), {0: [0, 1]}, powers,
+                                      {key: ("counter", 0.001, "counter")})
+    assert changed == [key] and out[0].C == 0.0 and out[1].C ** 2 * powers[1] == pytest.approx(5.0)
+    for senses in ({key: ("counter", 0.1, "counter")}, {key: ("counter", 0.001, "")}):
+        _, out, changed = split_to_senses(params, [_Measured()], _parts(1.0, 1.0), {0: [0, 1]}, powers, senses)
+        assert changed == [] and [ln.C for ln in out] == [1.0, 1.0]
+
+
+def _cage_wheel() -> fw.Wheel:
+    """Family wheel 0 rebuilt as session 62's trial wheel: 7.5 kg, I_zz/I_rr 1.55, modes 135 / 88 / 310 Hz, a
+    counter-rotating cage line h 0.41 on the radial force and torque, 34 speeds over 300-4500 rpm at 3 kHz."""
+    L = fw.Line
+    U_s, U_d = 4e-6, 2.5e-7
+    lines = [L("radial_force", 1.0, U_s, 1.0, "imbalance"), L("radial_force", 2.0, 3e-7, 1.0, "2x"),
+             L("radial_force", 0.41, 6e-7, 0.0, "cage"), L("radial_force", 3.63, 4e-7, 1.0, "BPFO"),
+             L("radial_force", 7.26, 2e-7, 0.0, "2xBPFO"), L("radial_force", 4.37, 3e-7, 0.5, "2xBSF"),
+             L("radial_torque", 1.0, U_d, 1.0, "imbalance"), L("radial_torque", 2.0, 4e-8, 1.0, "2x"),
+             L("radial_torque", 0.41, 8e-8, 0.0, "cage"), L("radial_torque", 3.63, 5e-8, 0.0, "BPFO"),
+             L("axial_force", 1.0, 8e-7, 1.0, "1x"), L("axial_force", 3.63, 3e-7, 1.0, "BPFO"),
+             L("axial_force", 7.26, 1.5e-7, 1.0, "2xBPFO")]
+    I_rr = 7.5 * 0.12 ** 2 / 4
+    return replace(fw.family()[0], mass=7.5, I_zz=1.55 * I_rr, I_rr=I_rr, f_trans=135.0, f_rock=88.0, f_axial=310.0,
+                   zeta_trans=0.025, zeta_rock=0.02, zeta_axial=0.03, lines=tuple(lines), min_rpm=300.0,
+                   max_rpm=4500.0, sample_rate=3000.0, n_speeds=34, n_samples=12000)
+
+
+def test_a_counter_rotating_cage_torque_line_gets_no_co_part(tmp_path, capsys):
+    """``rwadist fit DATA -o model.json --extended`` (steady runs, seed 1): every radial line that turns one way is
+    written with that sense alone, the cage torque line counter-rotating at its C within 3 % (main: a co part of 16 %
+    of its C, 1.24e-8 beside 7.98e-8, which at 4500 rpm turned with the spin where the data hold noise), its note in
+    the model; the planar line keeps both parts."""
+    from rwadist import api
+
+    wheel = _cage_wheel()
+    data = fw.write_steady(fw.steady(wheel, seed=1), tmp_path / "data")
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "model.json", "--extended", "--no-report")
+    assert code == 0, err
+    model = api.load_model(tmp_path / "model.json")
+    for line in (ln for ln in wheel.lines if ln.direction in ("radial_force", "radial_torque")):
+        parts = [hm for hm in model.harmonics(line.direction) if abs(hm.h - line.h) < 2e-3 * line.h]
+        if line.co in (0.0, 1.0):
+            assert [hm.sense for hm in parts] == ["co" if line.co else "counter"], (line.direction, line.h, parts)
+        else:
+            assert sorted(hm.sense for hm in parts) == ["co", "counter"], (line.direction, line.h, parts)
+    cage = next(hm for hm in model.harmonics("radial_torque") if abs(hm.h - 0.41) < 1e-3)
+    assert cage.C == pytest.approx(8e-8, rel=0.03)
+    notes = model.analytical["fit"]["notes"]
+    assert any(n.startswith("radial_torque h=0.41") and "co-rotating response" in n for n in notes), notes
