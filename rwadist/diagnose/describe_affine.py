@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .describe_alias import ALIAS_TELLS, alias_causes, alias_tracks, folded
+from .describe_alias import MIN_RUNS as ALIAS_MIN_RUNS
 from .describe_lines import RIDGE_FRACTION, _lit, log_parabola_offset, sliced
 from .unexplained import Unexplained
 
@@ -123,12 +125,12 @@ def _tracks(lit: np.ndarray, spin: np.ndarray, df: float, k_lo: int, k_hi: int) 
     return [c[1:] for c in cands[:MAX_CANDIDATES]], seg
 
 
-def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list) -> tuple | None:
+def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list, least: int = MIN_RUNS) -> tuple | None:
     """(offset f0 Hz, slope b, RMS misfit Hz, peak dB) of the line in ``windows`` ((first, last) bin in each run of ``runs``):
     each run's peak of ``ratio`` (the data over the model summed over the line's channels, a row per run) there, refined by a parabola through the log
     powers of the top three bins, a least-squares line through them against f_spin, twice without the peaks off it by
     :data:`OUTLIER_BINS` (another line's, where the track passes under a model line), at least :data:`KEPT_FRACTION`
-    of the runs kept; peak dB: the median over the runs kept of the peak's ``ratio``, dB."""
+    of the runs kept (and ``least``); peak dB: the median over the runs kept of the peak's ``ratio``, dB."""
     df = ctx.df
     f_pk = np.full(runs.size, np.nan)
     r_pk = np.full(runs.size, np.nan)
@@ -142,11 +144,11 @@ def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list) -> tupl
     spin = np.abs(ctx.omega[runs]) / (2 * np.pi)
     ok = np.isfinite(f_pk)
     for _ in range(2):              # a run whose peak is another line's (under a model line, the track is not lit)
-        if ok.sum() < MIN_RUNS:
+        if ok.sum() < least:
             return None
         b, f0 = np.polyfit(spin[ok], f_pk[ok], 1)
         ok &= np.abs(f_pk - (f0 + b * spin)) <= OUTLIER_BINS * df
-    if ok.sum() < max(MIN_RUNS, KEPT_FRACTION * runs.size):
+    if ok.sum() < max(least, KEPT_FRACTION * runs.size):
         return None
     b, f0 = np.polyfit(spin[ok], f_pk[ok], 1)
     rms = float(np.sqrt(np.mean((f_pk[ok] - (f0 + b * spin[ok])) ** 2)))
@@ -160,12 +162,19 @@ def _offset_from_ratio(f0: float, b: float, spin: np.ndarray) -> float:
     return float(np.max(np.abs(f - h * spin)))
 
 
+def _sample_rate(ctx) -> float | None:
+    """The sample rate (Hz) every run of the context's test shares, or None (no time series, or several rates)."""
+    test = getattr(ctx, "test", None)
+    rates = {float(test.runs[int(r)].sample_rate) for r in ctx.runs} if test is not None else set()
+    return rates.pop() if len(rates) == 1 else None
+
+
 def affine_lines(ctx, state, shares, carriers=()) -> list:
     """``affine_line`` records of the residual's straight ridges f = f0 + b·f_spin (module docstring); ``shares``
     gives (share, level) of a track's cells (channels, frequency per run, runs), ``carriers`` the fixed lines found
     before the search (:class:`~rwadist.diagnose.fixed_lines.FixedLine`)."""
     runs = ctx.runs
-    if runs.size < MIN_RUNS or sliced(ctx):
+    if runs.size < ALIAS_MIN_RUNS or sliced(ctx):
         return []
     df = float(ctx.df)
     spin = np.abs(ctx.omega[runs]) / (2 * np.pi)
@@ -173,10 +182,16 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
     pooled = np.any(np.stack(list(lits.values())), axis=0)
     out: list[Unexplained] = []
     tracks, seg = _tracks(pooled, spin, df, ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1))
+    fs = _sample_rate(ctx)
+    if fs is not None:
+        # a line above the Nyquist frequency folded at the sample rate: one parameter, counted over fewer runs
+        folds = alias_tracks(pooled, seg, spin, df, fs, ctx.k_lo, min(ctx.k_hi, ctx.f.size - 1))
+        tracks = sorted([t + (False,) for t in tracks] + folds, key=lambda t: -t[3])
     bins = np.arange(ctx.f.size)
     claimed: set = set()            # the lit stretches of the lines read so far
     ratios: dict = {}               # the data over the model summed over a channel set, per set
-    for b, jj, runs_lit, frac, labels in tracks:
+    for b, jj, runs_lit, frac, labels, *fold in tracks:
+        least = ALIAS_MIN_RUNS if fold and fold[0] else MIN_RUNS
         mine = labels[labels > 0].tolist()
         if sum(x in claimed for x in mine) >= 0.5 * len(mine):
             continue                # mostly a line already read (or refused): the same line at another slope
@@ -191,13 +206,13 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
         if chans not in ratios:
             ratios[chans] = sum(ctx.data(state, c, runs)[runs] / np.maximum(ctx.predict(state, c, runs), 1e-300)
                                 for c in chans)
-        got = _read_track(ctx, ratios[chans][rows], runs[runs_lit], windows)
+        got = _read_track(ctx, ratios[chans][rows], runs[runs_lit], windows, least)
         for _ in range(REREADS):        # the counted slope is a grid's, through a stretch: read again on the line read
             if got is None:
                 break
             k_fit = np.rint((got[0] + got[1] * s) / df).astype(int)
             got = _read_track(ctx, ratios[chans][rows], runs[runs_lit],
-                              [(int(k) - WINDOW_BINS, int(k) + WINDOW_BINS) for k in k_fit])
+                              [(int(k) - WINDOW_BINS, int(k) + WINDOW_BINS) for k in k_fit], least)
         if got is None:
             continue
         claimed.update(mine)
@@ -221,10 +236,11 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
                         "peak_over_model_dB": float(peak_db),
                         "h_at_lowest_speed": float(f_run[np.argmin(s)] / s.min()),
                         "h_at_highest_speed": float(f_run[np.argmax(s)] / s.max())},
-            causes=_causes(f0, b),
-            would_tell="a record with the wheel still shows a source of its own at the offset frequency; runs at more "
-                       "speeds, and below and above these, show whether the offset stays fixed (a mixing of two "
-                       "sources) or the ratio keeps drifting (a slip)"))
+            causes=(alias_causes(f0, b, fs) if fs is not None and folded(f0, b, fs, df) else ()) + _causes(f0, b),
+            would_tell=ALIAS_TELLS if folded(f0, b, fs, df) else
+            "a record with the wheel still shows a source of its own at the offset frequency; runs at more "
+            "speeds, and below and above these, show whether the offset stays fixed (a mixing of two "
+            "sources) or the ratio keeps drifting (a slip)"))
     return out
 
 

@@ -1,0 +1,69 @@
+"""A line above the Nyquist frequency, folded at the sample rate, is described as one (an ``affine_line`` whose cause
+is the fold), not passed over.
+
+Session 62's trial (a 7.5-kg wheel at 3 kHz, a motor-stator line h 24 and no anti-alias filter): the line folded to
+1455 -> 1200 Hz over the 6 runs of 3864-4500 rpm, 0.016-0.022 N, and ``rwadist diagnose`` said nothing of it: the
+straight-track search counts slopes |b| <= 4 over 8 runs or more.
+
+Data: family wheels (tests/family_wheel.py, time-integrated physics) with a co-rotating radial-force line at h·f_spin
+added at the cell as sampling without an anti-alias filter records it: where h·f_spin lies between f_s/2 and f_s, a
+line at f_s − h·f_spin (a sampled sinusoid e^{iωt} at ω = 2πf is e^{i(ω − 2πf_s)t} at the sample instants: the fold
+turns a co-rotating line counter-rotating), elsewhere above f_s nothing (the family's own anti-alias cut)."""
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import family_effects as fe  # noqa: E402
+import family_wheel as fw  # noqa: E402
+from cli_run import run  # noqa: E402
+
+
+class FoldedLine(fe.Effect):
+    """A radial-force line C·Ω² at h × the speed, co-rotating, recorded without an anti-alias filter."""
+
+    kind = "folded_line"
+    expects = "unexplained"
+
+    def __init__(self, h: float, C: float, fs: float):
+        super().__init__(h=h, C=C, fs=fs)
+
+    def cell_components(self, omega, run, rng, wheel):
+        p = self.params
+        f = p["h"] * abs(omega) / (2 * np.pi)
+        fold = 0.5 * p["fs"] < f < p["fs"]
+        a = p["C"] * omega ** 2 * np.exp(1j * rng.uniform(0, 2 * np.pi)) if fold else 0.0
+        # co-rotating at f: Fx = cos, Fy = sin; sampled, the same values as cos/−sin at f_s − f
+        A = np.zeros((1, 6), complex)
+        A[0, 0], A[0, 1] = a, -1j * a
+        w = np.array([2 * np.pi * ((p["fs"] - f) if fold else 1.0)])
+        return fw.Components(["cell"], w, np.ones(1), np.ones(1, complex), [self.kind]), A
+
+
+@pytest.mark.parametrize("index, h", [(2, 30.0), (5, 36.0)])
+def test_a_line_folded_at_the_sample_rate_is_described_with_its_order(tmp_path, capsys, index, h):
+    """``rwadist diagnose DATA -o R`` (no model): an ``affine_line`` on Fx and Fy whose offset is the sample rate
+    within 0.5 % and whose slope is −h within 1 %, its first cause the fold at the sample rate naming h; the wheel's
+    suspension modes still within 2 %.  Wheel 2 (2 kHz, h 30: 9 runs of 2000-3000 rpm, slope beyond the straight-track
+    search's 4) and wheel 5 (8 kHz, h 36: 9 runs of 6700-10000 rpm)."""
+    wheel = fw.family()[index]
+    C = 0.02 * wheel.imbalance("radial_force")                     # 2 % of the imbalance's load
+    effect = FoldedLine(h, C, wheel.sample_rate)
+    data = fw.write_steady(fw.steady(wheel, seed=1 + 100 * index, effects=[effect]), tmp_path / "data")
+    code, out, err = run(capsys, "diagnose", data, "-o", tmp_path / "r")
+    assert code == 0, err
+    summary = json.loads((tmp_path / "r" / "summary.json").read_text())
+    folded = [u for u in summary["unexplained"] if u["signature"] == "affine_line"
+              and abs(u["parameters"]["offset_Hz"] / wheel.sample_rate - 1) < 0.005]
+    assert folded, [(u["signature"], u.get("parameters")) for u in summary["unexplained"]]
+    u = folded[0]
+    assert u["parameters"]["slope"] == pytest.approx(-h, rel=0.01), u["parameters"]
+    assert set(u["channels"]) == {"Fx", "Fy"}, u["channels"]
+    assert "folded at the sample rate" in u["causes"][0] and f"{h:.4g} × the speed" in u["causes"][0], u["causes"]
+    assert any("folded at the sample rate" in row for row in out.splitlines()), out
+    modes = next(e for e in summary["effects"] if e["kind"] == "suspension_modes")
+    for m, f in wheel.modes_hz().items():
+        assert modes[f"{m}_Hz"] == pytest.approx(f, rel=0.02), (m, modes[f"{m}_Hz"], f)
