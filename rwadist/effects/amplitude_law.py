@@ -44,6 +44,11 @@ class AmplitudeLaw(Element):
     runs_beyond_stand: int | None = field(default=None, metadata=check(COUNT))
     exponent_beyond_stand: float | None = field(default=None, metadata=check(statistic(ge=None)))
     exponent_beyond_stand_stderr: float | None = field(default=None, metadata=check(statistic(ge=0.0)))
+    #: on a model with the wheel's suspension modes (``rwadist diagnose``): the exponent of the line as the load cell
+    #: reads it, the law's plus the slope of the modes' gain on the line over its runs.  Near 2 with the law's far
+    #: from it, the line is C·Ω² at the interface: a load that reaches it without the suspension.  Absent on a model
+    #: without modes.
+    exponent_at_interface: float | None = field(default=None, metadata=check(statistic(ge=None)))
 
     @property
     def law(self) -> tuple:
@@ -62,7 +67,27 @@ class AmplitudeLaw(Element):
         d = e["direction"]
         return (f"{words(d)}, h {num(e['h'])}, amplitude ∝ |Ω|^{num(e['exponent'], '.3g')}"
                 f"{plus_minus(e, 'exponent_stderr')}, {num(e['amplitude_ref'], '.3g')} {cls.AMPLITUDE_UNIT[d]} at "
-                f"{rpm(e['omega_ref_rad_s'])}{cls._beyond_stand(e)}")
+                f"{rpm(e['omega_ref_rad_s'])}{cls._at_interface(e)}{cls._beyond_stand(e)}")
+
+    #: |exponent at the interface − 2| within this (or twice the exponent's standard error) with the law's own 2 or
+    #: more from it: C·Ω² at the load cell, a load that bypasses the suspension (:meth:`_at_interface`)
+    INTERFACE_OMEGA2: ClassVar[float] = 0.15
+
+    @classmethod
+    def _at_interface(cls, e: Mapping) -> str:
+        """The law as the load cell reads it (``exponent_at_interface``) in words, with what it says when it is Ω²
+        there and the law is not; nothing on a model without modes."""
+        q = e.get("exponent_at_interface")
+        if q is None:
+            return ""
+        out = f" (|Ω|^{num(q, '.3g')} at the load cell, through the suspension modes"
+        se = e.get("exponent_stderr") or 0.0
+        if abs(float(q) - 2.0) <= max(cls.INTERFACE_OMEGA2, 2.0 * float(se)) and abs(float(e["exponent"]) - 2.0) >= 2.0 * \
+                cls.INTERFACE_OMEGA2:
+            out += (": C·Ω² there, which is also what a load that reaches the interface without the suspension "
+                    "gives (on the housing side: the motor stator's, a structure's); a tap or shaker test of the "
+                    "housing tells the two apart")
+        return out + ")"
 
     @staticmethod
     def _beyond_stand(e: Mapping) -> str:

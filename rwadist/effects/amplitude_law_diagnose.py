@@ -14,7 +14,7 @@ from ..diagnose.mode_reach import crossing_groups
 from ..diagnose.state import State
 from ..extended import is_imbalance
 from ..stand_detect import STAND_MIN_LOG_GAIN, log_power_gain
-from ..units import DIRECTION_CHANNELS
+from ..units import CHANNELS, DIRECTION_CHANNELS
 
 #: Standard errors an exponent must lie away from 2 (the model's C·Ω²) to be proposed as a law.
 EXPONENT_Z = 4.0
@@ -118,6 +118,26 @@ def _channel_sides(ctx: Context, state: State, direction: str, h: float, runs) -
     return tuple(out)
 
 
+def _through_modes_gain(state: State, direction: str, h: float, w: np.ndarray) -> np.ndarray | None:
+    """|T| (w.size,) of the suspension on the line (direction, h) of ``state``'s senses at the speeds ``w`` (rad/s): the
+    parts' gains' root-mean-square (a planar line's both, a co part where it has none); None on the empirical base.  A
+    law of the load |Ω|^p reads as the law of |Ω|^p·|T| at the load cell.  A line that reaches the interface without
+    the suspension (a motor stator's, on the housing side) reads there as C·Ω² and, carried through the modes above
+    them, as a law of p > 2 (session 62's trial: a stator line h 24, Ω² at the load cell, named Ω^3.87 through the
+    135-Hz translation)."""
+    from .. import extended as ext
+
+    if state.ext is None or w.size < 2:
+        return None
+    senses = [getattr(x, "sense", None) or "co" for x in state.model.harmonics(direction) if abs(x.h - h) < 1e-3]
+    lines = [ext.Line(direction, float(h), 1.0, part) for s in senses or ["co"]
+             for part in (("co", "counter") if s == "planar" else (s,))]
+    _, A = ext.steady_lines(state.ext, lines, w)
+    channel = CHANNELS.index(DIRECTION_CHANNELS[direction][0])
+    gain = np.sqrt(np.mean(np.abs(A[:, :, channel]) ** 2, axis=1)) / np.maximum(w**2, 1e-300)
+    return gain if np.all(gain > 0) else None
+
+
 @register(order=20)
 @dataclass
 class AmplitudeLaw:
@@ -146,6 +166,10 @@ class AmplitudeLaw:
     #: (:func:`rwadist.diagnose.describe_line_step.two_levels`), None when it makes none: a change of the line's
     #: source between runs, no law (:meth:`significant`)
     two_levels_dB: float | None = None
+    #: On the extended base, the exponent of the line as the load cell reads it: the law's plus the slope of the
+    #: suspension's gain on the line over its runs, fitted as the law is (:func:`_through_modes_gain`); None on the
+    #: empirical base
+    interface_exponent: float | None = None
     kind: str = "amplitude_law"
     #: it adds no line, only changes the amplitude of one the state has: judged with that line's beats at its own
     #: amplitudes (:func:`rwadist.diagnose.search._evidence`)
@@ -235,6 +259,8 @@ class AmplitudeLaw:
         out = {"direction": self.direction, "h": round(self.h, 4), "exponent": self.exponent,
                "exponent_stderr": self.exponent_stderr, "amplitude_ref": self.amplitude_ref,
                "omega_ref_rad_s": self.omega_ref}
+        if self.interface_exponent is not None:
+            out["exponent_at_interface"] = float(self.interface_exponent)
         if self.beyond_stand is not None:
             # the law checked beyond a named test stand (:meth:`significant`): on how many runs, with what exponent
             p, se, *n = self.beyond_stand
@@ -273,9 +299,12 @@ class AmplitudeLaw:
         sides = _mode_sides(state, direction, h, w, X, np.log(d), leak, var_noise)
         # the runs' levels over Ω² (dB) against ln|Ω|: a step is told from every law, a straight line there
         step = two_levels(np.log(w), 20.0 * np.log10(d / w**2))
+        # the same runs and weights read at the load cell: the law times the suspension's gain on the line
+        gain = _through_modes_gain(state, direction, h, w)
+        at_cell = None if gain is None else float(_law_lsq(X, np.log(d * gain), leak, var_noise)[0][1])
         return AmplitudeLaw(direction, float(h), float(coef[1]), float(np.exp(coef[0])), w_ref,
                             float(np.sqrt(cov[1, 1])), beyond, sides, _channel_sides(ctx, state, direction, h, runs),
-                            None if step is None else float(step["step_dB"]))
+                            None if step is None else float(step["step_dB"]), at_cell)
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
