@@ -400,8 +400,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
     result = fit_empirical(spectra, settings, name=name, progress=progress)
-    # each radial line's rotation sense as the x/y phase reads it (without one, every consumer reads it co-rotating)
-    result = replace(result, model=with_senses(result, test))
+    result = replace(result, model=with_senses(result, test, ("co", "counter")))     # not 'planar': the FMU's x load
     refuse_non_finite_model(result.model, "fit")
     result.model.provenance.update(reading_provenance(getattr(test, "meta", None)))
     if frozen or distorted:
@@ -409,10 +408,11 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     result.model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))
     if text := speed_scale_warning(result, test.meta):
         warnings.warn(RwadistWarning(text.removeprefix("WARNING: ")), stacklevel=2)
-    if text := speed_whirl.fit_tie_warning(test):      # a sweep's speed from the data, its 1x line a tie
-        warnings.warn(RwadistWarning(text), stacklevel=2)
-    if text := fit_warnings.unit_mixup_warning(spectra, result.model):     # a channel in another unit
-        warnings.warn(RwadistWarning(text), stacklevel=2)
+    # a sweep's speed from the data whose 1x line is a tie; a channel in another unit; a radial pair missing a channel
+    for text in (speed_whirl.fit_tie_warning(test), fit_warnings.unit_mixup_warning(spectra, result.model),
+                 fit_warnings.sense_unread_warning(spectra, result.model)):
+        if text:
+            warnings.warn(RwadistWarning(text), stacklevel=2)
     if not any(result.model.empirical.values()):
         warnings.warn(RwadistWarning(fit_warnings.empty_model_advice(test, settings, presence)), stacklevel=2)
     return result

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .units import RADIAL_PAIRS, unit_words
+from .units import DIRECTION_CHANNELS, RADIAL_PAIRS, unit_words
 
 #: A line is read on a channel of a radial pair when its power stands this many times over the channel's median
 #: PSD near it (both channels of the pair must read it)
@@ -92,3 +92,20 @@ def empty_model_advice(test, settings, presence: float) -> str:
 
 
 __all__ = ["pair_amplitude_ratios", "unit_mixup_warning", "empty_model_advice"]
+
+
+def sense_unread_warning(spectra, model) -> str:
+    """'' or the words for the radial directions whose lines the model holds while a channel of their pair is in
+    no run (:meth:`rwadist.spectra.Spectra.available`): their rotation senses cannot be read from the x/y phase, and
+    every consumer takes them co-rotating (session 62's trial without Fy: the imbalance and every force line had been
+    made counter-rotating)."""
+    said = []
+    for d, pair in DIRECTION_CHANNELS.items():
+        if d not in ("radial_force", "radial_torque") or not model.harmonics(d):
+            continue
+        lost = [c for c in pair if c not in spectra.channels or not spectra.available(c).any()]
+        if lost:
+            said.append(f"{' and '.join(lost)} in no run: the {d.replace('_', ' ')} lines' rotation senses cannot be "
+                        "read from the x/y phase (each is taken co-rotating: a counter-rotating line's whirl, coupling "
+                        "and FMU x/y phase are then wrong); record both channels of the pair to read them")
+    return "; ".join(said)

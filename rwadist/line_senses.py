@@ -83,7 +83,12 @@ def line_senses(test: SteadyTest, fit: EmpiricalFit, threshold: float = SENSE_SH
             q_hi = np.maximum(q_hi, np.where(seen, q, 0.0).max(axis=0))
             n_runs += seen.sum(axis=0)
         frac = p_co / np.maximum(p_co + p_ct, 1e-300)
-        for hk, fr, lo, hi, n_k in zip(h, frac, q_lo, q_hi, n_runs):
+        for hk, fr, lo, hi, n_k, read in zip(h, frac, q_lo, q_hi, n_runs, p_co + p_ct > 0):
+            if not read:
+                # no run holds both channels of the pair (one missing or frozen throughout): no phase, no sense (a
+                # line read as 0 of its power co-rotating was made counter-rotating, the imbalance too: session 62's
+                # trial without Fy, U_s 0 and every radial force line counter)
+                continue
             sense = "co" if fr >= threshold else ("counter" if fr <= 1 - threshold else "planar")
             every = "" if n_k < ONE_SENSE_RUNS else "co" if lo > ONE_SENSE else "counter" if hi < 1 - ONE_SENSE else ""
             out[(d, float(hk))] = (sense, float(fr), every)
@@ -134,10 +139,10 @@ IMBALANCE_H_TOL = 1e-3
 SAME_LINE_H = 2e-3
 
 
-def with_senses(fit: EmpiricalFit, test: SteadyTest):
+def with_senses(fit: EmpiricalFit, test: SteadyTest, kept: tuple = ("co", "counter", "planar")):
     """``fit``'s model with the rotation sense of each radial line the x/y phase of the whole runs reads
-    (:func:`line_senses`: co, counter or planar) on each harmonic that has none, but the imbalance's order; a copy
-    when one is set, else the model itself.  Without a sense every consumer reads a radial line co-rotating
+    (:func:`line_senses`) on each harmonic that has none, when it is one of ``kept``, but the imbalance's order; a
+    copy when one is set, else the model itself.  Without a sense every consumer reads a radial line co-rotating
     (docs/formats.md): a counter-rotating cage line fitted by ``rwadist fit`` was shown and used co-rotating (session
     61's new-user trial); ``rwadist diagnose`` starts from the model so sensed."""
     model = fit.model
@@ -150,7 +155,7 @@ def with_senses(fit: EmpiricalFit, test: SteadyTest):
         new = []
         for x in model.harmonics(d):
             got = next((v[0] for (dd, h), v in senses.items() if dd == d and abs(h - x.h) <= SAME_LINE_H), None)
-            if got is not None and x.sense is None and abs(x.h - 1.0) > IMBALANCE_H_TOL:
+            if got in kept and x.sense is None and abs(x.h - 1.0) > IMBALANCE_H_TOL:
                 x = replace(x, sense=got)
             new.append(x)
         if any(a is not b for a, b in zip(new, model.harmonics(d))):
