@@ -15,7 +15,6 @@ import functools
 import json
 import warnings
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -400,7 +399,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
     result = fit_empirical(spectra, settings, name=name, progress=progress)
-    result = replace(result, model=with_senses(result, test, ("co", "counter")))     # not 'planar': the FMU's x load
+    result.model = with_senses(result, test, ("co", "counter"))      # not 'planar' (the FMU's load along x)
     refuse_non_finite_model(result.model, "fit")
     result.model.provenance.update(reading_provenance(getattr(test, "meta", None)))
     if frozen or distorted:

@@ -226,6 +226,8 @@ def split_to_senses(params, meas_lines: list, fitted_lines: list, line_of: dict,
         k_co, k_ct = line_of[j]
         co_share = min(max(float(senses_xy[key][1]), 0.0), 1.0)
         k_own, k_other, m = (k_co, k_ct, 1.0 - co_share) if senses_xy[key][2] == "co" else (k_ct, k_co, co_share)
+        if out[k_other].imbalance:
+            continue    # an imbalance turns with the spin: read against it in every run, the speed's sign is in doubt
         p_own, p_other = out[k_own].C ** 2 * powers[k_own], out[k_other].C ** 2 * powers[k_other]
         total = p_own + p_other
         if not total > 0.0 or powers[k_own] <= 0.0 or m > PURE_SENSE or p_other / total <= SENSE_FACTOR * m:

@@ -279,6 +279,12 @@ def from_time_profile(t, omega, n_bins: int = 2000, source="time profile") -> Hi
     step = (hi - lo) / n_bins
     a = (np.minimum(w[:-1], w[1:]) - lo) / step - 0.5      # bin-centre units: bin k centred at k
     b = (np.maximum(w[:-1], w[1:]) - lo) / step - 0.5
+    # a hold is a point mass split between the two bins beside it: at the range's ends (the profile's top or bottom
+    # speed) into the end bin alone, not half past the grid (session 62's trial: a 10-s hold at the top speed after a
+    # 10-s ramp weighed as 5 s, the RMS 9.5 % low)
+    hold = b - a <= 1e-6
+    a = np.where(hold, np.clip(a, 0.0, n_bins - 1.0), a)
+    b = np.where(hold, np.clip(b, 0.0, n_bins - 1.0), b)
     bins = _spread(a, b, dt[None, :] / dt.sum(), n_bins).real[0]
     bins = np.maximum(bins, 0.0)
     return Histogram.from_weights(lo + step * np.arange(n_bins + 1), bins, source)

@@ -6,9 +6,9 @@ Session 62's trial (a 7.5-kg wheel at 3 kHz, a motor-stator line h 24 and no ant
 straight-track search counts slopes |b| <= 4 over 8 runs or more.
 
 Data: family wheels (tests/family_wheel.py, time-integrated physics) with a co-rotating radial-force line at h·f_spin
-added at the cell as sampling without an anti-alias filter records it: where h·f_spin lies between f_s/2 and f_s, a
-line at f_s − h·f_spin (a sampled sinusoid e^{iωt} at ω = 2πf is e^{i(ω − 2πf_s)t} at the sample instants: the fold
-turns a co-rotating line counter-rotating), elsewhere above f_s nothing (the family's own anti-alias cut)."""
+added at the cell as sampling without an anti-alias filter records it: below f_s/2 as it is, where h·f_spin lies
+between f_s/2 and f_s a line at f_s − h·f_spin (a sampled sinusoid e^{iωt} at ω = 2πf is e^{i(ω − 2πf_s)t} at the
+sample instants: the fold turns a co-rotating line counter-rotating), above f_s nothing."""
 import json
 import sys
 from pathlib import Path
@@ -23,7 +23,8 @@ from cli_run import run  # noqa: E402
 
 
 class FoldedLine(fe.Effect):
-    """A radial-force line C·Ω² at h × the speed, co-rotating, recorded without an anti-alias filter."""
+    """A radial-force line C·Ω² at h × the speed, co-rotating, recorded without an anti-alias filter: as it is below
+    the Nyquist frequency, folded between it and the sample rate."""
 
     kind = "folded_line"
     expects = "unexplained"
@@ -34,12 +35,16 @@ class FoldedLine(fe.Effect):
     def cell_components(self, omega, run, rng, wheel):
         p = self.params
         f = p["h"] * abs(omega) / (2 * np.pi)
-        fold = 0.5 * p["fs"] < f < p["fs"]
-        a = p["C"] * omega ** 2 * np.exp(1j * rng.uniform(0, 2 * np.pi)) if fold else 0.0
-        # co-rotating at f: Fx = cos, Fy = sin; sampled, the same values as cos/−sin at f_s − f
+        a = p["C"] * omega ** 2 * np.exp(1j * rng.uniform(0, 2 * np.pi)) if f < p["fs"] else 0.0
         A = np.zeros((1, 6), complex)
-        A[0, 0], A[0, 1] = a, -1j * a
-        w = np.array([2 * np.pi * ((p["fs"] - f) if fold else 1.0)])
+        if f < 0.5 * p["fs"]:
+            # co-rotating at f (Fx, Fy) = Re((a, −ia)·e^{iωt}), recorded as it is
+            A[0, 0], A[0, 1] = a, -1j * a
+        else:
+            # sampled at t = n/f_s, e^{iωt} = conj(e^{iω't}) with ω' = 2π(f_s − f): the same samples as
+            # Re((ā, iā)·e^{iω't}), a counter-rotating line at f_s − f
+            A[0, 0], A[0, 1] = np.conj(a), 1j * np.conj(a)
+        w = np.array([2 * np.pi * (f if f < 0.5 * p["fs"] else p["fs"] - f if f < p["fs"] else 1.0)])
         return fw.Components(["cell"], w, np.ones(1), np.ones(1, complex), [self.kind]), A
 
 

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .describe_alias import ALIAS_TELLS, alias_causes, alias_tracks, folded
+from .describe_alias import ALIAS_TELLS, alias_causes, alias_tracks, folded, reads_as_counted
 from .describe_alias import MIN_RUNS as ALIAS_MIN_RUNS
 from .describe_lines import RIDGE_FRACTION, _lit, log_parabola_offset, sliced
 from .unexplained import Unexplained
@@ -190,13 +190,13 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
     bins = np.arange(ctx.f.size)
     claimed: set = set()            # the lit stretches of the lines read so far
     ratios: dict = {}               # the data over the model summed over a channel set, per set
-    for b, jj, runs_lit, frac, labels, *fold in tracks:
+    for b_counted, jj, runs_lit, frac, labels, *fold in tracks:
         least = ALIAS_MIN_RUNS if fold and fold[0] else MIN_RUNS
         mine = labels[labels > 0].tolist()
         if sum(x in claimed for x in mine) >= 0.5 * len(mine):
             continue                # mostly a line already read (or refused): the same line at another slope
         s = spin[runs_lit]
-        k_run = np.clip(np.rint((jj * df + b * s) / df).astype(int), 0, ctx.f.size - 1)
+        k_run = np.clip(np.rint((jj * df + b_counted * s) / df).astype(int), 0, ctx.f.size - 1)
         chans = tuple(c for c in ctx.channels if lits[c][runs_lit][np.arange(s.size), k_run].mean() >= CHANNEL_FRACTION)
         if not chans:
             continue
@@ -215,8 +215,10 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
                               [(int(k) - WINDOW_BINS, int(k) + WINDOW_BINS) for k in k_fit], least)
         if got is None:
             continue
-        claimed.update(mine)
         f0, b, rms, peak_db = got
+        if fold and fold[0] and not reads_as_counted(f0, b, -float(b_counted), s, fs or 0.0, df):
+            continue                # a fold counted over few runs read as another line: none of its gates passed
+        claimed.update(mine)
         # a fixed line's sideband (its lower side past 0 Hz folds: f0 = -f_c) is the sideband detector's
         if rms > MAX_MISFIT_BINS * df or np.ptp(b * s) < MIN_MOVE_BINS * df or \
                 _offset_from_ratio(f0, b, s) < MIN_OFFSET_BINS * df or \

@@ -42,26 +42,50 @@ def alias_tracks(lit: np.ndarray, seg: np.ndarray, spin: np.ndarray, df: float, 
     if h_hi <= h_lo:
         return []
     h = np.arange(h_lo, h_hi, H_STEP_BINS * df / span)
-    hf = h[:, None] * spin[None, :]                                         # (H, R) Hz
-    k = np.rint((fs - hf) / df).astype(int)
-    inb = (hf > 0.5 * fs) & (hf < fs) & (k >= k_lo) & (k <= k_hi)
-    hit = lit[np.arange(R)[None, :], np.clip(k, 0, K - 1)] & inb
-    n_in, n_hit = inb.sum(1), hit.sum(1)
+    n_in, n_hit = np.zeros(h.size, int), np.zeros(h.size, int)
+    for lo in range(0, h.size, CHUNK):                  # (chunk, R) at a time: long records make the h grid fine
+        k, inb = _folded_bins(h[lo:lo + CHUNK], spin, df, fs, k_lo, k_hi)
+        n_in[lo:lo + CHUNK] = inb.sum(1)
+        n_hit[lo:lo + CHUNK] = (lit[np.arange(R)[None, :], np.clip(k, 0, K - 1)] & inb).sum(1)
     frac = np.where(n_in >= MIN_RUNS, n_hit / np.maximum(n_in, 1), 0.0)
     ok = (frac >= RIDGE_FRACTION) & (n_hit >= MIN_RUNS)
-    peaks = np.flatnonzero(ok & (frac >= np.roll(frac, 1)) & (frac >= np.roll(frac, -1)))
+    # a ridge's peak inside the grid, the first of a plateau of equal lit fractions
+    inner = np.zeros(h.size, bool)
+    inner[1:-1] = (frac[1:-1] > frac[:-2]) & (frac[1:-1] >= frac[2:])
+    peaks = np.flatnonzero(ok & inner)
     out = []
     j_fs = int(np.rint(fs / df))
     for i in peaks[np.lexsort((-n_hit[peaks], -frac[peaks]))][:MAX_TRACKS]:
-        labels = np.where(hit[i], seg[np.arange(R), np.clip(k[i], 0, K - 1)], 0)
-        out.append((-float(h[i]), j_fs, hit[i], float(frac[i]), labels, True))
+        k, inb = _folded_bins(h[i:i + 1], spin, df, fs, k_lo, k_hi)
+        hit = lit[np.arange(R), np.clip(k[0], 0, K - 1)] & inb[0]
+        labels = np.where(hit, seg[np.arange(R), np.clip(k[0], 0, K - 1)], 0)
+        out.append((-float(h[i]), j_fs, hit, float(frac[i]), labels, True))
     return out
+
+
+#: h values of the grid counted at once (memory: CHUNK × runs cells)
+CHUNK = 4096
+
+
+def _folded_bins(h: np.ndarray, spin: np.ndarray, df: float, fs: float, k_lo: int, k_hi: int) -> tuple:
+    """(bins (len(h), R) of the folds fs − h·f_spin, in band (len(h), R): h·f_spin between fs/2 and fs and the fold in
+    [``k_lo``, ``k_hi``])."""
+    hf = h[:, None] * spin[None, :]
+    k = np.rint((fs - hf) / df).astype(int)
+    return k, (hf > 0.5 * fs) & (hf < fs) & (k >= k_lo) & (k <= k_hi)
 
 
 def folded(f0: float, b: float, fs: float | None, df: float) -> bool:
     """Whether the track f0 + b·f_spin is a line folded at the sample rate ``fs`` (Hz; None: runs of several rates):
     falling, from an offset within :data:`FOLD_BINS` Welch bins (``df`` Hz) of it."""
     return fs is not None and b < 0 and abs(f0 - fs) <= FOLD_BINS * df
+
+
+def reads_as_counted(f0: float, b: float, h: float, spin: np.ndarray, fs: float, df: float) -> bool:
+    """Whether a folded track counted at ``h`` was read as one (:func:`folded`, its slope −h within
+    :data:`FOLD_BINS` Welch bins over the spin frequencies ``spin`` Hz): a candidate counted over few runs and read
+    as any other straight line is not described (it passed none of the ``affine_line`` search's own gates)."""
+    return folded(f0, b, fs, df) and abs(b + h) * float(np.ptp(spin)) <= FOLD_BINS * df
 
 
 def alias_causes(f0: float, b: float, fs: float) -> tuple:

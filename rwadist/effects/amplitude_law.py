@@ -69,8 +69,8 @@ class AmplitudeLaw(Element):
                 f"{plus_minus(e, 'exponent_stderr')}, {num(e['amplitude_ref'], '.3g')} {cls.AMPLITUDE_UNIT[d]} at "
                 f"{rpm(e['omega_ref_rad_s'])}{cls._at_interface(e)}{cls._beyond_stand(e)}")
 
-    #: |exponent at the interface − 2| within this (or twice the exponent's standard error) with the law's own 2 or
-    #: more from it: C·Ω² at the load cell, a load that bypasses the suspension (:meth:`_at_interface`)
+    #: |exponent at the interface − 2| within this (or twice the exponent's standard error, at most twice this) with
+    #: the law's own twice this or more from it: C·Ω² at the load cell, a load that bypasses the suspension (:meth:`_at_interface`)
     INTERFACE_OMEGA2: ClassVar[float] = 0.15
 
     @classmethod
@@ -82,7 +82,7 @@ class AmplitudeLaw(Element):
             return ""
         out = f" (|Ω|^{num(q, '.3g')} at the load cell, through the suspension modes"
         se = e.get("exponent_stderr") or 0.0
-        if abs(float(q) - 2.0) <= max(cls.INTERFACE_OMEGA2, 2.0 * float(se)) and abs(float(e["exponent"]) - 2.0) >= 2.0 * \
+        if abs(float(q) - 2.0) <= min(max(cls.INTERFACE_OMEGA2, 2.0 * float(se)), 2.0 * cls.INTERFACE_OMEGA2) and abs(float(e["exponent"]) - 2.0) >= 2.0 * \
                 cls.INTERFACE_OMEGA2:
             out += (": C·Ω² there, which is also what a load that reaches the interface without the suspension "
                     "gives (on the housing side: the motor stator's, a structure's); a tap or shaker test of the "
