@@ -18,7 +18,8 @@ import family_wheel as fw  # noqa: E402
 @pytest.mark.slow
 def test_a_run_up_read_with_its_tach_is_diagnosed_as_well_as_without_it(tmp_path):
     """``rwadist.diagnose`` (no model) of the run-up with its tach column: the slices' highest line sweeps at most
-    2 bins of a Welch segment (the rule says so), every suspension mode located within 2 %, and the error within
+    2 bins of a Welch segment (the rule says so), every suspension mode located within 2 % (a damping may be declared
+    held: the translation's ζ 0.0099, held within 5e-5-0.0164, on every OpenBLAS kernel), and the error within
     twice that of the same file without the tach column (on main: 19 slices against 37, the translation and rocking
     modes 14x and 27x off, the error 0.205 against 0.0088)."""
     from rwadist import api
@@ -35,7 +36,8 @@ def test_a_run_up_read_with_its_tach_is_diagnosed_as_well_as_without_it(tmp_path
     slicing = test.meta["slicing"]
     assert slicing["speed_source"] == "tach" and "chirp" in slicing["slice_rule"], slicing["slice_rule"]
     sm = next(e for e in d.model.effects if e["kind"] == "suspension_modes")
-    assert not sm.get("unconstrained")
+    # every mode located (its damping may be declared held: ζ_trans 0.0099 of a 40-s run-up's slices)
+    assert not [m for m in sm.get("unconstrained") or [] if not m.startswith("zeta_")], sm.get("unconstrained")
     for m, f in wheel.modes_hz().items():
         assert abs(sm[f"{m}_Hz"] / f - 1) < 0.02, (m, sm[f"{m}_Hz"], f)
     assert d.error_after < 2.0 * got[False][1].error_after, (d.error_after, got[False][1].error_after)
