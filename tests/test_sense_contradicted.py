@@ -68,35 +68,28 @@ class _Measured:
     direction, h, C = "radial_torque", 2.5, 1.0
 
 
-def test_a_contradicted_split_is_the_phases_with_the_power_kept():
+@pytest.mark.parametrize("own", ["co", "counter"])
+def test_a_contradicted_split_is_the_phases_with_the_power_kept(own):
     """Closed form: parts C_co = C_counter = 1 whose response powers per unit C² are 4 and 1 (a co part through the
     forward whirl) predict a counter share of 1/5 of the response.  Measured co-rotating in every run, all but 0.001
     of it: the line co-rotating alone, C_co² = 5/4 (the response's power 5 kept), no counter part.  Not where the
     response turns both ways (co in every run but 10 % counter, or 0.1 % counter without every run co): the parts are
-    left as fitted."""
+    left as fitted.  The mirror (``own`` counter): powers 1 (co) and 4 (counter, through the backward whirl), measured
+    counter-rotating in every run but 0.001: counter-rotating alone, C_counter² = 5/4, no co part."""
     params = replace(ext.from_table_4_2(), U_d=0.0)
-    powers = np.array([4.0, 1.0])
+    k, other = (0, 1) if own == "co" else (1, 0)
+    powers = np.array([4.0, 1.0]) if own == "co" else np.array([1.0, 4.0])
     key = ("radial_torque", 2.5)
-    _, out, changed = split_to_senses(params, [_Measured()], _parts(1.0, 1.0), {0: [0, 1]}, powers,
-                                      {key: ("co", 0.999, "co")})
-    assert changed == [key] and out[1].C == 0.0 and out[0].C ** 2 * powers[0] == pytest.approx(5.0)
-    for senses in ({key: ("co", 0.9, "co")}, {key: ("co", 0.999, "")}):
-        _, out, changed = split_to_senses(params, [_Measured()], _parts(1.0, 1.0), {0: [0, 1]}, powers, senses)
-        assert changed == [] and [ln.C for ln in out] == [1.0, 1.0]
 
+    def read(share_own: float, every: str) -> tuple:
+        co = share_own if own == "co" else 1.0 - share_own
+        return split_to_senses(params, [_Measured()], _parts(1.0, 1.0), {0: [0, 1]}, powers,
+                               {key: (own, co, every)})[1:]
 
-def test_a_contradicted_co_part_of_a_counter_rotating_line_is_dropped_too():
-    """The mirror of the closed form above: parts whose response powers per unit C² are 1 (co) and 4 (counter, through
-    the backward whirl) predict a co share of 1/5; measured counter-rotating in every run, all but 0.001 of it: the
-    line counter-rotating alone, C_counter² = 5/4, no co part; left as fitted where the response turns both ways."""
-    params = replace(ext.from_table_4_2(), U_d=0.0)
-    powers = np.array([1.0, 4.0])
-    key = ("radial_torque", 2.5)
-    _, out, changed = split_to_senses(params, [_Measured()], _parts(1.0, 1.0), {0: [0, 1]}, powers,
-                                      {key: ("counter", 0.001, "counter")})
-    assert changed == [key] and out[0].C == 0.0 and out[1].C ** 2 * powers[1] == pytest.approx(5.0)
-    for senses in ({key: ("counter", 0.1, "counter")}, {key: ("counter", 0.001, "")}):
-        _, out, changed = split_to_senses(params, [_Measured()], _parts(1.0, 1.0), {0: [0, 1]}, powers, senses)
+    out, changed = read(0.999, own)
+    assert changed == [key] and out[other].C == 0.0 and out[k].C ** 2 * powers[k] == pytest.approx(5.0)
+    for share, every in ((0.9, own), (0.999, "")):
+        out, changed = read(share, every)
         assert changed == [] and [ln.C for ln in out] == [1.0, 1.0]
 
 
