@@ -27,8 +27,9 @@ def empirical_only(name="ithaco-e"):
 
 
 def closed_form_lines(doc, omega, t):
-    """(n, 6) wheel-frame loads of the empirical harmonics at constant speed ``omega`` (rad/s): each line
-    C·Ω² rotating at hΩ (co +, counter −, planar: along x), axial lines C·Ω²·cos(hΩt); rotor angle Ωt."""
+    """(n, 6) wheel-frame loads of the empirical harmonics at constant speed ``omega`` (rad/s), the model file's
+    phases (0): each line C·Ω² rotating at hΩ (co +, counter −; planar: C·Ω²·cos(hΩt) on x and on y, the fit's
+    C on each channel), axial lines C·Ω²·cos(hΩt); rotor angle Ωt."""
     out = np.zeros((t.size, 6))
     phi = omega * t
     for d, items in doc["empirical"].items():
@@ -36,7 +37,7 @@ def closed_form_lines(doc, omega, t):
             h, a, sense = item["h"], item["C"] * omega**2, item.get("sense") or "co"
             if d in ("radial_force", "radial_torque"):
                 z = {"co": np.exp(1j * h * phi), "counter": np.exp(-1j * h * phi),
-                     "planar": np.cos(h * phi) + 0j}[sense] * a
+                     "planar": (1 + 1j) * np.cos(h * phi)}[sense] * a
                 k = 0 if d == "radial_force" else 3
                 out[:, k] += z.real
                 out[:, k + 1] += z.imag
@@ -62,6 +63,56 @@ def test_empirical_only_fmu_outputs_are_the_lines(empirical_fmu, rpm):
     ref = closed_form_lines(doc, rpm * RPM, t)
     assert np.max(np.abs(out[:, :6] - ref)) <= 1e-9 * np.max(np.abs(ref))
     assert np.allclose(out[:, 6:], out[:, :6], rtol=0, atol=1e-20)     # identity mounting
+
+
+def with_planar_lines(doc):
+    """``doc`` with its fundamentals, a planar radial force line (h 2.7) and a planar radial torque line (h 3.3)."""
+    emp = doc["empirical"]
+    emp["radial_force"] = emp["radial_force"][:1] + [{"h": 2.7, "C": 4.0e-7, "sense": "planar"}]
+    emp["radial_torque"] = emp["radial_torque"][:1] + [{"h": 3.3, "C": 2.0e-8, "sense": "planar"}]
+    emp["axial_force"] = emp["axial_force"][:1]
+    return doc
+
+
+def line_phasor(y, t, f):
+    """Complex amplitude of the line at ``f`` Hz in ``y`` (n, k) over whole periods (t spans them)."""
+    return 2.0 * np.mean(y * np.exp(-2j * np.pi * f * t)[:, None], axis=0)
+
+
+@pytest.mark.parametrize("native", [False, True])
+def test_empirical_planar_line_puts_its_power_on_both_channels(tmp_path, native):
+    """A planar radial line of an empirical fit (``rwadist diagnose`` on the empirical base writes them) has the
+    fit's C on each channel of its pair, as the model file defines C (C²Ω⁴/2 on each channel) and as the PSD
+    reads it (:func:`rwadist.broadband.empirical_lines`: independent x and y sources): with a seed, |Fx| = |Fy|
+    = C·Ω² at the line's frequency and x and y have phases of their own (two loads, not one along x, which
+    put nothing on Fy).  Python runtime and native FMU alike, and equal to each other."""
+    from rwadist import model as model_io
+    from rwadist.broadband import empirical_lines
+
+    if native and not __import__("rwadist.fmu.build", fromlist=["x"]).native_supported():
+        pytest.skip("native FMU: Linux x86-64")
+    doc = with_planar_lines(empirical_only())
+    path = build_fmu(doc, tmp_path / "planar.fmu", native=native)
+    w = 2400 * RPM
+    t = np.arange(2000) * (2 * np.pi / w / 200)          # 10 turns: whole periods of h 2.7 (27) and 3.3 (33)
+    wheel = np.full(t.size, w)
+    out = hosts.run_fmpy(path, t, {"wheel_speed": wheel}, {"seed": 11})
+    params, lines = rt.model_from_doc(doc)
+    py = rt.WheelRuntime(params, lines, seed=11, modes=False).run(t, wheel)
+    assert np.max(np.abs(out[:, :6] - py[:, :6])) <= 1e-9 * np.max(np.abs(py[:, :6]))
+    src = empirical_lines(model_io.from_json(doc))
+    for (cx, cy), h, C in (((0, 1), 2.7, 4.0e-7), ((3, 4), 3.3, 2.0e-8)):
+        a = line_phasor(out[:, [cx, cy]], t, h * w / (2 * np.pi))
+        assert np.allclose(np.abs(a), C * w**2, rtol=1e-6), (h, np.abs(a) / (C * w**2))
+        dphi = np.angle(a[1] / a[0])
+        assert min(abs(dphi), abs(abs(dphi) - np.pi)) > 0.05        # not one load along a line
+        # the PSD's own sources: two of them for this line, each of the fit's C
+        own = [s for s in src.spec if s[0] in ("radial_force", "radial_torque") and s[1] == C]
+        assert sorted(m for _, _, m in own) == ["x", "y"]
+    # the file's phases (seed -1): both channels C·Ω²·cos(hΩt), the closed form
+    ref = closed_form_lines(doc, w, t)
+    out0 = hosts.run_fmpy(path, t, {"wheel_speed": wheel}, {})
+    assert np.max(np.abs(out0[:, :6] - ref)) <= 1e-9 * np.max(np.abs(ref))
 
 
 def test_model_description_states_the_physics(empirical_fmu, tmp_path):

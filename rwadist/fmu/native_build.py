@@ -104,7 +104,7 @@ VARIABLES = [
     for ch, unit in (("Fx", "N"), ("Fy", "N"), ("Fz", "N"), ("Tx", "N.m"), ("Ty", "N.m"), ("Tz", "N.m"))]
 UNITS = {"N": dict(kg=1, m=1, s=-2), "N.m": dict(kg=1, m=2, s=-2), "rad/s": dict(s=-1, rad=1),
          "rad/s2": dict(s=-2, rad=1), "s": dict(s=1), "m": dict(m=1), "Hz": dict(s=-1), "1": {}}
-SENSES = {"co": 0, "counter": 1, "planar": 2}
+SENSES = {"co": 0, "counter": 1, "planar": 2, rt.PLANAR_Y: 3}      # 3: planar along y
 
 
 def _f(x) -> str:

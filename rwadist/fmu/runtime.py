@@ -95,6 +95,7 @@ load_model = _model.load_model
 model_from_doc = _model.model_from_doc
 physics_of = _model.physics_of
 components = _model.components
+PLANAR_Y = _model.PLANAR_Y
 rotation_check = _model.rotation_check
 expand_lines = _model.expand_lines
 fmu_switches = _model.fmu_switches

@@ -281,10 +281,16 @@ def _empirical_only(doc, source):
     """(params, lines) of a model without an ``analytical`` section: every empirical harmonic is a
     line of amplitude C·Ω² at its own h and sense, hard-mounted (the loads measured at the
     interface reach it directly: no suspension, torques already about the interface, height 0).
-    The co-rotating radial fundamentals are the imbalance: they keep their tangential term −i·C·Ω̇
+    A planar radial line is two loads of amplitude C·Ω², along x and along y, each with a phase of its own (the
+    fit read C from each channel's power, C²Ω⁴/2 on each, as :func:`rwadist.broadband.empirical_lines` reads it;
+    one load along x carried all of it on x and none on y).  The co-rotating radial fundamentals are the imbalance: they keep their tangential term −i·C·Ω̇
     (zero at constant speed) and follow the ``imbalance`` switch.  params carry
     ``suspension`` False and no modal values (0): :class:`WheelRuntime` refuses modes on."""
-    lines = [(d, h, C, sense, fundamental) for d, h, C, sense, fundamental in _harmonics(doc, source)]
+    lines = []
+    for d, h, C, sense, fundamental in _harmonics(doc, source):
+        lines.append((d, h, C, sense, fundamental))
+        if sense == "planar" and d in ("radial_force", "radial_torque"):
+            lines.append((d, h, C, PLANAR_Y, False))      # the fit's C on each channel, phases of their own
     if not lines:
         raise ModelError(f"{source}: empirical: no harmonics and no analytical section; the model has no lines")
     p = {name: 0.0 for name in PARAM_KEYS}
@@ -296,7 +302,8 @@ def _empirical_only(doc, source):
 def physics_of(params, lines, effects=None) -> str:
     """One sentence saying which physics a model carries (for the FMU's description and logs)."""
     if not params.get("suspension", True):
-        what = f"empirical harmonics only ({len(lines)} lines, amplitude C*Omega^2), hard-mounted"
+        n = sum(1 for line in lines if line[3] != PLANAR_Y)           # a planar line's y load is not a line
+        what = f"empirical harmonics only ({n} lines, amplitude C*Omega^2), hard-mounted"
     elif params.get("modes_assumed"):
         what = ("extended model with ASSUMED suspension modes (datasheet wheel; hard-mounted unless "
                 "modes = true)")
@@ -310,12 +317,19 @@ def physics_of(params, lines, effects=None) -> str:
     return what
 
 
+#: Internal sense of the y load of an empirical model's planar line (:func:`_empirical_only`): planar along +y.
+PLANAR_Y = "planar_y"
+
+
 def components(direction, sense, phase, angle=0.0):
-    """[(sigma, coef)] of a line, as ``rwadist.extended.Line.components``."""
+    """[(sigma, coef)] of a line, as ``rwadist.extended.Line.components`` (sense :data:`PLANAR_Y`: planar at
+    ``angle`` + π/2)."""
     if direction in ("axial_force", "axial_torque") or sense == "co":
         return [(1, cmath.exp(1j * phase))]
     if sense == "counter":
         return [(-1, cmath.exp(-1j * phase))]
+    if sense == PLANAR_Y:
+        angle = angle + 0.5 * math.pi
     return [(1, 0.5 * cmath.exp(1j * (angle + phase))), (-1, 0.5 * cmath.exp(1j * (angle - phase)))]
 
 

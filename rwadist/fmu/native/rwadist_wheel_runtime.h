@@ -138,10 +138,12 @@ static int line_components(const RwLine *ln, double phase, int sigma[2], double 
         coef[0] = CMPLX(cos(-phase), sin(-phase));
         return 1;
     }
+    /* planar: along x (sense 2) or along y (sense 3, the y load of an empirical planar line) */
+    const double angle = ln->sense == 3 ? 0.5 * 3.14159265358979311600 : 0.0;
     sigma[0] = 1;
     sigma[1] = -1;
-    coef[0] = 0.5 * CMPLX(cos(phase), sin(phase));
-    coef[1] = 0.5 * CMPLX(cos(-phase), sin(-phase));
+    coef[0] = 0.5 * CMPLX(cos(angle + phase), sin(angle + phase));
+    coef[1] = 0.5 * CMPLX(cos(angle - phase), sin(angle - phase));
     return 2;
 }
 
@@ -231,7 +233,7 @@ static int build_model(Wheel *w)
         int k = 0;
         for (int r = 0; r < RW_N_RES; r++)
             k += (RW_RES[r].dirmask >> ln->dir) & 1;
-        const int nc = (ln->dir < 2 && ln->sense == 2) ? 2 : 1;
+        const int nc = (ln->dir < 2 && ln->sense >= 2) ? 2 : 1;
         n += nc;
         n_res += nc * k;
     }
