@@ -95,17 +95,19 @@ __all__ = ["pair_amplitude_ratios", "unit_mixup_warning", "empty_model_advice"]
 
 
 def sense_unread_warning(spectra, model) -> str:
-    """'' or the words for the radial directions whose lines the model holds while a channel of their pair is in
-    no run (:meth:`rwadist.spectra.Spectra.available`): their rotation senses cannot be read from the x/y phase, and
+    """'' or the words for the radial directions whose lines the model holds while no run has both channels of their
+    pair (:meth:`rwadist.spectra.Spectra.available`): their rotation senses cannot be read from the x/y phase, and
     every consumer takes them co-rotating (session 62's trial without Fy: the imbalance and every force line had been
-    made counter-rotating)."""
+    made counter-rotating; a reviewer's Fx and Fy recorded in alternate runs, never together: no sense, no word)."""
     said = []
     for d, pair in DIRECTION_CHANNELS.items():
         if d not in ("radial_force", "radial_torque") or not model.harmonics(d):
             continue
         lost = [c for c in pair if c not in spectra.channels or not spectra.available(c).any()]
-        if lost:
-            said.append(f"{' and '.join(lost)} in no run: the {d.replace('_', ' ')} lines' rotation senses cannot be "
+        what = " and ".join(lost) + " in no run" if lost else " and ".join(pair) + " in no run together"
+        if lost or not (spectra.available(pair[0]) & spectra.available(pair[1])).any():
+            said.append(f"{what}: the {d.replace('_', ' ')} lines' rotation senses cannot be "
                         "read from the x/y phase (each is taken co-rotating: a counter-rotating line's whirl, coupling "
-                        "and FMU x/y phase are then wrong); record both channels of the pair to read them")
+                        "and FMU x/y phase are then wrong); record both channels of the pair in the same runs to read "
+                        "them")
     return "; ".join(said)

@@ -82,3 +82,26 @@ def test_a_pair_missing_a_channel_gives_no_sense_and_keeps_the_imbalance(tmp_pat
     U_s = api.load_model(tmp_path / "ext.json").analytical["U_s_kg_m"]       # per unit mass: the C of U_s·Ω²
     imbalance = next(ln for ln in wheel.lines if ln.direction == "radial_force" and ln.name == "imbalance")
     assert U_s == pytest.approx(imbalance.C, rel=0.05), (U_s, imbalance.C)
+
+
+def test_a_pair_never_read_together_is_said(tmp_path, capsys):
+    """Fx left out of the even runs and Fy out of the odd ones (each channel in half the runs, never both at once: no
+    x/y phase anywhere): ``rwadist fit`` says the radial force senses cannot be read, naming the pair, and writes none
+    (before: no word, while every consumer took the counter-rotating lines co-rotating)."""
+    import csv
+
+    from rwadist import api
+
+    wheel = fw.family()[2]
+    data = fw.write_steady(fw.steady(wheel, seed=201), tmp_path / "data")
+    for i, path in enumerate(sorted(data.glob("run_*.csv"))):
+        rows = list(csv.reader(path.open()))
+        drop = rows[0].index("Fy_N" if i % 2 else "Fx_N")
+        path.write_text("\n".join(",".join(r[:drop] + r[drop + 1:]) for r in rows) + "\n")
+    code, _, err = run(capsys, "fit", data, "-o", tmp_path / "model.json", "--no-report")
+    assert code == 0, err
+    assert "Fx and Fy in no run together: the radial force lines' rotation senses cannot be read" in err, err
+    assert "radial torque" not in err, err
+    model = api.load_model(tmp_path / "model.json")
+    assert model.harmonics("radial_force") and all(hm.sense is None for hm in model.harmonics("radial_force"))
+    assert any(hm.sense is not None for hm in model.harmonics("radial_torque")), model.harmonics("radial_torque")
