@@ -125,10 +125,22 @@ def _tracks(lit: np.ndarray, spin: np.ndarray, df: float, k_lo: int, k_hi: int) 
     return [c[1:] for c in cands[:MAX_CANDIDATES]], seg
 
 
-def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list, least: int = MIN_RUNS) -> tuple | None:
+def _line_through(spin: np.ndarray, f: np.ndarray, offset: float | None) -> tuple:
+    """(slope b, offset f0) of the least-squares line f = f0 + b·f_spin; with ``offset`` given, f0 is it and b alone is
+    fitted (a line folded at the sample rate: its offset is known, and fitted free the track's few top runs, read back
+    to 0 Hz, carried each peak's error ~8 times into f0)."""
+    if offset is None:
+        b, f0 = np.polyfit(spin, f, 1)
+        return float(b), float(f0)
+    return float(np.dot(spin, f - offset) / np.dot(spin, spin)), float(offset)
+
+
+def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list, least: int = MIN_RUNS,
+                offset: float | None = None) -> tuple | None:
     """(offset f0 Hz, slope b, RMS misfit Hz, peak dB) of the line in ``windows`` ((first, last) bin in each run of ``runs``):
     each run's peak of ``ratio`` (the data over the model summed over the line's channels, a row per run) there, refined by a parabola through the log
-    powers of the top three bins, a least-squares line through them against f_spin, twice without the peaks off it by
+    powers of the top three bins, a least-squares line through them against f_spin (through f0 = ``offset`` when given,
+    :func:`_line_through`), twice without the peaks off it by
     :data:`OUTLIER_BINS` (another line's, where the track passes under a model line), at least :data:`KEPT_FRACTION`
     of the runs kept (and ``least``); peak dB: the median over the runs kept of the peak's ``ratio``, dB."""
     df = ctx.df
@@ -146,11 +158,11 @@ def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list, least: 
     for _ in range(2):              # a run whose peak is another line's (under a model line, the track is not lit)
         if ok.sum() < least:
             return None
-        b, f0 = np.polyfit(spin[ok], f_pk[ok], 1)
+        b, f0 = _line_through(spin[ok], f_pk[ok], offset)
         ok &= np.abs(f_pk - (f0 + b * spin)) <= OUTLIER_BINS * df
     if ok.sum() < max(least, KEPT_FRACTION * runs.size):
         return None
-    b, f0 = np.polyfit(spin[ok], f_pk[ok], 1)
+    b, f0 = _line_through(spin[ok], f_pk[ok], offset)
     rms = float(np.sqrt(np.mean((f_pk[ok] - (f0 + b * spin[ok])) ** 2)))
     return float(f0), float(b), rms, float(10 * np.log10(max(float(np.median(r_pk[ok])), 1e-300)))
 
@@ -191,7 +203,8 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
     claimed: set = set()            # the lit stretches of the lines read so far
     ratios: dict = {}               # the data over the model summed over a channel set, per set
     for b_counted, jj, runs_lit, frac, labels, *fold in tracks:
-        least = ALIAS_MIN_RUNS if fold and fold[0] else MIN_RUNS
+        is_fold = bool(fold and fold[0])
+        least, offset = (ALIAS_MIN_RUNS, fs) if is_fold else (MIN_RUNS, None)
         mine = labels[labels > 0].tolist()
         if sum(x in claimed for x in mine) >= 0.5 * len(mine):
             continue                # mostly a line already read (or refused): the same line at another slope
@@ -206,17 +219,17 @@ def affine_lines(ctx, state, shares, carriers=()) -> list:
         if chans not in ratios:
             ratios[chans] = sum(ctx.data(state, c, runs)[runs] / np.maximum(ctx.predict(state, c, runs), 1e-300)
                                 for c in chans)
-        got = _read_track(ctx, ratios[chans][rows], runs[runs_lit], windows, least)
+        got = _read_track(ctx, ratios[chans][rows], runs[runs_lit], windows, least, offset)
         for _ in range(REREADS):        # the counted slope is a grid's, through a stretch: read again on the line read
             if got is None:
                 break
             k_fit = np.rint((got[0] + got[1] * s) / df).astype(int)
             got = _read_track(ctx, ratios[chans][rows], runs[runs_lit],
-                              [(int(k) - WINDOW_BINS, int(k) + WINDOW_BINS) for k in k_fit], least)
+                              [(int(k) - WINDOW_BINS, int(k) + WINDOW_BINS) for k in k_fit], least, offset)
         if got is None:
             continue
         f0, b, rms, peak_db = got
-        if fold and fold[0] and not reads_as_counted(f0, b, -float(b_counted), s, fs or 0.0, df):
+        if is_fold and (not reads_as_counted(f0, b, -float(b_counted), s, fs or 0.0, df) or rms > MAX_MISFIT_BINS * df):
             continue                # a fold counted over few runs read as another line: none of its gates passed
         claimed.update(mine)
         # a fixed line's sideband (its lower side past 0 Hz folds: f0 = -f_c) is the sideband detector's
