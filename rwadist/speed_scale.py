@@ -58,6 +58,13 @@ TEMPLATE_LAG = 0.02
 INTEGER_ORDERS = 4
 #: relative tolerance of "an integer multiple"
 INTEGER_TOL = 0.004
+#: No line of a wheel turns slower than this share of the rotor: a ball bearing's cage, the slowest, turns at
+#: ½(1 − (d/D)·cos α) >= 0.35 of it (:data:`rwadist.bearings.RATIO_RANGES`), less a margin.  A 1× candidate that puts a
+#: line of the pattern below it is not taken while another is there (a new user's ball-pass line at 4.70 with its 2x had
+#: been taken, the imbalance then at h 0.21 and the cage at 0.081: every speed 4.7x too high in ``rwadist fit``)
+SLOWEST_LINE = 0.3
+#: Speed sidebands of a carrier lie within this share of its order (:func:`_between_sidebands`)
+SIDEBAND_SPAN = 0.15
 #: a line has a rotation sense in a pair when this share of its power turns one way
 POLARIZED = 0.6
 #: a line counts in a pair when its power there is this many times the local noise's
@@ -310,6 +317,13 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
     seen = strength > 0
     if (cand & seen).any():
         cand &= seen
+    # a candidate that puts a line of the pattern below the slowest cage is not the rotor's (module docstring)
+    below = np.array([np.any(seen & (orders < SLOWEST_LINE * orders[c])) for c in range(n)], dtype=bool)
+    if (cand & ~below).any() and (cand & below).any():
+        how += (f"; not the line{'s' if (cand & below).sum() > 1 else ''} at order "
+                + ", ".join(f"{orders[c]:.4g}" for c in np.flatnonzero(cand & below))
+                + f", which would put a line below {SLOWEST_LINE:g}x the speed")
+        cand &= ~below
     multiples = {}
     for c in np.flatnonzero(cand):
         ratio = orders / orders[c]
@@ -318,6 +332,9 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
         multiples[int(c)] = sorted({int(x) for x in k[hit]} | {1})
     most = max(len(m) for m in multiples.values())
     tied = sorted((c for c, m in multiples.items() if len(m) == most), key=lambda c: orders[c])
+    carriers = [c for c in tied if _between_sidebands(orders, seen, c)]
+    if carriers:                    # a carrier and its speed sidebands tie: the carrier, not its lower sideband
+        tied = carriers + [c for c in tied if c not in carriers]
     best = tied[0]
     mult = multiples[best]
     others = [{"h": float(orders[c] / orders[best]), "multiples_found": multiples[c]} for c in tied[1:]]
@@ -329,8 +346,19 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
     reason = f"the 1x line: {how}, with the most integer multiples (found {mult})"
     if others:
         reason += ("; as many for the line" + ("s" if len(others) > 1 else "") + " at h "
-                   + ", ".join(f"{o['h']:.4g}" for o in others) + ": the lowest taken")
+                   + ", ".join(f"{o['h']:.4g}" for o in others)
+                   + (": the one midway between two lines (a carrier and its sidebands) taken" if carriers
+                      else ": the lowest taken"))
     return best, float(sense[best]), evidence, reason
+
+
+def _between_sidebands(orders: np.ndarray, seen: np.ndarray, c: int) -> bool:
+    """Whether line ``c`` lies midway (within :data:`INTEGER_TOL` of its order) between two other lines of the pattern
+    at most :data:`SIDEBAND_SPAN` of its order away: a carrier with its lower and upper speed sidebands."""
+    o = orders[c]
+    near = seen & (np.abs(orders - o) <= SIDEBAND_SPAN * o) & (np.arange(orders.size) != c)
+    lo, hi = orders[near & (orders < o)], orders[near & (orders > o)]
+    return bool(lo.size and hi.size and np.min(np.abs((lo[:, None] + hi[None, :]) / 2.0 - o)) <= INTEGER_TOL * o)
 
 
 # ------------------------------------------------------------------------------------------ the lines' ratios
