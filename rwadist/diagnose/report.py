@@ -445,8 +445,9 @@ def write_report(diag: Diagnosis, out_dir) -> list:
         narrow = ("" if h.narrow_gain_fraction is None
                   else f", {h.narrow_gain_fraction:.1%} of the narrow-line misfit (taken on it: its power share is "
                        "below min_gain)")
-        md.append(f"- **{words}**: held-out gain {h.gain_fraction:.1%} of the unexplained "
-                  f"power{beyond_power(h.gain_fraction)}{narrow}, {h.t:.1f} noise standard errors (parameters: {par})"
+        of_what = beyond_power(h.gain_fraction) or " of the unexplained power"
+        md.append(f"- **{words}**: held-out gain {h.gain_fraction:.1%}{of_what}{narrow}, {h.t:.1f} noise standard "
+                  f"errors (parameters: {par})"
                   + "".join(f"; beside it h = {m['h_before']:.5g}"
                             + (f" ({m['sense']}-rotating part)" if m.get("sense") in ("co", "counter") else "")
                             + f", C = {m['C_before']:.4g} was the two lines' blend on "
