@@ -218,3 +218,26 @@ def test_a_line_turning_no_one_way_turns_no_speed_round():
     assert sw._line_sense(scale, 0.41)[0] is None
     assert sw._line_sense(scale, 1.0)[0] is None
     assert sw._line_sense(scale, 2.0)[0] == -1
+
+
+def test_a_ball_pass_with_its_harmonic_is_not_the_one_x_when_it_puts_the_cage_below_any_cage():
+    """A new user's 2.5-kg wheel (session 63), swept without a speed column: the imbalance at 1 with no integer line
+    beside it, a ball pass at 4.7036 with its 2x at 9.4072 (co-rotating in force and torque), a counter-rotating line
+    at 7.1083 and a cage at 0.3812 (force only).  Counted, the ball pass had the most multiples and ``rwadist fit``
+    read every h 4.7x low (the cage at 0.081, the imbalance at 0.2126); no cage turns slower than 0.35 of the rotor,
+    so a 1x that puts a line below 0.3x is not taken while another candidate is there."""
+    orders = np.array([0.3812, 1.0, 4.7036, 7.1083, 9.4072])
+    strength = np.full(orders.size, 5.0)
+    nan = np.nan
+    senses = {"F": (np.array([0.0, 1.0, 1.0, 0.0, 1.0]), None), "T": (np.array([nan, 1.0, 1.0, 0.0, 1.0]), None)}
+    best, sense, ev, why = sc.imbalance_line(orders, strength, senses)
+    assert best == 1 and sense == 1.0 and ev["multiples_found"] == [1], why
+    assert "not the lines at order 4.704, 7.108, 9.407" in why
+    # the same wheel with speed sidebands at 0.93 and 1.07 of the imbalance's, co-rotating too: they tie with it (one
+    # multiple each), and the lowest of a tie was taken (every speed 7 % low); the carrier lies midway between them
+    orders = np.array([0.3812, 0.93, 1.0, 1.07, 4.7036, 7.1083, 9.4072])
+    senses = {"F": (np.array([0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 1.0]), None),
+              "T": (np.array([nan, 1.0, 1.0, 1.0, 1.0, 0.0, 1.0]), None)}
+    best, _, ev, why = sc.imbalance_line(orders, np.full(orders.size, 5.0), senses)
+    assert best == 2 and sorted(round(c["h"], 2) for c in ev["tied"]) == [0.93, 1.07], why
+    assert "midway between two lines" in why
