@@ -213,9 +213,13 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
     find_broadband_copies`) of the targets the lines gave none: every pair of two directions, a force in a torque
     (:data:`LEVER_ARM_PAIRS`) too unless its mirror pair (:data:`LEVER_ARM_MIRROR`, the same component of a load-cell
     offset's r) reads −κ or cannot be read (:func:`~rwadist.diagnose.channel_copy_broadband.offset_mirror`: an
-    offset's r × F, left to ``cross_coupling``); of a pair read both ways the way whose removal takes the more of the
-    target's power at the source's lines (the copied lines leave the target; read backwards, the source's own lines
-    stay).  ``X``, ``noise``, ``src``, ``run_of``, ``h``: the lines' points of :func:`find_channel_copies`.
+    offset's r × F, left to ``cross_coupling``); of a pair read both ways, when a channel of it is radial with its
+    partner recorded, the way whose removal leaves the radial channels' lines round (:func:`_round_after`), else the
+    way whose removal takes the more of the target's power at the source's lines (the copied lines leave the target;
+    read backwards, the source's own lines stay -- unless the target has lines of its own at the source's: a new
+    user's Ty += 0.15·Fx on a wheel whose torque lines share the force lines' h, 22 % of Ty's power at Fx's points,
+    took 0.781 of it forward and 0.774 backward, and the random phases read it backwards, "Fx reads 5.72 × Ty", on 2
+    seeds of 9).  ``X``, ``noise``, ``src``, ``run_of``, ``h``: the lines' points of :func:`find_channel_copies`.
 
     On the lines a copy of a force in a torque at a real κ is an offset's r × F to the last digit (trial24's
     T_z += 0.02·F_x: r_y = −20 mm explains T_z as well, :func:`_lever_arm_of_forces`); the floor tells them apart: an
@@ -238,6 +242,10 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
             # lines tell: the copy removed the right way leaves them as a rotating load has them, x and y of one
             # amplitude (trial 30, Fy += 0.2·Fx: median |ln| of the ratio 0 that way, 0.04 the other)
             gain[g[:2]] = -_out_of_round(Xs, Xt - g[2] * Xs)
+            continue
+        rounded = _round_after(X, chans, (src == s) | (src == t), g[0], g[1], g[2])
+        if rounded is not None:
+            gain[g[:2]] = -rounded
             continue
         total = float(np.sum(np.abs(Xt) ** 2))
         gain[g[:2]] = 1.0 - float(np.sum(np.abs(Xt - g[2] * Xs) ** 2)) / total if total > 0 else 0.0
@@ -301,6 +309,24 @@ def _mirror_missing(copy: ChannelCopy, X: np.ndarray, src: np.ndarray, chans: tu
         A, b = np.concatenate([fz.real, fz.imag]), np.concatenate([left.real, left.imag])
         left = left - (float(A @ b / (A @ A)) if A @ A > 0 else 0.0) * fz
     return float(np.median(np.abs(left) / np.abs(pred[heard]))) > MIRROR_MISFIT
+
+
+def _round_after(X: np.ndarray, chans, points: np.ndarray, source: str, target: str, kappa: complex) -> float | None:
+    """How far from round (:func:`_out_of_round`, summed) the radial channels of a copy's pair leave the lines at
+    ``points`` (both channels' line points, so that both ways of a pair are judged on one set) once ``kappa`` ×
+    ``source`` is taken off ``target``; None when neither channel is radial with its partner recorded.  A rotor's
+    radial lines are rotating loads, x and y of one amplitude: the copy removed the right way leaves them so, read
+    backwards it leaves the copy in one channel and puts the other's own lines into the source."""
+    s = chans.index(source)
+    total, n = 0.0, 0
+    for c in (source, target):
+        partner = PARTNER.get(c)
+        if partner is None or partner not in chans:
+            continue
+        x = X[points, chans.index(c)] - (kappa * X[points, s] if c == target else 0.0)
+        total += _out_of_round(X[points, chans.index(partner)], x)
+        n += 1
+    return total if n else None
 
 
 def _out_of_round(a: np.ndarray, b: np.ndarray) -> float:
