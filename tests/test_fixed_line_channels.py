@@ -60,3 +60,15 @@ def test_mains_pickup_on_the_axial_channels_is_listed_on_them_alone():
     found = {round(x.f_Hz): x.channels for x in fixed_lines.find_fixed_lines(ctx)}
     assert found.get(50) == ("Fz", "Tz"), found
     assert all(chans == ("Fz", "Tz") for chans in found.values()), found
+
+
+def test_the_line_says_how_far_a_fixed_line_stands_over_the_noise():
+    """A fixed line taken out of the data before the search reads ~0 dB over the model in its bins; its line says too
+    how far it stands over the noise floor (the new user's 50 Hz pickup, 33 dB, read "+0.1 dB over the model")."""
+    from rwadist.diagnose.unexplained import Unexplained
+
+    u = Unexplained(signature="fixed_line", channels=("Fz", "Tz"), speed_rpm=(500.0, 10000.0), f_Hz=(50.0, 50.0),
+                    level_dB=0.09, share=0.005, n_runs=40, parameters={"f_Hz": 50.0, "level_over_floor_dB": 33.08,
+                                                                       "removed_before_the_search": True})
+    assert "+0.1 dB over the model in its bins (median), +33.1 dB over the noise floor at its own bins (taken out of " \
+           "the data before the search)" in u.text(), u.text()

@@ -208,6 +208,12 @@ class Unexplained:
         lift = _number(self.parameters.get("largest_line_lift_dB")) if self.signature == "moving_resonance" else None
         if lift is not None:
             out += f" in its track's bands, the lines it lifts up to {lift:+.1f} dB"
+        floor = _number(self.parameters.get("level_over_floor_dB")) if self.signature == "fixed_line" else None
+        if floor is not None:
+            # a fixed line taken out of the data before the search reads ~0 dB over the model in its bins (a new
+            # user's 50 Hz pickup, 33 dB over the noise, was "+0.1 dB over the model" and nothing else)
+            out += f", {floor:+.1f} dB over the noise floor at its own bins" + (
+                " (taken out of the data before the search)" if self.parameters.get("removed_before_the_search") else "")
         peak = _number(self.parameters.get("peak_over_model_dB"))
         if peak is not None:
             # a narrow line's bands hold the model's lines beside it: its own bins say how far it stands out
