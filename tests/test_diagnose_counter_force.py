@@ -77,6 +77,11 @@ def test_counter_rotation_of_the_force_fundamental_found(seed, tmp_path):
           if ln.direction == "radial_force" and ln.sense == "counter" and abs(ln.h - 1) < 1e-9]
     assert len(ct) == 1
     assert ct[0].C == pytest.approx(E.extended.U_s * np.sqrt(Q), rel=0.02)
+    # the counter harmonic's standard error is the split's, C·dq/(2√q) (it had none)
+    counter = next(x for x in m.harmonics("radial_force") if x.sense == "counter")
+    c_tot = np.hypot(U, counter.C)
+    assert counter.C_stderr == pytest.approx(c_tot * e["counter_fraction_stderr"] / (2 * np.sqrt(
+        e["counter_fraction"])), rel=0.02)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
