@@ -448,12 +448,12 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     Parameters
     ----------
     data : SteadyTest, str or pathlib.Path
-        The test, or a path :func:`read` takes.
+        The test, or a path :func:`read` takes (a sweep's speed from the data: warns when the whirl contradicts it).
     empirical : rwadist.empirical.EmpiricalFit or None
         Its empirical fit; default :func:`fit` of ``data`` with default settings.
     mass : float or None
-        Rotor mass, kg; default the preset's.  Without mass and radius the fit is per unit mass and
-        inertia (the interface loads depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr and I_zz/I_rr).
+        Rotor mass, kg; default the preset's.  Without mass and radius: per unit mass and inertia (the loads
+        depend only on k/M, c/M, k_θ/I_rr, c_θ/I_rr and I_zz/I_rr).
     radius : float or None
         Rotor radius, m (thin-disc inertias); default the preset's.  Give both or neither.
     height : float
@@ -475,6 +475,7 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     ParameterError
         mass, radius or height out of range, or one of mass and radius without the other.
     """
+    from . import speed_whirl
     from .extended_fit import to_model
     from .stand_axes import axis_stand, fit_beside
     from .stand_resonance import fit_extended_beside_stand
@@ -484,9 +485,8 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     test = _as_test(data)
     if empirical is None:
         empirical = fit(test)
-    # a fixture resonance lifting every channel is fitted with the wheel's modes, never into them (a mode the data do
-    # not tell apart from it is declared by the joint fit's standard errors); one that lifts one channel of each radial
-    # pair is measured on their x/y ratios and divided out of its channels (rwadist.stand_axes)
+    # a fixture lifting every channel is fitted with the wheel's modes, never into them (a mode not told apart from it is
+    # declared by the joint fit's standard errors); one lifting one channel of each radial pair: rwadist.stand_axes
     options = dict(mass=mass, radius=radius, height=height, start=start, progress=progress)
     axis = axis_stand(empirical)
     efit = None if axis is None else fit_beside(test, empirical, axis, **options)
@@ -495,6 +495,7 @@ def fit_extended(data, empirical=None, *, mass: float | None = None, radius: flo
     model = to_model(efit, empirical)
     refuse_non_finite_model(model, "fit")
     model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))
+    speed_whirl.warn_whirl_against_scale(test, efit)
     return efit, model
 
 

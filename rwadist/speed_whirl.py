@@ -253,6 +253,34 @@ def fit_tie_warning(test) -> str | None:
                        + TACH_ADVICE) if tied else None
 
 
+def fit_whirl_warning(test, efit) -> str | None:
+    """The warning :func:`rwadist.api.fit_extended` gives when a sweep's speed from the data (:func:`data_scale`) has
+    the located rocking whirl read an inertia ratio outside :func:`band`: the 1× line taken is likely not the rotor's
+    (a new user's ball pass at 4.7 with its 2x had been, and ``fit --extended`` printed I_zz/I_rr 0.286 as a note);
+    diagnose takes the candidate that brings the ratio into the band, the fit says so.  None otherwise."""
+    scale = data_scale(test)
+    if not scale or not efit.identified.get("rocking", False) or plausible(efit.params.inertia_ratio):
+        return None
+    lo, hi = band()
+    one_x = scale.get("one_x") or {}
+    others = [f"{c['h']:.4g}" for c in one_x.get("candidates", [])]
+    return (f"the rocking whirl reads I_zz/I_rr {efit.params.inertia_ratio:.3g}, outside {lo:.2g}-{hi:.2g} (a "
+            "flywheel's 1-2, widened by the fit's error): the speed taken from the data is likely scaled by the wrong "
+            "line as 1x" + (f" (other candidates at h {', '.join(others)})" if others else "")
+            + "; `rwadist diagnose` tries the candidates against the whirl; or " + TACH_ADVICE)
+
+
+def warn_whirl_against_scale(test, efit) -> None:
+    """Warn (:class:`~rwadist.errors.RwadistWarning`, at the caller of :func:`rwadist.api.fit_extended`) with
+    :func:`fit_whirl_warning`'s words, if any."""
+    import warnings
+
+    from .errors import RwadistWarning
+
+    if text := fit_whirl_warning(test, efit):
+        warnings.warn(RwadistWarning(text), stacklevel=3)
+
+
 def speed_record(meta, check: dict | None = None) -> dict:
     """How the runs' speeds were obtained, for summary.json and report.md: ``source`` "measured" (a steady test's
     speeds as given), "scaled" (a steady test's speed column multiplied by the scale its imbalance's 1× lines
