@@ -16,13 +16,16 @@ therefore found in two steps that assume no line set:
    F_y lags F_x by 90°, |X + iY|² against |X − iY|²).  The imbalance is at exactly 1× the rotor speed, static
    in the radial force and dynamic in the radial torque, both turning with the rotor: the candidates are the
    lines with one sense in the radial-force pair and the same sense in the radial-torque pair (one pair when
-   only one is recorded).  Among them the 1× line is the one with the most integer multiples 1..INTEGER_ORDERS
+   only one is recorded), not one that would put another candidate below SLOWEST_LINE of the speed (no load
+   turning one way in force and torque turns slower than a cage).  Among them the 1× line is the one with the most
+   integer multiples 1..INTEGER_ORDERS
    among the lines found (the integer harmonics: misalignment, looseness; the imbalance itself counted); a
    bearing line's multiples are non-integer in the rotor's units.  The count of lines, never their strength:
    every clear line's strength saturates at L_CAP, and a summed strength flipped with the sweep's duration
    (trial 11: a 300-s run-up took a ball-pass line at 3.6 with its 2× at 7.2 for the imbalance with its 2×,
    summed strengths 11.93 against 11.89; every speed 3.6× too high).  Candidates with equally many multiples
-   tie: a ball-pass line with its harmonics lies above the rotor's fundamental, so the lowest is taken and the
+   tie: a ball-pass line with its harmonics lies above the rotor's fundamental, so the lowest is taken (unless it is
+   the lower speed sideband of a carrier in the tie within SIDEBAND_SPAN: the carrier) and the
    others are kept (``tied``) for a second, physical test the data can give (the gyroscopic whirl of the
    wheel's rocking mode reads I_zz/I_rr in proportion to the speed scale, :mod:`rwadist.speed_whirl`); a
    cage line with a harmonic (below 1×) is what that test catches.  Its sense is the sign of the speed.  The
@@ -58,11 +61,14 @@ TEMPLATE_LAG = 0.02
 INTEGER_ORDERS = 4
 #: relative tolerance of "an integer multiple"
 INTEGER_TOL = 0.004
-#: No line of a wheel turns slower than this share of the rotor: a ball bearing's cage, the slowest, turns at
-#: ½(1 − (d/D)·cos α) >= 0.35 of it (:data:`rwadist.bearings.RATIO_RANGES`), less a margin.  A 1× candidate that puts a
-#: line of the pattern below it is not taken while another is there (a new user's ball-pass line at 4.70 with its 2x had
-#: been taken, the imbalance then at h 0.21 and the cage at 0.081: every speed 4.7x too high in ``rwadist fit``)
-SLOWEST_LINE = 0.3
+#: No load of a wheel turning one way in both the radial force and torque, as the imbalance does, turns slower than
+#: this share of the rotor: a ball bearing's cage, the slowest of its lines, turns at ½(1 − (d/D)·cos α) >= 0.35 of it
+#: (:data:`rwadist.bearings.RATIO_RANGES`), less a wide margin (trial 11's ball pass 3.6 with its 2x, tied with the
+#: imbalance, would put it at 0.278: left to the whirl).  A 1× candidate that puts another candidate below it is not
+#: taken while another is there (a new user's ball-pass line at 4.70 with its 2x had been taken, the imbalance then at
+#: h 0.21: every speed 4.7x too high in ``rwadist fit``); it stays among the candidates the whirl tests.  Lines of one
+#: pair or of no one sense (a cage in the force alone, a sub-synchronous whirl) do not exclude.
+SLOWEST_LINE = 0.25
 #: Speed sidebands of a carrier lie within this share of its order (:func:`_between_sidebands`)
 SIDEBAND_SPAN = 0.15
 #: a line has a rotation sense in a pair when this share of its power turns one way
@@ -317,28 +323,33 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
     seen = strength > 0
     if (cand & seen).any():
         cand &= seen
-    # a candidate that puts a line of the pattern below the slowest cage is not the rotor's (module docstring)
-    below = np.array([np.any(seen & (orders < SLOWEST_LINE * orders[c])) for c in range(n)], dtype=bool)
-    if (cand & ~below).any() and (cand & below).any():
-        how += (f"; not the line{'s' if (cand & below).sum() > 1 else ''} at order "
-                + ", ".join(f"{orders[c]:.4g}" for c in np.flatnonzero(cand & below))
-                + f", which would put a line below {SLOWEST_LINE:g}x the speed")
-        cand &= ~below
+    # a candidate that puts another candidate (a load turning one way in force and torque, as the imbalance does)
+    # below the slowest cage is not the rotor's (module docstring); it stays a candidate for the whirl's test
+    below = np.array([np.any(cand & (orders < SLOWEST_LINE * orders[c])) for c in range(n)], dtype=bool)
+    excluded = cand & below if (cand & ~below).any() else np.zeros(n, dtype=bool)
+    if excluded.any():
+        how += (f"; not the line{'s' if excluded.sum() > 1 else ''} at order "
+                + ", ".join(f"{orders[c]:.4g}" for c in np.flatnonzero(excluded))
+                + f", which would put a line turning one way in force and torque below {SLOWEST_LINE:g}x the speed")
     multiples = {}
     for c in np.flatnonzero(cand):
         ratio = orders / orders[c]
         k = np.rint(ratio)
         hit = seen & (k >= 1) & (k <= INTEGER_ORDERS) & (np.abs(ratio - k) <= INTEGER_TOL * np.maximum(k, 1))
         multiples[int(c)] = sorted({int(x) for x in k[hit]} | {1})
-    most = max(len(m) for m in multiples.values())
-    tied = sorted((c for c, m in multiples.items() if len(m) == most), key=lambda c: orders[c])
-    carriers = [c for c in tied if _between_sidebands(orders, seen, c)]
-    if carriers:                    # a carrier and its speed sidebands tie: the carrier, not its lower sideband
-        tied = carriers + [c for c in tied if c not in carriers]
+    most = max(len(m) for c, m in multiples.items() if not excluded[c])
+    tied = sorted((c for c, m in multiples.items() if len(m) == most and not excluded[c]), key=lambda c: orders[c])
+    # the lowest of a tie the lower sideband of a carrier in the tie: the carrier (speed sidebands at 0.93 and 1.07 tie
+    # with the imbalance at 1, one multiple each)
+    carriers = [c for c in tied[1:] if orders[c] <= (1 + SIDEBAND_SPAN) * orders[tied[0]]
+                and _between_sidebands(orders, seen, c)]
+    if carriers:
+        tied = carriers[:1] + [c for c in tied if c != carriers[0]]
     best = tied[0]
     mult = multiples[best]
     others = [{"h": float(orders[c] / orders[best]), "multiples_found": multiples[c]} for c in tied[1:]]
-    rest = sorted((c for c in multiples if c not in tied), key=lambda c: (-len(multiples[c]), orders[c]))
+    rest = sorted((c for c in multiples if c not in tied), key=lambda c: (bool(excluded[c]), -len(multiples[c]),
+                                                                          orders[c]))
     evidence = {"order": float(orders[best]), "multiples_found": mult, "tied": others,
                 "candidates": others + [{"h": float(orders[c] / orders[best]), "multiples_found": multiples[c]}
                                         for c in rest],
