@@ -213,8 +213,10 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
     find_broadband_copies`) of the targets the lines gave none: every pair of two directions, a force in a torque
     (:data:`LEVER_ARM_PAIRS`) too unless its mirror pair (:data:`LEVER_ARM_MIRROR`, the same component of a load-cell
     offset's r) reads −κ or cannot be read (:func:`~rwadist.diagnose.channel_copy_broadband.offset_mirror`: an
-    offset's r × F, left to ``cross_coupling``); of a pair read both ways, when a channel of it is radial with its
-    partner recorded, the way whose removal leaves the radial channels' lines round (:func:`_round_after`), else the
+    offset's r × F, left to ``cross_coupling``); of a pair read both ways, when both its channels are radial (with a
+    partner recorded), the way whose removal leaves their lines round (:func:`_round_after`; with one radial channel
+    the forward way leaves it as it was whatever κ, and the noise chose: a reviewer's Fz += 0.1·Fx on the floor was
+    read backwards on 6 seeds of 10), else the
     way whose removal takes the more of the target's power at the source's lines (the copied lines leave the target;
     read backwards, the source's own lines stay -- unless the target has lines of its own at the source's: a new
     user's Ty += 0.15·Fx on a wheel whose torque lines share the force lines' h, 22 % of Ty's power at Fx's points,
@@ -243,7 +245,8 @@ def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
             # amplitude (trial 30, Fy += 0.2·Fx: median |ln| of the ratio 0 that way, 0.04 the other)
             gain[g[:2]] = -_out_of_round(Xs, Xt - g[2] * Xs)
             continue
-        rounded = _round_after(X, chans, (src == s) | (src == t), g[0], g[1], g[2])
+        rounded = _round_after(X, chans, (src == s) | (src == t), g[0], g[1], g[2]) \
+            if g[0] in PARTNER and g[1] in PARTNER else None
         if rounded is not None:
             gain[g[:2]] = -rounded
             continue
