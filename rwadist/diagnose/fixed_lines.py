@@ -206,7 +206,9 @@ def _measure(ctx, k0: int, chans) -> FixedLine | None:
     read = np.isfinite(mag).any(axis=0)
     med = np.full(mag.shape[1], np.nan)
     med[read] = np.nanmedian(mag[:, read], axis=0)
-    within = np.nanmean((mag <= STEADY_RATIO * med) & (mag >= med / STEADY_RATIO), axis=0)
+    # over the runs that read the tone in each channel (a channel absent from some runs is not unsteady for it)
+    near = (mag <= STEADY_RATIO * med) & (mag >= med / STEADY_RATIO)
+    within = np.sum(near, axis=0) / np.maximum(np.sum(np.isfinite(mag), axis=0), 1)
     steady = within >= STEADY_FRACTION
     if not np.any(steady):
         return None
