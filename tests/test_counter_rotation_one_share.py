@@ -52,3 +52,22 @@ def test_a_true_counter_part_is_one_share_and_still_found():
     got = [e for e in d.model.effects if e["kind"] == "counter_rotation"]
     assert got and got[0]["counter_fraction"] == pytest.approx(0.3, rel=0.1)
     assert np.isfinite(got[0]["counter_fraction_stderr"])
+
+
+def test_the_parts_standard_errors_hold_the_lines_and_the_splits():
+    """The co and counter parts a ``counter_rotation`` writes, C·√(1 − q) and C·√q, carry standard errors that hold both
+    the line's own (σ_C) and the split's (σ_q): against the spread of the parts over 20000 draws of C and q (a second
+    method, Monte Carlo), within 3 %, for a split read sharply (q's error 2.4e-5, the line's 2 %: before, the counter
+    part's standard error held q's alone and was 170x too small) and for a coarse one."""
+    from rwadist.effects.counter_rotation_diagnose import CounterRotation
+    from rwadist.model import Harmonic
+
+    rng = np.random.default_rng(63)
+    for q, se_q, C, se_C in ((0.1, 2.4e-5, 1e-6, 2e-8), (0.3, 0.02, 1e-6, 1e-8)):
+        eff = CounterRotation("radial_force", 1.0, q, se_q)
+        c_co, c_ct = C * np.sqrt(1 - q), C * np.sqrt(q)
+        line = [Harmonic(h=1.0, C=C, C_stderr=se_C)]
+        Cs, qs = rng.normal(C, se_C, 20000), rng.normal(q, se_q, 20000)
+        for sense, draws in ((1.0, Cs * np.sqrt(1 - qs)), (-1.0, Cs * np.sqrt(qs))):
+            got = eff._part_stderr(c_co, c_ct, sense, line)
+            assert got == pytest.approx(np.std(draws), rel=0.03), (q, sense, got, np.std(draws))

@@ -136,26 +136,32 @@ class CounterRotation:
             new.append(replace(x, h=h_key, C=c_co, sense="co",
                                C_stderr=None if x.C_stderr is None else x.C_stderr * c_co / max(x.C, 1e-300)))
         elif c_co > 0:
-            new.append(Harmonic(h=h_key, C=c_co, sense="co", C_stderr=self._part_stderr(c_co, c_ct, 1.0),
+            new.append(Harmonic(h=h_key, C=c_co, sense="co", C_stderr=self._part_stderr(c_co, c_ct, 1.0, at_h),
                                 n_points=at_h[0].n_points if at_h else 0))
         if c_ct > 0:
-            # its standard error from the split's (C₋ = C·√q: dC₋ = C·dq / (2√q)), its measurements the line's
-            new.append(Harmonic(h=h_key, C=c_ct, sense="counter", C_stderr=self._part_stderr(c_co, c_ct, -1.0),
+            # its standard error from the line's and the split's (C₋ = C·√q), its measurements the line's
+            new.append(Harmonic(h=h_key, C=c_ct, sense="counter", C_stderr=self._part_stderr(c_co, c_ct, -1.0, at_h),
                                 n_points=at_h[0].n_points if at_h else 0))
         s.model.empirical[d] = sorted(keep + new, key=lambda x: (x.h, x.sense == "counter"))
         s.effects.append(self)
         return s
 
-    def _part_stderr(self, c_co: float, c_ct: float, sense: float) -> float | None:
-        """Standard error of the co (``sense`` +1) or counter (−1) part of the split C·√(1 − q), C·√q from q's
-        (``counter_fraction_stderr``), C = √(C₊² + C₋²); None where q's is not known (a new user's ``model show`` had
-        the counter part with no standard error and 0 points beside the effect's q ± 2.4e-5)."""
+    def _part_stderr(self, c_co: float, c_ct: float, sense: float, line=()) -> float | None:
+        """Standard error of the co (``sense`` +1) or counter (−1) part of the split C·√(1 − q), C·√q: relative
+        √((σ_C/C)² + (σ_q/(2s))²), s the part's power share (1 − q or q), σ_q ``counter_fraction_stderr``, σ_C/C the
+        line's own before the split (``line``: its harmonics at h, √(Σ C_i² σ_i²)/Σ C_i²; 0 where none is known);
+        None where σ_q is not known (a new user's ``model show`` had the counter part with no standard error and 0
+        points beside the effect's q ± 2.4e-5)."""
         se = self.counter_fraction_stderr
         c_tot = float(np.hypot(c_co, c_ct))
-        part = (c_co if sense > 0 else c_ct) / max(c_tot, 1e-300)
-        if se is None or not np.isfinite(se) or part <= 0:
+        part = c_co if sense > 0 else c_ct
+        share = (part / max(c_tot, 1e-300)) ** 2
+        if se is None or not np.isfinite(se) or share <= 0:
             return None
-        return float(c_tot * se / (2.0 * part))
+        known = [(x.C, x.C_stderr) for x in line if x.C_stderr is not None and np.isfinite(x.C_stderr)]
+        total = sum(c**2 for c, _ in known)
+        rel_line = float(np.sqrt(sum((c * e) ** 2 for c, e in known)) / total) if known and total > 0 else 0.0
+        return float(part * np.hypot(rel_line, se / (2.0 * share)))
 
     def significant(self) -> bool:
         """Where the time series give the x/y phase estimate (``counter_fraction_phase``, independent of the PSD fit),
