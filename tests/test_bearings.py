@@ -193,12 +193,15 @@ def test_a_ball_pass_is_named_before_the_cage_lines_high_multiple():
     assert any("3rd multiple of the line h = 0.4" in x for x in line_causes(1.2, 0.002, others=[0.4]))
 
 
-def test_a_ball_pass_relation_holds_within_half_a_percent_whatever_the_ball_count():
+def test_a_ball_pass_relation_holds_within_a_percent_whatever_the_ball_count():
     """A ball pass is exactly n × the cage's rate: a coarse resolution (a sweep's slices: one bin 1.5 % of the cage at
     the top speed) must not name n × cage for a line 1.9 % or 2.8 % off (a new user's 7.108 and 4.702 beside a cage at
-    0.3812 were "19 × 0.3812 = 7.243" and "12 × 0.3812 = 4.574"); 19 × 0.3812 itself, 0.1 % off, is named."""
+    0.3812 were "19 × 0.3812 = 7.243" and "12 × 0.3812 = 4.574"); 19 × 0.3812 itself is named, with the cage read
+    exactly or 0.6 % off (its error times 19: a reviewer's case)."""
     res = 0.0073
     assert not any("-ball bearing whose cage" in x for x in line_causes(7.108, res, others=[0.3812, 1.0]))
     assert not any("-ball bearing whose cage" in x for x in line_causes(4.702, res, others=[0.3812, 1.0]))
     assert any("19-ball bearing whose cage is the line h = 0.3812" in x
                for x in line_causes(19 * 0.3812 * 1.001, res, others=[0.3812, 1.0]))
+    assert any("19-ball bearing whose cage is the line h = 0.3835" in x
+               for x in line_causes(19 * 0.3812, res, others=[0.3835, 1.0]))
