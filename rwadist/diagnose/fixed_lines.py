@@ -206,9 +206,11 @@ def _measure(ctx, k0: int, chans) -> FixedLine | None:
     read = np.isfinite(mag).any(axis=0)
     med = np.full(mag.shape[1], np.nan)
     med[read] = np.nanmedian(mag[:, read], axis=0)
-    # over the runs that read the tone in each channel (a channel absent from some runs is not unsteady for it)
+    # over the runs that have the channel (one absent from some runs is not unsteady for it; a run whose tone fit
+    # failed is: the wheel's axial mode rung by a broadband floor, a peak at 139 Hz of a random amplitude, passed)
     near = (mag <= STEADY_RATIO * med) & (mag >= med / STEADY_RATIO)
-    within = np.sum(near, axis=0) / np.maximum(np.sum(np.isfinite(mag), axis=0), 1)
+    have = np.stack([np.isfinite(ctx.sp.psd[c][runs, 0]) for c in chans], axis=1)
+    within = np.sum(near, axis=0) / np.maximum(np.sum(have, axis=0), 1)
     steady = within >= STEADY_FRACTION
     if not np.any(steady):
         return None
