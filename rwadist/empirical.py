@@ -348,15 +348,11 @@ def _first_where(h_grid: np.ndarray, speed: np.ndarray, test) -> np.ndarray:
 
 
 def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, direction: str,
-                       df: float | None = None, smear: np.ndarray | None = None):
+                       df: float | None = None):
     """Harmonic numbers of one direction: candidate bins from N_bin(h), each h
     refined by least squares of f = h·|Ω| over its lines (Eq. 3.2), kept when
     P >= P_0 and, given the spectra's resolution ``df`` (Hz), not the sidebands of a stronger line at a fixed offset
-    (:func:`rwadist.fit_sidebands.fixed_offset_sidebands`).  Candidates closer than ε are one line; on a test cut from
-    a sweep closer than the chirp's smear too (``smear``: per pair, the relative speed change over one segment,
-    |dΩ/dt|·T/|Ω|; a line sweeps h × it in h across a segment, so two lines closer than that overlap on every
-    segment's spectrum, at its least over the candidate's in-band pairs).  Returns a list of :class:`BinStat` sorted
-    by h."""
+    (:func:`rwadist.fit_sidebands.fixed_offset_sidebands`).  Returns a list of :class:`BinStat` sorted by h."""
     if lines.pair_run.size == 0:
         return []
     h_hi = min(s.h_range[1], f_hi / lines.pair_speed_hz.min())
@@ -385,34 +381,26 @@ def identify_harmonics(lines: _Lines, f_lo: float, f_hi: float, s: FitSettings, 
     # refined between a carrier and its sidebands scatters by their offset
     scatter = [float(np.median(np.abs(fpk[i, ok[i]] - h[i] * lines.pair_speed_hz[ok[i]]))) if ok[i].any() else np.inf
                for i in range(h.size)]
-    merge_tol = np.full(h.size, s.epsilon)
-    if smear is not None:
-        band = in_band(h, lines, f_lo, f_hi) & np.isfinite(smear)[None, :]
-        least = np.min(np.where(band, smear[None, :], np.inf), axis=1)
-        merge_tol = np.maximum(merge_tol, np.where(np.isfinite(least), h * least, 0.0))
     stats_ = []
-    for hk, nb, npss, sc, tk in zip(h, n_b, n_p, scatter, merge_tol):
+    for hk, nb, npss, sc in zip(h, n_b, n_p, scatter):
         presence = float(nb / npss) if npss else 0.0
         kept = bool(presence >= s.presence_min and nb >= s.min_detections)
         reason = "" if kept else (f"presence {presence:.0%} < P0 {s.presence_min:.0%}"
                                   if presence < s.presence_min else f"only {int(nb)} detections")
-        stats_.append((BinStat(direction, float(hk), int(nb), int(npss), presence, kept, reason), sc, tk))
+        stats_.append((BinStat(direction, float(hk), int(nb), int(npss), presence, kept, reason), sc))
     stats_.sort(key=lambda bs: bs[0].h)
     merged: list[BinStat] = []
-    merged_scatter, merged_tol = np.inf, s.epsilon
-    for b, sc, tk in stats_:
+    merged_scatter = np.inf
+    for b, sc in stats_:
         # two candidates refined onto one line: keep the better supported, of two as well supported the one on its
         # law (a 1x line amplitude-modulated at 0.7 Hz, trial nuR: candidates at h 0.985, 1.0 and 1.0145 all in every
-        # run; the first kept on a tie, the carrier merged into its lower sideband's candidate and the 1x line lost);
-        # on a sweep's slices, closer than the chirp's smear (a new user's 40-s run-up, its torque line h 9.407 swept
-        # 15 bins across a 4096-sample segment: candidates at 9.379 and 9.404, both "not resolved", became three lines
-        # in the extended fit, 9.3785, 9.4044 and their mirror 9.4303)
-        if merged and abs(b.h - merged[-1].h) < max(tk, merged_tol):
+        # run; the first kept on a tie, the carrier merged into its lower sideband's candidate and the 1x line lost)
+        if merged and abs(b.h - merged[-1].h) < s.epsilon:
             if (b.n_bin, -sc) > (merged[-1].n_bin, -merged_scatter):
-                merged[-1], merged_scatter, merged_tol = b, sc, tk
+                merged[-1], merged_scatter = b, sc
             continue
         merged.append(b)
-        merged_scatter, merged_tol = sc, tk
+        merged_scatter = sc
     if df is not None:
         fixed_offset_sidebands(merged, lines, df, f_lo, f_hi)
     return merged
@@ -539,11 +527,7 @@ def measure_direction(spectra: Spectra, direction: str, s: FitSettings, floors: 
     df = spectra.df
     f_lo, f_hi = s.f_min_bins * df, spectra.band_limit
     lines = collect_lines(spectra, chans, fit_runs, detected, s.epsilon)
-    smear = None
-    if spectra.speed_rate is not None and lines.pair_run.size:
-        seconds = spectra.nperseg / spectra.sample_rate
-        smear = spectra.speed_rate[lines.pair_run] * seconds / (2 * np.pi * np.maximum(lines.pair_speed_hz, 1e-300))
-    bins = identify_harmonics(lines, f_lo, f_hi, s, direction, df, smear)
+    bins = identify_harmonics(lines, f_lo, f_hi, s, direction, df)
     kept = [b for b in bins if b.kept]
     if not kept:
         return _DirectionMeasurements(bins)

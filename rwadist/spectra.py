@@ -30,8 +30,6 @@ class Spectra:
     sample_rate : Hz.  nperseg : FFT length.  n_segments : Welch averages per run.
     window : window name.  f_lim : upper limit of good data, Hz (None: Nyquist).
     run_names : source file of each run.
-    speed_rate : |dΩ/dt| of each run, rad/s², on a test cut from a sweep (:func:`rwadist.chirp.sliced_rates`; NaN
-        where unknown), else None (steady runs).
     """
 
     f: np.ndarray
@@ -44,7 +42,6 @@ class Spectra:
     window: str = "hann"
     f_lim: float | None = None
     run_names: list = field(default_factory=list)
-    speed_rate: np.ndarray | None = None
 
     @property
     def df(self) -> float:
@@ -125,11 +122,9 @@ def compute_spectra(test: SteadyTest, nperseg: int | None = None, overlap: float
             block = np.stack([test.runs[i].signals[ch] for i in have])
             psd[ch][have] = welch_psd(block, fs, win, noverlap)
     amplitude = {ch: np.sqrt(2.0 * psd[ch] * to_power) for ch in channels}
-    from .chirp import sliced_rates
-
     return Spectra(f=f, speed=test.speeds, psd=psd, amplitude=amplitude, sample_rate=fs,
                    nperseg=nperseg, n_segments=n_segments, window=window, f_lim=f_lim,
-                   run_names=[r.name for r in test.runs], speed_rate=sliced_rates(test))
+                   run_names=[r.name for r in test.runs])
 
 
 #: samples (rows × segments × segment length) of the detrended segments :func:`welch_psd` holds at once (64 MB)

@@ -43,8 +43,7 @@ def fit_spectra(ctx: Context, test, runs: list):
     sel = slice(rows[0], rows[-1] + 1) if rows.size and np.all(np.diff(rows) == 1) else rows
     sp = replace(full, speed=full.speed[sel], psd={c: full.psd[c][sel] for c in chans},
                  amplitude={c: full.amplitude[c][sel] for c in chans}, n_segments=full.n_segments[sel],
-                 run_names=[full.run_names[r] for r in rows],
-                 speed_rate=None if full.speed_rate is None else full.speed_rate[sel])
+                 run_names=[full.run_names[r] for r in rows])
     if rows.size and np.any(np.diff(rows) <= 0):
         return sp, None                 # the lines' renumbering needs the runs in order
     return sp, detections_of_runs({c: det[c] for c in chans if c in det}, rows)
