@@ -26,7 +26,10 @@ FS, N = 4000.0, 16000
 LINES = ((1.0, 2.5e-6, 2e-7), (2.0, 4e-7, 3e-8), (3.6, 1.5e-7, 1.2e-8), (5.4, 1e-7, 8e-9))
 
 
-def _copied(seed: int) -> SteadyTest:
+def _copied(seed: int, lines=LINES, axial=(3.6, 3e-7), target: str = "Ty", kappa: float = KAPPA,
+            ellipse: float = 1.0) -> SteadyTest:
+    """30 runs of the radial ``lines`` (Fy ``ellipse`` × a quarter turn of Fx: 1, round), an Fz line ``axial``
+    (h, C), white noise, and ``target`` += ``kappa``·Fx on the records."""
     rng = np.random.default_rng(seed)
     t = np.arange(N) / FS
     runs = []
@@ -34,13 +37,13 @@ def _copied(seed: int) -> SteadyTest:
         om = rpm * 2 * np.pi / 60
         sig = {c: 0.05 * rng.standard_normal(N) for c in ("Fx", "Fy", "Fz")}
         sig.update({c: 0.003 * rng.standard_normal(N) for c in ("Tx", "Ty", "Tz")})
-        for h, c_force, c_torque in LINES:
+        for h, c_force, c_torque in lines:
             for (cx, cy), c in ((("Fx", "Fy"), c_force), (("Tx", "Ty"), c_torque)):
                 ph = rng.uniform(0, 2 * np.pi)
                 sig[cx] += c * om**2 * np.cos(h * om * t + ph)
-                sig[cy] += c * om**2 * np.sin(h * om * t + ph)
-        sig["Fz"] += 3e-7 * om**2 * np.cos(3.6 * om * t + rng.uniform(0, 2 * np.pi))
-        sig["Ty"] = sig["Ty"] + KAPPA * sig["Fx"]
+                sig[cy] += ellipse * c * om**2 * np.sin(h * om * t + ph)
+        sig["Fz"] += axial[1] * om**2 * np.cos(axial[0] * om * t + rng.uniform(0, 2 * np.pi))
+        sig[target] = sig[target] + kappa * sig["Fx"]
         runs.append(Run(float(om), FS, sig, name=f"r{rpm:.0f}.csv"))
     return SteadyTest(runs)
 
@@ -56,22 +59,8 @@ def test_a_force_copied_into_a_torque_with_lines_of_its_own_is_read_forward(seed
 def _force_in_axial(seed: int, ellipse: float) -> SteadyTest:
     """Fz += 0.1·Fx where Fx's lines stand under 10 dB in Fz (read on the floor alone); Fy = ``ellipse`` × a quarter
     turn of Fx on every radial line (1: round)."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(N) / FS
-    runs = []
-    for rpm in np.linspace(500.0, 5000.0, 30):
-        om = rpm * 2 * np.pi / 60
-        sig = {c: 0.05 * rng.standard_normal(N) for c in ("Fx", "Fy", "Fz")}
-        sig.update({c: 0.003 * rng.standard_normal(N) for c in ("Tx", "Ty", "Tz")})
-        for h, c_force, c_torque in ((1.0, 2.5e-7, 2e-8), (2.0, 4e-8, 3e-9), (3.27, 3e-8, 2e-9), (4.1, 2e-8, 0.0)):
-            for (cx, cy), c in ((("Fx", "Fy"), c_force), (("Tx", "Ty"), c_torque)):
-                ph = rng.uniform(0, 2 * np.pi)
-                sig[cx] += c * om**2 * np.cos(h * om * t + ph)
-                sig[cy] += ellipse * c * om**2 * np.sin(h * om * t + ph)
-        sig["Fz"] += 3e-8 * om**2 * np.cos(3.27 * om * t + rng.uniform(0, 2 * np.pi))
-        sig["Fz"] = sig["Fz"] + 0.1 * sig["Fx"]
-        runs.append(Run(float(om), FS, sig, name=f"r{rpm:.0f}.csv"))
-    return SteadyTest(runs)
+    return _copied(seed, ((1.0, 2.5e-7, 2e-8), (2.0, 4e-8, 3e-9), (3.27, 3e-8, 2e-9), (4.1, 2e-8, 0.0)),
+                   axial=(3.27, 3e-8), target="Fz", kappa=0.1, ellipse=ellipse)
 
 
 @pytest.mark.parametrize("seed, ellipse", [(0, 1.0), (1, 1.0), (2, 0.8)])
