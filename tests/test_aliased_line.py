@@ -81,8 +81,8 @@ def test_a_fold_is_read_through_the_sample_rate():
     ``affine_line`` gate, its free offset within 4 of its standard errors of the sample rate) in 97 % of 2000 draws
     or more; read with a free offset and a 2-bin gate (before) 6 runs' errors, carried back to 0 Hz, put the offset
     over 2 bins from the sample rate in ~40 % of them and the line was dropped unsaid."""
-    from rwadist.diagnose.describe_affine import MAX_MISFIT_BINS, _line_through, _offset_holds
-    from rwadist.diagnose.describe_alias import reads_as_counted
+    from rwadist.diagnose.describe_affine import MAX_MISFIT_BINS, _line_through
+    from rwadist.diagnose.describe_alias import offset_holds, reads_as_counted
 
     fs, h = 3000.0, 24.0
     df = fs / 4096
@@ -92,7 +92,7 @@ def test_a_fold_is_read_through_the_sample_rate():
     def reads(f, offset):
         b, f0 = _line_through(spin, f, offset)
         rms = np.sqrt(np.mean((f - (f0 + b * spin)) ** 2))
-        held = offset is None or _offset_holds(spin, f, offset, df)
+        held = offset is None or offset_holds(spin, f, offset, df)
         return bool(held and rms <= MAX_MISFIT_BINS * df and reads_as_counted(f0, b, h, spin, fs, df))
 
     passed = {None: 0, fs: 0}

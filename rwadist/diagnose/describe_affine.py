@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .describe_alias import ALIAS_TELLS, alias_causes, alias_tracks, folded, reads_as_counted
+from .describe_alias import ALIAS_TELLS, alias_causes, alias_tracks, folded, offset_holds, reads_as_counted
 from .describe_alias import MIN_RUNS as ALIAS_MIN_RUNS
 from .describe_lines import RIDGE_FRACTION, _lit, log_parabola_offset, sliced
 from .unexplained import Unexplained
@@ -135,27 +135,6 @@ def _line_through(spin: np.ndarray, f: np.ndarray, offset: float | None) -> tupl
     return float(np.dot(spin, f - offset) / np.dot(spin, spin)), float(offset)
 
 
-#: A fold's offset, read free, lies within this many of its standard errors of the sample rate (or FOLD_BINS bins)
-FOLD_STDERRS = 4.0
-
-
-def _offset_holds(spin: np.ndarray, f: np.ndarray, offset: float, df: float) -> bool:
-    """Whether the peaks ``f`` (Hz) over the spin frequencies ``spin`` (Hz) allow the line's offset to be ``offset``:
-    their free least-squares offset within :data:`FOLD_STDERRS` of its standard error (from the residuals, n − 2
-    degrees of freedom) or :data:`~rwadist.diagnose.describe_alias.FOLD_BINS` Welch bins of it.  A falling line 3-10
-    bins off the sample rate, read sharply, is not a fold (read through the sample rate it passed the misfit gate)."""
-    from .describe_alias import FOLD_BINS
-
-    n = spin.size
-    b, f0 = np.polyfit(spin, f, 1)
-    if n <= 2:
-        return abs(f0 - offset) <= FOLD_BINS * df
-    resid = f - (f0 + b * spin)
-    sxx = float(np.sum((spin - spin.mean()) ** 2))
-    se = float(np.sqrt(np.sum(resid**2) / (n - 2) * (1.0 / n + spin.mean() ** 2 / max(sxx, 1e-300))))
-    return abs(f0 - offset) <= max(FOLD_BINS * df, FOLD_STDERRS * se)
-
-
 def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list, least: int = MIN_RUNS,
                 offset: float | None = None) -> tuple | None:
     """(offset f0 Hz, slope b, RMS misfit Hz, peak dB) of the line in ``windows`` ((first, last) bin in each run of ``runs``):
@@ -183,7 +162,7 @@ def _read_track(ctx, ratio: np.ndarray, runs: np.ndarray, windows: list, least: 
         ok &= np.abs(f_pk - (f0 + b * spin)) <= OUTLIER_BINS * df
     if ok.sum() < max(least, KEPT_FRACTION * runs.size):
         return None
-    if offset is not None and not _offset_holds(spin[ok], f_pk[ok], offset, df):
+    if offset is not None and not offset_holds(spin[ok], f_pk[ok], offset, df):
         return None
     b, f0 = _line_through(spin[ok], f_pk[ok], offset)
     rms = float(np.sqrt(np.mean((f_pk[ok] - (f0 + b * spin[ok])) ** 2)))

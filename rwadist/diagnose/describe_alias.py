@@ -81,6 +81,25 @@ def folded(f0: float, b: float, fs: float | None, df: float) -> bool:
     return fs is not None and b < 0 and abs(f0 - fs) <= FOLD_BINS * df
 
 
+#: A fold's offset, read free, lies within this many of its standard errors of the sample rate (or FOLD_BINS bins)
+FOLD_STDERRS = 4.0
+
+
+def offset_holds(spin: np.ndarray, f: np.ndarray, offset: float, df: float) -> bool:
+    """Whether the peaks ``f`` (Hz) over the spin frequencies ``spin`` (Hz) allow the line's offset to be ``offset``:
+    their free least-squares offset within :data:`FOLD_STDERRS` of its standard error (from the residuals, n − 2
+    degrees of freedom) or :data:`FOLD_BINS` Welch bins of it.  A falling line 3-10
+    bins off the sample rate, read sharply, is not a fold (read through the sample rate it passed the misfit gate)."""
+    n = spin.size
+    b, f0 = np.polyfit(spin, f, 1)
+    if n <= 2:
+        return abs(f0 - offset) <= FOLD_BINS * df
+    resid = f - (f0 + b * spin)
+    sxx = float(np.sum((spin - spin.mean()) ** 2))
+    se = float(np.sqrt(np.sum(resid**2) / (n - 2) * (1.0 / n + spin.mean() ** 2 / max(sxx, 1e-300))))
+    return abs(f0 - offset) <= max(FOLD_BINS * df, FOLD_STDERRS * se)
+
+
 def reads_as_counted(f0: float, b: float, h: float, spin: np.ndarray, fs: float, df: float) -> bool:
     """Whether a folded track counted at ``h`` was read as one (:func:`folded`, its slope −h within
     :data:`FOLD_BINS` Welch bins over the spin frequencies ``spin`` Hz): a candidate counted over few runs and read
