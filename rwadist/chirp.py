@@ -52,6 +52,22 @@ def sliced_rates(test) -> np.ndarray | None:
     return rates if np.isfinite(rates).any() else None
 
 
+def sliced_slopes(test) -> np.ndarray | None:
+    """d|Ω|/dt (rad/s², signed: > 0 while the wheel speeds up) of each run of a test cut from a sweep, in the test's
+    run order (``np.gradient`` of |speed| against the runs' centre times, taken in time order); None for any other
+    test (:func:`sliced_rates`) and NaN for a run without a speed."""
+    rates = sliced_rates(test)
+    if rates is None:
+        return None
+    t_mid = np.array([r.t0 + 0.5 * r.n_samples / r.sample_rate for r in test.runs])
+    speed = np.abs([r.speed for r in test.runs])
+    ok = np.isfinite(rates)
+    idx = np.flatnonzero(ok)[np.argsort(t_mid[ok], kind="stable")]
+    out = np.full(speed.shape, np.nan)
+    out[idx] = np.gradient(speed[idx], t_mid[idx])
+    return out
+
+
 def chirp_bins(h, rate, seconds: float):
     """Bins of a segment of ``seconds`` s a line of harmonic ``h`` sweeps across it at |dΩ/dt| = ``rate`` rad/s²:
     h·rate·L²/(2π) (broadcast)."""

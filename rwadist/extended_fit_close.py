@@ -14,16 +14,33 @@ strongest one (h₀ − δ without h₀ + δ: one of a speed-sideband pair, the 
 detection) has its mirror looked for the same way and kept when the records show it.  A measurement is kept where
 the line's power stands :data:`MIN_SNR` over the noise the block floor gives in one record bin (white noise of
 one-sided PSD S: E|X|² = S·f_s/2·Σw², Σw² = 3n/8; a line of amplitude a at its bin: |X| = a·n/4).
+
+A run cut from a sweep is not steady: over its record of T s a line of harmonic h moves by c = h·(d|Ω|/dt)·T²/(2π)
+record bins (:func:`rwadist.chirp.chirp_bins`).  There each line's column is the windowed transform of a linear chirp
+of that c (:func:`chirp_transform`, a function of the offset from the line's mean frequency in bins, signed by the
+sweep's direction), the grid reaches c/2 bins further each side, and two lines are measured apart only where their
+mean frequencies are max(1, |c|) record bins apart or more: closer, their smears overlap and one chirp fits them both
+(a fast run-up's line, smeared over 22 record bins, was read as three lines 0.4 % apart, each half a bin off the
+others: :meth:`_Span.merge_smeared`).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import replace
 
 import numpy as np
 
+from .chirp import sliced_slopes
 from .dft import hann_transform, run_window, windowed_dfts, windowed_records
 from .units import DIRECTION_CHANNELS
 
+#: A line of a sweep's run whose chirp across the record is below this many record bins is read as a steady line
+CHIRP_MIN_BINS = 0.5
+#: Steps per record bin of the tabulated chirp transform (:func:`chirp_transform`; linear interpolation between)
+CHIRP_TABLE_STEPS = 32
+#: ... for a chirp rounded to this many steps per bin (a 1/32-bin change of a chirp of 1 bin or more moves no
+#: measurement beyond its noise)
+CHIRP_C_STEPS = 16
 #: A measurement of a close line is kept when its power over the noise in one record bin reaches this (10 dB)
 MIN_SNR = 10.0
 #: Lines of a span measured together where each two are at least this many record bins apart
@@ -94,6 +111,7 @@ def close_lines(test, fit) -> list:
         chans = [c for c in DIRECTION_CHANNELS[d] if c in sp.psd]
         for hs, lost in groups:
             span = _Span(test, fit, chans, hs, lost, eps)
+            span.merge_smeared()
             span.refine()
             span.add_mirrors(min_points)
             for j in span.lost:
@@ -116,7 +134,8 @@ class _Span:
         self.floors = fit.detections
         self.f_axis = fit.spectra.f
         self.band_limit = fit.spectra.band_limit
-        self.runs = []              # (run index, |Ω|, n, fs, channels, grid f (G,), X (G, K))
+        self.runs = []              # (run index, |Ω|, n, fs, channels, grid f (G,), X (G, K), d|Ω|/dt rad/s²)
+        slopes = sliced_slopes(test)
         lo, hi = self.h.min() - eps, self.h.max() + eps
         for r, run in enumerate(test.runs):
             w = abs(float(run.speed))
@@ -125,29 +144,63 @@ class _Span:
             chs = [c for c in chans if run.usable(c)]
             if w <= 0 or not chs or lo * w / (2 * np.pi) < 4 * bin_hz or hi * w / (2 * np.pi) > self.band_limit:
                 continue
-            grid = np.arange(lo * w / (2 * np.pi) - 2 * bin_hz, hi * w / (2 * np.pi) + 2 * bin_hz, 0.25 * bin_hz)
+            slope = 0.0 if slopes is None or not np.isfinite(slopes[r]) else float(slopes[r])
+            reach = 2 + 0.5 * abs(_chirp(hi, slope, n, fs))         # a chirp's smear beyond the span, bins
+            grid = np.arange(lo * w / (2 * np.pi) - reach * bin_hz, hi * w / (2 * np.pi) + reach * bin_hz,
+                             0.25 * bin_hz)
             x = windowed_records([[run.signals[c] for c in chs]], run_window("hann", n)[0])
-            self.runs.append((r, w, n, fs, chs, grid, windowed_dfts(x, fs, grid[None, :])[0]))
+            self.runs.append((r, w, n, fs, chs, grid, windowed_dfts(x, fs, grid[None, :])[0], slope))
+
+    def _apart(self, h, run) -> bool:
+        """Lines ``h`` can be measured apart on ``run``: their mean frequencies each max(:data:`MIN_SEPARATION_BINS`,
+        |c|) record bins apart or more (c the larger of the two's chirp)."""
+        _, w, n, fs = run[:4]
+        order = np.argsort(h)
+        f, c = np.asarray(h)[order] * w / (2 * np.pi), np.abs(_chirp(np.asarray(h)[order], run[7], n, fs))
+        need = np.maximum(MIN_SEPARATION_BINS, np.maximum(c[1:], c[:-1]))
+        return bool(np.all(np.diff(f) >= need * fs / n))
 
     def _solve(self, h, run):
         """(A (L, K) complex amplitudes, residual power) of lines ``h`` on one run's record, or None where two lines
-        are closer than :data:`MIN_SEPARATION_BINS`."""
-        _, w, n, fs, _, grid, X = run
-        f = h * w / (2 * np.pi)
-        if np.any(np.diff(np.sort(f)) < MIN_SEPARATION_BINS * fs / n):
+        are too close to measure apart (:meth:`_apart`)."""
+        _, w, n, fs, _, grid, X, slope = run
+        if not self._apart(h, run):
             return None
-        M = 0.5 * hann_transform(n, fs, grid[:, None] - f[None, :])                    # (G, L)
+        f = h * w / (2 * np.pi)
+        c = _chirp(h, slope, n, fs)
+        M = np.empty((grid.size, f.size), complex)
+        for j in range(f.size):
+            M[:, j] = 0.5 * chirp_transform(n, fs, grid - f[j], c[j])                      # (G,)
         A, *_ = np.linalg.lstsq(M, X, rcond=None)
         return A, float(np.sum(np.abs(X - M @ A) ** 2))
 
     def _costs(self, h) -> np.ndarray:
-        """Residual power of lines ``h`` on each run (NaN where two lines are closer than a bin)."""
+        """Residual power of lines ``h`` on each run (NaN where two lines are too close to measure apart)."""
         out = np.full(len(self.runs), np.nan)
         for i, run in enumerate(self.runs):
             got = self._solve(h, run)
             if got is not None:
                 out[i] = got[1]
         return out
+
+    def merge_smeared(self) -> None:
+        """Neighbouring lines, one of them lost, that no run measures apart (:meth:`_apart`) are one line's smear: a lost
+        line beside a measured one is dropped; two lost ones become one lost line at their mean h.  Only on a sweep's
+        slices: on steady runs two lines within a record bin of each other are two lines the records cannot split
+        (``line_property`` "blended_lines" describes them), not one smeared line."""
+        while any(run[7] for run in self.runs):
+            order = np.argsort(self.h)
+            for a, b in zip(order[:-1], order[1:]):
+                if (a in self.lost or b in self.lost) and \
+                        not any(self._apart(self.h[[a, b]], run) for run in self.runs):
+                    break
+            else:
+                return
+            if a in self.lost and b in self.lost:
+                self.h[a] = 0.5 * (self.h[a] + self.h[b])
+            drop = b if b in self.lost else a
+            self.h = np.delete(self.h, drop)
+            self.lost = [j - (j > drop) for j in self.lost if j != drop]
 
     def refine(self) -> None:
         """Each lost line's h: the least residual power within ±eps, summed over the runs that every point of the
@@ -218,3 +271,37 @@ class _Span:
                     ch_out.append(c)
                     a_out.append(amp)
         return np.asarray(w_out, float), np.asarray(ch_out, dtype=object).astype(str), np.asarray(a_out, float)
+
+
+def _chirp(h, slope: float, n: int, fs: float) -> np.ndarray:
+    """Record bins (signed) a line of harmonic ``h`` sweeps across a record of ``n`` samples at ``fs`` Hz while the
+    speed changes at ``slope`` = d|Ω|/dt rad/s² (0 on a steady run)."""
+    return np.asarray(h, dtype=float) * slope * (n / fs) ** 2 / (2 * np.pi)
+
+
+def chirp_transform(n: int, fs: float, offset_hz: np.ndarray, c: float) -> np.ndarray:
+    """Σ_m w[m]·e^{jπc(m/n − ½)²}·e^{−2πj·offset·m/fs}: the periodic Hann window's transform (:func:`rwadist.dft.
+    hann_transform`) of a linear chirp sweeping ``c`` record bins across the record, at ``offset_hz`` (1-D) from its
+    mean frequency.  For |c| below :data:`CHIRP_MIN_BINS` the steady line's closed form; otherwise a table
+    (:func:`_chirp_table`) linearly interpolated."""
+    offset_hz = np.asarray(offset_hz, dtype=float)
+    if abs(c) < CHIRP_MIN_BINS:
+        return hann_transform(n, fs, offset_hz)
+    bins = offset_hz * n / fs
+    reach = 8 * int(np.ceil((np.max(np.abs(bins)) + 1) / 8))
+    at, table = _chirp_table(n, round(c * CHIRP_C_STEPS) / CHIRP_C_STEPS, reach)
+    return np.interp(bins, at, table.real) + 1j * np.interp(bins, at, table.imag)
+
+
+@functools.lru_cache(maxsize=256)
+def _chirp_table(n: int, c: float, reach: int) -> tuple:
+    """(offsets in bins, transform) of :func:`chirp_transform` on :data:`CHIRP_TABLE_STEPS` points per bin from
+    −``reach`` to ``reach`` bins: the zoom FFT (:func:`scipy.signal.zoom_fft`) of the windowed chirp (one per run
+    length, chirp and reach: the lines of a span ask for the same few on every step of their h grids)."""
+    from scipy.signal import zoom_fft
+
+    m = 2 * reach * CHIRP_TABLE_STEPS + 1
+    x = np.arange(n) / n - 0.5
+    table = zoom_fft(run_window("hann", n)[0] * np.exp(1j * np.pi * c * x**2), [-reach, reach], m=m, fs=n,
+                     endpoint=True)
+    return np.linspace(-reach, reach, m), table
