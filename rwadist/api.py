@@ -407,9 +407,9 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     result.model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))
     if text := speed_scale_warning(result, test.meta):
         warnings.warn(RwadistWarning(text.removeprefix("WARNING: ")), stacklevel=2)
-    # a sweep's speed from the data whose 1x line is a tie; a channel in another unit; a radial pair missing a channel
-    for text in (speed_whirl.fit_tie_warning(test), fit_warnings.unit_mixup_warning(spectra, result.model),
-                 fit_warnings.sense_unread_warning(spectra, result.model)):
+    # a sweep's speed from the data whose 1x line is a tie; a channel in another unit; a radial pair missing a channel;
+    # lines the fit detected but did not measure apart
+    for text in (speed_whirl.fit_tie_warning(test), *fit_warnings.model_warnings(spectra, result, test)):
         if text:
             warnings.warn(RwadistWarning(text), stacklevel=2)
     if not any(result.model.empirical.values()):

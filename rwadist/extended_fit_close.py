@@ -18,10 +18,10 @@ one-sided PSD S: E|X|² = S·f_s/2·Σw², Σw² = 3n/8; a line of amplitude a a
 A run cut from a sweep is not steady: over its record of T s a line of harmonic h moves by c = h·(d|Ω|/dt)·T²/(2π)
 record bins (:func:`rwadist.chirp.chirp_bins`).  There each line's column is the windowed transform of a linear chirp
 of that c (:func:`chirp_transform`, a function of the offset from the line's mean frequency in bins, signed by the
-sweep's direction), the grid reaches c/2 bins further each side, and two lines are measured apart only where their
-mean frequencies are max(1, |c|) record bins apart or more: closer, their smears overlap and one chirp fits them both
-(a fast run-up's line, smeared over 22 record bins, was read as three lines 0.4 % apart, each half a bin off the
-others: :meth:`_Span.merge_smeared`).
+sweep's direction) and the grid reaches c/2 bins further each side: with the steady kernel a fast run-up's line,
+smeared over 22 record bins, was read as three lines 0.4 % apart.  Two lines are measured apart where their mean
+frequencies are 1 + ½|c₁ − c₂| record bins apart (two lines chirp nearly alike: the chirp taken off, a steady pair);
+candidates that no chirping run measures apart are one line's smear (:meth:`_Span.merge_smeared`).
 """
 from __future__ import annotations
 
@@ -34,13 +34,18 @@ from .chirp import sliced_slopes
 from .dft import hann_transform, run_window, windowed_dfts, windowed_records
 from .units import DIRECTION_CHANNELS
 
-#: A line of a sweep's run whose chirp across the record is below this many record bins is read as a steady line
-CHIRP_MIN_BINS = 0.5
-#: Steps per record bin of the tabulated chirp transform (:func:`chirp_transform`; linear interpolation between)
-CHIRP_TABLE_STEPS = 32
-#: ... for a chirp rounded to this many steps per bin (a 1/32-bin change of a chirp of 1 bin or more moves no
-#: measurement beyond its noise)
-CHIRP_C_STEPS = 16
+#: A line of a sweep's run whose chirp across the record is below this many record bins is read as a steady line (the
+#: steady kernel is then within 2e-3 of the chirp's transform, relative to its peak)
+CHIRP_MIN_BINS = 1.0 / 64
+#: Steps per record bin of the tabulated chirp transform (:func:`chirp_transform`; its linear phase taken off, the
+#: rest linearly interpolated: within 4e-5 of its peak)
+CHIRP_TABLE_STEPS = 64
+#: ... for a chirp rounded to this many steps per bin (a chirp 1/128 bin off moves its transform by 8e-4 of its peak
+#: at most: measured against the direct sum)
+CHIRP_C_STEPS = 64
+#: Candidates are merged as one line's smear (:meth:`_Span.merge_smeared`) only on runs where a line chirps over this
+#: many record bins or more: a smear that moves the line less than a bin cannot split it into peaks
+SMEAR_MIN_BINS = 1.0
 #: A measurement of a close line is kept when its power over the noise in one record bin reaches this (10 dB)
 MIN_SNR = 10.0
 #: Lines of a span measured together where each two are at least this many record bins apart
@@ -152,13 +157,15 @@ class _Span:
             self.runs.append((r, w, n, fs, chs, grid, windowed_dfts(x, fs, grid[None, :])[0], slope))
 
     def _apart(self, h, run) -> bool:
-        """Lines ``h`` can be measured apart on ``run``: their mean frequencies each max(:data:`MIN_SEPARATION_BINS`,
-        |c|) record bins apart or more (c the larger of the two's chirp)."""
+        """Lines ``h`` can be measured apart on ``run``: their mean frequencies each :data:`MIN_SEPARATION_BINS` + ½|c₁ −
+        c₂| record bins apart or more.  Two lines of a sweep chirp nearly alike (c ∝ h): the chirp taken off, they
+        are two steady lines as far apart, whose columns correlate as a steady pair's do (a bin apart: 0.67, two
+        bins: 0.17, whatever c); only the difference of their chirps widens the least squares' need."""
         _, w, n, fs = run[:4]
-        order = np.argsort(h)
-        f, c = np.asarray(h)[order] * w / (2 * np.pi), np.abs(_chirp(np.asarray(h)[order], run[7], n, fs))
-        need = np.maximum(MIN_SEPARATION_BINS, np.maximum(c[1:], c[:-1]))
-        return bool(np.all(np.diff(f) >= need * fs / n))
+        hs = np.sort(np.asarray(h, dtype=float))
+        c = _chirp(hs, run[7], n, fs)
+        need = MIN_SEPARATION_BINS + 0.5 * np.abs(np.diff(c))
+        return bool(np.all(np.diff(hs * w / (2 * np.pi)) >= need * fs / n))
 
     def _solve(self, h, run):
         """(A (L, K) complex amplitudes, residual power) of lines ``h`` on one run's record, or None where two lines
@@ -184,23 +191,26 @@ class _Span:
         return out
 
     def merge_smeared(self) -> None:
-        """Neighbouring lines, one of them lost, that no run measures apart (:meth:`_apart`) are one line's smear: a lost
-        line beside a measured one is dropped; two lost ones become one lost line at their mean h.  Only on a sweep's
-        slices: on steady runs two lines within a record bin of each other are two lines the records cannot split
+        """Neighbouring lines, one of them lost, that no run whose lines chirp (|c| ≥ :data:`SMEAR_MIN_BINS`) measures
+        apart (:meth:`_apart`) are one line's smear: a lost line beside a measured one is dropped; lost ones become one
+        lost line at their mean h.  Only where the runs chirp: on steady runs (and runs of a sweep so slow that a line
+        moves less than that) two lines within a record bin of each other are two lines the records cannot split
         (``line_property`` "blended_lines" describes them), not one smeared line."""
-        while any(run[7] for run in self.runs):
+        chirped = [run for run in self.runs if abs(_chirp(self.h.max(), run[7], run[2], run[3])) >= SMEAR_MIN_BINS]
+        merged = np.ones(self.h.size)           # lines each lost line stands for (its h their mean)
+        while chirped:
             order = np.argsort(self.h)
-            for a, b in zip(order[:-1], order[1:]):
-                if (a in self.lost or b in self.lost) and \
-                        not any(self._apart(self.h[[a, b]], run) for run in self.runs):
-                    break
-            else:
+            pair = next(((a, b) for a, b in zip(order[:-1], order[1:]) if (a in self.lost or b in self.lost)
+                         and not any(self._apart(self.h[[a, b]], run) for run in chirped)), None)
+            if pair is None:
                 return
+            a, b = pair
             if a in self.lost and b in self.lost:
-                self.h[a] = 0.5 * (self.h[a] + self.h[b])
+                self.h[a] = (merged[a] * self.h[a] + merged[b] * self.h[b]) / (merged[a] + merged[b])
+                merged[a] += merged[b]
             drop = b if b in self.lost else a
-            self.h = np.delete(self.h, drop)
-            self.lost = [j - (j > drop) for j in self.lost if j != drop]
+            self.h, merged = np.delete(self.h, drop), np.delete(merged, drop)
+            self.lost = [int(j - (j > drop)) for j in self.lost if j != drop]
 
     def refine(self) -> None:
         """Each lost line's h: the least residual power within ±eps, summed over the runs that every point of the
@@ -290,10 +300,16 @@ def chirp_transform(n: int, fs: float, offset_hz: np.ndarray, c: float) -> np.nd
     bins = offset_hz * n / fs
     reach = 8 * int(np.ceil((np.max(np.abs(bins)) + 1) / 8))
     at, table = _chirp_table(n, round(c * CHIRP_C_STEPS) / CHIRP_C_STEPS, reach)
-    return np.interp(bins, at, table.real) + 1j * np.interp(bins, at, table.imag)
+    return (np.interp(bins, at, table.real) + 1j * np.interp(bins, at, table.imag)) * _turn(bins, n)
 
 
-@functools.lru_cache(maxsize=256)
+def _turn(bins, n: int) -> np.ndarray:
+    """e^{−jπ·δ(n − 1)/n}: the linear phase of a window's transform at δ bins (the delay of its centre, (n − 1)/2
+    samples), which turns by π per bin: taken off the table, the rest is smooth to interpolate."""
+    return np.exp(-1j * np.pi * np.asarray(bins, dtype=float) * (n - 1) / n)
+
+
+@functools.lru_cache(maxsize=1024)
 def _chirp_table(n: int, c: float, reach: int) -> tuple:
     """(offsets in bins, transform) of :func:`chirp_transform` on :data:`CHIRP_TABLE_STEPS` points per bin from
     −``reach`` to ``reach`` bins: the zoom FFT (:func:`scipy.signal.zoom_fft`) of the windowed chirp (one per run
@@ -304,4 +320,5 @@ def _chirp_table(n: int, c: float, reach: int) -> tuple:
     x = np.arange(n) / n - 0.5
     table = zoom_fft(run_window("hann", n)[0] * np.exp(1j * np.pi * c * x**2), [-reach, reach], m=m, fs=n,
                      endpoint=True)
-    return np.linspace(-reach, reach, m), table
+    at = np.linspace(-reach, reach, m)
+    return at, table / _turn(at, n)

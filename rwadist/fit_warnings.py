@@ -111,3 +111,30 @@ def sense_unread_warning(spectra, model) -> str:
                         "and FMU x/y phase are then wrong); record both channels of the pair in the same runs to read "
                         "them")
     return "; ".join(said)
+
+
+def unresolved_warning(fit, test=None) -> str:
+    """'' or the words for the harmonics an empirical fit (:class:`rwadist.empirical.EmpiricalFit`) of ``test`` detected
+    in enough runs but did not measure, no measurement being resolved from a line beside them (their power windows of
+    ±``line_half_width`` bins overlap at every speed): the model lacks them, with no other word (trial nuV's 2.5-kg
+    wheel: a run-up's line smeared over its slices, read as two candidates 0.4 % apart, neither measured; family wheel
+    1's 30-s run-up: axial h 6.65 and 6.69, the wheel's 6.66).  On a sweep's slices (``test.meta["slicing"]``) such
+    a pair is often one line the speed smears across the slice; on steady runs longer segments resolve a pair."""
+    lost = sorted({(b.direction, round(b.h, 3)) for b in fit.bins
+                   if not b.kept and b.reason.startswith("no measurement resolved")})
+    if not lost:
+        return ""
+    names = [f"{d} h={h:.4g}" for d, h in lost]
+    sliced = "slicing" in (getattr(test, "meta", None) or {})
+    return (f"{len(lost)} harmonic(s) the data show were not measured apart from a line beside them "
+            f"({', '.join(names[:6])}{' and more' if names[6:] else ''}; bins.csv in the report gives the reasons): "
+            "the empirical model lacks them; the extended fit (--extended) and rwadist diagnose measure such lines "
+            "together on each run's whole record" + (" (a line the speed smears across a slice as one line)" if sliced
+                                                     else ", and longer segments (--nperseg) resolve them on the PSDs"))
+
+
+def model_warnings(spectra, fit, test) -> list:
+    """The words of :func:`unit_mixup_warning`, :func:`sense_unread_warning` and :func:`unresolved_warning` on the
+    empirical fit ``fit`` of ``test`` (its ``spectra``), each '' when it has nothing to say."""
+    return [unit_mixup_warning(spectra, fit.model), sense_unread_warning(spectra, fit.model),
+            unresolved_warning(fit, test)]

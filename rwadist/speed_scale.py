@@ -25,7 +25,8 @@ therefore found in two steps that assume no line set:
    (trial 11: a 300-s run-up took a ball-pass line at 3.6 with its 2× at 7.2 for the imbalance with its 2×,
    summed strengths 11.93 against 11.89; every speed 3.6× too high).  Candidates with equally many multiples
    tie: a ball-pass line with its harmonics lies above the rotor's fundamental, so the lowest is taken (unless it is
-   the lower speed sideband of a carrier in the tie within SIDEBAND_SPAN: the carrier) and the
+   the lower speed sideband of a carrier in the tie within SIDEBAND_SPAN: the carrier; or it lies at a cage's ratio,
+   0.35-0.48, of a tied line stronger in the radial-force pair: that line, whose cage it is) and the
    others are kept (``tied``) for a second, physical test the data can give (the gyroscopic whirl of the
    wheel's rocking mode reads I_zz/I_rr in proportion to the speed scale, :mod:`rwadist.speed_whirl`); a
    cage line with a harmonic (below 1×) is what that test catches.  Its sense is the sign of the speed.  The
@@ -44,6 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal
 
+from .bearings import RATIO_RANGES
 from .spectra import find_lines
 
 #: step of the registration grid in u = ln f (0.02 %)
@@ -327,10 +329,6 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
     # below the slowest cage is not the rotor's (module docstring); it stays a candidate for the whirl's test
     below = np.array([np.any(cand & (orders < SLOWEST_LINE * orders[c])) for c in range(n)], dtype=bool)
     excluded = cand & below if (cand & ~below).any() else np.zeros(n, dtype=bool)
-    if excluded.any():
-        how += (f"; not the line{'s' if excluded.sum() > 1 else ''} at order "
-                + ", ".join(f"{orders[c]:.4g}" for c in np.flatnonzero(excluded))
-                + f", which would put a line turning one way in force and torque below {SLOWEST_LINE:g}x the speed")
     multiples = {}
     for c in np.flatnonzero(cand):
         ratio = orders / orders[c]
@@ -345,7 +343,20 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
                 and _between_sidebands(orders, seen, c)]
     if carriers:
         tied = carriers[:1] + [c for c in tied if c != carriers[0]]
+    # the lowest of a tie at a cage's ratio of a stronger line in the tie: that line (a cage turns one way in force and
+    # torque as the imbalance does, far weaker; a new user's wheel of a 1x, a cage 0.414 and ball-pass lines with no
+    # integer harmonic had every speed read 2.42x too low on the cage)
+    power = _pair_power(senses, n)
+    lo, hi = RATIO_RANGES["FTF"][:2]
+    rotors = [c for c in tied[1:] if not carriers and lo <= orders[tied[0]] / orders[c] <= hi
+              and power[c] > power[tied[0]]]
+    if rotors:
+        tied = rotors[:1] + [c for c in tied if c != rotors[0]]
     best = tied[0]
+    if excluded.any():
+        how += (f"; not the line{'s' if excluded.sum() > 1 else ''} at h "
+                + ", ".join(f"{orders[c] / orders[best]:.4g}" for c in np.flatnonzero(excluded))
+                + f", which would put a line turning one way in force and torque below {SLOWEST_LINE:g}x the speed")
     mult = multiples[best]
     others = [{"h": float(orders[c] / orders[best]), "multiples_found": multiples[c]} for c in tied[1:]]
     rest = sorted((c for c in multiples if c not in tied), key=lambda c: (bool(excluded[c]), -len(multiples[c]),
@@ -359,8 +370,27 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
         reason += ("; as many for the line" + ("s" if len(others) > 1 else "") + " at h "
                    + ", ".join(f"{o['h']:.4g}" for o in others)
                    + (": the one midway between two lines (a carrier and its sidebands) taken" if carriers
+                      else f": the one whose cage the lowest would be ({lo:.2f}-{hi:.2f} of it, weaker) taken" if rotors
                       else ": the lowest taken"))
     return best, float(sense[best]), evidence, reason
+
+
+def _pair_power(senses: dict, n: int) -> np.ndarray:
+    """Per line (n,) its median power over the local noise in the radial-force pair (the radial-torque pair when no
+    force pair is recorded) over the slices where it stands out (:func:`pair_senses`'s snr); 0 where it never does
+    or no pair is recorded.  Not saturated as the template's strength is: a cage line is far weaker than the
+    imbalance whose cage it is."""
+    key = "F" if "F" in senses else "T" if "T" in senses else None
+    if key is None:
+        return np.zeros(n)
+    if senses[key][1] is None:
+        return np.zeros(n)
+    snr = np.asarray(senses[key][1], dtype=float)
+    out = np.zeros(n)
+    for j in range(n):
+        lit = snr[:, j][snr[:, j] >= PAIR_SNR]
+        out[j] = float(np.median(lit)) if lit.size else 0.0
+    return out
 
 
 def _between_sidebands(orders: np.ndarray, seen: np.ndarray, c: int) -> bool:

@@ -26,7 +26,8 @@ found from physics alone, assuming no line set:
    the same in the radial torque (the static and dynamic imbalances turn with
    the rotor), with the most integer multiples among the lines (itself
    included; a count, never a summed strength, which saturates and flipped
-   with the sweep's duration), the lowest of a tie, the others kept for the
+   with the sweep's duration), the lowest of a tie (not a cage of a stronger
+   tied line: :func:`rwadist.speed_scale.imbalance_line`), the others kept for the
    gyroscopic whirl's test (:mod:`rwadist.speed_whirl`); every other line
    keeps its ratio h_i to it.
 3. **Refinement.**  The lines near h_i·f0 are found and their frequencies

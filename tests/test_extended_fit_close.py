@@ -68,8 +68,8 @@ def test_speed_sidebands_beside_the_imbalance_are_measured(n_samples):
 def test_a_chirped_line_is_the_chirp_written(c):
     """A cosine whose frequency moves linearly by ``c`` record bins across the record (a line of a sweep's slice;
     negative: a run-down), in white noise 60 dB down: the chirp's windowed transform equals the direct sum
-    Σ w[m]·e^{jπc(m/n − ½)²}·e^{−2πjδm/n} to 1e-3 of its peak, and the least squares with it gives the amplitude to
-    1e-3, where the steady line's kernel reads it far short."""
+    Σ w[m]·e^{jπc(m/n − ½)²}·e^{−2πjδm/n} to 1e-3 of its peak between the nodes of its table, and the least squares
+    with it gives the amplitude to 1e-3, where the steady line's kernel reads it far short."""
     rng = np.random.default_rng(5)
     n, fs = 4096, 5000.0
     b = fs / n
@@ -78,7 +78,8 @@ def test_a_chirped_line_is_the_chirp_written(c):
     k = c * b / (n / fs)                              # Hz/s
     x = 0.8 * np.cos(2 * np.pi * (f0 * (t - t[n // 2]) + 0.5 * k * (t - t[n // 2]) ** 2) + 1.1)
     x = x + 1e-3 * rng.standard_normal(n)
-    grid = np.arange(f0 - (abs(c) / 2 + 2) * b, f0 + (abs(c) / 2 + 2) * b, 0.25 * b)
+    # the grid off the kernel's table nodes (1/64 bin apart) by 0.37 of a node
+    grid = np.arange(f0 - (abs(c) / 2 + 2) * b, f0 + (abs(c) / 2 + 2) * b, 0.25 * b) + 0.37 / 64 * b
     kern = chirp_transform(n, fs, grid - f0, c)
     m = np.arange(n)
     w = run_window("hann", n)[0]
@@ -126,3 +127,38 @@ def test_a_line_smeared_over_a_fast_sweeps_record_is_held_once(tmp_path, capsys,
     held = [r for r in model["empirical"][direction] if abs(r["h"] / h_true - 1) < 0.03]
     true_C = [ln.C for ln in wheel.lines if ln.direction == direction and ln.h == h_true]
     assert len(held) == 1 and held[0]["C"] == pytest.approx(true_C[0], rel=0.1), held
+
+
+def _span(h, lost, slope_rad_s2, speeds_rpm=(1000.0, 2000.0, 3000.0), n=8192, fs=8192.0):
+    """A span of lines ``h`` (``lost`` the indices the fit did not measure) over runs of one-second records at
+    ``speeds_rpm`` whose speed changes at ``slope_rad_s2`` (the records themselves not needed by the merge)."""
+    from rwadist.extended_fit_close import _Span
+
+    span = object.__new__(_Span)
+    span.h, span.lost = np.array(h, float), list(lost)
+    span.runs = [(0, rpm * 2 * np.pi / 60, n, fs, [], None, None, slope_rad_s2) for rpm in speeds_rpm]
+    return span
+
+
+@pytest.mark.parametrize("slope", [30.0, 100.0])
+def test_sidebands_beside_a_chirping_carrier_are_not_its_smear(slope):
+    """Speed sidebands 0.94 / 1.06 beside a measured carrier on a sweep whose line chirps over 4.8-16 record bins:
+    1-3 bins from the carrier, and the carrier's chirp differs from theirs by 0.3-1 bin, so the least squares
+    tells them apart (the chirp taken off, a steady triple): none is merged into the carrier (the rule "apart by
+    max(1, |c|) bins" had dropped both)."""
+    span = _span([0.94, 1.0, 1.06], [0, 2], slope)
+    span.merge_smeared()
+    assert list(span.h) == [0.94, 1.0, 1.06] and span.lost == [0, 2]
+
+
+def test_candidates_inside_one_smear_are_one_line_and_only_on_a_sweep():
+    """Three lost candidates 0.002 apart in h (under a record bin at every speed) on a sweep whose lines chirp: one
+    lost line at their mean; the same on steady runs, or on a sweep so slow its lines chirp 0.02 bin: left as they
+    are (two lines the record cannot split are described, not merged)."""
+    fast = _span([6.662, 6.658, 6.660, 5.0], [0, 1, 2], 30.0)
+    fast.merge_smeared()
+    assert fast.h == pytest.approx([6.660, 5.0]) and fast.lost == [0]
+    for slope in (0.0, 0.05):
+        slow = _span([2.999, 3.0, 3.001], [0, 2], slope)
+        slow.merge_smeared()
+        assert list(slow.h) == [2.999, 3.0, 3.001] and slow.lost == [0, 2]

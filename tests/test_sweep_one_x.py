@@ -231,7 +231,7 @@ def test_a_ball_pass_with_its_harmonic_is_not_the_one_x_when_it_puts_the_cage_be
     senses = {"F": (np.array([0.0, 1.0, 1.0, 0.0, 1.0]), None), "T": (np.array([nan, 1.0, 1.0, 0.0, 1.0]), None)}
     best, sense, ev, why = sc.imbalance_line(orders, strength, senses)
     assert best == 1 and sense == 1.0 and ev["multiples_found"] == [1], why
-    assert "not the lines at order 4.704, 7.108, 9.407" in why and ev["tied"] == []
+    assert "not the lines at h 4.704, 7.108, 9.407" in why and ev["tied"] == []
     assert sorted(round(c["h"], 3) for c in ev["candidates"]) == [4.704, 7.108, 9.407]
     # the same wheel with speed sidebands at 0.93 and 1.07 of the imbalance's, co-rotating too: they tie with it (one
     # multiple each), and the lowest of a tie was taken (every speed 7 % low); the carrier lies midway between them, and
@@ -254,3 +254,28 @@ def test_a_ball_pass_with_its_harmonic_is_not_the_one_x_when_it_puts_the_cage_be
     senses = {"F": (np.array([1.0, 1.0, 1.0, 1.0, 1.0]), None), "T": (np.array([nan, nan, 1.0, nan, 1.0]), None)}
     best, _, _, why = sc.imbalance_line(orders, np.full(orders.size, 5.0), senses)
     assert best == 2 and "not the line" not in why
+
+
+def _snr(power) -> np.ndarray:
+    """Per-slice pair snr (3 slices, lines) of lines of median power ``power`` over the local noise."""
+    return np.tile(np.asarray(power, float), (3, 1)) * np.array([[0.8], [1.0], [1.3]])
+
+
+def test_a_tie_with_a_cage_below_a_stronger_line_takes_the_stronger():
+    """A new user's wheel (session 64, trial nuA): a 1x, its bearing's cage at 0.4137 and ball-pass lines 3.6871 and
+    7.3742, no integer harmonic, every radial line co-rotating: the 1x and the cage tie (one multiple each) and the
+    lowest was taken, every speed 2.42x low.  A tie's lowest at a cage's ratio (0.35-0.48) of a tied line stronger
+    in the radial-force pair is that line's cage: that line taken.  Controls: a 1x stronger than a one-way line at
+    2.42x above it (the 1x the lowest: kept); a cage stronger than the line above it (no ground to move: the lowest)."""
+    orders = np.array([0.4137, 1.0, 3.6871, 7.3742])
+    strength = np.full(orders.size, 6.0)                        # saturated: the template's strength tells nothing
+    co = np.ones(orders.size)
+    senses = {"F": (co, _snr([40.0, 5000.0, 300.0, 60.0])), "T": (co, _snr([20.0, 900.0, 80.0, 20.0]))}
+    best, _, ev, why = sc.imbalance_line(orders, strength, senses)
+    assert best == 1 and [round(t["h"], 4) for t in ev["tied"]] == [0.4137], why
+    assert "the one whose cage the lowest would be" in why
+    orders2 = np.array([1.0, 2.42, 3.6871])                     # a 1x and a stronger-than-nothing line 2.42x above
+    senses2 = {"F": (np.ones(3), _snr([5000.0, 40.0, 300.0]))}
+    assert sc.imbalance_line(orders2, np.full(3, 6.0), senses2)[0] == 0
+    senses3 = {"F": (co, _snr([9000.0, 5000.0, 300.0, 60.0]))}
+    assert sc.imbalance_line(orders, strength, senses3)[0] == 0
