@@ -563,6 +563,7 @@ def _summary_md(fit, rows, table, top, files, extended=None) -> str:
            f"- runs: {len(sp.speed)}, |speed| {rpm.min():.0f}–{rpm.max():.0f} rpm; channels: "
            f"{', '.join(sp.channels)}",
            f"- sample rate {sp.sample_rate:g} Hz, resolution {sp.df:.4g} Hz, band used 0–{top:g} Hz", ""]
+    out += _speed_md(prov)
     if extended:
         out += extended + ["", "# The empirical fit (the extended fit's starting point)", ""]
     out += ["## Harmonics (amplitude = C·Ω², Ω in rad/s)", "",
@@ -595,6 +596,30 @@ def _summary_md(fit, rows, table, top, files, extended=None) -> str:
         out.append(f"- {ch}: {med}")
     out += ["", "## Files", ""] + [f"- `{p.name}`" for p in files] + ["- `summary.md`", ""]
     return "\n".join(out)
+
+
+def _speed_md(prov: dict) -> list:
+    """summary.md's "Speed" section for a sweep cut into slices (the model's ``provenance.reading.slicing``): where the
+    speeds came from, which line the data's speed scale took as 1x and how well the lines agree with it, and a tie the
+    lines cannot settle (a new user's run-up fitted on its cage line said so on the console only); [] otherwise."""
+    slicing = ((prov.get("reading") or {}).get("slicing") or {}) if isinstance(prov, dict) else {}
+    if not slicing:
+        return []
+    out = ["## Speed", "", f"- a sweep cut into {slicing.get('n_kept', '?')} slices of "
+           f"{slicing.get('slice_duration_s', float('nan')):.3g} s; speed from the {slicing.get('speed_source', '?')}"]
+    scale = slicing.get("speed_scale") or {}
+    if scale:
+        out.append(f"- {str(scale.get('method', '')).removeprefix('speed from the data: ')}")
+        if scale.get("agreement_rel_rms") is not None:
+            out.append(f"- the lines agree with the speed to {100 * scale['agreement_rel_rms']:.3g} % RMS")
+        tied = [t["h"] for t in (scale.get("one_x") or {}).get("tied") or []]
+        if tied:
+            out.append("- **the data cannot tell the 1x line**: the line" + ("s" if len(tied) > 1 else "") + " at h "
+                       + ", ".join(f"{h:.4g}" for h in tied) + " of the one taken ha" + ("ve" if len(tied) > 1 else "s")
+                       + " as many integer multiples, and every ratio holds at either scale (every h and speed off by "
+                       "that factor): record the wheel's speed (a tach or speed_rpm column), or let `rwadist diagnose` "
+                       "test the scale with the wheel's gyroscopic whirl")
+    return out + [""]
 
 
 def write_report(fit, out_dir, cumulative_speeds_rpm=None, f_max: float | None = None,

@@ -4,7 +4,8 @@ Session 64's new-user trial (nuA): a hard-mounted rigid wheel, a 1x line in the 
 bearing's cage at 0.4137 and ball-pass lines at 3.6871 and 2 x 3.6871, no integer harmonic, every radial line
 co-rotating.  The 1x and the cage tie for the 1x line (one integer multiple each) and the lowest was taken: every speed
 2.42x low, every h 2.42x high in the model `rwadist fit` wrote.  Generated here with numpy alone (phases integrated from
-the speed, C·Ω² amplitudes, 1 % white noise), not with rwadist's physics; the truth is this file's line list.
+the speed, C·Ω² amplitudes, 1 % white noise), not with rwadist's physics; the truth is this file's line list.  The
+fit report's summary.md says how the speed was obtained and that the lines alone cannot settle the tie.
 """
 import json
 
@@ -44,8 +45,13 @@ def _run_up(path, rpm0=600.0, rpm1=4800.0, seconds=24.0, fs=4000.0, seed=3):
 @pytest.mark.slow
 def test_the_imbalance_not_its_cage_is_the_one_x_line(tmp_path, capsys):
     csv = _run_up(tmp_path / "run_up.csv")
-    assert main(["fit", str(csv), "-o", str(tmp_path / "model.json"), "--no-report"]) == 0
+    assert main(["fit", str(csv), "-o", str(tmp_path / "model.json"), "--report", str(tmp_path / "r")]) == 0
     capsys.readouterr()
+    # the report says how the speed was read, and that the lines alone cannot settle the tie (on the console only before)
+    md = (tmp_path / "r" / "summary.md").read_text()
+    speed = md.split("## Speed", 1)[1].split("\n## ", 1)[0]
+    assert "speed from the data" in speed and "the 1x line" in speed and "agree with the speed" in speed
+    assert "cannot tell the 1x line" in speed and "h 0.4137" in speed and "tach" in speed
     model = json.loads((tmp_path / "model.json").read_text())
     for d, rows in model["empirical"].items():
         truth = np.array([h for dd, h, _ in LINES if dd == d])
