@@ -375,7 +375,7 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
         radial channel reads its partner's lines by a unit factor (:func:`rwadist.fit_warnings.unit_mixup_warning`:
         one of them in lbf, kgf, in·lbf, ...); no harmonic passed the presence threshold (the model is empty).
     """
-    from . import channel_distortion, data_quality, fit_warnings, speed_whirl
+    from . import channel_distortion, chirp, data_quality, fit_warnings, speed_whirl
     from .empirical import FitSettings, fit_empirical
     from .line_senses import with_senses
     from .spectra import _default_nperseg, compute_spectra
@@ -398,7 +398,8 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     check_run_lengths(test, nperseg or _default_nperseg(int(np.median([r.n_samples for r in test.runs]))))
     spectra = compute_spectra(test, nperseg=nperseg, f_lim=_f_lim(test, f_lim))
     settings = FitSettings(presence_min=presence, epsilon=epsilon, exclude_modes=exclude_modes)
-    result = fit_empirical(spectra, settings, name=name, progress=progress)
+    # a sweep's slices, read in one segment each: every line's amplitudes corrected for its chirp (as the extended fit)
+    result = chirp.unsmeared_fit(test, fit_empirical(spectra, settings, name=name, progress=progress))
     result.model = with_senses(result, test, ("co", "counter"))      # not 'planar' (the FMU's load along x)
     refuse_non_finite_model(result.model, "fit")
     result.model.provenance.update(reading_provenance(getattr(test, "meta", None)))
@@ -407,11 +408,10 @@ def fit(data, *, f_lim: float | None = None, nperseg: int | None = None, presenc
     result.model.provenance.update(model_io.stamp(data if isinstance(data, (str, Path)) else test))
     if text := speed_scale_warning(result, test.meta):
         warnings.warn(RwadistWarning(text.removeprefix("WARNING: ")), stacklevel=2)
-    # a sweep's speed from the data whose 1x line is a tie; a channel in another unit; a radial pair missing a channel;
-    # lines the fit detected but did not measure apart
-    for text in (speed_whirl.fit_tie_warning(test), *fit_warnings.model_warnings(spectra, result, test)):
-        if text:
-            warnings.warn(RwadistWarning(text), stacklevel=2)
+    # a sweep's 1x line a tie; a channel in another unit; a radial pair missing a channel; lines not measured apart
+    for said in ([RwadistWarning(t) for t in (speed_whirl.fit_tie_warning(test),) if t]
+                 + fit_warnings.model_warnings(spectra, result, test)):
+        warnings.warn(said, stacklevel=2)
     if not any(result.model.empirical.values()):
         warnings.warn(RwadistWarning(fit_warnings.empty_model_advice(test, settings, presence)), stacklevel=2)
     return result

@@ -7,6 +7,7 @@ import json
 import os
 import sys
 import time
+import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -19,7 +20,7 @@ from .cli_catalogue import cmd_catalogue_list, cmd_catalogue_show, cmd_model_com
 from .cli_fmu import cmd_fmu_build, cmd_fmu_check  # noqa: F401 (parser)
 from .cli_parser import _version, check_fit_flags, check_parsed, check_psd_flags
 from .data import DataError
-from .errors import ParameterError, RwadistError
+from .errors import ParameterError, RwadistError, UnresolvedLinesWarning
 from .outputs import (
     atomic_dataset_dir,
     check_dataset_dir,
@@ -164,7 +165,10 @@ def cmd_fit(args) -> int:
     test = load_steady(args.data, args)
     if args.cumulative_rpm and report_dir is not None:
         check_within_test(parse_speeds(args.cumulative_rpm, flag="--cumulative-rpm", n_flag=None), test, "cumulative_rpm")
-    fit = run_fit(test, args, name=Path(args.data).name)
+    with warnings.catch_warnings():
+        if args.extended:       # the extended fit measures the lines the empirical one could not tell apart
+            warnings.filterwarnings("ignore", category=UnresolvedLinesWarning)
+        fit = run_fit(test, args, name=Path(args.data).name)
     fit.model.provenance["data"] = str(args.data)
     model = fit.model
     efit = None
@@ -695,8 +699,6 @@ def _library_warnings():
     """The library's warnings (:class:`rwadist.RwadistWarning`) each printed once as one line on stderr, with the
     parameters they name given by their flags, not in Python's warning format: ``WARNING: --speed-rpm 0:10000 rpm
     reaches ...``; a model file's unread keys (:class:`rwadist.model.ModelKeyWarning`) as ``rwadist: warning: ...``."""
-    import warnings
-
     from .errors import RwadistWarning
     from .model import ModelKeyWarning
 

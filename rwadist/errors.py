@@ -74,3 +74,9 @@ class RwadistWarning(UserWarning):
     def __init__(self, text: str, parameter: str | None = None):
         self.text, self.parameter = text, parameter
         super().__init__(text if parameter is None else f"{parameter}: {text}")
+
+
+class UnresolvedLinesWarning(RwadistWarning):
+    """An empirical fit detected harmonics it did not measure apart from a line beside them (the model lacks them:
+    :func:`rwadist.fit_warnings.unresolved_warning`); the extended fit measures them, and ``rwadist fit --extended``
+    silences it."""

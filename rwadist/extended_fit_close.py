@@ -191,17 +191,18 @@ class _Span:
         return out
 
     def merge_smeared(self) -> None:
-        """Neighbouring lines, one of them lost, that no run whose lines chirp (|c| ≥ :data:`SMEAR_MIN_BINS`) measures
-        apart (:meth:`_apart`) are one line's smear: a lost line beside a measured one is dropped; lost ones become one
-        lost line at their mean h.  Only where the runs chirp: on steady runs (and runs of a sweep so slow that a line
-        moves less than that) two lines within a record bin of each other are two lines the records cannot split
-        (``line_property`` "blended_lines" describes them), not one smeared line."""
+        """Neighbouring lines, one of them lost, that no run measures apart (:meth:`_apart`; a pair apart on the slow,
+        nearly steady top of a run-up stays two) are one line's smear: a lost line beside a measured one is dropped;
+        lost ones become one lost line at their mean h.  Only where some run's lines chirp |c| ≥
+        :data:`SMEAR_MIN_BINS`: on steady runs (and a sweep so slow that a line moves less than that) two lines within
+        a record bin of each other are two lines the records cannot split (``line_property`` "blended_lines" describes
+        them), not one smeared line."""
         chirped = [run for run in self.runs if abs(_chirp(self.h.max(), run[7], run[2], run[3])) >= SMEAR_MIN_BINS]
         merged = np.ones(self.h.size)           # lines each lost line stands for (its h their mean)
         while chirped:
             order = np.argsort(self.h)
             pair = next(((a, b) for a, b in zip(order[:-1], order[1:]) if (a in self.lost or b in self.lost)
-                         and not any(self._apart(self.h[[a, b]], run) for run in chirped)), None)
+                         and not any(self._apart(self.h[[a, b]], run) for run in self.runs)), None)
             if pair is None:
                 return
             a, b = pair
@@ -304,8 +305,9 @@ def chirp_transform(n: int, fs: float, offset_hz: np.ndarray, c: float) -> np.nd
 
 
 def _turn(bins, n: int) -> np.ndarray:
-    """e^{−jπ·δ(n − 1)/n}: the linear phase of a window's transform at δ bins (the delay of its centre, (n − 1)/2
-    samples), which turns by π per bin: taken off the table, the rest is smooth to interpolate."""
+    """e^{−jπ·δ(n − 1)/n}: about the linear phase of a window's transform at δ bins (the delay of its centre, n/2
+    samples for the periodic Hann), which turns by π per bin: taken off the table (and put back exactly), the rest is
+    smooth to interpolate."""
     return np.exp(-1j * np.pi * np.asarray(bins, dtype=float) * (n - 1) / n)
 
 

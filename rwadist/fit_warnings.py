@@ -119,7 +119,9 @@ def unresolved_warning(fit, test=None) -> str:
     ±``line_half_width`` bins overlap at every speed): the model lacks them, with no other word (trial nuV's 2.5-kg
     wheel: a run-up's line smeared over its slices, read as two candidates 0.4 % apart, neither measured; family wheel
     1's 30-s run-up: axial h 6.65 and 6.69, the wheel's 6.66).  On a sweep's slices (``test.meta["slicing"]``) such
-    a pair is often one line the speed smears across the slice; on steady runs longer segments resolve a pair."""
+    a pair is often one line the speed smears across the slice; on steady runs longer segments resolve a pair.
+    Its own category (:class:`rwadist.errors.UnresolvedLinesWarning`): ``rwadist fit --extended`` measures those lines
+    and silences it."""
     lost = sorted({(b.direction, round(b.h, 3)) for b in fit.bins
                    if not b.kept and b.reason.startswith("no measurement resolved")})
     if not lost:
@@ -127,14 +129,19 @@ def unresolved_warning(fit, test=None) -> str:
     names = [f"{d} h={h:.4g}" for d, h in lost]
     sliced = "slicing" in (getattr(test, "meta", None) or {})
     return (f"{len(lost)} harmonic(s) the data show were not measured apart from a line beside them "
-            f"({', '.join(names[:6])}{' and more' if names[6:] else ''}; bins.csv in the report gives the reasons): "
+            f"({', '.join(names[:6])}{' and more' if names[6:] else ''}): "
             "the empirical model lacks them; the extended fit (--extended) and rwadist diagnose measure such lines "
             "together on each run's whole record" + (" (a line the speed smears across a slice as one line)" if sliced
                                                      else ", and longer segments (--nperseg) resolve them on the PSDs"))
 
 
 def model_warnings(spectra, fit, test) -> list:
-    """The words of :func:`unit_mixup_warning`, :func:`sense_unread_warning` and :func:`unresolved_warning` on the
-    empirical fit ``fit`` of ``test`` (its ``spectra``), each '' when it has nothing to say."""
-    return [unit_mixup_warning(spectra, fit.model), sense_unread_warning(spectra, fit.model),
-            unresolved_warning(fit, test)]
+    """The warnings (:class:`rwadist.RwadistWarning`) of :func:`unit_mixup_warning`, :func:`sense_unread_warning` and
+    :func:`unresolved_warning` (an :class:`rwadist.errors.UnresolvedLinesWarning`) on the empirical fit ``fit`` of
+    ``test`` (its ``spectra``), those with something to say."""
+    from .errors import RwadistWarning, UnresolvedLinesWarning
+
+    texts = [(unit_mixup_warning(spectra, fit.model), RwadistWarning),
+             (sense_unread_warning(spectra, fit.model), RwadistWarning),
+             (unresolved_warning(fit, test), UnresolvedLinesWarning)]
+    return [kind(text) for text, kind in texts if text]

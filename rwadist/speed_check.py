@@ -102,7 +102,7 @@ def run_line(run, channels: tuple, f0: float, spectra: dict | None = None) -> tu
     den = a - 2 * b + c
     f_peak = (k + (float(np.clip(0.5 * (a - c) / den, -0.5, 0.5)) if den < 0 else 0.0)) * f[1]
     if len(channels) == 2:
-        share, snr = next(iter(slice_senses({ch: v[None, :] for ch, v in spec.items()}, f, PAD,
+        share, snr, _ = next(iter(slice_senses({ch: v[None, :] for ch, v in spec.items()}, f, PAD,
                                             np.array([[f_peak]])).values()))
         return f_peak, float(snr[0, 0]), float(share[0, 0])
     noise = float(np.median(power(k + NOISE_BINS)))

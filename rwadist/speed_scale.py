@@ -26,7 +26,7 @@ therefore found in two steps that assume no line set:
    summed strengths 11.93 against 11.89; every speed 3.6× too high).  Candidates with equally many multiples
    tie: a ball-pass line with its harmonics lies above the rotor's fundamental, so the lowest is taken (unless it is
    the lower speed sideband of a carrier in the tie within SIDEBAND_SPAN: the carrier; or it lies at a cage's ratio,
-   0.35-0.48, of a tied line stronger in the radial-force pair: that line, whose cage it is) and the
+   0.35-0.48, of a tied line 10 times stronger in the radial-force pair: that line, whose cage it is) and the
    others are kept (``tied``) for a second, physical test the data can give (the gyroscopic whirl of the
    wheel's rocking mode reads I_zz/I_rr in proportion to the speed scale, :mod:`rwadist.speed_whirl`); a
    cage line with a harmonic (below 1×) is what that test catches.  Its sense is the sign of the speed.  The
@@ -71,6 +71,11 @@ INTEGER_TOL = 0.004
 #: h 0.21: every speed 4.7x too high in ``rwadist fit``); it stays among the candidates the whirl tests.  Lines of one
 #: pair or of no one sense (a cage in the force alone, a sub-synchronous whirl) do not exclude.
 SLOWEST_LINE = 0.25
+#: The lowest of a tie at a cage's ratio of another tied line is that line's cage when this many times weaker in
+#: power ... (:func:`_far_stronger`)
+CAGE_POWER_RATIO = 10.0
+#: ... in this share of the slices where both stand out
+CAGE_SLICES = 0.8
 #: Speed sidebands of a carrier lie within this share of its order (:func:`_between_sidebands`)
 SIDEBAND_SPAN = 0.15
 #: a line has a rotation sense in a pair when this share of its power turns one way
@@ -231,7 +236,8 @@ def line_orders(f_meas: np.ndarray, orders0: np.ndarray, passes: int = 3) -> np.
 
 # ------------------------------------------------------------------------------------------ rotation sense
 def pair_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray) -> dict:
-    """Per radial pair present: (co share (n_lines,), snr (n_slices, n_lines)); the co share is the median over
+    """Per radial pair present: (co share (n_lines,), snr (n_slices, n_lines), power (n_slices, n_lines): |X|² + |Y|²
+    at the line); the co share is the median over
     the slices where the line stands PAIR_SNR over the local noise in the pair of |X + iY|²/(|X + iY|² +
     |X − iY|²) (nan where it never does): a median, so a slice where a fixed-frequency line crosses it cannot
     outweigh the others.  ``spectra``: channel -> complex
@@ -241,18 +247,18 @@ def pair_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray)
     counter |X − iY|².  The local noise is the median |X|² + |Y|² at ±4..8 native bins off the line (each slice's
     reading: :func:`slice_senses`)."""
     out = {}
-    for key, (share, snr) in slice_senses(spectra, f_pad, pad, f_lines).items():
+    for key, (share, snr, power) in slice_senses(spectra, f_pad, pad, f_lines).items():
         with np.errstate(invalid="ignore"):
             med = np.full(share.shape[1], np.nan)
             seen = np.isfinite(share).any(axis=0)
             med[seen] = np.nanmedian(share[:, seen], axis=0)
-        out[key] = (med, snr)
+        out[key] = (med, snr, power)
     return out
 
 
 def slice_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray) -> dict:
-    """Per radial pair present ("F", "T"): (co share (n_slices, n_lines), snr (n_slices, n_lines)) of each slice
-    apart, the share nan where the line does not stand PAIR_SNR over the local noise: what :func:`pair_senses` takes
+    """Per radial pair present ("F", "T"): (co share (n_slices, n_lines), snr (n_slices, n_lines), power |X|² + |Y|²
+    at the line (n_slices, n_lines)) of each slice apart, the share nan where the line does not stand PAIR_SNR over the local noise: what :func:`pair_senses` takes
     the median of over the slices (same arguments); a steady test's run is one slice
     (:func:`rwadist.speed_check.run_line`)."""
     dfp = f_pad[1] - f_pad[0]
@@ -271,7 +277,7 @@ def slice_senses(spectra: dict, f_pad: np.ndarray, pad: int, f_lines: np.ndarray
         off = sum(np.abs(spectra[c][rows[..., None], ko]) ** 2 for c in pair)
         snr = np.where(ok, line / np.maximum(np.median(off, axis=-1), 1e-300), 0.0)
         co, ct = np.abs(X + 1j * Y) ** 2, np.abs(X - 1j * Y) ** 2
-        out[pair[0][0]] = (np.where(snr >= PAIR_SNR, co / np.maximum(co + ct, 1e-300), np.nan), snr)
+        out[pair[0][0]] = (np.where(snr >= PAIR_SNR, co / np.maximum(co + ct, 1e-300), np.nan), snr, line)
     return out
 
 
@@ -343,13 +349,12 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
                 and _between_sidebands(orders, seen, c)]
     if carriers:
         tied = carriers[:1] + [c for c in tied if c != carriers[0]]
-    # the lowest of a tie at a cage's ratio of a stronger line in the tie: that line (a cage turns one way in force and
-    # torque as the imbalance does, far weaker; a new user's wheel of a 1x, a cage 0.414 and ball-pass lines with no
+    # the lowest of a tie at a cage's ratio of a far stronger line in the tie: that line (a cage turns one way in force
+    # and torque as the imbalance does, far weaker; a new user's wheel of a 1x, a cage 0.414 and ball-pass lines with no
     # integer harmonic had every speed read 2.42x too low on the cage)
-    power = _pair_power(senses, n)
     lo, hi = RATIO_RANGES["FTF"][:2]
     rotors = [c for c in tied[1:] if not carriers and lo <= orders[tied[0]] / orders[c] <= hi
-              and power[c] > power[tied[0]]]
+              and _far_stronger(senses, tied[0], c)]
     if rotors:
         tied = rotors[:1] + [c for c in tied if c != rotors[0]]
     best = tied[0]
@@ -370,27 +375,29 @@ def imbalance_line(orders: np.ndarray, strength: np.ndarray, senses: dict) -> tu
         reason += ("; as many for the line" + ("s" if len(others) > 1 else "") + " at h "
                    + ", ".join(f"{o['h']:.4g}" for o in others)
                    + (": the one midway between two lines (a carrier and its sidebands) taken" if carriers
-                      else f": the one whose cage the lowest would be ({lo:.2f}-{hi:.2f} of it, weaker) taken" if rotors
-                      else ": the lowest taken"))
+                      else f": the one whose cage the lowest would be ({lo:.2f}-{hi:.2f} of it, "
+                      f"{CAGE_POWER_RATIO:g}x weaker) taken" if rotors else ": the lowest taken"))
     return best, float(sense[best]), evidence, reason
 
 
-def _pair_power(senses: dict, n: int) -> np.ndarray:
-    """Per line (n,) its median power over the local noise in the radial-force pair (the radial-torque pair when no
-    force pair is recorded) over the slices where it stands out (:func:`pair_senses`'s snr); 0 where it never does
-    or no pair is recorded.  Not saturated as the template's strength is: a cage line is far weaker than the
-    imbalance whose cage it is."""
+def _far_stronger(senses: dict, weak: int, strong: int) -> bool:
+    """Whether line ``strong``'s power |X|² + |Y|² in the radial-force pair (the radial-torque pair when no force pair
+    is recorded) is :data:`CAGE_POWER_RATIO` times line ``weak``'s or more in :data:`CAGE_SLICES` of the slices where
+    both stand PAIR_SNR over their local noise (3 such slices at least; :func:`pair_senses`): compared slice by slice,
+    at one speed, where C·Ω² makes the ratio (C_strong/C_weak)² (the higher line's wider chirp lowers its peak up to
+    the ratio of their h).  Not over the local noise: a strong line's snr is held down by its own leakage (a new
+    user's 1x over its cage read 4-3000 from slice to slice for a C² ratio of 121); and not a mere "stronger": a line
+    on a mode is lifted 10-30 times, and a one-way line 2.42x above a weak 1x had been taken for the 1x (a reviewer's
+    well-balanced wheel, 6x the 1x's power; one crossing a mode)."""
     key = "F" if "F" in senses else "T" if "T" in senses else None
-    if key is None:
-        return np.zeros(n)
-    if senses[key][1] is None:
-        return np.zeros(n)
-    snr = np.asarray(senses[key][1], dtype=float)
-    out = np.zeros(n)
-    for j in range(n):
-        lit = snr[:, j][snr[:, j] >= PAIR_SNR]
-        out[j] = float(np.median(lit)) if lit.size else 0.0
-    return out
+    got = senses.get(key) if key else None
+    if got is None or len(got) < 3 or got[1] is None or got[2] is None:
+        return False
+    snr, power = np.asarray(got[1], dtype=float), np.asarray(got[2], dtype=float)
+    both = (snr[:, weak] >= PAIR_SNR) & (snr[:, strong] >= PAIR_SNR)
+    if both.sum() < 3:
+        return False
+    return bool(np.mean(power[both, strong] >= CAGE_POWER_RATIO * power[both, weak]) >= CAGE_SLICES)
 
 
 def _between_sidebands(orders: np.ndarray, seen: np.ndarray, c: int) -> bool:

@@ -131,12 +131,14 @@ def test_a_line_smeared_over_a_fast_sweeps_record_is_held_once(tmp_path, capsys,
 
 def _span(h, lost, slope_rad_s2, speeds_rpm=(1000.0, 2000.0, 3000.0), n=8192, fs=8192.0):
     """A span of lines ``h`` (``lost`` the indices the fit did not measure) over runs of one-second records at
-    ``speeds_rpm`` whose speed changes at ``slope_rad_s2`` (the records themselves not needed by the merge)."""
+    ``speeds_rpm`` whose speed changes at ``slope_rad_s2`` (one per run, or one for all; the records themselves not
+    needed by the merge)."""
     from rwadist.extended_fit_close import _Span
 
     span = object.__new__(_Span)
     span.h, span.lost = np.array(h, float), list(lost)
-    span.runs = [(0, rpm * 2 * np.pi / 60, n, fs, [], None, None, slope_rad_s2) for rpm in speeds_rpm]
+    slopes = np.broadcast_to(np.asarray(slope_rad_s2, float), (len(speeds_rpm),))
+    span.runs = [(0, rpm * 2 * np.pi / 60, n, fs, [], None, None, float(a)) for rpm, a in zip(speeds_rpm, slopes)]
     return span
 
 
@@ -162,3 +164,8 @@ def test_candidates_inside_one_smear_are_one_line_and_only_on_a_sweep():
         slow = _span([2.999, 3.0, 3.001], [0, 2], slope)
         slow.merge_smeared()
         assert list(slow.h) == [2.999, 3.0, 3.001] and slow.lost == [0, 2]
+    # two lost lines 0.03 apart that the fast, chirping runs do not measure apart, but the slow top of the run-up
+    # does (a reviewer's case: merged when only the chirping runs were asked): two lines
+    top = _span([3.0, 3.03], [0, 1], (30.0, 20.0, 0.3, 0.2), speeds_rpm=(1000.0, 1500.0, 3000.0, 3200.0))
+    top.merge_smeared()
+    assert list(top.h) == [3.0, 3.03] and top.lost == [0, 1]

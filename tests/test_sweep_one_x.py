@@ -256,26 +256,28 @@ def test_a_ball_pass_with_its_harmonic_is_not_the_one_x_when_it_puts_the_cage_be
     assert best == 2 and "not the line" not in why
 
 
-def _snr(power) -> np.ndarray:
-    """Per-slice pair snr (3 slices, lines) of lines of median power ``power`` over the local noise."""
+def _per_slice(power) -> np.ndarray:
+    """Per-slice values (3 slices, lines) about ``power`` (per line)."""
     return np.tile(np.asarray(power, float), (3, 1)) * np.array([[0.8], [1.0], [1.3]])
 
 
-def test_a_tie_with_a_cage_below_a_stronger_line_takes_the_stronger():
+def test_a_tie_with_a_cage_below_a_far_stronger_line_takes_the_stronger():
     """A new user's wheel (session 64, trial nuA): a 1x, its bearing's cage at 0.4137 and ball-pass lines 3.6871 and
     7.3742, no integer harmonic, every radial line co-rotating: the 1x and the cage tie (one multiple each) and the
-    lowest was taken, every speed 2.42x low.  A tie's lowest at a cage's ratio (0.35-0.48) of a tied line stronger
-    in the radial-force pair is that line's cage: that line taken.  Controls: a 1x stronger than a one-way line at
-    2.42x above it (the 1x the lowest: kept); a cage stronger than the line above it (no ground to move: the lowest)."""
+    lowest was taken, every speed 2.42x low.  A tie's lowest at a cage's ratio (0.35-0.48) of a tied line 10x
+    stronger in the radial-force pair's power, slice by slice, is that line's cage: that line taken.  Controls: a
+    weak 1x with a one-way line 2.42x above it 6x stronger (a reviewer's well-balanced wheel: the lowest, the 1x,
+    kept); a cage stronger than the line above it (no ground to move: the lowest)."""
     orders = np.array([0.4137, 1.0, 3.6871, 7.3742])
     strength = np.full(orders.size, 6.0)                        # saturated: the template's strength tells nothing
     co = np.ones(orders.size)
-    senses = {"F": (co, _snr([40.0, 5000.0, 300.0, 60.0])), "T": (co, _snr([20.0, 900.0, 80.0, 20.0]))}
+    lit = _per_slice([40.0, 900.0, 300.0, 60.0])                # over the local noise: all stand out
+    senses = {"F": (co, lit, _per_slice([4e-3, 0.48, 0.02, 3e-3])), "T": (co, lit, _per_slice([1, 30, 2, 1]))}
     best, _, ev, why = sc.imbalance_line(orders, strength, senses)
     assert best == 1 and [round(t["h"], 4) for t in ev["tied"]] == [0.4137], why
     assert "the one whose cage the lowest would be" in why
-    orders2 = np.array([1.0, 2.42, 3.6871])                     # a 1x and a stronger-than-nothing line 2.42x above
-    senses2 = {"F": (np.ones(3), _snr([5000.0, 40.0, 300.0]))}
+    orders2 = np.array([1.0, 2.42, 3.6871])
+    senses2 = {"F": (np.ones(3), _per_slice([900.0, 900.0, 300.0]), _per_slice([0.16, 1.0, 0.2]))}
     assert sc.imbalance_line(orders2, np.full(3, 6.0), senses2)[0] == 0
-    senses3 = {"F": (co, _snr([9000.0, 5000.0, 300.0, 60.0]))}
+    senses3 = {"F": (co, lit, _per_slice([0.9, 0.48, 0.02, 3e-3]))}
     assert sc.imbalance_line(orders, strength, senses3)[0] == 0
