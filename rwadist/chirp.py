@@ -182,6 +182,9 @@ def unsmeared_fit(test, fit):
         return fit
     out = []
     for x in lines:
+        if not np.any(x.used):          # nothing to fit C to (the fit's own C of such a line kept as it is)
+            out.append(x)
+            continue
         w = np.abs(np.asarray(x.speed, dtype=float))
         run = np.unique(w, return_inverse=True)[1]           # one speed per run (as unsmeared_lines reads them)
         C = line_C(x.amplitude[x.used], w[x.used])
