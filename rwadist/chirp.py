@@ -31,6 +31,11 @@ def speed_rates(t_mid, speeds) -> np.ndarray:
     """|dΩ/dt| of each run of one sweep, rad/s², in the order given: ``np.gradient`` of the speeds (rad/s) against the
     runs' centre times ``t_mid`` (s), taken in time order.  NaN for a run without a speed (0 or nan); all NaN with
     fewer than 3 runs with a speed or two of them at one time (not one sweep: steady runs all start at 0)."""
+    return np.abs(_gradient(t_mid, speeds))
+
+
+def _gradient(t_mid, speeds) -> np.ndarray:
+    """:func:`speed_rates` signed: ``np.gradient`` of ``speeds`` against ``t_mid`` in time order (same NaN rules)."""
     t = np.asarray(t_mid, dtype=float)
     w = np.asarray(speeds, dtype=float)
     out = np.full(w.shape, np.nan)
@@ -40,8 +45,13 @@ def speed_rates(t_mid, speeds) -> np.ndarray:
     idx = np.flatnonzero(ok)[np.argsort(t[ok], kind="stable")]
     if np.any(np.diff(t[idx]) <= 0):
         return out
-    out[idx] = np.abs(np.gradient(w[idx], t[idx]))
+    out[idx] = np.gradient(w[idx], t[idx])
     return out
+
+
+def _centres(test) -> np.ndarray:
+    """Each run's centre time, s (its ``t0`` the first sample's time)."""
+    return np.array([r.t0 + 0.5 * r.n_samples / r.sample_rate for r in test.runs])
 
 
 def sliced_rates(test) -> np.ndarray | None:
@@ -49,25 +59,17 @@ def sliced_rates(test) -> np.ndarray | None:
     first sample's time), in the test's run order; None for any other test (steady runs)."""
     if test is None or "slicing" not in (getattr(test, "meta", None) or {}):
         return None
-    t_mid = [r.t0 + 0.5 * r.n_samples / r.sample_rate for r in test.runs]
-    rates = speed_rates(t_mid, [r.speed for r in test.runs])
+    rates = speed_rates(_centres(test), [r.speed for r in test.runs])
     return rates if np.isfinite(rates).any() else None
 
 
 def sliced_slopes(test) -> np.ndarray | None:
     """d|Ω|/dt (rad/s², signed: > 0 while the wheel speeds up) of each run of a test cut from a sweep, in the test's
-    run order (``np.gradient`` of |speed| against the runs' centre times, taken in time order); None for any other
-    test (:func:`sliced_rates`) and NaN for a run without a speed."""
-    rates = sliced_rates(test)
-    if rates is None:
+    run order (:func:`speed_rates` of |speed|, its sign kept); None for any other test (:func:`sliced_rates`) and NaN
+    for a run without a speed."""
+    if sliced_rates(test) is None:
         return None
-    t_mid = np.array([r.t0 + 0.5 * r.n_samples / r.sample_rate for r in test.runs])
-    speed = np.abs([r.speed for r in test.runs])
-    ok = np.isfinite(rates)
-    idx = np.flatnonzero(ok)[np.argsort(t_mid[ok], kind="stable")]
-    out = np.full(speed.shape, np.nan)
-    out[idx] = np.gradient(speed[idx], t_mid[idx])
-    return out
+    return _gradient(_centres(test), np.abs([r.speed for r in test.runs]))
 
 
 def chirp_bins(h, rate, seconds: float):
