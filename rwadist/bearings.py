@@ -250,7 +250,7 @@ def _relations(h: float, resolution: float, others, parents=()) -> list:
     out = []
     multiple_of: dict = {}              # a multiple's sentence -> the line it is a multiple of
     cage = [RATIO_RANGES[k][:2] for k in ("FTF", "FTF_outer")]
-    for o in others:
+    for o in _distinct_lines(others, resolution):
         if abs(o - h) <= resolution:
             continue
         if any(lo <= o <= hi for lo, hi in cage) and h > 1.5:
@@ -286,6 +286,21 @@ def _relations(h: float, resolution: float, others, parents=()) -> list:
     return list(dict.fromkeys(x[2] for x in out))
 
 
+def _distinct_lines(ratios, resolution: float) -> list:
+    """The ratios ``ratios`` with each run of them closer than ``resolution`` to the next taken as one line at their
+    mean, ascending: one line read in several directions (a cage at 0.4137 in the radial force and 0.4138 in the
+    torque) is one line, and the relations it takes part in are said once (a new user's report named one ball pass
+    twice, "whose cage is the line h = 0.4137" and "... h = 0.4138")."""
+    vals = sorted(float(o) for o in ratios)
+    groups: list[list[float]] = []
+    for v in vals:
+        if groups and v - groups[-1][-1] <= resolution:
+            groups[-1].append(v)
+        else:
+            groups.append([v])
+    return [sum(g) / len(g) for g in groups]
+
+
 def _ordinal(k: int) -> str:
     """2nd, 3rd, 4th, ..., 11th, 12th, 13th, 21st, ..."""
     return f"{k}{'th' if 10 <= k % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(k % 10, 'th')}"
@@ -299,7 +314,7 @@ def _combinations(h: float, resolution: float, others) -> list:
     trial's quadratic load cell channel: 3.22 = 3.63 − 0.41 and 4.04 = 3.63 + 0.41 were named ball passes of 8- and
     10-ball bearings and nothing said they were combinations."""
     out = []
-    uniq = sorted(set(float(o) for o in others))
+    uniq = _distinct_lines(others, resolution)
     for i, a in enumerate(uniq):
         for b in uniq[:i]:                              # b < a
             for value, word, sign in ((a + b, "sum", "+"), (a - b, "difference", "−")):

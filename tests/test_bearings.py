@@ -125,6 +125,22 @@ def test_one_line_read_in_several_directions_is_one_relation():
     assert len(multiples) == 1 and len(causes) == len(set(causes))
 
 
+def test_a_cage_read_a_little_apart_in_two_directions_is_one_cage_of_the_ball_pass():
+    """Session 64's trial: the cage read at 0.4137 in one direction and 0.4138 in another, within the resolution of
+    each other; report.md named the 9-ball pass over the still race twice, once per reading ("whose cage is the line
+    h = 0.4137 (9 × 0.4137 = 3.723)" and "h = 0.4138 (... 3.724)"), and each sum and difference with them twice.  A
+    closed form decides: 9 × 0.41375 = 3.72375, h + 0.41375 = 4.1375 is their sum."""
+    causes = line_causes(3.72375, 0.002, others=[0.4137, 0.4138, 1.0])
+    passes = [x for x in causes if x.startswith("ball pass over the still race of a 9-ball bearing")]
+    assert len(passes) == 1 and "h = 0.4138 (9 × 0.4138 = 3.724)" in passes[0], causes
+    sums = [x for x in line_causes(4.1375, 0.002, parents=[3.72375, 0.4137, 0.4138]) if x.startswith("the sum")]
+    assert len(sums) == 1 and "h = 3.724 and 0.4138" in sums[0], sums
+    # lines more than the resolution apart stay two lines, each with its own relation (3.4 = 3 + 0.40, and 3 + 0.4031
+    # within twice the resolution)
+    two = [x for x in line_causes(3.40, 0.002, parents=[3.0, 0.40, 0.4031]) if x.startswith("the sum")]
+    assert len(two) == 2, two
+
+
 def test_relations_that_hold_exactly_come_before_those_within_the_tolerance_only():
     """trial14's 11-ball bearing (d 7.144 mm, pitch 42 mm, 20°, inner race turning), its ratios from the closed form
     FTF = ½(1 − (d/D)·cos α), BPFO = n·FTF, BPFI = n − BPFO, BSF: the line 2·BPFO is first the 2nd multiple of BPFO
