@@ -117,5 +117,9 @@ def test_spin_acceleration_on_the_default_command_is_the_ramp(tmp_path, case):
     ramp = (end - start) * RPM / duration          # dΩ/dt: negative on the run-down (printed unsigned before)
     assert spin[0]["alpha_rad_s2"] == pytest.approx(ramp, rel=0.01)
     assert spin[0]["alpha_residual_rad_s2"] == pytest.approx(ramp, rel=0.25)
+    # a ramp's slices are one acceleration each: the slowest and fastest between them within 5 % of it, no word of
+    # a compromise (tests/test_spin_acceleration_span.py has the exponential run's)
+    assert spin[0]["alpha_slowest_rad_s2"] == pytest.approx(ramp, rel=0.05)
+    assert spin[0]["alpha_fastest_rad_s2"] == pytest.approx(ramp, rel=0.05)
     console = (tmp_path / "r" / "report.md").read_text()
-    assert ("(a run-down)" in console) == (ramp < 0)
+    assert ("(a run-down)" in console) == (ramp < 0) and "one α for slices" not in console

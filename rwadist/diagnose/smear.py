@@ -109,20 +109,39 @@ def segment_chirp(alpha: float, h: float, nperseg: int, fs: float) -> float:
     return abs(float(alpha)) * h * (nperseg / fs) ** 2 / (2 * np.pi)
 
 
-def speed_track(ctx, runs, signed: bool = False) -> float:
-    """Median |dΩ/dt| (rad/s²; ``signed``: dΩ/dt, negative on a run-down) of the runs' speeds against their start
-    times (runs of one sweep, ``Run.t0`` distinct), or NaN (no time series, fewer than 3 runs, start times not known or
-    repeated)."""
+def _track_rates(ctx, runs) -> np.ndarray | None:
+    """dΩ/dt (rad/s², signed) between each two runs next in start time (runs of one sweep, ``Run.t0`` distinct), or
+    None (no time series, fewer than 3 runs, start times not known or repeated)."""
     if ctx.test is None or len(runs) < 3:
-        return float("nan")
+        return None
     t0 = np.array([ctx.test.runs[r].t0 for r in runs], dtype=float)
     w = np.asarray(ctx.omega, dtype=float)[runs]
     order = np.argsort(t0)
     dt = np.diff(t0[order])
     if not np.all(np.isfinite(t0)) or np.any(dt <= 0):
+        return None
+    return np.diff(w[order]) / dt
+
+
+def speed_track(ctx, runs, signed: bool = False) -> float:
+    """Median |dΩ/dt| (rad/s²; ``signed``: dΩ/dt, negative on a run-down) of the runs' speeds against their start
+    times (runs of one sweep, ``Run.t0`` distinct), or NaN (no time series, fewer than 3 runs, start times not known or
+    repeated)."""
+    rates = _track_rates(ctx, runs)
+    if rates is None:
         return float("nan")
-    rates = np.diff(w[order]) / dt
     return float(np.median(rates if signed else np.abs(rates)))
+
+
+def track_span(ctx, runs) -> tuple[float, float]:
+    """(slowest, fastest) dΩ/dt (rad/s², signed) between runs next in start time, by |dΩ/dt|: how far one acceleration
+    (the median, :func:`speed_track`) is from the sweep's own (a motor's exponential run-down falls from its fastest
+    at the start to a crawl at the end); (NaN, NaN) when :func:`speed_track` is NaN."""
+    rates = _track_rates(ctx, runs)
+    if rates is None:
+        return float("nan"), float("nan")
+    order = np.argsort(np.abs(rates), kind="stable")
+    return float(rates[order[0]]), float(rates[order[-1]])
 
 
 def sweep_sign(ctx) -> float:

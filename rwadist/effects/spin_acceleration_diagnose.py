@@ -7,7 +7,7 @@ import numpy as np
 
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context, noise_estimate
-from ..diagnose.smear import speed_track
+from ..diagnose.smear import speed_track, track_span
 from ..diagnose.state import State
 from ..units import CHANNELS
 
@@ -27,6 +27,7 @@ class SpinAcceleration:
     alpha_track: float = float("nan")
     noise: dict | None = None        # instrument noise re-estimated with the smeared lines masked
     alpha_residual: float = float("nan")
+    alpha_span: tuple = (float("nan"), float("nan"))   # the slowest and fastest dΩ/dt between slices (track_span)
     kind: str = "spin_acceleration"
 
     @property
@@ -51,7 +52,9 @@ class SpinAcceleration:
 
     def params(self) -> dict:
         return {"alpha_rad_s2": self.alpha, "alpha_track_rad_s2": _or_none(self.alpha_track),
-                "alpha_residual_rad_s2": _or_none(self.alpha_residual), "role": "measurement"}
+                "alpha_residual_rad_s2": _or_none(self.alpha_residual),
+                "alpha_slowest_rad_s2": _or_none(self.alpha_span[0]), "alpha_fastest_rad_s2": _or_none(self.alpha_span[1]),
+                "role": "measurement"}
 
     @staticmethod
     def track(ctx: Context, runs) -> float:
@@ -95,7 +98,8 @@ class SpinAcceleration:
         res = optimize.minimize_scalar(cost, bounds=(0.0, a_max), method="bounded",
                                        options={"xatol": 1e-3 * a_max})
         trial = state.plus(SpinAcceleration(track))
-        return SpinAcceleration(signed, signed, noise_estimate(ctx, trial), sign * float(res.x))
+        return SpinAcceleration(signed, signed, noise_estimate(ctx, trial), sign * float(res.x),
+                                track_span(ctx, np.asarray(runs)))
 
     @staticmethod
     def candidates(ctx: Context, state: State, runs) -> list:
