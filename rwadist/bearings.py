@@ -247,10 +247,11 @@ def _relations(h: float, resolution: float, others, parents=()) -> list:
     line).  trial14's 11-ball bearing: 9.242 was first
     "16 × 0.5799 = 9.278", 14 whole-record bins off, before the exact 2nd multiple of 4.621."""
     n_lo, n_hi = BALL_COUNTS
-    out = []
+    found: list = []                    # (key: the relation and the line's group, (closeness, rank, sentence))
     multiple_of: dict = {}              # a multiple's sentence -> the line it is a multiple of
     cage = [RATIO_RANGES[k][:2] for k in ("FTF", "FTF_outer")]
-    for o in _distinct_lines(others, resolution):
+    group = _line_groups(others, resolution)
+    for o in sorted(group):
         if abs(o - h) <= resolution:
             continue
         if any(lo <= o <= hi for lo, hi in cage) and h > 1.5:
@@ -258,16 +259,18 @@ def _relations(h: float, resolution: float, others, parents=()) -> list:
                 n = round(h / base)
                 tol = min(resolution * (1 + n), BALL_PASS_REL_TOL * h)
                 if n_lo <= n <= n_hi and abs(h - n * base) <= tol:
-                    out.append((abs(h - n * base) / tol, 2,
-                                f"ball pass {name} of a {n}-ball bearing whose cage is the line h = {o:.4g} "
-                                f"({n} × {base:.4g} = {n * base:.4g})"))
+                    found.append((("pass", name, n, group[o]),
+                                  (abs(h - n * base) / tol, 2,
+                                   f"ball pass {name} of a {n}-ball bearing whose cage is the line h = {o:.4g} "
+                                   f"({n} × {base:.4g} = {n * base:.4g})")))
         s = h + o
         n = round(s)
         if n_lo <= n <= n_hi and abs(s - n) <= 2 * resolution and abs(o - round(o)) > 2 * resolution \
                 and RATIO_RANGES["FTF"][0] <= min(h, o) / n <= RATIO_RANGES["FTF"][1]:
-            out.append((abs(s - n) / (2 * resolution), 1,
-                        f"an outer/inner ball-pass pair of a {n}-ball bearing with the line h = {o:.4g} "
-                        f"(BPFO + BPFI = n; cage {min(h, o) / n:.4g})"))
+            found.append((("pair", n, group[o]),
+                          (abs(s - n) / (2 * resolution), 1,
+                           f"an outer/inner ball-pass pair of a {n}-ball bearing with the line h = {o:.4g} "
+                           f"(BPFO + BPFI = n; cage {min(h, o) / n:.4g})")))
         k = round(h / o) if o > 0 else 0
         # a cage-range line's multiples beyond the 3rd are its ball passes' relation (BPFO = Z·FTF), said above
         top = 3 if any(lo <= o <= hi for lo, hi in cage) else MAX_MULTIPLE
@@ -275,7 +278,8 @@ def _relations(h: float, resolution: float, others, parents=()) -> list:
             sentence = (f"the {_ordinal(k)} multiple of the line h = {o:.4g} (a harmonic of that line's cause: a "
                         "bearing line's impacts are not sinusoidal)")
             multiple_of[sentence] = o
-            out.append((abs(h - k * o) / (k * resolution), 0, sentence))
+            found.append((("multiple", k, group[o]), (abs(h - k * o) / (k * resolution), 0, sentence)))
+    out = _closest_of_each(found)
     out += _combinations(h, resolution, [o for o in parents if abs(o - h) > resolution and o > 0])
     # of the multiples that hold, the one of the lowest line first: the series' own base (trial nuR's impacts at
     # 3.31·k: h 13.24 read "the 2nd multiple of 6.62" and h 29.79 "the 3rd of 9.93")
@@ -286,19 +290,30 @@ def _relations(h: float, resolution: float, others, parents=()) -> list:
     return list(dict.fromkeys(x[2] for x in out))
 
 
-def _distinct_lines(ratios, resolution: float) -> list:
-    """The ratios ``ratios`` with each run of them closer than ``resolution`` to the next taken as one line at their
-    mean, ascending: one line read in several directions (a cage at 0.4137 in the radial force and 0.4138 in the
-    torque) is one line, and the relations it takes part in are said once (a new user's report named one ball pass
-    twice, "whose cage is the line h = 0.4137" and "... h = 0.4138")."""
-    vals = sorted(float(o) for o in ratios)
-    groups: list[list[float]] = []
-    for v in vals:
-        if groups and v - groups[-1][-1] <= resolution:
-            groups[-1].append(v)
-        else:
-            groups.append([v])
-    return [sum(g) / len(g) for g in groups]
+def _line_groups(ratios, resolution: float) -> dict:
+    """Each distinct ratio of ``ratios`` -> the index of its line: ascending, a ratio is the line of the group it
+    starts unless it lies within ``resolution`` of that group's first ratio (a group spans the resolution at most, so
+    a run of lines each a little closer than it to the next stays several lines).  One line read in several
+    directions (a cage at 0.4137 in the radial force and 0.4138 in the torque) is one line: a relation of it is named
+    once (:func:`_closest_of_each`), not once per reading (a new user's report named one ball pass twice, "whose cage
+    is the line h = 0.4137" and "... h = 0.4138")."""
+    out: dict = {}
+    first, index = None, -1
+    for v in sorted({float(o) for o in ratios}):
+        if first is None or v - first > resolution:
+            first, index = v, index + 1
+        out[v] = index
+    return out
+
+
+def _closest_of_each(found: list) -> list:
+    """The (closeness, rank, sentence) of least closeness of each key of ``found`` [(key, entry)], in the order the
+    keys first appear: of one line's readings, the one that holds a relation best names it."""
+    best: dict = {}
+    for key, entry in found:
+        if key not in best or entry[0] < best[key][0]:
+            best[key] = entry
+    return list(best.values())
 
 
 def _ordinal(k: int) -> str:
@@ -313,15 +328,19 @@ def _combinations(h: float, resolution: float, others) -> list:
     or the measuring chain (a quadratic term makes every sum and difference of the lines it carries).  The new-user
     trial's quadratic load cell channel: 3.22 = 3.63 − 0.41 and 4.04 = 3.63 + 0.41 were named ball passes of 8- and
     10-ball bearings and nothing said they were combinations."""
-    out = []
-    uniq = _distinct_lines(others, resolution)
+    found = []
+    group = _line_groups(others, resolution)
+    uniq = sorted(group)
     for i, a in enumerate(uniq):
         for b in uniq[:i]:                              # b < a
+            if group[a] == group[b]:
+                continue                                # two readings of one line
             for value, word, sign in ((a + b, "sum", "+"), (a - b, "difference", "−")):
                 if abs(h - value) <= 2 * resolution:
-                    out.append((abs(h - value) / (2 * resolution), 1,
-                                f"the {word} of the lines h = {a:.4g} and {b:.4g} ({a:.4g} {sign} {b:.4g} = {value:.4g}): "
-                                "one modulating the other (a bearing defect's line carried round by the cage or the "
-                                "shaft) or a nonlinearity of the structure or the measuring chain, which puts lines at "
-                                "every sum and difference of the lines it carries"))
-    return out
+                    found.append(((word, group[a], group[b]),
+                                  (abs(h - value) / (2 * resolution), 1,
+                                   f"the {word} of the lines h = {a:.4g} and {b:.4g} ({a:.4g} {sign} {b:.4g} = "
+                                   f"{value:.4g}): one modulating the other (a bearing defect's line carried round by the "
+                                   "cage or the shaft) or a nonlinearity of the structure or the measuring chain, which "
+                                   "puts lines at every sum and difference of the lines it carries")))
+    return _closest_of_each(found)

@@ -41,7 +41,8 @@ def _typed(doc: dict, path: tuple) -> bool:
 
 
 #: fields that may be negative (signed lengths, phases, accelerations, speed pairs)
-_SIGNED = {"height_m", "r_m", "alpha_rad_s2", "alpha_track_rad_s2", "alpha_residual_rad_s2", "counter_fraction_phase", "excluded_rpm"}
+_SIGNED = {"height_m", "r_m", "alpha_rad_s2", "alpha_track_rad_s2", "alpha_residual_rad_s2", "alpha_slowest_rad_s2",
+           "alpha_fastest_rad_s2", "counter_fraction_phase", "excluded_rpm"}
 
 
 def _mutate(doc: dict, rng: random.Random) -> tuple:

@@ -14,8 +14,9 @@ from .element import Element, num
 class SpinAcceleration(Element):
     """The runs were recorded while the wheel accelerated at alpha_rad_s2 (rad/s², dΩ/dt from the runs' speeds against
     their start times: negative on a run-down); alpha_residual_rad_s2 is the acceleration that best explains the
-    residual alone, the check; alpha_slowest_rad_s2 and alpha_fastest_rad_s2 the slowest and fastest dΩ/dt between
-    runs next in time (one α, their median, stands for them all).  Measurement only."""
+    residual alone, the check; alpha_slowest_rad_s2 and alpha_fastest_rad_s2 the slowest and fastest dΩ/dt over an
+    eighth of the runs (:func:`rwadist.diagnose.smear.track_span`: one α, the median, stands for them all).
+    Measurement only."""
 
     KIND: ClassVar[str] = "spin_acceleration"
     ORDER: ClassVar[int] = 90
@@ -41,10 +42,10 @@ SPREAD_SAID = 2.0
 
 
 def _span_text(e: Mapping) -> str:
-    """'; one α for slices from ... to ... rad/s²: ...' when the sweep's dΩ/dt between slices spreads over a factor
-    :data:`SPREAD_SAID` or more (a motor's exponential run-down), else ''."""
+    """'; one α for slices from ... to ... rad/s²: ...' when the sweep's dΩ/dt spreads over a factor :data:`SPREAD_SAID`
+    or more (a motor's exponential run-down) one way (a sweep that dwells or turns back is not this: '')."""
     slow, fast = e.get("alpha_slowest_rad_s2"), e.get("alpha_fastest_rad_s2")
-    if slow is None or fast is None or not abs(fast) >= SPREAD_SAID * abs(slow):
+    if slow is None or fast is None or not slow * fast > 0 or not abs(fast) >= SPREAD_SAID * abs(slow):
         return ""
     return (f"; one α for slices whose dΩ/dt runs from {num(slow, '.3g')} to {num(fast, '.3g')} rad/s²: the fastest "
             "slices' smear is predicted short and the slowest's long")
