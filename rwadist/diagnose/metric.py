@@ -148,9 +148,10 @@ class Metric:
         segments at 50 % overlap (the phase difference turns by 2πx from one segment to the next).  A line's
         image at −f (a channel is a real signal) beats with the line itself and its neighbours near 0 Hz as a
         line of phase −φ.  The lines and their sidebands as :meth:`predict` has them (each within ±KERNEL_HALF of
-        its bin), under a speed ripple with its orders near the line (:meth:`_ripple_parts`); zero under a spin smear
-        (its lines are no steady lines) and for other windows (the term is not modelled).  Cached on the state; each pair's shape on the context; a subset of the
-        runs whose variance on every run is kept reads its rows (a pair near only in other runs adds exact zeros)."""
+        its bin), under a speed ripple with its orders near the line (:meth:`_ripple_parts`); under a spin smear as the
+        steady lines' at the runs' mean speeds; zero for other windows (the term is not modelled).  Cached on the
+        state; each pair's shape on the context; a subset of the runs whose variance on every run is kept reads its
+        rows (a pair near only in other runs adds exact zeros)."""
         key = ("beat", c, runs.tobytes())
         if key in state._cache:
             return state._cache[key]
@@ -160,7 +161,12 @@ class Metric:
             state._cache[key] = whole[pos]
             return state._cache[key]
         out = np.zeros((runs.size, self.n_bands))
-        if state.smear is None and self.sp.window == "hann":
+        # under a spin smear too: a co/counter pair's parts turn together (one relative phase over the whole run, every
+        # segment's Fx/Fy split alike) and lines near each other sweep together, so their beats stay.  Zero there, the
+        # smear at any |α| > 0 counted as misplaced power what the steady lines' beats allow for (the E wheel's 8-s run-up
+        # with its radial-force lines planar: 1.188 without a smear, 1.883 at α 1e-6 rad/s²), and the smear's own test
+        # (SpinAcceleration.fit, its cost at α 0 against the track's) compared two states without beats
+        if self.sp.window == "hann":
             comps, mixed = [], []
             for (h, law, amp, _), mix in zip(self.channel_lines(state, c, runs), self.line_mixing(state, c, runs)):
                 f0 = h * self.omega[runs] / (2 * np.pi)
