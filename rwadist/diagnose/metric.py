@@ -162,7 +162,8 @@ class Metric:
             return state._cache[key]
         out = np.zeros((runs.size, self.n_bands))
         # under a spin smear too: a co/counter pair's parts turn together (one relative phase over the whole run, every
-        # segment's Fx/Fy split alike) and lines near each other sweep together, so their beats stay.  Zero there, the
+        # segment's Fx/Fy split alike), so their beat stays, in sum (the steady kernel places it, not the smeared
+        # shape; near lines' beats under a chirp are larger than the steady formula's).  Zero there, the
         # smear at any |α| > 0 counted as misplaced power what the steady lines' beats allow for (the E wheel's 8-s run-up
         # with its radial-force lines planar: 1.188 without a smear, 1.883 at α 1e-6 rad/s²), and the smear's own test
         # (SpinAcceleration.fit, its cost at α 0 against the track's) compared two states without beats
