@@ -162,9 +162,8 @@ def sweep_sign(ctx) -> float:
     test = ctx.test
     if test is None or len(ctx.runs) < 2:
         return 1.0
-    # a start time of 0.0 is a time (the first slice's), not a missing one
-    t0 = np.array([np.nan if getattr(test.runs[r], "t0", None) is None else test.runs[r].t0 for r in ctx.runs],
-                  dtype=float)
+    # read as _track reads them: every Run has a start time, and the first slice's 0.0 is one (``t0 or nan`` was not)
+    t0 = np.array([test.runs[r].t0 for r in ctx.runs], dtype=float)
     w = np.abs(np.asarray(ctx.omega, dtype=float)[ctx.runs])
     if not np.all(np.isfinite(t0)) or np.ptp(t0) <= 0:
         return 1.0
