@@ -205,8 +205,13 @@ def settle(test, run) -> tuple:
                                       + ", ".join(f"{r:.4g}" for r in sc2.get("ratios", [])) + ")"))
             return t2, d2
     diagnosis = run(test, None)
-    scale["whirl"] = dict(rec, status="disagrees", inertia_ratio=rho, rocking_located=whirl_ratio(diagnosis) is not None,
-                          text=(f"the gyroscopic whirl reads I_zz/I_rr {rho:.3g}, outside {lo:.2g}-{hi:.2g} (no rigid "
+    located = whirl_ratio(diagnosis) is not None
+    # a rocking mode the fit did not locate still carries the whirl it was fitted with: said as such, not as a reading
+    # (a new user's run-up: "reads I_zz/I_rr 0.145" beside "rocking at rest not located")
+    reads = ("the gyroscopic whirl reads" if located else
+             "the rocking mode was not located; the whirl it was fitted with gives")
+    scale["whirl"] = dict(rec, status="disagrees", inertia_ratio=rho, rocking_located=located,
+                          text=(f"{reads} I_zz/I_rr {rho:.3g}, outside {lo:.2g}-{hi:.2g} (no rigid "
                                 "rotor exceeds 2; a flywheel is above 1)"
                                 + (f"; candidate scales tried: {'; '.join(tried)}" if tried else
                                    "; no other 1x candidate brings it into the band")),

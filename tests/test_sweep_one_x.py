@@ -152,6 +152,33 @@ def test_settle_follows_the_whirl_and_says_when_it_cannot():
     assert sw.speed_record({})["source"] == "measured"
 
 
+def test_a_whirl_of_a_rocking_mode_not_located_is_said_as_no_reading():
+    """A diagnosis whose rocking mode is not located (``unconstrained``) still carries the ratio it was fitted with;
+    settle's verdict says the mode was not located rather than that the whirl "reads" that ratio (a new user's run-up:
+    "the gyroscopic whirl reads I_zz/I_rr 0.145" beside "rocking at rest not located")."""
+    from rwadist.diagnose.search import BaseRejected
+
+    test, _, _ = _sliced(30.0)
+
+    class Unlocated:
+        entry = {"kind": "suspension_modes", "inertia_ratio": 0.145, "unconstrained": ["rocking"]}
+
+        def summary(self):
+            return {"effects": [self.entry]}
+
+    def run(t, check):
+        e = Unlocated()
+        if check is not None and not check(e.entry):
+            raise BaseRejected(e.entry)
+        return e
+
+    kept, _ = sw.settle(test, run)
+    whirl = kept.meta["slicing"]["speed_scale"]["whirl"]
+    assert whirl["status"] == "disagrees" and whirl["rocking_located"] is False
+    assert whirl["text"].startswith("the rocking mode was not located") and "whirl reads" not in whirl["text"]
+    assert "suspect" in whirl["warning"]
+
+
 def test_report_says_how_the_speed_was_obtained(tmp_path):
     """Hard-mounted (no modes: nothing the whirl can read) 30-s run-up of trial 11's wheel: diagnose's summary.json
     and report.md say the speed came from the data, which line is 1x, the ratios, the agreement and that the data
