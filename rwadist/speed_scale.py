@@ -92,6 +92,13 @@ PEAK_PROMINENCE = 0.2
 FIXED_PRESENCE = 0.5
 #: ... and such points are left out of the registration only while they hold less than this share of all content
 FIXED_SHARE = 0.5
+#: Fixed points closer than this many grid steps (0.02 in ln f) are one group, whose content must stand still: the
+#: centroid of each third's median content over the group widened by FIXED_WINDOW of its width on either side moves
+#: by at most FIXED_MOVE of its width between the thirds (a pickup stands; a wheel's low line, lit over several 1 Hz
+#: bins, is lit at one point through a sweep of x1.5 and moves)
+FIXED_GAP = 100
+FIXED_WINDOW = 2
+FIXED_MOVE = 0.1
 
 
 @dataclass(frozen=True)
@@ -173,8 +180,11 @@ def fixed_content(L: np.ndarray, active: np.ndarray) -> np.ndarray:
     """Per point of the registration grid (n_u,), True where the log content ``L`` (n_slices, n_u) holds a line in
     :data:`FIXED_PRESENCE` of the ``active`` slices or more in each third of the record: content at a fixed
     frequency (a 50 Hz pickup, a machine of the stand), where a sweep's lines pass in a few slices each.  In each
-    third, not over the whole: a run-down that slows exponentially dwells near its lowest speed, and its 1x line
-    sat at 6.5-7.7 Hz in over half the slices of family wheel 2's 90-s run-down (the late ones only).  All False when those points hold
+    third, not over the whole: a run-down that slows exponentially dwells near its lowest speed, and its 1x line,
+    lit over several 1 Hz bins, lit 6.5-7.7 Hz in over half the slices of a 90-s run-down of family wheel 2 (the late
+    ones only).  A group of such points is fixed only when the content around it stands still from third to third
+    (:data:`FIXED_MOVE`): a sweep of x1.5 lights the middle of a wheel's low line in every slice (a new user's wheel at
+    1000-1500 rpm: its cage and 1x masked, 8 of 60 slices right; all 60 without).  All False when those points hold
     :data:`FIXED_SHARE` of the content or more: the lines themselves stand still (a record that hardly sweeps), and
     there is no pattern without them."""
     rows = L[np.asarray(active, dtype=bool)]
@@ -186,6 +196,15 @@ def fixed_content(L: np.ndarray, active: np.ndarray) -> np.ndarray:
     total = float(np.sum(rows))
     if not fixed.any() or total <= 0.0 or float(np.sum(rows[:, fixed])) >= FIXED_SHARE * total:
         return np.zeros(L.shape[1], dtype=bool)
+    medians = [np.median(part, axis=0) for part in np.array_split(rows, 3)]
+    idx = np.flatnonzero(fixed)
+    for group in np.split(idx, np.flatnonzero(np.diff(idx) > FIXED_GAP) + 1):
+        width = group[-1] - group[0] + 1
+        lo, hi = max(group[0] - FIXED_WINDOW * width, 0), min(group[-1] + FIXED_WINDOW * width + 1, L.shape[1])
+        x = np.arange(lo, hi)
+        centres = [float(np.sum(x * m[lo:hi]) / max(float(np.sum(m[lo:hi])), 1e-30)) for m in medians]
+        if max(centres) - min(centres) > FIXED_MOVE * width:
+            fixed[group[0]:group[-1] + 1] = False
     return fixed
 
 
@@ -194,14 +213,18 @@ def relative_track(L: np.ndarray, u: np.ndarray, active: np.ndarray) -> np.ndarr
     passes against the template (module docstring).  The first active slice is 0.
 
     Content at a fixed frequency (:func:`fixed_content`) is left out of the registration: it correlates at lag 0
-    between every two slices and pulls each step towards standing still (a 2 % pickup at 50 Hz on a 90-s run-down
-    from 4000 rpm read as 2048-sample slices: the track spanned ln 1.82 for the sweep's 2.56, and the cage was taken
+    between every two slices and pulls each step towards standing still (a 2 % pickup at 50 Hz on a new user's 90-s
+    run-down from 4000 rpm read as 2048-sample slices: the track spanned ln 1.82 for the sweep's 2.56, and the cage was taken
     for the 1x line).  The template the caller reads the lines from keeps it, smeared."""
+    L = np.where(fixed_content(L, active)[None, :], 0.0, L)
+    # a slice whose only content stood still (a stopped wheel's pickup) has nothing to register: left out as an
+    # inactive one, not chained on the -MAX_STEP_LAG an all-zero correlation peaks at (a run-down to a stop and up
+    # again, 2 % pickup: 31 of 90 slices right with it chained, 66 left out)
+    active = np.asarray(active, dtype=bool) & (L.max(axis=1) > 0.0)
     shifts = np.full(L.shape[0], np.nan)
     idx = np.flatnonzero(active)
     if idx.size == 0:
         return shifts
-    L = np.where(fixed_content(L, active)[None, :], 0.0, L)
     max_lag = int(MAX_STEP_LAG / LOG_STEP)
     shifts[idx[0]] = 0.0
     for prev, k in zip(idx[:-1], idx[1:]):
