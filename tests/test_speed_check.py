@@ -392,6 +392,9 @@ def test_an_inertia_ratio_below_one_names_the_speed_column(ratio, noted):
          "zeta_rocking": 0.02, "zeta_axial": 0.03, "inertia_ratio": ratio}
     text = SuspensionModes.describe(e)
     assert ("longer than it is wide" in text and "pulses per turn" in text) is noted
+    # a sweep's speed from the data has no tach: the sentence names what then reads the speed (a new user's run-up
+    # with no speed column was told to check the tach's pulses alone)
+    assert ("which line was taken as 1x" in text) is noted
 
 
 def test_runs_whose_weak_lines_scatter_about_a_true_column_stay_as_given(monkeypatch):

@@ -89,8 +89,9 @@ class SuspensionModes(Element):
                     "an effective ratio of the whirls, from a flexible rotor or rocking coupled with other motion)")
         elif isinstance(a, (int, float)) and a < WHEEL_INERTIA_RATIO_MIN:
             note = (f" (below {WHEEL_INERTIA_RATIO_MIN:g}: a rotor longer than it is wide, not a wheel's disc; the "
-                    "whirls' split grows as I_zz/I_rr times the speed, so a speed column reading k times the rotor's "
-                    "speed reads the ratio k times low: check the tach's pulses per turn and the column's unit)")
+                    "whirls' split grows as I_zz/I_rr times the speed, so speeds k times the rotor's read the ratio "
+                    "k times low: check the tach's pulses per turn and the column's unit, or, with the speed from "
+                    "the data, which line was taken as 1x)")
 
         def mode(name: str, label: str) -> str:
             # a mode the data do not locate has no frequency to print: the fit's end point is no finding
