@@ -99,6 +99,9 @@ FIXED_SHARE = 0.5
 FIXED_GAP = 100
 FIXED_WINDOW = 2
 FIXED_MOVE = 0.1
+#: a slice is registered when its content (fixed content out) is at least this share of the median active slice's
+#: (:func:`relative_track`)
+REGISTER_CONTENT = 0.01
 
 
 @dataclass(frozen=True)
@@ -217,10 +220,15 @@ def relative_track(L: np.ndarray, u: np.ndarray, active: np.ndarray) -> np.ndarr
     run-down from 4000 rpm read as 2048-sample slices: the track spanned ln 1.82 for the sweep's 2.56, and the cage was taken
     for the 1x line).  The template the caller reads the lines from keeps it, smeared."""
     L = np.where(fixed_content(L, active)[None, :], 0.0, L)
-    # a slice whose only content stood still (a stopped wheel's pickup) has nothing to register: left out as an
-    # inactive one, not chained on the -MAX_STEP_LAG an all-zero correlation peaks at (a run-down to a stop and up
-    # again, 2 % pickup: 31 of 90 slices right with it chained, 66 left out)
-    active = np.asarray(active, dtype=bool) & (L.max(axis=1) > 0.0)
+    # a slice whose only content stood still (a stopped wheel's pickup), or whose lines are too faint to place (near
+    # zero speed), has nothing to register: left out as an inactive one, not chained on the lag an all-zero or
+    # noise-only correlation peaks at (a run-down to a stop and up again, 2 % pickup: 31 of 90 slices right with the
+    # stopped slices chained, 66 left out; +3000 -> -3000 rpm with the pickup: 41 with the faint slices around zero
+    # chained, which the pickup itself had held at lag 0 before it was left out)
+    active = np.asarray(active, dtype=bool)
+    content = L.sum(axis=1)
+    floor = REGISTER_CONTENT * float(np.median(content[active])) if active.any() else 0.0
+    active = active & (L.max(axis=1) > 0.0) & (content >= floor)
     shifts = np.full(L.shape[0], np.nan)
     idx = np.flatnonzero(active)
     if idx.size == 0:

@@ -127,12 +127,9 @@ def test_a_sweep_of_one_and_a_half_keeps_the_wheels_low_lines_in_the_registratio
     assert right == n == 60
 
 
-def test_a_stop_inside_a_run_with_pickup_leaves_the_slices_of_the_pickup_alone_out(monkeypatch):
-    """3000 -> 300 rpm, a stop, 300 -> 3000 rpm in 90 s with the pickup: the stopped slices hold the pickup alone,
-    which has no pattern to register; chained on an all-zero correlation's -0.6 lag they had put 31 of the 90
-    slices right (67 with no mask), now at least 60."""
-    knots_t, knots_rpm = [0.0, 0.4, 0.45, 0.55, 0.6, 1.0], [3000.0, 300.0, 0.0, 0.0, 300.0, 3000.0]
-
+def _knotted_sweep(monkeypatch, knots_t, knots_rpm, duration: float = 90.0):
+    """The trial's wheel swept through the speeds ``knots_rpm`` (signed, rpm) at the times ``knots_t`` (shares of
+    ``duration`` s), straight between them: the generator's own integration of that profile."""
     def profile(t, rpm_start, rpm_end, duration, profile="linear"):
         om = np.interp(np.clip(t, 0.0, duration), np.asarray(knots_t) * duration,
                        np.asarray(knots_rpm) * 2 * np.pi / 60.0)
@@ -140,9 +137,29 @@ def test_a_stop_inside_a_run_with_pickup_leaves_the_slices_of_the_pickup_alone_o
         return om, np.concatenate([[0.0], np.cumsum(0.5 * (om[1:] + om[:-1]) * dt)]), np.gradient(om, dt)
 
     monkeypatch.setattr(fw, "speed_profile", profile)
-    data = fw.sweep(_wheel(), 3000.0, 3000.0, 90.0, sample_rate=2048.0, noise=0.01, seed=1)
+    return fw.sweep(_wheel(), 3000.0, 3000.0, duration, sample_rate=2048.0, noise=0.01, seed=1)
+
+
+def test_a_stop_inside_a_run_with_pickup_leaves_the_slices_of_the_pickup_alone_out(monkeypatch):
+    """3000 -> 300 rpm, a stop, 300 -> 3000 rpm in 90 s with the pickup: the stopped slices hold the pickup alone,
+    which has no pattern to register; chained on an all-zero correlation's -0.6 lag they had put 31 of the 90
+    slices right (67 with no mask), now at least 60."""
+    data = _knotted_sweep(monkeypatch, [0.0, 0.4, 0.45, 0.55, 0.6, 1.0], [3000.0, 300.0, 0.0, 0.0, 300.0, 3000.0])
     right, n = _slices_right(_pickup(data))
     assert n == 90 and right >= 60
+
+
+@pytest.mark.parametrize("knots_rpm, pickup, least", [((3000.0, -3000.0), True, 80),
+                                                      ((3000.0, 0.0, -1500.0), False, 75)])
+def test_a_sweep_through_zero_speed_is_followed_across_its_faint_slices(monkeypatch, knots_rpm, pickup, least):
+    """A reaction wheel's sweep through zero speed: the slices around zero hold lines too faint to place, and chained
+    on their noise they threw the track off for every slice after them.  +3000 -> -3000 rpm with the pickup: 41 of 90
+    slices right once the pickup (which had held them at lag 0) was left out, at least 80 now; 3000 -> 0 -> -1500
+    rpm with no pickup: none right on 3a04096, at least 75 now."""
+    knots_t = np.linspace(0.0, 1.0, len(knots_rpm))
+    data = _knotted_sweep(monkeypatch, knots_t, knots_rpm)
+    right, n = _slices_right(_pickup(data) if pickup else data)
+    assert n == 90 and right >= least
 
 
 def test_fixed_content_is_what_stands_still_in_every_third_of_the_record():
