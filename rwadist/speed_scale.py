@@ -212,13 +212,14 @@ def fixed_content(L: np.ndarray, active: np.ndarray) -> np.ndarray:
 
 
 def relative_track(L: np.ndarray, u: np.ndarray, active: np.ndarray) -> np.ndarray:
-    """ln of the relative speed of every slice (nan where not ``active``): consecutive registration, then two
-    passes against the template (module docstring).  The first active slice is 0.
+    """ln of the relative speed of every slice (nan where not ``active``, and where the slice holds nothing to
+    register: see below): consecutive registration, then two passes against the template (module docstring).  The
+    first registered slice is 0.
 
     Content at a fixed frequency (:func:`fixed_content`) is left out of the registration: it correlates at lag 0
     between every two slices and pulls each step towards standing still (a 2 % pickup at 50 Hz on a new user's 90-s
-    run-down from 4000 rpm read as 2048-sample slices: the track spanned ln 1.82 for the sweep's 2.56, and the cage was taken
-    for the 1x line).  The template the caller reads the lines from keeps it, smeared."""
+    run-down from 4000 rpm read as 2048-sample slices: the track spanned ln 1.82 for the sweep's 2.56, and the cage
+    was taken for the 1x line).  The template the caller reads the lines from keeps it, smeared."""
     L = np.where(fixed_content(L, active)[None, :], 0.0, L)
     # a slice whose only content stood still (a stopped wheel's pickup), or whose lines are too faint to place (near
     # zero speed), has nothing to register: left out as an inactive one, not chained on the lag an all-zero or

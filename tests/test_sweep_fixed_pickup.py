@@ -23,6 +23,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import family_test  # noqa: E402
 import family_wheel as fw  # noqa: E402
 
 from rwadist import speed_scale as sc  # noqa: E402
@@ -104,12 +105,9 @@ def _pickup(data, share: float = 0.02):
 
 def _slices_right(data, slice_samples: int = 2048) -> tuple:
     """(slices whose speed from the data is within 0.5 % of the generator's mean over the slice, slices)."""
-    from rwadist.data import Sweep
     from rwadist.sweep import estimate_speed_track
 
-    sweep = Sweep(time=data.time, signals={c: data.signals[j] for j, c in enumerate(fw.CHANNELS)},
-                  sample_rate=data.sample_rate, tach=None)
-    infos, _ = estimate_speed_track(sweep, slice_samples)
+    infos, _ = estimate_speed_track(family_test.sweep_record(data), slice_samples)
     est = np.array([abs(i.speed) for i in infos])
     truth = np.array([np.mean(np.abs(data.speed[i.start:i.stop])) for i in infos])
     with np.errstate(invalid="ignore"):

@@ -17,10 +17,10 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import family_test  # noqa: E402
 import family_wheel as fw  # noqa: E402
 
 from rwadist import speed_scale as sc  # noqa: E402
-from rwadist.data import Sweep  # noqa: E402
 from rwadist.sweep import slice_sweep, speed_note  # noqa: E402
 
 
@@ -30,13 +30,10 @@ def _run(way: str, profile: str):
     wheel = fw.family()[0]
     lo, hi = (600.0, 6000.0) if way == "up" else (6000.0, 600.0)
     data = fw.sweep(wheel, lo, hi, 60.0, sample_rate=2500.0, noise=0.01, seed=4, profile=profile)
-    test, infos = slice_sweep(_as_sweep(data), slice_samples=4096, speed_source="data")
+    test, infos = slice_sweep(family_test.sweep_record(data), slice_samples=4096, speed_source="data")
     return data, test, infos
 
 
-def _as_sweep(data: fw.SweepData) -> Sweep:
-    return Sweep(time=data.time, signals={c: data.signals[j] for j, c in enumerate(fw.CHANNELS)},
-                 sample_rate=data.sample_rate, tach=None)
 
 
 def _slice_truth(data: fw.SweepData, infos) -> np.ndarray:
@@ -127,7 +124,7 @@ def test_the_imbalance_is_the_line_with_one_sense_in_force_and_torque_and_intege
 def _fast_run_up():
     """The 30-s run-up 300 -> 3000 rpm of family wheel 4 (E-like, 3840 Hz), no speed column, sliced."""
     data = fw.sweep(fw.family()[4], 300.0, 3000.0, 30.0, noise=0.01, seed=7)
-    return data, slice_sweep(_as_sweep(data))
+    return data, slice_sweep(family_test.sweep_record(data))
 
 
 def test_ratios_near_a_ridge_are_the_speed_scales_within_the_lobe():
@@ -184,7 +181,7 @@ def test_auto_slice_length_follows_the_sweep_rate():
         truth = np.array([ln.h for ln in wheel.lines if ln.direction == d])
         for x in model.harmonics(d):
             assert np.min(np.abs(x.h / truth - 1)) < 0.002, (d, x.h)
-    assert slice_sweep(_as_sweep(_run("up", "linear")[0]))[0].meta["slicing"]["slice_samples"] == 4096
+    assert slice_sweep(family_test.sweep_record(_run("up", "linear")[0]))[0].meta["slicing"]["slice_samples"] == 4096
 
 
 def test_auto_slices_keep_the_fast_start_of_a_motor_run_up_quasi_steady():
@@ -197,7 +194,7 @@ def test_auto_slices_keep_the_fast_start_of_a_motor_run_up_quasi_steady():
 
     wheel = fw.family()[2]
     data = fw.sweep(wheel, 300.0, 3000.0, 60.0, noise=0.01, seed=2, profile="exp")
-    test, infos = slice_sweep(_as_sweep(data))
+    test, infos = slice_sweep(family_test.sweep_record(data))
     n = test.meta["slicing"]["slice_samples"]
     seg = n / SEGMENTS_READ / data.sample_rate
     centre = np.array([0.5 * (i.start + i.stop) / data.sample_rate for i in infos])
