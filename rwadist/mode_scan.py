@@ -512,6 +512,8 @@ def _part_first(search, data: tuple, f_grid, z_grid, a_grid, two_parts, fi, ai) 
 #: capped there moved their rocking mode 3-4 % to make up the whirl (family wheels 2 and 7) and left the rest to an
 #: invented amplitude law.  The model's own bound (:data:`rwadist.schema.MAX_INERTIA_RATIO`).
 A_MAX = MAX_INERTIA_RATIO
+#: Least I_zz/I_rr the rocking scan's refinement reaches
+A_MIN = 0.02
 #: I_zz/I_rr grid of the rocking scan when the ratio is unknown (steps of 0.2; 2.0 on the grid)
 A_GRID = np.round(np.arange(0.2, A_MAX + 1e-9, 0.2), 10)
 #: Half-width (a factor) of the f0 window a scan with ``near_hz`` searches first (:func:`scan_mode`)
@@ -549,6 +551,60 @@ def _competitor(line, h, omega, power, grids, ssr, io, f_step, f_best, tolerance
 #: to 154 Hz: 237.5 Hz at a large ζ, then declared and its rise described as two lines' laws), and a suspension mode's
 #: damping is well under it
 QUASI_STATIC_ZETA = 0.15
+
+
+#: Times the rocking scan's refinement window is moved along the whirl's valley at most (:func:`_follow_valley`)
+MAX_VALLEY_STEPS = 12
+
+
+def _follow_valley(data: tuple, grids: tuple, at: tuple, best: float, offsets: tuple, f_edge: bool) -> tuple:
+    """(SSR, (f0 Hz, ζ, I_zz/I_rr)) of the rocking scan's refinement followed along the whirl's valley: while the best
+    point of the window searched (``grids``: its f0, ζ and a grids; ``at``: the best point's indices, SSR ``best``)
+    lies on the window's I_zz/I_rr edge inside the scan's range (or, with ``f_edge``, on its f0 edge), the window is
+    recentred on it (``offsets``: ln f0, ln ζ and a about the centre) and searched again, as long as the SSR falls.
+
+    Where the lines cross one whirl only (co-rotating lines through the forward whirl: one torque line crossing it),
+    the data fix the crossing, f0²/(h² − h·a), and f0 and a trade along a long, shallow valley that a window of ±0.2
+    in a does not span: trial C (f0 260 Hz, I_zz/I_rr 1.25, a 5.1x torque line) was refined from a coarse 0.8 to
+    1.019 on the window's edge, 267.6 Hz (+2.9 %), at an SSR 1.7x that of the truth's."""
+    line, h, omega, power, two_parts = data
+    (f_grid, z_grid, a_grid), (i, j, k) = grids, at
+    f_off, z_off, a_off = offsets
+    point = (float(f_grid[i]), float(z_grid[j]), float(a_grid[k]))
+    z_lo, z_hi = float(z_grid.min()), float(z_grid.max())     # the valley runs in f0 and a: ζ stays in its window
+    for _ in range(MAX_VALLEY_STEPS):
+        a_edge = (k == 0 and a_grid[0] > A_MIN + 1e-9) or (k == a_grid.size - 1 and a_grid[-1] < A_MAX - 1e-9)
+        if not (a_edge or (f_edge and i in (0, f_grid.size - 1))):
+            break
+        f_grid, z_grid = point[0] * np.exp(f_off), np.unique(np.clip(point[1] * np.exp(z_off), z_lo, z_hi))
+        a_grid = np.unique(np.clip(np.round(point[2] + a_off, 9), A_MIN, A_MAX))
+        ssr = _screened_search(line, h, omega, power, f_grid, z_grid, a_grid, two_parts)
+        i, j, k = np.unravel_index(np.nanargmin(ssr), ssr.shape)
+        if not float(ssr[i, j, k]) < best:
+            break
+        best, point = float(ssr[i, j, k]), (float(f_grid[i]), float(z_grid[j]), float(a_grid[k]))
+    return best, point
+
+
+def _refine_ratio(data: tuple, grids: tuple, at: tuple, best: float, f_step: float) -> tuple:
+    """(SSR, (f0 Hz, ζ, I_zz/I_rr)) of the rocking scan's refinement when I_zz/I_rr is scanned: the fine window
+    (``grids``, its best point at indices ``at``, SSR ``best``) followed along the whirl's valley, then a to 0.001
+    about its best point, followed again (:func:`_follow_valley`)."""
+    best, (f_best, z_best, a_best) = _follow_valley(
+        data, grids, at, best, (np.arange(-2 * f_step - 0.01, 2 * f_step + 0.0101, 0.001),
+                                np.linspace(-0.75, 0.75, 11), np.linspace(-0.2, 0.2, 21)), f_edge=False)
+    # I_zz/I_rr is not refined later (the extended fit frees k and c only), and one step of 0.02 moves a whirl
+    # branch by up to 1 % of the spin frequency at the mode: 0.5 % of the forward whirl at 9000 rpm, enough to
+    # under-predict a line passing near it by 16 % (trial15: an invented amplitude law on clean data).  The
+    # neighbourhood of the best point once more, a to 0.001 (f0 and ζ move with it along the whirl's valley)
+    offsets = (np.arange(-0.003, 0.00301, 0.0005), np.linspace(-0.1, 0.1, 5), np.arange(-0.02, 0.02001, 0.001))
+    f_2, z_2 = f_best * np.exp(offsets[0]), z_best * np.exp(offsets[1])
+    a_2 = np.unique(np.clip(np.round(a_best + offsets[2], 9), A_MIN, A_MAX))
+    fine_2 = _screened_search(*data[:4], f_2, z_2, a_2, data[4])
+    gi, gj, gk = np.unravel_index(np.nanargmin(fine_2), fine_2.shape)
+    if float(fine_2[gi, gj, gk]) < best:
+        return _follow_valley(data, (f_2, z_2, a_2), (gi, gj, gk), float(fine_2[gi, gj, gk]), offsets, f_edge=True)
+    return best, (f_best, z_best, a_best)
 
 
 def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = None, tolerance: float = 0.02,
@@ -604,25 +660,15 @@ def scan_mode(mode: str, line, h, omega, power, inertia_ratio: float | None = No
     # refine around the best point: f0 to 0.1 %, ζ and a finer
     f_fine = f0_grid[i] * np.exp(np.arange(-2 * f_step - 0.01, 2 * f_step + 0.0101, 0.001))
     z_fine = zeta_grid[j] * np.exp(np.linspace(-0.5, 0.5, 11) * (1 if a_grid.size == 1 else 1.5))
-    a_fine = a_grid if a_grid.size == 1 else np.unique(np.clip(a_grid[k] + np.linspace(-0.2, 0.2, 21), 0.02, A_MAX))
+    a_fine = a_grid if a_grid.size == 1 else np.unique(np.clip(a_grid[k] + np.linspace(-0.2, 0.2, 21), A_MIN, A_MAX))
     # screened in single precision, its best the double-precision grid's; whole (a part first: a false local minimum)
     fine = _screened_search(line, h, omega, power, f_fine, z_fine, a_fine, two_parts)
     fi, fj, fk = np.unravel_index(np.nanargmin(fine), fine.shape)
     best = float(fine[fi, fj, fk])
     f_best, z_best, a_best = float(f_fine[fi]), float(z_fine[fj]), float(a_fine[fk])
     if a_fine.size > 1:
-        # I_zz/I_rr is not refined later (the extended fit frees k and c only), and one step of 0.02 moves a whirl
-        # branch by up to 1 % of the spin frequency at the mode: 0.5 % of the forward whirl at 9000 rpm, enough to
-        # under-predict a line passing near it by 16 % (trial15: an invented amplitude law on clean data).  The
-        # neighbourhood of the best point once more, a to 0.001 (f0 and ζ move with it along the whirl's valley)
-        f_2 = f_best * np.exp(np.arange(-0.003, 0.00301, 0.0005))
-        z_2 = z_best * np.exp(np.linspace(-0.1, 0.1, 5))
-        a_2 = np.unique(np.clip(np.round(a_best + np.arange(-0.02, 0.02001, 0.001), 9), 0.02, A_MAX))
-        fine_2 = _screened_search(line, h, omega, power, f_2, z_2, a_2, two_parts)
-        gi, gj, gk = np.unravel_index(np.nanargmin(fine_2), fine_2.shape)
-        if float(fine_2[gi, gj, gk]) < best:
-            best = float(fine_2[gi, gj, gk])
-            f_best, z_best, a_best = float(f_2[gi]), float(z_2[gj]), float(a_2[gk])
+        best, (f_best, z_best, a_best) = _refine_ratio((line, h, omega, power, two_parts), (f_fine, z_fine, a_fine),
+                                                       (fi, fj, fk), best, f_step)
     if z_best > QUASI_STATIC_ZETA and zeta_max > QUASI_STATIC_ZETA and f_best > float(f_line.max()):
         return scan_mode(mode, line, h, omega, power, inertia_ratio, tolerance, min_log_lr, near_hz, near_a,
                          zeta_max=QUASI_STATIC_ZETA, sense=two_parts if isinstance(two_parts, np.ndarray) else None)
