@@ -18,6 +18,7 @@ from functools import partial
 
 import numpy as np
 
+from .describe_reach import TRACK_SHARE_FLOOR, lifted_hold, on_a_moving_skirt, without_notched_lines
 from .engine import Context
 from .fixed_lines import describe_fixed_lines, find_fixed_lines, remove_fixed_lines
 from .run_order import read_in_recorded_order as in_order
@@ -429,7 +430,8 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     # made of a narrow line's leakage into the model's lines it passes is that line's
     out = with_affine_lines(ctx, state, with_drifts(ctx, state, out, of_line), affine_lines(ctx, state, of_track_f,
                                                                                              carriers))
-    return structure.without_line_leaks(out, float(ctx.df))
+    # a line the track's antiresonance takes down is no source that stops
+    return without_notched_lines(structure.without_line_leaks(out, float(ctx.df)))
 
 
 def _run_change(ctx, state, read: list, of_runs, in_order, taken_out: bool) -> list:
@@ -622,7 +624,10 @@ def holds_content(u, res: Residual) -> bool:
     total = sum(int(np.size(x)) for x in res.e.values())
     if n == 0 or total == 0:
         return False
-    return res.measure(cells)[0] >= n / total
+    share = res.measure(cells)[0]
+    if share >= n / total:
+        return True
+    return u.signature == "moving_resonance" and share >= TRACK_SHARE_FLOOR * n / total and lifted_hold(u, res, total)
 
 
 #: An effect the search added is taken back when at least this share of what it gains (misplaced power, on the data
@@ -669,7 +674,7 @@ def forced_effects(diag, opened: Opened, search_before: State, search_after: Sta
     for e in search_after.effects:
         if id(e) in base:
             continue
-        on_track = _on_a_moving_track(e, found)
+        on_track = _on_a_moving_track(e, found) or on_a_moving_skirt(e, found)
         if on_track:
             out.append((e, on_track))
             continue
