@@ -600,7 +600,8 @@ def _refine_ratio(data: tuple, grids: tuple, at: tuple, best: float, f_step: flo
     offsets = (np.arange(-0.003, 0.00301, 0.0005), np.linspace(-0.1, 0.1, 5), np.arange(-0.02, 0.02001, 0.001))
     f_2, z_2 = f_best * np.exp(offsets[0]), z_best * np.exp(offsets[1])
     a_2 = np.unique(np.clip(np.round(a_best + offsets[2], 9), A_MIN, A_MAX))
-    fine_2 = _screened_search(*data[:4], f_2, z_2, a_2, data[4])
+    line, h, omega, power, two_parts = data
+    fine_2 = _screened_search(line, h, omega, power, f_2, z_2, a_2, two_parts)
     gi, gj, gk = np.unravel_index(np.nanargmin(fine_2), fine_2.shape)
     if float(fine_2[gi, gj, gk]) < best:
         return _follow_valley(data, (f_2, z_2, a_2), (gi, gj, gk), float(fine_2[gi, gj, gk]), offsets, f_edge=True)

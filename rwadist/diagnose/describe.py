@@ -21,6 +21,12 @@ import numpy as np
 from .describe_reach import TRACK_SHARE_FLOOR, lifted_hold, on_a_moving_skirt, without_notched_lines
 from .engine import Context
 from .fixed_lines import describe_fixed_lines, find_fixed_lines, remove_fixed_lines
+from .one_channel_lines import (
+    describe_one_channel_lines,
+    find_one_channel_lines,
+    one_channel_line_shares,
+    remove_one_channel_lines,
+)
 from .run_order import read_in_recorded_order as in_order
 from .state import State
 
@@ -44,6 +50,9 @@ class Opened:
     whole: Context | None = None
     #: the fixed lines' sidebands taken out with them (:class:`~rwadist.diagnose.describe_carrier.Sideband`)
     sidebands: list = field(default_factory=list)
+    #: lines at a constant ratio of the speed on one channel of the radial-force pair that the wheel's translation mode
+    #: does not lift, taken out (:class:`~rwadist.diagnose.one_channel_lines.OneChannelLine`)
+    one_channel: list = field(default_factory=list)
 
 
 def start(ctx: Context, steps: dict | None = None) -> Opened:
@@ -66,22 +75,29 @@ def start(ctx: Context, steps: dict | None = None) -> Opened:
     steps = dict(steps or {})
     if steps and test is not None:
         test = scale_runs(test, {r: dB for r, dB in steps.items() if np.isfinite(dB)}, on)
-    if not fixed and not copies and not steps:
-        return Opened(ctx, ctx)
     from ..spectra import compute_spectra
 
     def context(test):
         sp = compute_spectra(test, nperseg=ctx.sp.nperseg, window=ctx.sp.window, f_lim=ctx.sp.f_lim)
         return Context(sp, ctx.channels, test)
 
-    whole = context(test)
+    # a line of one radial-force channel that the wheel's translation mode does not lift: a source outside the wheel
+    # (:mod:`.one_channel_lines`), read once the fixed lines and copies are out; left in, the empirical base made it a
+    # planar radial-force line (both channels) and the modes' fit carried it through the translation mode
+    read = ctx if test is ctx.test else context(test)
+    ones = find_one_channel_lines(read)
+    if ones:
+        test = remove_one_channel_lines(read, ones)
+    if not fixed and not copies and not steps and not ones:
+        return Opened(ctx, ctx)
+    whole = read if not ones and read is not ctx else context(test)
     unread = {r for r, dB in steps.items() if not np.isfinite(dB)}
     if not unread or test is None:
-        return Opened(whole, ctx, fixed, copies, steps, sidebands=sidebands)
+        return Opened(whole, ctx, fixed, copies, steps, sidebands=sidebands, one_channel=ones)
     from ..data import SteadyTest
 
     kept = SteadyTest([run for i, run in enumerate(test.runs) if i not in unread], dict(test.meta))
-    return Opened(context(kept), ctx, fixed, copies, steps, whole, sidebands=sidebands)
+    return Opened(context(kept), ctx, fixed, copies, steps, whole, sidebands=sidebands, one_channel=ones)
 
 
 class RunSteps(dict):
@@ -492,6 +508,7 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
 
     found = describe_fixed_lines(opened.raw, opened.fixed, fixed_line_shares(res, opened.fixed))
     found += describe_sidebands(res, opened.sidebands)
+    found += describe_one_channel_lines(opened.raw, opened.one_channel, one_channel_line_shares(res, opened.one_channel))
     found += describe_channel_copies(opened.raw, opened.copies, channel_copy_shares(res, opened.copies))
     # the final model's residual on the data the search read (the fixed lines and copies out), shares on the data
     found += describe_residual(searched or res, bearings, res, changes=bool(opened.steps), carriers=opened.fixed,
@@ -764,7 +781,9 @@ def finish(diag, opened: Opened, bearings=(), rebuild=None):
         if not forced:
             found, res = _described(diag, opened, search_after, bearings)
     diag.unexplained = tuple(found)
-    diag.line_causes = line_causes(diag, bearings, [u.h for u in found if u.h is not None])
+    # (a line of a source outside the wheel, :mod:`.one_channel_lines`, is no relation of the wheel's lines)
+    diag.line_causes = line_causes(diag, bearings, [u.h for u in found if u.h is not None
+                                                    and "one_channel" not in u.parameters])
     diag.bearings = bearings
     # the lines the search added to an empirical base carry the sense their x/y phase reads, as the base's do
     from .start_model import sensed_lines

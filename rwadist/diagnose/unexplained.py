@@ -220,6 +220,18 @@ class Unexplained:
             # user's 50 Hz pickup, 33 dB over the noise, was "+0.1 dB over the model" and nothing else)
             out += f", {floor:+.1f} dB over the noise floor at its own bins" + (
                 " (taken out of the data before the search)" if self.parameters.get("removed_before_the_search") else "")
+        if self.signature == "speed_line" and self.parameters.get("one_channel"):
+            # a line of one radial channel the translation mode does not lift (:mod:`.one_channel_lines`): its
+            # signature is where it is not, and the lift it lacks
+            p = self.parameters
+            out += (f", on {p['one_channel']} alone ({p['partner']} {_number(p.get('partner_dB')) or 0:+.0f} dB under "
+                    f"it, median over its runs), C {_number(p.get('C')) or 0:.3g}, and not lifted by the wheel's "
+                    f"translation mode ({_number(p.get('translation_Hz')) or 0:.4g} Hz, crossed at "
+                    f"{_number(p.get('crossing_rpm')) or 0:.0f} rpm): it follows "
+                    f"{round(_number(p.get('lift_followed')) or 0.0, 2) + 0.0:.2f} of the {_number(p.get('largest_lift_dB')) or 0:.0f} "
+                    "dB lift the wheel's other radial-force lines locate there")
+            if p.get("removed_before_the_search"):
+                out += " (taken out of the data before the search)"
         peak = _number(self.parameters.get("peak_over_model_dB"))
         if peak is not None:
             # a narrow line's bands hold the model's lines beside it: its own bins say how far it stands out
