@@ -88,3 +88,16 @@ def test_an_amplitude_law_is_taken_for_the_skirt_only_when_the_shape_accounts_fo
     assert (on_a_moving_skirt(law, [track]) == "moving_resonance") is taken
     axial = AmplitudeLaw(direction="axial_force", h=2.0, exponent=exponent, amplitude_ref=0.0277, omega_ref_rad_s=333.7)
     assert on_a_moving_skirt(axial, [track]) is None
+
+
+def test_a_line_the_track_lifts_is_said_to_be_lifted_by_it_not_to_grow_at_its_source(diagnosed):
+    """The h 5.238 line crosses the track near 5300 rpm and the h 3.762 line lies below it: both read as laws steeper
+    than Ω² (Ω^2.7, Ω^2.2 in the trial), "a bearing defect's impacts" before.  The data are C·Ω² at the source: each
+    such record's first cause is the described resonance's shape
+    (:func:`rwadist.diagnose.describe_reach.with_track_causes`)."""
+    laws = [u for u in diagnosed.unexplained if u.signature == "line_property"
+            and u.parameters.get("property") == "amplitude_law" and {"Fx", "Fy"} & set(u.channels)]
+    assert laws
+    for u in laws:
+        assert u.causes[0].startswith("the moving resonance described on Fx Fy"), (u.h, u.causes[0][:100])
+

@@ -18,7 +18,7 @@ from functools import partial
 
 import numpy as np
 
-from .describe_reach import TRACK_SHARE_FLOOR, lifted_hold, on_a_moving_skirt, without_notched_lines
+from .describe_reach import TRACK_SHARE_FLOOR, lifted_hold, on_a_moving_skirt, with_track_causes, without_notched_lines
 from .engine import Context
 from .fixed_lines import describe_fixed_lines, find_fixed_lines, remove_fixed_lines
 from .one_channel_lines import (
@@ -516,7 +516,8 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
     from .describe_law import describe_laws
 
     found += describe_laws(res, getattr(diag, "laws_below_gain", ()))
-    return found, res
+    # a law a described moving resonance's shape makes is said so first
+    return with_track_causes(found), res
 
 
 def cells_of(u, res: Residual) -> dict:
