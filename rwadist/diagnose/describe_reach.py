@@ -49,6 +49,21 @@ def lifted_hold(u, res, total: int) -> bool:
     return n > 0 and res.measure(cells)[0] >= LIFTED_CONTENT_FACTOR * n / total
 
 
+def _shape_db(track, h: float, spin) -> np.ndarray:
+    """20·log10 |H| of the ``moving_resonance`` record ``track``'s fitted shape (``zeta``, ``peak_gain``,
+    ``gain_far_above``) on its track at the line of ratio ``h`` at spin frequencies ``spin`` (Hz, |Ω|/2π; the track
+    extended straight past its own speeds); NaN where the track is at or below 0 Hz or its speeds span nothing."""
+    p = track.parameters
+    s_lo, s_hi = abs(track.speed_rpm[0]) / 60.0, abs(track.speed_rpm[1]) / 60.0
+    spin = np.asarray(spin, dtype=float)
+    if not s_hi > s_lo:
+        return np.full(spin.shape, np.nan)
+    f_r = p["f_at_lowest_speed_Hz"] + (p["f_at_highest_speed_Hz"] - p["f_at_lowest_speed_Hz"]) * (spin - s_lo) / (s_hi - s_lo)
+    db = _resonance_db(h * spin, np.maximum(f_r, 1e-300), float(p["zeta"]), float(p["peak_gain"]),
+                       float(p["gain_far_above"]))
+    return np.where(f_r > 0, db, np.nan)
+
+
 #: A ``partial_line`` is a described moving resonance's notch when the resonance's fitted shape takes the line down by
 #: this much (dB, median over the runs it is absent from) ...
 NOTCH_DB = 6.0
@@ -71,14 +86,13 @@ def without_notched_lines(records: list) -> list:
     notched: dict = {}
     kept = []
     for u in records:
-        m = next((t for t in tracks if u.signature == "partial_line" and set(u.channels) & set(t.channels)
-                  and _notch_db(u, t) is not None), None)
+        m, down = next(((t, d) for t in tracks if u.signature == "partial_line" and set(u.channels) & set(t.channels)
+                        and (d := _notch_db(u, t)) is not None), (None, None))
         if m is None:
             kept.append(u)
         else:
             notched.setdefault(id(m), []).append({"h": float(u.parameters["h"]), "speed_rpm": list(u.speed_rpm),
-                                                  "absent_rpm": list(u.parameters["absent_rpm"]),
-                                                  "shape_dB": _notch_db(u, m)})
+                                                  "absent_rpm": list(u.parameters["absent_rpm"]), "shape_dB": down})
     return [replace(u, parameters=dict(u.parameters) | {"notched_lines": notched[id(u)]}) if id(u) in notched else u
             for u in kept]
 
@@ -86,22 +100,16 @@ def without_notched_lines(records: list) -> list:
 def _notch_db(line, track) -> float | None:
     """The median change (dB) the ``moving_resonance`` record ``track``'s shape makes to the ``partial_line`` record
     ``line`` in the runs it is absent from, when that is a notch (:func:`without_notched_lines`), else None."""
-    p, q = track.parameters, line.parameters
+    q = line.parameters
     s_lo, s_hi = track.speed_rpm[0] / 60.0, track.speed_rpm[1] / 60.0
     absent = np.abs(np.asarray(q.get("absent_rpm", []), float)) / 60.0
     present = np.abs(np.asarray(q.get("present_rpm", []), float)) / 60.0
     inside = (absent >= s_lo - 1e-9) & (absent <= s_hi + 1e-9)
     if absent.size == 0 or inside.mean() < 2.0 / 3.0:
         return None
-
-    def shape_db(spin):
-        f_r = p["f_at_lowest_speed_Hz"] + (p["f_at_highest_speed_Hz"] - p["f_at_lowest_speed_Hz"]) * \
-            (spin - s_lo) / max(s_hi - s_lo, 1e-12)
-        return _resonance_db(float(q["h"]) * spin, f_r, float(p["zeta"]), float(p["peak_gain"]),
-                             float(p["gain_far_above"]))
-
-    down = float(np.median(shape_db(absent[inside])))
-    up = float(np.median(shape_db(present))) if present.size else 0.0
+    h = float(q["h"])
+    down = float(np.median(_shape_db(track, h, absent[inside])))
+    up = float(np.median(_shape_db(track, h, present))) if present.size else 0.0
     return down if down <= -NOTCH_DB and abs(up) <= NOTCH_PRESENT_DB else None
 
 
@@ -128,9 +136,7 @@ def on_a_moving_skirt(effect, found) -> str | None:
         s_lo, s_hi = abs(u.speed_rpm[0]) / 60.0, abs(u.speed_rpm[1]) / 60.0
         if not s_hi > s_lo > 0:
             continue
-        spin = np.array([s_lo, s_hi])
-        f_r = np.array([p["f_at_lowest_speed_Hz"], p["f_at_highest_speed_Hz"]])
-        shape = _resonance_db(effect.h * spin, f_r, float(p["zeta"]), float(p["peak_gain"]), float(p["gain_far_above"]))
+        shape = _shape_db(u, effect.h, np.array([s_lo, s_hi]))
         law = 20.0 * (effect.exponent - 2.0) * np.log10(s_hi / s_lo)
         change = float(shape[1] - shape[0])
         if law != 0 and change * law > 0 and abs(change) >= SKIRT_SHARE * abs(law):
@@ -151,14 +157,14 @@ def with_track_causes(records: list) -> list:
     out = []
     for u in records:
         p = u.parameters or {}
-        track = None
+        track, change = None, None
         if u.signature == "line_property" and p.get("property") == "amplitude_law" and u.h is not None:
-            track = next((t for t in tracks if set(u.channels) & set(t.channels)
-                          and _track_change(t, float(u.h), u.speed_rpm, float(p.get("exponent", 2.0))) is not None), None)
+            track, change = next(((t, c) for t in tracks if set(u.channels) & set(t.channels) and
+                                  (c := _track_change(t, float(u.h), u.speed_rpm, float(p.get("exponent", 2.0))))
+                                  is not None), (None, None))
         if track is None:
             out.append(u)
             continue
-        change = _track_change(track, float(u.h), u.speed_rpm, float(p.get("exponent", 2.0)))
         lo, hi = track.f_Hz
         out.append(replace(u, causes=(f"the moving resonance described on {' '.join(track.channels)} ({lo:.4g}-{hi:.4g} "
                                       f"Hz): its shape on its track reads as a change of this line by {change:+.1f} dB from "
@@ -171,16 +177,13 @@ def _track_change(track, h: float, speed_rpm: tuple, exponent: float) -> float |
     ``speed_rpm`` (its track extended straight past its own speeds), read as a law reads it: the slope of the shape's dB
     on log10 of the speed at 24 speeds across the range, times the range's decades.  Returned when that slope is at
     least :data:`SKIRT_SHARE` of the law's own, 20·(``exponent`` − 2) dB per decade, in the same sense; else None."""
-    p = track.parameters
-    s_lo, s_hi = track.speed_rpm[0] / 60.0, track.speed_rpm[1] / 60.0
     lo, hi = (abs(float(x)) / 60.0 for x in speed_rpm)
-    if not (hi > lo > 0 and s_hi > s_lo) or exponent == 2.0:
+    if not hi > lo > 0 or exponent == 2.0:
         return None
     spin = np.geomspace(lo, hi, 24)
-    f_r = p["f_at_lowest_speed_Hz"] + (p["f_at_highest_speed_Hz"] - p["f_at_lowest_speed_Hz"]) * (spin - s_lo) / (s_hi - s_lo)
-    if np.any(f_r <= 0):
+    shape = _shape_db(track, h, spin)
+    if not np.all(np.isfinite(shape)):
         return None
-    shape = _resonance_db(h * spin, f_r, float(p["zeta"]), float(p["peak_gain"]), float(p["gain_far_above"]))
     slope = float(np.polyfit(np.log10(spin), shape, 1)[0])
     law = 20.0 * (exponent - 2.0)
     if slope * law > 0 and abs(slope) >= SKIRT_SHARE * abs(law):

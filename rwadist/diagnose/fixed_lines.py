@@ -335,10 +335,8 @@ def remove_fixed_lines(ctx, lines) -> SteadyTest:
     wheel line at the same frequency there, not told apart).  A line's ``f_runs`` (a fixed line's sideband,
     :class:`rwadist.diagnose.describe_carrier.Sideband`), when it has one, gives its frequency in each run instead of
     ``f_Hz``.  The runs' signals are new arrays (the input is not changed)."""
-    from ..data import SteadyTest
-
     test = ctx.test
-    new_signals = [dict(r.signals) for r in test.runs]
+    tones = []
     for ln in lines:
         A = ln.amplitudes
         mag = np.abs(A)
@@ -346,13 +344,23 @@ def remove_fixed_lines(ctx, lines) -> SteadyTest:
         med = np.array([np.median(m[np.isfinite(m)]) if np.isfinite(m).any() else np.nan for m in mag.T])
         A = np.where((np.abs(A) > SAME_AMPLITUDE * med) | (np.abs(A) < med / SAME_AMPLITUDE), np.nan, A)
         f_runs = np.broadcast_to(np.asarray(getattr(ln, "f_runs", ln.f_Hz), dtype=float), (len(test.runs),))
-        for i, run in enumerate(test.runs):
-            if not np.isfinite(f_runs[i]):
-                continue
-            e = np.exp(2j * np.pi * f_runs[i] * np.arange(run.n_samples) / run.sample_rate)
-            for j, c in enumerate(ln.channels):
-                if run.usable(c) and np.isfinite(A[i, j]):
-                    new_signals[i][c] = new_signals[i][c] - np.real(A[i, j] * e)
+        tones += [(c, f_runs, A[:, j]) for j, c in enumerate(ln.channels)]
+    return subtract_tones(test, tones)
+
+
+def subtract_tones(test, tones) -> SteadyTest:
+    """A copy of ``test`` with each tone of ``tones`` ((channel, frequency Hz per run (R,), complex amplitude per run
+    (R,))) subtracted from its channel's records: x − Re(A·e^{2πj f t}), in every run where both are finite and the
+    channel is usable.  The runs' signals are new arrays (the input is not changed)."""
+    from ..data import SteadyTest
+
+    new_signals = [dict(r.signals) for r in test.runs]
+    for i, run in enumerate(test.runs):
+        n = np.arange(run.n_samples)
+        for c, f_runs, A in tones:
+            if np.isfinite(f_runs[i]) and np.isfinite(A[i]) and run.usable(c):
+                e = np.exp(2j * np.pi * f_runs[i] * n / run.sample_rate)
+                new_signals[i][c] = new_signals[i][c] - np.real(A[i] * e)
     return SteadyTest([replace(r, signals=s) for r, s in zip(test.runs, new_signals)], dict(test.meta))
 
 

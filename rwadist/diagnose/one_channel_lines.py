@@ -212,23 +212,12 @@ def _run_frequencies(ctx, c: str, f_runs: np.ndarray) -> np.ndarray:
     return out
 
 
-def remove_one_channel_lines(ctx, lines) -> "object":
+def remove_one_channel_lines(ctx, lines):
     """A copy of the context's test with each line of ``lines`` subtracted from its channel's records in every run
-    where its amplitude was read: x − Re(A·e^{2πj f t}), f = h·|Ω|/2π."""
-    from dataclasses import replace
+    where its amplitude was read: x − Re(A·e^{2πj f t}), f = h·|Ω|/2π (:func:`.fixed_lines.subtract_tones`)."""
+    from .fixed_lines import subtract_tones
 
-    from ..data import SteadyTest
-
-    test = ctx.test
-    signals = [dict(r.signals) for r in test.runs]
-    for ln in lines:
-        for i, run in enumerate(test.runs):
-            a, f = ln.amplitudes[i], ln.f_runs[i]
-            if not (np.isfinite(a) and np.isfinite(f)) or not run.usable(ln.channel):
-                continue
-            e = np.exp(2j * np.pi * f * np.arange(run.n_samples) / run.sample_rate)
-            signals[i][ln.channel] = signals[i][ln.channel] - np.real(a * e)
-    return SteadyTest([replace(r, signals=s) for r, s in zip(test.runs, signals)], dict(test.meta))
+    return subtract_tones(ctx.test, [(ln.channel, ln.f_runs, ln.amplitudes) for ln in lines])
 
 
 def one_channel_line_shares(res, lines) -> dict:
