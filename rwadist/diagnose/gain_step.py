@@ -41,6 +41,12 @@ SCATTER_FLOOR_DB = 0.02
 READ_SHARE = 0.5
 #: The channel that moved holds at least this fraction more of the step than its partner (else both are named).
 OWN_FACTOR = 2.0
+#: What a record says of the modes the stepped channel's lines hold, fitted on the records as given ...
+THROUGH_THE_GAINS = "fitted through the two gains: suspect"
+#: ... and when the search was run again with the step taken out (:func:`channel_steps`)
+TAKEN_OUT = "fitted on the records with {moved}'s gain brought to {reference}'s on either side of the step"
+#: A side whose gain is within this of its partner's (dB of power) is left as recorded.
+SIDE_TOLERANCE_DB = 1e-3
 
 
 def per_run(d: np.ndarray, good: np.ndarray) -> np.ndarray:
@@ -145,7 +151,7 @@ def gain_step(ctx, state, pair: tuple, h: np.ndarray, q: tuple, good: np.ndarray
     if not modes:
         return replace(u, parameters={**u.parameters, "modes_on_changed_runs": []})
     note = (f"; the {', '.join(m.replace('_', ' ') for m in modes)} mode{'s rest' if len(modes) > 1 else ' rests'} "
-            f"on {cx} and {cy} across the step, fitted through the two gains: suspect")
+            f"on {cx} and {cy} across the step, {THROUGH_THE_GAINS}")
     return replace(u, parameters={**u.parameters, "modes_on_changed_runs": modes},
                    causes=(u.causes[0] + note,) + tuple(u.causes[1:]))
 
@@ -195,3 +201,46 @@ def _record(ctx, pair, h, stepping, cp, own, moved, shares) -> Unexplained:
                     "runs_above": [names[i] for i in above], "own_step_dB": {c: float(v) for c, v in own.items()},
                     "lines_h": [float(x) for x in h[stepping]], "scatter_dB": float(cp["scatter_dB"])},
         causes=causes, would_tell=would)
+
+
+def channel_steps(diag) -> tuple | None:
+    """(run index -> dB of power, (channel,)): the gain of the one channel that moved in a ``step`` record of ``diag``
+    (:func:`gain_step`) on whose lines a wheel's mode rests, per run of the test, against its partner's on the run's
+    side of the step: taken out of that channel's records (:func:`rwadist.diagnose.describe.scale_runs`), the two
+    channels read alike in every run, as an axisymmetric wheel's lines do.  None when no such record (or no time
+    series).  Which side's gain is right the data cannot say; the partner's, unmoved, is the reference.  Left in, the
+    modes are fitted through the two gains (the session-68 trial, wheel A, Ty × 1.35 from 4100 rpm: rocking +2.5 %,
+    I_zz/I_rr −7.3 %, described "suspect" and kept)."""
+    ctx = diag.ctx
+    recs = [u for u in diag.unexplained if u.signature == "line_property"
+            and u.parameters.get("property") == "channel_gain" and u.parameters.get("pattern") == "step"
+            and len(u.parameters.get("moved", ())) == 1 and u.parameters.get("modes_on_changed_runs")]
+    if not recs or ctx.test is None:
+        return None
+    p = recs[0].parameters
+    # the ratios are the partner's (``channel``) over the reference's amplitude: the reference moving inverts them
+    sign = 1.0 if p["moved"][0] == p["channel"] else -1.0
+    below, above = (sign * 20.0 * np.log10(p[k]) for k in ("amplitude_ratio_below", "amplitude_ratio_above"))
+    first = p["step_between_rpm"][1]
+    rpm = np.array([run.speed for run in ctx.test.runs]) * RAD_S_TO_RPM
+    # each run of the test on its side by speed: the runs the step was not read on (too few lines: the lowest) too
+    steps = {i: float(above if r >= first * (1 - 1e-9) else below) for i, r in enumerate(rpm)}
+    return {i: dB for i, dB in steps.items() if abs(dB) >= SIDE_TOLERANCE_DB}, tuple(p["moved"])
+
+
+def with_step_taken_out(again, first) -> tuple:
+    """The ``unexplained`` records of ``again`` (the search run on the records with :func:`channel_steps` of ``first``
+    taken out) with ``first``'s step record in front, in place of any gain record of that pair: the corrected records
+    no longer show the step, the data as given do; its modes' words say where they were fitted."""
+    (u,) = [u for u in first.unexplained if u.signature == "line_property"
+            and u.parameters.get("property") == "channel_gain" and u.parameters.get("pattern") == "step"
+            and len(u.parameters.get("moved", ())) == 1 and u.parameters.get("modes_on_changed_runs")][:1]
+    p = u.parameters
+    words = TAKEN_OUT.format(moved=p["moved"][0], reference=p["reference"] if p["moved"][0] == p["channel"]
+                             else p["channel"])
+    step = replace(u, parameters={**p, "factors_taken_out": True},
+                   causes=(u.causes[0].replace(THROUGH_THE_GAINS, words),) + tuple(u.causes[1:]))
+    others = [v for v in again.unexplained if not (v.signature == "line_property"
+                                                     and v.parameters.get("property") == "channel_gain"
+                                                     and set(v.channels) == set(u.channels))]
+    return (step, *others)

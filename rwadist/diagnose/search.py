@@ -618,7 +618,7 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
 
     sets = step_sets(diag, describe.run_steps, describe.search_standing(diag)[0])
     if not sets:
-        return diag
+        return _with_channel_step(diag, args)
     # the runs whose change was not read (NaN) may be changed ones: searched with them left in (as unchanged) and left
     # out, each kept by the search's own standard below (family wheel 2, the switched 442-rpm run unread: left in, an
     # amplitude law was added; family wheel 7 --seed 2, the unread 1000-rpm run unchanged: left out, the rocking
@@ -634,6 +634,23 @@ def diagnose(spectra: Spectra, model: WheelModel | None = None, k_sigma: float =
         if describe.search_standing(again) > describe.search_standing(best):
             best = again
     return best
+
+
+def _with_channel_step(diag: Diagnosis, args: tuple) -> Diagnosis:
+    """``diag``, or the search run again on the records with a channel's gain step taken out
+    (:func:`.gain_step.channel_steps`: one channel of a radial pair switched gain between runs, and a wheel's mode
+    rests on its lines) when that does as well by the search's own standard (:func:`.describe.search_standing`): its
+    modes are then fitted on one gain, not through two, and the step is described as it was read."""
+    from .gain_step import channel_steps, with_step_taken_out
+
+    got = channel_steps(diag)
+    if got is None:
+        return diag
+    again = _search(*args, steps=describe.RunSteps(*got))
+    if describe.search_standing(again) < describe.search_standing(diag):
+        return diag
+    again.unexplained = with_step_taken_out(again, diag)
+    return again
 
 
 def _search(*args, **kwargs) -> Diagnosis:
