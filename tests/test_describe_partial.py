@@ -33,9 +33,9 @@ PARTIAL_H, PARTIAL_C, EVERY = 2.7, 0.5, 3
 
 
 @functools.lru_cache(maxsize=None)
-def _truth_state(onset_rpm: float | None = None):
+def _truth_state(onset_rpm: float | None = None, stop_rpm: float = np.inf):
     """(context, the generator's truth as a state) of the records with the sidebands and the partial line (in every
-    third run; with ``onset_rpm``, in the runs above that speed instead)."""
+    third run; with ``onset_rpm``, in the runs above that speed, and below ``stop_rpm``, instead)."""
     test = simulate_steady(preset("ithaco-e"), SPEEDS, sample_rate=FS, n_samples=N, modes=False, noise=0.01, seed=5)
     c1 = TRUTH.empirical["radial_force"][0].C
     lines = [(1 - DELTA, DEPTH / 2 * c1, 1), (1 + DELTA, DEPTH / 2 * c1, 1), (PARTIAL_H, PARTIAL_C * c1, EVERY)]
@@ -44,7 +44,8 @@ def _truth_state(onset_rpm: float | None = None):
         t = np.arange(run.n_samples) / run.sample_rate
         w = abs(run.speed)
         for h, C, every in lines:
-            if (i % every == 0) if (onset_rpm is None or h != PARTIAL_H) else w * 60 / (2 * np.pi) > onset_rpm:
+            if (i % every == 0) if (onset_rpm is None or h != PARTIAL_H) else \
+                    onset_rpm < w * 60 / (2 * np.pi) < stop_rpm:
                 phase = h * w * t + rng.uniform(0, 2 * np.pi)
                 run.signals["Fx"] = run.signals["Fx"] + C * w**2 * np.cos(phase)
                 run.signals["Fy"] = run.signals["Fy"] + C * w**2 * np.sin(phase)
@@ -117,3 +118,20 @@ def test_a_line_that_starts_at_one_speed_says_between_which_speeds_it_starts():
     p = u.parameters
     assert p["interleaved"] is False and max(p["absent_rpm"]) < onset < min(p["present_rpm"])
     assert f"starts between {max(p['absent_rpm']):.0f} and {min(p['present_rpm']):.0f} rpm" in u.text(), u.text()
+
+
+def test_a_line_over_one_band_of_speeds_says_where_it_starts_and_stops_not_interleaved():
+    """The 2.7 line present only at 2460-3900 rpm (one band, the runs without it on both sides): described as starting
+    and stopping between the runs bracketing the generator's band, not as interleaved with the runs lacking it (a new
+    user's trial, wheel A's h 2.73 on Fz at 2054-3954 rpm: "the two interleaved", "an intermittent source")."""
+    onset, stop = 2460.0, 3900.0        # between runs of the 120 rpm grid
+    ctx, state = _truth_state(onset, stop)
+    found = describe_residual(Residual.of(ctx, state))
+    (u,) = [u for u in found if u.signature == "partial_line"]
+    p = u.parameters
+    assert p["interleaved"] is False and onset < min(p["present_rpm"]) and max(p["present_rpm"]) < stop
+    below = max(x for x in p["absent_rpm"] if x < onset)
+    above = min(x for x in p["absent_rpm"] if x > stop)
+    assert (f"starts between {below:.0f} and {min(p['present_rpm']):.0f} rpm and stops between "
+            f"{max(p['present_rpm']):.0f} and {above:.0f} rpm") in u.text(), u.text()
+    assert u.causes[0].startswith("a source that starts or stops"), u.causes

@@ -20,13 +20,9 @@ import numpy as np
 
 from .describe_reach import TRACK_SHARE_FLOOR, lifted_hold, on_a_moving_skirt, with_track_causes, without_notched_lines
 from .engine import Context
-from .fixed_lines import describe_fixed_lines, find_fixed_lines, remove_fixed_lines
-from .one_channel_lines import (
-    describe_one_channel_lines,
-    find_one_channel_lines,
-    one_channel_line_shares,
-    remove_one_channel_lines,
-)
+from .fixed_lines import describe_fixed_lines, find_fixed_lines, remove_fixed_lines, subtract_tones
+from .one_channel_lines import describe_one_channel_lines, find_one_channel_lines, one_channel_line_shares
+from .range_lines import describe_range_lines, find_range_lines, range_line_shares, range_line_tones
 from .run_order import read_in_recorded_order as in_order
 from .state import State
 
@@ -53,6 +49,9 @@ class Opened:
     #: lines at a constant ratio of the speed on one channel of the radial-force pair that the wheel's translation mode
     #: does not lift, taken out (:class:`~rwadist.diagnose.one_channel_lines.OneChannelLine`)
     one_channel: list = field(default_factory=list)
+    #: lines on the radial-force pair over one band of speeds that the translation mode does not lift, taken out
+    #: (:class:`~rwadist.diagnose.range_lines.RangeLine`)
+    ranged: list = field(default_factory=list)
 
 
 def start(ctx: Context, steps: dict | None = None) -> Opened:
@@ -84,20 +83,25 @@ def start(ctx: Context, steps: dict | None = None) -> Opened:
     # a line of one radial-force channel that the wheel's translation mode does not lift: a source outside the wheel
     # (:mod:`.one_channel_lines`), read once the fixed lines and copies are out; left in, the empirical base made it a
     # planar radial-force line (both channels) and the modes' fit carried it through the translation mode
+    # (and a line on the pair over one band of speeds, not lifted either: :mod:`.range_lines`; one empirical fit)
+    from .one_channel_lines import one_channel_tones, pair_fit
+
     read = ctx if test is ctx.test else context(test)
-    ones = find_one_channel_lines(read)
-    if ones:
-        test = remove_one_channel_lines(read, ones)
-    if not fixed and not copies and not steps and not ones:
+    fit = pair_fit(read)
+    ones = find_one_channel_lines(read, fit) if fit is not None else []
+    ranged = find_range_lines(read, fit, ones) if fit is not None else []
+    if ones or ranged:
+        test = subtract_tones(read.test, one_channel_tones(ones) + range_line_tones(ranged))
+    if not fixed and not copies and not steps and not ones and not ranged:
         return Opened(ctx, ctx)
-    whole = read if not ones and read is not ctx else context(test)
+    whole = read if not ones and not ranged and read is not ctx else context(test)
     unread = {r for r, dB in steps.items() if not np.isfinite(dB)}
     if not unread or test is None:
-        return Opened(whole, ctx, fixed, copies, steps, sidebands=sidebands, one_channel=ones)
+        return Opened(whole, ctx, fixed, copies, steps, sidebands=sidebands, one_channel=ones, ranged=ranged)
     from ..data import SteadyTest
 
     kept = SteadyTest([run for i, run in enumerate(test.runs) if i not in unread], dict(test.meta))
-    return Opened(context(kept), ctx, fixed, copies, steps, whole, sidebands=sidebands, one_channel=ones)
+    return Opened(context(kept), ctx, fixed, copies, steps, whole, sidebands=sidebands, one_channel=ones, ranged=ranged)
 
 
 class RunSteps(dict):
@@ -509,6 +513,7 @@ def _described(diag, opened: Opened, search_after: State, bearings=()) -> tuple:
     found = describe_fixed_lines(opened.raw, opened.fixed, fixed_line_shares(res, opened.fixed))
     found += describe_sidebands(res, opened.sidebands)
     found += describe_one_channel_lines(opened.raw, opened.one_channel, one_channel_line_shares(res, opened.one_channel))
+    found += describe_range_lines(opened.raw, opened.ranged, range_line_shares(res, opened.ranged))
     found += describe_channel_copies(opened.raw, opened.copies, channel_copy_shares(res, opened.copies))
     # the final model's residual on the data the search read (the fixed lines and copies out), shares on the data
     found += describe_residual(searched or res, bearings, res, changes=bool(opened.steps), carriers=opened.fixed,
@@ -782,9 +787,10 @@ def finish(diag, opened: Opened, bearings=(), rebuild=None):
         if not forced:
             found, res = _described(diag, opened, search_after, bearings)
     diag.unexplained = tuple(found)
-    # (a line of a source outside the wheel, :mod:`.one_channel_lines`, is no relation of the wheel's lines)
+    # (a line of a source outside the wheel, :mod:`.one_channel_lines`, :mod:`.range_lines`, is no relation of the
+    # wheel's lines: both say the translation mode they are not lifted by)
     diag.line_causes = line_causes(diag, bearings, [u.h for u in found if u.h is not None
-                                                    and "one_channel" not in u.parameters])
+                                                    and "translation_Hz" not in u.parameters])
     diag.bearings = bearings
     # the lines the search added to an empirical base carry the sense their x/y phase reads, as the base's do
     from .start_model import sensed_lines

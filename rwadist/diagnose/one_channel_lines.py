@@ -16,7 +16,7 @@ value and left the mode declared not located (a new user's trial, W5 with h 2.37
 line's missing lift was described as a ``partial_line`` "absent" from the three runs at the crossing.
 
 The telling signature needs both halves: one channel alone (:func:`_partner_dB`), and no lift where the wheel's
-other radial-force lines show one (:func:`_lift_followed`: the slope of the line's log level against the log gain
+other radial-force lines show one (:func:`lift_followed`: the slope of the line's log level against the log gain
 of the translation mode those lines locate, :func:`rwadist.mode_scan.scan_mode`; 1 for a load of the wheel, 0 for
 one added at the load cell).  A one-channel line that does not cross a lift the other lines show (a hard-mounted
 wheel, a line far from the mode) cannot be told from a planar load of the wheel and is left to the search.
@@ -50,7 +50,7 @@ MAX_LIFT_FOLLOWED = 0.25
 #: the imbalance's order is left to the search (a counter_rotation names a one-sided 1x)
 IMBALANCE_H_TOL = 1e-3
 #: each run's frequency of the line is refined on its record within this many record bins of h·|Ω|/2π, on a grid of
-#: REFINE_STEP record bins (:func:`_run_frequencies`): the empirical fit's h (4 places) is off by up to a few 1e-4,
+#: REFINE_STEP record bins (:func:`run_frequencies`): the empirical fit's h (4 places) is off by up to a few 1e-4,
 #: a quarter turn of phase over a long record, and the tone taken out with it left 10 % of the line in each Welch
 #: segment, read again as a line there
 REFINE_HALF_BINS = 0.5
@@ -84,6 +84,17 @@ class OneChannelLine:
     f_runs: np.ndarray | None = field(default=None, repr=False, compare=False)
 
 
+def pair_fit(ctx):
+    """The empirical fit of the context's spectra the lines outside the wheel are read on (this module's and
+    :mod:`.range_lines`'), or None without the time series, both channels of the radial-force pair or
+    :data:`MIN_RUNS` runs (nothing to read: no fit made)."""
+    from ..empirical import fit_empirical
+
+    if ctx.test is None or not set(DIRECTION_CHANNELS[DIRECTION]) <= set(ctx.channels) or ctx.runs.size < MIN_RUNS:
+        return None
+    return fit_empirical(ctx.sp)
+
+
 def find_one_channel_lines(ctx, fit=None) -> list:
     """The :class:`OneChannelLine` of the context's data (its empirical fit ``fit``, fitted here when None); [] without
     the time series or both channels of the pair."""
@@ -105,7 +116,7 @@ def find_one_channel_lines(ctx, fit=None) -> list:
         cands.append((ln, chans.pop()))
     if not cands:
         return []
-    mode = _translation(fit, [ln for ln, _ in cands])
+    mode = translation_mode(fit, [ln for ln, _ in cands])
     if mode is None:
         return []
     out = []
@@ -116,7 +127,7 @@ def find_one_channel_lines(ctx, fit=None) -> list:
     return out
 
 
-def _translation(fit, leave_out) -> tuple | None:
+def translation_mode(fit, leave_out) -> tuple | None:
     """(f0 Hz, ζ) of the radial translation mode the fit's radial-force lines measured on both channels locate (every
     speed: :attr:`rwadist.empirical.EmpiricalFit.without_mode_exclusion`), ``leave_out``'s h left out; None when the
     scan does not find it (a hard-mounted wheel, no line near the mode: no lift to test a line against)."""
@@ -142,7 +153,6 @@ def _judge(ctx, ln, c: str, partner: str, mode: tuple) -> OneChannelLine | None:
     """The line ``ln`` of the empirical fit measured on channel ``c`` alone as a :class:`OneChannelLine` when its
     ``partner`` stays under it in every run (:data:`PARTNER_MEDIAN_DB`, :data:`PARTNER_P90_DB`) and it does not follow
     the lift of the translation mode ``mode`` (f0 Hz, ζ) at its runs (:data:`MAX_LIFT_FOLLOWED`), else None."""
-    from ..mode_scan import transmissibility_sq
     from .fixed_lines import run_amplitudes
 
     w_all = np.abs(np.asarray(ctx.sp.speed, dtype=float))
@@ -164,24 +174,15 @@ def _judge(ctx, ln, c: str, partner: str, mode: tuple) -> OneChannelLine | None:
     if not (med <= PARTNER_MEDIAN_DB and p90 <= PARTNER_P90_DB):
         return None
     w = w_all[rows]
-    f0, zeta = mode
-    gain = np.sqrt(transmissibility_sq(ln.h * w, w, [f0], [zeta], [0.0])[0])
-    if gain.max() / gain.min() < MIN_LIFT_RANGE or int(np.sum(gain >= LIFT_MIN)) < MIN_LIFTED_RUNS:
-        return None                         # no lift of the wheel's lines at its runs to tell it by
-    y = np.log(a_c / w**2)
-    x = np.log(gain)
-    X = np.column_stack([np.ones_like(x), x])
-    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
-    resid = y - X @ coef
-    dof = max(rows.size - 2, 1)
-    cov = float(resid @ resid) / dof * np.linalg.inv(X.T @ X)
-    slope, se = float(coef[1]), float(math.sqrt(max(cov[1, 1], 0.0)))
-    if slope > MAX_LIFT_FOLLOWED:
+    got = lift_followed(a_c, w, ln.h, mode)
+    if got is None or got[0] > MAX_LIFT_FOLLOWED:
         return None
+    slope, se, gain = got
+    f0, zeta = mode
     k = int(np.argmax(gain))
     # the amplitude subtracted in each run: the tone fitted on the whole record beside any line passing it (NaN where
     # a line inside its main lobe is not told apart: that run is left as it is), at the run's own frequency of it
-    f_runs = _run_frequencies(ctx, c, f_runs)
+    f_runs = run_frequencies(ctx, c, f_runs)
     A = run_amplitudes(ctx, f_runs, (c,))[:, 0]
     h = float(np.median(f_runs[rows] * 2 * np.pi / w))     # the ratio the runs' own frequencies give
     return OneChannelLine(h=h, channel=c, partner=partner, C=float(np.median(a_c / w**2)),
@@ -191,7 +192,27 @@ def _judge(ctx, ln, c: str, partner: str, mode: tuple) -> OneChannelLine | None:
                           amplitudes=A, f_runs=f_runs)
 
 
-def _run_frequencies(ctx, c: str, f_runs: np.ndarray) -> np.ndarray:
+def lift_followed(a: np.ndarray, w: np.ndarray, h: float, mode: tuple) -> tuple | None:
+    """(slope, its standard error, the gain |T| per run) of a line's log level ``log(a/Ω²)`` (``a``: its amplitude at
+    the speeds ``w`` rad/s) on the log gain the translation mode ``mode`` (f0 Hz, ζ) gives h·Ω at Ω: 1 for a load of
+    the wheel, 0 for one added at the load cell; None when that gain does not lift the line at its runs enough to
+    tell (:data:`MIN_LIFT_RANGE`, :data:`LIFT_MIN` in :data:`MIN_LIFTED_RUNS` runs)."""
+    from ..mode_scan import transmissibility_sq
+
+    f0, zeta = mode
+    gain = np.sqrt(transmissibility_sq(h * w, w, [f0], [zeta], [0.0])[0])
+    if gain.max() / gain.min() < MIN_LIFT_RANGE or int(np.sum(gain >= LIFT_MIN)) < MIN_LIFTED_RUNS:
+        return None                         # no lift of the wheel's lines at its runs to tell it by
+    y = np.log(a / w**2)
+    x = np.log(gain)
+    X = np.column_stack([np.ones_like(x), x])
+    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+    resid = y - X @ coef
+    cov = float(resid @ resid) / max(w.size - 2, 1) * np.linalg.inv(X.T @ X)
+    return float(coef[1]), float(math.sqrt(max(cov[1, 1], 0.0))), gain
+
+
+def run_frequencies(ctx, c: str, f_runs: np.ndarray) -> np.ndarray:
     """Each run's frequency of a line near ``f_runs`` (Hz, every run of the test; NaN kept) on channel ``c``: the
     maximum of |X|² of the whole record over ±:data:`REFINE_HALF_BINS` record bins, a parabola through its logarithm's
     top three points; the nominal one where the maximum lies on the grid's edge."""
@@ -212,12 +233,10 @@ def _run_frequencies(ctx, c: str, f_runs: np.ndarray) -> np.ndarray:
     return out
 
 
-def remove_one_channel_lines(ctx, lines):
-    """A copy of the context's test with each line of ``lines`` subtracted from its channel's records in every run
-    where its amplitude was read: x − Re(A·e^{2πj f t}), f = h·|Ω|/2π (:func:`.fixed_lines.subtract_tones`)."""
-    from .fixed_lines import subtract_tones
-
-    return subtract_tones(ctx.test, [(ln.channel, ln.f_runs, ln.amplitudes) for ln in lines])
+def one_channel_tones(lines) -> list:
+    """The tones (channel, frequency Hz per run, complex amplitude per run) of ``lines`` to take out of the records
+    (:func:`.fixed_lines.subtract_tones`): each line on its channel in every run where its amplitude was read."""
+    return [(ln.channel, ln.f_runs, ln.amplitudes) for ln in lines]
 
 
 def one_channel_line_shares(res, lines) -> dict:

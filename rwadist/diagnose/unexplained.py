@@ -232,6 +232,8 @@ class Unexplained:
                     "dB lift the wheel's other radial-force lines locate there")
             if p.get("removed_before_the_search"):
                 out += " (taken out of the data before the search)"
+        if self.signature == "speed_line" and "present_over_noise_dB" in self.parameters:
+            out += self._range_line_words()
         peak = _number(self.parameters.get("peak_over_model_dB"))
         if peak is not None:
             # a narrow line's bands hold the model's lines beside it: its own bins say how far it stands out
@@ -249,6 +251,21 @@ class Unexplained:
             out += self._partial_span()
         return out
 
+    def _range_line_words(self) -> str:
+        """A line on the radial-force pair over one band of speeds that the translation mode does not lift
+        (:mod:`.range_lines`) in words: where it starts and stops, and the lift it lacks."""
+        p = self.parameters
+        edges = [f"{w} between {e[0]:.0f} and {e[1]:.0f} rpm" for w, e in (("starts", p.get("starts_between_rpm")),
+                                                                        ("stops", p.get("stops_between_rpm"))) if e]
+        out = (f", present over one band of speeds ({_number(p.get('present_over_noise_dB')) or 0:+.0f} dB over the "
+               f"noise there; at the noise outside it, where its C·Ω² would stand "
+               f"{_number(p.get('expected_over_noise_dB')) or 0:+.0f} dB over it: it {' and '.join(edges)}), and not "
+               f"lifted by the wheel's translation mode ({_number(p.get('translation_Hz')) or 0:.4g} Hz, crossed at "
+               f"{_number(p.get('crossing_rpm')) or 0:.0f} rpm): it follows "
+               f"{round(_number(p.get('lift_followed')) or 0.0, 2) + 0.0:.2f} of the "
+               f"{_number(p.get('largest_lift_dB')) or 0:.0f} dB lift the wheel's other radial-force lines locate there")
+        return out + (" (taken out of the data before the search)" if p.get("removed_before_the_search") else "")
+
     def _partial_span(self) -> str:
         """A partial line's runs in words: where it is absent and present, and, when the two part at one speed, the
         speeds it starts (stops) between (trial25's rub, present above 2800 rpm, read "1625-4000 rpm" alone)."""
@@ -262,6 +279,10 @@ class Unexplained:
             return out + ", the two interleaved)"
         if max(absent) < min(present):
             return out + f": it starts between {max(absent):.0f} and {min(present):.0f} rpm)"
+        if min(absent) < min(present):          # one band of runs holding it, runs without it on both sides
+            below, above = max(x for x in absent if x < min(present)), min(x for x in absent if x > max(present))
+            return out + (f": it starts between {below:.0f} and {min(present):.0f} rpm and stops between "
+                          f"{max(present):.0f} and {above:.0f} rpm)")
         return out + f": it stops between {max(present):.0f} and {min(absent):.0f} rpm)"
 
     def _run_change_level(self) -> str:
