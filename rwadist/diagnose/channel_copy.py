@@ -201,11 +201,25 @@ def find_channel_copies(ctx, test=None) -> list:
     # is the same copy read backwards)
     out = []
     for ct in dict.fromkeys(x.target for x in found):
+        # a crosstalk term is a real gain: of a source and its pair's partner (a co-rotating line's x and y a quarter
+        # turn apart: both fit), the one read in phase or in antiphase leads a tie by lines, or a deficit of one (the
+        # session-68 trial, Fz += 0.3·Fx on co-rotating lines: "0.307 × Fy at +95.6°", Fy holding one more run)
         cands = sorted((x for x in found if x.target == ct and (abs(x.kappa) < 1.0 or x.floor_z > 0)),
-                       key=lambda x: (-len(x.lines_h), -len(x.runs)))
+                       key=lambda x: (-(len(x.lines_h) + IN_PHASE_LINES * _in_phase(x.kappa)), -len(x.runs)))
         if cands:
             out.append(replace(cands[0], alternatives=tuple(x.source for x in cands[1:])))
     return out
+
+
+#: A copy's ratio within this of 0° or 180° (deg) is in phase, as a crosstalk term (a real gain) is ...
+IN_PHASE_DEG = 30.0
+#: ... and counts this many lines more when the copies of one target are ranked (a source against its partner)
+IN_PHASE_LINES = 1
+
+
+def _in_phase(kappa: complex) -> bool:
+    """True when the complex ratio ``kappa`` lies within :data:`IN_PHASE_DEG` of the real axis."""
+    return abs(np.sin(np.angle(kappa))) <= np.sin(np.radians(IN_PHASE_DEG))
 
 
 def _floor_copies(test, runs, chans, found, X, noise, src, run_of, h) -> list:
