@@ -42,12 +42,13 @@ def test_the_words_give_the_band_that_holds_the_floors_power():
     """A floor's line of words gives the band of the central 90 % of its power and its peak's frequency, not the knots'
     whole range (the session-68 trial's hump at 420 Hz, fitted as a floor over 8-1990 Hz, was said "8–1990 Hz").
     A flat floor over 0-1000 Hz holds 5 % of its power below 50 Hz and above 950 Hz (its cumulative power is linear);
-    a triangle of half-width 20 Hz about 420 Hz holds its central 90 % within 400-440 Hz."""
+    a triangle of half-width 20 Hz about 420 Hz holds 5 % of its power below 400 + 20·√0.1 Hz (the cumulative power of
+    its rising side is ½·((f − 400)/20)²) and 5 % above 440 − 20·√0.1 Hz."""
     base = {"kind": "broadband_floor", "channel": ["Fz"], "exponent": 3.0, "omega_ref_rad_s": 300.0}
     flat = describe_effect({**base, "f_Hz": [0.0, 1000.0], "psd_ref": [1e-6, 1e-6]})
     assert "90 % of its power at 50–950 Hz" in flat
     f = [8.0, 400.0, 420.0, 440.0, 1990.0]
     hump = describe_effect({**base, "f_Hz": f, "psd_ref": [0.0, 0.0, 2e-6, 0.0, 0.0]})
     lo, hi = (float(x) for x in hump.split("of its power at ")[1].split(" Hz")[0].split("–"))
-    assert 400.0 <= lo < 410.0 and 430.0 < hi <= 440.0
+    assert lo == round(400.0 + 20.0 * np.sqrt(0.1)) and hi == round(440.0 - 20.0 * np.sqrt(0.1))
     assert "peak 2e-06 N²/Hz at 420 Hz" in hump and "8–1990" not in hump

@@ -1,6 +1,7 @@
 """``broadband_floor``: a broadband (noise-like) load floor of some channels, growing with speed."""
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -88,10 +89,20 @@ class BroadbandFloor(Element):
         total = float(seg.sum())
         if not total > 0:
             return float(f.min()), float(f.max())
-        cum = np.concatenate([[0.0], np.cumsum(seg)]) / total
-        tail = 0.5 * (1.0 - POWER_SHARE)
-        # the cumulative power is piecewise quadratic between the knots: interpolated linearly, to a knot's spacing
-        return float(np.interp(tail, cum, f)), float(np.interp(1.0 - tail, cum, f))
+        cum = np.concatenate([[0.0], np.cumsum(seg)])
+        tail = 0.5 * (1.0 - POWER_SHARE) * total
+
+        def at(power: float) -> float:
+            # the cumulative power is quadratic in each segment, P(f0 + t) = P0 + p0·t + (p1 − p0)/(2Δ)·t²: its root
+            # in the segment that holds ``power``, in the form that keeps its precision when the slope vanishes
+            k = int(np.clip(np.searchsorted(cum, power, side="right") - 1, 0, f.size - 2))
+            d = f[k + 1] - f[k]
+            a, b, r = (psd[k + 1] - psd[k]) / (2.0 * d), psd[k], power - cum[k]
+            root = math.sqrt(max(b * b + 4.0 * a * r, 0.0))
+            t = 2.0 * r / (b + root) if b + root > 0 else d
+            return float(f[k] + min(max(t, 0.0), d))
+
+        return at(tail), at(total - tail)
 
     @staticmethod
     def _psd_unit(e) -> str:
