@@ -4,8 +4,9 @@ Written for tests/test_moving_structure_mode.py, independent of rwadist's physic
 through the suspension's transmissibility (radial translation and axial: (k + jcω)/(k − mω² + jcω); the rocking mode's
 co-rotating whirl: (ω0² + 2jζω0ω)/(ω0² − ω² + aΩω + 2jζω0ω)), radial lines co-rotating (x = Re, y = Im), times a
 structure mode holding a share μ of the rotor's mass on the chosen channels, H = 1 + μr²/(1 − r² + 2jζr) with
-r = f/f_s(rpm), f_s = f0 + slope·rpm (1 below, 1 − μ far above, an antiresonance at f_s/sqrt(1 − μ)), and white
-noise; written in the interchange format of docs/formats.md (runs.csv, run_NNNN.csv, meta.json).
+r = f/f_s(rpm), f_s = f0 + slope·rpm (1 below, 1 − μ far above, an antiresonance at f_s/sqrt(1 − μ); a slope of either
+sign: rising with speed, tests/test_moving_structure_mode.py, or falling on every channel, a structure under the load
+cell, tests/test_moving_stand_reach.py), and white noise; written in the interchange format of docs/formats.md (runs.csv, run_NNNN.csv, meta.json).
 """
 from __future__ import annotations
 

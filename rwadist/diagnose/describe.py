@@ -370,8 +370,9 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
     from .describe_hump import broadband_hump, humps_in_some_runs
     from .describe_line_step import line_steps, with_line_steps, without_steps
     from .describe_lines import speed_lines
-    from .describe_mode_drift import drifting_modes, same_track
+    from .describe_mode_drift import drifting_modes
     from .describe_partial import partial_lines
+    from .describe_pooled import moving_resonances
     from .describe_split import radial_pairs
     from .describe_trend import gain_trend
 
@@ -426,8 +427,7 @@ def describe_residual(searched: Residual, bearings=(), res: Residual | None = No
               for r in ratios]
     # the model's own mode moving over the runs first: a resonance lifting lines fits only its rise
     drifting = [u for u in drifting_modes(ctx, state, steady, of_track) if holds_content(u, res)]
-    out += drifting + [u for u in structure.moving_resonance(ctx, state, steady, of_track) if holds_content(u, res)
-                       and not any(same_track(u, v) for v in drifting)]
+    out += drifting + moving_resonances(ctx, state, steady, of_track, lambda u: holds_content(u, res), drifting)
     read = structure.line_ratios(res.ctx, res.state) if changes else ratios
     out += _run_change(ctx, state, read, of_runs, in_order, changes)
     out += speed_lines(ctx, state, of_line, bearings, others, ctx.left_out)

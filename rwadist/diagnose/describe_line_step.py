@@ -129,7 +129,7 @@ def _on_a_track(records, direction: str, f: np.ndarray, spin: np.ndarray) -> boo
         if p.get("property") == "channel_resonance" and set(u.channels) & set(DIRECTION_CHANNELS[direction]):
             if _lifted(f, p["f_r_Hz"], p["zeta"], p["peak_gain"]):
                 return True
-        elif u.signature == "moving_resonance" and p.get("direction") == direction:
+        elif u.signature == "moving_resonance" and direction in (p.get("direction"), *p.get("directions", ())):
             s_lo, s_hi = (x / 60.0 for x in u.speed_rpm)
             f_lo, f_hi = p["f_at_lowest_speed_Hz"], p["f_at_highest_speed_Hz"]
             track = f_lo + (f_hi - f_lo) * (spin - s_lo) / (s_hi - s_lo) if s_hi > s_lo else np.full(spin.shape, f_lo)

@@ -13,6 +13,7 @@ from ..diagnose.stands import StandSet
 from ..diagnose.state import State
 from ..resonance import log_power_gain_jacobian, numerator_damping, resonance
 from ..units import CHANNEL_DIRECTION, DIRECTION_CHANNELS, RADIAL_PAIRS
+from .fixed_resonance_moving import in_moving_reach, split_halves
 
 #: Smallest peak gain (or 1/gain, an anti-resonance of a test stand) proposed: |H| within 10 % of 1 everywhere is the size of the
 #: fit's own model error near a mode (a per-unit extended base leaves ~1-3 % there), not a resonance.
@@ -269,7 +270,7 @@ def speed_split(ctx: Context, state: State, e: "FixedResonance") -> dict | None:
     """The resonance ``e`` (proposed on ``state``, which does not hold it) fitted with one centre for the slower and
     one for the faster half of the runs (ζ, the numerator's damping γ and, fixed, its gain far above shared), against
     one centre for both; None when a half holds fewer than :data:`SPLIT_MIN_RUNS` runs or the lines give too few
-    points.
+    points (the halves: :func:`rwadist.effects.fixed_resonance_moving.split_halves`).
 
     Both fits are robust (soft-L1) least squares of ln|H|² (:func:`rwadist.resonance.general_log_power_gain`) on the
     log power gains of ``e``'s channels' lines (:func:`_line_gain_points`, measured on each half's runs), from ``e``
@@ -288,17 +289,13 @@ def speed_split(ctx: Context, state: State, e: "FixedResonance") -> dict | None:
 
     from ..resonance import general_log_power_gain, numerator_damping
 
-    runs = np.asarray(ctx.runs)
-    half = runs.size // 2
-    if half < SPLIT_MIN_RUNS:
-        return None
-    order = np.argsort(np.abs(ctx.omega[runs]), kind="stable")
     chans = [c for c in e.channels if c in ctx.channels]
-    parts = [_line_gain_points(ctx, state, chans, np.sort(runs[o]))[:3] for o in (order[:half], order[-half:])]
+    # the halves of every run, else of the runs whose lines reach it (a half under its reach places no centre)
+    parts = split_halves(ctx, e, lambda runs, **kw: _line_gain_points(ctx, state, chans, runs, **kw), SPLIT_MIN_RUNS)
+    if parts is None:
+        return None
     f, y, w = (np.concatenate([p[k] for p in parts]) for k in range(3))
     fast = np.repeat([False, True], [parts[0][0].size, parts[1][0].size])
-    if min(p[0].size for p in parts) < 3 or f.size < 8 or not all(_straddles(e, p[0]) for p in parts):
-        return None
     sw, beta = np.sqrt(w), float(e.gain_above)
 
     def res_jac(x, split):
@@ -324,25 +321,19 @@ def speed_split(ctx: Context, state: State, e: "FixedResonance") -> dict | None:
             "moved": float(abs(np.log(f_fast / f_slow)))}
 
 
-def _straddles(e: "FixedResonance", f: np.ndarray) -> bool:
-    """Whether lines at ``f`` (Hz) place the centre of ``e``: some below it and some above it where it changes their
-    power by 1.5x or more.  A half of the runs whose lines reach only one skirt cannot (the new-user trial of session
-    54: a fixture at 800 Hz crossed only by the lines of the runs above 5450 rpm, the slower half's skirt put its centre
-    11 % from the faster half's, ζ 0.0045, and the fixture was refused as moving with the speed)."""
-    from ..stand_detect import STAND_MIN_LOG_GAIN, log_power_gain
-
-    near = f[np.abs(log_power_gain(e, f)) >= STAND_MIN_LOG_GAIN]
-    return bool(np.any(near < e.f_r) and np.any(near > e.f_r))
-
-
 def moves_with_speed(ctx: Context, state: State, e: "FixedResonance") -> bool:
     """Whether the proposed fixed resonance ``e`` moves with the speed (:func:`speed_split`): the data want a centre of
     their own for each half of the runs (evidence > 0) and the two lie more than the resonance's relative half-power
     half-width ζ (and :data:`SPLIT_MIN_MOVE`) apart, beyond what a resonance of that width resolves.  Such a resonance
     is no fixed resonance: the open world describes it (``moving_resonance``, :mod:`rwadist.diagnose.describe_structure`)."""
+    return moving_split(ctx, state, e) is not None
+
+
+def moving_split(ctx: Context, state: State, e: "FixedResonance") -> dict | None:
+    """:func:`speed_split` of ``e`` when it moves with the speed (:func:`moves_with_speed`), else None."""
     split = speed_split(ctx, state, e)
-    return bool(split is not None and split["evidence"] > 0
-                and split["moved"] > max(split["zeta"], SPLIT_MIN_MOVE))
+    moved = split is not None and split["evidence"] > 0 and split["moved"] > max(split["zeta"], SPLIT_MIN_MOVE)
+    return split if moved else None
 
 
 def _fit_stand_with_levels(ctx: Context, state: State, channels, chans, runs, f0, n_iter) -> "FixedResonance | None":
@@ -666,7 +657,11 @@ class FixedResonance:
         # 300-3000 rpm: a 'wheel mode' at 158.5 Hz; the slower half of the runs wants 151.7 Hz, the faster 159.3 Hz)
         # (read with the line levels fitted with it: a fixture biases the base's C, and a line read against a biased C
         # lifts the half of the speeds on the fixture's other side, W7 trial wheel on a 120-Hz fixture)
-        out = [e for e in out if not moves_with_speed(ctx, e.levelled(state) if e.line_levels else state, e)]
+        # (and one direction's resonance within the reach of one of more channels refused so: its lines cross the
+        # moving one in a few runs, which its own split cannot place: :func:`.fixed_resonance_moving.in_moving_reach`)
+        splits = [moving_split(ctx, e.levelled(state) if e.line_levels else state, e) for e in out]
+        moving = [(e, s) for e, s in zip(out, splits) if s is not None]
+        out = [e for e, s in zip(out, splits) if s is None and not in_moving_reach(e, moving)]
         # the fixtures the modes located together, each kept so far: also as one hypothesis (:class:`StandSet`)
         located = [e for e in out if e.extended_stand is not None and e.role == "test_stand"]
         return out + ([StandSet(tuple(located))] if len(located) >= 2 else [])
