@@ -5,8 +5,8 @@ resonance falling 512 -> 400 Hz with the speed on every channel, H = 1 + μr²/(
 lines reach 400-500 Hz only above ~2400 rpm: the slower half of the runs (200-2200 rpm) held no line within its reach,
 :func:`rwadist.effects.fixed_resonance_diagnose.speed_split` told nothing and a 'test stand' at 421.5 Hz on every
 channel was added, I_zz/I_rr 3 % off; on wheel A (300-6000 rpm) 'wheel modes' at 399 and 413 Hz on one direction.
-Now the runs that reach it are split (:func:`rwadist.effects.fixed_resonance_moving.split_halves`): the stand is refused
-as moving, and so is one direction's resonance in its reach (:func:`rwadist.effects.fixed_resonance_moving.in_moving_reach`);
+Now the runs that reach it are split (:func:`rwadist.diagnose.fixed_resonance_moving.split_halves`): the stand is refused
+as moving, and so is one direction's resonance in its reach (:func:`rwadist.diagnose.fixed_resonance_moving.in_moving_reach`);
 a stand as high that does not move is kept.  Refused, it is described as one ``moving_resonance`` on every direction's
 lines pooled (:mod:`rwadist.diagnose.describe_pooled`; no direction's lines read its slope alone), and the amplitude
 laws fitted to its rise are taken back (before: h 4.31 Ω^2.2 on Fz and Tx, Ty; h 2 Ω^2.07 and h 3.62 Ω^2.27 on wheel A).
@@ -27,8 +27,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from structure_mode_wheel import write_runs  # noqa: E402
 
 import rwadist.effects.fixed_resonance_diagnose as frd  # noqa: E402
+from rwadist.diagnose.fixed_resonance_moving import in_moving_reach  # noqa: E402
 from rwadist.effects.fixed_resonance_diagnose import FixedResonance  # noqa: E402
-from rwadist.effects.fixed_resonance_moving import in_moving_reach  # noqa: E402
 
 #: the trial's wheel B: its lines (h) and speeds, the resonance's ends, mass share and damping
 HS = (0.385, 1.0, 2.0, 4.31, 6.69, 8.62)

@@ -1,7 +1,7 @@
 """Two fixtures in series on every channel, each a base-excitation transmissibility (1 + 2jζr)/(1 − r² + 2jζr), the
 upper one crossed by the lines of the fastest runs only (rwadist.diagnose.stands.StandSet, and the fixed-resonance
 rules it needed: rwadist.effects.fixed_resonance_diagnose ``DIRECTION_MIN_POINTS`` and
-rwadist.effects.fixed_resonance_moving ``straddles``).
+rwadist.diagnose.fixed_resonance_moving ``straddles``).
 
 The new-user trial of session 54 (its own generator: a 2.5 kg wheel, modes 480 / 190 / 650 Hz, on fixtures at 350 Hz,
 ζ 0.03, and 800 Hz, ζ 0.02) had one resonance at 349 Hz with 0.67 of the load far above named, a compromise over

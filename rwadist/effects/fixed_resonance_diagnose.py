@@ -9,11 +9,11 @@ from ..diagnose.constants import LINE_HALF, SNR_KNEE
 from ..diagnose.describe_line_step import two_levels
 from ..diagnose.effects.base import register, schema_entry
 from ..diagnose.engine import Context
+from ..diagnose.fixed_resonance_moving import in_moving_reach, split_halves
 from ..diagnose.stands import StandSet
 from ..diagnose.state import State
 from ..resonance import log_power_gain_jacobian, numerator_damping, resonance
 from ..units import CHANNEL_DIRECTION, DIRECTION_CHANNELS, RADIAL_PAIRS
-from .fixed_resonance_moving import in_moving_reach, split_halves
 
 #: Smallest peak gain (or 1/gain, an anti-resonance of a test stand) proposed: |H| within 10 % of 1 everywhere is the size of the
 #: fit's own model error near a mode (a per-unit extended base leaves ~1-3 % there), not a resonance.
@@ -270,7 +270,7 @@ def speed_split(ctx: Context, state: State, e: "FixedResonance") -> dict | None:
     """The resonance ``e`` (proposed on ``state``, which does not hold it) fitted with one centre for the slower and
     one for the faster half of the runs (ζ, the numerator's damping γ and, fixed, its gain far above shared), against
     one centre for both; None when a half holds fewer than :data:`SPLIT_MIN_RUNS` runs or the lines give too few
-    points (the halves: :func:`rwadist.effects.fixed_resonance_moving.split_halves`).
+    points (the halves: :func:`rwadist.diagnose.fixed_resonance_moving.split_halves`).
 
     Both fits are robust (soft-L1) least squares of ln|H|² (:func:`rwadist.resonance.general_log_power_gain`) on the
     log power gains of ``e``'s channels' lines (:func:`_line_gain_points`, measured on each half's runs), from ``e``
@@ -658,7 +658,8 @@ class FixedResonance:
         # (read with the line levels fitted with it: a fixture biases the base's C, and a line read against a biased C
         # lifts the half of the speeds on the fixture's other side, W7 trial wheel on a 120-Hz fixture)
         # (and one direction's resonance within the reach of one of more channels refused so: its lines cross the
-        # moving one in a few runs, which its own split cannot place: :func:`.fixed_resonance_moving.in_moving_reach`)
+        # moving one in a few runs, which its own split cannot place: :func:`~rwadist.diagnose.fixed_resonance_moving.
+        # in_moving_reach`)
         splits = [moving_split(ctx, e.levelled(state) if e.line_levels else state, e) for e in out]
         moving = [(e, s) for e, s in zip(out, splits) if s is not None]
         out = [e for e, s in zip(out, splits) if s is None and not in_moving_reach(e, moving)]
