@@ -203,6 +203,14 @@ def _record(ctx, pair, h, stepping, cp, own, moved, shares) -> Unexplained:
         causes=causes, would_tell=would)
 
 
+def _step_with_modes(diag) -> Unexplained | None:
+    """The first ``step`` record of ``diag`` (:func:`gain_step`) of one channel that moved, with a wheel's mode on its
+    lines (``modes_on_changed_runs``), or None."""
+    return next((u for u in diag.unexplained if u.signature == "line_property"
+                 and u.parameters.get("property") == "channel_gain" and u.parameters.get("pattern") == "step"
+                 and len(u.parameters.get("moved", ())) == 1 and u.parameters.get("modes_on_changed_runs")), None)
+
+
 def channel_steps(diag) -> tuple | None:
     """(run index -> dB of power, (channel,)): the gain of the one channel that moved in a ``step`` record of ``diag``
     (:func:`gain_step`) on whose lines a wheel's mode rests, per run of the test, against its partner's on the run's
@@ -212,17 +220,16 @@ def channel_steps(diag) -> tuple | None:
     modes are fitted through the two gains (the session-68 trial, wheel A, Ty × 1.35 from 4100 rpm: rocking +2.5 %,
     I_zz/I_rr −7.3 %, described "suspect" and kept)."""
     ctx = diag.ctx
-    recs = [u for u in diag.unexplained if u.signature == "line_property"
-            and u.parameters.get("property") == "channel_gain" and u.parameters.get("pattern") == "step"
-            and len(u.parameters.get("moved", ())) == 1 and u.parameters.get("modes_on_changed_runs")]
-    if not recs or ctx.test is None:
+    u = _step_with_modes(diag)
+    if u is None or ctx.test is None:
         return None
-    p = recs[0].parameters
+    p = u.parameters
     # the ratios are the partner's (``channel``) over the reference's amplitude: the reference moving inverts them
     sign = 1.0 if p["moved"][0] == p["channel"] else -1.0
     below, above = (sign * 20.0 * np.log10(p[k]) for k in ("amplitude_ratio_below", "amplitude_ratio_above"))
     first = p["step_between_rpm"][1]
-    rpm = np.array([run.speed for run in ctx.test.runs]) * RAD_S_TO_RPM
+    # unsigned, as the record's speeds (a test run clockwise has negative speeds)
+    rpm = np.abs(np.array([run.speed for run in ctx.test.runs], dtype=float)) * RAD_S_TO_RPM
     # each run of the test on its side by speed: the runs the step was not read on (too few lines: the lowest) too
     steps = {i: float(above if r >= first * (1 - 1e-9) else below) for i, r in enumerate(rpm)}
     return {i: dB for i, dB in steps.items() if abs(dB) >= SIDE_TOLERANCE_DB}, tuple(p["moved"])
@@ -232,9 +239,9 @@ def with_step_taken_out(again, first) -> tuple:
     """The ``unexplained`` records of ``again`` (the search run on the records with :func:`channel_steps` of ``first``
     taken out) with ``first``'s step record in front, in place of any gain record of that pair: the corrected records
     no longer show the step, the data as given do; its modes' words say where they were fitted."""
-    (u,) = [u for u in first.unexplained if u.signature == "line_property"
-            and u.parameters.get("property") == "channel_gain" and u.parameters.get("pattern") == "step"
-            and len(u.parameters.get("moved", ())) == 1 and u.parameters.get("modes_on_changed_runs")][:1]
+    u = _step_with_modes(first)
+    if u is None:
+        return tuple(again.unexplained)
     p = u.parameters
     words = TAKEN_OUT.format(moved=p["moved"][0], reference=p["reference"] if p["moved"][0] == p["channel"]
                              else p["channel"])
