@@ -1,5 +1,6 @@
 """The family generator's data (tests/family_wheel.py: numpy arrays, no rwadist import) as rwadist's
-:class:`rwadist.data.SteadyTest` and :class:`rwadist.data.Sweep`, written once for the tests that read it."""
+:class:`rwadist.data.SteadyTest` and :class:`rwadist.data.Sweep`, written once for the tests that read it, and the
+checks several tests make of a diagnosis of it."""
 from __future__ import annotations
 
 import family_wheel as fw
@@ -19,3 +20,22 @@ def sweep_record(data: fw.SweepData) -> Sweep:
     """``data`` as a sweep record with no speed column: its six channels in :data:`family_wheel.CHANNELS` order."""
     return Sweep(time=data.time, signals={c: data.signals[j] for j, c in enumerate(fw.CHANNELS)},
                  sample_rate=data.sample_rate, tach=None)
+
+
+def diagnosed_without_line(path, wheel: fw.Wheel, direction: str, h: float):
+    """``rwadist diagnose`` (:func:`rwadist.api.diagnose`, no model) of the steady data at ``path``, checked to fit
+    the wheel's translation mode located (within 1 %, ζ within 15 %) and to leave no line at ratio ``h`` (±0.01) of
+    ``direction`` in the model: a source outside the wheel taken out before the search.  Returns the diagnosis."""
+    import warnings
+
+    from rwadist import api
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        diag = api.diagnose(str(path))
+    modes = next(e for e in diag.state_after.effects if e.kind == "suspension_modes")
+    assert not modes.unconstrained, modes.unconstrained
+    assert abs(modes.f0_Hz["radial_translation"] / wheel.f_trans - 1) < 0.01
+    assert abs(modes.zeta["radial_translation"] / wheel.zeta_trans - 1) < 0.15, (modes.zeta, wheel.zeta_trans)
+    assert not [x for x in diag.model.harmonics(direction) if abs(x.h - h) < 0.01]
+    return diag

@@ -218,6 +218,21 @@ def family(seed: int = 0) -> list:
     return [make_wheel(i, *row, seed=seed) for i, row in enumerate(FAMILY_TABLE)]
 
 
+def trial_wheel_a() -> Wheel:
+    """Session 68's new-user trial wheel A (6 kg, I_zz/I_rr 1.6, translation 180 Hz, rocking 110 Hz, axial 260 Hz,
+    300-6000 rpm at 4 kHz; a cage 0.41 and ball-pass 3.62 / 5.38 line set): its torque lines sparse (one imbalance
+    20-40× the bearing lines), so the rocking whirl's course is read mostly on the imbalance line."""
+    L = Line
+    lines = [L("radial_force", 1.0, 5e-6, 1.0, "imbalance"), L("radial_force", 2.0, 4e-7), L("radial_force", 0.41, 2e-7),
+             L("radial_force", 3.62, 3e-7), L("radial_force", 5.38, 2e-7), L("radial_force", 7.24, 1e-7),
+             L("radial_torque", 1.0, 2e-6, 1.0, "imbalance"), L("radial_torque", 0.41, 5e-8),
+             L("radial_torque", 3.62, 1e-7), L("radial_torque", 5.38, 6e-8), L("axial_force", 1.0, 3e-7),
+             L("axial_force", 2.0, 2e-7), L("axial_force", 3.62, 4e-7), L("axial_force", 7.24, 2e-7)]
+    return Wheel(name="trial-A", mass=6.0, I_zz=0.048, I_rr=0.03, f_trans=180.0, f_rock=110.0, f_axial=260.0,
+                 zeta_trans=0.02, zeta_rock=0.02, zeta_axial=0.025, lines=tuple(lines), min_rpm=300.0,
+                 max_rpm=6000.0, sample_rate=4000.0, n_speeds=24)
+
+
 # ------------------------------------------------------------------------------ harmonic balance (steady)
 def transfer(wheel: Wheel, direction: str, w, omega) -> np.ndarray:
     """Reaction over load of a direction at forcing frequencies ``w`` (rad/s, >= 0) and wheel speed

@@ -16,7 +16,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import family_wheel as fw  # noqa: E402
 from family_test import steady_test  # noqa: E402
-from test_channel_gain_step_modes import _wheel  # noqa: E402
 
 
 @pytest.mark.parametrize("source, partner, gain, seed", [("Fy", "Fx", 0.3, 0), ("Fx", "Fy", -0.2, 1)])
@@ -25,7 +24,7 @@ def test_the_copy_is_named_on_the_channel_it_copies_in_phase(source, partner, ga
     from rwadist.diagnose.engine import Context
     from rwadist.spectra import compute_spectra
 
-    data = fw.steady(_wheel(), noise=0.01, seed=seed)
+    data = fw.steady(fw.trial_wheel_a(), noise=0.01, seed=seed)
     data.signals[:, fw.CHANNELS.index("Fz")] += gain * data.signals[:, fw.CHANNELS.index(source)]
     test = steady_test(data)
     (cp,) = find_channel_copies(Context(compute_spectra(test), test=test))
@@ -38,7 +37,7 @@ def test_the_users_command_takes_the_copy_out_whole():
     """``rwadist.diagnose`` (no model) of Fz += 0.3·Fy: the copy named on Fy, nothing of it left for a partial line."""
     from rwadist.api import diagnose
 
-    data = fw.steady(_wheel(), noise=0.01, seed=2)
+    data = fw.steady(fw.trial_wheel_a(), noise=0.01, seed=2)
     data.signals[:, fw.CHANNELS.index("Fz")] += 0.3 * data.signals[:, fw.CHANNELS.index("Fy")]
     diag = diagnose(steady_test(data))
     (u,) = [u for u in diag.unexplained if u.signature == "channel_copy"]

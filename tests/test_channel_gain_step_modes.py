@@ -19,25 +19,10 @@ from family_test import steady_test  # noqa: E402
 
 from rwadist.api import diagnose  # noqa: E402
 
-L = fw.Line
-
-
-def _wheel() -> fw.Wheel:
-    """The trial's wheel A: its torque lines sparse (one imbalance 20-40× the bearing lines), so the rocking whirl's
-    course is read mostly on the imbalance line above the step."""
-    lines = [L("radial_force", 1.0, 5e-6, 1.0, "imbalance"), L("radial_force", 2.0, 4e-7), L("radial_force", 0.41, 2e-7),
-             L("radial_force", 3.62, 3e-7), L("radial_force", 5.38, 2e-7), L("radial_force", 7.24, 1e-7),
-             L("radial_torque", 1.0, 2e-6, 1.0, "imbalance"), L("radial_torque", 0.41, 5e-8),
-             L("radial_torque", 3.62, 1e-7), L("radial_torque", 5.38, 6e-8), L("axial_force", 1.0, 3e-7),
-             L("axial_force", 2.0, 2e-7), L("axial_force", 3.62, 4e-7), L("axial_force", 7.24, 2e-7)]
-    return fw.Wheel(name="gain-step", mass=6.0, I_zz=0.048, I_rr=0.03, f_trans=180.0, f_rock=110.0, f_axial=260.0,
-                    zeta_trans=0.02, zeta_rock=0.02, zeta_axial=0.025, lines=tuple(lines), min_rpm=300.0,
-                    max_rpm=6000.0, sample_rate=4000.0, n_speeds=24)
-
 
 @pytest.mark.parametrize("channel, factor, from_share, seed", [("Ty", 1.35, 0.65, 0), ("Tx", 0.75, 0.4, 1)])
 def test_the_modes_are_fitted_with_a_channels_gain_step_taken_out(channel, factor, from_share, seed):
-    wheel = _wheel()
+    wheel = fw.trial_wheel_a()
     data = fw.steady(wheel, noise=0.01, seed=seed)
     first = int(from_share * wheel.n_speeds)
     data.signals[first:, fw.CHANNELS.index(channel)] *= factor

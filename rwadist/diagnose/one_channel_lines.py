@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
+from .lift_test import MAX_LIFT_FOLLOWED, LiftTest, lift_followed
 
 #: the direction read (the translation mode lifts both senses of a radial force alike; a radial torque's whirls
 #: split by sense, and a planar torque line's two parts would need the rocking mode's whirls to be read)
@@ -40,13 +41,6 @@ MIN_RUNS = 6
 PARTNER_MEDIAN_DB = -20.0
 #: ... and in 90 % of those runs at most this (dB: a run where the line is weak reads the partner's noise)
 PARTNER_P90_DB = -10.0
-#: the translation gain's range over the line's runs (max/min of |T|), at least: a lift to tell
-MIN_LIFT_RANGE = 3.0
-#: runs where the translation mode lifts the line by this factor or more, at least MIN_LIFTED_RUNS of them
-LIFT_MIN = 2.0
-MIN_LIFTED_RUNS = 2
-#: the share of the translation mode's lift the line follows (slope of its log level on the log gain), at most
-MAX_LIFT_FOLLOWED = 0.25
 #: the imbalance's order is left to the search (a counter_rotation names a one-sided 1x)
 IMBALANCE_H_TOL = 1e-3
 #: each run's frequency of the line is refined on its record within this many record bins of h·|Ω|/2π, on a grid of
@@ -61,9 +55,8 @@ REFINE_STEP = 0.05
 class OneChannelLine:
     """A line at ratio ``h`` of the speed on ``channel`` alone of the radial-force pair (``partner`` its other
     channel), not lifted by the translation mode: C (median |A|/Ω²), the runs where it was measured (indices of the
-    spectra), the partner's power against it (dB, median and 90th percentile), the translation mode the wheel's other
-    radial-force lines locate (f0 Hz, ζ), the largest lift that mode gives at the line's runs (dB, amplitude) and the
-    share of the lift the line follows (slope ± standard error)."""
+    spectra), the partner's power against it (dB, median and 90th percentile) and the lift test (``lift``) against
+    the translation mode the wheel's other radial-force lines locate."""
 
     h: float
     channel: str
@@ -72,12 +65,7 @@ class OneChannelLine:
     runs: tuple
     partner_dB: float
     partner_p90_dB: float
-    mode_Hz: float
-    mode_zeta: float
-    largest_lift_dB: float
-    lift_followed: float
-    lift_followed_stderr: float
-    crossing_rpm: float
+    lift: LiftTest
     #: complex amplitude (every run of the test) of the line on ``channel``
     amplitudes: np.ndarray | None = field(default=None, repr=False, compare=False)
     #: frequency (Hz) in every run of the test (NaN for a run without a speed)
@@ -177,39 +165,14 @@ def _judge(ctx, ln, c: str, partner: str, mode: tuple) -> OneChannelLine | None:
     got = lift_followed(a_c, w, ln.h, mode)
     if got is None or got[0] > MAX_LIFT_FOLLOWED:
         return None
-    slope, se, gain = got
-    f0, zeta = mode
-    k = int(np.argmax(gain))
     # the amplitude subtracted in each run: the tone fitted on the whole record beside any line passing it (NaN where
     # a line inside its main lobe is not told apart: that run is left as it is), at the run's own frequency of it
     f_runs = run_frequencies(ctx, c, f_runs)
     A = run_amplitudes(ctx, f_runs, (c,))[:, 0]
     h = float(np.median(f_runs[rows] * 2 * np.pi / w))     # the ratio the runs' own frequencies give
     return OneChannelLine(h=h, channel=c, partner=partner, C=float(np.median(a_c / w**2)),
-                          runs=tuple(int(r) for r in rows), partner_dB=med, partner_p90_dB=p90, mode_Hz=f0,
-                          mode_zeta=zeta, largest_lift_dB=float(20 * np.log10(gain[k])), lift_followed=slope,
-                          lift_followed_stderr=se, crossing_rpm=float(2 * np.pi * f0 / h * RAD_S_TO_RPM),
-                          amplitudes=A, f_runs=f_runs)
-
-
-def lift_followed(a: np.ndarray, w: np.ndarray, h: float, mode: tuple) -> tuple | None:
-    """(slope, its standard error, the gain |T| per run) of a line's log level ``log(a/Ω²)`` (``a``: its amplitude at
-    the speeds ``w`` rad/s) on the log gain the translation mode ``mode`` (f0 Hz, ζ) gives h·Ω at Ω: 1 for a load of
-    the wheel, 0 for one added at the load cell; None when that gain does not lift the line at its runs enough to
-    tell (:data:`MIN_LIFT_RANGE`, :data:`LIFT_MIN` in :data:`MIN_LIFTED_RUNS` runs)."""
-    from ..mode_scan import transmissibility_sq
-
-    f0, zeta = mode
-    gain = np.sqrt(transmissibility_sq(h * w, w, [f0], [zeta], [0.0])[0])
-    if gain.max() / gain.min() < MIN_LIFT_RANGE or int(np.sum(gain >= LIFT_MIN)) < MIN_LIFTED_RUNS:
-        return None                         # no lift of the wheel's lines at its runs to tell it by
-    y = np.log(a / w**2)
-    x = np.log(gain)
-    X = np.column_stack([np.ones_like(x), x])
-    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
-    resid = y - X @ coef
-    cov = float(resid @ resid) / max(w.size - 2, 1) * np.linalg.inv(X.T @ X)
-    return float(coef[1]), float(math.sqrt(max(cov[1, 1], 0.0))), gain
+                          runs=tuple(int(r) for r in rows), partner_dB=med, partner_p90_dB=p90,
+                          lift=LiftTest.of(mode, got, h), amplitudes=A, f_runs=f_runs)
 
 
 def run_frequencies(ctx, c: str, f_runs: np.ndarray) -> np.ndarray:
@@ -271,10 +234,7 @@ def describe_one_channel_lines(ctx, lines, shares: dict) -> list:
             f_Hz=(float(f.min()), float(f.max())), level_dB=level, share=share, n_runs=len(runs), h=ln.h,
             parameters={"direction": DIRECTION, "h": ln.h, "one_channel": ln.channel, "partner": ln.partner,
                         "C": ln.C, "partner_dB": ln.partner_dB, "partner_p90_dB": ln.partner_p90_dB,
-                        "translation_Hz": ln.mode_Hz, "translation_zeta": ln.mode_zeta,
-                        "crossing_rpm": ln.crossing_rpm, "largest_lift_dB": ln.largest_lift_dB,
-                        "lift_followed": ln.lift_followed, "lift_followed_stderr": ln.lift_followed_stderr,
-                        "removed_before_the_search": True},
+                        **ln.lift.parameters(), "removed_before_the_search": True},
             causes=(f"a source outside the wheel, added at the load cell: a part of the test stand driven at the "
                     f"wheel's speed, the {ln.channel} sensor's own chain, or electrical pickup synchronous with the "
                     "spin (the drive's commutation, a tach or encoder signal)",

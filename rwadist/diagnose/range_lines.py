@@ -16,7 +16,7 @@ mode's misfit 2.7 dB), so the mode's damping went to +71 % (+42 % on wheel A) an
 the line's missing runs were described as a ``partial_line`` of the wheel, "interleaved" on wheel A.
 
 Both halves of the signature are needed: the band (:func:`_band`), and no lift where the wheel's other radial-force
-lines show one (:func:`.one_channel_lines.lift_followed`).  A wheel's own line that starts or stops at a speed is
+lines show one (:func:`.lift_test.lift_followed`).  A wheel's own line that starts or stops at a speed is
 lifted at the crossing and stays the search's (``partial_line``); a band that does not cross the lift the other lines
 show cannot be told from one and is left to the search too.
 """
@@ -28,14 +28,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..units import CHANNELS, DIRECTION_CHANNELS, RAD_S_TO_RPM
-from .one_channel_lines import (
-    IMBALANCE_H_TOL,
-    MAX_LIFT_FOLLOWED,
-    MIN_RUNS,
-    lift_followed,
-    run_frequencies,
-    translation_mode,
-)
+from .lift_test import MAX_LIFT_FOLLOWED, LiftTest, lift_followed
+from .one_channel_lines import IMBALANCE_H_TOL, MIN_RUNS, run_frequencies, translation_mode
 
 #: the direction read (the translation mode lifts both senses of a radial force alike)
 DIRECTION = "radial_force"
@@ -61,10 +55,9 @@ NOISE_OFFSETS = np.r_[-9:-3, 4:10].astype(float)
 class RangeLine:
     """A line at ratio ``h`` of the speed on the radial-force pair, present in the runs ``runs`` (indices of the
     spectra; ``rpm`` their speed range) and absent from ``absent`` (their speeds ``absent_rpm``), not lifted by the
-    translation mode (f0 Hz, ζ) the wheel's other radial-force lines locate: C (median amplitude/Ω² where present, the
-    amplitude √(|A_x|² + |A_y|²) on the pair), the
-    power over the noise (dB) where present (median), where absent (90th percentile) and what C·Ω² would give there
-    (median), the largest lift the mode gives at the line's runs (dB) and the share of it the line follows."""
+    translation mode the wheel's other radial-force lines locate (``lift``): C (median amplitude/Ω² where present, the
+    amplitude √(|A_x|² + |A_y|²) on the pair), the power over the noise (dB) where present (median), where absent
+    (90th percentile) and what C·Ω² would give there (median)."""
 
     h: float
     channels: tuple
@@ -74,12 +67,7 @@ class RangeLine:
     present_dB: float
     absent_dB: float
     expected_dB: float
-    mode_Hz: float
-    mode_zeta: float
-    largest_lift_dB: float
-    lift_followed: float
-    lift_followed_stderr: float
-    crossing_rpm: float
+    lift: LiftTest
     #: complex amplitude (every run of the test, NaN outside ``runs``) of the line on each of ``channels``
     amplitudes: np.ndarray | None = field(default=None, repr=False, compare=False)
     #: frequency (Hz) in every run of the test (NaN outside ``runs``)
@@ -157,7 +145,6 @@ def _judge(ctx, ln, pair: tuple, band: tuple, mode: tuple) -> RangeLine | None:
     got = lift_followed(a, w_all[rows], ln.h, mode)
     if got is None or got[0] > MAX_LIFT_FOLLOWED:
         return None
-    slope, se, gain = got
     # the amplitude subtracted in each run of the band (and no other): the tone fitted on the whole record, at the
     # run's own frequency of it (:func:`.one_channel_lines.run_frequencies`, on the channel holding more of it)
     f_runs = np.full(w_all.size, np.nan)
@@ -166,14 +153,11 @@ def _judge(ctx, ln, pair: tuple, band: tuple, mode: tuple) -> RangeLine | None:
     c = max(pair, key=lambda ch: float(np.nansum(np.abs(X[:, CHANNELS.index(ch)]) ** 2)))
     f_runs = run_frequencies(ctx, c, f_runs)
     h = float(np.median(f_runs[rows] * 2 * np.pi / w_all[rows]))
-    f0, zeta = mode
     return RangeLine(h=h, channels=tuple(pair), C=float(np.median(a / w_all[rows] ** 2)),
                      runs=tuple(int(r) for r in rows),
                      absent_rpm=tuple(float(x) for x in np.sort(w_all[absent]) * RAD_S_TO_RPM),
-                     present_dB=present_dB, absent_dB=absent_dB, expected_dB=expected_dB, mode_Hz=f0,
-                     mode_zeta=zeta, largest_lift_dB=float(20 * np.log10(gain.max())), lift_followed=slope,
-                     lift_followed_stderr=se, crossing_rpm=float(2 * np.pi * f0 / h * RAD_S_TO_RPM),
-                     amplitudes=run_amplitudes(ctx, f_runs, pair), f_runs=f_runs)
+                     present_dB=present_dB, absent_dB=absent_dB, expected_dB=expected_dB,
+                     lift=LiftTest.of(mode, got, h), amplitudes=run_amplitudes(ctx, f_runs, pair), f_runs=f_runs)
 
 
 def range_line_tones(lines) -> list:
@@ -220,10 +204,7 @@ def describe_range_lines(ctx, lines, shares: dict) -> list:
                         "stops_between_rpm": [hi, min(above)] if above else None,
                         "absent_rpm": list(ln.absent_rpm), "present_over_noise_dB": ln.present_dB,
                         "absent_over_noise_dB": ln.absent_dB, "expected_over_noise_dB": ln.expected_dB,
-                        "translation_Hz": ln.mode_Hz, "translation_zeta": ln.mode_zeta,
-                        "crossing_rpm": ln.crossing_rpm, "largest_lift_dB": ln.largest_lift_dB,
-                        "lift_followed": ln.lift_followed, "lift_followed_stderr": ln.lift_followed_stderr,
-                        "removed_before_the_search": True},
+                        **ln.lift.parameters(), "removed_before_the_search": True},
             causes=("a source outside the wheel, added at the load cell, that a speed switches on or off: a part of "
                     "the test stand driven at the wheel's speed that touches, or comes loose, over a band of speeds, "
                     "or electrical pickup synchronous with the spin from a drive that changes its commutation or "

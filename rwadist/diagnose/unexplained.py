@@ -13,6 +13,8 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from .lift_test import lift_words
+
 
 class FrozenMapping(dict):
     """A dict that refuses changes (a record's ``parameters``): read like a dict, pickled and copied as one."""
@@ -225,11 +227,7 @@ class Unexplained:
             # signature is where it is not, and the lift it lacks
             p = self.parameters
             out += (f", on {p['one_channel']} alone ({p['partner']} {_number(p.get('partner_dB')) or 0:+.0f} dB under "
-                    f"it, median over its runs), C {_number(p.get('C')) or 0:.3g}, and not lifted by the wheel's "
-                    f"translation mode ({_number(p.get('translation_Hz')) or 0:.4g} Hz, crossed at "
-                    f"{_number(p.get('crossing_rpm')) or 0:.0f} rpm): it follows "
-                    f"{round(_number(p.get('lift_followed')) or 0.0, 2) + 0.0:.2f} of the {_number(p.get('largest_lift_dB')) or 0:.0f} "
-                    "dB lift the wheel's other radial-force lines locate there")
+                    f"it, median over its runs), C {_number(p.get('C')) or 0:.3g}, and " + lift_words(p))
             if p.get("removed_before_the_search"):
                 out += " (taken out of the data before the search)"
         if self.signature == "speed_line" and "present_over_noise_dB" in self.parameters:
@@ -259,11 +257,8 @@ class Unexplained:
                                                                         ("stops", p.get("stops_between_rpm"))) if e]
         out = (f", present over one band of speeds ({_number(p.get('present_over_noise_dB')) or 0:+.0f} dB over the "
                f"noise there; at the noise outside it, where its C·Ω² would stand "
-               f"{_number(p.get('expected_over_noise_dB')) or 0:+.0f} dB over it: it {' and '.join(edges)}), and not "
-               f"lifted by the wheel's translation mode ({_number(p.get('translation_Hz')) or 0:.4g} Hz, crossed at "
-               f"{_number(p.get('crossing_rpm')) or 0:.0f} rpm): it follows "
-               f"{round(_number(p.get('lift_followed')) or 0.0, 2) + 0.0:.2f} of the "
-               f"{_number(p.get('largest_lift_dB')) or 0:.0f} dB lift the wheel's other radial-force lines locate there")
+               f"{_number(p.get('expected_over_noise_dB')) or 0:+.0f} dB over it: it {' and '.join(edges)}), and "
+               + lift_words(p))
         return out + (" (taken out of the data before the search)" if p.get("removed_before_the_search") else "")
 
     def _partial_span(self) -> str:
