@@ -22,7 +22,7 @@ import numpy as np
 from . import model as model_io
 from .api_psd import psd, write_nastran
 from .data import SteadyTest, Sweep
-from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistWarning
+from .errors import DataError, MissingDependencyError, ModelError, ParameterError, RwadistWarning, own_models
 from .formats.records import reading_provenance
 from .model import WheelModel
 from .model import load as _load
@@ -625,13 +625,13 @@ def diagnose(data, model=None, *, preset: str | None = None, base: str = "auto",
 
     def run(test, base_check):
         spectra = compute_spectra(test, nperseg=nperseg or diagnose_nperseg(test), f_lim=_f_lim(test, f_lim))
-        return _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base, bearings=bearings,
-                         base_check=base_check)
+        with own_models("the diagnosis"):       # a model given was checked above
+            return _diagnose(spectra, model, k_sigma=k_sigma, min_gain=min_gain, test=test, base=base,
+                             bearings=bearings, base_check=base_check)
 
-    # a speed from the data is tested by the wheel's gyroscopic whirl (and the data diagnosed again on the scale it
-    # supports); a radial channel recorded late (read on the records at the model's lines) moved back and the data
-    # diagnosed again; how the speed was obtained, and what was put right, go to the summary and the report
-    # (the speed scale the whirl settled is kept: the test diagnosed again on it, not judged again)
+    # a speed from the data is tested by the wheel's gyroscopic whirl (the data diagnosed again on the scale it
+    # supports, kept: not judged again); a radial channel recorded late (read on the records at the model's lines)
+    # moved back and the data diagnosed again; how the speed was obtained, and what was put right, are reported
     test, diagnosis, late = channel_timing.in_time(speed_whirl.settle(test, run), lambda t: (t, run(t, None)))
     for rec in late:
         warnings.warn(RwadistWarning(channel_timing.summary_line(rec)), stacklevel=2)

@@ -21,6 +21,9 @@ user should know (assumed suspension modes, speeds beyond the rated one, modes t
 """
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+
 from .schema import ModelError, RwadistError
 
 __all__ = ["RwadistError", "DataError", "ModelError", "ParameterError", "MissingDependencyError",
@@ -80,3 +83,15 @@ class UnresolvedLinesWarning(RwadistWarning):
     """An empirical fit detected harmonics it did not measure apart from a line beside them (the model lacks them:
     :func:`rwadist.fit_warnings.unresolved_warning`); the extended fit measures them, and ``rwadist fit --extended``
     silences it."""
+
+
+@contextmanager
+def own_models(who: str) -> Iterator[None]:
+    """Within: a :class:`ModelError` is raised by a model the library made itself (``who``, e.g. "the diagnosis"),
+    never by the user's input, which was checked before: re-raised as a RuntimeError, an internal error (exit 3 with
+    its traceback in a file), not bad input (a new user's fixture on the rocking mode, no model given, got "error:
+    <model>: effects[2]..." and exit 2)."""
+    try:
+        yield
+    except ModelError as exc:
+        raise RuntimeError(f"{who} made a model that does not validate: {exc}") from exc

@@ -181,3 +181,19 @@ def test_the_law_checked_beyond_the_stand_is_in_its_words_and_model_file_entry()
         back = parse_effects([entry], "<test>")[0]
         assert back.runs_beyond_stand == entry.get("runs_beyond_stand")
         assert back.exponent_beyond_stand == entry.get("exponent_beyond_stand")
+
+
+def test_a_law_beside_a_stand_that_leaves_too_few_runs_writes_null_and_says_so():
+    """(nan, nan, n) beyond the stand: the model file holds null for what could not be computed (NaN is no JSON
+    number: the schema refused the diagnosis's own model, a new user's fixture on the rocking mode), and the
+    description says the law was not checked there."""
+    from rwadist.effects.amplitude_law import AmplitudeLaw as Element
+    from rwadist.schema import parse_effects
+
+    law = AmplitudeLaw("radial_force", 1.0, 2.6, 1.0, 300.0, 0.01, (float("nan"), float("nan"), 3))
+    entry = law.to_schema()
+    assert entry["exponent_beyond_stand"] is None and entry["exponent_beyond_stand_stderr"] is None
+    assert entry["runs_beyond_stand"] == 3
+    (typed,) = parse_effects([entry], "<model>")
+    assert typed.exponent_beyond_stand is None and typed.runs_beyond_stand == 3
+    assert "leaves 3 runs out of its reach, too few" in Element.describe(entry), Element.describe(entry)

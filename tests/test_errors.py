@@ -134,3 +134,28 @@ def test_coupling_model_error_keeps_both_contracts():
     whole = CouplingModelError("wheel: mass_kg and radius_m must be positive, got 0, 0.1")
     assert (whole.parameter, whole.field, whole.problem) == (None, None, str(whole))
     assert user_message(whole) == str(whole)
+
+
+def test_a_model_the_diagnosis_made_that_does_not_validate_is_an_internal_error(tmp_path, capsys, monkeypatch):
+    """The diagnosis's own model refused by the schema is a bug, not the user's input: exit 3 with its traceback in a
+    file (a new user's fixture on the rocking mode, no model given, got "error: <model>: effects[2]...", exit 2)."""
+    import importlib
+
+    from rwadist import api
+    from rwadist.errors import ModelError
+
+    data = tmp_path / "d"
+    assert main(["simulate-test", str(data), "--preset", "ithaco-e", "--speeds-rpm", "600,1200", "--samples",
+                 "256"]) == 0
+    capsys.readouterr()
+
+    def broken(*args, **kwargs):
+        raise ModelError("<model>: effects[2].exponent_beyond_stand: NaN is not a JSON number")
+
+    monkeypatch.setattr(importlib.import_module("rwadist.diagnose"), "diagnose", broken)
+    with pytest.raises(RuntimeError, match="the diagnosis made a model that does not validate"):
+        api.diagnose(str(data))
+    assert main(["diagnose", str(data), "-o", str(tmp_path / "r")]) == 3
+    err = capsys.readouterr().err
+    assert "internal error" in err and "exponent_beyond_stand" in err, err
+    Path(re.search(r"full traceback in (\S+);", err).group(1)).unlink()

@@ -98,9 +98,10 @@ class AmplitudeLaw(Element):
             return ""
         p = e.get("exponent_beyond_stand")
         if p is None or not np.isfinite(float(p)):
-            return (f"; beside a test stand that leaves {int(n)} runs out of its reach, too few or too close in speed "
-                    "to check the law there (judged over every run)")
-        return (f"; beyond the test stand ({int(n)} runs out of its reach) |Ω|^{num(p, '.3g')}"
+            return (f"; beside a test stand that leaves {int(n)} run{'' if int(n) == 1 else 's'} out of its reach, "
+                    "too few or too close in speed to check the law there (judged over every run)")
+        return (f"; beyond the test stand ({int(n)} run{'' if int(n) == 1 else 's'} out of its reach) "
+                f"|Ω|^{num(p, '.3g')}"
                 f"{plus_minus(e, 'exponent_beyond_stand_stderr')}")
 
     # ------------------------------------------------------------------ injection

@@ -7,7 +7,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..diagnose.describe_line_step import two_levels
-from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.effects.base import finite_or_none, register, schema_entry
 from ..diagnose.engine import Context
 from ..diagnose.measure import in_unresolved_span, measure_run_powers
 from ..diagnose.mode_reach import crossing_groups
@@ -264,8 +264,9 @@ class AmplitudeLaw:
         if self.beyond_stand is not None:
             # the law checked beyond a named test stand (:meth:`significant`): on how many runs, with what exponent
             p, se, *n = self.beyond_stand
-            out.update(runs_beyond_stand=int(n[0]) if n else None, exponent_beyond_stand=float(p),
-                       exponent_beyond_stand_stderr=float(se))
+            # (nan, nan, n) when the stand leaves too few runs to fit on: null, "not checked there"
+            out.update(runs_beyond_stand=int(n[0]) if n else None, exponent_beyond_stand=finite_or_none(p),
+                       exponent_beyond_stand_stderr=finite_or_none(se))
         return out
 
     @staticmethod

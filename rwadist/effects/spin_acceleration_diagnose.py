@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..diagnose.effects.base import register, schema_entry
+from ..diagnose.effects.base import finite_or_none, register, schema_entry
 from ..diagnose.engine import Context, noise_estimate
 from ..diagnose.smear import speed_track, track_span
 from ..diagnose.state import State
@@ -51,9 +51,9 @@ class SpinAcceleration:
         return schema_entry(self)
 
     def params(self) -> dict:
-        return {"alpha_rad_s2": self.alpha, "alpha_track_rad_s2": _or_none(self.alpha_track),
-                "alpha_residual_rad_s2": _or_none(self.alpha_residual),
-                "alpha_slowest_rad_s2": _or_none(self.alpha_span[0]), "alpha_fastest_rad_s2": _or_none(self.alpha_span[1]),
+        return {"alpha_rad_s2": self.alpha, "alpha_track_rad_s2": finite_or_none(self.alpha_track),
+                "alpha_residual_rad_s2": finite_or_none(self.alpha_residual),
+                "alpha_slowest_rad_s2": finite_or_none(self.alpha_span[0]), "alpha_fastest_rad_s2": finite_or_none(self.alpha_span[1]),
                 "role": "measurement"}
 
     @staticmethod
@@ -105,8 +105,3 @@ class SpinAcceleration:
     def candidates(ctx: Context, state: State, runs) -> list:
         e = SpinAcceleration.fit(ctx, state, runs)
         return [] if e is None else [e]
-
-
-def _or_none(x: float) -> float | None:
-    """``x``, or None for NaN (the model file's null: not computed)."""
-    return None if not np.isfinite(x) else float(x)

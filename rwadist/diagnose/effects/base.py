@@ -5,6 +5,7 @@ search (:mod:`rwadist.diagnose.search`) sees only the protocol, never a concrete
 """
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, ClassVar, Protocol, runtime_checkable
 
 if TYPE_CHECKING:
@@ -78,3 +79,10 @@ def register(order: int):
 def schema_entry(effect) -> dict:
     """``{"kind", **params(), "channel"}`` of ``effect``: the shared body of every family's ``to_schema``."""
     return {"kind": effect.kind, **effect.params(), "channel": list(effect.channels)}
+
+
+def finite_or_none(x) -> float | None:
+    """``x`` as a float, or None (the model file's null: a statistic that could not be computed) for NaN and the
+    infinities, which JSON cannot hold and the schema refuses (:func:`rwadist.schema.statistic`)."""
+    x = float(x)
+    return x if math.isfinite(x) else None
