@@ -124,6 +124,11 @@ def test_one_line_in_a_fixed_phase_through_two_modes_is_no_copy():
     assert _pair(**both) is None
     both["X_s"][n:] /= 25.0                                                # now the copied line is the strongest
     both["X_t"][n:] /= 25.0
+    # ... but a copy puts the source's other line in the target at κ too: Tz holding h 2 at a third of 0.3·Tx there
+    # (a line of its own) is a load of its own in a fixed phase to Tx, not a copy (a new user's rotor of fixed phases
+    # on a test stand: Fz's axial imbalance read as 0.096 × Fy, Fy's other lines in Fz at 0.0004-0.002 of that)
+    assert _pair(**both) is None
+    both["X_t"][n:] += 0.3 * both["X_s"][n:]                               # Tz holds the copy of h 2 as well
     assert _pair(**both) is not None
 
 

@@ -441,6 +441,25 @@ def _one_line_copy(X_s, X_t, omega, runs, h, near, strong) -> list:
     return [float(strongest)] if abs(slope) <= SINGLE_RATIO_SLOPE else []
 
 
+def _lacks_other_lines(X_s, X_t, kappa: complex, runs, h, heard, line: float) -> bool:
+    """Whether the target lacks another of the source's lines that a copy of the source would put in it: a line other
+    than ``line`` heard at κ over the target's noise (``heard``: :data:`MIN_COPY_DB`) in at least :data:`MIN_RUNS`
+    runs, where the target carries under :data:`STRONGEST_HELD` of κ·X_s (the median over those runs).
+
+    A copy scales every line of the source alike; one line of two channels at one complex ratio whose other lines the
+    target lacks is a load of the target's own direction in a fixed phase to the source's (a new user's rotor, its
+    phases fixed from run to run, with a test stand at 252 Hz on every channel: Fz's 1× line, the axial imbalance,
+    followed Fy's departure from C·Ω² through the stand at 0.096 × Fy, read as a copy and taken out, while Fy's
+    other lines stood in Fz far under 0.096 of them)."""
+    for hv in np.unique(h[heard]):
+        sel = (h == hv) & heard
+        if hv == line or np.unique(runs[sel]).size < MIN_RUNS:
+            continue
+        if np.median(np.abs(X_t[sel]) / np.maximum(np.abs(kappa * X_s[sel]), 1e-300)) < STRONGEST_HELD:
+            return True
+    return False
+
+
 def _holds_strongest(X_s, X_t, kappa: complex, runs, h, strong) -> bool:
     """Whether the target holds, at the source's strongest line where a copy would stand clear (``strong``), at least
     :data:`STRONGEST_HELD` of the copy κ·X_s there (the median over those runs of |X_t|/|κ·X_s|).
@@ -508,7 +527,7 @@ def _pair(X_s, X_t, noise_t, runs, h, cs: str, ct: str, omega) -> ChannelCopy | 
             lines.append(float(hv))
     if len(lines) < MIN_COPIED_LINES:
         lines = _one_line_copy(X_s, X_t, omega, runs, h, near, strong)
-        if not lines:
+        if not lines or _lacks_other_lines(X_s, X_t, kappa, runs, h, heard, lines[0]):
             return None
     elif not _holds_strongest(X_s, X_t, kappa, runs, h, strong):
         return None
