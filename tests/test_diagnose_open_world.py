@@ -525,9 +525,9 @@ def test_a_moving_resonance_beside_a_mode_the_model_lacks_is_described():
 
 def test_an_effect_a_later_one_needs_is_not_taken_back_alone():
     """Taking an effect back re-applies the others in their order; when one of them cannot be applied without it (a
-    counter_rotation splitting a line the taken-back effect made), :func:`describe._without` says so (None) instead of
+    counter_rotation splitting a line the taken-back effect made), :func:`take_back.without` says so (None) instead of
     raising: a 60-s run-up of family wheel 7 ended diagnose with an internal error there."""
-    from rwadist.diagnose.describe import _without
+    from rwadist.diagnose.take_back import without as _without
 
     class Add:
         def __init__(self, name, needs=None):

@@ -18,6 +18,7 @@ from functools import partial
 
 import numpy as np
 
+from . import take_back
 from .describe_reach import TRACK_SHARE_FLOOR, lifted_hold, on_a_moving_skirt, with_track_causes, without_notched_lines
 from .engine import Context
 from .fixed_lines import describe_fixed_lines, find_fixed_lines, remove_fixed_lines, subtract_tones
@@ -25,6 +26,7 @@ from .one_channel_lines import describe_one_channel_lines, find_one_channel_line
 from .range_lines import describe_range_lines, find_range_lines, range_line_shares, range_line_tones
 from .run_order import read_in_recorded_order as in_order
 from .state import State
+from .take_back import on_a_moving_track, with_groups, without_taken_back
 
 
 @dataclass
@@ -658,33 +660,6 @@ def holds_content(u, res: Residual) -> bool:
 FORCED_SHARE = 0.5
 
 
-def _on_a_moving_track(effect, found) -> str | None:
-    """"moving_resonance" when ``effect`` is a fixed resonance (the ``fixed_resonance`` class) on a channel of a
-    described moving resonance, at a frequency its track passes: one frame of the moving resonance, fitted as fixed."""
-    f_r, chans = getattr(effect, "f_r", None), set(getattr(effect, "channels", ()) or ())
-    if f_r is None:
-        return None
-    for u in found:
-        if u.signature == "moving_resonance" and chans & set(u.channels) and u.f_Hz[0] <= f_r <= u.f_Hz[1]:
-            return u.signature
-    return None
-
-
-def _without(start: State, effects, e) -> State | None:
-    """``start`` with every effect of ``effects`` but ``e`` applied in their order, or None when one of them cannot be
-    applied without ``e`` (a ``counter_rotation`` splits the sense of a line that an effect before it made or left
-    free: it raises on a state without that line): ``e`` is then not taken back alone (family wheel 7, a 60-s run-up
-    without a speed column: the search ended with an internal error)."""
-    state = start
-    for other in effects:
-        if other is not e:
-            try:
-                state = other.apply(state)
-            except (TypeError, ValueError):
-                return None
-    return state
-
-
 def forced_effects(diag, opened: Opened, search_before: State, search_after: State, found, res: Residual) -> list:
     """[(effect, signature)] of the effects the search added after its base (not the wheel's ``suspension_modes``,
     not the lines completed into the base) whose gain lies for :data:`FORCED_SHARE` or more in the cells of a record
@@ -697,11 +672,11 @@ def forced_effects(diag, opened: Opened, search_before: State, search_after: Sta
     for e in search_after.effects:
         if id(e) in base:
             continue
-        on_track = _on_a_moving_track(e, found) or on_a_moving_skirt(e, found)
+        on_track = on_a_moving_track(e, found) or on_a_moving_skirt(e, found)
         if on_track:
             out.append((e, on_track))
             continue
-        without = _without(search_before, search_after.effects, e)
+        without = take_back.without(search_before, search_after.effects, e)
         if without is None:
             continue
         res0 = Residual.of(opened.raw, without.copy())
@@ -714,28 +689,6 @@ def forced_effects(diag, opened: Opened, search_before: State, search_after: Sta
             if inside >= FORCED_SHARE * total:
                 out.append((e, u.signature))
                 break
-    return out
-
-
-def _with_groups(hypotheses, gone: dict) -> dict:
-    """``gone`` (id of an effect taken back -> the signature it was fitted to) with every other part of an effect of
-    several parts one of whose parts it holds (``Hypothesis.group``: a floor law of several channels), under that
-    part's signature.
-
-    A group stands or falls together: its parts share one exponent, fitted over every part's bands at once, and it
-    passed as one hypothesis on their summed held-out evidence.  A part fitted to content no class explains put that
-    content into the shared exponent and into the evidence the others passed on; without a new fit and judgement of
-    the other channels alone (the search's, not the description's), they stand on nothing of their own."""
-    sig: dict = {}
-    for h in hypotheses:
-        g = getattr(h, "group", None)
-        if g is not None and id(h.effect) in gone:
-            sig.setdefault(id(g), gone[id(h.effect)])
-    out = dict(gone)
-    for h in hypotheses:
-        g = getattr(h, "group", None)
-        if g is not None and id(g) in sig:
-            out.setdefault(id(h.effect), sig[id(g)])
     return out
 
 
@@ -758,11 +711,8 @@ def finish(diag, opened: Opened, bearings=(), rebuild=None):
     found, res = _described(diag, opened, search_after, bearings)
     forced = forced_effects(diag, opened, search_before, search_after, found, res) if found and rebuild else []
     while forced:
-        gone = _with_groups(diag.hypotheses, {id(e): sig for e, sig in forced})
-        state = search_before
-        for e in search_after.effects:
-            if id(e) not in gone:
-                state = e.apply(state)
+        gone, state = without_taken_back(search_before, search_after.effects,
+                                         with_groups(diag.hypotheses, {id(e): sig for e, sig in forced}))
         found_without, res_without = _described(diag, opened, state, bearings)
         # a moving resonance read on the lines of the effect it takes back is gone with them: the take-back stands
         # only where one is still described without the effect (else the effect's own lines were the track's

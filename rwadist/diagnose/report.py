@@ -85,9 +85,12 @@ def counter_rotating_lines(model) -> list:
 
 
 def _fmt(v, spec: str) -> str:
-    """A parameter for the report: floats with ``spec``, short lists space-separated (no commas: CSV)."""
+    """A parameter for the report: floats with ``spec``, short lists space-separated and mappings as ``{key: value
+    ...}`` (no commas: CSV)."""
     if isinstance(v, (list, tuple)):
         return "[" + " ".join(_fmt(x, spec) for x in v) + "]"
+    if isinstance(v, dict):             # (a mode's ζ interval: its numbers to spec, not Python's repr of 17 digits)
+        return "{" + " ".join(f"{k}: {_fmt(x, spec)}" for k, x in v.items()) + "}"
     if v is None:
         return "none"
     if isinstance(v, bool):
