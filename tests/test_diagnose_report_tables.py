@@ -62,3 +62,14 @@ def test_one_cell_format():
     assert [cell(True), cell(np.bool_(False)), cell(np.int64(3)), cell(0.1), cell(np.float64(-2.5e-7), 3),
             cell(float("nan")), cell(-np.inf), cell(None), cell("a,b")] == \
         ["true", "false", "3", "0.1", "-2.5e-07", "", "", "", "a,b"]
+
+
+def test_a_mapping_parameter_reads_to_its_precision_not_as_pythons_repr():
+    """A mode's ζ interval (a mapping of lists) in report.md's parameters: its numbers to the report's precision, no
+    commas (hypotheses.csv shares the format), not "{'radial_translation': [0.019994940519915492, ...]}" (a new user's
+    design-review reading)."""
+    from rwadist.diagnose.report import _fmt
+
+    got = _fmt({"radial_translation": [0.019994940519915492, 0.02171], "rocking": None}, ".5g")
+    assert got == "{radial_translation: [0.019995 0.02171] rocking: none}"
+    assert "," not in got and "'" not in got
