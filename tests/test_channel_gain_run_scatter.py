@@ -48,3 +48,21 @@ def test_a_constant_gain_is_read_as_one(index):
     assert u.parameters["run_scatter_dB"] < 0.1
     assert u.parameters["amplitude_ratio"] == pytest.approx(1.15, rel=0.01)
     assert u.causes[0].startswith("a gain or calibration error of Fy or Fx: Fy reads 1.15 x Fx")
+
+
+@pytest.mark.parametrize("index", [1, 4])
+def test_a_gain_drifting_in_the_recorded_order_is_read_in_that_order(index, tmp_path):
+    """The runs recorded in shuffled speed order (runs.csv's rows), Fy's gain rising 1.0 -> 1.3 over them (session
+    69's new-user trial: "so the runs' order of recording decides", though runs.csv gave it): the drift read in that
+    order, +2.28 dB of power from the first run recorded to the last, and no order asked for."""
+    wheel = fw.family()[index]
+    speeds = np.random.default_rng(index).permutation(np.linspace(wheel.min_rpm, wheel.max_rpm, wheel.n_speeds))
+    data = fw.steady(wheel, speeds_rpm=speeds, noise=0.01, seed=index)
+    gains = np.linspace(1.0, 1.3, speeds.size)
+    data.signals[:, FY] *= gains[:, None]
+    diag = diagnose(str(fw.write_steady(data, tmp_path / "runs")))
+    (u,) = [u for u in diag.unexplained if u.parameters.get("property") == "channel_gain"]
+    assert u.parameters["recorded_drift_dB"] == pytest.approx(20 * np.log10(1.3), abs=0.15), u.parameters
+    assert u.parameters["rank_correlation"] > 0.9
+    assert "in the order the runs were recorded it drifts" in u.causes[0] and "order they were recorded" not in \
+        u.would_tell, (u.causes[0], u.would_tell)

@@ -159,21 +159,23 @@ def channel_gain(ctx, state, shares, resonances=()) -> list:
         carry = np.zeros_like(good)                 # the lines that carry the ratio (a gain acts on all alike)
         carry[np.asarray(lines)[agree]] = good[np.asarray(lines)[agree]]
         scatter, spread = _run_scatter(np.where(good, d, 0.0), carry)
+        order = _in_recorded_order(ctx, np.where(good, d, 0.0), carry) if _varies(scatter) else None
         out.append(Unexplained(
             signature="line_property", channels=(cx, cy), speed_rpm=(float(rpm.min()), float(rpm.max())),
             f_Hz=(float(f.min()), float(f.max())), level_dB=med, share=share, n_runs=int(used.size),
             parameters={"property": "channel_gain", "channel": cy, "reference": cx,
                         "amplitude_ratio": float(ratio), "power_ratio_dB": med, "stderr_dB": se,
                         "lines_h": [float(x) for x in h[lines][agree]], "cells": int(cells.size),
-                        "run_scatter_dB": scatter, "run_range_dB": spread},
-            causes=_varying(hi_c, lo_c, scatter, spread) + (
+                        "run_scatter_dB": scatter, "run_range_dB": spread, **(order or {}).get("parameters", {})},
+            causes=_varying(hi_c, lo_c, scatter, spread, order) + (
                     f"a gain or calibration error of {hi_c} or {lo_c}: {hi_c} reads {max(ratio, 1 / ratio):.3g} x "
                     f"{lo_c} on {'every line read' if agree.all() else _lines_words(h[lines][agree], h[lines])} (a "
                     f"rotating load gives x and y the same power){unit_words(max(ratio, 1 / ratio), cx)}",
                     "a support or fixture stiffer in one direction: the suspension mode splits into an x and a y mode, "
                     "and the ratio changes across them but stays nearly constant on the lines well above both "
                     "(about (f_x/f_y)² in amplitude), as a gain's does"),
-            would_tell=("the runs in the order they were recorded (a drift grows with time); " if _varies(scatter) else "")
+            would_tell=("the runs in the order they were recorded (a drift grows with time); "
+                        if _varies(scatter) and order is None else "")
             + f"a calibration of {cx} and {cy} with one known load (a mass hung, a shaker's force), or the "
               "load cell turned 90 degrees on the stand (a channel's gain goes with the channel)"))
     return out
@@ -228,12 +230,34 @@ def _varies(scatter: float) -> bool:
     return scatter >= RUN_SCATTER_DB
 
 
-def _varying(hi_c: str, lo_c: str, scatter: float, spread: list) -> tuple:
+def _in_recorded_order(ctx, d: np.ndarray, carry: np.ndarray) -> dict | None:
+    """The change of the pair's ratio per run (:func:`.gain_step.per_run` of ``d`` where ``carry``, dB of power) in
+    the order the runs were recorded (:func:`.run_order.recorded_change`: a drift or a step), as {"parameters", "words"},
+    or None when that order is unknown or shows neither."""
+    from .gain_step import per_run
+    from .run_order import ordinal, recorded_change
+
+    change = recorded_change(ctx, per_run(d, carry))
+    if change is None:
+        return None
+    if change["kind"] == "drift":
+        return {"parameters": {"recorded_drift_dB": change["drift_dB"], "rank_correlation": change["rank_correlation"]},
+                "words": f"in the order the runs were recorded it drifts {change['drift_dB']:+.2f} dB of power from the "
+                         f"first to the last (rank correlation {change['rank_correlation']:.2f})"}
+    n = change["recorded_before"]
+    return {"parameters": {"recorded_step_dB": change["step_dB"], "recorded_before_the_step": n},
+            "words": f"in the order the runs were recorded it steps {change['step_dB']:+.2f} dB of power from the "
+                     f"{ordinal(n + 1)} run recorded on"}
+
+
+def _varying(hi_c: str, lo_c: str, scatter: float, spread: list, order: dict | None = None) -> tuple:
     """() or the first cause of a ratio that scatters from run to run by :data:`RUN_SCATTER_DB` or more (with no
-    step or trend in speed: :mod:`.gain_step` read none)."""
+    step or trend in speed: :mod:`.gain_step` read none), with what the order of recording shows (``order``:
+    :func:`_in_recorded_order`) when it is known."""
     if not _varies(scatter):
         return ()
+    known = f"; {order['words']}" if order else ", so the runs' order of recording decides"
     return (f"a gain of {hi_c} or {lo_c} that changes from run to run: the ratio scatters {scatter:.2g} dB between "
             f"runs ({spread[0]:+.2f} to {spread[1]:+.2f} dB of power; a fixed gain's ratio scatters 0.01-0.05 dB), "
             "with no step or trend in speed: a drift with time (an amplifier or bridge warming, a connector working "
-            "loose), so the runs' order of recording decides",)
+            f"loose){known}",)
