@@ -83,3 +83,18 @@ def test_a_spring_fitted_a_hair_below_zero_far_above_reads_zero():
     assert ", 0.7 of the load far above" in FixedResonance.describe(dict(e, gain_above=0.7))
     assert "of the load far above" not in FixedResonance.describe(dict(e, gain_above=1.0))
     assert "of the load far above" not in FixedResonance.describe(dict(e, gain_above=0.9999996))
+
+
+def test_a_moving_resonance_whose_shape_does_not_hold_the_lift_says_so():
+    """A track's fitted shape of peak gain 1.2 (+1.6 dB) beside lines lifted +29.5 dB (session 69's new user: a design
+    review stops on "zeta 0.0125, peak_gain 1.2" next to "+29.5 dB"): the text says the shape does not hold the lift;
+    a shape of peak gain 20 (+26 dB) beside the same lift says nothing more."""
+    from rwadist.diagnose.unexplained import Unexplained
+
+    def record(gain):
+        return Unexplained(signature="moving_resonance", channels=("Tx", "Ty"), speed_rpm=(1229.0, 9000.0),
+                           f_Hz=(88.45, 315.1), level_dB=2.0, share=0.5, n_runs=33,
+                           parameters={"largest_line_lift_dB": 29.5, "peak_gain": gain, "zeta": 0.0125})
+
+    assert "its fitted shape peaks at +1.6 dB only: the lift is read on the lines" in record(1.2).text()
+    assert "fitted shape peaks" not in record(20.0).text()
