@@ -74,7 +74,7 @@ from .line_senses import ONE_SENSE, ONE_SENSE_RUNS, _line_senses_once, line_sens
 from .mode_scan import MODE_DIRECTION, scan_mode
 from .model import Harmonic
 from .off_law_lines import line_regressors, off_law_note
-from .resonance import resonance
+from .resonance import resonance, resonance_response
 from .spectra import compute_spectra, welch_dof
 from .stand_every import log_data as _log_data
 from .units import DIRECTION_CHANNELS, RAD_S_TO_RPM
@@ -342,13 +342,14 @@ def _scan_all(meas_lines, radial, la, sa, aa, inertia_ratio, tolerance, near=Non
 
 
 def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: list, stand_direction: str | None = None,
-                    stand_on: tuple | None = None, fit_stand: bool = False):
+                    stand_on: tuple | None = None, fit_stand: bool = False, moving: tuple | None = None):
     """(test, empirical fit, measured lines, x/y senses) the extended fit works on: the lever-arm torque ``height`` × F
     removed from the test and its fit (:func:`rwadist.geometry.remove_lever_arm`); every line the data show, with
     every measurement (the empirical fit without modal exclusion: with it, lines that are amplified or attenuated at
     most speeds are dropped; close lines measured together on the records); the fixture resonances ``stands`` divided
     out of their amplitudes (the first only out of the lines of ``stand_direction``, or of the measurements on the
-    channels ``stand_on``, when given: held, not with ``fit_stand``, ValueError)."""
+    channels ``stand_on``, when given: held, not with ``fit_stand``, ValueError), and the resonance ``moving`` (f0 Hz,
+    slope Hz per Hz of spin, ζ, peak gain, gain above: at f0 + slope·|Ω|/2π in each run) out of every line's."""
     if stand_on is not None and fit_stand:
         raise ValueError("a stand on some channels is held (measured on the x/y ratios, rwadist.stand_axes), not fitted")
     if height:
@@ -370,6 +371,11 @@ def _measured_lines(test: SteadyTest, fit: EmpiricalFit, height: float, stands: 
             return np.prod(gains, axis=0) if acting else np.ones_like(f)
 
         meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / fixture_gain(x)) for x in meas.lines])
+    if moving is not None:
+        f0, slope, *shape = moving
+        spin = [np.abs(x.speed) / (2 * np.pi) for x in meas.lines]
+        meas = replace(meas, lines=[replace(x, amplitude=x.amplitude / np.abs(resonance_response(
+            x.h * s / np.maximum(f0 + slope * s, 1e-6), *shape))) for x, s in zip(meas.lines, spin)])
     return test, fit, meas, senses_xy
 
 
@@ -515,7 +521,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
                  progress: bool = False, tolerance: float = 0.02, stand: tuple | None = None,
                  more_stands: tuple = (), near: dict | None = None, fit_stand: bool = False,
                  declare: bool = True, stand_direction: str | None = None, fit_more_stands: bool = False,
-                 stand_on: tuple | None = None) -> ExtendedFit:
+                 stand_on: tuple | None = None, moving: tuple | None = None) -> ExtendedFit:
     """Fit the extended model to a steady test whose empirical fit is ``fit``.
 
     mass (kg), radius (m): datasheet values (thin-disc inertias, I_zz/I_rr = 2).  Either may be None: the interface
@@ -540,7 +546,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     of the wheel's structure on that load direction only (``rwadist diagnose``'s ``fixed_resonance`` of role
     wheel_mode), divided out of that direction's lines alone, H → 1 far above it (β = 1).  fit_more_stands: with
     ``fit_stand``, ``more_stands`` fitted in its least squares too (:mod:`rwadist.stand_every`).  stand_on: the channels
-    a held ``stand`` acts on when not every one (:mod:`rwadist.stand_axes`); not with ``fit_stand``.
+    a held ``stand`` acts on when not every one (:mod:`rwadist.stand_axes`); not with ``fit_stand``.  moving: held.
 
     Each mode is located by a profile scan over its frequency, damping (and I_zz/I_rr) on every measured line at every
     speed, both whirls included (:mod:`rwadist.mode_scan`); a mode the data do not pin down keeps its starting value,
@@ -555,7 +561,7 @@ def fit_extended(test: SteadyTest, fit: EmpiricalFit, mass: float | None = None,
     # the force sensors' noise in the torques: wheel 1's forces 28 dB noisier, 5-9x the torques' floor, 2.6-3.5x less h)
     noisy = recorded_noisy_sensors(test, fit.without_mode_exclusion.lines) if height else None
     test, fit, meas, senses_xy = _measured_lines(test, fit, height, ([] if stand is None else [stand]) + list(more_stands),
-                                                 stand_direction if stand is not None else None, stand_on, fit_stand)
+                                                 None if stand is None else stand_direction, stand_on, fit_stand, moving)
     peaks = amplification_peaks(fit)
     la, sa, ca, aa, na = _axial_measurements(meas)
     lr, sr, pr, dr, nr = radial = _radial_power(meas.lines, _read_speeds(meas.spectra))

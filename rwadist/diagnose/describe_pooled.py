@@ -31,6 +31,11 @@ from .unexplained import Unexplained
 #: The pooled track describes a resonance of this many directions at least (the directions whose lines it lifts): a
 #: track lifting one direction's lines is that direction's own fit's (:func:`.describe_structure.moving_resonance`)
 POOL_MIN_DIRECTIONS = 2
+#: ... and is fitted beside single directions' records that describe every lifted direction when they are this many:
+#: one resonance of the whole load path read on each (the session-69 trial, every channel: four records).  Two are
+#: left as they are (tests/test_moving_structure_mode.py: a mode in the path of Fx, Fy and Fz, its Fx Fy record's
+#: antiresonance and the line laws it explains read on that direction's own track)
+POOL_SAID_DIRECTIONS = 3
 #: The ``direction`` parameter of a pooled record (its ``directions``: the directions whose lines it lifts)
 POOLED = "pooled"
 #: The radial directions, whose lines alone the rocking mode's whirl lifts (:func:`.describe_whirl.whirl_note`)
@@ -225,15 +230,17 @@ def moving_resonances(ctx, state, ratios: list, shares, holds, drifting: list) -
     list
         Each direction's records (:func:`.describe_structure.moving_resonance`) that hold content and are no drifting
         mode's rise; when they leave a direction with lines lifted by :data:`~.describe_structure.MOVING_GATE_DB`
-        undescribed, the pooled one (:func:`pooled_moving_resonance`) too, which takes the place of the single
-        directions' records on its track (:func:`_on_track`: its pieces).
+        undescribed, or describe :data:`POOL_SAID_DIRECTIONS` directions or more (one resonance every direction reads
+        is described on each: the session-69 trial's 150 + 0.9·f_spin Hz on every channel, four records on Fx Fy, Tx
+        Ty, Fz and Tz), the pooled one (:func:`pooled_moving_resonance`) too, which takes
+        the place of the single directions' records on its track (:func:`_on_track`: its pieces).
     """
     def keep(u) -> bool:
         return holds(u) and not any(same_track(u, v) for v in drifting)
 
     single = [u for u in structure.moving_resonance(ctx, state, ratios, shares) if keep(u)]
     said = {u.parameters.get("direction") for u in single}
-    if all(r.direction in said or not np.any(r.q >= MOVING_GATE_DB) for r in ratios):
+    if len(said) < POOL_SAID_DIRECTIONS and all(r.direction in said or not np.any(r.q >= MOVING_GATE_DB) for r in ratios):
         return single
     pooled = [u for u in pooled_moving_resonance(ctx, state, ratios, shares) if keep(u)]
     return [u for u in single if not any(_on_track(u, p) for p in pooled)] + pooled

@@ -224,9 +224,9 @@ class Unexplained:
             for x in self.parameters.get("notched_lines") or ():
                 # a line in its antiresonance (a partial line that is none, describe_structure.without_notched_lines)
                 rpm = [v for v in x.get("absent_rpm", ()) if _number(v) is not None]
-                if rpm and _number(x.get("shape_dB")) is not None:
-                    out += (f", its antiresonance taking h = {x['h']:.4g} {x['shape_dB']:+.0f} dB at "
-                            f"{min(rpm):.0f}-{max(rpm):.0f} rpm")
+                said = (f", its antiresonance taking h = {x['h']:.4g} {x['shape_dB']:+.0f} dB at "
+                        f"{min(rpm):.0f}-{max(rpm):.0f} rpm") if rpm and _number(x.get("shape_dB")) is not None else ""
+                out += "" if said in out else said         # a pooled track's line of several directions: once
         floor = _number(self.parameters.get("level_over_floor_dB")) if self.signature == "fixed_line" else None
         if floor is not None:
             # a fixed line taken out of the data before the search reads ~0 dB over the model in its bins (a new

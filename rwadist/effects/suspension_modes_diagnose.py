@@ -161,7 +161,7 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
     from ..extended_fit import fit_extended
 
     if len(ctx.channels) <= 3:
-        return fit_extended(test, fit, near=near), None
+        return _or_beside_moving(test, fit, fit_extended(test, fit, near=near), near), None
     axis = _beside_axis_stand(ctx, test, fit, near)
     if axis is not None:
         return axis, axis.stand
@@ -178,7 +178,25 @@ def _locate(ctx: Context, test, fit, stand_start, near=None):
         held = _beside_whole_data_stand(ctx, test, fit, efit)
         if held is not None:
             efit = held
+    efit = _or_beside_moving(test, fit, efit, near)
     return efit, efit.stand
+
+
+def _or_beside_moving(test, fit, efit, near):
+    """``efit``, or when it locates no mode the modes located beside a resonance on every channel moving with speed
+    that its lines hold (:func:`rwadist.diagnose.modes_moving.beside_moving`): fitted on its lines, every mode was
+    pulled and declared, and no suspension_modes was proposed (the session-69 trial: a resonance at 150 + 0.9·f_spin Hz
+    on every channel; the empirical base's mode exclusion then dropped the dynamic imbalance from the model).  A fixed
+    resonance fitted with the modes over its track (a 'stand' that locates no mode either: its envelope) is left out:
+    the track is read on the fit without one."""
+    from ..diagnose.modes_moving import beside_moving
+    from ..extended_fit import fit_extended
+
+    if not efit.locates_no_mode:
+        return efit
+    plain = efit if efit.stand is None and not efit.more_stands else fit_extended(test, fit, near=near)
+    moved = beside_moving(test, fit, plain, near)
+    return efit if moved is None else moved
 
 
 def _beside_axis_stand(ctx: Context, test, fit, near):
