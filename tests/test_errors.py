@@ -76,15 +76,22 @@ def test_the_library_names_no_command_line_flag():
     assert not found, "\n".join(found)
 
 
+def _small_test(tmp_path, capsys) -> Path:
+    """A two-speed E-wheel test written by ``rwadist simulate-test`` (its console output read away): data for a
+    command that is made to fail inside."""
+    data = tmp_path / "d"
+    assert main(["simulate-test", str(data), "--preset", "ithaco-e", "--speeds-rpm", "600,1200", "--samples",
+                 "256"]) == 0
+    capsys.readouterr()
+    return data
+
+
 def test_an_internal_error_is_never_bad_input(tmp_path, capsys, monkeypatch):
     """A ValueError that is no RwadistError is a bug: exit 3 with its traceback in a file, not 'bad input' (the CLI
     read every ValueError as bad input, and every ValueError of diagnose's engine as a --base problem)."""
     from rwadist import api
 
-    data = tmp_path / "d"
-    assert main(["simulate-test", str(data), "--preset", "ithaco-e", "--speeds-rpm", "600,1200", "--samples",
-                 "256"]) == 0
-    capsys.readouterr()
+    data = _small_test(tmp_path, capsys)
 
     def broken(*args, **kwargs):
         raise ValueError("operands could not be broadcast together")
@@ -144,10 +151,7 @@ def test_a_model_the_diagnosis_made_that_does_not_validate_is_an_internal_error(
     from rwadist import api
     from rwadist.errors import ModelError
 
-    data = tmp_path / "d"
-    assert main(["simulate-test", str(data), "--preset", "ithaco-e", "--speeds-rpm", "600,1200", "--samples",
-                 "256"]) == 0
-    capsys.readouterr()
+    data = _small_test(tmp_path, capsys)
 
     def broken(*args, **kwargs):
         raise ModelError("<model>: effects[2].exponent_beyond_stand: NaN is not a JSON number")
